@@ -1,0 +1,179 @@
+// The adaptive red-green multiresolution mesh: a base triangle mesh and a forest of quad-trees,
+// one per base triangle (paper, section II-A).
+//
+// Child order and local indexing (fixed here and nowhere else):
+//   a node is a triangle (v0, v1, v2); edge e joins v[e] and v[(e+1)%3]; m_e is its midpoint.
+//   child 0 = (v0, m0, m2)   corner child at v0
+//   child 1 = (m0, v1, m1)   corner child at v1
+//   child 2 = (m2, m1, v2)   corner child at v2
+//   child 3 = (m1, m2, m0)   center child
+// Every child's edge e is parallel to the parent's edge e, so local indices mean the same thing
+// on all levels; the first half of parent edge e is child e's edge e, the second half is child
+// (e+1)%3's edge e. Corner child k and the center share their edge (k+1)%3.
+//
+// Balance: the levels of leaves that share (part of) an edge differ by at most one. Equivalently
+// a node may have children only if each of its non-boundary edges has a neighbour of the same
+// level (paper: "1-regularity"). Closure: a leaf whose three edges carry hanging nodes is red
+// refined. Leaves with one or two hanging nodes are closed by green triangles (leaf_mesh.cpp).
+#pragma once
+
+#include <amc/mesh.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace amc {
+
+using NodeId = uint32_t;
+using VertexId = uint32_t;
+constexpr NodeId kNoNode = 0xffffffffu;
+constexpr int kMaxLevel = 30;  // a level cap far beyond any mesh that fits in memory
+
+class Hierarchy {
+public:
+    Hierarchy() = default;
+    // Builds the forest of unrefined roots over a validated base mesh (validate_triangle_mesh).
+    // Root i is base triangle i; root ids are 0 .. base_triangle_count()-1.
+    explicit Hierarchy(TriangleMesh base);
+
+    // ---- structure -------------------------------------------------------------------------
+    const TriangleMesh& base() const { return base_; }
+    uint32_t root_count() const { return static_cast<uint32_t>(base_.triangles.size()); }
+    // Node ids are stable while a node exists; ids of removed nodes are reused.
+    uint32_t node_capacity() const { return static_cast<uint32_t>(nodes_.size()); }
+    bool is_alive(NodeId n) const { return n < nodes_.size() && nodes_[n].level != kDeadLevel; }
+
+    bool is_leaf(NodeId n) const { return nodes_[n].first_child == kNoNode; }
+    NodeId child(NodeId n, int k) const { return nodes_[n].first_child + static_cast<NodeId>(k); }
+    NodeId parent(NodeId n) const { return nodes_[n].parent; }
+    int level(NodeId n) const { return nodes_[n].level; }
+    // 0..3 for children, -1 for roots.
+    int child_index(NodeId n) const { return nodes_[n].parent == kNoNode ? -1 : int(nodes_[n].child_index); }
+    VertexId vertex(NodeId n, int i) const { return nodes_[n].v[i]; }
+    // Same-level neighbour across edge e, or kNoNode (boundary, or the region there is coarser).
+    NodeId neighbor(NodeId n, int e) const { return nodes_[n].nbr[e]; }
+    // The neighbour's local index of the shared edge (valid when neighbor(n, e) != kNoNode).
+    int neighbor_edge(NodeId n, int e) const { return (nodes_[n].nbr_edge >> (2 * e)) & 3; }
+    bool is_boundary_edge(NodeId n, int e) const { return (nodes_[n].flags >> e) & 1; }
+    // Edge e carries a hanging node: the same-level neighbour there is refined.
+    bool has_hanging_node(NodeId n, int e) const {
+        NodeId q = nodes_[n].nbr[e];
+        return q != kNoNode && nodes_[q].first_child != kNoNode;
+    }
+    int hanging_node_count(NodeId n) const;
+    // Every non-boundary edge has a same-level neighbour: what balance asks of a refined node.
+    bool has_all_neighbors(NodeId n) const;
+    // A leaf may be split without breaking balance (has_all_neighbors) and below the level cap.
+    bool can_split(NodeId n) const;
+    // Midpoint vertex of edge e of a refined node.
+    VertexId midpoint(NodeId n, int e) const { return nodes_[child(n, 3)].v[(e + 2) % 3]; }
+
+    // ---- diagonal of a two-hanging-node closure ---------------------------------------------
+    // The default rule (documented in docs/HIERARCHY.md): with unrefined edge u, the diagonal
+    // joins m_{(u+1)%3} and v_u. A per-node flag selects the other diagonal, m_{(u+2)%3}–v_{(u+1)%3},
+    // so hierarchies made by programs with other rules are represented exactly. The flag only
+    // matters while the node is a leaf with exactly two hanging nodes.
+    bool diagonal_flipped(NodeId n) const { return (nodes_[n].flags >> 3) & 1; }
+    void set_diagonal_flipped(NodeId n, bool flipped);
+
+    // ---- counts ------------------------------------------------------------------------------
+    uint32_t node_count() const { return live_nodes_; }
+    uint32_t leaf_count() const { return live_nodes_ - (live_nodes_ - root_count()) / 4; }
+    int depth() const;  // finest level that has nodes
+    uint32_t vertex_count() const { return live_vertices_; }
+
+    // ---- geometry ----------------------------------------------------------------------------
+    // Vertex positions by id; ids of removed vertices are reused (position of a dead id unused).
+    const std::vector<Vec3>& positions() const { return positions_; }
+    Vec3 position(VertexId v) const { return positions_[v]; }
+    void set_position(VertexId v, Vec3 p) { positions_[v] = p; }
+    bool single_precision() const { return base_.single_precision; }
+    // Called for every vertex that refinement creates, with the edge's end points; the default
+    // places new vertices at edge midpoints (rounded to float when the base is single precision).
+    // A null placer restores the default.
+    using VertexPlacer = Vec3 (*)(void* context, Vec3 a, Vec3 b);
+    void set_vertex_placer(VertexPlacer placer, void* context);
+
+    // ---- refinement ----------------------------------------------------------------------------
+    // Red-refines leaf n, first refining coarser neighbours as balance requires, then applying the
+    // closure (leaves with three hanging nodes are refined) until the hierarchy is valid again.
+    // Returns the number of nodes split (0 if n was already refined).
+    uint32_t refine(NodeId n);
+    // Removes the four children of n if they are leaves and removing them keeps the hierarchy
+    // balanced and closed. Returns whether it did.
+    bool coarsen(NodeId n);
+    bool can_coarsen(NodeId n) const;
+    // Splits leaf n with no balancing or closure; requires can_split(n). The building block of
+    // refine() and of readers/decoders that replay a stored forest.
+    void split(NodeId n);
+
+    // Visits every live node level by level, roots first, children in child order: the canonical
+    // breadth-first order that files and coders use.
+    std::vector<NodeId> breadth_first_order() const;
+    std::vector<NodeId> leaves() const;  // leaves in breadth-first order
+
+private:
+    static constexpr uint8_t kDeadLevel = 0xff;
+    struct Node {
+        VertexId v[3];
+        NodeId parent;
+        NodeId first_child;
+        NodeId nbr[3];
+        uint8_t nbr_edge;  // 2 bits per edge
+        uint8_t level;
+        uint8_t flags;  // bits 0-2: boundary edge; bit 3: diagonal flipped
+        uint8_t child_index;  // 0..3; unused for roots
+    };
+    void link(NodeId a, int ea, NodeId b, int eb);
+    VertexId new_vertex(Vec3 p);
+    NodeId allocate_children();
+
+    TriangleMesh base_;
+    std::vector<Node> nodes_;
+    std::vector<NodeId> free_blocks_;  // first ids of unused blocks of four
+    std::vector<Vec3> positions_;
+    std::vector<VertexId> free_vertices_;
+    uint32_t live_nodes_ = 0;
+    uint32_t live_vertices_ = 0;
+    VertexPlacer placer_ = nullptr;
+    void* placer_context_ = nullptr;
+};
+
+// Structural and geometric equality: same base mesh, same forest, same effective diagonals (flags
+// of leaves with two hanging nodes), same positions — compared in canonical order, so node and
+// vertex ids may differ.
+bool identical(const Hierarchy& a, const Hierarchy& b);
+
+// Canonical vertex numbering: base vertices first, then new vertices in order of first
+// appearance over refined nodes in breadth-first order, edges 0, 1, 2. Maps vertex id -> index
+// (0xffffffff for dead ids).
+std::vector<uint32_t> canonical_vertex_order(const Hierarchy& h);
+
+// ---- the conforming leaf mesh (green closure) ----------------------------------------------
+
+struct LeafMesh {
+    TriangleMesh mesh;           // vertices in canonical order
+    CellData cells;              // level and red/green flag per triangle
+    std::vector<NodeId> source;  // the node each triangle belongs to
+};
+
+// The conforming mesh of the leaves, or of the hierarchy cut at `max_level` (nodes of that level
+// treated as leaves) when max_level >= 0. Red leaves as they are; leaves with one hanging node
+// bisected; leaves with two hanging nodes cut into three by the node's diagonal.
+LeafMesh extract_leaf_mesh(const Hierarchy& h, int max_level = -1);
+
+// ---- invariants ----------------------------------------------------------------------------
+
+// Checks every structural invariant (links symmetric, balance, closure, children geometry,
+// shared midpoints, counts) and returns a description of the first violation, or "" if valid.
+std::string check_invariants(const Hierarchy& h);
+
+// ---- the hierarchy file (.amh, docs/HIERARCHY.md) -------------------------------------------
+
+std::string serialize_hierarchy(const Hierarchy& h);
+// Validates everything; `what` names the source in messages. Throws Error.
+Hierarchy deserialize_hierarchy(const std::string& bytes, const std::string& what);
+void write_hierarchy(const std::string& path, const Hierarchy& h);
+Hierarchy read_hierarchy(const std::string& path);
+
+}  // namespace amc

@@ -1,0 +1,317 @@
+// The red-green forest: construction over a base mesh, split, balanced refinement with closure,
+// coarsening, and the canonical breadth-first order.
+#include <amc/hierarchy.h>
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+#include <unordered_map>
+
+namespace amc {
+
+namespace {
+
+Vec3 midpoint_placer(void* single_precision, Vec3 a, Vec3 b) {
+    Vec3 m = 0.5 * (a + b);
+    if (single_precision != nullptr) {
+        m = {double(float(m.x)), double(float(m.y)), double(float(m.z))};
+    }
+    return m;
+}
+
+uint64_t edge_key(uint32_t a, uint32_t b) { return (uint64_t(a) << 32) | b; }
+
+}  // namespace
+
+Hierarchy::Hierarchy(TriangleMesh base) : base_(std::move(base)) {
+    const uint32_t f0 = root_count();
+    nodes_.resize(f0);
+    positions_ = base_.positions;
+    live_nodes_ = f0;
+    live_vertices_ = static_cast<uint32_t>(positions_.size());
+
+    std::unordered_map<uint64_t, uint32_t> directed;  // (a,b) -> 3*triangle + edge
+    directed.reserve(3 * size_t(f0));
+    for (uint32_t t = 0; t < f0; ++t) {
+        Node& node = nodes_[t];
+        for (int i = 0; i < 3; ++i) {
+            node.v[i] = base_.triangles[t][i];
+            node.nbr[i] = kNoNode;
+        }
+        node.parent = kNoNode;
+        node.first_child = kNoNode;
+        node.nbr_edge = 0;
+        node.level = 0;
+        node.flags = 0;
+        node.child_index = 0;
+        for (int e = 0; e < 3; ++e) directed[edge_key(node.v[e], node.v[(e + 1) % 3])] = 3 * t + e;
+    }
+    for (uint32_t t = 0; t < f0; ++t) {
+        for (int e = 0; e < 3; ++e) {
+            auto it = directed.find(edge_key(nodes_[t].v[(e + 1) % 3], nodes_[t].v[e]));
+            if (it == directed.end()) {
+                nodes_[t].flags |= uint8_t(1u << e);
+            } else {
+                nodes_[t].nbr[e] = it->second / 3;
+                nodes_[t].nbr_edge |= uint8_t((it->second % 3) << (2 * e));
+            }
+        }
+    }
+    set_vertex_placer(nullptr, nullptr);
+}
+
+void Hierarchy::set_vertex_placer(VertexPlacer placer, void* context) {
+    if (placer == nullptr) {
+        static int round_to_float;  // any non-null context asks the midpoint placer to round
+        placer = midpoint_placer;
+        context = base_.single_precision ? &round_to_float : nullptr;
+    }
+    placer_ = placer;
+    placer_context_ = context;
+}
+
+int Hierarchy::hanging_node_count(NodeId n) const {
+    return int(has_hanging_node(n, 0)) + int(has_hanging_node(n, 1)) + int(has_hanging_node(n, 2));
+}
+
+bool Hierarchy::has_all_neighbors(NodeId n) const {
+    for (int e = 0; e < 3; ++e) {
+        if (nodes_[n].nbr[e] == kNoNode && !is_boundary_edge(n, e)) return false;
+    }
+    return true;
+}
+
+bool Hierarchy::can_split(NodeId n) const {
+    return is_leaf(n) && nodes_[n].level < kMaxLevel && has_all_neighbors(n);
+}
+
+void Hierarchy::set_diagonal_flipped(NodeId n, bool flipped) {
+    nodes_[n].flags = uint8_t((nodes_[n].flags & ~8u) | (flipped ? 8u : 0u));
+}
+
+int Hierarchy::depth() const {
+    int d = 0;
+    for (const Node& node : nodes_) {
+        if (node.level != kDeadLevel) d = std::max(d, int(node.level));
+    }
+    return d;
+}
+
+void Hierarchy::link(NodeId a, int ea, NodeId b, int eb) {
+    nodes_[a].nbr[ea] = b;
+    nodes_[a].nbr_edge = uint8_t((nodes_[a].nbr_edge & ~(3u << (2 * ea))) | (unsigned(eb) << (2 * ea)));
+    nodes_[b].nbr[eb] = a;
+    nodes_[b].nbr_edge = uint8_t((nodes_[b].nbr_edge & ~(3u << (2 * eb))) | (unsigned(ea) << (2 * eb)));
+}
+
+VertexId Hierarchy::new_vertex(Vec3 p) {
+    ++live_vertices_;
+    if (!free_vertices_.empty()) {
+        VertexId v = free_vertices_.back();
+        free_vertices_.pop_back();
+        positions_[v] = p;
+        return v;
+    }
+    positions_.push_back(p);
+    return static_cast<VertexId>(positions_.size() - 1);
+}
+
+NodeId Hierarchy::allocate_children() {
+    live_nodes_ += 4;
+    if (!free_blocks_.empty()) {
+        NodeId c = free_blocks_.back();
+        free_blocks_.pop_back();
+        return c;
+    }
+    NodeId c = static_cast<NodeId>(nodes_.size());
+    nodes_.resize(nodes_.size() + 4);
+    return c;
+}
+
+void Hierarchy::split(NodeId n) {
+    VertexId m[3];
+    for (int e = 0; e < 3; ++e) {
+        NodeId q = nodes_[n].nbr[e];
+        if (q != kNoNode && !is_leaf(q)) {
+            m[e] = midpoint(q, neighbor_edge(n, e));
+        } else {
+            Vec3 a = positions_[nodes_[n].v[e]];
+            Vec3 b = positions_[nodes_[n].v[(e + 1) % 3]];
+            m[e] = new_vertex(placer_(placer_context_, a, b));
+        }
+    }
+    const NodeId c = allocate_children();  // may reallocate nodes_: no references held across
+    const Node parent = nodes_[n];
+    const VertexId layout[4][3] = {{parent.v[0], m[0], m[2]},
+                                   {m[0], parent.v[1], m[1]},
+                                   {m[2], m[1], parent.v[2]},
+                                   {m[1], m[2], m[0]}};
+    for (int k = 0; k < 4; ++k) {
+        Node& child = nodes_[c + k];
+        for (int i = 0; i < 3; ++i) {
+            child.v[i] = layout[k][i];
+            child.nbr[i] = kNoNode;
+        }
+        child.parent = n;
+        child.first_child = kNoNode;
+        child.nbr_edge = 0;
+        child.level = uint8_t(parent.level + 1);
+        child.child_index = uint8_t(k);
+        // Corner child k lies on the parent's edges k and (k+2)%3; the center on none.
+        child.flags = k == 3 ? 0 : uint8_t(parent.flags & ((1u << k) | (1u << ((k + 2) % 3))));
+    }
+    for (int k = 0; k < 3; ++k) link(c + k, (k + 1) % 3, c + 3, (k + 1) % 3);
+    for (int e = 0; e < 3; ++e) {
+        NodeId q = parent.nbr[e];
+        if (q == kNoNode || is_leaf(q)) continue;
+        int eq = neighbor_edge(n, e);
+        link(c + e, e, child(q, (eq + 1) % 3), eq);
+        link(c + (e + 1) % 3, e, child(q, eq), eq);
+    }
+    nodes_[n].first_child = c;
+}
+
+uint32_t Hierarchy::refine(NodeId n) {
+    if (!is_leaf(n)) return 0;
+    uint32_t splits = 0;
+    std::vector<NodeId> todo{n};
+    while (!todo.empty()) {
+        const NodeId x = todo.back();
+        if (!is_leaf(x)) {
+            todo.pop_back();
+            continue;
+        }
+        // Balance: a missing same-level neighbour means the region across that edge is a
+        // coarser leaf (the parent's neighbour); refine it first.
+        bool blocked = false;
+        for (int e = 0; e < 3 && !blocked; ++e) {
+            if (nodes_[x].nbr[e] == kNoNode && !is_boundary_edge(x, e)) {
+                todo.push_back(nodes_[nodes_[x].parent].nbr[e]);
+                blocked = true;
+            }
+        }
+        if (blocked) continue;
+        todo.pop_back();
+        if (nodes_[x].level >= kMaxLevel) throw Error("refine: level cap reached");
+        split(x);
+        ++splits;
+        // Closure: a same-level leaf with three hanging nodes is red refined.
+        for (int e = 0; e < 3; ++e) {
+            NodeId q = nodes_[x].nbr[e];
+            if (q != kNoNode && is_leaf(q) && hanging_node_count(q) == 3) todo.push_back(q);
+        }
+    }
+    return splits;
+}
+
+bool Hierarchy::can_coarsen(NodeId n) const {
+    if (is_leaf(n)) return false;
+    for (int k = 0; k < 4; ++k) {
+        if (!is_leaf(child(n, k))) return false;
+    }
+    int refined_neighbours = 0;
+    for (int e = 0; e < 3; ++e) {
+        NodeId q = nodes_[n].nbr[e];
+        if (q == kNoNode || is_leaf(q)) continue;
+        ++refined_neighbours;
+        int eq = neighbor_edge(n, e);
+        // Children of q along the shared edge must stay within one level of n.
+        if (!is_leaf(child(q, eq)) || !is_leaf(child(q, (eq + 1) % 3))) return false;
+    }
+    return refined_neighbours < 3;  // otherwise the closure would refine n again
+}
+
+bool Hierarchy::coarsen(NodeId n) {
+    if (!can_coarsen(n)) return false;
+    const NodeId c = nodes_[n].first_child;
+    for (int e = 0; e < 3; ++e) {
+        NodeId q = nodes_[n].nbr[e];
+        if (q != kNoNode && !is_leaf(q)) {
+            int eq = neighbor_edge(n, e);
+            nodes_[child(q, eq)].nbr[eq] = kNoNode;
+            nodes_[child(q, (eq + 1) % 3)].nbr[eq] = kNoNode;
+        } else {
+            free_vertices_.push_back(midpoint(n, e));
+            --live_vertices_;
+        }
+    }
+    for (int k = 0; k < 4; ++k) nodes_[c + k].level = kDeadLevel;
+    free_blocks_.push_back(c);
+    live_nodes_ -= 4;
+    nodes_[n].first_child = kNoNode;
+    return true;
+}
+
+std::vector<NodeId> Hierarchy::breadth_first_order() const {
+    std::vector<NodeId> order;
+    order.reserve(live_nodes_);
+    for (NodeId r = 0; r < root_count(); ++r) order.push_back(r);
+    for (size_t i = 0; i < order.size(); ++i) {
+        NodeId n = order[i];
+        if (!is_leaf(n)) {
+            for (int k = 0; k < 4; ++k) order.push_back(child(n, k));
+        }
+    }
+    return order;
+}
+
+std::vector<NodeId> Hierarchy::leaves() const {
+    std::vector<NodeId> result;
+    for (NodeId n : breadth_first_order()) {
+        if (is_leaf(n)) result.push_back(n);
+    }
+    return result;
+}
+
+std::vector<uint32_t> canonical_vertex_order(const Hierarchy& h) {
+    std::vector<uint32_t> order(h.positions().size(), 0xffffffffu);
+    uint32_t next = 0;
+    for (uint32_t v = 0; v < h.base().positions.size(); ++v) order[v] = next++;
+    for (NodeId n : h.breadth_first_order()) {
+        if (h.is_leaf(n)) continue;
+        for (int e = 0; e < 3; ++e) {
+            VertexId m = h.midpoint(n, e);
+            if (order[m] == 0xffffffffu) order[m] = next++;
+        }
+    }
+    return order;
+}
+
+namespace {
+
+bool same_bits(Vec3 a, Vec3 b) { return std::memcmp(&a, &b, sizeof(Vec3)) == 0; }
+
+int two_hanging_diagonal(const Hierarchy& h, NodeId n) {
+    return h.is_leaf(n) && h.hanging_node_count(n) == 2 ? int(h.diagonal_flipped(n)) : -1;
+}
+
+}  // namespace
+
+bool identical(const Hierarchy& a, const Hierarchy& b) {
+    if (a.base().triangles != b.base().triangles) return false;
+    if (a.base().positions.size() != b.base().positions.size()) return false;
+    if (a.single_precision() != b.single_precision()) return false;
+    const std::vector<NodeId> oa = a.breadth_first_order();
+    const std::vector<NodeId> ob = b.breadth_first_order();
+    if (oa.size() != ob.size()) return false;
+    for (size_t i = 0; i < oa.size(); ++i) {
+        if (a.is_leaf(oa[i]) != b.is_leaf(ob[i])) return false;
+        if (two_hanging_diagonal(a, oa[i]) != two_hanging_diagonal(b, ob[i])) return false;
+    }
+    const std::vector<uint32_t> va = canonical_vertex_order(a);
+    const std::vector<uint32_t> vb = canonical_vertex_order(b);
+    std::vector<Vec3> pa(a.vertex_count()), pb(b.vertex_count());
+    if (pa.size() != pb.size()) return false;
+    for (size_t v = 0; v < va.size(); ++v) {
+        if (va[v] != 0xffffffffu) pa[va[v]] = a.position(VertexId(v));
+    }
+    for (size_t v = 0; v < vb.size(); ++v) {
+        if (vb[v] != 0xffffffffu) pb[vb[v]] = b.position(VertexId(v));
+    }
+    for (size_t i = 0; i < pa.size(); ++i) {
+        if (!same_bits(pa[i], pb[i])) return false;
+    }
+    return true;
+}
+
+}  // namespace amc

@@ -1,0 +1,239 @@
+// The uncompressed hierarchy file (.amh), specified in docs/HIERARCHY.md: base mesh, refinement
+// bits in breadth-first order, diagonal overrides and the positions of refinement vertices.
+#include <amc/hierarchy.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace amc {
+
+namespace {
+
+constexpr char kMagic[4] = {'A', 'M', 'C', 'H'};
+constexpr uint32_t kVersion = 1;
+constexpr uint32_t kFlagSinglePrecision = 1;
+constexpr size_t kHeaderSize = 4 + 4 * 7;
+
+void put_u32(std::string& out, uint32_t v) {
+    for (int i = 0; i < 4; ++i) out.push_back(char((v >> (8 * i)) & 0xff));
+}
+
+void put_coordinate(std::string& out, double x, bool single) {
+    if (single) {
+        float f = float(x);
+        uint32_t bits;
+        std::memcpy(&bits, &f, 4);
+        put_u32(out, bits);
+    } else {
+        uint64_t bits;
+        std::memcpy(&bits, &x, 8);
+        put_u32(out, uint32_t(bits));
+        put_u32(out, uint32_t(bits >> 32));
+    }
+}
+
+class Reader {
+public:
+    Reader(const std::string& bytes, const std::string& what) : bytes_(bytes), what_(what) {}
+    [[noreturn]] void fail(const std::string& message) const { throw Error(what_ + ": " + message); }
+    uint32_t u32() {
+        need(4);
+        uint32_t v = 0;
+        for (int i = 0; i < 4; ++i) v |= uint32_t(uint8_t(bytes_[pos_ + i])) << (8 * i);
+        pos_ += 4;
+        return v;
+    }
+    double coordinate(bool single) {
+        if (single) {
+            uint32_t bits = u32();
+            float f;
+            std::memcpy(&f, &bits, 4);
+            return f;
+        }
+        uint64_t lo = u32(), hi = u32();
+        uint64_t bits = lo | (hi << 32);
+        double d;
+        std::memcpy(&d, &bits, 8);
+        return d;
+    }
+    const char* take(size_t n) {
+        need(n);
+        const char* p = bytes_.data() + pos_;
+        pos_ += n;
+        return p;
+    }
+    size_t remaining() const { return bytes_.size() - pos_; }
+
+private:
+    void need(size_t n) const {
+        if (bytes_.size() - pos_ < n) fail("file is truncated");
+    }
+    const std::string& bytes_;
+    const std::string& what_;
+    size_t pos_ = 0;
+};
+
+}  // namespace
+
+std::string serialize_hierarchy(const Hierarchy& h) {
+    const bool single = h.single_precision();
+    const std::vector<NodeId> order = h.breadth_first_order();
+    const std::vector<uint32_t> canonical = canonical_vertex_order(h);
+    std::vector<uint32_t> flipped;
+    for (uint32_t i = 0; i < order.size(); ++i) {
+        NodeId n = order[i];
+        if (h.is_leaf(n) && h.hanging_node_count(n) == 2 && h.diagonal_flipped(n)) flipped.push_back(i);
+    }
+    const uint32_t base_vertices = uint32_t(h.base().positions.size());
+    const uint32_t new_vertices = h.vertex_count() - base_vertices;
+
+    std::string out(kMagic, 4);
+    put_u32(out, kVersion);
+    put_u32(out, single ? kFlagSinglePrecision : 0);
+    put_u32(out, base_vertices);
+    put_u32(out, h.root_count());
+    put_u32(out, uint32_t(order.size()));
+    put_u32(out, uint32_t(flipped.size()));
+    put_u32(out, new_vertices);
+    for (const Vec3& p : h.base().positions) {
+        put_coordinate(out, p.x, single);
+        put_coordinate(out, p.y, single);
+        put_coordinate(out, p.z, single);
+    }
+    for (const Triangle& t : h.base().triangles) {
+        for (uint32_t v : t) put_u32(out, v);
+    }
+    std::string bits((order.size() + 7) / 8, '\0');
+    for (size_t i = 0; i < order.size(); ++i) {
+        if (!h.is_leaf(order[i])) bits[i / 8] = char(uint8_t(bits[i / 8]) | (1u << (i % 8)));
+    }
+    out += bits;
+    for (uint32_t i : flipped) put_u32(out, i);
+    std::vector<Vec3> refinement_positions(new_vertices);
+    for (size_t v = 0; v < canonical.size(); ++v) {
+        if (canonical[v] != 0xffffffffu && canonical[v] >= base_vertices)
+            refinement_positions[canonical[v] - base_vertices] = h.position(VertexId(v));
+    }
+    for (const Vec3& p : refinement_positions) {
+        put_coordinate(out, p.x, single);
+        put_coordinate(out, p.y, single);
+        put_coordinate(out, p.z, single);
+    }
+    return out;
+}
+
+Hierarchy deserialize_hierarchy(const std::string& bytes, const std::string& what) {
+    Reader in(bytes, what);
+    const char* magic = in.take(4);
+    if (std::memcmp(magic, kMagic, 4) != 0) in.fail("not a hierarchy file (bad magic)");
+    const uint32_t version = in.u32();
+    if (version != kVersion) in.fail("unsupported hierarchy file version " + std::to_string(version));
+    const uint32_t flags = in.u32();
+    if (flags & ~kFlagSinglePrecision) in.fail("unknown flags " + std::to_string(flags));
+    const bool single = flags & kFlagSinglePrecision;
+    const uint32_t base_vertices = in.u32();
+    const uint32_t base_triangles = in.u32();
+    const uint32_t node_count = in.u32();
+    const uint32_t flip_count = in.u32();
+    const uint32_t new_vertices = in.u32();
+
+    // Every count is checked against the bytes that remain before anything is allocated.
+    const uint64_t coordinate_size = single ? 4 : 8;
+    const uint64_t expected = uint64_t(base_vertices) * 3 * coordinate_size + uint64_t(base_triangles) * 12 +
+                              (uint64_t(node_count) + 7) / 8 + uint64_t(flip_count) * 4 +
+                              uint64_t(new_vertices) * 3 * coordinate_size;
+    if (expected != in.remaining())
+        in.fail("file size does not match its header (" + std::to_string(in.remaining()) + " bytes after the header, " +
+                std::to_string(expected) + " expected)");
+    if (base_triangles == 0) in.fail("base mesh has no triangles");
+    if (node_count < base_triangles) in.fail("fewer nodes than base triangles");
+
+    TriangleMesh base;
+    base.single_precision = single;
+    base.positions.resize(base_vertices);
+    for (Vec3& p : base.positions) {
+        p.x = in.coordinate(single);
+        p.y = in.coordinate(single);
+        p.z = in.coordinate(single);
+    }
+    base.triangles.resize(base_triangles);
+    for (Triangle& t : base.triangles) {
+        for (uint32_t& v : t) v = in.u32();
+    }
+    validate_triangle_mesh(base, what + " (base mesh)");
+    Hierarchy h(std::move(base));
+    h.set_vertex_placer([](void*, Vec3 a, Vec3) { return a; }, nullptr);  // positions follow
+
+    // Replay the refinement bits breadth-first; every split must keep balance.
+    const uint8_t* bits = reinterpret_cast<const uint8_t*>(in.take((uint64_t(node_count) + 7) / 8));
+    std::vector<NodeId> order;
+    order.reserve(node_count);
+    for (NodeId r = 0; r < h.root_count(); ++r) order.push_back(r);
+    for (size_t i = 0; i < order.size(); ++i) {
+        if (i >= node_count) in.fail("refinement bits end before the forest is complete");
+        if (!((bits[i / 8] >> (i % 8)) & 1)) continue;
+        const NodeId n = order[i];
+        if (!h.can_split(n))
+            in.fail("node " + std::to_string(i) + " (level " + std::to_string(h.level(n)) +
+                    ") is refined next to a coarser element: the hierarchy is not balanced");
+        h.split(n);
+        for (int k = 0; k < 4; ++k) order.push_back(h.child(n, k));
+    }
+    if (order.size() != node_count)
+        in.fail("header announces " + std::to_string(node_count) + " nodes but the forest has " +
+                std::to_string(order.size()));
+    for (size_t i = node_count; i < (uint64_t(node_count) + 7) / 8 * 8; ++i) {
+        if ((bits[i / 8] >> (i % 8)) & 1) in.fail("padding bits after the forest are not zero");
+    }
+    for (NodeId n : order) {
+        if (h.is_leaf(n) && h.hanging_node_count(n) == 3)
+            in.fail("element " + std::to_string(n) + " has three hanging nodes but is not refined (closure)");
+    }
+    int64_t previous = -1;
+    for (uint32_t i = 0; i < flip_count; ++i) {
+        const uint32_t index = in.u32();
+        if (int64_t(index) <= previous || index >= node_count)
+            in.fail("diagonal override " + std::to_string(i) + " is out of order or range");
+        previous = index;
+        const NodeId n = order[index];
+        if (!h.is_leaf(n) || h.hanging_node_count(n) != 2)
+            in.fail("diagonal override on node " + std::to_string(index) + ", which is not closed by two hanging nodes");
+        h.set_diagonal_flipped(n, true);
+    }
+    if (h.vertex_count() - h.base().positions.size() != new_vertices)
+        in.fail("header announces " + std::to_string(new_vertices) + " refinement vertices but the forest makes " +
+                std::to_string(h.vertex_count() - h.base().positions.size()));
+    const std::vector<uint32_t> canonical = canonical_vertex_order(h);
+    std::vector<Vec3> refinement_positions(new_vertices);
+    for (uint32_t i = 0; i < new_vertices; ++i) {
+        Vec3& p = refinement_positions[i];
+        p.x = in.coordinate(single);
+        p.y = in.coordinate(single);
+        p.z = in.coordinate(single);
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+            in.fail("refinement vertex " + std::to_string(i) + " has a non-finite coordinate");
+    }
+    for (size_t v = 0; v < canonical.size(); ++v) {
+        if (canonical[v] != 0xffffffffu && canonical[v] >= base_vertices)
+            h.set_position(VertexId(v), refinement_positions[canonical[v] - base_vertices]);
+    }
+    h.set_vertex_placer(nullptr, nullptr);
+    return h;
+}
+
+void write_hierarchy(const std::string& path, const Hierarchy& h) {
+    write_file_atomically(path, serialize_hierarchy(h));
+}
+
+Hierarchy read_hierarchy(const std::string& path) {
+    std::ifstream file(path, std::ios::binary);
+    if (!file) throw Error(path + ": cannot open file");
+    std::ostringstream bytes;
+    bytes << file.rdbuf();
+    if (file.bad()) throw Error(path + ": read error");
+    return deserialize_hierarchy(bytes.str(), path);
+}
+
+}  // namespace amc

@@ -1,0 +1,84 @@
+// Every structural invariant of a red-green hierarchy, checked from scratch. Used by tests after
+// every operation and by readers of stored hierarchies.
+#include <amc/hierarchy.h>
+
+#include <sstream>
+
+namespace amc {
+
+namespace {
+
+std::string node_text(const Hierarchy& h, NodeId n) {
+    std::ostringstream s;
+    s << "node " << n << " (level " << h.level(n) << ")";
+    return s.str();
+}
+
+}  // namespace
+
+std::string check_invariants(const Hierarchy& h) {
+    uint32_t nodes = 0;
+    uint64_t split_edges = 0;
+    for (NodeId n = 0; n < h.node_capacity(); ++n) {
+        if (!h.is_alive(n)) continue;
+        ++nodes;
+        for (int e = 0; e < 3; ++e) {
+            const NodeId q = h.neighbor(n, e);
+            if (q == kNoNode) {
+                if (h.is_boundary_edge(n, e)) continue;
+                // No same-level neighbour: the region across is a coarser leaf, so n can not
+                // have children (balance), and n's parent must see that coarser leaf.
+                if (!h.is_leaf(n)) return node_text(h, n) + " is refined next to a coarser leaf (balance)";
+                const NodeId p = h.parent(n);
+                if (p == kNoNode) return node_text(h, n) + ": root without neighbour on inner edge";
+                const NodeId pq = h.neighbor(p, e);
+                if (pq == kNoNode || !h.is_leaf(pq))
+                    return node_text(h, n) + ": missing neighbour link on edge " + std::to_string(e);
+                continue;
+            }
+            if (!h.is_alive(q)) return node_text(h, n) + " links to a removed node";
+            const int eq = h.neighbor_edge(n, e);
+            if (h.neighbor(q, eq) != n || h.neighbor_edge(q, eq) != e)
+                return node_text(h, n) + ": neighbour link on edge " + std::to_string(e) + " is not mutual";
+            if (h.level(q) != h.level(n)) return node_text(h, n) + ": neighbour on another level";
+            if (h.vertex(q, eq) != h.vertex(n, (e + 1) % 3) || h.vertex(q, (eq + 1) % 3) != h.vertex(n, e))
+                return node_text(h, n) + ": neighbour does not share edge " + std::to_string(e);
+            if (h.is_boundary_edge(n, e)) return node_text(h, n) + ": boundary edge with a neighbour";
+        }
+        if (h.is_leaf(n)) {
+            if (h.hanging_node_count(n) == 3) return node_text(h, n) + " has three hanging nodes (closure)";
+            continue;
+        }
+        if (!h.has_all_neighbors(n))
+            return node_text(h, n) + " is refined but not all neighbours have its level (balance)";
+        for (int k = 0; k < 4; ++k) {
+            const NodeId c = h.child(n, k);
+            if (!h.is_alive(c) || h.parent(c) != n || h.child_index(c) != k || h.level(c) != h.level(n) + 1)
+                return node_text(h, n) + ": child " + std::to_string(k) + " is inconsistent";
+        }
+        const VertexId v0 = h.vertex(n, 0), v1 = h.vertex(n, 1), v2 = h.vertex(n, 2);
+        const VertexId m0 = h.midpoint(n, 0), m1 = h.midpoint(n, 1), m2 = h.midpoint(n, 2);
+        const VertexId layout[4][3] = {{v0, m0, m2}, {m0, v1, m1}, {m2, m1, v2}, {m1, m2, m0}};
+        for (int k = 0; k < 4; ++k) {
+            for (int i = 0; i < 3; ++i) {
+                if (h.vertex(h.child(n, k), i) != layout[k][i])
+                    return node_text(h, n) + ": child " + std::to_string(k) + " has wrong vertices";
+            }
+        }
+        for (int e = 0; e < 3; ++e) {
+            const NodeId q = h.neighbor(n, e);
+            if (q == kNoNode || h.is_leaf(q) || q > n) {
+                ++split_edges;  // count each split edge once
+            } else if (h.midpoint(q, h.neighbor_edge(n, e)) != h.midpoint(n, e)) {
+                return node_text(h, n) + ": midpoint of edge " + std::to_string(e) + " not shared";
+            }
+        }
+    }
+    if (nodes != h.node_count()) return "node count " + std::to_string(h.node_count()) + " but " + std::to_string(nodes) + " live nodes";
+    if (h.vertex_count() != h.base().positions.size() + split_edges)
+        return "vertex count " + std::to_string(h.vertex_count()) + " != base vertices + split edges (" +
+               std::to_string(h.base().positions.size() + split_edges) + ")";
+    return "";
+}
+
+}  // namespace amc
