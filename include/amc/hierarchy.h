@@ -97,8 +97,9 @@ public:
     // ---- refinement ----------------------------------------------------------------------------
     // Red-refines leaf n, first refining coarser neighbours as balance requires, then applying the
     // closure (leaves with three hanging nodes are refined) until the hierarchy is valid again.
-    // Returns the number of nodes split (0 if n was already refined).
-    uint32_t refine(NodeId n);
+    // Returns the number of nodes split (0 if n was already refined); appends them to `split_nodes`
+    // when given.
+    uint32_t refine(NodeId n, std::vector<NodeId>* split_nodes = nullptr);
     // Removes the four children of n if they are leaves and removing them keeps the hierarchy
     // balanced and closed. Returns whether it did.
     bool coarsen(NodeId n);

@@ -171,7 +171,7 @@ void Hierarchy::split(NodeId n) {
     nodes_[n].first_child = c;
 }
 
-uint32_t Hierarchy::refine(NodeId n) {
+uint32_t Hierarchy::refine(NodeId n, std::vector<NodeId>* split_nodes) {
     if (!is_leaf(n)) return 0;
     uint32_t splits = 0;
     std::vector<NodeId> todo{n};
@@ -195,6 +195,7 @@ uint32_t Hierarchy::refine(NodeId n) {
         if (nodes_[x].level >= kMaxLevel) throw Error("refine: level cap reached");
         split(x);
         ++splits;
+        if (split_nodes != nullptr) split_nodes->push_back(x);
         // Closure: a same-level leaf with three hanging nodes is red refined.
         for (int e = 0; e < 3; ++e) {
             NodeId q = nodes_[x].nbr[e];

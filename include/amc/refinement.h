@@ -1,0 +1,74 @@
+// Making hierarchies: procedural base meshes and the adaptive refinement drivers that produce
+// realistic red-green hierarchies (curvature-adaptive surface remeshing, planar finite-element
+// style refinement, uniform and random refinement for tests).
+#pragma once
+
+#include <amc/hierarchy.h>
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace amc {
+
+// ---- procedural base meshes ------------------------------------------------------------------
+TriangleMesh make_icosahedron();                  // 12 vertices, 20 triangles, closed, genus 0
+TriangleMesh make_torus(int rings, int segments, double major_radius, double minor_radius);  // genus 1
+TriangleMesh make_square(int cells);             // [0,1]^2 in z=0, 2*cells^2 triangles, boundary
+// L-shaped domain [-1,1]^2 without (0,1]x[-1,0): re-entrant corner at the origin.
+TriangleMesh make_l_shape(int cells_per_unit);
+// A closed, fine procedural surface: an icosphere subdivided `subdivisions` times and displaced
+// radially by smooth bumps, for the embedded default (20 * 4^subdivisions triangles).
+TriangleMesh make_bumpy_sphere(int subdivisions);
+
+// ---- simple drivers ------------------------------------------------------------------------
+void refine_uniformly(Hierarchy& h, int levels);
+// Refines random leaves (below max_level) until the hierarchy has at least `target_leaves`
+// leaves; with coarsen_ratio > 0 it also coarsens random nodes on the way. Deterministic per seed.
+void refine_randomly(Hierarchy& h, uint32_t target_leaves, int max_level, uint64_t seed,
+                     double coarsen_ratio = 0.0);
+// Refines every leaf whose size exceeds the local target size given by `size_at(centroid)`,
+// until none does or max_level is reached (the classic a-priori adaptive FE loop).
+void refine_to_size(Hierarchy& h, const std::function<double(Vec3)>& size_at, int max_level);
+
+// ---- surface remeshing -----------------------------------------------------------------------
+enum class RefinementCriterion { mean_curvature, gauss_curvature, approximation_error };
+
+struct SurfaceRemeshOptions {
+    RefinementCriterion criterion = RefinementCriterion::mean_curvature;
+    uint32_t base_triangles = 500;    // target size of the simplified base mesh
+    uint32_t target_faces = 150000;   // stop once the leaf mesh has about this many faces
+    int max_level = 7;
+};
+
+struct SurfaceRemeshStats {
+    uint32_t base_triangles = 0;
+    double simplify_seconds = 0;
+    double refine_seconds = 0;
+};
+
+// Simplifies `reference` to a coarse base (meshoptimizer), then refines greedily where the
+// criterion is largest (curvature of the reference times element size, or distance of the
+// element's centroid from the reference), projecting every new vertex onto the reference surface.
+Hierarchy remesh_adaptively(const TriangleMesh& reference, const SurfaceRemeshOptions& options,
+                            SurfaceRemeshStats* stats = nullptr);
+
+// ---- planar finite-element style models -------------------------------------------------------
+// L-shaped domain graded towards the re-entrant corner.
+Hierarchy make_l_shape_model(int max_level);
+// A front (a circular arc) sweeping across the unit square: one hierarchy per time step, each
+// obtained from the previous one by coarsening behind the front and refining ahead of it.
+std::vector<Hierarchy> make_moving_front_sequence(int steps, int max_level);
+
+// ---- statistics ------------------------------------------------------------------------------
+struct HierarchyStats {
+    uint32_t base_triangles = 0, base_vertices = 0;
+    uint32_t nodes = 0, leaves = 0, levels = 0, vertices = 0;
+    uint32_t faces = 0, red_faces = 0, green_faces = 0;
+    uint32_t one_hanging = 0, two_hanging = 0;  // leaves closed by one / two hanging nodes
+    std::vector<uint32_t> nodes_per_level;
+};
+HierarchyStats compute_stats(const Hierarchy& h);
+
+}  // namespace amc

@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Installs the Debian packages amcodec builds with, skipping those already present.
+set -euo pipefail
+packages=(g++ cmake make pkg-config libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
+          libtinyobjloader-dev libmeshoptimizer-dev)
+if [[ "${1:-}" == "--bench" ]]; then
+  packages+=(libdraco-dev libzstd-dev xz-utils)
+fi
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  sudo=""
+  [[ $(id -u) -eq 0 ]] || sudo="sudo"
+  $sudo apt-get update
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y --no-install-recommends "${missing[@]}"
+fi

@@ -1,0 +1,397 @@
+// Closest point on a triangle mesh: an AABB tree (flat node array, binned SAH split) and
+// Ericson's point-triangle test, searched branch and bound, nearer child first.
+#include "geometry/closest_point.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace amc {
+namespace {
+
+constexpr uint32_t kLeafSize = 2;
+constexpr uint32_t kEmpty = std::numeric_limits<uint32_t>::max();
+constexpr int kBins = 16;
+// SAH splits may be unbalanced; below this depth only median splits, which halve the count. So
+// the depth is at most kSahDepth + 32, and the traversal stack grows by at most one entry per
+// level.
+constexpr uint32_t kSahDepth = 48;
+constexpr int kStackSize = kSahDepth + 34;
+// A node is pruned when its box distance exceeds the best distance by more than this relative
+// slack: both squared distances carry a few ulps of rounding error, and a node must never be
+// pruned when it holds a triangle whose computed distance equals or beats the best.
+constexpr double kPruneSlack = 1e-13;
+
+double squared_length(Vec3 v) { return dot(v, v); }
+
+// Float bounds rounded outward, so the float box contains the double one.
+float float_below(double x) {
+    if (!(x >= -FLT_MAX)) return -std::numeric_limits<float>::infinity();
+    if (x > FLT_MAX) return FLT_MAX;
+    float f = static_cast<float>(x);
+    return static_cast<double>(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity())
+                                      : f;
+}
+float float_above(double x) {
+    if (!(x <= FLT_MAX)) return std::numeric_limits<float>::infinity();
+    if (x < -FLT_MAX) return -FLT_MAX;
+    float f = static_cast<float>(x);
+    return static_cast<double>(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity())
+                                      : f;
+}
+
+Vec3 component_min(Vec3 a, Vec3 b) {
+    return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)};
+}
+Vec3 component_max(Vec3 a, Vec3 b) {
+    return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)};
+}
+double component(Vec3 v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
+
+// Closest point to p on segment [x, y]; t is the weight of y.
+Vec3 closest_point_on_segment(Vec3 p, Vec3 x, Vec3 y, double& t) {
+    Vec3 xy = y - x;
+    double length_squared = dot(xy, xy);
+    t = length_squared > 0 ? std::clamp(dot(p - x, xy) / length_squared, 0.0, 1.0) : 0.0;
+    return x + t * xy;
+}
+
+// Zero-area (or numerically hopeless) triangles: the nearest of the closest points on the three
+// edges. Such a triangle is a segment or a point, so this is exact.
+Vec3 closest_point_on_edges(Vec3 p, Vec3 a, Vec3 b, Vec3 c, Vec3& barycentric) {
+    double t_ab, t_bc, t_ca;
+    Vec3 q_ab = closest_point_on_segment(p, a, b, t_ab);
+    Vec3 q_bc = closest_point_on_segment(p, b, c, t_bc);
+    Vec3 q_ca = closest_point_on_segment(p, c, a, t_ca);
+    double d_ab = squared_length(p - q_ab);
+    double d_bc = squared_length(p - q_bc);
+    double d_ca = squared_length(p - q_ca);
+    if (d_ab <= d_bc && d_ab <= d_ca) {
+        barycentric = {1 - t_ab, t_ab, 0};
+        return q_ab;
+    }
+    if (d_bc <= d_ca) {
+        barycentric = {0, 1 - t_bc, t_bc};
+        return q_bc;
+    }
+    barycentric = {t_ca, 0, 1 - t_ca};
+    return q_ca;
+}
+
+}  // namespace
+
+Vec3 closest_point_on_triangle(Vec3 p, Vec3 a, Vec3 b, Vec3 c, Vec3& barycentric) {
+    // Ericson, Real-Time Collision Detection, 5.1.5: vertex regions, edge regions, then the face.
+    Vec3 ab = b - a;
+    Vec3 ac = c - a;
+    Vec3 ap = p - a;
+    double d1 = dot(ab, ap);
+    double d2 = dot(ac, ap);
+    if (d1 <= 0 && d2 <= 0) {
+        barycentric = {1, 0, 0};
+        return a;
+    }
+    Vec3 bp = p - b;
+    double d3 = dot(ab, bp);
+    double d4 = dot(ac, bp);
+    if (d3 >= 0 && d4 <= d3) {
+        barycentric = {0, 1, 0};
+        return b;
+    }
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+        double v = d1 / (d1 - d3);
+        barycentric = {1 - v, v, 0};
+        return a + v * ab;
+    }
+    Vec3 cp = p - c;
+    double d5 = dot(ab, cp);
+    double d6 = dot(ac, cp);
+    if (d6 >= 0 && d5 <= d6) {
+        barycentric = {0, 0, 1};
+        return c;
+    }
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+        double w = d2 / (d2 - d6);
+        barycentric = {1 - w, 0, w};
+        return a + w * ac;
+    }
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
+        double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        barycentric = {0, 1 - w, w};
+        return b + w * (c - b);
+    }
+    // Face region. va + vb + vc = |ab x ac|^2; in exact arithmetic all three are positive here,
+    // but a (nearly) zero-area triangle can reach this point with rounding noise instead.
+    double sum = va + vb + vc;
+    if (!(va > 0 && vb > 0 && vc > 0 && sum > 0 && std::isfinite(sum))) {
+        return closest_point_on_edges(p, a, b, c, barycentric);
+    }
+    double v = vb / sum;
+    double w = vc / sum;
+    barycentric = {std::max(1 - v - w, 0.0), v, w};
+    return a + v * ab + w * ac;
+}
+
+ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
+    const std::vector<Vec3>& positions = reference.positions;
+    const std::vector<Triangle>& triangles = reference.triangles;
+    if (triangles.empty()) throw Error("closest point query: the reference mesh has no triangles");
+    if (triangles.size() >= kEmpty) {
+        throw Error("closest point query: the reference mesh has too many triangles");
+    }
+    const uint32_t n = static_cast<uint32_t>(triangles.size());
+
+    // Per-triangle centroids and the largest coordinate magnitude, which sizes the margin that
+    // covers the rounding of computed closest points (a few ulps of the coordinates).
+    std::vector<Vec3> centroids(n);
+    double max_abs = 0;
+    for (uint32_t t = 0; t < n; ++t) {
+        for (uint32_t v : triangles[t]) {
+            if (v >= positions.size()) {
+                throw Error("closest point query: triangle " + std::to_string(t) +
+                            " refers to vertex " + std::to_string(v) + " of " +
+                            std::to_string(positions.size()));
+            }
+            const Vec3& q = positions[v];
+            max_abs = std::max({max_abs, std::abs(q.x), std::abs(q.y), std::abs(q.z)});
+        }
+        const Vec3& a = positions[triangles[t][0]];
+        const Vec3& b = positions[triangles[t][1]];
+        const Vec3& c = positions[triangles[t][2]];
+        centroids[t] = (1.0 / 3.0) * (a + b + c);
+    }
+    const double margin = 16 * DBL_EPSILON * max_abs;
+
+    std::vector<uint32_t> order(n);
+    for (uint32_t t = 0; t < n; ++t) order[t] = t;
+
+    // Bounds of the triangles order[begin, end) and of their centroids.
+    struct Bounds {
+        Vec3 lo{DBL_MAX, DBL_MAX, DBL_MAX}, hi{-DBL_MAX, -DBL_MAX, -DBL_MAX};
+        Vec3 centroid_lo{DBL_MAX, DBL_MAX, DBL_MAX}, centroid_hi{-DBL_MAX, -DBL_MAX, -DBL_MAX};
+    };
+    auto measure = [&](uint32_t begin, uint32_t end) {
+        Bounds bounds;
+        for (uint32_t i = begin; i < end; ++i) {
+            uint32_t t = order[i];
+            for (uint32_t v : triangles[t]) {
+                bounds.lo = component_min(bounds.lo, positions[v]);
+                bounds.hi = component_max(bounds.hi, positions[v]);
+            }
+            bounds.centroid_lo = component_min(bounds.centroid_lo, centroids[t]);
+            bounds.centroid_hi = component_max(bounds.centroid_hi, centroids[t]);
+        }
+        return bounds;
+    };
+    // Binned surface area heuristic (SAH-lite) on the longest centroid axis: of the kBins - 1
+    // planes between equal-width centroid bins, the one minimising area(left) * count(left) +
+    // area(right) * count(right). From depth kSahDepth on, or when the centroids do not separate,
+    // the object median instead (ties by triangle index, so the tree does not depend on the
+    // standard library's nth_element), which bounds the depth. Returns the split position.
+    auto split = [&](uint32_t begin, uint32_t end, const Bounds& bounds, uint32_t depth) {
+        const Vec3 extent = bounds.centroid_hi - bounds.centroid_lo;
+        const int axis =
+            extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
+        const double axis_lo = component(bounds.centroid_lo, axis);
+        const double axis_extent = component(extent, axis);
+        if (depth < kSahDepth && axis_extent > 0) {
+            const double scale = kBins / axis_extent;
+            auto bin_of = [&](uint32_t t) {
+                double x = (component(centroids[t], axis) - axis_lo) * scale;
+                return std::min(static_cast<int>(x), kBins - 1);
+            };
+            Bounds bins[kBins];
+            uint32_t counts[kBins] = {};
+            for (uint32_t i = begin; i < end; ++i) {
+                const uint32_t t = order[i];
+                const int bin = bin_of(t);
+                ++counts[bin];
+                for (uint32_t v : triangles[t]) {
+                    bins[bin].lo = component_min(bins[bin].lo, positions[v]);
+                    bins[bin].hi = component_max(bins[bin].hi, positions[v]);
+                }
+            }
+            auto half_area = [](Vec3 lo, Vec3 hi) {
+                Vec3 e = hi - lo;
+                return e.x * e.y + e.y * e.z + e.z * e.x;
+            };
+            double right_cost[kBins] = {};  // right_cost[i]: bins i.. on the right
+            Vec3 lo = bins[kBins - 1].lo, hi = bins[kBins - 1].hi;
+            uint32_t count = 0;
+            for (int i = kBins - 1; i > 0; --i) {
+                lo = component_min(lo, bins[i].lo);
+                hi = component_max(hi, bins[i].hi);
+                count += counts[i];
+                right_cost[i] = count > 0 ? half_area(lo, hi) * count : 0;
+            }
+            lo = bins[0].lo;
+            hi = bins[0].hi;
+            count = 0;
+            double best_cost = std::numeric_limits<double>::infinity();
+            int best_plane = 0;
+            for (int i = 1; i < kBins; ++i) {
+                lo = component_min(lo, bins[i - 1].lo);
+                hi = component_max(hi, bins[i - 1].hi);
+                count += counts[i - 1];
+                const uint32_t right_count = (end - begin) - count;
+                if (count == 0 || right_count == 0) continue;
+                const double cost = half_area(lo, hi) * count + right_cost[i];
+                if (cost < best_cost) {
+                    best_cost = cost;
+                    best_plane = i;
+                }
+            }
+            if (best_plane > 0) {
+                auto middle = std::partition(order.begin() + begin, order.begin() + end,
+                                             [&](uint32_t t) { return bin_of(t) < best_plane; });
+                return static_cast<uint32_t>(middle - order.begin());
+            }
+        }
+        const uint32_t mid = begin + (end - begin) / 2;
+        std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end,
+                         [&](uint32_t s, uint32_t t) {
+                             double cs = component(centroids[s], axis);
+                             double ct = component(centroids[t], axis);
+                             return cs < ct || (cs == ct && s < t);
+                         });
+        return mid;
+    };
+
+    // Top-down build with an explicit work list: each item is a range of triangles that becomes
+    // child `slot` of node `parent`. Every level touches each triangle a constant number of times
+    // and splits halve the count: O(n log n).
+    struct Work {
+        uint32_t parent, slot, begin, end, depth;
+    };
+    std::vector<Work> work;
+    nodes_.reserve(n / 2 + 1);
+    nodes_.push_back(Node{});
+    {
+        Bounds all = measure(0, n);
+        if (n <= kLeafSize) {
+            work.push_back({0, 0, 0, n, 1});
+            Node& root = nodes_[0];
+            for (int axis = 0; axis < 3; ++axis) {
+                root.lo[1][axis] = std::numeric_limits<float>::infinity();
+                root.hi[1][axis] = -std::numeric_limits<float>::infinity();
+            }
+            root.index[1] = kEmpty;
+            root.count[1] = 0;
+        } else {
+            uint32_t mid = split(0, n, all, 0);
+            work.push_back({0, 1, mid, n, 1});
+            work.push_back({0, 0, 0, mid, 1});
+        }
+    }
+    while (!work.empty()) {
+        Work item = work.back();
+        work.pop_back();
+        Bounds bounds = measure(item.begin, item.end);
+        const Vec3 lo = bounds.lo - Vec3{margin, margin, margin};
+        const Vec3 hi = bounds.hi + Vec3{margin, margin, margin};
+        for (int axis = 0; axis < 3; ++axis) {
+            nodes_[item.parent].lo[item.slot][axis] = float_below(component(lo, axis));
+            nodes_[item.parent].hi[item.slot][axis] = float_above(component(hi, axis));
+        }
+        const uint32_t count = item.end - item.begin;
+        if (count <= kLeafSize) {
+            nodes_[item.parent].index[item.slot] = item.begin;
+            nodes_[item.parent].count[item.slot] = count;
+            continue;
+        }
+        const uint32_t child = static_cast<uint32_t>(nodes_.size());
+        nodes_.push_back(Node{});
+        nodes_[item.parent].index[item.slot] = child;
+        nodes_[item.parent].count[item.slot] = 0;
+        uint32_t mid = split(item.begin, item.end, bounds, item.depth);
+        work.push_back({child, 1, mid, item.end, item.depth + 1});
+        work.push_back({child, 0, item.begin, mid, item.depth + 1});
+    }
+
+    records_.resize(n);
+    triangles_.resize(n);
+    for (uint32_t i = 0; i < n; ++i) {
+        uint32_t t = order[i];
+        records_[i] = {positions[triangles[t][0]], positions[triangles[t][1]],
+                       positions[triangles[t][2]]};
+        triangles_[i] = t;
+    }
+}
+
+std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p,
+                                                                double bound_squared) const {
+    double best = bound_squared;
+    double prune = best * (1 + kPruneSlack);
+    uint32_t best_record = kEmpty;
+    uint32_t best_triangle = kEmpty;
+    Vec3 best_point, best_barycentric;
+
+    // Pending subtrees (or leaves), each with the squared distance to its box.
+    struct Entry {
+        uint32_t index, count;
+        double distance_squared;
+    };
+    Entry stack[kStackSize];
+    int size = 0;
+    stack[size++] = {0, 0, 0.0};
+    while (size > 0) {
+        const Entry entry = stack[--size];
+        if (entry.distance_squared > prune) continue;
+        if (entry.count > 0) {
+            for (uint32_t r = entry.index; r < entry.index + entry.count; ++r) {
+                const Record& record = records_[r];
+                Vec3 barycentric;
+                Vec3 q = closest_point_on_triangle(p, record.a, record.b, record.c, barycentric);
+                double d = squared_length(p - q);
+                if (d < best || (d == best && triangles_[r] < best_triangle)) {
+                    best = d;
+                    prune = best * (1 + kPruneSlack);
+                    best_record = r;
+                    best_triangle = triangles_[r];
+                    best_point = q;
+                    best_barycentric = barycentric;
+                }
+            }
+            continue;
+        }
+        const Node& node = nodes_[entry.index];
+        double d[2];
+        for (int slot = 0; slot < 2; ++slot) {
+            double dx = std::max(std::max(node.lo[slot][0] - p.x, p.x - node.hi[slot][0]), 0.0);
+            double dy = std::max(std::max(node.lo[slot][1] - p.y, p.y - node.hi[slot][1]), 0.0);
+            double dz = std::max(std::max(node.lo[slot][2] - p.z, p.z - node.hi[slot][2]), 0.0);
+            d[slot] = dx * dx + dy * dy + dz * dz;
+        }
+        // Push the farther child first, so that the nearer one is searched first.
+        const int near = d[1] < d[0] ? 1 : 0;
+        for (int slot : {1 - near, near}) {
+            if (node.index[slot] != kEmpty && d[slot] <= prune) {
+                stack[size++] = {node.index[slot], node.count[slot], d[slot]};
+            }
+        }
+    }
+    if (best_record == kEmpty) return std::nullopt;
+    return Hit{best_point, best_triangle, best, best_barycentric};
+}
+
+ClosestPointQuery::Hit ClosestPointQuery::closest(Vec3 p) const {
+    std::optional<Hit> hit = search(p, std::numeric_limits<double>::infinity());
+    if (!hit) {
+        // Only non-finite input (a NaN coordinate) compares false against every distance.
+        throw Error("closest point query: the query point is not finite");
+    }
+    return *hit;
+}
+
+std::optional<ClosestPointQuery::Hit> ClosestPointQuery::closest(Vec3 p,
+                                                                 double max_distance) const {
+    if (!(max_distance >= 0)) return std::nullopt;
+    return search(p, max_distance * max_distance);
+}
+
+}  // namespace amc

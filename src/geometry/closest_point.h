@@ -1,0 +1,74 @@
+// Closest point on a triangle mesh: the "reference surface" query of the adaptive refinement
+// driver, which projects every new vertex (an edge midpoint) onto the fine input mesh.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "amc/mesh.h"
+
+namespace amc {
+
+// The point of triangle (a, b, c) closest to p, by Voronoi regions of the vertices, edges and face
+// (Ericson, Real-Time Collision Detection, 5.1.5). `barycentric` receives the weights of a, b, c
+// (they sum to 1, each in [0, 1]). Zero-area triangles are handled as their three edges, so the
+// result is always finite for finite input.
+Vec3 closest_point_on_triangle(Vec3 p, Vec3 a, Vec3 b, Vec3 c, Vec3& barycentric);
+
+// An AABB tree over a triangle mesh answering "closest point on the surface" queries.
+//
+// The tree is built once in O(n log n): binned SAH split on the longest centroid axis, object
+// median splits from depth 48 on (which bounds the depth), at most two triangles per leaf, one
+// flat array of 64-byte nodes that each hold both children's boxes. A query is a branch-and-bound
+// descent that visits the nearer child first. The query copies what it needs from the mesh (the
+// corners of every triangle, in leaf order), so the mesh may be dropped after
+// construction. Queries are const and keep no state: any number of threads may query at once.
+//
+// Results are deterministic and independent of the tree: the hit is the triangle of least
+// distance, ties broken by the lowest triangle index, exactly as a brute-force loop over all
+// triangles calling closest_point_on_triangle() would find it.
+class ClosestPointQuery {
+public:
+    struct Hit {
+        Vec3 point;               // closest point on the surface
+        uint32_t triangle = 0;    // index into reference.triangles
+        double distance_squared = 0;
+        Vec3 barycentric;         // weights of the triangle's corners 0, 1, 2 at `point`
+    };
+
+    // Throws Error if the mesh has no triangles or a triangle index is out of range.
+    explicit ClosestPointQuery(const TriangleMesh& reference);
+
+    Hit closest(Vec3 p) const;
+
+    // As closest(p), but only among points within `max_distance` of p (inclusive); nullopt if
+    // there are none. Faster than closest(p) when the bound prunes most of the tree.
+    std::optional<Hit> closest(Vec3 p, double max_distance) const;
+
+    std::size_t triangle_count() const { return triangles_.size(); }
+    std::size_t node_count() const { return nodes_.size(); }
+
+private:
+    // One cache line: the bounds of both children (float, rounded outward) and what they are.
+    // A child with count > 0 is a leaf: records [index, index + count); with count == 0 it is
+    // the inner node nodes_[index]; index kEmpty marks the missing second child of a tiny tree.
+    struct alignas(64) Node {
+        float lo[2][3];
+        float hi[2][3];
+        uint32_t index[2];
+        uint32_t count[2];
+    };
+    struct Record {  // the corners of one triangle, in leaf order
+        Vec3 a, b, c;
+    };
+
+    std::optional<Hit> search(Vec3 p, double bound_squared) const;
+
+    std::vector<Node> nodes_;           // nodes_[0] is the root
+    std::vector<Record> records_;
+    std::vector<uint32_t> triangles_;   // triangle index of each record
+};
+
+}  // namespace amc

@@ -1,0 +1,136 @@
+// OFF reader and writer.
+#include "mesh/off_io.h"
+
+#include <cstdint>
+
+#include "mesh/text_number.h"
+
+namespace amc {
+namespace {
+
+[[noreturn]] void fail(const std::string& what, const std::string& message) {
+    throw Error(what + ": " + message);
+}
+
+// Fewest bytes a vertex ("\n0 0 0") and a face ("\n3 0 1 2") can take, separator included.
+constexpr uint64_t min_vertex_bytes = 6;
+constexpr uint64_t min_face_bytes = 8;
+
+uint64_t read_count(text::TokenCursor& in, const std::string& what, const char* name) {
+    std::string_view token = in.next();
+    int64_t value = 0;
+    if (token.empty()) fail(what, std::string("truncated header: missing ") + name + " count");
+    if (!text::parse_int(token, value) || value < 0) {
+        fail(what, std::string("bad ") + name + " count " + text::quote_token(token) + " (line " +
+                       std::to_string(in.line()) + ")");
+    }
+    return static_cast<uint64_t>(value);
+}
+
+}  // namespace
+
+TriangleMesh parse_off(std::string_view text, const std::string& what) {
+    text::TokenCursor in(text, /*hash_comments=*/true);
+    std::string_view magic = in.next();
+    if (magic != "OFF") {
+        fail(what, "not an OFF file (expected \"OFF\", found " +
+                       (magic.empty() ? std::string("nothing") : text::quote_token(magic)) + ")");
+    }
+    const uint64_t vertex_count = read_count(in, what, "vertex");
+    const uint64_t face_count = read_count(in, what, "face");
+    read_count(in, what, "edge");  // unused, but must be present
+    // Check the counts against the bytes left before allocating anything.
+    if (vertex_count > UINT32_MAX || face_count > UINT32_MAX ||
+        vertex_count * min_vertex_bytes + face_count * min_face_bytes > in.remaining()) {
+        fail(what, "header declares " + std::to_string(vertex_count) + " vertices and " +
+                       std::to_string(face_count) + " faces, more than the " +
+                       std::to_string(in.remaining()) + " bytes after it can hold");
+    }
+
+    TriangleMesh mesh;
+    mesh.positions.resize(vertex_count);
+    mesh.single_precision = true;
+    for (uint64_t v = 0; v < vertex_count; ++v) {
+        double xyz[3];
+        for (double& c : xyz) {
+            std::string_view token = in.next();
+            if (token.empty()) {
+                fail(what, "truncated: file ends in vertex " + std::to_string(v) + " of " +
+                               std::to_string(vertex_count));
+            }
+            if (!text::parse_real(token, c)) {
+                fail(what, "vertex " + std::to_string(v) + " (line " + std::to_string(in.line()) +
+                               ") has a malformed coordinate " + text::quote_token(token));
+            }
+            if (static_cast<double>(static_cast<float>(c)) != c) mesh.single_precision = false;
+        }
+        mesh.positions[v] = {xyz[0], xyz[1], xyz[2]};
+    }
+
+    mesh.triangles.resize(face_count);
+    for (uint64_t f = 0; f < face_count; ++f) {
+        std::string_view token = in.next();
+        if (token.empty()) {
+            fail(what, "truncated: file ends before face " + std::to_string(f) + " of " +
+                           std::to_string(face_count));
+        }
+        int64_t corners = 0;
+        if (!text::parse_int(token, corners)) {
+            fail(what, "face " + std::to_string(f) + " (line " + std::to_string(in.line()) +
+                           ") has a malformed vertex count " + text::quote_token(token));
+        }
+        if (corners != 3) {
+            fail(what, "face " + std::to_string(f) + " has " + std::to_string(corners) +
+                           " vertices; only triangle meshes are supported");
+        }
+        for (uint32_t& index : mesh.triangles[f]) {
+            token = in.next();
+            int64_t value = 0;
+            if (token.empty()) {
+                fail(what, "truncated: file ends in face " + std::to_string(f) + " of " +
+                               std::to_string(face_count));
+            }
+            if (!text::parse_int(token, value)) {
+                fail(what, "face " + std::to_string(f) + " (line " + std::to_string(in.line()) +
+                               ") has a malformed index " + text::quote_token(token));
+            }
+            if (value < 0 || static_cast<uint64_t>(value) >= vertex_count) {
+                fail(what, "face " + std::to_string(f) + " has index " + std::to_string(value) +
+                               " out of range (" + std::to_string(vertex_count) + " vertices)");
+            }
+            index = static_cast<uint32_t>(value);
+        }
+        in.skip_line();  // optional face colour
+    }
+    return mesh;
+}
+
+std::string format_off(const TriangleMesh& mesh) {
+    std::string out = "OFF\n";
+    text::append_uint(out, mesh.positions.size());
+    out += ' ';
+    text::append_uint(out, mesh.triangles.size());
+    out += " 0\n";
+    // Shortest decimals of the double values (also for single_precision meshes: the shortest
+    // decimal of a float would read back as a different double).
+    for (const Vec3& p : mesh.positions) {
+        text::append_real(out, p.x);
+        out += ' ';
+        text::append_real(out, p.y);
+        out += ' ';
+        text::append_real(out, p.z);
+        out += '\n';
+    }
+    for (const Triangle& t : mesh.triangles) {
+        out += "3 ";
+        text::append_uint(out, t[0]);
+        out += ' ';
+        text::append_uint(out, t[1]);
+        out += ' ';
+        text::append_uint(out, t[2]);
+        out += '\n';
+    }
+    return out;
+}
+
+}  // namespace amc

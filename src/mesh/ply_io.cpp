@@ -1,0 +1,454 @@
+// PLY reader (ASCII, binary little- and big-endian) and binary little-endian writer.
+#include "mesh/ply_io.h"
+
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "mesh/text_number.h"
+
+namespace amc {
+namespace {
+
+[[noreturn]] void fail(const std::string& what, const std::string& message) {
+    throw Error(what + ": " + message);
+}
+
+enum class Encoding { ascii, binary_little_endian, binary_big_endian };
+enum class Type { int8, uint8, int16, uint16, int32, uint32, float32, float64 };
+
+struct Property {
+    std::string name;
+    Type type = Type::float32;  // the item type for a list
+    bool is_list = false;
+    Type count_type = Type::uint8;
+};
+
+struct Element {
+    std::string name;
+    uint64_t count = 0;
+    std::vector<Property> properties;
+};
+
+struct Header {
+    Encoding encoding = Encoding::ascii;
+    std::vector<Element> elements;
+    std::size_t data_offset = 0;
+};
+
+bool parse_type(std::string_view name, Type& type) {
+    static const struct {
+        const char* name;
+        Type type;
+    } names[] = {{"char", Type::int8},       {"int8", Type::int8},       {"uchar", Type::uint8},
+                 {"uint8", Type::uint8},     {"short", Type::int16},     {"int16", Type::int16},
+                 {"ushort", Type::uint16},   {"uint16", Type::uint16},   {"int", Type::int32},
+                 {"int32", Type::int32},     {"uint", Type::uint32},     {"uint32", Type::uint32},
+                 {"float", Type::float32},   {"float32", Type::float32}, {"double", Type::float64},
+                 {"float64", Type::float64}};
+    for (const auto& n : names) {
+        if (name == n.name) {
+            type = n.type;
+            return true;
+        }
+    }
+    return false;
+}
+
+std::size_t type_size(Type type) {
+    switch (type) {
+        case Type::int8:
+        case Type::uint8: return 1;
+        case Type::int16:
+        case Type::uint16: return 2;
+        case Type::int32:
+        case Type::uint32:
+        case Type::float32: return 4;
+        case Type::float64: return 8;
+    }
+    return 8;
+}
+
+bool is_integer(Type type) { return type != Type::float32 && type != Type::float64; }
+
+std::vector<std::string_view> split_words(std::string_view line) {
+    std::vector<std::string_view> words;
+    text::TokenCursor cursor(line, /*hash_comments=*/false);
+    for (std::string_view w = cursor.next(); !w.empty(); w = cursor.next()) words.push_back(w);
+    return words;
+}
+
+Header parse_header(std::string_view bytes, const std::string& what) {
+    Header header;
+    std::size_t pos = 0;
+    std::size_t line_number = 0;
+    bool have_format = false;
+    for (;;) {
+        const std::size_t end = bytes.find('\n', pos);
+        if (end == std::string_view::npos) fail(what, "bad PLY header: no end_header line");
+        std::string_view line = bytes.substr(pos, end - pos);
+        pos = end + 1;
+        ++line_number;
+        if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+        const std::string at = " (header line " + std::to_string(line_number) + ")";
+        if (line_number == 1) {
+            if (line != "ply") fail(what, "not a PLY file (the first line is not \"ply\")");
+            continue;
+        }
+        std::vector<std::string_view> words = split_words(line);
+        if (words.empty()) continue;
+        const std::string_view keyword = words[0];
+        if (keyword == "comment" || keyword == "obj_info") continue;
+        if (keyword == "end_header") break;
+        if (keyword == "format") {
+            if (words.size() != 3) fail(what, "bad PLY header: malformed format line" + at);
+            if (words[1] == "ascii") {
+                header.encoding = Encoding::ascii;
+            } else if (words[1] == "binary_little_endian") {
+                header.encoding = Encoding::binary_little_endian;
+            } else if (words[1] == "binary_big_endian") {
+                header.encoding = Encoding::binary_big_endian;
+            } else {
+                fail(what, "bad PLY header: unknown format " + text::quote_token(words[1]) + at);
+            }
+            have_format = true;
+        } else if (keyword == "element") {
+            int64_t count = 0;
+            if (words.size() != 3 || !text::parse_int(words[2], count) || count < 0) {
+                fail(what, "bad PLY header: malformed element line" + at);
+            }
+            header.elements.push_back({std::string(words[1]), static_cast<uint64_t>(count), {}});
+        } else if (keyword == "property") {
+            if (header.elements.empty()) fail(what, "bad PLY header: property before element" + at);
+            Property p;
+            if (words.size() == 5 && words[1] == "list") {
+                p.is_list = true;
+                if (!parse_type(words[2], p.count_type) || !is_integer(p.count_type) ||
+                    !parse_type(words[3], p.type)) {
+                    fail(what, "bad PLY header: bad list property types" + at);
+                }
+                p.name = std::string(words[4]);
+            } else if (words.size() == 3 && parse_type(words[1], p.type)) {
+                p.name = std::string(words[2]);
+            } else {
+                fail(what, "bad PLY header: malformed property line" + at);
+            }
+            header.elements.back().properties.push_back(p);
+        } else {
+            fail(what, "bad PLY header: unknown keyword " + text::quote_token(keyword) + at);
+        }
+    }
+    if (!have_format) fail(what, "bad PLY header: no format line");
+    header.data_offset = pos;
+    return header;
+}
+
+// Fewest bytes one item of the element can take: every fixed property and every list count in
+// binary; one character and one separator per property in ASCII.
+uint64_t min_item_bytes(const Element& e, Encoding encoding) {
+    uint64_t bytes = 0;
+    for (const Property& p : e.properties) {
+        if (encoding == Encoding::ascii) {
+            bytes += 2;
+        } else {
+            bytes += type_size(p.is_list ? p.count_type : p.type);
+        }
+    }
+    return bytes;
+}
+
+void check_counts(const Header& header, std::size_t data_bytes, const std::string& what) {
+    uint64_t total = 0;
+    for (const Element& e : header.elements) {
+        if (e.count == 0) continue;
+        if (e.properties.empty()) {
+            fail(what, "bad PLY header: element '" + e.name + "' has no properties");
+        }
+        const uint64_t item = min_item_bytes(e, header.encoding);
+        // ASCII: n tokens need 2n - 1 bytes; allow for the missing last separator.
+        const uint64_t available = data_bytes + (header.encoding == Encoding::ascii ? 1 : 0);
+        if (e.count > available / item || total + e.count * item > available) {
+            fail(what, "element '" + e.name + "' declares " + std::to_string(e.count) +
+                           " items, more than the " + std::to_string(data_bytes) +
+                           " bytes of data can hold");
+        }
+        total += e.count * item;
+    }
+}
+
+// Reads the values of one encoding as doubles (exact for every PLY type).
+class ValueReader {
+public:
+    ValueReader(std::string_view bytes, std::size_t offset, Encoding encoding,
+                const std::string& what)
+        : bytes_(bytes), pos_(offset), encoding_(encoding), what_(what),
+          tokens_(bytes, /*hash_comments=*/false, offset) {
+        for (std::size_t i = 0; i < offset; ++i) header_lines_ += bytes[i] == '\n';
+    }
+
+    // `context` says where we are, for messages ("vertex 12").
+    double read(Type type, const std::string& context) {
+        if (encoding_ == Encoding::ascii) return read_ascii(type, context);
+        const std::size_t size = type_size(type);
+        if (bytes_.size() - pos_ < size) fail(what_, "truncated data in " + context);
+        unsigned char b[8];
+        std::memcpy(b, bytes_.data() + pos_, size);
+        pos_ += size;
+        if (encoding_ == Encoding::binary_big_endian) {
+            for (std::size_t i = 0; i < size / 2; ++i) std::swap(b[i], b[size - 1 - i]);
+        }
+        uint64_t u = 0;  // little-endian bytes to an unsigned integer
+        for (std::size_t i = 0; i < size; ++i) u |= uint64_t(b[i]) << (8 * i);
+        switch (type) {
+            case Type::int8: return static_cast<int8_t>(static_cast<uint8_t>(u));
+            case Type::uint8: return static_cast<uint8_t>(u);
+            case Type::int16: return static_cast<int16_t>(static_cast<uint16_t>(u));
+            case Type::uint16: return static_cast<uint16_t>(u);
+            case Type::int32: return static_cast<int32_t>(static_cast<uint32_t>(u));
+            case Type::uint32: return static_cast<uint32_t>(u);
+            case Type::float32: {
+                uint32_t u32 = static_cast<uint32_t>(u);
+                float f;
+                std::memcpy(&f, &u32, 4);
+                return f;
+            }
+            case Type::float64: {
+                double d;
+                std::memcpy(&d, &u, 8);
+                return d;
+            }
+        }
+        return 0;
+    }
+
+    // Skips `count` values of one type.
+    void skip(Type type, uint64_t count, const std::string& context) {
+        if (encoding_ == Encoding::ascii) {
+            for (uint64_t i = 0; i < count; ++i) read_ascii(type, context);
+            return;
+        }
+        const uint64_t size = type_size(type);
+        if (count > (bytes_.size() - pos_) / size) fail(what_, "truncated data in " + context);
+        pos_ += count * size;
+    }
+
+    // A list count or an index: an integer value in [0, limit].
+    uint64_t read_index(Type type, uint64_t limit, const std::string& context, const char* name) {
+        const double v = read(type, context);
+        if (!(v >= 0 && v <= static_cast<double>(limit)) ||
+            v != static_cast<double>(static_cast<uint64_t>(v))) {
+            fail(what_, context + " has a bad " + name + " " + format(v));
+        }
+        return static_cast<uint64_t>(v);
+    }
+
+private:
+    static std::string format(double v) {
+        std::string s;
+        text::append_real(s, v);
+        return s;
+    }
+
+    double read_ascii(Type type, const std::string& context) {
+        std::string_view token = tokens_.next();
+        if (token.empty()) fail(what_, "truncated data in " + context);
+        const std::string at = " (line " + std::to_string(tokens_.line() + header_lines_) + ")";
+        if (type == Type::float32) {
+            float f;
+            if (!text::parse_real(token, f)) {
+                fail(what_, context + " has a malformed value " + text::quote_token(token) + at);
+            }
+            return f;
+        }
+        if (type == Type::float64) {
+            double d;
+            if (!text::parse_real(token, d)) {
+                fail(what_, context + " has a malformed value " + text::quote_token(token) + at);
+            }
+            return d;
+        }
+        int64_t i = 0;
+        if (!text::parse_int(token, i)) {
+            fail(what_, context + " has a malformed integer " + text::quote_token(token) + at);
+        }
+        int64_t lo = 0, hi = 0;
+        switch (type) {
+            case Type::int8: lo = INT8_MIN, hi = INT8_MAX; break;
+            case Type::uint8: lo = 0, hi = UINT8_MAX; break;
+            case Type::int16: lo = INT16_MIN, hi = INT16_MAX; break;
+            case Type::uint16: lo = 0, hi = UINT16_MAX; break;
+            case Type::int32: lo = INT32_MIN, hi = INT32_MAX; break;
+            default: lo = 0, hi = UINT32_MAX; break;
+        }
+        if (i < lo || i > hi) {
+            fail(what_, context + " has value " + std::to_string(i) +
+                            " out of the range of its type" + at);
+        }
+        return static_cast<double>(i);
+    }
+
+    std::string_view bytes_;
+    std::size_t pos_;
+    Encoding encoding_;
+    const std::string& what_;
+    text::TokenCursor tokens_;
+    std::size_t header_lines_ = 0;  // so that ASCII messages give file line numbers
+};
+
+int find_property(const Element& e, std::string_view name) {
+    for (std::size_t i = 0; i < e.properties.size(); ++i) {
+        if (e.properties[i].name == name) return static_cast<int>(i);
+    }
+    return -1;
+}
+
+}  // namespace
+
+TriangleMesh parse_ply(std::string_view bytes, const std::string& what) {
+    const Header header = parse_header(bytes, what);
+    check_counts(header, bytes.size() - header.data_offset, what);
+
+    const Element* vertex_element = nullptr;
+    const Element* face_element = nullptr;
+    for (const Element& e : header.elements) {
+        if (e.name == "vertex" || e.name == "face") {
+            const Element*& slot = e.name == "vertex" ? vertex_element : face_element;
+            if (slot) fail(what, "bad PLY header: two '" + e.name + "' elements");
+            slot = &e;
+        }
+    }
+    if (!vertex_element) fail(what, "bad PLY header: no vertex element");
+    if (!face_element) fail(what, "bad PLY header: no face element");
+    int xyz[3];
+    for (int k = 0; k < 3; ++k) {
+        const char* name = k == 0 ? "x" : k == 1 ? "y" : "z";
+        xyz[k] = find_property(*vertex_element, name);
+        if (xyz[k] < 0 || vertex_element->properties[xyz[k]].is_list) {
+            fail(what, std::string("bad PLY header: the vertex element has no scalar property ") +
+                           name);
+        }
+    }
+    int corner_property = find_property(*face_element, "vertex_indices");
+    if (corner_property < 0) corner_property = find_property(*face_element, "vertex_index");
+    if (corner_property < 0 || !face_element->properties[corner_property].is_list) {
+        fail(what, "bad PLY header: the face element has no vertex_indices list");
+    }
+    if (vertex_element->count > UINT32_MAX) fail(what, "too many vertices");
+
+    TriangleMesh mesh;
+    // check_counts bounded both counts by the data size, so these allocations are safe.
+    mesh.positions.resize(vertex_element->count);
+    mesh.triangles.resize(face_element->count);
+    ValueReader in(bytes, header.data_offset, header.encoding, what);
+    for (const Element& e : header.elements) {
+        const bool is_vertex = &e == vertex_element, is_face = &e == face_element;
+        for (uint64_t item = 0; item < e.count; ++item) {
+            const std::string context = e.name + " " + std::to_string(item);
+            for (std::size_t pi = 0; pi < e.properties.size(); ++pi) {
+                const Property& p = e.properties[pi];
+                if (p.is_list) {
+                    const uint64_t n = in.read_index(p.count_type, UINT32_MAX, context, "list size");
+                    if (is_face && static_cast<int>(pi) == corner_property) {
+                        if (n != 3) {
+                            fail(what, "face " + std::to_string(item) + " has " +
+                                           std::to_string(n) +
+                                           " vertices; only triangle meshes are supported");
+                        }
+                        for (uint32_t& index : mesh.triangles[item]) {
+                            index = static_cast<uint32_t>(
+                                in.read_index(p.type, UINT32_MAX, context, "vertex index"));
+                        }
+                    } else {
+                        in.skip(p.type, n, context);
+                    }
+                } else if (is_vertex && (static_cast<int>(pi) == xyz[0] ||
+                                         static_cast<int>(pi) == xyz[1] ||
+                                         static_cast<int>(pi) == xyz[2])) {
+                    Vec3& pos = mesh.positions[item];
+                    double* coordinate = static_cast<int>(pi) == xyz[0]   ? &pos.x
+                                         : static_cast<int>(pi) == xyz[1] ? &pos.y
+                                                                          : &pos.z;
+                    *coordinate = in.read(p.type, context);
+                } else {
+                    in.skip(p.type, 1, context);
+                }
+            }
+        }
+    }
+
+    // Float properties give floats; integer or double ones may happen to be floats too.
+    mesh.single_precision = true;
+    for (const Vec3& p : mesh.positions) {
+        for (double c : {p.x, p.y, p.z}) {
+            if (static_cast<double>(static_cast<float>(c)) != c) mesh.single_precision = false;
+        }
+    }
+    return mesh;
+}
+
+namespace {
+
+template <typename T>
+void append_le(std::string& out, T value) {
+    static_assert(sizeof(T) <= 8, "scalar");
+    uint64_t u = 0;
+    if constexpr (sizeof(T) == 8) {
+        std::memcpy(&u, &value, 8);
+    } else if constexpr (sizeof(T) == 4) {
+        uint32_t u32;
+        std::memcpy(&u32, &value, 4);
+        u = u32;
+    } else {
+        uint8_t u8;
+        std::memcpy(&u8, &value, 1);
+        u = u8;
+    }
+    for (std::size_t i = 0; i < sizeof(T); ++i) out += static_cast<char>((u >> (8 * i)) & 0xff);
+}
+
+}  // namespace
+
+std::string format_ply(const TriangleMesh& mesh, const CellData* cells) {
+    const bool write_level = cells && !cells->level.empty();
+    const bool write_green = cells && !cells->is_green.empty();
+    if ((write_level && cells->level.size() != mesh.triangles.size()) ||
+        (write_green && cells->is_green.size() != mesh.triangles.size())) {
+        throw Error("PLY writer: cell data size does not match the triangle count");
+    }
+    const bool wide_indices = mesh.positions.size() > static_cast<std::size_t>(INT32_MAX);
+    const char* real = mesh.single_precision ? "float" : "double";
+    std::string out = "ply\nformat binary_little_endian 1.0\ncomment written by amcodec\n";
+    out += "element vertex " + std::to_string(mesh.positions.size()) + "\n";
+    out += std::string("property ") + real + " x\nproperty " + real + " y\nproperty " + real +
+           " z\n";
+    out += "element face " + std::to_string(mesh.triangles.size()) + "\n";
+    out += wide_indices ? "property list uchar uint vertex_indices\n"
+                        : "property list uchar int vertex_indices\n";
+    if (write_level) out += "property uchar level\n";
+    if (write_green) out += "property uchar green\n";
+    out += "end_header\n";
+
+    const std::size_t real_size = mesh.single_precision ? 4 : 8;
+    out.reserve(out.size() + mesh.positions.size() * 3 * real_size +
+                mesh.triangles.size() * (13 + write_level + write_green));
+    for (const Vec3& p : mesh.positions) {
+        for (double c : {p.x, p.y, p.z}) {
+            if (mesh.single_precision) {
+                append_le(out, static_cast<float>(c));
+            } else {
+                append_le(out, c);
+            }
+        }
+    }
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+        out += static_cast<char>(3);
+        for (uint32_t v : mesh.triangles[t]) append_le(out, v);
+        if (write_level) out += static_cast<char>(cells->level[t]);
+        if (write_green) out += static_cast<char>(cells->is_green[t]);
+    }
+    return out;
+}
+
+}  // namespace amc

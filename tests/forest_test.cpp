@@ -1,0 +1,179 @@
+// The red-green forest: known answers for refinement, balance, closure and coarsening.
+#include "hierarchy_checks.h"
+
+namespace amc {
+namespace {
+
+using testing::fixture_meshes;
+using testing::hierarchy_is_valid;
+
+TEST(Forest, RootsMatchTheBaseMesh) {
+    for (const auto& [name, mesh] : fixture_meshes()) {
+        Hierarchy h(mesh);
+        EXPECT_EQ(h.node_count(), mesh.triangles.size()) << name;
+        EXPECT_EQ(h.leaf_count(), mesh.triangles.size()) << name;
+        EXPECT_EQ(h.vertex_count(), mesh.positions.size()) << name;
+        EXPECT_EQ(h.depth(), 0) << name;
+        EXPECT_TRUE(hierarchy_is_valid(h)) << name;
+    }
+}
+
+TEST(Forest, UniformRefinementGivesFourToTheKTimesFaces) {
+    for (const auto& [name, mesh] : fixture_meshes()) {
+        for (int k = 0; k <= 4; ++k) {
+            Hierarchy h(mesh);
+            refine_uniformly(h, k);
+            const LeafMesh leaf = extract_leaf_mesh(h);
+            uint64_t expected = mesh.triangles.size();
+            for (int i = 0; i < k; ++i) expected *= 4;
+            EXPECT_EQ(leaf.mesh.triangles.size(), expected) << name << " k=" << k;
+            EXPECT_EQ(compute_stats(h).green_faces, 0u) << name;
+            EXPECT_EQ(h.depth(), k) << name;
+            EXPECT_TRUE(hierarchy_is_valid(h)) << name;
+        }
+    }
+}
+
+// One refined triangle of a closed mesh: its 4 children, each of the 3 neighbours bisected into
+// 2 green triangles, every other triangle unchanged: f0 - 4 + 4 + 3 * 2 = f0 + 6 faces and
+// 3 new vertices (one per split edge).
+TEST(Forest, OneRefinedTriangleInAClosedMesh) {
+    Hierarchy h(make_icosahedron());
+    EXPECT_EQ(h.refine(7), 1u);
+    const LeafMesh leaf = extract_leaf_mesh(h);
+    EXPECT_EQ(leaf.mesh.triangles.size(), 20u + 6u);
+    EXPECT_EQ(h.vertex_count(), 12u + 3u);
+    const HierarchyStats s = compute_stats(h);
+    EXPECT_EQ(s.red_faces, 4u + 16u);
+    EXPECT_EQ(s.green_faces, 6u);
+    EXPECT_EQ(s.one_hanging, 3u);
+    EXPECT_TRUE(hierarchy_is_valid(h));
+}
+
+// Two refined triangles sharing an edge: 2 * 4 red children; their four other edge neighbours
+// (all distinct on the icosahedron) get one hanging node each and become 2 green triangles:
+// 20 - 2 - 4 + 8 + 4 * 2 = 30 faces; 5 split edges, so 12 + 5 vertices.
+TEST(Forest, TwoAdjacentRefinedTriangles) {
+    Hierarchy h(make_icosahedron());
+    const NodeId a = 0;
+    const NodeId b = h.neighbor(a, 0);
+    h.refine(a);
+    h.refine(b);
+    EXPECT_EQ(h.vertex_count(), 12u + 5u);
+    EXPECT_EQ(extract_leaf_mesh(h).mesh.triangles.size(), 30u);
+    EXPECT_TRUE(hierarchy_is_valid(h));
+}
+
+TEST(Forest, ThreeRefinedNeighboursForceClosure) {
+    Hierarchy h(make_icosahedron());
+    const NodeId center = 5;
+    for (int e = 0; e < 3; ++e) h.refine(h.neighbor(center, e));
+    EXPECT_FALSE(h.is_leaf(center)) << "a leaf with three hanging nodes must be red refined";
+    EXPECT_TRUE(hierarchy_is_valid(h));
+}
+
+TEST(Forest, RefiningDeepKeepsBalance) {
+    for (const auto& [name, mesh] : fixture_meshes()) {
+        Hierarchy h(mesh);
+        NodeId n = 0;
+        for (int level = 0; level < 8; ++level) {
+            h.refine(n);
+            n = h.child(n, level % 4);
+        }
+        EXPECT_EQ(h.depth(), 8) << name;
+        EXPECT_TRUE(hierarchy_is_valid(h)) << name;
+        // Balance: every refined node has a same-level neighbour on every inner edge.
+        for (NodeId m : h.breadth_first_order()) {
+            if (!h.is_leaf(m)) {
+                EXPECT_TRUE(h.has_all_neighbors(m)) << name;
+            }
+        }
+    }
+}
+
+TEST(Forest, ChildLayoutFollowsThePaper) {
+    TriangleMesh mesh;
+    mesh.positions = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}};
+    mesh.triangles = {{0, 1, 2}};
+    Hierarchy h(mesh);
+    h.refine(0);
+    auto at = [&](NodeId n, int i) { return h.position(h.vertex(n, i)); };
+    // Corner children at the parent's vertices 0, 1, 2 (keeping that vertex's local index), then
+    // the center child whose vertex i is the midpoint opposite parent vertex i.
+    EXPECT_EQ(at(h.child(0, 0), 0), (Vec3{0, 0, 0}));
+    EXPECT_EQ(at(h.child(0, 1), 1), (Vec3{4, 0, 0}));
+    EXPECT_EQ(at(h.child(0, 2), 2), (Vec3{0, 4, 0}));
+    EXPECT_EQ(at(h.child(0, 3), 0), (Vec3{2, 2, 0}));
+    EXPECT_EQ(at(h.child(0, 3), 1), (Vec3{0, 2, 0}));
+    EXPECT_EQ(at(h.child(0, 3), 2), (Vec3{2, 0, 0}));
+    for (int k = 0; k < 4; ++k) EXPECT_EQ(h.child_index(h.child(0, k)), k);
+    EXPECT_TRUE(hierarchy_is_valid(h));
+}
+
+TEST(Forest, CoarsenUndoesRefine) {
+    for (const auto& [name, mesh] : fixture_meshes()) {
+        Hierarchy h(mesh);
+        const Hierarchy original = h;
+        h.refine(0);
+        EXPECT_TRUE(h.coarsen(0)) << name;
+        EXPECT_TRUE(identical(h, original)) << name;
+        EXPECT_TRUE(hierarchy_is_valid(h)) << name;
+    }
+}
+
+TEST(Forest, CoarsenRefusesWhatBalanceForbids) {
+    Hierarchy h(make_icosahedron());
+    h.refine(0);
+    h.refine(h.child(0, 0));  // balance refines 0's neighbours across edges 0 and 2
+    const NodeId neighbour = h.neighbor(0, 0);
+    ASSERT_FALSE(h.is_leaf(neighbour));
+    // Coarsening the neighbour would put level-2 leaves next to a level-0 leaf.
+    const Hierarchy before = h;
+    EXPECT_FALSE(h.can_coarsen(neighbour));
+    EXPECT_FALSE(h.coarsen(neighbour));
+    EXPECT_TRUE(identical(h, before));
+    EXPECT_FALSE(h.coarsen(0)) << "node 0 has a refined child";
+    EXPECT_TRUE(h.coarsen(h.child(0, 0)));
+    EXPECT_TRUE(h.coarsen(neighbour));
+    EXPECT_TRUE(hierarchy_is_valid(h));
+}
+
+TEST(Forest, CoarsenRefusesWhenClosureWouldRefineAgain) {
+    Hierarchy h(make_icosahedron());
+    const NodeId center = 5;
+    for (int e = 0; e < 3; ++e) h.refine(h.neighbor(center, e));
+    ASSERT_FALSE(h.is_leaf(center));
+    EXPECT_FALSE(h.can_coarsen(center));
+    EXPECT_FALSE(h.coarsen(center));
+    EXPECT_TRUE(hierarchy_is_valid(h));
+}
+
+TEST(Forest, SingleSplitRequiresNeighbours) {
+    Hierarchy h(make_icosahedron());
+    h.split(0);
+    const NodeId c = h.child(0, 0);
+    EXPECT_FALSE(h.can_split(c)) << "its outer neighbours are coarser";
+    EXPECT_TRUE(h.can_split(h.child(0, 3))) << "the center's neighbours are its siblings";
+}
+
+// Guards the GCC 12 miscompile noted in CMakeLists.txt: rounding all three coordinates to float.
+bool is_float(double x) {
+    volatile float f = static_cast<float>(x);
+    return static_cast<double>(f) == x;
+}
+
+TEST(Forest, SinglePrecisionBaseKeepsFloatVertices) {
+    const TriangleMesh mesh = make_bumpy_sphere(1);
+    for (const Vec3& p : mesh.positions) {
+        EXPECT_TRUE(is_float(p.x) && is_float(p.y) && is_float(p.z));
+    }
+    Hierarchy h(mesh);
+    refine_uniformly(h, 2);
+    for (uint32_t v = 0; v < h.positions().size(); ++v) {
+        const Vec3 p = h.position(v);
+        EXPECT_TRUE(is_float(p.x) && is_float(p.y) && is_float(p.z)) << v;
+    }
+}
+
+}  // namespace
+}  // namespace amc

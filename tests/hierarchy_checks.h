@@ -1,0 +1,62 @@
+// Shared fixtures and checks of the hierarchy tests: base meshes of several topologies and the
+// full set of invariants every hierarchy must satisfy.
+#pragma once
+
+#include <amc/hierarchy.h>
+#include <amc/refinement.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace amc::testing {
+
+struct NamedMesh {
+    std::string name;
+    TriangleMesh mesh;
+};
+
+// Closed genus 0, closed genus 1, open (one boundary loop), non-convex open domain.
+inline std::vector<NamedMesh> fixture_meshes() {
+    return {{"icosahedron", make_icosahedron()},
+            {"torus", make_torus(6, 5, 2.0, 0.7)},
+            {"square", make_square(3)},
+            {"l_shape", make_l_shape(1)}};
+}
+
+inline int64_t euler_characteristic(const TriangleMesh& mesh) {
+    std::vector<std::pair<uint32_t, uint32_t>> edges;
+    for (const Triangle& t : mesh.triangles) {
+        for (int e = 0; e < 3; ++e) edges.push_back(std::minmax(t[e], t[(e + 1) % 3]));
+    }
+    std::sort(edges.begin(), edges.end());
+    const int64_t unique_edges = std::unique(edges.begin(), edges.end()) - edges.begin();
+    return int64_t(mesh.positions.size()) - unique_edges + int64_t(mesh.triangles.size());
+}
+
+// Every invariant of the issue: structure (check_invariants: balance, closure, links, shared
+// midpoints, vertex count = base vertices + split edges), a conforming edge-manifold leaf mesh
+// with the base mesh's Euler characteristic, and leaf count consistency.
+inline ::testing::AssertionResult hierarchy_is_valid(const Hierarchy& h) {
+    const std::string problem = check_invariants(h);
+    if (!problem.empty()) return ::testing::AssertionFailure() << problem;
+    const LeafMesh leaf = extract_leaf_mesh(h);
+    try {
+        validate_triangle_mesh(leaf.mesh, "leaf mesh");
+    } catch (const Error& e) {
+        return ::testing::AssertionFailure() << e.what();
+    }
+    if (euler_characteristic(leaf.mesh) != euler_characteristic(h.base()))
+        return ::testing::AssertionFailure() << "Euler characteristic changed";
+    if (leaf.mesh.positions.size() != h.vertex_count())
+        return ::testing::AssertionFailure() << "leaf mesh does not use every vertex";
+    const HierarchyStats stats = compute_stats(h);
+    if (stats.faces != leaf.mesh.triangles.size() || stats.leaves != h.leaf_count())
+        return ::testing::AssertionFailure() << "face or leaf counts disagree";
+    return ::testing::AssertionSuccess();
+}
+
+}  // namespace amc::testing

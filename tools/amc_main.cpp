@@ -1,0 +1,205 @@
+// amc: the command-line tool. Each subcommand is a thin layer over the public API.
+#include <amc/hierarchy.h>
+#include <amc/refinement.h>
+
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+namespace {
+
+using namespace amc;
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+bool has_extension(const std::string& path, const std::string& extension) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return ext == extension;
+}
+
+void print_stats_header() {
+    std::printf("%-22s %7s %9s %9s %6s %9s %9s %9s %8s\n", "model", "base_f", "faces", "nodes", "levels", "red",
+                "green", "vertices", "seconds");
+}
+
+void print_stats_row(const std::string& name, const Hierarchy& h, double seconds) {
+    const HierarchyStats s = compute_stats(h);
+    std::printf("%-22s %7u %9u %9u %6u %9u %9u %9u %8.2f\n", name.c_str(), s.base_triangles, s.faces, s.nodes,
+                s.levels, s.red_faces, s.green_faces, s.vertices, seconds);
+}
+
+// Writes the leaf mesh (or the mesh of one level) in the format named by the extension.
+void write_leaf_mesh(const std::string& path, const Hierarchy& h, int level) {
+    const LeafMesh leaf = extract_leaf_mesh(h, level);
+    write_mesh(path, leaf.mesh, &leaf.cells);
+}
+
+void save(const std::string& path, const Hierarchy& h) {
+    if (has_extension(path, ".amh")) {
+        write_hierarchy(path, h);
+    } else {
+        write_leaf_mesh(path, h, -1);
+    }
+}
+
+RefinementCriterion parse_criterion(const std::string& name) {
+    if (name == "mean") return RefinementCriterion::mean_curvature;
+    if (name == "gauss") return RefinementCriterion::gauss_curvature;
+    if (name == "error") return RefinementCriterion::approximation_error;
+    throw Error("unknown criterion '" + name + "' (mean, gauss, error)");
+}
+
+// The main job on the embedded default: a procedural surface, remeshed adaptively by mean
+// curvature, stored, read back and checked.
+int run_demo(const std::string& out_dir) {
+    std::filesystem::create_directories(out_dir);
+    auto start = std::chrono::steady_clock::now();
+    const TriangleMesh reference = make_bumpy_sphere(6);
+    SurfaceRemeshOptions options;
+    options.base_triangles = 300;
+    options.target_faces = 100000;
+    options.max_level = 7;
+    Hierarchy h = remesh_adaptively(reference, options);
+    const double seconds = seconds_since(start);
+    print_stats_header();
+    print_stats_row("bumpy_sphere_mean", h, seconds);
+
+    const std::string problem = check_invariants(h);
+    if (!problem.empty()) throw Error("demo hierarchy is invalid: " + problem);
+    const std::string amh = out_dir + "/demo.amh", vtu = out_dir + "/demo.vtu";
+    write_hierarchy(amh, h);
+    write_leaf_mesh(vtu, h, -1);
+    const Hierarchy back = read_hierarchy(amh);
+    if (!identical(h, back)) throw Error("demo: hierarchy read back from " + amh + " differs");
+    std::printf("wrote %s (%ju bytes) and %s; read back identical: yes\n", amh.c_str(),
+                uintmax_t(std::filesystem::file_size(amh)), vtu.c_str());
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"amc: lossless compression of adaptive multiresolution meshes"};
+    app.require_subcommand(1);
+
+    std::string out_dir = "amc_demo";
+    auto* demo = app.add_subcommand("demo", "Build, store and check a hierarchy from the embedded procedural model");
+    demo->add_option("--out-dir", out_dir, "Folder for demo.amh and demo.vtu")->capture_default_str();
+
+    std::string input, model = "surface", criterion = "mean", output, leaf_output;
+    uint32_t faces = 150000, base_faces = 500;
+    int max_level = 7, levels = 3, steps = 5;
+    uint64_t seed = 1;
+    auto* refine = app.add_subcommand("refine", "Make an adaptive red-green hierarchy");
+    refine->add_option("--input", input, "Reference surface (OBJ/OFF/PLY) for --model surface");
+    refine->add_option("--model", model, "surface | bumpy | lshape | front | uniform | random")->capture_default_str();
+    refine->add_option("--criterion", criterion, "mean | gauss | error (surface models)")->capture_default_str();
+    refine->add_option("--faces", faces, "Target number of leaves (surface, random)")->capture_default_str();
+    refine->add_option("--base-faces", base_faces, "Size of the simplified base mesh")->capture_default_str();
+    refine->add_option("--max-level", max_level, "Level cap")->capture_default_str();
+    refine->add_option("--levels", levels, "Levels of uniform refinement")->capture_default_str();
+    refine->add_option("--steps", steps, "Time steps of the moving front")->capture_default_str();
+    refine->add_option("--seed", seed, "Seed of random refinement")->capture_default_str();
+    refine->add_option("-o,--output", output, "Hierarchy file (.amh) or leaf mesh (.obj/.off/.ply/.vtu); "
+                                              "for --model front, a prefix: <prefix>_<step>.amh");
+    refine->add_option("--leaf-mesh", leaf_output, "Also write the leaf mesh (.obj/.off/.ply/.vtu)");
+
+    std::string extract_input, extract_output;
+    int extract_level = -1;
+    auto* extract = app.add_subcommand("extract", "Write the leaf mesh, or the mesh of one level, of a hierarchy");
+    extract->add_option("input", extract_input, "Hierarchy file (.amh)")->required();
+    extract->add_option("-o,--output", extract_output, "Mesh file (.obj/.off/.ply/.vtu)")->required();
+    extract->add_option("--level", extract_level, "Cut the hierarchy at this level");
+
+    std::string info_input;
+    auto* info = app.add_subcommand("info", "Describe a mesh (.obj/.off/.ply) or hierarchy (.amh) file");
+    info->add_option("file", info_input, "Input file")->required();
+
+    CLI11_PARSE(app, argc, argv);
+
+    try {
+        if (*demo) return run_demo(out_dir);
+        if (*refine) {
+            auto start = std::chrono::steady_clock::now();
+            std::vector<std::pair<std::string, Hierarchy>> results;
+            if (model == "surface" || model == "bumpy") {
+                TriangleMesh reference;
+                std::string name = model;
+                if (model == "surface") {
+                    if (input.empty()) throw Error("--model surface needs --input MESH");
+                    reference = read_mesh(input);
+                    name = std::filesystem::path(input).stem().string();
+                } else {
+                    reference = make_bumpy_sphere(6);
+                }
+                SurfaceRemeshOptions options;
+                options.criterion = parse_criterion(criterion);
+                options.base_triangles = base_faces;
+                options.target_faces = faces;
+                options.max_level = max_level;
+                results.emplace_back(name + "_" + criterion, remesh_adaptively(reference, options));
+            } else if (model == "lshape") {
+                results.emplace_back("lshape", make_l_shape_model(max_level));
+            } else if (model == "front") {
+                std::vector<Hierarchy> sequence = make_moving_front_sequence(steps, max_level);
+                for (size_t i = 0; i < sequence.size(); ++i)
+                    results.emplace_back("front_" + std::to_string(i), std::move(sequence[i]));
+            } else if (model == "uniform" || model == "random") {
+                Hierarchy h(input.empty() ? make_icosahedron() : read_mesh(input));
+                if (model == "uniform") {
+                    refine_uniformly(h, levels);
+                } else {
+                    refine_randomly(h, faces, max_level, seed);
+                }
+                results.emplace_back(model, std::move(h));
+            } else {
+                throw Error("unknown model '" + model + "'");
+            }
+            const double seconds = seconds_since(start);
+            print_stats_header();
+            for (auto& [name, h] : results) {
+                print_stats_row(name, h, seconds / double(results.size()));
+                std::string target = output;
+                if (!target.empty() && results.size() > 1) target = output + "_" + name.substr(name.rfind('_') + 1) + ".amh";
+                if (!target.empty()) save(target, h);
+                if (!leaf_output.empty() && results.size() == 1) write_leaf_mesh(leaf_output, h, -1);
+            }
+            return 0;
+        }
+        if (*extract) {
+            const Hierarchy h = read_hierarchy(extract_input);
+            if (extract_level > h.depth()) {
+                throw Error(extract_input + ": level " + std::to_string(extract_level) + " requested but the hierarchy has levels 0.." +
+                            std::to_string(h.depth()));
+            }
+            write_leaf_mesh(extract_output, h, extract_level);
+            return 0;
+        }
+        if (*info) {
+            if (has_extension(info_input, ".amh")) {
+                const Hierarchy h = read_hierarchy(info_input);
+                print_stats_header();
+                print_stats_row(std::filesystem::path(info_input).filename().string(), h, 0.0);
+                const HierarchyStats s = compute_stats(h);
+                std::printf("nodes per level:");
+                for (uint32_t n : s.nodes_per_level) std::printf(" %u", n);
+                std::printf("\nleaves closed by one / two hanging nodes: %u / %u\n", s.one_hanging, s.two_hanging);
+            } else {
+                const TriangleMesh mesh = read_mesh(info_input);
+                std::printf("%s: %zu vertices, %zu triangles, %s precision\n", info_input.c_str(), mesh.positions.size(),
+                            mesh.triangles.size(), mesh.single_precision ? "single" : "double");
+            }
+            return 0;
+        }
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "amc: error: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}
