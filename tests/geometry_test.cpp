@@ -282,6 +282,22 @@ TEST(ClosestPointQuery, MatchesBruteForceNearASphere) {
     expect_same_as_brute_force(mesh, queries);
 }
 
+TEST(ClosestPointQuery, MatchesBruteForceBeyondFloatRange) {
+    // Node bounds are floats rounded outward; coordinates beyond float range must still work.
+    for (double scale : {1e-30, 1e60, 1e100}) {
+        TriangleMesh mesh = random_soup(300, 21);
+        for (Vec3& p : mesh.positions) p = scale * p + Vec3{scale, -2 * scale, 0};
+        std::mt19937 rng(22);
+        std::uniform_real_distribution<double> coordinate(-0.5, 1.5);
+        std::vector<Vec3> queries;
+        for (int i = 0; i < 300; ++i) {
+            queries.push_back(scale * Vec3{coordinate(rng), coordinate(rng), coordinate(rng)} +
+                              Vec3{scale, -2 * scale, 0});
+        }
+        expect_same_as_brute_force(mesh, queries);
+    }
+}
+
 TEST(ClosestPointQuery, PointsOnTheSurfaceMapToThemselves) {
     TriangleMesh mesh = icosphere(4, 3.0);
     ClosestPointQuery query(mesh);

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <queue>
 
 namespace amc {
@@ -133,10 +134,21 @@ TriangleMesh simplify_to_base(const TriangleMesh& reference, uint32_t target) {
                                               reference.positions.size(), 3 * sizeof(float), size_t(target) * 3,
                                               1.0f, 0, nullptr);
         simplified.resize(count);
+        // The simplifier can fold a thin part into a "pillow": two triangles on the same three
+        // vertices. Both go; the validation below decides whether what is left is usable.
+        std::map<std::array<unsigned, 3>, int> copies;
+        for (size_t i = 0; i + 2 < simplified.size(); i += 3) {
+            std::array<unsigned, 3> key{simplified[i], simplified[i + 1], simplified[i + 2]};
+            std::sort(key.begin(), key.end());
+            ++copies[key];
+        }
         TriangleMesh base;
         base.single_precision = reference.single_precision;
         std::vector<uint32_t> remap(reference.positions.size(), 0xffffffffu);
         for (size_t i = 0; i + 2 < simplified.size(); i += 3) {
+            std::array<unsigned, 3> key{simplified[i], simplified[i + 1], simplified[i + 2]};
+            std::sort(key.begin(), key.end());
+            if (copies[key] > 1) continue;
             Triangle t;
             for (int k = 0; k < 3; ++k) {
                 uint32_t& id = remap[simplified[i + k]];
