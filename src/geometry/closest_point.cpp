@@ -14,8 +14,8 @@ namespace {
 constexpr uint32_t kLeafSize = 2;
 constexpr uint32_t kEmpty = std::numeric_limits<uint32_t>::max();
 constexpr int kBins = 16;
-// SAH splits may be unbalanced; below this depth only median splits, which halve the count. So
-// the depth is at most kSahDepth + 32, and the traversal stack grows by at most one entry per
+// SAH splits may be unbalanced; from this depth on only median splits, which halve the count.
+// So the depth is at most kSahDepth + 32, and the traversal stack grows by at most one entry per
 // level.
 constexpr uint32_t kSahDepth = 48;
 constexpr int kStackSize = kSahDepth + 34;
@@ -163,7 +163,7 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
         const Vec3& a = positions[triangles[t][0]];
         const Vec3& b = positions[triangles[t][1]];
         const Vec3& c = positions[triangles[t][2]];
-        centroids[t] = (1.0 / 3.0) * (a + b + c);
+        centroids[t] = (1.0 / 3.0) * a + (1.0 / 3.0) * b + (1.0 / 3.0) * c;  // no overflow
     }
     const double margin = 16 * DBL_EPSILON * max_abs;
 
@@ -202,8 +202,9 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
         if (depth < kSahDepth && axis_extent > 0) {
             const double scale = kBins / axis_extent;
             auto bin_of = [&](uint32_t t) {
-                double x = (component(centroids[t], axis) - axis_lo) * scale;
-                return std::min(static_cast<int>(x), kBins - 1);
+                const double x = (component(centroids[t], axis) - axis_lo) * scale;
+                if (!(x >= 0)) return 0;  // also NaN from non-finite input
+                return x < kBins ? static_cast<int>(x) : kBins - 1;
             };
             Bounds bins[kBins];
             uint32_t counts[kBins] = {};

@@ -1,0 +1,58 @@
+// Header of the hierarchy stream (layout in hierarchy_stream.h and docs/FORMAT.md).
+#include "coding/hierarchy_stream.h"
+
+#include <amc/mesh.h>
+
+#include <string>
+
+namespace amc {
+
+std::vector<uint8_t> write_hierarchy_stream_header(const HierarchyStreamHeader& header) {
+    const HierarchyCoderOptions& o = header.options;
+    uint8_t switches = uint8_t(o.cull_one_regularity) | uint8_t(o.cull_hanging_nodes) << 1 |
+                       uint8_t(o.uniform_levels) << 2 | uint8_t(o.truncate_stream) << 3 |
+                       uint8_t(o.use_contexts) << 4 | uint8_t(o.traversal == Traversal::improved) << 5 |
+                       uint8_t(header.orientation_coded) << 6;
+    std::vector<uint8_t> out{switches, header.uniform_levels, uint8_t(header.diagonal_rule)};
+    if (o.truncate_stream) {
+        uint64_t v = header.symbol_count;
+        do {
+            out.push_back(uint8_t((v & 0x7f) | (v > 0x7f ? 0x80 : 0)));
+            v >>= 7;
+        } while (v != 0);
+    }
+    return out;
+}
+
+size_t read_hierarchy_stream_header(const uint8_t* data, size_t size, HierarchyStreamHeader& header) {
+    if (size < 3) throw Error("hierarchy stream: header is truncated");
+    const uint8_t switches = data[0];
+    if (switches & 0x80) throw Error("hierarchy stream: reserved switch bit is set");
+    HierarchyCoderOptions& o = header.options;
+    o.cull_one_regularity = switches & 1;
+    o.cull_hanging_nodes = switches & 2;
+    o.uniform_levels = switches & 4;
+    o.truncate_stream = switches & 8;
+    o.use_contexts = switches & 16;
+    o.traversal = (switches & 32) ? Traversal::improved : Traversal::naive;
+    header.orientation_coded = switches & 64;
+    header.uniform_levels = data[1];
+    if (header.uniform_levels > kMaxUniformLevels || (!o.uniform_levels && header.uniform_levels != 0))
+        throw Error("hierarchy stream: " + std::to_string(header.uniform_levels) + " uniform levels is out of range");
+    if (data[2] >= kDiagonalRuleCount) throw Error("hierarchy stream: unknown diagonal rule " + std::to_string(data[2]));
+    header.diagonal_rule = DiagonalRule(data[2]);
+    size_t used = 3;
+    header.symbol_count = 0;
+    if (o.truncate_stream) {
+        for (int shift = 0;; shift += 7) {
+            if (used >= size) throw Error("hierarchy stream: symbol count is truncated");
+            if (shift > 56) throw Error("hierarchy stream: symbol count is too long");
+            const uint8_t byte = data[used++];
+            header.symbol_count |= uint64_t(byte & 0x7f) << shift;
+            if (!(byte & 0x80)) break;
+        }
+    }
+    return used;
+}
+
+}  // namespace amc

@@ -1,0 +1,294 @@
+// The hierarchy coder: exact round trips under every combination of switches, exhaustive small
+// hierarchies, known answers (uniform meshes cost nothing), entropy bound, corrupt streams.
+#include "hierarchy_checks.h"
+
+#include <amc/hierarchy_coder.h>
+
+#include <cmath>
+
+namespace amc {
+namespace {
+
+struct Random {
+    uint64_t state;
+    uint64_t next() {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return state >> 33;
+    }
+};
+
+HierarchyCoderOptions options_from_bits(int bits) {
+    HierarchyCoderOptions o;
+    o.cull_one_regularity = bits & 1;
+    o.cull_hanging_nodes = bits & 2;
+    o.uniform_levels = bits & 4;
+    o.truncate_stream = bits & 8;
+    o.use_contexts = bits & 16;
+    o.traversal = (bits & 32) ? Traversal::improved : Traversal::naive;
+    return o;
+}
+constexpr int kOptionCombinations = 64;
+
+// Same base, forest and effective diagonals (positions are not part of this stream).
+bool same_connectivity(const Hierarchy& a, const Hierarchy& b) {
+    const std::vector<NodeId> oa = a.breadth_first_order(), ob = b.breadth_first_order();
+    if (oa.size() != ob.size() || a.base().triangles != b.base().triangles) return false;
+    for (size_t i = 0; i < oa.size(); ++i) {
+        if (a.is_leaf(oa[i]) != b.is_leaf(ob[i])) return false;
+        if (a.is_leaf(oa[i]) && a.hanging_node_count(oa[i]) == 2 &&
+            a.diagonal_flipped(oa[i]) != b.diagonal_flipped(ob[i]))
+            return false;
+    }
+    return extract_leaf_mesh(a).mesh.triangles == extract_leaf_mesh(b).mesh.triangles;
+}
+
+::testing::AssertionResult round_trips(const Hierarchy& h, const HierarchyCoderOptions& o) {
+    const std::vector<uint8_t> bytes = encode_hierarchy(h, o);
+    const Hierarchy back = decode_hierarchy(h.base(), bytes.data(), bytes.size());
+    if (!same_connectivity(h, back)) return ::testing::AssertionFailure() << "decoded hierarchy differs";
+    return ::testing::AssertionSuccess();
+}
+
+// Random hierarchies with random diagonals: half follow one of the rules, half are random.
+Hierarchy random_hierarchy(uint64_t seed) {
+    Random random{seed};
+    const auto meshes = testing::fixture_meshes();
+    Hierarchy h(meshes[random.next() % meshes.size()].mesh);
+    const uint32_t leaves = h.root_count() + uint32_t(random.next() % 300);
+    refine_randomly(h, leaves, 1 + int(random.next() % 5), seed, (random.next() % 3) * 0.15);
+    const int mode = int(random.next() % 6);
+    for (NodeId n : h.leaves()) {
+        if (h.hanging_node_count(n) != 2) continue;
+        int u = 0;
+        while (h.has_hanging_node(n, u)) ++u;
+        const bool flag = mode < kDiagonalRuleCount ? diagonal_flag_by_rule(DiagonalRule(mode), u)
+                                                    : bool(random.next() % 2);
+        h.set_diagonal_flipped(n, flag);
+    }
+    return h;
+}
+
+TEST(HierarchyCoder, TenThousandRandomHierarchiesUnderEverySwitchCombination) {
+    uint64_t round_trips_done = 0;
+    for (uint64_t seed = 1; seed <= 10000; ++seed) {
+        const Hierarchy h = random_hierarchy(seed);
+        // Every hierarchy under the full method and one rotating combination; the first 300
+        // under all 64 combinations.
+        ASSERT_TRUE(round_trips(h, {})) << "seed " << seed;
+        ASSERT_TRUE(round_trips(h, options_from_bits(int(seed % kOptionCombinations)))) << "seed " << seed;
+        round_trips_done += 2;
+        if (seed <= 300) {
+            for (int bits = 0; bits < kOptionCombinations; ++bits) {
+                ASSERT_TRUE(round_trips(h, options_from_bits(bits))) << "seed " << seed << " switches " << bits;
+                ++round_trips_done;
+            }
+        }
+    }
+    EXPECT_EQ(round_trips_done, 20000u + 300u * 64u);
+}
+
+// Every balanced, closed hierarchy of one triangle up to depth 3 and of two triangles up to
+// depth 2, found by deciding every node breadth-first (each choice replayed on a fresh copy).
+void enumerate(const Hierarchy& h, std::vector<NodeId> level, size_t index, int depth_left,
+               std::vector<Hierarchy>& out) {
+    if (index == level.size()) {
+        for (NodeId n : level) {
+            if (h.is_leaf(n) && h.hanging_node_count(n) == 3) return;  // closure violated
+        }
+        std::vector<NodeId> next;
+        for (NodeId n : level) {
+            if (!h.is_leaf(n)) {
+                for (int k = 0; k < 4; ++k) next.push_back(h.child(n, k));
+            }
+        }
+        if (next.empty() || depth_left == 0) {
+            if (depth_left == 0 && !next.empty()) return;
+            out.push_back(h);
+            return;
+        }
+        enumerate(h, next, 0, depth_left - 1, out);
+        return;
+    }
+    enumerate(h, level, index + 1, depth_left, out);  // leave level[index] a leaf
+    if (depth_left > 0 && h.can_split(level[index])) {
+        Hierarchy refined = h;
+        refined.split(level[index]);
+        enumerate(refined, level, index + 1, depth_left, out);
+    }
+}
+
+TEST(HierarchyCoder, ExhaustiveSmallHierarchies) {
+    TriangleMesh triangle;
+    triangle.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    triangle.triangles = {{0, 1, 2}};
+    TriangleMesh square = make_square(1);
+    std::vector<Hierarchy> all;
+    enumerate(Hierarchy(triangle), {0}, 0, 3, all);
+    const size_t triangle_count = all.size();
+    enumerate(Hierarchy(square), {0, 1}, 0, 2, all);
+    EXPECT_GT(triangle_count, 100u);
+    EXPECT_GT(all.size() - triangle_count, 100u);
+    for (size_t index = 0; index < all.size(); ++index) {
+        const Hierarchy& h = all[index];
+        ASSERT_EQ(check_invariants(h), "");
+        // With every diagonal choice of its two-hanging-node leaves (up to 2^3 of them), and once under a
+        // rotating switch combination.
+        std::vector<NodeId> two;
+        for (NodeId n : h.leaves()) {
+            if (h.hanging_node_count(n) == 2) two.push_back(n);
+        }
+        const uint32_t choices = two.size() > 3 ? 8 : 1u << two.size();
+        for (uint32_t c = 0; c < choices; ++c) {
+            Hierarchy variant = h;
+            for (size_t i = 0; i < two.size(); ++i) variant.set_diagonal_flipped(two[i], (c >> (i % 3)) & 1);
+            ASSERT_TRUE(round_trips(variant, options_from_bits(63)));
+        }
+        ASSERT_TRUE(round_trips(h, options_from_bits(int(index % kOptionCombinations))));
+    }
+    std::printf("exhaustive: %zu hierarchies of a triangle (depth <= 3), %zu of a square (depth <= 2)\n",
+                triangle_count, all.size() - triangle_count);
+}
+
+TEST(HierarchyCoder, UniformMeshCodesNoSymbol) {
+    for (const auto& [name, mesh] : testing::fixture_meshes()) {
+        for (int levels = 0; levels <= 4; ++levels) {
+            Hierarchy h(mesh);
+            refine_uniformly(h, levels);
+            HierarchyCodeStats stats;
+            const std::vector<uint8_t> bytes = encode_hierarchy(h, {}, &stats);
+            EXPECT_EQ(stats.coded, 0u) << name;
+            EXPECT_EQ(stats.uniform_levels, levels) << name;
+            EXPECT_EQ(stats.payload_bytes, 0u) << name;
+            EXPECT_EQ(bytes.size(), 4u) << name << ": switches, U, rule, symbol count 0";
+            const Hierarchy back = decode_hierarchy(h.base(), bytes.data(), bytes.size());
+            EXPECT_TRUE(identical(h, back)) << name;
+        }
+    }
+}
+
+TEST(HierarchyCoder, SymbolAccountingAddsUp) {
+    for (uint64_t seed = 1; seed <= 50; ++seed) {
+        const Hierarchy h = random_hierarchy(seed);
+        HierarchyCodeStats s;
+        encode_hierarchy(h, {}, &s);
+        EXPECT_EQ(s.nodes, h.node_count());
+        EXPECT_EQ(s.culled_uniform + s.culled_one_regularity + s.culled_hanging_nodes + s.truncated + s.coded, s.nodes);
+        uint64_t grouped = 0;
+        for (const ContextGroupStats& g : s.groups) grouped += g.symbols;
+        EXPECT_EQ(grouped, s.coded);
+        EXPECT_EQ(s.groups[context_group_index(3, 0, 0)].symbols, 0u) << "(3,0,0) is always culled";
+    }
+}
+
+TEST(HierarchyCoder, DiagonalsOfAnyLocalIndexRuleAreFree) {
+    Hierarchy h(make_torus(6, 5, 2.0, 0.7));
+    refine_randomly(h, 3000, 5, 17);
+    for (int rule = 0; rule < kDiagonalRuleCount; ++rule) {
+        for (NodeId n : h.leaves()) {
+            if (h.hanging_node_count(n) != 2) continue;
+            int u = 0;
+            while (h.has_hanging_node(n, u)) ++u;
+            h.set_diagonal_flipped(n, diagonal_flag_by_rule(DiagonalRule(rule), u));
+        }
+        HierarchyCodeStats s;
+        const std::vector<uint8_t> bytes = encode_hierarchy(h, {}, &s);
+        EXPECT_GT(s.two_hanging_leaves, 50u);
+        EXPECT_EQ(s.diagonal_exceptions, 0u) << "rule " << rule;
+        EXPECT_FALSE(s.orientation_coded);
+        EXPECT_EQ(s.orientation_bits, 0.0);
+        const Hierarchy back = decode_hierarchy(h.base(), bytes.data(), bytes.size());
+        EXPECT_TRUE(same_connectivity(h, back));
+    }
+    // One exception: orientation bits are coded, with their own model, and cost little.
+    NodeId exception = kNoNode;
+    for (NodeId n : h.leaves()) {
+        if (h.hanging_node_count(n) == 2) exception = n;
+    }
+    h.set_diagonal_flipped(exception, !h.diagonal_flipped(exception));
+    HierarchyCodeStats s;
+    const std::vector<uint8_t> bytes = encode_hierarchy(h, {}, &s);
+    EXPECT_EQ(s.diagonal_exceptions, 1u);
+    EXPECT_TRUE(s.orientation_coded);
+    EXPECT_LT(s.orientation_bits, 40.0);
+    EXPECT_TRUE(same_connectivity(h, decode_hierarchy(h.base(), bytes.data(), bytes.size())));
+}
+
+TEST(HierarchyCoder, CodeSizeApproachesConditionalEntropy) {
+    Hierarchy h(make_bumpy_sphere(0));
+    refine_randomly(h, 200000, 8, 5);
+    HierarchyCodeStats s;
+    const std::vector<uint8_t> bytes = encode_hierarchy(h, {}, &s);
+    const double bound_bytes = s.conditional_entropy_bits / 8 + s.header_bytes;
+    EXPECT_LT(double(bytes.size()), 1.01 * bound_bytes) << "within 1% of H(X|context) plus header";
+    EXPECT_NEAR(double(s.payload_bytes) * 8, s.adaptive_code_bits, 0.005 * s.adaptive_code_bits + 64);
+}
+
+TEST(HierarchyCoder, ContextsAndImprovedTraversalPayOff) {
+    const Hierarchy h = make_l_shape_model(9);
+    HierarchyCodeStats full, no_context, naive;
+    HierarchyCoderOptions o;
+    encode_hierarchy(h, o, &full);
+    o.use_contexts = false;
+    encode_hierarchy(h, o, &no_context);
+    o.use_contexts = true;
+    o.traversal = Traversal::naive;
+    encode_hierarchy(h, o, &naive);
+    EXPECT_LT(full.payload_bytes, no_context.payload_bytes);
+    EXPECT_LT(full.payload_bytes, naive.payload_bytes);
+    EXPECT_LE(full.groups[context_group_index(0, 0, 3)].symbols, 4u) << "one start per connected region";
+}
+
+TEST(HierarchyCoder, ProgressiveDecodingStopsAfterAnyLevel) {
+    Hierarchy h(make_icosahedron());
+    refine_randomly(h, 20000, 7, 23);
+    const std::vector<uint8_t> bytes = encode_hierarchy(h);
+    for (int level = 0; level <= h.depth(); ++level) {
+        HierarchyDecodeOptions options;
+        options.max_level = level;
+        const Hierarchy part = decode_hierarchy(h.base(), bytes.data(), bytes.size(), options);
+        EXPECT_LE(part.depth(), level);
+        EXPECT_EQ(extract_leaf_mesh(part).mesh.triangles, extract_leaf_mesh(h, level).mesh.triangles) << level;
+    }
+}
+
+TEST(HierarchyCoder, EveryTruncationAndRandomCorruptionIsSafe) {
+    Hierarchy h(make_torus(6, 5, 2.0, 0.7));
+    refine_randomly(h, 2000, 6, 31);
+    const std::vector<uint8_t> bytes = encode_hierarchy(h);
+    HierarchyDecodeOptions options;
+    options.max_nodes = 1u << 20;
+    uint64_t errors = 0, valid = 0;
+    for (size_t length = 0; length < bytes.size(); ++length) {
+        try {
+            const Hierarchy back = decode_hierarchy(h.base(), bytes.data(), length, options);
+            EXPECT_EQ(check_invariants(back), "");
+            ++valid;
+        } catch (const Error&) {
+            ++errors;
+        }
+    }
+    Random random{99};
+    for (int trial = 0; trial < 5000; ++trial) {
+        std::vector<uint8_t> corrupt = bytes;
+        const int flips = 1 + int(random.next() % 4);
+        for (int f = 0; f < flips; ++f) corrupt[random.next() % corrupt.size()] ^= uint8_t(1u << (random.next() % 8));
+        try {
+            const Hierarchy back = decode_hierarchy(h.base(), corrupt.data(), corrupt.size(), options);
+            EXPECT_EQ(check_invariants(back), "");
+            ++valid;
+        } catch (const Error&) {
+            ++errors;
+        }
+    }
+    EXPECT_GT(errors, bytes.size() / 2) << "most truncations are detected";
+}
+
+TEST(HierarchyCoder, HugeUniformLevelCountIsRefused) {
+    Hierarchy h(make_icosahedron());
+    std::vector<uint8_t> bytes = encode_hierarchy(h);
+    bytes[1] = 19;  // 20 * 4^19 nodes
+    EXPECT_THROW(decode_hierarchy(h.base(), bytes.data(), bytes.size()), Error);
+}
+
+}  // namespace
+}  // namespace amc
