@@ -2,6 +2,8 @@
 #include <amc/hierarchy.h>
 #include <amc/refinement.h>
 
+#include "stats_report.h"
+
 #include <CLI/CLI.hpp>
 
 #include <chrono>
@@ -121,6 +123,12 @@ int main(int argc, char** argv) {
     auto* info = app.add_subcommand("info", "Describe a mesh (.obj/.off/.ply) or hierarchy (.amh) file");
     info->add_option("file", info_input, "Input file")->required();
 
+    std::vector<std::string> stats_inputs;
+    bool stats_groups = false;
+    auto* stats = app.add_subcommand("stats", "Hierarchy coder statistics: the paper's Tables 1 and 2");
+    stats->add_option("files", stats_inputs, "Hierarchy files (.amh)")->required();
+    stats->add_flag("--groups", stats_groups, "Also print the context groups (Table 2) of each file");
+
     CLI11_PARSE(app, argc, argv);
 
     try {
@@ -179,6 +187,19 @@ int main(int argc, char** argv) {
                             std::to_string(h.depth()));
             }
             write_leaf_mesh(extract_output, h, extract_level);
+            return 0;
+        }
+        if (*stats) {
+            print_table1_header();
+            for (const std::string& file : stats_inputs) {
+                print_table1_row(std::filesystem::path(file).stem().string(), read_hierarchy(file));
+            }
+            if (stats_groups) {
+                for (const std::string& file : stats_inputs) {
+                    std::printf("\n");
+                    print_table2(std::filesystem::path(file).stem().string(), read_hierarchy(file));
+                }
+            }
             return 0;
         }
         if (*info) {

@@ -60,11 +60,20 @@ public:
         NodeId q = nodes_[n].nbr[e];
         return q != kNoNode && nodes_[q].first_child != kNoNode;
     }
-    int hanging_node_count(NodeId n) const;
+    int hanging_node_count(NodeId n) const {
+        return int(has_hanging_node(n, 0)) + int(has_hanging_node(n, 1)) + int(has_hanging_node(n, 2));
+    }
     // Every non-boundary edge has a same-level neighbour: what balance asks of a refined node.
-    bool has_all_neighbors(NodeId n) const;
+    bool has_all_neighbors(NodeId n) const {
+        const Node& node = nodes_[n];
+        // An edge without neighbour must be a boundary edge (flag bits 0-2).
+        return ((node.nbr[0] != kNoNode) | (node.flags & 1)) & ((node.nbr[1] != kNoNode) | ((node.flags >> 1) & 1)) &
+               ((node.nbr[2] != kNoNode) | ((node.flags >> 2) & 1));
+    }
     // A leaf may be split without breaking balance (has_all_neighbors) and below the level cap.
-    bool can_split(NodeId n) const;
+    bool can_split(NodeId n) const {
+        return is_leaf(n) && nodes_[n].level < kMaxLevel && has_all_neighbors(n);
+    }
     // Midpoint vertex of edge e of a refined node.
     VertexId midpoint(NodeId n, int e) const { return nodes_[child(n, 3)].v[(e + 2) % 3]; }
 

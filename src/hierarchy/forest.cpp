@@ -70,21 +70,6 @@ void Hierarchy::set_vertex_placer(VertexPlacer placer, void* context) {
     placer_context_ = context;
 }
 
-int Hierarchy::hanging_node_count(NodeId n) const {
-    return int(has_hanging_node(n, 0)) + int(has_hanging_node(n, 1)) + int(has_hanging_node(n, 2));
-}
-
-bool Hierarchy::has_all_neighbors(NodeId n) const {
-    for (int e = 0; e < 3; ++e) {
-        if (nodes_[n].nbr[e] == kNoNode && !is_boundary_edge(n, e)) return false;
-    }
-    return true;
-}
-
-bool Hierarchy::can_split(NodeId n) const {
-    return is_leaf(n) && nodes_[n].level < kMaxLevel && has_all_neighbors(n);
-}
-
 void Hierarchy::set_diagonal_flipped(NodeId n, bool flipped) {
     nodes_[n].flags = uint8_t((nodes_[n].flags & ~8u) | (flipped ? 8u : 0u));
 }

@@ -1,0 +1,15 @@
+// `amc stats`: the paper's Table 1 (removal of redundant symbols, code size with and without
+// contexts) and Table 2 (context groups under naive and improved traversal) for hierarchies.
+#pragma once
+
+#include <amc/hierarchy.h>
+
+#include <string>
+
+namespace amc {
+
+void print_table1_header();
+void print_table1_row(const std::string& name, const Hierarchy& h);
+void print_table2(const std::string& name, const Hierarchy& h);
+
+}  // namespace amc
