@@ -178,6 +178,14 @@ LeafMesh extract_leaf_mesh(const Hierarchy& h, int max_level = -1);
 // shared midpoints, counts) and returns a description of the first violation, or "" if valid.
 std::string check_invariants(const Hierarchy& h);
 
+// ---- base order ------------------------------------------------------------------------------
+
+// The same hierarchy over the base mesh reordered: new vertex i is old vertex vertex_order[i];
+// new triangle t is old triangle triangle_order[t] with its vertices rotated by rotation[t]
+// (new local vertex i = old local vertex (i + rotation[t]) % 3). Throws Error on bad orders.
+Hierarchy reorder_base(const Hierarchy& h, const std::vector<uint32_t>& vertex_order,
+                       const std::vector<uint32_t>& triangle_order, const std::vector<uint8_t>& rotation);
+
 // ---- the hierarchy file (.amh, docs/HIERARCHY.md) -------------------------------------------
 
 std::string serialize_hierarchy(const Hierarchy& h);
