@@ -1,0 +1,327 @@
+// Residual coding of coordinates (Lindstrom & Isenburg 2006) and the uniform quantizer; see
+// float_coder.h for the bitstream.
+#include "coding/float_coder.h"
+
+#include <cfloat>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+
+namespace amc {
+
+namespace {
+
+constexpr uint64_t kSign64 = uint64_t{1} << 63;
+constexpr uint32_t kSign32 = uint32_t{1} << 31;
+
+int width_bits(Precision precision) { return precision == Precision::float32 ? 32 : 64; }
+uint64_t width_mask(Precision precision) {
+    return precision == Precision::float32 ? 0xFFFFFFFFull : ~uint64_t{0};
+}
+// Levels of the bit-length tree: enough for k = 0 .. width.
+int tree_depth(Precision precision) { return precision == Precision::float32 ? 6 : 7; }
+constexpr int kQuantizedTreeDepth = 5;  // k = 0 .. 30 < 32
+
+int bit_length(uint64_t m) {
+    int k = 0;
+    while (m != 0) {
+        ++k;
+        m >>= 1;
+    }
+    return k;
+}
+
+double finite_or_zero(double x) { return std::isfinite(x) ? x : 0.0; }
+
+// A residual as sign and magnitude; magnitude has at most kMaxLength bits.
+void encode_residual(ArithmeticEncoder& encoder, FloatResidualModels::Context& ctx, int depth,
+                     bool negative, uint64_t magnitude) {
+    const int k = bit_length(magnitude);
+    int node = 1;
+    for (int i = depth - 1; i >= 0; --i) {
+        const int bit = (k >> i) & 1;
+        encoder.encode(bit != 0, ctx.length[node]);
+        node = 2 * node + bit;
+    }
+    if (k == 0) return;
+    encoder.encode(negative, ctx.sign);
+    int remaining = k - 1;  // bits below the leading one
+    if (remaining > 0) {
+        const bool first = (magnitude >> (remaining - 1)) & 1;
+        encoder.encode(first, ctx.high[k][0]);
+        --remaining;
+        if (remaining > 0) {
+            const bool second = (magnitude >> (remaining - 1)) & 1;
+            encoder.encode(second, ctx.high[k][1 + int(first)]);
+            --remaining;
+        }
+    }
+    while (remaining > 0) {
+        const int chunk = remaining > 32 ? remaining - 32 : remaining;  // high chunk first
+        remaining -= chunk;
+        encoder.encode_bits_raw(static_cast<uint32_t>(magnitude >> remaining) &
+                                    static_cast<uint32_t>((uint64_t{1} << chunk) - 1),
+                                chunk);
+    }
+}
+
+// Decodes sign and magnitude; k is clamped to max_length (marking the stream invalid).
+void decode_residual(ArithmeticDecoder& decoder, FloatResidualModels& models,
+                     FloatResidualModels::Context& ctx, int depth, int max_length,
+                     bool& negative, uint64_t& magnitude) {
+    int node = 1;
+    for (int i = 0; i < depth; ++i) node = 2 * node + int(decoder.decode(ctx.length[node]));
+    int k = node - (1 << depth);
+    negative = false;
+    magnitude = 0;
+    if (k > max_length) {
+        models.mark_invalid();
+        k = max_length;
+    }
+    if (k == 0) return;
+    negative = decoder.decode(ctx.sign);
+    magnitude = 1;
+    int remaining = k - 1;
+    if (remaining > 0) {
+        const bool first = decoder.decode(ctx.high[k][0]);
+        magnitude = (magnitude << 1) | uint64_t(first);
+        --remaining;
+        if (remaining > 0) {
+            const bool second = decoder.decode(ctx.high[k][1 + int(first)]);
+            magnitude = (magnitude << 1) | uint64_t(second);
+            --remaining;
+        }
+    }
+    while (remaining > 0) {
+        const int chunk = remaining > 32 ? remaining - 32 : remaining;
+        remaining -= chunk;
+        magnitude = (magnitude << chunk) | decoder.decode_bits_raw(chunk);
+    }
+}
+
+void check_bits(int bits, const char* where) {
+    if (bits < kMinQuantizationBits || bits > kMaxQuantizationBits) {
+        throw Error(std::string(where) + ": quantization bits " + std::to_string(bits) +
+                    " outside [1, 30]");
+    }
+}
+
+double axis_value(Vec3 p, int axis) { return axis == 0 ? p.x : axis == 1 ? p.y : p.z; }
+
+}  // namespace
+
+// ---- the monotone map ------------------------------------------------------------------------
+
+uint64_t ordered_bits(double x, Precision precision) {
+    if (precision == Precision::float32) {
+        const float f = static_cast<float>(x);
+        uint32_t b;
+        std::memcpy(&b, &f, sizeof b);
+        return (b & kSign32) ? uint32_t(~b) : (b | kSign32);
+    }
+    uint64_t b;
+    std::memcpy(&b, &x, sizeof b);
+    return (b & kSign64) ? ~b : (b | kSign64);
+}
+
+double from_ordered_bits(uint64_t u, Precision precision) {
+    if (precision == Precision::float32) {
+        const uint32_t v = static_cast<uint32_t>(u);
+        const uint32_t b = (v & kSign32) ? (v & ~kSign32) : ~v;
+        float f;
+        std::memcpy(&f, &b, sizeof f);
+        return static_cast<double>(f);
+    }
+    const uint64_t b = (u & kSign64) ? (u & ~kSign64) : ~u;
+    double x;
+    std::memcpy(&x, &b, sizeof x);
+    return x;
+}
+
+double coder_prediction(double predicted, Precision precision) {
+    double p = finite_or_zero(predicted);
+    if (precision == Precision::float32) {
+        if (p > FLT_MAX) p = FLT_MAX;
+        if (p < -FLT_MAX) p = -FLT_MAX;
+        p = static_cast<double>(static_cast<float>(p));
+    }
+    return p;
+}
+
+// ---- models -----------------------------------------------------------------------------------
+
+FloatResidualModels::FloatResidualModels(int contexts) {
+    if (contexts < 1) {
+        throw Error("FloatResidualModels: context count " + std::to_string(contexts) + " < 1");
+    }
+    contexts_.resize(static_cast<size_t>(contexts));
+}
+
+FloatResidualModels::Context& FloatResidualModels::context(int c) {
+    if (c < 0 || c >= context_count()) {
+        throw Error("FloatResidualModels: context " + std::to_string(c) + " outside [0, " +
+                    std::to_string(context_count()) + ")");
+    }
+    return contexts_[static_cast<size_t>(c)];
+}
+
+// ---- floating-point residuals -------------------------------------------------------------------
+
+void encode_coordinate(ArithmeticEncoder& encoder, FloatResidualModels& models, int context,
+                       Precision precision, double actual, double predicted) {
+    FloatResidualModels::Context& ctx = models.context(context);
+    if (precision == Precision::float32 && !std::isnan(actual)) {
+        const bool in_range = !std::isfinite(actual) || std::fabs(actual) <= FLT_MAX;
+        if (!in_range || static_cast<double>(static_cast<float>(actual)) != actual ||
+            std::signbit(static_cast<float>(actual)) != std::signbit(actual)) {
+            throw Error("encode_coordinate: " + std::to_string(actual) +
+                        " is not a single precision value");
+        }
+    }
+    const uint64_t mask = width_mask(precision);
+    const uint64_t a = ordered_bits(actual, precision);
+    const uint64_t p = ordered_bits(coder_prediction(predicted, precision), precision);
+    const uint64_t r = (a - p) & mask;
+    const uint64_t top = uint64_t{1} << (width_bits(precision) - 1);
+    const bool negative = (r & top) != 0;
+    const uint64_t magnitude = negative ? ((uint64_t{0} - r) & mask) : r;
+    encode_residual(encoder, ctx, tree_depth(precision), negative, magnitude);
+}
+
+double decode_coordinate(ArithmeticDecoder& decoder, FloatResidualModels& models, int context,
+                         Precision precision, double predicted) {
+    FloatResidualModels::Context& ctx = models.context(context);
+    bool negative;
+    uint64_t magnitude;
+    decode_residual(decoder, models, ctx, tree_depth(precision), width_bits(precision), negative,
+                    magnitude);
+    const uint64_t mask = width_mask(precision);
+    const uint64_t p = ordered_bits(coder_prediction(predicted, precision), precision);
+    const uint64_t a = (negative ? p - magnitude : p + magnitude) & mask;
+    return from_ordered_bits(a, precision);
+}
+
+void encode_position(ArithmeticEncoder& encoder, FloatResidualModels& models, int first_context,
+                     Precision precision, Vec3 actual, Vec3 predicted) {
+    encode_coordinate(encoder, models, first_context + 0, precision, actual.x, predicted.x);
+    encode_coordinate(encoder, models, first_context + 1, precision, actual.y, predicted.y);
+    encode_coordinate(encoder, models, first_context + 2, precision, actual.z, predicted.z);
+}
+
+Vec3 decode_position(ArithmeticDecoder& decoder, FloatResidualModels& models, int first_context,
+                     Precision precision, Vec3 predicted) {
+    Vec3 p;
+    p.x = decode_coordinate(decoder, models, first_context + 0, precision, predicted.x);
+    p.y = decode_coordinate(decoder, models, first_context + 1, precision, predicted.y);
+    p.z = decode_coordinate(decoder, models, first_context + 2, precision, predicted.z);
+    return p;
+}
+
+// ---- quantized mode ---------------------------------------------------------------------------
+
+Quantizer make_quantizer(Vec3 box_min, Vec3 box_max, int bits) {
+    check_bits(bits, "make_quantizer");
+    double extent = 0.0;
+    for (int axis = 0; axis < 3; ++axis) {
+        const double lo = axis_value(box_min, axis), hi = axis_value(box_max, axis);
+        if (!std::isfinite(lo) || !std::isfinite(hi) || !(lo <= hi)) {
+            throw Error("make_quantizer: invalid bounding box");
+        }
+        const double e = hi - lo;
+        if (!std::isfinite(e)) throw Error("make_quantizer: bounding box extent overflows");
+        if (e > extent) extent = e;
+    }
+    Quantizer q;
+    q.origin = box_min;
+    q.bits = bits;
+    q.step = extent > 0.0 ? extent / static_cast<double>(q.max_coordinate()) : 1.0;
+    if (q.step == 0.0) q.step = std::numeric_limits<double>::denorm_min();
+    return q;
+}
+
+Quantizer make_quantizer(const std::vector<Vec3>& points, int bits) {
+    if (points.empty()) throw Error("make_quantizer: no points");
+    Vec3 lo = points[0], hi = points[0];
+    for (const Vec3& p : points) {
+        lo = {std::fmin(lo.x, p.x), std::fmin(lo.y, p.y), std::fmin(lo.z, p.z)};
+        hi = {std::fmax(hi.x, p.x), std::fmax(hi.y, p.y), std::fmax(hi.z, p.z)};
+    }
+    return make_quantizer(lo, hi, bits);
+}
+
+uint32_t quantize_coordinate(const Quantizer& quantizer, int axis, double x) {
+    const double t = (x - axis_value(quantizer.origin, axis)) / quantizer.step;
+    const double top = static_cast<double>(quantizer.max_coordinate());
+    if (!(t > 0.0)) return 0;  // also NaN
+    if (t >= top) return quantizer.max_coordinate();
+    return static_cast<uint32_t>(std::floor(t + 0.5));
+}
+
+GridPoint quantize(const Quantizer& quantizer, Vec3 p) {
+    return {quantize_coordinate(quantizer, 0, p.x), quantize_coordinate(quantizer, 1, p.y),
+            quantize_coordinate(quantizer, 2, p.z)};
+}
+
+double dequantize_coordinate(const Quantizer& quantizer, int axis, uint32_t q) {
+    return axis_value(quantizer.origin, axis) + static_cast<double>(q) * quantizer.step;
+}
+
+Vec3 dequantize(const Quantizer& quantizer, GridPoint q) {
+    return {dequantize_coordinate(quantizer, 0, q[0]), dequantize_coordinate(quantizer, 1, q[1]),
+            dequantize_coordinate(quantizer, 2, q[2])};
+}
+
+double quantization_error_bound(const Quantizer& quantizer) {
+    // (x - o) / step, the rounding, q * step and o + q * step each round once: a few ulps of the
+    // largest magnitude involved.
+    const Vec3 o = quantizer.origin;
+    const double magnitude = std::fmax(std::fabs(o.x), std::fmax(std::fabs(o.y), std::fabs(o.z))) +
+                             static_cast<double>(quantizer.max_coordinate() + 1.0) * quantizer.step;
+    return 0.5 * quantizer.step + 4.0 * DBL_EPSILON * magnitude;
+}
+
+double max_quantization_error(const Quantizer& quantizer, const std::vector<Vec3>& points) {
+    double worst = 0.0;
+    for (const Vec3& p : points) {
+        const Vec3 r = dequantize(quantizer, quantize(quantizer, p));
+        worst = std::fmax(worst, std::fabs(r.x - p.x));
+        worst = std::fmax(worst, std::fabs(r.y - p.y));
+        worst = std::fmax(worst, std::fabs(r.z - p.z));
+    }
+    return worst;
+}
+
+void encode_quantized(ArithmeticEncoder& encoder, FloatResidualModels& models, int context,
+                      int bits, uint32_t actual, uint32_t predicted) {
+    check_bits(bits, "encode_quantized");
+    FloatResidualModels::Context& ctx = models.context(context);
+    const uint32_t top = (uint32_t{1} << bits) - 1;
+    if (actual > top || predicted > top) {
+        throw Error("encode_quantized: grid coordinate outside [0, 2^" + std::to_string(bits) +
+                    ")");
+    }
+    const bool negative = actual < predicted;
+    const uint64_t magnitude = negative ? predicted - actual : actual - predicted;
+    encode_residual(encoder, ctx, kQuantizedTreeDepth, negative, magnitude);
+}
+
+uint32_t decode_quantized(ArithmeticDecoder& decoder, FloatResidualModels& models, int context,
+                          int bits, uint32_t predicted) {
+    check_bits(bits, "decode_quantized");
+    FloatResidualModels::Context& ctx = models.context(context);
+    const uint32_t top = (uint32_t{1} << bits) - 1;
+    if (predicted > top) predicted = top;
+    bool negative;
+    uint64_t magnitude;
+    decode_residual(decoder, models, ctx, kQuantizedTreeDepth, bits, negative, magnitude);
+    const int64_t value = negative ? int64_t(predicted) - int64_t(magnitude)
+                                   : int64_t(predicted) + int64_t(magnitude);
+    if (value < 0 || value > int64_t(top)) {
+        models.mark_invalid();
+        return value < 0 ? 0 : top;
+    }
+    return static_cast<uint32_t>(value);
+}
+
+}  // namespace amc

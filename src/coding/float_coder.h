@@ -1,0 +1,140 @@
+// Lossless coding of coordinates against a prediction (paper III, "data quantization": Isenburg's
+// fast floating-point compression, P. Lindstrom and M. Isenburg, "Fast and efficient compression
+// of floating-point data", TVCG 2006), and a uniform quantizer for the lossy-by-choice mode.
+//
+// Floating-point residuals. The IEEE bits of the actual value A and of the prediction P are mapped
+// to unsigned integers that order like the numbers themselves (ordered_bits: negative values have
+// all bits inverted, non-negative values get the sign bit set; -0.0 maps just below +0.0). The
+// residual r = map(A) - map(P) is taken modulo 2^N (N = 32 for float32, 64 for float64) and read as
+// an N-bit two's complement number, so every A is reachable from every P. It is coded as
+//   1. k = bit length of |r| (0 .. 32 resp. 64): a binary tree of adaptive BitModels over k
+//      (6 resp. 7 levels, most significant bit first), one tree per context;
+//   2. if k > 0 the sign of r (1 = negative), one BitModel per context;
+//   3. the k - 1 bits of |r| below its leading one: the top kModelledBits of them with adaptive
+//      models per context and k (a two-level binary tree), the rest as raw bits, most
+//      significant first, in chunks of at most 32.
+// The decoder adds the residual to map(P) modulo 2^N and maps back: the value is bit-identical
+// (signed zeros, denormals, any finite magnitude). Infinities and NaNs are outside the contract
+// (inputs are validated finite) but neither side crashes on them.
+//
+// Predictions are first made canonical (coder_prediction): a non-finite prediction becomes 0;
+// in float32 the prediction is clamped to the float range and rounded to float, so encoder and
+// decoder agree on it whatever the prediction's low bits were.
+//
+// Quantized residuals use the same three steps on the integer difference q - q_pred of grid
+// coordinates (k = 0 .. bits, 5-level tree).
+//
+// Contexts are chosen by the caller (for example 3 * level_class + axis): each context owns its
+// own statistics. The symbol layout above is part of any format that uses it: describe it in
+// docs/FORMAT.md and pin it with golden bytes before changing it.
+#pragma once
+
+#include "coding/arithmetic_coder.h"
+
+#include <amc/mesh.h>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace amc {
+
+// Written to streams: values are frozen.
+enum class Precision : uint8_t { float32 = 0, float64 = 1 };
+
+// Monotone map of the IEEE bits of x to an unsigned integer (N significant bits). For float32, x
+// must be a float value (it is converted to float; callers pass exactly representable values).
+uint64_t ordered_bits(double x, Precision precision);
+// Inverse of ordered_bits (u is taken modulo 2^N).
+double from_ordered_bits(uint64_t u, Precision precision);
+// The prediction both coder sides actually use: non-finite -> 0; float32: clamped to
+// [-FLT_MAX, FLT_MAX] and rounded to float.
+double coder_prediction(double predicted, Precision precision);
+
+// Adaptive models for `contexts` independent contexts.
+class FloatResidualModels {
+public:
+    static constexpr int kLengthTreeSize = 128;  // nodes 1..127 of a 7-level tree
+    static constexpr int kMaxLength = 64;        // largest bit length of a residual
+    static constexpr int kModelledBits = 2;      // bits below the leading one with models
+
+    struct Context {
+        std::array<BitModel, kLengthTreeSize> length{};
+        BitModel sign{};
+        // Per bit length k: [0] first bit below the leading one, [1 + first] the second.
+        std::array<std::array<BitModel, 3>, kMaxLength + 1> high{};
+    };
+
+    // contexts >= 1; throws Error otherwise.
+    explicit FloatResidualModels(int contexts);
+
+    int context_count() const { return static_cast<int>(contexts_.size()); }
+    // Throws Error for a context outside [0, context_count()).
+    Context& context(int c);
+
+    // Set by the decoding functions when they met a symbol an encoder cannot produce (a bit
+    // length too large for the precision, a grid coordinate out of range): the stream is
+    // corrupt. Decoding continues with clamped values; check this (and overran()) afterwards.
+    bool saw_invalid_symbol() const { return invalid_; }
+    void mark_invalid() { invalid_ = true; }
+
+private:
+    std::vector<Context> contexts_;
+    bool invalid_ = false;
+};
+
+// Codes `actual` given `predicted`. In float32, actual must be exactly representable as float
+// (throws Error otherwise); the decoded value is then double(float) of the same bits.
+void encode_coordinate(ArithmeticEncoder& encoder, FloatResidualModels& models, int context,
+                       Precision precision, double actual, double predicted);
+double decode_coordinate(ArithmeticDecoder& decoder, FloatResidualModels& models, int context,
+                         Precision precision, double predicted);
+
+// The three coordinates with contexts first_context + 0, 1, 2 (x, y, z).
+void encode_position(ArithmeticEncoder& encoder, FloatResidualModels& models, int first_context,
+                     Precision precision, Vec3 actual, Vec3 predicted);
+Vec3 decode_position(ArithmeticDecoder& decoder, FloatResidualModels& models, int first_context,
+                     Precision precision, Vec3 predicted);
+
+// ---- quantized mode ---------------------------------------------------------------------------
+
+constexpr int kMinQuantizationBits = 1;
+constexpr int kMaxQuantizationBits = 30;
+
+// A uniform grid: coordinate x on axis a has grid coordinate q = round((x - origin[a]) / step),
+// clamped to [0, 2^bits - 1], and is reconstructed as origin[a] + q * step. One step for all
+// axes (the bounding box's largest extent / (2^bits - 1)), so the grid is isotropic.
+struct Quantizer {
+    Vec3 origin;
+    double step = 1.0;
+    int bits = 16;
+    uint32_t max_coordinate() const { return (uint32_t{1} << bits) - 1; }
+};
+using GridPoint = std::array<uint32_t, 3>;
+
+// bits in [1, 30]; the box must be finite with box_min <= box_max and its extent finite.
+// Throws Error otherwise. A box of zero extent gets step 1.
+Quantizer make_quantizer(Vec3 box_min, Vec3 box_max, int bits);
+// The bounding box of `points` (at least one point).
+Quantizer make_quantizer(const std::vector<Vec3>& points, int bits);
+
+// Grid coordinate of x on axis 0, 1, 2 (NaN -> 0; out-of-box values clamp to the grid).
+uint32_t quantize_coordinate(const Quantizer& quantizer, int axis, double x);
+GridPoint quantize(const Quantizer& quantizer, Vec3 p);
+double dequantize_coordinate(const Quantizer& quantizer, int axis, uint32_t q);
+Vec3 dequantize(const Quantizer& quantizer, GridPoint q);
+// A bound on |x - dequantize(quantize(x))| for every x inside the quantizer's box: step / 2
+// plus the rounding of the arithmetic.
+double quantization_error_bound(const Quantizer& quantizer);
+// The largest coordinate error max |x - dequantize(quantize(x))| over the points.
+double max_quantization_error(const Quantizer& quantizer, const std::vector<Vec3>& points);
+
+// Codes the grid coordinate `actual` given the grid coordinate `predicted` (both < 2^bits;
+// throws Error otherwise). Predictions in quantized mode come from reconstructed (dequantized)
+// positions, quantized again (closed loop), so both sides see the same values.
+void encode_quantized(ArithmeticEncoder& encoder, FloatResidualModels& models, int context,
+                      int bits, uint32_t actual, uint32_t predicted);
+uint32_t decode_quantized(ArithmeticDecoder& decoder, FloatResidualModels& models, int context,
+                          int bits, uint32_t predicted);
+
+}  // namespace amc

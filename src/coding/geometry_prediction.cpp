@@ -1,0 +1,91 @@
+// Predictions of refinement vertices (midpoint, butterfly) and of base vertices (parallelogram);
+// see geometry_prediction.h.
+#include "coding/geometry_prediction.h"
+
+namespace amc {
+
+namespace {
+
+Vec3 round_if_single(const Hierarchy& h, Vec3 p) {
+    if (h.single_precision()) {
+        // One coordinate at a time (see CMakeLists.txt on GCC 12's SLP vectorizer).
+        p.x = static_cast<double>(static_cast<float>(p.x));
+        p.y = static_cast<double>(static_cast<float>(p.y));
+        p.z = static_cast<double>(static_cast<float>(p.z));
+    }
+    return p;
+}
+
+// The vertex of node m opposite its edge f.
+Vec3 opposite(const Hierarchy& h, NodeId m, int f) { return h.position(h.vertex(m, (f + 2) % 3)); }
+
+// Vertex opposite edge f of node m in the same-level neighbour across f, or `fallback`.
+Vec3 wing(const Hierarchy& h, NodeId m, int f, Vec3 fallback) {
+    const NodeId r = h.neighbor(m, f);
+    return r == kNoNode ? fallback : opposite(h, r, h.neighbor_edge(m, f));
+}
+
+}  // namespace
+
+std::vector<std::vector<NodeId>> nodes_by_level(const Hierarchy& h) {
+    std::vector<std::vector<NodeId>> levels;
+    for (NodeId n : h.breadth_first_order()) {
+        const size_t l = static_cast<size_t>(h.level(n));
+        if (levels.size() <= l) levels.resize(l + 1);
+        levels[l].push_back(n);
+    }
+    return levels;
+}
+
+std::vector<std::pair<NodeId, int>> new_vertices_of_level(const Hierarchy& h,
+                                                          const std::vector<NodeId>& level_nodes) {
+    // A midpoint is shared only with the same-level neighbour across the edge; it was listed
+    // before iff that neighbour is refined and comes earlier in level order. A vertex flag is
+    // the simplest exact test of that.
+    std::vector<bool> seen(h.positions().size(), false);
+    std::vector<std::pair<NodeId, int>> out;
+    for (NodeId n : level_nodes) {
+        if (h.is_leaf(n)) continue;
+        for (int e = 0; e < 3; ++e) {
+            const VertexId m = h.midpoint(n, e);
+            if (seen[m]) continue;
+            seen[m] = true;
+            out.emplace_back(n, e);
+        }
+    }
+    return out;
+}
+
+Vec3 predict_midpoint(const Hierarchy& h, NodeId n, int e) {
+    const Vec3 a = h.position(h.vertex(n, e));
+    const Vec3 b = h.position(h.vertex(n, (e + 1) % 3));
+    return round_if_single(h, 0.5 * (a + b));  // the expression of forest.cpp's midpoint_placer
+}
+
+Vec3 predict_butterfly(const Hierarchy& h, NodeId n, int e) {
+    const NodeId q = h.neighbor(n, e);
+    if (q == kNoNode) return predict_midpoint(h, n, e);
+    const int e1 = (e + 1) % 3, e2 = (e + 2) % 3;
+    const Vec3 a = h.position(h.vertex(n, e));
+    const Vec3 b = h.position(h.vertex(n, e1));
+    const Vec3 c = h.position(h.vertex(n, e2));
+    const int eq = h.neighbor_edge(n, e);  // q's edge eq runs b -> a
+    const Vec3 d = opposite(h, q, eq);
+    const Vec3 w_bc = wing(h, n, e1, b + c - a);
+    const Vec3 w_ca = wing(h, n, e2, c + a - b);
+    const Vec3 w_ad = wing(h, q, (eq + 1) % 3, a + d - b);
+    const Vec3 w_db = wing(h, q, (eq + 2) % 3, d + b - a);
+    const Vec3 p = 0.5 * (a + b) + 0.125 * (c + d) - 0.0625 * ((w_bc + w_ca) + (w_ad + w_db));
+    return round_if_single(h, p);
+}
+
+Vec3 predict_parallelogram(const std::vector<Vec3>& decoded, std::array<int32_t, 3> stencil) {
+    const auto valid = [&](int32_t i) { return i >= 0 && static_cast<size_t>(i) < decoded.size(); };
+    if (valid(stencil[0]) && valid(stencil[1]) && valid(stencil[2])) {
+        return decoded[size_t(stencil[0])] + decoded[size_t(stencil[1])] - decoded[size_t(stencil[2])];
+    }
+    if (valid(stencil[0])) return decoded[size_t(stencil[0])];
+    return Vec3{};
+}
+
+}  // namespace amc
