@@ -2,7 +2,7 @@
 # Installs the Debian packages amcodec builds with, skipping those already present.
 set -euo pipefail
 packages=(g++ cmake make pkg-config libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
-          libtinyobjloader-dev libmeshoptimizer-dev)
+          libtinyobjloader-dev libmeshoptimizer-dev libxxhash-dev)
 if [[ "${1:-}" == "--bench" ]]; then
   packages+=(libdraco-dev libzstd-dev xz-utils)
 fi

@@ -1,4 +1,5 @@
 // amc: the command-line tool. Each subcommand is a thin layer over the public API.
+#include <amc/codec.h>
 #include <amc/hierarchy.h>
 #include <amc/refinement.h>
 
@@ -9,6 +10,8 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 namespace {
@@ -48,6 +51,56 @@ void save(const std::string& path, const Hierarchy& h) {
     } else {
         write_leaf_mesh(path, h, -1);
     }
+}
+
+std::vector<uint8_t> read_bytes(const std::string& path) {
+    std::ifstream file(path, std::ios::binary);
+    if (!file) throw Error(path + ": cannot open file");
+    std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    if (file.bad()) throw Error(path + ": read error");
+    return bytes;
+}
+
+// A hierarchy from a hierarchy file, or from a compressed .amc file.
+Hierarchy load_hierarchy(const std::string& path, int max_level = -1) {
+    if (has_extension(path, ".amc")) {
+        const std::vector<uint8_t> bytes = read_bytes(path);
+        DecodeOptions options;
+        options.max_level = max_level;
+        try {
+            return decode(bytes.data(), bytes.size(), options);
+        } catch (const Error& e) {
+            throw Error(path + ": " + e.what());
+        }
+    }
+    return read_hierarchy(path);
+}
+
+const char* predictor_name(GeometryPredictor p) {
+    return p == GeometryPredictor::butterfly ? "butterfly" : p == GeometryPredictor::midpoint ? "midpoint" : "automatic";
+}
+
+void print_encode_stats(const std::string& name, const EncodeStats& s, double encode_seconds, double decode_seconds) {
+    std::printf("%s: %lu bytes = %.3f bits/face, %.2f bits/vertex (%lu faces, %lu vertices, %lu nodes, %d levels)\n",
+                name.c_str(), (unsigned long)s.total_bytes, 8.0 * s.total_bytes / double(s.faces),
+                8.0 * s.total_bytes / double(s.vertices), (unsigned long)s.faces, (unsigned long)s.vertices,
+                (unsigned long)s.nodes, s.levels);
+    std::printf("  connectivity %lu bytes (base %lu, hierarchy %lu) = %.3f bits/face; geometry %lu bytes (base %lu, "
+                "refinement %lu); header %lu, framing %lu\n",
+                (unsigned long)(s.base_connectivity_bytes + s.hierarchy_bytes), (unsigned long)s.base_connectivity_bytes,
+                (unsigned long)s.hierarchy_bytes, 8.0 * (s.base_connectivity_bytes + s.hierarchy_bytes) / double(s.faces),
+                (unsigned long)(s.base_geometry_bytes + s.geometry_bytes), (unsigned long)s.base_geometry_bytes,
+                (unsigned long)s.geometry_bytes, (unsigned long)s.header_bytes, (unsigned long)s.framing_bytes);
+    std::printf("  predictor per level:");
+    for (const LevelStats& level : s.per_level) {
+        if (level.new_vertices > 0) std::printf(" %s", predictor_name(level.predictor));
+    }
+    std::printf("\n");
+    if (s.max_error > 0) std::printf("  quantized: max coordinate error %.3g\n", s.max_error);
+    if (encode_seconds > 0)
+        std::printf("  encode %.3f s (%.2f M faces/s)", encode_seconds, s.faces / encode_seconds / 1e6);
+    if (decode_seconds > 0) std::printf(", decode %.3f s (%.2f M faces/s)", decode_seconds, s.faces / decode_seconds / 1e6);
+    if (encode_seconds > 0) std::printf("\n");
 }
 
 RefinementCriterion parse_criterion(const std::string& name) {
@@ -123,6 +176,23 @@ int main(int argc, char** argv) {
     auto* info = app.add_subcommand("info", "Describe a mesh (.obj/.off/.ply) or hierarchy (.amh) file");
     info->add_option("file", info_input, "Input file")->required();
 
+    std::string encode_input, encode_output;
+    int quantize_bits = 0;
+    std::string predictor_option = "auto";
+    auto* encode_cmd = app.add_subcommand("encode", "Compress a hierarchy (.amh) to an .amc file");
+    encode_cmd->add_option("input", encode_input, "Hierarchy file (.amh)")->required();
+    encode_cmd->add_option("-o,--output", encode_output, "Compressed file (.amc)")->required();
+    encode_cmd->add_option("--quantize", quantize_bits, "Quantize coordinates to BITS per axis (lossy; 0 = bit-exact)")
+        ->check(CLI::Range(0, 30));
+    encode_cmd->add_option("--predictor", predictor_option, "auto | midpoint | butterfly")->capture_default_str();
+
+    std::string decode_input, decode_output;
+    int decode_level = -1;
+    auto* decode_cmd = app.add_subcommand("decode", "Decompress an .amc file to a leaf mesh or hierarchy file");
+    decode_cmd->add_option("input", decode_input, "Compressed file (.amc)")->required();
+    decode_cmd->add_option("-o,--output", decode_output, "Leaf mesh (.obj/.off/.ply/.vtu) or hierarchy (.amh)")->required();
+    decode_cmd->add_option("--level", decode_level, "Decode only up to this level (progressive)");
+
     std::vector<std::string> stats_inputs;
     bool stats_groups = false;
     auto* stats = app.add_subcommand("stats", "Hierarchy coder statistics: the paper's Tables 1 and 2");
@@ -181,12 +251,34 @@ int main(int argc, char** argv) {
             return 0;
         }
         if (*extract) {
-            const Hierarchy h = read_hierarchy(extract_input);
+            const Hierarchy h = load_hierarchy(extract_input);
             if (extract_level > h.depth()) {
                 throw Error(extract_input + ": level " + std::to_string(extract_level) + " requested but the hierarchy has levels 0.." +
                             std::to_string(h.depth()));
             }
             write_leaf_mesh(extract_output, h, extract_level);
+            return 0;
+        }
+        if (*encode_cmd) {
+            const Hierarchy h = load_hierarchy(encode_input);
+            EncodeOptions options;
+            options.quantize_bits = quantize_bits;
+            if (predictor_option == "midpoint") options.predictor = GeometryPredictor::midpoint;
+            else if (predictor_option == "butterfly") options.predictor = GeometryPredictor::butterfly;
+            else if (predictor_option != "auto") throw Error("unknown predictor '" + predictor_option + "'");
+            EncodeStats stats;
+            auto start = std::chrono::steady_clock::now();
+            const std::vector<uint8_t> bytes = encode(h, options, &stats);
+            const double seconds = seconds_since(start);
+            write_file_atomically(encode_output, std::string(bytes.begin(), bytes.end()));
+            print_encode_stats(encode_output, stats, seconds, 0);
+            return 0;
+        }
+        if (*decode_cmd) {
+            const Hierarchy h = load_hierarchy(decode_input, decode_level);
+            save(decode_output, h);
+            std::printf("%s: %u nodes, %u vertices, depth %d -> %s\n", decode_input.c_str(), h.node_count(),
+                        h.vertex_count(), h.depth(), decode_output.c_str());
             return 0;
         }
         if (*stats) {
@@ -203,6 +295,30 @@ int main(int argc, char** argv) {
             return 0;
         }
         if (*info) {
+            if (has_extension(info_input, ".amc")) {
+                const std::vector<uint8_t> bytes = read_bytes(info_input);
+                FileInfo file;
+                try {
+                    file = inspect(bytes.data(), bytes.size());
+                } catch (const Error& e) {
+                    throw Error(info_input + ": " + e.what());
+                }
+                std::printf("%s: amc version %d, %s coordinates", info_input.c_str(), file.version,
+                            file.quantize_bits ? "quantized" : file.single_precision ? "float32" : "float64");
+                if (file.quantize_bits) std::printf(" (%d bits)", file.quantize_bits);
+                std::printf("\n  base mesh %lu vertices, %lu triangles; %lu nodes, %d levels, %lu vertices, %lu faces\n",
+                            (unsigned long)file.base_vertices, (unsigned long)file.base_triangles, (unsigned long)file.nodes,
+                            file.levels, (unsigned long)file.vertices, (unsigned long)file.faces);
+                std::printf("  %lu bytes: %.3f bits/face, %.2f bits/vertex\n", (unsigned long)bytes.size(),
+                            8.0 * bytes.size() / double(file.faces), 8.0 * bytes.size() / double(file.vertices));
+                std::printf("  %-20s %10s %10s\n", "block", "offset", "bytes");
+                for (const FileBlock& b : file.blocks) {
+                    std::string name = b.name;
+                    if (b.level >= 0) name += " " + std::to_string(b.level);
+                    std::printf("  %-20s %10lu %10lu\n", name.c_str(), (unsigned long)b.offset, (unsigned long)b.size);
+                }
+                return 0;
+            }
             if (has_extension(info_input, ".amh")) {
                 const Hierarchy h = read_hierarchy(info_input);
                 print_stats_header();

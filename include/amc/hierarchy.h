@@ -97,6 +97,12 @@ public:
     Vec3 position(VertexId v) const { return positions_[v]; }
     void set_position(VertexId v, Vec3 p) { positions_[v] = p; }
     bool single_precision() const { return base_.single_precision; }
+    // Declares the coordinates float32 (new midpoints rounded to float) or float64; restores the
+    // default vertex placer.
+    void set_single_precision(bool single) {
+        base_.single_precision = single;
+        set_vertex_placer(nullptr, nullptr);
+    }
     // Called for every vertex that refinement creates, with the edge's end points; the default
     // places new vertices at edge midpoints (rounded to float when the base is single precision).
     // A null placer restores the default.
@@ -116,6 +122,11 @@ public:
     // Splits leaf n with no balancing or closure; requires can_split(n). The building block of
     // refine() and of readers/decoders that replay a stored forest.
     void split(NodeId n);
+    // Hints the processor to fetch node n (for traversals that know their next nodes early).
+    void prefetch(NodeId n) const { __builtin_prefetch(nodes_.data() + n); }
+    // Reserves room for `nodes` nodes and `vertices` vertex ids (a hint for bulk builders, which
+    // then grow without reallocation; large reservations may be backed by huge pages).
+    void reserve(size_t nodes, size_t vertices);
 
     // Visits every live node level by level, roots first, children in child order: the canonical
     // breadth-first order that files and coders use.

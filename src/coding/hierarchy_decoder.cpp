@@ -1,78 +1,114 @@
 // Hierarchy decoder: the mirror of hierarchy_encoder.cpp. It grows the forest over the shared base
 // mesh level by level, taking each decision from a rule or from the stream.
-#include "coding/arithmetic_coder.h"
-#include "coding/hierarchy_stream.h"
-#include "coding/hierarchy_traversal.h"
+#include "coding/hierarchy_level_coder.h"
 
 #include <string>
 
 namespace amc {
 
+namespace {
+
+HierarchyStreamHeader parse_header(const uint8_t* data, size_t size) {
+    HierarchyStreamHeader header;
+    if (read_hierarchy_stream_header(data, size, header) != size) throw Error("hierarchy stream: header has trailing bytes");
+    return header;
+}
+
+}  // namespace
+
+HierarchyLevelDecoder::HierarchyLevelDecoder(const TriangleMesh& base, const uint8_t* header, size_t header_size,
+                                             uint64_t max_nodes)
+    : HierarchyLevelDecoder(base, parse_header(header, header_size), max_nodes) {}
+
+HierarchyLevelDecoder::HierarchyLevelDecoder(const TriangleMesh& base, const HierarchyStreamHeader& header,
+                                             uint64_t max_nodes)
+    : header_(header), max_nodes_(max_nodes), h_(base), traversal_(header.options) {
+    // Uniform levels alone would build root_count * (4^(U+1) - 1) / 3 nodes: check before.
+    uint64_t uniform_nodes = base.triangles.size(), level_nodes = base.triangles.size();
+    for (int l = 0; l < header_.uniform_levels && uniform_nodes <= max_nodes_; ++l) {
+        level_nodes *= 4;
+        uniform_nodes += level_nodes;
+    }
+    if (uniform_nodes > max_nodes_)
+        throw Error("hierarchy stream would build more than " + std::to_string(max_nodes_) + " nodes");
+    root_level(h_, level_);
+    node_count_ = h_.root_count();
+    level_ids_.resize(h_.root_count());
+    for (NodeId r = 0; r < h_.root_count(); ++r) level_ids_[r] = r;
+}
+
+void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder) {
+    if (done()) throw Error("hierarchy stream: no level left to decode");
+    const int l = level_index_;
+    const LevelNode* nodes = level_.data();
+    const uint32_t n = static_cast<uint32_t>(level_.size());
+    auto check_split = [&](uint32_t i) {
+        if (l >= kMaxLevel || !(nodes[i].flags & kCompleteFlag))
+            throw Error("hierarchy stream is corrupt: node " + std::to_string(level_ids_[i]) + " (level " +
+                        std::to_string(l) + ") can not be refined");
+        if (node_count_ + 4 > max_nodes_)
+            throw Error("hierarchy stream would build more than " + std::to_string(max_nodes_) + " nodes");
+        node_count_ += 4;
+    };
+    const bool use_contexts = header_.options.use_contexts;
+    traversal_.run(
+        level_, l < header_.uniform_levels,
+        [&](uint32_t i, int group) {
+            // II-C, stream truncation: once the stored symbols are used up, the rest are 0.
+            if (symbols_read_ == header_.symbol_count && header_.options.truncate_stream) return false;
+            ++symbols_read_;
+            const bool refined = decoder.decode(models_.for_group(group, use_contexts));
+            if (refined) check_split(i);
+            return refined;
+        },
+        [&](uint32_t i, Fate, bool refined) {
+            if (refined) check_split(i);
+            return refined;
+        });
+    // Diagonals of the leaves closed by two hanging nodes, then the splits in canonical order
+    // (so the children of level l get consecutive ids, as the level forest numbers them).
+    for (uint32_t i = 0; i < n; ++i) {
+        if (nodes[i].state & kRefined) continue;
+        const int hanging = refined_neighbor_count(nodes, i);
+        if (hanging == 3)
+            throw Error("hierarchy stream is corrupt: element " + std::to_string(level_ids_[i]) +
+                        " has three hanging nodes but was not refined");
+        if (hanging == 2) {
+            bool flag = diagonal_flag_by_rule(header_.diagonal_rule, unrefined_edge(nodes, i));
+            if (header_.orientation_coded) flag ^= decoder.decode(models_.orientation);
+            if (flag) h_.set_diagonal_flipped(level_ids_[i], true);
+        }
+    }
+    if (decoder.overran()) throw Error("hierarchy stream is truncated");
+    std::vector<NodeId> next_ids;
+    next_ids.reserve(size_t(4) * (node_count_ - h_.node_count()));
+    for (uint32_t i = 0; i < n; ++i) {
+        if (!(nodes[i].state & kRefined)) continue;
+        h_.split(level_ids_[i]);
+        const NodeId c = h_.child(level_ids_[i], 0);
+        next_ids.insert(next_ids.end(), {c, c + 1, c + 2, c + 3});
+    }
+    derive_next_level(level_, scratch_, next_);
+    level_.swap(next_);
+    level_ids_.swap(next_ids);
+    ++level_index_;
+}
+
+void HierarchyLevelDecoder::finish() const {
+    if (header_.options.truncate_stream && symbols_read_ != header_.symbol_count)
+        throw Error("hierarchy stream is corrupt: " + std::to_string(header_.symbol_count) + " symbols announced, " +
+                    std::to_string(symbols_read_) + " used");
+}
+
 Hierarchy decode_hierarchy(const TriangleMesh& base, const uint8_t* data, size_t size,
                            const HierarchyDecodeOptions& options) {
     HierarchyStreamHeader header;
     const size_t header_size = read_hierarchy_stream_header(data, size, header);
+    HierarchyLevelDecoder coder(base, header, options.max_nodes);
     ArithmeticDecoder decoder(data + header_size, size - header_size);
-    HierarchyModels models;
-    const bool use_contexts = header.options.use_contexts;
-
-    // Uniform levels alone would build root_count * (4^(U+1) - 1) / 3 nodes: check before.
-    uint64_t uniform_nodes = base.triangles.size(), level_nodes = base.triangles.size();
-    for (int l = 0; l < header.uniform_levels && uniform_nodes <= options.max_nodes; ++l) {
-        level_nodes *= 4;
-        uniform_nodes += level_nodes;
-    }
-    if (uniform_nodes > options.max_nodes)
-        throw Error("hierarchy stream would build more than " + std::to_string(options.max_nodes) + " nodes");
-
-    Hierarchy h(base);
-    uint64_t symbols_read = 0;
-    auto split = [&](NodeId n) {
-        if (!h.can_split(n))
-            throw Error("hierarchy stream is corrupt: node " + std::to_string(n) + " (level " +
-                        std::to_string(h.level(n)) + ") can not be refined");
-        if (h.node_count() + 4 > options.max_nodes)
-            throw Error("hierarchy stream would build more than " + std::to_string(options.max_nodes) + " nodes");
-        h.split(n);
-    };
-
-    LevelTraversal traversal(header.options);
-    std::vector<NodeId> level, next;
-    for (NodeId r = 0; r < h.root_count(); ++r) level.push_back(r);
-    for (int l = 0; !level.empty() && l != options.max_level; ++l) {
-        traversal.run(
-            h, level, l < header.uniform_levels,
-            [&](NodeId n, int group) {
-                // II-C, stream truncation: once the stored symbols are used up, the rest are 0.
-                if (symbols_read == header.symbol_count && header.options.truncate_stream) return false;
-                ++symbols_read;
-                const bool refined = decoder.decode(models.for_group(group, use_contexts));
-                if (refined) split(n);
-                return refined;
-            },
-            [&](NodeId n, Fate, bool refined) {
-                if (refined) split(n);
-            });
-        for (NodeId n : level) {
-            if (!h.is_leaf(n)) continue;
-            const int hanging = h.hanging_node_count(n);
-            if (hanging == 3)
-                throw Error("hierarchy stream is corrupt: element " + std::to_string(n) +
-                            " has three hanging nodes but was not refined");
-            if (hanging == 2) {
-                bool flag = diagonal_flag_by_rule(header.diagonal_rule, unrefined_edge(h, n));
-                if (header.orientation_coded) flag ^= decoder.decode(models.orientation);
-                h.set_diagonal_flipped(n, flag);
-            }
-        }
-        if (decoder.overran()) throw Error("hierarchy stream is truncated");
-        next_level(h, level, next);
-        level.swap(next);
-    }
-    if (options.max_level < 0 && header.options.truncate_stream && symbols_read != header.symbol_count)
-        throw Error("hierarchy stream is corrupt: " + std::to_string(header.symbol_count) + " symbols announced, " +
-                    std::to_string(symbols_read) + " used");
-    return h;
+    while (!coder.done() && coder.level() != options.max_level) coder.decode_level(decoder);
+    if (coder.done()) coder.finish();
+    return std::move(coder.hierarchy());
 }
 
 }  // namespace amc

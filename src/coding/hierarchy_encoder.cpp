@@ -1,79 +1,89 @@
 // Hierarchy encoder: decides every node level by level (hierarchy_traversal.h), chooses the
-// diagonal rule, truncates trailing zeros, and arithmetic codes what is left. Stream layout in
-// docs/FORMAT.md ("hierarchy stream").
-#include "coding/arithmetic_coder.h"
-#include "coding/hierarchy_stream.h"
-#include "coding/hierarchy_traversal.h"
+// diagonal rule, truncates trailing zeros, and arithmetic codes what is left, one level at a time.
+// Stream layout in docs/FORMAT.md ("hierarchy stream").
+#include "coding/hierarchy_level_coder.h"
 
 namespace amc {
 
-namespace {
+HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const HierarchyCoderOptions& options)
+    : options_(options) {
+    HierarchyCodeStats& stats = stats_;
+    // Levels 0..U-1 with every node refined (counted on the way: a level is uniform when it and
+    // all coarser levels are refined everywhere).
+    int uniform_levels = 0;
+    uint64_t faces = 0;
 
-// One decision in stream order: a hierarchy symbol or an orientation bit.
-struct Event {
-    uint8_t group;  // context group, or kOrientationEvent
-    uint8_t bit;
-};
-constexpr uint8_t kOrientationEvent = 0xff;
-
-// Levels 0..U-1 with every node refined.
-int count_uniform_levels(const Hierarchy& h) {
-    std::vector<NodeId> level, next;
-    for (NodeId r = 0; r < h.root_count(); ++r) level.push_back(r);
-    int uniform = 0;
-    while (!level.empty() && uniform < kMaxUniformLevels) {
-        for (NodeId n : level) {
-            if (h.is_leaf(n)) return uniform;
-        }
-        ++uniform;
-        next_level(h, level, next);
-        level.swap(next);
-    }
-    return uniform;
-}
-
-}  // namespace
-
-std::vector<uint8_t> encode_hierarchy(const Hierarchy& h, const HierarchyCoderOptions& options,
-                                      HierarchyCodeStats* stats_out) {
-    HierarchyCodeStats stats;
-    stats.uniform_levels = options.uniform_levels ? count_uniform_levels(h) : 0;
-
-    // Pass 1: decide every node in the coder's order and record the events.
-    std::vector<Event> events;
+    // Pass 1: decide every node in the coder's order and record the events. The traversal runs on
+    // the level forest (hierarchy_traversal.h); `ids` maps a level's local indices to h's nodes.
+    events_.reserve(h.node_count());
     std::vector<std::pair<int, bool>> two_hanging;  // (unrefined edge, flag) in stream order
     std::vector<size_t> orientation_slots;         // event index of each two_hanging entry
     LevelTraversal traversal(options);
-    std::vector<NodeId> level, next;
-    for (NodeId r = 0; r < h.root_count(); ++r) level.push_back(r);
+    std::vector<LevelNode> level, next;
+    std::vector<NodeId> ids, next_ids;
+    std::vector<uint8_t> refined;
+    std::vector<uint32_t> scratch;
+    root_level(h, level);
+    ids.resize(h.root_count());
+    for (NodeId r = 0; r < h.root_count(); ++r) ids[r] = r;
     for (int l = 0; !level.empty(); ++l) {
-        stats.nodes += level.size();
+        const uint32_t n = static_cast<uint32_t>(level.size());
+        stats.nodes += n;
+        refined.resize(n);
+        next_ids.clear();
+        bool all_refined = true;
+        constexpr uint32_t kAhead = 16;
+        for (uint32_t i = 0; i < n && i < kAhead; ++i) h.prefetch(ids[i]);
+        for (uint32_t i = 0; i < n; ++i) {
+            if (i + kAhead < n) h.prefetch(ids[i + kAhead]);
+            const NodeId id = ids[i];
+            const bool r = !h.is_leaf(id);
+            refined[i] = r;
+            all_refined &= r;
+            if (r) {
+                const NodeId c = h.child(id, 0);
+                next_ids.insert(next_ids.end(), {c, c + 1, c + 2, c + 3});
+            }
+        }
+        const bool uniform = options.uniform_levels && all_refined && l == uniform_levels && l < kMaxUniformLevels;
+        if (uniform) ++uniform_levels;
+        const uint8_t* truth = refined.data();
         traversal.run(
-            h, level, l < stats.uniform_levels,
-            [&](NodeId n, int group) {
-                const bool refined = !h.is_leaf(n);
-                events.push_back({uint8_t(group), uint8_t(refined)});
-                return refined;
+            level, uniform,
+            [&](uint32_t i, int group) {
+                const bool r = truth[i] != 0;
+                events_.push_back({uint8_t(group), uint8_t(r)});
+                return r;
             },
-            [&](NodeId, Fate fate, bool) {
+            [&](uint32_t i, Fate fate, bool) {
                 switch (fate) {
                     case Fate::uniform: ++stats.culled_uniform; break;
                     case Fate::one_regularity: ++stats.culled_one_regularity; break;
                     case Fate::hanging_nodes: ++stats.culled_hanging_nodes; break;
                     case Fate::coded: break;
                 }
+                return truth[i] != 0;
             });
-        for (NodeId n : level) {
-            if (h.is_leaf(n) && h.hanging_node_count(n) == 2) {
-                two_hanging.push_back({unrefined_edge(h, n), h.diagonal_flipped(n)});
-                orientation_slots.push_back(events.size());
-                events.push_back({kOrientationEvent, 0});
+        const LevelNode* nodes = level.data();
+        for (uint32_t i = 0; i < n; ++i) {
+            if (nodes[i].state & kRefined) continue;
+            const int hanging = refined_neighbor_count(nodes, i);
+            faces += 1 + uint64_t(hanging);
+            if (hanging == 2) {
+                two_hanging.push_back({unrefined_edge(nodes, i), h.diagonal_flipped(ids[i])});
+                orientation_slots.push_back(events_.size());
+                events_.push_back({kOrientationEvent, 0});
             }
         }
         stats.levels = l + 1;
-        next_level(h, level, next);
+        level_end_.push_back(events_.size());
+        derive_next_level(level, scratch, next);
         level.swap(next);
+        level_ids_.push_back(ids);
+        ids.swap(next_ids);
     }
+    stats.uniform_levels = uniform_levels;
+    stats.faces = faces;
 
     // The diagonal rule that leaves the fewest exceptions; orientation bits only if any.
     uint64_t best_exceptions = UINT64_MAX;
@@ -90,54 +100,57 @@ std::vector<uint8_t> encode_hierarchy(const Hierarchy& h, const HierarchyCoderOp
     stats.orientation_coded = stats.diagonal_exceptions > 0;
     for (size_t i = 0; i < two_hanging.size(); ++i) {
         const auto [edge, flag] = two_hanging[i];
-        events[orientation_slots[i]].bit = uint8_t(diagonal_flag_by_rule(stats.diagonal_rule, edge) != flag);
+        events_[orientation_slots[i]].bit = uint8_t(diagonal_flag_by_rule(stats.diagonal_rule, edge) != flag);
     }
 
     // Stream truncation (II-C): symbols after the last coded 1 are implied zeros.
-    uint64_t symbol_count = 0, kept_symbols = 0;
-    for (const Event& e : events) {
+    uint64_t symbol_count = 0;
+    for (const Event& e : events_) {
         if (e.group == kOrientationEvent) continue;
         ++symbol_count;
-        if (e.bit) kept_symbols = symbol_count;
+        if (e.bit) kept_symbols_ = symbol_count;
     }
-    if (!options.truncate_stream) kept_symbols = symbol_count;
-    stats.truncated = symbol_count - kept_symbols;
-    stats.coded = kept_symbols;
+    if (!options.truncate_stream) kept_symbols_ = symbol_count;
+    stats.truncated = symbol_count - kept_symbols_;
+    stats.coded = kept_symbols_;
 
-    // Pass 2: arithmetic coding.
     HierarchyStreamHeader header;
     header.options = options;
     header.uniform_levels = uint8_t(stats.uniform_levels);
     header.diagonal_rule = stats.diagonal_rule;
     header.orientation_coded = stats.orientation_coded;
-    header.symbol_count = kept_symbols;
-    std::vector<uint8_t> out = write_hierarchy_stream_header(header);
-    stats.header_bytes = out.size();
+    header.symbol_count = kept_symbols_;
+    header_ = write_hierarchy_stream_header(header);
+}
 
-    HierarchyModels models;
-    ArithmeticEncoder encoder;
-    uint64_t symbols_written = 0;
-    for (const Event& e : events) {
+void HierarchyLevelEncoder::encode_level(int l, ArithmeticEncoder& encoder) {
+    if (l != next_level_) throw Error("hierarchy levels must be encoded in order");
+    ++next_level_;
+    const size_t begin = l == 0 ? 0 : level_end_[size_t(l) - 1];
+    for (size_t k = begin; k < level_end_[size_t(l)]; ++k) {
+        const Event e = events_[k];
         if (e.group == kOrientationEvent) {
-            if (!stats.orientation_coded) continue;
-            stats.orientation_bits += models.orientation.cost_bits(e.bit);
-            encoder.encode(e.bit, models.orientation);
+            if (!stats_.orientation_coded) continue;
+            stats_.orientation_bits += models_.orientation.cost_bits(e.bit);
+            encoder.encode(e.bit, models_.orientation);
             continue;
         }
-        if (symbols_written == kept_symbols) continue;
-        ++symbols_written;
-        BitModel& model = models.for_group(e.group, options.use_contexts);
-        ContextGroupStats& group = stats.groups[e.group];
+        if (symbols_written_ == kept_symbols_) continue;
+        ++symbols_written_;
+        BitModel& model = models_.for_group(e.group, options_.use_contexts);
+        ContextGroupStats& group = stats_.groups[e.group];
         group.symbols += 1;
         group.ones += e.bit;
-        stats.coded_ones += e.bit;
+        stats_.coded_ones += e.bit;
         group.coded_bits += model.cost_bits(e.bit);
         encoder.encode(e.bit, model);
     }
-    const std::vector<uint8_t> payload = encoder.finish();
-    out.insert(out.end(), payload.begin(), payload.end());
-    stats.payload_bytes = payload.size();
+}
 
+HierarchyCodeStats HierarchyLevelEncoder::stats() const {
+    HierarchyCodeStats stats = stats_;
+    stats.conditional_entropy_bits = 0;
+    stats.adaptive_code_bits = 0;
     for (int g = 0; g < kContextGroupCount; ++g) {
         ContextGroupStats& group = stats.groups[g];
         for (int x = 0; x <= 3; ++x) {
@@ -153,10 +166,21 @@ std::vector<uint8_t> encode_hierarchy(const Hierarchy& h, const HierarchyCoderOp
         stats.adaptive_code_bits += group.coded_bits;
     }
     stats.adaptive_code_bits += stats.orientation_bits;
+    stats.header_bytes = header_.size();
+    return stats;
+}
+
+std::vector<uint8_t> encode_hierarchy(const Hierarchy& h, const HierarchyCoderOptions& options,
+                                      HierarchyCodeStats* stats_out) {
+    HierarchyLevelEncoder coder(h, options);
+    ArithmeticEncoder encoder;
+    for (int l = 0; l < coder.level_count(); ++l) coder.encode_level(l, encoder);
+    const std::vector<uint8_t> payload = encoder.finish();
+    std::vector<uint8_t> out = coder.header();
+    out.insert(out.end(), payload.begin(), payload.end());
     if (stats_out != nullptr) {
-        stats.faces = 0;
-        for (NodeId n : h.leaves()) stats.faces += 1 + uint64_t(h.hanging_node_count(n));
-        *stats_out = stats;
+        *stats_out = coder.stats();
+        stats_out->payload_bytes = payload.size();
     }
     return out;
 }

@@ -2,10 +2,14 @@
 // coarsening, and the canonical breadth-first order.
 #include <amc/hierarchy.h>
 
+#include "common/huge_pages.h"
+
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <string>
 #include <unordered_map>
+
 
 namespace amc {
 
@@ -68,6 +72,17 @@ void Hierarchy::set_vertex_placer(VertexPlacer placer, void* context) {
     }
     placer_ = placer;
     placer_context_ = context;
+}
+
+void Hierarchy::reserve(size_t nodes, size_t vertices) {
+    if (nodes > nodes_.capacity()) {
+        nodes_.reserve(nodes);
+        advise_huge_pages(nodes_.data() + nodes_.size(), (nodes_.capacity() - nodes_.size()) * sizeof(Node));
+    }
+    if (vertices > positions_.capacity()) {
+        positions_.reserve(vertices);
+        advise_huge_pages(positions_.data() + positions_.size(), (positions_.capacity() - positions_.size()) * sizeof(Vec3));
+    }
 }
 
 void Hierarchy::set_diagonal_flipped(NodeId n, bool flipped) {

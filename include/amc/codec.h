@@ -1,0 +1,89 @@
+// The .amc file: a hierarchy (base mesh, forest, diagonals, positions) compressed losslessly,
+// laid out coarse to fine so that any prefix of levels decodes (docs/FORMAT.md).
+#pragma once
+
+#include <amc/hierarchy.h>
+#include <amc/hierarchy_coder.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace amc {
+
+enum class GeometryPredictor : uint8_t {
+    automatic = 0,  // per level, whichever of midpoint and butterfly codes smaller
+    midpoint = 1,
+    butterfly = 2,
+};
+
+struct EncodeOptions {
+    HierarchyCoderOptions hierarchy;  // the connectivity coder's switches (defaults: the full method)
+    // 0: bit-exact coordinates. 1..30: coordinates quantized to a grid of 2^bits steps over the
+    // bounding box (lossy; EncodeStats::max_error tells how much).
+    int quantize_bits = 0;
+    GeometryPredictor predictor = GeometryPredictor::automatic;
+};
+
+struct LevelStats {
+    uint64_t nodes = 0;          // nodes of this level
+    uint64_t new_vertices = 0;   // vertices its refinement creates
+    uint64_t bytes = 0;          // size of the level block
+    GeometryPredictor predictor = GeometryPredictor::midpoint;
+};
+
+struct EncodeStats {
+    uint64_t total_bytes = 0;
+    uint64_t header_bytes = 0;              // file header and metadata block
+    uint64_t base_connectivity_bytes = 0;
+    uint64_t base_geometry_bytes = 0;
+    uint64_t hierarchy_bytes = 0;           // refinement symbols and orientation bits, all levels
+    uint64_t geometry_bytes = 0;            // positions of refinement vertices, all levels
+    uint64_t framing_bytes = 0;             // block headers and checksums
+    uint64_t faces = 0, vertices = 0, nodes = 0, base_vertices = 0, base_triangles = 0;
+    int levels = 0;
+    double max_error = 0;                   // largest coordinate error (0 unless quantized)
+    std::vector<LevelStats> per_level;
+    HierarchyCodeStats hierarchy;           // the hierarchy coder's own statistics
+};
+
+// Compresses `h`. The decoder rebuilds it over the base mesh in the base coder's order (vertices
+// and triangles renumbered, each triangle's vertices possibly rotated; see reorder_base), so the
+// result is identical to reorder_base(h, ...) of the input — same elements, same positions.
+std::vector<uint8_t> encode(const Hierarchy& h, const EncodeOptions& options = {}, EncodeStats* stats = nullptr);
+
+struct DecodeOptions {
+    int max_level = -1;                  // stop after this level: the mesh of that level
+    uint64_t max_nodes = 1ull << 26;     // refuse files that would build more nodes than this
+};
+
+// Throws Error naming the problem (bad magic, newer version, checksum, structure) on a corrupt or
+// truncated file; never crashes, hangs, or allocates without bound.
+Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options = {});
+
+// The same without exceptions, for callers that prefer status values.
+struct DecodeResult {
+    bool ok = false;
+    std::string error;
+    Hierarchy hierarchy;
+};
+DecodeResult try_decode(const uint8_t* data, size_t size, const DecodeOptions& options = {}) noexcept;
+
+// What `amc info` prints: the blocks of a file with their sizes, without decoding the payloads.
+struct FileBlock {
+    uint8_t type = 0;
+    std::string name;
+    uint64_t offset = 0, size = 0;  // the whole block: header, payload, checksum
+    int level = -1;                 // for level blocks
+};
+struct FileInfo {
+    int version = 0;
+    bool single_precision = false;
+    int quantize_bits = 0;
+    uint64_t base_vertices = 0, base_triangles = 0, nodes = 0, vertices = 0, faces = 0;
+    int levels = 0;
+    std::vector<FileBlock> blocks;
+};
+FileInfo inspect(const uint8_t* data, size_t size);  // throws Error like decode
+
+}  // namespace amc

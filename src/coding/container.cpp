@@ -1,0 +1,132 @@
+// Blocks of the .amc file: writing, and reading with every length and checksum verified.
+#include "coding/container.h"
+
+#include <amc/mesh.h>
+
+#include <xxhash.h>
+
+#include <cstring>
+
+namespace amc {
+
+namespace {
+
+void put_u32(std::vector<uint8_t>& out, uint32_t v) {
+    for (int i = 0; i < 4; ++i) out.push_back(uint8_t(v >> (8 * i)));
+}
+
+uint32_t get_u32(const uint8_t* p) {
+    return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+}
+
+}  // namespace
+
+const char* block_type_name(uint8_t type) {
+    switch (BlockType(type)) {
+        case BlockType::end: return "end";
+        case BlockType::metadata: return "metadata";
+        case BlockType::base_connectivity: return "base connectivity";
+        case BlockType::base_geometry: return "base geometry";
+        case BlockType::level: return "level";
+    }
+    return "unknown";
+}
+
+BlockWriter::BlockWriter(uint8_t flags) {
+    out_.assign(kFileMagic, kFileMagic + 4);
+    out_.push_back(kFileVersion);
+    out_.push_back(flags);
+    out_.push_back(0);
+    out_.push_back(0);
+}
+
+void BlockWriter::add(BlockType type, const std::vector<uint8_t>& payload) {
+    const size_t start = out_.size();
+    out_.push_back(uint8_t(type));
+    put_u32(out_, uint32_t(payload.size()));
+    out_.insert(out_.end(), payload.begin(), payload.end());
+    // The checksum covers the type, the length and the payload.
+    put_u32(out_, XXH32(out_.data() + start, out_.size() - start, 0));
+}
+
+std::vector<uint8_t> BlockWriter::finish() {
+    add(BlockType::end, {});
+    return std::move(out_);
+}
+
+BlockReader::BlockReader(const uint8_t* data, size_t size) : data_(data), size_(size) {
+    if (size < kFileHeaderSize || std::memcmp(data, kFileMagic, 4) != 0) throw Error("not an .amc file (bad magic)");
+    version_ = data[4];
+    flags_ = data[5];
+    if (version_ != kFileVersion)
+        throw Error("unsupported .amc version " + std::to_string(version_) + " (this build reads version " +
+                    std::to_string(kFileVersion) + ")");
+    if (flags_ & ~(kFlagSinglePrecision | kFlagQuantized)) throw Error("unknown flags in the file header");
+    if (data[6] != 0 || data[7] != 0) throw Error("reserved header bytes are not zero");
+}
+
+bool BlockReader::next(Block& block) {
+    if (ended_) return false;
+    if (size_ - pos_ < kBlockOverhead) throw Error("file is truncated (block header at byte " + std::to_string(pos_) + ")");
+    const uint8_t type = data_[pos_];
+    const uint32_t length = get_u32(data_ + pos_ + 1);
+    if (length > size_ - pos_ - kBlockOverhead)
+        throw Error("file is truncated (" + std::string(block_type_name(type)) + " block at byte " +
+                    std::to_string(pos_) + " announces " + std::to_string(length) + " bytes)");
+    const uint32_t stored = get_u32(data_ + pos_ + 5 + length);
+    if (XXH32(data_ + pos_, 5 + size_t(length), 0) != stored)
+        throw Error("checksum mismatch in the " + std::string(block_type_name(type)) + " block at byte " +
+                    std::to_string(pos_));
+    if (type > uint8_t(BlockType::level)) throw Error("unknown block type " + std::to_string(type));
+    block = {BlockType(type), data_ + pos_ + 5, length, pos_};
+    pos_ += kBlockOverhead + length;
+    if (block.type == BlockType::end) {
+        ended_ = true;
+        if (length != 0) throw Error("end block is not empty");
+        if (pos_ != size_) throw Error(std::to_string(size_ - pos_) + " bytes after the end block");
+    }
+    return true;
+}
+
+void put_varint(std::vector<uint8_t>& out, uint64_t value) {
+    do {
+        out.push_back(uint8_t((value & 0x7f) | (value > 0x7f ? 0x80 : 0)));
+        value >>= 7;
+    } while (value != 0);
+}
+
+void put_f64(std::vector<uint8_t>& out, double value) {
+    uint64_t bits;
+    std::memcpy(&bits, &value, 8);
+    for (int i = 0; i < 8; ++i) out.push_back(uint8_t(bits >> (8 * i)));
+}
+
+void PayloadReader::fail(const std::string& problem) const { throw Error(std::string(what_) + ": " + problem); }
+
+uint64_t PayloadReader::varint() {
+    uint64_t value = 0;
+    for (int shift = 0;; shift += 7) {
+        if (pos_ >= size_) fail("truncated number");
+        if (shift > 63) fail("number too long");
+        const uint8_t byte = data_[pos_++];
+        value |= uint64_t(byte & 0x7f) << shift;
+        if (!(byte & 0x80)) return value;
+    }
+}
+
+uint8_t PayloadReader::u8() {
+    if (pos_ >= size_) fail("truncated");
+    return data_[pos_++];
+}
+
+double PayloadReader::f64() {
+    if (size_ - pos_ < 8) fail("truncated");
+    uint64_t bits = 0;
+    for (int i = 0; i < 8; ++i) bits |= uint64_t(data_[pos_ + i]) << (8 * i);
+    pos_ += 8;
+    double value;
+    std::memcpy(&value, &bits, 8);
+    return value;
+}
+
+}  // namespace amc

@@ -1,0 +1,88 @@
+// The block structure of the .amc file (docs/FORMAT.md, section 3): a fixed header, then typed
+// blocks, each with its length and an XXH32 checksum, ending with an END block.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace amc {
+
+constexpr char kFileMagic[4] = {'A', 'M', 'C', 'F'};
+constexpr uint8_t kFileVersion = 1;
+constexpr size_t kFileHeaderSize = 8;
+constexpr size_t kBlockOverhead = 1 + 4 + 4;  // type, payload length, checksum
+
+// Block types: frozen values (they are written to files).
+enum class BlockType : uint8_t {
+    end = 0,
+    metadata = 1,
+    base_connectivity = 2,
+    base_geometry = 3,
+    level = 4,
+};
+const char* block_type_name(uint8_t type);
+
+// File header flags.
+constexpr uint8_t kFlagSinglePrecision = 1;
+constexpr uint8_t kFlagQuantized = 2;
+
+class BlockWriter {
+public:
+    explicit BlockWriter(uint8_t flags);
+    void add(BlockType type, const std::vector<uint8_t>& payload);
+    std::vector<uint8_t> finish();  // appends the END block
+    size_t size() const { return out_.size(); }
+
+private:
+    std::vector<uint8_t> out_;
+};
+
+struct Block {
+    BlockType type;
+    const uint8_t* payload;
+    size_t size;
+    size_t offset;  // of the block header in the file
+};
+
+// Validates the header and walks the blocks; every length and checksum is checked before use.
+class BlockReader {
+public:
+    BlockReader(const uint8_t* data, size_t size);  // throws Error on a bad header
+    uint8_t flags() const { return flags_; }
+    uint8_t version() const { return version_; }
+    // The next block; throws Error on truncation, a bad checksum, an unknown type, or bytes after
+    // END. Returns false after END.
+    bool next(Block& block);
+
+private:
+    const uint8_t* data_;
+    size_t size_;
+    size_t pos_ = kFileHeaderSize;
+    uint8_t flags_ = 0, version_ = 0;
+    bool ended_ = false;
+};
+
+// Little helpers for payloads: LEB128 varints and fixed-size values.
+void put_varint(std::vector<uint8_t>& out, uint64_t value);
+void put_f64(std::vector<uint8_t>& out, double value);
+
+class PayloadReader {
+public:
+    PayloadReader(const uint8_t* data, size_t size, const char* what) : data_(data), size_(size), what_(what) {}
+    uint64_t varint();
+    uint8_t u8();
+    double f64();
+    size_t position() const { return pos_; }
+    const uint8_t* rest() const { return data_ + pos_; }
+    size_t remaining() const { return size_ - pos_; }
+
+private:
+    [[noreturn]] void fail(const std::string& problem) const;
+    const uint8_t* data_;
+    size_t size_;
+    const char* what_;
+    size_t pos_ = 0;
+};
+
+}  // namespace amc

@@ -1,0 +1,82 @@
+// The hierarchy coder one level at a time, so that a container can interleave each level's
+// decisions with the positions of the vertices that level creates (progressive stream). The
+// one-shot encode_hierarchy / decode_hierarchy of <amc/hierarchy_coder.h> are built on these.
+#pragma once
+
+#include "coding/arithmetic_coder.h"
+#include "coding/hierarchy_stream.h"
+#include "coding/hierarchy_traversal.h"
+
+#include <amc/hierarchy_coder.h>
+
+#include <vector>
+
+namespace amc {
+
+class HierarchyLevelEncoder {
+public:
+    // Decides every node (first pass): fixes the uniform levels, the diagonal rule and the number
+    // of coded symbols, so the header is known before any level is coded.
+    HierarchyLevelEncoder(const Hierarchy& h, const HierarchyCoderOptions& options);
+    const std::vector<uint8_t>& header() const { return header_; }
+    int level_count() const { return int(level_ids_.size()); }
+    // Nodes of level l (ids in the encoded hierarchy) in canonical order.
+    const std::vector<NodeId>& level_nodes(int l) const { return level_ids_[size_t(l)]; }
+    // Codes level l's symbols and orientation bits; levels must be coded in order 0, 1, ...
+    void encode_level(int l, ArithmeticEncoder& encoder);
+    // Statistics of everything coded so far (all of it after the last level). payload_bytes and
+    // header_bytes are left to the caller, who owns the arithmetic coder.
+    HierarchyCodeStats stats() const;
+
+private:
+    struct Event {
+        uint8_t group;  // context group, or kOrientationEvent
+        uint8_t bit;
+    };
+    static constexpr uint8_t kOrientationEvent = 0xff;
+
+    HierarchyCoderOptions options_;
+    HierarchyCodeStats stats_;
+    std::vector<Event> events_;
+    std::vector<size_t> level_end_;  // events of level l end at level_end_[l]
+    std::vector<std::vector<NodeId>> level_ids_;
+    std::vector<uint8_t> header_;
+    HierarchyModels models_;
+    uint64_t kept_symbols_ = 0, symbols_written_ = 0;
+    int next_level_ = 0;
+};
+
+class HierarchyLevelDecoder {
+public:
+    // `header` is the hierarchy stream header (exactly its bytes). Throws Error on a bad header or
+    // when the uniform levels alone would exceed max_nodes.
+    HierarchyLevelDecoder(const TriangleMesh& base, const uint8_t* header, size_t header_size, uint64_t max_nodes);
+    HierarchyLevelDecoder(const TriangleMesh& base, const HierarchyStreamHeader& header, uint64_t max_nodes);
+    bool done() const { return level_.empty(); }
+    int level() const { return level_index_; }
+    // Nodes of the current level (ids in hierarchy()) in canonical order.
+    const std::vector<NodeId>& level_nodes() const { return level_ids_; }
+    // Decides the current level from `decoder` (symbols, orientation bits), splits its refined
+    // nodes in hierarchy() and moves to the next level. Throws Error on a corrupt stream.
+    void decode_level(ArithmeticDecoder& decoder);
+    // After the last level: every announced symbol must have been used.
+    void finish() const;
+    Hierarchy& hierarchy() { return h_; }
+
+private:
+    void check_limits();
+
+    HierarchyStreamHeader header_;
+    uint64_t max_nodes_;
+    Hierarchy h_;
+    HierarchyModels models_;
+    LevelTraversal traversal_;
+    std::vector<LevelNode> level_, next_;
+    std::vector<uint32_t> scratch_;
+    std::vector<NodeId> level_ids_;
+    std::vector<uint8_t> refined_;
+    int level_index_ = 0;
+    uint64_t node_count_ = 0, symbols_read_ = 0;
+};
+
+}  // namespace amc

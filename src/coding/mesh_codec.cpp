@@ -1,0 +1,348 @@
+// The .amc file: base mesh, then one block per level with that level's hierarchy decisions and the
+// positions of the vertices its refinement creates (docs/FORMAT.md, section 3).
+#include <amc/codec.h>
+
+#include "coding/arithmetic_coder.h"
+#include "coding/base_mesh_coder.h"
+#include "coding/container.h"
+#include "coding/float_coder.h"
+#include "coding/geometry_prediction.h"
+#include "coding/hierarchy_level_coder.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace amc {
+
+namespace {
+
+// Geometry contexts: 3 for base vertices, then 3 per level (levels beyond 15 share the last).
+constexpr int kLevelContextClasses = 16;
+constexpr int kGeometryContexts = 3 * (1 + kLevelContextClasses);
+int level_context(int level) { return 3 * (1 + std::min(level, kLevelContextClasses - 1)); }
+
+// Codes positions, bit-exact (float32 or float64) or on a quantization grid.
+class PositionCoder {
+public:
+    PositionCoder(Precision precision, const Quantizer* quantizer)
+        : precision_(precision), quantized_(quantizer != nullptr), models_(kGeometryContexts) {
+        if (quantizer != nullptr) quantizer_ = *quantizer;
+    }
+    void encode(ArithmeticEncoder& encoder, int context, Vec3 actual, Vec3 predicted) {
+        if (!quantized_) {
+            encode_position(encoder, models_, context, precision_, actual, predicted);
+            return;
+        }
+        const GridPoint a = quantize(quantizer_, actual), p = quantize(quantizer_, predicted);
+        for (int axis = 0; axis < 3; ++axis) encode_quantized(encoder, models_, context + axis, quantizer_.bits, a[axis], p[axis]);
+    }
+    Vec3 decode(ArithmeticDecoder& decoder, int context, Vec3 predicted) {
+        if (!quantized_) return decode_position(decoder, models_, context, precision_, predicted);
+        const GridPoint p = quantize(quantizer_, predicted);
+        GridPoint a;
+        for (int axis = 0; axis < 3; ++axis) a[axis] = decode_quantized(decoder, models_, context + axis, quantizer_.bits, p[axis]);
+        return dequantize(quantizer_, a);
+    }
+    bool saw_invalid_symbol() const { return models_.saw_invalid_symbol(); }
+
+private:
+    Precision precision_;
+    bool quantized_;
+    Quantizer quantizer_;
+    FloatResidualModels models_;
+};
+
+Vec3 predict(const Hierarchy& h, GeometryPredictor predictor, NodeId n, int e) {
+    return predictor == GeometryPredictor::butterfly ? predict_butterfly(h, n, e) : predict_midpoint(h, n, e);
+}
+
+struct Metadata {
+    uint64_t base_vertices = 0, base_triangles = 0, nodes = 0, vertices = 0, faces = 0, levels = 0;
+    std::vector<uint8_t> hierarchy_header;
+    Quantizer quantizer;
+};
+
+std::vector<uint8_t> write_metadata(const Metadata& m, bool quantized) {
+    std::vector<uint8_t> out;
+    for (uint64_t v : {m.base_vertices, m.base_triangles, m.nodes, m.vertices, m.faces, m.levels}) put_varint(out, v);
+    put_varint(out, m.hierarchy_header.size());
+    out.insert(out.end(), m.hierarchy_header.begin(), m.hierarchy_header.end());
+    if (quantized) {
+        out.push_back(uint8_t(m.quantizer.bits));
+        put_f64(out, m.quantizer.origin.x);
+        put_f64(out, m.quantizer.origin.y);
+        put_f64(out, m.quantizer.origin.z);
+        put_f64(out, m.quantizer.step);
+    }
+    return out;
+}
+
+Metadata read_metadata(const Block& block, bool quantized) {
+    PayloadReader in(block.payload, block.size, "metadata block");
+    Metadata m;
+    m.base_vertices = in.varint();
+    m.base_triangles = in.varint();
+    m.nodes = in.varint();
+    m.vertices = in.varint();
+    m.faces = in.varint();
+    m.levels = in.varint();
+    const uint64_t header_size = in.varint();
+    if (header_size > in.remaining()) throw Error("metadata block: hierarchy header is truncated");
+    m.hierarchy_header.assign(in.rest(), in.rest() + header_size);
+    for (uint64_t i = 0; i < header_size; ++i) in.u8();
+    if (quantized) {
+        m.quantizer.bits = in.u8();
+        m.quantizer.origin = {in.f64(), in.f64(), in.f64()};
+        m.quantizer.step = in.f64();
+        if (m.quantizer.bits < kMinQuantizationBits || m.quantizer.bits > kMaxQuantizationBits ||
+            !std::isfinite(m.quantizer.step) || !(m.quantizer.step > 0) || !std::isfinite(m.quantizer.origin.x) ||
+            !std::isfinite(m.quantizer.origin.y) || !std::isfinite(m.quantizer.origin.z))
+            throw Error("metadata block: bad quantization parameters");
+    }
+    if (in.remaining() != 0) throw Error("metadata block has trailing bytes");
+    if (m.base_triangles == 0 || m.levels == 0 || m.levels > kMaxLevel + 1 || m.nodes < m.base_triangles ||
+        m.vertices < m.base_vertices)
+        throw Error("metadata block: inconsistent counts");
+    return m;
+}
+
+std::vector<Vec3> all_positions(const Hierarchy& h) {
+    std::vector<Vec3> points;
+    const std::vector<uint32_t> canonical = canonical_vertex_order(h);
+    for (size_t v = 0; v < canonical.size(); ++v) {
+        if (canonical[v] != 0xffffffffu) points.push_back(h.position(VertexId(v)));
+    }
+    return points;
+}
+
+uint64_t face_count(const Hierarchy& h) {
+    uint64_t faces = 0;
+    for (NodeId n : h.leaves()) faces += 1 + uint64_t(h.hanging_node_count(n));
+    return faces;
+}
+
+}  // namespace
+
+std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options, EncodeStats* stats_out) {
+    EncodeStats stats;
+    const std::string problem = check_invariants(input);
+    if (!problem.empty()) throw Error("encode: invalid hierarchy: " + problem);
+    const bool quantized = options.quantize_bits != 0;
+    // Quantized coordinates are reconstructed as doubles on the grid, whatever the input precision.
+    const Precision precision = input.single_precision() && !quantized ? Precision::float32 : Precision::float64;
+
+    // II-B: code the base mesh first and express the forest in the decoder's base order.
+    const BaseMeshCode base_code = encode_base_connectivity(input.base());
+    Hierarchy h = reorder_base(input, base_code.vertex_order, base_code.triangle_order, base_code.triangle_rotation);
+    Quantizer quantizer;
+    if (quantized) {
+        h.set_single_precision(false);
+        const std::vector<Vec3> points = all_positions(h);
+        quantizer = make_quantizer(points, options.quantize_bits);
+        stats.max_error = max_quantization_error(quantizer, points);
+        // Closed loop: predictions are made from what the decoder will have.
+        for (VertexId v = 0; v < h.positions().size(); ++v) h.set_position(v, dequantize(quantizer, quantize(quantizer, h.position(v))));
+    }
+
+    HierarchyLevelEncoder hierarchy(h, options.hierarchy);
+    Metadata meta;
+    meta.base_vertices = h.base().positions.size();
+    meta.base_triangles = h.root_count();
+    meta.nodes = h.node_count();
+    meta.vertices = h.vertex_count();
+    meta.faces = face_count(h);
+    meta.levels = uint64_t(hierarchy.level_count());
+    meta.hierarchy_header = hierarchy.header();
+    meta.quantizer = quantizer;
+
+    BlockWriter writer(uint8_t((precision == Precision::float32 ? kFlagSinglePrecision : 0) | (quantized ? kFlagQuantized : 0)));
+    writer.add(BlockType::metadata, write_metadata(meta, quantized));
+    stats.header_bytes = writer.size();
+    writer.add(BlockType::base_connectivity, base_code.bytes);
+    stats.base_connectivity_bytes = base_code.bytes.size();
+
+    PositionCoder positions(precision, quantized ? &quantizer : nullptr);
+    {
+        ArithmeticEncoder encoder;
+        std::vector<Vec3> decoded;
+        for (uint32_t i = 0; i < meta.base_vertices; ++i) {
+            const Vec3 p = h.position(i);
+            positions.encode(encoder, 0, p, predict_parallelogram(decoded, base_code.stencils[i]));
+            decoded.push_back(p);
+        }
+        const std::vector<uint8_t> payload = encoder.finish();
+        writer.add(BlockType::base_geometry, payload);
+        stats.base_geometry_bytes = payload.size();
+    }
+
+    for (int l = 0; l < hierarchy.level_count(); ++l) {
+        const std::vector<NodeId>& level = hierarchy.level_nodes(l);
+        const std::vector<std::pair<NodeId, int>> created = new_vertices_of_level(h, level);
+        // Pick the predictor of this level: try both on a copy of the models when automatic.
+        GeometryPredictor predictor = options.predictor == GeometryPredictor::automatic ? GeometryPredictor::midpoint : options.predictor;
+        if (options.predictor == GeometryPredictor::automatic && !created.empty()) {
+            size_t best = SIZE_MAX;
+            for (GeometryPredictor candidate : {GeometryPredictor::midpoint, GeometryPredictor::butterfly}) {
+                PositionCoder trial = positions;
+                ArithmeticEncoder encoder;
+                for (auto [n, e] : created)
+                    trial.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)), predict(h, candidate, n, e));
+                const size_t size = encoder.finish().size();
+                if (size < best) {
+                    best = size;
+                    predictor = candidate;
+                }
+            }
+        }
+        std::vector<uint8_t> payload{uint8_t(predictor)};
+        ArithmeticEncoder encoder;
+        hierarchy.encode_level(l, encoder);
+        const size_t hierarchy_part = encoder.bytes_so_far();
+        for (auto [n, e] : created)
+            positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)), predict(h, predictor, n, e));
+        const std::vector<uint8_t> coded = encoder.finish();
+        payload.insert(payload.end(), coded.begin(), coded.end());
+        writer.add(BlockType::level, payload);
+        // The hierarchy/geometry split of a level block is estimated at the coder's byte count
+        // when the hierarchy part ended (they share one arithmetic code).
+        const uint64_t hierarchy_bytes = std::min<uint64_t>(hierarchy_part, coded.size());
+        stats.hierarchy_bytes += hierarchy_bytes;
+        stats.geometry_bytes += coded.size() - hierarchy_bytes;
+        stats.framing_bytes += kBlockOverhead + 1;
+        LevelStats level_stats;
+        level_stats.nodes = level.size();
+        level_stats.new_vertices = created.size();
+        level_stats.bytes = kBlockOverhead + payload.size();
+        level_stats.predictor = predictor;
+        stats.per_level.push_back(level_stats);
+    }
+    std::vector<uint8_t> out = writer.finish();
+    stats.framing_bytes += 3 * kBlockOverhead + kBlockOverhead;  // base blocks and END
+    stats.total_bytes = out.size();
+    stats.faces = meta.faces;
+    stats.vertices = meta.vertices;
+    stats.nodes = meta.nodes;
+    stats.base_vertices = meta.base_vertices;
+    stats.base_triangles = meta.base_triangles;
+    stats.levels = hierarchy.level_count();
+    stats.hierarchy = hierarchy.stats();
+    if (stats_out != nullptr) *stats_out = stats;
+    return out;
+}
+
+Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options) {
+    BlockReader reader(data, size);
+    const bool quantized = reader.flags() & kFlagQuantized;
+    const Precision precision = (reader.flags() & kFlagSinglePrecision) ? Precision::float32 : Precision::float64;
+    Block block{};
+    auto expect = [&](BlockType type) {
+        if (!reader.next(block) || block.type != type)
+            throw Error(std::string("expected a ") + block_type_name(uint8_t(type)) + " block");
+    };
+    expect(BlockType::metadata);
+    const Metadata meta = read_metadata(block, quantized);
+    if (meta.nodes > options.max_nodes)
+        throw Error("file holds " + std::to_string(meta.nodes) + " nodes, more than the limit of " +
+                    std::to_string(options.max_nodes));
+    if (meta.vertices > 3 * meta.nodes + meta.base_vertices) throw Error("metadata block: inconsistent vertex count");
+
+    expect(BlockType::base_connectivity);
+    const DecodedBaseConnectivity connectivity =
+        decode_base_connectivity(block.payload, block.size, uint32_t(std::min<uint64_t>(meta.base_vertices, UINT32_MAX)));
+    if (connectivity.vertex_count != meta.base_vertices || connectivity.triangles.size() != meta.base_triangles)
+        throw Error("base connectivity does not match the metadata");
+
+    TriangleMesh base;
+    base.single_precision = precision == Precision::float32;
+    base.triangles = connectivity.triangles;
+    PositionCoder positions(precision, quantized ? &meta.quantizer : nullptr);
+    expect(BlockType::base_geometry);
+    {
+        ArithmeticDecoder decoder(block.payload, block.size);
+        for (uint32_t i = 0; i < connectivity.vertex_count; ++i) {
+            base.positions.push_back(positions.decode(decoder, 0, predict_parallelogram(base.positions, connectivity.stencils[i])));
+            const Vec3 p = base.positions.back();
+            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+                throw Error("base geometry is corrupt (non-finite coordinate)");
+        }
+        if (decoder.overran() || positions.saw_invalid_symbol()) throw Error("base geometry block is truncated or corrupt");
+    }
+    validate_triangle_mesh(base, "decoded base mesh");
+
+    HierarchyLevelDecoder hierarchy(base, meta.hierarchy_header.data(), meta.hierarchy_header.size(),
+                                    std::min<uint64_t>(meta.nodes, options.max_nodes));
+    Hierarchy& h = hierarchy.hierarchy();
+    int level = 0;
+    while (reader.next(block)) {
+        if (block.type == BlockType::end) break;
+        if (block.type != BlockType::level) throw Error("unexpected block between level blocks");
+        if (hierarchy.done()) throw Error("level block after the last level");
+        if (options.max_level >= 0 && level >= options.max_level) return h;  // progressive: stop here
+        if (block.size < 1 || block.payload[0] < 1 || block.payload[0] > 2) throw Error("level block: bad predictor");
+        const GeometryPredictor predictor = GeometryPredictor(block.payload[0]);
+        ArithmeticDecoder decoder(block.payload + 1, block.size - 1);
+        const std::vector<NodeId> nodes = hierarchy.level_nodes();
+        hierarchy.decode_level(decoder);
+        for (auto [n, e] : new_vertices_of_level(h, nodes)) {
+            const Vec3 p = positions.decode(decoder, level_context(h.level(n)), predict(h, predictor, n, e));
+            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+                throw Error("level " + std::to_string(level) + " geometry is corrupt (non-finite coordinate)");
+            h.set_position(h.midpoint(n, e), p);
+        }
+        if (decoder.overran() || positions.saw_invalid_symbol())
+            throw Error("level " + std::to_string(level) + " block is truncated or corrupt");
+        ++level;
+    }
+    if (!hierarchy.done()) {
+        if (options.max_level >= 0 && level >= options.max_level) return h;
+        throw Error("file ends before the last level");
+    }
+    hierarchy.finish();
+    if (h.node_count() != meta.nodes || h.vertex_count() != meta.vertices || uint64_t(level) != meta.levels)
+        throw Error("decoded hierarchy does not match the metadata");
+    return h;
+}
+
+DecodeResult try_decode(const uint8_t* data, size_t size, const DecodeOptions& options) noexcept {
+    DecodeResult result;
+    try {
+        result.hierarchy = decode(data, size, options);
+        result.ok = true;
+    } catch (const std::exception& e) {
+        result.error = e.what();
+    }
+    return result;
+}
+
+FileInfo inspect(const uint8_t* data, size_t size) {
+    BlockReader reader(data, size);
+    FileInfo info;
+    info.version = reader.version();
+    info.single_precision = reader.flags() & kFlagSinglePrecision;
+    const bool quantized = reader.flags() & kFlagQuantized;
+    Block block{};
+    int level = 0;
+    while (reader.next(block)) {
+        FileBlock entry;
+        entry.type = uint8_t(block.type);
+        entry.name = block_type_name(entry.type);
+        entry.offset = block.offset;
+        entry.size = block.size + kBlockOverhead;
+        if (block.type == BlockType::metadata) {
+            const Metadata meta = read_metadata(block, quantized);
+            info.base_vertices = meta.base_vertices;
+            info.base_triangles = meta.base_triangles;
+            info.nodes = meta.nodes;
+            info.vertices = meta.vertices;
+            info.faces = meta.faces;
+            info.levels = int(meta.levels);
+            info.quantize_bits = quantized ? meta.quantizer.bits : 0;
+        }
+        if (block.type == BlockType::level) entry.level = level++;
+        info.blocks.push_back(entry);
+    }
+    return info;
+}
+
+}  // namespace amc

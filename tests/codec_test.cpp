@@ -1,0 +1,202 @@
+// The .amc file: bit-exact round trips, quantization, progressive decoding, corrupt files.
+#include "hierarchy_checks.h"
+
+#include "coding/base_mesh_coder.h"
+
+#include <amc/codec.h>
+
+#include <cmath>
+#include <cstring>
+
+namespace amc {
+namespace {
+
+struct Random {
+    uint64_t state;
+    uint64_t next() {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return state ^ (state >> 29);
+    }
+};
+
+// What the decoder must give back: the input expressed in the base coder's order.
+Hierarchy expected_decoding(const Hierarchy& h) {
+    const BaseMeshCode code = encode_base_connectivity(h.base());
+    return reorder_base(h, code.vertex_order, code.triangle_order, code.triangle_rotation);
+}
+
+// Coordinates that stress a lossless float coder: random bit patterns of finite values,
+// denormals, signed zeros, huge and tiny magnitudes, and exact midpoints.
+double stress_coordinate(Random& random, bool single) {
+    switch (random.next() % 6) {
+        case 0: return 0.0;
+        case 1: return -0.0;
+        case 2: return (random.next() % 2 ? 1 : -1) * std::ldexp(double(random.next() % 1000 + 1), single ? -149 : -1074);  // denormal
+        case 3: return (random.next() % 2 ? 1 : -1) * std::ldexp(double(random.next() % 1000), single ? 100 : 900);
+        case 4: return std::ldexp(double(random.next() % 100000), -random.next() % 60);
+        default: {
+            if (single) {
+                uint32_t bits = uint32_t(random.next());
+                float f;
+                std::memcpy(&f, &bits, 4);
+                return std::isfinite(f) ? double(f) : 1.5;
+            }
+            uint64_t bits = random.next();
+            double d;
+            std::memcpy(&d, &bits, 8);
+            return std::isfinite(d) ? d : 2.5;
+        }
+    }
+}
+
+Hierarchy random_hierarchy(uint64_t seed, bool single) {
+    Random random{seed};
+    const auto meshes = testing::fixture_meshes();
+    TriangleMesh base = meshes[random.next() % meshes.size()].mesh;
+    base.single_precision = single;
+    for (Vec3& p : base.positions) {
+        if (single) p = Vec3{double(float(p.x)), double(float(p.y)), double(float(p.z))};
+    }
+    Hierarchy h(base);
+    refine_randomly(h, h.root_count() + uint32_t(random.next() % 400), 1 + int(random.next() % 5), seed);
+    for (NodeId n : h.leaves()) {
+        if (h.hanging_node_count(n) == 2 && random.next() % 3 == 0) h.set_diagonal_flipped(n, true);
+    }
+    if (seed % 2 == 0) {  // half keep exact midpoints (finite-element style), half get stress values
+        for (VertexId v = 0; v < h.positions().size(); ++v) {
+            h.set_position(v, {stress_coordinate(random, single), stress_coordinate(random, single),
+                               stress_coordinate(random, single)});
+        }
+    }
+    return h;
+}
+
+TEST(Codec, ThousandRandomHierarchiesRoundTripBitExactly) {
+    for (uint64_t seed = 1; seed <= 1000; ++seed) {
+        const bool single = seed % 4 < 2;
+        const Hierarchy h = random_hierarchy(seed, single);
+        EncodeOptions options;
+        options.predictor = GeometryPredictor(seed % 3);
+        const std::vector<uint8_t> bytes = encode(h, options);
+        const Hierarchy back = decode(bytes.data(), bytes.size());
+        ASSERT_TRUE(identical(back, expected_decoding(h))) << "seed " << seed;
+        ASSERT_EQ(check_invariants(back), "");
+    }
+}
+
+TEST(Codec, ExactMidpointsCostAlmostNothing) {
+    Hierarchy h(make_l_shape(4));
+    refine_randomly(h, 50000, 9, 3);
+    EncodeStats stats;
+    const std::vector<uint8_t> bytes = encode(h, {}, &stats);
+    EXPECT_LT(double(stats.geometry_bytes) * 8 / double(stats.vertices - stats.base_vertices), 0.1)
+        << "bits per refinement vertex";
+    EXPECT_TRUE(identical(decode(bytes.data(), bytes.size()), expected_decoding(h)));
+}
+
+TEST(Codec, QuantizedErrorIsBounded) {
+    const Hierarchy h = random_hierarchy(3, false);
+    Hierarchy smooth(make_bumpy_sphere(1));
+    refine_randomly(smooth, 3000, 5, 9);
+    for (int bits : {8, 12, 16}) {
+        EncodeOptions options;
+        options.quantize_bits = bits;
+        EncodeStats stats;
+        const std::vector<uint8_t> bytes = encode(smooth, options, &stats);
+        const Hierarchy back = decode(bytes.data(), bytes.size());
+        const Hierarchy expected = expected_decoding(smooth);
+        ASSERT_EQ(back.node_count(), expected.node_count());
+        const std::vector<uint32_t> ca = canonical_vertex_order(back), cb = canonical_vertex_order(expected);
+        std::vector<Vec3> pa(back.vertex_count()), pb(expected.vertex_count());
+        for (size_t v = 0; v < ca.size(); ++v) if (ca[v] != 0xffffffffu) pa[ca[v]] = back.position(VertexId(v));
+        for (size_t v = 0; v < cb.size(); ++v) if (cb[v] != 0xffffffffu) pb[cb[v]] = expected.position(VertexId(v));
+        double worst = 0;
+        for (size_t i = 0; i < pa.size(); ++i) {
+            worst = std::max({worst, std::fabs(pa[i].x - pb[i].x), std::fabs(pa[i].y - pb[i].y), std::fabs(pa[i].z - pb[i].z)});
+        }
+        EXPECT_LE(worst, stats.max_error * (1 + 1e-9)) << bits;
+        EXPECT_GT(stats.max_error, 0.0);
+        EXPECT_LE(stats.max_error, 2.5 / double(1u << bits) * 1.01) << "half a step of a box about 2.5 wide";
+    }
+    (void)h;
+}
+
+TEST(Codec, ProgressiveDecodingGivesEveryLevelMesh) {
+    Hierarchy h(make_icosahedron());
+    refine_randomly(h, 5000, 6, 21);
+    const std::vector<uint8_t> bytes = encode(h);
+    const Hierarchy expected = expected_decoding(h);
+    for (int level = 0; level <= h.depth(); ++level) {
+        DecodeOptions options;
+        options.max_level = level;
+        const Hierarchy part = decode(bytes.data(), bytes.size(), options);
+        const LeafMesh got = extract_leaf_mesh(part), want = extract_leaf_mesh(expected, level);
+        EXPECT_EQ(got.mesh.triangles, want.mesh.triangles) << level;
+        ASSERT_EQ(got.mesh.positions.size(), want.mesh.positions.size()) << level;
+        for (size_t i = 0; i < got.mesh.positions.size(); ++i) ASSERT_TRUE(got.mesh.positions[i] == want.mesh.positions[i]);
+    }
+}
+
+TEST(Codec, BaseMeshesWithBoundaryHandlesAndComponents) {
+    TriangleMesh two = make_torus(6, 5, 2.0, 0.7);
+    const TriangleMesh square = make_square(3);
+    const uint32_t offset = uint32_t(two.positions.size());
+    for (Vec3 p : square.positions) two.positions.push_back(p + Vec3{10, 0, 0});
+    for (Triangle t : square.triangles) two.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+    for (const TriangleMesh& mesh : {two, make_l_shape(2), make_torus(9, 7, 3.0, 1.0)}) {
+        Hierarchy h(mesh);
+        refine_randomly(h, 2000, 5, 4);
+        const std::vector<uint8_t> bytes = encode(h);
+        EXPECT_TRUE(identical(decode(bytes.data(), bytes.size()), expected_decoding(h)));
+    }
+}
+
+TEST(Codec, EveryTruncationAndManyCorruptionsAreErrors) {
+    Hierarchy h(make_torus(6, 5, 2.0, 0.7));
+    refine_randomly(h, 800, 4, 8);
+    const std::vector<uint8_t> bytes = encode(h);
+    for (size_t length = 0; length < bytes.size(); ++length) {
+        EXPECT_THROW(decode(bytes.data(), length), Error) << length;
+    }
+    Random random{77};
+    int accepted = 0;
+    for (int trial = 0; trial < 10000; ++trial) {
+        std::vector<uint8_t> corrupt = bytes;
+        const int flips = 1 + int(random.next() % 3);
+        for (int f = 0; f < flips; ++f) corrupt[random.next() % corrupt.size()] ^= uint8_t(1u << (random.next() % 8));
+        const DecodeResult result = try_decode(corrupt.data(), corrupt.size());
+        if (result.ok) ++accepted;
+        else EXPECT_FALSE(result.error.empty());
+    }
+    EXPECT_EQ(accepted, 0) << "checksums catch every corruption of this size";
+}
+
+TEST(Codec, NewerVersionIsRefusedClearly) {
+    Hierarchy h(make_icosahedron());
+    std::vector<uint8_t> bytes = encode(h);
+    bytes[4] = 2;
+    try {
+        decode(bytes.data(), bytes.size());
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("version"), std::string::npos);
+    }
+}
+
+TEST(Codec, InspectListsTheBlocks) {
+    Hierarchy h(make_icosahedron());
+    refine_randomly(h, 500, 4, 2);
+    const std::vector<uint8_t> bytes = encode(h);
+    const FileInfo info = inspect(bytes.data(), bytes.size());
+    ASSERT_GE(info.blocks.size(), 5u);
+    EXPECT_EQ(info.blocks.front().name, "metadata");
+    EXPECT_EQ(info.blocks.back().name, "end");
+    uint64_t total = 8;
+    for (const FileBlock& b : info.blocks) total += b.size;
+    EXPECT_EQ(total, bytes.size());
+    EXPECT_EQ(info.nodes, h.node_count());
+    EXPECT_EQ(info.levels, h.depth() + 1);
+}
+
+}  // namespace
+}  // namespace amc
