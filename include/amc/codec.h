@@ -52,6 +52,11 @@ struct EncodeStats {
 // result is identical to reorder_base(h, ...) of the input — same elements, same positions.
 std::vector<uint8_t> encode(const Hierarchy& h, const EncodeOptions& options = {}, EncodeStats* stats = nullptr);
 
+// `h` as decode(encode(h)) returns it: over the base mesh in the base coder's order (cheap: codes
+// the base connectivity only). identical(decode(encode(h)), in_decoder_order(h)) holds for every
+// bit-exact encoding.
+Hierarchy in_decoder_order(const Hierarchy& h);
+
 struct DecodeOptions {
     int max_level = -1;                  // stop after this level: the mesh of that level
     uint64_t max_nodes = 1ull << 26;     // refuse files that would build more nodes than this

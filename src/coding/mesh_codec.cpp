@@ -304,6 +304,11 @@ Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options)
     return h;
 }
 
+Hierarchy in_decoder_order(const Hierarchy& h) {
+    const BaseMeshCode code = encode_base_connectivity(h.base());
+    return reorder_base(h, code.vertex_order, code.triangle_order, code.triangle_rotation);
+}
+
 DecodeResult try_decode(const uint8_t* data, size_t size, const DecodeOptions& options) noexcept {
     DecodeResult result;
     try {
