@@ -231,6 +231,12 @@ int main(int argc, char** argv) {
     decode_cmd->add_option("-o,--output", decode_output, "Leaf mesh (.obj/.off/.ply/.vtu) or hierarchy (.amh)")->required();
     decode_cmd->add_option("--level", decode_level, "Decode only up to this level (progressive)");
 
+    std::vector<std::string> report_inputs;
+    int report_runs = 3;
+    auto* report = app.add_subcommand("report", "The .amc file per model: sizes by part, lossless and quantized, speeds");
+    report->add_option("files", report_inputs, "Hierarchy files (.amh)")->required();
+    report->add_option("--runs", report_runs, "Runs per measurement (the median is reported)")->capture_default_str();
+
     std::vector<std::string> stats_inputs;
     bool stats_groups = false;
     auto* stats = app.add_subcommand("stats", "Hierarchy coder statistics: the paper's Tables 1 and 2");
@@ -317,6 +323,12 @@ int main(int argc, char** argv) {
             save(decode_output, h);
             std::printf("%s: %u nodes, %u vertices, depth %d -> %s\n", decode_input.c_str(), h.node_count(),
                         h.vertex_count(), h.depth(), decode_output.c_str());
+            return 0;
+        }
+        if (*report) {
+            print_codec_report_header();
+            for (const std::string& file : report_inputs)
+                print_codec_report(std::filesystem::path(file).stem().string(), load_hierarchy(file), std::max(1, report_runs));
             return 0;
         }
         if (*stats) {

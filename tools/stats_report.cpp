@@ -75,3 +75,58 @@ void print_table2(const std::string& name, const Hierarchy& h) {
 }
 
 }  // namespace amc
+
+// ---- amc report: the .amc file per model and coordinate mode ----------------------------------
+
+#include <amc/codec.h>
+
+#include <algorithm>
+#include <chrono>
+
+namespace amc {
+
+namespace {
+
+double median_seconds(std::vector<double> samples) {
+    std::sort(samples.begin(), samples.end());
+    return samples[samples.size() / 2];
+}
+
+}  // namespace
+
+void print_codec_report_header() {
+    std::printf("| model | faces | vertices | coordinates | total bytes | connectivity bytes (base + hierarchy) | "
+                "geometry bytes | bits/face | bits/vertex | conn. bits/face | max error | encode M faces/s | decode M faces/s |\n");
+    std::printf("|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+}
+
+void print_codec_report(const std::string& name, const Hierarchy& h, int runs) {
+    for (int bits : {0, 16, 12}) {
+        EncodeOptions options;
+        options.quantize_bits = bits;
+        EncodeStats stats;
+        std::vector<uint8_t> bytes;
+        std::vector<double> encode_times, decode_times;
+        for (int r = 0; r < runs; ++r) {
+            auto t0 = std::chrono::steady_clock::now();
+            bytes = encode(h, options, &stats);
+            auto t1 = std::chrono::steady_clock::now();
+            const Hierarchy back = decode(bytes.data(), bytes.size());
+            auto t2 = std::chrono::steady_clock::now();
+            if (back.node_count() != h.node_count()) throw Error(name + ": decoded node count differs");
+            encode_times.push_back(std::chrono::duration<double>(t1 - t0).count());
+            decode_times.push_back(std::chrono::duration<double>(t2 - t1).count());
+        }
+        const uint64_t connectivity = stats.base_connectivity_bytes + stats.hierarchy_bytes;
+        const uint64_t geometry = stats.base_geometry_bytes + stats.geometry_bytes;
+        const std::string mode = bits == 0 ? (h.single_precision() ? "float32 exact" : "float64 exact") : std::to_string(bits) + " bits";
+        std::printf("| %s | %lu | %lu | %s | %zu | %lu (%lu + %lu) | %lu | %.2f | %.2f | %.3f | %.3g | %.2f | %.2f |\n",
+                    name.c_str(), (unsigned long)stats.faces, (unsigned long)stats.vertices, mode.c_str(), bytes.size(),
+                    (unsigned long)connectivity, (unsigned long)stats.base_connectivity_bytes,
+                    (unsigned long)stats.hierarchy_bytes, (unsigned long)geometry, 8.0 * bytes.size() / double(stats.faces),
+                    8.0 * bytes.size() / double(stats.vertices), 8.0 * connectivity / double(stats.faces), stats.max_error,
+                    stats.faces / median_seconds(encode_times) / 1e6, stats.faces / median_seconds(decode_times) / 1e6);
+    }
+}
+
+}  // namespace amc

@@ -12,4 +12,9 @@ void print_table1_header();
 void print_table1_row(const std::string& name, const Hierarchy& h);
 void print_table2(const std::string& name, const Hierarchy& h);
 
+// `amc report`: size of the .amc file by part, lossless and at 16 and 12 bits, and median encode and
+// decode speeds over `runs` runs, one markdown table row per model and mode.
+void print_codec_report_header();
+void print_codec_report(const std::string& name, const Hierarchy& h, int runs);
+
 }  // namespace amc
