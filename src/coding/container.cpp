@@ -38,6 +38,7 @@ BlockWriter::BlockWriter(uint8_t flags) {
     out_.push_back(flags);
     out_.push_back(0);
     out_.push_back(0);
+    put_u32(out_, XXH32(out_.data(), 8, 0));
 }
 
 void BlockWriter::add(BlockType type, const std::vector<uint8_t>& payload) {
@@ -55,12 +56,16 @@ std::vector<uint8_t> BlockWriter::finish() {
 }
 
 BlockReader::BlockReader(const uint8_t* data, size_t size) : data_(data), size_(size) {
-    if (size < kFileHeaderSize || std::memcmp(data, kFileMagic, 4) != 0) throw Error("not an .amc file (bad magic)");
+    if (size < 4 || std::memcmp(data, kFileMagic, 4) != 0) throw Error("not an .amc file (bad magic)");
+    if (size < 5) throw Error("file is truncated (header)");
     version_ = data[4];
-    flags_ = data[5];
+    // The version comes first: a newer file may have a header this build does not know.
     if (version_ != kFileVersion)
         throw Error("unsupported .amc version " + std::to_string(version_) + " (this build reads version " +
                     std::to_string(kFileVersion) + ")");
+    if (size < kFileHeaderSize) throw Error("file is truncated (header)");
+    if (XXH32(data, 8, 0) != get_u32(data + 8)) throw Error("checksum mismatch in the file header");
+    flags_ = data[5];
     if (flags_ & ~(kFlagSinglePrecision | kFlagQuantized)) throw Error("unknown flags in the file header");
     if (data[6] != 0 || data[7] != 0) throw Error("reserved header bytes are not zero");
 }

@@ -1,4 +1,4 @@
-// The block structure of the .amc file (docs/FORMAT.md, section 3): a fixed header, then typed
+// The block structure of the .amc file (docs/FORMAT.md, section 3): a fixed, checksummed header, then typed
 // blocks, each with its length and an XXH32 checksum, ending with an END block.
 #pragma once
 
@@ -10,7 +10,7 @@ namespace amc {
 
 constexpr char kFileMagic[4] = {'A', 'M', 'C', 'F'};
 constexpr uint8_t kFileVersion = 1;
-constexpr size_t kFileHeaderSize = 8;
+constexpr size_t kFileHeaderSize = 12;  // magic, version, flags, 2 reserved, XXH32 of those 8
 constexpr size_t kBlockOverhead = 1 + 4 + 4;  // type, payload length, checksum
 
 // Block types: frozen values (they are written to files).

@@ -53,19 +53,37 @@ private:
     FloatResidualModels models_;
 };
 
+// A base triangle's rotation (0, 1, 2): "is it 0?", then "is it 1?".
+struct RotationModels {
+    BitModel zero, one;
+};
+void encode_rotation(ArithmeticEncoder& encoder, RotationModels& models, uint8_t rotation) {
+    encoder.encode(rotation == 0, models.zero);
+    if (rotation != 0) encoder.encode(rotation == 1, models.one);
+}
+uint8_t decode_rotation(ArithmeticDecoder& decoder, RotationModels& models) {
+    if (decoder.decode(models.zero)) return 0;
+    return decoder.decode(models.one) ? 1 : 2;
+}
+
 Vec3 predict(const Hierarchy& h, GeometryPredictor predictor, NodeId n, int e) {
     return predictor == GeometryPredictor::butterfly ? predict_butterfly(h, n, e) : predict_midpoint(h, n, e);
 }
 
+// Metadata option bits.
+constexpr uint64_t kOptionRootRotations = 1;  // base triangles keep the input's local vertex order
+
 struct Metadata {
     uint64_t base_vertices = 0, base_triangles = 0, nodes = 0, vertices = 0, faces = 0, levels = 0;
+    uint64_t options = 0;
     std::vector<uint8_t> hierarchy_header;
     Quantizer quantizer;
 };
 
 std::vector<uint8_t> write_metadata(const Metadata& m, bool quantized) {
     std::vector<uint8_t> out;
-    for (uint64_t v : {m.base_vertices, m.base_triangles, m.nodes, m.vertices, m.faces, m.levels}) put_varint(out, v);
+    for (uint64_t v : {m.base_vertices, m.base_triangles, m.nodes, m.vertices, m.faces, m.levels, m.options})
+        put_varint(out, v);
     put_varint(out, m.hierarchy_header.size());
     out.insert(out.end(), m.hierarchy_header.begin(), m.hierarchy_header.end());
     if (quantized) {
@@ -87,6 +105,8 @@ Metadata read_metadata(const Block& block, bool quantized) {
     m.vertices = in.varint();
     m.faces = in.varint();
     m.levels = in.varint();
+    m.options = in.varint();
+    if (m.options & ~kOptionRootRotations) throw Error("metadata block: unknown options");
     const uint64_t header_size = in.varint();
     if (header_size > in.remaining()) throw Error("metadata block: hierarchy header is truncated");
     m.hierarchy_header.assign(in.rest(), in.rest() + header_size);
@@ -122,6 +142,26 @@ uint64_t face_count(const Hierarchy& h) {
     return faces;
 }
 
+// The input over the base mesh in the base coder's order. The base coder may rotate each
+// triangle's vertices. The default diagonal rule does not care, but hierarchies made under a rule
+// of absolute local indices would pay orientation bits: then storing each root's rotation
+// (log2 3 bits) to keep the input's local order may be cheaper (`keep_rotations`).
+Hierarchy in_base_code_order(const Hierarchy& input, const BaseMeshCode& base_code, bool& keep_rotations) {
+    keep_rotations = false;
+    Hierarchy h = reorder_base(input, base_code.vertex_order, base_code.triangle_order, base_code.triangle_rotation);
+    const HierarchyCodeStats rotated = HierarchyLevelEncoder(h, {}).stats();
+    if (rotated.diagonal_exceptions == 0) return h;
+    Hierarchy kept = reorder_base(input, base_code.vertex_order, base_code.triangle_order,
+                                  std::vector<uint8_t>(base_code.triangle_order.size(), 0));
+    const HierarchyCodeStats original = HierarchyLevelEncoder(kept, {}).stats();
+    const double rotated_bits = binary_entropy_bits(rotated.diagonal_exceptions, rotated.two_hanging_leaves);
+    const double kept_bits = binary_entropy_bits(original.diagonal_exceptions, original.two_hanging_leaves) +
+                             1.585 * double(base_code.triangle_order.size());
+    if (kept_bits >= rotated_bits) return h;
+    keep_rotations = true;
+    return kept;
+}
+
 }  // namespace
 
 std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options, EncodeStats* stats_out) {
@@ -134,7 +174,8 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
 
     // II-B: code the base mesh first and express the forest in the decoder's base order.
     const BaseMeshCode base_code = encode_base_connectivity(input.base());
-    Hierarchy h = reorder_base(input, base_code.vertex_order, base_code.triangle_order, base_code.triangle_rotation);
+    bool keep_rotations = false;
+    Hierarchy h = in_base_code_order(input, base_code, keep_rotations);
     Quantizer quantizer;
     if (quantized) {
         h.set_single_precision(false);
@@ -155,6 +196,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     meta.levels = uint64_t(hierarchy.level_count());
     meta.hierarchy_header = hierarchy.header();
     meta.quantizer = quantizer;
+    meta.options = keep_rotations ? kOptionRootRotations : 0;
 
     BlockWriter writer(uint8_t((precision == Precision::float32 ? kFlagSinglePrecision : 0) | (quantized ? kFlagQuantized : 0)));
     writer.add(BlockType::metadata, write_metadata(meta, quantized));
@@ -165,6 +207,10 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     PositionCoder positions(precision, quantized ? &quantizer : nullptr);
     {
         ArithmeticEncoder encoder;
+        if (keep_rotations) {
+            RotationModels models;
+            for (uint8_t r : base_code.triangle_rotation) encode_rotation(encoder, models, r);
+        }
         std::vector<Vec3> decoded;
         for (uint32_t i = 0; i < meta.base_vertices; ++i) {
             const Vec3 p = h.position(i);
@@ -260,6 +306,15 @@ Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options)
     expect(BlockType::base_geometry);
     {
         ArithmeticDecoder decoder(block.payload, block.size);
+        if (meta.options & kOptionRootRotations) {
+            // Undo the base coder's rotations: decoded (o[r], o[r+1], o[r+2]) back to o.
+            RotationModels models;
+            for (Triangle& t : base.triangles) {
+                const uint8_t r = decode_rotation(decoder, models);
+                const Triangle decoded = t;
+                for (int i = 0; i < 3; ++i) t[(i + r) % 3] = decoded[i];
+            }
+        }
         for (uint32_t i = 0; i < connectivity.vertex_count; ++i) {
             base.positions.push_back(positions.decode(decoder, 0, predict_parallelogram(base.positions, connectivity.stencils[i])));
             const Vec3 p = base.positions.back();
@@ -305,8 +360,8 @@ Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options)
 }
 
 Hierarchy in_decoder_order(const Hierarchy& h) {
-    const BaseMeshCode code = encode_base_connectivity(h.base());
-    return reorder_base(h, code.vertex_order, code.triangle_order, code.triangle_rotation);
+    bool keep_rotations = false;
+    return in_base_code_order(h, encode_base_connectivity(h.base()), keep_rotations);
 }
 
 DecodeResult try_decode(const uint8_t* data, size_t size, const DecodeOptions& options) noexcept {
