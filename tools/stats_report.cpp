@@ -114,6 +114,8 @@ void print_codec_report(const std::string& name, const Hierarchy& h, int runs) {
             const Hierarchy back = decode(bytes.data(), bytes.size());
             auto t2 = std::chrono::steady_clock::now();
             if (back.node_count() != h.node_count()) throw Error(name + ": decoded node count differs");
+            if (bits == 0 && r == 0 && !identical(back, in_decoder_order(h)))
+                throw Error(name + ": the lossless round trip is not bit-exact");
             encode_times.push_back(std::chrono::duration<double>(t1 - t0).count());
             decode_times.push_back(std::chrono::duration<double>(t2 - t1).count());
         }
