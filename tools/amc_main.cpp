@@ -242,6 +242,8 @@ int main(int argc, char** argv) {
     auto* stats = app.add_subcommand("stats", "Hierarchy coder statistics: the paper's Tables 1 and 2");
     stats->add_option("files", stats_inputs, "Hierarchy files (.amh)")->required();
     stats->add_flag("--groups", stats_groups, "Also print the context groups (Table 2) of each file");
+    bool stats_verify = false;
+    stats->add_flag("--verify", stats_verify, "Round-trip every file under all 64 switch combinations");
 
     CLI11_PARSE(app, argc, argv);
 
@@ -335,6 +337,12 @@ int main(int argc, char** argv) {
             print_table1_header();
             for (const std::string& file : stats_inputs) {
                 print_table1_row(std::filesystem::path(file).stem().string(), read_hierarchy(file));
+            }
+            if (stats_verify) {
+                for (const std::string& file : stats_inputs) {
+                    const int n = verify_all_switch_combinations(load_hierarchy(file));
+                    std::printf("%s: round trip identical under all %d switch combinations\n", file.c_str(), n);
+                }
             }
             if (stats_groups) {
                 for (const std::string& file : stats_inputs) {

@@ -42,6 +42,34 @@ void print_table1_row(const std::string& name, const Hierarchy& h) {
                 100.0 * (1.0 - double(full.payload_bytes) / double(naive.payload_bytes)));
 }
 
+int verify_all_switch_combinations(const Hierarchy& h) {
+    const std::vector<NodeId> order = h.breadth_first_order();
+    const LeafMesh leaf = extract_leaf_mesh(h);
+    int combinations = 0;
+    for (int bits = 0; bits < 64; ++bits) {
+        HierarchyCoderOptions o;
+        o.cull_one_regularity = bits & 1;
+        o.cull_hanging_nodes = bits & 2;
+        o.uniform_levels = bits & 4;
+        o.truncate_stream = bits & 8;
+        o.use_contexts = bits & 16;
+        o.traversal = (bits & 32) ? Traversal::improved : Traversal::naive;
+        const std::vector<uint8_t> bytes = encode_hierarchy(h, o);
+        const Hierarchy back = decode_hierarchy(h.base(), bytes.data(), bytes.size());
+        const std::vector<NodeId> back_order = back.breadth_first_order();
+        bool same = back_order.size() == order.size();
+        for (size_t i = 0; same && i < order.size(); ++i) {
+            same = h.is_leaf(order[i]) == back.is_leaf(back_order[i]) &&
+                   (!h.is_leaf(order[i]) || h.hanging_node_count(order[i]) != 2 ||
+                    h.diagonal_flipped(order[i]) == back.diagonal_flipped(back_order[i]));
+        }
+        same = same && extract_leaf_mesh(back).mesh.triangles == leaf.mesh.triangles;
+        if (!same) throw Error("hierarchy round trip differs under switch combination " + std::to_string(bits));
+        ++combinations;
+    }
+    return combinations;
+}
+
 void print_table2(const std::string& name, const Hierarchy& h) {
     HierarchyCodeStats by_traversal[2];
     HierarchyCoderOptions options;

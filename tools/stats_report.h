@@ -11,6 +11,9 @@ namespace amc {
 void print_table1_header();
 void print_table1_row(const std::string& name, const Hierarchy& h);
 void print_table2(const std::string& name, const Hierarchy& h);
+// Encodes and decodes the forest under all 64 combinations of the coder's switches; throws Error
+// if any differs. Returns the number of combinations checked.
+int verify_all_switch_combinations(const Hierarchy& h);
 
 // `amc report`: size of the .amc file by part, lossless and at 16 and 12 bits, and median encode and
 // decode speeds over `runs` runs, one markdown table row per model and mode.
