@@ -42,6 +42,7 @@ BlockWriter::BlockWriter(uint8_t flags) {
 }
 
 void BlockWriter::add(BlockType type, const std::vector<uint8_t>& payload) {
+    if (payload.size() > UINT32_MAX) throw Error(std::string(block_type_name(uint8_t(type))) + " block is larger than 4 GiB");
     const size_t start = out_.size();
     out_.push_back(uint8_t(type));
     put_u32(out_, uint32_t(payload.size()));

@@ -281,6 +281,7 @@ Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options)
     BlockReader reader(data, size);
     const bool quantized = reader.flags() & kFlagQuantized;
     const Precision precision = (reader.flags() & kFlagSinglePrecision) ? Precision::float32 : Precision::float64;
+    if (quantized && precision == Precision::float32) throw Error("file header: quantized and float32 flags together");
     Block block{};
     auto expect = [&](BlockType type) {
         if (!reader.next(block) || block.type != type)
