@@ -367,7 +367,13 @@ int main(int argc, char** argv) {
                 std::printf("\n  base mesh %lu vertices, %lu triangles; %lu nodes, %d levels, %lu vertices, %lu faces\n",
                             (unsigned long)file.base_vertices, (unsigned long)file.base_triangles, (unsigned long)file.nodes,
                             file.levels, (unsigned long)file.vertices, (unsigned long)file.faces);
-                std::printf("  %lu bytes: %.3f bits/face, %.2f bits/vertex\n", (unsigned long)bytes.size(),
+                // Decoding validates what the block checksums can not: the structure of the payloads.
+                try {
+                    decode(bytes.data(), bytes.size());
+                } catch (const Error& e) {
+                    throw Error(info_input + ": " + e.what());
+                }
+                std::printf("  %lu bytes: %.3f bits/face, %.2f bits/vertex; decodes: yes\n", (unsigned long)bytes.size(),
                             8.0 * bytes.size() / double(file.faces), 8.0 * bytes.size() / double(file.vertices));
                 std::printf("  %-20s %10s %10s\n", "block", "offset", "bytes");
                 for (const FileBlock& b : file.blocks) {
