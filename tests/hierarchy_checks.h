@@ -14,6 +14,15 @@
 
 namespace amc::testing {
 
+// A tiny generator whose output is the same on every platform (std distributions are not).
+struct Random {
+    uint64_t state;
+    uint64_t next() {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return state >> 33;
+    }
+};
+
 struct NamedMesh {
     std::string name;
     TriangleMesh mesh;

@@ -9,25 +9,10 @@
 namespace amc {
 namespace {
 
-struct Random {
-    uint64_t state;
-    uint64_t next() {
-        state = state * 6364136223846793005ull + 1442695040888963407ull;
-        return state >> 33;
-    }
-};
+using testing::Random;
 
-HierarchyCoderOptions options_from_bits(int bits) {
-    HierarchyCoderOptions o;
-    o.cull_one_regularity = bits & 1;
-    o.cull_hanging_nodes = bits & 2;
-    o.uniform_levels = bits & 4;
-    o.truncate_stream = bits & 8;
-    o.use_contexts = bits & 16;
-    o.traversal = (bits & 32) ? Traversal::improved : Traversal::naive;
-    return o;
-}
-constexpr int kOptionCombinations = 64;
+HierarchyCoderOptions options_from_bits(int bits) { return coder_options_from_switches(bits); }
+constexpr int kOptionCombinations = kCoderSwitchCombinations;
 
 // Same base, forest and effective diagonals (positions are not part of this stream).
 bool same_connectivity(const Hierarchy& a, const Hierarchy& b) {

@@ -5,13 +5,7 @@
 namespace amc {
 namespace {
 
-struct Random {
-    uint64_t state;
-    uint64_t next() {
-        state = state * 6364136223846793005ull + 1442695040888963407ull;
-        return state >> 33;
-    }
-};
+using testing::Random;
 
 TEST(RandomHierarchies, ThousandRefineCoarsenSequencesKeepEveryInvariant) {
     const auto meshes = testing::fixture_meshes();

@@ -46,14 +46,8 @@ int verify_all_switch_combinations(const Hierarchy& h) {
     const std::vector<NodeId> order = h.breadth_first_order();
     const LeafMesh leaf = extract_leaf_mesh(h);
     int combinations = 0;
-    for (int bits = 0; bits < 64; ++bits) {
-        HierarchyCoderOptions o;
-        o.cull_one_regularity = bits & 1;
-        o.cull_hanging_nodes = bits & 2;
-        o.uniform_levels = bits & 4;
-        o.truncate_stream = bits & 8;
-        o.use_contexts = bits & 16;
-        o.traversal = (bits & 32) ? Traversal::improved : Traversal::naive;
+    for (int bits = 0; bits < kCoderSwitchCombinations; ++bits) {
+        const HierarchyCoderOptions o = coder_options_from_switches(bits);
         const std::vector<uint8_t> bytes = encode_hierarchy(h, o);
         const Hierarchy back = decode_hierarchy(h.base(), bytes.data(), bytes.size());
         const std::vector<NodeId> back_order = back.breadth_first_order();

@@ -7,12 +7,25 @@
 
 namespace amc {
 
+HierarchyCoderOptions coder_options_from_switches(int switches) {
+    HierarchyCoderOptions o;
+    o.cull_one_regularity = switches & 1;
+    o.cull_hanging_nodes = switches & 2;
+    o.uniform_levels = switches & 4;
+    o.truncate_stream = switches & 8;
+    o.use_contexts = switches & 16;
+    o.traversal = (switches & 32) ? Traversal::improved : Traversal::naive;
+    return o;
+}
+
+int coder_switches(const HierarchyCoderOptions& o) {
+    return int(o.cull_one_regularity) | int(o.cull_hanging_nodes) << 1 | int(o.uniform_levels) << 2 |
+           int(o.truncate_stream) << 3 | int(o.use_contexts) << 4 | int(o.traversal == Traversal::improved) << 5;
+}
+
 std::vector<uint8_t> write_hierarchy_stream_header(const HierarchyStreamHeader& header) {
     const HierarchyCoderOptions& o = header.options;
-    uint8_t switches = uint8_t(o.cull_one_regularity) | uint8_t(o.cull_hanging_nodes) << 1 |
-                       uint8_t(o.uniform_levels) << 2 | uint8_t(o.truncate_stream) << 3 |
-                       uint8_t(o.use_contexts) << 4 | uint8_t(o.traversal == Traversal::improved) << 5 |
-                       uint8_t(header.orientation_coded) << 6;
+    const uint8_t switches = uint8_t(coder_switches(o) | int(header.orientation_coded) << 6);
     std::vector<uint8_t> out{switches, header.uniform_levels, uint8_t(header.diagonal_rule)};
     if (o.truncate_stream) {
         uint64_t v = header.symbol_count;
@@ -28,13 +41,8 @@ size_t read_hierarchy_stream_header(const uint8_t* data, size_t size, HierarchyS
     if (size < 3) throw Error("hierarchy stream: header is truncated");
     const uint8_t switches = data[0];
     if (switches & 0x80) throw Error("hierarchy stream: reserved switch bit is set");
-    HierarchyCoderOptions& o = header.options;
-    o.cull_one_regularity = switches & 1;
-    o.cull_hanging_nodes = switches & 2;
-    o.uniform_levels = switches & 4;
-    o.truncate_stream = switches & 8;
-    o.use_contexts = switches & 16;
-    o.traversal = (switches & 32) ? Traversal::improved : Traversal::naive;
+    header.options = coder_options_from_switches(switches & 63);
+    const HierarchyCoderOptions& o = header.options;
     header.orientation_coded = switches & 64;
     header.uniform_levels = data[1];
     if (header.uniform_levels > kMaxUniformLevels || (!o.uniform_levels && header.uniform_levels != 0))
