@@ -80,17 +80,25 @@ void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder) {
         }
     }
     if (decoder.overran()) throw Error("hierarchy stream is truncated");
-    std::vector<NodeId> next_ids;
-    next_ids.reserve(size_t(4) * (node_count_ - h_.node_count()));
-    for (uint32_t i = 0; i < n; ++i) {
-        if (!(nodes[i].state & kRefined)) continue;
-        h_.split(level_ids_[i]);
-        const NodeId c = h_.child(level_ids_[i], 0);
-        next_ids.insert(next_ids.end(), {c, c + 1, c + 2, c + 3});
-    }
+    // The next level's links are exactly the links of the new children: split the whole level in
+    // one pass from them, in canonical order (so the children of level l get consecutive ids, as
+    // the level forest numbers them). level_ids_ is compacted in place to the refined nodes, then
+    // becomes the next level's ids.
     derive_next_level(level_, scratch_, next_);
+    NodeId* ids = level_ids_.data();
+    uint32_t count = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        ids[count] = ids[i];
+        count += (nodes[i].state & kRefined) ? 1u : 0u;
+    }
+    h_.split_level(ids, count, next_.empty() ? nullptr : next_[0].nbr, sizeof(LevelNode) / sizeof(uint32_t));
+    level_ids_.resize(size_t(4) * count);
+    ids = level_ids_.data();
+    for (uint32_t r = count; r-- > 0;) {
+        const NodeId c = h_.child(ids[r], 0);
+        for (uint32_t k = 0; k < 4; ++k) ids[size_t(4) * r + k] = c + k;
+    }
     level_.swap(next_);
-    level_ids_.swap(next_ids);
     ++level_index_;
 }
 

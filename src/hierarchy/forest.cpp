@@ -171,6 +171,83 @@ void Hierarchy::split(NodeId n) {
     nodes_[n].first_child = c;
 }
 
+void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_t* child_links, size_t stride) {
+    if (!free_blocks_.empty() || !free_vertices_.empty()) {
+        // Reused ids: take the general path (the decoders never get here).
+        for (uint32_t i = 0; i < count; ++i) split(parents[i]);
+        return;
+    }
+    const size_t c0 = nodes_.size();
+    const size_t new_nodes = c0 + size_t(4) * count;
+    const size_t max_vertices = positions_.size() + size_t(3) * count;
+    if (new_nodes > nodes_.capacity()) reserve(std::max(new_nodes, nodes_.capacity() + nodes_.capacity() / 2), 0);
+    if (max_vertices > positions_.capacity())
+        reserve(0, std::max(max_vertices, positions_.capacity() + positions_.capacity() / 2));
+    nodes_.resize(new_nodes);
+    const size_t v0 = positions_.size();
+    positions_.resize(max_vertices);
+    Node* nodes = nodes_.data();
+    Vec3* positions = positions_.data();
+    VertexId next_vertex = VertexId(v0);
+    const bool default_placer = placer_ == midpoint_placer;
+    for (uint32_t i = 0; i < count; ++i) {
+        const NodeId n = parents[i];
+        Node& parent = nodes[n];
+        const NodeId c = NodeId(c0 + size_t(4) * i);
+        const uint32_t* links[4];
+        for (int k = 0; k < 4; ++k) links[k] = child_links + stride * (size_t(4) * i + size_t(k));
+        VertexId m[3];
+        for (int e = 0; e < 3; ++e) {
+            // The neighbour across e, when refined, holds child (eq+1)%3 or eq on either half.
+            const uint32_t t = links[e][e];
+            const unsigned eq = (parent.nbr_edge >> (2 * e)) & 3u;
+            if (t != kNoNode && t / 4 < i) {
+                m[e] = nodes[c0 + (t & ~3u) + 3].v[(eq + 2) % 3];
+            } else {
+                const Vec3 a = positions[parent.v[e]];
+                const Vec3 b = positions[parent.v[e == 2 ? 0 : e + 1]];
+                positions[next_vertex] = default_placer ? midpoint_placer(placer_context_, a, b)
+                                                        : placer_(placer_context_, a, b);
+                m[e] = next_vertex++;
+            }
+        }
+        const VertexId layout[4][3] = {{parent.v[0], m[0], m[2]},
+                                       {m[0], parent.v[1], m[1]},
+                                       {m[2], m[1], parent.v[2]},
+                                       {m[1], m[2], m[0]}};
+        const uint8_t level = uint8_t(parent.level + 1);
+        for (int k = 0; k < 4; ++k) {
+            Node& child = nodes[c + k];
+            uint8_t edges = 0;
+            for (int e = 0; e < 3; ++e) {
+                child.v[e] = layout[k][e];
+                const uint32_t t = links[k][e];
+                child.nbr[e] = t == kNoNode ? kNoNode : NodeId(c0 + t);
+            }
+            // Linked outer edges take the parent's neighbour edge index (children are parallel
+            // to their parents); the inner edge pairs with the center's edge of the same index.
+            if (k == 3) {
+                edges = uint8_t(0 | (1 << 2) | (2 << 4));
+            } else {
+                const int inner = k == 2 ? 0 : k + 1, prev = k == 0 ? 2 : k - 1;
+                const unsigned ek = (parent.nbr_edge >> (2 * k)) & 3u, ep = (parent.nbr_edge >> (2 * prev)) & 3u;
+                edges = uint8_t((unsigned(inner) << (2 * inner)) | (child.nbr[k] != kNoNode ? ek << (2 * k) : 0u) |
+                                (child.nbr[prev] != kNoNode ? ep << (2 * prev) : 0u));
+            }
+            child.parent = n;
+            child.first_child = kNoNode;
+            child.nbr_edge = edges;
+            child.level = level;
+            child.child_index = uint8_t(k);
+            child.flags = k == 3 ? 0 : uint8_t(parent.flags & ((1u << k) | (1u << (k == 0 ? 2 : k - 1))));
+        }
+        parent.first_child = c;
+    }
+    positions_.resize(next_vertex);
+    live_nodes_ += 4 * count;
+    live_vertices_ += uint32_t(next_vertex - v0);
+}
+
 uint32_t Hierarchy::refine(NodeId n, std::vector<NodeId>* split_nodes) {
     if (!is_leaf(n)) return 0;
     uint32_t splits = 0;
