@@ -167,21 +167,11 @@ std::string format_obj(const TriangleMesh& mesh) {
     // when read back, and OBJ has no way to say "these are floats".
     for (const Vec3& p : mesh.positions) {
         out += "v ";
-        text::append_real(out, p.x);
-        out += ' ';
-        text::append_real(out, p.y);
-        out += ' ';
-        text::append_real(out, p.z);
-        out += '\n';
+        text::append_real_line(out, p.x, p.y, p.z);
     }
     for (const Triangle& t : mesh.triangles) {
         out += "f ";
-        text::append_uint(out, uint64_t(t[0]) + 1);
-        out += ' ';
-        text::append_uint(out, uint64_t(t[1]) + 1);
-        out += ' ';
-        text::append_uint(out, uint64_t(t[2]) + 1);
-        out += '\n';
+        text::append_uint_line(out, uint64_t(t[0]) + 1, uint64_t(t[1]) + 1, uint64_t(t[2]) + 1);
     }
     return out;
 }

@@ -114,21 +114,11 @@ std::string format_off(const TriangleMesh& mesh) {
     // Shortest decimals of the double values (also for single_precision meshes: the shortest
     // decimal of a float would read back as a different double).
     for (const Vec3& p : mesh.positions) {
-        text::append_real(out, p.x);
-        out += ' ';
-        text::append_real(out, p.y);
-        out += ' ';
-        text::append_real(out, p.z);
-        out += '\n';
+        text::append_real_line(out, p.x, p.y, p.z);
     }
     for (const Triangle& t : mesh.triangles) {
         out += "3 ";
-        text::append_uint(out, t[0]);
-        out += ' ';
-        text::append_uint(out, t[1]);
-        out += ' ';
-        text::append_uint(out, t[2]);
-        out += '\n';
+        text::append_uint_line(out, t[0], t[1], t[2]);
     }
     return out;
 }

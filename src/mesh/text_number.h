@@ -51,6 +51,26 @@ inline void append_uint(std::string& out, uint64_t value) {
     out.append(buf, ptr);
 }
 
+// Three values separated by spaces, then a newline: a vertex or a triangle line.
+template <typename Real>
+void append_real_line(std::string& out, Real x, Real y, Real z) {
+    append_real(out, x);
+    out += ' ';
+    append_real(out, y);
+    out += ' ';
+    append_real(out, z);
+    out += '\n';
+}
+
+inline void append_uint_line(std::string& out, uint64_t a, uint64_t b, uint64_t c) {
+    append_uint(out, a);
+    out += ' ';
+    append_uint(out, b);
+    out += ' ';
+    append_uint(out, c);
+    out += '\n';
+}
+
 // Shortens a token for an error message.
 inline std::string quote_token(std::string_view token) {
     std::string s;
