@@ -136,12 +136,6 @@ std::vector<Vec3> all_positions(const Hierarchy& h) {
     return points;
 }
 
-uint64_t face_count(const Hierarchy& h) {
-    uint64_t faces = 0;
-    for (NodeId n : h.leaves()) faces += 1 + uint64_t(h.hanging_node_count(n));
-    return faces;
-}
-
 // The input over the base mesh in the base coder's order. The base coder may rotate each
 // triangle's vertices. The default diagonal rule does not care, but hierarchies made under a rule
 // of absolute local indices would pay orientation bits: then storing each root's rotation
@@ -192,7 +186,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     meta.base_triangles = h.root_count();
     meta.nodes = h.node_count();
     meta.vertices = h.vertex_count();
-    meta.faces = face_count(h);
+    meta.faces = hierarchy.stats().faces;  // counted by the coder's first pass
     meta.levels = uint64_t(hierarchy.level_count());
     meta.hierarchy_header = hierarchy.header();
     meta.quantizer = quantizer;
