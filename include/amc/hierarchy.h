@@ -145,6 +145,9 @@ public:
 private:
     static constexpr uint8_t kDeadLevel = 0xff;
     struct Node {
+        // Left uninitialized: every path that makes a node sets all its fields, and bulk growth
+        // (split_level) would otherwise write every new node twice.
+        Node() {}
         VertexId v[3];
         NodeId parent;
         NodeId first_child;

@@ -33,19 +33,26 @@ HierarchyLevelDecoder::HierarchyLevelDecoder(const TriangleMesh& base, const Hie
         throw Error("hierarchy stream would build more than " + std::to_string(max_nodes_) + " nodes");
     root_level(h_, level_);
     node_count_ = h_.root_count();
+    vertex_count_ = base.positions.size();
     level_ids_.resize(h_.root_count());
     for (NodeId r = 0; r < h_.root_count(); ++r) level_ids_[r] = r;
 }
 
 void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder) {
+    decide_level(decoder);
+    build_decided_levels();
+}
+
+void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
     if (done()) throw Error("hierarchy stream: no level left to decode");
     const int l = level_index_;
-    const LevelNode* nodes = level_.data();
+    LevelNode* nodes = level_.data();
     const uint32_t n = static_cast<uint32_t>(level_.size());
+    // Errors name the element by its level and canonical index: its node id may not exist yet.
     auto check_split = [&](uint32_t i) {
         if (l >= kMaxLevel || !(nodes[i].flags & kCompleteFlag))
-            throw Error("hierarchy stream is corrupt: node " + std::to_string(level_ids_[i]) + " (level " +
-                        std::to_string(l) + ") can not be refined");
+            throw Error("hierarchy stream is corrupt: element " + std::to_string(i) + " of level " +
+                        std::to_string(l) + " can not be refined");
         if (node_count_ + 4 > max_nodes_)
             throw Error("hierarchy stream would build more than " + std::to_string(max_nodes_) + " nodes");
         node_count_ += 4;
@@ -65,41 +72,61 @@ void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder) {
             if (refined) check_split(i);
             return refined;
         });
-    // Diagonals of the leaves closed by two hanging nodes, then the splits in canonical order
-    // (so the children of level l get consecutive ids, as the level forest numbers them).
+    // Diagonals of the leaves closed by two hanging nodes; and the number of vertices the level's
+    // splits create: one per edge of a refined node, shared where the neighbour is refined too.
+    uint64_t edge_ends = 0;
     for (uint32_t i = 0; i < n; ++i) {
-        if (nodes[i].state & kRefined) continue;
         const int hanging = refined_neighbor_count(nodes, i);
+        if (nodes[i].state & kRefined) {
+            edge_ends += uint64_t(6 - hanging);
+            continue;
+        }
         if (hanging == 3)
-            throw Error("hierarchy stream is corrupt: element " + std::to_string(level_ids_[i]) +
-                        " has three hanging nodes but was not refined");
+            throw Error("hierarchy stream is corrupt: element " + std::to_string(i) + " of level " +
+                        std::to_string(l) + " has three hanging nodes but was not refined");
         if (hanging == 2) {
             bool flag = diagonal_flag_by_rule(header_.diagonal_rule, unrefined_edge(nodes, i));
             if (header_.orientation_coded) flag ^= decoder.decode(models_.orientation);
-            if (flag) h_.set_diagonal_flipped(level_ids_[i], true);
+            if (flag) nodes[i].flags |= kFlippedFlag;
         }
     }
+    vertex_count_ += edge_ends / 2;
     if (decoder.overran()) throw Error("hierarchy stream is truncated");
-    // The next level's links are exactly the links of the new children: split the whole level in
-    // one pass from them, in canonical order (so the children of level l get consecutive ids, as
-    // the level forest numbers them). level_ids_ is compacted in place to the refined nodes, then
-    // becomes the next level's ids.
     derive_next_level(level_, scratch_, next_);
-    NodeId* ids = level_ids_.data();
-    uint32_t count = 0;
-    for (uint32_t i = 0; i < n; ++i) {
-        ids[count] = ids[i];
-        count += (nodes[i].state & kRefined) ? 1u : 0u;
-    }
-    h_.split_level(ids, count, next_.empty() ? nullptr : next_[0].nbr, sizeof(LevelNode) / sizeof(uint32_t));
-    level_ids_.resize(size_t(4) * count);
-    ids = level_ids_.data();
-    for (uint32_t r = count; r-- > 0;) {
-        const NodeId c = h_.child(ids[r], 0);
-        for (uint32_t k = 0; k < 4; ++k) ids[size_t(4) * r + k] = c + k;
-    }
-    level_.swap(next_);
+    decided_.push_back(std::move(level_));
+    level_ = std::move(next_);
+    next_ = std::vector<LevelNode>();
     ++level_index_;
+}
+
+void HierarchyLevelDecoder::build_decided_levels() {
+    for (size_t k = 0; k < decided_.size(); ++k) {
+        const std::vector<LevelNode>& level = decided_[k];
+        const std::vector<LevelNode>& children = k + 1 < decided_.size() ? decided_[k + 1] : level_;
+        const LevelNode* nodes = level.data();
+        const uint32_t n = static_cast<uint32_t>(level.size());
+        // The next level's links are exactly the links of the new children: split the whole
+        // level in one pass from them, in canonical order (so the children of level l get
+        // consecutive ids, as the level forest numbers them). level_ids_ is compacted in place
+        // to the refined nodes, then becomes the next level's ids.
+        NodeId* ids = level_ids_.data();
+        uint32_t count = 0;
+        for (uint32_t i = 0; i < n; ++i) {
+            if (nodes[i].flags & kFlippedFlag) h_.set_diagonal_flipped(ids[i], true);
+            ids[count] = ids[i];
+            count += (nodes[i].state & kRefined) ? 1u : 0u;
+        }
+        h_.split_level(ids, count, children.empty() ? nullptr : children[0].nbr, sizeof(LevelNode) / sizeof(uint32_t));
+        level_ids_.resize(size_t(4) * count);
+        ids = level_ids_.data();
+        for (uint32_t r = count; r-- > 0;) {
+            const NodeId c = h_.child(ids[r], 0);
+            for (uint32_t k4 = 0; k4 < 4; ++k4) ids[size_t(4) * r + k4] = c + k4;
+        }
+    }
+    // Keep one array's memory for the next level.
+    if (!decided_.empty()) next_.swap(decided_.back());
+    decided_.clear();
 }
 
 void HierarchyLevelDecoder::finish() const {
@@ -114,8 +141,11 @@ Hierarchy decode_hierarchy(const TriangleMesh& base, const uint8_t* data, size_t
     const size_t header_size = read_hierarchy_stream_header(data, size, header);
     HierarchyLevelDecoder coder(base, header, options.max_nodes);
     ArithmeticDecoder decoder(data + header_size, size - header_size);
-    while (!coder.done() && coder.level() != options.max_level) coder.decode_level(decoder);
+    // All decisions first, so that the hierarchy is built in memory of its exact final size.
+    while (!coder.done() && coder.level() != options.max_level) coder.decide_level(decoder);
     if (coder.done()) coder.finish();
+    coder.hierarchy().reserve(coder.node_count(), coder.vertex_count());
+    coder.build_decided_levels();
     return std::move(coder.hierarchy());
 }
 

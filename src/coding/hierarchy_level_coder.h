@@ -59,24 +59,30 @@ public:
     // Decides the current level from `decoder` (symbols, orientation bits), splits its refined
     // nodes in hierarchy() and moves to the next level. Throws Error on a corrupt stream.
     void decode_level(ArithmeticDecoder& decoder);
+    // decode_level in two halves, for callers that want every decision before building: decide
+    // the current level and move to the next (hierarchy() is not touched); then split every
+    // decided level in hierarchy(). In between, node_count() and vertex_count() tell the size
+    // the hierarchy will have, so it can be reserved at once.
+    void decide_level(ArithmeticDecoder& decoder);
+    void build_decided_levels();
+    uint64_t node_count() const { return node_count_; }
+    uint64_t vertex_count() const { return vertex_count_; }
     // After the last level: every announced symbol must have been used.
     void finish() const;
     Hierarchy& hierarchy() { return h_; }
 
 private:
-    void check_limits();
-
     HierarchyStreamHeader header_;
     uint64_t max_nodes_;
     Hierarchy h_;
     HierarchyModels models_;
     LevelTraversal traversal_;
     std::vector<LevelNode> level_, next_;
+    std::vector<std::vector<LevelNode>> decided_;  // decided levels not yet built, oldest first
     std::vector<uint32_t> scratch_;
-    std::vector<NodeId> level_ids_;
-    std::vector<uint8_t> refined_;
+    std::vector<NodeId> level_ids_;  // node ids of the oldest level not yet built
     int level_index_ = 0;
-    uint64_t node_count_ = 0, symbols_read_ = 0;
+    uint64_t node_count_ = 0, vertex_count_ = 0, symbols_read_ = 0;
 };
 
 }  // namespace amc

@@ -33,12 +33,14 @@ constexpr uint32_t kNoLocal = 0xffffffffu;
 struct LevelNode {
     uint32_t nbr[3];   // same-level neighbour across edge e (local index), or kNoLocal
     uint8_t nbr_edge;  // the neighbour's local index of the shared edge, 2 bits per edge
-    uint8_t flags;     // bits 0-2: boundary edge; bit 3: complete (Hierarchy::has_all_neighbors)
+    uint8_t flags;     // bits 0-2: boundary edge; bit 3: complete (Hierarchy::has_all_neighbors);
+                       // bit 4: diagonal flipped (decoder, once the level is decided)
     uint8_t state;     // bit 0 decided, bit 1 refined; bits 4-5 decided refined neighbours (edges)
     uint8_t priority;  // improved traversal's bucket
 };
 static_assert(sizeof(LevelNode) == 16, "LevelNode is meant to be 16 bytes");
 constexpr uint8_t kCompleteFlag = 8;
+constexpr uint8_t kFlippedFlag = 16;
 constexpr uint8_t kDecided = 1;
 constexpr uint8_t kRefined = 2;
 constexpr uint8_t kRefinedNeighbor = 16;  // unit of the refined-neighbour count in `state`
@@ -172,32 +174,56 @@ public:
             return;
         }
         // Improved traversal: a bucket queue over priorities 0 (culled: nothing to code) to 4 (no
-        // neighbour coded yet); each coded neighbour lowers a node's priority by one. Stale queue
-        // entries are skipped, so every node enters the queue at most four times: linear time.
-        for (auto& bucket : buckets_) bucket.clear();
-        buckets_[4].reserve(n);
-        for (uint32_t i = n; i-- > 0;) {
-            const uint8_t p = fate_of(nodes, i) != Fate::coded ? 0 : 4;
-            nodes[i].priority = p;
-            buckets_[p].push_back(i);
+        // neighbour decided yet); each decided neighbour lowers a node's priority by one. The
+        // lowest non-empty bucket goes first, each bucket last in, first out; an entry is stale
+        // once its node is decided or has moved to a lower bucket, and is skipped. Every node
+        // enters at most five buckets: linear time.
+        // Two buckets need no storage: bucket 4 starts with every unculled node in canonical order
+        // and never receives another, so it is a cursor; bucket 0 starts with the nodes culled at
+        // the outset in canonical order (a cursor) under a stack of nodes culled later.
+        const bool cull_incomplete = options_.cull_one_regularity;
+        for (uint32_t i = 0; i < n; ++i)
+            nodes[i].priority = cull_incomplete && !(nodes[i].flags & kCompleteFlag) ? 0 : 4;
+        for (auto& stack : stacks_) {
+            stack.clear();
+            if (stack.capacity() < n) stack.reserve(n);
         }
-        int current = 0;
+        uint32_t* const top_base[4] = {stacks_[0].data(), stacks_[1].data(), stacks_[2].data(), stacks_[3].data()};
+        uint32_t* top[4] = {top_base[0], top_base[1], top_base[2], top_base[3]};
+        uint32_t culled_cursor = 0, fresh_cursor = 0;
         for (;;) {
-            while (current < 5 && buckets_[current].empty()) ++current;
-            if (current == 5) break;
-            const uint32_t i = buckets_[current].back();
-            buckets_[current].pop_back();
-            if ((nodes[i].state & kDecided) || nodes[i].priority != current) continue;
+            uint32_t i;
+            if (top[0] != top_base[0]) {
+                i = *--top[0];  // entries of bucket 0 are never stale
+            } else {
+                while (culled_cursor < n && (nodes[culled_cursor].priority != 0 || (nodes[culled_cursor].state & kDecided)))
+                    ++culled_cursor;
+                if (culled_cursor < n) {
+                    i = culled_cursor++;
+                } else {
+                    int p = 1;
+                    while (p < 4 && top[p] == top_base[p]) ++p;
+                    if (p < 4) {
+                        i = *--top[p];
+                        if ((nodes[i].state & kDecided) || nodes[i].priority != p) continue;
+                    } else {
+                        while (fresh_cursor < n && (nodes[fresh_cursor].priority != 4 || (nodes[fresh_cursor].state & kDecided)))
+                            ++fresh_cursor;
+                        if (fresh_cursor == n) break;
+                        i = fresh_cursor++;
+                    }
+                }
+            }
             decide(nodes, i, code, force);
             for (int e = 0; e < 3; ++e) {
                 const uint32_t q = nodes[i].nbr[e];
-                if (q == kNoLocal || (nodes[q].state & kDecided) || nodes[q].priority == 0) continue;
-                const uint8_t pq = nodes[q].priority;
-                const uint8_t next = fate_of(nodes, q) != Fate::coded ? 0 : uint8_t(pq > 1 ? pq - 1 : 1);
-                if (next != pq) {
-                    nodes[q].priority = next;
-                    buckets_[next].push_back(q);
-                    if (next < current) current = next;
+                if (q == kNoLocal) continue;
+                LevelNode& m = nodes[q];
+                if ((m.state & kDecided) || m.priority == 0) continue;
+                const uint8_t next = fate_of(nodes, q) != Fate::coded ? 0 : uint8_t(m.priority > 1 ? m.priority - 1 : 1);
+                if (next != m.priority) {
+                    m.priority = next;
+                    *top[next]++ = q;
                 }
             }
         }
@@ -244,7 +270,7 @@ private:
     }
 
     HierarchyCoderOptions options_;
-    std::array<std::vector<uint32_t>, 5> buckets_;
+    std::array<std::vector<uint32_t>, 4> stacks_;  // buckets 0-3 (each holds at most one entry per node)
 };
 
 }  // namespace amc

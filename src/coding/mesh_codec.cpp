@@ -323,6 +323,8 @@ Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options)
     HierarchyLevelDecoder hierarchy(base, meta.hierarchy_header.data(), meta.hierarchy_header.size(),
                                     std::min<uint64_t>(meta.nodes, options.max_nodes));
     Hierarchy& h = hierarchy.hierarchy();
+    // The metadata's counts (checked against the limit above) let the hierarchy grow in place.
+    h.reserve(meta.nodes, meta.vertices);
     int level = 0;
     while (reader.next(block)) {
         if (block.type == BlockType::end) break;

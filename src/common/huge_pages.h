@@ -25,6 +25,18 @@ inline void advise_huge_pages(const void* begin, size_t bytes) {
 #endif
 }
 
+// v.reserve(capacity), with the whole new buffer offered to huge pages before the old contents
+// are copied in, so that the copy itself faults in huge pages rather than 4 KiB ones.
+template <class T>
+void reserve_huge(std::vector<T>& v, size_t capacity) {
+    if (capacity <= v.capacity()) return;
+    std::vector<T> fresh;
+    fresh.reserve(capacity);
+    advise_huge_pages(fresh.data(), fresh.capacity() * sizeof(T));
+    fresh.insert(fresh.end(), v.begin(), v.end());
+    v.swap(fresh);
+}
+
 // v.resize(n), reallocating (without copying the old contents) at least geometrically when it
 // must, so a sequence of growing levels faults in each page once.
 template <class T>

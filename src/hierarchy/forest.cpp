@@ -75,14 +75,8 @@ void Hierarchy::set_vertex_placer(VertexPlacer placer, void* context) {
 }
 
 void Hierarchy::reserve(size_t nodes, size_t vertices) {
-    if (nodes > nodes_.capacity()) {
-        nodes_.reserve(nodes);
-        advise_huge_pages(nodes_.data() + nodes_.size(), (nodes_.capacity() - nodes_.size()) * sizeof(Node));
-    }
-    if (vertices > positions_.capacity()) {
-        positions_.reserve(vertices);
-        advise_huge_pages(positions_.data() + positions_.size(), (positions_.capacity() - positions_.size()) * sizeof(Vec3));
-    }
+    reserve_huge(nodes_, nodes);
+    reserve_huge(positions_, vertices);
 }
 
 void Hierarchy::set_diagonal_flipped(NodeId n, bool flipped) {
@@ -179,15 +173,20 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
     }
     const size_t c0 = nodes_.size();
     const size_t new_nodes = c0 + size_t(4) * count;
-    const size_t max_vertices = positions_.size() + size_t(3) * count;
+    // Edge e of parent i gets a new vertex unless an earlier parent across it made one.
+    size_t new_vertices = 0;
+    for (uint32_t i = 0; i < count; ++i) {
+        for (int e = 0; e < 3; ++e) {
+            const uint32_t t = child_links[stride * (size_t(4) * i + size_t(e)) + size_t(e)];
+            new_vertices += !(t != kNoNode && t / 4 < i);
+        }
+    }
+    const size_t vertices = positions_.size() + new_vertices;
     if (new_nodes > nodes_.capacity()) reserve(std::max(new_nodes, nodes_.capacity() + nodes_.capacity() / 2), 0);
-    if (max_vertices > positions_.capacity())
-        reserve(0, std::max(max_vertices, positions_.capacity() + positions_.capacity() / 2));
+    if (vertices > positions_.capacity()) reserve(0, std::max(vertices, positions_.capacity() + positions_.capacity() / 2));
     nodes_.resize(new_nodes);
     const size_t v0 = positions_.size();
-    positions_.resize(max_vertices);
     Node* nodes = nodes_.data();
-    Vec3* positions = positions_.data();
     VertexId next_vertex = VertexId(v0);
     const bool default_placer = placer_ == midpoint_placer;
     for (uint32_t i = 0; i < count; ++i) {
@@ -204,10 +203,11 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
             if (t != kNoNode && t / 4 < i) {
                 m[e] = nodes[c0 + (t & ~3u) + 3].v[(eq + 2) % 3];
             } else {
-                const Vec3 a = positions[parent.v[e]];
-                const Vec3 b = positions[parent.v[e == 2 ? 0 : e + 1]];
-                positions[next_vertex] = default_placer ? midpoint_placer(placer_context_, a, b)
-                                                        : placer_(placer_context_, a, b);
+                // Within the reserved capacity: no reallocation, references stay valid.
+                const Vec3& a = positions_[parent.v[e]];
+                const Vec3& b = positions_[parent.v[e == 2 ? 0 : e + 1]];
+                positions_.push_back(default_placer ? midpoint_placer(placer_context_, a, b)
+                                                    : placer_(placer_context_, a, b));
                 m[e] = next_vertex++;
             }
         }
@@ -243,7 +243,6 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
         }
         parent.first_child = c;
     }
-    positions_.resize(next_vertex);
     live_nodes_ += 4 * count;
     live_vertices_ += uint32_t(next_vertex - v0);
 }
