@@ -1,0 +1,364 @@
+// compare_bench: amcodec side by side with Draco, meshoptimizer, zstd and xz on the leaf meshes of a
+// corpus of hierarchies (.amh): connectivity sizes (the paper's Table 3), complete meshes at 12 and
+// 16 bits and lossless, encode and decode speeds (median of --runs, one thread, all in one
+// process), and a check of every decoded result against its input. See docs/BENCHMARKS.md.
+//
+//   compare_bench [--runs N] [--csv FILE] [--markdown FILE] corpus/*.amh
+#include "compare_check.h"
+#include "compare_draco.h"
+#include "compare_general.h"
+#include "compare_report.h"
+
+#include <amc/codec.h>
+#include <amc/hierarchy.h>
+#include <amc/hierarchy_coder.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace amc_bench {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+double median(std::vector<double> samples) {
+    if (samples.empty()) return 0;
+    std::sort(samples.begin(), samples.end());
+    const size_t n = samples.size();
+    return n % 2 ? samples[n / 2] : 0.5 * (samples[n / 2 - 1] + samples[n / 2]);
+}
+
+// Runs `step` `runs` times and returns the median time; `step` keeps its last output itself.
+template <class Step>
+double median_seconds(int runs, Step&& step) {
+    std::vector<double> samples;
+    for (int r = 0; r < runs; ++r) {
+        const Clock::time_point start = Clock::now();
+        step();
+        samples.push_back(seconds_since(start));
+    }
+    return median(samples);
+}
+
+struct Model {
+    std::string name;
+    amc::Hierarchy hierarchy;
+    amc::Hierarchy expected;  // as the .amc decoder returns it (in_decoder_order)
+    amc::TriangleMesh leaf;   // the conforming leaf mesh every peer codes
+    std::vector<uint32_t> indices;
+};
+
+Result make_result(const Model& m, const std::string& coder, const std::string& payload) {
+    Result r;
+    r.model = m.name;
+    r.faces = m.leaf.triangles.size();
+    r.vertices = m.leaf.positions.size();
+    r.nodes = m.hierarchy.node_count();
+    r.coder = coder;
+    r.payload = payload;
+    return r;
+}
+
+std::string check_text(const MeshCheck& check) { return check.ok ? "ok" : check.problem; }
+
+// ---- general-purpose coders over the index buffer ----------------------------------------------
+
+void measure_general_coders(const Model& m, int runs, std::vector<Result>& out) {
+    const size_t raw_size = m.indices.size() * sizeof(uint32_t);
+    Result raw = make_result(m, "raw", "connectivity");
+    raw.bytes = raw_size;
+    raw.check = "computed";
+    out.push_back(raw);
+
+    struct ByteCoder {
+        const char* id;
+        std::vector<uint8_t> (*encode)(const void*, size_t);
+        std::vector<uint8_t> (*decode)(const std::vector<uint8_t>&, size_t);
+    };
+    const ByteCoder byte_coders[] = {
+        {"zstd-19", [](const void* d, size_t n) { return zstd_compress(d, n, 19); },
+         [](const std::vector<uint8_t>& c, size_t) { return zstd_decompress(c); }},
+        {"xz-9", [](const void* d, size_t n) { return xz_compress(d, n, 9); },
+         [](const std::vector<uint8_t>& c, size_t n) { return xz_decompress(c, n); }},
+    };
+    for (const ByteCoder& coder : byte_coders) {
+        Result r = make_result(m, coder.id, "connectivity");
+        std::vector<uint8_t> packed, unpacked;
+        r.encode_seconds = median_seconds(runs, [&] { packed = coder.encode(m.indices.data(), raw_size); });
+        r.decode_seconds = median_seconds(runs, [&] { unpacked = coder.decode(packed, raw_size); });
+        r.bytes = packed.size();
+        const bool same = unpacked.size() == raw_size && std::memcmp(unpacked.data(), m.indices.data(), raw_size) == 0;
+        r.check = same ? "ok" : "decoded index buffer differs";
+        out.push_back(r);
+    }
+
+    const size_t vertex_count = m.leaf.positions.size();
+    for (const bool with_zstd : {false, true}) {
+        Result r = make_result(m, with_zstd ? "meshopt+zstd" : "meshopt", "connectivity");
+        std::vector<uint8_t> packed;
+        std::vector<uint32_t> indices;
+        r.encode_seconds = median_seconds(runs, [&] {
+            packed = meshopt_encode(m.indices, vertex_count);
+            if (with_zstd) packed = zstd_compress(packed.data(), packed.size(), 19);
+        });
+        r.decode_seconds = median_seconds(runs, [&] {
+            indices = with_zstd ? meshopt_decode(zstd_decompress(packed), m.indices.size()) : meshopt_decode(packed, m.indices.size());
+        });
+        r.bytes = packed.size();
+        std::vector<amc::Triangle> faces(indices.size() / 3);
+        for (size_t f = 0; f < faces.size(); ++f) faces[f] = {indices[3 * f], indices[3 * f + 1], indices[3 * f + 2]};
+        r.check = check_text(check_same_faces(m.leaf.triangles, faces));
+        out.push_back(r);
+    }
+}
+
+// ---- Draco ----------------------------------------------------------------------------------
+
+double largest_extent(const amc::TriangleMesh& mesh) {
+    amc::Vec3 lo = mesh.positions.at(0), hi = lo;
+    for (const amc::Vec3& p : mesh.positions) {
+        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    }
+    return std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+}
+
+void measure_draco(const Model& m, int runs, std::vector<Result>& out) {
+    const auto lossy_input = make_draco_mesh(m.leaf, false);
+    const auto exact_input = make_draco_mesh(m.leaf, true);
+    const double extent = largest_extent(m.leaf);
+    for (const int speed : {5, 0}) {
+        const std::string coder = speed == 0 ? "draco-best" : "draco-default";
+        Result connectivity = make_result(m, coder, "connectivity");
+        std::vector<double> connectivity_encode, connectivity_decode;
+        std::vector<std::string> problems;
+        DracoDecoded lossless;  // the checked lossless decode, the reference for the quantized ones
+        bool lossless_ok = false;
+        for (const int bits : {0, 16, 12}) {
+            const DracoSettings settings{speed, bits};
+            const draco::Mesh& input = bits == 0 ? *exact_input : *lossy_input;
+            Result r = make_result(m, coder, bits == 0 ? "mesh-lossless" : "mesh-" + std::to_string(bits));
+            DracoEncoded encoded;
+            DracoDecoded decoded;
+            std::vector<double> encode_times, decode_times;
+            try {
+                for (int run = 0; run < runs; ++run) {
+                    encoded = draco_encode(input, settings);
+                    encode_times.push_back(encoded.seconds);
+                    connectivity_encode.push_back(encoded.connectivity_seconds);
+                }
+                for (int run = 0; run < runs; ++run) {
+                    decoded = draco_decode(encoded.bytes);
+                    decode_times.push_back(decoded.seconds);
+                    connectivity_decode.push_back(decoded.connectivity_seconds);
+                }
+            } catch (const std::exception& e) {
+                r.check = e.what();
+                problems.push_back(r.payload + ": " + r.check);
+                out.push_back(r);
+                continue;
+            }
+            r.bytes = encoded.bytes.size();
+            r.connectivity_bytes = encoded.connectivity_bytes;
+            r.encode_seconds = median(encode_times);
+            r.decode_seconds = median(decode_times);
+            MeshCheck check;
+            if (bits == 0) {
+                check = check_decoded_mesh(m.leaf, decoded.positions, decoded.triangles);
+                lossless_ok = check.ok;
+                lossless = decoded;
+            } else {
+                // Draco quantizes over the largest side of the bounding box in 2^bits - 1 steps; a
+                // vertex moves by half a step, plus float32 rounding: one step is the bound checked.
+                const double step = extent / double((1u << bits) - 1);
+                check = lossless_ok ? check_quantized_decode(lossless.positions, lossless.triangles, decoded.positions,
+                                                             decoded.triangles, step)
+                                    : MeshCheck{false, "no checked lossless decode to compare with"};
+            }
+            r.max_error = check.max_error;
+            r.check = check_text(check);
+            if (check.ok && check.split_vertices > 0)
+                r.note = std::to_string(check.split_vertices) + " more vertices decoded than coded (Draco splits vertices whose faces form several fans)";
+            if (check.ok && bits == 12 && encoded.bytes != draco_encode_public(input, settings))
+                r.check = "file differs from draco::Encoder::EncodeMeshToBuffer's";
+            if (r.check != "ok") problems.push_back(r.payload + ": " + r.check);
+            // The connectivity code does not depend on the positions: the same in every mode.
+            if (connectivity.bytes == 0) connectivity.bytes = encoded.connectivity_bytes;
+            if (connectivity.bytes != encoded.connectivity_bytes) problems.push_back(r.payload + ": connectivity size differs");
+            out.push_back(r);
+        }
+        connectivity.encode_seconds = median(connectivity_encode);
+        connectivity.decode_seconds = median(connectivity_decode);
+        connectivity.check = problems.empty() ? "ok" : problems.front();
+        for (const Result& r : out)
+            if (r.model == m.name && r.coder == coder && !r.note.empty()) connectivity.note = r.note;
+        out.push_back(connectivity);
+    }
+}
+
+// ---- amcodec ----------------------------------------------------------------------------------
+
+struct AmcMode {
+    const char* coder;
+    amc::HierarchyCoderOptions options;
+};
+
+std::vector<AmcMode> amc_connectivity_modes() {
+    amc::HierarchyCoderOptions none = amc::coder_options_from_switches(0);  // naive coder: every switch off
+    amc::HierarchyCoderOptions paper_naive;  // the paper's complete method ...
+    paper_naive.traversal = amc::Traversal::naive;
+    amc::HierarchyCoderOptions paper_improved;
+    paper_improved.traversal = amc::Traversal::improved;
+    return {{"naive-hierarchy", none},
+            {"amc-paper-naive", paper_naive},
+            {"amc-paper-improved", paper_improved},
+            {"amc-best", amc::EncodeOptions{}.hierarchy}};
+}
+
+// Same conforming mesh (canonical vertex order on both sides) and every coordinate within `tolerance`.
+MeshCheck compare_leaf_meshes(const amc::Hierarchy& decoded, const amc::TriangleMesh& expected, double tolerance) {
+    MeshCheck check;
+    const amc::TriangleMesh got = amc::extract_leaf_mesh(decoded).mesh;
+    if (got.triangles != expected.triangles) {
+        check.problem = "leaf mesh connectivity differs";
+        return check;
+    }
+    if (got.positions.size() != expected.positions.size()) {
+        check.problem = "vertex count differs";
+        return check;
+    }
+    for (size_t v = 0; v < got.positions.size(); ++v) {
+        const amc::Vec3 d = got.positions[v] - expected.positions[v];
+        check.max_error = std::max({check.max_error, std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+    }
+    if (check.max_error > tolerance) {
+        check.problem = "coordinate error " + std::to_string(check.max_error) + " above the reported " + std::to_string(tolerance);
+        return check;
+    }
+    check.ok = true;
+    return check;
+}
+
+void measure_amcodec(const Model& m, int runs, std::vector<Result>& out) {
+    const amc::TriangleMesh expected_leaf = amc::extract_leaf_mesh(m.expected).mesh;
+    uint64_t base_connectivity_bytes = 0;
+
+    // Complete files, default options: lossless, 16 and 12 bits.
+    for (const int bits : {0, 16, 12}) {
+        Result r = make_result(m, "amc-best", bits == 0 ? "mesh-lossless" : "mesh-" + std::to_string(bits));
+        amc::EncodeOptions options;
+        options.quantize_bits = bits;
+        amc::EncodeStats stats;
+        std::vector<uint8_t> file;
+        amc::Hierarchy back;
+        r.encode_seconds = median_seconds(runs, [&] { file = amc::encode(m.hierarchy, options, &stats); });
+        r.decode_seconds = median_seconds(runs, [&] { back = amc::decode(file.data(), file.size()); });
+        r.bytes = file.size();
+        r.max_error = stats.max_error;
+        // In the file, hierarchy symbols and positions share one arithmetic code per level; the
+        // library counts the hierarchy part up to the byte where it ended.
+        r.connectivity_bytes = stats.base_connectivity_bytes + stats.hierarchy_bytes;
+        base_connectivity_bytes = stats.base_connectivity_bytes;
+        if (bits == 0) {
+            r.check = amc::identical(back, m.expected) ? "ok" : "decoded hierarchy not identical to the input";
+        } else {
+            r.check = check_text(compare_leaf_meshes(back, expected_leaf, stats.max_error));
+        }
+        out.push_back(r);
+    }
+
+    // 1 bit per node: what the forest costs before any coding.
+    Result one_bit = make_result(m, "one-bit-per-node", "connectivity");
+    one_bit.bytes = base_connectivity_bytes + (m.hierarchy.node_count() + 7) / 8;
+    one_bit.check = "computed";
+    out.push_back(one_bit);
+
+    // Connectivity alone: base connectivity (as the .amc file codes it) plus the hierarchy stream
+    // of encode_hierarchy, which decodes on its own over the shared base mesh.
+    for (const AmcMode& mode : amc_connectivity_modes()) {
+        Result r = make_result(m, mode.coder, "connectivity");
+        std::vector<uint8_t> stream;
+        amc::Hierarchy back;
+        r.encode_seconds = median_seconds(runs, [&] { stream = amc::encode_hierarchy(m.expected, mode.options); });
+        r.decode_seconds = median_seconds(runs, [&] { back = amc::decode_hierarchy(m.expected.base(), stream.data(), stream.size()); });
+        r.bytes = base_connectivity_bytes + stream.size();
+        const amc::TriangleMesh got = amc::extract_leaf_mesh(back).mesh;
+        r.check = got.triangles == expected_leaf.triangles ? "ok" : "decoded leaf mesh connectivity differs";
+        out.push_back(r);
+    }
+}
+
+Model load_model(const std::string& path) {
+    Model m;
+    m.name = std::filesystem::path(path).stem().string();
+    m.hierarchy = amc::read_hierarchy(path);
+    m.expected = amc::in_decoder_order(m.hierarchy);
+    m.leaf = amc::extract_leaf_mesh(m.hierarchy).mesh;
+    m.indices.reserve(3 * m.leaf.triangles.size());
+    for (const amc::Triangle& t : m.leaf.triangles) m.indices.insert(m.indices.end(), t.begin(), t.end());
+    return m;
+}
+
+int run(int argc, char** argv) {
+    int runs = 3;
+    std::string csv_path, markdown_path;
+    std::vector<std::string> inputs;
+    std::string command = "compare_bench";
+    for (int i = 1; i < argc; ++i) {
+        const std::string arg = argv[i];
+        command += " " + arg;
+        auto value = [&]() -> std::string {
+            if (i + 1 >= argc) throw std::runtime_error(arg + " needs a value");
+            command += std::string(" ") + argv[i + 1];
+            return argv[++i];
+        };
+        if (arg == "--runs") runs = std::max(1, std::stoi(value()));
+        else if (arg == "--csv") csv_path = value();
+        else if (arg == "--markdown") markdown_path = value();
+        else if (arg.rfind("--", 0) == 0) throw std::runtime_error("unknown option " + arg);
+        else inputs.push_back(arg);
+    }
+    if (inputs.empty()) {
+        std::fprintf(stderr, "usage: compare_bench [--runs N] [--csv FILE] [--markdown FILE] model.amh...\n");
+        return 2;
+    }
+    std::vector<Result> results;
+    for (const std::string& path : inputs) {
+        const Clock::time_point start = Clock::now();
+        const Model m = load_model(path);
+        const size_t first = results.size();
+        measure_general_coders(m, runs, results);
+        measure_draco(m, runs, results);
+        measure_amcodec(m, runs, results);
+        int failed = 0;
+        for (size_t i = first; i < results.size(); ++i) failed += results[i].check != "ok" && results[i].check != "computed";
+        std::fprintf(stderr, "%-18s %7zu faces  %5.1f s  %s\n", m.name.c_str(), m.leaf.triangles.size(), seconds_since(start),
+                     failed ? "SOME CHECKS FAILED" : "all checks passed");
+    }
+    if (!csv_path.empty()) write_csv(csv_path, results);
+    if (!markdown_path.empty()) write_markdown(markdown_path, results, RunInfo{runs, command});
+    return 0;
+}
+
+}  // namespace
+
+}  // namespace amc_bench
+
+int main(int argc, char** argv) {
+    try {
+        return amc_bench::run(argc, argv);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "compare_bench: %s\n", e.what());
+        return 1;
+    }
+}
