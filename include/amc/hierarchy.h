@@ -129,7 +129,8 @@ public:
     // earlier entry of `parents`. The caller supplies the links between the new children: for child k of
     // parents[i], the three words at child_links + stride * (4 * i + k) hold, per edge e, the index
     // 4 * j + k' of the same-level neighbour (child k' of parents[j]) or kNoNode, as split() would
-    // link them.
+    // link them. When no ids are free for reuse (a hierarchy that was only ever refined), child k
+    // of parents[i] gets id node_capacity() + 4 * i + k, node_capacity() taken before the call.
     void split_level(const NodeId* parents, uint32_t count, const uint32_t* child_links, size_t stride);
     // Hints the processor to fetch node n (for traversals that know their next nodes early).
     void prefetch(NodeId n) const { __builtin_prefetch(nodes_.data() + n); }

@@ -3,6 +3,7 @@
 #include "coding/hierarchy_level_coder.h"
 
 #include <string>
+#include <utility>
 
 namespace amc {
 
@@ -46,25 +47,33 @@ void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder) {
 void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
     if (done()) throw Error("hierarchy stream: no level left to decode");
     const int l = level_index_;
-    LevelNode* nodes = level_.data();
+    uint8_t* state = level_.state.data();
     const uint32_t n = static_cast<uint32_t>(level_.size());
+    // The coder's state lives in locals while the level is decided: every state byte the
+    // traversal writes could alias a member as far as the compiler knows, and members would be
+    // reloaded for every node.
+    ArithmeticDecoder d = decoder;
+    HierarchyModels models = models_;
+    uint64_t symbols_read = symbols_read_, node_count = node_count_;
+    const uint64_t max_nodes = max_nodes_;
+    // II-C, stream truncation: once the stored symbols are used up, the rest are 0.
+    const uint64_t symbol_limit = header_.options.truncate_stream ? header_.symbol_count : UINT64_MAX;
+    const int group_mask = header_.options.use_contexts ? 0xff : 0;
     // Errors name the element by its level and canonical index: its node id may not exist yet.
     auto check_split = [&](uint32_t i) {
-        if (l >= kMaxLevel || !(nodes[i].flags & kCompleteFlag))
+        if (l >= kMaxLevel || !(state[i] & kComplete))
             throw Error("hierarchy stream is corrupt: element " + std::to_string(i) + " of level " +
                         std::to_string(l) + " can not be refined");
-        if (node_count_ + 4 > max_nodes_)
-            throw Error("hierarchy stream would build more than " + std::to_string(max_nodes_) + " nodes");
-        node_count_ += 4;
+        if (node_count + 4 > max_nodes)
+            throw Error("hierarchy stream would build more than " + std::to_string(max_nodes) + " nodes");
+        node_count += 4;
     };
-    const bool use_contexts = header_.options.use_contexts;
     traversal_.run(
         level_, l < header_.uniform_levels,
         [&](uint32_t i, int group) {
-            // II-C, stream truncation: once the stored symbols are used up, the rest are 0.
-            if (symbols_read_ == header_.symbol_count && header_.options.truncate_stream) return false;
-            ++symbols_read_;
-            const bool refined = decoder.decode(models_.for_group(group, use_contexts));
+            if (symbols_read == symbol_limit) return false;
+            ++symbols_read;
+            const bool refined = d.decode(models.groups[size_t(group & group_mask)]);
             if (refined) check_split(i);
             return refined;
         },
@@ -76,8 +85,8 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
     // splits create: one per edge of a refined node, shared where the neighbour is refined too.
     uint64_t edge_ends = 0;
     for (uint32_t i = 0; i < n; ++i) {
-        const int hanging = refined_neighbor_count(nodes, i);
-        if (nodes[i].state & kRefined) {
+        const int hanging = refined_neighbors(state[i]);
+        if (state[i] & kRefined) {
             edge_ends += uint64_t(6 - hanging);
             continue;
         }
@@ -85,25 +94,30 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
             throw Error("hierarchy stream is corrupt: element " + std::to_string(i) + " of level " +
                         std::to_string(l) + " has three hanging nodes but was not refined");
         if (hanging == 2) {
-            bool flag = diagonal_flag_by_rule(header_.diagonal_rule, unrefined_edge(nodes, i));
-            if (header_.orientation_coded) flag ^= decoder.decode(models_.orientation);
-            if (flag) nodes[i].flags |= kFlippedFlag;
+            bool flag = diagonal_flag_by_rule(header_.diagonal_rule, unrefined_edge(level_, i));
+            if (header_.orientation_coded) flag ^= d.decode(models.orientation);
+            if (flag) level_.links[i].flags |= kFlippedFlag;
         }
     }
+    decoder = d;
+    models_ = models;
+    symbols_read_ = symbols_read;
+    node_count_ = node_count;
     vertex_count_ += edge_ends / 2;
     if (decoder.overran()) throw Error("hierarchy stream is truncated");
     derive_next_level(level_, scratch_, next_);
     decided_.push_back(std::move(level_));
     level_ = std::move(next_);
-    next_ = std::vector<LevelNode>();
+    next_ = Level();
     ++level_index_;
 }
 
 void HierarchyLevelDecoder::build_decided_levels() {
     for (size_t k = 0; k < decided_.size(); ++k) {
-        const std::vector<LevelNode>& level = decided_[k];
-        const std::vector<LevelNode>& children = k + 1 < decided_.size() ? decided_[k + 1] : level_;
-        const LevelNode* nodes = level.data();
+        const Level& level = decided_[k];
+        const Level& children = k + 1 < decided_.size() ? decided_[k + 1] : level_;
+        const LevelLinks* links = level.links.data();
+        const uint8_t* state = level.state.data();
         const uint32_t n = static_cast<uint32_t>(level.size());
         // The next level's links are exactly the links of the new children: split the whole
         // level in one pass from them, in canonical order (so the children of level l get
@@ -112,20 +126,19 @@ void HierarchyLevelDecoder::build_decided_levels() {
         NodeId* ids = level_ids_.data();
         uint32_t count = 0;
         for (uint32_t i = 0; i < n; ++i) {
-            if (nodes[i].flags & kFlippedFlag) h_.set_diagonal_flipped(ids[i], true);
+            if (links[i].flags & kFlippedFlag) h_.set_diagonal_flipped(ids[i], true);
             ids[count] = ids[i];
-            count += (nodes[i].state & kRefined) ? 1u : 0u;
+            count += (state[i] & kRefined) ? 1u : 0u;
         }
-        h_.split_level(ids, count, children.empty() ? nullptr : children[0].nbr, sizeof(LevelNode) / sizeof(uint32_t));
+        // The decoder's hierarchy never frees ids, so the children are numbered consecutively.
+        const NodeId first_child = h_.node_capacity();
+        h_.split_level(ids, count, children.empty() ? nullptr : children.links[0].nbr, sizeof(LevelLinks) / sizeof(uint32_t));
         level_ids_.resize(size_t(4) * count);
         ids = level_ids_.data();
-        for (uint32_t r = count; r-- > 0;) {
-            const NodeId c = h_.child(ids[r], 0);
-            for (uint32_t k4 = 0; k4 < 4; ++k4) ids[size_t(4) * r + k4] = c + k4;
-        }
+        for (uint32_t c = 0; c < 4 * count; ++c) ids[c] = first_child + c;
     }
     // Keep one array's memory for the next level.
-    if (!decided_.empty()) next_.swap(decided_.back());
+    if (!decided_.empty()) std::swap(next_, decided_.back());
     decided_.clear();
 }
 

@@ -3,6 +3,8 @@
 // Stream layout in docs/FORMAT.md ("hierarchy stream").
 #include "coding/hierarchy_level_coder.h"
 
+#include <utility>
+
 namespace amc {
 
 HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const HierarchyCoderOptions& options)
@@ -19,7 +21,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
     std::vector<std::pair<int, bool>> two_hanging;  // (unrefined edge, flag) in stream order
     std::vector<size_t> orientation_slots;         // event index of each two_hanging entry
     LevelTraversal traversal(options);
-    std::vector<LevelNode> level, next;
+    Level level, next;
     std::vector<NodeId> ids, next_ids;
     std::vector<uint8_t> refined;
     std::vector<uint32_t> scratch;
@@ -64,13 +66,13 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
                 }
                 return truth[i] != 0;
             });
-        const LevelNode* nodes = level.data();
+        const uint8_t* state = level.state.data();
         for (uint32_t i = 0; i < n; ++i) {
-            if (nodes[i].state & kRefined) continue;
-            const int hanging = refined_neighbor_count(nodes, i);
+            if (state[i] & kRefined) continue;
+            const int hanging = refined_neighbors(state[i]);
             faces += 1 + uint64_t(hanging);
             if (hanging == 2) {
-                two_hanging.push_back({unrefined_edge(nodes, i), h.diagonal_flipped(ids[i])});
+                two_hanging.push_back({unrefined_edge(level, i), h.diagonal_flipped(ids[i])});
                 orientation_slots.push_back(events_.size());
                 events_.push_back({kOrientationEvent, 0});
             }
@@ -78,7 +80,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         stats.levels = l + 1;
         level_end_.push_back(events_.size());
         derive_next_level(level, scratch, next);
-        level.swap(next);
+        std::swap(level, next);
         level_ids_.push_back(ids);
         ids.swap(next_ids);
     }

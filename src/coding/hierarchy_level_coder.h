@@ -77,8 +77,8 @@ private:
     Hierarchy h_;
     HierarchyModels models_;
     LevelTraversal traversal_;
-    std::vector<LevelNode> level_, next_;
-    std::vector<std::vector<LevelNode>> decided_;  // decided levels not yet built, oldest first
+    Level level_, next_;
+    std::vector<Level> decided_;  // decided levels not yet built, oldest first
     std::vector<uint32_t> scratch_;
     std::vector<NodeId> level_ids_;  // node ids of the oldest level not yet built
     int level_index_ = 0;

@@ -5,12 +5,16 @@
 // The encoder answers `code` from the hierarchy it holds; the decoder from the stream. Both see
 // the same decisions in the same order, so they agree on every context.
 //
-// The traversal does not run on amc::Hierarchy but on a "level forest": one level at a time as a
-// dense array of 16-byte nodes in canonical (breadth-first) order, with neighbours as local indices
-// into the same array. Level l+1 is derived from level l and its decisions alone, mirroring
-// Hierarchy::split's linking, so the coder touches compact memory in near-sequential order and the
-// decoder builds the Hierarchy once at the end. Local index i of level l is the node's position
-// in the level's canonical order, which is also the order of the naive traversal.
+// The traversal does not run on amc::Hierarchy but on a "level forest": one level at a time as
+// dense arrays in canonical (breadth-first) order, with neighbours as local indices into the same
+// arrays. Level l+1 is derived from level l and its decisions alone, mirroring Hierarchy::split's
+// linking, so the coder touches compact memory in near-sequential order and the decoder builds
+// the Hierarchy once at the end. Local index i of level l is the node's position in the level's
+// canonical order, which is also the order of the naive traversal.
+//
+// A level is two arrays: the links (16 bytes a node, read once per decision) and one state byte
+// a node, which the traversal reads and writes for every neighbour; kept apart, the states of
+// even the finest level stay in the processor's L2 cache.
 #pragma once
 
 #include "coding/context_groups.h"
@@ -29,35 +33,46 @@ enum class Fate : uint8_t { coded, uniform, one_regularity, hanging_nodes };
 
 constexpr uint32_t kNoLocal = 0xffffffffu;
 
-// One node of a level.
-struct LevelNode {
+struct LevelLinks {
     uint32_t nbr[3];   // same-level neighbour across edge e (local index), or kNoLocal
     uint8_t nbr_edge;  // the neighbour's local index of the shared edge, 2 bits per edge
-    uint8_t flags;     // bits 0-2: boundary edge; bit 3: complete (Hierarchy::has_all_neighbors);
-                       // bit 4: diagonal flipped (decoder, once the level is decided)
-    uint8_t state;     // bit 0 decided, bit 1 refined; bits 4-5 decided refined neighbours (edges)
-    uint8_t priority;  // improved traversal's bucket
+    uint8_t flags;     // bits 0-2: boundary edge; bit 3: diagonal flipped (decoder, once decided)
+    LevelLinks() {}  // uninitialized: every node's fields are set when its level is made
 };
-static_assert(sizeof(LevelNode) == 16, "LevelNode is meant to be 16 bytes");
-constexpr uint8_t kCompleteFlag = 8;
-constexpr uint8_t kFlippedFlag = 16;
+static_assert(sizeof(LevelLinks) == 16, "LevelLinks is meant to be 16 bytes");
+constexpr uint8_t kFlippedFlag = 8;
+
+// The state byte of a node.
 constexpr uint8_t kDecided = 1;
 constexpr uint8_t kRefined = 2;
-constexpr uint8_t kRefinedNeighbor = 16;  // unit of the refined-neighbour count in `state`
-constexpr uint8_t kRefinedNeighborMask = 0x30;
+constexpr uint8_t kRefinedNeighbor = 4;        // unit of the count of refined neighbours (bits 2-3)
+constexpr uint8_t kRefinedNeighborMask = 12;   // decided refined neighbours; exact once all are decided
+constexpr uint8_t kComplete = 16;              // Hierarchy::has_all_neighbors
+constexpr int kPriorityShift = 5;              // bits 5-7: the improved traversal's bucket, 0..4
+constexpr uint8_t kPriorityMask = 0xe0;
 
-inline uint8_t complete_flag(const uint32_t nbr[3], uint8_t boundary) {
+struct Level {
+    std::vector<LevelLinks> links;
+    std::vector<uint8_t> state;
+    size_t size() const { return links.size(); }
+    bool empty() const { return links.empty(); }
+};
+
+inline int refined_neighbors(uint8_t state) { return (state & kRefinedNeighborMask) >> 2; }
+
+inline uint8_t complete_state(const uint32_t nbr[3], uint8_t boundary) {
     return ((nbr[0] != kNoLocal) | (boundary & 1)) & ((nbr[1] != kNoLocal) | ((boundary >> 1) & 1)) &
                    ((nbr[2] != kNoLocal) | ((boundary >> 2) & 1))
-               ? kCompleteFlag
+               ? kComplete
                : 0;
 }
 
 // Level 0: the roots of `h` (root ids are local indices).
-inline void root_level(const Hierarchy& h, std::vector<LevelNode>& level) {
-    level.resize(h.root_count());
+inline void root_level(const Hierarchy& h, Level& level) {
+    level.links.resize(h.root_count());
+    level.state.resize(h.root_count());
     for (NodeId r = 0; r < h.root_count(); ++r) {
-        LevelNode& node = level[r];
+        LevelLinks& node = level.links[r];
         uint8_t boundary = 0, edges = 0;
         for (int e = 0; e < 3; ++e) {
             node.nbr[e] = h.neighbor(r, e);
@@ -65,30 +80,31 @@ inline void root_level(const Hierarchy& h, std::vector<LevelNode>& level) {
             boundary = uint8_t(boundary | (int(h.is_boundary_edge(r, e)) << e));
         }
         node.nbr_edge = edges;
-        node.flags = uint8_t(boundary | complete_flag(node.nbr, boundary));
-        node.state = 0;
-        node.priority = 0;
+        node.flags = boundary;
+        level.state[r] = complete_state(node.nbr, boundary);
     }
 }
 
 // Level l+1 from level l (every node decided): the children of the refined nodes in canonical
 // order, linked exactly as Hierarchy::split links them. `first_child` is scratch.
-inline void derive_next_level(const std::vector<LevelNode>& level, std::vector<uint32_t>& first_child,
-                              std::vector<LevelNode>& next) {
+inline void derive_next_level(const Level& level, std::vector<uint32_t>& first_child, Level& next) {
     const size_t n = level.size();
+    const uint8_t* state = level.state.data();
     resize_scratch(first_child, n);
     uint32_t count = 0;
     for (size_t i = 0; i < n; ++i) {
         first_child[i] = count;
-        count += (level[i].state & kRefined) ? 4u : 0u;
+        count += (state[i] & kRefined) ? 4u : 0u;
     }
-    resize_scratch(next, count);
-    const LevelNode* in = level.data();
+    resize_scratch(next.links, count);
+    resize_scratch(next.state, count);
+    const LevelLinks* in = level.links.data();
     const uint32_t* fc = first_child.data();
-    LevelNode* out = next.data();
+    LevelLinks* out = next.links.data();
+    uint8_t* out_state = next.state.data();
     for (size_t i = 0; i < n; ++i) {
-        const LevelNode& p = in[i];
-        if (!(p.state & kRefined)) continue;
+        if (!(state[i] & kRefined)) continue;
+        const LevelLinks& p = in[i];
         // Across parent edge e: the neighbour's children for the first half (child e) and the
         // second half (child (e+1)%3) of the edge.
         uint32_t first_half[3], second_half[3];
@@ -96,7 +112,7 @@ inline void derive_next_level(const std::vector<LevelNode>& level, std::vector<u
         for (int e = 0; e < 3; ++e) {
             const uint32_t q = p.nbr[e];
             eq[e] = (p.nbr_edge >> (2 * e)) & 3u;
-            if (q != kNoLocal && (in[q].state & kRefined)) {
+            if (q != kNoLocal && (state[q] & kRefined)) {
                 const uint32_t qc = fc[q];
                 first_half[e] = qc + (eq[e] == 2 ? 0 : eq[e] + 1);
                 second_half[e] = qc + eq[e];
@@ -106,71 +122,79 @@ inline void derive_next_level(const std::vector<LevelNode>& level, std::vector<u
             }
         }
         const uint32_t c = fc[i];
-        LevelNode* ch = out + c;
+        LevelLinks* ch = out + c;
         const uint8_t boundary = p.flags & 7;
         for (int k = 0; k < 3; ++k) {
             const int inner = k == 2 ? 0 : k + 1;  // (k+1)%3, shared with the center
             const int prev = k == 0 ? 2 : k - 1;   // (k+2)%3
-            LevelNode& node = ch[k];
+            LevelLinks& node = ch[k];
             node.nbr[k] = first_half[k];
             node.nbr[prev] = second_half[prev];
             node.nbr[inner] = c + 3;
             node.nbr_edge = uint8_t((eq[k] << (2 * k)) | (eq[prev] << (2 * prev)) | (unsigned(inner) << (2 * inner)));
             const uint8_t b = uint8_t(boundary & ((1u << k) | (1u << prev)));
-            node.flags = uint8_t(b | complete_flag(node.nbr, b));
-            node.state = 0;
-            node.priority = 0;
+            node.flags = b;
+            out_state[c + k] = complete_state(node.nbr, b);
         }
-        LevelNode& center = ch[3];
+        LevelLinks& center = ch[3];
         for (int e = 0; e < 3; ++e) center.nbr[e] = c + uint32_t(e == 0 ? 2 : e - 1);  // corner (e+2)%3
         center.nbr_edge = uint8_t(0 | (1 << 2) | (2 << 4));
-        center.flags = kCompleteFlag;
-        center.state = 0;
-        center.priority = 0;
+        center.flags = 0;
+        out_state[c + 3] = kComplete;
     }
 }
 
-// Number of refined neighbours of a decided level's node (its hanging nodes once it is a leaf).
-inline int refined_neighbor_count(const LevelNode* nodes, uint32_t i) {
-    int count = 0;
-    for (int e = 0; e < 3; ++e) {
-        const uint32_t q = nodes[i].nbr[e];
-        count += q != kNoLocal && (nodes[q].state & kRefined);
-    }
-    return count;
-}
-
-// The unrefined edge of a leaf with exactly two hanging nodes.
-inline int unrefined_edge(const LevelNode* nodes, uint32_t i) {
+// The unrefined edge of a decided leaf with exactly two hanging nodes.
+inline int unrefined_edge(const Level& level, uint32_t i) {
     for (int e = 0; e < 2; ++e) {
-        const uint32_t q = nodes[i].nbr[e];
-        if (q == kNoLocal || !(nodes[q].state & kRefined)) return e;
+        const uint32_t q = level.links[i].nbr[e];
+        if (q == kNoLocal || !(level.state[q] & kRefined)) return e;
     }
     return 2;
 }
+
+// The culling rules in force (paper II-C): which rule decides a node in state s, or Fate::coded.
+struct CullRules {
+    bool one_regularity;
+    bool hanging_nodes;
+    Fate fate(uint8_t s) const {
+        if (one_regularity && !(s & kComplete)) return Fate::one_regularity;
+        // The count of decided refined neighbours is kept up to date by LevelTraversal.
+        if (hanging_nodes && (s & kRefinedNeighborMask) == 3 * kRefinedNeighbor) return Fate::hanging_nodes;
+        return Fate::coded;
+    }
+};
 
 class LevelTraversal {
 public:
     explicit LevelTraversal(const HierarchyCoderOptions& options) : options_(options) {}
 
     // Decides every node of `level` (undecided, canonical order) and records the decisions in
-    // the nodes' state.
+    // the nodes' state; afterwards each state's refined-neighbour count is exact.
     //   code(uint32_t i, int context_group) -> bool   the node's symbol (coded by the caller)
     //   force(uint32_t i, Fate fate, bool refined) -> bool   a decision implied by a rule; returns
     //       the node's actual state (the decoder: `refined`; the encoder: the hierarchy's, so even
     //       an invalid hierarchy keeps the level forest in step with it)
     template <class Code, class Force>
-    void run(std::vector<LevelNode>& level, bool uniform_level, Code&& code, Force&& force) {
-        LevelNode* nodes = level.data();
+    void run(Level& level, bool uniform_level, Code&& code, Force&& force) {
+        const LevelLinks* links = level.links.data();
+        uint8_t* state = level.state.data();
         const uint32_t n = static_cast<uint32_t>(level.size());
+        // A copy in a local: the state bytes written below could alias options_.
+        const CullRules rules{options_.cull_one_regularity, options_.cull_hanging_nodes};
         if (uniform_level) {
             for (uint32_t i = 0; i < n; ++i) {
-                nodes[i].state = uint8_t(kDecided | (force(i, Fate::uniform, true) ? kRefined : 0));
+                if (force(i, Fate::uniform, true)) {
+                    state[i] = uint8_t(state[i] | kDecided | kRefined);
+                    add_refined_neighbor(links[i], state);
+                } else {
+                    state[i] = uint8_t(state[i] | kDecided);
+                }
             }
             return;
         }
         if (options_.traversal == Traversal::naive) {
-            for (uint32_t i = 0; i < n; ++i) decide(nodes, i, code, force);
+            for (uint32_t i = 0; i < n; ++i) decide(rules, links, state, i, code, force);
             return;
         }
         // Improved traversal: a bucket queue over priorities 0 (culled: nothing to code) to 4 (no
@@ -181,92 +205,122 @@ public:
         // Two buckets need no storage: bucket 4 starts with every unculled node in canonical order
         // and never receives another, so it is a cursor; bucket 0 starts with the nodes culled at
         // the outset in canonical order (a cursor) under a stack of nodes culled later.
-        const bool cull_incomplete = options_.cull_one_regularity;
-        for (uint32_t i = 0; i < n; ++i)
-            nodes[i].priority = cull_incomplete && !(nodes[i].flags & kCompleteFlag) ? 0 : 4;
+        const uint8_t initially_culled = rules.one_regularity ? uint8_t(0) : kComplete;
+        for (uint32_t i = 0; i < n; ++i) {
+            const uint8_t s = state[i];
+            state[i] = uint8_t(((s | initially_culled) & kComplete) ? s | (4 << kPriorityShift) : s);
+        }
         for (auto& stack : stacks_) {
             stack.clear();
             if (stack.capacity() < n) stack.reserve(n);
         }
-        uint32_t* const top_base[4] = {stacks_[0].data(), stacks_[1].data(), stacks_[2].data(), stacks_[3].data()};
-        uint32_t* top[4] = {top_base[0], top_base[1], top_base[2], top_base[3]};
+        // The stacks' tops in separate locals, so that they stay in registers.
+        uint32_t* const bottom0 = stacks_[0].data();
+        uint32_t* const bottom1 = stacks_[1].data();
+        uint32_t* const bottom2 = stacks_[2].data();
+        uint32_t* const bottom3 = stacks_[3].data();
+        uint32_t *top0 = bottom0, *top1 = bottom1, *top2 = bottom2, *top3 = bottom3;
         uint32_t culled_cursor = 0, fresh_cursor = 0;
+        constexpr uint8_t kDecidedOrPriority = kDecided | kPriorityMask;
+        const uint8_t hanging_culled = rules.hanging_nodes ? uint8_t(3 * kRefinedNeighbor) : uint8_t(0xff);
         for (;;) {
             uint32_t i;
-            if (top[0] != top_base[0]) {
-                i = *--top[0];  // entries of bucket 0 are never stale
+            // A node from bucket 0 is culled; from any other bucket it carries a symbol (its
+            // priority was set when its fate last changed).
+            bool culled = false;
+            if (top0 != bottom0) {
+                i = *--top0;  // entries of bucket 0 are never stale
+                culled = true;
             } else {
-                while (culled_cursor < n && (nodes[culled_cursor].priority != 0 || (nodes[culled_cursor].state & kDecided)))
-                    ++culled_cursor;
+                while (culled_cursor < n && (state[culled_cursor] & kDecidedOrPriority) != 0) ++culled_cursor;
                 if (culled_cursor < n) {
                     i = culled_cursor++;
+                    culled = true;
+                } else if (top1 != bottom1) {
+                    i = *--top1;
+                    if ((state[i] & kDecidedOrPriority) != (1 << kPriorityShift)) continue;
+                } else if (top2 != bottom2) {
+                    i = *--top2;
+                    if ((state[i] & kDecidedOrPriority) != (2 << kPriorityShift)) continue;
+                } else if (top3 != bottom3) {
+                    i = *--top3;
+                    if ((state[i] & kDecidedOrPriority) != (3 << kPriorityShift)) continue;
                 } else {
-                    int p = 1;
-                    while (p < 4 && top[p] == top_base[p]) ++p;
-                    if (p < 4) {
-                        i = *--top[p];
-                        if ((nodes[i].state & kDecided) || nodes[i].priority != p) continue;
-                    } else {
-                        while (fresh_cursor < n && (nodes[fresh_cursor].priority != 4 || (nodes[fresh_cursor].state & kDecided)))
-                            ++fresh_cursor;
-                        if (fresh_cursor == n) break;
-                        i = fresh_cursor++;
-                    }
+                    while (fresh_cursor < n && (state[fresh_cursor] & kDecidedOrPriority) != (4 << kPriorityShift))
+                        ++fresh_cursor;
+                    if (fresh_cursor == n) break;
+                    i = fresh_cursor++;
                 }
             }
-            decide(nodes, i, code, force);
+            const LevelLinks node = links[i];
+            bool refined;
+            if (culled) {
+                const Fate fate = rules.fate(state[i]);
+                refined = force(i, fate, fate == Fate::hanging_nodes);
+            } else {
+                refined = code(i, context_group(node, state));
+            }
+            state[i] = uint8_t(state[i] | kDecided | (refined ? kRefined : 0));
+            if (refined) add_refined_neighbor(node, state);
+            // Each undecided neighbour moves one bucket down (not below 1), or to bucket 0 once
+            // three refined neighbours make it culled. (A neighbour culled by 1-regularity is
+            // in bucket 0 from the outset.)
             for (int e = 0; e < 3; ++e) {
-                const uint32_t q = nodes[i].nbr[e];
+                const uint32_t q = node.nbr[e];
                 if (q == kNoLocal) continue;
-                LevelNode& m = nodes[q];
-                if ((m.state & kDecided) || m.priority == 0) continue;
-                const uint8_t next = fate_of(nodes, q) != Fate::coded ? 0 : uint8_t(m.priority > 1 ? m.priority - 1 : 1);
-                if (next != m.priority) {
-                    m.priority = next;
-                    *top[next]++ = q;
-                }
+                const uint8_t s = state[q];
+                const int p = s >> kPriorityShift;
+                if ((s & kDecided) || p == 0) continue;
+                const int next = (s & kRefinedNeighborMask) == hanging_culled ? 0 : (p > 1 ? p - 1 : 1);
+                if (next == p) continue;
+                state[q] = uint8_t((s & ~kPriorityMask) | (next << kPriorityShift));
+                // Last in, first out: q is likely to be decided soon, and its links are usually
+                // not in cache yet.
+                __builtin_prefetch(links + q);
+                if (next == 2) *top2++ = q;
+                else if (next == 1) *top1++ = q;
+                else if (next == 3) *top3++ = q;
+                else *top0++ = q;
             }
         }
     }
 
 private:
-    // The rule that decides node i given what is known now, or Fate::coded.
-    Fate fate_of(const LevelNode* nodes, uint32_t i) const {
-        if (options_.cull_one_regularity && !(nodes[i].flags & kCompleteFlag)) return Fate::one_regularity;
-        // The count of decided refined neighbours is kept up to date by decide().
-        if (options_.cull_hanging_nodes && (nodes[i].state & kRefinedNeighborMask) == 3 * kRefinedNeighbor)
-            return Fate::hanging_nodes;
-        return Fate::coded;
+    static void add_refined_neighbor(const LevelLinks& node, uint8_t* state) {
+        for (int e = 0; e < 3; ++e) {
+            const uint32_t q = node.nbr[e];
+            if (q != kNoLocal && (state[q] & kRefinedNeighborMask) != kRefinedNeighborMask)
+                state[q] = uint8_t(state[q] + kRefinedNeighbor);
+        }
+    }
+
+    // The context group of a node: its neighbours refined, not refined, not yet decided.
+    static int context_group(const LevelLinks& node, const uint8_t* state) {
+        int r = 0, u = 0;
+        for (int e = 0; e < 3; ++e) {
+            const uint32_t q = node.nbr[e];
+            if (q == kNoLocal) {
+                ++u;  // boundary, or a coarser region: see context_groups.h
+            } else {
+                const uint8_t s = state[q];
+                r += (s >> 1) & 1;
+                u += s & ~(s >> 1) & 1;
+            }
+        }
+        return context_group_of(r, u);
     }
 
     template <class Code, class Force>
-    void decide(LevelNode* nodes, uint32_t i, Code& code, Force& force) {
-        const Fate fate = fate_of(nodes, i);
+    static void decide(CullRules rules, const LevelLinks* links, uint8_t* state, uint32_t i, Code& code, Force& force) {
+        const Fate fate = rules.fate(state[i]);
         bool refined;
         if (fate == Fate::coded) {
-            int r = 0, u = 0;
-            for (int e = 0; e < 3; ++e) {
-                const uint32_t q = nodes[i].nbr[e];
-                if (q == kNoLocal) {
-                    ++u;  // boundary, or a coarser region: see context_groups.h
-                } else {
-                    const uint8_t s = nodes[q].state;
-                    r += (s >> 1) & 1;
-                    u += s & ~(s >> 1) & 1;
-                }
-            }
-            refined = code(i, context_group_of(r, u));
+            refined = code(i, context_group(links[i], state));
         } else {
             refined = force(i, fate, fate == Fate::hanging_nodes);
         }
-        nodes[i].state = uint8_t(nodes[i].state | kDecided | (refined ? kRefined : 0));
-        if (refined) {
-            for (int e = 0; e < 3; ++e) {
-                const uint32_t q = nodes[i].nbr[e];
-                if (q != kNoLocal && (nodes[q].state & kRefinedNeighborMask) != kRefinedNeighborMask)
-                    nodes[q].state = uint8_t(nodes[q].state + kRefinedNeighbor);
-            }
-        }
+        state[i] = uint8_t(state[i] | kDecided | (refined ? kRefined : 0));
+        if (refined) add_refined_neighbor(links[i], state);
     }
 
     HierarchyCoderOptions options_;

@@ -173,17 +173,20 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
     }
     const size_t c0 = nodes_.size();
     const size_t new_nodes = c0 + size_t(4) * count;
-    // Edge e of parent i gets a new vertex unless an earlier parent across it made one.
-    size_t new_vertices = 0;
-    for (uint32_t i = 0; i < count; ++i) {
-        for (int e = 0; e < 3; ++e) {
-            const uint32_t t = child_links[stride * (size_t(4) * i + size_t(e)) + size_t(e)];
-            new_vertices += !(t != kNoNode && t / 4 < i);
-        }
-    }
-    const size_t vertices = positions_.size() + new_vertices;
     if (new_nodes > nodes_.capacity()) reserve(std::max(new_nodes, nodes_.capacity() + nodes_.capacity() / 2), 0);
-    if (vertices > positions_.capacity()) reserve(0, std::max(vertices, positions_.capacity() + positions_.capacity() / 2));
+    if (positions_.size() + size_t(3) * count > positions_.capacity()) {
+        // Maybe not enough room: count exactly. Edge e of parent i gets a new vertex unless an
+        // earlier parent across it made one.
+        size_t new_vertices = 0;
+        for (uint32_t i = 0; i < count; ++i) {
+            for (int e = 0; e < 3; ++e) {
+                const uint32_t t = child_links[stride * (size_t(4) * i + size_t(e)) + size_t(e)];
+                new_vertices += !(t != kNoNode && t / 4 < i);
+            }
+        }
+        const size_t vertices = positions_.size() + new_vertices;
+        if (vertices > positions_.capacity()) reserve(0, std::max(vertices, positions_.capacity() + positions_.capacity() / 2));
+    }
     nodes_.resize(new_nodes);
     const size_t v0 = positions_.size();
     Node* nodes = nodes_.data();
