@@ -2,7 +2,7 @@
 # The side-by-side benchmark (docs/BENCHMARKS.md), in one command: installs the bench packages,
 # builds amc and bench/compare_bench (Release), makes the corpus, measures every coder on every
 # model, and rewrites the generated part of docs/BENCHMARKS.md and the chart
-# docs/images/benchmarks_connectivity.svg. About 10 minutes on a 2-core machine from a clean build.
+# docs/images/benchmarks_connectivity.svg. About 5 minutes on a 2-core machine from a clean build.
 # Usage: scripts/benchmarks.sh [build-dir] [runs]
 set -euo pipefail
 start=$(date +%s)
