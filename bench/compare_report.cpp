@@ -301,6 +301,25 @@ void mesh_table(FILE* f, const Index& index) {
     std::fprintf(f, "\n");
 }
 
+// The per-model rates of a speed table's columns, for its closing row of medians.
+struct SpeedColumns {
+    std::vector<std::vector<double>> encode, decode;  // million faces per second
+    explicit SpeedColumns(size_t columns) : encode(columns), decode(columns) {}
+    void add(size_t column, const Result* r) {
+        if (!r || r->encode_seconds <= 0 || r->decode_seconds <= 0) return;
+        encode[column].push_back(double(r->faces) / r->encode_seconds / 1e6);
+        decode[column].push_back(double(r->faces) / r->decode_seconds / 1e6);
+    }
+    void print_medians(FILE* f) const {
+        std::vector<std::string> medians;
+        for (size_t i = 0; i < encode.size(); ++i)
+            medians.push_back("**" + speed(1000000, 1.0 / median_of(encode[i])) + " / " +
+                              speed(1000000, 1.0 / median_of(decode[i])) + "**");
+        print_row(f, "**median over models**", medians);
+        std::fprintf(f, "\n");
+    }
+};
+
 void connectivity_speed_table(FILE* f, const Index& index) {
     std::fprintf(f, "### Speed, connectivity: encode / decode, million faces per second\n\n");
     std::vector<std::string> columns;
@@ -311,24 +330,17 @@ void connectivity_speed_table(FILE* f, const Index& index) {
         columns.push_back(c.label);
     }
     print_header(f, "model", columns, "---:");
-    std::vector<std::vector<double>> encode(timed.size()), decode(timed.size());
+    SpeedColumns speeds(timed.size());
     for (const std::string& model : index.models()) {
         std::vector<std::string> cells;
         for (size_t i = 0; i < timed.size(); ++i) {
             const Result* r = index.find(model, timed[i]->coder, "connectivity");
             cells.push_back(speed_pair(r));
-            if (r && r->encode_seconds > 0 && r->decode_seconds > 0) {
-                encode[i].push_back(double(r->faces) / r->encode_seconds / 1e6);
-                decode[i].push_back(double(r->faces) / r->decode_seconds / 1e6);
-            }
+            speeds.add(i, r);
         }
         print_row(f, model, cells);
     }
-    std::vector<std::string> medians;
-    for (size_t i = 0; i < timed.size(); ++i)
-        medians.push_back("**" + speed(1000000, 1.0 / median_of(encode[i])) + " / " + speed(1000000, 1.0 / median_of(decode[i])) + "**");
-    print_row(f, "**median over models**", medians);
-    std::fprintf(f, "\n");
+    speeds.print_medians(f);
 }
 
 void mesh_speed_table(FILE* f, const Index& index) {
@@ -338,7 +350,7 @@ void mesh_speed_table(FILE* f, const Index& index) {
         for (const char* payload : kMeshPayloads)
             columns.push_back(std::string(c.label) + (std::string(payload) == "mesh-lossless" ? " lossless" : " " + std::string(payload).substr(5) + " bits"));
     print_header(f, "model", columns, "---:");
-    std::vector<std::vector<double>> encode(columns.size()), decode(columns.size());
+    SpeedColumns speeds(columns.size());
     for (const std::string& model : index.models()) {
         std::vector<std::string> cells;
         size_t i = 0;
@@ -346,19 +358,11 @@ void mesh_speed_table(FILE* f, const Index& index) {
             for (const char* payload : kMeshPayloads) {
                 const Result* r = index.find(model, c.coder, payload);
                 cells.push_back(speed_pair(r));
-                if (r && r->encode_seconds > 0 && r->decode_seconds > 0) {
-                    encode[i].push_back(double(r->faces) / r->encode_seconds / 1e6);
-                    decode[i].push_back(double(r->faces) / r->decode_seconds / 1e6);
-                }
-                ++i;
+                speeds.add(i++, r);
             }
         print_row(f, model, cells);
     }
-    std::vector<std::string> medians;
-    for (size_t i = 0; i < columns.size(); ++i)
-        medians.push_back("**" + speed(1000000, 1.0 / median_of(encode[i])) + " / " + speed(1000000, 1.0 / median_of(decode[i])) + "**");
-    print_row(f, "**median over models**", medians);
-    std::fprintf(f, "\n");
+    speeds.print_medians(f);
 }
 
 void check_summary(FILE* f, const std::vector<Result>& results, const RunInfo& info) {
