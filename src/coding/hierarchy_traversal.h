@@ -165,9 +165,41 @@ struct CullRules {
     }
 };
 
+// Context group by the neighbours' kinds, two bits each (edge e at bits 2e): 0 not yet decided,
+// 1 not refined (or no neighbour: boundary, coarser region), 3 refined.
+struct ContextTable {
+    uint8_t group[64];
+    constexpr ContextTable() : group() {
+        for (int code = 0; code < 64; ++code) {
+            int refined = 0, unrefined = 0;
+            for (int e = 0; e < 3; ++e) {
+                const int kind = (code >> (2 * e)) & 3;
+                refined += kind == 3;
+                unrefined += kind == 1 || kind == 2;
+            }
+            group[code] = uint8_t(kContextGroupOf[refined][unrefined]);
+        }
+    }
+};
+constexpr ContextTable kContextTable{};
+
 class LevelTraversal {
 public:
-    explicit LevelTraversal(const HierarchyCoderOptions& options) : options_(options) {}
+    explicit LevelTraversal(const HierarchyCoderOptions& options) : options_(options) {
+        // What a decided neighbour does to a node's state in the improved traversal: an
+        // undecided node outside bucket 0 moves one bucket down (not below 1), or to bucket 0
+        // once its three refined neighbours make it culled (a node culled by 1-regularity is in
+        // bucket 0 from the outset).
+        for (int s = 0; s < 256; ++s) {
+            const int p = s >> kPriorityShift;
+            int next = p;
+            if (!(s & kDecided) && p != 0 && p <= 4) {
+                const bool culled = options.cull_hanging_nodes && (s & kRefinedNeighborMask) == 3 * kRefinedNeighbor;
+                next = culled ? 0 : (p > 1 ? p - 1 : 1);
+            }
+            after_neighbor_decided_[s] = uint8_t((s & ~kPriorityMask) | (next << kPriorityShift));
+        }
+    }
 
     // Decides every node of `level` (undecided, canonical order) and records the decisions in
     // the nodes' state; afterwards each state's refined-neighbour count is exact.
@@ -214,43 +246,41 @@ public:
             stack.clear();
             if (stack.capacity() < n) stack.reserve(n);
         }
-        // The stacks' tops in separate locals, so that they stay in registers.
-        uint32_t* const bottom0 = stacks_[0].data();
-        uint32_t* const bottom1 = stacks_[1].data();
-        uint32_t* const bottom2 = stacks_[2].data();
-        uint32_t* const bottom3 = stacks_[3].data();
-        uint32_t *top0 = bottom0, *top1 = bottom1, *top2 = bottom2, *top3 = bottom3;
+        uint32_t* const bottom[4] = {stacks_[0].data(), stacks_[1].data(), stacks_[2].data(), stacks_[3].data()};
+        uint32_t* top[4] = {bottom[0], bottom[1], bottom[2], bottom[3]};
         uint32_t culled_cursor = 0, fresh_cursor = 0;
         constexpr uint8_t kDecidedOrPriority = kDecided | kPriorityMask;
-        const uint8_t hanging_culled = rules.hanging_nodes ? uint8_t(3 * kRefinedNeighbor) : uint8_t(0xff);
+        uint8_t transition[256];  // a local copy: the state bytes written below could alias the member
+        for (int k = 0; k < 256; ++k) transition[k] = after_neighbor_decided_[k];
+        int current = 0;  // every bucket below this one is empty
         for (;;) {
             uint32_t i;
             // A node from bucket 0 is culled; from any other bucket it carries a symbol (its
             // priority was set when its fate last changed).
             bool culled = false;
-            if (top0 != bottom0) {
-                i = *--top0;  // entries of bucket 0 are never stale
-                culled = true;
-            } else {
-                while (culled_cursor < n && (state[culled_cursor] & kDecidedOrPriority) != 0) ++culled_cursor;
-                if (culled_cursor < n) {
+            if (current == 0) {
+                if (top[0] != bottom[0]) {
+                    i = *--top[0];  // entries of bucket 0 are never stale
+                } else if (culled_cursor < n) {
                     i = culled_cursor++;
-                    culled = true;
-                } else if (top1 != bottom1) {
-                    i = *--top1;
-                    if ((state[i] & kDecidedOrPriority) != (1 << kPriorityShift)) continue;
-                } else if (top2 != bottom2) {
-                    i = *--top2;
-                    if ((state[i] & kDecidedOrPriority) != (2 << kPriorityShift)) continue;
-                } else if (top3 != bottom3) {
-                    i = *--top3;
-                    if ((state[i] & kDecidedOrPriority) != (3 << kPriorityShift)) continue;
+                    if ((state[i] & kDecidedOrPriority) != 0) continue;
                 } else {
-                    while (fresh_cursor < n && (state[fresh_cursor] & kDecidedOrPriority) != (4 << kPriorityShift))
-                        ++fresh_cursor;
-                    if (fresh_cursor == n) break;
-                    i = fresh_cursor++;
+                    current = 1;
+                    continue;
                 }
+                culled = true;
+            } else if (current < 4) {
+                if (top[current] == bottom[current]) {
+                    ++current;
+                    continue;
+                }
+                i = *--top[current];
+                if ((state[i] & kDecidedOrPriority) != (current << kPriorityShift)) continue;
+            } else if (fresh_cursor < n) {
+                i = fresh_cursor++;
+                if ((state[i] & kDecidedOrPriority) != (4 << kPriorityShift)) continue;
+            } else {
+                break;
             }
             const LevelLinks node = links[i];
             bool refined;
@@ -262,25 +292,19 @@ public:
             }
             state[i] = uint8_t(state[i] | kDecided | (refined ? kRefined : 0));
             if (refined) add_refined_neighbor(node, state);
-            // Each undecided neighbour moves one bucket down (not below 1), or to bucket 0 once
-            // three refined neighbours make it culled. (A neighbour culled by 1-regularity is
-            // in bucket 0 from the outset.)
             for (int e = 0; e < 3; ++e) {
                 const uint32_t q = node.nbr[e];
                 if (q == kNoLocal) continue;
                 const uint8_t s = state[q];
-                const int p = s >> kPriorityShift;
-                if ((s & kDecided) || p == 0) continue;
-                const int next = (s & kRefinedNeighborMask) == hanging_culled ? 0 : (p > 1 ? p - 1 : 1);
-                if (next == p) continue;
-                state[q] = uint8_t((s & ~kPriorityMask) | (next << kPriorityShift));
+                const uint8_t t = transition[s];
+                if (t == s) continue;
+                state[q] = t;
                 // Last in, first out: q is likely to be decided soon, and its links are usually
                 // not in cache yet.
                 __builtin_prefetch(links + q);
-                if (next == 2) *top2++ = q;
-                else if (next == 1) *top1++ = q;
-                else if (next == 3) *top3++ = q;
-                else *top0++ = q;
+                const int bucket = t >> kPriorityShift;
+                *top[bucket]++ = q;
+                if (bucket < current) current = bucket;
             }
         }
     }
@@ -296,18 +320,15 @@ private:
 
     // The context group of a node: its neighbours refined, not refined, not yet decided.
     static int context_group(const LevelLinks& node, const uint8_t* state) {
-        int r = 0, u = 0;
+        unsigned code = 0;
         for (int e = 0; e < 3; ++e) {
             const uint32_t q = node.nbr[e];
-            if (q == kNoLocal) {
-                ++u;  // boundary, or a coarser region: see context_groups.h
-            } else {
-                const uint8_t s = state[q];
-                r += (s >> 1) & 1;
-                u += s & ~(s >> 1) & 1;
-            }
+            // No neighbour (boundary, or a coarser region: see context_groups.h) counts as not
+            // refined; a neighbour's kind is its decided and refined bits.
+            const unsigned kind = q == kNoLocal ? 1u : state[q] & (kDecided | kRefined);
+            code |= kind << (2 * e);
         }
-        return context_group_of(r, u);
+        return kContextTable.group[code];
     }
 
     template <class Code, class Force>
@@ -324,6 +345,7 @@ private:
     }
 
     HierarchyCoderOptions options_;
+    uint8_t after_neighbor_decided_[256];  // state -> state, see the constructor
     std::array<std::vector<uint32_t>, 4> stacks_;  // buckets 0-3 (each holds at most one entry per node)
 };
 
