@@ -253,12 +253,15 @@ public:
         uint8_t transition[256];  // a local copy: the state bytes written below could alias the member
         for (int k = 0; k < 256; ++k) transition[k] = after_neighbor_decided_[k];
         int current = 0;  // every bucket below this one is empty
+        uint32_t i = 0;
+        bool culled = false;
+        bool popped = false;  // i was taken off its bucket by the previous step
         for (;;) {
-            uint32_t i;
             // A node from bucket 0 is culled; from any other bucket it carries a symbol (its
             // priority was set when its fate last changed).
-            bool culled = false;
-            if (current == 0) {
+            if (popped) {
+                popped = false;
+            } else if (current == 0) {
                 if (top[0] != bottom[0]) {
                     i = *--top[0];  // entries of bucket 0 are never stale
                 } else if (culled_cursor < n) {
@@ -276,9 +279,11 @@ public:
                 }
                 i = *--top[current];
                 if ((state[i] & kDecidedOrPriority) != (current << kPriorityShift)) continue;
+                culled = false;
             } else if (fresh_cursor < n) {
                 i = fresh_cursor++;
                 if ((state[i] & kDecidedOrPriority) != (4 << kPriorityShift)) continue;
+                culled = false;
             } else {
                 break;
             }
@@ -292,6 +297,12 @@ public:
             }
             state[i] = uint8_t(state[i] | kDecided | (refined ? kRefined : 0));
             if (refined) add_refined_neighbor(node, state);
+            // The pushes of this step; the last one into the lowest bucket is the next node
+            // whenever that bucket is now the lowest non-empty one. Knowing it here, rather than
+            // reading it back from the bucket, keeps the stack and the state byte out of the
+            // chain of loads from one node to the next.
+            uint32_t next = 0;
+            int next_bucket = 5;
             for (int e = 0; e < 3; ++e) {
                 const uint32_t q = node.nbr[e];
                 if (q == kNoLocal) continue;
@@ -304,7 +315,17 @@ public:
                 __builtin_prefetch(links + q);
                 const int bucket = t >> kPriorityShift;
                 *top[bucket]++ = q;
-                if (bucket < current) current = bucket;
+                if (bucket <= next_bucket) {
+                    next = q;
+                    next_bucket = bucket;
+                }
+            }
+            if (next_bucket <= current) {
+                current = next_bucket;
+                --top[current];
+                i = next;
+                culled = current == 0;
+                popped = true;
             }
         }
     }
