@@ -45,14 +45,27 @@ void ArithmeticEncoder::flush_cache() {
 
 void ArithmeticEncoder::encode_bits_raw(uint32_t value, int count) {
     check_raw_count(count, "ArithmeticEncoder::encode_bits_raw");
+    // The interval in locals between the byte shifts (about every 8 bits), so that it stays in
+    // registers.
+    uint64_t low = low_;
+    uint32_t range = range_;
     for (int i = count - 1; i >= 0; --i) {
-        range_ >>= 1;
-        if ((value >> i) & 1u) low_ += range_;
-        while (range_ < kTop) {
-            range_ <<= 8;
-            shift_low();
+        range >>= 1;
+        // Raw bits are noise (low mantissa bits): a branch on them would mispredict half the time.
+        low += range & (0u - ((value >> i) & 1u));
+        if (range < kTop) {
+            low_ = low;
+            range_ = range;
+            do {
+                range_ <<= 8;
+                shift_low();
+            } while (range_ < kTop);
+            low = low_;
+            range = range_;
         }
     }
+    low_ = low;
+    range_ = range;
 }
 
 std::vector<uint8_t> ArithmeticEncoder::finish() {
@@ -85,16 +98,19 @@ ArithmeticDecoder::ArithmeticDecoder(const uint8_t* data, size_t size)
 uint32_t ArithmeticDecoder::decode_bits_raw(int count) {
     check_raw_count(count, "ArithmeticDecoder::decode_bits_raw");
     uint32_t value = 0;
+    uint32_t range = range_, code = code_;  // in registers, as in the encoder
     for (int i = 0; i < count; ++i) {
-        range_ >>= 1;
-        const bool bit = code_ >= range_;
-        if (bit) code_ -= range_;
-        value = (value << 1) | static_cast<uint32_t>(bit);
-        while (range_ < kTop) {
-            range_ <<= 8;
-            code_ = (code_ << 8) | next_byte();
+        range >>= 1;
+        const uint32_t bit = code >= range ? 1u : 0u;
+        code -= range & (0u - bit);  // without a branch, as in the encoder
+        value = (value << 1) | bit;
+        while (range < kTop) {
+            range <<= 8;
+            code = (code << 8) | next_byte();
         }
     }
+    range_ = range;
+    code_ = code;
     return value;
 }
 
