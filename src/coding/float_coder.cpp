@@ -23,14 +23,7 @@ uint64_t width_mask(Precision precision) {
 int tree_depth(Precision precision) { return precision == Precision::float32 ? 6 : 7; }
 constexpr int kQuantizedTreeDepth = 5;  // k = 0 .. 30 < 32
 
-int bit_length(uint64_t m) {
-    int k = 0;
-    while (m != 0) {
-        ++k;
-        m >>= 1;
-    }
-    return k;
-}
+int bit_length(uint64_t m) { return m == 0 ? 0 : 64 - __builtin_clzll(m); }
 
 double finite_or_zero(double x) { return std::isfinite(x) ? x : 0.0; }
 
