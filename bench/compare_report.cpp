@@ -124,13 +124,6 @@ double geometric_mean(const std::vector<double>& v) {
     return v.empty() ? 0 : std::exp(sum / double(v.size()));
 }
 
-double median_of(std::vector<double> v) {
-    if (v.empty()) return 0;
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 void print_header(FILE* f, const std::string& first, const std::vector<std::string>& columns, const std::string& align) {
     std::fprintf(f, "| %s |", first.c_str());
     for (const std::string& c : columns) std::fprintf(f, " %s |", c.c_str());
@@ -313,8 +306,8 @@ struct SpeedColumns {
     void print_medians(FILE* f) const {
         std::vector<std::string> medians;
         for (size_t i = 0; i < encode.size(); ++i)
-            medians.push_back("**" + speed(1000000, 1.0 / median_of(encode[i])) + " / " +
-                              speed(1000000, 1.0 / median_of(decode[i])) + "**");
+            medians.push_back("**" + speed(1000000, 1.0 / median(encode[i])) + " / " +
+                              speed(1000000, 1.0 / median(decode[i])) + "**");
         print_row(f, "**median over models**", medians);
         std::fprintf(f, "\n");
     }
@@ -394,6 +387,13 @@ void check_summary(FILE* f, const std::vector<Result>& results, const RunInfo& i
 }
 
 }  // namespace
+
+double median(std::vector<double> samples) {
+    if (samples.empty()) return 0;
+    std::sort(samples.begin(), samples.end());
+    const size_t n = samples.size();
+    return n % 2 ? samples[n / 2] : 0.5 * (samples[n / 2 - 1] + samples[n / 2]);
+}
 
 void write_csv(const std::string& path, const std::vector<Result>& results) {
     FILE* f = std::fopen(path.c_str(), "w");

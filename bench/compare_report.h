@@ -42,6 +42,9 @@ struct RunInfo {
     std::string command;
 };
 
+// The median of the samples (the mean of the middle two for an even count); 0 for none.
+double median(std::vector<double> samples);
+
 void write_csv(const std::string& path, const std::vector<Result>& results);
 // The tables of docs/BENCHMARKS.md (sizes, bits per face, ratios, complete meshes, speeds, checks).
 void write_markdown(const std::string& path, const std::vector<Result>& results, const RunInfo& info);

@@ -171,15 +171,8 @@ struct CutBorder {
     // S: the tip is node n = k steps after v (2 <= k <= length - 3). The part v .. n becomes a
     // loop of its own, pushed below the current one; returns the new node of w in that part.
     uint32_t op_split(uint32_t n, uint32_t k) {
-        Loop& l = top();
-        const uint32_t g = l.gate, nv = next[g], pn = prev[n];
-        const uint32_t nw = new_node(vert[n], vert[g]);
-        opp[g] = vert[nv];
-        link(pn, nw);
-        link(nw, nv);
-        link(g, n);
-        const uint32_t length = l.length;
-        l.length = length - k;
+        const uint32_t nw = close_gate_at(n);
+        top().length -= k;
         stack.insert(stack.end() - 1, Loop{nw, k + 1});
         return nw;
     }
@@ -187,14 +180,20 @@ struct CutBorder {
     uint32_t op_merge(uint32_t n, size_t index) {
         const uint32_t other_length = stack[index].length;
         stack.erase(stack.begin() + static_cast<std::ptrdiff_t>(index));
-        Loop& l = top();
-        const uint32_t g = l.gate, nv = next[g], pn = prev[n];
+        const uint32_t nw = close_gate_at(n);
+        top().length += other_length + 1;
+        return nw;
+    }
+    // S and M alike: the gate's triangle has its tip at node n elsewhere on the loops (so n's
+    // predecessor is not the gate and n is not the gate's far end). The gate now leads to n, and
+    // a second node of the tip's vertex joins n's predecessor to the gate's far end; returns it.
+    uint32_t close_gate_at(uint32_t n) {
+        const uint32_t g = top().gate, nv = next[g], pn = prev[n];
         const uint32_t nw = new_node(vert[n], vert[g]);
         opp[g] = vert[nv];
         link(g, n);
         link(pn, nw);
         link(nw, nv);
-        l.length += other_length + 1;
         return nw;
     }
     // Moves the gate of the current loop to the node whose vertex has the most decoded triangles

@@ -190,13 +190,12 @@ public:
         // undecided node outside bucket 0 moves one bucket down (not below 1), or to bucket 0
         // once its three refined neighbours make it culled (a node culled by 1-regularity is in
         // bucket 0 from the outset).
+        const CullRules rules{options.cull_one_regularity, options.cull_hanging_nodes};
         for (int s = 0; s < 256; ++s) {
             const int p = s >> kPriorityShift;
             int next = p;
-            if (!(s & kDecided) && p != 0 && p <= 4) {
-                const bool culled = options.cull_hanging_nodes && (s & kRefinedNeighborMask) == 3 * kRefinedNeighbor;
-                next = culled ? 0 : (p > 1 ? p - 1 : 1);
-            }
+            if (!(s & kDecided) && p != 0 && p <= 4)
+                next = rules.fate(uint8_t(s)) != Fate::coded ? 0 : (p > 1 ? p - 1 : 1);
             after_neighbor_decided_[s] = uint8_t((s & ~kPriorityMask) | (next << kPriorityShift));
         }
     }
@@ -226,7 +225,7 @@ public:
             return;
         }
         if (options_.traversal == Traversal::naive) {
-            for (uint32_t i = 0; i < n; ++i) decide(rules, links, state, i, code, force);
+            for (uint32_t i = 0; i < n; ++i) decide(rules.fate(state[i]), links[i], state, i, code, force);
             return;
         }
         // Improved traversal: a bucket queue over priorities 0 (culled: nothing to code) to 4 (no
@@ -288,15 +287,7 @@ public:
                 break;
             }
             const LevelLinks node = links[i];
-            bool refined;
-            if (culled) {
-                const Fate fate = rules.fate(state[i]);
-                refined = force(i, fate, fate == Fate::hanging_nodes);
-            } else {
-                refined = code(i, context_group(node, state));
-            }
-            state[i] = uint8_t(state[i] | kDecided | (refined ? kRefined : 0));
-            if (refined) add_refined_neighbor(node, state);
+            decide(culled ? rules.fate(state[i]) : Fate::coded, node, state, i, code, force);
             // The pushes of this step; the last one into the lowest bucket is the next node
             // whenever that bucket is now the lowest non-empty one. Knowing it here, rather than
             // reading it back from the bucket, keeps the stack and the state byte out of the
@@ -352,17 +343,14 @@ private:
         return kContextTable.group[code];
     }
 
+    // Decides node i (links `node`) whose fate is known: codes its symbol or applies the rule,
+    // records the decision and counts it at the neighbours.
     template <class Code, class Force>
-    static void decide(CullRules rules, const LevelLinks* links, uint8_t* state, uint32_t i, Code& code, Force& force) {
-        const Fate fate = rules.fate(state[i]);
-        bool refined;
-        if (fate == Fate::coded) {
-            refined = code(i, context_group(links[i], state));
-        } else {
-            refined = force(i, fate, fate == Fate::hanging_nodes);
-        }
+    static void decide(Fate fate, const LevelLinks& node, uint8_t* state, uint32_t i, Code& code, Force& force) {
+        const bool refined = fate == Fate::coded ? code(i, context_group(node, state))
+                                                 : force(i, fate, fate == Fate::hanging_nodes);
         state[i] = uint8_t(state[i] | kDecided | (refined ? kRefined : 0));
-        if (refined) add_refined_neighbor(links[i], state);
+        if (refined) add_refined_neighbor(node, state);
     }
 
     HierarchyCoderOptions options_;
