@@ -47,7 +47,7 @@ void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder) {
 void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
     if (done()) throw Error("hierarchy stream: no level left to decode");
     const int l = level_index_;
-    uint8_t* state = level_.state.data();
+    uint8_t* state = level_.state();
     const uint32_t n = static_cast<uint32_t>(level_.size());
     // The coder's state lives in locals while the level is decided: every state byte the
     // traversal writes could alias a member as far as the compiler knows, and members would be
@@ -68,6 +68,13 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
             throw Error("hierarchy stream would build more than " + std::to_string(max_nodes) + " nodes");
         node_count += 4;
     };
+    if (symbols_read == symbol_limit && l >= header_.uniform_levels) {
+        // Stream truncation: every symbol left is 0, and with no node of this level refined yet
+        // no rule can force one. The level is all leaves (and the last): no traversal needed.
+        for (uint32_t i = 0; i < n; ++i) state[i] = uint8_t(state[i] | kDecided);
+        finish_level(d, models, symbols_read, node_count, 0);
+        return;
+    }
     traversal_.run(
         level_, l < header_.uniform_levels,
         [&](uint32_t i, int group) {
@@ -96,14 +103,19 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
         if (hanging == 2) {
             bool flag = diagonal_flag_by_rule(header_.diagonal_rule, unrefined_edge(level_, i));
             if (header_.orientation_coded) flag ^= d.decode(models.orientation);
-            if (flag) level_.links[i].flags |= kFlippedFlag;
+            if (flag) level_.flipped.push_back(i);
         }
     }
+    finish_level(d, models, symbols_read, node_count, edge_ends / 2);
     decoder = d;
+}
+
+void HierarchyLevelDecoder::finish_level(const ArithmeticDecoder& decoder, const HierarchyModels& models,
+                                         uint64_t symbols_read, uint64_t node_count, uint64_t new_vertices) {
     models_ = models;
     symbols_read_ = symbols_read;
     node_count_ = node_count;
-    vertex_count_ += edge_ends / 2;
+    vertex_count_ += new_vertices;
     if (decoder.overran()) throw Error("hierarchy stream is truncated");
     derive_next_level(level_, scratch_, next_);
     decided_.push_back(std::move(level_));
@@ -116,23 +128,22 @@ void HierarchyLevelDecoder::build_decided_levels() {
     for (size_t k = 0; k < decided_.size(); ++k) {
         const Level& level = decided_[k];
         const Level& children = k + 1 < decided_.size() ? decided_[k + 1] : level_;
-        const LevelLinks* links = level.links.data();
-        const uint8_t* state = level.state.data();
+        const uint8_t* state = level.state();
         const uint32_t n = static_cast<uint32_t>(level.size());
-        // The next level's links are exactly the links of the new children: split the whole
-        // level in one pass from them, in canonical order (so the children of level l get
-        // consecutive ids, as the level forest numbers them). level_ids_ is compacted in place
-        // to the refined nodes, then becomes the next level's ids.
+        // The next level's sibling blocks hold the refined nodes' neighbours among themselves
+        // (slots 0-2, the first halves of their edges): split the whole level in one pass from them, in canonical order (so the
+        // children of level l get consecutive ids, as the level forest numbers them). level_ids_
+        // is compacted in place to the refined nodes, then becomes the next level's ids.
         NodeId* ids = level_ids_.data();
+        for (const uint32_t i : level.flipped) h_.set_diagonal_flipped(ids[i], true);
         uint32_t count = 0;
         for (uint32_t i = 0; i < n; ++i) {
-            if (links[i].flags & kFlippedFlag) h_.set_diagonal_flipped(ids[i], true);
             ids[count] = ids[i];
             count += (state[i] & kRefined) ? 1u : 0u;
         }
         // The decoder's hierarchy never frees ids, so the children are numbered consecutively.
         const NodeId first_child = h_.node_capacity();
-        h_.split_level(ids, count, children.empty() ? nullptr : children.links[0].nbr, sizeof(LevelLinks) / sizeof(uint32_t));
+        h_.split_level(ids, count, children.empty() ? nullptr : children.blocks[0].slot, sizeof(SiblingBlock) / sizeof(uint32_t));
         level_ids_.resize(size_t(4) * count);
         ids = level_ids_.data();
         for (uint32_t c = 0; c < 4 * count; ++c) ids[c] = first_child + c;

@@ -66,7 +66,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
                 }
                 return truth[i] != 0;
             });
-        const uint8_t* state = level.state.data();
+        const uint8_t* state = level.state();
         for (uint32_t i = 0; i < n; ++i) {
             if (state[i] & kRefined) continue;
             const int hanging = refined_neighbors(state[i]);

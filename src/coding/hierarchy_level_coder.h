@@ -72,6 +72,10 @@ public:
     Hierarchy& hierarchy() { return h_; }
 
 private:
+    // Takes the decided level's counts back from decide_level's locals and moves to the next level.
+    void finish_level(const ArithmeticDecoder& decoder, const HierarchyModels& models, uint64_t symbols_read,
+                      uint64_t node_count, uint64_t new_vertices);
+
     HierarchyStreamHeader header_;
     uint64_t max_nodes_;
     Hierarchy h_;

@@ -12,9 +12,13 @@
 // the Hierarchy once at the end. Local index i of level l is the node's position in the level's
 // canonical order, which is also the order of the naive traversal.
 //
-// A level is two arrays: the links (16 bytes a node, read once per decision) and one state byte
-// a node, which the traversal reads and writes for every neighbour; kept apart, the states of
-// even the finest level stay in the processor's L2 cache.
+// A level is its links and one state byte a node, which the traversal reads and writes for every
+// neighbour; kept apart, the states of even the finest level stay in the processor's L2 cache.
+// The roots' links are stored node by node (LevelLinks). Every finer level comes in blocks of
+// four siblings (nodes 4b..4b+3 are the children of the level above's b-th refined node, in
+// child order), and four siblings' links follow from their parent's neighbours alone, so one
+// 16-byte SiblingBlock holds the links of four nodes: a quarter of the memory, derived in a
+// quarter of the writes.
 #pragma once
 
 #include "coding/context_groups.h"
@@ -33,14 +37,60 @@ enum class Fate : uint8_t { coded, uniform, one_regularity, hanging_nodes };
 
 constexpr uint32_t kNoLocal = 0xffffffffu;
 
+// The links of one node.
 struct LevelLinks {
     uint32_t nbr[3];   // same-level neighbour across edge e (local index), or kNoLocal
-    uint8_t nbr_edge;  // the neighbour's local index of the shared edge, 2 bits per edge
-    uint8_t flags;     // bits 0-2: boundary edge; bit 3: diagonal flipped (decoder, once decided)
+    uint8_t nbr_edge;  // the neighbour's local index of the shared edge, 2 bits per edge (0 if none)
+    uint8_t flags;     // bits 0-2: boundary edge
     LevelLinks() {}  // uninitialized: every node's fields are set when its level is made
 };
 static_assert(sizeof(LevelLinks) == 16, "LevelLinks is meant to be 16 bytes");
-constexpr uint8_t kFlippedFlag = 8;
+
+// The links of the four children of one refined node p (nodes 4b..4b+3), given by p's own. Across
+// p's edge e lies p's neighbour q with its index eq of the edge; when q is refined, the first half
+// of the edge meets q's child (eq+1)%3 and the second half q's child eq (Hierarchy::split). Corner
+// child k lies on p's edges k (first half) and (k+2)%3 (second half) and meets the center across
+// its edge (k+1)%3; the center's edge e meets corner (e+2)%3. The block stores the six children
+// across p's edges and its own first node, so that each neighbour of each child is one table
+// lookup away.
+struct SiblingBlock {
+    uint32_t slot[7];  // 0-2: first-half neighbour across p's edge e, 3-5: second-half (or kNoLocal); 6: 4b
+    uint8_t nbr_edge;  // p's neighbour_edge, 2 bits per edge (0 where q is not refined)
+    uint8_t boundary;  // bits 0-2: p's boundary edges
+    uint8_t unused[2];
+    SiblingBlock() {}  // uninitialized, as LevelLinks
+};
+static_assert(sizeof(SiblingBlock) == 32, "SiblingBlock is meant to be 32 bytes");
+
+// Neighbour across edge e of child k: slot kSiblingSlot[k][e] of its block plus kSiblingAdd[k][e].
+constexpr uint8_t kSiblingSlot[4][3] = {{0, 6, 5}, {3, 1, 6}, {6, 4, 2}, {6, 6, 6}};
+constexpr uint8_t kSiblingAdd[4][3] = {{0, 3, 0}, {0, 0, 3}, {3, 0, 0}, {2, 0, 1}};
+
+struct Neighbors {
+    uint32_t nbr[3];  // across edge e: local index, or kNoLocal
+};
+
+inline Neighbors sibling_neighbors(const SiblingBlock& b, uint32_t i) {
+    const unsigned k = i & 3;
+    Neighbors out;
+    for (int e = 0; e < 3; ++e) out.nbr[e] = b.slot[kSiblingSlot[k][e]] + kSiblingAdd[k][e];
+    return out;
+}
+
+inline LevelLinks sibling_links(const SiblingBlock& b, uint32_t i) {
+    const unsigned k = i & 3;
+    LevelLinks out;
+    const Neighbors q = sibling_neighbors(b, i);
+    for (int e = 0; e < 3; ++e) out.nbr[e] = q.nbr[e];
+    // Outer edges keep p's neighbour edge index (children are parallel to their parent); the
+    // inner edges pair with the same index.
+    constexpr uint8_t kOuter[4] = {0x33, 0x0f, 0x3c, 0x00};
+    constexpr uint8_t kInner[4] = {1u << 2, 2u << 4, 0u, 0u | (1u << 2) | (2u << 4)};
+    constexpr uint8_t kBoundary[4] = {5, 3, 6, 0};
+    out.nbr_edge = uint8_t((b.nbr_edge & kOuter[k]) | kInner[k]);
+    out.flags = uint8_t(b.boundary & kBoundary[k]);
+    return out;
+}
 
 // The state byte of a node.
 constexpr uint8_t kDecided = 1;
@@ -51,12 +101,58 @@ constexpr uint8_t kComplete = 16;              // Hierarchy::has_all_neighbors
 constexpr int kPriorityShift = 5;              // bits 5-7: the improved traversal's bucket, 0..4
 constexpr uint8_t kPriorityMask = 0xe0;
 
+// The state a missing neighbour (kNoLocal) reads as: decided, not refined, and with a saturated
+// refined-neighbour count, so that no rule or transition ever writes it.
+constexpr uint8_t kNoNeighborState = kDecided | kRefinedNeighborMask;
+
 struct Level {
-    std::vector<LevelLinks> links;
-    std::vector<uint8_t> state;
-    size_t size() const { return links.size(); }
-    bool empty() const { return links.empty(); }
+    std::vector<LevelLinks> roots;     // level 0: every node's links
+    std::vector<SiblingBlock> blocks;  // finer levels: one block of links for four nodes
+    std::vector<uint32_t> flipped;     // decoder: the nodes whose diagonal is flipped, ascending
+
+    size_t size() const { return states_.empty() ? 0 : states_.size() - 1; }
+    bool empty() const { return size() == 0; }
+    // One state byte a node, preceded by kNoNeighborState: a neighbour index q reads its state at
+    // state()[int32_t(q)], which for kNoLocal (-1) is that byte, so the hot loops need no test
+    // for a missing neighbour.
+    uint8_t* state() { return states_.data() + 1; }
+    const uint8_t* state() const { return states_.data() + 1; }
+    void resize_state(size_t n) {
+        resize_scratch(states_, n + 1);
+        states_[0] = kNoNeighborState;
+    }
+    bool is_root_level() const { return !roots.empty(); }
+    LevelLinks links(uint32_t i) const { return is_root_level() ? roots[i] : sibling_links(blocks[i >> 2], i); }
+
+private:
+    std::vector<uint8_t> states_;
 };
+
+// The state byte of neighbour q (kNoLocal included, see Level::state).
+inline uint8_t& neighbor_state(uint8_t* state, uint32_t q) { return state[static_cast<int32_t>(q)]; }
+inline uint8_t neighbor_state(const uint8_t* state, uint32_t q) { return state[static_cast<int32_t>(q)]; }
+
+// Link accessors for code that is instantiated per kind of level (hot loops): the branch on the
+// kind is taken once a level, not once a node.
+struct RootLinks {
+    const LevelLinks* roots;
+    LevelLinks operator()(uint32_t i) const { return roots[i]; }
+    Neighbors neighbors(uint32_t i) const { return {{roots[i].nbr[0], roots[i].nbr[1], roots[i].nbr[2]}}; }
+    void prefetch(uint32_t i) const { __builtin_prefetch(roots + i); }
+};
+struct BlockLinks {
+    const SiblingBlock* blocks;
+    LevelLinks operator()(uint32_t i) const { return sibling_links(blocks[i >> 2], i); }
+    Neighbors neighbors(uint32_t i) const { return sibling_neighbors(blocks[i >> 2], i); }
+    void prefetch(uint32_t i) const { __builtin_prefetch(blocks + (i >> 2)); }
+};
+
+// Calls f(links accessor) with the accessor for `level`'s kind.
+template <class F>
+decltype(auto) with_links(const Level& level, F&& f) {
+    if (level.is_root_level()) return f(RootLinks{level.roots.data()});
+    return f(BlockLinks{level.blocks.data()});
+}
 
 inline int refined_neighbors(uint8_t state) { return (state & kRefinedNeighborMask) >> 2; }
 
@@ -69,10 +165,12 @@ inline uint8_t complete_state(const uint32_t nbr[3], uint8_t boundary) {
 
 // Level 0: the roots of `h` (root ids are local indices).
 inline void root_level(const Hierarchy& h, Level& level) {
-    level.links.resize(h.root_count());
-    level.state.resize(h.root_count());
+    level.blocks.clear();
+    level.flipped.clear();
+    level.roots.resize(h.root_count());
+    level.resize_state(h.root_count());
     for (NodeId r = 0; r < h.root_count(); ++r) {
-        LevelLinks& node = level.links[r];
+        LevelLinks& node = level.roots[r];
         uint8_t boundary = 0, edges = 0;
         for (int e = 0; e < 3; ++e) {
             node.nbr[e] = h.neighbor(r, e);
@@ -81,74 +179,82 @@ inline void root_level(const Hierarchy& h, Level& level) {
         }
         node.nbr_edge = edges;
         node.flags = boundary;
-        level.state[r] = complete_state(node.nbr, boundary);
+        level.state()[r] = complete_state(node.nbr, boundary);
     }
 }
 
+// The state bytes of a new block's four children (byte k: child k), by which of the parent's edges
+// have a refined neighbour (bits 0-2) or are boundary edges (bits 3-5): corner k is complete when
+// its two outer edges (the parent's k and (k+2)%3) each have a neighbour or are boundary; the
+// center always is.
+struct SiblingStates {
+    uint32_t word[64];
+    constexpr SiblingStates() : word() {
+        for (int code = 0; code < 64; ++code) {
+            uint32_t w = uint32_t(kComplete) << 24;
+            for (int k = 0; k < 3; ++k) {
+                const int prev = k == 0 ? 2 : k - 1;
+                const bool ok = (((code >> k) | (code >> (3 + k))) & 1) && (((code >> prev) | (code >> (3 + prev))) & 1);
+                if (ok) w |= uint32_t(kComplete) << (8 * k);
+            }
+            word[code] = w;
+        }
+    }
+};
+constexpr SiblingStates kSiblingStates{};
+
 // Level l+1 from level l (every node decided): the children of the refined nodes in canonical
-// order, linked exactly as Hierarchy::split links them. `first_child` is scratch.
-inline void derive_next_level(const Level& level, std::vector<uint32_t>& first_child, Level& next) {
+// order, linked exactly as Hierarchy::split links them. `block_of` is scratch.
+inline void derive_next_level(const Level& level, std::vector<uint32_t>& block_of, Level& next) {
     const size_t n = level.size();
-    const uint8_t* state = level.state.data();
-    resize_scratch(first_child, n);
+    const uint8_t* state = level.state();
+    resize_scratch(block_of, n);
+    uint32_t* block = block_of.data();
     uint32_t count = 0;
     for (size_t i = 0; i < n; ++i) {
-        first_child[i] = count;
-        count += (state[i] & kRefined) ? 4u : 0u;
+        const uint32_t refined = (state[i] & kRefined) >> 1;
+        block[i] = refined ? count : kNoLocal;
+        count += refined;
     }
-    resize_scratch(next.links, count);
-    resize_scratch(next.state, count);
-    const LevelLinks* in = level.links.data();
-    const uint32_t* fc = first_child.data();
-    LevelLinks* out = next.links.data();
-    uint8_t* out_state = next.state.data();
-    for (size_t i = 0; i < n; ++i) {
-        if (!(state[i] & kRefined)) continue;
-        const LevelLinks& p = in[i];
-        // Across parent edge e: the neighbour's children for the first half (child e) and the
-        // second half (child (e+1)%3) of the edge.
-        uint32_t first_half[3], second_half[3];
-        unsigned eq[3];
-        for (int e = 0; e < 3; ++e) {
-            const uint32_t q = p.nbr[e];
-            eq[e] = (p.nbr_edge >> (2 * e)) & 3u;
-            if (q != kNoLocal && (state[q] & kRefined)) {
-                const uint32_t qc = fc[q];
-                first_half[e] = qc + (eq[e] == 2 ? 0 : eq[e] + 1);
-                second_half[e] = qc + eq[e];
-            } else {
-                first_half[e] = second_half[e] = kNoLocal;
-                eq[e] = 0;
+    next.roots.clear();
+    next.flipped.clear();
+    resize_scratch(next.blocks, count);
+    next.resize_state(size_t(4) * count);
+    SiblingBlock* out = next.blocks.data();
+    uint8_t* out_state = next.state();
+    with_links(level, [&](auto links) {
+        for (size_t i = 0; i < n; ++i) {
+            const uint32_t b = block[i];
+            if (b == kNoLocal) continue;
+            const LevelLinks p = links(uint32_t(i));
+            SiblingBlock& child = out[b];
+            unsigned edges = 0, linked = 0;
+            for (int e = 0; e < 3; ++e) {
+                const uint32_t q = p.nbr[e] == kNoLocal ? kNoLocal : block[p.nbr[e]];
+                const unsigned eq = (p.nbr_edge >> (2 * e)) & 3u;
+                child.slot[e] = q == kNoLocal ? kNoLocal : 4 * q + (eq == 2 ? 0 : eq + 1);
+                child.slot[3 + e] = q == kNoLocal ? kNoLocal : 4 * q + eq;
+                if (q != kNoLocal) {
+                    edges |= eq << (2 * e);
+                    linked |= 1u << e;
+                }
             }
+            child.slot[6] = 4 * b;
+            child.nbr_edge = uint8_t(edges);
+            child.boundary = uint8_t(p.flags & 7);
+            child.unused[0] = child.unused[1] = 0;
+            const uint32_t word = kSiblingStates.word[linked | ((p.flags & 7u) << 3)];
+            for (int k = 0; k < 4; ++k) out_state[size_t(4) * b + size_t(k)] = uint8_t(word >> (8 * k));
         }
-        const uint32_t c = fc[i];
-        LevelLinks* ch = out + c;
-        const uint8_t boundary = p.flags & 7;
-        for (int k = 0; k < 3; ++k) {
-            const int inner = k == 2 ? 0 : k + 1;  // (k+1)%3, shared with the center
-            const int prev = k == 0 ? 2 : k - 1;   // (k+2)%3
-            LevelLinks& node = ch[k];
-            node.nbr[k] = first_half[k];
-            node.nbr[prev] = second_half[prev];
-            node.nbr[inner] = c + 3;
-            node.nbr_edge = uint8_t((eq[k] << (2 * k)) | (eq[prev] << (2 * prev)) | (unsigned(inner) << (2 * inner)));
-            const uint8_t b = uint8_t(boundary & ((1u << k) | (1u << prev)));
-            node.flags = b;
-            out_state[c + k] = complete_state(node.nbr, b);
-        }
-        LevelLinks& center = ch[3];
-        for (int e = 0; e < 3; ++e) center.nbr[e] = c + uint32_t(e == 0 ? 2 : e - 1);  // corner (e+2)%3
-        center.nbr_edge = uint8_t(0 | (1 << 2) | (2 << 4));
-        center.flags = 0;
-        out_state[c + 3] = kComplete;
-    }
+    });
 }
 
 // The unrefined edge of a decided leaf with exactly two hanging nodes.
 inline int unrefined_edge(const Level& level, uint32_t i) {
+    const LevelLinks node = level.links(i);
     for (int e = 0; e < 2; ++e) {
-        const uint32_t q = level.links[i].nbr[e];
-        if (q == kNoLocal || !(level.state[q] & kRefined)) return e;
+        const uint32_t q = node.nbr[e];
+        if (q == kNoLocal || !(level.state()[q] & kRefined)) return e;
     }
     return 2;
 }
@@ -208,16 +314,21 @@ public:
     //       an invalid hierarchy keeps the level forest in step with it)
     template <class Code, class Force>
     void run(Level& level, bool uniform_level, Code&& code, Force&& force) {
-        const LevelLinks* links = level.links.data();
-        uint8_t* state = level.state.data();
-        const uint32_t n = static_cast<uint32_t>(level.size());
+        with_links(level, [&](auto links) {
+            run_on(links, level.state(), static_cast<uint32_t>(level.size()), uniform_level, code, force);
+        });
+    }
+
+private:
+    template <class Links, class Code, class Force>
+    void run_on(Links links, uint8_t* state, uint32_t n, bool uniform_level, Code& code, Force& force) {
         // A copy in a local: the state bytes written below could alias options_.
         const CullRules rules{options_.cull_one_regularity, options_.cull_hanging_nodes};
         if (uniform_level) {
             for (uint32_t i = 0; i < n; ++i) {
                 if (force(i, Fate::uniform, true)) {
                     state[i] = uint8_t(state[i] | kDecided | kRefined);
-                    add_refined_neighbor(links[i], state);
+                    add_refined_neighbor(links.neighbors(i), state);
                 } else {
                     state[i] = uint8_t(state[i] | kDecided);
                 }
@@ -225,7 +336,7 @@ public:
             return;
         }
         if (options_.traversal == Traversal::naive) {
-            for (uint32_t i = 0; i < n; ++i) decide(rules.fate(state[i]), links[i], state, i, code, force);
+            for (uint32_t i = 0; i < n; ++i) decide(rules.fate(state[i]), links.neighbors(i), state, i, code, force);
             return;
         }
         // Improved traversal: a bucket queue over priorities 0 (culled: nothing to code) to 4 (no
@@ -286,7 +397,7 @@ public:
             } else {
                 break;
             }
-            const LevelLinks node = links[i];
+            const Neighbors node = links.neighbors(i);
             decide(culled ? rules.fate(state[i]) : Fate::coded, node, state, i, code, force);
             // The pushes of this step; the last one into the lowest bucket is the next node
             // whenever that bucket is now the lowest non-empty one. Knowing it here, rather than
@@ -296,14 +407,13 @@ public:
             int next_bucket = 5;
             for (int e = 0; e < 3; ++e) {
                 const uint32_t q = node.nbr[e];
-                if (q == kNoLocal) continue;
-                const uint8_t s = state[q];
+                const uint8_t s = neighbor_state(state, q);
                 const uint8_t t = transition[s];
-                if (t == s) continue;
+                if (t == s) continue;  // decided (or no neighbour), or already in bucket 1
                 state[q] = t;
                 // Last in, first out: q is likely to be decided soon, and its links are usually
                 // not in cache yet.
-                __builtin_prefetch(links + q);
+                links.prefetch(q);
                 const int bucket = t >> kPriorityShift;
                 *top[bucket]++ = q;
                 if (bucket <= next_bucket) {
@@ -321,23 +431,22 @@ public:
         }
     }
 
-private:
-    static void add_refined_neighbor(const LevelLinks& node, uint8_t* state) {
+    static void add_refined_neighbor(const Neighbors& node, uint8_t* state) {
         for (int e = 0; e < 3; ++e) {
             const uint32_t q = node.nbr[e];
-            if (q != kNoLocal && (state[q] & kRefinedNeighborMask) != kRefinedNeighborMask)
-                state[q] = uint8_t(state[q] + kRefinedNeighbor);
+            uint8_t& s = neighbor_state(state, q);
+            if ((s & kRefinedNeighborMask) != kRefinedNeighborMask) s = uint8_t(s + kRefinedNeighbor);
         }
     }
 
     // The context group of a node: its neighbours refined, not refined, not yet decided.
-    static int context_group(const LevelLinks& node, const uint8_t* state) {
+    static int context_group(const Neighbors& node, const uint8_t* state) {
         unsigned code = 0;
         for (int e = 0; e < 3; ++e) {
             const uint32_t q = node.nbr[e];
             // No neighbour (boundary, or a coarser region: see context_groups.h) counts as not
             // refined; a neighbour's kind is its decided and refined bits.
-            const unsigned kind = q == kNoLocal ? 1u : state[q] & (kDecided | kRefined);
+            const unsigned kind = neighbor_state(state, q) & (kDecided | kRefined);
             code |= kind << (2 * e);
         }
         return kContextTable.group[code];
@@ -346,7 +455,7 @@ private:
     // Decides node i (links `node`) whose fate is known: codes its symbol or applies the rule,
     // records the decision and counts it at the neighbours.
     template <class Code, class Force>
-    static void decide(Fate fate, const LevelLinks& node, uint8_t* state, uint32_t i, Code& code, Force& force) {
+    static void decide(Fate fate, const Neighbors& node, uint8_t* state, uint32_t i, Code& code, Force& force) {
         const bool refined = fate == Fate::coded ? code(i, context_group(node, state))
                                                  : force(i, fate, fate == Fate::hanging_nodes);
         state[i] = uint8_t(state[i] | kDecided | (refined ? kRefined : 0));

@@ -165,7 +165,7 @@ void Hierarchy::split(NodeId n) {
     nodes_[n].first_child = c;
 }
 
-void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_t* child_links, size_t stride) {
+void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_t* first_half_links, size_t stride) {
     if (!free_blocks_.empty() || !free_vertices_.empty()) {
         // Reused ids: take the general path (the decoders never get here).
         for (uint32_t i = 0; i < count; ++i) split(parents[i]);
@@ -180,7 +180,7 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
         size_t new_vertices = 0;
         for (uint32_t i = 0; i < count; ++i) {
             for (int e = 0; e < 3; ++e) {
-                const uint32_t t = child_links[stride * (size_t(4) * i + size_t(e)) + size_t(e)];
+                const uint32_t t = first_half_links[stride * i + size_t(e)];
                 new_vertices += !(t != kNoNode && t / 4 < i);
             }
         }
@@ -196,15 +196,25 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
         const NodeId n = parents[i];
         Node& parent = nodes[n];
         const NodeId c = NodeId(c0 + size_t(4) * i);
-        const uint32_t* links[4];
-        for (int k = 0; k < 4; ++k) links[k] = child_links + stride * (size_t(4) * i + size_t(k));
+        const uint32_t* across = first_half_links + stride * i;
+        // Across edge e, when the neighbour parents[j] is split too: the first half of the edge
+        // meets its child (eq+1)%3, the second half its child eq (eq: its index of the edge).
+        NodeId first_half[3], second_half[3];
+        unsigned linked_edges = 0;
         VertexId m[3];
         for (int e = 0; e < 3; ++e) {
-            // The neighbour across e, when refined, holds child (eq+1)%3 or eq on either half.
-            const uint32_t t = links[e][e];
+            const uint32_t j = across[e] == kNoNode ? kNoNode : across[e] / 4;
             const unsigned eq = (parent.nbr_edge >> (2 * e)) & 3u;
-            if (t != kNoNode && t / 4 < i) {
-                m[e] = nodes[c0 + (t & ~3u) + 3].v[(eq + 2) % 3];
+            if (j != kNoNode) {
+                const NodeId cq = NodeId(c0 + size_t(4) * j);
+                first_half[e] = cq + (eq == 2 ? 0 : eq + 1);
+                second_half[e] = cq + eq;
+                linked_edges |= 3u << (2 * e);
+            } else {
+                first_half[e] = second_half[e] = kNoNode;
+            }
+            if (j != kNoNode && j < i) {
+                m[e] = nodes[c0 + size_t(4) * j + 3].v[(eq + 2) % 3];
             } else {
                 // Within the reserved capacity: no reallocation, references stay valid.
                 const Vec3& a = positions_[parent.v[e]];
@@ -218,28 +228,26 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
                                        {m[0], parent.v[1], m[1]},
                                        {m[2], m[1], parent.v[2]},
                                        {m[1], m[2], m[0]}};
+        // Corner child k: its edge k is the first half of the parent's edge k, its edge (k+2)%3
+        // the second half of edge (k+2)%3, its edge (k+1)%3 meets the center. Linked outer edges
+        // take the parent's neighbour edge index (children are parallel to their parents).
+        const NodeId links[4][3] = {{first_half[0], c + 3, second_half[2]},
+                                    {second_half[0], first_half[1], c + 3},
+                                    {c + 3, second_half[1], first_half[2]},
+                                    {c + 2, c, c + 1}};
+        const unsigned outer = parent.nbr_edge & linked_edges;
+        const uint8_t edges[4] = {uint8_t((outer & 0x33u) | (1u << 2)), uint8_t((outer & 0x0fu) | (2u << 4)),
+                                  uint8_t(outer & 0x3cu), uint8_t(0u | (1u << 2) | (2u << 4))};
         const uint8_t level = uint8_t(parent.level + 1);
         for (int k = 0; k < 4; ++k) {
             Node& child = nodes[c + k];
-            uint8_t edges = 0;
             for (int e = 0; e < 3; ++e) {
                 child.v[e] = layout[k][e];
-                const uint32_t t = links[k][e];
-                child.nbr[e] = t == kNoNode ? kNoNode : NodeId(c0 + t);
-            }
-            // Linked outer edges take the parent's neighbour edge index (children are parallel
-            // to their parents); the inner edge pairs with the center's edge of the same index.
-            if (k == 3) {
-                edges = uint8_t(0 | (1 << 2) | (2 << 4));
-            } else {
-                const int inner = k == 2 ? 0 : k + 1, prev = k == 0 ? 2 : k - 1;
-                const unsigned ek = (parent.nbr_edge >> (2 * k)) & 3u, ep = (parent.nbr_edge >> (2 * prev)) & 3u;
-                edges = uint8_t((unsigned(inner) << (2 * inner)) | (child.nbr[k] != kNoNode ? ek << (2 * k) : 0u) |
-                                (child.nbr[prev] != kNoNode ? ep << (2 * prev) : 0u));
+                child.nbr[e] = links[k][e];
             }
             child.parent = n;
             child.first_child = kNoNode;
-            child.nbr_edge = edges;
+            child.nbr_edge = edges[k];
             child.level = level;
             child.child_index = uint8_t(k);
             child.flags = k == 3 ? 0 : uint8_t(parent.flags & ((1u << k) | (1u << (k == 0 ? 2 : k - 1))));
