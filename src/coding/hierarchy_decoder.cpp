@@ -49,75 +49,78 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
     const int l = level_index_;
     uint8_t* state = level_.state();
     const uint32_t n = static_cast<uint32_t>(level_.size());
-    // The coder's state lives in locals while the level is decided: every state byte the
-    // traversal writes could alias a member as far as the compiler knows, and members would be
-    // reloaded for every node.
-    ArithmeticDecoder d = decoder;
-    HierarchyModels models = models_;
-    uint64_t symbols_read = symbols_read_, node_count = node_count_;
-    const uint64_t max_nodes = max_nodes_;
     // II-C, stream truncation: once the stored symbols are used up, the rest are 0.
     const uint64_t symbol_limit = header_.options.truncate_stream ? header_.symbol_count : UINT64_MAX;
-    const int group_mask = header_.options.use_contexts ? 0xff : 0;
-    // Errors name the element by its level and canonical index: its node id may not exist yet.
-    auto check_split = [&](uint32_t i) {
-        if (l >= kMaxLevel || !(state[i] & kComplete))
-            throw Error("hierarchy stream is corrupt: element " + std::to_string(i) + " of level " +
-                        std::to_string(l) + " can not be refined");
-        if (node_count + 4 > max_nodes)
-            throw Error("hierarchy stream would build more than " + std::to_string(max_nodes) + " nodes");
-        node_count += 4;
-    };
-    if (symbols_read == symbol_limit && l >= header_.uniform_levels) {
-        // Stream truncation: every symbol left is 0, and with no node of this level refined yet
-        // no rule can force one. The level is all leaves (and the last): no traversal needed.
+    if (symbols_read_ == symbol_limit && l >= header_.uniform_levels) {
+        // Every symbol left is 0, and with no node of this level refined yet no rule can force
+        // one: the level is all leaves (and the last). No traversal needed.
         for (uint32_t i = 0; i < n; ++i) state[i] = uint8_t(state[i] | kDecided);
-        finish_level(d, models, symbols_read, node_count, 0);
+        finish_level(0, 0);
         return;
     }
+    // The coder's state lives in locals while the level is decided: every state byte the
+    // traversal writes could alias a member as far as the compiler knows, and members would be
+    // reloaded for every node. Whether a refined node may be refined is checked afterwards.
+    ArithmeticDecoder d = decoder;
+    HierarchyModels models = models_;
+    uint64_t symbols_read = symbols_read_;
+    const int group_mask = header_.options.use_contexts ? 0xff : 0;
     traversal_.run(
         level_, l < header_.uniform_levels,
-        [&](uint32_t i, int group) {
+        [&](uint32_t, int group) {
             if (symbols_read == symbol_limit) return false;
             ++symbols_read;
-            const bool refined = d.decode(models.groups[size_t(group & group_mask)]);
-            if (refined) check_split(i);
-            return refined;
+            return d.decode(models.groups[size_t(group & group_mask)]);
         },
-        [&](uint32_t i, Fate, bool refined) {
-            if (refined) check_split(i);
-            return refined;
-        });
-    // Diagonals of the leaves closed by two hanging nodes; and the number of vertices the level's
-    // splits create: one per edge of a refined node, shared where the neighbour is refined too.
+        [&](uint32_t, Fate, bool refined) { return refined; });
+    // In one pass: the next level's numbering of the refined nodes; the number of vertices the
+    // level's splits create (one per edge of a refined node, shared where the neighbour is refined
+    // too); the diagonals of the leaves closed by two hanging nodes; and the checks. Errors name
+    // the element by its level and canonical index: its node id may not exist yet.
+    auto corrupt = [&](uint32_t i, const char* what) {
+        return Error("hierarchy stream is corrupt: element " + std::to_string(i) + " of level " + std::to_string(l) +
+                     what);
+    };
+    resize_scratch(scratch_, n);
+    uint32_t* block = scratch_.data();
+    uint32_t count = 0;
     uint64_t edge_ends = 0;
+    bool invalid_split = false;
     for (uint32_t i = 0; i < n; ++i) {
-        const int hanging = refined_neighbors(state[i]);
-        if (state[i] & kRefined) {
-            edge_ends += uint64_t(6 - hanging);
+        const uint8_t s = state[i];
+        const unsigned hanging = (s & kRefinedNeighborMask) >> 2;
+        if (s & kRefined) {
+            block[i] = count++;
+            edge_ends += 6 - hanging;
+            invalid_split |= !(s & kComplete);
             continue;
         }
-        if (hanging == 3)
-            throw Error("hierarchy stream is corrupt: element " + std::to_string(i) + " of level " +
-                        std::to_string(l) + " has three hanging nodes but was not refined");
-        if (hanging == 2) {
-            bool flag = diagonal_flag_by_rule(header_.diagonal_rule, unrefined_edge(level_, i));
-            if (header_.orientation_coded) flag ^= d.decode(models.orientation);
-            if (flag) level_.flipped.push_back(i);
+        block[i] = kNoLocal;
+        if (hanging < 2) continue;
+        if (hanging == 3) throw corrupt(i, " has three hanging nodes but was not refined");
+        bool flag = diagonal_flag_by_rule(header_.diagonal_rule, unrefined_edge(level_, i));
+        if (header_.orientation_coded) flag ^= d.decode(models.orientation);
+        if (flag) level_.flipped.push_back(i);
+    }
+    if (count > 0 && (invalid_split || l >= kMaxLevel)) {
+        for (uint32_t i = 0; i < n; ++i) {
+            if ((state[i] & kRefined) && (!(state[i] & kComplete) || l >= kMaxLevel))
+                throw corrupt(i, " can not be refined");
         }
     }
-    finish_level(d, models, symbols_read, node_count, edge_ends / 2);
+    if (node_count_ + uint64_t(4) * count > max_nodes_)
+        throw Error("hierarchy stream would build more than " + std::to_string(max_nodes_) + " nodes");
+    if (d.overran()) throw Error("hierarchy stream is truncated");
     decoder = d;
-}
-
-void HierarchyLevelDecoder::finish_level(const ArithmeticDecoder& decoder, const HierarchyModels& models,
-                                         uint64_t symbols_read, uint64_t node_count, uint64_t new_vertices) {
     models_ = models;
     symbols_read_ = symbols_read;
-    node_count_ = node_count;
+    finish_level(count, edge_ends / 2);
+}
+
+void HierarchyLevelDecoder::finish_level(uint32_t refined_count, uint64_t new_vertices) {
+    node_count_ += uint64_t(4) * refined_count;
     vertex_count_ += new_vertices;
-    if (decoder.overran()) throw Error("hierarchy stream is truncated");
-    derive_next_level(level_, scratch_, next_);
+    derive_next_level(level_, scratch_, refined_count, next_);
     decided_.push_back(std::move(level_));
     level_ = std::move(next_);
     next_ = Level();

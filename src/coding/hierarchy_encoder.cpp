@@ -79,7 +79,8 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         }
         stats.levels = l + 1;
         level_end_.push_back(events_.size());
-        derive_next_level(level, scratch, next);
+        const uint32_t refined_count = number_refined(level, scratch);
+        derive_next_level(level, scratch, refined_count, next);
         std::swap(level, next);
         level_ids_.push_back(ids);
         ids.swap(next_ids);

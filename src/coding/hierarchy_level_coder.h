@@ -72,9 +72,9 @@ public:
     Hierarchy& hierarchy() { return h_; }
 
 private:
-    // Takes the decided level's counts back from decide_level's locals and moves to the next level.
-    void finish_level(const ArithmeticDecoder& decoder, const HierarchyModels& models, uint64_t symbols_read,
-                      uint64_t node_count, uint64_t new_vertices);
+    // Counts the decided level's splits and moves to the next level (scratch_ holds the numbering
+    // of the refined nodes, number_refined).
+    void finish_level(uint32_t refined_count, uint64_t new_vertices);
 
     HierarchyStreamHeader header_;
     uint64_t max_nodes_;

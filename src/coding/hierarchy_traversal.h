@@ -203,9 +203,9 @@ struct SiblingStates {
 };
 constexpr SiblingStates kSiblingStates{};
 
-// Level l+1 from level l (every node decided): the children of the refined nodes in canonical
-// order, linked exactly as Hierarchy::split links them. `block_of` is scratch.
-inline void derive_next_level(const Level& level, std::vector<uint32_t>& block_of, Level& next) {
+// The next level's block of each refined node of `level` (its rank among them in canonical
+// order), kNoLocal for the others; returns the number of refined nodes.
+inline uint32_t number_refined(const Level& level, std::vector<uint32_t>& block_of) {
     const size_t n = level.size();
     const uint8_t* state = level.state();
     resize_scratch(block_of, n);
@@ -216,10 +216,19 @@ inline void derive_next_level(const Level& level, std::vector<uint32_t>& block_o
         block[i] = refined ? count : kNoLocal;
         count += refined;
     }
+    return count;
+}
+
+// Level l+1 from level l (every node decided, `block_of` and `count` from number_refined): the
+// children of the refined nodes in canonical order, linked exactly as Hierarchy::split links them.
+inline void derive_next_level(const Level& level, const std::vector<uint32_t>& block_of, uint32_t count, Level& next) {
+    const size_t n = level.size();
+    const uint32_t* block = block_of.data();
     next.roots.clear();
     next.flipped.clear();
     resize_scratch(next.blocks, count);
     next.resize_state(size_t(4) * count);
+    if (count == 0) return;
     SiblingBlock* out = next.blocks.data();
     uint8_t* out_state = next.state();
     with_links(level, [&](auto links) {

@@ -192,7 +192,21 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
     Node* nodes = nodes_.data();
     VertexId next_vertex = VertexId(v0);
     const bool default_placer = placer_ == midpoint_placer;
+    const Vec3* positions = positions_.data();
+    // The loads that miss the cache (a parent's corner positions, a neighbour's center child
+    // made earlier) have addresses known well ahead: fetch them a few parents early.
+    constexpr uint32_t kAhead = 8;
+    auto prefetch = [&](uint32_t i) {
+        const Node& parent = nodes[parents[i]];
+        for (int e = 0; e < 3; ++e) {
+            __builtin_prefetch(positions + parent.v[e]);
+            const uint32_t t = first_half_links[stride * i + size_t(e)];
+            if (t != kNoNode && t / 4 < i) __builtin_prefetch(nodes + c0 + (t & ~3u) + 3);
+        }
+    };
     for (uint32_t i = 0; i < count; ++i) {
+        if (i + 2 * kAhead < count) __builtin_prefetch(nodes + parents[i + 2 * kAhead]);
+        if (i + kAhead < count) prefetch(i + kAhead);
         const NodeId n = parents[i];
         Node& parent = nodes[n];
         const NodeId c = NodeId(c0 + size_t(4) * i);
