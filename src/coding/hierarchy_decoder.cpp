@@ -89,14 +89,13 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
     for (uint32_t i = 0; i < n; ++i) {
         const uint8_t s = state[i];
         const unsigned hanging = (s & kRefinedNeighborMask) >> 2;
-        if (s & kRefined) {
-            block[i] = count++;
-            edge_ends += 6 - hanging;
-            invalid_split |= !(s & kComplete);
-            continue;
-        }
-        block[i] = kNoLocal;
-        if (hanging < 2) continue;
+        const bool refined = (s & kRefined) != 0;
+        // Selects, not branches: the decisions of a level follow no pattern a predictor learns.
+        block[i] = refined ? count : kNoLocal;
+        count += refined;
+        edge_ends += refined ? 6 - hanging : 0;
+        invalid_split |= refined & !(s & kComplete);
+        if (refined || hanging < 2) continue;
         if (hanging == 3) throw corrupt(i, " has three hanging nodes but was not refined");
         bool flag = diagonal_flag_by_rule(header_.diagonal_rule, unrefined_edge(level_, i));
         if (header_.orientation_coded) flag ^= d.decode(models.orientation);

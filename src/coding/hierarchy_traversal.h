@@ -101,9 +101,9 @@ constexpr uint8_t kComplete = 16;              // Hierarchy::has_all_neighbors
 constexpr int kPriorityShift = 5;              // bits 5-7: the improved traversal's bucket, 0..4
 constexpr uint8_t kPriorityMask = 0xe0;
 
-// The state a missing neighbour (kNoLocal) reads as: decided, not refined, and with a saturated
-// refined-neighbour count, so that no rule or transition ever writes it.
-constexpr uint8_t kNoNeighborState = kDecided | kRefinedNeighborMask;
+// The state a missing neighbour (kNoLocal) reads as: decided, not refined. Decided states take no
+// transitions; the refined-neighbour counts added to it are never read.
+constexpr uint8_t kNoNeighborState = kDecided;
 
 struct Level {
     std::vector<LevelLinks> roots;     // level 0: every node's links
@@ -356,21 +356,60 @@ private:
         // Two buckets need no storage: bucket 4 starts with every unculled node in canonical order
         // and never receives another, so it is a cursor; bucket 0 starts with the nodes culled at
         // the outset in canonical order (a cursor) under a stack of nodes culled later.
+        // Bucket 0 at the outset holds the nodes 1-regularity culls (no refined node exists yet, so
+        // no other rule applies). They go first, in canonical order; none of them is refined, so
+        // none makes another node culled meanwhile, and the stack of bucket 0 stays empty until
+        // all are decided. Listing them first spares the main loop a scan with an unpredictable
+        // test per node.
         const uint8_t initially_culled = rules.one_regularity ? uint8_t(0) : kComplete;
+        if (culled_.size() < n) resize_scratch(culled_, n);
+        uint32_t* const culled_list = culled_.data();
+        uint32_t culled_count = 0;
         for (uint32_t i = 0; i < n; ++i) {
             const uint8_t s = state[i];
-            state[i] = uint8_t(((s | initially_culled) & kComplete) ? s | (4 << kPriorityShift) : s);
+            const bool fresh = ((s | initially_culled) & kComplete) != 0;
+            state[i] = uint8_t(fresh ? s | (4 << kPriorityShift) : s);
+            culled_list[culled_count] = i;
+            culled_count += !fresh;
         }
         for (auto& stack : stacks_) {
-            stack.clear();
-            if (stack.capacity() < n) stack.reserve(n);
+            if (stack.size() < n) resize_scratch(stack, n);
         }
         uint32_t* const bottom[4] = {stacks_[0].data(), stacks_[1].data(), stacks_[2].data(), stacks_[3].data()};
         uint32_t* top[4] = {bottom[0], bottom[1], bottom[2], bottom[3]};
-        uint32_t culled_cursor = 0, fresh_cursor = 0;
-        constexpr uint8_t kDecidedOrPriority = kDecided | kPriorityMask;
         uint8_t transition[256];  // a local copy: the state bytes written below could alias the member
         for (int k = 0; k < 256; ++k) transition[k] = after_neighbor_decided_[k];
+        // The pushes of node i's decision into the buckets; returns the lowest bucket pushed to
+        // (5 if none) and in `next` the node pushed last into it.
+        auto push_neighbors = [&](const Neighbors& node, uint32_t& next) {
+            int next_bucket = 5;
+            for (int e = 0; e < 3; ++e) {
+                const uint32_t q = node.nbr[e];
+                const uint8_t s = neighbor_state(state, q);
+                const uint8_t t = transition[s];
+                if (t == s) continue;  // decided (or no neighbour), or already in bucket 1
+                state[q] = t;
+                // Last in, first out: q is likely to be decided soon, and its links are usually
+                // not in cache yet.
+                links.prefetch(q);
+                const int bucket = t >> kPriorityShift;
+                *top[bucket]++ = q;
+                if (bucket <= next_bucket) {
+                    next = q;
+                    next_bucket = bucket;
+                }
+            }
+            return next_bucket;
+        };
+        for (uint32_t k = 0; k < culled_count; ++k) {
+            const uint32_t i = culled_list[k];
+            const Neighbors node = links.neighbors(i);
+            decide(rules.fate(state[i]), node, state, i, code, force);
+            uint32_t unused;
+            push_neighbors(node, unused);
+        }
+        uint32_t fresh_cursor = 0;
+        constexpr uint8_t kDecidedOrPriority = kDecided | kPriorityMask;
         int current = 0;  // every bucket below this one is empty
         uint32_t i = 0;
         bool culled = false;
@@ -381,15 +420,11 @@ private:
             if (popped) {
                 popped = false;
             } else if (current == 0) {
-                if (top[0] != bottom[0]) {
-                    i = *--top[0];  // entries of bucket 0 are never stale
-                } else if (culled_cursor < n) {
-                    i = culled_cursor++;
-                    if ((state[i] & kDecidedOrPriority) != 0) continue;
-                } else {
+                if (top[0] == bottom[0]) {
                     current = 1;
                     continue;
                 }
+                i = *--top[0];  // entries of bucket 0 are never stale
                 culled = true;
             } else if (current < 4) {
                 if (top[current] == bottom[current]) {
@@ -408,28 +443,12 @@ private:
             }
             const Neighbors node = links.neighbors(i);
             decide(culled ? rules.fate(state[i]) : Fate::coded, node, state, i, code, force);
-            // The pushes of this step; the last one into the lowest bucket is the next node
-            // whenever that bucket is now the lowest non-empty one. Knowing it here, rather than
-            // reading it back from the bucket, keeps the stack and the state byte out of the
-            // chain of loads from one node to the next.
+            // The last push into the lowest bucket is the next node whenever that bucket is now
+            // the lowest non-empty one. Knowing it here, rather than reading it back from the
+            // bucket, keeps the stack and the state byte out of the chain of loads from one node
+            // to the next.
             uint32_t next = 0;
-            int next_bucket = 5;
-            for (int e = 0; e < 3; ++e) {
-                const uint32_t q = node.nbr[e];
-                const uint8_t s = neighbor_state(state, q);
-                const uint8_t t = transition[s];
-                if (t == s) continue;  // decided (or no neighbour), or already in bucket 1
-                state[q] = t;
-                // Last in, first out: q is likely to be decided soon, and its links are usually
-                // not in cache yet.
-                links.prefetch(q);
-                const int bucket = t >> kPriorityShift;
-                *top[bucket]++ = q;
-                if (bucket <= next_bucket) {
-                    next = q;
-                    next_bucket = bucket;
-                }
-            }
+            const int next_bucket = push_neighbors(node, next);
             if (next_bucket <= current) {
                 current = next_bucket;
                 --top[current];
@@ -440,11 +459,13 @@ private:
         }
     }
 
+    // A node has at most three neighbour edges, so its count of refined neighbours never
+    // overflows; the shared kNoNeighborState byte may, harmlessly: adding multiples of 4 keeps its
+    // decided, not refined bits.
     static void add_refined_neighbor(const Neighbors& node, uint8_t* state) {
         for (int e = 0; e < 3; ++e) {
-            const uint32_t q = node.nbr[e];
-            uint8_t& s = neighbor_state(state, q);
-            if ((s & kRefinedNeighborMask) != kRefinedNeighborMask) s = uint8_t(s + kRefinedNeighbor);
+            uint8_t& s = neighbor_state(state, node.nbr[e]);
+            s = uint8_t(s + kRefinedNeighbor);
         }
     }
 
@@ -474,6 +495,7 @@ private:
     HierarchyCoderOptions options_;
     uint8_t after_neighbor_decided_[256];  // state -> state, see the constructor
     std::array<std::vector<uint32_t>, 4> stacks_;  // buckets 0-3 (each holds at most one entry per node)
+    std::vector<uint32_t> culled_;                 // the nodes culled at the outset
 };
 
 }  // namespace amc
