@@ -55,6 +55,8 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
         // Every symbol left is 0, and with no node of this level refined yet no rule can force
         // one: the level is all leaves (and the last). No traversal needed.
         for (uint32_t i = 0; i < n; ++i) state[i] = uint8_t(state[i] | kDecided);
+        numbering_.resize(0);
+        numbering_.count = 0;
         finish_level(0, 0);
         return;
     }
@@ -81,26 +83,34 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
         return Error("hierarchy stream is corrupt: element " + std::to_string(i) + " of level " + std::to_string(l) +
                      what);
     };
-    resize_scratch(scratch_, n);
-    uint32_t* block = scratch_.data();
-    uint32_t count = 0;
+    RefinedNumbering& numbering = numbering_;
+    numbering.resize(n);
+    numbering.count = 0;
+    resize_scratch(closures_, n);
+    uint32_t* closures = closures_.data();
+    uint32_t closure_count = 0;
     uint64_t edge_ends = 0;
     bool invalid_split = false;
+    // Without branches on the decisions, which follow no pattern a predictor learns; the leaves
+    // with two (or, in a corrupt stream, three) hanging nodes are listed and handled after.
     for (uint32_t i = 0; i < n; ++i) {
         const uint8_t s = state[i];
         const unsigned hanging = (s & kRefinedNeighborMask) >> 2;
         const bool refined = (s & kRefined) != 0;
-        // Selects, not branches: the decisions of a level follow no pattern a predictor learns.
-        block[i] = refined ? count : kNoLocal;
-        count += refined;
-        edge_ends += refined ? 6 - hanging : 0;
+        numbering.add(i, refined);
+        edge_ends += (6 - hanging) & (0u - unsigned(refined));
         invalid_split |= refined & !(s & kComplete);
-        if (refined || hanging < 2) continue;
-        if (hanging == 3) throw corrupt(i, " has three hanging nodes but was not refined");
+        closures[closure_count] = i;
+        closure_count += !refined & (hanging >= 2);
+    }
+    for (uint32_t k = 0; k < closure_count; ++k) {
+        const uint32_t i = closures[k];
+        if (refined_neighbors(state[i]) == 3) throw corrupt(i, " has three hanging nodes but was not refined");
         bool flag = diagonal_flag_by_rule(header_.diagonal_rule, unrefined_edge(level_, i));
         if (header_.orientation_coded) flag ^= d.decode(models.orientation);
         if (flag) level_.flipped.push_back(i);
     }
+    const uint32_t count = numbering.count;
     if (count > 0 && (invalid_split || l >= kMaxLevel)) {
         for (uint32_t i = 0; i < n; ++i) {
             if ((state[i] & kRefined) && (!(state[i] & kComplete) || l >= kMaxLevel))
@@ -119,7 +129,7 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
 void HierarchyLevelDecoder::finish_level(uint32_t refined_count, uint64_t new_vertices) {
     node_count_ += uint64_t(4) * refined_count;
     vertex_count_ += new_vertices;
-    derive_next_level(level_, scratch_, refined_count, next_);
+    derive_next_level(level_, numbering_, next_);
     decided_.push_back(std::move(level_));
     level_ = std::move(next_);
     next_ = Level();

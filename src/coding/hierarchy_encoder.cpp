@@ -24,7 +24,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
     Level level, next;
     std::vector<NodeId> ids, next_ids;
     std::vector<uint8_t> refined;
-    std::vector<uint32_t> scratch;
+    RefinedNumbering numbering;
     root_level(h, level);
     ids.resize(h.root_count());
     for (NodeId r = 0; r < h.root_count(); ++r) ids[r] = r;
@@ -79,8 +79,8 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         }
         stats.levels = l + 1;
         level_end_.push_back(events_.size());
-        const uint32_t refined_count = number_refined(level, scratch);
-        derive_next_level(level, scratch, refined_count, next);
+        number_refined(level, numbering);
+        derive_next_level(level, numbering, next);
         std::swap(level, next);
         level_ids_.push_back(ids);
         ids.swap(next_ids);

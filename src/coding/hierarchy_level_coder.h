@@ -72,8 +72,8 @@ public:
     Hierarchy& hierarchy() { return h_; }
 
 private:
-    // Counts the decided level's splits and moves to the next level (scratch_ holds the numbering
-    // of the refined nodes, number_refined).
+    // Counts the decided level's splits and moves to the next level (numbering_ holds the
+    // numbering of its refined nodes).
     void finish_level(uint32_t refined_count, uint64_t new_vertices);
 
     HierarchyStreamHeader header_;
@@ -83,7 +83,8 @@ private:
     LevelTraversal traversal_;
     Level level_, next_;
     std::vector<Level> decided_;  // decided levels not yet built, oldest first
-    std::vector<uint32_t> scratch_;
+    RefinedNumbering numbering_;     // of the level being decided
+    std::vector<uint32_t> closures_;  // scratch: the leaves with two or three hanging nodes
     std::vector<NodeId> level_ids_;  // node ids of the oldest level not yet built
     int level_index_ = 0;
     uint64_t node_count_ = 0, vertex_count_ = 0, symbols_read_ = 0;

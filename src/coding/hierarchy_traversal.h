@@ -203,50 +203,63 @@ struct SiblingStates {
 };
 constexpr SiblingStates kSiblingStates{};
 
-// The next level's block of each refined node of `level` (its rank among them in canonical
-// order), kNoLocal for the others; returns the number of refined nodes.
-inline uint32_t number_refined(const Level& level, std::vector<uint32_t>& block_of) {
-    const size_t n = level.size();
-    const uint8_t* state = level.state();
-    resize_scratch(block_of, n);
-    uint32_t* block = block_of.data();
+// How the refined nodes of a decided level become the next level's blocks: the refined nodes in
+// canonical order, and each node's block (its rank among them) or kNoLocal. block_of() has one
+// more entry in front, kNoLocal, read for a missing neighbour as block_of()[int32_t(kNoLocal)].
+struct RefinedNumbering {
+    std::vector<uint32_t> refined;
     uint32_t count = 0;
-    for (size_t i = 0; i < n; ++i) {
-        const uint32_t refined = (state[i] & kRefined) >> 1;
-        block[i] = refined ? count : kNoLocal;
-        count += refined;
+    uint32_t* block_of() { return blocks_.data() + 1; }
+    const uint32_t* block_of() const { return blocks_.data() + 1; }
+    void resize(size_t n) {
+        resize_scratch(blocks_, n + 1);
+        blocks_[0] = kNoLocal;
+        resize_scratch(refined, n);
     }
-    return count;
+    // Numbers node i (nodes in canonical order), without a branch on `is_refined`.
+    void add(uint32_t i, bool is_refined) {
+        blocks_[size_t(i) + 1] = count | (uint32_t(is_refined) - 1u);  // kNoLocal unless refined
+        refined[count] = i;
+        count += is_refined;
+    }
+
+private:
+    std::vector<uint32_t> blocks_;
+};
+
+inline void number_refined(const Level& level, RefinedNumbering& numbering) {
+    const uint32_t n = static_cast<uint32_t>(level.size());
+    const uint8_t* state = level.state();
+    numbering.resize(n);
+    numbering.count = 0;
+    for (uint32_t i = 0; i < n; ++i) numbering.add(i, (state[i] & kRefined) != 0);
 }
 
-// Level l+1 from level l (every node decided, `block_of` and `count` from number_refined): the
-// children of the refined nodes in canonical order, linked exactly as Hierarchy::split links them.
-inline void derive_next_level(const Level& level, const std::vector<uint32_t>& block_of, uint32_t count, Level& next) {
-    const size_t n = level.size();
-    const uint32_t* block = block_of.data();
+// Level l+1 from level l (every node decided and numbered): the children of the refined nodes in
+// canonical order, linked exactly as Hierarchy::split links them.
+inline void derive_next_level(const Level& level, const RefinedNumbering& numbering, Level& next) {
+    const uint32_t count = numbering.count;
+    const uint32_t* block = numbering.block_of();
+    const uint32_t* refined = numbering.refined.data();
     next.roots.clear();
     next.flipped.clear();
     resize_scratch(next.blocks, count);
     next.resize_state(size_t(4) * count);
-    if (count == 0) return;
     SiblingBlock* out = next.blocks.data();
     uint8_t* out_state = next.state();
     with_links(level, [&](auto links) {
-        for (size_t i = 0; i < n; ++i) {
-            const uint32_t b = block[i];
-            if (b == kNoLocal) continue;
-            const LevelLinks p = links(uint32_t(i));
+        for (uint32_t b = 0; b < count; ++b) {
+            const LevelLinks p = links(refined[b]);
             SiblingBlock& child = out[b];
             unsigned edges = 0, linked = 0;
             for (int e = 0; e < 3; ++e) {
-                const uint32_t q = p.nbr[e] == kNoLocal ? kNoLocal : block[p.nbr[e]];
+                const uint32_t q = block[static_cast<int32_t>(p.nbr[e])];  // kNoLocal for none
+                const uint32_t none = q == kNoLocal ? kNoLocal : 0u;
                 const unsigned eq = (p.nbr_edge >> (2 * e)) & 3u;
-                child.slot[e] = q == kNoLocal ? kNoLocal : 4 * q + (eq == 2 ? 0 : eq + 1);
-                child.slot[3 + e] = q == kNoLocal ? kNoLocal : 4 * q + eq;
-                if (q != kNoLocal) {
-                    edges |= eq << (2 * e);
-                    linked |= 1u << e;
-                }
+                child.slot[e] = (4 * q + (eq == 2 ? 0 : eq + 1)) | none;
+                child.slot[3 + e] = (4 * q + eq) | none;
+                edges |= (eq << (2 * e)) & ~none;
+                linked |= (1u << e) & ~none;
             }
             child.slot[6] = 4 * b;
             child.nbr_edge = uint8_t(edges);
