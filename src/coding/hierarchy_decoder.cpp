@@ -55,8 +55,7 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
         // Every symbol left is 0, and with no node of this level refined yet no rule can force
         // one: the level is all leaves (and the last). No traversal needed.
         for (uint32_t i = 0; i < n; ++i) state[i] = uint8_t(state[i] | kDecided);
-        numbering_.resize(0);
-        numbering_.count = 0;
+        numbering_.reset(0);
         finish_level(0, 0);
         return;
     }
@@ -84,10 +83,8 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
                      what);
     };
     RefinedNumbering& numbering = numbering_;
-    numbering.resize(n);
-    numbering.count = 0;
-    resize_scratch(closures_, n);
-    uint32_t* closures = closures_.data();
+    numbering.reset(n);
+    uint32_t* const closures = closures_.reserve(n);
     uint32_t closure_count = 0;
     uint64_t edge_ends = 0;
     bool invalid_split = false;

@@ -84,7 +84,7 @@ private:
     Level level_, next_;
     std::vector<Level> decided_;  // decided levels not yet built, oldest first
     RefinedNumbering numbering_;     // of the level being decided
-    std::vector<uint32_t> closures_;  // scratch: the leaves with two or three hanging nodes
+    ScratchArray<uint32_t> closures_;  // the leaves with two or three hanging nodes
     std::vector<NodeId> level_ids_;  // node ids of the oldest level not yet built
     int level_index_ = 0;
     uint64_t node_count_ = 0, vertex_count_ = 0, symbols_read_ = 0;

@@ -207,31 +207,31 @@ constexpr SiblingStates kSiblingStates{};
 // canonical order, and each node's block (its rank among them) or kNoLocal. block_of() has one
 // more entry in front, kNoLocal, read for a missing neighbour as block_of()[int32_t(kNoLocal)].
 struct RefinedNumbering {
-    std::vector<uint32_t> refined;
     uint32_t count = 0;
     uint32_t* block_of() { return blocks_.data() + 1; }
     const uint32_t* block_of() const { return blocks_.data() + 1; }
-    void resize(size_t n) {
-        resize_scratch(blocks_, n + 1);
-        blocks_[0] = kNoLocal;
-        resize_scratch(refined, n);
+    const uint32_t* refined() const { return refined_.data(); }
+    // Room for n nodes; count restarts at 0.
+    void reset(size_t n) {
+        blocks_.reserve(n + 1)[0] = kNoLocal;
+        refined_.reserve(n);
+        count = 0;
     }
     // Numbers node i (nodes in canonical order), without a branch on `is_refined`.
     void add(uint32_t i, bool is_refined) {
-        blocks_[size_t(i) + 1] = count | (uint32_t(is_refined) - 1u);  // kNoLocal unless refined
-        refined[count] = i;
+        blocks_.data()[size_t(i) + 1] = count | (uint32_t(is_refined) - 1u);  // kNoLocal unless refined
+        refined_.data()[count] = i;
         count += is_refined;
     }
 
 private:
-    std::vector<uint32_t> blocks_;
+    ScratchArray<uint32_t> blocks_, refined_;
 };
 
 inline void number_refined(const Level& level, RefinedNumbering& numbering) {
     const uint32_t n = static_cast<uint32_t>(level.size());
     const uint8_t* state = level.state();
-    numbering.resize(n);
-    numbering.count = 0;
+    numbering.reset(n);
     for (uint32_t i = 0; i < n; ++i) numbering.add(i, (state[i] & kRefined) != 0);
 }
 
@@ -240,7 +240,7 @@ inline void number_refined(const Level& level, RefinedNumbering& numbering) {
 inline void derive_next_level(const Level& level, const RefinedNumbering& numbering, Level& next) {
     const uint32_t count = numbering.count;
     const uint32_t* block = numbering.block_of();
-    const uint32_t* refined = numbering.refined.data();
+    const uint32_t* refined = numbering.refined();
     next.roots.clear();
     next.flipped.clear();
     resize_scratch(next.blocks, count);
@@ -375,8 +375,7 @@ private:
         // all are decided. Listing them first spares the main loop a scan with an unpredictable
         // test per node.
         const uint8_t initially_culled = rules.one_regularity ? uint8_t(0) : kComplete;
-        if (culled_.size() < n) resize_scratch(culled_, n);
-        uint32_t* const culled_list = culled_.data();
+        uint32_t* const culled_list = culled_.reserve(n);
         uint32_t culled_count = 0;
         for (uint32_t i = 0; i < n; ++i) {
             const uint8_t s = state[i];
@@ -385,10 +384,8 @@ private:
             culled_list[culled_count] = i;
             culled_count += !fresh;
         }
-        for (auto& stack : stacks_) {
-            if (stack.size() < n) resize_scratch(stack, n);
-        }
-        uint32_t* const bottom[4] = {stacks_[0].data(), stacks_[1].data(), stacks_[2].data(), stacks_[3].data()};
+        uint32_t* const bottom[4] = {stacks_[0].reserve(n), stacks_[1].reserve(n), stacks_[2].reserve(n),
+                                     stacks_[3].reserve(n)};
         uint32_t* top[4] = {bottom[0], bottom[1], bottom[2], bottom[3]};
         uint8_t transition[256];  // a local copy: the state bytes written below could alias the member
         for (int k = 0; k < 256; ++k) transition[k] = after_neighbor_decided_[k];
@@ -507,8 +504,8 @@ private:
 
     HierarchyCoderOptions options_;
     uint8_t after_neighbor_decided_[256];  // state -> state, see the constructor
-    std::array<std::vector<uint32_t>, 4> stacks_;  // buckets 0-3 (each holds at most one entry per node)
-    std::vector<uint32_t> culled_;                 // the nodes culled at the outset
+    std::array<ScratchArray<uint32_t>, 4> stacks_;  // buckets 0-3 (each holds at most one entry per node)
+    ScratchArray<uint32_t> culled_;                 // the nodes culled at the outset
 };
 
 }  // namespace amc

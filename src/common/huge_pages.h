@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #if defined(__linux__)
@@ -49,5 +50,28 @@ void resize_scratch(std::vector<T>& v, size_t n) {
     }
     v.resize(n);
 }
+
+// Scratch storage for trivial types that a pass fills before reading: grows (geometrically, without
+// keeping the old contents) and is never zero-filled, unlike std::vector::resize.
+template <class T>
+class ScratchArray {
+public:
+    // Room for at least n elements, contents unspecified.
+    T* reserve(size_t n) {
+        if (n > capacity_) {
+            const size_t capacity = n > 2 * capacity_ ? n : 2 * capacity_;
+            data_.reset(new T[capacity]);  // default-initialized: no writes
+            capacity_ = capacity;
+            advise_huge_pages(data_.get(), capacity * sizeof(T));
+        }
+        return data_.get();
+    }
+    T* data() { return data_.get(); }
+    const T* data() const { return data_.get(); }
+
+private:
+    std::unique_ptr<T[]> data_;
+    size_t capacity_ = 0;
+};
 
 }  // namespace amc

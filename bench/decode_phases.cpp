@@ -1,0 +1,174 @@
+// Where a hierarchy decode's time goes: deciding every node (traversal, arithmetic decoding,
+// deriving each next level) and building the Hierarchy, timed apart on the models of coder_bench.
+// Besides wall time it reads the processor's counters for this thread in user space (cycles,
+// instructions, branch misses) where Linux allows it: unlike time, they hardly move when other
+// virtual machines load the host, so two builds can be compared with few runs.
+//
+//   decode_phases [--nodes N] [--runs R]
+#include "coding/hierarchy_level_coder.h"
+
+#include <amc/hierarchy_coder.h>
+#include <amc/refinement.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#if defined(__linux__)
+#include <linux/perf_event.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#endif
+
+namespace {
+
+constexpr int kCounters = 3;
+const char* const kCounterNames[kCounters] = {"cycles", "instructions", "branch misses"};
+
+// The user-space counters of this thread, or none where perf events are not available.
+class Counters {
+public:
+    Counters() {
+#if defined(__linux__)
+        const uint64_t configs[kCounters] = {PERF_COUNT_HW_CPU_CYCLES, PERF_COUNT_HW_INSTRUCTIONS,
+                                             PERF_COUNT_HW_BRANCH_MISSES};
+        for (int k = 0; k < kCounters; ++k) {
+            perf_event_attr attr{};
+            attr.type = PERF_TYPE_HARDWARE;
+            attr.size = sizeof(attr);
+            attr.config = configs[k];
+            attr.exclude_kernel = 1;
+            attr.exclude_hv = 1;
+            fd_[k] = int(syscall(SYS_perf_event_open, &attr, 0, -1, -1, 0));
+        }
+#endif
+    }
+    ~Counters() {
+#if defined(__linux__)
+        for (int fd : fd_) {
+            if (fd >= 0) close(fd);
+        }
+#endif
+    }
+    bool available() const { return fd_[0] >= 0; }
+    void read_all(double out[kCounters]) const {
+        for (int k = 0; k < kCounters; ++k) {
+            uint64_t value = 0;
+#if defined(__linux__)
+            if (fd_[k] < 0 || read(fd_[k], &value, sizeof(value)) != sizeof(value)) value = 0;
+#endif
+            out[k] = double(value);
+        }
+    }
+
+private:
+    int fd_[kCounters] = {-1, -1, -1};
+};
+
+using Clock = std::chrono::steady_clock;
+
+struct Sample {
+    double ms[2];                    // decide, build
+    double counts[2][kCounters];     // per phase
+};
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+}
+
+void report(const char* name, const amc::Hierarchy& h, int runs, const Counters& counters) {
+    const std::vector<uint8_t> bytes = amc::encode_hierarchy(h);
+    std::vector<Sample> samples;
+    for (int r = 0; r < runs; ++r) {
+        Sample s{};
+        double c0[kCounters], c1[kCounters], c2[kCounters];
+        counters.read_all(c0);
+        const Clock::time_point t0 = Clock::now();
+        amc::HierarchyStreamHeader header;
+        const size_t header_size = amc::read_hierarchy_stream_header(bytes.data(), bytes.size(), header);
+        amc::HierarchyLevelDecoder coder(h.base(), header, amc::HierarchyDecodeOptions().max_nodes);
+        amc::ArithmeticDecoder decoder(bytes.data() + header_size, bytes.size() - header_size);
+        while (!coder.done()) coder.decide_level(decoder);
+        coder.finish();
+        const Clock::time_point t1 = Clock::now();
+        counters.read_all(c1);
+        coder.hierarchy().reserve(coder.node_count(), coder.vertex_count());
+        coder.build_decided_levels();
+        {
+            amc::Hierarchy decoded = std::move(coder.hierarchy());
+            if (decoded.node_count() != h.node_count()) {
+                std::fprintf(stderr, "decode_phases: %s decoded to %u nodes, not %u\n", name, decoded.node_count(),
+                             h.node_count());
+                std::exit(1);
+            }
+        }  // freeing the hierarchy is part of building it
+        const Clock::time_point t2 = Clock::now();
+        counters.read_all(c2);
+        s.ms[0] = std::chrono::duration<double, std::milli>(t1 - t0).count();
+        s.ms[1] = std::chrono::duration<double, std::milli>(t2 - t1).count();
+        for (int k = 0; k < kCounters; ++k) {
+            s.counts[0][k] = c1[k] - c0[k];
+            s.counts[1][k] = c2[k] - c1[k];
+        }
+        samples.push_back(s);
+    }
+    const double nodes = h.node_count();
+    std::printf("%s: %u nodes, %zu bytes, %d runs (min / median)\n", name, h.node_count(), bytes.size(), runs);
+    std::vector<double> total;
+    for (const Sample& s : samples) total.push_back(s.ms[0] + s.ms[1]);
+    std::printf("  decode  %7.1f / %7.1f ms   %5.1f / %5.1f M nodes/s\n", *std::min_element(total.begin(), total.end()),
+                median(total), nodes / *std::min_element(total.begin(), total.end()) / 1e3, nodes / median(total) / 1e3);
+    const char* const phases[2] = {"decide", "build"};
+    for (int p = 0; p < 2; ++p) {
+        std::vector<double> ms;
+        for (const Sample& s : samples) ms.push_back(s.ms[p]);
+        std::printf("  %-7s %7.1f / %7.1f ms", phases[p], *std::min_element(ms.begin(), ms.end()), median(ms));
+        if (counters.available()) {
+            for (int k = 0; k < kCounters; ++k) {
+                std::vector<double> c;
+                for (const Sample& s : samples) c.push_back(s.counts[p][k]);
+                std::printf("   %s %.1f / %.1f M", kCounterNames[k], *std::min_element(c.begin(), c.end()) / 1e6,
+                            median(c) / 1e6);
+            }
+        }
+        std::printf("\n");
+    }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    long nodes = 1000000;
+    int runs = 15;
+    for (int i = 1; i < argc; ++i) {
+        const std::string arg = argv[i];
+        if ((arg == "--nodes" || arg == "--runs") && i + 1 < argc) {
+            const long value = std::strtol(argv[++i], nullptr, 10);
+            if (value <= 0) {
+                std::fprintf(stderr, "decode_phases: %s needs a positive number\n", arg.c_str());
+                return 2;
+            }
+            if (arg == "--nodes") nodes = value;
+            else runs = int(std::min(value, 1000L));
+        } else {
+            std::fprintf(stderr, "usage: decode_phases [--nodes N] [--runs R]\n");
+            return 2;
+        }
+    }
+    const Counters counters;
+    if (!counters.available()) std::printf("(no hardware counters here: wall time only)\n");
+    // The models of coder_bench.
+    amc::SurfaceRemeshOptions options;
+    options.base_triangles = 500;
+    options.max_level = 8;
+    options.target_faces = uint32_t(nodes * 3 / 4);
+    report("surface", amc::remesh_adaptively(amc::make_bumpy_sphere(6), options), runs, counters);
+    amc::Hierarchy random(amc::make_torus(16, 24, 1.0, 0.35));
+    amc::refine_randomly(random, uint32_t(nodes * 3 / 4), 12, 7);
+    report("random", random, runs, counters);
+}
