@@ -140,9 +140,10 @@ void HierarchyLevelDecoder::build_decided_levels() {
         const uint8_t* state = level.state();
         const uint32_t n = static_cast<uint32_t>(level.size());
         // The next level's sibling blocks hold the refined nodes' neighbours among themselves
-        // (slots 0-2, the first halves of their edges): split the whole level in one pass from them, in canonical order (so the
-        // children of level l get consecutive ids, as the level forest numbers them). level_ids_
-        // is compacted in place to the refined nodes, then becomes the next level's ids.
+        // (slots 0-2, the first halves of their edges): split the whole level in one pass from
+        // them, in canonical order (so the children of level l get consecutive ids, as the level
+        // forest numbers them). level_ids_ is compacted in place to the refined nodes, then
+        // becomes the next level's ids.
         NodeId* ids = level_ids_.data();
         for (const uint32_t i : level.flipped) h_.set_diagonal_flipped(ids[i], true);
         uint32_t count = 0;

@@ -17,8 +17,8 @@
 // The roots' links are stored node by node (LevelLinks). Every finer level comes in blocks of
 // four siblings (nodes 4b..4b+3 are the children of the level above's b-th refined node, in
 // child order), and four siblings' links follow from their parent's neighbours alone, so one
-// 16-byte SiblingBlock holds the links of four nodes: a quarter of the memory, derived in a
-// quarter of the writes.
+// 32-byte SiblingBlock holds the links of four nodes: half the memory of 16 bytes a node, written
+// once per parent.
 #pragma once
 
 #include "coding/context_groups.h"
@@ -366,14 +366,12 @@ private:
         // lowest non-empty bucket goes first, each bucket last in, first out; an entry is stale
         // once its node is decided or has moved to a lower bucket, and is skipped. Every node
         // enters at most five buckets: linear time.
-        // Two buckets need no storage: bucket 4 starts with every unculled node in canonical order
-        // and never receives another, so it is a cursor; bucket 0 starts with the nodes culled at
-        // the outset in canonical order (a cursor) under a stack of nodes culled later.
-        // Bucket 0 at the outset holds the nodes 1-regularity culls (no refined node exists yet, so
-        // no other rule applies). They go first, in canonical order; none of them is refined, so
-        // none makes another node culled meanwhile, and the stack of bucket 0 stays empty until
-        // all are decided. Listing them first spares the main loop a scan with an unpredictable
-        // test per node.
+        // Bucket 4 starts with every unculled node in canonical order and never receives another,
+        // so it is a cursor. Bucket 0 starts with the nodes 1-regularity culls (no node is refined
+        // yet, so no other rule applies), in canonical order, under a stack of nodes culled later.
+        // Those first nodes go first: none of them is refined, so none makes another node culled
+        // meanwhile and the stack stays empty until all are decided. They are listed while the
+        // priorities are set, which spares the main loop a cursor testing every node.
         const uint8_t initially_culled = rules.one_regularity ? uint8_t(0) : kComplete;
         uint32_t* const culled_list = culled_.reserve(n);
         uint32_t culled_count = 0;
