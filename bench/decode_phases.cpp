@@ -153,7 +153,7 @@ int main(int argc, char** argv) {
                 std::fprintf(stderr, "decode_phases: %s needs a positive number\n", arg.c_str());
                 return 2;
             }
-            if (arg == "--nodes") nodes = value;
+            if (arg == "--nodes") nodes = std::min(value, 20000000L);  // a few GB at most
             else runs = int(std::min(value, 1000L));
         } else {
             std::fprintf(stderr, "usage: decode_phases [--nodes N] [--runs R]\n");
