@@ -388,13 +388,6 @@ void check_summary(FILE* f, const std::vector<Result>& results, const RunInfo& i
 
 }  // namespace
 
-double median(std::vector<double> samples) {
-    if (samples.empty()) return 0;
-    std::sort(samples.begin(), samples.end());
-    const size_t n = samples.size();
-    return n % 2 ? samples[n / 2] : 0.5 * (samples[n / 2 - 1] + samples[n / 2]);
-}
-
 void write_csv(const std::string& path, const std::vector<Result>& results) {
     FILE* f = std::fopen(path.c_str(), "w");
     if (f == nullptr) throw std::runtime_error(path + ": cannot write");

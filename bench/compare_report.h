@@ -2,6 +2,8 @@
 // coder and payload, and the markdown tables of docs/BENCHMARKS.md.
 #pragma once
 
+#include "bench_common.h"
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -42,8 +44,6 @@ struct RunInfo {
     std::string command;
 };
 
-// The median of the samples (the mean of the middle two for an even count); 0 for none.
-double median(std::vector<double> samples);
 
 void write_csv(const std::string& path, const std::vector<Result>& results);
 // The tables of docs/BENCHMARKS.md (sizes, bits per face, ratios, complete meshes, speeds, checks).

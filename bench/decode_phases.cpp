@@ -5,10 +5,10 @@
 // virtual machines load the host, so two builds can be compared with few runs.
 //
 //   decode_phases [--nodes N] [--runs R]
+#include "bench_common.h"
 #include "coding/hierarchy_level_coder.h"
 
 #include <amc/hierarchy_coder.h>
-#include <amc/refinement.h>
 
 #include <algorithm>
 #include <chrono>
@@ -75,11 +75,6 @@ struct Sample {
     double ms[2];                    // decide, build
     double counts[2][kCounters];     // per phase
 };
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-}
 
 void report(const char* name, const amc::Hierarchy& h, int runs, const Counters& counters) {
     const std::vector<uint8_t> bytes = amc::encode_hierarchy(h);
@@ -163,12 +158,6 @@ int main(int argc, char** argv) {
     const Counters counters;
     if (!counters.available()) std::printf("(no hardware counters here: wall time only)\n");
     // The models of coder_bench.
-    amc::SurfaceRemeshOptions options;
-    options.base_triangles = 500;
-    options.max_level = 8;
-    options.target_faces = uint32_t(nodes * 3 / 4);
-    report("surface", amc::remesh_adaptively(amc::make_bumpy_sphere(6), options), runs, counters);
-    amc::Hierarchy random(amc::make_torus(16, 24, 1.0, 0.35));
-    amc::refine_randomly(random, uint32_t(nodes * 3 / 4), 12, 7);
-    report("random", random, runs, counters);
+    report("surface", make_bench_hierarchy(BenchModel::surface, nodes), runs, counters);
+    report("random", make_bench_hierarchy(BenchModel::random, nodes), runs, counters);
 }

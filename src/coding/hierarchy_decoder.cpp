@@ -56,7 +56,7 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
         // one: the level is all leaves (and the last). No traversal needed.
         for (uint32_t i = 0; i < n; ++i) state[i] = uint8_t(state[i] | kDecided);
         numbering_.reset(0);
-        finish_level(0, 0);
+        finish_level(0);
         return;
     }
     // The coder's state lives in locals while the level is decided: every state byte the
@@ -120,11 +120,11 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
     decoder = d;
     models_ = models;
     symbols_read_ = symbols_read;
-    finish_level(count, edge_ends / 2);
+    finish_level(edge_ends / 2);
 }
 
-void HierarchyLevelDecoder::finish_level(uint32_t refined_count, uint64_t new_vertices) {
-    node_count_ += uint64_t(4) * refined_count;
+void HierarchyLevelDecoder::finish_level(uint64_t new_vertices) {
+    node_count_ += uint64_t(4) * numbering_.count;
     vertex_count_ += new_vertices;
     derive_next_level(level_, numbering_, next_);
     decided_.push_back(std::move(level_));

@@ -72,9 +72,9 @@ public:
     Hierarchy& hierarchy() { return h_; }
 
 private:
-    // Counts the decided level's splits and moves to the next level (numbering_ holds the
-    // numbering of its refined nodes).
-    void finish_level(uint32_t refined_count, uint64_t new_vertices);
+    // Counts the decided level's splits (numbering_ holds the numbering of its refined nodes) and
+    // the vertices they create, and moves to the next level.
+    void finish_level(uint64_t new_vertices);
 
     HierarchyStreamHeader header_;
     uint64_t max_nodes_;

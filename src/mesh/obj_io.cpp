@@ -167,11 +167,11 @@ std::string format_obj(const TriangleMesh& mesh) {
     // when read back, and OBJ has no way to say "these are floats".
     for (const Vec3& p : mesh.positions) {
         out += "v ";
-        text::append_real_line(out, p.x, p.y, p.z);
+        text::append_line(out, p.x, p.y, p.z);
     }
     for (const Triangle& t : mesh.triangles) {
         out += "f ";
-        text::append_uint_line(out, uint64_t(t[0]) + 1, uint64_t(t[1]) + 1, uint64_t(t[2]) + 1);
+        text::append_line(out, uint64_t(t[0]) + 1, uint64_t(t[1]) + 1, uint64_t(t[2]) + 1);
     }
     return out;
 }

@@ -114,11 +114,11 @@ std::string format_off(const TriangleMesh& mesh) {
     // Shortest decimals of the double values (also for single_precision meshes: the shortest
     // decimal of a float would read back as a different double).
     for (const Vec3& p : mesh.positions) {
-        text::append_real_line(out, p.x, p.y, p.z);
+        text::append_line(out, p.x, p.y, p.z);
     }
     for (const Triangle& t : mesh.triangles) {
         out += "3 ";
-        text::append_uint_line(out, t[0], t[1], t[2]);
+        text::append_line(out, t[0], t[1], t[2]);
     }
     return out;
 }

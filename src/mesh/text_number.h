@@ -8,6 +8,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <type_traits>
 
 namespace amc::text {
 
@@ -51,24 +52,19 @@ inline void append_uint(std::string& out, uint64_t value) {
     out.append(buf, ptr);
 }
 
-// Three values separated by spaces, then a newline: a vertex or a triangle line.
-template <typename Real>
-void append_real_line(std::string& out, Real x, Real y, Real z) {
-    append_real(out, x);
-    out += ' ';
-    append_real(out, y);
-    out += ' ';
-    append_real(out, z);
-    out += '\n';
-}
-
-inline void append_uint_line(std::string& out, uint64_t a, uint64_t b, uint64_t c) {
-    append_uint(out, a);
-    out += ' ';
-    append_uint(out, b);
-    out += ' ';
-    append_uint(out, c);
-    out += '\n';
+// Three numbers separated by spaces, then a newline: a vertex line (floating point) or a triangle
+// line (unsigned).
+template <typename T>
+void append_line(std::string& out, T a, T b, T c) {
+    const T values[3] = {a, b, c};
+    for (int k = 0; k < 3; ++k) {
+        if constexpr (std::is_floating_point_v<T>) {
+            append_real(out, values[k]);
+        } else {
+            append_uint(out, values[k]);
+        }
+        out += k < 2 ? ' ' : '\n';
+    }
 }
 
 // Shortens a token for an error message.

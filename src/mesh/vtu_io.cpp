@@ -63,7 +63,7 @@ std::string format_vtu(const TriangleMesh& mesh, const CellData* cells) {
     out += "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
     for (const Triangle& t : mesh.triangles) {
         out += "          ";
-        text::append_uint_line(out, t[0], t[1], t[2]);
+        text::append_line(out, t[0], t[1], t[2]);
     }
     out += "        </DataArray>\n";
     out += "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";

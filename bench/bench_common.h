@@ -1,0 +1,35 @@
+// What the benchmark programs share: the hierarchies coder_bench and decode_phases time, and the
+// median of repeated timings.
+#pragma once
+
+#include <amc/hierarchy.h>
+#include <amc/refinement.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+enum class BenchModel { surface = 0, random = 1 };
+
+// surface: a curvature-adaptive remesh of the procedural bumpy sphere; random: a random hierarchy
+// over a torus. Both with about target_nodes nodes.
+inline amc::Hierarchy make_bench_hierarchy(BenchModel model, int64_t target_nodes) {
+    if (model == BenchModel::surface) {
+        amc::SurfaceRemeshOptions options;
+        options.base_triangles = 500;
+        options.max_level = 8;
+        options.target_faces = uint32_t(target_nodes * 3 / 4);
+        return amc::remesh_adaptively(amc::make_bumpy_sphere(6), options);
+    }
+    amc::Hierarchy h(amc::make_torus(16, 24, 1.0, 0.35));
+    amc::refine_randomly(h, uint32_t(target_nodes * 3 / 4), 12, 7);
+    return h;
+}
+
+// The median of the samples (the mean of the middle two for an even count); 0 for none.
+inline double median(std::vector<double> samples) {
+    if (samples.empty()) return 0;
+    std::sort(samples.begin(), samples.end());
+    const size_t n = samples.size();
+    return n % 2 ? samples[n / 2] : 0.5 * (samples[n / 2 - 1] + samples[n / 2]);
+}
