@@ -125,14 +125,14 @@ public:
     // Splits the leaves parents[0..count) in that order with the result of calling split() on
     // each in turn (same node ids, vertex ids and links), in one pass: the bulk form for decoders
     // that replay a stored forest level by level. The parents must be distinct splittable leaves
-    // of one level whose same-level neighbours are not refined yet. The caller says which of them
-    // are neighbours: the three words at first_half_links + stride * i hold, per edge e of
-    // parents[i], the same-level neighbour of child e on that edge (the first half of the
-    // parent's edge e) as a local index 4 * j + k' (child k' of parents[j]), or kNoNode where the
-    // neighbour across e is not in `parents` (it stays a leaf). When no ids are free for reuse (a
-    // hierarchy that was only ever refined), child k of parents[i] gets id
-    // node_capacity() + 4 * i + k, node_capacity() taken before the call.
-    void split_level(const NodeId* parents, uint32_t count, const uint32_t* first_half_links, size_t stride);
+    // of one level whose same-level neighbours are not refined yet. The caller gives the links of
+    // the new nodes: the twelve words at child_links + 12 * i hold, for child k of parents[i] and
+    // its edge e (word 3 * k + e), its same-level neighbour as a local index 4 * j + k' (child k'
+    // of parents[j]), or kNoNode where it has none (boundary, or the neighbour across the
+    // parent's edge is not in `parents` and stays a leaf). They must be the links split() makes.
+    // When no ids are free for reuse (a hierarchy that was only ever refined), child k of
+    // parents[i] gets id node_capacity() + 4 * i + k, node_capacity() taken before the call.
+    void split_level(const NodeId* parents, uint32_t count, const uint32_t* child_links);
     // Hints the processor to fetch node n (for traversals that know their next nodes early).
     void prefetch(NodeId n) const { __builtin_prefetch(nodes_.data() + n); }
     // Reserves room for `nodes` nodes and `vertices` vertex ids (a hint for bulk builders, which

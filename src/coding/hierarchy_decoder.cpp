@@ -35,8 +35,13 @@ HierarchyLevelDecoder::HierarchyLevelDecoder(const TriangleMesh& base, const Hie
     root_level(h_, level_);
     node_count_ = h_.root_count();
     vertex_count_ = base.positions.size();
-    level_ids_.resize(h_.root_count());
-    for (NodeId r = 0; r < h_.root_count(); ++r) level_ids_[r] = r;
+}
+
+std::vector<NodeId> HierarchyLevelDecoder::level_nodes() const {
+    const size_t n = decided_.empty() ? level_.size() : decided_.front().size();
+    std::vector<NodeId> ids(n);
+    for (size_t i = 0; i < n; ++i) ids[i] = level_base_ + NodeId(i);
+    return ids;
 }
 
 void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder) {
@@ -55,7 +60,7 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
         // Every symbol left is 0, and with no node of this level refined yet no rule can force
         // one: the level is all leaves (and the last). No traversal needed.
         for (uint32_t i = 0; i < n; ++i) state[i] = uint8_t(state[i] | kDecided);
-        numbering_.reset(0);
+        level_.refined_count = 0;
         finish_level(0);
         return;
     }
@@ -83,7 +88,7 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
                      what);
     };
     RefinedNumbering& numbering = numbering_;
-    numbering.reset(n);
+    numbering.reset(level_);
     uint32_t* const closures = closures_.reserve(n);
     uint32_t closure_count = 0;
     uint64_t edge_ends = 0;
@@ -100,6 +105,7 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
         closures[closure_count] = i;
         closure_count += !refined & (hanging >= 2);
     }
+    numbering.finish(level_);
     for (uint32_t k = 0; k < closure_count; ++k) {
         const uint32_t i = closures[k];
         if (refined_neighbors(state[i]) == 3) throw corrupt(i, " has three hanging nodes but was not refined");
@@ -107,7 +113,7 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
         if (header_.orientation_coded) flag ^= d.decode(models.orientation);
         if (flag) level_.flipped.push_back(i);
     }
-    const uint32_t count = numbering.count;
+    const uint32_t count = level_.refined_count;
     if (count > 0 && (invalid_split || l >= kMaxLevel)) {
         for (uint32_t i = 0; i < n; ++i) {
             if ((state[i] & kRefined) && (!(state[i] & kComplete) || l >= kMaxLevel))
@@ -124,7 +130,7 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
 }
 
 void HierarchyLevelDecoder::finish_level(uint64_t new_vertices) {
-    node_count_ += uint64_t(4) * numbering_.count;
+    node_count_ += uint64_t(4) * level_.refined_count;
     vertex_count_ += new_vertices;
     derive_next_level(level_, numbering_, next_);
     decided_.push_back(std::move(level_));
@@ -135,30 +141,21 @@ void HierarchyLevelDecoder::finish_level(uint64_t new_vertices) {
 
 void HierarchyLevelDecoder::build_decided_levels() {
     for (size_t k = 0; k < decided_.size(); ++k) {
-        const Level& level = decided_[k];
+        Level& level = decided_[k];
         const Level& children = k + 1 < decided_.size() ? decided_[k + 1] : level_;
-        const uint8_t* state = level.state();
-        const uint32_t n = static_cast<uint32_t>(level.size());
-        // The next level's sibling blocks hold the refined nodes' neighbours among themselves
-        // (slots 0-2, the first halves of their edges): split the whole level in one pass from
-        // them, in canonical order (so the children of level l get consecutive ids, as the level
-        // forest numbers them). level_ids_ is compacted in place to the refined nodes, then
-        // becomes the next level's ids.
-        NodeId* ids = level_ids_.data();
-        for (const uint32_t i : level.flipped) h_.set_diagonal_flipped(ids[i], true);
-        uint32_t count = 0;
-        for (uint32_t i = 0; i < n; ++i) {
-            ids[count] = ids[i];
-            count += (state[i] & kRefined) ? 1u : 0u;
-        }
-        // The decoder's hierarchy never frees ids, so the children are numbered consecutively.
+        // Node ids of the decoder's hierarchy are level_base_ + local index: roots are 0..R-1 and
+        // the children of each level are numbered consecutively (no ids are ever freed). The
+        // next level's links are the children's links, so the whole level splits in one pass,
+        // in canonical order.
+        for (const uint32_t i : level.flipped) h_.set_diagonal_flipped(level_base_ + i, true);
+        const uint32_t count = level.refined_count;
+        uint32_t* parents = level.refined.data();
+        for (uint32_t b = 0; b < count; ++b) parents[b] += level_base_;
         const NodeId first_child = h_.node_capacity();
-        h_.split_level(ids, count, children.empty() ? nullptr : children.blocks[0].slot, sizeof(SiblingBlock) / sizeof(uint32_t));
-        level_ids_.resize(size_t(4) * count);
-        ids = level_ids_.data();
-        for (uint32_t c = 0; c < 4 * count; ++c) ids[c] = first_child + c;
+        h_.split_level(parents, count, count == 0 ? nullptr : children.nbr.data()->nbr);
+        level_base_ = first_child;
     }
-    // Keep one array's memory for the next level.
+    // Keep one level's memory for the next level.
     if (!decided_.empty()) std::swap(next_, decided_.back());
     decided_.clear();
 }

@@ -55,7 +55,7 @@ public:
     bool done() const { return level_.empty(); }
     int level() const { return level_index_; }
     // Nodes of the current level (ids in hierarchy()) in canonical order.
-    const std::vector<NodeId>& level_nodes() const { return level_ids_; }
+    std::vector<NodeId> level_nodes() const;
     // Decides the current level from `decoder` (symbols, orientation bits), splits its refined
     // nodes in hierarchy() and moves to the next level. Throws Error on a corrupt stream.
     void decode_level(ArithmeticDecoder& decoder);
@@ -72,8 +72,8 @@ public:
     Hierarchy& hierarchy() { return h_; }
 
 private:
-    // Counts the decided level's splits (numbering_ holds the numbering of its refined nodes) and
-    // the vertices they create, and moves to the next level.
+    // Counts the decided level's splits (level_.refined, numbered in numbering_) and the vertices
+    // they create, and moves to the next level.
     void finish_level(uint64_t new_vertices);
 
     HierarchyStreamHeader header_;
@@ -85,7 +85,7 @@ private:
     std::vector<Level> decided_;  // decided levels not yet built, oldest first
     RefinedNumbering numbering_;     // of the level being decided
     ScratchArray<uint32_t> closures_;  // the leaves with two or three hanging nodes
-    std::vector<NodeId> level_ids_;  // node ids of the oldest level not yet built
+    NodeId level_base_ = 0;  // node id of local index 0 of the oldest level not yet built
     int level_index_ = 0;
     uint64_t node_count_ = 0, vertex_count_ = 0, symbols_read_ = 0;
 };

@@ -46,49 +46,28 @@ struct LevelLinks {
 };
 static_assert(sizeof(LevelLinks) == 16, "LevelLinks is meant to be 16 bytes");
 
-// The links of the four children of one refined node p (nodes 4b..4b+3), given by p's own. Across
-// p's edge e lies p's neighbour q with its index eq of the edge; when q is refined, the first half
-// of the edge meets q's child (eq+1)%3 and the second half q's child eq (Hierarchy::split). Corner
-// child k lies on p's edges k (first half) and (k+2)%3 (second half) and meets the center across
-// its edge (k+1)%3; the center's edge e meets corner (e+2)%3. The block stores the six children
-// across p's edges and its own first node, so that each neighbour of each child is one table
-// lookup away.
-struct SiblingBlock {
-    uint32_t slot[7];  // 0-2: first-half neighbour across p's edge e, 3-5: second-half (or kNoLocal); 6: 4b
-    uint8_t nbr_edge;  // p's neighbour_edge, 2 bits per edge (0 where q is not refined)
-    uint8_t boundary;  // bits 0-2: p's boundary edges
-    uint8_t unused[2];
-    SiblingBlock() {}  // uninitialized, as LevelLinks
-};
-static_assert(sizeof(SiblingBlock) == 32, "SiblingBlock is meant to be 32 bytes");
-
-// Neighbour across edge e of child k: slot kSiblingSlot[k][e] of its block plus kSiblingAdd[k][e].
-constexpr uint8_t kSiblingSlot[4][3] = {{0, 6, 5}, {3, 1, 6}, {6, 4, 2}, {6, 6, 6}};
-constexpr uint8_t kSiblingAdd[4][3] = {{0, 3, 0}, {0, 0, 3}, {3, 0, 0}, {2, 0, 1}};
-
 struct Neighbors {
     uint32_t nbr[3];  // across edge e: local index, or kNoLocal
 };
 
-inline Neighbors sibling_neighbors(const SiblingBlock& b, uint32_t i) {
-    const unsigned k = i & 3;
-    Neighbors out;
-    for (int e = 0; e < 3; ++e) out.nbr[e] = b.slot[kSiblingSlot[k][e]] + kSiblingAdd[k][e];
-    return out;
-}
+// What the four children of one refined node p take from p besides their neighbours: p's
+// neighbour_edge (2 bits per edge, 0 where the neighbour is not refined) and boundary edges.
+struct BlockEdges {
+    uint8_t nbr_edge;
+    uint8_t boundary;  // bits 0-2
+};
 
-inline LevelLinks sibling_links(const SiblingBlock& b, uint32_t i) {
-    const unsigned k = i & 3;
-    LevelLinks out;
-    const Neighbors q = sibling_neighbors(b, i);
-    for (int e = 0; e < 3; ++e) out.nbr[e] = q.nbr[e];
-    // Outer edges keep p's neighbour edge index (children are parallel to their parent); the
-    // inner edges pair with the same index.
+// The links of child k (0..3) of a block, by its parent's BlockEdges. Outer edges keep p's
+// neighbour edge index (children are parallel to their parent); the inner edges pair with the
+// same index.
+inline LevelLinks child_links(const Neighbors& nbr, BlockEdges parent, unsigned k) {
     constexpr uint8_t kOuter[4] = {0x33, 0x0f, 0x3c, 0x00};
     constexpr uint8_t kInner[4] = {1u << 2, 2u << 4, 0u, 0u | (1u << 2) | (2u << 4)};
     constexpr uint8_t kBoundary[4] = {5, 3, 6, 0};
-    out.nbr_edge = uint8_t((b.nbr_edge & kOuter[k]) | kInner[k]);
-    out.flags = uint8_t(b.boundary & kBoundary[k]);
+    LevelLinks out;
+    for (int e = 0; e < 3; ++e) out.nbr[e] = nbr.nbr[e];
+    out.nbr_edge = uint8_t((parent.nbr_edge & kOuter[k]) | kInner[k]);
+    out.flags = uint8_t(parent.boundary & kBoundary[k]);
     return out;
 }
 
@@ -106,15 +85,24 @@ constexpr uint8_t kPriorityMask = 0xe0;
 constexpr uint8_t kNoNeighborState = kDecided;
 
 struct Level {
-    std::vector<LevelLinks> roots;     // level 0: every node's links
-    std::vector<SiblingBlock> blocks;  // finer levels: one block of links for four nodes
-    std::vector<uint32_t> flipped;     // decoder: the nodes whose diagonal is flipped, ascending
+    std::vector<LevelLinks> roots;  // level 0: every node's links
+    ScratchArray<Neighbors> nbr;    // finer levels: every node's neighbours
+    ScratchArray<BlockEdges> edges;  // finer levels: what each block of four siblings takes from its parent
+    // The nodes without all neighbours (1-regularity culls them), in canonical order.
+    ScratchArray<uint32_t> incomplete;
+    uint32_t incomplete_count = 0;
+    // After the level is decided (decoder): its refined nodes in canonical order, and the nodes
+    // whose diagonal is flipped, ascending.
+    ScratchArray<uint32_t> refined;
+    uint32_t refined_count = 0;
+    std::vector<uint32_t> flipped;
 
     size_t size() const { return states_.empty() ? 0 : states_.size() - 1; }
     bool empty() const { return size() == 0; }
     // One state byte a node, preceded by kNoNeighborState: a neighbour index q reads its state at
     // state()[int32_t(q)], which for kNoLocal (-1) is that byte, so the hot loops need no test
-    // for a missing neighbour.
+    // for a missing neighbour. A new level's states say whether the node is complete and put
+    // complete nodes in the improved traversal's bucket 4.
     uint8_t* state() { return states_.data() + 1; }
     const uint8_t* state() const { return states_.data() + 1; }
     void resize_state(size_t n) {
@@ -122,7 +110,9 @@ struct Level {
         states_[0] = kNoNeighborState;
     }
     bool is_root_level() const { return !roots.empty(); }
-    LevelLinks links(uint32_t i) const { return is_root_level() ? roots[i] : sibling_links(blocks[i >> 2], i); }
+    LevelLinks links(uint32_t i) const {
+        return is_root_level() ? roots[i] : child_links(nbr.data()[i], edges.data()[i >> 2], i & 3);
+    }
 
 private:
     std::vector<uint8_t> states_;
@@ -141,18 +131,22 @@ struct RootLinks {
     void prefetch(uint32_t i) const { __builtin_prefetch(roots + i); }
 };
 struct BlockLinks {
-    const SiblingBlock* blocks;
-    LevelLinks operator()(uint32_t i) const { return sibling_links(blocks[i >> 2], i); }
-    Neighbors neighbors(uint32_t i) const { return sibling_neighbors(blocks[i >> 2], i); }
-    void prefetch(uint32_t i) const { __builtin_prefetch(blocks + (i >> 2)); }
+    const Neighbors* nbr;
+    const BlockEdges* edges;
+    LevelLinks operator()(uint32_t i) const { return child_links(nbr[i], edges[i >> 2], i & 3); }
+    Neighbors neighbors(uint32_t i) const { return nbr[i]; }
+    void prefetch(uint32_t i) const { __builtin_prefetch(nbr + i); }
 };
 
 // Calls f(links accessor) with the accessor for `level`'s kind.
 template <class F>
 decltype(auto) with_links(const Level& level, F&& f) {
     if (level.is_root_level()) return f(RootLinks{level.roots.data()});
-    return f(BlockLinks{level.blocks.data()});
+    return f(BlockLinks{level.nbr.data(), level.edges.data()});
 }
+
+// The priority a new node starts with (kPriorityShift): bucket 4 if complete, else 0.
+constexpr uint8_t kFreshPriority = 4 << kPriorityShift;
 
 inline int refined_neighbors(uint8_t state) { return (state & kRefinedNeighborMask) >> 2; }
 
@@ -165,11 +159,14 @@ inline uint8_t complete_state(const uint32_t nbr[3], uint8_t boundary) {
 
 // Level 0: the roots of `h` (root ids are local indices).
 inline void root_level(const Hierarchy& h, Level& level) {
-    level.blocks.clear();
+    const uint32_t n = h.root_count();
     level.flipped.clear();
-    level.roots.resize(h.root_count());
-    level.resize_state(h.root_count());
-    for (NodeId r = 0; r < h.root_count(); ++r) {
+    level.refined_count = 0;
+    level.roots.resize(n);
+    level.resize_state(n);
+    uint32_t* incomplete = level.incomplete.reserve(n);
+    uint32_t incomplete_count = 0;
+    for (NodeId r = 0; r < n; ++r) {
         LevelLinks& node = level.roots[r];
         uint8_t boundary = 0, edges = 0;
         for (int e = 0; e < 3; ++e) {
@@ -179,23 +176,28 @@ inline void root_level(const Hierarchy& h, Level& level) {
         }
         node.nbr_edge = edges;
         node.flags = boundary;
-        level.state()[r] = complete_state(node.nbr, boundary);
+        const uint8_t complete = complete_state(node.nbr, boundary);
+        level.state()[r] = complete ? uint8_t(complete | kFreshPriority) : uint8_t(0);
+        incomplete[incomplete_count] = r;
+        incomplete_count += !complete;
     }
+    level.incomplete_count = incomplete_count;
 }
 
 // The state bytes of a new block's four children (byte k: child k), by which of the parent's edges
 // have a refined neighbour (bits 0-2) or are boundary edges (bits 3-5): corner k is complete when
 // its two outer edges (the parent's k and (k+2)%3) each have a neighbour or are boundary; the
-// center always is.
+// center always is. Complete children start in bucket 4 (kFreshPriority).
 struct SiblingStates {
     uint32_t word[64];
     constexpr SiblingStates() : word() {
+        constexpr uint32_t kFresh = kComplete | kFreshPriority;
         for (int code = 0; code < 64; ++code) {
-            uint32_t w = uint32_t(kComplete) << 24;
+            uint32_t w = kFresh << 24;
             for (int k = 0; k < 3; ++k) {
                 const int prev = k == 0 ? 2 : k - 1;
                 const bool ok = (((code >> k) | (code >> (3 + k))) & 1) && (((code >> prev) | (code >> (3 + prev))) & 1);
-                if (ok) w |= uint32_t(kComplete) << (8 * k);
+                if (ok) w |= kFresh << (8 * k);
             }
             word[code] = w;
         }
@@ -203,72 +205,92 @@ struct SiblingStates {
 };
 constexpr SiblingStates kSiblingStates{};
 
-// How the refined nodes of a decided level become the next level's blocks: the refined nodes in
-// canonical order, and each node's block (its rank among them) or kNoLocal. block_of() has one
-// more entry in front, kNoLocal, read for a missing neighbour as block_of()[int32_t(kNoLocal)].
-struct RefinedNumbering {
-    uint32_t count = 0;
+// How the refined nodes of a decided level become the next level's blocks: each node's block (its
+// rank among the refined nodes) or kNoLocal, and the refined nodes in canonical order (the
+// level's `refined`). block_of() has one more entry in front, kNoLocal, read for a missing
+// neighbour as block_of()[int32_t(kNoLocal)].
+class RefinedNumbering {
+public:
     uint32_t* block_of() { return blocks_.data() + 1; }
     const uint32_t* block_of() const { return blocks_.data() + 1; }
-    const uint32_t* refined() const { return refined_.data(); }
-    // Room for n nodes; count restarts at 0.
-    void reset(size_t n) {
+    // Room for the n nodes of `level`; its refined count restarts at 0.
+    void reset(Level& level) {
+        const size_t n = level.size();
         blocks_.reserve(n + 1)[0] = kNoLocal;
-        refined_.reserve(n);
-        count = 0;
+        refined_ = level.refined.reserve(n);
+        count_ = 0;
     }
     // Numbers node i (nodes in canonical order), without a branch on `is_refined`.
     void add(uint32_t i, bool is_refined) {
-        blocks_.data()[size_t(i) + 1] = count | (uint32_t(is_refined) - 1u);  // kNoLocal unless refined
-        refined_.data()[count] = i;
-        count += is_refined;
+        blocks_.data()[size_t(i) + 1] = count_ | (uint32_t(is_refined) - 1u);  // kNoLocal unless refined
+        refined_[count_] = i;
+        count_ += is_refined;
     }
+    // Ends the numbering of `level`.
+    void finish(Level& level) const { level.refined_count = count_; }
 
 private:
-    ScratchArray<uint32_t> blocks_, refined_;
+    ScratchArray<uint32_t> blocks_;
+    uint32_t* refined_ = nullptr;
+    uint32_t count_ = 0;
 };
 
-inline void number_refined(const Level& level, RefinedNumbering& numbering) {
+inline void number_refined(Level& level, RefinedNumbering& numbering) {
     const uint32_t n = static_cast<uint32_t>(level.size());
     const uint8_t* state = level.state();
-    numbering.reset(n);
+    numbering.reset(level);
     for (uint32_t i = 0; i < n; ++i) numbering.add(i, (state[i] & kRefined) != 0);
+    numbering.finish(level);
 }
 
 // Level l+1 from level l (every node decided and numbered): the children of the refined nodes in
-// canonical order, linked exactly as Hierarchy::split links them.
+// canonical order, linked exactly as Hierarchy::split links them. Across p's edge e lies p's
+// neighbour q with its index eq of the edge; when q is refined, the first half of the edge meets
+// q's child (eq+1)%3 and the second half q's child eq. Corner child k lies on p's edges k (first
+// half) and (k+2)%3 (second half) and meets the center across its edge (k+1)%3.
 inline void derive_next_level(const Level& level, const RefinedNumbering& numbering, Level& next) {
-    const uint32_t count = numbering.count;
+    const uint32_t count = level.refined_count;
     const uint32_t* block = numbering.block_of();
-    const uint32_t* refined = numbering.refined();
+    const uint32_t* refined = level.refined.data();
     next.roots.clear();
     next.flipped.clear();
-    resize_scratch(next.blocks, count);
+    next.refined_count = 0;
     next.resize_state(size_t(4) * count);
-    SiblingBlock* out = next.blocks.data();
+    Neighbors* out = next.nbr.reserve(size_t(4) * count);
+    BlockEdges* out_edges = next.edges.reserve(count);
+    uint32_t* incomplete = next.incomplete.reserve(size_t(3) * count);
+    uint32_t incomplete_count = 0;
     uint8_t* out_state = next.state();
     with_links(level, [&](auto links) {
         for (uint32_t b = 0; b < count; ++b) {
             const LevelLinks p = links(refined[b]);
-            SiblingBlock& child = out[b];
+            uint32_t first[3], second[3];
             unsigned edges = 0, linked = 0;
             for (int e = 0; e < 3; ++e) {
                 const uint32_t q = block[static_cast<int32_t>(p.nbr[e])];  // kNoLocal for none
                 const uint32_t none = q == kNoLocal ? kNoLocal : 0u;
                 const unsigned eq = (p.nbr_edge >> (2 * e)) & 3u;
-                child.slot[e] = (4 * q + (eq == 2 ? 0 : eq + 1)) | none;
-                child.slot[3 + e] = (4 * q + eq) | none;
+                first[e] = (4 * q + (eq == 2 ? 0 : eq + 1)) | none;
+                second[e] = (4 * q + eq) | none;
                 edges |= (eq << (2 * e)) & ~none;
                 linked |= (1u << e) & ~none;
             }
-            child.slot[6] = 4 * b;
-            child.nbr_edge = uint8_t(edges);
-            child.boundary = uint8_t(p.flags & 7);
-            child.unused[0] = child.unused[1] = 0;
+            const uint32_t c = 4 * b;
+            Neighbors* child = out + c;
+            child[0] = {{first[0], c + 3, second[2]}};
+            child[1] = {{second[0], first[1], c + 3}};
+            child[2] = {{c + 3, second[1], first[2]}};
+            child[3] = {{c + 2, c, c + 1}};
+            out_edges[b] = {uint8_t(edges), uint8_t(p.flags & 7)};
             const uint32_t word = kSiblingStates.word[linked | ((p.flags & 7u) << 3)];
-            for (int k = 0; k < 4; ++k) out_state[size_t(4) * b + size_t(k)] = uint8_t(word >> (8 * k));
+            for (int k = 0; k < 4; ++k) out_state[c + k] = uint8_t(word >> (8 * k));
+            for (uint32_t k = 0; k < 3; ++k) {
+                incomplete[incomplete_count] = c + k;
+                incomplete_count += !((word >> (8 * k)) & kComplete);
+            }
         }
     });
+    next.incomplete_count = incomplete_count;
 }
 
 // The unrefined edge of a decided leaf with exactly two hanging nodes.
@@ -337,13 +359,15 @@ public:
     template <class Code, class Force>
     void run(Level& level, bool uniform_level, Code&& code, Force&& force) {
         with_links(level, [&](auto links) {
-            run_on(links, level.state(), static_cast<uint32_t>(level.size()), uniform_level, code, force);
+            run_on(links, level.state(), static_cast<uint32_t>(level.size()), level.incomplete.data(),
+                   level.incomplete_count, uniform_level, code, force);
         });
     }
 
 private:
     template <class Links, class Code, class Force>
-    void run_on(Links links, uint8_t* state, uint32_t n, bool uniform_level, Code& code, Force& force) {
+    void run_on(Links links, uint8_t* state, uint32_t n, const uint32_t* level_incomplete,
+                uint32_t level_incomplete_count, bool uniform_level, Code& code, Force& force) {
         // A copy in a local: the state bytes written below could alias options_.
         const CullRules rules{options_.cull_one_regularity, options_.cull_hanging_nodes};
         if (uniform_level) {
@@ -367,20 +391,17 @@ private:
         // once its node is decided or has moved to a lower bucket, and is skipped. Every node
         // enters at most five buckets: linear time.
         // Bucket 4 starts with every unculled node in canonical order and never receives another,
-        // so it is a cursor. Bucket 0 starts with the nodes 1-regularity culls (no node is refined
-        // yet, so no other rule applies), in canonical order, under a stack of nodes culled later.
-        // Those first nodes go first: none of them is refined, so none makes another node culled
-        // meanwhile and the stack stays empty until all are decided. They are listed while the
-        // priorities are set, which spares the main loop a cursor testing every node.
-        const uint8_t initially_culled = rules.one_regularity ? uint8_t(0) : kComplete;
-        uint32_t* const culled_list = culled_.reserve(n);
-        uint32_t culled_count = 0;
-        for (uint32_t i = 0; i < n; ++i) {
-            const uint8_t s = state[i];
-            const bool fresh = ((s | initially_culled) & kComplete) != 0;
-            state[i] = uint8_t(fresh ? s | (4 << kPriorityShift) : s);
-            culled_list[culled_count] = i;
-            culled_count += !fresh;
+        // so it is a cursor. Bucket 0 starts with the nodes 1-regularity culls (the level's
+        // incomplete nodes: no node is refined yet, so no other rule applies), in canonical order,
+        // under a stack of nodes culled later. Those first nodes go first: none of them is
+        // refined, so none makes another node culled meanwhile and the stack stays empty until
+        // all are decided. A new level's states already hold these priorities (bucket 4 for
+        // complete nodes); without the 1-regularity rule every node starts in bucket 4.
+        const uint32_t* culled_list = level_incomplete;
+        uint32_t culled_count = level_incomplete_count;
+        if (!rules.one_regularity) {
+            for (uint32_t i = 0; i < n; ++i) state[i] = uint8_t(state[i] | kFreshPriority);
+            culled_count = 0;
         }
         uint32_t* const bottom[4] = {stacks_[0].reserve(n), stacks_[1].reserve(n), stacks_[2].reserve(n),
                                      stacks_[3].reserve(n)};
@@ -503,7 +524,6 @@ private:
     HierarchyCoderOptions options_;
     uint8_t after_neighbor_decided_[256];  // state -> state, see the constructor
     std::array<ScratchArray<uint32_t>, 4> stacks_;  // buckets 0-3 (each holds at most one entry per node)
-    ScratchArray<uint32_t> culled_;                 // the nodes culled at the outset
 };
 
 }  // namespace amc

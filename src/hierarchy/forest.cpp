@@ -165,12 +165,14 @@ void Hierarchy::split(NodeId n) {
     nodes_[n].first_child = c;
 }
 
-void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_t* first_half_links, size_t stride) {
+void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_t* child_links) {
     if (!free_blocks_.empty() || !free_vertices_.empty()) {
         // Reused ids: take the general path (the decoders never get here).
         for (uint32_t i = 0; i < count; ++i) split(parents[i]);
         return;
     }
+    // The neighbour of child e of parents[i] across the first half of the parent's edge e.
+    auto first_half = [child_links](uint32_t i, int e) { return child_links[size_t(12) * i + size_t(4 * e)]; };
     const size_t c0 = nodes_.size();
     const size_t new_nodes = c0 + size_t(4) * count;
     if (new_nodes > nodes_.capacity()) reserve(std::max(new_nodes, nodes_.capacity() + nodes_.capacity() / 2), 0);
@@ -179,10 +181,7 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
         // earlier parent across it made one.
         size_t new_vertices = 0;
         for (uint32_t i = 0; i < count; ++i) {
-            for (int e = 0; e < 3; ++e) {
-                const uint32_t t = first_half_links[stride * i + size_t(e)];
-                new_vertices += !(t != kNoNode && t / 4 < i);
-            }
+            for (int e = 0; e < 3; ++e) new_vertices += !(first_half(i, e) / 4 < i);
         }
         const size_t vertices = positions_.size() + new_vertices;
         if (vertices > positions_.capacity()) reserve(0, std::max(vertices, positions_.capacity() + positions_.capacity() / 2));
@@ -200,35 +199,25 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
         const Node& parent = nodes[parents[i]];
         for (int e = 0; e < 3; ++e) {
             __builtin_prefetch(positions + parent.v[e]);
-            const uint32_t t = first_half_links[stride * i + size_t(e)];
-            if (t != kNoNode && t / 4 < i) __builtin_prefetch(nodes + c0 + (t & ~3u) + 3);
+            const uint32_t t = first_half(i, e);
+            if (t / 4 < i) __builtin_prefetch(nodes + c0 + (t & ~3u) + 3);
         }
     };
+    const uint32_t offset = uint32_t(c0);
     for (uint32_t i = 0; i < count; ++i) {
         if (i + 2 * kAhead < count) __builtin_prefetch(nodes + parents[i + 2 * kAhead]);
         if (i + kAhead < count) prefetch(i + kAhead);
         const NodeId n = parents[i];
         Node& parent = nodes[n];
         const NodeId c = NodeId(c0 + size_t(4) * i);
-        const uint32_t* across = first_half_links + stride * i;
-        // Across edge e, when the neighbour parents[j] is split too: the first half of the edge
-        // meets its child (eq+1)%3, the second half its child eq (eq: its index of the edge).
-        NodeId first_half[3], second_half[3];
         unsigned linked_edges = 0;
         VertexId m[3];
         for (int e = 0; e < 3; ++e) {
-            const uint32_t j = across[e] == kNoNode ? kNoNode : across[e] / 4;
-            const unsigned eq = (parent.nbr_edge >> (2 * e)) & 3u;
-            if (j != kNoNode) {
-                const NodeId cq = NodeId(c0 + size_t(4) * j);
-                first_half[e] = cq + (eq == 2 ? 0 : eq + 1);
-                second_half[e] = cq + eq;
-                linked_edges |= 3u << (2 * e);
-            } else {
-                first_half[e] = second_half[e] = kNoNode;
-            }
-            if (j != kNoNode && j < i) {
-                m[e] = nodes[c0 + size_t(4) * j + 3].v[(eq + 2) % 3];
+            const uint32_t t = first_half(i, e);  // kNoNode / 4 is never below i
+            linked_edges |= t == kNoNode ? 0u : 3u << (2 * e);
+            if (t / 4 < i) {
+                const unsigned eq = (parent.nbr_edge >> (2 * e)) & 3u;
+                m[e] = nodes[c0 + (t & ~3u) + 3].v[eq == 0 ? 2 : eq - 1];
             } else {
                 // Within the reserved capacity: no reallocation, references stay valid.
                 const Vec3& a = positions_[parent.v[e]];
@@ -242,22 +231,19 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
                                        {m[0], parent.v[1], m[1]},
                                        {m[2], m[1], parent.v[2]},
                                        {m[1], m[2], m[0]}};
-        // Corner child k: its edge k is the first half of the parent's edge k, its edge (k+2)%3
-        // the second half of edge (k+2)%3, its edge (k+1)%3 meets the center. Linked outer edges
-        // take the parent's neighbour edge index (children are parallel to their parents).
-        const NodeId links[4][3] = {{first_half[0], c + 3, second_half[2]},
-                                    {second_half[0], first_half[1], c + 3},
-                                    {c + 3, second_half[1], first_half[2]},
-                                    {c + 2, c, c + 1}};
+        // Linked outer edges take the parent's neighbour edge index (children are parallel to
+        // their parents); the edges between corner k and the center are their edges (k+1)%3.
         const unsigned outer = parent.nbr_edge & linked_edges;
         const uint8_t edges[4] = {uint8_t((outer & 0x33u) | (1u << 2)), uint8_t((outer & 0x0fu) | (2u << 4)),
                                   uint8_t(outer & 0x3cu), uint8_t(0u | (1u << 2) | (2u << 4))};
         const uint8_t level = uint8_t(parent.level + 1);
+        const uint32_t* links = child_links + size_t(12) * i;
         for (int k = 0; k < 4; ++k) {
             Node& child = nodes[c + k];
             for (int e = 0; e < 3; ++e) {
                 child.v[e] = layout[k][e];
-                child.nbr[e] = links[k][e];
+                const uint32_t t = links[3 * k + e];
+                child.nbr[e] = t == kNoNode ? kNoNode : t + offset;
             }
             child.parent = n;
             child.first_child = kNoNode;
