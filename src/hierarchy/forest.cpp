@@ -227,31 +227,41 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
                 m[e] = next_vertex++;
             }
         }
-        const VertexId layout[4][3] = {{parent.v[0], m[0], m[2]},
-                                       {m[0], parent.v[1], m[1]},
-                                       {m[2], m[1], parent.v[2]},
-                                       {m[1], m[2], m[0]}};
-        // Linked outer edges take the parent's neighbour edge index (children are parallel to
-        // their parents); the edges between corner k and the center are their edges (k+1)%3.
-        const unsigned outer = parent.nbr_edge & linked_edges;
-        const uint8_t edges[4] = {uint8_t((outer & 0x33u) | (1u << 2)), uint8_t((outer & 0x0fu) | (2u << 4)),
-                                  uint8_t(outer & 0x3cu), uint8_t(0u | (1u << 2) | (2u << 4))};
-        const uint8_t level = uint8_t(parent.level + 1);
+        // The children's neighbours: across the first and second half of the parent's edge e
+        // (local indices made node ids; kNoNode, all ones, stays), and each other.
+        uint32_t first[3], second[3];
         const uint32_t* links = child_links + size_t(12) * i;
-        for (int k = 0; k < 4; ++k) {
-            Node& child = nodes[c + k];
-            for (int e = 0; e < 3; ++e) {
-                child.v[e] = layout[k][e];
-                const uint32_t t = links[3 * k + e];
-                child.nbr[e] = t == kNoNode ? kNoNode : t + offset;
-            }
+        for (int e = 0; e < 3; ++e) {
+            const uint32_t t = links[4 * e], u = links[3 * (e == 2 ? 0 : e + 1) + e];
+            first[e] = (t + offset) | uint32_t(int32_t(t) >> 31);
+            second[e] = (u + offset) | uint32_t(int32_t(u) >> 31);
+        }
+        // Linked outer edges take the parent's neighbour edge index (children are parallel to
+        // their parents); corner k and the center meet across their edges (k+1)%3. Corner k lies
+        // on the parent's boundary edges k and (k+2)%3, the center on none.
+        const unsigned outer = parent.nbr_edge & linked_edges;
+        const uint8_t level = uint8_t(parent.level + 1);
+        const unsigned boundary = parent.flags;
+        auto make = [&](Node& child, VertexId a, VertexId b, VertexId d, NodeId na, NodeId nb, NodeId nd,
+                        unsigned nbr_edge, unsigned flags, int k) {
+            child.v[0] = a;
+            child.v[1] = b;
+            child.v[2] = d;
             child.parent = n;
             child.first_child = kNoNode;
-            child.nbr_edge = edges[k];
+            child.nbr[0] = na;
+            child.nbr[1] = nb;
+            child.nbr[2] = nd;
+            child.nbr_edge = uint8_t(nbr_edge);
             child.level = level;
+            child.flags = uint8_t(flags);
             child.child_index = uint8_t(k);
-            child.flags = k == 3 ? 0 : uint8_t(parent.flags & ((1u << k) | (1u << (k == 0 ? 2 : k - 1))));
-        }
+        };
+        Node* child = nodes + c;
+        make(child[0], parent.v[0], m[0], m[2], first[0], c + 3, second[2], (outer & 0x33u) | (1u << 2), boundary & 5u, 0);
+        make(child[1], m[0], parent.v[1], m[1], second[0], first[1], c + 3, (outer & 0x0fu) | (2u << 4), boundary & 3u, 1);
+        make(child[2], m[2], m[1], parent.v[2], c + 3, second[1], first[2], outer & 0x3cu, boundary & 6u, 2);
+        make(child[3], m[1], m[2], m[0], c + 2, c, c + 1, (1u << 2) | (2u << 4), 0u, 3);
         parent.first_child = c;
     }
     live_nodes_ += 4 * count;
