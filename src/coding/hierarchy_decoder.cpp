@@ -61,7 +61,7 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
         // one: the level is all leaves (and the last). No traversal needed.
         for (uint32_t i = 0; i < n; ++i) state[i] = uint8_t(state[i] | kDecided);
         level_.refined_count = 0;
-        finish_level(0);
+        finish_level();
         return;
     }
     // The coder's state lives in locals while the level is decided: every state byte the
@@ -79,33 +79,16 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
             return d.decode(models.groups[size_t(group & group_mask)]);
         },
         [&](uint32_t, Fate, bool refined) { return refined; });
-    // In one pass: the next level's numbering of the refined nodes; the number of vertices the
-    // level's splits create (one per edge of a refined node, shared where the neighbour is refined
-    // too); the diagonals of the leaves closed by two hanging nodes; and the checks. Errors name
-    // the element by its level and canonical index: its node id may not exist yet.
+    // The next level's numbering of the refined nodes, the leaves closed by two hanging nodes
+    // (their diagonals come next in the stream) and the checks. Errors name the element by its
+    // level and canonical index: its node id may not exist yet.
     auto corrupt = [&](uint32_t i, const char* what) {
         return Error("hierarchy stream is corrupt: element " + std::to_string(i) + " of level " + std::to_string(l) +
                      what);
     };
-    RefinedNumbering& numbering = numbering_;
-    numbering.reset(level_);
     uint32_t* const closures = closures_.reserve(n);
-    uint32_t closure_count = 0;
-    uint64_t edge_ends = 0;
-    bool invalid_split = false;
-    // Without branches on the decisions, which follow no pattern a predictor learns; the leaves
-    // with two (or, in a corrupt stream, three) hanging nodes are listed and handled after.
-    for (uint32_t i = 0; i < n; ++i) {
-        const uint8_t s = state[i];
-        const unsigned hanging = (s & kRefinedNeighborMask) >> 2;
-        const bool refined = (s & kRefined) != 0;
-        numbering.add(i, refined);
-        edge_ends += (6 - hanging) & (0u - unsigned(refined));
-        invalid_split |= refined & !(s & kComplete);
-        closures[closure_count] = i;
-        closure_count += !refined & (hanging >= 2);
-    }
-    numbering.finish(level_);
+    const DecidedLevelScan scan = scan_decided_level(level_, numbering_, closures);
+    const uint32_t closure_count = scan.closures;
     for (uint32_t k = 0; k < closure_count; ++k) {
         const uint32_t i = closures[k];
         if (refined_neighbors(state[i]) == 3) throw corrupt(i, " has three hanging nodes but was not refined");
@@ -114,7 +97,7 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
         if (flag) level_.flipped.push_back(i);
     }
     const uint32_t count = level_.refined_count;
-    if (count > 0 && (invalid_split || l >= kMaxLevel)) {
+    if (count > 0 && (scan.refined_incomplete || l >= kMaxLevel)) {
         for (uint32_t i = 0; i < n; ++i) {
             if ((state[i] & kRefined) && (!(state[i] & kComplete) || l >= kMaxLevel))
                 throw corrupt(i, " can not be refined");
@@ -126,13 +109,12 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
     decoder = d;
     models_ = models;
     symbols_read_ = symbols_read;
-    finish_level(edge_ends / 2);
+    finish_level();
 }
 
-void HierarchyLevelDecoder::finish_level(uint64_t new_vertices) {
+void HierarchyLevelDecoder::finish_level() {
     node_count_ += uint64_t(4) * level_.refined_count;
-    vertex_count_ += new_vertices;
-    derive_next_level(level_, numbering_, next_);
+    vertex_count_ += derive_next_level(level_, numbering_, next_);
     decided_.push_back(std::move(level_));
     level_ = std::move(next_);
     next_ = Level();

@@ -79,7 +79,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         }
         stats.levels = l + 1;
         level_end_.push_back(events_.size());
-        number_refined(level, numbering);
+        scan_decided_level(level, numbering, nullptr);
         derive_next_level(level, numbering, next);
         std::swap(level, next);
         level_ids_.push_back(ids);

@@ -74,7 +74,7 @@ public:
 private:
     // Counts the decided level's splits (level_.refined, numbered in numbering_) and the vertices
     // they create, and moves to the next level.
-    void finish_level(uint64_t new_vertices);
+    void finish_level();
 
     HierarchyStreamHeader header_;
     uint64_t max_nodes_;

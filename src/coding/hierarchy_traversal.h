@@ -27,9 +27,14 @@
 #include <amc/hierarchy.h>
 #include <amc/hierarchy_coder.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace amc {
 
@@ -206,49 +211,82 @@ struct SiblingStates {
 constexpr SiblingStates kSiblingStates{};
 
 // How the refined nodes of a decided level become the next level's blocks: each node's block (its
-// rank among the refined nodes) or kNoLocal, and the refined nodes in canonical order (the
-// level's `refined`). block_of() has one more entry in front, kNoLocal, read for a missing
-// neighbour as block_of()[int32_t(kNoLocal)].
+// rank among the refined nodes) or kNoLocal. block_of() has one more entry in front, kNoLocal,
+// read for a missing neighbour as block_of()[int32_t(kNoLocal)].
 class RefinedNumbering {
 public:
-    uint32_t* block_of() { return blocks_.data() + 1; }
     const uint32_t* block_of() const { return blocks_.data() + 1; }
-    // Room for the n nodes of `level`; its refined count restarts at 0.
-    void reset(Level& level) {
-        const size_t n = level.size();
-        blocks_.reserve(n + 1)[0] = kNoLocal;
-        refined_ = level.refined.reserve(n);
-        count_ = 0;
+    // Room for n nodes, all kNoLocal.
+    uint32_t* reset(size_t n) {
+        uint32_t* blocks = blocks_.reserve(n + 1);
+        std::fill(blocks, blocks + n + 1, kNoLocal);
+        return blocks + 1;
     }
-    // Numbers node i (nodes in canonical order), without a branch on `is_refined`.
-    void add(uint32_t i, bool is_refined) {
-        blocks_.data()[size_t(i) + 1] = count_ | (uint32_t(is_refined) - 1u);  // kNoLocal unless refined
-        refined_[count_] = i;
-        count_ += is_refined;
-    }
-    // Ends the numbering of `level`.
-    void finish(Level& level) const { level.refined_count = count_; }
 
 private:
     ScratchArray<uint32_t> blocks_;
-    uint32_t* refined_ = nullptr;
-    uint32_t count_ = 0;
 };
 
-inline void number_refined(Level& level, RefinedNumbering& numbering) {
+// What a scan of a decided level finds besides the numbering.
+struct DecidedLevelScan {
+    uint32_t closures = 0;          // leaves with two or three hanging nodes listed
+    bool refined_incomplete = false;  // a refined node lacks a neighbour: it can not be split
+};
+
+// Numbers the refined nodes of a decided level: level.refined (canonical order) and the
+// numbering. When `closures` is given, lists there the leaves with two or three hanging nodes.
+// The decisions follow no pattern a branch predictor learns, so the state bytes are read 16 at a
+// time as bit masks and only the set bits are visited.
+inline DecidedLevelScan scan_decided_level(Level& level, RefinedNumbering& numbering, uint32_t* closures) {
     const uint32_t n = static_cast<uint32_t>(level.size());
     const uint8_t* state = level.state();
-    numbering.reset(level);
-    for (uint32_t i = 0; i < n; ++i) numbering.add(i, (state[i] & kRefined) != 0);
-    numbering.finish(level);
+    uint32_t* block = numbering.reset(n);
+    uint32_t* refined = level.refined.reserve(n);
+    uint32_t count = 0;
+    DecidedLevelScan scan;
+    uint32_t bad = 0;
+    // Masks of 16 nodes from i: refined (bit 1 of the state), complete (bit 4), two or more
+    // refined neighbours (bit 3).
+    auto visit = [&](uint32_t i, uint32_t is_refined, uint32_t complete, uint32_t two_hanging) {
+        bad |= is_refined & ~complete;
+        for (uint32_t r = is_refined; r != 0; r &= r - 1) {
+            const uint32_t j = i + uint32_t(__builtin_ctz(r));
+            block[j] = count;
+            refined[count++] = j;
+        }
+        if (closures == nullptr) return;
+        for (uint32_t c = two_hanging & ~is_refined; c != 0; c &= c - 1) closures[scan.closures++] = i + uint32_t(__builtin_ctz(c));
+    };
+    uint32_t i = 0;
+#if defined(__SSE2__)
+    for (; i + 16 <= n; i += 16) {
+        const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(state + i));
+        // Shifting 16-bit lanes moves bit b of each byte to bit 7 of the same byte.
+        visit(i, uint32_t(_mm_movemask_epi8(_mm_slli_epi16(v, 6))), uint32_t(_mm_movemask_epi8(_mm_slli_epi16(v, 3))),
+              uint32_t(_mm_movemask_epi8(_mm_slli_epi16(v, 4))));
+    }
+#endif
+    for (; i < n; i += 16) {
+        uint32_t r = 0, c = 0, h = 0;
+        for (uint32_t k = 0; k < 16 && i + k < n; ++k) {
+            r |= uint32_t((state[i + k] >> 1) & 1) << k;
+            c |= uint32_t((state[i + k] >> 4) & 1) << k;
+            h |= uint32_t((state[i + k] >> 3) & 1) << k;
+        }
+        visit(i, r, c, h);
+    }
+    level.refined_count = count;
+    scan.refined_incomplete = bad != 0;
+    return scan;
 }
 
 // Level l+1 from level l (every node decided and numbered): the children of the refined nodes in
-// canonical order, linked exactly as Hierarchy::split links them. Across p's edge e lies p's
+// canonical order, linked exactly as Hierarchy::split links them. Returns the number of vertices
+// the splits create: one per edge of a refined node, shared where the neighbour is refined too. Across p's edge e lies p's
 // neighbour q with its index eq of the edge; when q is refined, the first half of the edge meets
 // q's child (eq+1)%3 and the second half q's child eq. Corner child k lies on p's edges k (first
 // half) and (k+2)%3 (second half) and meets the center across its edge (k+1)%3.
-inline void derive_next_level(const Level& level, const RefinedNumbering& numbering, Level& next) {
+inline uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering, Level& next) {
     const uint32_t count = level.refined_count;
     const uint32_t* block = numbering.block_of();
     const uint32_t* refined = level.refined.data();
@@ -261,6 +299,7 @@ inline void derive_next_level(const Level& level, const RefinedNumbering& number
     uint32_t* incomplete = next.incomplete.reserve(size_t(3) * count);
     uint32_t incomplete_count = 0;
     uint8_t* out_state = next.state();
+    uint64_t edge_ends = 0;  // each new vertex has two: one from each refined node on its edge, or both from one
     with_links(level, [&](auto links) {
         for (uint32_t b = 0; b < count; ++b) {
             const LevelLinks p = links(refined[b]);
@@ -282,6 +321,7 @@ inline void derive_next_level(const Level& level, const RefinedNumbering& number
             child[2] = {{c + 3, second[1], first[2]}};
             child[3] = {{c + 2, c, c + 1}};
             out_edges[b] = {uint8_t(edges), uint8_t(p.flags & 7)};
+            edge_ends += 6 - ((linked & 1) + ((linked >> 1) & 1) + (linked >> 2));
             const uint32_t word = kSiblingStates.word[linked | ((p.flags & 7u) << 3)];
             for (int k = 0; k < 4; ++k) out_state[c + k] = uint8_t(word >> (8 * k));
             for (uint32_t k = 0; k < 3; ++k) {
@@ -291,6 +331,7 @@ inline void derive_next_level(const Level& level, const RefinedNumbering& number
         }
     });
     next.incomplete_count = incomplete_count;
+    return edge_ends / 2;
 }
 
 // The unrefined edge of a decided leaf with exactly two hanging nodes.
