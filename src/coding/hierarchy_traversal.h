@@ -30,6 +30,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #if defined(__SSE2__)
@@ -210,6 +211,22 @@ struct SiblingStates {
 };
 constexpr SiblingStates kSiblingStates{};
 
+// By which of a refined node's edges have a refined neighbour (bits 0-2): the mask of their two-bit
+// neighbour edge indices, and the ends its new vertices count (2 on an edge of its own, 1 shared).
+struct EdgePairs {
+    uint8_t mask[8];
+    uint8_t ends[8];
+    constexpr EdgePairs() : mask(), ends() {
+        for (int linked = 0; linked < 8; ++linked) {
+            for (int e = 0; e < 3; ++e) {
+                if ((linked >> e) & 1) mask[linked] = uint8_t(mask[linked] | (3 << (2 * e)));
+                ends[linked] = uint8_t(ends[linked] + ((linked >> e) & 1 ? 1 : 2));
+            }
+        }
+    }
+};
+constexpr EdgePairs kEdgePairs{};
+
 // How the refined nodes of a decided level become the next level's blocks: each node's block (its
 // rank among the refined nodes) or kNoLocal. block_of() has one more entry in front, kNoLocal,
 // read for a missing neighbour as block_of()[int32_t(kNoLocal)].
@@ -304,14 +321,13 @@ inline uint64_t derive_next_level(const Level& level, const RefinedNumbering& nu
         for (uint32_t b = 0; b < count; ++b) {
             const LevelLinks p = links(refined[b]);
             uint32_t first[3], second[3];
-            unsigned edges = 0, linked = 0;
+            unsigned linked = 0;
             for (int e = 0; e < 3; ++e) {
                 const uint32_t q = block[static_cast<int32_t>(p.nbr[e])];  // kNoLocal for none
-                const uint32_t none = q == kNoLocal ? kNoLocal : 0u;
+                const uint32_t none = uint32_t(static_cast<int32_t>(q) >> 31);  // blocks are below 2^30
                 const unsigned eq = (p.nbr_edge >> (2 * e)) & 3u;
-                first[e] = (4 * q + (eq == 2 ? 0 : eq + 1)) | none;
+                first[e] = (4 * q + ((0x9u >> (2 * eq)) & 3u)) | none;  // (eq + 1) % 3
                 second[e] = (4 * q + eq) | none;
-                edges |= (eq << (2 * e)) & ~none;
                 linked |= (1u << e) & ~none;
             }
             const uint32_t c = 4 * b;
@@ -320,10 +336,14 @@ inline uint64_t derive_next_level(const Level& level, const RefinedNumbering& nu
             child[1] = {{second[0], first[1], c + 3}};
             child[2] = {{c + 3, second[1], first[2]}};
             child[3] = {{c + 2, c, c + 1}};
-            out_edges[b] = {uint8_t(edges), uint8_t(p.flags & 7)};
-            edge_ends += 6 - ((linked & 1) + ((linked >> 1) & 1) + (linked >> 2));
+            out_edges[b] = {uint8_t(p.nbr_edge & kEdgePairs.mask[linked]), uint8_t(p.flags & 7)};
+            edge_ends += kEdgePairs.ends[linked];
             const uint32_t word = kSiblingStates.word[linked | ((p.flags & 7u) << 3)];
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+            std::memcpy(out_state + c, &word, 4);  // byte k: child k
+#else
             for (int k = 0; k < 4; ++k) out_state[c + k] = uint8_t(word >> (8 * k));
+#endif
             for (uint32_t k = 0; k < 3; ++k) {
                 incomplete[incomplete_count] = c + k;
                 incomplete_count += !((word >> (8 * k)) & kComplete);
