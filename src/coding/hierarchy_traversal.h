@@ -196,7 +196,8 @@ inline void root_level(const Hierarchy& h, Level& level) {
 // center always is. Complete children start in bucket 4 (kFreshPriority).
 struct SiblingStates {
     uint32_t word[64];
-    constexpr SiblingStates() : word() {
+    uint8_t incomplete[64];  // bit k: corner k is not complete
+    constexpr SiblingStates() : word(), incomplete() {
         constexpr uint32_t kFresh = kComplete | kFreshPriority;
         for (int code = 0; code < 64; ++code) {
             uint32_t w = kFresh << 24;
@@ -204,12 +205,25 @@ struct SiblingStates {
                 const int prev = k == 0 ? 2 : k - 1;
                 const bool ok = (((code >> k) | (code >> (3 + k))) & 1) && (((code >> prev) | (code >> (3 + prev))) & 1);
                 if (ok) w |= kFresh << (8 * k);
+                else incomplete[code] = uint8_t(incomplete[code] | (1 << k));
             }
             word[code] = w;
         }
     }
 };
 constexpr SiblingStates kSiblingStates{};
+
+// By a node's neighbour edge indices (2 bits per edge): byte e holds (eq + 1) % 3 for edge e's eq,
+// the neighbour's child on the first half of the edge.
+struct NextEdges {
+    uint32_t byte[64];
+    constexpr NextEdges() : byte() {
+        for (int code = 0; code < 64; ++code) {
+            for (int e = 0; e < 3; ++e) byte[code] |= uint32_t((((code >> (2 * e)) & 3) + 1) % 3) << (8 * e);
+        }
+    }
+};
+constexpr NextEdges kNextEdges{};
 
 // By which of a refined node's edges have a refined neighbour (bits 0-2): the mask of their two-bit
 // neighbour edge indices, and the ends its new vertices count (2 on an edge of its own, 1 shared).
@@ -322,12 +336,12 @@ inline uint64_t derive_next_level(const Level& level, const RefinedNumbering& nu
             const LevelLinks p = links(refined[b]);
             uint32_t first[3], second[3];
             unsigned linked = 0;
+            const uint32_t next_edges = kNextEdges.byte[p.nbr_edge & 63u];
             for (int e = 0; e < 3; ++e) {
                 const uint32_t q = block[static_cast<int32_t>(p.nbr[e])];  // kNoLocal for none
                 const uint32_t none = uint32_t(static_cast<int32_t>(q) >> 31);  // blocks are below 2^30
-                const unsigned eq = (p.nbr_edge >> (2 * e)) & 3u;
-                first[e] = (4 * q + ((0x9u >> (2 * eq)) & 3u)) | none;  // (eq + 1) % 3
-                second[e] = (4 * q + eq) | none;
+                first[e] = (4 * q + ((next_edges >> (8 * e)) & 3u)) | none;
+                second[e] = (4 * q + ((p.nbr_edge >> (2 * e)) & 3u)) | none;
                 linked |= (1u << e) & ~none;
             }
             const uint32_t c = 4 * b;
@@ -344,10 +358,13 @@ inline uint64_t derive_next_level(const Level& level, const RefinedNumbering& nu
 #else
             for (int k = 0; k < 4; ++k) out_state[c + k] = uint8_t(word >> (8 * k));
 #endif
-            for (uint32_t k = 0; k < 3; ++k) {
-                incomplete[incomplete_count] = c + k;
-                incomplete_count += !((word >> (8 * k)) & kComplete);
-            }
+            const unsigned corners = kSiblingStates.incomplete[linked | ((p.flags & 7u) << 3)];
+            incomplete[incomplete_count] = c;
+            incomplete_count += corners & 1u;
+            incomplete[incomplete_count] = c + 1;
+            incomplete_count += (corners >> 1) & 1u;
+            incomplete[incomplete_count] = c + 2;
+            incomplete_count += corners >> 2;
         }
     });
     next.incomplete_count = incomplete_count;
