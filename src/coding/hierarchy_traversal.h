@@ -16,9 +16,9 @@
 // neighbour; kept apart, the states of even the finest level stay in the processor's L2 cache.
 // The roots' links are stored node by node (LevelLinks). Every finer level comes in blocks of
 // four siblings (nodes 4b..4b+3 are the children of the level above's b-th refined node, in
-// child order), and four siblings' links follow from their parent's neighbours alone, so one
-// 32-byte SiblingBlock holds the links of four nodes: half the memory of 16 bytes a node, written
-// once per parent.
+// child order): each node keeps its three neighbours, which the traversal reads for every node
+// it decides, and each block the two bytes of links its children take from their parent
+// (BlockEdges). The decoder hands the neighbours on to Hierarchy::split_level as they are.
 #pragma once
 
 #include "coding/context_groups.h"
