@@ -23,6 +23,7 @@
 
 #include "coding/context_groups.h"
 #include "common/huge_pages.h"
+#include "hierarchy/child_links.h"
 
 #include <amc/hierarchy.h>
 #include <amc/hierarchy_coder.h>
@@ -63,17 +64,12 @@ struct BlockEdges {
     uint8_t boundary;  // bits 0-2
 };
 
-// The links of child k (0..3) of a block, by its parent's BlockEdges. Outer edges keep p's
-// neighbour edge index (children are parallel to their parent); the inner edges pair with the
-// same index.
+// The links of child k (0..3) of a block, by its parent's BlockEdges (kChildEdges).
 inline LevelLinks child_links(const Neighbors& nbr, BlockEdges parent, unsigned k) {
-    constexpr uint8_t kOuter[4] = {0x33, 0x0f, 0x3c, 0x00};
-    constexpr uint8_t kInner[4] = {1u << 2, 2u << 4, 0u, 0u | (1u << 2) | (2u << 4)};
-    constexpr uint8_t kBoundary[4] = {5, 3, 6, 0};
     LevelLinks out;
     for (int e = 0; e < 3; ++e) out.nbr[e] = nbr.nbr[e];
-    out.nbr_edge = uint8_t((parent.nbr_edge & kOuter[k]) | kInner[k]);
-    out.flags = uint8_t(parent.boundary & kBoundary[k]);
+    out.nbr_edge = uint8_t((parent.nbr_edge & kChildEdges[k].outer) | kChildEdges[k].inner);
+    out.flags = uint8_t(parent.boundary & kChildEdges[k].boundary);
     return out;
 }
 
@@ -151,7 +147,7 @@ decltype(auto) with_links(const Level& level, F&& f) {
     return f(BlockLinks{level.nbr.data(), level.edges.data()});
 }
 
-// The priority a new node starts with (kPriorityShift): bucket 4 if complete, else 0.
+// The priority bits of bucket 4, where a complete node starts (an incomplete one starts in 0).
 constexpr uint8_t kFreshPriority = 4 << kPriorityShift;
 
 inline int refined_neighbors(uint8_t state) { return (state & kRefinedNeighborMask) >> 2; }
@@ -313,10 +309,9 @@ inline DecidedLevelScan scan_decided_level(Level& level, RefinedNumbering& numbe
 
 // Level l+1 from level l (every node decided and numbered): the children of the refined nodes in
 // canonical order, linked exactly as Hierarchy::split links them. Returns the number of vertices
-// the splits create: one per edge of a refined node, shared where the neighbour is refined too. Across p's edge e lies p's
-// neighbour q with its index eq of the edge; when q is refined, the first half of the edge meets
-// q's child (eq+1)%3 and the second half q's child eq. Corner child k lies on p's edges k (first
-// half) and (k+2)%3 (second half) and meets the center across its edge (k+1)%3.
+// the splits create: one per edge of a refined node, shared where the neighbour is refined too.
+// Across p's edge e lies p's neighbour q with its index eq of the edge; when q is refined, the
+// first half of the edge meets q's child (eq+1)%3 and the second half q's child eq.
 inline uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering, Level& next) {
     const uint32_t count = level.refined_count;
     const uint32_t* block = numbering.block_of();
@@ -345,11 +340,9 @@ inline uint64_t derive_next_level(const Level& level, const RefinedNumbering& nu
                 linked |= (1u << e) & ~none;
             }
             const uint32_t c = 4 * b;
-            Neighbors* child = out + c;
-            child[0] = {{first[0], c + 3, second[2]}};
-            child[1] = {{second[0], first[1], c + 3}};
-            child[2] = {{c + 3, second[1], first[2]}};
-            child[3] = {{c + 2, c, c + 1}};
+            const ChildNeighbors children = child_neighbors(c, first, second);
+            static_assert(sizeof(children.nbr) == 4 * sizeof(Neighbors), "four children's neighbours");
+            std::memcpy(out + c, children.nbr, sizeof(children.nbr));
             out_edges[b] = {uint8_t(p.nbr_edge & kEdgePairs.mask[linked]), uint8_t(p.flags & 7)};
             edge_ends += kEdgePairs.ends[linked];
             const uint32_t word = kSiblingStates.word[linked | ((p.flags & 7u) << 3)];

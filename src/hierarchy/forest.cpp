@@ -3,6 +3,7 @@
 #include <amc/hierarchy.h>
 
 #include "common/huge_pages.h"
+#include "hierarchy/child_links.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -151,8 +152,7 @@ void Hierarchy::split(NodeId n) {
         child.nbr_edge = 0;
         child.level = uint8_t(parent.level + 1);
         child.child_index = uint8_t(k);
-        // Corner child k lies on the parent's edges k and (k+2)%3; the center on none.
-        child.flags = k == 3 ? 0 : uint8_t(parent.flags & ((1u << k) | (1u << ((k + 2) % 3))));
+        child.flags = uint8_t(parent.flags & kChildEdges[k].boundary);
     }
     for (int k = 0; k < 3; ++k) link(c + k, (k + 1) % 3, c + 3, (k + 1) % 3);
     for (int e = 0; e < 3; ++e) {
@@ -227,18 +227,16 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
                 m[e] = next_vertex++;
             }
         }
-        // The children's neighbours: across the first and second half of the parent's edge e
-        // (local indices made node ids; kNoNode, all ones, stays), and each other.
+        // The neighbours across the first and second half of the parent's edge e (local indices
+        // made node ids; kNoNode, all ones, stays).
         uint32_t first[3], second[3];
-        const uint32_t* links = child_links + size_t(12) * i;
         for (int e = 0; e < 3; ++e) {
-            const uint32_t t = links[4 * e], u = links[3 * (e == 2 ? 0 : e + 1) + e];
+            const uint32_t t = first_half(i, e), u = child_links[size_t(12) * i + size_t(3 * (e == 2 ? 0 : e + 1) + e)];
             first[e] = (t + offset) | uint32_t(int32_t(t) >> 31);
             second[e] = (u + offset) | uint32_t(int32_t(u) >> 31);
         }
-        // Linked outer edges take the parent's neighbour edge index (children are parallel to
-        // their parents); corner k and the center meet across their edges (k+1)%3. Corner k lies
-        // on the parent's boundary edges k and (k+2)%3, the center on none.
+        // The children's edges (kChildEdges): linked outer edges take the parent's neighbour edge
+        // index.
         const unsigned outer = parent.nbr_edge & linked_edges;
         const uint8_t level = uint8_t(parent.level + 1);
         const unsigned boundary = parent.flags;
@@ -257,11 +255,17 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
             child.flags = uint8_t(flags);
             child.child_index = uint8_t(k);
         };
+        const ChildNeighbors links = child_neighbors(c, first, second);
         Node* child = nodes + c;
-        make(child[0], parent.v[0], m[0], m[2], first[0], c + 3, second[2], (outer & 0x33u) | (1u << 2), boundary & 5u, 0);
-        make(child[1], m[0], parent.v[1], m[1], second[0], first[1], c + 3, (outer & 0x0fu) | (2u << 4), boundary & 3u, 1);
-        make(child[2], m[2], m[1], parent.v[2], c + 3, second[1], first[2], outer & 0x3cu, boundary & 6u, 2);
-        make(child[3], m[1], m[2], m[0], c + 2, c, c + 1, (1u << 2) | (2u << 4), 0u, 3);
+        // Child by child with literal k: a loop, or a helper taking k, compiled to worse code.
+        make(child[0], parent.v[0], m[0], m[2], links.nbr[0][0], links.nbr[0][1], links.nbr[0][2],
+             (outer & kChildEdges[0].outer) | kChildEdges[0].inner, boundary & kChildEdges[0].boundary, 0);
+        make(child[1], m[0], parent.v[1], m[1], links.nbr[1][0], links.nbr[1][1], links.nbr[1][2],
+             (outer & kChildEdges[1].outer) | kChildEdges[1].inner, boundary & kChildEdges[1].boundary, 1);
+        make(child[2], m[2], m[1], parent.v[2], links.nbr[2][0], links.nbr[2][1], links.nbr[2][2],
+             (outer & kChildEdges[2].outer) | kChildEdges[2].inner, boundary & kChildEdges[2].boundary, 2);
+        make(child[3], m[1], m[2], m[0], links.nbr[3][0], links.nbr[3][1], links.nbr[3][2],
+             (outer & kChildEdges[3].outer) | kChildEdges[3].inner, boundary & kChildEdges[3].boundary, 3);
         parent.first_child = c;
     }
     live_nodes_ += 4 * count;
