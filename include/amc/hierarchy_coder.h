@@ -48,9 +48,15 @@ enum class DiagonalRule : uint8_t {
 constexpr int kDiagonalRuleCount = 4;
 // The Hierarchy flag (flip relative to the default) that `rule` implies for unrefined edge u.
 bool diagonal_flag_by_rule(DiagonalRule rule, int unrefined_edge);
-// Over the leaves of `h` closed by two hanging nodes: how many differ from the rule that fits best
-// (the encoder's choice, without coding anything). `two_hanging` receives the number of such leaves.
-uint64_t fewest_diagonal_exceptions(const Hierarchy& h, uint64_t& two_hanging);
+// Over leaves closed by two hanging nodes: how many flags each rule gets wrong. The encoder codes
+// the flags relative to best().
+struct DiagonalExceptions {
+    uint64_t by_rule[kDiagonalRuleCount] = {};
+    uint64_t leaves = 0;
+    void add(int unrefined_edge, bool flipped);
+    DiagonalRule best() const;  // the first rule with the fewest exceptions
+    uint64_t fewest() const { return by_rule[size_t(best())]; }
+};
 
 // Context group of a symbol: counts of edge neighbours that are refined, not refined, unknown
 // (not yet coded). Boundary edges count as not refined. (3,0,0) never carries a symbol when

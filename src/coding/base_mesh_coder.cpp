@@ -3,6 +3,7 @@
 #include "coding/base_mesh_coder.h"
 
 #include "coding/arithmetic_coder.h"
+#include "common/bits.h"
 
 #include <algorithm>
 #include <numeric>
@@ -24,15 +25,6 @@ constexpr bool kUseV = false;
 
 // Internal inconsistency of the encoder: caught, and the mesh is coded explicitly.
 struct EncoderGaveUp {};
-
-int bit_length(uint64_t x) {
-    int n = 0;
-    while (x != 0) {
-        ++n;
-        x >>= 1;
-    }
-    return n;
-}
 
 void put_count(ArithmeticEncoder& enc, uint32_t x) {
     if (x > kMaxCount) throw EncoderGaveUp{};

@@ -1,6 +1,7 @@
 // Diagonal rules of two-hanging-node closures (paper, section II-B: the orientation bit) and the
 // context-group naming shared by the coder and its statistics.
 #include "coding/context_groups.h"
+#include "coding/hierarchy_level_coder.h"
 
 namespace amc {
 
@@ -16,19 +17,24 @@ bool diagonal_flag_by_rule(DiagonalRule rule, int unrefined_edge) {
     return refined_edge != next;
 }
 
-uint64_t fewest_diagonal_exceptions(const Hierarchy& h, uint64_t& two_hanging) {
-    uint64_t exceptions[kDiagonalRuleCount] = {};
-    two_hanging = 0;
-    for (NodeId n : h.leaves()) {
-        if (h.hanging_node_count(n) != 2) continue;
-        ++two_hanging;
-        const int u = !h.has_hanging_node(n, 0) ? 0 : !h.has_hanging_node(n, 1) ? 1 : 2;
-        for (int r = 0; r < kDiagonalRuleCount; ++r)
-            exceptions[r] += diagonal_flag_by_rule(DiagonalRule(r), u) != h.diagonal_flipped(n);
+void DiagonalExceptions::add(int unrefined_edge, bool flipped) {
+    ++leaves;
+    for (int r = 0; r < kDiagonalRuleCount; ++r) by_rule[r] += diagonal_flag_by_rule(DiagonalRule(r), unrefined_edge) != flipped;
+}
+
+DiagonalRule DiagonalExceptions::best() const {
+    int best = 0;
+    for (int r = 1; r < kDiagonalRuleCount; ++r) best = by_rule[r] < by_rule[best] ? r : best;
+    return DiagonalRule(best);
+}
+
+DiagonalExceptions diagonal_exceptions(const Hierarchy& h) {
+    DiagonalExceptions tally;
+    for (NodeId n = 0; n < h.node_capacity(); ++n) {
+        if (!h.is_alive(n) || !h.is_leaf(n) || h.hanging_node_count(n) != 2) continue;
+        tally.add(!h.has_hanging_node(n, 0) ? 0 : !h.has_hanging_node(n, 1) ? 1 : 2, h.diagonal_flipped(n));
     }
-    uint64_t fewest = exceptions[0];
-    for (uint64_t e : exceptions) fewest = e < fewest ? e : fewest;
-    return fewest;
+    return tally;
 }
 
 int context_group_index(int refined, int unrefined, int unknown) {

@@ -2,6 +2,8 @@
 // float_coder.h for the bitstream.
 #include "coding/float_coder.h"
 
+#include "common/bits.h"
+
 #include <cfloat>
 #include <cmath>
 #include <cstring>
@@ -22,8 +24,6 @@ uint64_t width_mask(Precision precision) {
 // Levels of the bit-length tree: enough for k = 0 .. width.
 int tree_depth(Precision precision) { return precision == Precision::float32 ? 6 : 7; }
 constexpr int kQuantizedTreeDepth = 5;  // k = 0 .. 30 < 32
-
-int bit_length(uint64_t m) { return m == 0 ? 0 : 64 - __builtin_clzll(m); }
 
 double finite_or_zero(double x) { return std::isfinite(x) ? x : 0.0; }
 

@@ -89,17 +89,11 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
     stats.faces = faces;
 
     // The diagonal rule that leaves the fewest exceptions; orientation bits only if any.
-    uint64_t best_exceptions = UINT64_MAX;
-    for (int r = 0; r < kDiagonalRuleCount; ++r) {
-        uint64_t exceptions = 0;
-        for (auto [edge, flag] : two_hanging) exceptions += diagonal_flag_by_rule(DiagonalRule(r), edge) != flag;
-        if (exceptions < best_exceptions) {
-            best_exceptions = exceptions;
-            stats.diagonal_rule = DiagonalRule(r);
-        }
-    }
-    stats.two_hanging_leaves = two_hanging.size();
-    stats.diagonal_exceptions = two_hanging.empty() ? 0 : best_exceptions;
+    DiagonalExceptions tally;
+    for (auto [edge, flag] : two_hanging) tally.add(edge, flag);
+    stats.diagonal_rule = tally.best();
+    stats.two_hanging_leaves = tally.leaves;
+    stats.diagonal_exceptions = tally.fewest();
     stats.orientation_coded = stats.diagonal_exceptions > 0;
     for (size_t i = 0; i < two_hanging.size(); ++i) {
         const auto [edge, flag] = two_hanging[i];

@@ -13,6 +13,10 @@
 
 namespace amc {
 
+// The diagonal flags of h's leaves closed by two hanging nodes against every rule (what the
+// encoder would choose, without coding anything).
+DiagonalExceptions diagonal_exceptions(const Hierarchy& h);
+
 class HierarchyLevelEncoder {
 public:
     // Decides every node (first pass): fixes the uniform levels, the diagonal rule and the number

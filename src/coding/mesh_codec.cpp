@@ -143,14 +143,14 @@ std::vector<Vec3> all_positions(const Hierarchy& h) {
 Hierarchy in_base_code_order(const Hierarchy& input, const BaseMeshCode& base_code, bool& keep_rotations) {
     keep_rotations = false;
     Hierarchy h = reorder_base(input, base_code.vertex_order, base_code.triangle_order, base_code.triangle_rotation);
-    uint64_t two_hanging = 0;
-    const uint64_t rotated_exceptions = fewest_diagonal_exceptions(h, two_hanging);
-    if (rotated_exceptions == 0) return h;
+    const DiagonalExceptions rotated = diagonal_exceptions(h);
+    if (rotated.fewest() == 0) return h;
     Hierarchy kept = reorder_base(input, base_code.vertex_order, base_code.triangle_order,
                                   std::vector<uint8_t>(base_code.triangle_order.size(), 0));
-    const uint64_t kept_exceptions = fewest_diagonal_exceptions(kept, two_hanging);
-    const double rotated_bits = binary_entropy_bits(rotated_exceptions, two_hanging);
-    const double kept_bits = binary_entropy_bits(kept_exceptions, two_hanging) + 1.585 * double(base_code.triangle_order.size());
+    const DiagonalExceptions unrotated = diagonal_exceptions(kept);
+    const double rotated_bits = binary_entropy_bits(rotated.fewest(), rotated.leaves);
+    const double kept_bits =
+        binary_entropy_bits(unrotated.fewest(), unrotated.leaves) + 1.585 * double(base_code.triangle_order.size());
     if (kept_bits >= rotated_bits) return h;
     keep_rotations = true;
     return kept;
