@@ -38,15 +38,17 @@ void reserve_huge(std::vector<T>& v, size_t capacity) {
     v.swap(fresh);
 }
 
-// v.resize(n), reallocating (without copying the old contents) at least geometrically when it
-// must, so a sequence of growing levels faults in each page once.
+// The capacity scratch storage grows to for n elements: at least double, so a sequence of
+// growing levels reallocates a logarithmic number of times.
+inline size_t grown_capacity(size_t n, size_t capacity) { return n > 2 * capacity ? n : 2 * capacity; }
+
+// v.resize(n), reallocating (without copying the old contents) when it must, so a sequence of
+// growing levels faults in each page once.
 template <class T>
 void resize_scratch(std::vector<T>& v, size_t n) {
     if (n > v.capacity()) {
-        std::vector<T> fresh;
-        fresh.reserve(n > 2 * v.capacity() ? n : 2 * v.capacity());
-        advise_huge_pages(fresh.data(), fresh.capacity() * sizeof(T));
-        v.swap(fresh);
+        v.clear();
+        reserve_huge(v, grown_capacity(n, v.capacity()));
     }
     v.resize(n);
 }
@@ -59,7 +61,7 @@ public:
     // Room for at least n elements, contents unspecified.
     T* reserve(size_t n) {
         if (n > capacity_) {
-            const size_t capacity = n > 2 * capacity_ ? n : 2 * capacity_;
+            const size_t capacity = grown_capacity(n, capacity_);
             data_.reset(new T[capacity]);  // default-initialized: no writes
             capacity_ = capacity;
             advise_huge_pages(data_.get(), capacity * sizeof(T));
