@@ -4,7 +4,7 @@ set -euo pipefail
 packages=(g++ cmake make pkg-config libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
           libtinyobjloader-dev libmeshoptimizer-dev libxxhash-dev)
 if [[ "${1:-}" == "--bench" ]]; then
-  packages+=(libdraco-dev libzstd-dev liblzma-dev xz-utils python3)
+  packages+=(libdraco-dev libzstd-dev liblzma-dev python3)
 fi
 missing=()
 for p in "${packages[@]}"; do
