@@ -121,6 +121,26 @@ TEST(Forest, CoarsenUndoesRefine) {
     }
 }
 
+// A reset hierarchy is the fresh one over the new base, and refines as it does: no node, vertex,
+// free id or vertex placer of its past shows.
+TEST(Forest, ResetGivesTheFreshHierarchy) {
+    const auto meshes = fixture_meshes();
+    Hierarchy h(meshes[0].mesh);
+    for (const auto& [name, mesh] : meshes) {
+        refine_randomly(h, h.root_count() + 200, 4, 3);
+        h.coarsen(h.parent(h.leaves().back()));  // leaves free ids behind
+        h.set_vertex_placer([](void*, Vec3 a, Vec3) { return a; }, nullptr);
+        h.reset(mesh);
+        Hierarchy fresh(mesh);
+        EXPECT_TRUE(identical(h, fresh)) << name;
+        EXPECT_EQ(h.node_capacity(), fresh.node_capacity()) << name;
+        refine_randomly(h, h.root_count() + 100, 3, 9);
+        refine_randomly(fresh, fresh.root_count() + 100, 3, 9);
+        EXPECT_TRUE(identical(h, fresh)) << name;
+        EXPECT_TRUE(hierarchy_is_valid(h)) << name;
+    }
+}
+
 TEST(Forest, CoarsenRefusesWhatBalanceForbids) {
     Hierarchy h(make_icosahedron());
     h.refine(0);

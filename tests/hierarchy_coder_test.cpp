@@ -268,6 +268,43 @@ TEST(HierarchyCoder, EveryTruncationAndRandomCorruptionIsSafe) {
     EXPECT_GT(errors, bytes.size() / 2) << "most truncations are detected";
 }
 
+// One decoder and one target hierarchy for stream after stream of other bases, sizes, switches
+// and depths, corrupt streams among them: each result is exactly decode_hierarchy's.
+TEST(HierarchyCoder, ReusedDecoderMatchesFreshDecodes) {
+    HierarchyDecoder decoder;
+    Hierarchy out;
+    Random random{5};
+    int decoded = 0, refused = 0;
+    for (uint64_t seed = 1; seed <= 400; ++seed) {
+        const Hierarchy h = random_hierarchy(seed);
+        std::vector<uint8_t> bytes = encode_hierarchy(h, options_from_bits(int(random.next() % kOptionCombinations)));
+        HierarchyDecodeOptions options;
+        if (seed % 5 == 0) options.max_level = int(random.next() % 4);
+        if (seed % 7 == 0) bytes.resize(random.next() % (bytes.size() + 1));
+        if (seed % 11 == 0 && !bytes.empty()) bytes[random.next() % bytes.size()] ^= uint8_t(1u << (random.next() % 8));
+        Hierarchy fresh;
+        bool fresh_ok = true;
+        try {
+            fresh = decode_hierarchy(h.base(), bytes.data(), bytes.size(), options);
+        } catch (const Error&) {
+            fresh_ok = false;
+        }
+        try {
+            decoder.decode(h.base(), bytes.data(), bytes.size(), out, options);
+            ASSERT_TRUE(fresh_ok) << "seed " << seed;
+            ASSERT_TRUE(identical(out, fresh)) << "seed " << seed;
+            ASSERT_EQ(check_invariants(out), "") << "seed " << seed;
+            ++decoded;
+        } catch (const Error&) {
+            ASSERT_FALSE(fresh_ok) << "seed " << seed;
+            ASSERT_EQ(check_invariants(out), "") << "seed " << seed;
+            ++refused;
+        }
+    }
+    EXPECT_GT(decoded, 300);
+    EXPECT_GT(refused, 10);
+}
+
 TEST(HierarchyCoder, HugeUniformLevelCountIsRefused) {
     Hierarchy h(make_icosahedron());
     std::vector<uint8_t> bytes = encode_hierarchy(h);

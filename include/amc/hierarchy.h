@@ -35,6 +35,9 @@ public:
     // Builds the forest of unrefined roots over a validated base mesh (validate_triangle_mesh).
     // Root i is base triangle i; root ids are 0 .. base_triangle_count()-1.
     explicit Hierarchy(TriangleMesh base);
+    // Becomes Hierarchy(base) while keeping the memory of its nodes and vertices, so that a
+    // hierarchy rebuilt again and again (the time steps of a simulation) does not allocate anew.
+    void reset(TriangleMesh base);
 
     // ---- structure -------------------------------------------------------------------------
     const TriangleMesh& base() const { return base_; }

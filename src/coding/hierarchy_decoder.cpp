@@ -23,7 +23,14 @@ HierarchyLevelDecoder::HierarchyLevelDecoder(const TriangleMesh& base, const uin
 
 HierarchyLevelDecoder::HierarchyLevelDecoder(const TriangleMesh& base, const HierarchyStreamHeader& header,
                                              uint64_t max_nodes)
-    : header_(header), max_nodes_(max_nodes), h_(base), traversal_(header.options) {
+    : traversal_(header.options) {
+    restart(base, header, max_nodes);
+}
+
+void HierarchyLevelDecoder::restart(const TriangleMesh& base, const HierarchyStreamHeader& header, uint64_t max_nodes) {
+    header_ = header;
+    max_nodes_ = max_nodes;
+    h_.reset(base);
     // Uniform levels alone would build root_count * (4^(U+1) - 1) / 3 nodes: check before.
     uint64_t uniform_nodes = base.triangles.size(), level_nodes = base.triangles.size();
     for (int l = 0; l < header_.uniform_levels && uniform_nodes <= max_nodes_; ++l) {
@@ -32,9 +39,16 @@ HierarchyLevelDecoder::HierarchyLevelDecoder(const TriangleMesh& base, const Hie
     }
     if (uniform_nodes > max_nodes_)
         throw Error("hierarchy stream would build more than " + std::to_string(max_nodes_) + " nodes");
+    models_ = HierarchyModels();
+    traversal_.configure(header.options);
+    for (Level& level : decided_) spare_.push_back(std::move(level));
+    decided_.clear();
     root_level(h_, level_);
+    level_index_ = 0;
+    level_base_ = 0;
     node_count_ = h_.root_count();
     vertex_count_ = base.positions.size();
+    symbols_read_ = 0;
 }
 
 std::vector<NodeId> HierarchyLevelDecoder::level_nodes() const {
@@ -117,7 +131,12 @@ void HierarchyLevelDecoder::finish_level() {
     vertex_count_ += derive_next_level(level_, numbering_, next_);
     decided_.push_back(std::move(level_));
     level_ = std::move(next_);
-    next_ = Level();
+    if (spare_.empty()) {
+        next_ = Level();
+    } else {
+        next_ = std::move(spare_.back());
+        spare_.pop_back();
+    }
     ++level_index_;
 }
 
@@ -137,8 +156,8 @@ void HierarchyLevelDecoder::build_decided_levels() {
         h_.split_level(parents, count, count == 0 ? nullptr : children.nbr.data()->nbr);
         level_base_ = first_child;
     }
-    // Keep one level's memory for the next level.
-    if (!decided_.empty()) std::swap(next_, decided_.back());
+    // Their memory serves the levels to come.
+    for (Level& level : decided_) spare_.push_back(std::move(level));
     decided_.clear();
 }
 
@@ -150,16 +169,36 @@ void HierarchyLevelDecoder::finish() const {
 
 Hierarchy decode_hierarchy(const TriangleMesh& base, const uint8_t* data, size_t size,
                            const HierarchyDecodeOptions& options) {
+    Hierarchy h;
+    HierarchyDecoder().decode(base, data, size, h, options);
+    return h;
+}
+
+HierarchyDecoder::HierarchyDecoder() = default;
+HierarchyDecoder::~HierarchyDecoder() = default;
+HierarchyDecoder::HierarchyDecoder(HierarchyDecoder&&) noexcept = default;
+HierarchyDecoder& HierarchyDecoder::operator=(HierarchyDecoder&&) noexcept = default;
+
+void HierarchyDecoder::decode(const TriangleMesh& base, const uint8_t* data, size_t size, Hierarchy& out,
+                              const HierarchyDecodeOptions& options) {
     HierarchyStreamHeader header;
     const size_t header_size = read_hierarchy_stream_header(data, size, header);
-    HierarchyLevelDecoder coder(base, header, options.max_nodes);
+    if (coder_ == nullptr) coder_ = std::make_unique<HierarchyLevelDecoder>();
+    // The coder builds in the memory of `out`; its own hierarchy waits in `out` meanwhile and
+    // goes back to it at the end, whatever happens.
+    std::swap(coder_->hierarchy(), out);
+    struct SwapBack {
+        Hierarchy& a;
+        Hierarchy& b;
+        ~SwapBack() { std::swap(a, b); }
+    } swap_back{coder_->hierarchy(), out};
+    coder_->restart(base, header, options.max_nodes);
     ArithmeticDecoder decoder(data + header_size, size - header_size);
     // All decisions first, so that the hierarchy is built in memory of its exact final size.
-    while (!coder.done() && coder.level() != options.max_level) coder.decide_level(decoder);
-    if (coder.done()) coder.finish();
-    coder.hierarchy().reserve(coder.node_count(), coder.vertex_count());
-    coder.build_decided_levels();
-    return std::move(coder.hierarchy());
+    while (!coder_->done() && coder_->level() != options.max_level) coder_->decide_level(decoder);
+    if (coder_->done()) coder_->finish();
+    coder_->hierarchy().reserve(coder_->node_count(), coder_->vertex_count());
+    coder_->build_decided_levels();
 }
 
 }  // namespace amc

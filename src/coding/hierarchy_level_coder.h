@@ -56,6 +56,11 @@ public:
     // when the uniform levels alone would exceed max_nodes.
     HierarchyLevelDecoder(const TriangleMesh& base, const uint8_t* header, size_t header_size, uint64_t max_nodes);
     HierarchyLevelDecoder(const TriangleMesh& base, const HierarchyStreamHeader& header, uint64_t max_nodes);
+    // A decoder with no stream yet (done() until restart).
+    HierarchyLevelDecoder() : traversal_(HierarchyCoderOptions{}) {}
+    // Starts on another stream as the constructor does, keeping the working memory and the
+    // memory of hierarchy() (rebuilt over `base`).
+    void restart(const TriangleMesh& base, const HierarchyStreamHeader& header, uint64_t max_nodes);
     bool done() const { return level_.empty(); }
     int level() const { return level_index_; }
     // Nodes of the current level (ids in hierarchy()) in canonical order.
@@ -81,12 +86,13 @@ private:
     void finish_level();
 
     HierarchyStreamHeader header_;
-    uint64_t max_nodes_;
+    uint64_t max_nodes_ = 0;
     Hierarchy h_;
     HierarchyModels models_;
     LevelTraversal traversal_;
     Level level_, next_;
     std::vector<Level> decided_;  // decided levels not yet built, oldest first
+    std::vector<Level> spare_;    // built levels, whose memory the next levels reuse
     RefinedNumbering numbering_;     // of the level being decided
     ScratchArray<uint32_t> closures_;  // the leaves with two or three hanging nodes
     NodeId level_base_ = 0;  // node id of local index 0 of the oldest level not yet built

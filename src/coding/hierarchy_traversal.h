@@ -406,7 +406,11 @@ constexpr ContextTable kContextTable{};
 
 class LevelTraversal {
 public:
-    explicit LevelTraversal(const HierarchyCoderOptions& options) : options_(options) {
+    explicit LevelTraversal(const HierarchyCoderOptions& options) { configure(options); }
+
+    // Switches to other options, keeping the working memory.
+    void configure(const HierarchyCoderOptions& options) {
+        options_ = options;
         // What a decided neighbour does to a node's state in the improved traversal: an
         // undecided node outside bucket 0 moves one bucket down (not below 1), or to bucket 0
         // once its three refined neighbours make it culled (a node culled by 1-regularity is in

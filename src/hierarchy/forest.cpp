@@ -65,6 +65,18 @@ Hierarchy::Hierarchy(TriangleMesh base) : base_(std::move(base)) {
     set_vertex_placer(nullptr, nullptr);
 }
 
+void Hierarchy::reset(TriangleMesh base) {
+    Hierarchy roots(std::move(base));
+    nodes_.assign(roots.nodes_.begin(), roots.nodes_.end());
+    positions_.assign(roots.positions_.begin(), roots.positions_.end());
+    free_blocks_.clear();
+    free_vertices_.clear();
+    base_ = std::move(roots.base_);
+    live_nodes_ = roots.live_nodes_;
+    live_vertices_ = roots.live_vertices_;
+    set_vertex_placer(nullptr, nullptr);
+}
+
 void Hierarchy::set_vertex_placer(VertexPlacer placer, void* context) {
     if (placer == nullptr) {
         static int round_to_float;  // any non-null context asks the midpoint placer to round
