@@ -1,11 +1,12 @@
-// What the benchmark programs share: the hierarchies coder_bench and decode_phases time, and the
-// median of repeated timings.
+// What the benchmark programs share: the hierarchies coder_bench and decode_phases time, the
+// clock and the median of repeated timings.
 #pragma once
 
 #include <amc/hierarchy.h>
 #include <amc/refinement.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <vector>
 
@@ -25,6 +26,11 @@ inline amc::Hierarchy make_bench_hierarchy(BenchModel model, int64_t target_node
     amc::refine_randomly(h, uint32_t(target_nodes * 3 / 4), 12, 7);
     return h;
 }
+
+using Clock = std::chrono::steady_clock;
+
+// Seconds from `start` to now.
+inline double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 // The median of the samples (the mean of the middle two for an even count); 0 for none.
 inline double median(std::vector<double> samples) {

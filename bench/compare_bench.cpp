@@ -4,6 +4,7 @@
 // process), and a check of every decoded result against its input. See docs/BENCHMARKS.md.
 //
 //   compare_bench [--runs N] [--csv FILE] [--markdown FILE] corpus/*.amh
+#include "bench_common.h"
 #include "compare_check.h"
 #include "compare_draco.h"
 #include "compare_general.h"
@@ -14,8 +15,6 @@
 #include <amc/hierarchy_coder.h>
 
 #include <algorithm>
-#include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -26,10 +25,6 @@
 namespace amc_bench {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 // Runs `step` `runs` times and returns the median time; `step` keeps its last output itself.
 template <class Step>
@@ -63,6 +58,9 @@ Result make_result(const Model& m, const std::string& coder, const std::string& 
 }
 
 std::string check_text(const MeshCheck& check) { return check.ok ? "ok" : check.problem; }
+
+// The payload id of a complete mesh with positions quantized to `bits` (0: lossless).
+std::string mesh_payload(int bits) { return bits == 0 ? "mesh-lossless" : "mesh-" + std::to_string(bits); }
 
 // ---- general-purpose coders over the index buffer ----------------------------------------------
 
@@ -135,12 +133,13 @@ void measure_draco(const Model& m, int runs, std::vector<Result>& out) {
         Result connectivity = make_result(m, coder, "connectivity");
         std::vector<double> connectivity_encode, connectivity_decode;
         std::vector<std::string> problems;
+        std::string note;  // what a mode's check tolerated, for the connectivity row
         DracoDecoded lossless;  // the checked lossless decode, the reference for the quantized ones
         bool lossless_ok = false;
         for (const int bits : {0, 16, 12}) {
             const DracoSettings settings{speed, bits};
             const draco::Mesh& input = bits == 0 ? *exact_input : *lossy_input;
-            Result r = make_result(m, coder, bits == 0 ? "mesh-lossless" : "mesh-" + std::to_string(bits));
+            Result r = make_result(m, coder, mesh_payload(bits));
             DracoEncoded encoded;
             DracoDecoded decoded;
             std::vector<double> encode_times, decode_times;
@@ -174,14 +173,17 @@ void measure_draco(const Model& m, int runs, std::vector<Result>& out) {
                 // Draco quantizes over the largest side of the bounding box in 2^bits - 1 steps; a
                 // vertex moves by half a step, plus float32 rounding: one step is the bound checked.
                 const double step = extent / double((1u << bits) - 1);
-                check = lossless_ok ? check_quantized_decode(lossless.positions, lossless.triangles, decoded.positions,
-                                                             decoded.triangles, step)
+                check = lossless_ok ? check_same_mesh_within(lossless.positions, lossless.triangles, decoded.positions,
+                                                             decoded.triangles, step,
+                                                             "the lossless decode of the same connectivity code")
                                     : MeshCheck{false, "no checked lossless decode to compare with"};
             }
             r.max_error = check.max_error;
             r.check = check_text(check);
-            if (check.ok && check.split_vertices > 0)
+            if (check.ok && check.split_vertices > 0) {
                 r.note = std::to_string(check.split_vertices) + " more vertices decoded than coded (Draco splits vertices whose faces form several fans)";
+                note = r.note;
+            }
             if (check.ok && bits == 12 && encoded.bytes != draco_encode_public(input, settings))
                 r.check = "file differs from draco::Encoder::EncodeMeshToBuffer's";
             if (r.check != "ok") problems.push_back(r.payload + ": " + r.check);
@@ -193,8 +195,7 @@ void measure_draco(const Model& m, int runs, std::vector<Result>& out) {
         connectivity.encode_seconds = median(connectivity_encode);
         connectivity.decode_seconds = median(connectivity_decode);
         connectivity.check = problems.empty() ? "ok" : problems.front();
-        for (const Result& r : out)
-            if (r.model == m.name && r.coder == coder && !r.note.empty()) connectivity.note = r.note;
+        connectivity.note = note;
         out.push_back(connectivity);
     }
 }
@@ -218,37 +219,13 @@ std::vector<AmcMode> amc_connectivity_modes() {
             {"amc-best", amc::EncodeOptions{}.hierarchy}};
 }
 
-// Same conforming mesh (canonical vertex order on both sides) and every coordinate within `tolerance`.
-MeshCheck compare_leaf_meshes(const amc::Hierarchy& decoded, const amc::TriangleMesh& expected, double tolerance) {
-    MeshCheck check;
-    const amc::TriangleMesh got = amc::extract_leaf_mesh(decoded).mesh;
-    if (got.triangles != expected.triangles) {
-        check.problem = "leaf mesh connectivity differs";
-        return check;
-    }
-    if (got.positions.size() != expected.positions.size()) {
-        check.problem = "vertex count differs";
-        return check;
-    }
-    for (size_t v = 0; v < got.positions.size(); ++v) {
-        const amc::Vec3 d = got.positions[v] - expected.positions[v];
-        check.max_error = std::max({check.max_error, std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
-    }
-    if (check.max_error > tolerance) {
-        check.problem = "coordinate error " + std::to_string(check.max_error) + " above the reported " + std::to_string(tolerance);
-        return check;
-    }
-    check.ok = true;
-    return check;
-}
-
 void measure_amcodec(const Model& m, int runs, std::vector<Result>& out) {
     const amc::TriangleMesh expected_leaf = amc::extract_leaf_mesh(m.expected).mesh;
     uint64_t base_connectivity_bytes = 0;
 
     // Complete files, default options: lossless, 16 and 12 bits.
     for (const int bits : {0, 16, 12}) {
-        Result r = make_result(m, "amc-best", bits == 0 ? "mesh-lossless" : "mesh-" + std::to_string(bits));
+        Result r = make_result(m, "amc-best", mesh_payload(bits));
         amc::EncodeOptions options;
         options.quantize_bits = bits;
         amc::EncodeStats stats;
@@ -265,7 +242,11 @@ void measure_amcodec(const Model& m, int runs, std::vector<Result>& out) {
         if (bits == 0) {
             r.check = amc::identical(back, m.expected) ? "ok" : "decoded hierarchy not identical to the input";
         } else {
-            r.check = check_text(compare_leaf_meshes(back, expected_leaf, stats.max_error));
+            // The same conforming mesh (canonical vertex order on both sides), every coordinate
+            // within the error the encoder reported.
+            const amc::TriangleMesh got = amc::extract_leaf_mesh(back).mesh;
+            r.check = check_text(check_same_mesh_within(expected_leaf.positions, expected_leaf.triangles, got.positions,
+                                                        got.triangles, stats.max_error, "the input's leaf mesh"));
         }
         out.push_back(r);
     }
@@ -306,13 +287,10 @@ int run(int argc, char** argv) {
     int runs = 3;
     std::string csv_path, markdown_path;
     std::vector<std::string> inputs;
-    std::string command = "compare_bench";
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
-        command += " " + arg;
         auto value = [&]() -> std::string {
             if (i + 1 >= argc) throw std::runtime_error(arg + " needs a value");
-            command += std::string(" ") + argv[i + 1];
             return argv[++i];
         };
         if (arg == "--runs") runs = std::max(1, std::stoi(value()));
@@ -334,12 +312,12 @@ int run(int argc, char** argv) {
         measure_draco(m, runs, results);
         measure_amcodec(m, runs, results);
         int failed = 0;
-        for (size_t i = first; i < results.size(); ++i) failed += results[i].check != "ok" && results[i].check != "computed";
+        for (size_t i = first; i < results.size(); ++i) failed += !passed(results[i]);
         std::fprintf(stderr, "%-18s %7zu faces  %5.1f s  %s\n", m.name.c_str(), m.leaf.triangles.size(), seconds_since(start),
                      failed ? "SOME CHECKS FAILED" : "all checks passed");
     }
     if (!csv_path.empty()) write_csv(csv_path, results);
-    if (!markdown_path.empty()) write_markdown(markdown_path, results, RunInfo{runs, command});
+    if (!markdown_path.empty()) write_markdown(markdown_path, results, runs);
     return 0;
 }
 

@@ -129,19 +129,25 @@ MeshCheck check_decoded_mesh(const amc::TriangleMesh& original, const std::vecto
     return check;
 }
 
-MeshCheck check_quantized_decode(const std::vector<amc::Vec3>& lossless_positions,
-                                 const std::vector<amc::Triangle>& lossless_triangles,
+MeshCheck check_same_mesh_within(const std::vector<amc::Vec3>& reference_positions,
+                                 const std::vector<amc::Triangle>& reference_triangles,
                                  const std::vector<amc::Vec3>& positions, const std::vector<amc::Triangle>& triangles,
-                                 double tolerance) {
+                                 double tolerance, const std::string& reference) {
     MeshCheck check;
-    if (triangles != lossless_triangles || positions.size() != lossless_positions.size()) {
-        check.problem = "faces differ from the lossless decode of the same connectivity code";
+    if (triangles != reference_triangles) {
+        check.problem = "faces differ from " + reference;
+        return check;
+    }
+    if (positions.size() != reference_positions.size()) {
+        check.problem = std::to_string(positions.size()) + " vertices decoded, " + std::to_string(reference_positions.size()) +
+                        " in " + reference;
         return check;
     }
     for (size_t d = 0; d < positions.size(); ++d)
-        check.max_error = std::max(check.max_error, chebyshev_distance(positions[d], lossless_positions[d]));
+        check.max_error = std::max(check.max_error, chebyshev_distance(positions[d], reference_positions[d]));
     if (check.max_error > tolerance) {
-        check.problem = "coordinate error " + std::to_string(check.max_error) + " above " + std::to_string(tolerance);
+        check.problem = "coordinate error " + std::to_string(check.max_error) + " from " + reference + " above " +
+                        std::to_string(tolerance);
         return check;
     }
     check.ok = true;

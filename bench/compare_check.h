@@ -31,13 +31,15 @@ MeshCheck check_same_faces(const std::vector<amc::Triangle>& original, const std
 MeshCheck check_decoded_mesh(const amc::TriangleMesh& original, const std::vector<amc::Vec3>& positions,
                              const std::vector<amc::Triangle>& triangles);
 
-// A quantized decode of the same connectivity code as an earlier, checked lossless decode: the
-// same faces in the same order, every vertex within `tolerance` per coordinate of the lossless
-// decode's vertex. (Matching by position alone would be ambiguous: a coarse grid can put two
-// vertices on one point.)
-MeshCheck check_quantized_decode(const std::vector<amc::Vec3>& lossless_positions,
-                                 const std::vector<amc::Triangle>& lossless_triangles,
+// A mesh against a reference with the same vertex numbering: the same faces in the same order,
+// as many vertices, every vertex within `tolerance` per coordinate of the reference's vertex;
+// max_error is the largest coordinate difference. `reference` names the reference in the problem
+// text. Used for a quantized decode against the checked lossless decode of the same connectivity
+// code (matching by position alone would be ambiguous: a coarse grid can put two vertices on one
+// point), and for amcodec's quantized leaf mesh against the input's.
+MeshCheck check_same_mesh_within(const std::vector<amc::Vec3>& reference_positions,
+                                 const std::vector<amc::Triangle>& reference_triangles,
                                  const std::vector<amc::Vec3>& positions, const std::vector<amc::Triangle>& triangles,
-                                 double tolerance);
+                                 double tolerance, const std::string& reference);
 
 }  // namespace amc_bench

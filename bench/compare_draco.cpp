@@ -1,22 +1,19 @@
 #include "compare_draco.h"
 
+#include "bench_common.h"
+
 #include <draco/compression/decode.h>
 #include <draco/compression/encode.h>
 #include <draco/compression/mesh/mesh_edgebreaker_decoder.h>
 #include <draco/compression/mesh/mesh_edgebreaker_encoder.h>
 #include <draco/mesh/mesh.h>
 
-#include <chrono>
 #include <stdexcept>
 #include <string>
 
 namespace amc_bench {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
 // Draco's Edgebreaker encoder, measuring its connectivity stage: EncodeConnectivity() is a
 // protected virtual of MeshEdgebreakerEncoder in 1.5.5, called once per Encode().
@@ -30,7 +27,7 @@ protected:
         const size_t before = buffer()->size();
         const Clock::time_point start = Clock::now();
         draco::Status status = draco::MeshEdgebreakerEncoder::EncodeConnectivity();
-        connectivity_seconds = seconds_between(start, Clock::now());
+        connectivity_seconds = seconds_since(start);
         connectivity_bytes = buffer()->size() - before;
         return status;
     }
@@ -46,7 +43,7 @@ protected:
     bool DecodeConnectivity() override {
         const Clock::time_point start = Clock::now();
         const bool ok = draco::MeshEdgebreakerDecoder::DecodeConnectivity();
-        connectivity_seconds = seconds_between(start, Clock::now());
+        connectivity_seconds = seconds_since(start);
         return ok;
     }
 };
@@ -100,7 +97,7 @@ DracoEncoded draco_encode(const draco::Mesh& mesh, const DracoSettings& settings
     counting.SetMesh(mesh);
     draco::EncoderBuffer buffer;
     throw_unless_ok(counting.Encode(options, &buffer), "draco encode");
-    result.seconds = seconds_between(start, Clock::now());
+    result.seconds = seconds_since(start);
     result.bytes.assign(buffer.data(), buffer.data() + buffer.size());
     result.connectivity_bytes = counting.connectivity_bytes;
     result.connectivity_seconds = counting.connectivity_seconds;
@@ -123,7 +120,7 @@ DracoDecoded draco_decode(const std::vector<char>& bytes) {
     TimingEdgebreakerDecoder decoder;
     draco::DecoderOptions options;
     throw_unless_ok(decoder.Decode(options, &buffer, &mesh), "draco decode");
-    result.seconds = seconds_between(start, Clock::now());
+    result.seconds = seconds_since(start);
     result.connectivity_seconds = decoder.connectivity_seconds;
 
     const draco::PointAttribute* position = mesh.GetNamedAttribute(draco::GeometryAttribute::POSITION);

@@ -1,5 +1,7 @@
 #include "compare_report.h"
 
+#include "bench_common.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -88,8 +90,6 @@ private:
     std::vector<std::string> models_;
 };
 
-bool passed(const Result& r) { return r.check == "ok" || r.check == "computed"; }
-
 std::string format(const char* pattern, double value) {
     char text[64];
     std::snprintf(text, sizeof text, pattern, value);
@@ -101,10 +101,18 @@ double bits_per_face(const Result& r) { return 8.0 * double(r.bytes) / double(r.
 // Marks a figure whose decoded result did not match its input.
 std::string flagged(const Result& r, const std::string& text) { return passed(r) ? text : text + " (FAILED)"; }
 
-std::string speed(uint64_t faces, double seconds) {
-    if (seconds <= 0) return "–";
-    const double mfaces = double(faces) / seconds / 1e6;
-    return format(mfaces >= 100 ? "%.0f" : mfaces >= 10 ? "%.1f" : "%.2f", mfaces);
+// Million faces per second; 0 when not timed.
+double mfaces_per_second(uint64_t faces, double seconds) { return seconds > 0 ? double(faces) / seconds / 1e6 : 0.0; }
+
+// A rate in million faces per second as the speed tables write it: two decimals below 10, one
+// below 100, none from 100.
+std::string rate_text(double mfaces) { return format(mfaces >= 100 ? "%.0f" : mfaces >= 10 ? "%.1f" : "%.2f", mfaces); }
+
+std::string speed(uint64_t faces, double seconds) { return seconds <= 0 ? "–" : rate_text(mfaces_per_second(faces, seconds)); }
+
+// How the tables name a complete-mesh payload: "lossless" for mesh-lossless, "16 bits" for mesh-16.
+std::string payload_label(const std::string& payload) {
+    return payload == "mesh-lossless" ? "lossless" : payload.substr(std::string("mesh-").size()) + " bits";
 }
 
 std::string speed_pair(const Result* r) {
@@ -273,8 +281,7 @@ void mesh_table(FILE* f, const Index& index) {
     print_header(f, "model", columns, "---:");
     for (const std::string& model : index.models()) {
         for (const char* payload : kMeshPayloads) {
-            const std::string mode = std::string(payload) == "mesh-lossless" ? "lossless" : std::string(payload).substr(5) + " bits";
-            std::vector<std::string> cells{mode};
+            std::vector<std::string> cells{payload_label(payload)};
             const Result* ours = index.find(model, "amc-best", payload);
             const Result* draco = index.find(model, "draco-best", payload);
             for (const Column& c : kMeshCoders) {
@@ -300,14 +307,13 @@ struct SpeedColumns {
     explicit SpeedColumns(size_t columns) : encode(columns), decode(columns) {}
     void add(size_t column, const Result* r) {
         if (!r || r->encode_seconds <= 0 || r->decode_seconds <= 0) return;
-        encode[column].push_back(double(r->faces) / r->encode_seconds / 1e6);
-        decode[column].push_back(double(r->faces) / r->decode_seconds / 1e6);
+        encode[column].push_back(mfaces_per_second(r->faces, r->encode_seconds));
+        decode[column].push_back(mfaces_per_second(r->faces, r->decode_seconds));
     }
     void print_medians(FILE* f) const {
         std::vector<std::string> medians;
         for (size_t i = 0; i < encode.size(); ++i)
-            medians.push_back("**" + speed(1000000, 1.0 / median(encode[i])) + " / " +
-                              speed(1000000, 1.0 / median(decode[i])) + "**");
+            medians.push_back("**" + rate_text(median(encode[i])) + " / " + rate_text(median(decode[i])) + "**");
         print_row(f, "**median over models**", medians);
         std::fprintf(f, "\n");
     }
@@ -341,7 +347,7 @@ void mesh_speed_table(FILE* f, const Index& index) {
     std::vector<std::string> columns;
     for (const Column& c : kMeshCoders)
         for (const char* payload : kMeshPayloads)
-            columns.push_back(std::string(c.label) + (std::string(payload) == "mesh-lossless" ? " lossless" : " " + std::string(payload).substr(5) + " bits"));
+            columns.push_back(std::string(c.label) + " " + payload_label(payload));
     print_header(f, "model", columns, "---:");
     SpeedColumns speeds(columns.size());
     for (const std::string& model : index.models()) {
@@ -358,18 +364,18 @@ void mesh_speed_table(FILE* f, const Index& index) {
     speeds.print_medians(f);
 }
 
-void check_summary(FILE* f, const std::vector<Result>& results, const RunInfo& info) {
+void check_summary(FILE* f, const std::vector<Result>& results, int runs) {
     size_t checked = 0;
     std::vector<const Result*> failed;
     for (const Result& r : results) {
         if (r.check == "computed") continue;
         ++checked;
-        if (r.check != "ok") failed.push_back(&r);
+        if (!passed(r)) failed.push_back(&r);
     }
     std::fprintf(f, "### Checks\n\n");
     if (failed.empty()) {
         std::fprintf(f, "All %zu decoded results (every coder, model and mode, last of %d runs) matched their input.\n\n", checked,
-                     info.runs);
+                     runs);
     } else {
         std::fprintf(f, "%zu of %zu decoded results did **not** match their input:\n\n", failed.size(), checked);
         print_header(f, "model", {"coder", "payload", "problem"}, "---");
@@ -388,6 +394,8 @@ void check_summary(FILE* f, const std::vector<Result>& results, const RunInfo& i
 
 }  // namespace
 
+bool passed(const Result& r) { return r.check == "ok" || r.check == "computed"; }
+
 void write_csv(const std::string& path, const std::vector<Result>& results) {
     FILE* f = std::fopen(path.c_str(), "w");
     if (f == nullptr) throw std::runtime_error(path + ": cannot write");
@@ -403,13 +411,13 @@ void write_csv(const std::string& path, const std::vector<Result>& results) {
                      (unsigned long long)r.faces, (unsigned long long)r.vertices, (unsigned long long)r.nodes, r.coder.c_str(),
                      r.payload.c_str(), (unsigned long long)r.bytes, r.faces ? bits_per_face(r) : 0.0,
                      (unsigned long long)r.connectivity_bytes, r.max_error, r.encode_seconds, r.decode_seconds,
-                     r.encode_seconds > 0 ? double(r.faces) / r.encode_seconds / 1e6 : 0.0,
-                     r.decode_seconds > 0 ? double(r.faces) / r.decode_seconds / 1e6 : 0.0, check.c_str(), note.c_str());
+                     mfaces_per_second(r.faces, r.encode_seconds), mfaces_per_second(r.faces, r.decode_seconds), check.c_str(),
+                     note.c_str());
     }
     if (std::fclose(f) != 0) throw std::runtime_error(path + ": write error");
 }
 
-void write_markdown(const std::string& path, const std::vector<Result>& results, const RunInfo& info) {
+void write_markdown(const std::string& path, const std::vector<Result>& results, int runs) {
     FILE* f = std::fopen(path.c_str(), "w");
     if (f == nullptr) throw std::runtime_error(path + ": cannot write");
     const Index index(results);
@@ -420,7 +428,7 @@ void write_markdown(const std::string& path, const std::vector<Result>& results,
     mesh_table(f, index);
     connectivity_speed_table(f, index);
     mesh_speed_table(f, index);
-    check_summary(f, results, info);
+    check_summary(f, results, runs);
     if (std::fclose(f) != 0) throw std::runtime_error(path + ": write error");
 }
 

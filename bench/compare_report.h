@@ -2,8 +2,6 @@
 // coder and payload, and the markdown tables of docs/BENCHMARKS.md.
 #pragma once
 
-#include "bench_common.h"
-
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -39,14 +37,12 @@ struct Result {
     std::string note;              // what a passing check tolerated (Draco's split vertices)
 };
 
-struct RunInfo {
-    int runs = 0;
-    std::string command;
-};
-
+// A decoded result that matched its input, or a figure with nothing to decode ("computed").
+bool passed(const Result& r);
 
 void write_csv(const std::string& path, const std::vector<Result>& results);
-// The tables of docs/BENCHMARKS.md (sizes, bits per face, ratios, complete meshes, speeds, checks).
-void write_markdown(const std::string& path, const std::vector<Result>& results, const RunInfo& info);
+// The tables of docs/BENCHMARKS.md (sizes, bits per face, ratios, complete meshes, speeds, checks);
+// `runs`: how many times each figure was measured.
+void write_markdown(const std::string& path, const std::vector<Result>& results, int runs);
 
 }  // namespace amc_bench

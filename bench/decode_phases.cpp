@@ -14,7 +14,6 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <string>
 #include <vector>
 
@@ -69,12 +68,21 @@ private:
     int fd_[kCounters] = {-1, -1, -1};
 };
 
-using Clock = std::chrono::steady_clock;
-
 struct Sample {
     double ms[2];                    // decide, build
     double counts[2][kCounters];     // per phase
 };
+
+// The smallest and the median value of one figure of the samples (at least one).
+struct Spread {
+    double min, median;
+};
+template <class Figure>
+Spread spread(const std::vector<Sample>& samples, Figure figure) {
+    std::vector<double> values;
+    for (const Sample& s : samples) values.push_back(figure(s));
+    return {*std::min_element(values.begin(), values.end()), median(values)};
+}
 
 void report(const char* name, const amc::Hierarchy& h, int runs, const Counters& counters) {
     const std::vector<uint8_t> bytes = amc::encode_hierarchy(h);
@@ -114,21 +122,17 @@ void report(const char* name, const amc::Hierarchy& h, int runs, const Counters&
     }
     const double nodes = h.node_count();
     std::printf("%s: %u nodes, %zu bytes, %d runs (min / median)\n", name, h.node_count(), bytes.size(), runs);
-    std::vector<double> total;
-    for (const Sample& s : samples) total.push_back(s.ms[0] + s.ms[1]);
-    std::printf("  decode  %7.1f / %7.1f ms   %5.1f / %5.1f M nodes/s\n", *std::min_element(total.begin(), total.end()),
-                median(total), nodes / *std::min_element(total.begin(), total.end()) / 1e3, nodes / median(total) / 1e3);
+    const Spread total = spread(samples, [](const Sample& s) { return s.ms[0] + s.ms[1]; });
+    std::printf("  decode  %7.1f / %7.1f ms   %5.1f / %5.1f M nodes/s\n", total.min, total.median, nodes / total.min / 1e3,
+                nodes / total.median / 1e3);
     const char* const phases[2] = {"decide", "build"};
     for (int p = 0; p < 2; ++p) {
-        std::vector<double> ms;
-        for (const Sample& s : samples) ms.push_back(s.ms[p]);
-        std::printf("  %-7s %7.1f / %7.1f ms", phases[p], *std::min_element(ms.begin(), ms.end()), median(ms));
+        const Spread ms = spread(samples, [p](const Sample& s) { return s.ms[p]; });
+        std::printf("  %-7s %7.1f / %7.1f ms", phases[p], ms.min, ms.median);
         if (counters.available()) {
             for (int k = 0; k < kCounters; ++k) {
-                std::vector<double> c;
-                for (const Sample& s : samples) c.push_back(s.counts[p][k]);
-                std::printf("   %s %.1f / %.1f M", kCounterNames[k], *std::min_element(c.begin(), c.end()) / 1e6,
-                            median(c) / 1e6);
+                const Spread c = spread(samples, [p, k](const Sample& s) { return s.counts[p][k]; });
+                std::printf("   %s %.1f / %.1f M", kCounterNames[k], c.min / 1e6, c.median / 1e6);
             }
         }
         std::printf("\n");
