@@ -4,7 +4,11 @@
 // instructions, branch misses) where Linux allows it: unlike time, they hardly move when other
 // virtual machines load the host, so two builds can be compared with few runs.
 //
-//   decode_phases [--nodes N] [--runs R]
+//   decode_phases [--nodes N] [--runs R] [--reuse]
+//
+// --reuse keeps one decoder, and the hierarchy it decodes into, from run to run (as
+// amc::HierarchyDecoder does): no fresh memory. Without it every run starts from nothing and
+// frees its hierarchy within the build time.
 #include "bench_common.h"
 #include "coding/hierarchy_level_coder.h"
 
@@ -14,6 +18,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -84,9 +89,10 @@ Spread spread(const std::vector<Sample>& samples, Figure figure) {
     return {*std::min_element(values.begin(), values.end()), median(values)};
 }
 
-void report(const char* name, const amc::Hierarchy& h, int runs, const Counters& counters) {
+void report(const char* name, const amc::Hierarchy& h, int runs, bool reuse, const Counters& counters) {
     const std::vector<uint8_t> bytes = amc::encode_hierarchy(h);
     std::vector<Sample> samples;
+    amc::HierarchyLevelDecoder kept;
     for (int r = 0; r < runs; ++r) {
         Sample s{};
         double c0[kCounters], c1[kCounters], c2[kCounters];
@@ -94,7 +100,9 @@ void report(const char* name, const amc::Hierarchy& h, int runs, const Counters&
         const Clock::time_point t0 = Clock::now();
         amc::HierarchyStreamHeader header;
         const size_t header_size = amc::read_hierarchy_stream_header(bytes.data(), bytes.size(), header);
-        amc::HierarchyLevelDecoder coder(h.base(), header, amc::HierarchyDecodeOptions().max_nodes);
+        std::optional<amc::HierarchyLevelDecoder> fresh;
+        amc::HierarchyLevelDecoder& coder = reuse ? kept : fresh.emplace();
+        coder.restart(h.base(), header, amc::HierarchyDecodeOptions().max_nodes);
         amc::ArithmeticDecoder decoder(bytes.data() + header_size, bytes.size() - header_size);
         while (!coder.done()) coder.decide_level(decoder);
         coder.finish();
@@ -102,14 +110,12 @@ void report(const char* name, const amc::Hierarchy& h, int runs, const Counters&
         counters.read_all(c1);
         coder.hierarchy().reserve(coder.node_count(), coder.vertex_count());
         coder.build_decided_levels();
-        {
-            amc::Hierarchy decoded = std::move(coder.hierarchy());
-            if (decoded.node_count() != h.node_count()) {
-                std::fprintf(stderr, "decode_phases: %s decoded to %u nodes, not %u\n", name, decoded.node_count(),
-                             h.node_count());
-                std::exit(1);
-            }
-        }  // freeing the hierarchy is part of building it
+        if (coder.hierarchy().node_count() != h.node_count()) {
+            std::fprintf(stderr, "decode_phases: %s decoded to %u nodes, not %u\n", name, coder.hierarchy().node_count(),
+                         h.node_count());
+            std::exit(1);
+        }
+        if (!reuse) amc::Hierarchy freed = std::move(coder.hierarchy());  // freeing it is part of building it
         const Clock::time_point t2 = Clock::now();
         counters.read_all(c2);
         s.ms[0] = std::chrono::duration<double, std::milli>(t1 - t0).count();
@@ -121,7 +127,8 @@ void report(const char* name, const amc::Hierarchy& h, int runs, const Counters&
         samples.push_back(s);
     }
     const double nodes = h.node_count();
-    std::printf("%s: %u nodes, %zu bytes, %d runs (min / median)\n", name, h.node_count(), bytes.size(), runs);
+    std::printf("%s: %u nodes, %zu bytes, %d runs%s (min / median)\n", name, h.node_count(), bytes.size(), runs,
+                reuse ? ", reusing the decoder" : "");
     const Spread total = spread(samples, [](const Sample& s) { return s.ms[0] + s.ms[1]; });
     std::printf("  decode  %7.1f / %7.1f ms   %5.1f / %5.1f M nodes/s\n", total.min, total.median, nodes / total.min / 1e3,
                 nodes / total.median / 1e3);
@@ -144,9 +151,12 @@ void report(const char* name, const amc::Hierarchy& h, int runs, const Counters&
 int main(int argc, char** argv) {
     long nodes = 1000000;
     int runs = 15;
+    bool reuse = false;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
-        if ((arg == "--nodes" || arg == "--runs") && i + 1 < argc) {
+        if (arg == "--reuse") {
+            reuse = true;
+        } else if ((arg == "--nodes" || arg == "--runs") && i + 1 < argc) {
             const long value = std::strtol(argv[++i], nullptr, 10);
             if (value <= 0) {
                 std::fprintf(stderr, "decode_phases: %s needs a positive number\n", arg.c_str());
@@ -155,13 +165,13 @@ int main(int argc, char** argv) {
             if (arg == "--nodes") nodes = std::min(value, 20000000L);  // a few GB at most
             else runs = int(std::min(value, 1000L));
         } else {
-            std::fprintf(stderr, "usage: decode_phases [--nodes N] [--runs R]\n");
+            std::fprintf(stderr, "usage: decode_phases [--nodes N] [--runs R] [--reuse]\n");
             return 2;
         }
     }
     const Counters counters;
     if (!counters.available()) std::printf("(no hardware counters here: wall time only)\n");
     // The models of coder_bench.
-    report("surface", make_bench_hierarchy(BenchModel::surface, nodes), runs, counters);
-    report("random", make_bench_hierarchy(BenchModel::random, nodes), runs, counters);
+    report("surface", make_bench_hierarchy(BenchModel::surface, nodes), runs, reuse, counters);
+    report("random", make_bench_hierarchy(BenchModel::random, nodes), runs, reuse, counters);
 }
