@@ -7,9 +7,14 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstddef>
 #include <cstring>
 #include <string>
 #include <unordered_map>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 
 namespace amc {
@@ -177,6 +182,61 @@ void Hierarchy::split(NodeId n) {
     nodes_[n].first_child = c;
 }
 
+// split_level writes each new node as three pieces: its vertices and parent (bytes 0-15), its
+// first child (none) and neighbours (bytes 16-31), and its four bytes of edges, level, flags and
+// child index.
+void Hierarchy::write_vertices(Node& node, VertexId a, VertexId b, VertexId d, NodeId parent) {
+    node.v[0] = a;
+    node.v[1] = b;
+    node.v[2] = d;
+    node.parent = parent;
+}
+
+void Hierarchy::write_tail(Node& node, uint32_t word) {
+    // Bytes nbr_edge, level, flags, child_index in that order (little endian word).
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+    std::memcpy(&node.nbr_edge, &word, 4);
+#else
+    node.nbr_edge = uint8_t(word);
+    node.level = uint8_t(word >> 8);
+    node.flags = uint8_t(word >> 16);
+    node.child_index = uint8_t(word >> 24);
+#endif
+}
+
+// The first child (none) and the neighbours of four new siblings from their twelve words of
+// local links (word 3k + e: child k, edge e); a local index becomes the id offset + index,
+// kNoNode stays.
+void Hierarchy::write_neighbors(Node* child, const uint32_t* links, uint32_t offset) {
+    static_assert(sizeof(Node) == 36 && offsetof(Node, first_child) == 16 && offsetof(Node, nbr) == 20 &&
+                      offsetof(Node, nbr_edge) == 32,
+                  "split_level writes nodes by this layout");
+#if defined(__SSE2__)
+    const __m128i all_ones = _mm_set1_epi32(-1);
+    const __m128i add = _mm_set1_epi32(int(offset));
+    auto ids = [&](const uint32_t* at) {
+        const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(at));
+        return _mm_or_si128(_mm_add_epi32(v, add), _mm_cmpeq_epi32(v, all_ones));
+    };
+    const __m128i t0 = ids(links), t1 = ids(links + 4), t2 = ids(links + 8);
+    // Lane 0 of each piece is first_child: kNoNode. Lanes 1-3 are words 3k..3k+2.
+    const __m128i lane0 = _mm_cvtsi32_si128(-1);
+    auto store = [](Node& node, __m128i v) { _mm_storeu_si128(reinterpret_cast<__m128i*>(&node.first_child), v); };
+    store(child[0], _mm_or_si128(_mm_slli_si128(t0, 4), lane0));
+    store(child[1], _mm_or_si128(_mm_or_si128(_mm_srli_si128(t0, 8), _mm_slli_si128(t1, 8)), lane0));
+    store(child[2], _mm_or_si128(_mm_or_si128(_mm_srli_si128(t1, 4), _mm_slli_si128(t2, 12)), lane0));
+    store(child[3], _mm_or_si128(t2, lane0));
+#else
+    for (int k = 0; k < 4; ++k) {
+        child[k].first_child = kNoNode;
+        for (int e = 0; e < 3; ++e) {
+            const uint32_t t = links[3 * k + e];
+            child[k].nbr[e] = t == kNoNode ? kNoNode : t + offset;
+        }
+    }
+#endif
+}
+
 void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_t* child_links) {
     if (!free_blocks_.empty() || !free_vertices_.empty()) {
         // Reused ids: take the general path (the decoders never get here).
@@ -239,45 +299,26 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
                 m[e] = next_vertex++;
             }
         }
-        // The neighbours across the first and second half of the parent's edge e (local indices
-        // made node ids; kNoNode, all ones, stays).
-        uint32_t first[3], second[3];
-        for (int e = 0; e < 3; ++e) {
-            const uint32_t t = first_half(i, e), u = child_links[size_t(12) * i + size_t(3 * (e == 2 ? 0 : e + 1) + e)];
-            first[e] = (t + offset) | uint32_t(int32_t(t) >> 31);
-            second[e] = (u + offset) | uint32_t(int32_t(u) >> 31);
-        }
         // The children's edges (kChildEdges): linked outer edges take the parent's neighbour edge
         // index.
         const unsigned outer = parent.nbr_edge & linked_edges;
-        const uint8_t level = uint8_t(parent.level + 1);
+        const uint32_t level = uint32_t(parent.level + 1) << 8;
         const unsigned boundary = parent.flags;
-        auto make = [&](Node& child, VertexId a, VertexId b, VertexId d, NodeId na, NodeId nb, NodeId nd,
-                        unsigned nbr_edge, unsigned flags, int k) {
-            child.v[0] = a;
-            child.v[1] = b;
-            child.v[2] = d;
-            child.parent = n;
-            child.first_child = kNoNode;
-            child.nbr[0] = na;
-            child.nbr[1] = nb;
-            child.nbr[2] = nd;
-            child.nbr_edge = uint8_t(nbr_edge);
-            child.level = level;
-            child.flags = uint8_t(flags);
-            child.child_index = uint8_t(k);
-        };
-        const ChildNeighbors links = child_neighbors(c, first, second);
         Node* child = nodes + c;
         // Child by child with literal k: a loop, or a helper taking k, compiled to worse code.
-        make(child[0], parent.v[0], m[0], m[2], links.nbr[0][0], links.nbr[0][1], links.nbr[0][2],
-             (outer & kChildEdges[0].outer) | kChildEdges[0].inner, boundary & kChildEdges[0].boundary, 0);
-        make(child[1], m[0], parent.v[1], m[1], links.nbr[1][0], links.nbr[1][1], links.nbr[1][2],
-             (outer & kChildEdges[1].outer) | kChildEdges[1].inner, boundary & kChildEdges[1].boundary, 1);
-        make(child[2], m[2], m[1], parent.v[2], links.nbr[2][0], links.nbr[2][1], links.nbr[2][2],
-             (outer & kChildEdges[2].outer) | kChildEdges[2].inner, boundary & kChildEdges[2].boundary, 2);
-        make(child[3], m[1], m[2], m[0], links.nbr[3][0], links.nbr[3][1], links.nbr[3][2],
-             (outer & kChildEdges[3].outer) | kChildEdges[3].inner, boundary & kChildEdges[3].boundary, 3);
+        write_vertices(child[0], parent.v[0], m[0], m[2], n);
+        write_vertices(child[1], m[0], parent.v[1], m[1], n);
+        write_vertices(child[2], m[2], m[1], parent.v[2], n);
+        write_vertices(child[3], m[1], m[2], m[0], n);
+        write_neighbors(child, child_links + size_t(12) * i, offset);
+        auto tail = [&](int k) {
+            return ((outer & kChildEdges[k].outer) | kChildEdges[k].inner) | level |
+                   uint32_t(boundary & kChildEdges[k].boundary) << 16 | uint32_t(k) << 24;
+        };
+        write_tail(child[0], tail(0));
+        write_tail(child[1], tail(1));
+        write_tail(child[2], tail(2));
+        write_tail(child[3], tail(3));
         parent.first_child = c;
     }
     live_nodes_ += 4 * count;
