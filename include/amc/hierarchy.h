@@ -163,7 +163,7 @@ private:
         uint8_t child_index;  // 0..3; unused for roots
     };
     void link(NodeId a, int ea, NodeId b, int eb);
-    static void write_vertices(Node& node, VertexId a, VertexId b, VertexId d, NodeId parent);
+    static void write_vertices(Node* child, const VertexId corner[3], const VertexId m[3], NodeId parent);
     static void write_neighbors(Node* child, const uint32_t* links, uint32_t offset);
     static void write_tail(Node& node, uint32_t word);
     VertexId new_vertex(Vec3 p);

@@ -184,12 +184,33 @@ void Hierarchy::split(NodeId n) {
 
 // split_level writes each new node as three pieces: its vertices and parent (bytes 0-15), its
 // first child (none) and neighbours (bytes 16-31), and its four bytes of edges, level, flags and
-// child index.
-void Hierarchy::write_vertices(Node& node, VertexId a, VertexId b, VertexId d, NodeId parent) {
-    node.v[0] = a;
-    node.v[1] = b;
-    node.v[2] = d;
-    node.parent = parent;
+// child index. Four siblings' pieces are made in registers and stored whole: scalar stores of
+// every field made the build store-bound.
+
+// The vertices and parent of four new siblings (the layout of Hierarchy::split) from their
+// parent's corners and the midpoints of its edges.
+void Hierarchy::write_vertices(Node* child, const VertexId corner[3], const VertexId m[3], NodeId parent) {
+#if defined(__SSE2__)
+    const __m128i p = _mm_set_epi32(int(parent), int(corner[2]), int(corner[1]), int(corner[0]));
+    const __m128i q = _mm_set_epi32(int(parent), int(m[2]), int(m[1]), int(m[0]));
+    // Lanes 0-1 of shuffle_ps come from its first operand, 2-3 from its second.
+    const __m128 pf = _mm_castsi128_ps(p), qf = _mm_castsi128_ps(q);
+    const __m128 pq = _mm_castsi128_ps(_mm_unpacklo_epi32(p, q));  // corner 0, m 0, corner 1, m 1
+    auto store = [](Node& node, __m128 v) {
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(node.v), _mm_castps_si128(v));
+    };
+    store(child[0], _mm_shuffle_ps(pq, qf, _MM_SHUFFLE(3, 2, 1, 0)));  // corner 0, m 0, m 2
+    store(child[1], _mm_shuffle_ps(pq, qf, _MM_SHUFFLE(3, 1, 2, 1)));  // m 0, corner 1, m 1
+    store(child[2], _mm_shuffle_ps(qf, pf, _MM_SHUFFLE(3, 2, 1, 2)));  // m 2, m 1, corner 2
+    store(child[3], _mm_castsi128_ps(_mm_shuffle_epi32(q, _MM_SHUFFLE(3, 0, 2, 1))));  // m 1, m 2, m 0
+#else
+    const VertexId layout[4][3] = {
+        {corner[0], m[0], m[2]}, {m[0], corner[1], m[1]}, {m[2], m[1], corner[2]}, {m[1], m[2], m[0]}};
+    for (int k = 0; k < 4; ++k) {
+        for (int i = 0; i < 3; ++i) child[k].v[i] = layout[k][i];
+        child[k].parent = parent;
+    }
+#endif
 }
 
 void Hierarchy::write_tail(Node& node, uint32_t word) {
@@ -208,8 +229,8 @@ void Hierarchy::write_tail(Node& node, uint32_t word) {
 // local links (word 3k + e: child k, edge e); a local index becomes the id offset + index,
 // kNoNode stays.
 void Hierarchy::write_neighbors(Node* child, const uint32_t* links, uint32_t offset) {
-    static_assert(sizeof(Node) == 36 && offsetof(Node, first_child) == 16 && offsetof(Node, nbr) == 20 &&
-                      offsetof(Node, nbr_edge) == 32,
+    static_assert(sizeof(Node) == 36 && offsetof(Node, parent) == 12 && offsetof(Node, first_child) == 16 &&
+                      offsetof(Node, nbr) == 20 && offsetof(Node, nbr_edge) == 32,
                   "split_level writes nodes by this layout");
 #if defined(__SSE2__)
     const __m128i all_ones = _mm_set1_epi32(-1);
@@ -221,7 +242,9 @@ void Hierarchy::write_neighbors(Node* child, const uint32_t* links, uint32_t off
     const __m128i t0 = ids(links), t1 = ids(links + 4), t2 = ids(links + 8);
     // Lane 0 of each piece is first_child: kNoNode. Lanes 1-3 are words 3k..3k+2.
     const __m128i lane0 = _mm_cvtsi32_si128(-1);
-    auto store = [](Node& node, __m128i v) { _mm_storeu_si128(reinterpret_cast<__m128i*>(&node.first_child), v); };
+    auto store = [](Node& node, __m128i v) {
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(&node.first_child), v);
+    };
     store(child[0], _mm_or_si128(_mm_slli_si128(t0, 4), lane0));
     store(child[1], _mm_or_si128(_mm_or_si128(_mm_srli_si128(t0, 8), _mm_slli_si128(t1, 8)), lane0));
     store(child[2], _mm_or_si128(_mm_or_si128(_mm_srli_si128(t1, 4), _mm_slli_si128(t2, 12)), lane0));
@@ -306,10 +329,7 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
         const unsigned boundary = parent.flags;
         Node* child = nodes + c;
         // Child by child with literal k: a loop, or a helper taking k, compiled to worse code.
-        write_vertices(child[0], parent.v[0], m[0], m[2], n);
-        write_vertices(child[1], m[0], parent.v[1], m[1], n);
-        write_vertices(child[2], m[2], m[1], parent.v[2], n);
-        write_vertices(child[3], m[1], m[2], m[0], n);
+        write_vertices(child, parent.v, m, n);
         write_neighbors(child, child_links + size_t(12) * i, offset);
         auto tail = [&](int k) {
             return ((outer & kChildEdges[k].outer) | kChildEdges[k].inner) | level |
