@@ -76,15 +76,19 @@ struct BitModel {
         return q == 0 ? 1 : q;  // p < 2^32 so q <= 2^16 - 1 already
     }
 
-    void update(bool bit) {
-        if (static_cast<uint32_t>(n) + 2 < (uint32_t{1} << limit_log2)) {
+    void update(bool bit) { update_with_limit(bit, limit_log2); }
+
+    // update() for a model whose limit_log2 is `limit`: with a constant limit (the hierarchy
+    // coder's models all have the default) the window is folded into the code.
+    void update_with_limit(bool bit, int limit) {
+        if (static_cast<uint32_t>(n) + 2 < (uint32_t{1} << limit)) {
             const uint32_t d = static_cast<uint32_t>(n) + 2;  // KT ramp-up: rate 1/(n+2)
             if (bit) p += ~p / d;
             else p -= p / d;
             ++n;
         } else {
-            if (bit) p += ~p >> limit_log2;
-            else p -= p >> limit_log2;
+            if (bit) p += ~p >> limit;
+            else p -= p >> limit;
         }
     }
 
@@ -99,20 +103,12 @@ class ArithmeticEncoder {
 public:
     ArithmeticEncoder() = default;
 
-    void encode(bool bit, BitModel& model) {
-        const uint32_t bound =
-            static_cast<uint32_t>((uint64_t{range_} * model.p16()) >> kProbBits);
-        if (bit) {
-            range_ = bound;
-        } else {
-            low_ += bound;
-            range_ -= bound;
-        }
-        model.update(bit);
-        while (range_ < kTop) {
-            range_ <<= 8;
-            shift_low();
-        }
+    void encode(bool bit, BitModel& model) { encode_with_limit(bit, model, model.limit_log2); }
+
+    // encode() for a model whose limit_log2 is kLimitLog2 (see BitModel::update_with_limit).
+    template <int kLimitLog2>
+    void encode_with_limit(bool bit, BitModel& model) {
+        encode_with_limit(bit, model, kLimitLog2);
     }
 
     // The low `count` bits of `value`, most significant first, each with probability 1/2.
@@ -131,6 +127,22 @@ public:
 
 private:
     static constexpr uint32_t kTop = uint32_t{1} << 24;
+
+    void encode_with_limit(bool bit, BitModel& model, int limit_log2) {
+        const uint32_t bound =
+            static_cast<uint32_t>((uint64_t{range_} * model.p16()) >> kProbBits);
+        if (bit) {
+            range_ = bound;
+        } else {
+            low_ += bound;
+            range_ -= bound;
+        }
+        model.update_with_limit(bit, limit_log2);
+        while (range_ < kTop) {
+            range_ <<= 8;
+            shift_low();
+        }
+    }
 
     // Moves the top byte of the 32-bit low out; resolves carries into the held-back bytes.
     void shift_low() {
@@ -155,22 +167,12 @@ public:
     // Reads at most `size` bytes from `data`; never past it. `data` must outlive the decoder.
     ArithmeticDecoder(const uint8_t* data, size_t size);
 
-    bool decode(BitModel& model) {
-        const uint32_t bound =
-            static_cast<uint32_t>((uint64_t{range_} * model.p16()) >> kProbBits);
-        const bool bit = code_ < bound;
-        if (bit) {
-            range_ = bound;
-        } else {
-            code_ -= bound;
-            range_ -= bound;
-        }
-        model.update(bit);
-        while (range_ < kTop) {
-            range_ <<= 8;
-            code_ = (code_ << 8) | next_byte();
-        }
-        return bit;
+    bool decode(BitModel& model) { return decode_with_limit(model, model.limit_log2); }
+
+    // decode() for a model whose limit_log2 is kLimitLog2 (see BitModel::update_with_limit).
+    template <int kLimitLog2>
+    bool decode_with_limit(BitModel& model) {
+        return decode_with_limit(model, kLimitLog2);
     }
 
     // count in [0, 32]; throws amc::Error otherwise.
@@ -186,6 +188,24 @@ public:
 
 private:
     static constexpr uint32_t kTop = uint32_t{1} << 24;
+
+    bool decode_with_limit(BitModel& model, int limit_log2) {
+        const uint32_t bound =
+            static_cast<uint32_t>((uint64_t{range_} * model.p16()) >> kProbBits);
+        const bool bit = code_ < bound;
+        if (bit) {
+            range_ = bound;
+        } else {
+            code_ -= bound;
+            range_ -= bound;
+        }
+        model.update_with_limit(bit, limit_log2);
+        while (range_ < kTop) {
+            range_ <<= 8;
+            code_ = (code_ << 8) | next_byte();
+        }
+        return bit;
+    }
 
     uint32_t next_byte() {
         if (pos_ < size_) return data_[pos_++];

@@ -92,13 +92,13 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
         // The level has fewer nodes than symbols are left: no symbol can be the last.
         decide_with([&](uint32_t, int group) {
             ++symbols_read;
-            return d.decode(models.groups[size_t(group & group_mask)]);
+            return d.decode_with_limit<kHierarchyModelLimit>(models.groups[size_t(group & group_mask)]);
         });
     } else {
         decide_with([&](uint32_t, int group) {
             if (symbols_read == symbol_limit) return false;
             ++symbols_read;
-            return d.decode(models.groups[size_t(group & group_mask)]);
+            return d.decode_with_limit<kHierarchyModelLimit>(models.groups[size_t(group & group_mask)]);
         });
     }
     // The next level's numbering of the refined nodes, the leaves closed by two hanging nodes
@@ -115,7 +115,7 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
         const uint32_t i = closures[k];
         if (refined_neighbors(state[i]) == 3) throw corrupt(i, " has three hanging nodes but was not refined");
         bool flag = diagonal_flag_by_rule(header_.diagonal_rule, unrefined_edge(level_, i));
-        if (header_.orientation_coded) flag ^= d.decode(models.orientation);
+        if (header_.orientation_coded) flag ^= d.decode_with_limit<kHierarchyModelLimit>(models.orientation);
         if (flag) level_.flipped.push_back(i);
     }
     const uint32_t count = level_.refined_count;

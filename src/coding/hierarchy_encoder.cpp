@@ -129,7 +129,7 @@ void HierarchyLevelEncoder::encode_level(int l, ArithmeticEncoder& encoder) {
         if (e.group == kOrientationEvent) {
             if (!stats_.orientation_coded) continue;
             stats_.orientation_bits += models_.orientation.cost_bits(e.bit);
-            encoder.encode(e.bit, models_.orientation);
+            encoder.encode_with_limit<kHierarchyModelLimit>(e.bit, models_.orientation);
             continue;
         }
         if (symbols_written_ == kept_symbols_) continue;
@@ -140,7 +140,7 @@ void HierarchyLevelEncoder::encode_level(int l, ArithmeticEncoder& encoder) {
         group.ones += e.bit;
         stats_.coded_ones += e.bit;
         group.coded_bits += model.cost_bits(e.bit);
-        encoder.encode(e.bit, model);
+        encoder.encode_with_limit<kHierarchyModelLimit>(e.bit, model);
     }
 }
 

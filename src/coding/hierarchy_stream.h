@@ -35,6 +35,8 @@ size_t read_hierarchy_stream_header(const uint8_t* data, size_t size, HierarchyS
 
 // One adaptive model per context group (or one shared model without contexts), and one for the
 // orientation bits.
+// Every model of the hierarchy coder has the default window: the coders pass it as a constant.
+constexpr int kHierarchyModelLimit = BitModel::kDefaultLimitLog2;
 struct HierarchyModels {
     std::array<BitModel, kContextGroupCount> groups{};
     BitModel orientation{};
