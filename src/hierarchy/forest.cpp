@@ -213,6 +213,25 @@ void Hierarchy::write_vertices(Node* child, const VertexId corner[3], const Vert
 #endif
 }
 
+// The last four bytes of four new siblings but their level (word k: child k), by the parent's
+// neighbour edge indices of its linked edges (bits 0-5) and its boundary edges (bits 6-8).
+struct ChildTails {
+    uint32_t word[4];
+};
+struct ChildTailTable {
+    ChildTails of[512];
+    constexpr ChildTailTable() : of() {
+        for (unsigned code = 0; code < 512; ++code) {
+            const unsigned outer = code & 63u, boundary = code >> 6;
+            for (unsigned k = 0; k < 4; ++k) {
+                of[code].word[k] = ((outer & kChildEdges[k].outer) | kChildEdges[k].inner) |
+                                   (boundary & kChildEdges[k].boundary) << 16 | k << 24;
+            }
+        }
+    }
+};
+constexpr ChildTailTable kChildTails{};
+
 void Hierarchy::write_tail(Node& node, uint32_t word) {
     // Bytes nbr_edge, level, flags, child_index in that order (little endian word).
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
@@ -331,14 +350,8 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
         // Child by child with literal k: a loop, or a helper taking k, compiled to worse code.
         write_vertices(child, parent.v, m, n);
         write_neighbors(child, child_links + size_t(12) * i, offset);
-        auto tail = [&](int k) {
-            return ((outer & kChildEdges[k].outer) | kChildEdges[k].inner) | level |
-                   uint32_t(boundary & kChildEdges[k].boundary) << 16 | uint32_t(k) << 24;
-        };
-        write_tail(child[0], tail(0));
-        write_tail(child[1], tail(1));
-        write_tail(child[2], tail(2));
-        write_tail(child[3], tail(3));
+        const ChildTails& tails = kChildTails.of[outer | (boundary & 7u) << 6];
+        for (int k = 0; k < 4; ++k) write_tail(child[k], tails.word[k] | level);
         parent.first_child = c;
     }
     live_nodes_ += 4 * count;
