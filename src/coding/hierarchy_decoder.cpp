@@ -3,6 +3,7 @@
 #include "coding/hierarchy_level_coder.h"
 
 #include <string>
+#include <type_traits>
 #include <utility>
 
 namespace amc {
@@ -85,22 +86,20 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
     HierarchyModels models = models_;
     uint64_t symbols_read = symbols_read_;
     const int group_mask = header_.options.use_contexts ? 0xff : 0;
-    auto decide_with = [&](auto&& code) {
-        traversal_.run(level_, l < header_.uniform_levels, code, [&](uint32_t, Fate, bool refined) { return refined; });
+    // may_end: whether the stored symbols can run out within this level (a compile-time switch,
+    // so that the other levels test nothing per symbol).
+    auto decide = [&](auto may_end) {
+        traversal_.run(
+            level_, l < header_.uniform_levels,
+            [&](uint32_t, int group) {
+                if (decltype(may_end)::value && symbols_read == symbol_limit) return false;
+                ++symbols_read;
+                return d.decode_with_limit<kHierarchyModelLimit>(models.groups[size_t(group & group_mask)]);
+            },
+            [&](uint32_t, Fate, bool refined) { return refined; });
     };
-    if (symbol_limit - symbols_read >= n) {
-        // The level has fewer nodes than symbols are left: no symbol can be the last.
-        decide_with([&](uint32_t, int group) {
-            ++symbols_read;
-            return d.decode_with_limit<kHierarchyModelLimit>(models.groups[size_t(group & group_mask)]);
-        });
-    } else {
-        decide_with([&](uint32_t, int group) {
-            if (symbols_read == symbol_limit) return false;
-            ++symbols_read;
-            return d.decode_with_limit<kHierarchyModelLimit>(models.groups[size_t(group & group_mask)]);
-        });
-    }
+    if (symbol_limit - symbols_read >= n) decide(std::false_type{});  // fewer nodes than symbols left
+    else decide(std::true_type{});
     // The next level's numbering of the refined nodes, the leaves closed by two hanging nodes
     // (their diagonals come next in the stream) and the checks. Errors name the element by its
     // level and canonical index: its node id may not exist yet.

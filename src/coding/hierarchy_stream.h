@@ -33,10 +33,11 @@ std::vector<uint8_t> write_hierarchy_stream_header(const HierarchyStreamHeader& 
 // Parses the header; returns the bytes it used. Throws Error on a malformed header.
 size_t read_hierarchy_stream_header(const uint8_t* data, size_t size, HierarchyStreamHeader& header);
 
-// One adaptive model per context group (or one shared model without contexts), and one for the
-// orientation bits.
 // Every model of the hierarchy coder has the default window: the coders pass it as a constant.
 constexpr int kHierarchyModelLimit = BitModel::kDefaultLimitLog2;
+
+// One adaptive model per context group (or one shared model without contexts), and one for the
+// orientation bits.
 struct HierarchyModels {
     std::array<BitModel, kContextGroupCount> groups{};
     BitModel orientation{};

@@ -6,8 +6,8 @@
 #include "hierarchy/child_links.h"
 
 #include <algorithm>
-#include <cstdint>
 #include <cstddef>
+#include <cstdint>
 #include <cstring>
 #include <string>
 #include <unordered_map>
@@ -347,7 +347,6 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
         const uint32_t level = uint32_t(parent.level + 1) << 8;
         const unsigned boundary = parent.flags;
         Node* child = nodes + c;
-        // Child by child with literal k: a loop, or a helper taking k, compiled to worse code.
         write_vertices(child, parent.v, m, n);
         write_neighbors(child, child_links + size_t(12) * i, offset);
         const ChildTails& tails = kChildTails.of[outer | (boundary & 7u) << 6];
