@@ -4,7 +4,7 @@
 // instructions, branch misses) where Linux allows it: unlike time, they hardly move when other
 // virtual machines load the host, so two builds can be compared with few runs.
 //
-//   decode_phases [--nodes N] [--runs R] [--reuse]
+//   decode_phases [--nodes N] [--runs R] [--reuse] [--model surface|random]
 //
 // --reuse keeps one decoder, and the hierarchy it decodes into, from run to run (as
 // amc::HierarchyDecoder does): no fresh memory. Without it every run starts from nothing and
@@ -152,10 +152,13 @@ int main(int argc, char** argv) {
     long nodes = 1000000;
     int runs = 15;
     bool reuse = false;
+    std::string model;  // both when empty
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         if (arg == "--reuse") {
             reuse = true;
+        } else if (arg == "--model" && i + 1 < argc && (std::string(argv[i + 1]) == "surface" || std::string(argv[i + 1]) == "random")) {
+            model = argv[++i];
         } else if ((arg == "--nodes" || arg == "--runs") && i + 1 < argc) {
             const long value = std::strtol(argv[++i], nullptr, 10);
             if (value <= 0) {
@@ -165,13 +168,13 @@ int main(int argc, char** argv) {
             if (arg == "--nodes") nodes = std::min(value, 20000000L);  // a few GB at most
             else runs = int(std::min(value, 1000L));
         } else {
-            std::fprintf(stderr, "usage: decode_phases [--nodes N] [--runs R] [--reuse]\n");
+            std::fprintf(stderr, "usage: decode_phases [--nodes N] [--runs R] [--reuse] [--model surface|random]\n");
             return 2;
         }
     }
     const Counters counters;
     if (!counters.available()) std::printf("(no hardware counters here: wall time only)\n");
     // The models of coder_bench.
-    report("surface", make_bench_hierarchy(BenchModel::surface, nodes), runs, reuse, counters);
-    report("random", make_bench_hierarchy(BenchModel::random, nodes), runs, reuse, counters);
+    if (model != "random") report("surface", make_bench_hierarchy(BenchModel::surface, nodes), runs, reuse, counters);
+    if (model != "surface") report("random", make_bench_hierarchy(BenchModel::random, nodes), runs, reuse, counters);
 }

@@ -209,18 +209,6 @@ struct SiblingStates {
 };
 constexpr SiblingStates kSiblingStates{};
 
-// By a node's neighbour edge indices (2 bits per edge): byte e holds (eq + 1) % 3 for edge e's eq,
-// the neighbour's child on the first half of the edge.
-struct NextEdges {
-    uint32_t byte[64];
-    constexpr NextEdges() : byte() {
-        for (int code = 0; code < 64; ++code) {
-            for (int e = 0; e < 3; ++e) byte[code] |= uint32_t((((code >> (2 * e)) & 3) + 1) % 3) << (8 * e);
-        }
-    }
-};
-constexpr NextEdges kNextEdges{};
-
 // By which of a refined node's edges have a refined neighbour (bits 0-2): the mask of their two-bit
 // neighbour edge indices, and the ends its new vertices count (2 on an edge of its own, 1 shared).
 struct EdgePairs {
@@ -307,6 +295,70 @@ inline DecidedLevelScan scan_decided_level(Level& level, RefinedNumbering& numbe
     return scan;
 }
 
+// By a node's neighbour edge indices (2 bits per edge): lane e holds the child of the neighbour
+// across edge e that meets the edge's first half ((eq+1)%3) or its second half (eq); lane 3 the
+// center child's and corner 2's offsets within the node's own block (3 and 2), see below.
+struct HalfEdgeChildren {
+    alignas(16) uint32_t first[64][4];
+    alignas(16) uint32_t second[64][4];
+    constexpr HalfEdgeChildren() : first(), second() {
+        for (int code = 0; code < 64; ++code) {
+            for (int e = 0; e < 3; ++e) {
+                const uint32_t eq = uint32_t(code >> (2 * e)) & 3u;
+                first[code][e] = (eq + 1) % 3;
+                second[code][e] = eq;
+            }
+            first[code][3] = 3;
+            second[code][3] = 2;
+        }
+    }
+};
+constexpr HalfEdgeChildren kHalfEdgeChildren{};
+
+// The neighbours of the four children of block b (Neighbors out[0..3], the layout of
+// child_neighbors) from the blocks q0..q2 of the parent's neighbours (kNoLocal for none, blocks are
+// below 2^30) and the parent's neighbour edge indices. Returns the parent's edges with a refined
+// neighbour (bits 0-2).
+inline unsigned write_child_neighbors(Neighbors* out, uint32_t b, uint32_t q0, uint32_t q1, uint32_t q2,
+                                      uint8_t nbr_edge) {
+    const unsigned code = nbr_edge & 63u;
+#if defined(__SSE2__)
+    // Lanes 0-2: edge e; lane 3: the block itself, whose first child is c = 4b.
+    const __m128i q = _mm_set_epi32(int(b), int(q2), int(q1), int(q0));
+    const __m128i none = _mm_srai_epi32(q, 31);
+    const __m128i base = _mm_slli_epi32(q, 2);
+    auto halves = [&](const uint32_t* offsets) {
+        const __m128i v = _mm_add_epi32(base, _mm_load_si128(reinterpret_cast<const __m128i*>(offsets)));
+        return _mm_castsi128_ps(_mm_or_si128(v, none));
+    };
+    const __m128 first = halves(kHalfEdgeChildren.first[code]);    // first 0-2, c + 3
+    const __m128 second = halves(kHalfEdgeChildren.second[code]);  // second 0-2, c + 2
+    // The twelve words {first0, c+3, second2 | second0, first1, c+3 | c+3, second1, first2 | c+2, c,
+    // c+1} as three vectors; lanes 0-1 of shuffle_ps come from its first operand, 2-3 from its second.
+    auto store = [&](int k, __m128 v) { _mm_storeu_si128(reinterpret_cast<__m128i*>(out->nbr) + k, _mm_castps_si128(v)); };
+    store(0, _mm_shuffle_ps(first, second, _MM_SHUFFLE(0, 2, 3, 0)));
+    store(1, _mm_castsi128_ps(_mm_add_epi32(_mm_castps_si128(_mm_shuffle_ps(first, second, _MM_SHUFFLE(1, 3, 3, 1))),
+                                            _mm_set_epi32(0, 1, 0, 0))));
+    store(2, _mm_castsi128_ps(_mm_add_epi32(_mm_castps_si128(_mm_shuffle_ps(first, second, _MM_SHUFFLE(3, 3, 3, 2))),
+                                            _mm_set_epi32(-1, -2, -1, 0))));
+    return ~unsigned(_mm_movemask_ps(_mm_castsi128_ps(none))) & 7u;
+#else
+    const uint32_t q[3] = {q0, q1, q2};
+    uint32_t first[3], second[3];
+    unsigned linked = 0;
+    for (int e = 0; e < 3; ++e) {
+        const uint32_t none = uint32_t(static_cast<int32_t>(q[e]) >> 31);
+        first[e] = (4 * q[e] + kHalfEdgeChildren.first[code][e]) | none;
+        second[e] = (4 * q[e] + kHalfEdgeChildren.second[code][e]) | none;
+        linked |= (1u << e) & ~none;
+    }
+    const ChildNeighbors children = child_neighbors(4 * b, first, second);
+    static_assert(sizeof(children.nbr) == 4 * sizeof(Neighbors), "four children's neighbours");
+    std::memcpy(out, children.nbr, sizeof(children.nbr));
+    return linked;
+#endif
+}
+
 // Level l+1 from level l (every node decided and numbered): the children of the refined nodes in
 // canonical order, linked exactly as Hierarchy::split links them. Returns the number of vertices
 // the splits create: one per edge of a refined node, shared where the neighbour is refined too.
@@ -329,20 +381,10 @@ inline uint64_t derive_next_level(const Level& level, const RefinedNumbering& nu
     with_links(level, [&](auto links) {
         for (uint32_t b = 0; b < count; ++b) {
             const LevelLinks p = links(refined[b]);
-            uint32_t first[3], second[3];
-            unsigned linked = 0;
-            const uint32_t next_edges = kNextEdges.byte[p.nbr_edge & 63u];
-            for (int e = 0; e < 3; ++e) {
-                const uint32_t q = block[static_cast<int32_t>(p.nbr[e])];  // kNoLocal for none
-                const uint32_t none = uint32_t(static_cast<int32_t>(q) >> 31);  // blocks are below 2^30
-                first[e] = (4 * q + ((next_edges >> (8 * e)) & 3u)) | none;
-                second[e] = (4 * q + ((p.nbr_edge >> (2 * e)) & 3u)) | none;
-                linked |= (1u << e) & ~none;
-            }
             const uint32_t c = 4 * b;
-            const ChildNeighbors children = child_neighbors(c, first, second);
-            static_assert(sizeof(children.nbr) == 4 * sizeof(Neighbors), "four children's neighbours");
-            std::memcpy(out + c, children.nbr, sizeof(children.nbr));
+            const unsigned linked = write_child_neighbors(
+                out + c, b, block[static_cast<int32_t>(p.nbr[0])], block[static_cast<int32_t>(p.nbr[1])],
+                block[static_cast<int32_t>(p.nbr[2])], p.nbr_edge);  // kNoLocal for none
             out_edges[b] = {uint8_t(p.nbr_edge & kEdgePairs.mask[linked]), uint8_t(p.flags & 7)};
             edge_ends += kEdgePairs.ends[linked];
             const uint32_t word = kSiblingStates.word[linked | ((p.flags & 7u) << 3)];
