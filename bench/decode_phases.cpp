@@ -139,7 +139,7 @@ void report(const char* name, const amc::Hierarchy& h, int runs, bool reuse, con
         if (counters.available()) {
             for (int k = 0; k < kCounters; ++k) {
                 const Spread c = spread(samples, [p, k](const Sample& s) { return s.counts[p][k]; });
-                std::printf("   %s %.1f / %.1f M", kCounterNames[k], c.min / 1e6, c.median / 1e6);
+                std::printf("   %s %.2f / %.2f M", kCounterNames[k], c.min / 1e6, c.median / 1e6);
             }
         }
         std::printf("\n");
