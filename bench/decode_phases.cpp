@@ -160,10 +160,12 @@ int main(int argc, char** argv) {
         const std::string arg = argv[i];
         if (arg == "--reuse") {
             reuse = true;
-        } else if (arg == "--model" && i + 1 < argc &&
-                   (std::string(argv[i + 1]) == "surface" || std::string(argv[i + 1]) == "random" ||
-                    std::string(argv[i + 1]) == "fe")) {
+        } else if (arg == "--model" && i + 1 < argc) {
             model = argv[++i];
+            if (model != "surface" && model != "random" && model != "fe") {
+                std::fprintf(stderr, "decode_phases: --model is surface, random or fe, not %s\n", model.c_str());
+                return 2;
+            }
         } else if ((arg == "--nodes" || arg == "--runs") && i + 1 < argc) {
             const long value = std::strtol(argv[++i], nullptr, 10);
             if (value <= 0) {

@@ -315,10 +315,13 @@ struct HalfEdgeChildren {
 };
 constexpr HalfEdgeChildren kHalfEdgeChildren{};
 
-// The neighbours of the four children of block b (Neighbors out[0..3], the layout of
-// child_neighbors) from the blocks q0..q2 of the parent's neighbours (kNoLocal for none, blocks are
-// below 2^30) and the parent's neighbour edge indices. Returns the parent's edges with a refined
-// neighbour (bits 0-2).
+// The neighbours of the four children of block b (Neighbors out[0..3]) from the blocks q0..q2 of
+// the parent's neighbours (kNoLocal for none, blocks are below 2^30) and the parent's neighbour
+// edge indices. With c = 4b, first[e] / second[e] the neighbours across the first / second half of
+// the parent's edge e (kNoLocal for none), the twelve words are
+//   corner 0: first0, c+3, second2   corner 1: second0, first1, c+3
+//   corner 2: c+3, second1, first2   center:   c+2, c, c+1
+// Returns the parent's edges with a refined neighbour (bits 0-2).
 inline unsigned write_child_neighbors(Neighbors* out, uint32_t b, uint32_t q0, uint32_t q1, uint32_t q2,
                                       uint8_t nbr_edge) {
     const unsigned code = nbr_edge & 63u;
@@ -333,8 +336,8 @@ inline unsigned write_child_neighbors(Neighbors* out, uint32_t b, uint32_t q0, u
     };
     const __m128 first = halves(kHalfEdgeChildren.first[code]);    // first 0-2, c + 3
     const __m128 second = halves(kHalfEdgeChildren.second[code]);  // second 0-2, c + 2
-    // The twelve words {first0, c+3, second2 | second0, first1, c+3 | c+3, second1, first2 | c+2, c,
-    // c+1} as three vectors; lanes 0-1 of shuffle_ps come from its first operand, 2-3 from its second.
+    // The twelve words as three vectors; lanes 0-1 of shuffle_ps come from its first operand, 2-3
+    // from its second.
     auto store = [&](int k, __m128 v) { _mm_storeu_si128(reinterpret_cast<__m128i*>(out->nbr) + k, _mm_castps_si128(v)); };
     store(0, _mm_shuffle_ps(first, second, _MM_SHUFFLE(0, 2, 3, 0)));
     store(1, _mm_castsi128_ps(_mm_add_epi32(_mm_castps_si128(_mm_shuffle_ps(first, second, _MM_SHUFFLE(1, 3, 3, 1))),
@@ -352,9 +355,11 @@ inline unsigned write_child_neighbors(Neighbors* out, uint32_t b, uint32_t q0, u
         second[e] = (4 * q[e] + kHalfEdgeChildren.second[code][e]) | none;
         linked |= (1u << e) & ~none;
     }
-    const ChildNeighbors children = child_neighbors(4 * b, first, second);
-    static_assert(sizeof(children.nbr) == 4 * sizeof(Neighbors), "four children's neighbours");
-    std::memcpy(out, children.nbr, sizeof(children.nbr));
+    const uint32_t c = 4 * b;
+    out[0] = {{first[0], c + 3, second[2]}};
+    out[1] = {{second[0], first[1], c + 3}};
+    out[2] = {{c + 3, second[1], first[2]}};
+    out[3] = {{c + 2, c, c + 1}};
     return linked;
 #endif
 }

@@ -23,17 +23,4 @@ constexpr ChildEdges kChildEdges[4] = {
     {0x00, (1u << 2) | (2u << 4), 0},
 };
 
-// The same-level neighbours of the four children (nbr[k][e]: child k across its edge e), given
-// the first child's id c and, per parent edge e, the neighbours across its first half (child e's
-// edge e) and its second half (child (e+1)%3's edge e).
-struct ChildNeighbors {
-    uint32_t nbr[4][3];
-};
-inline ChildNeighbors child_neighbors(uint32_t c, const uint32_t first[3], const uint32_t second[3]) {
-    return {{{first[0], c + 3, second[2]},
-             {second[0], first[1], c + 3},
-             {c + 3, second[1], first[2]},
-             {c + 2, c, c + 1}}};
-}
-
 }  // namespace amc

