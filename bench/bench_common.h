@@ -7,14 +7,33 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
-enum class BenchModel { surface = 0, random = 1 };
+enum class BenchModel { surface = 0, random = 1, fe = 2 };
 
 // surface: a curvature-adaptive remesh of the procedural bumpy sphere; random: a random hierarchy
-// over a torus. Both with about target_nodes nodes.
+// over a torus; fe: a planar finite-element model, the L-shaped domain of amc::make_l_shape_model
+// graded towards its re-entrant corner, with element sizes scaled to the target. All with about
+// target_nodes nodes.
 inline amc::Hierarchy make_bench_hierarchy(BenchModel model, int64_t target_nodes) {
+    if (model == BenchModel::fe) {
+        auto graded = [](double scale) {
+            amc::Hierarchy h(amc::make_l_shape(4));
+            amc::refine_to_size(
+                h, [scale](amc::Vec3 x) { return scale * std::pow(std::sqrt(x.x * x.x + x.y * x.y), 0.6); }, 14);
+            return h;
+        };
+        // make_l_shape_model's scale gives 1.2 * 10^5 nodes; the node count goes as 1 / scale^2.
+        double scale = 0.025;
+        amc::Hierarchy h = graded(scale);
+        for (int step = 0; step < 2; ++step) {
+            scale *= std::sqrt(double(h.node_count()) / double(target_nodes));
+            h = graded(scale);
+        }
+        return h;
+    }
     if (model == BenchModel::surface) {
         amc::SurfaceRemeshOptions options;
         options.base_triangles = 500;

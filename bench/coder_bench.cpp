@@ -1,7 +1,7 @@
 // Hierarchy coder throughput, single thread, in nodes per second (items_per_second): encode,
 // decode into a new Hierarchy, and decode reusing one decoder and its target hierarchy, of
-// curvature-adaptive hierarchies of the procedural surface and of random hierarchies, at about
-// 10^5 and 10^6 nodes. The hierarchies are built once, outside the timing.
+// curvature-adaptive hierarchies of the procedural surface, of random hierarchies and of graded
+// planar finite-element hierarchies, at about 10^5 and 10^6 nodes. The hierarchies are built once, outside the timing.
 #include "bench_common.h"
 
 #include <amc/hierarchy_coder.h>
@@ -61,10 +61,10 @@ void BM_DecodeReusing(benchmark::State& state) {
 }
 
 void sizes(benchmark::internal::Benchmark* b) {
-    for (BenchModel model : {BenchModel::surface, BenchModel::random}) {
+    for (BenchModel model : {BenchModel::surface, BenchModel::random, BenchModel::fe}) {
         for (int64_t nodes : {100000, 1000000}) b->Args({int64_t(model), nodes});
     }
-    b->ArgNames({"model(0=surface,1=random)", "nodes"})->Unit(benchmark::kMillisecond)->MinTime(0.5);
+    b->ArgNames({"model(0=surface,1=random,2=fe)", "nodes"})->Unit(benchmark::kMillisecond)->MinTime(0.5);
 }
 
 BENCHMARK(BM_Encode)->Apply(sizes);

@@ -6,8 +6,7 @@
 //
 //   decode_phases [--nodes N] [--runs R] [--reuse] [--model surface|random|fe]
 //
-// fe, only when asked for: the planar finite-element model of the corpus (amc::make_l_shape_model(10),
-// graded towards the re-entrant corner), about 1.2 * 10^5 nodes whatever --nodes says.
+// Without --model: surface, random and fe, in that order (see make_bench_hierarchy).
 //
 // --reuse keeps one decoder, and the hierarchy it decodes into, from run to run (as
 // amc::HierarchyDecoder does): no fresh memory. Without it every run starts from nothing and
@@ -155,7 +154,7 @@ int main(int argc, char** argv) {
     long nodes = 1000000;
     int runs = 15;
     bool reuse = false;
-    std::string model;  // both when empty
+    std::string model;  // all three when empty
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         if (arg == "--reuse") {
@@ -186,5 +185,5 @@ int main(int argc, char** argv) {
         report("surface", make_bench_hierarchy(BenchModel::surface, nodes), runs, reuse, counters);
     if (model.empty() || model == "random")
         report("random", make_bench_hierarchy(BenchModel::random, nodes), runs, reuse, counters);
-    if (model == "fe") report("fe", amc::make_l_shape_model(10), runs, reuse, counters);
+    if (model.empty() || model == "fe") report("fe", make_bench_hierarchy(BenchModel::fe, nodes), runs, reuse, counters);
 }
