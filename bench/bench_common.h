@@ -19,18 +19,12 @@ enum class BenchModel { surface = 0, random = 1, fe = 2 };
 // target_nodes nodes.
 inline amc::Hierarchy make_bench_hierarchy(BenchModel model, int64_t target_nodes) {
     if (model == BenchModel::fe) {
-        auto graded = [](double scale) {
-            amc::Hierarchy h(amc::make_l_shape(4));
-            amc::refine_to_size(
-                h, [scale](amc::Vec3 x) { return scale * std::pow(std::sqrt(x.x * x.x + x.y * x.y), 0.6); }, 14);
-            return h;
-        };
-        // make_l_shape_model's scale gives 1.2 * 10^5 nodes; the node count goes as 1 / scale^2.
+        // The node count goes about as 1 / scale^2: two corrections from the default scale.
         double scale = 0.025;
-        amc::Hierarchy h = graded(scale);
+        amc::Hierarchy h = amc::make_l_shape_model(14, scale);
         for (int step = 0; step < 2; ++step) {
             scale *= std::sqrt(double(h.node_count()) / double(target_nodes));
-            h = graded(scale);
+            h = amc::make_l_shape_model(14, scale);
         }
         return h;
     }

@@ -1,7 +1,8 @@
 // Hierarchy coder throughput, single thread, in nodes per second (items_per_second): encode,
 // decode into a new Hierarchy, and decode reusing one decoder and its target hierarchy, of
 // curvature-adaptive hierarchies of the procedural surface, of random hierarchies and of graded
-// planar finite-element hierarchies, at about 10^5 and 10^6 nodes. The hierarchies are built once, outside the timing.
+// planar finite-element hierarchies, at about 10^5 and 10^6 nodes. The hierarchies are built
+// once, outside the timing.
 #include "bench_common.h"
 
 #include <amc/hierarchy_coder.h>

@@ -55,8 +55,10 @@ Hierarchy remesh_adaptively(const TriangleMesh& reference, const SurfaceRemeshOp
                             SurfaceRemeshStats* stats = nullptr);
 
 // ---- planar finite-element style models -------------------------------------------------------
-// L-shaped domain graded towards the re-entrant corner.
-Hierarchy make_l_shape_model(int max_level);
+// L-shaped domain graded towards the re-entrant corner: element size size_scale * r^0.6 at
+// distance r from it. The default gives 1.2 * 10^5 nodes at max_level 10; the node count grows
+// about as 1 / size_scale^2.
+Hierarchy make_l_shape_model(int max_level, double size_scale = 0.025);
 // A front (a circular arc) sweeping across the unit square: one hierarchy per time step, each
 // obtained from the previous one by coarsening behind the front and refining ahead of it.
 std::vector<Hierarchy> make_moving_front_sequence(int steps, int max_level);

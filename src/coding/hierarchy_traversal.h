@@ -112,9 +112,6 @@ struct Level {
         states_[0] = kNoNeighborState;
     }
     bool is_root_level() const { return !roots.empty(); }
-    LevelLinks links(uint32_t i) const {
-        return is_root_level() ? roots[i] : child_links(nbr.data()[i], edges.data()[i >> 2], i & 3);
-    }
 
 private:
     std::vector<uint8_t> states_;
@@ -413,7 +410,7 @@ inline uint64_t derive_next_level(const Level& level, const RefinedNumbering& nu
 
 // The unrefined edge of a decided leaf with exactly two hanging nodes.
 inline int unrefined_edge(const Level& level, uint32_t i) {
-    const LevelLinks node = level.links(i);
+    const Neighbors node = with_links(level, [i](auto links) { return links.neighbors(i); });
     for (int e = 0; e < 2; ++e) {
         const uint32_t q = node.nbr[e];
         if (q == kNoLocal || !(level.state()[q] & kRefined)) return e;

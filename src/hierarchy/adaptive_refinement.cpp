@@ -232,12 +232,17 @@ Hierarchy remesh_adaptively(const TriangleMesh& reference, const SurfaceRemeshOp
     return h;
 }
 
-Hierarchy make_l_shape_model(int max_level) {
+Hierarchy make_l_shape_model(int max_level, double size_scale) {
     Hierarchy h(make_l_shape(4));
     // A-priori grading for the corner singularity r^(2/3): element size ~ r^(1/3) far out,
     // shrinking to the finest level at the corner.
     refine_to_size(
-        h, [](Vec3 x) { const double r = std::sqrt(x.x * x.x + x.y * x.y); return 0.025 * std::pow(r, 0.6); }, max_level);
+        h,
+        [size_scale](Vec3 x) {
+            const double r = std::sqrt(x.x * x.x + x.y * x.y);
+            return size_scale * std::pow(r, 0.6);
+        },
+        max_level);
     return h;
 }
 
