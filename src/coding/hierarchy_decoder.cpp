@@ -24,7 +24,7 @@ HierarchyLevelDecoder::HierarchyLevelDecoder(const TriangleMesh& base, const uin
 
 HierarchyLevelDecoder::HierarchyLevelDecoder(const TriangleMesh& base, const HierarchyStreamHeader& header,
                                              uint64_t max_nodes)
-    : traversal_(header.options) {
+    : HierarchyLevelDecoder() {
     restart(base, header, max_nodes);
 }
 

@@ -163,17 +163,10 @@ void Hierarchy::split(NodeId n) {
     }
     const NodeId c = allocate_children();  // may reallocate nodes_: no references held across
     const Node parent = nodes_[n];
-    const VertexId layout[4][3] = {{parent.v[0], m[0], m[2]},
-                                   {m[0], parent.v[1], m[1]},
-                                   {m[2], m[1], parent.v[2]},
-                                   {m[1], m[2], m[0]}};
+    write_vertices(&nodes_[c], parent.v, m, n);
     for (int k = 0; k < 4; ++k) {
         Node& child = nodes_[c + k];
-        for (int i = 0; i < 3; ++i) {
-            child.v[i] = layout[k][i];
-            child.nbr[i] = kNoNode;
-        }
-        child.parent = n;
+        for (int i = 0; i < 3; ++i) child.nbr[i] = kNoNode;
         child.first_child = kNoNode;
         child.nbr_edge = 0;
         child.level = uint8_t(parent.level + 1);
@@ -196,8 +189,8 @@ void Hierarchy::split(NodeId n) {
 // child index. Four siblings' pieces are made in registers and stored whole: scalar stores of
 // every field made the build store-bound.
 
-// The vertices and parent of four new siblings (the layout of Hierarchy::split) from their
-// parent's corners and the midpoints of its edges.
+// The vertices and parent of four new siblings, in the child order of <amc/hierarchy.h>, from
+// their parent's corners and the midpoints of its edges (split and split_level).
 void Hierarchy::write_vertices(Node* child, const VertexId corner[3], const VertexId m[3], NodeId parent) {
 #if defined(__SSE2__)
     const __m128i p = _mm_set_epi32(int(parent), int(corner[2]), int(corner[1]), int(corner[0]));
