@@ -324,53 +324,69 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
     Node* nodes = nodes_.data();
     VertexId next_vertex = VertexId(v0);
     const bool default_placer = placer_ == midpoint_placer;
-    const Vec3* positions = positions_.data();
-    // The loads that miss the cache (a parent's corner positions, a neighbour's center child
-    // made earlier) have addresses known well ahead: fetch them a few parents early.
+    // The parents go in chunks: first their children and links, listing the end points of the
+    // new vertices, then the new vertices' positions. Apart, the position loads (which miss the
+    // cache) overlap each other instead of stalling the loop that writes the nodes.
+    constexpr uint32_t kChunk = 256;
+    struct Ends {
+        VertexId a, b;
+    };
+    Ends ends[3 * kChunk];
+    // The loads that miss the cache (a parent, a neighbour's center child made earlier) have
+    // addresses known well ahead: fetch them a few parents early.
     constexpr uint32_t kAhead = 8;
     auto prefetch = [&](uint32_t i) {
-        const Node& parent = nodes[parents[i]];
         for (int e = 0; e < 3; ++e) {
-            __builtin_prefetch(positions + parent.v[e]);
             const uint32_t t = first_half(i, e);
             if (t / 4 < i) __builtin_prefetch(nodes + c0 + (t & ~3u) + 3);
         }
     };
     const uint32_t offset = uint32_t(c0);
-    for (uint32_t i = 0; i < count; ++i) {
-        if (i + 2 * kAhead < count) __builtin_prefetch(nodes + parents[i + 2 * kAhead]);
-        if (i + kAhead < count) prefetch(i + kAhead);
-        const NodeId n = parents[i];
-        Node& parent = nodes[n];
-        const NodeId c = NodeId(c0 + size_t(4) * i);
-        unsigned linked_edges = 0;
-        VertexId m[3];
-        for (int e = 0; e < 3; ++e) {
-            const uint32_t t = first_half(i, e);  // kNoNode / 4 is never below i
-            linked_edges |= t == kNoNode ? 0u : 3u << (2 * e);
-            if (t / 4 < i) {
-                const unsigned eq = (parent.nbr_edge >> (2 * e)) & 3u;
-                m[e] = nodes[c0 + (t & ~3u) + 3].v[eq == 0 ? 2 : eq - 1];
-            } else {
-                // Within the reserved capacity: no reallocation, references stay valid.
-                const Vec3& a = positions_[parent.v[e]];
-                const Vec3& b = positions_[parent.v[e == 2 ? 0 : e + 1]];
-                positions_.push_back(default_placer ? midpoint_placer(placer_context_, a, b)
-                                                    : placer_(placer_context_, a, b));
-                m[e] = next_vertex++;
+    for (uint32_t chunk = 0; chunk < count; chunk += kChunk) {
+        const uint32_t chunk_end = std::min(count, chunk + kChunk);
+        uint32_t new_vertices = 0;
+        for (uint32_t i = chunk; i < chunk_end; ++i) {
+            if (i + 2 * kAhead < count) __builtin_prefetch(nodes + parents[i + 2 * kAhead]);
+            if (i + kAhead < count) prefetch(i + kAhead);
+            const NodeId n = parents[i];
+            Node& parent = nodes[n];
+            const NodeId c = NodeId(c0 + size_t(4) * i);
+            unsigned linked_edges = 0;
+            VertexId m[3];
+            for (int e = 0; e < 3; ++e) {
+                const uint32_t t = first_half(i, e);  // kNoNode / 4 is never below i
+                linked_edges |= t == kNoNode ? 0u : 3u << (2 * e);
+                if (t / 4 < i) {
+                    const unsigned eq = (parent.nbr_edge >> (2 * e)) & 3u;
+                    m[e] = nodes[c0 + (t & ~3u) + 3].v[eq == 0 ? 2 : eq - 1];
+                } else {
+                    ends[new_vertices++] = {parent.v[e], parent.v[e == 2 ? 0 : e + 1]};
+                    m[e] = next_vertex++;
+                }
             }
+            // The children's edges (kChildEdges): linked outer edges take the parent's neighbour
+            // edge index.
+            const unsigned outer = parent.nbr_edge & linked_edges;
+            const uint32_t level = uint32_t(parent.level + 1) << 8;
+            const unsigned boundary = parent.flags;
+            Node* child = nodes + c;
+            write_vertices(child, parent.v, m, n);
+            write_neighbors(child, child_links + size_t(12) * i, offset);
+            const ChildTails& tails = kChildTails.of[outer | (boundary & 7u) << 6];
+            for (int k = 0; k < 4; ++k) write_tail(child[k], tails.word[k] | level);
+            parent.first_child = c;
         }
-        // The children's edges (kChildEdges): linked outer edges take the parent's neighbour edge
-        // index.
-        const unsigned outer = parent.nbr_edge & linked_edges;
-        const uint32_t level = uint32_t(parent.level + 1) << 8;
-        const unsigned boundary = parent.flags;
-        Node* child = nodes + c;
-        write_vertices(child, parent.v, m, n);
-        write_neighbors(child, child_links + size_t(12) * i, offset);
-        const ChildTails& tails = kChildTails.of[outer | (boundary & 7u) << 6];
-        for (int k = 0; k < 4; ++k) write_tail(child[k], tails.word[k] | level);
-        parent.first_child = c;
+        // Within the reserved capacity: no reallocation.
+        const Vec3* positions = positions_.data();
+        for (uint32_t k = 0; k < new_vertices; ++k) {
+            if (k + kAhead < new_vertices) {
+                __builtin_prefetch(positions + ends[k + kAhead].a);
+                __builtin_prefetch(positions + ends[k + kAhead].b);
+            }
+            const Vec3& a = positions[ends[k].a];
+            const Vec3& b = positions[ends[k].b];
+            positions_.push_back(default_placer ? midpoint_placer(placer_context_, a, b) : placer_(placer_context_, a, b));
+        }
     }
     live_nodes_ += 4 * count;
     live_vertices_ += uint32_t(next_vertex - v0);
