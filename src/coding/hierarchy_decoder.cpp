@@ -110,10 +110,13 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
     uint32_t* const closures = closures_.reserve(n);
     const DecidedLevelScan scan = scan_decided_level(level_, numbering_, closures);
     const uint32_t closure_count = scan.closures;
+    const bool flag_by_rule[3] = {diagonal_flag_by_rule(header_.diagonal_rule, 0),
+                                  diagonal_flag_by_rule(header_.diagonal_rule, 1),
+                                  diagonal_flag_by_rule(header_.diagonal_rule, 2)};
     for (uint32_t k = 0; k < closure_count; ++k) {
         const uint32_t i = closures[k];
         if (refined_neighbors(state[i]) == 3) throw corrupt(i, " has three hanging nodes but was not refined");
-        bool flag = diagonal_flag_by_rule(header_.diagonal_rule, unrefined_edge(level_, i));
+        bool flag = flag_by_rule[unrefined_edge(level_, i)];
         if (header_.orientation_coded) flag ^= d.decode_with_limit<kHierarchyModelLimit>(models.orientation);
         if (flag) level_.flipped.push_back(i);
     }
