@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "amc/mesh.h"
+#include "mesh/vertex_buckets.h"
 
 namespace amc {
 namespace {
@@ -57,21 +58,6 @@ void check_positions(const TriangleMesh& mesh, const std::string& what) {
                            " is not used by any triangle (isolated vertices cannot be coded)");
         }
     }
-}
-
-// Groups items by a vertex id with a counting sort (O(n), no comparison sort over the whole
-// mesh); `bucket_of(i)` gives the vertex of item i. Returns the start of every bucket.
-template <typename Entry, typename BucketOf, typename MakeEntry>
-std::vector<std::size_t> bucket_by_vertex(std::size_t vertex_count, std::size_t item_count,
-                                          BucketOf bucket_of, MakeEntry make_entry,
-                                          std::vector<Entry>& entries) {
-    std::vector<std::size_t> start(vertex_count + 2, 0);
-    for (std::size_t i = 0; i < item_count; ++i) ++start[bucket_of(i) + 2];
-    for (std::size_t v = 2; v < start.size(); ++v) start[v] += start[v - 1];
-    entries.resize(item_count);
-    for (std::size_t i = 0; i < item_count; ++i) entries[start[bucket_of(i) + 1]++] = make_entry(i);
-    start.pop_back();
-    return start;  // bucket v is [start[v], start[v + 1])
 }
 
 // Two triangles over the same three vertices (in either orientation).
