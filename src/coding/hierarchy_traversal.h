@@ -577,12 +577,24 @@ private:
                 i = *--top[0];  // entries of bucket 0 are never stale
                 culled = true;
             } else if (current < 4) {
-                if (top[current] == bottom[current]) {
+                // Most entries below a bucket's top are stale (every move from bucket 3 to 2
+                // leaves one in 3); they are skipped here rather than by the outer loop.
+                const uint8_t live = uint8_t(current << kPriorityShift);
+                uint32_t* t = top[current];
+                uint32_t* const b = bottom[current];
+                bool found = false;
+                while (t != b) {
+                    i = *--t;
+                    if ((state[i] & kDecidedOrPriority) == live) {
+                        found = true;
+                        break;
+                    }
+                }
+                top[current] = t;
+                if (!found) {
                     ++current;
                     continue;
                 }
-                i = *--top[current];
-                if ((state[i] & kDecidedOrPriority) != (current << kPriorityShift)) continue;
                 culled = false;
             } else {
                 i = next_fresh(state, n, fresh_cursor);
