@@ -48,10 +48,10 @@ public:
 
     bool is_leaf(NodeId n) const { return nodes_[n].first_child == kNoNode; }
     NodeId child(NodeId n, int k) const { return nodes_[n].first_child + static_cast<NodeId>(k); }
-    NodeId parent(NodeId n) const { return nodes_[n].parent; }
+    NodeId parent(NodeId n) const { return n < root_count() ? kNoNode : block_parent_[(n - root_count()) / 4]; }
     int level(NodeId n) const { return nodes_[n].level; }
     // 0..3 for children, -1 for roots.
-    int child_index(NodeId n) const { return nodes_[n].parent == kNoNode ? -1 : int(nodes_[n].child_index); }
+    int child_index(NodeId n) const { return n < root_count() ? -1 : int(nodes_[n].child_index); }
     VertexId vertex(NodeId n, int i) const { return nodes_[n].v[i]; }
     // Same-level neighbour across edge e, or kNoNode (boundary, or the region there is coarser).
     NodeId neighbor(NodeId n, int e) const { return nodes_[n].nbr[e]; }
@@ -149,12 +149,13 @@ public:
 
 private:
     static constexpr uint8_t kDeadLevel = 0xff;
-    struct Node {
+    // 32 bytes, aligned: a node never straddles two cache lines. The parent is kept once per block
+    // of four siblings (block_parent_), not in each node.
+    struct alignas(32) Node {
         // Left uninitialized: every path that makes a node sets all its fields, and bulk growth
         // (split_level) would otherwise write every new node twice.
         Node() {}
         VertexId v[3];
-        NodeId parent;
         NodeId first_child;
         NodeId nbr[3];
         uint8_t nbr_edge;  // 2 bits per edge
@@ -163,7 +164,7 @@ private:
         uint8_t child_index;  // 0..3; unused for roots
     };
     void link(NodeId a, int ea, NodeId b, int eb);
-    static void write_vertices(Node* child, const VertexId corner[3], const VertexId m[3], NodeId parent);
+    static void write_vertices(Node* child, const VertexId corner[3], const VertexId m[3]);
     static void write_neighbors(Node* child, const uint32_t* links, uint32_t offset);
     static void write_tail(Node& node, uint32_t word);
     VertexId new_vertex(Vec3 p);
@@ -171,6 +172,9 @@ private:
 
     TriangleMesh base_;
     std::vector<Node> nodes_;
+    // Nodes past the roots come in blocks of four siblings: block b (nodes root_count() + 4b ..
+    // + 3) has parent block_parent_[b].
+    std::vector<NodeId> block_parent_;
     std::vector<NodeId> free_blocks_;  // first ids of unused blocks of four
     std::vector<Vec3> positions_;
     std::vector<VertexId> free_vertices_;

@@ -53,7 +53,6 @@ Hierarchy::Hierarchy(TriangleMesh base) : base_(std::move(base)) {
             node.nbr[i] = kNoNode;
             vertex_end = std::max(vertex_end, uint64_t{node.v[i]} + 1);
         }
-        node.parent = kNoNode;
         node.first_child = kNoNode;
         node.nbr_edge = 0;
         node.level = 0;
@@ -92,6 +91,7 @@ Hierarchy::Hierarchy(TriangleMesh base) : base_(std::move(base)) {
 void Hierarchy::reset(TriangleMesh base) {
     Hierarchy roots(std::move(base));
     nodes_.assign(roots.nodes_.begin(), roots.nodes_.end());
+    block_parent_.clear();
     positions_.assign(roots.positions_.begin(), roots.positions_.end());
     free_blocks_.clear();
     free_vertices_.clear();
@@ -113,6 +113,7 @@ void Hierarchy::set_vertex_placer(VertexPlacer placer, void* context) {
 
 void Hierarchy::reserve(size_t nodes, size_t vertices) {
     reserve_huge(nodes_, nodes);
+    reserve_huge(block_parent_, nodes > root_count() ? (nodes - root_count()) / 4 : 0);
     reserve_huge(positions_, vertices);
 }
 
@@ -156,6 +157,7 @@ NodeId Hierarchy::allocate_children() {
     }
     NodeId c = static_cast<NodeId>(nodes_.size());
     nodes_.resize(nodes_.size() + 4);
+    block_parent_.push_back(kNoNode);  // set by the caller
     return c;
 }
 
@@ -173,7 +175,8 @@ void Hierarchy::split(NodeId n) {
     }
     const NodeId c = allocate_children();  // may reallocate nodes_: no references held across
     const Node parent = nodes_[n];
-    write_vertices(&nodes_[c], parent.v, m, n);
+    block_parent_[(c - root_count()) / 4] = n;
+    write_vertices(&nodes_[c], parent.v, m);
     for (int k = 0; k < 4; ++k) {
         Node& child = nodes_[c + k];
         for (int i = 0; i < 3; ++i) child.nbr[i] = kNoNode;
@@ -194,17 +197,21 @@ void Hierarchy::split(NodeId n) {
     nodes_[n].first_child = c;
 }
 
-// split_level writes each new node as three pieces: its vertices and parent (bytes 0-15), its
-// first child (none) and neighbours (bytes 16-31), and its four bytes of edges, level, flags and
-// child index. Four siblings' pieces are made in registers and stored whole: scalar stores of
-// every field made the build store-bound.
+// split_level writes each new node as three pieces: its vertices and first child (none; bytes
+// 0-15), its neighbours (bytes 16-27) and its four bytes of edges, level, flags and child index.
+// Four siblings' pieces are made in registers and stored whole: scalar stores of every field
+// made the build store-bound.
 
-// The vertices and parent of four new siblings, in the child order of <amc/hierarchy.h>, from
-// their parent's corners and the midpoints of its edges (split and split_level).
-void Hierarchy::write_vertices(Node* child, const VertexId corner[3], const VertexId m[3], NodeId parent) {
+// The vertices of four new siblings, in the child order of <amc/hierarchy.h>, from their parent's
+// corners and the midpoints of its edges, and their first child (none) (split and split_level).
+void Hierarchy::write_vertices(Node* child, const VertexId corner[3], const VertexId m[3]) {
+    static_assert(sizeof(Node) == 32 && offsetof(Node, first_child) == 12 && offsetof(Node, nbr) == 16 &&
+                      offsetof(Node, nbr_edge) == 28,
+                  "split_level writes nodes by this layout");
 #if defined(__SSE2__)
-    const __m128i p = _mm_set_epi32(int(parent), int(corner[2]), int(corner[1]), int(corner[0]));
-    const __m128i q = _mm_set_epi32(int(parent), int(m[2]), int(m[1]), int(m[0]));
+    // Lane 3 of every piece is first_child: kNoNode.
+    const __m128i p = _mm_set_epi32(-1, int(corner[2]), int(corner[1]), int(corner[0]));
+    const __m128i q = _mm_set_epi32(-1, int(m[2]), int(m[1]), int(m[0]));
     // Lanes 0-1 of shuffle_ps come from its first operand, 2-3 from its second.
     const __m128 pf = _mm_castsi128_ps(p), qf = _mm_castsi128_ps(q);
     const __m128 pq = _mm_castsi128_ps(_mm_unpacklo_epi32(p, q));  // corner 0, m 0, corner 1, m 1
@@ -220,7 +227,7 @@ void Hierarchy::write_vertices(Node* child, const VertexId corner[3], const Vert
         {corner[0], m[0], m[2]}, {m[0], corner[1], m[1]}, {m[2], m[1], corner[2]}, {m[1], m[2], m[0]}};
     for (int k = 0; k < 4; ++k) {
         for (int i = 0; i < 3; ++i) child[k].v[i] = layout[k][i];
-        child[k].parent = parent;
+        child[k].first_child = kNoNode;
     }
 #endif
 }
@@ -256,13 +263,10 @@ void Hierarchy::write_tail(Node& node, uint32_t word) {
 #endif
 }
 
-// The first child (none) and the neighbours of four new siblings from their twelve words of
-// local links (word 3k + e: child k, edge e); a local index becomes the id offset + index,
-// kNoNode stays.
+// The neighbours of four new siblings from their twelve words of local links (word 3k + e: child
+// k, edge e); a local index becomes the id offset + index, kNoNode stays. Each child's store
+// also fills its last four bytes, which write_tail writes afterwards.
 void Hierarchy::write_neighbors(Node* child, const uint32_t* links, uint32_t offset) {
-    static_assert(sizeof(Node) == 36 && offsetof(Node, parent) == 12 && offsetof(Node, first_child) == 16 &&
-                      offsetof(Node, nbr) == 20 && offsetof(Node, nbr_edge) == 32,
-                  "split_level writes nodes by this layout");
 #if defined(__SSE2__)
     const __m128i all_ones = _mm_set1_epi32(-1);
     const __m128i add = _mm_set1_epi32(int(offset));
@@ -271,18 +275,14 @@ void Hierarchy::write_neighbors(Node* child, const uint32_t* links, uint32_t off
         return _mm_or_si128(_mm_add_epi32(v, add), _mm_cmpeq_epi32(v, all_ones));
     };
     const __m128i t0 = ids(links), t1 = ids(links + 4), t2 = ids(links + 8);
-    // Lane 0 of each piece is first_child: kNoNode. Lanes 1-3 are words 3k..3k+2.
-    const __m128i lane0 = _mm_cvtsi32_si128(-1);
-    auto store = [](Node& node, __m128i v) {
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(&node.first_child), v);
-    };
-    store(child[0], _mm_or_si128(_mm_slli_si128(t0, 4), lane0));
-    store(child[1], _mm_or_si128(_mm_or_si128(_mm_srli_si128(t0, 8), _mm_slli_si128(t1, 8)), lane0));
-    store(child[2], _mm_or_si128(_mm_or_si128(_mm_srli_si128(t1, 4), _mm_slli_si128(t2, 12)), lane0));
-    store(child[3], _mm_or_si128(t2, lane0));
+    // Lanes 0-2 of each piece are words 3k..3k+2.
+    auto store = [](Node& node, __m128i v) { _mm_storeu_si128(reinterpret_cast<__m128i*>(node.nbr), v); };
+    store(child[0], t0);
+    store(child[1], _mm_or_si128(_mm_srli_si128(t0, 12), _mm_slli_si128(t1, 4)));
+    store(child[2], _mm_or_si128(_mm_srli_si128(t1, 8), _mm_slli_si128(t2, 8)));
+    store(child[3], _mm_srli_si128(t2, 4));
 #else
     for (int k = 0; k < 4; ++k) {
-        child[k].first_child = kNoNode;
         for (int e = 0; e < 3; ++e) {
             const uint32_t t = links[3 * k + e];
             child[k].nbr[e] = t == kNoNode ? kNoNode : t + offset;
@@ -313,6 +313,8 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
         if (vertices > positions_.capacity()) reserve(0, std::max(vertices, positions_.capacity() + positions_.capacity() / 2));
     }
     nodes_.resize(new_nodes);
+    block_parent_.resize((new_nodes - root_count()) / 4);
+    NodeId* const block_parent = block_parent_.data() + (c0 - root_count()) / 4;
     const size_t v0 = positions_.size();
     Node* nodes = nodes_.data();
     VertexId next_vertex = VertexId(v0);
@@ -363,8 +365,9 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
             const uint32_t level = uint32_t(parent.level + 1) << 8;
             const unsigned boundary = parent.flags;
             Node* child = nodes + c;
-            write_vertices(child, parent.v, m, n);
+            write_vertices(child, parent.v, m);
             write_neighbors(child, child_links + size_t(12) * i, offset);
+            block_parent[i] = n;
             const ChildTails& tails = kChildTails.of[outer | (boundary & 7u) << 6];
             for (int k = 0; k < 4; ++k) write_tail(child[k], tails.word[k] | level);
             parent.first_child = c;
@@ -400,7 +403,7 @@ uint32_t Hierarchy::refine(NodeId n, std::vector<NodeId>* split_nodes) {
         bool blocked = false;
         for (int e = 0; e < 3 && !blocked; ++e) {
             if (nodes_[x].nbr[e] == kNoNode && !is_boundary_edge(x, e)) {
-                todo.push_back(nodes_[nodes_[x].parent].nbr[e]);
+                todo.push_back(nodes_[parent(x)].nbr[e]);
                 blocked = true;
             }
         }
