@@ -51,7 +51,7 @@ public:
     NodeId parent(NodeId n) const { return n < root_count() ? kNoNode : block_parent_[(n - root_count()) / 4]; }
     int level(NodeId n) const { return nodes_[n].level; }
     // 0..3 for children, -1 for roots.
-    int child_index(NodeId n) const { return n < root_count() ? -1 : int(nodes_[n].child_index); }
+    int child_index(NodeId n) const { return n < root_count() ? -1 : int((n - root_count()) % 4); }
     VertexId vertex(NodeId n, int i) const { return nodes_[n].v[i]; }
     // Same-level neighbour across edge e, or kNoNode (boundary, or the region there is coarser).
     NodeId neighbor(NodeId n, int e) const { return nodes_[n].nbr[e]; }
@@ -149,8 +149,9 @@ public:
 
 private:
     static constexpr uint8_t kDeadLevel = 0xff;
-    // 32 bytes, aligned: a node never straddles two cache lines. The parent is kept once per block
-    // of four siblings (block_parent_), not in each node.
+    // 32 bytes, aligned: a node never straddles two cache lines. Siblings share what their ids
+    // already tell: the parent is kept once per block of four (block_parent_), and the child
+    // index is the node's place in its block.
     struct alignas(32) Node {
         // Left uninitialized: every path that makes a node sets all its fields, and bulk growth
         // (split_level) would otherwise write every new node twice.
@@ -161,14 +162,14 @@ private:
         uint8_t nbr_edge;  // 2 bits per edge
         uint8_t level;
         uint8_t flags;  // bits 0-2: boundary edge; bit 3: diagonal flipped
-        uint8_t child_index;  // 0..3; unused for roots
+        uint8_t reserved;  // 0
     };
     void link(NodeId a, int ea, NodeId b, int eb);
     static void write_vertices(Node* child, const VertexId corner[3], const VertexId m[3]);
     static void write_neighbors(Node* child, const uint32_t* links, uint32_t offset);
     static void write_tail(Node& node, uint32_t word);
     VertexId new_vertex(Vec3 p);
-    NodeId allocate_children();
+    NodeId allocate_children(NodeId parent);
 
     TriangleMesh base_;
     std::vector<Node> nodes_;

@@ -57,7 +57,7 @@ Hierarchy::Hierarchy(TriangleMesh base) : base_(std::move(base)) {
         node.nbr_edge = 0;
         node.level = 0;
         node.flags = 0;
-        node.child_index = 0;
+        node.reserved = 0;
     }
     if (vertex_end > positions_.size())  // not a validated mesh: refuse before sizing by it
         throw Error("base mesh: a triangle refers to vertex " + std::to_string(vertex_end - 1) + " of " +
@@ -148,16 +148,17 @@ VertexId Hierarchy::new_vertex(Vec3 p) {
     return static_cast<VertexId>(positions_.size() - 1);
 }
 
-NodeId Hierarchy::allocate_children() {
+NodeId Hierarchy::allocate_children(NodeId parent) {
     live_nodes_ += 4;
     if (!free_blocks_.empty()) {
         NodeId c = free_blocks_.back();
         free_blocks_.pop_back();
+        block_parent_[(c - root_count()) / 4] = parent;
         return c;
     }
     NodeId c = static_cast<NodeId>(nodes_.size());
     nodes_.resize(nodes_.size() + 4);
-    block_parent_.push_back(kNoNode);  // set by the caller
+    block_parent_.push_back(parent);
     return c;
 }
 
@@ -173,18 +174,16 @@ void Hierarchy::split(NodeId n) {
             m[e] = new_vertex(placer_(placer_context_, a, b));
         }
     }
-    const NodeId c = allocate_children();  // may reallocate nodes_: no references held across
+    const NodeId c = allocate_children(n);  // may reallocate nodes_: no references held across
     const Node parent = nodes_[n];
-    block_parent_[(c - root_count()) / 4] = n;
     write_vertices(&nodes_[c], parent.v, m);
     for (int k = 0; k < 4; ++k) {
         Node& child = nodes_[c + k];
         for (int i = 0; i < 3; ++i) child.nbr[i] = kNoNode;
-        child.first_child = kNoNode;
         child.nbr_edge = 0;
         child.level = uint8_t(parent.level + 1);
-        child.child_index = uint8_t(k);
         child.flags = uint8_t(parent.flags & kChildEdges[k].boundary);
+        child.reserved = 0;
     }
     for (int k = 0; k < 3; ++k) link(c + k, (k + 1) % 3, c + 3, (k + 1) % 3);
     for (int e = 0; e < 3; ++e) {
@@ -198,7 +197,7 @@ void Hierarchy::split(NodeId n) {
 }
 
 // split_level writes each new node as three pieces: its vertices and first child (none; bytes
-// 0-15), its neighbours (bytes 16-27) and its four bytes of edges, level, flags and child index.
+// 0-15), its neighbours (bytes 16-27) and its four bytes of edges, level, flags and a reserved 0.
 // Four siblings' pieces are made in registers and stored whole: scalar stores of every field
 // made the build store-bound.
 
@@ -232,7 +231,8 @@ void Hierarchy::write_vertices(Node* child, const VertexId corner[3], const Vert
 #endif
 }
 
-// The last four bytes of four new siblings but their level (word k: child k), by the parent's
+// The last four bytes of four new siblings but their level (word k: child k; the last byte is
+// `reserved`, 0), by the parent's
 // neighbour edge indices of its linked edges (bits 0-5) and its boundary edges (bits 6-8).
 struct ChildTails {
     uint32_t word[4];
@@ -244,7 +244,7 @@ struct ChildTailTable {
             const unsigned outer = code & 63u, boundary = code >> 6;
             for (unsigned k = 0; k < 4; ++k) {
                 of[code].word[k] = ((outer & kChildEdges[k].outer) | kChildEdges[k].inner) |
-                                   (boundary & kChildEdges[k].boundary) << 16 | k << 24;
+                                   (boundary & kChildEdges[k].boundary) << 16;
             }
         }
     }
@@ -252,14 +252,14 @@ struct ChildTailTable {
 constexpr ChildTailTable kChildTails{};
 
 void Hierarchy::write_tail(Node& node, uint32_t word) {
-    // Bytes nbr_edge, level, flags, child_index in that order (little endian word).
+    // Bytes nbr_edge, level, flags, reserved in that order (little endian word).
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
     std::memcpy(&node.nbr_edge, &word, 4);
 #else
     node.nbr_edge = uint8_t(word);
     node.level = uint8_t(word >> 8);
     node.flags = uint8_t(word >> 16);
-    node.child_index = uint8_t(word >> 24);
+    node.reserved = uint8_t(word >> 24);
 #endif
 }
 
