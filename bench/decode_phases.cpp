@@ -4,13 +4,16 @@
 // instructions, branch misses) where Linux allows it: unlike time, they hardly move when other
 // virtual machines load the host, so two builds can be compared with few runs.
 //
-//   decode_phases [--nodes N] [--runs R] [--reuse] [--model surface|random|fe]
+//   decode_phases [--nodes N] [--runs R] [--reuse] [--naive] [--model surface|random|fe]
 //
 // Without --model: surface, random and fe, in that order (see make_bench_hierarchy).
 //
 // --reuse keeps one decoder, and the hierarchy it decodes into, from run to run (as
 // amc::HierarchyDecoder does): no fresh memory. Without it every run starts from nothing and
 // frees its hierarchy within the build time.
+//
+// --naive codes the models with the naive (canonical order) traversal instead of the improved
+// one (the default): what the priority order costs to decode.
 #include "bench_common.h"
 #include "coding/hierarchy_level_coder.h"
 
@@ -91,8 +94,9 @@ Spread spread(const std::vector<Sample>& samples, Figure figure) {
     return {*std::min_element(values.begin(), values.end()), median(values)};
 }
 
-void report(const char* name, const amc::Hierarchy& h, int runs, bool reuse, const Counters& counters) {
-    const std::vector<uint8_t> bytes = amc::encode_hierarchy(h);
+void report(const char* name, const amc::Hierarchy& h, int runs, bool reuse, const amc::HierarchyCoderOptions& options,
+            const Counters& counters) {
+    const std::vector<uint8_t> bytes = amc::encode_hierarchy(h, options);
     std::vector<Sample> samples;
     amc::HierarchyLevelDecoder kept;
     for (int r = 0; r < runs; ++r) {
@@ -129,8 +133,8 @@ void report(const char* name, const amc::Hierarchy& h, int runs, bool reuse, con
         samples.push_back(s);
     }
     const double nodes = h.node_count();
-    std::printf("%s: %u nodes, %zu bytes, %d runs%s (min / median)\n", name, h.node_count(), bytes.size(), runs,
-                reuse ? ", reusing the decoder" : "");
+    std::printf("%s: %u nodes, %zu bytes, %d runs%s%s (min / median)\n", name, h.node_count(), bytes.size(), runs,
+                options.traversal == amc::Traversal::naive ? ", naive traversal" : "", reuse ? ", reusing the decoder" : "");
     const Spread total = spread(samples, [](const Sample& s) { return s.ms[0] + s.ms[1]; });
     std::printf("  decode  %7.1f / %7.1f ms   %5.1f / %5.1f M nodes/s\n", total.min, total.median, nodes / total.min / 1e3,
                 nodes / total.median / 1e3);
@@ -154,11 +158,14 @@ int main(int argc, char** argv) {
     long nodes = 1000000;
     int runs = 15;
     bool reuse = false;
+    amc::HierarchyCoderOptions options;
     std::string model;  // all three when empty
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         if (arg == "--reuse") {
             reuse = true;
+        } else if (arg == "--naive") {
+            options.traversal = amc::Traversal::naive;
         } else if (arg == "--model" && i + 1 < argc) {
             model = argv[++i];
             if (model != "surface" && model != "random" && model != "fe") {
@@ -174,7 +181,7 @@ int main(int argc, char** argv) {
             if (arg == "--nodes") nodes = std::min(value, 20000000L);  // a few GB at most
             else runs = int(std::min(value, 1000L));
         } else {
-            std::fprintf(stderr, "usage: decode_phases [--nodes N] [--runs R] [--reuse] [--model surface|random|fe]\n");
+            std::fprintf(stderr, "usage: decode_phases [--nodes N] [--runs R] [--reuse] [--naive] [--model surface|random|fe]\n");
             return 2;
         }
     }
@@ -182,8 +189,9 @@ int main(int argc, char** argv) {
     if (!counters.available()) std::printf("(no hardware counters here: wall time only)\n");
     // The models of coder_bench.
     if (model.empty() || model == "surface")
-        report("surface", make_bench_hierarchy(BenchModel::surface, nodes), runs, reuse, counters);
+        report("surface", make_bench_hierarchy(BenchModel::surface, nodes), runs, reuse, options, counters);
     if (model.empty() || model == "random")
-        report("random", make_bench_hierarchy(BenchModel::random, nodes), runs, reuse, counters);
-    if (model.empty() || model == "fe") report("fe", make_bench_hierarchy(BenchModel::fe, nodes), runs, reuse, counters);
+        report("random", make_bench_hierarchy(BenchModel::random, nodes), runs, reuse, options, counters);
+    if (model.empty() || model == "fe")
+        report("fe", make_bench_hierarchy(BenchModel::fe, nodes), runs, reuse, options, counters);
 }
