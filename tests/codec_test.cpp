@@ -197,12 +197,13 @@ TEST(Codec, MutatedBlocksWithValidChecksumsAreErrorsOrValidHierarchies) {
         options.quantize_bits = quantize_bits[random.next() % 6];
         const std::vector<uint8_t> bytes = encode(h, options);
         BlockReader reader(bytes.data(), bytes.size());
-        std::vector<std::pair<BlockType, std::vector<uint8_t>>> blocks;
+        using Blocks = std::vector<std::pair<BlockType, std::vector<uint8_t>>>;
+        Blocks blocks;
         Block block;
         while (reader.next(block)) {
             if (block.type != BlockType::end) blocks.push_back({block.type, {block.payload, block.payload + block.size}});
         }
-        auto rewrite = [&](uint8_t flags, const std::vector<std::pair<BlockType, std::vector<uint8_t>>>& parts) {
+        auto rewrite = [](uint8_t flags, const Blocks& parts) {
             BlockWriter writer(flags);
             for (const auto& [type, payload] : parts) writer.add(type, payload);
             return writer.finish();
