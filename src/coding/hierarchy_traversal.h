@@ -183,44 +183,42 @@ inline void root_level(const Hierarchy& h, Level& level) {
     level.incomplete_count = incomplete_count;
 }
 
-// The state bytes of a new block's four children (byte k: child k), by which of the parent's edges
-// have a refined neighbour (bits 0-2) or are boundary edges (bits 3-5): corner k is complete when
-// its two outer edges (the parent's k and (k+2)%3) each have a neighbour or are boundary; the
-// center always is. Complete children start in bucket 4 (kFreshPriority).
-struct SiblingStates {
-    uint32_t word[64];
-    uint8_t incomplete[64];  // bit k: corner k is not complete
-    constexpr SiblingStates() : word(), incomplete() {
+// What a new block takes from its parent's linked edges (bits 0-2: the edges with a refined
+// neighbour) and boundary edges (bits 3-5), in one 32-byte entry so that one register addresses it:
+//  - the four children's state bytes (byte k: child k). Corner k is complete when its two outer
+//    edges (the parent's k and (k+2)%3) each have a neighbour or are boundary; the center always
+//    is. Complete children start in bucket 4 (kFreshPriority);
+//  - the offsets within the block of the corners that are not complete, packed, and their count;
+//  - the mask of the linked edges' two-bit neighbour edge indices;
+//  - the ends the new vertices count (2 on an edge of its own, 1 on an edge shared with a refined
+//    neighbour).
+struct NewBlock {
+    alignas(16) uint32_t incomplete[4] = {};
+    uint32_t states = 0;
+    uint8_t incomplete_count = 0;
+    uint8_t edge_mask = 0;
+    uint8_t ends = 0;
+};
+struct NewBlocks {
+    NewBlock of[64];
+    constexpr NewBlocks() : of() {
         constexpr uint32_t kFresh = kComplete | kFreshPriority;
         for (int code = 0; code < 64; ++code) {
-            uint32_t w = kFresh << 24;
+            NewBlock& block = of[code];
+            block.states = kFresh << 24;
             for (int k = 0; k < 3; ++k) {
                 const int prev = k == 0 ? 2 : k - 1;
                 const bool ok = (((code >> k) | (code >> (3 + k))) & 1) && (((code >> prev) | (code >> (3 + prev))) & 1);
-                if (ok) w |= kFresh << (8 * k);
-                else incomplete[code] = uint8_t(incomplete[code] | (1 << k));
-            }
-            word[code] = w;
-        }
-    }
-};
-constexpr SiblingStates kSiblingStates{};
-
-// By which of a refined node's edges have a refined neighbour (bits 0-2): the mask of their two-bit
-// neighbour edge indices, and the ends its new vertices count (2 on an edge of its own, 1 shared).
-struct EdgePairs {
-    uint8_t mask[8];
-    uint8_t ends[8];
-    constexpr EdgePairs() : mask(), ends() {
-        for (int linked = 0; linked < 8; ++linked) {
-            for (int e = 0; e < 3; ++e) {
-                if ((linked >> e) & 1) mask[linked] = uint8_t(mask[linked] | (3 << (2 * e)));
-                ends[linked] = uint8_t(ends[linked] + ((linked >> e) & 1 ? 1 : 2));
+                if (ok) block.states |= kFresh << (8 * k);
+                else block.incomplete[block.incomplete_count++] = uint32_t(k);
+                const bool linked = (code >> k) & 1;
+                if (linked) block.edge_mask = uint8_t(block.edge_mask | (3 << (2 * k)));
+                block.ends = uint8_t(block.ends + (linked ? 1 : 2));
             }
         }
     }
 };
-constexpr EdgePairs kEdgePairs{};
+constexpr NewBlocks kNewBlocks{};
 
 // How the refined nodes of a decided level become the next level's blocks: each node's block (its
 // rank among the refined nodes) or kNoLocal. block_of() has one more entry in front, kNoLocal,
@@ -295,18 +293,22 @@ inline DecidedLevelScan scan_decided_level(Level& level, RefinedNumbering& numbe
 // By a node's neighbour edge indices (2 bits per edge): lane e holds the child of the neighbour
 // across edge e that meets the edge's first half ((eq+1)%3) or its second half (eq); lane 3 the
 // center child's and corner 2's offsets within the node's own block (3 and 2), see below.
+// Both halves of one code share a 32-byte entry, so that one register addresses them.
 struct HalfEdgeChildren {
-    alignas(16) uint32_t first[64][4];
-    alignas(16) uint32_t second[64][4];
-    constexpr HalfEdgeChildren() : first(), second() {
+    struct Entry {
+        alignas(16) uint32_t first[4];
+        uint32_t second[4];
+    };
+    Entry of[64];
+    constexpr HalfEdgeChildren() : of() {
         for (int code = 0; code < 64; ++code) {
             for (int e = 0; e < 3; ++e) {
                 const uint32_t eq = uint32_t(code >> (2 * e)) & 3u;
-                first[code][e] = (eq + 1) % 3;
-                second[code][e] = eq;
+                of[code].first[e] = (eq + 1) % 3;
+                of[code].second[e] = eq;
             }
-            first[code][3] = 3;
-            second[code][3] = 2;
+            of[code].first[3] = 3;
+            of[code].second[3] = 2;
         }
     }
 };
@@ -331,8 +333,8 @@ inline unsigned write_child_neighbors(Neighbors* out, uint32_t b, uint32_t q0, u
         const __m128i v = _mm_add_epi32(base, _mm_load_si128(reinterpret_cast<const __m128i*>(offsets)));
         return _mm_castsi128_ps(_mm_or_si128(v, none));
     };
-    const __m128 first = halves(kHalfEdgeChildren.first[code]);    // first 0-2, c + 3
-    const __m128 second = halves(kHalfEdgeChildren.second[code]);  // second 0-2, c + 2
+    const __m128 first = halves(kHalfEdgeChildren.of[code].first);    // first 0-2, c + 3
+    const __m128 second = halves(kHalfEdgeChildren.of[code].second);  // second 0-2, c + 2
     // The twelve words as three vectors; lanes 0-1 of shuffle_ps come from its first operand, 2-3
     // from its second.
     auto store = [&](int k, __m128 v) { _mm_storeu_si128(reinterpret_cast<__m128i*>(out->nbr) + k, _mm_castps_si128(v)); };
@@ -348,8 +350,8 @@ inline unsigned write_child_neighbors(Neighbors* out, uint32_t b, uint32_t q0, u
     unsigned linked = 0;
     for (int e = 0; e < 3; ++e) {
         const uint32_t none = uint32_t(static_cast<int32_t>(q[e]) >> 31);
-        first[e] = (4 * q[e] + kHalfEdgeChildren.first[code][e]) | none;
-        second[e] = (4 * q[e] + kHalfEdgeChildren.second[code][e]) | none;
+        first[e] = (4 * q[e] + kHalfEdgeChildren.of[code].first[e]) | none;
+        second[e] = (4 * q[e] + kHalfEdgeChildren.of[code].second[e]) | none;
         linked |= (1u << e) & ~none;
     }
     const uint32_t c = 4 * b;
@@ -376,7 +378,7 @@ inline uint64_t derive_next_level(const Level& level, const RefinedNumbering& nu
     next.resize_state(size_t(4) * count);
     Neighbors* out = next.nbr.reserve(size_t(4) * count);
     BlockEdges* out_edges = next.edges.reserve(count);
-    uint32_t* incomplete = next.incomplete.reserve(size_t(3) * count);
+    uint32_t* incomplete = next.incomplete.reserve(size_t(3) * count + 1);  // + 1: each block writes four words
     uint32_t incomplete_count = 0;
     uint8_t* out_state = next.state();
     uint64_t edge_ends = 0;  // each new vertex has two: one from each refined node on its edge, or both from one
@@ -387,21 +389,22 @@ inline uint64_t derive_next_level(const Level& level, const RefinedNumbering& nu
             const unsigned linked = write_child_neighbors(
                 out + c, b, block[static_cast<int32_t>(p.nbr[0])], block[static_cast<int32_t>(p.nbr[1])],
                 block[static_cast<int32_t>(p.nbr[2])], p.nbr_edge);  // kNoLocal for none
-            out_edges[b] = {uint8_t(p.nbr_edge & kEdgePairs.mask[linked]), uint8_t(p.flags & 7)};
-            edge_ends += kEdgePairs.ends[linked];
-            const uint32_t word = kSiblingStates.word[linked | ((p.flags & 7u) << 3)];
+            const NewBlock& block = kNewBlocks.of[linked | ((p.flags & 7u) << 3)];
+            out_edges[b] = {uint8_t(p.nbr_edge & block.edge_mask), uint8_t(p.flags & 7)};
+            edge_ends += block.ends;
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
-            std::memcpy(out_state + c, &word, 4);  // byte k: child k
+            std::memcpy(out_state + c, &block.states, 4);  // byte k: child k
 #else
-            for (int k = 0; k < 4; ++k) out_state[c + k] = uint8_t(word >> (8 * k));
+            for (int k = 0; k < 4; ++k) out_state[c + k] = uint8_t(block.states >> (8 * k));
 #endif
-            const unsigned corners = kSiblingStates.incomplete[linked | ((p.flags & 7u) << 3)];
-            incomplete[incomplete_count] = c;
-            incomplete_count += corners & 1u;
-            incomplete[incomplete_count] = c + 1;
-            incomplete_count += (corners >> 1) & 1u;
-            incomplete[incomplete_count] = c + 2;
-            incomplete_count += corners >> 2;
+#if defined(__SSE2__)
+            const __m128i offsets = _mm_load_si128(reinterpret_cast<const __m128i*>(block.incomplete));
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(incomplete + incomplete_count),
+                             _mm_add_epi32(offsets, _mm_set1_epi32(int(c))));
+#else
+            for (int k = 0; k < 3; ++k) incomplete[incomplete_count + k] = c + block.incomplete[k];
+#endif
+            incomplete_count += block.incomplete_count;
         }
     });
     next.incomplete_count = incomplete_count;
