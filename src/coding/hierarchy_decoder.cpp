@@ -86,20 +86,23 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
     HierarchyModels models = models_;
     uint64_t symbols_read = symbols_read_;
     const int group_mask = header_.options.use_contexts ? 0xff : 0;
-    // may_end: whether the stored symbols can run out within this level (a compile-time switch,
-    // so that the other levels test nothing per symbol).
-    auto decide = [&](auto may_end) {
+    // fast: the stored symbols can not run out within this level and every context group has its
+    // model (a compile-time switch, so that such levels test and mask nothing per symbol); the
+    // other levels take the general path.
+    auto decide = [&](auto fast) {
         traversal_.run(
             level_, l < header_.uniform_levels,
             [&](uint32_t, int group) {
-                if (decltype(may_end)::value && symbols_read == symbol_limit) return false;
+                if (!decltype(fast)::value && symbols_read == symbol_limit) return false;
                 ++symbols_read;
-                return d.decode_with_limit<kHierarchyModelLimit>(models.groups[size_t(group & group_mask)]);
+                const int model = decltype(fast)::value ? group : group & group_mask;
+                return d.decode_with_limit<kHierarchyModelLimit>(models.groups[size_t(model)]);
             },
             [&](uint32_t, Fate, bool refined) { return refined; });
     };
-    if (symbol_limit - symbols_read >= n) decide(std::false_type{});  // fewer nodes than symbols left
-    else decide(std::true_type{});
+    // Fast when there are fewer nodes than symbols left.
+    if (symbol_limit - symbols_read >= n && header_.options.use_contexts) decide(std::true_type{});
+    else decide(std::false_type{});
     // The next level's numbering of the refined nodes, the leaves closed by two hanging nodes
     // (their diagonals come next in the stream) and the checks. Errors name the element by its
     // level and canonical index: its node id may not exist yet.
