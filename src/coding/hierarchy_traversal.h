@@ -389,22 +389,22 @@ inline uint64_t derive_next_level(const Level& level, const RefinedNumbering& nu
             const unsigned linked = write_child_neighbors(
                 out + c, b, block[static_cast<int32_t>(p.nbr[0])], block[static_cast<int32_t>(p.nbr[1])],
                 block[static_cast<int32_t>(p.nbr[2])], p.nbr_edge);  // kNoLocal for none
-            const NewBlock& block = kNewBlocks.of[linked | ((p.flags & 7u) << 3)];
-            out_edges[b] = {uint8_t(p.nbr_edge & block.edge_mask), uint8_t(p.flags & 7)};
-            edge_ends += block.ends;
+            const NewBlock& entry = kNewBlocks.of[linked | ((p.flags & 7u) << 3)];
+            out_edges[b] = {uint8_t(p.nbr_edge & entry.edge_mask), uint8_t(p.flags & 7)};
+            edge_ends += entry.ends;
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
-            std::memcpy(out_state + c, &block.states, 4);  // byte k: child k
+            std::memcpy(out_state + c, &entry.states, 4);  // byte k: child k
 #else
-            for (int k = 0; k < 4; ++k) out_state[c + k] = uint8_t(block.states >> (8 * k));
+            for (int k = 0; k < 4; ++k) out_state[c + k] = uint8_t(entry.states >> (8 * k));
 #endif
 #if defined(__SSE2__)
-            const __m128i offsets = _mm_load_si128(reinterpret_cast<const __m128i*>(block.incomplete));
+            const __m128i offsets = _mm_load_si128(reinterpret_cast<const __m128i*>(entry.incomplete));
             _mm_storeu_si128(reinterpret_cast<__m128i*>(incomplete + incomplete_count),
                              _mm_add_epi32(offsets, _mm_set1_epi32(int(c))));
 #else
-            for (int k = 0; k < 3; ++k) incomplete[incomplete_count + k] = c + block.incomplete[k];
+            for (int k = 0; k < 3; ++k) incomplete[incomplete_count + k] = c + entry.incomplete[k];
 #endif
-            incomplete_count += block.incomplete_count;
+            incomplete_count += entry.incomplete_count;
         }
     });
     next.incomplete_count = incomplete_count;
