@@ -16,6 +16,14 @@ HierarchyStreamHeader parse_header(const uint8_t* data, size_t size) {
     return header;
 }
 
+// At most how many symbols deciding `level` can read: one a node, none for the nodes
+// 1-regularity culls (the incomplete ones). Not inlined: GCC's register allocation in the
+// traversal is easily upset (see HIERARCHY_CODER.md, Speed).
+__attribute__((noinline)) uint32_t codable_symbols(const Level& level, const HierarchyCoderOptions& options) {
+    const uint32_t n = static_cast<uint32_t>(level.size());
+    return options.cull_one_regularity ? n - level.incomplete_count : n;
+}
+
 }  // namespace
 
 HierarchyLevelDecoder::HierarchyLevelDecoder(const TriangleMesh& base, const uint8_t* header, size_t header_size,
@@ -69,6 +77,7 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
     const int l = level_index_;
     uint8_t* state = level_.state();
     const uint32_t n = static_cast<uint32_t>(level_.size());
+    const uint32_t codable = codable_symbols(level_, header_.options);
     // II-C, stream truncation: once the stored symbols are used up, the rest are 0.
     const uint64_t symbol_limit = header_.options.truncate_stream ? header_.symbol_count : UINT64_MAX;
     if (symbols_read_ == symbol_limit && l >= header_.uniform_levels) {
@@ -100,8 +109,10 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
             },
             [&](uint32_t, Fate, bool refined) { return refined; });
     };
-    // Fast when there are fewer nodes than symbols left.
-    if (symbol_limit - symbols_read >= n && header_.options.use_contexts) decide(std::true_type{});
+    // Fast when the level can not code more symbols than are left: at most one a node, and none
+    // for the nodes 1-regularity culls (the incomplete ones; this bound makes the second-finest
+    // levels of a random refinement fast too).
+    if (symbol_limit - symbols_read >= codable && header_.options.use_contexts) decide(std::true_type{});
     else decide(std::false_type{});
     // The next level's numbering of the refined nodes, the leaves closed by two hanging nodes
     // (their diagonals come next in the stream) and the checks. Errors name the element by its
