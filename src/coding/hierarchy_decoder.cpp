@@ -3,7 +3,6 @@
 #include "coding/hierarchy_level_coder.h"
 
 #include <string>
-#include <type_traits>
 #include <utility>
 
 namespace amc {
@@ -17,11 +16,39 @@ HierarchyStreamHeader parse_header(const uint8_t* data, size_t size) {
 }
 
 // At most how many symbols deciding `level` can read: one a node, none for the nodes
-// 1-regularity culls (the incomplete ones). Not inlined: GCC's register allocation in the
-// traversal is easily upset (see HIERARCHY_CODER.md, Speed).
-__attribute__((noinline)) uint32_t codable_symbols(const Level& level, const HierarchyCoderOptions& options) {
+// 1-regularity culls (the incomplete ones). Not inlined nor analysed across calls: GCC's register
+// allocation in the traversal is easily upset (see HIERARCHY_CODER.md, Speed).
+__attribute__((noipa)) uint32_t codable_symbols(const Level& level, const HierarchyCoderOptions& options) {
     const uint32_t n = static_cast<uint32_t>(level.size());
     return options.cull_one_regularity ? n - level.incomplete_count : n;
+}
+
+// Decides `level` with `traversal`, its symbols from `decoder` in `models` (a symbol past
+// `symbol_limit` is 0, the context groups are masked by `group_mask`): the general path, for the
+// levels where the stored symbols may run out. A function of its own whose locals hold the
+// coder's state while the traversal, inlined, runs: every state byte the traversal writes could
+// alias anything reached through a pointer or a reference, which would then be reloaded for
+// every node. (Called from decide_level, the traversal had reached the coder through its
+// lambdas' references: 12% more instructions per node than the fast path.) No interprocedural
+// analysis: what GCC learnt of this function cost decide_level's fast path 9% more instructions.
+__attribute__((noipa)) void decide_symbols_general(LevelTraversal& traversal, Level& level, bool uniform_level,
+                                                      ArithmeticDecoder& decoder, HierarchyModels& level_models,
+                                                      uint64_t& level_symbols_read, uint64_t symbol_limit,
+                                                      int group_mask) {
+    ArithmeticDecoder d = decoder;
+    HierarchyModels models = level_models;
+    uint64_t symbols_read = level_symbols_read;
+    traversal.run(
+        level, uniform_level,
+        [&](uint32_t, int group) {
+            if (symbols_read == symbol_limit) return false;
+            ++symbols_read;
+            return d.decode_with_limit<kHierarchyModelLimit>(models.groups[size_t(group & group_mask)]);
+        },
+        [&](uint32_t, Fate, bool refined) { return refined; });
+    decoder = d;
+    level_models = models;
+    level_symbols_read = symbols_read;
 }
 
 }  // namespace
@@ -77,7 +104,6 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
     const int l = level_index_;
     uint8_t* state = level_.state();
     const uint32_t n = static_cast<uint32_t>(level_.size());
-    const uint32_t codable = codable_symbols(level_, header_.options);
     // II-C, stream truncation: once the stored symbols are used up, the rest are 0.
     const uint64_t symbol_limit = header_.options.truncate_stream ? header_.symbol_count : UINT64_MAX;
     if (symbols_read_ == symbol_limit && l >= header_.uniform_levels) {
@@ -95,25 +121,25 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
     HierarchyModels models = models_;
     uint64_t symbols_read = symbols_read_;
     const int group_mask = header_.options.use_contexts ? 0xff : 0;
-    // fast: the stored symbols can not run out within this level and every context group has its
-    // model (a compile-time switch, so that such levels test and mask nothing per symbol); the
-    // other levels take the general path.
-    auto decide = [&](auto fast) {
+    // Fast when the level can not code more symbols than are left: at most one a node, and none
+    // for the nodes 1-regularity culls (the incomplete ones; this bound makes the second-finest
+    // levels of a random refinement fast too). Then every context group has its model, and
+    // nothing is tested or masked per symbol. (Marked likely, GCC spills less in the traversal's
+    // loop: 1-1.5% fewer instructions on every model. Even moving group_mask's definition into
+    // the call below cost 2.5%: see HIERARCHY_CODER.md, Speed, item 29.)
+    if (__builtin_expect(
+            header_.options.use_contexts && symbol_limit - symbols_read >= codable_symbols(level_, header_.options), 1)) {
         traversal_.run(
             level_, l < header_.uniform_levels,
             [&](uint32_t, int group) {
-                if (!decltype(fast)::value && symbols_read == symbol_limit) return false;
                 ++symbols_read;
-                const int model = decltype(fast)::value ? group : group & group_mask;
-                return d.decode_with_limit<kHierarchyModelLimit>(models.groups[size_t(model)]);
+                return d.decode_with_limit<kHierarchyModelLimit>(models.groups[size_t(group)]);
             },
             [&](uint32_t, Fate, bool refined) { return refined; });
-    };
-    // Fast when the level can not code more symbols than are left: at most one a node, and none
-    // for the nodes 1-regularity culls (the incomplete ones; this bound makes the second-finest
-    // levels of a random refinement fast too).
-    if (symbol_limit - symbols_read >= codable && header_.options.use_contexts) decide(std::true_type{});
-    else decide(std::false_type{});
+    } else {
+        decide_symbols_general(traversal_, level_, l < header_.uniform_levels, d, models, symbols_read, symbol_limit,
+                               group_mask);
+    }
     // The next level's numbering of the refined nodes, the leaves closed by two hanging nodes
     // (their diagonals come next in the stream) and the checks. Errors name the element by its
     // level and canonical index: its node id may not exist yet.
