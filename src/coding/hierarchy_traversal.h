@@ -554,12 +554,10 @@ private:
             }
             return next_bucket;
         };
-        for (uint32_t k = 0; k < culled_count; ++k) {
-            const uint32_t i = culled_list[k];
-            const Neighbors node = links.neighbors(i);
-            decide(rules.fate(state[i]), node, state, i, code, force);
-            uint32_t unused;
-            push_neighbors(node, unused);
+        if (culled_count != 0) {
+            const BucketTops tops = decide_one_regularity_culled(links, state, culled_list, culled_count,
+                                                                 BucketTops{{top[0], top[1], top[2], top[3]}}, force);
+            for (int b = 0; b < 4; ++b) top[b] = tops.at[b];
         }
         uint32_t fresh_cursor = 0;
         constexpr uint8_t kDecidedOrPriority = kDecided | kPriorityMask;
@@ -621,6 +619,40 @@ private:
                 popped = true;
             }
         }
+    }
+
+    struct BucketTops {
+        uint32_t* at[4];
+    };
+    // The nodes 1-regularity culls (incomplete: listed only with that rule, so their fate is
+    // known), decided first, and the moves their decisions make in the buckets, in the order
+    // run_on's pushes would make them. A function of its own, so that GCC allocates run_on's
+    // registers for the loop over coded nodes alone; the tops go by value and the transitions
+    // come from the member, as whatever run_on passes by address could alias the state bytes
+    // written here. No prefetch of a pushed node's links: it waits for the rest of this phase.
+    template <class Links, class Force>
+    __attribute__((noipa)) BucketTops decide_one_regularity_culled(Links links, uint8_t* state, const uint32_t* culled_list,
+                                                                   uint32_t culled_count, BucketTops tops, Force& force) {
+        uint8_t transition[256];
+        for (int k = 0; k < 256; ++k) transition[k] = after_neighbor_decided_[k];
+        uint32_t* top[4] = {tops.at[0], tops.at[1], tops.at[2], tops.at[3]};
+        for (uint32_t k = 0; k < culled_count; ++k) {
+            const uint32_t i = culled_list[k];
+            const Neighbors node = links.neighbors(i);
+            const bool refined = force(i, Fate::one_regularity, false);
+            state[i] = uint8_t(state[i] | kDecided | (refined ? kRefined : 0));
+            if (refined) add_refined_neighbor(node, state);
+            for (int e = 0; e < 3; ++e) {
+                const uint32_t q = node.nbr[e];
+                const uint8_t s = neighbor_state(state, q);
+                const uint8_t t = transition[s];
+                if (t == s) continue;  // decided (or no neighbour), or already in bucket 1
+                state[q] = t;
+                *top[t >> kPriorityShift]++ = q;
+            }
+        }
+        for (int b = 0; b < 4; ++b) tops.at[b] = top[b];
+        return tops;
     }
 
     // Bucket 4: the first node from `cursor` on that is undecided with no decided neighbour, or n.
