@@ -642,6 +642,8 @@ private:
             const bool refined = force(i, Fate::one_regularity, false);
             state[i] = uint8_t(state[i] | kDecided | (refined ? kRefined : 0));
             if (refined) add_refined_neighbor(node, state);
+            // run_on's push_neighbors without the prefetch and the next node. (One helper for both
+            // made GCC's code for run_on's loop 4% longer.)
             for (int e = 0; e < 3; ++e) {
                 const uint32_t q = node.nbr[e];
                 const uint8_t s = neighbor_state(state, q);
