@@ -1,5 +1,6 @@
 // The hierarchy coder: exact round trips under every combination of switches, exhaustive small
 // hierarchies, known answers (uniform meshes cost nothing), entropy bound, corrupt streams.
+#include "coding/hierarchy_level_coder.h"
 #include "hierarchy_checks.h"
 
 #include <amc/hierarchy_coder.h>
@@ -303,6 +304,55 @@ TEST(HierarchyCoder, ReusedDecoderMatchesFreshDecodes) {
     }
     EXPECT_GT(decoded, 300);
     EXPECT_GT(refused, 10);
+}
+
+// Every new vertex of `h` lies where `place` puts it from its edge's end points.
+::testing::AssertionResult midpoints_placed(const Hierarchy& h, Vec3 (*place)(Vec3, Vec3)) {
+    for (NodeId n : h.breadth_first_order()) {
+        if (h.is_leaf(n)) continue;
+        for (int e = 0; e < 3; ++e) {
+            const Vec3 expected = place(h.position(h.vertex(n, e)), h.position(h.vertex(n, (e + 1) % 3)));
+            if (!(h.position(h.midpoint(n, e)) == expected))
+                return ::testing::AssertionFailure() << "midpoint of edge " << e << " of node " << n;
+        }
+    }
+    return ::testing::AssertionSuccess();
+}
+
+Vec3 lifted(Vec3 a, Vec3 b) { return 0.5 * (a + b) + Vec3{0, 0, 0.125}; }
+
+// The decoder builds each level in one pass (Hierarchy::split_level), with one loop for each kind
+// of vertex placer: the default midpoint of double and of single precision bases, and any other.
+TEST(HierarchyCoder, DecodedVerticesArePlacedByTheHierarchysPlacer) {
+    for (uint64_t seed = 1; seed <= 30; ++seed) {
+        Hierarchy h = random_hierarchy(seed);
+        const bool single = seed % 2 == 0;
+        TriangleMesh base = h.base();
+        base.single_precision = single;
+        for (Vec3& p : base.positions) {
+            if (single) p = Vec3{double(float(p.x)), double(float(p.y)), double(float(p.z))};
+        }
+        const std::vector<uint8_t> bytes = encode_hierarchy(h, HierarchyCoderOptions{});
+        const Hierarchy decoded = decode_hierarchy(base, bytes.data(), bytes.size());
+        ASSERT_TRUE(same_connectivity(h, decoded)) << "seed " << seed;
+        if (single) {
+            EXPECT_TRUE(midpoints_placed(decoded, [](Vec3 a, Vec3 b) {
+                const Vec3 m = 0.5 * (a + b);
+                return Vec3{double(float(m.x)), double(float(m.y)), double(float(m.z))};
+            })) << "seed " << seed;
+        } else {
+            EXPECT_TRUE(midpoints_placed(decoded, [](Vec3 a, Vec3 b) { return 0.5 * (a + b); })) << "seed " << seed;
+        }
+        // Another placer, symmetric in its end points as every placer must be.
+        HierarchyStreamHeader header;
+        const size_t header_size = read_hierarchy_stream_header(bytes.data(), bytes.size(), header);
+        HierarchyLevelDecoder coder(base, header, UINT64_MAX);
+        coder.hierarchy().set_vertex_placer([](void*, Vec3 a, Vec3 b) { return lifted(a, b); }, nullptr);
+        ArithmeticDecoder decoder(bytes.data() + header_size, bytes.size() - header_size);
+        while (!coder.done()) coder.decode_level(decoder);
+        ASSERT_TRUE(same_connectivity(h, coder.hierarchy())) << "seed " << seed;
+        EXPECT_TRUE(midpoints_placed(coder.hierarchy(), lifted)) << "seed " << seed;
+    }
 }
 
 TEST(HierarchyCoder, HugeUniformLevelCountIsRefused) {

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <iterator>
 #include <string>
 #include <utility>
 #include <vector>
@@ -30,6 +31,79 @@ Vec3 midpoint_placer(void* single_precision, Vec3 a, Vec3 b) {
     }
     return m;
 }
+
+// The end points of a new vertex.
+struct Ends {
+    VertexId a, b;
+};
+
+// A random-access range over the end points of new vertices whose elements are their positions,
+// made by `Place` as std::vector::insert copies them: each is written once, into the reserved
+// capacity, with no test of the capacity per vertex (push_back's) and no zero-fill first
+// (resize's). The end points' positions are fetched kAhead vertices early.
+template <class Place>
+class NewPositions {
+public:
+    using iterator_category = std::random_access_iterator_tag;
+    using value_type = Vec3;
+    using difference_type = std::ptrdiff_t;
+    using pointer = const Vec3*;
+    using reference = Vec3;
+
+    NewPositions(const Ends* at, const Ends* end, const Vec3* positions, Place place)
+        : at_(at), end_(end), positions_(positions), place_(place) {}
+    Vec3 operator*() const { return place_(positions_[at_->a], positions_[at_->b]); }
+    NewPositions& operator++() {
+        if (at_ + kAhead < end_) {
+            __builtin_prefetch(positions_ + at_[kAhead].a);
+            __builtin_prefetch(positions_ + at_[kAhead].b);
+        }
+        ++at_;
+        return *this;
+    }
+    NewPositions operator++(int) {
+        NewPositions old = *this;
+        ++*this;
+        return old;
+    }
+    NewPositions& operator--() {
+        --at_;
+        return *this;
+    }
+    NewPositions operator--(int) {
+        NewPositions old = *this;
+        --at_;
+        return old;
+    }
+    NewPositions& operator+=(difference_type n) {
+        at_ += n;
+        return *this;
+    }
+    NewPositions& operator-=(difference_type n) {
+        at_ -= n;
+        return *this;
+    }
+    NewPositions operator+(difference_type n) const { return NewPositions(*this) += n; }
+    NewPositions operator-(difference_type n) const { return NewPositions(*this) -= n; }
+    friend NewPositions operator+(difference_type n, const NewPositions& it) { return it + n; }
+    difference_type operator-(const NewPositions& other) const { return at_ - other.at_; }
+    Vec3 operator[](difference_type n) const { return *(*this + n); }
+    bool operator==(const NewPositions& other) const { return at_ == other.at_; }
+    bool operator!=(const NewPositions& other) const { return at_ != other.at_; }
+    bool operator<(const NewPositions& other) const { return at_ < other.at_; }
+    bool operator>(const NewPositions& other) const { return at_ > other.at_; }
+    bool operator<=(const NewPositions& other) const { return at_ <= other.at_; }
+    bool operator>=(const NewPositions& other) const { return at_ >= other.at_; }
+
+private:
+    // The end points' positions miss the cache far more often than the nodes: with 8 vertices
+    // ahead, the loads still waited.
+    static constexpr std::ptrdiff_t kAhead = 32;
+    const Ends* at_;
+    const Ends* end_;
+    const Vec3* positions_;
+    Place place_;
+};
 
 }  // namespace
 
@@ -323,9 +397,6 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
     // new vertices, then the new vertices' positions. Apart, the position loads (which miss the
     // cache) overlap each other instead of stalling the loop that writes the nodes.
     constexpr uint32_t kChunk = 256;
-    struct Ends {
-        VertexId a, b;
-    };
     Ends ends[3 * kChunk];
     // The parents are fetched 16 parents early. (Fetching the neighbours' center children made
     // earlier too cost 9 M instructions per random decode at 10^6 nodes and made the build slower.)
@@ -365,19 +436,20 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
             for (int k = 0; k < 4; ++k) write_tail(child[k], tails.word[k] | level);
             parent.first_child = c;
         }
-        // Within the reserved capacity: no reallocation. The end points' positions miss the
-        // cache far more often than the nodes: they are fetched further ahead (with 8 vertices
-        // ahead, the loads still waited).
+        // Within the reserved capacity: no reallocation, so `positions` stays valid. One loop a
+        // vertex placer, so that the default ones are inlined.
         const Vec3* positions = positions_.data();
-        constexpr uint32_t kPositionsAhead = 32;
-        for (uint32_t k = 0; k < new_vertices; ++k) {
-            if (k + kPositionsAhead < new_vertices) {
-                __builtin_prefetch(positions + ends[k + kPositionsAhead].a);
-                __builtin_prefetch(positions + ends[k + kPositionsAhead].b);
-            }
-            const Vec3& a = positions[ends[k].a];
-            const Vec3& b = positions[ends[k].b];
-            positions_.push_back(default_placer ? midpoint_placer(placer_context_, a, b) : placer_(placer_context_, a, b));
+        auto append = [&](auto place) {
+            using Made = NewPositions<decltype(place)>;
+            positions_.insert(positions_.end(), Made(ends, ends + new_vertices, positions, place),
+                              Made(ends + new_vertices, ends + new_vertices, positions, place));
+        };
+        if (!default_placer) {
+            append([placer = placer_, context = placer_context_](Vec3 a, Vec3 b) { return placer(context, a, b); });
+        } else if (placer_context_ != nullptr) {
+            append([context = placer_context_](Vec3 a, Vec3 b) { return midpoint_placer(context, a, b); });
+        } else {
+            append([](Vec3 a, Vec3 b) { return midpoint_placer(nullptr, a, b); });
         }
     }
     live_nodes_ += 4 * count;
