@@ -1,6 +1,7 @@
 // Hierarchy decoder: the mirror of hierarchy_encoder.cpp. It grows the forest over the shared base
 // mesh level by level, taking each decision from a rule or from the stream.
 #include "coding/hierarchy_level_coder.h"
+#include "common/compiler.h"
 
 #include <string>
 #include <utility>
@@ -18,7 +19,7 @@ HierarchyStreamHeader parse_header(const uint8_t* data, size_t size) {
 // At most how many symbols deciding `level` can read: one a node, none for the nodes
 // 1-regularity culls (the incomplete ones). Not inlined nor analysed across calls: GCC's register
 // allocation in the traversal is easily upset (see HIERARCHY_CODER.md, Speed).
-__attribute__((noipa)) uint32_t codable_symbols(const Level& level, const HierarchyCoderOptions& options) {
+AMC_NOIPA uint32_t codable_symbols(const Level& level, const HierarchyCoderOptions& options) {
     const uint32_t n = static_cast<uint32_t>(level.size());
     return options.cull_one_regularity ? n - level.incomplete_count : n;
 }
@@ -31,7 +32,7 @@ __attribute__((noipa)) uint32_t codable_symbols(const Level& level, const Hierar
 // every node. (Called from decide_level, the traversal had reached the coder through its
 // lambdas' references: 12% more instructions per node than the fast path.) No interprocedural
 // analysis: what GCC learnt of this function cost decide_level's fast path 9% more instructions.
-__attribute__((noipa)) void decide_symbols_general(LevelTraversal& traversal, Level& level, bool uniform_level,
+AMC_NOIPA void decide_symbols_general(LevelTraversal& traversal, Level& level, bool uniform_level,
                                                       ArithmeticDecoder& decoder, HierarchyModels& level_models,
                                                       uint64_t& level_symbols_read, uint64_t symbol_limit,
                                                       int group_mask) {

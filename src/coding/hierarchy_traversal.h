@@ -22,6 +22,7 @@
 #pragma once
 
 #include "coding/context_groups.h"
+#include "common/compiler.h"
 #include "common/huge_pages.h"
 #include "hierarchy/child_links.h"
 
@@ -631,7 +632,7 @@ private:
     // come from the member, as whatever run_on passes by address could alias the state bytes
     // written here. No prefetch of a pushed node's links: it waits for the rest of this phase.
     template <class Links, class Force>
-    __attribute__((noipa)) BucketTops decide_one_regularity_culled(Links links, uint8_t* state, const uint32_t* culled_list,
+    AMC_NOIPA BucketTops decide_one_regularity_culled(Links links, uint8_t* state, const uint32_t* culled_list,
                                                                    uint32_t culled_count, BucketTops tops, Force& force) {
         uint8_t transition[256];
         for (int k = 0; k < 256; ++k) transition[k] = after_neighbor_decided_[k];
