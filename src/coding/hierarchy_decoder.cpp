@@ -33,9 +33,8 @@ AMC_NOIPA uint32_t codable_symbols(const Level& level, const HierarchyCoderOptio
 // lambdas' references: 12% more instructions per node than the fast path.) No interprocedural
 // analysis: what GCC learnt of this function cost decide_level's fast path 9% more instructions.
 AMC_NOIPA void decide_symbols_general(LevelTraversal& traversal, Level& level, bool uniform_level,
-                                                      ArithmeticDecoder& decoder, HierarchyModels& level_models,
-                                                      uint64_t& level_symbols_read, uint64_t symbol_limit,
-                                                      int group_mask) {
+                                      ArithmeticDecoder& decoder, HierarchyModels& level_models,
+                                      uint64_t& level_symbols_read, uint64_t symbol_limit, int group_mask) {
     ArithmeticDecoder d = decoder;
     HierarchyModels models = level_models;
     uint64_t symbols_read = level_symbols_read;

@@ -633,7 +633,7 @@ private:
     // written here. No prefetch of a pushed node's links: it waits for the rest of this phase.
     template <class Links, class Force>
     AMC_NOIPA BucketTops decide_one_regularity_culled(Links links, uint8_t* state, const uint32_t* culled_list,
-                                                                   uint32_t culled_count, BucketTops tops, Force& force) {
+                                                      uint32_t culled_count, BucketTops tops, Force& force) {
         uint8_t transition[256];
         for (int k = 0; k < 256; ++k) transition[k] = after_neighbor_decided_[k];
         uint32_t* top[4] = {tops.at[0], tops.at[1], tops.at[2], tops.at[3]};
