@@ -320,26 +320,25 @@ TEST(HierarchyCoder, ReusedDecoderMatchesFreshDecodes) {
 }
 
 Vec3 lifted(Vec3 a, Vec3 b) { return 0.5 * (a + b) + Vec3{0, 0, 0.125}; }
+Vec3 to_single(Vec3 p) { return {double(float(p.x)), double(float(p.y)), double(float(p.z))}; }
 
 // The decoder builds each level in one pass (Hierarchy::split_level), with one loop for each kind
 // of vertex placer: the default midpoint of double and of single precision bases, and any other.
 TEST(HierarchyCoder, DecodedVerticesArePlacedByTheHierarchysPlacer) {
     for (uint64_t seed = 1; seed <= 30; ++seed) {
-        Hierarchy h = random_hierarchy(seed);
+        const Hierarchy h = random_hierarchy(seed);
         const bool single = seed % 2 == 0;
         TriangleMesh base = h.base();
         base.single_precision = single;
-        for (Vec3& p : base.positions) {
-            if (single) p = Vec3{double(float(p.x)), double(float(p.y)), double(float(p.z))};
+        if (single) {
+            for (Vec3& p : base.positions) p = to_single(p);
         }
         const std::vector<uint8_t> bytes = encode_hierarchy(h, HierarchyCoderOptions{});
         const Hierarchy decoded = decode_hierarchy(base, bytes.data(), bytes.size());
         ASSERT_TRUE(same_connectivity(h, decoded)) << "seed " << seed;
         if (single) {
-            EXPECT_TRUE(midpoints_placed(decoded, [](Vec3 a, Vec3 b) {
-                const Vec3 m = 0.5 * (a + b);
-                return Vec3{double(float(m.x)), double(float(m.y)), double(float(m.z))};
-            })) << "seed " << seed;
+            EXPECT_TRUE(midpoints_placed(decoded, [](Vec3 a, Vec3 b) { return to_single(0.5 * (a + b)); }))
+                << "seed " << seed;
         } else {
             EXPECT_TRUE(midpoints_placed(decoded, [](Vec3 a, Vec3 b) { return 0.5 * (a + b); })) << "seed " << seed;
         }
