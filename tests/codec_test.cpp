@@ -287,7 +287,7 @@ TEST(Codec, DiagonalRulesOfAbsoluteLocalIndicesStayCheap) {
 TEST(Codec, NewerVersionIsRefusedClearly) {
     Hierarchy h(make_icosahedron());
     std::vector<uint8_t> bytes = encode(h);
-    bytes[4] = 2;
+    bytes[4] = 3;
     try {
         decode(bytes.data(), bytes.size());
         FAIL();

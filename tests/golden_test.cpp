@@ -1,4 +1,4 @@
-// Golden .amc files: the bytes of version 1 are pinned. A change that alters the bitstream fails
+// Golden .amc files: the bytes of version 2 are pinned. A change that alters the bitstream fails
 // here; if it is deliberate, bump the format version, update docs/FORMAT.md, and regenerate with
 // AMC_UPDATE_GOLDEN=1 ./amc_tests --gtest_filter='Golden*' (in the same commit).
 #include "hierarchy_checks.h"
@@ -72,7 +72,7 @@ TEST(Golden, EncodingsMatchTheGoldenFiles) {
         const Hierarchy back = decode(golden.data(), golden.size());
         EXPECT_EQ(back.node_count(), c.hierarchy.node_count()) << c.name;
         const FileInfo info = inspect(golden.data(), golden.size());
-        EXPECT_EQ(info.version, 1);
+        EXPECT_EQ(info.version, 2);
         EXPECT_EQ(info.quantize_bits, c.options.quantize_bits);
         EXPECT_EQ(info.single_precision, c.hierarchy.single_precision() && c.options.quantize_bits == 0);
         ASSERT_EQ(info.blocks.size(), size_t(4 + info.levels)) << "metadata, base connectivity, base geometry, levels, end";

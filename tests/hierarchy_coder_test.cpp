@@ -354,6 +354,24 @@ TEST(HierarchyCoder, DecodedVerticesArePlacedByTheHierarchysPlacer) {
     }
 }
 
+// A node split against Hierarchy::split's precondition (it lacks a neighbour) has no stream: the
+// decoder would refuse it. The encoder says so, under every switch combination.
+TEST(HierarchyCoder, UnbalancedHierarchyIsRefusedByTheEncoder) {
+    Hierarchy h(make_icosahedron());
+    h.split(0);
+    const NodeId corner = h.child(0, 0);
+    ASSERT_FALSE(h.has_all_neighbors(corner));
+    h.split(corner);
+    for (int bits = 0; bits < kOptionCombinations; ++bits) {
+        try {
+            encode_hierarchy(h, options_from_bits(bits));
+            ADD_FAILURE() << "switches " << bits << ": encoded an unbalanced hierarchy";
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("not balanced"), std::string::npos) << e.what();
+        }
+    }
+}
+
 TEST(HierarchyCoder, HugeUniformLevelCountIsRefused) {
     Hierarchy h(make_icosahedron());
     std::vector<uint8_t> bytes = encode_hierarchy(h);

@@ -9,7 +9,7 @@
 namespace amc {
 
 constexpr char kFileMagic[4] = {'A', 'M', 'C', 'F'};
-constexpr uint8_t kFileVersion = 1;
+constexpr uint8_t kFileVersion = 2;
 constexpr size_t kFileHeaderSize = 12;  // magic, version, flags, 2 reserved, XXH32 of those 8
 constexpr size_t kBlockOverhead = 1 + 4 + 4;  // type, payload length, checksum
 

@@ -79,7 +79,7 @@ void HierarchyLevelDecoder::restart(const TriangleMesh& base, const HierarchyStr
     traversal_.configure(header.options);
     for (Level& level : decided_) spare_.push_back(std::move(level));
     decided_.clear();
-    root_level(h_, level_);
+    root_level(h_, level_, header.options.cull_one_regularity);
     level_index_ = 0;
     level_base_ = 0;
     node_count_ = h_.root_count();
@@ -178,7 +178,7 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
 
 void HierarchyLevelDecoder::finish_level() {
     node_count_ += uint64_t(4) * level_.refined_count;
-    vertex_count_ += derive_next_level(level_, numbering_, next_);
+    vertex_count_ += derive_next_level(level_, numbering_, next_, header_.options.cull_one_regularity);
     decided_.push_back(std::move(level_));
     level_ = std::move(next_);
     if (spare_.empty()) {

@@ -3,6 +3,7 @@
 // Stream layout in docs/FORMAT.md ("hierarchy stream").
 #include "coding/hierarchy_level_coder.h"
 
+#include <string>
 #include <utility>
 
 namespace amc {
@@ -25,7 +26,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
     std::vector<NodeId> ids, next_ids;
     std::vector<uint8_t> refined;
     RefinedNumbering numbering;
-    root_level(h, level);
+    root_level(h, level, options.cull_one_regularity);
     ids.resize(h.root_count());
     for (NodeId r = 0; r < h.root_count(); ++r) ids[r] = r;
     for (int l = 0; !level.empty(); ++l) {
@@ -49,6 +50,16 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         }
         const bool uniform = options.uniform_levels && all_refined && l == uniform_levels && l < kMaxUniformLevels;
         if (uniform) ++uniform_levels;
+        // A refined node needs all its neighbours (Hierarchy::can_split); no stream could say
+        // otherwise, and with the 1-regularity rule such nodes start decided as leaves.
+        if (level.incomplete_count != 0) {
+            for (uint32_t i = 0; i < n; ++i) {
+                if (refined[i] && !(level.state()[i] & kComplete))
+                    throw Error("encode_hierarchy: node " + std::to_string(ids[i]) + " of level " + std::to_string(l) +
+                                " is refined but lacks a neighbour (the hierarchy is not balanced)");
+            }
+            if (options.cull_one_regularity && !uniform) stats.culled_one_regularity += level.incomplete_count;
+        }
         const uint8_t* truth = refined.data();
         traversal.run(
             level, uniform,
@@ -60,7 +71,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
             [&](uint32_t i, Fate fate, bool) {
                 switch (fate) {
                     case Fate::uniform: ++stats.culled_uniform; break;
-                    case Fate::one_regularity: ++stats.culled_one_regularity; break;
+                    case Fate::one_regularity: break;  // counted above: those nodes are decided already
                     case Fate::hanging_nodes: ++stats.culled_hanging_nodes; break;
                     case Fate::coded: break;
                 }
@@ -80,7 +91,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         stats.levels = l + 1;
         level_end_.push_back(events_.size());
         scan_decided_level(level, numbering, nullptr);
-        derive_next_level(level, numbering, next);
+        derive_next_level(level, numbering, next, options.cull_one_regularity);
         std::swap(level, next);
         level_ids_.push_back(ids);
         ids.swap(next_ids);

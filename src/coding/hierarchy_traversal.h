@@ -91,9 +91,11 @@ struct Level {
     std::vector<LevelLinks> roots;  // level 0: every node's links
     ScratchArray<Neighbors> nbr;    // finer levels: every node's neighbours
     ScratchArray<BlockEdges> edges;  // finer levels: what each block of four siblings takes from its parent
-    // The nodes without all neighbours (1-regularity culls them), in canonical order.
-    ScratchArray<uint32_t> incomplete;
+    // The number of nodes without all neighbours (1-regularity culls them).
     uint32_t incomplete_count = 0;
+    // Working memory of derive_next_level: the nodes whose priority a culled node in another block
+    // lowers.
+    ScratchArray<uint32_t> lowered;
     // After the level is decided (decoder): its refined nodes in canonical order, and the nodes
     // whose diagonal is flipped, ascending.
     ScratchArray<uint32_t> refined;
@@ -148,6 +150,21 @@ decltype(auto) with_links(const Level& level, F&& f) {
 // The priority bits of bucket 4, where a complete node starts (an incomplete one starts in 0).
 constexpr uint8_t kFreshPriority = 4 << kPriorityShift;
 
+// The state of a node once one more of its neighbours is culled by 1-regularity, before any node
+// of the level is decided otherwise: an undecided node moves one bucket down, not below 1 (the
+// improved traversal's rule; with nothing refined, no other rule can cull it). A table: the
+// lowered nodes follow no pattern, and GCC made the test a branch.
+struct LoweredByCulledNeighbor {
+    uint8_t of[256];
+    constexpr LoweredByCulledNeighbor() : of() {
+        for (int s = 0; s < 256; ++s) {
+            const bool moves = !(s & kDecided) && (s >> kPriorityShift) > 1;
+            of[s] = uint8_t(s - (moves ? 1 << kPriorityShift : 0));
+        }
+    }
+};
+constexpr LoweredByCulledNeighbor kLoweredByCulledNeighbor{};
+
 inline int refined_neighbors(uint8_t state) { return (state & kRefinedNeighborMask) >> 2; }
 
 inline uint8_t complete_state(const uint32_t nbr[3], uint8_t boundary) {
@@ -157,15 +174,17 @@ inline uint8_t complete_state(const uint32_t nbr[3], uint8_t boundary) {
                : 0;
 }
 
-// Level 0: the roots of `h` (root ids are local indices).
-inline void root_level(const Hierarchy& h, Level& level) {
+// Level 0: the roots of `h` (root ids are local indices). With `cull_one_regularity`, the
+// incomplete roots are decided (not refined) and their neighbours' priorities lowered, as in
+// derive_next_level.
+inline void root_level(const Hierarchy& h, Level& level, bool cull_one_regularity) {
     const uint32_t n = h.root_count();
     level.flipped.clear();
     level.refined_count = 0;
     level.roots.resize(n);
     level.resize_state(n);
-    uint32_t* incomplete = level.incomplete.reserve(n);
     uint32_t incomplete_count = 0;
+    uint8_t* state = level.state();
     for (NodeId r = 0; r < n; ++r) {
         LevelLinks& node = level.roots[r];
         uint8_t boundary = 0, edges = 0;
@@ -177,44 +196,82 @@ inline void root_level(const Hierarchy& h, Level& level) {
         node.nbr_edge = edges;
         node.flags = boundary;
         const uint8_t complete = complete_state(node.nbr, boundary);
-        level.state()[r] = complete ? uint8_t(complete | kFreshPriority) : uint8_t(0);
-        incomplete[incomplete_count] = r;
+        state[r] = complete ? uint8_t(complete | kFreshPriority) : cull_one_regularity ? kDecided : uint8_t(0);
         incomplete_count += !complete;
     }
     level.incomplete_count = incomplete_count;
+    if (!cull_one_regularity || incomplete_count == 0) return;
+    for (NodeId r = 0; r < n; ++r) {
+        if (state[r] & kComplete) continue;
+        for (int e = 0; e < 3; ++e) {
+            uint8_t& s = neighbor_state(state, level.roots[r].nbr[e]);
+            s = kLoweredByCulledNeighbor.of[s];
+        }
+    }
 }
 
 // What a new block takes from its parent's linked edges (bits 0-2: the edges with a refined
-// neighbour) and boundary edges (bits 3-5), in one 32-byte entry so that one register addresses it:
+// neighbour) and boundary edges (bits 3-5), in one 16-byte entry; a table without the 1-regularity
+// rule and one with it:
 //  - the four children's state bytes (byte k: child k). Corner k is complete when its two outer
 //    edges (the parent's k and (k+2)%3) each have a neighbour or are boundary; the center always
-//    is. Complete children start in bucket 4 (kFreshPriority);
-//  - the offsets within the block of the corners that are not complete, packed, and their count;
+//    is. Without the rule every child starts undecided, a complete one in bucket 4
+//    (kFreshPriority), an incomplete one in 0. With the rule an incomplete corner starts decided
+//    (not refined), and the center, whose neighbours are the three corners, one bucket lower for
+//    each of them;
+//  - with the rule, the neighbours outside the block of its incomplete corners, whose priority
+//    goes down once the rule culls those corners, as byte offsets into the block's twelve words of
+//    neighbours (write_child_neighbors: word 3k + e is child k's neighbour across edge e). An
+//    incomplete corner has at most one such neighbour, a block at most two: on a linked edge f,
+//    first_f when edge (f+2)%3 has neither neighbour nor boundary, second_f when edge (f+1)%3 has
+//    neither;
 //  - the mask of the linked edges' two-bit neighbour edge indices;
-//  - the ends the new vertices count (2 on an edge of its own, 1 on an edge shared with a refined
-//    neighbour).
+//  - two counts in one word, so that one addition keeps both: the ends the new vertices count
+//    beyond 3 (bits 0-31: a vertex on an edge of its own counts 2 ends, one on an edge shared with
+//    a refined neighbour 1, so 3 to 6 a block) and the corners that are not complete (bits
+//    32-63). Neither sum can overflow: a level has fewer than 2^32 nodes, so fewer than 2^30
+//    blocks.
 struct NewBlock {
-    alignas(16) uint32_t incomplete[4] = {};
     uint32_t states = 0;
-    uint8_t incomplete_count = 0;
+    uint8_t lowered_offset[2] = {};
+    uint8_t lowered_count = 0;
     uint8_t edge_mask = 0;
-    uint8_t ends = 0;
+    uint64_t counts = 0;
 };
+static_assert(sizeof(NewBlock) == 16, "NewBlock is meant to be 16 bytes");
 struct NewBlocks {
-    NewBlock of[64];
+    NewBlock of[2][64];  // [cull_one_regularity][code]
     constexpr NewBlocks() : of() {
         constexpr uint32_t kFresh = kComplete | kFreshPriority;
-        for (int code = 0; code < 64; ++code) {
-            NewBlock& block = of[code];
-            block.states = kFresh << 24;
-            for (int k = 0; k < 3; ++k) {
-                const int prev = k == 0 ? 2 : k - 1;
-                const bool ok = (((code >> k) | (code >> (3 + k))) & 1) && (((code >> prev) | (code >> (3 + prev))) & 1);
-                if (ok) block.states |= kFresh << (8 * k);
-                else block.incomplete[block.incomplete_count++] = uint32_t(k);
-                const bool linked = (code >> k) & 1;
-                if (linked) block.edge_mask = uint8_t(block.edge_mask | (3 << (2 * k)));
-                block.ends = uint8_t(block.ends + (linked ? 1 : 2));
+        // The neighbour words of first_f and second_f (see write_child_neighbors).
+        constexpr int kFirstWord[3] = {0, 4, 8}, kSecondWord[3] = {3, 7, 2};
+        for (int culled = 0; culled < 2; ++culled) {
+            for (int code = 0; code < 64; ++code) {
+                NewBlock& block = of[culled][code];
+                bool missing[3] = {};
+                for (int e = 0; e < 3; ++e) missing[e] = !(((code >> e) | (code >> (3 + e))) & 1);
+                block.states = kFresh << 24;
+                uint32_t ends = 0, incomplete = 0;
+                for (int k = 0; k < 3; ++k) {
+                    const int prev = k == 0 ? 2 : k - 1;
+                    if (!missing[k] && !missing[prev]) {
+                        block.states |= kFresh << (8 * k);
+                    } else {
+                        if (culled) block.states |= uint32_t(kDecided) << (8 * k);
+                        ++incomplete;
+                    }
+                    const bool linked = (code >> k) & 1;
+                    if (linked) block.edge_mask = uint8_t(block.edge_mask | (3 << (2 * k)));
+                    ends += linked ? 1 : 2;
+                }
+                block.counts = (ends - 3) | uint64_t(incomplete) << 32;
+                if (!culled) continue;
+                block.states -= incomplete << (24 + kPriorityShift);
+                for (int f = 0; f < 3; ++f) {
+                    if (!((code >> f) & 1)) continue;
+                    if (missing[(f + 2) % 3]) block.lowered_offset[block.lowered_count++] = uint8_t(4 * kFirstWord[f]);
+                    if (missing[(f + 1) % 3]) block.lowered_offset[block.lowered_count++] = uint8_t(4 * kSecondWord[f]);
+                }
             }
         }
     }
@@ -369,7 +426,11 @@ inline unsigned write_child_neighbors(Neighbors* out, uint32_t b, uint32_t q0, u
 // the splits create: one per edge of a refined node, shared where the neighbour is refined too.
 // Across p's edge e lies p's neighbour q with its index eq of the edge; when q is refined, the
 // first half of the edge meets q's child (eq+1)%3 and the second half q's child eq.
-inline uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering, Level& next) {
+// With `cull_one_regularity` the incomplete nodes start decided (not refined) and every other
+// node one bucket lower for each incomplete neighbour (NewBlock), as the improved traversal wants
+// them: what the culled nodes' decisions would do to their neighbours, in any order.
+inline uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering, Level& next,
+                                  bool cull_one_regularity) {
     const uint32_t count = level.refined_count;
     const uint32_t* block = numbering.block_of();
     const uint32_t* refined = level.refined.data();
@@ -379,10 +440,12 @@ inline uint64_t derive_next_level(const Level& level, const RefinedNumbering& nu
     next.resize_state(size_t(4) * count);
     Neighbors* out = next.nbr.reserve(size_t(4) * count);
     BlockEdges* out_edges = next.edges.reserve(count);
-    uint32_t* incomplete = next.incomplete.reserve(size_t(3) * count + 1);  // + 1: each block writes four words
-    uint32_t incomplete_count = 0;
+    uint32_t* lowered = next.lowered.reserve(size_t(2) * count);  // each block writes two words
+    uint32_t lowered_count = 0;
+    const NewBlock* const new_blocks = kNewBlocks.of[cull_one_regularity ? 1 : 0];
     uint8_t* out_state = next.state();
-    uint64_t edge_ends = 0;  // each new vertex has two: one from each refined node on its edge, or both from one
+    // Each new vertex has two edge ends: one from each refined node on its edge, or both from one.
+    uint64_t counts = 0;  // bits 0-31 the edge ends beyond 3 a block, 32-63 the incomplete nodes
     with_links(level, [&](auto links) {
         for (uint32_t b = 0; b < count; ++b) {
             const LevelLinks p = links(refined[b]);
@@ -390,26 +453,30 @@ inline uint64_t derive_next_level(const Level& level, const RefinedNumbering& nu
             const unsigned linked = write_child_neighbors(
                 out + c, b, block[static_cast<int32_t>(p.nbr[0])], block[static_cast<int32_t>(p.nbr[1])],
                 block[static_cast<int32_t>(p.nbr[2])], p.nbr_edge);  // kNoLocal for none
-            const NewBlock& entry = kNewBlocks.of[linked | ((p.flags & 7u) << 3)];
+            const NewBlock& entry = new_blocks[linked | ((p.flags & 7u) << 3)];
             out_edges[b] = {uint8_t(p.nbr_edge & entry.edge_mask), uint8_t(p.flags & 7)};
-            edge_ends += entry.ends;
+            counts += entry.counts;
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
             std::memcpy(out_state + c, &entry.states, 4);  // byte k: child k
 #else
             for (int k = 0; k < 4; ++k) out_state[c + k] = uint8_t(entry.states >> (8 * k));
 #endif
-#if defined(__SSE2__)
-            const __m128i offsets = _mm_load_si128(reinterpret_cast<const __m128i*>(entry.incomplete));
-            _mm_storeu_si128(reinterpret_cast<__m128i*>(incomplete + incomplete_count),
-                             _mm_add_epi32(offsets, _mm_set1_epi32(int(c))));
-#else
-            for (int k = 0; k < 3; ++k) incomplete[incomplete_count + k] = c + entry.incomplete[k];
-#endif
-            incomplete_count += entry.incomplete_count;
+            // Both words always, kept by the count (no branch: which blocks have incomplete
+            // corners follows no pattern). memcpy: the words are read as the bytes of out's
+            // array.
+            const char* words = reinterpret_cast<const char*>(out + c);
+            std::memcpy(lowered + lowered_count, words + entry.lowered_offset[0], 4);
+            std::memcpy(lowered + lowered_count + 1, words + entry.lowered_offset[1], 4);
+            lowered_count += entry.lowered_count;
         }
     });
-    next.incomplete_count = incomplete_count;
-    return edge_ends / 2;
+    next.incomplete_count = uint32_t(counts >> 32);
+    // Those neighbours may lie in blocks written after theirs: lowered once every state is made.
+    for (uint32_t k = 0; k < lowered_count; ++k) {
+        uint8_t& s = out_state[lowered[k]];
+        s = kLoweredByCulledNeighbor.of[s];
+    }
+    return (uint64_t(uint32_t(counts)) + uint64_t(3) * count) / 2;
 }
 
 // The unrefined edge of a decided leaf with exactly two hanging nodes. Which edge it is follows
@@ -484,15 +551,15 @@ public:
     template <class Code, class Force>
     void run(Level& level, bool uniform_level, Code&& code, Force&& force) {
         with_links(level, [&](auto links) {
-            run_on(links, level.state(), static_cast<uint32_t>(level.size()), level.incomplete.data(),
-                   level.incomplete_count, uniform_level, code, force);
+            run_on(links, level.state(), static_cast<uint32_t>(level.size()), level.incomplete_count, uniform_level,
+                   code, force);
         });
     }
 
 private:
     template <class Links, class Code, class Force>
-    void run_on(Links links, uint8_t* state, uint32_t n, const uint32_t* level_incomplete,
-                uint32_t level_incomplete_count, bool uniform_level, Code& code, Force& force) {
+    void run_on(Links links, uint8_t* state, uint32_t n, uint32_t incomplete_count, bool uniform_level, Code& code,
+                Force& force) {
         // A copy in a local: the state bytes written below could alias options_.
         const CullRules rules{options_.cull_one_regularity, options_.cull_hanging_nodes};
         if (uniform_level) {
@@ -507,7 +574,10 @@ private:
             return;
         }
         if (options_.traversal == Traversal::naive) {
-            for (uint32_t i = 0; i < n; ++i) decide(rules.fate(state[i]), links.neighbors(i), state, i, code, force);
+            // (The nodes 1-regularity culls are decided already.)
+            for (uint32_t i = 0; i < n; ++i) {
+                if (!(state[i] & kDecided)) decide(rules.fate(state[i]), links.neighbors(i), state, i, code, force);
+            }
             return;
         }
         // Improved traversal: a bucket queue over priorities 0 (culled: nothing to code) to 4 (no
@@ -515,18 +585,14 @@ private:
         // lowest non-empty bucket goes first, each bucket last in, first out; an entry is stale
         // once its node is decided or has moved to a lower bucket, and is skipped. Every node
         // enters at most five buckets: linear time.
-        // Bucket 4 starts with every unculled node in canonical order and never receives another,
-        // so it is a cursor. Bucket 0 starts with the nodes 1-regularity culls (the level's
-        // incomplete nodes: no node is refined yet, so no other rule applies), in canonical order,
-        // under a stack of nodes culled later. Those first nodes go first: none of them is
-        // refined, so none makes another node culled meanwhile and the stack stays empty until
-        // all are decided. A new level's states already hold these priorities (bucket 4 for
-        // complete nodes); without the 1-regularity rule every node starts in bucket 4.
-        const uint32_t* culled_list = level_incomplete;
-        uint32_t culled_count = level_incomplete_count;
+        // The nodes 1-regularity culls (the incomplete ones) are decided first, and a new level's
+        // states hold their decisions and the priorities they leave (derive_next_level). The
+        // nodes of buckets 1-3 go onto their stacks in reverse canonical order, so that each
+        // stack pops in canonical order. Bucket 4 holds every other node in canonical order and
+        // never receives another, so it is a cursor. Without the 1-regularity rule every node
+        // starts in bucket 4.
         if (!rules.one_regularity) {
             for (uint32_t i = 0; i < n; ++i) state[i] = uint8_t(state[i] | kFreshPriority);
-            culled_count = 0;
         }
         uint32_t* const bottom[4] = {stacks_[0].reserve(n), stacks_[1].reserve(n), stacks_[2].reserve(n),
                                      stacks_[3].reserve(n)};
@@ -555,9 +621,8 @@ private:
             }
             return next_bucket;
         };
-        if (culled_count != 0) {
-            const BucketTops tops = decide_one_regularity_culled(links, state, culled_list, culled_count,
-                                                                 BucketTops{{top[0], top[1], top[2], top[3]}}, force);
+        if (rules.one_regularity && incomplete_count != 0) {
+            const BucketTops tops = push_lowered(state, n, BucketTops{{top[0], top[1], top[2], top[3]}});
             for (int b = 0; b < 4; ++b) top[b] = tops.at[b];
         }
         uint32_t fresh_cursor = 0;
@@ -625,36 +690,37 @@ private:
     struct BucketTops {
         uint32_t* at[4];
     };
-    // The nodes 1-regularity culls (incomplete: listed only with that rule, so their fate is
-    // known), decided first, and the moves their decisions make in the buckets, in the order
-    // run_on's pushes would make them. A function of its own, so that GCC allocates run_on's
-    // registers for the loop over coded nodes alone; the tops go by value and the transitions
-    // come from the member, as whatever run_on passes by address could alias the state bytes
-    // written here. No prefetch of a pushed node's links: it waits for the rest of this phase.
-    template <class Links, class Force>
-    AMC_NOIPA BucketTops decide_one_regularity_culled(Links links, uint8_t* state, const uint32_t* culled_list,
-                                                      uint32_t culled_count, BucketTops tops, Force& force) {
-        uint8_t transition[256];
-        for (int k = 0; k < 256; ++k) transition[k] = after_neighbor_decided_[k];
-        uint32_t* top[4] = {tops.at[0], tops.at[1], tops.at[2], tops.at[3]};
-        for (uint32_t k = 0; k < culled_count; ++k) {
-            const uint32_t i = culled_list[k];
-            const Neighbors node = links.neighbors(i);
-            const bool refined = force(i, Fate::one_regularity, false);
-            state[i] = uint8_t(state[i] | kDecided | (refined ? kRefined : 0));
-            if (refined) add_refined_neighbor(node, state);
-            // run_on's push_neighbors without the prefetch and the next node. (One helper for both
-            // made GCC's code for run_on's loop 4% longer.)
-            for (int e = 0; e < 3; ++e) {
-                const uint32_t q = node.nbr[e];
-                const uint8_t s = neighbor_state(state, q);
-                const uint8_t t = transition[s];
-                if (t == s) continue;  // decided (or no neighbour), or already in bucket 1
-                state[q] = t;
-                *top[t >> kPriorityShift]++ = q;
+    // Pushes the undecided nodes below bucket 4 (those the culled nodes lowered) onto their
+    // stacks, in reverse canonical order. Where they are follows no pattern, so the state bytes
+    // are read 16 at a time as bit masks and only the set bits are visited. A function of its
+    // own, so that GCC allocates run_on's registers for the loop over coded nodes alone.
+    AMC_NOIPA static BucketTops push_lowered(const uint8_t* state, uint32_t n, BucketTops tops) {
+        constexpr uint8_t kDecidedOrBucket4 = kDecided | kFreshPriority;  // priorities are 0..4
+        auto push = [&](uint32_t i) {
+            uint32_t*& top = tops.at[state[i] >> kPriorityShift];
+            *top++ = i;
+        };
+        uint32_t i = n;
+        for (; i % 16 != 0; --i) {
+            if (!(state[i - 1] & kDecidedOrBucket4)) push(i - 1);
+        }
+#if defined(__SSE2__)
+        const __m128i mask = _mm_set1_epi8(char(kDecidedOrBucket4));
+        const __m128i zero = _mm_setzero_si128();
+        for (; i != 0; i -= 16) {
+            const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(state + i - 16));
+            unsigned hits = unsigned(_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_and_si128(v, mask), zero)));
+            while (hits != 0) {
+                const unsigned j = 31u - unsigned(__builtin_clz(hits));
+                push(i - 16 + j);
+                hits ^= 1u << j;
             }
         }
-        for (int b = 0; b < 4; ++b) tops.at[b] = top[b];
+#else
+        for (; i != 0; --i) {
+            if (!(state[i - 1] & kDecidedOrBucket4)) push(i - 1);
+        }
+#endif
         return tops;
     }
 
