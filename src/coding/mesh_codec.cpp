@@ -266,8 +266,10 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     stats.base_vertices = meta.base_vertices;
     stats.base_triangles = meta.base_triangles;
     stats.levels = hierarchy.level_count();
-    stats.hierarchy = hierarchy.stats();
-    if (stats_out != nullptr) *stats_out = stats;
+    if (stats_out != nullptr) {
+        stats.hierarchy = hierarchy.stats();  // replays the coded symbols: only when asked for
+        *stats_out = stats;
+    }
     return out;
 }
 
