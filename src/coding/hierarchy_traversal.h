@@ -107,7 +107,9 @@ struct Level {
     // One state byte a node, preceded by kNoNeighborState: a neighbour index q reads its state at
     // state()[int32_t(q)], which for kNoLocal (-1) is that byte, so the hot loops need no test
     // for a missing neighbour. A new level's states say whether the node is complete and put
-    // complete nodes in the improved traversal's bucket 4.
+    // complete nodes in the improved traversal's bucket 4; with the 1-regularity rule the
+    // incomplete ones are decided already and their neighbours' buckets lowered
+    // (derive_next_level).
     uint8_t* state() { return states_.data() + 1; }
     const uint8_t* state() const { return states_.data() + 1; }
     void resize_state(size_t n) {
