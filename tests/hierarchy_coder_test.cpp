@@ -5,6 +5,7 @@
 
 #include <amc/hierarchy_coder.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace amc {
@@ -352,6 +353,68 @@ TEST(HierarchyCoder, DecodedVerticesArePlacedByTheHierarchysPlacer) {
         ASSERT_TRUE(same_connectivity(h, coder.hierarchy())) << "seed " << seed;
         EXPECT_TRUE(midpoints_placed(coder.hierarchy(), lifted)) << "seed " << seed;
     }
+}
+
+// The improved traversal's starting states (FORMAT.md, section 2): with the 1-regularity rule,
+// a level's incomplete nodes are decided (not refined) before its traversal, and every other node
+// starts in bucket max(1, 4 - its incomplete neighbours). derive_next_level makes them from
+// tables; here they are counted over each level's links, on every level of 300 random
+// hierarchies. (The round trips can not see a wrong start: encoder and decoder share it.)
+TEST(HierarchyCoder, LevelsStartWithTheCulledNodesDecided) {
+    size_t nodes = 0, culled = 0, lowered = 0;
+    for (uint64_t seed = 1; seed <= 300; ++seed) {
+        const Hierarchy h = random_hierarchy(seed);
+        LevelTraversal traversal{HierarchyCoderOptions{}};
+        Level level, next;
+        RefinedNumbering numbering;
+        root_level(h, level, true);
+        std::vector<NodeId> ids(h.root_count()), next_ids;
+        for (NodeId r = 0; r < h.root_count(); ++r) ids[r] = r;
+        for (int l = 0; !level.empty(); ++l) {
+            const uint32_t n = uint32_t(level.size());
+            const uint8_t* state = level.state();
+            size_t wrong = 0;
+            with_links(level, [&](auto links) {
+                auto complete = [&](uint32_t i) {
+                    const LevelLinks node = links(i);
+                    return complete_state(node.nbr, node.flags) != 0;
+                };
+                for (uint32_t i = 0; i < n; ++i) {
+                    uint8_t expected = kDecided;
+                    if (complete(i)) {
+                        int culled_neighbours = 0;
+                        for (const uint32_t q : links(i).nbr) culled_neighbours += q != kNoLocal && !complete(q);
+                        expected = uint8_t(kComplete | std::max(1, 4 - culled_neighbours) << kPriorityShift);
+                        lowered += culled_neighbours > 0;
+                    } else {
+                        ++culled;
+                    }
+                    if (state[i] != expected && wrong++ == 0)
+                        ADD_FAILURE() << "seed " << seed << ", level " << l << ", node " << i << ": state "
+                                      << int(state[i]) << ", expected " << int(expected);
+                }
+            });
+            ASSERT_EQ(wrong, 0u);
+            nodes += n;
+            // Decided as the encoder decides them, from the hierarchy.
+            auto refined = [&](uint32_t i) { return !h.is_leaf(ids[i]); };
+            traversal.run(level, false, [&](uint32_t i, int) { return refined(i); },
+                          [&](uint32_t i, Fate, bool) { return refined(i); });
+            next_ids.clear();
+            for (uint32_t i = 0; i < n; ++i) {
+                if (!refined(i)) continue;
+                const NodeId c = h.child(ids[i], 0);
+                next_ids.insert(next_ids.end(), {c, c + 1, c + 2, c + 3});
+            }
+            scan_decided_level(level, numbering, nullptr);
+            derive_next_level(level, numbering, next, true);
+            std::swap(level, next);
+            ids.swap(next_ids);
+        }
+    }
+    // The hierarchies exercise the rule: many culled nodes, many lowered neighbours.
+    EXPECT_GT(culled, nodes / 10);
+    EXPECT_GT(lowered, nodes / 10);
 }
 
 // A node split against Hierarchy::split's precondition (it lacks a neighbour) has no stream: the
