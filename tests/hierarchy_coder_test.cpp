@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <utility>
 
 namespace amc {
 namespace {
@@ -415,6 +417,128 @@ TEST(HierarchyCoder, LevelsStartWithTheCulledNodesDecided) {
     // The hierarchies exercise the rule: many culled nodes, many lowered neighbours.
     EXPECT_GT(culled, nodes / 10);
     EXPECT_GT(lowered, nodes / 10);
+}
+
+// FORMAT.md, section 2, read literally and run on the Hierarchy itself: the symbols of every level
+// in the order and with the context groups the text gives, for all switches on (improved) or all
+// but the improved traversal (naive). Diagonals follow rule 0, so the stream has no orientation
+// bits; U and the symbol count come from the coder's header.
+std::vector<std::pair<int, bool>> symbols_as_specified(const Hierarchy& h, bool improved, int uniform_levels) {
+    std::vector<std::pair<int, bool>> symbols;
+    const std::vector<NodeId> order = h.breadth_first_order();  // canonical: level by level
+    const int group_of[4][4] = {{8, 7, 6, 5}, {4, 3, 2, -1}, {1, 0, -1, -1}, {9, -1, -1, -1}};  // [x][y]
+    size_t begin = 0;
+    for (int l = 0; begin < order.size(); ++l) {
+        size_t end = begin;
+        while (end < order.size() && h.level(order[end]) == l) ++end;
+        const std::vector<NodeId> level(order.begin() + long(begin), order.begin() + long(end));
+        begin = end;
+        if (l < uniform_levels) continue;
+        std::map<NodeId, uint32_t> index;
+        for (uint32_t i = 0; i < level.size(); ++i) index[level[i]] = i;
+        const uint32_t n = uint32_t(level.size());
+        std::vector<bool> decided(n, false), refined(n, false);
+        std::vector<int> priority(n, 4);
+        auto neighbour = [&](uint32_t i, int e) -> int64_t {
+            const NodeId q = h.neighbor(level[i], e);
+            return q == kNoNode ? -1 : int64_t(index.at(q));
+        };
+        auto culled_by_one_regularity = [&](uint32_t i) {
+            for (int e = 0; e < 3; ++e) {
+                if (neighbour(i, e) < 0 && !h.is_boundary_edge(level[i], e)) return true;
+            }
+            return false;
+        };
+        auto hanging = [&](uint32_t i) {
+            for (int e = 0; e < 3; ++e) {
+                const int64_t q = neighbour(i, e);
+                if (q < 0 || !decided[size_t(q)] || !refined[size_t(q)]) return false;
+            }
+            return true;
+        };
+        // First every node 1-regularity culls: not refined, no symbol.
+        for (uint32_t i = 0; i < n; ++i) decided[i] = culled_by_one_regularity(i);
+        auto decide = [&](uint32_t i) {
+            if (hanging(i)) {
+                refined[i] = true;
+            } else {
+                int x = 0, y = 0;
+                for (int e = 0; e < 3; ++e) {
+                    const int64_t q = neighbour(i, e);
+                    if (q < 0) ++y;
+                    else if (decided[size_t(q)]) (refined[size_t(q)] ? x : y) += 1;
+                }
+                refined[i] = !h.is_leaf(level[i]);
+                symbols.push_back({group_of[x][y], refined[i]});
+            }
+            decided[i] = true;
+        };
+        if (!improved) {
+            for (uint32_t i = 0; i < n; ++i) {
+                if (!decided[i]) decide(i);
+            }
+            continue;
+        }
+        for (uint32_t i = 0; i < n; ++i) {
+            if (decided[i]) continue;
+            int culled = 0;
+            for (int e = 0; e < 3; ++e) culled += neighbour(i, e) >= 0 && decided[size_t(neighbour(i, e))];
+            priority[i] = std::max(1, 4 - culled);
+        }
+        std::vector<std::pair<uint32_t, int>> stack[5];  // (node, its priority when pushed)
+        for (uint32_t i = n; i-- > 0;) {
+            if (!decided[i]) stack[priority[i]].push_back({i, priority[i]});
+        }
+        for (;;) {
+            int p = 0;
+            while (p < 5 && stack[p].empty()) ++p;
+            if (p == 5) break;
+            const auto [i, pushed] = stack[p].back();
+            stack[p].pop_back();
+            if (decided[i] || priority[i] != pushed) continue;
+            decide(i);
+            for (int e = 0; e < 3; ++e) {
+                const int64_t q = neighbour(i, e);
+                if (q < 0 || decided[size_t(q)] || priority[size_t(q)] == 0) continue;
+                const int now = hanging(uint32_t(q)) ? 0 : std::max(1, priority[size_t(q)] - 1);
+                if (now == priority[size_t(q)]) continue;
+                priority[size_t(q)] = now;
+                stack[now].push_back({uint32_t(q), now});
+            }
+        }
+    }
+    return symbols;
+}
+
+TEST(HierarchyCoder, StreamsFollowTheFormatText) {
+    for (uint64_t seed = 1; seed <= 200; ++seed) {
+        Hierarchy h = random_hierarchy(seed);
+        for (NodeId n : h.leaves()) {
+            if (h.hanging_node_count(n) != 2) continue;
+            int u = 0;
+            while (h.has_hanging_node(n, u)) ++u;
+            h.set_diagonal_flipped(n, diagonal_flag_by_rule(DiagonalRule(0), u));
+        }
+        for (const bool improved : {true, false}) {
+            HierarchyCoderOptions options;
+            options.traversal = improved ? Traversal::improved : Traversal::naive;
+            const std::vector<uint8_t> stream = encode_hierarchy(h, options);
+            HierarchyStreamHeader header;
+            const size_t header_size = read_hierarchy_stream_header(stream.data(), stream.size(), header);
+            ASSERT_FALSE(header.orientation_coded);
+            const auto symbols = symbols_as_specified(h, improved, header.uniform_levels);
+            ASSERT_LE(header.symbol_count, symbols.size());
+            HierarchyModels models;
+            ArithmeticEncoder encoder;
+            for (uint64_t k = 0; k < header.symbol_count; ++k) {
+                encoder.encode(symbols[k].second, models.for_group(symbols[k].first, true));
+            }
+            for (uint64_t k = header.symbol_count; k < symbols.size(); ++k) ASSERT_FALSE(symbols[k].second);
+            const std::vector<uint8_t> payload = encoder.finish();
+            ASSERT_EQ(std::vector<uint8_t>(stream.begin() + long(header_size), stream.end()), payload)
+                << "seed " << seed << (improved ? ", improved" : ", naive") << " traversal";
+        }
+    }
 }
 
 // A node split against Hierarchy::split's precondition (it lacks a neighbour) has no stream: the
