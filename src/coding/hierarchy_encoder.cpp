@@ -71,7 +71,6 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
             [&](uint32_t i, Fate fate, bool) {
                 switch (fate) {
                     case Fate::uniform: ++stats.culled_uniform; break;
-                    case Fate::one_regularity: break;  // counted above: those nodes are decided already
                     case Fate::hanging_nodes: ++stats.culled_hanging_nodes; break;
                     case Fate::coded: break;
                 }
@@ -135,16 +134,9 @@ void HierarchyLevelEncoder::encode_level(int l, ArithmeticEncoder& encoder) {
     if (l != next_level_) throw Error("hierarchy levels must be encoded in order");
     ++next_level_;
     const size_t begin = l == 0 ? 0 : level_end_[size_t(l) - 1];
-    for (size_t k = begin; k < level_end_[size_t(l)]; ++k) {
-        const Event e = events_[k];
-        if (e.group == kOrientationEvent) {
-            if (stats_.orientation_coded) encoder.encode_with_limit<kHierarchyModelLimit>(e.bit, models_.orientation);
-            continue;
-        }
-        if (symbols_written_ == kept_symbols_) continue;
-        ++symbols_written_;
-        encoder.encode_with_limit<kHierarchyModelLimit>(e.bit, models_.for_group(e.group, options_.use_contexts));
-    }
+    for_each_coded(begin, level_end_[size_t(l)], models_, symbols_written_, [&](BitModel& model, Event e) {
+        encoder.encode_with_limit<kHierarchyModelLimit>(e.bit, model);
+    });
 }
 
 HierarchyCodeStats HierarchyLevelEncoder::stats() const {
@@ -155,24 +147,19 @@ HierarchyCodeStats HierarchyLevelEncoder::stats() const {
     HierarchyModels models;
     uint64_t symbols = 0;
     const size_t end = next_level_ == 0 ? 0 : level_end_[size_t(next_level_) - 1];
-    for (size_t k = 0; k < end; ++k) {
-        const Event e = events_[k];
+    for_each_coded(0, end, models, symbols, [&](BitModel& model, Event e) {
+        const double bits = model.cost_bits(e.bit);
+        model.update_with_limit(e.bit, kHierarchyModelLimit);
         if (e.group == kOrientationEvent) {
-            if (!stats.orientation_coded) continue;
-            stats.orientation_bits += models.orientation.cost_bits(e.bit);
-            models.orientation.update_with_limit(e.bit, kHierarchyModelLimit);
-            continue;
+            stats.orientation_bits += bits;
+            return;
         }
-        if (symbols == kept_symbols_) continue;
-        ++symbols;
-        BitModel& model = models.for_group(e.group, options_.use_contexts);
         ContextGroupStats& group = stats.groups[e.group];
         group.symbols += 1;
         group.ones += e.bit;
         stats.coded_ones += e.bit;
-        group.coded_bits += model.cost_bits(e.bit);
-        model.update_with_limit(e.bit, kHierarchyModelLimit);
-    }
+        group.coded_bits += bits;
+    });
     stats.conditional_entropy_bits = 0;
     stats.adaptive_code_bits = 0;
     for (int g = 0; g < kContextGroupCount; ++g) {

@@ -39,6 +39,23 @@ private:
     };
     static constexpr uint8_t kOrientationEvent = 0xff;
 
+    // Calls f(model, event) for each event of [begin, end) that the stream holds, with its model
+    // in `models`: orientation bits when any is coded, hierarchy symbols up to the kept count
+    // (`symbols` counts those passed so far). encode_level codes them, stats() replays them.
+    template <class F>
+    void for_each_coded(size_t begin, size_t end, HierarchyModels& models, uint64_t& symbols, F&& f) const {
+        for (size_t k = begin; k < end; ++k) {
+            const Event e = events_[k];
+            if (e.group == kOrientationEvent) {
+                if (stats_.orientation_coded) f(models.orientation, e);
+                continue;
+            }
+            if (symbols == kept_symbols_) continue;
+            ++symbols;
+            f(models.for_group(e.group, options_.use_contexts), e);
+        }
+    }
+
     HierarchyCoderOptions options_;
     HierarchyCodeStats stats_;
     std::vector<Event> events_;

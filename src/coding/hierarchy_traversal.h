@@ -41,7 +41,7 @@
 
 namespace amc {
 
-enum class Fate : uint8_t { coded, uniform, one_regularity, hanging_nodes };
+enum class Fate : uint8_t { coded, uniform, hanging_nodes };
 
 constexpr uint32_t kNoLocal = 0xffffffffu;
 
@@ -493,12 +493,13 @@ inline int unrefined_edge(const Level& level, uint32_t i) {
     return int((kByRefined >> (2 * refined)) & 3);
 }
 
-// The culling rules in force (paper II-C): which rule decides a node in state s, or Fate::coded.
+// The culling rules in force (paper II-C): which rule decides an undecided node in state s
+// during the traversal, or Fate::coded. (The nodes 1-regularity culls are decided before it:
+// root_level and derive_next_level make them so.)
 struct CullRules {
     bool one_regularity;
     bool hanging_nodes;
     Fate fate(uint8_t s) const {
-        if (one_regularity && !(s & kComplete)) return Fate::one_regularity;
         // The count of decided refined neighbours is kept up to date by LevelTraversal.
         if (hanging_nodes && (s & kRefinedNeighborMask) == 3 * kRefinedNeighbor) return Fate::hanging_nodes;
         return Fate::coded;
