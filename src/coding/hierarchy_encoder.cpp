@@ -35,6 +35,10 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         refined.resize(n);
         next_ids.clear();
         bool all_refined = true;
+        // A refined node needs all its neighbours (Hierarchy::can_split); no stream could say
+        // otherwise, and with the 1-regularity rule such nodes start decided as leaves.
+        uint32_t unbalanced = n;
+        const uint8_t* state = level.state();
         constexpr uint32_t kAhead = 16;
         for (uint32_t i = 0; i < n && i < kAhead; ++i) h.prefetch(ids[i]);
         for (uint32_t i = 0; i < n; ++i) {
@@ -43,6 +47,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
             const bool r = !h.is_leaf(id);
             refined[i] = r;
             all_refined &= r;
+            if (r && !(state[i] & kComplete) && unbalanced == n) unbalanced = i;
             if (r) {
                 const NodeId c = h.child(id, 0);
                 next_ids.insert(next_ids.end(), {c, c + 1, c + 2, c + 3});
@@ -50,16 +55,10 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         }
         const bool uniform = options.uniform_levels && all_refined && l == uniform_levels && l < kMaxUniformLevels;
         if (uniform) ++uniform_levels;
-        // A refined node needs all its neighbours (Hierarchy::can_split); no stream could say
-        // otherwise, and with the 1-regularity rule such nodes start decided as leaves.
-        if (level.incomplete_count != 0) {
-            for (uint32_t i = 0; i < n; ++i) {
-                if (refined[i] && !(level.state()[i] & kComplete))
-                    throw Error("encode_hierarchy: node " + std::to_string(ids[i]) + " of level " + std::to_string(l) +
-                                " is refined but lacks a neighbour (the hierarchy is not balanced)");
-            }
-            if (options.cull_one_regularity && !uniform) stats.culled_one_regularity += level.incomplete_count;
-        }
+        if (unbalanced != n)
+            throw Error("encode_hierarchy: node " + std::to_string(ids[unbalanced]) + " of level " + std::to_string(l) +
+                        " is refined but lacks a neighbour (the hierarchy is not balanced)");
+        if (options.cull_one_regularity && !uniform) stats.culled_one_regularity += level.incomplete_count;
         const uint8_t* truth = refined.data();
         traversal.run(
             level, uniform,
@@ -76,7 +75,6 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
                 }
                 return truth[i] != 0;
             });
-        const uint8_t* state = level.state();
         for (uint32_t i = 0; i < n; ++i) {
             if (state[i] & kRefined) continue;
             const int hanging = refined_neighbors(state[i]);
