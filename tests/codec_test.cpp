@@ -203,8 +203,8 @@ TEST(Codec, MutatedBlocksWithValidChecksumsAreErrorsOrValidHierarchies) {
         while (reader.next(block)) {
             if (block.type != BlockType::end) blocks.push_back({block.type, {block.payload, block.payload + block.size}});
         }
-        auto rewrite = [](uint8_t flags, const Blocks& parts) {
-            BlockWriter writer(flags);
+        auto rewrite = [&reader](uint8_t flags, const Blocks& parts) {
+            BlockWriter writer(reader.version(), flags);
             for (const auto& [type, payload] : parts) writer.add(type, payload);
             return writer.finish();
         };
@@ -287,7 +287,7 @@ TEST(Codec, DiagonalRulesOfAbsoluteLocalIndicesStayCheap) {
 TEST(Codec, NewerVersionIsRefusedClearly) {
     Hierarchy h(make_icosahedron());
     std::vector<uint8_t> bytes = encode(h);
-    bytes[4] = 3;
+    bytes[4] = kNewestVersion + 1;
     try {
         decode(bytes.data(), bytes.size());
         FAIL();

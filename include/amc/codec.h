@@ -4,6 +4,7 @@
 
 #include <amc/hierarchy.h>
 #include <amc/hierarchy_coder.h>
+#include <amc/numbering.h>
 
 #include <cstdint>
 #include <string>
@@ -23,6 +24,12 @@ struct EncodeOptions {
     // bounding box (lossy; EncodeStats::max_error tells how much).
     int quantize_bits = 0;
     GeometryPredictor predictor = GeometryPredictor::automatic;
+    // The caller's numbering of the input's leaf mesh (leaf_numbering()), or null. The encoder
+    // re-expresses it against the leaf mesh the decoder rebuilds (EncodeStats::numbering) and,
+    // with store_numbering, stores it in the file so that decode returns it (docs/FORMAT.md,
+    // section 6; its cost per model is in docs/CODEC.md).
+    const LeafNumbering* numbering = nullptr;
+    bool store_numbering = true;
 };
 
 struct LevelStats {
@@ -40,11 +47,15 @@ struct EncodeStats {
     uint64_t hierarchy_bytes = 0;           // refinement symbols and orientation bits, all levels
     uint64_t geometry_bytes = 0;            // positions of refinement vertices, all levels
     uint64_t framing_bytes = 0;             // block headers and checksums
+    uint64_t numbering_bytes = 0;           // the numbering block's payload (0 without one)
     uint64_t faces = 0, vertices = 0, nodes = 0, base_vertices = 0, base_triangles = 0;
     int levels = 0;
     double max_error = 0;                   // largest coordinate error (0 unless quantized)
     std::vector<LevelStats> per_level;
     HierarchyCodeStats hierarchy;           // the hierarchy coder's own statistics
+    // EncodeOptions::numbering against extract_leaf_mesh of the decoded hierarchy (empty without
+    // one): the map a caller keeps when the file does not store it.
+    LeafNumbering numbering;
 };
 
 // Compresses `h`. The decoder rebuilds it over the base mesh in the base coder's order (vertices
@@ -64,13 +75,18 @@ struct DecodeOptions {
 
 // Throws Error naming the problem (bad magic, newer version, checksum, structure) on a corrupt or
 // truncated file; never crashes, hangs, or allocates without bound.
-Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options = {});
+// When the file stores a numbering and `numbering` is not null, it receives it (relative to
+// extract_leaf_mesh of the result); it is left empty otherwise, and always when max_level cuts
+// the decoding short (a numbering describes the whole leaf mesh).
+Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options = {},
+                 LeafNumbering* numbering = nullptr);
 
 // The same without exceptions, for callers that prefer status values.
 struct DecodeResult {
     bool ok = false;
     std::string error;
     Hierarchy hierarchy;
+    LeafNumbering numbering;  // the stored numbering, if any (see decode)
 };
 DecodeResult try_decode(const uint8_t* data, size_t size, const DecodeOptions& options = {}) noexcept;
 

@@ -27,6 +27,7 @@ namespace amc {
 using NodeId = uint32_t;
 using VertexId = uint32_t;
 constexpr NodeId kNoNode = 0xffffffffu;
+constexpr VertexId kNoVertex = 0xffffffffu;  // a dead vertex id in maps over vertex ids
 constexpr int kMaxLevel = 30;  // a level cap far beyond any mesh that fits in memory
 
 class Hierarchy {
@@ -192,7 +193,7 @@ bool identical(const Hierarchy& a, const Hierarchy& b);
 
 // Canonical vertex numbering: base vertices first, then new vertices in order of first
 // appearance over refined nodes in breadth-first order, edges 0, 1, 2. Maps vertex id -> index
-// (0xffffffff for dead ids).
+// (kNoVertex for dead ids).
 std::vector<uint32_t> canonical_vertex_order(const Hierarchy& h);
 
 // ---- the conforming leaf mesh (green closure) ----------------------------------------------
@@ -219,8 +220,11 @@ std::string check_invariants(const Hierarchy& h);
 // The same hierarchy over the base mesh reordered: new vertex i is old vertex vertex_order[i];
 // new triangle t is old triangle triangle_order[t] with its vertices rotated by rotation[t]
 // (new local vertex i = old local vertex (i + rotation[t]) % 3). Throws Error on bad orders.
+// `vertex_map`, when given, receives for every vertex id of h its id in the result (kNoVertex for
+// dead ids).
 Hierarchy reorder_base(const Hierarchy& h, const std::vector<uint32_t>& vertex_order,
-                       const std::vector<uint32_t>& triangle_order, const std::vector<uint8_t>& rotation);
+                       const std::vector<uint32_t>& triangle_order, const std::vector<uint8_t>& rotation,
+                       std::vector<VertexId>* vertex_map = nullptr);
 
 // ---- the hierarchy file (.amh, docs/HIERARCHY.md) -------------------------------------------
 

@@ -28,13 +28,14 @@ const char* block_type_name(uint8_t type) {
         case BlockType::base_connectivity: return "base connectivity";
         case BlockType::base_geometry: return "base geometry";
         case BlockType::level: return "level";
+        case BlockType::numbering: return "numbering";
     }
     return "unknown";
 }
 
-BlockWriter::BlockWriter(uint8_t flags) {
+BlockWriter::BlockWriter(uint8_t version, uint8_t flags) {
     out_.assign(kFileMagic, kFileMagic + 4);
-    out_.push_back(kFileVersion);
+    out_.push_back(version);
     out_.push_back(flags);
     out_.push_back(0);
     out_.push_back(0);
@@ -61,9 +62,9 @@ BlockReader::BlockReader(const uint8_t* data, size_t size) : data_(data), size_(
     if (size < 5) throw Error("file is truncated (header)");
     version_ = data[4];
     // The version comes first: a newer file may have a header this build does not know.
-    if (version_ != kFileVersion)
-        throw Error("unsupported .amc version " + std::to_string(version_) + " (this build reads version " +
-                    std::to_string(kFileVersion) + ")");
+    if (version_ < kOldestReadableVersion || version_ > kNewestVersion)
+        throw Error("unsupported .amc version " + std::to_string(version_) + " (this build reads versions " +
+                    std::to_string(kOldestReadableVersion) + " to " + std::to_string(kNewestVersion) + ")");
     if (size < kFileHeaderSize) throw Error("file is truncated (header)");
     if (XXH32(data, 8, 0) != get_u32(data + 8)) throw Error("checksum mismatch in the file header");
     flags_ = data[5];
@@ -83,7 +84,8 @@ bool BlockReader::next(Block& block) {
     if (XXH32(data_ + pos_, 5 + size_t(length), 0) != stored)
         throw Error("checksum mismatch in the " + std::string(block_type_name(type)) + " block at byte " +
                     std::to_string(pos_));
-    if (type > uint8_t(BlockType::level)) throw Error("unknown block type " + std::to_string(type));
+    const uint8_t newest_type = version_ >= kNumberingVersion ? uint8_t(BlockType::numbering) : uint8_t(BlockType::level);
+    if (type > newest_type) throw Error("unknown block type " + std::to_string(type));
     block = {BlockType(type), data_ + pos_ + 5, length, pos_};
     pos_ += kBlockOverhead + length;
     if (block.type == BlockType::end) {

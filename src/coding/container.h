@@ -9,7 +9,12 @@
 namespace amc {
 
 constexpr char kFileMagic[4] = {'A', 'M', 'C', 'F'};
-constexpr uint8_t kFileVersion = 2;
+// Versions this build reads. A writer writes the lowest version that holds what the file holds:
+// version 3 only for files with a numbering block, version 2 otherwise.
+constexpr uint8_t kOldestReadableVersion = 2;
+constexpr uint8_t kNewestVersion = 3;
+constexpr uint8_t kBaseVersion = 2;       // everything but the numbering block
+constexpr uint8_t kNumberingVersion = 3;  // the first version with a numbering block
 constexpr size_t kFileHeaderSize = 12;  // magic, version, flags, 2 reserved, XXH32 of those 8
 constexpr size_t kBlockOverhead = 1 + 4 + 4;  // type, payload length, checksum
 
@@ -20,6 +25,7 @@ enum class BlockType : uint8_t {
     base_connectivity = 2,
     base_geometry = 3,
     level = 4,
+    numbering = 5,
 };
 const char* block_type_name(uint8_t type);
 
@@ -29,7 +35,7 @@ constexpr uint8_t kFlagQuantized = 2;
 
 class BlockWriter {
 public:
-    explicit BlockWriter(uint8_t flags);
+    BlockWriter(uint8_t version, uint8_t flags);
     void add(BlockType type, const std::vector<uint8_t>& payload);
     std::vector<uint8_t> finish();  // appends the END block
     size_t size() const { return out_.size(); }

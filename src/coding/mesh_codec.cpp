@@ -8,6 +8,7 @@
 #include "coding/float_coder.h"
 #include "coding/geometry_prediction.h"
 #include "coding/hierarchy_level_coder.h"
+#include "coding/numbering_coder.h"
 
 #include <algorithm>
 #include <cmath>
@@ -140,20 +141,39 @@ std::vector<Vec3> all_positions(const Hierarchy& h) {
 // triangle's vertices. The default diagonal rule does not care, but hierarchies made under a rule
 // of absolute local indices would pay orientation bits: then storing each root's rotation
 // (log2 3 bits) to keep the input's local order may be cheaper (`keep_rotations`).
-Hierarchy in_base_code_order(const Hierarchy& input, const BaseMeshCode& base_code, bool& keep_rotations) {
+// `vertex_map` receives the input's vertex ids in the result.
+Hierarchy in_base_code_order(const Hierarchy& input, const BaseMeshCode& base_code, bool& keep_rotations,
+                             std::vector<VertexId>* vertex_map = nullptr) {
     keep_rotations = false;
-    Hierarchy h = reorder_base(input, base_code.vertex_order, base_code.triangle_order, base_code.triangle_rotation);
+    Hierarchy h = reorder_base(input, base_code.vertex_order, base_code.triangle_order, base_code.triangle_rotation, vertex_map);
     const DiagonalExceptions rotated = diagonal_exceptions(h);
     if (rotated.fewest() == 0) return h;
+    std::vector<VertexId> kept_map;
     Hierarchy kept = reorder_base(input, base_code.vertex_order, base_code.triangle_order,
-                                  std::vector<uint8_t>(base_code.triangle_order.size(), 0));
+                                  std::vector<uint8_t>(base_code.triangle_order.size(), 0), &kept_map);
     const DiagonalExceptions unrotated = diagonal_exceptions(kept);
     const double rotated_bits = binary_entropy_bits(rotated.fewest(), rotated.leaves);
     const double kept_bits =
         binary_entropy_bits(unrotated.fewest(), unrotated.leaves) + 1.585 * double(base_code.triangle_order.size());
     if (kept_bits >= rotated_bits) return h;
     keep_rotations = true;
+    if (vertex_map != nullptr) *vertex_map = std::move(kept_map);
     return kept;
+}
+
+// The caller's numbering of the input's leaf mesh, re-expressed against the leaf mesh of `h`, the
+// input reordered (vertex_map: input vertex id -> id in h).
+LeafNumbering numbering_after_reorder(const Hierarchy& input, const LeafNumbering& numbering, const Hierarchy& h,
+                                      const std::vector<VertexId>& vertex_map) {
+    const TriangleMesh caller = renumber_leaf_mesh(extract_leaf_mesh(input), numbering);
+    const std::vector<uint32_t> canonical = canonical_vertex_order(input);
+    std::vector<VertexId> id_of_leaf_vertex(input.vertex_count());
+    for (VertexId v = 0; v < canonical.size(); ++v) {
+        if (canonical[v] != kNoVertex) id_of_leaf_vertex[canonical[v]] = v;
+    }
+    std::vector<VertexId> vertex_of_input(numbering.vertex.size());
+    for (size_t i = 0; i < numbering.vertex.size(); ++i) vertex_of_input[i] = vertex_map[id_of_leaf_vertex[numbering.vertex[i]]];
+    return leaf_numbering(h, caller, vertex_of_input);
 }
 
 }  // namespace
@@ -169,7 +189,10 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     // II-B: code the base mesh first and express the forest in the decoder's base order.
     const BaseMeshCode base_code = encode_base_connectivity(input.base());
     bool keep_rotations = false;
-    Hierarchy h = in_base_code_order(input, base_code, keep_rotations);
+    std::vector<VertexId> vertex_map;
+    Hierarchy h = in_base_code_order(input, base_code, keep_rotations, options.numbering ? &vertex_map : nullptr);
+    const bool store_numbering = options.numbering != nullptr && options.store_numbering;
+    if (options.numbering != nullptr) stats.numbering = numbering_after_reorder(input, *options.numbering, h, vertex_map);
     Quantizer quantizer;
     if (quantized) {
         h.set_single_precision(false);
@@ -192,7 +215,8 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     meta.quantizer = quantizer;
     meta.options = keep_rotations ? kOptionRootRotations : 0;
 
-    BlockWriter writer(uint8_t((precision == Precision::float32 ? kFlagSinglePrecision : 0) | (quantized ? kFlagQuantized : 0)));
+    BlockWriter writer(store_numbering ? kNumberingVersion : kBaseVersion,
+                       uint8_t((precision == Precision::float32 ? kFlagSinglePrecision : 0) | (quantized ? kFlagQuantized : 0)));
     writer.add(BlockType::metadata, write_metadata(meta, quantized));
     stats.header_bytes = writer.size();
     writer.add(BlockType::base_connectivity, base_code.bytes);
@@ -257,6 +281,12 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
         level_stats.predictor = predictor;
         stats.per_level.push_back(level_stats);
     }
+    if (store_numbering) {
+        const std::vector<uint8_t> payload = encode_numbering(stats.numbering, extract_leaf_mesh(h).mesh.triangles);
+        writer.add(BlockType::numbering, payload);
+        stats.numbering_bytes = payload.size();
+        stats.framing_bytes += kBlockOverhead;
+    }
     std::vector<uint8_t> out = writer.finish();
     stats.framing_bytes += 3 * kBlockOverhead + kBlockOverhead;  // base blocks and END
     stats.total_bytes = out.size();
@@ -273,7 +303,8 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     return out;
 }
 
-Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options) {
+Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options, LeafNumbering* numbering) {
+    if (numbering != nullptr) *numbering = {};
     BlockReader reader(data, size);
     const bool quantized = reader.flags() & kFlagQuantized;
     const Precision precision = (reader.flags() & kFlagSinglePrecision) ? Precision::float32 : Precision::float64;
@@ -328,8 +359,17 @@ Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options)
     // The metadata's counts (checked against the limit above) let the hierarchy grow in place.
     h.reserve(meta.nodes, meta.vertices);
     int level = 0;
+    Block numbering_block{};
+    bool has_numbering = false;
     while (reader.next(block)) {
         if (block.type == BlockType::end) break;
+        if (block.type == BlockType::numbering) {
+            if (!hierarchy.done() || has_numbering) throw Error("numbering block out of place");
+            numbering_block = block;
+            has_numbering = true;
+            continue;
+        }
+        if (has_numbering) throw Error("level block after the numbering block");
         if (block.type != BlockType::level) throw Error("unexpected block between level blocks");
         if (hierarchy.done()) throw Error("level block after the last level");
         if (options.max_level >= 0 && level >= options.max_level) return h;  // progressive: stop here
@@ -355,6 +395,9 @@ Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options)
     hierarchy.finish();
     if (h.node_count() != meta.nodes || h.vertex_count() != meta.vertices || uint64_t(level) != meta.levels)
         throw Error("decoded hierarchy does not match the metadata");
+    if (has_numbering && numbering != nullptr)
+        *numbering = decode_numbering(numbering_block.payload, numbering_block.size, extract_leaf_mesh(h).mesh.triangles,
+                                      h.vertex_count());
     return h;
 }
 
@@ -366,7 +409,7 @@ Hierarchy in_decoder_order(const Hierarchy& h) {
 DecodeResult try_decode(const uint8_t* data, size_t size, const DecodeOptions& options) noexcept {
     DecodeResult result;
     try {
-        result.hierarchy = decode(data, size, options);
+        result.hierarchy = decode(data, size, options, &result.numbering);
         result.ok = true;
     } catch (const std::exception& e) {
         result.error = e.what();

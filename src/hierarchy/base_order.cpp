@@ -7,7 +7,8 @@
 namespace amc {
 
 Hierarchy reorder_base(const Hierarchy& h, const std::vector<uint32_t>& vertex_order,
-                       const std::vector<uint32_t>& triangle_order, const std::vector<uint8_t>& rotation) {
+                       const std::vector<uint32_t>& triangle_order, const std::vector<uint8_t>& rotation,
+                       std::vector<VertexId>* vertex_map) {
     const TriangleMesh& old_base = h.base();
     if (vertex_order.size() != old_base.positions.size() || triangle_order.size() != old_base.triangles.size() ||
         rotation.size() != triangle_order.size())
@@ -35,6 +36,7 @@ Hierarchy reorder_base(const Hierarchy& h, const std::vector<uint32_t>& vertex_o
     // corner child (k + r) % 3, rotated by r as well; the centre stays the centre. The default
     // diagonal rule is cyclic, so diagonal flags carry over unchanged.
     Hierarchy out(std::move(base));
+    if (vertex_map != nullptr) vertex_map->assign(h.positions().size(), kNoVertex);
     out.set_vertex_placer([](void*, Vec3 a, Vec3) { return a; }, nullptr);  // positions copied below
     std::vector<std::pair<NodeId, NodeId>> queue;  // (old node, new node)
     std::vector<uint8_t> node_rotation;
@@ -46,6 +48,9 @@ Hierarchy reorder_base(const Hierarchy& h, const std::vector<uint32_t>& vertex_o
         const auto [old_node, new_node] = queue[i];
         const int r = node_rotation[i];
         out.set_diagonal_flipped(new_node, h.diagonal_flipped(old_node));
+        if (vertex_map != nullptr) {
+            for (int i = 0; i < 3; ++i) (*vertex_map)[h.vertex(old_node, (i + r) % 3)] = out.vertex(new_node, i);
+        }
         if (h.is_leaf(old_node)) continue;
         out.split(new_node);
         for (int e = 0; e < 3; ++e) out.set_position(out.midpoint(new_node, e), h.position(h.midpoint(old_node, (e + r) % 3)));

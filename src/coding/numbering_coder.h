@@ -1,0 +1,21 @@
+// The numbering block of the .amc file (docs/FORMAT.md, section 6): the caller's vertex and face
+// numbering of the leaf mesh, coded against the canonical leaf mesh the decoder rebuilds.
+#pragma once
+
+#include <amc/numbering.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace amc {
+
+// The block's payload for `numbering` of a leaf mesh with these triangles (in leaf order). The
+// encoder tries every reference order and method and keeps the smallest code.
+std::vector<uint8_t> encode_numbering(const LeafNumbering& numbering, const std::vector<Triangle>& leaf_triangles);
+
+// Decodes a payload for the leaf mesh with these triangles and `vertices` vertices. Throws Error
+// on a payload that does not fit it (counts, methods, ranks out of range, truncation).
+LeafNumbering decode_numbering(const uint8_t* data, size_t size, const std::vector<Triangle>& leaf_triangles,
+                               uint32_t vertices);
+
+}  // namespace amc
