@@ -230,6 +230,32 @@ TEST(ArithmeticCoder, ManyContextsInterleaved) {
     EXPECT_LE(coded.bytes.size() * 8.0, static_entropy_bits(s, 9) * 1.01 + 128);
 }
 
+// The bound decoders check counts against: no payload yields max_decodable_symbols of it
+// without overrunning, whatever its bytes and however the models lean; and past a few bytes the
+// bound is within a factor 2 of what a saturated model reaches.
+TEST(ArithmeticCoder, NoPayloadHoldsMoreSymbolsThanTheBound) {
+    std::mt19937 random(11);
+    for (size_t size : {0, 1, 2, 3, 7, 20}) {
+        for (int pattern = 0; pattern < 4; ++pattern) {
+            std::vector<uint8_t> payload(size);
+            for (uint8_t& b : payload) b = pattern == 0 ? 0x00 : pattern == 1 ? 0xFF : uint8_t(random());
+            ArithmeticDecoder decoder(payload.data(), payload.size());
+            BitModel model;
+            uint64_t symbols = 0;
+            const uint64_t bound = max_decodable_symbols(size);
+            while (!decoder.overran() && symbols <= bound) {
+                if (pattern == 3 && symbols % 97 == 0) decoder.decode_bits_raw(1);
+                else decoder.decode(model);
+                ++symbols;
+            }
+            EXPECT_LT(symbols, bound) << size << " bytes, pattern " << pattern;
+            if (pattern == 0 && size >= 7) {
+                EXPECT_GT(symbols, bound / 2) << size << " bytes: the bound is loose";
+            }
+        }
+    }
+}
+
 TEST(ArithmeticCoder, RawBitsMixedWithModelledBits) {
     BitSource src(0.1, 77), pick(0.5, 78);
     std::vector<Symbol> s;

@@ -56,9 +56,9 @@ void save(const std::string& path, const Hierarchy& h) {
 
 std::vector<uint8_t> read_bytes(const std::string& path) {
     std::ifstream file(path, std::ios::binary);
-    if (!file) throw Error(path + ": cannot open file");
+    if (!file) throw Error(ErrorCode::io, path + ": cannot open file");
     std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-    if (file.bad()) throw Error(path + ": read error");
+    if (file.bad()) throw Error(ErrorCode::io, path + ": read error");
     return bytes;
 }
 
@@ -71,7 +71,7 @@ Hierarchy load_hierarchy(const std::string& path, int max_level = -1) {
         try {
             return decode(bytes.data(), bytes.size(), options);
         } catch (const Error& e) {
-            throw Error(path + ": " + e.what());
+            throw e.prefixed(path);
         }
     }
     return read_hierarchy(path);
@@ -359,7 +359,7 @@ int main(int argc, char** argv) {
                 try {
                     file = inspect(bytes.data(), bytes.size());
                 } catch (const Error& e) {
-                    throw Error(info_input + ": " + e.what());
+                    throw e.prefixed(info_input);
                 }
                 std::printf("%s: amc version %d, %s coordinates", info_input.c_str(), file.version,
                             file.quantize_bits ? "quantized" : file.single_precision ? "float32" : "float64");
@@ -371,7 +371,7 @@ int main(int argc, char** argv) {
                 try {
                     decode(bytes.data(), bytes.size());
                 } catch (const Error& e) {
-                    throw Error(info_input + ": " + e.what());
+                    throw e.prefixed(info_input);
                 }
                 std::printf("  %lu bytes: %.3f bits/face, %.2f bits/vertex; decodes: yes\n", (unsigned long)bytes.size(),
                             8.0 * bytes.size() / double(file.faces), 8.0 * bytes.size() / double(file.vertices));

@@ -74,7 +74,9 @@ struct DecodeOptions {
 };
 
 // Throws Error naming the problem (bad magic, newer version, checksum, structure) on a corrupt or
-// truncated file; never crashes, hangs, or allocates without bound.
+// truncated file, with its kind in Error::code(); never crashes or hangs. Memory and time grow at
+// most linearly with `size`, and the hierarchy is bounded by options.max_nodes besides: every
+// count is checked against the bytes that can hold it before anything is allocated for it.
 // When the file stores a numbering and `numbering` is not null, it receives it (relative to
 // extract_leaf_mesh of the result); it is left empty otherwise, and always when max_level cuts
 // the decoding short (a numbering describes the whole leaf mesh).
@@ -84,7 +86,8 @@ Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options 
 // The same without exceptions, for callers that prefer status values.
 struct DecodeResult {
     bool ok = false;
-    std::string error;
+    ErrorCode code = ErrorCode::invalid_input;  // when !ok: the kind of problem
+    std::string error;                          // when !ok: the message decode would throw
     Hierarchy hierarchy;
     LeafNumbering numbering;  // the stored numbering, if any (see decode)
 };

@@ -109,7 +109,9 @@ struct HierarchyDecodeOptions {
 
 // Rebuilds the hierarchy over `base` (which must be the encoder's base mesh, same order) from a
 // stream made by encode_hierarchy. New vertices sit at edge midpoints. Throws Error on a corrupt,
-// truncated or over-large stream; never crashes, hangs or allocates without bound.
+// truncated or over-large stream; never crashes or hangs. The stream holds no positions, and
+// culled and uniformly refined levels cost no bits, so a short stream may describe a large
+// forest: options.max_nodes bounds memory and time.
 Hierarchy decode_hierarchy(const TriangleMesh& base, const uint8_t* data, size_t size,
                            const HierarchyDecodeOptions& options = {});
 
@@ -133,6 +135,8 @@ public:
                 const HierarchyDecodeOptions& options = {});
 
 private:
+    void decode_stream(const TriangleMesh& base, const uint8_t* data, size_t size, Hierarchy& out,
+                       const HierarchyDecodeOptions& options);
     std::unique_ptr<HierarchyLevelDecoder> coder_;
 };
 

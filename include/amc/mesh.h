@@ -9,10 +9,34 @@
 
 namespace amc {
 
-// Every error that reaches a user: a file or stage name and the first offending element.
+// What went wrong, as a value a caller can branch on (Error::code(), DecodeResult::code).
+// Frozen: names and values are part of the API; messages may change, codes do not.
+enum class ErrorCode : uint8_t {
+    invalid_input = 1,        // an argument, mesh or hierarchy that breaks the rules
+    io = 2,                   // a file that can not be opened, read or written
+    truncated = 3,            // data that ends before what it announces
+    bad_magic = 4,            // not a file or stream of the expected kind
+    unsupported_version = 5,  // a format version this build does not read
+    checksum = 6,             // a checksum that does not match
+    corrupt = 7,              // structure no encoder writes: a count, index or symbol out of place
+    limit_exceeded = 8,       // beyond the caller's limits (DecodeOptions::max_nodes) or this build's
+};
+// "invalid input", "I/O", "truncated", "bad magic", "unsupported version", "checksum", "corrupt",
+// "limit exceeded".
+const char* error_code_name(ErrorCode code);
+
+// Every error that reaches a user: a file or stage name and the first offending element, and
+// the kind of problem as a code.
 class Error : public std::runtime_error {
 public:
-    using std::runtime_error::runtime_error;
+    Error(ErrorCode code, const std::string& message) : std::runtime_error(message), code_(code) {}
+    explicit Error(const std::string& message) : Error(ErrorCode::invalid_input, message) {}
+    ErrorCode code() const noexcept { return code_; }
+    // The same error with `context` (a file name, say) in front of the message.
+    Error prefixed(const std::string& context) const { return Error(code_, context + ": " + what()); }
+
+private:
+    ErrorCode code_;
 };
 
 struct Vec3 {

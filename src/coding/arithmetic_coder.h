@@ -99,6 +99,14 @@ struct BitModel {
 // n * H(ones / n) in bits, with H the binary entropy; 0 for n == 0.
 double binary_entropy_bits(uint64_t ones, uint64_t n);
 
+// At most how many symbols, modelled or raw, an ArithmeticDecoder can read from a payload of
+// `payload_bytes` bytes without overrunning it: decoders check every count a stream announces
+// against this before they allocate for it. Each symbol narrows the range by more than 2^-16
+// bits (a modelled bit keeps at most 1 - 2^-16 + 2^-24 of it, p16 being at most 2^16 - 1 and the
+// range at least 2^24; a raw bit halves it), while the decoder can take in at most
+// 8 * (payload_bytes + 1) bits of range before overran() turns true (docs/FORMAT.md, 3.7).
+constexpr uint64_t max_decodable_symbols(uint64_t payload_bytes) { return (payload_bytes + 1) << 19; }
+
 class ArithmeticEncoder {
 public:
     ArithmeticEncoder() = default;

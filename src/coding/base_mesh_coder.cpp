@@ -4,6 +4,7 @@
 
 #include "coding/arithmetic_coder.h"
 #include "common/bits.h"
+#include "common/check.h"
 
 #include <algorithm>
 #include <numeric>
@@ -21,7 +22,9 @@ constexpr int kDegreeContexts = 8;
 constexpr bool kChooseGate = true;
 constexpr bool kUseV = false;
 
-[[noreturn]] void fail(const std::string& what) { throw Error("base mesh stream: " + what); }
+[[noreturn]] void fail(const std::string& what, ErrorCode code = ErrorCode::corrupt) {
+    throw_error(code, "base mesh stream: " + what);
+}
 
 // Internal inconsistency of the encoder: caught, and the mesh is coded explicitly.
 struct EncoderGaveUp {};
@@ -217,7 +220,7 @@ DecodedBaseConnectivity decode_explicit(ArithmeticDecoder& dec, size_t size,
                                         uint32_t max_vertices) {
     DecodedBaseConnectivity out;
     out.vertex_count = get_count(dec);
-    if (out.vertex_count > max_vertices) fail("too many vertices");
+    if (out.vertex_count > max_vertices) fail("too many vertices", ErrorCode::limit_exceeded);
     const uint32_t faces = get_count(dec);
     const int bits = bit_length(out.vertex_count == 0 ? 0 : out.vertex_count - 1);
     if (faces > 0 && (out.vertex_count < 3 ||
@@ -242,7 +245,7 @@ DecodedBaseConnectivity decode_cut_border(ArithmeticDecoder& dec, size_t size,
     const uint32_t copies = get_count(dec);
     const uint32_t components = get_count(dec);
     const uint32_t merges = get_count(dec);
-    if (vertex_count > max_vertices) fail("too many vertices");
+    if (vertex_count > max_vertices) fail("too many vertices", ErrorCode::limit_exceeded);
     if (isolated > vertex_count) fail("bad isolated vertex count");
     const uint64_t stream_bits = 8 * (uint64_t{size} + 8);
     // Every copy and merge costs at least two raw bits.
@@ -257,6 +260,9 @@ DecodedBaseConnectivity decode_cut_border(ArithmeticDecoder& dec, size_t size,
                                  4 * int64_t(merges);
     if (closed_faces < 0 || closed_faces > kMaxCount || (components == 0) != (closed_faces == 0))
         fail("bad triangle count");
+    // Every triangle but a component's first costs an operation, at least one modelled symbol.
+    if (uint64_t(closed_faces) - components > max_decodable_symbols(size))
+        fail("triangle count exceeds the stream");
 
     OpModels models;
     CutBorder border;
@@ -266,8 +272,10 @@ DecodedBaseConnectivity decode_cut_border(ArithmeticDecoder& dec, size_t size,
     std::vector<uint8_t> is_dummy;
     std::vector<BaseStencil> raw_stencils;
     std::vector<Triangle> tris;
-    degree.reserve(vc);
-    tris.reserve(std::min<uint32_t>(fc, 1u << 20));
+    // Room for what a stream of this size typically holds (a few triangles a byte); more grows.
+    const uint64_t typical = 64 * uint64_t{size} + 64;
+    degree.reserve(std::min<uint64_t>(vc, typical));
+    tris.reserve(std::min<uint64_t>(fc, typical));
     uint32_t dummy_seen = 0;
 
     auto add_vertex = [&](BaseStencil s, bool dummy) {
@@ -295,7 +303,7 @@ DecodedBaseConnectivity decode_cut_border(ArithmeticDecoder& dec, size_t size,
         border.start(a, b, c);
         while (!border.stack.empty()) {
             if (tris.size() >= fc) fail("more triangles than announced");
-            if (dec.overran()) fail("truncated");
+            if (dec.overran()) fail("truncated", ErrorCode::truncated);
             CutBorder::Loop& loop = border.top();
             const uint32_t g = loop.gate, nv = border.next[g];
             const uint32_t u = border.vert[g], v = border.vert[nv];
@@ -356,7 +364,7 @@ DecodedBaseConnectivity decode_cut_border(ArithmeticDecoder& dec, size_t size,
         target[copy] = to;
         previous_copy = copy;
     }
-    if (dec.overran()) fail("truncated");
+    if (dec.overran()) fail("truncated", ErrorCode::truncated);
 
     DecodedBaseConnectivity out;
     out.vertex_count = vertex_count;
@@ -830,15 +838,17 @@ BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh) {
 
 DecodedBaseConnectivity decode_base_connectivity(const uint8_t* data, size_t size,
                                                  uint32_t max_vertices) {
-    if (data == nullptr && size != 0) fail("no data");
-    ArithmeticDecoder dec(data, size);
-    const uint32_t mode = dec.decode_bits_raw(2);
-    DecodedBaseConnectivity out;
-    if (mode == kModeCutBorder) out = decode_cut_border(dec, size, max_vertices);
-    else if (mode == kModeExplicit) out = decode_explicit(dec, size, max_vertices);
-    else fail("unknown mode " + std::to_string(mode));
-    if (dec.overran()) fail("truncated");
-    return out;
+    if (data == nullptr && size != 0) fail("no data", ErrorCode::invalid_input);
+    return with_allocation_errors_as_limits("base mesh stream", [&] {
+        ArithmeticDecoder dec(data, size);
+        const uint32_t mode = dec.decode_bits_raw(2);
+        DecodedBaseConnectivity out;
+        if (mode == kModeCutBorder) out = decode_cut_border(dec, size, max_vertices);
+        else if (mode == kModeExplicit) out = decode_explicit(dec, size, max_vertices);
+        else fail("unknown mode " + std::to_string(mode));
+        if (dec.overran()) fail("truncated", ErrorCode::truncated);
+        return out;
+    });
 }
 
 }  // namespace amc

@@ -74,7 +74,9 @@ struct DecodedBaseConnectivity {
 };
 
 // Decodes a stream of encode_base_connectivity; refuses more than `max_vertices` vertices.
-// Throws Error on corrupt or truncated input.
+// Throws Error on corrupt or truncated input. The stream bounds its triangles, but isolated
+// vertices cost it no bits: the caller bounds them with `max_vertices` (the .amc decoder by the
+// base geometry block, where every vertex costs at least 15 symbols).
 DecodedBaseConnectivity decode_base_connectivity(const uint8_t* data, size_t size,
                                                  uint32_t max_vertices);
 

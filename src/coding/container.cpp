@@ -1,7 +1,7 @@
 // Blocks of the .amc file: writing, and reading with every length and checksum verified.
 #include "coding/container.h"
 
-#include <amc/mesh.h>
+#include "common/check.h"
 
 #include <xxhash.h>
 
@@ -43,7 +43,8 @@ BlockWriter::BlockWriter(uint8_t version, uint8_t flags) {
 }
 
 void BlockWriter::add(BlockType type, const std::vector<uint8_t>& payload) {
-    if (payload.size() > UINT32_MAX) throw Error(std::string(block_type_name(uint8_t(type))) + " block is larger than 4 GiB");
+    AMC_REQUIRE(payload.size() <= UINT32_MAX, limit_exceeded,
+                std::string(block_type_name(uint8_t(type))) + " block is larger than 4 GiB");
     const size_t start = out_.size();
     out_.push_back(uint8_t(type));
     put_u32(out_, uint32_t(payload.size()));
@@ -58,40 +59,41 @@ std::vector<uint8_t> BlockWriter::finish() {
 }
 
 BlockReader::BlockReader(const uint8_t* data, size_t size) : data_(data), size_(size) {
-    if (size < 4 || std::memcmp(data, kFileMagic, 4) != 0) throw Error("not an .amc file (bad magic)");
-    if (size < 5) throw Error("file is truncated (header)");
+    AMC_REQUIRE(size >= 4 && std::memcmp(data, kFileMagic, 4) == 0, bad_magic, "not an .amc file (bad magic)");
+    AMC_REQUIRE(size >= 5, truncated, "file is truncated (header)");
     version_ = data[4];
     // The version comes first: a newer file may have a header this build does not know.
-    if (version_ < kOldestReadableVersion || version_ > kNewestVersion)
-        throw Error("unsupported .amc version " + std::to_string(version_) + " (this build reads versions " +
+    AMC_REQUIRE(version_ >= kOldestReadableVersion && version_ <= kNewestVersion, unsupported_version,
+                "unsupported .amc version " + std::to_string(version_) + " (this build reads versions " +
                     std::to_string(kOldestReadableVersion) + " to " + std::to_string(kNewestVersion) + ")");
-    if (size < kFileHeaderSize) throw Error("file is truncated (header)");
-    if (XXH32(data, 8, 0) != get_u32(data + 8)) throw Error("checksum mismatch in the file header");
+    AMC_REQUIRE(size >= kFileHeaderSize, truncated, "file is truncated (header)");
+    AMC_REQUIRE(XXH32(data, 8, 0) == get_u32(data + 8), checksum, "checksum mismatch in the file header");
     flags_ = data[5];
-    if (flags_ & ~(kFlagSinglePrecision | kFlagQuantized)) throw Error("unknown flags in the file header");
-    if (data[6] != 0 || data[7] != 0) throw Error("reserved header bytes are not zero");
+    AMC_REQUIRE(!(flags_ & ~(kFlagSinglePrecision | kFlagQuantized)), corrupt, "unknown flags in the file header");
+    AMC_REQUIRE(data[6] == 0 && data[7] == 0, corrupt, "reserved header bytes are not zero");
 }
 
 bool BlockReader::next(Block& block) {
     if (ended_) return false;
-    if (size_ - pos_ < kBlockOverhead) throw Error("file is truncated (block header at byte " + std::to_string(pos_) + ")");
+    AMC_REQUIRE(size_ - pos_ >= kBlockOverhead, truncated,
+                "file is truncated (block header at byte " + std::to_string(pos_) + ")");
     const uint8_t type = data_[pos_];
     const uint32_t length = get_u32(data_ + pos_ + 1);
-    if (length > size_ - pos_ - kBlockOverhead)
-        throw Error("file is truncated (" + std::string(block_type_name(type)) + " block at byte " +
+    AMC_REQUIRE(length <= size_ - pos_ - kBlockOverhead, truncated,
+                "file is truncated (" + std::string(block_type_name(type)) + " block at byte " +
                     std::to_string(pos_) + " announces " + std::to_string(length) + " bytes)");
     const uint32_t stored = get_u32(data_ + pos_ + 5 + length);
-    if (XXH32(data_ + pos_, 5 + size_t(length), 0) != stored)
-        throw Error("checksum mismatch in the " + std::string(block_type_name(type)) + " block at byte " +
+    AMC_REQUIRE(XXH32(data_ + pos_, 5 + size_t(length), 0) == stored, checksum,
+                "checksum mismatch in the " + std::string(block_type_name(type)) + " block at byte " +
                     std::to_string(pos_));
     const uint8_t newest_type = version_ >= kNumberingVersion ? uint8_t(BlockType::numbering) : uint8_t(BlockType::level);
-    if (type > newest_type) throw Error("unknown block type " + std::to_string(type));
+    AMC_REQUIRE(type <= newest_type, corrupt, "unknown block type " + std::to_string(type));
     block = {BlockType(type), data_ + pos_ + 5, length, pos_};
     pos_ += kBlockOverhead + length;
     if (block.type == BlockType::end) {
         ended_ = true;
-        if (length != 0) throw Error("end block is not empty");
-        if (pos_ != size_) throw Error(std::to_string(size_ - pos_) + " bytes after the end block");
+        AMC_REQUIRE(length == 0, corrupt, "end block is not empty");
+        AMC_REQUIRE(pos_ == size_, corrupt, std::to_string(size_ - pos_) + " bytes after the end block");
     }
     return true;
 }
@@ -109,26 +111,29 @@ void put_f64(std::vector<uint8_t>& out, double value) {
     for (int i = 0; i < 8; ++i) out.push_back(uint8_t(bits >> (8 * i)));
 }
 
-void PayloadReader::fail(const std::string& problem) const { throw Error(std::string(what_) + ": " + problem); }
+void PayloadReader::fail(ErrorCode code, const std::string& problem) const {
+    throw_error(code, std::string(what_) + ": " + problem);
+}
 
 uint64_t PayloadReader::varint() {
     uint64_t value = 0;
     for (int shift = 0;; shift += 7) {
-        if (pos_ >= size_) fail("truncated number");
-        if (shift > 63) fail("number too long");
+        if (pos_ >= size_) fail(ErrorCode::truncated, "truncated number");
+        if (shift > 63) fail(ErrorCode::corrupt, "number too long");
         const uint8_t byte = data_[pos_++];
+        if (shift == 63 && byte > 1) fail(ErrorCode::corrupt, "number too long");
         value |= uint64_t(byte & 0x7f) << shift;
         if (!(byte & 0x80)) return value;
     }
 }
 
 uint8_t PayloadReader::u8() {
-    if (pos_ >= size_) fail("truncated");
+    if (pos_ >= size_) fail(ErrorCode::truncated, "truncated");
     return data_[pos_++];
 }
 
 double PayloadReader::f64() {
-    if (size_ - pos_ < 8) fail("truncated");
+    if (size_ - pos_ < 8) fail(ErrorCode::truncated, "truncated");
     uint64_t bits = 0;
     for (int i = 0; i < 8; ++i) bits |= uint64_t(data_[pos_ + i]) << (8 * i);
     pos_ += 8;

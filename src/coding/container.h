@@ -2,6 +2,8 @@
 // blocks, each with its length and an XXH32 checksum, ending with an END block.
 #pragma once
 
+#include <amc/mesh.h>
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -60,6 +62,8 @@ public:
     // The next block; throws Error on truncation, a bad checksum, an unknown type, or bytes after
     // END. Returns false after END.
     bool next(Block& block);
+    // Bytes after the blocks read so far.
+    size_t remaining() const { return size_ - pos_; }
 
 private:
     const uint8_t* data_;
@@ -84,7 +88,7 @@ public:
     size_t remaining() const { return size_ - pos_; }
 
 private:
-    [[noreturn]] void fail(const std::string& problem) const;
+    [[noreturn]] void fail(ErrorCode code, const std::string& problem) const;
     const uint8_t* data_;
     size_t size_;
     const char* what_;

@@ -24,6 +24,8 @@ uint64_t width_mask(Precision precision) {
 // Levels of the bit-length tree: enough for k = 0 .. width.
 int tree_depth(Precision precision) { return precision == Precision::float32 ? 6 : 7; }
 constexpr int kQuantizedTreeDepth = 5;  // k = 0 .. 30 < 32
+static_assert(kMinSymbolsPerCoordinate <= kQuantizedTreeDepth && kQuantizedTreeDepth < 6,
+              "kMinSymbolsPerCoordinate is the shallowest tree");
 
 double finite_or_zero(double x) { return std::isfinite(x) ? x : 0.0; }
 

@@ -98,6 +98,14 @@ Vec3 decode_position(ArithmeticDecoder& decoder, FloatResidualModels& models, in
 
 // ---- quantized mode ---------------------------------------------------------------------------
 
+// The fewest symbols a coordinate costs: the bit-length tree's depth, 5 for quantized
+// coordinates (6 float32, 7 float64). Decoders bound vertex counts by the bytes with it.
+constexpr int kMinSymbolsPerCoordinate = 5;
+// At most how many positions (three coordinates each) a payload of `payload_bytes` can hold.
+constexpr uint64_t max_decodable_positions(uint64_t payload_bytes) {
+    return max_decodable_symbols(payload_bytes) / (3 * kMinSymbolsPerCoordinate);
+}
+
 constexpr int kMinQuantizationBits = 1;
 constexpr int kMaxQuantizationBits = 30;
 

@@ -1,6 +1,7 @@
 // Hierarchy decoder: the mirror of hierarchy_encoder.cpp. It grows the forest over the shared base
 // mesh level by level, taking each decision from a rule or from the stream.
 #include "coding/hierarchy_level_coder.h"
+#include "common/check.h"
 #include "common/compiler.h"
 
 #include <string>
@@ -12,7 +13,8 @@ namespace {
 
 HierarchyStreamHeader parse_header(const uint8_t* data, size_t size) {
     HierarchyStreamHeader header;
-    if (read_hierarchy_stream_header(data, size, header) != size) throw Error("hierarchy stream: header has trailing bytes");
+    AMC_REQUIRE(read_hierarchy_stream_header(data, size, header) == size, corrupt,
+                "hierarchy stream: header has trailing bytes");
     return header;
 }
 
@@ -73,8 +75,8 @@ void HierarchyLevelDecoder::restart(const TriangleMesh& base, const HierarchyStr
         level_nodes *= 4;
         uniform_nodes += level_nodes;
     }
-    if (uniform_nodes > max_nodes_)
-        throw Error("hierarchy stream would build more than " + std::to_string(max_nodes_) + " nodes");
+    AMC_REQUIRE(uniform_nodes <= max_nodes_, limit_exceeded,
+                "hierarchy stream would build more than " + std::to_string(max_nodes_) + " nodes");
     models_ = HierarchyModels();
     traversal_.configure(header.options);
     for (Level& level : decided_) spare_.push_back(std::move(level));
@@ -94,13 +96,13 @@ std::vector<NodeId> HierarchyLevelDecoder::level_nodes() const {
     return ids;
 }
 
-void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder) {
-    decide_level(decoder);
+void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder, uint64_t max_refined) {
+    decide_level(decoder, max_refined);
     build_decided_levels();
 }
 
-void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
-    if (done()) throw Error("hierarchy stream: no level left to decode");
+void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder, uint64_t max_refined) {
+    AMC_REQUIRE(!done(), invalid_input, "hierarchy stream: no level left to decode");
     const int l = level_index_;
     uint8_t* state = level_.state();
     const uint32_t n = static_cast<uint32_t>(level_.size());
@@ -144,8 +146,8 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
     // (their diagonals come next in the stream) and the checks. Errors name the element by its
     // level and canonical index: its node id may not exist yet.
     auto corrupt = [&](uint32_t i, const char* what) {
-        return Error("hierarchy stream is corrupt: element " + std::to_string(i) + " of level " + std::to_string(l) +
-                     what);
+        return Error(ErrorCode::corrupt, "hierarchy stream is corrupt: element " + std::to_string(i) + " of level " +
+                                             std::to_string(l) + what);
     };
     uint32_t* const closures = closures_.reserve(n);
     const DecidedLevelScan scan = scan_decided_level(level_, numbering_, closures);
@@ -167,9 +169,12 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder) {
                 throw corrupt(i, " can not be refined");
         }
     }
-    if (node_count_ + uint64_t(4) * count > max_nodes_)
-        throw Error("hierarchy stream would build more than " + std::to_string(max_nodes_) + " nodes");
-    if (d.overran()) throw Error("hierarchy stream is truncated");
+    AMC_REQUIRE(d.overran() == false, truncated, "hierarchy stream is truncated");
+    AMC_REQUIRE(count <= max_refined, corrupt,
+                "level " + std::to_string(l) + " refines " + std::to_string(count) +
+                    " nodes, more than its block can hold the new vertices of");
+    AMC_REQUIRE(node_count_ + uint64_t(4) * count <= max_nodes_, limit_exceeded,
+                "hierarchy stream would build more than " + std::to_string(max_nodes_) + " nodes");
     decoder = d;
     models_ = models;
     symbols_read_ = symbols_read;
@@ -212,8 +217,8 @@ void HierarchyLevelDecoder::build_decided_levels() {
 }
 
 void HierarchyLevelDecoder::finish() const {
-    if (header_.options.truncate_stream && symbols_read_ != header_.symbol_count)
-        throw Error("hierarchy stream is corrupt: " + std::to_string(header_.symbol_count) + " symbols announced, " +
+    AMC_REQUIRE(!header_.options.truncate_stream || symbols_read_ == header_.symbol_count, corrupt,
+                "hierarchy stream is corrupt: " + std::to_string(header_.symbol_count) + " symbols announced, " +
                     std::to_string(symbols_read_) + " used");
 }
 
@@ -231,6 +236,12 @@ HierarchyDecoder& HierarchyDecoder::operator=(HierarchyDecoder&&) noexcept = def
 
 void HierarchyDecoder::decode(const TriangleMesh& base, const uint8_t* data, size_t size, Hierarchy& out,
                               const HierarchyDecodeOptions& options) {
+    AMC_REQUIRE(data != nullptr || size == 0, invalid_input, "hierarchy stream: no data");
+    with_allocation_errors_as_limits("hierarchy stream", [&] { decode_stream(base, data, size, out, options); });
+}
+
+void HierarchyDecoder::decode_stream(const TriangleMesh& base, const uint8_t* data, size_t size, Hierarchy& out,
+                                     const HierarchyDecodeOptions& options) {
     HierarchyStreamHeader header;
     const size_t header_size = read_hierarchy_stream_header(data, size, header);
     if (coder_ == nullptr) coder_ = std::make_unique<HierarchyLevelDecoder>();

@@ -83,13 +83,15 @@ public:
     // Nodes of the current level (ids in hierarchy()) in canonical order.
     std::vector<NodeId> level_nodes() const;
     // Decides the current level from `decoder` (symbols, orientation bits), splits its refined
-    // nodes in hierarchy() and moves to the next level. Throws Error on a corrupt stream.
-    void decode_level(ArithmeticDecoder& decoder);
+    // nodes in hierarchy() and moves to the next level. Throws Error on a corrupt stream, and
+    // when the level refines more than `max_refined` nodes (a bound the caller knows from its
+    // own data, checked before the next level is allocated).
+    void decode_level(ArithmeticDecoder& decoder, uint64_t max_refined = UINT64_MAX);
     // decode_level in two halves, for callers that want every decision before building: decide
     // the current level and move to the next (hierarchy() is not touched); then split every
     // decided level in hierarchy(). In between, node_count() and vertex_count() tell the size
     // the hierarchy will have, so it can be reserved at once.
-    void decide_level(ArithmeticDecoder& decoder);
+    void decide_level(ArithmeticDecoder& decoder, uint64_t max_refined = UINT64_MAX);
     void build_decided_levels();
     uint64_t node_count() const { return node_count_; }
     uint64_t vertex_count() const { return vertex_count_; }

@@ -1,7 +1,7 @@
 // Header of the hierarchy stream (layout in hierarchy_stream.h and docs/FORMAT.md).
 #include "coding/hierarchy_stream.h"
 
-#include <amc/mesh.h>
+#include "common/check.h"
 
 #include <string>
 
@@ -38,23 +38,23 @@ std::vector<uint8_t> write_hierarchy_stream_header(const HierarchyStreamHeader& 
 }
 
 size_t read_hierarchy_stream_header(const uint8_t* data, size_t size, HierarchyStreamHeader& header) {
-    if (size < 3) throw Error("hierarchy stream: header is truncated");
+    AMC_REQUIRE(size >= 3, truncated, "hierarchy stream: header is truncated");
     const uint8_t switches = data[0];
-    if (switches & 0x80) throw Error("hierarchy stream: reserved switch bit is set");
+    AMC_REQUIRE(!(switches & 0x80), corrupt, "hierarchy stream: reserved switch bit is set");
     header.options = coder_options_from_switches(switches & 63);
     const HierarchyCoderOptions& o = header.options;
     header.orientation_coded = switches & 64;
     header.uniform_levels = data[1];
-    if (header.uniform_levels > kMaxUniformLevels || (!o.uniform_levels && header.uniform_levels != 0))
-        throw Error("hierarchy stream: " + std::to_string(header.uniform_levels) + " uniform levels is out of range");
-    if (data[2] >= kDiagonalRuleCount) throw Error("hierarchy stream: unknown diagonal rule " + std::to_string(data[2]));
+    AMC_REQUIRE(header.uniform_levels <= kMaxUniformLevels && (o.uniform_levels || header.uniform_levels == 0),
+                corrupt, "hierarchy stream: " + std::to_string(header.uniform_levels) + " uniform levels is out of range");
+    AMC_REQUIRE(data[2] < kDiagonalRuleCount, corrupt, "hierarchy stream: unknown diagonal rule " + std::to_string(data[2]));
     header.diagonal_rule = DiagonalRule(data[2]);
     size_t used = 3;
     header.symbol_count = 0;
     if (o.truncate_stream) {
         for (int shift = 0;; shift += 7) {
-            if (used >= size) throw Error("hierarchy stream: symbol count is truncated");
-            if (shift > 56) throw Error("hierarchy stream: symbol count is too long");
+            AMC_REQUIRE(used < size, truncated, "hierarchy stream: symbol count is truncated");
+            AMC_REQUIRE(shift <= 56, corrupt, "hierarchy stream: symbol count is too long");
             const uint8_t byte = data[used++];
             header.symbol_count |= uint64_t(byte & 0x7f) << shift;
             if (!(byte & 0x80)) break;

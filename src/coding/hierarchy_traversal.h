@@ -285,7 +285,8 @@ constexpr NewBlocks kNewBlocks{};
 // read for a missing neighbour as block_of()[int32_t(kNoLocal)].
 class RefinedNumbering {
 public:
-    const uint32_t* block_of() const { return blocks_.data() + 1; }
+    // Null before the first reset (a level decided without a scan refines nothing: never read).
+    const uint32_t* block_of() const { return blocks_.data() == nullptr ? nullptr : blocks_.data() + 1; }
     // Room for n nodes, all kNoLocal.
     uint32_t* reset(size_t n) {
         uint32_t* blocks = blocks_.reserve(n + 1);

@@ -9,6 +9,7 @@
 #include "coding/geometry_prediction.h"
 #include "coding/hierarchy_level_coder.h"
 #include "coding/numbering_coder.h"
+#include "common/check.h"
 
 #include <algorithm>
 #include <cmath>
@@ -107,25 +108,51 @@ Metadata read_metadata(const Block& block, bool quantized) {
     m.faces = in.varint();
     m.levels = in.varint();
     m.options = in.varint();
-    if (m.options & ~kOptionRootRotations) throw Error("metadata block: unknown options");
+    AMC_REQUIRE(!(m.options & ~kOptionRootRotations), corrupt, "metadata block: unknown options");
     const uint64_t header_size = in.varint();
-    if (header_size > in.remaining()) throw Error("metadata block: hierarchy header is truncated");
+    AMC_REQUIRE(header_size <= in.remaining(), truncated, "metadata block: hierarchy header is truncated");
     m.hierarchy_header.assign(in.rest(), in.rest() + header_size);
     for (uint64_t i = 0; i < header_size; ++i) in.u8();
     if (quantized) {
         m.quantizer.bits = in.u8();
         m.quantizer.origin = {in.f64(), in.f64(), in.f64()};
         m.quantizer.step = in.f64();
-        if (m.quantizer.bits < kMinQuantizationBits || m.quantizer.bits > kMaxQuantizationBits ||
-            !std::isfinite(m.quantizer.step) || !(m.quantizer.step > 0) || !std::isfinite(m.quantizer.origin.x) ||
-            !std::isfinite(m.quantizer.origin.y) || !std::isfinite(m.quantizer.origin.z))
-            throw Error("metadata block: bad quantization parameters");
+        AMC_REQUIRE(m.quantizer.bits >= kMinQuantizationBits && m.quantizer.bits <= kMaxQuantizationBits &&
+                        std::isfinite(m.quantizer.step) && m.quantizer.step > 0 && std::isfinite(m.quantizer.origin.x) &&
+                        std::isfinite(m.quantizer.origin.y) && std::isfinite(m.quantizer.origin.z),
+                    corrupt, "metadata block: bad quantization parameters");
     }
-    if (in.remaining() != 0) throw Error("metadata block has trailing bytes");
-    if (m.base_triangles == 0 || m.levels == 0 || m.levels > kMaxLevel + 1 || m.nodes < m.base_triangles ||
-        m.vertices < m.base_vertices)
-        throw Error("metadata block: inconsistent counts");
+    AMC_REQUIRE(in.remaining() == 0, corrupt, "metadata block has trailing bytes");
+    // Counts that no hierarchy has: the refined nodes R = (nodes - T) / 4 create between 1.5 R
+    // (every midpoint shared by two of them) and 3 R new vertices, and every level but the last
+    // refines at least one node.
+    const uint64_t refined = (m.nodes - m.base_triangles) / 4;
+    AMC_REQUIRE(m.base_triangles != 0 && m.levels != 0 && m.levels <= kMaxLevel + 1 && m.nodes >= m.base_triangles &&
+                    m.vertices >= m.base_vertices && (m.nodes - m.base_triangles) % 4 == 0 &&
+                    m.vertices - m.base_vertices <= 3 * refined && 2 * (m.vertices - m.base_vertices) >= 3 * refined &&
+                    m.levels - 1 <= refined,
+                corrupt, "metadata block: inconsistent counts");
     return m;
+}
+
+// Checks the metadata's counts against the `bytes_after` bytes of the file that follow it, before
+// anything is allocated for them: every vertex costs at least max_decodable_positions' share of a
+// payload, every base triangle at least half a symbol (FORMAT.md, 3.7), so a file can announce no
+// more than its bytes can hold. Then against the caller's node limit.
+void check_counts_against_size(const Metadata& m, uint64_t bytes_after, const DecodeOptions& options) {
+    const uint64_t positions = max_decodable_positions(bytes_after);
+    auto cannot_hold = [&](uint64_t count, const char* what) {
+        return "metadata block: " + std::to_string(count) + " " + what + " can not be coded in the " +
+               std::to_string(bytes_after) + " bytes that follow";
+    };
+    AMC_REQUIRE(m.base_vertices <= positions, corrupt, cannot_hold(m.base_vertices, "base vertices"));
+    AMC_REQUIRE(m.vertices - m.base_vertices <= positions, corrupt,
+                cannot_hold(m.vertices - m.base_vertices, "refinement vertices"));
+    AMC_REQUIRE(m.base_triangles <= 2 * max_decodable_symbols(bytes_after), corrupt,
+                cannot_hold(m.base_triangles, "base triangles"));
+    AMC_REQUIRE(m.nodes <= options.max_nodes, limit_exceeded,
+                "file holds " + std::to_string(m.nodes) + " nodes, more than the limit of " +
+                    std::to_string(options.max_nodes));
 }
 
 std::vector<Vec3> all_positions(const Hierarchy& h) {
@@ -181,7 +208,7 @@ LeafNumbering numbering_after_reorder(const Hierarchy& input, const LeafNumberin
 std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options, EncodeStats* stats_out) {
     EncodeStats stats;
     const std::string problem = check_invariants(input);
-    if (!problem.empty()) throw Error("encode: invalid hierarchy: " + problem);
+    AMC_REQUIRE(problem.empty(), invalid_input, "encode: invalid hierarchy: " + problem);
     const bool quantized = options.quantize_bits != 0;
     // Quantized coordinates are reconstructed as doubles on the grid, whatever the input precision.
     const Precision precision = input.single_precision() && !quantized ? Precision::float32 : Precision::float64;
@@ -303,37 +330,46 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     return out;
 }
 
-Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options, LeafNumbering* numbering) {
+namespace {
+
+// Nodes reserved up front per byte of the file: a multiple of what real files hold (about one
+// node per byte), so that they are decoded in memory of their final size, while a small file
+// that announces a large hierarchy gets no more than its bytes warrant before it is decoded.
+constexpr uint64_t kReservedNodesPerFileByte = 64;
+
+Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& options, LeafNumbering* numbering) {
     if (numbering != nullptr) *numbering = {};
+    AMC_REQUIRE(data != nullptr || size == 0, invalid_input, "no data");
     BlockReader reader(data, size);
     const bool quantized = reader.flags() & kFlagQuantized;
     const Precision precision = (reader.flags() & kFlagSinglePrecision) ? Precision::float32 : Precision::float64;
-    if (quantized && precision == Precision::float32) throw Error("file header: quantized and float32 flags together");
+    AMC_REQUIRE(!(quantized && precision == Precision::float32), corrupt, "file header: quantized and float32 flags together");
     Block block{};
     auto expect = [&](BlockType type) {
-        if (!reader.next(block) || block.type != type)
-            throw Error(std::string("expected a ") + block_type_name(uint8_t(type)) + " block");
+        AMC_REQUIRE(reader.next(block) && block.type == type, corrupt,
+                    std::string("expected a ") + block_type_name(uint8_t(type)) + " block");
+        return block;
     };
-    expect(BlockType::metadata);
-    const Metadata meta = read_metadata(block, quantized);
-    if (meta.nodes > options.max_nodes)
-        throw Error("file holds " + std::to_string(meta.nodes) + " nodes, more than the limit of " +
-                    std::to_string(options.max_nodes));
-    if (meta.vertices > 3 * meta.nodes + meta.base_vertices) throw Error("metadata block: inconsistent vertex count");
+    const Metadata meta = read_metadata(expect(BlockType::metadata), quantized);
+    check_counts_against_size(meta, reader.remaining(), options);
+    const Block connectivity_block = expect(BlockType::base_connectivity);
+    const Block geometry_block = expect(BlockType::base_geometry);
+    AMC_REQUIRE(meta.base_vertices <= max_decodable_positions(geometry_block.size), corrupt,
+                "metadata block: " + std::to_string(meta.base_vertices) + " base vertices can not be coded in the " +
+                    std::to_string(geometry_block.size) + " bytes of the base geometry block");
 
-    expect(BlockType::base_connectivity);
     const DecodedBaseConnectivity connectivity =
-        decode_base_connectivity(block.payload, block.size, uint32_t(std::min<uint64_t>(meta.base_vertices, UINT32_MAX)));
-    if (connectivity.vertex_count != meta.base_vertices || connectivity.triangles.size() != meta.base_triangles)
-        throw Error("base connectivity does not match the metadata");
+        decode_base_connectivity(connectivity_block.payload, connectivity_block.size, uint32_t(meta.base_vertices));
+    AMC_REQUIRE(connectivity.vertex_count == meta.base_vertices && connectivity.triangles.size() == meta.base_triangles,
+                corrupt, "base connectivity does not match the metadata");
 
     TriangleMesh base;
     base.single_precision = precision == Precision::float32;
     base.triangles = connectivity.triangles;
+    base.positions.reserve(connectivity.vertex_count);
     PositionCoder positions(precision, quantized ? &meta.quantizer : nullptr);
-    expect(BlockType::base_geometry);
     {
-        ArithmeticDecoder decoder(block.payload, block.size);
+        ArithmeticDecoder decoder(geometry_block.payload, geometry_block.size);
         if (meta.options & kOptionRootRotations) {
             // Undo the base coder's rotations: decoded (o[r], o[r+1], o[r+2]) back to o.
             RotationModels models;
@@ -343,62 +379,78 @@ Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options,
                 for (int i = 0; i < 3; ++i) t[(i + r) % 3] = decoded[i];
             }
         }
-        for (uint32_t i = 0; i < connectivity.vertex_count; ++i) {
-            base.positions.push_back(positions.decode(decoder, 0, predict_parallelogram(base.positions, connectivity.stencils[i])));
-            const Vec3 p = base.positions.back();
-            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-                throw Error("base geometry is corrupt (non-finite coordinate)");
+        // The overrun check a vertex (15 symbols or more) stops a block that ends early at once.
+        for (uint32_t i = 0; i < connectivity.vertex_count && !decoder.overran(); ++i) {
+            const Vec3 p = positions.decode(decoder, 0, predict_parallelogram(base.positions, connectivity.stencils[i]));
+            AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
+                        "base geometry is corrupt (non-finite coordinate)");
+            base.positions.push_back(p);
         }
-        if (decoder.overran() || positions.saw_invalid_symbol()) throw Error("base geometry block is truncated or corrupt");
+        AMC_REQUIRE(!decoder.overran() && !positions.saw_invalid_symbol(), corrupt,
+                    "base geometry block is truncated or corrupt");
     }
-    validate_triangle_mesh(base, "decoded base mesh");
+    try {
+        validate_triangle_mesh(base, "decoded base mesh");
+    } catch (const Error& e) {
+        throw_error(ErrorCode::corrupt, e.what());  // a file whose base breaks the rules is corrupt
+    }
 
     HierarchyLevelDecoder hierarchy(base, meta.hierarchy_header.data(), meta.hierarchy_header.size(),
                                     std::min<uint64_t>(meta.nodes, options.max_nodes));
     Hierarchy& h = hierarchy.hierarchy();
-    // The metadata's counts (checked against the limit above) let the hierarchy grow in place.
-    h.reserve(meta.nodes, meta.vertices);
+    // The metadata's counts let the hierarchy grow in place, as far as the file's size warrants.
+    const uint64_t reserved_nodes = std::min<uint64_t>(meta.nodes, meta.base_triangles + kReservedNodesPerFileByte * size);
+    h.reserve(reserved_nodes, std::min<uint64_t>(meta.vertices, meta.base_vertices + reserved_nodes));
     int level = 0;
     Block numbering_block{};
     bool has_numbering = false;
     while (reader.next(block)) {
         if (block.type == BlockType::end) break;
         if (block.type == BlockType::numbering) {
-            if (!hierarchy.done() || has_numbering) throw Error("numbering block out of place");
+            AMC_REQUIRE(hierarchy.done() && !has_numbering, corrupt, "numbering block out of place");
             numbering_block = block;
             has_numbering = true;
             continue;
         }
-        if (has_numbering) throw Error("level block after the numbering block");
-        if (block.type != BlockType::level) throw Error("unexpected block between level blocks");
-        if (hierarchy.done()) throw Error("level block after the last level");
+        AMC_REQUIRE(!has_numbering, corrupt, "level block after the numbering block");
+        AMC_REQUIRE(block.type == BlockType::level, corrupt, "unexpected block between level blocks");
+        AMC_REQUIRE(!hierarchy.done(), corrupt, "level block after the last level");
         if (options.max_level >= 0 && level >= options.max_level) return h;  // progressive: stop here
-        if (block.size < 1 || block.payload[0] < 1 || block.payload[0] > 2) throw Error("level block: bad predictor");
+        AMC_REQUIRE(block.size >= 1 && block.payload[0] >= 1 && block.payload[0] <= 2, corrupt, "level block: bad predictor");
         const GeometryPredictor predictor = GeometryPredictor(block.payload[0]);
         ArithmeticDecoder decoder(block.payload + 1, block.size - 1);
         const std::vector<NodeId> nodes = hierarchy.level_nodes();
-        hierarchy.decode_level(decoder);
+        // The refined nodes R of a level create at least 1.5 R vertices, whose positions are in
+        // this block: it bounds R before the next level is allocated.
+        hierarchy.decode_level(decoder, 2 * max_decodable_positions(block.size - 1) / 3);
         for (auto [n, e] : new_vertices_of_level(h, nodes)) {
+            if (decoder.overran()) break;
             const Vec3 p = positions.decode(decoder, level_context(h.level(n)), predict(h, predictor, n, e));
-            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-                throw Error("level " + std::to_string(level) + " geometry is corrupt (non-finite coordinate)");
+            AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
+                        "level " + std::to_string(level) + " geometry is corrupt (non-finite coordinate)");
             h.set_position(h.midpoint(n, e), p);
         }
-        if (decoder.overran() || positions.saw_invalid_symbol())
-            throw Error("level " + std::to_string(level) + " block is truncated or corrupt");
+        AMC_REQUIRE(!decoder.overran() && !positions.saw_invalid_symbol(), corrupt,
+                    "level " + std::to_string(level) + " block is truncated or corrupt");
         ++level;
     }
     if (!hierarchy.done()) {
         if (options.max_level >= 0 && level >= options.max_level) return h;
-        throw Error("file ends before the last level");
+        throw_error(ErrorCode::truncated, "file ends before the last level");
     }
     hierarchy.finish();
-    if (h.node_count() != meta.nodes || h.vertex_count() != meta.vertices || uint64_t(level) != meta.levels)
-        throw Error("decoded hierarchy does not match the metadata");
+    AMC_REQUIRE(h.node_count() == meta.nodes && h.vertex_count() == meta.vertices && uint64_t(level) == meta.levels,
+                corrupt, "decoded hierarchy does not match the metadata");
     if (has_numbering && numbering != nullptr)
         *numbering = decode_numbering(numbering_block.payload, numbering_block.size, extract_leaf_mesh(h).mesh.triangles,
                                       h.vertex_count());
     return h;
+}
+
+}  // namespace
+
+Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options, LeafNumbering* numbering) {
+    return with_allocation_errors_as_limits("decode", [&] { return decode_file(data, size, options, numbering); });
 }
 
 Hierarchy in_decoder_order(const Hierarchy& h) {
@@ -411,13 +463,18 @@ DecodeResult try_decode(const uint8_t* data, size_t size, const DecodeOptions& o
     try {
         result.hierarchy = decode(data, size, options, &result.numbering);
         result.ok = true;
-    } catch (const std::exception& e) {
+    } catch (const Error& e) {
+        result.code = e.code();
+        result.error = e.what();
+    } catch (const std::exception& e) {  // nothing else is thrown; should it be, it is still a value
+        result.code = ErrorCode::invalid_input;
         result.error = e.what();
     }
     return result;
 }
 
 FileInfo inspect(const uint8_t* data, size_t size) {
+    AMC_REQUIRE(data != nullptr || size == 0, invalid_input, "no data");
     BlockReader reader(data, size);
     FileInfo info;
     info.version = reader.version();

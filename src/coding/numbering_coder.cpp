@@ -186,7 +186,7 @@ std::vector<uint32_t> decode_permutation(ArithmeticDecoder& decoder, Permutation
         uint32_t d = 0;
         if (method != PermutationMethod::identity &&
             !decode_difference(decoder, models, method, walk.remaining(), previous_zero, d))
-            throw Error(std::string("numbering block: corrupt ") + what + " order");
+            throw Error(ErrorCode::corrupt, std::string("numbering block: corrupt ") + what + " order");
         sequence[k] = walk.value_of(d);
         walk.take(sequence[k]);
     }
@@ -329,11 +329,11 @@ std::vector<uint8_t> encode_numbering(const LeafNumbering& numbering, const std:
 LeafNumbering decode_numbering(const uint8_t* data, size_t size, const std::vector<Triangle>& leaf, uint32_t vertices) {
     PayloadReader in(data, size, "numbering block");
     if (in.varint() != vertices || in.varint() != leaf.size())
-        throw Error("numbering block: its counts do not match the leaf mesh");
+        throw Error(ErrorCode::corrupt, "numbering block: its counts do not match the leaf mesh");
     const uint8_t vertex_method = in.u8(), face_reference = in.u8(), face_method = in.u8(), rotation_mode = in.u8();
     if (vertex_method > uint8_t(PermutationMethod::adaptive) || face_method > uint8_t(PermutationMethod::adaptive) ||
         face_reference > uint8_t(FaceReference::highest_vertex) || rotation_mode > uint8_t(RotationMode::lowest_corner))
-        throw Error("numbering block: unknown method");
+        throw Error(ErrorCode::corrupt, "numbering block: unknown method");
     ArithmeticDecoder decoder(in.rest(), in.remaining());
 
     const std::vector<uint32_t> caller_vertex = decode_permutation(decoder, PermutationMethod(vertex_method), vertices, "vertex");
@@ -362,7 +362,7 @@ LeafNumbering decode_numbering(const uint8_t* data, size_t size, const std::vect
                 uint8_t((s + reference_corner(RotationMode(rotation_mode), leaf[t], caller_vertex)) % 3);
         }
     }
-    if (decoder.overran()) throw Error("numbering block is truncated or corrupt");
+    if (decoder.overran()) throw Error(ErrorCode::corrupt, "numbering block is truncated or corrupt");
     return numbering;
 }
 

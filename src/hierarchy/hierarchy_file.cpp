@@ -2,6 +2,8 @@
 // bits in breadth-first order, diagonal overrides and the positions of refinement vertices.
 #include <amc/hierarchy.h>
 
+#include "common/check.h"
+
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -37,7 +39,9 @@ void put_coordinate(std::string& out, double x, bool single) {
 class Reader {
 public:
     Reader(const std::string& bytes, const std::string& what) : bytes_(bytes), what_(what) {}
-    [[noreturn]] void fail(const std::string& message) const { throw Error(what_ + ": " + message); }
+    [[noreturn]] void fail(const std::string& message, ErrorCode code = ErrorCode::corrupt) const {
+        throw_error(code, what_ + ": " + message);
+    }
     uint32_t u32() {
         need(4);
         uint32_t v = 0;
@@ -68,7 +72,7 @@ public:
 
 private:
     void need(size_t n) const {
-        if (bytes_.size() - pos_ < n) fail("file is truncated");
+        if (bytes_.size() - pos_ < n) fail("file is truncated", ErrorCode::truncated);
     }
     const std::string& bytes_;
     const std::string& what_;
@@ -124,12 +128,15 @@ std::string serialize_hierarchy(const Hierarchy& h) {
     return out;
 }
 
-Hierarchy deserialize_hierarchy(const std::string& bytes, const std::string& what) {
+namespace {
+
+Hierarchy parse_hierarchy(const std::string& bytes, const std::string& what) {
     Reader in(bytes, what);
     const char* magic = in.take(4);
-    if (std::memcmp(magic, kMagic, 4) != 0) in.fail("not a hierarchy file (bad magic)");
+    if (std::memcmp(magic, kMagic, 4) != 0) in.fail("not a hierarchy file (bad magic)", ErrorCode::bad_magic);
     const uint32_t version = in.u32();
-    if (version != kVersion) in.fail("unsupported hierarchy file version " + std::to_string(version));
+    if (version != kVersion)
+        in.fail("unsupported hierarchy file version " + std::to_string(version), ErrorCode::unsupported_version);
     const uint32_t flags = in.u32();
     if (flags & ~kFlagSinglePrecision) in.fail("unknown flags " + std::to_string(flags));
     const bool single = flags & kFlagSinglePrecision;
@@ -146,7 +153,8 @@ Hierarchy deserialize_hierarchy(const std::string& bytes, const std::string& wha
                               uint64_t(new_vertices) * 3 * coordinate_size;
     if (expected != in.remaining())
         in.fail("file size does not match its header (" + std::to_string(in.remaining()) + " bytes after the header, " +
-                std::to_string(expected) + " expected)");
+                std::to_string(expected) + " expected)",
+            expected > in.remaining() ? ErrorCode::truncated : ErrorCode::corrupt);
     if (base_triangles == 0) in.fail("base mesh has no triangles");
     if (node_count < base_triangles) in.fail("fewer nodes than base triangles");
 
@@ -162,7 +170,11 @@ Hierarchy deserialize_hierarchy(const std::string& bytes, const std::string& wha
     for (Triangle& t : base.triangles) {
         for (uint32_t& v : t) v = in.u32();
     }
-    validate_triangle_mesh(base, what + " (base mesh)");
+    try {
+        validate_triangle_mesh(base, what + " (base mesh)");
+    } catch (const Error& e) {
+        throw_error(ErrorCode::corrupt, e.what());  // a file whose base breaks the rules is corrupt
+    }
     Hierarchy h(std::move(base));
     h.set_vertex_placer([](void*, Vec3 a, Vec3) { return a; }, nullptr);  // positions follow
 
@@ -223,16 +235,22 @@ Hierarchy deserialize_hierarchy(const std::string& bytes, const std::string& wha
     return h;
 }
 
+}  // namespace
+
+Hierarchy deserialize_hierarchy(const std::string& bytes, const std::string& what) {
+    return with_allocation_errors_as_limits(what.c_str(), [&] { return parse_hierarchy(bytes, what); });
+}
+
 void write_hierarchy(const std::string& path, const Hierarchy& h) {
     write_file_atomically(path, serialize_hierarchy(h));
 }
 
 Hierarchy read_hierarchy(const std::string& path) {
     std::ifstream file(path, std::ios::binary);
-    if (!file) throw Error(path + ": cannot open file");
+    AMC_REQUIRE(file, io, path + ": cannot open file");
     std::ostringstream bytes;
     bytes << file.rdbuf();
-    if (file.bad()) throw Error(path + ": read error");
+    AMC_REQUIRE(!file.bad(), io, path + ": read error");
     return deserialize_hierarchy(bytes.str(), path);
 }
 

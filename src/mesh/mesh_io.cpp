@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "amc/mesh.h"
+#include "common/check.h"
 #include "mesh/obj_io.h"
 #include "mesh/off_io.h"
 #include "mesh/ply_io.h"
@@ -21,16 +22,16 @@ std::string read_file(const std::string& path) {
     std::error_code ec;
     const std::filesystem::file_status status = std::filesystem::status(path, ec);
     if (ec || !std::filesystem::exists(status)) {
-        throw Error(path + ": cannot open file (" +
+        throw Error(ErrorCode::io, path + ": cannot open file (" +
                     (ec ? ec.message() : std::string("No such file or directory")) + ")");
     }
-    if (!std::filesystem::is_regular_file(status)) throw Error(path + ": not a regular file");
+    if (!std::filesystem::is_regular_file(status)) throw Error(ErrorCode::io, path + ": not a regular file");
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(path + ": cannot open file (" + std::strerror(errno) + ")");
+    if (!in) throw Error(ErrorCode::io, path + ": cannot open file (" + std::strerror(errno) + ")");
     std::string bytes;
     char buffer[1 << 16];
     while (in.read(buffer, sizeof buffer) || in.gcount() > 0) bytes.append(buffer, in.gcount());
-    if (in.bad()) throw Error(path + ": read error");
+    if (in.bad()) throw Error(ErrorCode::io, path + ": read error");
     return bytes;
 }
 
@@ -56,15 +57,17 @@ TriangleMesh read_mesh(const std::string& path) {
         throw Error(path + ": reading .vtu files is not supported (use .obj, .off or .ply)");
     }
     const std::string bytes = read_file(path);
-    TriangleMesh mesh;
-    switch (format) {
-        case MeshFormat::obj: mesh = parse_obj(bytes, path); break;
-        case MeshFormat::off: mesh = parse_off(bytes, path); break;
-        case MeshFormat::ply: mesh = parse_ply(bytes, path); break;
-        case MeshFormat::vtu: break;
-    }
-    validate_triangle_mesh(mesh, path);
-    return mesh;
+    return with_allocation_errors_as_limits(path.c_str(), [&] {
+        TriangleMesh mesh;
+        switch (format) {
+            case MeshFormat::obj: mesh = parse_obj(bytes, path); break;
+            case MeshFormat::off: mesh = parse_off(bytes, path); break;
+            case MeshFormat::ply: mesh = parse_ply(bytes, path); break;
+            case MeshFormat::vtu: break;
+        }
+        validate_triangle_mesh(mesh, path);
+        return mesh;
+    });
 }
 
 void write_mesh(const std::string& path, const TriangleMesh& mesh, const CellData* cells) {
@@ -78,7 +81,7 @@ void write_mesh(const std::string& path, const TriangleMesh& mesh, const CellDat
             case MeshFormat::vtu: bytes = format_vtu(mesh, cells); break;
         }
     } catch (const Error& e) {
-        throw Error(path + ": " + e.what());
+        throw e.prefixed(path);
     }
     write_file_atomically(path, bytes);
 }
@@ -87,7 +90,7 @@ void write_file_atomically(const std::string& path, const std::string& bytes) {
     const std::string temp = path + ".tmp." + std::to_string(static_cast<long>(::getpid()));
     std::FILE* file = std::fopen(temp.c_str(), "wb");
     if (!file) {
-        throw Error(path + ": cannot create " + temp + " (" + std::strerror(errno) + ")");
+        throw Error(ErrorCode::io, path + ": cannot create " + temp + " (" + std::strerror(errno) + ")");
     }
     const bool written = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
     int saved_errno = errno;
@@ -97,12 +100,12 @@ void write_file_atomically(const std::string& path, const std::string& bytes) {
     if (flushed && !closed) saved_errno = errno;
     if (!written || !flushed || !closed) {
         std::remove(temp.c_str());
-        throw Error(path + ": cannot write file (" + std::strerror(saved_errno) + ")");
+        throw Error(ErrorCode::io, path + ": cannot write file (" + std::strerror(saved_errno) + ")");
     }
     if (std::rename(temp.c_str(), path.c_str()) != 0) {
         saved_errno = errno;
         std::remove(temp.c_str());
-        throw Error(path + ": cannot rename " + temp + " to it (" + std::strerror(saved_errno) + ")");
+        throw Error(ErrorCode::io, path + ": cannot rename " + temp + " to it (" + std::strerror(saved_errno) + ")");
     }
 }
 

@@ -20,13 +20,14 @@
 
 #include <tiny_obj_loader.h>
 
+#include "common/check.h"
 #include "mesh/text_number.h"
 
 namespace amc {
 namespace {
 
-[[noreturn]] void fail(const std::string& what, const std::string& message) {
-    throw Error(what + ": " + message);
+[[noreturn]] void fail(const std::string& what, const std::string& message, ErrorCode code = ErrorCode::corrupt) {
+    throw_error(code, what + ": " + message);
 }
 
 std::string first_line(const std::string& s) {
@@ -85,7 +86,7 @@ ObjScan scan_obj(std::string_view text, const std::string& what) {
             if (corners != 3) {
                 fail(what, "face " + std::to_string(scan.face_count) + " (line " +
                                std::to_string(line_number) + ") has " + std::to_string(corners) +
-                               " vertices; only triangle meshes are supported");
+                               " vertices; only triangle meshes are supported", ErrorCode::invalid_input);
             }
             ++scan.face_count;
         }
@@ -110,7 +111,7 @@ TriangleMesh parse_obj(const std::string& text, const std::string& what) {
     if (scan.positions.size() * 3 != attrib.vertices.size()) {
         fail(what, "OBJ parse error: inconsistent vertex count");
     }
-    if (scan.positions.size() > UINT32_MAX) fail(what, "too many vertices");
+    if (scan.positions.size() > UINT32_MAX) fail(what, "too many vertices", ErrorCode::limit_exceeded);
 
     TriangleMesh mesh;
     mesh.positions = std::move(scan.positions);
@@ -123,9 +124,9 @@ TriangleMesh parse_obj(const std::string& text, const std::string& what) {
             const std::size_t face = mesh.triangles.size();  // 0-based, like "triangle N"
             if (corners != 3) {
                 fail(what, "face " + std::to_string(face) + " has " + std::to_string(corners) +
-                               " vertices; only triangle meshes are supported");
+                               " vertices; only triangle meshes are supported", ErrorCode::invalid_input);
             }
-            if (offset + 3 > indices.size()) fail(what, "OBJ parse error: truncated face list");
+            if (offset + 3 > indices.size()) fail(what, "OBJ parse error: truncated face list", ErrorCode::truncated);
             Triangle tri;
             for (int k = 0; k < 3; ++k) {
                 // tinyobjloader resolves relative (negative) indices but checks no range.

@@ -3,13 +3,14 @@
 
 #include <cstdint>
 
+#include "common/check.h"
 #include "mesh/text_number.h"
 
 namespace amc {
 namespace {
 
-[[noreturn]] void fail(const std::string& what, const std::string& message) {
-    throw Error(what + ": " + message);
+[[noreturn]] void fail(const std::string& what, const std::string& message, ErrorCode code = ErrorCode::corrupt) {
+    throw_error(code, what + ": " + message);
 }
 
 // Fewest bytes a vertex ("\n0 0 0") and a face ("\n3 0 1 2") can take, separator included.
@@ -19,7 +20,7 @@ constexpr uint64_t min_face_bytes = 8;
 uint64_t read_count(text::TokenCursor& in, const std::string& what, const char* name) {
     std::string_view token = in.next();
     int64_t value = 0;
-    if (token.empty()) fail(what, std::string("truncated header: missing ") + name + " count");
+    if (token.empty()) fail(what, std::string("truncated header: missing ") + name + " count", ErrorCode::truncated);
     if (!text::parse_int(token, value) || value < 0) {
         fail(what, std::string("bad ") + name + " count " + text::quote_token(token) + " (line " +
                        std::to_string(in.line()) + ")");
@@ -34,7 +35,7 @@ TriangleMesh parse_off(std::string_view text, const std::string& what) {
     std::string_view magic = in.next();
     if (magic != "OFF") {
         fail(what, "not an OFF file (expected \"OFF\", found " +
-                       (magic.empty() ? std::string("nothing") : text::quote_token(magic)) + ")");
+                       (magic.empty() ? std::string("nothing") : text::quote_token(magic)) + ")", ErrorCode::bad_magic);
     }
     const uint64_t vertex_count = read_count(in, what, "vertex");
     const uint64_t face_count = read_count(in, what, "face");
@@ -56,7 +57,7 @@ TriangleMesh parse_off(std::string_view text, const std::string& what) {
             std::string_view token = in.next();
             if (token.empty()) {
                 fail(what, "truncated: file ends in vertex " + std::to_string(v) + " of " +
-                               std::to_string(vertex_count));
+                               std::to_string(vertex_count), ErrorCode::truncated);
             }
             if (!text::parse_real(token, c)) {
                 fail(what, "vertex " + std::to_string(v) + " (line " + std::to_string(in.line()) +
@@ -72,7 +73,7 @@ TriangleMesh parse_off(std::string_view text, const std::string& what) {
         std::string_view token = in.next();
         if (token.empty()) {
             fail(what, "truncated: file ends before face " + std::to_string(f) + " of " +
-                           std::to_string(face_count));
+                           std::to_string(face_count), ErrorCode::truncated);
         }
         int64_t corners = 0;
         if (!text::parse_int(token, corners)) {
@@ -81,14 +82,14 @@ TriangleMesh parse_off(std::string_view text, const std::string& what) {
         }
         if (corners != 3) {
             fail(what, "face " + std::to_string(f) + " has " + std::to_string(corners) +
-                           " vertices; only triangle meshes are supported");
+                           " vertices; only triangle meshes are supported", ErrorCode::invalid_input);
         }
         for (uint32_t& index : mesh.triangles[f]) {
             token = in.next();
             int64_t value = 0;
             if (token.empty()) {
                 fail(what, "truncated: file ends in face " + std::to_string(f) + " of " +
-                               std::to_string(face_count));
+                               std::to_string(face_count), ErrorCode::truncated);
             }
             if (!text::parse_int(token, value)) {
                 fail(what, "face " + std::to_string(f) + " (line " + std::to_string(in.line()) +

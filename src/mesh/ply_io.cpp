@@ -7,13 +7,14 @@
 #include <utility>
 #include <vector>
 
+#include "common/check.h"
 #include "mesh/text_number.h"
 
 namespace amc {
 namespace {
 
-[[noreturn]] void fail(const std::string& what, const std::string& message) {
-    throw Error(what + ": " + message);
+[[noreturn]] void fail(const std::string& what, const std::string& message, ErrorCode code = ErrorCode::corrupt) {
+    throw_error(code, what + ": " + message);
 }
 
 enum class Encoding { ascii, binary_little_endian, binary_big_endian };
@@ -94,7 +95,7 @@ Header parse_header(std::string_view bytes, const std::string& what) {
         if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
         const std::string at = " (header line " + std::to_string(line_number) + ")";
         if (line_number == 1) {
-            if (line != "ply") fail(what, "not a PLY file (the first line is not \"ply\")");
+            if (line != "ply") fail(what, "not a PLY file (the first line is not \"ply\")", ErrorCode::bad_magic);
             continue;
         }
         std::vector<std::string_view> words = split_words(line);
@@ -192,7 +193,7 @@ public:
     double read(Type type, const std::string& context) {
         if (encoding_ == Encoding::ascii) return read_ascii(type, context);
         const std::size_t size = type_size(type);
-        if (bytes_.size() - pos_ < size) fail(what_, "truncated data in " + context);
+        if (bytes_.size() - pos_ < size) fail(what_, "truncated data in " + context, ErrorCode::truncated);
         unsigned char b[8];
         std::memcpy(b, bytes_.data() + pos_, size);
         pos_ += size;
@@ -230,7 +231,7 @@ public:
             return;
         }
         const uint64_t size = type_size(type);
-        if (count > (bytes_.size() - pos_) / size) fail(what_, "truncated data in " + context);
+        if (count > (bytes_.size() - pos_) / size) fail(what_, "truncated data in " + context, ErrorCode::truncated);
         pos_ += count * size;
     }
 
@@ -253,7 +254,7 @@ private:
 
     double read_ascii(Type type, const std::string& context) {
         std::string_view token = tokens_.next();
-        if (token.empty()) fail(what_, "truncated data in " + context);
+        if (token.empty()) fail(what_, "truncated data in " + context, ErrorCode::truncated);
         const std::string at = " (line " + std::to_string(tokens_.line() + header_lines_) + ")";
         if (type == Type::float32) {
             float f;
@@ -335,7 +336,7 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& what) {
     if (corner_property < 0 || !face_element->properties[corner_property].is_list) {
         fail(what, "bad PLY header: the face element has no vertex_indices list");
     }
-    if (vertex_element->count > UINT32_MAX) fail(what, "too many vertices");
+    if (vertex_element->count > UINT32_MAX) fail(what, "too many vertices", ErrorCode::limit_exceeded);
 
     TriangleMesh mesh;
     // check_counts bounded both counts by the data size, so these allocations are safe.
@@ -354,7 +355,7 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& what) {
                         if (n != 3) {
                             fail(what, "face " + std::to_string(item) + " has " +
                                            std::to_string(n) +
-                                           " vertices; only triangle meshes are supported");
+                                           " vertices; only triangle meshes are supported", ErrorCode::invalid_input);
                         }
                         for (uint32_t& index : mesh.triangles[item]) {
                             index = static_cast<uint32_t>(
