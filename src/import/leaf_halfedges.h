@@ -1,0 +1,49 @@
+// Directed-edge index of a triangle mesh (the leaf mesh being imported): the face on the left of
+// u->v, its third vertex, and the fan of faces around a vertex. Built in linear time.
+#pragma once
+
+#include <amc/mesh.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace amc {
+
+class LeafHalfedges {
+public:
+    static constexpr uint32_t kNone = 0xffffffffu;
+
+    explicit LeafHalfedges(const TriangleMesh& mesh);
+
+    // The face that holds the directed edge u->v, or kNone.
+    uint32_t face(uint32_t u, uint32_t v) const {
+        const Entry* e = find(u, v);
+        return e == nullptr ? kNone : e->face;
+    }
+    // The third vertex of that face, or kNone.
+    uint32_t apex(uint32_t u, uint32_t v) const {
+        const Entry* e = find(u, v);
+        return e == nullptr ? kNone : e->apex;
+    }
+    // Number of faces around u (the directed edges leaving u).
+    uint32_t degree(uint32_t u) const { return start_[u + 1] - start_[u]; }
+    // The i-th directed edge leaving u (in no particular order): its end and its face.
+    uint32_t out_vertex(uint32_t u, uint32_t i) const { return entries_[start_[u] + i].to; }
+    uint32_t out_face(uint32_t u, uint32_t i) const { return entries_[start_[u] + i].face; }
+    uint32_t vertex_count() const { return uint32_t(start_.size() - 1); }
+
+private:
+    struct Entry {
+        uint32_t to, apex, face;
+    };
+    const Entry* find(uint32_t u, uint32_t v) const {
+        for (uint32_t i = start_[u], end = start_[u + 1]; i < end; ++i) {
+            if (entries_[i].to == v) return &entries_[i];
+        }
+        return nullptr;
+    }
+    std::vector<uint32_t> start_;
+    std::vector<Entry> entries_;
+};
+
+}  // namespace amc

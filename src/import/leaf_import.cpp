@@ -1,0 +1,147 @@
+// import_leaf_mesh: base mesh + conforming leaf mesh -> hierarchy (docs/IMPORT.md, section 1).
+// Checks the inputs, matches the base vertices, runs the reconstruction (leaf_reconstruction.cpp)
+// and compares the extracted leaf mesh with the input, face by face.
+#include <amc/import.h>
+
+#include "import/leaf_halfedges.h"
+#include "import/leaf_reconstruction.h"
+#include "import/position_index.h"
+#include "import/uniform_lattice.h"
+
+#include <string>
+#include <vector>
+
+namespace amc {
+
+namespace {
+
+constexpr uint32_t kNone = 0xffffffffu;
+
+[[noreturn]] void fail(const std::string& what, const std::string& message) { throw Error(what + ": " + message); }
+
+std::string position_text(Vec3 p) {
+    char buffer[96];
+    std::snprintf(buffer, sizeof buffer, "(%.9g, %.9g, %.9g)", p.x, p.y, p.z);
+    return buffer;
+}
+
+std::vector<uint32_t> match_base_vertices(const TriangleMesh& base, const TriangleMesh& leaf,
+                                          const std::vector<uint32_t>& leaf_vertex_of_base,
+                                          const PositionIndex& leaf_positions, const std::string& what) {
+    const size_t v0 = base.positions.size();
+    std::vector<uint32_t> match(v0, kNone);
+    std::vector<uint32_t> base_of_leaf(leaf.positions.size(), kNone);
+    if (!leaf_vertex_of_base.empty()) {
+        if (leaf_vertex_of_base.size() != v0)
+            fail(what, "the base vertex map has " + std::to_string(leaf_vertex_of_base.size()) + " entries for " +
+                           std::to_string(v0) + " base vertices");
+        match = leaf_vertex_of_base;
+    } else {
+        for (uint32_t b = 0; b < v0; ++b) match[b] = leaf_positions.find(base.positions[b]);
+    }
+    for (uint32_t b = 0; b < v0; ++b) {
+        const uint32_t l = match[b];
+        if (l == kNone)
+            fail(what, "base vertex " + std::to_string(b) + " at " + position_text(base.positions[b]) +
+                           " is not a vertex of the leaf mesh (wrong base?)");
+        if (l >= leaf.positions.size())
+            fail(what, "base vertex " + std::to_string(b) + " maps to leaf vertex " + std::to_string(l) + " of " +
+                           std::to_string(leaf.positions.size()));
+        if (base_of_leaf[l] != kNone)
+            fail(what, "base vertices " + std::to_string(base_of_leaf[l]) + " and " + std::to_string(b) +
+                           " both map to leaf vertex " + std::to_string(l));
+        base_of_leaf[l] = b;
+    }
+    return match;
+}
+
+// extract_leaf_mesh(h) must be the input: every extracted triangle an input face with the same
+// orientation, every input face extracted once.
+void verify_leaf_mesh(const Hierarchy& h, const std::vector<uint32_t>& leaf_of_vertex, const TriangleMesh& leaf,
+                      const LeafHalfedges& halfedges, const std::string& what) {
+    const LeafMesh extracted = extract_leaf_mesh(h);
+    const std::vector<uint32_t> canonical = canonical_vertex_order(h);
+    std::vector<uint32_t> leaf_of_canonical(extracted.mesh.positions.size(), kNone);
+    for (size_t v = 0; v < canonical.size(); ++v) {
+        if (canonical[v] < leaf_of_canonical.size()) leaf_of_canonical[canonical[v]] = leaf_of_vertex[v];
+    }
+    std::vector<uint8_t> used(leaf.triangles.size(), 0);
+    for (size_t t = 0; t < extracted.mesh.triangles.size(); ++t) {
+        const Triangle& tri = extracted.mesh.triangles[t];
+        const uint32_t a = leaf_of_canonical[tri[0]], b = leaf_of_canonical[tri[1]], c = leaf_of_canonical[tri[2]];
+        const uint32_t f = (a == kNone || b == kNone) ? kNone : halfedges.face(a, b);
+        if (f == kNone || halfedges.apex(a, b) != c || used[f])
+            fail(what, "the reconstruction has a triangle (" + std::to_string(a) + ", " + std::to_string(b) + ", " +
+                           std::to_string(c) + ") that is not a face of the leaf mesh");
+        used[f] = 1;
+    }
+    for (size_t f = 0; f < used.size(); ++f) {
+        if (!used[f]) fail(what, "face " + std::to_string(f) + " is not part of a red-green refinement of the base");
+    }
+}
+
+}  // namespace
+
+ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh& leaf,
+                                   const std::vector<uint32_t>& leaf_vertex_of_base, const std::string& what) {
+    validate_triangle_mesh(base, what + " (base mesh)");
+    validate_triangle_mesh(leaf, what);
+    uint32_t first = kNone, second = kNone;
+    const PositionIndex leaf_positions(leaf.positions, &first, &second);
+    if (first != kNone)
+        fail(what, "vertices " + std::to_string(first) + " and " + std::to_string(second) + " have the same position " +
+                       position_text(leaf.positions[first]) + " (duplicate vertex)");
+    const std::vector<uint32_t> leaf_of_base =
+        match_base_vertices(base, leaf, leaf_vertex_of_base, leaf_positions, what);
+
+    TriangleMesh hierarchy_base;
+    hierarchy_base.triangles = base.triangles;
+    hierarchy_base.single_precision = leaf.single_precision;
+    hierarchy_base.positions.reserve(base.positions.size());
+    for (uint32_t l : leaf_of_base) hierarchy_base.positions.push_back(leaf.positions[l]);
+
+    const LeafHalfedges halfedges(leaf);
+    ImportedHierarchy out;
+    std::vector<uint32_t> leaf_of_vertex;
+    // Three ways in, cheapest first; each result is checked against the whole leaf mesh.
+    // 1. New vertices at edge midpoints (as amcodec writes them): found by position.
+    // 2. A uniform refinement (semi-regular remeshes): read off the connectivity as grids.
+    // 3. The general reconstruction from the connectivity.
+    auto attempt = [&](int way) {
+        out.hierarchy = Hierarchy(hierarchy_base);
+        if (way == 2) {
+            leaf_of_vertex = reconstruct_uniform(out.hierarchy, leaf_of_base, leaf, halfedges);
+            if (leaf_of_vertex.empty()) throw Error(what + ": not a uniform refinement");
+        } else {
+            leaf_of_vertex = reconstruct_hierarchy(out.hierarchy, leaf_of_base, leaf, halfedges,
+                                                   way == 1 ? &leaf_positions : nullptr, what);
+        }
+        verify_leaf_mesh(out.hierarchy, leaf_of_vertex, leaf, halfedges, what);
+    };
+    bool done = false;
+    for (int way = 1; way <= 2 && !done; ++way) {
+        try {
+            attempt(way);
+            done = true;
+        } catch (const Error&) {
+        }
+    }
+    if (!done) attempt(3);
+
+    out.vertex_of_input.assign(leaf.positions.size(), kNone);
+    for (VertexId v = 0; v < leaf_of_vertex.size(); ++v) {
+        const uint32_t l = leaf_of_vertex[v];
+        if (l == kNone) continue;
+        out.vertex_of_input[l] = v;
+        out.hierarchy.set_position(v, leaf.positions[l]);
+    }
+    return out;
+}
+
+ImportedHierarchy import_leaf_mesh_files(const std::string& base_path, const std::string& leaf_path) {
+    const TriangleMesh base = read_mesh(base_path);
+    const TriangleMesh leaf = read_mesh(leaf_path);
+    return import_leaf_mesh(base, leaf, {}, leaf_path);
+}
+
+}  // namespace amc

@@ -1,0 +1,187 @@
+// Top-down reconstruction of the forest from the leaf mesh (docs/IMPORT.md, section 1).
+#include "import/leaf_reconstruction.h"
+
+#include "import/nearest_vertex.h"
+
+#include <cmath>
+#include <memory>
+
+#include <string>
+#include <vector>
+
+namespace amc {
+
+namespace {
+
+constexpr uint32_t kNone = 0xffffffffu;
+
+class Reconstruction {
+public:
+    Reconstruction(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base, const TriangleMesh& leaf,
+                   const LeafHalfedges& halfedges, const PositionIndex* exact, const std::string& what)
+        : h_(h), leaf_(leaf), he_(halfedges), exact_(exact), what_(what) {
+        leaf_of_vertex_.assign(h.positions().size(), kNone);
+        vertex_of_leaf_.assign(leaf.positions.size(), kNone);
+        for (VertexId v = 0; v < leaf_of_base.size(); ++v) assign(v, leaf_of_base[v]);
+    }
+
+    std::vector<uint32_t> run() {
+        std::vector<NodeId> level;
+        for (NodeId r = 0; r < h_.root_count(); ++r) level.push_back(r);
+        std::vector<NodeId> refined, next;
+        while (!level.empty()) {
+            refined.clear();
+            reveals_.clear();
+            for (NodeId n : level) {
+                if (classify(n)) refined.push_back(n);
+            }
+            for (NodeId n : refined) {
+                if (!h_.can_split(n)) fail_node(n, "is refined next to a coarser element (2:1 balance violated)");
+                h_.split(n);
+            }
+            leaf_of_vertex_.resize(h_.positions().size(), kNone);
+            for (const Reveal& r : reveals_) {
+                const NodeId q = h_.neighbor(r.node, r.edge);
+                if (q == kNoNode || h_.is_leaf(q))
+                    fail(std::string("vertex ") + std::to_string(r.leaf_vertex) +
+                         " lies on an edge whose other side is not refined (T-junction)");
+                const VertexId m = h_.midpoint(q, h_.neighbor_edge(r.node, r.edge));
+                if (leaf_of_vertex_[m] == kNone) {
+                    assign(m, r.leaf_vertex);
+                } else if (leaf_of_vertex_[m] != r.leaf_vertex) {
+                    fail("vertices " + std::to_string(leaf_of_vertex_[m]) + " and " + std::to_string(r.leaf_vertex) +
+                         " both split the edge (" + edge_text(q, h_.neighbor_edge(r.node, r.edge)) + ")");
+                }
+            }
+            next.clear();
+            for (NodeId n : refined) {
+                for (int e = 0; e < 3; ++e) {
+                    const VertexId m = h_.midpoint(n, e);
+                    if (leaf_of_vertex_[m] == kNone) assign(m, find_midpoint(n, e));
+                }
+                for (int k = 0; k < 4; ++k) next.push_back(h_.child(n, k));
+            }
+            level.swap(next);
+        }
+        return leaf_of_vertex_;
+    }
+
+private:
+    struct Reveal {
+        NodeId node;
+        int edge;
+        uint32_t leaf_vertex;
+    };
+
+    [[noreturn]] void fail(const std::string& message) const { throw Error(what_ + ": " + message); }
+
+    uint32_t corner(NodeId n, int i) const { return leaf_of_vertex_[h_.vertex(n, i)]; }
+
+    std::string edge_text(NodeId n, int e) const {
+        return std::to_string(corner(n, e)) + "," + std::to_string(corner(n, (e + 1) % 3));
+    }
+
+    [[noreturn]] void fail_node(NodeId n, const std::string& message) const {
+        fail("the element on vertices (" + std::to_string(corner(n, 0)) + ", " + std::to_string(corner(n, 1)) + ", " +
+             std::to_string(corner(n, 2)) + ") " + message);
+    }
+
+    void assign(VertexId v, uint32_t l) {
+        if (l == kNone) fail("internal: no leaf vertex for hierarchy vertex " + std::to_string(v));
+        if (vertex_of_leaf_[l] != kNone)
+            fail("vertex " + std::to_string(l) + " would be used twice by the refinement (not a red-green refinement)");
+        leaf_of_vertex_[v] = l;
+        vertex_of_leaf_[l] = v;
+    }
+
+    // Decides whether node n (all corners known) is refined. A leaf keeps at least one edge
+    // unsplit (closure), and that edge is then a leaf edge with n on its left; a refined node has
+    // none. For a leaf, checks its red or green triangles and notes the hanging nodes, which are
+    // the midpoints of the refined neighbours' edges.
+    bool classify(NodeId n) {
+        const uint32_t p[3] = {corner(n, 0), corner(n, 1), corner(n, 2)};
+        bool unsplit[3];
+        int count = 0;
+        for (int e = 0; e < 3; ++e) {
+            unsplit[e] = he_.face(p[e], p[(e + 1) % 3]) != LeafHalfedges::kNone;
+            count += unsplit[e];
+        }
+        if (count == 0) return true;
+        if (count == 3) {
+            if (he_.apex(p[0], p[1]) != p[2]) fail_node(n, "is not a face of the leaf mesh, nor split by it");
+        } else if (count == 2) {
+            const int e = !unsplit[0] ? 0 : !unsplit[1] ? 1 : 2;  // the split edge
+            const uint32_t m = he_.apex(p[(e + 1) % 3], p[(e + 2) % 3]);
+            if (m == kNone || he_.apex(p[(e + 2) % 3], p[e]) != m)
+                fail_node(n, "has one split edge but no bisection (" + edge_text(n, (e + 1) % 3) + ")");
+            reveals_.push_back({n, e, m});
+        } else {
+            const int u = unsplit[0] ? 0 : unsplit[1] ? 1 : 2;  // the unsplit edge
+            const uint32_t a = p[u], b = p[(u + 1) % 3], c = p[(u + 2) % 3];
+            const uint32_t w = he_.apex(a, b);
+            // Default diagonal m_{u+1}--v_u: (a, b, m1), (a, m1, m2), (m2, m1, c).
+            const uint32_t x = he_.apex(a, w);
+            const bool as_default = x != kNone && he_.apex(x, w) == c;
+            // Flipped diagonal m_{u+2}--v_{u+1}: (a, b, m2), (b, m1, m2), (m2, m1, c).
+            const uint32_t y = he_.apex(w, b);
+            const bool as_flipped = !as_default && y != kNone && he_.apex(w, y) == c;
+            if (as_default) {
+                reveals_.push_back({n, (u + 1) % 3, w});
+                reveals_.push_back({n, (u + 2) % 3, x});
+            } else if (as_flipped) {
+                reveals_.push_back({n, (u + 1) % 3, y});
+                reveals_.push_back({n, (u + 2) % 3, w});
+                h_.set_diagonal_flipped(n, true);
+            } else {
+                fail_node(n, "has two split edges but no green closure on edge (" + edge_text(n, u) + ")");
+            }
+        }
+        return false;
+    }
+
+    // The leaf vertex that splits edge e of refined node n, which no green neighbour revealed.
+    uint32_t find_midpoint(NodeId n, int e) {
+        const uint32_t a = corner(n, e), b = corner(n, (e + 1) % 3);
+        if (exact_ != nullptr) {
+            Vec3 m = 0.5 * (leaf_.positions[a] + leaf_.positions[b]);
+            if (leaf_.single_precision) m = {double(float(m.x)), double(float(m.y)), double(float(m.z))};
+            const uint32_t found = exact_->find(m);
+            if (found == kNone) fail("no vertex at the midpoint of edge (" + edge_text(n, e) + ")");
+            return found;
+        }
+        if (!nearest_) {
+            double total = 0;
+            for (const Triangle& t : leaf_.triangles) {
+                const Vec3 d = leaf_.positions[t[0]] - leaf_.positions[t[1]];
+                total += std::sqrt(dot(d, d));
+            }
+            nearest_ = std::make_unique<NearestVertex>(leaf_.positions, total / double(leaf_.triangles.size()));
+        }
+        // Where the vertex would be without any displacement: the midpoint subdivision of the
+        // base, which the hierarchy's default placer has computed.
+        const Vec3 m = h_.position(h_.midpoint(n, e));
+        const uint32_t found = nearest_->find(m, [&](uint32_t v) { return vertex_of_leaf_[v] == kNone; });
+        if (found == kNone) fail("no vertex left to split the edge (" + edge_text(n, e) + ")");
+        return found;
+    }
+
+    Hierarchy& h_;
+    const TriangleMesh& leaf_;
+    const LeafHalfedges& he_;
+    const PositionIndex* exact_;
+    const std::string& what_;
+    std::vector<uint32_t> leaf_of_vertex_;
+    std::vector<uint32_t> vertex_of_leaf_;
+    std::vector<Reveal> reveals_;
+    std::unique_ptr<NearestVertex> nearest_;
+};
+
+}  // namespace
+
+std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
+                                            const TriangleMesh& leaf, const LeafHalfedges& halfedges,
+                                            const PositionIndex* exact_midpoints, const std::string& what) {
+    return Reconstruction(h, leaf_of_base, leaf, halfedges, exact_midpoints, what).run();
+}
+
+}  // namespace amc

@@ -1,0 +1,25 @@
+// The reconstruction of a hierarchy from its leaf mesh (docs/IMPORT.md, section 1): top-down over
+// the forest, level by level.
+#pragma once
+
+#include <amc/hierarchy.h>
+
+#include "import/leaf_halfedges.h"
+#include "import/position_index.h"
+
+#include <string>
+#include <vector>
+
+namespace amc {
+
+// Builds the forest of `h` (a hierarchy of unrefined roots over the base, whose vertex i is leaf
+// vertex leaf_of_base[i]) so that its leaf mesh is `leaf`; returns the leaf vertex of every
+// vertex of `h` (0xffffffff for none). With `exact_midpoints`, the vertex an edge split creates is
+// looked up at the edge's midpoint (the fast path for unmoved meshes); without, it is found from
+// the connectivity alone. Throws Error when the leaf mesh does not fit; the caller verifies the
+// whole leaf mesh afterwards.
+std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
+                                            const TriangleMesh& leaf, const LeafHalfedges& halfedges,
+                                            const PositionIndex* exact_midpoints, const std::string& what);
+
+}  // namespace amc

@@ -1,0 +1,60 @@
+// Exact lookup of vertices by position (bit patterns of the three coordinates): matching base
+// vertices to leaf vertices, finding duplicate vertices, and the exact-midpoint fast path.
+#pragma once
+
+#include <amc/mesh.h>
+
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+namespace amc {
+
+class PositionIndex {
+public:
+    static constexpr uint32_t kNone = 0xffffffffu;
+
+    // Indexes every position; `duplicate_of` receives, when not null, the first pair (earlier,
+    // later) of vertices with the same position, or {kNone, kNone}.
+    explicit PositionIndex(const std::vector<Vec3>& positions, uint32_t* first_duplicate = nullptr,
+                           uint32_t* second_duplicate = nullptr)
+        : positions_(positions) {
+        size_t capacity = 16;
+        while (capacity < 2 * positions.size()) capacity *= 2;
+        slots_.assign(capacity, kNone);
+        if (first_duplicate != nullptr) *first_duplicate = *second_duplicate = kNone;
+        for (uint32_t v = 0; v < positions.size(); ++v) {
+            size_t s = slot_of(positions[v]);
+            while (slots_[s] != kNone && !same(positions[slots_[s]], positions[v])) s = (s + 1) & (slots_.size() - 1);
+            if (slots_[s] == kNone) {
+                slots_[s] = v;
+            } else if (first_duplicate != nullptr && *first_duplicate == kNone) {
+                *first_duplicate = slots_[s];
+                *second_duplicate = v;
+            }
+        }
+    }
+
+    // The first vertex at exactly p, or kNone.
+    uint32_t find(Vec3 p) const {
+        for (size_t s = slot_of(p);; s = (s + 1) & (slots_.size() - 1)) {
+            if (slots_[s] == kNone) return kNone;
+            if (same(positions_[slots_[s]], p)) return slots_[s];
+        }
+    }
+
+private:
+    static bool same(Vec3 a, Vec3 b) { return std::memcmp(&a, &b, sizeof(Vec3)) == 0; }
+    size_t slot_of(Vec3 p) const {
+        uint64_t bits[3];
+        std::memcpy(bits, &p, sizeof bits);
+        uint64_t h = bits[0] * 0x9e3779b97f4a7c15ull;
+        h = (h ^ (h >> 29) ^ bits[1]) * 0xbf58476d1ce4e5b9ull;
+        h = (h ^ (h >> 31) ^ bits[2]) * 0x94d049bb133111ebull;
+        return size_t(h ^ (h >> 32)) & (slots_.size() - 1);
+    }
+    const std::vector<Vec3>& positions_;
+    std::vector<uint32_t> slots_;
+};
+
+}  // namespace amc

@@ -1,0 +1,142 @@
+// Uniform refinement read off the connectivity: straight lines through degree-6 vertices and the
+// triangular grid of each base triangle (docs/IMPORT.md, "uniform refinement").
+#include "import/uniform_lattice.h"
+
+#include <utility>
+#include <vector>
+
+namespace amc {
+
+namespace {
+
+constexpr uint32_t kNone = 0xffffffffu;
+
+// The vertex after `p` on the straight line coming from `previous`: three faces clockwise around
+// p, the line having the faces of its left side on the left. In a uniform refinement every leaf
+// triangle is red, so this is exact, inside and along the boundary.
+uint32_t straight_on(const LeafHalfedges& he, uint32_t previous, uint32_t p) {
+    uint32_t w = previous;
+    for (int k = 0; k < 3 && w != kNone; ++k) w = he.apex(w, p);
+    return w;
+}
+
+// Walks `steps` leaf edges from a through x; the vertex reached, or kNone.
+uint32_t walk(const LeafHalfedges& he, uint32_t a, uint32_t x, uint32_t steps) {
+    uint32_t previous = a, p = x;
+    for (uint32_t s = 1; s < steps && p != kNone; ++s) {
+        const uint32_t next = straight_on(he, previous, p);
+        previous = p;
+        p = next;
+    }
+    return p;
+}
+
+}  // namespace
+
+std::vector<uint32_t> reconstruct_uniform(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
+                                          const TriangleMesh& leaf, const LeafHalfedges& he) {
+    const uint32_t f0 = h.root_count();
+    int depth = 0;
+    for (uint64_t f = f0; f < leaf.triangles.size(); f *= 4) ++depth;
+    if ((uint64_t(f0) << (2 * depth)) != leaf.triangles.size() || depth == 0 || depth > 15) return {};
+    const uint32_t n = 1u << depth;
+    std::vector<uint8_t> is_base(leaf.positions.size(), 0);
+    for (uint32_t l : leaf_of_base) is_base[l] = 1;
+
+    // The first leaf vertex on root t's edge c (from corner c toward corner c + 1).
+    std::vector<uint32_t> ray(3 * size_t(f0), kNone);
+    for (NodeId t = 0; t < f0; ++t) {
+        for (int c = 0; c < 3; ++c) {
+            if (ray[3 * t + c] != kNone) continue;
+            // Find the direction toward corner c + 1 by walking from each neighbour of corner c;
+            // then turn around the corner: one leaf face per base triangle.
+            const uint32_t a = leaf_of_base[h.vertex(t, c)];
+            const uint32_t b = leaf_of_base[h.vertex(t, (c + 1) % 3)];
+            uint32_t x = kNone;
+            for (uint32_t i = 0; i < he.degree(a) && x == kNone; ++i) {
+                const uint32_t candidate = he.out_vertex(a, i);
+                if (walk(he, a, candidate, n) == b) x = candidate;
+            }
+            if (x == kNone) return {};
+            NodeId r = t;
+            int corner = c;
+            for (uint32_t turns = 0; turns < he.degree(a) + 1 && ray[3 * r + corner] == kNone; ++turns) {
+                ray[3 * r + corner] = x;  // CCW: the next triangle around a holds the edge a -> corner + 2
+                const int e = (corner + 2) % 3;
+                const NodeId next = h.neighbor(r, e);
+                if (next == kNoNode) break;
+                corner = h.neighbor_edge(r, e);
+                r = next;
+                x = he.apex(a, x);
+                if (x == kNone) return {};
+            }
+        }
+    }
+
+    // Each root's grid P(i, j), i + j <= n: row 0 is its edge 0, row j + 1 the apexes of the
+    // upward triangles (P(i, j), P(i + 1, j), P(i, j + 1)).
+    const size_t grid_size = size_t(n + 1) * (n + 2) / 2;
+    auto row_start = [n](uint32_t j) { return size_t(j) * (n + 1) - size_t(j) * (j - 1) / 2; };
+    std::vector<uint32_t> grid(grid_size * f0, kNone);
+    for (NodeId t = 0; t < f0; ++t) {
+        uint32_t* g = grid.data() + grid_size * t;
+        g[0] = leaf_of_base[h.vertex(t, 0)];
+        g[1] = ray[3 * t];
+        for (uint32_t i = 1; i < n; ++i) {
+            g[i + 1] = straight_on(he, g[i - 1], g[i]);
+            if (g[i + 1] == kNone || (is_base[g[i]])) return {};
+        }
+        if (g[n] != leaf_of_base[h.vertex(t, 1)]) return {};
+        for (uint32_t j = 0; j < n; ++j) {
+            const uint32_t* row = g + row_start(j);
+            uint32_t* above = g + row_start(j + 1);
+            for (uint32_t i = 0; i + j < n; ++i) {
+                above[i] = he.apex(row[i], row[i + 1]);
+                if (above[i] == kNone) return {};
+            }
+        }
+        if (g[row_start(n)] != leaf_of_base[h.vertex(t, 2)]) return {};
+    }
+
+    for (int level = 0; level < depth; ++level) {
+        for (NodeId node : h.leaves()) h.split(node);
+    }
+    std::vector<uint32_t> leaf_of_vertex(h.positions().size(), kNone);
+    for (VertexId v = 0; v < leaf_of_base.size(); ++v) leaf_of_vertex[v] = leaf_of_base[v];
+    struct Item {
+        NodeId node;
+        uint32_t i[3], j[3];  // grid coordinates of the corners
+    };
+    std::vector<Item> stack;
+    for (NodeId t = 0; t < f0; ++t) {
+        const uint32_t* g = grid.data() + grid_size * t;
+        stack.push_back({t, {0, n, 0}, {0, 0, n}});
+        while (!stack.empty()) {
+            const Item item = stack.back();
+            stack.pop_back();
+            for (int c = 0; c < 3; ++c) {
+                const uint32_t l = g[row_start(item.j[c]) + item.i[c]];
+                uint32_t& known = leaf_of_vertex[h.vertex(item.node, c)];
+                if (known == kNone) {
+                    known = l;
+                } else if (known != l) {
+                    return {};  // two grids disagree along a shared edge
+                }
+            }
+            if (h.is_leaf(item.node)) continue;
+            uint32_t mi[3], mj[3];
+            for (int e = 0; e < 3; ++e) {
+                mi[e] = (item.i[e] + item.i[(e + 1) % 3]) / 2;
+                mj[e] = (item.j[e] + item.j[(e + 1) % 3]) / 2;
+            }
+            const NodeId c0 = h.child(item.node, 0);
+            stack.push_back({c0, {item.i[0], mi[0], mi[2]}, {item.j[0], mj[0], mj[2]}});
+            stack.push_back({c0 + 1, {mi[0], item.i[1], mi[1]}, {mj[0], item.j[1], mj[1]}});
+            stack.push_back({c0 + 2, {mi[2], mi[1], item.i[2]}, {mj[2], mj[1], item.j[2]}});
+            stack.push_back({c0 + 3, {mi[1], mi[2], mi[0]}, {mj[1], mj[2], mj[0]}});
+        }
+    }
+    return leaf_of_vertex;
+}
+
+}  // namespace amc
