@@ -2,10 +2,15 @@
 // known answers, and every kind of bad input refused with a message naming the culprit.
 #include "hierarchy_checks.h"
 
+#include <amc/codec.h>
 #include <amc/import.h>
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <iostream>
 #include <numeric>
+#include <set>
 
 namespace amc {
 namespace {
@@ -128,6 +133,306 @@ TEST(ImportLeafMesh, MovedVerticesRoundTrip) {
             EXPECT_TRUE(imports_back(h, user, true)) << fixture.name << " seed " << seed;
         }
     }
+}
+
+TEST(ImportLeafMesh, FiniteElementModelsRoundTrip) {
+    std::vector<Hierarchy> models;
+    models.push_back(make_l_shape_model(7));
+    for (Hierarchy& h : make_moving_front_sequence(3, 7)) models.push_back(std::move(h));
+    for (size_t i = 0; i < models.size(); ++i) {
+        for (Placement placement : {Placement::midpoints, Placement::moved}) {
+            const UserLeafMesh user = user_leaf_mesh(models[i], 40 + i, placement);
+            EXPECT_TRUE(imports_back(models[i], user, true)) << "model " << i;
+            EXPECT_TRUE(imports_back(models[i], user, false)) << "model " << i;
+        }
+    }
+}
+
+// Uniform refinements are read off the connectivity alone: positions anywhere.
+TEST(ImportLeafMesh, UniformRefinementsWithScatteredVerticesRoundTrip) {
+    for (const auto& fixture : testing::fixture_meshes()) {
+        for (int levels = 1; levels <= 3; ++levels) {
+            Hierarchy h(fixture.mesh);
+            refine_uniformly(h, levels);
+            const UserLeafMesh user = user_leaf_mesh(h, uint64_t(levels), Placement::scattered);
+            EXPECT_TRUE(imports_back(h, user, true)) << fixture.name << " levels " << levels;
+            EXPECT_TRUE(imports_back(h, user, false)) << fixture.name << " levels " << levels;
+        }
+    }
+}
+
+// ---- bad input: every kind refused with an error naming the culprit ----------------------------
+
+// The message of the Error that importing throws, or "" when it succeeds.
+std::string import_error(const TriangleMesh& base, const TriangleMesh& leaf, const std::vector<uint32_t>& map = {}) {
+    try {
+        import_leaf_mesh(base, leaf, map, "input.obj");
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "";
+}
+
+struct BadInputFixture {
+    Hierarchy h = random_hierarchy(make_square(3), 300, 5, 11, true, false);
+    UserLeafMesh user = user_leaf_mesh(h, 5, Placement::moved);
+    // The faces of leaf n in user numbering.
+    std::vector<Triangle> faces_of(NodeId n) const {
+        const LeafMesh leaf = extract_leaf_mesh(h);
+        std::vector<Triangle> out;
+        for (size_t i = 0; i < leaf.source.size(); ++i) {
+            if (leaf.source[i] != n) continue;
+            const Triangle& t = leaf.mesh.triangles[i];
+            out.push_back({user.user_of_canonical[t[0]], user.user_of_canonical[t[1]], user.user_of_canonical[t[2]]});
+        }
+        return out;
+    }
+    uint32_t user_vertex(VertexId v) const { return user.user_of_canonical[canonical_vertex_order(h)[v]]; }
+    // Removes the faces equal (up to rotation) to any of `faces`.
+    void remove(const std::vector<Triangle>& faces) {
+        auto same = [](const Triangle& a, const Triangle& b) {
+            for (int r = 0; r < 3; ++r) {
+                if (a[0] == b[r] && a[1] == b[(r + 1) % 3] && a[2] == b[(r + 2) % 3]) return true;
+            }
+            return false;
+        };
+        auto& tris = user.mesh.triangles;
+        tris.erase(std::remove_if(tris.begin(), tris.end(),
+                                  [&](const Triangle& t) {
+                                      for (const Triangle& f : faces) {
+                                          if (same(t, f)) return true;
+                                      }
+                                      return false;
+                                  }),
+                   tris.end());
+    }
+    std::string error() const { return import_error(h.base(), user.mesh); }
+};
+
+TEST(ImportLeafMesh, FixtureImports) {
+    BadInputFixture f;
+    EXPECT_EQ(f.error(), "");
+}
+
+TEST(ImportLeafMesh, RefusesMissingFace) {
+    BadInputFixture f;
+    f.user.mesh.triangles.erase(f.user.mesh.triangles.begin() + 17);
+    const std::string message = f.error();
+    EXPECT_NE(message.find("missing face"), std::string::npos) << message;
+}
+
+TEST(ImportLeafMesh, RefusesExtraFace) {
+    BadInputFixture f;
+    // A triangle hung on a boundary edge of the open square: a vertex outside, one more face.
+    std::set<std::pair<uint32_t, uint32_t>> directed;
+    for (const Triangle& t : f.user.mesh.triangles) {
+        for (int e = 0; e < 3; ++e) directed.insert({t[e], t[(e + 1) % 3]});
+    }
+    uint32_t a = 0, b = 0;
+    for (const auto& [u, v] : directed) {
+        if (!directed.count({v, u})) {
+            a = u, b = v;
+            break;
+        }
+    }
+    f.user.mesh.positions.push_back({2.0, 2.0, 1.0});
+    f.user.mesh.triangles.push_back({b, a, uint32_t(f.user.mesh.positions.size() - 1)});
+    const std::string message = f.error();
+    EXPECT_NE(message.find("face " + std::to_string(f.user.mesh.triangles.size() - 1)), std::string::npos) << message;
+}
+
+TEST(ImportLeafMesh, RefusesTJunction) {
+    BadInputFixture f;
+    // A green bisection replaced by its unsplit triangle: the hanging vertex is left on an edge.
+    NodeId green = kNoNode;
+    for (NodeId n : f.h.leaves()) {
+        if (f.h.hanging_node_count(n) == 1) green = n;
+    }
+    ASSERT_NE(green, kNoNode);
+    f.remove(f.faces_of(green));
+    f.user.mesh.triangles.push_back({f.user_vertex(f.h.vertex(green, 0)), f.user_vertex(f.h.vertex(green, 1)),
+                                     f.user_vertex(f.h.vertex(green, 2))});
+    const std::string message = f.error();
+    EXPECT_NE(message.find("T-junction"), std::string::npos) << message;
+}
+
+TEST(ImportLeafMesh, RefusesFlippedFace) {
+    BadInputFixture f;
+    std::swap(f.user.mesh.triangles[5][0], f.user.mesh.triangles[5][1]);
+    const std::string message = f.error();
+    EXPECT_NE(message.find("orientation"), std::string::npos) << message;
+}
+
+TEST(ImportLeafMesh, RefusesWrongBase) {
+    BadInputFixture f;
+    TriangleMesh moved = f.h.base();
+    moved.positions[3].x += 0.01;
+    std::string message = import_error(moved, f.user.mesh);
+    EXPECT_NE(message.find("base vertex 3"), std::string::npos) << message;
+    // Every base vertex present, but the base triangles cut the square along the other diagonals.
+    TriangleMesh other = f.h.base();
+    Triangle& p = other.triangles[0];
+    Triangle& q = other.triangles[1];
+    const uint32_t a = p[0], b = p[1], c = p[2], d = q[2];  // (a, b, c), (a, c, d) -> (a, b, d), (b, c, d)
+    p = {a, b, d};
+    q = {b, c, d};
+    message = import_error(other, f.user.mesh);
+    EXPECT_NE(message.find("input.obj: "), std::string::npos) << message;
+    std::cout << message << "\n";
+}
+
+TEST(ImportLeafMesh, RefusesNonManifoldLeafMesh) {
+    BadInputFixture f;
+    const Triangle t = f.user.mesh.triangles[0];
+    f.user.mesh.positions.push_back({0.5, 0.5, 1.0});
+    f.user.mesh.triangles.push_back({t[0], t[1], uint32_t(f.user.mesh.positions.size() - 1)});
+    const std::string message = f.error();
+    EXPECT_NE(message.find("non-manifold"), std::string::npos) << message;
+}
+
+TEST(ImportLeafMesh, RefusesDuplicateVertex) {
+    BadInputFixture f;
+    const uint32_t v = f.user.mesh.triangles[0][0];
+    f.user.mesh.positions.push_back(f.user.mesh.positions[v]);
+    f.user.mesh.triangles[0][0] = uint32_t(f.user.mesh.positions.size() - 1);
+    const std::string message = f.error();
+    EXPECT_NE(message.find("duplicate vertex"), std::string::npos) << message;
+    EXPECT_NE(message.find(std::to_string(v)), std::string::npos) << message;
+}
+
+TEST(ImportLeafMesh, RefusesUnusedVertex) {
+    BadInputFixture f;
+    f.user.mesh.positions.push_back({5, 5, 5});
+    const std::string message = f.error();
+    EXPECT_NE(message.find("vertex " + std::to_string(f.user.mesh.positions.size() - 1)), std::string::npos)
+        << message;
+}
+
+TEST(ImportLeafMesh, RefusesUnbalancedRefinement) {
+    // The square's lower triangle split, and its child at the shared diagonal split again while the
+    // upper triangle stays whole; the upper one closed by a fan over the three vertices on the
+    // diagonal. Conforming, but two levels meet across the diagonal.
+    Hierarchy h(make_square(1));
+    h.split(0);
+    const NodeId child = h.child(0, 0);
+    ASSERT_FALSE(h.can_split(child));
+    h.split(child);  // what refine() would not do
+    LeafMesh leaf = extract_leaf_mesh(h);
+    const std::vector<uint32_t> canonical = canonical_vertex_order(h);
+    std::vector<Triangle> faces;
+    for (size_t i = 0; i < leaf.source.size(); ++i) {
+        if (leaf.source[i] != 1) faces.push_back(leaf.mesh.triangles[i]);
+    }
+    // Root 1 is (a, c, d); the diagonal a -> c carries x (level 2) and m (level 1).
+    const uint32_t a = canonical[h.vertex(1, 0)], c = canonical[h.vertex(1, 1)], d = canonical[h.vertex(1, 2)];
+    const uint32_t m = canonical[h.midpoint(0, 2)];
+    const uint32_t x = canonical[h.midpoint(child, 2)];
+    faces.push_back({a, x, d});
+    faces.push_back({x, m, d});
+    faces.push_back({m, c, d});
+    leaf.mesh.triangles = faces;
+    const std::string message = import_error(h.base(), leaf.mesh);
+    EXPECT_NE(message.find("2:1 balance"), std::string::npos) << message;
+}
+
+TEST(ImportLeafMesh, RefusesGreenClosureOfThreeHangingNodes) {
+    // A node split red whose three neighbours are refined too: its four red triangles replaced by
+    // a fan from one edge's vertex over the hexagon, a green closure of three hanging nodes.
+    Hierarchy h = random_hierarchy(make_icosahedron(), 400, 4, 3, false, false);
+    NodeId target = kNoNode;
+    for (NodeId n : h.breadth_first_order()) {
+        if (h.is_leaf(n)) continue;
+        bool ok = true;
+        for (int k = 0; k < 4; ++k) ok = ok && h.is_leaf(h.child(n, k)) && h.hanging_node_count(h.child(n, k)) == 0;
+        for (int e = 0; e < 3; ++e) ok = ok && h.neighbor(n, e) != kNoNode && !h.is_leaf(h.neighbor(n, e));
+        if (ok) {
+            target = n;
+            break;
+        }
+    }
+    ASSERT_NE(target, kNoNode);
+    LeafMesh leaf = extract_leaf_mesh(h);
+    const std::vector<uint32_t> canonical = canonical_vertex_order(h);
+    std::vector<Triangle> faces;
+    for (size_t i = 0; i < leaf.source.size(); ++i) {
+        if (h.parent(leaf.source[i]) != target) faces.push_back(leaf.mesh.triangles[i]);
+    }
+    uint32_t v[3], m[3];
+    for (int i = 0; i < 3; ++i) {
+        v[i] = canonical[h.vertex(target, i)];
+        m[i] = canonical[h.midpoint(target, i)];
+    }
+    faces.push_back({m[1], v[2], m[2]});
+    faces.push_back({m[1], m[2], v[0]});
+    faces.push_back({m[1], v[0], m[0]});
+    faces.push_back({m[1], m[0], v[1]});
+    leaf.mesh.triangles = faces;
+    const std::string message = import_error(h.base(), leaf.mesh);
+    EXPECT_NE(message.find("three hanging nodes"), std::string::npos) << message;
+}
+
+TEST(ImportLeafMesh, RefusesQuadsInTheFile) {
+    const std::string dir = ::testing::TempDir();
+    write_mesh(dir + "/import_base.obj", make_square(1));
+    try {
+        import_leaf_mesh_files(dir + "/import_base.obj", std::string(AMC_TEST_DATA_DIR) + "/bad/obj_quad.obj");
+        FAIL() << "a quad was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("has 4 vertices; only triangle meshes"), std::string::npos) << e.what();
+    }
+}
+
+// ---- the semi-regular meshes of ../shared/data ----------------------------------------------
+
+// A leaf mesh with vertices and faces shuffled and faces rotated (positions unchanged).
+TriangleMesh shuffled(const TriangleMesh& mesh, uint64_t seed, std::vector<uint32_t>* new_index) {
+    Random random{seed};
+    std::vector<uint32_t> order(mesh.positions.size());
+    std::iota(order.begin(), order.end(), 0u);
+    for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[random.next() % i]);
+    TriangleMesh out;
+    out.single_precision = mesh.single_precision;
+    out.positions.resize(mesh.positions.size());
+    for (size_t v = 0; v < order.size(); ++v) out.positions[order[v]] = mesh.positions[v];
+    out.triangles = mesh.triangles;
+    for (size_t i = out.triangles.size(); i > 1; --i) std::swap(out.triangles[i - 1], out.triangles[random.next() % i]);
+    for (Triangle& t : out.triangles) {
+        const int r = int(random.next() % 3);
+        t = {order[t[r]], order[t[(r + 1) % 3]], order[t[(r + 2) % 3]]};
+    }
+    if (new_index != nullptr) *new_index = order;
+    return out;
+}
+
+void expect_semi_regular(const std::string& base_name, const std::string& leaf_name, int levels) {
+    const std::string dir = AMC_SHARED_DATA_DIR;
+    if (!std::ifstream(dir + "/" + leaf_name).good()) GTEST_SKIP() << "shared data not found (" << dir << ")";
+    const TriangleMesh base = read_mesh(dir + "/" + base_name);
+    const TriangleMesh leaf = read_mesh(dir + "/" + leaf_name);
+    for (uint64_t seed : {0u, 1u, 2u}) {
+        std::vector<uint32_t> new_index;
+        const TriangleMesh input = seed == 0 ? leaf : shuffled(leaf, seed, &new_index);
+        const ImportedHierarchy imported = import_leaf_mesh(base, input);
+        const Hierarchy& h = imported.hierarchy;
+        const HierarchyStats stats = compute_stats(h);
+        // The uniform forest: every node of the first `levels` levels refined, every leaf red.
+        EXPECT_EQ(stats.levels, uint32_t(levels + 1)) << leaf_name;
+        EXPECT_EQ(stats.leaves, uint32_t(base.triangles.size()) << (2 * levels)) << leaf_name;
+        EXPECT_EQ(stats.green_faces, 0u) << leaf_name;
+        // The decoded leaf mesh is the input: every hierarchy vertex at its input position, and
+        // the file's bytes decode to the same hierarchy.
+        for (size_t i = 0; i < input.positions.size(); ++i) {
+            ASSERT_TRUE(h.position(imported.vertex_of_input[i]) == input.positions[i]) << leaf_name << " vertex " << i;
+        }
+        const std::vector<uint8_t> file = encode(h);
+        EXPECT_TRUE(identical(decode(file.data(), file.size()), in_decoder_order(h))) << leaf_name;
+    }
+}
+
+TEST(ImportLeafMeshSharedData, BunnySemiRegularLevel3OverLevel0) { expect_semi_regular("bunny-sr-l0.obj", "bunny-sr-l3.obj", 3); }
+
+TEST(ImportLeafMeshSharedData, ElephantSemiRegularLevel2OverLevel0) {
+    expect_semi_regular("elephant-sr-l0.obj", "elephant-sr-l2.obj", 2);
 }
 
 }  // namespace

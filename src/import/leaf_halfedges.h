@@ -5,6 +5,7 @@
 #include <amc/mesh.h>
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace amc {
@@ -43,7 +44,7 @@ private:
         return nullptr;
     }
     std::vector<uint32_t> start_;
-    std::vector<Entry> entries_;
+    std::unique_ptr<Entry[]> entries_;  // 3 per face, grouped by start vertex; filled, never zeroed
 };
 
 }  // namespace amc

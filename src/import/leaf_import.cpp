@@ -8,6 +8,8 @@
 #include "import/position_index.h"
 #include "import/uniform_lattice.h"
 
+#include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -85,7 +87,17 @@ void verify_leaf_mesh(const Hierarchy& h, const std::vector<uint32_t>& leaf_of_v
 ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh& leaf,
                                    const std::vector<uint32_t>& leaf_vertex_of_base, const std::string& what) {
     validate_triangle_mesh(base, what + " (base mesh)");
-    validate_triangle_mesh(leaf, what);
+    // The leaf mesh is checked in full only when it does not import: a reconstruction whose
+    // extracted leaf mesh equals it proves it a valid mesh. What the reconstruction relies on
+    // first: faces, indices in range, finite coordinates.
+    if (leaf.triangles.empty() || leaf.triangles.size() > UINT32_MAX / 4) validate_triangle_mesh(leaf, what);
+    for (const Triangle& t : leaf.triangles) {
+        if (t[0] >= leaf.positions.size() || t[1] >= leaf.positions.size() || t[2] >= leaf.positions.size())
+            validate_triangle_mesh(leaf, what);
+    }
+    for (const Vec3& p : leaf.positions) {
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) validate_triangle_mesh(leaf, what);
+    }
     uint32_t first = kNone, second = kNone;
     const PositionIndex leaf_positions(leaf.positions, &first, &second);
     if (first != kNone)
@@ -103,30 +115,41 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     const LeafHalfedges halfedges(leaf);
     ImportedHierarchy out;
     std::vector<uint32_t> leaf_of_vertex;
-    // Three ways in, cheapest first; each result is checked against the whole leaf mesh.
-    // 1. New vertices at edge midpoints (as amcodec writes them): found by position.
-    // 2. A uniform refinement (semi-regular remeshes): read off the connectivity as grids.
-    // 3. The general reconstruction from the connectivity.
+    // Four ways in, cheapest first; the first whose result is exactly the leaf mesh wins.
+    //  1. new vertices at edge midpoints (as amcodec writes them): found by position;
+    //  2. a uniform refinement (semi-regular remeshes): read off the connectivity as grids;
+    //  3. the general reconstruction, guided by midpoint subdivision of the base;
+    //  4. the same, guided by the surface: meshes whose new vertices were projected onto it.
     auto attempt = [&](int way) {
         out.hierarchy = Hierarchy(hierarchy_base);
+        // A leaf mesh of F faces comes from at most F leaves, so from at most 4F/3 + roots nodes.
+        out.hierarchy.reserve(leaf.triangles.size() * 4 / 3 + base.triangles.size() + 4, leaf.positions.size());
         if (way == 2) {
             leaf_of_vertex = reconstruct_uniform(out.hierarchy, leaf_of_base, leaf, halfedges);
             if (leaf_of_vertex.empty()) throw Error(what + ": not a uniform refinement");
         } else {
-            leaf_of_vertex = reconstruct_hierarchy(out.hierarchy, leaf_of_base, leaf, halfedges,
-                                                   way == 1 ? &leaf_positions : nullptr, what);
+            const MidpointGuide guide = way == 1   ? MidpointGuide::exact
+                                        : way == 3 ? MidpointGuide::subdivision
+                                                   : MidpointGuide::surface;
+            leaf_of_vertex = reconstruct_hierarchy(out.hierarchy, leaf_of_base, leaf, halfedges, guide,
+                                                   leaf_positions, what);
         }
         verify_leaf_mesh(out.hierarchy, leaf_of_vertex, leaf, halfedges, what);
     };
+    std::string first_error;
     bool done = false;
-    for (int way = 1; way <= 2 && !done; ++way) {
+    for (int way = 1; way <= 4 && !done; ++way) {
         try {
             attempt(way);
             done = true;
-        } catch (const Error&) {
+        } catch (const Error& e) {
+            if (way == 3) first_error = e.what();
         }
     }
-    if (!done) attempt(3);
+    if (!done) {
+        validate_triangle_mesh(leaf, what);  // a structural fault has the clearer message
+        throw Error(first_error);
+    }
 
     out.vertex_of_input.assign(leaf.positions.size(), kNone);
     for (VertexId v = 0; v < leaf_of_vertex.size(); ++v) {
@@ -134,6 +157,9 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
         if (l == kNone) continue;
         out.vertex_of_input[l] = v;
         out.hierarchy.set_position(v, leaf.positions[l]);
+    }
+    for (uint32_t l = 0; l < leaf.positions.size(); ++l) {
+        if (out.vertex_of_input[l] == kNone) validate_triangle_mesh(leaf, what);  // an unused vertex
     }
     return out;
 }

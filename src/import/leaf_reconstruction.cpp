@@ -1,6 +1,7 @@
 // Top-down reconstruction of the forest from the leaf mesh (docs/IMPORT.md, section 1).
 #include "import/leaf_reconstruction.h"
 
+#include "geometry/closest_point.h"
 #include "import/nearest_vertex.h"
 
 #include <cmath>
@@ -18,8 +19,9 @@ constexpr uint32_t kNone = 0xffffffffu;
 class Reconstruction {
 public:
     Reconstruction(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base, const TriangleMesh& leaf,
-                   const LeafHalfedges& halfedges, const PositionIndex* exact, const std::string& what)
-        : h_(h), leaf_(leaf), he_(halfedges), exact_(exact), what_(what) {
+                   const LeafHalfedges& halfedges, MidpointGuide guide, const PositionIndex& positions,
+                   const std::string& what)
+        : h_(h), leaf_(leaf), he_(halfedges), guide_(guide), positions_(positions), what_(what) {
         leaf_of_vertex_.assign(h.positions().size(), kNone);
         vertex_of_leaf_.assign(leaf.positions.size(), kNone);
         for (VertexId v = 0; v < leaf_of_base.size(); ++v) assign(v, leaf_of_base[v]);
@@ -32,6 +34,7 @@ public:
         while (!level.empty()) {
             refined.clear();
             reveals_.clear();
+            unsplit_edges_.clear();
             for (NodeId n : level) {
                 if (classify(n)) refined.push_back(n);
             }
@@ -39,9 +42,19 @@ public:
                 if (!h_.can_split(n)) fail_node(n, "is refined next to a coarser element (2:1 balance violated)");
                 h_.split(n);
             }
+            // A leaf edge across which the same-level neighbour is refined: the neighbour's
+            // vertex on it is not closed on this side.
+            for (const UnsplitEdge& u : unsplit_edges_) {
+                const NodeId q = h_.neighbor(u.node, u.edge);
+                if (q != kNoNode && !h_.is_leaf(q))
+                    fail("face " + std::to_string(he_.face(corner(u.node, u.edge), corner(u.node, (u.edge + 1) % 3))) +
+                         " has the edge (" + edge_text(u.node, u.edge) +
+                         ") whole, but the element across splits it (T-junction)");
+            }
             leaf_of_vertex_.resize(h_.positions().size(), kNone);
             for (const Reveal& r : reveals_) {
                 const NodeId q = h_.neighbor(r.node, r.edge);
+                if (q == kNoNode || h_.is_leaf(q)) explain_misfit(r.node);
                 if (q == kNoNode || h_.is_leaf(q))
                     fail(std::string("vertex ") + std::to_string(r.leaf_vertex) +
                          " lies on an edge whose other side is not refined (T-junction)");
@@ -67,6 +80,10 @@ public:
     }
 
 private:
+    struct UnsplitEdge {
+        NodeId node;
+        int edge;
+    };
     struct Reveal {
         NodeId node;
         int edge;
@@ -106,14 +123,36 @@ private:
             unsplit[e] = he_.face(p[e], p[(e + 1) % 3]) != LeafHalfedges::kNone;
             count += unsplit[e];
         }
-        if (count == 0) return true;
+        if (count == 0) {
+            // A refined element has no leaf edge between its corners, in either direction.
+            for (int e = 0; e < 3; ++e) {
+                const uint32_t across = he_.face(p[(e + 1) % 3], p[e]);
+                if (across != LeafHalfedges::kNone)
+                    fail("edge (" + edge_text(n, e) + ") of face " + std::to_string(across) +
+                         " has nothing on its other side, where the element (" + std::to_string(p[0]) + ", " +
+                         std::to_string(p[1]) + ", " + std::to_string(p[2]) +
+                         ") is split: a missing face, or a T-junction in face " + std::to_string(across));
+            }
+            return true;
+        }
+        for (int e = 0; e < 3; ++e) {
+            if (unsplit[e]) unsplit_edges_.push_back({n, e});
+        }
         if (count == 3) {
             if (he_.apex(p[0], p[1]) != p[2]) fail_node(n, "is not a face of the leaf mesh, nor split by it");
         } else if (count == 2) {
             const int e = !unsplit[0] ? 0 : !unsplit[1] ? 1 : 2;  // the split edge
             const uint32_t m = he_.apex(p[(e + 1) % 3], p[(e + 2) % 3]);
-            if (m == kNone || he_.apex(p[(e + 2) % 3], p[e]) != m)
+            const uint32_t m_other = he_.apex(p[(e + 2) % 3], p[e]);
+            if (m == kNone || m_other != m) {
+                explain_misfit(n);
+                if (m != kNone && m_other != kNone)
+                    fail("the edge (" + edge_text(n, e) + ") of the element (" + std::to_string(p[0]) + ", " +
+                         std::to_string(p[1]) + ", " + std::to_string(p[2]) + ") carries more than one vertex (" +
+                         std::to_string(m_other) + ", " + std::to_string(m) +
+                         "): the elements across are more than one level finer (2:1 balance violated)");
                 fail_node(n, "has one split edge but no bisection (" + edge_text(n, (e + 1) % 3) + ")");
+            }
             reveals_.push_back({n, e, m});
         } else {
             const int u = unsplit[0] ? 0 : unsplit[1] ? 1 : 2;  // the unsplit edge
@@ -133,19 +172,38 @@ private:
                 reveals_.push_back({n, (u + 2) % 3, w});
                 h_.set_diagonal_flipped(n, true);
             } else {
+                explain_misfit(n);
                 fail_node(n, "has two split edges but no green closure on edge (" + edge_text(n, u) + ")");
             }
         }
         return false;
     }
 
+    // A child whose faces do not fit often means that its parent, split on all three edges, was
+    // closed by green triangles instead of being split red (closure): a leaf edge then joins a
+    // midpoint of the parent to the opposite corner, as bisections and diagonals do.
+    void explain_misfit(NodeId n) const {
+        const NodeId parent = h_.parent(n);
+        if (parent == kNoNode) return;
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t m = leaf_of_vertex_[h_.midpoint(parent, k)];
+            const uint32_t opposite = corner(parent, (k + 2) % 3);
+            if (m == kNone) continue;
+            uint32_t face = he_.face(m, opposite);
+            if (face == LeafHalfedges::kNone) face = he_.face(opposite, m);
+            if (face != LeafHalfedges::kNone)
+                fail_node(parent, "is split on all three edges but closed by green triangles (face " +
+                                      std::to_string(face) + "); three hanging nodes call for the red split");
+        }
+    }
+
     // The leaf vertex that splits edge e of refined node n, which no green neighbour revealed.
     uint32_t find_midpoint(NodeId n, int e) {
         const uint32_t a = corner(n, e), b = corner(n, (e + 1) % 3);
-        if (exact_ != nullptr) {
+        if (guide_ == MidpointGuide::exact) {
             Vec3 m = 0.5 * (leaf_.positions[a] + leaf_.positions[b]);
             if (leaf_.single_precision) m = {double(float(m.x)), double(float(m.y)), double(float(m.z))};
-            const uint32_t found = exact_->find(m);
+            const uint32_t found = positions_.find(m);
             if (found == kNone) fail("no vertex at the midpoint of edge (" + edge_text(n, e) + ")");
             return found;
         }
@@ -157,9 +215,14 @@ private:
             }
             nearest_ = std::make_unique<NearestVertex>(leaf_.positions, total / double(leaf_.triangles.size()));
         }
-        // Where the vertex would be without any displacement: the midpoint subdivision of the
-        // base, which the hierarchy's default placer has computed.
-        const Vec3 m = h_.position(h_.midpoint(n, e));
+        // Where midpoint subdivision of the base puts the vertex (the hierarchy's default placer
+        // has computed it), or the midpoint of the edge as the leaf mesh places its ends.
+        Vec3 m = guide_ == MidpointGuide::subdivision ? h_.position(h_.midpoint(n, e))
+                                                     : 0.5 * (leaf_.positions[a] + leaf_.positions[b]);
+        if (guide_ == MidpointGuide::surface) {
+            if (!surface_) surface_ = std::make_unique<ClosestPointQuery>(leaf_);
+            m = surface_->closest(m).point;
+        }
         const uint32_t found = nearest_->find(m, [&](uint32_t v) { return vertex_of_leaf_[v] == kNone; });
         if (found == kNone) fail("no vertex left to split the edge (" + edge_text(n, e) + ")");
         return found;
@@ -168,20 +231,24 @@ private:
     Hierarchy& h_;
     const TriangleMesh& leaf_;
     const LeafHalfedges& he_;
-    const PositionIndex* exact_;
+    const MidpointGuide guide_;
+    const PositionIndex& positions_;
     const std::string& what_;
     std::vector<uint32_t> leaf_of_vertex_;
     std::vector<uint32_t> vertex_of_leaf_;
     std::vector<Reveal> reveals_;
+    std::vector<UnsplitEdge> unsplit_edges_;
     std::unique_ptr<NearestVertex> nearest_;
+    std::unique_ptr<ClosestPointQuery> surface_;
 };
 
 }  // namespace
 
 std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
                                             const TriangleMesh& leaf, const LeafHalfedges& halfedges,
-                                            const PositionIndex* exact_midpoints, const std::string& what) {
-    return Reconstruction(h, leaf_of_base, leaf, halfedges, exact_midpoints, what).run();
+                                            MidpointGuide guide, const PositionIndex& positions,
+                                            const std::string& what) {
+    return Reconstruction(h, leaf_of_base, leaf, halfedges, guide, positions, what).run();
 }
 
 }  // namespace amc

@@ -12,6 +12,14 @@
 
 namespace amc {
 
+// How the reconstruction finds a vertex that no green neighbour reveals (docs/IMPORT.md).
+enum class MidpointGuide {
+    exact,          // the vertex at the edge's midpoint, bit for bit
+    subdivision,    // the vertex nearest to where midpoint subdivision of the base puts it
+    surface,        // the vertex nearest to the leaf mesh's surface point closest to the
+                    // midpoint of the edge's end vertices (meshes projected onto a surface)
+};
+
 // Builds the forest of `h` (a hierarchy of unrefined roots over the base, whose vertex i is leaf
 // vertex leaf_of_base[i]) so that its leaf mesh is `leaf`; returns the leaf vertex of every
 // vertex of `h` (0xffffffff for none). With `exact_midpoints`, the vertex an edge split creates is
@@ -20,6 +28,7 @@ namespace amc {
 // whole leaf mesh afterwards.
 std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
                                             const TriangleMesh& leaf, const LeafHalfedges& halfedges,
-                                            const PositionIndex* exact_midpoints, const std::string& what);
+                                            MidpointGuide guide, const PositionIndex& positions,
+                                            const std::string& what);
 
 }  // namespace amc

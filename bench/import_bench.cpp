@@ -1,0 +1,120 @@
+// import_leaf_mesh throughput in leaf faces per second (docs/IMPORT.md, "Speed"): the leaf
+// meshes of the bench models (surface, random, fe) at about 10^5 and 10^6 nodes, vertices and
+// faces shuffled, with new vertices at their midpoints (the exact path) or moved off them (the
+// connectivity paths); and the semi-regular bunny of ../shared/data when it is there.
+//
+// Usage: import_bench [repetitions]   (default 5; prints the median and the range of the runs)
+// Times are the thread's CPU time, which the other jobs on a shared machine disturb less.
+#include "bench_common.h"
+
+#include <amc/import.h>
+
+#include <cstdio>
+#include <ctime>
+#include <cstdlib>
+#include <filesystem>
+#include <numeric>
+#include <string>
+#include <vector>
+
+namespace {
+
+// A tiny generator whose output is the same on every platform.
+struct Random {
+    uint64_t state;
+    uint64_t next() {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return state >> 33;
+    }
+};
+
+// The leaf mesh as a user holds it: vertices and faces shuffled, faces rotated, every non-base
+// vertex moved by up to `move` times the distance to its nearest neighbour.
+amc::TriangleMesh user_leaf_mesh(const amc::TriangleMesh& leaf, uint32_t base_vertices, double move, uint64_t seed) {
+    Random random{seed};
+    const uint32_t n = uint32_t(leaf.positions.size());
+    std::vector<uint32_t> order(n);
+    std::iota(order.begin(), order.end(), 0u);
+    for (uint32_t i = n; i > 1; --i) std::swap(order[i - 1], order[random.next() % i]);
+    std::vector<double> shortest(n, 1e300);
+    for (const amc::Triangle& t : leaf.triangles) {
+        for (int e = 0; e < 3; ++e) {
+            const amc::Vec3 d = leaf.positions[t[e]] - leaf.positions[t[(e + 1) % 3]];
+            const double length = std::sqrt(amc::dot(d, d));
+            shortest[t[e]] = std::min(shortest[t[e]], length);
+            shortest[t[(e + 1) % 3]] = std::min(shortest[t[(e + 1) % 3]], length);
+        }
+    }
+    auto unit = [&] { return double(random.next() % 2000001) / 1000000.0 - 1.0; };
+    amc::TriangleMesh out;
+    out.single_precision = leaf.single_precision;
+    out.positions.resize(n);
+    for (uint32_t v = 0; v < n; ++v) {
+        amc::Vec3 p = leaf.positions[v];
+        if (v >= base_vertices && move > 0) p = p + (move * shortest[v]) * amc::Vec3{unit(), unit(), unit()};
+        if (out.single_precision) p = {double(float(p.x)), double(float(p.y)), double(float(p.z))};
+        out.positions[order[v]] = p;
+    }
+    out.triangles = leaf.triangles;
+    for (size_t i = out.triangles.size(); i > 1; --i) std::swap(out.triangles[i - 1], out.triangles[random.next() % i]);
+    for (amc::Triangle& t : out.triangles) {
+        const int r = int(random.next() % 3);
+        t = {order[t[r]], order[t[(r + 1) % 3]], order[t[(r + 2) % 3]]};
+    }
+    return out;
+}
+
+// CPU time of this thread: on the shared machine wall time also counts other jobs' turns.
+double thread_seconds() {
+    timespec t;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+void run(const char* name, const amc::TriangleMesh& base, const amc::TriangleMesh& leaf, int repetitions) {
+    std::vector<double> rates;
+    for (int r = 0; r < repetitions; ++r) {
+        const double start = thread_seconds();
+        try {
+            const amc::ImportedHierarchy imported = amc::import_leaf_mesh(base, leaf);
+            if (imported.vertex_of_input.size() != leaf.positions.size()) std::abort();
+        } catch (const amc::Error& e) {
+            std::printf("%-34s %9zu faces  refused after %.2f s: %.60s...\n", name, leaf.triangles.size(),
+                        thread_seconds() - start, e.what());
+            return;
+        }
+        rates.push_back(double(leaf.triangles.size()) / (thread_seconds() - start));
+    }
+    std::sort(rates.begin(), rates.end());
+    std::printf("%-34s %9zu faces  %6.2f M faces/s  (runs %.2f-%.2f)\n", name, leaf.triangles.size(),
+                median(rates) * 1e-6, rates.front() * 1e-6, rates.back() * 1e-6);
+    std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const int repetitions = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
+    const char* names[] = {"surface", "random", "fe"};
+    for (int64_t nodes : {int64_t(100000), int64_t(1000000)}) {
+        for (int model = 0; model < 3; ++model) {
+            const amc::Hierarchy h = make_bench_hierarchy(BenchModel(model), nodes);
+            const amc::LeafMesh leaf = amc::extract_leaf_mesh(h);
+            const uint32_t v0 = uint32_t(h.base().positions.size());
+            for (double move : {0.0, 0.3}) {
+                const std::string name = std::string(names[model]) + " " + std::to_string(nodes / 1000) + "k nodes" +
+                                         (move > 0 ? ", moved" : ", midpoints");
+                run(name.c_str(), h.base(), user_leaf_mesh(leaf.mesh, v0, move, 17), repetitions);
+            }
+        }
+    }
+    const std::string data = std::string(AMC_SHARED_DATA_DIR);
+    if (std::filesystem::exists(data + "/bunny-sr-l3.obj")) {
+        const amc::TriangleMesh base = amc::read_mesh(data + "/bunny-sr-l0.obj");
+        const amc::TriangleMesh leaf = amc::read_mesh(data + "/bunny-sr-l3.obj");
+        run("bunny-sr-l3 (uniform, projected)", base, user_leaf_mesh(leaf, 0, 0.0, 17), repetitions);
+    } else {
+        std::printf("(%s/bunny-sr-l3.obj not found: semi-regular case skipped)\n", data.c_str());
+    }
+    return 0;
+}
