@@ -37,4 +37,40 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
 // The same on files (read_mesh: OBJ, OFF, PLY); errors name the files.
 ImportedHierarchy import_leaf_mesh_files(const std::string& base_path, const std::string& leaf_path);
 
+// ---- refinement histories (docs/IMPORT.md, section 3) -----------------------------------------
+
+// One adaptation step as finite-element codes mark it. Elements are the triangles of the current
+// state's leaf mesh, numbered as extract_leaf_mesh lists them.
+struct AdaptationStep {
+    std::vector<uint32_t> refine;   // each element's node is refined red (balance and closure follow)
+    std::vector<uint32_t> coarsen;  // a parent is coarsened when every element of its four children
+                                    // is listed (and none is refined) and balance allows it
+    uint32_t line = 0;              // the step's line in its file (0: not read from a file)
+};
+
+// Applies one step to h: first every refinement (Hierarchy::refine, so balance and closure refine
+// more), then the coarsenings, deepest level first (Hierarchy::coarsen). New vertices are placed
+// by h's vertex placer. Throws Error (ErrorCode::invalid_input) naming the element for an index
+// out of range, an element listed twice, or an element listed for both; h is unchanged then.
+void apply_adaptation_step(Hierarchy& h, const std::vector<uint32_t>& refine, const std::vector<uint32_t>& coarsen);
+
+struct RefinementHistory {
+    TriangleMesh base;
+    std::vector<AdaptationStep> steps;
+    std::string source = "history";  // names the history in error messages
+};
+
+// The hierarchy after each step: result[i] is the state after steps[0..i]. An element index out
+// of range for its state is refused here (the file reader can not know the states): the error
+// names the source, the step's line and the element.
+std::vector<Hierarchy> replay_history(const RefinementHistory& history);
+
+// The history file (docs/IMPORT.md, "The history file"): parse_history validates everything and
+// names the line of each problem; `what` names the source, `directory` is where a relative base
+// path is looked for. format_history writes the base inline (coordinates exactly).
+RefinementHistory parse_history(const std::string& text, const std::string& what, const std::string& directory = ".");
+RefinementHistory read_history(const std::string& path);
+std::string format_history(const RefinementHistory& history);
+void write_history(const std::string& path, const RefinementHistory& history);
+
 }  // namespace amc
