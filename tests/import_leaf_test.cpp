@@ -277,8 +277,18 @@ TEST(ImportLeafMesh, RefusesWrongBase) {
     p = {a, b, d};
     q = {b, c, d};
     message = import_error(other, f.user.mesh);
-    EXPECT_NE(message.find("input.obj: "), std::string::npos) << message;
-    std::cout << message << "\n";
+    EXPECT_NE(message.find("input.obj: the element on vertices ("), std::string::npos) << message;
+}
+
+TEST(ImportLeafMesh, RefusesABaseTriangleThatIsNoElement) {
+    // The square's two base triangles, unrefined, against a base cut along the other diagonal.
+    Hierarchy h(make_square(1));
+    TriangleMesh other = h.base();
+    const Triangle p = other.triangles[0], q = other.triangles[1];
+    other.triangles = {{p[0], p[1], q[2]}, {p[1], p[2], q[2]}};
+    const std::string message = import_error(other, extract_leaf_mesh(h).mesh);
+    EXPECT_NE(message.find("input.obj: vertex "), std::string::npos) << message;
+    EXPECT_NE(message.find("(wrong base?)"), std::string::npos) << message;
 }
 
 TEST(ImportLeafMesh, RefusesNonManifoldLeafMesh) {

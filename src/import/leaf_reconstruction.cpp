@@ -57,7 +57,8 @@ public:
                 if (q == kNoNode || h_.is_leaf(q)) explain_misfit(r.node);
                 if (q == kNoNode || h_.is_leaf(q))
                     fail(std::string("vertex ") + std::to_string(r.leaf_vertex) +
-                         " lies on an edge whose other side is not refined (T-junction)");
+                         " lies on an edge whose other side is not refined (T-junction)" +
+                         (h_.level(r.node) == 0 ? " (wrong base?)" : ""));
                 const VertexId m = h_.midpoint(q, h_.neighbor_edge(r.node, r.edge));
                 if (leaf_of_vertex_[m] == kNone) {
                     assign(m, r.leaf_vertex);
@@ -99,8 +100,11 @@ private:
     }
 
     [[noreturn]] void fail_node(NodeId n, const std::string& message) const {
-        fail("the element on vertices (" + std::to_string(corner(n, 0)) + ", " + std::to_string(corner(n, 1)) + ", " +
-             std::to_string(corner(n, 2)) + ") " + message);
+        // A base triangle that does not fit points at the base rather than at the leaf mesh.
+        const std::string which = h_.level(n) == 0 ? "the base triangle " + std::to_string(n) + " on vertices ("
+                                                   : "the element on vertices (";
+        fail(which + std::to_string(corner(n, 0)) + ", " + std::to_string(corner(n, 1)) + ", " +
+             std::to_string(corner(n, 2)) + ") " + message + (h_.level(n) == 0 ? " (wrong base?)" : ""));
     }
 
     void assign(VertexId v, uint32_t l) {
@@ -131,7 +135,8 @@ private:
                     fail("edge (" + edge_text(n, e) + ") of face " + std::to_string(across) +
                          " has nothing on its other side, where the element (" + std::to_string(p[0]) + ", " +
                          std::to_string(p[1]) + ", " + std::to_string(p[2]) +
-                         ") is split: a missing face, or a T-junction in face " + std::to_string(across));
+                         ") is split: a missing face, or a T-junction in face " + std::to_string(across) +
+                         (h_.level(n) == 0 ? " (wrong base?)" : ""));
             }
             return true;
         }
