@@ -105,7 +105,7 @@ void report(const char* name, const amc::Hierarchy& h, int runs, bool reuse, con
         counters.read_all(c0);
         const Clock::time_point t0 = Clock::now();
         amc::HierarchyStreamHeader header;
-        const size_t header_size = amc::read_hierarchy_stream_header(bytes.data(), bytes.size(), header);
+        const size_t header_size = amc::read_standalone_stream_header(bytes.data(), bytes.size(), header);
         std::optional<amc::HierarchyLevelDecoder> fresh;
         amc::HierarchyLevelDecoder& coder = reuse ? kept : fresh.emplace();
         coder.restart(h.base(), header, amc::HierarchyDecodeOptions().max_nodes);

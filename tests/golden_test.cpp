@@ -1,12 +1,19 @@
-// Golden .amc files: the bytes of version 2 are pinned. A change that alters the bitstream fails
-// here; if it is deliberate, bump the format version, update docs/FORMAT.md, and regenerate with
-// AMC_UPDATE_GOLDEN=1 ./amc_tests --gtest_filter='Golden*' (in the same commit).
+// Golden .amc files, one directory per format version (tests/data/golden/vN/), kept forever and
+// never regenerated (docs/FORMAT.md, "Versions and compatibility"). Every file of every version
+// decodes to the hierarchy it was made from; the files of the current version also pin the
+// encoder's bytes. A change that alters the bitstream fails here: it is a new format version, whose
+// files AMC_UPDATE_GOLDEN=1 ./amc_tests --gtest_filter='Golden*' writes into a new directory (it
+// never overwrites a file).
 #include "hierarchy_checks.h"
+
+#include "coding/float_coder.h"
+#include "coding/format_version.h"
 
 #include <amc/codec.h>
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 
@@ -19,6 +26,7 @@ struct GoldenCase {
     EncodeOptions options;
 };
 
+// The hierarchies of the golden files: the same in every version.
 std::vector<GoldenCase> golden_cases() {
     std::vector<GoldenCase> cases;
     {
@@ -55,35 +63,78 @@ std::vector<GoldenCase> golden_cases() {
     return cases;
 }
 
-std::string golden_path(const std::string& name) { return std::string(AMC_TEST_DATA_DIR) + "/golden/" + name + ".amc"; }
+std::string golden_path(int version, const std::string& name) {
+    return std::string(AMC_TEST_DATA_DIR) + "/golden/v" + std::to_string(version) + "/" + name + ".amc";
+}
 
-TEST(Golden, EncodingsMatchTheGoldenFiles) {
+std::vector<uint8_t> read_golden(const std::string& path) {
+    std::ifstream file(path, std::ios::binary);
+    return std::vector<uint8_t>((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+}
+
+// What decoding an encoding of `h` gives: h in the decoder's order, with every position snapped to
+// the quantizer's grid (FORMAT.md 5.4: the bounding box of all positions) when quantized.
+Hierarchy expected_decoding(const Hierarchy& h, int quantize_bits) {
+    Hierarchy expected = in_decoder_order(h);
+    if (quantize_bits == 0) return expected;
+    expected.set_single_precision(false);
+    std::vector<Vec3> points;
+    const std::vector<uint32_t> order = canonical_vertex_order(expected);
+    for (VertexId v = 0; v < order.size(); ++v) {
+        if (order[v] != 0xffffffffu) points.push_back(expected.position(v));
+    }
+    const Quantizer quantizer = make_quantizer(points, quantize_bits);
+    for (VertexId v = 0; v < order.size(); ++v) {
+        if (order[v] != 0xffffffffu) expected.set_position(v, dequantize(quantizer, quantize(quantizer, expected.position(v))));
+    }
+    return expected;
+}
+
+// The versions with these cases: version 3 adds only the numbering block, whose golden file
+// tests/numbering_test.cpp pins; files without one are still written as version 2.
+constexpr int kVersionsOfTheCases[] = {1, 2};
+
+TEST(Golden, FilesOfEveryVersionDecodeToTheirHierarchies) {
+    for (const int version : kVersionsOfTheCases) {
+        for (const GoldenCase& c : golden_cases()) {
+            const std::string path = golden_path(version, c.name);
+            const std::vector<uint8_t> golden = read_golden(path);
+            ASSERT_FALSE(golden.empty()) << path << " is missing";
+            SCOPED_TRACE(path);
+            const FileInfo info = inspect(golden.data(), golden.size());
+            EXPECT_EQ(info.version, version);
+            EXPECT_EQ(info.quantize_bits, c.options.quantize_bits);
+            EXPECT_EQ(info.single_precision, c.hierarchy.single_precision() && c.options.quantize_bits == 0);
+            ASSERT_EQ(info.blocks.size(), size_t(4 + info.levels)) << "metadata, base connectivity, base geometry, levels, end";
+            EXPECT_EQ(info.blocks[0].name, "metadata");
+            EXPECT_EQ(info.blocks[1].name, "base connectivity");
+            EXPECT_EQ(info.blocks[2].name, "base geometry");
+            for (int l = 0; l < info.levels; ++l) EXPECT_EQ(info.blocks[size_t(3 + l)].level, l);
+            EXPECT_EQ(info.blocks.back().name, "end");
+            const Hierarchy back = decode(golden.data(), golden.size());
+            EXPECT_TRUE(identical(back, expected_decoding(c.hierarchy, c.options.quantize_bits)));
+            // Every prefix of levels too (progressive decoding).
+            for (int l = 0; l < info.levels; ++l) {
+                DecodeOptions prefix;
+                prefix.max_level = l;
+                EXPECT_EQ(decode(golden.data(), golden.size(), prefix).depth(), std::min(l, back.depth())) << "level " << l;
+            }
+        }
+    }
+}
+
+TEST(Golden, EncodingsMatchTheCurrentVersionsFiles) {
     const bool update = std::getenv("AMC_UPDATE_GOLDEN") != nullptr;
     for (const GoldenCase& c : golden_cases()) {
         const std::vector<uint8_t> bytes = encode(c.hierarchy, c.options);
-        if (update) {
-            std::ofstream(golden_path(c.name), std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+        const std::string path = golden_path(kBaseVersion, c.name);
+        if (update && !std::filesystem::exists(path)) {
+            std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+            std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
         }
-        std::ifstream file(golden_path(c.name), std::ios::binary);
-        ASSERT_TRUE(file) << golden_path(c.name) << " is missing";
-        const std::vector<uint8_t> golden((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-        EXPECT_EQ(bytes, golden) << c.name << ": the bitstream changed";
-        // The golden file decodes, and inspect() sees the blocks FORMAT.md describes.
-        const Hierarchy back = decode(golden.data(), golden.size());
-        EXPECT_EQ(back.node_count(), c.hierarchy.node_count()) << c.name;
-        const FileInfo info = inspect(golden.data(), golden.size());
-        EXPECT_EQ(info.version, 2);
-        EXPECT_EQ(info.quantize_bits, c.options.quantize_bits);
-        EXPECT_EQ(info.single_precision, c.hierarchy.single_precision() && c.options.quantize_bits == 0);
-        ASSERT_EQ(info.blocks.size(), size_t(4 + info.levels)) << "metadata, base connectivity, base geometry, levels, end";
-        EXPECT_EQ(info.blocks[0].name, "metadata");
-        EXPECT_EQ(info.blocks[1].name, "base connectivity");
-        EXPECT_EQ(info.blocks[2].name, "base geometry");
-        for (int l = 0; l < info.levels; ++l) EXPECT_EQ(info.blocks[size_t(3 + l)].level, l);
-        EXPECT_EQ(info.blocks.back().name, "end");
-        if (c.options.quantize_bits == 0) {
-            EXPECT_TRUE(identical(back, in_decoder_order(c.hierarchy))) << c.name;
-        }
+        const std::vector<uint8_t> golden = read_golden(path);
+        ASSERT_FALSE(golden.empty()) << path << " is missing";
+        EXPECT_EQ(bytes, golden) << c.name << ": the bitstream changed (a new format version: FORMAT.md, Versions)";
     }
 }
 

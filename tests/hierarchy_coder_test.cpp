@@ -148,7 +148,7 @@ TEST(HierarchyCoder, UniformMeshCodesNoSymbol) {
             EXPECT_EQ(stats.coded, 0u) << name;
             EXPECT_EQ(stats.uniform_levels, levels) << name;
             EXPECT_EQ(stats.payload_bytes, 0u) << name;
-            EXPECT_EQ(bytes.size(), 4u) << name << ": switches, U, rule, symbol count 0";
+            EXPECT_EQ(bytes.size(), 9u) << name << ": magic, version, switches, U, rule, symbol count 0";
             const Hierarchy back = decode_hierarchy(h.base(), bytes.data(), bytes.size());
             EXPECT_TRUE(identical(h, back)) << name;
         }
@@ -347,7 +347,7 @@ TEST(HierarchyCoder, DecodedVerticesArePlacedByTheHierarchysPlacer) {
         }
         // Another placer, symmetric in its end points as every placer must be.
         HierarchyStreamHeader header;
-        const size_t header_size = read_hierarchy_stream_header(bytes.data(), bytes.size(), header);
+        const size_t header_size = read_standalone_stream_header(bytes.data(), bytes.size(), header);
         HierarchyLevelDecoder coder(base, header, UINT64_MAX);
         coder.hierarchy().set_vertex_placer([](void*, Vec3 a, Vec3 b) { return lifted(a, b); }, nullptr);
         ArithmeticDecoder decoder(bytes.data() + header_size, bytes.size() - header_size);
@@ -366,7 +366,7 @@ TEST(HierarchyCoder, LevelsStartWithTheCulledNodesDecided) {
     size_t nodes = 0, culled = 0, lowered = 0;
     for (uint64_t seed = 1; seed <= 300; ++seed) {
         const Hierarchy h = random_hierarchy(seed);
-        LevelTraversal traversal{HierarchyCoderOptions{}};
+        LevelTraversal traversal{HierarchyCoderOptions{}, kHierarchyStreamVersion};
         Level level, next;
         RefinedNumbering numbering;
         root_level(h, level, true);
@@ -420,10 +420,11 @@ TEST(HierarchyCoder, LevelsStartWithTheCulledNodesDecided) {
 }
 
 // FORMAT.md, section 2, read literally and run on the Hierarchy itself: the symbols of every level
-// in the order and with the context groups the text gives, for all switches on (improved) or all
-// but the improved traversal (naive). Diagonals follow rule 0, so the stream has no orientation
-// bits; U and the symbol count come from the coder's header.
-std::vector<std::pair<int, bool>> symbols_as_specified(const Hierarchy& h, bool improved, int uniform_levels) {
+// in the order and with the context groups the text gives for stream `version` (1 or 2), for all
+// switches on (improved) or all but the improved traversal (naive). Diagonals follow rule 0, so
+// the stream has no orientation bits; U and the symbol count come from the coder's header.
+std::vector<std::pair<int, bool>> symbols_as_specified(const Hierarchy& h, int version, bool improved,
+                                                       int uniform_levels) {
     std::vector<std::pair<int, bool>> symbols;
     const std::vector<NodeId> order = h.breadth_first_order();  // canonical: level by level
     const int group_of[4][4] = {{8, 7, 6, 5}, {4, 3, 2, -1}, {1, 0, -1, -1}, {9, -1, -1, -1}};  // [x][y]
@@ -456,8 +457,6 @@ std::vector<std::pair<int, bool>> symbols_as_specified(const Hierarchy& h, bool 
             }
             return true;
         };
-        // First every node 1-regularity culls: not refined, no symbol.
-        for (uint32_t i = 0; i < n; ++i) decided[i] = culled_by_one_regularity(i);
         auto decide = [&](uint32_t i) {
             if (hanging(i)) {
                 refined[i] = true;
@@ -473,21 +472,54 @@ std::vector<std::pair<int, bool>> symbols_as_specified(const Hierarchy& h, bool 
             }
             decided[i] = true;
         };
-        if (!improved) {
-            for (uint32_t i = 0; i < n; ++i) {
-                if (!decided[i]) decide(i);
-            }
-            continue;
-        }
-        for (uint32_t i = 0; i < n; ++i) {
-            if (decided[i]) continue;
-            int culled = 0;
-            for (int e = 0; e < 3; ++e) culled += neighbour(i, e) >= 0 && decided[size_t(neighbour(i, e))];
-            priority[i] = std::max(1, 4 - culled);
-        }
         std::vector<std::pair<uint32_t, int>> stack[5];  // (node, its priority when pushed)
-        for (uint32_t i = n; i-- > 0;) {
-            if (!decided[i]) stack[priority[i]].push_back({i, priority[i]});
+        // Step 2's update of the neighbours of a decided node.
+        auto update_neighbours = [&](uint32_t i) {
+            for (int e = 0; e < 3; ++e) {
+                const int64_t q = neighbour(i, e);
+                if (q < 0 || decided[size_t(q)] || priority[size_t(q)] == 0) continue;
+                const int now = hanging(uint32_t(q)) ? 0 : std::max(1, priority[size_t(q)] - 1);
+                if (now == priority[size_t(q)]) continue;
+                priority[size_t(q)] = now;
+                stack[now].push_back({uint32_t(q), now});
+            }
+        };
+        if (version == 1) {
+            // "Version 1": the culled nodes are decided in their turn.
+            if (!improved) {
+                for (uint32_t i = 0; i < n; ++i) {
+                    if (culled_by_one_regularity(i)) decided[i] = true;  // not refined, no symbol
+                    else decide(i);
+                }
+                continue;
+            }
+            for (uint32_t i = 0; i < n; ++i) priority[i] = culled_by_one_regularity(i) ? 0 : 4;
+            for (uint32_t i = n; i-- > 0;) {
+                if (priority[i] == 4) stack[4].push_back({i, 4});
+            }
+            for (uint32_t i = 0; i < n; ++i) {
+                if (priority[i] != 0) continue;
+                decided[i] = true;
+                update_neighbours(i);
+            }
+        } else {
+            // First every node 1-regularity culls: not refined, no symbol.
+            for (uint32_t i = 0; i < n; ++i) decided[i] = culled_by_one_regularity(i);
+            if (!improved) {
+                for (uint32_t i = 0; i < n; ++i) {
+                    if (!decided[i]) decide(i);
+                }
+                continue;
+            }
+            for (uint32_t i = 0; i < n; ++i) {
+                if (decided[i]) continue;
+                int culled = 0;
+                for (int e = 0; e < 3; ++e) culled += neighbour(i, e) >= 0 && decided[size_t(neighbour(i, e))];
+                priority[i] = std::max(1, 4 - culled);
+            }
+            for (uint32_t i = n; i-- > 0;) {
+                if (!decided[i]) stack[priority[i]].push_back({i, priority[i]});
+            }
         }
         for (;;) {
             int p = 0;
@@ -497,17 +529,21 @@ std::vector<std::pair<int, bool>> symbols_as_specified(const Hierarchy& h, bool 
             stack[p].pop_back();
             if (decided[i] || priority[i] != pushed) continue;
             decide(i);
-            for (int e = 0; e < 3; ++e) {
-                const int64_t q = neighbour(i, e);
-                if (q < 0 || decided[size_t(q)] || priority[size_t(q)] == 0) continue;
-                const int now = hanging(uint32_t(q)) ? 0 : std::max(1, priority[size_t(q)] - 1);
-                if (now == priority[size_t(q)]) continue;
-                priority[size_t(q)] = now;
-                stack[now].push_back({uint32_t(q), now});
-            }
+            update_neighbours(i);
         }
     }
     return symbols;
+}
+
+// A hierarchy stream of `version` (the header's fields and the payload, without the tag).
+std::vector<uint8_t> stream_of_version(const Hierarchy& h, const HierarchyCoderOptions& options, uint8_t version) {
+    HierarchyLevelEncoder coder(h, options, version);
+    ArithmeticEncoder encoder;
+    for (int l = 0; l < coder.level_count(); ++l) coder.encode_level(l, encoder);
+    const std::vector<uint8_t> payload = encoder.finish();
+    std::vector<uint8_t> out = coder.header();
+    out.insert(out.end(), payload.begin(), payload.end());
+    return out;
 }
 
 TEST(HierarchyCoder, StreamsFollowTheFormatText) {
@@ -519,14 +555,16 @@ TEST(HierarchyCoder, StreamsFollowTheFormatText) {
             while (h.has_hanging_node(n, u)) ++u;
             h.set_diagonal_flipped(n, diagonal_flag_by_rule(DiagonalRule(0), u));
         }
-        for (const bool improved : {true, false}) {
+        for (const int run : {0, 1, 2, 3}) {
+            const int version = 1 + run / 2;
+            const bool improved = run % 2 == 0;
             HierarchyCoderOptions options;
             options.traversal = improved ? Traversal::improved : Traversal::naive;
-            const std::vector<uint8_t> stream = encode_hierarchy(h, options);
+            const std::vector<uint8_t> stream = stream_of_version(h, options, uint8_t(version));
             HierarchyStreamHeader header;
             const size_t header_size = read_hierarchy_stream_header(stream.data(), stream.size(), header);
             ASSERT_FALSE(header.orientation_coded);
-            const auto symbols = symbols_as_specified(h, improved, header.uniform_levels);
+            const auto symbols = symbols_as_specified(h, version, improved, header.uniform_levels);
             ASSERT_LE(header.symbol_count, symbols.size());
             HierarchyModels models;
             ArithmeticEncoder encoder;
@@ -536,8 +574,14 @@ TEST(HierarchyCoder, StreamsFollowTheFormatText) {
             for (uint64_t k = header.symbol_count; k < symbols.size(); ++k) ASSERT_FALSE(symbols[k].second);
             const std::vector<uint8_t> payload = encoder.finish();
             ASSERT_EQ(std::vector<uint8_t>(stream.begin() + long(header_size), stream.end()), payload)
-                << "seed " << seed << (improved ? ", improved" : ", naive") << " traversal";
+                << "seed " << seed << ", version " << version << (improved ? ", improved" : ", naive") << " traversal";
         }
+        // The encoder's own streams are version 2.
+        HierarchyStreamHeader header;
+        const std::vector<uint8_t> stream = encode_hierarchy(h);
+        read_standalone_stream_header(stream.data(), stream.size(), header, 1);
+        EXPECT_EQ(header.version, 2);
+        EXPECT_EQ(std::vector<uint8_t>(stream.begin() + 5, stream.end()), stream_of_version(h, {}, 2)) << "tag: 5 bytes";
     }
 }
 
@@ -562,8 +606,85 @@ TEST(HierarchyCoder, UnbalancedHierarchyIsRefusedByTheEncoder) {
 TEST(HierarchyCoder, HugeUniformLevelCountIsRefused) {
     Hierarchy h(make_icosahedron());
     std::vector<uint8_t> bytes = encode_hierarchy(h);
-    bytes[1] = 19;  // 20 * 4^19 nodes
-    EXPECT_THROW(decode_hierarchy(h.base(), bytes.data(), bytes.size()), Error);
+    bytes[5 + 1] = 19;  // after the tag, U: 20 * 4^19 nodes
+    try {
+        decode_hierarchy(h.base(), bytes.data(), bytes.size());
+        ADD_FAILURE() << "decoded";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("more than"), std::string::npos) << e.what();
+    }
+}
+
+std::string decode_error(const TriangleMesh& base, const std::vector<uint8_t>& bytes,
+                         const HierarchyDecodeOptions& options = {}) {
+    try {
+        decode_hierarchy(base, bytes.data(), bytes.size(), options);
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "";
+}
+
+std::vector<uint8_t> concatenated(std::vector<uint8_t> a, const std::vector<uint8_t>& b) {
+    a.insert(a.end(), b.begin(), b.end());
+    return a;
+}
+
+// Every version of the stream decodes, tagged or not (FORMAT.md, section 2): version 1 under every
+// switch combination, untagged streams as the caller says; a newer version is refused as such.
+TEST(HierarchyCoder, EveryStreamVersionDecodes) {
+    for (uint64_t seed = 1; seed <= 300; ++seed) {
+        const Hierarchy h = random_hierarchy(seed);
+        const HierarchyCoderOptions options = options_from_bits(int(seed % kOptionCombinations));
+        const std::vector<uint8_t> v1 = stream_of_version(h, options, 1), v2 = stream_of_version(h, options, 2);
+        HierarchyDecodeOptions untagged_v1;
+        untagged_v1.untagged_version = 1;
+        const std::pair<std::vector<uint8_t>, HierarchyDecodeOptions> cases[] = {
+            {concatenated(hierarchy_stream_tag(1), v1), {}},
+            {concatenated(hierarchy_stream_tag(2), v2), {}},
+            {concatenated(hierarchy_stream_tag(1), v1), untagged_v1},  // the tag wins
+            {v1, untagged_v1},
+            {v2, {}}};
+        for (const auto& [bytes, decode_options] : cases) {
+            const Hierarchy back = decode_hierarchy(h.base(), bytes.data(), bytes.size(), decode_options);
+            ASSERT_TRUE(same_connectivity(h, back)) << "seed " << seed;
+        }
+    }
+    // The versions differ: a version-1 stream read as version 2 decodes wrongly or not at all on
+    // some of these hierarchies.
+    int misread = 0;
+    for (uint64_t seed = 1; seed <= 100; ++seed) {
+        const Hierarchy h = random_hierarchy(seed);
+        const std::vector<uint8_t> v1 = stream_of_version(h, {}, 1);
+        try {
+            misread += !same_connectivity(h, decode_hierarchy(h.base(), v1.data(), v1.size()));
+        } catch (const Error&) {
+            ++misread;
+        }
+    }
+    EXPECT_GT(misread, 10);
+}
+
+TEST(HierarchyCoder, NewerAndUnknownStreamVersionsAreRefused) {
+    Hierarchy h(make_icosahedron());
+    refine_uniformly(h, 1);
+    std::vector<uint8_t> bytes = encode_hierarchy(h);
+    ASSERT_EQ(std::string(bytes.begin(), bytes.begin() + 4), "AMHS");
+    ASSERT_EQ(bytes[4], kHierarchyStreamVersion);
+    bytes[4] = kHierarchyStreamVersion + 1;
+    EXPECT_NE(decode_error(h.base(), bytes).find("unsupported version 3 (newer than this build, which reads versions 1 to 2)"),
+              std::string::npos)
+        << decode_error(h.base(), bytes);
+    bytes[4] = 0;
+    EXPECT_NE(decode_error(h.base(), bytes).find("unknown version 0"), std::string::npos);
+    bytes[4] = kHierarchyStreamVersion;
+    bytes[3] = 'X';
+    EXPECT_NE(decode_error(h.base(), bytes).find("bad magic"), std::string::npos);
+    EXPECT_NE(decode_error(h.base(), {'A', 'M', 'H', 'S'}).find("truncated"), std::string::npos);
+    HierarchyDecodeOptions untagged_v3;
+    untagged_v3.untagged_version = 3;
+    const std::vector<uint8_t> untagged = stream_of_version(h, {}, 2);
+    EXPECT_NE(decode_error(h.base(), untagged, untagged_v3).find("unsupported version 3"), std::string::npos);
 }
 
 }  // namespace

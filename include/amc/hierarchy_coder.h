@@ -98,20 +98,24 @@ struct HierarchyCodeStats {
 
 int context_group_index(int refined, int unrefined, int unknown);
 
-// Encodes the forest and diagonals of `h` (positions are not coded here).
+// Encodes the forest and diagonals of `h` (positions are not coded here). The stream starts with
+// its magic and version (docs/FORMAT.md, section 2).
 std::vector<uint8_t> encode_hierarchy(const Hierarchy& h, const HierarchyCoderOptions& options = {},
                                       HierarchyCodeStats* stats = nullptr);
 
 struct HierarchyDecodeOptions {
     int max_level = -1;               // stop after this level (progressive decoding); -1: all
     uint64_t max_nodes = 1ull << 26;  // refuse streams that would build more nodes than this
+    // The version of a stream without magic and version, as encode_hierarchy wrote them before
+    // 2026-12: 2, or 1 for streams written before 2026-11-24 (docs/FORMAT.md, section 2).
+    uint8_t untagged_version = 2;
 };
 
 // Rebuilds the hierarchy over `base` (which must be the encoder's base mesh, same order) from a
-// stream made by encode_hierarchy. New vertices sit at edge midpoints. Throws Error on a corrupt,
-// truncated or over-large stream; never crashes or hangs. The stream holds no positions, and
-// culled and uniformly refined levels cost no bits, so a short stream may describe a large
-// forest: options.max_nodes bounds memory and time.
+// stream made by encode_hierarchy, of any version this build reads (a newer one is refused). New
+// vertices sit at edge midpoints. Throws Error on a corrupt, truncated or over-large stream; never
+// crashes or hangs. The stream holds no positions, and culled and uniformly refined levels cost no
+// bits, so a short stream may describe a large forest: options.max_nodes bounds memory and time.
 Hierarchy decode_hierarchy(const TriangleMesh& base, const uint8_t* data, size_t size,
                            const HierarchyDecodeOptions& options = {});
 

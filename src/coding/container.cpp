@@ -63,9 +63,10 @@ BlockReader::BlockReader(const uint8_t* data, size_t size) : data_(data), size_(
     AMC_REQUIRE(size >= 5, truncated, "file is truncated (header)");
     version_ = data[4];
     // The version comes first: a newer file may have a header this build does not know.
-    AMC_REQUIRE(version_ >= kOldestReadableVersion && version_ <= kNewestVersion, unsupported_version,
-                "unsupported .amc version " + std::to_string(version_) + " (this build reads versions " +
+    AMC_REQUIRE(version_ <= kNewestVersion, unsupported_version,
+                "unsupported .amc version " + std::to_string(version_) + " (newer than this build, which reads versions " +
                     std::to_string(kOldestReadableVersion) + " to " + std::to_string(kNewestVersion) + ")");
+    AMC_REQUIRE(version_ >= kOldestReadableVersion, corrupt, "unknown .amc version " + std::to_string(version_));
     AMC_REQUIRE(size >= kFileHeaderSize, truncated, "file is truncated (header)");
     AMC_REQUIRE(XXH32(data, 8, 0) == get_u32(data + 8), checksum, "checksum mismatch in the file header");
     flags_ = data[5];

@@ -2,6 +2,8 @@
 // blocks, each with its length and an XXH32 checksum, ending with an END block.
 #pragma once
 
+#include "coding/format_version.h"
+
 #include <amc/mesh.h>
 
 #include <cstdint>
@@ -11,12 +13,6 @@
 namespace amc {
 
 constexpr char kFileMagic[4] = {'A', 'M', 'C', 'F'};
-// Versions this build reads. A writer writes the lowest version that holds what the file holds:
-// version 3 only for files with a numbering block, version 2 otherwise.
-constexpr uint8_t kOldestReadableVersion = 2;
-constexpr uint8_t kNewestVersion = 3;
-constexpr uint8_t kBaseVersion = 2;       // everything but the numbering block
-constexpr uint8_t kNumberingVersion = 3;  // the first version with a numbering block
 constexpr size_t kFileHeaderSize = 12;  // magic, version, flags, 2 reserved, XXH32 of those 8
 constexpr size_t kBlockOverhead = 1 + 4 + 4;  // type, payload length, checksum
 
@@ -56,7 +52,8 @@ struct Block {
 // Validates the header and walks the blocks; every length and checksum is checked before use.
 class BlockReader {
 public:
-    BlockReader(const uint8_t* data, size_t size);  // throws Error on a bad header
+    // Throws Error on a bad header, and on a version outside kOldestReadableVersion .. kNewestVersion.
+    BlockReader(const uint8_t* data, size_t size);
     uint8_t flags() const { return flags_; }
     uint8_t version() const { return version_; }
     // The next block; throws Error on truncation, a bad checksum, an unknown type, or bytes after

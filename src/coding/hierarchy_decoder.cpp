@@ -11,36 +11,47 @@ namespace amc {
 
 namespace {
 
-HierarchyStreamHeader parse_header(const uint8_t* data, size_t size) {
+HierarchyStreamHeader parse_header(const uint8_t* data, size_t size, uint8_t version) {
     HierarchyStreamHeader header;
     AMC_REQUIRE(read_hierarchy_stream_header(data, size, header) == size, corrupt,
                 "hierarchy stream: header has trailing bytes");
+    header.version = version;
     return header;
 }
 
 // At most how many symbols deciding `level` can read: one a node, none for the nodes
-// 1-regularity culls (the incomplete ones). Not inlined nor analysed across calls: GCC's register
+// 1-regularity culls (the incomplete ones); more than any stream holds for a version-1 stream,
+// which never takes the fast path. Not inlined nor analysed across calls: GCC's register
 // allocation in the traversal is easily upset (see HIERARCHY_CODER.md, Speed).
-AMC_NOIPA uint32_t codable_symbols(const Level& level, const HierarchyCoderOptions& options) {
+AMC_NOIPA uint64_t codable_symbols(const Level& level, const HierarchyStreamHeader& header) {
+    if (culls_decided_in_turn(header.version)) return UINT64_MAX;
     const uint32_t n = static_cast<uint32_t>(level.size());
-    return options.cull_one_regularity ? n - level.incomplete_count : n;
+    return header.options.cull_one_regularity ? n - level.incomplete_count : n;
 }
 
 // Decides `level` with `traversal`, its symbols from `decoder` in `models` (a symbol past
 // `symbol_limit` is 0, the context groups are masked by `group_mask`): the general path, for the
-// levels where the stored symbols may run out. A function of its own whose locals hold the
-// coder's state while the traversal, inlined, runs: every state byte the traversal writes could
-// alias anything reached through a pointer or a reference, which would then be reloaded for
-// every node. (Called from decide_level, the traversal had reached the coder through its
-// lambdas' references: 12% more instructions per node than the fast path.) No interprocedural
-// analysis: what GCC learnt of this function cost decide_level's fast path 9% more instructions.
+// levels where the stored symbols may run out, and for every level of a version-1 stream (which
+// goes its own way from here: a test of the version, or a call, in decide_level cost the fast
+// path 3.6% more instructions, HIERARCHY_CODER.md, Speed, item 34). A function of its own whose
+// locals hold the coder's state while the traversal, inlined, runs: every state byte the
+// traversal writes could alias anything reached through a pointer or a reference, which would
+// then be reloaded for every node. (Called from decide_level, the traversal had reached the coder
+// through its lambdas' references: 12% more instructions per node than the fast path.) No
+// interprocedural analysis: what GCC learnt of this function cost decide_level's fast path 9% more
+// instructions.
 AMC_NOIPA void decide_symbols_general(LevelTraversal& traversal, Level& level, bool uniform_level,
                                       ArithmeticDecoder& decoder, HierarchyModels& level_models,
                                       uint64_t& level_symbols_read, uint64_t symbol_limit, int group_mask) {
+    if (traversal.culls_in_turn()) {
+        decide_symbols_version1(traversal, level, uniform_level, decoder, level_models, level_symbols_read,
+                                symbol_limit, group_mask);
+        return;
+    }
     ArithmeticDecoder d = decoder;
     HierarchyModels models = level_models;
     uint64_t symbols_read = level_symbols_read;
-    traversal.run(
+    traversal.run_newest(
         level, uniform_level,
         [&](uint32_t, int group) {
             if (symbols_read == symbol_limit) return false;
@@ -56,8 +67,8 @@ AMC_NOIPA void decide_symbols_general(LevelTraversal& traversal, Level& level, b
 }  // namespace
 
 HierarchyLevelDecoder::HierarchyLevelDecoder(const TriangleMesh& base, const uint8_t* header, size_t header_size,
-                                             uint64_t max_nodes)
-    : HierarchyLevelDecoder(base, parse_header(header, header_size), max_nodes) {}
+                                             uint8_t stream_version, uint64_t max_nodes)
+    : HierarchyLevelDecoder(base, parse_header(header, header_size, stream_version), max_nodes) {}
 
 HierarchyLevelDecoder::HierarchyLevelDecoder(const TriangleMesh& base, const HierarchyStreamHeader& header,
                                              uint64_t max_nodes)
@@ -78,7 +89,7 @@ void HierarchyLevelDecoder::restart(const TriangleMesh& base, const HierarchyStr
     AMC_REQUIRE(uniform_nodes <= max_nodes_, limit_exceeded,
                 "hierarchy stream would build more than " + std::to_string(max_nodes_) + " nodes");
     models_ = HierarchyModels();
-    traversal_.configure(header.options);
+    traversal_.configure(header.options, header.version);
     for (Level& level : decided_) spare_.push_back(std::move(level));
     decided_.clear();
     root_level(h_, level_, header.options.cull_one_regularity);
@@ -106,8 +117,9 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder, uint64_t ma
     const int l = level_index_;
     uint8_t* state = level_.state();
     const uint32_t n = static_cast<uint32_t>(level_.size());
-    // II-C, stream truncation: once the stored symbols are used up, the rest are 0.
-    const uint64_t symbol_limit = header_.options.truncate_stream ? header_.symbol_count : UINT64_MAX;
+    // II-C, stream truncation: once the stored symbols are used up, the rest are 0. (Without it no
+    // limit: UINT64_MAX - 1, so that no level can seem to have room for codable_symbols' UINT64_MAX.)
+    const uint64_t symbol_limit = header_.options.truncate_stream ? header_.symbol_count : UINT64_MAX - 1;
     if (symbols_read_ == symbol_limit && l >= header_.uniform_levels) {
         // Every symbol left is 0, and with no node of this level refined yet no rule can force
         // one: the level is all leaves (and the last). No traversal needed.
@@ -129,9 +141,9 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder, uint64_t ma
     // nothing is tested or masked per symbol. (Marked likely, GCC spills less in the traversal's
     // loop: 1-1.5% fewer instructions on every model. Even moving group_mask's definition into
     // the call below cost 2.5%: see HIERARCHY_CODER.md, Speed, item 29.)
-    if (__builtin_expect(
-            header_.options.use_contexts && symbol_limit - symbols_read >= codable_symbols(level_, header_.options), 1)) {
-        traversal_.run(
+    if (__builtin_expect(header_.options.use_contexts && symbol_limit - symbols_read >= codable_symbols(level_, header_),
+                         1)) {
+        traversal_.run_newest(
             level_, l < header_.uniform_levels,
             [&](uint32_t, int group) {
                 ++symbols_read;
@@ -243,7 +255,7 @@ void HierarchyDecoder::decode(const TriangleMesh& base, const uint8_t* data, siz
 void HierarchyDecoder::decode_stream(const TriangleMesh& base, const uint8_t* data, size_t size, Hierarchy& out,
                                      const HierarchyDecodeOptions& options) {
     HierarchyStreamHeader header;
-    const size_t header_size = read_hierarchy_stream_header(data, size, header);
+    const size_t header_size = read_standalone_stream_header(data, size, header, options.untagged_version);
     if (coder_ == nullptr) coder_ = std::make_unique<HierarchyLevelDecoder>();
     // The coder builds in the memory of `out`; its own hierarchy waits in `out` meanwhile and
     // goes back to it at the end, whatever happens.

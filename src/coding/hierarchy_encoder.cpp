@@ -8,7 +8,8 @@
 
 namespace amc {
 
-HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const HierarchyCoderOptions& options)
+HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const HierarchyCoderOptions& options,
+                                             uint8_t stream_version)
     : options_(options) {
     HierarchyCodeStats& stats = stats_;
     // Levels 0..U-1 with every node refined (counted on the way: a level is uniform when it and
@@ -21,7 +22,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
     events_.reserve(h.node_count());
     std::vector<std::pair<int, bool>> two_hanging;  // (unrefined edge, flag) in stream order
     std::vector<size_t> orientation_slots;         // event index of each two_hanging entry
-    LevelTraversal traversal(options);
+    LevelTraversal traversal(options, stream_version);
     Level level, next;
     std::vector<NodeId> ids, next_ids;
     std::vector<uint8_t> refined;
@@ -185,10 +186,12 @@ std::vector<uint8_t> encode_hierarchy(const Hierarchy& h, const HierarchyCoderOp
     ArithmeticEncoder encoder;
     for (int l = 0; l < coder.level_count(); ++l) coder.encode_level(l, encoder);
     const std::vector<uint8_t> payload = encoder.finish();
-    std::vector<uint8_t> out = coder.header();
+    std::vector<uint8_t> out = hierarchy_stream_tag(kHierarchyStreamVersion);
+    out.insert(out.end(), coder.header().begin(), coder.header().end());
     out.insert(out.end(), payload.begin(), payload.end());
     if (stats_out != nullptr) {
         *stats_out = coder.stats();
+        stats_out->header_bytes = out.size() - payload.size();  // the tag included
         stats_out->payload_bytes = payload.size();
     }
     return out;

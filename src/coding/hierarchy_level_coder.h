@@ -20,8 +20,10 @@ DiagonalExceptions diagonal_exceptions(const Hierarchy& h);
 class HierarchyLevelEncoder {
 public:
     // Decides every node (first pass): fixes the uniform levels, the diagonal rule and the number
-    // of coded symbols, so the header is known before any level is coded.
-    HierarchyLevelEncoder(const Hierarchy& h, const HierarchyCoderOptions& options);
+    // of coded symbols, so the header is known before any level is coded. `stream_version`: an
+    // older hierarchy stream version may be written for tests of the decoder's older paths.
+    HierarchyLevelEncoder(const Hierarchy& h, const HierarchyCoderOptions& options,
+                          uint8_t stream_version = kHierarchyStreamVersion);
     const std::vector<uint8_t>& header() const { return header_; }
     int level_count() const { return int(level_ids_.size()); }
     // Nodes of level l (ids in the encoded hierarchy) in canonical order.
@@ -67,14 +69,22 @@ private:
     int next_level_ = 0;
 };
 
+// Decides `level` of a version-1 stream (hierarchy_decoder_v1.cpp) as the decoder's general path
+// does the newest version's: symbols from `decoder` in `models`, none past `symbol_limit`, context
+// groups masked by `group_mask`.
+void decide_symbols_version1(LevelTraversal& traversal, Level& level, bool uniform_level, ArithmeticDecoder& decoder,
+                             HierarchyModels& level_models, uint64_t& level_symbols_read, uint64_t symbol_limit,
+                             int group_mask);
+
 class HierarchyLevelDecoder {
 public:
-    // `header` is the hierarchy stream header (exactly its bytes). Throws Error on a bad header or
-    // when the uniform levels alone would exceed max_nodes.
-    HierarchyLevelDecoder(const TriangleMesh& base, const uint8_t* header, size_t header_size, uint64_t max_nodes);
+    // `header` is the hierarchy stream header's fields (exactly their bytes), of `stream_version`.
+    // Throws Error on a bad header or when the uniform levels alone would exceed max_nodes.
+    HierarchyLevelDecoder(const TriangleMesh& base, const uint8_t* header, size_t header_size, uint8_t stream_version,
+                          uint64_t max_nodes);
     HierarchyLevelDecoder(const TriangleMesh& base, const HierarchyStreamHeader& header, uint64_t max_nodes);
     // A decoder with no stream yet (done() until restart).
-    HierarchyLevelDecoder() : traversal_(HierarchyCoderOptions{}) {}
+    HierarchyLevelDecoder() : traversal_(HierarchyCoderOptions{}, kHierarchyStreamVersion) {}
     // Starts on another stream as the constructor does, keeping the working memory and the
     // memory of hierarchy() (rebuilt over `base`).
     void restart(const TriangleMesh& base, const HierarchyStreamHeader& header, uint64_t max_nodes);
@@ -103,6 +113,10 @@ private:
     // Counts the decided level's splits (level_.refined, numbered in numbering_) and the vertices
     // they create, and moves to the next level.
     void finish_level();
+    // decide_level for a stream of the newest version, or of version 1 (kVersion1).
+    template <bool kVersion1>
+    void decide_level_of(ArithmeticDecoder& decoder);
+    void decide_level_version1(ArithmeticDecoder& decoder);
 
     HierarchyStreamHeader header_;
     uint64_t max_nodes_ = 0;

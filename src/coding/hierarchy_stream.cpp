@@ -3,6 +3,7 @@
 
 #include "common/check.h"
 
+#include <cstring>
 #include <string>
 
 namespace amc {
@@ -21,6 +22,33 @@ HierarchyCoderOptions coder_options_from_switches(int switches) {
 int coder_switches(const HierarchyCoderOptions& o) {
     return int(o.cull_one_regularity) | int(o.cull_hanging_nodes) << 1 | int(o.uniform_levels) << 2 |
            int(o.truncate_stream) << 3 | int(o.use_contexts) << 4 | int(o.traversal == Traversal::improved) << 5;
+}
+
+namespace {
+
+void check_version(uint8_t version) {
+    AMC_REQUIRE(version <= kHierarchyStreamVersion, unsupported_version,
+                "hierarchy stream: unsupported version " + std::to_string(version) +
+                    " (newer than this build, which reads versions " + std::to_string(kOldestHierarchyStreamVersion) +
+                    " to " + std::to_string(kHierarchyStreamVersion) + ")");
+    AMC_REQUIRE(version >= kOldestHierarchyStreamVersion, corrupt, "hierarchy stream: unknown version " + std::to_string(version));
+}
+
+}  // namespace
+
+std::vector<uint8_t> hierarchy_stream_tag(uint8_t version) {
+    std::vector<uint8_t> out(kHierarchyStreamMagic, kHierarchyStreamMagic + 4);
+    out.push_back(version);
+    return out;
+}
+
+size_t read_hierarchy_stream_tag(const uint8_t* data, size_t size, uint8_t& version) {
+    if (size < 2 || data[0] != uint8_t(kHierarchyStreamMagic[0]) || data[1] != uint8_t(kHierarchyStreamMagic[1])) return 0;
+    AMC_REQUIRE(size >= 4 && std::memcmp(data, kHierarchyStreamMagic, 4) == 0, bad_magic, "hierarchy stream: bad magic");
+    AMC_REQUIRE(size >= 5, truncated, "hierarchy stream: truncated before its version");
+    version = data[4];
+    check_version(version);
+    return 5;
 }
 
 std::vector<uint8_t> write_hierarchy_stream_header(const HierarchyStreamHeader& header) {
@@ -61,6 +89,14 @@ size_t read_hierarchy_stream_header(const uint8_t* data, size_t size, HierarchyS
         }
     }
     return used;
+}
+
+size_t read_standalone_stream_header(const uint8_t* data, size_t size, HierarchyStreamHeader& header,
+                                     uint8_t untagged_version) {
+    header.version = untagged_version;
+    const size_t tag_size = read_hierarchy_stream_tag(data, size, header.version);
+    if (tag_size == 0) check_version(untagged_version);
+    return tag_size + read_hierarchy_stream_header(data + tag_size, size - tag_size, header);
 }
 
 }  // namespace amc

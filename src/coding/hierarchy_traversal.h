@@ -22,6 +22,7 @@
 #pragma once
 
 #include "coding/context_groups.h"
+#include "coding/format_version.h"
 #include "common/compiler.h"
 #include "common/huge_pages.h"
 #include "hierarchy/child_links.h"
@@ -527,11 +528,14 @@ constexpr ContextTable kContextTable{};
 
 class LevelTraversal {
 public:
-    explicit LevelTraversal(const HierarchyCoderOptions& options) { configure(options); }
+    // `stream_version`: the hierarchy stream's version (format_version.h), which says when the
+    // nodes 1-regularity culls are decided.
+    LevelTraversal(const HierarchyCoderOptions& options, uint8_t stream_version) { configure(options, stream_version); }
 
     // Switches to other options, keeping the working memory.
-    void configure(const HierarchyCoderOptions& options) {
+    void configure(const HierarchyCoderOptions& options, uint8_t stream_version) {
         options_ = options;
+        culls_in_turn_ = culls_decided_in_turn(stream_version);
         // What a decided neighbour does to a node's state in the improved traversal: an
         // undecided node outside bucket 0 moves one bucket down (not below 1), or to bucket 0
         // once its three refined neighbours make it culled (a node culled by 1-regularity is in
@@ -555,13 +559,37 @@ public:
     template <class Code, class Force>
     void run(Level& level, bool uniform_level, Code&& code, Force&& force) {
         with_links(level, [&](auto links) {
-            run_on(links, level.state(), static_cast<uint32_t>(level.size()), level.incomplete_count, uniform_level,
-                   code, force);
+            if (culls_in_turn_) {
+                run_on<true>(links, level.state(), static_cast<uint32_t>(level.size()), level.incomplete_count,
+                             uniform_level, code, force);
+            } else {
+                run_on<false>(links, level.state(), static_cast<uint32_t>(level.size()), level.incomplete_count,
+                              uniform_level, code, force);
+            }
         });
     }
+    // run for the newest stream version only (culls_in_turn() is false): for hot paths, which
+    // then hold no code of older versions (see HierarchyLevelDecoder::decide_level).
+    template <class Code, class Force>
+    void run_newest(Level& level, bool uniform_level, Code&& code, Force&& force) {
+        with_links(level, [&](auto links) {
+            run_on<false>(links, level.state(), static_cast<uint32_t>(level.size()), level.incomplete_count,
+                          uniform_level, code, force);
+        });
+    }
+    // run for version 1 only (culls_in_turn() is true).
+    template <class Code, class Force>
+    void run_version1(Level& level, bool uniform_level, Code&& code, Force&& force) {
+        with_links(level, [&](auto links) {
+            run_on<true>(links, level.state(), static_cast<uint32_t>(level.size()), level.incomplete_count,
+                         uniform_level, code, force);
+        });
+    }
+    // Hierarchy stream version 1 (see configure).
+    bool culls_in_turn() const { return culls_in_turn_; }
 
 private:
-    template <class Links, class Code, class Force>
+    template <bool kCullsInTurn, class Links, class Code, class Force>
     void run_on(Links links, uint8_t* state, uint32_t n, uint32_t incomplete_count, bool uniform_level, Code& code,
                 Force& force) {
         // A copy in a local: the state bytes written below could alias options_.
@@ -578,6 +606,12 @@ private:
             return;
         }
         if (options_.traversal == Traversal::naive) {
+            if constexpr (kCullsInTurn) {
+                if (rules.one_regularity && incomplete_count != 0) {
+                    run_naive_culls_in_turn(links, state, n, code, force);
+                    return;
+                }
+            }
             // (The nodes 1-regularity culls are decided already.)
             for (uint32_t i = 0; i < n; ++i) {
                 if (!(state[i] & kDecided)) decide(rules.fate(state[i]), links.neighbors(i), state, i, code, force);
@@ -626,7 +660,12 @@ private:
             return next_bucket;
         };
         if (rules.one_regularity && incomplete_count != 0) {
-            const BucketTops tops = push_lowered(state, n, BucketTops{{top[0], top[1], top[2], top[3]}});
+            BucketTops tops{{top[0], top[1], top[2], top[3]}};
+            if constexpr (kCullsInTurn) {
+                tops = push_culled_in_turn(links, state, n, tops);
+            } else {
+                tops = push_lowered(state, n, tops);
+            }
             for (int b = 0; b < 4; ++b) top[b] = tops.at[b];
         }
         uint32_t fresh_cursor = 0;
@@ -728,6 +767,49 @@ private:
         return tops;
     }
 
+    // Hierarchy stream version 1, improved traversal: the nodes 1-regularity culls went first, one
+    // by one in canonical order, each pushing its undecided neighbours one bucket lower as
+    // run_on's steps do; a node lowered twice or three times left stale entries behind, and each
+    // stack holds its nodes in the order they were lowered. The level's states hold version 2's
+    // priorities (derive_next_level): they are put back in bucket 4 and lowered again in that order.
+    template <class Links>
+    AMC_NOIPA BucketTops push_culled_in_turn(Links links, uint8_t* state, uint32_t n, BucketTops tops) const {
+        for (uint32_t i = 0; i < n; ++i) {
+            if (!(state[i] & kDecided)) state[i] = uint8_t((state[i] & ~kPriorityMask) | kFreshPriority);
+        }
+        for (uint32_t i = 0; i < n; ++i) {
+            if (!(state[i] & kDecided)) continue;  // decided at the outset: culled by 1-regularity
+            const Neighbors node = links.neighbors(i);
+            for (int e = 0; e < 3; ++e) {
+                const uint32_t q = node.nbr[e];
+                const uint8_t s = neighbor_state(state, q);
+                const uint8_t t = after_neighbor_decided_[s];
+                if (t == s) continue;
+                state[q] = t;
+                *tops.at[t >> kPriorityShift]++ = q;
+            }
+        }
+        return tops;
+    }
+
+    // Hierarchy stream version 1, naive traversal: a node 1-regularity culls is decided in its
+    // turn, so the nodes before it see it undecided (context group). The level's states hold it
+    // decided (derive_next_level): it is made undecided again first.
+    template <class Links, class Code, class Force>
+    AMC_NOIPA void run_naive_culls_in_turn(Links links, uint8_t* state, uint32_t n, Code& code, Force& force) const {
+        const CullRules rules{options_.cull_one_regularity, options_.cull_hanging_nodes};
+        for (uint32_t i = 0; i < n; ++i) {
+            if (!(state[i] & kComplete)) state[i] = 0;
+        }
+        for (uint32_t i = 0; i < n; ++i) {
+            if (!(state[i] & kComplete)) {
+                state[i] = uint8_t(state[i] | kDecided);  // culled: not refined
+                continue;
+            }
+            decide(rules.fate(state[i]), links.neighbors(i), state, i, code, force);
+        }
+    }
+
     // Bucket 4: the first node from `cursor` on that is undecided with no decided neighbour, or n.
     // Most nodes the cursor passes were decided meanwhile; they are skipped 16 at a time.
     static uint32_t next_fresh(const uint8_t* state, uint32_t n, uint32_t cursor) {
@@ -781,6 +863,7 @@ private:
     }
 
     HierarchyCoderOptions options_;
+    bool culls_in_turn_ = false;  // hierarchy stream version 1 (see configure)
     uint8_t after_neighbor_decided_[256];  // state -> state, see the constructor
     std::array<ScratchArray<uint32_t>, 4> stacks_;  // buckets 0-3 (each holds at most one entry per node)
 };

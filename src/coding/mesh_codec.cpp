@@ -396,6 +396,7 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     }
 
     HierarchyLevelDecoder hierarchy(base, meta.hierarchy_header.data(), meta.hierarchy_header.size(),
+                                    hierarchy_stream_version_of_file(reader.version()),
                                     std::min<uint64_t>(meta.nodes, options.max_nodes));
     Hierarchy& h = hierarchy.hierarchy();
     // The metadata's counts let the hierarchy grow in place, as far as the file's size warrants.

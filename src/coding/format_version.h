@@ -1,0 +1,39 @@
+// The version numbers of amcodec's streams and which hierarchy stream each .amc version holds: the
+// one place that knows them (docs/FORMAT.md, "Versions and compatibility"). Writers write the
+// newest version; readers read every version from the oldest on and refuse newer ones.
+#pragma once
+
+#include <cstdint>
+
+namespace amc {
+
+// The .amc file (FORMAT.md section 3). decode() reads kOldestReadableVersion .. kNewestVersion. A
+// writer writes the lowest version that holds what the file holds: version 3 only for files with
+// a numbering block, version 2 otherwise.
+constexpr uint8_t kOldestReadableVersion = 1;
+constexpr uint8_t kNewestVersion = 3;
+constexpr uint8_t kBaseVersion = 2;       // everything but the numbering block
+constexpr uint8_t kNumberingVersion = 3;  // the first version with a numbering block
+
+// The hierarchy stream (FORMAT.md section 2).
+constexpr uint8_t kHierarchyStreamVersion = 2;
+constexpr uint8_t kOldestHierarchyStreamVersion = 1;
+// Version 1 decides the nodes 1-regularity culls in their turn, version 2 before the traversal of
+// their level starts.
+constexpr bool culls_decided_in_turn(uint8_t stream_version) { return stream_version < 2; }
+
+// The hierarchy stream version that a readable .amc version holds (a new .amc version that keeps
+// the hierarchy stream adds a case here).
+constexpr uint8_t hierarchy_stream_version_of_file(uint8_t file_version) {
+    switch (file_version) {
+        case 1: return 1;
+        case 2: return 2;
+        case 3: return 2;
+    }
+    return 0;
+}
+static_assert(hierarchy_stream_version_of_file(kBaseVersion) == kHierarchyStreamVersion &&
+                  hierarchy_stream_version_of_file(kNewestVersion) == kHierarchyStreamVersion,
+              "encode() writes the newest hierarchy stream");
+
+}  // namespace amc
