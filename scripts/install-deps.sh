@@ -2,7 +2,8 @@
 # Installs the Debian packages amcodec builds with, skipping those already present.
 set -euo pipefail
 packages=(g++ cmake make pkg-config libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
-          libtinyobjloader-dev libmeshoptimizer-dev libxxhash-dev)
+          libtinyobjloader-dev libmeshoptimizer-dev libxxhash-dev zlib1g-dev
+          python3-meshio python3-vtk9 python3-pytest)
 if [[ "${1:-}" == "--bench" ]]; then
   packages+=(libdraco-dev libzstd-dev liblzma-dev python3)
 fi

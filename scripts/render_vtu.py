@@ -20,6 +20,7 @@ un-zoomed, fitted view: u runs left to right, v runs top to bottom.
 """
 
 import argparse
+import base64
 import math
 import struct
 import sys
@@ -38,33 +39,115 @@ _INT_TYPES = {"Int8", "UInt8", "Int16", "UInt16", "Int32", "UInt32", "Int64", "U
 _FLOAT_TYPES = {"Float32", "Float64"}
 
 
-def _read_array(elem, what):
+_STRUCT = {"Int8": "b", "UInt8": "B", "Int16": "h", "UInt16": "H", "Int32": "i", "UInt32": "I",
+           "Int64": "q", "UInt64": "Q", "Float32": "f", "Float64": "d"}
+
+
+class _Binary:
+    """How the file stores binary arrays: byte order, header words, compression, appended data."""
+
+    def __init__(self, root, appended):
+        self.order = ">" if root.get("byte_order") == "BigEndian" else "<"
+        self.word = "Q" if root.get("header_type") == "UInt64" else "I"
+        compressor = root.get("compressor") or ""
+        if compressor not in ("", "vtkZLibDataCompressor"):
+            raise VtuError("compressor %r is not supported (only zlib)" % compressor)
+        self.zlib = bool(compressor)
+        self.appended = appended  # (encoding, bytes after the '_') or None
+
+    def decode(self, raw, what):
+        """The array's bytes from its header and (compressed) data."""
+        size = struct.calcsize(self.word)
+        words = lambda n, at: struct.unpack_from(self.order + self.word * n, raw, at)
+        try:
+            if not self.zlib:
+                (n,) = words(1, 0)
+                return raw[size:size + n]
+            blocks, _, _ = words(3, 0)
+            sizes = words(blocks, 3 * size)
+            at, out = (3 + blocks) * size, []
+            for c in sizes:
+                out.append(zlib.decompress(raw[at:at + c]))
+                at += c
+            return b"".join(out)
+        except (struct.error, zlib.error) as e:
+            raise VtuError("%s: bad binary data (%s)" % (what, e))
+
+
+def _base64_run(text, nbytes):
+    """Decodes base64 quantum by quantum until nbytes are out (header and data may be padded
+    separately, as VTK writes them)."""
+    text = "".join(text.split())
+    out = bytearray()
+    at = 0
+    while len(out) < nbytes and at < len(text):
+        out += base64.b64decode(text[at:at + 4])
+        at += 4
+    return bytes(out), at
+
+
+def _binary_bytes(text, binary, what):
+    size = struct.calcsize(binary.word)
+    head, _ = _base64_run(text, 3 * size if binary.zlib else size)
+    if binary.zlib:
+        blocks = struct.unpack_from(binary.order + binary.word, head, 0)[0]
+        head, _ = _base64_run(text, (3 + blocks) * size)
+        total = (3 + blocks) * size + sum(struct.unpack_from(binary.order + binary.word * blocks, head, 3 * size))
+    else:
+        total = size + struct.unpack_from(binary.order + binary.word, head, 0)[0]
+    raw, _ = _base64_run(text, total)
+    return binary.decode(raw, what)
+
+
+def _read_array(elem, what, binary):
     fmt = (elem.get("format") or "ascii").lower()
-    if fmt != "ascii":
-        raise VtuError(
-            "%s: DataArray format=%r is not supported (only inline ascii, as written by "
-            "amc); re-save the file in ASCII, e.g. with ParaView 'Data Mode: Ascii'" % (what, fmt))
     typ = elem.get("type", "Float64")
-    words = (elem.text or "").split()
-    if typ in _INT_TYPES:
-        return [int(w) for w in words]
-    if typ in _FLOAT_TYPES:
-        return [float(w) for w in words]
-    raise VtuError("%s: unsupported DataArray type %r" % (what, typ))
+    if typ not in _STRUCT:
+        raise VtuError("%s: unsupported DataArray type %r" % (what, typ))
+    if fmt == "ascii":
+        words = (elem.text or "").split()
+        return [int(w) for w in words] if typ in _INT_TYPES else [float(w) for w in words]
+    if fmt == "binary":
+        data = _binary_bytes(elem.text or "", binary, what)
+    elif fmt == "appended" and binary.appended:
+        encoding, appended = binary.appended
+        offset = int(elem.get("offset", "0"))
+        if encoding == "base64":
+            data = _binary_bytes(appended[offset:].decode("ascii", "replace").split("<")[0], binary, what)
+        else:
+            data = binary.decode(appended[offset:], what)
+    else:
+        raise VtuError("%s: DataArray format=%r is not supported" % (what, fmt))
+    code = _STRUCT[typ]
+    count = len(data) // struct.calcsize(code)
+    return list(struct.unpack(binary.order + code * count, data[:count * struct.calcsize(code)]))
 
 
 def read_vtu(path):
     """Return (points, triangles, level, green); points as list of (x,y,z)."""
+    with open(path, "rb") as f:
+        data = f.read()
+    appended = None
+    start = data.find(b"<AppendedData")
+    if start >= 0:
+        # Raw appended data is not XML: parse the head alone and keep the data aside.
+        tag_end = data.find(b">", start)
+        underscore = data.find(b"_", tag_end)
+        if tag_end < 0 or underscore < 0:
+            raise VtuError("%s: malformed AppendedData" % path)
+        encoding = b"raw" if b'encoding="raw"' in data[start:tag_end] else b"base64"
+        appended = (encoding.decode(), data[underscore + 1:])
+        data = data[:start] + b"</VTKFile>"
     try:
-        root = ET.parse(path).getroot()
+        root = ET.fromstring(data)
     except ET.ParseError as e:
         raise VtuError("%s: not a readable XML file (%s)" % (path, e))
     if root.tag != "VTKFile" or root.get("type") != "UnstructuredGrid":
         raise VtuError("%s: not a VTK UnstructuredGrid XML file" % path)
-    if root.find("AppendedData") is not None:
-        raise VtuError("%s: appended (raw/base64) data is not supported; only inline ascii" % path)
-    if root.get("compressor"):
-        raise VtuError("%s: compressed VTU files are not supported; only inline ascii" % path)
+    try:
+        binary = _Binary(root, appended)
+    except VtuError as e:
+        raise VtuError("%s: %s" % (path, e))
     piece = root.find("UnstructuredGrid/Piece")
     if piece is None:
         raise VtuError("%s: no UnstructuredGrid/Piece element" % path)
@@ -75,7 +158,7 @@ def read_vtu(path):
     if pa is None:
         raise VtuError("%s: no Points DataArray" % path)
     ncomp = int(pa.get("NumberOfComponents", "3"))
-    coords = _read_array(pa, "Points")
+    coords = _read_array(pa, "Points", binary)
     if len(coords) != npts * ncomp:
         raise VtuError("%s: expected %d point coordinates, found %d" % (path, npts * ncomp, len(coords)))
     if ncomp == 3:
@@ -91,9 +174,9 @@ def read_vtu(path):
     for name in ("connectivity", "offsets"):
         if name not in arrays:
             raise VtuError("%s: Cells has no %r DataArray" % (path, name))
-    conn = _read_array(arrays["connectivity"], "connectivity")
-    offs = _read_array(arrays["offsets"], "offsets")
-    types = _read_array(arrays["types"], "types") if "types" in arrays else [5] * len(offs)
+    conn = _read_array(arrays["connectivity"], "connectivity", binary)
+    offs = _read_array(arrays["offsets"], "offsets", binary)
+    types = _read_array(arrays["types"], "types", binary) if "types" in arrays else [5] * len(offs)
     if len(offs) != ncells or len(types) != ncells:
         raise VtuError("%s: Cells arrays do not match NumberOfCells=%d" % (path, ncells))
 
@@ -101,7 +184,7 @@ def read_vtu(path):
     cd = piece.find("CellData")
     if cd is not None:
         for da in cd.findall("DataArray"):
-            vals = _read_array(da, da.get("Name", "?"))
+            vals = _read_array(da, da.get("Name", "?"), binary)
             if len(vals) == ncells:
                 cell_data[da.get("Name")] = vals
     level_c = cell_data.get("level", [0] * ncells)

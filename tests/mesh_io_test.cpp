@@ -20,7 +20,6 @@
 #include "mesh/obj_io.h"
 #include "mesh/off_io.h"
 #include "mesh/ply_io.h"
-#include "mesh/vtu_io.h"
 
 namespace fs = std::filesystem;
 using namespace amc;
@@ -376,31 +375,6 @@ TEST(PlyReader, RejectsHugeCountsBeforeAllocating) {
              "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
     expect_error_containing([&] { parse_ply(header + std::string(64, '\0'), "h.ply"); },
                             "h.ply: element 'junk' declares 4000000000 items");
-}
-
-TEST(VtuWriter, ContainsPointsCellsAndCellData) {
-    TriangleMesh mesh = grid_mesh(2, 2, false);
-    CellData cells;
-    cells.level.assign(mesh.triangles.size(), 3);
-    cells.is_green.assign(mesh.triangles.size(), 1);
-    const std::string xml = format_vtu(mesh, &cells);
-    for (const char* needle :
-         {"<VTKFile type=\"UnstructuredGrid\"", "NumberOfPoints=\"9\" NumberOfCells=\"8\"",
-          "type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\"", "Name=\"connectivity\"",
-          "Name=\"offsets\"", "Name=\"types\"", "<DataArray type=\"UInt8\" Name=\"level\"",
-          "<DataArray type=\"UInt8\" Name=\"green\"", "</VTKFile>", "3 6 9 12 15 18 21 24\n",
-          "5 5 5 5 5 5 5 5\n", "3 3 3 3 3 3 3 3\n", "1 1 1 1 1 1 1 1\n", "0 3 4\n"}) {
-        EXPECT_NE(xml.find(needle), std::string::npos) << needle;
-    }
-    mesh.single_precision = true;
-    const std::string plain = format_vtu(mesh);
-    EXPECT_NE(plain.find("type=\"Float32\""), std::string::npos);
-    EXPECT_EQ(plain.find("CellData"), std::string::npos);
-
-    TempDir dir;
-    write_mesh(dir.file("leaf.VTU"), mesh, &cells);
-    EXPECT_EQ(read_bytes(dir.file("leaf.VTU")), format_vtu(mesh, &cells));
-    expect_error_containing([&] { read_mesh(dir.file("leaf.VTU")); }, "leaf.VTU: reading .vtu");
 }
 
 // ---------------------------------------------------------------------------------------------

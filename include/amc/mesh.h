@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace amc {
@@ -73,8 +74,8 @@ enum class MeshFormat { obj, off, ply, vtu };
 // Format from the file name's extension (.obj, .off, .ply, .vtu); throws Error otherwise.
 MeshFormat mesh_format_from_path(const std::string& path);
 
-// Reads an OBJ, OFF or PLY file (by extension) and validates it with validate_triangle_mesh.
-// Throws Error naming the file and the first offending element.
+// Reads an OBJ, OFF, PLY or VTU file (by extension) and validates it with
+// validate_triangle_mesh. Throws Error naming the file and the first offending element.
 TriangleMesh read_mesh(const std::string& path);
 
 // Checks that the mesh is a triangle mesh fit to be a base mesh: indices in range, coordinates
@@ -84,9 +85,65 @@ TriangleMesh read_mesh(const std::string& path);
 void validate_triangle_mesh(const TriangleMesh& mesh, const std::string& what);
 
 // Writes a mesh; format from the extension. Cell data is written where the format can hold it
-// (VTU cell arrays, PLY face properties) and ignored otherwise. The file is written to a
-// temporary name and renamed, so it is never half-written. Throws Error.
+// (VTU cell arrays, PLY face properties) and ignored otherwise; VTU is written as
+// VtuEncoding::binary_zlib. The file is written to a temporary name and renamed, so it is never
+// half-written. Throws Error.
 void write_mesh(const std::string& path, const TriangleMesh& mesh, const CellData* cells = nullptr);
+
+// ---------------------------------------------------------------------------------------------
+// VTK XML UnstructuredGrid (.vtu) with point and cell data
+
+// The value types of a VTK DataArray, in the order of DataArray::Values' alternatives.
+enum class ValueType : uint8_t { int8, uint8, int16, uint16, int32, uint32, int64, uint64, float32, float64 };
+
+// A named array of point or cell data: `components` values per point (or cell), tuple after
+// tuple. Values keep their own type, so every value (64-bit integers, NaN payloads) survives a
+// read and a write bit for bit.
+struct DataArray {
+    using Values = std::variant<std::vector<int8_t>, std::vector<uint8_t>, std::vector<int16_t>,
+                                std::vector<uint16_t>, std::vector<int32_t>, std::vector<uint32_t>,
+                                std::vector<int64_t>, std::vector<uint64_t>, std::vector<float>,
+                                std::vector<double>>;
+    std::string name;
+    uint32_t components = 1;
+    Values values;  // values[i * components + k]: component k of point (or cell) i
+
+    ValueType type() const { return static_cast<ValueType>(values.index()); }
+    std::size_t size() const;               // number of values (tuples x components)
+    double value(std::size_t index) const;  // one value converted to double
+};
+
+// A triangle mesh with the point data (one tuple per vertex) and cell data (one tuple per
+// triangle) of a VTU file.
+struct VtuMesh {
+    TriangleMesh mesh;
+    std::vector<DataArray> point_data;
+    std::vector<DataArray> cell_data;
+};
+
+// Reads a .vtu file as VTK, ParaView, meshio and DUNE write it: inline ascii or base64
+// ("binary"), or appended raw or base64 data; UInt32 or UInt64 headers; zlib-compressed
+// (vtkZLibDataCompressor) or not; little- or big-endian. Every cell must be a triangle (VTK
+// type 5, or a polygon of 3 points); Points as Float32 set single_precision. A file of several
+// Pieces reads as their concatenation (points of later pieces numbered after earlier ones, as
+// VTK's reader does); their point and cell arrays must match in name, type and components.
+// The mesh is validated with validate_triangle_mesh. Throws Error naming the file.
+VtuMesh read_vtu(const std::string& path);
+
+// The cell arrays "level" and "green" (UInt8) of the non-empty arrays of `cells`, as write_mesh
+// writes them: VtuMesh{leaf.mesh, {}, cell_data_arrays(leaf.cells)}.
+std::vector<DataArray> cell_data_arrays(const CellData& cells);
+
+enum class VtuEncoding {
+    binary_zlib,  // appended raw data, zlib-compressed blocks, UInt64 headers (VTK's default)
+    ascii,        // inline text, for reading by eye
+};
+
+// Writes a .vtu file: Points as Float32 when mesh.single_precision, else Float64; cells as
+// triangles; every array of point_data and cell_data (sizes must match the vertex and triangle
+// counts). Through a temporary file and a rename. Throws Error.
+void write_vtu(const std::string& path, const VtuMesh& vtu,
+               VtuEncoding encoding = VtuEncoding::binary_zlib);
 
 // Writes `bytes` to `path` through a temporary file and a rename. Throws Error.
 void write_file_atomically(const std::string& path, const std::string& bytes);

@@ -13,7 +13,8 @@
 #include "mesh/obj_io.h"
 #include "mesh/off_io.h"
 #include "mesh/ply_io.h"
-#include "mesh/vtu_io.h"
+#include "mesh/vtu_reader.h"
+#include "mesh/vtu_writer.h"
 
 namespace amc {
 namespace {
@@ -53,9 +54,7 @@ MeshFormat mesh_format_from_path(const std::string& path) {
 
 TriangleMesh read_mesh(const std::string& path) {
     const MeshFormat format = mesh_format_from_path(path);
-    if (format == MeshFormat::vtu) {
-        throw Error(path + ": reading .vtu files is not supported (use .obj, .off or .ply)");
-    }
+    if (format == MeshFormat::vtu) return read_vtu(path).mesh;
     const std::string bytes = read_file(path);
     return with_allocation_errors_as_limits(path.c_str(), [&] {
         TriangleMesh mesh;
@@ -78,10 +77,30 @@ void write_mesh(const std::string& path, const TriangleMesh& mesh, const CellDat
             case MeshFormat::obj: bytes = format_obj(mesh); break;
             case MeshFormat::off: bytes = format_off(mesh); break;
             case MeshFormat::ply: bytes = format_ply(mesh, cells); break;
-            case MeshFormat::vtu: bytes = format_vtu(mesh, cells); break;
+            case MeshFormat::vtu:
+                bytes = format_vtu(mesh, {}, cells ? cell_data_arrays(*cells) : std::vector<DataArray>{},
+                                   VtuEncoding::binary_zlib);
+                break;
         }
     } catch (const Error& e) {
         throw e.prefixed(path);
+    }
+    write_file_atomically(path, bytes);
+}
+
+VtuMesh read_vtu(const std::string& path) {
+    const std::string bytes = read_file(path);
+    VtuMesh vtu = parse_vtu(bytes, path);
+    validate_triangle_mesh(vtu.mesh, path);
+    return vtu;
+}
+
+void write_vtu(const std::string& path, const VtuMesh& vtu, VtuEncoding encoding) {
+    std::string bytes;
+    try {
+        bytes = format_vtu(vtu.mesh, vtu.point_data, vtu.cell_data, encoding);
+    } catch (const Error& e) {
+        throw Error(path + ": " + e.what());
     }
     write_file_atomically(path, bytes);
 }
