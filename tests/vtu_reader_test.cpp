@@ -351,6 +351,38 @@ TEST(VtuReader, RefusesHandMadeDefectsNamingThem) {
     refuse(two, "piece 1's cell data array 'v' does not match piece 0's 'u'");
 }
 
+// Thousands of pieces (one triangle each, point data in each): concatenated in order. Messages
+// name lines, and the line numbers are counted once over the file, not once per tag.
+TEST(VtuReader, ManyPiecesConcatenateInOrder) {
+    const uint32_t pieces = 5000;
+    std::string file = "<VTKFile type=\"UnstructuredGrid\">\n<UnstructuredGrid>\n";
+    for (uint32_t k = 0; k < pieces; ++k) {
+        file += "<Piece NumberOfPoints=\"3\" NumberOfCells=\"1\">\n<PointData><DataArray type=\"UInt32\" Name=\"k\">" +
+                std::to_string(k) + " " + std::to_string(k) + " " + std::to_string(k) +
+                "</DataArray></PointData>\n<Points>" + kAsciiPoints + "</Points>\n<Cells>" + kAsciiCells +
+                "</Cells>\n</Piece>\n";
+    }
+    file += "</UnstructuredGrid>\n</VTKFile>\n";
+    const VtuMesh vtu = parse_vtu(file, "many.vtu");
+    ASSERT_EQ(vtu.mesh.triangles.size(), pieces);
+    EXPECT_EQ(vtu.mesh.triangles.back(), (Triangle{3 * pieces - 3, 3 * pieces - 2, 3 * pieces - 1}));
+    ASSERT_EQ(vtu.point_data.size(), 1u);
+    ASSERT_EQ(vtu.point_data[0].size(), 3u * pieces);
+    EXPECT_EQ(vtu.point_data[0].value(3 * pieces - 1), pieces - 1);
+    // An error in the last piece names its line.
+    std::string quad = file;
+    quad.replace(quad.rfind(">5</DataArray>"), 2, ">9");
+    expect_error_containing([&] { parse_vtu(quad, "many.vtu"); }, "cell 4999 is a quad (VTK type 9)");
+    std::string renamed = file;
+    renamed.replace(renamed.rfind("Name=\"k\""), 8, "Name=\"j\"");
+    expect_error_containing([&] { parse_vtu(renamed, "many.vtu"); },
+                            "piece 4999's point data array 'j' does not match piece 0's 'k'");
+    std::string bad_components = file;
+    bad_components.replace(bad_components.rfind("NumberOfComponents=\"3\""), 22, "NumberOfComponents=\"x\"");
+    expect_error_containing([&] { parse_vtu(bad_components, "many.vtu"); },
+                            "<DataArray> has a bad NumberOfComponents 'x' (line 25000)");
+}
+
 TEST(VtuReader, EveryBadFixtureIsRefusedWithItsReason) {
     const struct {
         const char* file;

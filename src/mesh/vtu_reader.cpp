@@ -38,7 +38,7 @@ struct ArrayElement {
     DataFormat format = DataFormat::ascii;
     uint64_t offset = 0;    // appended: where the data starts after the '_'
     std::string_view text;  // ascii and binary: the element's text
-    std::size_t tag_offset = 0;
+    std::size_t line = 0;  // of the DataArray tag, for messages
 };
 
 struct PieceElement {
@@ -61,13 +61,31 @@ std::size_t line_of(std::string_view bytes, std::size_t offset) {
     return 1 + static_cast<std::size_t>(std::count(bytes.begin(), bytes.begin() + offset, '\n'));
 }
 
+// Line numbers of tags met in file order, counted once over the file (not from the start for
+// each tag, which a file of many tags would make quadratic).
+class LineCounter {
+public:
+    explicit LineCounter(std::string_view bytes) : bytes_(bytes) {}
+    std::size_t at(std::size_t offset) {
+        offset = std::min(offset, bytes_.size());
+        if (offset < pos_) return line_of(bytes_, offset);
+        line_ += static_cast<std::size_t>(std::count(bytes_.begin() + pos_, bytes_.begin() + offset, '\n'));
+        pos_ = offset;
+        return line_;
+    }
+
+private:
+    std::string_view bytes_;
+    std::size_t pos_ = 0, line_ = 1;
+};
+
 // ---------------------------------------------------------------------------------------------
 // Structure
 
 uint64_t count_attribute(const XmlToken& tag, const char* name, std::optional<uint64_t> fallback,
-                         const std::string& what, std::string_view bytes) {
+                         const std::string& what, std::size_t line) {
     const std::string* value = tag.attribute(name);
-    const std::string at = " (line " + std::to_string(line_of(bytes, tag.begin)) + ")";
+    const std::string at = " (line " + std::to_string(line) + ")";
     if (!value) {
         if (fallback) return *fallback;
         fail(what, "<" + std::string(tag.name) + "> has no " + name + " attribute" + at);
@@ -112,20 +130,19 @@ void read_root(const XmlToken& tag, Layout& layout, const std::string& what) {
 }
 
 ArrayElement read_array_tag(const XmlToken& tag, Section section, const std::string& what,
-                            std::string_view bytes) {
+                            std::size_t line) {
     ArrayElement a;
     a.section = section;
-    a.tag_offset = tag.begin;
+    a.line = line;
     if (const std::string* name = tag.attribute("Name")) a.name = *name;
-    const std::string array = "DataArray " + text::quote_token(a.name) + " (line " +
-                              std::to_string(line_of(bytes, tag.begin)) + ")";
+    const std::string array = "DataArray " + text::quote_token(a.name) + " (line " + std::to_string(line) + ")";
     const std::string* type = tag.attribute("type");
     if (!type) fail(what, array + " has no type");
     if (!parse_vtk_type_name(*type, a.type)) {
         fail(what, array + " has type " + text::quote_token(*type) +
                        ", which is not read (Int8 to Int64, UInt8 to UInt64, Float32, Float64)");
     }
-    a.components = count_attribute(tag, "NumberOfComponents", 1, what, bytes);
+    a.components = count_attribute(tag, "NumberOfComponents", 1, what, line);
     if (a.components == 0 || a.components > kMaxElements) {
         fail(what, array + " has " + std::to_string(a.components) + " components");
     }
@@ -136,7 +153,7 @@ ArrayElement read_array_tag(const XmlToken& tag, Section section, const std::str
         a.format = DataFormat::binary;
     } else if (*format == "appended") {
         a.format = DataFormat::appended;
-        a.offset = count_attribute(tag, "offset", std::nullopt, what, bytes);
+        a.offset = count_attribute(tag, "offset", std::nullopt, what, line);
     } else {
         fail(what, array + " has unknown format " + text::quote_token(*format));
     }
@@ -173,6 +190,7 @@ void locate_appended(const XmlToken& tag, std::string_view bytes, Layout& layout
 Layout read_layout(std::string_view bytes, const std::string& what) {
     Layout layout;
     XmlTokenizer xml(bytes, what);
+    LineCounter lines(bytes);
     std::vector<std::string_view> stack;
     bool saw_root = false;
     // The DataArray whose text is being collected: (piece, array index), at this depth.
@@ -193,7 +211,7 @@ Layout read_layout(std::string_view bytes, const std::string& what) {
                 if (!blank) {
                     if (!a.text.empty()) {
                         fail(what, "DataArray " + text::quote_token(a.name) + " (line " +
-                                       std::to_string(line_of(bytes, a.tag_offset)) +
+                                       std::to_string(a.line) +
                                        ") has text in several places");
                     }
                     a.text = token.text;
@@ -203,7 +221,7 @@ Layout read_layout(std::string_view bytes, const std::string& what) {
         }
         if (token.kind == XmlToken::Kind::end_tag) {
             if (stack.empty() || stack.back() != token.name) {
-                fail(what, "bad XML at line " + std::to_string(line_of(bytes, token.begin)) + ": </" +
+                fail(what, "bad XML at line " + std::to_string(lines.at(token.begin)) + ": </" +
                                std::string(token.name.substr(0, 32)) + "> closes " +
                                (stack.empty() ? std::string("nothing")
                                               : "<" + std::string(stack.back()) + ">"));
@@ -224,8 +242,9 @@ Layout read_layout(std::string_view bytes, const std::string& what) {
             break;
         } else if (depth == 2 && token.name == "Piece" && stack[1] == "UnstructuredGrid") {
             PieceElement piece;
-            piece.points = count_attribute(token, "NumberOfPoints", std::nullopt, what, bytes);
-            piece.cells = count_attribute(token, "NumberOfCells", std::nullopt, what, bytes);
+            const std::size_t line = lines.at(token.begin);
+            piece.points = count_attribute(token, "NumberOfPoints", std::nullopt, what, line);
+            piece.cells = count_attribute(token, "NumberOfCells", std::nullopt, what, line);
             layout.pieces.push_back(std::move(piece));
         } else if (depth == 4 && token.name == "DataArray" && stack[1] == "UnstructuredGrid" &&
                    stack[2] == "Piece") {
@@ -237,7 +256,7 @@ Layout read_layout(std::string_view bytes, const std::string& what) {
             if (parent == "CellData") section = Section::cell_data;
             if (section) {
                 PieceElement& piece = layout.pieces.back();
-                piece.arrays.push_back(read_array_tag(token, *section, what, bytes));
+                piece.arrays.push_back(read_array_tag(token, *section, what, lines.at(token.begin)));
                 if (!token.self_closing) {
                     open_array = std::make_pair(layout.pieces.size() - 1, piece.arrays.size() - 1);
                 }
@@ -294,7 +313,7 @@ private:
 };
 
 // Names one array in messages: "Points", "Cells array 'types'", "point data 'u'".
-std::string describe(const ArrayElement& a, std::string_view bytes, const std::string& piece) {
+std::string describe(const ArrayElement& a, const std::string& piece) {
     std::string s;
     switch (a.section) {
         case Section::points: s = "Points array"; break;
@@ -303,7 +322,7 @@ std::string describe(const ArrayElement& a, std::string_view bytes, const std::s
         case Section::cell_data: s = "cell data"; break;
     }
     if (!a.name.empty()) s += " " + text::quote_token(a.name);
-    return piece + s + " (line " + std::to_string(line_of(bytes, a.tag_offset)) + ")";
+    return piece + s + " (line " + std::to_string(a.line) + ")";
 }
 
 template <typename T>
@@ -359,8 +378,7 @@ bool parse_value(std::string_view token, T& out) {
 
 class ArrayDecoder {
 public:
-    ArrayDecoder(const Layout& layout, std::string_view bytes, const std::string& what)
-        : layout_(layout), bytes_(bytes), what_(what) {}
+    ArrayDecoder(const Layout& layout, const std::string& what) : layout_(layout), what_(what) {}
 
     // The array's values, which must be `tuples` tuples of its components. `piece` prefixes
     // messages ("piece 2: " or "").
@@ -368,7 +386,7 @@ public:
         DataArray out;
         out.name = a.name;
         out.components = static_cast<uint32_t>(a.components);
-        const std::string where = describe(a, bytes_, piece);
+        const std::string where = describe(a, piece);
         // tuples and components are both below 2^32, so count and its bytes fit in 64 bits.
         const uint64_t count = tuples * a.components;
         const std::size_t size = value_size(a.type);
@@ -522,7 +540,6 @@ private:
     }
 
     const Layout& layout_;
-    std::string_view bytes_;
     const std::string& what_;
 };
 
@@ -591,7 +608,7 @@ const ArrayElement* find_cells_array(const PieceElement& piece, const char* name
 
 VtuMesh parse_vtu(std::string_view bytes, const std::string& what) {
     const Layout layout = read_layout(bytes, what);
-    const ArrayDecoder decoder(layout, bytes, what);
+    const ArrayDecoder decoder(layout, what);
     VtuMesh out;
     out.mesh.single_precision = true;
     uint64_t first_point = 0, first_cell = 0;
@@ -609,7 +626,7 @@ VtuMesh parse_vtu(std::string_view bytes, const std::string& what) {
         };
         const auto integers = [&](const ArrayElement& a, uint64_t tuples) {
             if (!is_integer(a.type) || a.components != 1) {
-                fail(what, describe(a, bytes, prefix) + ": has type " + std::string(vtk_type_name(a.type)) +
+                fail(what, describe(a, prefix) + ": has type " + std::string(vtk_type_name(a.type)) +
                                " with " + std::to_string(a.components) +
                                " components; one integer per cell is needed");
             }
@@ -648,7 +665,7 @@ VtuMesh parse_vtu(std::string_view bytes, const std::string& what) {
         if (!points && piece.points > 0) fail(what, prefix + "no Points DataArray");
         if (points) {
             if (points->components != 3) {
-                fail(what, describe(*points, bytes, prefix) + ": has " + std::to_string(points->components) +
+                fail(what, describe(*points, prefix) + ": has " + std::to_string(points->components) +
                                " components; points need 3");
             }
             const DataArray coordinates = decoder.decode(*points, piece.points, prefix);
