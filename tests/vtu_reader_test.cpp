@@ -386,34 +386,40 @@ TEST(VtuReader, ManyPiecesConcatenateInOrder) {
 TEST(VtuReader, EveryBadFixtureIsRefusedWithItsReason) {
     const struct {
         const char* file;
+        ErrorCode code;
         const char* message;
     } cases[] = {
-        {"mesh.vtu", "no UnstructuredGrid Piece in the file"},
-        {"vtu_bad_base64_character.vtu", "Points array (line 6): the data holds a character that is not base64"},
-        {"vtu_bad_zlib.vtu", "Points array (line 6): compressed block 0 of 1 is not valid zlib data of 144 bytes"},
-        {"vtu_huge_block_count.vtu", "declares 1099511627776 compressed blocks, more than the data can hold"},
-        {"vtu_huge_compressed_size.vtu", "compressed block 0 declares 2400000000 bytes, more than its 55 compressed bytes can hold"},
-        {"vtu_huge_point_count.vtu", "needs 12000000000 values, more than its 149 characters of text can hold"},
-        {"vtu_index_out_of_range.vtu", "cell 7 refers to point 6, out of range (6 points)"},
-        {"vtu_lzma_compressor.vtu", "compressor 'vtkLZMADataCompressor' is not supported"},
-        {"vtu_missing_types.vtu", "Cells has no 'types' DataArray"},
-        {"vtu_not_xml.vtu", "bad XML at line 2"},
-        {"vtu_offset_past_end.vtu", "offset 99999 is past the end of the 74 bytes of appended data"},
-        {"vtu_polydata.vtu", "is a VTK 'PolyData' file; only UnstructuredGrid (.vtu) files are read"},
-        {"vtu_polygon_of_4.vtu", "cell 1 is a polygon (VTK type 7) of 4 points (offset 7)"},
-        {"vtu_quad_cells.vtu", "cell 5 is a quad (VTK type 9); only triangles (VTK type 5)"},
-        {"vtu_truncated_appended.vtu", "a compressed block of 55 bytes is longer than the data left (truncated?)"},
-        {"vtu_truncated_base64.vtu", "declares 144 bytes, but only 69 remain (truncated?)"},
-        {"vtu_unclosed.vtu", "the file ends inside <VTKFile> (truncated?)"},
-        {"vtu_unknown_type.vtu", "DataArray '' (line 6) has type 'Float16', which is not read"},
-        {"vtu_wrong_header_size.vtu", "its header says 136 bytes, expected 144 bytes (18 Float64 values)"},
-        {"vtu_wrong_point_count.vtu", "Points array (line 6): holds 18 values, expected 21"},
+        {"mesh.vtu", ErrorCode::corrupt, "no UnstructuredGrid Piece in the file"},
+        {"vtu_bad_base64_character.vtu", ErrorCode::corrupt, "Points array (line 6): the data holds a character that is not base64"},
+        {"vtu_bad_zlib.vtu", ErrorCode::corrupt, "Points array (line 6): compressed block 0 of 1 is not valid zlib data of 144 bytes"},
+        {"vtu_huge_block_count.vtu", ErrorCode::corrupt, "declares 1099511627776 compressed blocks, more than the data can hold"},
+        {"vtu_huge_compressed_size.vtu", ErrorCode::corrupt, "compressed block 0 declares 2400000000 bytes, more than its 55 compressed bytes can hold"},
+        {"vtu_huge_point_count.vtu", ErrorCode::corrupt, "needs 12000000000 values, more than its 149 characters of text can hold"},
+        {"vtu_index_out_of_range.vtu", ErrorCode::corrupt, "cell 7 refers to point 6, out of range (6 points)"},
+        {"vtu_lzma_compressor.vtu", ErrorCode::invalid_input, "compressor 'vtkLZMADataCompressor' is not supported"},
+        {"vtu_missing_types.vtu", ErrorCode::corrupt, "Cells has no 'types' DataArray"},
+        {"vtu_not_xml.vtu", ErrorCode::corrupt, "bad XML at line 2"},
+        {"vtu_offset_past_end.vtu", ErrorCode::corrupt, "offset 99999 is past the end of the 74 bytes of appended data"},
+        {"vtu_polydata.vtu", ErrorCode::invalid_input, "is a VTK 'PolyData' file; only UnstructuredGrid (.vtu) files are read"},
+        {"vtu_polygon_of_4.vtu", ErrorCode::invalid_input, "cell 1 is a polygon (VTK type 7) of 4 points (offset 7)"},
+        {"vtu_quad_cells.vtu", ErrorCode::invalid_input, "cell 5 is a quad (VTK type 9); only triangles (VTK type 5)"},
+        {"vtu_truncated_appended.vtu", ErrorCode::truncated, "a compressed block of 55 bytes is longer than the data left (truncated?)"},
+        {"vtu_truncated_base64.vtu", ErrorCode::truncated, "declares 144 bytes, but only 69 remain (truncated?)"},
+        {"vtu_unclosed.vtu", ErrorCode::truncated, "the file ends inside <VTKFile> (truncated?)"},
+        {"vtu_unknown_type.vtu", ErrorCode::invalid_input, "DataArray '' (line 6) has type 'Float16', which is not read"},
+        {"vtu_wrong_header_size.vtu", ErrorCode::corrupt, "its header says 136 bytes, expected 144 bytes (18 Float64 values)"},
+        {"vtu_wrong_point_count.vtu", ErrorCode::corrupt, "Points array (line 6): holds 18 values, expected 21"},
     };
     for (const auto& c : cases) {
         const std::string path = bad_fixture(c.file);
         ASSERT_TRUE(fs::exists(path)) << path;
         expect_error_containing([&] { read_vtu(path); }, c.message);
         expect_error_containing([&] { read_vtu(path); }, path + ": ");
+        try {
+            read_vtu(path);
+        } catch (const Error& e) {
+            EXPECT_EQ(e.code(), c.code) << c.file << ": " << error_code_name(e.code());
+        }
     }
 }
 

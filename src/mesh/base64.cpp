@@ -37,8 +37,8 @@ bool Base64Reader::decode_quantum() {
         }
         if (d == kInvalid) {
             // At a quantum's start, '<' is the closing tag: the text ended.
-            failure_ = count == 0 && text_[pos_] == '<' ? "ends early (truncated?)"
-                                                        : "holds a character that is not base64";
+            malformed_ = count > 0 || text_[pos_] != '<';
+            failure_ = malformed_ ? "holds a character that is not base64" : "ends early (truncated?)";
             return false;
         }
         digits[count++] = d;
@@ -49,6 +49,7 @@ bool Base64Reader::decode_quantum() {
     if (digits[3] == kPad) bytes = digits[2] == kPad ? 1 : 2;
     if (digits[0] == kPad || digits[1] == kPad || (digits[2] == kPad && digits[3] != kPad)) {
         failure_ = "holds misplaced base64 padding";
+        malformed_ = true;
         return false;
     }
     const uint32_t word = (uint32_t(digits[0]) << 18) | (uint32_t(digits[1]) << 12) |

@@ -22,6 +22,8 @@ public:
     std::size_t max_remaining() const { return (pending_end_ - pending_pos_) + (text_.size() - pos_) / 4 * 3; }
 
     const char* failure() const { return failure_; }
+    // True when read() failed on a malformed quantum rather than at the end of the text.
+    bool malformed() const { return malformed_; }
 
 private:
     bool decode_quantum();
@@ -31,6 +33,7 @@ private:
     uint8_t pending_[3] = {};
     int pending_pos_ = 0, pending_end_ = 0;
     const char* failure_ = "";
+    bool malformed_ = false;
 };
 
 }  // namespace amc

@@ -100,7 +100,7 @@ void write_vtu(const std::string& path, const VtuMesh& vtu, VtuEncoding encoding
     try {
         bytes = format_vtu(vtu.mesh, vtu.point_data, vtu.cell_data, encoding);
     } catch (const Error& e) {
-        throw Error(path + ": " + e.what());
+        throw e.prefixed(path);
     }
     write_file_atomically(path, bytes);
 }

@@ -20,8 +20,12 @@
 namespace amc {
 namespace {
 
-[[noreturn]] void fail(const std::string& what, const std::string& message) {
-    throw Error(what + ": " + message);
+// Structure no writer produces is `corrupt` unless a call says otherwise: `truncated` for data
+// that ends early, `invalid_input` for valid VTK that is not a triangle mesh we read,
+// `bad_magic` for files that are not VTK XML, `limit_exceeded` past 32-bit counts.
+[[noreturn]] void fail(const std::string& what, const std::string& message,
+                       ErrorCode code = ErrorCode::corrupt) {
+    throw Error(code, what + ": " + message);
 }
 
 // Point indices and triangle numbers are 32-bit.
@@ -100,13 +104,13 @@ uint64_t count_attribute(const XmlToken& tag, const char* name, std::optional<ui
 
 void read_root(const XmlToken& tag, Layout& layout, const std::string& what) {
     if (tag.name != "VTKFile") {
-        fail(what, "not a VTK XML file (the root element is <" + std::string(tag.name.substr(0, 32)) + ">)");
+        fail(what, "not a VTK XML file (the root element is <" + std::string(tag.name.substr(0, 32)) + ">)", ErrorCode::bad_magic);
     }
     const std::string* type = tag.attribute("type");
     if (!type) fail(what, "<VTKFile> has no type attribute");
     if (*type != "UnstructuredGrid") {
         fail(what, "is a VTK " + text::quote_token(*type) +
-                       " file; only UnstructuredGrid (.vtu) files are read");
+                       " file; only UnstructuredGrid (.vtu) files are read", ErrorCode::invalid_input);
     }
     const std::string* order = tag.attribute("byte_order");
     if (order && *order == "BigEndian") {
@@ -125,7 +129,7 @@ void read_root(const XmlToken& tag, Layout& layout, const std::string& what) {
         layout.zlib = true;
     } else if (compressor && !compressor->empty()) {
         fail(what, "compressor " + text::quote_token(*compressor) +
-                       " is not supported (only vtkZLibDataCompressor, or none)");
+                       " is not supported (only vtkZLibDataCompressor, or none)", ErrorCode::invalid_input);
     }
 }
 
@@ -140,7 +144,7 @@ ArrayElement read_array_tag(const XmlToken& tag, Section section, const std::str
     if (!type) fail(what, array + " has no type");
     if (!parse_vtk_type_name(*type, a.type)) {
         fail(what, array + " has type " + text::quote_token(*type) +
-                       ", which is not read (Int8 to Int64, UInt8 to UInt64, Float32, Float64)");
+                       ", which is not read (Int8 to Int64, UInt8 to UInt64, Float32, Float64)", ErrorCode::invalid_input);
     }
     a.components = count_attribute(tag, "NumberOfComponents", 1, what, line);
     if (a.components == 0 || a.components > kMaxElements) {
@@ -198,9 +202,9 @@ Layout read_layout(std::string_view bytes, const std::string& what) {
     for (;;) {
         XmlToken token = xml.next();
         if (token.kind == XmlToken::Kind::end_of_input) {
-            if (!saw_root) fail(what, "not a VTK XML file (no VTKFile element)");
+            if (!saw_root) fail(what, "not a VTK XML file (no VTKFile element)", ErrorCode::bad_magic);
             if (!stack.empty()) {
-                fail(what, "the file ends inside <" + std::string(stack.back()) + "> (truncated?)");
+                fail(what, "the file ends inside <" + std::string(stack.back()) + "> (truncated?)", ErrorCode::truncated);
             }
             break;
         }
@@ -302,9 +306,9 @@ public:
         return base64_ ? base64_->max_remaining() : raw_.size() - pos_;
     }
 
-    std::string failure() const {
-        return base64_ && *base64_->failure() ? base64_->failure() : "ends early (truncated?)";
-    }
+    // Why take() failed: the data ended, or its base64 is malformed.
+    bool truncated() const { return !base64_ || !base64_->malformed(); }
+    std::string failure() const { return truncated() ? "ends early (truncated?)" : base64_->failure(); }
 
 private:
     std::string_view raw_;
@@ -442,10 +446,16 @@ private:
         return values;
     }
 
+    [[noreturn]] void fail_source(const ByteSource& source, const std::string& where,
+                                  const std::string& suffix) const {
+        fail(what_, where + ": the data " + source.failure() + suffix,
+             source.truncated() ? ErrorCode::truncated : ErrorCode::corrupt);
+    }
+
     uint64_t read_word(ByteSource& source, const std::string& where, const char* what_word) const {
         std::vector<uint8_t> scratch;
         const uint8_t* p = source.take(layout_.header_bytes, scratch);
-        if (!p) fail(what_, where + ": the data " + source.failure() + " (in the " + what_word + ")");
+        if (!p) fail_source(source, where, std::string(" (in the ") + what_word + ")");
         uint64_t word = 0;
         for (unsigned i = 0; i < layout_.header_bytes; ++i) {
             const unsigned byte = layout_.big_endian ? i : layout_.header_bytes - 1 - i;
@@ -471,10 +481,10 @@ private:
             }
             if (declared > source.max_remaining()) {
                 fail(what_, where + ": declares " + std::to_string(declared) + " bytes, but only " +
-                                std::to_string(source.max_remaining()) + " remain (truncated?)");
+                                std::to_string(source.max_remaining()) + " remain (truncated?)", ErrorCode::truncated);
             }
             const uint8_t* p = source.take(declared, scratch);
-            if (!p) fail(what_, where + ": the data " + source.failure());
+            if (!p) fail_source(source, where, "");
             return std::vector<uint8_t>(p, p + declared);
         }
         // vtkZLibDataCompressor: block count, block size, size of the last block (0: full), the
@@ -508,13 +518,13 @@ private:
             c = read_word(source, where, "compression header");
             if (c > source.max_remaining()) {
                 fail(what_, where + ": a compressed block of " + std::to_string(c) +
-                                " bytes is longer than the data left (truncated?)");
+                                " bytes is longer than the data left (truncated?)", ErrorCode::truncated);
             }
             compressed_total += c;  // each term is bounded by the input size: no overflow
         }
         if (compressed_total > source.max_remaining()) {
             fail(what_, where + ": the compressed blocks need " + std::to_string(compressed_total) +
-                            " bytes, but only " + std::to_string(source.max_remaining()) + " remain (truncated?)");
+                            " bytes, but only " + std::to_string(source.max_remaining()) + " remain (truncated?)", ErrorCode::truncated);
         }
         // The output grows block by block, each block first checked against what zlib can
         // expand its bytes to: no allocation is larger than the input can back.
@@ -527,7 +537,7 @@ private:
                                 " compressed bytes can hold");
             }
             const uint8_t* p = source.take(compressed[b], scratch);
-            if (!p) fail(what_, where + ": the data " + source.failure());
+            if (!p) fail_source(source, where, "");
             const std::size_t at = out.size();
             out.resize(at + size);
             if (!inflate_zlib_block(p, compressed[b], out.data() + at, size)) {
@@ -579,14 +589,14 @@ void append_data(std::vector<DataArray>& all, std::vector<DataArray>&& piece, bo
     }
     if (piece.size() != all.size()) {
         fail(what, "piece " + std::to_string(piece_index) + " has " + std::to_string(piece.size()) + " " +
-                       kind + " arrays, piece 0 has " + std::to_string(all.size()));
+                       kind + " arrays, piece 0 has " + std::to_string(all.size()), ErrorCode::invalid_input);
     }
     for (std::size_t i = 0; i < all.size(); ++i) {
         if (piece[i].name != all[i].name || piece[i].type() != all[i].type() ||
             piece[i].components != all[i].components) {
             fail(what, "piece " + std::to_string(piece_index) + "'s " + kind + " array " +
                            text::quote_token(piece[i].name) + " does not match piece 0's " +
-                           text::quote_token(all[i].name) + " (name, type and components)");
+                           text::quote_token(all[i].name) + " (name, type and components)", ErrorCode::invalid_input);
         }
         std::visit(
             [&](auto& v) {
@@ -617,7 +627,7 @@ VtuMesh parse_vtu(std::string_view bytes, const std::string& what) {
         const std::string prefix = layout.pieces.size() > 1 ? "piece " + std::to_string(k) + ": " : "";
         if (piece.points > kMaxElements - first_point || piece.cells > kMaxElements - first_cell) {
             fail(what, prefix + "declares " + std::to_string(piece.points) + " points and " +
-                           std::to_string(piece.cells) + " cells, more than 2^32 - 1 in all");
+                           std::to_string(piece.cells) + " cells, more than 2^32 - 1 in all", ErrorCode::limit_exceeded);
         }
         const auto need = [&](const char* name) -> const ArrayElement& {
             const ArrayElement* a = find_cells_array(piece, name);
@@ -628,7 +638,7 @@ VtuMesh parse_vtu(std::string_view bytes, const std::string& what) {
             if (!is_integer(a.type) || a.components != 1) {
                 fail(what, describe(a, prefix) + ": has type " + std::string(vtk_type_name(a.type)) +
                                " with " + std::to_string(a.components) +
-                               " components; one integer per cell is needed");
+                               " components; one integer per cell is needed", ErrorCode::invalid_input);
             }
             return decoder.decode(a, tuples, prefix);
         };
@@ -638,7 +648,7 @@ VtuMesh parse_vtu(std::string_view bytes, const std::string& what) {
         for_each_integer(types, [&](std::size_t i, int64_t type) {
             if (type != kVtkTriangle && type != kVtkPolygon) {
                 fail(what, "cell " + std::to_string(first_cell + i) + " is " + describe_vtk_cell_type(type) +
-                               "; only triangles (VTK type 5) and polygons of 3 points are read");
+                               "; only triangles (VTK type 5) and polygons of 3 points are read", ErrorCode::invalid_input);
             }
         });
         const DataArray offsets = integers(need("offsets"), piece.cells);
@@ -650,7 +660,7 @@ VtuMesh parse_vtu(std::string_view bytes, const std::string& what) {
                 fail(what, "cell " + std::to_string(first_cell + i) + " is " + describe_vtk_cell_type(type) +
                                " of " + (end >= begin ? std::to_string(end - begin) : std::string("fewer than 0")) +
                                " points (offset " + std::to_string(end) +
-                               "); only cells of 3 points are read");
+                               "); only cells of 3 points are read", ErrorCode::invalid_input);
             }
         });
         const DataArray connectivity = integers(need("connectivity"), 3 * piece.cells);
@@ -666,7 +676,7 @@ VtuMesh parse_vtu(std::string_view bytes, const std::string& what) {
         if (points) {
             if (points->components != 3) {
                 fail(what, describe(*points, prefix) + ": has " + std::to_string(points->components) +
-                               " components; points need 3");
+                               " components; points need 3", ErrorCode::invalid_input);
             }
             const DataArray coordinates = decoder.decode(*points, piece.points, prefix);
             if (points->type != ValueType::float32) out.mesh.single_precision = false;

@@ -49,7 +49,7 @@ std::size_t XmlTokenizer::line_of(std::size_t offset) const {
 }
 
 void XmlTokenizer::fail(std::size_t offset, const std::string& message) const {
-    throw Error(what_ + ": bad XML at line " + std::to_string(line_of(offset)) + ": " + message);
+    throw Error(ErrorCode::corrupt, what_ + ": bad XML at line " + std::to_string(line_of(offset)) + ": " + message);
 }
 
 void XmlTokenizer::skip_until(std::string_view terminator, std::size_t start, const char* what) {

@@ -17,7 +17,7 @@ CompressedBlocks compress_zlib_blocks(const uint8_t* data, std::size_t size, std
         const std::size_t length = std::min(block_size, size - begin);
         uLongf compressed = static_cast<uLongf>(buffer.size());
         if (compress2(buffer.data(), &compressed, data + begin, static_cast<uLong>(length), level) != Z_OK) {
-            throw Error("zlib compression failed");
+            throw Error(ErrorCode::limit_exceeded, "zlib compression failed (out of memory)");
         }
         out.compressed_sizes.push_back(compressed);
         out.bytes.append(reinterpret_cast<const char*>(buffer.data()), compressed);
