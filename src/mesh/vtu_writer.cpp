@@ -148,7 +148,7 @@ public:
         }
         xml_ += array_tag(a, "format=\"appended\" offset=\"" + std::to_string(appended_.size()) + "\"/>\n");
         const auto [data, size] = raw_bytes(a);
-        const CompressedBlocks blocks = compress_zlib_blocks(data, size, kVtkBlockSize, kVtkZlibLevel);
+        const CompressedBlocks blocks = compress_zlib_blocks(data, size, kVtkBlockSize, kZlibLevel);
         const uint64_t count = blocks.compressed_sizes.size();
         const uint64_t last = size % kVtkBlockSize;
         append_word(count);
