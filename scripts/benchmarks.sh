@@ -35,7 +35,7 @@ else
     for criterion in mean gauss; do
       faces=$mean_faces
       [[ $criterion == gauss ]] && faces=$gauss_faces
-      "$amc" refine --input "$data/$file" --criterion "$criterion" --faces "$faces" --base-faces 500 --max-level 5 \
+      "$amc" -f refine --input "$data/$file" --criterion "$criterion" --faces "$faces" --base-faces 500 --max-level 5 \
         -o "$corpus/${model}_$criterion.amh" > /dev/null
       models+=("$corpus/${model}_$criterion.amh")
     done
@@ -52,10 +52,10 @@ mountain    mountain.obj    100000 100000
 LIST
 fi
 # Planar finite-element models, a uniform and a random refinement.
-"$amc" refine --model lshape --max-level 10 -o "$corpus/lshape.amh" > /dev/null
-"$amc" refine --model front --steps 3 --max-level 9 -o "$corpus/front" > /dev/null
-"$amc" refine --model uniform --levels 7 -o "$corpus/uniform.amh" > /dev/null
-"$amc" refine --model random --faces 150000 --seed 7 -o "$corpus/random.amh" > /dev/null
+"$amc" -f refine --model lshape --max-level 10 -o "$corpus/lshape.amh" > /dev/null
+"$amc" -f refine --model front --steps 3 --max-level 9 -o "$corpus/front" > /dev/null
+"$amc" -f refine --model uniform --levels 7 -o "$corpus/uniform.amh" > /dev/null
+"$amc" -f refine --model random --faces 150000 --seed 7 -o "$corpus/random.amh" > /dev/null
 models+=("$corpus/lshape.amh" "$corpus"/front_*.amh "$corpus/uniform.amh" "$corpus/random.amh")
 
 # ---- measure -------------------------------------------------------------------------------

@@ -14,7 +14,7 @@ if [[ ! -d $data ]]; then
 else
   # model        input             criterion  faces
   while read -r name input criterion faces; do
-    "$amc" refine --input "$data/$input" --criterion "$criterion" --faces "$faces" --base-faces 500 \
+    "$amc" -f refine --input "$data/$input" --criterion "$criterion" --faces "$faces" --base-faces 500 \
       --max-level 5 -o "$out/$name.amh" > /dev/null
   done <<'LIST'
 bunny          bunny-hr.obj    mean   90771
@@ -27,6 +27,6 @@ rabbit         bunny-hr.obj    gauss  68506
 venus          venus.off       gauss  138672
 LIST
 fi
-"$amc" refine --model lshape --max-level 10 -o "$out/lshape.amh" > /dev/null
-"$amc" refine --model front --steps 3 --max-level 9 -o "$out/front" > /dev/null
+"$amc" -f refine --model lshape --max-level 10 -o "$out/lshape.amh" > /dev/null
+"$amc" -f refine --model front --steps 3 --max-level 9 -o "$out/front" > /dev/null
 "$amc" stats "$out"/*.amh --groups

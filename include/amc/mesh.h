@@ -74,9 +74,15 @@ enum class MeshFormat { obj, off, ply, vtu };
 // Format from the file name's extension (.obj, .off, .ply, .vtu); throws Error otherwise.
 MeshFormat mesh_format_from_path(const std::string& path);
 
+// The format a file's first bytes announce (PLY, OFF and VTU have magic words; OBJ has none and
+// is taken for text that starts like an OBJ file). Returns false when the bytes name no format.
+bool mesh_format_from_content(const std::string& bytes, MeshFormat& format);
+
 // Reads an OBJ, OFF, PLY or VTU file (by extension) and validates it with
 // validate_triangle_mesh. Throws Error naming the file and the first offending element.
 TriangleMesh read_mesh(const std::string& path);
+// The same for a file's bytes already in memory; `what` names the source in messages.
+TriangleMesh parse_mesh(const std::string& bytes, MeshFormat format, const std::string& what);
 
 // Checks that the mesh is a triangle mesh fit to be a base mesh: indices in range, coordinates
 // finite, no degenerate (repeated-vertex) or repeated triangles, every edge shared by at most two
@@ -89,6 +95,8 @@ void validate_triangle_mesh(const TriangleMesh& mesh, const std::string& what);
 // VtuEncoding::binary_zlib. The file is written to a temporary name and renamed, so it is never
 // half-written. Throws Error.
 void write_mesh(const std::string& path, const TriangleMesh& mesh, const CellData* cells = nullptr);
+// The bytes write_mesh would write, for a format chosen by the caller (output to a stream).
+std::string format_mesh(const TriangleMesh& mesh, const CellData* cells, MeshFormat format);
 
 // ---------------------------------------------------------------------------------------------
 // VTK XML UnstructuredGrid (.vtu) with point and cell data

@@ -1,4 +1,5 @@
 // read_mesh / write_mesh: format dispatch by extension, whole-file reads and atomic writes.
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -52,36 +53,61 @@ MeshFormat mesh_format_from_path(const std::string& path) {
                 " (expected .obj, .off, .ply or .vtu)");
 }
 
-TriangleMesh read_mesh(const std::string& path) {
-    const MeshFormat format = mesh_format_from_path(path);
-    if (format == MeshFormat::vtu) return read_vtu(path).mesh;
-    const std::string bytes = read_file(path);
-    return with_allocation_errors_as_limits(path.c_str(), [&] {
+bool mesh_format_from_content(const std::string& bytes, MeshFormat& format) {
+    size_t start = 0;  // skip a byte-order mark and leading white space
+    if (bytes.compare(0, 3, "\xEF\xBB\xBF") == 0) start = 3;
+    while (start < bytes.size() && start < 4096 && std::isspace(static_cast<unsigned char>(bytes[start]))) ++start;
+    auto starts_with = [&](const char* word) { return bytes.compare(start, std::strlen(word), word) == 0; };
+    if (bytes.compare(0, 4, "ply\n") == 0 || bytes.compare(0, 5, "ply\r\n") == 0) {
+        format = MeshFormat::ply;
+    } else if (starts_with("OFF") || starts_with("COFF") || starts_with("NOFF") || starts_with("CNOFF")) {
+        format = MeshFormat::off;
+    } else if (starts_with("<?xml") || starts_with("<VTKFile")) {
+        format = MeshFormat::vtu;
+    } else if (starts_with("#") || starts_with("v ") || starts_with("v\t") || starts_with("o ") || starts_with("g ") ||
+               starts_with("mtllib") || starts_with("vn ") || starts_with("vt ") || starts_with("f ") || starts_with("s ")) {
+        format = MeshFormat::obj;
+    } else {
+        return false;
+    }
+    return true;
+}
+
+TriangleMesh parse_mesh(const std::string& bytes, MeshFormat format, const std::string& what) {
+    return with_allocation_errors_as_limits(what.c_str(), [&] {
         TriangleMesh mesh;
         switch (format) {
-            case MeshFormat::obj: mesh = parse_obj(bytes, path); break;
-            case MeshFormat::off: mesh = parse_off(bytes, path); break;
-            case MeshFormat::ply: mesh = parse_ply(bytes, path); break;
-            case MeshFormat::vtu: break;
+            case MeshFormat::obj: mesh = parse_obj(bytes, what); break;
+            case MeshFormat::off: mesh = parse_off(bytes, what); break;
+            case MeshFormat::ply: mesh = parse_ply(bytes, what); break;
+            case MeshFormat::vtu: mesh = parse_vtu(bytes, what).mesh; break;
         }
-        validate_triangle_mesh(mesh, path);
+        validate_triangle_mesh(mesh, what);
         return mesh;
     });
+}
+
+TriangleMesh read_mesh(const std::string& path) {
+    const MeshFormat format = mesh_format_from_path(path);
+    return parse_mesh(read_file(path), format, path);
+}
+
+std::string format_mesh(const TriangleMesh& mesh, const CellData* cells, MeshFormat format) {
+    switch (format) {
+        case MeshFormat::obj: return format_obj(mesh);
+        case MeshFormat::off: return format_off(mesh);
+        case MeshFormat::ply: return format_ply(mesh, cells);
+        case MeshFormat::vtu:
+            return format_vtu(mesh, {}, cells ? cell_data_arrays(*cells) : std::vector<DataArray>{}, VtuEncoding::binary_zlib);
+    }
+    return {};
 }
 
 void write_mesh(const std::string& path, const TriangleMesh& mesh, const CellData* cells) {
     const MeshFormat format = mesh_format_from_path(path);
     std::string bytes;
     try {
-        switch (format) {
-            case MeshFormat::obj: bytes = format_obj(mesh); break;
-            case MeshFormat::off: bytes = format_off(mesh); break;
-            case MeshFormat::ply: bytes = format_ply(mesh, cells); break;
-            case MeshFormat::vtu:
-                bytes = format_vtu(mesh, {}, cells ? cell_data_arrays(*cells) : std::vector<DataArray>{},
-                                   VtuEncoding::binary_zlib);
-                break;
-        }
+        bytes = format_mesh(mesh, cells, format);
     } catch (const Error& e) {
         throw e.prefixed(path);
     }

@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# The command-line conventions of `amc` (those of zstd and xz): exit codes 0/1/2, default output
+# names, refusal to overwrite without -f, - for stdin and stdout, input kind from magic bytes,
+# output kind from the extension, range checks, -q, --version, the numbering restored.
+# Usage: cli_conventions.sh AMC DATA_DIR
+set -u
+amc=$1
+data=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work" || exit 1
+failures=0
+
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+# expect CODE COMMAND...: runs the command, checks its exit code.
+expect() {
+  local code=$1; shift
+  "$@" > out.txt 2> err.txt
+  local got=$?
+  [[ $got == "$code" ]] || fail "'$*' exited $got, expected $code; stderr: $(head -c 300 err.txt)"
+}
+# The mesh of an OBJ file without comments: vertices and faces as numbers.
+mesh_of() { grep -v '^#' "$1" | awk '{print $1, $2 + 0, $3 + 0, $4 + 0}'; }
+
+expect 0 "$amc" --version
+grep -q '^amc [0-9]' out.txt || fail "--version prints no version"
+expect 2 "$amc"
+expect 2 "$amc" encode
+expect 2 "$amc" encode --no-such-option x
+expect 0 "$amc" --help
+grep -q 'Examples' out.txt || fail "--help shows no examples"
+
+# A plain mesh and a hierarchy to work on.
+expect 2 "$amc" refine --model random --faces 3000 --seed 3
+expect 0 "$amc" refine --model random --faces 3000 --seed 3 -o r.amh --leaf-mesh r.obj
+expect 1 "$amc" refine --model random --faces 3000 --seed 3 -o r.amh
+expect 0 "$amc" -f refine --model random --faces 3000 --seed 3 -o r.amh
+expect 0 "$amc" refine --model front --steps 2 --max-level 5 -o front.amh
+[[ -f front_0.amh && -f front_1.amh ]] || fail "refine --model front -o front.amh wrote no front_0.amh, front_1.amh"
+expect 2 "$amc" refine --model lshape --max-level 40 -o l.amh
+
+# Default names, refusal, -f.
+expect 0 "$amc" encode r.amh
+[[ -s r.amc ]] || fail "encode r.amh wrote no r.amc"
+expect 1 "$amc" encode r.amh
+grep -q 'already exists' err.txt || fail "refusal does not say the file exists"
+expect 0 "$amc" encode -f r.amh
+expect 0 "$amc" encode r.amh -o r2.amc -q
+[[ -s out.txt ]] && fail "-q printed: $(head -c 200 out.txt)"
+expect 0 "$amc" decode r.amc
+[[ -s r.ply ]] || fail "decode r.amc wrote no r.ply"
+expect 2 "$amc" encode r.amh -o r.obj
+[[ -e r.obj.tmp* ]] && fail "a temporary file was left"
+expect 2 "$amc" decode r.amc -o x.amc
+expect 2 "$amc" decode r.amc -o x.bin
+[[ -e x.bin ]] && fail "decode wrote x.bin after refusing it"
+
+# Ranges, the same in every subcommand.
+expect 2 "$amc" decode r.amc -o l.ply --level -5
+expect 2 "$amc" decode r.amc -o l.ply --level 99
+expect 1 "$amc" decode r.amc -o l.ply --level 29
+[[ -e l.ply ]] && fail "decode --level past the depth wrote l.ply"
+expect 1 "$amc" extract r.amh -o l.ply --level 29
+expect 0 "$amc" decode r.amc -o l1.vtu --level 1
+expect 2 "$amc" encode r.amh -o q.amc --quantize 31
+
+# Kinds from magic bytes, not from names.
+cp r.amc renamed.bin
+expect 0 "$amc" info renamed.bin
+grep -q 'amc version' out.txt || fail "info did not see .amc data in renamed.bin"
+expect 0 "$amc" info "$data/tetrahedron_off_no_extension"
+grep -q '4 vertices, 4 triangles' out.txt || fail "info did not read the OFF file without extension"
+expect 1 "$amc" decode r.amh -o x.ply
+grep -q 'expected compressed' err.txt || fail "decode of a hierarchy says: $(cat err.txt)"
+
+# stdin and stdout.
+"$amc" encode - -q < r.amh > s.amc || fail "encode - > s.amc"
+cmp -s s.amc r.amc || fail "encode from stdin differs from encode from the file"
+"$amc" decode - -o - --format obj -q < r.amc > s.obj || fail "decode - -o -"
+expect 0 "$amc" decode r.amc -o d.obj -q
+cmp -s s.obj d.obj || fail "decode to stdout differs from decode to a file"
+
+# A plain mesh in, its own numbering back.
+expect 0 "$amc" encode r.obj -o m.amc --keep-numbering --map m.map
+expect 0 "$amc" decode m.amc -o m.obj
+diff -q <(mesh_of m.obj) <(mesh_of r.obj) > /dev/null || fail "decode of --keep-numbering is not the input mesh"
+head -1 m.map | grep -q 'amc-numbering-map 1' || fail "encode --map wrote no map"
+expect 0 "$amc" decode m.amc -o mc.obj --canonical
+expect 0 "$amc" decode m.amc -o m2.ply --map m2.map
+cmp -s m.map m2.map || fail "the map stored in the file differs from the one encode wrote"
+expect 1 "$amc" decode r.amc -o r3.ply --map r3.map
+expect 2 "$amc" encode r.amh -o r4.amc --keep-numbering
+
+if ((failures)); then
+  echo "$failures failure(s)"
+  exit 1
+fi
+echo "all CLI conventions hold"

@@ -1,0 +1,126 @@
+// Input and output files of the `amc` command (see cli_files.h).
+#include "cli_files.h"
+
+#include <amc/hierarchy.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+
+namespace amc::cli {
+
+namespace {
+
+std::string lower_extension(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return ext;
+}
+
+bool starts_with(const std::string& bytes, const char* magic) { return bytes.compare(0, std::strlen(magic), magic) == 0; }
+
+}  // namespace
+
+const char* file_kind_name(FileKind kind) {
+    switch (kind) {
+        case FileKind::compressed: return "compressed .amc data";
+        case FileKind::hierarchy: return "a hierarchy (.amh)";
+        case FileKind::mesh: return "a mesh";
+    }
+    return "?";
+}
+
+InputFile read_input(const std::string& path) {
+    InputFile in;
+    if (path == "-") {
+        in.name = "stdin";
+        in.bytes.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
+        if (std::cin.bad()) throw Error(ErrorCode::io, "stdin: read error");
+    } else {
+        in.name = path;
+        std::error_code ec;
+        const std::filesystem::file_status status = std::filesystem::status(path, ec);
+        if (ec || !std::filesystem::exists(status))
+            throw Error(ErrorCode::io, path + ": cannot open file (" + (ec ? ec.message() : std::string("No such file or directory")) + ")");
+        if (!std::filesystem::is_regular_file(status)) throw Error(ErrorCode::io, path + ": not a regular file");
+        std::ifstream file(path, std::ios::binary);
+        if (!file) throw Error(ErrorCode::io, path + ": cannot open file (" + std::strerror(errno) + ")");
+        in.bytes.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+        if (file.bad()) throw Error(ErrorCode::io, path + ": read error");
+    }
+    if (starts_with(in.bytes, "AMCF")) {
+        in.kind = FileKind::compressed;
+    } else if (starts_with(in.bytes, "AMCH")) {
+        in.kind = FileKind::hierarchy;
+    } else if (mesh_format_from_content(in.bytes, in.mesh_format)) {
+        in.kind = FileKind::mesh;
+    } else if (lower_extension(path) == ".obj") {
+        in.kind = FileKind::mesh;  // OBJ has no magic word: trust the name
+        in.mesh_format = MeshFormat::obj;
+    } else {
+        throw Error(ErrorCode::bad_magic, in.name + ": " + (in.bytes.empty() ? "empty file" : "not a file amc reads") +
+                    " (expected .amc, .amh, or a mesh: OBJ, OFF, PLY, VTU)");
+    }
+    return in;
+}
+
+std::string default_output(const std::string& input, const std::string& extension) {
+    if (input == "-") return "-";
+    return std::filesystem::path(input).replace_extension(extension).string();
+}
+
+OutputKind output_kind(const std::string& path, MeshFormat* mesh_format) {
+    const std::string ext = lower_extension(path);
+    if (ext == ".amc") return OutputKind::compressed;
+    if (ext == ".amh") return OutputKind::hierarchy;
+    for (auto [name, format] : {std::pair{".obj", MeshFormat::obj}, std::pair{".off", MeshFormat::off},
+                                std::pair{".ply", MeshFormat::ply}, std::pair{".vtu", MeshFormat::vtu}}) {
+        if (ext == name) {
+            if (mesh_format != nullptr) *mesh_format = format;
+            return OutputKind::mesh;
+        }
+    }
+    return OutputKind::other;
+}
+
+void write_output(const std::string& path, const std::string& bytes, bool force) {
+    if (path == "-") {
+        std::fwrite(bytes.data(), 1, bytes.size(), stdout);
+        if (std::fflush(stdout) != 0 || std::ferror(stdout)) throw Error(ErrorCode::io, "stdout: write error");
+        return;
+    }
+    if (!force) refuse_existing(path);
+    write_file_atomically(path, bytes);
+}
+
+void refuse_existing(const std::string& path) {
+    std::error_code ec;
+    if (path != "-" && std::filesystem::exists(path, ec)) throw Error(ErrorCode::io, path + ": already exists (use -f to overwrite)");
+}
+
+Hierarchy decode_input(const InputFile& input, const DecodeOptions& options, LeafNumbering* numbering) {
+    if (input.kind != FileKind::compressed)
+        throw Error(input.name + ": expected compressed .amc data, found " + file_kind_name(input.kind));
+    try {
+        return decode(reinterpret_cast<const uint8_t*>(input.bytes.data()), input.bytes.size(), options, numbering);
+    } catch (const Error& e) {
+        throw e.prefixed(input.name);
+    }
+}
+
+Hierarchy hierarchy_of(const InputFile& input) {
+    if (input.kind != FileKind::hierarchy)
+        throw Error(input.name + ": expected a hierarchy (.amh), found " + file_kind_name(input.kind));
+    return deserialize_hierarchy(input.bytes, input.name);
+}
+
+TriangleMesh mesh_of(const InputFile& input) {
+    if (input.kind != FileKind::mesh) throw Error(input.name + ": expected a mesh, found " + file_kind_name(input.kind));
+    return parse_mesh(input.bytes, input.mesh_format, input.name);
+}
+
+}  // namespace amc::cli

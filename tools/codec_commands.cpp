@@ -1,0 +1,161 @@
+// `amc encode` and `amc decode`: files in, .amc out, and back.
+#include "cli_files.h"
+#include "commands.h"
+#include "mesh_import.h"
+
+#include <amc/codec.h>
+#include <amc/numbering.h>
+
+#include <chrono>
+#include <cstdio>
+
+namespace amc::cli {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+const char* predictor_name(GeometryPredictor p) {
+    return p == GeometryPredictor::butterfly ? "butterfly" : p == GeometryPredictor::midpoint ? "midpoint" : "automatic";
+}
+
+GeometryPredictor parse_predictor(const std::string& name) {
+    if (name == "auto") return GeometryPredictor::automatic;
+    if (name == "midpoint") return GeometryPredictor::midpoint;
+    if (name == "butterfly") return GeometryPredictor::butterfly;
+    throw UsageError("--predictor: unknown predictor '" + name + "' (auto, midpoint, butterfly)");
+}
+
+// Summaries go to stderr when the data goes to stdout.
+std::FILE* report_stream(const std::string& output) { return output == "-" ? stderr : stdout; }
+
+void print_encode_stats(std::FILE* out, const std::string& name, const EncodeStats& s, double seconds) {
+    std::fprintf(out, "%s: %lu bytes = %.3f bits/face, %.2f bits/vertex (%lu faces, %lu vertices, %lu nodes, %d levels)\n",
+                 name.c_str(), (unsigned long)s.total_bytes, 8.0 * s.total_bytes / double(s.faces),
+                 8.0 * s.total_bytes / double(s.vertices), (unsigned long)s.faces, (unsigned long)s.vertices,
+                 (unsigned long)s.nodes, s.levels);
+    std::fprintf(out,
+                 "  connectivity %lu bytes (base %lu, hierarchy %lu) = %.3f bits/face; geometry %lu bytes (base %lu, "
+                 "refinement %lu); header %lu, framing %lu",
+                 (unsigned long)(s.base_connectivity_bytes + s.hierarchy_bytes), (unsigned long)s.base_connectivity_bytes,
+                 (unsigned long)s.hierarchy_bytes, 8.0 * (s.base_connectivity_bytes + s.hierarchy_bytes) / double(s.faces),
+                 (unsigned long)(s.base_geometry_bytes + s.geometry_bytes), (unsigned long)s.base_geometry_bytes,
+                 (unsigned long)s.geometry_bytes, (unsigned long)s.header_bytes, (unsigned long)s.framing_bytes);
+    if (s.numbering_bytes > 0) std::fprintf(out, "; numbering %lu", (unsigned long)s.numbering_bytes);
+    std::fprintf(out, "\n  predictor per level:");
+    for (const LevelStats& level : s.per_level) {
+        if (level.new_vertices > 0) std::fprintf(out, " %s", predictor_name(level.predictor));
+    }
+    std::fprintf(out, "\n");
+    if (s.max_error > 0) std::fprintf(out, "  quantized: max coordinate error %.3g\n", s.max_error);
+    std::fprintf(out, "  encode %.3f s (%.2f M faces/s)\n", seconds, s.faces / seconds / 1e6);
+}
+
+}  // namespace
+
+void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
+    const InputFile input = read_input(command.input);
+    const std::string output = command.output.empty() ? default_output(command.input, ".amc") : command.output;
+    const OutputKind kind = output_kind(output);
+    if (output != "-" && (kind == OutputKind::mesh || kind == OutputKind::hierarchy))
+        throw UsageError("encode writes compressed .amc data, but " + output + " names a " +
+                         (kind == OutputKind::mesh ? "mesh" : "hierarchy") + " file (use .amc)");
+    if (input.kind == FileKind::compressed) throw Error(input.name + ": already compressed .amc data");
+    if (!command.base.empty() && input.kind != FileKind::mesh)
+        throw UsageError("--base applies to a mesh input; " + input.name + " is " + file_kind_name(input.kind));
+    if ((command.keep_numbering || !command.map.empty()) && input.kind != FileKind::mesh)
+        throw UsageError("--keep-numbering and --map apply to a mesh input; " + input.name + " is " +
+                         file_kind_name(input.kind) + ", which is numbered canonically already");
+    if (!global.force && !command.map.empty()) refuse_existing(command.map);
+
+    EncodeOptions options;
+    options.quantize_bits = command.quantize_bits;
+    options.predictor = parse_predictor(command.predictor);
+    Hierarchy h;
+    LeafNumbering numbering;
+    auto start = std::chrono::steady_clock::now();
+    if (input.kind == FileKind::hierarchy) {
+        h = hierarchy_of(input);
+    } else {
+        ImportedMesh imported = import_input(input, command.base, global);
+        h = std::move(imported.hierarchy);
+        numbering = std::move(imported.numbering);
+        options.numbering = &numbering;
+        options.store_numbering = command.keep_numbering;
+    }
+    const double import_seconds = seconds_since(start);
+    EncodeStats stats;
+    start = std::chrono::steady_clock::now();
+    const std::vector<uint8_t> bytes = encode(h, options, &stats);
+    const double seconds = seconds_since(start);
+    write_output(output, std::string(bytes.begin(), bytes.end()), global.force);
+    if (!command.map.empty()) write_output(command.map, format_numbering_map(stats.numbering), global.force);
+    if (global.verbosity > 0) {
+        std::FILE* out = report_stream(output);
+        print_encode_stats(out, output == "-" ? "stdout" : output, stats, seconds);
+        if (input.kind == FileKind::mesh)
+            std::fprintf(out, "  import %.3f s: base %lu triangles (%s)\n", import_seconds, (unsigned long)h.root_count(),
+                         command.base.empty() ? "detected" : command.base.c_str());
+    }
+}
+
+void run_decode(const DecodeCommand& command, const GlobalOptions& global) {
+    const InputFile input = read_input(command.input);
+    const std::string output = command.output.empty() ? default_output(command.input, ".ply") : command.output;
+    MeshFormat mesh_format = MeshFormat::ply;
+    OutputKind kind = output_kind(output, &mesh_format);
+    if (output == "-") {
+        kind = OutputKind::mesh;
+        if (command.format == "amh") kind = OutputKind::hierarchy;
+        else if (command.format == "obj") mesh_format = MeshFormat::obj;
+        else if (command.format == "off") mesh_format = MeshFormat::off;
+        else if (command.format == "vtu") mesh_format = MeshFormat::vtu;
+        else if (!command.format.empty() && command.format != "ply")
+            throw UsageError("--format: unknown format '" + command.format + "' (ply, obj, off, vtu, amh)");
+    } else if (!command.format.empty()) {
+        throw UsageError("--format applies to stdout (-o -); the extension of " + output + " names the format");
+    }
+    if (kind == OutputKind::compressed || kind == OutputKind::other)
+        throw UsageError("decode writes a mesh (.obj .off .ply .vtu) or a hierarchy (.amh), not " + output);
+    if (!command.map.empty() && command.level >= 0)
+        throw UsageError("--map describes the whole leaf mesh: it does not combine with --level");
+    if (!global.force && !command.map.empty()) refuse_existing(command.map);
+
+    DecodeOptions options;
+    options.max_level = command.level;
+    if (command.max_nodes > 0) options.max_nodes = command.max_nodes;
+    LeafNumbering numbering;
+    auto start = std::chrono::steady_clock::now();
+    const Hierarchy h = decode_input(input, options, &numbering);
+    const double seconds = seconds_since(start);
+    if (command.level > h.depth())
+        throw Error(input.name + ": level " + std::to_string(command.level) + " requested but the file has levels 0.." +
+                    std::to_string(h.depth()));
+    if (!command.map.empty() && numbering.empty())
+        throw Error(input.name + ": the file stores no numbering (encode a mesh with --keep-numbering, or keep the map "
+                    "that encode --map writes)");
+
+    bool renumbered = false;
+    if (kind == OutputKind::hierarchy) {
+        write_output(output, serialize_hierarchy(h), global.force);
+    } else {
+        const LeafMesh leaf = extract_leaf_mesh(h, command.level);
+        if (!numbering.empty() && !command.canonical) {
+            CellData cells;
+            const TriangleMesh mesh = renumber_leaf_mesh(leaf, numbering, &cells);
+            write_output(output, format_mesh(mesh, &cells, mesh_format), global.force);
+            renumbered = true;
+        } else {
+            write_output(output, format_mesh(leaf.mesh, &leaf.cells, mesh_format), global.force);
+        }
+    }
+    if (!command.map.empty()) write_output(command.map, format_numbering_map(numbering), global.force);
+    if (global.verbosity > 0)
+        std::fprintf(report_stream(output), "%s: %u nodes, %u vertices, depth %d -> %s%s (%.3f s)\n", input.name.c_str(),
+                     h.node_count(), h.vertex_count(), h.depth(), output == "-" ? "stdout" : output.c_str(),
+                     renumbered ? " in the input's numbering" : "", seconds);
+}
+
+}  // namespace amc::cli

@@ -1,0 +1,26 @@
+// Meshes as users have them, turned into hierarchies for `amc encode` and `amc import`, and the
+// numbering map that ties the user's vertex and face numbers to the decoded leaf mesh.
+#pragma once
+
+#include "cli_files.h"
+#include "commands.h"
+
+#include <amc/numbering.h>
+
+#include <string>
+
+namespace amc::cli {
+
+struct ImportedMesh {
+    Hierarchy hierarchy;
+    LeafNumbering numbering;  // the input mesh's numbering against extract_leaf_mesh(hierarchy)
+};
+
+// A mesh input over the base mesh in `base_path`, or over the coarsest base found in it.
+ImportedMesh import_input(const InputFile& input, const std::string& base_path, const GlobalOptions& global);
+
+// The map as text (docs/IMPORT.md, "The numbering map"): for every input vertex its leaf vertex,
+// for every input face its leaf triangle and rotation.
+std::string format_numbering_map(const LeafNumbering& numbering);
+
+}  // namespace amc::cli
