@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <functional>
 #include <string>
 
 namespace amc {
@@ -15,7 +16,7 @@ namespace amc {
 namespace {
 
 // Frozen values (written to files).
-enum class PermutationMethod : uint8_t { identity = 0, uniform = 1, adaptive = 2 };
+enum class PermutationMethod : uint8_t { identity = 0, uniform = 1, adaptive = 2, walk = 3 };
 enum class FaceReference : uint8_t { leaf_order = 0, lowest_vertex = 1, highest_vertex = 2 };
 enum class RotationMode : uint8_t { none = 0, leaf_corners = 1, lowest_corner = 2 };
 
@@ -193,6 +194,149 @@ std::vector<uint32_t> decode_permutation(ArithmeticDecoder& decoder, Permutation
     return sequence;
 }
 
+// A graph over the elements of a permutation (vertices: leaf mesh edges; triangles: shared
+// edges), as adjacency lists sorted by element.
+struct Graph {
+    std::vector<uint32_t> start, neighbors;
+};
+
+Graph vertex_graph(const std::vector<Triangle>& leaf, uint32_t vertices) {
+    std::vector<std::pair<uint32_t, uint32_t>> edges;
+    edges.reserve(6 * leaf.size());
+    for (const Triangle& t : leaf) {
+        for (int c = 0; c < 3; ++c) {
+            edges.push_back({t[c], t[(c + 1) % 3]});
+            edges.push_back({t[(c + 1) % 3], t[c]});
+        }
+    }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    Graph g;
+    g.start.assign(size_t(vertices) + 1, 0);
+    for (auto [a, b] : edges) ++g.start[a + 1];
+    for (uint32_t v = 0; v < vertices; ++v) g.start[v + 1] += g.start[v];
+    for (auto [a, b] : edges) g.neighbors.push_back(b);
+    return g;
+}
+
+// Triangles are neighbours when they share an edge.
+Graph triangle_graph(const std::vector<Triangle>& leaf) {
+    // Half-edges (a, b, triangle), sorted; the triangle across (a, b) holds (b, a).
+    std::vector<std::array<uint32_t, 3>> halfedges;
+    halfedges.reserve(3 * leaf.size());
+    for (uint32_t t = 0; t < leaf.size(); ++t)
+        for (int c = 0; c < 3; ++c) halfedges.push_back({leaf[t][c], leaf[t][(c + 1) % 3], t});
+    std::sort(halfedges.begin(), halfedges.end());
+    std::vector<std::pair<uint32_t, uint32_t>> pairs;
+    for (const auto& [a, b, t] : halfedges) {
+        const auto it = std::lower_bound(halfedges.begin(), halfedges.end(), std::array<uint32_t, 3>{b, a, 0});
+        if (it != halfedges.end() && (*it)[0] == b && (*it)[1] == a) pairs.push_back({t, (*it)[2]});
+    }
+    std::sort(pairs.begin(), pairs.end());
+    Graph g;
+    g.start.assign(leaf.size() + 1, 0);
+    for (auto [a, b] : pairs) ++g.start[a + 1];
+    for (size_t t = 0; t < leaf.size(); ++t) g.start[t + 1] += g.start[t];
+    for (auto [a, b] : pairs) g.neighbors.push_back(b);
+    return g;
+}
+
+constexpr int kCandidateModels = 8;
+
+struct WalkModels {
+    std::array<BitModel, 2> hit{};                        // context: the previous element was a hit
+    std::array<BitModel, kCandidateModels> candidate{};  // unary over the candidates' positions
+    PermutationModels miss;
+};
+
+// Method 3: the sequence in the caller's order, each element predicted to be one of the unused
+// neighbours of the one before it (a caller's order that walks the mesh costs a few bits each);
+// other elements as rank differences among all unused ones.
+class SequenceWalk {
+public:
+    SequenceWalk(const Graph& graph, uint32_t n) : graph_(graph), used_(n, false), ranks_(n) {}
+    // The unused neighbours of the previous element, in increasing order.
+    const std::vector<uint32_t>& candidates() {
+        candidates_.clear();
+        if (started_) {
+            for (uint32_t k = graph_.start[previous_]; k < graph_.start[previous_ + 1]; ++k)
+                if (!used_[graph_.neighbors[k]]) candidates_.push_back(graph_.neighbors[k]);
+        }
+        return candidates_;
+    }
+    RankWalk& ranks() { return ranks_; }
+    bool started() const { return started_; }
+    void take(uint32_t value) {
+        used_[value] = true;
+        ranks_.take(value);
+        previous_ = value;
+        started_ = true;
+    }
+
+private:
+    const Graph& graph_;
+    std::vector<bool> used_;
+    RankWalk ranks_;
+    std::vector<uint32_t> candidates_;
+    uint32_t previous_ = 0;
+    bool started_ = false;
+};
+
+void encode_walk(ArithmeticEncoder& encoder, const Graph& graph, const std::vector<uint32_t>& sequence) {
+    SequenceWalk walk(graph, uint32_t(sequence.size()));
+    WalkModels models;
+    bool previous_hit = false, previous_zero = false;
+    for (uint32_t value : sequence) {
+        const std::vector<uint32_t>& candidates = walk.candidates();
+        const auto found = std::find(candidates.begin(), candidates.end(), value);
+        if (!candidates.empty()) {
+            const bool hit = found != candidates.end();
+            encoder.encode(hit, models.hit[previous_hit]);
+            previous_hit = hit;
+            if (hit) {
+                const size_t position = size_t(found - candidates.begin());
+                for (size_t j = 0; j + 1 < candidates.size() && j <= position; ++j)
+                    encoder.encode(j == position, models.candidate[std::min<size_t>(j, kCandidateModels - 1)]);
+                walk.take(value);
+                continue;
+            }
+        }
+        encode_difference(encoder, models.miss, walk.started() ? PermutationMethod::adaptive : PermutationMethod::uniform,
+                          walk.ranks().difference_of(value), walk.ranks().remaining(), previous_zero);
+        walk.take(value);
+    }
+}
+
+std::vector<uint32_t> decode_walk(ArithmeticDecoder& decoder, const Graph& graph, uint32_t n, const char* what) {
+    std::vector<uint32_t> sequence(n);
+    SequenceWalk walk(graph, n);
+    WalkModels models;
+    bool previous_hit = false, previous_zero = false;
+    for (uint32_t i = 0; i < n; ++i) {
+        const std::vector<uint32_t>& candidates = walk.candidates();
+        if (!candidates.empty()) {
+            const bool hit = decoder.decode(models.hit[previous_hit]);
+            previous_hit = hit;
+            if (hit) {
+                size_t position = 0;
+                while (position + 1 < candidates.size() &&
+                       !decoder.decode(models.candidate[std::min<size_t>(position, kCandidateModels - 1)]))
+                    ++position;
+                sequence[i] = candidates[position];
+                walk.take(sequence[i]);
+                continue;
+            }
+        }
+        uint32_t d = 0;
+        if (!decode_difference(decoder, models.miss, walk.started() ? PermutationMethod::adaptive : PermutationMethod::uniform,
+                               walk.ranks().remaining(), previous_zero, d))
+            throw Error(ErrorCode::corrupt, std::string("numbering block: corrupt ") + what + " order");
+        sequence[i] = walk.ranks().value_of(d);
+        walk.take(sequence[i]);
+    }
+    return sequence;
+}
+
 // Differences that are all zero need no code; otherwise the smaller of the two methods.
 PermutationMethod best_method(const std::vector<uint32_t>& sequence) {
     bool identity = true;
@@ -256,12 +400,52 @@ void encode_rotations(ArithmeticEncoder& encoder, const std::vector<uint8_t>& sy
 
 }  // namespace
 
-std::vector<uint8_t> encode_numbering(const LeafNumbering& numbering, const std::vector<Triangle>& leaf) {
+namespace {
+
+size_t coded_size(const std::function<void(ArithmeticEncoder&)>& code) {
+    ArithmeticEncoder trial;
+    code(trial);
+    return trial.finish().size();
+}
+
+// One permutation's choice: its method, the face reference (faces only) and the sequence coded.
+struct PermutationChoice {
+    PermutationMethod method = PermutationMethod::identity;
+    FaceReference reference = FaceReference::leaf_order;
+    std::vector<uint32_t> sequence;
+    size_t size = SIZE_MAX;
+};
+
+void encode_choice(ArithmeticEncoder& encoder, const PermutationChoice& choice, const Graph& graph) {
+    if (choice.method == PermutationMethod::walk) {
+        encode_walk(encoder, graph, choice.sequence);
+    } else {
+        encode_permutation(encoder, choice.method, choice.sequence);
+    }
+}
+
+// The cheapest of the rank methods over `sequence` (leaf order -> caller index) and the walk over
+// `caller_order` (caller order -> leaf element).
+void consider(PermutationChoice& best, FaceReference reference, std::vector<uint32_t> sequence) {
+    const PermutationMethod method = best_method(sequence);
+    const size_t size = coded_size([&](ArithmeticEncoder& e) { encode_permutation(e, method, sequence); });
+    if (size < best.size) best = {method, reference, std::move(sequence), size};
+}
+
+void consider_walk(PermutationChoice& best, const Graph& graph, const std::vector<uint32_t>& caller_order) {
+    const size_t size = coded_size([&](ArithmeticEncoder& e) { encode_walk(e, graph, caller_order); });
+    if (size < best.size) best = {PermutationMethod::walk, FaceReference::leaf_order, caller_order, size};
+}
+
+}  // namespace
+
+std::vector<uint8_t> encode_numbering(const LeafNumbering& numbering, const std::vector<Triangle>& leaf,
+                                      NumberingCodeStats* stats) {
     const uint32_t vertices = uint32_t(numbering.vertex.size());
     const std::string problem = check_numbering(numbering, vertices, leaf.size());
     if (!problem.empty()) throw Error("encode: numbering does not fit the leaf mesh: " + problem);
 
-    // Coded in the decoder's order: for leaf vertex k (triangle t), the caller's index.
+    // For leaf vertex k (triangle t), the caller's index.
     std::vector<uint32_t> caller_vertex(vertices), caller_face(leaf.size());
     std::vector<uint8_t> caller_rotation(leaf.size());
     for (uint32_t i = 0; i < vertices; ++i) caller_vertex[numbering.vertex[i]] = i;
@@ -269,41 +453,33 @@ std::vector<uint8_t> encode_numbering(const LeafNumbering& numbering, const std:
         caller_face[numbering.face[j]] = j;
         caller_rotation[numbering.face[j]] = numbering.rotation[j];
     }
-    const PermutationMethod vertex_method = best_method(caller_vertex);
+    const Graph vertex_neighbors = vertex_graph(leaf, vertices), triangle_neighbors = triangle_graph(leaf);
 
-    size_t best_size = SIZE_MAX;
-    FaceReference face_reference = FaceReference::leaf_order;
-    std::vector<uint32_t> face_sequence;
-    PermutationMethod face_method = PermutationMethod::identity;
+    PermutationChoice vertex_choice;
+    consider(vertex_choice, FaceReference::leaf_order, caller_vertex);
+    if (vertex_choice.method != PermutationMethod::identity) consider_walk(vertex_choice, vertex_neighbors, numbering.vertex);
+
+    PermutationChoice face_choice;
     for (FaceReference reference : {FaceReference::leaf_order, FaceReference::lowest_vertex, FaceReference::highest_vertex}) {
         const std::vector<uint32_t> order = reference_order(reference, leaf, caller_vertex);
         std::vector<uint32_t> sequence(order.size());
         for (uint32_t k = 0; k < order.size(); ++k) sequence[k] = caller_face[order[k]];
-        const PermutationMethod method = best_method(sequence);
-        ArithmeticEncoder trial;
-        encode_permutation(trial, method, sequence);
-        const size_t size = trial.finish().size();
-        if (size < best_size) {
-            best_size = size;
-            face_reference = reference;
-            face_sequence = std::move(sequence);
-            face_method = method;
-        }
+        consider(face_choice, reference, std::move(sequence));
     }
+    if (face_choice.method != PermutationMethod::identity) consider_walk(face_choice, triangle_neighbors, numbering.face);
 
     RotationMode rotation_mode = RotationMode::none;
     std::vector<uint8_t> rotation_symbols;
+    size_t rotation_size = 0;
     if (std::any_of(caller_rotation.begin(), caller_rotation.end(), [](uint8_t r) { return r != 0; })) {
-        best_size = SIZE_MAX;
+        rotation_size = SIZE_MAX;
         for (RotationMode mode : {RotationMode::leaf_corners, RotationMode::lowest_corner}) {
             std::vector<uint8_t> symbols(leaf.size());
             for (uint32_t t = 0; t < leaf.size(); ++t)
                 symbols[t] = uint8_t((caller_rotation[t] + 3 - reference_corner(mode, leaf[t], caller_vertex)) % 3);
-            ArithmeticEncoder trial;
-            encode_rotations(trial, symbols);
-            const size_t size = trial.finish().size();
-            if (size < best_size) {
-                best_size = size;
+            const size_t size = coded_size([&](ArithmeticEncoder& e) { encode_rotations(e, symbols); });
+            if (size < rotation_size) {
+                rotation_size = size;
                 rotation_mode = mode;
                 rotation_symbols = std::move(symbols);
             }
@@ -313,16 +489,25 @@ std::vector<uint8_t> encode_numbering(const LeafNumbering& numbering, const std:
     std::vector<uint8_t> out;
     put_varint(out, vertices);
     put_varint(out, leaf.size());
-    out.push_back(uint8_t(vertex_method));
-    out.push_back(uint8_t(face_reference));
-    out.push_back(uint8_t(face_method));
+    out.push_back(uint8_t(vertex_choice.method));
+    out.push_back(uint8_t(face_choice.reference));
+    out.push_back(uint8_t(face_choice.method));
     out.push_back(uint8_t(rotation_mode));
     ArithmeticEncoder encoder;
-    encode_permutation(encoder, vertex_method, caller_vertex);
-    encode_permutation(encoder, face_method, face_sequence);
+    encode_choice(encoder, vertex_choice, vertex_neighbors);
+    encode_choice(encoder, face_choice, triangle_neighbors);
     if (rotation_mode != RotationMode::none) encode_rotations(encoder, rotation_symbols);
     const std::vector<uint8_t> coded = encoder.finish();
     out.insert(out.end(), coded.begin(), coded.end());
+    if (stats != nullptr) {
+        stats->vertex_method = int(vertex_choice.method);
+        stats->face_method = int(face_choice.method);
+        stats->face_reference = int(face_choice.reference);
+        stats->rotation_mode = int(rotation_mode);
+        stats->vertex_bytes = vertex_choice.method == PermutationMethod::identity ? 0 : vertex_choice.size;
+        stats->face_bytes = face_choice.method == PermutationMethod::identity ? 0 : face_choice.size;
+        stats->rotation_bytes = rotation_size;
+    }
     return out;
 }
 
@@ -331,35 +516,48 @@ LeafNumbering decode_numbering(const uint8_t* data, size_t size, const std::vect
     if (in.varint() != vertices || in.varint() != leaf.size())
         throw Error(ErrorCode::corrupt, "numbering block: its counts do not match the leaf mesh");
     const uint8_t vertex_method = in.u8(), face_reference = in.u8(), face_method = in.u8(), rotation_mode = in.u8();
-    if (vertex_method > uint8_t(PermutationMethod::adaptive) || face_method > uint8_t(PermutationMethod::adaptive) ||
-        face_reference > uint8_t(FaceReference::highest_vertex) || rotation_mode > uint8_t(RotationMode::lowest_corner))
+    if (vertex_method > uint8_t(PermutationMethod::walk) || face_method > uint8_t(PermutationMethod::walk) ||
+        face_reference > uint8_t(FaceReference::highest_vertex) || rotation_mode > uint8_t(RotationMode::lowest_corner) ||
+        (face_method == uint8_t(PermutationMethod::walk) && face_reference != uint8_t(FaceReference::leaf_order)))
         throw Error(ErrorCode::corrupt, "numbering block: unknown method");
     ArithmeticDecoder decoder(in.rest(), in.remaining());
 
-    const std::vector<uint32_t> caller_vertex = decode_permutation(decoder, PermutationMethod(vertex_method), vertices, "vertex");
-    const std::vector<uint32_t> order = reference_order(FaceReference(face_reference), leaf, caller_vertex);
-    const std::vector<uint32_t> face_sequence =
-        decode_permutation(decoder, PermutationMethod(face_method), uint32_t(leaf.size()), "face");
-
     LeafNumbering numbering;
-    numbering.vertex.resize(vertices);
-    for (uint32_t k = 0; k < vertices; ++k) numbering.vertex[caller_vertex[k]] = k;
-    numbering.face.resize(leaf.size());
-    numbering.rotation.assign(leaf.size(), 0);
-    std::vector<uint32_t> caller_face(leaf.size());
-    for (uint32_t k = 0; k < order.size(); ++k) {
-        numbering.face[face_sequence[k]] = order[k];
-        caller_face[order[k]] = face_sequence[k];
+    std::vector<uint32_t> caller_vertex(vertices);
+    if (vertex_method == uint8_t(PermutationMethod::walk)) {
+        numbering.vertex = decode_walk(decoder, vertex_graph(leaf, vertices), vertices, "vertex");
+        for (uint32_t i = 0; i < vertices; ++i) caller_vertex[numbering.vertex[i]] = i;
+    } else {
+        caller_vertex = decode_permutation(decoder, PermutationMethod(vertex_method), vertices, "vertex");
+        numbering.vertex.resize(vertices);
+        for (uint32_t k = 0; k < vertices; ++k) numbering.vertex[caller_vertex[k]] = k;
     }
+
+    std::vector<uint32_t> caller_face(leaf.size());
+    if (face_method == uint8_t(PermutationMethod::walk)) {
+        numbering.face = decode_walk(decoder, triangle_graph(leaf), uint32_t(leaf.size()), "face");
+        for (uint32_t j = 0; j < leaf.size(); ++j) caller_face[numbering.face[j]] = j;
+    } else {
+        const std::vector<uint32_t> order = reference_order(FaceReference(face_reference), leaf, caller_vertex);
+        const std::vector<uint32_t> sequence =
+            decode_permutation(decoder, PermutationMethod(face_method), uint32_t(leaf.size()), "face");
+        numbering.face.resize(leaf.size());
+        for (uint32_t k = 0; k < order.size(); ++k) {
+            numbering.face[sequence[k]] = order[k];
+            caller_face[order[k]] = sequence[k];
+        }
+    }
+
+    numbering.rotation.assign(leaf.size(), 0);
     if (rotation_mode != uint8_t(RotationMode::none)) {
         RotationModels m;
         uint8_t previous = 0;
         for (uint32_t t = 0; t < leaf.size(); ++t) {
-            uint8_t s = 0;
-            if (!decoder.decode(m.models[previous][0])) s = decoder.decode(m.models[previous][1]) ? 1 : 2;
-            previous = s;
+            uint8_t symbol = 0;
+            if (!decoder.decode(m.models[previous][0])) symbol = decoder.decode(m.models[previous][1]) ? 1 : 2;
+            previous = symbol;
             numbering.rotation[caller_face[t]] =
-                uint8_t((s + reference_corner(RotationMode(rotation_mode), leaf[t], caller_vertex)) % 3);
+                uint8_t((symbol + reference_corner(RotationMode(rotation_mode), leaf[t], caller_vertex)) % 3);
         }
     }
     if (decoder.overran()) throw Error(ErrorCode::corrupt, "numbering block is truncated or corrupt");

@@ -9,9 +9,16 @@
 
 namespace amc {
 
+// What the encoder chose, and the size of each part (bytes of its code on its own).
+struct NumberingCodeStats {
+    int vertex_method = 0, face_method = 0, face_reference = 0, rotation_mode = 0;
+    size_t vertex_bytes = 0, face_bytes = 0, rotation_bytes = 0;
+};
+
 // The block's payload for `numbering` of a leaf mesh with these triangles (in leaf order). The
 // encoder tries every reference order and method and keeps the smallest code.
-std::vector<uint8_t> encode_numbering(const LeafNumbering& numbering, const std::vector<Triangle>& leaf_triangles);
+std::vector<uint8_t> encode_numbering(const LeafNumbering& numbering, const std::vector<Triangle>& leaf_triangles,
+                                      NumberingCodeStats* stats = nullptr);
 
 // Decodes a payload for the leaf mesh with these triangles and `vertices` vertices. Throws Error
 // on a payload that does not fit it (counts, methods, ranks out of range, truncation).
