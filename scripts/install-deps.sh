@@ -3,7 +3,7 @@
 set -euo pipefail
 packages=(g++ cmake make pkg-config libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
           libtinyobjloader-dev libmeshoptimizer-dev libxxhash-dev zlib1g-dev
-          python3-meshio python3-vtk9 python3-pytest)
+          pybind11-dev python3-dev python3-numpy python3-pytest python3-meshio python3-vtk9)
 if [[ "${1:-}" == "--bench" ]]; then
   packages+=(libdraco-dev libzstd-dev liblzma-dev python3)
 fi

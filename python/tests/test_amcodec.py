@@ -1,0 +1,114 @@
+"""The Python module: arrays in and out, round trips exact, numbering kept, errors as exceptions."""
+import numpy as np
+import pytest
+
+import amcodec
+
+
+def icosahedron():
+    t = (1 + 5 ** 0.5) / 2
+    points = np.array([[-1, t, 0], [1, t, 0], [-1, -t, 0], [1, -t, 0], [0, -1, t], [0, 1, t], [0, -1, -t], [0, 1, -t],
+                       [t, 0, -1], [t, 0, 1], [-t, 0, -1], [-t, 0, 1]], dtype=np.float64)
+    triangles = np.array([[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4], [11, 10, 2],
+                          [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9], [4, 9, 5],
+                          [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]], dtype=np.int64)
+    return points, triangles
+
+
+def adaptive_leaf_mesh(seed=1):
+    """A red-green hierarchy refined at random, and its leaf mesh with vertices and faces shuffled."""
+    points, triangles = icosahedron()
+    h = amcodec.Hierarchy(points, triangles)
+    rng = np.random.default_rng(seed)
+    for _ in range(40):
+        leaves = h.leaves()
+        h.refine(leaves[rng.integers(len(leaves))])
+    mesh = h.leaf_mesh()
+    order = rng.permutation(len(mesh["points"]))
+    inverse = np.empty_like(order)
+    inverse[order] = np.arange(len(order))
+    shuffled_points = mesh["points"][order]
+    shuffled_triangles = inverse[mesh["triangles"]][rng.permutation(len(mesh["triangles"]))]
+    return h, shuffled_points, shuffled_triangles
+
+
+def test_hierarchy_round_trip_is_identical():
+    h, _, _ = adaptive_leaf_mesh()
+    assert h.check() == ""
+    data = h.encode()
+    back = amcodec.decode_hierarchy(data)
+    assert back.node_count == h.node_count
+    assert back.leaf_mesh()["triangles"].shape == h.leaf_mesh()["triangles"].shape
+
+
+def test_mesh_round_trip_keeps_the_numbering():
+    _, points, triangles = adaptive_leaf_mesh(2)
+    data = amcodec.encode(points, triangles, keep_numbering=True)
+    mesh = amcodec.decode(data)
+    assert np.array_equal(mesh["points"], points)
+    assert np.array_equal(mesh["triangles"], triangles)
+    assert mesh["numbering"] is not None
+    assert mesh["level"].shape == (len(triangles),)
+
+
+def test_detected_base_is_the_icosahedron():
+    _, points, triangles = adaptive_leaf_mesh(3)
+    h, vertex_of_input = amcodec.import_mesh(points, triangles)
+    assert h.root_count == 20
+    assert len(vertex_of_input) == len(points)
+
+
+def test_without_numbering_the_map_ties_input_to_output():
+    _, points, triangles = adaptive_leaf_mesh(4)
+    data, stats = amcodec.encode(points, triangles, return_stats=True)
+    assert stats["numbering_bytes"] == 0
+    mesh = amcodec.decode(data)
+    vertex = stats["numbering"]["vertex"]
+    assert np.array_equal(mesh["points"][vertex], points)
+
+
+def test_float32_stays_float32_and_quantized_is_within_the_error():
+    _, points, triangles = adaptive_leaf_mesh(5)
+    mesh = amcodec.decode(amcodec.encode(points.astype(np.float32), triangles, keep_numbering=True))
+    assert mesh["points"].dtype == np.float32
+    assert np.array_equal(mesh["points"], points.astype(np.float32))
+    data, stats = amcodec.encode(points, triangles, keep_numbering=True, quantize=12, return_stats=True)
+    lossy = amcodec.decode(data)
+    assert np.max(np.abs(lossy["points"] - points)) <= stats["max_error"]
+
+
+def test_bad_input_raises_amcodec_error_with_the_message():
+    points, triangles = icosahedron()
+    bad = triangles.copy()
+    bad[0, 0] = 99
+    with pytest.raises(amcodec.Error, match="out of range"):
+        amcodec.encode(points, bad)
+    with pytest.raises(amcodec.Error, match="magic"):
+        amcodec.decode(b"not an amc file")
+    data = amcodec.encode(points, triangles)
+    with pytest.raises(amcodec.Error):
+        amcodec.decode(data[: len(data) // 2])
+
+
+def test_meshio_round_trip():
+    meshio = pytest.importorskip("meshio")
+    _, points, triangles = adaptive_leaf_mesh(6)
+    mesh = meshio.Mesh(points, [("triangle", triangles)])
+    back = amcodec.decode_meshio(amcodec.encode_meshio(mesh))
+    assert np.array_equal(back.points, points)
+    assert np.array_equal(back.cells[0].data, triangles)
+    assert "level" in back.cell_data
+
+
+def test_meshio_file_in_and_out(tmp_path):
+    """The README's session: a mesh file read with meshio, compressed, decoded, compared."""
+    meshio = pytest.importorskip("meshio")
+    _, points, triangles = adaptive_leaf_mesh(7)
+    meshio.write(tmp_path / "leaf.vtu", meshio.Mesh(points, [("triangle", triangles)]))
+    mesh = meshio.read(tmp_path / "leaf.vtu")
+    data = amcodec.encode_meshio(mesh)
+    (tmp_path / "leaf.amc").write_bytes(data)
+    back = amcodec.decode_meshio((tmp_path / "leaf.amc").read_bytes())
+    assert np.array_equal(back.points, mesh.points)
+    assert np.array_equal(back.cells[0].data, mesh.cells[0].data)
+    meshio.write(tmp_path / "back.vtu", back)
