@@ -39,6 +39,10 @@ expect 0 "$amc" refine --model front --steps 2 --max-level 5 -o front.amh
 [[ -f front_0.amh && -f front_1.amh ]] || fail "refine --model front -o front.amh wrote no front_0.amh, front_1.amh"
 expect 2 "$amc" refine --model lshape --max-level 40 -o l.amh
 
+# Progress only on a terminal: a run of a few seconds with stderr in a file leaves it empty.
+expect 0 "$amc" refine --model random --faces 600000 --max-level 9 -o big.amh
+[[ -s err.txt ]] && fail "progress or messages written to stderr that is not a terminal: $(head -c 200 err.txt)"
+
 # Default names, refusal, -f.
 expect 0 "$amc" encode r.amh
 [[ -s r.amc ]] || fail "encode r.amh wrote no r.amc"

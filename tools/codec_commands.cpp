@@ -2,6 +2,7 @@
 #include "cli_files.h"
 #include "commands.h"
 #include "mesh_import.h"
+#include "progress.h"
 
 #include <amc/codec.h>
 #include <amc/numbering.h>
@@ -56,6 +57,8 @@ void print_encode_stats(std::FILE* out, const std::string& name, const EncodeSta
 }  // namespace
 
 void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
+    Progress progress(global.verbosity > 0);
+    progress.phase("reading " + command.input);
     const InputFile input = read_input(command.input);
     const std::string output = command.output.empty() ? default_output(command.input, ".amc") : command.output;
     const OutputKind kind = output_kind(output);
@@ -79,6 +82,7 @@ void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     if (input.kind == FileKind::hierarchy) {
         h = hierarchy_of(input);
     } else {
+        progress.phase("importing " + input.name);
         ImportedMesh imported = import_input(input, command.base, global);
         h = std::move(imported.hierarchy);
         numbering = std::move(imported.numbering);
@@ -87,11 +91,13 @@ void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     }
     const double import_seconds = seconds_since(start);
     EncodeStats stats;
+    progress.phase("encoding " + input.name);
     start = std::chrono::steady_clock::now();
     const std::vector<uint8_t> bytes = encode(h, options, &stats);
     const double seconds = seconds_since(start);
     write_output(output, std::string(bytes.begin(), bytes.end()), global.force);
     if (!command.map.empty()) write_output(command.map, format_numbering_map(stats.numbering), global.force);
+    progress.finish();
     if (global.verbosity > 0) {
         std::FILE* out = report_stream(output);
         print_encode_stats(out, output == "-" ? "stdout" : output, stats, seconds);
@@ -102,6 +108,8 @@ void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
 }
 
 void run_decode(const DecodeCommand& command, const GlobalOptions& global) {
+    Progress progress(global.verbosity > 0);
+    progress.phase("reading " + command.input);
     const InputFile input = read_input(command.input);
     const std::string output = command.output.empty() ? default_output(command.input, ".ply") : command.output;
     MeshFormat mesh_format = MeshFormat::ply;
@@ -127,6 +135,7 @@ void run_decode(const DecodeCommand& command, const GlobalOptions& global) {
     options.max_level = command.level;
     if (command.max_nodes > 0) options.max_nodes = command.max_nodes;
     LeafNumbering numbering;
+    progress.phase("decoding " + input.name);
     auto start = std::chrono::steady_clock::now();
     const Hierarchy h = decode_input(input, options, &numbering);
     const double seconds = seconds_since(start);
@@ -138,6 +147,7 @@ void run_decode(const DecodeCommand& command, const GlobalOptions& global) {
                     "that encode --map writes)");
 
     bool renumbered = false;
+    progress.phase("writing " + output);
     if (kind == OutputKind::hierarchy) {
         write_output(output, serialize_hierarchy(h), global.force);
     } else {
@@ -152,6 +162,7 @@ void run_decode(const DecodeCommand& command, const GlobalOptions& global) {
         }
     }
     if (!command.map.empty()) write_output(command.map, format_numbering_map(numbering), global.force);
+    progress.finish();
     if (global.verbosity > 0)
         std::fprintf(report_stream(output), "%s: %u nodes, %u vertices, depth %d -> %s%s (%.3f s)\n", input.name.c_str(),
                      h.node_count(), h.vertex_count(), h.depth(), output == "-" ? "stdout" : output.c_str(),

@@ -1,5 +1,6 @@
 // `amc import`, and the import step of `amc encode` for mesh inputs.
 #include "mesh_import.h"
+#include "progress.h"
 
 #include <amc/import.h>
 
@@ -37,6 +38,8 @@ std::string format_numbering_map(const LeafNumbering& numbering) {
 }
 
 void run_import(const ImportCommand& command, const GlobalOptions& global) {
+    Progress progress(global.verbosity > 0);
+    progress.phase("reading " + command.input);
     const InputFile input = read_input(command.input);
     const std::string output = command.output.empty() ? default_output(command.input, ".amh") : command.output;
     if (output != "-" && output_kind(output) != OutputKind::hierarchy)
@@ -45,11 +48,13 @@ void run_import(const ImportCommand& command, const GlobalOptions& global) {
         refuse_existing(output);
         if (!command.map.empty()) refuse_existing(command.map);
     }
+    progress.phase("importing " + input.name);
     const auto start = std::chrono::steady_clock::now();
     const ImportedMesh imported = import_input(input, command.base, global);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     write_output(output, serialize_hierarchy(imported.hierarchy), global.force);
     if (!command.map.empty()) write_output(command.map, format_numbering_map(imported.numbering), global.force);
+    progress.finish();
     if (global.verbosity > 0) {
         const HierarchyStats s = compute_stats(imported.hierarchy);
         std::fprintf(output == "-" ? stderr : stdout,

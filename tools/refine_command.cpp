@@ -1,6 +1,7 @@
 // `amc refine`: adaptive red-green hierarchies from the refinement drivers.
 #include "cli_files.h"
 #include "commands.h"
+#include "progress.h"
 
 #include <chrono>
 #include <cstdio>
@@ -54,6 +55,8 @@ void run_refine(const RefineCommand& c, const GlobalOptions& global) {
         refuse_existing(c.leaf_output.empty() ? "-" : c.leaf_output);
     }
 
+    Progress progress(global.verbosity > 0);
+    progress.phase("refining (" + c.model + ")");
     const auto start = std::chrono::steady_clock::now();
     std::vector<std::pair<std::string, Hierarchy>> results;
     if (c.model == "surface" || c.model == "bumpy") {
@@ -88,6 +91,7 @@ void run_refine(const RefineCommand& c, const GlobalOptions& global) {
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
+    progress.finish();
     std::FILE* report = c.output == "-" ? stderr : stdout;
     if (global.verbosity > 0)
         std::fprintf(report, "%-22s %7s %9s %9s %6s %9s %9s %9s %8s\n", "model", "base_f", "faces", "nodes", "levels", "red",
