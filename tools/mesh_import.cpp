@@ -13,7 +13,9 @@ ImportedMesh import_input(const InputFile& input, const std::string& base_path, 
     const TriangleMesh mesh = mesh_of(input);
     ImportedHierarchy imported;
     if (base_path.empty()) {
-        imported = import_mesh(mesh, input.name);
+        // Until base detection (issue 23, part 2) lands: the mesh is its own base.
+        imported.hierarchy = Hierarchy(mesh);
+        for (uint32_t i = 0; i < mesh.positions.size(); ++i) imported.vertex_of_input.push_back(i);
     } else {
         imported = import_leaf_mesh(mesh_of(read_input(base_path)), mesh, {}, input.name);
     }

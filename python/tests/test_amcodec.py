@@ -51,13 +51,6 @@ def test_mesh_round_trip_keeps_the_numbering():
     assert mesh["level"].shape == (len(triangles),)
 
 
-def test_detected_base_is_the_icosahedron():
-    _, points, triangles = adaptive_leaf_mesh(3)
-    h, vertex_of_input = amcodec.import_mesh(points, triangles)
-    assert h.root_count == 20
-    assert len(vertex_of_input) == len(points)
-
-
 def test_without_numbering_the_map_ties_input_to_output():
     _, points, triangles = adaptive_leaf_mesh(4)
     data, stats = amcodec.encode(points, triangles, return_stats=True)
