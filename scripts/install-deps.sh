@@ -5,7 +5,7 @@ packages=(g++ cmake make pkg-config libcli11-dev libgtest-dev libgmock-dev libbe
           libtinyobjloader-dev libmeshoptimizer-dev libxxhash-dev zlib1g-dev
           pybind11-dev python3-dev python3-numpy python3-pytest python3-meshio python3-vtk9)
 if [[ "${1:-}" == "--bench" ]]; then
-  packages+=(libdraco-dev libzstd-dev liblzma-dev python3)
+  packages+=(libdraco-dev libzstd-dev liblzma-dev libzfp-dev python3)
 fi
 missing=()
 for p in "${packages[@]}"; do

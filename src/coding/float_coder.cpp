@@ -106,6 +106,16 @@ double axis_value(Vec3 p, int axis) { return axis == 0 ? p.x : axis == 1 ? p.y :
 
 }  // namespace
 
+void encode_signed_residual(ArithmeticEncoder& encoder, FloatResidualModels::Context& context, bool negative,
+                            uint64_t magnitude) {
+    encode_residual(encoder, context, 7, negative, magnitude);
+}
+
+void decode_signed_residual(ArithmeticDecoder& decoder, FloatResidualModels& models,
+                            FloatResidualModels::Context& context, bool& negative, uint64_t& magnitude) {
+    decode_residual(decoder, models, context, 7, FloatResidualModels::kMaxLength, negative, magnitude);
+}
+
 // ---- the monotone map ------------------------------------------------------------------------
 
 uint64_t ordered_bits(double x, Precision precision) {

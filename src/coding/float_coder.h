@@ -96,6 +96,15 @@ void encode_position(ArithmeticEncoder& encoder, FloatResidualModels& models, in
 Vec3 decode_position(ArithmeticDecoder& decoder, FloatResidualModels& models, int first_context,
                      Precision precision, Vec3 predicted);
 
+// The residual layout above for any sign and magnitude of up to 64 bits, with the 7-level
+// bit-length tree: the building block of the series file's field coder (docs/FORMAT.md, series
+// section), which codes integer differences and ordered-bit differences with it. The decoder
+// clamps a bit length above 64 to 64 and marks the models invalid.
+void encode_signed_residual(ArithmeticEncoder& encoder, FloatResidualModels::Context& context, bool negative,
+                            uint64_t magnitude);
+void decode_signed_residual(ArithmeticDecoder& decoder, FloatResidualModels& models,
+                            FloatResidualModels::Context& context, bool& negative, uint64_t& magnitude);
+
 // ---- quantized mode ---------------------------------------------------------------------------
 
 // The fewest symbols a coordinate costs: the bit-length tree's depth, 5 for quantized

@@ -1,0 +1,143 @@
+// Time series of adaptive meshes with their fields: every step of an adaptive run in one file
+// (.amcs, docs/FORMAT.md section 7, docs/SERIES.md). One base mesh, then frames; each frame is a
+// hierarchy over that base (refined and coarsened freely from the previous frame), its vertex
+// positions and its fields. A frame is coded against the previous one (connectivity, positions
+// and fields predicted from it), except keyframes, which decode on their own.
+#pragma once
+
+#include <amc/field.h>
+#include <amc/hierarchy.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace amc {
+
+struct SeriesOptions {
+    // Frames 0, K, 2K, ... are keyframes (decodable without the frames before them); 0: only
+    // frame 0. Random access to frame k decodes from the last keyframe at or before k.
+    uint32_t keyframe_interval = 0;
+    // An absolute error bound for every float field (0: bit-exact), and bounds by field name
+    // that override it. The decoder guarantees |decoded - input| <= bound for every value.
+    double error_bound = 0;
+    std::vector<std::pair<std::string, double>> field_bounds;
+};
+
+struct FieldStats {
+    std::string name;
+    uint64_t bytes = 0;
+    bool bounded = false;
+    double max_error = 0;
+};
+
+struct SeriesFrameStats {
+    bool keyframe = false;
+    uint64_t bytes = 0;               // the whole frame block
+    uint64_t connectivity_bytes = 0;  // forest and diagonals
+    uint64_t geometry_bytes = 0;      // positions
+    uint64_t field_bytes = 0;         // all fields
+    uint64_t nodes = 0, vertices = 0, faces = 0;
+    uint64_t changed_nodes = 0;       // nodes added, removed or whose refinement changed since the previous frame
+    bool moving = false;              // persisting vertices moved
+    std::vector<FieldStats> fields;
+    double max_error = 0;             // over the bounded fields
+};
+
+// Writes a series frame by frame, to memory or straight to a file (each frame is appended and
+// flushed as it is added, so a reader sees every complete frame even if the writer dies).
+class SeriesWriter {
+public:
+    // In memory: bytes() holds the file so far.
+    explicit SeriesWriter(const TriangleMesh& base, const SeriesOptions& options = {});
+    // To a file (created or truncated). Throws Error (io) when it can not be written.
+    SeriesWriter(const std::string& path, const TriangleMesh& base, const SeriesOptions& options = {});
+    ~SeriesWriter();  // closes the file without the END block if close() was not called
+    SeriesWriter(const SeriesWriter&) = delete;
+    SeriesWriter& operator=(const SeriesWriter&) = delete;
+
+    // Adds a frame: a hierarchy over the base mesh (same triangles in the same order; positions,
+    // base vertices included, may change from frame to frame), its time and fields. Point fields
+    // have one tuple per vertex in canonical order (extract_leaf_mesh's vertices), cell fields
+    // one per triangle of extract_leaf_mesh. Throws Error (invalid_input) naming the problem; the
+    // series is unchanged then.
+    SeriesFrameStats add_frame(const Hierarchy& h, double time, const std::vector<Field>& fields = {});
+    // Writes the END block (and closes the file). No frame can be added afterwards.
+    void close();
+
+    uint64_t frame_count() const { return frames_; }
+    const std::vector<uint8_t>& bytes() const { return bytes_; }  // in memory only
+
+private:
+    struct State;
+    void write(const std::vector<uint8_t>& data);
+    std::unique_ptr<State> state_;
+    SeriesOptions options_;
+    std::vector<uint8_t> bytes_;
+    std::FILE* file_ = nullptr;
+    std::string path_;
+    uint64_t frames_ = 0;
+    bool closed_ = false;
+};
+
+struct SeriesReadOptions {
+    // Read a file whose writer has not finished (no END block) or died in the middle of a frame:
+    // every complete frame is read, the incomplete rest ignored. Otherwise such a file is refused
+    // (ErrorCode::truncated).
+    bool allow_unfinished = false;
+    uint64_t max_nodes = 1ull << 26;  // per frame
+};
+
+struct SeriesFrame {
+    Hierarchy hierarchy;  // over the series' base mesh
+    double time = 0;
+    std::vector<Field> fields;
+};
+
+struct SeriesFrameInfo {
+    uint64_t offset = 0, size = 0;  // of the frame block
+    bool keyframe = false;
+    double time = 0;
+    uint64_t nodes = 0, vertices = 0, faces = 0;
+    int levels = 0;
+};
+
+// Reads a series: the constructor checks the framing of the whole file (every block's length and
+// checksum) without decoding frames; frame(k) decodes from the last keyframe at or before k (or
+// from the frame decoded last, when k follows it).
+class SeriesReader {
+public:
+    // `what` names the file in messages. Throws Error (bad magic, unsupported version, checksum,
+    // truncated, corrupt) naming the problem.
+    SeriesReader(std::vector<uint8_t> bytes, const std::string& what = "series", const SeriesReadOptions& options = {});
+    static SeriesReader open(const std::string& path, const SeriesReadOptions& options = {});
+    ~SeriesReader();
+    SeriesReader(SeriesReader&&) noexcept;
+
+    const TriangleMesh& base() const;
+    size_t frame_count() const { return frames_.size(); }
+    const SeriesFrameInfo& info(size_t k) const { return frames_.at(k); }
+    bool finished() const { return finished_; }       // the END block is there
+    uint64_t ignored_bytes() const { return ignored_; }  // an incomplete frame at the end (allow_unfinished)
+    uint32_t keyframe_interval() const { return keyframe_interval_; }
+
+    // Throws Error naming the frame on a corrupt frame; std::out_of_range for k >= frame_count().
+    SeriesFrame frame(size_t k);
+
+private:
+    struct State;
+    void decode_next(size_t k);
+    std::vector<uint8_t> bytes_;
+    std::string what_;
+    SeriesReadOptions options_;
+    std::vector<SeriesFrameInfo> frames_;
+    std::unique_ptr<State> state_;
+    bool finished_ = false;
+    uint64_t ignored_ = 0;
+    uint32_t keyframe_interval_ = 0;
+};
+
+}  // namespace amc

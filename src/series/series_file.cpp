@@ -1,0 +1,461 @@
+// The series file: framing, SeriesWriter and SeriesReader (include/amc/series.h, docs/FORMAT.md
+// section 7). A frame is coded by code_frame / decode_frame against the state of the frame before
+// it (or the unrefined base for a keyframe).
+#include <amc/hierarchy_coder.h>
+#include <amc/series.h>
+
+#include "coding/container.h"
+#include "common/check.h"
+#include "series/field_coder.h"
+#include "series/frame_connectivity.h"
+#include "series/frame_geometry.h"
+#include "series/frame_state.h"
+#include "series/series_format.h"
+
+#include <xxhash.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+namespace amc {
+
+namespace {
+
+void put_u32(std::vector<uint8_t>& out, uint32_t v) {
+    for (int i = 0; i < 4; ++i) out.push_back(uint8_t(v >> (8 * i)));
+}
+uint32_t get_u32(const uint8_t* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
+
+std::vector<uint8_t> block(SeriesBlock type, const std::vector<uint8_t>& payload) {
+    AMC_REQUIRE(payload.size() <= 0xFFFFFFFFu, limit_exceeded, "series: a frame of more than 4 GiB");
+    std::vector<uint8_t> out;
+    out.reserve(payload.size() + kSeriesBlockOverhead);
+    out.push_back(uint8_t(type));
+    put_u32(out, uint32_t(payload.size()));
+    out.insert(out.end(), payload.begin(), payload.end());
+    put_u32(out, XXH32(out.data(), out.size(), 0));
+    return out;
+}
+
+std::vector<uint8_t> header(bool single_precision, uint32_t keyframe_interval) {
+    std::vector<uint8_t> out(kSeriesMagic, kSeriesMagic + 4);
+    out.push_back(kSeriesVersion);
+    out.push_back(single_precision ? kSeriesFlagSinglePrecision : 0);
+    out.push_back(0);
+    out.push_back(0);
+    put_u32(out, keyframe_interval);
+    put_u32(out, XXH32(out.data(), 12, 0));
+    return out;
+}
+
+std::vector<uint8_t> base_payload(const TriangleMesh& base) {
+    std::vector<uint8_t> out;
+    put_varint(out, base.positions.size());
+    put_varint(out, base.triangles.size());
+    for (const Triangle& t : base.triangles)
+        for (uint32_t v : t) put_varint(out, v);
+    for (const Vec3& p : base.positions)
+        for (double x : {p.x, p.y, p.z}) {
+            if (base.single_precision) {
+                const float f = float(x);
+                uint32_t bits;
+                std::memcpy(&bits, &f, 4);
+                put_u32(out, bits);
+            } else {
+                put_f64(out, x);
+            }
+        }
+    return out;
+}
+
+TriangleMesh read_base(const uint8_t* data, size_t size, bool single_precision, const std::string& what) {
+    PayloadReader in(data, size, "base mesh block");
+    TriangleMesh base;
+    base.single_precision = single_precision;
+    const uint64_t vertices = in.varint(), triangles = in.varint();
+    const size_t coordinate = single_precision ? 4 : 8;
+    AMC_REQUIRE(triangles >= 1 && triangles <= in.remaining() / 3 && vertices <= in.remaining() / (3 * coordinate),
+                corrupt, what + ": base mesh block: " + std::to_string(vertices) + " vertices and " +
+                             std::to_string(triangles) + " triangles can not fit in the block");
+    base.triangles.resize(size_t(triangles));
+    for (Triangle& t : base.triangles)
+        for (uint32_t& v : t) {
+            const uint64_t index = in.varint();
+            AMC_REQUIRE(index < vertices, corrupt, what + ": base mesh block: vertex index out of range");
+            v = uint32_t(index);
+        }
+    AMC_REQUIRE(in.remaining() == vertices * 3 * coordinate, corrupt,
+                what + ": base mesh block: its size does not match its counts");
+    base.positions.resize(size_t(vertices));
+    const uint8_t* p = in.rest();
+    for (Vec3& v : base.positions) {
+        double xyz[3];
+        for (double& x : xyz) {
+            if (single_precision) {
+                const uint32_t bits = get_u32(p);
+                float f;
+                std::memcpy(&f, &bits, 4);
+                x = f;
+                p += 4;
+            } else {
+                uint64_t bits = uint64_t(get_u32(p)) | uint64_t(get_u32(p + 4)) << 32;
+                std::memcpy(&x, &bits, 8);
+                p += 8;
+            }
+        }
+        v = {xyz[0], xyz[1], xyz[2]};
+    }
+    try {
+        validate_triangle_mesh(base, what + ": base mesh");
+    } catch (const Error& e) {
+        throw Error(ErrorCode::corrupt, e.what());
+    }
+    return base;
+}
+
+uint64_t face_count(const Hierarchy& h) {
+    uint64_t faces = 0;
+    for (NodeId n : h.leaves()) faces += 1 + uint64_t(h.hanging_node_count(n));
+    return faces;
+}
+
+// Frame header fields (FORMAT.md 7.4).
+struct FrameHeader {
+    double time = 0;
+    uint64_t nodes = 0, vertices = 0, faces = 0, levels = 0;
+};
+
+FrameHeader read_frame_header(PayloadReader& in, uint64_t base_vertices, uint64_t base_triangles,
+                              const std::string& what) {
+    FrameHeader f;
+    f.time = in.f64();
+    f.nodes = in.varint();
+    f.vertices = in.varint();
+    f.faces = in.varint();
+    f.levels = in.varint();
+    AMC_REQUIRE(f.nodes >= base_triangles && (f.nodes - base_triangles) % 4 == 0 && f.vertices >= base_vertices &&
+                    f.vertices <= 3 * f.nodes + base_vertices && f.faces >= base_triangles && f.faces <= 3 * f.nodes &&
+                    f.levels >= 1 && f.levels <= uint64_t(kMaxLevel) + 1,
+                corrupt, what + ": inconsistent counts in the frame header");
+    return f;
+}
+
+}  // namespace
+
+// ---- writer ----------------------------------------------------------------------------------
+
+struct SeriesWriter::State {
+    TriangleMesh base;
+    FrameState prev;
+};
+
+SeriesWriter::SeriesWriter(const TriangleMesh& base, const SeriesOptions& options)
+    : state_(new State), options_(options) {
+    validate_triangle_mesh(base, "series base mesh");
+    state_->base = base;
+    AMC_REQUIRE(options.error_bound >= 0 && std::isfinite(options.error_bound), invalid_input,
+                "series: the error bound must be finite and >= 0");
+    for (const auto& [name, bound] : options.field_bounds)
+        AMC_REQUIRE(bound >= 0 && std::isfinite(bound), invalid_input,
+                    "series: the error bound of field \"" + name + "\" must be finite and >= 0");
+    std::vector<uint8_t> start = header(base.single_precision, options.keyframe_interval);
+    const std::vector<uint8_t> b = block(SeriesBlock::base, base_payload(base));
+    start.insert(start.end(), b.begin(), b.end());
+    bytes_ = std::move(start);
+}
+
+SeriesWriter::SeriesWriter(const std::string& path, const TriangleMesh& base, const SeriesOptions& options)
+    : SeriesWriter(base, options) {
+    path_ = path;
+    file_ = std::fopen(path.c_str(), "wb");
+    AMC_REQUIRE(file_ != nullptr, io, path + ": can not open for writing: " + std::strerror(errno));
+    std::vector<uint8_t> start;
+    start.swap(bytes_);
+    write(start);
+}
+
+SeriesWriter::~SeriesWriter() {
+    if (file_) std::fclose(file_);
+}
+
+void SeriesWriter::write(const std::vector<uint8_t>& data) {
+    if (!file_) {
+        bytes_.insert(bytes_.end(), data.begin(), data.end());
+        return;
+    }
+    const bool ok = std::fwrite(data.data(), 1, data.size(), file_) == data.size() && std::fflush(file_) == 0;
+    AMC_REQUIRE(ok, io, path_ + ": write failed: " + std::strerror(errno));
+}
+
+SeriesFrameStats SeriesWriter::add_frame(const Hierarchy& h, double time, const std::vector<Field>& fields) {
+    AMC_REQUIRE(!closed_, invalid_input, "series: add_frame after close");
+    const TriangleMesh& base = state_->base;
+    AMC_REQUIRE(h.base().triangles == base.triangles, invalid_input,
+                "series frame " + std::to_string(frames_) + ": not over the series' base mesh (other base triangles)");
+    AMC_REQUIRE(h.single_precision() == base.single_precision, invalid_input,
+                "series frame " + std::to_string(frames_) + ": coordinate precision differs from the base mesh's");
+    const bool keyframe = frames_ == 0 || (options_.keyframe_interval && frames_ % options_.keyframe_interval == 0);
+    const FrameState initial = keyframe ? initial_state(base) : FrameState{};
+    const FrameState& ref = keyframe ? initial : state_->prev;
+    SeriesFrameStats stats;
+    stats.keyframe = keyframe;
+
+    FrameState next;
+    Counterparts cp;
+    std::vector<uint8_t> connectivity;
+    if (keyframe) {
+        connectivity = encode_hierarchy(h);
+        next.h = decode_hierarchy(base, connectivity.data(), connectivity.size());
+        cp = match_nodes(ref.h, next.h);
+    } else {
+        ArithmeticEncoder encoder;
+        encode_frame_connectivity(ref.h, h, encoder, next.h, cp);
+        connectivity = encoder.finish();
+    }
+    for (NodeId n = 0; n < cp.size(); ++n) stats.changed_nodes += next.h.is_alive(n) && cp[n] == kNoNode;
+    {
+        uint64_t kept = 0;
+        for (NodeId n = 0; n < cp.size(); ++n) kept += next.h.is_alive(n) && cp[n] != kNoNode;
+        stats.changed_nodes += ref.h.node_count() - kept;
+    }
+    const std::vector<FrameVertex> order = frame_vertex_order(next.h, ref.h, cp);
+    std::vector<Vec3> positions(order.size());
+    {
+        const std::vector<uint32_t> canonical = canonical_vertex_order(h);
+        for (size_t v = 0; v < canonical.size(); ++v)
+            if (canonical[v] != kNoVertex) positions[canonical[v]] = h.position(VertexId(v));
+    }
+    FrameGeometryMode mode;
+    const std::vector<uint8_t> geometry = encode_frame_geometry(ref.h, order, positions, next.h, &mode);
+    stats.moving = mode == FrameGeometryMode::moving;
+    index_frame(next);
+
+    std::vector<uint8_t> payload;
+    put_f64(payload, time);
+    stats.nodes = next.h.node_count();
+    stats.vertices = next.h.vertex_count();
+    stats.faces = face_count(next.h);
+    const FieldFrame field_frame(ref, next, cp, order);
+    put_varint(payload, stats.nodes);
+    put_varint(payload, stats.vertices);
+    put_varint(payload, stats.faces);
+    put_varint(payload, uint64_t(field_frame.levels));
+    put_varint(payload, connectivity.size());
+    payload.insert(payload.end(), connectivity.begin(), connectivity.end());
+    put_varint(payload, geometry.size());
+    payload.insert(payload.end(), geometry.begin(), geometry.end());
+    AMC_REQUIRE(fields.size() <= kMaxSeriesFields, invalid_input, "series frame: more than 4096 fields");
+    put_varint(payload, fields.size());
+    const size_t fields_start = payload.size();
+    for (size_t i = 0; i < fields.size(); ++i) {
+        for (size_t j = 0; j < i; ++j)
+            AMC_REQUIRE(fields[j].name != fields[i].name || fields[j].association != fields[i].association,
+                        invalid_input, "series frame: two fields named \"" + fields[i].name + "\"");
+        double bound = options_.error_bound;
+        for (const auto& [name, b] : options_.field_bounds)
+            if (name == fields[i].name) bound = b;
+        const size_t before = payload.size();
+        Field decoded;
+        FieldCodeStats fs;
+        encode_field(fields[i], bound, field_frame, payload, decoded, &fs);
+        stats.fields.push_back({fields[i].name, payload.size() - before, fs.bounded, fs.max_error});
+        stats.max_error = std::max(stats.max_error, fs.max_error);
+        next.fields.push_back(std::move(decoded));
+    }
+    stats.connectivity_bytes = connectivity.size();
+    stats.geometry_bytes = geometry.size();
+    stats.field_bytes = payload.size() - fields_start;
+    const std::vector<uint8_t> b = block(keyframe ? SeriesBlock::keyframe : SeriesBlock::frame, payload);
+    stats.bytes = b.size();
+    write(b);
+    state_->prev = std::move(next);
+    ++frames_;
+    return stats;
+}
+
+void SeriesWriter::close() {
+    if (closed_) return;
+    write(block(SeriesBlock::end, {}));
+    closed_ = true;
+    if (file_) {
+        const bool ok = std::fclose(file_) == 0;
+        file_ = nullptr;
+        AMC_REQUIRE(ok, io, path_ + ": close failed: " + std::strerror(errno));
+    }
+}
+
+// ---- reader ----------------------------------------------------------------------------------
+
+struct SeriesReader::State {
+    TriangleMesh base;
+    FrameState current;
+    long long current_index = -1;  // the frame `current` holds, -1 none
+};
+
+SeriesReader::SeriesReader(std::vector<uint8_t> bytes, const std::string& what, const SeriesReadOptions& options)
+    : bytes_(std::move(bytes)), what_(what), options_(options), state_(new State) {
+    const uint8_t* data = bytes_.data();
+    const size_t size = bytes_.size();
+    AMC_REQUIRE(size >= 4 && std::memcmp(data, kSeriesMagic, 4) == 0, bad_magic, what + ": not an amcodec series file (magic)");
+    AMC_REQUIRE(size >= 5, truncated, what + ": truncated header");
+    AMC_REQUIRE(data[4] != 0, corrupt, what + ": unknown series version 0");
+    AMC_REQUIRE(data[4] <= kNewestSeriesVersion, unsupported_version,
+                what + ": unsupported series version " + std::to_string(data[4]) +
+                    " (newer than this build, which reads version 1 to " + std::to_string(kNewestSeriesVersion) + ")");
+    AMC_REQUIRE(size >= kSeriesHeaderSize, truncated, what + ": truncated header");
+    AMC_REQUIRE(XXH32(data, 12, 0) == get_u32(data + 12), checksum, what + ": checksum mismatch in the header");
+    AMC_REQUIRE((data[5] & ~kSeriesFlagSinglePrecision) == 0 && data[6] == 0 && data[7] == 0, corrupt,
+                what + ": reserved header bits set");
+    keyframe_interval_ = get_u32(data + 8);
+    const bool single = data[5] & kSeriesFlagSinglePrecision;
+
+    size_t pos = kSeriesHeaderSize;
+    bool have_base = false;
+    while (true) {
+        if (pos == size) {
+            AMC_REQUIRE(options.allow_unfinished, truncated,
+                        what + ": unfinished series: no END block after " + std::to_string(frames_.size()) +
+                            " complete frames (the writer did not close it; read with allow_unfinished / --partial)");
+            break;
+        }
+        const bool fits = size - pos >= kSeriesBlockOverhead &&
+                          get_u32(data + pos + 1) <= size - pos - kSeriesBlockOverhead;
+        if (!fits) {
+            AMC_REQUIRE(options.allow_unfinished && have_base, truncated,
+                        what + ": truncated in " + (have_base ? "frame " + std::to_string(frames_.size()) : std::string("the base mesh block")) +
+                            " at byte " + std::to_string(pos) + " (" + std::to_string(frames_.size()) +
+                            " complete frames before it" + (have_base ? "; read them with allow_unfinished / --partial)" : ")"));
+            ignored_ = size - pos;
+            break;
+        }
+        const uint8_t type = data[pos];
+        const uint32_t length = get_u32(data + pos + 1);
+        AMC_REQUIRE(XXH32(data + pos, 5 + size_t(length), 0) == get_u32(data + pos + 5 + length), checksum,
+                    what + ": checksum mismatch in the block at byte " + std::to_string(pos) +
+                        (have_base ? " (frame " + std::to_string(frames_.size()) + ")" : std::string()));
+        const uint8_t* payload = data + pos + 5;
+        AMC_REQUIRE(type <= uint8_t(SeriesBlock::frame), corrupt,
+                    what + ": unknown block type " + std::to_string(type) + " at byte " + std::to_string(pos));
+        const SeriesBlock kind = SeriesBlock(type);
+        if (!have_base) {
+            AMC_REQUIRE(kind == SeriesBlock::base, corrupt, what + ": the first block is not the base mesh");
+            state_->base = read_base(payload, length, single, what);
+            have_base = true;
+        } else if (kind == SeriesBlock::end) {
+            AMC_REQUIRE(length == 0, corrupt, what + ": END block with a payload");
+            AMC_REQUIRE(pos + kSeriesBlockOverhead == size, corrupt, what + ": bytes after the END block");
+            finished_ = true;
+            break;
+        } else {
+            AMC_REQUIRE(kind != SeriesBlock::base, corrupt, what + ": a second base mesh block");
+            AMC_REQUIRE(kind == SeriesBlock::keyframe || !frames_.empty(), corrupt, what + ": frame 0 is not a keyframe");
+            PayloadReader in(payload, length, "frame header");
+            const std::string frame_what = what + ": frame " + std::to_string(frames_.size());
+            const FrameHeader fh = read_frame_header(in, state_->base.positions.size(), state_->base.triangles.size(), frame_what);
+            SeriesFrameInfo info;
+            info.offset = pos;
+            info.size = length + kSeriesBlockOverhead;
+            info.keyframe = kind == SeriesBlock::keyframe;
+            info.time = fh.time;
+            info.nodes = fh.nodes;
+            info.vertices = fh.vertices;
+            info.faces = fh.faces;
+            info.levels = int(fh.levels);
+            frames_.push_back(info);
+        }
+        pos += kSeriesBlockOverhead + length;
+    }
+}
+
+SeriesReader SeriesReader::open(const std::string& path, const SeriesReadOptions& options) {
+    std::ifstream in(path, std::ios::binary);
+    AMC_REQUIRE(in.good(), io, path + ": can not open");
+    std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    AMC_REQUIRE(!in.bad(), io, path + ": read failed");
+    return SeriesReader(std::move(bytes), path, options);
+}
+
+SeriesReader::~SeriesReader() = default;
+SeriesReader::SeriesReader(SeriesReader&&) noexcept = default;
+
+const TriangleMesh& SeriesReader::base() const { return state_->base; }
+
+void SeriesReader::decode_next(size_t k) {
+    const SeriesFrameInfo& info = frames_[k];
+    const std::string what = what_ + ": frame " + std::to_string(k);
+    const uint8_t* payload = bytes_.data() + info.offset + 5;
+    const size_t length = info.size - kSeriesBlockOverhead;
+    const TriangleMesh& base = state_->base;
+    const FrameState initial = info.keyframe ? initial_state(base) : FrameState{};
+    const FrameState& ref = info.keyframe ? initial : state_->current;
+    try {
+        PayloadReader in(payload, length, "frame");
+        const FrameHeader fh = read_frame_header(in, base.positions.size(), base.triangles.size(), what);
+        AMC_REQUIRE(fh.nodes <= options_.max_nodes, limit_exceeded,
+                    std::to_string(fh.nodes) + " nodes, more than the limit (" + std::to_string(options_.max_nodes) + ")");
+        const uint64_t connectivity_length = in.varint();
+        AMC_REQUIRE(connectivity_length <= in.remaining(), truncated, "connectivity longer than the frame");
+        const uint8_t* connectivity = in.rest();
+        for (uint64_t i = 0; i < connectivity_length; ++i) in.u8();
+        FrameState next;
+        Counterparts cp;
+        if (info.keyframe) {
+            HierarchyDecodeOptions options;
+            options.max_nodes = fh.nodes;
+            next.h = decode_hierarchy(base, connectivity, size_t(connectivity_length), options);
+            cp = match_nodes(ref.h, next.h);
+        } else {
+            ArithmeticDecoder decoder(connectivity, size_t(connectivity_length));
+            decode_frame_connectivity(ref.h, decoder, fh.nodes, next.h, cp);
+            AMC_REQUIRE(!decoder.overran(), truncated, "connectivity: the payload ends early");
+        }
+        AMC_REQUIRE(next.h.node_count() == fh.nodes && next.h.vertex_count() == fh.vertices, corrupt,
+                    "the forest does not match the counts of the frame header");
+        const uint64_t geometry_length = in.varint();
+        AMC_REQUIRE(geometry_length <= in.remaining(), truncated, "geometry longer than the frame");
+        const uint8_t* geometry = in.rest();
+        for (uint64_t i = 0; i < geometry_length; ++i) in.u8();
+        const std::vector<FrameVertex> order = frame_vertex_order(next.h, ref.h, cp);
+        decode_frame_geometry(ref.h, order, geometry, size_t(geometry_length), next.h);
+        index_frame(next);
+        const FieldFrame field_frame(ref, next, cp, order);
+        AMC_REQUIRE(uint64_t(field_frame.levels) == fh.levels && field_frame.cell_node.size() == fh.faces, corrupt,
+                    "the forest does not match the counts of the frame header");
+        const uint64_t field_count = in.varint();
+        AMC_REQUIRE(field_count <= kMaxSeriesFields, corrupt, std::to_string(field_count) + " fields (at most 4096)");
+        for (uint64_t i = 0; i < field_count; ++i) {
+            Field f = decode_field(in, field_frame);
+            for (const Field& g : next.fields)
+                AMC_REQUIRE(g.name != f.name || g.association != f.association, corrupt,
+                            "two fields named \"" + f.name + "\"");
+            next.fields.push_back(std::move(f));
+        }
+        AMC_REQUIRE(in.remaining() == 0, corrupt, "bytes after the last field");
+        next.h.set_single_precision(base.single_precision);
+        state_->current = std::move(next);
+        state_->current_index = (long long)k;
+    } catch (const Error& e) {
+        state_->current_index = -1;
+        if (std::string(e.what()).rfind(what, 0) == 0) throw;
+        throw e.prefixed(what);
+    }
+}
+
+SeriesFrame SeriesReader::frame(size_t k) {
+    if (k >= frames_.size()) throw std::out_of_range("series frame " + std::to_string(k) + " of " + std::to_string(frames_.size()));
+    size_t start = k;
+    while (!frames_[start].keyframe) --start;
+    size_t from = start;
+    if (state_->current_index >= (long long)start && state_->current_index <= (long long)k) from = size_t(state_->current_index) + 1;
+    if (state_->current_index == (long long)k) from = k + 1;
+    for (size_t i = from; i <= k; ++i) decode_next(i);
+    SeriesFrame out;
+    out.hierarchy = state_->current.h;
+    out.time = frames_[k].time;
+    out.fields = state_->current.fields;
+    return out;
+}
+
+}  // namespace amc
