@@ -141,3 +141,34 @@ private:
 };
 
 }  // namespace amc
+
+namespace amc {
+
+// ---- series as ParaView collections of VTU files (src/series/series_vtu.cpp) -------------------
+
+// One dataset of a ParaView collection (.pvd): its time step and its file, as written in the .pvd
+// (relative to the .pvd's directory unless absolute).
+struct PvdEntry {
+    double time = 0;
+    std::string file;
+};
+// Reads the <DataSet timestep=... file=...> entries of a .pvd file, in file order (part and group
+// attributes are ignored). Throws Error naming the file and line.
+std::vector<PvdEntry> read_pvd(const std::string& path);
+// Writes a .pvd collection (through a temporary file and a rename).
+void write_pvd(const std::string& path, const std::vector<PvdEntry>& entries);
+
+// A field as a VTK DataArray of the same name, type and values, and back.
+Field field_from_array(const DataArray& array, FieldAssociation association);
+DataArray array_from_field(const Field& field);
+
+// A VTU leaf mesh with point and cell data, read as a frame over `base` (import_leaf_mesh): the
+// point and cell arrays become fields, reordered to canonical vertex order and leaf-mesh order.
+SeriesFrame frame_from_vtu(const TriangleMesh& base, const VtuMesh& vtu, double time = 0,
+                           const std::string& what = "vtu");
+// The frame's leaf mesh (or the mesh of `max_level`, which keeps only the point fields: cell
+// fields belong to the leaf mesh) with its fields as point and cell data, plus the cell arrays
+// "level" and "green" unless the frame has fields of those names.
+VtuMesh vtu_from_frame(const SeriesFrame& frame, int max_level = -1);
+
+}  // namespace amc
