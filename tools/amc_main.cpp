@@ -28,6 +28,9 @@ Examples:
   amc import leaf.off --base coarse.off -o leaf.amh
   amc refine --model lshape --max-level 10 -o lshape.amh
   amc info mesh.amc
+  amc series encode run.pvd --base coarse.vtu    -> run.amcs (frames with their point and cell data)
+  amc series decode run.amcs -o out.pvd          -> out.pvd + out_<k>.vtu
+  amc decode run.amcs --frame 40 -o f40.vtu      one frame, from the keyframe before it
   cat mesh.ply | amc encode - > mesh.amc
 
 Exit status: 0 success, 1 error (bad input, existing output without -f), 2 usage error.
@@ -67,6 +70,7 @@ int main(int argc, char** argv) {
     encode_cmd->add_option("--quantize", encode.quantize_bits, "Quantize coordinates to BITS per axis (lossy; 0 = bit-exact)")
         ->check(CLI::Range(0, 30));
     encode_cmd->add_option("--predictor", encode.predictor, "auto | midpoint | butterfly")->capture_default_str();
+    encode_cmd->add_flag("--series", encode.series, "The input is a series (as 'amc series encode'; implied by a .pvd input)");
 
     DecodeCommand decode;
     auto* decode_cmd = app.add_subcommand("decode", "Decompress an .amc file to a leaf mesh or a hierarchy");
@@ -75,6 +79,8 @@ int main(int argc, char** argv) {
                            "Leaf mesh (.obj .off .ply .vtu) or hierarchy (.amh) (default: the input with .ply; - for stdout)");
     decode_cmd->add_option("--format", decode.format, "Format for stdout: ply | obj | off | vtu | amh");
     decode_cmd->add_option("--level", decode.level, "Decode only up to this level (progressive)")->check(CLI::Range(0, kMaxLevel));
+    decode_cmd->add_option("--frame", decode.frame, "A series (.amcs): only this frame")
+        ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
     decode_cmd->add_flag("--canonical", decode.canonical, "Write the canonical numbering even if the file stores another");
     decode_cmd->add_option("--map", decode.map, "Write the stored numbering map (input's numbering -> canonical)");
     add_max_nodes(decode_cmd, decode.max_nodes);
@@ -94,7 +100,7 @@ int main(int argc, char** argv) {
     add_max_nodes(extract_cmd, extract.max_nodes);
 
     InfoCommand info;
-    auto* info_cmd = app.add_subcommand("info", "Describe a mesh, hierarchy (.amh) or compressed (.amc) file");
+    auto* info_cmd = app.add_subcommand("info", "Describe a mesh, hierarchy (.amh), compressed (.amc) or series (.amcs) file");
     info_cmd->add_option("file", info.input, "Input file, or - for stdin")->required();
     add_max_nodes(info_cmd, info.max_nodes);
 
@@ -122,6 +128,44 @@ int main(int argc, char** argv) {
     report->add_option("files", report_inputs, "Hierarchy files (.amh)")->required();
     report->add_option("--runs", report_runs, "Runs per measurement (the median is reported)")->capture_default_str()->check(CLI::Range(1, 1000));
 
+    auto* series = app.add_subcommand("series", "Time series of adaptive meshes with their fields (.amcs)");
+    series->require_subcommand(1);
+    SeriesEncodeCommand series_encode;
+    auto* series_encode_cmd = series->add_subcommand("encode", "Compress a ParaView collection (.pvd) or frame files to .amcs");
+    series_encode_cmd->add_option("inputs", series_encode.inputs,
+                                  "A .pvd, or frame files in order: VTU (with point and cell data), OBJ, OFF, PLY, .amh, .amc")
+        ->required();
+    series_encode_cmd->add_option("-o,--output", series_encode.output, "Series file (default: the first input with .amcs; - for stdout)");
+    series_encode_cmd->add_option("--base", series_encode.base, "Base mesh of mesh frames (default: the first frame's mesh)");
+    series_encode_cmd->add_option("--keyframe", series_encode.keyframe_interval,
+                                  "A keyframe every K frames, for random access (default 0: frame 0 only)")
+        ->check(CLI::Range(0u, 1u << 30));
+    series_encode_cmd->add_option("--error-bound", series_encode.error_bound,
+                                  "Absolute error bound of every float field (default 0: bit-exact)")
+        ->check(CLI::Range(0.0, 1e300));
+    series_encode_cmd->add_option("--field-bound", series_encode.field_bounds, "NAME=BOUND: a bound for one field (repeatable)");
+    SeriesDecodeCommand series_decode;
+    auto* series_decode_cmd = series->add_subcommand("decode", "Decompress an .amcs file to a .pvd and one VTU per frame");
+    series_decode_cmd->add_option("input", series_decode.input, "Series file (.amcs), or - for stdin")->required();
+    series_decode_cmd->add_option("-o,--output", series_decode.output,
+                                  "Collection (.pvd; frames go to NAME_<k>.vtu beside it), or with --frame the frame's "
+                                  ".vtu .obj .off .ply .amh (default: the input with .pvd, or NAME_<k>.vtu)");
+    series_decode_cmd->add_option("--frame", series_decode.frame, "Only this frame (decodes from the keyframe before it)")
+        ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
+    series_decode_cmd->add_option("--level", series_decode.level, "The mesh of this level (point fields only)")
+        ->check(CLI::Range(0, kMaxLevel));
+    series_decode_cmd->add_flag("--partial", series_decode.allow_unfinished,
+                                "Read the complete frames of a file whose writer has not finished");
+    add_max_nodes(series_decode_cmd, series_decode.max_nodes);
+    SeriesInfoCommand series_info;
+    auto* series_info_cmd = series->add_subcommand("info", "Frames of an .amcs file: times, sizes, meshes, fields");
+    series_info_cmd->add_option("input", series_info.input, "Series file (.amcs), or - for stdin")->required();
+    series_info_cmd->add_option("--frame", series_info.frame, "Describe this frame's fields (default: frame 0's)")
+        ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
+    series_info_cmd->add_flag("--partial", series_info.allow_unfinished,
+                              "Read the complete frames of a file whose writer has not finished");
+    add_max_nodes(series_info_cmd, series_info.max_nodes);
+
     std::vector<std::string> stats_inputs;
     bool stats_groups = false, stats_verify = false;
     auto* stats = app.add_subcommand("stats", "Hierarchy coder statistics: the paper's Tables 1 and 2");
@@ -145,6 +189,9 @@ int main(int argc, char** argv) {
         if (*import_cmd) run_import(import, global);
         if (*extract_cmd) run_extract(extract, global);
         if (*info_cmd) run_info(info, global);
+        if (*series_encode_cmd) run_series_encode(series_encode, global);
+        if (*series_decode_cmd) run_series_decode(read_input(series_decode.input), series_decode, global);
+        if (*series_info_cmd) run_series_info(read_input(series_info.input), series_info, global);
         if (*refine_cmd) run_refine(refine, global);
         if (*report) {
             print_codec_report_header();

@@ -30,6 +30,7 @@ const char* file_kind_name(FileKind kind) {
         case FileKind::compressed: return "compressed .amc data";
         case FileKind::hierarchy: return "a hierarchy (.amh)";
         case FileKind::mesh: return "a mesh";
+        case FileKind::series: return "a series (.amcs)";
     }
     return "?";
 }
@@ -56,6 +57,8 @@ InputFile read_input(const std::string& path) {
         in.kind = FileKind::compressed;
     } else if (starts_with(in.bytes, "AMCH")) {
         in.kind = FileKind::hierarchy;
+    } else if (starts_with(in.bytes, "AMCS")) {
+        in.kind = FileKind::series;
     } else if (mesh_format_from_content(in.bytes, in.mesh_format)) {
         in.kind = FileKind::mesh;
     } else if (lower_extension(path) == ".obj") {
@@ -63,7 +66,7 @@ InputFile read_input(const std::string& path) {
         in.mesh_format = MeshFormat::obj;
     } else {
         throw Error(ErrorCode::bad_magic, in.name + ": " + (in.bytes.empty() ? "empty file" : "not a file amc reads") +
-                    " (expected .amc, .amh, or a mesh: OBJ, OFF, PLY, VTU)");
+                    " (expected .amc, .amh, .amcs, or a mesh: OBJ, OFF, PLY, VTU)");
     }
     return in;
 }

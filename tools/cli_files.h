@@ -16,7 +16,7 @@ public:
     using Error::Error;
 };
 
-enum class FileKind { compressed, hierarchy, mesh };
+enum class FileKind { compressed, hierarchy, mesh, series };
 const char* file_kind_name(FileKind kind);
 
 struct InputFile {
@@ -26,8 +26,8 @@ struct InputFile {
     MeshFormat mesh_format = MeshFormat::obj;  // when kind is mesh
 };
 
-// Reads a file, or standard input for "-". The kind comes from the magic bytes (.amc, .amh, PLY,
-// OFF, VTU); text without a magic word is read as OBJ when the name or content says so. Throws
+// Reads a file, or standard input for "-". The kind comes from the magic bytes (.amc, .amh, .amcs,
+// PLY, OFF, VTU); text without a magic word is read as OBJ when the name or content says so. Throws
 // Error naming the file when no kind fits.
 InputFile read_input(const std::string& path);
 

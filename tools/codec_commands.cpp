@@ -57,6 +57,16 @@ void print_encode_stats(std::FILE* out, const std::string& name, const EncodeSta
 }  // namespace
 
 void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
+    if (command.series || is_pvd(command.input)) {
+        if (command.keep_numbering || !command.map.empty() || command.quantize_bits != 0 || command.predictor != "auto")
+            throw UsageError("--keep-numbering, --map, --quantize and --predictor do not apply to a series");
+        SeriesEncodeCommand series;
+        series.inputs = {command.input};
+        series.output = command.output;
+        series.base = command.base;
+        run_series_encode(series, global);
+        return;
+    }
     Progress progress(global.verbosity > 0);
     progress.phase("reading " + command.input);
     const InputFile input = read_input(command.input);
@@ -111,6 +121,15 @@ void run_decode(const DecodeCommand& command, const GlobalOptions& global) {
     Progress progress(global.verbosity > 0);
     progress.phase("reading " + command.input);
     const InputFile input = read_input(command.input);
+    if (input.kind == FileKind::series) {
+        if (!command.format.empty() || command.canonical || !command.map.empty())
+            throw UsageError("--format, --canonical and --map do not apply to a series (.amcs)");
+        progress.finish();
+        run_series_decode(input, {command.input, command.output, command.frame, command.level, false, command.max_nodes},
+                          global);
+        return;
+    }
+    if (command.frame >= 0) throw UsageError("--frame applies to a series (.amcs); " + input.name + " is " + file_kind_name(input.kind));
     const std::string output = command.output.empty() ? default_output(command.input, ".ply") : command.output;
     MeshFormat mesh_format = MeshFormat::ply;
     OutputKind kind = output_kind(output, &mesh_format);

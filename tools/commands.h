@@ -10,6 +10,8 @@
 
 namespace amc::cli {
 
+struct InputFile;
+
 struct GlobalOptions {
     bool force = false;  // overwrite existing outputs
     int verbosity = 1;   // 0 with -q (errors only), 2 with -v
@@ -22,6 +24,7 @@ struct EncodeCommand {
     std::string map;              // write the numbering map (input -> decoded) here
     int quantize_bits = 0;
     std::string predictor = "auto";
+    bool series = false;          // the input is a series (.pvd, or a list of VTU files): run_series_encode
 };
 void run_encode(const EncodeCommand& command, const GlobalOptions& global);
 
@@ -32,6 +35,7 @@ struct DecodeCommand {
     bool canonical = false;      // ignore a stored numbering
     std::string map;             // write the stored numbering map here
     uint64_t max_nodes = 0;      // 0: the library's default limit
+    int64_t frame = -1;          // a series: only this frame
 };
 void run_decode(const DecodeCommand& command, const GlobalOptions& global);
 
@@ -62,6 +66,36 @@ struct RefineCommand {
     uint64_t seed = 1;
 };
 void run_refine(const RefineCommand& command, const GlobalOptions& global);
+
+// Series of frames with fields (.amcs), from and to ParaView collections (series_commands.cpp).
+struct SeriesEncodeCommand {
+    std::vector<std::string> inputs;  // one .pvd, or frame files (VTU with point and cell data, meshes, .amh, .amc)
+    std::string output;
+    std::string base;                 // base mesh of mesh frames; empty: the first frame's
+    uint32_t keyframe_interval = 0;
+    double error_bound = 0;           // absolute, for every float field; 0: bit-exact
+    std::vector<std::string> field_bounds;  // NAME=BOUND
+};
+void run_series_encode(const SeriesEncodeCommand& command, const GlobalOptions& global);
+
+struct SeriesDecodeCommand {
+    std::string input, output;
+    int64_t frame = -1;     // only this frame (random access)
+    int level = -1;         // the mesh of this level
+    bool allow_unfinished = false;
+    uint64_t max_nodes = 0;
+};
+void run_series_decode(const InputFile& input, const SeriesDecodeCommand& command, const GlobalOptions& global);
+
+struct SeriesInfoCommand {
+    std::string input;
+    int64_t frame = -1;     // describe this frame's fields (default: frame 0's)
+    bool allow_unfinished = false;
+    uint64_t max_nodes = 0;
+};
+void run_series_info(const InputFile& input, const SeriesInfoCommand& command, const GlobalOptions& global);
+
+bool is_pvd(const std::string& path);  // a ParaView collection, by its name
 
 // The main job on the embedded default (README, first command).
 void run_demo(const std::string& out_dir, const GlobalOptions& global);

@@ -54,13 +54,14 @@ void print_compressed_info(const InputFile& input, uint64_t max_nodes) {
 
 }  // namespace
 
-void run_info(const InfoCommand& command, const GlobalOptions&) {
+void run_info(const InfoCommand& command, const GlobalOptions& global) {
     const InputFile input = read_input(command.input);
     switch (input.kind) {
         case FileKind::compressed: print_compressed_info(input, command.max_nodes); break;
         case FileKind::hierarchy:
             print_hierarchy_summary(std::filesystem::path(input.name).filename().string(), hierarchy_of(input));
             break;
+        case FileKind::series: run_series_info(input, {command.input, -1, false, command.max_nodes}, global); break;
         case FileKind::mesh: {
             const TriangleMesh mesh = mesh_of(input);
             std::printf("%s: %zu vertices, %zu triangles, %s precision\n", input.name.c_str(), mesh.positions.size(),

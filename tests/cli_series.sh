@@ -1,0 +1,101 @@
+#!/usr/bin/env bash
+# `amc series` and the series paths of encode, decode and info: a run of frames to .amcs and back
+# through a ParaView collection, one frame by random access, exit codes 0/1/2, -f, -q, default
+# names, truncated and foreign files.
+# Usage: cli_series.sh AMC
+set -u
+amc=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work" || exit 1
+failures=0
+
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+expect() {
+  local code=$1; shift
+  "$@" > out.txt 2> err.txt
+  local got=$?
+  [[ $got == "$code" ]] || fail "'$*' exited $got, expected $code; stderr: $(head -c 300 err.txt)"
+}
+
+# Frames: a moving front, refined ahead and coarsened behind, as hierarchy files.
+expect 0 "$amc" refine --model front --steps 6 --max-level 6 -o front.amh
+expect 0 "$amc" extract front_0.amh --level 0 -o base.vtu
+
+# Hierarchies -> series -> collection; default names.
+expect 0 "$amc" series encode front_0.amh front_1.amh front_2.amh front_3.amh front_4.amh front_5.amh
+[[ -s front_0.amcs ]] || fail "series encode wrote no front_0.amcs"
+grep -q '6 frames' out.txt || fail "series encode does not report 6 frames: $(head -c 200 out.txt)"
+expect 1 "$amc" series encode front_0.amh front_1.amh
+grep -q 'already exists' err.txt || fail "series encode overwrote front_0.amcs"
+expect 0 "$amc" series decode front_0.amcs
+[[ -s front_0.pvd && -s front_0_5.vtu ]] || fail "series decode wrote no front_0.pvd + front_0_<k>.vtu"
+[[ $(grep -c '<DataSet' front_0.pvd) == 6 ]] || fail "front_0.pvd does not list 6 frames"
+expect 1 "$amc" series decode front_0.amcs
+expect 0 "$amc" -f series decode front_0.amcs -q
+[[ -s out.txt ]] && fail "-q printed: $(head -c 200 out.txt)"
+
+# The collection (frames with the cell data "level" and "green") -> series with keyframes;
+# `amc encode` of a .pvd is a series encode.
+expect 0 "$amc" encode front_0.pvd --base base.vtu -o run.amcs
+expect 0 "$amc" series encode front_0.pvd --base base.vtu -o key.amcs --keyframe 2
+grep -q '3 keyframes' out.txt || fail "--keyframe 2 over 6 frames did not make 3 keyframes: $(head -c 300 out.txt)"
+grep -q 'field green' out.txt || fail "the VTU cell data did not become fields"
+expect 1 "$amc" series encode front_0.pvd -o nobase.amcs
+grep -q 'without --base' err.txt || fail "a frame off the first frame's mesh does not hint at --base"
+
+# Info, per frame.
+expect 0 "$amc" info key.amcs
+[[ $(grep -cE '^ +[0-9]+ ' out.txt) -ge 6 ]] || fail "info lists fewer than 6 frames"
+grep -q 'decodes: yes' out.txt || fail "info did not decode the frames"
+expect 0 "$amc" series info key.amcs --frame 3
+grep -q 'fields of frame 3' out.txt || fail "series info --frame 3 describes no fields"
+
+# Random access: frame 3 alone equals frame 3 of the whole decode, in every file.
+expect 0 "$amc" series decode key.amcs -o all.pvd
+expect 0 "$amc" decode key.amcs --frame 3 -o key3.vtu
+expect 0 "$amc" series decode run.amcs --frame 3 -o run3.vtu
+cmp -s key3.vtu all_3.vtu || fail "decode --frame 3 differs from frame 3 of the collection"
+cmp -s run3.vtu all_3.vtu || fail "frame 3 differs between a file with keyframes and one without"
+expect 0 "$amc" series decode key.amcs --frame 3 --level 2 -o key3_level2.vtu
+expect 0 "$amc" series decode key.amcs --frame 4 -o key4.amh
+expect 0 "$amc" info key4.amh
+expect 1 "$amc" decode key.amcs --frame 6 -o x.vtu
+grep -q 'frames 0..5' err.txt || fail "an absent frame is not named: $(head -c 200 err.txt)"
+expect 1 "$amc" series decode key.amcs --frame 1 --level 30 -o x.vtu
+
+# Usage errors (2).
+expect 0 "$amc" encode front_0.amh
+expect 2 "$amc" series
+expect 2 "$amc" series decode key.amcs -o x.amc
+expect 2 "$amc" series decode key.amcs -o -
+expect 2 "$amc" series encode front_0.pvd -o x.amc
+expect 2 "$amc" series encode front_0.pvd --base base.vtu --field-bound level -o y.amcs
+expect 2 "$amc" series decode key.amcs --frame -1
+expect 2 "$amc" decode front_0.amc --frame 1
+expect 2 "$amc" encode front_0.pvd --quantize 12 -o z.amcs
+[[ -e x.amc || -e y.amcs || -e z.amcs ]] && fail "an output was written after a usage error"
+
+# Bad data (1): truncated, corrupted, not a series.
+head -c 3000 key.amcs > cut.amcs
+expect 1 "$amc" series info cut.amcs
+grep -q 'truncated' err.txt || fail "a truncated series is not called truncated: $(head -c 200 err.txt)"
+expect 0 "$amc" series info cut.amcs --partial
+grep -q 'unfinished' out.txt || fail "--partial does not say the file is unfinished"
+cp key.amcs bad.amcs
+printf '\x00\x11\x22\x33' | dd of=bad.amcs bs=1 seek=2500 conv=notrunc 2> /dev/null
+cmp -s key.amcs bad.amcs && fail "bad.amcs is not corrupted"
+expect 1 "$amc" series decode bad.amcs -o bad.pvd
+grep -q 'checksum' err.txt || fail "a corrupted series is not called a checksum error: $(head -c 200 err.txt)"
+[[ -e bad.pvd ]] && fail "a collection was written for a corrupted series"
+expect 1 "$amc" series info front_0.amh
+grep -q 'expected a series' err.txt || fail "a hierarchy given to series info is not refused by kind"
+echo "not a series" > junk.amcs
+expect 1 "$amc" series info junk.amcs
+expect 1 "$amc" extract key.amcs -o e.ply
+
+if ((failures)); then
+  echo "$failures failure(s)"
+  exit 1
+fi
+echo "all series CLI checks passed"
