@@ -5,7 +5,9 @@
 // frame, random access, and speeds.
 //
 //   series_bench [--scenario lshape|rotating|front] [--frames N] [--target ELEMENTS]
-//                [--max-level L] [--keyframe K] [--bound B] [--repeat R]
+//                [--max-level L] [--keyframe K] [--bound B] [--repeat R] [--speed-only 1] [--peers 0]
+// Times are CPU seconds; --speed-only leaves out the peers and the bounded file (for large frames);
+// --peers 0 leaves out zstd, xz and zfp (the costly part), keeping the .amc files.
 #include <amc/codec.h>
 #include <amc/hierarchy_coder.h>
 #include <amc/refinement.h>
@@ -19,7 +21,7 @@
 #endif
 
 #include <algorithm>
-#include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -37,7 +39,13 @@ struct Frame {
     std::vector<Field> fields;
 };
 
-double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+// CPU seconds of this (single-threaded) process: the machine is shared, wall time says more about the
+// neighbours than about the codec.
+double now() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
 
 template <class T>
 void append(std::vector<uint8_t>& out, const std::vector<T>& v) {
@@ -136,6 +144,7 @@ int main(int argc, char** argv) {
     int frames = 100, max_level = 10, repeat = 3;
     uint32_t target = 20000, keyframe = 0;
     double bound = 1e-6;
+    bool speed_only = false, peers = true;
     for (int i = 1; i + 1 < argc; i += 2) {
         const std::string a = argv[i];
         if (a == "--scenario") scenario = argv[i + 1];
@@ -145,6 +154,8 @@ int main(int argc, char** argv) {
         else if (a == "--keyframe") keyframe = uint32_t(std::atoi(argv[i + 1]));
         else if (a == "--bound") bound = std::atof(argv[i + 1]);
         else if (a == "--repeat") repeat = std::atoi(argv[i + 1]);
+        else if (a == "--speed-only") speed_only = std::atoi(argv[i + 1]) != 0;
+        else if (a == "--peers") peers = std::atoi(argv[i + 1]) != 0;
         else {
             std::fprintf(stderr, "unknown option %s\n", argv[i]);
             return 2;
@@ -217,6 +228,20 @@ int main(int argc, char** argv) {
         random_access = now() - t0;
         if (!identical(f.hierarchy, seq[seq.size() / 2].h)) std::printf("RANDOM ACCESS MISMATCH\n");
     }
+    auto print_speed = [&] {
+        const double n = double(seq.size());
+        std::printf("speed (%d runs, CPU s): encode %.1f-%.1f frames/s, decode %.1f-%.1f frames/s (%.0f faces a frame)\n",
+                    repeat, n / *std::max_element(encode_times.begin(), encode_times.end()),
+                    n / *std::min_element(encode_times.begin(), encode_times.end()),
+                    n / *std::max_element(decode_times.begin(), decode_times.end()),
+                    n / *std::min_element(decode_times.begin(), decode_times.end()), double(faces) / n);
+    };
+    if (speed_only) {
+        std::printf("series file: %zu bytes; round trips: %zu/%zu frames bit-exact\n", series.size(), exact_ok, seq.size());
+        std::printf("random access to frame %zu from a fresh reader: %.1f ms\n", seq.size() / 2, 1e3 * random_access);
+        print_speed();
+        return exact_ok == seq.size() ? 0 : 1;
+    }
     SeriesOptions bounded_options = exact_options;
     bounded_options.error_bound = bound;
     std::vector<SeriesFrameStats> bounded_stats;
@@ -250,6 +275,8 @@ int main(int argc, char** argv) {
     for (size_t k = 0; k < seq.size(); ++k) {
         const Frame& f = seq[k];
         amc_total += encode(f.h).size();
+        if (!peers) goto ours;
+        {
         const std::vector<uint8_t> vtu = vtu_arrays(f, true, true);
         vtu_raw += vtu.size();
         vtu_zstd += zstd_size(vtu, 19);
@@ -268,6 +295,8 @@ int main(int argc, char** argv) {
             field_zfp_bounded += zfp_size(field.values, bound, &zfp_error);
         }
 #endif
+        }
+    ours:
         series_conn += stats[k].connectivity_bytes;
         series_geom += stats[k].geometry_bytes;
         series_fields += stats[k].field_bytes;
@@ -290,42 +319,55 @@ int main(int argc, char** argv) {
     row("  positions", series_geom);
     row("  fields", series_fields);
     row("independent .amc files (mesh only, no fields)", amc_total);
+    if (peers) {
     row("binary VTU arrays, raw", vtu_raw);
     row("binary VTU arrays, zstd -19 per frame", vtu_zstd);
     row("binary VTU arrays, xz -9 per frame", vtu_xz);
+    }
     if (!bounded.empty()) {
         std::printf("\nFields alone (all frames):\n\n| what | bytes | vs ours |\n|---|---:|---:|\n");
         auto frow = [&](const char* what, uint64_t bytes, uint64_t ours) {
             std::printf("| %s | %llu | %.2f |\n", what, (unsigned long long)bytes, double(bytes) / double(ours));
         };
         frow("series fields, bit-exact", series_fields, series_fields);
-        frow("raw arrays", field_raw, series_fields);
-        frow("zstd -19 of the raw arrays, per frame", field_zstd, series_fields);
+        if (peers) {
+            frow("raw arrays", field_raw, series_fields);
+            frow("zstd -19 of the raw arrays, per frame", field_zstd, series_fields);
 #ifdef AMC_HAVE_ZFP
-        frow("zfp reversible, per array and frame", field_zfp, series_fields);
+            frow("zfp reversible, per array and frame", field_zfp, series_fields);
 #endif
+        }
         char label[128];
         std::snprintf(label, sizeof label, "series fields, bound %g (max error %.3g)", bound, bounded_error);
         frow(label, series_bounded_fields, series_bounded_fields);
 #ifdef AMC_HAVE_ZFP
         std::snprintf(label, sizeof label, "zfp accuracy %g, per array and frame (max error %.3g)", bound, zfp_error);
-        frow(label, field_zfp_bounded, series_bounded_fields);
+        if (peers) frow(label, field_zfp_bounded, series_bounded_fields);
 #endif
     }
     // Per field: ours against zstd -19 of that array alone.
     if (!seq.front().fields.empty()) {
-        std::printf("\nPer field (all frames, bit-exact):\n\n| field | ours | zstd -19 | raw |\n|---|---:|---:|---:|\n");
+        std::printf("\nPer field (all frames, bit-exact; bits per value, a value being one component of a "
+                    "vertex's or cell's tuple):\n\n| field | ours | bits/value | zstd -19 | bits/value | raw |\n"
+                    "|---|---:|---:|---:|---:|---:|\n");
         for (size_t i = 0; i < seq.front().fields.size(); ++i) {
-            uint64_t ours = 0, z = 0, raw = 0;
+            uint64_t ours = 0, z = 0, raw = 0, values = 0;
             for (size_t k = 0; k < seq.size(); ++k) {
                 ours += stats[k].fields[i].bytes;
+                values += seq[k].fields[i].value_count();
                 Frame one{Hierarchy(), 0, {seq[k].fields[i]}};
                 const std::vector<uint8_t> a = vtu_arrays(one, false, true);
                 raw += a.size();
-                z += zstd_size(a, 19);
+                if (peers) z += zstd_size(a, 19);
             }
-            std::printf("| %s | %llu | %llu | %llu |\n", seq.front().fields[i].name.c_str(), (unsigned long long)ours,
-                        (unsigned long long)z, (unsigned long long)raw);
+            const double v = double(values);
+            if (peers)
+                std::printf("| %s | %llu | %.2f | %llu | %.2f | %llu |\n", seq.front().fields[i].name.c_str(),
+                            (unsigned long long)ours, 8.0 * double(ours) / v, (unsigned long long)z, 8.0 * double(z) / v,
+                            (unsigned long long)raw);
+            else
+                std::printf("| %s | %llu | %.2f | - | - | %llu |\n", seq.front().fields[i].name.c_str(),
+                            (unsigned long long)ours, 8.0 * double(ours) / v, (unsigned long long)raw);
         }
     }
     std::vector<double> sorted_share = changed_share;
@@ -343,10 +385,6 @@ int main(int argc, char** argv) {
     std::printf("round trips: %zu/%zu frames bit-exact; bounded: %zu/%zu frames within %g (max error %.3g)\n",
                 exact_ok, seq.size(), bounded_ok, bounded.empty() ? 0 : seq.size(), bound, bounded_error);
     std::printf("random access to frame %zu from a fresh reader: %.1f ms\n", seq.size() / 2, 1e3 * random_access);
-    std::printf("speed (%d runs): encode %.0f-%.0f frames/s, decode %.0f-%.0f frames/s (%.0f faces a frame)\n", repeat,
-                n / *std::max_element(encode_times.begin(), encode_times.end()),
-                n / *std::min_element(encode_times.begin(), encode_times.end()),
-                n / *std::max_element(decode_times.begin(), decode_times.end()),
-                n / *std::min_element(decode_times.begin(), decode_times.end()), double(faces) / n);
+    print_speed();
     return exact_ok == seq.size() && bounded_ok == (bounded.empty() ? 0 : seq.size()) ? 0 : 1;
 }
