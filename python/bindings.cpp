@@ -4,13 +4,16 @@
 #include <amc/hierarchy.h>
 #include <amc/import.h>
 #include <amc/numbering.h>
+#include <amc/series.h>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <cstring>
+#include <memory>
 #include <optional>
+#include <variant>
 #include <string>
 
 namespace py = pybind11;
@@ -137,6 +140,91 @@ ImportedHierarchy import_arrays(const TriangleMesh& mesh, const py::object& base
 
 py::bytes to_bytes(const std::vector<uint8_t>& data) { return py::bytes(reinterpret_cast<const char*>(data.data()), data.size()); }
 
+// ---- series (.amcs): fields as numpy arrays, (n,) or (n, components), of the field's own type ----
+
+template <class T>
+DataArray data_array_of(const std::string& name, const py::array& a) {
+    const auto typed = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(a);
+    DataArray out;
+    out.name = name;
+    out.components = a.ndim() == 2 ? uint32_t(a.shape(1)) : 1;
+    out.values = std::vector<T>(typed.data(), typed.data() + typed.size());
+    return out;
+}
+
+DataArray data_array_of(const std::string& name, const py::array& a) {
+    if (a.ndim() < 1 || a.ndim() > 2 || (a.ndim() == 2 && a.shape(1) < 1))
+        throw Error("field \"" + name + "\": expected an (n,) or (n, components) array");
+    const char kind = a.dtype().kind();
+    const size_t size = size_t(a.dtype().itemsize());
+    if (kind == 'f' && size == 4) return data_array_of<float>(name, a);
+    if (kind == 'f' && size == 8) return data_array_of<double>(name, a);
+    if (kind == 'i' && size == 1) return data_array_of<int8_t>(name, a);
+    if (kind == 'i' && size == 2) return data_array_of<int16_t>(name, a);
+    if (kind == 'i' && size == 4) return data_array_of<int32_t>(name, a);
+    if (kind == 'i' && size == 8) return data_array_of<int64_t>(name, a);
+    if ((kind == 'u' || kind == 'b') && size == 1) return data_array_of<uint8_t>(name, a);
+    if (kind == 'u' && size == 2) return data_array_of<uint16_t>(name, a);
+    if (kind == 'u' && size == 4) return data_array_of<uint32_t>(name, a);
+    if (kind == 'u' && size == 8) return data_array_of<uint64_t>(name, a);
+    throw Error("field \"" + name + "\": unsupported dtype " + std::string(py::str(a.dtype())));
+}
+
+std::vector<DataArray> data_arrays_of(const py::dict& arrays) {
+    std::vector<DataArray> out;
+    for (const auto& [name, value] : arrays) out.push_back(data_array_of(py::str(name), py::array::ensure(value)));
+    return out;
+}
+
+py::array array_of(const DataArray& a) {
+    return std::visit(
+        [&](const auto& values) -> py::array {
+            using T = typename std::decay_t<decltype(values)>::value_type;
+            const size_t tuples = a.components == 0 ? 0 : values.size() / a.components;
+            py::array_t<T> out = a.components == 1 ? py::array_t<T>(py::ssize_t(tuples))
+                                                   : py::array_t<T>({py::ssize_t(tuples), py::ssize_t(a.components)});
+            if (!values.empty()) std::memcpy(out.mutable_data(), values.data(), values.size() * sizeof(T));
+            return std::move(out);
+        },
+        a.values);
+}
+
+// A decoded frame: its leaf mesh (canonical numbering) with level and green, its time, and its
+// fields as point_data and cell_data dicts.
+py::dict frame_dict(const SeriesFrame& frame) {
+    const LeafMesh leaf = extract_leaf_mesh(frame.hierarchy);
+    py::dict d = mesh_dict(leaf.mesh, leaf.cells, nullptr);
+    d.attr("pop")("numbering");
+    d["time"] = frame.time;
+    py::dict point_data, cell_data;
+    for (const Field& f : frame.fields)
+        (f.association == FieldAssociation::point ? point_data : cell_data)[py::str(f.name)] = array_of(array_from_field(f));
+    d["point_data"] = point_data;
+    d["cell_data"] = cell_data;
+    return d;
+}
+
+py::dict frame_stats_dict(const SeriesFrameStats& s) {
+    py::dict d;
+    d["keyframe"] = s.keyframe;
+    d["bytes"] = s.bytes;
+    d["connectivity_bytes"] = s.connectivity_bytes;
+    d["geometry_bytes"] = s.geometry_bytes;
+    d["field_bytes"] = s.field_bytes;
+    d["nodes"] = s.nodes;
+    d["vertices"] = s.vertices;
+    d["faces"] = s.faces;
+    d["changed_nodes"] = s.changed_nodes;
+    d["max_error"] = s.max_error;
+    return d;
+}
+
+// The writer as Python sees it: in memory (bytes()) or appending to a file (path).
+struct PySeriesWriter {
+    std::unique_ptr<SeriesWriter> writer;
+    TriangleMesh base;
+};
+
 }  // namespace
 
 PYBIND11_MODULE(_amcodec, m) {
@@ -259,6 +347,118 @@ PYBIND11_MODULE(_amcodec, m) {
           },
           py::arg("points"), py::arg("triangles"), py::arg("base") = py::none(),
           "A mesh as a Hierarchy (over `base` or the coarsest base found) and, per input vertex, its hierarchy vertex id.");
+
+    py::class_<PySeriesWriter>(m, "SeriesWriter",
+                               "Writes a series (.amcs) frame by frame: in memory (bytes()) or appended to `path` as each\n"
+                               "frame is added, so that a reader sees every complete frame even if the writer dies.")
+        .def(py::init([](const py::array& base_points, const py::array& base_triangles, const py::object& path,
+                         uint32_t keyframe_interval, double error_bound, const py::dict& field_bounds) {
+                 SeriesOptions options;
+                 options.keyframe_interval = keyframe_interval;
+                 options.error_bound = error_bound;
+                 for (const auto& [name, bound] : field_bounds) options.field_bounds.push_back({py::str(name), bound.cast<double>()});
+                 auto w = std::make_unique<PySeriesWriter>();
+                 w->base = mesh_from_arrays(base_points, base_triangles, "base");
+                 w->writer = path.is_none() ? std::make_unique<SeriesWriter>(w->base, options)
+                                            : std::make_unique<SeriesWriter>(path.cast<std::string>(), w->base, options);
+                 return w;
+             }),
+             py::arg("base_points"), py::arg("base_triangles"), py::arg("path") = py::none(), py::arg("keyframe_interval") = 0,
+             py::arg("error_bound") = 0.0, py::arg("field_bounds") = py::dict(),
+             "base: the mesh every frame refines. keyframe_interval K: frames 0, K, 2K... decode on their own.\n"
+             "error_bound: absolute bound of every float field (0: bit-exact); field_bounds: {name: bound}.")
+        .def("add_frame", [](PySeriesWriter& w, const Hierarchy& h, double time, const py::dict& point_data, const py::dict& cell_data) {
+                 std::vector<Field> fields;
+                 for (const DataArray& a : data_arrays_of(point_data)) fields.push_back(field_from_array(a, FieldAssociation::point));
+                 for (const DataArray& a : data_arrays_of(cell_data)) fields.push_back(field_from_array(a, FieldAssociation::cell));
+                 SeriesFrameStats stats;
+                 {
+                     py::gil_scoped_release release;
+                     stats = w.writer->add_frame(h, time, fields);
+                 }
+                 return frame_stats_dict(stats);
+             },
+             py::arg("hierarchy"), py::arg("time") = 0.0, py::arg("point_data") = py::dict(), py::arg("cell_data") = py::dict(),
+             "Adds a Hierarchy over the base; point_data arrays follow its leaf mesh's vertices (canonical order), cell_data\n"
+             "its triangles. Returns the frame's sizes.")
+        .def("add_mesh", [](PySeriesWriter& w, const py::array& points, const py::array& triangles, double time,
+                            const py::dict& point_data, const py::dict& cell_data) {
+                 VtuMesh vtu;
+                 vtu.mesh = mesh_from_arrays(points, triangles, "frame");
+                 vtu.point_data = data_arrays_of(point_data);
+                 vtu.cell_data = data_arrays_of(cell_data);
+                 SeriesFrameStats stats;
+                 {
+                     py::gil_scoped_release release;
+                     const SeriesFrame frame = frame_from_vtu(w.base, vtu, time, "frame " + std::to_string(w.writer->frame_count()));
+                     stats = w.writer->add_frame(frame.hierarchy, frame.time, frame.fields);
+                 }
+                 return frame_stats_dict(stats);
+             },
+             py::arg("points"), py::arg("triangles"), py::arg("time") = 0.0, py::arg("point_data") = py::dict(),
+             py::arg("cell_data") = py::dict(),
+             "Adds a leaf mesh over the base in any numbering, with its point and cell data in that numbering (a solver's\n"
+             "output step). The reader returns it in canonical numbering.")
+        .def("close", [](PySeriesWriter& w) { w.writer->close(); }, "Writes the END block (and closes the file).")
+        .def("bytes", [](const PySeriesWriter& w) { return to_bytes(w.writer->bytes()); }, "The series so far (in memory).")
+        .def("__len__", [](const PySeriesWriter& w) { return w.writer->frame_count(); });
+
+    py::class_<SeriesReader>(m, "SeriesReader",
+                             "Reads a series (.amcs); frame(k) decodes from the last keyframe at or before k.")
+        .def(py::init([](py::bytes data, bool partial) {
+                 const std::string bytes = data;
+                 SeriesReadOptions options;
+                 options.allow_unfinished = partial;
+                 return SeriesReader(std::vector<uint8_t>(bytes.begin(), bytes.end()), "series", options);
+             }),
+             py::arg("data"), py::arg("partial") = false,
+             "data: the bytes of an .amcs file. partial: read the complete frames of a file still being written.")
+        .def_static("open", [](const std::string& path, bool partial) {
+                 SeriesReadOptions options;
+                 options.allow_unfinished = partial;
+                 return SeriesReader::open(path, options);
+             }, py::arg("path"), py::arg("partial") = false, "Reads an .amcs file.")
+        .def("__len__", &SeriesReader::frame_count)
+        .def("frame", [](SeriesReader& r, int64_t k) {
+                 if (k < 0) k += int64_t(r.frame_count());
+                 if (k < 0 || uint64_t(k) >= r.frame_count())
+                     throw py::index_error("frame " + std::to_string(k) + " of " + std::to_string(r.frame_count()));
+                 SeriesFrame frame;
+                 {
+                     py::gil_scoped_release release;
+                     frame = r.frame(size_t(k));
+                 }
+                 return frame_dict(frame);
+             }, py::arg("k"),
+             "Frame k as a dict: points, triangles, level, green (canonical numbering), time, point_data, cell_data.")
+        .def("hierarchy", [](SeriesReader& r, size_t k) {
+                 if (k >= r.frame_count()) throw py::index_error("frame " + std::to_string(k) + " of " + std::to_string(r.frame_count()));
+                 Hierarchy h;
+                 {
+                     py::gil_scoped_release release;
+                     h = r.frame(k).hierarchy;
+                 }
+                 return h;
+             }, py::arg("k"), "Frame k's Hierarchy.")
+        .def("info", [](const SeriesReader& r, size_t k) {
+                 if (k >= r.frame_count()) throw py::index_error("frame " + std::to_string(k) + " of " + std::to_string(r.frame_count()));
+                 const SeriesFrameInfo& f = r.info(k);
+                 py::dict d;
+                 d["offset"] = f.offset;
+                 d["bytes"] = f.size;
+                 d["keyframe"] = f.keyframe;
+                 d["time"] = f.time;
+                 d["nodes"] = f.nodes;
+                 d["vertices"] = f.vertices;
+                 d["faces"] = f.faces;
+                 d["levels"] = f.levels;
+                 return d;
+             }, py::arg("k"), "Frame k's place and counts, without decoding it.")
+        .def_property_readonly("finished", &SeriesReader::finished, "The END block is there.")
+        .def_property_readonly("keyframe_interval", &SeriesReader::keyframe_interval)
+        .def_property_readonly("base", [](const SeriesReader& r) {
+            return py::make_tuple(points_array(r.base()), triangles_array(r.base().triangles));
+        }, "The base mesh: (points, triangles).");
 
     m.attr("__version__") = AMC_VERSION;
 }

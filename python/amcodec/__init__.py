@@ -13,12 +13,21 @@ coarsest red-green base is found in it (adaptive and semi-regular meshes), or gi
 library's message.
 
 With meshio (when installed): :func:`encode_meshio` and :func:`decode_meshio`.
+
+Series (.amcs, one file for every output step of an adaptive run, with its fields)::
+
+    writer = amcodec.SeriesWriter(base_points, base_triangles, path="run.amcs", keyframe_interval=10)
+    writer.add_mesh(points, triangles, time, point_data={"u": u}, cell_data={"error": eta})  # any numbering
+    writer.close()
+    reader = amcodec.SeriesReader.open("run.amcs")
+    frame = reader.frame(40)  # dict: points, triangles, level, green, time, point_data, cell_data
 """
 
-from ._amcodec import Error, Hierarchy, __version__, decode, decode_hierarchy, encode, import_mesh
+from ._amcodec import (Error, Hierarchy, SeriesReader, SeriesWriter, __version__, decode, decode_hierarchy, encode,
+                       import_mesh)
 
-__all__ = ["Error", "Hierarchy", "__version__", "decode", "decode_hierarchy", "encode", "import_mesh",
-           "encode_meshio", "decode_meshio"]
+__all__ = ["Error", "Hierarchy", "SeriesReader", "SeriesWriter", "__version__", "decode", "decode_hierarchy", "encode",
+           "import_mesh", "encode_meshio", "decode_meshio"]
 
 
 def encode_meshio(mesh, keep_numbering=True, quantize=0, base=None):
