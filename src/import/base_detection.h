@@ -1,0 +1,36 @@
+// Base detection: the coarsest base mesh of which a triangle mesh is a red-green refinement,
+// found from connectivity alone by undoing one level of refinement at a time
+// (inverse_refinement.h) until no level can be undone. Where the mesh has no such structure it is
+// its own base. docs/IMPORT.md describes the method and its figures.
+#pragma once
+
+#include <amc/hierarchy.h>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace amc {
+
+struct DetectedLevel {
+    // Every split undone at this level: parent (v0, v1, v2) and midpoints (m0 on v0 -> v1, m1,
+    // m2), as vertex ids of the input mesh.
+    std::vector<std::array<uint32_t, 6>> splits;
+    uint32_t closures = 0;             // green closures merged into their coarse triangle
+    std::vector<Triangle> triangles;   // the mesh left after this level (input vertex ids)
+};
+
+struct DetectedBase {
+    TriangleMesh base;                          // positions copied from the input mesh
+    std::vector<uint32_t> leaf_vertex_of_base;  // base vertex i is input vertex leaf_vertex_of_base[i]
+    std::vector<DetectedLevel> levels;          // the levels undone, finest first
+};
+
+// Validates `mesh` (validate_triangle_mesh; `what` names it in messages) and finds its base.
+DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what = "mesh");
+
+// The base of `mesh` after undoing only its first `levels` detected levels (0: the mesh itself).
+DetectedBase truncated(const TriangleMesh& mesh, DetectedBase detected, size_t levels);
+
+}  // namespace amc

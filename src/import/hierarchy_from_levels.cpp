@@ -1,0 +1,125 @@
+#include "import/hierarchy_from_levels.h"
+
+#include <algorithm>
+#include <unordered_map>
+#include <unordered_set>
+
+namespace amc {
+namespace {
+
+constexpr uint32_t kUnset = 0xffffffffu;
+
+// A triangle's vertex set as a key (the three ids sorted, 21 bits each would not do for large
+// meshes, so two words).
+struct TripleKey {
+    uint64_t low, high;
+    bool operator==(const TripleKey& o) const { return low == o.low && high == o.high; }
+};
+struct TripleHash {
+    size_t operator()(const TripleKey& k) const { return std::hash<uint64_t>()(k.low * 0x9e3779b97f4a7c15ull ^ k.high); }
+};
+TripleKey triple_key(uint32_t a, uint32_t b, uint32_t c) {
+    if (a > b) std::swap(a, b);
+    if (b > c) std::swap(b, c);
+    if (a > b) std::swap(a, b);
+    return {(uint64_t(a) << 32) | b, c};
+}
+
+uint64_t directed(uint32_t a, uint32_t b) { return (uint64_t(a) << 32) | b; }
+
+// A triangle rotated so that its smallest id comes first (orientation kept).
+Triangle normalized(Triangle t) {
+    const int r = t[0] < t[1] ? (t[0] < t[2] ? 0 : 2) : (t[1] < t[2] ? 1 : 2);
+    return {t[size_t(r)], t[size_t(r + 1) % 3], t[size_t(r + 2) % 3]};
+}
+
+}  // namespace
+
+DetectedHierarchy hierarchy_from_levels(const TriangleMesh& mesh, const DetectedBase& detected,
+                                        const std::string& what) {
+    auto fail = [&](const std::string& message) -> void { throw Error(what + ": base detection: " + message); };
+    validate_triangle_mesh(detected.base, what + " (detected base)");
+    DetectedHierarchy out;
+    Hierarchy& h = out.hierarchy;
+    h = Hierarchy(detected.base);
+    std::vector<uint32_t> input_of = detected.leaf_vertex_of_base;  // hierarchy vertex -> input vertex
+    std::unordered_map<TripleKey, NodeId, TripleHash> node_of;
+    auto key_of = [&](NodeId n) { return triple_key(input_of[h.vertex(n, 0)], input_of[h.vertex(n, 1)], input_of[h.vertex(n, 2)]); };
+    for (NodeId root = 0; root < h.root_count(); ++root) node_of[key_of(root)] = root;
+
+    for (size_t level = detected.levels.size(); level-- > 0;) {
+        for (const auto& s : detected.levels[level].splits) {
+            const auto it = node_of.find(triple_key(s[0], s[1], s[2]));
+            if (it == node_of.end() || !h.is_leaf(it->second)) {
+                fail("level " + std::to_string(level) + " splits a triangle that is not a leaf");
+            }
+            const NodeId n = it->second;
+            int r = 0;
+            while (r < 3 && input_of[h.vertex(n, r)] != s[0]) ++r;
+            if (r == 3 || input_of[h.vertex(n, (r + 1) % 3)] != s[1] || input_of[h.vertex(n, (r + 2) % 3)] != s[2]) {
+                fail("a split parent has the wrong orientation");
+            }
+            if (!h.can_split(n)) fail("a split breaks balance");
+            h.split(n);
+            for (int e = 0; e < 3; ++e) {
+                const VertexId v = h.midpoint(n, e);
+                const uint32_t m = s[size_t(3 + (e - r + 3) % 3)];  // node edge e is split edge e - r
+                if (v >= input_of.size()) input_of.resize(size_t(v) + 1, kUnset);
+                if (input_of[v] == kUnset) {
+                    input_of[v] = m;
+                    h.set_position(v, mesh.positions[m]);
+                } else if (input_of[v] != m) {
+                    fail("two midpoints for one edge");
+                }
+            }
+            for (int k = 0; k < 4; ++k) node_of[key_of(h.child(n, k))] = h.child(n, k);
+        }
+    }
+
+    // Diagonals of two-hanging-node leaves: the default one joins m_{u+1} and v_u (a triangle
+    // (v_u, m_{u+1}, m_{u+2}) exists), the other m_{u+2} and v_{u+1}.
+    std::unordered_set<uint64_t> edges;
+    edges.reserve(mesh.triangles.size() * 3);
+    for (const Triangle& t : mesh.triangles) {
+        for (int e = 0; e < 3; ++e) edges.insert(directed(t[size_t(e)], t[size_t(e + 1) % 3]));
+    }
+    for (NodeId n : h.leaves()) {
+        if (h.hanging_node_count(n) != 2) continue;
+        const int u = !h.has_hanging_node(n, 0) ? 0 : !h.has_hanging_node(n, 1) ? 1 : 2;
+        const int e1 = (u + 1) % 3;
+        const VertexId m1 = h.midpoint(h.neighbor(n, e1), h.neighbor_edge(n, e1));
+        h.set_diagonal_flipped(n, !edges.count(directed(input_of[h.vertex(n, u)], input_of[m1])));
+    }
+
+    // The check: every input vertex used once, the same triangles, a valid hierarchy.
+    out.vertex_of_input.assign(mesh.positions.size(), kUnset);
+    for (VertexId v = 0; v < input_of.size(); ++v) {
+        if (input_of[v] == kUnset) continue;
+        if (out.vertex_of_input[input_of[v]] != kUnset) fail("an input vertex is used twice");
+        out.vertex_of_input[input_of[v]] = v;
+    }
+    if (std::count(out.vertex_of_input.begin(), out.vertex_of_input.end(), kUnset) != 0) {
+        fail("an input vertex is missing from the hierarchy");
+    }
+    const std::string problem = check_invariants(h);
+    if (!problem.empty()) fail(problem);
+    const LeafMesh leaf = extract_leaf_mesh(h);
+    const std::vector<uint32_t> canonical = canonical_vertex_order(h);
+    std::vector<uint32_t> input_of_canonical(leaf.mesh.positions.size(), kUnset);
+    for (VertexId v = 0; v < canonical.size(); ++v) {
+        if (canonical[v] < input_of_canonical.size()) input_of_canonical[canonical[v]] = input_of[v];
+    }
+    std::vector<Triangle> built, given;
+    built.reserve(leaf.mesh.triangles.size());
+    for (const Triangle& t : leaf.mesh.triangles) {
+        built.push_back(normalized({input_of_canonical[t[0]], input_of_canonical[t[1]], input_of_canonical[t[2]]}));
+    }
+    given.reserve(mesh.triangles.size());
+    for (const Triangle& t : mesh.triangles) given.push_back(normalized(t));
+    std::sort(built.begin(), built.end());
+    std::sort(given.begin(), given.end());
+    if (built != given) fail("the hierarchy's leaf mesh differs from the input");
+    return out;
+}
+
+}  // namespace amc

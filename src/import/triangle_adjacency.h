@@ -1,0 +1,41 @@
+// Half-edge adjacency of an edge-manifold, consistently oriented triangle list whose vertex ids are
+// drawn from a larger range (the coarser meshes of base detection keep the leaf mesh's vertex ids).
+// Half-edge 3t+i runs from triangle t's vertex i to its vertex (i+1)%3.
+#pragma once
+
+#include <amc/mesh.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace amc::detail {
+
+constexpr uint32_t kNoHalfEdge = 0xffffffffu;
+
+class TriangleAdjacency {
+public:
+    // Linear in triangles + vertex_count: half-edges are grouped by start vertex with a counting
+    // sort, and each vertex's few half-edges are sorted by their end vertex.
+    TriangleAdjacency(const std::vector<Triangle>& triangles, uint32_t vertex_count);
+
+    // The opposite half-edge, or kNoHalfEdge on the boundary.
+    uint32_t twin(uint32_t half_edge) const { return twin_[half_edge]; }
+    // The half-edges that start at v: one per triangle around v.
+    uint32_t star_size(uint32_t v) const { return out_start_[v + 1] - out_start_[v]; }
+    const uint32_t* outgoing_begin(uint32_t v) const { return out_half_edge_.data() + out_start_[v]; }
+    const uint32_t* outgoing_end(uint32_t v) const { return out_half_edge_.data() + out_start_[v + 1]; }
+    bool on_boundary(uint32_t v) const { return boundary_[v] != 0; }
+    // Whether some triangle has the edge a-b (in either direction).
+    bool has_edge(uint32_t a, uint32_t b) const { return find(a, b) != kNoHalfEdge || find(b, a) != kNoHalfEdge; }
+
+private:
+    uint32_t find(uint32_t from, uint32_t to) const;  // the half-edge from -> to, or kNoHalfEdge
+
+    std::vector<uint32_t> twin_;
+    std::vector<uint32_t> out_start_;      // half-edges by start vertex: [out_start_[v], out_start_[v+1])
+    std::vector<uint32_t> out_end_;        // their end vertices, ascending within a vertex
+    std::vector<uint32_t> out_half_edge_;  // their ids
+    std::vector<uint8_t> boundary_;
+};
+
+}  // namespace amc::detail
