@@ -91,15 +91,3 @@ TEST(BaseDetection, Data) {
     }
 }
 }}
-namespace amc { namespace {
-TEST(BaseDetection, Corpus) {
-    for (const char* name : {"lshape", "front_0", "front_1", "front_2", "bunny_mean", "fandisk_gauss", "random", "uniform"}) {
-        const Hierarchy h = read_hierarchy(std::string("/tmp/detect-corpus/") + name + ".amh");
-        const LeafMesh leaf = extract_leaf_mesh(h);
-        const auto start = std::chrono::steady_clock::now();
-        const DetectedBase base = detect_base(shuffled(leaf.mesh, 3));
-        const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        std::printf("%-14s leaf %7zu, true base %5u depth %d -> found %7zu, levels %zu, %.2f s\n", name, leaf.mesh.triangles.size(), h.root_count(), h.depth(), base.base.triangles.size(), base.levels.size(), s);
-    }
-}
-}}

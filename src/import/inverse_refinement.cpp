@@ -83,7 +83,7 @@ public:
         : tri_(fine), refined_(refined), adjacency_(fine, vertex_count), forced_old_(vertex_count, 0),
           midpoint_count_(vertex_count, 0), corner_count_(vertex_count, 0),
           midpoint_block_(vertex_count, {kNone, kNone}), block_of_(fine.size(), kNone), closure_of_(fine.size(), kNone),
-          pinned_old_(vertex_count, 0), covered_(fine.size(), 0), visits_(fine.size(), 0),
+          pinned_old_(vertex_count, 0), covered_(fine.size(), 0),
           banned_(fine.size(), 0) {
         // A midpoint has its block's three triangles on one side and the boundary, another block
         // (three) or a green closure (two or three triangles around it) on the other.
@@ -94,12 +94,99 @@ public:
         }
     }
 
-    CoarserLevel run() {
-        std::vector<uint32_t> seeds(tri_.size());
-        for (uint32_t t = 0; t < tri_.size(); ++t) seeds[t] = t;
-        commit_best_first(seeds);
-        improve_patches();
-        return coarser_level();
+    // Commits patches best first, in rounds (patches that could not grow while other readings were
+    // still possible around them may grow once committed patches hold their labels; later rounds
+    // seed only near what the last one committed), then improves them. Returns the patch count.
+    size_t commit() {
+        const size_t first = patches_.size();
+        std::vector<uint32_t> seeds;
+        for (uint32_t t = 0; t < tri_.size(); ++t) seeds.push_back(t);
+        for (int round = 0; round < 4 && !seeds.empty(); ++round) {
+            const size_t before = patches_.size();
+            if (commit_best_first(seeds) == 0) break;
+            // The next round seeds only near what this one committed.
+            seeds = free_triangles_near(before);
+        }
+        improve_patches(first);
+        return patches_.size();
+    }
+
+    // The vertices patch `id` removes.
+    uint32_t removed_by(size_t id) const {
+        uint32_t removed = 0;
+        const Patch& patch = patches_[id];
+        for (uint32_t i = patch.first; i < patch.end; ++i) {
+            if (!blocks_[i].alive) continue;
+            for (uint32_t m : blocks_[i].m) removed += midpoint_block_[m][0] / 3 == i || midpoint_block_[m][0] / 3 < patch.first;
+        }
+        return removed;
+    }
+
+    // Per triangle: whether it is the center or a corner of a block that could be placed (its
+    // shape and stars allow it), whatever its patch.
+    std::vector<uint8_t> in_placeable_blocks() {
+        std::vector<uint8_t> inside(tri_.size(), 0);
+        for (uint32_t t = 0; t < tri_.size(); ++t) {
+            const uint32_t start = uint32_t(blocks_.size());
+            if (!place_block(t)) continue;
+            inside[blocks_[start].center] = 1;
+            for (uint32_t c : blocks_[start].corner) inside[c] = 1;
+            roll_back(start);
+        }
+        return inside;
+    }
+
+    // Undoes the committed patch `id` (no other patch depends on it: patches are closed).
+    void release_patch(size_t id) {
+        hold(uint32_t(id), false);
+        for (uint32_t i = patches_[id].first; i < patches_[id].end; ++i) {
+            if (blocks_[i].alive) release(i);
+        }
+    }
+
+    // The triangles of the coarser mesh that patch `id`'s blocks became (see coarser_level).
+    std::vector<uint32_t> parents_of(size_t id, const std::vector<uint32_t>& parent_of_block) const {
+        std::vector<uint32_t> parents;
+        for (uint32_t i = patches_[id].first; i < patches_[id].end; ++i) {
+            if (blocks_[i].alive) parents.push_back(parent_of_block[i]);
+        }
+        return parents;
+    }
+
+
+    // `parent_of_block` (if given) receives, per block, the index of its parent in the result.
+    CoarserLevel coarser_level(std::vector<uint32_t>* parent_of_block = nullptr) const {
+        CoarserLevel out;
+        if (parent_of_block) parent_of_block->assign(blocks_.size(), kNone);
+        std::vector<uint8_t> merged(tri_.size(), 0);
+        for (uint32_t index = 0; index < blocks_.size(); ++index) {
+            const Block& b = blocks_[index];
+            if (!b.alive) continue;
+            ++out.red_blocks;
+            if (parent_of_block) (*parent_of_block)[index] = uint32_t(out.triangles.size());
+            out.triangles.push_back({b.v[0], b.v[1], b.v[2]});
+            out.splits.push_back({b.v[0], b.v[1], b.v[2], b.m[0], b.m[1], b.m[2]});
+            out.refined.push_back(1);
+            merged[b.center] = 1;
+            for (int k = 0; k < 3; ++k) merged[b.corner[size_t(k)]] = 1;
+            for (int i = 0; i < 3; ++i) {
+                const Side side = classify(index, i);
+                if (side.kind == Side::green && side.emits) {
+                    ++out.green_groups;
+                    out.triangles.push_back(side.coarse);
+                    out.refined.push_back(0);
+                    for (int k = 0; k < side.count; ++k) merged[side.group[k]] = 1;
+                }
+            }
+        }
+        if (out.red_blocks == 0) return CoarserLevel{};
+        for (uint32_t t = 0; t < tri_.size(); ++t) {
+            if (merged[t]) continue;
+            out.triangles.push_back(tri_[t]);
+            out.refined.push_back(refined_[t]);
+        }
+        for (uint32_t v = 0; v < midpoint_count_.size(); ++v) out.removed_vertices += midpoint_count_[v] != 0;
+        return out;
     }
 
 private:
@@ -437,32 +524,22 @@ private:
     // placed on the way.
     uint32_t grow_patch(uint32_t t, Preference preference, bool exploring = false) {
         const uint32_t start = uint32_t(blocks_.size());
-        // While exploring, a center reached by several earlier patches ends the growth: its patch
-        // has been grown already, and the work stays linear.
-        bool abandoned = false;
-        auto place = [&](uint32_t center) {
-            if (exploring && visits_[center] >= kMaxVisits) {
-                abandoned = true;
-                return false;
-            }
-            if (!place_block(center)) return false;
-            if (exploring) ++visits_[center], covered_[center] = 1;
-            return true;
-        };
-        if (!place(t)) return 0;
-        for (uint32_t next = start; next < blocks_.size() && !abandoned; ++next) {
-            for (int i = 0; i < 3 && !abandoned; ++i) {
+        if (!place_block(t)) return 0;
+        for (uint32_t next = start; next < blocks_.size(); ++next) {
+            for (int i = 0; i < 3; ++i) {
                 const Fan fan = walk_fan(blocks_[next], i);
                 if (fan.kind != Fan::triangles || block_of_[fan.triangle[1]] != kNone) continue;
                 const uint32_t partner = closure_partner(blocks_[next], i, fan);
-                if (preference == Preference::closure_first && partner != kNone && place(partner)) continue;
-                if (fan.size == 3 && place(fan.triangle[1])) continue;
-                if (preference == Preference::block_first && fan.size == 3 && partner != kNone) place(partner);
+                if (preference == Preference::closure_first && partner != kNone && place_block(partner)) continue;
+                if (fan.size == 3 && place_block(fan.triangle[1])) continue;
+                if (preference == Preference::block_first && fan.size == 3 && partner != kNone) place_block(partner);
             }
         }
-        if (abandoned) {
-            roll_back(start);
-            return 0;
+        // Growth from any center of this patch would give the same patch under this preference:
+        // those centers need not seed again (this keeps the search linear).
+        if (exploring) {
+            const uint8_t bit = uint8_t(1u << int(preference));
+            for (uint32_t i = start; i < blocks_.size(); ++i) covered_[blocks_[i].center] |= bit;
         }
         for (uint32_t i = start; i < blocks_.size(); ++i) {
             if (!sides_valid(i)) {
@@ -484,6 +561,7 @@ private:
     Candidate best_patch(uint32_t t, bool exploring) {
         Candidate best{0, t, Preference::closure_first};
         for (Preference preference : {Preference::closure_first, Preference::block_first}) {
+            if (exploring && (covered_[t] >> int(preference)) & 1) continue;
             const uint32_t start = uint32_t(blocks_.size());
             const uint32_t removed = grow_patch(t, preference, exploring);
             roll_back(start);
@@ -496,9 +574,9 @@ private:
     // a patch that earlier commits changed goes back into the queue with its new count.
     uint32_t commit_best_first(const std::vector<uint32_t>& seeds) {
         std::vector<Candidate> queue;
-        for (uint32_t t : seeds) covered_[t] = 0, visits_[t] = 0;
+        for (uint32_t t : seeds) covered_[t] = 0;
         for (uint32_t t : seeds) {
-            if (covered_[t] || block_of_[t] != kNone) continue;
+            if (covered_[t] == 3 || block_of_[t] != kNone) continue;
             const Candidate c = best_patch(t, true);
             if (c.removed > 0) queue.push_back(c);
         }
@@ -525,6 +603,32 @@ private:
         return total;
     }
 
+    // The triangles within two edge-rings of the blocks of patches [first, end) that no block or
+    // closure has taken.
+    std::vector<uint32_t> free_triangles_near(size_t first) {
+        std::vector<uint32_t> ring;
+        for (size_t id = first; id < patches_.size(); ++id) {
+            for (uint32_t i = patches_[id].first; i < patches_[id].end; ++i) {
+                if (!blocks_[i].alive) continue;
+                ring.push_back(blocks_[i].center);
+                for (uint32_t c : blocks_[i].corner) ring.push_back(c);
+            }
+        }
+        for (int step = 0; step < 2; ++step) {
+            const size_t count = ring.size();
+            for (size_t k = 0; k < count; ++k) {
+                for (int e = 0; e < 3; ++e) {
+                    const uint32_t h = adjacency_.twin(3 * ring[k] + uint32_t(e));
+                    if (h != kNoHalfEdge) ring.push_back(h / 3);
+                }
+            }
+            std::sort(ring.begin(), ring.end());
+            ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+        }
+        ring.erase(std::remove_if(ring.begin(), ring.end(), [&](uint32_t t) { return taken(t); }), ring.end());
+        return ring;
+    }
+
     // A committed patch holds its closures: their triangles are taken and their vertices stay old,
     // so that later patches cannot change how its sides read.
     void hold(uint32_t id, bool on) {
@@ -547,9 +651,9 @@ private:
     // Takes each patch out and solves its neighbourhood again without its centers; keeps the
     // alternative when it removes more vertices (two true isolated blocks beat one wrong pair
     // glued at an old vertex).
-    void improve_patches() {
+    void improve_patches(size_t first) {
         const size_t count = patches_.size();
-        for (size_t r = 0; r < count; ++r) {
+        for (size_t r = first; r < count; ++r) {
             const Patch patch = patches_[r];
             uint32_t before = 0;
             std::vector<uint32_t> seeds, taken;
@@ -584,39 +688,6 @@ private:
         }
     }
 
-    // ---- the coarser mesh --------------------------------------------------------------------
-    CoarserLevel coarser_level() const {
-        CoarserLevel out;
-        std::vector<uint8_t> merged(tri_.size(), 0);
-        for (uint32_t index = 0; index < blocks_.size(); ++index) {
-            const Block& b = blocks_[index];
-            if (!b.alive) continue;
-            ++out.red_blocks;
-            out.triangles.push_back({b.v[0], b.v[1], b.v[2]});
-            out.splits.push_back({b.v[0], b.v[1], b.v[2], b.m[0], b.m[1], b.m[2]});
-            out.refined.push_back(1);
-            merged[b.center] = 1;
-            for (int k = 0; k < 3; ++k) merged[b.corner[size_t(k)]] = 1;
-            for (int i = 0; i < 3; ++i) {
-                const Side side = classify(index, i);
-                if (side.kind == Side::green && side.emits) {
-                    ++out.green_groups;
-                    out.triangles.push_back(side.coarse);
-                    out.refined.push_back(0);
-                    for (int k = 0; k < side.count; ++k) merged[side.group[k]] = 1;
-                }
-            }
-        }
-        if (out.red_blocks == 0) return CoarserLevel{};
-        for (uint32_t t = 0; t < tri_.size(); ++t) {
-            if (merged[t]) continue;
-            out.triangles.push_back(tri_[t]);
-            out.refined.push_back(refined_[t]);
-        }
-        for (uint32_t v = 0; v < midpoint_count_.size(); ++v) out.removed_vertices += midpoint_count_[v] != 0;
-        return out;
-    }
-
     const std::vector<Triangle>& tri_;
     const std::vector<uint8_t>& refined_;
     TriangleAdjacency adjacency_;
@@ -628,9 +699,7 @@ private:
     std::vector<uint32_t> block_of_;       // per triangle
     std::vector<uint32_t> closure_of_;     // per triangle: block * 3 + side of a committed closure
     std::vector<uint32_t> pinned_old_;     // per vertex: closures of committed patches it is a corner of
-    std::vector<uint8_t> covered_;         // per triangle: a center some grown patch reached
-    std::vector<uint8_t> visits_;          // per triangle: patches that placed it as a center
-    static constexpr uint8_t kMaxVisits = 4;
+    std::vector<uint8_t> covered_;         // per triangle: bit p, a center of a patch grown with preference p
     std::vector<uint8_t> banned_;          // per triangle: not a center (while a patch is improved)
     std::vector<Block> blocks_;
     std::vector<Patch> patches_;
@@ -640,7 +709,35 @@ private:
 
 CoarserLevel undo_refinement_level(const std::vector<Triangle>& fine, const std::vector<uint8_t>& refined,
                                    uint32_t vertex_count) {
-    return LevelFinder(fine, refined, vertex_count).run();
+    // Large patches first: they are what a level looks like where the mesh is finest. Small
+    // ones are also what wrong readings look like where it is not finest yet (the true blocks
+    // there become valid only once the finer ones around are undone), so a small patch is kept
+    // only when the next level confirms it: one of its parents lies in a valid patch there.
+    LevelFinder finder(fine, refined, vertex_count);
+    constexpr uint32_t kLarge = 12;  // vertices removed: four blocks or more
+    const size_t all = finder.commit();
+    std::vector<size_t> small;
+    for (size_t id = 0; id < all; ++id) {
+        if (finder.removed_by(id) < kLarge) small.push_back(id);
+    }
+    if (small.empty()) return finder.coarser_level();
+    std::vector<uint32_t> parent_of_block;
+    const CoarserLevel trial = finder.coarser_level(&parent_of_block);
+    const std::vector<uint8_t> confirmed =
+        LevelFinder(trial.triangles, trial.refined, vertex_count).in_placeable_blocks();
+    auto is_confirmed = [&](size_t id) {
+        for (uint32_t parent : finder.parents_of(id, parent_of_block)) {
+            if (confirmed[parent]) return true;
+        }
+        return false;
+    };
+    const size_t kept = all - small.size() + size_t(std::count_if(small.begin(), small.end(), is_confirmed));
+    // Nothing confirmed and nothing large: the small patches are all there is (the top level).
+    if (kept == 0) return trial;
+    for (size_t id : small) {
+        if (!is_confirmed(id)) finder.release_patch(id);
+    }
+    return finder.coarser_level();
 }
 
 }  // namespace amc::detail
