@@ -1,6 +1,7 @@
 // Importing adaptive meshes that amcodec did not build itself (docs/IMPORT.md):
 //   * a base mesh and a conforming leaf mesh (any vertex and face order) -> the hierarchy whose
 //     extract_leaf_mesh is exactly that leaf mesh;
+//   * a leaf mesh alone -> the same, over the coarsest base found in its connectivity;
 //   * refinement histories: "refine these elements / coarsen these" steps replayed on a base.
 #pragma once
 
@@ -36,6 +37,15 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
 
 // The same on files (read_mesh: OBJ, OFF, PLY); errors name the files.
 ImportedHierarchy import_leaf_mesh_files(const std::string& base_path, const std::string& leaf_path);
+
+// ---- leaf mesh alone -> hierarchy (docs/IMPORT.md, section 2) --------------------------------
+
+// Finds the coarsest base of which `mesh` is a red-green refinement and returns the hierarchy
+// (vertex_of_input as in ImportedHierarchy): adaptive and semi-regular meshes get their forest,
+// an irregular mesh (mostly) itself as the base with no refinement. Combinatorial: no position is
+// consulted. Never fails on a valid mesh (validate_triangle_mesh; `what` names it in the error
+// otherwise). Linear time in practice (docs/IMPORT.md, "Speed").
+ImportedHierarchy import_mesh(const TriangleMesh& mesh, const std::string& what = "mesh");
 
 // ---- refinement histories (docs/IMPORT.md, section 3) -----------------------------------------
 

@@ -36,15 +36,18 @@ DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what) {
     DetectedBase out;
     const std::vector<Triangle>* triangles = &mesh.triangles;
     std::vector<uint8_t> refined(mesh.triangles.size(), 0);
+    std::vector<uint8_t> changed;
     // Each level undone adds one to the depth of the hierarchy, which kMaxLevel caps.
     while (out.levels.size() < size_t(kMaxLevel)) {
-        detail::CoarserLevel coarser = detail::undo_refinement_level(*triangles, refined, vertex_count);
+        detail::CoarserLevel coarser =
+            detail::undo_refinement_level(*triangles, refined, vertex_count, out.levels.empty() ? nullptr : &changed);
         if (coarser.red_blocks == 0) break;
         DetectedLevel level;
         level.splits = std::move(coarser.splits);
         level.closures = coarser.green_groups;
         level.triangles = std::move(coarser.triangles);
         refined = std::move(coarser.refined);
+        changed = std::move(coarser.changed);
         out.levels.push_back(std::move(level));
         triangles = &out.levels.back().triangles;
     }

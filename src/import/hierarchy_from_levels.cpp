@@ -35,11 +35,11 @@ Triangle normalized(Triangle t) {
 
 }  // namespace
 
-DetectedHierarchy hierarchy_from_levels(const TriangleMesh& mesh, const DetectedBase& detected,
+ImportedHierarchy hierarchy_from_levels(const TriangleMesh& mesh, const DetectedBase& detected,
                                         const std::string& what) {
     auto fail = [&](const std::string& message) -> void { throw Error(what + ": base detection: " + message); };
     validate_triangle_mesh(detected.base, what + " (detected base)");
-    DetectedHierarchy out;
+    ImportedHierarchy out;
     Hierarchy& h = out.hierarchy;
     h = Hierarchy(detected.base);
     std::vector<uint32_t> input_of = detected.leaf_vertex_of_base;  // hierarchy vertex -> input vertex

@@ -6,23 +6,16 @@
 
 #include "import/base_detection.h"
 
-#include <amc/hierarchy.h>
+#include <amc/import.h>
 
 #include <string>
-#include <vector>
 
 namespace amc {
-
-struct DetectedHierarchy {
-    Hierarchy hierarchy;
-    // Input vertex i is vertex vertex_of_input[i] of `hierarchy`.
-    std::vector<VertexId> vertex_of_input;
-};
 
 // Builds the hierarchy and checks that its leaf mesh is exactly `mesh` (same triangles, same
 // orientation, same positions) and that it passes check_invariants. Throws Error (naming `what`)
 // when it does not, which a correct detection never causes.
-DetectedHierarchy hierarchy_from_levels(const TriangleMesh& mesh, const DetectedBase& detected,
+ImportedHierarchy hierarchy_from_levels(const TriangleMesh& mesh, const DetectedBase& detected,
                                         const std::string& what);
 
 }  // namespace amc

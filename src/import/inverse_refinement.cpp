@@ -23,7 +23,6 @@
 
 #include <algorithm>
 #include <array>
-#include <unordered_map>
 #include <utility>
 
 namespace amc::detail {
@@ -73,10 +72,6 @@ struct Patch {
     uint32_t first, end;
 };
 
-uint64_t edge_key(uint32_t a, uint32_t b) {
-    return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a;
-}
-
 class LevelFinder {
 public:
     LevelFinder(const std::vector<Triangle>& fine, const std::vector<uint8_t>& refined, uint32_t vertex_count)
@@ -84,7 +79,7 @@ public:
           midpoint_count_(vertex_count, 0), corner_count_(vertex_count, 0),
           midpoint_block_(vertex_count, {kNone, kNone}), block_of_(fine.size(), kNone), closure_of_(fine.size(), kNone),
           pinned_old_(vertex_count, 0), covered_(fine.size(), 0),
-          banned_(fine.size(), 0) {
+          banned_(fine.size(), 0), deferred_(fine.size(), 0) {
         // A midpoint has its block's three triangles on one side and the boundary, another block
         // (three) or a green closure (two or three triangles around it) on the other.
         for (uint32_t v = 0; v < vertex_count; ++v) {
@@ -97,10 +92,15 @@ public:
     // Commits patches best first, in rounds (patches that could not grow while other readings were
     // still possible around them may grow once committed patches hold their labels; later rounds
     // seed only near what the last one committed), then improves them. Returns the patch count.
-    size_t commit() {
+    // `active` (if given) limits the first seeds to the triangles it marks and two rings around
+    // them: elsewhere the mesh is what the previous step left unchanged, with nothing to undo.
+    size_t commit(const std::vector<uint8_t>* active) {
         const size_t first = patches_.size();
         std::vector<uint32_t> seeds;
-        for (uint32_t t = 0; t < tri_.size(); ++t) seeds.push_back(t);
+        for (uint32_t t = 0; t < tri_.size(); ++t) {
+            if (!active || (*active)[t]) seeds.push_back(t);
+        }
+        if (active) seeds = free_near(std::move(seeds), 2);
         for (int round = 0; round < 4 && !seeds.empty(); ++round) {
             const size_t before = patches_.size();
             if (commit_best_first(seeds) == 0) break;
@@ -122,23 +122,30 @@ public:
         return removed;
     }
 
-    // Per triangle: whether it is the center or a corner of a block that could be placed (its
-    // shape and stars allow it), whatever its patch.
-    std::vector<uint8_t> in_placeable_blocks() {
-        std::vector<uint8_t> inside(tri_.size(), 0);
-        for (uint32_t t = 0; t < tri_.size(); ++t) {
-            const uint32_t start = uint32_t(blocks_.size());
-            if (!place_block(t)) continue;
-            inside[blocks_[start].center] = 1;
-            for (uint32_t c : blocks_[start].corner) inside[c] = 1;
-            roll_back(start);
+    // Whether triangle t is the center or a corner of a block that could be placed (its shape
+    // and stars allow it), whatever its patch.
+    bool could_be_in_block(uint32_t t) {
+        uint32_t centers[4] = {t, kNone, kNone, kNone};
+        for (int e = 0; e < 3; ++e) {
+            const uint32_t h = adjacency_.twin(3 * t + uint32_t(e));
+            if (h != kNoHalfEdge) centers[e + 1] = h / 3;
         }
-        return inside;
+        for (uint32_t c : centers) {
+            if (c == kNone) continue;
+            const uint32_t start = uint32_t(blocks_.size());
+            if (!place_block(c)) continue;
+            roll_back(start);
+            return true;
+        }
+        return false;
     }
 
     // Undoes the committed patch `id` (no other patch depends on it: patches are closed).
     void release_patch(size_t id) {
         hold(uint32_t(id), false);
+        for (uint32_t i = patches_[id].first; i < patches_[id].end; ++i) {
+            if (blocks_[i].alive) deferred_[blocks_[i].center] = 1;
+        }
         for (uint32_t i = patches_[id].first; i < patches_[id].end; ++i) {
             if (blocks_[i].alive) release(i);
         }
@@ -167,6 +174,7 @@ public:
             out.triangles.push_back({b.v[0], b.v[1], b.v[2]});
             out.splits.push_back({b.v[0], b.v[1], b.v[2], b.m[0], b.m[1], b.m[2]});
             out.refined.push_back(1);
+            out.changed.push_back(1);
             merged[b.center] = 1;
             for (int k = 0; k < 3; ++k) merged[b.corner[size_t(k)]] = 1;
             for (int i = 0; i < 3; ++i) {
@@ -175,6 +183,7 @@ public:
                     ++out.green_groups;
                     out.triangles.push_back(side.coarse);
                     out.refined.push_back(0);
+                    out.changed.push_back(1);
                     for (int k = 0; k < side.count; ++k) merged[side.group[k]] = 1;
                 }
             }
@@ -184,6 +193,7 @@ public:
             if (merged[t]) continue;
             out.triangles.push_back(tri_[t]);
             out.refined.push_back(refined_[t]);
+            out.changed.push_back(deferred_[t]);
         }
         for (uint32_t v = 0; v < midpoint_count_.size(); ++v) out.removed_vertices += midpoint_count_[v] != 0;
         return out;
@@ -256,7 +266,8 @@ private:
 
     // ---- placing blocks ----------------------------------------------------------------------
     // Whether the block centered at t fits the labels (its midpoints not old, its apexes not
-    // new) and the mesh (its coarse edges are not edges already, nor coarse edges of others).
+    // new) and the mesh (its coarse edges are not edges already; that they are not coarse edges
+    // of other blocks is checked with the sides, once the patch is grown).
     bool fits(const Block& b) const {
         if (taken(b.center) || banned_[b.center]) return false;
         for (int k = 0; k < 3; ++k) {
@@ -267,10 +278,21 @@ private:
         for (int i = 0; i < 3; ++i) {
             const uint32_t a = b.v[size_t(i)], c = b.v[size_t(i + 1) % 3];
             if (adjacency_.has_edge(a, c)) return false;
-            const auto it = coarse_edges_.find(edge_key(a, c));
-            if (it != coarse_edges_.end() && it->second != b.m[size_t(i)]) return false;
         }
         return true;
+    }
+
+    // Whether a midpoint other than m already splits the coarse edge a-b. It would be a neighbour
+    // of a (the first half of its edge), so a's star is searched.
+    bool has_other_midpoint(uint32_t a, uint32_t b, uint32_t m) const {
+        for (const uint32_t* h = adjacency_.outgoing_begin(a); h != adjacency_.outgoing_end(a); ++h) {
+            for (uint32_t w : {vertex_at(*h, 1), vertex_at(*h, 2)}) {
+                if (w == m || midpoint_count_[w] == 0) continue;
+                const auto [s, t] = coarse_edge(midpoint_block_[w][0]);
+                if ((s == a && t == b) || (s == b && t == a)) return true;
+            }
+        }
+        return false;
     }
 
     // Places the block centered at t if it fits and each of its sides has a shape a block side
@@ -303,7 +325,6 @@ private:
             const uint32_t m = b.m[size_t(k)];
             midpoint_block_[m][midpoint_count_[m]++] = index * 3 + uint32_t(k);
             ++corner_count_[b.v[size_t(k)]];
-            coarse_edges_[edge_key(b.v[size_t(k)], b.v[size_t(k + 1) % 3])] = m;
         }
     }
 
@@ -317,7 +338,7 @@ private:
             auto& slots = midpoint_block_[m];
             if (slots[0] / 3 == index) slots[0] = slots[1];
             slots[1] = kNone;
-            if (--midpoint_count_[m] == 0) coarse_edges_.erase(edge_key(b.v[size_t(k)], b.v[size_t(k + 1) % 3]));
+            --midpoint_count_[m];
             --corner_count_[b.v[size_t(k)]];
         }
     }
@@ -504,6 +525,10 @@ private:
     }
 
     bool sides_valid(uint32_t index) const {
+        const Block& b = blocks_[index];
+        for (int i = 0; i < 3; ++i) {
+            if (has_other_midpoint(b.v[size_t(i)], b.v[size_t(i + 1) % 3], b.m[size_t(i)])) return false;
+        }
         uint32_t red_neighbor[3];
         for (int i = 0; i < 3; ++i) {
             const Side side = classify(index, i);
@@ -529,10 +554,14 @@ private:
             for (int i = 0; i < 3; ++i) {
                 const Fan fan = walk_fan(blocks_[next], i);
                 if (fan.kind != Fan::triangles || block_of_[fan.triangle[1]] != kNone) continue;
-                const uint32_t partner = closure_partner(blocks_[next], i, fan);
-                if (preference == Preference::closure_first && partner != kNone && place_block(partner)) continue;
-                if (fan.size == 3 && place_block(fan.triangle[1])) continue;
-                if (preference == Preference::block_first && fan.size == 3 && partner != kNone) place_block(partner);
+                if (preference == Preference::closure_first) {
+                    const uint32_t partner = closure_partner(blocks_[next], i, fan);
+                    if (partner != kNone && place_block(partner)) continue;
+                    if (fan.size == 3) place_block(fan.triangle[1]);
+                } else if (fan.size == 3 && !place_block(fan.triangle[1])) {
+                    const uint32_t partner = closure_partner(blocks_[next], i, fan);
+                    if (partner != kNone) place_block(partner);
+                }
             }
         }
         // Growth from any center of this patch would give the same patch under this preference:
@@ -545,6 +574,13 @@ private:
             if (!sides_valid(i)) {
                 roll_back(start);
                 return 0;
+            }
+        }
+        // A valid patch: no other reading needs to seed inside it.
+        if (exploring) {
+            for (uint32_t i = start; i < blocks_.size(); ++i) {
+                covered_[blocks_[i].center] = 3;
+                for (uint32_t c : blocks_[i].corner) covered_[c] = 3;
             }
         }
         uint32_t removed = 0;
@@ -596,7 +632,10 @@ private:
             }
             roll_back(start);
             if (c.removed == 0) c = best_patch(c.center, false);
-            if (c.removed == 0) continue;
+            if (c.removed == 0) {
+                deferred_[c.center] = 1;  // valid once: worth a seed in the next step
+                continue;
+            }
             queue.push_back(c);
             std::push_heap(queue.begin(), queue.end());
         }
@@ -614,7 +653,12 @@ private:
                 for (uint32_t c : blocks_[i].corner) ring.push_back(c);
             }
         }
-        for (int step = 0; step < 2; ++step) {
+        return free_near(std::move(ring), 2);
+    }
+
+    // The triangles within `rings` edge-rings of `ring` that no block or closure has taken.
+    std::vector<uint32_t> free_near(std::vector<uint32_t> ring, int rings) const {
+        for (int step = 0; step < rings; ++step) {
             const size_t count = ring.size();
             for (size_t k = 0; k < count; ++k) {
                 for (int e = 0; e < 3; ++e) {
@@ -695,12 +739,12 @@ private:
     std::vector<uint8_t> midpoint_count_;  // per vertex: blocks it is a midpoint of (0-2)
     std::vector<uint32_t> corner_count_;   // per vertex: blocks it is a parent vertex of
     std::vector<std::array<uint32_t, 2>> midpoint_block_;  // block * 3 + edge, per midpoint role
-    std::unordered_map<uint64_t, uint32_t> coarse_edges_;  // coarse edge -> its midpoint
     std::vector<uint32_t> block_of_;       // per triangle
     std::vector<uint32_t> closure_of_;     // per triangle: block * 3 + side of a committed closure
     std::vector<uint32_t> pinned_old_;     // per vertex: closures of committed patches it is a corner of
     std::vector<uint8_t> covered_;         // per triangle: bit p, a center of a patch grown with preference p
     std::vector<uint8_t> banned_;          // per triangle: not a center (while a patch is improved)
+    std::vector<uint8_t> deferred_;        // per triangle: center of a valid patch left for later
     std::vector<Block> blocks_;
     std::vector<Patch> patches_;
 };
@@ -708,34 +752,35 @@ private:
 }  // namespace
 
 CoarserLevel undo_refinement_level(const std::vector<Triangle>& fine, const std::vector<uint8_t>& refined,
-                                   uint32_t vertex_count) {
+                                   uint32_t vertex_count, const std::vector<uint8_t>* active) {
     // Large patches first: they are what a level looks like where the mesh is finest. Small
     // ones are also what wrong readings look like where it is not finest yet (the true blocks
     // there become valid only once the finer ones around are undone), so a small patch is kept
     // only when the next level confirms it: one of its parents lies in a valid patch there.
     LevelFinder finder(fine, refined, vertex_count);
     constexpr uint32_t kLarge = 12;  // vertices removed: four blocks or more
-    const size_t all = finder.commit();
+    const size_t all = finder.commit(active);
     std::vector<size_t> small;
     for (size_t id = 0; id < all; ++id) {
         if (finder.removed_by(id) < kLarge) small.push_back(id);
     }
     if (small.empty()) return finder.coarser_level();
     std::vector<uint32_t> parent_of_block;
-    const CoarserLevel trial = finder.coarser_level(&parent_of_block);
-    const std::vector<uint8_t> confirmed =
-        LevelFinder(trial.triangles, trial.refined, vertex_count).in_placeable_blocks();
-    auto is_confirmed = [&](size_t id) {
-        for (uint32_t parent : finder.parents_of(id, parent_of_block)) {
-            if (confirmed[parent]) return true;
+    CoarserLevel trial = finder.coarser_level(&parent_of_block);
+    LevelFinder next(trial.triangles, trial.refined, vertex_count);
+    std::vector<uint8_t> confirmed(small.size(), 0);
+    for (size_t k = 0; k < small.size(); ++k) {
+        for (uint32_t parent : finder.parents_of(small[k], parent_of_block)) {
+            if (next.could_be_in_block(parent)) {
+                confirmed[k] = 1;
+                break;
+            }
         }
-        return false;
-    };
-    const size_t kept = all - small.size() + size_t(std::count_if(small.begin(), small.end(), is_confirmed));
+    }
     // Nothing confirmed and nothing large: the small patches are all there is (the top level).
-    if (kept == 0) return trial;
-    for (size_t id : small) {
-        if (!is_confirmed(id)) finder.release_patch(id);
+    if (all == small.size() && std::count(confirmed.begin(), confirmed.end(), 1) == 0) return trial;
+    for (size_t k = 0; k < small.size(); ++k) {
+        if (!confirmed[k]) finder.release_patch(small[k]);
     }
     return finder.coarser_level();
 }

@@ -23,6 +23,9 @@ struct CoarserLevel {
     std::vector<Triangle> triangles;  // B' over the vertex ids of B (removed ids unused)
     std::vector<uint8_t> refined;     // per triangle of B': it has children (it is a red parent,
                                       // or an untouched triangle of B that was refined)
+    std::vector<uint8_t> changed;     // per triangle of B': new (a parent or a closure's coarse
+                                      // triangle), or left for a later step: where the next step
+                                      // seeds
     uint32_t red_blocks = 0;          // blocks of four merged into their parent
     uint32_t green_groups = 0;        // closures merged into their coarse triangle
     uint32_t removed_vertices = 0;
@@ -31,9 +34,11 @@ struct CoarserLevel {
 };
 
 // `fine` is edge-manifold and consistently oriented over vertex ids below vertex_count;
-// refined[t] tells whether triangle t of `fine` has children. Returns red_blocks == 0 (and an
-// empty mesh) when no level can be undone anywhere. Linear in fine.size() + vertex_count.
+// refined[t] tells whether triangle t of `fine` has children; `active` (if given) marks where
+// `fine` changed in the previous step (CoarserLevel::changed): only there is a new patch sought.
+// Returns red_blocks == 0 (and an empty mesh) when no level can be undone anywhere. Linear in
+// fine.size() + vertex_count.
 CoarserLevel undo_refinement_level(const std::vector<Triangle>& fine, const std::vector<uint8_t>& refined,
-                                   uint32_t vertex_count);
+                                   uint32_t vertex_count, const std::vector<uint8_t>* active = nullptr);
 
 }  // namespace amc::detail
