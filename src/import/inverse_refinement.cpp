@@ -74,7 +74,8 @@ struct Patch {
 
 class LevelFinder {
 public:
-    LevelFinder(const std::vector<Triangle>& fine, const std::vector<uint8_t>& refined, uint32_t vertex_count)
+    LevelFinder(const std::vector<Triangle>& fine, const std::vector<uint8_t>& refined, uint32_t vertex_count,
+                const std::vector<uint8_t>* kept)
         : tri_(fine), refined_(refined), adjacency_(fine, vertex_count), forced_old_(vertex_count, 0),
           midpoint_count_(vertex_count, 0), corner_count_(vertex_count, 0),
           midpoint_block_(vertex_count, {kNone, kNone}), block_of_(fine.size(), kNone), closure_of_(fine.size(), kNone),
@@ -85,7 +86,7 @@ public:
         for (uint32_t v = 0; v < vertex_count; ++v) {
             const uint32_t s = adjacency_.star_size(v);
             const bool can_be_midpoint = adjacency_.on_boundary(v) ? s == 3 : (s == 5 || s == 6);
-            forced_old_[v] = !can_be_midpoint;
+            forced_old_[v] = !can_be_midpoint || (kept && (*kept)[v]);
         }
     }
 
@@ -752,12 +753,13 @@ private:
 }  // namespace
 
 CoarserLevel undo_refinement_level(const std::vector<Triangle>& fine, const std::vector<uint8_t>& refined,
-                                   uint32_t vertex_count, const std::vector<uint8_t>* active) {
+                                   uint32_t vertex_count, const std::vector<uint8_t>* active,
+                                   const std::vector<uint8_t>* kept) {
     // Large patches first: they are what a level looks like where the mesh is finest. Small
     // ones are also what wrong readings look like where it is not finest yet (the true blocks
     // there become valid only once the finer ones around are undone), so a small patch is kept
     // only when the next level confirms it: one of its parents lies in a valid patch there.
-    LevelFinder finder(fine, refined, vertex_count);
+    LevelFinder finder(fine, refined, vertex_count, kept);
     constexpr uint32_t kLarge = 12;  // vertices removed: four blocks or more
     const size_t all = finder.commit(active);
     std::vector<size_t> small;
@@ -767,7 +769,7 @@ CoarserLevel undo_refinement_level(const std::vector<Triangle>& fine, const std:
     if (small.empty()) return finder.coarser_level();
     std::vector<uint32_t> parent_of_block;
     CoarserLevel trial = finder.coarser_level(&parent_of_block);
-    LevelFinder next(trial.triangles, trial.refined, vertex_count);
+    LevelFinder next(trial.triangles, trial.refined, vertex_count, kept);
     std::vector<uint8_t> confirmed(small.size(), 0);
     for (size_t k = 0; k < small.size(); ++k) {
         for (uint32_t parent : finder.parents_of(small[k], parent_of_block)) {

@@ -36,9 +36,11 @@ struct CoarserLevel {
 // `fine` is edge-manifold and consistently oriented over vertex ids below vertex_count;
 // refined[t] tells whether triangle t of `fine` has children; `active` (if given) marks where
 // `fine` changed in the previous step (CoarserLevel::changed): only there is a new patch sought.
+// `kept` (if given) marks vertices that must stay (the base vertices of an anchored import).
 // Returns red_blocks == 0 (and an empty mesh) when no level can be undone anywhere. Linear in
 // fine.size() + vertex_count.
 CoarserLevel undo_refinement_level(const std::vector<Triangle>& fine, const std::vector<uint8_t>& refined,
-                                   uint32_t vertex_count, const std::vector<uint8_t>* active = nullptr);
+                                   uint32_t vertex_count, const std::vector<uint8_t>* active = nullptr,
+                                   const std::vector<uint8_t>* kept = nullptr);
 
 }  // namespace amc::detail

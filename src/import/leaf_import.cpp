@@ -3,6 +3,7 @@
 // and compares the extracted leaf mesh with the input, face by face.
 #include <amc/import.h>
 
+#include "import/anchored_reconstruction.h"
 #include "import/leaf_halfedges.h"
 #include "import/leaf_reconstruction.h"
 #include "import/position_index.h"
@@ -115,11 +116,13 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     const LeafHalfedges halfedges(leaf);
     ImportedHierarchy out;
     std::vector<uint32_t> leaf_of_vertex;
-    // Four ways in, cheapest first; the first whose result is exactly the leaf mesh wins.
+    // Five ways in, cheapest first; the first whose result is exactly the leaf mesh wins.
     //  1. new vertices at edge midpoints (as amcodec writes them): found by position;
     //  2. a uniform refinement (semi-regular remeshes): read off the connectivity as grids;
     //  3. the general reconstruction, guided by midpoint subdivision of the base;
-    //  4. the same, guided by the surface: meshes whose new vertices were projected onto it.
+    //  4. the same, guided by the surface: meshes whose new vertices were projected onto it;
+    //  5. anchored inverse refinement: levels undone bottom-up from the connectivity alone, the
+    //     base vertices kept (positions anywhere; not every adaptive mesh yet, docs/IMPORT.md).
     auto attempt = [&](int way) {
         out.hierarchy = Hierarchy(hierarchy_base);
         // A leaf mesh of F faces comes from at most F leaves, so from at most 4F/3 + roots nodes.
@@ -127,6 +130,10 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
         if (way == 2) {
             leaf_of_vertex = reconstruct_uniform(out.hierarchy, leaf_of_base, leaf, halfedges);
             if (leaf_of_vertex.empty()) throw Error(what + ": not a uniform refinement");
+        } else if (way == 5) {
+            validate_triangle_mesh(leaf, what);  // the inverse step needs an oriented manifold
+            leaf_of_vertex = reconstruct_anchored(out.hierarchy, leaf_of_base, leaf, what);
+            if (leaf_of_vertex.empty()) throw Error(what + ": anchored inverse refinement did not reach the base");
         } else {
             const MidpointGuide guide = way == 1   ? MidpointGuide::exact
                                         : way == 3 ? MidpointGuide::subdivision
@@ -138,7 +145,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     };
     std::string first_error;
     bool done = false;
-    for (int way = 1; way <= 4 && !done; ++way) {
+    for (int way = 1; way <= 5 && !done; ++way) {
         try {
             attempt(way);
             done = true;
