@@ -6,6 +6,7 @@
 // Usage: import_bench [repetitions]   (default 5; prints the median and the range of the runs)
 // Times are the thread's CPU time, which the other jobs on a shared machine disturb less.
 #include "bench_common.h"
+#include "user_leaf_mesh.h"
 
 #include <amc/import.h>
 
@@ -18,51 +19,6 @@
 #include <vector>
 
 namespace {
-
-// A tiny generator whose output is the same on every platform.
-struct Random {
-    uint64_t state;
-    uint64_t next() {
-        state = state * 6364136223846793005ull + 1442695040888963407ull;
-        return state >> 33;
-    }
-};
-
-// The leaf mesh as a user holds it: vertices and faces shuffled, faces rotated, every non-base
-// vertex moved by up to `move` times the distance to its nearest neighbour.
-amc::TriangleMesh user_leaf_mesh(const amc::TriangleMesh& leaf, uint32_t base_vertices, double move, uint64_t seed) {
-    Random random{seed};
-    const uint32_t n = uint32_t(leaf.positions.size());
-    std::vector<uint32_t> order(n);
-    std::iota(order.begin(), order.end(), 0u);
-    for (uint32_t i = n; i > 1; --i) std::swap(order[i - 1], order[random.next() % i]);
-    std::vector<double> shortest(n, 1e300);
-    for (const amc::Triangle& t : leaf.triangles) {
-        for (int e = 0; e < 3; ++e) {
-            const amc::Vec3 d = leaf.positions[t[e]] - leaf.positions[t[(e + 1) % 3]];
-            const double length = std::sqrt(amc::dot(d, d));
-            shortest[t[e]] = std::min(shortest[t[e]], length);
-            shortest[t[(e + 1) % 3]] = std::min(shortest[t[(e + 1) % 3]], length);
-        }
-    }
-    auto unit = [&] { return double(random.next() % 2000001) / 1000000.0 - 1.0; };
-    amc::TriangleMesh out;
-    out.single_precision = leaf.single_precision;
-    out.positions.resize(n);
-    for (uint32_t v = 0; v < n; ++v) {
-        amc::Vec3 p = leaf.positions[v];
-        if (v >= base_vertices && move > 0) p = p + (move * shortest[v]) * amc::Vec3{unit(), unit(), unit()};
-        if (out.single_precision) p = {double(float(p.x)), double(float(p.y)), double(float(p.z))};
-        out.positions[order[v]] = p;
-    }
-    out.triangles = leaf.triangles;
-    for (size_t i = out.triangles.size(); i > 1; --i) std::swap(out.triangles[i - 1], out.triangles[random.next() % i]);
-    for (amc::Triangle& t : out.triangles) {
-        const int r = int(random.next() % 3);
-        t = {order[t[r]], order[t[(r + 1) % 3]], order[t[(r + 2) % 3]]};
-    }
-    return out;
-}
 
 // CPU time of this thread: on the shared machine wall time also counts other jobs' turns.
 double thread_seconds() {
@@ -104,7 +60,7 @@ int main(int argc, char** argv) {
             for (double move : {0.0, 0.3}) {
                 const std::string name = std::string(names[model]) + " " + std::to_string(nodes / 1000) + "k nodes" +
                                          (move > 0 ? ", moved" : ", midpoints");
-                run(name.c_str(), h.base(), user_leaf_mesh(leaf.mesh, v0, move, 17), repetitions);
+                run(name.c_str(), h.base(), bench::user_leaf_mesh(leaf.mesh, v0, move, 17), repetitions);
             }
         }
     }
@@ -112,7 +68,7 @@ int main(int argc, char** argv) {
     if (std::filesystem::exists(data + "/bunny-sr-l3.obj")) {
         const amc::TriangleMesh base = amc::read_mesh(data + "/bunny-sr-l0.obj");
         const amc::TriangleMesh leaf = amc::read_mesh(data + "/bunny-sr-l3.obj");
-        run("bunny-sr-l3 (uniform, projected)", base, user_leaf_mesh(leaf, 0, 0.0, 17), repetitions);
+        run("bunny-sr-l3 (uniform, projected)", base, bench::user_leaf_mesh(leaf, 0, 0.0, 17), repetitions);
     } else {
         std::printf("(%s/bunny-sr-l3.obj not found: semi-regular case skipped)\n", data.c_str());
     }

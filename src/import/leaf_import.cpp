@@ -116,41 +116,47 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     const LeafHalfedges halfedges(leaf);
     ImportedHierarchy out;
     std::vector<uint32_t> leaf_of_vertex;
-    // Five ways in, cheapest first; the first whose result is exactly the leaf mesh wins.
-    //  1. new vertices at edge midpoints (as amcodec writes them): found by position;
-    //  2. a uniform refinement (semi-regular remeshes): read off the connectivity as grids;
-    //  3. the general reconstruction, guided by midpoint subdivision of the base;
-    //  4. the same, guided by the surface: meshes whose new vertices were projected onto it;
-    //  5. anchored inverse refinement: levels undone bottom-up from the connectivity alone, the
-    //     base vertices kept (positions anywhere; not every adaptive mesh yet, docs/IMPORT.md).
-    auto attempt = [&](int way) {
+    // Six ways in, cheapest first; the first whose result is exactly the leaf mesh wins.
+    enum class Way {
+        exact_midpoints,  // new vertices at edge midpoints (as amcodec writes them): found by position
+        uniform,          // a uniform refinement (semi-regular remeshes): read off the connectivity as grids
+        leaf_midpoint,    // the general reconstruction, guided by the midpoint of the edge's leaf vertices
+        subdivision,      // the same, guided by midpoint subdivision of the base
+        surface,          // the same, guided by the surface: new vertices projected onto it
+        anchored,         // levels undone bottom-up from the connectivity alone, the base vertices kept
+                          // (positions anywhere; not every adaptive mesh yet, docs/IMPORT.md)
+    };
+    auto attempt = [&](Way way) {
         out.hierarchy = Hierarchy(hierarchy_base);
         // A leaf mesh of F faces comes from at most F leaves, so from at most 4F/3 + roots nodes.
         out.hierarchy.reserve(leaf.triangles.size() * 4 / 3 + base.triangles.size() + 4, leaf.positions.size());
-        if (way == 2) {
+        if (way == Way::uniform) {
             leaf_of_vertex = reconstruct_uniform(out.hierarchy, leaf_of_base, leaf, halfedges);
             if (leaf_of_vertex.empty()) throw Error(what + ": not a uniform refinement");
-        } else if (way == 5) {
+        } else if (way == Way::anchored) {
             validate_triangle_mesh(leaf, what);  // the inverse step needs an oriented manifold
             leaf_of_vertex = reconstruct_anchored(out.hierarchy, leaf_of_base, leaf, what);
             if (leaf_of_vertex.empty()) throw Error(what + ": anchored inverse refinement did not reach the base");
         } else {
-            const MidpointGuide guide = way == 1   ? MidpointGuide::exact
-                                        : way == 3 ? MidpointGuide::subdivision
-                                                   : MidpointGuide::surface;
+            const MidpointGuide guide = way == Way::exact_midpoints ? MidpointGuide::exact
+                                        : way == Way::leaf_midpoint ? MidpointGuide::leaf_midpoint
+                                        : way == Way::subdivision   ? MidpointGuide::subdivision
+                                                                    : MidpointGuide::surface;
             leaf_of_vertex = reconstruct_hierarchy(out.hierarchy, leaf_of_base, leaf, halfedges, guide,
                                                    leaf_positions, what);
         }
         verify_leaf_mesh(out.hierarchy, leaf_of_vertex, leaf, halfedges, what);
     };
+    // The subdivision-guided way's error is the one reported: it goes furthest on most bad input.
     std::string first_error;
     bool done = false;
-    for (int way = 1; way <= 5 && !done; ++way) {
+    for (Way way : {Way::exact_midpoints, Way::uniform, Way::leaf_midpoint, Way::subdivision, Way::surface, Way::anchored}) {
         try {
             attempt(way);
             done = true;
+            break;
         } catch (const Error& e) {
-            if (way == 3) first_error = e.what();
+            if (way == Way::subdivision) first_error = e.what();
         }
     }
     if (!done) {

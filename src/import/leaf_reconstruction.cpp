@@ -221,7 +221,8 @@ private:
             nearest_ = std::make_unique<NearestVertex>(leaf_.positions, total / double(leaf_.triangles.size()));
         }
         // Where midpoint subdivision of the base puts the vertex (the hierarchy's default placer
-        // has computed it), or the midpoint of the edge as the leaf mesh places its ends.
+        // has computed it), or the midpoint of the edge as the leaf mesh places its ends (which
+        // follows projected and moved ends; the surface guide then projects it onto the mesh).
         Vec3 m = guide_ == MidpointGuide::subdivision ? h_.position(h_.midpoint(n, e))
                                                      : 0.5 * (leaf_.positions[a] + leaf_.positions[b]);
         if (guide_ == MidpointGuide::surface) {

@@ -15,6 +15,8 @@ namespace amc {
 // How the reconstruction finds a vertex that no green neighbour reveals (docs/IMPORT.md).
 enum class MidpointGuide {
     exact,          // the vertex at the edge's midpoint, bit for bit
+    leaf_midpoint,  // the vertex nearest to the midpoint of the edge's end vertices (as the leaf
+                    // mesh places them)
     subdivision,    // the vertex nearest to where midpoint subdivision of the base puts it
     surface,        // the vertex nearest to the leaf mesh's surface point closest to the
                     // midpoint of the edge's end vertices (meshes projected onto a surface)

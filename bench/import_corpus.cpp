@@ -1,0 +1,92 @@
+// The corpus check of issue 23 (docs/IMPORT.md, "The corpus check"): for every hierarchy given,
+// its leaf mesh as a user holds it (vertices and faces shuffled, every non-base vertex moved off
+// its midpoint by up to 0.3 of its shortest edge per coordinate):
+//   * import_leaf_mesh with the base (matched by position) must give the identical hierarchy;
+//   * import_mesh without it: the base it finds and the connectivity code of its hierarchy
+//     (base connectivity + hierarchy stream of the .amc file) against the true hierarchy's.
+// Prints a Markdown table. Exit status 1 if any import with the base is not identical.
+//
+// Usage: import_corpus [--move X] corpus/*.amh   (scripts/import_corpus.sh makes the corpus)
+#include "user_leaf_mesh.h"
+
+#include <amc/codec.h>
+#include <amc/import.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace {
+
+double thread_seconds() {
+    timespec t;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+uint64_t connectivity_bytes(const amc::Hierarchy& h) {
+    amc::EncodeStats stats;
+    amc::encode(h, {}, &stats);
+    return stats.base_connectivity_bytes + stats.hierarchy_bytes;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    double move = 0.3;
+    std::vector<std::string> files;
+    for (int i = 1; i < argc; ++i) {
+        const std::string arg = argv[i];
+        if (arg == "--move" && i + 1 < argc) {
+            move = std::atof(argv[++i]);
+        } else {
+            files.push_back(arg);
+        }
+    }
+    if (files.empty()) {
+        std::fprintf(stderr, "usage: import_corpus [--move X] hierarchy.amh...\n");
+        return 2;
+    }
+    std::printf("| model | leaf faces | base triangles | with base | s | base found (triangles) | connectivity bytes, true | found | found / true | s |\n");
+    std::printf("|---|---:|---:|---|---:|---:|---:|---:|---:|---:|\n");
+    int not_identical = 0;
+    for (const std::string& file : files) {
+        const amc::Hierarchy h = amc::read_hierarchy(file);
+        const amc::LeafMesh leaf = amc::extract_leaf_mesh(h);
+        std::vector<uint32_t> user_of_leaf;
+        const amc::TriangleMesh user =
+            bench::user_leaf_mesh(leaf.mesh, uint32_t(h.base().positions.size()), move, 23, &user_of_leaf);
+        // The hierarchy the import must give: h with the user's positions.
+        amc::Hierarchy expected = h;
+        const std::vector<uint32_t> canonical = amc::canonical_vertex_order(h);
+        for (amc::VertexId v = 0; v < canonical.size(); ++v) {
+            if (canonical[v] != amc::kNoVertex) expected.set_position(v, user.positions[user_of_leaf[canonical[v]]]);
+        }
+        std::string with_base;
+        double start = thread_seconds();
+        try {
+            const amc::ImportedHierarchy imported = amc::import_leaf_mesh(h.base(), user);
+            with_base = amc::identical(imported.hierarchy, expected) ? "identical" : "DIFFERENT";
+        } catch (const amc::Error& e) {
+            with_base = std::string("refused: ") + e.what();
+            if (with_base.size() > 70) with_base = with_base.substr(0, 67) + "...";
+        }
+        const double with_base_seconds = thread_seconds() - start;
+        if (with_base != "identical") ++not_identical;
+
+        start = thread_seconds();
+        const amc::ImportedHierarchy detected = amc::import_mesh(user);
+        const double detect_seconds = thread_seconds() - start;
+        const uint64_t truth = connectivity_bytes(h), found = connectivity_bytes(detected.hierarchy);
+        std::printf("| %s | %zu | %zu | %s | %.2f | %u | %llu | %llu | %.3f | %.2f |\n",
+                    std::filesystem::path(file).stem().string().c_str(), leaf.mesh.triangles.size(),
+                    h.base().triangles.size(), with_base.c_str(), with_base_seconds, detected.hierarchy.root_count(),
+                    (unsigned long long)truth, (unsigned long long)found, double(found) / double(truth),
+                    detect_seconds);
+        std::fflush(stdout);
+    }
+    return not_identical == 0 ? 0 : 1;
+}
