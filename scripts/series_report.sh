@@ -4,17 +4,25 @@
 # 10^5 faces, each speed measured in several runs (ranges). Sizes are deterministic; times are CPU
 # seconds. Needs a build with -DAMC_BUILD_BENCH=ON (scripts/install-deps.sh --bench: zstd, xz, zfp).
 #
-#   scripts/series_report.sh [BUILD_DIR] [RUNS] > series_report.txt
+#   scripts/series_report.sh [BUILD_DIR] [RUNS] [ELEMENTS] > series_report.txt
+#
+# ELEMENTS (default 5000) is the heat runs' target mesh size; the peers (xz -9 above all) cost
+# about 2 CPU s a frame at 20000.
 set -euo pipefail
 build=${1:-build}
 runs=${2:-3}
+elements=${3:-5000}
 bench="$build/bench/series_bench"
 [[ -x $bench ]] || { echo "no $bench: cmake -S . -B $build -DAMC_BUILD_BENCH=ON && cmake --build $build -j2" >&2; exit 1; }
 echo "# scripts/series_report.sh $build $runs on $(uname -m), $(nproc) cores, $(date -u +%Y-%m-%d)"
 echo
 run() { nice -n 19 "$bench" "$@"; echo; }
-run --scenario lshape --frames 100 --repeat "$runs"
-run --scenario rotating --frames 100 --repeat "$runs"
-run --scenario front --frames 100 --max-level 8 --repeat "$runs"
-run --scenario lshape --frames 100 --keyframe 10 --repeat "$runs" --speed-only 1
-run --scenario lshape --frames 20 --target 100000 --max-level 12 --repeat "$runs" --speed-only 1
+# The comparison with the peers (zstd -19, xz -9, zfp) on the L-shape run: the costly part.
+run --scenario lshape --frames 100 --target "$elements" --repeat "$runs"
+# Speed on frames of about 10^5 faces.
+run --scenario lshape --frames 5 --target 100000 --max-level 12 --repeat "$runs" --speed-only 1
+# The other sequences, without the peers: sizes against independent .amc files, changed nodes.
+run --scenario front --frames 100 --max-level 8 --repeat "$runs" --peers 0
+run --scenario rotating --frames 100 --target "$elements" --repeat "$runs" --peers 0
+# Random access with a keyframe every 10 frames.
+run --scenario lshape --frames 100 --target "$elements" --keyframe 10 --repeat "$runs" --speed-only 1
