@@ -59,10 +59,10 @@ void run_demo(const std::string& out_dir, const GlobalOptions& global) {
     if (loud)
         std::printf("\n%-12s %10s %8s %10s %10s %12s %10s %10s %s\n", "coding", "bytes", "ratio", "bits/face", "conn b/f",
                     "max error", "enc Mf/s", "dec Mf/s", "check");
-    const Hierarchy expected = in_decoder_order(h);
     for (int bits : {0, 16, 12}) {
         EncodeOptions encode_options;
         encode_options.quantize_bits = bits;
+        const Hierarchy expected = in_decoder_order(h, encode_options);
         EncodeStats stats;
         auto t0 = std::chrono::steady_clock::now();
         const std::vector<uint8_t> bytes = encode(h, encode_options, &stats);

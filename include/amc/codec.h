@@ -63,10 +63,11 @@ struct EncodeStats {
 // result is identical to reorder_base(h, ...) of the input — same elements, same positions.
 std::vector<uint8_t> encode(const Hierarchy& h, const EncodeOptions& options = {}, EncodeStats* stats = nullptr);
 
-// `h` as decode(encode(h)) returns it: over the base mesh in the base coder's order (cheap: codes
-// the base connectivity only). identical(decode(encode(h)), in_decoder_order(h)) holds for every
-// bit-exact encoding.
-Hierarchy in_decoder_order(const Hierarchy& h);
+// `h` as decode(encode(h, options)) returns it: over the base mesh in the base coder's order
+// (cheap: codes the base connectivity only), with the input's positions. The order depends on the
+// base positions the decoder sees, so pass the options of the encoding (only quantize_bits
+// matters). identical(decode(encode(h)), in_decoder_order(h)) holds for every bit-exact encoding.
+Hierarchy in_decoder_order(const Hierarchy& h, const EncodeOptions& options = {});
 
 struct DecodeOptions {
     int max_level = -1;                  // stop after this level: the mesh of that level

@@ -66,11 +66,16 @@ int main(int argc, char** argv) {
             naive.hierarchy.traversal = amc::Traversal::naive;
             butterfly.predictor = amc::GeometryPredictor::butterfly;
             quantized.quantize_bits = 12;
-            write_bytes(name + ".lossless.amc", amc::encode(h, lossless));
-            write_bytes(name + ".naive.amc", amc::encode(h, naive));
-            write_bytes(name + ".butterfly.amc", amc::encode(h, butterfly));
-            write_bytes(name + ".q12.amc", amc::encode(h, quantized));
-            files += 68;
+            // Each file with what this build decodes it to: the base order is the writing build's
+            // (it changed with the base coder's mode 2, format version 4).
+            const std::pair<const char*, const amc::EncodeOptions*> kinds[] = {
+                {"lossless", &lossless}, {"naive", &naive}, {"butterfly", &butterfly}, {"q12", &quantized}};
+            for (const auto& [kind, options] : kinds) {
+                const std::vector<uint8_t> bytes = amc::encode(h, *options);
+                write_bytes(name + "." + kind + ".amc", bytes);
+                amc::write_hierarchy(name + "." + kind + ".decoded.amh", amc::decode(bytes.data(), bytes.size()));
+            }
+            files += 72;
         }
     }
     std::printf("write_vectors: %d hierarchies, %d files in %s\n", seeds * int(bases.size()), files, out.c_str());

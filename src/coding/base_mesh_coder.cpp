@@ -1,782 +1,44 @@
-// Single-rate connectivity coder of the base mesh; see base_mesh_coder.h for the scheme and the
-// stream layout.
+// Single-rate coder of the base mesh: the mode dispatch, the explicit mode (FORMAT.md 4.2, 4.8)
+// and the encoder's self-check; see base_mesh_coder.h.
 #include "coding/base_mesh_coder.h"
 
 #include "coding/arithmetic_coder.h"
+#include "coding/base_angle_coder.h"
+#include "coding/base_cut_border_coder.h"
+#include "coding/base_mesh_stream.h"
 #include "common/bits.h"
 #include "common/check.h"
 
 #include <algorithm>
 #include <numeric>
 #include <string>
-#include <unordered_map>
 
 namespace amc {
 namespace {
 
-constexpr uint32_t kNone = 0xFFFFFFFFu;
-constexpr uint32_t kModeCutBorder = 0;
-constexpr uint32_t kModeExplicit = 1;
-constexpr uint32_t kMaxCount = 0x7FFFFFFFu;  // counts are coded as gamma(x + 1) in 32 bits
-constexpr int kDegreeContexts = 8;
-constexpr bool kChooseGate = true;
-constexpr bool kUseV = false;
-
-[[noreturn]] void fail(const std::string& what, ErrorCode code = ErrorCode::corrupt) {
-    throw_error(code, "base mesh stream: " + what);
-}
-
-// Internal inconsistency of the encoder: caught, and the mesh is coded explicitly.
-struct EncoderGaveUp {};
-
-void put_count(ArithmeticEncoder& enc, uint32_t x) {
-    if (x > kMaxCount) throw EncoderGaveUp{};
-    const uint32_t y = x + 1;
-    const int n = bit_length(y);
-    enc.encode_bits_raw(0, n - 1);
-    enc.encode_bits_raw(y, n);
-}
-
-uint32_t get_count(ArithmeticDecoder& dec) {
-    int zeros = 0;
-    while (dec.decode_bits_raw(1) == 0) {
-        if (++zeros > 31) fail("bad count");
-    }
-    const uint32_t y = (uint32_t{1} << zeros) | dec.decode_bits_raw(zeros);
-    return y - 1;
-}
-
-// A value in [0, range) with bit_length(range - 1) raw bits.
-void put_index(ArithmeticEncoder& enc, uint32_t value, uint32_t range) {
-    if (value >= range) throw EncoderGaveUp{};
-    enc.encode_bits_raw(value, bit_length(range - 1));
-}
-
-uint32_t get_index(ArithmeticDecoder& dec, uint32_t range, const char* what) {
-    if (range == 0) fail(std::string("empty range for ") + what);
-    const uint32_t value = dec.decode_bits_raw(bit_length(range - 1));
-    if (value >= range) fail(std::string(what) + " out of range");
-    return value;
-}
-
-// The adaptive models of mode 0 (shared layout of encoder and decoder).
-struct OpModels {
-    BitModel is_new[kDegreeContexts * 4];  // C or not, by triangles around u and v
-    BitModel is_right[kDegreeContexts];    // R (E on a 3-loop) or not, by triangles around u
-    BitModel is_left[kDegreeContexts];     // L or not, by triangles around v
-    BitModel is_split;                     // S or M when both are possible
-    BitModel is_dummy;                     // a new vertex is a boundary loop's dummy vertex
-    BitModel split_side;                   // split tip nearer to v (1) or to u (0)
-    BitModel split_length[33];             // unary bit length of the split distance + 1
-
-    static int degree_class(uint32_t d) { return static_cast<int>(std::min<uint32_t>(d, 7)); }
-    BitModel& new_model(uint32_t du, uint32_t dv) {
-        return is_new[degree_class(du) * 4 + (kUseV ? std::min<uint32_t>(dv, 3) : 0)];
-    }
-};
-
-// Split offset d in [0, range): the side it is nearer to (adaptive), then the distance from that
-// side as an Elias-gamma code with an adaptive unary bit length and raw mantissa bits.
-void put_split(ArithmeticEncoder& enc, OpModels& m, uint32_t d, uint32_t range) {
-    if (d >= range) throw EncoderGaveUp{};
-    const bool near_v = d <= range - 1 - d;
-    enc.encode(near_v, m.split_side);
-    const uint32_t y = (near_v ? d : range - 1 - d) + 1;
-    const int n = bit_length(y) - 1;
-    for (int i = 0; i < n; ++i) enc.encode(true, m.split_length[i]);
-    if (n < bit_length(range)) enc.encode(false, m.split_length[n]);
-    enc.encode_bits_raw(y, n);
-}
-
-uint32_t get_split(ArithmeticDecoder& dec, OpModels& m, uint32_t range) {
-    const bool near_v = dec.decode(m.split_side);
-    int n = 0;
-    const int max_n = bit_length(range);
-    while (n < max_n && dec.decode(m.split_length[n])) ++n;
-    if (n >= max_n) fail("split offset out of range");
-    const uint64_t y = (uint64_t{1} << n) | dec.decode_bits_raw(n);
-    if (y > range) fail("split offset out of range");
-    const uint32_t dist = static_cast<uint32_t>(y - 1);
-    return near_v ? dist : range - 1 - dist;
-}
-
-// The cut border: a stack of loops of border nodes (doubly linked, cyclic). A node stands for a
-// vertex on the border and for the border edge leaving it; `opp` is the third vertex of the
-// decoded triangle on the other side of that edge (the parallelogram stencil of a new vertex).
-// The top of the stack is the current loop; its gate is the edge leaving the gate node.
-struct CutBorder {
-    struct Loop {
-        uint32_t gate;
-        uint32_t length;
-    };
-    std::vector<uint32_t> next, prev, vert, opp;
-    std::vector<Loop> stack;
-
-    uint32_t new_node(uint32_t v, uint32_t o) {
-        next.push_back(kNone);
-        prev.push_back(kNone);
-        vert.push_back(v);
-        opp.push_back(o);
-        return static_cast<uint32_t>(vert.size() - 1);
-    }
-    void link(uint32_t a, uint32_t b) {
-        next[a] = b;
-        prev[b] = a;
-    }
-    Loop& top() { return stack.back(); }
-
-    // Starts a component with triangle (a, b, c): loop a -> c -> b, gate at a.
-    void start(uint32_t a, uint32_t b, uint32_t c) {
-        const uint32_t na = new_node(a, b), nc = new_node(c, a), nb = new_node(b, c);
-        link(na, nc);
-        link(nc, nb);
-        link(nb, na);
-        stack.push_back({na, 3});
-    }
-    // C: new vertex w on the gate; returns its node.
-    uint32_t op_new(uint32_t w) {
-        Loop& l = top();
-        const uint32_t g = l.gate, nv = next[g];
-        const uint32_t nw = new_node(w, vert[g]);
-        opp[g] = vert[nv];
-        link(g, nw);
-        link(nw, nv);
-        ++l.length;
-        return nw;
-    }
-    // R: the tip is the vertex before u; u leaves the border, the gate moves back.
-    void op_right() {
-        Loop& l = top();
-        const uint32_t g = l.gate, p = prev[g], nv = next[g];
-        opp[p] = vert[g];
-        link(p, nv);
-        l.gate = p;
-        --l.length;
-    }
-    // L: the tip is the vertex after v; v leaves the border.
-    void op_left() {
-        Loop& l = top();
-        const uint32_t g = l.gate, nv = next[g], nw = next[nv];
-        opp[g] = vert[nv];
-        link(g, nw);
-        --l.length;
-    }
-    // E: the 3-loop is closed.
-    void op_end() { stack.pop_back(); }
-    // S: the tip is node n = k steps after v (2 <= k <= length - 3). The part v .. n becomes a
-    // loop of its own, pushed below the current one; returns the new node of w in that part.
-    uint32_t op_split(uint32_t n, uint32_t k) {
-        const uint32_t nw = close_gate_at(n);
-        top().length -= k;
-        stack.insert(stack.end() - 1, Loop{nw, k + 1});
-        return nw;
-    }
-    // M: the tip is node n of the stack loop `index` (stack position); the loops are merged.
-    uint32_t op_merge(uint32_t n, size_t index) {
-        const uint32_t other_length = stack[index].length;
-        stack.erase(stack.begin() + static_cast<std::ptrdiff_t>(index));
-        const uint32_t nw = close_gate_at(n);
-        top().length += other_length + 1;
-        return nw;
-    }
-    // S and M alike: the gate's triangle has its tip at node n elsewhere on the loops (so n's
-    // predecessor is not the gate and n is not the gate's far end). The gate now leads to n, and
-    // a second node of the tip's vertex joins n's predecessor to the gate's far end; returns it.
-    uint32_t close_gate_at(uint32_t n) {
-        const uint32_t g = top().gate, nv = next[g], pn = prev[n];
-        const uint32_t nw = new_node(vert[n], vert[g]);
-        opp[g] = vert[nv];
-        link(g, n);
-        link(pn, nw);
-        link(nw, nv);
-        return nw;
-    }
-    // Moves the gate of the current loop to the node whose vertex has the most decoded triangles
-    // (the vertex closest to completion: fewer splits, as in Alliez–Desbrun's conquest), the
-    // first such node after the current gate on ties.
-    void choose_gate(const std::vector<uint32_t>& degree) {
-        if (stack.empty()) return;
-        Loop& l = top();
-        uint32_t best = l.gate, best_degree = degree[vert[best]], n = l.gate;
-        for (uint32_t i = 1; i < l.length; ++i) {
-            n = next[n];
-            if (degree[vert[n]] > best_degree) {
-                best = n;
-                best_degree = degree[vert[n]];
-            }
-        }
-        l.gate = best;
-    }
-    uint32_t walk(uint32_t n, uint32_t steps) const {
-        for (uint32_t i = 0; i < steps; ++i) n = next[n];
-        return n;
-    }
-};
-
-// ---------------------------------------------------------------------------------------------
-// Decoder
-
-DecodedBaseConnectivity decode_explicit(ArithmeticDecoder& dec, size_t size,
-                                        uint32_t max_vertices) {
-    DecodedBaseConnectivity out;
+DecodedBaseMesh decode_explicit(ArithmeticDecoder& dec, size_t size, uint32_t vertex_count) {
+    DecodedBaseMesh out;
     out.vertex_count = get_count(dec);
-    if (out.vertex_count > max_vertices) fail("too many vertices", ErrorCode::limit_exceeded);
+    if (out.vertex_count != vertex_count) fail_base_stream("vertex count differs from the caller's");
     const uint32_t faces = get_count(dec);
     const int bits = bit_length(out.vertex_count == 0 ? 0 : out.vertex_count - 1);
     if (faces > 0 && (out.vertex_count < 3 ||
                       uint64_t{faces} * 3 * static_cast<uint64_t>(bits) > 8 * (uint64_t{size} + 8)))
-        fail("triangle count exceeds the stream");
+        fail_base_stream("triangle count exceeds the stream");
     out.triangles.resize(faces);
     for (Triangle& t : out.triangles) {
         for (uint32_t& v : t) v = get_index(dec, out.vertex_count, "vertex index");
-        if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) fail("degenerate triangle");
+        if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) fail_base_stream("degenerate triangle");
     }
     out.stencils.resize(out.vertex_count);
-    for (uint32_t i = 0; i < out.vertex_count; ++i)
-        out.stencils[i] = {static_cast<int32_t>(i) - 1, -1, -1};
+    for (uint32_t i = 0; i < out.vertex_count; ++i) out.stencils[i] = {static_cast<int32_t>(i) - 1, -1, -1};
     return out;
-}
-
-DecodedBaseConnectivity decode_cut_border(ArithmeticDecoder& dec, size_t size,
-                                          uint32_t max_vertices) {
-    const uint32_t vertex_count = get_count(dec);
-    const uint32_t isolated = get_count(dec);
-    const uint32_t dummies = get_count(dec);
-    const uint32_t copies = get_count(dec);
-    const uint32_t components = get_count(dec);
-    const uint32_t merges = get_count(dec);
-    if (vertex_count > max_vertices) fail("too many vertices", ErrorCode::limit_exceeded);
-    if (isolated > vertex_count) fail("bad isolated vertex count");
-    const uint64_t stream_bits = 8 * (uint64_t{size} + 8);
-    // Every copy and merge costs at least two raw bits.
-    if (2 * uint64_t{copies} > stream_bits || 2 * uint64_t{merges} > stream_bits)
-        fail("copy or merge count exceeds the stream");
-    const uint64_t used = vertex_count - isolated;
-    const uint64_t closed_vertices = used + dummies + copies;
-    if (dummies > (used + copies) / 3 + 1 || closed_vertices > kMaxCount)
-        fail("bad dummy vertex count");
-    if (3 * uint64_t{components} > closed_vertices) fail("bad component count");
-    const int64_t closed_faces = 2 * int64_t(closed_vertices) - 4 * int64_t(components) +
-                                 4 * int64_t(merges);
-    if (closed_faces < 0 || closed_faces > kMaxCount || (components == 0) != (closed_faces == 0))
-        fail("bad triangle count");
-    // Every triangle but a component's first costs an operation, at least one modelled symbol.
-    if (uint64_t(closed_faces) - components > max_decodable_symbols(size))
-        fail("triangle count exceeds the stream");
-
-    OpModels models;
-    CutBorder border;
-    const uint32_t vc = static_cast<uint32_t>(closed_vertices);
-    const uint32_t fc = static_cast<uint32_t>(closed_faces);
-    std::vector<uint32_t> degree;
-    std::vector<uint8_t> is_dummy;
-    std::vector<BaseStencil> raw_stencils;
-    std::vector<Triangle> tris;
-    // Room for what a stream of this size typically holds (a few triangles a byte); more grows.
-    const uint64_t typical = 64 * uint64_t{size} + 64;
-    degree.reserve(std::min<uint64_t>(vc, typical));
-    tris.reserve(std::min<uint64_t>(fc, typical));
-    uint32_t dummy_seen = 0;
-
-    auto add_vertex = [&](BaseStencil s, bool dummy) {
-        if (degree.size() >= vc) fail("more vertices than announced");
-        degree.push_back(0);
-        is_dummy.push_back(dummy ? 1 : 0);
-        raw_stencils.push_back(s);
-        return static_cast<uint32_t>(degree.size() - 1);
-    };
-    auto add_triangle = [&](uint32_t a, uint32_t b, uint32_t c) {
-        if (tris.size() >= fc) fail("more triangles than announced");
-        if (a == b || b == c || a == c) fail("degenerate triangle");
-        tris.push_back({a, b, c});
-        ++degree[a];
-        ++degree[b];
-        ++degree[c];
-    };
-
-    for (uint32_t comp = 0; comp < components; ++comp) {
-        const int32_t last = static_cast<int32_t>(degree.size()) - 1;
-        const uint32_t a = add_vertex({last, -1, -1}, false);
-        const uint32_t b = add_vertex({int32_t(a), -1, -1}, false);
-        const uint32_t c = add_vertex({int32_t(b), -1, -1}, false);
-        add_triangle(a, b, c);
-        border.start(a, b, c);
-        while (!border.stack.empty()) {
-            if (tris.size() >= fc) fail("more triangles than announced");
-            if (dec.overran()) fail("truncated", ErrorCode::truncated);
-            CutBorder::Loop& loop = border.top();
-            const uint32_t g = loop.gate, nv = border.next[g];
-            const uint32_t u = border.vert[g], v = border.vert[nv];
-            if (dec.decode(models.new_model(degree[u], degree[v]))) {
-                const bool dummy = dummies > 0 && dec.decode(models.is_dummy);
-                dummy_seen += dummy ? 1 : 0;
-                const uint32_t w =
-                    add_vertex({int32_t(u), int32_t(v), int32_t(border.opp[g])}, dummy);
-                add_triangle(u, v, w);
-                border.op_new(w);
-                continue;
-            }
-            const uint32_t length = loop.length;
-            const bool right = dec.decode(models.is_right[OpModels::degree_class(degree[u])]);
-            if (right) {
-                add_triangle(u, v, border.vert[border.prev[g]]);
-                if (length == 3) border.op_end();
-                else border.op_right();
-                if (kChooseGate) border.choose_gate(degree);
-                continue;
-            }
-            if (length > 3 && dec.decode(models.is_left[OpModels::degree_class(degree[v])])) {
-                add_triangle(u, v, border.vert[border.next[nv]]);
-                border.op_left();
-                continue;
-            }
-            const bool can_split = length >= 5, can_merge = border.stack.size() >= 2;
-            if (!can_split && !can_merge) fail("impossible operation");
-            const bool split = can_split && (!can_merge || dec.decode(models.is_split));
-            if (split) {
-                const uint32_t k = 2 + get_split(dec, models, length - 4);
-                const uint32_t n = border.walk(nv, k);
-                add_triangle(u, v, border.vert[n]);
-                border.op_split(n, k);
-            } else {
-                const size_t depth = get_index(
-                    dec, static_cast<uint32_t>(border.stack.size() - 1), "merge loop");
-                const size_t index = border.stack.size() - 2 - depth;
-                const CutBorder::Loop other = border.stack[index];
-                const uint32_t n = border.walk(other.gate, get_index(dec, other.length, "merge offset"));
-                add_triangle(u, v, border.vert[n]);
-                border.op_merge(n, index);
-            }
-        }
-    }
-    if (tris.size() != fc || degree.size() != vc) fail("counts do not match the operations");
-    if (dummy_seen != dummies) fail("dummy vertex count does not match");
-
-    // Copies of non-manifold vertices: merged into earlier vertices.
-    std::vector<uint32_t> target(vc, kNone);
-    uint32_t previous_copy = 0;
-    for (uint32_t i = 0; i < copies; ++i) {
-        const uint32_t copy = get_index(dec, vc, "copy index");
-        const uint32_t to = get_index(dec, vc, "copy target");
-        if ((i > 0 && copy <= previous_copy) || to >= copy || is_dummy[copy] || is_dummy[to] ||
-            target[to] != kNone)
-            fail("bad vertex copy");
-        target[copy] = to;
-        previous_copy = copy;
-    }
-    if (dec.overran()) fail("truncated", ErrorCode::truncated);
-
-    DecodedBaseConnectivity out;
-    out.vertex_count = vertex_count;
-    std::vector<int32_t> final_index(vc, -1);
-    int32_t next_final = 0;
-    for (uint32_t i = 0; i < vc; ++i) {
-        if (is_dummy[i]) continue;
-        if (target[i] != kNone) {
-            final_index[i] = final_index[target[i]];
-            continue;
-        }
-        final_index[i] = next_final++;
-        const BaseStencil& s = raw_stencils[i];
-        auto map = [&](int32_t x) { return x < 0 ? -1 : final_index[x]; };
-        const int32_t m0 = map(s[0]), m1 = map(s[1]), m2 = map(s[2]);
-        if (m0 >= 0 && m1 >= 0 && m2 >= 0) out.stencils.push_back({m0, m1, m2});
-        else if (m0 >= 0) out.stencils.push_back({m0, -1, -1});
-        else if (m1 >= 0) out.stencils.push_back({m1, -1, -1});
-        else out.stencils.push_back({next_final - 2, -1, -1});
-    }
-    if (uint64_t(next_final) != used) fail("vertex count does not match");
-    for (uint32_t i = 0; i < isolated; ++i) {
-        out.stencils.push_back({next_final - 1, -1, -1});
-        ++next_final;
-    }
-    for (const Triangle& t : tris) {
-        if (is_dummy[t[0]] || is_dummy[t[1]] || is_dummy[t[2]]) continue;
-        const Triangle m = {uint32_t(final_index[t[0]]), uint32_t(final_index[t[1]]),
-                            uint32_t(final_index[t[2]])};
-        if (m[0] == m[1] || m[1] == m[2] || m[0] == m[2]) fail("degenerate triangle");
-        out.triangles.push_back(m);
-    }
-    return out;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Encoder
-
-// The mesh made closed and manifold: one vertex per fan of an original vertex, a dummy vertex
-// per boundary loop. Closed triangles 0 .. F-1 are the original ones (same rotation).
-struct ClosedMesh {
-    std::vector<Triangle> triangles;
-    std::vector<uint32_t> original;  // per closed vertex: original vertex, or kNone for dummies
-    std::vector<uint32_t> twin;      // per halfedge 3 t + k (from corner k to k + 1)
-    uint32_t real_triangles = 0;
-    uint32_t dummies = 0;
-};
-
-uint64_t edge_key(uint32_t a, uint32_t b) { return (uint64_t{a} << 32) | b; }
-
-uint32_t find_root(std::vector<uint32_t>& parent, uint32_t x) {
-    while (parent[x] != x) {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-    }
-    return x;
-}
-
-ClosedMesh make_closed(const TriangleMesh& mesh) {
-    const uint32_t f = static_cast<uint32_t>(mesh.triangles.size());
-    ClosedMesh cm;
-    cm.real_triangles = f;
-    std::unordered_map<uint64_t, uint32_t> halfedge;
-    halfedge.reserve(3 * size_t{f});
-    for (uint32_t t = 0; t < f; ++t) {
-        for (int k = 0; k < 3; ++k) {
-            const Triangle& tri = mesh.triangles[t];
-            if (!halfedge.emplace(edge_key(tri[k], tri[(k + 1) % 3]), 3 * t + k).second)
-                throw EncoderGaveUp{};
-        }
-    }
-    // Corners of one vertex sharing an edge belong to one fan.
-    std::vector<uint32_t> parent(3 * size_t{f});
-    std::iota(parent.begin(), parent.end(), 0u);
-    for (uint32_t t = 0; t < f; ++t) {
-        const Triangle& tri = mesh.triangles[t];
-        for (int k = 0; k < 3; ++k) {
-            const auto it = halfedge.find(edge_key(tri[(k + 1) % 3], tri[k]));
-            if (it == halfedge.end()) continue;
-            const uint32_t other = it->second / 3 * 3 + (it->second % 3 + 1) % 3;  // corner of tri[k]
-            parent[find_root(parent, 3 * t + k)] = find_root(parent, other);
-        }
-    }
-    std::vector<uint32_t> closed_of_root(3 * size_t{f}, kNone);
-    cm.triangles.resize(f);
-    for (uint32_t c = 0; c < 3 * f; ++c) {
-        const uint32_t r = find_root(parent, c);
-        if (closed_of_root[r] == kNone) {
-            closed_of_root[r] = static_cast<uint32_t>(cm.original.size());
-            cm.original.push_back(mesh.triangles[c / 3][c % 3]);
-        }
-        cm.triangles[c / 3][c % 3] = closed_of_root[r];
-    }
-    // Boundary loops, closed by dummy fans.
-    halfedge.clear();
-    for (uint32_t t = 0; t < f; ++t)
-        for (int k = 0; k < 3; ++k)
-            if (!halfedge.emplace(edge_key(cm.triangles[t][k], cm.triangles[t][(k + 1) % 3]), 3 * t + k).second)
-                throw EncoderGaveUp{};
-    const uint32_t used = static_cast<uint32_t>(cm.original.size());
-    std::vector<uint32_t> boundary_next(used, kNone);
-    for (uint32_t t = 0; t < f; ++t) {
-        for (int k = 0; k < 3; ++k) {
-            const uint32_t a = cm.triangles[t][k], b = cm.triangles[t][(k + 1) % 3];
-            if (halfedge.count(edge_key(b, a))) continue;
-            if (boundary_next[a] != kNone) throw EncoderGaveUp{};
-            boundary_next[a] = b;
-        }
-    }
-    std::vector<uint8_t> done(used, 0);
-    for (uint32_t start = 0; start < used; ++start) {
-        if (boundary_next[start] == kNone || done[start]) continue;
-        const uint32_t d = static_cast<uint32_t>(cm.original.size());
-        cm.original.push_back(kNone);
-        ++cm.dummies;
-        uint32_t a = start;
-        for (uint32_t steps = 0; !done[a]; ++steps) {
-            if (steps > used) throw EncoderGaveUp{};
-            done[a] = 1;
-            const uint32_t b = boundary_next[a];
-            if (b == kNone) throw EncoderGaveUp{};
-            cm.triangles.push_back({b, a, d});
-            a = b;
-        }
-        if (a != start) throw EncoderGaveUp{};
-    }
-    // Twins; every halfedge must have one now.
-    halfedge.clear();
-    const uint32_t fc = static_cast<uint32_t>(cm.triangles.size());
-    for (uint32_t t = 0; t < fc; ++t)
-        for (int k = 0; k < 3; ++k)
-            if (!halfedge.emplace(edge_key(cm.triangles[t][k], cm.triangles[t][(k + 1) % 3]), 3 * t + k).second)
-                throw EncoderGaveUp{};
-    cm.twin.assign(3 * size_t{fc}, kNone);
-    for (uint32_t t = 0; t < fc; ++t) {
-        for (int k = 0; k < 3; ++k) {
-            const auto it = halfedge.find(edge_key(cm.triangles[t][(k + 1) % 3], cm.triangles[t][k]));
-            if (it == halfedge.end()) throw EncoderGaveUp{};
-            cm.twin[3 * t + k] = it->second;
-        }
-    }
-    return cm;
-}
-
-struct ClosedTraversal {
-    std::vector<uint32_t> vertex_sequence;    // closed vertices in decoder order
-    std::vector<uint32_t> triangle_sequence;  // closed triangles in decoder order
-    std::vector<uint8_t> rotation;            // per decoded triangle
-    uint32_t components = 0, merges = 0;
-};
-
-std::vector<uint8_t> encode_cut_border(const TriangleMesh& mesh, BaseMeshCode& code) {
-    const ClosedMesh cm = make_closed(mesh);
-    const uint32_t fc = static_cast<uint32_t>(cm.triangles.size());
-    const uint32_t vc = static_cast<uint32_t>(cm.original.size());
-    auto corner_vertex = [&](uint32_t he) { return cm.triangles[he / 3][he % 3]; };
-    auto next_he = [](uint32_t he) { return he / 3 * 3 + (he % 3 + 1) % 3; };
-    auto prev_he = [](uint32_t he) { return he / 3 * 3 + (he % 3 + 2) % 3; };
-
-    // Pass 1: the traversal, recording the ops; pass 2 writes them once the counts are known.
-    struct Op {
-        uint8_t kind;  // 0 start, 1 C, 2 R/E, 3 L, 4 S, 5 M
-        uint32_t a = 0, b = 0;
-    };
-    std::vector<Op> ops;
-    ClosedTraversal ec;
-    std::vector<uint32_t> decoder_index(vc, kNone);
-    std::vector<uint8_t> processed(fc, 0);
-    CutBorder border;
-    std::vector<uint32_t> out_he;  // per node: the unprocessed halfedge of its border edge
-    std::vector<std::vector<uint32_t>> nodes_of(vc);
-    std::vector<uint8_t> alive;
-
-    auto visit_vertex = [&](uint32_t v) {
-        decoder_index[v] = static_cast<uint32_t>(ec.vertex_sequence.size());
-        ec.vertex_sequence.push_back(v);
-    };
-    std::vector<uint32_t> degree1(vc, 0);
-    auto visit_triangle = [&](uint32_t he) {
-        const uint32_t t = he / 3;
-        if (processed[t]) throw EncoderGaveUp{};
-        processed[t] = 1;
-        for (uint32_t x : cm.triangles[t]) ++degree1[x];
-        ec.triangle_sequence.push_back(t);
-        ec.rotation.push_back(static_cast<uint8_t>(he % 3));
-    };
-    auto track = [&](uint32_t node, uint32_t he) {
-        if (out_he.size() <= node) {
-            out_he.resize(node + 1, kNone);
-            alive.resize(node + 1, 0);
-        }
-        out_he[node] = he;
-        alive[node] = 1;
-        nodes_of[border.vert[node]].push_back(node);
-    };
-    // Is triangle t in the unprocessed sector of node n (between its out edge and in edge)?
-    auto sector_holds = [&](uint32_t n, uint32_t t) {
-        uint32_t he = out_he[n];
-        const uint32_t stop = out_he[border.prev[n]] / 3;
-        for (uint32_t steps = 0; steps <= fc; ++steps) {
-            if (he / 3 == t) return true;
-            if (he / 3 == stop) return false;
-            he = cm.twin[prev_he(he)];
-        }
-        throw EncoderGaveUp{};
-    };
-
-    for (uint32_t start = 0; start < cm.real_triangles; ++start) {
-        if (processed[start]) continue;
-        const Triangle& st = cm.triangles[start];
-        for (uint32_t v : st)
-            if (decoder_index[v] != kNone) throw EncoderGaveUp{};
-        ++ec.components;
-        ops.push_back({0});
-        for (uint32_t v : st) visit_vertex(v);
-        visit_triangle(3 * start);
-        border.start(st[0], st[1], st[2]);
-        const uint32_t na = border.top().gate, nc = border.next[na], nb = border.next[nc];
-        track(na, cm.twin[3 * start + 2]);
-        track(nc, cm.twin[3 * start + 1]);
-        track(nb, cm.twin[3 * start + 0]);
-        for (uint64_t guard = 0; !border.stack.empty(); ++guard) {
-            if (guard > fc) throw EncoderGaveUp{};
-            CutBorder::Loop& loop = border.top();
-            const uint32_t g = loop.gate, nv = border.next[g];
-            const uint32_t he = out_he[g];
-            const uint32_t t = he / 3;
-            if (processed[t] || corner_vertex(he) != border.vert[g] ||
-                corner_vertex(next_he(he)) != border.vert[nv])
-                throw EncoderGaveUp{};
-            const uint32_t w = corner_vertex(prev_he(he));
-            const uint32_t to_v = cm.twin[next_he(he)];  // w -> v, beyond the edge v -> w
-            const uint32_t to_w = cm.twin[prev_he(he)];  // u -> w, beyond the edge w -> u
-            visit_triangle(he);
-            if (decoder_index[w] == kNone) {
-                visit_vertex(w);
-                ops.push_back({1, cm.original[w] == kNone ? 1u : 0u});
-                const uint32_t nw = border.op_new(w);
-                out_he[g] = to_w;
-                track(nw, to_v);
-                continue;
-            }
-            const uint32_t p = border.prev[g];
-            if (border.vert[p] == w) {
-                ops.push_back({2});
-                if (loop.length == 3) {
-                    alive[g] = alive[nv] = alive[p] = 0;
-                    border.op_end();
-                } else {
-                    alive[g] = 0;
-                    border.op_right();
-                    out_he[p] = to_v;
-                }
-                if (kChooseGate) border.choose_gate(degree1);
-                continue;
-            }
-            if (loop.length > 3 && border.vert[border.next[nv]] == w) {
-                ops.push_back({3});
-                alive[nv] = 0;
-                border.op_left();
-                out_he[g] = to_w;
-                continue;
-            }
-            uint32_t n = kNone;
-            for (uint32_t cand : nodes_of[w]) {
-                if (alive[cand] && sector_holds(cand, t)) {
-                    n = cand;
-                    break;
-                }
-            }
-            if (n == kNone) throw EncoderGaveUp{};
-            uint32_t k = 0, x = nv;
-            while (k < loop.length && x != n) {
-                x = border.next[x];
-                ++k;
-            }
-            if (x == n) {
-                if (k < 2 || k + 3 > loop.length) throw EncoderGaveUp{};
-                ops.push_back({4, k - 2, loop.length - 4});
-                const uint32_t nw = border.op_split(n, k);
-                out_he[g] = to_w;
-                track(nw, to_v);
-                continue;
-            }
-            // Another loop of the stack: find it by walking from n to a loop's gate.
-            size_t index = border.stack.size();
-            uint32_t offset = 0;
-            for (size_t j = 0; j + 1 < border.stack.size() && index == border.stack.size(); ++j) {
-                uint32_t y = border.stack[j].gate;
-                for (uint32_t s = 0; s < border.stack[j].length; ++s, y = border.next[y]) {
-                    if (y == n) {
-                        index = j;
-                        offset = s;
-                        break;
-                    }
-                }
-            }
-            if (index == border.stack.size()) throw EncoderGaveUp{};
-            ++ec.merges;
-            const uint32_t depth = static_cast<uint32_t>(border.stack.size() - 2 - index);
-            ops.push_back({5, depth, offset});
-            ops.back().kind = 5;
-            // Stack size and loop length are needed to write the op: stored beside it.
-            ops.push_back({6, static_cast<uint32_t>(border.stack.size() - 1),
-                           border.stack[index].length});
-            const uint32_t nw = border.op_merge(n, index);
-            out_he[g] = to_w;
-            track(nw, to_v);
-        }
-    }
-    if (ec.triangle_sequence.size() != fc || ec.vertex_sequence.size() != vc) throw EncoderGaveUp{};
-
-    // Vertex order, copies and triangle order.
-    const uint32_t v_total = static_cast<uint32_t>(mesh.positions.size());
-    std::vector<uint32_t> representative(v_total, kNone);
-    std::vector<std::pair<uint32_t, uint32_t>> copies;
-    code.vertex_order.clear();
-    for (uint32_t i = 0; i < vc; ++i) {
-        const uint32_t orig = cm.original[ec.vertex_sequence[i]];
-        if (orig == kNone) continue;
-        if (representative[orig] != kNone) {
-            copies.emplace_back(i, representative[orig]);
-            continue;
-        }
-        representative[orig] = i;
-        code.vertex_order.push_back(orig);
-    }
-    const uint32_t used = static_cast<uint32_t>(code.vertex_order.size());
-    for (uint32_t v = 0; v < v_total; ++v)
-        if (representative[v] == kNone) code.vertex_order.push_back(v);
-    code.triangle_order.clear();
-    code.triangle_rotation.clear();
-    for (size_t i = 0; i < ec.triangle_sequence.size(); ++i) {
-        if (ec.triangle_sequence[i] >= cm.real_triangles) continue;
-        code.triangle_order.push_back(ec.triangle_sequence[i]);
-        code.triangle_rotation.push_back(ec.rotation[i]);
-    }
-
-    // Pass 2: replay the ops with the decoder's contexts.
-    ArithmeticEncoder enc;
-    enc.encode_bits_raw(kModeCutBorder, 2);
-    put_count(enc, v_total);
-    put_count(enc, v_total - used);
-    put_count(enc, cm.dummies);
-    put_count(enc, static_cast<uint32_t>(copies.size()));
-    put_count(enc, ec.components);
-    put_count(enc, ec.merges);
-    OpModels models;
-    CutBorder replay;  // only for the contexts (degrees) and loop lengths: mirrors the decoder
-    std::vector<uint32_t> degree(vc, 0);
-    size_t next_vertex = 0, next_triangle = 0;
-    auto count_triangle = [&]() {
-        const Triangle& tri = cm.triangles[ec.triangle_sequence[next_triangle++]];
-        for (uint32_t v : tri) ++degree[decoder_index[v]];
-    };
-    for (size_t i = 0; i < ops.size(); ++i) {
-        const Op& op = ops[i];
-        if (op.kind == 0) {
-            next_vertex += 3;
-            count_triangle();
-            replay.start(uint32_t(next_vertex - 3), uint32_t(next_vertex - 2), uint32_t(next_vertex - 1));
-            continue;
-        }
-        const CutBorder::Loop loop = replay.top();
-        const uint32_t g = loop.gate, nv = replay.next[g];
-        const uint32_t u = replay.vert[g], v = replay.vert[nv];
-        enc.encode(op.kind == 1, models.new_model(degree[u], degree[v]));
-        if (op.kind == 1) {
-            if (cm.dummies > 0) enc.encode(op.a != 0, models.is_dummy);
-            count_triangle();
-            replay.op_new(uint32_t(next_vertex++));
-            continue;
-        }
-        count_triangle();
-        enc.encode(op.kind == 2, models.is_right[OpModels::degree_class(degree[u] - 1)]);
-        if (op.kind == 2) {
-            if (loop.length == 3) replay.op_end();
-            else replay.op_right();
-            if (kChooseGate) replay.choose_gate(degree);
-            continue;
-        }
-        if (loop.length > 3) enc.encode(op.kind == 3, models.is_left[OpModels::degree_class(degree[v] - 1)]);
-        if (op.kind == 3) {
-            replay.op_left();
-            continue;
-        }
-        const bool can_split = loop.length >= 5, can_merge = replay.stack.size() >= 2;
-        if (can_split && can_merge) enc.encode(op.kind == 4, models.is_split);
-        if (op.kind == 4) {
-            if (!can_split) throw EncoderGaveUp{};
-            put_split(enc, models, op.a, op.b);
-            replay.op_split(replay.walk(nv, op.a + 2), op.a + 2);
-        } else {
-            const Op& extra = ops[++i];
-            if (!can_merge) throw EncoderGaveUp{};
-            put_index(enc, op.a, extra.a);
-            put_index(enc, op.b, extra.b);
-            const size_t index = replay.stack.size() - 2 - op.a;
-            replay.op_merge(replay.walk(replay.stack[index].gate, op.b), index);
-        }
-    }
-    for (const auto& [copy, to] : copies) {
-        put_index(enc, copy, vc);
-        put_index(enc, to, vc);
-    }
-    return enc.finish();
 }
 
 std::vector<uint8_t> encode_explicit(const TriangleMesh& mesh, BaseMeshCode& code) {
     const uint32_t v = static_cast<uint32_t>(mesh.positions.size());
     ArithmeticEncoder enc;
-    enc.encode_bits_raw(kModeExplicit, 2);
+    enc.encode_bits_raw(uint32_t(BaseConnectivityMode::explicit_triangles), 2);
     put_count(enc, v);
     put_count(enc, static_cast<uint32_t>(mesh.triangles.size()));
     for (const Triangle& t : mesh.triangles)
@@ -790,14 +52,13 @@ std::vector<uint8_t> encode_explicit(const TriangleMesh& mesh, BaseMeshCode& cod
 }
 
 // The decoder's output mapped back must be the original mesh, triangle for triangle.
-bool reproduces(const TriangleMesh& mesh, const BaseMeshCode& code,
-                const DecodedBaseConnectivity& dec) {
+bool reproduces(const TriangleMesh& mesh, const BaseMeshCode& code, const DecodedBaseMesh& dec) {
     if (dec.vertex_count != mesh.positions.size() || code.vertex_order.size() != dec.vertex_count ||
-        dec.triangles.size() != mesh.triangles.size() ||
-        code.triangle_order.size() != dec.triangles.size() ||
-        dec.stencils.size() != dec.vertex_count)
+        dec.triangles.size() != mesh.triangles.size() || code.triangle_order.size() != dec.triangles.size() ||
+        code.triangle_rotation.size() != dec.triangles.size() || dec.stencils.size() != dec.vertex_count)
         return false;
     for (size_t t = 0; t < dec.triangles.size(); ++t) {
+        if (code.triangle_order[t] >= mesh.triangles.size() || code.triangle_rotation[t] > 2) return false;
         const Triangle& o = mesh.triangles[code.triangle_order[t]];
         const int r = code.triangle_rotation[t];
         for (int k = 0; k < 3; ++k)
@@ -806,47 +67,85 @@ bool reproduces(const TriangleMesh& mesh, const BaseMeshCode& code,
     return true;
 }
 
-}  // namespace
-
-BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh) {
-    const size_t v = mesh.positions.size();
-    if (v > kMaxCount || mesh.triangles.size() > kMaxCount / 4)
-        throw Error("base mesh coder: mesh too large");
-    for (size_t t = 0; t < mesh.triangles.size(); ++t)
-        for (uint32_t x : mesh.triangles[t])
-            if (x >= v)
-                throw Error("base mesh coder: triangle " + std::to_string(t) +
-                            " has a vertex index out of range");
-    BaseMeshCode code;
+// Codes with one mode and checks the stream by decoding it with the mesh's own positions;
+// false when the mode does not fit the mesh.
+bool try_mode(const TriangleMesh& mesh, BaseConnectivityMode mode, BaseMeshCode& code) {
     try {
-        code.bytes = encode_cut_border(mesh, code);
-        const DecodedBaseConnectivity dec =
-            decode_base_connectivity(code.bytes.data(), code.bytes.size(), uint32_t(v));
-        if (reproduces(mesh, code, dec)) {
-            code.stencils = dec.stencils;
-            return code;
+        code = BaseMeshCode{};
+        code.mode = mode;
+        switch (mode) {
+            case BaseConnectivityMode::angle: code.bytes = encode_angle_mode(mesh, code); break;
+            case BaseConnectivityMode::cut_border: code.bytes = encode_cut_border(mesh, code); break;
+            case BaseConnectivityMode::explicit_triangles: code.bytes = encode_explicit(mesh, code); break;
         }
+        if (code.vertex_order.size() != mesh.positions.size()) return false;
+        const DecodedBaseMesh dec = decode_base_mesh(
+            code.bytes.data(), code.bytes.size(), static_cast<uint32_t>(mesh.positions.size()),
+            [&](uint32_t vertex, const BaseStencil&, const std::vector<Vec3>&) {
+                return mesh.positions[code.vertex_order[vertex]];
+            });
+        if (!reproduces(mesh, code, dec)) return false;
+        code.stencils = dec.stencils;
+        return true;
     } catch (const EncoderGaveUp&) {
     } catch (const Error&) {
     }
-    code = BaseMeshCode{};
-    code.bytes = encode_explicit(mesh, code);
-    code.stencils =
-        decode_base_connectivity(code.bytes.data(), code.bytes.size(), uint32_t(v)).stencils;
+    return false;
+}
+
+void check_encodable(const TriangleMesh& mesh) {
+    const size_t v = mesh.positions.size();
+    if (v > kMaxBaseCount || mesh.triangles.size() > kMaxBaseCount / 4) throw Error("base mesh coder: mesh too large");
+    for (size_t t = 0; t < mesh.triangles.size(); ++t)
+        for (uint32_t x : mesh.triangles[t])
+            if (x >= v)
+                throw Error("base mesh coder: triangle " + std::to_string(t) + " has a vertex index out of range");
+}
+
+}  // namespace
+
+BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh) {
+    check_encodable(mesh);
+    BaseMeshCode code;
+    if (try_mode(mesh, BaseConnectivityMode::angle, code)) return code;
+    if (!try_mode(mesh, BaseConnectivityMode::explicit_triangles, code))
+        throw Error("base mesh coder: the explicit mode failed its self-check");
     return code;
 }
 
-DecodedBaseConnectivity decode_base_connectivity(const uint8_t* data, size_t size,
-                                                 uint32_t max_vertices) {
-    if (data == nullptr && size != 0) fail("no data", ErrorCode::invalid_input);
+BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh, BaseConnectivityMode mode) {
+    check_encodable(mesh);
+    BaseMeshCode code;
+    if (!try_mode(mesh, mode, code))
+        throw Error("base mesh coder: the mesh does not fit mode " + std::to_string(int(mode)));
+    return code;
+}
+
+BaseConnectivityMode base_connectivity_mode(const uint8_t* data, size_t size) {
+    if (data == nullptr && size != 0) fail_base_stream("no data");
+    ArithmeticDecoder dec(data, size);
+    return BaseConnectivityMode(dec.decode_bits_raw(2));
+}
+
+DecodedBaseMesh decode_base_mesh(const uint8_t* data, size_t size, uint32_t vertex_count,
+                                 const BasePositionSource& positions) {
+    if (data == nullptr && size != 0) fail_base_stream("no data", ErrorCode::invalid_input);
     return with_allocation_errors_as_limits("base mesh stream", [&] {
         ArithmeticDecoder dec(data, size);
         const uint32_t mode = dec.decode_bits_raw(2);
-        DecodedBaseConnectivity out;
-        if (mode == kModeCutBorder) out = decode_cut_border(dec, size, max_vertices);
-        else if (mode == kModeExplicit) out = decode_explicit(dec, size, max_vertices);
-        else fail("unknown mode " + std::to_string(mode));
-        if (dec.overran()) fail("truncated", ErrorCode::truncated);
+        DecodedBaseMesh out;
+        if (mode == uint32_t(BaseConnectivityMode::angle)) {
+            out = decode_angle_mode(dec, size, vertex_count, positions);
+        } else {
+            if (mode == uint32_t(BaseConnectivityMode::cut_border)) out = decode_cut_border(dec, size, vertex_count);
+            else if (mode == uint32_t(BaseConnectivityMode::explicit_triangles)) out = decode_explicit(dec, size, vertex_count);
+            else fail_base_stream("unknown mode " + std::to_string(mode));
+            if (dec.overran()) fail_base_stream("truncated", ErrorCode::truncated);
+            // These modes know their connectivity without positions: they are read afterwards.
+            out.positions.reserve(std::min<uint32_t>(out.vertex_count, 1u << 20));
+            for (uint32_t i = 0; i < out.vertex_count; ++i) out.positions.push_back(positions(i, out.stencils[i], out.positions));
+        }
+        if (dec.overran()) fail_base_stream("truncated", ErrorCode::truncated);
         return out;
     });
 }

@@ -1,44 +1,19 @@
-// Single-rate connectivity coder of the base mesh (paper II-B: "the base mesh is coded by a
-// single-rate coder"). The refinement hierarchy is coded relative to the base mesh, so the base
-// mesh only needs its triangles; positions are coded separately with the parallelogram stencils
-// this coder reports.
+// Single-rate coder of the base mesh (paper II-B: "the base mesh is coded by a single-rate
+// coder"). The refinement hierarchy is coded relative to the base mesh, which also serves as the
+// whole mesh when a plain irregular mesh is coded without refinement.
 //
-// Scheme: a cut-border machine (Gumhold–Straßer; Edgebreaker-like "C/L/R/E/S" plus "M" merge ops)
-// over a CLOSED, manifold version of the mesh, with every symbol coded by the adaptive binary
-// arithmetic coder of arithmetic_coder.h.
-//  * Non-manifold vertices (several triangle fans touching at one vertex) are split into one
-//    vertex per fan; the decoder merges them back with an explicit copy list.
-//  * Every boundary loop is closed by a dummy vertex and a fan of dummy triangles; dummy vertices
-//    are flagged when created and dropped, with their triangles, by the decoder.
-//  * Each connected component starts with one triangle (three new vertices) and is conquered
-//    from a stack of border loops. The gate is the border edge (u, v) after the focus vertex u;
-//    the triangle beyond it has tip w and is one of
-//      C  w is new                       (gate stays at u: the fan of u is walked)
-//      R  w is the border vertex before u (u is finished; the gate moves to the border vertex
-//         with the most decoded triangles, CutBorder::choose_gate)
-//      L  w is the border vertex after v
-//      E  the loop has three vertices and is closed
-//      S  w is elsewhere on the current loop: split (offset: adaptive side bit and gamma length,
-//         raw mantissa)
-//      M  w is on another loop of the stack: merge (loop index and offset, raw bits; one per
-//         handle, so the number of M ops is the genus)
-//    The C and R/L decisions are coded with contexts from the number of triangles already
-//    decoded around u (and v), which makes them close to a valence code.
-//  * If anything about the mesh defeats the scheme (or the encoder's self-check by decoding
-//    fails), the encoder falls back to an explicit list of triangles (mode 1). It never fails on
-//    a mesh with indices in range.
-//
-// Stream (whole-buffer: the decoder must be given exactly the bytes of `BaseMeshCode::bytes`;
-// the container stores the length). All of it is one arithmetic-coded stream:
-//   2 raw bits mode (0 = cut-border, 1 = explicit, 2-3 reserved: rejected).
-//   Mode 0: counts, each Elias-gamma of (x + 1) in raw bits: vertex count V, isolated vertices I
-//     (appended at the end of the vertex order), dummy vertices D, vertex copies K, components C,
-//     merges M. The closed mesh has Vc = V - I + D + K vertices and Fc = 2 Vc - 4 C + 4 M
-//     triangles. Then per component the start triangle and the ops (C: one adaptive dummy flag
-//     when D > 0), then K pairs (copy, target) of closed vertex indices in raw bits.
-//   Mode 1: V and F (gamma), then 3 F vertex indices of bit_length(V - 1) raw bits.
-// The decoder validates every count and index, bounds every loop by the counts, and throws
-// amc::Error on anything inconsistent or on a truncated stream.
+// The stream (FORMAT.md section 4) has modes:
+//  * 2, angle-guided cut border (base_angle_coder.h): a cut-border conquest over a closed,
+//    manifold version of the mesh whose ops are predicted from the geometry decoded so far — the
+//    angle a triangle closing the gap at the gate's vertices would have there — and whose gate
+//    moves to the border vertex with the smallest such gap. The decoder therefore reads the base
+//    positions (FORMAT.md 3.5) while it decodes the connectivity, vertex by vertex, through a
+//    BasePositionSource. This is what the encoder writes.
+//  * 1, explicit: a list of triangles. The fallback for anything mode 2 can not code.
+//  * 0, cut border with degree contexts (base_cut_border_coder.h): format versions 1 and 2 wrote
+//    it; it still decodes.
+// Whatever the mode, the decoder also reports one parallelogram stencil per vertex; positions
+// are predicted from it (section 3.5) in decoder order.
 #pragma once
 
 #include <amc/mesh.h>
@@ -46,38 +21,60 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace amc {
+
+// Written to the stream (its first two raw bits): values are frozen.
+enum class BaseConnectivityMode : uint8_t { cut_border = 0, explicit_triangles = 1, angle = 2 };
 
 // Parallelogram stencil (a, b, c) of a vertex: predict a + b - c from vertices decoded earlier.
 // (a, -1, -1) means "predict a"; (-1, -1, -1) means no prediction.
 using BaseStencil = std::array<int32_t, 3>;
 
 struct BaseMeshCode {
-    std::vector<uint8_t> bytes;              // whole-buffer stream (see above)
+    std::vector<uint8_t> bytes;              // whole-buffer stream (FORMAT.md section 4)
     std::vector<uint32_t> vertex_order;      // decoder vertex i = original vertex vertex_order[i]
     std::vector<uint32_t> triangle_order;    // decoder triangle t = original triangle_order[t]
     std::vector<uint8_t> triangle_rotation;  // decoder triangle t = (o[r], o[r+1], o[r+2]) of
                                              // original triangle o, r = rotation
     std::vector<BaseStencil> stencils;       // per decoder vertex, as the decoder reports them
+    BaseConnectivityMode mode = BaseConnectivityMode::explicit_triangles;
 };
 
-// Codes the connectivity of `mesh` (positions unused). Throws Error only when a triangle's
-// index is out of range.
+// Codes the connectivity of `mesh`. Its positions must be exactly those the decoder will
+// reconstruct (quantized ones snapped to the grid): mode 2 predicts from them. Throws Error only
+// when a triangle's index is out of range or the mesh is too large for the stream's counts.
 BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh);
 
-struct DecodedBaseConnectivity {
+// The same with one given mode (tests and benchmarks); throws Error when the mesh does not fit
+// it (the explicit mode always fits).
+BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh, BaseConnectivityMode mode);
+
+// The decoder's source of base positions: the position of decoder vertex `vertex`, whose
+// stencil is `stencil`, given the positions of vertices 0 .. vertex-1 in `decoded`. Called once
+// per vertex, in order 0, 1, ...; mode 2 calls it while it decodes the connectivity, the other
+// modes after. It may throw to abort the decode.
+using BasePositionSource =
+    std::function<Vec3(uint32_t vertex, const BaseStencil& stencil, const std::vector<Vec3>& decoded)>;
+
+struct DecodedBaseMesh {
     uint32_t vertex_count = 0;
     std::vector<Triangle> triangles;    // in decoder order, same orientation as the original
     std::vector<BaseStencil> stencils;  // per decoder vertex, entries decoded earlier or -1
+    std::vector<Vec3> positions;        // per decoder vertex, from the source
 };
 
-// Decodes a stream of encode_base_connectivity; refuses more than `max_vertices` vertices.
-// Throws Error on corrupt or truncated input. The stream bounds its triangles, but isolated
-// vertices cost it no bits: the caller bounds them with `max_vertices` (the .amc decoder by the
-// base geometry block, where every vertex costs at least 15 symbols).
-DecodedBaseConnectivity decode_base_connectivity(const uint8_t* data, size_t size,
-                                                 uint32_t max_vertices);
+// The mode of a stream (its first two raw bits), without decoding it.
+BaseConnectivityMode base_connectivity_mode(const uint8_t* data, size_t size);
+
+// Decodes a stream of encode_base_connectivity of a mesh with exactly `vertex_count` vertices.
+// Throws Error on corrupt or truncated input; memory and time stay linear in vertex_count and
+// the stream's size. The stream bounds its triangles, but isolated vertices cost it no bits: the
+// caller bounds them with `vertex_count` (the .amc decoder by the base geometry block, where
+// every vertex costs at least 15 symbols).
+DecodedBaseMesh decode_base_mesh(const uint8_t* data, size_t size, uint32_t vertex_count,
+                                 const BasePositionSource& positions);
 
 }  // namespace amc

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <memory>
 
 namespace amc {
 
@@ -164,6 +165,14 @@ std::vector<Vec3> all_positions(const Hierarchy& h) {
     return points;
 }
 
+// The base mesh with the positions the decoder reconstructs: the base coder predicts from them.
+TriangleMesh base_as_decoded(const Hierarchy& h, const Quantizer* quantizer) {
+    TriangleMesh base = h.base();
+    if (quantizer != nullptr)
+        for (Vec3& p : base.positions) p = dequantize(*quantizer, quantize(*quantizer, p));
+    return base;
+}
+
 // The input over the base mesh in the base coder's order. The base coder may rotate each
 // triangle's vertices. The default diagonal rule does not care, but hierarchies made under a rule
 // of absolute local indices would pay orientation bits: then storing each root's rotation
@@ -213,19 +222,21 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     // Quantized coordinates are reconstructed as doubles on the grid, whatever the input precision.
     const Precision precision = input.single_precision() && !quantized ? Precision::float32 : Precision::float64;
 
+    Quantizer quantizer;
+    if (quantized) {
+        const std::vector<Vec3> points = all_positions(input);
+        quantizer = make_quantizer(points, options.quantize_bits);
+        stats.max_error = max_quantization_error(quantizer, points);
+    }
     // II-B: code the base mesh first and express the forest in the decoder's base order.
-    const BaseMeshCode base_code = encode_base_connectivity(input.base());
+    const BaseMeshCode base_code = encode_base_connectivity(base_as_decoded(input, quantized ? &quantizer : nullptr));
     bool keep_rotations = false;
     std::vector<VertexId> vertex_map;
     Hierarchy h = in_base_code_order(input, base_code, keep_rotations, options.numbering ? &vertex_map : nullptr);
     const bool store_numbering = options.numbering != nullptr && options.store_numbering;
     if (options.numbering != nullptr) stats.numbering = numbering_after_reorder(input, *options.numbering, h, vertex_map);
-    Quantizer quantizer;
     if (quantized) {
         h.set_single_precision(false);
-        const std::vector<Vec3> points = all_positions(h);
-        quantizer = make_quantizer(points, options.quantize_bits);
-        stats.max_error = max_quantization_error(quantizer, points);
         // Closed loop: predictions are made from what the decoder will have.
         for (VertexId v = 0; v < h.positions().size(); ++v) h.set_position(v, dequantize(quantizer, quantize(quantizer, h.position(v))));
     }
@@ -242,7 +253,10 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     meta.quantizer = quantizer;
     meta.options = keep_rotations ? kOptionRootRotations : 0;
 
-    BlockWriter writer(store_numbering ? kNumberingVersion : kBaseVersion,
+    const uint8_t version = base_code.mode == BaseConnectivityMode::angle ? kAngleBaseVersion
+                            : store_numbering                             ? kNumberingVersion
+                                                                          : kBaseVersion;
+    BlockWriter writer(version,
                        uint8_t((precision == Precision::float32 ? kFlagSinglePrecision : 0) | (quantized ? kFlagQuantized : 0)));
     writer.add(BlockType::metadata, write_metadata(meta, quantized));
     stats.header_bytes = writer.size();
@@ -358,36 +372,47 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
                 "metadata block: " + std::to_string(meta.base_vertices) + " base vertices can not be coded in the " +
                     std::to_string(geometry_block.size) + " bytes of the base geometry block");
 
-    const DecodedBaseConnectivity connectivity =
-        decode_base_connectivity(connectivity_block.payload, connectivity_block.size, uint32_t(meta.base_vertices));
-    AMC_REQUIRE(connectivity.vertex_count == meta.base_vertices && connectivity.triangles.size() == meta.base_triangles,
-                corrupt, "base connectivity does not match the metadata");
+    AMC_REQUIRE(meta.base_vertices <= UINT32_MAX, limit_exceeded, "metadata block: too many base vertices");
+    AMC_REQUIRE(base_connectivity_mode(connectivity_block.payload, connectivity_block.size) != BaseConnectivityMode::angle ||
+                    reader.version() >= kAngleBaseVersion,
+                corrupt, "base connectivity block: mode 2 in a version-" + std::to_string(reader.version()) + " file");
 
     TriangleMesh base;
     base.single_precision = precision == Precision::float32;
-    base.triangles = connectivity.triangles;
-    base.positions.reserve(connectivity.vertex_count);
     PositionCoder positions(precision, quantized ? &meta.quantizer : nullptr);
     {
         ArithmeticDecoder decoder(geometry_block.payload, geometry_block.size);
+        std::vector<uint8_t> rotations;
         if (meta.options & kOptionRootRotations) {
-            // Undo the base coder's rotations: decoded (o[r], o[r+1], o[r+2]) back to o.
             RotationModels models;
-            for (Triangle& t : base.triangles) {
-                const uint8_t r = decode_rotation(decoder, models);
-                const Triangle decoded = t;
-                for (int i = 0; i < 3; ++i) t[(i + r) % 3] = decoded[i];
+            for (uint64_t t = 0; t < meta.base_triangles; ++t) {
+                rotations.push_back(decode_rotation(decoder, models));
+                AMC_REQUIRE(!decoder.overran(), corrupt, "base geometry block is truncated or corrupt");
             }
         }
-        // The overrun check a vertex (15 symbols or more) stops a block that ends early at once.
-        for (uint32_t i = 0; i < connectivity.vertex_count && !decoder.overran(); ++i) {
-            const Vec3 p = positions.decode(decoder, 0, predict_parallelogram(base.positions, connectivity.stencils[i]));
-            AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
-                        "base geometry is corrupt (non-finite coordinate)");
-            base.positions.push_back(p);
-        }
+        // The base connectivity decoder reads the base positions as it creates the vertices
+        // (FORMAT.md 3.5); the overrun check a vertex (15 symbols or more) stops a block that ends
+        // early at once.
+        DecodedBaseMesh decoded = decode_base_mesh(
+            connectivity_block.payload, connectivity_block.size, uint32_t(meta.base_vertices),
+            [&](uint32_t, const BaseStencil& stencil, const std::vector<Vec3>& previous) {
+                AMC_REQUIRE(!decoder.overran(), corrupt, "base geometry block is truncated or corrupt");
+                const Vec3 p = positions.decode(decoder, 0, predict_parallelogram(previous, stencil));
+                AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
+                            "base geometry is corrupt (non-finite coordinate)");
+                return p;
+            });
+        AMC_REQUIRE(decoded.vertex_count == meta.base_vertices && decoded.triangles.size() == meta.base_triangles, corrupt,
+                    "base connectivity does not match the metadata");
         AMC_REQUIRE(!decoder.overran() && !positions.saw_invalid_symbol(), corrupt,
                     "base geometry block is truncated or corrupt");
+        base.triangles = std::move(decoded.triangles);
+        base.positions = std::move(decoded.positions);
+        // Undo the base coder's rotations: decoded (o[r], o[r+1], o[r+2]) back to o.
+        for (size_t t = 0; t < rotations.size(); ++t) {
+            const Triangle d = base.triangles[t];
+            for (int i = 0; i < 3; ++i) base.triangles[t][(i + rotations[t]) % 3] = d[i];
+        }
     }
     try {
         validate_triangle_mesh(base, "decoded base mesh");
@@ -454,9 +479,12 @@ Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options,
     return with_allocation_errors_as_limits("decode", [&] { return decode_file(data, size, options, numbering); });
 }
 
-Hierarchy in_decoder_order(const Hierarchy& h) {
+Hierarchy in_decoder_order(const Hierarchy& h, const EncodeOptions& options) {
+    std::unique_ptr<Quantizer> quantizer;
+    if (options.quantize_bits != 0)
+        quantizer = std::make_unique<Quantizer>(make_quantizer(all_positions(h), options.quantize_bits));
     bool keep_rotations = false;
-    return in_base_code_order(h, encode_base_connectivity(h.base()), keep_rotations);
+    return in_base_code_order(h, encode_base_connectivity(base_as_decoded(h, quantizer.get())), keep_rotations);
 }
 
 DecodeResult try_decode(const uint8_t* data, size_t size, const DecodeOptions& options) noexcept {

@@ -1,0 +1,372 @@
+// Encoder of mode 2, the angle-guided cut-border coder (FORMAT.md 4.10-4.16; base_angle_coder.h).
+// It runs the decoder's border and models (base_angle_border.h) on the closed mesh, reads each op
+// off the mesh and codes it at once; once per context set, keeping the shortest stream.
+#include "coding/base_angle_border.h"
+#include "coding/base_angle_coder.h"
+#include "coding/base_mesh_closing.h"
+
+#include <algorithm>
+
+namespace amc {
+
+using angle_mode::Border;
+using angle_mode::Models;
+
+namespace {
+
+class Encoder {
+public:
+    Encoder(const TriangleMesh& mesh, const ClosedMesh& cm, int set, uint32_t gate_radius)
+        : mesh_(mesh), cm_(cm), set_(set), models_(set) {
+        border_.gate_radius = gate_radius;
+    }
+
+    std::vector<uint8_t> run(BaseMeshCode& code) {
+        count_vertices();
+        count_components_and_merges();
+        enc_.encode_bits_raw(uint32_t(BaseConnectivityMode::angle), 2);
+        enc_.encode_bits_raw(static_cast<uint32_t>(set_), 2);
+        enc_.encode_bits_raw(border_.gate_radius, 3);
+        const uint32_t isolated = static_cast<uint32_t>(mesh_.positions.size()) - used_;
+        const bool plain = isolated == 0 && cm_.dummies == 0 && copies_ == 0 && components_ == 1 && merges_ == 0;
+        enc_.encode_bits_raw(plain ? 1 : 0, 1);
+        if (!plain) {
+            put_count(enc_, isolated);
+            put_count(enc_, cm_.dummies);
+            put_count(enc_, copies_);
+            put_count(enc_, components_);
+            put_count(enc_, merges_);
+        }
+        traverse();
+        if (triangles_.size() != cm_.triangles.size() || cm_of_.size() != cm_.original.size() ||
+            merges_seen_ != merges_)
+            throw EncoderGaveUp{};
+        fill_orders(code);
+        return enc_.finish();
+    }
+
+private:
+    const TriangleMesh& mesh_;
+    const ClosedMesh& cm_;
+    const int set_;
+    uint32_t used_ = 0, copies_ = 0, components_ = 0, merges_ = 0, merges_seen_ = 0;
+    ArithmeticEncoder enc_;
+    Models models_;
+    Border border_;
+    // Closed vertices: decoder numbering (creation order) and the closed mesh's.
+    std::vector<uint32_t> decoder_id_, cm_of_;
+    std::vector<uint32_t> final_of_original_;  // final index of an input vertex's first closed vertex
+    uint32_t finals_ = 0;
+    // Nodes: the unprocessed halfedge across the node's border edge, and whether it is on the
+    // border still; per decoder vertex, a list of its nodes (first node, then node to node).
+    std::vector<uint32_t> out_he_, node_link_, first_node_;
+    std::vector<uint8_t> alive_, processed_;
+    std::vector<uint32_t> triangles_;  // closed triangles in decoder order
+    std::vector<uint8_t> rotations_;
+    uint64_t walked_ = 0;
+
+    void count_vertices() {
+        std::vector<uint8_t> seen(mesh_.positions.size(), 0);
+        for (uint32_t o : cm_.original) {
+            if (o == kNoVertex) continue;
+            if (seen[o]) ++copies_;
+            else ++used_;
+            seen[o] = 1;
+        }
+        if (uint64_t{copies_} > 2 * uint64_t{used_} || uint64_t{cm_.dummies} > (uint64_t{used_} + copies_) / 3 + 1)
+            throw EncoderGaveUp{};
+    }
+
+    // Components of the closed mesh, and the merges Euler's formula asks for (FORMAT.md 4.3).
+    void count_components_and_merges() {
+        const size_t fc = cm_.triangles.size();
+        std::vector<uint8_t> reached(fc, 0);
+        std::vector<uint32_t> queue;
+        for (uint32_t s = 0; s < cm_.real_triangles; ++s) {
+            if (reached[s]) continue;
+            ++components_;
+            reached[s] = 1;
+            queue.assign(1, s);
+            while (!queue.empty()) {
+                const uint32_t t = queue.back();
+                queue.pop_back();
+                for (int k = 0; k < 3; ++k) {
+                    const uint32_t n = cm_.twin[3 * t + k] / 3;
+                    if (!reached[n]) {
+                        reached[n] = 1;
+                        queue.push_back(n);
+                    }
+                }
+            }
+        }
+        const int64_t four_m = int64_t(fc) - 2 * int64_t(cm_.original.size()) + 4 * int64_t(components_);
+        if (four_m < 0 || four_m % 4 != 0 || four_m / 4 > kMaxBaseCount) throw EncoderGaveUp{};
+        merges_ = static_cast<uint32_t>(four_m / 4);
+    }
+
+    void put_bit(BitModel& model, bool bit) { enc_.encode(bit, model); }
+    void charge_walk(uint64_t nodes) {
+        walked_ += nodes;
+        if (walked_ > angle_mode::walk_budget(cm_.triangles.size())) throw EncoderGaveUp{};
+    }
+
+    // Creates the decoder vertex of closed vertex x, with its dummy and copy symbols.
+    uint32_t create_vertex(uint32_t x, bool may_be_dummy) {
+        if (x >= decoder_id_.size() || decoder_id_[x] != kNoVertex) throw EncoderGaveUp{};
+        const uint32_t original = cm_.original[x];
+        const bool dummy = original == kNoVertex;
+        if (dummy && !may_be_dummy) throw EncoderGaveUp{};
+        if (may_be_dummy && cm_.dummies > 0) put_bit(models_.dummy, dummy);
+        if (!dummy) {
+            const uint32_t target = final_of_original_[original];
+            if (copies_ > 0 && finals_ > 0) {
+                put_bit(models_.copy, target != kNoVertex);
+                if (target != kNoVertex) put_index(enc_, target, finals_);
+            } else if (target != kNoVertex) {
+                throw EncoderGaveUp{};
+            }
+            if (target == kNoVertex) final_of_original_[original] = finals_++;
+        }
+        const uint32_t id = border_.add_vertex(dummy ? Vec3{} : mesh_.positions[original], !dummy);
+        decoder_id_[x] = id;
+        cm_of_.push_back(x);
+        first_node_.push_back(kNoVertex);
+        return id;
+    }
+
+    void visit_triangle(uint32_t he) {
+        const uint32_t t = he / 3;
+        if (processed_[t]) throw EncoderGaveUp{};
+        processed_[t] = 1;
+        triangles_.push_back(t);
+        rotations_.push_back(static_cast<uint8_t>(he % 3));
+        const Triangle& tri = cm_.triangles[t];
+        border_.count_triangle(decoder_id_[tri[0]], decoder_id_[tri[1]], decoder_id_[tri[2]]);
+    }
+
+    void track(uint32_t node, uint32_t he) {
+        if (out_he_.size() <= node) {
+            out_he_.resize(node + 1, kNoVertex);
+            alive_.resize(node + 1, 0);
+            node_link_.resize(node + 1, kNoVertex);
+        }
+        out_he_[node] = he;
+        alive_[node] = 1;
+        const uint32_t v = border_.vert(node);
+        node_link_[node] = first_node_[v];
+        first_node_[v] = node;
+    }
+
+    // Is closed triangle t in the unprocessed sector of node n (between its out and in edges)?
+    bool sector_holds(uint32_t n, uint32_t t) const {
+        uint32_t he = out_he_[n];
+        const uint32_t stop = out_he_[border_.prev(n)] / 3;
+        for (size_t steps = 0; steps <= cm_.triangles.size(); ++steps) {
+            if (he / 3 == t) return true;
+            if (he / 3 == stop) return false;
+            he = cm_.twin[ClosedMesh::prev_halfedge(he)];
+        }
+        throw EncoderGaveUp{};
+    }
+    // The border node of decoder vertex w whose sector holds triangle t.
+    uint32_t tip_node(uint32_t w, uint32_t t) const {
+        uint32_t only = kNoVertex, alive = 0;
+        for (uint32_t n = first_node_[w]; n != kNoVertex; n = node_link_[n]) {
+            if (!alive_[n]) continue;
+            ++alive;
+            only = n;
+        }
+        if (alive == 1) return only;
+        for (uint32_t n = first_node_[w]; n != kNoVertex; n = node_link_[n])
+            if (alive_[n] && sector_holds(n, t)) return n;
+        throw EncoderGaveUp{};
+    }
+
+    void traverse() {
+        decoder_id_.assign(cm_.original.size(), kNoVertex);
+        final_of_original_.assign(mesh_.positions.size(), kNoVertex);
+        processed_.assign(cm_.triangles.size(), 0);
+        border_.reserve(cm_.original.size(), cm_.original.size() + cm_.original.size() / 8 + 16);
+        for (uint32_t s = 0; s < cm_.real_triangles; ++s) {
+            if (processed_[s]) continue;
+            ++components_;
+            const Triangle& st = cm_.triangles[s];
+            const uint32_t a = create_vertex(st[0], false);
+            const uint32_t b = create_vertex(st[1], false);
+            const uint32_t c = create_vertex(st[2], false);
+            visit_triangle(3 * s);
+            border_.start(a, b, c);
+            const uint32_t na = border_.top().gate, nc = border_.next(na), nb = border_.next(nc);
+            track(na, cm_.twin[3 * s + 2]);
+            track(nc, cm_.twin[3 * s + 1]);
+            track(nb, cm_.twin[3 * s + 0]);
+            while (!border_.stack.empty()) {
+                if (triangles_.size() >= cm_.triangles.size()) throw EncoderGaveUp{};
+                encode_op();
+            }
+        }
+    }
+
+    void encode_op() {
+        Border& b = border_;
+        const Border::Loop loop = b.top();
+        const uint32_t g = loop.gate, nv = b.next(g), p = b.prev(g);
+        const uint32_t u = b.vert(g), v = b.vert(nv);
+        const uint32_t he = out_he_[g];
+        const uint32_t t = he / 3;
+        if (processed_[t] || cm_.corner_vertex(he) != cm_of_[u] ||
+            cm_.corner_vertex(ClosedMesh::next_halfedge(he)) != cm_of_[v])
+            throw EncoderGaveUp{};
+        const uint32_t w_closed = cm_.corner_vertex(ClosedMesh::prev_halfedge(he));
+        const uint32_t to_v = cm_.twin[ClosedMesh::next_halfedge(he)];  // beyond the new edge w -> v
+        const uint32_t to_w = cm_.twin[ClosedMesh::prev_halfedge(he)];  // beyond the new edge u -> w
+        const bool is_new = decoder_id_[w_closed] == kNoVertex;
+        const uint32_t n = is_new ? kNoVertex : tip_node(decoder_id_[w_closed], t);
+
+        const bool right = n == p;
+        // A closed vertex has at least three triangles (else the decoder's rule fails: give up).
+        if (b.degree(u) >= 2) put_bit(models_.close_u[Models::closing_context(set_, b.corner(g), b.degree(u))], right);
+        else if (right) throw EncoderGaveUp{};
+        if (right) {
+            visit_triangle(he);
+            if (loop.length == 3) {
+                alive_[g] = alive_[nv] = alive_[p] = 0;
+                b.op_end();
+            } else {
+                alive_[g] = 0;
+                out_he_[p] = to_v;
+                b.op_right();
+            }
+            return;
+        }
+        if (loop.length > 3) {
+            const bool left = n == b.next(nv);
+            if (b.degree(v) >= 2) put_bit(models_.close_v[Models::closing_context(set_, b.corner(nv), b.degree(v))], left);
+            else if (left) throw EncoderGaveUp{};
+            if (left) {
+                visit_triangle(he);
+                alive_[nv] = 0;
+                out_he_[g] = to_w;
+                b.op_left();
+                return;
+            }
+        }
+        const bool can_split = loop.length >= 5, can_merge = b.stack.size() >= 2;
+        if (can_split || can_merge) put_bit(models_.new_vertex[set_ == 0 ? Models::new_vertex_context(b.corner(g)) : 0], is_new);
+        else if (!is_new) throw EncoderGaveUp{};
+        if (is_new) {
+            const uint32_t w = create_vertex(w_closed, true);
+            visit_triangle(he);
+            const uint32_t nw = b.op_new(w);
+            out_he_[g] = to_w;
+            track(nw, to_v);
+            return;
+        }
+        // S if the tip is on the current loop, M otherwise.
+        uint32_t k = 0;
+        for (uint32_t x = nv; k < loop.length && x != n; x = b.next(x)) ++k;
+        charge_walk(k);
+        const bool split = k < loop.length;
+        if (split && (k < 2 || k + 3 > loop.length)) throw EncoderGaveUp{};
+        if ((split && !can_split) || (!split && !can_merge)) throw EncoderGaveUp{};
+        if (can_split && can_merge) put_bit(models_.split, split);
+        uint32_t nw;
+        if (split) {
+            encode_split_tip(g, nv, n, k, loop.length);
+            visit_triangle(he);
+            nw = b.op_split(n, k);
+        } else {
+            size_t index = b.stack.size();
+            uint32_t offset = 0;
+            for (size_t j = 0; j + 1 < b.stack.size() && index == b.stack.size(); ++j) {
+                uint32_t y = b.stack[j].gate;
+                for (uint32_t s = 0; s < b.stack[j].length; ++s, y = b.next(y)) {
+                    if (y == n) {
+                        index = j;
+                        offset = s;
+                        break;
+                    }
+                }
+            }
+            if (index == b.stack.size()) throw EncoderGaveUp{};
+            ++merges_seen_;
+            const uint32_t length = b.stack[index].length;
+            put_index(enc_, static_cast<uint32_t>(b.stack.size() - 2 - index), static_cast<uint32_t>(b.stack.size() - 1));
+            put_index(enc_, offset, length);
+            charge_walk(std::min(offset, length - offset));
+            visit_triangle(he);
+            nw = b.op_merge(n, index);
+        }
+        out_he_[g] = to_w;
+        track(nw, to_v);
+    }
+
+    // The decoder's rule (base_angle_decoder.cpp, split_tip): the nearest-tip bit when there is a
+    // prediction, else the offset.
+    void encode_split_tip(uint32_t g, uint32_t nv, uint32_t n, uint32_t k, uint32_t length) {
+        const Border& b = border_;
+        const uint32_t o = b.opp(g);
+        if (b.located(b.vert(g)) && b.located(b.vert(nv)) && b.located(o)) {
+            const Vec3 predicted = (b.position(b.vert(g)) + b.position(b.vert(nv))) - b.position(o);
+            charge_walk(length - 4);
+            uint32_t best = angle_mode::kNoNode;
+            double best_distance = 0;
+            uint32_t x = b.next(b.next(nv));
+            for (uint32_t i = 2; i + 3 <= length; ++i, x = b.next(x)) {
+                if (!b.located(b.vert(x))) continue;
+                const Vec3 d = b.position(b.vert(x)) - predicted;
+                const double distance = dot(d, d);
+                if (best == angle_mode::kNoNode || distance < best_distance) {
+                    best = x;
+                    best_distance = distance;
+                }
+            }
+            if (best != angle_mode::kNoNode) {
+                put_bit(models_.nearest, best == n);
+                if (best == n) return;
+            }
+        }
+        put_split_offset(enc_, models_.split_offset, k - 2, length - 4);
+        charge_walk(std::min(k + 1, length - k - 1));
+    }
+
+    void fill_orders(BaseMeshCode& code) const {
+        code.vertex_order.assign(finals_, kNoVertex);
+        for (uint32_t o = 0; o < mesh_.positions.size(); ++o)
+            if (final_of_original_[o] != kNoVertex) code.vertex_order[final_of_original_[o]] = o;
+        for (uint32_t o = 0; o < mesh_.positions.size(); ++o)
+            if (final_of_original_[o] == kNoVertex) code.vertex_order.push_back(o);
+        code.triangle_order.clear();
+        code.triangle_rotation.clear();
+        for (size_t i = 0; i < triangles_.size(); ++i) {
+            if (triangles_[i] >= cm_.real_triangles) continue;
+            code.triangle_order.push_back(triangles_[i]);
+            code.triangle_rotation.push_back(rotations_[i]);
+        }
+    }
+};
+
+// Gates are looked for within 5 nodes of a closed vertex: measured best for size
+// (docs/BASE_CODER.md); the decoder accepts 0-7.
+constexpr uint32_t kGateRadius = 5;
+
+}  // namespace
+
+std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code) {
+    const ClosedMesh cm = make_closed(mesh);
+    std::vector<uint8_t> best;
+    for (int set = 0; set < angle_mode::kContextSets; ++set) {
+        BaseMeshCode candidate;
+        Encoder e(mesh, cm, set, kGateRadius);
+        std::vector<uint8_t> bytes = e.run(candidate);
+        if (best.empty() || bytes.size() < best.size()) {
+            best = std::move(bytes);
+            code.vertex_order = std::move(candidate.vertex_order);
+            code.triangle_order = std::move(candidate.triangle_order);
+            code.triangle_rotation = std::move(candidate.triangle_rotation);
+        }
+    }
+    return best;
+}
+
+}  // namespace amc

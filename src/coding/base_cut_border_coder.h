@@ -1,0 +1,27 @@
+// Mode 0 of the base connectivity stream: the cut-border coder of format versions 1 and 2 (a
+// Gumhold–Straßer cut-border machine with Edgebreaker-like C/R/L/E/S ops and M merges, ops
+// coded with contexts from the number of triangles decoded around the gate's vertices; FORMAT.md
+// 4.3-4.7). The encoder no longer chooses it; it is kept so that earlier files decode, and its
+// encoder so that tests can make such streams.
+#pragma once
+
+#include "coding/arithmetic_coder.h"
+#include "coding/base_mesh_coder.h"
+
+#include <amc/mesh.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace amc {
+
+// The whole stream, mode bits included; fills the code's orders. Throws EncoderGaveUp when the
+// mesh does not fit the mode.
+std::vector<uint8_t> encode_cut_border(const TriangleMesh& mesh, BaseMeshCode& code);
+
+// Decodes the rest of a mode-0 stream (after the two mode bits) of `size` bytes: connectivity
+// and stencils, no positions. Throws Error.
+DecodedBaseMesh decode_cut_border(ArithmeticDecoder& dec, size_t size, uint32_t vertex_count);
+
+}  // namespace amc
