@@ -7,6 +7,7 @@
 // codes that with its own symbols and contexts.
 //
 //   base_coder_designs mesh.obj mesh.off ...      (a markdown table, bits per vertex)
+//   base_coder_designs --starts N mesh.obj ...    (mode 2's design from N start triangles)
 //
 // Gate rules: `spiral` (the vertex before the closed one, Touma–Gotsman's order), `max-degree`
 // (the loop's vertex with the most decoded triangles: mode 0), `min-free` (the loop's vertex with
@@ -91,16 +92,22 @@ public:
     uint32_t valence(uint32_t x) const { return valence_[x]; }
     bool dummy(uint32_t x) const { return !located_[x]; }
 
-    void run(const std::function<void(const Event&)>& sink) {
-        for (uint32_t s = 0; s < cm_.real_triangles; ++s) {
+    // Components start at their first triangle in input order, the first one at triangle `first`
+    // with its corners rotated by `rotation` (the start-triangle experiment, --starts).
+    void run(const std::function<void(const Event&)>& sink, uint32_t first = 0, uint32_t rotation = 0) {
+        for (uint32_t i = 0; i < cm_.real_triangles; ++i) {
+            const uint32_t s = (first + i) % cm_.real_triangles;
             if (done_[s]) continue;
-            const amc::Triangle& t = cm_.triangles[s];
+            const uint32_t r = i == 0 ? rotation % 3 : 0;
+            const amc::Triangle& st = cm_.triangles[s];
+            const amc::Triangle t = {st[r], st[(r + 1) % 3], st[(r + 2) % 3]};
+            const auto twin = [&](uint32_t k) { return cm_.twin[3 * s + (k + r) % 3]; };
             for (uint32_t x : t) seen_[x] = 1;
             add(s);
             const uint32_t id = loop_ids_++;
-            const uint32_t a = node(t[0], cm_.twin[3 * s + 2], valence_[t[0]] - 1, id, t[1]);
-            const uint32_t c = node(t[2], cm_.twin[3 * s + 1], valence_[t[2]] - 1, id, t[0]);
-            const uint32_t b = node(t[1], cm_.twin[3 * s + 0], valence_[t[1]] - 1, id, t[2]);
+            const uint32_t a = node(t[0], twin(2), valence_[t[0]] - 1, id, t[1]);
+            const uint32_t c = node(t[2], twin(1), valence_[t[2]] - 1, id, t[0]);
+            const uint32_t b = node(t[1], twin(0), valence_[t[1]] - 1, id, t[2]);
             link(a, c);
             link(c, b);
             link(b, a);
@@ -458,11 +465,44 @@ void angle_design(Cost& c, const Event& e, const Conquest& q, bool holes, AngleC
 
 }  // namespace
 
+// --starts N: mode 2's design (angle, angle-r5) started at N triangles spread over the mesh, each
+// in its three rotations: how much the choice of the start triangle is worth.
+int run_start_experiment(int starts, int argc, char** argv, int first_file) {
+    std::printf("| mesh | V | input order's start | best of %d starts | median | worst |\n|---|--:|--:|--:|--:|--:|\n", 3 * starts);
+    for (int i = first_file; i < argc; ++i) {
+        const amc::TriangleMesh mesh = amc::read_mesh(argv[i]);
+        ClosedMesh cm;
+        try {
+            cm = amc::make_closed(mesh);
+        } catch (const amc::EncoderGaveUp&) {
+            std::fprintf(stderr, "%s: not closable\n", argv[i]);
+            continue;
+        }
+        const double v = double(mesh.positions.size());
+        std::vector<double> bits;
+        for (int k = 0; k < starts; ++k)
+            for (uint32_t rotation = 0; rotation < 3; ++rotation) {
+                const uint32_t first = uint32_t(uint64_t(k) * cm.real_triangles / uint64_t(starts));
+                Conquest q(cm, mesh.positions, Gate::angle_r5);
+                Cost cost;
+                q.run([&](const Event& e) { angle_design(cost, e, q, cm.dummies > 0, AngleContext::angle_class); }, first, rotation);
+                bits.push_back(cost.bits / v);
+            }
+        const double original = bits[0];
+        std::sort(bits.begin(), bits.end());
+        std::printf("| %s | %zu | %.3f | %.3f | %.3f | %.3f |\n", std::filesystem::path(argv[i]).stem().c_str(),
+                    mesh.positions.size(), original, bits.front(), bits[bits.size() / 2], bits.back());
+        std::fflush(stdout);
+    }
+    return 0;
+}
+
 int main(int argc, char** argv) {
     if (argc < 2) {
-        std::fprintf(stderr, "usage: base_coder_designs mesh.obj ...\n");
+        std::fprintf(stderr, "usage: base_coder_designs [--starts N] mesh.obj ...\n");
         return 2;
     }
+    if (std::string(argv[1]) == "--starts" && argc > 3) return run_start_experiment(std::max(1, std::atoi(argv[2])), argc, argv, 3);
     using namespace std::placeholders;
     const std::vector<Design> designs = {
         {"valence", Gate::min_free, [](Cost& c, const Event& e, const Conquest& q, bool h) { valence_design(c, e, q, h, false); }},
