@@ -136,7 +136,7 @@ int main(int argc, char** argv) {
                                   "A .pvd, or frame files in order: VTU (with point and cell data), OBJ, OFF, PLY, .amh, .amc")
         ->required();
     series_encode_cmd->add_option("-o,--output", series_encode.output, "Series file (default: the first input with .amcs; - for stdout)");
-    series_encode_cmd->add_option("--base", series_encode.base, "Base mesh of mesh frames (default: the first frame's mesh)");
+    series_encode_cmd->add_option("--base", series_encode.base, "Base mesh of mesh frames (default: the coarsest base found in the first frame)");
     series_encode_cmd->add_option("--keyframe", series_encode.keyframe_interval,
                                   "A keyframe every K frames, for random access (default 0: frame 0 only)")
         ->check(CLI::Range(0u, 1u << 30));

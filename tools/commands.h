@@ -71,7 +71,7 @@ void run_refine(const RefineCommand& command, const GlobalOptions& global);
 struct SeriesEncodeCommand {
     std::vector<std::string> inputs;  // one .pvd, or frame files (VTU with point and cell data, meshes, .amh, .amc)
     std::string output;
-    std::string base;                 // base mesh of mesh frames; empty: the first frame's
+    std::string base;                 // base mesh of mesh frames; empty: detected in the first frame
     uint32_t keyframe_interval = 0;
     double error_bound = 0;           // absolute, for every float field; 0: bit-exact
     std::vector<std::string> field_bounds;  // NAME=BOUND

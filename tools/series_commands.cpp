@@ -5,6 +5,7 @@
 #include "commands.h"
 #include "progress.h"
 
+#include <amc/import.h>
 #include <amc/series.h>
 
 #include <algorithm>
@@ -80,16 +81,10 @@ SeriesFrame read_frame(const FrameSource& source, std::optional<TriangleMesh>& b
         case FileKind::compressed: frame.hierarchy = decode_input(input, {}); break;
         case FileKind::series: throw Error(input.name + ": a series file can not be a frame of another series");
         case FileKind::mesh: {
-            // Until base detection lands, a leaf mesh without --base is its own base (as for encode).
-            if (input.mesh_format == MeshFormat::vtu) {
-                const VtuMesh vtu = read_vtu(source.path);
-                if (!base) base = vtu.mesh;
-                return frame_from_vtu(*base, vtu, source.time, input.name);
-            }
-            const TriangleMesh mesh = mesh_of(input);
-            if (!base) base = mesh;
-            frame.hierarchy = frame_from_vtu(*base, VtuMesh{mesh, {}, {}}, source.time, input.name).hierarchy;
-            return frame;
+            // Without --base: the coarsest base found in the first frame (import_mesh).
+            const VtuMesh vtu = input.mesh_format == MeshFormat::vtu ? read_vtu(source.path) : VtuMesh{mesh_of(input), {}, {}};
+            if (!base) base = import_mesh(vtu.mesh, input.name).hierarchy.base();
+            return frame_from_vtu(*base, vtu, source.time, input.name);
         }
     }
     if (!base) base = frame.hierarchy.base();
@@ -156,9 +151,10 @@ void run_series_encode(const SeriesEncodeCommand& command, const GlobalOptions& 
         try {
             frame = read_frame(sources[k], base);
         } catch (const Error& e) {
-            if (k == 0 || !command.base.empty() || !base_given) throw;
+            const bool off_base = std::string(e.what()).find("wrong base") != std::string::npos;
+            if (k == 0 || !command.base.empty() || !base_given || !off_base) throw;
             throw Error(e.code(), std::string(e.what()) + " (frame " + std::to_string(k) +
-                                  "; without --base the first frame's mesh is the base of the series)");
+                                  "; without --base the base is the coarsest one found in the first frame)");
         }
         read_seconds += seconds_since(start);
         start = std::chrono::steady_clock::now();
