@@ -33,8 +33,17 @@ const char* block_type_name(uint8_t type) {
     return "unknown";
 }
 
-BlockWriter::BlockWriter(uint8_t version, uint8_t flags) {
-    out_.assign(kFileMagic, kFileMagic + 4);
+namespace {
+uint8_t amc_last_block_type(uint8_t version) {
+    return version >= kNumberingVersion ? uint8_t(BlockType::numbering) : uint8_t(BlockType::level);
+}
+}  // namespace
+
+const FileFraming kAmcFraming = {{kFileMagic[0], kFileMagic[1], kFileMagic[2], kFileMagic[3]}, ".amc", kOldestReadableVersion, kNewestVersion,
+                                 kFlagSinglePrecision | kFlagQuantized, amc_last_block_type, block_type_name};
+
+BlockWriter::BlockWriter(const FileFraming& framing, uint8_t version, uint8_t flags) : framing_(&framing) {
+    out_.assign(framing.magic, framing.magic + 4);
     out_.push_back(version);
     out_.push_back(flags);
     out_.push_back(0);
@@ -42,9 +51,9 @@ BlockWriter::BlockWriter(uint8_t version, uint8_t flags) {
     put_u32(out_, XXH32(out_.data(), 8, 0));
 }
 
-void BlockWriter::add(BlockType type, const std::vector<uint8_t>& payload) {
+void BlockWriter::add(uint8_t type, const std::vector<uint8_t>& payload) {
     AMC_REQUIRE(payload.size() <= UINT32_MAX, limit_exceeded,
-                std::string(block_type_name(uint8_t(type))) + " block is larger than 4 GiB");
+                std::string(framing_->block_name(type)) + " block is larger than 4 GiB");
     const size_t start = out_.size();
     out_.push_back(uint8_t(type));
     put_u32(out_, uint32_t(payload.size()));
@@ -54,23 +63,25 @@ void BlockWriter::add(BlockType type, const std::vector<uint8_t>& payload) {
 }
 
 std::vector<uint8_t> BlockWriter::finish() {
-    add(BlockType::end, {});
+    add(uint8_t(BlockType::end), {});
     return std::move(out_);
 }
 
-BlockReader::BlockReader(const uint8_t* data, size_t size) : data_(data), size_(size) {
-    AMC_REQUIRE(size >= 4 && std::memcmp(data, kFileMagic, 4) == 0, bad_magic, "not an .amc file (bad magic)");
+BlockReader::BlockReader(const uint8_t* data, size_t size, const FileFraming& framing)
+    : framing_(&framing), data_(data), size_(size) {
+    const std::string ext = framing.extension;
+    AMC_REQUIRE(size >= 4 && std::memcmp(data, framing.magic, 4) == 0, bad_magic, "not an " + ext + " file (bad magic)");
     AMC_REQUIRE(size >= 5, truncated, "file is truncated (header)");
     version_ = data[4];
     // The version comes first: a newer file may have a header this build does not know.
-    AMC_REQUIRE(version_ <= kNewestVersion, unsupported_version,
-                "unsupported .amc version " + std::to_string(version_) + " (newer than this build, which reads versions " +
-                    std::to_string(kOldestReadableVersion) + " to " + std::to_string(kNewestVersion) + ")");
-    AMC_REQUIRE(version_ >= kOldestReadableVersion, corrupt, "unknown .amc version " + std::to_string(version_));
+    AMC_REQUIRE(version_ <= framing.newest_version, unsupported_version,
+                "unsupported " + ext + " version " + std::to_string(version_) + " (newer than this build, which reads versions " +
+                    std::to_string(framing.oldest_version) + " to " + std::to_string(framing.newest_version) + ")");
+    AMC_REQUIRE(version_ >= framing.oldest_version, corrupt, "unknown " + ext + " version " + std::to_string(version_));
     AMC_REQUIRE(size >= kFileHeaderSize, truncated, "file is truncated (header)");
     AMC_REQUIRE(XXH32(data, 8, 0) == get_u32(data + 8), checksum, "checksum mismatch in the file header");
     flags_ = data[5];
-    AMC_REQUIRE(!(flags_ & ~(kFlagSinglePrecision | kFlagQuantized)), corrupt, "unknown flags in the file header");
+    AMC_REQUIRE(!(flags_ & ~framing.known_flags), corrupt, "unknown flags in the file header");
     AMC_REQUIRE(data[6] == 0 && data[7] == 0, corrupt, "reserved header bytes are not zero");
 }
 
@@ -81,14 +92,13 @@ bool BlockReader::next(Block& block) {
     const uint8_t type = data_[pos_];
     const uint32_t length = get_u32(data_ + pos_ + 1);
     AMC_REQUIRE(length <= size_ - pos_ - kBlockOverhead, truncated,
-                "file is truncated (" + std::string(block_type_name(type)) + " block at byte " +
+                "file is truncated (" + std::string(framing_->block_name(type)) + " block at byte " +
                     std::to_string(pos_) + " announces " + std::to_string(length) + " bytes)");
     const uint32_t stored = get_u32(data_ + pos_ + 5 + length);
     AMC_REQUIRE(XXH32(data_ + pos_, 5 + size_t(length), 0) == stored, checksum,
-                "checksum mismatch in the " + std::string(block_type_name(type)) + " block at byte " +
+                "checksum mismatch in the " + std::string(framing_->block_name(type)) + " block at byte " +
                     std::to_string(pos_));
-    const uint8_t newest_type = version_ >= kNumberingVersion ? uint8_t(BlockType::numbering) : uint8_t(BlockType::level);
-    AMC_REQUIRE(type <= newest_type, corrupt, "unknown block type " + std::to_string(type));
+    AMC_REQUIRE(type <= framing_->last_block_type(version_), corrupt, "unknown block type " + std::to_string(type));
     block = {BlockType(type), data_ + pos_ + 5, length, pos_};
     pos_ += kBlockOverhead + length;
     if (block.type == BlockType::end) {

@@ -27,18 +27,33 @@ enum class BlockType : uint8_t {
 };
 const char* block_type_name(uint8_t type);
 
+// The framing of one kind of file: the .amc file (kAmcFraming) and the octree forest file (.amq,
+// src/octree/octree_file.h) share the header and block layout and differ in these.
+struct FileFraming {
+    char magic[4];
+    const char* extension;  // ".amc": messages say "not an .amc file"
+    uint8_t oldest_version, newest_version;
+    uint8_t known_flags;
+    uint8_t (*last_block_type)(uint8_t version);  // the highest block type a version may hold
+    const char* (*block_name)(uint8_t type);
+};
+extern const FileFraming kAmcFraming;
+
 // File header flags.
 constexpr uint8_t kFlagSinglePrecision = 1;
 constexpr uint8_t kFlagQuantized = 2;
 
 class BlockWriter {
 public:
-    BlockWriter(uint8_t version, uint8_t flags);
-    void add(BlockType type, const std::vector<uint8_t>& payload);
+    BlockWriter(uint8_t version, uint8_t flags) : BlockWriter(kAmcFraming, version, flags) {}
+    BlockWriter(const FileFraming& framing, uint8_t version, uint8_t flags);
+    void add(BlockType type, const std::vector<uint8_t>& payload) { add(uint8_t(type), payload); }
+    void add(uint8_t type, const std::vector<uint8_t>& payload);
     std::vector<uint8_t> finish();  // appends the END block
     size_t size() const { return out_.size(); }
 
 private:
+    const FileFraming* framing_;
     std::vector<uint8_t> out_;
 };
 
@@ -53,7 +68,9 @@ struct Block {
 class BlockReader {
 public:
     // Throws Error on a bad header, and on a version outside kOldestReadableVersion .. kNewestVersion.
-    BlockReader(const uint8_t* data, size_t size);
+    BlockReader(const uint8_t* data, size_t size) : BlockReader(data, size, kAmcFraming) {}
+    // The same for another kind of file.
+    BlockReader(const uint8_t* data, size_t size, const FileFraming& framing);
     uint8_t flags() const { return flags_; }
     uint8_t version() const { return version_; }
     // The next block; throws Error on truncation, a bad checksum, an unknown type, or bytes after
@@ -63,6 +80,7 @@ public:
     size_t remaining() const { return size_ - pos_; }
 
 private:
+    const FileFraming* framing_;
     const uint8_t* data_;
     size_t size_;
     size_t pos_ = kFileHeaderSize;
