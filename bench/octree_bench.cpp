@@ -1,0 +1,121 @@
+// Octree forests (issue 28): size per leaf of the .amq file against one raw bit per octant, a
+// p4est_save-like file (12 bytes per leaf in 2D, 16 in 3D: p4est's layout, written here) and that
+// file through xz -9 (liblzma preset 9), and encode / decode speeds in leaves per second. Prints
+// a Markdown table (docs/OCTREE.md). Usage: octree_bench [--runs N] [--quick]
+#include <amc/octree.h>
+
+#include <lzma.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+using namespace amc;
+
+namespace {
+
+struct Case {
+    std::string name;
+    OctreeForest forest;
+};
+
+// p4est_save's per-leaf layout: per tree its leaf count (8 bytes), per leaf x, y, (z), level as
+// int32 (p4est_qcoord_t), native byte order; p4est's header and connectivity left out.
+std::vector<uint8_t> p4est_layout(const OctreeForest& f) {
+    std::vector<uint8_t> out;
+    auto put = [&out](const void* p, size_t n) { out.insert(out.end(), (const uint8_t*)p, (const uint8_t*)p + n); };
+    for (uint32_t t = 0; t < f.tree_count(); ++t) {
+        const uint64_t count = f.tree_offsets[t + 1] - f.tree_offsets[t];
+        put(&count, 8);
+        for (uint64_t i = f.tree_offsets[t]; i < f.tree_offsets[t + 1]; ++i) {
+            const Octant& o = f.leaves[i];
+            const int32_t level = o.level;
+            put(&o.x, 4);
+            put(&o.y, 4);
+            if (f.dim() == 3) put(&o.z, 4);
+            put(&level, 4);
+        }
+    }
+    return out;
+}
+
+size_t xz9_size(const std::vector<uint8_t>& data) {
+    std::vector<uint8_t> out(lzma_stream_buffer_bound(data.size()));
+    size_t pos = 0;
+    if (lzma_easy_buffer_encode(9, LZMA_CHECK_CRC64, nullptr, data.data(), data.size(), out.data(), &pos, out.size()) != LZMA_OK)
+        return 0;
+    return pos;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    int runs = 5;
+    bool quick = false;
+    for (int i = 1; i < argc; ++i) {
+        if (!std::strcmp(argv[i], "--runs") && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
+        else if (!std::strcmp(argv[i], "--quick")) quick = true;
+        else {
+            std::fprintf(stderr, "usage: octree_bench [--runs N] [--quick]\n");
+            return 2;
+        }
+    }
+    const int q = quick ? 3 : 0;  // levels fewer in --quick mode
+    const TreeConnectivity square = brick_connectivity(2, 1, 1), bricks2 = brick_connectivity(2, 4, 2);
+    const TreeConnectivity cube = brick_connectivity(3, 1, 1, 1), bricks3 = brick_connectivity(3, 2, 2, 1);
+    std::vector<Case> cases;
+    auto add = [&](std::string name, OctreeForest f, OctreeBalance b) {
+        cases.push_back({name + (b == OctreeBalance::face ? ", face" : ", corner"), balance_octree_forest(f, b)});
+    };
+    for (OctreeBalance b : {OctreeBalance::face, OctreeBalance::corner}) {
+        add("2D circle L" + std::to_string(13 - q), sphere_octree_forest(square, {0.5, 0.5, 0}, 0.35, 13 - q), b);
+        add("2D front 4x2 L" + std::to_string(11 - q), front_octree_forest(bricks2, 2.1, 11 - q), b);
+        add("3D sphere L" + std::to_string(8 - q / 2), sphere_octree_forest(cube, {0.5, 0.5, 0.5}, 0.35, 8 - q / 2), b);
+        add("3D front 2x2x1 L" + std::to_string(7 - q / 2), front_octree_forest(bricks3, 1.1, 7 - q / 2), b);
+    }
+    add("2D random L" + std::to_string(11 - q), random_octree_forest(square, 7, 0.45, 4, 11 - q), OctreeBalance::face);
+    add("3D random L" + std::to_string(7 - q / 2), random_octree_forest(cube, 7, 0.3, 2, 7 - q / 2), OctreeBalance::face);
+
+    std::printf("| forest | leaves | octants | .amq bytes | bits/leaf | bits/octant | 1 bit/octant (bytes) | x smaller | "
+                "p4est layout (bytes) | x smaller | + xz -9 (bytes) | x smaller | encode Mleaves/s | decode Mleaves/s |\n");
+    std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|\n");
+    for (const Case& c : cases) {
+        OctreeEncodeStats stats;
+        std::vector<uint8_t> bytes = encode_octree_forest(c.forest, {}, &stats);
+        std::vector<double> enc, dec;
+        for (int r = 0; r < runs; ++r) {
+            auto t0 = std::chrono::steady_clock::now();
+            bytes = encode_octree_forest(c.forest);
+            enc.push_back(seconds_since(t0));
+            t0 = std::chrono::steady_clock::now();
+            const OctreeForest back = decode_octree_forest(bytes.data(), bytes.size());
+            dec.push_back(seconds_since(t0));
+            if (!(back == c.forest)) {
+                std::fprintf(stderr, "%s: round trip failed\n", c.name.c_str());
+                return 1;
+            }
+        }
+        std::sort(enc.begin(), enc.end());
+        std::sort(dec.begin(), dec.end());
+        const double leaves = double(stats.leaves);
+        const double raw = std::ceil(double(stats.nodes) / 8);
+        const std::vector<uint8_t> p4 = p4est_layout(c.forest);
+        const size_t xz = xz9_size(p4);
+        std::printf("| %s | %llu | %llu | %zu | %.3f | %.3f | %.0f | %.1f | %zu | %.0f | %zu | %.1f | %.2f-%.2f | %.2f-%.2f |\n",
+                    c.name.c_str(), (unsigned long long)stats.leaves, (unsigned long long)stats.nodes, bytes.size(),
+                    8.0 * bytes.size() / leaves, 8.0 * bytes.size() / double(stats.nodes), raw, raw / bytes.size(), p4.size(),
+                    double(p4.size()) / bytes.size(), xz, double(xz) / bytes.size(), leaves / enc.back() / 1e6,
+                    leaves / enc.front() / 1e6, leaves / dec.back() / 1e6, leaves / dec.front() / 1e6);
+        std::fflush(stdout);
+    }
+    std::printf("\n%d runs per forest; speeds: slowest-fastest run, one core.\n", runs);
+    return 0;
+}

@@ -1,0 +1,152 @@
+// Quadtree and octree forests as p4est, deal.II and t8code use them (issue 28): a coarse mesh of
+// quadrilaterals (dim 2) or hexahedra (dim 3), "trees" glued face to face with an orientation,
+// and one quadtree or octree per tree. Leaves are stored as p4est stores them: per tree, in
+// Morton order, each an Octant with p4est's integer coordinates. docs/OCTREE.md describes the
+// model, the coder and its figures; docs/FORMAT.md section 8 the `.amq` file.
+//
+// Conventions (p4est's, fixed here and nowhere else):
+//   - corners of a tree in z-order: corner c sits at (c & 1, (c >> 1) & 1, (c >> 2) & 1);
+//   - face f lies on axis f / 2, on its lower (f even) or upper (f odd) side;
+//   - the corners of a face are the tree corners on it, in increasing order ("face corners");
+//   - children of an octant in z-order: child c is offset by c's bits as a corner;
+//   - an octant of level l has coordinates that are multiples of 2^(root_log2 - l), in
+//     [0, 2^root_log2); root_log2 is 30 in 2D and 19 in 3D (P4EST_MAXLEVEL, P8EST_MAXLEVEL),
+//     and levels go up to 29 and 18 (P4EST_QMAXLEVEL, P8EST_QMAXLEVEL).
+//   - tree_to_face = neighbour face + 2 * dim * orientation; the orientation is the face corner of
+//     the higher-numbered face of the two that touches face corner 0 of the lower one
+//     (p8est_connectivity.h); a boundary face is glued to itself (same tree, same face).
+// Balance: a forest is 2:1 balanced by faces when leaves that share (part of) a face differ by at
+// most one level; equivalently every refined octant's face neighbours of its own level exist (the
+// octree form of the paper's "1-regularity", which the coder uses to cull symbols).
+#pragma once
+
+#include <amc/mesh.h>
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace amc {
+
+constexpr int octree_root_log2(int dim) { return dim == 2 ? 30 : 19; }
+constexpr int octree_max_level(int dim) { return dim == 2 ? 29 : 18; }
+constexpr int octree_children(int dim) { return 1 << dim; }
+constexpr int octree_faces(int dim) { return 2 * dim; }
+constexpr int octree_orientations(int dim) { return dim == 2 ? 2 : 4; }
+
+// The coarse mesh and how its trees touch (p4est_connectivity_t's fields of the same names).
+struct TreeConnectivity {
+    int dim = 2;
+    std::vector<Vec3> vertices;            // may be empty (then the geometry is the unit tree)
+    std::vector<uint32_t> tree_to_vertex;  // 2^dim per tree, z-order; empty iff vertices is
+    std::vector<uint32_t> tree_to_tree;    // 2 * dim per tree
+    std::vector<uint8_t> tree_to_face;     // 2 * dim per tree: face + 2 * dim * orientation
+
+    uint32_t tree_count() const { return uint32_t(tree_to_tree.size() / (2 * dim)); }
+};
+
+// nx * ny (* nz) unit trees in lexicographic order (x fastest), vertices at integer positions,
+// optionally periodic in each direction. (p4est's own brick orders its trees along a Morton curve.)
+TreeConnectivity brick_connectivity(int dim, int nx, int ny, int nz = 1, bool periodic_x = false,
+                                    bool periodic_y = false, bool periodic_z = false);
+// Glues the trees whose faces share the same vertices (p4est_connectivity_complete's rule); the
+// other faces are boundary. Throws Error on a face shared by more than two trees, repeated
+// vertices in a tree or (3D) trees glued against their orientation (left-handed; in 2D trees may
+// be of either hand, as on p4est's Moebius strip).
+TreeConnectivity connectivity_from_vertices(int dim, std::vector<Vec3> vertices,
+                                            std::vector<uint32_t> tree_to_vertex);
+// Sizes, ranges, symmetry (the neighbour's neighbour is back where we started, with the inverse
+// orientation), in range. Throws Error naming `what`.
+void validate_connectivity(const TreeConnectivity& conn, const std::string& what);
+
+// A leaf (p4est_quadrant_t's fields): coordinates in [0, 2^root_log2), multiples of the
+// octant's length 2^(root_log2 - level); z is 0 in 2D.
+struct Octant {
+    int32_t x = 0, y = 0, z = 0;
+    int8_t level = 0;
+};
+inline bool operator==(const Octant& a, const Octant& b) {
+    return a.x == b.x && a.y == b.y && a.z == b.z && a.level == b.level;
+}
+
+struct OctreeForest {
+    TreeConnectivity connectivity;
+    std::vector<uint64_t> tree_offsets;  // tree_count + 1: leaves of tree t are [offsets[t], offsets[t+1])
+    std::vector<Octant> leaves;          // per tree, in Morton order
+
+    uint32_t tree_count() const { return connectivity.tree_count(); }
+    int dim() const { return connectivity.dim; }
+};
+bool operator==(const OctreeForest& a, const OctreeForest& b);
+
+// Every tree's leaves tile it exactly, in Morton order, at levels 0 .. octree_max_level, and
+// the connectivity is valid. Throws Error naming `what` and the first bad leaf.
+void validate_octree_forest(const OctreeForest& forest, const std::string& what);
+
+// Which leaves must be within one level of each other: those sharing a face, or also an edge
+// (3D), or also a corner (p4est's P4EST_CONNECT_FACE / P8EST_CONNECT_EDGE / _CORNER). Across the
+// coarse mesh, edge and corner neighbours are found by crossing faces one after the other, so
+// trees that touch only at an edge or a corner of the coarse mesh do not constrain each other.
+enum class OctreeBalance : uint8_t { face = 1, edge = 2, corner = 3 };
+
+// The smallest refinement of `forest` that is balanced (p4est_balance).
+OctreeForest balance_octree_forest(const OctreeForest& forest, OctreeBalance balance);
+// "" when balanced, else the first violation in words (tree, octant, neighbour).
+std::string octree_balance_violation(const OctreeForest& forest, OctreeBalance balance);
+
+// ---- forests for tests and benchmarks --------------------------------------------------------
+OctreeForest uniform_octree_forest(const TreeConnectivity& conn, int level);
+// Refines leaves (recursively, children too) while refine(tree, octant) says so, up to max_level.
+OctreeForest refine_octree_forest(const OctreeForest& forest,
+                                  const std::function<bool(uint32_t tree, const Octant&)>& refine,
+                                  int max_level);
+// The point of a tree at reference coordinates u, v, w in [0, 1]: multilinear in its corner
+// vertices (the unit cube at the origin when the connectivity has no vertices).
+Vec3 tree_point(const TreeConnectivity& conn, uint32_t tree, double u, double v, double w);
+// Refined where the octant's box meets the sphere |p - center| = radius (the circle in 2D), up
+// to max_level: the classic test of p4est's examples. Not balanced.
+OctreeForest sphere_octree_forest(const TreeConnectivity& conn, Vec3 center, double radius, int max_level);
+// A moving front: the curve / surface x + 0.3 sin(4 y) (+ 0.2 cos(3 z)) = t, refined up to
+// max_level in a band of about two leaves around it, and graded away from it. Not balanced.
+OctreeForest front_octree_forest(const TreeConnectivity& conn, double t, int max_level);
+// Random refinement: uniform down to min_level, then leaves split with probability `p` per level
+// until max_level. Not balanced.
+OctreeForest random_octree_forest(const TreeConnectivity& conn, uint64_t seed, double p, int min_level, int max_level);
+
+// Levels and counts.
+struct OctreeForestCounts {
+    uint64_t leaves = 0, nodes = 0;  // nodes: every octant of every tree, leaves included
+    int depth = 0;                   // finest leaf level
+};
+OctreeForestCounts count_octree_forest(const OctreeForest& forest);
+
+// ---- the coder (docs/OCTREE.md, docs/FORMAT.md section 8) ------------------------------------
+struct OctreeEncodeOptions {
+    bool cull_by_balance = true;   // skip octants balance forbids to refine; refuses unbalanced forests
+    bool uniform_levels = true;    // levels where every octant is refined cost nothing
+    bool truncate = true;          // trailing zeros are dropped (a count is stored)
+    bool context_groups = true;    // contexts from the face neighbours' states (else one model)
+    bool improved_traversal = true;  // priority traversal (else Morton order)
+};
+
+struct OctreeEncodeStats {
+    uint64_t nodes = 0, leaves = 0;
+    uint64_t uniform = 0, culled = 0, truncated = 0, coded = 0;  // nodes by fate
+    uint64_t connectivity_bytes = 0, level_bytes = 0, file_bytes = 0;
+};
+
+// The .amq file. Throws Error on an invalid forest (validate_octree_forest) and, with
+// cull_by_balance, on a forest not balanced by faces.
+std::vector<uint8_t> encode_octree_forest(const OctreeForest& forest, const OctreeEncodeOptions& options = {},
+                                          OctreeEncodeStats* stats = nullptr);
+
+struct OctreeDecodeOptions {
+    int max_level = -1;              // >= 0: progressive, only levels 0 .. max_level
+    uint64_t max_nodes = uint64_t{1} << 26;  // refuse files announcing more octants (about 50 bytes each)
+};
+// Throws Error (truncated, checksum, corrupt, limit_exceeded, ...) on anything but a file
+// encode_octree_forest writes.
+OctreeForest decode_octree_forest(const uint8_t* data, size_t size, const OctreeDecodeOptions& options = {});
+
+}  // namespace amc

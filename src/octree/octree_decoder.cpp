@@ -1,0 +1,75 @@
+// .amq file -> octree forest (docs/FORMAT.md section 8.5): the mirror of octree_encoder.cpp, with
+// every count checked before it is used.
+#include "coding/arithmetic_coder.h"
+#include "common/check.h"
+#include "octree/octree_file.h"
+#include "octree/octree_traversal.h"
+
+namespace amc {
+
+namespace {
+
+Block next_block(BlockReader& reader, OctreeBlock expected) {
+    Block block{};
+    AMC_REQUIRE(reader.next(block), truncated, "file ends before its end block");
+    AMC_REQUIRE(uint8_t(block.type) == uint8_t(expected), corrupt,
+                "block at byte " + std::to_string(block.offset) + ": expected a " +
+                    kOctreeFraming.block_name(uint8_t(expected)) + " block, found a " + kOctreeFraming.block_name(uint8_t(block.type)) +
+                    " block");
+    return block;
+}
+
+}  // namespace
+
+OctreeForest decode_octree_forest(const uint8_t* data, size_t size, const OctreeDecodeOptions& options) {
+    return with_allocation_errors_as_limits("decode_octree_forest", [&]() {
+        BlockReader reader(data, size, kOctreeFraming);
+        Block block = next_block(reader, OctreeBlock::metadata);
+        const OctreeMetadata meta = read_octree_metadata(block.payload, block.size, options.max_nodes);
+        block = next_block(reader, OctreeBlock::connectivity);
+        const TreeConnectivity conn = read_octree_connectivity(block.payload, block.size, meta.dim, meta.trees);
+
+        OctreeLevels levels(conn);
+        std::vector<BitModel> models(octree_model_count(meta.dim));
+        OctreeTraversal traversal;
+        OctreeLevelFates fates;
+        uint64_t read = 0;
+        const bool truncating = meta.switches & kOctreeTruncate;
+        for (int l = 0; l < int(meta.levels); ++l) {
+            block = next_block(reader, OctreeBlock::level);
+            if (options.max_level >= 0 && l >= options.max_level) return levels.leaves(conn);  // progressive: levels 0 .. l
+            ArithmeticDecoder decoder(block.payload, block.size);
+            decide_octree_level(l > 0 ? &levels.level(l - 1) : nullptr, levels.level(l), l, meta.dim, meta.switches, meta.uniform_levels, traversal,
+                                [&](uint32_t, int model) {
+                                    if (truncating && read == meta.count) return false;
+                                    ++read;
+                                    return decoder.decode(models[model]);
+                                },
+                                fates);
+            AMC_REQUIRE(!decoder.overran(), truncated, "level block " + std::to_string(l) + ": the symbols run past its end");
+            std::vector<uint8_t>& refined = traversal.state;
+            uint64_t refined_count = 0;
+            for (uint8_t& s : refined) {
+                s = s == kDecidedRefined;
+                refined_count += s;
+            }
+            if (l + 1 == int(meta.levels)) {
+                AMC_REQUIRE(refined_count == 0, corrupt, "the last level block refines " + std::to_string(refined_count) + " octants");
+                break;
+            }
+            AMC_REQUIRE(refined_count > 0, corrupt, "level block " + std::to_string(l) + " refines no octant, but more levels follow");
+            AMC_REQUIRE(levels.octant_count() + (refined_count << meta.dim) <= meta.octants, corrupt,
+                        "level block " + std::to_string(l) + ": more octants than the metadata announces");
+            levels.add_children(refined, meta.octants);
+        }
+        block = next_block(reader, OctreeBlock::end);
+        AMC_REQUIRE(!truncating || read == meta.count, corrupt,
+                    "the level blocks hold " + std::to_string(read) + " symbols, the metadata announces " + std::to_string(meta.count));
+        AMC_REQUIRE(levels.octant_count() == meta.octants, corrupt,
+                    "the forest has " + std::to_string(levels.octant_count()) + " octants, the metadata announces " +
+                        std::to_string(meta.octants));
+        return levels.leaves(conn);
+    });
+}
+
+}  // namespace amc
