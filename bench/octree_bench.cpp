@@ -1,8 +1,17 @@
-// Octree forests (issue 28): size per leaf of the .amq file against one raw bit per octant, a
-// p4est_save-like file (12 bytes per leaf in 2D, 16 in 3D: p4est's layout, written here) and that
-// file through xz -9 (liblzma preset 9), and encode / decode speeds in leaves per second. Prints
-// a Markdown table (docs/OCTREE.md). Usage: octree_bench [--runs N] [--quick]
+// Octree forests (issue 28): size per leaf of the .amq file against one raw bit per octant, the
+// file p4est_save writes (built with AMC_WITH_P4EST; else p4est's per-leaf layout, 12 bytes per
+// leaf in 2D and 16 in 3D, written here) and that file through xz -9 (liblzma preset 9); encode
+// and decode speeds in leaves per second, and p4est_save_ext / p4est_load_ext's with p4est.
+// Prints a Markdown table (docs/OCTREE.md). Usage: octree_bench [--runs N] [--quick]
 #include <amc/octree.h>
+
+#ifdef AMC_HAVE_P4EST
+#include "octree/p4est_forest.h"
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#endif
 
 #include <lzma.h>
 
@@ -84,9 +93,16 @@ int main(int argc, char** argv) {
     add("2D random L" + std::to_string(11 - q), random_octree_forest(square, 7, 0.45, 4, 11 - q), OctreeBalance::face);
     add("3D random L" + std::to_string(7 - q / 2), random_octree_forest(cube, 7, 0.3, 2, 7 - q / 2), OctreeBalance::face);
 
+#ifdef AMC_HAVE_P4EST
+    const char* p4est_column = "p4est_save file";
+#else
+    const char* p4est_column = "p4est layout";
+#endif
     std::printf("| forest | leaves | octants | .amq bytes | bits/leaf | bits/octant | 1 bit/octant (bytes) | x smaller | "
-                "p4est layout (bytes) | x smaller | + xz -9 (bytes) | x smaller | encode Mleaves/s | decode Mleaves/s |\n");
-    std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|\n");
+                "%s (bytes) | x smaller | + xz -9 (bytes) | x smaller | encode Mleaves/s | decode Mleaves/s | "
+                "p4est save Mleaves/s | p4est load Mleaves/s |\n",
+                p4est_column);
+    std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|---|---|\n");
     for (const Case& c : cases) {
         OctreeEncodeStats stats;
         std::vector<uint8_t> bytes = encode_octree_forest(c.forest, {}, &stats);
@@ -107,13 +123,37 @@ int main(int argc, char** argv) {
         std::sort(dec.begin(), dec.end());
         const double leaves = double(stats.leaves);
         const double raw = std::ceil(double(stats.nodes) / 8);
-        const std::vector<uint8_t> p4 = p4est_layout(c.forest);
+        std::vector<uint8_t> p4 = p4est_layout(c.forest);
+        std::string p4est_speeds = "- | -";
+#ifdef AMC_HAVE_P4EST
+        {
+            const std::string path = (std::filesystem::temp_directory_path() / "octree_bench.p4est").string();
+            std::vector<double> save, load;
+            for (int r = 0; r < runs; ++r) {
+                double s = 0, l = 0;
+                if (c.forest.dim() == 2) time_p4est_save_load_2d(c.forest, path, &s, &l);
+                else time_p4est_save_load_3d(c.forest, path, &s, &l);
+                save.push_back(s);
+                load.push_back(l);
+            }
+            std::sort(save.begin(), save.end());
+            std::sort(load.begin(), load.end());
+            std::ifstream in(path, std::ios::binary);
+            p4.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+            std::filesystem::remove(path);
+            char buf[96];
+            std::snprintf(buf, sizeof buf, "%.2f-%.2f | %.2f-%.2f", double(stats.leaves) / save.back() / 1e6,
+                          double(stats.leaves) / save.front() / 1e6, double(stats.leaves) / load.back() / 1e6,
+                          double(stats.leaves) / load.front() / 1e6);
+            p4est_speeds = buf;
+        }
+#endif
         const size_t xz = xz9_size(p4);
-        std::printf("| %s | %llu | %llu | %zu | %.3f | %.3f | %.0f | %.1f | %zu | %.0f | %zu | %.1f | %.2f-%.2f | %.2f-%.2f |\n",
+        std::printf("| %s | %llu | %llu | %zu | %.3f | %.3f | %.0f | %.1f | %zu | %.0f | %zu | %.1f | %.2f-%.2f | %.2f-%.2f | %s |\n",
                     c.name.c_str(), (unsigned long long)stats.leaves, (unsigned long long)stats.nodes, bytes.size(),
                     8.0 * bytes.size() / leaves, 8.0 * bytes.size() / double(stats.nodes), raw, raw / bytes.size(), p4.size(),
                     double(p4.size()) / bytes.size(), xz, double(xz) / bytes.size(), leaves / enc.back() / 1e6,
-                    leaves / enc.front() / 1e6, leaves / dec.back() / 1e6, leaves / dec.front() / 1e6);
+                    leaves / enc.front() / 1e6, leaves / dec.back() / 1e6, leaves / dec.front() / 1e6, p4est_speeds.c_str());
         std::fflush(stdout);
     }
     std::printf("\n%d runs per forest; speeds: slowest-fastest run, one core.\n", runs);

@@ -4,9 +4,12 @@ set -euo pipefail
 packages=(g++ cmake make pkg-config libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
           libtinyobjloader-dev libmeshoptimizer-dev libxxhash-dev zlib1g-dev
           pybind11-dev python3-dev python3-numpy python3-pytest python3-meshio python3-vtk9)
-if [[ "${1:-}" == "--bench" ]]; then
-  packages+=(libdraco-dev libzstd-dev liblzma-dev libzfp-dev python3)
-fi
+for arg in "$@"; do
+  case "$arg" in
+    --bench) packages+=(libdraco-dev libzstd-dev liblzma-dev libzfp-dev python3) ;;
+    --p4est) packages+=(libp4est-dev libopenmpi-dev) ;;  # cmake -DAMC_WITH_P4EST=ON (octree forests)
+  esac
+done
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -121,6 +121,11 @@ struct OctreeForestCounts {
 };
 OctreeForestCounts count_octree_forest(const OctreeForest& forest);
 
+// The leaves as VTU cells (VTK_QUAD in 2D, VTK_HEXAHEDRON in 3D, hanging nodes left as they
+// are) with cell data "level" and "tree"; corners placed by tree_point, shared within a tree and
+// repeated on tree boundaries. Through a temporary file and a rename. Throws Error.
+void write_octree_vtu(const std::string& path, const OctreeForest& forest, VtuEncoding encoding = VtuEncoding::binary_zlib);
+
 // ---- the coder (docs/OCTREE.md, docs/FORMAT.md section 8) ------------------------------------
 struct OctreeEncodeOptions {
     bool cull_by_balance = true;   // skip octants balance forbids to refine; refuses unbalanced forests
@@ -148,5 +153,21 @@ struct OctreeDecodeOptions {
 // Throws Error (truncated, checksum, corrupt, limit_exceeded, ...) on anything but a file
 // encode_octree_forest writes.
 OctreeForest decode_octree_forest(const uint8_t* data, size_t size, const OctreeDecodeOptions& options = {});
+
+// ---- p4est (optional: cmake -DAMC_WITH_P4EST=ON with Debian's libp4est-dev) -------------------
+// Without it every function below but octree_p4est_available throws Error.
+bool octree_p4est_available();
+// A p4est_save file (2D or 3D, told by its first bytes) through p4est_load_ext, and p4est's
+// checksum of it. p4est aborts the process on a malformed file: read only files you trust.
+OctreeForest read_p4est_file(const std::string& path, uint32_t* checksum = nullptr);
+// The forest built in p4est (refined from the roots), saved with p4est_save_ext (no data, no
+// partition).
+void write_p4est_file(const std::string& path, const OctreeForest& forest);
+// p4est_checksum of the forest built in p4est.
+uint32_t octree_p4est_checksum(const OctreeForest& forest);
+// A forest made by p4est itself: refined (p4est_refine) where quadrants meet the sphere (circle),
+// up to max_level, balanced by p4est_balance, saved with p4est_save_ext. For tests and benchmarks.
+void write_p4est_sphere_forest(const std::string& path, const TreeConnectivity& conn, Vec3 center, double radius, int max_level,
+                               OctreeBalance balance);
 
 }  // namespace amc

@@ -22,45 +22,42 @@ struct GeometryArrays {
 };
 
 template <typename Index>
-void fill_cells(const TriangleMesh& mesh, GeometryArrays& g) {
-    std::vector<Index> connectivity, offsets;
-    connectivity.reserve(3 * mesh.triangles.size());
-    offsets.reserve(mesh.triangles.size());
-    for (const Triangle& t : mesh.triangles) {
-        for (uint32_t v : t) connectivity.push_back(static_cast<Index>(v));
-        offsets.push_back(static_cast<Index>(connectivity.size()));
-    }
+void fill_cells(const VtuCells& cells, GeometryArrays& g) {
+    const std::size_t n = cells.count * std::size_t(cells.corners);
+    std::vector<Index> connectivity(n), offsets(cells.count);
+    for (std::size_t i = 0; i < n; ++i) connectivity[i] = static_cast<Index>(cells.connectivity[i]);
+    for (std::size_t c = 0; c < cells.count; ++c) offsets[c] = static_cast<Index>((c + 1) * std::size_t(cells.corners));
     g.connectivity.values = std::move(connectivity);
     g.offsets.values = std::move(offsets);
 }
 
-GeometryArrays geometry_arrays(const TriangleMesh& mesh) {
+GeometryArrays geometry_arrays(const std::vector<Vec3>& positions, bool single_precision, const VtuCells& cells) {
     GeometryArrays g;
     g.points.name = "Points";
     g.points.components = 3;
-    if (mesh.single_precision) {
+    if (single_precision) {
         std::vector<float> xyz;
-        xyz.reserve(3 * mesh.positions.size());
-        for (const Vec3& p : mesh.positions) {
+        xyz.reserve(3 * positions.size());
+        for (const Vec3& p : positions) {
             xyz.insert(xyz.end(), {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)});
         }
         g.points.values = std::move(xyz);
     } else {
         std::vector<double> xyz;
-        xyz.reserve(3 * mesh.positions.size());
-        for (const Vec3& p : mesh.positions) xyz.insert(xyz.end(), {p.x, p.y, p.z});
+        xyz.reserve(3 * positions.size());
+        for (const Vec3& p : positions) xyz.insert(xyz.end(), {p.x, p.y, p.z});
         g.points.values = std::move(xyz);
     }
     g.connectivity.name = "connectivity";
     g.offsets.name = "offsets";
     g.types.name = "types";
     const uint64_t int32_max = std::numeric_limits<int32_t>::max();
-    if (3 * uint64_t(mesh.triangles.size()) <= int32_max && mesh.positions.size() <= int32_max) {
-        fill_cells<int32_t>(mesh, g);
+    if (uint64_t(cells.corners) * cells.count <= int32_max && positions.size() <= int32_max) {
+        fill_cells<int32_t>(cells, g);
     } else {
-        fill_cells<int64_t>(mesh, g);
+        fill_cells<int64_t>(cells, g);
     }
-    g.types.values = std::vector<uint8_t>(mesh.triangles.size(), static_cast<uint8_t>(kVtkTriangle));
+    g.types.values = std::vector<uint8_t>(cells.count, cells.vtk_type);
     return g;
 }
 
@@ -184,21 +181,30 @@ std::vector<DataArray> cell_data_arrays(const CellData& cells) {
 
 std::string format_vtu(const TriangleMesh& mesh, const std::vector<DataArray>& point_data,
                        const std::vector<DataArray>& cell_data, VtuEncoding encoding) {
-    check_sizes(point_data, mesh.positions.size(), "point data");
-    check_sizes(cell_data, mesh.triangles.size(), "cell data");
-    const GeometryArrays geometry = geometry_arrays(mesh);
+    static_assert(sizeof(Triangle) == 3 * sizeof(uint32_t), "triangles are three packed indices");
+    const VtuCells triangles{mesh.triangles.empty() ? nullptr : mesh.triangles[0].data(), mesh.triangles.size(), 3,
+                             static_cast<uint8_t>(kVtkTriangle)};
+    return format_vtu_cells(mesh.positions, mesh.single_precision, triangles, point_data, cell_data, encoding);
+}
+
+std::string format_vtu_cells(const std::vector<Vec3>& positions, bool single_precision, const VtuCells& cells,
+                             const std::vector<DataArray>& point_data, const std::vector<DataArray>& cell_data,
+                             VtuEncoding encoding) {
+    check_sizes(point_data, positions.size(), "point data");
+    check_sizes(cell_data, cells.count, "cell data");
+    const GeometryArrays geometry = geometry_arrays(positions, single_precision, cells);
     const bool binary = encoding == VtuEncoding::binary_zlib;
 
     std::string xml;
-    xml.reserve(binary ? 4096 : mesh.positions.size() * 60 + mesh.triangles.size() * 40 + 4096);
+    xml.reserve(binary ? 4096 : positions.size() * 60 + cells.count * (12 + 8 * std::size_t(cells.corners)) + 4096);
     xml += "<?xml version=\"1.0\"?>\n";
     xml += "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"";
     xml += kHostBigEndian ? "BigEndian" : "LittleEndian";
     xml += "\" header_type=\"UInt64\"";
     if (binary) xml += " compressor=\"vtkZLibDataCompressor\"";
     xml += ">\n  <UnstructuredGrid>\n";
-    xml += "    <Piece NumberOfPoints=\"" + std::to_string(mesh.positions.size()) + "\" NumberOfCells=\"" +
-           std::to_string(mesh.triangles.size()) + "\">\n";
+    xml += "    <Piece NumberOfPoints=\"" + std::to_string(positions.size()) + "\" NumberOfCells=\"" +
+           std::to_string(cells.count) + "\">\n";
     ArrayWriter arrays(xml, encoding);
     if (!point_data.empty()) {
         xml += "      <PointData>\n";

@@ -15,4 +15,18 @@ namespace amc {
 std::string format_vtu(const TriangleMesh& mesh, const std::vector<DataArray>& point_data,
                        const std::vector<DataArray>& cell_data, VtuEncoding encoding);
 
+// Cells of one VTK type with `corners` points each: `count` cells, their point indices one cell
+// after the other in `connectivity` (the octree forests' quads and hexahedra, say).
+struct VtuCells {
+    const uint32_t* connectivity;
+    std::size_t count;
+    int corners;
+    uint8_t vtk_type;
+};
+
+// format_vtu for any such cells; points as Float32 when single_precision.
+std::string format_vtu_cells(const std::vector<Vec3>& positions, bool single_precision, const VtuCells& cells,
+                             const std::vector<DataArray>& point_data, const std::vector<DataArray>& cell_data,
+                             VtuEncoding encoding);
+
 }  // namespace amc
