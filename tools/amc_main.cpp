@@ -32,6 +32,8 @@ Examples:
   amc series decode run.amcs -o out.pvd          -> out.pvd + out_<k>.vtu
   amc decode run.amcs --frame 40 -o f40.vtu      one frame, from the keyframe before it
   cat mesh.ply | amc encode - > mesh.amc
+  amc octree make --dim 3 --model sphere --level 7 -o sphere.amq
+  amc octree decode sphere.amq -o sphere.vtu     leaves as hexahedra (or -o x.p4est with p4est)
 
 Exit status: 0 success, 1 error (bad input, existing output without -f), 2 usage error.
 )";
@@ -173,6 +175,33 @@ int main(int argc, char** argv) {
     stats->add_flag("--groups", stats_groups, "Also print the context groups (Table 2) of each file");
     stats->add_flag("--verify", stats_verify, "Round-trip every file under all 64 switch combinations");
 
+    auto* octree = app.add_subcommand("octree", "Quadtree and octree forests as p4est keeps them (.amq)");
+    octree->require_subcommand(1);
+    OctreeMakeCommand octree_make;
+    auto* octree_make_cmd = octree->add_subcommand("make", "Make a forest (2:1 balanced) and write it as .amq, .vtu or .p4est");
+    octree_make_cmd->add_option("--dim", octree_make.dim, "2 (quadtrees) or 3 (octrees)")->check(CLI::Range(2, 3))->capture_default_str();
+    octree_make_cmd->add_option("--model", octree_make.model, "sphere, front, random or uniform")->capture_default_str();
+    octree_make_cmd->add_option("--level", octree_make.level, "Finest level")->check(CLI::Range(0, 18))->capture_default_str();
+    octree_make_cmd->add_option("--trees", octree_make.trees, "Brick of trees, NXxNY or NXxNYxNZ")->capture_default_str();
+    octree_make_cmd->add_option("--balance", octree_make.balance, "face, edge, corner or none")->capture_default_str();
+    octree_make_cmd->add_option("--seed", octree_make.seed, "Random model's seed")->capture_default_str();
+    octree_make_cmd->add_option("-o,--output", octree_make.output, "Output (.amq, .vtu, .p4est; - for .amq to stdout)")->required();
+    OctreeEncodeCommand octree_encode;
+    auto* octree_encode_cmd = octree->add_subcommand("encode", "Compress a p4est file (needs AMC_WITH_P4EST) to .amq");
+    octree_encode_cmd->add_option("input", octree_encode.input, "p4est_save file (.p4est) or .amq")->required();
+    octree_encode_cmd->add_option("-o,--output", octree_encode.output, "Output (default: the input with .amq)");
+    OctreeDecodeCommand octree_decode;
+    auto* octree_decode_cmd = octree->add_subcommand("decode", "Decompress an .amq file to VTU (or p4est)");
+    octree_decode_cmd->add_option("input", octree_decode.input, ".amq file, or - for stdin")->required();
+    octree_decode_cmd->add_option("-o,--output", octree_decode.output, "Output .vtu or .p4est (default: the input with .vtu)");
+    octree_decode_cmd->add_option("--level", octree_decode.level, "Progressive: only the levels up to this one")
+        ->check(CLI::Range(0, 29));
+    add_max_nodes(octree_decode_cmd, octree_decode.max_nodes);
+    OctreeInfoCommand octree_info;
+    auto* octree_info_cmd = octree->add_subcommand("info", "Describe an .amq file (decodes it)");
+    octree_info_cmd->add_option("input", octree_info.input, ".amq file, or - for stdin")->required();
+    add_max_nodes(octree_info_cmd, octree_info.max_nodes);
+
     try {
         app.parse(argc, argv);
         if (quiet && verbose) throw CLI::ValidationError("-q and -v exclude each other");
@@ -193,6 +222,10 @@ int main(int argc, char** argv) {
         if (*series_decode_cmd) run_series_decode(read_input(series_decode.input), series_decode, global);
         if (*series_info_cmd) run_series_info(read_input(series_info.input), series_info, global);
         if (*refine_cmd) run_refine(refine, global);
+        if (*octree_make_cmd) run_octree_make(octree_make, global);
+        if (*octree_encode_cmd) run_octree_encode(octree_encode, global);
+        if (*octree_decode_cmd) run_octree_decode(octree_decode, global);
+        if (*octree_info_cmd) run_octree_info(octree_info, global);
         if (*report) {
             print_codec_report_header();
             for (const std::string& file : report_inputs)

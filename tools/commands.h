@@ -97,6 +97,29 @@ void run_series_info(const InputFile& input, const SeriesInfoCommand& command, c
 
 bool is_pvd(const std::string& path);  // a ParaView collection, by its name
 
+// Quadtree and octree forests (.amq, octree_commands.cpp).
+struct OctreeMakeCommand {
+    int dim = 2, level = 8;
+    std::string model = "sphere", trees = "1x1x1", balance = "face", output;
+    uint64_t seed = 1;
+};
+void run_octree_make(const OctreeMakeCommand& command, const GlobalOptions& global);
+struct OctreeEncodeCommand {
+    std::string input, output;  // input: a p4est file (with AMC_WITH_P4EST) or an .amq file
+};
+void run_octree_encode(const OctreeEncodeCommand& command, const GlobalOptions& global);
+struct OctreeDecodeCommand {
+    std::string input, output;  // output: .vtu or .p4est
+    int level = -1;
+    uint64_t max_nodes = 0;
+};
+void run_octree_decode(const OctreeDecodeCommand& command, const GlobalOptions& global);
+struct OctreeInfoCommand {
+    std::string input;
+    uint64_t max_nodes = 0;
+};
+void run_octree_info(const OctreeInfoCommand& command, const GlobalOptions& global);
+
 // The main job on the embedded default (README, first command).
 void run_demo(const std::string& out_dir, const GlobalOptions& global);
 

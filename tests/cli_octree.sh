@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# `amc octree make | encode | decode | info`: forests to .amq and back, VTU output, progressive
+# decoding, exit codes 0/1/2, -f, truncated and foreign files.
+# Usage: cli_octree.sh AMC
+set -u
+amc=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work" || exit 1
+failures=0
+
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+expect() {
+  local code=$1; shift
+  "$@" > out.txt 2> err.txt
+  local got=$?
+  [[ $got == "$code" ]] || fail "'$*' exited $got, expected $code; stderr: $(head -c 300 err.txt)"
+}
+
+expect 0 "$amc" octree make --dim 3 --model sphere --level 5 --trees 2x2x1 -o sphere.amq
+[[ -s sphere.amq ]] || fail "make wrote no sphere.amq"
+expect 0 "$amc" octree info sphere.amq
+grep -q '3D forest of 4 trees' out.txt || fail "info: $(head -c 200 out.txt)"
+grep -q 'face balanced: yes' out.txt || fail "info does not see a balanced forest: $(head -c 300 out.txt)"
+expect 0 "$amc" octree decode sphere.amq
+grep -q 'NumberOfCells' sphere.vtu || fail "decode wrote no VTU cells"
+expect 1 "$amc" octree decode sphere.amq
+grep -q 'already exists' err.txt || fail "decode overwrote sphere.vtu"
+expect 0 "$amc" -f octree decode sphere.amq --level 2 -o coarse.vtu
+expect 0 "$amc" octree make --dim 2 --model front --level 7 --balance corner -o - 
+[[ -s out.txt ]] || fail "make to stdout wrote nothing"
+cp out.txt front.amq
+expect 0 "$amc" octree info - < front.amq
+grep -q '2D forest of 1 trees' out.txt || fail "info of stdin: $(head -c 200 out.txt)"
+# Bad input: truncated, foreign, and usage errors.
+head -c 40 sphere.amq > cut.amq
+expect 1 "$amc" octree info cut.amq
+expect 1 "$amc" octree decode sphere.vtu -o x.vtu
+expect 2 "$amc" octree make --dim 4 -o x.amq
+expect 2 "$amc" octree make --model moon -o x.amq
+expect 2 "$amc" octree decode sphere.amq -o x.amq
+
+((failures == 0)) && echo "cli_octree: all checks passed"
+exit $((failures > 0))

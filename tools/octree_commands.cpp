@@ -1,0 +1,121 @@
+// `amc octree make | encode | decode | info`: quadtree and octree forests (.amq, docs/OCTREE.md),
+// from and to p4est files (when built with AMC_WITH_P4EST) and VTU.
+#include "cli_files.h"
+#include "commands.h"
+
+#include <amc/octree.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <sstream>
+
+namespace amc::cli {
+
+namespace {
+
+std::string extension_of(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return ext;
+}
+
+std::string read_bytes(const std::string& path) {
+    if (path == "-") return std::string(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(ErrorCode::io, path + ": can not open");
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+OctreeForest decode_bytes(const std::string& name, const std::string& bytes, const OctreeDecodeOptions& options) {
+    try {
+        return decode_octree_forest(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size(), options);
+    } catch (const Error& e) {
+        throw e.prefixed(name);
+    }
+}
+
+// The forest in the format the output's extension names: .amq (default), .vtu or .p4est.
+void write_forest(const std::string& path, const OctreeForest& forest, const GlobalOptions& global) {
+    const std::string ext = extension_of(path);
+    if (ext == ".vtu" || ext == ".p4est") {
+        if (path == "-") throw UsageError("VTU and p4est output need a file name");
+        if (!global.force) refuse_existing(path);
+        if (ext == ".vtu") write_octree_vtu(path, forest);
+        else write_p4est_file(path, forest);
+    } else {
+        const std::vector<uint8_t> bytes = encode_octree_forest(forest);
+        write_output(path, std::string(bytes.begin(), bytes.end()), global.force);
+    }
+    if (global.verbosity > 0 && path != "-")
+        std::fprintf(stderr, "%s: %zu leaves in %u trees\n", path.c_str(), forest.leaves.size(), forest.tree_count());
+}
+
+OctreeBalance balance_named(const std::string& name) {
+    if (name == "face") return OctreeBalance::face;
+    if (name == "edge") return OctreeBalance::edge;
+    if (name == "corner") return OctreeBalance::corner;
+    throw UsageError("--balance: expected face, edge, corner or none, got '" + name + "'");
+}
+
+}  // namespace
+
+void run_octree_make(const OctreeMakeCommand& c, const GlobalOptions& global) {
+    int n[3] = {1, 1, 1};
+    if (std::sscanf(c.trees.c_str(), "%dx%dx%d", &n[0], &n[1], &n[2]) < c.dim || n[0] < 1 || n[1] < 1 || n[2] < 1)
+        throw UsageError("--trees: expected NXxNY (2D) or NXxNYxNZ (3D), got '" + c.trees + "'");
+    const TreeConnectivity conn = brick_connectivity(c.dim, n[0], n[1], c.dim == 3 ? n[2] : 1);
+    const Vec3 center{0.5 * n[0], 0.5 * n[1], c.dim == 3 ? 0.5 * n[2] : 0.0};
+    OctreeForest forest;
+    if (c.model == "sphere") forest = sphere_octree_forest(conn, center, 0.35 * std::min(n[0], n[1]), c.level);
+    else if (c.model == "front") forest = front_octree_forest(conn, 0.5 * n[0], c.level);
+    else if (c.model == "random") forest = random_octree_forest(conn, c.seed, 0.4, std::min(2, c.level), c.level);
+    else if (c.model == "uniform") forest = uniform_octree_forest(conn, c.level);
+    else throw UsageError("--model: expected sphere, front, random or uniform, got '" + c.model + "'");
+    if (c.balance != "none") forest = balance_octree_forest(forest, balance_named(c.balance));
+    write_forest(c.output, forest, global);
+}
+
+void run_octree_encode(const OctreeEncodeCommand& c, const GlobalOptions& global) {
+    const std::string ext = extension_of(c.input);
+    OctreeForest forest;
+    if (ext == ".p4est") {
+        forest = read_p4est_file(c.input);
+    } else {
+        forest = decode_bytes(c.input, read_bytes(c.input), {});
+    }
+    const std::string output = c.output.empty() ? default_output(c.input, ".amq") : c.output;
+    write_forest(output, forest, global);
+}
+
+void run_octree_decode(const OctreeDecodeCommand& c, const GlobalOptions& global) {
+    OctreeDecodeOptions options;
+    options.max_level = c.level;
+    if (c.max_nodes > 0) options.max_nodes = c.max_nodes;
+    const OctreeForest forest = decode_bytes(c.input, read_bytes(c.input), options);
+    const std::string output = c.output.empty() ? default_output(c.input, ".vtu") : c.output;
+    if (extension_of(output) == ".amq") throw UsageError(output + ": decode writes .vtu or .p4est");
+    write_forest(output, forest, global);
+}
+
+void run_octree_info(const OctreeInfoCommand& c, const GlobalOptions&) {
+    OctreeDecodeOptions options;
+    if (c.max_nodes > 0) options.max_nodes = c.max_nodes;
+    const std::string bytes = read_bytes(c.input);
+    const OctreeForest forest = decode_bytes(c.input, bytes, options);
+    const OctreeForestCounts counts = count_octree_forest(forest);
+    std::printf("%s: %dD forest of %u trees, %llu leaves, %llu octants, %d levels\n", c.input.c_str(), forest.dim(),
+                forest.tree_count(), (unsigned long long)counts.leaves, (unsigned long long)counts.nodes, counts.depth + 1);
+    std::printf("  %zu bytes: %.4f bits/leaf, %.4f bits/octant; face balanced: %s\n", bytes.size(),
+                8.0 * double(bytes.size()) / double(counts.leaves), 8.0 * double(bytes.size()) / double(counts.nodes),
+                octree_balance_violation(forest, OctreeBalance::face).empty() ? "yes" : "no");
+    std::vector<uint64_t> per_level(counts.depth + 1, 0);
+    for (const Octant& o : forest.leaves) ++per_level[o.level];
+    std::printf("  leaves per level:");
+    for (uint64_t n : per_level) std::printf(" %llu", (unsigned long long)n);
+    std::printf("\n");
+}
+
+}  // namespace amc::cli
