@@ -34,23 +34,54 @@ void refine_to_size(Hierarchy& h, const std::function<double(Vec3)>& size_at, in
 
 // ---- surface remeshing -----------------------------------------------------------------------
 enum class RefinementCriterion { mean_curvature, gauss_curvature, approximation_error };
+// Coordinates of the remesh: float32 when the reference is single precision (the default), or
+// as asked.
+enum class SurfacePrecision { as_reference, float32, float64 };
 
 struct SurfaceRemeshOptions {
     RefinementCriterion criterion = RefinementCriterion::mean_curvature;
-    uint32_t base_triangles = 500;    // target size of the simplified base mesh
-    uint32_t target_faces = 150000;   // stop once the leaf mesh has about this many faces
-    int max_level = 7;
+    uint32_t base_triangles = 500;    // target size of the simplified base (doubled while it folds over more than the reference)
+    uint32_t target_faces = 150000;   // triangles of the conforming leaf mesh to stop at (or just past)
+    int max_level = 7;                // 0 .. kMaxLevel
+    // Every leaf-mesh triangle gets at least this quality (4 sqrt(3) area / sum of squared
+    // edges: 1 equilateral, 0 degenerate), or a third of its base triangle's if that is lower.
+    double min_quality = 0.1;
+    SurfacePrecision precision = SurfacePrecision::as_reference;
+    bool measure = false;             // fill the measures of SurfaceRemeshStats (about 2 s per 10^5 faces)
 };
 
 struct SurfaceRemeshStats {
     uint32_t base_triangles = 0;
-    double simplify_seconds = 0;
-    double refine_seconds = 0;
+    uint32_t base_attempts = 0;        // simplifications tried (each with twice the triangles)
+    double base_min_quality = 0;       // of the base after shape improvement
+    uint32_t base_fold_overs = 0;      // left in the base (thin parts it cannot show)
+    uint32_t faces = 0;                // triangles of the conforming leaf mesh
+    uint32_t corrected_vertices = 0;   // new vertices moved by the correction
+    uint32_t inherited_fold_overs = 0; // fold-overs left where the flat subdivision of the base folds
+    // With options.measure, the leaf mesh against the reference: fold-overs (adjacent triangles
+    // whose normals are more than 150 degrees apart), vertices at the position of another vertex,
+    // the smallest triangle quality, and the two-sided (Hausdorff) distance relative to the
+    // reference's bounding-box diagonal: the largest found, a certified upper bound of it, and the
+    // root mean square over both surfaces (docs/REMESHER.md says how they are sampled).
+    uint32_t reference_fold_overs = 0; // always filled
+    uint32_t fold_overs = 0;
+    uint32_t coincident_vertices = 0;
+    double min_quality = 0;
+    double max_distance = 0, max_distance_bound = 0, rms_distance = 0;
+    double simplify_seconds = 0, refine_seconds = 0, correct_seconds = 0, measure_seconds = 0;
 };
 
-// Simplifies `reference` to a coarse base (meshoptimizer), then refines greedily where the
-// criterion is largest (curvature of the reference times element size, or distance of the
-// element's centroid from the reference), projecting every new vertex onto the reference surface.
+// Simplifies `reference` to a coarse base (meshoptimizer) and improves its triangles (flips and
+// relaxation on the surface that never move it away from the reference), refines first where the
+// base folds over and then greedily where the criterion is largest (curvature of the reference
+// times element size, or distance of the element's centroid from the reference) until the leaf
+// mesh has `target_faces` triangles, placing every new vertex on the reference (along the
+// elements' normal, boundary vertices on the reference's boundary), and finally corrects the
+// vertices of fold-overs, triangles below the quality bound and coincident vertices: slid along
+// the surface, or stepped back towards their edge midpoints (docs/REMESHER.md). The result has
+// no coincident vertices, no triangle below min(min_quality, a third of its base triangle's
+// quality), and fold-overs only where the base folds over (SurfaceRemeshStats says how many).
+// Throws Error if max_level is outside 0..kMaxLevel.
 Hierarchy remesh_adaptively(const TriangleMesh& reference, const SurfaceRemeshOptions& options,
                             SurfaceRemeshStats* stats = nullptr);
 

@@ -316,16 +316,21 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
 
     records_.resize(n);
     triangles_.resize(n);
+    normals_.resize(n);
     for (uint32_t i = 0; i < n; ++i) {
         uint32_t t = order[i];
-        records_[i] = {positions[triangles[t][0]], positions[triangles[t][1]],
-                       positions[triangles[t][2]]};
+        const Record record{positions[triangles[t][0]], positions[triangles[t][1]], positions[triangles[t][2]]};
+        records_[i] = record;
         triangles_[i] = t;
+        const Vec3 normal = cross(record.b - record.a, record.c - record.a);
+        const double length = std::sqrt(squared_length(normal));
+        normals_[i] = length > 0 && std::isfinite(length) ? (1 / length) * normal : Vec3{};
     }
 }
 
-std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p,
-                                                                double bound_squared) const {
+template <class Accept>
+std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p, double bound_squared,
+                                                                const Accept& accept) const {
     double best = bound_squared;
     double prune = best * (1 + kPruneSlack);
     uint32_t best_record = kEmpty;
@@ -345,6 +350,7 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p,
         if (entry.distance_squared > prune) continue;
         if (entry.count > 0) {
             for (uint32_t r = entry.index; r < entry.index + entry.count; ++r) {
+                if (!accept(r)) continue;
                 const Record& record = records_[r];
                 Vec3 barycentric;
                 Vec3 q = closest_point_on_triangle(p, record.a, record.b, record.c, barycentric);
@@ -381,7 +387,7 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p,
 }
 
 ClosestPointQuery::Hit ClosestPointQuery::closest(Vec3 p) const {
-    std::optional<Hit> hit = search(p, std::numeric_limits<double>::infinity());
+    std::optional<Hit> hit = search(p, std::numeric_limits<double>::infinity(), [](uint32_t) { return true; });
     if (!hit) {
         // Only non-finite input (a NaN coordinate) compares false against every distance.
         throw Error("closest point query: the query point is not finite");
@@ -392,7 +398,99 @@ ClosestPointQuery::Hit ClosestPointQuery::closest(Vec3 p) const {
 std::optional<ClosestPointQuery::Hit> ClosestPointQuery::closest(Vec3 p,
                                                                  double max_distance) const {
     if (!(max_distance >= 0)) return std::nullopt;
-    return search(p, max_distance * max_distance);
+    return search(p, max_distance * max_distance, [](uint32_t) { return true; });
+}
+
+std::optional<ClosestPointQuery::Hit> ClosestPointQuery::closest_facing(Vec3 p, Vec3 direction, double min_cosine,
+                                                                        double max_distance) const {
+    if (!(max_distance >= 0)) return std::nullopt;
+    const double threshold = min_cosine * std::sqrt(squared_length(direction));
+    return search(p, max_distance * max_distance,
+                  [&](uint32_t r) { return dot(normals_[r], normals_[r]) > 0 && dot(normals_[r], direction) >= threshold; });
+}
+
+}  // namespace amc
+
+namespace amc {
+
+std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 origin, Vec3 direction,
+                                                                       double reach) const {
+    const double direction_length = std::sqrt(squared_length(direction));
+    if (!(direction_length > 0) || !(reach >= 0)) return std::nullopt;
+    const Vec3 d = (1 / direction_length) * direction;
+    double best = reach;  // |t| of the best hit so far, in units of length
+    uint32_t best_record = kEmpty, best_triangle = kEmpty;
+    Vec3 best_barycentric;
+    // Slab test of the segment origin + t d, |t| <= best, against a box; returns its |t| lower bound.
+    const double inverse[3] = {1 / d.x, 1 / d.y, 1 / d.z};
+    const double o[3] = {origin.x, origin.y, origin.z};
+    auto enters = [&](const float* lo, const float* hi, double& near) {
+        double t0 = -best, t1 = best;
+        for (int axis = 0; axis < 3; ++axis) {
+            double a = (lo[axis] - o[axis]) * inverse[axis], b = (hi[axis] - o[axis]) * inverse[axis];
+            if (std::isnan(a) || std::isnan(b)) {  // parallel to the slab, on its plane: inside it
+                a = -std::numeric_limits<double>::infinity();
+                b = std::numeric_limits<double>::infinity();
+            }
+            if (a > b) std::swap(a, b);
+            t0 = std::max(t0, a);
+            t1 = std::min(t1, b);
+        }
+        if (t0 > t1) return false;
+        near = t0 <= 0 && t1 >= 0 ? 0 : std::min(std::fabs(t0), std::fabs(t1));
+        return near <= best;
+    };
+    struct Entry {
+        uint32_t index, count;
+        double near;
+    };
+    Entry stack[kStackSize];
+    int size = 0;
+    stack[size++] = {0, 0, 0.0};
+    while (size > 0) {
+        const Entry entry = stack[--size];
+        if (entry.near > best) continue;
+        if (entry.count > 0) {
+            for (uint32_t r = entry.index; r < entry.index + entry.count; ++r) {
+                if (!(dot(normals_[r], d) > 0)) continue;
+                // Moller-Trumbore, two-sided in t.
+                const Record& record = records_[r];
+                const Vec3 e1 = record.b - record.a, e2 = record.c - record.a;
+                const Vec3 pv = cross(d, e2);
+                const double det = dot(e1, pv);
+                if (!(std::fabs(det) > 0)) continue;
+                const double inv = 1 / det;
+                const Vec3 tv = origin - record.a;
+                const double u = dot(tv, pv) * inv;
+                if (u < 0 || u > 1) continue;
+                const Vec3 qv = cross(tv, e1);
+                const double v = dot(d, qv) * inv;
+                if (v < 0 || u + v > 1) continue;
+                const double t = dot(e2, qv) * inv;
+                const double at = std::fabs(t);
+                if (at < best || (at == best && best_record != kEmpty && triangles_[r] < best_triangle)) {
+                    best = at;
+                    best_record = r;
+                    best_triangle = triangles_[r];
+                    best_barycentric = {1 - u - v, u, v};
+                }
+            }
+            continue;
+        }
+        const Node& node = nodes_[entry.index];
+        double near[2];
+        bool hit[2];
+        for (int slot = 0; slot < 2; ++slot)
+            hit[slot] = node.index[slot] != kEmpty && enters(node.lo[slot], node.hi[slot], near[slot]);
+        const int first = hit[1] && (!hit[0] || near[1] < near[0]) ? 1 : 0;
+        for (int slot : {1 - first, first}) {
+            if (hit[slot]) stack[size++] = {node.index[slot], node.count[slot], near[slot]};
+        }
+    }
+    if (best_record == kEmpty) return std::nullopt;
+    const Record& record = records_[best_record];
+    const Vec3 point = best_barycentric.x * record.a + best_barycentric.y * record.b + best_barycentric.z * record.c;
+    return Hit{point, best_triangle, squared_length(point - origin), best_barycentric};
 }
 
 }  // namespace amc

@@ -47,6 +47,18 @@ public:
     // there are none. Faster than closest(p) when the bound prunes most of the tree.
     std::optional<Hit> closest(Vec3 p, double max_distance) const;
 
+    // As closest(p, max_distance), but only among the triangles that face `direction`: those
+    // whose unit normal n has dot(n, direction) >= min_cosine * |direction| (zero-area triangles
+    // face nowhere). The surface remesher projects with it so that a point between two sheets
+    // of a thin part lands on the sheet its element belongs to.
+    std::optional<Hit> closest_facing(Vec3 p, Vec3 direction, double min_cosine, double max_distance) const;
+
+    // The intersection of the line {origin + t * direction} with the triangles facing
+    // `direction` (as closest_facing with min_cosine 0: dot(n, direction) > 0) of least |t|,
+    // among |t| * |direction| <= reach; nullopt if there is none. Ties go to the lower triangle
+    // index. Hit::distance_squared is the squared distance from origin to the hit point.
+    std::optional<Hit> intersect_line(Vec3 origin, Vec3 direction, double reach) const;
+
     std::size_t triangle_count() const { return triangles_.size(); }
     std::size_t node_count() const { return nodes_.size(); }
 
@@ -64,11 +76,13 @@ private:
         Vec3 a, b, c;
     };
 
-    std::optional<Hit> search(Vec3 p, double bound_squared) const;
+    template <class Accept>
+    std::optional<Hit> search(Vec3 p, double bound_squared, const Accept& accept) const;
 
     std::vector<Node> nodes_;           // nodes_[0] is the root
     std::vector<Record> records_;
     std::vector<uint32_t> triangles_;   // triangle index of each record
+    std::vector<Vec3> normals_;         // unit normal of each record, zero for zero-area ones
 };
 
 }  // namespace amc

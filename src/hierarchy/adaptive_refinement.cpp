@@ -1,17 +1,9 @@
-// Adaptive refinement drivers: uniform, random, size-field (finite-element style) and
-// curvature-adaptive surface remeshing onto a reference mesh.
+// Adaptive refinement drivers: uniform, random, size-field (finite-element style); the surface
+// remesher is in surface_remeshing.cpp.
 #include <amc/refinement.h>
 
-#include "geometry/closest_point.h"
-#include "geometry/curvature.h"
-
-#include <meshoptimizer.h>
-
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <map>
-#include <queue>
 
 namespace amc {
 
@@ -28,10 +20,6 @@ struct Random {
     }
     size_t below(size_t n) { return size_t(next() % n); }
 };
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 Vec3 centroid(const Hierarchy& h, NodeId n) {
     return (1.0 / 3.0) * (h.position(h.vertex(n, 0)) + h.position(h.vertex(n, 1)) + h.position(h.vertex(n, 2)));
@@ -115,122 +103,7 @@ void coarsen_to_size(Hierarchy& h, const std::function<double(Vec3)>& size_at) {
     }
 }
 
-// Simplifies to about `target` triangles with meshoptimizer and keeps the result only if it is a
-// valid base mesh (the simplifier does not promise manifold output); retries with more triangles.
-TriangleMesh simplify_to_base(const TriangleMesh& reference, uint32_t target) {
-    std::vector<float> xyz;
-    xyz.reserve(reference.positions.size() * 3);
-    for (const Vec3& p : reference.positions) {
-        xyz.push_back(float(p.x));
-        xyz.push_back(float(p.y));
-        xyz.push_back(float(p.z));
-    }
-    std::vector<unsigned> indices;
-    for (const Triangle& t : reference.triangles) indices.insert(indices.end(), t.begin(), t.end());
-    std::string last_problem;
-    for (int attempt = 0; attempt < 8; ++attempt) {
-        std::vector<unsigned> simplified(indices.size());
-        const size_t count = meshopt_simplify(simplified.data(), indices.data(), indices.size(), xyz.data(),
-                                              reference.positions.size(), 3 * sizeof(float), size_t(target) * 3,
-                                              1.0f, 0, nullptr);
-        simplified.resize(count);
-        // The simplifier can fold a thin part into a "pillow": two triangles on the same three
-        // vertices. Both go; the validation below decides whether what is left is usable.
-        std::map<std::array<unsigned, 3>, int> copies;
-        for (size_t i = 0; i + 2 < simplified.size(); i += 3) {
-            std::array<unsigned, 3> key{simplified[i], simplified[i + 1], simplified[i + 2]};
-            std::sort(key.begin(), key.end());
-            ++copies[key];
-        }
-        TriangleMesh base;
-        base.single_precision = reference.single_precision;
-        std::vector<uint32_t> remap(reference.positions.size(), 0xffffffffu);
-        for (size_t i = 0; i + 2 < simplified.size(); i += 3) {
-            std::array<unsigned, 3> key{simplified[i], simplified[i + 1], simplified[i + 2]};
-            std::sort(key.begin(), key.end());
-            if (copies[key] > 1) continue;
-            Triangle t;
-            for (int k = 0; k < 3; ++k) {
-                uint32_t& id = remap[simplified[i + k]];
-                if (id == 0xffffffffu) {
-                    id = uint32_t(base.positions.size());
-                    base.positions.push_back(reference.positions[simplified[i + k]]);
-                }
-                t[k] = id;
-            }
-            base.triangles.push_back(t);
-        }
-        try {
-            validate_triangle_mesh(base, "simplified base mesh");
-            return base;
-        } catch (const Error& e) {
-            last_problem = e.what();
-            target = target + target / 3 + 8;
-        }
-    }
-    throw Error("could not simplify the reference to a valid base mesh: " + last_problem);
-}
-
-struct Projection {
-    const ClosestPointQuery* query;
-    bool single_precision;
-};
-
-Vec3 project_midpoint(void* context, Vec3 a, Vec3 b) {
-    const Projection& projection = *static_cast<const Projection*>(context);
-    Vec3 p = projection.query->closest(0.5 * (a + b)).point;
-    if (projection.single_precision) p = {double(float(p.x)), double(float(p.y)), double(float(p.z))};
-    return p;
-}
-
 }  // namespace
-
-Hierarchy remesh_adaptively(const TriangleMesh& reference, const SurfaceRemeshOptions& options,
-                            SurfaceRemeshStats* stats) {
-    auto start = std::chrono::steady_clock::now();
-    Hierarchy h(simplify_to_base(reference, options.base_triangles));
-    if (stats != nullptr) {
-        stats->base_triangles = h.root_count();
-        stats->simplify_seconds = seconds_since(start);
-    }
-    start = std::chrono::steady_clock::now();
-    const ClosestPointQuery query(reference);
-    Projection projection{&query, h.single_precision()};
-    h.set_vertex_placer(project_midpoint, &projection);
-
-    std::vector<double> curvature;
-    if (options.criterion == RefinementCriterion::mean_curvature) {
-        curvature = mean_curvature(reference);
-    } else if (options.criterion == RefinementCriterion::gauss_curvature) {
-        curvature = gauss_curvature(reference);
-        for (double& k : curvature) k = std::sqrt(std::fabs(k));  // a length^-1 like |H|
-    }
-    // Priority of a leaf: how far the flat element is from the surface, either measured (distance
-    // of its centroid from the reference) or predicted (curvature times size).
-    auto priority = [&](NodeId n) {
-        const auto hit = query.closest(centroid(h, n));
-        if (options.criterion == RefinementCriterion::approximation_error) return std::sqrt(hit.distance_squared);
-        return std::fabs(interpolate_at(reference, curvature, hit)) * diameter(h, n);
-    };
-
-    using Entry = std::pair<double, NodeId>;
-    std::priority_queue<Entry> queue;
-    for (NodeId r = 0; r < h.root_count(); ++r) queue.push({priority(r), r});
-    std::vector<NodeId> split;
-    while (!queue.empty() && h.leaf_count() < options.target_faces) {
-        const NodeId n = queue.top().second;
-        queue.pop();
-        if (!h.is_leaf(n) || h.level(n) >= options.max_level) continue;
-        split.clear();
-        h.refine(n, &split);
-        for (NodeId s : split) {
-            for (int k = 0; k < 4; ++k) queue.push({priority(h.child(s, k)), h.child(s, k)});
-        }
-    }
-    h.set_vertex_placer(nullptr, nullptr);
-    if (stats != nullptr) stats->refine_seconds = seconds_since(start);
-    return h;
-}
 
 Hierarchy make_l_shape_model(int max_level, double size_scale) {
     Hierarchy h(make_l_shape(4));

@@ -1,0 +1,303 @@
+// Edge flips and tangential relaxation of a coarse mesh on its reference surface, each step kept
+// only when it improves the triangles it touches without moving them away from the surface.
+#include "geometry/shape_improvement.h"
+
+#include "geometry/surface_quality.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+
+namespace amc {
+namespace {
+
+constexpr uint32_t kNone = 0xffffffffu;
+// Flips outside fold-overs only where the pair is nearly planar before and after (normals within
+// this angle): there the diagonal is a choice of shape, not of geometry.
+constexpr double kFlipBendDegrees = 30.0;
+// Relaxation moves a vertex this fraction of the way to the centroid of the triangles around it.
+constexpr double kRelaxationStep = 0.5;
+// A step must raise the worst quality it touches by this factor (or remove a fold-over).
+constexpr double kGain = 1.01;
+
+double length(Vec3 v) { return std::sqrt(dot(v, v)); }
+Vec3 unit(Vec3 v) {
+    const double l = length(v);
+    return l > 0 ? (1 / l) * v : Vec3{};
+}
+double cos_degrees(double degrees) { return std::cos(degrees * 3.14159265358979323846 / 180.0); }
+
+// Half-edge 3t+k runs from corner k to corner k+1 of triangle t; opposite[h] is the half-edge of
+// the other triangle on that edge, or kNone on the boundary.
+std::vector<uint32_t> opposite_halfedges(const TriangleMesh& mesh) {
+    std::vector<std::pair<uint64_t, uint32_t>> edges;
+    edges.reserve(3 * mesh.triangles.size());
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+        for (int k = 0; k < 3; ++k) {
+            uint64_t u = mesh.triangles[t][k], v = mesh.triangles[t][(k + 1) % 3];
+            if (u > v) std::swap(u, v);
+            edges.push_back({u << 32 | v, uint32_t(3 * t + k)});
+        }
+    }
+    std::sort(edges.begin(), edges.end());
+    std::vector<uint32_t> opposite(edges.size(), kNone);
+    for (size_t i = 0; i + 1 < edges.size(); ++i) {
+        if (edges[i].first != edges[i + 1].first) continue;
+        opposite[edges[i].second] = edges[i + 1].second;
+        opposite[edges[i + 1].second] = edges[i].second;
+    }
+    return opposite;
+}
+
+uint64_t edge_key(uint64_t u, uint64_t v) { return u < v ? u << 32 | v : v << 32 | u; }
+
+// The state of the mesh and what keeps it faithful: every reference vertex belongs to the mesh
+// triangle nearest to it, and a step may not move the triangles it changes farther from the
+// reference vertices they own (which would lose a thin part or round a corner off), or their
+// chords farther from the surface, than they were or than the worst of the mesh as it came.
+class Improver {
+public:
+    Improver(TriangleMesh& mesh, const ReferenceSurface& surface, const TriangleMesh& reference)
+        : mesh_(mesh), surface_(surface), reference_(reference), owned_(mesh.triangles.size()) {
+        const ClosestPointQuery nearest(mesh);
+        for (uint32_t v = 0; v < reference.positions.size(); ++v)
+            owned_[nearest.closest(reference.positions[v]).triangle].push_back(v);
+        std::vector<uint32_t> all(mesh.triangles.size());
+        for (uint32_t t = 0; t < all.size(); ++t) all[t] = t;
+        allowed_owned_ = owned_error(all, mesh.triangles);
+        allowed_chord_ = chord_error(mesh.triangles);
+    }
+
+    uint32_t flip_pass();
+    uint32_t relaxation_pass(const std::vector<uint8_t>& fixed);
+
+private:
+    Vec3 normal(const Triangle& t) const {
+        const Vec3 a = mesh_.positions[t[0]];
+        return cross(mesh_.positions[t[1]] - a, mesh_.positions[t[2]] - a);
+    }
+    double quality(const Triangle& t) const {
+        return triangle_quality(mesh_.positions[t[0]], mesh_.positions[t[1]], mesh_.positions[t[2]]);
+    }
+    double distance_to(Vec3 p, const Triangle& t) const {
+        Vec3 weights;
+        const Vec3 c = closest_point_on_triangle(p, mesh_.positions[t[0]], mesh_.positions[t[1]], mesh_.positions[t[2]], weights);
+        return length(c - p);
+    }
+    // The largest distance of the reference vertices owned by `owners` to the triangles `shape`.
+    double owned_error(const std::vector<uint32_t>& owners, const std::vector<Triangle>& shape) const {
+        double worst = 0;
+        for (uint32_t t : owners) {
+            for (uint32_t r : owned_[t]) {
+                double nearest = std::numeric_limits<double>::infinity();
+                for (const Triangle& s : shape) nearest = std::min(nearest, distance_to(reference_.positions[r], s));
+                worst = std::max(worst, nearest);
+            }
+        }
+        return worst;
+    }
+    // The largest distance of the edge midpoints and centroids of `shape` to the surface.
+    double chord_error(const std::vector<Triangle>& shape) const {
+        double worst = 0;
+        for (const Triangle& t : shape) {
+            const Vec3 a = mesh_.positions[t[0]], b = mesh_.positions[t[1]], c = mesh_.positions[t[2]];
+            for (Vec3 p : {0.5 * (a + b), 0.5 * (b + c), 0.5 * (c + a), (1.0 / 3.0) * (a + b + c)})
+                worst = std::max(worst, std::sqrt(surface_.faces().closest(p).distance_squared));
+        }
+        return worst;
+    }
+
+    TriangleMesh& mesh_;
+    const ReferenceSurface& surface_;
+    const TriangleMesh& reference_;
+    std::vector<std::vector<uint32_t>> owned_;  // reference vertices nearest to each triangle
+    // The mesh's largest errors as it came: a step may raise a local error up to them, never above.
+    double allowed_owned_ = 0, allowed_chord_ = 0;
+};
+
+uint32_t Improver::flip_pass() {
+    const std::vector<uint32_t> opposite = opposite_halfedges(mesh_);
+    std::set<uint64_t> edges;
+    for (const Triangle& t : mesh_.triangles)
+        for (int k = 0; k < 3; ++k) edges.insert(edge_key(t[k], t[(k + 1) % 3]));
+    std::vector<uint8_t> touched(mesh_.triangles.size(), 0);
+    const double flat = cos_degrees(kFlipBendDegrees);
+    uint32_t flips = 0;
+    for (uint32_t h = 0; h < opposite.size(); ++h) {
+        const uint32_t g = opposite[h];
+        if (g == kNone || g < h) continue;
+        const uint32_t t1 = h / 3, t2 = g / 3;
+        if (touched[t1] || touched[t2]) continue;
+        const Triangle old1 = mesh_.triangles[t1], old2 = mesh_.triangles[t2];
+        const uint32_t u = old1[h % 3], v = old1[(h % 3 + 1) % 3], w1 = old1[(h % 3 + 2) % 3];
+        const uint32_t w2 = old2[(g % 3 + 2) % 3];
+        if (w1 == w2 || edges.count(edge_key(w1, w2))) continue;
+        const Triangle new1{w1, u, w2}, new2{w2, v, w1};
+        const Vec3 n_old1 = normal(old1), n_old2 = normal(old2), n_new1 = normal(new1), n_new2 = normal(new2);
+        const bool was_fold = is_fold_over(n_old1, n_old2);
+        if (is_fold_over(n_new1, n_new2)) continue;
+        if (!was_fold) {
+            if (dot(unit(n_old1), unit(n_old2)) < flat || dot(unit(n_new1), unit(n_new2)) < flat) continue;
+            if (!(std::min(quality(new1), quality(new2)) > kGain * std::min(quality(old1), quality(old2)))) continue;
+        }
+        // No fold-over with the four triangles around the pair (left alone if one of them was
+        // flipped in this pass: the links here are stale for it).
+        const uint32_t outer[4] = {opposite[3 * t1 + (h % 3 + 2) % 3], opposite[3 * t2 + (g % 3 + 1) % 3],
+                                   opposite[3 * t2 + (g % 3 + 2) % 3], opposite[3 * t1 + (h % 3 + 1) % 3]};
+        bool blocked = false;
+        for (int i = 0; i < 4 && !blocked; ++i) {
+            if (outer[i] == kNone) continue;
+            const uint32_t t = outer[i] / 3;
+            blocked = touched[t] || is_fold_over(i < 2 ? n_new1 : n_new2, normal(mesh_.triangles[t]));
+        }
+        if (blocked) continue;
+        const std::vector<uint32_t> owners{t1, t2};
+        if (owned_error(owners, {new1, new2}) > std::max(owned_error(owners, {old1, old2}), allowed_owned_)) continue;
+        if (chord_error({new1, new2}) > std::max(chord_error({old1, old2}), allowed_chord_)) continue;
+        mesh_.triangles[t1] = new1;
+        mesh_.triangles[t2] = new2;
+        // The owned vertices go to the nearer of the two new triangles.
+        std::vector<uint32_t> pool = owned_[t1];
+        pool.insert(pool.end(), owned_[t2].begin(), owned_[t2].end());
+        owned_[t1].clear();
+        owned_[t2].clear();
+        for (uint32_t r : pool) {
+            const Vec3 p = reference_.positions[r];
+            owned_[distance_to(p, new1) <= distance_to(p, new2) ? t1 : t2].push_back(r);
+        }
+        edges.erase(edge_key(u, v));
+        edges.insert(edge_key(w1, w2));
+        touched[t1] = touched[t2] = 1;
+        ++flips;
+    }
+    return flips;
+}
+
+uint32_t Improver::relaxation_pass(const std::vector<uint8_t>& fixed) {
+    const std::vector<uint32_t> opposite = opposite_halfedges(mesh_);
+    std::vector<uint32_t> start(mesh_.positions.size() + 1, 0), around(3 * mesh_.triangles.size());
+    for (const Triangle& t : mesh_.triangles)
+        for (uint32_t v : t) ++start[v + 1];
+    for (size_t v = 0; v < mesh_.positions.size(); ++v) start[v + 1] += start[v];
+    {
+        std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+        for (uint32_t t = 0; t < mesh_.triangles.size(); ++t)
+            for (uint32_t v : mesh_.triangles[t]) around[fill[v]++] = t;
+    }
+    // Fold-overs of the triangles around v with their neighbours, and their worst quality.
+    auto state_around = [&](uint32_t v, int& folds, double& worst) {
+        folds = 0;
+        worst = 1;
+        for (uint32_t i = start[v]; i < start[v + 1]; ++i) {
+            const uint32_t t = around[i];
+            const Vec3 n = normal(mesh_.triangles[t]);
+            for (int k = 0; k < 3; ++k) {
+                const uint32_t g = opposite[3 * t + k];
+                folds += g != kNone && is_fold_over(n, normal(mesh_.triangles[g / 3]));
+            }
+            worst = std::min(worst, quality(mesh_.triangles[t]));
+        }
+    };
+    uint32_t moves = 0;
+    for (uint32_t v = 0; v < mesh_.positions.size(); ++v) {
+        if (fixed[v] || start[v] == start[v + 1]) continue;
+        const Vec3 p = mesh_.positions[v];
+        Vec3 centroid{}, normal_sum{};
+        double weight = 0;
+        std::vector<uint32_t> ring;
+        std::vector<Triangle> shape;
+        for (uint32_t i = start[v]; i < start[v + 1]; ++i) {
+            const Triangle& t = mesh_.triangles[around[i]];
+            const Vec3 n = normal(t);
+            const double area = 0.5 * length(n);
+            normal_sum = normal_sum + n;
+            centroid = centroid + area * ((1.0 / 3.0) * (mesh_.positions[t[0]] + mesh_.positions[t[1]] + mesh_.positions[t[2]]));
+            weight += area;
+            ring.push_back(around[i]);
+            shape.push_back(t);
+        }
+        if (!(weight > 0)) continue;
+        const Vec3 n = unit(normal_sum);
+        Vec3 step = kRelaxationStep * ((1 / weight) * centroid - p);
+        step = step - dot(step, n) * n;
+        const auto projected = surface_.project(p + step, n, 2 * length(step));
+        if (!projected) continue;
+        Vec3 q = *projected;
+        if (mesh_.single_precision) q = {double(float(q.x)), double(float(q.y)), double(float(q.z))};
+        int folds = 0, new_folds = 0;
+        double worst = 1, new_worst = 1;
+        state_around(v, folds, worst);
+        mesh_.positions[v] = q;
+        state_around(v, new_folds, new_worst);
+        if (!(new_folds < folds || (new_folds == folds && new_worst > kGain * worst))) {
+            mesh_.positions[v] = p;
+            continue;
+        }
+        // The costlier guards only for a move that would be taken.
+        const double owned_after = owned_error(ring, shape), chord_after = chord_error(shape);
+        mesh_.positions[v] = p;
+        if (owned_after > std::max(owned_error(ring, shape), allowed_owned_) ||
+            chord_after > std::max(chord_error(shape), allowed_chord_))
+            continue;
+        mesh_.positions[v] = q;
+        ++moves;
+    }
+    return moves;
+}
+
+}  // namespace
+
+std::vector<uint8_t> sharp_vertices(const TriangleMesh& mesh, double degrees) {
+    const std::vector<uint32_t> opposite = opposite_halfedges(mesh);
+    const double limit = cos_degrees(degrees);
+    std::vector<uint8_t> sharp(mesh.positions.size(), 0);
+    auto normal_of = [&](uint32_t t) {
+        const Triangle& c = mesh.triangles[t];
+        return unit(cross(mesh.positions[c[1]] - mesh.positions[c[0]], mesh.positions[c[2]] - mesh.positions[c[0]]));
+    };
+    for (uint32_t h = 0; h < opposite.size(); ++h) {
+        const uint32_t g = opposite[h];
+        if (g == kNone || dot(normal_of(h / 3), normal_of(g / 3)) >= limit) continue;
+        sharp[mesh.triangles[h / 3][h % 3]] = 1;
+        sharp[mesh.triangles[h / 3][(h % 3 + 1) % 3]] = 1;
+    }
+    return sharp;
+}
+
+ShapeImprovementStats improve_shapes(TriangleMesh& mesh, const ReferenceSurface& surface, const TriangleMesh& reference,
+                                     const std::vector<uint8_t>& locked, int rounds) {
+    ShapeImprovementStats stats;
+    const MeshShape before = measure_shape(mesh);
+    stats.min_quality_before = before.min_quality;
+    stats.fold_overs_before = before.fold_overs;
+    std::vector<uint8_t> fixed(mesh.positions.size(), 0);
+    for (size_t v = 0; v < fixed.size() && v < locked.size(); ++v) fixed[v] = locked[v];
+    {
+        const std::vector<uint32_t> opposite = opposite_halfedges(mesh);
+        for (uint32_t h = 0; h < opposite.size(); ++h) {
+            if (opposite[h] != kNone) continue;
+            fixed[mesh.triangles[h / 3][h % 3]] = 1;
+            fixed[mesh.triangles[h / 3][(h % 3 + 1) % 3]] = 1;
+        }
+    }
+    Improver improver(mesh, surface, reference);
+    for (int round = 0; round < rounds; ++round) {
+        uint32_t flips = 0;
+        for (int pass = 0; pass < 8; ++pass) {
+            const uint32_t f = improver.flip_pass();
+            flips += f;
+            if (f == 0) break;
+        }
+        const uint32_t moves = improver.relaxation_pass(fixed);
+        stats.flips += flips;
+        stats.moves += moves;
+        if (flips == 0 && moves == 0) break;
+    }
+    const MeshShape after = measure_shape(mesh);
+    stats.min_quality_after = after.min_quality;
+    stats.fold_overs_after = after.fold_overs;
+    return stats;
+}
+
+}  // namespace amc
