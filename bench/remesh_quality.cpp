@@ -1,14 +1,15 @@
 // The measures of docs/REMESHER.md for a remeshed surface against the mesh it approximates:
 // fold-overs (of both), smallest triangle quality, coincident vertices, degenerate triangles, the
 // certified two-sided distance (Hausdorff and RMS, relative to the reference's bounding-box
-// diagonal), face count and precision. One tab-separated line per approximation; the table
-// script (scripts/remesher_table.sh) runs it on the leaf meshes `amc refine` writes.
+// diagonal), face count and precision. One tab-separated line per mesh.
 //
 //   remesh_quality [--header] [--tolerance T] REFERENCE APPROXIMATION...
+//       measures approximations made elsewhere (e.g. the leaf meshes `amc refine` writes);
 //   remesh_quality [--header] [--tolerance T] --remesh mean|gauss|error [--faces N] [--base-faces B]
 //                  [--max-level L] REFERENCE...
-// The second form remeshes each reference with remesh_adaptively itself and measures the leaf
-// mesh (seconds: the remeshing alone).
+//       remeshes each reference with remesh_adaptively and measures the leaf mesh; `cpu_s` is the
+//       process CPU time of the remeshing alone (wall time is meaningless on a shared machine).
+// scripts/remesher_table.sh runs the second form on every mesh of ../shared/data.
 #include "geometry/surface_quality.h"
 
 #include <amc/mesh.h>
@@ -17,28 +18,30 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <string>
 #include <vector>
 
 namespace {
 
-// seconds < 0: the measuring time is printed instead.
-void print_row(const std::string& name, const amc::TriangleMesh& reference, const amc::MeshShape& input,
-               const amc::TriangleMesh& mesh, double seconds, double tolerance) {
-    const auto start = std::chrono::steady_clock::now();
+double cpu_seconds() { return double(std::clock()) / CLOCKS_PER_SEC; }
+
+// The measures of `mesh` against `reference`, tab-separated, after the caller's first columns.
+void print_measures(const amc::TriangleMesh& reference, const amc::MeshShape& input, const amc::TriangleMesh& mesh,
+                    double tolerance) {
     const amc::MeshShape shape = amc::measure_shape(mesh);
     const amc::SurfaceDistance d = amc::surface_distance(reference, mesh, tolerance);
-    if (seconds < 0) seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::printf("%s\t%zu\t%d\t%u\t%u\t%u\t%u\t%.3g\t%.3f\t%.3e\t%.3e\t%.3e\t%llu\t%.2f\n", name.c_str(),
-                mesh.triangles.size(), int(mesh.single_precision), input.fold_overs, shape.fold_overs,
-                shape.degenerate_triangles, shape.coincident_vertices, shape.min_quality, shape.mean_quality, d.max,
-                d.max_upper, d.rms, (unsigned long long)(d.to_reference.evaluations + d.from_reference.evaluations),
-                seconds);
-    std::fflush(stdout);
+    std::printf("%zu\t%d\t%u\t%u\t%u\t%u\t%.3g\t%.3f\t%.3e\t%.3e\t%.3e", mesh.triangles.size(),
+                int(mesh.single_precision), input.fold_overs, shape.fold_overs, shape.degenerate_triangles,
+                shape.coincident_vertices, shape.min_quality, shape.mean_quality, d.max, d.max_upper, d.rms);
     for (const amc::OneSidedDistance* side : {&d.to_reference, &d.from_reference})
-        std::fprintf(stderr, "  %s: max %.4g at (%.6g, %.6g, %.6g)\n", side == &d.to_reference ? "to reference" : "from reference",
-                     side->max, side->max_point.x, side->max_point.y, side->max_point.z);
+        std::fprintf(stderr, "  %s: max %.4g at (%.6g, %.6g, %.6g), %llu evaluations\n",
+                     side == &d.to_reference ? "to reference" : "from reference", side->max, side->max_point.x,
+                     side->max_point.y, side->max_point.z, (unsigned long long)side->evaluations);
 }
+
+const char* kMeasureColumns =
+    "faces\tfloat32\tinput_folds\tfolds\tdegenerate\tcoincident\tmin_quality\tmean_quality\tmax\tmax_upper\trms";
 
 }  // namespace
 
@@ -69,46 +72,49 @@ int main(int argc, char** argv) {
             files.push_back(arg);
         }
     }
-    if (header)
-        std::printf("file\tfaces\tfloat32\tinput_folds\tfolds\tdegenerate\tcoincident\tmin_quality\tmean_quality\t"
-                    "max\tmax_upper\trms\tevaluations\tseconds\n");
-    if (!criterion.empty()) {
-        try {
+    try {
+        if (!criterion.empty()) {
+            if (header)
+                std::printf("file\tinput_faces\tbase\tbase_attempts\tbase_folds\tasked\t%s\tinherited\tcpu_s\n",
+                            kMeasureColumns);
             for (const std::string& file : files) {
                 const amc::TriangleMesh reference = amc::read_mesh(file);
                 const amc::MeshShape input = amc::measure_shape(reference);
-                const auto start = std::chrono::steady_clock::now();
+                const double start = cpu_seconds();
                 amc::SurfaceRemeshStats stats;
                 const amc::Hierarchy h = amc::remesh_adaptively(reference, options, &stats);
-                const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+                const double seconds = cpu_seconds() - start;
                 std::fprintf(stderr,
-                             "%s: base %u triangles (quality %.3f, %u fold-overs), %u vertices corrected, %u inherited "
-                             "fold-overs; seconds: simplify %.2f refine %.2f correct %.2f\n",
-                             file.c_str(), stats.base_triangles, stats.base_min_quality, stats.base_fold_overs,
-                             stats.corrected_vertices, stats.inherited_fold_overs, stats.simplify_seconds,
+                             "%s: base %u triangles after %u attempts (quality %.3f, %u fold-overs), %u vertices "
+                             "corrected; wall seconds: simplify %.2f refine %.2f correct %.2f\n",
+                             file.c_str(), stats.base_triangles, stats.base_attempts, stats.base_min_quality,
+                             stats.base_fold_overs, stats.corrected_vertices, stats.simplify_seconds,
                              stats.refine_seconds, stats.correct_seconds);
-                const amc::TriangleMesh mesh = amc::extract_leaf_mesh(h).mesh;
-                print_row(file, reference, input, mesh, seconds, tolerance);
+                const std::string name = file.substr(file.find_last_of('/') + 1);
+                std::printf("%s\t%zu\t%u\t%u\t%u\t%u\t", name.c_str(), reference.triangles.size(), stats.base_triangles,
+                            stats.base_attempts, stats.base_fold_overs, options.target_faces);
+                print_measures(reference, input, amc::extract_leaf_mesh(h).mesh, tolerance);
+                std::printf("\t%u\t%.2f\n", stats.inherited_fold_overs, seconds);
+                std::fflush(stdout);
             }
-        } catch (const amc::Error& e) {
-            std::fprintf(stderr, "remesh_quality: %s\n", e.what());
-            return 1;
+            return 0;
         }
-        return 0;
-    }
-    if (files.size() < 2) {
-        if (header) return 0;
-        std::fprintf(stderr, "usage: remesh_quality [--header] [--tolerance T] REFERENCE APPROXIMATION...\n");
-        return 2;
-    }
-    try {
+        if (files.size() < 2) {
+            if (header) {
+                std::printf("file\t%s\n", kMeasureColumns);
+                return 0;
+            }
+            std::fprintf(stderr, "usage: remesh_quality [--header] [--tolerance T] REFERENCE APPROXIMATION...\n");
+            return 2;
+        }
+        if (header) std::printf("file\t%s\n", kMeasureColumns);
         const amc::TriangleMesh reference = amc::read_mesh(files[0]);
         const amc::MeshShape input = amc::measure_shape(reference);
         for (size_t i = 1; i < files.size(); ++i) {
-            const auto start = std::chrono::steady_clock::now();
-            const amc::TriangleMesh mesh = amc::read_mesh(files[i]);
-            print_row(files[i], reference, input, mesh, -1, tolerance);
-            (void)start;
+            std::printf("%s\t", files[i].c_str());
+            print_measures(reference, input, amc::read_mesh(files[i]), tolerance);
+            std::printf("\n");
+            std::fflush(stdout);
         }
     } catch (const amc::Error& e) {
         std::fprintf(stderr, "remesh_quality: %s\n", e.what());

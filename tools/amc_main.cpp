@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
     refine_cmd->add_option("--input", refine.input, "Reference surface (--model surface) or base mesh (uniform, random)");
     refine_cmd->add_option("--model", refine.model, "surface | bumpy | lshape | front | uniform | random")->capture_default_str();
     refine_cmd->add_option("--criterion", refine.criterion, "mean | gauss | error (surface models)")->capture_default_str();
-    refine_cmd->add_option("--faces", refine.faces, "Target number of leaves (surface, random)")
+    refine_cmd->add_option("--faces", refine.faces, "Target number of leaf-mesh triangles (surface), of leaves (random)")
         ->capture_default_str()->check(CLI::Range(1u, 1u << 30));
     refine_cmd->add_option("--base-faces", refine.base_faces, "Size of the simplified base mesh")
         ->capture_default_str()->check(CLI::Range(4u, 1u << 24));
@@ -123,6 +123,10 @@ int main(int argc, char** argv) {
                            "Hierarchy (.amh) or leaf mesh (.obj .off .ply .vtu); --model front: one file per step, "
                            "NAME_<step>.amh")->required();
     refine_cmd->add_option("--leaf-mesh", refine.leaf_output, "Also write the leaf mesh (.obj .off .ply .vtu)");
+    refine_cmd->add_option("--precision", refine.precision, "Coordinates of a remesh: input (float32 if the input is) | float32 | float64")
+        ->capture_default_str()->check(CLI::IsMember({"input", "float32", "float64"}));
+    refine_cmd->add_flag("--no-measure", refine.no_measure,
+                         "Surface models: skip measuring the remesh against its input (fold-overs, quality, distance)");
 
     std::vector<std::string> report_inputs;
     int report_runs = 3;

@@ -61,6 +61,8 @@ void run_info(const InfoCommand& command, const GlobalOptions& global);
 
 struct RefineCommand {
     std::string input, model = "surface", criterion = "mean", output, leaf_output;
+    std::string precision = "input";  // surface models: input | float32 | float64
+    bool no_measure = false;          // surface models: skip the remesh report
     uint32_t faces = 150000, base_faces = 500;
     int max_level = 7, levels = 3, steps = 5;
     uint64_t seed = 1;

@@ -33,6 +33,18 @@ std::string step_path(const std::string& path, size_t step, const std::string& d
     return p.replace_extension().string() + "_" + std::to_string(step) + extension;
 }
 
+// What the surface remesher did and how close and well-shaped its leaf mesh is (docs/REMESHER.md).
+void print_remesh_report(std::FILE* out, const SurfaceRemeshStats& s, uint32_t asked, bool measured) {
+    std::fprintf(out, "remesh: base %u triangles (%u tried, %u fold-overs), %u leaf-mesh triangles (%u asked), %u vertices corrected\n",
+                 s.base_triangles, s.base_attempts, s.base_fold_overs, s.faces, asked, s.corrected_vertices);
+    if (!measured) return;
+    std::fprintf(out,
+                 "remesh: fold-overs %u (input %u), coincident vertices %u, worst triangle quality %.3g; distance to "
+                 "the input: max %.3e (certified <= %.3e), RMS %.3e of the bounding-box diagonal\n",
+                 s.fold_overs, s.reference_fold_overs, s.coincident_vertices, s.min_quality, s.max_distance,
+                 s.max_distance_bound, s.rms_distance);
+}
+
 }  // namespace
 
 void run_refine(const RefineCommand& c, const GlobalOptions& global) {
@@ -59,6 +71,8 @@ void run_refine(const RefineCommand& c, const GlobalOptions& global) {
     progress.phase("refining (" + c.model + ")");
     const auto start = std::chrono::steady_clock::now();
     std::vector<std::pair<std::string, Hierarchy>> results;
+    SurfaceRemeshStats remesh_stats;
+    bool remeshed = false;
     if (c.model == "surface" || c.model == "bumpy") {
         TriangleMesh reference;
         std::string name = c.model;
@@ -74,7 +88,12 @@ void run_refine(const RefineCommand& c, const GlobalOptions& global) {
         options.base_triangles = c.base_faces;
         options.target_faces = c.faces;
         options.max_level = c.max_level;
-        results.emplace_back(name + "_" + c.criterion, remesh_adaptively(reference, options));
+        options.precision = c.precision == "float32"   ? SurfacePrecision::float32
+                             : c.precision == "float64" ? SurfacePrecision::float64
+                                                        : SurfacePrecision::as_reference;
+        options.measure = !c.no_measure && global.verbosity > 0;
+        results.emplace_back(name + "_" + c.criterion, remesh_adaptively(reference, options, &remesh_stats));
+        remeshed = true;
     } else if (c.model == "lshape") {
         results.emplace_back("lshape", make_l_shape_model(c.max_level));
     } else if (c.model == "front") {
@@ -113,6 +132,7 @@ void run_refine(const RefineCommand& c, const GlobalOptions& global) {
             write_output(leaf_target, format_mesh(leaf.mesh, &leaf.cells, format), global.force);
         }
     }
+    if (remeshed && global.verbosity > 0) print_remesh_report(report, remesh_stats, c.faces, !c.no_measure);
 }
 
 }  // namespace amc::cli
