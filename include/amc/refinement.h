@@ -40,7 +40,7 @@ enum class SurfacePrecision { as_reference, float32, float64 };
 
 struct SurfaceRemeshOptions {
     RefinementCriterion criterion = RefinementCriterion::mean_curvature;
-    uint32_t base_triangles = 500;    // target size of the simplified base (others are tried if it folds over)
+    uint32_t base_triangles = 500;    // target size of the simplified base (doubled while it folds over more than the reference)
     uint32_t target_faces = 150000;   // triangles of the conforming leaf mesh to stop at (or just past)
     int max_level = 7;                // 0 .. kMaxLevel
     // Every leaf-mesh triangle gets at least this quality (4 sqrt(3) area / sum of squared
@@ -52,7 +52,7 @@ struct SurfaceRemeshOptions {
 
 struct SurfaceRemeshStats {
     uint32_t base_triangles = 0;
-    uint32_t base_attempts = 0;        // simplifications tried (remesh_adaptively says which sizes)
+    uint32_t base_attempts = 0;        // simplifications tried (each with twice the triangles)
     double base_min_quality = 0;       // of the base after shape improvement
     uint32_t base_fold_overs = 0;      // left in the base (thin parts it cannot show)
     uint32_t faces = 0;                // triangles of the conforming leaf mesh

@@ -159,45 +159,31 @@ Hierarchy remesh_adaptively(const TriangleMesh& reference, const SurfaceRemeshOp
                         (options.precision == SurfacePrecision::as_reference && reference.single_precision);
     const std::vector<uint8_t> sharp = sharp_vertices(reference, kSharpDegrees);
     s.reference_fold_overs = measure_shape(reference).fold_overs;
-    // A base that folds over passes its folds on to every level below it (the correction falls
-    // back on the flat subdivision of the base, which folds wherever the base does). Sizes B, 2B,
-    // 4B, 8B (below the reference's), then B/2 and B/4 are tried; the first base without
-    // fold-overs is taken, else the one with the fewest (the earliest of those).
-    const uint64_t reference_size = reference.triangles.size();
-    const uint64_t asked = std::max<uint32_t>(options.base_triangles, 4);
-    std::vector<uint64_t> targets;
-    for (uint64_t t = asked; t < reference_size && targets.size() < 4; t *= 2) targets.push_back(t);
-    if (targets.empty()) targets.push_back(asked);  // the reference is its own base
-    for (uint64_t t = std::min(asked, reference_size) / 2; t >= 50 && targets.size() < 6; t /= 2) targets.push_back(t);
+    // A base that folds over where the reference does not (a thin part the simplifier flattened
+    // into a double sheet) passes its folds on to every level below it: retry with twice the
+    // triangles until it folds no more than the reference, at worst the reference itself.
     TriangleMesh base;
-    bool have_base = false;
-    std::string problem;
-    for (const uint64_t target : targets) {
+    for (uint32_t target = std::max<uint32_t>(options.base_triangles, 4);; target = 2 * target) {
         std::vector<uint32_t> source;
-        TriangleMesh candidate;
         try {
-            candidate = simplify_to_base(reference, uint32_t(target), source);
-        } catch (const Error& e) {
-            problem = e.what();  // no valid base near this size (simplify_to_base tried a few)
+            base = simplify_to_base(reference, target, source);
+        } catch (const Error&) {
+            // No valid base near this size (simplify_to_base tried a few): try twice as many.
+            if (target >= reference.triangles.size()) throw;
             continue;
         }
-        ++s.base_attempts;
         if (single) {
-            for (Vec3& p : candidate.positions) p = round_to_float(p);
+            for (Vec3& p : base.positions) p = round_to_float(p);
         }
-        candidate.single_precision = single;
-        std::vector<uint8_t> locked(candidate.positions.size());
+        base.single_precision = single;
+        std::vector<uint8_t> locked(base.positions.size());
         for (size_t v = 0; v < locked.size(); ++v) locked[v] = sharp[source[v]];
-        const ShapeImprovementStats improved = improve_shapes(candidate, surface, reference, locked);
-        if (!have_base || improved.fold_overs_after < s.base_fold_overs) {
-            base = std::move(candidate);
-            have_base = true;
-            s.base_min_quality = improved.min_quality_after;
-            s.base_fold_overs = improved.fold_overs_after;
-        }
-        if (s.base_fold_overs == 0) break;
+        const ShapeImprovementStats improved = improve_shapes(base, surface, reference, locked);
+        s.base_min_quality = improved.min_quality_after;
+        s.base_fold_overs = improved.fold_overs_after;
+        ++s.base_attempts;
+        if (s.base_fold_overs <= s.reference_fold_overs || target >= reference.triangles.size()) break;
     }
-    if (!have_base) throw Error(problem);
     Hierarchy h(std::move(base));
     s.base_triangles = h.root_count();
     s.simplify_seconds = seconds_since(start);
