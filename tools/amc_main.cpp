@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <new>
 
 namespace {
 
@@ -254,6 +255,10 @@ int main(int argc, char** argv) {
     } catch (const UsageError& e) {
         std::fprintf(stderr, "amc: %s\nRun 'amc --help' for usage.\n", e.what());
         return kExitUsage;
+    } catch (const std::bad_alloc&) {
+        // The decoders bound their allocations by the input; what remains is a machine short of memory.
+        std::fprintf(stderr, "amc: error: out of memory\n");
+        return kExitError;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "amc: error: %s\n", e.what());
         return kExitError;

@@ -115,6 +115,12 @@ Hierarchy decode_input(const InputFile& input, const DecodeOptions& options, Lea
     }
 }
 
+void check_level(const std::string& name, int level, int depth) {
+    if (level > depth)
+        throw Error(ErrorCode::invalid_input, name + ": level " + std::to_string(level) +
+                                                  " requested but the hierarchy has levels 0.." + std::to_string(depth));
+}
+
 Hierarchy hierarchy_of(const InputFile& input) {
     if (input.kind != FileKind::hierarchy)
         throw Error(input.name + ": expected a hierarchy (.amh), found " + file_kind_name(input.kind));

@@ -158,9 +158,7 @@ void run_decode(const DecodeCommand& command, const GlobalOptions& global) {
     auto start = std::chrono::steady_clock::now();
     const Hierarchy h = decode_input(input, options, &numbering);
     const double seconds = seconds_since(start);
-    if (command.level > h.depth())
-        throw Error(input.name + ": level " + std::to_string(command.level) + " requested but the file has levels 0.." +
-                    std::to_string(h.depth()));
+    check_level(input.name, command.level, h.depth());  // a file cut short ends at its last level
     if (!command.map.empty() && numbering.empty())
         throw Error(input.name + ": the file stores no numbering (encode a mesh with --keep-numbering, or keep the map "
                     "that encode --map writes)");

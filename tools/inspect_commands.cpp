@@ -85,9 +85,7 @@ void run_extract(const ExtractCommand& command, const GlobalOptions& global) {
     } else {
         h = hierarchy_of(input);
     }
-    if (command.level > h.depth())
-        throw Error(input.name + ": level " + std::to_string(command.level) + " requested but the hierarchy has levels 0.." +
-                    std::to_string(h.depth()));
+    check_level(input.name, command.level, h.depth());
     const LeafMesh leaf = extract_leaf_mesh(h, command.level);
     write_output(command.output, format_mesh(leaf.mesh, &leaf.cells, format), global.force);
 }

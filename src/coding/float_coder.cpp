@@ -242,6 +242,11 @@ Quantizer make_quantizer(Vec3 box_min, Vec3 box_max, int bits) {
     q.bits = bits;
     q.step = extent > 0.0 ? extent / static_cast<double>(q.max_coordinate()) : 1.0;
     if (q.step == 0.0) q.step = std::numeric_limits<double>::denorm_min();
+    // Every grid point must be a finite double: o + (2^bits - 1) * step may round past DBL_MAX
+    // when the box reaches it (the decoder refuses non-finite coordinates).
+    for (int axis = 0; axis < 3; ++axis) {
+        while (!std::isfinite(dequantize_coordinate(q, axis, q.max_coordinate()))) q.step = std::nextafter(q.step, 0.0);
+    }
     return q;
 }
 
