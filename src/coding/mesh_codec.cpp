@@ -133,6 +133,9 @@ Metadata read_metadata(const Block& block, bool quantized) {
                     m.vertices - m.base_vertices <= 3 * refined && 2 * (m.vertices - m.base_vertices) >= 3 * refined &&
                     m.levels - 1 <= refined,
                 corrupt, "metadata block: inconsistent counts");
+    // Every leaf has one to three faces (1 + its hanging nodes).
+    const uint64_t leaves = m.nodes - refined;
+    AMC_REQUIRE(m.faces >= leaves && m.faces <= 3 * leaves, corrupt, "metadata block: inconsistent face count");
     return m;
 }
 
@@ -151,6 +154,10 @@ void check_counts_against_size(const Metadata& m, uint64_t bytes_after, const De
                 cannot_hold(m.vertices - m.base_vertices, "refinement vertices"));
     AMC_REQUIRE(m.base_triangles <= 2 * max_decodable_symbols(bytes_after), corrupt,
                 cannot_hold(m.base_triangles, "base triangles"));
+    HierarchyStreamHeader header;
+    read_hierarchy_stream_header(m.hierarchy_header.data(), m.hierarchy_header.size(), header);
+    AMC_REQUIRE(header.symbol_count <= std::min(m.nodes, max_decodable_symbols(bytes_after)), corrupt,
+                cannot_hold(header.symbol_count, "hierarchy symbols"));
     AMC_REQUIRE(m.nodes <= options.max_nodes, limit_exceeded,
                 "file holds " + std::to_string(m.nodes) + " nodes, more than the limit of " +
                     std::to_string(options.max_nodes));
@@ -218,6 +225,16 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     EncodeStats stats;
     const std::string problem = check_invariants(input);
     AMC_REQUIRE(problem.empty(), invalid_input, "encode: invalid hierarchy: " + problem);
+    // The decoder refuses non-finite coordinates (FORMAT.md, 3.7): so does the encoder. Midpoints
+    // of coordinates beyond DBL_MAX / 2 overflow to infinity.
+    for (NodeId n = 0; n < input.node_capacity(); ++n) {
+        if (!input.is_alive(n) || !input.is_leaf(n)) continue;  // the leaves' corners are every live vertex
+        for (int i = 0; i < 3; ++i) {
+            const Vec3 p = input.position(input.vertex(n, i));
+            AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), invalid_input,
+                        "encode: vertex " + std::to_string(input.vertex(n, i)) + " has a non-finite coordinate");
+        }
+    }
     const bool quantized = options.quantize_bits != 0;
     // Quantized coordinates are reconstructed as doubles on the grid, whatever the input precision.
     const Precision precision = input.single_precision() && !quantized ? Precision::float32 : Precision::float64;

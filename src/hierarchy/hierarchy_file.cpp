@@ -16,7 +16,6 @@ namespace {
 constexpr char kMagic[4] = {'A', 'M', 'C', 'H'};
 constexpr uint32_t kVersion = 1;
 constexpr uint32_t kFlagSinglePrecision = 1;
-constexpr size_t kHeaderSize = 4 + 4 * 7;
 
 void put_u32(std::string& out, uint32_t v) {
     for (int i = 0; i < 4; ++i) out.push_back(char((v >> (8 * i)) & 0xff));

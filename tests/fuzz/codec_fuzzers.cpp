@@ -1,0 +1,83 @@
+// Fuzz targets of the .amc file: decode (whole, every prefix of levels, and encoded again) and
+// inspect, each on the input as it is and with its checksums made valid, so that mutations reach
+// the payload decoders behind the checksums.
+#include "fuzz_targets.h"
+
+#include <amc/codec.h>
+#include <amc/refinement.h>
+
+#include <algorithm>
+
+namespace amc::fuzz {
+namespace {
+
+// Keeps a run short and its memory small (a node takes about 40 bytes): most of the time goes to
+// the decoders' checks, not to building large hierarchies.
+constexpr uint64_t kMaxNodes = uint64_t(1) << 16;
+
+void decode_file(const uint8_t* data, size_t size) {
+    DecodeOptions options;
+    options.max_nodes = kMaxNodes;
+    LeafNumbering numbering;
+    Hierarchy h;
+    try {
+        h = decode(data, size, options, &numbering);
+    } catch (const Error&) {
+        // Refused whole, its first levels may still decode (or be refused as well).
+        options.max_level = int(size % 5);
+        try {
+            decode(data, size, options);
+        } catch (const Error&) {
+        }
+        return;
+    }
+    FUZZ_CHECK(check_invariants(h).empty());
+    if (!numbering.empty()) {
+        FUZZ_CHECK(check_numbering(numbering, h.vertex_count(), extract_leaf_mesh(h).mesh.triangles.size()).empty());
+    }
+    // A prefix of levels decodes, to the first levels of the whole (one cut a run, chosen by the
+    // input, keeps valid files as quick as broken ones).
+    const std::vector<uint32_t> levels = compute_stats(h).nodes_per_level;
+    {
+        const int cut = int(size % size_t(h.depth() + 2));
+        options.max_level = cut;
+        const Hierarchy prefix = decode(data, size, options);  // throws: a finding
+        const std::vector<uint32_t> prefix_levels = compute_stats(prefix).nodes_per_level;
+        FUZZ_CHECK(prefix_levels.size() == std::min(levels.size(), size_t(cut) + 1));
+        FUZZ_CHECK(std::equal(prefix_levels.begin(), prefix_levels.end(), levels.begin()));
+    }
+    // What the decoder accepts the encoder accepts, and the file it writes decodes to it.
+    EncodeOptions fixed;
+    fixed.predictor = GeometryPredictor::midpoint;  // no trial encodings
+    const std::vector<uint8_t> again = encode(h, fixed);
+    FUZZ_CHECK(identical(decode(again.data(), again.size()), in_decoder_order(h)));
+}
+
+void inspect_file(const uint8_t* data, size_t size) {
+    FileInfo info;
+    try {
+        info = inspect(data, size);
+    } catch (const Error&) {
+        return;
+    }
+    uint64_t total = 12;
+    for (const FileBlock& block : info.blocks) total += block.size;
+    FUZZ_CHECK(total == size);
+    FUZZ_CHECK(!info.blocks.empty() && info.blocks.back().name == "end");
+}
+
+}  // namespace
+
+void amc_decode(const uint8_t* data, size_t size) {
+    decode_file(data, size);
+    const std::vector<uint8_t> repaired = with_valid_checksums(data, size);
+    if (!std::equal(repaired.begin(), repaired.end(), data)) decode_file(repaired.data(), repaired.size());
+}
+
+void amc_inspect(const uint8_t* data, size_t size) {
+    inspect_file(data, size);
+    const std::vector<uint8_t> repaired = with_valid_checksums(data, size);
+    if (!std::equal(repaired.begin(), repaired.end(), data)) inspect_file(repaired.data(), repaired.size());
+}
+
+}  // namespace amc::fuzz

@@ -1,0 +1,60 @@
+// The list of targets and what they share.
+#include "fuzz_targets.h"
+
+#include <xxhash.h>
+
+#include <cstdio>
+#include <cstdlib>
+
+namespace amc::fuzz {
+
+const std::vector<Target>& targets() {
+    static const std::vector<Target> all = {
+        {"amc_decode", amc_decode},
+        {"amc_inspect", amc_inspect},
+        {"amh_read", amh_read},
+        {"hierarchy_stream", hierarchy_stream},
+        {"base_connectivity", base_connectivity},
+        {"geometry", geometry},
+        {"obj_read", obj_read},
+        {"off_read", off_read},
+        {"ply_read", ply_read},
+        {"round_trip", round_trip},
+    };
+    return all;
+}
+
+void violated(const char* what, const char* file, int line) {
+    std::fprintf(stderr, "fuzz property violated: %s (%s:%d)\n", what, file, line);
+    std::abort();
+}
+
+namespace {
+
+uint32_t get_u32(const uint8_t* p) {
+    return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+}
+
+void put_u32(uint8_t* p, uint32_t v) {
+    for (int i = 0; i < 4; ++i) p[i] = uint8_t(v >> (8 * i));
+}
+
+}  // namespace
+
+// The framing of docs/FORMAT.md, 3.1 and 3.2: a 12-byte header whose last four bytes are the
+// XXH32 of the first eight, then blocks of type, length, payload and XXH32 of those.
+std::vector<uint8_t> with_valid_checksums(const uint8_t* data, size_t size) {
+    std::vector<uint8_t> out(data, data + size);
+    if (size < 12) return out;
+    put_u32(out.data() + 8, XXH32(out.data(), 8, 0));
+    size_t pos = 12;
+    while (size - pos >= 9) {
+        const uint32_t length = get_u32(out.data() + pos + 1);
+        if (length > size - pos - 9) break;
+        put_u32(out.data() + pos + 5 + length, XXH32(out.data() + pos, 5 + size_t(length), 0));
+        pos += 9 + size_t(length);
+    }
+    return out;
+}
+
+}  // namespace amc::fuzz

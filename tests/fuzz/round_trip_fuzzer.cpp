@@ -1,0 +1,141 @@
+// The round-trip property: the input drives a random hierarchy (base mesh, refinements and
+// coarsenings, flipped diagonals, coordinates anywhere in the float or double range, a caller's
+// numbering) and the encoder's options (quantization, predictor, the coder's 64 switch
+// combinations). The encoder either refuses it as invalid input or writes a file that decodes:
+// bit-exactly to the input in the decoder's order, or on the grid within the reported error.
+#include "fuzz_targets.h"
+
+#include <amc/codec.h>
+#include <amc/refinement.h>
+
+#include <cfloat>
+#include <cmath>
+#include <cstring>
+#include <numeric>
+#include <utility>
+
+namespace amc::fuzz {
+namespace {
+
+constexpr uint32_t kMaxNodes = 20000;  // the hierarchy a run builds at most
+constexpr int kMaxRefinedLevel = 7;
+
+// Any finite value of the precision, from raw bits: infinities and NaNs become the largest
+// finite value of their sign, so the extremes come up often.
+double any_coordinate(ByteReader& in, bool single) {
+    if (single) {
+        const uint32_t bits = in.u32();
+        float f;
+        std::memcpy(&f, &bits, 4);
+        if (!std::isfinite(f)) f = std::signbit(f) ? -FLT_MAX : FLT_MAX;
+        return f;
+    }
+    const uint64_t bits = in.u64();
+    double d;
+    std::memcpy(&d, &bits, 8);
+    if (!std::isfinite(d)) d = std::signbit(d) ? -DBL_MAX : DBL_MAX;
+    return d;
+}
+
+Vec3 any_position(ByteReader& in, bool single) {
+    const double x = any_coordinate(in, single), y = any_coordinate(in, single);
+    return {x, y, any_coordinate(in, single)};
+}
+
+std::vector<uint32_t> any_permutation(ByteReader& in, uint32_t n) {
+    std::vector<uint32_t> p(n);
+    std::iota(p.begin(), p.end(), 0u);
+    for (uint32_t i = n; i > 1; --i) std::swap(p[i - 1], p[in.u32() % i]);
+    return p;
+}
+
+// Positions in canonical order (the order the decoder's file and extract_leaf_mesh use).
+std::vector<Vec3> canonical_positions(const Hierarchy& h) {
+    const std::vector<uint32_t> order = canonical_vertex_order(h);
+    std::vector<Vec3> out(h.vertex_count());
+    for (size_t v = 0; v < order.size(); ++v)
+        if (order[v] != 0xffffffffu) out[order[v]] = h.position(VertexId(v));
+    return out;
+}
+
+}  // namespace
+
+void round_trip(const uint8_t* data, size_t size) {
+    ByteReader in(data, size);
+    const uint8_t flags = in.u8();
+    const bool single = flags & 1, wild = flags & 2, numbered = flags & 4;
+    const std::vector<TriangleMesh>& bases = stream_bases();
+    TriangleMesh base = bases[in.u8() % bases.size()];
+    base.single_precision = single;
+    for (Vec3& p : base.positions) {
+        if (wild) p = any_position(in, single);
+        else if (single) p = {float(p.x), float(p.y), float(p.z)};
+    }
+
+    Hierarchy h(base);
+    const int operations = in.u8() % 64;
+    for (int i = 0; i < operations && h.node_count() < kMaxNodes; ++i) {
+        const NodeId n = in.u32() % h.node_capacity();
+        const uint8_t op = in.u8();
+        if (!h.is_alive(n)) continue;
+        if (op % 4 != 0) {
+            if (h.is_leaf(n) && h.level(n) < kMaxRefinedLevel) h.refine(n);
+        } else if (!h.is_leaf(n)) {
+            h.coarsen(n);
+        }
+    }
+    for (NodeId n = 0; n < h.node_capacity(); ++n) {
+        if (h.is_alive(n) && h.is_leaf(n) && h.hanging_node_count(n) == 2 && (flags & 8) && (in.u8() & 1))
+            h.set_diagonal_flipped(n, true);
+    }
+    if (wild) {
+        const std::vector<uint32_t> order = canonical_vertex_order(h);
+        for (VertexId v = 0; v < order.size(); ++v)
+            if (order[v] != 0xffffffffu && order[v] >= base.positions.size() && (in.u8() & 1))
+                h.set_position(v, any_position(in, single));
+    }
+
+    EncodeOptions options;
+    const uint8_t q = in.u8();
+    options.quantize_bits = q < 160 ? 0 : 1 + q % 30;
+    options.predictor = GeometryPredictor(in.u8() % 3);
+    options.hierarchy = coder_options_from_switches(in.u8() % kCoderSwitchCombinations);
+    LeafNumbering numbering;
+    if (numbered) {
+        const uint32_t faces = uint32_t(extract_leaf_mesh(h).mesh.triangles.size());
+        numbering.vertex = any_permutation(in, h.vertex_count());
+        numbering.face = any_permutation(in, faces);
+        numbering.rotation.resize(faces);
+        for (uint8_t& r : numbering.rotation) r = in.u8() % 3;
+        options.numbering = &numbering;
+    }
+
+    std::vector<uint8_t> file;
+    EncodeStats stats;
+    try {
+        file = encode(h, options, &stats);
+    } catch (const Error& e) {
+        FUZZ_CHECK(e.code() == ErrorCode::invalid_input);  // refused as input the format can not hold
+        return;
+    }
+    LeafNumbering decoded_numbering;
+    const Hierarchy decoded = decode(file.data(), file.size(), {}, &decoded_numbering);  // throws: a finding
+    const Hierarchy expected = in_decoder_order(h);
+    if (numbered) {
+        FUZZ_CHECK(decoded_numbering.vertex == stats.numbering.vertex && decoded_numbering.face == stats.numbering.face &&
+                   decoded_numbering.rotation == stats.numbering.rotation);
+    }
+    if (options.quantize_bits == 0) {
+        FUZZ_CHECK(identical(decoded, expected));
+        return;
+    }
+    FUZZ_CHECK(decoded.node_count() == expected.node_count() && decoded.vertex_count() == expected.vertex_count());
+    FUZZ_CHECK(extract_leaf_mesh(decoded).mesh.triangles == extract_leaf_mesh(expected).mesh.triangles);
+    const std::vector<Vec3> a = canonical_positions(decoded), b = canonical_positions(expected);
+    for (size_t i = 0; i < a.size(); ++i) {
+        FUZZ_CHECK(std::fabs(a[i].x - b[i].x) <= stats.max_error && std::fabs(a[i].y - b[i].y) <= stats.max_error &&
+                   std::fabs(a[i].z - b[i].z) <= stats.max_error);
+    }
+}
+
+}  // namespace amc::fuzz

@@ -1,0 +1,51 @@
+// Every input a fuzzer found a problem with (tests/data/fuzz-regressions/<target>/, named after
+// the finding) runs through its target again, as do the golden files through the .amc targets:
+// a crash, sanitizer report, uncaught exception or violated property fails the test.
+#include "fuzz_targets.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+namespace amc {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::vector<uint8_t> read_bytes(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::vector<uint8_t>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+class FuzzRegressions : public ::testing::TestWithParam<fuzz::Target> {};
+
+TEST_P(FuzzRegressions, EveryFoundInputPasses) {
+    const fuzz::Target target = GetParam();
+    std::vector<fs::path> inputs;
+    const fs::path data = AMC_TEST_DATA_DIR;
+    const fs::path regressions = data / "fuzz-regressions" / target.name;
+    if (fs::is_directory(regressions))
+        for (const auto& entry : fs::directory_iterator(regressions)) inputs.push_back(entry.path());
+    if (std::string(target.name).rfind("amc_", 0) == 0)
+        for (const auto& entry : fs::recursive_directory_iterator(data / "golden"))
+            if (entry.is_regular_file()) inputs.push_back(entry.path());
+    target.run(nullptr, 0);
+    for (const fs::path& input : inputs) {
+        SCOPED_TRACE(input.string());
+        const std::vector<uint8_t> bytes = read_bytes(input);
+        const auto start = std::chrono::steady_clock::now();
+        target.run(bytes.data(), bytes.size());
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        EXPECT_LT(seconds, 5.0) << "slow input (a run takes milliseconds)";
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(All, FuzzRegressions, ::testing::ValuesIn(fuzz::targets()),
+                         [](const ::testing::TestParamInfo<fuzz::Target>& info) { return std::string(info.param.name); });
+
+}  // namespace
+}  // namespace amc
