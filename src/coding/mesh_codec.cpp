@@ -363,10 +363,11 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
 
 namespace {
 
-// Nodes reserved up front per byte of the file: a multiple of what real files hold (about one
-// node per byte), so that they are decoded in memory of their final size, while a small file
-// that announces a large hierarchy gets no more than its bytes warrant before it is decoded.
-constexpr uint64_t kReservedNodesPerFileByte = 64;
+// Nodes reserved up front per byte of the file: more than real files hold (about one node per
+// byte; a finite-element hierarchy with exact midpoints about 100), so that they are decoded in
+// memory of their final size, while a small file that announces a large hierarchy gets no more
+// than its bytes warrant before it is decoded (more grows as the levels are built).
+constexpr uint64_t kReservedNodesPerFileByte = 128;
 
 Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& options, LeafNumbering* numbering) {
     if (numbering != nullptr) *numbering = {};
@@ -467,7 +468,6 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
         // this block: it bounds R before the next level is allocated.
         hierarchy.decode_level(decoder, 2 * max_decodable_positions(block.size - 1) / 3);
         for (auto [n, e] : new_vertices_of_level(h, nodes)) {
-            if (decoder.overran()) break;
             const Vec3 p = positions.decode(decoder, level_context(h.level(n)), predict(h, predictor, n, e));
             AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
                         "level " + std::to_string(level) + " geometry is corrupt (non-finite coordinate)");
