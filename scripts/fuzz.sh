@@ -2,8 +2,9 @@
 # Builds the libFuzzer targets of tests/fuzz (clang, ASan + UBSan, every finding fatal) and runs
 # them one after the other under nice -n 19, each for --seconds (default an hour).
 #
-#   scripts/fuzz.sh [--seconds N] [--build DIR] [TARGET ...]
+#   scripts/fuzz.sh [--seconds N] [--seed S] [--build DIR] [TARGET ...]
 #
+# --seed fixes libFuzzer's random seed (CI: the same mutations every run); 0, the default, draws one.
 # Corpora persist in DIR/corpus/<target> (DIR = build-fuzz) and start from the seeds fuzz_seeds
 # writes (golden files, tests/data, small encodings of every kind, regression inputs). A crash,
 # leak, timeout (-timeout: 25 s, where a run takes milliseconds; the machine is shared), out of
@@ -15,13 +16,15 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=3600
+seed=0
 build=build-fuzz
 targets=()
 while (($#)); do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
+    --seed) seed="$2"; shift 2 ;;
     --build) build="$2"; shift 2 ;;
-    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
     *) targets+=("$1"); shift ;;
   esac
 done
@@ -41,7 +44,7 @@ for t in "${targets[@]}"; do
   log="$build/logs/$t.log"
   start=$(date +%s)
   # The first folder collects the new inputs; the seeds are read only.
-  nice -n 19 "$bin/fuzz_$t" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=25 -print_final_stats=1 \
+  nice -n 19 "$bin/fuzz_$t" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=25 -seed="$seed" -print_final_stats=1 \
     -artifact_prefix="$build/findings/$t/" "$build/corpus/$t" "$build/seeds/$t" > "$log" 2>&1 || true
   elapsed=$(($(date +%s) - start))
   executions=$(grep -o 'stat::number_of_executed_units: [0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)

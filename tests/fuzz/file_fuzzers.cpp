@@ -5,11 +5,14 @@
 #include "mesh/obj_io.h"
 #include "mesh/off_io.h"
 #include "mesh/ply_io.h"
+#include "mesh/vtu_reader.h"
+#include "mesh/vtu_writer.h"
 
 #include <amc/hierarchy.h>
 
 #include <cstring>
 #include <string>
+#include <variant>
 
 namespace amc::fuzz {
 namespace {
@@ -18,6 +21,22 @@ bool same_bits(const TriangleMesh& a, const TriangleMesh& b) {
     return a.single_precision == b.single_precision && a.triangles == b.triangles &&
            a.positions.size() == b.positions.size() &&
            (a.positions.empty() || std::memcmp(a.positions.data(), b.positions.data(), a.positions.size() * sizeof(Vec3)) == 0);
+}
+
+bool same_bits(const std::vector<DataArray>& a, const std::vector<DataArray>& b) {
+    if (a.size() != b.size()) return false;
+    for (size_t i = 0; i < a.size(); ++i) {
+        if (a[i].name != b[i].name || a[i].components != b[i].components || a[i].values.index() != b[i].values.index())
+            return false;
+        const bool same = std::visit(
+            [&](const auto& x) {
+                const auto& y = std::get<std::decay_t<decltype(x)>>(b[i].values);
+                return x.size() == y.size() && (x.empty() || std::memcmp(x.data(), y.data(), x.size() * sizeof(x[0])) == 0);
+            },
+            a[i].values);
+        if (!same) return false;
+    }
+    return true;
 }
 
 template <class Parse, class Format>
@@ -62,6 +81,23 @@ void off_read(const uint8_t* data, size_t size) {
 void ply_read(const uint8_t* data, size_t size) {
     read_mesh_bytes(data, size, [](const std::string& text, const std::string& what) { return parse_ply(text, what); },
                     [](const TriangleMesh& mesh) { return format_ply(mesh); });
+}
+
+void vtu_read(const uint8_t* data, size_t size) {
+    const std::string_view bytes(reinterpret_cast<const char*>(data), size);
+    VtuMesh vtu;
+    try {
+        vtu = parse_vtu(bytes, "input");
+        validate_triangle_mesh(vtu.mesh, "input");
+    } catch (const Error&) {
+        return;
+    }
+    // Written again (binary or ascii, by the input's size), it reads back bit for bit.
+    const std::string written = format_vtu(vtu.mesh, vtu.point_data, vtu.cell_data,
+                                           size % 2 ? VtuEncoding::ascii : VtuEncoding::binary_zlib);
+    const VtuMesh back = parse_vtu(written, "written");
+    FUZZ_CHECK(same_bits(back.mesh, vtu.mesh));
+    FUZZ_CHECK(same_bits(back.point_data, vtu.point_data) && same_bits(back.cell_data, vtu.cell_data));
 }
 
 }  // namespace amc::fuzz

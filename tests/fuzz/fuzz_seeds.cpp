@@ -11,6 +11,7 @@
 #include "mesh/obj_io.h"
 #include "mesh/off_io.h"
 #include "mesh/ply_io.h"
+#include "mesh/vtu_writer.h"
 
 #include <amc/codec.h>
 #include <amc/refinement.h>
@@ -183,6 +184,7 @@ void mesh_seeds(const std::vector<Hierarchy>& hierarchies) {
         write_seed("obj_read", format_obj(mesh));
         write_seed("off_read", format_off(mesh));
         write_seed("ply_read", format_ply(mesh));
+        write_seed("vtu_read", format_vtu(mesh, {}, cell_data_arrays(extract_leaf_mesh(hierarchies[i]).cells), VtuEncoding::ascii));
         mesh.single_precision = true;
         for (Vec3& p : mesh.positions) p = {float(p.x), float(p.y), float(p.z)};
         write_seed("ply_read", format_ply(mesh));
@@ -229,6 +231,8 @@ int main(int argc, char** argv) {
     copy_files(data / "bad", "obj_read", ".obj");
     copy_files(data / "bad", "off_read", ".off");
     copy_files(data / "bad", "ply_read", ".ply");
+    copy_files(data / "bad", "vtu_read", ".vtu");
+    copy_files(data / "vtu", "vtu_read", ".vtu");
     for (const fuzz::Target& target : fuzz::targets()) copy_files(data / "fuzz-regressions" / target.name, target.name, "");
     for (const fuzz::Target& target : fuzz::targets()) {
         const fs::path dir = out_dir / target.name;

@@ -19,6 +19,7 @@ const std::vector<Target>& targets() {
         {"obj_read", obj_read},
         {"off_read", off_read},
         {"ply_read", ply_read},
+        {"vtu_read", vtu_read},
         {"round_trip", round_trip},
     };
     return all;

@@ -30,6 +30,7 @@ void geometry(const uint8_t* data, size_t size);           // the coordinate (fl
 void obj_read(const uint8_t* data, size_t size);           // mesh readers and writers
 void off_read(const uint8_t* data, size_t size);
 void ply_read(const uint8_t* data, size_t size);
+void vtu_read(const uint8_t* data, size_t size);
 void round_trip(const uint8_t* data, size_t size);         // random hierarchy -> encode -> decode
 
 // Input layouts of the stream targets, which fuzz_seeds writes too.
