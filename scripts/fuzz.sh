@@ -11,8 +11,9 @@
 # memory (-rss_limit_mb: 2 GiB) or violated property is saved to DIR/findings/<target>/; once
 # fixed, each becomes a regression input in tests/data/fuzz-regressions/<target>/ (amc_tests
 # runs them). Prints, and appends to DIR/fuzz-summary.txt, a line per target: executions,
-# seconds, coverage (libFuzzer's cov and ft), corpus size, findings. Exits 1 when any target
-# found something. .ci/run runs every target briefly.
+# wall-clock seconds, CPU seconds (under nice -n 19 on a loaded machine the two differ a lot),
+# coverage (libFuzzer's cov and ft), corpus size, findings. Exits 1 when any target found
+# something. .ci/run runs every target briefly.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=3600
@@ -38,14 +39,16 @@ rm -rf "$build/seeds"
 ((${#targets[@]})) || mapfile -t targets < <("$bin/fuzz_seeds" --list)
 
 status=0
-printf '%-18s %12s %8s %7s %7s %7s %8s\n' target executions seconds cov ft corpus findings
+printf '%-18s %12s %8s %8s %7s %7s %7s %8s\n' target executions seconds cpu_s cov ft corpus findings
+TIMEFORMAT='%3U %3S'
 for t in "${targets[@]}"; do
   mkdir -p "$build/corpus/$t" "$build/findings/$t" "$build/logs"
   log="$build/logs/$t.log"
   start=$(date +%s)
   # The first folder collects the new inputs; the seeds are read only.
-  nice -n 19 "$bin/fuzz_$t" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=25 -seed="$seed" -print_final_stats=1 \
-    -artifact_prefix="$build/findings/$t/" "$build/corpus/$t" "$build/seeds/$t" > "$log" 2>&1 || true
+  { time nice -n 19 "$bin/fuzz_$t" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=25 -seed="$seed" -print_final_stats=1 \
+    -artifact_prefix="$build/findings/$t/" "$build/corpus/$t" "$build/seeds/$t" > "$log" 2>&1; } 2> "$build/logs/$t.time" || true
+  cpu=$(awk '{printf "%.0f", $1 + $2}' "$build/logs/$t.time")
   elapsed=$(($(date +%s) - start))
   executions=$(grep -o 'stat::number_of_executed_units: [0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
   last=$(grep -E '^#[0-9]+' "$log" | tail -1)
@@ -53,7 +56,7 @@ for t in "${targets[@]}"; do
   ft=$(grep -o 'ft: [0-9]*' <<< "$last" | grep -o '[0-9]*' || echo 0)
   corpus=$(find "$build/corpus/$t" -type f | wc -l)
   findings=$(find "$build/findings/$t" -type f | wc -l)
-  line=$(printf '%-18s %12s %8s %7s %7s %7s %8s' "$t" "${executions:-0}" "$elapsed" "${cov:-0}" "${ft:-0}" "$corpus" "$findings")
+  line=$(printf '%-18s %12s %8s %8s %7s %7s %7s %8s' "$t" "${executions:-0}" "$elapsed" "${cpu:-0}" "${cov:-0}" "${ft:-0}" "$corpus" "$findings")
   echo "$line"
   echo "$(date -u +%FT%TZ) $line" >> "$build/fuzz-summary.txt"
   if ((findings > 0)); then
