@@ -69,7 +69,8 @@ void base_connectivity(const uint8_t* data, size_t size) {
     // Layout: u16 vertex count (the .amc metadata gives it to the decoder), then the stream.
     // Positions come from base_position(): mode 2 reads them while it decodes.
     ByteReader in(data, size);
-    const uint32_t n = uint32_t(in.u8()) | uint32_t(in.u8()) << 8;
+    const uint32_t low = in.u8();
+    const uint32_t n = low | uint32_t(in.u8()) << 8;
     const BasePositionSource source = [](uint32_t v, const BaseStencil&, const std::vector<Vec3>&) { return base_position(v); };
     DecodedBaseMesh decoded;
     try {
