@@ -115,6 +115,11 @@ void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
             std::fprintf(out, "  import %.3f s: base %lu triangles (%s)\n", import_seconds, (unsigned long)h.root_count(),
                          command.base.empty() ? "detected" : command.base.c_str());
     }
+    // Not an error (a caller may raise the limit), but the default decode refuses such a file.
+    if (stats.nodes > DecodeOptions().max_nodes)
+        std::fprintf(stderr, "amc: warning: %s holds %lu nodes, more than decoders read by default (%lu): decode it with --max-nodes %lu\n",
+                     output == "-" ? "stdout" : output.c_str(), (unsigned long)stats.nodes,
+                     (unsigned long)DecodeOptions().max_nodes, (unsigned long)stats.nodes);
 }
 
 void run_decode(const DecodeCommand& command, const GlobalOptions& global) {

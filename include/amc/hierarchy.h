@@ -99,7 +99,12 @@ public:
     // Vertex positions by id; ids of removed vertices are reused (position of a dead id unused).
     const std::vector<Vec3>& positions() const { return positions_; }
     Vec3 position(VertexId v) const { return positions_[v]; }
-    void set_position(VertexId v, Vec3 p) { positions_[v] = p; }
+    // A base vertex's position is the base mesh's too (base().positions).
+    void set_position(VertexId v, Vec3 p) {
+        positions_[v] = p;
+        if (v < base_.positions.size()) base_.positions[v] = p;
+        far_positions_ |= is_far(p);
+    }
     bool single_precision() const { return base_.single_precision; }
     // Declares the coordinates float32 (new midpoints rounded to float) or float64; restores the
     // default vertex placer.
@@ -108,7 +113,8 @@ public:
         set_vertex_placer(nullptr, nullptr);
     }
     // Called for every vertex that refinement creates, with the edge's end points; the default
-    // places new vertices at edge midpoints (rounded to float when the base is single precision).
+    // places new vertices at edge midpoints, 0.5 * (a + b) (computed without overflow where a + b
+    // would overflow) rounded to float when the base is single precision.
     // A null placer restores the default.
     using VertexPlacer = Vec3 (*)(void* context, Vec3 a, Vec3 b);
     void set_vertex_placer(VertexPlacer placer, void* context);
@@ -184,6 +190,15 @@ private:
     uint32_t live_vertices_ = 0;
     VertexPlacer placer_ = nullptr;
     void* placer_context_ = nullptr;
+    // Some position may lie beyond DBL_MAX / 2 (or be NaN), where 0.5 * (a + b) overflows: the
+    // default placer then takes its overflow-safe path in split_level too. (Midpoints lie within
+    // their ends' range, so only set_position and other placers can set it.)
+    bool far_positions_ = false;
+    static bool is_far(Vec3 p) {
+        constexpr double kHalfMax = 8.98846567431157953865e307;  // DBL_MAX / 2
+        return !(p.x <= kHalfMax && p.x >= -kHalfMax && p.y <= kHalfMax && p.y >= -kHalfMax && p.z <= kHalfMax &&
+                 p.z >= -kHalfMax);
+    }
 };
 
 // Structural and geometric equality: same base mesh, same forest, same effective diagonals (flags
@@ -212,8 +227,12 @@ LeafMesh extract_leaf_mesh(const Hierarchy& h, int max_level = -1);
 // ---- invariants ----------------------------------------------------------------------------
 
 // Checks every structural invariant (links symmetric, balance, closure, children geometry,
-// shared midpoints, counts) and returns a description of the first violation, or "" if valid.
+// shared midpoints, counts, the level cap) and returns a description of the first violation, or
+// "" if valid.
 std::string check_invariants(const Hierarchy& h);
+// Checks the positions of the live vertices: finite, and float32 values in a single-precision
+// hierarchy (what its files store). Returns a description of the first violation, or "".
+std::string check_positions(const Hierarchy& h);
 
 // ---- base order ------------------------------------------------------------------------------
 

@@ -282,6 +282,14 @@ Vec3 dequantize(const Quantizer& quantizer, GridPoint q) {
             dequantize_coordinate(quantizer, 2, q[2])};
 }
 
+GridPoint snap_to_grid(const Quantizer& quantizer, Vec3 p) {
+    GridPoint q = quantize(quantizer, p);
+    for (int axis = 0; axis < 3; ++axis) {
+        while (q[size_t(axis)] > 0 && !std::isfinite(dequantize_coordinate(quantizer, axis, q[size_t(axis)]))) --q[size_t(axis)];
+    }
+    return q;
+}
+
 double quantization_error_bound(const Quantizer& quantizer) {
     // (x - o) / step, the rounding, q * step and o + q * step each round once: a few ulps of the
     // largest magnitude involved.
@@ -294,7 +302,7 @@ double quantization_error_bound(const Quantizer& quantizer) {
 double max_quantization_error(const Quantizer& quantizer, const std::vector<Vec3>& points) {
     double worst = 0.0;
     for (const Vec3& p : points) {
-        const Vec3 r = dequantize(quantizer, quantize(quantizer, p));
+        const Vec3 r = dequantize(quantizer, snap_to_grid(quantizer, p));
         worst = std::fmax(worst, std::fabs(r.x - p.x));
         worst = std::fmax(worst, std::fabs(r.y - p.y));
         worst = std::fmax(worst, std::fabs(r.z - p.z));

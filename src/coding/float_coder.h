@@ -140,10 +140,14 @@ uint32_t quantize_coordinate(const Quantizer& quantizer, int axis, double x);
 GridPoint quantize(const Quantizer& quantizer, Vec3 p);
 double dequantize_coordinate(const Quantizer& quantizer, int axis, uint32_t q);
 Vec3 dequantize(const Quantizer& quantizer, GridPoint q);
+// The grid point the encoder stores for a position: quantize()'s, one step lower on an axis where
+// that would reconstruct beyond the largest double (a box that reaches DBL_MAX), so that every
+// reconstruction is finite.
+GridPoint snap_to_grid(const Quantizer& quantizer, Vec3 p);
 // A bound on |x - dequantize(quantize(x))| for every x inside the quantizer's box: step / 2
 // plus the rounding of the arithmetic.
 double quantization_error_bound(const Quantizer& quantizer);
-// The largest coordinate error max |x - dequantize(quantize(x))| over the points.
+// The largest coordinate error max |x - dequantize(snap_to_grid(x))| over the points.
 double max_quantization_error(const Quantizer& quantizer, const std::vector<Vec3>& points);
 
 // Codes the grid coordinate `actual` given the grid coordinate `predicted` (both < 2^bits;

@@ -59,7 +59,7 @@ std::vector<std::pair<NodeId, int>> new_vertices_of_level(const Hierarchy& h,
 Vec3 predict_midpoint(const Hierarchy& h, NodeId n, int e) {
     const Vec3 a = h.position(h.vertex(n, e));
     const Vec3 b = h.position(h.vertex(n, (e + 1) % 3));
-    return round_if_single(h, 0.5 * (a + b));  // the expression of forest.cpp's midpoint_placer
+    return round_if_single(h, 0.5 * (a + b));  // FORMAT.md 5.5 (forest.cpp's placer where a + b is finite)
 }
 
 Vec3 predict_butterfly(const Hierarchy& h, NodeId n, int e) {

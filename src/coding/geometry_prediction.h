@@ -26,9 +26,9 @@ std::vector<std::vector<NodeId>> nodes_by_level(const Hierarchy& h);
 std::vector<std::pair<NodeId, int>> new_vertices_of_level(const Hierarchy& h,
                                                           const std::vector<NodeId>& level_nodes);
 
-// Midpoint of edge e of node n, computed exactly as the hierarchy's default vertex placer does
-// (0.5 * (a + b), rounded to float for single-precision hierarchies): exact finite-element
-// midpoints predict with residual 0.
+// Midpoint of edge e of node n, 0.5 * (a + b) (rounded to float for single-precision
+// hierarchies), as FORMAT.md 5.5 fixes it: the hierarchy's default vertex placer wherever a + b
+// does not overflow, so exact finite-element midpoints predict with residual 0.
 Vec3 predict_midpoint(const Hierarchy& h, NodeId n, int e);
 
 // The 8-point butterfly stencil (Dyn, Levin, Gregory 1990) for edge e of node n on n's level:

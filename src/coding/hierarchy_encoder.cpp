@@ -2,6 +2,7 @@
 // diagonal rule, truncates trailing zeros, and arithmetic codes what is left, one level at a time.
 // Stream layout in docs/FORMAT.md ("hierarchy stream").
 #include "coding/hierarchy_level_coder.h"
+#include "common/check.h"
 
 #include <string>
 #include <utility>
@@ -59,6 +60,9 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         if (unbalanced != n)
             throw Error("encode_hierarchy: node " + std::to_string(ids[unbalanced]) + " of level " + std::to_string(l) +
                         " is refined but lacks a neighbour (the hierarchy is not balanced)");
+        AMC_REQUIRE(l < kMaxLevel || next_ids.empty(), invalid_input,
+                    "encode_hierarchy: a node of level " + std::to_string(l) + " is refined beyond the level cap " +
+                        std::to_string(kMaxLevel));
         if (options.cull_one_regularity && !uniform) stats.culled_one_regularity += level.incomplete_count;
         const uint8_t* truth = refined.data();
         traversal.run(
@@ -79,6 +83,9 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         for (uint32_t i = 0; i < n; ++i) {
             if (state[i] & kRefined) continue;
             const int hanging = refined_neighbors(state[i]);
+            AMC_REQUIRE(hanging != 3, invalid_input,
+                        "encode_hierarchy: node " + std::to_string(ids[i]) + " of level " + std::to_string(l) +
+                            " has three hanging nodes but is not refined (the hierarchy is not closed)");
             faces += 1 + uint64_t(hanging);
             if (hanging == 2) {
                 two_hanging.push_back({unrefined_edge(level, i), h.diagonal_flipped(ids[i])});
@@ -182,6 +189,10 @@ HierarchyCodeStats HierarchyLevelEncoder::stats() const {
 
 std::vector<uint8_t> encode_hierarchy(const Hierarchy& h, const HierarchyCoderOptions& options,
                                       HierarchyCodeStats* stats_out) {
+    // The structure the stream can hold is checked as the coder goes (balance, closure, level
+    // cap); the base mesh here, in linear time of its own (a broken one links roots that no
+    // stream describes).
+    validate_triangle_mesh(h.base(), "encode_hierarchy: base mesh");
     HierarchyLevelEncoder coder(h, options);
     ArithmeticEncoder encoder;
     for (int l = 0; l < coder.level_count(); ++l) coder.encode_level(l, encoder);

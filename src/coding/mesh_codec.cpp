@@ -10,6 +10,7 @@
 #include "coding/hierarchy_level_coder.h"
 #include "coding/numbering_coder.h"
 #include "common/check.h"
+#include "hierarchy/writer_checks.h"
 
 #include <algorithm>
 #include <cmath>
@@ -160,7 +161,7 @@ void check_counts_against_size(const Metadata& m, uint64_t bytes_after, const De
                 cannot_hold(header.symbol_count, "hierarchy symbols"));
     AMC_REQUIRE(m.nodes <= options.max_nodes, limit_exceeded,
                 "file holds " + std::to_string(m.nodes) + " nodes, more than the limit of " +
-                    std::to_string(options.max_nodes));
+                    std::to_string(options.max_nodes) + " (raise it: amc decode --max-nodes, DecodeOptions::max_nodes)");
 }
 
 std::vector<Vec3> all_positions(const Hierarchy& h) {
@@ -176,7 +177,7 @@ std::vector<Vec3> all_positions(const Hierarchy& h) {
 TriangleMesh base_as_decoded(const Hierarchy& h, const Quantizer* quantizer) {
     TriangleMesh base = h.base();
     if (quantizer != nullptr)
-        for (Vec3& p : base.positions) p = dequantize(*quantizer, quantize(*quantizer, p));
+        for (Vec3& p : base.positions) p = dequantize(*quantizer, snap_to_grid(*quantizer, p));
     return base;
 }
 
@@ -223,18 +224,8 @@ LeafNumbering numbering_after_reorder(const Hierarchy& input, const LeafNumberin
 
 std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options, EncodeStats* stats_out) {
     EncodeStats stats;
-    const std::string problem = check_invariants(input);
-    AMC_REQUIRE(problem.empty(), invalid_input, "encode: invalid hierarchy: " + problem);
-    // The decoder refuses non-finite coordinates (FORMAT.md, 3.7): so does the encoder. Midpoints
-    // of coordinates beyond DBL_MAX / 2 overflow to infinity.
-    for (NodeId n = 0; n < input.node_capacity(); ++n) {
-        if (!input.is_alive(n) || !input.is_leaf(n)) continue;  // the leaves' corners are every live vertex
-        for (int i = 0; i < 3; ++i) {
-            const Vec3 p = input.position(input.vertex(n, i));
-            AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), invalid_input,
-                        "encode: vertex " + std::to_string(input.vertex(n, i)) + " has a non-finite coordinate");
-        }
-    }
+    // Whatever is encoded decodes: the decoder's checks first (base mesh, structure, positions).
+    check_before_writing(input, "encode", true);
     const bool quantized = options.quantize_bits != 0;
     // Quantized coordinates are reconstructed as doubles on the grid, whatever the input precision.
     const Precision precision = input.single_precision() && !quantized ? Precision::float32 : Precision::float64;
@@ -242,7 +233,12 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     Quantizer quantizer;
     if (quantized) {
         const std::vector<Vec3> points = all_positions(input);
-        quantizer = make_quantizer(points, options.quantize_bits);
+        try {
+            quantizer = make_quantizer(points, options.quantize_bits);
+        } catch (const Error& e) {
+            throw_error(e.code(), std::string("encode: ") + e.what() +
+                                      " (positions that span more than the double range can only be stored bit-exact)");
+        }
         stats.max_error = max_quantization_error(quantizer, points);
     }
     // II-B: code the base mesh first and express the forest in the decoder's base order.
@@ -255,7 +251,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     if (quantized) {
         h.set_single_precision(false);
         // Closed loop: predictions are made from what the decoder will have.
-        for (VertexId v = 0; v < h.positions().size(); ++v) h.set_position(v, dequantize(quantizer, quantize(quantizer, h.position(v))));
+        for (VertexId v = 0; v < h.positions().size(); ++v) h.set_position(v, dequantize(quantizer, snap_to_grid(quantizer, h.position(v))));
     }
 
     HierarchyLevelEncoder hierarchy(h, options.hierarchy);

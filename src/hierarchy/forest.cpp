@@ -7,6 +7,8 @@
 #include "mesh/vertex_buckets.h"
 
 #include <algorithm>
+#include <cfloat>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -24,13 +26,25 @@ namespace amc {
 
 namespace {
 
-Vec3 midpoint_placer(void* single_precision, Vec3 a, Vec3 b) {
-    Vec3 m = 0.5 * (a + b);
-    if (single_precision != nullptr) {
-        m = {double(float(m.x)), double(float(m.y)), double(float(m.z))};
-    }
+// 0.5 * (a + b) bit for bit wherever that is finite: the correctly rounded midpoint (halving is
+// exact). Where a + b overflows (coordinates beyond DBL_MAX / 2), 0.5 * a + 0.5 * b: exact halves
+// of such large values rounded once, the same correctly rounded midpoint, and finite.
+double midpoint_coordinate(double a, double b) {
+    const double s = a + b;
+    return std::fabs(s) <= DBL_MAX ? 0.5 * s : 0.5 * a + 0.5 * b;
+}
+
+Vec3 round_if(void* single_precision, Vec3 m) {
+    if (single_precision != nullptr) m = {double(float(m.x)), double(float(m.y)), double(float(m.z))};
     return m;
 }
+
+Vec3 midpoint_placer(void* single_precision, Vec3 a, Vec3 b) {
+    return round_if(single_precision, {midpoint_coordinate(a.x, b.x), midpoint_coordinate(a.y, b.y), midpoint_coordinate(a.z, b.z)});
+}
+
+// midpoint_placer where no coordinate lies beyond DBL_MAX / 2: then a + b can not overflow.
+Vec3 near_midpoint_placer(void* single_precision, Vec3 a, Vec3 b) { return round_if(single_precision, 0.5 * (a + b)); }
 
 // The end points of a new vertex.
 struct Ends {
@@ -111,6 +125,7 @@ Hierarchy::Hierarchy(TriangleMesh base) : base_(std::move(base)) {
     const uint32_t f0 = root_count();
     nodes_.resize(f0);
     positions_ = base_.positions;
+    for (const Vec3& p : positions_) far_positions_ |= is_far(p);
     live_nodes_ = f0;
     live_vertices_ = static_cast<uint32_t>(positions_.size());
 
@@ -167,6 +182,7 @@ void Hierarchy::reset(TriangleMesh base) {
     nodes_.assign(roots.nodes_.begin(), roots.nodes_.end());
     block_parent_.clear();
     positions_.assign(roots.positions_.begin(), roots.positions_.end());
+    far_positions_ = roots.far_positions_;
     free_blocks_.clear();
     free_vertices_.clear();
     base_ = std::move(roots.base_);
@@ -216,9 +232,11 @@ VertexId Hierarchy::new_vertex(Vec3 p) {
         VertexId v = free_vertices_.back();
         free_vertices_.pop_back();
         positions_[v] = p;
+        far_positions_ |= is_far(p);
         return v;
     }
     positions_.push_back(p);
+    far_positions_ |= is_far(p);
     return static_cast<VertexId>(positions_.size() - 1);
 }
 
@@ -444,12 +462,14 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
             positions_.insert(positions_.end(), Made(ends, ends + new_vertices, positions, place),
                               Made(ends + new_vertices, ends + new_vertices, positions, place));
         };
-        if (!default_placer) {
+        if (!default_placer || far_positions_) {
+            const size_t first = positions_.size();
             append([placer = placer_, context = placer_context_](Vec3 a, Vec3 b) { return placer(context, a, b); });
+            for (size_t v = first; v < positions_.size(); ++v) far_positions_ |= is_far(positions_[v]);
         } else if (placer_context_ != nullptr) {
-            append([context = placer_context_](Vec3 a, Vec3 b) { return midpoint_placer(context, a, b); });
+            append([context = placer_context_](Vec3 a, Vec3 b) { return near_midpoint_placer(context, a, b); });
         } else {
-            append([](Vec3 a, Vec3 b) { return midpoint_placer(nullptr, a, b); });
+            append([](Vec3 a, Vec3 b) { return near_midpoint_placer(nullptr, a, b); });
         }
     }
     live_nodes_ += 4 * count;

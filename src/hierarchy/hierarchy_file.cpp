@@ -1,5 +1,7 @@
 // The uncompressed hierarchy file (.amh), specified in docs/HIERARCHY.md: base mesh, refinement
 // bits in breadth-first order, diagonal overrides and the positions of refinement vertices.
+#include "hierarchy/writer_checks.h"
+
 #include <amc/hierarchy.h>
 
 #include "common/check.h"
@@ -81,6 +83,7 @@ private:
 }  // namespace
 
 std::string serialize_hierarchy(const Hierarchy& h) {
+    check_before_writing(h, "hierarchy file", true);  // what deserialize_hierarchy checks
     const bool single = h.single_precision();
     const std::vector<NodeId> order = h.breadth_first_order();
     const std::vector<uint32_t> canonical = canonical_vertex_order(h);
@@ -241,7 +244,13 @@ Hierarchy deserialize_hierarchy(const std::string& bytes, const std::string& wha
 }
 
 void write_hierarchy(const std::string& path, const Hierarchy& h) {
-    write_file_atomically(path, serialize_hierarchy(h));
+    std::string bytes;
+    try {
+        bytes = serialize_hierarchy(h);
+    } catch (const Error& e) {
+        throw e.prefixed(path);
+    }
+    write_file_atomically(path, bytes);
 }
 
 Hierarchy read_hierarchy(const std::string& path) {

@@ -1,12 +1,24 @@
 // Every structural invariant of a red-green hierarchy, checked from scratch. Used by tests after
-// every operation and by readers of stored hierarchies.
+// every operation, and by every writer before it writes (writer_checks.h).
+#include "hierarchy/writer_checks.h"
+
+#include "common/check.h"
+
 #include <amc/hierarchy.h>
 
+#include <cmath>
 #include <sstream>
 
 namespace amc {
 
 namespace {
+
+std::string number_text(double x) {
+    std::ostringstream s;
+    s.precision(17);
+    s << x;
+    return s.str();
+}
 
 std::string node_text(const Hierarchy& h, NodeId n) {
     std::ostringstream s;
@@ -51,6 +63,7 @@ std::string check_invariants(const Hierarchy& h) {
         }
         if (!h.has_all_neighbors(n))
             return node_text(h, n) + " is refined but not all neighbours have its level (balance)";
+        if (h.level(n) >= kMaxLevel) return node_text(h, n) + " is refined beyond the level cap " + std::to_string(kMaxLevel);
         for (int k = 0; k < 4; ++k) {
             const NodeId c = h.child(n, k);
             if (!h.is_alive(c) || h.parent(c) != n || h.child_index(c) != k || h.level(c) != h.level(n) + 1)
@@ -79,6 +92,30 @@ std::string check_invariants(const Hierarchy& h) {
         return "vertex count " + std::to_string(h.vertex_count()) + " != base vertices + split edges (" +
                std::to_string(h.base().positions.size() + split_edges) + ")";
     return "";
+}
+
+std::string check_positions(const Hierarchy& h) {
+    const std::vector<uint32_t> canonical = canonical_vertex_order(h);
+    for (VertexId v = 0; v < canonical.size(); ++v) {
+        if (canonical[v] == 0xffffffffu) continue;
+        const Vec3 p = h.position(v);
+        for (const double x : {p.x, p.y, p.z}) {
+            if (!std::isfinite(x)) return "vertex " + std::to_string(v) + " has a non-finite coordinate";
+            if (h.single_precision() && double(float(x)) != x)
+                return "vertex " + std::to_string(v) + " has a coordinate that is not a float32 value (" +
+                       number_text(x) + ") in a single-precision hierarchy";
+        }
+    }
+    return "";
+}
+
+void check_before_writing(const Hierarchy& h, const std::string& what, bool positions) {
+    validate_triangle_mesh(h.base(), what + ": base mesh");
+    const std::string problem = check_invariants(h);
+    AMC_REQUIRE(problem.empty(), invalid_input, what + ": invalid hierarchy: " + problem);
+    if (!positions) return;
+    const std::string position_problem = check_positions(h);
+    AMC_REQUIRE(position_problem.empty(), invalid_input, what + ": " + position_problem);
 }
 
 }  // namespace amc
