@@ -153,7 +153,11 @@ enum class VtuEncoding {
 void write_vtu(const std::string& path, const VtuMesh& vtu,
                VtuEncoding encoding = VtuEncoding::binary_zlib);
 
-// Writes `bytes` to `path` through a temporary file and a rename. Throws Error.
+// Writes `bytes` to `path` through a temporary file beside it (`path.tmp.PID.N`), flushed to the
+// disk, and a rename: a reader, or a writer killed at any moment (or a crash of the machine),
+// finds the old file or the whole new one, never a part. A killed writer may leave its temporary
+// file behind. Threads may write the same path at once: each file is whole, the last rename
+// wins. Throws Error.
 void write_file_atomically(const std::string& path, const std::string& bytes);
 
 }  // namespace amc

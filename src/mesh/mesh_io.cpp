@@ -1,12 +1,15 @@
 // read_mesh / write_mesh: format dispatch by extension, whole-file reads and atomic writes.
+#include <atomic>
 #include <cctype>
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include "amc/mesh.h"
@@ -132,25 +135,36 @@ void write_vtu(const std::string& path, const VtuMesh& vtu, VtuEncoding encoding
 }
 
 void write_file_atomically(const std::string& path, const std::string& bytes) {
-    const std::string temp = path + ".tmp." + std::to_string(static_cast<long>(::getpid()));
-    std::FILE* file = std::fopen(temp.c_str(), "wb");
-    if (!file) {
-        throw Error(ErrorCode::io, path + ": cannot create " + temp + " (" + std::strerror(errno) + ")");
+    // A name no other call uses, in this process or another, in the directory of `path`, so that
+    // the rename stays within one file system.
+    static std::atomic<uint64_t> calls{0};
+    const std::string temp = path + ".tmp." + std::to_string(static_cast<long>(::getpid())) + "." +
+                             std::to_string(calls.fetch_add(1, std::memory_order_relaxed));
+    const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd < 0) throw Error(ErrorCode::io, path + ": cannot create " + temp + " (" + std::strerror(errno) + ")");
+    auto fail = [&](const std::string& what, int error) {
+        if (fd >= 0) ::close(fd);
+        ::unlink(temp.c_str());
+        throw Error(ErrorCode::io, path + ": " + what + " (" + std::strerror(error) + ")");
+    };
+    for (size_t done = 0; done < bytes.size();) {
+        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) fail("cannot write file", n < 0 ? errno : EIO);
+        done += size_t(n);
     }
-    const bool written = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
-    int saved_errno = errno;
-    const bool flushed = written && std::fflush(file) == 0;
-    if (written && !flushed) saved_errno = errno;
-    const bool closed = std::fclose(file) == 0;
-    if (flushed && !closed) saved_errno = errno;
-    if (!written || !flushed || !closed) {
-        std::remove(temp.c_str());
-        throw Error(ErrorCode::io, path + ": cannot write file (" + std::strerror(saved_errno) + ")");
+    // On the disk before the rename: after a crash of the machine too, the path holds the old file
+    // or the whole new one.
+    if (::fsync(fd) != 0) fail("cannot write file", errno);
+    if (::close(fd) != 0) {
+        const int error = errno;
+        ::unlink(temp.c_str());
+        throw Error(ErrorCode::io, path + ": cannot write file (" + std::strerror(error) + ")");
     }
-    if (std::rename(temp.c_str(), path.c_str()) != 0) {
-        saved_errno = errno;
-        std::remove(temp.c_str());
-        throw Error(ErrorCode::io, path + ": cannot rename " + temp + " to it (" + std::strerror(saved_errno) + ")");
+    if (::rename(temp.c_str(), path.c_str()) != 0) {
+        const int error = errno;
+        ::unlink(temp.c_str());
+        throw Error(ErrorCode::io, path + ": cannot rename " + temp + " to it (" + std::strerror(error) + ")");
     }
 }
 
