@@ -5,6 +5,7 @@
 // files AMC_UPDATE_GOLDEN=1 ./amc_tests --gtest_filter='Golden*' writes into a new directory (it
 // never overwrites a file).
 #include "hierarchy_checks.h"
+#include "sha256.h"
 
 #include "coding/base_mesh_coder.h"
 #include "coding/float_coder.h"
@@ -12,11 +13,15 @@
 
 #include <amc/codec.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <set>
+#include <sstream>
 
 namespace amc {
 namespace {
@@ -157,6 +162,52 @@ TEST(Golden, EncodingsMatchTheCurrentVersionsFiles) {
         const std::vector<uint8_t> golden = read_golden(path);
         ASSERT_FALSE(golden.empty()) << path << " is missing";
         EXPECT_EQ(bytes, golden) << c.name << ": the bitstream changed (a new format version: FORMAT.md, Versions)";
+    }
+}
+
+// tests/data/golden/SHA256SUMS lists every golden file with its SHA-256, as `sha256sum` writes it
+// (cd tests/data/golden && sha256sum -c SHA256SUMS): a file regenerated in place, added without
+// its line, or lost fails here, and so does a readable version without golden files.
+TEST(Golden, EveryFileHasItsCommittedHashAndEveryVersionItsFiles) {
+    // FIPS 180-4's known answers first: the manifest is only as good as the hash.
+    ASSERT_EQ(test::sha256_hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+    ASSERT_EQ(test::sha256_hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+    ASSERT_EQ(test::sha256_hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
+              "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+
+    const std::filesystem::path root = std::filesystem::path(AMC_TEST_DATA_DIR) / "golden";
+    std::ifstream manifest_file(root / "SHA256SUMS");
+    ASSERT_TRUE(manifest_file) << (root / "SHA256SUMS") << " is missing";
+    std::map<std::string, std::string> manifest;  // path below golden/ -> hash
+    for (std::string line; std::getline(manifest_file, line);) {
+        std::istringstream fields(line);
+        std::string hash, path;
+        fields >> hash >> path;
+        ASSERT_EQ(hash.size(), 64u) << "malformed line: " << line;
+        ASSERT_TRUE(manifest.emplace(path, hash).second) << path << " is listed twice";
+    }
+    std::set<std::string> seen;
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(root)) {
+        if (!entry.is_regular_file() || entry.path().filename() == "SHA256SUMS") continue;
+        const std::string path = entry.path().lexically_relative(root).generic_string();
+        seen.insert(path);
+        const auto listed = manifest.find(path);
+        if (listed == manifest.end()) {
+            ADD_FAILURE() << path << " is not in SHA256SUMS: a new golden file gets its line "
+                          << "(cd tests/data/golden && sha256sum " << path << " >> SHA256SUMS)";
+            continue;
+        }
+        std::ifstream file(entry.path(), std::ios::binary);
+        const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+        EXPECT_EQ(test::sha256_hex(bytes), listed->second)
+            << path << " changed: golden files are never regenerated (a new format version gets a new directory)";
+    }
+    for (const auto& [path, hash] : manifest) EXPECT_TRUE(seen.count(path)) << path << " is listed but missing";
+    for (int version = kOldestReadableVersion; version <= kNewestVersion; ++version) {
+        const std::string prefix = "v" + std::to_string(version) + "/";
+        const bool any = std::any_of(manifest.begin(), manifest.end(),
+                                     [&](const auto& entry) { return entry.first.rfind(prefix, 0) == 0; });
+        EXPECT_TRUE(any) << ".amc version " << version << " is readable but has no golden file in " << prefix;
     }
 }
 

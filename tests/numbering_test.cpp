@@ -241,8 +241,8 @@ namespace amc {
 namespace {
 
 // Files with a numbering block are pinned byte for byte: tests/data/golden/v3/ (base connectivity
-// mode 0, decoded only) and v4/ (what the encoder writes now). Write a new version's file only
-// with that version (AMC_UPDATE_GOLDEN=1), never in place.
+// mode 0, decoded only) and v4/ (what the encoder writes now). A new version's file goes into a new
+// directory (AMC_UPDATE_GOLDEN=1 writes only a missing file), never over an old one.
 TEST(NumberingGolden, NumberedFilesArePinnedAndRestoreTheCallersMesh) {
     Hierarchy h(make_l_shape(2));
     refine_randomly(h, 300, 5, 17);
@@ -253,7 +253,7 @@ TEST(NumberingGolden, NumberedFilesArePinnedAndRestoreTheCallersMesh) {
     options.numbering = &numbering;
     const std::vector<uint8_t> bytes = encode(h, options);
     const std::string v4 = std::string(AMC_TEST_DATA_DIR) + "/golden/v4/lshape_random_numbered.amc";
-    if (std::getenv("AMC_UPDATE_GOLDEN") != nullptr)
+    if (std::getenv("AMC_UPDATE_GOLDEN") != nullptr && !std::ifstream(v4))  // a new file, never over an old one
         std::ofstream(v4, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
     for (const int version : {3, 4}) {
         const std::string path = std::string(AMC_TEST_DATA_DIR) + "/golden/v" + std::to_string(version) + "/lshape_random_numbered.amc";
