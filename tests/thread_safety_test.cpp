@@ -1,0 +1,90 @@
+// The thread-safety promise of README.md ("Threads"): calls on different objects, and const calls on
+// one shared object, run at once from any number of threads. Run under ThreadSanitizer by .ci/run
+// (AMC_SANITIZE_THREAD), where a data race is fatal; without it these tests still check results.
+#include "hierarchy_checks.h"
+
+#include <amc/codec.h>
+#include <amc/hierarchy_coder.h>
+#include <amc/mesh.h>
+
+#include <algorithm>
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <thread>
+#include <vector>
+
+#include <unistd.h>
+
+namespace amc {
+namespace {
+
+constexpr int kThreads = 4;
+
+Hierarchy test_hierarchy(uint64_t seed) {
+    Hierarchy h(seed % 2 ? make_icosahedron() : make_torus(6, 5, 2.0, 0.7));
+    refine_randomly(h, 400, 4, seed);
+    return h;
+}
+
+// One shared hierarchy and one shared file, encoded, decoded and inspected by every thread at once,
+// each also building, encoding and decoding hierarchies of its own.
+TEST(ThreadSafety, ConcurrentEncodesAndDecodesGiveTheSerialResults) {
+    const Hierarchy shared = test_hierarchy(7);
+    const std::vector<uint8_t> shared_bytes = encode(shared);
+    const Hierarchy shared_back = decode(shared_bytes.data(), shared_bytes.size());
+    std::atomic<int> mismatches{0};
+    std::vector<std::thread> threads;
+    for (int t = 0; t < kThreads; ++t) {
+        threads.emplace_back([&, t] {
+            for (int round = 0; round < 3; ++round) {
+                EncodeOptions options;
+                options.quantize_bits = round == 2 ? 14 : 0;
+                options.predictor = round == 1 ? GeometryPredictor::butterfly : GeometryPredictor::automatic;
+                if (options.quantize_bits == 0 && options.predictor == GeometryPredictor::automatic && encode(shared, options) != shared_bytes)
+                    ++mismatches;
+                if (!identical(decode(shared_bytes.data(), shared_bytes.size()), shared_back)) ++mismatches;
+                if (inspect(shared_bytes.data(), shared_bytes.size()).levels == 0) ++mismatches;
+                const Hierarchy own = test_hierarchy(uint64_t(100 + t * 10 + round));
+                const std::vector<uint8_t> bytes = encode(own, options);
+                const DecodeResult back = try_decode(bytes.data(), bytes.size());
+                if (!back.ok || (options.quantize_bits == 0 && !identical(back.hierarchy, in_decoder_order(own)))) ++mismatches;
+                const std::vector<uint8_t> stream = encode_hierarchy(own);
+                if (decode_hierarchy(own.base(), stream.data(), stream.size()).leaf_count() != own.leaf_count()) ++mismatches;
+            }
+        });
+    }
+    for (std::thread& thread : threads) thread.join();
+    EXPECT_EQ(mismatches.load(), 0);
+}
+
+// Threads writing the same path at once: every write is whole, the last rename wins, no temporary
+// file is left (write_file_atomically's names are unique per call).
+TEST(ThreadSafety, ConcurrentAtomicWritesOfOnePathLeaveOneWholeFile) {
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("amc_threads_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    const std::string path = (dir / "out.amc").string();
+    std::vector<std::string> contents;
+    for (int t = 0; t < kThreads; ++t) contents.push_back(std::string(size_t(200000 + 1000 * t), char('a' + t)));
+    std::vector<std::thread> threads;
+    for (int t = 0; t < kThreads; ++t) {
+        threads.emplace_back([&, t] {
+            for (int round = 0; round < 20; ++round) write_file_atomically(path, contents[size_t(t)]);
+        });
+    }
+    for (std::thread& thread : threads) thread.join();
+    std::ifstream file(path, std::ios::binary);
+    const std::string written((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    EXPECT_NE(std::find(contents.begin(), contents.end(), written), contents.end()) << "a mixed or partial file";
+    int entries = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+        ++entries;
+        EXPECT_EQ(entry.path().filename(), "out.amc");
+    }
+    EXPECT_EQ(entries, 1);
+    std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace amc
