@@ -147,22 +147,22 @@ Hierarchy random_case(uint64_t seed, Random& random, bool& corrupted) {
     return h;
 }
 
-// What decoding an encoding of `h` gives: h in decoder order, its positions snapped to the
-// encoder's grid when quantized.
+// What decoding an encoding of `h` gives: h with its positions snapped to the encoder's grid when
+// quantized, in decoder order (base connectivity mode 2 orders the base by the decoded positions).
 Hierarchy expected_decoding(const Hierarchy& h, int quantize_bits) {
-    Hierarchy expected = in_decoder_order(h);
-    if (quantize_bits == 0) return expected;
-    expected.set_single_precision(false);
+    if (quantize_bits == 0) return in_decoder_order(h);
+    Hierarchy snapped = h;
+    snapped.set_single_precision(false);
     std::vector<Vec3> points;
-    const std::vector<uint32_t> order = canonical_vertex_order(expected);
+    const std::vector<uint32_t> order = canonical_vertex_order(snapped);
     for (VertexId v = 0; v < order.size(); ++v) {
-        if (order[v] != 0xffffffffu) points.push_back(expected.position(v));
+        if (order[v] != 0xffffffffu) points.push_back(snapped.position(v));
     }
     const Quantizer quantizer = make_quantizer(points, quantize_bits);
     for (VertexId v = 0; v < order.size(); ++v) {
-        if (order[v] != 0xffffffffu) expected.set_position(v, dequantize(quantizer, snap_to_grid(quantizer, expected.position(v))));
+        if (order[v] != 0xffffffffu) snapped.set_position(v, dequantize(quantizer, snap_to_grid(quantizer, snapped.position(v))));
     }
-    return expected;
+    return in_decoder_order(snapped);
 }
 
 TEST(EncodeDecode, EveryWriterRefusesOrWritesWhatItsReaderReadsBack) {
