@@ -157,9 +157,11 @@ SeriesWriter::SeriesWriter(const TriangleMesh& base, const SeriesOptions& option
     state_->base = base;
     AMC_REQUIRE(options.error_bound >= 0 && std::isfinite(options.error_bound), invalid_input,
                 "series: the error bound must be finite and >= 0");
-    for (const auto& [name, bound] : options.field_bounds)
-        AMC_REQUIRE(bound >= 0 && std::isfinite(bound), invalid_input,
+    for (const auto& field_bound : options.field_bounds) {
+        const std::string& name = field_bound.first;  // not a structured binding: lambdas cannot capture one in C++17
+        AMC_REQUIRE(field_bound.second >= 0 && std::isfinite(field_bound.second), invalid_input,
                     "series: the error bound of field \"" + name + "\" must be finite and >= 0");
+    }
     std::vector<uint8_t> start = header(base.single_precision, options.keyframe_interval);
     const std::vector<uint8_t> b = block(SeriesBlock::base, base_payload(base));
     start.insert(start.end(), b.begin(), b.end());
