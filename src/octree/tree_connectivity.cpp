@@ -242,7 +242,8 @@ TreeConnectivity connectivity_from_vertices(int dim, std::vector<Vec3> vertices,
             by_vertices[key].push_back(t * faces + f);
         }
     }
-    for (const auto& [key, sides] : by_vertices) {
+    for (const auto& key_sides : by_vertices) {
+        const std::vector<uint32_t>& sides = key_sides.second;  // named: AMC_REQUIRE's lambda cannot capture a structured binding
         AMC_REQUIRE(sides.size() <= 2, invalid_input,
                     "connectivity: " + std::to_string(sides.size()) + " trees share the face of tree " +
                         std::to_string(sides[0] / faces) + " face " + std::to_string(sides[0] % faces));
