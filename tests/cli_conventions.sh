@@ -95,6 +95,27 @@ cmp -s m.map m2.map || fail "the map stored in the file differs from the one enc
 expect 1 "$amc" decode r.amc -o r3.ply --map r3.map
 expect 2 "$amc" encode r.amh -o r4.amc --keep-numbering
 
+# A file still arriving: --partial decodes the complete levels and says how far it got.
+size=$(stat -c %s r.amc)
+head -c $((size * 3 / 4)) r.amc > cut.amc
+expect 1 "$amc" decode cut.amc -o cut.ply
+grep -q 'truncated' err.txt || fail "a cut file is not refused as truncated without --partial"
+expect 0 "$amc" decode --partial cut.amc -o cut.ply
+grep -q 'partial: levels 0\.\.' out.txt || fail "decode --partial does not say which level it reached: $(cat out.txt)"
+head -c 40 r.amc > cut2.amc
+expect 1 "$amc" decode --partial cut2.amc -o cut2.ply
+grep -q 'base mesh' err.txt || fail "a prefix that cuts the base mesh is not refused as such: $(cat err.txt)"
+[[ -e cut2.ply ]] && fail "decode --partial wrote cut2.ply for a prefix without the base mesh"
+expect 0 "$amc" decode --partial r.amc -o whole.ply
+cmp -s whole.ply r.ply || fail "decode --partial of a whole file differs from decode"
+grep -q 'partial' out.txt && fail "decode --partial of a whole file calls it partial"
+
+# --ascii: text PLY with the level and green face properties.
+expect 0 "$amc" decode r.amc -o a.ply --ascii
+head -3 a.ply | grep -q 'format ascii' || fail "--ascii wrote no ASCII PLY"
+grep -q 'property uchar level' a.ply || fail "ASCII PLY lacks the level property"
+grep -q 'property uchar level' r.ply && fail "binary PLY has face properties (meshio 5 can not read them)"
+
 if ((failures)); then
   echo "$failures failure(s)"
   exit 1

@@ -170,6 +170,79 @@ TEST(Codec, EveryTruncationAndManyCorruptionsAreErrors) {
     EXPECT_EQ(accepted, 0) << "checksums catch every corruption of this size";
 }
 
+// A file still arriving: every prefix that holds the base mesh decodes to the levels whose blocks
+// are complete, exactly as --level of the whole file; shorter prefixes are refused as truncated.
+TEST(Codec, EveryPrefixDecodesPartiallyAsTheLevelsItHolds) {
+    Hierarchy h(make_torus(6, 5, 2.0, 0.7));
+    refine_randomly(h, 800, 4, 8);
+    const LeafMesh leaf = extract_leaf_mesh(h);
+    LeafNumbering reversed;  // any bijection will do: the numbering block must arrive whole too
+    for (uint32_t v = 0; v < leaf.mesh.positions.size(); ++v) reversed.vertex.push_back(uint32_t(leaf.mesh.positions.size()) - 1 - v);
+    for (uint32_t f = 0; f < leaf.mesh.triangles.size(); ++f) reversed.face.push_back(uint32_t(leaf.mesh.triangles.size()) - 1 - f);
+    reversed.rotation.assign(leaf.mesh.triangles.size(), 0);
+    EncodeOptions options;
+    options.numbering = &reversed;
+    const std::vector<uint8_t> bytes = encode(h, options);
+    const FileInfo info = inspect(bytes.data(), bytes.size());
+    ASSERT_GE(info.levels, 4);
+    LeafNumbering full_numbering;
+    const Hierarchy full = decode(bytes.data(), bytes.size(), {}, &full_numbering);
+    ASSERT_FALSE(full_numbering.empty());
+
+    std::vector<Hierarchy> at_level;
+    for (int level = 0; level < info.levels; ++level) {
+        DecodeOptions cut;
+        cut.max_level = level;
+        at_level.push_back(decode(bytes.data(), bytes.size(), cut));
+    }
+    size_t base_end = 0;
+    for (const FileBlock& block : info.blocks)
+        if (block.name == "base geometry") base_end = block.offset + block.size;
+    ASSERT_GT(base_end, 0u);
+    int complete_files = 0;
+    for (size_t length = 0; length <= bytes.size(); ++length) {
+        if (length < base_end) {
+            try {
+                decode_partial(bytes.data(), length);
+                ADD_FAILURE() << "a prefix of " << length << " bytes cuts the base mesh but decoded";
+            } catch (const Error& e) {
+                EXPECT_TRUE(e.code() == ErrorCode::truncated || e.code() == ErrorCode::bad_magic) << length << ": " << e.what();
+            }
+            continue;
+        }
+        int arrived = 0;  // level blocks wholly inside the prefix
+        bool numbering_arrived = false;
+        for (const FileBlock& block : info.blocks) {
+            if (block.offset + block.size > length) continue;
+            if (block.level >= 0) ++arrived;
+            if (block.name == "numbering") numbering_arrived = true;
+        }
+        const PartialDecode partial = decode_partial(bytes.data(), length);
+        EXPECT_EQ(partial.levels, info.levels);
+        if (arrived == info.levels) {
+            ++complete_files;
+            EXPECT_TRUE(partial.complete) << length;
+            EXPECT_EQ(partial.level, info.levels - 1);
+            EXPECT_TRUE(identical(partial.hierarchy, full)) << length;
+            EXPECT_EQ(partial.numbering.vertex, numbering_arrived ? full_numbering.vertex : std::vector<uint32_t>{}) << length;
+        } else {
+            EXPECT_FALSE(partial.complete) << length;
+            EXPECT_EQ(partial.level, arrived) << length;
+            EXPECT_TRUE(identical(partial.hierarchy, at_level[size_t(arrived)])) << length;
+            EXPECT_TRUE(partial.numbering.empty());
+        }
+    }
+    EXPECT_GT(complete_files, 10);  // the numbering and end blocks arrive after the last level
+
+    // A complete block that is damaged is an error, not a block still to come.
+    size_t level0 = 0;
+    for (const FileBlock& block : info.blocks)
+        if (block.level == 0) level0 = block.offset;
+    std::vector<uint8_t> damaged(bytes.begin(), bytes.end() - 1);
+    damaged[level0 + 6] ^= 1;
+    EXPECT_THROW(decode_partial(damaged.data(), damaged.size()), Error);
+}
+
 // The checksums stop the corruptions above at the container, so here each mutated block gets a
 // valid checksum again: every payload parser (base connectivity and geometry, levels, metadata)
 // and the checks between blocks see bit flips, overwritten, inserted and removed bytes, truncated

@@ -203,7 +203,7 @@ TEST(RoundTrip, PlyWritesFloatOrDoubleByPrecision) {
     EXPECT_EQ(parse_ply(format_ply(mesh), "t.ply").triangles, mesh.triangles);
 }
 
-TEST(RoundTrip, PlyCellDataIsWrittenAndSkippedOnRead) {
+TEST(RoundTrip, PlyCellDataIsWrittenInAsciiAndSkippedOnRead) {
     TriangleMesh mesh = grid_mesh(3, 3, false);
     mesh.single_precision = true;  // small integers and quarters: read back as floats
     CellData cells;
@@ -211,14 +211,34 @@ TEST(RoundTrip, PlyCellDataIsWrittenAndSkippedOnRead) {
         cells.level.push_back(static_cast<uint8_t>(t % 5));
         cells.is_green.push_back(static_cast<uint8_t>(t % 2));
     }
-    const std::string bytes = format_ply(mesh, &cells);
-    EXPECT_NE(bytes.find("property uchar level\nproperty uchar green\nend_header\n"),
+    const std::string ascii = format_ply(mesh, &cells, MeshEncoding::ascii);
+    EXPECT_NE(ascii.find("format ascii 1.0\n"), std::string::npos);
+    EXPECT_NE(ascii.find("property uchar level\nproperty uchar green\nend_header\n"), std::string::npos);
+    EXPECT_NE(ascii.find("\n3 " + std::to_string(mesh.triangles[4][0]) + " " +
+                         std::to_string(mesh.triangles[4][1]) + " " + std::to_string(mesh.triangles[4][2]) +
+                         " 4 0\n"),
               std::string::npos);
-    expect_bit_exact(mesh, parse_ply(bytes, "t.ply"));
+    expect_bit_exact(mesh, parse_ply(ascii, "t.ply"));
+
+    // Binary PLY holds vertices and faces only: meshio 5 reads no other face property there.
+    const std::string binary = format_ply(mesh, &cells);
+    EXPECT_EQ(binary.find("level"), std::string::npos);
+    EXPECT_EQ(binary, format_ply(mesh));
+    expect_bit_exact(mesh, parse_ply(binary, "t.ply"));
+
     cells.level.pop_back();
     TempDir dir;
-    EXPECT_THROW(write_mesh(dir.file("x.ply"), mesh, &cells), Error);
+    EXPECT_THROW(write_mesh(dir.file("x.ply"), mesh, &cells, MeshEncoding::ascii), Error);
     EXPECT_FALSE(fs::exists(dir.file("x.ply")));
+}
+
+TEST(RoundTrip, AsciiPlyIsBitExactInDoublePrecision) {
+    TriangleMesh mesh = grid_mesh(4, 3, false);
+    mesh.single_precision = false;
+    for (Vec3& p : mesh.positions) p = {p.x + 0.1, p.y * 1e-300, -p.z - 1.0 / 3.0};
+    const TriangleMesh back = parse_ply(format_ply(mesh, nullptr, MeshEncoding::ascii), "t.ply");
+    expect_bit_exact(mesh, back);
+    EXPECT_FALSE(back.single_precision);
 }
 
 TEST(RoundTrip, SinglePrecisionIsDetectedFromValues) {

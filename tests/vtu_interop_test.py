@@ -1,4 +1,4 @@
-"""VTU files that amcodec writes, opened by meshio and by VTK (Debian's python3-meshio and
+"""VTU and PLY files that amcodec writes, opened by meshio and by VTK (Debian's python3-meshio and
 python3-vtk9) with their points, triangles and every point and cell array intact.
 
 Run by .ci/run after the build:  AMC_BUILD_DIR=build /usr/bin/python3 -m pytest tests/vtu_interop_test.py
@@ -120,3 +120,37 @@ def test_amc_demo_vtu_opens_in_meshio_and_vtk(tmp_path):
         assert np.array_equal(from_meshio, from_vtk)
     assert set(np.unique(mesh.cell_data["green"][0])) == {0, 1}
     assert mesh.cell_data["level"][0].max() > 0
+
+
+def vtk_read_ply(path):
+    reader = vtk.vtkPLYReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    return reader.GetOutput()
+
+
+@pytest.mark.parametrize("ascii", [False, True])
+def test_amc_decoded_ply_opens_in_meshio_and_vtk(tmp_path, ascii):
+    """Binary PLY (the default) holds vertices and faces; --ascii adds level and green per face,
+    which meshio reads (VTK's PLY reader keeps only its own property names)."""
+    amc = os.path.join(BUILD, "amc")
+    subprocess.run([amc, "-q", "demo", "--out-dir", str(tmp_path)], check=True)
+    ply = tmp_path / "leaf.ply"
+    subprocess.run([amc, "-q", "decode", str(tmp_path / "demo.amc"), "-o", str(ply)] +
+                   (["--ascii"] if ascii else []), check=True)
+    subprocess.run([amc, "-q", "decode", str(tmp_path / "demo.amc"), "-o", str(tmp_path / "leaf.vtu")], check=True)
+    reference = meshio.read(str(tmp_path / "leaf.vtu"))
+    mesh = meshio.read(str(ply))
+    assert np.array_equal(mesh.points, reference.points)
+    assert np.array_equal(mesh.cells[0].data, reference.cells[0].data)
+    if ascii:
+        for key in ("level", "green"):
+            assert np.array_equal(mesh.cell_data[key][0], reference.cell_data[key][0])
+    else:
+        assert "level" not in mesh.cell_data
+    poly = vtk_read_ply(ply)
+    assert poly.GetNumberOfPoints() == len(reference.points)
+    assert poly.GetNumberOfCells() == len(reference.cells[0].data)
+    triangles = numpy_support.vtk_to_numpy(poly.GetPolys().GetData()).reshape(-1, 4)
+    assert np.array_equal(triangles[:, 1:], reference.cells[0].data)
+    assert np.array_equal(numpy_support.vtk_to_numpy(poly.GetPoints().GetData()), reference.points)

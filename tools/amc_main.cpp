@@ -57,6 +57,8 @@ int main(int argc, char** argv) {
     app.add_flag("-f,--force", global.force, "Overwrite existing output files");
     app.add_flag("-q,--quiet", quiet, "Print errors only");
     app.add_flag("-v,--verbose", verbose, "Print more");
+    bool ascii = false;
+    app.add_flag("--ascii", ascii, "Write PLY and VTU outputs as text (ASCII PLY carries the level and green face properties)");
 
     std::string out_dir = "amc_demo";
     auto* demo = app.add_subcommand("demo", "Build, compress and check a hierarchy from the embedded procedural model");
@@ -85,6 +87,8 @@ int main(int argc, char** argv) {
     decode_cmd->add_option("--frame", decode.frame, "A series (.amcs): only this frame")
         ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
     decode_cmd->add_flag("--canonical", decode.canonical, "Write the canonical numbering even if the file stores another");
+    decode_cmd->add_flag("--partial", decode.partial,
+                         "Accept a file still arriving (cut anywhere after the base mesh): decode its complete levels");
     decode_cmd->add_option("--map", decode.map, "Write the stored numbering map (input's numbering -> canonical)");
     add_max_nodes(decode_cmd, decode.max_nodes);
 
@@ -215,6 +219,7 @@ int main(int argc, char** argv) {
         return code == 0 ? 0 : kExitUsage;
     }
     global.verbosity = quiet ? 0 : verbose ? 2 : 1;
+    global.mesh_encoding = ascii ? MeshEncoding::ascii : MeshEncoding::binary;
 
     try {
         if (*demo) run_demo(out_dir, global);

@@ -121,6 +121,16 @@ void check_level(const std::string& name, int level, int depth) {
                                                   " requested but the hierarchy has levels 0.." + std::to_string(depth));
 }
 
+PartialDecode decode_partial_input(const InputFile& input, const DecodeOptions& options) {
+    if (input.kind != FileKind::compressed)
+        throw Error(input.name + ": expected compressed .amc data, found " + file_kind_name(input.kind));
+    try {
+        return decode_partial(reinterpret_cast<const uint8_t*>(input.bytes.data()), input.bytes.size(), options);
+    } catch (const Error& e) {
+        throw e.prefixed(input.name);
+    }
+}
+
 Hierarchy hierarchy_of(const InputFile& input) {
     if (input.kind != FileKind::hierarchy)
         throw Error(input.name + ": expected a hierarchy (.amh), found " + file_kind_name(input.kind));

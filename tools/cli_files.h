@@ -46,6 +46,7 @@ void refuse_existing(const std::string& path);
 
 // Data read from an InputFile, with the file named in every error.
 Hierarchy decode_input(const InputFile& input, const DecodeOptions& options, LeafNumbering* numbering = nullptr);
+PartialDecode decode_partial_input(const InputFile& input, const DecodeOptions& options);
 Hierarchy hierarchy_of(const InputFile& input);  // .amh
 // Refuses a level asked for on the command line (-1: all) that a hierarchy of levels 0..depth
 // does not have: decode and extract say it alike (their options' ranges are checked when parsed).

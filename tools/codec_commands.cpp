@@ -161,9 +161,24 @@ void run_decode(const DecodeCommand& command, const GlobalOptions& global) {
     LeafNumbering numbering;
     progress.phase("decoding " + input.name);
     auto start = std::chrono::steady_clock::now();
-    const Hierarchy h = decode_input(input, options, &numbering);
+    Hierarchy h;
+    std::string partial_note;  // how far a partial file got
+    if (command.partial) {
+        PartialDecode partial = decode_partial_input(input, options);
+        h = std::move(partial.hierarchy);
+        numbering = std::move(partial.numbering);
+        if (!partial.complete)
+            partial_note = ", partial: levels 0.." + std::to_string(partial.level) + " of 0.." +
+                           std::to_string(partial.levels - 1);
+        if (!partial.complete && !command.map.empty())
+            throw Error(input.name + ": the file is partial (levels 0.." + std::to_string(partial.level) + " of 0.." +
+                        std::to_string(partial.levels - 1) + "): --map needs the whole file");
+    } else {
+        h = decode_input(input, options, &numbering);
+    }
     const double seconds = seconds_since(start);
-    check_level(input.name, command.level, h.depth());  // a file cut short ends at its last level
+    if (partial_note.empty())  // a partial file gives what has arrived
+        check_level(input.name, command.level, h.depth());
     if (!command.map.empty() && numbering.empty())
         throw Error(input.name + ": the file stores no numbering (encode a mesh with --keep-numbering, or keep the map "
                     "that encode --map writes)");
@@ -177,18 +192,18 @@ void run_decode(const DecodeCommand& command, const GlobalOptions& global) {
         if (!numbering.empty() && !command.canonical) {
             CellData cells;
             const TriangleMesh mesh = renumber_leaf_mesh(leaf, numbering, &cells);
-            write_output(output, format_mesh(mesh, &cells, mesh_format), global.force);
+            write_output(output, format_mesh(mesh, &cells, mesh_format, global.mesh_encoding), global.force);
             renumbered = true;
         } else {
-            write_output(output, format_mesh(leaf.mesh, &leaf.cells, mesh_format), global.force);
+            write_output(output, format_mesh(leaf.mesh, &leaf.cells, mesh_format, global.mesh_encoding), global.force);
         }
     }
     if (!command.map.empty()) write_output(command.map, format_numbering_map(numbering), global.force);
     progress.finish();
     if (global.verbosity > 0)
-        std::fprintf(report_stream(output), "%s: %u nodes, %u vertices, depth %d -> %s%s (%.3f s)\n", input.name.c_str(),
-                     h.node_count(), h.vertex_count(), h.depth(), output == "-" ? "stdout" : output.c_str(),
-                     renumbered ? " in the input's numbering" : "", seconds);
+        std::fprintf(report_stream(output), "%s: %u nodes, %u vertices, depth %d%s -> %s%s (%.3f s)\n", input.name.c_str(),
+                     h.node_count(), h.vertex_count(), h.depth(), partial_note.c_str(),
+                     output == "-" ? "stdout" : output.c_str(), renumbered ? " in the input's numbering" : "", seconds);
 }
 
 }  // namespace amc::cli

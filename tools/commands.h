@@ -2,6 +2,7 @@
 // success and throws Error (exit code 1) or UsageError (exit code 2).
 #pragma once
 
+#include <amc/mesh.h>
 #include <amc/refinement.h>
 
 #include <cstdint>
@@ -15,6 +16,7 @@ struct InputFile;
 struct GlobalOptions {
     bool force = false;  // overwrite existing outputs
     int verbosity = 1;   // 0 with -q (errors only), 2 with -v
+    MeshEncoding mesh_encoding = MeshEncoding::binary;  // PLY and VTU outputs; ascii with --ascii
 };
 
 struct EncodeCommand {
@@ -33,6 +35,7 @@ struct DecodeCommand {
     std::string format;          // output format for stdout (obj, off, ply, vtu, amh)
     int level = -1;              // progressive: stop after this level
     bool canonical = false;      // ignore a stored numbering
+    bool partial = false;        // a file still arriving: decode the levels whose blocks are complete
     std::string map;             // write the stored numbering map here
     uint64_t max_nodes = 0;      // 0: the library's default limit
     int64_t frame = -1;          // a series: only this frame

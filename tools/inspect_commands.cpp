@@ -87,7 +87,7 @@ void run_extract(const ExtractCommand& command, const GlobalOptions& global) {
     }
     check_level(input.name, command.level, h.depth());
     const LeafMesh leaf = extract_leaf_mesh(h, command.level);
-    write_output(command.output, format_mesh(leaf.mesh, &leaf.cells, format), global.force);
+    write_output(command.output, format_mesh(leaf.mesh, &leaf.cells, format, global.mesh_encoding), global.force);
 }
 
 }  // namespace amc::cli

@@ -19,11 +19,11 @@ RefinementCriterion parse_criterion(const std::string& name) {
 }
 
 // A hierarchy (.amh, also for stdout) or its leaf mesh, by the output's extension.
-std::string hierarchy_or_leaf_bytes(const std::string& path, const Hierarchy& h) {
+std::string hierarchy_or_leaf_bytes(const std::string& path, const Hierarchy& h, MeshEncoding encoding) {
     MeshFormat format = MeshFormat::ply;
     if (path == "-" || output_kind(path, &format) == OutputKind::hierarchy) return serialize_hierarchy(h);
     const LeafMesh leaf = extract_leaf_mesh(h);
-    return format_mesh(leaf.mesh, &leaf.cells, format);
+    return format_mesh(leaf.mesh, &leaf.cells, format, encoding);
 }
 
 // "front.amh" -> "front_3.amh"; a name without extension is a prefix: "front" -> "front_3.amh".
@@ -123,13 +123,13 @@ void run_refine(const RefineCommand& c, const GlobalOptions& global) {
                          s.nodes, s.levels, s.red_faces, s.green_faces, s.vertices, seconds / double(results.size()));
         }
         const std::string target = series ? step_path(c.output, i, ".amh") : c.output;
-        write_output(target, hierarchy_or_leaf_bytes(target, h), global.force);
+        write_output(target, hierarchy_or_leaf_bytes(target, h, global.mesh_encoding), global.force);
         if (!c.leaf_output.empty()) {
             const std::string leaf_target = series ? step_path(c.leaf_output, i, ".vtu") : c.leaf_output;
             MeshFormat format = MeshFormat::vtu;
             output_kind(leaf_target, &format);
             const LeafMesh leaf = extract_leaf_mesh(h);
-            write_output(leaf_target, format_mesh(leaf.mesh, &leaf.cells, format), global.force);
+            write_output(leaf_target, format_mesh(leaf.mesh, &leaf.cells, format, global.mesh_encoding), global.force);
         }
     }
     if (remeshed && global.verbosity > 0) print_remesh_report(report, remesh_stats, c.faces, !c.no_measure);

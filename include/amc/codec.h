@@ -94,6 +94,19 @@ struct DecodeResult {
 };
 DecodeResult try_decode(const uint8_t* data, size_t size, const DecodeOptions& options = {}) noexcept;
 
+// A file that is still arriving: the bytes so far, cut anywhere after the base mesh's blocks.
+// Complete blocks are checked as decode checks them; the block being received is ignored.
+struct PartialDecode {
+    Hierarchy hierarchy;      // levels 0 .. level, as decode with max_level = level returns it
+    int level = 0;            // the finest level whose nodes are all known
+    int levels = 0;           // the file's level count, from its metadata
+    bool complete = false;    // every level block arrived: the whole hierarchy (level = levels - 1)
+    LeafNumbering numbering;  // the stored numbering, once complete and its block arrived
+};
+// Throws Error (ErrorCode::truncated) when the prefix ends before the base mesh is complete, and
+// like decode on anything corrupt in the complete blocks.
+PartialDecode decode_partial(const uint8_t* data, size_t size, const DecodeOptions& options = {});
+
 // What `amc info` prints: the blocks of a file with their sizes, without decoding the payloads.
 struct FileBlock {
     uint8_t type = 0;

@@ -90,13 +90,18 @@ TriangleMesh parse_mesh(const std::string& bytes, MeshFormat format, const std::
 // `what` names the source in messages. Throws Error.
 void validate_triangle_mesh(const TriangleMesh& mesh, const std::string& what);
 
+// Binary or text for the formats that have both (PLY, VTU); OBJ and OFF are always text.
+enum class MeshEncoding { binary, ascii };
+
 // Writes a mesh; format from the extension. Cell data is written where the format can hold it
-// (VTU cell arrays, PLY face properties) and ignored otherwise; VTU is written as
-// VtuEncoding::binary_zlib. The file is written to a temporary name and renamed, so it is never
-// half-written. Throws Error.
-void write_mesh(const std::string& path, const TriangleMesh& mesh, const CellData* cells = nullptr);
+// and its readers read it (VTU cell arrays; ASCII PLY face properties, see format_ply) and
+// ignored otherwise; binary VTU is VtuEncoding::binary_zlib. The file is written to a temporary
+// name and renamed, so it is never half-written. Throws Error.
+void write_mesh(const std::string& path, const TriangleMesh& mesh, const CellData* cells = nullptr,
+                MeshEncoding encoding = MeshEncoding::binary);
 // The bytes write_mesh would write, for a format chosen by the caller (output to a stream).
-std::string format_mesh(const TriangleMesh& mesh, const CellData* cells, MeshFormat format);
+std::string format_mesh(const TriangleMesh& mesh, const CellData* cells, MeshFormat format,
+                        MeshEncoding encoding = MeshEncoding::binary);
 
 // ---------------------------------------------------------------------------------------------
 // VTK XML UnstructuredGrid (.vtu) with point and cell data

@@ -85,6 +85,10 @@ BlockReader::BlockReader(const uint8_t* data, size_t size, const FileFraming& fr
     AMC_REQUIRE(data[6] == 0 && data[7] == 0, corrupt, "reserved header bytes are not zero");
 }
 
+bool BlockReader::next_block_arrived() const {
+    return size_ - pos_ >= kBlockOverhead && get_u32(data_ + pos_ + 1) <= size_ - pos_ - kBlockOverhead;
+}
+
 bool BlockReader::next(Block& block) {
     if (ended_) return false;
     AMC_REQUIRE(size_ - pos_ >= kBlockOverhead, truncated,

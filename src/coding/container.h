@@ -78,6 +78,9 @@ public:
     bool next(Block& block);
     // Bytes after the blocks read so far.
     size_t remaining() const { return size_ - pos_; }
+    // Whether the bytes left hold the next block whole (header, payload and checksum): false in
+    // a file cut while that block was being written or received.
+    bool next_block_arrived() const;
 
 private:
     const FileFraming* framing_;

@@ -365,7 +365,14 @@ namespace {
 // than its bytes warrant before it is decoded (more grows as the levels are built).
 constexpr uint64_t kReservedNodesPerFileByte = 128;
 
-Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& options, LeafNumbering* numbering) {
+// How far a partial file got (decode_partial); null for a whole file.
+struct PartialProgress {
+    int levels_decoded = 0, levels_in_file = 0;
+    bool complete = false;
+};
+
+Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& options, LeafNumbering* numbering,
+                      PartialProgress* partial = nullptr) {
     if (numbering != nullptr) *numbering = {};
     AMC_REQUIRE(data != nullptr || size == 0, invalid_input, "no data");
     BlockReader reader(data, size);
@@ -374,6 +381,9 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     AMC_REQUIRE(!(quantized && precision == Precision::float32), corrupt, "file header: quantized and float32 flags together");
     Block block{};
     auto expect = [&](BlockType type) {
+        AMC_REQUIRE(partial == nullptr || reader.next_block_arrived(), truncated,
+                    std::string("file ends before its ") + block_type_name(uint8_t(type)) +
+                        " block: a partial file decodes once the base mesh has arrived");
         AMC_REQUIRE(reader.next(block) && block.type == type, corrupt,
                     std::string("expected a ") + block_type_name(uint8_t(type)) + " block");
         return block;
@@ -444,7 +454,9 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     int level = 0;
     Block numbering_block{};
     bool has_numbering = false;
-    while (reader.next(block)) {
+    if (partial != nullptr) partial->levels_in_file = int(meta.levels);
+    // A partial file ends at the first block that has not arrived whole.
+    while ((partial == nullptr || reader.next_block_arrived()) && reader.next(block)) {
         if (block.type == BlockType::end) break;
         if (block.type == BlockType::numbering) {
             AMC_REQUIRE(hierarchy.done() && !has_numbering, corrupt, "numbering block out of place");
@@ -472,11 +484,14 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
         AMC_REQUIRE(!decoder.overran() && !positions.saw_invalid_symbol(), corrupt,
                     "level " + std::to_string(level) + " block is truncated or corrupt");
         ++level;
+        if (partial != nullptr) partial->levels_decoded = level;
     }
     if (!hierarchy.done()) {
         if (options.max_level >= 0 && level >= options.max_level) return h;
+        if (partial != nullptr) return h;
         throw_error(ErrorCode::truncated, "file ends before the last level");
     }
+    if (partial != nullptr) partial->complete = true;
     hierarchy.finish();
     AMC_REQUIRE(h.node_count() == meta.nodes && h.vertex_count() == meta.vertices && uint64_t(level) == meta.levels,
                 corrupt, "decoded hierarchy does not match the metadata");
@@ -490,6 +505,17 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
 
 Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options, LeafNumbering* numbering) {
     return with_allocation_errors_as_limits("decode", [&] { return decode_file(data, size, options, numbering); });
+}
+
+PartialDecode decode_partial(const uint8_t* data, size_t size, const DecodeOptions& options) {
+    PartialDecode result;
+    PartialProgress progress;
+    result.hierarchy = with_allocation_errors_as_limits(
+        "decode", [&] { return decode_file(data, size, options, &result.numbering, &progress); });
+    result.levels = progress.levels_in_file;
+    result.complete = progress.complete;
+    result.level = result.complete ? progress.levels_decoded - 1 : progress.levels_decoded;
+    return result;
 }
 
 Hierarchy in_decoder_order(const Hierarchy& h, const EncodeOptions& options) {

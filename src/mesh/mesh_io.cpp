@@ -95,22 +95,25 @@ TriangleMesh read_mesh(const std::string& path) {
     return parse_mesh(read_file(path), format, path);
 }
 
-std::string format_mesh(const TriangleMesh& mesh, const CellData* cells, MeshFormat format) {
+std::string format_mesh(const TriangleMesh& mesh, const CellData* cells, MeshFormat format,
+                        MeshEncoding encoding) {
     switch (format) {
         case MeshFormat::obj: return format_obj(mesh);
         case MeshFormat::off: return format_off(mesh);
-        case MeshFormat::ply: return format_ply(mesh, cells);
+        case MeshFormat::ply: return format_ply(mesh, cells, encoding);
         case MeshFormat::vtu:
-            return format_vtu(mesh, {}, cells ? cell_data_arrays(*cells) : std::vector<DataArray>{}, VtuEncoding::binary_zlib);
+            return format_vtu(mesh, {}, cells ? cell_data_arrays(*cells) : std::vector<DataArray>{},
+                              encoding == MeshEncoding::ascii ? VtuEncoding::ascii : VtuEncoding::binary_zlib);
     }
     return {};
 }
 
-void write_mesh(const std::string& path, const TriangleMesh& mesh, const CellData* cells) {
+void write_mesh(const std::string& path, const TriangleMesh& mesh, const CellData* cells,
+                MeshEncoding encoding) {
     const MeshFormat format = mesh_format_from_path(path);
     std::string bytes;
     try {
-        bytes = format_mesh(mesh, cells, format);
+        bytes = format_mesh(mesh, cells, format, encoding);
     } catch (const Error& e) {
         throw e.prefixed(path);
     }

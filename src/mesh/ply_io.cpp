@@ -411,16 +411,18 @@ void append_le(std::string& out, T value) {
 
 }  // namespace
 
-std::string format_ply(const TriangleMesh& mesh, const CellData* cells) {
-    const bool write_level = cells && !cells->level.empty();
-    const bool write_green = cells && !cells->is_green.empty();
+std::string format_ply(const TriangleMesh& mesh, const CellData* cells, MeshEncoding encoding) {
+    const bool ascii = encoding == MeshEncoding::ascii;
+    const bool write_level = ascii && cells && !cells->level.empty();
+    const bool write_green = ascii && cells && !cells->is_green.empty();
     if ((write_level && cells->level.size() != mesh.triangles.size()) ||
         (write_green && cells->is_green.size() != mesh.triangles.size())) {
         throw Error("PLY writer: cell data size does not match the triangle count");
     }
     const bool wide_indices = mesh.positions.size() > static_cast<std::size_t>(INT32_MAX);
     const char* real = mesh.single_precision ? "float" : "double";
-    std::string out = "ply\nformat binary_little_endian 1.0\ncomment written by amcodec\n";
+    std::string out = ascii ? "ply\nformat ascii 1.0\n" : "ply\nformat binary_little_endian 1.0\n";
+    out += "comment written by amcodec\n";
     out += "element vertex " + std::to_string(mesh.positions.size()) + "\n";
     out += std::string("property ") + real + " x\nproperty " + real + " y\nproperty " + real +
            " z\n";
@@ -431,9 +433,35 @@ std::string format_ply(const TriangleMesh& mesh, const CellData* cells) {
     if (write_green) out += "property uchar green\n";
     out += "end_header\n";
 
+    if (ascii) {
+        for (const Vec3& p : mesh.positions) {
+            if (mesh.single_precision) {
+                text::append_line(out, static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z));
+            } else {
+                text::append_line(out, p.x, p.y, p.z);
+            }
+        }
+        for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+            out += "3 ";
+            const auto& tri = mesh.triangles[t];
+            text::append_line(out, uint64_t{tri[0]}, uint64_t{tri[1]}, uint64_t{tri[2]});
+            if (!write_level && !write_green) continue;
+            out.pop_back();  // the face's properties go on its line
+            if (write_level) {
+                out += ' ';
+                text::append_uint(out, cells->level[t]);
+            }
+            if (write_green) {
+                out += ' ';
+                text::append_uint(out, cells->is_green[t]);
+            }
+            out += '\n';
+        }
+        return out;
+    }
+
     const std::size_t real_size = mesh.single_precision ? 4 : 8;
-    out.reserve(out.size() + mesh.positions.size() * 3 * real_size +
-                mesh.triangles.size() * (13 + write_level + write_green));
+    out.reserve(out.size() + mesh.positions.size() * 3 * real_size + mesh.triangles.size() * 13);
     for (const Vec3& p : mesh.positions) {
         for (double c : {p.x, p.y, p.z}) {
             if (mesh.single_precision) {
@@ -443,11 +471,9 @@ std::string format_ply(const TriangleMesh& mesh, const CellData* cells) {
             }
         }
     }
-    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    for (const auto& tri : mesh.triangles) {
         out += static_cast<char>(3);
-        for (uint32_t v : mesh.triangles[t]) append_le(out, v);
-        if (write_level) out += static_cast<char>(cells->level[t]);
-        if (write_green) out += static_cast<char>(cells->is_green[t]);
+        for (uint32_t v : tri) append_le(out, v);
     }
     return out;
 }

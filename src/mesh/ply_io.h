@@ -14,9 +14,12 @@ namespace amc {
 // Element counts are checked against the data size before anything is allocated. Throws Error.
 TriangleMesh parse_ply(std::string_view bytes, const std::string& what);
 
-// Binary little-endian PLY: float x, y, z when mesh.single_precision, double otherwise; faces as
-// "list uchar int vertex_indices", plus "uchar level" and "uchar green" face properties for the
-// non-empty arrays of `cells` (their sizes must equal the triangle count).
-std::string format_ply(const TriangleMesh& mesh, const CellData* cells = nullptr);
+// PLY with float x, y, z when mesh.single_precision, double otherwise, and faces as
+// "list uchar int vertex_indices". Binary (little-endian) files hold nothing else: meshio 5 cannot
+// read a binary face element with more properties, nor a file with more elements. ASCII files add
+// "uchar level" and "uchar green" face properties for the non-empty arrays of `cells` (their sizes
+// must equal the triangle count), which meshio reads as cell data.
+std::string format_ply(const TriangleMesh& mesh, const CellData* cells = nullptr,
+                       MeshEncoding encoding = MeshEncoding::binary);
 
 }  // namespace amc
