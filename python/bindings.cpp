@@ -311,28 +311,46 @@ PYBIND11_MODULE(_amcodec, m) {
           "over the coarsest base found in it. keep_numbering stores the mesh's own vertex and face numbering, so\n"
           "that decode returns it; return_stats also returns a dict of sizes and the numbering map.");
 
-    m.def("decode", [](py::bytes data, int level, bool canonical) {
+    m.def("decode", [](py::bytes data, int level, bool canonical, bool partial) {
               const std::string bytes = data;
               LeafNumbering numbering;
               Hierarchy h;
+              PartialDecode arrived;
               {
                   py::gil_scoped_release release;
                   DecodeOptions options;
                   options.max_level = level;
-                  h = decode(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size(), options, &numbering);
+                  const auto* begin = reinterpret_cast<const uint8_t*>(bytes.data());
+                  if (partial) {
+                      arrived = decode_partial(begin, bytes.size(), options);
+                      h = std::move(arrived.hierarchy);
+                      numbering = std::move(arrived.numbering);
+                  } else {
+                      h = decode(begin, bytes.size(), options, &numbering);
+                  }
               }
               const LeafMesh leaf = extract_leaf_mesh(h, level);
+              py::dict result;
               if (!numbering.empty() && !canonical) {
                   CellData cells;
                   const TriangleMesh mesh = renumber_leaf_mesh(leaf, numbering, &cells);
-                  return mesh_dict(mesh, cells, &numbering);
+                  result = mesh_dict(mesh, cells, &numbering);
+              } else {
+                  result = mesh_dict(leaf.mesh, leaf.cells, &numbering);
               }
-              return mesh_dict(leaf.mesh, leaf.cells, &numbering);
+              if (partial) {
+                  result["complete"] = arrived.complete;
+                  result["reached_level"] = arrived.level;
+                  result["levels"] = arrived.levels;
+              }
+              return result;
           },
-          py::arg("data"), py::arg("level") = -1, py::arg("canonical") = false,
+          py::arg("data"), py::arg("level") = -1, py::arg("canonical") = false, py::arg("partial") = false,
           "Decodes .amc bytes to a dict: points, triangles, level and green per triangle, and numbering (the stored\n"
           "map from the input's numbering to the canonical one, or None). The mesh is in the input's numbering\n"
-          "when the file stores it, unless canonical=True; level cuts the decoding at that level.");
+          "when the file stores it, unless canonical=True; level cuts the decoding at that level. partial=True\n"
+          "accepts a file still arriving (cut after its base mesh): the levels complete so far, with 'complete',\n"
+          "'reached_level' and 'levels' in the dict.");
 
     m.def("decode_hierarchy", [](py::bytes data) {
               const std::string bytes = data;

@@ -60,6 +60,22 @@ def test_without_numbering_the_map_ties_input_to_output():
     assert np.array_equal(mesh["points"][vertex], points)
 
 
+def test_partial_file_decodes_the_levels_that_arrived():
+    h, _, _ = adaptive_leaf_mesh(4)
+    data = h.encode()
+    whole = amcodec.decode(data, partial=True)
+    assert whole["complete"] and whole["reached_level"] == whole["levels"] - 1
+    assert np.array_equal(whole["triangles"], amcodec.decode(data)["triangles"])
+    cut = amcodec.decode(data[:len(data) * 3 // 4], partial=True)
+    assert not cut["complete"] and 0 <= cut["reached_level"] < whole["levels"] - 1
+    same = amcodec.decode(data, level=cut["reached_level"])
+    assert np.array_equal(cut["triangles"], same["triangles"]) and np.array_equal(cut["points"], same["points"])
+    with pytest.raises(amcodec.Error, match="truncated|base mesh"):
+        amcodec.decode(data[:30], partial=True)
+    with pytest.raises(amcodec.Error):
+        amcodec.decode(data[:len(data) * 3 // 4])
+
+
 def test_float32_stays_float32_and_quantized_is_within_the_error():
     _, points, triangles = adaptive_leaf_mesh(5)
     mesh = amcodec.decode(amcodec.encode(points.astype(np.float32), triangles, keep_numbering=True))
