@@ -49,7 +49,7 @@ const char* method_name(int method) {
 void report(const std::string& name, const TriangleMesh& mesh, bool import) {
     ImportedHierarchy imported;
     if (import) {
-        throw Error("--import needs base detection (issue 23, part 2)");
+        imported = import_mesh(mesh, name);
     } else {
         imported.hierarchy = Hierarchy(mesh);
         for (uint32_t i = 0; i < mesh.positions.size(); ++i) imported.vertex_of_input.push_back(i);

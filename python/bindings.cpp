@@ -125,11 +125,8 @@ py::dict stats_dict(const EncodeStats& s) {
 
 ImportedHierarchy import_arrays(const TriangleMesh& mesh, const py::object& base) {
     if (base.is_none()) {
-        // Until base detection (issue 23, part 2) lands: the mesh is its own base.
-        ImportedHierarchy own;
-        own.hierarchy = Hierarchy(mesh);
-        for (uint32_t i = 0; i < mesh.positions.size(); ++i) own.vertex_of_input.push_back(i);
-        return own;
+        py::gil_scoped_release release;
+        return import_mesh(mesh, "mesh");
     }
     const py::tuple pair = base.cast<py::tuple>();
     if (pair.size() != 2) throw Error("base: expected a (points, triangles) pair");

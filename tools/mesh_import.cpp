@@ -11,14 +11,8 @@ namespace amc::cli {
 
 ImportedMesh import_input(const InputFile& input, const std::string& base_path, const GlobalOptions& global) {
     const TriangleMesh mesh = mesh_of(input);
-    ImportedHierarchy imported;
-    if (base_path.empty()) {
-        // Until base detection (issue 23, part 2) lands: the mesh is its own base.
-        imported.hierarchy = Hierarchy(mesh);
-        for (uint32_t i = 0; i < mesh.positions.size(); ++i) imported.vertex_of_input.push_back(i);
-    } else {
-        imported = import_leaf_mesh(mesh_of(read_input(base_path)), mesh, {}, input.name);
-    }
+    ImportedHierarchy imported = base_path.empty() ? import_mesh(mesh, input.name)
+                                                   : import_leaf_mesh(mesh_of(read_input(base_path)), mesh, {}, input.name);
     if (global.verbosity > 1) {
         const HierarchyStats stats = compute_stats(imported.hierarchy);
         std::fprintf(stderr, "%s: base %u triangles, %u levels, %u nodes\n", input.name.c_str(), stats.base_triangles,

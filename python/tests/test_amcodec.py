@@ -51,6 +51,24 @@ def test_mesh_round_trip_keeps_the_numbering():
     assert mesh["level"].shape == (len(triangles),)
 
 
+def test_plain_mesh_gets_its_coarsest_base_detected():
+    points, triangles = icosahedron()
+    h = amcodec.Hierarchy(points, triangles)
+    for _ in range(2):
+        for leaf in h.leaves():
+            h.refine(leaf)
+    mesh = h.leaf_mesh()
+    rng = np.random.default_rng(5)
+    order = rng.permutation(len(mesh["points"]))
+    inverse = np.empty_like(order)
+    inverse[order] = np.arange(len(order))
+    shuffled = inverse[mesh["triangles"]][rng.permutation(len(mesh["triangles"]))]
+    data, stats = amcodec.encode(mesh["points"][order], shuffled, keep_numbering=True, return_stats=True)
+    assert stats["base_triangles"] == 20 and stats["levels"] == 3
+    back = amcodec.decode(data)
+    assert np.array_equal(back["points"], mesh["points"][order]) and np.array_equal(back["triangles"], shuffled)
+
+
 def test_without_numbering_the_map_ties_input_to_output():
     _, points, triangles = adaptive_leaf_mesh(4)
     data, stats = amcodec.encode(points, triangles, return_stats=True)
