@@ -22,10 +22,13 @@ namespace amc_bench {
 //   amc-paper-naive     the paper's method with its naive traversal
 //   amc-paper-improved  the paper's method with its improved traversal
 //   amc-best            amcodec's default options
+//   amc-imported        amcodec from the leaf mesh alone, as users have it: import_mesh (the
+//                       coarsest base found in the connectivity), then the default options
 // Complete meshes (payload mesh-lossless, mesh-16, mesh-12): draco-default, draco-best, amc-best.
 struct Result {
     std::string model;
     uint64_t faces = 0, vertices = 0, nodes = 0;
+    uint64_t base_triangles = 0;   // of the hierarchy coded (amc-imported: of the base found)
     std::string coder;
     std::string payload;           // connectivity, mesh-lossless, mesh-16 or mesh-12
     uint64_t bytes = 0;

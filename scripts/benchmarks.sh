@@ -57,6 +57,11 @@ fi
 "$amc" -f refine --model uniform --levels 7 -o "$corpus/uniform.amh" > /dev/null
 "$amc" -f refine --model random --faces 150000 --seed 7 -o "$corpus/random.amh" > /dev/null
 models+=("$corpus/lshape.amh" "$corpus"/front_*.amh "$corpus/uniform.amh" "$corpus/random.amh")
+# Irregular meshes as users have them (mesh files, no hierarchy): imported over the coarsest base
+# found in them, which for these is mostly the mesh itself, so the base coder does the work.
+if [[ -d $data ]]; then
+  for file in bunny.obj horse.obj feline.off fandisk.obj venus.off; do models+=("$data/$file"); done
+fi
 
 # ---- measure -------------------------------------------------------------------------------
 "$build/bench/compare_bench" --runs "$runs" --csv "$build/benchmarks.csv" --markdown "$build/benchmarks_tables.md" "${models[@]}"
