@@ -89,7 +89,8 @@ expect 0 "$amc" encode r.obj -o m.amc --keep-numbering --map m.map
 expect 0 "$amc" decode m.amc -o m.obj
 diff -q <(mesh_of m.obj) <(mesh_of r.obj) > /dev/null || fail "decode of --keep-numbering is not the input mesh"
 head -1 m.map | grep -q 'amc-numbering-map 1' || fail "encode --map wrote no map"
-"$amc" info m.amc | grep -q 'base mesh [0-9]* vertices, 20 triangles' || fail "encode of a plain mesh found no coarser base: $("$amc" info m.amc | head -2)"
+# Base detection undoes part of a random adaptive refinement (docs/IMPORT.md): a coarser base than the mesh.
+"$amc" info m.amc | awk '/base mesh/ {exit !($5 + 0 < $13 + 0)}' || fail "encode of a plain mesh found no coarser base: $("$amc" info m.amc | head -2)"
 expect 0 "$amc" decode m.amc -o mc.obj --canonical
 expect 0 "$amc" decode m.amc -o m2.ply --map m2.map
 cmp -s m.map m2.map || fail "the map stored in the file differs from the one encode wrote"
