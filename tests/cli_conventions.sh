@@ -6,19 +6,7 @@
 set -u
 amc=$1
 data=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-cd "$work" || exit 1
-failures=0
-
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-# expect CODE COMMAND...: runs the command, checks its exit code.
-expect() {
-  local code=$1; shift
-  "$@" > out.txt 2> err.txt
-  local got=$?
-  [[ $got == "$code" ]] || fail "'$*' exited $got, expected $code; stderr: $(head -c 300 err.txt)"
-}
+source "$(dirname "${BASH_SOURCE[0]}")/cli_lib.sh"
 # The mesh of an OBJ file without comments: vertices and faces as numbers.
 mesh_of() { grep -v '^#' "$1" | awk '{print $1, $2 + 0, $3 + 0, $4 + 0}'; }
 
@@ -118,8 +106,4 @@ head -3 a.ply | grep -q 'format ascii' || fail "--ascii wrote no ASCII PLY"
 grep -q 'property uchar level' a.ply || fail "ASCII PLY lacks the level property"
 grep -q 'property uchar level' r.ply && fail "binary PLY has face properties (meshio 5 can not read them)"
 
-if ((failures)); then
-  echo "$failures failure(s)"
-  exit 1
-fi
-echo "all CLI conventions hold"
+finish cli_conventions

@@ -4,18 +4,7 @@
 # Usage: cli_octree.sh AMC
 set -u
 amc=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-cd "$work" || exit 1
-failures=0
-
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-expect() {
-  local code=$1; shift
-  "$@" > out.txt 2> err.txt
-  local got=$?
-  [[ $got == "$code" ]] || fail "'$*' exited $got, expected $code; stderr: $(head -c 300 err.txt)"
-}
+source "$(dirname "${BASH_SOURCE[0]}")/cli_lib.sh"
 
 expect 0 "$amc" octree make --dim 3 --model sphere --level 5 --trees 2x2x1 -o sphere.amq
 [[ -s sphere.amq ]] || fail "make wrote no sphere.amq"
@@ -40,5 +29,4 @@ expect 2 "$amc" octree make --dim 4 -o x.amq
 expect 2 "$amc" octree make --model moon -o x.amq
 expect 2 "$amc" octree decode sphere.amq -o x.amq
 
-((failures == 0)) && echo "cli_octree: all checks passed"
-exit $((failures > 0))
+finish cli_octree

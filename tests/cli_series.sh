@@ -5,18 +5,7 @@
 # Usage: cli_series.sh AMC
 set -u
 amc=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-cd "$work" || exit 1
-failures=0
-
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-expect() {
-  local code=$1; shift
-  "$@" > out.txt 2> err.txt
-  local got=$?
-  [[ $got == "$code" ]] || fail "'$*' exited $got, expected $code; stderr: $(head -c 300 err.txt)"
-}
+source "$(dirname "${BASH_SOURCE[0]}")/cli_lib.sh"
 
 # Frames: a moving front, refined ahead and coarsened behind, as hierarchy files.
 expect 0 "$amc" refine --model front --steps 6 --max-level 6 -o front.amh
@@ -99,8 +88,4 @@ echo "not a series" > junk.amcs
 expect 1 "$amc" series info junk.amcs
 expect 1 "$amc" extract key.amcs -o e.ply
 
-if ((failures)); then
-  echo "$failures failure(s)"
-  exit 1
-fi
-echo "all series CLI checks passed"
+finish cli_series
