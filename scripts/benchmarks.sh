@@ -24,39 +24,9 @@ amc=$build/amc
 # ---- the corpus: deterministic, remade on every run -------------------------------------------
 rm -rf "$corpus"
 mkdir -p "$corpus"
-models=()
-if [[ ! -d $data ]]; then
-  echo "note: $data is absent; the remeshed surface models are skipped, only the procedural models are made" >&2
-else
-  # Every real model adaptively remeshed by mean and by Gauss curvature (the paper's feline_mean /
-  # feline_gauss): a base of about 500 triangles, refined up to level 5 until about `faces` leaves.
-  # model      file            faces (mean)  faces (gauss)
-  while read -r model file mean_faces gauss_faces; do
-    for criterion in mean gauss; do
-      faces=$mean_faces
-      [[ $criterion == gauss ]] && faces=$gauss_faces
-      "$amc" -f refine --input "$data/$file" --criterion "$criterion" --faces "$faces" --base-faces 500 --max-level 5 \
-        -o "$corpus/${model}_$criterion.amh" > /dev/null
-      models+=("$corpus/${model}_$criterion.amh")
-    done
-  done <<'LIST'
-bunny-hr    bunny-hr.obj    100000 100000
-horse       horse.obj       100000 100000
-feline      feline.off      250000 200000
-venus       venus.off       140000 140000
-fandisk     fandisk.obj     100000 100000
-rocker-arm  rocker-arm.obj  100000 100000
-femur       femur.obj       100000 100000
-camelhead   camelhead.off   100000 100000
-mountain    mountain.obj    100000 100000
-LIST
-fi
-# Planar finite-element models, a uniform and a random refinement.
-"$amc" -f refine --model lshape --max-level 10 -o "$corpus/lshape.amh" > /dev/null
-"$amc" -f refine --model front --steps 3 --max-level 9 -o "$corpus/front" > /dev/null
-"$amc" -f refine --model uniform --levels 7 -o "$corpus/uniform.amh" > /dev/null
-"$amc" -f refine --model random --faces 150000 --seed 7 -o "$corpus/random.amh" > /dev/null
-models+=("$corpus/lshape.amh" "$corpus"/front_*.amh "$corpus/uniform.amh" "$corpus/random.amh")
+source "$here/scripts/corpus.sh"
+make_corpus "$amc" "$data" "$corpus"
+models=("${corpus_models[@]}")
 # Irregular meshes as users have them (mesh files, no hierarchy): imported over the coarsest base
 # found in them, which for these is mostly the mesh itself, so the base coder does the work.
 if [[ -d $data ]]; then

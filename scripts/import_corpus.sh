@@ -19,32 +19,7 @@ cmake --build "$build" -j2 --target amc import_corpus >&2
 amc=$build/amc
 
 if [[ ! -d $corpus ]] || ! compgen -G "$corpus/*.amh" > /dev/null; then
-  mkdir -p "$corpus"
-  if [[ -d $data ]]; then
-    while read -r model file mean_faces gauss_faces; do
-      for criterion in mean gauss; do
-        faces=$mean_faces
-        [[ $criterion == gauss ]] && faces=$gauss_faces
-        "$amc" -f refine --input "$data/$file" --criterion "$criterion" --faces "$faces" --base-faces 500 --max-level 5 \
-          -o "$corpus/${model}_$criterion.amh" > /dev/null
-      done
-    done <<'LIST'
-bunny-hr    bunny-hr.obj    100000 100000
-horse       horse.obj       100000 100000
-feline      feline.off      250000 200000
-venus       venus.off       140000 140000
-fandisk     fandisk.obj     100000 100000
-rocker-arm  rocker-arm.obj  100000 100000
-femur       femur.obj       100000 100000
-camelhead   camelhead.off   100000 100000
-mountain    mountain.obj    100000 100000
-LIST
-  else
-    echo "note: $data is absent; the remeshed surface models are skipped" >&2
-  fi
-  "$amc" -f refine --model lshape --max-level 10 -o "$corpus/lshape.amh" > /dev/null
-  "$amc" -f refine --model front --steps 3 --max-level 9 -o "$corpus/front" > /dev/null
-  "$amc" -f refine --model uniform --levels 7 -o "$corpus/uniform.amh" > /dev/null
-  "$amc" -f refine --model random --faces 150000 --seed 7 -o "$corpus/random.amh" > /dev/null
+  source "$here/scripts/corpus.sh"
+  make_corpus "$amc" "$data" "$corpus"
 fi
 "$build/bench/import_corpus" --move "$move" "$corpus"/*.amh
