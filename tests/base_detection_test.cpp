@@ -15,25 +15,7 @@ namespace amc {
 namespace {
 
 using testing::Random;
-
-// The mesh with its vertices renumbered, its triangles reordered and each rotated, at random.
-TriangleMesh shuffled(const TriangleMesh& mesh, uint64_t seed) {
-    Random random{seed};
-    std::vector<uint32_t> order(mesh.positions.size());
-    std::iota(order.begin(), order.end(), 0u);
-    for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[random.next() % i]);
-    TriangleMesh out;
-    out.single_precision = mesh.single_precision;
-    out.positions.resize(mesh.positions.size());
-    for (size_t v = 0; v < order.size(); ++v) out.positions[order[v]] = mesh.positions[v];
-    out.triangles = mesh.triangles;
-    for (size_t i = out.triangles.size(); i > 1; --i) std::swap(out.triangles[i - 1], out.triangles[random.next() % i]);
-    for (Triangle& t : out.triangles) {
-        const int r = int(random.next() % 3);
-        t = {order[t[size_t(r)]], order[t[size_t(r + 1) % 3]], order[t[size_t(r + 2) % 3]]};
-    }
-    return out;
-}
+using testing::shuffled;
 
 Triangle normalized(Triangle t) {
     const int r = t[0] < t[1] ? (t[0] < t[2] ? 0 : 2) : (t[1] < t[2] ? 1 : 2);

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <numeric>
 #include <string>
 #include <utility>
 #include <vector>
@@ -22,6 +23,27 @@ struct Random {
         return state >> 33;
     }
 };
+
+// The mesh with its vertices renumbered, its triangles reordered and each rotated, at random
+// (positions unchanged); new_index, if given, receives the new number of every old vertex.
+inline TriangleMesh shuffled(const TriangleMesh& mesh, uint64_t seed, std::vector<uint32_t>* new_index = nullptr) {
+    Random random{seed};
+    std::vector<uint32_t> order(mesh.positions.size());
+    std::iota(order.begin(), order.end(), 0u);
+    for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[random.next() % i]);
+    TriangleMesh out;
+    out.single_precision = mesh.single_precision;
+    out.positions.resize(mesh.positions.size());
+    for (size_t v = 0; v < order.size(); ++v) out.positions[order[v]] = mesh.positions[v];
+    out.triangles = mesh.triangles;
+    for (size_t i = out.triangles.size(); i > 1; --i) std::swap(out.triangles[i - 1], out.triangles[random.next() % i]);
+    for (Triangle& t : out.triangles) {
+        const size_t r = size_t(random.next() % 3);
+        t = {order[t[r]], order[t[(r + 1) % 3]], order[t[(r + 2) % 3]]};
+    }
+    if (new_index != nullptr) *new_index = order;
+    return out;
+}
 
 struct NamedMesh {
     std::string name;

@@ -17,6 +17,7 @@ namespace amc {
 namespace {
 
 using testing::Random;
+using testing::shuffled;
 
 // A hierarchy's leaf mesh as a user would hold it: vertices and faces in random order, each
 // face's vertices rotated, every non-base vertex moved off its midpoint (by `move` times the
@@ -453,26 +454,6 @@ TEST(ImportLeafMesh, RefusesQuadsInTheFile) {
 }
 
 // ---- the semi-regular meshes of ../shared/data ----------------------------------------------
-
-// A leaf mesh with vertices and faces shuffled and faces rotated (positions unchanged).
-TriangleMesh shuffled(const TriangleMesh& mesh, uint64_t seed, std::vector<uint32_t>* new_index) {
-    Random random{seed};
-    std::vector<uint32_t> order(mesh.positions.size());
-    std::iota(order.begin(), order.end(), 0u);
-    for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[random.next() % i]);
-    TriangleMesh out;
-    out.single_precision = mesh.single_precision;
-    out.positions.resize(mesh.positions.size());
-    for (size_t v = 0; v < order.size(); ++v) out.positions[order[v]] = mesh.positions[v];
-    out.triangles = mesh.triangles;
-    for (size_t i = out.triangles.size(); i > 1; --i) std::swap(out.triangles[i - 1], out.triangles[random.next() % i]);
-    for (Triangle& t : out.triangles) {
-        const int r = int(random.next() % 3);
-        t = {order[t[r]], order[t[(r + 1) % 3]], order[t[(r + 2) % 3]]};
-    }
-    if (new_index != nullptr) *new_index = order;
-    return out;
-}
 
 void expect_semi_regular(const std::string& base_name, const std::string& leaf_name, int levels) {
     const std::string dir = AMC_SHARED_DATA_DIR;
