@@ -302,10 +302,13 @@ int main(int argc, char** argv) {
         series_fields += stats[k].field_bytes;
         if (!bounded_stats.empty()) series_bounded_fields += bounded_stats[k].field_bytes;
         const double share = double(stats[k].changed_nodes) / double(stats[k].nodes);
-        changed_share.push_back(share);
+        if (k > 0) changed_share.push_back(share);  // frame 0 against the unrefined base is no change
         if (!stats[k].keyframe && share <= 0.05) {
             const uint64_t intra = encode_hierarchy(f.h).size();
             small_change_ratio.push_back(double(stats[k].connectivity_bytes) / double(intra));
+            std::printf("frame %zu: %.2f%% of the nodes changed, connectivity %llu bytes, alone %llu bytes (%.1f%%)\n", k,
+                        100 * share, (unsigned long long)stats[k].connectivity_bytes, (unsigned long long)intra,
+                        100 * small_change_ratio.back());
         }
     }
     const double n = double(seq.size());

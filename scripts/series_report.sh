@@ -26,3 +26,6 @@ run --scenario front --frames 100 --max-level 8 --repeat "$runs" --peers 0
 run --scenario rotating --frames 100 --target "$elements" --repeat "$runs" --peers 0
 # Random access with a keyframe every 10 frames.
 run --scenario lshape --frames 100 --target "$elements" --keyframe 10 --repeat "$runs" --speed-only 1
+# The inter-frame connectivity's context designs: H(X|ctx) and adaptive code lengths.
+designs="$build/bench/series_context_designs"
+[[ -x $designs ]] && { nice -n 19 "$designs" --scenario lshape --frames 100 --target "$elements"; echo; }

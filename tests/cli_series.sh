@@ -27,9 +27,12 @@ expect 0 "$amc" -f series decode front_0.amcs -q
 # The collection (frames with the cell data "level" and "green") -> series with keyframes;
 # `amc encode` of a .pvd is a series encode.
 expect 0 "$amc" encode front_0.pvd --base base.vtu -o run.amcs
-expect 0 "$amc" series encode front_0.pvd --base base.vtu -o key.amcs --keyframe 2
+expect 0 "$amc" series encode front_0.pvd --base base.vtu -o key.amcs --keyframe 2 --fixed-keyframes
 grep -q '3 keyframes' out.txt || fail "--keyframe 2 over 6 frames did not make 3 keyframes: $(head -c 300 out.txt)"
 grep -q 'field green' out.txt || fail "the VTU cell data did not become fields"
+expect 0 "$amc" series encode front_0.pvd --base base.vtu -o chosen.amcs --keyframe 2
+expect 0 "$amc" series info chosen.amcs
+grep -q 'amc series version 2' out.txt || fail "series info does not give the version: $(head -c 300 out.txt)"
 # Without --base: the base found in the first frame.
 expect 0 "$amc" series encode front_0.pvd -o nobase.amcs
 expect 0 "$amc" series info nobase.amcs

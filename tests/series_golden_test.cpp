@@ -3,6 +3,7 @@
 // was made from, and the current writer's bytes are pinned to the current version's file. The
 // frames use only correctly rounded arithmetic (no libm transcendental), so the bytes are the same
 // on every IEEE platform. AMC_UPDATE_GOLDEN=1 writes a missing file (never overwrites one).
+#include <amc/import.h>
 #include <amc/refinement.h>
 #include <amc/series.h>
 
@@ -59,6 +60,35 @@ std::vector<GoldenFrame> golden_frames() {
     return frames;
 }
 
+// Version 2 on: an adaptive run in miniature, whose refinement follows its own cell field "eta"
+// (a peak moving across the square; refine where eta is large, coarsen where it is small), so
+// that the inter-frame forests take eta as their indicator (FORMAT.md 7.6). Only + - * /.
+std::vector<GoldenFrame> indicator_frames() {
+    std::vector<GoldenFrame> frames;
+    Hierarchy h(make_square(4));
+    for (int k = 0; k < 8; ++k) {
+        const LeafMesh leaf = extract_leaf_mesh(h);
+        Field eta{"eta", FieldAssociation::cell, FieldType::float64, 1, {}, {}};
+        const double px = 0.15 + 0.1 * double(k), py = 0.5;
+        for (const Triangle& t : leaf.mesh.triangles) {
+            const Vec3 s = leaf.mesh.positions[t[0]] + leaf.mesh.positions[t[1]] + leaf.mesh.positions[t[2]];
+            const Vec3 c{s.x / 3, s.y / 3, s.z / 3};
+            const Vec3 e1 = leaf.mesh.positions[t[1]] - leaf.mesh.positions[t[0]];
+            const Vec3 e2 = leaf.mesh.positions[t[2]] - leaf.mesh.positions[t[0]];
+            const double area = 0.5 * cross(e1, e2).z;
+            eta.values.push_back(area / (0.01 + (c.x - px) * (c.x - px) + (c.y - py) * (c.y - py)));
+        }
+        frames.push_back({h, double(k), {eta}});
+        std::vector<uint32_t> refine, coarsen;
+        for (uint32_t e = 0; e < eta.values.size(); ++e) {
+            if (eta.values[e] > 0.02 && leaf.cells.level[e] < 6) refine.push_back(e);
+            else if (eta.values[e] < 0.002) coarsen.push_back(e);
+        }
+        apply_adaptation_step(h, refine, coarsen);
+    }
+    return frames;
+}
+
 SeriesOptions golden_options() {
     SeriesOptions options;
     options.keyframe_interval = 3;
@@ -66,8 +96,8 @@ SeriesOptions golden_options() {
     return options;
 }
 
-std::string golden_path(int version) {
-    return std::string(AMC_TEST_DATA_DIR) + "/golden/series/v" + std::to_string(version) + "/front_fields.amcs";
+std::string golden_path(int version, const std::string& name = "front_fields") {
+    return std::string(AMC_TEST_DATA_DIR) + "/golden/series/v" + std::to_string(version) + "/" + name + ".amcs";
 }
 
 std::vector<uint8_t> read_file(const std::string& path) {
@@ -92,14 +122,16 @@ TEST(SeriesGolden, EncodingMatchesTheCurrentVersionsFile) {
 }
 
 TEST(SeriesGolden, FilesOfEveryVersionDecodeToTheirFrames) {
-    const std::vector<GoldenFrame> frames = golden_frames();
     for (int version = 1; version <= kNewestSeriesVersion; ++version) {
         SCOPED_TRACE(golden_path(version));
+        const std::vector<GoldenFrame> frames = golden_frames();
         SeriesReader reader(read_file(golden_path(version)), golden_path(version));
         ASSERT_EQ(reader.frame_count(), frames.size());
         for (size_t k = 0; k < frames.size(); ++k) {
             const SeriesFrame f = reader.frame(k);
-            EXPECT_EQ(reader.info(k).keyframe, k % 3 == 0);
+            if (k % 3 == 0) {
+                EXPECT_TRUE(reader.info(k).keyframe) << k;  // version 2: and the encoder's choices
+            }
             EXPECT_TRUE(identical(f.hierarchy, frames[k].h)) << "frame " << k;
             EXPECT_EQ(f.time, frames[k].time);
             ASSERT_EQ(f.fields.size(), frames[k].fields.size());
@@ -110,6 +142,34 @@ TEST(SeriesGolden, FilesOfEveryVersionDecodeToTheirFrames) {
                     EXPECT_TRUE(identical(f.fields[i], frames[k].fields[i])) << "frame " << k << " " << f.fields[i].name;
                 }
             }
+        }
+    }
+}
+
+void write_missing_golden(const std::string& path, const std::vector<uint8_t>& bytes) {
+    if (!std::getenv("AMC_UPDATE_GOLDEN") || std::filesystem::exists(path)) return;
+    std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+    std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+}
+
+TEST(SeriesGolden, TheIndicatorFileOfVersion2DecodesAndIsWhatTheWriterWrites) {
+    const std::vector<GoldenFrame> frames = indicator_frames();
+    SeriesWriter writer(frames[0].h.base());
+    std::vector<SeriesFrameStats> stats;
+    for (const GoldenFrame& f : frames) stats.push_back(writer.add_frame(f.h, f.time, f.fields));
+    writer.close();
+    const std::string current = golden_path(kSeriesVersion, "indicator");
+    write_missing_golden(current, writer.bytes());
+    EXPECT_EQ(writer.bytes(), read_file(current)) << "the series bitstream changed (a new series version: FORMAT.md, section 7)";
+    for (int version = 2; version <= kNewestSeriesVersion; ++version) {
+        const std::string path = golden_path(version, "indicator");
+        SeriesReader reader(read_file(path), path);
+        ASSERT_EQ(reader.frame_count(), frames.size());
+        for (size_t k = 0; k < frames.size(); ++k) {
+            const SeriesFrame f = reader.frame(k);
+            EXPECT_TRUE(identical(f.hierarchy, frames[k].h)) << path << " frame " << k;
+            ASSERT_EQ(f.fields.size(), 1u);
+            EXPECT_TRUE(identical(f.fields[0], frames[k].fields[0])) << path << " frame " << k;
         }
     }
 }

@@ -1,10 +1,13 @@
 // The series file (include/amc/series.h, docs/FORMAT.md section 7): round trips frame by frame on
 // the adaptive heat run and the front model, random access, keyframes, moving meshes, fields of
-// every kind, error bounds, cost of unchanged frames, truncation, corruption, a writer killed
-// mid-frame, and the golden file of version 1.
+// every kind, error bounds, cost of unchanged frames, encoder-chosen keyframes, the refinement
+// indicator (version 2), truncation, corruption and a writer killed mid-frame.
 #include <amc/refinement.h>
 #include <amc/series.h>
 #include <amc/simulation.h>
+
+#include "series/frame_connectivity.h"
+#include "series/series_format.h"
 
 #include <gtest/gtest.h>
 #include <xxhash.h>
@@ -95,8 +98,10 @@ TEST(Series, HeatRunRoundTripsFrameByFrame) {
     ASSERT_EQ(reader.frame_count(), frames.size());
     EXPECT_TRUE(reader.finished());
     for (size_t k = 0; k < frames.size(); ++k) {
-        EXPECT_EQ(reader.info(k).keyframe, k % 5 == 0);
-        EXPECT_EQ(stats[k].keyframe, k % 5 == 0);
+        if (k % 5 == 0) {
+            EXPECT_TRUE(stats[k].keyframe) << k;  // and any frame the encoder found smaller alone
+        }
+        EXPECT_EQ(reader.info(k).keyframe, stats[k].keyframe) << k;
         const SeriesFrame f = reader.frame(k);
         EXPECT_TRUE(identical(f.hierarchy, frames[k].h)) << "frame " << k;
         EXPECT_EQ(f.time, frames[k].time);
@@ -119,15 +124,85 @@ TEST(Series, FrontModelWithCoarseningRoundTrips) {
     for (size_t k = 0; k < frames.size(); ++k) EXPECT_TRUE(identical(reader.frame(k).hierarchy, frames[k].h)) << k;
 }
 
+TEST(Series, TheEncoderWritesAKeyframeWhenTheFrameAloneIsSmaller) {
+    // The front moves by more than the width of its refined band from frame to frame: nothing
+    // persists, and a frame coded alone is smaller than against the frame before it.
+    std::vector<Frame> frames;
+    for (Hierarchy& h : make_moving_front_sequence(12, 7)) frames.push_back({std::move(h), 0.0, {}});
+    std::vector<SeriesFrameStats> chosen, fixed;
+    const std::vector<uint8_t> with_choice = write_series(frames, {}, &chosen);
+    SeriesOptions only_first;
+    only_first.choose_keyframes = false;
+    const std::vector<uint8_t> without = write_series(frames, only_first, &fixed);
+    size_t keyframes = 0;
+    for (size_t k = 0; k < frames.size(); ++k) {
+        keyframes += chosen[k].keyframe;
+        EXPECT_EQ(fixed[k].keyframe, k == 0) << k;
+    }
+    EXPECT_GT(keyframes, 1u);
+    EXPECT_LT(with_choice.size(), without.size());
+    // Random access starts at the chosen keyframes; every frame decodes in any order.
+    SeriesReader reader(with_choice);
+    for (size_t k : {11u, 4u, 7u, 0u, 8u}) {
+        EXPECT_EQ(reader.info(k).keyframe, chosen[k].keyframe) << k;
+        EXPECT_TRUE(identical(reader.frame(k).hierarchy, frames[k].h)) << k;
+    }
+}
+
+TEST(Series, TheErrorIndicatorOfTheFrameBeforePredictsTheForest) {
+    // Version 2 takes a refinement indicator from a cell field of the frame before (FORMAT.md
+    // 7.6): with the solver's error indicator the forests cost much less than without it.
+    const std::vector<Frame> frames = heat_frames(12);
+    std::vector<Frame> without = frames;
+    for (Frame& f : without) f.fields.clear();
+    std::vector<SeriesFrameStats> with_stats, without_stats;
+    write_series(frames, {}, &with_stats);
+    const std::vector<uint8_t> bytes = write_series(without, {}, &without_stats);
+    uint64_t with_indicator = 0, no_indicator = 0;
+    for (size_t k = 1; k < frames.size(); ++k) {
+        with_indicator += with_stats[k].connectivity_bytes;
+        no_indicator += without_stats[k].connectivity_bytes;
+    }
+    EXPECT_LT(with_indicator * 3, no_indicator * 2) << with_indicator << " vs " << no_indicator;
+    SeriesReader reader(bytes);
+    for (size_t k = 0; k < frames.size(); ++k) EXPECT_TRUE(identical(reader.frame(k).hierarchy, frames[k].h)) << k;
+}
+
+TEST(Series, IndicatorLevelsAreExactEighthsOfAnOctave) {
+    // floor(8 log2(x^2 / mean square)) per cell, computed without libm (FORMAT.md 7.6): known
+    // answers, the special values, and libm's answer wherever it is not within 1e-9 of a step.
+    const Hierarchy h(make_square(1));  // two roots, one cell each
+    const std::vector<uint32_t> first_cell = {0, 1};
+    auto levels = [&](double a, double b) { return indicator_levels(h, first_cell, {a, b}).levels; };
+    EXPECT_EQ(levels(1, 1), (std::vector<int32_t>{0, 0}));
+    EXPECT_EQ(levels(2, 0), (std::vector<int32_t>{8, kZeroIndicator}));        // q = 4 / 2, 0
+    EXPECT_EQ(levels(1, 3), (std::vector<int32_t>{-19, 6}));                   // 8 log2 0.2 = -18.6, 8 log2 1.8 = 6.8
+    EXPECT_EQ(levels(-3, 1), (std::vector<int32_t>{6, -19}));
+    EXPECT_EQ(levels(std::nan(""), 1), (std::vector<int32_t>{kZeroIndicator, kZeroIndicator}));  // the mean is NaN
+    EXPECT_EQ(levels(1e200, 1e-200), (std::vector<int32_t>{kZeroIndicator, kZeroIndicator}));  // inf / inf, 0 / inf
+    std::mt19937_64 rng(8);
+    int compared = 0;
+    for (int i = 0; i < 2000; ++i) {
+        const double a = std::ldexp(double(rng() % 1000000 + 1), int(rng() % 40) - 20), b = double(rng() % 1000 + 1);
+        const double q = a * a / ((a * a + b * b) / 2);
+        const double exact = 8 * std::log2(q);
+        if (std::fabs(exact - std::round(exact)) < 1e-9) continue;
+        EXPECT_EQ(levels(a, b)[0], int32_t(std::floor(exact))) << a << " " << b;
+        ++compared;
+    }
+    EXPECT_GT(compared, 1000);
+}
+
 TEST(Series, UnchangedFramesCostNextToNothing) {
     const std::vector<Frame> frames = heat_frames(1);
     std::vector<Frame> same = {frames[0], frames[0], frames[0]};
     std::vector<SeriesFrameStats> stats;
     write_series(same, {}, &stats);
-    EXPECT_LE(stats[1].connectivity_bytes, 2u);
+    EXPECT_LE(stats[1].connectivity_bytes, 4u);  // the indicator byte and a few bytes of certain symbols
+    EXPECT_LE(stats[2].connectivity_bytes, 4u);
     EXPECT_EQ(stats[1].changed_nodes, 0u);
     EXPECT_FALSE(stats[1].moving);
-    EXPECT_LE(stats[1].geometry_bytes, 12u);  // mode and predictor bytes, an empty payload
+    EXPECT_EQ(stats[1].geometry_bytes, 1u);  // mode 2: the byte of the mode
     // Fields repeated exactly: temporal prediction leaves zeros.
     EXPECT_LT(stats[1].field_bytes * 10, stats[0].field_bytes);
 }
@@ -271,7 +346,7 @@ TEST(Series, CorruptedFilesAreRefusedWithClearErrors) {
     }
     EXPECT_EQ(refused, 400);  // every flip breaks a checksum
     std::vector<uint8_t> newer = bytes;
-    newer[4] = 2;
+    newer[4] = kNewestSeriesVersion + 1;
     try {
         SeriesReader r(newer);
         FAIL();

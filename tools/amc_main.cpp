@@ -149,8 +149,10 @@ int main(int argc, char** argv) {
     series_encode_cmd->add_option("-o,--output", series_encode.output, "Series file (default: the first input with .amcs; - for stdout)");
     series_encode_cmd->add_option("--base", series_encode.base, "Base mesh of mesh frames (default: the coarsest base found in the first frame)");
     series_encode_cmd->add_option("--keyframe", series_encode.keyframe_interval,
-                                  "A keyframe every K frames, for random access (default 0: frame 0 only)")
+                                  "A keyframe every K frames, for random access (default 0: frame 0 only), besides any frame that is smaller coded alone")
         ->check(CLI::Range(0u, 1u << 30));
+    series_encode_cmd->add_flag("--fixed-keyframes", series_encode.fixed_keyframes,
+                                "Keyframes only where --keyframe puts them (no frame made a keyframe because it is smaller alone)");
     series_encode_cmd->add_option("--error-bound", series_encode.error_bound,
                                   "Absolute error bound of every float field (default 0: bit-exact)")
         ->check(CLI::Range(0.0, 1e300));

@@ -78,6 +78,7 @@ struct SeriesEncodeCommand {
     std::string output;
     std::string base;                 // base mesh of mesh frames; empty: detected in the first frame
     uint32_t keyframe_interval = 0;
+    bool fixed_keyframes = false;     // no encoder-chosen keyframes
     double error_bound = 0;           // absolute, for every float field; 0: bit-exact
     std::vector<std::string> field_bounds;  // NAME=BOUND
 };

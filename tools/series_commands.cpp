@@ -132,6 +132,7 @@ void run_series_encode(const SeriesEncodeCommand& command, const GlobalOptions& 
     if (!global.force) refuse_existing(output);
     SeriesOptions options;
     options.keyframe_interval = command.keyframe_interval;
+    options.choose_keyframes = !command.fixed_keyframes;
     options.error_bound = command.error_bound;
     for (const std::string& b : command.field_bounds) options.field_bounds.push_back(parse_field_bound(b));
 
@@ -284,10 +285,11 @@ void run_series_decode(const InputFile& input, const SeriesDecodeCommand& comman
 void run_series_info(const InputFile& input, const SeriesInfoCommand& command, const GlobalOptions&) {
     SeriesReader reader = open_series(input, command.allow_unfinished, command.max_nodes);
     const TriangleMesh& base = reader.base();
-    std::printf("%s: amc series, %zu frames, %lu bytes; keyframes %s; %s\n", input.name.c_str(), reader.frame_count(),
-                (unsigned long)input.bytes.size(),
-                reader.keyframe_interval() ? ("every " + std::to_string(reader.keyframe_interval()) + " frames").c_str()
-                                           : "frame 0 only",
+    size_t keyframes = 0;
+    for (size_t k = 0; k < reader.frame_count(); ++k) keyframes += reader.info(k).keyframe;
+    std::printf("%s: amc series version %d, %zu frames, %lu bytes; %zu keyframes (interval %s, and the encoder's choices); %s\n",
+                input.name.c_str(), reader.version(), reader.frame_count(), (unsigned long)input.bytes.size(), keyframes,
+                reader.keyframe_interval() ? std::to_string(reader.keyframe_interval()).c_str() : "none",
                 reader.finished() ? "finished"
                                   : ("unfinished (" + std::to_string(reader.ignored_bytes()) + " bytes of an incomplete frame ignored)").c_str());
     std::printf("  base mesh %zu vertices, %zu triangles\n", base.positions.size(), base.triangles.size());

@@ -25,6 +25,9 @@ struct SeriesOptions {
     // that override it. The decoder guarantees |decoded - input| <= bound for every value.
     double error_bound = 0;
     std::vector<std::pair<std::string, double>> field_bounds;
+    // Write a frame as a keyframe also when it is smaller coded alone than against the frame
+    // before it (a sequence that changes faster than it persists).
+    bool choose_keyframes = true;
 };
 
 struct FieldStats {
@@ -123,6 +126,7 @@ public:
     bool finished() const { return finished_; }       // the END block is there
     uint64_t ignored_bytes() const { return ignored_; }  // an incomplete frame at the end (allow_unfinished)
     uint32_t keyframe_interval() const { return keyframe_interval_; }
+    int version() const { return version_; }  // of the file's format (FORMAT.md 7.1)
 
     // Throws Error naming the frame on a corrupt frame; std::out_of_range for k >= frame_count().
     SeriesFrame frame(size_t k);
@@ -138,6 +142,7 @@ private:
     bool finished_ = false;
     uint64_t ignored_ = 0;
     uint32_t keyframe_interval_ = 0;
+    int version_ = 0;
 };
 
 }  // namespace amc

@@ -48,7 +48,8 @@ def test_frames_come_back_bit_exact_and_by_random_access():
     data = writer.bytes()
     reader = amcodec.SeriesReader(data)
     assert len(reader) == len(seq) and reader.finished and reader.keyframe_interval == 3
-    assert [reader.info(k)["keyframe"] for k in range(len(seq))] == [k % 3 == 0 for k in range(len(seq))]
+    # Frames 0, 3, 6, ... and any frame the encoder found smaller coded alone.
+    assert all(reader.info(k)["keyframe"] for k in range(0, len(seq), 3))
     for k in [5, 0, 7, 6, 1]:  # random access, backwards too
         h, time, point_data, cell_data = seq[k]
         frame = reader.frame(k)

@@ -38,10 +38,16 @@ uint64_t residual_bits(Vec3 actual, Vec3 predicted, Precision precision) {
 
 bool same_bits(Vec3 a, Vec3 b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
+// The midpoint prediction as the decoder turns it into a position (a zero residual).
+Vec3 midpoint_position(const Hierarchy& h, const FrameVertex& v, Precision precision) {
+    const Vec3 p = predict_midpoint(h, v.node, v.edge);
+    return {coder_prediction(p.x, precision), coder_prediction(p.y, precision), coder_prediction(p.z, precision)};
+}
+
 }  // namespace
 
 std::vector<uint8_t> encode_frame_geometry(const Hierarchy& prev, const std::vector<FrameVertex>& order,
-                                           const std::vector<Vec3>& positions, Hierarchy& out,
+                                           const std::vector<Vec3>& positions, int version, Hierarchy& out,
                                            FrameGeometryMode* mode_out) {
     const Precision precision = out.single_precision() ? Precision::float32 : Precision::float64;
     AMC_REQUIRE(positions.size() == order.size(), invalid_input, "series frame: position count mismatch");
@@ -50,6 +56,16 @@ std::vector<uint8_t> encode_frame_geometry(const Hierarchy& prev, const std::vec
         out.set_position(order[i].id, positions[i]);
         if (order[i].previous != kNoVertex && !same_bits(prev.position(order[i].previous), positions[i]))
             mode = FrameGeometryMode::moving;
+    }
+    if (version >= 2 && mode == FrameGeometryMode::static_mesh) {
+        bool at_midpoints = true;
+        for (size_t i = 0; at_midpoints && i < order.size(); ++i)
+            if (order[i].previous == kNoVertex && order[i].level > 0)
+                at_midpoints = same_bits(positions[i], midpoint_position(out, order[i], precision));
+        if (at_midpoints) {
+            if (mode_out) *mode_out = FrameGeometryMode::at_midpoints;
+            return {uint8_t(FrameGeometryMode::at_midpoints)};
+        }
     }
     // Predictor per vertex level, from the final positions (predictions only read earlier vertices).
     const int levels = vertex_level_count(order);
@@ -82,8 +98,19 @@ std::vector<uint8_t> encode_frame_geometry(const Hierarchy& prev, const std::vec
 }
 
 void decode_frame_geometry(const Hierarchy& prev, const std::vector<FrameVertex>& order, const uint8_t* data,
-                           size_t size, Hierarchy& out) {
+                           size_t size, int version, Hierarchy& out) {
     const Precision precision = out.single_precision() ? Precision::float32 : Precision::float64;
+    AMC_REQUIRE(size >= 1, truncated, "geometry section: shorter than its header");
+    if (version >= 2 && data[0] == uint8_t(FrameGeometryMode::at_midpoints)) {
+        AMC_REQUIRE(size == 1, corrupt, "geometry section: bytes after mode 2");
+        for (const FrameVertex& v : order) {
+            const Vec3 p = v.previous != kNoVertex ? prev.position(v.previous) : midpoint_position(out, v, precision);
+            AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
+                        "geometry section: a non-finite coordinate");
+            out.set_position(v.id, p);
+        }
+        return;
+    }
     const int levels = vertex_level_count(order);
     AMC_REQUIRE(size >= size_t(levels), truncated, "geometry section: shorter than its header");
     AMC_REQUIRE(data[0] <= 1, corrupt, "geometry section: unknown mode " + std::to_string(data[0]));

@@ -18,6 +18,7 @@ struct FrameState {
     std::vector<uint32_t> first_cell;  // node id -> its first triangle in the leaf mesh (leaves only)
     std::vector<uint8_t> closure;      // node id -> hanging-edge mask | diagonal flag << 3 (leaves only)
     std::vector<Field> fields;         // as decoded: point fields in canonical order, cells in leaf order
+    ConnectivityMemory memory;         // what the next frame's connectivity starts from (version 2)
 };
 
 // Fills canonical, first_cell and closure from h.

@@ -115,6 +115,14 @@ TriangleMesh read_base(const uint8_t* data, size_t size, bool single_precision, 
     return base;
 }
 
+uint64_t zigzag(int32_t v) { return v < 0 ? 2 * uint64_t(-int64_t(v)) - 1 : 2 * uint64_t(v); }
+int32_t unzigzag(uint64_t z) { return z & 1 ? int32_t(-int64_t((z + 1) / 2)) : int32_t(z / 2); }
+
+// A field of the reference that may serve as the refinement indicator (FORMAT.md 7.6).
+bool is_indicator_candidate(const Field& f) {
+    return f.association == FieldAssociation::cell && is_float_type(f.type) && f.components == 1;
+}
+
 uint64_t face_count(const Hierarchy& h) {
     uint64_t faces = 0;
     for (NodeId n : h.leaves()) faces += 1 + uint64_t(h.hanging_node_count(n));
@@ -191,20 +199,22 @@ void SeriesWriter::write(const std::vector<uint8_t>& data) {
     AMC_REQUIRE(ok, io, path_ + ": write failed: " + std::strerror(errno));
 }
 
-SeriesFrameStats SeriesWriter::add_frame(const Hierarchy& h, double time, const std::vector<Field>& fields) {
-    AMC_REQUIRE(!closed_, invalid_input, "series: add_frame after close");
-    const TriangleMesh& base = state_->base;
-    AMC_REQUIRE(h.base().triangles == base.triangles, invalid_input,
-                "series frame " + std::to_string(frames_) + ": not over the series' base mesh (other base triangles)");
-    AMC_REQUIRE(h.single_precision() == base.single_precision, invalid_input,
-                "series frame " + std::to_string(frames_) + ": coordinate precision differs from the base mesh's");
-    const bool keyframe = frames_ == 0 || (options_.keyframe_interval && frames_ % options_.keyframe_interval == 0);
-    const FrameState initial = keyframe ? initial_state(base) : FrameState{};
-    const FrameState& ref = keyframe ? initial : state_->prev;
-    SeriesFrameStats stats;
-    stats.keyframe = keyframe;
+namespace {
 
+// One frame coded against `ref` (the unrefined base for a keyframe): its block and the state the
+// decoder will hold after it.
+struct CodedFrame {
+    std::vector<uint8_t> block;
     FrameState next;
+    SeriesFrameStats stats;
+};
+
+CodedFrame code_frame(const TriangleMesh& base, const SeriesOptions& options, const FrameState& ref, bool keyframe,
+                      const Hierarchy& h, double time, const std::vector<Field>& fields) {
+    CodedFrame coded;
+    SeriesFrameStats& stats = coded.stats;
+    FrameState& next = coded.next;
+    stats.keyframe = keyframe;
     Counterparts cp;
     std::vector<uint8_t> connectivity;
     if (keyframe) {
@@ -212,15 +222,34 @@ SeriesFrameStats SeriesWriter::add_frame(const Hierarchy& h, double time, const 
         next.h = decode_hierarchy(base, connectivity.data(), connectivity.size());
         cp = match_nodes(ref.h, next.h);
     } else {
-        ArithmeticEncoder encoder;
-        encode_frame_connectivity(ref.h, h, encoder, next.h, cp);
-        connectivity = encoder.finish();
-    }
-    for (NodeId n = 0; n < cp.size(); ++n) stats.changed_nodes += next.h.is_alive(n) && cp[n] == kNoNode;
-    {
-        uint64_t kept = 0;
-        for (NodeId n = 0; n < cp.size(); ++n) kept += next.h.is_alive(n) && cp[n] != kNoNode;
-        stats.changed_nodes += ref.h.node_count() - kept;
+        // The indicator: none, or the reference's scalar float cell field that codes the forest
+        // in the fewest bytes, with the thresholds that mispredict fewest nodes (FORMAT.md 7.9).
+        const Counterparts matched = match_nodes(ref.h, h);
+        for (size_t choice = 0; choice <= ref.fields.size(); ++choice) {
+            if (choice > 0 && !is_indicator_candidate(ref.fields[choice - 1])) continue;
+            Indicator indicator;
+            std::vector<uint8_t> bytes;
+            put_varint(bytes, choice);
+            if (choice > 0) {
+                indicator = indicator_levels(ref.h, ref.first_cell, ref.fields[choice - 1].values);
+                fit_indicator_thresholds(ref.h, h, matched, indicator);
+                for (int32_t t : indicator.threshold) put_varint(bytes, zigzag(t));
+            }
+            ArithmeticEncoder encoder;
+            ConnectivityMemory memory = ref.memory;
+            Hierarchy out;
+            Counterparts out_cp;
+            encode_frame_connectivity(ref.h, h, kSeriesVersion, memory, choice > 0 ? &indicator : nullptr, encoder, out,
+                                      out_cp);
+            const std::vector<uint8_t> payload = encoder.finish();
+            bytes.insert(bytes.end(), payload.begin(), payload.end());
+            if (choice == 0 || bytes.size() < connectivity.size()) {
+                connectivity = std::move(bytes);
+                next.h = std::move(out);
+                next.memory = memory;
+                cp = std::move(out_cp);
+            }
+        }
     }
     const std::vector<FrameVertex> order = frame_vertex_order(next.h, ref.h, cp);
     std::vector<Vec3> positions(order.size());
@@ -230,7 +259,7 @@ SeriesFrameStats SeriesWriter::add_frame(const Hierarchy& h, double time, const 
             if (canonical[v] != kNoVertex) positions[canonical[v]] = h.position(VertexId(v));
     }
     FrameGeometryMode mode;
-    const std::vector<uint8_t> geometry = encode_frame_geometry(ref.h, order, positions, next.h, &mode);
+    const std::vector<uint8_t> geometry = encode_frame_geometry(ref.h, order, positions, kSeriesVersion, next.h, &mode);
     stats.moving = mode == FrameGeometryMode::moving;
     index_frame(next);
 
@@ -255,9 +284,9 @@ SeriesFrameStats SeriesWriter::add_frame(const Hierarchy& h, double time, const 
         for (size_t j = 0; j < i; ++j)
             AMC_REQUIRE(fields[j].name != fields[i].name || fields[j].association != fields[i].association,
                         invalid_input, "series frame: two fields named \"" + fields[i].name + "\"");
-        double bound = options_.error_bound;
-        for (const auto& [name, b] : options_.field_bounds)
-            if (name == fields[i].name) bound = b;
+        double bound = options.error_bound;
+        for (const auto& field_bound : options.field_bounds)
+            if (field_bound.first == fields[i].name) bound = field_bound.second;
         const size_t before = payload.size();
         Field decoded;
         FieldCodeStats fs;
@@ -269,12 +298,40 @@ SeriesFrameStats SeriesWriter::add_frame(const Hierarchy& h, double time, const 
     stats.connectivity_bytes = connectivity.size();
     stats.geometry_bytes = geometry.size();
     stats.field_bytes = payload.size() - fields_start;
-    const std::vector<uint8_t> b = block(keyframe ? SeriesBlock::keyframe : SeriesBlock::frame, payload);
-    stats.bytes = b.size();
-    write(b);
-    state_->prev = std::move(next);
+    coded.block = block(keyframe ? SeriesBlock::keyframe : SeriesBlock::frame, payload);
+    stats.bytes = coded.block.size();
+    return coded;
+}
+
+}  // namespace
+
+SeriesFrameStats SeriesWriter::add_frame(const Hierarchy& h, double time, const std::vector<Field>& fields) {
+    AMC_REQUIRE(!closed_, invalid_input, "series: add_frame after close");
+    const TriangleMesh& base = state_->base;
+    AMC_REQUIRE(h.base().triangles == base.triangles, invalid_input,
+                "series frame " + std::to_string(frames_) + ": not over the series' base mesh (other base triangles)");
+    AMC_REQUIRE(h.single_precision() == base.single_precision, invalid_input,
+                "series frame " + std::to_string(frames_) + ": coordinate precision differs from the base mesh's");
+    const bool keyframe = frames_ == 0 || (options_.keyframe_interval && frames_ % options_.keyframe_interval == 0);
+    CodedFrame coded = code_frame(base, options_, keyframe ? initial_state(base) : state_->prev, keyframe, h, time, fields);
+    // An encoder-chosen keyframe when the frame coded alone is smaller (FORMAT.md 7.9): tried in
+    // full only when the forest alone says it may be.
+    if (!keyframe && options_.choose_keyframes &&
+        encode_hierarchy(h).size() < coded.stats.connectivity_bytes + coded.stats.geometry_bytes) {
+        CodedFrame alone = code_frame(base, options_, initial_state(base), true, h, time, fields);
+        if (alone.block.size() < coded.block.size()) coded = std::move(alone);
+    }
+    // Nodes added or removed since the previous frame (whatever the frame was coded against).
+    const FrameState first = frames_ == 0 ? initial_state(base) : FrameState{};
+    const Hierarchy& before = frames_ == 0 ? first.h : state_->prev.h;
+    const Counterparts cp = match_nodes(before, coded.next.h);
+    uint64_t kept = 0;
+    for (NodeId n = 0; n < cp.size(); ++n) kept += coded.next.h.is_alive(n) && cp[n] != kNoNode;
+    coded.stats.changed_nodes = (coded.next.h.node_count() - kept) + (before.node_count() - kept);
+    write(coded.block);
+    state_->prev = std::move(coded.next);
     ++frames_;
-    return stats;
+    return coded.stats;
 }
 
 void SeriesWriter::close() {
@@ -310,6 +367,7 @@ SeriesReader::SeriesReader(std::vector<uint8_t> bytes, const std::string& what, 
     AMC_REQUIRE(XXH32(data, 12, 0) == get_u32(data + 12), checksum, what + ": checksum mismatch in the header");
     AMC_REQUIRE((data[5] & ~kSeriesFlagSinglePrecision) == 0 && data[6] == 0 && data[7] == 0, corrupt,
                 what + ": reserved header bits set");
+    version_ = data[4];
     keyframe_interval_ = get_u32(data + 8);
     const bool single = data[5] & kSeriesFlagSinglePrecision;
 
@@ -343,7 +401,12 @@ SeriesReader::SeriesReader(std::vector<uint8_t> bytes, const std::string& what, 
         const SeriesBlock kind = SeriesBlock(type);
         if (!have_base) {
             AMC_REQUIRE(kind == SeriesBlock::base, corrupt, what + ": the first block is not the base mesh");
-            state_->base = read_base(payload, length, single, what);
+            try {
+                state_->base = read_base(payload, length, single, what);
+            } catch (const Error& e) {
+                if (std::string(e.what()).rfind(what, 0) == 0) throw;
+                throw e.prefixed(what);
+            }
             have_base = true;
         } else if (kind == SeriesBlock::end) {
             AMC_REQUIRE(length == 0, corrupt, what + ": END block with a payload");
@@ -397,7 +460,7 @@ void SeriesReader::decode_next(size_t k) {
         const FrameHeader fh = read_frame_header(in, base.positions.size(), base.triangles.size(), what);
         AMC_REQUIRE(fh.nodes <= options_.max_nodes, limit_exceeded,
                     std::to_string(fh.nodes) + " nodes, more than the limit (" + std::to_string(options_.max_nodes) + ")");
-        const uint64_t connectivity_length = in.varint();
+        uint64_t connectivity_length = in.varint();
         AMC_REQUIRE(connectivity_length <= in.remaining(), truncated, "connectivity longer than the frame");
         const uint8_t* connectivity = in.rest();
         for (uint64_t i = 0; i < connectivity_length; ++i) in.u8();
@@ -409,8 +472,30 @@ void SeriesReader::decode_next(size_t k) {
             next.h = decode_hierarchy(base, connectivity, size_t(connectivity_length), options);
             cp = match_nodes(ref.h, next.h);
         } else {
+            Indicator indicator;
+            uint64_t choice = 0;
+            if (version_ >= 2) {
+                PayloadReader section(connectivity, size_t(connectivity_length), "connectivity");
+                choice = section.varint();
+                AMC_REQUIRE(choice <= ref.fields.size() && (choice == 0 || is_indicator_candidate(ref.fields[choice - 1])),
+                            corrupt, "connectivity: indicator " + std::to_string(choice) + " is not a scalar float cell field of the frame before");
+                if (choice > 0) {
+                    indicator = indicator_levels(ref.h, ref.first_cell, ref.fields[choice - 1].values);
+                    for (int32_t& t : indicator.threshold) {
+                        const uint64_t z = section.varint();
+                        AMC_REQUIRE(z <= 2 * uint64_t(kMaxIndicatorThreshold), corrupt,
+                                    "connectivity: an indicator threshold out of range");
+                        t = unzigzag(z);
+                    }
+                }
+                const size_t skip = size_t(connectivity_length) - section.remaining();
+                connectivity += skip;
+                connectivity_length -= skip;
+            }
             ArithmeticDecoder decoder(connectivity, size_t(connectivity_length));
-            decode_frame_connectivity(ref.h, decoder, fh.nodes, next.h, cp);
+            next.memory = ref.memory;
+            decode_frame_connectivity(ref.h, version_, next.memory, choice > 0 ? &indicator : nullptr, decoder, fh.nodes,
+                                      next.h, cp);
             AMC_REQUIRE(!decoder.overran(), truncated, "connectivity: the payload ends early");
         }
         AMC_REQUIRE(next.h.node_count() == fh.nodes && next.h.vertex_count() == fh.vertices, corrupt,
@@ -420,7 +505,7 @@ void SeriesReader::decode_next(size_t k) {
         const uint8_t* geometry = in.rest();
         for (uint64_t i = 0; i < geometry_length; ++i) in.u8();
         const std::vector<FrameVertex> order = frame_vertex_order(next.h, ref.h, cp);
-        decode_frame_geometry(ref.h, order, geometry, size_t(geometry_length), next.h);
+        decode_frame_geometry(ref.h, order, geometry, size_t(geometry_length), version_, next.h);
         index_frame(next);
         const FieldFrame field_frame(ref, next, cp, order);
         AMC_REQUIRE(uint64_t(field_frame.levels) == fh.levels && field_frame.cell_node.size() == fh.faces, corrupt,

@@ -7,8 +7,8 @@
 namespace amc {
 
 constexpr char kSeriesMagic[4] = {'A', 'M', 'C', 'S'};
-constexpr uint8_t kSeriesVersion = 1;         // written
-constexpr uint8_t kNewestSeriesVersion = 1;   // read: 1 .. this
+constexpr uint8_t kSeriesVersion = 2;         // written
+constexpr uint8_t kNewestSeriesVersion = 2;   // read: 1 .. this
 constexpr size_t kSeriesHeaderSize = 16;      // magic, version, flags, 2 reserved, keyframe interval, XXH32
 constexpr size_t kSeriesBlockOverhead = 9;    // type, u32 length, u32 checksum
 constexpr uint8_t kSeriesFlagSinglePrecision = 1;
