@@ -28,5 +28,9 @@ expect 1 "$amc" octree decode sphere.vtu -o x.vtu
 expect 2 "$amc" octree make --dim 4 -o x.amq
 expect 2 "$amc" octree make --model moon -o x.amq
 expect 2 "$amc" octree decode sphere.amq -o x.amq
+expect 2 "$amc" octree encode sphere.amq --data u:Float64 -o x.amq
+expect 2 "$amc" octree encode sphere.amq --vertex-step -1 -o x.amq
+expect 0 "$amc" octree encode sphere.amq --vertex-step 0.25 -o again.amq
+cmp -s sphere.amq again.amq || fail "re-encoding a brick forest changed its bytes"
 
 finish cli_octree

@@ -151,7 +151,7 @@ TEST(OctreeCoder, EveryTruncationAndEveryChangedByteIsAnError) {
 // A file whose blocks are well framed (checksums right) but whose contents lie.
 std::vector<uint8_t> framed(const OctreeMetadata& meta, const std::vector<uint8_t>& connectivity,
                             const std::vector<std::vector<uint8_t>>& level_payloads) {
-    BlockWriter writer(kOctreeFraming, kOctreeFileVersion, 0);
+    BlockWriter writer(kOctreeFraming, kOctreeBaseVersion, 0);
     writer.add(uint8_t(OctreeBlock::metadata), write_octree_metadata(meta));
     writer.add(uint8_t(OctreeBlock::connectivity), connectivity);
     for (const auto& p : level_payloads) writer.add(uint8_t(OctreeBlock::level), p);
@@ -211,7 +211,7 @@ TEST(OctreeCoder, WrongMagicAndNewerVersion) {
     amc[2] = 'C', amc[3] = 'F';
     EXPECT_EQ(error_of(amc), ErrorCode::bad_magic);
     std::vector<uint8_t> newer = bytes;
-    newer[4] = 2;
+    newer[4] = kOctreeNewestVersion + 1;
     EXPECT_EQ(error_of(newer), ErrorCode::unsupported_version);
 }
 

@@ -215,6 +215,46 @@ TEST(OctreeBalance, AcrossTurnedAndPeriodicTrees) {
     }
 }
 
+// Trees that meet only at a corner (2D: two squares touching at one vertex; 3D: two cubes sharing
+// one edge) constrain each other under corner (3D: edge) balance, and only then.
+TEST(OctreeBalance, TreesMeetingOnlyAtACornerOrAnEdge) {
+    for (int dim : {2, 3}) {
+        std::vector<Vec3> vertices;
+        std::vector<uint32_t> t2v;
+        for (int t = 0; t < 2; ++t)
+            for (int c = 0; c < (1 << dim); ++c) {
+                // Tree 1 is tree 0 moved by (1, 1, 0): they share the vertex (1, 1) in 2D, the edge
+                // x = y = 1 in 3D.
+                const Vec3 p{double((c & 1) + t), double(((c >> 1) & 1) + t), double((c >> 2) & 1)};
+                uint32_t v = 0;
+                while (v < vertices.size() && !(vertices[v].x == p.x && vertices[v].y == p.y && vertices[v].z == p.z)) ++v;
+                if (v == vertices.size()) vertices.push_back(p);
+                t2v.push_back(v);
+            }
+        const TreeConnectivity conn = connectivity_from_vertices(dim, vertices, t2v);
+        for (size_t i = 0; i < conn.tree_to_tree.size(); ++i) EXPECT_EQ(conn.tree_to_tree[i], i / (2 * dim)) << "no face is shared";
+        // Tree 0 refined to level 4 at its corner (1, 1, 0).
+        const int root = octree_root_log2(dim), level = dim == 2 ? 4 : 3;
+        const OctreeForest raw = refine_octree_forest(
+            uniform_octree_forest(conn, 0),
+            [&](uint32_t tree, const Octant& o) {
+                const int32_t len = int32_t(1) << (root - o.level);
+                return tree == 0 && o.x + len == (int32_t(1) << root) && o.y + len == (int32_t(1) << root) && o.z == 0;
+            },
+            level);
+        const OctreeBalance across = dim == 2 ? OctreeBalance::corner : OctreeBalance::edge;
+        EXPECT_EQ(octree_balance_violation(raw, OctreeBalance::face), "");
+        const std::string violation = octree_balance_violation(raw, across);
+        EXPECT_NE(violation.find("in tree 1"), std::string::npos) << violation;
+        // Face balance leaves tree 1 alone; corner / edge balance grades it down to level - 1 at (0, 0, 0).
+        const OctreeForest by_face = balance_octree_forest(raw, OctreeBalance::face);
+        EXPECT_EQ(by_face.tree_offsets[2] - by_face.tree_offsets[1], 1u);
+        const OctreeForest balanced = balance_octree_forest(raw, across);
+        EXPECT_EQ(octree_balance_violation(balanced, across), "");
+        EXPECT_EQ(balanced.leaves[balanced.tree_offsets[1]].level, level - 1) << "dim " << dim;
+    }
+}
+
 TEST(OctreeForest, GeneratorsRefineWhereAsked) {
     const TreeConnectivity conn = brick_connectivity(2, 2, 2);
     const OctreeForest circle = sphere_octree_forest(conn, {1, 1, 0}, 0.7, 6);

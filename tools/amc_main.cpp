@@ -201,6 +201,12 @@ int main(int argc, char** argv) {
     auto* octree_encode_cmd = octree->add_subcommand("encode", "Compress a p4est file (needs AMC_WITH_P4EST) to .amq");
     octree_encode_cmd->add_option("input", octree_encode.input, "p4est_save file (.p4est) or .amq")->required();
     octree_encode_cmd->add_option("-o,--output", octree_encode.output, "Output (default: the input with .amq)");
+    octree_encode_cmd->add_option("--data", octree_encode.data,
+                                  "p4est user data as leaf fields NAME:TYPE[:COMPONENTS],... in order (TYPE Int8 .. UInt64, "
+                                  "Float32, Float64; default one UInt8 field p4est_data)");
+    octree_encode_cmd->add_option("--vertex-step", octree_encode.vertex_step,
+                                  "Coarse-mesh vertices on a grid of this step (default 0: bit-exact)")
+        ->check(CLI::NonNegativeNumber);
     OctreeDecodeCommand octree_decode;
     auto* octree_decode_cmd = octree->add_subcommand("decode", "Decompress an .amq file to VTU (or p4est)");
     octree_decode_cmd->add_option("input", octree_decode.input, ".amq file, or - for stdin")->required();

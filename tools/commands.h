@@ -112,6 +112,8 @@ struct OctreeMakeCommand {
 void run_octree_make(const OctreeMakeCommand& command, const GlobalOptions& global);
 struct OctreeEncodeCommand {
     std::string input, output;  // input: a p4est file (with AMC_WITH_P4EST) or an .amq file
+    std::string data;           // p4est user data as fields: NAME:TYPE[:COMPONENTS],... (empty: UInt8 bytes)
+    double vertex_step = 0;     // > 0: coarse-mesh vertices on a grid of this step
 };
 void run_octree_encode(const OctreeEncodeCommand& command, const GlobalOptions& global);
 struct OctreeDecodeCommand {

@@ -6,6 +6,7 @@
 #include <amc/octree.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -37,8 +38,36 @@ OctreeForest decode_bytes(const std::string& name, const std::string& bytes, con
     }
 }
 
+// --data NAME:TYPE[:COMPONENTS],...: the layout of p4est user data.
+std::vector<Field> data_layout(const std::string& spec) {
+    std::vector<Field> layout;
+    std::stringstream items(spec);
+    for (std::string item; std::getline(items, item, ',');) {
+        std::stringstream parts(item);
+        std::string name, type, components = "1";
+        std::getline(parts, name, ':');
+        std::getline(parts, type, ':');
+        std::getline(parts, components, ':');
+        Field f;
+        f.name = name;
+        f.association = FieldAssociation::cell;
+        bool known = false;
+        for (int t = 0; t <= int(FieldType::float64); ++t)
+            if (type == field_type_name(FieldType(t))) f.type = FieldType(t), known = true;
+        char* end = nullptr;
+        const unsigned long n = std::strtoul(components.c_str(), &end, 10);
+        if (name.empty() || !known || *end != 0 || n < 1 || n > 1024)
+            throw UsageError("--data: expected NAME:TYPE[:COMPONENTS] (TYPE Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64, "
+                             "Float32 or Float64; 1 to 1024 components), got '" + item + "'");
+        f.components = uint32_t(n);
+        layout.push_back(f);
+    }
+    return layout;
+}
+
 // The forest in the format the output's extension names: .amq (default), .vtu or .p4est.
-void write_forest(const std::string& path, const OctreeForest& forest, const GlobalOptions& global) {
+void write_forest(const std::string& path, const OctreeForest& forest, const GlobalOptions& global,
+                  const OctreeEncodeOptions& options = {}) {
     const std::string ext = extension_of(path);
     if (ext == ".vtu" || ext == ".p4est") {
         if (path == "-") throw UsageError("VTU and p4est output need a file name");
@@ -46,7 +75,7 @@ void write_forest(const std::string& path, const OctreeForest& forest, const Glo
         if (ext == ".vtu") write_octree_vtu(path, forest);
         else write_p4est_file(path, forest);
     } else {
-        const std::vector<uint8_t> bytes = encode_octree_forest(forest);
+        const std::vector<uint8_t> bytes = encode_octree_forest(forest, options);
         write_output(path, std::string(bytes.begin(), bytes.end()), global.force);
     }
     if (global.verbosity > 0 && path != "-")
@@ -82,12 +111,15 @@ void run_octree_encode(const OctreeEncodeCommand& c, const GlobalOptions& global
     const std::string ext = extension_of(c.input);
     OctreeForest forest;
     if (ext == ".p4est") {
-        forest = read_p4est_file(c.input);
+        forest = read_p4est_file(c.input, nullptr, data_layout(c.data));
     } else {
+        if (!c.data.empty()) throw UsageError("--data describes p4est user data: the input is not a .p4est file");
         forest = decode_bytes(c.input, read_bytes(c.input), {});
     }
     const std::string output = c.output.empty() ? default_output(c.input, ".amq") : c.output;
-    write_forest(output, forest, global);
+    OctreeEncodeOptions options;
+    options.vertex_step = c.vertex_step;
+    write_forest(output, forest, global, options);
 }
 
 void run_octree_decode(const OctreeDecodeCommand& c, const GlobalOptions& global) {
@@ -116,6 +148,8 @@ void run_octree_info(const OctreeInfoCommand& c, const GlobalOptions&) {
     std::printf("  leaves per level:");
     for (uint64_t n : per_level) std::printf(" %llu", (unsigned long long)n);
     std::printf("\n");
+    for (const Field& f : forest.leaf_data)
+        std::printf("  leaf field \"%s\": %s x %u\n", f.name.c_str(), field_type_name(f.type), f.components);
 }
 
 }  // namespace amc::cli

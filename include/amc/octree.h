@@ -20,6 +20,7 @@
 // octree form of the paper's "1-regularity", which the coder uses to cull symbols).
 #pragma once
 
+#include <amc/field.h>
 #include <amc/mesh.h>
 
 #include <cstdint>
@@ -74,20 +75,27 @@ struct OctreeForest {
     TreeConnectivity connectivity;
     std::vector<uint64_t> tree_offsets;  // tree_count + 1: leaves of tree t are [offsets[t], offsets[t+1])
     std::vector<Octant> leaves;          // per tree, in Morton order
+    // Per-leaf data (solution values, labels): cell fields, one tuple per leaf in `leaves` order,
+    // written to VTU as cell data and to p4est files as the quadrants' user data. Names are
+    // unique, 1 to 1024 bytes; 1 to 1024 components; coded bit-exact.
+    std::vector<Field> leaf_data;
 
     uint32_t tree_count() const { return connectivity.tree_count(); }
     int dim() const { return connectivity.dim; }
 };
 bool operator==(const OctreeForest& a, const OctreeForest& b);
 
-// Every tree's leaves tile it exactly, in Morton order, at levels 0 .. octree_max_level, and
-// the connectivity is valid. Throws Error naming `what` and the first bad leaf.
+// Every tree's leaves tile it exactly, in Morton order, at levels 0 .. octree_max_level, the
+// connectivity is valid and every leaf field has one tuple per leaf. Throws Error naming `what`
+// and the first bad leaf or field.
 void validate_octree_forest(const OctreeForest& forest, const std::string& what);
 
 // Which leaves must be within one level of each other: those sharing a face, or also an edge
 // (3D), or also a corner (p4est's P4EST_CONNECT_FACE / P8EST_CONNECT_EDGE / _CORNER). Across the
-// coarse mesh, edge and corner neighbours are found by crossing faces one after the other, so
-// trees that touch only at an edge or a corner of the coarse mesh do not constrain each other.
+// coarse mesh, edge and corner neighbours are every tree around the coarse vertex or edge (trees
+// that share its vertices: any number, face neighbours or not, as p4est's corner and edge
+// connectivity), and those reached by crossing faces one after the other (periodic gluing, and
+// connectivities without vertices).
 enum class OctreeBalance : uint8_t { face = 1, edge = 2, corner = 3 };
 
 // The smallest refinement of `forest` that is balanced (p4est_balance).
@@ -133,25 +141,32 @@ struct OctreeEncodeOptions {
     bool truncate = true;          // trailing zeros are dropped (a count is stored)
     bool context_groups = true;    // contexts from the face neighbours' states (else one model)
     bool improved_traversal = true;  // priority traversal (else Morton order)
+    // Coarse-mesh vertex positions: 0 stores them bit-exact (float64); > 0 snaps every coordinate
+    // to the nearest multiple of this step (error at most step / 2), coded as grid differences.
+    double vertex_step = 0;
 };
 
 struct OctreeEncodeStats {
     uint64_t nodes = 0, leaves = 0;
     uint64_t uniform = 0, culled = 0, truncated = 0, coded = 0;  // nodes by fate
-    uint64_t connectivity_bytes = 0, level_bytes = 0, file_bytes = 0;
+    uint64_t connectivity_bytes = 0, level_bytes = 0, leaf_data_bytes = 0, file_bytes = 0;
 };
 
-// The .amq file. Throws Error on an invalid forest (validate_octree_forest) and, with
-// cull_by_balance, on a forest not balanced by faces.
+// The .amq file: version 1 when the forest has no leaf data and the vertices are stored
+// bit-exact, else version 2 (docs/FORMAT.md section 8). Throws Error on an invalid forest
+// (validate_octree_forest), with cull_by_balance on a forest not balanced by faces, and on a
+// vertex_step that is not finite and positive or too small for the positions (grid indices
+// beyond 2^52).
 std::vector<uint8_t> encode_octree_forest(const OctreeForest& forest, const OctreeEncodeOptions& options = {},
                                           OctreeEncodeStats* stats = nullptr);
 
 struct OctreeDecodeOptions {
     int max_level = -1;              // >= 0: progressive, only levels 0 .. max_level
     uint64_t max_nodes = uint64_t{1} << 26;  // refuse files announcing more octants (about 50 bytes each)
+    uint64_t max_leaf_values = uint64_t{1} << 28;  // refuse leaf fields of more values (8 bytes each)
 };
 // Throws Error (truncated, checksum, corrupt, limit_exceeded, ...) on anything but a file
-// encode_octree_forest writes.
+// encode_octree_forest writes. Progressive decoding (max_level) leaves out the leaf data.
 OctreeForest decode_octree_forest(const uint8_t* data, size_t size, const OctreeDecodeOptions& options = {});
 
 // ---- p4est (optional: cmake -DAMC_WITH_P4EST=ON with Debian's libp4est-dev) -------------------
@@ -159,15 +174,34 @@ OctreeForest decode_octree_forest(const uint8_t* data, size_t size, const Octree
 bool octree_p4est_available();
 // A p4est_save file (2D or 3D, told by its first bytes) through p4est_load_ext, and p4est's
 // checksum of it. p4est aborts the process on a malformed file: read only files you trust.
-OctreeForest read_p4est_file(const std::string& path, uint32_t* checksum = nullptr);
-// The forest built in p4est (refined from the roots), saved with p4est_save_ext (no data, no
-// partition).
+// A file saved with data (data_size > 0 bytes per quadrant) gives leaf fields: as `data_layout`
+// says (name, type and components of each field, packed in this order, little-endian, their
+// sizes adding up to data_size; values ignored), or without a layout one UInt8 field
+// "p4est_data" of data_size components. Throws Error when the layout does not fit the file.
+OctreeForest read_p4est_file(const std::string& path, uint32_t* checksum = nullptr,
+                             const std::vector<Field>& data_layout = {});
+// The forest built in p4est (refined from the roots), saved with p4est_save_ext (no
+// partition); leaf fields, packed in their order as above, become the quadrants' user data
+// (saved with data_size = the bytes of one tuple of each field).
 void write_p4est_file(const std::string& path, const OctreeForest& forest);
+// The bytes per leaf of the forest's leaf data as p4est user data (0 without leaf data).
+size_t octree_leaf_data_bytes(const std::vector<Field>& leaf_data);
 // p4est_checksum of the forest built in p4est.
 uint32_t octree_p4est_checksum(const OctreeForest& forest);
 // A forest made by p4est itself: refined (p4est_refine) where quadrants meet the sphere (circle),
 // up to max_level, balanced by p4est_balance, saved with p4est_save_ext. For tests and benchmarks.
 void write_p4est_sphere_forest(const std::string& path, const TreeConnectivity& conn, Vec3 center, double radius, int max_level,
                                OctreeBalance balance);
+// The smallest balanced refinement as p4est_balance makes it (with p4est's corner and edge
+// connectivity completed from the vertices when they glue the trees).
+OctreeForest balanced_by_p4est(const OctreeForest& forest, OctreeBalance balance);
+// p4est_is_balanced on the forest built in p4est.
+bool is_balanced_in_p4est(const OctreeForest& forest, OctreeBalance balance);
+// One of p4est's catalogue of connectivities (p4est_connectivity_new_byname): 2D brick23, corner,
+// cubed, disk, moebius, periodic, pillow, rotwrap, star, unit; 3D brick235, periodic, rotcubes,
+// rotwrap, shell, sphere, twocubes, twowrap, unit.
+TreeConnectivity p4est_builtin_connectivity(int dim, const std::string& name);
+// The same around front_octree_forest's moving front at time t.
+void write_p4est_front_forest(const std::string& path, const TreeConnectivity& conn, double t, int max_level, OctreeBalance balance);
 
 }  // namespace amc

@@ -5,6 +5,7 @@
 #include "octree/octree_levels.h"
 
 #include "common/check.h"
+#include "octree/tree_corners.h"
 
 #include <algorithm>
 #include <array>
@@ -43,6 +44,18 @@ struct Key {  // an octant of some level: its tree and coordinates
     bool operator==(const Key& o) const { return tree == o.tree && c[0] == o.c[0] && c[1] == o.c[1] && c[2] == o.c[2]; }
 };
 
+// The same-level positions an offset from octant c of `tree` reaches: across faces one after the
+// other, and (offsets that leave the tree on two or more axes) around the coarse vertex or edge.
+void reached(const TreeFaces& faces, const TreeCorners& corners, uint32_t tree, int l, const int32_t c[3],
+             const std::array<int, 3>& off, std::vector<TreeCorners::Place>& out) {
+    out.clear();
+    TreeCorners::Place q{tree, {c[0] + off[0], c[1] + off[1], c[2] + off[2]}};
+    int outside = 0;
+    for (int a = 0; a < 3; ++a) outside += q.c[a] < 0 || q.c[a] >= (int32_t(1) << l);
+    if (outside >= 2) corners.neighbours(tree, l, q.c, out);
+    if (faces.wrap(q.tree, l, q.c)) out.push_back(q);
+}
+
 std::string describe(const OctreeLevel& lv, uint32_t n, int l) {
     return "tree " + std::to_string(lv.tree[n]) + " octant (" + std::to_string(lv.coord[3 * size_t(n)]) + ", " +
            std::to_string(lv.coord[3 * size_t(n) + 1]) + ", " + std::to_string(lv.coord[3 * size_t(n) + 2]) + ") of level " +
@@ -56,7 +69,9 @@ OctreeForest balance_octree_forest(const OctreeForest& forest, OctreeBalance bal
     std::vector<std::vector<uint8_t>> refined;
     const OctreeLevels levels = octree_levels_of(forest, &refined, UINT64_MAX);
     const TreeFaces& faces = levels.faces();
+    const TreeCorners corners(forest.connectivity);
     const auto offsets = neighbor_offsets(forest.dim(), balance);
+    std::vector<TreeCorners::Place> places;
     // must[l]: the octants of level l that must be refined, sorted.
     std::vector<std::vector<Key>> must(levels.depth() + 1);
     for (int l = 0; l <= levels.depth(); ++l) {
@@ -70,9 +85,8 @@ OctreeForest balance_octree_forest(const OctreeForest& forest, OctreeBalance bal
         for (const Key& k : must[l]) {
             must[l - 1].push_back({k.tree, {k.c[0] >> 1, k.c[1] >> 1, k.c[2] >> 1}});
             for (const auto& off : offsets) {
-                Key q{k.tree, {k.c[0] + off[0], k.c[1] + off[1], k.c[2] + off[2]}};
-                if (!faces.wrap(q.tree, l, q.c)) continue;
-                must[l - 1].push_back({q.tree, {q.c[0] >> 1, q.c[1] >> 1, q.c[2] >> 1}});
+                reached(faces, corners, k.tree, l, k.c, off, places);
+                for (const TreeCorners::Place& q : places) must[l - 1].push_back({q.tree, {q.c[0] >> 1, q.c[1] >> 1, q.c[2] >> 1}});
             }
         }
     }
@@ -94,17 +108,19 @@ std::string octree_balance_violation(const OctreeForest& forest, OctreeBalance b
     std::vector<std::vector<uint8_t>> refined;
     const OctreeLevels levels = octree_levels_of(forest, &refined, UINT64_MAX);
     const auto offsets = neighbor_offsets(forest.dim(), balance);
+    const TreeCorners corners(forest.connectivity);
+    std::vector<TreeCorners::Place> places;
     for (int l = 1; l <= levels.depth(); ++l) {
         const OctreeLevel& lv = levels.level(l);
         for (uint32_t n = 0; n < lv.size(); ++n) {
             if (!refined[l][n]) continue;
             for (const auto& off : offsets) {
-                uint32_t tree = lv.tree[n];
-                int32_t c[3] = {lv.coord[3 * n] + off[0], lv.coord[3 * n + 1] + off[1], lv.coord[3 * n + 2] + off[2]};
-                if (!levels.faces().wrap(tree, l, c)) continue;
-                if (levels.find(tree, l, c) == kNoOctant)
-                    return describe(lv, n, l) + " is refined, but its neighbour at offset (" + std::to_string(off[0]) + ", " +
-                           std::to_string(off[1]) + ", " + std::to_string(off[2]) + ") lies in a leaf two or more levels coarser";
+                reached(levels.faces(), corners, lv.tree[n], l, &lv.coord[3 * size_t(n)], off, places);
+                for (const TreeCorners::Place& q : places)
+                    if (levels.find(q.tree, l, q.c) == kNoOctant)
+                        return describe(lv, n, l) + " is refined, but its neighbour at offset (" + std::to_string(off[0]) + ", " +
+                               std::to_string(off[1]) + ", " + std::to_string(off[2]) + ") in tree " + std::to_string(q.tree) +
+                               " lies in a leaf two or more levels coarser";
             }
         }
     }

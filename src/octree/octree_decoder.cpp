@@ -3,15 +3,21 @@
 #include "coding/arithmetic_coder.h"
 #include "common/check.h"
 #include "octree/octree_file.h"
+#include "octree/octree_leaf_data.h"
 #include "octree/octree_traversal.h"
 
 namespace amc {
 
 namespace {
 
-Block next_block(BlockReader& reader, OctreeBlock expected) {
+Block next_block(BlockReader& reader) {
     Block block{};
     AMC_REQUIRE(reader.next(block), truncated, "file ends before its end block");
+    return block;
+}
+
+Block next_block(BlockReader& reader, OctreeBlock expected) {
+    const Block block = next_block(reader);
     AMC_REQUIRE(uint8_t(block.type) == uint8_t(expected), corrupt,
                 "block at byte " + std::to_string(block.offset) + ": expected a " +
                     kOctreeFraming.block_name(uint8_t(expected)) + " block, found a " + kOctreeFraming.block_name(uint8_t(block.type)) +
@@ -27,7 +33,7 @@ OctreeForest decode_octree_forest(const uint8_t* data, size_t size, const Octree
         Block block = next_block(reader, OctreeBlock::metadata);
         const OctreeMetadata meta = read_octree_metadata(block.payload, block.size, options.max_nodes);
         block = next_block(reader, OctreeBlock::connectivity);
-        const TreeConnectivity conn = read_octree_connectivity(block.payload, block.size, meta.dim, meta.trees);
+        const TreeConnectivity conn = read_octree_connectivity(block.payload, block.size, meta.dim, meta.trees, reader.version());
 
         OctreeLevels levels(conn);
         std::vector<BitModel> models(octree_model_count(meta.dim));
@@ -62,13 +68,26 @@ OctreeForest decode_octree_forest(const uint8_t* data, size_t size, const Octree
                         "level block " + std::to_string(l) + ": more octants than the metadata announces");
             levels.add_children(refined, meta.octants);
         }
-        block = next_block(reader, OctreeBlock::end);
         AMC_REQUIRE(!truncating || read == meta.count, corrupt,
                     "the level blocks hold " + std::to_string(read) + " symbols, the metadata announces " + std::to_string(meta.count));
         AMC_REQUIRE(levels.octant_count() == meta.octants, corrupt,
                     "the forest has " + std::to_string(levels.octant_count()) + " octants, the metadata announces " +
                         std::to_string(meta.octants));
-        return levels.leaves(conn);
+        OctreeForest forest = levels.leaves(conn);
+        // Leaf field blocks (version 2), then the end block.
+        uint64_t values = 0;
+        for (block = next_block(reader); uint8_t(block.type) != uint8_t(OctreeBlock::end); block = next_block(reader)) {
+            AMC_REQUIRE(uint8_t(block.type) == uint8_t(OctreeBlock::leaf_field), corrupt,
+                        "block at byte " + std::to_string(block.offset) + ": expected a leaf field or end block, found a " +
+                            kOctreeFraming.block_name(uint8_t(block.type)) + " block");
+            AMC_REQUIRE(values <= options.max_leaf_values, limit_exceeded, "the leaf fields hold more values than the limit");
+            Field field = read_leaf_field(block.payload, block.size, forest.leaves, options.max_leaf_values - values);
+            values += field.value_count();
+            for (const Field& other : forest.leaf_data)
+                AMC_REQUIRE(other.name != field.name, corrupt, "two leaf fields named \"" + field.name + "\"");
+            forest.leaf_data.push_back(std::move(field));
+        }
+        return forest;
     });
 }
 

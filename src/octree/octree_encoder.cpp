@@ -3,6 +3,7 @@
 #include "coding/arithmetic_coder.h"
 #include "common/check.h"
 #include "octree/octree_file.h"
+#include "octree/octree_leaf_data.h"
 #include "octree/octree_traversal.h"
 
 namespace amc {
@@ -24,6 +25,10 @@ uint8_t switches_of(const OctreeEncodeOptions& o) {
 
 std::vector<uint8_t> encode_octree_forest(const OctreeForest& forest, const OctreeEncodeOptions& options, OctreeEncodeStats* stats) {
     validate_octree_forest(forest, "encode_octree_forest");
+    // Before the work: a bad step is refused at once.
+    const std::vector<uint8_t> conn = write_octree_connectivity(forest.connectivity, options.vertex_step);
+    const uint8_t version =
+        forest.leaf_data.empty() && !is_quantized_connectivity(conn) ? kOctreeBaseVersion : kOctreeLeafDataVersion;
     const int d = forest.dim();
     std::vector<std::vector<uint8_t>> refined;
     const OctreeLevels levels = octree_levels_of(forest, &refined, UINT64_MAX);
@@ -76,9 +81,8 @@ std::vector<uint8_t> encode_octree_forest(const OctreeForest& forest, const Octr
         }
     meta.count = options.truncate ? last_one : total;
 
-    BlockWriter writer(kOctreeFraming, kOctreeFileVersion, 0);
+    BlockWriter writer(kOctreeFraming, version, 0);
     writer.add(uint8_t(OctreeBlock::metadata), write_octree_metadata(meta));
-    const std::vector<uint8_t> conn = write_octree_connectivity(forest.connectivity);
     writer.add(uint8_t(OctreeBlock::connectivity), conn);
     std::vector<BitModel> models(octree_model_count(d));
     uint64_t coded = 0, level_bytes = 0;
@@ -93,6 +97,12 @@ std::vector<uint8_t> encode_octree_forest(const OctreeForest& forest, const Octr
         level_bytes += payload.size();
         writer.add(uint8_t(OctreeBlock::level), payload);
     }
+    uint64_t leaf_data_bytes = 0;
+    for (const Field& field : forest.leaf_data) {
+        const std::vector<uint8_t> payload = write_leaf_field(field, forest.leaves);
+        leaf_data_bytes += payload.size();
+        writer.add(uint8_t(OctreeBlock::leaf_field), payload);
+    }
     std::vector<uint8_t> file = writer.finish();
     if (stats) {
         stats->nodes = meta.octants;
@@ -103,6 +113,7 @@ std::vector<uint8_t> encode_octree_forest(const OctreeForest& forest, const Octr
         stats->truncated = fates.coded - meta.count;
         stats->connectivity_bytes = conn.size();
         stats->level_bytes = level_bytes;
+        stats->leaf_data_bytes = leaf_data_bytes;
         stats->file_bytes = file.size();
     }
     return file;

@@ -11,7 +11,9 @@ namespace amc {
 
 namespace {
 
-uint8_t octree_last_block_type(uint8_t) { return uint8_t(OctreeBlock::level); }
+uint8_t octree_last_block_type(uint8_t version) {
+    return uint8_t(version >= kOctreeLeafDataVersion ? OctreeBlock::leaf_field : OctreeBlock::level);
+}
 
 const char* octree_block_name(uint8_t type) {
     switch (OctreeBlock(type)) {
@@ -19,13 +21,14 @@ const char* octree_block_name(uint8_t type) {
         case OctreeBlock::metadata: return "metadata";
         case OctreeBlock::connectivity: return "connectivity";
         case OctreeBlock::level: return "level";
+        case OctreeBlock::leaf_field: return "leaf field";
     }
     return "unknown";
 }
 
 }  // namespace
 
-const FileFraming kOctreeFraming = {{'A', 'M', 'Q', 'T'}, ".amq", 1, kOctreeFileVersion, 0, octree_last_block_type,
+const FileFraming kOctreeFraming = {{'A', 'M', 'Q', 'T'}, ".amq", kOctreeBaseVersion, kOctreeNewestVersion, 0, octree_last_block_type,
                                     octree_block_name};
 
 std::vector<uint8_t> write_octree_metadata(const OctreeMetadata& m) {
@@ -97,9 +100,56 @@ bool find_brick(const TreeConnectivity& conn, int n[3], uint8_t& periodic) {
     return false;
 }
 
+// Grid indices of quantized positions stay within 2^52, where doubles hold every integer.
+constexpr double kMaxGridIndex = 4503599627370496.0;
+
+uint64_t zigzag(int64_t v) { return (uint64_t(v) << 1) ^ uint64_t(v >> 63); }
+int64_t unzigzag(uint64_t u) { return int64_t(u >> 1) ^ -int64_t(u & 1); }
+
+void put_quantized_positions(std::vector<uint8_t>& out, const std::vector<Vec3>& vertices, double step) {
+    put_f64(out, step);
+    int64_t previous[3] = {0, 0, 0};
+    for (const Vec3& p : vertices) {
+        const double xyz[3] = {p.x, p.y, p.z};
+        for (int a = 0; a < 3; ++a) {
+            const double q = std::nearbyint(xyz[a] / step);
+            AMC_REQUIRE(std::fabs(q) <= kMaxGridIndex, invalid_input,
+                        "encode_octree_forest: vertex_step " + std::to_string(step) + " is too small for a coordinate " +
+                            std::to_string(xyz[a]) + " (grid indices beyond 2^52)");
+            put_varint(out, zigzag(int64_t(q) - previous[a]));
+            previous[a] = int64_t(q);
+        }
+    }
+}
+
+void read_quantized_positions(PayloadReader& in, std::vector<Vec3>& vertices) {
+    const double step = in.f64();
+    AMC_REQUIRE(std::isfinite(step) && step > 0, corrupt, "connectivity block: a grid step that is not finite and positive");
+    int64_t q[3] = {0, 0, 0};
+    for (Vec3& p : vertices) {
+        double xyz[3];
+        for (int a = 0; a < 3; ++a) {
+            const uint64_t delta = in.varint();
+            const double next = double(q[a]) + double(unzigzag(delta));
+            AMC_REQUIRE(std::fabs(next) <= kMaxGridIndex, corrupt, "connectivity block: a grid index beyond 2^52");
+            q[a] = int64_t(next);
+            xyz[a] = double(q[a]) * step;
+            AMC_REQUIRE(std::isfinite(xyz[a]), corrupt, "connectivity block: a vertex is not finite");
+        }
+        p = {xyz[0], xyz[1], xyz[2]};
+    }
+}
+
 }  // namespace
 
-std::vector<uint8_t> write_octree_connectivity(const TreeConnectivity& conn) {
+bool is_quantized_connectivity(const std::vector<uint8_t>& payload) {
+    return !payload.empty() && (payload[0] == uint8_t(OctreeConnectivityMode::glued_by_quantized_vertices) ||
+                                payload[0] == uint8_t(OctreeConnectivityMode::explicit_with_quantized_vertices));
+}
+
+std::vector<uint8_t> write_octree_connectivity(const TreeConnectivity& conn, double vertex_step) {
+    AMC_REQUIRE(vertex_step == 0 || (std::isfinite(vertex_step) && vertex_step > 0), invalid_input,
+                "encode_octree_forest: vertex_step must be 0 (exact) or finite and positive");
     std::vector<uint8_t> out;
     int n[3] = {1, 1, 1};
     uint8_t periodic = 0;
@@ -121,13 +171,19 @@ std::vector<uint8_t> write_octree_connectivity(const TreeConnectivity& conn) {
             // Not gluable by vertices (periodic, say): stored explicitly.
         }
     }
+    const bool quantized = has_vertices && vertex_step > 0;
+    if (quantized)
+        mode = mode == OctreeConnectivityMode::glued_by_vertices ? OctreeConnectivityMode::glued_by_quantized_vertices
+                                                                 : OctreeConnectivityMode::explicit_with_quantized_vertices;
     out.push_back(uint8_t(mode));
     if (has_vertices) {
         put_varint(out, conn.vertices.size());
-        for (const Vec3& p : conn.vertices) put_f64(out, p.x), put_f64(out, p.y), put_f64(out, p.z);
+        if (quantized) put_quantized_positions(out, conn.vertices, vertex_step);
+        else
+            for (const Vec3& p : conn.vertices) put_f64(out, p.x), put_f64(out, p.y), put_f64(out, p.z);
         for (uint32_t v : conn.tree_to_vertex) put_varint(out, v);
     }
-    if (mode != OctreeConnectivityMode::glued_by_vertices) {
+    if (mode != OctreeConnectivityMode::glued_by_vertices && mode != OctreeConnectivityMode::glued_by_quantized_vertices) {
         for (size_t i = 0; i < conn.tree_to_tree.size(); ++i) {
             put_varint(out, conn.tree_to_tree[i]);
             out.push_back(conn.tree_to_face[i]);
@@ -136,10 +192,17 @@ std::vector<uint8_t> write_octree_connectivity(const TreeConnectivity& conn) {
     return out;
 }
 
-TreeConnectivity read_octree_connectivity(const uint8_t* data, size_t size, int dim, uint64_t trees) {
+TreeConnectivity read_octree_connectivity(const uint8_t* data, size_t size, int dim, uint64_t trees, uint8_t version) {
     PayloadReader in(data, size, "connectivity block");
-    const uint8_t mode = in.u8();
-    AMC_REQUIRE(mode <= uint8_t(OctreeConnectivityMode::brick), corrupt, "connectivity block: unknown mode " + std::to_string(mode));
+    uint8_t mode = in.u8();
+    const uint8_t last_mode = uint8_t(version >= kOctreeLeafDataVersion ? OctreeConnectivityMode::explicit_with_quantized_vertices
+                                                                        : OctreeConnectivityMode::brick);
+    AMC_REQUIRE(mode <= last_mode, corrupt, "connectivity block: unknown mode " + std::to_string(mode));
+    const bool quantized = mode == uint8_t(OctreeConnectivityMode::glued_by_quantized_vertices) ||
+                           mode == uint8_t(OctreeConnectivityMode::explicit_with_quantized_vertices);
+    if (quantized)  // the same as modes 0 and 1 but for the positions
+        mode = uint8_t(mode == uint8_t(OctreeConnectivityMode::glued_by_quantized_vertices) ? OctreeConnectivityMode::glued_by_vertices
+                                                                                             : OctreeConnectivityMode::explicit_with_vertices);
     const int corners = 1 << dim, faces = 2 * dim;
     TreeConnectivity conn;
     conn.dim = dim;
@@ -158,14 +221,20 @@ TreeConnectivity read_octree_connectivity(const uint8_t* data, size_t size, int 
     }
     if (mode != uint8_t(OctreeConnectivityMode::explicit_without_vertices)) {
         const uint64_t vertices = in.varint();
-        AMC_REQUIRE(vertices >= 1 && vertices <= in.remaining() / 24, corrupt,
+        const uint64_t vertex_bytes = quantized ? 3 : 24;  // three varints of at least a byte, or three f64
+        AMC_REQUIRE(vertices >= 1 && vertices <= in.remaining() / vertex_bytes, corrupt,
                     "connectivity block: " + std::to_string(vertices) + " vertices do not fit in it");
-        AMC_REQUIRE(trees * corners <= in.remaining() - vertices * 24, corrupt,
+        AMC_REQUIRE(trees * corners <= in.remaining() - vertices * vertex_bytes, corrupt,
                     "connectivity block: " + std::to_string(trees) + " trees do not fit in it");
         conn.vertices.resize(vertices);
-        for (Vec3& p : conn.vertices) {
-            p.x = in.f64(), p.y = in.f64(), p.z = in.f64();
-            AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt, "connectivity block: a vertex is not finite");
+        if (quantized) {
+            read_quantized_positions(in, conn.vertices);
+            AMC_REQUIRE(trees * corners <= in.remaining(), corrupt, "connectivity block: " + std::to_string(trees) + " trees do not fit in it");
+        } else {
+            for (Vec3& p : conn.vertices) {
+                p.x = in.f64(), p.y = in.f64(), p.z = in.f64();
+                AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt, "connectivity block: a vertex is not finite");
+            }
         }
         conn.tree_to_vertex.resize(trees * corners);
         for (uint32_t& v : conn.tree_to_vertex) {

@@ -12,10 +12,13 @@
 
 namespace amc {
 
-constexpr uint8_t kOctreeFileVersion = 1;
+// Versions (FORMAT.md 8): a file takes the lowest version that holds what it holds.
+constexpr uint8_t kOctreeBaseVersion = 1;      // forests alone, vertices as float64
+constexpr uint8_t kOctreeLeafDataVersion = 2;  // + leaf field blocks, quantized vertices
+constexpr uint8_t kOctreeNewestVersion = 2;
 
 // Block types of the .amq file: frozen values.
-enum class OctreeBlock : uint8_t { end = 0, metadata = 1, connectivity = 2, level = 3 };
+enum class OctreeBlock : uint8_t { end = 0, metadata = 1, connectivity = 2, level = 3, leaf_field = 4 };
 
 extern const FileFraming kOctreeFraming;
 
@@ -25,6 +28,9 @@ enum class OctreeConnectivityMode : uint8_t {
     explicit_with_vertices = 1,
     explicit_without_vertices = 2,
     brick = 3,  // brick_connectivity(dim, nx, ny, nz, periodic...): sizes and periodicity only
+    // Version 2: modes 0 and 1 with the positions on a grid (a step, then grid differences).
+    glued_by_quantized_vertices = 4,
+    explicit_with_quantized_vertices = 5,
 };
 
 struct OctreeMetadata {
@@ -39,8 +45,12 @@ std::vector<uint8_t> write_octree_metadata(const OctreeMetadata& m);
 // Checks ranges (dimension, switches, levels, U) and the octant limit.
 OctreeMetadata read_octree_metadata(const uint8_t* data, size_t size, uint64_t max_octants);
 
-std::vector<uint8_t> write_octree_connectivity(const TreeConnectivity& conn);
-// The connectivity of `trees` trees of dimension `dim`, validated.
-TreeConnectivity read_octree_connectivity(const uint8_t* data, size_t size, int dim, uint64_t trees);
+// vertex_step > 0: positions snapped to multiples of it (a quantized mode, version 2) unless the
+// connectivity is a brick. Throws Error on a step that is not finite and positive or that gives
+// grid indices beyond 2^52.
+std::vector<uint8_t> write_octree_connectivity(const TreeConnectivity& conn, double vertex_step = 0);
+bool is_quantized_connectivity(const std::vector<uint8_t>& payload);
+// The connectivity of `trees` trees of dimension `dim` in a file of `version`, validated.
+TreeConnectivity read_octree_connectivity(const uint8_t* data, size_t size, int dim, uint64_t trees, uint8_t version);
 
 }  // namespace amc

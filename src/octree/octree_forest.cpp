@@ -3,6 +3,7 @@
 #include "octree/octree_levels.h"
 
 #include "common/check.h"
+#include "octree/octree_leaf_data.h"
 
 #include <algorithm>
 #include <cmath>
@@ -13,7 +14,8 @@ bool operator==(const OctreeForest& a, const OctreeForest& b) {
     const TreeConnectivity &x = a.connectivity, &y = b.connectivity;
     return x.dim == y.dim && x.vertices == y.vertices && x.tree_to_vertex == y.tree_to_vertex &&
            x.tree_to_tree == y.tree_to_tree && x.tree_to_face == y.tree_to_face && a.tree_offsets == b.tree_offsets &&
-           a.leaves == b.leaves;
+           a.leaves == b.leaves && a.leaf_data.size() == b.leaf_data.size() &&
+           std::equal(a.leaf_data.begin(), a.leaf_data.end(), b.leaf_data.begin(), identical);
 }
 
 void validate_octree_forest(const OctreeForest& forest, const std::string& what) {
@@ -50,6 +52,7 @@ void validate_octree_forest(const OctreeForest& forest, const std::string& what)
         }
         AMC_REQUIRE(expected == uint64_t(1) << (d * root), invalid_input, what + ": the leaves of tree " + std::to_string(t) + " do not cover it");
     }
+    validate_leaf_fields(forest.leaf_data, forest.leaves.size(), what);
 }
 
 OctreeForestCounts count_octree_forest(const OctreeForest& forest) {

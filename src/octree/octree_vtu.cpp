@@ -1,8 +1,11 @@
 // The leaves of a forest as VTU cells: VTK_QUAD in 2D, VTK_HEXAHEDRON in 3D, hanging nodes left
-// as they are (ParaView draws them as they come), with the cell arrays "level" and "tree".
+// as they are (ParaView draws them as they come), with the cell arrays "level" and "tree" and the
+// forest's leaf fields.
 #include "common/check.h"
 #include "mesh/vtu_writer.h"
 #include "octree/octree_levels.h"
+
+#include <amc/series.h>
 
 #include <cmath>
 #include <unordered_map>
@@ -49,7 +52,16 @@ void write_octree_vtu(const std::string& path, const OctreeForest& forest, VtuEn
             trees.push_back(t);
         }
     }
-    std::vector<DataArray> cell_data = {{"level", 1, std::move(levels)}, {"tree", 1, std::move(trees)}};
+    // The leaf fields, after "level" and "tree" unless a leaf field takes one of those names.
+    std::vector<DataArray> cell_data;
+    const auto has_field = [&](const char* name) {
+        for (const Field& f : forest.leaf_data)
+            if (f.name == name) return true;
+        return false;
+    };
+    if (!has_field("level")) cell_data.push_back({"level", 1, std::move(levels)});
+    if (!has_field("tree")) cell_data.push_back({"tree", 1, std::move(trees)});
+    for (const Field& f : forest.leaf_data) cell_data.push_back(array_from_field(f));
     VtuCells cells{connectivity.data(), forest.leaves.size(), corners, d == 2 ? kVtkQuad : kVtkHexahedron};
     write_file_atomically(path, format_vtu_cells(points, false, cells, {}, cell_data, encoding));
 }

@@ -1,0 +1,166 @@
+// Leaf field blocks of the .amq file (docs/FORMAT.md section 8.6).
+#include "octree/octree_leaf_data.h"
+
+#include "coding/container.h"
+#include "coding/float_coder.h"
+#include "common/check.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+namespace amc {
+
+namespace {
+
+constexpr size_t kMaxLeafFieldName = 1024;
+constexpr uint32_t kMaxLeafFieldComponents = 1024;
+constexpr int kMinSymbolsPerValue = 7;  // the bit-length tree of encode_signed_residual
+// Contexts: component (0, 1, 2, 3 and more) x the leaf's level against the leaf before it
+// (same, finer, coarser).
+constexpr int kLeafFieldContexts = 12;
+
+int value_context(uint32_t component, const Octant* before, const Octant& leaf) {
+    const int step = before == nullptr || before->level == leaf.level ? 0 : leaf.level > before->level ? 1 : 2;
+    return step * 4 + int(std::min<uint32_t>(component, 3));
+}
+
+bool in_range(int64_t v, FieldType t) {
+    switch (t) {
+        case FieldType::int8: return v >= INT8_MIN && v <= INT8_MAX;
+        case FieldType::uint8: return v >= 0 && v <= UINT8_MAX;
+        case FieldType::int16: return v >= INT16_MIN && v <= INT16_MAX;
+        case FieldType::uint16: return v >= 0 && v <= UINT16_MAX;
+        case FieldType::int32: return v >= INT32_MIN && v <= INT32_MAX;
+        case FieldType::uint32: return v >= 0 && v <= int64_t(UINT32_MAX);
+        default: return true;
+    }
+}
+
+// Values as N-bit words whose differences are coded: integers as themselves (N = 64), floats as
+// their ordered bits (float_coder.h; N = 32 or 64).
+int word_bits(FieldType t) { return t == FieldType::float32 ? 32 : 64; }
+uint64_t word_mask(FieldType t) { return word_bits(t) == 32 ? 0xFFFFFFFFull : ~uint64_t{0}; }
+uint64_t word_of(const Field& f, size_t k) {
+    if (f.type == FieldType::float32) return ordered_bits(f.values[k], Precision::float32);
+    if (f.type == FieldType::float64) return ordered_bits(f.values[k], Precision::float64);
+    return uint64_t(f.integers[k]);
+}
+
+std::string field_what(const std::string& name) { return "leaf field \"" + name + "\""; }
+
+}  // namespace
+
+size_t field_type_bytes(FieldType type) {
+    switch (type) {
+        case FieldType::int8: case FieldType::uint8: return 1;
+        case FieldType::int16: case FieldType::uint16: return 2;
+        case FieldType::int32: case FieldType::uint32: case FieldType::float32: return 4;
+        default: return 8;
+    }
+}
+
+size_t octree_leaf_data_bytes(const std::vector<Field>& leaf_data) {
+    size_t bytes = 0;
+    for (const Field& f : leaf_data) bytes += field_type_bytes(f.type) * f.components;
+    return bytes;
+}
+
+void validate_leaf_fields(const std::vector<Field>& fields, uint64_t leaves, const std::string& what) {
+    std::set<std::string> names;
+    for (const Field& f : fields) {
+        const std::string where = what + ": " + field_what(f.name);
+        AMC_REQUIRE(!f.name.empty() && f.name.size() <= kMaxLeafFieldName, invalid_input, where + ": a name of 1 to 1024 bytes is required");
+        AMC_REQUIRE(names.insert(f.name).second, invalid_input, where + ": the name is used twice");
+        AMC_REQUIRE(f.association == FieldAssociation::cell, invalid_input, where + ": leaf data are cell fields (one tuple per leaf)");
+        AMC_REQUIRE(uint8_t(f.type) <= uint8_t(FieldType::float64), invalid_input, where + ": unknown type");
+        AMC_REQUIRE(f.components >= 1 && f.components <= kMaxLeafFieldComponents, invalid_input, where + ": components must be 1 to 1024");
+        const bool is_float = is_float_type(f.type);
+        AMC_REQUIRE(f.value_count() == leaves * f.components && (is_float ? f.integers.empty() : f.values.empty()), invalid_input,
+                    where + ": " + std::to_string(f.value_count()) + " values for " + std::to_string(leaves) + " leaves of " +
+                        std::to_string(f.components) + " components");
+        for (int64_t v : f.integers) AMC_REQUIRE(in_range(v, f.type), invalid_input, where + ": a value out of the type's range");
+        if (f.type == FieldType::float32)
+            for (double v : f.values) AMC_REQUIRE(std::isnan(v) || double(float(v)) == v, invalid_input, where + ": a Float32 value that is not a float");
+    }
+}
+
+std::vector<uint8_t> write_leaf_field(const Field& field, const std::vector<Octant>& leaves) {
+    std::vector<uint8_t> out;
+    put_varint(out, field.name.size());
+    out.insert(out.end(), field.name.begin(), field.name.end());
+    out.push_back(uint8_t(field.type));
+    put_varint(out, field.components);
+    const uint32_t comps = field.components;
+    const uint64_t mask = word_mask(field.type);
+    const int top = word_bits(field.type) - 1;
+    FloatResidualModels models(kLeafFieldContexts);
+    ArithmeticEncoder encoder;
+    for (size_t i = 0; i < leaves.size(); ++i) {
+        for (uint32_t c = 0; c < comps; ++c) {
+            const uint64_t predicted = i > 0 ? word_of(field, (i - 1) * comps + c) : 0;
+            const uint64_t d = (word_of(field, i * comps + c) - predicted) & mask;
+            const bool negative = (d >> top) & 1;
+            encode_signed_residual(encoder, models.context(value_context(c, i > 0 ? &leaves[i - 1] : nullptr, leaves[i])), negative,
+                                   negative ? (~d + 1) & mask : d);
+        }
+    }
+    const std::vector<uint8_t> stream = encoder.finish();
+    out.insert(out.end(), stream.begin(), stream.end());
+    return out;
+}
+
+Field read_leaf_field(const uint8_t* data, size_t size, const std::vector<Octant>& leaves, uint64_t max_values) {
+    PayloadReader in(data, size, "leaf field block");
+    Field f;
+    f.association = FieldAssociation::cell;
+    const uint64_t name_size = in.varint();
+    AMC_REQUIRE(name_size >= 1 && name_size <= kMaxLeafFieldName && name_size <= in.remaining(), corrupt,
+                "leaf field block: a name of " + std::to_string(name_size) + " bytes");
+    f.name.assign(reinterpret_cast<const char*>(in.rest()), size_t(name_size));
+    for (uint64_t k = 0; k < name_size; ++k) in.u8();
+    const std::string what = field_what(f.name);
+    const uint8_t type = in.u8();
+    AMC_REQUIRE(type <= uint8_t(FieldType::float64), corrupt, what + ": unknown type " + std::to_string(type));
+    f.type = FieldType(type);
+    const uint64_t comps = in.varint();
+    AMC_REQUIRE(comps >= 1 && comps <= kMaxLeafFieldComponents, corrupt, what + ": " + std::to_string(comps) + " components");
+    f.components = uint32_t(comps);
+    const uint64_t values = uint64_t(leaves.size()) * comps;
+    AMC_REQUIRE(values <= max_values, limit_exceeded,
+                what + ": " + std::to_string(values) + " values, more than the limit " + std::to_string(max_values));
+    AMC_REQUIRE(values <= max_decodable_symbols(in.remaining()) / kMinSymbolsPerValue, corrupt,
+                what + ": " + std::to_string(values) + " values do not fit in " + std::to_string(in.remaining()) + " bytes");
+    const bool is_float = is_float_type(f.type);
+    if (is_float) f.values.resize(values);
+    else f.integers.resize(values);
+    const uint64_t mask = word_mask(f.type);
+    const Precision precision = f.type == FieldType::float32 ? Precision::float32 : Precision::float64;
+    FloatResidualModels models(kLeafFieldContexts);
+    ArithmeticDecoder decoder(in.rest(), in.remaining());
+    uint64_t bad_range = 0;
+    std::vector<uint64_t> previous(comps, 0);
+    for (size_t i = 0; i < leaves.size(); ++i) {
+        for (uint32_t c = 0; c < comps; ++c) {
+            bool negative;
+            uint64_t magnitude;
+            decode_signed_residual(decoder, models, models.context(value_context(c, i > 0 ? &leaves[i - 1] : nullptr, leaves[i])), negative,
+                                   magnitude);
+            const uint64_t w = (negative ? previous[c] - magnitude : previous[c] + magnitude) & mask;
+            previous[c] = w;
+            const size_t k = i * comps + c;
+            if (is_float) {
+                f.values[k] = from_ordered_bits(w, precision);
+            } else {
+                f.integers[k] = int64_t(w);
+                bad_range += !in_range(f.integers[k], f.type);
+            }
+        }
+    }
+    AMC_REQUIRE(!decoder.overran(), truncated, what + ": the values run past the end of the block");
+    AMC_REQUIRE(!models.saw_invalid_symbol(), corrupt, what + ": an invalid residual");
+    AMC_REQUIRE(bad_range == 0, corrupt, what + ": " + std::to_string(bad_range) + " values out of the type's range");
+    return f;
+}
+
+}  // namespace amc
