@@ -271,10 +271,15 @@ void measure_amcodec(const Model& m, int runs, std::vector<Result>& out) {
         amc::encode(imported, {}, &stats);
         r.bytes = stats.base_connectivity_bytes + stream.size();
         r.base_triangles = imported.root_count();
+        // The stream holds connectivity only (the decoded vertices sit at midpoints), so the
+        // decoded leaf mesh's triangles are compared, as for the other connectivity rows.
         const amc::TriangleMesh input_again = amc::extract_leaf_mesh(imported).mesh;
-        if (!amc::identical(back, imported)) r.check = "decoded hierarchy not identical to the imported one";
-        else if (input_again.triangles.size() != m.leaf.triangles.size()) r.check = "imported leaf mesh differs from the input";
-        else r.check = "ok";
+        if (amc::extract_leaf_mesh(back).mesh.triangles != input_again.triangles)
+            r.check = "decoded leaf mesh connectivity differs from the imported one";
+        else if (input_again.triangles.size() != m.leaf.triangles.size())
+            r.check = "imported leaf mesh differs from the input";
+        else
+            r.check = "ok";
         out.push_back(r);
     }
 

@@ -22,7 +22,7 @@ cmake --build "$build" -j2 --target amc compare_bench
 amc=$build/amc
 
 # ---- the corpus: deterministic, remade on every run -------------------------------------------
-rm -rf "$corpus"
+[[ ${AMC_REUSE_CORPUS:-0} == 1 ]] || rm -rf "$corpus"  # AMC_REUSE_CORPUS=1: keep the surface models made before (scripts/corpus.sh)
 mkdir -p "$corpus"
 source "$here/scripts/corpus.sh"
 make_corpus "$amc" "$data" "$corpus"
