@@ -10,7 +10,7 @@
 namespace amc {
 
 HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const HierarchyCoderOptions& options,
-                                             uint8_t stream_version)
+                                             uint8_t stream_version, std::vector<CodedSymbol>* trace)
     : options_(options) {
     HierarchyCodeStats& stats = stats_;
     // Levels 0..U-1 with every node refined (counted on the way: a level is uniform when it and
@@ -70,6 +70,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
             [&](uint32_t i, int group) {
                 const bool r = truth[i] != 0;
                 events_.push_back({uint8_t(group), uint8_t(r)});
+                if (trace != nullptr) trace->push_back({ids[i], uint8_t(group), r});
                 return r;
             },
             [&](uint32_t i, Fate fate, bool) {

@@ -17,13 +17,22 @@ namespace amc {
 // encoder would choose, without coding anything).
 DiagonalExceptions diagonal_exceptions(const Hierarchy& h);
 
+// One coded hierarchy symbol in the coder's order, for studies of its contexts (bench/context_study).
+struct CodedSymbol {
+    NodeId node;
+    uint8_t group;  // context group
+    bool refined;
+};
+
 class HierarchyLevelEncoder {
 public:
     // Decides every node (first pass): fixes the uniform levels, the diagonal rule and the number
     // of coded symbols, so the header is known before any level is coded. `stream_version`: an
     // older hierarchy stream version may be written for tests of the decoder's older paths.
+    // `trace`, if given, receives every symbol the first pass decides by coding, in order (the
+    // stream keeps the first stats().coded of them).
     HierarchyLevelEncoder(const Hierarchy& h, const HierarchyCoderOptions& options,
-                          uint8_t stream_version = kHierarchyStreamVersion);
+                          uint8_t stream_version = kHierarchyStreamVersion, std::vector<CodedSymbol>* trace = nullptr);
     const std::vector<uint8_t>& header() const { return header_; }
     int level_count() const { return int(level_ids_.size()); }
     // Nodes of level l (ids in the encoded hierarchy) in canonical order.
