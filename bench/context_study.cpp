@@ -241,6 +241,33 @@ int main(int argc, char** argv) {
                 std::printf(" %+.1f%% |", 100.0 * (bits_of[d][m] - bits_of[0][m]) / bits_of[0][m]);
         }
     }
+    std::printf("\n\n");
+    // The same, summed by kind: curvature-adaptive surface remeshes (corpus names *_mean, *_gauss)
+    // and the others (planar finite-element and random models).
+    auto is_surface = [&](size_t m) {
+        return names[m].find("_mean") != std::string::npos || names[m].find("_gauss") != std::string::npos;
+    };
+    std::printf("| context | all | surface remeshes | range | other models | range |\n|---|---:|---:|---|---:|---|");
+    for (size_t d = 0; d < designs.size(); ++d) {
+        double sum[2] = {0, 0}, base[2] = {0, 0}, low[2] = {1e9, 1e9}, high[2] = {-1e9, -1e9};
+        for (size_t m = 0; m < names.size(); ++m) {
+            const int kind = is_surface(m) ? 0 : 1;
+            sum[kind] += bits_of[d][m];
+            base[kind] += bits_of[0][m];
+            if (bits_of[0][m] <= 0) continue;
+            const double change = 100.0 * (bits_of[d][m] - bits_of[0][m]) / bits_of[0][m];
+            low[kind] = std::min(low[kind], change);
+            high[kind] = std::max(high[kind], change);
+        }
+        std::printf("\n| %s | %+.1f%% |", designs[d].name, 100.0 * (totals[d] - totals[0]) / totals[0]);
+        for (int kind = 0; kind < 2; ++kind) {
+            if (base[kind] <= 0) {
+                std::printf(" | |");
+                continue;
+            }
+            std::printf(" %+.1f%% | %+.1f%% .. %+.1f%% |", 100.0 * (sum[kind] - base[kind]) / base[kind], low[kind], high[kind]);
+        }
+    }
     std::printf("\n");
     return 0;
 }
