@@ -371,6 +371,22 @@ TEST(ImportLeafMesh, RefusesDuplicateVertex) {
     EXPECT_NE(message.find(std::to_string(v)), std::string::npos) << message;
 }
 
+// A projection may put two new vertices of a valid refinement on one point: that alone is no
+// reason to refuse (only a base vertex matched by position would be ambiguous).
+TEST(ImportLeafMesh, TwoNewVerticesAtOnePositionImport) {
+    Hierarchy h(make_square(3));
+    refine_uniformly(h, 2);
+    UserLeafMesh user = user_leaf_mesh(h, 3, Placement::scattered);
+    const uint32_t v0 = uint32_t(h.base().positions.size());
+    user.mesh.positions[user.user_of_canonical[v0 + 1]] = user.mesh.positions[user.user_of_canonical[v0]];
+    EXPECT_TRUE(imports_back(h, user, false));
+    // The same position given to a base vertex makes matching by position ambiguous.
+    user.mesh.positions[user.user_of_canonical[v0]] = user.mesh.positions[user.leaf_of_base[0]];
+    const std::string message = import_error(h.base(), user.mesh);
+    EXPECT_NE(message.find("duplicate vertex"), std::string::npos) << message;
+    EXPECT_NE(message.find(std::to_string(user.leaf_of_base[0])), std::string::npos) << message;
+}
+
 TEST(ImportLeafMesh, RefusesUnusedVertex) {
     BadInputFixture f;
     f.user.mesh.positions.push_back({5, 5, 5});

@@ -31,6 +31,9 @@ public:
     // The i-th directed edge leaving u (in no particular order): its end and its face.
     uint32_t out_vertex(uint32_t u, uint32_t i) const { return entries_[start_[u] + i].to; }
     uint32_t out_face(uint32_t u, uint32_t i) const { return entries_[start_[u] + i].face; }
+    // The third vertex of that face (out ends and out apexes together are all of u's neighbours,
+    // also on the boundary).
+    uint32_t out_apex(uint32_t u, uint32_t i) const { return entries_[start_[u] + i].apex; }
     uint32_t vertex_count() const { return uint32_t(start_.size() - 1); }
 
 private:

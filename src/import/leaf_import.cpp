@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -101,9 +102,22 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     }
     uint32_t first = kNone, second = kNone;
     const PositionIndex leaf_positions(leaf.positions, &first, &second);
-    if (first != kNone)
-        fail(what, "vertices " + std::to_string(first) + " and " + std::to_string(second) + " have the same position " +
-                       position_text(leaf.positions[first]) + " (duplicate vertex)");
+    // Two vertices at one position are refused where they make the input ambiguous (a base vertex
+    // matched by position) or when the import fails; a projection may put two new vertices of a
+    // valid refinement on one point.
+    auto refuse_duplicate = [&](uint32_t a, uint32_t b) {
+        fail(what, "vertices " + std::to_string(a) + " and " + std::to_string(b) + " have the same position " +
+                       position_text(leaf.positions[a]) + " (duplicate vertex)");
+    };
+    if (first != kNone && leaf_vertex_of_base.empty()) {
+        for (const Vec3& p : base.positions) {
+            if (!leaf_positions.shared(p)) continue;
+            const uint32_t a = leaf_positions.find(p);
+            for (uint32_t b = a + 1; b < leaf.positions.size(); ++b) {
+                if (std::memcmp(&leaf.positions[b], &p, sizeof p) == 0) refuse_duplicate(a, b);
+            }
+        }
+    }
     const std::vector<uint32_t> leaf_of_base =
         match_base_vertices(base, leaf, leaf_vertex_of_base, leaf_positions, what);
 
@@ -160,6 +174,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
         }
     }
     if (!done) {
+        if (first != kNone) refuse_duplicate(first, second);
         validate_triangle_mesh(leaf, what);  // a structural fault has the clearer message
         throw Error(first_error);
     }

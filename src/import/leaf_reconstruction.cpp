@@ -212,6 +212,9 @@ private:
             if (found == kNone) fail("no vertex at the midpoint of edge (" + edge_text(n, e) + ")");
             return found;
         }
+        // From the connectivity alone where it tells: the halves of the edge are leaf edges.
+        const uint32_t common = only_unmatched_common_neighbor(a, b);
+        if (common != kNone) return common;
         if (!nearest_) {
             double total = 0;
             for (const Triangle& t : leaf_.triangles) {
@@ -220,18 +223,53 @@ private:
             }
             nearest_ = std::make_unique<NearestVertex>(leaf_.positions, total / double(leaf_.triangles.size()));
         }
-        // Where midpoint subdivision of the base puts the vertex (the hierarchy's default placer
-        // has computed it), or the midpoint of the edge as the leaf mesh places its ends (which
-        // follows projected and moved ends; the surface guide then projects it onto the mesh).
+        const uint32_t found =
+            nearest_->find(guide_position(n, e), [&](uint32_t v) { return vertex_of_leaf_[v] == kNone; });
+        if (found == kNone) fail("no vertex left to split the edge (" + edge_text(n, e) + ")");
+        return found;
+    }
+
+    // Where the guide expects the vertex that splits edge e of n: where midpoint subdivision of
+    // the base puts it (the hierarchy's default placer has computed it), or the midpoint of the
+    // edge as the leaf mesh places its ends (which follows projected and moved ends; the surface
+    // guide then projects it onto the mesh).
+    Vec3 guide_position(NodeId n, int e) {
+        const uint32_t a = corner(n, e), b = corner(n, (e + 1) % 3);
         Vec3 m = guide_ == MidpointGuide::subdivision ? h_.position(h_.midpoint(n, e))
                                                      : 0.5 * (leaf_.positions[a] + leaf_.positions[b]);
         if (guide_ == MidpointGuide::surface) {
             if (!surface_) surface_ = std::make_unique<ClosestPointQuery>(leaf_);
             m = surface_->closest(m).point;
         }
-        const uint32_t found = nearest_->find(m, [&](uint32_t v) { return vertex_of_leaf_[v] == kNone; });
-        if (found == kNone) fail("no vertex left to split the edge (" + edge_text(n, e) + ")");
-        return found;
+        return m;
+    }
+
+    bool adjacent(uint32_t u, uint32_t v) const {
+        return he_.face(u, v) != LeafHalfedges::kNone || he_.face(v, u) != LeafHalfedges::kNone;
+    }
+
+    // Calls f on every leaf-mesh neighbour of u (some twice).
+    template <class F>
+    void for_each_neighbor(uint32_t u, F f) const {
+        for (uint32_t i = 0, d = he_.degree(u); i < d; ++i) {
+            f(he_.out_vertex(u, i));
+            f(he_.out_apex(u, i));
+        }
+    }
+
+    // When the children along an edge (a, b) keep their halves unsplit, its midpoint is a common
+    // neighbour of a and b, and the only unmatched one: inside the two elements on the edge, a's
+    // leaf edges stay in the corner child at a and b's in the corner child at b, which meet only
+    // at the midpoint. kNone unless exactly one exists (the final check guards the rest).
+    uint32_t only_unmatched_common_neighbor(uint32_t a, uint32_t b) const {
+        uint32_t found = kNone;
+        bool ambiguous = false;
+        for_each_neighbor(a, [&](uint32_t x) {
+            if (vertex_of_leaf_[x] != kNone || x == found || !adjacent(x, b)) return;
+            if (found != kNone) ambiguous = true;
+            found = x;
+        });
+        return ambiguous ? kNone : found;
     }
 
     Hierarchy& h_;

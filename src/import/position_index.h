@@ -28,9 +28,13 @@ public:
             while (slots_[s] != kNone && !same(positions[slots_[s]], positions[v])) s = (s + 1) & (slots_.size() - 1);
             if (slots_[s] == kNone) {
                 slots_[s] = v;
-            } else if (first_duplicate != nullptr && *first_duplicate == kNone) {
-                *first_duplicate = slots_[s];
-                *second_duplicate = v;
+            } else {
+                if (shared_.empty()) shared_.assign(slots_.size(), 0);
+                shared_[s] = 1;
+                if (first_duplicate != nullptr && *first_duplicate == kNone) {
+                    *first_duplicate = slots_[s];
+                    *second_duplicate = v;
+                }
             }
         }
     }
@@ -40,6 +44,15 @@ public:
         for (size_t s = slot_of(p);; s = (s + 1) & (slots_.size() - 1)) {
             if (slots_[s] == kNone) return kNone;
             if (same(positions_[slots_[s]], p)) return slots_[s];
+        }
+    }
+
+    // More than one vertex is at exactly p.
+    bool shared(Vec3 p) const {
+        if (shared_.empty()) return false;
+        for (size_t s = slot_of(p);; s = (s + 1) & (slots_.size() - 1)) {
+            if (slots_[s] == kNone) return false;
+            if (same(positions_[slots_[s]], p)) return shared_[s] != 0;
         }
     }
 
@@ -55,6 +68,7 @@ private:
     }
     const std::vector<Vec3>& positions_;
     std::vector<uint32_t> slots_;
+    std::vector<uint8_t> shared_;  // per slot: another vertex has the same position (empty: none)
 };
 
 }  // namespace amc
