@@ -81,6 +81,25 @@ int main(int argc, char** argv) {
     const TreeConnectivity square = brick_connectivity(2, 1, 1), bricks2 = brick_connectivity(2, 4, 2);
     const TreeConnectivity cube = brick_connectivity(3, 1, 1, 1), bricks3 = brick_connectivity(3, 2, 2, 1);
     std::vector<Case> cases;
+#ifdef AMC_HAVE_P4EST
+    // The forests p4est itself makes: refined by p4est_refine around the circle / sphere or the
+    // front, balanced by p4est_balance, saved by p4est_save; read back through p4est_load.
+    const std::string made = (std::filesystem::temp_directory_path() / "octree_bench_made.p4est").string();
+    auto add = [&](std::string name, auto&& write, OctreeBalance b) {
+        write(b);
+        cases.push_back({name + (b == OctreeBalance::face ? ", face" : ", corner"), read_p4est_file(made)});
+    };
+    for (OctreeBalance b : {OctreeBalance::face, OctreeBalance::corner}) {
+        add("2D circle L" + std::to_string(13 - q), [&](OctreeBalance x) { write_p4est_sphere_forest(made, square, {0.5, 0.5, 0}, 0.35, 13 - q, x); }, b);
+        add("2D front 4x2 L" + std::to_string(11 - q), [&](OctreeBalance x) { write_p4est_front_forest(made, bricks2, 2.1, 11 - q, x); }, b);
+        add("3D sphere L" + std::to_string(8 - q / 2),
+            [&](OctreeBalance x) { write_p4est_sphere_forest(made, cube, {0.5, 0.5, 0.5}, 0.35, 8 - q / 2, x); }, b);
+        add("3D front 2x2x1 L" + std::to_string(7 - q / 2), [&](OctreeBalance x) { write_p4est_front_forest(made, bricks3, 1.1, 7 - q / 2, x); },
+            b);
+    }
+    std::filesystem::remove(made);
+    const char* made_by = "p4est (p4est_refine, p4est_balance)";
+#else
     auto add = [&](std::string name, OctreeForest f, OctreeBalance b) {
         cases.push_back({name + (b == OctreeBalance::face ? ", face" : ", corner"), balance_octree_forest(f, b)});
     };
@@ -90,8 +109,14 @@ int main(int argc, char** argv) {
         add("3D sphere L" + std::to_string(8 - q / 2), sphere_octree_forest(cube, {0.5, 0.5, 0.5}, 0.35, 8 - q / 2), b);
         add("3D front 2x2x1 L" + std::to_string(7 - q / 2), front_octree_forest(bricks3, 1.1, 7 - q / 2), b);
     }
-    add("2D random L" + std::to_string(11 - q), random_octree_forest(square, 7, 0.45, 4, 11 - q), OctreeBalance::face);
-    add("3D random L" + std::to_string(7 - q / 2), random_octree_forest(cube, 7, 0.3, 2, 7 - q / 2), OctreeBalance::face);
+    const char* made_by = "amcodec (sphere_octree_forest, front_octree_forest, balance_octree_forest)";
+#endif
+    // Random forests (amcodec's generator): refinement independent from octant to octant.
+    cases.push_back({"2D random L" + std::to_string(11 - q) + ", face",
+                     balance_octree_forest(random_octree_forest(square, 7, 0.45, 4, 11 - q), OctreeBalance::face)});
+    cases.push_back({"3D random L" + std::to_string(7 - q / 2) + ", face",
+                     balance_octree_forest(random_octree_forest(cube, 7, 0.3, 2, 7 - q / 2), OctreeBalance::face)});
+    std::printf("Adaptive forests made by %s; random forests by amcodec.\n\n", made_by);
 
 #ifdef AMC_HAVE_P4EST
     const char* p4est_column = "p4est_save file";
@@ -157,5 +182,52 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
     }
     std::printf("\n%d runs per forest; speeds: slowest-fastest run, one core.\n", runs);
+
+    // Per-leaf data: a smooth Float64 value without symmetries (which xz would find as repeats:
+    // the forests are symmetric) and an Int32 label (inside or outside the circle / sphere) on the
+    // first 2D and 3D forests.
+    std::printf("\n| forest + leaf data | leaves | .amq bytes | data bytes/leaf | %s with data (bytes) | x smaller | + xz -9 "
+                "(bytes) | x smaller |\n|---|---:|---:|---:|---:|---:|---:|---:|\n",
+                p4est_column);
+    for (size_t k : {size_t(0), size_t(2)}) {
+        if (k >= cases.size()) continue;
+        OctreeForest f = cases[k].forest;
+        const int d = f.dim(), root = octree_root_log2(d);
+        Field u, label;
+        u.name = "u", label.name = "inside";
+        u.association = label.association = FieldAssociation::cell;
+        u.type = FieldType::float64, label.type = FieldType::int32;
+        for (uint32_t t = 0; t < f.tree_count(); ++t)
+            for (uint64_t i = f.tree_offsets[t]; i < f.tree_offsets[t + 1]; ++i) {
+                const Octant& o = f.leaves[i];
+                const double h = std::ldexp(0.5, -o.level);
+                const Vec3 c = tree_point(f.connectivity, t, std::ldexp(double(o.x), -root) + h, std::ldexp(double(o.y), -root) + h,
+                                          d == 3 ? std::ldexp(double(o.z), -root) + h : 0.0);
+                const double r = std::sqrt((c.x - 0.5) * (c.x - 0.5) + (c.y - 0.5) * (c.y - 0.5) + (d == 3 ? (c.z - 0.5) * (c.z - 0.5) : 0.0));
+                u.values.push_back(std::exp(-3 * (c.x - 0.31) * (c.x - 0.31) - 2 * (c.y - 0.47) * (c.y - 0.47) - c.z * c.z) +
+                                   0.1 * c.x * c.y);
+                label.integers.push_back(r < 0.35 ? 1 : 0);
+            }
+        f.leaf_data = {u, label};
+        OctreeEncodeStats stats;
+        const std::vector<uint8_t> bytes = encode_octree_forest(f, {}, &stats);
+        std::vector<uint8_t> p4 = p4est_layout(f);
+#ifdef AMC_HAVE_P4EST
+        {
+            const std::string path = (std::filesystem::temp_directory_path() / "octree_bench_data.p4est").string();
+            write_p4est_file(path, f);
+            std::ifstream in(path, std::ios::binary);
+            p4.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+            std::filesystem::remove(path);
+        }
+#else
+        // The layout with the data: data_size more bytes per leaf.
+        p4.resize(p4.size() + f.leaves.size() * octree_leaf_data_bytes(f.leaf_data), 0);
+#endif
+        const size_t xz = xz9_size(p4);
+        std::printf("| %s + u (Float64), inside (Int32) | %zu | %zu | %.2f | %zu | %.1f | %zu | %.1f |\n", cases[k].name.c_str(),
+                    f.leaves.size(), bytes.size(), double(stats.leaf_data_bytes) / double(f.leaves.size()), p4.size(),
+                    double(p4.size()) / double(bytes.size()), xz, double(xz) / double(bytes.size()));
+    }
     return 0;
 }

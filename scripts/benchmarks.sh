@@ -2,7 +2,7 @@
 # The side-by-side benchmark (docs/BENCHMARKS.md), in one command: installs the bench packages,
 # builds amc and bench/compare_bench (Release), makes the corpus, measures every coder on every
 # model, and rewrites the generated part of docs/BENCHMARKS.md and the chart
-# docs/images/benchmarks_connectivity.svg. About 5 minutes on a 2-core machine from a clean build.
+# docs/images/benchmarks_connectivity.svg; then scripts/octree_benchmarks.sh (docs/OCTREE.md). About 5 minutes on a 2-core machine from a clean build.
 # Usage: scripts/benchmarks.sh [build-dir] [runs]
 set -euo pipefail
 start=$(date +%s)
@@ -70,4 +70,6 @@ if i < 0 or j < 0:
     sys.exit(f"{doc_path}: generated-part markers not found")
 open(doc_path, "w").write(doc[:i] + generated + doc[j + len(end):])
 PY
+# The octree forests of issue 28 (docs/OCTREE.md), in the same run: its own Release build with p4est.
+"$here/scripts/octree_benchmarks.sh" "$build-octree" "$runs"
 echo "wrote $doc and $chart in $(( ($(date +%s) - start) / 60 )) min $(( ($(date +%s) - start) % 60 )) s"
