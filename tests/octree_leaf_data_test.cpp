@@ -154,6 +154,8 @@ TEST(OctreeLeafData, BadFieldsAreRefusedByTheEncoder) {
     f = cell_field("notfloat", FieldType::float32, 1);
     f.values.assign(base.leaves.size(), 0.1);
     refused(f);
+    f.values.assign(base.leaves.size(), 1e300);  // beyond the float range
+    refused(f);
     f = cell_field("point", FieldType::float64, 1);
     f.association = FieldAssociation::point;
     f.values.assign(base.leaves.size(), 0.0);

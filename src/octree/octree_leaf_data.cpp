@@ -6,6 +6,7 @@
 #include "common/check.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <set>
 
@@ -81,7 +82,9 @@ void validate_leaf_fields(const std::vector<Field>& fields, uint64_t leaves, con
                         std::to_string(f.components) + " components");
         for (int64_t v : f.integers) AMC_REQUIRE(in_range(v, f.type), invalid_input, where + ": a value out of the type's range");
         if (f.type == FieldType::float32)
-            for (double v : f.values) AMC_REQUIRE(std::isnan(v) || double(float(v)) == v, invalid_input, where + ": a Float32 value that is not a float");
+            for (double v : f.values)  // beyond the float range the conversion is undefined: checked first
+                AMC_REQUIRE(!std::isfinite(v) || (std::fabs(v) <= FLT_MAX && double(float(v)) == v), invalid_input,
+                            where + ": a Float32 value that is not a float");
     }
 }
 
