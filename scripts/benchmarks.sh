@@ -2,7 +2,9 @@
 # The side-by-side benchmark (docs/BENCHMARKS.md), in one command: installs the bench packages,
 # builds amc and bench/compare_bench (Release), makes the corpus, measures every coder on every
 # model, and rewrites the generated part of docs/BENCHMARKS.md and the chart
-# docs/images/benchmarks_connectivity.svg; then scripts/octree_benchmarks.sh (docs/OCTREE.md). About 5 minutes on a 2-core machine from a clean build.
+# docs/images/benchmarks_connectivity.svg; then scripts/octree_benchmarks.sh (docs/OCTREE.md).
+# About 5 minutes on an idle 2-core machine with a built tree (32 minutes under a load average of
+# 16, surface corpus reused); AMC_REUSE_CORPUS=1 keeps a corpus made before.
 # Usage: scripts/benchmarks.sh [build-dir] [runs]
 set -euo pipefail
 start=$(date +%s)
