@@ -223,8 +223,26 @@ private:
             }
             nearest_ = std::make_unique<NearestVertex>(leaf_.positions, total / double(leaf_.triangles.size()));
         }
-        const uint32_t found =
-            nearest_->find(guide_position(n, e), [&](uint32_t v) { return vertex_of_leaf_[v] == kNone; });
+        // The midpoint's leaf neighbours lie in the children of n and of the element across that
+        // touch it: of the vertices matched so far, only a, b and those elements' midpoints.
+        uint32_t allowed[8] = {a, b, kNone, kNone, kNone, kNone, kNone, kNone};
+        const NodeId q = h_.neighbor(n, e);
+        for (int k = 0; k < 3; ++k) {
+            allowed[2 + k] = leaf_of_vertex_[h_.midpoint(n, k)];
+            if (q != kNoNode && !h_.is_leaf(q)) allowed[5 + k] = leaf_of_vertex_[h_.midpoint(q, k)];
+        }
+        auto may_be_midpoint = [&](uint32_t v) {
+            if (vertex_of_leaf_[v] != kNone) return false;
+            bool fits = true;
+            for_each_neighbor(v, [&](uint32_t w) {
+                if (vertex_of_leaf_[w] == kNone) return;
+                bool listed = false;
+                for (uint32_t x : allowed) listed |= x == w;
+                fits &= listed;
+            });
+            return fits;
+        };
+        const uint32_t found = nearest_->find(guide_position(n, e), may_be_midpoint);
         if (found == kNone) fail("no vertex left to split the edge (" + edge_text(n, e) + ")");
         return found;
     }
