@@ -32,10 +32,10 @@ public:
                     for (int64_t k = -r; k <= r; ++k) {
                         if (std::max(std::llabs(i), std::max(std::llabs(j), std::llabs(k))) != r) continue;
                         for (uint32_t v : cell_vertices(c[0] + i, c[1] + j, c[2] + k)) {
-                            if (!usable(v)) continue;
                             const Vec3 d = positions_[v] - p;
                             const double distance = dot(d, d);
-                            if (best == kNone || distance < best_distance) {
+                            // usable() last: it may cost more than the distance.
+                            if ((best == kNone || distance < best_distance) && usable(v)) {
                                 best = v;
                                 best_distance = distance;
                                 if (found_ring < 0) found_ring = r;
