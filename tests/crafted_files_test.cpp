@@ -67,7 +67,9 @@ double cpu_milliseconds() {
 
 // Runs `read` on a crafted input: it must throw amc::Error of the `expected` kind, fast and
 // without allocating much.
-void expect_refused_cheaply(const std::string& what, ErrorCode expected, const std::function<void()>& read) {
+// `must_say`, when given, must occur in the message (the check meant, not another one).
+void expect_refused_cheaply(const std::string& what, ErrorCode expected, const std::function<void()>& read,
+                            const char* must_say = nullptr) {
     const uint64_t bytes_before = g_allocated.load();
     const double start = cpu_milliseconds();
     bool refused = false;
@@ -85,6 +87,9 @@ void expect_refused_cheaply(const std::string& what, ErrorCode expected, const s
     EXPECT_TRUE(refused) << what << " was accepted";
     if (refused) {
         EXPECT_EQ(error_code_name(code), std::string(error_code_name(expected))) << what << " (" << message << ")";
+        if (must_say) {
+            EXPECT_NE(message.find(must_say), std::string::npos) << what << " (" << message << ")";
+        }
     }
     EXPECT_LT(allocated, kMaxBytes) << what << " (" << message << ")";
     EXPECT_LT(milliseconds, kMaxMilliseconds) << what << " (" << message << ")";
@@ -336,6 +341,17 @@ std::vector<uint8_t> cut_border_counts(uint64_t v, uint64_t isolated, uint64_t d
     return encoder.finish();
 }
 
+std::vector<uint8_t> angle_counts(uint64_t isolated, uint64_t dummies, uint64_t copies, uint64_t components, uint64_t merges) {
+    ArithmeticEncoder encoder;
+    encoder.encode_bits_raw(2, 2);  // mode 2
+    encoder.encode_bits_raw(0, 2);  // context set
+    encoder.encode_bits_raw(0, 3);  // gate radius
+    encoder.encode_bits_raw(0, 1);  // not plain: the counts follow
+    for (uint64_t c : {isolated, dummies, copies, components, merges}) put_count(encoder, c);
+    for (int i = 0; i < 64; ++i) encoder.encode_bits_raw(0x5a5a5a5a, 32);
+    return encoder.finish();
+}
+
 std::vector<uint8_t> explicit_counts(uint64_t v, uint64_t f) {
     ArithmeticEncoder encoder;
     encoder.encode_bits_raw(1, 2);
@@ -347,12 +363,13 @@ std::vector<uint8_t> explicit_counts(uint64_t v, uint64_t f) {
 
 TEST(CraftedFiles, BaseConnectivityCounts) {
     // As the .amc decoder calls it: with the base vertices the metadata announces (bounded by
-    // the base geometry block: here a block of 64 bytes), which the stream must repeat.
+    // the base geometry block: here a block of 64 bytes), which the stream must repeat, and no
+    // isolated vertex allowed.
     const uint32_t vertices = uint32_t(max_decodable_positions(64));
     const BasePositionSource origin = [](uint32_t, const BaseStencil&, const std::vector<Vec3>&) { return Vec3{0, 0, 0}; };
-    auto refused = [&](const std::string& what, const std::vector<uint8_t>& stream) {
-        expect_refused_cheaply(what, ErrorCode::corrupt,
-                               [&] { decode_base_mesh(stream.data(), stream.size(), vertices, origin); });
+    auto refused = [&](const std::string& what, const std::vector<uint8_t>& stream, const char* must_say = nullptr) {
+        expect_refused_cheaply(
+            what, ErrorCode::corrupt, [&] { decode_base_mesh(stream.data(), stream.size(), vertices, origin, 0); }, must_say);
     };
     const uint64_t big = 0x7ffffffe, fits = vertices;
     refused("V", cut_border_counts(big, 0, 0, 0, 1, 0));
@@ -364,10 +381,13 @@ TEST(CraftedFiles, BaseConnectivityCounts) {
     refused("merges", cut_border_counts(fits, 0, 0, 0, 1, big));
     refused("explicit V", explicit_counts(big, 0));
     refused("explicit F", explicit_counts(fits, big));
-    // Not here: isolated vertices (cut border I = V, explicit F = 0) cost the stream no bits;
-    // the .amc decoder bounds them by the base geometry block only, and refuses them after
-    // decoding (validate_triangle_mesh). The early refusal the fuzz branch had (I = 0 in an .amc
-    // file) did not survive the port to the split base coder.
+    // Isolated vertices cost the stream no bits (here 2.3 M of them, 28 MB of stencils): refused
+    // on the counts.
+    refused("isolated vertices", cut_border_counts(fits, fits, 0, 0, 0, 0), "isolated");
+    refused("one isolated vertex", cut_border_counts(fits, 1, 0, 0, 1, 0), "isolated");
+    refused("mode 2 isolated vertices", angle_counts(fits, 0, 0, 0, 0), "isolated");
+    refused("explicit V without triangles", explicit_counts(fits, 0), "isolated");
+    refused("explicit V > 3F", explicit_counts(fits, 5), "isolated");
 }
 
 // ---- the other files and streams ---------------------------------------------------------------

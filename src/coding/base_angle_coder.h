@@ -33,6 +33,6 @@ std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& c
 // Decodes the rest of a mode-2 stream (after the two mode bits) of `size` bytes, reading the
 // positions from `source` as vertices are created. Throws Error.
 DecodedBaseMesh decode_angle_mode(ArithmeticDecoder& dec, size_t size, uint32_t vertex_count,
-                                  const BasePositionSource& source);
+                                  const BasePositionSource& source, uint32_t max_isolated);
 
 }  // namespace amc

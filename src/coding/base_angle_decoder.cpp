@@ -21,7 +21,7 @@ struct Header {
 };
 
 // FORMAT.md 4.10: every count is checked before anything is sized by it.
-Header read_header(ArithmeticDecoder& dec, size_t size, uint32_t vertex_count) {
+Header read_header(ArithmeticDecoder& dec, size_t size, uint32_t vertex_count, uint32_t max_isolated) {
     Header h;
     h.context_set = static_cast<int>(dec.decode_bits_raw(2));
     if (h.context_set >= angle_mode::kContextSets) fail_base_stream("unknown context set");
@@ -38,6 +38,7 @@ Header read_header(ArithmeticDecoder& dec, size_t size, uint32_t vertex_count) {
         h.merges = get_count(dec);
     }
     if (isolated > vertex_count) fail_base_stream("bad isolated vertex count");
+    if (isolated > max_isolated) fail_base_stream(isolated_refused(isolated, max_isolated));
     h.used = vertex_count - isolated;
     if (uint64_t{h.copies} > 2 * uint64_t{h.used}) fail_base_stream("bad copy count");
     if (uint64_t{h.dummies} > (uint64_t{h.used} + h.copies) / 3 + 1) fail_base_stream("bad dummy count");
@@ -247,8 +248,8 @@ private:
 }  // namespace
 
 DecodedBaseMesh decode_angle_mode(ArithmeticDecoder& dec, size_t size, uint32_t vertex_count,
-                                  const BasePositionSource& source) {
-    const Header header = read_header(dec, size, vertex_count);
+                                  const BasePositionSource& source, uint32_t max_isolated) {
+    const Header header = read_header(dec, size, vertex_count, max_isolated);
     return Decoder(dec, size, header, vertex_count, source).run();
 }
 

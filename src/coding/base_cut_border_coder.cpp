@@ -145,7 +145,7 @@ struct CutBorder {
 
 }  // namespace
 
-DecodedBaseMesh decode_cut_border(ArithmeticDecoder& dec, size_t size, uint32_t expected_vertices) {
+DecodedBaseMesh decode_cut_border(ArithmeticDecoder& dec, size_t size, uint32_t expected_vertices, uint32_t max_isolated) {
     const uint32_t vertex_count = get_count(dec);
     const uint32_t isolated = get_count(dec);
     const uint32_t dummies = get_count(dec);
@@ -154,6 +154,7 @@ DecodedBaseMesh decode_cut_border(ArithmeticDecoder& dec, size_t size, uint32_t 
     const uint32_t merges = get_count(dec);
     if (vertex_count != expected_vertices) fail_base_stream("vertex count differs from the caller's");
     if (isolated > vertex_count) fail_base_stream("bad isolated vertex count");
+    if (isolated > max_isolated) fail_base_stream(isolated_refused(isolated, max_isolated));
     const uint64_t stream_bits = 8 * (uint64_t{size} + 8);
     // Every copy and merge costs at least two raw bits.
     if (2 * uint64_t{copies} > stream_bits || 2 * uint64_t{merges} > stream_bits)

@@ -22,6 +22,6 @@ std::vector<uint8_t> encode_cut_border(const TriangleMesh& mesh, BaseMeshCode& c
 
 // Decodes the rest of a mode-0 stream (after the two mode bits) of `size` bytes: connectivity
 // and stencils, no positions. Throws Error.
-DecodedBaseMesh decode_cut_border(ArithmeticDecoder& dec, size_t size, uint32_t vertex_count);
+DecodedBaseMesh decode_cut_border(ArithmeticDecoder& dec, size_t size, uint32_t vertex_count, uint32_t max_isolated);
 
 }  // namespace amc

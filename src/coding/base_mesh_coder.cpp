@@ -16,7 +16,7 @@
 namespace amc {
 namespace {
 
-DecodedBaseMesh decode_explicit(ArithmeticDecoder& dec, size_t size, uint32_t vertex_count) {
+DecodedBaseMesh decode_explicit(ArithmeticDecoder& dec, size_t size, uint32_t vertex_count, uint32_t max_isolated) {
     DecodedBaseMesh out;
     out.vertex_count = get_count(dec);
     if (out.vertex_count != vertex_count) fail_base_stream("vertex count differs from the caller's");
@@ -25,6 +25,9 @@ DecodedBaseMesh decode_explicit(ArithmeticDecoder& dec, size_t size, uint32_t ve
     if (faces > 0 && (out.vertex_count < 3 ||
                       uint64_t{faces} * 3 * static_cast<uint64_t>(bits) > 8 * (uint64_t{size} + 8)))
         fail_base_stream("triangle count exceeds the stream");
+    // F triangles use at most 3F vertices: the others are isolated.
+    if (out.vertex_count > 3 * uint64_t{faces} + max_isolated)
+        fail_base_stream(isolated_refused(out.vertex_count - 3 * uint64_t{faces}, max_isolated, "at least "));
     out.triangles.resize(faces);
     for (Triangle& t : out.triangles) {
         for (uint32_t& v : t) v = get_index(dec, out.vertex_count, "vertex index");
@@ -128,17 +131,18 @@ BaseConnectivityMode base_connectivity_mode(const uint8_t* data, size_t size) {
 }
 
 DecodedBaseMesh decode_base_mesh(const uint8_t* data, size_t size, uint32_t vertex_count,
-                                 const BasePositionSource& positions) {
+                                 const BasePositionSource& positions, uint32_t max_isolated) {
     if (data == nullptr && size != 0) fail_base_stream("no data", ErrorCode::invalid_input);
     return with_allocation_errors_as_limits("base mesh stream", [&] {
         ArithmeticDecoder dec(data, size);
         const uint32_t mode = dec.decode_bits_raw(2);
         DecodedBaseMesh out;
         if (mode == uint32_t(BaseConnectivityMode::angle)) {
-            out = decode_angle_mode(dec, size, vertex_count, positions);
+            out = decode_angle_mode(dec, size, vertex_count, positions, max_isolated);
         } else {
-            if (mode == uint32_t(BaseConnectivityMode::cut_border)) out = decode_cut_border(dec, size, vertex_count);
-            else if (mode == uint32_t(BaseConnectivityMode::explicit_triangles)) out = decode_explicit(dec, size, vertex_count);
+            if (mode == uint32_t(BaseConnectivityMode::cut_border)) out = decode_cut_border(dec, size, vertex_count, max_isolated);
+            else if (mode == uint32_t(BaseConnectivityMode::explicit_triangles))
+                out = decode_explicit(dec, size, vertex_count, max_isolated);
             else fail_base_stream("unknown mode " + std::to_string(mode));
             if (dec.overran()) fail_base_stream("truncated", ErrorCode::truncated);
             // These modes know their connectivity without positions: they are read afterwards.

@@ -71,10 +71,11 @@ BaseConnectivityMode base_connectivity_mode(const uint8_t* data, size_t size);
 
 // Decodes a stream of encode_base_connectivity of a mesh with exactly `vertex_count` vertices.
 // Throws Error on corrupt or truncated input; memory and time stay linear in vertex_count and
-// the stream's size. The stream bounds its triangles, but isolated vertices cost it no bits: the
-// caller bounds them with `vertex_count` (the .amc decoder by the base geometry block, where
-// every vertex costs at least 15 symbols).
+// the stream's size. The stream bounds its triangles, but isolated vertices (used by no
+// triangle) cost it no bits: a stream announcing more than `max_isolated` of them is refused on
+// its counts, before anything is sized by them (the .amc decoder passes 0: its base mesh uses
+// every vertex).
 DecodedBaseMesh decode_base_mesh(const uint8_t* data, size_t size, uint32_t vertex_count,
-                                 const BasePositionSource& positions);
+                                 const BasePositionSource& positions, uint32_t max_isolated = UINT32_MAX);
 
 }  // namespace amc

@@ -10,6 +10,12 @@ namespace amc {
 
 void fail_base_stream(const std::string& what, ErrorCode code) { throw_error(code, "base mesh stream: " + what); }
 
+std::string isolated_refused(uint64_t isolated, uint32_t max, const char* qualifier) {
+    return std::string(qualifier) + std::to_string(isolated) + (isolated == 1 ? " isolated vertex" : " isolated vertices") +
+           " (used by no triangle), " +
+           (max == 0 ? std::string("where the base mesh must use every vertex") : "more than " + std::to_string(max));
+}
+
 void put_count(ArithmeticEncoder& enc, uint32_t x) {
     if (x > kMaxBaseCount) throw EncoderGaveUp{};
     const uint32_t y = x + 1;

@@ -20,6 +20,8 @@ struct EncoderGaveUp {};
 
 // Throws amc::Error(code, "base mesh stream: <what>").
 [[noreturn]] void fail_base_stream(const std::string& what, ErrorCode code = ErrorCode::corrupt);
+// The message for a stream announcing `isolated` isolated vertices where the caller allows `max`.
+std::string isolated_refused(uint64_t isolated, uint32_t max, const char* qualifier = "");
 
 // count: Elias gamma of x + 1, raw bits (x <= kMaxBaseCount, else EncoderGaveUp).
 void put_count(ArithmeticEncoder& enc, uint32_t x);

@@ -425,7 +425,8 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
                 AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
                             "base geometry is corrupt (non-finite coordinate)");
                 return p;
-            });
+            },
+            0);  // an .amc base mesh uses every vertex (validate_triangle_mesh): none isolated
         AMC_REQUIRE(decoded.vertex_count == meta.base_vertices && decoded.triangles.size() == meta.base_triangles, corrupt,
                     "base connectivity does not match the metadata");
         AMC_REQUIRE(!decoder.overran() && !positions.saw_invalid_symbol(), corrupt,

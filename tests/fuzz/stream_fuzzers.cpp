@@ -10,6 +10,7 @@
 #include <amc/hierarchy_coder.h>
 #include <amc/refinement.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -85,6 +86,15 @@ void base_connectivity(const uint8_t* data, size_t size) {
     }
     for (uint32_t i = 0; i < n; ++i) {
         for (int32_t s : decoded.stencils[i]) FUZZ_CHECK(s >= -1 && s < int32_t(i));
+    }
+    // The .amc decoder allows no isolated vertex (refused on the stream's counts): a stream whose
+    // mesh uses every vertex passes that check and decodes the same.
+    std::vector<bool> used(n, false);
+    for (const Triangle& t : decoded.triangles)
+        for (uint32_t v : t) used[v] = true;
+    if (std::find(used.begin(), used.end(), false) == used.end()) {
+        const DecodedBaseMesh strict = decode_base_mesh(in.rest(), in.remaining(), n, source, 0);  // throws: a finding
+        FUZZ_CHECK(strict.triangles == decoded.triangles && strict.stencils == decoded.stencils);
     }
     // Encoded again, the decoder gives the same triangles in the coder's order (fed the positions
     // in that order).
