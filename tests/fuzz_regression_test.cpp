@@ -1,6 +1,7 @@
 // Every input a fuzzer found a problem with (tests/data/fuzz-regressions/<target>/, named after
-// the finding) runs through its target again, as do the golden files through the .amc targets:
-// a crash, sanitizer report, uncaught exception or violated property fails the test.
+// the finding) runs through its target again, as do the golden files through the .amc targets
+// (all of them) and the series and octree targets (.amcs, .amq): a crash, sanitizer report,
+// uncaught exception or violated property fails the test.
 #include "fuzz_targets.h"
 
 #include <gtest/gtest.h>
@@ -30,9 +31,12 @@ TEST_P(FuzzRegressions, EveryFoundInputPasses) {
     const fs::path regressions = data / "fuzz-regressions" / target.name;
     if (fs::is_directory(regressions))
         for (const auto& entry : fs::directory_iterator(regressions)) inputs.push_back(entry.path());
-    if (std::string(target.name).rfind("amc_", 0) == 0)
+    const std::string name = target.name;
+    const std::string golden_extension = name == "series_read" ? ".amcs" : name == "octree_decode" ? ".amq" : "";
+    if (name.rfind("amc_", 0) == 0 || !golden_extension.empty())
         for (const auto& entry : fs::recursive_directory_iterator(data / "golden"))
-            if (entry.is_regular_file()) inputs.push_back(entry.path());
+            if (entry.is_regular_file() && (golden_extension.empty() || entry.path().extension() == golden_extension))
+                inputs.push_back(entry.path());
     target.run(nullptr, 0);
     for (const fs::path& input : inputs) {
         SCOPED_TRACE(input.string());

@@ -12,9 +12,13 @@
 #include "mesh/off_io.h"
 #include "mesh/ply_io.h"
 #include "mesh/vtu_writer.h"
+#include "../octree_test_util.h"
 
 #include <amc/codec.h>
+#include <amc/octree.h>
 #include <amc/refinement.h>
+#include <amc/series.h>
+#include <amc/simulation.h>
 
 #include <cstdio>
 #include <cstring>
@@ -204,6 +208,65 @@ void round_trip_seeds() {
     }
 }
 
+// Small series of the heat run: keyframes or not, lossless or bounded fields, a base in single
+// precision, an unfinished file (no END block), one without fields.
+void series_seeds() {
+    HeatRunOptions run;
+    run.frames = 4;
+    run.max_level = 4;
+    run.target_elements = 120;
+    run.initial_adaptations = 2;
+    std::vector<SeriesFrame> frames;
+    run_heat_simulation(run, [&](const SimulationFrame& f) { frames.push_back({*f.hierarchy, f.time, f.fields}); });
+    for (int k = 0; k < 5; ++k) {
+        SeriesOptions options;
+        options.keyframe_interval = k % 2 ? 2 : 0;
+        options.error_bound = k == 2 ? 1e-3 : 0;
+        if (k == 3) options.field_bounds = {{"heat_flux", 1e-2}};
+        TriangleMesh base = frames.front().hierarchy.base();
+        if (k == 4) {
+            base.single_precision = true;
+            for (Vec3& p : base.positions) p = {float(p.x), float(p.y), float(p.z)};
+        }
+        SeriesWriter writer(base, options);
+        for (const SeriesFrame& f : frames) {
+            if (k == 4) {
+                Hierarchy h(base);
+                refine_randomly(h, h.root_count() + 40, 3, uint64_t(f.time * 1000) + 1);
+                writer.add_frame(h, f.time);
+            } else {
+                writer.add_frame(f.hierarchy, f.time, f.fields);
+            }
+        }
+        if (k != 1) writer.close();
+        write_seed("series_read", writer.bytes());
+    }
+}
+
+// Forests of every connectivity mode (brick, periodic brick, glued by vertices, explicit without
+// vertices), 2D and 3D, balanced or not, with every switch somewhere.
+void octree_seeds() {
+    std::mt19937_64 rng(3);
+    for (int k = 0; k < 16; ++k) {
+        const int dim = 2 + k % 2;
+        OctreeForest forest = octree_test::random_balanced_forest(dim, rng);
+        OctreeEncodeOptions options;
+        options.uniform_levels = k & 1;
+        options.truncate = k & 2;
+        options.context_groups = k & 4;
+        options.improved_traversal = k & 8;
+        if (k % 5 == 4) {  // unbalanced, coded without culling
+            forest = random_octree_forest(forest.connectivity, uint64_t(k), 0.4, 1, dim == 2 ? 5 : 3);
+            options.cull_by_balance = false;
+        }
+        if (k % 7 == 6) {  // explicit, without vertices
+            forest.connectivity.vertices.clear();
+            forest.connectivity.tree_to_vertex.clear();
+        }
+        write_seed("octree_decode", encode_octree_forest(forest, options));
+    }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -223,10 +286,14 @@ int main(int argc, char** argv) {
     geometry_seeds();
     mesh_seeds(hierarchies);
     round_trip_seeds();
+    series_seeds();
+    octree_seeds();
     for (const char* target : {"amc_decode", "amc_inspect"}) {
         copy_files(data / "golden", target, ".amc");
         copy_files(data / "bad", target, ".amc");
     }
+    copy_files(data / "golden", "series_read", ".amcs");
+    copy_files(data / "golden", "octree_decode", ".amq");
     copy_files(data / "bad", "amh_read", ".amh");
     copy_files(data / "bad", "obj_read", ".obj");
     copy_files(data / "bad", "off_read", ".off");

@@ -21,6 +21,8 @@ const std::vector<Target>& targets() {
         {"ply_read", ply_read},
         {"vtu_read", vtu_read},
         {"round_trip", round_trip},
+        {"series_read", series_read},
+        {"octree_decode", octree_decode},
     };
     return all;
 }
@@ -42,13 +44,13 @@ void put_u32(uint8_t* p, uint32_t v) {
 
 }  // namespace
 
-// The framing of docs/FORMAT.md, 3.1 and 3.2: a 12-byte header whose last four bytes are the
-// XXH32 of the first eight, then blocks of type, length, payload and XXH32 of those.
-std::vector<uint8_t> with_valid_checksums(const uint8_t* data, size_t size) {
+// The framing of docs/FORMAT.md, 3.1 and 3.2 (7.1 and 8.1 for .amcs and .amq): a header whose last
+// four bytes are the XXH32 of the others, then blocks of type, length, payload and XXH32 of those.
+std::vector<uint8_t> with_valid_checksums(const uint8_t* data, size_t size, size_t header_size) {
     std::vector<uint8_t> out(data, data + size);
-    if (size < 12) return out;
-    put_u32(out.data() + 8, XXH32(out.data(), 8, 0));
-    size_t pos = 12;
+    if (size < header_size) return out;
+    put_u32(out.data() + header_size - 4, XXH32(out.data(), header_size - 4, 0));
+    size_t pos = header_size;
     while (size - pos >= 9) {
         const uint32_t length = get_u32(out.data() + pos + 1);
         if (length > size - pos - 9) break;

@@ -32,6 +32,8 @@ void off_read(const uint8_t* data, size_t size);
 void ply_read(const uint8_t* data, size_t size);
 void vtu_read(const uint8_t* data, size_t size);
 void round_trip(const uint8_t* data, size_t size);         // random hierarchy -> encode -> decode
+void series_read(const uint8_t* data, size_t size);        // .amcs reader, every frame, written again
+void octree_decode(const uint8_t* data, size_t size);      // .amq decode: whole, progressive, encoded again
 
 // Input layouts of the stream targets, which fuzz_seeds writes too.
 //   hierarchy_stream: u8 base (index into stream_bases()), u8 max_level + 1 (0: all levels), the stream.
@@ -81,9 +83,12 @@ const std::vector<Target>& targets();
 // A property does not hold: prints `what` and aborts (libFuzzer saves the input).
 [[noreturn]] void violated(const char* what, const char* file, int line);
 
-// A copy of an .amc file with the header's and every block's XXH32 recomputed, as far as the
-// framing can be walked: lets mutated files past the checksums into the payload decoders.
-std::vector<uint8_t> with_valid_checksums(const uint8_t* data, size_t size);
+// A copy of an .amc file (or an .amq, .amcs file: same framing, their header is `header_size` bytes
+// long) with the header's and every block's XXH32 recomputed, as far as the framing can be walked:
+// lets mutated files past the checksums into the payload decoders.
+constexpr size_t kAmcHeaderSize = 12;    // also .amq's
+constexpr size_t kSeriesHeaderSize = 16;
+std::vector<uint8_t> with_valid_checksums(const uint8_t* data, size_t size, size_t header_size = kAmcHeaderSize);
 
 }  // namespace amc::fuzz
 
