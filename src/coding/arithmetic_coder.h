@@ -191,9 +191,6 @@ public:
     // Check it after decoding; a corrupted stream may still decode to wrong symbols without it.
     bool overran() const { return past_end_ > kMaxImplicitZeroBytes; }
 
-    // Bytes read past the end of the buffer (each read as 0).
-    size_t bytes_past_end() const { return past_end_; }
-
 private:
     static constexpr uint32_t kTop = uint32_t{1} << 24;
 

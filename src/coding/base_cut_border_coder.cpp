@@ -12,12 +12,10 @@ namespace amc {
 namespace {
 
 constexpr int kDegreeContexts = 8;
-constexpr bool kChooseGate = true;
-constexpr bool kUseV = false;
 
 // The adaptive models of mode 0 (shared layout of encoder and decoder).
 struct OpModels {
-    BitModel is_new[kDegreeContexts * 4];  // C or not, by triangles around u and v
+    BitModel is_new[kDegreeContexts];      // C or not, by triangles around u
     BitModel is_right[kDegreeContexts];    // R (E on a 3-loop) or not, by triangles around u
     BitModel is_left[kDegreeContexts];     // L or not, by triangles around v
     BitModel is_split;                     // S or M when both are possible
@@ -25,9 +23,7 @@ struct OpModels {
     SplitOffsetModels split;               // split offsets (tip counted from v or from u)
 
     static int degree_class(uint32_t d) { return static_cast<int>(std::min<uint32_t>(d, 7)); }
-    BitModel& new_model(uint32_t du, uint32_t dv) {
-        return is_new[degree_class(du) * 4 + (kUseV ? std::min<uint32_t>(dv, 3) : 0)];
-    }
+    BitModel& new_model(uint32_t du) { return is_new[degree_class(du)]; }
 };
 
 // The cut border: a stack of loops of border nodes (doubly linked, cyclic). A node stands for a
@@ -215,7 +211,7 @@ DecodedBaseMesh decode_cut_border(ArithmeticDecoder& dec, size_t size, uint32_t 
             CutBorder::Loop& loop = border.top();
             const uint32_t g = loop.gate, nv = border.next[g];
             const uint32_t u = border.vert[g], v = border.vert[nv];
-            if (dec.decode(models.new_model(degree[u], degree[v]))) {
+            if (dec.decode(models.new_model(degree[u]))) {
                 const bool dummy = dummies > 0 && dec.decode(models.is_dummy);
                 dummy_seen += dummy ? 1 : 0;
                 const uint32_t w =
@@ -230,7 +226,7 @@ DecodedBaseMesh decode_cut_border(ArithmeticDecoder& dec, size_t size, uint32_t 
                 add_triangle(u, v, border.vert[border.prev[g]]);
                 if (length == 3) border.op_end();
                 else border.op_right();
-                if (kChooseGate) border.choose_gate(degree);
+                border.choose_gate(degree);
                 continue;
             }
             if (length > 3 && dec.decode(models.is_left[OpModels::degree_class(degree[v])])) {
@@ -421,7 +417,7 @@ std::vector<uint8_t> encode_cut_border(const TriangleMesh& mesh, BaseMeshCode& c
                     border.op_right();
                     out_he[p] = to_v;
                 }
-                if (kChooseGate) border.choose_gate(degree1);
+                border.choose_gate(degree1);
                 continue;
             }
             if (loop.length > 3 && border.vert[border.next[nv]] == w) {
@@ -534,7 +530,7 @@ std::vector<uint8_t> encode_cut_border(const TriangleMesh& mesh, BaseMeshCode& c
         const CutBorder::Loop loop = replay.top();
         const uint32_t g = loop.gate, nv = replay.next[g];
         const uint32_t u = replay.vert[g], v = replay.vert[nv];
-        enc.encode(op.kind == 1, models.new_model(degree[u], degree[v]));
+        enc.encode(op.kind == 1, models.new_model(degree[u]));
         if (op.kind == 1) {
             if (cm.dummies > 0) enc.encode(op.a != 0, models.is_dummy);
             count_triangle();
@@ -546,7 +542,7 @@ std::vector<uint8_t> encode_cut_border(const TriangleMesh& mesh, BaseMeshCode& c
         if (op.kind == 2) {
             if (loop.length == 3) replay.op_end();
             else replay.op_right();
-            if (kChooseGate) replay.choose_gate(degree);
+            replay.choose_gate(degree);
             continue;
         }
         if (loop.length > 3) enc.encode(op.kind == 3, models.is_left[OpModels::degree_class(degree[v] - 1)]);

@@ -5,14 +5,13 @@
 
 #include "coding/base_mesh_stream.h"
 
+#include <amc/hierarchy.h>  // kNoVertex
 #include <amc/mesh.h>
 
 #include <cstdint>
 #include <vector>
 
 namespace amc {
-
-constexpr uint32_t kNoVertex = 0xFFFFFFFFu;
 
 struct ClosedMesh {
     std::vector<Triangle> triangles;  // 0 .. real_triangles-1 are the input's, same rotation

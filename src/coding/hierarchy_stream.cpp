@@ -1,6 +1,7 @@
 // Header of the hierarchy stream (layout in hierarchy_stream.h and docs/FORMAT.md).
 #include "coding/hierarchy_stream.h"
 
+#include "coding/container.h"
 #include "common/check.h"
 
 #include <cstring>
@@ -55,13 +56,7 @@ std::vector<uint8_t> write_hierarchy_stream_header(const HierarchyStreamHeader& 
     const HierarchyCoderOptions& o = header.options;
     const uint8_t switches = uint8_t(coder_switches(o) | int(header.orientation_coded) << 6);
     std::vector<uint8_t> out{switches, header.uniform_levels, uint8_t(header.diagonal_rule)};
-    if (o.truncate_stream) {
-        uint64_t v = header.symbol_count;
-        do {
-            out.push_back(uint8_t((v & 0x7f) | (v > 0x7f ? 0x80 : 0)));
-            v >>= 7;
-        } while (v != 0);
-    }
+    if (o.truncate_stream) put_varint(out, header.symbol_count);
     return out;
 }
 
