@@ -12,6 +12,7 @@
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
 #include <amc/mesh.h>
+#include <amc/mesh_io.h>
 
 #include <draco/compression/decode.h>
 #include <draco/compression/mesh/mesh_edgebreaker_decoder.h>

@@ -24,6 +24,7 @@
 #include "coding/base_mesh_closing.h"
 
 #include <amc/mesh.h>
+#include <amc/mesh_io.h>
 
 #include <algorithm>
 #include <cmath>

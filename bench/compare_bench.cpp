@@ -16,6 +16,7 @@
 #include <amc/hierarchy.h>
 #include <amc/hierarchy_coder.h>
 #include <amc/import.h>
+#include <amc/mesh_io.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -212,7 +213,8 @@ struct AmcMode {
 };
 
 std::vector<AmcMode> amc_connectivity_modes() {
-    amc::HierarchyCoderOptions none = amc::coder_options_from_switches(0);  // naive coder: every switch off
+    // The naive coder: every switch off.
+    const amc::HierarchyCoderOptions none{false, false, false, false, false, amc::Traversal::naive};
     amc::HierarchyCoderOptions paper_naive;  // the paper's complete method ...
     paper_naive.traversal = amc::Traversal::naive;
     amc::HierarchyCoderOptions paper_improved;

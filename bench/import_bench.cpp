@@ -9,6 +9,7 @@
 #include "user_leaf_mesh.h"
 
 #include <amc/import.h>
+#include <amc/mesh_io.h>
 
 #include <cstdio>
 #include <ctime>

@@ -5,6 +5,7 @@
 //   numbering_bench [--import] mesh.obj ...
 #include <amc/codec.h>
 #include <amc/import.h>
+#include <amc/mesh_io.h>
 #include <amc/numbering.h>
 
 #include "coding/numbering_coder.h"

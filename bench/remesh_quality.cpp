@@ -13,6 +13,7 @@
 #include "geometry/surface_quality.h"
 
 #include <amc/mesh.h>
+#include <amc/mesh_io.h>
 #include <amc/refinement.h>
 
 #include <chrono>

@@ -5,6 +5,7 @@
 //   vtu_io_bench big.amh [runs=3] [dir=/tmp]
 #include <amc/hierarchy.h>
 #include <amc/mesh.h>
+#include <amc/mesh_io.h>
 
 #include <algorithm>
 #include <cstdio>

@@ -5,6 +5,7 @@
 #include "import/base_detection.h"
 
 #include <amc/import.h>
+#include <amc/mesh_io.h>
 
 #include <algorithm>
 #include <cstdio>

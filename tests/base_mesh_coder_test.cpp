@@ -8,6 +8,7 @@
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
 #include <amc/mesh.h>
+#include <amc/mesh_io.h>
 #include <amc/refinement.h>
 
 #include <gtest/gtest.h>

@@ -2,6 +2,7 @@
 // try_decode reports the same kind as decode throws.
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
+#include <amc/mesh_io.h>
 #include <amc/refinement.h>
 
 #include <gtest/gtest.h>

@@ -3,6 +3,7 @@
 #include "hierarchy_checks.h"
 
 #include <amc/import.h>
+#include <amc/mesh_io.h>
 
 #include <algorithm>
 

@@ -4,6 +4,7 @@
 
 #include <amc/codec.h>
 #include <amc/import.h>
+#include <amc/mesh_io.h>
 #include <amc/refinement.h>
 
 #include <algorithm>

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "amc/mesh.h"
+#include "amc/mesh_io.h"
 #include "mesh/obj_io.h"
 #include "mesh/off_io.h"
 #include "mesh/ply_io.h"

@@ -4,6 +4,8 @@
 #include "octree/octree_file.h"
 #include "octree_test_util.h"
 
+#include <amc/mesh_io.h>
+
 #include <gtest/gtest.h>
 
 #include <cmath>

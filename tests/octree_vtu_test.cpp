@@ -1,4 +1,5 @@
 // Leaves of octree forests as VTU quads and hexahedra.
+#include <amc/mesh_io.h>
 #include <amc/octree.h>
 
 #include <gtest/gtest.h>

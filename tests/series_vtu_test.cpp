@@ -1,4 +1,5 @@
 // Series frames to and from VTU files with point and cell data, and ParaView collections (.pvd).
+#include <amc/mesh_io.h>
 #include <amc/series.h>
 #include <amc/simulation.h>
 

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "amc/mesh.h"
+#include "amc/mesh_io.h"
 #include "mesh/vtu_reader.h"
 #include "mesh/zlib_blocks.h"
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "amc/mesh.h"
+#include "amc/mesh_io.h"
 
 using namespace amc;
 

@@ -2,12 +2,13 @@
 #include "cli_files.h"
 
 #include <amc/hierarchy.h>
+#include <amc/mesh_io.h>
 
-#include <cerrno>
+#include "common/file_io.h"
+
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <iterator>
 
@@ -43,15 +44,7 @@ InputFile read_input(const std::string& path) {
         if (std::cin.bad()) throw Error(ErrorCode::io, "stdin: read error");
     } else {
         in.name = path;
-        std::error_code ec;
-        const std::filesystem::file_status status = std::filesystem::status(path, ec);
-        if (ec || !std::filesystem::exists(status))
-            throw Error(ErrorCode::io, path + ": cannot open file (" + (ec ? ec.message() : std::string("No such file or directory")) + ")");
-        if (!std::filesystem::is_regular_file(status)) throw Error(ErrorCode::io, path + ": not a regular file");
-        std::ifstream file(path, std::ios::binary);
-        if (!file) throw Error(ErrorCode::io, path + ": cannot open file (" + std::strerror(errno) + ")");
-        in.bytes.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
-        if (file.bad()) throw Error(ErrorCode::io, path + ": read error");
+        in.bytes = read_whole_file(path);
     }
     if (starts_with(in.bytes, "AMCF")) {
         in.kind = FileKind::compressed;

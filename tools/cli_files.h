@@ -5,6 +5,7 @@
 
 #include <amc/codec.h>
 #include <amc/mesh.h>
+#include <amc/mesh_io.h>
 
 #include <string>
 

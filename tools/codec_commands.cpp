@@ -5,6 +5,7 @@
 #include "progress.h"
 
 #include <amc/codec.h>
+#include <amc/mesh_io.h>
 #include <amc/numbering.h>
 
 #include <chrono>

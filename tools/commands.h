@@ -3,6 +3,7 @@
 #pragma once
 
 #include <amc/mesh.h>
+#include <amc/mesh_io.h>
 #include <amc/refinement.h>
 
 #include <cstdint>

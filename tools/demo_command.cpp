@@ -3,6 +3,7 @@
 #include "commands.h"
 
 #include <amc/codec.h>
+#include <amc/mesh_io.h>
 
 #include <chrono>
 #include <cmath>

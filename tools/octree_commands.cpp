@@ -3,6 +3,7 @@
 #include "cli_files.h"
 #include "commands.h"
 
+#include <amc/mesh_io.h>
 #include <amc/octree.h>
 
 #include <cstdio>

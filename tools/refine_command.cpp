@@ -3,6 +3,8 @@
 #include "commands.h"
 #include "progress.h"
 
+#include <amc/mesh_io.h>
+
 #include <chrono>
 #include <cstdio>
 #include <filesystem>

@@ -6,6 +6,7 @@
 #include "progress.h"
 
 #include <amc/import.h>
+#include <amc/mesh_io.h>
 #include <amc/series.h>
 
 #include <algorithm>

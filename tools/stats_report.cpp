@@ -3,6 +3,8 @@
 
 #include <amc/hierarchy_coder.h>
 
+#include "coding/coder_switches.h"
+
 #include <cstdio>
 
 namespace amc {

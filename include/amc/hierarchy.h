@@ -132,19 +132,6 @@ public:
     // Splits leaf n with no balancing or closure; requires can_split(n). The building block of
     // refine() and of readers/decoders that replay a stored forest.
     void split(NodeId n);
-    // Splits the leaves parents[0..count) in that order with the result of calling split() on
-    // each in turn (same node ids, vertex ids and links), in one pass: the bulk form for decoders
-    // that replay a stored forest level by level. The parents must be distinct splittable leaves
-    // of one level whose same-level neighbours are not refined yet. The caller gives the links of
-    // the new nodes: the twelve words at child_links + 12 * i hold, for child k of parents[i] and
-    // its edge e (word 3 * k + e), its same-level neighbour as a local index 4 * j + k' (child k'
-    // of parents[j]), or kNoNode where it has none (boundary, or the neighbour across the
-    // parent's edge is not in `parents` and stays a leaf). They must be the links split() makes.
-    // When no ids are free for reuse (a hierarchy that was only ever refined), child k of
-    // parents[i] gets id node_capacity() + 4 * i + k, node_capacity() taken before the call.
-    void split_level(const NodeId* parents, uint32_t count, const uint32_t* child_links);
-    // Hints the processor to fetch node n (for traversals that know their next nodes early).
-    void prefetch(NodeId n) const { __builtin_prefetch(nodes_.data() + n); }
     // Reserves room for `nodes` nodes and `vertices` vertex ids (a hint for bulk builders, which
     // then grow without reallocation; large reservations may be backed by huge pages).
     void reserve(size_t nodes, size_t vertices);
@@ -155,6 +142,10 @@ public:
     std::vector<NodeId> leaves() const;  // leaves in breadth-first order
 
 private:
+    // The decoders' bulk build of a level, split_level (src/hierarchy/hierarchy_builder.h).
+    friend struct HierarchyBuilder;
+    void split_level(const NodeId* parents, uint32_t count, const uint32_t* child_links);
+
     static constexpr uint8_t kDeadLevel = 0xff;
     // 32 bytes, aligned: a node never straddles two cache lines. Siblings share what their ids
     // already tell: the parent is kept once per block of four (block_parent_), and the child

@@ -31,12 +31,6 @@ struct HierarchyCoderOptions {
     Traversal traversal = Traversal::improved;
 };
 
-// The six switches as bits (0 1-regularity, 1 hanging nodes, 2 uniform levels, 3 truncation,
-// 4 contexts, 5 improved traversal), as the stream header stores them; 64 combinations.
-constexpr int kCoderSwitchCombinations = 64;
-HierarchyCoderOptions coder_options_from_switches(int switches);
-int coder_switches(const HierarchyCoderOptions& options);
-
 // Local-index rules by which producers choose the diagonal of a leaf closed with two hanging
 // nodes (unrefined edge u): the diagonal joins the midpoint of refined edge r to its opposite
 // corner v_{(r+2)%3}. Frozen values: they are written to the stream.

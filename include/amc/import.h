@@ -35,9 +35,6 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
                                    const std::vector<uint32_t>& leaf_vertex_of_base = {},
                                    const std::string& what = "leaf mesh");
 
-// The same on files (read_mesh: OBJ, OFF, PLY); errors name the files.
-ImportedHierarchy import_leaf_mesh_files(const std::string& base_path, const std::string& leaf_path);
-
 // ---- leaf mesh alone -> hierarchy (docs/IMPORT.md, section 2) --------------------------------
 
 // Finds the coarsest base of which `mesh` is a red-green refinement and returns the hierarchy
@@ -74,13 +71,5 @@ struct RefinementHistory {
 // of range for its state is refused here (the file reader can not know the states): the error
 // names the source, the step's line and the element.
 std::vector<Hierarchy> replay_history(const RefinementHistory& history);
-
-// The history file (docs/IMPORT.md, "The history file"): parse_history validates everything and
-// names the line of each problem; `what` names the source, `directory` is where a relative base
-// path is looked for. format_history writes the base inline (coordinates exactly).
-RefinementHistory parse_history(const std::string& text, const std::string& what, const std::string& directory = ".");
-RefinementHistory read_history(const std::string& path);
-std::string format_history(const RefinementHistory& history);
-void write_history(const std::string& path, const RefinementHistory& history);
 
 }  // namespace amc

@@ -1,4 +1,5 @@
-// Triangle meshes: the value type shared by every stage, and the readers/writers of mesh files.
+// Triangle meshes: the value type shared by every stage, its errors and its checks (the readers
+// and writers of mesh files are in <amc/mesh_io.h>).
 #pragma once
 
 #include <array>
@@ -69,42 +70,14 @@ struct CellData {
     std::vector<uint8_t> is_green;  // 1 for closure (green) triangles, 0 for red ones
 };
 
-enum class MeshFormat { obj, off, ply, vtu };
-
-// Format from the file name's extension (.obj, .off, .ply, .vtu); throws Error otherwise.
-MeshFormat mesh_format_from_path(const std::string& path);
-
-// The format a file's first bytes announce (PLY, OFF and VTU have magic words; OBJ has none and
-// is taken for text that starts like an OBJ file). Returns false when the bytes name no format.
-bool mesh_format_from_content(const std::string& bytes, MeshFormat& format);
-
-// Reads an OBJ, OFF, PLY or VTU file (by extension) and validates it with
-// validate_triangle_mesh. Throws Error naming the file and the first offending element.
-TriangleMesh read_mesh(const std::string& path);
-// The same for a file's bytes already in memory; `what` names the source in messages.
-TriangleMesh parse_mesh(const std::string& bytes, MeshFormat format, const std::string& what);
-
 // Checks that the mesh is a triangle mesh fit to be a base mesh: indices in range, coordinates
 // finite, no degenerate (repeated-vertex) or repeated triangles, every edge shared by at most two
 // triangles with opposite orientation (edge-manifold, consistently oriented).
 // `what` names the source in messages. Throws Error.
 void validate_triangle_mesh(const TriangleMesh& mesh, const std::string& what);
 
-// Binary or text for the formats that have both (PLY, VTU); OBJ and OFF are always text.
-enum class MeshEncoding { binary, ascii };
-
-// Writes a mesh; format from the extension. Cell data is written where the format can hold it
-// and its readers read it (VTU cell arrays; ASCII PLY face properties, see format_ply) and
-// ignored otherwise; binary VTU is VtuEncoding::binary_zlib. The file is written to a temporary
-// name and renamed, so it is never half-written. Throws Error.
-void write_mesh(const std::string& path, const TriangleMesh& mesh, const CellData* cells = nullptr,
-                MeshEncoding encoding = MeshEncoding::binary);
-// The bytes write_mesh would write, for a format chosen by the caller (output to a stream).
-std::string format_mesh(const TriangleMesh& mesh, const CellData* cells, MeshFormat format,
-                        MeshEncoding encoding = MeshEncoding::binary);
-
 // ---------------------------------------------------------------------------------------------
-// VTK XML UnstructuredGrid (.vtu) with point and cell data
+// The contents of a VTK XML UnstructuredGrid (.vtu): point and cell data
 
 // The value types of a VTK DataArray, in the order of DataArray::Values' alternatives.
 enum class ValueType : uint8_t { int8, uint8, int16, uint16, int32, uint32, int64, uint64, float32, float64 };
@@ -134,29 +107,9 @@ struct VtuMesh {
     std::vector<DataArray> cell_data;
 };
 
-// Reads a .vtu file as VTK, ParaView, meshio and DUNE write it: inline ascii or base64
-// ("binary"), or appended raw or base64 data; UInt32 or UInt64 headers; zlib-compressed
-// (vtkZLibDataCompressor) or not; little- or big-endian. Every cell must be a triangle (VTK
-// type 5, or a polygon of 3 points); Points as Float32 set single_precision. A file of several
-// Pieces reads as their concatenation (points of later pieces numbered after earlier ones, as
-// VTK's reader does); their point and cell arrays must match in name, type and components.
-// The mesh is validated with validate_triangle_mesh. Throws Error naming the file.
-VtuMesh read_vtu(const std::string& path);
-
 // The cell arrays "level" and "green" (UInt8) of the non-empty arrays of `cells`, as write_mesh
 // writes them: VtuMesh{leaf.mesh, {}, cell_data_arrays(leaf.cells)}.
 std::vector<DataArray> cell_data_arrays(const CellData& cells);
-
-enum class VtuEncoding {
-    binary_zlib,  // appended raw data, zlib-compressed blocks, UInt64 headers (VTK's default)
-    ascii,        // inline text, for reading by eye
-};
-
-// Writes a .vtu file: Points as Float32 when mesh.single_precision, else Float64; cells as
-// triangles; every array of point_data and cell_data (sizes must match the vertex and triangle
-// counts). Through a temporary file and a rename. Throws Error.
-void write_vtu(const std::string& path, const VtuMesh& vtu,
-               VtuEncoding encoding = VtuEncoding::binary_zlib);
 
 // Writes `bytes` to `path` through a temporary file beside it (`path.tmp.PID.N`), flushed to the
 // disk, and a rename: a reader, or a writer killed at any moment (or a crash of the machine),

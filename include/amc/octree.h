@@ -129,11 +129,6 @@ struct OctreeForestCounts {
 };
 OctreeForestCounts count_octree_forest(const OctreeForest& forest);
 
-// The leaves as VTU cells (VTK_QUAD in 2D, VTK_HEXAHEDRON in 3D, hanging nodes left as they
-// are) with cell data "level" and "tree"; corners placed by tree_point, shared within a tree and
-// repeated on tree boundaries. Through a temporary file and a rename. Throws Error.
-void write_octree_vtu(const std::string& path, const OctreeForest& forest, VtuEncoding encoding = VtuEncoding::binary_zlib);
-
 // ---- the coder (docs/OCTREE.md, docs/FORMAT.md section 8) ------------------------------------
 struct OctreeEncodeOptions {
     bool cull_by_balance = true;   // skip octants balance forbids to refine; refuses unbalanced forests

@@ -6,6 +6,7 @@
 
 #include "coding/arithmetic_coder.h"
 #include "coding/base_mesh_stream.h"
+#include "common/exact_float.h"
 
 #include <amc/mesh.h>
 
@@ -36,23 +37,24 @@ constexpr uint32_t kMinCornerDegree = 2;  // FORMAT.md 4.11
 // Squared cosines of the class bounds 30, 50, 70 and 120 degrees, as written in the spec.
 constexpr double kCos2Of30 = 0.75, kCos2Of50 = 0.41, kCos2Of70 = 0.117, kCos2Of120 = 0.25;
 
-// IEEE binary64 in exactly this order (mesh.h's dot; no fused multiply-add, see CMakeLists.txt):
-// both sides of the coder get the same class on every platform. With x = v - u, y = t - u,
-// z = o - u, the closing triangle faces like the one behind when the dot product of their normals,
-// -(x × z)·(x × y) = (x·y)(x·z) - (x·x)(y·z), is positive.
+// IEEE binary64 in exactly this order, every product rounded before it is added
+// (common/exact_float.h): both sides of the coder get the same class on every platform and with
+// any compiler flags. With x = v - u, y = t - u, z = o - u, the closing triangle faces like the
+// one behind when the dot product of their normals, -(x × z)·(x × y) = (x·y)(x·z) - (x·x)(y·z), is
+// positive.
 inline CornerClass corner_class(const Vec3& u, const Vec3& v, const Vec3& t, const Vec3& o) {
     const Vec3 x = v - u, y = t - u, z = o - u;
-    const double xx = dot(x, x), xy = dot(x, y), xz = dot(x, z), yz = dot(y, z);
-    if (!(xy * xz - xx * yz > 0)) return kReflex;
-    const double q = xx * dot(y, y);
-    const double c2 = xy * xy;
+    const double xx = exact_dot(x, x), xy = exact_dot(x, y), xz = exact_dot(x, z), yz = exact_dot(y, z);
+    if (!(rounded(xy * xz) - rounded(xx * yz) > 0)) return kReflex;
+    const double q = rounded(xx * exact_dot(y, y));
+    const double c2 = rounded(xy * xy);
     if (xy > 0) {
-        if (c2 > kCos2Of30 * q) return kBelow30;
-        if (c2 > kCos2Of50 * q) return kBelow50;
-        if (c2 > kCos2Of70 * q) return kBelow70;
+        if (c2 > rounded(kCos2Of30 * q)) return kBelow30;
+        if (c2 > rounded(kCos2Of50 * q)) return kBelow50;
+        if (c2 > rounded(kCos2Of70 * q)) return kBelow70;
         return kBelow90;
     }
-    return c2 < kCos2Of120 * q ? kBelow120 : kWide;
+    return c2 < rounded(kCos2Of120 * q) ? kBelow120 : kWide;
 }
 
 // The adaptive models of mode 2. They start from prior probabilities (FORMAT.md 4.12), as if a

@@ -315,7 +315,7 @@ private:
             for (uint32_t i = 2; i + 3 <= length; ++i, x = b.next(x)) {
                 if (!b.located(b.vert(x))) continue;
                 const Vec3 d = b.position(b.vert(x)) - predicted;
-                const double distance = dot(d, d);
+                const double distance = exact_dot(d, d);
                 if (best == angle_mode::kNoNode || distance < best_distance) {
                     best = x;
                     best_distance = distance;

@@ -3,6 +3,7 @@
 #include "coding/float_coder.h"
 
 #include "common/bits.h"
+#include "common/exact_float.h"
 
 #include <cfloat>
 #include <cmath>
@@ -149,7 +150,7 @@ double coder_prediction(double predicted, Precision precision) {
     if (precision == Precision::float32) {
         if (p > FLT_MAX) p = FLT_MAX;
         if (p < -FLT_MAX) p = -FLT_MAX;
-        p = static_cast<double>(static_cast<float>(p));
+        p = rounded_to_float(p);
     }
     return p;
 }
@@ -178,7 +179,7 @@ void encode_coordinate(ArithmeticEncoder& encoder, FloatResidualModels& models, 
     FloatResidualModels::Context& ctx = models.context(context);
     if (precision == Precision::float32 && !std::isnan(actual)) {
         const bool in_range = !std::isfinite(actual) || std::fabs(actual) <= FLT_MAX;
-        if (!in_range || static_cast<double>(static_cast<float>(actual)) != actual ||
+        if (!in_range || rounded_to_float(actual) != actual ||
             std::signbit(static_cast<float>(actual)) != std::signbit(actual)) {
             throw Error("encode_coordinate: " + std::to_string(actual) +
                         " is not a single precision value");
@@ -274,7 +275,7 @@ GridPoint quantize(const Quantizer& quantizer, Vec3 p) {
 }
 
 double dequantize_coordinate(const Quantizer& quantizer, int axis, uint32_t q) {
-    return axis_value(quantizer.origin, axis) + static_cast<double>(q) * quantizer.step;
+    return axis_value(quantizer.origin, axis) + rounded(static_cast<double>(q) * quantizer.step);
 }
 
 Vec3 dequantize(const Quantizer& quantizer, GridPoint q) {

@@ -2,19 +2,13 @@
 // see geometry_prediction.h.
 #include "coding/geometry_prediction.h"
 
+#include "common/exact_float.h"
+
 namespace amc {
 
 namespace {
 
-Vec3 round_if_single(const Hierarchy& h, Vec3 p) {
-    if (h.single_precision()) {
-        // One coordinate at a time (see CMakeLists.txt on GCC 12's SLP vectorizer).
-        p.x = static_cast<double>(static_cast<float>(p.x));
-        p.y = static_cast<double>(static_cast<float>(p.y));
-        p.z = static_cast<double>(static_cast<float>(p.z));
-    }
-    return p;
-}
+Vec3 round_if_single(const Hierarchy& h, Vec3 p) { return h.single_precision() ? rounded_to_float(p) : p; }
 
 // The vertex of node m opposite its edge f.
 Vec3 opposite(const Hierarchy& h, NodeId m, int f) { return h.position(h.vertex(m, (f + 2) % 3)); }
@@ -59,7 +53,7 @@ std::vector<std::pair<NodeId, int>> new_vertices_of_level(const Hierarchy& h,
 Vec3 predict_midpoint(const Hierarchy& h, NodeId n, int e) {
     const Vec3 a = h.position(h.vertex(n, e));
     const Vec3 b = h.position(h.vertex(n, (e + 1) % 3));
-    return round_if_single(h, 0.5 * (a + b));  // FORMAT.md 5.5 (forest.cpp's placer where a + b is finite)
+    return round_if_single(h, rounded_scaled(0.5, a + b));  // FORMAT.md 5.5 (forest.cpp's placer where a + b is finite)
 }
 
 Vec3 predict_butterfly(const Hierarchy& h, NodeId n, int e) {
@@ -75,7 +69,9 @@ Vec3 predict_butterfly(const Hierarchy& h, NodeId n, int e) {
     const Vec3 w_ca = wing(h, n, e2, c + a - b);
     const Vec3 w_ad = wing(h, q, (eq + 1) % 3, a + d - b);
     const Vec3 w_db = wing(h, q, (eq + 2) % 3, d + b - a);
-    const Vec3 p = 0.5 * (a + b) + 0.125 * (c + d) - 0.0625 * ((w_bc + w_ca) + (w_ad + w_db));
+    // Every product rounded before it is added (common/exact_float.h): the decoder computes the same.
+    const Vec3 p = rounded_scaled(0.5, a + b) + rounded_scaled(0.125, c + d) -
+                   rounded_scaled(0.0625, (w_bc + w_ca) + (w_ad + w_db));
     return round_if_single(h, p);
 }
 

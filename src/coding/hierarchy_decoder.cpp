@@ -3,6 +3,7 @@
 #include "coding/hierarchy_level_coder.h"
 #include "common/check.h"
 #include "common/compiler.h"
+#include "hierarchy/hierarchy_builder.h"
 
 #include <string>
 #include <utility>
@@ -220,7 +221,7 @@ void HierarchyLevelDecoder::build_decided_levels() {
         uint32_t* parents = level.refined.data();
         for (uint32_t b = 0; b < count; ++b) parents[b] += level_base_;
         const NodeId first_child = h_.node_capacity();
-        h_.split_level(parents, count, count == 0 ? nullptr : children.nbr.data()->nbr);
+        HierarchyBuilder::split_level(h_, parents, count, count == 0 ? nullptr : children.nbr.data()->nbr);
         level_base_ = first_child;
     }
     // Their memory serves the levels to come.

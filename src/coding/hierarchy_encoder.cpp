@@ -3,6 +3,7 @@
 // Stream layout in docs/FORMAT.md ("hierarchy stream").
 #include "coding/hierarchy_level_coder.h"
 #include "common/check.h"
+#include "hierarchy/hierarchy_builder.h"
 
 #include <string>
 #include <utility>
@@ -42,9 +43,9 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         uint32_t unbalanced = n;
         const uint8_t* state = level.state();
         constexpr uint32_t kAhead = 16;
-        for (uint32_t i = 0; i < n && i < kAhead; ++i) h.prefetch(ids[i]);
+        for (uint32_t i = 0; i < n && i < kAhead; ++i) HierarchyBuilder::prefetch(h, ids[i]);
         for (uint32_t i = 0; i < n; ++i) {
-            if (i + kAhead < n) h.prefetch(ids[i + kAhead]);
+            if (i + kAhead < n) HierarchyBuilder::prefetch(h, ids[i + kAhead]);
             const NodeId id = ids[i];
             const bool r = !h.is_leaf(id);
             refined[i] = r;

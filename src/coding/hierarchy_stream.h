@@ -12,6 +12,7 @@
 #pragma once
 
 #include "coding/arithmetic_coder.h"
+#include "coding/coder_switches.h"
 #include "coding/context_groups.h"
 #include "coding/format_version.h"
 

@@ -25,6 +25,7 @@
 #include "coding/format_version.h"
 #include "common/compiler.h"
 #include "common/huge_pages.h"
+#include "common/simd.h"
 #include "hierarchy/child_links.h"
 
 #include <amc/hierarchy.h>
@@ -35,10 +36,6 @@
 #include <cstdint>
 #include <cstring>
 #include <vector>
-
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 namespace amc {
 
@@ -330,7 +327,7 @@ inline DecidedLevelScan scan_decided_level(Level& level, RefinedNumbering& numbe
         for (uint32_t c = two_hanging & ~is_refined; c != 0; c &= c - 1) closures[scan.closures++] = i + uint32_t(__builtin_ctz(c));
     };
     uint32_t i = 0;
-#if defined(__SSE2__)
+#if AMC_SSE2
     for (; i + 16 <= n; i += 16) {
         const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(state + i));
         // Shifting 16-bit lanes moves bit b of each byte to bit 7 of the same byte.
@@ -386,7 +383,7 @@ constexpr HalfEdgeChildren kHalfEdgeChildren{};
 inline unsigned write_child_neighbors(Neighbors* out, uint32_t b, uint32_t q0, uint32_t q1, uint32_t q2,
                                       uint8_t nbr_edge) {
     const unsigned code = nbr_edge & 63u;
-#if defined(__SSE2__)
+#if AMC_SSE2
     // Lanes 0-2: edge e; lane 3: the block itself, whose first child is c = 4b.
     const __m128i q = _mm_set_epi32(int(b), int(q2), int(q1), int(q0));
     const __m128i none = _mm_srai_epi32(q, 31);
@@ -460,7 +457,7 @@ inline uint64_t derive_next_level(const Level& level, const RefinedNumbering& nu
             const NewBlock& entry = new_blocks[linked | ((p.flags & 7u) << 3)];
             out_edges[b] = {uint8_t(p.nbr_edge & entry.edge_mask), uint8_t(p.flags & 7)};
             counts += entry.counts;
-#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+#if AMC_LITTLE_ENDIAN
             std::memcpy(out_state + c, &entry.states, 4);  // byte k: child k
 #else
             for (int k = 0; k < 4; ++k) out_state[c + k] = uint8_t(entry.states >> (8 * k));
@@ -747,7 +744,7 @@ private:
         for (; i % 16 != 0; --i) {
             if (!(state[i - 1] & kDecidedOrBucket4)) push(i - 1);
         }
-#if defined(__SSE2__)
+#if AMC_SSE2
         const __m128i mask = _mm_set1_epi8(char(kDecidedOrBucket4));
         const __m128i zero = _mm_setzero_si128();
         for (; i != 0; i -= 16) {
@@ -814,7 +811,7 @@ private:
     // Most nodes the cursor passes were decided meanwhile; they are skipped 16 at a time.
     static uint32_t next_fresh(const uint8_t* state, uint32_t n, uint32_t cursor) {
         constexpr uint8_t kDecidedOrPriority = kDecided | kPriorityMask;
-#if defined(__SSE2__)
+#if AMC_SSE2
         const __m128i mask = _mm_set1_epi8(char(kDecidedOrPriority));
         const __m128i fresh = _mm_set1_epi8(char(kFreshPriority));
         for (; cursor + 16 <= n; cursor += 16) {

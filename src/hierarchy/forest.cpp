@@ -2,7 +2,9 @@
 // coarsening, and the canonical breadth-first order.
 #include <amc/hierarchy.h>
 
+#include "common/exact_float.h"
 #include "common/huge_pages.h"
+#include "common/simd.h"
 #include "hierarchy/child_links.h"
 #include "mesh/vertex_buckets.h"
 
@@ -17,11 +19,6 @@
 #include <utility>
 #include <vector>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
-
 namespace amc {
 
 namespace {
@@ -31,12 +28,11 @@ namespace {
 // of such large values rounded once, the same correctly rounded midpoint, and finite.
 double midpoint_coordinate(double a, double b) {
     const double s = a + b;
-    return std::fabs(s) <= DBL_MAX ? 0.5 * s : 0.5 * a + 0.5 * b;
+    return std::fabs(s) <= DBL_MAX ? rounded(0.5 * s) : rounded(0.5 * a) + rounded(0.5 * b);
 }
 
 Vec3 round_if(void* single_precision, Vec3 m) {
-    if (single_precision != nullptr) m = {double(float(m.x)), double(float(m.y)), double(float(m.z))};
-    return m;
+    return single_precision != nullptr ? rounded_to_float(m) : m;
 }
 
 Vec3 midpoint_placer(void* single_precision, Vec3 a, Vec3 b) {
@@ -44,7 +40,7 @@ Vec3 midpoint_placer(void* single_precision, Vec3 a, Vec3 b) {
 }
 
 // midpoint_placer where no coordinate lies beyond DBL_MAX / 2: then a + b can not overflow.
-Vec3 near_midpoint_placer(void* single_precision, Vec3 a, Vec3 b) { return round_if(single_precision, 0.5 * (a + b)); }
+Vec3 near_midpoint_placer(void* single_precision, Vec3 a, Vec3 b) { return round_if(single_precision, rounded_scaled(0.5, a + b)); }
 
 // The end points of a new vertex.
 struct Ends {
@@ -299,7 +295,7 @@ void Hierarchy::write_vertices(Node* child, const VertexId corner[3], const Vert
     static_assert(sizeof(Node) == 32 && offsetof(Node, first_child) == 12 && offsetof(Node, nbr) == 16 &&
                       offsetof(Node, nbr_edge) == 28,
                   "split_level writes nodes by this layout");
-#if defined(__SSE2__)
+#if AMC_SSE2
     // Lane 3 of every piece is first_child: kNoNode.
     const __m128i p = _mm_set_epi32(-1, int(corner[2]), int(corner[1]), int(corner[0]));
     const __m128i q = _mm_set_epi32(-1, int(m[2]), int(m[1]), int(m[0]));
@@ -345,7 +341,7 @@ constexpr ChildTailTable kChildTails{};
 
 void Hierarchy::write_tail(Node& node, uint32_t word) {
     // Bytes nbr_edge, level, flags, reserved in that order (little endian word).
-#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+#if AMC_LITTLE_ENDIAN
     std::memcpy(&node.nbr_edge, &word, 4);
 #else
     node.nbr_edge = uint8_t(word);
@@ -359,7 +355,7 @@ void Hierarchy::write_tail(Node& node, uint32_t word) {
 // k, edge e); a local index becomes the id offset + index, kNoNode stays. Each child's store
 // also fills its last four bytes, which write_tail writes afterwards.
 void Hierarchy::write_neighbors(Node* child, const uint32_t* links, uint32_t offset) {
-#if defined(__SSE2__)
+#if AMC_SSE2
     const __m128i all_ones = _mm_set1_epi32(-1);
     const __m128i add = _mm_set1_epi32(int(offset));
     auto ids = [&](const uint32_t* at) {

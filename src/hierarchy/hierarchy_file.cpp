@@ -5,11 +5,10 @@
 #include <amc/hierarchy.h>
 
 #include "common/check.h"
+#include "common/file_io.h"
 
 #include <cmath>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 
 namespace amc {
 
@@ -254,12 +253,7 @@ void write_hierarchy(const std::string& path, const Hierarchy& h) {
 }
 
 Hierarchy read_hierarchy(const std::string& path) {
-    std::ifstream file(path, std::ios::binary);
-    AMC_REQUIRE(file, io, path + ": cannot open file");
-    std::ostringstream bytes;
-    bytes << file.rdbuf();
-    AMC_REQUIRE(!file.bad(), io, path + ": read error");
-    return deserialize_hierarchy(bytes.str(), path);
+    return deserialize_hierarchy(read_whole_file(path), path);
 }
 
 }  // namespace amc

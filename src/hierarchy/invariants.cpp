@@ -3,6 +3,7 @@
 #include "hierarchy/writer_checks.h"
 
 #include "common/check.h"
+#include "common/exact_float.h"
 
 #include <amc/hierarchy.h>
 
@@ -102,7 +103,7 @@ std::string check_positions(const Hierarchy& h) {
         const Vec3 p = h.position(v);
         for (const double x : {p.x, p.y, p.z}) {
             if (!std::isfinite(x)) return "vertex " + std::to_string(v) + " has a non-finite coordinate";
-            if (h.single_precision() && !(std::fabs(x) <= FLT_MAX && double(float(x)) == x))
+            if (h.single_precision() && !(std::fabs(x) <= FLT_MAX && rounded_to_float(x) == x))
                 return "vertex " + std::to_string(v) + " has a coordinate that is not a float32 value (" +
                        number_text(x) + ") in a single-precision hierarchy";
         }

@@ -1,14 +1,14 @@
 // The refinement history file, version 1 (docs/IMPORT.md, "The history file"): a magic line,
 // a base mesh (a path or inline), then steps of "refine" / "coarsen" element lists.
 #include <amc/import.h>
+#include <amc/mesh_io.h>
 
 #include "common/check.h"
+#include "common/file_io.h"
 #include "mesh/text_number.h"
 
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -197,12 +197,7 @@ RefinementHistory parse_history(const std::string& text, const std::string& what
 }
 
 RefinementHistory read_history(const std::string& path) {
-    std::ifstream file(path, std::ios::binary);
-    AMC_REQUIRE(file, io, path + ": cannot open file");
-    std::ostringstream bytes;
-    bytes << file.rdbuf();
-    AMC_REQUIRE(!file.bad(), io, path + ": read error");
-    return parse_history(bytes.str(), path, std::filesystem::path(path).parent_path().string());
+    return parse_history(read_whole_file(path), path, std::filesystem::path(path).parent_path().string());
 }
 
 std::string format_history(const RefinementHistory& history) {

@@ -192,10 +192,4 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     return out;
 }
 
-ImportedHierarchy import_leaf_mesh_files(const std::string& base_path, const std::string& leaf_path) {
-    const TriangleMesh base = read_mesh(base_path);
-    const TriangleMesh leaf = read_mesh(leaf_path);
-    return import_leaf_mesh(base, leaf, {}, leaf_path);
-}
-
 }  // namespace amc

@@ -1,6 +1,7 @@
 // Top-down reconstruction of the forest from the leaf mesh (docs/IMPORT.md, section 1).
 #include "import/leaf_reconstruction.h"
 
+#include "common/exact_float.h"
 #include "geometry/closest_point.h"
 #include "import/nearest_vertex.h"
 
@@ -206,8 +207,8 @@ private:
     uint32_t find_midpoint(NodeId n, int e) {
         const uint32_t a = corner(n, e), b = corner(n, (e + 1) % 3);
         if (guide_ == MidpointGuide::exact) {
-            Vec3 m = 0.5 * (leaf_.positions[a] + leaf_.positions[b]);
-            if (leaf_.single_precision) m = {double(float(m.x)), double(float(m.y)), double(float(m.z))};
+            Vec3 m = rounded_scaled(0.5, leaf_.positions[a] + leaf_.positions[b]);  // as the placer computes it
+            if (leaf_.single_precision) m = rounded_to_float(m);
             const uint32_t found = positions_.find(m);
             if (found == kNone) fail("no vertex at the midpoint of edge (" + edge_text(n, e) + ")");
             return found;

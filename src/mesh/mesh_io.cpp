@@ -1,19 +1,13 @@
-// read_mesh / write_mesh: format dispatch by extension, whole-file reads and atomic writes.
-#include <atomic>
+// read_mesh / write_mesh: format dispatch by extension and content (<amc/mesh_io.h>).
 #include <cctype>
-#include <cerrno>
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <string>
 
-#include <fcntl.h>
-#include <unistd.h>
-
-#include "amc/mesh.h"
+#include "amc/mesh_io.h"
 #include "common/check.h"
+#include "common/file_io.h"
 #include "mesh/obj_io.h"
 #include "mesh/off_io.h"
 #include "mesh/ply_io.h"
@@ -21,26 +15,6 @@
 #include "mesh/vtu_writer.h"
 
 namespace amc {
-namespace {
-
-std::string read_file(const std::string& path) {
-    std::error_code ec;
-    const std::filesystem::file_status status = std::filesystem::status(path, ec);
-    if (ec || !std::filesystem::exists(status)) {
-        throw Error(ErrorCode::io, path + ": cannot open file (" +
-                    (ec ? ec.message() : std::string("No such file or directory")) + ")");
-    }
-    if (!std::filesystem::is_regular_file(status)) throw Error(ErrorCode::io, path + ": not a regular file");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(ErrorCode::io, path + ": cannot open file (" + std::strerror(errno) + ")");
-    std::string bytes;
-    char buffer[1 << 16];
-    while (in.read(buffer, sizeof buffer) || in.gcount() > 0) bytes.append(buffer, in.gcount());
-    if (in.bad()) throw Error(ErrorCode::io, path + ": read error");
-    return bytes;
-}
-
-}  // namespace
 
 MeshFormat mesh_format_from_path(const std::string& path) {
     std::string ext = std::filesystem::path(path).extension().string();
@@ -92,7 +66,7 @@ TriangleMesh parse_mesh(const std::string& bytes, MeshFormat format, const std::
 
 TriangleMesh read_mesh(const std::string& path) {
     const MeshFormat format = mesh_format_from_path(path);
-    return parse_mesh(read_file(path), format, path);
+    return parse_mesh(read_whole_file(path), format, path);
 }
 
 std::string format_mesh(const TriangleMesh& mesh, const CellData* cells, MeshFormat format,
@@ -121,7 +95,7 @@ void write_mesh(const std::string& path, const TriangleMesh& mesh, const CellDat
 }
 
 VtuMesh read_vtu(const std::string& path) {
-    const std::string bytes = read_file(path);
+    const std::string bytes = read_whole_file(path);
     VtuMesh vtu = parse_vtu(bytes, path);
     validate_triangle_mesh(vtu.mesh, path);
     return vtu;
@@ -137,38 +111,10 @@ void write_vtu(const std::string& path, const VtuMesh& vtu, VtuEncoding encoding
     write_file_atomically(path, bytes);
 }
 
-void write_file_atomically(const std::string& path, const std::string& bytes) {
-    // A name no other call uses, in this process or another, in the directory of `path`, so that
-    // the rename stays within one file system.
-    static std::atomic<uint64_t> calls{0};
-    const std::string temp = path + ".tmp." + std::to_string(static_cast<long>(::getpid())) + "." +
-                             std::to_string(calls.fetch_add(1, std::memory_order_relaxed));
-    const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd < 0) throw Error(ErrorCode::io, path + ": cannot create " + temp + " (" + std::strerror(errno) + ")");
-    auto fail = [&](const std::string& what, int error) {
-        if (fd >= 0) ::close(fd);
-        ::unlink(temp.c_str());
-        throw Error(ErrorCode::io, path + ": " + what + " (" + std::strerror(error) + ")");
-    };
-    for (size_t done = 0; done < bytes.size();) {
-        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) fail("cannot write file", n < 0 ? errno : EIO);
-        done += size_t(n);
-    }
-    // On the disk before the rename: after a crash of the machine too, the path holds the old file
-    // or the whole new one.
-    if (::fsync(fd) != 0) fail("cannot write file", errno);
-    if (::close(fd) != 0) {
-        const int error = errno;
-        ::unlink(temp.c_str());
-        throw Error(ErrorCode::io, path + ": cannot write file (" + std::strerror(error) + ")");
-    }
-    if (::rename(temp.c_str(), path.c_str()) != 0) {
-        const int error = errno;
-        ::unlink(temp.c_str());
-        throw Error(ErrorCode::io, path + ": cannot rename " + temp + " to it (" + std::strerror(error) + ")");
-    }
+ImportedHierarchy import_leaf_mesh_files(const std::string& base_path, const std::string& leaf_path) {
+    const TriangleMesh base = read_mesh(base_path);
+    const TriangleMesh leaf = read_mesh(leaf_path);
+    return import_leaf_mesh(base, leaf, {}, leaf_path);
 }
 
 }  // namespace amc

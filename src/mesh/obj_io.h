@@ -4,6 +4,7 @@
 #include <string>
 
 #include "amc/mesh.h"
+#include "amc/mesh_io.h"
 
 namespace amc {
 

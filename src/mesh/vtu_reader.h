@@ -6,7 +6,7 @@
 #include <string>
 #include <string_view>
 
-#include "amc/mesh.h"
+#include "amc/mesh_io.h"
 
 namespace amc {
 

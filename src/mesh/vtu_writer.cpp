@@ -172,13 +172,6 @@ private:
 
 }  // namespace
 
-std::vector<DataArray> cell_data_arrays(const CellData& cells) {
-    std::vector<DataArray> arrays;
-    if (!cells.level.empty()) arrays.push_back({"level", 1, cells.level});
-    if (!cells.is_green.empty()) arrays.push_back({"green", 1, cells.is_green});
-    return arrays;
-}
-
 std::string format_vtu(const TriangleMesh& mesh, const std::vector<DataArray>& point_data,
                        const std::vector<DataArray>& cell_data, VtuEncoding encoding) {
     static_assert(sizeof(Triangle) == 3 * sizeof(uint32_t), "triangles are three packed indices");

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "amc/mesh.h"
+#include "amc/mesh_io.h"
 
 namespace amc {
 

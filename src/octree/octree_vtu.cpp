@@ -1,6 +1,8 @@
 // The leaves of a forest as VTU cells: VTK_QUAD in 2D, VTK_HEXAHEDRON in 3D, hanging nodes left
 // as they are (ParaView draws them as they come), with the cell arrays "level" and "tree" and the
 // forest's leaf fields.
+#include <amc/mesh_io.h>
+
 #include "common/check.h"
 #include "mesh/vtu_writer.h"
 #include "octree/octree_levels.h"

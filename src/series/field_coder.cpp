@@ -3,6 +3,7 @@
 
 #include "coding/float_coder.h"
 #include "common/bits.h"
+#include "common/exact_float.h"
 #include "common/check.h"
 
 #include <cmath>
@@ -26,8 +27,8 @@ constexpr double kGridLimit = 4611686018427387904.0;  // 2^62: |q| stays far fro
 bool on_grid(double x, double step) { return std::isfinite(x) && std::fabs(x / step) < kGridLimit; }
 int64_t grid_index(double x, double step) { return on_grid(x, step) ? std::llround(x / step) : 0; }
 double grid_value(int64_t q, double step, FieldType type) {
-    const double x = double(q) * step;
-    return type == FieldType::float32 ? double(float(x)) : x;
+    const double x = rounded(double(q) * step);
+    return type == FieldType::float32 ? rounded_to_float(x) : x;
 }
 
 // Integer range of each type (as int64; uint64 holds any bit pattern).
@@ -67,7 +68,7 @@ struct FloatDomain {  // bit-exact float fields: ordered-bit differences (FORMAT
     using V = double;
     Precision precision = Precision::float64;
     static V zero() { return 0.0; }
-    static V mean(V a, V b) { return 0.5 * (a + b); }
+    static V mean(V a, V b) { return rounded(0.5 * (a + b)); }
     static V hybrid(V t, V now, V before) { return t + (now - before); }
     V from_prev(const Field& ref, size_t k) const { return ref.values[k]; }
     int width() const { return precision == Precision::float32 ? 32 : 64; }
@@ -254,7 +255,7 @@ void encode_field(const Field& field, double bound, const FieldFrame& frame, std
     for (int64_t v : field.integers) AMC_REQUIRE(in_range(v, field.type), invalid_input, what + ": a value out of the type's range");
     if (field.type == FieldType::float32)
         for (double v : field.values)
-            AMC_REQUIRE(std::isnan(v) || double(float(v)) == v, invalid_input, what + ": a Float32 value that is not a float");
+            AMC_REQUIRE(std::isnan(v) || rounded_to_float(v) == v, invalid_input, what + ": a Float32 value that is not a float");
 
     const Field* ref = find_reference(frame.prev, field);
     const std::vector<uint32_t> prev_cell =

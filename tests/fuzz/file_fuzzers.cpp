@@ -9,6 +9,7 @@
 #include "mesh/vtu_writer.h"
 
 #include <amc/hierarchy.h>
+#include <amc/mesh_io.h>
 
 #include <cstring>
 #include <string>

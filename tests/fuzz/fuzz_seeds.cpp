@@ -7,6 +7,7 @@
 
 #include "coding/arithmetic_coder.h"
 #include "coding/base_mesh_coder.h"
+#include "coding/coder_switches.h"
 #include "coding/float_coder.h"
 #include "mesh/obj_io.h"
 #include "mesh/off_io.h"
@@ -15,6 +16,7 @@
 #include "../octree_test_util.h"
 
 #include <amc/codec.h>
+#include <amc/mesh_io.h>
 #include <amc/octree.h>
 #include <amc/refinement.h>
 #include <amc/series.h>

@@ -5,6 +5,8 @@
 // bit-exactly to the input in the decoder's order, or on the grid within the reported error.
 #include "fuzz_targets.h"
 
+#include "coding/coder_switches.h"
+
 #include <amc/codec.h>
 #include <amc/refinement.h>
 
