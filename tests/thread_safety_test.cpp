@@ -6,6 +6,9 @@
 #include <amc/codec.h>
 #include <amc/hierarchy_coder.h>
 #include <amc/mesh.h>
+#include <amc/octree.h>
+#include <amc/series.h>
+#include <amc/simulation.h>
 
 #include <algorithm>
 #include <atomic>
@@ -53,6 +56,52 @@ TEST(ThreadSafety, ConcurrentEncodesAndDecodesGiveTheSerialResults) {
                 const std::vector<uint8_t> stream = encode_hierarchy(own);
                 if (decode_hierarchy(own.base(), stream.data(), stream.size()).leaf_count() != own.leaf_count()) ++mismatches;
             }
+        });
+    }
+    for (std::thread& thread : threads) thread.join();
+    EXPECT_EQ(mismatches.load(), 0);
+}
+
+// The series file and the octree coder the same way: one shared file read by every thread (each with
+// a reader of its own: SeriesReader keeps the frame it decoded last), one shared forest encoded by
+// all, and each thread writing a series and a forest of its own.
+TEST(ThreadSafety, ConcurrentSeriesAndOctreeCodingGivesTheSerialResults) {
+    HeatRunOptions run;
+    run.frames = 3;
+    run.max_level = 4;
+    run.target_elements = 150;
+    run.initial_adaptations = 2;
+    std::vector<SeriesFrame> frames;
+    run_heat_simulation(run, [&](const SimulationFrame& f) { frames.push_back({*f.hierarchy, f.time, f.fields}); });
+    auto write_series = [&](const SeriesOptions& options) {
+        SeriesWriter writer(frames.front().hierarchy.base(), options);
+        for (const SeriesFrame& f : frames) writer.add_frame(f.hierarchy, f.time, f.fields);
+        writer.close();
+        return writer.bytes();
+    };
+    const std::vector<uint8_t> series = write_series({});
+    const OctreeForest forest = balance_octree_forest(
+        random_octree_forest(brick_connectivity(3, 2, 1, 1, true), 5, 0.4, 1, 3), OctreeBalance::face);
+    const std::vector<uint8_t> amq = encode_octree_forest(forest);
+    std::atomic<int> mismatches{0};
+    std::vector<std::thread> threads;
+    for (int t = 0; t < kThreads; ++t) {
+        threads.emplace_back([&, t] {
+            SeriesReader reader(series);
+            for (size_t k = frames.size(); k-- > 0;)  // backwards: every frame from its keyframe
+                if (!identical(reader.frame(k).hierarchy, frames[k].hierarchy)) ++mismatches;
+            SeriesOptions own;
+            own.keyframe_interval = uint32_t(1 + t % 2);
+            own.error_bound = t % 2 ? 1e-4 : 0;
+            const std::vector<uint8_t> bytes = write_series(own);
+            SeriesReader own_reader(bytes);
+            if (own_reader.frame_count() != frames.size() || !identical(own_reader.frame(1).hierarchy, frames[1].hierarchy))
+                ++mismatches;
+            if (encode_octree_forest(forest) != amq || !(decode_octree_forest(amq.data(), amq.size()) == forest)) ++mismatches;
+            const OctreeForest mine = balance_octree_forest(
+                random_octree_forest(brick_connectivity(2, 1 + t, 2, 1), uint64_t(t), 0.5, 1, 5), OctreeBalance::face);
+            const std::vector<uint8_t> mine_bytes = encode_octree_forest(mine);
+            if (!(decode_octree_forest(mine_bytes.data(), mine_bytes.size()) == mine)) ++mismatches;
         });
     }
     for (std::thread& thread : threads) thread.join();
