@@ -32,9 +32,10 @@ void print_measures(const amc::TriangleMesh& reference, const amc::MeshShape& in
                     double tolerance) {
     const amc::MeshShape shape = amc::measure_shape(mesh);
     const amc::SurfaceDistance d = amc::surface_distance(reference, mesh, tolerance);
-    std::printf("%zu\t%d\t%u\t%u\t%u\t%u\t%.3g\t%.3f\t%.3e\t%.3e\t%.3e", mesh.triangles.size(),
+    std::printf("%zu\t%d\t%u\t%u\t%u\t%u\t%.3g\t%.3f\t%.3e\t%.3e\t%.3e\t%u\t%.3g", mesh.triangles.size(),
                 int(mesh.single_precision), input.fold_overs, shape.fold_overs, shape.degenerate_triangles,
-                shape.coincident_vertices, shape.min_quality, shape.mean_quality, d.max, d.max_upper, d.rms);
+                shape.coincident_vertices, shape.min_quality, shape.mean_quality, d.max, d.max_upper, d.rms,
+                input.coincident_vertices, input.min_quality);
     for (const amc::OneSidedDistance* side : {&d.to_reference, &d.from_reference})
         std::fprintf(stderr, "  %s: max %.4g at (%.6g, %.6g, %.6g), %llu evaluations\n",
                      side == &d.to_reference ? "to reference" : "from reference", side->max, side->max_point.x,
@@ -42,7 +43,7 @@ void print_measures(const amc::TriangleMesh& reference, const amc::MeshShape& in
 }
 
 const char* kMeasureColumns =
-    "faces\tfloat32\tinput_folds\tfolds\tdegenerate\tcoincident\tmin_quality\tmean_quality\tmax\tmax_upper\trms";
+    "faces\tfloat32\tinput_folds\tfolds\tdegenerate\tcoincident\tmin_quality\tmean_quality\tmax\tmax_upper\trms\tinput_coincident\tinput_min_quality";
 
 }  // namespace
 
@@ -76,7 +77,7 @@ int main(int argc, char** argv) {
     try {
         if (!criterion.empty()) {
             if (header)
-                std::printf("file\tinput_faces\tbase\tbase_attempts\tbase_folds\tasked\t%s\tinherited\tcpu_s\n",
+                std::printf("file\tinput_faces\tbase\tbase_attempts\tbase_folds\tbase_distance\tasked\t%s\tinherited\tcpu_s\n",
                             kMeasureColumns);
             for (const std::string& file : files) {
                 const amc::TriangleMesh reference = amc::read_mesh(file);
@@ -92,8 +93,9 @@ int main(int argc, char** argv) {
                              stats.base_fold_overs, stats.corrected_vertices, stats.simplify_seconds,
                              stats.refine_seconds, stats.correct_seconds);
                 const std::string name = file.substr(file.find_last_of('/') + 1);
-                std::printf("%s\t%zu\t%u\t%u\t%u\t%u\t", name.c_str(), reference.triangles.size(), stats.base_triangles,
-                            stats.base_attempts, stats.base_fold_overs, options.target_faces);
+                std::printf("%s\t%zu\t%u\t%u\t%u\t%.3e\t%u\t", name.c_str(), reference.triangles.size(),
+                            stats.base_triangles, stats.base_attempts, stats.base_fold_overs, stats.base_distance,
+                            options.target_faces);
                 print_measures(reference, input, amc::extract_leaf_mesh(h).mesh, tolerance);
                 std::printf("\t%u\t%.2f\n", stats.inherited_fold_overs, seconds);
                 std::fflush(stdout);

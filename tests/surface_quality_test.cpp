@@ -194,5 +194,35 @@ TEST(ShapeImprovement, RaisesTheWorstQualityAndStaysOnTheSurface) {
     EXPECT_NO_THROW(validate_triangle_mesh(coarse, "improved"));
 }
 
+TEST(ShapeImprovement, UnfoldRemovesFoldOversByTheLeastMove) {
+    // The centre vertex of a flat 4x4 grid dragged across its neighbour at (0.75, 0.5): some of
+    // its triangles turn over (normals opposite to their neighbours', fold-overs).
+    TriangleMesh mesh = make_square(4);
+    uint32_t dragged = 0;
+    for (uint32_t v = 0; v < mesh.positions.size(); ++v)
+        if (mesh.positions[v] == Vec3{0.5, 0.5, 0}) dragged = v;
+    mesh.positions[dragged] = {0.9, 0.55, 0};
+    const TriangleMesh folded = mesh;
+    ASSERT_GT(measure_shape(mesh).fold_overs, 0u);
+    EXPECT_EQ(unfold(mesh, 0.1), 0u);
+    const MeshShape shape = measure_shape(mesh);
+    EXPECT_EQ(shape.fold_overs, 0u);
+    EXPECT_EQ(shape.degenerate_triangles, 0u);
+    EXPECT_EQ(shape.coincident_vertices, 0u);
+    EXPECT_GT(shape.min_quality, 0.0);
+    // Only vertices of fold-overs move, within the plane; the boundary stays.
+    for (size_t v = 0; v < mesh.positions.size(); ++v) {
+        const Vec3 p = folded.positions[v];
+        EXPECT_EQ(mesh.positions[v].z, 0.0);
+        if (p.x == 0 || p.y == 0 || p.x == 1 || p.y == 1) {
+            EXPECT_TRUE(mesh.positions[v] == p);
+        }
+    }
+    // A mesh without fold-overs is left as it is.
+    TriangleMesh flat = make_square(4);
+    EXPECT_EQ(unfold(flat, 0.1), 0u);
+    for (size_t v = 0; v < flat.positions.size(); ++v) EXPECT_TRUE(flat.positions[v] == make_square(4).positions[v]);
+}
+
 }  // namespace
 }  // namespace amc

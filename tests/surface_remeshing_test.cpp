@@ -1,5 +1,5 @@
 // The surface remesher's guarantees (docs/REMESHER.md) on procedural surfaces: no fold-overs
-// beyond those the base inherits, no coincident vertices, the quality bound, the face count, the
+// (even where the reference has its own), no coincident vertices, the quality bound, the face count, the
 // precision, and thin parts kept.
 #include "hierarchy_checks.h"
 
@@ -18,13 +18,26 @@ TriangleMesh thin_disk() {
     return mesh;
 }
 
+// A reference with fold-overs of its own, as scanned meshes have (femur, horse, venus): one vertex
+// of the bumpy sphere dragged across a neighbour, turning some of its triangles over.
+TriangleMesh dragged_vertex() {
+    TriangleMesh mesh = make_bumpy_sphere(4);
+    const uint32_t v = mesh.triangles[100][0], w = mesh.triangles[100][1];
+    mesh.positions[v] = mesh.positions[v] + 1.6 * (mesh.positions[w] - mesh.positions[v]);
+    return mesh;
+}
+
+// A thin tube: a torus whose tube is 1/50 of its size, which a simplifier collapses into
+// "pillows" (two triangles on three vertices) or drops where the base is too coarse for it.
+TriangleMesh thin_tube() { return make_torus(96, 12, 1.0, 0.04); }
+
 struct Case {
     const char* name;
     TriangleMesh reference;
     uint32_t base_triangles, target_faces;
     int max_level;
-    // The thin disk's rim folds over in the reference itself (its float32 z rounding): the base
-    // keeps those folds and the leaf mesh inherits them, with slivers along them.
+    // The reference has fold-overs of its own (the thin disk's rim, from its float32 z rounding;
+    // the dragged vertex): the remesh has none all the same.
     bool reference_folds;
     // Bound of the Hausdorff distance relative to the diagonal. The thin disk is 0.04 thick, 1.4%
     // of its diagonal: a lost sheet would put the other at that distance.
@@ -34,7 +47,9 @@ struct Case {
 std::vector<Case> cases() {
     return {{"bumpy sphere", make_bumpy_sphere(4), 200, 12000, 6, false, 0.015},
             {"torus", make_torus(24, 48, 1.0, 0.3), 300, 12000, 6, false, 0.015},
-            {"thin disk", thin_disk(), 300, 12000, 6, true, 0.007}};
+            {"thin disk", thin_disk(), 300, 12000, 6, true, 0.007},
+            {"dragged vertex", dragged_vertex(), 200, 12000, 6, true, 0.015},
+            {"thin tube", thin_tube(), 60, 12000, 6, false, 0.007}};
 }
 
 // Every leaf triangle's quality against its bound: min(min_quality, a third of its base
@@ -67,20 +82,17 @@ TEST(SurfaceRemeshing, KeepsItsGuarantees) {
         ASSERT_TRUE(testing::hierarchy_is_valid(h));
         const LeafMesh leaf = extract_leaf_mesh(h);
         const MeshShape shape = measure_shape(leaf.mesh);
-        EXPECT_EQ(shape.fold_overs, stats.inherited_fold_overs) << "a fold-over the correction left";
+        // No fold-over at all (so none added to the reference's own), none left in the base.
+        EXPECT_EQ(shape.fold_overs, 0u);
+        EXPECT_LE(shape.fold_overs, stats.reference_fold_overs);
+        EXPECT_EQ(stats.base_fold_overs, 0u);
+        EXPECT_EQ(stats.inherited_fold_overs, 0u);
         EXPECT_EQ(shape.coincident_vertices, 0u);
         EXPECT_EQ(shape.degenerate_triangles, 0u);
         EXPECT_GE(worst_quality_margin(h, leaf, options.min_quality), 0.0);
-        EXPECT_LE(stats.base_fold_overs, stats.reference_fold_overs);
-        if (c.reference_folds) {
-            EXPECT_GT(stats.reference_fold_overs, 0u);
-            EXPECT_GT(stats.base_attempts, 1u) << "the first base folds over more than the reference";
-        } else {
-            EXPECT_EQ(stats.reference_fold_overs, 0u);
-            EXPECT_EQ(stats.inherited_fold_overs, 0u) << "the base folds over";
-            EXPECT_GE(stats.base_min_quality, 0.15) << "the base improvement should reach this";
-            EXPECT_GE(shape.min_quality, 0.05);
-        }
+        EXPECT_GE(shape.min_quality, 0.01);
+        EXPECT_EQ(stats.reference_fold_overs > 0, c.reference_folds);
+        EXPECT_LE(stats.base_distance, 0.01) << "the base misses a part of the reference";
         // --faces counts the conforming leaf mesh's triangles; the last refinement overshoots by
         // a handful.
         EXPECT_EQ(stats.faces, leaf.mesh.triangles.size());

@@ -37,8 +37,11 @@ std::string step_path(const std::string& path, size_t step, const std::string& d
 
 // What the surface remesher did and how close and well-shaped its leaf mesh is (docs/REMESHER.md).
 void print_remesh_report(std::FILE* out, const SurfaceRemeshStats& s, uint32_t asked, bool measured) {
-    std::fprintf(out, "remesh: base %u triangles (%u tried, %u fold-overs), %u leaf-mesh triangles (%u asked), %u vertices corrected\n",
-                 s.base_triangles, s.base_attempts, s.base_fold_overs, s.faces, asked, s.corrected_vertices);
+    std::fprintf(out,
+                 "remesh: base %u triangles (%u tried, %u fold-overs, within %.2e of the input), %u leaf-mesh "
+                 "triangles (%u asked), %u vertices corrected\n",
+                 s.base_triangles, s.base_attempts, s.base_fold_overs, s.base_distance, s.faces, asked,
+                 s.corrected_vertices);
     if (!measured) return;
     std::fprintf(out,
                  "remesh: fold-overs %u (input %u), coincident vertices %u, worst triangle quality %.3g; distance to "

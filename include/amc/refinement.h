@@ -40,7 +40,7 @@ enum class SurfacePrecision { as_reference, float32, float64 };
 
 struct SurfaceRemeshOptions {
     RefinementCriterion criterion = RefinementCriterion::mean_curvature;
-    uint32_t base_triangles = 500;    // target size of the simplified base (doubled while it folds over more than the reference)
+    uint32_t base_triangles = 500;    // target size of the simplified base (others tried if it folds over or misses a thin part)
     uint32_t target_faces = 150000;   // triangles of the conforming leaf mesh to stop at (or just past)
     int max_level = 7;                // 0 .. kMaxLevel
     // Every leaf-mesh triangle gets at least this quality (4 sqrt(3) area / sum of squared
@@ -52,9 +52,12 @@ struct SurfaceRemeshOptions {
 
 struct SurfaceRemeshStats {
     uint32_t base_triangles = 0;
-    uint32_t base_attempts = 0;        // simplifications tried (each with twice the triangles)
+    uint32_t base_attempts = 0;        // simplifications tried (sizes B, 2B, 4B, 8B, B/2, B/4)
     double base_min_quality = 0;       // of the base after shape improvement
     uint32_t base_fold_overs = 0;      // left in the base (thin parts it cannot show)
+    // Largest distance between the base and the reference, both ways (at the reference's vertices
+    // and the base's edge midpoints and centroids), relative to the diagonal.
+    double base_distance = 0;
     uint32_t faces = 0;                // triangles of the conforming leaf mesh
     uint32_t corrected_vertices = 0;   // new vertices moved by the correction
     uint32_t inherited_fold_overs = 0; // fold-overs left where the flat subdivision of the base folds
@@ -71,8 +74,10 @@ struct SurfaceRemeshStats {
     double simplify_seconds = 0, refine_seconds = 0, correct_seconds = 0, measure_seconds = 0;
 };
 
-// Simplifies `reference` to a coarse base (meshoptimizer) and improves its triangles (flips and
-// relaxation on the surface that never move it away from the reference), refines first where the
+// Simplifies `reference` to a coarse base (meshoptimizer; the reference's own triangles kept where
+// the simplified base strays from it by more than 1% of the diagonal, a thin part), improves its
+// triangles (flips and relaxation on the surface that never move it away from the reference) and
+// moves the vertices of any fold-over left until it has none, refines first where the
 // base folds over and then greedily where the criterion is largest (curvature of the reference
 // times element size, or distance of the element's centroid from the reference) until the leaf
 // mesh has `target_faces` triangles, placing every new vertex on the reference (along the
@@ -80,7 +85,8 @@ struct SurfaceRemeshStats {
 // vertices of fold-overs, triangles below the quality bound and coincident vertices: slid along
 // the surface, or stepped back towards their edge midpoints (docs/REMESHER.md). The result has
 // no coincident vertices, no triangle below min(min_quality, a third of its base triangle's
-// quality), and fold-overs only where the base folds over (SurfaceRemeshStats says how many).
+// quality), and fold-overs only where the base folds over (none on every mesh measured;
+// SurfaceRemeshStats::base_fold_overs says how many the base kept).
 // Throws Error if max_level is outside 0..kMaxLevel.
 Hierarchy remesh_adaptively(const TriangleMesh& reference, const SurfaceRemeshOptions& options,
                             SurfaceRemeshStats* stats = nullptr);

@@ -248,6 +248,93 @@ uint32_t Improver::relaxation_pass(const std::vector<uint8_t>& fixed) {
 
 }  // namespace
 
+uint32_t unfold(TriangleMesh& mesh, double min_quality, int rounds) {
+    const std::vector<uint32_t> opposite = opposite_halfedges(mesh);
+    const size_t n = mesh.positions.size();
+    std::vector<uint32_t> start(n + 1, 0), around(3 * mesh.triangles.size());
+    for (const Triangle& t : mesh.triangles)
+        for (uint32_t v : t) ++start[v + 1];
+    for (size_t v = 0; v < n; ++v) start[v + 1] += start[v];
+    {
+        std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+        for (uint32_t t = 0; t < mesh.triangles.size(); ++t)
+            for (uint32_t v : mesh.triangles[t]) around[fill[v]++] = t;
+    }
+    std::vector<uint8_t> on_boundary(n, 0);  // boundary vertices stay: they keep the boundary's shape
+    for (uint32_t h = 0; h < opposite.size(); ++h) {
+        if (opposite[h] != kNone) continue;
+        on_boundary[mesh.triangles[h / 3][h % 3]] = 1;
+        on_boundary[mesh.triangles[h / 3][(h % 3 + 1) % 3]] = 1;
+    }
+    auto normal = [&](uint32_t t) {
+        const Triangle& c = mesh.triangles[t];
+        return cross(mesh.positions[c[1]] - mesh.positions[c[0]], mesh.positions[c[2]] - mesh.positions[c[0]]);
+    };
+    auto folds_at = [&](uint32_t h) {
+        return opposite[h] != kNone && is_fold_over(normal(h / 3), normal(opposite[h] / 3));
+    };
+    // Fold-overs on the edges of the triangles around v, and their worst quality.
+    auto state_around = [&](uint32_t v, int& folds, double& worst) {
+        folds = 0;
+        worst = 1;
+        for (uint32_t i = start[v]; i < start[v + 1]; ++i) {
+            const uint32_t t = around[i];
+            for (int k = 0; k < 3; ++k) folds += folds_at(3 * t + k);
+            const Triangle& c = mesh.triangles[t];
+            worst = std::min(worst, triangle_quality(mesh.positions[c[0]], mesh.positions[c[1]], mesh.positions[c[2]]));
+        }
+    };
+    uint32_t left = 0;
+    for (int round = 0; round < rounds; ++round) {
+        std::vector<uint32_t> candidates;
+        for (uint32_t h = 0; h < opposite.size(); ++h) {
+            if (opposite[h] == kNone || opposite[h] < h || !folds_at(h)) continue;
+            for (uint32_t e : {h, opposite[h]})
+                for (int k = 0; k < 3; ++k) candidates.push_back(mesh.triangles[e / 3][k]);
+        }
+        left = 0;
+        for (uint32_t h = 0; h < opposite.size(); ++h) left += opposite[h] != kNone && opposite[h] > h && folds_at(h);
+        if (left == 0) return 0;
+        std::sort(candidates.begin(), candidates.end());
+        candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+        uint32_t moves = 0;
+        for (uint32_t v : candidates) {
+            if (on_boundary[v]) continue;
+            Vec3 centroid{};
+            double count = 0;
+            for (uint32_t i = start[v]; i < start[v + 1]; ++i) {
+                for (uint32_t w : mesh.triangles[around[i]]) {
+                    if (w == v) continue;
+                    centroid = centroid + mesh.positions[w];
+                    count += 1;
+                }
+            }
+            if (count == 0) continue;
+            centroid = (1 / count) * centroid;
+            const Vec3 p = mesh.positions[v];
+            int folds = 0;
+            double worst = 1;
+            state_around(v, folds, worst);
+            if (folds == 0) continue;
+            for (double f : {0.0625, 0.125, 0.25, 0.5, 0.75, 1.0}) {
+                Vec3 q = p + f * (centroid - p);
+                if (mesh.single_precision) q = {double(float(q.x)), double(float(q.y)), double(float(q.z))};
+                mesh.positions[v] = q;
+                int new_folds = 0;
+                double new_worst = 1;
+                state_around(v, new_folds, new_worst);
+                if (new_folds < folds && new_worst >= std::min(worst, min_quality)) break;
+                mesh.positions[v] = p;
+            }
+            moves += !(mesh.positions[v] == p);
+        }
+        if (moves == 0) break;
+    }
+    left = 0;
+    for (uint32_t h = 0; h < opposite.size(); ++h) left += opposite[h] != kNone && opposite[h] > h && folds_at(h);
+    return left;
+}
+
 std::vector<uint8_t> sharp_vertices(const TriangleMesh& mesh, double degrees) {
     const std::vector<uint32_t> opposite = opposite_halfedges(mesh);
     const double limit = cos_degrees(degrees);

@@ -32,6 +32,14 @@ struct ShapeImprovementStats {
 ShapeImprovementStats improve_shapes(TriangleMesh& mesh, const ReferenceSurface& surface, const TriangleMesh& reference,
                                      const std::vector<uint8_t>& locked, int rounds = 3);
 
+// Moves vertices of fold-overs of `mesh` (not on its boundary) towards the centroid of their neighbours (off the
+// surface: a fold-over of a coarse mesh is a defect of its reference or a part too thin for it),
+// each by the least of 1/16, 1/8, 1/4, 1/2, 3/4 or all of the way that lowers the
+// fold-overs around it and leaves its triangles a quality of at least `min_quality` (or what they
+// had). Rounds until no fold-over is left or none moves; returns the fold-overs left. With
+// mesh.single_precision moved vertices are rounded to float.
+uint32_t unfold(TriangleMesh& mesh, double min_quality, int rounds = 16);
+
 // Per vertex of `mesh`: 1 where two of its incident triangles meet at an edge at more than
 // `degrees` (between their normals): a crease or corner that relaxation must not smooth away.
 std::vector<uint8_t> sharp_vertices(const TriangleMesh& mesh, double degrees);
