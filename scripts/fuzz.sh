@@ -84,7 +84,7 @@ for t in "${targets[@]}"; do
   cpu=$(awk '{printf "%.0f", $1 + $2}' "$build/logs/$t.time")
   elapsed=$(($(date +%s) - start))
   executions=$(grep -o 'stat::number_of_executed_units: [0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
-  last=$(grep -E '^#[0-9]+' "$log" | tail -1)
+  last=$(grep -E '^#[0-9]+' "$log" | tail -1 || true)  # none when the seeds themselves fail
   cov=$(grep -o 'cov: [0-9]*' <<< "$last" | grep -o '[0-9]*' || echo 0)
   ft=$(grep -o 'ft: [0-9]*' <<< "$last" | grep -o '[0-9]*' || echo 0)
   inputs=$(find "$corpus/$t" -type f | wc -l)
@@ -94,7 +94,7 @@ for t in "${targets[@]}"; do
   echo "$(date -u +%FT%TZ) $line" >> "$corpus/fuzz-summary.txt"
   if ((findings > 0)); then
     status=1
-    grep -E 'ERROR|SUMMARY|violated|what\(\)' "$log" | head -5 | sed 's/^/    /'
+    grep -E 'ERROR|SUMMARY|violated|what\(\)' "$log" | head -5 | sed 's/^/    /' || true
   fi
 done
 exit $status
