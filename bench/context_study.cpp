@@ -12,6 +12,7 @@
 #include "coding/hierarchy_level_coder.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdlib>
 #include <cmath>
 #include <cstdio>
@@ -44,27 +45,25 @@ Vec3 unit_normal(const Hierarchy& h, NodeId n) {
     return len > 0 ? (1.0 / len) * x : Vec3{0, 0, 0};
 }
 
-double bend_sum(const Hierarchy& h, NodeId n) {
+// The angles between n's normal and its same-level neighbours' normals (0 where none).
+std::array<double, 3> neighbor_angles(const Hierarchy& h, NodeId n) {
     const Vec3 normal = unit_normal(h, n);
-    double sum = 0;
+    std::array<double, 3> angles{};
     for (int e = 0; e < 3; ++e) {
         const NodeId q = h.neighbor(n, e);
-        if (q == kNoNode) continue;
-        sum += std::acos(std::clamp(dot(normal, unit_normal(h, q)), -1.0, 1.0));
+        if (q != kNoNode) angles[size_t(e)] = std::acos(std::clamp(dot(normal, unit_normal(h, q)), -1.0, 1.0));
     }
-    return sum;
+    return angles;
 }
 
 double bend(const Hierarchy& h, NodeId n) {
-    const Vec3 normal = unit_normal(h, n);
-    double largest = 0;
-    for (int e = 0; e < 3; ++e) {
-        const NodeId q = h.neighbor(n, e);
-        if (q == kNoNode) continue;
-        const double c = std::clamp(dot(normal, unit_normal(h, q)), -1.0, 1.0);
-        largest = std::max(largest, std::acos(c));
-    }
-    return largest;
+    const std::array<double, 3> a = neighbor_angles(h, n);
+    return std::max({a[0], a[1], a[2]});
+}
+
+double bend_sum(const Hierarchy& h, NodeId n) {
+    const std::array<double, 3> a = neighbor_angles(h, n);
+    return a[0] + a[1] + a[2];
 }
 
 // The bin (0..bins-1) of each value among the sorted values of its level.
