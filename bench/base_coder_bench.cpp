@@ -1,4 +1,4 @@
-// base_coder_bench: the base-mesh connectivity coder (src/coding/base_mesh_coder.h) beside Draco's
+// base_coder_bench: the base-mesh connectivity coder (src/coding/base/base_mesh_coder.h) beside Draco's
 // Edgebreaker on plain triangle meshes: connectivity bits per vertex and decode speed in faces per
 // second (median of --runs, one thread). Draco is timed inside DecodeConnectivity() (as in
 // compare_bench), amcodec over the whole decode_base_mesh() call with the positions handed over. See docs/BASE_CODER.md.
@@ -7,7 +7,7 @@
 #include "bench_common.h"
 #include "compare_draco.h"
 
-#include "coding/base_mesh_coder.h"
+#include "coding/base/base_mesh_coder.h"
 
 #include <amc/codec.h>
 #include <amc/hierarchy.h>

@@ -20,8 +20,8 @@
 // of the gap the closing triangle would fill, split tips as "nearest to the predicted vertex"),
 // `angle-deg` (class × degree), `angle-sum` (class × remaining triangles estimated from the
 // angle sum at the vertex).
-#include "coding/arithmetic_coder.h"
-#include "coding/base_mesh_closing.h"
+#include "coding/entropy/arithmetic_coder.h"
+#include "coding/base/base_mesh_closing.h"
 
 #include <amc/mesh.h>
 #include <amc/mesh_io.h>

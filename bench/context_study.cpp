@@ -7,9 +7,9 @@
 //   context_study model.amh ...
 #include <amc/hierarchy.h>
 
-#include "coding/arithmetic_coder.h"
-#include "coding/context_groups.h"
-#include "coding/hierarchy_level_coder.h"
+#include "coding/entropy/arithmetic_coder.h"
+#include "coding/hierarchy/context_groups.h"
+#include "coding/hierarchy/hierarchy_level_coder.h"
 
 #include <algorithm>
 #include <array>

@@ -15,7 +15,7 @@
 // --naive codes the models with the naive (canonical order) traversal instead of the improved
 // one (the default): what the priority order costs to decode.
 #include "bench_common.h"
-#include "coding/hierarchy_level_coder.h"
+#include "coding/hierarchy/hierarchy_level_coder.h"
 
 #include <amc/hierarchy_coder.h>
 

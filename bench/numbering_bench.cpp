@@ -8,7 +8,7 @@
 #include <amc/mesh_io.h>
 #include <amc/numbering.h>
 
-#include "coding/numbering_coder.h"
+#include "coding/numbering/numbering_coder.h"
 
 #include <algorithm>
 #include <cmath>

@@ -14,7 +14,7 @@
 #include <amc/refinement.h>
 #include <amc/simulation.h>
 
-#include "coding/arithmetic_coder.h"
+#include "coding/entropy/arithmetic_coder.h"
 #include "series/frame_connectivity.h"
 
 #include <algorithm>

@@ -1,6 +1,6 @@
 // Tests of the adaptive binary range coder: round trips, efficiency against the ideal adaptive
 // code length and the static entropy, golden bytes, and robustness on truncated/garbage input.
-#include "coding/arithmetic_coder.h"
+#include "coding/entropy/arithmetic_coder.h"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
 // Base mesh connectivity coder (paper II-B): exact round trips over meshes of every topology the
 // coder must handle, compression rates on the shared base meshes, and corrupt streams.
-#include "coding/base_mesh_coder.h"
+#include "coding/base/base_mesh_coder.h"
 
-#include "coding/arithmetic_coder.h"
+#include "coding/entropy/arithmetic_coder.h"
 #include "coding/container.h"
 
 #include <amc/codec.h>

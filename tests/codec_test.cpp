@@ -1,6 +1,6 @@
 // The .amc file: bit-exact round trips, quantization, progressive decoding, corrupt files.
 #include "coding/container.h"
-#include "coding/coder_switches.h"
+#include "coding/hierarchy/coder_switches.h"
 #include "hierarchy_checks.h"
 
 #include <amc/codec.h>

@@ -3,11 +3,11 @@
 // (docs/FORMAT.md, 3.7: every count is checked against the bytes that can hold it before anything
 // is allocated for it). A test binary of its own: it counts every allocation through a global
 // operator new.
-#include "coding/arithmetic_coder.h"
-#include "coding/base_mesh_coder.h"
+#include "coding/entropy/arithmetic_coder.h"
+#include "coding/base/base_mesh_coder.h"
 #include "coding/container.h"
-#include "coding/float_coder.h"
-#include "coding/hierarchy_stream.h"
+#include "coding/geometry/float_coder.h"
+#include "coding/hierarchy/hierarchy_stream.h"
 #include "common/bits.h"
 
 #include <amc/codec.h>

@@ -3,8 +3,8 @@
 // property test over random hierarchies, corrupted in every way the public API allows, with
 // positions anywhere in the double range, float32 and float64, quantized or not; and the known
 // cases one by one.
-#include "coding/coder_switches.h"
-#include "coding/float_coder.h"
+#include "coding/hierarchy/coder_switches.h"
+#include "coding/geometry/float_coder.h"
 #include "hierarchy_checks.h"
 
 #include <amc/codec.h>

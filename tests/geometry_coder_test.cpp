@@ -1,7 +1,7 @@
 // Tests of the coordinate residual coder (float_coder.h) and of the geometry predictions
 // (geometry_prediction.h): bit-exact round trips, code sizes, quantization, corrupt streams.
-#include "coding/float_coder.h"
-#include "coding/geometry_prediction.h"
+#include "coding/geometry/float_coder.h"
+#include "coding/geometry/geometry_prediction.h"
 
 #include <gtest/gtest.h>
 

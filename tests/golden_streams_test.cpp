@@ -7,7 +7,7 @@
 #include "hierarchy_checks.h"
 
 #include "coding/format_version.h"
-#include "coding/hierarchy_stream.h"
+#include "coding/hierarchy/hierarchy_stream.h"
 
 #include <amc/codec.h>
 #include <amc/hierarchy_coder.h>

@@ -7,8 +7,8 @@
 #include "hierarchy_checks.h"
 #include "sha256.h"
 
-#include "coding/base_mesh_coder.h"
-#include "coding/float_coder.h"
+#include "coding/base/base_mesh_coder.h"
+#include "coding/geometry/float_coder.h"
 #include "coding/format_version.h"
 
 #include <amc/codec.h>

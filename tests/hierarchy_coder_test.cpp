@@ -1,7 +1,7 @@
 // The hierarchy coder: exact round trips under every combination of switches, exhaustive small
 // hierarchies, known answers (uniform meshes cost nothing), entropy bound, corrupt streams.
-#include "coding/coder_switches.h"
-#include "coding/hierarchy_level_coder.h"
+#include "coding/hierarchy/coder_switches.h"
+#include "coding/hierarchy/hierarchy_level_coder.h"
 #include "hierarchy_checks.h"
 
 #include <amc/hierarchy_coder.h>

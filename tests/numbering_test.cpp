@@ -4,7 +4,7 @@
 #include <amc/refinement.h>
 
 #include "coding/container.h"
-#include "coding/numbering_coder.h"
+#include "coding/numbering/numbering_coder.h"
 #include "hierarchy_checks.h"
 
 #include <gtest/gtest.h>

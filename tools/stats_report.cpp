@@ -3,7 +3,7 @@
 
 #include <amc/hierarchy_coder.h>
 
-#include "coding/coder_switches.h"
+#include "coding/hierarchy/coder_switches.h"
 
 #include <cstdio>
 

@@ -2,13 +2,13 @@
 // positions of the vertices its refinement creates (docs/FORMAT.md, section 3).
 #include <amc/codec.h>
 
-#include "coding/arithmetic_coder.h"
-#include "coding/base_mesh_coder.h"
+#include "coding/entropy/arithmetic_coder.h"
+#include "coding/base/base_mesh_coder.h"
 #include "coding/container.h"
-#include "coding/float_coder.h"
-#include "coding/geometry_prediction.h"
-#include "coding/hierarchy_level_coder.h"
-#include "coding/numbering_coder.h"
+#include "coding/geometry/float_coder.h"
+#include "coding/geometry/geometry_prediction.h"
+#include "coding/hierarchy/hierarchy_level_coder.h"
+#include "coding/numbering/numbering_coder.h"
 #include "common/check.h"
 #include "hierarchy/writer_checks.h"
 

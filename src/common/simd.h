@@ -1,5 +1,5 @@
 // The one place that chooses the instruction set of the hand-vectorised kernels (forest.cpp and
-// coding/hierarchy_traversal.h): SSE2 where the compiler targets it, else their scalar twins,
+// coding/hierarchy/hierarchy_traversal.h): SSE2 where the compiler targets it, else their scalar twins,
 // which compute the same. AMC_SCALAR (CMake option AMC_SCALAR) forces the scalar twins and the
 // byte-by-byte forms of the little-endian shortcuts, so that CI builds and tests them on x86-64.
 #pragma once

@@ -1,6 +1,6 @@
 // .amq file -> octree forest (docs/FORMAT.md section 8.5): the mirror of octree_encoder.cpp, with
 // every count checked before it is used.
-#include "coding/arithmetic_coder.h"
+#include "coding/entropy/arithmetic_coder.h"
 #include "common/check.h"
 #include "octree/octree_file.h"
 #include "octree/octree_leaf_data.h"

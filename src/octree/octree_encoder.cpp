@@ -1,6 +1,6 @@
 // Octree forest -> .amq file (docs/FORMAT.md section 8): the refinement of every octant, level by
 // level, minus what the rules decide, arithmetic-coded in context groups.
-#include "coding/arithmetic_coder.h"
+#include "coding/entropy/arithmetic_coder.h"
 #include "common/check.h"
 #include "octree/octree_file.h"
 #include "octree/octree_leaf_data.h"

@@ -2,7 +2,7 @@
 #include "octree/octree_leaf_data.h"
 
 #include "coding/container.h"
-#include "coding/float_coder.h"
+#include "coding/geometry/float_coder.h"
 #include "common/check.h"
 
 #include <algorithm>

@@ -1,7 +1,7 @@
 // Fields of a series frame; see field_coder.h and docs/FORMAT.md, section 7.7.
 #include "series/field_coder.h"
 
-#include "coding/float_coder.h"
+#include "coding/geometry/float_coder.h"
 #include "common/bits.h"
 #include "common/exact_float.h"
 #include "common/check.h"

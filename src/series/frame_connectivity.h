@@ -5,7 +5,7 @@
 // neighbourhood change). An unchanged region costs next to nothing.
 #pragma once
 
-#include "coding/arithmetic_coder.h"
+#include "coding/entropy/arithmetic_coder.h"
 
 #include <amc/hierarchy.h>
 

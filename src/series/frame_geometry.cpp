@@ -1,8 +1,8 @@
 // Positions of a series frame; see frame_geometry.h and docs/FORMAT.md, section 7.6.
 #include "series/frame_geometry.h"
 
-#include "coding/float_coder.h"
-#include "coding/geometry_prediction.h"
+#include "coding/geometry/float_coder.h"
+#include "coding/geometry/geometry_prediction.h"
 #include "common/bits.h"
 #include "common/check.h"
 

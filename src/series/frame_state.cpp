@@ -1,7 +1,7 @@
 // Frame state and vertex order of the series coder (frame_state.h).
 #include "series/frame_state.h"
 
-#include "coding/geometry_prediction.h"
+#include "coding/geometry/geometry_prediction.h"
 
 namespace amc {
 

@@ -5,10 +5,10 @@
 //   fuzz_seeds --list                                   the targets' names, one a line
 #include "fuzz_targets.h"
 
-#include "coding/arithmetic_coder.h"
-#include "coding/base_mesh_coder.h"
-#include "coding/coder_switches.h"
-#include "coding/float_coder.h"
+#include "coding/entropy/arithmetic_coder.h"
+#include "coding/base/base_mesh_coder.h"
+#include "coding/hierarchy/coder_switches.h"
+#include "coding/geometry/float_coder.h"
 #include "mesh/obj_io.h"
 #include "mesh/off_io.h"
 #include "mesh/ply_io.h"

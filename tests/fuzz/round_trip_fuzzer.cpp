@@ -5,8 +5,8 @@
 // bit-exactly to the input in the decoder's order, or on the grid within the reported error.
 #include "fuzz_targets.h"
 
-#include "coding/coder_switches.h"
-#include "coding/float_coder.h"
+#include "coding/hierarchy/coder_switches.h"
+#include "coding/geometry/float_coder.h"
 
 #include <amc/codec.h>
 #include <amc/refinement.h>

@@ -3,9 +3,9 @@
 // coordinates. Whatever decodes is encoded again and must decode to the same.
 #include "fuzz_targets.h"
 
-#include "coding/arithmetic_coder.h"
-#include "coding/base_mesh_coder.h"
-#include "coding/float_coder.h"
+#include "coding/entropy/arithmetic_coder.h"
+#include "coding/base/base_mesh_coder.h"
+#include "coding/geometry/float_coder.h"
 
 #include <amc/hierarchy_coder.h>
 #include <amc/refinement.h>

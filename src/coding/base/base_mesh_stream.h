@@ -2,7 +2,7 @@
 // bounded indices and split offsets in one arithmetic-coded payload, and the decoder's error.
 #pragma once
 
-#include "coding/arithmetic_coder.h"
+#include "coding/entropy/arithmetic_coder.h"
 
 #include <amc/mesh.h>
 

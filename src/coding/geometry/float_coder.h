@@ -29,7 +29,7 @@
 // docs/FORMAT.md and pin it with golden bytes before changing it.
 #pragma once
 
-#include "coding/arithmetic_coder.h"
+#include "coding/entropy/arithmetic_coder.h"
 
 #include <amc/mesh.h>
 

@@ -11,9 +11,9 @@
 //   ...     arithmetic-coded payload to the end of the stream
 #pragma once
 
-#include "coding/arithmetic_coder.h"
-#include "coding/coder_switches.h"
-#include "coding/context_groups.h"
+#include "coding/entropy/arithmetic_coder.h"
+#include "coding/hierarchy/coder_switches.h"
+#include "coding/hierarchy/context_groups.h"
 #include "coding/format_version.h"
 
 #include <amc/hierarchy_coder.h>

@@ -1,5 +1,5 @@
 // LZMA-style binary range coder; see arithmetic_coder.h for the bitstream and the model.
-#include "coding/arithmetic_coder.h"
+#include "coding/entropy/arithmetic_coder.h"
 
 #include <cmath>
 #include <string>

@@ -4,8 +4,8 @@
 // same code, so they can not disagree on a context or a gate.
 #pragma once
 
-#include "coding/arithmetic_coder.h"
-#include "coding/base_mesh_stream.h"
+#include "coding/entropy/arithmetic_coder.h"
+#include "coding/base/base_mesh_stream.h"
 #include "common/exact_float.h"
 
 #include <amc/mesh.h>

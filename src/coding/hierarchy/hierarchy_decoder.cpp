@@ -1,6 +1,6 @@
 // Hierarchy decoder: the mirror of hierarchy_encoder.cpp. It grows the forest over the shared base
 // mesh level by level, taking each decision from a rule or from the stream.
-#include "coding/hierarchy_level_coder.h"
+#include "coding/hierarchy/hierarchy_level_coder.h"
 #include "common/check.h"
 #include "common/compiler.h"
 #include "hierarchy/hierarchy_builder.h"

@@ -1,5 +1,5 @@
 // Header of the hierarchy stream (layout in hierarchy_stream.h and docs/FORMAT.md).
-#include "coding/hierarchy_stream.h"
+#include "coding/hierarchy/hierarchy_stream.h"
 
 #include "coding/container.h"
 #include "common/check.h"

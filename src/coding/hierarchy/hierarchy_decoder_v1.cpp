@@ -3,7 +3,7 @@
 // such a stream takes. In a file of its own, so that the decoder's file holds the newest version's
 // traversal only and its fast path is compiled as before version 1 came back (HIERARCHY_CODER.md,
 // Speed, item 34).
-#include "coding/hierarchy_level_coder.h"
+#include "coding/hierarchy/hierarchy_level_coder.h"
 
 namespace amc {
 

@@ -1,9 +1,9 @@
 // Encoder of mode 2, the angle-guided cut-border coder (FORMAT.md 4.10-4.16; base_angle_coder.h).
 // It runs the decoder's border and models (base_angle_border.h) on the closed mesh, reads each op
 // off the mesh and codes it at once; once per context set, keeping the shortest stream.
-#include "coding/base_angle_border.h"
-#include "coding/base_angle_coder.h"
-#include "coding/base_mesh_closing.h"
+#include "coding/base/base_angle_border.h"
+#include "coding/base/base_angle_coder.h"
+#include "coding/base/base_mesh_closing.h"
 
 #include <algorithm>
 

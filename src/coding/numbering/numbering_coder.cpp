@@ -1,9 +1,9 @@
 // The numbering block: permutations coded as ranks among the values not used yet, each relative
 // to the rank that continues the previous value (a caller's order that follows the canonical one
 // costs almost nothing; a random one costs about log2(n!) bits).
-#include "coding/numbering_coder.h"
+#include "coding/numbering/numbering_coder.h"
 
-#include "coding/arithmetic_coder.h"
+#include "coding/entropy/arithmetic_coder.h"
 #include "coding/container.h"
 
 #include <algorithm>

@@ -5,8 +5,8 @@
 // encoder so that tests can make such streams.
 #pragma once
 
-#include "coding/arithmetic_coder.h"
-#include "coding/base_mesh_coder.h"
+#include "coding/entropy/arithmetic_coder.h"
+#include "coding/base/base_mesh_coder.h"
 
 #include <amc/mesh.h>
 

@@ -1,11 +1,11 @@
 // Single-rate coder of the base mesh: the mode dispatch, the explicit mode (FORMAT.md 4.2, 4.8)
 // and the encoder's self-check; see base_mesh_coder.h.
-#include "coding/base_mesh_coder.h"
+#include "coding/base/base_mesh_coder.h"
 
-#include "coding/arithmetic_coder.h"
-#include "coding/base_angle_coder.h"
-#include "coding/base_cut_border_coder.h"
-#include "coding/base_mesh_stream.h"
+#include "coding/entropy/arithmetic_coder.h"
+#include "coding/base/base_angle_coder.h"
+#include "coding/base/base_cut_border_coder.h"
+#include "coding/base/base_mesh_stream.h"
 #include "common/bits.h"
 #include "common/check.h"
 

@@ -1,5 +1,5 @@
 // Fields of the base connectivity stream; see base_mesh_stream.h and FORMAT.md 4.1, 4.6.
-#include "coding/base_mesh_stream.h"
+#include "coding/base/base_mesh_stream.h"
 
 #include "common/bits.h"
 #include "common/check.h"

@@ -21,7 +21,7 @@
 // (BlockEdges). The decoder hands the neighbours on to Hierarchy::split_level as they are.
 #pragma once
 
-#include "coding/context_groups.h"
+#include "coding/hierarchy/context_groups.h"
 #include "coding/format_version.h"
 #include "common/compiler.h"
 #include "common/huge_pages.h"

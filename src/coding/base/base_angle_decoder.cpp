@@ -1,6 +1,6 @@
 // Decoder of mode 2, the angle-guided cut-border coder (FORMAT.md 4.10-4.16; base_angle_coder.h).
-#include "coding/base_angle_border.h"
-#include "coding/base_angle_coder.h"
+#include "coding/base/base_angle_border.h"
+#include "coding/base/base_angle_coder.h"
 
 #include <algorithm>
 #include <string>

@@ -1,7 +1,7 @@
 // Hierarchy encoder: decides every node level by level (hierarchy_traversal.h), chooses the
 // diagonal rule, truncates trailing zeros, and arithmetic codes what is left, one level at a time.
 // Stream layout in docs/FORMAT.md ("hierarchy stream").
-#include "coding/hierarchy_level_coder.h"
+#include "coding/hierarchy/hierarchy_level_coder.h"
 #include "common/check.h"
 #include "hierarchy/hierarchy_builder.h"
 

@@ -1,5 +1,5 @@
 // The closed, manifold version of a base mesh; see base_mesh_closing.h.
-#include "coding/base_mesh_closing.h"
+#include "coding/base/base_mesh_closing.h"
 
 #include <numeric>
 #include <unordered_map>

@@ -15,8 +15,8 @@
 //    predicted: one bit says so.
 #pragma once
 
-#include "coding/arithmetic_coder.h"
-#include "coding/base_mesh_coder.h"
+#include "coding/entropy/arithmetic_coder.h"
+#include "coding/base/base_mesh_coder.h"
 
 #include <amc/mesh.h>
 

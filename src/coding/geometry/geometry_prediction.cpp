@@ -1,6 +1,6 @@
 // Predictions of refinement vertices (midpoint, butterfly) and of base vertices (parallelogram);
 // see geometry_prediction.h.
-#include "coding/geometry_prediction.h"
+#include "coding/geometry/geometry_prediction.h"
 
 #include "common/exact_float.h"
 

@@ -3,9 +3,9 @@
 // one-shot encode_hierarchy / decode_hierarchy of <amc/hierarchy_coder.h> are built on these.
 #pragma once
 
-#include "coding/arithmetic_coder.h"
-#include "coding/hierarchy_stream.h"
-#include "coding/hierarchy_traversal.h"
+#include "coding/entropy/arithmetic_coder.h"
+#include "coding/hierarchy/hierarchy_stream.h"
+#include "coding/hierarchy/hierarchy_traversal.h"
 
 #include <amc/hierarchy_coder.h>
 

@@ -1,7 +1,7 @@
 // Diagonal rules of two-hanging-node closures (paper, section II-B: the orientation bit) and the
 // context-group naming shared by the coder and its statistics.
-#include "coding/context_groups.h"
-#include "coding/hierarchy_level_coder.h"
+#include "coding/hierarchy/context_groups.h"
+#include "coding/hierarchy/hierarchy_level_coder.h"
 
 namespace amc {
 

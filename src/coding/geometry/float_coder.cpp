@@ -1,6 +1,6 @@
 // Residual coding of coordinates (Lindstrom & Isenburg 2006) and the uniform quantizer; see
 // float_coder.h for the bitstream.
-#include "coding/float_coder.h"
+#include "coding/geometry/float_coder.h"
 
 #include "common/bits.h"
 #include "common/exact_float.h"

@@ -3,7 +3,7 @@
 // closed by a *dummy* vertex with a fan of dummy triangles. Encoder side only.
 #pragma once
 
-#include "coding/base_mesh_stream.h"
+#include "coding/base/base_mesh_stream.h"
 
 #include <amc/hierarchy.h>  // kNoVertex
 #include <amc/mesh.h>
