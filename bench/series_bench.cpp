@@ -4,10 +4,15 @@
 // of the raw arrays and zfp (reversible, and at the same absolute bound), round trips frame by
 // frame, random access, and speeds.
 //
-//   series_bench [--scenario lshape|rotating|front] [--frames N] [--target ELEMENTS]
-//                [--max-level L] [--keyframe K] [--bound B] [--repeat R] [--speed-only 1] [--peers 0]
+//   series_bench [--scenario lshape|rotating|front|front-cfl] [--frames N] [--target ELEMENTS]
+//                [--end-time T] [--cfl C] [--max-level L] [--keyframe K] [--bound B] [--repeat R]
+//                [--speed-only 1] [--peers 0] [--per-frame 1]
 // Times are CPU seconds; --speed-only leaves out the peers and the bounded file (for large frames);
-// --peers 0 leaves out zstd, xz and zfp (the costly part), keeping the .amc files.
+// --peers 0 leaves out zstd, xz and zfp (the costly part), keeping the .amc files. --end-time
+// shortens the heat runs' time span (dt = T / frames: smaller output intervals). front-cfl is the
+// front advancing C finest-element sizes a step (a CFL-bounded solver's front), front the model's
+// own step. Every frame's connectivity is compared with the same frame coded alone, binned by the
+// share of nodes that changed (--per-frame 1 lists them one by one).
 #include <amc/codec.h>
 #include <amc/hierarchy_coder.h>
 #include <amc/refinement.h>
@@ -131,10 +136,42 @@ size_t zfp_size(const std::vector<double>& values, double tolerance, double* max
 }
 #endif
 
+// make_moving_front_sequence's front (a circle around (-0.3, -0.2), element size 1.2 times the
+// distance to it, coarsened behind and refined ahead) advancing `advance` a step from radius 0.5.
+Vec3 centroid(const Hierarchy& h, NodeId n) {
+    return (1.0 / 3.0) * (h.position(h.vertex(n, 0)) + h.position(h.vertex(n, 1)) + h.position(h.vertex(n, 2)));
+}
+double diameter(const Hierarchy& h, NodeId n) {
+    double longest = 0;
+    for (int e = 0; e < 3; ++e) {
+        const Vec3 d = h.position(h.vertex(n, e)) - h.position(h.vertex(n, (e + 1) % 3));
+        longest = std::max(longest, dot(d, d));
+    }
+    return std::sqrt(longest);
+}
+std::vector<Hierarchy> front_sequence(int steps, int max_level, double advance) {
+    std::vector<Hierarchy> sequence;
+    Hierarchy h(make_square(8));
+    for (int step = 0; step < steps; ++step) {
+        const double radius = 0.5 + advance * step;
+        auto size_at = [radius](Vec3 x) { return 1.2 * std::fabs(std::hypot(x.x + 0.3, x.y + 0.2) - radius); };
+        for (bool changed = true; changed;) {
+            changed = false;
+            const std::vector<NodeId> order = h.breadth_first_order();
+            for (auto it = order.rbegin(); it != order.rend(); ++it)
+                if (h.is_alive(*it) && !h.is_leaf(*it) && diameter(h, *it) <= size_at(centroid(h, *it)) && h.coarsen(*it))
+                    changed = true;
+        }
+        refine_to_size(h, size_at, max_level);
+        sequence.push_back(h);
+    }
+    return sequence;
+}
+
 double median(std::vector<double> v) {
     if (v.empty()) return 0;
     std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
+    return v.size() % 2 ? v[v.size() / 2] : (v[v.size() / 2 - 1] + v[v.size() / 2]) / 2;
 }
 
 }  // namespace
@@ -143,8 +180,8 @@ int main(int argc, char** argv) {
     std::string scenario = "lshape";
     int frames = 100, max_level = 10, repeat = 3;
     uint32_t target = 20000, keyframe = 0;
-    double bound = 1e-6;
-    bool speed_only = false, peers = true;
+    double bound = 1e-6, end_time = 1.0, cfl = 0.5;
+    bool speed_only = false, peers = true, per_frame = false;
     for (int i = 1; i + 1 < argc; i += 2) {
         const std::string a = argv[i];
         if (a == "--scenario") scenario = argv[i + 1];
@@ -156,6 +193,9 @@ int main(int argc, char** argv) {
         else if (a == "--repeat") repeat = std::atoi(argv[i + 1]);
         else if (a == "--speed-only") speed_only = std::atoi(argv[i + 1]) != 0;
         else if (a == "--peers") peers = std::atoi(argv[i + 1]) != 0;
+        else if (a == "--per-frame") per_frame = std::atoi(argv[i + 1]) != 0;
+        else if (a == "--end-time") end_time = std::atof(argv[i + 1]);
+        else if (a == "--cfl") cfl = std::atof(argv[i + 1]);
         else {
             std::fprintf(stderr, "unknown option %s\n", argv[i]);
             return 2;
@@ -167,12 +207,19 @@ int main(int argc, char** argv) {
     double simulate = now();
     if (scenario == "front") {
         for (Hierarchy& h : make_moving_front_sequence(frames, max_level)) seq.push_back({std::move(h), 0.0, {}});
+    } else if (scenario == "front-cfl") {
+        // The finest element's longest edge: the base square's cells are 1/8 wide.
+        const double finest = std::sqrt(2.0) / 8 / double(1 << max_level);
+        std::printf("front-cfl: the front advances %g a step (%g finest elements of %g); the front model's step is %g\n", cfl * finest,
+                    cfl, finest, 1.0 / std::max(1, frames - 1));
+        for (Hierarchy& h : front_sequence(frames, max_level, cfl * finest)) seq.push_back({std::move(h), 0.0, {}});
     } else {
         HeatRunOptions options;
         options.scenario = scenario == "rotating" ? HeatScenario::rotating : HeatScenario::lshape;
         options.frames = frames;
         options.max_level = max_level;
         options.target_elements = target;
+        options.end_time = end_time;
         run_heat_simulation(options, [&](const SimulationFrame& f) { seq.push_back({*f.hierarchy, f.time, f.fields}); });
     }
     simulate = now() - simulate;
@@ -183,8 +230,8 @@ int main(int argc, char** argv) {
         min_faces = std::min(min_faces, n);
         max_faces = std::max(max_faces, n);
     }
-    std::printf("# series_bench --scenario %s --frames %d --target %u --max-level %d --keyframe %u --bound %g\n\n",
-                scenario.c_str(), frames, target, max_level, keyframe, bound);
+    std::printf("# series_bench --scenario %s --frames %d --target %u --end-time %g --cfl %g --max-level %d --keyframe %u --bound %g\n\n",
+                scenario.c_str(), frames, target, end_time, cfl, max_level, keyframe, bound);
     std::printf("data: %zu frames, %llu-%llu faces a frame (%.0f on average), %zu fields; simulated in %.2f s\n\n",
                 seq.size(), (unsigned long long)min_faces, (unsigned long long)max_faces, double(faces) / seq.size(),
                 seq.front().fields.size(), simulate);
@@ -272,6 +319,11 @@ int main(int argc, char** argv) {
     uint64_t series_conn = 0, series_geom = 0, series_fields = 0, series_bounded_fields = 0;
     double zfp_error = 0;
     std::vector<double> small_change_ratio, changed_share;
+    struct FrameRatio {
+        double share, ratio;
+        bool keyframe;
+    };
+    std::vector<FrameRatio> frame_ratio;
     for (size_t k = 0; k < seq.size(); ++k) {
         const Frame& f = seq[k];
         amc_total += encode(f.h).size();
@@ -303,12 +355,17 @@ int main(int argc, char** argv) {
         if (!bounded_stats.empty()) series_bounded_fields += bounded_stats[k].field_bytes;
         const double share = double(stats[k].changed_nodes) / double(stats[k].nodes);
         if (k > 0) changed_share.push_back(share);  // frame 0 against the unrefined base is no change
-        if (!stats[k].keyframe && share <= 0.05) {
+        if (k > 0) {
+            // Every frame after the first against the same frame coded alone (what a keyframe's
+            // forest costs), whether the encoder coded it against the frame before or alone.
             const uint64_t intra = encode_hierarchy(f.h).size();
-            small_change_ratio.push_back(double(stats[k].connectivity_bytes) / double(intra));
-            std::printf("frame %zu: %.2f%% of the nodes changed, connectivity %llu bytes, alone %llu bytes (%.1f%%)\n", k,
-                        100 * share, (unsigned long long)stats[k].connectivity_bytes, (unsigned long long)intra,
-                        100 * small_change_ratio.back());
+            const double ratio = double(stats[k].connectivity_bytes) / double(intra);
+            frame_ratio.push_back({share, ratio, stats[k].keyframe});
+            if (share <= 0.05) small_change_ratio.push_back(ratio);
+            if (per_frame)
+                std::printf("frame %zu: %.2f%% of the nodes changed, connectivity %llu bytes%s, alone %llu bytes (%.1f%%)\n", k,
+                            100 * share, (unsigned long long)stats[k].connectivity_bytes, stats[k].keyframe ? " (keyframe)" : "",
+                            (unsigned long long)intra, 100 * ratio);
         }
     }
     const double n = double(seq.size());
@@ -377,11 +434,32 @@ int main(int argc, char** argv) {
     std::sort(sorted_share.begin(), sorted_share.end());
     std::printf("\nchanged nodes per frame: median %.2f%%, max %.2f%%\n", 100 * median(changed_share),
                 100 * sorted_share.back());
+    // The distribution over every frame: connectivity in the series against the frame alone, by the
+    // share of nodes changed since the frame before.
+    std::printf("\nconnectivity against the same frame coded alone (encode_hierarchy), frames 1..%zu by share of nodes "
+                "changed:\n\n| changed | frames | keyframes | median | max | above 15%% |\n|---|---:|---:|---:|---:|---:|\n",
+                seq.size() - 1);
+    const double edges[] = {0, 0.01, 0.025, 0.05, 0.10, 0.20, 0.50, 1e300};
+    const char* labels[] = {"<= 1%", "1-2.5%", "2.5-5%", "5-10%", "10-20%", "20-50%", "> 50%"};
+    for (int b = 0; b < 7; ++b) {
+        std::vector<double> r;
+        int keyframes = 0, above = 0;
+        for (const FrameRatio& f : frame_ratio)
+            if (f.share > (b == 0 ? -1.0 : edges[b]) && f.share <= edges[b + 1]) {
+                r.push_back(f.ratio);
+                keyframes += f.keyframe;
+                above += f.ratio > 0.15;
+            }
+        if (r.empty()) continue;
+        std::printf("| %s | %zu | %d | %.1f%% | %.1f%% | %d |\n", labels[b], r.size(), keyframes, 100 * median(r),
+                    100 * *std::max_element(r.begin(), r.end()), above);
+    }
     if (!small_change_ratio.empty()) {
         std::sort(small_change_ratio.begin(), small_change_ratio.end());
         std::printf("frames with <= 5%% of the nodes changed: %zu; their connectivity against the same frame coded alone "
-                    "(encode_hierarchy): median %.1f%%, max %.1f%%\n",
-                    small_change_ratio.size(), 100 * median(small_change_ratio), 100 * small_change_ratio.back());
+                    "(encode_hierarchy): median %.1f%%, max %.1f%%, %zu above 15%%\n",
+                    small_change_ratio.size(), 100 * median(small_change_ratio), 100 * small_change_ratio.back(),
+                    size_t(std::count_if(small_change_ratio.begin(), small_change_ratio.end(), [](double r) { return r > 0.15; })));
     }
     std::printf("independent .amc files / series file: %.2fx (mesh alone: .amc / (connectivity + positions) = %.2fx)\n",
                 double(amc_total) / double(series.size()), double(amc_total) / double(series_conn + series_geom));
