@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # `amc series` and the series paths of encode, decode and info: a run of frames to .amcs and back
 # through a ParaView collection, one frame by random access, exit codes 0/1/2, -f, -q, default
-# names, truncated and foreign files.
+# names, truncated and foreign files; series of forests (.amq frames).
 # Usage: cli_series.sh AMC
 set -u
 amc=$1
@@ -32,7 +32,7 @@ grep -q '3 keyframes' out.txt || fail "--keyframe 2 over 6 frames did not make 3
 grep -q 'field green' out.txt || fail "the VTU cell data did not become fields"
 expect 0 "$amc" series encode front_0.pvd --base base.vtu -o chosen.amcs --keyframe 2
 expect 0 "$amc" series info chosen.amcs
-grep -q 'amc series version 2' out.txt || fail "series info does not give the version: $(head -c 300 out.txt)"
+grep -q 'amc series version 3' out.txt || fail "series info does not give the version: $(head -c 300 out.txt)"
 # Without --base: the base found in the first frame.
 expect 0 "$amc" series encode front_0.pvd -o nobase.amcs
 expect 0 "$amc" series info nobase.amcs
@@ -90,5 +90,24 @@ grep -q 'expected a series' err.txt || fail "a hierarchy given to series info is
 echo "not a series" > junk.amcs
 expect 1 "$amc" series info junk.amcs
 expect 1 "$amc" extract key.amcs -o e.ply
+
+# Forests (.amq frames) -> a forest series; one frame back as .amq (the same bytes as the input),
+# all frames as a collection of VTU files; info; a bound refused; a forest series cut short.
+expect 0 "$amc" octree make --dim 2 --model front --level 6 --trees 2x1 -o q0.amq
+expect 0 "$amc" octree make --dim 2 --model front --level 7 --trees 2x1 -o q1.amq
+expect 0 "$amc" octree make --dim 2 --model sphere --level 7 --trees 2x1 -o q2.amq
+expect 0 "$amc" series encode q0.amq q1.amq q2.amq q1.amq -o forests.amcs
+grep -q '4 forest frames' out.txt || fail "series encode of .amq frames does not report 4 forest frames: $(head -c 300 out.txt)"
+expect 0 "$amc" series decode forests.amcs --frame 2 -o back2.amq
+cmp -s q2.amq back2.amq || fail "frame 2 of the forest series is not the .amq file it came from"
+expect 0 "$amc" series decode forests.amcs -o forests.pvd
+[[ -s forests_3.vtu && $(grep -c '<DataSet' forests.pvd) == 4 ]] || fail "forest series decode wrote no collection of 4 VTU files"
+expect 0 "$amc" series info forests.amcs
+grep -q '2D forests of 2 trees' out.txt || fail "series info does not describe the forests: $(head -c 300 out.txt)"
+expect 2 "$amc" series encode q0.amq q1.amq -o bounded.amcs --error-bound 0.1
+expect 2 "$amc" series encode q0.amq front_1.amh -o mixed.amcs
+head -c 200 forests.amcs > cutf.amcs
+expect 1 "$amc" series decode cutf.amcs -o cutf.pvd
+grep -q 'truncated' err.txt || fail "a truncated forest series is not called truncated: $(head -c 200 err.txt)"
 
 finish cli_series

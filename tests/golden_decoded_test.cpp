@@ -1,5 +1,6 @@
 // What the golden files decode to, pinned by hash (tests/data/golden-decoded.sha256): the hierarchy
-// of every .amc file as an .amh byte string, and every frame of the series file with its fields.
+// of every .amc file as an .amh byte string, and every frame of the series file with its fields
+// (a forest series: its leaves and leaf fields).
 // The hashes were made by the reference build (GCC, no floating-point flags); a build with other
 // flags (CI: -ffp-contract=fast -O3 -march=native) that decodes one bit differently fails here,
 // whatever its procedural models compute. AMC_UPDATE_GOLDEN=1 writes the list when it is missing.
@@ -35,7 +36,29 @@ std::string read_bytes(const std::string& path) {
 void append_raw(std::string& out, const void* data, size_t size) { out.append(static_cast<const char*>(data), size); }
 
 // Every frame: its hierarchy (.amh bytes), its time and its fields, values bit for bit.
+// A forest series: every frame's trees and leaves, its time and its leaf fields.
+std::string decoded_forest_series(const std::string& bytes, const std::string& what) {
+    ForestSeriesReader reader(std::vector<uint8_t>(bytes.begin(), bytes.end()), what);
+    std::string out;
+    for (size_t k = 0; k < reader.frame_count(); ++k) {
+        const ForestSeriesFrame frame = reader.frame(k);
+        append_raw(out, frame.forest.tree_offsets.data(), frame.forest.tree_offsets.size() * sizeof(uint64_t));
+        for (const Octant& o : frame.forest.leaves) {
+            const int32_t leaf[4] = {o.x, o.y, o.z, o.level};
+            append_raw(out, leaf, sizeof leaf);
+        }
+        append_raw(out, &frame.time, sizeof frame.time);
+        for (const Field& f : frame.forest.leaf_data) {
+            out += f.name;
+            append_raw(out, f.values.data(), f.values.size() * sizeof(double));
+            append_raw(out, f.integers.data(), f.integers.size() * sizeof(int64_t));
+        }
+    }
+    return out;
+}
+
 std::string decoded_series(const std::string& bytes, const std::string& what) {
+    if (is_forest_series(std::vector<uint8_t>(bytes.begin(), bytes.end()))) return decoded_forest_series(bytes, what);
     SeriesReader reader(std::vector<uint8_t>(bytes.begin(), bytes.end()), what);
     std::string out;
     for (size_t k = 0; k < reader.frame_count(); ++k) {

@@ -1,12 +1,14 @@
 // `amc series encode | decode | info`: time series of adaptive meshes with their fields (.amcs,
-// docs/SERIES.md), from and to ParaView collections (.pvd + one VTU per frame). `amc encode` of a
-// .pvd (or with --series), `amc decode` and `amc info` of an .amcs file come here too.
+// docs/SERIES.md), from and to ParaView collections (.pvd + one VTU per frame), and series of
+// quadtree/octree forests from and to .amq (or p4est) files, one a frame. `amc encode` of a .pvd
+// (or with --series), `amc decode` and `amc info` of an .amcs file come here too.
 #include "cli_files.h"
 #include "commands.h"
 #include "progress.h"
 
 #include <amc/import.h>
 #include <amc/mesh_io.h>
+#include <amc/octree.h>
 #include <amc/series.h>
 
 #include <algorithm>
@@ -15,6 +17,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -120,6 +124,169 @@ std::string frame_file(const std::string& pvd, size_t k) {
     return fs::path(pvd).stem().string() + "_" + std::to_string(k) + ".vtu";
 }
 
+// ---- forest series -----------------------------------------------------------------------------
+
+// A frame file of a forest series: an .amq file or (with AMC_WITH_P4EST) a p4est_save file.
+bool is_forest_input(const std::string& path) {
+    const std::string ext = lower_extension(path);
+    return ext == ".amq" || ext == ".p4est";
+}
+
+OctreeForest read_forest_frame(const std::string& path) {
+    try {
+        if (lower_extension(path) == ".p4est") return read_p4est_file(path);
+        std::ifstream in(path, std::ios::binary);
+        if (!in) throw Error(ErrorCode::io, "can not open");
+        const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        return decode_octree_forest(bytes.data(), bytes.size());
+    } catch (const Error& e) {
+        throw e.prefixed(path);
+    }
+}
+
+void encode_forest_series(const std::vector<FrameSource>& sources, const std::string& output, const SeriesOptions& options,
+                          const GlobalOptions& global) {
+    if (options.error_bound > 0 || !options.field_bounds.empty())
+        throw UsageError("series encode: forest leaf data are coded bit-exact (no --error-bound or --field-bound)");
+    Progress progress(global.verbosity > 0);
+    std::unique_ptr<ForestSeriesWriter> writer;
+    std::vector<ForestSeriesFrameStats> stats;
+    double encode_seconds = 0;
+    for (size_t k = 0; k < sources.size(); ++k) {
+        progress.phase("frame " + std::to_string(k) + " of " + std::to_string(sources.size()) + ": " + sources[k].path);
+        if (!is_forest_input(sources[k].path))
+            throw UsageError("series encode: " + sources[k].path + " is not a forest (.amq, .p4est) like the first frame");
+        const OctreeForest forest = read_forest_frame(sources[k].path);
+        const auto start = std::chrono::steady_clock::now();
+        if (!writer) writer = std::make_unique<ForestSeriesWriter>(forest.connectivity, options);
+        try {
+            stats.push_back(writer->add_frame(forest, sources[k].time));
+        } catch (const Error& e) {
+            throw e.prefixed(sources[k].path + " (frame " + std::to_string(k) + ")");
+        }
+        encode_seconds += seconds_since(start);
+    }
+    writer->close();
+    const std::vector<uint8_t>& bytes = writer->bytes();
+    write_output(output, std::string(bytes.begin(), bytes.end()), global.force);
+    progress.finish();
+    if (global.verbosity == 0) return;
+    std::FILE* out = output == "-" ? stderr : stdout;
+    uint64_t connectivity = 0, fields = 0, leaves = 0, keyframes = 0;
+    for (const ForestSeriesFrameStats& s : stats) {
+        connectivity += s.connectivity_bytes;
+        fields += s.field_bytes;
+        leaves += s.leaves;
+        keyframes += s.keyframe;
+    }
+    std::fprintf(out, "%s: %zu forest frames (%lu keyframe%s), %lu bytes, %.0f bytes a frame (%.0f leaves a frame)\n",
+                 output == "-" ? "stdout" : output.c_str(), stats.size(), (unsigned long)keyframes, keyframes == 1 ? "" : "s",
+                 (unsigned long)bytes.size(), double(bytes.size()) / double(stats.size()), double(leaves) / double(stats.size()));
+    std::fprintf(out, "  forests %lu bytes (%.4f bits/leaf), leaf fields %lu; encode %.3f s (%.1f frames/s)\n",
+                 (unsigned long)connectivity, 8.0 * double(connectivity) / double(leaves), (unsigned long)fields, encode_seconds,
+                 double(stats.size()) / encode_seconds);
+    if (global.verbosity > 1)
+        for (size_t k = 0; k < stats.size(); ++k)
+            std::fprintf(out, "  frame %5zu %4s %10lu bytes, forest %8lu, fields %10lu, %9lu leaves, %9lu changed octants\n", k,
+                         stats[k].keyframe ? "key" : "", (unsigned long)stats[k].bytes, (unsigned long)stats[k].connectivity_bytes,
+                         (unsigned long)stats[k].field_bytes, (unsigned long)stats[k].leaves, (unsigned long)stats[k].changed_octants);
+}
+
+ForestSeriesReader open_forest_series(const InputFile& input, bool allow_unfinished, uint64_t max_nodes) {
+    SeriesReadOptions options;
+    options.allow_unfinished = allow_unfinished;
+    if (max_nodes > 0) options.max_nodes = max_nodes;
+    return ForestSeriesReader(std::vector<uint8_t>(input.bytes.begin(), input.bytes.end()), input.name, options);
+}
+
+ForestSeriesFrame decode_forest_frame(ForestSeriesReader& reader, size_t k, const std::string& name) {
+    try {
+        return reader.frame(k);
+    } catch (const Error& e) {
+        throw e.prefixed(name);
+    }
+}
+
+// Frame k's forest beside the collection: run.pvd -> run_<k>.vtu.
+void write_forest_frame(const std::string& path, const OctreeForest& forest, bool force) {
+    const std::string ext = lower_extension(path);
+    if (ext == ".vtu") write_octree_vtu(path, forest);
+    else if (ext == ".p4est") write_p4est_file(path, forest);
+    else {
+        const std::vector<uint8_t> bytes = encode_octree_forest(forest);
+        write_output(path, std::string(bytes.begin(), bytes.end()), force);
+    }
+}
+
+void decode_forest_series(const InputFile& input, const SeriesDecodeCommand& command, const GlobalOptions& global) {
+    if (command.level >= 0) throw UsageError("series decode: --level is for triangle series (decode a frame to .amq, then amc octree decode --level)");
+    const bool one_frame = command.frame >= 0;
+    std::string output = command.output;
+    if (output.empty())
+        output = one_frame ? default_output(command.input, "") + "_" + std::to_string(command.frame) + ".amq"
+                           : default_output(command.input, ".pvd");
+    const std::string ext = lower_extension(output);
+    if (output == "-" || !(is_pvd(output) || (one_frame && (ext == ".amq" || ext == ".vtu" || ext == ".p4est"))))
+        throw UsageError(std::string("series decode of forests writes a collection (.pvd + one VTU a frame)") +
+                         (one_frame ? " or the frame's forest (.amq .vtu .p4est)" : "") + ", not " + output);
+    ForestSeriesReader reader = open_forest_series(input, command.allow_unfinished, command.max_nodes);
+    if (one_frame && uint64_t(command.frame) >= reader.frame_count())
+        throw Error(input.name + ": frame " + std::to_string(command.frame) + " requested but the file has frames 0.." +
+                    std::to_string(int64_t(reader.frame_count()) - 1));
+    const fs::path dir = fs::path(output).parent_path();
+    if (!global.force) {
+        refuse_existing(output);
+        if (is_pvd(output))
+            for (size_t k = 0; k < reader.frame_count(); ++k) refuse_existing((dir / frame_file(output, k)).string());
+    }
+    if (one_frame) {
+        write_forest_frame(output, decode_forest_frame(reader, size_t(command.frame), input.name).forest, global.force);
+    } else {
+        std::vector<PvdEntry> entries;
+        for (size_t k = 0; k < reader.frame_count(); ++k) {
+            const ForestSeriesFrame frame = decode_forest_frame(reader, k, input.name);
+            write_octree_vtu((dir / frame_file(output, k)).string(), frame.forest);
+            entries.push_back({frame.time, frame_file(output, k)});
+        }
+        write_pvd(output, entries);
+    }
+    if (global.verbosity > 0)
+        std::printf("%s: %s -> %s\n", input.name.c_str(), one_frame ? ("frame " + std::to_string(command.frame)).c_str() : "every frame",
+                    output.c_str());
+}
+
+void forest_series_info(const InputFile& input, const SeriesInfoCommand& command) {
+    ForestSeriesReader reader = open_forest_series(input, command.allow_unfinished, command.max_nodes);
+    const TreeConnectivity& conn = reader.connectivity();
+    size_t keyframes = 0;
+    for (size_t k = 0; k < reader.frame_count(); ++k) keyframes += reader.info(k).keyframe;
+    std::printf("%s: amc series version %d, %dD forests of %u trees, %zu frames, %lu bytes; %zu keyframes (interval %s, and the "
+                "encoder's choices); %s\n",
+                input.name.c_str(), reader.version(), conn.dim, conn.tree_count(), reader.frame_count(), (unsigned long)input.bytes.size(),
+                keyframes, reader.keyframe_interval() ? std::to_string(reader.keyframe_interval()).c_str() : "none",
+                reader.finished() ? "finished"
+                                  : ("unfinished (" + std::to_string(reader.ignored_bytes()) + " bytes of an incomplete frame ignored)").c_str());
+    if (command.frame >= 0 && uint64_t(command.frame) >= reader.frame_count())
+        throw Error(input.name + ": frame " + std::to_string(command.frame) + " requested but the file has frames 0.." +
+                    std::to_string(int64_t(reader.frame_count()) - 1));
+    const size_t described = command.frame >= 0 ? size_t(command.frame) : 0;
+    ForestSeriesFrame shown;
+    for (size_t k = 0; k < reader.frame_count(); ++k) {
+        ForestSeriesFrame frame = decode_forest_frame(reader, k, input.name);
+        if (k == described) shown = std::move(frame);
+    }
+    std::printf("  decodes: yes\n  %5s %12s %4s %10s %10s %10s %10s %6s\n", "frame", "time", "key", "offset", "bytes", "octants",
+                "leaves", "levels");
+    for (size_t k = 0; k < reader.frame_count(); ++k) {
+        const ForestSeriesFrameInfo& f = reader.info(k);
+        std::printf("  %5zu %12.6g %4s %10lu %10lu %10lu %10lu %6d\n", k, f.time, f.keyframe ? "yes" : "", (unsigned long)f.offset,
+                    (unsigned long)f.size, (unsigned long)f.octants, (unsigned long)f.leaves, f.levels);
+    }
+    if (reader.frame_count() == 0) return;
+    std::printf("  leaf fields of frame %zu:%s\n", described, shown.forest.leaf_data.empty() ? " none" : "");
+    for (const Field& f : shown.forest.leaf_data) std::printf("    %s\n", field_summary(f).c_str());
+}
+
 }  // namespace
 
 bool is_pvd(const std::string& path) { return lower_extension(path) == ".pvd"; }
@@ -137,9 +304,14 @@ void run_series_encode(const SeriesEncodeCommand& command, const GlobalOptions& 
     options.error_bound = command.error_bound;
     for (const std::string& b : command.field_bounds) options.field_bounds.push_back(parse_field_bound(b));
 
+    const std::vector<FrameSource> sources = frame_sources(command.inputs);
+    if (!sources.empty() && is_forest_input(sources.front().path)) {
+        if (!command.base.empty()) throw UsageError("series encode: --base is for triangle frames; forests carry their trees");
+        encode_forest_series(sources, output, options, global);
+        return;
+    }
     Progress progress(global.verbosity > 0);
     progress.phase("reading " + command.inputs.front());
-    const std::vector<FrameSource> sources = frame_sources(command.inputs);
     std::optional<TriangleMesh> base;
     if (!command.base.empty()) base = mesh_of(read_input(command.base));
     std::unique_ptr<SeriesWriter> writer;
@@ -218,6 +390,8 @@ void run_series_encode(const SeriesEncodeCommand& command, const GlobalOptions& 
 }
 
 void run_series_decode(const InputFile& input, const SeriesDecodeCommand& command, const GlobalOptions& global) {
+    if (input.kind == FileKind::series && is_forest_series(std::vector<uint8_t>(input.bytes.begin(), input.bytes.end())))
+        return decode_forest_series(input, command, global);
     const bool one_frame = command.frame >= 0;
     std::string output = command.output;
     if (output.empty())
@@ -284,6 +458,8 @@ void run_series_decode(const InputFile& input, const SeriesDecodeCommand& comman
 }
 
 void run_series_info(const InputFile& input, const SeriesInfoCommand& command, const GlobalOptions&) {
+    if (input.kind == FileKind::series && is_forest_series(std::vector<uint8_t>(input.bytes.begin(), input.bytes.end())))
+        return forest_series_info(input, command);
     SeriesReader reader = open_series(input, command.allow_unfinished, command.max_nodes);
     const TriangleMesh& base = reader.base();
     size_t keyframes = 0;

@@ -7,6 +7,7 @@
 
 #include <amc/field.h>
 #include <amc/hierarchy.h>
+#include <amc/octree.h>
 
 #include <cstdint>
 #include <cstdio>
@@ -175,5 +176,101 @@ SeriesFrame frame_from_vtu(const TriangleMesh& base, const VtuMesh& vtu, double 
 // fields belong to the leaf mesh) with its fields as point and cell data, plus the cell arrays
 // "level" and "green" unless the frame has fields of those names.
 VtuMesh vtu_from_frame(const SeriesFrame& frame, int max_level = -1);
+
+}  // namespace amc
+
+namespace amc {
+
+// ---- series of quadtree/octree forests (src/series/forest_series.cpp, FORMAT.md 7.10-7.12) -----
+// The same file (.amcs, version 3) with a coarse mesh of trees instead of a base mesh: each frame
+// a forest over it (OctreeForest) with its leaf data as fields, coded against the previous
+// frame's forest and fields, keyframes as in SeriesOptions (error bounds are for triangle series
+// only: forest fields are bit-exact).
+
+struct ForestSeriesFrameStats {
+    bool keyframe = false;
+    uint64_t bytes = 0, connectivity_bytes = 0, field_bytes = 0;
+    uint64_t octants = 0, leaves = 0;
+    uint64_t changed_octants = 0;  // octants added or removed since the previous frame
+    std::vector<FieldStats> fields;
+};
+
+class ForestSeriesWriter {
+public:
+    explicit ForestSeriesWriter(const TreeConnectivity& conn, const SeriesOptions& options = {});
+    // Appends to a file (created or truncated), each frame flushed as it is added.
+    ForestSeriesWriter(const std::string& path, const TreeConnectivity& conn, const SeriesOptions& options = {});
+    ~ForestSeriesWriter();
+    ForestSeriesWriter(const ForestSeriesWriter&) = delete;
+    ForestSeriesWriter& operator=(const ForestSeriesWriter&) = delete;
+
+    // A forest over the series' connectivity (validate_octree_forest), its leaf data the frame's
+    // fields. Throws Error (invalid_input) naming the problem; the series is unchanged then.
+    ForestSeriesFrameStats add_frame(const OctreeForest& forest, double time);
+    void close();  // the END block
+    uint64_t frame_count() const { return frames_; }
+    const std::vector<uint8_t>& bytes() const { return bytes_; }  // in memory only
+
+private:
+    struct State;
+    void write(const std::vector<uint8_t>& data);
+    std::unique_ptr<State> state_;
+    SeriesOptions options_;
+    std::vector<uint8_t> bytes_;
+    std::FILE* file_ = nullptr;
+    std::string path_;
+    uint64_t frames_ = 0;
+    bool closed_ = false;
+};
+
+struct ForestSeriesFrame {
+    OctreeForest forest;  // leaf_data: the frame's fields
+    double time = 0;
+};
+
+struct ForestSeriesFrameInfo {
+    uint64_t offset = 0, size = 0;
+    bool keyframe = false;
+    double time = 0;
+    uint64_t octants = 0, leaves = 0;
+    int levels = 0;
+};
+
+class ForestSeriesReader {
+public:
+    // Checks the framing of the whole file, as SeriesReader. max_nodes limits octants per frame.
+    ForestSeriesReader(std::vector<uint8_t> bytes, const std::string& what = "series", const SeriesReadOptions& options = {});
+    static ForestSeriesReader open(const std::string& path, const SeriesReadOptions& options = {});
+    ~ForestSeriesReader();
+    ForestSeriesReader(ForestSeriesReader&&) noexcept;
+
+    const TreeConnectivity& connectivity() const;
+    size_t frame_count() const { return frames_.size(); }
+    const ForestSeriesFrameInfo& info(size_t k) const { return frames_.at(k); }
+    bool finished() const { return finished_; }
+    uint64_t ignored_bytes() const { return ignored_; }
+    uint32_t keyframe_interval() const { return keyframe_interval_; }
+    int version() const { return version_; }
+    // Decodes from the last keyframe at or before k (or the frame decoded last). Throws Error
+    // naming the frame; std::out_of_range for k >= frame_count().
+    ForestSeriesFrame frame(size_t k);
+
+private:
+    struct State;
+    void decode_next(size_t k);
+    std::vector<uint8_t> bytes_;
+    std::string what_;
+    SeriesReadOptions options_;
+    std::vector<ForestSeriesFrameInfo> frames_;
+    std::unique_ptr<State> state_;
+    bool finished_ = false;
+    uint64_t ignored_ = 0;
+    uint32_t keyframe_interval_ = 0;
+    int version_ = 0;
+};
+
+// Whether a series file holds forests (its first block is a forest base block); false for
+// anything else, a triangle series or not a series at all.
+bool is_forest_series(const std::vector<uint8_t>& bytes);
 
 }  // namespace amc

@@ -63,6 +63,31 @@ int refine_context_v2(const NodeContext& c) {
             std::min(c.decided_changed, 2)) * 2 + int(c.parent_area);
 }
 
+// Version 3: fresh refine models (the first type-3 frame after a keyframe) start from what the
+// class and the indicator predict, so that a small frame does not pay for learning it: a node
+// below its threshold (or a leaf without indicator) most likely not refined, one above it (or a
+// refined node without indicator) most likely refined, near the threshold less sure; class 0
+// even. The prior weighs as much as kPriorWeight symbols seen.
+constexpr uint16_t kPriorWeight = 1;
+
+uint32_t refine_prior(int cls, int x) {
+    constexpr uint32_t sure = uint32_t{1} << 26, unsure = uint32_t{1} << 30;  // 1/64, 1/4
+    if (cls == 0) return uint32_t{1} << 31;
+    if (x == 0) return cls == 1 ? sure : ~sure;
+    if (x >= 8) return x <= 9 ? ~unsure : ~sure;  // level at or above the threshold (13: infinite)
+    return x >= 6 ? unsure : sure;                // below it (1: zero)
+}
+
+void prime_refine_models(FrameConnectivityModels& models) {
+    constexpr int per_indicator = 3 * 3 * 2;
+    for (size_t ctx = 0; ctx < models.refine.size(); ++ctx) {
+        const int x = int(ctx / per_indicator) % FrameConnectivityModels::kIndicatorContexts;
+        const int cls = int(ctx / (per_indicator * FrameConnectivityModels::kIndicatorContexts));
+        models.refine[ctx].p = refine_prior(cls, x);
+        models.refine[ctx].n = cls == 0 ? 0 : kPriorWeight;
+    }
+}
+
 // The distance of a node's indicator level to its class's threshold, in 12 steps (FORMAT.md 7.6).
 int indicator_context(const Indicator& indicator, NodeId p, int cls) {
     const int32_t level = indicator.levels[p];
@@ -80,6 +105,10 @@ void code_forest(const Hierarchy& prev, int version, ConnectivityMemory& memory,
                  Io& io, uint64_t max_nodes, Hierarchy& out, Counterparts& cp, FrameConnectivityStats* stats) {
     FrameConnectivityModels fresh;
     FrameConnectivityModels& models = version >= 2 ? memory.models : fresh;
+    if (version >= 3 && !memory.primed) {
+        prime_refine_models(models);
+        memory.primed = true;
+    }
     std::vector<uint8_t> state;
     const uint32_t roots = out.root_count();
     cp.assign(roots, kNoNode);

@@ -43,6 +43,7 @@ struct FrameConnectivityModels {
 // What the connectivity of a frame carries to the next one (version 2): its models.
 struct ConnectivityMemory {
     FrameConnectivityModels models;
+    bool primed = false;  // version 3: the fresh refine models were given their prior (FORMAT.md 7.6)
 };
 
 struct FrameConnectivityStats {

@@ -11,8 +11,7 @@
 #include "series/frame_geometry.h"
 #include "series/frame_state.h"
 #include "series/series_format.h"
-
-#include <xxhash.h>
+#include "series/series_framing.h"
 
 #include <cmath>
 #include <cstring>
@@ -23,31 +22,11 @@ namespace amc {
 
 namespace {
 
-void put_u32(std::vector<uint8_t>& out, uint32_t v) {
-    for (int i = 0; i < 4; ++i) out.push_back(uint8_t(v >> (8 * i)));
-}
-uint32_t get_u32(const uint8_t* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
+void put_u32(std::vector<uint8_t>& out, uint32_t v) { put_series_u32(out, v); }
+uint32_t get_u32(const uint8_t* p) { return get_series_u32(p); }
 
 std::vector<uint8_t> block(SeriesBlock type, const std::vector<uint8_t>& payload) {
-    AMC_REQUIRE(payload.size() <= 0xFFFFFFFFu, limit_exceeded, "series: a frame of more than 4 GiB");
-    std::vector<uint8_t> out;
-    out.reserve(payload.size() + kSeriesBlockOverhead);
-    out.push_back(uint8_t(type));
-    put_u32(out, uint32_t(payload.size()));
-    out.insert(out.end(), payload.begin(), payload.end());
-    put_u32(out, XXH32(out.data(), out.size(), 0));
-    return out;
-}
-
-std::vector<uint8_t> header(bool single_precision, uint32_t keyframe_interval) {
-    std::vector<uint8_t> out(kSeriesMagic, kSeriesMagic + 4);
-    out.push_back(kSeriesVersion);
-    out.push_back(single_precision ? kSeriesFlagSinglePrecision : 0);
-    out.push_back(0);
-    out.push_back(0);
-    put_u32(out, keyframe_interval);
-    put_u32(out, XXH32(out.data(), 12, 0));
-    return out;
+    return series_block(uint8_t(type), payload);
 }
 
 std::vector<uint8_t> base_payload(const TriangleMesh& base) {
@@ -170,7 +149,7 @@ SeriesWriter::SeriesWriter(const TriangleMesh& base, const SeriesOptions& option
         AMC_REQUIRE(field_bound.second >= 0 && std::isfinite(field_bound.second), invalid_input,
                     "series: the error bound of field \"" + name + "\" must be finite and >= 0");
     }
-    std::vector<uint8_t> start = header(base.single_precision, options.keyframe_interval);
+    std::vector<uint8_t> start = series_header(kSeriesVersion, base.single_precision ? kSeriesFlagSinglePrecision : 0, options.keyframe_interval);
     const std::vector<uint8_t> b = block(SeriesBlock::base, base_payload(base));
     start.insert(start.end(), b.begin(), b.end());
     bytes_ = std::move(start);
@@ -355,82 +334,42 @@ struct SeriesReader::State {
 
 SeriesReader::SeriesReader(std::vector<uint8_t> bytes, const std::string& what, const SeriesReadOptions& options)
     : bytes_(std::move(bytes)), what_(what), options_(options), state_(new State) {
-    const uint8_t* data = bytes_.data();
-    const size_t size = bytes_.size();
-    AMC_REQUIRE(size >= 4 && std::memcmp(data, kSeriesMagic, 4) == 0, bad_magic, what + ": not an amcodec series file (magic)");
-    AMC_REQUIRE(size >= 5, truncated, what + ": truncated header");
-    AMC_REQUIRE(data[4] != 0, corrupt, what + ": unknown series version 0");
-    AMC_REQUIRE(data[4] <= kNewestSeriesVersion, unsupported_version,
-                what + ": unsupported series version " + std::to_string(data[4]) +
-                    " (newer than this build, which reads version 1 to " + std::to_string(kNewestSeriesVersion) + ")");
-    AMC_REQUIRE(size >= kSeriesHeaderSize, truncated, what + ": truncated header");
-    AMC_REQUIRE(XXH32(data, 12, 0) == get_u32(data + 12), checksum, what + ": checksum mismatch in the header");
-    AMC_REQUIRE((data[5] & ~kSeriesFlagSinglePrecision) == 0 && data[6] == 0 && data[7] == 0, corrupt,
-                what + ": reserved header bits set");
-    version_ = data[4];
-    keyframe_interval_ = get_u32(data + 8);
-    const bool single = data[5] & kSeriesFlagSinglePrecision;
-
-    size_t pos = kSeriesHeaderSize;
-    bool have_base = false;
-    while (true) {
-        if (pos == size) {
-            AMC_REQUIRE(options.allow_unfinished, truncated,
-                        what + ": unfinished series: no END block after " + std::to_string(frames_.size()) +
-                            " complete frames (the writer did not close it; read with allow_unfinished / --partial)");
-            break;
-        }
-        const bool fits = size - pos >= kSeriesBlockOverhead &&
-                          get_u32(data + pos + 1) <= size - pos - kSeriesBlockOverhead;
-        if (!fits) {
-            AMC_REQUIRE(options.allow_unfinished && have_base, truncated,
-                        what + ": truncated in " + (have_base ? "frame " + std::to_string(frames_.size()) : std::string("the base mesh block")) +
-                            " at byte " + std::to_string(pos) + " (" + std::to_string(frames_.size()) +
-                            " complete frames before it" + (have_base ? "; read them with allow_unfinished / --partial)" : ")"));
-            ignored_ = size - pos;
-            break;
-        }
-        const uint8_t type = data[pos];
-        const uint32_t length = get_u32(data + pos + 1);
-        AMC_REQUIRE(XXH32(data + pos, 5 + size_t(length), 0) == get_u32(data + pos + 5 + length), checksum,
-                    what + ": checksum mismatch in the block at byte " + std::to_string(pos) +
-                        (have_base ? " (frame " + std::to_string(frames_.size()) + ")" : std::string()));
-        const uint8_t* payload = data + pos + 5;
-        AMC_REQUIRE(type <= uint8_t(SeriesBlock::frame), corrupt,
-                    what + ": unknown block type " + std::to_string(type) + " at byte " + std::to_string(pos));
-        const SeriesBlock kind = SeriesBlock(type);
-        if (!have_base) {
+    const SeriesScan scan = scan_series_file(bytes_, what, options.allow_unfinished, kSeriesFlagSinglePrecision,
+                                             uint8_t(SeriesBlock::forest_frame));
+    version_ = scan.version;
+    keyframe_interval_ = scan.keyframe_interval;
+    finished_ = scan.finished;
+    ignored_ = scan.ignored;
+    const bool single = scan.flags & kSeriesFlagSinglePrecision;
+    for (const SeriesBlockView& b : scan.blocks) {
+        const SeriesBlock kind = SeriesBlock(b.type);
+        AMC_REQUIRE(!is_forest_block(kind), corrupt,
+                    what + ": a series of quadtree/octree forests (read it with ForestSeriesReader, or amc series decode)");
+        if (&b == &scan.blocks.front()) {
             AMC_REQUIRE(kind == SeriesBlock::base, corrupt, what + ": the first block is not the base mesh");
             try {
-                state_->base = read_base(payload, length, single, what);
+                state_->base = read_base(b.payload, b.length, single, what);
             } catch (const Error& e) {
                 if (std::string(e.what()).rfind(what, 0) == 0) throw;
                 throw e.prefixed(what);
             }
-            have_base = true;
-        } else if (kind == SeriesBlock::end) {
-            AMC_REQUIRE(length == 0, corrupt, what + ": END block with a payload");
-            AMC_REQUIRE(pos + kSeriesBlockOverhead == size, corrupt, what + ": bytes after the END block");
-            finished_ = true;
-            break;
-        } else {
-            AMC_REQUIRE(kind != SeriesBlock::base, corrupt, what + ": a second base mesh block");
-            AMC_REQUIRE(kind == SeriesBlock::keyframe || !frames_.empty(), corrupt, what + ": frame 0 is not a keyframe");
-            PayloadReader in(payload, length, "frame header");
-            const std::string frame_what = what + ": frame " + std::to_string(frames_.size());
-            const FrameHeader fh = read_frame_header(in, state_->base.positions.size(), state_->base.triangles.size(), frame_what);
-            SeriesFrameInfo info;
-            info.offset = pos;
-            info.size = length + kSeriesBlockOverhead;
-            info.keyframe = kind == SeriesBlock::keyframe;
-            info.time = fh.time;
-            info.nodes = fh.nodes;
-            info.vertices = fh.vertices;
-            info.faces = fh.faces;
-            info.levels = int(fh.levels);
-            frames_.push_back(info);
+            continue;
         }
-        pos += kSeriesBlockOverhead + length;
+        AMC_REQUIRE(kind != SeriesBlock::base, corrupt, what + ": a second base mesh block");
+        AMC_REQUIRE(kind == SeriesBlock::keyframe || !frames_.empty(), corrupt, what + ": frame 0 is not a keyframe");
+        PayloadReader in(b.payload, b.length, "frame header");
+        const std::string frame_what = what + ": frame " + std::to_string(frames_.size());
+        const FrameHeader fh = read_frame_header(in, state_->base.positions.size(), state_->base.triangles.size(), frame_what);
+        SeriesFrameInfo info;
+        info.offset = b.offset;
+        info.size = b.length + kSeriesBlockOverhead;
+        info.keyframe = kind == SeriesBlock::keyframe;
+        info.time = fh.time;
+        info.nodes = fh.nodes;
+        info.vertices = fh.vertices;
+        info.faces = fh.faces;
+        info.levels = int(fh.levels);
+        frames_.push_back(info);
     }
 }
 

@@ -1,0 +1,97 @@
+// Series file framing (docs/FORMAT.md 7.1-7.2).
+#include "series/series_framing.h"
+
+#include "common/check.h"
+#include "series/series_format.h"
+
+#include <xxhash.h>
+
+#include <cstring>
+
+namespace amc {
+
+void put_series_u32(std::vector<uint8_t>& out, uint32_t v) {
+    for (int i = 0; i < 4; ++i) out.push_back(uint8_t(v >> (8 * i)));
+}
+
+uint32_t get_series_u32(const uint8_t* p) {
+    return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+}
+
+std::vector<uint8_t> series_header(uint8_t version, uint8_t flags, uint32_t keyframe_interval) {
+    std::vector<uint8_t> out(kSeriesMagic, kSeriesMagic + 4);
+    out.push_back(version);
+    out.push_back(flags);
+    out.push_back(0);
+    out.push_back(0);
+    put_series_u32(out, keyframe_interval);
+    put_series_u32(out, XXH32(out.data(), 12, 0));
+    return out;
+}
+
+std::vector<uint8_t> series_block(uint8_t type, const std::vector<uint8_t>& payload) {
+    AMC_REQUIRE(payload.size() <= 0xFFFFFFFFu, limit_exceeded, "series: a frame of more than 4 GiB");
+    std::vector<uint8_t> out;
+    out.reserve(payload.size() + kSeriesBlockOverhead);
+    out.push_back(type);
+    put_series_u32(out, uint32_t(payload.size()));
+    out.insert(out.end(), payload.begin(), payload.end());
+    put_series_u32(out, XXH32(out.data(), out.size(), 0));
+    return out;
+}
+
+SeriesScan scan_series_file(const std::vector<uint8_t>& bytes, const std::string& what, bool allow_unfinished,
+                            uint8_t allowed_flags, uint8_t max_type) {
+    const uint8_t* data = bytes.data();
+    const size_t size = bytes.size();
+    AMC_REQUIRE(size >= 4 && std::memcmp(data, kSeriesMagic, 4) == 0, bad_magic, what + ": not an amcodec series file (magic)");
+    AMC_REQUIRE(size >= 5, truncated, what + ": truncated header");
+    AMC_REQUIRE(data[4] != 0, corrupt, what + ": unknown series version 0");
+    AMC_REQUIRE(data[4] <= kNewestSeriesVersion, unsupported_version,
+                what + ": unsupported series version " + std::to_string(data[4]) +
+                    " (newer than this build, which reads version 1 to " + std::to_string(kNewestSeriesVersion) + ")");
+    AMC_REQUIRE(size >= kSeriesHeaderSize, truncated, what + ": truncated header");
+    AMC_REQUIRE(XXH32(data, 12, 0) == get_series_u32(data + 12), checksum, what + ": checksum mismatch in the header");
+    AMC_REQUIRE((data[5] & ~allowed_flags) == 0 && data[6] == 0 && data[7] == 0, corrupt, what + ": reserved header bits set");
+    SeriesScan scan;
+    scan.version = data[4];
+    scan.flags = data[5];
+    scan.keyframe_interval = get_series_u32(data + 8);
+    size_t pos = kSeriesHeaderSize;
+    while (true) {
+        const bool have_base = !scan.blocks.empty();
+        const size_t frames = have_base ? scan.blocks.size() - 1 : 0;
+        if (pos == size) {
+            AMC_REQUIRE(allow_unfinished, truncated,
+                        what + ": unfinished series: no END block after " + std::to_string(frames) +
+                            " complete frames (the writer did not close it; read with allow_unfinished / --partial)");
+            break;
+        }
+        const bool fits = size - pos >= kSeriesBlockOverhead && get_series_u32(data + pos + 1) <= size - pos - kSeriesBlockOverhead;
+        if (!fits) {
+            AMC_REQUIRE(allow_unfinished && have_base, truncated,
+                        what + ": truncated in " + (have_base ? "frame " + std::to_string(frames) : std::string("the base block")) +
+                            " at byte " + std::to_string(pos) + " (" + std::to_string(frames) + " complete frames before it" +
+                            (have_base ? "; read them with allow_unfinished / --partial)" : ")"));
+            scan.ignored = size - pos;
+            break;
+        }
+        const uint8_t type = data[pos];
+        const uint32_t length = get_series_u32(data + pos + 1);
+        AMC_REQUIRE(XXH32(data + pos, 5 + size_t(length), 0) == get_series_u32(data + pos + 5 + length), checksum,
+                    what + ": checksum mismatch in the block at byte " + std::to_string(pos) +
+                        (have_base ? " (frame " + std::to_string(frames) + ")" : std::string()));
+        AMC_REQUIRE(type <= max_type, corrupt, what + ": unknown block type " + std::to_string(type) + " at byte " + std::to_string(pos));
+        if (type == uint8_t(SeriesBlock::end) && have_base) {
+            AMC_REQUIRE(length == 0, corrupt, what + ": END block with a payload");
+            AMC_REQUIRE(pos + kSeriesBlockOverhead == size, corrupt, what + ": bytes after the END block");
+            scan.finished = true;
+            break;
+        }
+        scan.blocks.push_back({type, pos, data + pos + 5, length});
+        pos += kSeriesBlockOverhead + length;
+    }
+    return scan;
+}
+
+}  // namespace amc

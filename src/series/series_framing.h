@@ -1,0 +1,44 @@
+// The framing of the series file (docs/FORMAT.md 7.1-7.2), shared by the triangle and the forest
+// series: the header, checksummed blocks, and the scan a reader makes of the whole file before it
+// decodes anything.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace amc {
+
+void put_series_u32(std::vector<uint8_t>& out, uint32_t v);
+uint32_t get_series_u32(const uint8_t* p);
+
+// The 16-byte header of a file of `version`.
+std::vector<uint8_t> series_header(uint8_t version, uint8_t flags, uint32_t keyframe_interval);
+// One block: type, length, payload, XXH32 of the three.
+std::vector<uint8_t> series_block(uint8_t type, const std::vector<uint8_t>& payload);
+
+struct SeriesBlockView {
+    uint8_t type;
+    size_t offset;  // of the block in the file
+    const uint8_t* payload;
+    uint32_t length;
+};
+
+struct SeriesScan {
+    uint8_t version = 0, flags = 0;
+    uint32_t keyframe_interval = 0;
+    std::vector<SeriesBlockView> blocks;  // the base block, then the frames (the END block left out)
+    bool finished = false;                // the END block is there
+    uint64_t ignored = 0;                 // bytes of an incomplete block at the end (allow_unfinished)
+};
+
+// Checks the header (magic, version, checksum, reserved bits; `allowed_flags` may be set) and the
+// length and checksum of every block, in order, up to the END block (empty, last). Block types
+// beyond `max_type` are refused; what the blocks hold is the caller's. An incomplete last block or
+// a missing END block is refused (truncated) unless `allow_unfinished`, and then only after the
+// first block. Throws Error naming `what`.
+SeriesScan scan_series_file(const std::vector<uint8_t>& bytes, const std::string& what, bool allow_unfinished,
+                            uint8_t allowed_flags, uint8_t max_type);
+
+}  // namespace amc
