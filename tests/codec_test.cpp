@@ -372,14 +372,14 @@ std::string decode_error(const std::vector<uint8_t>& bytes) {
 TEST(Codec, NewerVersionIsRefusedClearly) {
     Hierarchy h(make_icosahedron());
     std::vector<uint8_t> bytes = encode(h);
-    ASSERT_EQ(bytes[4], kAngleBaseVersion);  // its base is in connectivity mode 2
+    ASSERT_EQ(bytes[4], kSearchedBaseVersion);  // its base is in connectivity mode 2
     bytes[4] = kNewestVersion + 1;
     const std::string newer = "unsupported .amc version " + std::to_string(kNewestVersion + 1) +
                               " (newer than this build, which reads versions 1 to " + std::to_string(kNewestVersion) + ")";
     EXPECT_EQ(decode_error(bytes), newer);
     bytes[4] = 0;
     EXPECT_EQ(decode_error(bytes), "unknown .amc version 0");
-    bytes[4] = kAngleBaseVersion;
+    bytes[4] = kSearchedBaseVersion;
     EXPECT_EQ(decode_error(bytes), "");
 }
 

@@ -6,6 +6,7 @@
 #include "coding/base/base_mesh_closing.h"
 
 #include <algorithm>
+#include <iterator>
 
 namespace amc {
 
@@ -16,8 +17,9 @@ namespace {
 
 class Encoder {
 public:
-    Encoder(const TriangleMesh& mesh, const ClosedMesh& cm, int set, uint32_t gate_radius)
-        : mesh_(mesh), cm_(cm), set_(set), models_(set) {
+    Encoder(const TriangleMesh& mesh, const ClosedMesh& cm, int set, uint32_t gate_radius, uint32_t first,
+            uint32_t rotation)
+        : mesh_(mesh), cm_(cm), set_(set), first_(first), rotation_(rotation), models_(set) {
         border_.gate_radius = gate_radius;
     }
 
@@ -49,6 +51,7 @@ private:
     const TriangleMesh& mesh_;
     const ClosedMesh& cm_;
     const int set_;
+    const uint32_t first_, rotation_;  // the first component's start triangle and its first corner
     uint32_t used_ = 0, copies_ = 0, components_ = 0, merges_ = 0, merges_seen_ = 0;
     ArithmeticEncoder enc_;
     Models models_;
@@ -187,19 +190,22 @@ private:
         final_of_original_.assign(mesh_.positions.size(), kNoVertex);
         processed_.assign(cm_.triangles.size(), 0);
         border_.reserve(cm_.original.size(), cm_.original.size() + cm_.original.size() / 8 + 16);
-        for (uint32_t s = 0; s < cm_.real_triangles; ++s) {
+        for (uint32_t i = 0; i < cm_.real_triangles; ++i) {
+            // The first component starts at the chosen triangle, the others at their first in input order.
+            const uint32_t s = i == 0 ? first_ : i <= first_ ? i - 1 : i;
             if (processed_[s]) continue;
+            const uint32_t r = i == 0 ? rotation_ : 0;
             ++components_;
             const Triangle& st = cm_.triangles[s];
-            const uint32_t a = create_vertex(st[0], false);
-            const uint32_t b = create_vertex(st[1], false);
-            const uint32_t c = create_vertex(st[2], false);
-            visit_triangle(3 * s);
+            const uint32_t a = create_vertex(st[r], false);
+            const uint32_t b = create_vertex(st[(r + 1) % 3], false);
+            const uint32_t c = create_vertex(st[(r + 2) % 3], false);
+            visit_triangle(3 * s + r);
             border_.start(a, b, c);
             const uint32_t na = border_.top().gate, nc = border_.next(na), nb = border_.next(nc);
-            track(na, cm_.twin[3 * s + 2]);
-            track(nc, cm_.twin[3 * s + 1]);
-            track(nb, cm_.twin[3 * s + 0]);
+            track(na, cm_.twin[3 * s + (r + 2) % 3]);
+            track(nc, cm_.twin[3 * s + (r + 1) % 3]);
+            track(nb, cm_.twin[3 * s + r]);
             while (!border_.stack.empty()) {
                 if (triangles_.size() >= cm_.triangles.size()) throw EncoderGaveUp{};
                 encode_op();
@@ -346,26 +352,65 @@ private:
     }
 };
 
-// Gates are looked for within 5 nodes of a closed vertex: measured best for size
-// (docs/BASE_CODER.md); the decoder accepts 0-7.
-constexpr uint32_t kGateRadius = 5;
+// The encoder's search (FORMAT.md 4.16): the stream is written from several start triangles
+// with several gate radii, each with every context set, and the shortest is kept. The decoder
+// reads whichever was chosen. Measured (docs/BASE_CODER.md): 3-12 % on the coarse bases.
+// The first candidate is what version 4's encoder wrote.
+constexpr uint32_t kSearchStarts = 16;                          // start triangles spread over the input order
+constexpr uint32_t kSearchRadii[] = {5, 3, 4, 6, 7};            // 5 first: the best single radius
+constexpr uint64_t kSearchBudget = uint64_t{1} << 20;           // closed triangles coded in all, about 0.15 s
+
+struct Start {
+    uint32_t first, rotation, radius;
+};
+
+// The candidates in the order they are tried, as many as the budget allows (at least one: the
+// first triangle in input order, radius 5).
+std::vector<Start> search_candidates(uint32_t real_triangles, size_t closed_triangles) {
+    const uint64_t per_candidate = uint64_t(angle_mode::kContextSets) * std::max<size_t>(closed_triangles, 1);
+    // A mesh too large to try every radius from one start is written as from the first start
+    // alone: on the large meshes the search gained nothing (docs/BASE_CODER.md).
+    uint64_t allowed = kSearchBudget / per_candidate;
+    if (allowed < std::size(kSearchRadii)) allowed = 1;
+    std::vector<Start> out;
+    for (uint32_t k = 0; k < kSearchStarts; ++k) {
+        const uint32_t first = static_cast<uint32_t>(uint64_t{k} * real_triangles / kSearchStarts);
+        if (k > 0 && first == out.back().first) break;  // fewer triangles than starts
+        for (uint32_t rotation = 0; rotation < 3; ++rotation)
+            for (uint32_t radius : kSearchRadii) {
+                if (out.size() == allowed) return out;
+                out.push_back({first, rotation, radius});
+            }
+    }
+    return out;
+}
 
 }  // namespace
 
-std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code) {
+std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, bool search) {
     const ClosedMesh cm = make_closed(mesh);
     std::vector<uint8_t> best;
-    for (int set = 0; set < angle_mode::kContextSets; ++set) {
-        BaseMeshCode candidate;
-        Encoder e(mesh, cm, set, kGateRadius);
-        std::vector<uint8_t> bytes = e.run(candidate);
-        if (best.empty() || bytes.size() < best.size()) {
-            best = std::move(bytes);
-            code.vertex_order = std::move(candidate.vertex_order);
-            code.triangle_order = std::move(candidate.triangle_order);
-            code.triangle_rotation = std::move(candidate.triangle_rotation);
+    std::vector<Start> candidates = search_candidates(cm.real_triangles, cm.triangles.size());
+    if (!search) candidates.resize(1);
+    for (const Start& start : candidates) {
+        for (int set = 0; set < angle_mode::kContextSets; ++set) {
+            BaseMeshCode candidate;
+            std::vector<uint8_t> bytes;
+            try {
+                Encoder e(mesh, cm, set, start.radius, start.first, start.rotation);
+                bytes = e.run(candidate);
+            } catch (const EncoderGaveUp&) {
+                continue;  // this start does not fit (a walk over the budget, say): try the others
+            }
+            if (best.empty() || bytes.size() < best.size()) {
+                best = std::move(bytes);
+                code.vertex_order = std::move(candidate.vertex_order);
+                code.triangle_order = std::move(candidate.triangle_order);
+                code.triangle_rotation = std::move(candidate.triangle_rotation);
+            }
         }
     }
+    if (best.empty()) throw EncoderGaveUp{};
     return best;
 }
 

@@ -72,12 +72,12 @@ bool reproduces(const TriangleMesh& mesh, const BaseMeshCode& code, const Decode
 
 // Codes with one mode and checks the stream by decoding it with the mesh's own positions;
 // false when the mode does not fit the mesh.
-bool try_mode(const TriangleMesh& mesh, BaseConnectivityMode mode, BaseMeshCode& code) {
+bool try_mode(const TriangleMesh& mesh, BaseConnectivityMode mode, BaseMeshCode& code, bool search = true) {
     try {
         code = BaseMeshCode{};
         code.mode = mode;
         switch (mode) {
-            case BaseConnectivityMode::angle: code.bytes = encode_angle_mode(mesh, code); break;
+            case BaseConnectivityMode::angle: code.bytes = encode_angle_mode(mesh, code, search); break;
             case BaseConnectivityMode::cut_border: code.bytes = encode_cut_border(mesh, code); break;
             case BaseConnectivityMode::explicit_triangles: code.bytes = encode_explicit(mesh, code); break;
         }
@@ -116,10 +116,10 @@ BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh) {
     return code;
 }
 
-BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh, BaseConnectivityMode mode) {
+BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh, BaseConnectivityMode mode, bool search) {
     check_encodable(mesh);
     BaseMeshCode code;
-    if (!try_mode(mesh, mode, code))
+    if (!try_mode(mesh, mode, code, search))
         throw Error("base mesh coder: the mesh does not fit mode " + std::to_string(int(mode)));
     return code;
 }

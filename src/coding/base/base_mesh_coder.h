@@ -49,8 +49,9 @@ struct BaseMeshCode {
 BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh);
 
 // The same with one given mode (tests and benchmarks); throws Error when the mesh does not fit
-// it (the explicit mode always fits).
-BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh, BaseConnectivityMode mode);
+// it (the explicit mode always fits). Without `search`, mode 2 starts at the first input triangle
+// with gate radius 5 alone: the stream format version 4's encoder wrote (FORMAT.md 4.16).
+BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh, BaseConnectivityMode mode, bool search = true);
 
 // The decoder's source of base positions: the position of decoder vertex `vertex`, whose
 // stencil is `stencil`, given the positions of vertices 0 .. vertex-1 in `decoded`. Called once
