@@ -65,6 +65,9 @@ struct Event {
     uint32_t length = 0;                  // of the current loop
     double gap_u = -1, gap_v = -1;        // degrees in [0, 360); -1 with a dummy involved
     double angle_sum_u = 0;               // of the decoded triangles at u
+    double bend_u = 2, bend_v = 2;        // least cosine between the closing triangle's normal and those behind it (2: unknown)
+    double ratio_u = -1, ratio_v = -1;    // closing edge length over the mean of the two border edges
+    double pdist_u = -1, pdist_v = -1;    // squared distance of the R (L) tip from the parallelogram, over |u - v|^2
     uint32_t offset_range = 0;            // split or merge offsets
     int nearest_rank = -1;                // split tip among the loop by distance to the prediction
     uint32_t sector_range = 0;            // splits: choices for the tip's two sectors
@@ -174,6 +177,25 @@ private:
         const double a = angle_between(position_[other] - position_[at], position_[t] - position_[at]);
         return amc::dot(behind, closing) > 0 ? a : 360 - a;
     }
+    // Triangle (u, v, t) closing the gap at u, between the decoded triangles (v, u, o1) behind
+    // u -> v and (u, t, o2) behind t -> u: the smaller cosine of its normal with theirs, and its
+    // edge v - t over the mean of u - v and u - t.
+    void closing_shape(uint32_t u, uint32_t v, uint32_t t, uint32_t o1, uint32_t o2, double& bend, double& ratio) const {
+        bend = 2;
+        ratio = -1;
+        if (!(located_[u] && located_[v] && located_[t])) return;
+        const Vec3 pu = position_[u], pv = position_[v], pt = position_[t];
+        const Vec3 nc = amc::cross(pv - pu, pt - pu);
+        auto cosine = [&](uint32_t a, uint32_t b, uint32_t o) {
+            if (!located_[o]) return 2.0;
+            const Vec3 n = amc::cross(position_[b] - position_[a], position_[o] - position_[a]);
+            const double d = std::sqrt(amc::dot(n, n) * amc::dot(nc, nc));
+            return d > 0 ? amc::dot(n, nc) / d : 2.0;
+        };
+        bend = std::min(cosine(v, u, o1), cosine(u, t, o2));
+        const double a = std::sqrt(amc::dot(pv - pu, pv - pu)), b = std::sqrt(amc::dot(pt - pu, pt - pu));
+        ratio = std::sqrt(amc::dot(pt - pv, pt - pv)) / (0.5 * (a + b));
+    }
     double node_gap(uint32_t n) const { return gap(vert_[n], vert_[next_[n]], vert_[prev_[n]], opp_[n], vert_[n]); }
     // Smaller is a better gate.
     double angle_score(uint32_t n) const {
@@ -251,6 +273,20 @@ private:
         e.gap_u = gap(u, v, vert_[p], opp_[g], u);
         e.gap_v = gap(u, v, vert_[nn], opp_[g], v);
         e.angle_sum_u = angle_sum_[u];
+        closing_shape(u, v, vert_[p], opp_[g], opp_[p], e.bend_u, e.ratio_u);
+        {  // L closes (u, v, nn): behind it (v, u, opp g) and (nn, v, opp nv)
+            double b, r;
+            closing_shape(v, vert_[nn], u, opp_[nv], opp_[g], b, r);
+            e.bend_v = b;
+            e.ratio_v = r;
+        }
+        if (located_[u] && located_[v] && located_[opp_[g]]) {
+            const Vec3 pp = position_[u] + position_[v] - position_[opp_[g]];
+            const double uv = amc::dot(position_[v] - position_[u], position_[v] - position_[u]);
+            auto pd = [&](uint32_t x) { return located_[x] ? amc::dot(position_[x] - pp, position_[x] - pp) / uv : -1.0; };
+            e.pdist_u = pd(vert_[p]);
+            e.pdist_v = pd(vert_[nn]);
+        }
         add(t);
         if (!seen_[w]) {
             seen_[w] = 1;
@@ -464,6 +500,166 @@ void angle_design(Cost& c, const Event& e, const Conquest& q, bool holes, AngleC
     split_or_merge(c, e, true);
 }
 
+
+// --study: context variants of mode 2's design (angle, angle-r5), ideal code lengths with fresh
+// models, and logistic mixing of several contexts' predictions (doubles: a measurement only).
+class MixCost {
+public:
+    double bits = 0;
+    std::map<std::string, double> part;
+    double rate = 0.02, init = 0.3;
+    // Codes `b` with the logistic mix of the models named by `contexts` (one weight set per
+    // `select`), or with the first model alone when there is one.
+    void bit(const std::string& name, const std::vector<uint64_t>& contexts, uint64_t select, bool b) {
+        std::vector<BitModel*> ms;
+        for (size_t i = 0; i < contexts.size(); ++i) ms.push_back(&models_[name + char('0' + i)][contexts[i]]);
+        double p;
+        if (ms.size() == 1) {
+            p = ms[0]->p16() / 65536.0;
+        } else {
+            std::vector<double>& w = weights_[name][select];
+            if (w.empty()) w.assign(ms.size(), init);
+            std::vector<double> st(ms.size());
+            double dot = 0;
+            for (size_t i = 0; i < ms.size(); ++i) {
+                const double q = ms[i]->p16() / 65536.0;
+                st[i] = std::log(q / (1 - q));
+                dot += w[i] * st[i];
+            }
+            p = 1 / (1 + std::exp(-dot));
+            p = std::min(std::max(p, 1.0 / 65536), 1 - 1.0 / 65536);
+            for (size_t i = 0; i < ms.size(); ++i) w[i] += rate * ((b ? 1 : 0) - p) * st[i];
+        }
+        const double c = -std::log2(b ? p : 1 - p);
+        bits += c;
+        part[name] += c;
+        for (BitModel* m : ms) m->update(b);
+    }
+    void raw(const std::string& name, double n) {
+        bits += n;
+        part[name] += n;
+    }
+
+private:
+    std::map<std::string, std::map<uint64_t, BitModel>> models_;
+    std::map<std::string, std::map<uint64_t, std::vector<double>>> weights_;
+};
+
+int fine_class(double gap) {
+    if (gap < 0) return 0;
+    if (gap >= 180) return 1;
+    const double bounds[] = {20, 30, 40, 50, 60, 70, 80, 90, 105, 120, 140, 160};
+    for (int i = 0; i < 12; ++i)
+        if (gap < bounds[i]) return 2 + i;
+    return 14;
+}
+uint64_t pdist_bin(double d) { return d < 0 ? 0 : d < 0.25 ? 1 : d < 0.8 ? 2 : 3; }
+uint64_t pdist_fine(double d) {
+    if (d < 0) return 0;
+    const double b[] = {0.05, 0.1, 0.2, 0.35, 0.5, 0.8, 1.2};
+    for (int i = 0; i < 7; ++i)
+        if (d < b[i]) return 1 + i;
+    return 8;
+}
+uint64_t bend_bin(double c) { return c > 1.5 ? 0 : c > 0.85 ? 1 : c > 0.5 ? 2 : 3; }
+uint64_t ratio_bin(double r) { return r < 0 ? 0 : r < 1.2 ? 1 : r < 1.6 ? 2 : 3; }
+int coarse_class(double gap) { return gap < 0 ? 0 : gap >= 180 ? 1 : gap < 70 ? 2 : gap < 120 ? 3 : 4; }
+
+struct Variant {
+    std::string name;
+    // contexts of R, L and new bits
+    std::function<std::vector<uint64_t>(const Event&)> r, l, n;
+    std::function<uint64_t(const Event&)> select_r = [](const Event& e) { return uint64_t(angle_class(e.gap_u)); };
+    std::function<uint64_t(const Event&)> select_l = [](const Event& e) { return uint64_t(angle_class(e.gap_v)); };
+};
+
+void variant_design(MixCost& c, const Event& e, const Conquest& q, bool holes, const Variant& v) {
+    if (e.kind == Event::start) return;
+    const bool right = e.kind == Event::right || e.kind == Event::end;
+    if (e.degree_u >= 2) c.bit("R", v.r(e), v.select_r(e), right);
+    if (right) return;
+    if (e.length > 3 && e.degree_v >= 2) {
+        c.bit("L", v.l(e), v.select_l(e), e.kind == Event::left);
+        if (e.kind == Event::left) return;
+    }
+    c.bit("new", v.n(e), 0, e.kind == Event::create);
+    if (e.kind == Event::create) {
+        if (holes) c.bit("dummy", {0}, 0, q.dummy(e.w));
+        return;
+    }
+    c.bit("split", {0}, 0, e.kind == Event::split);
+    if (e.kind == Event::split && e.nearest_rank >= 0) {
+        c.bit("nearest", {0}, 0, e.nearest_rank == 0);
+        if (e.nearest_rank == 0) return;
+    }
+    c.raw("offset", e.offset_range > 1 ? std::ceil(std::log2(e.offset_range)) : 0);
+}
+
+int run_study(int argc, char** argv, int first_file, double rate, double init) {
+    using V = std::vector<uint64_t>;
+    auto cu = [](const Event& e) { return uint64_t(angle_class(e.gap_u)); };
+    auto cv = [](const Event& e) { return uint64_t(angle_class(e.gap_v)); };
+    auto du = [](const Event& e) { return uint64_t(std::min(e.degree_u, 15u)); };
+    auto dv = [](const Event& e) { return uint64_t(std::min(e.degree_v, 15u)); };
+    auto zero = [](const Event&) { return V{0}; };
+    const std::vector<Variant> variants = {
+        {"base", [=](const Event& e) { return V{cu(e)}; }, [=](const Event& e) { return V{cv(e)}; }, zero},
+        {"deg5", [=](const Event& e) { return V{cu(e) * 16 + std::min<uint64_t>(du(e), 5)}; },
+         [=](const Event& e) { return V{cv(e) * 16 + std::min<uint64_t>(dv(e), 5)}; }, zero},
+        {"fine", [=](const Event& e) { return V{uint64_t(fine_class(e.gap_u))}; }, [=](const Event& e) { return V{uint64_t(fine_class(e.gap_v))}; }, zero},
+        {"uxv", [=](const Event& e) { return V{cu(e) * 8 + uint64_t(coarse_class(e.gap_v))}; },
+         [=](const Event& e) { return V{cv(e) * 8 + uint64_t(coarse_class(e.gap_u))}; }, zero},
+        {"new2", [=](const Event& e) { return V{cu(e)}; }, [=](const Event& e) { return V{cv(e)}; },
+         [=](const Event& e) { return V{uint64_t(coarse_class(e.gap_u) * 8 + coarse_class(e.gap_v))}; }},
+        {"newlen", [=](const Event& e) { return V{cu(e)}; }, [=](const Event& e) { return V{cv(e)}; },
+         [=](const Event& e) { return V{uint64_t(std::min(e.length, 12u))}; }},
+        {"pdist", [=](const Event& e) { return V{cu(e) * 4 + pdist_bin(e.pdist_u)}; }, [=](const Event& e) { return V{cv(e) * 4 + pdist_bin(e.pdist_v)}; }, zero},
+        {"pdist-only", [=](const Event& e) { return V{uint64_t(cu(e) <= 1 ? cu(e) : 2 + pdist_fine(e.pdist_u))}; }, [=](const Event& e) { return V{uint64_t(cv(e) <= 1 ? cv(e) : 2 + pdist_fine(e.pdist_v))}; }, zero},
+        {"mix-pdist", [=](const Event& e) { return V{cu(e), cu(e) * 4 + pdist_bin(e.pdist_u)}; }, [=](const Event& e) { return V{cv(e), cv(e) * 4 + pdist_bin(e.pdist_v)}; }, zero},
+        {"bend3", [=](const Event& e) { return V{cu(e) * 4 + bend_bin(e.bend_u)}; }, [=](const Event& e) { return V{cv(e) * 4 + bend_bin(e.bend_v)}; }, zero},
+        {"ratio3", [=](const Event& e) { return V{cu(e) * 4 + ratio_bin(e.ratio_u)}; }, [=](const Event& e) { return V{cv(e) * 4 + ratio_bin(e.ratio_v)}; }, zero},
+        {"bendonly", [=](const Event& e) { return V{uint64_t(cu(e) <= 1 ? cu(e) : 2 + bend_bin(e.bend_u))}; }, [=](const Event& e) { return V{uint64_t(cv(e) <= 1 ? cv(e) : 2 + bend_bin(e.bend_v))}; }, zero},
+        {"mix-bend", [=](const Event& e) { return V{cu(e), cu(e) * 4 + bend_bin(e.bend_u), cu(e) * 4 + ratio_bin(e.ratio_u)}; },
+         [=](const Event& e) { return V{cv(e), cv(e) * 4 + bend_bin(e.bend_v), cv(e) * 4 + ratio_bin(e.ratio_v)}; }, zero},
+        {"mix-deg", [=](const Event& e) { return V{cu(e), cu(e) * 16 + du(e)}; }, [=](const Event& e) { return V{cv(e), cv(e) * 16 + dv(e)}; }, zero},
+        {"mix-deg-fine", [=](const Event& e) { return V{cu(e), cu(e) * 16 + du(e), uint64_t(fine_class(e.gap_u))}; },
+         [=](const Event& e) { return V{cv(e), cv(e) * 16 + dv(e), uint64_t(fine_class(e.gap_v))}; }, zero},
+        {"mix-all", [=](const Event& e) { return V{cu(e), cu(e) * 16 + du(e), uint64_t(fine_class(e.gap_u)), cu(e) * 8 + uint64_t(coarse_class(e.gap_v))}; },
+         [=](const Event& e) { return V{cv(e), cv(e) * 16 + dv(e), uint64_t(fine_class(e.gap_v)), cv(e) * 8 + uint64_t(coarse_class(e.gap_u))}; },
+         [=](const Event& e) { return V{0, uint64_t(coarse_class(e.gap_u) * 8 + coarse_class(e.gap_v))}; }},
+    };
+    std::printf("| mesh | V |");
+    for (const Variant& v : variants) std::printf(" %s |", v.name.c_str());
+    std::printf(" base: R / L / new / split+offset |\n|---|--:|");
+    for (size_t i = 0; i <= variants.size(); ++i) std::printf("--:|");
+    std::printf("\n");
+    for (int i = first_file; i < argc; ++i) {
+        const amc::TriangleMesh mesh = amc::read_mesh(argv[i]);
+        ClosedMesh cm;
+        try {
+            cm = amc::make_closed(mesh);
+        } catch (const amc::EncoderGaveUp&) {
+            continue;
+        }
+        const double v = double(mesh.positions.size());
+        std::printf("| %s | %zu |", std::filesystem::path(argv[i]).stem().c_str(), mesh.positions.size());
+        std::map<std::string, double> base_part;
+        for (size_t k = 0; k < variants.size(); ++k) {
+            Conquest q(cm, mesh.positions, Gate::angle_r5);
+            MixCost cost;
+            cost.rate = rate;
+            cost.init = init;
+            q.run([&](const Event& e) { variant_design(cost, e, q, cm.dummies > 0, variants[k]); });
+            std::printf(" %.3f |", cost.bits / v);
+            if (k == 0) base_part = cost.part;
+        }
+        std::printf(" %.2f / %.2f / %.2f / %.2f |\n", base_part["R"] / v, base_part["L"] / v, base_part["new"] / v,
+                    (base_part["split"] + base_part["nearest"] + base_part["offset"]) / v);
+        std::fflush(stdout);
+    }
+    return 0;
+}
+
 }  // namespace
 
 // --starts N: mode 2's design (angle, angle-r5) started at N triangles spread over the mesh, each
@@ -503,6 +699,8 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "usage: base_coder_designs [--starts N] mesh.obj ...\n");
         return 2;
     }
+    if (std::string(argv[1]) == "--study" && argc > 4)
+        return run_study(argc, argv, 4, std::atof(argv[2]), std::atof(argv[3]));
     if (std::string(argv[1]) == "--starts" && argc > 3) return run_start_experiment(std::max(1, std::atoi(argv[2])), argc, argv, 3);
     using namespace std::placeholders;
     const std::vector<Design> designs = {
