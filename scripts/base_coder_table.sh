@@ -22,23 +22,25 @@ rows = {}
 for r in range(1, repeats + 1):
     for line in open(f"{out}/run{r}.md"):
         cells = [c.strip() for c in line.strip().strip('|').split('|')]
-        if len(cells) != 16 or not cells[1].isdigit():
+        if len(cells) != 17 or not cells[1].isdigit():
             continue
         rows.setdefault(cells[0], []).append(cells)
 def rng(values):
     lo, hi = min(values), max(values)
     return f"{lo:.1f}" if f"{lo:.1f}" == f"{hi:.1f}" else f"{lo:.1f}–{hi:.1f}"
-table = ["| mesh | V | F | mode 2 | mode 0 | Draco best | Draco default | mode 2 / Draco best | mode 2 decode Mf/s"
-         " | Draco best decode Mf/s | 16-bit file: amc / Draco bytes | amc decode Mf/s | Draco decode Mf/s |",
-         "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"]
+table = ["| mesh | V | F | mode 2 | mode 2, version 4's encoder | mode 0 | Draco best | Draco default | mode 2 / Draco best"
+         " | mode 2 decode Mf/s | mode 2 decode Mv/s | Draco best decode Mf/s | 16-bit file: amc / Draco bytes"
+         " | amc decode Mf/s | Draco decode Mf/s |",
+         "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"]
 for name, reps in rows.items():
-    sizes = {tuple(c[:9] + c[12:14]) for c in reps}
+    sizes = {tuple(c[:10] + c[13:15]) for c in reps}
     if len(sizes) != 1:
         sys.exit(f"{name}: sizes differ between repeats")
     c = reps[0]
-    speed = lambda i: rng([float(x[i]) for x in reps])
-    table.append(f"| {name} | {c[1]} | {c[2]} | **{c[4]}** | {c[5]} | {c[6]} | {c[7]} | {float(c[8]):.2f} | {speed(9)} | "
-                 f"{speed(10)} | {int(c[12]) / int(c[13]):.2f} | {speed(14)} | {speed(15)} |")
+    speed = lambda i, scale=1.0: rng([float(x[i]) * scale for x in reps])
+    per_face = int(c[1]) / int(c[2])  # vertices per face: M faces/s to M vertices/s
+    table.append(f"| {name} | {c[1]} | {c[2]} | **{c[4]}** | {c[5]} | {c[6]} | {c[7]} | {c[8]} | {float(c[9]):.2f} | "
+                 f"{speed(10)} | {speed(10, per_face)} | {speed(11)} | {int(c[13]) / int(c[14]):.2f} | {speed(15)} | {speed(16)} |")
 when = datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M UTC")
 load = os.getloadavg()[0]
 table.append("")
