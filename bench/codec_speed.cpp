@@ -1,0 +1,77 @@
+// Sizes and speeds of complete .amc files, per model (docs/CODEC.md, "Geometry"): each hierarchy
+// encoded and decoded RUNS times in turn with the public API, one thread; prints bytes, bits per
+// vertex and encode / decode million faces per second as median [min - max], over the process's
+// CPU time (on a shared machine wall time mostly measures the other processes). Uses only
+// <amc/codec.h>, so the same source builds against an older library for side-by-side runs.
+//   codec_speed RUNS BITS model.amh ...      (BITS 0: bit-exact)
+#include <amc/codec.h>
+#include <amc/hierarchy.h>
+
+#include <algorithm>
+#include <ctime>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace {
+
+// Seconds of CPU time this process has used.
+double cpu_seconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+struct Range {
+    double median, low, high;
+};
+
+Range range_of(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    return {n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]), v.front(), v.back()};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 4) {
+        std::fprintf(stderr, "usage: codec_speed RUNS BITS model.amh ...\n");
+        return 2;
+    }
+    const int runs = std::max(1, std::atoi(argv[1]));
+    amc::EncodeOptions options;
+    options.quantize_bits = std::atoi(argv[2]);
+    // PREDICTOR=1, 2, ...: a fixed geometry predictor (amc::GeometryPredictor) instead of automatic.
+    if (const char* p = std::getenv("PREDICTOR")) options.predictor = amc::GeometryPredictor(std::atoi(p));
+    std::printf("| model | bits | faces | bytes | bits/vertex | encode M faces/s | decode M faces/s |\n|---|---:|---:|---:|---:|---:|---:|\n");
+    for (int a = 3; a < argc; ++a) {
+        const amc::Hierarchy h = amc::read_hierarchy(argv[a]);
+        std::vector<double> encode_rate, decode_rate;
+        std::vector<uint8_t> bytes;
+        amc::EncodeStats stats;
+        for (int r = 0; r < runs; ++r) {
+            double start = cpu_seconds();
+            bytes = amc::encode(h, options, &stats);
+            const double encode_seconds = cpu_seconds() - start;
+            start = cpu_seconds();
+            const amc::Hierarchy back = amc::decode(bytes.data(), bytes.size());
+            const double decode_seconds = cpu_seconds() - start;
+            if (back.node_count() != h.node_count()) {
+                std::fprintf(stderr, "%s: decoded %u nodes, expected %u\n", argv[a], unsigned(back.node_count()), unsigned(h.node_count()));
+                return 1;
+            }
+            encode_rate.push_back(double(stats.faces) / encode_seconds * 1e-6);
+            decode_rate.push_back(double(stats.faces) / decode_seconds * 1e-6);
+        }
+        const Range e = range_of(encode_rate), d = range_of(decode_rate);
+        std::printf("| %s | %d | %llu | %zu | %.2f | %.2f [%.2f-%.2f] | %.2f [%.2f-%.2f] |\n",
+                    std::filesystem::path(argv[a]).stem().string().c_str(), options.quantize_bits,
+                    (unsigned long long)stats.faces, bytes.size(), 8.0 * double(bytes.size()) / double(stats.vertices), e.median,
+                    e.low, e.high, d.median, d.low, d.high);
+        std::fflush(stdout);
+    }
+    return 0;
+}

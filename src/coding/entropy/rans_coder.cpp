@@ -1,0 +1,129 @@
+// Interleaved static rANS and the raw bit stream; see rans_coder.h.
+#include "coding/entropy/rans_coder.h"
+
+#include <amc/mesh.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace amc {
+
+RansTable RansTable::from_counts(const std::vector<uint64_t>& counts) {
+    if (counts.empty() || counts.size() > size_t(kRansMaxSymbols)) {
+        throw Error("RansTable: " + std::to_string(counts.size()) + " symbols (1 to " + std::to_string(kRansMaxSymbols) + ")");
+    }
+    uint64_t total = 0;
+    size_t used = 0;
+    for (uint64_t c : counts) {
+        total += c;
+        used += c != 0;
+    }
+    if (total == 0 || used >= kRansScale) throw Error("RansTable: no counts, or more symbols than frequencies");
+    std::vector<uint32_t> f(counts.size(), 0);
+    if (used == 1) {
+        // One symbol may not take the whole scale: a neighbour that never occurs gets 1.
+        const size_t s = size_t(std::find_if(counts.begin(), counts.end(), [](uint64_t c) { return c != 0; }) - counts.begin());
+        if (f.size() == 1) f.push_back(0);
+        f[s] = kRansMaxFrequency;
+        f[s == 0 ? 1 : s - 1] = 1;
+    } else {
+        int64_t sum = 0;
+        for (size_t s = 0; s < counts.size(); ++s) {
+            if (counts[s] == 0) continue;
+            // counts[s] * M < 2^64 for any count below 2^52, more than a stream holds.
+            f[s] = uint32_t(std::max<uint64_t>(1, (counts[s] << kRansScaleBits) / total));
+            sum += f[s];
+        }
+        // Settle the rounding: add to the most frequent symbols, take from the largest frequencies.
+        std::vector<size_t> by_count(counts.size());
+        for (size_t s = 0; s < by_count.size(); ++s) by_count[s] = s;
+        std::stable_sort(by_count.begin(), by_count.end(), [&](size_t a, size_t b) { return counts[a] > counts[b]; });
+        for (size_t i = 0; sum < int64_t(kRansScale); i = (i + 1) % used) {
+            if (f[by_count[i]] < kRansMaxFrequency) {
+                ++f[by_count[i]];
+                ++sum;
+            }
+        }
+        while (sum > int64_t(kRansScale)) {
+            const size_t s = size_t(std::max_element(f.begin(), f.end()) - f.begin());
+            --f[s];  // the largest is above 1: sum > M >= 2 * used would be needed otherwise
+            --sum;
+        }
+    }
+    RansTable table;
+    table.assign(f);
+    return table;
+}
+
+bool RansTable::assign(const std::vector<uint32_t>& frequencies) {
+    if (frequencies.empty() || frequencies.size() > size_t(kRansMaxSymbols)) return false;
+    uint64_t sum = 0;
+    for (uint32_t f : frequencies) {
+        if (f > kRansMaxFrequency) return false;
+        sum += f;
+    }
+    if (sum != kRansScale) return false;
+    frequency_ = frequencies;
+    build();
+    return true;
+}
+
+void RansTable::build() {
+    start_.assign(frequency_.size(), 0);
+    slots_.resize(kRansScale);
+    uint32_t start = 0;
+    for (size_t s = 0; s < frequency_.size(); ++s) {
+        start_[s] = start;
+        for (uint32_t i = 0; i < frequency_[s]; ++i) slots_[start + i] = {uint16_t(s), uint16_t(frequency_[s]), uint16_t(i)};
+        start += frequency_[s];
+    }
+}
+
+double RansTable::cost_bits(int symbol) const {
+    return double(kRansScaleBits) - std::log2(double(frequency_[size_t(symbol)]));
+}
+
+std::vector<uint8_t> RansEncoder::finish() {
+    // Built back to front, reversed at the end.
+    std::vector<uint8_t> reversed;
+    reversed.reserve(queue_.size() / 2 + 16);
+    uint32_t state[2] = {kRansLow, kRansLow};
+    for (size_t i = queue_.size(); i-- > 0;) {
+        uint32_t& x = state[i & 1];
+        const Queued q = queue_[i];
+        // The largest state that stays below 256 L after coding: ((L / M) << 8) * f.
+        const uint32_t limit = ((kRansLow >> kRansScaleBits) << 8) * q.frequency;
+        while (x >= limit) {
+            reversed.push_back(uint8_t(x));
+            x >>= 8;
+        }
+        x = ((x / q.frequency) << kRansScaleBits) + (x % q.frequency) + q.start;
+    }
+    for (int s = 1; s >= 0; --s)
+        for (int shift = 24; shift >= 0; shift -= 8) reversed.push_back(uint8_t(state[s] >> shift));
+    queue_.clear();
+    return std::vector<uint8_t>(reversed.rbegin(), reversed.rend());
+}
+
+RansDecoder::RansDecoder(const uint8_t* data, size_t size) : data_(data), size_(size) {
+    for (uint32_t& x : state_) {
+        x = 0;
+        for (int shift = 0; shift < 32; shift += 8) x |= next_byte() << shift;
+        if (x < kRansLow) {  // no encoder ends below L; from there a run of zero bytes would never renormalise
+            overran_ = true;
+            x = kRansLow;
+        }
+    }
+}
+
+std::vector<uint8_t> RawBitWriter::finish() {
+    if (filled_ > 0) bytes_.push_back(uint8_t(buffer_));
+    buffer_ = 0;
+    filled_ = 0;
+    std::vector<uint8_t> out;
+    out.swap(bytes_);
+    return out;
+}
+
+}  // namespace amc

@@ -1,0 +1,167 @@
+// Static-table entropy coding built for decode throughput: interleaved rANS over symbols of
+// alphabets up to kRansMaxSymbols with frequency tables the stream carries, and a raw bit stream
+// for bits not worth modelling (the noise bits of bit-exact coordinates). Used by the geometry
+// coder's static mode (docs/FORMAT.md 5.6).
+//
+// rANS (J. Duda, "Asymmetric numeral systems", 2013) in the byte-wise form of F. Giesen's ryg_rans:
+// 32-bit state x in [L, 256 L), L = 2^23, probabilities as frequencies f summing to
+// M = 2^kRansScaleBits. Decoding a symbol: slot = x mod M, s = the symbol whose range
+// [start_s, start_s + f_s) holds slot, x = f_s * (x / M) + slot - start_s, then while x < L:
+// x = 256 x + next byte. Two states take the symbols in turn (symbol i with state i mod 2), so a
+// decoder's consecutive steps do not wait on each other. The encoder works backwards.
+//
+// Stream (frozen; docs/FORMAT.md 5.6): the decoder's initial state 0, then state 1, each 4 bytes
+// little endian, then the renormalisation bytes in the order the decoder reads them. An empty
+// symbol sequence is the 8 bytes of two states equal to L. After the last symbol both states are
+// L again (the encoder's initial states): a decoder checks it.
+//
+// Raw bits: packed least significant bit first into bytes, a value of c bits (c <= 57) at a time,
+// its low bit first.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace amc {
+
+constexpr int kRansScaleBits = 12;
+constexpr uint32_t kRansScale = uint32_t{1} << kRansScaleBits;
+constexpr uint32_t kRansLow = uint32_t{1} << 23;  // L: the lower bound of the normalised state
+constexpr int kRansMaxSymbols = 512;
+constexpr size_t kRansStateBytes = 8;  // two states of 4 bytes
+// No symbol may have the whole scale (at most M - 1): every coded symbol costs at least
+// -log2((M - 1) / M) bits of the encoder's output.
+constexpr uint32_t kRansMaxFrequency = kRansScale - 1;
+
+// A static frequency table: symbols 0 .. size()-1, frequencies summing to kRansScale, none above
+// kRansMaxFrequency (zero for symbols that never occur).
+class RansTable {
+public:
+    RansTable() = default;
+    // Scales counts (any, at least one nonzero; at most kRansMaxSymbols of them, at most
+    // kRansScale - 1 nonzero) to frequencies: every symbol with a nonzero count gets at least 1,
+    // the rest in proportion. Throws Error otherwise.
+    static RansTable from_counts(const std::vector<uint64_t>& counts);
+    // Takes frequencies as they are; returns false (table unchanged) unless they sum to
+    // kRansScale, none exceeds kRansMaxFrequency, and there are at most kRansMaxSymbols.
+    bool assign(const std::vector<uint32_t>& frequencies);
+
+    int size() const { return int(frequency_.size()); }
+    uint32_t frequency(int symbol) const { return frequency_[size_t(symbol)]; }
+    uint32_t start(int symbol) const { return start_[size_t(symbol)]; }
+    const std::vector<uint32_t>& frequencies() const { return frequency_; }
+    // -log2 of the symbol's probability (its code length in bits); the symbol must have a frequency.
+    double cost_bits(int symbol) const;
+
+    // The decoder's view: per slot of [0, M), the symbol, its frequency and slot - start.
+    struct Slot {
+        uint16_t symbol, frequency, offset;
+    };
+    const Slot* slots() const { return slots_.data(); }
+
+private:
+    void build();
+    std::vector<uint32_t> frequency_, start_;
+    std::vector<Slot> slots_;
+};
+
+class RansEncoder {
+public:
+    // Queues one symbol (it must have a nonzero frequency in `table`, which must outlive finish()).
+    void put(const RansTable& table, int symbol) { queue_.push_back({table.start(symbol), table.frequency(symbol)}); }
+    size_t symbols() const { return queue_.size(); }
+    // Codes the queued symbols; the encoder is empty again afterwards.
+    std::vector<uint8_t> finish();
+
+private:
+    struct Queued {
+        uint32_t start, frequency;
+    };
+    std::vector<Queued> queue_;
+};
+
+class RansDecoder {
+public:
+    // Reads at most `size` bytes; fewer than kRansStateBytes is an overrun at once.
+    RansDecoder(const uint8_t* data, size_t size);
+
+    int get(const RansTable& table) {
+        uint32_t& x = state_[which_];
+        which_ ^= 1;
+        const RansTable::Slot slot = table.slots()[x & (kRansScale - 1)];
+        x = uint32_t(slot.frequency) * (x >> kRansScaleBits) + slot.offset;
+        while (x < kRansLow) x = (x << 8) | next_byte();
+        return slot.symbol;
+    }
+
+    // True once the decoder needed bytes past the end: the stream is truncated or corrupt.
+    bool overran() const { return overran_; }
+    // After the last symbol: both states are back at L and every byte was read.
+    bool ended_cleanly() const { return !overran_ && state_[0] == kRansLow && state_[1] == kRansLow && pos_ == size_; }
+
+private:
+    uint32_t next_byte() {
+        if (pos_ < size_) return data_[pos_++];
+        overran_ = true;
+        return 0;
+    }
+    const uint8_t* data_;
+    size_t size_, pos_ = 0;
+    uint32_t state_[2] = {kRansLow, kRansLow};
+    int which_ = 0;
+    bool overran_ = false;
+};
+
+class RawBitWriter {
+public:
+    // The low `count` bits of value, count in [0, 57].
+    void put(uint64_t value, int count) {
+        buffer_ |= (count == 0 ? 0 : value & (~uint64_t{0} >> (64 - count))) << filled_;
+        filled_ += count;
+        while (filled_ >= 8) {
+            bytes_.push_back(uint8_t(buffer_));
+            buffer_ >>= 8;
+            filled_ -= 8;
+        }
+    }
+    size_t bits() const { return bytes_.size() * 8 + size_t(filled_); }
+    // Pads the last byte with zero bits and returns the bytes; the writer is empty again.
+    std::vector<uint8_t> finish();
+
+private:
+    std::vector<uint8_t> bytes_;
+    uint64_t buffer_ = 0;
+    int filled_ = 0;
+};
+
+class RawBitReader {
+public:
+    RawBitReader(const uint8_t* data, size_t size) : data_(data), size_(size) {}
+    // count in [0, 57]; bits past the end read as 0 and set overran().
+    uint64_t get(int count) {
+        if (filled_ < count) refill();
+        const uint64_t value = count == 0 ? 0 : buffer_ & (~uint64_t{0} >> (64 - count));
+        buffer_ >>= count;
+        filled_ -= count;
+        consumed_ += uint64_t(count);
+        return value;
+    }
+    bool overran() const { return consumed_ > uint64_t(size_) * 8; }
+    // Every bit read but the zero padding of the last byte (fewer than 8 bits).
+    bool ended_cleanly() const { return !overran() && uint64_t(size_) * 8 - consumed_ < 8; }
+
+private:
+    void refill() {
+        while (filled_ <= 56) {
+            buffer_ |= uint64_t(pos_ < size_ ? data_[pos_++] : 0) << filled_;
+            filled_ += 8;
+        }
+    }
+    const uint8_t* data_;
+    size_t size_, pos_ = 0;
+    uint64_t buffer_ = 0, consumed_ = 0;
+    int filled_ = 0;
+};
+
+}  // namespace amc

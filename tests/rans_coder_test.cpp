@@ -1,0 +1,165 @@
+// Tests of the static rANS coder and the raw bit stream: round trips, code length against the
+// table's entropy, golden bytes, and truncated or corrupt input.
+#include "coding/entropy/rans_coder.h"
+
+#include <amc/mesh.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+namespace amc {
+namespace {
+
+// Symbols drawn from a geometric-like distribution over `alphabet` symbols (std::mt19937's
+// sequence is fixed by the standard).
+std::vector<int> skewed_symbols(size_t n, int alphabet, uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::vector<int> out;
+    for (size_t i = 0; i < n; ++i) {
+        int s = 0;
+        while (s + 1 < alphabet && (rng() & 3) != 0) ++s;  // P(s) ~ (3/4)^s / 4
+        out.push_back(s);
+    }
+    return out;
+}
+
+// The symbols' counts, and one more of symbol 0 (a table needs one symbol at least).
+std::vector<uint64_t> counts_of(const std::vector<int>& symbols, int alphabet) {
+    std::vector<uint64_t> counts(size_t(alphabet), 0);
+    counts[0] = 1;
+    for (int s : symbols) ++counts[size_t(s)];
+    return counts;
+}
+
+TEST(RansTable, NormalisesCountsToTheScale) {
+    const RansTable t = RansTable::from_counts({5, 0, 1000000, 1, 3});
+    uint64_t sum = 0;
+    for (uint32_t f : t.frequencies()) sum += f;
+    EXPECT_EQ(sum, kRansScale);
+    EXPECT_EQ(t.frequency(1), 0u);
+    EXPECT_GE(t.frequency(0), 1u);
+    EXPECT_GE(t.frequency(3), 1u);
+    EXPECT_LE(t.frequency(2), kRansMaxFrequency);
+    EXPECT_GT(t.frequency(2), 4000u);
+    // One symbol alone may not take the whole scale.
+    const RansTable single = RansTable::from_counts({0, 0, 7});
+    EXPECT_EQ(single.frequency(2), kRansMaxFrequency);
+    EXPECT_EQ(single.frequency(1), 1u);
+    const RansTable only = RansTable::from_counts({9});
+    EXPECT_EQ(only.size(), 2);
+    EXPECT_EQ(only.frequency(0), kRansMaxFrequency);
+    EXPECT_THROW(RansTable::from_counts({}), Error);
+    EXPECT_THROW(RansTable::from_counts({0, 0}), Error);
+    EXPECT_THROW(RansTable::from_counts(std::vector<uint64_t>(kRansMaxSymbols + 1, 1)), Error);
+}
+
+TEST(RansTable, AssignChecksTheFrequencies) {
+    RansTable t;
+    EXPECT_TRUE(t.assign({kRansScale - 1, 1}));
+    EXPECT_FALSE(t.assign({kRansScale}));                 // one symbol with the whole scale
+    EXPECT_FALSE(t.assign({kRansScale - 2, 1}));          // sum too small
+    EXPECT_FALSE(t.assign({kRansScale - 1, 2}));          // sum too large
+    EXPECT_FALSE(t.assign({}));
+    EXPECT_EQ(t.size(), 2);  // unchanged by the refused ones
+}
+
+TEST(Rans, RoundTripsSeveralTablesInterleaved) {
+    for (size_t n : {size_t(0), size_t(1), size_t(2), size_t(3), size_t(1000), size_t(100000)}) {
+        const std::vector<int> a = skewed_symbols(n, 40, 1), b = skewed_symbols(n, 7, 2);
+        const RansTable ta = RansTable::from_counts(counts_of(a, 40)), tb = RansTable::from_counts(counts_of(b, 7));
+        RansEncoder encoder;
+        for (size_t i = 0; i < n; ++i) {
+            encoder.put(ta, a[i]);
+            encoder.put(tb, b[i]);
+        }
+        const std::vector<uint8_t> bytes = encoder.finish();
+        RansDecoder decoder(bytes.data(), bytes.size());
+        for (size_t i = 0; i < n; ++i) {
+            ASSERT_EQ(decoder.get(ta), a[i]) << n << " " << i;
+            ASSERT_EQ(decoder.get(tb), b[i]) << n << " " << i;
+        }
+        EXPECT_TRUE(decoder.ended_cleanly()) << n;
+    }
+}
+
+TEST(Rans, CodeLengthIsTheTablesEntropy) {
+    const std::vector<int> s = skewed_symbols(200000, 60, 3);
+    const RansTable t = RansTable::from_counts(counts_of(s, 60));
+    double ideal = 0;
+    RansEncoder encoder;
+    for (int x : s) {
+        encoder.put(t, x);
+        ideal += t.cost_bits(x);
+    }
+    const double bits = 8.0 * double(encoder.finish().size());
+    EXPECT_LT(bits, ideal * 1.001 + 64);  // the two states' 8 bytes and a little rounding
+    EXPECT_GT(bits, ideal * 0.999);
+}
+
+TEST(Rans, GoldenBytes) {
+    // Pins the stream layout of FORMAT.md 5.6: states first, little endian, then the bytes.
+    RansTable t;
+    ASSERT_TRUE(t.assign({2048, 1024, 1023, 1}));
+    RansEncoder encoder;
+    for (int s : {0, 1, 2, 3, 0, 0, 3, 2, 1, 0}) encoder.put(t, s);
+    const std::vector<uint8_t> bytes = encoder.finish();
+    const std::vector<uint8_t> expected = {0x1b, 0x95, 0x00, 0x02, 0xff, 0xbb, 0x00, 0x02, 0xff, 0x14, 0x10, 0x00};
+    EXPECT_EQ(bytes, expected);
+    RansEncoder empty;
+    EXPECT_EQ(empty.finish(), (std::vector<uint8_t>{0, 0, 0x80, 0, 0, 0, 0x80, 0}));
+}
+
+TEST(Rans, TruncatedOrCorruptInputNeverHangsAndIsNoticed) {
+    const std::vector<int> s = skewed_symbols(5000, 20, 4);
+    const RansTable t = RansTable::from_counts(counts_of(s, 20));
+    RansEncoder encoder;
+    for (int x : s) encoder.put(t, x);
+    const std::vector<uint8_t> bytes = encoder.finish();
+    for (size_t cut : {size_t(0), size_t(3), size_t(8), bytes.size() / 2, bytes.size() - 1}) {
+        RansDecoder decoder(bytes.data(), cut);
+        for (size_t i = 0; i < s.size(); ++i) decoder.get(t);
+        EXPECT_FALSE(decoder.ended_cleanly()) << cut;
+        EXPECT_TRUE(decoder.overran()) << cut;
+    }
+    std::vector<uint8_t> zeros(64, 0);  // a state below L
+    RansDecoder decoder(zeros.data(), zeros.size());
+    for (int i = 0; i < 1000; ++i) decoder.get(t);
+    EXPECT_TRUE(decoder.overran());
+    std::vector<uint8_t> flipped = bytes;
+    flipped[bytes.size() / 2] ^= 0x10;
+    RansDecoder damaged(flipped.data(), flipped.size());
+    bool same = true;
+    for (size_t i = 0; i < s.size(); ++i) same = damaged.get(t) == s[i] && same;
+    EXPECT_FALSE(same && damaged.ended_cleanly());
+}
+
+TEST(RawBits, RoundTripAndOverrun) {
+    std::mt19937_64 rng(5);
+    std::vector<std::pair<uint64_t, int>> values;
+    RawBitWriter writer;
+    for (int i = 0; i < 10000; ++i) {
+        const int count = int(rng() % 58);
+        const uint64_t v = count == 0 ? 0 : rng() & (~uint64_t{0} >> (64 - count));
+        values.emplace_back(v, count);
+        writer.put(v | (count < 57 ? uint64_t{1} << count : 0), count);  // bits above count are ignored
+    }
+    const size_t bits = writer.bits();
+    const std::vector<uint8_t> bytes = writer.finish();
+    EXPECT_EQ(bytes.size(), (bits + 7) / 8);
+    RawBitReader reader(bytes.data(), bytes.size());
+    for (auto [v, count] : values) ASSERT_EQ(reader.get(count), v);
+    EXPECT_TRUE(reader.ended_cleanly());
+    reader.get(9);
+    EXPECT_TRUE(reader.overran());
+    RawBitWriter small;
+    small.put(0x5, 3);
+    small.put(0x1ff, 9);
+    EXPECT_EQ(small.finish(), (std::vector<uint8_t>{0xfd, 0x0f}));
+}
+
+}  // namespace
+}  // namespace amc
