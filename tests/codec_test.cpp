@@ -6,6 +6,7 @@
 #include <amc/codec.h>
 #include <amc/hierarchy_coder.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -75,7 +76,7 @@ TEST(Codec, ThousandRandomHierarchiesRoundTripBitExactly) {
         const bool single = seed % 4 < 2;
         const Hierarchy h = random_hierarchy(seed, single);
         EncodeOptions options;
-        options.predictor = GeometryPredictor(seed % 3);
+        options.predictor = GeometryPredictor(seed % 4);
         const std::vector<uint8_t> bytes = encode(h, options);
         const Hierarchy back = decode(bytes.data(), bytes.size());
         ASSERT_TRUE(identical(back, expected_decoding(h))) << "seed " << seed;
@@ -118,6 +119,62 @@ TEST(Codec, QuantizedErrorIsBounded) {
         EXPECT_LE(stats.max_error, 2.5 / double(1u << bits) * 1.01) << "half a step of a box about 2.5 wide";
     }
     (void)h;
+}
+
+// Geometry mode 3 (normal frame, static tables, rANS): bit-exact and on the grid, in float32 and
+// float64, and chosen by the automatic encoder on a curved surface remesh, where it codes smaller.
+TEST(Codec, NormalFrameModeRoundTripsAndWinsOnSurfaces) {
+    SurfaceRemeshOptions remesh;
+    remesh.base_triangles = 200;
+    remesh.max_level = 5;
+    remesh.target_faces = 6000;
+    const Hierarchy surface = remesh_adaptively(make_bumpy_sphere(4), remesh);
+    for (int bits : {0, 12, 16}) {
+        for (bool single : {false, true}) {
+            if (single && bits != 0) continue;
+            Hierarchy h = surface;
+            if (single) {
+                h.set_single_precision(true);
+                for (VertexId v = 0; v < h.positions().size(); ++v) {
+                    const Vec3 p = h.position(v);
+                    h.set_position(v, Vec3{double(float(p.x)), double(float(p.y)), double(float(p.z))});
+                }
+            }
+            EncodeOptions options;
+            options.quantize_bits = bits;
+            size_t sizes[4] = {};
+            for (GeometryPredictor p : {GeometryPredictor::automatic, GeometryPredictor::midpoint, GeometryPredictor::butterfly,
+                                        GeometryPredictor::normal_frame}) {
+                options.predictor = p;
+                EncodeStats stats;
+                const std::vector<uint8_t> bytes = encode(h, options, &stats);
+                sizes[int(p)] = bytes.size();
+                const Hierarchy back = decode(bytes.data(), bytes.size());
+                const Hierarchy expected = in_decoder_order(h, options);
+                if (bits == 0) {
+                    ASSERT_TRUE(identical(back, expected)) << bits << " " << single << " " << int(p);
+                } else {
+                    ASSERT_EQ(back.vertex_count(), expected.vertex_count());
+                    // On the grid: each decoded position is the input's snapped to it.
+                    const std::vector<uint32_t> ca = canonical_vertex_order(back), cb = canonical_vertex_order(expected);
+                    std::vector<Vec3> pa(back.vertex_count()), pb(expected.vertex_count());
+                    for (size_t v = 0; v < ca.size(); ++v) if (ca[v] != 0xffffffffu) pa[ca[v]] = back.position(VertexId(v));
+                    for (size_t v = 0; v < cb.size(); ++v) if (cb[v] != 0xffffffffu) pb[cb[v]] = expected.position(VertexId(v));
+                    for (size_t i = 0; i < pa.size(); ++i) {
+                        ASSERT_LE(std::max({std::fabs(pa[i].x - pb[i].x), std::fabs(pa[i].y - pb[i].y), std::fabs(pa[i].z - pb[i].z)}),
+                                  stats.max_error * (1 + 1e-9)) << i;
+                    }
+                }
+                const uint8_t version = bytes[4];
+                const bool uses_mode_3 = std::any_of(stats.per_level.begin(), stats.per_level.end(),
+                                                     [](const LevelStats& l) { return l.predictor == GeometryPredictor::normal_frame; });
+                EXPECT_EQ(version == kStaticGeometryVersion, uses_mode_3) << int(p);
+            }
+            EXPECT_LT(sizes[3], sizes[1]) << "normal frame below midpoint, bits " << bits;
+            EXPECT_LT(sizes[3], sizes[2]) << "normal frame below butterfly, bits " << bits;
+            EXPECT_LE(sizes[0], std::min(sizes[1], sizes[2]) + 8) << "automatic is at most a few bytes above the best";
+        }
+    }
 }
 
 TEST(Codec, ProgressiveDecodingGivesEveryLevelMesh) {
@@ -269,6 +326,7 @@ TEST(Codec, MutatedBlocksWithValidChecksumsAreErrorsOrValidHierarchies) {
         options.hierarchy = coder_options_from_switches(int(random.next() % kCoderSwitchCombinations));
         const int quantize_bits[] = {0, 0, 8, 12, 16, 24};
         options.quantize_bits = quantize_bits[random.next() % 6];
+        if (file % 2 == 1) options.predictor = GeometryPredictor::normal_frame;  // geometry mode 3 in every level
         const std::vector<uint8_t> bytes = encode(h, options);
         BlockReader reader(bytes.data(), bytes.size());
         using Blocks = std::vector<std::pair<BlockType, std::vector<uint8_t>>>;

@@ -137,6 +137,59 @@ constexpr int kVersionsOfTheCases[] = {1, 2, 4, 5};
 // The version encode() writes for these cases.
 constexpr int kCurrentVersionOfTheCases = kSearchedBaseVersion;
 
+// Version 6 (level geometry mode 3, the normal frame with static tables and rANS): a random
+// refinement of the icosahedron with every vertex projected onto the unit sphere (new vertices lie
+// off their edge's midpoint along the normal, as in a surface remesh), bit-exact in float64 and at
+// 12 bits, where the automatic encoder picks mode 3, and the float32 random hierarchy with mode 3
+// forced.
+std::vector<GoldenCase> static_geometry_cases() {
+    std::vector<GoldenCase> cases;
+    Hierarchy sphere(make_icosahedron());
+    refine_randomly(sphere, 1200, 4, 7);
+    for (VertexId v = 0; v < sphere.positions().size(); ++v) {
+        const Vec3 p = sphere.position(v);
+        sphere.set_position(v, (1.0 / std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z)) * p);
+    }
+    cases.push_back({"sphere_random", sphere, {}});
+    EncodeOptions quantized;
+    quantized.quantize_bits = 12;
+    cases.push_back({"sphere_random_q12", sphere, quantized});
+    Hierarchy h(make_bumpy_sphere(0));  // float32 coordinates
+    refine_randomly(h, 400, 4, 11);
+    EncodeOptions forced;
+    forced.predictor = GeometryPredictor::normal_frame;
+    cases.push_back({"bumpy_random_float32_normal", h, forced});
+    return cases;
+}
+
+TEST(Golden, StaticGeometryFilesDecodeAndPinTheEncoder) {
+    const bool update = std::getenv("AMC_UPDATE_GOLDEN") != nullptr;
+    for (const GoldenCase& c : static_geometry_cases()) {
+        EncodeStats stats;
+        const std::vector<uint8_t> bytes = encode(c.hierarchy, c.options, &stats);
+        const std::string path = golden_path(kStaticGeometryVersion, c.name);
+        SCOPED_TRACE(path);
+        if (update && !std::filesystem::exists(path)) {
+            std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+            std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+        }
+        const std::vector<uint8_t> golden = read_golden(path);
+        ASSERT_FALSE(golden.empty()) << path << " is missing";
+        EXPECT_EQ(bytes, golden) << "the bitstream changed (a new format version: FORMAT.md, Versions)";
+        EXPECT_EQ(inspect(golden.data(), golden.size()).version, kStaticGeometryVersion);
+        EXPECT_TRUE(std::any_of(stats.per_level.begin(), stats.per_level.end(),
+                                [](const LevelStats& l) { return l.predictor == GeometryPredictor::normal_frame; }))
+            << "the case exercises geometry mode 3";
+        const Hierarchy back = decode(golden.data(), golden.size());
+        EXPECT_TRUE(decodes_to_one_of(back, expected_decodings(c.hierarchy, c.options, kStaticGeometryVersion)));
+        for (int l = 0; l < int(stats.levels); ++l) {
+            DecodeOptions prefix;
+            prefix.max_level = l;
+            EXPECT_EQ(decode(golden.data(), golden.size(), prefix).depth(), std::min(l, back.depth())) << "level " << l;
+        }
+    }
+}
+
 TEST(Golden, FilesOfEveryVersionDecodeToTheirHierarchies) {
     for (const int version : kVersionsOfTheCases) {
         for (const GoldenCase& c : golden_cases()) {

@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
     encode_cmd->add_option("--map", encode.map, "Write the map from the input's numbering to the decoded mesh (text)");
     encode_cmd->add_option("--quantize", encode.quantize_bits, "Quantize coordinates to BITS per axis (lossy; 0 = bit-exact)")
         ->check(CLI::Range(0, 30));
-    encode_cmd->add_option("--predictor", encode.predictor, "auto | midpoint | butterfly")->capture_default_str();
+    encode_cmd->add_option("--predictor", encode.predictor, "auto | midpoint | butterfly | normal")->capture_default_str();
     encode_cmd->add_flag("--series", encode.series, "The input is a series (as 'amc series encode'; implied by a .pvd input)");
 
     DecodeCommand decode;

@@ -20,14 +20,18 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 const char* predictor_name(GeometryPredictor p) {
-    return p == GeometryPredictor::butterfly ? "butterfly" : p == GeometryPredictor::midpoint ? "midpoint" : "automatic";
+    return p == GeometryPredictor::butterfly      ? "butterfly"
+           : p == GeometryPredictor::midpoint     ? "midpoint"
+           : p == GeometryPredictor::normal_frame ? "normal"
+                                                  : "automatic";
 }
 
 GeometryPredictor parse_predictor(const std::string& name) {
     if (name == "auto") return GeometryPredictor::automatic;
     if (name == "midpoint") return GeometryPredictor::midpoint;
     if (name == "butterfly") return GeometryPredictor::butterfly;
-    throw UsageError("--predictor: unknown predictor '" + name + "' (auto, midpoint, butterfly)");
+    if (name == "normal") return GeometryPredictor::normal_frame;
+    throw UsageError("--predictor: unknown predictor '" + name + "' (auto, midpoint, butterfly, normal)");
 }
 
 // Summaries go to stderr when the data goes to stdout.

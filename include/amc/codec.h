@@ -13,9 +13,12 @@
 namespace amc {
 
 enum class GeometryPredictor : uint8_t {
-    automatic = 0,  // per level, whichever of midpoint and butterfly codes smaller
+    automatic = 0,  // per level, whichever of the three codes smaller
     midpoint = 1,
     butterfly = 2,
+    // The normal frame with static tables and rANS (docs/FORMAT.md 5.6): faster to decode, and
+    // smaller on surface remeshes; files that use it are .amc version 6.
+    normal_frame = 3,
 };
 
 struct EncodeOptions {

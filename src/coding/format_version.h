@@ -11,13 +11,15 @@ namespace amc {
 // writer writes the lowest version that holds what the file holds: version 5 for files whose base
 // connectivity is in mode 2 (every base that mode can code), else version 3 for files with a
 // numbering block, else version 2. Version 5 holds version 4's streams; its encoder searches the
-// start triangle and gate radius of mode 2 (FORMAT.md 4.16), so it writes other bytes.
+// start triangle and gate radius of mode 2 (FORMAT.md 4.16), so it writes other bytes. Version 6 for files with a level in geometry
+// mode 3 (normal frame, static tables, rANS).
 constexpr uint8_t kOldestReadableVersion = 1;
-constexpr uint8_t kNewestVersion = 5;
+constexpr uint8_t kNewestVersion = 6;
 constexpr uint8_t kBaseVersion = 2;       // everything but the numbering block and mode 2
 constexpr uint8_t kNumberingVersion = 3;  // the first version with a numbering block
 constexpr uint8_t kAngleBaseVersion = 4;  // the first version with base connectivity mode 2
 constexpr uint8_t kSearchedBaseVersion = 5;  // mode 2 from the searching encoder: what mode-2 files are written as
+constexpr uint8_t kStaticGeometryVersion = 6;  // the first version with level geometry mode 3 (normal frame, rANS)
 
 // The hierarchy stream (FORMAT.md section 2).
 constexpr uint8_t kHierarchyStreamVersion = 2;
@@ -35,6 +37,7 @@ constexpr uint8_t hierarchy_stream_version_of_file(uint8_t file_version) {
         case 3: return 2;
         case 4: return 2;
         case 5: return 2;
+        case 6: return 2;
     }
     return 0;
 }

@@ -9,6 +9,7 @@
 #include "coding/geometry/geometry_prediction.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
 #include "coding/numbering/numbering_coder.h"
+#include "coding/geometry/static_position_coder.h"
 #include "common/check.h"
 #include "hierarchy/writer_checks.h"
 
@@ -281,14 +282,11 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     meta.quantizer = quantizer;
     meta.options = keep_rotations ? kOptionRootRotations : 0;
 
-    const uint8_t version = base_code.mode == BaseConnectivityMode::angle ? kSearchedBaseVersion
-                            : store_numbering                             ? kNumberingVersion
-                                                                          : kBaseVersion;
-    BlockWriter writer(version,
-                       uint8_t((precision == Precision::float32 ? kFlagSinglePrecision : 0) | (quantized ? kFlagQuantized : 0)));
-    writer.add(BlockType::metadata, write_metadata(meta, quantized));
-    stats.header_bytes = writer.size();
-    writer.add(BlockType::base_connectivity, base_code.bytes);
+    // The blocks are made first: the version in the header depends on the level modes chosen.
+    std::vector<std::pair<BlockType, std::vector<uint8_t>>> blocks;
+    blocks.emplace_back(BlockType::metadata, write_metadata(meta, quantized));
+    stats.header_bytes = kFileHeaderSize + kBlockOverhead + blocks.back().second.size();
+    blocks.emplace_back(BlockType::base_connectivity, base_code.bytes);
     stats.base_connectivity_bytes = base_code.bytes.size();
 
     PositionCoder positions(precision, quantized ? &quantizer : nullptr);
@@ -304,16 +302,20 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
             positions.encode(encoder, 0, p, predict_parallelogram(decoded, base_code.stencils[i]));
             decoded.push_back(p);
         }
-        const std::vector<uint8_t> payload = encoder.finish();
-        writer.add(BlockType::base_geometry, payload);
-        stats.base_geometry_bytes = payload.size();
+        blocks.emplace_back(BlockType::base_geometry, encoder.finish());
+        stats.base_geometry_bytes = blocks.back().second.size();
     }
 
+    const CoordinateSpace space{precision, quantized ? &quantizer : nullptr};
+    bool static_geometry = false;
     for (int l = 0; l < hierarchy.level_count(); ++l) {
         const std::vector<NodeId>& level = hierarchy.level_nodes(l);
         const std::vector<std::pair<NodeId, int>> created = new_vertices_of_level(h, level);
-        // Pick the predictor of this level: try both on a copy of the models when automatic.
+        // Pick the predictor of this level: try each on a copy of the models when automatic.
         GeometryPredictor predictor = options.predictor == GeometryPredictor::automatic ? GeometryPredictor::midpoint : options.predictor;
+        std::unique_ptr<StaticLevelEncoder> static_code;
+        if (predictor == GeometryPredictor::normal_frame || (options.predictor == GeometryPredictor::automatic && !created.empty()))
+            static_code = std::make_unique<StaticLevelEncoder>(h, created, space);
         if (options.predictor == GeometryPredictor::automatic && !created.empty()) {
             size_t best = SIZE_MAX;
             for (GeometryPredictor candidate : {GeometryPredictor::midpoint, GeometryPredictor::butterfly}) {
@@ -327,21 +329,34 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
                     predictor = candidate;
                 }
             }
+            if (static_code->estimated_bytes() < best) predictor = GeometryPredictor::normal_frame;
         }
         std::vector<uint8_t> payload{uint8_t(predictor)};
         ArithmeticEncoder encoder;
         hierarchy.encode_level(l, encoder);
         const size_t hierarchy_part = encoder.bytes_so_far();
-        for (auto [n, e] : created)
-            positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)), predict(h, predictor, n, e));
-        const std::vector<uint8_t> coded = encoder.finish();
-        payload.insert(payload.end(), coded.begin(), coded.end());
-        writer.add(BlockType::level, payload);
+        if (predictor == GeometryPredictor::normal_frame) {
+            // Mode 3: the arithmetic payload (hierarchy, tables) with its length, the rANS stream
+            // with its length, the raw bits.
+            static_geometry = true;
+            static_code->write_tables(encoder);
+            const std::vector<uint8_t> coded = encoder.finish();
+            put_varint(payload, coded.size());
+            payload.insert(payload.end(), coded.begin(), coded.end());
+            put_varint(payload, static_code->rans_bytes().size());
+            payload.insert(payload.end(), static_code->rans_bytes().begin(), static_code->rans_bytes().end());
+            payload.insert(payload.end(), static_code->raw_bytes().begin(), static_code->raw_bytes().end());
+        } else {
+            for (auto [n, e] : created)
+                positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)), predict(h, predictor, n, e));
+            const std::vector<uint8_t> coded = encoder.finish();
+            payload.insert(payload.end(), coded.begin(), coded.end());
+        }
         // The hierarchy/geometry split of a level block is estimated at the coder's byte count
         // when the hierarchy part ended (they share one arithmetic code).
-        const uint64_t hierarchy_bytes = std::min<uint64_t>(hierarchy_part, coded.size());
+        const uint64_t hierarchy_bytes = std::min<uint64_t>(hierarchy_part, payload.size() - 1);
         stats.hierarchy_bytes += hierarchy_bytes;
-        stats.geometry_bytes += coded.size() - hierarchy_bytes;
+        stats.geometry_bytes += payload.size() - 1 - hierarchy_bytes;
         stats.framing_bytes += kBlockOverhead + 1;
         LevelStats level_stats;
         level_stats.nodes = level.size();
@@ -349,13 +364,20 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
         level_stats.bytes = kBlockOverhead + payload.size();
         level_stats.predictor = predictor;
         stats.per_level.push_back(level_stats);
+        blocks.emplace_back(BlockType::level, std::move(payload));
     }
     if (store_numbering) {
-        const std::vector<uint8_t> payload = encode_numbering(stats.numbering, extract_leaf_mesh(h).mesh.triangles);
-        writer.add(BlockType::numbering, payload);
-        stats.numbering_bytes = payload.size();
+        blocks.emplace_back(BlockType::numbering, encode_numbering(stats.numbering, extract_leaf_mesh(h).mesh.triangles));
+        stats.numbering_bytes = blocks.back().second.size();
         stats.framing_bytes += kBlockOverhead;
     }
+    const uint8_t version = static_geometry                                   ? kStaticGeometryVersion
+                            : base_code.mode == BaseConnectivityMode::angle ? kSearchedBaseVersion
+                            : store_numbering                             ? kNumberingVersion
+                                                                          : kBaseVersion;
+    BlockWriter writer(version,
+                       uint8_t((precision == Precision::float32 ? kFlagSinglePrecision : 0) | (quantized ? kFlagQuantized : 0)));
+    for (const auto& block : blocks) writer.add(block.first, block.second);
     std::vector<uint8_t> out = writer.finish();
     stats.framing_bytes += 3 * kBlockOverhead + kBlockOverhead;  // base blocks and END
     stats.total_bytes = out.size();
@@ -484,21 +506,47 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
         AMC_REQUIRE(block.type == BlockType::level, corrupt, "unexpected block between level blocks");
         AMC_REQUIRE(!hierarchy.done(), corrupt, "level block after the last level");
         if (options.max_level >= 0 && level >= options.max_level) return h;  // progressive: stop here
-        AMC_REQUIRE(block.size >= 1 && block.payload[0] >= 1 && block.payload[0] <= 2, corrupt, "level block: bad predictor");
+        const uint8_t last_predictor = reader.version() >= kStaticGeometryVersion ? 3 : 2;
+        AMC_REQUIRE(block.size >= 1 && block.payload[0] >= 1 && block.payload[0] <= last_predictor, corrupt,
+                    "level block: bad predictor");
         const GeometryPredictor predictor = GeometryPredictor(block.payload[0]);
-        ArithmeticDecoder decoder(block.payload + 1, block.size - 1);
+        const std::string where = "level " + std::to_string(level) + " block";
+        // Mode 3: [arithmetic length, arithmetic payload, rANS length, rANS stream, raw bits].
+        PayloadReader parts(block.payload + 1, block.size - 1, "level block");
+        size_t arithmetic_size = block.size - 1;
+        if (predictor == GeometryPredictor::normal_frame) {
+            const uint64_t size = parts.varint();
+            AMC_REQUIRE(size <= parts.remaining(), corrupt, where + ": arithmetic part is longer than the block");
+            arithmetic_size = size_t(size);
+        }
+        ArithmeticDecoder decoder(parts.rest(), arithmetic_size);
         const std::vector<NodeId> nodes = hierarchy.level_nodes();
         // The refined nodes R of a level create at least 1.5 R vertices, whose positions are in
         // this block: it bounds R before the next level is allocated.
         hierarchy.decode_level(decoder, 2 * max_decodable_positions(block.size - 1) / 3);
-        for (auto [n, e] : new_vertices_of_level(h, nodes)) {
-            const Vec3 p = positions.decode(decoder, level_context(h.level(n)), predict(h, predictor, n, e));
-            AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
-                        "level " + std::to_string(level) + " geometry is corrupt (non-finite coordinate)");
-            h.set_position(h.midpoint(n, e), p);
+        const std::vector<std::pair<NodeId, int>> created = new_vertices_of_level(h, nodes);
+        if (predictor == GeometryPredictor::normal_frame) {
+            StaticTables tables;
+            const CoordinateSpace space{precision, quantized ? &meta.quantizer : nullptr};
+            AMC_REQUIRE(read_static_tables(decoder, space, tables) && !decoder.overran(), corrupt, where + ": bad geometry tables");
+            for (size_t i = 0; i < arithmetic_size; ++i) parts.u8();
+            const uint64_t rans_size = parts.varint();
+            AMC_REQUIRE(rans_size <= parts.remaining(), corrupt, where + ": rANS stream is longer than the block");
+            const uint8_t* rans = parts.rest();
+            const uint8_t* raw = rans + rans_size;
+            const size_t raw_size = parts.remaining() - size_t(rans_size);
+            AMC_REQUIRE(decode_static_positions(h, created, space, tables, rans, size_t(rans_size), raw, raw_size), corrupt,
+                        where + " is truncated or corrupt (positions)");
+        } else {
+            for (auto [n, e] : created) {
+                const Vec3 p = positions.decode(decoder, level_context(h.level(n)), predict(h, predictor, n, e));
+                AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
+                            "level " + std::to_string(level) + " geometry is corrupt (non-finite coordinate)");
+                h.set_position(h.midpoint(n, e), p);
+            }
+            AMC_REQUIRE(!positions.saw_invalid_symbol(), corrupt, where + " is truncated or corrupt");
         }
-        AMC_REQUIRE(!decoder.overran() && !positions.saw_invalid_symbol(), corrupt,
-                    "level " + std::to_string(level) + " block is truncated or corrupt");
+        AMC_REQUIRE(!decoder.overran(), corrupt, where + " is truncated or corrupt");
         ++level;
         if (partial != nullptr) partial->levels_decoded = level;
     }

@@ -4,6 +4,8 @@
 
 #include "common/exact_float.h"
 
+#include <cmath>
+
 namespace amc {
 
 namespace {
@@ -73,6 +75,42 @@ Vec3 predict_butterfly(const Hierarchy& h, NodeId n, int e) {
     const Vec3 p = rounded_scaled(0.5, a + b) + rounded_scaled(0.125, c + d) -
                    rounded_scaled(0.0625, (w_bc + w_ca) + (w_ad + w_db));
     return round_if_single(h, p);
+}
+
+namespace {
+
+double component(Vec3 p, int axis) { return axis == 0 ? p.x : axis == 1 ? p.y : p.z; }
+
+// u x v with every product rounded before the subtraction (no fused multiply-add).
+Vec3 exact_cross(Vec3 u, Vec3 v) {
+    return {rounded(u.y * v.z) - rounded(u.z * v.y), rounded(u.z * v.x) - rounded(u.x * v.z),
+            rounded(u.x * v.y) - rounded(u.y * v.x)};
+}
+
+}  // namespace
+
+NormalFrame normal_frame(const Hierarchy& h, NodeId n, int e) {
+    NormalFrame f;
+    f.midpoint = predict_midpoint(h, n, e);
+    const Vec3 a = h.position(h.vertex(n, e));
+    const Vec3 b = h.position(h.vertex(n, (e + 1) % 3));
+    const Vec3 c = h.position(h.vertex(n, (e + 2) % 3));
+    f.normal = exact_cross(b - a, c - a);
+    const NodeId q = h.neighbor(n, e);
+    if (q != kNoNode) f.normal = f.normal + exact_cross(a - b, opposite(h, q, h.neighbor_edge(n, e)) - b);
+    for (int i = 1; i < 3; ++i)
+        if (std::fabs(component(f.normal, i)) > std::fabs(component(f.normal, f.axis))) f.axis = i;
+    const double largest = std::fabs(component(f.normal, f.axis));
+    f.has_normal = largest > 0 && std::isfinite(largest);
+    return f;
+}
+
+Vec3 NormalFrame::predict(double first_axis_value) const {
+    if (!has_normal) return midpoint;
+    const double t = rounded((first_axis_value - component(midpoint, axis)) / component(normal, axis));
+    Vec3 p = midpoint + rounded_scaled(t, normal);
+    (axis == 0 ? p.x : axis == 1 ? p.y : p.z) = first_axis_value;
+    return p;
 }
 
 Vec3 predict_parallelogram(const std::vector<Vec3>& decoded, std::array<int32_t, 3> stencil) {

@@ -42,6 +42,23 @@ Vec3 predict_midpoint(const Hierarchy& h, NodeId n, int e);
 // single-precision hierarchies.
 Vec3 predict_butterfly(const Hierarchy& h, NodeId n, int e);
 
+// The frame of the normal-frame predictor (FORMAT.md 5.5): the midpoint of edge e of node n, the
+// summed normals N of n and of its same-level neighbour across e (cross products of edge vectors,
+// n's alone at a boundary), and the axis where |N| is largest. The vertex's coordinate on that
+// axis is coded first against the midpoint; the offset it shows, taken along N, predicts the
+// other two: surface remeshes place new vertices on the surface near the edge's midpoint, so the
+// residual lies mostly along the normal. has_normal is false when N is zero or not finite (then
+// all three coordinates are predicted by the midpoint, x first).
+struct NormalFrame {
+    Vec3 midpoint;
+    Vec3 normal;
+    int axis = 0;
+    bool has_normal = false;
+    // The other coordinates' prediction once the first axis's value is known.
+    Vec3 predict(double first_axis_value) const;
+};
+NormalFrame normal_frame(const Hierarchy& h, NodeId n, int e);
+
 // Parallelogram rule over already decoded positions: a + b - c when all three indices are valid
 // (>= 0 and < decoded.size()), else a when a is valid, else the zero vector.
 Vec3 predict_parallelogram(const std::vector<Vec3>& decoded, std::array<int32_t, 3> stencil);
