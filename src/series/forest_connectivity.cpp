@@ -58,8 +58,8 @@ PreviousLevel previous_level(const OctreeLevels& prev, int l, const std::vector<
     return out;
 }
 
-// The inter-frame context of octant n (FORMAT.md 7.11). `changed_up[p]`: the parent p's
-// refinement changed (it is refined now).
+// The inter-frame context of octant n (FORMAT.md 7.11). `parent_area_changed[p]`: the parent p or
+// a face neighbour of it changed its refinement (area_changed of the parents' level).
 int inter_context(const OctreeLevel& lv, uint32_t n, int faces, const PreviousLevel& before, const std::vector<uint8_t>& state,
                   const std::vector<uint8_t>& parent_area_changed) {
     int octants = 0, refined_before = 0, changed = 0, refined_now = 0;
