@@ -9,9 +9,12 @@
 #include "coding/geometry/float_coder.h"
 #include "coding/hierarchy/hierarchy_stream.h"
 #include "common/bits.h"
+#include "octree/octree_file.h"
+#include "octree/octree_traversal.h"
 
 #include <amc/codec.h>
 #include <amc/hierarchy_coder.h>
+#include <amc/octree.h>
 #include <amc/refinement.h>
 
 #include <gtest/gtest.h>
@@ -453,6 +456,97 @@ TEST(CraftedFiles, HierarchyStreamCounts) {
         expect_refused_cheaply("stream uniform levels = " + std::to_string(uniform), ErrorCode::limit_exceeded,
                                [&] { decode_hierarchy(base, stream.data(), stream.size(), options); });
     }
+}
+
+// ---- .amq files (docs/FORMAT.md 8.2, 8.3, 8.5) --------------------------------------------------
+
+std::vector<uint8_t> octree_file(const OctreeMetadata& meta, const std::vector<uint8_t>& connectivity,
+                                 const std::vector<std::vector<uint8_t>>& level_payloads) {
+    BlockWriter writer(kOctreeFraming, kOctreeBaseVersion, 0);
+    writer.add(uint8_t(OctreeBlock::metadata), write_octree_metadata(meta));
+    writer.add(uint8_t(OctreeBlock::connectivity), connectivity);
+    for (const auto& p : level_payloads) writer.add(uint8_t(OctreeBlock::level), p);
+    return writer.finish();
+}
+
+// Every octant of `levels - 1` levels over `trees` trees refined, the last level's leaves
+// truncated away: no symbol at all.
+OctreeMetadata uniform_forest_metadata(int dim, uint64_t trees, int levels) {
+    OctreeMetadata meta;
+    meta.dim = dim;
+    meta.trees = trees;
+    meta.levels = uint64_t(levels);
+    meta.uniform_levels = levels - 1;
+    meta.switches = kOctreeUniformLevels | kOctreeTruncate | kOctreeCullByBalance;
+    meta.count = 0;
+    uint64_t level_octants = trees;
+    for (int l = 0; l < levels; ++l, level_octants <<= dim) meta.octants += level_octants;
+    meta.leaves = meta.octants - (meta.octants - trees) / (uint64_t{1} << dim);
+    return meta;
+}
+
+void expect_octree_refused(const std::string& what, ErrorCode expected, const std::vector<uint8_t>& file,
+                           const char* must_say = nullptr, const OctreeDecodeOptions& options = {}) {
+    expect_refused_cheaply(what, expected, [&] { decode_octree_forest(file.data(), file.size(), options); }, must_say);
+}
+
+TEST(CraftedFiles, OctreeUniformForestBomb) {
+    // A 104-byte file announcing a uniform octree of depth 8 (19.2 M octants, within the default
+    // node limit): before the per-byte bound it decoded, asking about 1 GB; now refused on the
+    // metadata.
+    const std::vector<uint8_t> brick3 = write_octree_connectivity(brick_connectivity(3, 1, 1, 1));
+    const OctreeMetadata deep = uniform_forest_metadata(3, 1, 9);
+    ASSERT_LE(deep.octants, OctreeDecodeOptions().max_nodes);
+    expect_octree_refused("uniform octree of depth 8 in 104 bytes", ErrorCode::limit_exceeded,
+                          octree_file(deep, brick3, std::vector<std::vector<uint8_t>>(9)), "octants per byte");
+    // A quadtree of depth 12 (22.4 M octants).
+    const std::vector<uint8_t> brick2 = write_octree_connectivity(brick_connectivity(2, 1, 1));
+    expect_octree_refused("uniform quadtree of depth 12", ErrorCode::limit_exceeded,
+                          octree_file(uniform_forest_metadata(2, 1, 13), brick2, std::vector<std::vector<uint8_t>>(13)),
+                          "octants per byte");
+    // A brick of 4095 x 4096 trees, all leaves (16.8 M roots in a few bytes).
+    std::vector<uint8_t> wide = {uint8_t(OctreeConnectivityMode::brick), 0};  // not periodic
+    put_varint(wide, 4095);
+    put_varint(wide, 4096);
+    OctreeMetadata roots = uniform_forest_metadata(2, 4095 * 4096, 1);
+    roots.switches = kOctreeTruncate;
+    expect_octree_refused("brick of 16.8 M trees, all leaves", ErrorCode::limit_exceeded,
+                          octree_file(roots, wide, std::vector<std::vector<uint8_t>>(1)), "octants per byte");
+    // Exactly at the bound it decodes, one byte short it is refused (a bound of 64 octants per
+    // byte, to keep the forest small).
+    OctreeDecodeOptions tight;
+    tight.max_octants_per_byte = 64;
+    const OctreeMetadata small = uniform_forest_metadata(2, 1, 8);  // 21,845 octants
+    std::vector<std::vector<uint8_t>> levels(8);
+    const std::vector<uint8_t> unpadded = octree_file(small, brick2, levels);
+    const size_t after = unpadded.size() - kFileHeaderSize - kBlockOverhead - write_octree_metadata(small).size();
+    const size_t needed = (small.octants + 63) / 64;
+    ASSERT_LT(after, needed);
+    levels.back().resize(needed - after - 1);
+    expect_octree_refused("uniform quadtree one byte short", ErrorCode::limit_exceeded, octree_file(small, brick2, levels),
+                          "octants per byte", tight);
+    levels.back().resize(needed - after);
+    const std::vector<uint8_t> enough = octree_file(small, brick2, levels);
+    EXPECT_EQ(decode_octree_forest(enough.data(), enough.size(), tight), uniform_octree_forest(brick_connectivity(2, 1, 1), 7));
+    // The bound lifted, the unpadded file decodes too (files written before it).
+    tight.max_octants_per_byte = 0;
+    EXPECT_EQ(decode_octree_forest(unpadded.data(), unpadded.size(), tight).leaves.size(), small.leaves);
+}
+
+TEST(CraftedFiles, OctreeWriterPadsCostlessForests) {
+    // A uniform quadtree of depth 10 (1.4 M octants) costs no symbol: the writer pads its last
+    // level block so that the file holds at most kOctreeOctantsPerByte octants per byte after the
+    // metadata, and it decodes with the default options to the same forest.
+    const OctreeForest forest = uniform_octree_forest(brick_connectivity(2, 1, 1), 10);
+    OctreeEncodeStats stats;
+    const std::vector<uint8_t> file = encode_octree_forest(forest, {}, &stats);
+    EXPECT_EQ(stats.uniform, stats.nodes - forest.leaves.size());
+    BlockReader reader(file.data(), file.size(), kOctreeFraming);
+    Block metadata{};
+    ASSERT_TRUE(reader.next(metadata));
+    EXPECT_GE(reader.remaining() * kOctreeOctantsPerByte, stats.nodes);
+    EXPECT_LT((reader.remaining() - 1) * kOctreeOctantsPerByte, stats.nodes);  // no more than needed
+    EXPECT_EQ(decode_octree_forest(file.data(), file.size()), forest);
 }
 
 }  // namespace

@@ -155,10 +155,18 @@ struct OctreeEncodeStats {
 std::vector<uint8_t> encode_octree_forest(const OctreeForest& forest, const OctreeEncodeOptions& options = {},
                                           OctreeEncodeStats* stats = nullptr);
 
+// Octants a file may announce per byte after its metadata block (docs/FORMAT.md 8.5, Bounds):
+// uniform levels, truncated zeros and bricks cost no bits, so the writer pads a forest that would
+// hold more, and a reader refuses more before it allocates anything for the forest.
+constexpr uint64_t kOctreeOctantsPerByte = 4096;
+
 struct OctreeDecodeOptions {
     int max_level = -1;              // >= 0: progressive, only levels 0 .. max_level
     uint64_t max_nodes = uint64_t{1} << 26;  // refuse files announcing more octants (about 50 bytes each)
     uint64_t max_leaf_values = uint64_t{1} << 28;  // refuse leaf fields of more values (8 bytes each)
+    // Refuse files announcing more octants per byte after their metadata block; 0: no bound (files
+    // written before the bound, whose uniform forests of millions of octants may take a few bytes).
+    uint64_t max_octants_per_byte = kOctreeOctantsPerByte;
 };
 // Throws Error (truncated, checksum, corrupt, limit_exceeded, ...) on anything but a file
 // encode_octree_forest writes. Progressive decoding (max_level) leaves out the leaf data.

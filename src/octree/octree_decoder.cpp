@@ -32,6 +32,14 @@ OctreeForest decode_octree_forest(const uint8_t* data, size_t size, const Octree
         BlockReader reader(data, size, kOctreeFraming);
         Block block = next_block(reader, OctreeBlock::metadata);
         const OctreeMetadata meta = read_octree_metadata(block.payload, block.size, options.max_nodes);
+        // FORMAT.md 8.5, Bounds: the bytes after the metadata back the octants, whose memory (about
+        // 50 bytes each) would otherwise grow without them (uniform levels, truncation, bricks).
+        const uint64_t per_byte = options.max_octants_per_byte;
+        const uint64_t after = reader.remaining();
+        AMC_REQUIRE(per_byte == 0 || meta.octants / per_byte + (meta.octants % per_byte != 0) <= after, limit_exceeded,
+                    "metadata block: " + std::to_string(meta.octants) + " octants in the " + std::to_string(after) +
+                        " bytes after it, more than the limit of " + std::to_string(per_byte) +
+                        " octants per byte (OctreeDecodeOptions::max_octants_per_byte)");
         block = next_block(reader, OctreeBlock::connectivity);
         const TreeConnectivity conn = read_octree_connectivity(block.payload, block.size, meta.dim, meta.trees, reader.version());
 

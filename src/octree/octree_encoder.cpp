@@ -85,6 +85,7 @@ std::vector<uint8_t> encode_octree_forest(const OctreeForest& forest, const Octr
     writer.add(uint8_t(OctreeBlock::metadata), write_octree_metadata(meta));
     writer.add(uint8_t(OctreeBlock::connectivity), conn);
     std::vector<BitModel> models(octree_model_count(d));
+    std::vector<std::vector<uint8_t>> level_payloads(level_count);
     uint64_t coded = 0, level_bytes = 0;
     for (int l = 0; l < level_count; ++l) {
         ArithmeticEncoder encoder;
@@ -93,16 +94,26 @@ std::vector<uint8_t> encode_octree_forest(const OctreeForest& forest, const Octr
             encoder.encode(s.refined, models[s.model]);
             ++coded;
         }
-        const std::vector<uint8_t> payload = encoder.finish();
-        level_bytes += payload.size();
-        writer.add(uint8_t(OctreeBlock::level), payload);
+        level_payloads[l] = encoder.finish();
+        level_bytes += level_payloads[l].size();
     }
+    std::vector<std::vector<uint8_t>> field_payloads;
     uint64_t leaf_data_bytes = 0;
     for (const Field& field : forest.leaf_data) {
-        const std::vector<uint8_t> payload = write_leaf_field(field, forest.leaves);
-        leaf_data_bytes += payload.size();
-        writer.add(uint8_t(OctreeBlock::leaf_field), payload);
+        field_payloads.push_back(write_leaf_field(field, forest.leaves));
+        leaf_data_bytes += field_payloads.back().size();
     }
+    // FORMAT.md 8.5, Bounds: at most kOctreeOctantsPerByte octants per byte after the metadata
+    // block; zeros after the last level's symbols (read as the bytes past its end would be) make up
+    // what a forest of costless levels lacks.
+    const uint64_t after = conn.size() + level_bytes + leaf_data_bytes + (level_count + forest.leaf_data.size() + 2) * kBlockOverhead;
+    const uint64_t needed = meta.octants / kOctreeOctantsPerByte + (meta.octants % kOctreeOctantsPerByte != 0);
+    if (needed > after) {
+        level_payloads.back().resize(level_payloads.back().size() + (needed - after), 0);
+        level_bytes += needed - after;
+    }
+    for (const std::vector<uint8_t>& payload : level_payloads) writer.add(uint8_t(OctreeBlock::level), payload);
+    for (const std::vector<uint8_t>& payload : field_payloads) writer.add(uint8_t(OctreeBlock::leaf_field), payload);
     std::vector<uint8_t> file = writer.finish();
     if (stats) {
         stats->nodes = meta.octants;
