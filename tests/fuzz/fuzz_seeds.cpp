@@ -22,6 +22,7 @@
 #include <amc/series.h>
 #include <amc/simulation.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -48,12 +49,15 @@ void write_seed(const std::string& target, const std::string& bytes) {
     write_seed(target, std::vector<uint8_t>(bytes.begin(), bytes.end()));
 }
 
-void copy_files(const fs::path& dir, const std::string& target, const std::string& extension, const std::string& prefix = "") {
+// Every file under `dir` with the extension, named after its path below `dir` (golden files of
+// different versions share their names: v1/lshape_graded.amc, v4/lshape_graded.amc).
+void copy_files(const fs::path& dir, const std::string& target, const std::string& extension) {
     if (!fs::is_directory(dir)) return;
     for (const auto& entry : fs::recursive_directory_iterator(dir)) {
-        const std::string name = entry.path().filename().string();
-        if (!entry.is_regular_file() || name.rfind(prefix, 0) != 0) continue;
+        if (!entry.is_regular_file()) continue;
         if (!extension.empty() && entry.path().extension() != extension) continue;
+        std::string name = fs::relative(entry.path(), dir).string();
+        std::replace(name.begin(), name.end(), '/', '_');
         fs::create_directories(out_dir / target);
         fs::copy_file(entry.path(), out_dir / target / ("data_" + name), fs::copy_options::overwrite_existing);
     }
@@ -296,6 +300,7 @@ int main(int argc, char** argv) {
     }
     copy_files(data / "golden", "series_read", ".amcs");
     copy_files(data / "golden", "octree_decode", ".amq");
+    copy_files(data / "golden", "amh_read", ".amh");
     copy_files(data / "bad", "amh_read", ".amh");
     copy_files(data / "bad", "obj_read", ".obj");
     copy_files(data / "bad", "off_read", ".off");
