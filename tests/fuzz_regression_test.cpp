@@ -1,6 +1,6 @@
 // Every input a fuzzer found a problem with (tests/data/fuzz-regressions/<target>/, named after
 // the finding) runs through its target again, as do the golden files through the .amc targets
-// (all of them) and the series and octree targets (.amcs, .amq): a crash, sanitizer report,
+// (all of them) and the series, octree and .amh targets (.amcs, .amq, .amh): a crash, sanitizer report,
 // uncaught exception or violated property fails the test.
 #include "fuzz_targets.h"
 
@@ -32,7 +32,10 @@ TEST_P(FuzzRegressions, EveryFoundInputPasses) {
     if (fs::is_directory(regressions))
         for (const auto& entry : fs::directory_iterator(regressions)) inputs.push_back(entry.path());
     const std::string name = target.name;
-    const std::string golden_extension = name == "series_read" ? ".amcs" : name == "octree_decode" ? ".amq" : "";
+    const std::string golden_extension = name == "series_read" || name == "forest_series_read" ? ".amcs"
+                                         : name == "octree_decode"                              ? ".amq"
+                                         : name == "amh_read"                                   ? ".amh"
+                                                                                                : "";
     if (name.rfind("amc_", 0) == 0 || !golden_extension.empty())
         for (const auto& entry : fs::recursive_directory_iterator(data / "golden"))
             if (entry.is_regular_file() && (golden_extension.empty() || entry.path().extension() == golden_extension))

@@ -249,6 +249,22 @@ void series_seeds() {
     }
 }
 
+// Small forest series over bricks of 2D and 3D trees: random forests (unbalanced: coded without
+// culling), keyframes or not, an unfinished file.
+void forest_series_seeds() {
+    for (int k = 0; k < 4; ++k) {
+        const int dim = 2 + k % 2;
+        const TreeConnectivity conn = brick_connectivity(dim, 2, 1, 1);
+        SeriesOptions options;
+        options.keyframe_interval = k / 2 ? 2 : 0;
+        ForestSeriesWriter writer(conn, options);
+        for (int f = 0; f < 4; ++f)
+            writer.add_frame(random_octree_forest(conn, uint64_t(10 * k + f), 0.35, 1, dim == 2 ? 5 : 3), 0.5 * f);
+        if (k != 1) writer.close();
+        write_seed("forest_series_read", writer.bytes());
+    }
+}
+
 // Forests of every connectivity mode (brick, periodic brick, glued by vertices, explicit without
 // vertices), 2D and 3D, balanced or not, with every switch somewhere.
 void octree_seeds() {
@@ -293,12 +309,14 @@ int main(int argc, char** argv) {
     mesh_seeds(hierarchies);
     round_trip_seeds();
     series_seeds();
+    forest_series_seeds();
     octree_seeds();
     for (const char* target : {"amc_decode", "amc_inspect"}) {
         copy_files(data / "golden", target, ".amc");
         copy_files(data / "bad", target, ".amc");
     }
-    copy_files(data / "golden", "series_read", ".amcs");
+    copy_files(data / "golden", "series_read", ".amcs");  // forest series too: refused by name
+    copy_files(data / "golden", "forest_series_read", ".amcs");  // triangle series too: refused by name
     copy_files(data / "golden", "octree_decode", ".amq");
     copy_files(data / "golden", "amh_read", ".amh");
     copy_files(data / "bad", "amh_read", ".amh");

@@ -22,6 +22,7 @@ const std::vector<Target>& targets() {
         {"vtu_read", vtu_read},
         {"round_trip", round_trip},
         {"series_read", series_read},
+        {"forest_series_read", forest_series_read},
         {"octree_decode", octree_decode},
     };
     return all;

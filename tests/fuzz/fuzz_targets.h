@@ -33,6 +33,7 @@ void ply_read(const uint8_t* data, size_t size);
 void vtu_read(const uint8_t* data, size_t size);
 void round_trip(const uint8_t* data, size_t size);         // random hierarchy -> encode -> decode
 void series_read(const uint8_t* data, size_t size);        // .amcs reader, every frame, written again
+void forest_series_read(const uint8_t* data, size_t size); // .amcs forest series reader, every frame, written again
 void octree_decode(const uint8_t* data, size_t size);      // .amq decode: whole, progressive, encoded again
 
 // Input layouts of the stream targets, which fuzz_seeds writes too.
