@@ -3,7 +3,7 @@
 # them one after the other under nice -n 19, each for --seconds (default an hour).
 #
 #   scripts/fuzz.sh [--seconds N] [--runs N] [--timeout S] [--seed S] [--build DIR] [--corpus DIR] [--no-build] [TARGET ...]
-#   scripts/fuzz.sh --totals [--corpus DIR]
+#   scripts/fuzz.sh --totals [--markdown] [--corpus DIR]
 #
 # Each target stops after --seconds or --runs executions, whichever comes first. --seed fixes
 # libFuzzer's random seed (CI: the same mutations every run); 0, the default, draws one.
@@ -19,8 +19,9 @@
 # target: executions, wall-clock seconds, CPU seconds (under nice -n 19 on a loaded machine the
 # two differ a lot), coverage (libFuzzer's cov and ft at the end), corpus size, new findings.
 # --totals sums that file per target (executions and CPU seconds over every run, the last run's
-# coverage). --no-build runs the binaries already in DIR. Exits 1 when any target found
-# something. .ci/run runs every target briefly.
+# coverage); with --markdown as docs/FUZZING.md's table, saying which targets are below 10^7.
+# --no-build runs the binaries already in DIR. Exits 1 when any target found something. .ci/run
+# runs every target briefly.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=3600
@@ -31,6 +32,7 @@ build=build-fuzz
 corpus=
 do_build=1
 totals=0
+markdown=0
 targets=()
 while (($#)); do
   case "$1" in
@@ -42,17 +44,27 @@ while (($#)); do
     --corpus) corpus="$2"; shift 2 ;;
     --no-build) do_build=0; shift ;;
     --totals) totals=1; shift ;;
-    -h|--help) sed -n '2,23p' "$0"; exit 0 ;;
+    --markdown) markdown=1; shift ;;
+    -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
     *) targets+=("$1"); shift ;;
   esac
 done
 corpus="${corpus:-$build/corpus}"
 
 if ((totals)); then
-  # Summary lines: date target executions seconds cpu_s cov ft corpus findings.
-  printf '%-18s %5s %12s %9s %9s %7s %7s %7s %8s\n' target runs executions seconds cpu_s cov ft corpus findings
-  awk '{ n[$2] += $3; s[$2] += $4; c[$2] += $5; cov[$2] = $6; ft[$2] = $7; k[$2] = $8; f[$2] += $9; r[$2]++ }
-       END { for (t in n) printf "%-18s %5d %12d %9d %9d %7d %7d %7d %8d\n", t, r[t], n[t], s[t], c[t], cov[t], ft[t], k[t], f[t] }' \
+  # Summary lines: date target executions seconds cpu_s cov ft corpus findings. --markdown: the
+  # table of docs/FUZZING.md, with whether the target reached issue 24's 10^7 executions.
+  if ((markdown)); then
+    echo '| target | runs | executions | seconds | CPU seconds | cov | ft | corpus | findings | 10^7 executions |'
+    echo '|---|---:|---:|---:|---:|---:|---:|---:|---:|---|'
+  else
+    printf '%-18s %5s %12s %9s %9s %7s %7s %7s %8s\n' target runs executions seconds cpu_s cov ft corpus findings
+  fi
+  awk -v markdown="$markdown" '{ n[$2] += $3; s[$2] += $4; c[$2] += $5; cov[$2] = $6; ft[$2] = $7; k[$2] = $8; f[$2] += $9; r[$2]++ }
+       END { for (t in n)
+               if (markdown) printf "| `%s` | %d | %d | %d | %d | %d | %d | %d | %d | %s |\n", t, r[t], n[t], s[t], c[t], cov[t], ft[t], k[t], f[t],
+                                    (n[t] >= 10000000 ? "reached" : sprintf("**below** (%.1f%%)", n[t] / 1e5))
+               else printf "%-18s %5d %12d %9d %9d %7d %7d %7d %8d\n", t, r[t], n[t], s[t], c[t], cov[t], ft[t], k[t], f[t] }' \
     "$corpus/fuzz-summary.txt" | sort
   exit 0
 fi
