@@ -62,6 +62,8 @@ SeriesScan scan_series_file(const std::vector<uint8_t>& bytes, const std::string
         const bool have_base = !scan.blocks.empty();
         const size_t frames = have_base ? scan.blocks.size() - 1 : 0;
         if (pos == size) {
+            // Unfinished files are read from their base block on (FORMAT.md 7.2); a header alone has none.
+            AMC_REQUIRE(have_base, truncated, what + ": truncated after the header (no base block)");
             AMC_REQUIRE(allow_unfinished, truncated,
                         what + ": unfinished series: no END block after " + std::to_string(frames) +
                             " complete frames (the writer did not close it; read with allow_unfinished / --partial)");
