@@ -249,6 +249,39 @@ TEST(RoundTrip, SinglePrecisionIsDetectedFromValues) {
     EXPECT_TRUE(parse_obj("v 0.5 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "t.obj").single_precision);
 }
 
+// Float data printed as the shortest decimal of each float (8 or 9 digits on some coordinate)
+// is read as floats, and written back as the same text.
+TEST(RoundTrip, FloatDecimalsAreReadAsFloats) {
+    const std::string obj = "v 0.00040300004 -0.0401785 0.1\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    const TriangleMesh mesh = parse_obj(obj, "t.obj");
+    EXPECT_TRUE(mesh.single_precision);
+    EXPECT_EQ(mesh.positions[0].x, static_cast<double>(0.00040300004f));
+    EXPECT_EQ(mesh.positions[0].z, static_cast<double>(0.1f));
+    EXPECT_EQ(format_obj(mesh), obj);
+    const TriangleMesh off = parse_off("OFF 3 1 0  0.00040300004 -0.0401785 0.1  1 0 0  0 1 0  3 0 1 2", "t.off");
+    EXPECT_TRUE(off.single_precision);
+    expect_bit_exact(mesh, off);
+    EXPECT_EQ(format_off(off), "OFF\n3 1 0\n0.00040300004 -0.0401785 0.1\n1 0 0\n0 1 0\n3 0 1 2\n");
+
+    // One coordinate no float prints (9 digits, not a float's shortest): all stay doubles.
+    const TriangleMesh doubles = parse_obj("v 0.00040300004 0.123456789 0.1\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "t.obj");
+    EXPECT_FALSE(doubles.single_precision);
+    EXPECT_EQ(doubles.positions[0].x, 0.00040300004);
+    EXPECT_EQ(doubles.positions[0].z, 0.1);
+}
+
+// Floats whose decimals are all short (0.1f) would read back as doubles: they are printed as
+// doubles, which read back as exact floats.
+TEST(RoundTrip, ShortFloatDecimalsReadBackAsFloats) {
+    TriangleMesh mesh = tetrahedron();
+    mesh.single_precision = true;
+    for (Vec3& p : mesh.positions) p = {static_cast<float>(p.x + 0.1), static_cast<float>(p.y + 0.2), 0.3f};
+    for (const TriangleMesh& back : {parse_obj(format_obj(mesh), "t.obj"), parse_off(format_off(mesh), "t.off")}) {
+        EXPECT_TRUE(back.single_precision);
+        expect_bit_exact(mesh, back);
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Readers on hand-written input
 

@@ -21,6 +21,7 @@
 #include <tiny_obj_loader.h>
 
 #include "common/check.h"
+#include "mesh/float_text.h"
 #include "mesh/text_number.h"
 
 namespace amc {
@@ -152,23 +153,17 @@ TriangleMesh parse_obj(const std::string& text, const std::string& what) {
         fail(what, "OBJ parse error: inconsistent face count");
     }
 
-    mesh.single_precision = true;
-    for (const Vec3& p : mesh.positions) {
-        for (double c : {p.x, p.y, p.z}) {
-            if (static_cast<double>(static_cast<float>(c)) != c) mesh.single_precision = false;
-        }
-    }
+    text::adopt_float_text(mesh);
     return mesh;
 }
 
 std::string format_obj(const TriangleMesh& mesh) {
     std::string out;
     out.reserve(mesh.positions.size() * 40 + mesh.triangles.size() * 24);
-    // Doubles even when single_precision: the shortest decimal of a float is a different double
-    // when read back, and OBJ has no way to say "these are floats".
+    const bool float_text = text::prints_as_float_text(mesh);
     for (const Vec3& p : mesh.positions) {
         out += "v ";
-        text::append_line(out, p.x, p.y, p.z);
+        text::append_position(out, p, float_text);
     }
     for (const Triangle& t : mesh.triangles) {
         out += "f ";

@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "common/check.h"
+#include "mesh/float_text.h"
 #include "mesh/text_number.h"
 
 namespace amc {
@@ -50,7 +51,6 @@ TriangleMesh parse_off(std::string_view text, const std::string& what) {
 
     TriangleMesh mesh;
     mesh.positions.resize(vertex_count);
-    mesh.single_precision = true;
     for (uint64_t v = 0; v < vertex_count; ++v) {
         double xyz[3];
         for (double& c : xyz) {
@@ -63,7 +63,6 @@ TriangleMesh parse_off(std::string_view text, const std::string& what) {
                 fail(what, "vertex " + std::to_string(v) + " (line " + std::to_string(in.line()) +
                                ") has a malformed coordinate " + text::quote_token(token));
             }
-            if (static_cast<double>(static_cast<float>(c)) != c) mesh.single_precision = false;
         }
         mesh.positions[v] = {xyz[0], xyz[1], xyz[2]};
     }
@@ -103,6 +102,7 @@ TriangleMesh parse_off(std::string_view text, const std::string& what) {
         }
         in.skip_line();  // optional face colour
     }
+    text::adopt_float_text(mesh);
     return mesh;
 }
 
@@ -112,10 +112,9 @@ std::string format_off(const TriangleMesh& mesh) {
     out += ' ';
     text::append_uint(out, mesh.triangles.size());
     out += " 0\n";
-    // Shortest decimals of the double values (also for single_precision meshes: the shortest
-    // decimal of a float would read back as a different double).
+    const bool float_text = text::prints_as_float_text(mesh);
     for (const Vec3& p : mesh.positions) {
-        text::append_line(out, p.x, p.y, p.z);
+        text::append_position(out, p, float_text);
     }
     for (const Triangle& t : mesh.triangles) {
         out += "3 ";
