@@ -187,7 +187,7 @@ int main(int argc, char** argv) {
         for (const CodedSymbol& s : trace) {
             Features f{};
             f.group = s.group;
-            f.center = h.child_index(s.node) == 3;
+            f.center = h.child_index(s.node) == amc::red_split::kCenter;
             const NodeId p = h.parent(s.node);
             if (p != kNoNode) {
                 for (int e = 0; e < 3; ++e) {

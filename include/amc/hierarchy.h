@@ -1,15 +1,9 @@
 // The adaptive red-green multiresolution mesh: a base triangle mesh and a forest of quad-trees,
 // one per base triangle (paper, section II-A).
 //
-// Child order and local indexing (fixed here and nowhere else):
-//   a node is a triangle (v0, v1, v2); edge e joins v[e] and v[(e+1)%3]; m_e is its midpoint.
-//   child 0 = (v0, m0, m2)   corner child at v0
-//   child 1 = (m0, v1, m1)   corner child at v1
-//   child 2 = (m2, m1, v2)   corner child at v2
-//   child 3 = (m1, m2, m0)   center child
-// Every child's edge e is parallel to the parent's edge e, so local indices mean the same thing
-// on all levels; the first half of parent edge e is child e's edge e, the second half is child
-// (e+1)%3's edge e. Corner child k and the center share their edge (k+1)%3.
+// A node is a triangle (v0, v1, v2); edge e joins v[e] and v[(e+1)%3]. A refined node has four
+// children (a red split): which corners and edge midpoints each one has, and how they link, is
+// fixed in <amc/red_split.h> and nowhere else.
 //
 // Balance: the levels of leaves that share (part of) an edge differ by at most one. Equivalently
 // a node may have children only if each of its non-boundary edges has a neighbour of the same
@@ -18,6 +12,7 @@
 #pragma once
 
 #include <amc/mesh.h>
+#include <amc/red_split.h>
 
 #include <cstdint>
 #include <vector>
@@ -79,7 +74,9 @@ public:
         return is_leaf(n) && nodes_[n].level < kMaxLevel && has_all_neighbors(n);
     }
     // Midpoint vertex of edge e of a refined node.
-    VertexId midpoint(NodeId n, int e) const { return nodes_[child(n, 3)].v[(e + 2) % 3]; }
+    VertexId midpoint(NodeId n, int e) const {
+        return nodes_[child(n, red_split::kCenter)].v[red_split::kCenterVertexOfMidpoint[e]];
+    }
 
     // ---- diagonal of a two-hanging-node closure ---------------------------------------------
     // The default rule (documented in docs/HIERARCHY.md): with unrefined edge u, the diagonal

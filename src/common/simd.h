@@ -1,7 +1,8 @@
-// The one place that chooses the instruction set of the hand-vectorised kernels (forest.cpp and
-// coding/hierarchy/hierarchy_traversal.h): SSE2 where the compiler targets it, else their scalar twins,
-// which compute the same. AMC_SCALAR (CMake option AMC_SCALAR) forces the scalar twins and the
-// byte-by-byte forms of the little-endian shortcuts, so that CI builds and tests them on x86-64.
+// The one place that chooses the instruction set of the hand-vectorised kernels (forest.cpp,
+// hierarchy/red_split_kernels.h, coding/hierarchy/hierarchy_traversal.h): SSE2 where the compiler
+// targets it, else their scalar twins, which compute the same. AMC_SCALAR (CMake option
+// AMC_SCALAR) forces the scalar twins and the byte-by-byte forms of the little-endian shortcuts,
+// so that CI builds and tests them on x86-64.
 #pragma once
 
 #if defined(__SSE2__) && !defined(AMC_SCALAR)

@@ -32,8 +32,8 @@ Hierarchy reorder_base(const Hierarchy& h, const std::vector<uint32_t>& vertex_o
         for (int i = 0; i < 3; ++i) base.triangles[t][i] = new_id[old_base.triangles[o][(i + rotation[t]) % 3]];
     }
 
-    // Replay the forest breadth-first. A node rotated by r has its corner child k at the old
-    // corner child (k + r) % 3, rotated by r as well; the centre stays the centre. The default
+    // Replay the forest breadth-first. A node rotated by r has as child k the old node's child
+    // red_split::kRotatedChild[r][k], rotated by r as well. The default
     // diagonal rule is cyclic, so diagonal flags carry over unchanged.
     Hierarchy out(std::move(base));
     if (vertex_map != nullptr) vertex_map->assign(h.positions().size(), kNoVertex);
@@ -55,7 +55,7 @@ Hierarchy reorder_base(const Hierarchy& h, const std::vector<uint32_t>& vertex_o
         out.split(new_node);
         for (int e = 0; e < 3; ++e) out.set_position(out.midpoint(new_node, e), h.position(h.midpoint(old_node, (e + r) % 3)));
         for (int k = 0; k < 4; ++k) {
-            queue.push_back({h.child(old_node, k == 3 ? 3 : (k + r) % 3), out.child(new_node, k)});
+            queue.push_back({h.child(old_node, red_split::kRotatedChild[r][k]), out.child(new_node, k)});
             node_rotation.push_back(uint8_t(r));
         }
     }

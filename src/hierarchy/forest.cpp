@@ -5,7 +5,7 @@
 #include "common/exact_float.h"
 #include "common/huge_pages.h"
 #include "common/simd.h"
-#include "hierarchy/child_links.h"
+#include "hierarchy/red_split_kernels.h"
 #include "mesh/vertex_buckets.h"
 
 #include <algorithm>
@@ -270,16 +270,22 @@ void Hierarchy::split(NodeId n) {
         for (int i = 0; i < 3; ++i) child.nbr[i] = kNoNode;
         child.nbr_edge = 0;
         child.level = uint8_t(parent.level + 1);
-        child.flags = uint8_t(parent.flags & kChildEdges[k].boundary);
+        child.flags = uint8_t(parent.flags & red_split::kChildEdges[k].boundary);
         child.reserved = 0;
     }
-    for (int k = 0; k < 3; ++k) link(c + k, (k + 1) % 3, c + 3, (k + 1) % 3);
+    for (int k = 0; k < 4; ++k) {
+        for (int e = 0; e < 3; ++e) {
+            const int s = red_split::sibling(k, e);
+            if (s > k) link(c + NodeId(k), e, c + NodeId(s), e);
+        }
+    }
+    // The edge runs the other way in the neighbour: the first half of ours is the second of its.
     for (int e = 0; e < 3; ++e) {
         NodeId q = parent.nbr[e];
         if (q == kNoNode || is_leaf(q)) continue;
         int eq = neighbor_edge(n, e);
-        link(c + e, e, child(q, (eq + 1) % 3), eq);
-        link(c + (e + 1) % 3, e, child(q, eq), eq);
+        link(c + red_split::kFirstHalfChild[e], e, child(q, red_split::kSecondHalfChild[eq]), eq);
+        link(c + red_split::kSecondHalfChild[e], e, child(q, red_split::kFirstHalfChild[eq]), eq);
     }
     nodes_[n].first_child = c;
 }
@@ -289,34 +295,15 @@ void Hierarchy::split(NodeId n) {
 // Four siblings' pieces are made in registers and stored whole: scalar stores of every field
 // made the build store-bound.
 
-// The vertices of four new siblings, in the child order of <amc/hierarchy.h>, from their parent's
+// The vertices of four new siblings, in the child order of <amc/red_split.h>, from their parent's
 // corners and the midpoints of its edges, and their first child (none) (split and split_level).
 void Hierarchy::write_vertices(Node* child, const VertexId corner[3], const VertexId m[3]) {
     static_assert(sizeof(Node) == 32 && offsetof(Node, first_child) == 12 && offsetof(Node, nbr) == 16 &&
                       offsetof(Node, nbr_edge) == 28,
                   "split_level writes nodes by this layout");
-#if AMC_SSE2
-    // Lane 3 of every piece is first_child: kNoNode.
-    const __m128i p = _mm_set_epi32(-1, int(corner[2]), int(corner[1]), int(corner[0]));
-    const __m128i q = _mm_set_epi32(-1, int(m[2]), int(m[1]), int(m[0]));
-    // Lanes 0-1 of shuffle_ps come from its first operand, 2-3 from its second.
-    const __m128 pf = _mm_castsi128_ps(p), qf = _mm_castsi128_ps(q);
-    const __m128 pq = _mm_castsi128_ps(_mm_unpacklo_epi32(p, q));  // corner 0, m 0, corner 1, m 1
-    auto store = [](Node& node, __m128 v) {
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(node.v), _mm_castps_si128(v));
-    };
-    store(child[0], _mm_shuffle_ps(pq, qf, _MM_SHUFFLE(3, 2, 1, 0)));  // corner 0, m 0, m 2
-    store(child[1], _mm_shuffle_ps(pq, qf, _MM_SHUFFLE(3, 1, 2, 1)));  // m 0, corner 1, m 1
-    store(child[2], _mm_shuffle_ps(qf, pf, _MM_SHUFFLE(3, 2, 1, 2)));  // m 2, m 1, corner 2
-    store(child[3], _mm_castsi128_ps(_mm_shuffle_epi32(q, _MM_SHUFFLE(3, 0, 2, 1))));  // m 1, m 2, m 0
-#else
-    const VertexId layout[4][3] = {
-        {corner[0], m[0], m[2]}, {m[0], corner[1], m[1]}, {m[2], m[1], corner[2]}, {m[1], m[2], m[0]}};
-    for (int k = 0; k < 4; ++k) {
-        for (int i = 0; i < 3; ++i) child[k].v[i] = layout[k][i];
-        child[k].first_child = kNoNode;
-    }
-#endif
+    // The fourth word is first_child: kNoNode.
+    static_assert(kNoNode == 0xffffffffu, "write_child_vertices fills the fourth word with all ones");
+    red_split_kernels::write_child_vertices(child, corner, m);
 }
 
 // The last four bytes of four new siblings but their level (word k: child k; the last byte is
@@ -331,8 +318,8 @@ struct ChildTailTable {
         for (unsigned code = 0; code < 512; ++code) {
             const unsigned outer = code & 63u, boundary = code >> 6;
             for (unsigned k = 0; k < 4; ++k) {
-                of[code].word[k] = ((outer & kChildEdges[k].outer) | kChildEdges[k].inner) |
-                                   (boundary & kChildEdges[k].boundary) << 16;
+                const red_split::ChildEdges& edges = red_split::kChildEdges[k];
+                of[code].word[k] = ((outer & edges.outer) | edges.inner) | (boundary & edges.boundary) << 16;
             }
         }
     }
@@ -386,7 +373,10 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
         return;
     }
     // The neighbour of child e of parents[i] across the first half of the parent's edge e.
-    auto first_half = [child_links](uint32_t i, int e) { return child_links[size_t(12) * i + size_t(4 * e)]; };
+    auto first_half = [child_links](uint32_t i, int e) {
+        constexpr int kWord[3] = {red_split::first_half_word(0), red_split::first_half_word(1), red_split::first_half_word(2)};
+        return child_links[size_t(12) * i + size_t(kWord[e])];
+    };
     const size_t c0 = nodes_.size();
     const size_t new_nodes = c0 + size_t(4) * count;
     if (new_nodes > nodes_.capacity()) reserve(std::max(new_nodes, nodes_.capacity() + nodes_.capacity() / 2), 0);
@@ -431,13 +421,13 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
                 linked_edges |= t == kNoNode ? 0u : 3u << (2 * e);
                 if (t / 4 < i) {
                     const unsigned eq = (parent.nbr_edge >> (2 * e)) & 3u;
-                    m[e] = nodes[c0 + (t & ~3u) + 3].v[eq == 0 ? 2 : eq - 1];
+                    m[e] = nodes[c0 + (t & ~3u) + red_split::kCenter].v[red_split::kCenterVertexOfMidpoint[eq]];
                 } else {
                     ends[new_vertices++] = {parent.v[e], parent.v[e == 2 ? 0 : e + 1]};
                     m[e] = next_vertex++;
                 }
             }
-            // The children's edges (kChildEdges): linked outer edges take the parent's neighbour
+            // The children's edges (red_split::kChildEdges): linked outer edges take the parent's neighbour
             // edge index.
             const unsigned outer = parent.nbr_edge & linked_edges;
             const uint32_t level = uint32_t(parent.level + 1) << 8;
@@ -518,7 +508,8 @@ bool Hierarchy::can_coarsen(NodeId n) const {
         ++refined_neighbours;
         int eq = neighbor_edge(n, e);
         // Children of q along the shared edge must stay within one level of n.
-        if (!is_leaf(child(q, eq)) || !is_leaf(child(q, (eq + 1) % 3))) return false;
+        if (!is_leaf(child(q, red_split::kFirstHalfChild[eq])) || !is_leaf(child(q, red_split::kSecondHalfChild[eq])))
+            return false;
     }
     return refined_neighbours < 3;  // otherwise the closure would refine n again
 }
@@ -530,8 +521,8 @@ bool Hierarchy::coarsen(NodeId n) {
         NodeId q = nodes_[n].nbr[e];
         if (q != kNoNode && !is_leaf(q)) {
             int eq = neighbor_edge(n, e);
-            nodes_[child(q, eq)].nbr[eq] = kNoNode;
-            nodes_[child(q, (eq + 1) % 3)].nbr[eq] = kNoNode;
+            nodes_[child(q, red_split::kFirstHalfChild[eq])].nbr[eq] = kNoNode;
+            nodes_[child(q, red_split::kSecondHalfChild[eq])].nbr[eq] = kNoNode;
         } else {
             free_vertices_.push_back(midpoint(n, e));
             --live_vertices_;

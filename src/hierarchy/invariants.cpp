@@ -71,12 +71,12 @@ std::string check_invariants(const Hierarchy& h) {
             if (!h.is_alive(c) || h.parent(c) != n || h.child_index(c) != k || h.level(c) != h.level(n) + 1)
                 return node_text(h, n) + ": child " + std::to_string(k) + " is inconsistent";
         }
-        const VertexId v0 = h.vertex(n, 0), v1 = h.vertex(n, 1), v2 = h.vertex(n, 2);
-        const VertexId m0 = h.midpoint(n, 0), m1 = h.midpoint(n, 1), m2 = h.midpoint(n, 2);
-        const VertexId layout[4][3] = {{v0, m0, m2}, {m0, v1, m1}, {m2, m1, v2}, {m1, m2, m0}};
+        // The six points of the split (red_split.h): corners, then midpoints.
+        const VertexId points[6] = {h.vertex(n, 0),   h.vertex(n, 1),   h.vertex(n, 2),
+                                    h.midpoint(n, 0), h.midpoint(n, 1), h.midpoint(n, 2)};
         for (int k = 0; k < 4; ++k) {
             for (int i = 0; i < 3; ++i) {
-                if (h.vertex(h.child(n, k), i) != layout[k][i])
+                if (h.vertex(h.child(n, k), i) != points[red_split::kChildPoints[k][i]])
                     return node_text(h, n) + ": child " + std::to_string(k) + " has wrong vertices";
             }
         }

@@ -38,11 +38,9 @@ TriangleMesh icosphere(int subdivisions) {
         std::vector<Triangle> finer;
         finer.reserve(mesh.triangles.size() * 4);
         for (const Triangle& t : mesh.triangles) {
-            uint32_t m0 = midpoint(t[0], t[1]), m1 = midpoint(t[1], t[2]), m2 = midpoint(t[2], t[0]);
-            finer.push_back({t[0], m0, m2});
-            finer.push_back({m0, t[1], m1});
-            finer.push_back({m2, m1, t[2]});
-            finer.push_back({m1, m2, m0});
+            // The six points of a red split (red_split.h): corners, then edge midpoints.
+            const uint32_t points[6] = {t[0], t[1], t[2], midpoint(t[0], t[1]), midpoint(t[1], t[2]), midpoint(t[2], t[0])};
+            for (const auto& child : red_split::kChildPoints) finer.push_back({points[child[0]], points[child[1]], points[child[2]]});
         }
         mesh.triangles = std::move(finer);
     }

@@ -26,7 +26,7 @@
 #include "common/compiler.h"
 #include "common/huge_pages.h"
 #include "common/simd.h"
-#include "hierarchy/child_links.h"
+#include "hierarchy/red_split_kernels.h"
 
 #include <amc/hierarchy.h>
 #include <amc/hierarchy_coder.h>
@@ -63,12 +63,13 @@ struct BlockEdges {
     uint8_t boundary;  // bits 0-2
 };
 
-// The links of child k (0..3) of a block, by its parent's BlockEdges (kChildEdges).
+// The links of child k (0..3) of a block, by its parent's BlockEdges (red_split::kChildEdges).
 inline LevelLinks child_links(const Neighbors& nbr, BlockEdges parent, unsigned k) {
     LevelLinks out;
     for (int e = 0; e < 3; ++e) out.nbr[e] = nbr.nbr[e];
-    out.nbr_edge = uint8_t((parent.nbr_edge & kChildEdges[k].outer) | kChildEdges[k].inner);
-    out.flags = uint8_t(parent.boundary & kChildEdges[k].boundary);
+    const red_split::ChildEdges& edges = red_split::kChildEdges[k];
+    out.nbr_edge = uint8_t((parent.nbr_edge & edges.outer) | edges.inner);
+    out.flags = uint8_t(parent.boundary & edges.boundary);
     return out;
 }
 
@@ -213,22 +214,20 @@ inline void root_level(const Hierarchy& h, Level& level, bool cull_one_regularit
 // What a new block takes from its parent's linked edges (bits 0-2: the edges with a refined
 // neighbour) and boundary edges (bits 3-5), in one 16-byte entry; a table without the 1-regularity
 // rule and one with it:
-//  - the four children's state bytes (byte k: child k). Corner k is complete when its two outer
-//    edges (the parent's k and (k+2)%3) each have a neighbour or are boundary; the center always
-//    is. Without the rule every child starts undecided, a complete one in bucket 4
-//    (kFreshPriority), an incomplete one in 0. With the rule an incomplete corner starts decided
-//    (not refined), and the center, whose neighbours are the three corners, one bucket lower for
-//    each of them;
-//  - with the rule, the neighbours outside the block of its incomplete corners, whose priority
-//    goes down once the rule culls those corners, as byte offsets into the block's twelve words of
-//    neighbours (write_child_neighbors: word 3k + e is child k's neighbour across edge e). An
-//    incomplete corner has at most one such neighbour, a block at most two: on a linked edge f,
-//    first_f when edge (f+2)%3 has neither neighbour nor boundary, second_f when edge (f+1)%3 has
-//    neither;
+//  - the four children's state bytes (byte k: child k). A child is complete when each of its
+//    outer edges (red_split::is_outer) has a neighbour or is boundary; the center has none, so it
+//    always is. Without the rule every child starts undecided, a complete one in bucket 4
+//    (kFreshPriority), an incomplete one in 0. With the rule an incomplete child starts decided
+//    (not refined), and a complete one one bucket lower for each incomplete sibling;
+//  - with the rule, the neighbours outside the block of its incomplete children across linked
+//    edges, whose priority goes down once the rule culls those children, as byte offsets into the
+//    block's twelve words of neighbours (red_split::link_word). An incomplete child has at most one
+//    such neighbour (its other outer edge is missing), a block at most two (a third would not
+//    compile: writing past lowered_offset is no constant expression);
 //  - the mask of the linked edges' two-bit neighbour edge indices;
 //  - two counts in one word, so that one addition keeps both: the ends the new vertices count
 //    beyond 3 (bits 0-31: a vertex on an edge of its own counts 2 ends, one on an edge shared with
-//    a refined neighbour 1, so 3 to 6 a block) and the corners that are not complete (bits
+//    a refined neighbour 1, so 3 to 6 a block) and the children that are not complete (bits
 //    32-63). Neither sum can overflow: a level has fewer than 2^32 nodes, so fewer than 2^30
 //    blocks.
 struct NewBlock {
@@ -243,34 +242,44 @@ struct NewBlocks {
     NewBlock of[2][64];  // [cull_one_regularity][code]
     constexpr NewBlocks() : of() {
         constexpr uint32_t kFresh = kComplete | kFreshPriority;
-        // The neighbour words of first_f and second_f (see write_child_neighbors).
-        constexpr int kFirstWord[3] = {0, 4, 8}, kSecondWord[3] = {3, 7, 2};
         for (int culled = 0; culled < 2; ++culled) {
             for (int code = 0; code < 64; ++code) {
                 NewBlock& block = of[culled][code];
                 bool missing[3] = {};
                 for (int e = 0; e < 3; ++e) missing[e] = !(((code >> e) | (code >> (3 + e))) & 1);
-                block.states = kFresh << 24;
+                // A child is complete when none of its outer edges is missing (the center has none).
+                bool complete[4] = {};
                 uint32_t ends = 0, incomplete = 0;
-                for (int k = 0; k < 3; ++k) {
-                    const int prev = k == 0 ? 2 : k - 1;
-                    if (!missing[k] && !missing[prev]) {
-                        block.states |= kFresh << (8 * k);
-                    } else {
-                        if (culled) block.states |= uint32_t(kDecided) << (8 * k);
-                        ++incomplete;
+                for (int k = 0; k < 4; ++k) {
+                    complete[k] = true;
+                    for (int e = 0; e < 3; ++e) complete[k] = complete[k] && !(red_split::is_outer(k, e) && missing[e]);
+                    incomplete += !complete[k];
+                }
+                for (int k = 0; k < 4; ++k) {
+                    uint32_t state = complete[k] ? kFresh : culled ? uint32_t(kDecided) : 0u;
+                    if (culled && complete[k]) {
+                        // One bucket lower for each sibling the rule culls.
+                        for (int e = 0; e < 3; ++e) {
+                            const int s = red_split::sibling(k, e);
+                            if (s >= 0 && !complete[s]) state -= 1u << kPriorityShift;
+                        }
                     }
-                    const bool linked = (code >> k) & 1;
-                    if (linked) block.edge_mask = uint8_t(block.edge_mask | (3 << (2 * k)));
+                    block.states |= state << (8 * k);
+                }
+                for (int e = 0; e < 3; ++e) {
+                    const bool linked = (code >> e) & 1;
+                    if (linked) block.edge_mask = uint8_t(block.edge_mask | (3 << (2 * e)));
                     ends += linked ? 1 : 2;
                 }
                 block.counts = (ends - 3) | uint64_t(incomplete) << 32;
                 if (!culled) continue;
-                block.states -= incomplete << (24 + kPriorityShift);
+                // The incomplete children's neighbours across a linked edge lie outside the block.
                 for (int f = 0; f < 3; ++f) {
                     if (!((code >> f) & 1)) continue;
-                    if (missing[(f + 2) % 3]) block.lowered_offset[block.lowered_count++] = uint8_t(4 * kFirstWord[f]);
-                    if (missing[(f + 1) % 3]) block.lowered_offset[block.lowered_count++] = uint8_t(4 * kSecondWord[f]);
+                    if (!complete[red_split::first_half_child(f)])
+                        block.lowered_offset[block.lowered_count++] = uint8_t(4 * red_split::first_half_word(f));
+                    if (!complete[red_split::second_half_child(f)])
+                        block.lowered_offset[block.lowered_count++] = uint8_t(4 * red_split::second_half_word(f));
                 }
             }
         }
@@ -349,79 +358,6 @@ inline DecidedLevelScan scan_decided_level(Level& level, RefinedNumbering& numbe
     return scan;
 }
 
-// By a node's neighbour edge indices (2 bits per edge): lane e holds the child of the neighbour
-// across edge e that meets the edge's first half ((eq+1)%3) or its second half (eq); lane 3 the
-// center child's and corner 2's offsets within the node's own block (3 and 2), see below.
-// Both halves of one code share a 32-byte entry, so that one register addresses them.
-struct HalfEdgeChildren {
-    struct Entry {
-        alignas(16) uint32_t first[4];
-        uint32_t second[4];
-    };
-    Entry of[64];
-    constexpr HalfEdgeChildren() : of() {
-        for (int code = 0; code < 64; ++code) {
-            for (int e = 0; e < 3; ++e) {
-                const uint32_t eq = uint32_t(code >> (2 * e)) & 3u;
-                of[code].first[e] = (eq + 1) % 3;
-                of[code].second[e] = eq;
-            }
-            of[code].first[3] = 3;
-            of[code].second[3] = 2;
-        }
-    }
-};
-constexpr HalfEdgeChildren kHalfEdgeChildren{};
-
-// The neighbours of the four children of block b (Neighbors out[0..3]) from the blocks q0..q2 of
-// the parent's neighbours (kNoLocal for none, blocks are below 2^30) and the parent's neighbour
-// edge indices. With c = 4b, first[e] / second[e] the neighbours across the first / second half of
-// the parent's edge e (kNoLocal for none), the twelve words are
-//   corner 0: first0, c+3, second2   corner 1: second0, first1, c+3
-//   corner 2: c+3, second1, first2   center:   c+2, c, c+1
-// Returns the parent's edges with a refined neighbour (bits 0-2).
-inline unsigned write_child_neighbors(Neighbors* out, uint32_t b, uint32_t q0, uint32_t q1, uint32_t q2,
-                                      uint8_t nbr_edge) {
-    const unsigned code = nbr_edge & 63u;
-#if AMC_SSE2
-    // Lanes 0-2: edge e; lane 3: the block itself, whose first child is c = 4b.
-    const __m128i q = _mm_set_epi32(int(b), int(q2), int(q1), int(q0));
-    const __m128i none = _mm_srai_epi32(q, 31);
-    const __m128i base = _mm_slli_epi32(q, 2);
-    auto halves = [&](const uint32_t* offsets) {
-        const __m128i v = _mm_add_epi32(base, _mm_load_si128(reinterpret_cast<const __m128i*>(offsets)));
-        return _mm_castsi128_ps(_mm_or_si128(v, none));
-    };
-    const __m128 first = halves(kHalfEdgeChildren.of[code].first);    // first 0-2, c + 3
-    const __m128 second = halves(kHalfEdgeChildren.of[code].second);  // second 0-2, c + 2
-    // The twelve words as three vectors; lanes 0-1 of shuffle_ps come from its first operand, 2-3
-    // from its second.
-    auto store = [&](int k, __m128 v) { _mm_storeu_si128(reinterpret_cast<__m128i*>(out->nbr) + k, _mm_castps_si128(v)); };
-    store(0, _mm_shuffle_ps(first, second, _MM_SHUFFLE(0, 2, 3, 0)));
-    store(1, _mm_castsi128_ps(_mm_add_epi32(_mm_castps_si128(_mm_shuffle_ps(first, second, _MM_SHUFFLE(1, 3, 3, 1))),
-                                            _mm_set_epi32(0, 1, 0, 0))));
-    store(2, _mm_castsi128_ps(_mm_add_epi32(_mm_castps_si128(_mm_shuffle_ps(first, second, _MM_SHUFFLE(3, 3, 3, 2))),
-                                            _mm_set_epi32(-1, -2, -1, 0))));
-    return ~unsigned(_mm_movemask_ps(_mm_castsi128_ps(none))) & 7u;
-#else
-    const uint32_t q[3] = {q0, q1, q2};
-    uint32_t first[3], second[3];
-    unsigned linked = 0;
-    for (int e = 0; e < 3; ++e) {
-        const uint32_t none = uint32_t(static_cast<int32_t>(q[e]) >> 31);
-        first[e] = (4 * q[e] + kHalfEdgeChildren.of[code].first[e]) | none;
-        second[e] = (4 * q[e] + kHalfEdgeChildren.of[code].second[e]) | none;
-        linked |= (1u << e) & ~none;
-    }
-    const uint32_t c = 4 * b;
-    out[0] = {{first[0], c + 3, second[2]}};
-    out[1] = {{second[0], first[1], c + 3}};
-    out[2] = {{c + 3, second[1], first[2]}};
-    out[3] = {{c + 2, c, c + 1}};
-    return linked;
-#endif
-}
-
 // Level l+1 from level l (every node decided and numbered): the children of the refined nodes in
 // canonical order, linked exactly as Hierarchy::split links them. Returns the number of vertices
 // the splits create: one per edge of a refined node, shared where the neighbour is refined too.
@@ -451,7 +387,7 @@ inline uint64_t derive_next_level(const Level& level, const RefinedNumbering& nu
         for (uint32_t b = 0; b < count; ++b) {
             const LevelLinks p = links(refined[b]);
             const uint32_t c = 4 * b;
-            const unsigned linked = write_child_neighbors(
+            const unsigned linked = red_split_kernels::write_child_links(
                 out + c, b, block[static_cast<int32_t>(p.nbr[0])], block[static_cast<int32_t>(p.nbr[1])],
                 block[static_cast<int32_t>(p.nbr[2])], p.nbr_edge);  // kNoLocal for none
             const NewBlock& entry = new_blocks[linked | ((p.flags & 7u) << 3)];
