@@ -1,0 +1,138 @@
+// Making the levels of the level forest: the roots, the scan of a decided level, the next level.
+#include "coding/hierarchy/level_forest.h"
+
+#include "coding/hierarchy/level_tables.h"
+#include "common/simd.h"
+#include "hierarchy/red_split_kernels.h"
+
+#include <cstring>
+
+namespace amc {
+
+void root_level(const Hierarchy& h, Level& level, bool cull_one_regularity) {
+    const uint32_t n = h.root_count();
+    level.flipped.clear();
+    level.refined_count = 0;
+    level.roots.resize(n);
+    level.resize_state(n);
+    uint32_t incomplete_count = 0;
+    uint8_t* state = level.state();
+    for (NodeId r = 0; r < n; ++r) {
+        LevelLinks& node = level.roots[r];
+        uint8_t boundary = 0, edges = 0;
+        for (int e = 0; e < 3; ++e) {
+            node.nbr[e] = h.neighbor(r, e);
+            if (node.nbr[e] != kNoNode) edges = uint8_t(edges | (h.neighbor_edge(r, e) << (2 * e)));
+            boundary = uint8_t(boundary | (int(h.is_boundary_edge(r, e)) << e));
+        }
+        node.nbr_edge = edges;
+        node.flags = boundary;
+        const uint8_t complete = complete_state(node.nbr, boundary);
+        state[r] = complete ? uint8_t(complete | kFreshPriority) : cull_one_regularity ? kDecided : uint8_t(0);
+        incomplete_count += !complete;
+    }
+    level.incomplete_count = incomplete_count;
+    if (!cull_one_regularity || incomplete_count == 0) return;
+    for (NodeId r = 0; r < n; ++r) {
+        if (state[r] & kComplete) continue;
+        for (int e = 0; e < 3; ++e) {
+            uint8_t& s = neighbor_state(state, level.roots[r].nbr[e]);
+            s = kLoweredByCulledNeighbor.of[s];
+        }
+    }
+}
+
+DecidedLevelScan scan_decided_level(Level& level, RefinedNumbering& numbering, uint32_t* closures) {
+    const uint32_t n = static_cast<uint32_t>(level.size());
+    const uint8_t* state = level.state();
+    uint32_t* block = numbering.reset(n);
+    uint32_t* refined = level.refined.reserve(n);
+    uint32_t count = 0;
+    DecidedLevelScan scan;
+    uint32_t bad = 0;
+    // Masks of 16 nodes from i: refined (bit 1 of the state), complete (bit 4), two or more
+    // refined neighbours (bit 3).
+    auto visit = [&](uint32_t i, uint32_t is_refined, uint32_t complete, uint32_t two_hanging) {
+        bad |= is_refined & ~complete;
+        for (uint32_t r = is_refined; r != 0; r &= r - 1) {
+            const uint32_t j = i + uint32_t(__builtin_ctz(r));
+            block[j] = count;
+            refined[count++] = j;
+        }
+        if (closures == nullptr) return;
+        for (uint32_t c = two_hanging & ~is_refined; c != 0; c &= c - 1) closures[scan.closures++] = i + uint32_t(__builtin_ctz(c));
+    };
+    uint32_t i = 0;
+#if AMC_SSE2
+    for (; i + 16 <= n; i += 16) {
+        const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(state + i));
+        // Shifting 16-bit lanes moves bit b of each byte to bit 7 of the same byte.
+        visit(i, uint32_t(_mm_movemask_epi8(_mm_slli_epi16(v, 6))), uint32_t(_mm_movemask_epi8(_mm_slli_epi16(v, 3))),
+              uint32_t(_mm_movemask_epi8(_mm_slli_epi16(v, 4))));
+    }
+#endif
+    for (; i < n; i += 16) {
+        uint32_t r = 0, c = 0, h = 0;
+        for (uint32_t k = 0; k < 16 && i + k < n; ++k) {
+            r |= uint32_t((state[i + k] >> 1) & 1) << k;
+            c |= uint32_t((state[i + k] >> 4) & 1) << k;
+            h |= uint32_t((state[i + k] >> 3) & 1) << k;
+        }
+        visit(i, r, c, h);
+    }
+    level.refined_count = count;
+    scan.refined_incomplete = bad != 0;
+    return scan;
+}
+
+uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering, Level& next,
+                           bool cull_one_regularity) {
+    const uint32_t count = level.refined_count;
+    const uint32_t* block = numbering.block_of();
+    const uint32_t* refined = level.refined.data();
+    next.roots.clear();
+    next.flipped.clear();
+    next.refined_count = 0;
+    next.resize_state(size_t(4) * count);
+    Neighbors* out = next.nbr.reserve(size_t(4) * count);
+    BlockEdges* out_edges = next.edges.reserve(count);
+    uint32_t* lowered = next.lowered.reserve(size_t(2) * count);  // each block writes two words
+    uint32_t lowered_count = 0;
+    const NewBlock* const new_blocks = kNewBlocks.of[cull_one_regularity ? 1 : 0];
+    uint8_t* out_state = next.state();
+    // Each new vertex has two edge ends: one from each refined node on its edge, or both from one.
+    uint64_t counts = 0;  // bits 0-31 the edge ends beyond 3 a block, 32-63 the incomplete nodes
+    with_links(level, [&](auto links) {
+        for (uint32_t b = 0; b < count; ++b) {
+            const LevelLinks p = links(refined[b]);
+            const uint32_t c = 4 * b;
+            const unsigned linked = red_split_kernels::write_child_links(
+                out + c, b, block[static_cast<int32_t>(p.nbr[0])], block[static_cast<int32_t>(p.nbr[1])],
+                block[static_cast<int32_t>(p.nbr[2])], p.nbr_edge);  // kNoLocal for none
+            const NewBlock& entry = new_blocks[linked | ((p.flags & 7u) << 3)];
+            out_edges[b] = {uint8_t(p.nbr_edge & entry.edge_mask), uint8_t(p.flags & 7)};
+            counts += entry.counts;
+#if AMC_LITTLE_ENDIAN
+            std::memcpy(out_state + c, &entry.states, 4);  // byte k: child k
+#else
+            for (int k = 0; k < 4; ++k) out_state[c + k] = uint8_t(entry.states >> (8 * k));
+#endif
+            // Both words always, kept by the count (no branch: which blocks have incomplete
+            // corners follows no pattern). memcpy: the words are read as the bytes of out's
+            // array.
+            const char* words = reinterpret_cast<const char*>(out + c);
+            std::memcpy(lowered + lowered_count, words + entry.lowered_offset[0], 4);
+            std::memcpy(lowered + lowered_count + 1, words + entry.lowered_offset[1], 4);
+            lowered_count += entry.lowered_count;
+        }
+    });
+    next.incomplete_count = uint32_t(counts >> 32);
+    // Those neighbours may lie in blocks written after theirs: lowered once every state is made.
+    for (uint32_t k = 0; k < lowered_count; ++k) {
+        uint8_t& s = out_state[lowered[k]];
+        s = kLoweredByCulledNeighbor.of[s];
+    }
+    return (uint64_t(uint32_t(counts)) + uint64_t(3) * count) / 2;
+}
+
+}  // namespace amc
