@@ -5,6 +5,7 @@
 #include <amc/series.h>
 
 #include "common/check.h"
+#include "common/file_io.h"
 #include "octree/octree_file.h"
 #include "octree/octree_leaf_data.h"
 #include "series/forest_connectivity.h"
@@ -15,7 +16,6 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <iterator>
 
 namespace amc {
@@ -253,11 +253,8 @@ ForestSeriesReader::ForestSeriesReader(std::vector<uint8_t> bytes, const std::st
 }
 
 ForestSeriesReader ForestSeriesReader::open(const std::string& path, const SeriesReadOptions& options) {
-    std::ifstream in(path, std::ios::binary);
-    AMC_REQUIRE(in.good(), io, path + ": can not open");
-    std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    AMC_REQUIRE(!in.bad(), io, path + ": read failed");
-    return ForestSeriesReader(std::move(bytes), path, options);
+    const std::string text = read_whole_file(path);
+    return ForestSeriesReader(std::vector<uint8_t>(text.begin(), text.end()), path, options);
 }
 
 ForestSeriesReader::~ForestSeriesReader() = default;

@@ -6,6 +6,7 @@
 
 #include "coding/container.h"
 #include "common/check.h"
+#include "common/file_io.h"
 #include "series/field_coder.h"
 #include "series/frame_connectivity.h"
 #include "series/frame_geometry.h"
@@ -15,7 +16,6 @@
 
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <iterator>
 
 namespace amc {
@@ -374,11 +374,8 @@ SeriesReader::SeriesReader(std::vector<uint8_t> bytes, const std::string& what, 
 }
 
 SeriesReader SeriesReader::open(const std::string& path, const SeriesReadOptions& options) {
-    std::ifstream in(path, std::ios::binary);
-    AMC_REQUIRE(in.good(), io, path + ": can not open");
-    std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    AMC_REQUIRE(!in.bad(), io, path + ": read failed");
-    return SeriesReader(std::move(bytes), path, options);
+    const std::string text = read_whole_file(path);
+    return SeriesReader(std::vector<uint8_t>(text.begin(), text.end()), path, options);
 }
 
 SeriesReader::~SeriesReader() = default;
