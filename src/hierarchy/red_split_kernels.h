@@ -126,13 +126,20 @@ constexpr ShufflePlan kVertexPlan[4] = {vertex_plan(0), vertex_plan(1), vertex_p
 static_assert(kVertexPlan[0].found && kVertexPlan[1].found && kVertexPlan[2].found && kVertexPlan[3].found,
               "no shuffle writes these child vertices");
 
+// The immediates pass through template parameters: at -O0 GCC's intrinsic macros accept only a
+// literal constant, not a member of a constexpr object.
+template <int imm>
+inline __m128 shuffle_ps(__m128 a, __m128 b) { return _mm_shuffle_ps(a, b, imm); }
+template <int imm>
+inline __m128i shuffle_epi32(__m128i a) { return _mm_shuffle_epi32(a, imm); }
+
 template <int k>
 inline __m128 child_vertex_vector(__m128 p, __m128 q, __m128 pq) {
     constexpr ShufflePlan plan = kVertexPlan[k];
     const __m128 a = plan.a == kPQ ? pq : plan.a == kQ ? q : p;
     const __m128 b = plan.b == kPQ ? pq : plan.b == kQ ? q : p;
-    if constexpr (plan.a == plan.b) return _mm_castsi128_ps(_mm_shuffle_epi32(_mm_castps_si128(a), plan.imm));
-    return _mm_shuffle_ps(a, b, plan.imm);
+    if constexpr (plan.a == plan.b) return _mm_castsi128_ps(shuffle_epi32<plan.imm>(_mm_castps_si128(a)));
+    return shuffle_ps<plan.imm>(a, b);
 }
 
 template <class Node>
@@ -192,7 +199,7 @@ static_assert(kLinkPlan[0].found && kLinkPlan[1].found && kLinkPlan[2].found, "n
 template <int j>
 inline __m128i child_link_vector(__m128 f, __m128 s) {
     constexpr ShufflePlan plan = kLinkPlan[j];
-    const __m128i v = _mm_castps_si128(_mm_shuffle_ps(plan.a == kF ? f : s, plan.b == kF ? f : s, plan.imm));
+    const __m128i v = _mm_castps_si128(shuffle_ps<plan.imm>(plan.a == kF ? f : s, plan.b == kF ? f : s));
     if constexpr (!plan.adds) return v;
     return _mm_add_epi32(v, _mm_set_epi32(plan.add[3], plan.add[2], plan.add[1], plan.add[0]));
 }
