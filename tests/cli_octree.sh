@@ -21,6 +21,11 @@ expect 0 "$amc" octree make --dim 2 --model front --level 7 --balance corner -o 
 cp out.txt front.amq
 expect 0 "$amc" octree info - < front.amq
 grep -q '2D forest of 1 trees' out.txt || fail "info of stdin: $(head -c 200 out.txt)"
+# The octants-per-byte bound: lowered below the file's density it refuses, 0 lifts it.
+expect 1 "$amc" octree info sphere.amq --max-octants-per-byte 1
+grep -qi 'octants' err.txt || fail "octant bound: $(head -c 300 err.txt)"
+expect 0 "$amc" octree info sphere.amq --max-octants-per-byte 0
+expect 2 "$amc" octree info sphere.amq --max-octants-per-byte -1
 # Bad input: truncated, foreign, and usage errors.
 head -c 40 sphere.amq > cut.amq
 expect 1 "$amc" octree info cut.amq

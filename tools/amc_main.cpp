@@ -44,6 +44,13 @@ void add_max_nodes(CLI::App* command, uint64_t& max_nodes) {
         ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 32));
 }
 
+void add_octant_bound(CLI::App* command, int64_t& max_octants_per_byte) {
+    command->add_option("--max-octants-per-byte", max_octants_per_byte,
+                        "Refuse .amq files announcing more octants per byte after the metadata (default 4096; 0: no "
+                        "bound, for files whose writer did not pad, before 2026-12-02)")
+        ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -144,7 +151,8 @@ int main(int argc, char** argv) {
     SeriesEncodeCommand series_encode;
     auto* series_encode_cmd = series->add_subcommand("encode", "Compress a ParaView collection (.pvd) or frame files to .amcs");
     series_encode_cmd->add_option("inputs", series_encode.inputs,
-                                  "A .pvd, or frame files in order: VTU (with point and cell data), OBJ, OFF, PLY, .amh, .amc")
+                                  "A .pvd, or frame files in order: VTU (with point and cell data), OBJ, OFF, PLY, .amh, .amc; or "
+                                  ".amq forests (a forest series)")
         ->required();
     series_encode_cmd->add_option("-o,--output", series_encode.output, "Series file (default: the first input with .amcs; - for stdout)");
     series_encode_cmd->add_option("--base", series_encode.base, "Base mesh of mesh frames (default: the coarsest base found in the first frame)");
@@ -214,10 +222,12 @@ int main(int argc, char** argv) {
     octree_decode_cmd->add_option("--level", octree_decode.level, "Progressive: only the levels up to this one")
         ->check(CLI::Range(0, 29));
     add_max_nodes(octree_decode_cmd, octree_decode.max_nodes);
+    add_octant_bound(octree_decode_cmd, octree_decode.max_octants_per_byte);
     OctreeInfoCommand octree_info;
     auto* octree_info_cmd = octree->add_subcommand("info", "Describe an .amq file (decodes it)");
     octree_info_cmd->add_option("input", octree_info.input, ".amq file, or - for stdin")->required();
     add_max_nodes(octree_info_cmd, octree_info.max_nodes);
+    add_octant_bound(octree_info_cmd, octree_info.max_octants_per_byte);
 
     try {
         app.parse(argc, argv);

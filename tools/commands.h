@@ -121,11 +121,13 @@ struct OctreeDecodeCommand {
     std::string input, output;  // output: .vtu or .p4est
     int level = -1;
     uint64_t max_nodes = 0;
+    int64_t max_octants_per_byte = -1;  // -1: the reader's default; 0: no bound (unpadded files)
 };
 void run_octree_decode(const OctreeDecodeCommand& command, const GlobalOptions& global);
 struct OctreeInfoCommand {
     std::string input;
     uint64_t max_nodes = 0;
+    int64_t max_octants_per_byte = -1;
 };
 void run_octree_info(const OctreeInfoCommand& command, const GlobalOptions& global);
 

@@ -127,6 +127,7 @@ void run_octree_decode(const OctreeDecodeCommand& c, const GlobalOptions& global
     OctreeDecodeOptions options;
     options.max_level = c.level;
     if (c.max_nodes > 0) options.max_nodes = c.max_nodes;
+    if (c.max_octants_per_byte >= 0) options.max_octants_per_byte = uint64_t(c.max_octants_per_byte);
     const OctreeForest forest = decode_bytes(c.input, read_bytes(c.input), options);
     const std::string output = c.output.empty() ? default_output(c.input, ".vtu") : c.output;
     if (extension_of(output) == ".amq") throw UsageError(output + ": decode writes .vtu or .p4est");
@@ -136,6 +137,7 @@ void run_octree_decode(const OctreeDecodeCommand& c, const GlobalOptions& global
 void run_octree_info(const OctreeInfoCommand& c, const GlobalOptions&) {
     OctreeDecodeOptions options;
     if (c.max_nodes > 0) options.max_nodes = c.max_nodes;
+    if (c.max_octants_per_byte >= 0) options.max_octants_per_byte = uint64_t(c.max_octants_per_byte);
     const std::string bytes = read_bytes(c.input);
     const OctreeForest forest = decode_bytes(c.input, bytes, options);
     const OctreeForestCounts counts = count_octree_forest(forest);
