@@ -129,6 +129,12 @@ struct Quantizer {
 };
 using GridPoint = std::array<uint32_t, 3>;
 
+// How coordinates are stored: bit-exact in a precision, or on a grid (quantizer set).
+struct CoordinateSpace {
+    Precision precision = Precision::float64;
+    const Quantizer* quantizer = nullptr;
+};
+
 // bits in [1, 30]; the box must be finite with box_min <= box_max and its extent finite.
 // Throws Error otherwise. A box of zero extent gets step 1.
 Quantizer make_quantizer(Vec3 box_min, Vec3 box_max, int bits);

@@ -25,12 +25,6 @@
 
 namespace amc {
 
-// How coordinates are stored: bit-exact in a precision, or on a grid (quantizer set).
-struct CoordinateSpace {
-    Precision precision = Precision::float64;
-    const Quantizer* quantizer = nullptr;
-};
-
 constexpr int kStaticRoles = 3;
 using StaticTables = std::array<RansTable, kStaticRoles>;
 

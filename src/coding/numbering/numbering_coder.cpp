@@ -564,4 +564,17 @@ LeafNumbering decode_numbering(const uint8_t* data, size_t size, const std::vect
     return numbering;
 }
 
+LeafNumbering numbering_after_reorder(const Hierarchy& input, const LeafNumbering& numbering, const Hierarchy& h,
+                                      const std::vector<VertexId>& vertex_map) {
+    const TriangleMesh caller = renumber_leaf_mesh(extract_leaf_mesh(input), numbering);
+    const std::vector<uint32_t> canonical = canonical_vertex_order(input);
+    std::vector<VertexId> id_of_leaf_vertex(input.vertex_count());
+    for (VertexId v = 0; v < canonical.size(); ++v) {
+        if (canonical[v] != kNoVertex) id_of_leaf_vertex[canonical[v]] = v;
+    }
+    std::vector<VertexId> vertex_of_input(numbering.vertex.size());
+    for (size_t i = 0; i < numbering.vertex.size(); ++i) vertex_of_input[i] = vertex_map[id_of_leaf_vertex[numbering.vertex[i]]];
+    return leaf_numbering(h, caller, vertex_of_input);
+}
+
 }  // namespace amc

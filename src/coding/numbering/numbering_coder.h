@@ -25,4 +25,9 @@ std::vector<uint8_t> encode_numbering(const LeafNumbering& numbering, const std:
 LeafNumbering decode_numbering(const uint8_t* data, size_t size, const std::vector<Triangle>& leaf_triangles,
                                uint32_t vertices);
 
+// The caller's numbering of the input's leaf mesh, re-expressed against the leaf mesh of `h`, the
+// input reordered (vertex_map: input vertex id -> id in h): what the encoder stores.
+LeafNumbering numbering_after_reorder(const Hierarchy& input, const LeafNumbering& numbering, const Hierarchy& h,
+                                      const std::vector<VertexId>& vertex_map);
+
 }  // namespace amc

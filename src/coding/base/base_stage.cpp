@@ -1,0 +1,147 @@
+// The base mesh in the .amc file: see base_stage.h.
+#include "coding/base/base_stage.h"
+
+#include "coding/entropy/arithmetic_coder.h"
+#include "coding/geometry/geometry_prediction.h"
+#include "coding/hierarchy/hierarchy_level_coder.h"
+#include "common/check.h"
+
+#include <cmath>
+#include <string>
+#include <utility>
+
+namespace amc {
+
+namespace {
+
+// A base triangle's rotation (0, 1, 2): "is it 0?", then "is it 1?".
+struct RotationModels {
+    BitModel zero, one;
+};
+void encode_rotation(ArithmeticEncoder& encoder, RotationModels& models, uint8_t rotation) {
+    encoder.encode(rotation == 0, models.zero);
+    if (rotation != 0) encoder.encode(rotation == 1, models.one);
+}
+uint8_t decode_rotation(ArithmeticDecoder& decoder, RotationModels& models) {
+    if (decoder.decode(models.zero)) return 0;
+    return decoder.decode(models.one) ? 1 : 2;
+}
+
+// The base mesh with the positions the decoder reconstructs: the base coder predicts from them.
+TriangleMesh base_as_decoded(const Hierarchy& h, const Quantizer* quantizer) {
+    TriangleMesh base = h.base();
+    if (quantizer != nullptr)
+        for (Vec3& p : base.positions) p = dequantize(*quantizer, snap_to_grid(*quantizer, p));
+    return base;
+}
+
+}  // namespace
+
+// The base connectivity of a file. Mode 2's search (FORMAT.md 4.16) starts the conquest away from
+// the input's first triangle, which moves the decoder's base order away from the input's; a stored
+// numbering pays for that more than the search saves (tests/numbering_test.cpp: 134 bytes instead
+// of 92 for the canonical order), so with one the encoder makes version 4's single try.
+BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const EncodeOptions& options) {
+    const TriangleMesh base = base_as_decoded(h, quantizer);
+    if (options.numbering != nullptr && options.store_numbering) {
+        try {
+            return encode_base_connectivity(base, BaseConnectivityMode::angle, false);
+        } catch (const Error&) {  // mode 2 does not fit this start: the usual choice
+        }
+    }
+    return encode_base_connectivity(base);
+}
+
+// The base coder may rotate each triangle's vertices. The default diagonal rule does not care, but
+// hierarchies made under a rule of absolute local indices would pay orientation bits: then storing
+// each root's rotation (log2 3 bits) to keep the input's local order may be cheaper.
+ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& base_code, bool want_vertex_map) {
+    ReorderedInput r;
+    r.hierarchy = reorder_base(input, base_code.vertex_order, base_code.triangle_order, base_code.triangle_rotation,
+                               want_vertex_map ? &r.vertex_map : nullptr);
+    const DiagonalExceptions rotated = diagonal_exceptions(r.hierarchy);
+    if (rotated.fewest() == 0) return r;
+    std::vector<VertexId> kept_map;
+    Hierarchy kept = reorder_base(input, base_code.vertex_order, base_code.triangle_order,
+                                  std::vector<uint8_t>(base_code.triangle_order.size(), 0), &kept_map);
+    const DiagonalExceptions unrotated = diagonal_exceptions(kept);
+    const double rotated_bits = binary_entropy_bits(rotated.fewest(), rotated.leaves);
+    const double kept_bits =
+        binary_entropy_bits(unrotated.fewest(), unrotated.leaves) + 1.585 * double(base_code.triangle_order.size());
+    if (kept_bits >= rotated_bits) return r;
+    r.hierarchy = std::move(kept);
+    r.keep_rotations = true;
+    if (want_vertex_map) r.vertex_map = std::move(kept_map);
+    return r;
+}
+
+std::vector<uint8_t> encode_base_geometry(const Hierarchy& h, const BaseMeshCode& base_code, bool keep_rotations,
+                                          PositionCoder& positions) {
+    ArithmeticEncoder encoder;
+    if (keep_rotations) {
+        RotationModels models;
+        for (uint8_t r : base_code.triangle_rotation) encode_rotation(encoder, models, r);
+    }
+    std::vector<Vec3> decoded;
+    const size_t base_vertices = h.base().positions.size();
+    for (uint32_t i = 0; i < base_vertices; ++i) {
+        const Vec3 p = h.position(i);
+        positions.encode(encoder, kBaseGeometryContext, p, predict_parallelogram(decoded, base_code.stencils[i]));
+        decoded.push_back(p);
+    }
+    return encoder.finish();
+}
+
+TriangleMesh decode_base(const Block& connectivity, const Block& geometry, const Metadata& meta, uint8_t file_version,
+                         bool single_precision, PositionCoder& positions) {
+    AMC_REQUIRE(meta.base_vertices <= max_decodable_positions(geometry.size), corrupt,
+                "metadata block: " + std::to_string(meta.base_vertices) + " base vertices can not be coded in the " +
+                    std::to_string(geometry.size) + " bytes of the base geometry block");
+    AMC_REQUIRE(meta.base_vertices <= UINT32_MAX, limit_exceeded, "metadata block: too many base vertices");
+    AMC_REQUIRE(base_connectivity_mode(connectivity.payload, connectivity.size) != BaseConnectivityMode::angle ||
+                    file_version >= kAngleBaseVersion,
+                corrupt, "base connectivity block: mode 2 in a version-" + std::to_string(file_version) + " file");
+
+    TriangleMesh base;
+    base.single_precision = single_precision;
+    ArithmeticDecoder decoder(geometry.payload, geometry.size);
+    std::vector<uint8_t> rotations;
+    if (meta.options & kOptionRootRotations) {
+        RotationModels models;
+        for (uint64_t t = 0; t < meta.base_triangles; ++t) {
+            rotations.push_back(decode_rotation(decoder, models));
+            AMC_REQUIRE(!decoder.overran(), corrupt, "base geometry block is truncated or corrupt");
+        }
+    }
+    // The base connectivity decoder reads the base positions as it creates the vertices
+    // (FORMAT.md 3.5); the overrun check a vertex (15 symbols or more) stops a block that ends
+    // early at once.
+    DecodedBaseMesh decoded = decode_base_mesh(
+        connectivity.payload, connectivity.size, uint32_t(meta.base_vertices),
+        [&](uint32_t, const BaseStencil& stencil, const std::vector<Vec3>& previous) {
+            AMC_REQUIRE(!decoder.overran(), corrupt, "base geometry block is truncated or corrupt");
+            const Vec3 p = positions.decode(decoder, kBaseGeometryContext, predict_parallelogram(previous, stencil));
+            AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
+                        "base geometry is corrupt (non-finite coordinate)");
+            return p;
+        },
+        0);  // an .amc base mesh uses every vertex (validate_triangle_mesh): none isolated
+    AMC_REQUIRE(decoded.vertex_count == meta.base_vertices && decoded.triangles.size() == meta.base_triangles, corrupt,
+                "base connectivity does not match the metadata");
+    AMC_REQUIRE(!decoder.overran() && !positions.saw_invalid_symbol(), corrupt, "base geometry block is truncated or corrupt");
+    base.triangles = std::move(decoded.triangles);
+    base.positions = std::move(decoded.positions);
+    // Undo the base coder's rotations: decoded (o[r], o[r+1], o[r+2]) back to o.
+    for (size_t t = 0; t < rotations.size(); ++t) {
+        const Triangle d = base.triangles[t];
+        for (int i = 0; i < 3; ++i) base.triangles[t][(i + rotations[t]) % 3] = d[i];
+    }
+    try {
+        validate_triangle_mesh(base, "decoded base mesh");
+    } catch (const Error& e) {
+        throw_error(ErrorCode::corrupt, e.what());  // a file whose base breaks the rules is corrupt
+    }
+    return base;
+}
+
+}  // namespace amc

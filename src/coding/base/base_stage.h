@@ -1,0 +1,40 @@
+// The base mesh in the .amc file (docs/FORMAT.md 3.4, 3.5; paper II-B): the encoder codes the base
+// connectivity first and expresses the whole hierarchy in the decoder's base order; the base
+// connectivity block and the base geometry block (root rotations, then the base positions
+// predicted by the parallelogram rule as the connectivity decoder creates the vertices).
+#pragma once
+
+#include "coding/base/base_mesh_coder.h"
+#include "coding/container.h"
+#include "coding/file_metadata.h"
+#include "coding/geometry/position_coder.h"
+
+#include <amc/codec.h>
+#include <amc/hierarchy.h>
+
+#include <vector>
+
+namespace amc {
+
+// The base connectivity code of the input (positions as the decoder reconstructs them: on the
+// grid when `quantizer` is set).
+BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const EncodeOptions& options);
+
+// The input with its base mesh in the base coder's order.
+struct ReorderedInput {
+    Hierarchy hierarchy;
+    bool keep_rotations = false;     // the roots keep the input's local vertex order (kOptionRootRotations)
+    std::vector<VertexId> vertex_map;  // input vertex id -> id in hierarchy, when asked for
+};
+ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& base_code, bool want_vertex_map);
+
+// The base geometry block of h (in base code order, positions as the decoder reconstructs them).
+std::vector<uint8_t> encode_base_geometry(const Hierarchy& h, const BaseMeshCode& base_code, bool keep_rotations,
+                                          PositionCoder& positions);
+
+// Decodes the base mesh from its two blocks of a file of `file_version`, checked against the
+// metadata; the result is a valid triangle mesh. Throws Error on a corrupt or truncated block.
+TriangleMesh decode_base(const Block& connectivity, const Block& geometry, const Metadata& meta, uint8_t file_version,
+                         bool single_precision, PositionCoder& positions);
+
+}  // namespace amc

@@ -1,0 +1,115 @@
+// The geometry of a level block: see level_geometry.h.
+#include "coding/geometry/level_geometry.h"
+
+#include "coding/geometry/geometry_prediction.h"
+#include "common/check.h"
+
+#include <cmath>
+#include <cstdint>
+
+namespace amc {
+
+namespace {
+
+Vec3 predict(const Hierarchy& h, GeometryPredictor predictor, NodeId n, int e) {
+    return predictor == GeometryPredictor::butterfly ? predict_butterfly(h, n, e) : predict_midpoint(h, n, e);
+}
+
+void encode_adaptive(const Hierarchy& h, const NewVertices& created, GeometryPredictor predictor, PositionCoder& positions,
+                     ArithmeticEncoder& encoder) {
+    for (auto [n, e] : created)
+        positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)), predict(h, predictor, n, e));
+}
+
+}  // namespace
+
+LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& created, const PositionCoder& positions,
+                                        CoordinateSpace space, GeometryPredictor choice) {
+    const bool automatic = choice == GeometryPredictor::automatic;
+    LevelGeometryCode code;
+    code.predictor = automatic ? GeometryPredictor::midpoint : choice;
+    if (code.predictor == GeometryPredictor::normal_frame || (automatic && !created.empty()))
+        code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space);
+    if (!automatic || created.empty()) return code;
+    size_t best = SIZE_MAX;
+    for (GeometryPredictor candidate : {GeometryPredictor::midpoint, GeometryPredictor::butterfly}) {
+        PositionCoder trial = positions;
+        ArithmeticEncoder encoder;
+        encode_adaptive(h, created, candidate, trial, encoder);
+        const size_t size = encoder.finish().size();
+        if (size < best) {
+            best = size;
+            code.predictor = candidate;
+        }
+    }
+    if (code.static_code->estimated_bytes() < best) code.predictor = GeometryPredictor::normal_frame;
+    return code;
+}
+
+std::vector<uint8_t> finish_level_payload(const Hierarchy& h, const NewVertices& created, const LevelGeometryCode& code,
+                                          PositionCoder& positions, ArithmeticEncoder& encoder) {
+    std::vector<uint8_t> payload{uint8_t(code.predictor)};
+    if (code.predictor == GeometryPredictor::normal_frame) {
+        const StaticLevelEncoder& static_code = *code.static_code;
+        static_code.write_tables(encoder);
+        const std::vector<uint8_t> coded = encoder.finish();
+        put_varint(payload, coded.size());
+        payload.insert(payload.end(), coded.begin(), coded.end());
+        put_varint(payload, static_code.rans_bytes().size());
+        payload.insert(payload.end(), static_code.rans_bytes().begin(), static_code.rans_bytes().end());
+        payload.insert(payload.end(), static_code.raw_bytes().begin(), static_code.raw_bytes().end());
+        return payload;
+    }
+    encode_adaptive(h, created, code.predictor, positions, encoder);
+    const std::vector<uint8_t> coded = encoder.finish();
+    payload.insert(payload.end(), coded.begin(), coded.end());
+    return payload;
+}
+
+LevelBlockParts split_level_block(const Block& block, uint8_t file_version, const std::string& where) {
+    const uint8_t last_predictor = uint8_t(file_version >= kStaticGeometryVersion ? GeometryPredictor::normal_frame
+                                                                                  : GeometryPredictor::butterfly);
+    AMC_REQUIRE(block.size >= 1 && block.payload[0] >= uint8_t(GeometryPredictor::midpoint) && block.payload[0] <= last_predictor,
+                corrupt, "level block: bad predictor");
+    LevelBlockParts parts;
+    parts.predictor = GeometryPredictor(block.payload[0]);
+    PayloadReader in(block.payload + 1, block.size - 1, "level block");
+    size_t arithmetic_size = block.size - 1;
+    if (parts.predictor == GeometryPredictor::normal_frame) {
+        const uint64_t size = in.varint();
+        AMC_REQUIRE(size <= in.remaining(), corrupt, where + ": arithmetic part is longer than the block");
+        arithmetic_size = size_t(size);
+    }
+    parts.arithmetic = in.rest();
+    parts.arithmetic_size = arithmetic_size;
+    parts.after_arithmetic = in.rest() + arithmetic_size;
+    parts.after_arithmetic_size = in.remaining() - arithmetic_size;
+    return parts;
+}
+
+void decode_level_geometry(Hierarchy& h, const NewVertices& created, const LevelBlockParts& parts, ArithmeticDecoder& decoder,
+                           PositionCoder& positions, CoordinateSpace space, int level, const std::string& where) {
+    if (parts.predictor == GeometryPredictor::normal_frame) {
+        StaticTables tables;
+        AMC_REQUIRE(read_static_tables(decoder, space, tables) && !decoder.overran(), corrupt, where + ": bad geometry tables");
+        PayloadReader in(parts.after_arithmetic, parts.after_arithmetic_size, "level block");
+        const uint64_t rans_size = in.varint();
+        AMC_REQUIRE(rans_size <= in.remaining(), corrupt, where + ": rANS stream is longer than the block");
+        const uint8_t* rans = in.rest();
+        const uint8_t* raw = rans + rans_size;
+        const size_t raw_size = in.remaining() - size_t(rans_size);
+        AMC_REQUIRE(decode_static_positions(h, created, space, tables, rans, size_t(rans_size), raw, raw_size), corrupt,
+                    where + " is truncated or corrupt (positions)");
+    } else {
+        for (auto [n, e] : created) {
+            const Vec3 p = positions.decode(decoder, level_context(h.level(n)), predict(h, parts.predictor, n, e));
+            AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
+                        "level " + std::to_string(level) + " geometry is corrupt (non-finite coordinate)");
+            h.set_position(h.midpoint(n, e), p);
+        }
+        AMC_REQUIRE(!positions.saw_invalid_symbol(), corrupt, where + " is truncated or corrupt");
+    }
+    AMC_REQUIRE(!decoder.overran(), corrupt, where + " is truncated or corrupt");
+}
+
+}  // namespace amc

@@ -1,0 +1,64 @@
+// The geometry of a level block (docs/FORMAT.md 3.6, 5.5, 5.6): the predictor byte that opens the
+// block, then, after the level's hierarchy part in the same arithmetic code, the positions of the
+// vertices the level creates. Modes 1 and 2 (midpoint, butterfly) code them adaptively in that
+// arithmetic code; mode 3 (normal frame) puts its tables there and the positions in a rANS stream
+// and raw bits behind it: [predictor, arithmetic length, arithmetic payload, rANS length, rANS
+// stream, raw bits].
+#pragma once
+
+#include "coding/container.h"
+#include "coding/geometry/position_coder.h"
+#include "coding/geometry/static_position_coder.h"
+
+#include <amc/codec.h>
+
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace amc {
+
+// The vertices a level creates, as (node, edge) in canonical order (new_vertices_of_level).
+using NewVertices = std::vector<std::pair<NodeId, int>>;
+
+// ---- encoder ------------------------------------------------------------------------------------
+
+// A level's geometry code, chosen before the level block is written.
+struct LevelGeometryCode {
+    GeometryPredictor predictor = GeometryPredictor::midpoint;
+    std::unique_ptr<StaticLevelEncoder> static_code;  // mode 3's streams, when it was considered
+};
+
+// The predictor of the level that creates `created` (positions set in h as the decoder will have
+// them): `choice`, or when it is automatic the one that codes the level in the fewest bytes, each
+// adaptive predictor tried on a copy of `positions`' models.
+LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& created, const PositionCoder& positions,
+                                        CoordinateSpace space, GeometryPredictor choice);
+
+// The payload of a level block whose hierarchy part `encoder` holds: the predictor byte, then the
+// arithmetic code finished with the level's geometry (and mode 3's streams).
+std::vector<uint8_t> finish_level_payload(const Hierarchy& h, const NewVertices& created, const LevelGeometryCode& code,
+                                          PositionCoder& positions, ArithmeticEncoder& encoder);
+
+// ---- decoder ------------------------------------------------------------------------------------
+
+// A level block's payload split at its predictor byte and its arithmetic part.
+struct LevelBlockParts {
+    GeometryPredictor predictor = GeometryPredictor::midpoint;
+    const uint8_t* arithmetic = nullptr;  // hierarchy part, then geometry (or mode 3's tables)
+    size_t arithmetic_size = 0;
+    const uint8_t* after_arithmetic = nullptr;  // mode 3: rANS length, rANS stream, raw bits
+    size_t after_arithmetic_size = 0;
+};
+
+// Throws Error on a predictor the file's version does not have and on a mode-3 arithmetic length
+// beyond the block. `where` names the block in messages.
+LevelBlockParts split_level_block(const Block& block, uint8_t file_version, const std::string& where);
+
+// Decodes the positions of `created` (the level `level` just decoded from `decoder`) and sets them
+// in h. Throws Error on a corrupt or truncated block.
+void decode_level_geometry(Hierarchy& h, const NewVertices& created, const LevelBlockParts& parts, ArithmeticDecoder& decoder,
+                           PositionCoder& positions, CoordinateSpace space, int level, const std::string& where);
+
+}  // namespace amc

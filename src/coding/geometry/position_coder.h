@@ -1,0 +1,49 @@
+// The adaptive position coder of the .amc file: every coordinate under the bit-length models of
+// float_coder.h, bit-exact (float32 or float64) or on a quantization grid (FORMAT.md 3.5, 5.4).
+// Base vertices and each level's new vertices code under contexts of their own.
+#pragma once
+
+#include "coding/entropy/arithmetic_coder.h"
+#include "coding/geometry/float_coder.h"
+
+#include <algorithm>
+
+namespace amc {
+
+// Geometry contexts: 3 for base vertices, then 3 per level (levels beyond 15 share the last).
+constexpr int kBaseGeometryContext = 0;
+constexpr int kLevelContextClasses = 16;
+constexpr int kGeometryContexts = 3 * (1 + kLevelContextClasses);
+inline int level_context(int level) { return 3 * (1 + std::min(level, kLevelContextClasses - 1)); }
+
+class PositionCoder {
+public:
+    explicit PositionCoder(CoordinateSpace space)
+        : precision_(space.precision), quantized_(space.quantizer != nullptr), models_(kGeometryContexts) {
+        if (space.quantizer != nullptr) quantizer_ = *space.quantizer;
+    }
+    void encode(ArithmeticEncoder& encoder, int context, Vec3 actual, Vec3 predicted) {
+        if (!quantized_) {
+            encode_position(encoder, models_, context, precision_, actual, predicted);
+            return;
+        }
+        const GridPoint a = quantize(quantizer_, actual), p = quantize(quantizer_, predicted);
+        for (int axis = 0; axis < 3; ++axis) encode_quantized(encoder, models_, context + axis, quantizer_.bits, a[axis], p[axis]);
+    }
+    Vec3 decode(ArithmeticDecoder& decoder, int context, Vec3 predicted) {
+        if (!quantized_) return decode_position(decoder, models_, context, precision_, predicted);
+        const GridPoint p = quantize(quantizer_, predicted);
+        GridPoint a;
+        for (int axis = 0; axis < 3; ++axis) a[axis] = decode_quantized(decoder, models_, context + axis, quantizer_.bits, p[axis]);
+        return dequantize(quantizer_, a);
+    }
+    bool saw_invalid_symbol() const { return models_.saw_invalid_symbol(); }
+
+private:
+    Precision precision_;
+    bool quantized_;
+    Quantizer quantizer_;
+    FloatResidualModels models_;
+};
+
+}  // namespace amc
