@@ -16,6 +16,15 @@ grep -q 'NumberOfCells' sphere.vtu || fail "decode wrote no VTU cells"
 expect 1 "$amc" octree decode sphere.amq
 grep -q 'already exists' err.txt || fail "decode overwrote sphere.vtu"
 expect 0 "$amc" -f octree decode sphere.amq --level 2 -o coarse.vtu
+# --conforming: tetrahedra (VTK type 10) and triangles (5) instead of hexahedra and quads.
+expect 0 "$amc" octree decode sphere.amq --conforming -o tets.vtu
+grep -q 'Name="added_point"' tets.vtu || fail "conforming VTU without its point array"
+expect 0 "$amc" octree make --dim 2 --model sphere --level 4 --conforming -o tris.vtu
+expect 0 "$amc" octree make --dim 2 --model sphere --level 4 -o quads.vtu
+cells() { sed -n 's/.*NumberOfCells="\([0-9]*\)".*/\1/p' "$1"; }
+(( $(cells tris.vtu) > 2 * $(cells quads.vtu) )) || fail "conforming: $(cells tris.vtu) triangles for $(cells quads.vtu) quads"
+expect 2 "$amc" octree decode sphere.amq --conforming -o x.p4est
+expect 2 "$amc" octree make --dim 2 --conforming -o x.amq
 expect 0 "$amc" octree make --dim 2 --model front --level 7 --balance corner -o - 
 [[ -s out.txt ]] || fail "make to stdout wrote nothing"
 cp out.txt front.amq

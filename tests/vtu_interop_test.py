@@ -154,3 +154,31 @@ def test_amc_decoded_ply_opens_in_meshio_and_vtk(tmp_path, ascii):
     triangles = numpy_support.vtk_to_numpy(poly.GetPolys().GetData()).reshape(-1, 4)
     assert np.array_equal(triangles[:, 1:], reference.cells[0].data)
     assert np.array_equal(numpy_support.vtk_to_numpy(poly.GetPoints().GetData()), reference.points)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_conforming_octree_vtu_opens_in_meshio_and_vtk(tmp_path, dim):
+    """`amc octree make --conforming`: triangles / tetrahedra without hanging nodes, positively
+    oriented, covering the unit square / cube, with the leaves' level, tree and index per cell."""
+    path = tmp_path / "forest.vtu"
+    subprocess.run([os.path.join(BUILD, "amc"), "-q", "octree", "make", "--dim", str(dim), "--model", "sphere",
+                    "--level", "5" if dim == 2 else "3", "--conforming", "-o", str(path)], check=True)
+    mesh = meshio.read(str(path))
+    grid = vtk_read(path)
+    kind = "triangle" if dim == 2 else "tetra"
+    assert len(mesh.cells) == 1 and mesh.cells[0].type == kind
+    cells = mesh.cells[0].data
+    assert grid.GetNumberOfCells() == len(cells) and grid.GetNumberOfPoints() == len(mesh.points)
+    types = numpy_support.vtk_to_numpy(grid.GetCellTypesArray())
+    assert (types == (vtk.VTK_TRIANGLE if dim == 2 else vtk.VTK_TETRA)).all()
+    p = mesh.points[cells]
+    edges = p[:, 1:, :dim] - p[:, :1, :dim]
+    measure = np.linalg.det(edges) / (2 if dim == 2 else 6)
+    assert (measure > 0).all()
+    assert abs(measure.sum() - 1.0) < 1e-12
+    for key in ("level", "tree", "leaf"):
+        from_vtk = numpy_support.vtk_to_numpy(grid.GetCellData().GetArray(key))
+        assert np.array_equal(mesh.cell_data[key][0], from_vtk)
+    assert mesh.cell_data["level"][0].max() == (5 if dim == 2 else 3)
+    added = mesh.point_data["added_point"]
+    assert set(np.unique(added)) == {0, 1}

@@ -35,6 +35,7 @@ Examples:
   cat mesh.ply | amc encode - > mesh.amc
   amc octree make --dim 3 --model sphere --level 7 -o sphere.amq
   amc octree decode sphere.amq -o sphere.vtu     leaves as hexahedra (or -o x.p4est with p4est)
+  amc octree decode sphere.amq --conforming -o tets.vtu   tetrahedra, no hanging nodes
 
 Exit status: 0 success, 1 error (bad input, existing output without -f), 2 usage error.
 )";
@@ -205,6 +206,8 @@ int main(int argc, char** argv) {
     octree_make_cmd->add_option("--balance", octree_make.balance, "face, edge, corner or none")->capture_default_str();
     octree_make_cmd->add_option("--seed", octree_make.seed, "Random model's seed")->capture_default_str();
     octree_make_cmd->add_option("-o,--output", octree_make.output, "Output (.amq, .vtu, .p4est; - for .amq to stdout)")->required();
+    octree_make_cmd->add_flag("--conforming", octree_make.conforming,
+                              "VTU output as triangles / tetrahedra without hanging nodes (else quads / hexahedra)");
     OctreeEncodeCommand octree_encode;
     auto* octree_encode_cmd = octree->add_subcommand("encode", "Compress a p4est file (needs AMC_WITH_P4EST) to .amq");
     octree_encode_cmd->add_option("input", octree_encode.input, "p4est_save file (.p4est) or .amq")->required();
@@ -219,6 +222,8 @@ int main(int argc, char** argv) {
     auto* octree_decode_cmd = octree->add_subcommand("decode", "Decompress an .amq file to VTU (or p4est)");
     octree_decode_cmd->add_option("input", octree_decode.input, ".amq file, or - for stdin")->required();
     octree_decode_cmd->add_option("-o,--output", octree_decode.output, "Output .vtu or .p4est (default: the input with .vtu)");
+    octree_decode_cmd->add_flag("--conforming", octree_decode.conforming,
+                                "VTU output as triangles / tetrahedra without hanging nodes (else quads / hexahedra)");
     octree_decode_cmd->add_option("--level", octree_decode.level, "Progressive: only the levels up to this one")
         ->check(CLI::Range(0, 29));
     add_max_nodes(octree_decode_cmd, octree_decode.max_nodes);

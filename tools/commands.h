@@ -109,6 +109,7 @@ struct OctreeMakeCommand {
     int dim = 2, level = 8;
     std::string model = "sphere", trees = "1x1x1", balance = "face", output;
     uint64_t seed = 1;
+    bool conforming = false;  // VTU output as triangles / tetrahedra without hanging nodes
 };
 void run_octree_make(const OctreeMakeCommand& command, const GlobalOptions& global);
 struct OctreeEncodeCommand {
@@ -122,6 +123,7 @@ struct OctreeDecodeCommand {
     int level = -1;
     uint64_t max_nodes = 0;
     int64_t max_octants_per_byte = -1;  // -1: the reader's default; 0: no bound (unpadded files)
+    bool conforming = false;  // VTU output as triangles / tetrahedra without hanging nodes
 };
 void run_octree_decode(const OctreeDecodeCommand& command, const GlobalOptions& global);
 struct OctreeInfoCommand {

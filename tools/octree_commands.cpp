@@ -67,13 +67,16 @@ std::vector<Field> data_layout(const std::string& spec) {
 }
 
 // The forest in the format the output's extension names: .amq (default), .vtu or .p4est.
+// `conforming`: VTU cells as conforming triangles / tetrahedra (conforming_leaf_mesh).
 void write_forest(const std::string& path, const OctreeForest& forest, const GlobalOptions& global,
-                  const OctreeEncodeOptions& options = {}) {
+                  const OctreeEncodeOptions& options = {}, bool conforming = false) {
     const std::string ext = extension_of(path);
+    if (conforming && ext != ".vtu") throw UsageError("--conforming: the output must be a .vtu file, got '" + path + "'");
     if (ext == ".vtu" || ext == ".p4est") {
         if (path == "-") throw UsageError("VTU and p4est output need a file name");
         if (!global.force) refuse_existing(path);
-        if (ext == ".vtu") write_octree_vtu(path, forest);
+        if (ext == ".vtu")
+            write_octree_vtu(path, forest, VtuEncoding::binary_zlib, conforming ? OctreeVtuCells::conforming : OctreeVtuCells::leaves);
         else write_p4est_file(path, forest);
     } else {
         const std::vector<uint8_t> bytes = encode_octree_forest(forest, options);
@@ -105,7 +108,7 @@ void run_octree_make(const OctreeMakeCommand& c, const GlobalOptions& global) {
     else if (c.model == "uniform") forest = uniform_octree_forest(conn, c.level);
     else throw UsageError("--model: expected sphere, front, random or uniform, got '" + c.model + "'");
     if (c.balance != "none") forest = balance_octree_forest(forest, balance_named(c.balance));
-    write_forest(c.output, forest, global);
+    write_forest(c.output, forest, global, {}, c.conforming);
 }
 
 void run_octree_encode(const OctreeEncodeCommand& c, const GlobalOptions& global) {
@@ -131,7 +134,7 @@ void run_octree_decode(const OctreeDecodeCommand& c, const GlobalOptions& global
     const OctreeForest forest = decode_bytes(c.input, read_bytes(c.input), options);
     const std::string output = c.output.empty() ? default_output(c.input, ".vtu") : c.output;
     if (extension_of(output) == ".amq") throw UsageError(output + ": decode writes .vtu or .p4est");
-    write_forest(output, forest, global);
+    write_forest(output, forest, global, {}, c.conforming);
 }
 
 void run_octree_info(const OctreeInfoCommand& c, const GlobalOptions&) {

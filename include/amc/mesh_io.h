@@ -9,6 +9,7 @@
 #include <amc/octree.h>
 
 #include <string>
+#include <vector>
 
 namespace amc {
 
@@ -73,9 +74,39 @@ RefinementHistory read_history(const std::string& path);
 std::string format_history(const RefinementHistory& history);
 void write_history(const std::string& path, const RefinementHistory& history);
 
-// The leaves as VTU cells (VTK_QUAD in 2D, VTK_HEXAHEDRON in 3D, hanging nodes left as they
-// are) with cell data "level" and "tree"; corners placed by tree_point, shared within a tree and
-// repeated on tree boundaries. Through a temporary file and a rename. Throws Error.
-void write_octree_vtu(const std::string& path, const OctreeForest& forest, VtuEncoding encoding = VtuEncoding::binary_zlib);
+// ---- leaf meshes of quadtree and octree forests (docs/OCTREE.md) -------------------------------
+
+// The leaves of a forest as a conforming mesh of triangles (2D) or tetrahedra (3D) on the leaves'
+// corners plus added centres: every leaf covered exactly once by its cells, no hanging node left
+// (a leaf corner on another leaf's edge is a vertex of that leaf's cells), cells meeting face to
+// face across leaves and trees (with the trees' orientation; also across periodic gluing, where
+// the two sides get separate points in space with the same forest_point). Per leaf (docs/OCTREE.md,
+// "Conforming leaf meshes"): 2D, 2 triangles, or 4 + h fanned from the centre when h leaf corners
+// lie on its edges; 3D, the cone of the centre over each face's triangles (2 per face, 4 + h when
+// h leaf corners lie on its edges, or those of its quarters where the neighbour is finer): 12
+// tetrahedra without hanging nodes. Throws Error on an invalid forest (validate_octree_forest).
+struct ConformingLeafMesh {
+    int dim = 2;                         // 2: triangles, 3: tetrahedra
+    std::vector<Vec3> points;            // corner_points leaf corners first, then the added centres
+    uint32_t corner_points = 0;
+    std::vector<uint32_t> cells;         // dim + 1 points per cell, positively oriented in the tree's frame
+    std::vector<uint32_t> leaf;          // per cell: the index of its leaf in forest.leaves
+    std::vector<uint32_t> forest_point;  // per point: the point of the forest it stands for
+
+    size_t cell_count() const { return leaf.size(); }
+};
+ConformingLeafMesh conforming_leaf_mesh(const OctreeForest& forest);
+
+enum class OctreeVtuCells {
+    leaves,      // VTK_QUAD / VTK_HEXAHEDRON, hanging nodes left as they are
+    conforming,  // VTK_TRIANGLE / VTK_TETRA of conforming_leaf_mesh, point array "added_point"
+};
+
+// The leaves as VTU cells with cell data "level" and "tree" (and "leaf", the leaf's index, for
+// conforming cells) and the forest's leaf fields (each cell has its leaf's values). Leaves: corners
+// placed by tree_point, shared within a tree and repeated on tree boundaries. Through a temporary
+// file and a rename. Throws Error.
+void write_octree_vtu(const std::string& path, const OctreeForest& forest, VtuEncoding encoding = VtuEncoding::binary_zlib,
+                      OctreeVtuCells cells = OctreeVtuCells::leaves);
 
 }  // namespace amc
