@@ -1,8 +1,10 @@
 // Octree forests (issue 28): size per leaf of the .amq file against one raw bit per octant, the
 // file p4est_save writes (built with AMC_WITH_P4EST; else p4est's per-leaf layout, 12 bytes per
 // leaf in 2D and 16 in 3D, written here) and that file through xz -9 (liblzma preset 9); encode
-// and decode speeds in leaves per second, and p4est_save_ext / p4est_load_ext's with p4est.
+// and decode speeds in leaves per second, and p4est_save_ext / p4est_load_ext's with p4est; the
+// conforming triangle / tetrahedron meshes of the same forests (cells per leaf, extraction speed).
 // Prints a Markdown table (docs/OCTREE.md). Usage: octree_bench [--runs N] [--quick]
+#include <amc/mesh_io.h>
 #include <amc/octree.h>
 
 #ifdef AMC_HAVE_P4EST
@@ -228,6 +230,26 @@ int main(int argc, char** argv) {
         std::printf("| %s + u (Float64), inside (Int32) | %zu | %zu | %.2f | %zu | %.1f | %zu | %.1f |\n", cases[k].name.c_str(),
                     f.leaves.size(), bytes.size(), double(stats.leaf_data_bytes) / double(f.leaves.size()), p4.size(),
                     double(p4.size()) / double(bytes.size()), xz, double(xz) / double(bytes.size()));
+    }
+
+    // Conforming leaf meshes (conforming_leaf_mesh): triangles / tetrahedra without hanging nodes.
+    std::printf("\n| forest, conforming | leaves | cells | cells/leaf | points | added points | extraction Mleaves/s |\n"
+                "|---|---:|---:|---:|---:|---:|---|\n");
+    for (const Case& c : cases) {
+        ConformingLeafMesh mesh;
+        std::vector<double> times;
+        for (int r = 0; r < runs; ++r) {
+            mesh = {};
+            const auto t0 = std::chrono::steady_clock::now();
+            mesh = conforming_leaf_mesh(c.forest);
+            times.push_back(seconds_since(t0));
+        }
+        std::sort(times.begin(), times.end());
+        const double leaves = double(c.forest.leaves.size());
+        std::printf("| %s | %zu | %zu (%s) | %.2f | %zu | %zu | %.2f-%.2f |\n", c.name.c_str(), c.forest.leaves.size(), mesh.cell_count(),
+                    mesh.dim == 2 ? "triangles" : "tetrahedra", double(mesh.cell_count()) / leaves, mesh.points.size(),
+                    mesh.points.size() - mesh.corner_points, leaves / times.back() / 1e6, leaves / times.front() / 1e6);
+        std::fflush(stdout);
     }
     return 0;
 }

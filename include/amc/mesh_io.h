@@ -89,7 +89,7 @@ struct ConformingLeafMesh {
     int dim = 2;                         // 2: triangles, 3: tetrahedra
     std::vector<Vec3> points;            // corner_points leaf corners first, then the added centres
     uint32_t corner_points = 0;
-    std::vector<uint32_t> cells;         // dim + 1 points per cell, positively oriented in the tree's frame
+    std::vector<uint32_t> cells;         // dim + 1 points per cell, oriented alike (docs/OCTREE.md)
     std::vector<uint32_t> leaf;          // per cell: the index of its leaf in forest.leaves
     std::vector<uint32_t> forest_point;  // per point: the point of the forest it stands for
 

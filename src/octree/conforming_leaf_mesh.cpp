@@ -23,6 +23,35 @@ namespace {
 
 using Lattice = std::array<int64_t, 3>;
 
+// 2D trees may be of either hand (p4est's Moebius strip): +1 or -1 per tree, so that triangles
+// counter-clockwise in their tree's frame times its hand are oriented alike across every gluing
+// (a Moebius strip has no such choice; the first found is kept). Each connected part starts from
+// its first tree, whose hand makes its triangles counter-clockwise in the xy-plane when it is not
+// perpendicular to it (a planar forest's triangles all have positive area).
+std::vector<int> tree_hands(const TreeConnectivity& conn) {
+    static const int kTraversal[4] = {-1, 1, 1, -1};  // face corner order of a counter-clockwise walk, per face
+    std::vector<int> hand(conn.tree_count(), 0);
+    for (uint32_t seed = 0; seed < conn.tree_count(); ++seed) {
+        if (hand[seed] != 0) continue;
+        const Vec3 p0 = tree_point(conn, seed, 0, 0, 0), u = tree_point(conn, seed, 1, 0, 0) - p0, v = tree_point(conn, seed, 0, 1, 0) - p0;
+        hand[seed] = u.x * v.y - u.y * v.x < 0 ? -1 : 1;
+        std::vector<uint32_t> stack{seed};
+        while (!stack.empty()) {
+            const uint32_t t = stack.back();
+            stack.pop_back();
+            for (int f = 0; f < 4; ++f) {
+                const uint32_t nt = conn.tree_to_tree[size_t(t) * 4 + f];
+                const int nf = conn.tree_to_face[size_t(t) * 4 + f] % 4, reversed = conn.tree_to_face[size_t(t) * 4 + f] / 4;
+                if (hand[nt] != 0) continue;
+                // The two walks pass the shared side in opposite directions.
+                hand[nt] = -hand[t] * kTraversal[f] * kTraversal[nf] * (reversed ? -1 : 1);
+                stack.push_back(nt);
+            }
+        }
+    }
+    return hand;
+}
+
 struct Vertex {
     Lattice p;
     ForestPoints::Point point;
@@ -30,7 +59,9 @@ struct Vertex {
 
 class Extraction {
 public:
-    Extraction(const OctreeForest& forest, ConformingLeafMesh& out) : forest_(forest), out_(out), points_(forest.connectivity) {}
+    Extraction(const OctreeForest& forest, ConformingLeafMesh& out) : forest_(forest), out_(out), points_(forest.connectivity) {
+        if (forest.dim() == 2) hand_ = tree_hands(forest.connectivity);
+    }
 
     void run() {
         const int d = forest_.dim();
@@ -113,9 +144,9 @@ private:
         const Lattice corners[4] = {corner(o, 0), corner(o, 1), corner(o, 3), corner(o, 2)};  // counter-clockwise
         const int64_t half = length(o) / 2;
         split_or_fan(polygon(corners, 4), {o.x + half, o.y + half, 0}, true, [&](const Vertex& a, const Vertex& b, const Vertex& c) {
-            // Counter-clockwise in the tree's frame.
+            // Counter-clockwise in the tree's frame, times its hand.
             const int64_t cross = (b.p[0] - a.p[0]) * (c.p[1] - a.p[1]) - (b.p[1] - a.p[1]) * (c.p[0] - a.p[0]);
-            if (cross > 0) add_cell({&a, &b, &c});
+            if ((cross > 0) == (hand_[tree_] > 0)) add_cell({&a, &b, &c});
             else add_cell({&a, &c, &b});
         });
     }
@@ -163,6 +194,7 @@ private:
     const OctreeForest& forest_;
     ConformingLeafMesh& out_;
     ForestPoints points_;
+    std::vector<int> hand_;  // 2D: per tree, +1 or -1 (tree_hands)
     uint32_t corner_ids_ = 0, tree_ = 0, leaf_ = 0;
 };
 
