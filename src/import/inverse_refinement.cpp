@@ -80,7 +80,7 @@ public:
           midpoint_count_(vertex_count, 0), corner_count_(vertex_count, 0),
           midpoint_block_(vertex_count, {kNone, kNone}), block_of_(fine.size(), kNone), closure_of_(fine.size(), kNone),
           pinned_old_(vertex_count, 0), covered_(fine.size(), 0),
-          banned_(fine.size(), 0), deferred_(fine.size(), 0) {
+          banned_(fine.size(), 0), repair_banned_(fine.size(), 0), deferred_(fine.size(), 0) {
         // A midpoint has its block's three triangles on one side and the boundary, another block
         // (three) or a green closure (two or three triangles around it) on the other.
         for (uint32_t v = 0; v < vertex_count; ++v) {
@@ -270,7 +270,7 @@ private:
     // new) and the mesh (its coarse edges are not edges already; that they are not coarse edges
     // of other blocks is checked with the sides, once the patch is grown).
     bool fits(const Block& b) const {
-        if (taken(b.center) || banned_[b.center]) return false;
+        if (taken(b.center) || banned_[b.center] || repair_banned_[b.center]) return false;
         for (int k = 0; k < 3; ++k) {
             if (taken(b.corner[size_t(k)])) return false;
             const uint32_t m = b.m[size_t(k)];
@@ -548,7 +548,63 @@ private:
     // Keeps the patch when every side of every block is valid and returns the vertices it
     // removes; otherwise removes it and returns 0. `explored` (if given) marks every center
     // placed on the way.
+    //
+    // A large patch that fails on a few blocks is mostly a true reading with a few wrong turns
+    // (docs/IMPORT.md, "Bottom-up, measured against the truth"): the blocks that stand where the
+    // invalid sides need a block of their own are banned as centers and the patch is grown again
+    // from the same seed, at most kRepairs times, so a seed costs at most kRepairs + 1 growths.
     uint32_t grow_patch(uint32_t t, Preference preference, bool exploring = false) {
+        constexpr int kRepairs = 4;
+        std::vector<uint32_t> banned, suspects;
+        uint32_t removed = 0;
+        for (int attempt = 0;; ++attempt) {
+            suspects.clear();
+            removed = grow_patch_once(t, preference, exploring, attempt < kRepairs ? &suspects : nullptr);
+            if (removed != 0 || suspects.empty()) break;
+            const size_t before = banned.size();
+            for (uint32_t c : suspects) {
+                if (!repair_banned_[c]) repair_banned_[c] = 1, banned.push_back(c);
+            }
+            if (banned.size() == before) break;  // nothing new to take away: the same growth again
+        }
+        for (uint32_t c : banned) repair_banned_[c] = 0;
+        return removed;
+    }
+
+    // The blocks of an invalid patch [start, end) that stand in the way of its invalid sides: the
+    // blocks holding a triangle of the fan across an invalid side, and those that made a vertex
+    // of the block that would fit across it a midpoint; failing those, the invalid blocks.
+    void collect_suspects(uint32_t start, std::vector<uint32_t>& suspects) const {
+        constexpr size_t kRepairableShare = 16;  // at most one block in 16 invalid
+        std::vector<uint32_t> invalid;
+        for (uint32_t i = start; i < blocks_.size(); ++i) {
+            if (sides_valid(i)) continue;
+            invalid.push_back(blocks_[i].center);
+            for (int e = 0; e < 3; ++e) {
+                if (classify(i, e).kind != Side::invalid) continue;
+                const Fan fan = walk_fan(blocks_[i], e);
+                if (fan.kind != Fan::triangles) continue;
+                for (int k = 0; k < fan.size; ++k) {
+                    const uint32_t owner = block_of_[fan.triangle[k]];
+                    if (owner != kNone && owner != i) suspects.push_back(blocks_[owner].center);
+                }
+                Block across;
+                if (fan.size != 3 || !read_block(fan.triangle[1], across)) continue;
+                for (uint32_t v : across.v) {
+                    for (uint8_t k = 0; k < midpoint_count_[v]; ++k) suspects.push_back(blocks_[midpoint_block_[v][k] / 3].center);
+                }
+            }
+        }
+        // Many invalid blocks: a wrong reading, not a true one with a few wrong turns.
+        if (invalid.size() * kRepairableShare > blocks_.size() - start) {
+            suspects.clear();
+            return;
+        }
+        if (suspects.empty()) suspects = std::move(invalid);
+    }
+
+    uint32_t grow_patch_once(uint32_t t, Preference preference, bool exploring, std::vector<uint32_t>* suspects) {
+        constexpr uint32_t kRepairable = 16;  // blocks: smaller patches are taken or dropped whole
         const uint32_t start = uint32_t(blocks_.size());
         if (!place_block(t)) return 0;
         for (uint32_t next = start; next < blocks_.size(); ++next) {
@@ -573,6 +629,7 @@ private:
         }
         for (uint32_t i = start; i < blocks_.size(); ++i) {
             if (!sides_valid(i)) {
+                if (suspects && blocks_.size() - start >= kRepairable) collect_suspects(start, *suspects);
                 roll_back(start);
                 return 0;
             }
@@ -745,6 +802,7 @@ private:
     std::vector<uint32_t> pinned_old_;     // per vertex: closures of committed patches it is a corner of
     std::vector<uint8_t> covered_;         // per triangle: bit p, a center of a patch grown with preference p
     std::vector<uint8_t> banned_;          // per triangle: not a center (while a patch is improved)
+    std::vector<uint8_t> repair_banned_;   // per triangle: not a center (while a patch is grown again)
     std::vector<uint8_t> deferred_;        // per triangle: center of a valid patch left for later
     std::vector<Block> blocks_;
     std::vector<Patch> patches_;

@@ -1,0 +1,187 @@
+// Bottom-up base detection against the true hierarchy (docs/IMPORT.md, "Bottom-up, measured
+// against the truth"): for every corpus hierarchy, its leaf mesh as a user holds it (shuffled,
+// non-base vertices moved: the detection reads no position, so the move changes nothing), the
+// levels that undo_refinement_level finds one step at a time, each undone split compared with the
+// true hierarchy's splits (same three midpoints = true), free and with the base vertices kept
+// (the anchored way of import_leaf_mesh); beside it, what an ideal bottom-up search could undo
+// per step, computed on the true hierarchy:
+//   * whole: every node whose children are leaves, undone only together with every refined
+//     same-level neighbour (no midpoint stays: the model of undo_refinement_level's patches);
+//   * partial: the same, but a node may be undone while a neighbour stays refined (the node turns
+//     green, the shared midpoint stays a vertex; fewer than three such neighbours).
+// Prints a Markdown table, and with --steps every step.
+//
+// Usage: import_levels [--steps] corpus/*.amh
+#include "user_leaf_mesh.h"
+
+#include "import/inverse_refinement.h"
+
+#include <amc/hierarchy.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace {
+
+using amc::NodeId;
+using Key = std::array<uint32_t, 3>;
+
+Key sorted_key(uint32_t a, uint32_t b, uint32_t c) {
+    Key k{a, b, c};
+    std::sort(k.begin(), k.end());
+    return k;
+}
+
+// h rebuilt without the splits of the nodes marked in `drop` (whose children are leaves).
+amc::Hierarchy without(const amc::Hierarchy& h, const std::vector<uint8_t>& drop) {
+    amc::Hierarchy g(h.base());
+    std::vector<NodeId> map(h.node_capacity(), amc::kNoNode);
+    for (NodeId r = 0; r < h.root_count(); ++r) map[r] = r;
+    for (NodeId n : h.breadth_first_order()) {
+        if (h.is_leaf(n) || drop[n]) continue;
+        g.split(map[n]);
+        for (int k = 0; k < 4; ++k) map[h.child(n, k)] = g.child(map[n], k);
+    }
+    return g;
+}
+
+// Nodes undone per step by the ideal search (see the top of the file) until only the base is left.
+std::vector<size_t> ideal_steps(amc::Hierarchy h, bool partial) {
+    std::vector<size_t> steps;
+    while (steps.size() < 64) {
+        std::vector<uint8_t> undo(h.node_capacity(), 0);
+        size_t count = 0;
+        for (NodeId n = 0; n < h.node_capacity(); ++n) {
+            if (!h.is_alive(n) || h.is_leaf(n)) continue;
+            bool children_leaves = true;
+            for (int k = 0; k < 4; ++k) children_leaves &= h.is_leaf(h.child(n, k));
+            if (children_leaves) undo[n] = 1, ++count;
+        }
+        // Greatest valid subset: drop nodes whose undoing would break balance or closure.
+        for (bool changed = true; changed;) {
+            changed = false;
+            for (NodeId n = 0; n < h.node_capacity(); ++n) {
+                if (!undo[n]) continue;
+                int staying = 0;
+                bool valid = true;
+                for (int e = 0; e < 3; ++e) {
+                    const NodeId nb = h.neighbor(n, e);
+                    if (nb == amc::kNoNode || h.is_leaf(nb) || undo[nb]) continue;
+                    ++staying;
+                    const int ne = h.neighbor_edge(n, e);  // its children on the shared edge: corners ne, ne + 1
+                    for (int k : {ne, (ne + 1) % 3}) valid &= h.is_leaf(h.child(nb, k)) || undo[h.child(nb, k)];
+                }
+                if (partial ? staying == 3 || !valid : staying > 0) undo[n] = 0, --count, changed = true;
+            }
+        }
+        if (count == 0) break;
+        steps.push_back(count);
+        h = without(h, undo);
+    }
+    return steps;
+}
+
+struct Detection {
+    std::vector<std::array<size_t, 2>> steps;  // true, wrong blocks per step
+    size_t true_blocks = 0, wrong_blocks = 0, triangles_left = 0;
+    size_t first_step_finest = 0;  // true blocks of step 1 whose node is at the finest refined level
+};
+
+Detection detect(const amc::TriangleMesh& mesh, const std::map<Key, int>& level_of_split, int finest,
+                 const std::vector<uint8_t>* kept) {
+    Detection out;
+    const uint32_t vertex_count = uint32_t(mesh.positions.size());
+    std::vector<std::vector<amc::Triangle>> levels;
+    const std::vector<amc::Triangle>* triangles = &mesh.triangles;
+    std::vector<uint8_t> refined(mesh.triangles.size(), 0), changed;
+    for (int step = 0; step < amc::kMaxLevel; ++step) {
+        amc::detail::CoarserLevel coarser =
+            amc::detail::undo_refinement_level(*triangles, refined, vertex_count, step ? &changed : nullptr, kept);
+        if (coarser.red_blocks == 0) break;
+        std::array<size_t, 2> counts{0, 0};
+        for (const auto& s : coarser.splits) {
+            const auto it = level_of_split.find(sorted_key(s[3], s[4], s[5]));
+            ++counts[it == level_of_split.end()];
+            if (step == 0 && it != level_of_split.end() && it->second == finest) ++out.first_step_finest;
+        }
+        out.steps.push_back(counts);
+        out.true_blocks += counts[0];
+        out.wrong_blocks += counts[1];
+        refined = std::move(coarser.refined);
+        changed = std::move(coarser.changed);
+        levels.push_back(std::move(coarser.triangles));
+        triangles = &levels.back();
+    }
+    out.triangles_left = triangles->size();
+    return out;
+}
+
+std::string list(const std::vector<size_t>& v) {
+    std::string s;
+    for (size_t x : v) s += (s.empty() ? "" : ", ") + std::to_string(x);
+    return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    bool print_steps = false;
+    std::vector<std::string> files;
+    for (int i = 1; i < argc; ++i) {
+        const std::string arg = argv[i];
+        if (arg == "--steps") {
+            print_steps = true;
+        } else {
+            files.push_back(arg);
+        }
+    }
+    if (files.empty()) {
+        std::fprintf(stderr, "usage: import_levels [--steps] hierarchy.amh...\n");
+        return 2;
+    }
+    std::printf("| model | depth | refined nodes | ideal, whole patches: undone per step | ideal, partial | finest level's nodes found in step 1 | free: true / wrong blocks, triangles left | anchored: true / wrong, triangles left (base) |\n");
+    std::printf("|---|---:|---:|---|---|---:|---|---|\n");
+    for (const std::string& file : files) {
+        const amc::Hierarchy h = amc::read_hierarchy(file);
+        const amc::LeafMesh leaf = amc::extract_leaf_mesh(h);
+        std::vector<uint32_t> user_of_leaf;
+        const amc::TriangleMesh user =
+            bench::user_leaf_mesh(leaf.mesh, uint32_t(h.base().positions.size()), 0.3, 23, &user_of_leaf);
+        const std::vector<uint32_t> canonical = amc::canonical_vertex_order(h);
+        auto user_vertex = [&](amc::VertexId v) { return user_of_leaf[canonical[v]]; };
+        std::map<Key, int> level_of_split;
+        int finest = -1;
+        size_t at_finest = 0;
+        for (NodeId n : h.breadth_first_order()) {
+            if (h.is_leaf(n)) continue;
+            level_of_split[sorted_key(user_vertex(h.midpoint(n, 0)), user_vertex(h.midpoint(n, 1)),
+                                      user_vertex(h.midpoint(n, 2)))] = h.level(n);
+            finest = std::max(finest, h.level(n));
+        }
+        for (const auto& entry : level_of_split) at_finest += entry.second == finest;
+        std::vector<uint8_t> kept(user.positions.size(), 0);
+        for (amc::VertexId v = 0; v < h.base().positions.size(); ++v) kept[user_vertex(v)] = 1;
+        const Detection free = detect(user, level_of_split, finest, nullptr);
+        const Detection anchored = detect(user, level_of_split, finest, &kept);
+        const std::string name = std::filesystem::path(file).stem().string();
+        std::printf("| %s | %d | %zu | %s | %s | %zu / %zu | %zu / %zu, %zu | %zu / %zu, %zu (%u) |\n", name.c_str(),
+                    finest + 1, level_of_split.size(), list(ideal_steps(h, false)).c_str(),
+                    list(ideal_steps(h, true)).c_str(), free.first_step_finest, at_finest, free.true_blocks,
+                    free.wrong_blocks, free.triangles_left, anchored.true_blocks, anchored.wrong_blocks,
+                    anchored.triangles_left, h.root_count());
+        if (print_steps) {
+            for (const Detection* d : {&free, &anchored}) {
+                std::printf("|   %s steps (true/wrong): ", d == &free ? "free" : "anchored");
+                for (const auto& s : d->steps) std::printf("%zu/%zu ", s[0], s[1]);
+                std::printf("| | | | | | | |\n");
+            }
+        }
+        std::fflush(stdout);
+    }
+    return 0;
+}
