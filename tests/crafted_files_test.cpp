@@ -11,11 +11,14 @@
 #include "common/bits.h"
 #include "octree/octree_file.h"
 #include "octree/octree_traversal.h"
+#include "series/series_format.h"
+#include "series/series_framing.h"
 
 #include <amc/codec.h>
 #include <amc/hierarchy_coder.h>
 #include <amc/octree.h>
 #include <amc/refinement.h>
+#include <amc/series.h>
 
 #include <gtest/gtest.h>
 
@@ -547,6 +550,382 @@ TEST(CraftedFiles, OctreeWriterPadsCostlessForests) {
     EXPECT_GE(reader.remaining() * kOctreeOctantsPerByte, stats.nodes);
     EXPECT_LT((reader.remaining() - 1) * kOctreeOctantsPerByte, stats.nodes);  // no more than needed
     EXPECT_EQ(decode_octree_forest(file.data(), file.size()), forest);
+}
+
+// ---- .amcs series files (docs/FORMAT.md 7.2-7.4, 7.8, 7.10-7.12) --------------------------------
+
+struct SeriesParts {
+    std::vector<uint8_t> header;                               // the 16 bytes of 7.1
+    std::vector<std::pair<uint8_t, std::vector<uint8_t>>> blocks;  // base, frames (END excluded)
+};
+
+SeriesParts take_series_apart(const std::vector<uint8_t>& file) {
+    const SeriesScan scan = scan_series_file(file, "series", false, kSeriesFlagSinglePrecision, uint8_t(SeriesBlock::forest_frame));
+    SeriesParts parts{std::vector<uint8_t>(file.begin(), file.begin() + kSeriesHeaderSize), {}};
+    for (const SeriesBlockView& b : scan.blocks)
+        parts.blocks.push_back({b.type, std::vector<uint8_t>(b.payload, b.payload + b.length)});
+    return parts;
+}
+
+std::vector<uint8_t> put_series_together(const SeriesParts& parts) {
+    std::vector<uint8_t> file = parts.header;
+    for (const auto& block : parts.blocks) {
+        const std::vector<uint8_t> framed = series_block(block.first, block.second);
+        file.insert(file.end(), framed.begin(), framed.end());
+    }
+    const std::vector<uint8_t> end = series_block(uint8_t(SeriesBlock::end), {});
+    file.insert(file.end(), end.begin(), end.end());
+    return file;
+}
+
+// A frame block's payload (7.4; a forest frame, 7.11, has three counts and no geometry section).
+struct FramePayload {
+    bool forest = false;
+    double time = 0;
+    std::vector<uint64_t> counts;  // N, Vf, F, L (forest: O, Lv, L)
+    uint64_t connectivity_length = 0;
+    std::vector<uint8_t> connectivity;
+    uint64_t geometry_length = 0;
+    std::vector<uint8_t> geometry;
+    uint64_t field_count = 0;
+    std::vector<uint8_t> fields;  // the field records, as they are
+};
+
+FramePayload read_frame_payload(const std::vector<uint8_t>& payload, bool forest) {
+    PayloadReader in(payload.data(), payload.size(), "frame");
+    FramePayload f;
+    f.forest = forest;
+    f.time = in.f64();
+    for (int i = 0; i < (forest ? 3 : 4); ++i) f.counts.push_back(in.varint());
+    f.connectivity_length = in.varint();
+    for (uint64_t i = 0; i < f.connectivity_length; ++i) f.connectivity.push_back(in.u8());
+    if (!forest) {
+        f.geometry_length = in.varint();
+        for (uint64_t i = 0; i < f.geometry_length; ++i) f.geometry.push_back(in.u8());
+    }
+    f.field_count = in.varint();
+    f.fields.assign(in.rest(), in.rest() + in.remaining());
+    return f;
+}
+
+std::vector<uint8_t> write_frame_payload(const FramePayload& f) {
+    std::vector<uint8_t> out;
+    put_f64(out, f.time);
+    for (uint64_t c : f.counts) put_varint(out, c);
+    put_varint(out, f.connectivity_length);
+    out.insert(out.end(), f.connectivity.begin(), f.connectivity.end());
+    if (!f.forest) {
+        put_varint(out, f.geometry_length);
+        out.insert(out.end(), f.geometry.begin(), f.geometry.end());
+    }
+    put_varint(out, f.field_count);
+    out.insert(out.end(), f.fields.begin(), f.fields.end());
+    return out;
+}
+
+// Opens the file and decodes every frame.
+void read_series(const std::vector<uint8_t>& file, const SeriesReadOptions& options = {}) {
+    SeriesReader reader(file, "crafted.amcs", options);
+    for (size_t k = 0; k < reader.frame_count(); ++k) reader.frame(k);
+}
+
+void read_forest_series(const std::vector<uint8_t>& file, const SeriesReadOptions& options = {}) {
+    ForestSeriesReader reader(file, "crafted.amcs", options);
+    for (size_t k = 0; k < reader.frame_count(); ++k) reader.frame(k);
+}
+
+// A small series: a keyframe and a type-3 frame, each with a point and a cell field.
+std::vector<uint8_t> small_series() {
+    Hierarchy h(make_icosahedron());
+    refine_randomly(h, 12, 2, 7);
+    SeriesOptions options;
+    options.choose_keyframes = false;
+    SeriesWriter writer(h.base(), options);
+    for (int k = 0; k < 2; ++k) {
+        if (k == 1) refine_randomly(h, 8, 3, 9);
+        const LeafMesh leaf = extract_leaf_mesh(h);
+        Field u{"u", FieldAssociation::point, FieldType::float64, 1, {}, {}};
+        for (const Vec3& p : leaf.mesh.positions) u.values.push_back(p.x - 0.5 * p.y);
+        Field level{"level", FieldAssociation::cell, FieldType::uint8, 1, {}, {}};
+        for (size_t t = 0; t < leaf.mesh.triangles.size(); ++t) level.integers.push_back(leaf.cells.level[t]);
+        writer.add_frame(h, double(k), {u, level});
+    }
+    writer.close();
+    return writer.bytes();
+}
+
+TEST(CraftedFiles, SeriesBaseCounts) {
+    const std::vector<uint8_t> good = small_series();
+    ASSERT_NO_THROW(read_series(good));
+    for (uint64_t huge : kHuge) {
+        for (int field = 0; field < 2; ++field) {  // base vertices V, base triangles T (7.3)
+            SeriesParts parts = take_series_apart(good);
+            std::vector<uint8_t>& payload = parts.blocks[0].second;
+            PayloadReader in(payload.data(), payload.size(), "base");
+            uint64_t counts[2] = {in.varint(), in.varint()};
+            counts[field] = huge;
+            std::vector<uint8_t> changed;
+            put_varint(changed, counts[0]);
+            put_varint(changed, counts[1]);
+            changed.insert(changed.end(), in.rest(), in.rest() + in.remaining());
+            payload = changed;
+            const std::vector<uint8_t> file = put_series_together(parts);
+            expect_refused_cheaply(std::string(field ? "series base triangles" : "series base vertices") + " = " +
+                                       std::to_string(huge),
+                                   ErrorCode::corrupt, [&] { read_series(file); }, "can not fit");
+        }
+    }
+}
+
+TEST(CraftedFiles, SeriesFrameCounts) {
+    const std::vector<uint8_t> good = small_series();
+    const SeriesParts original = take_series_apart(good);
+    const uint64_t base_triangles = 20;
+    const char* const names[] = {"nodes", "vertices", "faces", "levels"};
+    for (size_t block = 1; block <= 2; ++block) {
+        const std::string frame = "series frame " + std::to_string(block - 1) + " ";
+        const FramePayload f = read_frame_payload(original.blocks[block].second, false);
+        const auto refused = [&](const std::string& what, ErrorCode code, const FramePayload& changed, const char* must_say) {
+            SeriesParts parts = original;
+            parts.blocks[block].second = write_frame_payload(changed);
+            const std::vector<uint8_t> file = put_series_together(parts);
+            expect_refused_cheaply(frame + what, code, [&] { read_series(file); }, must_say);
+        };
+        for (uint64_t huge : kHuge) {
+            for (int i = 0; i < 4; ++i) {
+                FramePayload changed = f;
+                changed.counts[size_t(i)] = huge;
+                if (i == 0 && (huge - base_triangles) % 4 == 0) changed.counts[0] += 1;  // N - T not divisible by 4
+                refused(std::string(names[i]) + " = " + std::to_string(changed.counts[size_t(i)]), ErrorCode::corrupt, changed,
+                        "inconsistent counts");
+            }
+            // Nodes consistent with the other counts (N - T divisible by 4): the node limit.
+            FramePayload nodes = f;
+            nodes.counts[0] = huge - (huge - base_triangles) % 4;
+            refused("nodes = " + std::to_string(nodes.counts[0]) + " (consistent)", ErrorCode::limit_exceeded, nodes, "limit");
+            FramePayload connectivity = f;
+            connectivity.connectivity_length = huge;
+            refused("connectivity length = " + std::to_string(huge), ErrorCode::truncated, connectivity, "connectivity longer");
+            FramePayload geometry = f;
+            geometry.geometry_length = huge;
+            refused("geometry length = " + std::to_string(huge), ErrorCode::truncated, geometry, "geometry longer");
+            FramePayload fields = f;
+            fields.field_count = huge;
+            refused("field count = " + std::to_string(huge), ErrorCode::corrupt, fields, "fields (at most 4096)");
+        }
+        // Nodes within the node limit but not within the block's bytes (7.2, Bounds).
+        FramePayload nodes = f;
+        nodes.counts[0] = SeriesReadOptions().max_nodes - (SeriesReadOptions().max_nodes - base_triangles) % 4;
+        refused("nodes = " + std::to_string(nodes.counts[0]), ErrorCode::limit_exceeded, nodes, "per byte");
+        // The first field record (7.8): name length, components, payload length.
+        PayloadReader in(f.fields.data(), f.fields.size(), "field");
+        const uint64_t name_length = in.varint();
+        for (uint64_t i = 0; i < name_length + 2; ++i) in.u8();  // name, association, type
+        const size_t components_at = f.fields.size() - in.remaining();
+        in.varint();
+        const uint8_t mode = in.u8();
+        if (mode == 1) in.f64();
+        for (uint64_t i = 0; i < f.counts[3]; ++i) in.u8();  // a predictor per level
+        const size_t payload_length_at = f.fields.size() - in.remaining();
+        const uint64_t payload_length = in.varint();
+        const size_t after = f.fields.size() - in.remaining();
+        const auto with_varint = [&](size_t at, size_t end, uint64_t value) {
+            FramePayload changed = f;
+            changed.fields.assign(f.fields.begin(), f.fields.begin() + ptrdiff_t(at));
+            put_varint(changed.fields, value);
+            changed.fields.insert(changed.fields.end(), f.fields.begin() + ptrdiff_t(end), f.fields.end());
+            return changed;
+        };
+        ASSERT_LE(payload_length, in.remaining());
+        for (uint64_t huge : kHuge) {
+            PayloadReader again(f.fields.data(), f.fields.size(), "field");
+            again.varint();
+            refused("field name length = " + std::to_string(huge), ErrorCode::corrupt,
+                    with_varint(0, f.fields.size() - again.remaining(), huge), "name");
+            PayloadReader components(f.fields.data() + components_at, f.fields.size() - components_at, "field");
+            components.varint();
+            refused("field components = " + std::to_string(huge), ErrorCode::corrupt,
+                    with_varint(components_at, f.fields.size() - components.remaining(), huge), "components");
+            refused("field payload length = " + std::to_string(huge), ErrorCode::truncated,
+                    with_varint(payload_length_at, after, huge), nullptr);
+        }
+    }
+}
+
+// An icosahedron refined uniformly `levels` times, as a keyframe that costs next to nothing: a
+// hierarchy stream of uniform levels and no symbol (7.6), positions of mode 2 (7.7), no field.
+std::vector<uint8_t> uniform_keyframe_series(int levels) {
+    SeriesWriter writer(make_icosahedron());
+    writer.close();  // the header and the base block
+    SeriesParts parts = take_series_apart(writer.bytes());
+    HierarchyStreamHeader header;
+    header.options.uniform_levels = true;
+    header.uniform_levels = uint8_t(levels);
+    FramePayload f;
+    f.connectivity = hierarchy_stream_tag(kHierarchyStreamVersion);
+    const std::vector<uint8_t> fields = write_hierarchy_stream_header(header);
+    f.connectivity.insert(f.connectivity.end(), fields.begin(), fields.end());
+    f.connectivity_length = f.connectivity.size();
+    const uint64_t power = uint64_t(1) << (2 * levels);
+    f.counts = {20 * (4 * power - 1) / 3, 10 * power + 2, 20 * power, uint64_t(levels) + 1};
+    f.geometry = {2};  // static, every new vertex at its midpoint
+    f.geometry_length = 1;
+    parts.blocks.push_back({uint8_t(SeriesBlock::keyframe), write_frame_payload(f)});
+    return put_series_together(parts);
+}
+
+TEST(CraftedFiles, SeriesCostlessFramesBomb) {
+    // A keyframe block of 43 bytes announcing a uniform refinement of depth 10 (28.0 M nodes,
+    // within the default node limit): before the per-byte bound it decoded (17.5 s, 4.7 GB
+    // allocated); now refused on the frame header.
+    const std::vector<uint8_t> bomb = uniform_keyframe_series(10);
+    const SeriesParts parts = take_series_apart(bomb);
+    const uint64_t nodes = read_frame_payload(parts.blocks[1].second, false).counts[0];
+    ASSERT_LE(nodes, SeriesReadOptions().max_nodes);
+    expect_refused_cheaply("uniform keyframe of " + std::to_string(nodes) + " nodes in " +
+                               std::to_string(parts.blocks[1].second.size() + kSeriesBlockOverhead) + " bytes",
+                           ErrorCode::limit_exceeded, [&] { read_series(bomb); }, "per byte");
+    // The same file of depth 3 is a valid series: it decodes to the uniform refinement, exactly at
+    // the bound, and is refused one node per byte below it.
+    const std::vector<uint8_t> small = uniform_keyframe_series(3);
+    const SeriesParts small_parts = take_series_apart(small);
+    const uint64_t small_nodes = read_frame_payload(small_parts.blocks[1].second, false).counts[0];
+    const uint64_t block = small_parts.blocks[1].second.size() + kSeriesBlockOverhead;
+    SeriesReadOptions tight;
+    tight.max_nodes_per_byte = (small_nodes + block - 1) / block;
+    Hierarchy uniform(make_icosahedron());
+    refine_uniformly(uniform, 3);
+    ASSERT_EQ(uniform.node_count(), small_nodes);
+    SeriesReader reader(small, "uniform.amcs", tight);
+    EXPECT_TRUE(identical(reader.frame(0).hierarchy, uniform));
+    tight.max_nodes_per_byte -= 1;
+    expect_refused_cheaply("uniform keyframe one node per byte over", ErrorCode::limit_exceeded,
+                           [&] { read_series(small, tight); }, "per byte");
+    // An unchanged type-3 frame: the same boundary.
+    SeriesOptions options;
+    options.choose_keyframes = false;
+    SeriesWriter writer(uniform.base(), options);
+    const uint64_t keyframe_bytes = writer.add_frame(uniform, 0).bytes;
+    const uint64_t frame_bytes = writer.add_frame(uniform, 1).bytes;
+    writer.close();
+    tight.max_nodes_per_byte = (small_nodes + frame_bytes - 1) / frame_bytes;
+    ASSERT_GE(tight.max_nodes_per_byte * keyframe_bytes, small_nodes);  // frame 0 within it too
+    SeriesReader unchanged(writer.bytes(), "unchanged.amcs", tight);
+    EXPECT_FALSE(unchanged.info(1).keyframe);
+    EXPECT_TRUE(identical(unchanged.frame(1).hierarchy, uniform));
+    tight.max_nodes_per_byte -= 1;
+    expect_refused_cheaply("unchanged type-3 frame one node per byte over", ErrorCode::limit_exceeded,
+                           [&] { read_series(writer.bytes(), tight); }, "per byte");
+}
+
+TEST(CraftedFiles, SeriesWriterPadsCostlessFrames) {
+    // A single triangle refined uniformly 9 times (349,525 nodes) costs no symbol as a keyframe
+    // and next to nothing unchanged: the writer pads both frame blocks to hold at most
+    // kSeriesNodesPerByte nodes per byte, and they read back with the default options.
+    TriangleMesh triangle;
+    triangle.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    triangle.triangles = {{0, 1, 2}};
+    Hierarchy h(triangle);
+    refine_uniformly(h, 9);
+    SeriesOptions options;
+    options.choose_keyframes = false;
+    SeriesWriter writer(triangle, options);
+    for (int k = 0; k < 2; ++k) {
+        const SeriesFrameStats stats = writer.add_frame(h, double(k));
+        EXPECT_GE(stats.bytes * kSeriesNodesPerByte, h.node_count()) << k;
+        EXPECT_LT((stats.bytes - 1) * kSeriesNodesPerByte, h.node_count()) << k;  // no more than needed
+    }
+    writer.close();
+    SeriesReader reader(writer.bytes());
+    for (size_t k = 0; k < 2; ++k) EXPECT_TRUE(identical(reader.frame(k).hierarchy, h)) << k;
+    // Octants: a uniform quadtree of depth 9 (349,525 octants) over one tree, twice.
+    const OctreeForest forest = uniform_octree_forest(brick_connectivity(2, 1, 1), 9);
+    ForestSeriesWriter forests(forest.connectivity, options);
+    for (int k = 0; k < 2; ++k) {
+        const ForestSeriesFrameStats stats = forests.add_frame(forest, double(k));
+        EXPECT_GE(stats.bytes * kSeriesNodesPerByte, stats.octants) << k;
+        EXPECT_LT((stats.bytes - 1) * kSeriesNodesPerByte, stats.octants) << k;
+    }
+    forests.close();
+    ForestSeriesReader forest_reader(forests.bytes());
+    for (size_t k = 0; k < 2; ++k) EXPECT_EQ(forest_reader.frame(k).forest, forest) << k;
+}
+
+// A forest series of two frames over a 2 x 2 brick, with a leaf field.
+std::vector<uint8_t> small_forest_series() {
+    const TreeConnectivity conn = brick_connectivity(2, 2, 2);
+    SeriesOptions options;
+    options.choose_keyframes = false;
+    ForestSeriesWriter writer(conn, options);
+    for (int k = 0; k < 2; ++k) {
+        OctreeForest forest = uniform_octree_forest(conn, 2 + k);
+        Field phi{"phi", FieldAssociation::cell, FieldType::float64, 1, {}, {}};
+        for (size_t i = 0; i < forest.leaves.size(); ++i) phi.values.push_back(0.25 * double(i));
+        forest.leaf_data = {phi};
+        writer.add_frame(forest, double(k));
+    }
+    writer.close();
+    return writer.bytes();
+}
+
+TEST(CraftedFiles, ForestSeriesCounts) {
+    const std::vector<uint8_t> good = small_forest_series();
+    ASSERT_NO_THROW(read_forest_series(good));
+    const SeriesParts original = take_series_apart(good);
+    // The forest base (7.10): trees beyond the octant limit, and a brick of 4096 x 4096 trees
+    // (within the limit, 16.8 M trees in a few bytes: before the bound, built on opening).
+    for (uint64_t trees : {uint64_t(1) << 31, uint64_t(1) << 40, uint64_t(4096) * 4096}) {
+        SeriesParts parts = original;
+        std::vector<uint8_t> base = {2};
+        put_varint(base, trees);
+        base.push_back(uint8_t(OctreeConnectivityMode::brick));
+        base.push_back(0);  // not periodic
+        put_varint(base, trees == uint64_t(4096) * 4096 ? 4096 : trees);
+        put_varint(base, trees == uint64_t(4096) * 4096 ? 4096 : 1);
+        parts.blocks[0].second = base;
+        parts.blocks.resize(1);
+        const std::vector<uint8_t> file = put_series_together(parts);
+        expect_refused_cheaply("forest base of " + std::to_string(trees) + " trees", ErrorCode::limit_exceeded,
+                               [&] { read_forest_series(file); }, trees == uint64_t(4096) * 4096 ? "per byte" : "limit");
+    }
+    const char* const names[] = {"octants", "leaves", "levels"};
+    for (size_t block = 1; block <= 2; ++block) {
+        const std::string frame = "forest series frame " + std::to_string(block - 1) + " ";
+        const FramePayload f = read_frame_payload(original.blocks[block].second, true);
+        const auto refused = [&](const std::string& what, ErrorCode code, const FramePayload& changed, const char* must_say) {
+            SeriesParts parts = original;
+            parts.blocks[block].second = write_frame_payload(changed);
+            const std::vector<uint8_t> file = put_series_together(parts);
+            expect_refused_cheaply(frame + what, code, [&] { read_forest_series(file); }, must_say);
+        };
+        for (uint64_t huge : kHuge) {
+            for (int i = 0; i < 3; ++i) {
+                FramePayload changed = f;
+                changed.counts[size_t(i)] = huge;
+                refused(std::string(names[i]) + " = " + std::to_string(huge), ErrorCode::corrupt, changed, "inconsistent counts");
+            }
+            FramePayload connectivity = f;
+            connectivity.connectivity_length = huge;
+            refused("connectivity length = " + std::to_string(huge), ErrorCode::truncated, connectivity, "connectivity longer");
+            FramePayload fields = f;
+            fields.field_count = huge;
+            refused("field count = " + std::to_string(huge), ErrorCode::corrupt, fields, "fields (at most 4096)");
+            // The field record (7.12): mode, then its length.
+            FramePayload record = f;
+            record.fields.resize(1);
+            put_varint(record.fields, huge);
+            record.fields.insert(record.fields.end(), f.fields.begin() + 1, f.fields.end());
+            refused("field record length = " + std::to_string(huge), ErrorCode::truncated, record, nullptr);
+        }
+        // Octants consistent with the leaves and levels, within the node limit but not the bytes:
+        // a uniform quadtree of depth 11 over the 4 trees (22.4 M octants).
+        FramePayload deep = f;
+        uint64_t octants = 0, level_octants = 4;
+        for (int l = 0; l <= 11; ++l, level_octants *= 4) octants += level_octants;
+        deep.counts = {octants, 4 + (octants - 4) / 4 * 3, 12};
+        ASSERT_LE(octants, SeriesReadOptions().max_nodes);
+        refused("octants = " + std::to_string(octants), ErrorCode::limit_exceeded, deep, "per byte");
+    }
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 // frames use only correctly rounded arithmetic (no libm transcendental), so the bytes are the same
 // on every IEEE platform. AMC_UPDATE_GOLDEN=1 writes a missing file (never overwrites one).
 #include <amc/import.h>
+#include <amc/octree.h>
 #include <amc/refinement.h>
 #include <amc/series.h>
 
@@ -171,6 +172,49 @@ TEST(SeriesGolden, TheIndicatorFileOfVersion2DecodesAndIsWhatTheWriterWrites) {
             ASSERT_EQ(f.fields.size(), 1u);
             EXPECT_TRUE(identical(f.fields[0], frames[k].fields[0])) << path << " frame " << k;
         }
+    }
+}
+
+// Frames that cost next to nothing, padded by the writer to at most kSeriesNodesPerByte nodes
+// (octants) per byte (FORMAT.md 7.2, Bounds): a single triangle refined uniformly 9 times (349,525
+// nodes), as a keyframe and again unchanged; a uniform quadtree of depth 9 over one tree, twice.
+TEST(SeriesGolden, PaddedFramesDecodeAndAreWhatTheWritersWrite) {
+    TriangleMesh triangle;
+    triangle.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    triangle.triangles = {{0, 1, 2}};
+    Hierarchy h(triangle);
+    refine_uniformly(h, 9);
+    SeriesOptions options;
+    options.choose_keyframes = false;
+    SeriesWriter writer(triangle, options);
+    writer.add_frame(h, 0);
+    writer.add_frame(h, 1);
+    writer.close();
+    const std::string path = golden_path(kSeriesVersion, "padded");
+    write_missing_golden(path, writer.bytes());
+    const std::vector<uint8_t> golden = read_file(path);
+    EXPECT_EQ(writer.bytes(), golden) << "the series bitstream changed (a new series version: FORMAT.md, section 7)";
+    SeriesReader reader(golden, path);
+    ASSERT_EQ(reader.frame_count(), 2u);
+    for (size_t k = 0; k < 2; ++k) {
+        EXPECT_TRUE(identical(reader.frame(k).hierarchy, h)) << path << " frame " << k;
+        EXPECT_LT((reader.info(k).size - 1) * kSeriesNodesPerByte, h.node_count()) << "frame " << k << " not padded";
+    }
+
+    const OctreeForest forest = uniform_octree_forest(brick_connectivity(2, 1, 1), 9);
+    ForestSeriesWriter forests(forest.connectivity, options);
+    forests.add_frame(forest, 0);
+    forests.add_frame(forest, 1);
+    forests.close();
+    const std::string forest_path = golden_path(kForestSeriesVersion, "padded_forest");
+    write_missing_golden(forest_path, forests.bytes());
+    const std::vector<uint8_t> forest_golden = read_file(forest_path);
+    EXPECT_EQ(forests.bytes(), forest_golden) << "the series bitstream changed (a new series version: FORMAT.md, section 7)";
+    ForestSeriesReader forest_reader(forest_golden, forest_path);
+    ASSERT_EQ(forest_reader.frame_count(), 2u);
+    for (size_t k = 0; k < 2; ++k) {
+        EXPECT_EQ(forest_reader.frame(k).forest, forest) << forest_path << " frame " << k;
+        EXPECT_LT((forest_reader.info(k).size - 1) * kSeriesNodesPerByte, forest_reader.info(k).octants) << "frame " << k;
     }
 }
 

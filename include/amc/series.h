@@ -87,12 +87,21 @@ private:
     bool closed_ = false;
 };
 
+// A frame block holds at most this many nodes (octants) per byte, framing included, and a forest
+// series at most this many trees per byte of the file after its header (docs/FORMAT.md 7.2,
+// Bounds): uniform levels and unchanged forests cost next to nothing, so the writer pads such
+// frames, and the reader's memory and time grow at most linearly with the file. The .amq bound.
+constexpr uint64_t kSeriesNodesPerByte = kOctreeOctantsPerByte;
+
 struct SeriesReadOptions {
     // Read a file whose writer has not finished (no END block) or died in the middle of a frame:
     // every complete frame is read, the incomplete rest ignored. Otherwise such a file is refused
     // (ErrorCode::truncated).
     bool allow_unfinished = false;
     uint64_t max_nodes = 1ull << 26;  // per frame
+    // More is refused as ErrorCode::limit_exceeded. 0 lifts the bound, for files written before
+    // it (2026-12-02), whose writer did not pad.
+    uint64_t max_nodes_per_byte = kSeriesNodesPerByte;
 };
 
 struct SeriesFrame {

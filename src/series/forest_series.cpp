@@ -33,14 +33,18 @@ std::vector<uint8_t> forest_base_payload(const TreeConnectivity& conn) {
     return out;
 }
 
-TreeConnectivity read_forest_base(const uint8_t* data, size_t size, uint64_t max_octants) {
+// `file_bytes`: the file's blocks after its header (the complete ones).
+TreeConnectivity read_forest_base(const uint8_t* data, size_t size, const SeriesReadOptions& options, uint64_t file_bytes) {
     PayloadReader in(data, size, "forest base block");
     const int dim = in.u8();
     AMC_REQUIRE(dim == 2 || dim == 3, corrupt, "forest base block: dimension " + std::to_string(dim));
     const uint64_t trees = in.varint();
     AMC_REQUIRE(trees >= 1, corrupt, "forest base block: no trees");
-    AMC_REQUIRE(trees <= max_octants, limit_exceeded,
-                "forest base block: " + std::to_string(trees) + " trees, more than the octant limit (" + std::to_string(max_octants) + ")");
+    AMC_REQUIRE(trees <= options.max_nodes, limit_exceeded,
+                "forest base block: " + std::to_string(trees) + " trees, more than the octant limit (" +
+                    std::to_string(options.max_nodes) + ")");
+    // A brick's trees cost no bits: bounded by the file's bytes, as octants are (FORMAT.md 7.10).
+    check_nodes_per_byte(trees, file_bytes, options.max_nodes_per_byte, "trees");
     // The .amq connectivity block (FORMAT.md 8.3) as version 2 reads it.
     return read_octree_connectivity(in.rest(), in.remaining(), dim, trees, kOctreeLeafDataVersion);
 }
@@ -92,15 +96,14 @@ CodedForestFrame code_forest_frame(const ForestState* ref, const OctreeForest& f
     if (ref) coded.models = ref->models;
     std::vector<uint8_t> connectivity;
     coded.levels.reset(new OctreeLevels(encode_forest_connectivity(ref ? ref->levels.get() : nullptr, forest, coded.models, connectivity)));
-    std::vector<uint8_t> payload;
-    put_f64(payload, time);
+    std::vector<uint8_t> head;
+    put_f64(head, time);
     stats.octants = coded.levels->octant_count();
     stats.leaves = forest.leaves.size();
-    put_varint(payload, stats.octants);
-    put_varint(payload, stats.leaves);
-    put_varint(payload, uint64_t(coded.levels->depth() + 1));
-    put_varint(payload, connectivity.size());
-    payload.insert(payload.end(), connectivity.begin(), connectivity.end());
+    put_varint(head, stats.octants);
+    put_varint(head, stats.leaves);
+    put_varint(head, uint64_t(coded.levels->depth() + 1));
+    std::vector<uint8_t> payload;  // after the connectivity section
     put_varint(payload, forest.leaf_data.size());
     const size_t fields_start = payload.size();
     const ForestFieldFrame frame(ref ? &ref->forest : nullptr, forest);
@@ -109,8 +112,9 @@ CodedForestFrame code_forest_frame(const ForestState* ref, const OctreeForest& f
         encode_forest_field(field, frame, payload);
         stats.fields.push_back({field.name, payload.size() - before, false, 0});
     }
-    stats.connectivity_bytes = connectivity.size();
     stats.field_bytes = payload.size() - fields_start;
+    payload = padded_frame_payload(head, connectivity, payload, stats.octants);
+    stats.connectivity_bytes = connectivity.size();
     coded.block = series_block(uint8_t(ref ? SeriesBlock::forest_frame : SeriesBlock::forest_keyframe), payload);
     stats.bytes = coded.block.size();
     return coded;
@@ -222,7 +226,7 @@ ForestSeriesReader::ForestSeriesReader(std::vector<uint8_t> bytes, const std::st
             AMC_REQUIRE(version_ >= kForestSeriesVersion, corrupt,
                         what + ": forest blocks in a file of version " + std::to_string(version_) + " (they came with version 3)");
             try {
-                state_->conn = read_forest_base(b.payload, b.length, options.max_nodes);
+                state_->conn = read_forest_base(b.payload, b.length, options, bytes_.size() - kSeriesHeaderSize - scan.ignored);
             } catch (const Error& e) {
                 throw e.prefixed(what);
             }
@@ -271,6 +275,7 @@ void ForestSeriesReader::decode_next(size_t k) {
         const ForestFrameHeader fh = read_forest_frame_header(in, state_->conn);
         AMC_REQUIRE(fh.octants <= options_.max_nodes, limit_exceeded,
                     std::to_string(fh.octants) + " octants, more than the limit (" + std::to_string(options_.max_nodes) + ")");
+        check_nodes_per_byte(fh.octants, info.size, options_.max_nodes_per_byte, "octants");
         const uint64_t length = in.varint();
         AMC_REQUIRE(length <= in.remaining(), truncated, "connectivity longer than the frame");
         const uint8_t* connectivity = in.rest();

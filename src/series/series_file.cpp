@@ -242,18 +242,17 @@ CodedFrame code_frame(const TriangleMesh& base, const SeriesOptions& options, co
     stats.moving = mode == FrameGeometryMode::moving;
     index_frame(next);
 
-    std::vector<uint8_t> payload;
-    put_f64(payload, time);
+    std::vector<uint8_t> head;
+    put_f64(head, time);
     stats.nodes = next.h.node_count();
     stats.vertices = next.h.vertex_count();
     stats.faces = face_count(next.h);
     const FieldFrame field_frame(ref, next, cp, order);
-    put_varint(payload, stats.nodes);
-    put_varint(payload, stats.vertices);
-    put_varint(payload, stats.faces);
-    put_varint(payload, uint64_t(field_frame.levels));
-    put_varint(payload, connectivity.size());
-    payload.insert(payload.end(), connectivity.begin(), connectivity.end());
+    put_varint(head, stats.nodes);
+    put_varint(head, stats.vertices);
+    put_varint(head, stats.faces);
+    put_varint(head, uint64_t(field_frame.levels));
+    std::vector<uint8_t> payload;  // after the connectivity section
     put_varint(payload, geometry.size());
     payload.insert(payload.end(), geometry.begin(), geometry.end());
     AMC_REQUIRE(fields.size() <= kMaxSeriesFields, invalid_input, "series frame: more than 4096 fields");
@@ -274,9 +273,10 @@ CodedFrame code_frame(const TriangleMesh& base, const SeriesOptions& options, co
         stats.max_error = std::max(stats.max_error, fs.max_error);
         next.fields.push_back(std::move(decoded));
     }
+    stats.field_bytes = payload.size() - fields_start;
+    payload = padded_frame_payload(head, connectivity, payload, stats.nodes);
     stats.connectivity_bytes = connectivity.size();
     stats.geometry_bytes = geometry.size();
-    stats.field_bytes = payload.size() - fields_start;
     coded.block = block(keyframe ? SeriesBlock::keyframe : SeriesBlock::frame, payload);
     stats.bytes = coded.block.size();
     return coded;
@@ -396,6 +396,7 @@ void SeriesReader::decode_next(size_t k) {
         const FrameHeader fh = read_frame_header(in, base.positions.size(), base.triangles.size(), what);
         AMC_REQUIRE(fh.nodes <= options_.max_nodes, limit_exceeded,
                     std::to_string(fh.nodes) + " nodes, more than the limit (" + std::to_string(options_.max_nodes) + ")");
+        check_nodes_per_byte(fh.nodes, info.size, options_.max_nodes_per_byte, "nodes");
         uint64_t connectivity_length = in.varint();
         AMC_REQUIRE(connectivity_length <= in.remaining(), truncated, "connectivity longer than the frame");
         const uint8_t* connectivity = in.rest();

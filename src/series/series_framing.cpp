@@ -1,10 +1,13 @@
 // Series file framing (docs/FORMAT.md 7.1-7.2).
 #include "series/series_framing.h"
 
+#include "coding/container.h"
 #include "common/check.h"
 #include "series/series_format.h"
 
 #include <xxhash.h>
+
+#include <amc/series.h>
 
 #include <cstring>
 
@@ -94,6 +97,31 @@ SeriesScan scan_series_file(const std::vector<uint8_t>& bytes, const std::string
         pos += kSeriesBlockOverhead + length;
     }
     return scan;
+}
+
+std::vector<uint8_t> padded_frame_payload(const std::vector<uint8_t>& head, std::vector<uint8_t>& connectivity,
+                                          const std::vector<uint8_t>& tail, uint64_t nodes) {
+    const uint64_t needed = nodes / kSeriesNodesPerByte + (nodes % kSeriesNodesPerByte != 0);
+    const auto block_size = [&] {
+        std::vector<uint8_t> length;
+        put_varint(length, connectivity.size());
+        return kSeriesBlockOverhead + head.size() + length.size() + connectivity.size() + tail.size();
+    };
+    // A longer section may lengthen its varint, so the block never ends up short.
+    while (block_size() < needed) connectivity.resize(connectivity.size() + size_t(needed - block_size()), 0);
+    std::vector<uint8_t> payload = head;
+    put_varint(payload, connectivity.size());
+    payload.insert(payload.end(), connectivity.begin(), connectivity.end());
+    payload.insert(payload.end(), tail.begin(), tail.end());
+    return payload;
+}
+
+void check_nodes_per_byte(uint64_t nodes, uint64_t bytes, uint64_t per_byte, const std::string& what) {
+    if (per_byte == 0) return;
+    const uint64_t needed = nodes / per_byte + (nodes % per_byte != 0);
+    AMC_REQUIRE(needed <= bytes, limit_exceeded,
+                std::to_string(nodes) + " " + what + " in " + std::to_string(bytes) + " bytes, more than " +
+                    std::to_string(per_byte) + " per byte (unpadded files written before 2026-12-02: max_nodes_per_byte = 0)");
 }
 
 }  // namespace amc

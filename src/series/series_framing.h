@@ -41,4 +41,16 @@ struct SeriesScan {
 SeriesScan scan_series_file(const std::vector<uint8_t>& bytes, const std::string& what, bool allow_unfinished,
                             uint8_t allowed_flags, uint8_t max_type);
 
+// A frame block's payload: `head` (time and counts), the connectivity section (its length as a
+// varint, then its bytes) and `tail`. The connectivity section, which ends with an arithmetic-coded
+// payload, is first padded with zeros until the block (framing included) holds at most
+// kSeriesNodesPerByte of the frame's `nodes` (or octants) per byte (FORMAT.md 7.2, Bounds); zeros
+// are what the decoder reads past a payload's end, so the symbols stay the same.
+std::vector<uint8_t> padded_frame_payload(const std::vector<uint8_t>& head, std::vector<uint8_t>& connectivity,
+                                          const std::vector<uint8_t>& tail, uint64_t nodes);
+
+// The reader's side of that bound: refuses (limit_exceeded) `nodes` in `bytes` bytes beyond
+// `per_byte` nodes per byte (0: no bound). `what` names the nodes ("nodes", "octants", "trees").
+void check_nodes_per_byte(uint64_t nodes, uint64_t bytes, uint64_t per_byte, const std::string& what);
+
 }  // namespace amc
