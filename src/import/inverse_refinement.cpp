@@ -16,7 +16,9 @@
 // the two stays.
 //
 // Conventions (docs/HIERARCHY.md): a block's parent is (v0, v1, v2), midpoint m_i lies on edge
-// v_i -> v_{i+1}; the children are corner k = (v_k, m_k, m_{k+2}) and center (m1, m2, m0).
+// v_i -> v_{i+1}; "corner k" is the block's triangle at v_k, the center the one of the three
+// midpoints. These are leaf triangles in the mesh's own vertex order: which child of the split
+// each becomes is red_split.h's business (the hierarchy is built from the splits' points).
 #include "import/inverse_refinement.h"
 
 #include "import/triangle_adjacency.h"

@@ -2,6 +2,8 @@
 // triangular grid of each base triangle (docs/IMPORT.md, "uniform refinement").
 #include "import/uniform_lattice.h"
 
+#include <amc/red_split.h>
+
 #include <utility>
 #include <vector>
 
@@ -124,16 +126,22 @@ std::vector<uint32_t> reconstruct_uniform(Hierarchy& h, const std::vector<uint32
                 }
             }
             if (h.is_leaf(item.node)) continue;
-            uint32_t mi[3], mj[3];
+            // The split's six points (red_split.h): corners, then the midpoints of edges 0-2.
+            uint32_t pi[6], pj[6];
             for (int e = 0; e < 3; ++e) {
-                mi[e] = (item.i[e] + item.i[(e + 1) % 3]) / 2;
-                mj[e] = (item.j[e] + item.j[(e + 1) % 3]) / 2;
+                pi[red_split::kCorner + e] = item.i[e];
+                pj[red_split::kCorner + e] = item.j[e];
+                pi[red_split::kMidpoint + e] = (item.i[e] + item.i[(e + 1) % 3]) / 2;
+                pj[red_split::kMidpoint + e] = (item.j[e] + item.j[(e + 1) % 3]) / 2;
             }
-            const NodeId c0 = h.child(item.node, 0);
-            stack.push_back({c0, {item.i[0], mi[0], mi[2]}, {item.j[0], mj[0], mj[2]}});
-            stack.push_back({c0 + 1, {mi[0], item.i[1], mi[1]}, {mj[0], item.j[1], mj[1]}});
-            stack.push_back({c0 + 2, {mi[2], mi[1], item.i[2]}, {mj[2], mj[1], item.j[2]}});
-            stack.push_back({c0 + 3, {mi[1], mi[2], mi[0]}, {mj[1], mj[2], mj[0]}});
+            for (int k = 0; k < 4; ++k) {
+                Item child{h.child(item.node, k), {}, {}};
+                for (int v = 0; v < 3; ++v) {
+                    child.i[v] = pi[red_split::kChildPoints[k][v]];
+                    child.j[v] = pj[red_split::kChildPoints[k][v]];
+                }
+                stack.push_back(child);
+            }
         }
     }
     return leaf_of_vertex;

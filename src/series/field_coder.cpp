@@ -6,6 +6,8 @@
 #include "common/exact_float.h"
 #include "common/check.h"
 
+#include <amc/red_split.h>
+
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -106,7 +108,7 @@ std::vector<uint32_t> previous_cells(const FieldFrame& f) {
             while (f.cp[m] == kNoNode) m = h.parent(m);
             out[j] = f.prev.first_cell[f.cp[m]];
         } else if (!p.is_leaf(q)) {  // coarsened: the centre leaf below it
-            while (!p.is_leaf(q)) q = p.child(q, 3);
+            while (!p.is_leaf(q)) q = p.child(q, red_split::kCenter);
             out[j] = f.prev.first_cell[q];
         } else {
             const uint32_t cells = 1 + uint32_t(p.hanging_node_count(q));
