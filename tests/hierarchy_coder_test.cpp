@@ -1,6 +1,7 @@
 // The hierarchy coder: exact round trips under every combination of switches, exhaustive small
 // hierarchies, known answers (uniform meshes cost nothing), entropy bound, corrupt streams.
 #include "coding/hierarchy/coder_switches.h"
+#include "coding/geometry/geometry_prediction.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
 #include "hierarchy_checks.h"
 
@@ -588,6 +589,33 @@ TEST(HierarchyCoder, StreamsFollowTheFormatText) {
 
 // A node split against Hierarchy::split's precondition (it lacks a neighbour) has no stream: the
 // decoder would refuse it. The encoder says so, under every switch combination.
+// The level coders hand the geometry coder each level's new vertices: the same list, in the same
+// order, as a walk of the level's nodes in the hierarchy finds.
+TEST(HierarchyCoder, LevelCodersListTheNewVerticesOfEachLevel) {
+    for (uint64_t seed = 1; seed <= 200; ++seed) {
+        const Hierarchy h = random_hierarchy(seed);
+        const HierarchyCoderOptions options = options_from_bits(int(seed % kOptionCombinations));
+        HierarchyLevelEncoder coder(h, options);
+        ArithmeticEncoder encoder;
+        size_t listed = 0;
+        for (int l = 0; l < coder.level_count(); ++l) {
+            ASSERT_EQ(coder.new_vertices(l), new_vertices_of_level(h, coder.level_nodes(l))) << "seed " << seed << ", level " << l;
+            listed += coder.new_vertices(l).size();
+            coder.encode_level(l, encoder);
+        }
+        ASSERT_EQ(listed, h.vertex_count() - h.base().positions.size()) << "seed " << seed;
+        const std::vector<uint8_t> payload = encoder.finish();
+        HierarchyLevelDecoder decoder(h.base(), coder.header().data(), coder.header().size(), kHierarchyStreamVersion,
+                                      UINT64_MAX);
+        ArithmeticDecoder in(payload.data(), payload.size());
+        while (!decoder.done()) {
+            const std::vector<NodeId> nodes = decoder.level_nodes();
+            decoder.decode_level(in);
+            ASSERT_EQ(decoder.new_vertices(), new_vertices_of_level(decoder.hierarchy(), nodes)) << "seed " << seed;
+        }
+    }
+}
+
 TEST(HierarchyCoder, UnbalancedHierarchyIsRefusedByTheEncoder) {
     Hierarchy h(make_icosahedron());
     h.split(0);

@@ -8,7 +8,6 @@
 #include "coding/base/base_stage.h"
 #include "coding/container.h"
 #include "coding/file_metadata.h"
-#include "coding/geometry/geometry_prediction.h"
 #include "coding/geometry/level_geometry.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
 #include "coding/numbering/numbering_coder.h"
@@ -119,7 +118,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
 
     bool static_geometry = false;
     for (int l = 0; l < hierarchy.level_count(); ++l) {
-        const NewVertices created = new_vertices_of_level(h, hierarchy.level_nodes(l));
+        const NewVertices& created = hierarchy.new_vertices(l);
         const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, options.predictor);
         ArithmeticEncoder encoder;
         hierarchy.encode_level(l, encoder);
@@ -220,12 +219,10 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
         const std::string where = "level " + std::to_string(level) + " block";
         const LevelBlockParts parts = split_level_block(block, reader.version(), where);
         ArithmeticDecoder decoder(parts.arithmetic, parts.arithmetic_size);
-        const std::vector<NodeId> nodes = hierarchy.level_nodes();
         // The refined nodes R of a level create at least 1.5 R vertices, whose positions are in
         // this block: it bounds R before the next level is allocated.
         hierarchy.decode_level(decoder, 2 * max_decodable_positions(block.size - 1) / 3);
-        const NewVertices created = new_vertices_of_level(h, nodes);
-        decode_level_geometry(h, created, parts, decoder, positions, space, level, where);
+        decode_level_geometry(h, hierarchy.new_vertices(), parts, decoder, positions, space, level, where);
         ++level;
         if (partial != nullptr) partial->levels_decoded = level;
     }

@@ -61,17 +61,17 @@ ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& ba
                                want_vertex_map ? &r.vertex_map : nullptr);
     const DiagonalExceptions rotated = diagonal_exceptions(r.hierarchy);
     if (rotated.fewest() == 0) return r;
-    std::vector<VertexId> kept_map;
-    Hierarchy kept = reorder_base(input, base_code.vertex_order, base_code.triangle_order,
-                                  std::vector<uint8_t>(base_code.triangle_order.size(), 0), &kept_map);
-    const DiagonalExceptions unrotated = diagonal_exceptions(kept);
+    // Without rotations every node keeps its local vertex order: the input's exceptions.
+    const DiagonalExceptions unrotated = diagonal_exceptions(input);
     const double rotated_bits = binary_entropy_bits(rotated.fewest(), rotated.leaves);
     const double kept_bits =
         binary_entropy_bits(unrotated.fewest(), unrotated.leaves) + 1.585 * double(base_code.triangle_order.size());
     if (kept_bits >= rotated_bits) return r;
-    r.hierarchy = std::move(kept);
+    r.vertex_map.clear();
+    r.hierarchy = reorder_base(input, base_code.vertex_order, base_code.triangle_order,
+                               std::vector<uint8_t>(base_code.triangle_order.size(), 0),
+                               want_vertex_map ? &r.vertex_map : nullptr);
     r.keep_rotations = true;
-    if (want_vertex_map) r.vertex_map = std::move(kept_map);
     return r;
 }
 

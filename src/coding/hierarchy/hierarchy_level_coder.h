@@ -9,6 +9,7 @@
 
 #include <amc/hierarchy_coder.h>
 
+#include <utility>
 #include <vector>
 
 namespace amc {
@@ -37,6 +38,9 @@ public:
     int level_count() const { return int(level_ids_.size()); }
     // Nodes of level l (ids in the encoded hierarchy) in canonical order.
     const std::vector<NodeId>& level_nodes(int l) const { return level_ids_[size_t(l)]; }
+    // The vertices level l's splits create, as (node, edge) in canonical order at their first
+    // appearance (new_vertices_of_level of level_nodes(l)): what the geometry coder codes.
+    const std::vector<std::pair<NodeId, int>>& new_vertices(int l) const { return new_vertices_[size_t(l)]; }
     // Codes level l's symbols and orientation bits; levels must be coded in order 0, 1, ...
     void encode_level(int l, ArithmeticEncoder& encoder);
     // Statistics of everything coded so far (all of it after the last level). payload_bytes and
@@ -72,6 +76,7 @@ private:
     std::vector<Event> events_;
     std::vector<size_t> level_end_;  // events of level l end at level_end_[l]
     std::vector<std::vector<NodeId>> level_ids_;
+    std::vector<std::vector<std::pair<NodeId, int>>> new_vertices_;
     std::vector<uint8_t> header_;
     HierarchyModels models_;
     uint64_t kept_symbols_ = 0, symbols_written_ = 0;
@@ -106,6 +111,9 @@ public:
     // when the level refines more than `max_refined` nodes (a bound the caller knows from its
     // own data, checked before the next level is allocated).
     void decode_level(ArithmeticDecoder& decoder, uint64_t max_refined = UINT64_MAX);
+    // The vertices the last decode_level created, as (node, edge) in canonical order at their
+    // first appearance (new_vertices_of_level of its level's nodes), positions not yet set.
+    const std::vector<std::pair<NodeId, int>>& new_vertices() const { return new_vertices_; }
     // decode_level in two halves, for callers that want every decision before building: decide
     // the current level and move to the next (hierarchy() is not touched); then split every
     // decided level in hierarchy(). In between, node_count() and vertex_count() tell the size
@@ -136,6 +144,7 @@ private:
     std::vector<Level> decided_;  // decided levels not yet built, oldest first
     std::vector<Level> spare_;    // built levels, whose memory the next levels reuse
     RefinedNumbering numbering_;     // of the level being decided
+    std::vector<std::pair<NodeId, int>> new_vertices_;  // of the last decode_level
     ScratchArray<uint32_t> closures_;  // the leaves with two or three hanging nodes
     NodeId level_base_ = 0;  // node id of local index 0 of the oldest level not yet built
     int level_index_ = 0;

@@ -192,6 +192,24 @@ DecidedLevelScan scan_decided_level(Level& level, RefinedNumbering& numbering, u
 uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering, Level& next,
                            bool cull_one_regularity);
 
+// The vertices the splits of a decided, numbered level create (derive_next_level counts them), in
+// canonical order at their first appearance, as Hierarchy::split_level numbers them: f(i, e) for
+// edge e of the refined node i (local index) unless the neighbour across e is a refined node
+// numbered before i (which made that midpoint).
+template <class F>
+void for_each_new_vertex(const Level& level, const RefinedNumbering& numbering, F&& f) {
+    const uint32_t* block = numbering.block_of();
+    const uint32_t* refined = level.refined.data();
+    with_links(level, [&](auto links) {
+        for (uint32_t b = 0; b < level.refined_count; ++b) {
+            const Neighbors node = links.neighbors(refined[b]);
+            for (int e = 0; e < 3; ++e) {
+                if (block[static_cast<int32_t>(node.nbr[e])] > b) f(refined[b], e);  // kNoLocal for none
+            }
+        }
+    });
+}
+
 // The unrefined edge of a decided leaf with exactly two hanging nodes. Which edge it is follows
 // no pattern, so it is looked up by the refined neighbours (bits 0-2) rather than searched for.
 inline int unrefined_edge(const Level& level, uint32_t i) {
