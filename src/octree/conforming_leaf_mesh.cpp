@@ -14,6 +14,7 @@
 #include "common/check.h"
 #include "octree/forest_points.h"
 
+#include <algorithm>
 #include <array>
 #include <cstdlib>
 
@@ -65,15 +66,23 @@ public:
 
     void run() {
         const int d = forest_.dim();
+        // About 1.1 corners per leaf, 0.6 added points per leaf in 3D; 3 triangles or 16 tetrahedra.
+        const size_t leaves = forest_.leaves.size();
+        points_.reserve(2 * leaves + 64);
+        leaf_corners_.reserve(leaves << d);
+        out_.cells.reserve((d == 2 ? 3 * 3 : 16 * 4) * leaves);
+        out_.leaf.reserve((d == 2 ? 3 : 16) * leaves);
         for (uint32_t t = 0; t < forest_.tree_count(); ++t)
             for (uint64_t i = forest_.tree_offsets[t]; i < forest_.tree_offsets[t + 1]; ++i)
-                for (int c = 0; c < (1 << d); ++c) points_.add(t, corner(forest_.leaves[i], c).data());
+                for (int c = 0; c < (1 << d); ++c) leaf_corners_.push_back(points_.add(t, corner(forest_.leaves[i], c).data()));
         corner_ids_ = points_.size();
         out_.corner_points = uint32_t(points_.positions().size());
         for (uint32_t t = 0; t < forest_.tree_count(); ++t) {
             tree_ = t;
             for (uint64_t i = forest_.tree_offsets[t]; i < forest_.tree_offsets[t + 1]; ++i) {
                 leaf_ = uint32_t(i);
+                origin_ = corner(forest_.leaves[i], 0), length_ = length(forest_.leaves[i]);
+                std::fill(edge_has_corner_, edge_has_corner_ + 12, int8_t(-1));
                 if (d == 2) leaf_2d(forest_.leaves[i]);
                 else leaf_3d(forest_.leaves[i]);
             }
@@ -91,7 +100,16 @@ private:
         return {o.x + ((c & 1) ? len : 0), o.y + ((c & 2) ? len : 0), o.z + ((c & 4) ? len : 0)};
     }
 
-    Vertex vertex(const Lattice& p) { return {p, points_.find(tree_, p.data())}; }
+    // The leaf's own corners come from the first pass, the rest from the table.
+    Vertex vertex(const Lattice& p) {
+        int c = 0;
+        for (int a = 0; a < 3; ++a) {
+            if (p[a] == origin_[a]) continue;
+            if (p[a] != origin_[a] + length_) return {p, points_.find(tree_, p.data())};
+            c |= 1 << a;
+        }
+        return {p, leaf_corners_[(size_t(leaf_) << forest_.dim()) + c]};
+    }
 
     bool is_leaf_corner(const Lattice& p) const {
         const ForestPoints::Point found = points_.find(tree_, p.data());
@@ -103,20 +121,31 @@ private:
         int64_t len = 0;
         Lattice m;
         for (int k = 0; k < 3; ++k) len = std::max(len, std::abs(b[k] - a[k])), m[k] = a[k] + (b[k] - a[k]) / 2;
-        if (len < 2 || !is_leaf_corner(m)) return;
+        if (len < 2) return;
+        if (len == length_) {  // a whole edge of the leaf: asked by its two faces (3D), looked up once
+            int axis = 0, bits = 0;
+            while (a[axis] == b[axis]) ++axis;
+            for (int k = 0, bit = 0; k < 3; ++k)
+                if (k != axis) bits |= (a[k] != origin_[k]) << bit++;
+            int8_t& known = edge_has_corner_[axis * 4 + bits];
+            if (known < 0) known = is_leaf_corner(m);
+            if (!known) return;
+        } else if (!is_leaf_corner(m)) {
+            return;
+        }
         edge_points(a, m, out);
         out.push_back(vertex(m));
         edge_points(m, b, out);
     }
 
-    // The polygon of corners (in order around) with the leaf corners on its sides.
-    std::vector<Vertex> polygon(const Lattice* corners, int n) {
-        std::vector<Vertex> poly;
+    // The polygon of corners (in order around) with the leaf corners on its sides, in poly_.
+    const std::vector<Vertex>& polygon(const Lattice* corners, int n) {
+        poly_.clear();
         for (int k = 0; k < n; ++k) {
-            poly.push_back(vertex(corners[k]));
-            edge_points(corners[k], corners[(k + 1) % n], poly);
+            poly_.push_back(vertex(corners[k]));
+            edge_points(corners[k], corners[(k + 1) % n], poly_);
         }
-        return poly;
+        return poly_;
     }
 
     // Triangles of a polygon of four corners and the points on its sides: two by the diagonal through
@@ -195,6 +224,11 @@ private:
     ConformingLeafMesh& out_;
     ForestPoints points_;
     std::vector<int> hand_;  // 2D: per tree, +1 or -1 (tree_hands)
+    std::vector<Vertex> poly_;  // polygon()'s, used before the next call
+    std::vector<ForestPoints::Point> leaf_corners_;  // 2^dim per leaf, z-order
+    Lattice origin_{0, 0, 0};  // the current leaf's corner 0 and length
+    int64_t length_ = 0;
+    int8_t edge_has_corner_[12] = {};  // per edge of the current leaf (axis * 4 + the other axes' sides): -1 unknown
     uint32_t corner_ids_ = 0, tree_ = 0, leaf_ = 0;
 };
 

@@ -26,7 +26,7 @@ std::array<uint32_t, 4> face_vertices(const TreeConnectivity& conn, uint32_t t, 
 }  // namespace
 
 ForestPoints::ForestPoints(const TreeConnectivity& conn)
-    : conn_(conn), dim_(conn.dim), n_(int64_t(1) << octree_root_log2(conn.dim)), faces_(conn), corners_(conn) {
+    : conn_(conn), dim_(conn.dim), n_(int64_t(1) << octree_root_log2(conn.dim)), faces_(conn), corners_(conn), slots_(64) {
     const int faces = 2 * dim_;
     face_in_place_.assign(size_t(conn.tree_count()) * faces, 1);
     if (conn.vertices.empty()) return;  // every tree is the unit tree: no place to tell apart
@@ -45,8 +45,32 @@ ForestPoints::Key ForestPoints::key(uint32_t tree, const int64_t p[3]) const {
 }
 
 ForestPoints::Point ForestPoints::find(uint32_t tree, const int64_t p[3]) const {
-    const auto it = points_.find(key(tree, p));
-    return it == points_.end() ? Point{} : it->second;
+    const Key k = key(tree, p);
+    const size_t mask = slots_.size() - 1;
+    for (size_t i = hash(k) & mask;; i = (i + 1) & mask) {
+        if (slots_[i].key == k) return slots_[i].point;
+        if (slots_[i].key.tree == kNone) return {};
+    }
+}
+
+void ForestPoints::reserve(size_t places) {
+    size_t size = slots_.size();
+    while (size < 2 * places) size *= 2;
+    if (size == slots_.size()) return;
+    std::vector<Slot> old(size);
+    old.swap(slots_);
+    used_ = 0;
+    for (const Slot& s : old)
+        if (s.key.tree != kNone) insert(s.key, s.point);
+}
+
+void ForestPoints::insert(const Key& key, Point point) {
+    if (2 * (used_ + 1) > slots_.size()) reserve(slots_.size());
+    const size_t mask = slots_.size() - 1;
+    size_t i = hash(key) & mask;
+    while (slots_[i].key.tree != kNone && !(slots_[i].key == key)) i = (i + 1) & mask;
+    if (slots_[i].key.tree == kNone) ++used_;
+    slots_[i] = {key, point};
 }
 
 uint32_t ForestPoints::new_position(const Place& place, uint32_t id) {
@@ -145,7 +169,7 @@ ForestPoints::Point ForestPoints::add(uint32_t tree, const int64_t p[3]) {
     for (size_t i = 0; i < places_.size(); ++i) {
         uint32_t& place = place_of_root[root(i)];
         if (place == kNone) place = new_position(places_[i], id);
-        points_.emplace(key(places_[i].tree, places_[i].p), Point{id, place});
+        insert(key(places_[i].tree, places_[i].p), Point{id, place});
         if (i == 0) first = {id, place};
     }
     return first;

@@ -13,7 +13,6 @@
 #include <amc/octree.h>
 
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
 
 namespace amc {
@@ -29,6 +28,8 @@ public:
     // `conn` must be valid (validate_connectivity) and outlive this.
     explicit ForestPoints(const TreeConnectivity& conn);
 
+    // Room for this many places without growing.
+    void reserve(size_t places);
     // The point at lattice coordinates p of `tree`, added with all its places when new.
     Point add(uint32_t tree, const int64_t p[3]);
     // A new point strictly inside a tree, which no other place can name (a cell centre).
@@ -46,14 +47,18 @@ private:
         uint32_t tree;
         bool operator==(const Key& o) const { return coords == o.coords && tree == o.tree; }
     };
-    struct KeyHash {
-        size_t operator()(const Key& k) const {
-            uint64_t x = k.coords ^ (uint64_t(k.tree) * 0x9e3779b97f4a7c15ull);
-            x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-            x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-            return size_t(x ^ (x >> 31));
-        }
+    // Open addressing with linear probing: one cache line per lookup, where std::unordered_map's
+    // nodes took two or more misses (the lookups are most of the extraction's time).
+    struct Slot {
+        Key key{0, kNone};  // tree kNone: empty
+        Point point;
     };
+    static uint64_t hash(const Key& k) {
+        uint64_t x = k.coords ^ (uint64_t(k.tree) * 0x9e3779b97f4a7c15ull);
+        x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+        x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+        return x ^ (x >> 31);
+    }
     struct Place {
         uint32_t tree;
         int64_t p[3];
@@ -73,7 +78,9 @@ private:
     TreeFaces faces_;
     TreeCorners corners_;
     std::vector<uint8_t> face_in_place_;  // per tree face: the face across is at the same place in space
-    std::unordered_map<Key, Point, KeyHash> points_;
+    void insert(const Key& key, Point point);
+    std::vector<Slot> slots_;  // a power of two, at most half full
+    size_t used_ = 0;
     std::vector<Vec3> positions_;
     std::vector<uint32_t> id_of_position_;
     uint32_t next_id_ = 0;
