@@ -190,6 +190,51 @@ TEST(Golden, StaticGeometryFilesDecodeAndPinTheEncoder) {
     }
 }
 
+// Version 7 (chunks): the cases above cut into chunks, so that seam edges cross boundaries, float32
+// and quantized coordinates, flipped diagonals next to the seam, and geometry mode 3 in chunks.
+std::vector<GoldenCase> chunked_cases() {
+    std::vector<GoldenCase> cases;
+    const std::vector<uint32_t> chunks = {4, 3, 5, 3, 2};
+    size_t k = 0;
+    for (GoldenCase c : golden_cases()) {
+        c.options.chunks = chunks[k++ % chunks.size()];
+        c.name += "_chunks" + std::to_string(c.options.chunks);
+        cases.push_back(std::move(c));
+    }
+    for (GoldenCase c : static_geometry_cases()) {
+        c.options.chunks = 4;
+        c.name += "_chunks4";
+        cases.push_back(std::move(c));
+    }
+    return cases;
+}
+
+TEST(Golden, ChunkedFilesDecodeAndPinTheEncoder) {
+    const bool update = std::getenv("AMC_UPDATE_GOLDEN") != nullptr;
+    for (const GoldenCase& c : chunked_cases()) {
+        const std::vector<uint8_t> bytes = encode(c.hierarchy, c.options);
+        const std::string path = golden_path(kChunkedVersion, c.name);
+        SCOPED_TRACE(path);
+        if (update && !std::filesystem::exists(path)) {
+            std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+            std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+        }
+        const std::vector<uint8_t> golden = read_golden(path);
+        ASSERT_FALSE(golden.empty()) << path << " is missing";
+        EXPECT_EQ(bytes, golden) << "the bitstream changed (a new format version: FORMAT.md, Versions)";
+        const FileInfo info = inspect(golden.data(), golden.size());
+        EXPECT_EQ(info.version, kChunkedVersion);
+        EXPECT_EQ(info.chunks.size(), size_t(c.options.chunks));
+        const Hierarchy back = decode(golden.data(), golden.size());
+        EXPECT_TRUE(decodes_to_one_of(back, expected_decodings(c.hierarchy, c.options, kChunkedVersion)));
+        for (int l = 0; l <= back.depth(); ++l) {
+            DecodeOptions prefix;
+            prefix.max_level = l;
+            EXPECT_EQ(decode(golden.data(), golden.size(), prefix).depth(), l) << "level " << l;
+        }
+    }
+}
+
 TEST(Golden, FilesOfEveryVersionDecodeToTheirHierarchies) {
     for (const int version : kVersionsOfTheCases) {
         for (const GoldenCase& c : golden_cases()) {

@@ -83,6 +83,14 @@ int main(int argc, char** argv) {
     encode_cmd->add_option("--quantize", encode.quantize_bits, "Quantize coordinates to BITS per axis (lossy; 0 = bit-exact)")
         ->check(CLI::Range(0, 30));
     encode_cmd->add_option("--predictor", encode.predictor, "auto | midpoint | butterfly | normal")->capture_default_str();
+    encode_cmd->add_option("--chunks", encode.chunks,
+                           "Cut the forest into this many chunks, each decodable alone (0: one per --chunk-faces faces)")
+        ->check(CLI::Range(0u, 1u << 30));
+    encode_cmd->add_option("--chunk-faces", encode.chunk_faces, "Faces per chunk when --chunks is 0")
+        ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 40))
+        ->capture_default_str();
+    encode_cmd->add_option("--threads", encode.threads, "Threads that code chunks at once (0: every core)")
+        ->check(CLI::Range(0u, 4096u));
     encode_cmd->add_flag("--series", encode.series, "The input is a series (as 'amc series encode'; implied by a .pvd input)");
 
     DecodeCommand decode;
@@ -99,6 +107,13 @@ int main(int argc, char** argv) {
                          "Accept a file still arriving (cut anywhere after the base mesh): decode its complete levels");
     decode_cmd->add_option("--map", decode.map, "Write the stored numbering map (input's numbering -> canonical)");
     add_max_nodes(decode_cmd, decode.max_nodes);
+    decode_cmd->add_option("--threads", decode.threads, "Threads that decode chunks at once (0: every core)")
+        ->check(CLI::Range(0u, 4096u));
+    decode_cmd->add_option("--chunks", decode.chunks,
+                           "Decode only these chunks (amc info lists them), e.g. 0,3-5: their roots' trees alone");
+    decode_cmd->add_option("--triangles", decode.triangles,
+                           "Decode only the chunks that hold these base triangles (file order), e.g. 7,120")
+        ->delimiter(',');
 
     ImportCommand import;
     auto* import_cmd = app.add_subcommand("import", "Turn a leaf mesh into a hierarchy file (.amh)");

@@ -8,8 +8,10 @@
 #include <amc/mesh_io.h>
 #include <amc/numbering.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <stdexcept>
 
 namespace amc::cli {
 
@@ -32,6 +34,35 @@ GeometryPredictor parse_predictor(const std::string& name) {
     if (name == "butterfly") return GeometryPredictor::butterfly;
     if (name == "normal") return GeometryPredictor::normal_frame;
     throw UsageError("--predictor: unknown predictor '" + name + "' (auto, midpoint, butterfly, normal)");
+}
+
+// "0,3-5" -> 0, 3, 4, 5 (increasing, each once).
+std::vector<uint32_t> parse_chunk_list(const std::string& text) {
+    std::vector<uint32_t> out;
+    size_t pos = 0;
+    while (pos <= text.size()) {
+        const size_t comma = std::min(text.find(',', pos), text.size());
+        const std::string item = text.substr(pos, comma - pos);
+        const size_t dash = item.find('-');
+        try {
+            size_t used = 0;
+            const unsigned long first = std::stoul(item.substr(0, dash), &used);
+            if (used != item.substr(0, dash).size()) throw std::invalid_argument(item);
+            unsigned long last = first;
+            if (dash != std::string::npos) {
+                last = std::stoul(item.substr(dash + 1), &used);
+                if (used != item.size() - dash - 1) throw std::invalid_argument(item);
+            }
+            if (last < first || last >= (1ul << 30)) throw std::invalid_argument(item);
+            for (unsigned long c = first; c <= last; ++c) out.push_back(uint32_t(c));
+        } catch (const std::logic_error&) {
+            throw UsageError("--chunks: '" + item + "' is not a chunk number or range (e.g. 0,3-5)");
+        }
+        pos = comma + 1;
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
 }
 
 // Summaries go to stderr when the data goes to stdout.
@@ -91,6 +122,9 @@ void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     EncodeOptions options;
     options.quantize_bits = command.quantize_bits;
     options.predictor = parse_predictor(command.predictor);
+    options.chunks = command.chunks;
+    options.chunk_faces = command.chunk_faces;
+    options.threads = command.threads;
     Hierarchy h;
     LeafNumbering numbering;
     auto start = std::chrono::steady_clock::now();
@@ -162,13 +196,28 @@ void run_decode(const DecodeCommand& command, const GlobalOptions& global) {
 
     DecodeOptions options;
     options.max_level = command.level;
+    options.threads = command.threads;
     if (command.max_nodes > 0) options.max_nodes = command.max_nodes;
+    const bool some_chunks = !command.chunks.empty() || !command.triangles.empty();
+    if (some_chunks && (command.partial || !command.map.empty() || !command.chunks.empty() == !command.triangles.empty()))
+        throw UsageError("--chunks and --triangles (one of them) do not combine with --partial or --map");
     LeafNumbering numbering;
     progress.phase("decoding " + input.name);
     auto start = std::chrono::steady_clock::now();
     Hierarchy h;
     std::string partial_note;  // how far a partial file got
-    if (command.partial) {
+    if (some_chunks) {
+        const auto* data = reinterpret_cast<const uint8_t*>(input.bytes.data());
+        try {
+            const std::vector<uint32_t> chunks = !command.chunks.empty()
+                                                     ? parse_chunk_list(command.chunks)
+                                                     : chunks_covering(inspect(data, input.bytes.size()), command.triangles);
+            h = decode_chunks(data, input.bytes.size(), chunks, options).hierarchy;
+        } catch (const Error& e) {
+            throw e.prefixed(input.name);
+        }
+        partial_note = ", chunks only";
+    } else if (command.partial) {
         PartialDecode partial = decode_partial_input(input, options);
         h = std::move(partial.hierarchy);
         numbering = std::move(partial.numbering);

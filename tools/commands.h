@@ -27,6 +27,9 @@ struct EncodeCommand {
     std::string map;              // write the numbering map (input -> decoded) here
     int quantize_bits = 0;
     std::string predictor = "auto";
+    uint32_t chunks = 0;          // 0: one per chunk_faces faces
+    uint64_t chunk_faces = 100000;
+    unsigned threads = 0;         // 0: every core
     bool series = false;          // the input is a series (.pvd, or a list of VTU files): run_series_encode
 };
 void run_encode(const EncodeCommand& command, const GlobalOptions& global);
@@ -40,6 +43,9 @@ struct DecodeCommand {
     std::string map;             // write the stored numbering map here
     uint64_t max_nodes = 0;      // 0: the library's default limit
     int64_t frame = -1;          // a series: only this frame
+    unsigned threads = 0;        // 0: every core
+    std::string chunks;          // only these chunks: "0,3-5"
+    std::vector<uint32_t> triangles;  // only the chunks holding these base triangles (decoder order)
 };
 void run_decode(const DecodeCommand& command, const GlobalOptions& global);
 

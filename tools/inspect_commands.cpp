@@ -51,6 +51,14 @@ void print_compressed_info(const InputFile& input, uint64_t max_nodes) {
         if (b.level >= 0) name += " " + std::to_string(b.level);
         std::printf("  %-20s %10lu %10lu\n", name.c_str(), (unsigned long)b.offset, (unsigned long)b.size);
     }
+    if (!file.chunks.empty()) {
+        std::printf("  %-8s %12s %10s %10s %10s\n", "chunk", "roots", "nodes", "offset", "bytes");
+        for (size_t c = 0; c < file.chunks.size(); ++c) {
+            const ChunkInfo& k = file.chunks[c];
+            std::printf("  %-8zu %5u-%-6u %10lu %10lu %10lu\n", c, k.first_root, k.first_root + k.roots - 1,
+                        (unsigned long)k.nodes, (unsigned long)k.offset, (unsigned long)k.size);
+        }
+    }
 }
 
 }  // namespace

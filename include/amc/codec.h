@@ -33,6 +33,14 @@ struct EncodeOptions {
     // section 6; its cost per model is in docs/CODEC.md).
     const LeafNumbering* numbering = nullptr;
     bool store_numbering = true;
+    // Chunks (docs/FORMAT.md 3.11): the forest cut into runs of roots, each decodable on its own,
+    // coded and decoded on several threads. 0: one chunk per `chunk_faces` faces of the leaf mesh
+    // (at least one). A file of one chunk is written as before chunks existed (version 6 or
+    // lower, byte for byte); more chunks make a version-7 file.
+    uint32_t chunks = 0;
+    uint64_t chunk_faces = 100000;
+    // Threads that code chunks at once; 0: every core. The bytes do not depend on it.
+    unsigned threads = 0;
 };
 
 struct LevelStats {
@@ -75,6 +83,7 @@ Hierarchy in_decoder_order(const Hierarchy& h, const EncodeOptions& options = {}
 struct DecodeOptions {
     int max_level = -1;                  // stop after this level: the mesh of that level
     uint64_t max_nodes = 1ull << 26;     // refuse files that would build more nodes than this
+    unsigned threads = 0;                // threads that decode chunks at once; 0: every core
 };
 
 // Throws Error naming the problem (bad magic, newer version, checksum, structure) on a corrupt or
@@ -117,8 +126,15 @@ struct FileBlock {
     uint64_t offset = 0, size = 0;  // the whole block: header, payload, checksum
     int level = -1;                 // for level blocks
 };
+// A chunk of a chunked file (version 7): its roots, nodes and block.
+struct ChunkInfo {
+    uint32_t first_root = 0, roots = 0;
+    uint64_t nodes = 0;
+    uint64_t offset = 0, size = 0;  // the chunk block: header, payload, checksum
+};
 struct FileInfo {
     int version = 0;
+    std::vector<ChunkInfo> chunks;  // empty for a file without chunks (it decodes as one)
     bool single_precision = false;
     int quantize_bits = 0;
     uint64_t base_vertices = 0, base_triangles = 0, nodes = 0, vertices = 0, faces = 0;
@@ -126,5 +142,22 @@ struct FileInfo {
     std::vector<FileBlock> blocks;
 };
 FileInfo inspect(const uint8_t* data, size_t size);  // throws Error like decode
+
+// Some chunks of a file alone: the hierarchy over the selected chunks' roots (their forests,
+// positions and diagonals; edges towards other chunks are boundary edges here, so a leaf there has
+// no hanging node from the other side). The base mesh is the selected roots' triangles in file
+// order over the base vertices they use, in file order.
+struct ChunkDecode {
+    Hierarchy hierarchy;
+    std::vector<uint32_t> roots;          // root i of the result is root roots[i] of the whole file
+    std::vector<uint32_t> base_vertices;  // base vertex i of the result is base vertex base_vertices[i]
+};
+// `chunks`: indices into inspect(...).chunks, increasing. A file without chunks has one, chunk 0.
+// Reads the header, the base mesh, the chunk table and the seam, then only the selected chunks'
+// blocks. Throws Error like decode, and ErrorCode::invalid_input for a chunk not in the file.
+ChunkDecode decode_chunks(const uint8_t* data, size_t size, const std::vector<uint32_t>& chunks,
+                          const DecodeOptions& options = {});
+// The chunks (increasing) that hold the given roots (base triangles of the file, in decoder order).
+std::vector<uint32_t> chunks_covering(const FileInfo& info, const std::vector<uint32_t>& base_triangles);
 
 }  // namespace amc

@@ -29,13 +29,18 @@ const char* block_type_name(uint8_t type) {
         case BlockType::base_geometry: return "base geometry";
         case BlockType::level: return "level";
         case BlockType::numbering: return "numbering";
+        case BlockType::chunk_table: return "chunk table";
+        case BlockType::seam: return "seam";
+        case BlockType::chunk: return "chunk";
     }
     return "unknown";
 }
 
 namespace {
 uint8_t amc_last_block_type(uint8_t version) {
-    return version >= kNumberingVersion ? uint8_t(BlockType::numbering) : uint8_t(BlockType::level);
+    return version >= kChunkedVersion     ? uint8_t(BlockType::chunk)
+           : version >= kNumberingVersion ? uint8_t(BlockType::numbering)
+                                          : uint8_t(BlockType::level);
 }
 }  // namespace
 
@@ -111,6 +116,13 @@ bool BlockReader::next(Block& block) {
         AMC_REQUIRE(pos_ == size_, corrupt, std::to_string(size_ - pos_) + " bytes after the end block");
     }
     return true;
+}
+
+void BlockReader::seek(size_t offset) {
+    AMC_REQUIRE(offset >= kFileHeaderSize && offset <= size_, corrupt,
+                "block offset " + std::to_string(offset) + " lies outside the file");
+    pos_ = offset;
+    ended_ = false;
 }
 
 void put_varint(std::vector<uint8_t>& out, uint64_t value) {

@@ -24,6 +24,9 @@ enum class BlockType : uint8_t {
     base_geometry = 3,
     level = 4,
     numbering = 5,
+    chunk_table = 6,  // version 7 on: the chunks of roots and where their blocks are (FORMAT.md 3.11)
+    seam = 7,         // version 7 on: the vertices on edges between chunks
+    chunk = 8,        // version 7 on: one chunk's levels
 };
 const char* block_type_name(uint8_t type);
 
@@ -81,6 +84,9 @@ public:
     // Whether the bytes left hold the next block whole (header, payload and checksum): false in
     // a file cut while that block was being written or received.
     bool next_block_arrived() const;
+    // Continues at `offset` (a block header) instead: a reader that seeks straight to a block it
+    // knows from a table. Throws Error if the offset lies outside the blocks.
+    void seek(size_t offset);
 
 private:
     const FileFraming* framing_;

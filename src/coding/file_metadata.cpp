@@ -37,7 +37,7 @@ Metadata read_metadata(const Block& block, bool quantized) {
     m.faces = in.varint();
     m.levels = in.varint();
     m.options = in.varint();
-    AMC_REQUIRE(!(m.options & ~kOptionRootRotations), corrupt, "metadata block: unknown options");
+    AMC_REQUIRE(!(m.options & ~(kOptionRootRotations | kOptionChunked)), corrupt, "metadata block: unknown options");
     const uint64_t header_size = in.varint();
     AMC_REQUIRE(header_size <= in.remaining(), truncated, "metadata block: hierarchy header is truncated");
     m.hierarchy_header.assign(in.rest(), in.rest() + header_size);
@@ -79,7 +79,8 @@ void check_counts_against_size(const Metadata& m, uint64_t bytes_after, const De
     AMC_REQUIRE(m.base_triangles <= 2 * max_decodable_symbols(bytes_after), corrupt,
                 cannot_hold(m.base_triangles, "base triangles"));
     HierarchyStreamHeader header;
-    read_hierarchy_stream_header(m.hierarchy_header.data(), m.hierarchy_header.size(), header);
+    if (!(m.options & kOptionChunked))  // a chunked file has one per chunk, none here
+        read_hierarchy_stream_header(m.hierarchy_header.data(), m.hierarchy_header.size(), header);
     AMC_REQUIRE(header.symbol_count <= std::min(m.nodes, max_decodable_symbols(bytes_after)), corrupt,
                 cannot_hold(header.symbol_count, "hierarchy symbols"));
     AMC_REQUIRE(m.nodes <= options.max_nodes, limit_exceeded,

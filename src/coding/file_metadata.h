@@ -15,6 +15,7 @@ namespace amc {
 
 // Metadata option bits.
 constexpr uint64_t kOptionRootRotations = 1;  // base triangles keep the input's local vertex order
+constexpr uint64_t kOptionChunked = 2;        // version 7: chunk blocks instead of level blocks (FORMAT.md 3.11)
 
 struct Metadata {
     uint64_t base_vertices = 0, base_triangles = 0, nodes = 0, vertices = 0, faces = 0, levels = 0;

@@ -14,12 +14,15 @@ namespace amc {
 // start triangle and gate radius of mode 2 (FORMAT.md 4.16), so it writes other bytes. Version 6 for files with a level in geometry
 // mode 3 (normal frame, static tables, rANS).
 constexpr uint8_t kOldestReadableVersion = 1;
-constexpr uint8_t kNewestVersion = 6;
+constexpr uint8_t kNewestVersion = 7;
 constexpr uint8_t kBaseVersion = 2;       // everything but the numbering block and mode 2
 constexpr uint8_t kNumberingVersion = 3;  // the first version with a numbering block
 constexpr uint8_t kAngleBaseVersion = 4;  // the first version with base connectivity mode 2
 constexpr uint8_t kSearchedBaseVersion = 5;  // mode 2 from the searching encoder: what mode-2 files are written as
 constexpr uint8_t kStaticGeometryVersion = 6;  // the first version with level geometry mode 3 (normal frame, rANS)
+// Files split into independent chunks of roots (chunk table, seam and chunk blocks instead of level
+// blocks): written only for files of more than one chunk.
+constexpr uint8_t kChunkedVersion = 7;
 
 // The hierarchy stream (FORMAT.md section 2).
 constexpr uint8_t kHierarchyStreamVersion = 2;
@@ -38,6 +41,7 @@ constexpr uint8_t hierarchy_stream_version_of_file(uint8_t file_version) {
         case 4: return 2;
         case 5: return 2;
         case 6: return 2;
+        case 7: return 2;
     }
     return 0;
 }

@@ -6,12 +6,14 @@
 #include <amc/codec.h>
 
 #include "coding/base/base_stage.h"
+#include "coding/chunks/chunked_file.h"
 #include "coding/container.h"
 #include "coding/file_metadata.h"
 #include "coding/geometry/level_geometry.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
 #include "coding/numbering/numbering_coder.h"
 #include "common/check.h"
+#include "common/parallel.h"
 #include "hierarchy/writer_checks.h"
 
 #include <algorithm>
@@ -45,8 +47,9 @@ Quantizer quantizer_of(const Hierarchy& input, int bits, double& max_error) {
 }
 
 // The lowest version that holds what the file holds (format_version.h).
-uint8_t file_version(bool static_geometry, BaseConnectivityMode base_mode, bool store_numbering) {
-    return static_geometry                               ? kStaticGeometryVersion
+uint8_t file_version(bool chunked, bool static_geometry, BaseConnectivityMode base_mode, bool store_numbering) {
+    return chunked                                       ? kChunkedVersion
+           : static_geometry                             ? kStaticGeometryVersion
            : base_mode == BaseConnectivityMode::angle ? kSearchedBaseVersion
            : store_numbering                          ? kNumberingVersion
                                                       : kBaseVersion;
@@ -94,17 +97,23 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
         for (VertexId v = 0; v < h.positions().size(); ++v) h.set_position(v, dequantize(quantizer, snap_to_grid(quantizer, h.position(v))));
     }
 
-    HierarchyLevelEncoder hierarchy(h, options.hierarchy);
+    // Chunks (FORMAT.md 3.11): more than one makes a version-7 file, whose chunks code the forest on
+    // several threads; the hierarchy coder then runs over the roots alone, for its header's sake.
+    const uint64_t faces = options.chunks == 1 ? 0 : leaf_face_count(h);
+    const std::vector<RootRange> chunks = balanced_chunks(nodes_per_root(h), chunk_count_for(options, faces));
+    const bool chunked = chunks.size() > 1;
+    const Hierarchy roots_only = chunked ? Hierarchy(h.base()) : Hierarchy();
+    HierarchyLevelEncoder hierarchy(chunked ? roots_only : h, options.hierarchy);
     Metadata meta;
     meta.base_vertices = h.base().positions.size();
     meta.base_triangles = h.root_count();
     meta.nodes = h.node_count();
     meta.vertices = h.vertex_count();
-    meta.faces = hierarchy.stats().faces;  // counted by the coder's first pass
-    meta.levels = uint64_t(hierarchy.level_count());
-    meta.hierarchy_header = hierarchy.header();
+    meta.faces = chunked ? faces : hierarchy.stats().faces;  // counted by the coder's first pass
+    meta.levels = uint64_t(chunked ? h.depth() + 1 : hierarchy.level_count());
+    if (!chunked) meta.hierarchy_header = hierarchy.header();
     meta.quantizer = quantizer;
-    meta.options = reordered.keep_rotations ? kOptionRootRotations : 0;
+    meta.options = (reordered.keep_rotations ? kOptionRootRotations : 0) | (chunked ? kOptionChunked : 0);
 
     // The blocks are made first: the version in the header depends on the level modes chosen.
     std::vector<std::pair<BlockType, std::vector<uint8_t>>> blocks;
@@ -117,7 +126,12 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     stats.base_geometry_bytes = blocks.back().second.size();
 
     bool static_geometry = false;
-    for (int l = 0; l < hierarchy.level_count(); ++l) {
+    if (chunked) {
+        ChunkedBlocks parts = encode_chunked(h, chunks, options, space, resolve_thread_count(options.threads), stats);
+        static_geometry = parts.static_geometry;
+        for (auto& block : parts.blocks) blocks.push_back(std::move(block));
+    }
+    for (int l = 0; !chunked && l < hierarchy.level_count(); ++l) {
         const NewVertices& created = hierarchy.new_vertices(l);
         const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, options.predictor);
         ArithmeticEncoder encoder;
@@ -133,7 +147,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
         stats.numbering_bytes = blocks.back().second.size();
         stats.framing_bytes += kBlockOverhead;
     }
-    BlockWriter writer(file_version(static_geometry, base_code.mode, store_numbering),
+    BlockWriter writer(file_version(chunked, static_geometry, base_code.mode, store_numbering),
                        uint8_t((precision == Precision::float32 ? kFlagSinglePrecision : 0) | (quantized ? kFlagQuantized : 0)));
     for (const auto& block : blocks) writer.add(block.first, block.second);
     std::vector<uint8_t> out = writer.finish();
@@ -144,9 +158,9 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     stats.nodes = meta.nodes;
     stats.base_vertices = meta.base_vertices;
     stats.base_triangles = meta.base_triangles;
-    stats.levels = hierarchy.level_count();
+    stats.levels = int(meta.levels);
     if (stats_out != nullptr) {
-        stats.hierarchy = hierarchy.stats();  // replays the coded symbols: only when asked for
+        if (!chunked) stats.hierarchy = hierarchy.stats();  // replays the coded symbols: only when asked for
         *stats_out = stats;
     }
     return out;
@@ -166,8 +180,62 @@ struct PartialProgress {
     bool complete = false;
 };
 
+// The chunks a reader asked for (decode_chunks); null for the whole file.
+struct ChunkRequest {
+    std::vector<uint32_t> chunks;
+    ChunkDecode* result;
+};
+
+// A chunked file (version 7) after its base mesh: chunk table, seam, chunks, then the numbering
+// block, if any, and END.
+Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const TriangleMesh& base, CoordinateSpace space,
+                              const DecodeOptions& options, LeafNumbering* numbering, PartialProgress* partial,
+                              const ChunkRequest* request) {
+    AMC_REQUIRE(reader.version() >= kChunkedVersion, corrupt, "metadata block: chunks in a version-" + std::to_string(reader.version()) + " file");
+    if (partial != nullptr) {
+        partial->levels_in_file = int(meta.levels);
+        // Chunks decode once all of them have arrived; before that a partial file gives its base.
+        BlockReader probe = reader;
+        Block block{};
+        bool complete = false;
+        while (!complete && probe.next_block_arrived() && probe.next(block)) complete = block.type == BlockType::end;
+        if (!complete) return Hierarchy(base);
+    }
+    const ChunkedDecodeInput input{&base, space, reader.version(), meta.vertices, options};
+    ChunkTable table;
+    Hierarchy h = decode_chunked(reader, input, meta.nodes, request != nullptr ? &request->chunks : nullptr, &table);
+    if (request != nullptr) {
+        for (uint32_t c : request->chunks)
+            for (uint32_t r = table.roots[c].first; r < table.roots[c].first + table.roots[c].count; ++r)
+                request->result->roots.push_back(r);
+        base_of_roots(base, [&] {
+            std::vector<RootRange> ranges;
+            for (uint32_t c : request->chunks) ranges.push_back(table.roots[c]);
+            return ranges;
+        }(), request->result->base_vertices);
+        return h;
+    }
+    if (options.max_level >= 0) return h;
+    Block block{};
+    AMC_REQUIRE(reader.next(block), corrupt, "file ends after its chunks");
+    if (block.type == BlockType::numbering) {
+        if (numbering != nullptr)
+            *numbering = decode_numbering(block.payload, block.size, extract_leaf_mesh(h).mesh.triangles, h.vertex_count());
+        AMC_REQUIRE(reader.next(block), corrupt, "file ends after its numbering block");
+    }
+    AMC_REQUIRE(block.type == BlockType::end, corrupt, std::string("unexpected ") + block_type_name(uint8_t(block.type)) + " block after the chunks");
+    AMC_REQUIRE(h.node_count() == meta.nodes && h.vertex_count() == meta.vertices && uint64_t(h.depth() + 1) == meta.levels &&
+                    leaf_face_count(h) == meta.faces,
+                corrupt, "decoded hierarchy does not match the metadata");
+    if (partial != nullptr) {
+        partial->complete = true;
+        partial->levels_decoded = int(meta.levels);
+    }
+    return h;
+}
+
 Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& options, LeafNumbering* numbering,
-                      PartialProgress* partial = nullptr) {
+                      PartialProgress* partial = nullptr, const ChunkRequest* request = nullptr) {
     if (numbering != nullptr) *numbering = {};
     AMC_REQUIRE(data != nullptr || size == 0, invalid_input, "no data");
     BlockReader reader(data, size);
@@ -191,6 +259,13 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     PositionCoder positions(space);
     const TriangleMesh base =
         decode_base(connectivity_block, geometry_block, meta, reader.version(), precision == Precision::float32, positions);
+    if (meta.options & kOptionChunked) return decode_chunked_file(reader, meta, base, space, options, numbering, partial, request);
+    if (request != nullptr) {  // a file without chunks is one chunk
+        AMC_REQUIRE(request->chunks.size() == 1 && request->chunks[0] == 0, invalid_input,
+                    "the file has no chunks: only chunk 0, the whole file, can be decoded");
+        for (uint32_t r = 0; r < base.triangles.size(); ++r) request->result->roots.push_back(r);
+        for (uint32_t v = 0; v < base.positions.size(); ++v) request->result->base_vertices.push_back(v);
+    }
 
     HierarchyLevelDecoder hierarchy(base, meta.hierarchy_header.data(), meta.hierarchy_header.size(),
                                     hierarchy_stream_version_of_file(reader.version()),
@@ -213,7 +288,8 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
             continue;
         }
         AMC_REQUIRE(!has_numbering, corrupt, "level block after the numbering block");
-        AMC_REQUIRE(block.type == BlockType::level, corrupt, "unexpected block between level blocks");
+        AMC_REQUIRE(block.type == BlockType::level && reader.version() < kChunkedVersion, corrupt,
+                    "unexpected block between level blocks");
         AMC_REQUIRE(!hierarchy.done(), corrupt, "level block after the last level");
         if (options.max_level >= 0 && level >= options.max_level) return std::move(h);  // progressive: stop here
         const std::string where = "level " + std::to_string(level) + " block";
@@ -256,6 +332,28 @@ PartialDecode decode_partial(const uint8_t* data, size_t size, const DecodeOptio
     result.complete = progress.complete;
     result.level = result.complete ? progress.levels_decoded - 1 : progress.levels_decoded;
     return result;
+}
+
+ChunkDecode decode_chunks(const uint8_t* data, size_t size, const std::vector<uint32_t>& chunks, const DecodeOptions& options) {
+    ChunkDecode result;
+    const ChunkRequest request{chunks, &result};
+    result.hierarchy = with_allocation_errors_as_limits(
+        "decode", [&] { return decode_file(data, size, options, nullptr, nullptr, &request); });
+    return result;
+}
+
+std::vector<uint32_t> chunks_covering(const FileInfo& info, const std::vector<uint32_t>& base_triangles) {
+    std::vector<uint32_t> out;
+    for (uint32_t t : base_triangles) {
+        AMC_REQUIRE(t < info.base_triangles, invalid_input,
+                    "base triangle " + std::to_string(t) + " is not in the file (it has " + std::to_string(info.base_triangles) + ")");
+        uint32_t c = 0;
+        while (c + 1 < info.chunks.size() && info.chunks[c + 1].first_root <= t) ++c;
+        out.push_back(c);
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
 }
 
 Hierarchy in_decoder_order(const Hierarchy& h, const EncodeOptions& options) {
@@ -306,6 +404,15 @@ FileInfo inspect(const uint8_t* data, size_t size) {
             info.quantize_bits = quantized ? meta.quantizer.bits : 0;
         }
         if (block.type == BlockType::level) entry.level = level++;
+        if (block.type == BlockType::chunk_table) {
+            const ChunkTable table = read_chunk_table(block, info.base_triangles, info.nodes, size);
+            for (size_t c = 0; c < table.roots.size(); ++c)
+                info.chunks.push_back({table.roots[c].first, table.roots[c].count, table.nodes[c], table.end + table.offsets[c], 0});
+        }
+        if (block.type == BlockType::chunk) {
+            for (ChunkInfo& chunk : info.chunks)
+                if (chunk.offset == block.offset) chunk.size = entry.size;
+        }
         info.blocks.push_back(entry);
     }
     return info;

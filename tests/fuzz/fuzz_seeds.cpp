@@ -86,6 +86,7 @@ void amc_seeds(const std::vector<Hierarchy>& hierarchies) {
         options.quantize_bits = k % 4 == 1 ? 12 : 0;
         options.predictor = GeometryPredictor(k % 3);
         options.hierarchy = coder_options_from_switches(k % 2 ? 63 : (k * 7) % kCoderSwitchCombinations);
+        if (k % 3 == 2) options.chunks = 3;  // a chunked file (version 7): chunk table, seam, chunks
         Hierarchy input = h;
         if (k % 4 == 2) {  // a forest over the base in single precision
             TriangleMesh base = h.base();

@@ -1,0 +1,133 @@
+// Chunked .amc files (docs/CODEC.md, "Chunks"): what chunking costs in bytes, per model, and what
+// threads buy in encode and decode time. Public API only.
+//
+//   chunks_bench sizes BITS model.amh ...          bytes with 1 chunk, the default chunks, and 2, 4, 8
+//                                                  chunks; every chunked file checked to decode
+//                                                  identical to the unchunked one
+//   chunks_bench speed RUNS BITS CHUNKS model.amh  wall time of encode and decode with 1 and with 2
+//                                                  threads (CHUNKS 0: the default count), runs
+//                                                  interleaved; median [min - max] and the ratio of
+//                                                  each run's pair (on a shared machine the load
+//                                                  moves: pairs taken a second apart compare best)
+#include <amc/codec.h>
+#include <amc/hierarchy.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace {
+
+double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+
+struct Range {
+    double median, low, high;
+};
+
+Range range_of(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    return {n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]), v.front(), v.back()};
+}
+
+std::string name_of(const char* path) { return std::filesystem::path(path).stem().string(); }
+
+int sizes(int bits, int argc, char** argv) {
+    std::printf("| model | faces | 1 chunk bytes | default: chunks | bytes | cost | 2 chunks | 4 chunks | 8 chunks |\n"
+                "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (int a = 0; a < argc; ++a) {
+        const amc::Hierarchy h = amc::read_hierarchy(argv[a]);
+        amc::EncodeOptions options;
+        options.quantize_bits = bits;
+        options.chunks = 1;
+        amc::EncodeStats stats;
+        const std::vector<uint8_t> one = amc::encode(h, options, &stats);
+        const amc::Hierarchy expected = amc::decode(one.data(), one.size());
+        auto chunked = [&](uint32_t chunks, size_t* count) {
+            amc::EncodeOptions o = options;
+            o.chunks = chunks;
+            const std::vector<uint8_t> bytes = amc::encode(h, o);
+            if (!amc::identical(amc::decode(bytes.data(), bytes.size()), expected)) {
+                std::fprintf(stderr, "%s: %u chunks do not decode to the unchunked hierarchy\n", argv[a], chunks);
+                std::exit(1);
+            }
+            if (count != nullptr) *count = std::max<size_t>(1, amc::inspect(bytes.data(), bytes.size()).chunks.size());
+            return double(bytes.size());
+        };
+        size_t default_count = 0;
+        const double base = double(one.size());
+        const double by_default = chunked(0, &default_count);
+        std::printf("| %s | %lu | %zu | %zu | %.0f | %+.2f %% | %+.2f %% | %+.2f %% | %+.2f %% |\n", name_of(argv[a]).c_str(),
+                    (unsigned long)stats.faces, one.size(), default_count, by_default, 100 * (by_default / base - 1),
+                    100 * (chunked(2, nullptr) / base - 1), 100 * (chunked(4, nullptr) / base - 1),
+                    100 * (chunked(8, nullptr) / base - 1));
+        std::fflush(stdout);
+    }
+    return 0;
+}
+
+int speed(int runs, int bits, uint32_t chunks, const char* path) {
+    const amc::Hierarchy h = amc::read_hierarchy(path);
+    amc::EncodeOptions options;
+    options.quantize_bits = bits;
+    options.chunks = chunks;
+    amc::EncodeStats stats;
+    const std::vector<uint8_t> bytes = amc::encode(h, options, &stats);
+    const amc::FileInfo info = amc::inspect(bytes.data(), bytes.size());
+    std::vector<double> encode_time[2], decode_time[2], encode_ratio, decode_ratio;
+    for (int r = 0; r < runs; ++r) {
+        double seconds[2][2];
+        for (unsigned threads : {1u, 2u}) {
+            amc::EncodeOptions o = options;
+            o.threads = threads;
+            double start = now();
+            const std::vector<uint8_t> again = amc::encode(h, o);
+            seconds[threads - 1][0] = now() - start;
+            if (again != bytes) {
+                std::fprintf(stderr, "%s: %u threads wrote other bytes\n", path, threads);
+                return 1;
+            }
+            amc::DecodeOptions d;
+            d.threads = threads;
+            start = now();
+            {
+                const amc::Hierarchy back = amc::decode(bytes.data(), bytes.size(), d);
+                seconds[threads - 1][1] = now() - start;
+                if (back.node_count() != h.node_count()) return 1;
+            }
+        }
+        for (int t = 0; t < 2; ++t) {
+            encode_time[t].push_back(seconds[t][0]);
+            decode_time[t].push_back(seconds[t][1]);
+        }
+        encode_ratio.push_back(seconds[0][0] / seconds[1][0]);
+        decode_ratio.push_back(seconds[0][1] / seconds[1][1]);
+    }
+    std::printf("%s: %lu faces, %zu bytes, %zu chunks, %d runs (wall time, seconds: median [min - max])\n", name_of(path).c_str(),
+                (unsigned long)stats.faces, bytes.size(), std::max<size_t>(1, info.chunks.size()), runs);
+    auto line = [&](const char* what, std::vector<double>* time, const std::vector<double>& ratio) {
+        const Range one = range_of(time[0]), two = range_of(time[1]), r = range_of(ratio);
+        std::printf("  %s: 1 thread %.3f [%.3f - %.3f] (%.2f M faces/s), 2 threads %.3f [%.3f - %.3f] (%.2f M faces/s); "
+                    "speed-up per run %.2f [%.2f - %.2f]\n",
+                    what, one.median, one.low, one.high, stats.faces / one.median / 1e6, two.median, two.low, two.high,
+                    stats.faces / two.median / 1e6, r.median, r.low, r.high);
+    };
+    line("encode", encode_time, encode_ratio);
+    line("decode", decode_time, decode_ratio);
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const std::string mode = argc > 1 ? argv[1] : "";
+    if (mode == "sizes" && argc >= 4) return sizes(std::atoi(argv[2]), argc - 3, argv + 3);
+    if (mode == "speed" && argc == 6)
+        return speed(std::max(1, std::atoi(argv[2])), std::atoi(argv[3]), uint32_t(std::atoi(argv[4])), argv[5]);
+    std::fprintf(stderr, "usage: chunks_bench sizes BITS model.amh ...\n       chunks_bench speed RUNS BITS CHUNKS model.amh\n");
+    return 2;
+}

@@ -1,0 +1,141 @@
+// A chunk block: the levels of one chunk, then the seam diagonals (chunk_coder.h).
+#include "coding/chunks/chunk_coder.h"
+
+#include "coding/container.h"
+#include "coding/geometry/level_geometry.h"
+#include "coding/geometry/position_coder.h"
+#include "coding/hierarchy/hierarchy_level_coder.h"
+#include "common/check.h"
+
+#include <cmath>
+#include <memory>
+
+namespace amc {
+
+namespace {
+
+// The seam vertex splitting edge e of n, or Seam::kNotSeam / kUnsplit. Only boundary edges of a
+// chunk can lie on the seam; their ends are base or seam vertices, which have keys.
+int32_t seam_vertex(const Hierarchy& h, const VertexKeys& keys, const Seam& seam, NodeId n, int e) {
+    if (!h.is_boundary_edge(n, e)) return Seam::kNotSeam;
+    const uint32_t a = keys[h.vertex(n, e)], b = keys[h.vertex(n, (e + 1) % 3)];
+    if (a == kNoVertex || b == kNoVertex) return Seam::kNotSeam;
+    return seam.find(a, b);
+}
+
+// The hanging nodes of a leaf in the whole hierarchy: its own chunk's, and one on each seam edge
+// that the seam splits (refined on the other side, since the leaf is not).
+int whole_hanging_count(const Hierarchy& h, const VertexKeys& keys, const Seam& seam, NodeId leaf) {
+    int count = h.hanging_node_count(leaf);
+    for (int e = 0; e < 3; ++e) count += seam_vertex(h, keys, seam, leaf, e) >= 0;
+    return count;
+}
+
+// The leaves among `level` (a level's nodes, decided) whose diagonal the chunk's own hierarchy
+// stream does not code: two hanging nodes in the whole hierarchy, fewer in the chunk's.
+template <class F>
+void for_each_seam_closure(const Hierarchy& h, const std::vector<NodeId>& level, const VertexKeys& keys, const Seam& seam,
+                           F&& f) {
+    for (NodeId n : level) {
+        if (!h.is_leaf(n) || h.hanging_node_count(n) >= 2) continue;
+        if (whole_hanging_count(h, keys, seam, n) == 2) f(n);
+    }
+}
+
+}  // namespace
+
+ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& seam, const HierarchyCoderOptions& options,
+                       GeometryPredictor fixed_predictor, CoordinateSpace space) {
+    ChunkCode out;
+    HierarchyLevelEncoder hierarchy(h, options);
+    const std::vector<uint8_t>& header = hierarchy.header();
+    put_varint(out.bytes, header.size());
+    out.bytes.insert(out.bytes.end(), header.begin(), header.end());
+    put_varint(out.bytes, uint64_t(hierarchy.level_count()));
+    PositionCoder positions(space);
+    BitModel flipped;  // the seam closures' diagonal flags
+    for (int l = 0; l < hierarchy.level_count(); ++l) {
+        const std::vector<NodeId>& level = hierarchy.level_nodes(l);
+        std::vector<std::pair<NodeId, int>> created;  // the chunk's own new vertices
+        for (auto [n, e] : hierarchy.new_vertices(l))
+            if (seam_vertex(h, keys, seam, n, e) < 0) created.emplace_back(n, e);
+        // The predictor, as the whole file's encoder picks it (FORMAT.md 3.9, 5.6).
+        const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, fixed_predictor);
+        ArithmeticEncoder encoder;
+        hierarchy.encode_level(l, encoder);
+        for_each_seam_closure(h, level, keys, seam, [&](NodeId n) { encoder.encode(h.diagonal_flipped(n), flipped); });
+        const size_t hierarchy_part = encoder.bytes_so_far();
+        const std::vector<uint8_t> payload = finish_level_payload(h, created, geometry, positions, encoder);
+        out.static_geometry |= geometry.predictor == GeometryPredictor::normal_frame;
+        const uint64_t hierarchy_bytes = std::min<uint64_t>(hierarchy_part, payload.size() - 1);
+        out.hierarchy_bytes += hierarchy_bytes;
+        out.geometry_bytes += payload.size() - 1 - hierarchy_bytes;
+        LevelStats stats;
+        stats.nodes = level.size();
+        stats.new_vertices = created.size();
+        stats.bytes = payload.size();
+        stats.predictor = geometry.predictor;
+        out.levels.push_back(stats);
+        put_varint(out.bytes, payload.size());
+        out.bytes.insert(out.bytes.end(), payload.begin(), payload.end());
+    }
+    for (NodeId n : h.leaves()) out.faces += 1 + uint64_t(whole_hanging_count(h, keys, seam, n));
+    return out;
+}
+
+Hierarchy decode_chunk(const uint8_t* data, size_t size, const TriangleMesh& base, const std::vector<VertexId>& base_vertex,
+                       const Seam& seam, CoordinateSpace space, const ChunkDecodeLimits& limits, const std::string& what,
+                       VertexKeys& keys) {
+    PayloadReader in(data, size, "chunk block");
+    const uint64_t header_size = in.varint();
+    AMC_REQUIRE(header_size <= in.remaining(), corrupt, what + ": hierarchy header is longer than the block");
+    const uint8_t* header = in.rest();
+    for (uint64_t i = 0; i < header_size; ++i) in.u8();
+    const uint64_t levels = in.varint();
+    AMC_REQUIRE(levels >= 1 && levels <= kMaxLevel + 1, corrupt, what + ": bad level count");
+    HierarchyLevelDecoder hierarchy(base, header, size_t(header_size), limits.stream_version, limits.max_nodes);
+    Hierarchy& h = hierarchy.hierarchy();
+    keys.assign(base_vertex.begin(), base_vertex.end());
+    PositionCoder positions(space);
+    BitModel flipped;
+    std::vector<std::pair<NodeId, int>> created;
+    bool stopped = false;
+    for (uint64_t level = 0; level < levels; ++level) {
+        AMC_REQUIRE(!hierarchy.done(), corrupt, what + ": more levels than its hierarchy has");
+        stopped = limits.max_level >= 0 && int(level) >= limits.max_level;
+        if (stopped) break;  // progressive: stop here
+        const std::string where = what + ", level " + std::to_string(level);
+        const uint64_t length = in.varint();
+        AMC_REQUIRE(length >= 1 && length <= in.remaining(), corrupt, where + ": bad length");
+        const Block level_block{BlockType::level, in.rest(), size_t(length), 0};
+        for (uint64_t i = 0; i < length; ++i) in.u8();
+        const LevelBlockParts parts = split_level_block(level_block, limits.file_version, where);
+        ArithmeticDecoder decoder(parts.arithmetic, parts.arithmetic_size);
+        const std::vector<NodeId> nodes = hierarchy.level_nodes();
+        hierarchy.decode_level(decoder);
+        for_each_seam_closure(h, nodes, keys, seam, [&](NodeId n) { h.set_diagonal_flipped(n, decoder.decode(flipped)); });
+        AMC_REQUIRE(!decoder.overran(), corrupt, where + ": hierarchy part is truncated or corrupt");
+        keys.resize(h.positions().size(), kNoVertex);
+        created.clear();
+        for (auto [n, e] : hierarchy.new_vertices()) {
+            const int32_t s = seam_vertex(h, keys, seam, n, e);
+            AMC_REQUIRE(s != Seam::kUnsplit, corrupt, where + ": refines a seam segment the seam block leaves unsplit");
+            if (s == Seam::kNotSeam) {
+                created.emplace_back(n, e);
+                continue;
+            }
+            const VertexId m = h.midpoint(n, e);
+            h.set_position(m, seam.position(uint32_t(s)));
+            keys[m] = seam.base_vertex_count() + uint32_t(s);
+        }
+        decode_level_geometry(h, created, parts, decoder, positions, space, int(level), where);
+    }
+    keys.resize(h.positions().size(), kNoVertex);
+    if (stopped) return std::move(h);
+    AMC_REQUIRE(hierarchy.done(), corrupt, what + ": ends before its hierarchy's last level");
+    AMC_REQUIRE(in.remaining() == 0, corrupt, what + ": bytes after the last level");
+    hierarchy.finish();
+    return std::move(h);
+}
+
+}  // namespace amc

@@ -1,0 +1,48 @@
+// One chunk of a chunked .amc file (docs/FORMAT.md 3.14): the hierarchy of the chunk's roots over
+// their own base triangles, coded level by level as a whole file codes its levels (hierarchy
+// symbols, orientation bits, new positions), except that the vertices on seam edges come from
+// the seam block, and followed by the diagonal flags of the leaves whose closure only the seam
+// reveals (a hanging node from another chunk).
+#pragma once
+
+#include "coding/chunks/seam.h"
+#include "coding/format_version.h"
+#include "coding/geometry/float_coder.h"  // CoordinateSpace
+
+#include <amc/codec.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace amc {
+
+struct ChunkCode {
+    std::vector<uint8_t> bytes;       // the chunk block's payload
+    uint64_t hierarchy_bytes = 0;     // estimated as in EncodeStats
+    uint64_t geometry_bytes = 0;
+    uint64_t faces = 0;               // faces of the whole leaf mesh that belong to the chunk's leaves
+    bool static_geometry = false;     // a level uses geometry mode 3 (predictor 3)
+    std::vector<LevelStats> levels;
+};
+
+// Codes `chunk` (extract_roots of the whole hierarchy, positions as the decoder will have them).
+// `keys` holds the seam keys of the chunk's vertex ids (seam.h).
+ChunkCode encode_chunk(const Hierarchy& chunk, const VertexKeys& keys, const Seam& seam, const HierarchyCoderOptions& options,
+                       GeometryPredictor predictor, CoordinateSpace space);
+
+struct ChunkDecodeLimits {
+    uint64_t max_nodes = 0;     // the chunk's node count from the chunk table (within the caller's limit)
+    int max_level = -1;         // progressive decoding: stop after this level
+    uint8_t file_version = kChunkedVersion;  // which level geometry modes the file may hold
+    uint8_t stream_version = kHierarchyStreamVersion;
+};
+
+// Decodes a chunk block's payload over `base` (base_of_roots of the chunk's roots) whose vertex i
+// is the whole base's vertex base_vertex[i]. Throws Error naming `what` on a corrupt chunk.
+// `keys` receives the seam keys of the result's vertex ids (base and seam vertices; kNoVertex for the
+// chunk's own).
+Hierarchy decode_chunk(const uint8_t* data, size_t size, const TriangleMesh& base, const std::vector<VertexId>& base_vertex,
+                       const Seam& seam, CoordinateSpace space, const ChunkDecodeLimits& limits, const std::string& what,
+                       VertexKeys& keys);
+
+}  // namespace amc

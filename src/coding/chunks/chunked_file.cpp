@@ -1,0 +1,223 @@
+// Chunk table, seam and chunk blocks of a chunked .amc file (chunked_file.h).
+#include "coding/chunks/chunked_file.h"
+
+#include "coding/chunks/chunk_coder.h"
+#include "coding/chunks/seam.h"
+#include "common/check.h"
+#include "common/parallel.h"
+#include "hierarchy/hierarchy_builder.h"
+
+#include <algorithm>
+#include <string>
+
+namespace amc {
+
+uint32_t chunk_count_for(const EncodeOptions& options, uint64_t faces) {
+    if (options.chunks != 0) return options.chunks;
+    const uint64_t per_chunk = std::max<uint64_t>(1, options.chunk_faces);
+    return uint32_t(std::max<uint64_t>(1, std::min<uint64_t>(faces / per_chunk, UINT32_MAX)));
+}
+
+uint64_t leaf_face_count(const Hierarchy& h) {
+    uint64_t faces = 0;
+    for (NodeId n : h.leaves()) faces += 1 + uint64_t(h.hanging_node_count(n));
+    return faces;
+}
+
+ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<RootRange>& ranges, const EncodeOptions& options,
+                             CoordinateSpace space, unsigned threads, EncodeStats& stats) {
+    std::vector<uint32_t> chunk_of_root(h.root_count());
+    for (uint32_t c = 0; c < ranges.size(); ++c)
+        for (uint32_t r = ranges[c].first; r < ranges[c].first + ranges[c].count; ++r) chunk_of_root[r] = c;
+    std::vector<uint32_t> key_of_vertex;
+    const Seam seam(h, chunk_of_root, key_of_vertex);
+    std::vector<ChunkCode> codes(ranges.size());
+    std::vector<uint64_t> nodes(ranges.size());
+    parallel_for(ranges.size(), threads, [&](size_t c) {
+        std::vector<VertexId> vertex_of;
+        const Hierarchy chunk = extract_roots(h, {ranges[c]}, &vertex_of);
+        VertexKeys keys(vertex_of.size(), kNoVertex);
+        for (size_t v = 0; v < vertex_of.size(); ++v)
+            if (vertex_of[v] != kNoVertex) keys[v] = key_of_vertex[vertex_of[v]];
+        codes[c] = encode_chunk(chunk, keys, seam, options.hierarchy, options.predictor, space);
+        nodes[c] = chunk.node_count();
+    });
+    ChunkedBlocks out;
+    std::vector<uint8_t> seam_bytes = seam.encode(space);
+    // Table: count, then per chunk its roots, nodes and where its block starts, counted from the
+    // end of the table block (so the table's own size does not matter).
+    std::vector<uint8_t> table;
+    put_varint(table, ranges.size());
+    uint64_t offset = kBlockOverhead + seam_bytes.size();
+    for (size_t c = 0; c < ranges.size(); ++c) {
+        put_varint(table, ranges[c].count);
+        put_varint(table, nodes[c]);
+        put_varint(table, offset);
+        offset += kBlockOverhead + codes[c].bytes.size();
+    }
+    out.blocks.emplace_back(BlockType::chunk_table, std::move(table));
+    stats.header_bytes += kBlockOverhead + out.blocks.back().second.size();
+    stats.geometry_bytes += seam_bytes.size();
+    stats.framing_bytes += kBlockOverhead;
+    out.blocks.emplace_back(BlockType::seam, std::move(seam_bytes));
+    for (ChunkCode& code : codes) {
+        out.static_geometry |= code.static_geometry;
+        out.levels = std::max(out.levels, int(code.levels.size()));
+        stats.hierarchy_bytes += code.hierarchy_bytes;
+        stats.geometry_bytes += code.geometry_bytes;
+        stats.framing_bytes += kBlockOverhead;
+        if (stats.per_level.size() < code.levels.size()) stats.per_level.resize(code.levels.size());
+        for (size_t l = 0; l < code.levels.size(); ++l) {
+            LevelStats& s = stats.per_level[l];
+            s.nodes += code.levels[l].nodes;
+            s.new_vertices += code.levels[l].new_vertices;
+            s.bytes += code.levels[l].bytes;
+            s.predictor = code.levels[l].predictor;  // the last chunk's
+        }
+        out.blocks.emplace_back(BlockType::chunk, std::move(code.bytes));
+    }
+    return out;
+}
+
+ChunkTable read_chunk_table(const Block& block, uint64_t base_triangles, uint64_t nodes, size_t file_size) {
+    PayloadReader in(block.payload, block.size, "chunk table block");
+    ChunkTable table;
+    table.end = block.offset + kBlockOverhead + block.size;
+    const uint64_t count = in.varint();
+    // Every chunk block takes kBlockOverhead bytes or more of what follows the table.
+    AMC_REQUIRE(count >= 2 && count <= base_triangles && count <= (file_size - table.end) / kBlockOverhead, corrupt,
+                "chunk table block: bad chunk count " + std::to_string(count));
+    uint64_t roots = 0, node_sum = 0, previous_end = 0;
+    for (uint64_t c = 0; c < count; ++c) {
+        const uint64_t r = in.varint(), n = in.varint(), offset = in.varint();
+        AMC_REQUIRE(r >= 1 && r <= base_triangles - roots && n >= r && (n - r) % 4 == 0 && n <= nodes - node_sum, corrupt,
+                    "chunk table block: chunk " + std::to_string(c) + " has inconsistent counts");
+        // Chunk blocks follow the seam block in order: each starts past the end of the one before.
+        AMC_REQUIRE(offset >= previous_end + kBlockOverhead && offset <= file_size - table.end - kBlockOverhead, corrupt,
+                    "chunk table block: chunk " + std::to_string(c) + " has a bad offset");
+        table.roots.push_back({uint32_t(roots), uint32_t(r)});
+        table.nodes.push_back(n);
+        table.offsets.push_back(offset);
+        roots += r;
+        node_sum += n;
+        previous_end = offset;
+    }
+    AMC_REQUIRE(roots == base_triangles && node_sum == nodes, corrupt,
+                "chunk table block: the chunks do not add up to the file's roots and nodes");
+    AMC_REQUIRE(in.remaining() == 0, corrupt, "chunk table block has trailing bytes");
+    return table;
+}
+
+Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, uint64_t nodes,
+                         const std::vector<uint32_t>* selected, ChunkTable* table_out) {
+    const TriangleMesh& base = *input.base;
+    Block block{};
+    AMC_REQUIRE(reader.next(block) && block.type == BlockType::chunk_table, corrupt, "expected a chunk table block");
+    const ChunkTable table = read_chunk_table(block, base.triangles.size(), nodes, block.offset + kBlockOverhead + block.size + reader.remaining());
+    AMC_REQUIRE(reader.next(block) && block.type == BlockType::seam, corrupt, "expected a seam block");
+    AMC_REQUIRE(block.offset + kBlockOverhead + block.size == table.end + table.offsets[0], corrupt,
+                "chunk table block: chunk 0 does not start after the seam block");
+    std::vector<uint32_t> chunk_of_root(base.triangles.size());
+    for (uint32_t c = 0; c < table.roots.size(); ++c)
+        for (uint32_t r = table.roots[c].first; r < table.roots[c].first + table.roots[c].count; ++r) chunk_of_root[r] = c;
+    const Seam seam = Seam::decode(block.payload, block.size, base, chunk_of_root, input.space,
+                                   input.vertices - base.positions.size());
+    std::vector<uint32_t> chunks;
+    if (selected != nullptr) {
+        chunks = *selected;
+        for (size_t i = 0; i < chunks.size(); ++i)
+            AMC_REQUIRE(chunks[i] < table.roots.size() && (i == 0 || chunks[i] > chunks[i - 1]), invalid_input,
+                        "chunk " + std::to_string(chunks[i]) + " is not in the file (it has " +
+                            std::to_string(table.roots.size()) + " chunks), or the chunks are not in increasing order");
+    } else {
+        for (uint32_t c = 0; c < table.roots.size(); ++c) chunks.push_back(c);
+    }
+    // Find every chunk's block through the table (the whole file: one after the other).
+    std::vector<Block> blocks(chunks.size());
+    for (size_t i = 0; i < chunks.size(); ++i) {
+        const size_t offset = table.end + size_t(table.offsets[chunks[i]]);
+        if (selected != nullptr) reader.seek(offset);
+        AMC_REQUIRE(reader.next(blocks[i]) && blocks[i].type == BlockType::chunk && blocks[i].offset == offset, corrupt,
+                    "chunk table block: no chunk block at the offset of chunk " + std::to_string(chunks[i]));
+    }
+    if (table_out != nullptr) *table_out = table;
+    // Each chunk alone, in parallel; then the whole (or the selected chunks) stitched together.
+    const unsigned threads = resolve_thread_count(input.options.threads);
+    const size_t n = chunks.size();
+    std::vector<Hierarchy> decoded(n);
+    std::vector<VertexKeys> keys(n);
+    std::vector<uint32_t> own(n);  // vertices that are neither base nor seam vertices
+    parallel_for(n, threads, [&](size_t i) {
+        const uint32_t c = chunks[i];
+        std::vector<VertexId> base_vertex;
+        const TriangleMesh chunk_base = base_of_roots(base, {table.roots[c]}, base_vertex);
+        ChunkDecodeLimits limits;
+        limits.max_nodes = std::min(table.nodes[c], input.options.max_nodes);
+        limits.max_level = input.options.max_level;
+        limits.file_version = input.version;
+        limits.stream_version = hierarchy_stream_version_of_file(input.version);
+        decoded[i] = decode_chunk(blocks[i].payload, blocks[i].size, chunk_base, base_vertex, seam, input.space, limits,
+                                  "chunk " + std::to_string(c), keys[i]);
+        AMC_REQUIRE(input.options.max_level >= 0 || decoded[i].node_count() == table.nodes[c], corrupt,
+                    "chunk " + std::to_string(c) + " does not hold the nodes the chunk table says");
+        for (uint32_t key : keys[i]) own[i] += key == kNoVertex;
+    });
+    // The result's vertices: the base of the selected roots, the seam vertices they use (in seam
+    // order), then each chunk's own vertices.
+    std::vector<RootRange> ranges;
+    for (uint32_t c : chunks) ranges.push_back(table.roots[c]);
+    std::vector<VertexId> union_vertex;  // result base vertex -> file base vertex
+    const TriangleMesh union_base = selected == nullptr ? base : base_of_roots(base, ranges, union_vertex);
+    std::vector<VertexId> base_id(base.positions.size(), kNoVertex);
+    for (VertexId v = 0; v < union_vertex.size(); ++v) base_id[union_vertex[v]] = v;
+    if (selected == nullptr)
+        for (VertexId v = 0; v < base_id.size(); ++v) base_id[v] = v;
+    const uint32_t file_base = uint32_t(base.positions.size());
+    std::vector<VertexId> seam_id(seam.vertex_count(), kNoVertex);
+    for (size_t i = 0; i < n; ++i)
+        for (uint32_t key : keys[i])
+            if (key != kNoVertex && key >= file_base) seam_id[key - file_base] = 0;
+    uint64_t next = union_base.positions.size();
+    std::vector<Vec3> positions(union_base.positions);
+    for (uint32_t s = 0; s < seam_id.size(); ++s) {
+        if (seam_id[s] == kNoVertex) continue;
+        seam_id[s] = VertexId(next++);
+        positions.push_back(seam.position(s));
+    }
+    std::vector<uint64_t> first_own(n);
+    for (size_t i = 0; i < n; ++i) {
+        first_own[i] = next;
+        next += own[i];
+    }
+    AMC_REQUIRE(next < kNoVertex, limit_exceeded, "too many vertices");
+    positions.resize(size_t(next));
+    std::vector<std::vector<VertexId>> vertex_id(n);
+    std::vector<HierarchyBuilder::StitchPart> parts(n);
+    NodeId first_root = 0, first_node = NodeId(union_base.triangles.size());
+    for (size_t i = 0; i < n; ++i) {
+        parts[i].part = &decoded[i];
+        parts[i].first_root = first_root;
+        parts[i].first_node = first_node;
+        first_root += decoded[i].root_count();
+        first_node += decoded[i].node_capacity() - decoded[i].root_count();
+    }
+    parallel_for(n, threads, [&](size_t i) {
+        const Hierarchy& h = decoded[i];
+        std::vector<VertexId>& id = vertex_id[i];
+        id.resize(keys[i].size());
+        VertexId own_id = VertexId(first_own[i]);
+        for (size_t v = 0; v < id.size(); ++v) {
+            const uint32_t key = keys[i][v];
+            if (key == kNoVertex) {
+                id[v] = own_id++;
+                positions[id[v]] = h.position(VertexId(v));
+            } else {
+                id[v] = key < file_base ? base_id[key] : seam_id[key - file_base];
+            }
+        }
+        parts[i].vertex_id = id.data();
+    });
+    return HierarchyBuilder::stitch(union_base, std::move(positions), parts, threads);
+}
+
+}  // namespace amc

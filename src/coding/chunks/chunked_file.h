@@ -1,0 +1,60 @@
+// The blocks of a chunked .amc file after its base mesh (docs/FORMAT.md 3.11-3.14): the chunk
+// table, the seam, one block per chunk. Chunks are coded and decoded on several threads; a reader
+// may decode any subset of them.
+#pragma once
+
+#include "coding/chunks/chunk_layout.h"
+#include "coding/container.h"
+#include "coding/geometry/float_coder.h"  // CoordinateSpace
+
+#include <amc/codec.h>
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace amc {
+
+// The chunk count EncodeOptions ask for a hierarchy of `faces` leaf faces.
+uint32_t chunk_count_for(const EncodeOptions& options, uint64_t faces);
+
+// Faces of the conforming leaf mesh (1 + hanging nodes per leaf).
+uint64_t leaf_face_count(const Hierarchy& h);
+
+struct ChunkedBlocks {
+    std::vector<std::pair<BlockType, std::vector<uint8_t>>> blocks;  // chunk table, seam, chunks
+    bool static_geometry = false;  // some chunk level uses geometry mode 3
+    int levels = 0;                // of the deepest chunk
+};
+
+// Codes `h` (decoder base order, positions as the decoder will have them) in the chunks `ranges`
+// on up to `threads` threads. Adds the hierarchy and geometry bytes and the level statistics
+// (summed over chunks) to `stats`.
+ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<RootRange>& ranges, const EncodeOptions& options,
+                             CoordinateSpace space, unsigned threads, EncodeStats& stats);
+
+// The chunk table, read and checked against the base (root counts) and the file's node count.
+struct ChunkTable {
+    std::vector<RootRange> roots;
+    std::vector<uint64_t> nodes;
+    std::vector<uint64_t> offsets;  // of each chunk block from the end of the table block
+    size_t end = 0;                 // file offset of the end of the table block
+};
+ChunkTable read_chunk_table(const Block& block, uint64_t base_triangles, uint64_t nodes, size_t file_size);
+
+struct ChunkedDecodeInput {
+    const TriangleMesh* base = nullptr;  // the decoded base mesh
+    CoordinateSpace space;
+    uint8_t version = kChunkedVersion;
+    uint64_t vertices = 0;  // the file's vertex count (metadata)
+    DecodeOptions options;
+};
+
+// Reads the chunk table and seam blocks at the reader's position and decodes the chunks in
+// `selected` (indices in increasing order; all of them when null), seeking to each through the
+// table, then merges them: the hierarchy over base_of_roots of their roots. Leaves the reader
+// after the last chunk block when all are decoded.
+Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, uint64_t nodes,
+                         const std::vector<uint32_t>* selected, ChunkTable* table_out = nullptr);
+
+}  // namespace amc

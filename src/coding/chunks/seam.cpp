@@ -1,0 +1,137 @@
+// The seam block: segment trees on the base edges between chunks (seam.h, FORMAT.md 3.13).
+#include "coding/chunks/seam.h"
+
+#include "coding/entropy/arithmetic_coder.h"
+#include "coding/geometry/position_coder.h"
+#include "common/check.h"
+#include "common/exact_float.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace amc {
+
+namespace {
+
+// Split bits: one model per level (levels beyond 15 share the last).
+constexpr int kSplitContexts = 16;
+using SplitModels = std::array<BitModel, kSplitContexts>;
+BitModel& split_model(SplitModels& models, int level) { return models[size_t(std::min(level, kSplitContexts - 1))]; }
+
+// FORMAT.md 5.5's midpoint of the segment's ends.
+Vec3 midpoint_prediction(Vec3 a, Vec3 b, bool single_precision) {
+    const Vec3 m = rounded_scaled(0.5, a + b);
+    return single_precision ? rounded_to_float(m) : m;
+}
+
+uint64_t directed(uint32_t a, uint32_t b) { return (uint64_t(a) << 32) | b; }
+
+}  // namespace
+
+std::vector<std::pair<uint32_t, int>> seam_edges(const TriangleMesh& base, const std::vector<uint32_t>& chunk_of_root) {
+    std::unordered_map<uint64_t, uint32_t> triangle_of_edge;
+    triangle_of_edge.reserve(3 * base.triangles.size());
+    for (uint32_t t = 0; t < base.triangles.size(); ++t)
+        for (int e = 0; e < 3; ++e) triangle_of_edge.emplace(directed(base.triangles[t][e], base.triangles[t][(e + 1) % 3]), t);
+    std::vector<std::pair<uint32_t, int>> edges;
+    for (uint32_t t = 0; t < base.triangles.size(); ++t) {
+        for (int e = 0; e < 3; ++e) {
+            // The neighbour holds the edge the other way round (a valid base mesh uses an edge at
+            // most once per direction).
+            const auto it = triangle_of_edge.find(directed(base.triangles[t][(e + 1) % 3], base.triangles[t][e]));
+            if (it == triangle_of_edge.end() || it->second <= t) continue;
+            if (chunk_of_root[it->second] != chunk_of_root[t]) edges.emplace_back(t, e);
+        }
+    }
+    return edges;
+}
+
+Seam::Seam(const Hierarchy& h, const std::vector<uint32_t>& chunk_of_root, std::vector<uint32_t>& key_of_vertex) {
+    base_vertices_ = uint32_t(h.base().positions.size());
+    single_precision_ = h.single_precision();
+    key_of_vertex.assign(h.positions().size(), kNoVertex);
+    for (uint32_t v = 0; v < base_vertices_; ++v) key_of_vertex[v] = v;
+    // Walks the segment on edge e of n (first side) and edge eq of q (the other side, where the
+    // edge runs the other way); either node may be missing where its side is coarser.
+    auto walk = [&](auto& self, NodeId n, int e, NodeId q, int eq, int level) -> void {
+        const VertexId a = n != kNoNode ? h.vertex(n, e) : h.vertex(q, (eq + 1) % 3);
+        const VertexId b = n != kNoNode ? h.vertex(n, (e + 1) % 3) : h.vertex(q, eq);
+        const bool n_split = n != kNoNode && !h.is_leaf(n), q_split = q != kNoNode && !h.is_leaf(q);
+        Segment segment{n_split || q_split, uint8_t(level), h.position(a), h.position(b), 0};
+        const uint64_t key = segment_key(key_of_vertex[a], key_of_vertex[b]);
+        if (!segment.split) {
+            segments_[key] = kUnsplit;
+            trace_.push_back(segment);
+            return;
+        }
+        const VertexId m = n_split ? h.midpoint(n, e) : h.midpoint(q, eq);
+        segment.vertex = uint32_t(positions_.size());
+        segments_[key] = int32_t(segment.vertex);
+        key_of_vertex[m] = base_vertices_ + segment.vertex;
+        positions_.push_back(h.position(m));
+        trace_.push_back(segment);
+        // The first half (a, m) is child kFirstHalfChild[e] of n and kSecondHalfChild[eq] of q.
+        self(self, n_split ? h.child(n, red_split::kFirstHalfChild[e]) : kNoNode, e,
+             q_split ? h.child(q, red_split::kSecondHalfChild[eq]) : kNoNode, eq, level + 1);
+        self(self, n_split ? h.child(n, red_split::kSecondHalfChild[e]) : kNoNode, e,
+             q_split ? h.child(q, red_split::kFirstHalfChild[eq]) : kNoNode, eq, level + 1);
+    };
+    for (auto [t, e] : seam_edges(h.base(), chunk_of_root)) {
+        const NodeId q = h.neighbor(t, e);
+        walk(walk, t, e, q, h.neighbor_edge(t, e), 0);
+    }
+}
+
+std::vector<uint8_t> Seam::encode(CoordinateSpace space) const {
+    ArithmeticEncoder encoder;
+    SplitModels models;
+    PositionCoder positions(space);
+    for (const Segment& s : trace_) {
+        encoder.encode(s.split, split_model(models, s.level));
+        if (s.split)
+            positions.encode(encoder, level_context(s.level), positions_[s.vertex],
+                             midpoint_prediction(s.a, s.b, single_precision_));
+    }
+    return encoder.finish();
+}
+
+Seam Seam::decode(const uint8_t* data, size_t size, const TriangleMesh& base, const std::vector<uint32_t>& chunk_of_root,
+                  CoordinateSpace space, uint64_t max_vertices) {
+    Seam seam;
+    seam.base_vertices_ = uint32_t(base.positions.size());
+    seam.single_precision_ = base.single_precision;
+    // Keys (base vertices, then seam vertices) stay below kNoVertex.
+    const uint64_t limit = std::min<uint64_t>({max_vertices, max_decodable_positions(size),
+                                               uint64_t(kNoVertex) - 1 - seam.base_vertices_});
+    ArithmeticDecoder decoder(data, size);
+    SplitModels models;
+    PositionCoder positions(space);
+    std::vector<Vec3> key_positions(base.positions);  // by key: base vertices, then seam vertices
+    auto walk = [&](auto& self, uint32_t a, uint32_t b, int level) -> void {
+        AMC_REQUIRE(!decoder.overran(), corrupt, "seam block is truncated or corrupt");
+        const uint64_t key = segment_key(a, b);
+        if (!decoder.decode(split_model(models, level))) {
+            seam.segments_[key] = kUnsplit;
+            return;
+        }
+        AMC_REQUIRE(level < kMaxLevel, corrupt, "seam block splits a segment of level " + std::to_string(level));
+        AMC_REQUIRE(seam.positions_.size() < limit, corrupt,
+                    "seam block holds more vertices than the file's counts or its " + std::to_string(size) + " bytes allow");
+        const Vec3 p = positions.decode(decoder, level_context(level),
+                                        midpoint_prediction(key_positions[a], key_positions[b], seam.single_precision_));
+        AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
+                    "seam block is corrupt (non-finite coordinate)");
+        const uint32_t m = seam.base_vertices_ + uint32_t(seam.positions_.size());
+        seam.segments_[key] = int32_t(seam.positions_.size());
+        seam.positions_.push_back(p);
+        key_positions.push_back(p);
+        self(self, a, m, level + 1);
+        self(self, m, b, level + 1);
+    };
+    for (auto [t, e] : seam_edges(base, chunk_of_root)) walk(walk, base.triangles[t][e], base.triangles[t][(e + 1) % 3], 0);
+    AMC_REQUIRE(!decoder.overran() && !positions.saw_invalid_symbol(), corrupt, "seam block is truncated or corrupt");
+    return seam;
+}
+
+}  // namespace amc

@@ -1,0 +1,74 @@
+// The seam of a chunked .amc file (docs/FORMAT.md 3.13): the base edges whose two triangles lie in
+// different chunks, and on each, the tree of its dyadic segments that refinement split (on either
+// side), with the position of every vertex that splitting created. Stored once, before the chunks,
+// so that each chunk decodes alone: a chunk takes the vertices on its edges to other chunks from
+// here instead of coding them (no vertex is stored twice), and learns whether a leaf of its own
+// carries a hanging node from the other side (the green closure's diagonals).
+//
+// Vertices are named by *keys*: base vertex v is key v, seam vertex s is key V + s (V base
+// vertices). A segment is named by its two end keys, in either order.
+#pragma once
+
+#include "coding/geometry/float_coder.h"  // CoordinateSpace
+
+#include <amc/hierarchy.h>
+
+#include <cstdint>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+namespace amc {
+
+// The base edges between chunks, as (triangle, local edge) of the lower-numbered of their two
+// triangles, triangles in order, edges 0, 1, 2: the order of the seam block.
+std::vector<std::pair<uint32_t, int>> seam_edges(const TriangleMesh& base, const std::vector<uint32_t>& chunk_of_root);
+
+class Seam {
+public:
+    static constexpr int32_t kNotSeam = -1;     // the segment lies on no seam edge
+    static constexpr int32_t kUnsplit = -2;     // a seam segment that nothing refined
+
+    Seam() = default;
+    // The seam of `h` (the encoder's, in decoder base order): `key_of_vertex` receives each vertex
+    // id's key (kNoVertex for vertices that are neither base nor seam vertices).
+    Seam(const Hierarchy& h, const std::vector<uint32_t>& chunk_of_root, std::vector<uint32_t>& key_of_vertex);
+    // The seam block's payload (FORMAT.md 3.13).
+    std::vector<uint8_t> encode(CoordinateSpace space) const;
+    // Reads a seam block. `max_vertices` bounds the seam vertices (the file's refinement vertices);
+    // the block's size bounds them too. Throws Error on a corrupt block.
+    static Seam decode(const uint8_t* data, size_t size, const TriangleMesh& base, const std::vector<uint32_t>& chunk_of_root,
+                       CoordinateSpace space, uint64_t max_vertices);
+
+    uint32_t base_vertex_count() const { return base_vertices_; }
+    uint32_t vertex_count() const { return uint32_t(positions_.size()); }
+    Vec3 position(uint32_t s) const { return positions_[s]; }
+    // The seam vertex splitting segment (a, b) (keys), kUnsplit, or kNotSeam.
+    int32_t find(uint32_t a, uint32_t b) const {
+        const auto it = segments_.find(segment_key(a, b));
+        return it == segments_.end() ? kNotSeam : it->second;
+    }
+
+private:
+    static uint64_t segment_key(uint32_t a, uint32_t b) {
+        return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a;
+    }
+    uint32_t base_vertices_ = 0;
+    std::vector<Vec3> positions_;  // of the seam vertices, in block order
+    std::unordered_map<uint64_t, int32_t> segments_;
+    // The encoder's trees in block order (pre-order): each segment, and its midpoint when split.
+    struct Segment {
+        bool split;
+        uint8_t level;
+        Vec3 a, b;  // ends
+        uint32_t vertex;  // seam vertex, when split
+    };
+    std::vector<Segment> trace_;
+    bool single_precision_ = false;
+};
+
+// The keys of a chunk hierarchy's vertices: base and seam vertices by the seam's keys, others
+// kNoVertex. A chunk's coder grows it level by level as vertices are created.
+using VertexKeys = std::vector<uint32_t>;
+
+}  // namespace amc

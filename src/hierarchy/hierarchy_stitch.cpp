@@ -1,0 +1,88 @@
+// Stitching hierarchies of disjoint root sets into one (hierarchy_builder.h): the decoder of
+// chunked .amc files builds each chunk alone, then copies them into the whole and links the seams.
+#include "hierarchy/hierarchy_builder.h"
+
+#include "common/check.h"
+#include "common/parallel.h"
+
+#include <utility>
+
+namespace amc {
+
+Hierarchy HierarchyBuilder::stitch(const TriangleMesh& base, std::vector<Vec3> positions, const std::vector<StitchPart>& parts,
+                                   unsigned threads) {
+    Hierarchy h(base);  // the roots, linked across every base edge
+    const size_t roots = h.root_count();
+    size_t nodes = roots;
+    for (const StitchPart& p : parts) nodes += p.part->node_capacity() - p.part->root_count();
+    AMC_REQUIRE(positions.size() >= base.positions.size() && positions.size() < kNoVertex && nodes < kNoNode, corrupt,
+                "hierarchy too large to stitch");
+    h.reserve(nodes, positions.size());
+    h.nodes_.resize(nodes);
+    h.block_parent_.resize((nodes - roots) / 4);
+    for (const Vec3& p : positions) h.far_positions_ |= Hierarchy::is_far(p);
+    h.positions_ = std::move(positions);
+    h.live_nodes_ = uint32_t(nodes);
+    h.live_vertices_ = uint32_t(h.positions_.size());
+
+    parallel_for(parts.size(), threads, [&](size_t k) {
+        const StitchPart& p = parts[k];
+        const Hierarchy& s = *p.part;
+        const NodeId r = s.root_count();
+        auto id = [&](NodeId n) { return n == kNoNode ? kNoNode : n < r ? p.first_root + n : p.first_node + (n - r); };
+        for (NodeId i = 0; i < r; ++i) {  // the roots keep the whole base's links
+            Hierarchy::Node& root = h.nodes_[p.first_root + i];
+            root.first_child = id(s.nodes_[i].first_child);
+            root.flags = uint8_t((root.flags & 7u) | (s.nodes_[i].flags & 8u));
+        }
+        for (NodeId j = r; j < s.node_capacity(); ++j) {
+            const Hierarchy::Node& from = s.nodes_[j];
+            Hierarchy::Node& to = h.nodes_[p.first_node + (j - r)];
+            for (int e = 0; e < 3; ++e) {
+                to.v[e] = p.vertex_id[from.v[e]];
+                to.nbr[e] = id(from.nbr[e]);
+            }
+            to.first_child = id(from.first_child);
+            to.nbr_edge = from.nbr_edge;
+            to.level = from.level;
+            to.flags = from.flags;  // seam edges are still boundary edges: linked below
+            to.reserved = 0;
+        }
+        for (size_t b = 0; b < s.block_parent_.size(); ++b) h.block_parent_[(p.first_node - roots) / 4 + b] = id(s.block_parent_[b]);
+    });
+
+    // The seams: the root edges that a part saw as boundary and the whole does not, then the halves
+    // of each, level by level (a node's links are complete before its children are linked).
+    std::vector<std::pair<NodeId, int>> seam, next;
+    for (const StitchPart& p : parts)
+        for (NodeId i = 0; i < p.part->root_count(); ++i)
+            for (int e = 0; e < 3; ++e)
+                if (p.part->is_boundary_edge(i, e) && !h.is_boundary_edge(p.first_root + i, e)) seam.emplace_back(p.first_root + i, e);
+    while (!seam.empty()) {
+        next.clear();
+        for (auto [n, e] : seam) {
+            const NodeId q = h.nodes_[n].nbr[e];
+            if (h.is_leaf(n)) {
+                AMC_REQUIRE(h.hanging_node_count(n) < 3, corrupt, "chunks do not fit together: a leaf with three hanging nodes");
+                continue;
+            }
+            AMC_REQUIRE(q != kNoNode, corrupt,
+                        "chunks do not fit together: a node of level " + std::to_string(h.level(n)) +
+                            " is refined next to a coarser region of another chunk");
+            const NodeId first = h.child(n, red_split::kFirstHalfChild[e]), second = h.child(n, red_split::kSecondHalfChild[e]);
+            h.nodes_[first].flags &= uint8_t(~(1u << e));
+            h.nodes_[second].flags &= uint8_t(~(1u << e));
+            if (!h.is_leaf(q)) {
+                const int eq = h.neighbor_edge(n, e);
+                h.link(first, e, h.child(q, red_split::kSecondHalfChild[eq]), eq);
+                h.link(second, e, h.child(q, red_split::kFirstHalfChild[eq]), eq);
+            }
+            next.emplace_back(first, e);
+            next.emplace_back(second, e);
+        }
+        std::swap(seam, next);
+    }
+    return h;
+}
+
+}  // namespace amc

@@ -1,0 +1,211 @@
+// Chunked .amc files (docs/FORMAT.md 3.11-3.14): chunked files decode to exactly what unchunked
+// ones do, any subset of chunks decodes to exactly its roots' trees, and the thread count changes
+// neither bytes nor results.
+#include "coding/chunks/chunk_layout.h"
+#include "coding/container.h"
+#include "coding/format_version.h"
+#include "hierarchy_checks.h"
+
+#include <amc/codec.h>
+
+#include <cmath>
+#include <cstring>
+
+namespace amc {
+namespace {
+
+using testing::Random;
+
+// A random adaptive hierarchy over one of the fixture meshes (boundaries, handles, several
+// components), some diagonals flipped, positions moved off the midpoints on every other seed.
+Hierarchy random_hierarchy(uint64_t seed, bool single) {
+    Random random{seed};
+    const auto meshes = testing::fixture_meshes();
+    TriangleMesh base = meshes[random.next() % meshes.size()].mesh;
+    base.single_precision = single;
+    if (single)
+        for (Vec3& p : base.positions) p = Vec3{double(float(p.x)), double(float(p.y)), double(float(p.z))};
+    Hierarchy h(base);
+    refine_randomly(h, h.root_count() + 50 + uint32_t(random.next() % 600), 1 + int(random.next() % 5), seed);
+    for (NodeId n : h.leaves())
+        if (h.hanging_node_count(n) == 2 && random.next() % 3 == 0) h.set_diagonal_flipped(n, true);
+    if (seed % 2 == 0) {
+        for (VertexId v = 0; v < h.positions().size(); ++v) {
+            const Vec3 p = h.position(v);
+            const double wobble = 1.0 + double(random.next() % 1000) / 1e4;
+            const Vec3 q{p.x * wobble, p.y - 0.01 * wobble, p.z + wobble * 0.001};
+            h.set_position(v, single ? Vec3{double(float(q.x)), double(float(q.y)), double(float(q.z))} : q);
+        }
+    }
+    return h;
+}
+
+EncodeOptions with_chunks(uint32_t chunks, unsigned threads = 0, int bits = 0) {
+    EncodeOptions options;
+    options.chunks = chunks;
+    options.threads = threads;
+    options.quantize_bits = bits;
+    return options;
+}
+
+TEST(Chunks, ChunkedFilesDecodeToWhatUnchunkedFilesDo) {
+    int chunked_files = 0;
+    for (uint64_t seed = 0; seed < 60; ++seed) {
+        SCOPED_TRACE("seed " + std::to_string(seed));
+        const Hierarchy h = random_hierarchy(seed, seed % 3 == 0);
+        const int bits = seed % 5 == 1 ? 12 : 0;
+        const std::vector<uint8_t> one = encode(h, with_chunks(1, 0, bits));
+        ASSERT_LT(inspect(one.data(), one.size()).version, kChunkedVersion);
+        const Hierarchy expected = decode(one.data(), one.size());
+        for (uint32_t chunks : {2u, 3u, 7u, 1000u}) {
+            EncodeOptions options = with_chunks(chunks, 0, bits);
+            options.predictor = GeometryPredictor(seed % 4);
+            const std::vector<uint8_t> bytes = encode(h, options);
+            const FileInfo info = inspect(bytes.data(), bytes.size());
+            if (h.root_count() >= 2) {
+                ASSERT_EQ(info.version, kChunkedVersion);
+                ASSERT_EQ(info.chunks.size(), std::min<size_t>(chunks, h.root_count()));
+                ++chunked_files;
+            }
+            const Hierarchy back = decode(bytes.data(), bytes.size());
+            ASSERT_TRUE(testing::hierarchy_is_valid(back));
+            ASSERT_TRUE(identical(back, expected)) << chunks << " chunks";
+            if (bits == 0) {
+                ASSERT_TRUE(identical(back, in_decoder_order(h, options)));
+            }
+        }
+    }
+    EXPECT_GT(chunked_files, 150);
+}
+
+TEST(Chunks, ThreadCountChangesNeitherBytesNorResults) {
+    for (uint64_t seed = 100; seed < 110; ++seed) {
+        const Hierarchy h = random_hierarchy(seed, false);
+        const std::vector<uint8_t> bytes = encode(h, with_chunks(5, 1));
+        for (unsigned threads : {2u, 3u, 8u}) EXPECT_EQ(encode(h, with_chunks(5, threads)), bytes) << threads << " threads";
+        const Hierarchy one = decode(bytes.data(), bytes.size(), DecodeOptions{-1, 1ull << 26, 1});
+        for (unsigned threads : {2u, 5u}) {
+            const Hierarchy back = decode(bytes.data(), bytes.size(), DecodeOptions{-1, 1ull << 26, threads});
+            EXPECT_TRUE(identical(back, one)) << threads << " threads";
+        }
+    }
+}
+
+TEST(Chunks, ChunkSubsetsDecodeToExactlyTheirRootsTrees) {
+    for (uint64_t seed = 200; seed < 230; ++seed) {
+        SCOPED_TRACE("seed " + std::to_string(seed));
+        const Hierarchy h = random_hierarchy(seed, seed % 2 == 0);
+        const std::vector<uint8_t> bytes = encode(h, with_chunks(4));
+        const FileInfo info = inspect(bytes.data(), bytes.size());
+        const Hierarchy whole = decode(bytes.data(), bytes.size());
+        const uint32_t count = uint32_t(std::max<size_t>(1, info.chunks.size()));
+        for (uint32_t mask = 1; mask < (1u << count); ++mask) {
+            std::vector<uint32_t> chunks;
+            std::vector<RootRange> ranges;
+            for (uint32_t c = 0; c < count; ++c) {
+                if (!(mask >> c & 1)) continue;
+                chunks.push_back(c);
+                ranges.push_back(info.chunks.empty() ? RootRange{0, whole.root_count()}
+                                                     : RootRange{info.chunks[c].first_root, info.chunks[c].roots});
+            }
+            const ChunkDecode part = decode_chunks(bytes.data(), bytes.size(), chunks);
+            ASSERT_TRUE(testing::hierarchy_is_valid(part.hierarchy));
+            std::vector<VertexId> base_vertices;
+            base_of_roots(whole.base(), ranges, base_vertices);
+            EXPECT_EQ(part.base_vertices, base_vertices);
+            std::vector<uint32_t> roots;
+            for (const RootRange& r : ranges)
+                for (uint32_t t = r.first; t < r.first + r.count; ++t) roots.push_back(t);
+            EXPECT_EQ(part.roots, roots);
+            EXPECT_TRUE(identical(part.hierarchy, extract_roots(whole, ranges))) << "chunk mask " << mask;
+            // The selected trees, node for node (levels and leaves), and their positions.
+            EXPECT_EQ(chunks_covering(info, roots), chunks);
+        }
+    }
+}
+
+TEST(Chunks, DefaultsKeepSmallFilesUnchangedAndChunkLargeOnes) {
+    const Hierarchy h = random_hierarchy(7, false);
+    EncodeOptions unchunked;
+    unchunked.chunks = 1;
+    EXPECT_EQ(encode(h, EncodeOptions{}), encode(h, unchunked)) << "fewer faces than chunk_faces: one chunk";
+    EncodeOptions small_chunks;
+    small_chunks.chunk_faces = 100;
+    EncodeStats stats;
+    const std::vector<uint8_t> bytes = encode(h, small_chunks, &stats);
+    const FileInfo info = inspect(bytes.data(), bytes.size());
+    EXPECT_EQ(info.chunks.size(), std::min<uint64_t>(stats.faces / 100, h.root_count()));
+    EXPECT_TRUE(identical(decode(bytes.data(), bytes.size()), in_decoder_order(h)));
+    // The chunk blocks are where the table says, and cover every root once.
+    uint32_t next_root = 0;
+    for (const ChunkInfo& c : info.chunks) {
+        EXPECT_EQ(c.first_root, next_root);
+        next_root += c.roots;
+        ASSERT_GT(c.size, kBlockOverhead);
+        EXPECT_EQ(bytes[c.offset], uint8_t(BlockType::chunk));
+    }
+    EXPECT_EQ(next_root, info.base_triangles);
+}
+
+TEST(Chunks, ProgressiveAndPartialDecodingOfChunkedFiles) {
+    const Hierarchy h = random_hierarchy(12, false);
+    const std::vector<uint8_t> chunked = encode(h, with_chunks(3));
+    const std::vector<uint8_t> plain = encode(h, with_chunks(1));
+    for (int level = 0; level <= h.depth(); ++level) {
+        DecodeOptions options;
+        options.max_level = level;
+        EXPECT_TRUE(identical(decode(chunked.data(), chunked.size(), options), decode(plain.data(), plain.size(), options)))
+            << "level " << level;
+    }
+    // A file cut anywhere after its base mesh gives the base until every chunk has arrived.
+    const FileInfo info = inspect(chunked.data(), chunked.size());
+    const size_t base_end = info.blocks[2].offset + info.blocks[2].size;
+    for (size_t size = base_end; size < chunked.size(); size += 1 + (chunked.size() - base_end) / 40) {
+        const PartialDecode part = decode_partial(chunked.data(), size);
+        EXPECT_FALSE(part.complete);
+        EXPECT_EQ(part.level, 0);
+        EXPECT_EQ(part.hierarchy.node_count(), h.root_count());
+    }
+    const PartialDecode whole = decode_partial(chunked.data(), chunked.size());
+    EXPECT_TRUE(whole.complete);
+    EXPECT_TRUE(identical(whole.hierarchy, decode(chunked.data(), chunked.size())));
+}
+
+TEST(Chunks, EveryTruncationAndCorruptionIsAnError) {
+    const Hierarchy h = random_hierarchy(14, false);
+    const std::vector<uint8_t> bytes = encode(h, with_chunks(4));
+    const Hierarchy expected = decode(bytes.data(), bytes.size());
+    for (size_t size = 0; size < bytes.size(); ++size) {
+        const DecodeResult r = try_decode(bytes.data(), size);
+        EXPECT_FALSE(r.ok) << "cut at " << size;
+    }
+    // A payload byte changed, the checksum made valid again: an error, or a valid hierarchy (the
+    // sizes stay, so the chunk table's offsets stay right and the chunk parsers see the change).
+    BlockReader reader(bytes.data(), bytes.size());
+    std::vector<std::pair<BlockType, std::vector<uint8_t>>> blocks;
+    Block block;
+    while (reader.next(block))
+        if (block.type != BlockType::end) blocks.push_back({block.type, {block.payload, block.payload + block.size}});
+    Random random{5};
+    int decoded = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+        auto mutated = blocks;
+        auto& payload = mutated[3 + random.next() % (mutated.size() - 3)].second;  // table, seam, chunks
+        if (payload.empty()) continue;
+        payload[random.next() % payload.size()] ^= uint8_t(1 + random.next() % 255);
+        BlockWriter writer(reader.version(), reader.flags());
+        for (const auto& [type, bytes_of] : mutated) writer.add(type, bytes_of);
+        const std::vector<uint8_t> file = writer.finish();
+        const DecodeResult r = try_decode(file.data(), file.size());
+        if (r.ok) {
+            ++decoded;
+            EXPECT_TRUE(testing::hierarchy_is_valid(r.hierarchy));
+        } else {
+            EXPECT_NE(r.code, ErrorCode::checksum) << r.error;
+        }
+    }
+    EXPECT_LT(decoded, 3000);
+}
+
+}  // namespace
+}  // namespace amc
