@@ -282,6 +282,42 @@ TEST(RoundTrip, ShortFloatDecimalsReadBackAsFloats) {
     }
 }
 
+// Any single-precision mesh written as OBJ or OFF reads back single precision, bit for bit:
+// floats drawn from their whole range by bit pattern (subnormals, FLT_MAX, signed zeros, short
+// and 8-9 digit decimals), meshes of one to three vertices so that the writer's choice (float
+// decimals or doubles) varies from mesh to mesh.
+TEST(RoundTrip, AnySinglePrecisionMeshReadsBackBitExact) {
+    std::mt19937 random(24);
+    const auto any_float = [&] {
+        for (;;) {
+            uint32_t bits = random();
+            if (random() % 4 == 0) bits &= 0x807fffffu | (uint32_t(random() % 3) << 23);  // zero, subnormal, tiny exponents
+            if (random() % 8 == 0) bits = (bits & 0x80000000u) | (0x7f7fffffu - uint32_t(random() % 4));  // near FLT_MAX
+            if (random() % 4 == 0) bits &= 0xffff0000u;  // short decimals
+            float f;
+            std::memcpy(&f, &bits, 4);
+            if (std::isfinite(f)) return f;
+        }
+    };
+    for (int trial = 0; trial < 20000; ++trial) {
+        TriangleMesh mesh = tetrahedron();
+        mesh.single_precision = true;
+        const size_t varied = 1 + size_t(trial % 3);
+        for (size_t v = 0; v < mesh.positions.size(); ++v) {
+            Vec3& p = mesh.positions[v];
+            if (v < varied) p = {any_float(), any_float(), any_float()};
+            else p = {static_cast<float>(p.x + 0.1), static_cast<float>(p.y), static_cast<float>(p.z)};
+        }
+        const TriangleMesh obj = parse_obj(format_obj(mesh), "t.obj");
+        const TriangleMesh off = parse_off(format_off(mesh), "t.off");
+        ASSERT_TRUE(obj.single_precision && off.single_precision) << "trial " << trial << "\n" << format_obj(mesh);
+        ASSERT_EQ(std::memcmp(obj.positions.data(), mesh.positions.data(), mesh.positions.size() * sizeof(Vec3)), 0)
+            << "trial " << trial << "\n" << format_obj(mesh);
+        ASSERT_EQ(std::memcmp(off.positions.data(), mesh.positions.data(), mesh.positions.size() * sizeof(Vec3)), 0)
+            << "trial " << trial << "\n" << format_off(mesh);
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Readers on hand-written input
 
