@@ -235,6 +235,54 @@ TEST(Golden, ChunkedFilesDecodeAndPinTheEncoder) {
     }
 }
 
+// Version 8 (the hierarchy coder's mixing mode, FORMAT.md 2.1): the projected sphere of version 6
+// bit-exact and at 12 bits (geometric contexts from decoded positions), the graded L-shape
+// (planar: structure only) and the torus with the naive traversal and no context groups (the
+// switches under the mixing mode).
+std::vector<GoldenCase> mixed_contexts_cases() {
+    std::vector<GoldenCase> cases;
+    EncodeOptions mixed;
+    mixed.hierarchy_contexts = HierarchyContexts::mixed;
+    for (GoldenCase& c : static_geometry_cases()) {
+        if (c.name == "bumpy_random_float32_normal") continue;
+        c.name += "_mixed";
+        c.options.hierarchy_contexts = HierarchyContexts::mixed;
+        cases.push_back(c);
+    }
+    for (GoldenCase& c : golden_cases()) {
+        if (c.name != "lshape_graded" && c.name != "torus_naive_butterfly" && c.name != "bumpy_random_float32") continue;
+        c.name += "_mixed";
+        c.options.hierarchy_contexts = HierarchyContexts::mixed;
+        cases.push_back(c);
+    }
+    return cases;
+}
+
+TEST(Golden, MixedContextsFilesDecodeAndPinTheEncoder) {
+    const bool update = std::getenv("AMC_UPDATE_GOLDEN") != nullptr;
+    for (const GoldenCase& c : mixed_contexts_cases()) {
+        EncodeStats stats;
+        const std::vector<uint8_t> bytes = encode(c.hierarchy, c.options, &stats);
+        const std::string path = golden_path(kMixedContextsVersion, c.name);
+        SCOPED_TRACE(path);
+        if (update && !std::filesystem::exists(path)) {
+            std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+            std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+        }
+        const std::vector<uint8_t> golden = read_golden(path);
+        ASSERT_FALSE(golden.empty()) << path << " is missing";
+        EXPECT_EQ(bytes, golden) << "the bitstream changed (a new format version: FORMAT.md, Versions)";
+        EXPECT_EQ(inspect(golden.data(), golden.size()).version, kMixedContextsVersion);
+        const Hierarchy back = decode(golden.data(), golden.size());
+        EXPECT_TRUE(decodes_to_one_of(back, expected_decodings(c.hierarchy, c.options, kMixedContextsVersion)));
+        for (int l = 0; l < int(stats.levels); ++l) {
+            DecodeOptions prefix;
+            prefix.max_level = l;
+            EXPECT_EQ(decode(golden.data(), golden.size(), prefix).depth(), std::min(l, back.depth())) << "level " << l;
+        }
+    }
+}
+
 TEST(Golden, FilesOfEveryVersionDecodeToTheirHierarchies) {
     for (const int version : kVersionsOfTheCases) {
         for (const GoldenCase& c : golden_cases()) {

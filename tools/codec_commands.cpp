@@ -94,8 +94,9 @@ void print_encode_stats(std::FILE* out, const std::string& name, const EncodeSta
 
 void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     if (command.series || is_pvd(command.input)) {
-        if (command.keep_numbering || !command.map.empty() || command.quantize_bits != 0 || command.predictor != "auto")
-            throw UsageError("--keep-numbering, --map, --quantize and --predictor do not apply to a series");
+        if (command.keep_numbering || !command.map.empty() || command.quantize_bits != 0 || command.predictor != "auto" ||
+            command.hierarchy_contexts != "paper")
+            throw UsageError("--keep-numbering, --map, --quantize, --predictor and --hierarchy-contexts do not apply to a series");
         SeriesEncodeCommand series;
         series.inputs = {command.input};
         series.output = command.output;
@@ -125,6 +126,7 @@ void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     options.chunks = command.chunks;
     options.chunk_faces = command.chunk_faces;
     options.threads = command.threads;
+    options.hierarchy_contexts = command.hierarchy_contexts == "mixed" ? HierarchyContexts::mixed : HierarchyContexts::paper;
     Hierarchy h;
     LeafNumbering numbering;
     auto start = std::chrono::steady_clock::now();

@@ -30,6 +30,7 @@ struct EncodeCommand {
     uint32_t chunks = 0;          // 0: one per chunk_faces faces
     uint64_t chunk_faces = 100000;
     unsigned threads = 0;         // 0: every core
+    std::string hierarchy_contexts = "paper";
     bool series = false;          // the input is a series (.pvd, or a list of VTU files): run_series_encode
 };
 void run_encode(const EncodeCommand& command, const GlobalOptions& global);

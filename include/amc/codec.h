@@ -21,8 +21,18 @@ enum class GeometryPredictor : uint8_t {
     normal_frame = 3,
 };
 
+// How the hierarchy symbols of an .amc file are modelled (docs/HIERARCHY_CODER.md).
+enum class HierarchyContexts : uint8_t {
+    paper = 0,  // the paper's ten context groups, one adaptive model each (the fastest to decode)
+    // Sixteen models under richer contexts (structure one level up, decided neighbours' neighbours,
+    // decoded geometry) mixed logistically: 5-33% smaller hierarchy code on the corpus, slower to
+    // decode; files that use it are .amc version 8, one chunk.
+    mixed = 1,
+};
+
 struct EncodeOptions {
     HierarchyCoderOptions hierarchy;  // the connectivity coder's switches (defaults: the full method)
+    HierarchyContexts hierarchy_contexts = HierarchyContexts::paper;
     // 0: bit-exact coordinates. 1..30: coordinates quantized to a grid of 2^bits steps over the
     // bounding box (lossy; EncodeStats::max_error tells how much).
     int quantize_bits = 0;

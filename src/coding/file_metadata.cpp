@@ -37,7 +37,7 @@ Metadata read_metadata(const Block& block, bool quantized) {
     m.faces = in.varint();
     m.levels = in.varint();
     m.options = in.varint();
-    AMC_REQUIRE(!(m.options & ~(kOptionRootRotations | kOptionChunked)), corrupt, "metadata block: unknown options");
+    AMC_REQUIRE(!(m.options & ~(kOptionRootRotations | kOptionChunked | kOptionMixedContexts)), corrupt, "metadata block: unknown options");
     const uint64_t header_size = in.varint();
     AMC_REQUIRE(header_size <= in.remaining(), truncated, "metadata block: hierarchy header is truncated");
     m.hierarchy_header.assign(in.rest(), in.rest() + header_size);

@@ -16,6 +16,7 @@ namespace amc {
 // Metadata option bits.
 constexpr uint64_t kOptionRootRotations = 1;  // base triangles keep the input's local vertex order
 constexpr uint64_t kOptionChunked = 2;        // version 7: chunk blocks instead of level blocks (FORMAT.md 3.11)
+constexpr uint64_t kOptionMixedContexts = 4;  // hierarchy symbols in the mixing mode (version 8; FORMAT.md 2.1)
 
 struct Metadata {
     uint64_t base_vertices = 0, base_triangles = 0, nodes = 0, vertices = 0, faces = 0, levels = 0;

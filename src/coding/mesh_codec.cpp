@@ -47,8 +47,10 @@ Quantizer quantizer_of(const Hierarchy& input, int bits, double& max_error) {
 }
 
 // The lowest version that holds what the file holds (format_version.h).
-uint8_t file_version(bool chunked, bool static_geometry, BaseConnectivityMode base_mode, bool store_numbering) {
-    return chunked                                       ? kChunkedVersion
+uint8_t file_version(bool mixed_contexts, bool chunked, bool static_geometry, BaseConnectivityMode base_mode,
+                     bool store_numbering) {
+    return mixed_contexts                                ? kMixedContextsVersion
+           : chunked                                     ? kChunkedVersion
            : static_geometry                             ? kStaticGeometryVersion
            : base_mode == BaseConnectivityMode::angle ? kSearchedBaseVersion
            : store_numbering                          ? kNumberingVersion
@@ -101,9 +103,11 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     // several threads; the hierarchy coder then runs over the roots alone, for its header's sake.
     const uint64_t faces = options.chunks == 1 ? 0 : leaf_face_count(h);
     const std::vector<RootRange> chunks = balanced_chunks(nodes_per_root(h), chunk_count_for(options, faces));
-    const bool chunked = chunks.size() > 1;
+    // The mixing mode (FORMAT.md 2.1) codes the forest as one stream: one chunk.
+    const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
+    const bool chunked = !mixed && chunks.size() > 1;
     const Hierarchy roots_only = chunked ? Hierarchy(h.base()) : Hierarchy();
-    HierarchyLevelEncoder hierarchy(chunked ? roots_only : h, options.hierarchy);
+    HierarchyLevelEncoder hierarchy(chunked ? roots_only : h, options.hierarchy, kHierarchyStreamVersion, nullptr, mixed);
     Metadata meta;
     meta.base_vertices = h.base().positions.size();
     meta.base_triangles = h.root_count();
@@ -113,7 +117,8 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     meta.levels = uint64_t(chunked ? h.depth() + 1 : hierarchy.level_count());
     if (!chunked) meta.hierarchy_header = hierarchy.header();
     meta.quantizer = quantizer;
-    meta.options = (reordered.keep_rotations ? kOptionRootRotations : 0) | (chunked ? kOptionChunked : 0);
+    meta.options = (reordered.keep_rotations ? kOptionRootRotations : 0) | (chunked ? kOptionChunked : 0) |
+                   (mixed ? kOptionMixedContexts : 0);
 
     // The blocks are made first: the version in the header depends on the level modes chosen.
     std::vector<std::pair<BlockType, std::vector<uint8_t>>> blocks;
@@ -147,7 +152,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
         stats.numbering_bytes = blocks.back().second.size();
         stats.framing_bytes += kBlockOverhead;
     }
-    BlockWriter writer(file_version(chunked, static_geometry, base_code.mode, store_numbering),
+    BlockWriter writer(file_version(mixed, chunked, static_geometry, base_code.mode, store_numbering),
                        uint8_t((precision == Precision::float32 ? kFlagSinglePrecision : 0) | (quantized ? kFlagQuantized : 0)));
     for (const auto& block : blocks) writer.add(block.first, block.second);
     std::vector<uint8_t> out = writer.finish();
@@ -259,6 +264,10 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     PositionCoder positions(space);
     const TriangleMesh base =
         decode_base(connectivity_block, geometry_block, meta, reader.version(), precision == Precision::float32, positions);
+    AMC_REQUIRE(!(meta.options & kOptionMixedContexts) || reader.version() >= kMixedContextsVersion, corrupt,
+                "metadata block: mixed hierarchy contexts in a version-" + std::to_string(reader.version()) + " file");
+    AMC_REQUIRE(!((meta.options & kOptionMixedContexts) && (meta.options & kOptionChunked)), corrupt,
+                "metadata block: mixed hierarchy contexts in a chunked file");
     if (meta.options & kOptionChunked) return decode_chunked_file(reader, meta, base, space, options, numbering, partial, request);
     if (request != nullptr) {  // a file without chunks is one chunk
         AMC_REQUIRE(request->chunks.size() == 1 && request->chunks[0] == 0, invalid_input,
@@ -270,6 +279,7 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     HierarchyLevelDecoder hierarchy(base, meta.hierarchy_header.data(), meta.hierarchy_header.size(),
                                     hierarchy_stream_version_of_file(reader.version()),
                                     std::min<uint64_t>(meta.nodes, options.max_nodes));
+    if (meta.options & kOptionMixedContexts) hierarchy.use_mixed_contexts();
     Hierarchy& h = hierarchy.hierarchy();
     // The metadata's counts let the hierarchy grow in place, as far as the file's size warrants.
     const uint64_t reserved_nodes = std::min<uint64_t>(meta.nodes, meta.base_triangles + kReservedNodesPerFileByte * size);
@@ -288,7 +298,10 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
             continue;
         }
         AMC_REQUIRE(!has_numbering, corrupt, "level block after the numbering block");
-        AMC_REQUIRE(block.type == BlockType::level && reader.version() < kChunkedVersion, corrupt,
+        // Level blocks: every version before chunks, and the unchunked files of the mixing mode.
+        AMC_REQUIRE(block.type == BlockType::level &&
+                        (reader.version() < kChunkedVersion || (meta.options & kOptionMixedContexts)),
+                    corrupt,
                     "unexpected block between level blocks");
         AMC_REQUIRE(!hierarchy.done(), corrupt, "level block after the last level");
         if (options.max_level >= 0 && level >= options.max_level) return std::move(h);  // progressive: stop here

@@ -119,6 +119,22 @@ public:
         encode_with_limit(bit, model, kLimitLog2);
     }
 
+    // A bit with probability p16 (in [1, 2^16 - 1], units of 2^-16) of a one, from a model of the
+    // caller's own (the hierarchy coder's mixing mode).
+    void encode_with_probability(bool bit, uint32_t p16) {
+        const uint32_t bound = static_cast<uint32_t>((uint64_t{range_} * p16) >> kProbBits);
+        if (bit) {
+            range_ = bound;
+        } else {
+            low_ += bound;
+            range_ -= bound;
+        }
+        while (range_ < kTop) {
+            range_ <<= 8;
+            shift_low();
+        }
+    }
+
     // The low `count` bits of `value`, most significant first, each with probability 1/2.
     // count in [0, 32]; throws amc::Error otherwise.
     void encode_bits_raw(uint32_t value, int count);
@@ -181,6 +197,23 @@ public:
     template <int kLimitLog2>
     bool decode_with_limit(BitModel& model) {
         return decode_with_limit(model, kLimitLog2);
+    }
+
+    // The mirror of ArithmeticEncoder::encode_with_probability.
+    bool decode_with_probability(uint32_t p16) {
+        const uint32_t bound = static_cast<uint32_t>((uint64_t{range_} * p16) >> kProbBits);
+        const bool bit = code_ < bound;
+        if (bit) {
+            range_ = bound;
+        } else {
+            code_ -= bound;
+            range_ -= bound;
+        }
+        while (range_ < kTop) {
+            range_ <<= 8;
+            code_ = (code_ << 8) | next_byte();
+        }
+        return bit;
     }
 
     // count in [0, 32]; throws amc::Error otherwise.

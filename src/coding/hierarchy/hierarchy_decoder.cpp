@@ -90,6 +90,7 @@ void HierarchyLevelDecoder::restart(const TriangleMesh& base, const HierarchyStr
     AMC_REQUIRE(uniform_nodes <= max_nodes_, limit_exceeded,
                 "hierarchy stream would build more than " + std::to_string(max_nodes_) + " nodes");
     models_ = HierarchyModels();
+    mixed_model_.reset();
     traversal_.configure(header.options, header.version);
     for (Level& level : decided_) spare_.push_back(std::move(level));
     decided_.clear();
@@ -148,8 +149,28 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder, uint64_t ma
     // nothing is tested or masked per symbol. (Marked likely, GCC spills less in the traversal's
     // loop: 1-1.5% fewer instructions on every model. Even moving group_mask's definition into
     // the call below cost 2.5%: see HIERARCHY_CODER.md, Speed, item 29.)
-    if (__builtin_expect(header_.options.use_contexts && symbol_limit - symbols_read >= codable_symbols(level_, header_),
-                         1)) {
+    if (mixed_model_ != nullptr) {
+        // The mixing mode (FORMAT.md 2.1): the features read this level's nodes in h_, built by
+        // decode_level with their corners placed; node id = level_base_ + local index.
+        AMC_REQUIRE(h_.node_capacity() == level_base_ + n, invalid_input,
+                    "hierarchy stream: the mixing mode decodes one level at a time");
+        MixedHierarchyModel& mixed = *mixed_model_;
+        const Hierarchy& h = h_;
+        const NodeId base = level_base_;
+        const Level& current = level_;
+        traversal_.run_newest(
+            level_, l < header_.uniform_levels,
+            [&](uint32_t i, int group) {
+                if (symbols_read == symbol_limit) return false;
+                ++symbols_read;
+                const bool bit = d.decode_with_probability(mixed.p16(mixed_features(h, base + i, current, i, group)));
+                mixed.update(bit);
+                return bit;
+            },
+            [&](uint32_t, Fate, bool refined) { return refined; });
+    } else if (__builtin_expect(header_.options.use_contexts &&
+                                    symbol_limit - symbols_read >= codable_symbols(level_, header_),
+                                1)) {
         traversal_.run_newest(
             level_, l < header_.uniform_levels,
             [&](uint32_t, int group) {

@@ -5,14 +5,17 @@
 #include "common/check.h"
 #include "hierarchy/hierarchy_builder.h"
 
+#include <cmath>
 #include <string>
 #include <utility>
 
 namespace amc {
 
 HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const HierarchyCoderOptions& options,
-                                             uint8_t stream_version, std::vector<CodedSymbol>* trace)
-    : options_(options) {
+                                             uint8_t stream_version, std::vector<CodedSymbol>* trace, bool mixed)
+    : options_(options), mixed_(mixed) {
+    AMC_REQUIRE(!mixed || stream_version == kHierarchyStreamVersion, invalid_input,
+                "the hierarchy coder's mixing mode needs the newest hierarchy stream version");
     HierarchyCodeStats& stats = stats_;
     // Levels 0..U-1 with every node refined (counted on the way: a level is uniform when it and
     // all coarser levels are refined everywhere).
@@ -70,6 +73,11 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
             level, uniform,
             [&](uint32_t i, int group) {
                 const bool r = truth[i] != 0;
+                if (mixed_) {
+                    if (event_feature_.size() < events_.size() + 1) event_feature_.resize(events_.size() + 1);
+                    event_feature_[events_.size()] = uint32_t(mixed_features_.size());
+                    mixed_features_.push_back(mixed_features(h, ids[i], level, i, group));
+                }
                 events_.push_back({uint8_t(group), uint8_t(r)});
                 if (trace != nullptr) trace->push_back({ids[i], uint8_t(group), r});
                 return r;
@@ -144,7 +152,16 @@ void HierarchyLevelEncoder::encode_level(int l, ArithmeticEncoder& encoder) {
     if (l != next_level_) throw Error("hierarchy levels must be encoded in order");
     ++next_level_;
     const size_t begin = l == 0 ? 0 : level_end_[size_t(l) - 1];
-    for_each_coded(begin, level_end_[size_t(l)], models_, symbols_written_, [&](BitModel& model, Event e) {
+    if (mixed_) {
+        if (mixed_model_ == nullptr) mixed_model_ = std::make_unique<MixedHierarchyModel>();
+        for_each_mixed(begin, level_end_[size_t(l)], models_, *mixed_model_, symbols_written_,
+                       [&](BitModel* model, uint32_t p16, Event e) {
+                           if (model != nullptr) encoder.encode_with_limit<kHierarchyModelLimit>(e.bit, *model);
+                           else encoder.encode_with_probability(e.bit != 0, p16);
+                       });
+        return;
+    }
+    for_each_coded(begin, level_end_[size_t(l)], models_, symbols_written_, [&](BitModel& model, Event e, size_t) {
         encoder.encode_with_limit<kHierarchyModelLimit>(e.bit, model);
     });
 }
@@ -157,9 +174,7 @@ HierarchyCodeStats HierarchyLevelEncoder::stats() const {
     HierarchyModels models;
     uint64_t symbols = 0;
     const size_t end = next_level_ == 0 ? 0 : level_end_[size_t(next_level_) - 1];
-    for_each_coded(0, end, models, symbols, [&](BitModel& model, Event e) {
-        const double bits = model.cost_bits(e.bit);
-        model.update_with_limit(e.bit, kHierarchyModelLimit);
+    auto tally = [&](double bits, Event e) {
         if (e.group == kOrientationEvent) {
             stats.orientation_bits += bits;
             return;
@@ -169,7 +184,24 @@ HierarchyCodeStats HierarchyLevelEncoder::stats() const {
         group.ones += e.bit;
         stats.coded_ones += e.bit;
         group.coded_bits += bits;
-    });
+    };
+    if (mixed_) {
+        MixedHierarchyModel mixed;
+        for_each_mixed(0, end, models, mixed, symbols, [&](BitModel* model, uint32_t p16, Event e) {
+            if (model != nullptr) {
+                tally(model->cost_bits(e.bit), e);
+                model->update_with_limit(e.bit, kHierarchyModelLimit);
+            } else {
+                tally(-std::log2(double(e.bit ? p16 : kProbOne - p16) / double(kProbOne)), e);
+            }
+        });
+    } else {
+        for_each_coded(0, end, models, symbols, [&](BitModel& model, Event e, size_t) {
+            const double bits = model.cost_bits(e.bit);
+            model.update_with_limit(e.bit, kHierarchyModelLimit);
+            tally(bits, e);
+        });
+    }
     stats.conditional_entropy_bits = 0;
     stats.adaptive_code_bits = 0;
     for (int g = 0; g < kContextGroupCount; ++g) {

@@ -6,9 +6,11 @@
 #include "coding/entropy/arithmetic_coder.h"
 #include "coding/hierarchy/hierarchy_stream.h"
 #include "coding/hierarchy/hierarchy_traversal.h"
+#include "coding/hierarchy/mixed_contexts.h"
 
 #include <amc/hierarchy_coder.h>
 
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -32,8 +34,13 @@ public:
     // older hierarchy stream version may be written for tests of the decoder's older paths.
     // `trace`, if given, receives every symbol the first pass decides by coding, in order (the
     // stream keeps the first stats().coded of them).
+    // `mixed`: the mixing mode (.amc version 8; FORMAT.md 2.1): symbols coded by
+    // MixedHierarchyModel from features of h's structure and positions, which must be the ones
+    // the decoder will have.
     HierarchyLevelEncoder(const Hierarchy& h, const HierarchyCoderOptions& options,
-                          uint8_t stream_version = kHierarchyStreamVersion, std::vector<CodedSymbol>* trace = nullptr);
+                          uint8_t stream_version = kHierarchyStreamVersion, std::vector<CodedSymbol>* trace = nullptr,
+                          bool mixed = false);
+    bool mixed() const { return mixed_; }
     const std::vector<uint8_t>& header() const { return header_; }
     int level_count() const { return int(level_ids_.size()); }
     // Nodes of level l (ids in the encoded hierarchy) in canonical order.
@@ -62,13 +69,27 @@ private:
         for (size_t k = begin; k < end; ++k) {
             const Event e = events_[k];
             if (e.group == kOrientationEvent) {
-                if (stats_.orientation_coded) f(models.orientation, e);
+                if (stats_.orientation_coded) f(models.orientation, e, k);
                 continue;
             }
             if (symbols == kept_symbols_) continue;
             ++symbols;
-            f(models.for_group(e.group, options_.use_contexts), e);
+            f(models.for_group(e.group, options_.use_contexts), e, k);
         }
+    }
+    // The mixing mode's coded symbols of [begin, end): f(probability, event) with the model's
+    // update after each.
+    template <class F>
+    void for_each_mixed(size_t begin, size_t end, HierarchyModels& models, MixedHierarchyModel& mixed,
+                        uint64_t& symbols, F&& f) const {
+        for_each_coded(begin, end, models, symbols, [&](BitModel& model, Event e, size_t k) {
+            if (e.group == kOrientationEvent) {
+                f(&model, 0, e);
+                return;
+            }
+            f(nullptr, mixed.p16(mixed_features_[event_feature_[k]]), e);
+            mixed.update(e.bit != 0);
+        });
     }
 
     HierarchyCoderOptions options_;
@@ -81,6 +102,10 @@ private:
     HierarchyModels models_;
     uint64_t kept_symbols_ = 0, symbols_written_ = 0;
     int next_level_ = 0;
+    bool mixed_ = false;
+    std::vector<MixedFeatures> mixed_features_;  // mixing mode: per hierarchy symbol event
+    std::vector<uint32_t> event_feature_;        // mixing mode: event index -> mixed_features_ index
+    std::unique_ptr<MixedHierarchyModel> mixed_model_;  // the mixing mode's state, or null
 };
 
 // Decides `level` of a version-1 stream (hierarchy_decoder_v1.cpp) as the decoder's general path
@@ -114,6 +139,10 @@ public:
     // The vertices the last decode_level created, as (node, edge) in canonical order at their
     // first appearance (new_vertices_of_level of its level's nodes), positions not yet set.
     const std::vector<std::pair<NodeId, int>>& new_vertices() const { return new_vertices_; }
+    // Switches to the mixing mode (.amc version 8; FORMAT.md 2.1) before the first level. Its
+    // features read the positions of hierarchy(): decode_level only, each level's new positions
+    // set before the next level is decoded.
+    void use_mixed_contexts() { mixed_model_ = std::make_unique<MixedHierarchyModel>(); }
     // decode_level in two halves, for callers that want every decision before building: decide
     // the current level and move to the next (hierarchy() is not touched); then split every
     // decided level in hierarchy(). In between, node_count() and vertex_count() tell the size
@@ -149,6 +178,7 @@ private:
     NodeId level_base_ = 0;  // node id of local index 0 of the oldest level not yet built
     int level_index_ = 0;
     uint64_t node_count_ = 0, vertex_count_ = 0, symbols_read_ = 0;
+    std::unique_ptr<MixedHierarchyModel> mixed_model_;  // the mixing mode's state, or null
 };
 
 }  // namespace amc

@@ -1,0 +1,158 @@
+// The hierarchy coder's mixing mode (.amc version 8, docs/FORMAT.md 2.1): bit-exact round trips
+// under every coder switch, quantized and float32 files, stress coordinates; smaller than the
+// paper's contexts on a curved remesh; refused in files of older versions.
+#include "coding/container.h"
+#include "coding/format_version.h"
+#include "coding/hierarchy/coder_switches.h"
+#include "coding/hierarchy/context_mixing.h"
+#include "hierarchy_checks.h"
+
+#include <amc/codec.h>
+#include <amc/refinement.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+
+namespace amc {
+namespace {
+
+struct Random {
+    uint64_t state;
+    uint64_t next() {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return state ^ (state >> 29);
+    }
+};
+
+// Positions that push the geometric features to their edges: huge, tiny, denormal and repeated
+// coordinates (overflowing products, zero areas and lengths).
+double wild_coordinate(Random& random) {
+    switch (random.next() % 5) {
+        case 0: return 0.0;
+        case 1: return std::ldexp(double(random.next() % 1000 + 1), -1074);
+        case 2: return (random.next() % 2 ? 1 : -1) * std::ldexp(double(random.next() % 1000), 900);
+        case 3: return 1.0;
+        default: return std::ldexp(double(random.next() % 100000), -int(random.next() % 60));
+    }
+}
+
+TEST(MixedContexts, SquashAndStretchAreMonotoneInverses) {
+    int previous = 0;
+    for (int x = -2047; x <= 2047; ++x) {
+        const int p = mixing::squash(x);
+        ASSERT_GE(p, previous) << x;
+        ASSERT_GE(p, 1);
+        ASSERT_LE(p, 4095);
+        previous = p;
+    }
+    for (int p = 1; p < 4096; ++p) {
+        // stretch(p) is the least x with squash(x) >= p (the top of the range above 4094).
+        const int x = mixing::stretch(p);
+        if (p > mixing::squash(2047)) continue;
+        ASSERT_GE(mixing::squash(x), p) << p;
+        if (x > -2047) {
+            ASSERT_LT(mixing::squash(x - 1), p) << p;
+        }
+    }
+    EXPECT_EQ(mixing::squash(0), 2047);
+    EXPECT_EQ(mixing::stretch(2047), 0);
+}
+
+TEST(MixedContexts, RandomHierarchiesRoundTripBitExactlyUnderEverySwitch) {
+    Random random{77};
+    const auto meshes = testing::fixture_meshes();
+    for (int trial = 0; trial < 240; ++trial) {
+        TriangleMesh base = meshes[random.next() % meshes.size()].mesh;
+        const bool single = trial % 3 == 1 && trial % 4 != 3;
+        base.single_precision = single;
+        if (single) {
+            for (Vec3& p : base.positions) p = Vec3{double(float(p.x)), double(float(p.y)), double(float(p.z))};
+        }
+        Hierarchy h(base);
+        refine_randomly(h, h.root_count() + uint32_t(random.next() % 600), 1 + int(random.next() % 5), random.next());
+        if (trial % 4 == 3) {
+            for (VertexId v = 0; v < h.positions().size(); ++v)
+                h.set_position(v, {wild_coordinate(random), wild_coordinate(random), wild_coordinate(random)});
+        } else if (!single) {
+            // Off the midpoints, as a surface remesh places them.
+            for (VertexId v = 0; v < h.positions().size(); ++v) {
+                const Vec3 p = h.position(v);
+                h.set_position(v, p + 0.01 * double(random.next() % 100) * Vec3{p.y, p.z, p.x});
+            }
+        }
+        EncodeOptions options;
+        options.hierarchy_contexts = HierarchyContexts::mixed;
+        options.hierarchy = coder_options_from_switches(int(random.next() % kCoderSwitchCombinations));
+        if (trial % 4 != 3) {
+            const int bits[] = {0, 0, 10, 16};
+            options.quantize_bits = single ? 0 : bits[random.next() % 4];
+        }
+        options.predictor = GeometryPredictor(random.next() % 4);
+        const std::vector<uint8_t> bytes = encode(h, options);
+        ASSERT_EQ(bytes[4], kMixedContextsVersion) << trial;
+        const Hierarchy back = decode(bytes.data(), bytes.size());
+        Hierarchy expected = in_decoder_order(h, options);
+        if (options.quantize_bits != 0) {
+            // The forest and the vertex numbering are the input's; the positions are on the grid.
+            ASSERT_EQ(back.vertex_count(), expected.vertex_count()) << "trial " << trial;
+            expected.set_single_precision(false);
+            for (VertexId v = 0; v < expected.positions().size(); ++v) expected.set_position(v, back.position(v));
+        }
+        ASSERT_TRUE(identical(back, expected)) << "trial " << trial;
+        ASSERT_EQ(check_invariants(back), "");
+        // Every prefix of levels too (progressive decoding).
+        for (int l = 0; l <= back.depth(); ++l) {
+            DecodeOptions prefix;
+            prefix.max_level = l;
+            ASSERT_EQ(decode(bytes.data(), bytes.size(), prefix).depth(), l) << "trial " << trial;
+        }
+    }
+}
+
+TEST(MixedContexts, SmallerThanThePapersContextsOnACurvedRemesh) {
+    SurfaceRemeshOptions remesh;
+    remesh.base_triangles = 200;
+    remesh.max_level = 5;
+    remesh.target_faces = 20000;
+    const Hierarchy h = remesh_adaptively(make_bumpy_sphere(4), remesh);
+    EncodeStats paper, mixed;
+    encode(h, {}, &paper);
+    EncodeOptions options;
+    options.hierarchy_contexts = HierarchyContexts::mixed;
+    const std::vector<uint8_t> bytes = encode(h, options, &mixed);
+    EXPECT_LT(double(mixed.hierarchy_bytes), 0.95 * double(paper.hierarchy_bytes))
+        << mixed.hierarchy_bytes << " against " << paper.hierarchy_bytes;
+    EXPECT_TRUE(identical(decode(bytes.data(), bytes.size()), in_decoder_order(h, options)));
+    // Without the option the file is what it was (the paper's contexts, an older version).
+    std::vector<uint8_t> plain = encode(h, {});
+    EXPECT_LT(plain[4], kMixedContextsVersion);
+}
+
+TEST(MixedContexts, TheModeIsRefusedInOlderVersions) {
+    Hierarchy h(make_icosahedron());
+    refine_randomly(h, 200, 3, 5);
+    EncodeOptions options;
+    options.hierarchy_contexts = HierarchyContexts::mixed;
+    const std::vector<uint8_t> bytes = encode(h, options);
+    // The same blocks framed as the version before.
+    BlockReader reader(bytes.data(), bytes.size());
+    BlockWriter writer(kMixedContextsVersion - 1, reader.flags());
+    Block block{};
+    while (reader.next(block)) {
+        if (block.type == BlockType::end) break;
+        writer.add(block.type, std::vector<uint8_t>(block.payload, block.payload + block.size));
+    }
+    const std::vector<uint8_t> older = writer.finish();
+    try {
+        decode(older.data(), older.size());
+        FAIL() << "a file of the version before with mixed contexts decoded";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("mixed hierarchy contexts in a version-" + std::to_string(kMixedContextsVersion - 1) + " file"),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
+}  // namespace
+}  // namespace amc
