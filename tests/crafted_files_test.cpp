@@ -46,6 +46,24 @@ void* operator new(std::size_t size) { return counted_allocation(size, 0); }
 void* operator new[](std::size_t size) { return counted_allocation(size, 0); }
 void* operator new(std::size_t size, std::align_val_t a) { return counted_allocation(size, std::size_t(a)); }
 void* operator new[](std::size_t size, std::align_val_t a) { return counted_allocation(size, std::size_t(a)); }
+// The nothrow forms too (std::stable_sort's buffer uses them): otherwise the library's new and this
+// file's delete would not pair up.
+void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
+    try { return counted_allocation(size, 0); } catch (const std::bad_alloc&) { return nullptr; }
+}
+void* operator new[](std::size_t size, const std::nothrow_t&) noexcept {
+    try { return counted_allocation(size, 0); } catch (const std::bad_alloc&) { return nullptr; }
+}
+void* operator new(std::size_t size, std::align_val_t a, const std::nothrow_t&) noexcept {
+    try { return counted_allocation(size, std::size_t(a)); } catch (const std::bad_alloc&) { return nullptr; }
+}
+void* operator new[](std::size_t size, std::align_val_t a, const std::nothrow_t&) noexcept {
+    try { return counted_allocation(size, std::size_t(a)); } catch (const std::bad_alloc&) { return nullptr; }
+}
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
 void operator delete(void* p) noexcept { std::free(p); }
 void operator delete[](void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }

@@ -60,7 +60,9 @@ Hierarchy HierarchyBuilder::stitch(const TriangleMesh& base, std::vector<Vec3> p
                 if (p.part->is_boundary_edge(i, e) && !h.is_boundary_edge(p.first_root + i, e)) seam.emplace_back(p.first_root + i, e);
     while (!seam.empty()) {
         next.clear();
-        for (auto [n, e] : seam) {
+        for (const auto& seam_edge : seam) {
+            const NodeId n = seam_edge.first;  // plain names: AMC_REQUIRE's lambda cannot capture a structured binding
+            const int e = seam_edge.second;
             const NodeId q = h.nodes_[n].nbr[e];
             if (h.is_leaf(n)) {
                 AMC_REQUIRE(h.hanging_node_count(n) < 3, corrupt, "chunks do not fit together: a leaf with three hanging nodes");
