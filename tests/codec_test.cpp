@@ -1,6 +1,7 @@
 // The .amc file: bit-exact round trips, quantization, progressive decoding, corrupt files.
 #include "coding/container.h"
 #include "coding/hierarchy/coder_switches.h"
+#include "coding/hierarchy/hierarchy_stream.h"
 #include "hierarchy_checks.h"
 
 #include <amc/codec.h>
@@ -395,6 +396,51 @@ TEST(Codec, MutatedBlocksWithValidChecksumsAreErrorsOrValidHierarchies) {
 // A producer whose diagonals follow a rule of absolute local indices: the file keeps the input's
 // local vertex order of the base triangles (their rotations cost log2 3 bits each) instead of
 // paying an orientation bit for about half the two-hanging-node leaves.
+// The one LEB128 reader and its limits: 64 bits in payloads, 63 (9 bytes) for the hierarchy
+// stream's symbol count (FORMAT.md 2).
+TEST(Codec, VarintsAreReadUpToTheirLimit) {
+    auto read = [](std::vector<uint8_t> bytes, int max_bits, uint64_t& value) {
+        size_t pos = 0;
+        return read_varint(bytes.data(), bytes.size(), pos, value, max_bits);
+    };
+    uint64_t value = 0;
+    std::vector<uint8_t> max64(9, 0xff);
+    max64.push_back(0x01);
+    EXPECT_EQ(read(max64, 64, value), VarintRead::ok);
+    EXPECT_EQ(value, UINT64_MAX);
+    max64.back() = 0x02;
+    EXPECT_EQ(read(max64, 64, value), VarintRead::too_long);
+    max64.back() = 0x81;
+    max64.push_back(0x00);
+    EXPECT_EQ(read(max64, 64, value), VarintRead::too_long);
+    EXPECT_EQ(read({0x80, 0x80}, 64, value), VarintRead::truncated);
+    std::vector<uint8_t> max63(8, 0xff);
+    max63.push_back(0x7f);
+    EXPECT_EQ(read(max63, 63, value), VarintRead::ok);
+    EXPECT_EQ(value, UINT64_MAX >> 1);
+    max63.back() = 0xff;
+    max63.push_back(0x00);
+    EXPECT_EQ(read(max63, 63, value), VarintRead::too_long);
+    std::vector<uint8_t> out;
+    for (uint64_t v : {uint64_t(0), uint64_t(127), uint64_t(128), uint64_t(1) << 35, UINT64_MAX}) {
+        out.clear();
+        put_varint(out, v);
+        EXPECT_EQ(read(out, 64, value), VarintRead::ok);
+        EXPECT_EQ(value, v);
+    }
+    // The hierarchy stream's header refuses a tenth byte of its symbol count.
+    HierarchyStreamHeader header;
+    std::vector<uint8_t> stream{uint8_t(coder_switches(HierarchyCoderOptions{})), 0, 0};
+    stream.insert(stream.end(), max63.begin(), max63.end());
+    try {
+        read_hierarchy_stream_header(stream.data(), stream.size(), header);
+        ADD_FAILURE() << "a 10-byte symbol count was read";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::corrupt);
+        EXPECT_NE(std::string(e.what()).find("symbol count is too long"), std::string::npos) << e.what();
+    }
+}
+
 TEST(Codec, DiagonalRulesOfAbsoluteLocalIndicesStayCheap) {
     Hierarchy h(make_torus(12, 10, 2.0, 0.7));
     refine_randomly(h, 20000, 6, 12);

@@ -18,15 +18,6 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// Positions in canonical vertex order.
-std::vector<Vec3> canonical_positions(const Hierarchy& h) {
-    const std::vector<uint32_t> canonical = canonical_vertex_order(h);
-    std::vector<Vec3> points(h.vertex_count());
-    for (size_t v = 0; v < canonical.size(); ++v)
-        if (canonical[v] != kNoVertex) points[canonical[v]] = h.position(VertexId(v));
-    return points;
-}
-
 }  // namespace
 
 void run_demo(const std::string& out_dir, const GlobalOptions& global) {

@@ -198,6 +198,8 @@ bool identical(const Hierarchy& a, const Hierarchy& b);
 // appearance over refined nodes in breadth-first order, edges 0, 1, 2. Maps vertex id -> index
 // (kNoVertex for dead ids).
 std::vector<uint32_t> canonical_vertex_order(const Hierarchy& h);
+// The positions of the live vertices in canonical order (vertex_count() of them).
+std::vector<Vec3> canonical_positions(const Hierarchy& h);
 
 // ---- the conforming leaf mesh (green closure) ----------------------------------------------
 

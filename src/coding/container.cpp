@@ -142,16 +142,26 @@ void PayloadReader::fail(ErrorCode code, const std::string& problem) const {
     throw_error(code, std::string(what_) + ": " + problem);
 }
 
+VarintRead read_varint(const uint8_t* data, size_t size, size_t& pos, uint64_t& value, int max_bits) {
+    value = 0;
+    for (int shift = 0;; shift += 7) {
+        if (pos >= size) return VarintRead::truncated;
+        if (shift >= max_bits) return VarintRead::too_long;
+        const uint8_t byte = data[pos++];
+        if (shift + 7 > max_bits && (byte >> (max_bits - shift)) != 0) return VarintRead::too_long;
+        value |= uint64_t(byte & 0x7f) << shift;
+        if (!(byte & 0x80)) return VarintRead::ok;
+    }
+}
+
 uint64_t PayloadReader::varint() {
     uint64_t value = 0;
-    for (int shift = 0;; shift += 7) {
-        if (pos_ >= size_) fail(ErrorCode::truncated, "truncated number");
-        if (shift > 63) fail(ErrorCode::corrupt, "number too long");
-        const uint8_t byte = data_[pos_++];
-        if (shift == 63 && byte > 1) fail(ErrorCode::corrupt, "number too long");
-        value |= uint64_t(byte & 0x7f) << shift;
-        if (!(byte & 0x80)) return value;
+    switch (read_varint(data_, size_, pos_, value)) {
+        case VarintRead::ok: break;
+        case VarintRead::truncated: fail(ErrorCode::truncated, "truncated number");
+        case VarintRead::too_long: fail(ErrorCode::corrupt, "number too long");
     }
+    return value;
 }
 
 uint8_t PayloadReader::u8() {

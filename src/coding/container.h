@@ -101,6 +101,11 @@ private:
 void put_varint(std::vector<uint8_t>& out, uint64_t value);
 void put_f64(std::vector<uint8_t>& out, double value);
 
+// The one LEB128 reader: the number at data[pos] (pos moves past what was read), of at most
+// `max_bits` bits (1..64). Longer numbers are too_long, numbers cut by the data's end truncated.
+enum class VarintRead : uint8_t { ok, truncated, too_long };
+VarintRead read_varint(const uint8_t* data, size_t size, size_t& pos, uint64_t& value, int max_bits = 64);
+
 class PayloadReader {
 public:
     PayloadReader(const uint8_t* data, size_t size, const char* what) : data_(data), size_(size), what_(what) {}

@@ -23,18 +23,20 @@ namespace amc {
 
 namespace {
 
-std::vector<Vec3> all_positions(const Hierarchy& h) {
+// The live vertices' positions in id order (the order fixes which of two equal-valued zeros
+// std::fmin keeps in the grid's origin, so it stays as files were written).
+std::vector<Vec3> live_positions(const Hierarchy& h) {
     std::vector<Vec3> points;
     const std::vector<uint32_t> canonical = canonical_vertex_order(h);
     for (size_t v = 0; v < canonical.size(); ++v) {
-        if (canonical[v] != 0xffffffffu) points.push_back(h.position(VertexId(v)));
+        if (canonical[v] != kNoVertex) points.push_back(h.position(VertexId(v)));
     }
     return points;
 }
 
 // The grid of `bits` over the input's positions; its largest error in `max_error`.
 Quantizer quantizer_of(const Hierarchy& input, int bits, double& max_error) {
-    const std::vector<Vec3> points = all_positions(input);
+    const std::vector<Vec3> points = live_positions(input);
     Quantizer quantizer;
     try {
         quantizer = make_quantizer(points, bits);
@@ -372,7 +374,7 @@ std::vector<uint32_t> chunks_covering(const FileInfo& info, const std::vector<ui
 Hierarchy in_decoder_order(const Hierarchy& h, const EncodeOptions& options) {
     std::unique_ptr<Quantizer> quantizer;
     if (options.quantize_bits != 0)
-        quantizer = std::make_unique<Quantizer>(make_quantizer(all_positions(h), options.quantize_bits));
+        quantizer = std::make_unique<Quantizer>(make_quantizer(live_positions(h), options.quantize_bits));
     return in_base_code_order(h, base_code_of(h, quantizer.get(), options), false).hierarchy;
 }
 

@@ -13,9 +13,9 @@ Hierarchy reorder_base(const Hierarchy& h, const std::vector<uint32_t>& vertex_o
     if (vertex_order.size() != old_base.positions.size() || triangle_order.size() != old_base.triangles.size() ||
         rotation.size() != triangle_order.size())
         throw Error("reorder_base: orders do not match the base mesh");
-    std::vector<uint32_t> new_id(vertex_order.size(), 0xffffffffu);
+    std::vector<uint32_t> new_id(vertex_order.size(), kNoVertex);
     for (uint32_t i = 0; i < vertex_order.size(); ++i) {
-        if (vertex_order[i] >= new_id.size() || new_id[vertex_order[i]] != 0xffffffffu)
+        if (vertex_order[i] >= new_id.size() || new_id[vertex_order[i]] != kNoVertex)
             throw Error("reorder_base: vertex order is not a permutation");
         new_id[vertex_order[i]] = i;
     }

@@ -85,7 +85,6 @@ std::string serialize_hierarchy(const Hierarchy& h) {
     check_before_writing(h, "hierarchy file", true);  // what deserialize_hierarchy checks
     const bool single = h.single_precision();
     const std::vector<NodeId> order = h.breadth_first_order();
-    const std::vector<uint32_t> canonical = canonical_vertex_order(h);
     std::vector<uint32_t> flipped;
     for (uint32_t i = 0; i < order.size(); ++i) {
         NodeId n = order[i];
@@ -116,15 +115,11 @@ std::string serialize_hierarchy(const Hierarchy& h) {
     }
     out += bits;
     for (uint32_t i : flipped) put_u32(out, i);
-    std::vector<Vec3> refinement_positions(new_vertices);
-    for (size_t v = 0; v < canonical.size(); ++v) {
-        if (canonical[v] != 0xffffffffu && canonical[v] >= base_vertices)
-            refinement_positions[canonical[v] - base_vertices] = h.position(VertexId(v));
-    }
-    for (const Vec3& p : refinement_positions) {
-        put_coordinate(out, p.x, single);
-        put_coordinate(out, p.y, single);
-        put_coordinate(out, p.z, single);
+    const std::vector<Vec3> positions = canonical_positions(h);  // base vertices first
+    for (size_t i = base_vertices; i < positions.size(); ++i) {
+        put_coordinate(out, positions[i].x, single);
+        put_coordinate(out, positions[i].y, single);
+        put_coordinate(out, positions[i].z, single);
     }
     return out;
 }
@@ -229,7 +224,7 @@ Hierarchy parse_hierarchy(const std::string& bytes, const std::string& what) {
             in.fail("refinement vertex " + std::to_string(i) + " has a non-finite coordinate");
     }
     for (size_t v = 0; v < canonical.size(); ++v) {
-        if (canonical[v] != 0xffffffffu && canonical[v] >= base_vertices)
+        if (canonical[v] != kNoVertex && canonical[v] >= base_vertices)
             h.set_position(VertexId(v), refinement_positions[canonical[v] - base_vertices]);
     }
     h.set_vertex_placer(nullptr, nullptr);

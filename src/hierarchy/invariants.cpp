@@ -99,7 +99,7 @@ std::string check_invariants(const Hierarchy& h) {
 std::string check_positions(const Hierarchy& h) {
     const std::vector<uint32_t> canonical = canonical_vertex_order(h);
     for (VertexId v = 0; v < canonical.size(); ++v) {
-        if (canonical[v] == 0xffffffffu) continue;
+        if (canonical[v] == kNoVertex) continue;
         const Vec3 p = h.position(v);
         for (const double x : {p.x, p.y, p.z}) {
             if (!std::isfinite(x)) return "vertex " + std::to_string(v) + " has a non-finite coordinate";

@@ -148,7 +148,7 @@ TriangleMesh simplify_to_base(const TriangleMesh& reference, const ClosestPointQ
         }
         TriangleMesh base;
         base.single_precision = reference.single_precision;
-        std::vector<uint32_t> remap(reference.positions.size(), 0xffffffffu);
+        std::vector<uint32_t> remap(reference.positions.size(), kNoVertex);
         for (size_t i = 0; i + 2 < simplified.size(); i += 3) {
             std::array<unsigned, 3> key{simplified[i], simplified[i + 1], simplified[i + 2]};
             std::sort(key.begin(), key.end());
@@ -156,7 +156,7 @@ TriangleMesh simplify_to_base(const TriangleMesh& reference, const ClosestPointQ
             Triangle t;
             for (int k = 0; k < 3; ++k) {
                 uint32_t& id = remap[simplified[i + k]];
-                if (id == 0xffffffffu) {
+                if (id == kNoVertex) {
                     id = uint32_t(base.positions.size());
                     base.positions.push_back(reference.positions[simplified[i + k]]);
                     source.push_back(simplified[i + k]);

@@ -16,7 +16,8 @@
 
 namespace amc::angle_mode {
 
-constexpr uint32_t kNoNode = 0xFFFFFFFFu;
+// No node of the cut border (amc::kNoNode is the hierarchy's: another id space).
+constexpr uint32_t kNoBorderNode = 0xFFFFFFFFu;
 
 // The corner a triangle closing the gap at a border vertex u would have at u: the angle between
 // the border edges u -> v (next) and u -> t (previous), "reflex" when the closing triangle would
@@ -249,7 +250,7 @@ private:
     std::vector<Node> nodes_;
 
     uint32_t new_node(uint32_t v, uint32_t o) {
-        nodes_.push_back({kNoNode, kNoNode, v, o, kStale});
+        nodes_.push_back({kNoBorderNode, kNoBorderNode, v, o, kStale});
         return static_cast<uint32_t>(nodes_.size() - 1);
     }
     void link(uint32_t a, uint32_t b) {

@@ -160,20 +160,20 @@ private:
         if (b.located(b.vert(g)) && b.located(b.vert(nv)) && b.located(o)) {
             const Vec3 predicted = (b.position(b.vert(g)) + b.position(b.vert(nv))) - b.position(o);
             charge_walk(length - 4);
-            uint32_t best = angle_mode::kNoNode, best_k = 0;
+            uint32_t best = angle_mode::kNoBorderNode, best_k = 0;
             double best_distance = 0;
             uint32_t x = b.next(b.next(nv));
             for (uint32_t i = 2; i + 3 <= length; ++i, x = b.next(x)) {
                 if (!b.located(b.vert(x))) continue;
                 const Vec3 d = b.position(b.vert(x)) - predicted;
                 const double distance = exact_dot(d, d);
-                if (best == angle_mode::kNoNode || distance < best_distance) {
+                if (best == angle_mode::kNoBorderNode || distance < best_distance) {
                     best = x;
                     best_k = i;
                     best_distance = distance;
                 }
             }
-            if (best != angle_mode::kNoNode && dec_.decode(models_.nearest)) {
+            if (best != angle_mode::kNoBorderNode && dec_.decode(models_.nearest)) {
                 k = best_k;
                 return best;
             }

@@ -5,6 +5,7 @@
 #include "coding/geometry/geometry_prediction.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
 #include "common/check.h"
+#include "common/exact_float.h"
 
 #include <cmath>
 #include <string>
@@ -13,6 +14,9 @@
 namespace amc {
 
 namespace {
+
+// What a stored rotation costs in the encoder's estimate: log2 3, as it has always been rounded.
+constexpr double kRotationBits = 1.585;
 
 // A base triangle's rotation (0, 1, 2): "is it 0?", then "is it 1?".
 struct RotationModels {
@@ -64,8 +68,9 @@ ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& ba
     // Without rotations every node keeps its local vertex order: the input's exceptions.
     const DiagonalExceptions unrotated = diagonal_exceptions(input);
     const double rotated_bits = binary_entropy_bits(rotated.fewest(), rotated.leaves);
-    const double kept_bits =
-        binary_entropy_bits(unrotated.fewest(), unrotated.leaves) + 1.585 * double(base_code.triangle_order.size());
+    // Products rounded (exact_float.h): however it is compiled, the encoder makes the same choice.
+    const double kept_bits = binary_entropy_bits(unrotated.fewest(), unrotated.leaves) +
+                             rounded(kRotationBits * double(base_code.triangle_order.size()));
     if (kept_bits >= rotated_bits) return r;
     r.vertex_map.clear();
     r.hierarchy = reorder_base(input, base_code.vertex_order, base_code.triangle_order,

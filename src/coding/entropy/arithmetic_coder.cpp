@@ -1,6 +1,8 @@
 // LZMA-style binary range coder; see arithmetic_coder.h for the bitstream and the model.
 #include "coding/entropy/arithmetic_coder.h"
 
+#include "common/exact_float.h"
+
 #include <cmath>
 #include <string>
 #include <utility>
@@ -19,7 +21,7 @@ double binary_entropy_bits(uint64_t ones, uint64_t n) {
     const double dn = static_cast<double>(n);
     const double d1 = static_cast<double>(ones);
     const double d0 = dn - d1;
-    return d1 * std::log2(dn / d1) + d0 * std::log2(dn / d0);
+    return rounded(d1 * std::log2(dn / d1)) + rounded(d0 * std::log2(dn / d0));  // unfused: encoders decide by it
 }
 
 static void check_raw_count(int count, const char* where) {

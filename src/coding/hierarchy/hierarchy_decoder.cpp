@@ -146,9 +146,8 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder, uint64_t ma
     // Fast when the level can not code more symbols than are left: at most one a node, and none
     // for the nodes 1-regularity culls (the incomplete ones; this bound makes the second-finest
     // levels of a random refinement fast too). Then every context group has its model, and
-    // nothing is tested or masked per symbol. (Marked likely, GCC spills less in the traversal's
-    // loop: 1-1.5% fewer instructions on every model. Even moving group_mask's definition into
-    // the call below cost 2.5%: see HIERARCHY_CODER.md, Speed, item 29.)
+    // nothing is tested or masked per symbol. Marked likely and group_mask defined above: GCC's
+    // register allocation around this path is fragile (HIERARCHY_CODER.md, Speed, item 29).
     if (mixed_model_ != nullptr) {
         // The mixing mode (FORMAT.md 2.1): the features read this level's nodes in h_, built by
         // decode_level with their corners placed; node id = level_base_ + local index.

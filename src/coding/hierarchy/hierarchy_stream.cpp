@@ -75,13 +75,10 @@ size_t read_hierarchy_stream_header(const uint8_t* data, size_t size, HierarchyS
     size_t used = 3;
     header.symbol_count = 0;
     if (o.truncate_stream) {
-        for (int shift = 0;; shift += 7) {
-            AMC_REQUIRE(used < size, truncated, "hierarchy stream: symbol count is truncated");
-            AMC_REQUIRE(shift <= 56, corrupt, "hierarchy stream: symbol count is too long");
-            const uint8_t byte = data[used++];
-            header.symbol_count |= uint64_t(byte & 0x7f) << shift;
-            if (!(byte & 0x80)) break;
-        }
+        // At most 9 bytes (63 bits), as the format fixes it.
+        const VarintRead read = read_varint(data, size, used, header.symbol_count, 63);
+        AMC_REQUIRE(read != VarintRead::truncated, truncated, "hierarchy stream: symbol count is truncated");
+        AMC_REQUIRE(read != VarintRead::too_long, corrupt, "hierarchy stream: symbol count is too long");
     }
     return used;
 }
