@@ -60,6 +60,13 @@ expect 0 "$amc" info key4.amh
 expect 1 "$amc" decode key.amcs --frame 6 -o x.vtu
 grep -q 'frames 0..5' err.txt || fail "an absent frame is not named: $(head -c 200 err.txt)"
 expect 1 "$amc" series decode key.amcs --frame 1 --level 30 -o x.vtu
+# The nodes-per-byte bound: lowered below the frames' density it refuses, 0 lifts it.
+expect 1 "$amc" series info key.amcs --max-nodes-per-byte 1
+grep -q 'per byte' err.txt || fail "node bound: $(head -c 300 err.txt)"
+expect 1 "$amc" series decode key.amcs --frame 3 --max-nodes-per-byte 1 -o x.vtu
+expect 0 "$amc" series decode key.amcs --frame 3 --max-nodes-per-byte 0 -o bound0.vtu
+cmp -s bound0.vtu all_3.vtu || fail "frame 3 read without the node bound differs"
+expect 2 "$amc" series info key.amcs --max-nodes-per-byte -1
 
 # Usage errors (2).
 expect 0 "$amc" encode front_0.amh
@@ -104,6 +111,8 @@ expect 0 "$amc" series decode forests.amcs -o forests.pvd
 [[ -s forests_3.vtu && $(grep -c '<DataSet' forests.pvd) == 4 ]] || fail "forest series decode wrote no collection of 4 VTU files"
 expect 0 "$amc" series info forests.amcs
 grep -q '2D forests of 2 trees' out.txt || fail "series info does not describe the forests: $(head -c 300 out.txt)"
+expect 1 "$amc" series info forests.amcs --max-nodes-per-byte 1
+expect 0 "$amc" series info forests.amcs --max-nodes-per-byte 0
 expect 2 "$amc" series encode q0.amq q1.amq -o bounded.amcs --error-bound 0.1
 expect 2 "$amc" series encode q0.amq front_1.amh -o mixed.amcs
 head -c 200 forests.amcs > cutf.amcs

@@ -45,10 +45,12 @@ void add_max_nodes(CLI::App* command, uint64_t& max_nodes) {
         ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 32));
 }
 
-void add_octant_bound(CLI::App* command, int64_t& max_octants_per_byte) {
-    command->add_option("--max-octants-per-byte", max_octants_per_byte,
-                        "Refuse .amq files announcing more octants per byte after the metadata (default 4096; 0: no "
-                        "bound, for files whose writer did not pad, before 2026-12-02)")
+// The readers' bound on what a file may announce per byte it holds (0 lifts it, for files written
+// before 2026-12-02, whose writers did not pad).
+void add_per_byte_bound(CLI::App* command, const std::string& flag, const std::string& what, int64_t& bound) {
+    command->add_option(flag, bound,
+                        "Refuse files announcing more " + what + " per byte (default 4096; 0: no bound, for files "
+                        "whose writer did not pad, before 2026-12-02)")
         ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
 }
 
@@ -198,6 +200,8 @@ int main(int argc, char** argv) {
     series_decode_cmd->add_flag("--partial", series_decode.allow_unfinished,
                                 "Read the complete frames of a file whose writer has not finished");
     add_max_nodes(series_decode_cmd, series_decode.max_nodes);
+    add_per_byte_bound(series_decode_cmd, "--max-nodes-per-byte", "nodes (trees of a forest series)",
+                       series_decode.max_nodes_per_byte);
     SeriesInfoCommand series_info;
     auto* series_info_cmd = series->add_subcommand("info", "Frames of an .amcs file: times, sizes, meshes, fields");
     series_info_cmd->add_option("input", series_info.input, "Series file (.amcs), or - for stdin")->required();
@@ -206,6 +210,8 @@ int main(int argc, char** argv) {
     series_info_cmd->add_flag("--partial", series_info.allow_unfinished,
                               "Read the complete frames of a file whose writer has not finished");
     add_max_nodes(series_info_cmd, series_info.max_nodes);
+    add_per_byte_bound(series_info_cmd, "--max-nodes-per-byte", "nodes (trees of a forest series)",
+                       series_info.max_nodes_per_byte);
 
     std::vector<std::string> stats_inputs;
     bool stats_groups = false, stats_verify = false;
@@ -246,12 +252,12 @@ int main(int argc, char** argv) {
     octree_decode_cmd->add_option("--level", octree_decode.level, "Progressive: only the levels up to this one")
         ->check(CLI::Range(0, 29));
     add_max_nodes(octree_decode_cmd, octree_decode.max_nodes);
-    add_octant_bound(octree_decode_cmd, octree_decode.max_octants_per_byte);
+    add_per_byte_bound(octree_decode_cmd, "--max-octants-per-byte", "octants", octree_decode.max_octants_per_byte);
     OctreeInfoCommand octree_info;
     auto* octree_info_cmd = octree->add_subcommand("info", "Describe an .amq file (decodes it)");
     octree_info_cmd->add_option("input", octree_info.input, ".amq file, or - for stdin")->required();
     add_max_nodes(octree_info_cmd, octree_info.max_nodes);
-    add_octant_bound(octree_info_cmd, octree_info.max_octants_per_byte);
+    add_per_byte_bound(octree_info_cmd, "--max-octants-per-byte", "octants", octree_info.max_octants_per_byte);
 
     try {
         app.parse(argc, argv);

@@ -171,7 +171,7 @@ void run_decode(const DecodeCommand& command, const GlobalOptions& global) {
         if (!command.format.empty() || command.canonical || !command.map.empty())
             throw UsageError("--format, --canonical and --map do not apply to a series (.amcs)");
         progress.finish();
-        run_series_decode(input, {command.input, command.output, command.frame, command.level, false, command.max_nodes},
+        run_series_decode(input, {command.input, command.output, command.frame, command.level, false, command.max_nodes, -1},
                           global);
         return;
     }

@@ -98,6 +98,7 @@ struct SeriesDecodeCommand {
     int level = -1;         // the mesh of this level
     bool allow_unfinished = false;
     uint64_t max_nodes = 0;
+    int64_t max_nodes_per_byte = -1;  // -1: the reader's default; 0: no bound (unpadded files)
 };
 void run_series_decode(const InputFile& input, const SeriesDecodeCommand& command, const GlobalOptions& global);
 
@@ -106,6 +107,7 @@ struct SeriesInfoCommand {
     int64_t frame = -1;     // describe this frame's fields (default: frame 0's)
     bool allow_unfinished = false;
     uint64_t max_nodes = 0;
+    int64_t max_nodes_per_byte = -1;
 };
 void run_series_info(const InputFile& input, const SeriesInfoCommand& command, const GlobalOptions& global);
 

@@ -70,7 +70,7 @@ void run_info(const InfoCommand& command, const GlobalOptions& global) {
         case FileKind::hierarchy:
             print_hierarchy_summary(std::filesystem::path(input.name).filename().string(), hierarchy_of(input));
             break;
-        case FileKind::series: run_series_info(input, {command.input, -1, false, command.max_nodes}, global); break;
+        case FileKind::series: run_series_info(input, {command.input, -1, false, command.max_nodes, -1}, global); break;
         case FileKind::mesh: {
             const TriangleMesh mesh = mesh_of(input);
             std::printf("%s: %zu vertices, %zu triangles, %s precision\n", input.name.c_str(), mesh.positions.size(),

@@ -96,12 +96,18 @@ SeriesFrame read_frame(const FrameSource& source, std::optional<TriangleMesh>& b
     return frame;
 }
 
-SeriesReader open_series(const InputFile& input, bool allow_unfinished, uint64_t max_nodes) {
+template <class Command>
+SeriesReadOptions read_options(const Command& command) {
+    SeriesReadOptions options;
+    options.allow_unfinished = command.allow_unfinished;
+    if (command.max_nodes > 0) options.max_nodes = command.max_nodes;
+    if (command.max_nodes_per_byte >= 0) options.max_nodes_per_byte = uint64_t(command.max_nodes_per_byte);
+    return options;
+}
+
+SeriesReader open_series(const InputFile& input, const SeriesReadOptions& options) {
     if (input.kind != FileKind::series)
         throw Error(input.name + ": expected a series file (.amcs), found " + file_kind_name(input.kind));
-    SeriesReadOptions options;
-    options.allow_unfinished = allow_unfinished;
-    if (max_nodes > 0) options.max_nodes = max_nodes;
     return SeriesReader(std::vector<uint8_t>(input.bytes.begin(), input.bytes.end()), input.name, options);
 }
 
@@ -192,10 +198,7 @@ void encode_forest_series(const std::vector<FrameSource>& sources, const std::st
                          (unsigned long)stats[k].field_bytes, (unsigned long)stats[k].leaves, (unsigned long)stats[k].changed_octants);
 }
 
-ForestSeriesReader open_forest_series(const InputFile& input, bool allow_unfinished, uint64_t max_nodes) {
-    SeriesReadOptions options;
-    options.allow_unfinished = allow_unfinished;
-    if (max_nodes > 0) options.max_nodes = max_nodes;
+ForestSeriesReader open_forest_series(const InputFile& input, const SeriesReadOptions& options) {
     return ForestSeriesReader(std::vector<uint8_t>(input.bytes.begin(), input.bytes.end()), input.name, options);
 }
 
@@ -229,7 +232,7 @@ void decode_forest_series(const InputFile& input, const SeriesDecodeCommand& com
     if (output == "-" || !(is_pvd(output) || (one_frame && (ext == ".amq" || ext == ".vtu" || ext == ".p4est"))))
         throw UsageError(std::string("series decode of forests writes a collection (.pvd + one VTU a frame)") +
                          (one_frame ? " or the frame's forest (.amq .vtu .p4est)" : "") + ", not " + output);
-    ForestSeriesReader reader = open_forest_series(input, command.allow_unfinished, command.max_nodes);
+    ForestSeriesReader reader = open_forest_series(input, read_options(command));
     if (one_frame && uint64_t(command.frame) >= reader.frame_count())
         throw Error(input.name + ": frame " + std::to_string(command.frame) + " requested but the file has frames 0.." +
                     std::to_string(int64_t(reader.frame_count()) - 1));
@@ -256,7 +259,7 @@ void decode_forest_series(const InputFile& input, const SeriesDecodeCommand& com
 }
 
 void forest_series_info(const InputFile& input, const SeriesInfoCommand& command) {
-    ForestSeriesReader reader = open_forest_series(input, command.allow_unfinished, command.max_nodes);
+    ForestSeriesReader reader = open_forest_series(input, read_options(command));
     const TreeConnectivity& conn = reader.connectivity();
     size_t keyframes = 0;
     for (size_t k = 0; k < reader.frame_count(); ++k) keyframes += reader.info(k).keyframe;
@@ -406,7 +409,7 @@ void run_series_decode(const InputFile& input, const SeriesDecodeCommand& comman
                          output);
     Progress progress(global.verbosity > 0);
     progress.phase("reading " + input.name);
-    SeriesReader reader = open_series(input, command.allow_unfinished, command.max_nodes);
+    SeriesReader reader = open_series(input, read_options(command));
     if (one_frame && uint64_t(command.frame) >= reader.frame_count())
         throw Error(input.name + ": frame " + std::to_string(command.frame) + " requested but the file has frames 0.." +
                     std::to_string(int64_t(reader.frame_count()) - 1));
@@ -460,7 +463,7 @@ void run_series_decode(const InputFile& input, const SeriesDecodeCommand& comman
 void run_series_info(const InputFile& input, const SeriesInfoCommand& command, const GlobalOptions&) {
     if (input.kind == FileKind::series && is_forest_series(std::vector<uint8_t>(input.bytes.begin(), input.bytes.end())))
         return forest_series_info(input, command);
-    SeriesReader reader = open_series(input, command.allow_unfinished, command.max_nodes);
+    SeriesReader reader = open_series(input, read_options(command));
     const TriangleMesh& base = reader.base();
     size_t keyframes = 0;
     for (size_t k = 0; k < reader.frame_count(); ++k) keyframes += reader.info(k).keyframe;

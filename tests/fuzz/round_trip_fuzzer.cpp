@@ -3,6 +3,7 @@
 // numbering) and the encoder's options (quantization, predictor, the coder's 64 switch
 // combinations). The encoder either refuses it as invalid input or writes a file that decodes:
 // bit-exactly to the input in the decoder's order, or on the grid within the reported error.
+// Files of several chunks and the mixing contexts come up too.
 #include "fuzz_targets.h"
 
 #include "coding/hierarchy/coder_switches.h"
@@ -94,6 +95,9 @@ void round_trip(const uint8_t* data, size_t size) {
     options.quantize_bits = q < 160 ? 0 : 1 + q % 30;
     options.predictor = GeometryPredictor(in.u8() % 3);
     options.hierarchy = coder_options_from_switches(in.u8() % kCoderSwitchCombinations);
+    if (flags & 16) options.hierarchy_contexts = HierarchyContexts::mixed;
+    if (flags & 32) options.chunks = 2 + in.u8() % 7;
+    options.threads = 1 + (flags >> 6 & 1);
     LeafNumbering numbering;
     if (numbered) {
         const uint32_t faces = uint32_t(extract_leaf_mesh(h).mesh.triangles.size());
@@ -113,7 +117,9 @@ void round_trip(const uint8_t* data, size_t size) {
         return;
     }
     LeafNumbering decoded_numbering;
-    const Hierarchy decoded = decode(file.data(), file.size(), {}, &decoded_numbering);  // throws: a finding
+    DecodeOptions decode_options;
+    decode_options.threads = options.threads;
+    const Hierarchy decoded = decode(file.data(), file.size(), decode_options, &decoded_numbering);  // throws: a finding
     // The base order depends on the options (a stored numbering codes the base in mode 2 without
     // the encoder's search): the expectation takes the same options.
     const Hierarchy expected = in_decoder_order(h, options);
