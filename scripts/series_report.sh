@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The figures of docs/SERIES.md: bench/series_bench on the adaptive heat runs (L-shape, rotating
 # source) and the moving front, the same sequence with keyframes, and the speed on frames of about
-# 10^5 faces, each speed measured in several runs (ranges); then the forest series (forest_series_bench). Sizes are deterministic; times are CPU
+# 10^5 faces, each speed measured in several runs (ranges); the front's motion study
+# (series_motion_study); then the forest series (forest_series_bench). Sizes are deterministic; times are CPU
 # seconds. Needs a build with -DAMC_BUILD_BENCH=ON (scripts/install-deps.sh --bench: zstd, xz, zfp).
 #
 #   scripts/series_report.sh [BUILD_DIR] [RUNS] [ELEMENTS] > series_report.txt
@@ -19,8 +20,8 @@ echo
 run() { nice -n 19 "$bench" "$@"; echo; }
 # The comparison with the peers (zstd -19, xz -9, zfp) on the L-shape run: the costly part.
 run --scenario lshape --frames 100 --target "$elements" --repeat "$runs"
-# Speed on frames of about 10^5 faces.
-run --scenario lshape --frames 5 --target 100000 --max-level 12 --repeat "$runs" --speed-only 1
+# Speed on frames of about 10^5 faces (57,000-188,000, 134,000 on average).
+run --scenario lshape --frames 8 --target 140000 --max-level 12 --repeat "$runs" --speed-only 1
 # The other sequences, without the peers: sizes against independent .amc files, changed nodes,
 # and every frame's connectivity against the frame alone by share of nodes changed.
 run --scenario front --frames 100 --max-level 8 --repeat "$runs" --peers 0
@@ -36,6 +37,14 @@ run --scenario lshape --frames 100 --target "$elements" --keyframe 10 --repeat "
 # The inter-frame connectivity's context designs: H(X|ctx) and adaptive code lengths.
 designs="$build/bench/series_context_designs"
 [[ -x $designs ]] && { nice -n 19 "$designs" --scenario lshape --frames 100 --target "$elements"; echo; }
+# Motion-compensated prediction of the front's refinement (H(X|ctx) and adaptive code lengths per
+# prediction): the model's step, and the CFL-like steps with pixels fine enough for their motion.
+motion="$build/bench/series_motion_study"
+if [[ -x $motion ]]; then
+  nice -n 19 "$motion" --scenario front --frames 100 --max-level 8; echo
+  nice -n 19 "$motion" --scenario front-cfl --cfl 0.5 --frames 100 --max-level 8 --subpixels 2 --search 16; echo
+  nice -n 19 "$motion" --scenario front-cfl --cfl 2 --frames 100 --max-level 8 --search 16; echo
+fi
 # Forest series (issue 28): a p4est-like moving front in 2D and 3D against .amq and p4est_save files.
 forests="$build/bench/forest_series_bench"
 if [[ -x $forests ]]; then
