@@ -383,7 +383,7 @@ int main(int argc, char** argv) {
                 "--subpixels %d (the front advances %.3g pixels a step)\n",
                 scenario.c_str(), frames, max_level, cfl, block, search, subpixels, step / px);
     std::printf("# %zu frames, %.0f leaves a frame on average; %zu coded symbols in frames 1..; frames 1.. coded alone "
-                "(encode_hierarchy): %llu bytes (frame 0: %llu); 100 independent files / 5 = %.0f bytes\n",
+                "(encode_hierarchy): %llu bytes (frame 0: %llu); every frame alone / 5 = %.0f bytes\n",
                 seq.size(), double(faces) / double(seq.size()), symbols.size(), (unsigned long long)alone_total,
                 (unsigned long long)alone_first, double(alone_total + alone_first) / 5);
     std::printf("# motion vectors (blocks of %d px, %d blocks a frame, %.1f moving on average): Elias-gamma "
