@@ -43,6 +43,7 @@ motion="$build/bench/series_motion_study"
 if [[ -x $motion ]]; then
   nice -n 19 "$motion" --scenario front --frames 100 --max-level 8; echo
   nice -n 19 "$motion" --scenario front-cfl --cfl 0.5 --frames 100 --max-level 8 --subpixels 2 --search 16; echo
+  nice -n 19 "$motion" --scenario front-cfl --cfl 0.5 --frames 100 --max-level 8 --subpixels 4 --search 16 --block 128; echo
   nice -n 19 "$motion" --scenario front-cfl --cfl 2 --frames 100 --max-level 8 --search 16; echo
 fi
 # Forest series (issue 28): a p4est-like moving front in 2D and 3D against .amq and p4est_save files.
