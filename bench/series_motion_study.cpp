@@ -7,6 +7,8 @@
 //   - the previous frame displaced by the motion estimated between the two frames before it
 //     (frame k-1 against k-2: the decoder can do that itself, nothing sent);
 //   - the depth extrapolated linearly from the two previous frames (2 d(k-1) - d(k-2));
+//   - either block motion replaced by one affine map a frame fitted to its moving blocks' vectors
+//     (six numbers to send, or none for the extrapolated one);
 //   - for reference, the previous frame displaced by the front's own motion, exactly (an oracle:
 //     the best any motion model could do).
 // The previous frames are seen as depth images: the level of the leaf covering each pixel (a
@@ -167,6 +169,46 @@ double gamma_bits(int v) {
     return 2 * std::floor(std::log2(double(z) + 1)) + 1;
 }
 
+// An affine motion field v(p) = A p + t (pixels) fitted by least squares to the moving blocks'
+// vectors (at the blocks' centres): one map a frame, six numbers to send.
+struct Affine {
+    double a[3] = {0, 0, 0}, b[3] = {0, 0, 0};  // vx = a0 x + a1 y + a2, vy = b0 x + b1 y + b2
+};
+Affine fit_affine(const Motion& m) {
+    double n[3][3] = {}, rx[3] = {}, ry[3] = {};
+    int count = 0;
+    for (int by = 0; by < m.bh; ++by)
+        for (int bx = 0; bx < m.bw; ++bx) {
+            const size_t i = size_t(by) * size_t(m.bw) + size_t(bx);
+            if (m.vx.empty() || (m.vx[i] == 0 && m.vy[i] == 0)) continue;
+            const double f[3] = {(bx + 0.5) * m.block, (by + 0.5) * m.block, 1.0};
+            for (int r = 0; r < 3; ++r) {
+                for (int c = 0; c < 3; ++c) n[r][c] += f[r] * f[c];
+                rx[r] += f[r] * m.vx[i];
+                ry[r] += f[r] * m.vy[i];
+            }
+            ++count;
+        }
+    Affine out;
+    if (count < 3) return out;
+    // Cramer's rule on the 3 x 3 normal equations.
+    auto det = [](const double q[3][3]) {
+        return q[0][0] * (q[1][1] * q[2][2] - q[1][2] * q[2][1]) - q[0][1] * (q[1][0] * q[2][2] - q[1][2] * q[2][0]) +
+               q[0][2] * (q[1][0] * q[2][1] - q[1][1] * q[2][0]);
+    };
+    const double d = det(n);
+    if (std::fabs(d) < 1e-9) return out;
+    for (int c = 0; c < 3; ++c) {
+        double qx[3][3], qy[3][3];
+        for (int r = 0; r < 3; ++r)
+            for (int k = 0; k < 3; ++k) qx[r][k] = qy[r][k] = n[r][k];
+        for (int r = 0; r < 3; ++r) qx[r][c] = rx[r], qy[r][c] = ry[r];
+        out.a[c] = det(qx) / d;
+        out.b[c] = det(qy) / d;
+    }
+    return out;
+}
+
 struct Prediction {
     // relative depth codes at the centroid and min / max over the centroid and the three
     // corner midpoints: 0 outside, 1: depth - level <= -1, 2: 0, 3: 1, 4: >= 2.
@@ -176,7 +218,7 @@ struct Prediction {
 struct Symbol {
     uint16_t frame;
     uint8_t level, cls, border, dec_changed, dec_refined, parent_area, bit;
-    Prediction none, sent, extra, linear, oracle;
+    Prediction none, sent, extra, linear, oracle, fitted, fitted_extra;
 };
 
 uint8_t rel_code(int depth, int level) {
@@ -259,6 +301,8 @@ void collect(int frame, const Hierarchy& prev, const Hierarchy& h, const Lookup 
                 s.extra = predict(lookups[2], pos, s.level);
                 s.linear = predict(lookups[3], pos, s.level);
                 s.oracle = predict(lookups[4], pos, s.level);
+                s.fitted = predict(lookups[5], pos, s.level);
+                s.fitted_extra = predict(lookups[6], pos, s.level);
                 s.bit = refined;
                 out.push_back(s);
             }
@@ -337,7 +381,13 @@ int main(int argc, char** argv) {
             ix = int(std::floor((x - b.x0) / b.h));
             iy = int(std::floor((y - b.y0) / b.h));
         };
-        const Lookup lookups[5] = {
+        const Affine fitted = fit_affine(sent), fitted_extra = k >= 2 ? fit_affine(extra) : Affine{};
+        auto affine_lookup = [&](const Affine& f, double x, double y) {
+            const double fx = (x - b.x0) / b.h, fy = (y - b.y0) / b.h;
+            const double vx = f.a[0] * fx + f.a[1] * fy + f.a[2], vy = f.b[0] * fx + f.b[1] * fy + f.b[2];
+            return b.at(int(std::floor(fx - vx)), int(std::floor(fy - vy)));
+        };
+        const Lookup lookups[7] = {
             [&](double x, double y) { int ix, iy; pix(x, y, ix, iy); return b.at(ix, iy); },
             [&](double x, double y) {
                 int ix, iy;
@@ -370,6 +420,8 @@ int main(int argc, char** argv) {
                 pix(-0.3 + dx * f, -0.2 + dy * f, ix, iy);
                 return b.at(ix, iy);
             },
+            [&](double x, double y) { return affine_lookup(fitted, x, y); },
+            [&](double x, double y) { return affine_lookup(fitted_extra, x, y); },
         };
         collect(int(k), seq[k - 1], seq[k], lookups, symbols);
         const uint64_t alone = encode_hierarchy(seq[k]).size();
@@ -409,6 +461,8 @@ int main(int argc, char** argv) {
         {"extrapolated motion: depth c/min/max", [&](const Symbol& s) { return pcode(s.extra); }},
         {"extrapolated motion: c/min/max + decided nbrs refined", [&](const Symbol& s) { return pcode(s.extra) * 4 + s.dec_refined; }},
         {"extrapolated motion: c/min/max + v3", [&](const Symbol& s) { return pcode(s.extra) * 100 + v3(s); }},
+        {"affine fit of the sent vectors: c/min/max + v3", [&](const Symbol& s) { return pcode(s.fitted) * 100 + v3(s); }},
+        {"affine fit of the extrapolated vectors: c/min/max + v3", [&](const Symbol& s) { return pcode(s.fitted_extra) * 100 + v3(s); }},
         {"the front's exact motion: depth at centroid", [&](const Symbol& s) { return s.oracle.c; }},
         {"the front's exact motion: c/min/max", [&](const Symbol& s) { return pcode(s.oracle); }},
         {"the front's exact motion: c/min/max + decided nbrs refined", [&](const Symbol& s) { return pcode(s.oracle) * 4 + s.dec_refined; }},
