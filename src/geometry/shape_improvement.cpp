@@ -2,6 +2,7 @@
 // only when it improves the triangles it touches without moving them away from the surface.
 #include "geometry/shape_improvement.h"
 
+#include "common/no_index.h"
 #include "geometry/surface_quality.h"
 
 #include <algorithm>
@@ -12,7 +13,6 @@
 namespace amc {
 namespace {
 
-constexpr uint32_t kNone = 0xffffffffu;
 // Flips outside fold-overs only where the pair is nearly planar before and after (normals within
 // this angle): there the diagonal is a choice of shape, not of geometry.
 constexpr double kFlipBendDegrees = 30.0;
@@ -29,7 +29,7 @@ Vec3 unit(Vec3 v) {
 double cos_degrees(double degrees) { return std::cos(degrees * 3.14159265358979323846 / 180.0); }
 
 // Half-edge 3t+k runs from corner k to corner k+1 of triangle t; opposite[h] is the half-edge of
-// the other triangle on that edge, or kNone on the boundary.
+// the other triangle on that edge, or kNoIndex on the boundary.
 std::vector<uint32_t> opposite_halfedges(const TriangleMesh& mesh) {
     std::vector<std::pair<uint64_t, uint32_t>> edges;
     edges.reserve(3 * mesh.triangles.size());
@@ -41,7 +41,7 @@ std::vector<uint32_t> opposite_halfedges(const TriangleMesh& mesh) {
         }
     }
     std::sort(edges.begin(), edges.end());
-    std::vector<uint32_t> opposite(edges.size(), kNone);
+    std::vector<uint32_t> opposite(edges.size(), kNoIndex);
     for (size_t i = 0; i + 1 < edges.size(); ++i) {
         if (edges[i].first != edges[i + 1].first) continue;
         opposite[edges[i].second] = edges[i + 1].second;
@@ -126,7 +126,7 @@ uint32_t Improver::flip_pass() {
     uint32_t flips = 0;
     for (uint32_t h = 0; h < opposite.size(); ++h) {
         const uint32_t g = opposite[h];
-        if (g == kNone || g < h) continue;
+        if (g == kNoIndex || g < h) continue;
         const uint32_t t1 = h / 3, t2 = g / 3;
         if (touched[t1] || touched[t2]) continue;
         const Triangle old1 = mesh_.triangles[t1], old2 = mesh_.triangles[t2];
@@ -147,7 +147,7 @@ uint32_t Improver::flip_pass() {
                                    opposite[3 * t2 + (g % 3 + 2) % 3], opposite[3 * t1 + (h % 3 + 1) % 3]};
         bool blocked = false;
         for (int i = 0; i < 4 && !blocked; ++i) {
-            if (outer[i] == kNone) continue;
+            if (outer[i] == kNoIndex) continue;
             const uint32_t t = outer[i] / 3;
             blocked = touched[t] || is_fold_over(i < 2 ? n_new1 : n_new2, normal(mesh_.triangles[t]));
         }
@@ -194,7 +194,7 @@ uint32_t Improver::relaxation_pass(const std::vector<uint8_t>& fixed) {
             const Vec3 n = normal(mesh_.triangles[t]);
             for (int k = 0; k < 3; ++k) {
                 const uint32_t g = opposite[3 * t + k];
-                folds += g != kNone && is_fold_over(n, normal(mesh_.triangles[g / 3]));
+                folds += g != kNoIndex && is_fold_over(n, normal(mesh_.triangles[g / 3]));
             }
             worst = std::min(worst, quality(mesh_.triangles[t]));
         }
@@ -262,7 +262,7 @@ uint32_t unfold(TriangleMesh& mesh, double min_quality, int rounds) {
     }
     std::vector<uint8_t> on_boundary(n, 0);  // boundary vertices stay: they keep the boundary's shape
     for (uint32_t h = 0; h < opposite.size(); ++h) {
-        if (opposite[h] != kNone) continue;
+        if (opposite[h] != kNoIndex) continue;
         on_boundary[mesh.triangles[h / 3][h % 3]] = 1;
         on_boundary[mesh.triangles[h / 3][(h % 3 + 1) % 3]] = 1;
     }
@@ -271,7 +271,7 @@ uint32_t unfold(TriangleMesh& mesh, double min_quality, int rounds) {
         return cross(mesh.positions[c[1]] - mesh.positions[c[0]], mesh.positions[c[2]] - mesh.positions[c[0]]);
     };
     auto folds_at = [&](uint32_t h) {
-        return opposite[h] != kNone && is_fold_over(normal(h / 3), normal(opposite[h] / 3));
+        return opposite[h] != kNoIndex && is_fold_over(normal(h / 3), normal(opposite[h] / 3));
     };
     // Fold-overs on the edges of the triangles around v, and their worst quality.
     auto state_around = [&](uint32_t v, int& folds, double& worst) {
@@ -288,12 +288,12 @@ uint32_t unfold(TriangleMesh& mesh, double min_quality, int rounds) {
     for (int round = 0; round < rounds; ++round) {
         std::vector<uint32_t> candidates;
         for (uint32_t h = 0; h < opposite.size(); ++h) {
-            if (opposite[h] == kNone || opposite[h] < h || !folds_at(h)) continue;
+            if (opposite[h] == kNoIndex || opposite[h] < h || !folds_at(h)) continue;
             for (uint32_t e : {h, opposite[h]})
                 for (int k = 0; k < 3; ++k) candidates.push_back(mesh.triangles[e / 3][k]);
         }
         left = 0;
-        for (uint32_t h = 0; h < opposite.size(); ++h) left += opposite[h] != kNone && opposite[h] > h && folds_at(h);
+        for (uint32_t h = 0; h < opposite.size(); ++h) left += opposite[h] != kNoIndex && opposite[h] > h && folds_at(h);
         if (left == 0) return 0;
         std::sort(candidates.begin(), candidates.end());
         candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
@@ -331,7 +331,7 @@ uint32_t unfold(TriangleMesh& mesh, double min_quality, int rounds) {
         if (moves == 0) break;
     }
     left = 0;
-    for (uint32_t h = 0; h < opposite.size(); ++h) left += opposite[h] != kNone && opposite[h] > h && folds_at(h);
+    for (uint32_t h = 0; h < opposite.size(); ++h) left += opposite[h] != kNoIndex && opposite[h] > h && folds_at(h);
     return left;
 }
 
@@ -345,7 +345,7 @@ std::vector<uint8_t> sharp_vertices(const TriangleMesh& mesh, double degrees) {
     };
     for (uint32_t h = 0; h < opposite.size(); ++h) {
         const uint32_t g = opposite[h];
-        if (g == kNone || dot(normal_of(h / 3), normal_of(g / 3)) >= limit) continue;
+        if (g == kNoIndex || dot(normal_of(h / 3), normal_of(g / 3)) >= limit) continue;
         sharp[mesh.triangles[h / 3][h % 3]] = 1;
         sharp[mesh.triangles[h / 3][(h % 3 + 1) % 3]] = 1;
     }
@@ -363,7 +363,7 @@ ShapeImprovementStats improve_shapes(TriangleMesh& mesh, const ReferenceSurface&
     {
         const std::vector<uint32_t> opposite = opposite_halfedges(mesh);
         for (uint32_t h = 0; h < opposite.size(); ++h) {
-            if (opposite[h] != kNone) continue;
+            if (opposite[h] != kNoIndex) continue;
             fixed[mesh.triangles[h / 3][h % 3]] = 1;
             fixed[mesh.triangles[h / 3][(h % 3 + 1) % 3]] = 1;
         }

@@ -1,6 +1,7 @@
 // Placing the remesher's new vertices on the reference, and correcting them on the leaf mesh.
 #include "hierarchy/vertex_placement.h"
 
+#include "common/no_index.h"
 #include "geometry/surface_quality.h"
 
 #include <algorithm>
@@ -44,8 +45,7 @@ bool admissible(const std::vector<std::array<Vec3, 3>>& halves, Vec3 p, bool fol
 }
 
 // Interior edges of a triangle list as pairs of triangle indices, through neighbour links:
-// neighbors[3t + k] is the triangle across edge k of t (corner k to k+1), or kNone.
-constexpr uint32_t kNone = 0xffffffffu;
+// neighbors[3t + k] is the triangle across edge k of t (corner k to k+1), or kNoIndex.
 std::vector<uint32_t> triangle_neighbors(const std::vector<Triangle>& triangles) {
     std::vector<std::pair<uint64_t, uint32_t>> edges;
     edges.reserve(3 * triangles.size());
@@ -57,7 +57,7 @@ std::vector<uint32_t> triangle_neighbors(const std::vector<Triangle>& triangles)
         }
     }
     std::sort(edges.begin(), edges.end());
-    std::vector<uint32_t> neighbors(3 * triangles.size(), kNone);
+    std::vector<uint32_t> neighbors(3 * triangles.size(), kNoIndex);
     for (size_t i = 0; i + 1 < edges.size(); ++i) {
         if (edges[i].first != edges[i + 1].first) continue;
         neighbors[edges[i].second] = edges[i + 1].second / 3;
@@ -96,7 +96,7 @@ private:
         const Vec3 n = normal(t);
         for (int k = 0; k < 3; ++k) {
             const uint32_t g = neighbors_[3 * t + k];
-            if (g != kNone && is_fold_over(n, normal(g)) && !inherited_fold(t, g)) return true;
+            if (g != kNoIndex && is_fold_over(n, normal(g)) && !inherited_fold(t, g)) return true;
         }
         return false;
     }
@@ -142,9 +142,9 @@ private:
     const ReferenceSurface& surface_;
     const LeafMesh leaf_;
     std::vector<VertexId> id_of_;           // hierarchy vertex of every leaf-mesh vertex
-    std::vector<uint32_t> leaf_index_;      // and back (kNone for dead ids)
+    std::vector<uint32_t> leaf_index_;      // and back (kNoIndex for dead ids)
     std::vector<double> bound_;             // quality bound of every leaf triangle
-    std::vector<uint32_t> neighbors_;       // 3 per triangle, kNone on the boundary
+    std::vector<uint32_t> neighbors_;       // 3 per triangle, kNoIndex on the boundary
     std::vector<uint32_t> start_, around_;  // triangles around every leaf vertex
     std::vector<Vec3> flat_;                // every leaf vertex in the flat subdivision of the base
     std::unordered_map<Vec3, uint32_t, PositionHash> count_at_;
@@ -155,7 +155,7 @@ LeafCorrection::LeafCorrection(Hierarchy& h, Placements& placements, const Refer
     : h_(h), placements_(placements), surface_(surface), leaf_(extract_leaf_mesh(h)) {
     const std::vector<uint32_t> canonical = canonical_vertex_order(h);
     id_of_.assign(leaf_.mesh.positions.size(), kNoVertex);
-    leaf_index_.assign(h.positions().size(), kNone);
+    leaf_index_.assign(h.positions().size(), kNoIndex);
     for (VertexId v = 0; v < canonical.size(); ++v) {
         if (canonical[v] == kNoVertex || canonical[v] >= id_of_.size()) continue;
         id_of_[canonical[v]] = v;
@@ -209,7 +209,7 @@ CorrectionResult LeafCorrection::run() {
             const uint32_t t = around_[i];
             push(t);
             for (int k = 0; k < 3; ++k)
-                if (neighbors_[3 * t + k] != kNone) push(neighbors_[3 * t + k]);
+                if (neighbors_[3 * t + k] != kNoIndex) push(neighbors_[3 * t + k]);
         }
     };
     // The bad triangles among those queued (the queue empties).
@@ -252,7 +252,7 @@ CorrectionResult LeafCorrection::run() {
             queued[t] = 0;
             if (!needs_work(t)) continue;
             const uint32_t v = step_one_corner(t);
-            if (v != kNone) {
+            if (v != kNoIndex) {
                 ++result.steps;
                 moved[id_of_[v]] = 1;
                 push_around(v);
@@ -270,7 +270,7 @@ CorrectionResult LeafCorrection::run() {
         const Vec3 n = normal(t);
         for (int k = 0; k < 3; ++k) {
             const uint32_t g = neighbors_[3 * t + k];
-            result.inherited_fold_overs += g != kNone && g > t && is_fold_over(n, normal(g)) && inherited_fold(t, g);
+            result.inherited_fold_overs += g != kNoIndex && g > t && is_fold_over(n, normal(g)) && inherited_fold(t, g);
         }
     }
     for (uint8_t m : moved) result.moved += m;
@@ -330,9 +330,9 @@ bool LeafCorrection::slide(uint32_t v) {
     return true;
 }
 
-// Steps one corner of triangle t back; returns the leaf vertex moved, or kNone if none can move.
+// Steps one corner of triangle t back; returns the leaf vertex moved, or kNoIndex if none can move.
 uint32_t LeafCorrection::step_one_corner(uint32_t t) {
-    uint32_t best_vertex = kNone;
+    uint32_t best_vertex = kNoIndex;
     int best_step = 0, best_change = 0;
     double best_distance = 0;
     for (uint32_t v : leaf_.mesh.triangles[t]) {
@@ -345,7 +345,7 @@ uint32_t LeafCorrection::step_one_corner(uint32_t t) {
             move(v, p);
             const int change = badness_around(v) - before;
             const double distance = length(p - old);
-            const bool better = best_vertex == kNone || (change < 0 && best_change >= 0) ||
+            const bool better = best_vertex == kNoIndex || (change < 0 && best_change >= 0) ||
                                 ((change < 0) == (best_change < 0) && distance < best_distance);
             if (better) {
                 best_vertex = v;
@@ -356,7 +356,7 @@ uint32_t LeafCorrection::step_one_corner(uint32_t t) {
         }
         move(v, old);
     }
-    if (best_vertex == kNone) return kNone;
+    if (best_vertex == kNoIndex) return kNoIndex;
     const VertexId id = id_of_[best_vertex];
     placements_.step[id] = uint8_t(best_step);
     stepped_.insert(id);
@@ -386,7 +386,7 @@ bool LeafCorrection::flatten(NodeId node, std::vector<uint8_t>& moved) {
 std::vector<uint32_t> LeafCorrection::follow_stepped() {
     std::vector<uint32_t> changed;
     for (VertexId id : stepped_) {
-        if (leaf_index_[id] == kNone) continue;
+        if (leaf_index_[id] == kNoIndex) continue;
         const Vec3 p = stepped_position(id, placements_.step[id]);
         if (p == h_.position(id)) continue;
         move(leaf_index_[id], p);
@@ -497,7 +497,7 @@ std::vector<NodeId> leaves_with_fold_overs(const Hierarchy& h) {
     for (uint32_t t = 0; t < leaf.mesh.triangles.size(); ++t) {
         for (int k = 0; k < 3; ++k) {
             const uint32_t g = neighbors[3 * t + k];
-            if (g != kNone && is_fold_over(normal(t), normal(g))) nodes.push_back(leaf.source[t]);
+            if (g != kNoIndex && is_fold_over(normal(t), normal(g))) nodes.push_back(leaf.source[t]);
         }
     }
     std::sort(nodes.begin(), nodes.end());

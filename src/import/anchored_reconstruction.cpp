@@ -1,5 +1,6 @@
 #include "import/anchored_reconstruction.h"
 
+#include "common/no_index.h"
 #include "import/base_detection.h"
 #include "import/hierarchy_from_levels.h"
 #include "import/inverse_refinement.h"
@@ -54,7 +55,7 @@ std::vector<uint32_t> reconstruct_anchored(Hierarchy& h, const std::vector<uint3
     detected.leaf_vertex_of_base = leaf_of_base;
     ImportedHierarchy built = hierarchy_from_levels(leaf, detected, what);
     h = std::move(built.hierarchy);
-    std::vector<uint32_t> leaf_of_vertex(h.positions().size(), 0xffffffffu);
+    std::vector<uint32_t> leaf_of_vertex(h.positions().size(), kNoIndex);
     for (uint32_t l = 0; l < built.vertex_of_input.size(); ++l) leaf_of_vertex[built.vertex_of_input[l]] = l;
     return leaf_of_vertex;
 }

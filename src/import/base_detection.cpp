@@ -1,5 +1,6 @@
 #include "import/base_detection.h"
 
+#include "common/no_index.h"
 #include "import/inverse_refinement.h"
 
 #include <utility>
@@ -10,7 +11,7 @@ namespace {
 // The base mesh over the used vertices of `triangles`, numbered in the order of their input ids.
 void set_base(const TriangleMesh& mesh, const std::vector<Triangle>& triangles, DetectedBase& out) {
     const uint32_t vertex_count = uint32_t(mesh.positions.size());
-    std::vector<uint32_t> base_index(vertex_count, 0xffffffffu);
+    std::vector<uint32_t> base_index(vertex_count, kNoIndex);
     for (const Triangle& t : triangles) {
         for (uint32_t v : t) base_index[v] = 0;
     }

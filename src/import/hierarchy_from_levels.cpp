@@ -1,5 +1,7 @@
 #include "import/hierarchy_from_levels.h"
 
+#include "common/no_index.h"
+
 #include <algorithm>
 #include <unordered_map>
 #include <unordered_set>
@@ -7,7 +9,6 @@
 namespace amc {
 namespace {
 
-constexpr uint32_t kUnset = 0xffffffffu;
 
 // A triangle's vertex set as a key (the three ids sorted, 21 bits each would not do for large
 // meshes, so two words).
@@ -64,8 +65,8 @@ ImportedHierarchy hierarchy_from_levels(const TriangleMesh& mesh, const Detected
             for (int e = 0; e < 3; ++e) {
                 const VertexId v = h.midpoint(n, e);
                 const uint32_t m = s[size_t(3 + (e - r + 3) % 3)];  // node edge e is split edge e - r
-                if (v >= input_of.size()) input_of.resize(size_t(v) + 1, kUnset);
-                if (input_of[v] == kUnset) {
+                if (v >= input_of.size()) input_of.resize(size_t(v) + 1, kNoIndex);
+                if (input_of[v] == kNoIndex) {
                     input_of[v] = m;
                     h.set_position(v, mesh.positions[m]);
                 } else if (input_of[v] != m) {
@@ -92,20 +93,20 @@ ImportedHierarchy hierarchy_from_levels(const TriangleMesh& mesh, const Detected
     }
 
     // The check: every input vertex used once, the same triangles, a valid hierarchy.
-    out.vertex_of_input.assign(mesh.positions.size(), kUnset);
+    out.vertex_of_input.assign(mesh.positions.size(), kNoIndex);
     for (VertexId v = 0; v < input_of.size(); ++v) {
-        if (input_of[v] == kUnset) continue;
-        if (out.vertex_of_input[input_of[v]] != kUnset) fail("an input vertex is used twice");
+        if (input_of[v] == kNoIndex) continue;
+        if (out.vertex_of_input[input_of[v]] != kNoIndex) fail("an input vertex is used twice");
         out.vertex_of_input[input_of[v]] = v;
     }
-    if (std::count(out.vertex_of_input.begin(), out.vertex_of_input.end(), kUnset) != 0) {
+    if (std::count(out.vertex_of_input.begin(), out.vertex_of_input.end(), kNoIndex) != 0) {
         fail("an input vertex is missing from the hierarchy");
     }
     const std::string problem = check_invariants(h);
     if (!problem.empty()) fail(problem);
     const LeafMesh leaf = extract_leaf_mesh(h);
     const std::vector<uint32_t> canonical = canonical_vertex_order(h);
-    std::vector<uint32_t> input_of_canonical(leaf.mesh.positions.size(), kUnset);
+    std::vector<uint32_t> input_of_canonical(leaf.mesh.positions.size(), kNoIndex);
     for (VertexId v = 0; v < canonical.size(); ++v) {
         if (canonical[v] < input_of_canonical.size()) input_of_canonical[canonical[v]] = input_of[v];
     }

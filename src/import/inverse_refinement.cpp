@@ -21,6 +21,7 @@
 // each becomes is red_split.h's business (the hierarchy is built from the splits' points).
 #include "import/inverse_refinement.h"
 
+#include "common/no_index.h"
 #include "import/triangle_adjacency.h"
 
 #include <algorithm>
@@ -30,7 +31,6 @@
 namespace amc::detail {
 namespace {
 
-constexpr uint32_t kNone = 0xffffffffu;
 
 struct Block {
     uint32_t center;
@@ -39,7 +39,7 @@ struct Block {
     std::array<uint32_t, 3> first_half;   // half-edge v_i -> m_i (in corner i)
     std::array<uint32_t, 3> second_half;  // half-edge m_i -> v_{i+1} (in corner i+1)
     bool alive;
-    uint32_t patch;  // the committed patch it belongs to, or kNone while growing
+    uint32_t patch;  // the committed patch it belongs to, or kNoIndex while growing
 };
 
 // The triangles around midpoint m_i outside its block, walked from v_{i+1} to v_i.
@@ -80,7 +80,7 @@ public:
                 const std::vector<uint8_t>* kept)
         : tri_(fine), refined_(refined), adjacency_(fine, vertex_count), forced_old_(vertex_count, 0),
           midpoint_count_(vertex_count, 0), corner_count_(vertex_count, 0),
-          midpoint_block_(vertex_count, {kNone, kNone}), block_of_(fine.size(), kNone), closure_of_(fine.size(), kNone),
+          midpoint_block_(vertex_count, {kNoIndex, kNoIndex}), block_of_(fine.size(), kNoIndex), closure_of_(fine.size(), kNoIndex),
           pinned_old_(vertex_count, 0), covered_(fine.size(), 0),
           banned_(fine.size(), 0), repair_banned_(fine.size(), 0), deferred_(fine.size(), 0) {
         // A midpoint has its block's three triangles on one side and the boundary, another block
@@ -128,13 +128,13 @@ public:
     // Whether triangle t is the center or a corner of a block that could be placed (its shape
     // and stars allow it), whatever its patch.
     bool could_be_in_block(uint32_t t) {
-        uint32_t centers[4] = {t, kNone, kNone, kNone};
+        uint32_t centers[4] = {t, kNoIndex, kNoIndex, kNoIndex};
         for (int e = 0; e < 3; ++e) {
             const uint32_t h = adjacency_.twin(3 * t + uint32_t(e));
             if (h != kNoHalfEdge) centers[e + 1] = h / 3;
         }
         for (uint32_t c : centers) {
-            if (c == kNone) continue;
+            if (c == kNoIndex) continue;
             const uint32_t start = uint32_t(blocks_.size());
             if (!place_block(c)) continue;
             roll_back(start);
@@ -167,7 +167,7 @@ public:
     // `parent_of_block` (if given) receives, per block, the index of its parent in the result.
     CoarserLevel coarser_level(std::vector<uint32_t>* parent_of_block = nullptr) const {
         CoarserLevel out;
-        if (parent_of_block) parent_of_block->assign(blocks_.size(), kNone);
+        if (parent_of_block) parent_of_block->assign(blocks_.size(), kNoIndex);
         std::vector<uint8_t> merged(tri_.size(), 0);
         for (uint32_t index = 0; index < blocks_.size(); ++index) {
             const Block& b = blocks_[index];
@@ -212,13 +212,13 @@ private:
     }
     bool is_new(uint32_t v) const { return midpoint_count_[v] != 0; }
     bool is_old(uint32_t v) const { return forced_old_[v] || corner_count_[v] != 0 || pinned_old_[v] != 0; }
-    bool taken(uint32_t t) const { return block_of_[t] != kNone || closure_of_[t] != kNone; }
+    bool taken(uint32_t t) const { return block_of_[t] != kNoIndex || closure_of_[t] != kNoIndex; }
 
     // The block whose center is t, read off the mesh (no labels consulted), or false.
     bool read_block(uint32_t t, Block& b) const {
         b.center = t;
         b.alive = false;
-        b.patch = kNone;
+        b.patch = kNoIndex;
         for (int k = 0; k < 3; ++k) {
             // Corner k shares center edge (k+1)%3; its half-edge there runs m_k -> m_{k+2}.
             const uint32_t h = adjacency_.twin(3 * t + uint32_t(k + 1) % 3);
@@ -334,13 +334,13 @@ private:
     void release(uint32_t index) {
         Block& b = blocks_[index];
         b.alive = false;
-        block_of_[b.center] = kNone;
+        block_of_[b.center] = kNoIndex;
         for (int k = 0; k < 3; ++k) {
-            block_of_[b.corner[size_t(k)]] = kNone;
+            block_of_[b.corner[size_t(k)]] = kNoIndex;
             const uint32_t m = b.m[size_t(k)];
             auto& slots = midpoint_block_[m];
             if (slots[0] / 3 == index) slots[0] = slots[1];
-            slots[1] = kNone;
+            slots[1] = kNoIndex;
             --midpoint_count_[m];
             --corner_count_[b.v[size_t(k)]];
         }
@@ -368,10 +368,10 @@ private:
         uint32_t around[3];
         for (int k = 0; k < 3; ++k) {
             h = ccw ? turn_ccw(h) : turn_cw(h);
-            if (h == kNoHalfEdge) return kNone;
+            if (h == kNoHalfEdge) return kNoIndex;
             around[k] = h;
         }
-        return vertex_at(around[2], ccw ? 2 : 1) == last ? around[1] / 3 : kNone;
+        return vertex_at(around[2], ccw ? 2 : 1) == last ? around[1] / 3 : kNoIndex;
     }
 
     // Whether the block centered at t could be placed with midpoint v on its edge from -> to.
@@ -387,10 +387,10 @@ private:
     // The fan across side i of block x may be a closure of two hanging nodes: the hanging node m
     // and an inner vertex p of the fan, which then needs a block on its far side with the right
     // coarse edge. Returns the center of such a block when it can be read off the mesh and fits
-    // the labels, else kNone. Names as in docs/HIERARCHY.md: closure of (A, B, C), unrefined edge
+    // the labels, else kNoIndex. Names as in docs/HIERARCHY.md: closure of (A, B, C), unrefined edge
     // A -> B, hanging nodes m1 on B -> C and m2 on C -> A.
     uint32_t closure_partner(const Block& x, int i, const Fan& fan) const {
-        if (fan.kind != Fan::triangles) return kNone;
+        if (fan.kind != Fan::triangles) return kNoIndex;
         const uint32_t a = x.v[size_t(i)], b = x.v[size_t(i + 1) % 3];
         if (fan.size == 3) {
             const uint32_t p1 = fan.inner[0], p2 = fan.inner[1];
@@ -398,25 +398,25 @@ private:
             // has edge A -> C; its triangles around p2 run from a to p1, away from the fan.
             if (!is_new(p1) && !is_new(p2) && !is_old(p2) && adjacency_.star_size(p2) == 5) {
                 const uint32_t z = middle_of_three(fan.entry[2], true, p1);
-                if (z != kNone && partner_fits(z, p2, p1, a)) return z;
+                if (z != kNoIndex && partner_fits(z, p2, p1, a)) return z;
             }
             // Flipped diagonal seen from m2: p1 = m1 on edge B=p2 -> C=b, p2 = B (old), whose
             // block has edge C -> B; its triangles around p1 run from b to p2.
             if (!is_new(p1) && !is_old(p1) && !is_new(p2) && adjacency_.star_size(p1) == 5) {
                 const uint32_t z = middle_of_three(next_half_edge(fan.entry[0], 2), false, p2);
-                if (z != kNone && partner_fits(z, p1, b, p2)) return z;
+                if (z != kNoIndex && partner_fits(z, p1, b, p2)) return z;
             }
-            return kNone;
+            return kNoIndex;
         }
         const uint32_t p = fan.inner[0];
-        if (is_new(p) || is_old(p) || adjacency_.star_size(p) != 6) return kNone;
+        if (is_new(p) || is_old(p) || adjacency_.star_size(p) != 6) return kNoIndex;
         // Flipped diagonal seen from m1 (B=b, C=a): p = m2 on edge a -> A, the third triangle
         // (A, b, p) lies across edge p -> b of the first fan triangle; p's block has edge A -> a.
         uint32_t h = adjacency_.twin(next_half_edge(fan.entry[0], 2));
         if (h != kNoHalfEdge) {
             const uint32_t apex = vertex_at(h, 2);
             const uint32_t z = middle_of_three(fan.entry[1], true, apex);
-            if (z != kNone && partner_fits(z, p, apex, a)) return z;
+            if (z != kNoIndex && partner_fits(z, p, apex, a)) return z;
         }
         // Default diagonal seen from m2 (A=a, C=b): p = m1 on edge B -> b, the third triangle
         // (a, B, p) lies across edge a -> p of the second fan triangle; p's block has edge b -> B.
@@ -424,14 +424,14 @@ private:
         if (h != kNoHalfEdge) {
             const uint32_t apex = vertex_at(h, 2);
             const uint32_t z = middle_of_three(next_half_edge(fan.entry[0], 2), false, apex);
-            if (z != kNone && partner_fits(z, p, b, apex)) return z;
+            if (z != kNoIndex && partner_fits(z, p, b, apex)) return z;
         }
-        return kNone;
+        return kNoIndex;
     }
 
     // ---- sides -------------------------------------------------------------------------------
     // The midpoint role of v: block index * 3 + edge, when v is the midpoint of exactly one block.
-    uint32_t only_midpoint_role(uint32_t v) const { return midpoint_count_[v] == 1 ? midpoint_block_[v][0] : kNone; }
+    uint32_t only_midpoint_role(uint32_t v) const { return midpoint_count_[v] == 1 ? midpoint_block_[v][0] : kNoIndex; }
     std::pair<uint32_t, uint32_t> coarse_edge(uint32_t role) const {
         const Block& z = blocks_[role / 3];
         const int e = int(role % 3);
@@ -449,13 +449,13 @@ private:
         }
         if (fan.kind != Fan::triangles) return side;
         const uint32_t other = block_of_[fan.triangle[0]];
-        if (other != kNone || block_of_[fan.triangle[1]] != kNone || (fan.size == 3 && block_of_[fan.triangle[2]] != kNone)) {
+        if (other != kNoIndex || block_of_[fan.triangle[1]] != kNoIndex || (fan.size == 3 && block_of_[fan.triangle[2]] != kNoIndex)) {
             if (fan.size == 3 && other != index && block_of_[fan.triangle[1]] == other && block_of_[fan.triangle[2]] == other)
                 side.kind = Side::red;
             return side;
         }
         for (int k = 0; k < fan.size; ++k) {
-            if (closure_of_[fan.triangle[k]] != kNone && closure_of_[fan.triangle[k]] != b.patch) return side;
+            if (closure_of_[fan.triangle[k]] != kNoIndex && closure_of_[fan.triangle[k]] != b.patch) return side;
         }
         const uint32_t a = b.v[size_t(i)], bb = b.v[size_t(i + 1) % 3];
         side.count = fan.size;
@@ -467,7 +467,7 @@ private:
                 side.emits = true;
             } else {
                 const uint32_t role = only_midpoint_role(p);
-                if (role == kNone) return side;
+                if (role == kNoIndex) return side;
                 const auto [s, t] = coarse_edge(role);
                 uint32_t across, apex;
                 if (t == a) {
@@ -486,8 +486,8 @@ private:
                 } else {
                     return side;
                 }
-                if (across == kNoHalfEdge || vertex_at(across, 2) != apex || block_of_[across / 3] != kNone ||
-                    (closure_of_[across / 3] != kNone && closure_of_[across / 3] != b.patch))
+                if (across == kNoHalfEdge || vertex_at(across, 2) != apex || block_of_[across / 3] != kNoIndex ||
+                    (closure_of_[across / 3] != kNoIndex && closure_of_[across / 3] != b.patch))
                     return side;
                 side.group[2] = across / 3;
                 side.count = 3;
@@ -497,13 +497,13 @@ private:
             if (!is_new(p1) && is_new(p2)) {
                 // m is m1 of a default closure (A=p1, B=b, C=a); p2 is m2 on edge C -> A.
                 const uint32_t role = only_midpoint_role(p2);
-                if (role == kNone || coarse_edge(role) != std::make_pair(p1, a)) return side;
+                if (role == kNoIndex || coarse_edge(role) != std::make_pair(p1, a)) return side;
                 side.coarse = {p1, bb, a};
                 side.emits = true;
             } else if (is_new(p1) && !is_new(p2)) {
                 // m is m2 of a flipped closure (A=a, B=p2, C=b); p1 is m1 on edge B -> C.
                 const uint32_t role = only_midpoint_role(p1);
-                if (role == kNone || coarse_edge(role) != std::make_pair(bb, p2)) return side;
+                if (role == kNoIndex || coarse_edge(role) != std::make_pair(bb, p2)) return side;
                 side.coarse = {a, p2, bb};
             } else {
                 return side;
@@ -537,7 +537,7 @@ private:
             const Side side = classify(index, i);
             if (side.kind == Side::invalid) return false;
             red_neighbor[i] = side.kind == Side::red ? block_of_[adjacency_.twin(blocks_[index].second_half[size_t(i)]) / 3]
-                                                     : kNone - uint32_t(i);
+                                                     : kNoIndex - uint32_t(i);
         }
         // Two blocks glued along all three edges would make two coincident coarse triangles.
         return !(red_neighbor[0] == red_neighbor[1] && red_neighbor[1] == red_neighbor[2]);
@@ -588,7 +588,7 @@ private:
                 if (fan.kind != Fan::triangles) continue;
                 for (int k = 0; k < fan.size; ++k) {
                     const uint32_t owner = block_of_[fan.triangle[k]];
-                    if (owner != kNone && owner != i) suspects.push_back(blocks_[owner].center);
+                    if (owner != kNoIndex && owner != i) suspects.push_back(blocks_[owner].center);
                 }
                 Block across;
                 if (fan.size != 3 || !read_block(fan.triangle[1], across)) continue;
@@ -612,14 +612,14 @@ private:
         for (uint32_t next = start; next < blocks_.size(); ++next) {
             for (int i = 0; i < 3; ++i) {
                 const Fan fan = walk_fan(blocks_[next], i);
-                if (fan.kind != Fan::triangles || block_of_[fan.triangle[1]] != kNone) continue;
+                if (fan.kind != Fan::triangles || block_of_[fan.triangle[1]] != kNoIndex) continue;
                 if (preference == Preference::closure_first) {
                     const uint32_t partner = closure_partner(blocks_[next], i, fan);
-                    if (partner != kNone && place_block(partner)) continue;
+                    if (partner != kNoIndex && place_block(partner)) continue;
                     if (fan.size == 3) place_block(fan.triangle[1]);
                 } else if (fan.size == 3 && !place_block(fan.triangle[1])) {
                     const uint32_t partner = closure_partner(blocks_[next], i, fan);
-                    if (partner != kNone) place_block(partner);
+                    if (partner != kNoIndex) place_block(partner);
                 }
             }
         }
@@ -672,7 +672,7 @@ private:
         std::vector<Candidate> queue;
         for (uint32_t t : seeds) covered_[t] = 0;
         for (uint32_t t : seeds) {
-            if (covered_[t] == 3 || block_of_[t] != kNone) continue;
+            if (covered_[t] == 3 || block_of_[t] != kNoIndex) continue;
             const Candidate c = best_patch(t, true);
             if (c.removed > 0) queue.push_back(c);
         }
@@ -740,14 +740,14 @@ private:
         std::vector<Side> sides;
         for (uint32_t i = patch.first; i < patch.end; ++i) {
             if (!blocks_[i].alive) continue;
-            blocks_[i].patch = on ? id : kNone;
+            blocks_[i].patch = on ? id : kNoIndex;
             for (int e = 0; e < 3; ++e) {
                 sides.push_back(classify(i, e));
             }
         }
         for (const Side& side : sides) {
             if (side.kind != Side::green) continue;
-            for (int k = 0; k < side.count; ++k) closure_of_[side.group[k]] = on ? id : kNone;
+            for (int k = 0; k < side.count; ++k) closure_of_[side.group[k]] = on ? id : kNoIndex;
             for (uint32_t v : side.coarse) on ? ++pinned_old_[v] : --pinned_old_[v];
         }
     }

@@ -2,6 +2,8 @@
 // u->v, its third vertex, and the fan of faces around a vertex. Built in linear time.
 #pragma once
 
+#include "common/no_index.h"
+
 #include <amc/mesh.h>
 
 #include <cstdint>
@@ -12,19 +14,18 @@ namespace amc {
 
 class LeafHalfedges {
 public:
-    static constexpr uint32_t kNone = 0xffffffffu;
 
     explicit LeafHalfedges(const TriangleMesh& mesh);
 
-    // The face that holds the directed edge u->v, or kNone.
+    // The face that holds the directed edge u->v, or kNoIndex.
     uint32_t face(uint32_t u, uint32_t v) const {
         const Entry* e = find(u, v);
-        return e == nullptr ? kNone : e->face;
+        return e == nullptr ? kNoIndex : e->face;
     }
-    // The third vertex of that face, or kNone.
+    // The third vertex of that face, or kNoIndex.
     uint32_t apex(uint32_t u, uint32_t v) const {
         const Entry* e = find(u, v);
-        return e == nullptr ? kNone : e->apex;
+        return e == nullptr ? kNoIndex : e->apex;
     }
     // Number of faces around u (the directed edges leaving u).
     uint32_t degree(uint32_t u) const { return start_[u + 1] - start_[u]; }

@@ -3,6 +3,7 @@
 // and compares the extracted leaf mesh with the input, face by face.
 #include <amc/import.h>
 
+#include "common/no_index.h"
 #include "import/anchored_reconstruction.h"
 #include "import/leaf_halfedges.h"
 #include "import/leaf_reconstruction.h"
@@ -19,7 +20,6 @@ namespace amc {
 
 namespace {
 
-constexpr uint32_t kNone = 0xffffffffu;
 
 [[noreturn]] void fail(const std::string& what, const std::string& message) { throw Error(what + ": " + message); }
 
@@ -33,8 +33,8 @@ std::vector<uint32_t> match_base_vertices(const TriangleMesh& base, const Triang
                                           const std::vector<uint32_t>& leaf_vertex_of_base,
                                           const PositionIndex& leaf_positions, const std::string& what) {
     const size_t v0 = base.positions.size();
-    std::vector<uint32_t> match(v0, kNone);
-    std::vector<uint32_t> base_of_leaf(leaf.positions.size(), kNone);
+    std::vector<uint32_t> match(v0, kNoIndex);
+    std::vector<uint32_t> base_of_leaf(leaf.positions.size(), kNoIndex);
     if (!leaf_vertex_of_base.empty()) {
         if (leaf_vertex_of_base.size() != v0)
             fail(what, "the base vertex map has " + std::to_string(leaf_vertex_of_base.size()) + " entries for " +
@@ -45,13 +45,13 @@ std::vector<uint32_t> match_base_vertices(const TriangleMesh& base, const Triang
     }
     for (uint32_t b = 0; b < v0; ++b) {
         const uint32_t l = match[b];
-        if (l == kNone)
+        if (l == kNoIndex)
             fail(what, "base vertex " + std::to_string(b) + " at " + position_text(base.positions[b]) +
                            " is not a vertex of the leaf mesh (wrong base?)");
         if (l >= leaf.positions.size())
             fail(what, "base vertex " + std::to_string(b) + " maps to leaf vertex " + std::to_string(l) + " of " +
                            std::to_string(leaf.positions.size()));
-        if (base_of_leaf[l] != kNone)
+        if (base_of_leaf[l] != kNoIndex)
             fail(what, "base vertices " + std::to_string(base_of_leaf[l]) + " and " + std::to_string(b) +
                            " both map to leaf vertex " + std::to_string(l));
         base_of_leaf[l] = b;
@@ -65,7 +65,7 @@ void verify_leaf_mesh(const Hierarchy& h, const std::vector<uint32_t>& leaf_of_v
                       const LeafHalfedges& halfedges, const std::string& what) {
     const LeafMesh extracted = extract_leaf_mesh(h);
     const std::vector<uint32_t> canonical = canonical_vertex_order(h);
-    std::vector<uint32_t> leaf_of_canonical(extracted.mesh.positions.size(), kNone);
+    std::vector<uint32_t> leaf_of_canonical(extracted.mesh.positions.size(), kNoIndex);
     for (size_t v = 0; v < canonical.size(); ++v) {
         if (canonical[v] < leaf_of_canonical.size()) leaf_of_canonical[canonical[v]] = leaf_of_vertex[v];
     }
@@ -73,8 +73,8 @@ void verify_leaf_mesh(const Hierarchy& h, const std::vector<uint32_t>& leaf_of_v
     for (size_t t = 0; t < extracted.mesh.triangles.size(); ++t) {
         const Triangle& tri = extracted.mesh.triangles[t];
         const uint32_t a = leaf_of_canonical[tri[0]], b = leaf_of_canonical[tri[1]], c = leaf_of_canonical[tri[2]];
-        const uint32_t f = (a == kNone || b == kNone) ? kNone : halfedges.face(a, b);
-        if (f == kNone || halfedges.apex(a, b) != c || used[f])
+        const uint32_t f = (a == kNoIndex || b == kNoIndex) ? kNoIndex : halfedges.face(a, b);
+        if (f == kNoIndex || halfedges.apex(a, b) != c || used[f])
             fail(what, "the reconstruction has a triangle (" + std::to_string(a) + ", " + std::to_string(b) + ", " +
                            std::to_string(c) + ") that is not a face of the leaf mesh");
         used[f] = 1;
@@ -100,7 +100,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     for (const Vec3& p : leaf.positions) {
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) validate_triangle_mesh(leaf, what);
     }
-    uint32_t first = kNone, second = kNone;
+    uint32_t first = kNoIndex, second = kNoIndex;
     const PositionIndex leaf_positions(leaf.positions, &first, &second);
     // Two vertices at one position are refused where they make the input ambiguous (a base vertex
     // matched by position) or when the import fails; a projection may put two new vertices of a
@@ -109,7 +109,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
         fail(what, "vertices " + std::to_string(a) + " and " + std::to_string(b) + " have the same position " +
                        position_text(leaf.positions[a]) + " (duplicate vertex)");
     };
-    if (first != kNone && leaf_vertex_of_base.empty()) {
+    if (first != kNoIndex && leaf_vertex_of_base.empty()) {
         for (const Vec3& p : base.positions) {
             if (!leaf_positions.shared(p)) continue;
             const uint32_t a = leaf_positions.find(p);
@@ -174,20 +174,20 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
         }
     }
     if (!done) {
-        if (first != kNone) refuse_duplicate(first, second);
+        if (first != kNoIndex) refuse_duplicate(first, second);
         validate_triangle_mesh(leaf, what);  // a structural fault has the clearer message
         throw Error(first_error);
     }
 
-    out.vertex_of_input.assign(leaf.positions.size(), kNone);
+    out.vertex_of_input.assign(leaf.positions.size(), kNoIndex);
     for (VertexId v = 0; v < leaf_of_vertex.size(); ++v) {
         const uint32_t l = leaf_of_vertex[v];
-        if (l == kNone) continue;
+        if (l == kNoIndex) continue;
         out.vertex_of_input[l] = v;
         out.hierarchy.set_position(v, leaf.positions[l]);
     }
     for (uint32_t l = 0; l < leaf.positions.size(); ++l) {
-        if (out.vertex_of_input[l] == kNone) validate_triangle_mesh(leaf, what);  // an unused vertex
+        if (out.vertex_of_input[l] == kNoIndex) validate_triangle_mesh(leaf, what);  // an unused vertex
     }
     return out;
 }

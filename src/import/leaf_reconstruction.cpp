@@ -2,6 +2,7 @@
 #include "import/leaf_reconstruction.h"
 
 #include "common/exact_float.h"
+#include "common/no_index.h"
 #include "geometry/closest_point.h"
 #include "import/nearest_vertex.h"
 
@@ -15,7 +16,6 @@ namespace amc {
 
 namespace {
 
-constexpr uint32_t kNone = 0xffffffffu;
 
 class Reconstruction {
 public:
@@ -23,8 +23,8 @@ public:
                    const LeafHalfedges& halfedges, MidpointGuide guide, const PositionIndex& positions,
                    const std::string& what)
         : h_(h), leaf_(leaf), he_(halfedges), guide_(guide), positions_(positions), what_(what) {
-        leaf_of_vertex_.assign(h.positions().size(), kNone);
-        vertex_of_leaf_.assign(leaf.positions.size(), kNone);
+        leaf_of_vertex_.assign(h.positions().size(), kNoIndex);
+        vertex_of_leaf_.assign(leaf.positions.size(), kNoIndex);
         for (VertexId v = 0; v < leaf_of_base.size(); ++v) assign(v, leaf_of_base[v]);
     }
 
@@ -52,7 +52,7 @@ public:
                          " has the edge (" + edge_text(u.node, u.edge) +
                          ") whole, but the element across splits it (T-junction)");
             }
-            leaf_of_vertex_.resize(h_.positions().size(), kNone);
+            leaf_of_vertex_.resize(h_.positions().size(), kNoIndex);
             for (const Reveal& r : reveals_) {
                 const NodeId q = h_.neighbor(r.node, r.edge);
                 if (q == kNoNode || h_.is_leaf(q)) explain_misfit(r.node);
@@ -61,7 +61,7 @@ public:
                          " lies on an edge whose other side is not refined (T-junction)" +
                          (h_.level(r.node) == 0 ? " (wrong base?)" : ""));
                 const VertexId m = h_.midpoint(q, h_.neighbor_edge(r.node, r.edge));
-                if (leaf_of_vertex_[m] == kNone) {
+                if (leaf_of_vertex_[m] == kNoIndex) {
                     assign(m, r.leaf_vertex);
                 } else if (leaf_of_vertex_[m] != r.leaf_vertex) {
                     fail("vertices " + std::to_string(leaf_of_vertex_[m]) + " and " + std::to_string(r.leaf_vertex) +
@@ -72,7 +72,7 @@ public:
             for (NodeId n : refined) {
                 for (int e = 0; e < 3; ++e) {
                     const VertexId m = h_.midpoint(n, e);
-                    if (leaf_of_vertex_[m] == kNone) assign(m, find_midpoint(n, e));
+                    if (leaf_of_vertex_[m] == kNoIndex) assign(m, find_midpoint(n, e));
                 }
                 for (int k = 0; k < 4; ++k) next.push_back(h_.child(n, k));
             }
@@ -109,8 +109,8 @@ private:
     }
 
     void assign(VertexId v, uint32_t l) {
-        if (l == kNone) fail("internal: no leaf vertex for hierarchy vertex " + std::to_string(v));
-        if (vertex_of_leaf_[l] != kNone)
+        if (l == kNoIndex) fail("internal: no leaf vertex for hierarchy vertex " + std::to_string(v));
+        if (vertex_of_leaf_[l] != kNoIndex)
             fail("vertex " + std::to_string(l) + " would be used twice by the refinement (not a red-green refinement)");
         leaf_of_vertex_[v] = l;
         vertex_of_leaf_[l] = v;
@@ -125,14 +125,14 @@ private:
         bool unsplit[3];
         int count = 0;
         for (int e = 0; e < 3; ++e) {
-            unsplit[e] = he_.face(p[e], p[(e + 1) % 3]) != LeafHalfedges::kNone;
+            unsplit[e] = he_.face(p[e], p[(e + 1) % 3]) != kNoIndex;
             count += unsplit[e];
         }
         if (count == 0) {
             // A refined element has no leaf edge between its corners, in either direction.
             for (int e = 0; e < 3; ++e) {
                 const uint32_t across = he_.face(p[(e + 1) % 3], p[e]);
-                if (across != LeafHalfedges::kNone)
+                if (across != kNoIndex)
                     fail("edge (" + edge_text(n, e) + ") of face " + std::to_string(across) +
                          " has nothing on its other side, where the element (" + std::to_string(p[0]) + ", " +
                          std::to_string(p[1]) + ", " + std::to_string(p[2]) +
@@ -150,9 +150,9 @@ private:
             const int e = !unsplit[0] ? 0 : !unsplit[1] ? 1 : 2;  // the split edge
             const uint32_t m = he_.apex(p[(e + 1) % 3], p[(e + 2) % 3]);
             const uint32_t m_other = he_.apex(p[(e + 2) % 3], p[e]);
-            if (m == kNone || m_other != m) {
+            if (m == kNoIndex || m_other != m) {
                 explain_misfit(n);
-                if (m != kNone && m_other != kNone)
+                if (m != kNoIndex && m_other != kNoIndex)
                     fail("the edge (" + edge_text(n, e) + ") of the element (" + std::to_string(p[0]) + ", " +
                          std::to_string(p[1]) + ", " + std::to_string(p[2]) + ") carries more than one vertex (" +
                          std::to_string(m_other) + ", " + std::to_string(m) +
@@ -166,10 +166,10 @@ private:
             const uint32_t w = he_.apex(a, b);
             // Default diagonal m_{u+1}--v_u: (a, b, m1), (a, m1, m2), (m2, m1, c).
             const uint32_t x = he_.apex(a, w);
-            const bool as_default = x != kNone && he_.apex(x, w) == c;
+            const bool as_default = x != kNoIndex && he_.apex(x, w) == c;
             // Flipped diagonal m_{u+2}--v_{u+1}: (a, b, m2), (b, m1, m2), (m2, m1, c).
             const uint32_t y = he_.apex(w, b);
-            const bool as_flipped = !as_default && y != kNone && he_.apex(w, y) == c;
+            const bool as_flipped = !as_default && y != kNoIndex && he_.apex(w, y) == c;
             if (as_default) {
                 reveals_.push_back({n, (u + 1) % 3, w});
                 reveals_.push_back({n, (u + 2) % 3, x});
@@ -194,10 +194,10 @@ private:
         for (int k = 0; k < 3; ++k) {
             const uint32_t m = leaf_of_vertex_[h_.midpoint(parent, k)];
             const uint32_t opposite = corner(parent, (k + 2) % 3);
-            if (m == kNone) continue;
+            if (m == kNoIndex) continue;
             uint32_t face = he_.face(m, opposite);
-            if (face == LeafHalfedges::kNone) face = he_.face(opposite, m);
-            if (face != LeafHalfedges::kNone)
+            if (face == kNoIndex) face = he_.face(opposite, m);
+            if (face != kNoIndex)
                 fail_node(parent, "is split on all three edges but closed by green triangles (face " +
                                       std::to_string(face) + "); three hanging nodes call for the red split");
         }
@@ -210,12 +210,12 @@ private:
             Vec3 m = rounded_scaled(0.5, leaf_.positions[a] + leaf_.positions[b]);  // as the placer computes it
             if (leaf_.single_precision) m = rounded_to_float(m);
             const uint32_t found = positions_.find(m);
-            if (found == kNone) fail("no vertex at the midpoint of edge (" + edge_text(n, e) + ")");
+            if (found == kNoIndex) fail("no vertex at the midpoint of edge (" + edge_text(n, e) + ")");
             return found;
         }
         // From the connectivity alone where it tells: the halves of the edge are leaf edges.
         const uint32_t common = only_unmatched_common_neighbor(a, b);
-        if (common != kNone) return common;
+        if (common != kNoIndex) return common;
         if (!nearest_) {
             double total = 0;
             for (const Triangle& t : leaf_.triangles) {
@@ -226,17 +226,17 @@ private:
         }
         // The midpoint's leaf neighbours lie in the children of n and of the element across that
         // touch it: of the vertices matched so far, only a, b and those elements' midpoints.
-        uint32_t allowed[8] = {a, b, kNone, kNone, kNone, kNone, kNone, kNone};
+        uint32_t allowed[8] = {a, b, kNoIndex, kNoIndex, kNoIndex, kNoIndex, kNoIndex, kNoIndex};
         const NodeId q = h_.neighbor(n, e);
         for (int k = 0; k < 3; ++k) {
             allowed[2 + k] = leaf_of_vertex_[h_.midpoint(n, k)];
             if (q != kNoNode && !h_.is_leaf(q)) allowed[5 + k] = leaf_of_vertex_[h_.midpoint(q, k)];
         }
         auto may_be_midpoint = [&](uint32_t v) {
-            if (vertex_of_leaf_[v] != kNone) return false;
+            if (vertex_of_leaf_[v] != kNoIndex) return false;
             bool fits = true;
             for_each_neighbor(v, [&](uint32_t w) {
-                if (vertex_of_leaf_[w] == kNone) return;
+                if (vertex_of_leaf_[w] == kNoIndex) return;
                 bool listed = false;
                 for (uint32_t x : allowed) listed |= x == w;
                 fits &= listed;
@@ -244,7 +244,7 @@ private:
             return fits;
         };
         const uint32_t found = nearest_->find(guide_position(n, e), may_be_midpoint);
-        if (found == kNone) fail("no vertex left to split the edge (" + edge_text(n, e) + ")");
+        if (found == kNoIndex) fail("no vertex left to split the edge (" + edge_text(n, e) + ")");
         return found;
     }
 
@@ -264,7 +264,7 @@ private:
     }
 
     bool adjacent(uint32_t u, uint32_t v) const {
-        return he_.face(u, v) != LeafHalfedges::kNone || he_.face(v, u) != LeafHalfedges::kNone;
+        return he_.face(u, v) != kNoIndex || he_.face(v, u) != kNoIndex;
     }
 
     // Calls f on every leaf-mesh neighbour of u (some twice).
@@ -279,16 +279,16 @@ private:
     // When the children along an edge (a, b) keep their halves unsplit, its midpoint is a common
     // neighbour of a and b, and the only unmatched one: inside the two elements on the edge, a's
     // leaf edges stay in the corner child at a and b's in the corner child at b, which meet only
-    // at the midpoint. kNone unless exactly one exists (the final check guards the rest).
+    // at the midpoint. kNoIndex unless exactly one exists (the final check guards the rest).
     uint32_t only_unmatched_common_neighbor(uint32_t a, uint32_t b) const {
-        uint32_t found = kNone;
+        uint32_t found = kNoIndex;
         bool ambiguous = false;
         for_each_neighbor(a, [&](uint32_t x) {
-            if (vertex_of_leaf_[x] != kNone || x == found || !adjacent(x, b)) return;
-            if (found != kNone) ambiguous = true;
+            if (vertex_of_leaf_[x] != kNoIndex || x == found || !adjacent(x, b)) return;
+            if (found != kNoIndex) ambiguous = true;
             found = x;
         });
-        return ambiguous ? kNone : found;
+        return ambiguous ? kNoIndex : found;
     }
 
     Hierarchy& h_;

@@ -1,6 +1,8 @@
 // Nearest not-yet-used vertex to a point (a uniform hash grid over the leaf vertices).
 #pragma once
 
+#include "common/no_index.h"
+
 #include <amc/mesh.h>
 
 #include <algorithm>
@@ -12,17 +14,16 @@ namespace amc {
 
 class NearestVertex {
 public:
-    static constexpr uint32_t kNone = 0xffffffffu;
 
     // `cell` is the grid spacing (about an edge length).
     NearestVertex(const std::vector<Vec3>& positions, double cell);
 
     // The vertex nearest to p among those for which usable(v) holds, searching up to
-    // `max_rings` rings of cells around p; kNone when none is found.
+    // `max_rings` rings of cells around p; kNoIndex when none is found.
     template <class Usable>
     uint32_t find(Vec3 p, Usable usable, int max_rings = 64) const {
         const int64_t c[3] = {cell_of(p.x), cell_of(p.y), cell_of(p.z)};
-        uint32_t best = kNone;
+        uint32_t best = kNoIndex;
         double best_distance = 0;
         int found_ring = -1;
         for (int r = 0; r <= max_rings; ++r) {
@@ -35,7 +36,7 @@ public:
                             const Vec3 d = positions_[v] - p;
                             const double distance = dot(d, d);
                             // usable() last: it may cost more than the distance.
-                            if ((best == kNone || distance < best_distance) && usable(v)) {
+                            if ((best == kNoIndex || distance < best_distance) && usable(v)) {
                                 best = v;
                                 best_distance = distance;
                                 if (found_ring < 0) found_ring = r;

@@ -2,6 +2,8 @@
 // vertices to leaf vertices, finding duplicate vertices, and the exact-midpoint fast path.
 #pragma once
 
+#include "common/no_index.h"
+
 #include <amc/mesh.h>
 
 #include <cstdint>
@@ -12,26 +14,25 @@ namespace amc {
 
 class PositionIndex {
 public:
-    static constexpr uint32_t kNone = 0xffffffffu;
 
     // Indexes every position; `duplicate_of` receives, when not null, the first pair (earlier,
-    // later) of vertices with the same position, or {kNone, kNone}.
+    // later) of vertices with the same position, or {kNoIndex, kNoIndex}.
     explicit PositionIndex(const std::vector<Vec3>& positions, uint32_t* first_duplicate = nullptr,
                            uint32_t* second_duplicate = nullptr)
         : positions_(positions) {
         size_t capacity = 16;
         while (capacity < 2 * positions.size()) capacity *= 2;
-        slots_.assign(capacity, kNone);
-        if (first_duplicate != nullptr) *first_duplicate = *second_duplicate = kNone;
+        slots_.assign(capacity, kNoIndex);
+        if (first_duplicate != nullptr) *first_duplicate = *second_duplicate = kNoIndex;
         for (uint32_t v = 0; v < positions.size(); ++v) {
             size_t s = slot_of(positions[v]);
-            while (slots_[s] != kNone && !same(positions[slots_[s]], positions[v])) s = (s + 1) & (slots_.size() - 1);
-            if (slots_[s] == kNone) {
+            while (slots_[s] != kNoIndex && !same(positions[slots_[s]], positions[v])) s = (s + 1) & (slots_.size() - 1);
+            if (slots_[s] == kNoIndex) {
                 slots_[s] = v;
             } else {
                 if (shared_.empty()) shared_.assign(slots_.size(), 0);
                 shared_[s] = 1;
-                if (first_duplicate != nullptr && *first_duplicate == kNone) {
+                if (first_duplicate != nullptr && *first_duplicate == kNoIndex) {
                     *first_duplicate = slots_[s];
                     *second_duplicate = v;
                 }
@@ -39,10 +40,10 @@ public:
         }
     }
 
-    // The first vertex at exactly p, or kNone.
+    // The first vertex at exactly p, or kNoIndex.
     uint32_t find(Vec3 p) const {
         for (size_t s = slot_of(p);; s = (s + 1) & (slots_.size() - 1)) {
-            if (slots_[s] == kNone) return kNone;
+            if (slots_[s] == kNoIndex) return kNoIndex;
             if (same(positions_[slots_[s]], p)) return slots_[s];
         }
     }
@@ -51,7 +52,7 @@ public:
     bool shared(Vec3 p) const {
         if (shared_.empty()) return false;
         for (size_t s = slot_of(p);; s = (s + 1) & (slots_.size() - 1)) {
-            if (slots_[s] == kNone) return false;
+            if (slots_[s] == kNoIndex) return false;
             if (same(positions_[slots_[s]], p)) return shared_[s] != 0;
         }
     }

@@ -3,6 +3,8 @@
 // Half-edge 3t+i runs from triangle t's vertex i to its vertex (i+1)%3.
 #pragma once
 
+#include "common/no_index.h"
+
 #include <amc/mesh.h>
 
 #include <cstdint>
@@ -10,7 +12,7 @@
 
 namespace amc::detail {
 
-constexpr uint32_t kNoHalfEdge = 0xffffffffu;
+constexpr uint32_t kNoHalfEdge = kNoIndex;
 
 class TriangleAdjacency {
 public:

@@ -2,6 +2,8 @@
 // triangular grid of each base triangle (docs/IMPORT.md, "uniform refinement").
 #include "import/uniform_lattice.h"
 
+#include "common/no_index.h"
+
 #include <amc/red_split.h>
 
 #include <utility>
@@ -11,21 +13,20 @@ namespace amc {
 
 namespace {
 
-constexpr uint32_t kNone = 0xffffffffu;
 
 // The vertex after `p` on the straight line coming from `previous`: three faces clockwise around
 // p, the line having the faces of its left side on the left. In a uniform refinement every leaf
 // triangle is red, so this is exact, inside and along the boundary.
 uint32_t straight_on(const LeafHalfedges& he, uint32_t previous, uint32_t p) {
     uint32_t w = previous;
-    for (int k = 0; k < 3 && w != kNone; ++k) w = he.apex(w, p);
+    for (int k = 0; k < 3 && w != kNoIndex; ++k) w = he.apex(w, p);
     return w;
 }
 
-// Walks `steps` leaf edges from a through x; the vertex reached, or kNone.
+// Walks `steps` leaf edges from a through x; the vertex reached, or kNoIndex.
 uint32_t walk(const LeafHalfedges& he, uint32_t a, uint32_t x, uint32_t steps) {
     uint32_t previous = a, p = x;
-    for (uint32_t s = 1; s < steps && p != kNone; ++s) {
+    for (uint32_t s = 1; s < steps && p != kNoIndex; ++s) {
         const uint32_t next = straight_on(he, previous, p);
         previous = p;
         p = next;
@@ -46,23 +47,23 @@ std::vector<uint32_t> reconstruct_uniform(Hierarchy& h, const std::vector<uint32
     for (uint32_t l : leaf_of_base) is_base[l] = 1;
 
     // The first leaf vertex on root t's edge c (from corner c toward corner c + 1).
-    std::vector<uint32_t> ray(3 * size_t(f0), kNone);
+    std::vector<uint32_t> ray(3 * size_t(f0), kNoIndex);
     for (NodeId t = 0; t < f0; ++t) {
         for (int c = 0; c < 3; ++c) {
-            if (ray[3 * t + c] != kNone) continue;
+            if (ray[3 * t + c] != kNoIndex) continue;
             // Find the direction toward corner c + 1 by walking from each neighbour of corner c;
             // then turn around the corner: one leaf face per base triangle.
             const uint32_t a = leaf_of_base[h.vertex(t, c)];
             const uint32_t b = leaf_of_base[h.vertex(t, (c + 1) % 3)];
-            uint32_t x = kNone;
-            for (uint32_t i = 0; i < he.degree(a) && x == kNone; ++i) {
+            uint32_t x = kNoIndex;
+            for (uint32_t i = 0; i < he.degree(a) && x == kNoIndex; ++i) {
                 const uint32_t candidate = he.out_vertex(a, i);
                 if (walk(he, a, candidate, n) == b) x = candidate;
             }
-            if (x == kNone) return {};
+            if (x == kNoIndex) return {};
             NodeId r = t;
             int corner = c;
-            for (uint32_t turns = 0; turns < he.degree(a) + 1 && ray[3 * r + corner] == kNone; ++turns) {
+            for (uint32_t turns = 0; turns < he.degree(a) + 1 && ray[3 * r + corner] == kNoIndex; ++turns) {
                 ray[3 * r + corner] = x;  // CCW: the next triangle around a holds the edge a -> corner + 2
                 const int e = (corner + 2) % 3;
                 const NodeId next = h.neighbor(r, e);
@@ -70,7 +71,7 @@ std::vector<uint32_t> reconstruct_uniform(Hierarchy& h, const std::vector<uint32
                 corner = h.neighbor_edge(r, e);
                 r = next;
                 x = he.apex(a, x);
-                if (x == kNone) return {};
+                if (x == kNoIndex) return {};
             }
         }
     }
@@ -79,14 +80,14 @@ std::vector<uint32_t> reconstruct_uniform(Hierarchy& h, const std::vector<uint32
     // upward triangles (P(i, j), P(i + 1, j), P(i, j + 1)).
     const size_t grid_size = size_t(n + 1) * (n + 2) / 2;
     auto row_start = [n](uint32_t j) { return size_t(j) * (n + 1) - size_t(j) * (j - 1) / 2; };
-    std::vector<uint32_t> grid(grid_size * f0, kNone);
+    std::vector<uint32_t> grid(grid_size * f0, kNoIndex);
     for (NodeId t = 0; t < f0; ++t) {
         uint32_t* g = grid.data() + grid_size * t;
         g[0] = leaf_of_base[h.vertex(t, 0)];
         g[1] = ray[3 * t];
         for (uint32_t i = 1; i < n; ++i) {
             g[i + 1] = straight_on(he, g[i - 1], g[i]);
-            if (g[i + 1] == kNone || (is_base[g[i]])) return {};
+            if (g[i + 1] == kNoIndex || (is_base[g[i]])) return {};
         }
         if (g[n] != leaf_of_base[h.vertex(t, 1)]) return {};
         for (uint32_t j = 0; j < n; ++j) {
@@ -94,7 +95,7 @@ std::vector<uint32_t> reconstruct_uniform(Hierarchy& h, const std::vector<uint32
             uint32_t* above = g + row_start(j + 1);
             for (uint32_t i = 0; i + j < n; ++i) {
                 above[i] = he.apex(row[i], row[i + 1]);
-                if (above[i] == kNone) return {};
+                if (above[i] == kNoIndex) return {};
             }
         }
         if (g[row_start(n)] != leaf_of_base[h.vertex(t, 2)]) return {};
@@ -103,7 +104,7 @@ std::vector<uint32_t> reconstruct_uniform(Hierarchy& h, const std::vector<uint32
     for (int level = 0; level < depth; ++level) {
         for (NodeId node : h.leaves()) h.split(node);
     }
-    std::vector<uint32_t> leaf_of_vertex(h.positions().size(), kNone);
+    std::vector<uint32_t> leaf_of_vertex(h.positions().size(), kNoIndex);
     for (VertexId v = 0; v < leaf_of_base.size(); ++v) leaf_of_vertex[v] = leaf_of_base[v];
     struct Item {
         NodeId node;
@@ -119,7 +120,7 @@ std::vector<uint32_t> reconstruct_uniform(Hierarchy& h, const std::vector<uint32
             for (int c = 0; c < 3; ++c) {
                 const uint32_t l = g[row_start(item.j[c]) + item.i[c]];
                 uint32_t& known = leaf_of_vertex[h.vertex(item.node, c)];
-                if (known == kNone) {
+                if (known == kNoIndex) {
                     known = l;
                 } else if (known != l) {
                     return {};  // two grids disagree along a shared edge

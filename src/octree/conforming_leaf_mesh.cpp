@@ -12,6 +12,7 @@
 #include <amc/mesh_io.h>
 
 #include "common/check.h"
+#include "common/no_index.h"
 #include "octree/forest_points.h"
 
 #include <algorithm>
@@ -113,7 +114,7 @@ private:
 
     bool is_leaf_corner(const Lattice& p) const {
         const ForestPoints::Point found = points_.find(tree_, p.data());
-        return found.id != ForestPoints::kNone && found.id < corner_ids_;
+        return found.id != kNoIndex && found.id < corner_ids_;
     }
 
     // Appends the leaf corners strictly between a and b (a dyadic segment of a leaf edge), from a on.
@@ -236,7 +237,7 @@ private:
 
 ConformingLeafMesh conforming_leaf_mesh(const OctreeForest& forest) {
     validate_octree_forest(forest, "forest");
-    AMC_REQUIRE(forest.leaves.size() < ForestPoints::kNone, limit_exceeded, "more than 2^32 - 1 leaves for a conforming leaf mesh");
+    AMC_REQUIRE(forest.leaves.size() < kNoIndex, limit_exceeded, "more than 2^32 - 1 leaves for a conforming leaf mesh");
     ConformingLeafMesh mesh;
     Extraction(forest, mesh).run();
     return mesh;

@@ -2,6 +2,7 @@
 #include "octree/forest_points.h"
 
 #include "common/check.h"
+#include "common/no_index.h"
 
 #include <algorithm>
 #include <array>
@@ -49,7 +50,7 @@ ForestPoints::Point ForestPoints::find(uint32_t tree, const int64_t p[3]) const 
     const size_t mask = slots_.size() - 1;
     for (size_t i = hash(k) & mask;; i = (i + 1) & mask) {
         if (slots_[i].key == k) return slots_[i].point;
-        if (slots_[i].key.tree == kNone) return {};
+        if (slots_[i].key.tree == kNoIndex) return {};
     }
 }
 
@@ -61,20 +62,20 @@ void ForestPoints::reserve(size_t places) {
     old.swap(slots_);
     used_ = 0;
     for (const Slot& s : old)
-        if (s.key.tree != kNone) insert(s.key, s.point);
+        if (s.key.tree != kNoIndex) insert(s.key, s.point);
 }
 
 void ForestPoints::insert(const Key& key, Point point) {
     if (2 * (used_ + 1) > slots_.size()) reserve(slots_.size());
     const size_t mask = slots_.size() - 1;
     size_t i = hash(key) & mask;
-    while (slots_[i].key.tree != kNone && !(slots_[i].key == key)) i = (i + 1) & mask;
-    if (slots_[i].key.tree == kNone) ++used_;
+    while (slots_[i].key.tree != kNoIndex && !(slots_[i].key == key)) i = (i + 1) & mask;
+    if (slots_[i].key.tree == kNoIndex) ++used_;
     slots_[i] = {key, point};
 }
 
 uint32_t ForestPoints::new_position(const Place& place, uint32_t id) {
-    AMC_REQUIRE(positions_.size() < kNone, limit_exceeded, "more than 2^32 - 1 points in a conforming leaf mesh");
+    AMC_REQUIRE(positions_.size() < kNoIndex, limit_exceeded, "more than 2^32 - 1 points in a conforming leaf mesh");
     const int root = octree_root_log2(dim_);
     positions_.push_back(tree_point(conn_, place.tree, std::ldexp(double(place.p[0]), -root),
                                     std::ldexp(double(place.p[1]), -root), std::ldexp(double(place.p[2]), -root)));
@@ -161,14 +162,14 @@ void ForestPoints::collect_places(uint32_t tree, const int64_t p[3]) {
 
 ForestPoints::Point ForestPoints::add(uint32_t tree, const int64_t p[3]) {
     const Point found = find(tree, p);
-    if (found.id != kNone) return found;
+    if (found.id != kNoIndex) return found;
     collect_places(tree, p);
     const uint32_t id = next_id_++;
-    std::vector<uint32_t> place_of_root(places_.size(), kNone);
+    std::vector<uint32_t> place_of_root(places_.size(), kNoIndex);
     Point first;
     for (size_t i = 0; i < places_.size(); ++i) {
         uint32_t& place = place_of_root[root(i)];
-        if (place == kNone) place = new_position(places_[i], id);
+        if (place == kNoIndex) place = new_position(places_[i], id);
         insert(key(places_[i].tree, places_[i].p), Point{id, place});
         if (i == 0) first = {id, place};
     }

@@ -7,6 +7,7 @@
 // in space, so that the mesh is conforming across the gluing and still drawn where it lies.
 #pragma once
 
+#include "common/no_index.h"
 #include "octree/tree_corners.h"
 #include "octree/tree_faces.h"
 
@@ -19,10 +20,9 @@ namespace amc {
 
 class ForestPoints {
 public:
-    static constexpr uint32_t kNone = 0xffffffffu;
     struct Point {
-        uint32_t id = kNone;     // the point of the forest (ids count from 0 in the order points are added)
-        uint32_t place = kNone;  // the point in space (index into positions())
+        uint32_t id = kNoIndex;     // the point of the forest (ids count from 0 in the order points are added)
+        uint32_t place = kNoIndex;  // the point in space (index into positions())
     };
 
     // `conn` must be valid (validate_connectivity) and outlive this.
@@ -34,7 +34,7 @@ public:
     Point add(uint32_t tree, const int64_t p[3]);
     // A new point strictly inside a tree, which no other place can name (a cell centre).
     Point add_inside(uint32_t tree, const int64_t p[3]);
-    // The point at (tree, p), or {kNone, kNone} when it was not added.
+    // The point at (tree, p), or {kNoIndex, kNoIndex} when it was not added.
     Point find(uint32_t tree, const int64_t p[3]) const;
 
     uint32_t size() const { return next_id_; }                      // points of the forest
@@ -50,7 +50,7 @@ private:
     // Open addressing with linear probing: one cache line per lookup, where std::unordered_map's
     // nodes took two or more misses (the lookups are most of the extraction's time).
     struct Slot {
-        Key key{0, kNone};  // tree kNone: empty
+        Key key{0, kNoIndex};  // tree kNoIndex: empty
         Point point;
     };
     static uint64_t hash(const Key& k) {
