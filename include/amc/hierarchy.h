@@ -25,6 +25,9 @@ constexpr NodeId kNoNode = 0xffffffffu;
 constexpr VertexId kNoVertex = 0xffffffffu;  // a dead vertex id in maps over vertex ids
 constexpr int kMaxLevel = 30;  // a level cap far beyond any mesh that fits in memory
 
+struct Neighbors;    // internal (src/hierarchy/hierarchy_builder.h)
+struct LevelSplits;  // internal (src/hierarchy/hierarchy_builder.h)
+
 class Hierarchy {
 public:
     Hierarchy() = default;
@@ -141,7 +144,7 @@ public:
 private:
     // The decoders' bulk build of a level, split_level (src/hierarchy/hierarchy_builder.h).
     friend struct HierarchyBuilder;
-    void split_level(const NodeId* parents, uint32_t count, const uint32_t* child_links);
+    void split_level(const LevelSplits& splits);
 
     static constexpr uint8_t kDeadLevel = 0xff;
     // 32 bytes, aligned: a node never straddles two cache lines. Siblings share what their ids
@@ -161,7 +164,7 @@ private:
     };
     void link(NodeId a, int ea, NodeId b, int eb);
     static void write_vertices(Node* child, const VertexId corner[3], const VertexId m[3]);
-    static void write_neighbors(Node* child, const uint32_t* links, uint32_t offset);
+    static void write_neighbors(Node* child, const Neighbors* links, uint32_t offset);
     static void write_tail(Node& node, uint32_t word);
     VertexId new_vertex(Vec3 p);
     NodeId allocate_children(NodeId parent);

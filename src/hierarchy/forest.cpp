@@ -5,6 +5,7 @@
 #include "common/exact_float.h"
 #include "common/huge_pages.h"
 #include "common/simd.h"
+#include "hierarchy/hierarchy_builder.h"
 #include "hierarchy/red_split_kernels.h"
 #include "mesh/vertex_buckets.h"
 
@@ -338,10 +339,11 @@ void Hierarchy::write_tail(Node& node, uint32_t word) {
 #endif
 }
 
-// The neighbours of four new siblings from their twelve words of local links (word 3k + e: child
-// k, edge e); a local index becomes the id offset + index, kNoNode stays. Each child's store
-// also fills its last four bytes, which write_tail writes afterwards.
-void Hierarchy::write_neighbors(Node* child, const uint32_t* links, uint32_t offset) {
+// The neighbours of four new siblings from their local links; a local index becomes the id
+// offset + index, kNoNode stays. Each child's store also fills its last four bytes, which
+// write_tail writes afterwards.
+void Hierarchy::write_neighbors(Node* child, const Neighbors* siblings, uint32_t offset) {
+    const uint32_t* links = siblings[0].nbr;  // word 3k + e: child k, edge e (Neighbors' static_assert)
 #if AMC_SSE2
     const __m128i all_ones = _mm_set1_epi32(-1);
     const __m128i add = _mm_set1_epi32(int(offset));
@@ -366,16 +368,17 @@ void Hierarchy::write_neighbors(Node* child, const uint32_t* links, uint32_t off
 #endif
 }
 
-void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_t* child_links) {
+void Hierarchy::split_level(const LevelSplits& splits) {
+    const NodeId* const parents = splits.parents;
+    const uint32_t count = splits.count;
     if (!free_blocks_.empty() || !free_vertices_.empty()) {
         // Reused ids: take the general path (the decoders never get here).
         for (uint32_t i = 0; i < count; ++i) split(parents[i]);
         return;
     }
     // The neighbour of child e of parents[i] across the first half of the parent's edge e.
-    auto first_half = [child_links](uint32_t i, int e) {
-        constexpr int kWord[3] = {red_split::first_half_word(0), red_split::first_half_word(1), red_split::first_half_word(2)};
-        return child_links[size_t(12) * i + size_t(kWord[e])];
+    auto first_half = [children = splits.children](uint32_t i, int e) {
+        return children[size_t(4) * i + red_split::kFirstHalfChild[e]].nbr[e];
     };
     const size_t c0 = nodes_.size();
     const size_t new_nodes = c0 + size_t(4) * count;
@@ -433,7 +436,7 @@ void Hierarchy::split_level(const NodeId* parents, uint32_t count, const uint32_
             const unsigned boundary = parent.flags;
             Node* child = nodes + c;
             write_vertices(child, parent.v, m);
-            write_neighbors(child, child_links + size_t(12) * i, offset);
+            write_neighbors(child, splits.children + size_t(4) * i, offset);
             block_parent[i] = n;
             const ChildTails& tails = kChildTails.of[outer | (boundary & 7u) << 6];
             for (int k = 0; k < 4; ++k) write_tail(child[k], tails.word[k] | level);

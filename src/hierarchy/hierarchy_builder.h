@@ -9,21 +9,32 @@
 
 namespace amc {
 
+// The same-level neighbours of a node across its edges 0-2, as local indices of its level
+// (kNoNode where it has none). The coder's level forest and split_level share this layout.
+struct Neighbors {
+    uint32_t nbr[3];
+};
+static_assert(sizeof(Neighbors) == 12, "split_level reads four siblings' Neighbors as twelve words");
+
+// A whole level's splits: the distinct splittable leaves parents[0..count) of one level, whose
+// same-level neighbours are not refined yet, in the order they are split, and the links of the
+// nodes they make: children[4 * i + k] for child k of parents[i], with local index 4 * j + k'
+// for child k' of parents[j], kNoNode where a child has no neighbour (boundary, or the
+// neighbour across the parent's edge is not in `parents` and stays a leaf). They must be the
+// links split() makes.
+struct LevelSplits {
+    const NodeId* parents = nullptr;
+    uint32_t count = 0;
+    const Neighbors* children = nullptr;
+};
+
 struct HierarchyBuilder {
-    // Splits the leaves parents[0..count) of h in that order with the result of calling split()
-    // on each in turn (same node ids, vertex ids and links), in one pass: the bulk form for
-    // decoders that replay a stored forest level by level. The parents must be distinct
-    // splittable leaves of one level whose same-level neighbours are not refined yet. The caller
-    // gives the links of the new nodes: the twelve words at child_links + 12 * i hold, for child k
-    // of parents[i] and its edge e (word 3 * k + e), its same-level neighbour as a local index
-    // 4 * j + k' (child k' of parents[j]), or kNoNode where it has none (boundary, or the
-    // neighbour across the parent's edge is not in `parents` and stays a leaf). They must be the
-    // links split() makes. When no ids are free for reuse (a hierarchy that was only ever
-    // refined), child k of parents[i] gets id node_capacity() + 4 * i + k, node_capacity() taken
-    // before the call.
-    static void split_level(Hierarchy& h, const NodeId* parents, uint32_t count, const uint32_t* child_links) {
-        h.split_level(parents, count, child_links);
-    }
+    // Splits level.parents in order with the result of calling split() on each in turn (same
+    // node ids, vertex ids and links), in one pass: the bulk form for decoders that replay a
+    // stored forest level by level. When no ids are free for reuse (a hierarchy that was only
+    // ever refined), child k of parents[i] gets id node_capacity() + 4 * i + k, node_capacity()
+    // taken before the call.
+    static void split_level(Hierarchy& h, const LevelSplits& level) { h.split_level(level); }
     // One piece of a hierarchy to stitch (stitch below): a hierarchy over some of the roots, and
     // where its nodes and vertices go in the whole.
     struct StitchPart {

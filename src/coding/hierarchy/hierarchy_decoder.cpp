@@ -247,7 +247,7 @@ void HierarchyLevelDecoder::build_decided_levels() {
         uint32_t* parents = level.refined.data();
         for (uint32_t b = 0; b < count; ++b) parents[b] += level_base_;
         const NodeId first_child = h_.node_capacity();
-        HierarchyBuilder::split_level(h_, parents, count, count == 0 ? nullptr : children.nbr.data()->nbr);
+        HierarchyBuilder::split_level(h_, LevelSplits{parents, count, children.nbr.data()});
         level_base_ = first_child;
     }
     // Their memory serves the levels to come.

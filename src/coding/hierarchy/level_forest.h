@@ -13,10 +13,11 @@
 // four siblings (nodes 4b..4b+3 are the children of the level above's b-th refined node, in
 // child order): each node keeps its three neighbours, which the traversal reads for every node
 // it decides, and each block the two bytes of links its children take from their parent
-// (BlockEdges). The decoder hands the neighbours on to Hierarchy::split_level as they are.
+// (BlockEdges). The decoder hands the neighbours on to HierarchyBuilder::split_level as they are.
 #pragma once
 
 #include "common/huge_pages.h"
+#include "hierarchy/hierarchy_builder.h"
 
 #include <amc/hierarchy.h>
 #include <amc/red_split.h>
@@ -37,10 +38,6 @@ struct LevelLinks {
     LevelLinks() {}  // uninitialized: every node's fields are set when its level is made
 };
 static_assert(sizeof(LevelLinks) == 16, "LevelLinks is meant to be 16 bytes");
-
-struct Neighbors {
-    uint32_t nbr[3];  // across edge e: local index, or kNoLocal
-};
 
 // What the four children of one refined node p take from p besides their neighbours: p's
 // neighbour_edge (2 bits per edge, 0 where the neighbour is not refined) and boundary edges.
