@@ -59,24 +59,27 @@ BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const 
 // The base coder may rotate each triangle's vertices. The default diagonal rule does not care, but
 // hierarchies made under a rule of absolute local indices would pay orientation bits: then storing
 // each root's rotation (log2 3 bits) to keep the input's local order may be cheaper.
+// Both readings are tallied on the input, so the hierarchy is reordered once.
 ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& base_code, bool want_vertex_map) {
+    std::vector<uint8_t> rotation_of_root(input.root_count(), 0);
+    for (size_t t = 0; t < base_code.triangle_order.size() && t < base_code.triangle_rotation.size(); ++t)
+        if (base_code.triangle_order[t] < rotation_of_root.size())
+            rotation_of_root[base_code.triangle_order[t]] = base_code.triangle_rotation[t];
     ReorderedInput r;
-    r.hierarchy = reorder_base(input, base_code.vertex_order, base_code.triangle_order, base_code.triangle_rotation,
-                               want_vertex_map ? &r.vertex_map : nullptr);
-    const DiagonalExceptions rotated = diagonal_exceptions(r.hierarchy);
-    if (rotated.fewest() == 0) return r;
-    // Without rotations every node keeps its local vertex order: the input's exceptions.
-    const DiagonalExceptions unrotated = diagonal_exceptions(input);
-    const double rotated_bits = binary_entropy_bits(rotated.fewest(), rotated.leaves);
-    // Products rounded (exact_float.h): however it is compiled, the encoder makes the same choice.
-    const double kept_bits = binary_entropy_bits(unrotated.fewest(), unrotated.leaves) +
-                             rounded(kRotationBits * double(base_code.triangle_order.size()));
-    if (kept_bits >= rotated_bits) return r;
-    r.vertex_map.clear();
+    const DiagonalExceptions rotated = diagonal_exceptions(input, rotation_of_root);
+    if (rotated.fewest() != 0) {
+        // Without rotations every node keeps its local vertex order: the input's exceptions.
+        const DiagonalExceptions unrotated = diagonal_exceptions(input);
+        const double rotated_bits = binary_entropy_bits(rotated.fewest(), rotated.leaves);
+        // Products rounded (exact_float.h): however it is compiled, the encoder makes the same choice.
+        const double kept_bits = binary_entropy_bits(unrotated.fewest(), unrotated.leaves) +
+                                 rounded(kRotationBits * double(base_code.triangle_order.size()));
+        r.keep_rotations = kept_bits < rotated_bits;
+    }
     r.hierarchy = reorder_base(input, base_code.vertex_order, base_code.triangle_order,
-                               std::vector<uint8_t>(base_code.triangle_order.size(), 0),
+                               r.keep_rotations ? std::vector<uint8_t>(base_code.triangle_order.size(), 0)
+                                                : base_code.triangle_rotation,
                                want_vertex_map ? &r.vertex_map : nullptr);
-    r.keep_rotations = true;
     return r;
 }
 

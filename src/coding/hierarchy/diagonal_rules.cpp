@@ -28,13 +28,30 @@ DiagonalRule DiagonalExceptions::best() const {
     return DiagonalRule(best);
 }
 
-DiagonalExceptions diagonal_exceptions(const Hierarchy& h) {
+namespace {
+
+template <class RotationOf>
+DiagonalExceptions tally_exceptions(const Hierarchy& h, RotationOf rotation_of) {
     DiagonalExceptions tally;
     for (NodeId n = 0; n < h.node_capacity(); ++n) {
         if (!h.is_alive(n) || !h.is_leaf(n) || h.hanging_node_count(n) != 2) continue;
-        tally.add(!h.has_hanging_node(n, 0) ? 0 : !h.has_hanging_node(n, 1) ? 1 : 2, h.diagonal_flipped(n));
+        const int unrefined = !h.has_hanging_node(n, 0) ? 0 : !h.has_hanging_node(n, 1) ? 1 : 2;
+        tally.add((unrefined + 3 - rotation_of(n)) % 3, h.diagonal_flipped(n));
     }
     return tally;
+}
+
+}  // namespace
+
+DiagonalExceptions diagonal_exceptions(const Hierarchy& h) {
+    return tally_exceptions(h, [](NodeId) { return 0; });
+}
+
+DiagonalExceptions diagonal_exceptions(const Hierarchy& h, const std::vector<uint8_t>& root_rotation) {
+    return tally_exceptions(h, [&](NodeId n) {
+        while (n >= h.root_count()) n = h.parent(n);
+        return int(root_rotation[n]);
+    });
 }
 
 int context_group_index(int refined, int unrefined, int unknown) {
