@@ -60,6 +60,7 @@ private:
     std::vector<uint32_t> decoder_id_, cm_of_;
     std::vector<uint32_t> final_of_original_;  // final index of an input vertex's first closed vertex
     uint32_t finals_ = 0;
+    std::vector<BaseStencil> stencils_;  // per final vertex, as the decoder derives them (FORMAT.md 4.10)
     // Nodes: the unprocessed halfedge across the node's border edge, and whether it is on the
     // border still; per decoder vertex, a list of its nodes (first node, then node to node).
     std::vector<uint32_t> out_he_, node_link_, first_node_;
@@ -113,8 +114,27 @@ private:
         if (walked_ > angle_mode::walk_budget(cm_.triangles.size())) throw EncoderGaveUp{};
     }
 
-    // Creates the decoder vertex of closed vertex x, with its dummy and copy symbols.
-    uint32_t create_vertex(uint32_t x, bool may_be_dummy) {
+    // The final index of decoder vertex id, or -1 (none, or a dummy).
+    int32_t final_of(int32_t id) const {
+        if (id < 0) return -1;
+        const uint32_t original = cm_.original[cm_of_[size_t(id)]];
+        return original == kNoVertex ? -1 : int32_t(final_of_original_[original]);
+    }
+
+    // The decoder's stencil of a new final vertex from the raw one of the border (decoder ids):
+    // the parallelogram where all three are final vertices, else the first that is, else the
+    // previous final vertex.
+    BaseStencil stencil_of(const BaseStencil& raw) const {
+        const int32_t m0 = final_of(raw[0]), m1 = final_of(raw[1]), m2 = final_of(raw[2]);
+        if (m0 >= 0 && m1 >= 0 && m2 >= 0) return {m0, m1, m2};
+        if (m0 >= 0) return {m0, -1, -1};
+        if (m1 >= 0) return {m1, -1, -1};
+        return {int32_t(finals_) - 1, -1, -1};
+    }
+
+    // Creates the decoder vertex of closed vertex x, with its dummy and copy symbols; `raw` is
+    // the stencil the decoder has for it in decoder ids.
+    uint32_t create_vertex(uint32_t x, bool may_be_dummy, const BaseStencil& raw) {
         if (x >= decoder_id_.size() || decoder_id_[x] != kNoVertex) throw EncoderGaveUp{};
         const uint32_t original = cm_.original[x];
         const bool dummy = original == kNoVertex;
@@ -128,7 +148,10 @@ private:
             } else if (target != kNoVertex) {
                 throw EncoderGaveUp{};
             }
-            if (target == kNoVertex) final_of_original_[original] = finals_++;
+            if (target == kNoVertex) {
+                stencils_.push_back(stencil_of(raw));
+                final_of_original_[original] = finals_++;
+            }
         }
         const uint32_t id = border_.add_vertex(dummy ? Vec3{} : mesh_.positions[original], !dummy);
         decoder_id_[x] = id;
@@ -197,9 +220,10 @@ private:
             const uint32_t r = i == 0 ? rotation_ : 0;
             ++components_;
             const Triangle& st = cm_.triangles[s];
-            const uint32_t a = create_vertex(st[r], false);
-            const uint32_t b = create_vertex(st[(r + 1) % 3], false);
-            const uint32_t c = create_vertex(st[(r + 2) % 3], false);
+            // A component's first vertices: the stencil is the vertex created before.
+            const uint32_t a = create_vertex(st[r], false, {int32_t(cm_of_.size()) - 1, -1, -1});
+            const uint32_t b = create_vertex(st[(r + 1) % 3], false, {int32_t(a), -1, -1});
+            const uint32_t c = create_vertex(st[(r + 2) % 3], false, {int32_t(b), -1, -1});
             visit_triangle(3 * s + r);
             border_.start(a, b, c);
             const uint32_t na = border_.top().gate, nc = border_.next(na), nb = border_.next(nc);
@@ -261,7 +285,7 @@ private:
         if (can_split || can_merge) put_bit(models_.new_vertex[set_ == 0 ? Models::new_vertex_context(b.corner(g)) : 0], is_new);
         else if (!is_new) throw EncoderGaveUp{};
         if (is_new) {
-            const uint32_t w = create_vertex(w_closed, true);
+            const uint32_t w = create_vertex(w_closed, true, {int32_t(u), int32_t(v), int32_t(b.opp(g))});
             visit_triangle(he);
             const uint32_t nw = b.op_new(w);
             out_he_[g] = to_w;
@@ -340,8 +364,13 @@ private:
         code.vertex_order.assign(finals_, kNoVertex);
         for (uint32_t o = 0; o < mesh_.positions.size(); ++o)
             if (final_of_original_[o] != kNoVertex) code.vertex_order[final_of_original_[o]] = o;
-        for (uint32_t o = 0; o < mesh_.positions.size(); ++o)
-            if (final_of_original_[o] == kNoVertex) code.vertex_order.push_back(o);
+        code.stencils = stencils_;
+        // Isolated vertices follow the used ones (FORMAT.md 4.15), each predicted by the one before.
+        for (uint32_t o = 0; o < mesh_.positions.size(); ++o) {
+            if (final_of_original_[o] != kNoVertex) continue;
+            code.stencils.push_back({int32_t(code.vertex_order.size()) - 1, -1, -1});
+            code.vertex_order.push_back(o);
+        }
         code.triangle_order.clear();
         code.triangle_rotation.clear();
         for (size_t i = 0; i < triangles_.size(); ++i) {
@@ -407,6 +436,7 @@ std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& c
                 code.vertex_order = std::move(candidate.vertex_order);
                 code.triangle_order = std::move(candidate.triangle_order);
                 code.triangle_rotation = std::move(candidate.triangle_rotation);
+                code.stencils = std::move(candidate.stencils);
             }
         }
     }
