@@ -1,4 +1,4 @@
-// The one place that chooses the instruction set of the hand-vectorised kernels (forest.cpp,
+// The one place that chooses the instruction set of the hand-vectorised kernels (level_split.cpp,
 // hierarchy/red_split_kernels.h, coding/hierarchy/hierarchy_traversal.h): SSE2 where the compiler
 // targets it, else their scalar twins, which compute the same. AMC_SCALAR (CMake option
 // AMC_SCALAR) forces the scalar twins and the byte-by-byte forms of the little-endian shortcuts,

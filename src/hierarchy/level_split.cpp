@@ -1,0 +1,269 @@
+// The decoders' bulk build of a level (HierarchyBuilder::split_level, hierarchy_builder.h): a
+// whole level's splits in one pass, with the links the decoder's level forest already knows.
+#include <amc/hierarchy.h>
+
+#include "common/huge_pages.h"
+#include "common/simd.h"
+#include "hierarchy/hierarchy_builder.h"
+#include "hierarchy/midpoint_placers.h"
+#include "hierarchy/red_split_kernels.h"
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <iterator>
+
+namespace amc {
+
+namespace {
+
+// The end points of a new vertex.
+struct Ends {
+    VertexId a, b;
+};
+
+// A random-access range over the end points of new vertices whose elements are their positions,
+// made by `Place` as std::vector::insert copies them: each is written once, into the reserved
+// capacity, with no test of the capacity per vertex (push_back's) and no zero-fill first
+// (resize's). The end points' positions are fetched kAhead vertices early.
+template <class Place>
+class NewPositions {
+public:
+    using iterator_category = std::random_access_iterator_tag;
+    using value_type = Vec3;
+    using difference_type = std::ptrdiff_t;
+    using pointer = const Vec3*;
+    using reference = Vec3;
+
+    NewPositions(const Ends* at, const Ends* end, const Vec3* positions, Place place)
+        : at_(at), end_(end), positions_(positions), place_(place) {}
+    Vec3 operator*() const { return place_(positions_[at_->a], positions_[at_->b]); }
+    NewPositions& operator++() {
+        if (at_ + kAhead < end_) {
+            __builtin_prefetch(positions_ + at_[kAhead].a);
+            __builtin_prefetch(positions_ + at_[kAhead].b);
+        }
+        ++at_;
+        return *this;
+    }
+    NewPositions operator++(int) {
+        NewPositions old = *this;
+        ++*this;
+        return old;
+    }
+    NewPositions& operator--() {
+        --at_;
+        return *this;
+    }
+    NewPositions operator--(int) {
+        NewPositions old = *this;
+        --at_;
+        return old;
+    }
+    NewPositions& operator+=(difference_type n) {
+        at_ += n;
+        return *this;
+    }
+    NewPositions& operator-=(difference_type n) {
+        at_ -= n;
+        return *this;
+    }
+    NewPositions operator+(difference_type n) const { return NewPositions(*this) += n; }
+    NewPositions operator-(difference_type n) const { return NewPositions(*this) -= n; }
+    friend NewPositions operator+(difference_type n, const NewPositions& it) { return it + n; }
+    difference_type operator-(const NewPositions& other) const { return at_ - other.at_; }
+    Vec3 operator[](difference_type n) const { return *(*this + n); }
+    bool operator==(const NewPositions& other) const { return at_ == other.at_; }
+    bool operator!=(const NewPositions& other) const { return at_ != other.at_; }
+    bool operator<(const NewPositions& other) const { return at_ < other.at_; }
+    bool operator>(const NewPositions& other) const { return at_ > other.at_; }
+    bool operator<=(const NewPositions& other) const { return at_ <= other.at_; }
+    bool operator>=(const NewPositions& other) const { return at_ >= other.at_; }
+
+private:
+    // The end points' positions miss the cache far more often than the nodes: with 8 vertices
+    // ahead, the loads still waited.
+    static constexpr std::ptrdiff_t kAhead = 32;
+    const Ends* at_;
+    const Ends* end_;
+    const Vec3* positions_;
+    Place place_;
+};
+
+}  // namespace
+
+// split_level writes each new node as three pieces: its vertices and first child (none; bytes
+// 0-15), its neighbours (bytes 16-27) and its four bytes of edges, level, flags and a reserved 0.
+// Four siblings' pieces are made in registers and stored whole: scalar stores of every field
+// made the build store-bound.
+
+// The vertices of four new siblings, in the child order of <amc/red_split.h>, from their parent's
+// corners and the midpoints of its edges, and their first child (none) (split and split_level).
+void Hierarchy::write_vertices(Node* child, const VertexId corner[3], const VertexId m[3]) {
+    static_assert(sizeof(Node) == 32 && offsetof(Node, first_child) == 12 && offsetof(Node, nbr) == 16 &&
+                      offsetof(Node, nbr_edge) == 28,
+                  "split_level writes nodes by this layout");
+    // The fourth word is first_child: kNoNode.
+    static_assert(kNoNode == 0xffffffffu, "write_child_vertices fills the fourth word with all ones");
+    red_split_kernels::write_child_vertices(child, corner, m);
+}
+
+// The last four bytes of four new siblings but their level (word k: child k; the last byte is
+// `reserved`, 0), by the parent's
+// neighbour edge indices of its linked edges (bits 0-5) and its boundary edges (bits 6-8).
+struct ChildTails {
+    uint32_t word[4];
+};
+struct ChildTailTable {
+    ChildTails of[512];
+    constexpr ChildTailTable() : of() {
+        for (unsigned code = 0; code < 512; ++code) {
+            const unsigned outer = code & 63u, boundary = code >> 6;
+            for (unsigned k = 0; k < 4; ++k) {
+                const red_split::ChildEdges& edges = red_split::kChildEdges[k];
+                of[code].word[k] = ((outer & edges.outer) | edges.inner) | (boundary & edges.boundary) << 16;
+            }
+        }
+    }
+};
+constexpr ChildTailTable kChildTails{};
+
+void Hierarchy::write_tail(Node& node, uint32_t word) {
+    // Bytes nbr_edge, level, flags, reserved in that order (little endian word).
+#if AMC_LITTLE_ENDIAN
+    std::memcpy(&node.nbr_edge, &word, 4);
+#else
+    node.nbr_edge = uint8_t(word);
+    node.level = uint8_t(word >> 8);
+    node.flags = uint8_t(word >> 16);
+    node.reserved = uint8_t(word >> 24);
+#endif
+}
+
+// The neighbours of four new siblings from their local links; a local index becomes the id
+// offset + index, kNoNode stays. Each child's store also fills its last four bytes, which
+// write_tail writes afterwards.
+void Hierarchy::write_neighbors(Node* child, const Neighbors* siblings, uint32_t offset) {
+    const uint32_t* links = siblings[0].nbr;  // word 3k + e: child k, edge e (Neighbors' static_assert)
+#if AMC_SSE2
+    const __m128i all_ones = _mm_set1_epi32(-1);
+    const __m128i add = _mm_set1_epi32(int(offset));
+    auto ids = [&](const uint32_t* at) {
+        const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(at));
+        return _mm_or_si128(_mm_add_epi32(v, add), _mm_cmpeq_epi32(v, all_ones));
+    };
+    const __m128i t0 = ids(links), t1 = ids(links + 4), t2 = ids(links + 8);
+    // Lanes 0-2 of each piece are words 3k..3k+2.
+    auto store = [](Node& node, __m128i v) { _mm_storeu_si128(reinterpret_cast<__m128i*>(node.nbr), v); };
+    store(child[0], t0);
+    store(child[1], _mm_or_si128(_mm_srli_si128(t0, 12), _mm_slli_si128(t1, 4)));
+    store(child[2], _mm_or_si128(_mm_srli_si128(t1, 8), _mm_slli_si128(t2, 8)));
+    store(child[3], _mm_srli_si128(t2, 4));
+#else
+    for (int k = 0; k < 4; ++k) {
+        for (int e = 0; e < 3; ++e) {
+            const uint32_t t = links[3 * k + e];
+            child[k].nbr[e] = t == kNoNode ? kNoNode : t + offset;
+        }
+    }
+#endif
+}
+
+void Hierarchy::split_level(const LevelSplits& splits) {
+    const NodeId* const parents = splits.parents;
+    const uint32_t count = splits.count;
+    if (!free_blocks_.empty() || !free_vertices_.empty()) {
+        // Reused ids: take the general path (the decoders never get here).
+        for (uint32_t i = 0; i < count; ++i) split(parents[i]);
+        return;
+    }
+    // The neighbour of child e of parents[i] across the first half of the parent's edge e.
+    auto first_half = [children = splits.children](uint32_t i, int e) {
+        return children[size_t(4) * i + red_split::kFirstHalfChild[e]].nbr[e];
+    };
+    const size_t c0 = nodes_.size();
+    const size_t new_nodes = c0 + size_t(4) * count;
+    if (new_nodes > nodes_.capacity()) reserve(std::max(new_nodes, nodes_.capacity() + nodes_.capacity() / 2), 0);
+    if (positions_.size() + size_t(3) * count > positions_.capacity()) {
+        // Maybe not enough room: count exactly. Edge e of parent i gets a new vertex unless an
+        // earlier parent across it made one.
+        size_t new_vertices = 0;
+        for (uint32_t i = 0; i < count; ++i) {
+            for (int e = 0; e < 3; ++e) new_vertices += !(first_half(i, e) / 4 < i);
+        }
+        const size_t vertices = positions_.size() + new_vertices;
+        if (vertices > positions_.capacity()) reserve(0, std::max(vertices, positions_.capacity() + positions_.capacity() / 2));
+    }
+    nodes_.resize(new_nodes);
+    block_parent_.resize((new_nodes - root_count()) / 4);
+    NodeId* const block_parent = block_parent_.data() + (c0 - root_count()) / 4;
+    const size_t v0 = positions_.size();
+    Node* nodes = nodes_.data();
+    VertexId next_vertex = VertexId(v0);
+    const bool default_placer = placer_ == midpoint_placer;
+    // The parents go in chunks: first their children and links, listing the end points of the
+    // new vertices, then the new vertices' positions. Apart, the position loads (which miss the
+    // cache) overlap each other instead of stalling the loop that writes the nodes.
+    constexpr uint32_t kChunk = 256;
+    Ends ends[3 * kChunk];
+    // The parents are fetched 16 parents early (what else was tried: HIERARCHY_CODER.md, Speed, item 13).
+    constexpr uint32_t kParentsAhead = 16;
+    const uint32_t offset = uint32_t(c0);
+    for (uint32_t chunk = 0; chunk < count; chunk += kChunk) {
+        const uint32_t chunk_end = std::min(count, chunk + kChunk);
+        uint32_t new_vertices = 0;
+        for (uint32_t i = chunk; i < chunk_end; ++i) {
+            if (i + kParentsAhead < count) __builtin_prefetch(nodes + parents[i + kParentsAhead]);
+            const NodeId n = parents[i];
+            Node& parent = nodes[n];
+            const NodeId c = NodeId(c0 + size_t(4) * i);
+            unsigned linked_edges = 0;
+            VertexId m[3];
+            for (int e = 0; e < 3; ++e) {
+                const uint32_t t = first_half(i, e);  // kNoNode / 4 is never below i
+                linked_edges |= t == kNoNode ? 0u : 3u << (2 * e);
+                if (t / 4 < i) {
+                    const unsigned eq = (parent.nbr_edge >> (2 * e)) & 3u;
+                    m[e] = nodes[c0 + (t & ~3u) + red_split::kCenter].v[red_split::kCenterVertexOfMidpoint[eq]];
+                } else {
+                    ends[new_vertices++] = {parent.v[e], parent.v[e == 2 ? 0 : e + 1]};
+                    m[e] = next_vertex++;
+                }
+            }
+            // The children's edges (red_split::kChildEdges): linked outer edges take the parent's neighbour
+            // edge index.
+            const unsigned outer = parent.nbr_edge & linked_edges;
+            const uint32_t level = uint32_t(parent.level + 1) << 8;
+            const unsigned boundary = parent.flags;
+            Node* child = nodes + c;
+            write_vertices(child, parent.v, m);
+            write_neighbors(child, splits.children + size_t(4) * i, offset);
+            block_parent[i] = n;
+            const ChildTails& tails = kChildTails.of[outer | (boundary & 7u) << 6];
+            for (int k = 0; k < 4; ++k) write_tail(child[k], tails.word[k] | level);
+            parent.first_child = c;
+        }
+        // Within the reserved capacity: no reallocation, so `positions` stays valid. One loop a
+        // vertex placer, so that the default ones are inlined.
+        const Vec3* positions = positions_.data();
+        auto append = [&](auto place) {
+            using Made = NewPositions<decltype(place)>;
+            positions_.insert(positions_.end(), Made(ends, ends + new_vertices, positions, place),
+                              Made(ends + new_vertices, ends + new_vertices, positions, place));
+        };
+        if (!default_placer || far_positions_) {
+            const size_t first = positions_.size();
+            append([placer = placer_, context = placer_context_](Vec3 a, Vec3 b) { return placer(context, a, b); });
+            for (size_t v = first; v < positions_.size(); ++v) far_positions_ |= is_far(positions_[v]);
+        } else if (placer_context_ != nullptr) {
+            append([context = placer_context_](Vec3 a, Vec3 b) { return near_midpoint_placer(context, a, b); });
+        } else {
+            append([](Vec3 a, Vec3 b) { return near_midpoint_placer(nullptr, a, b); });
+        }
+    }
+    live_nodes_ += 4 * count;
+    live_vertices_ += uint32_t(next_vertex - v0);
+}
+
+}  // namespace amc
