@@ -3,6 +3,8 @@
 // (docs/FORMAT.md, 3.7: every count is checked against the bytes that can hold it before anything
 // is allocated for it). A test binary of its own: it counts every allocation through a global
 // operator new.
+#include "padded_series.h"
+
 #include "coding/entropy/arithmetic_coder.h"
 #include "coding/base/base_mesh_coder.h"
 #include "coding/container.h"
@@ -652,6 +654,30 @@ void read_forest_series(const std::vector<uint8_t>& file, const SeriesReadOption
     for (size_t k = 0; k < reader.frame_count(); ++k) reader.frame(k);
 }
 
+// Refuses `original` with frame block `block` replaced by a changed payload, as `read` reads it
+// (read_series or read_forest_series); `frame` prefixes the case's name.
+using SeriesRead = void (*)(const std::vector<uint8_t>&, const SeriesReadOptions&);
+auto frame_refusal(const SeriesParts& original, size_t block, std::string frame, SeriesRead read) {
+    return [&original, block, frame = std::move(frame), read](const std::string& what, ErrorCode code,
+                                                              const FramePayload& changed, const char* must_say) {
+        SeriesParts parts = original;
+        parts.blocks[block].second = write_frame_payload(changed);
+        const std::vector<uint8_t> file = put_series_together(parts);
+        expect_refused_cheaply(frame + what, code, [&] { read(file, {}); }, must_say);
+    };
+}
+
+// What every frame block holds (FORMAT.md 7.4, 7.11): a connectivity length and a field count.
+template <class Refused>
+void refuse_huge_lengths(const Refused& refused, const FramePayload& f, uint64_t huge) {
+    FramePayload connectivity = f;
+    connectivity.connectivity_length = huge;
+    refused("connectivity length = " + std::to_string(huge), ErrorCode::truncated, connectivity, "connectivity longer");
+    FramePayload fields = f;
+    fields.field_count = huge;
+    refused("field count = " + std::to_string(huge), ErrorCode::corrupt, fields, "fields (at most 4096)");
+}
+
 // A small series: a keyframe and a type-3 frame, each with a point and a cell field.
 std::vector<uint8_t> small_series() {
     Hierarchy h(make_icosahedron());
@@ -701,14 +727,8 @@ TEST(CraftedFiles, SeriesFrameCounts) {
     const uint64_t base_triangles = 20;
     const char* const names[] = {"nodes", "vertices", "faces", "levels"};
     for (size_t block = 1; block <= 2; ++block) {
-        const std::string frame = "series frame " + std::to_string(block - 1) + " ";
         const FramePayload f = read_frame_payload(original.blocks[block].second, false);
-        const auto refused = [&](const std::string& what, ErrorCode code, const FramePayload& changed, const char* must_say) {
-            SeriesParts parts = original;
-            parts.blocks[block].second = write_frame_payload(changed);
-            const std::vector<uint8_t> file = put_series_together(parts);
-            expect_refused_cheaply(frame + what, code, [&] { read_series(file); }, must_say);
-        };
+        const auto refused = frame_refusal(original, block, "series frame " + std::to_string(block - 1) + " ", read_series);
         for (uint64_t huge : kHuge) {
             for (int i = 0; i < 4; ++i) {
                 FramePayload changed = f;
@@ -721,15 +741,10 @@ TEST(CraftedFiles, SeriesFrameCounts) {
             FramePayload nodes = f;
             nodes.counts[0] = huge - (huge - base_triangles) % 4;
             refused("nodes = " + std::to_string(nodes.counts[0]) + " (consistent)", ErrorCode::limit_exceeded, nodes, "limit");
-            FramePayload connectivity = f;
-            connectivity.connectivity_length = huge;
-            refused("connectivity length = " + std::to_string(huge), ErrorCode::truncated, connectivity, "connectivity longer");
+            refuse_huge_lengths(refused, f, huge);
             FramePayload geometry = f;
             geometry.geometry_length = huge;
             refused("geometry length = " + std::to_string(huge), ErrorCode::truncated, geometry, "geometry longer");
-            FramePayload fields = f;
-            fields.field_count = huge;
-            refused("field count = " + std::to_string(huge), ErrorCode::corrupt, fields, "fields (at most 4096)");
         }
         // Nodes within the node limit but not within the block's bytes (7.2, Bounds).
         FramePayload nodes = f;
@@ -837,36 +852,24 @@ TEST(CraftedFiles, SeriesCostlessFramesBomb) {
 }
 
 TEST(CraftedFiles, SeriesWriterPadsCostlessFrames) {
-    // A single triangle refined uniformly 9 times (349,525 nodes) costs no symbol as a keyframe
-    // and next to nothing unchanged: the writer pads both frame blocks to hold at most
-    // kSeriesNodesPerByte nodes per byte, and they read back with the default options.
-    TriangleMesh triangle;
-    triangle.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-    triangle.triangles = {{0, 1, 2}};
-    Hierarchy h(triangle);
-    refine_uniformly(h, 9);
-    SeriesOptions options;
-    options.choose_keyframes = false;
-    SeriesWriter writer(triangle, options);
-    for (int k = 0; k < 2; ++k) {
-        const SeriesFrameStats stats = writer.add_frame(h, double(k));
-        EXPECT_GE(stats.bytes * kSeriesNodesPerByte, h.node_count()) << k;
-        EXPECT_LT((stats.bytes - 1) * kSeriesNodesPerByte, h.node_count()) << k;  // no more than needed
+    // The padded series cost no symbol as a keyframe and next to nothing unchanged: the writers
+    // pad both frame blocks to hold at most kSeriesNodesPerByte nodes per byte, no more than
+    // needed, and they read back with the default options.
+    const test::PaddedSeries series = test::padded_series();
+    const uint64_t nodes = series.hierarchy.node_count();
+    SeriesReader reader(series.bytes);
+    for (size_t k = 0; k < 2; ++k) {
+        EXPECT_GE(series.stats[k].bytes * kSeriesNodesPerByte, nodes) << k;
+        EXPECT_LT((series.stats[k].bytes - 1) * kSeriesNodesPerByte, nodes) << k;
+        EXPECT_TRUE(identical(reader.frame(k).hierarchy, series.hierarchy)) << k;
     }
-    writer.close();
-    SeriesReader reader(writer.bytes());
-    for (size_t k = 0; k < 2; ++k) EXPECT_TRUE(identical(reader.frame(k).hierarchy, h)) << k;
-    // Octants: a uniform quadtree of depth 9 (349,525 octants) over one tree, twice.
-    const OctreeForest forest = uniform_octree_forest(brick_connectivity(2, 1, 1), 9);
-    ForestSeriesWriter forests(forest.connectivity, options);
-    for (int k = 0; k < 2; ++k) {
-        const ForestSeriesFrameStats stats = forests.add_frame(forest, double(k));
-        EXPECT_GE(stats.bytes * kSeriesNodesPerByte, stats.octants) << k;
-        EXPECT_LT((stats.bytes - 1) * kSeriesNodesPerByte, stats.octants) << k;
+    const test::PaddedForestSeries forests = test::padded_forest_series();
+    ForestSeriesReader forest_reader(forests.bytes);
+    for (size_t k = 0; k < 2; ++k) {
+        EXPECT_GE(forests.stats[k].bytes * kSeriesNodesPerByte, forests.stats[k].octants) << k;
+        EXPECT_LT((forests.stats[k].bytes - 1) * kSeriesNodesPerByte, forests.stats[k].octants) << k;
+        EXPECT_EQ(forest_reader.frame(k).forest, forests.forest) << k;
     }
-    forests.close();
-    ForestSeriesReader forest_reader(forests.bytes());
-    for (size_t k = 0; k < 2; ++k) EXPECT_EQ(forest_reader.frame(k).forest, forest) << k;
 }
 
 // A forest series of two frames over a 2 x 2 brick, with a leaf field.
@@ -908,26 +911,16 @@ TEST(CraftedFiles, ForestSeriesCounts) {
     }
     const char* const names[] = {"octants", "leaves", "levels"};
     for (size_t block = 1; block <= 2; ++block) {
-        const std::string frame = "forest series frame " + std::to_string(block - 1) + " ";
         const FramePayload f = read_frame_payload(original.blocks[block].second, true);
-        const auto refused = [&](const std::string& what, ErrorCode code, const FramePayload& changed, const char* must_say) {
-            SeriesParts parts = original;
-            parts.blocks[block].second = write_frame_payload(changed);
-            const std::vector<uint8_t> file = put_series_together(parts);
-            expect_refused_cheaply(frame + what, code, [&] { read_forest_series(file); }, must_say);
-        };
+        const auto refused =
+            frame_refusal(original, block, "forest series frame " + std::to_string(block - 1) + " ", read_forest_series);
         for (uint64_t huge : kHuge) {
             for (int i = 0; i < 3; ++i) {
                 FramePayload changed = f;
                 changed.counts[size_t(i)] = huge;
                 refused(std::string(names[i]) + " = " + std::to_string(huge), ErrorCode::corrupt, changed, "inconsistent counts");
             }
-            FramePayload connectivity = f;
-            connectivity.connectivity_length = huge;
-            refused("connectivity length = " + std::to_string(huge), ErrorCode::truncated, connectivity, "connectivity longer");
-            FramePayload fields = f;
-            fields.field_count = huge;
-            refused("field count = " + std::to_string(huge), ErrorCode::corrupt, fields, "fields (at most 4096)");
+            refuse_huge_lengths(refused, f, huge);
             // The field record (7.12): mode, then its length.
             FramePayload record = f;
             record.fields.resize(1);

@@ -94,7 +94,7 @@ std::vector<Hierarchy> expected_decodings(const Hierarchy& h, const EncodeOption
             std::vector<Vec3> points;
             const std::vector<uint32_t> order = canonical_vertex_order(h);
             for (VertexId v = 0; v < order.size(); ++v)
-                if (order[v] != 0xffffffffu) points.push_back(h.position(v));
+                if (order[v] != kNoVertex) points.push_back(h.position(v));
             const Quantizer quantizer = make_quantizer(points, options.quantize_bits);
             for (Vec3& p : base.positions) p = dequantize(quantizer, snap_to_grid(quantizer, p));
         }
@@ -114,11 +114,11 @@ std::vector<Hierarchy> expected_decodings(const Hierarchy& h, const EncodeOption
         std::vector<Vec3> points;
         const std::vector<uint32_t> order = canonical_vertex_order(expected);
         for (VertexId v = 0; v < order.size(); ++v) {
-            if (order[v] != 0xffffffffu) points.push_back(expected.position(v));
+            if (order[v] != kNoVertex) points.push_back(expected.position(v));
         }
         const Quantizer quantizer = make_quantizer(points, options.quantize_bits);
         for (VertexId v = 0; v < order.size(); ++v) {
-            if (order[v] != 0xffffffffu) expected.set_position(v, dequantize(quantizer, quantize(quantizer, expected.position(v))));
+            if (order[v] != kNoVertex) expected.set_position(v, dequantize(quantizer, quantize(quantizer, expected.position(v))));
         }
     }
     return candidates;
@@ -128,6 +128,33 @@ bool decodes_to_one_of(const Hierarchy& back, const std::vector<Hierarchy>& cand
     for (const Hierarchy& c : candidates)
         if (identical(back, c)) return true;
     return false;
+}
+
+// c's golden file of `version`, which the encoder must reproduce byte for byte (empty when it is
+// missing). AMC_UPDATE_GOLDEN writes a missing file first; it never overwrites one.
+std::vector<uint8_t> pinned_encoding(const GoldenCase& c, int version, EncodeStats* stats = nullptr) {
+    const std::vector<uint8_t> bytes = encode(c.hierarchy, c.options, stats);
+    const std::string path = golden_path(version, c.name);
+    if (std::getenv("AMC_UPDATE_GOLDEN") != nullptr && !std::filesystem::exists(path)) {
+        std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+        std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    }
+    const std::vector<uint8_t> golden = read_golden(path);
+    if (!golden.empty()) EXPECT_EQ(bytes, golden) << path << ": the bitstream changed (a new format version: FORMAT.md, Versions)";
+    return golden;
+}
+
+// A golden file of `version` decodes to c's hierarchy, and every prefix of its levels to that
+// level (progressive decoding).
+void check_decodes(const std::vector<uint8_t>& golden, const GoldenCase& c, int version) {
+    const Hierarchy back = decode(golden.data(), golden.size());
+    EXPECT_TRUE(decodes_to_one_of(back, expected_decodings(c.hierarchy, c.options, version)));
+    const int levels = inspect(golden.data(), golden.size()).levels;
+    for (int l = 0; l < levels; ++l) {
+        DecodeOptions prefix;
+        prefix.max_level = l;
+        EXPECT_EQ(decode(golden.data(), golden.size(), prefix).depth(), std::min(l, back.depth())) << "level " << l;
+    }
 }
 
 // The versions with these cases: version 3 adds only the numbering block, whose golden files
@@ -163,30 +190,16 @@ std::vector<GoldenCase> static_geometry_cases() {
 }
 
 TEST(Golden, StaticGeometryFilesDecodeAndPinTheEncoder) {
-    const bool update = std::getenv("AMC_UPDATE_GOLDEN") != nullptr;
     for (const GoldenCase& c : static_geometry_cases()) {
+        SCOPED_TRACE(golden_path(kStaticGeometryVersion, c.name));
         EncodeStats stats;
-        const std::vector<uint8_t> bytes = encode(c.hierarchy, c.options, &stats);
-        const std::string path = golden_path(kStaticGeometryVersion, c.name);
-        SCOPED_TRACE(path);
-        if (update && !std::filesystem::exists(path)) {
-            std::filesystem::create_directories(std::filesystem::path(path).parent_path());
-            std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-        }
-        const std::vector<uint8_t> golden = read_golden(path);
-        ASSERT_FALSE(golden.empty()) << path << " is missing";
-        EXPECT_EQ(bytes, golden) << "the bitstream changed (a new format version: FORMAT.md, Versions)";
+        const std::vector<uint8_t> golden = pinned_encoding(c, kStaticGeometryVersion, &stats);
+        ASSERT_FALSE(golden.empty()) << "missing";
         EXPECT_EQ(inspect(golden.data(), golden.size()).version, kStaticGeometryVersion);
         EXPECT_TRUE(std::any_of(stats.per_level.begin(), stats.per_level.end(),
                                 [](const LevelStats& l) { return l.predictor == GeometryPredictor::normal_frame; }))
             << "the case exercises geometry mode 3";
-        const Hierarchy back = decode(golden.data(), golden.size());
-        EXPECT_TRUE(decodes_to_one_of(back, expected_decodings(c.hierarchy, c.options, kStaticGeometryVersion)));
-        for (int l = 0; l < int(stats.levels); ++l) {
-            DecodeOptions prefix;
-            prefix.max_level = l;
-            EXPECT_EQ(decode(golden.data(), golden.size(), prefix).depth(), std::min(l, back.depth())) << "level " << l;
-        }
+        check_decodes(golden, c, kStaticGeometryVersion);
     }
 }
 
@@ -210,28 +223,14 @@ std::vector<GoldenCase> chunked_cases() {
 }
 
 TEST(Golden, ChunkedFilesDecodeAndPinTheEncoder) {
-    const bool update = std::getenv("AMC_UPDATE_GOLDEN") != nullptr;
     for (const GoldenCase& c : chunked_cases()) {
-        const std::vector<uint8_t> bytes = encode(c.hierarchy, c.options);
-        const std::string path = golden_path(kChunkedVersion, c.name);
-        SCOPED_TRACE(path);
-        if (update && !std::filesystem::exists(path)) {
-            std::filesystem::create_directories(std::filesystem::path(path).parent_path());
-            std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-        }
-        const std::vector<uint8_t> golden = read_golden(path);
-        ASSERT_FALSE(golden.empty()) << path << " is missing";
-        EXPECT_EQ(bytes, golden) << "the bitstream changed (a new format version: FORMAT.md, Versions)";
+        SCOPED_TRACE(golden_path(kChunkedVersion, c.name));
+        const std::vector<uint8_t> golden = pinned_encoding(c, kChunkedVersion);
+        ASSERT_FALSE(golden.empty()) << "missing";
         const FileInfo info = inspect(golden.data(), golden.size());
         EXPECT_EQ(info.version, kChunkedVersion);
         EXPECT_EQ(info.chunks.size(), size_t(c.options.chunks));
-        const Hierarchy back = decode(golden.data(), golden.size());
-        EXPECT_TRUE(decodes_to_one_of(back, expected_decodings(c.hierarchy, c.options, kChunkedVersion)));
-        for (int l = 0; l <= back.depth(); ++l) {
-            DecodeOptions prefix;
-            prefix.max_level = l;
-            EXPECT_EQ(decode(golden.data(), golden.size(), prefix).depth(), l) << "level " << l;
-        }
+        check_decodes(golden, c, kChunkedVersion);
     }
 }
 
@@ -259,27 +258,12 @@ std::vector<GoldenCase> mixed_contexts_cases() {
 }
 
 TEST(Golden, MixedContextsFilesDecodeAndPinTheEncoder) {
-    const bool update = std::getenv("AMC_UPDATE_GOLDEN") != nullptr;
     for (const GoldenCase& c : mixed_contexts_cases()) {
-        EncodeStats stats;
-        const std::vector<uint8_t> bytes = encode(c.hierarchy, c.options, &stats);
-        const std::string path = golden_path(kMixedContextsVersion, c.name);
-        SCOPED_TRACE(path);
-        if (update && !std::filesystem::exists(path)) {
-            std::filesystem::create_directories(std::filesystem::path(path).parent_path());
-            std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-        }
-        const std::vector<uint8_t> golden = read_golden(path);
-        ASSERT_FALSE(golden.empty()) << path << " is missing";
-        EXPECT_EQ(bytes, golden) << "the bitstream changed (a new format version: FORMAT.md, Versions)";
+        SCOPED_TRACE(golden_path(kMixedContextsVersion, c.name));
+        const std::vector<uint8_t> golden = pinned_encoding(c, kMixedContextsVersion);
+        ASSERT_FALSE(golden.empty()) << "missing";
         EXPECT_EQ(inspect(golden.data(), golden.size()).version, kMixedContextsVersion);
-        const Hierarchy back = decode(golden.data(), golden.size());
-        EXPECT_TRUE(decodes_to_one_of(back, expected_decodings(c.hierarchy, c.options, kMixedContextsVersion)));
-        for (int l = 0; l < int(stats.levels); ++l) {
-            DecodeOptions prefix;
-            prefix.max_level = l;
-            EXPECT_EQ(decode(golden.data(), golden.size(), prefix).depth(), std::min(l, back.depth())) << "level " << l;
-        }
+        check_decodes(golden, c, kMixedContextsVersion);
     }
 }
 
@@ -300,31 +284,14 @@ TEST(Golden, FilesOfEveryVersionDecodeToTheirHierarchies) {
             EXPECT_EQ(info.blocks[2].name, "base geometry");
             for (int l = 0; l < info.levels; ++l) EXPECT_EQ(info.blocks[size_t(3 + l)].level, l);
             EXPECT_EQ(info.blocks.back().name, "end");
-            const Hierarchy back = decode(golden.data(), golden.size());
-            EXPECT_TRUE(decodes_to_one_of(back, expected_decodings(c.hierarchy, c.options, version)));
-            // Every prefix of levels too (progressive decoding).
-            for (int l = 0; l < info.levels; ++l) {
-                DecodeOptions prefix;
-                prefix.max_level = l;
-                EXPECT_EQ(decode(golden.data(), golden.size(), prefix).depth(), std::min(l, back.depth())) << "level " << l;
-            }
+            check_decodes(golden, c, version);
         }
     }
 }
 
 TEST(Golden, EncodingsMatchTheCurrentVersionsFiles) {
-    const bool update = std::getenv("AMC_UPDATE_GOLDEN") != nullptr;
-    for (const GoldenCase& c : golden_cases()) {
-        const std::vector<uint8_t> bytes = encode(c.hierarchy, c.options);
-        const std::string path = golden_path(kCurrentVersionOfTheCases, c.name);
-        if (update && !std::filesystem::exists(path)) {
-            std::filesystem::create_directories(std::filesystem::path(path).parent_path());
-            std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-        }
-        const std::vector<uint8_t> golden = read_golden(path);
-        ASSERT_FALSE(golden.empty()) << path << " is missing";
-        EXPECT_EQ(bytes, golden) << c.name << ": the bitstream changed (a new format version: FORMAT.md, Versions)";
-    }
+    for (const GoldenCase& c : golden_cases())
+        EXPECT_FALSE(pinned_encoding(c, kCurrentVersionOfTheCases).empty()) << golden_path(kCurrentVersionOfTheCases, c.name) << " is missing";
 }
 
 // tests/data/golden/SHA256SUMS lists every golden file with its SHA-256, as `sha256sum` writes it

@@ -8,6 +8,7 @@
 #include <amc/refinement.h>
 #include <amc/series.h>
 
+#include "padded_series.h"
 #include "series/series_format.h"
 
 #include <gtest/gtest.h>
@@ -175,45 +176,30 @@ TEST(SeriesGolden, TheIndicatorFileOfVersion2DecodesAndIsWhatTheWriterWrites) {
     }
 }
 
-// Frames that cost next to nothing, padded by the writer to at most kSeriesNodesPerByte nodes
-// (octants) per byte (FORMAT.md 7.2, Bounds): a single triangle refined uniformly 9 times (349,525
-// nodes), as a keyframe and again unchanged; a uniform quadtree of depth 9 over one tree, twice.
+// The padded series (padded_series.h): frames that cost next to nothing, padded by the writers to
+// at most kSeriesNodesPerByte nodes (octants) per byte (FORMAT.md 7.2, Bounds).
 TEST(SeriesGolden, PaddedFramesDecodeAndAreWhatTheWritersWrite) {
-    TriangleMesh triangle;
-    triangle.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-    triangle.triangles = {{0, 1, 2}};
-    Hierarchy h(triangle);
-    refine_uniformly(h, 9);
-    SeriesOptions options;
-    options.choose_keyframes = false;
-    SeriesWriter writer(triangle, options);
-    writer.add_frame(h, 0);
-    writer.add_frame(h, 1);
-    writer.close();
+    const test::PaddedSeries series = test::padded_series();
     const std::string path = golden_path(kSeriesVersion, "padded");
-    write_missing_golden(path, writer.bytes());
+    write_missing_golden(path, series.bytes);
     const std::vector<uint8_t> golden = read_file(path);
-    EXPECT_EQ(writer.bytes(), golden) << "the series bitstream changed (a new series version: FORMAT.md, section 7)";
+    EXPECT_EQ(series.bytes, golden) << "the series bitstream changed (a new series version: FORMAT.md, section 7)";
     SeriesReader reader(golden, path);
     ASSERT_EQ(reader.frame_count(), 2u);
     for (size_t k = 0; k < 2; ++k) {
-        EXPECT_TRUE(identical(reader.frame(k).hierarchy, h)) << path << " frame " << k;
-        EXPECT_LT((reader.info(k).size - 1) * kSeriesNodesPerByte, h.node_count()) << "frame " << k << " not padded";
+        EXPECT_TRUE(identical(reader.frame(k).hierarchy, series.hierarchy)) << path << " frame " << k;
+        EXPECT_LT((reader.info(k).size - 1) * kSeriesNodesPerByte, series.hierarchy.node_count()) << "frame " << k << " not padded";
     }
 
-    const OctreeForest forest = uniform_octree_forest(brick_connectivity(2, 1, 1), 9);
-    ForestSeriesWriter forests(forest.connectivity, options);
-    forests.add_frame(forest, 0);
-    forests.add_frame(forest, 1);
-    forests.close();
+    const test::PaddedForestSeries forests = test::padded_forest_series();
     const std::string forest_path = golden_path(kForestSeriesVersion, "padded_forest");
-    write_missing_golden(forest_path, forests.bytes());
+    write_missing_golden(forest_path, forests.bytes);
     const std::vector<uint8_t> forest_golden = read_file(forest_path);
-    EXPECT_EQ(forests.bytes(), forest_golden) << "the series bitstream changed (a new series version: FORMAT.md, section 7)";
+    EXPECT_EQ(forests.bytes, forest_golden) << "the series bitstream changed (a new series version: FORMAT.md, section 7)";
     ForestSeriesReader forest_reader(forest_golden, forest_path);
     ASSERT_EQ(forest_reader.frame_count(), 2u);
     for (size_t k = 0; k < 2; ++k) {
-        EXPECT_EQ(forest_reader.frame(k).forest, forest) << forest_path << " frame " << k;
+        EXPECT_EQ(forest_reader.frame(k).forest, forests.forest) << forest_path << " frame " << k;
         EXPECT_LT((forest_reader.info(k).size - 1) * kSeriesNodesPerByte, forest_reader.info(k).octants) << "frame " << k;
     }
 }
