@@ -36,6 +36,7 @@ Hierarchy reorder_base(const Hierarchy& h, const std::vector<uint32_t>& vertex_o
     // red_split::kRotatedChild[r][k], rotated by r as well. The default
     // diagonal rule is cyclic, so diagonal flags carry over unchanged.
     Hierarchy out(std::move(base));
+    out.reserve(h.node_count(), h.vertex_count());  // grown once, not by doubling split by split
     if (vertex_map != nullptr) vertex_map->assign(h.positions().size(), kNoVertex);
     out.set_vertex_placer([](void*, Vec3 a, Vec3) { return a; }, nullptr);  // positions copied below
     std::vector<std::pair<NodeId, NodeId>> queue;  // (old node, new node)

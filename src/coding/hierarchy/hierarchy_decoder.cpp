@@ -110,12 +110,14 @@ std::vector<NodeId> HierarchyLevelDecoder::level_nodes() const {
 }
 
 void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder, uint64_t max_refined) {
+    const uint64_t vertices_before = vertex_count_;
     decide_level(decoder, max_refined);
     // Node ids are consecutive level by level: the decided level's nodes come right before its
     // children, the last nodes counted.
     const Level& level = decided_.back();
     const NodeId first = NodeId(node_count_ - uint64_t(4) * level.refined_count - level.size());
     new_vertices_.clear();
+    new_vertices_.reserve(vertex_count_ - vertices_before);  // once per level, not doubling vertex by vertex
     for_each_new_vertex(level, numbering_, [&](uint32_t i, int e) { new_vertices_.emplace_back(first + i, e); });
     build_decided_levels();
 }

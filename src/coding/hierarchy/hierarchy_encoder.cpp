@@ -106,9 +106,10 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         stats.levels = l + 1;
         level_end_.push_back(events_.size());
         scan_decided_level(level, numbering, nullptr);
+        const uint64_t created_count = derive_next_level(level, numbering, next, options.cull_one_regularity);
         std::vector<std::pair<NodeId, int>>& created = new_vertices_.emplace_back();
+        created.reserve(created_count);
         for_each_new_vertex(level, numbering, [&](uint32_t i, int e) { created.emplace_back(ids[i], e); });
-        derive_next_level(level, numbering, next, options.cull_one_regularity);
         std::swap(level, next);
         level_ids_.push_back(ids);
         ids.swap(next_ids);
