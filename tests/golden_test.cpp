@@ -140,7 +140,9 @@ std::vector<uint8_t> pinned_encoding(const GoldenCase& c, int version, EncodeSta
         std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
     }
     const std::vector<uint8_t> golden = read_golden(path);
-    if (!golden.empty()) EXPECT_EQ(bytes, golden) << path << ": the bitstream changed (a new format version: FORMAT.md, Versions)";
+    if (!golden.empty()) {
+        EXPECT_EQ(bytes, golden) << path << ": the bitstream changed (a new format version: FORMAT.md, Versions)";
+    }
     return golden;
 }
 
