@@ -1,6 +1,8 @@
 // Re-expressing a hierarchy over a reordered, rotated base mesh keeps every element and position.
 #include "hierarchy_checks.h"
 
+#include "coding/hierarchy/hierarchy_level_coder.h"
+
 #include <algorithm>
 #include <array>
 #include <numeric>
@@ -53,6 +55,13 @@ TEST(BaseOrder, ReorderedHierarchyHasTheSameElements) {
         EXPECT_TRUE(testing::hierarchy_is_valid(moved)) << name;
         EXPECT_EQ(moved.node_count(), h.node_count()) << name;
         EXPECT_EQ(geometric_triangles(moved), geometric_triangles(h)) << name;
+        // The encoder tallies the rotated hierarchy's diagonal exceptions on the input instead.
+        std::vector<uint8_t> rotation_of_root(triangle_order.size());
+        for (size_t t = 0; t < triangle_order.size(); ++t) rotation_of_root[triangle_order[t]] = rotation[t];
+        const DiagonalExceptions direct = diagonal_exceptions(moved), tallied = diagonal_exceptions(h, rotation_of_root);
+        EXPECT_GT(direct.leaves, 0u) << name;
+        EXPECT_EQ(tallied.leaves, direct.leaves) << name;
+        for (int r = 0; r < kDiagonalRuleCount; ++r) EXPECT_EQ(tallied.by_rule[r], direct.by_rule[r]) << name << " rule " << r;
     }
 }
 
