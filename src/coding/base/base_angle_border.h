@@ -151,6 +151,35 @@ public:
     uint32_t opp(uint32_t n) const { return nodes_[n].opp; }
     Loop& top() { return stack.back(); }
 
+    // A split's predicted tip (FORMAT.md 4.14): the node of the gate's loop of `length` nodes,
+    // k = 2 .. length - 3 links after gate g's next node nv, nearest to the parallelogram over the
+    // gate's triangle; node kNoBorderNode when no located node is a candidate. `predicted` is
+    // false (and the loop not walked) when the gate's triangle lacks a position.
+    struct NearestTip {
+        bool predicted = false;
+        uint32_t node = kNoBorderNode, k = 0;
+    };
+    NearestTip nearest_tip(uint32_t g, uint32_t nv, uint32_t length) const {
+        NearestTip tip;
+        const uint32_t o = opp(g);
+        if (!located(vert(g)) || !located(vert(nv)) || !located(o)) return tip;
+        tip.predicted = true;
+        const Vec3 predicted = (position(vert(g)) + position(vert(nv))) - position(o);
+        double best_distance = 0;
+        uint32_t x = next(next(nv));
+        for (uint32_t i = 2; i + 3 <= length; ++i, x = next(x)) {
+            if (!located(vert(x))) continue;
+            const Vec3 d = position(vert(x)) - predicted;
+            const double distance = exact_dot(d, d);
+            if (tip.node == kNoBorderNode || distance < best_distance) {
+                tip.node = x;
+                tip.k = i;
+                best_distance = distance;
+            }
+        }
+        return tip;
+    }
+
     // The corner class of node n as a gate: the gap at its vertex between the next and the
     // previous node. Cached; an op that relinks a node or changes its opp clears its cache.
     CornerClass corner(uint32_t n) {

@@ -155,28 +155,11 @@ private:
 
     // FORMAT.md 4.14: the nearest-tip bit, else the offset k - 2 from the gate's next node.
     uint32_t split_tip(uint32_t g, uint32_t nv, uint32_t length, uint32_t& k) {
-        Border& b = border_;
-        const uint32_t o = b.opp(g);
-        if (b.located(b.vert(g)) && b.located(b.vert(nv)) && b.located(o)) {
-            const Vec3 predicted = (b.position(b.vert(g)) + b.position(b.vert(nv))) - b.position(o);
-            charge_walk(length - 4);
-            uint32_t best = angle_mode::kNoBorderNode, best_k = 0;
-            double best_distance = 0;
-            uint32_t x = b.next(b.next(nv));
-            for (uint32_t i = 2; i + 3 <= length; ++i, x = b.next(x)) {
-                if (!b.located(b.vert(x))) continue;
-                const Vec3 d = b.position(b.vert(x)) - predicted;
-                const double distance = exact_dot(d, d);
-                if (best == angle_mode::kNoBorderNode || distance < best_distance) {
-                    best = x;
-                    best_k = i;
-                    best_distance = distance;
-                }
-            }
-            if (best != angle_mode::kNoBorderNode && dec_.decode(models_.nearest)) {
-                k = best_k;
-                return best;
-            }
+        const Border::NearestTip tip = border_.nearest_tip(g, nv, length);
+        if (tip.predicted) charge_walk(length - 4);
+        if (tip.node != angle_mode::kNoBorderNode && dec_.decode(models_.nearest)) {
+            k = tip.k;
+            return tip.node;
         }
         k = 2 + get_split_offset(dec_, models_.split_offset, length - 4);
         return walk_to(g, k + 1, length);

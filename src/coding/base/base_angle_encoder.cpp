@@ -334,27 +334,11 @@ private:
     // The decoder's rule (base_angle_decoder.cpp, split_tip): the nearest-tip bit when there is a
     // prediction, else the offset.
     void encode_split_tip(uint32_t g, uint32_t nv, uint32_t n, uint32_t k, uint32_t length) {
-        const Border& b = border_;
-        const uint32_t o = b.opp(g);
-        if (b.located(b.vert(g)) && b.located(b.vert(nv)) && b.located(o)) {
-            const Vec3 predicted = (b.position(b.vert(g)) + b.position(b.vert(nv))) - b.position(o);
-            charge_walk(length - 4);
-            uint32_t best = angle_mode::kNoBorderNode;
-            double best_distance = 0;
-            uint32_t x = b.next(b.next(nv));
-            for (uint32_t i = 2; i + 3 <= length; ++i, x = b.next(x)) {
-                if (!b.located(b.vert(x))) continue;
-                const Vec3 d = b.position(b.vert(x)) - predicted;
-                const double distance = exact_dot(d, d);
-                if (best == angle_mode::kNoBorderNode || distance < best_distance) {
-                    best = x;
-                    best_distance = distance;
-                }
-            }
-            if (best != angle_mode::kNoBorderNode) {
-                put_bit(models_.nearest, best == n);
-                if (best == n) return;
-            }
+        const Border::NearestTip tip = border_.nearest_tip(g, nv, length);
+        if (tip.predicted) charge_walk(length - 4);
+        if (tip.node != angle_mode::kNoBorderNode) {
+            put_bit(models_.nearest, tip.node == n);
+            if (tip.node == n) return;
         }
         put_split_offset(enc_, models_.split_offset, k - 2, length - 4);
         charge_walk(std::min(k + 1, length - k - 1));
