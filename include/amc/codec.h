@@ -49,6 +49,16 @@ struct EncodeOptions {
     // lower, byte for byte); more chunks make a version-7 file.
     uint32_t chunks = 0;
     uint64_t chunk_faces = 100000;
+    // Explicit chunks instead: the number of roots of each chunk, in file order (the input's own
+    // order with keep_base_order), adding up to the root count; `chunks` and `chunk_faces` are then
+    // ignored. One entry writes a file without chunks. A file written by MPI ranks (amc/mpi.h) is
+    // the serial encoder's with the ranks' root counts here and keep_base_order.
+    std::vector<uint32_t> chunk_roots;
+    // The base mesh kept in the input's vertex and triangle order (the base connectivity's explicit
+    // mode, docs/FORMAT.md 4.8) instead of the base coder's: root t of the decoded file is root t
+    // of the input, so chunks are runs of the caller's roots. Costs about 3 log2(V) bits per base
+    // triangle where the base coder needs 1-2 bits per vertex (docs/MPI.md).
+    bool keep_base_order = false;
     // Threads that code chunks at once; 0: every core. The bytes do not depend on it.
     unsigned threads = 0;
 };

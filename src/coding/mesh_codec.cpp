@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <string>
 
 namespace amc {
 
@@ -57,6 +58,20 @@ uint8_t file_version(bool mixed_contexts, bool chunked, bool static_geometry, Ba
            : base_mode == BaseConnectivityMode::angle ? kSearchedBaseVersion
            : store_numbering                          ? kNumberingVersion
                                                       : kBaseVersion;
+}
+
+// EncodeOptions::chunk_roots as runs of roots, checked against the root count.
+std::vector<RootRange> explicit_chunks(const std::vector<uint32_t>& roots_per_chunk, uint32_t roots) {
+    std::vector<RootRange> out;
+    uint64_t first = 0;
+    for (uint32_t count : roots_per_chunk) {
+        AMC_REQUIRE(count >= 1, invalid_input, "encode: chunk " + std::to_string(out.size()) + " of chunk_roots has no roots");
+        out.push_back({uint32_t(first), count});
+        first += count;
+    }
+    AMC_REQUIRE(first == roots, invalid_input,
+                "encode: chunk_roots add up to " + std::to_string(first) + " roots, the hierarchy has " + std::to_string(roots));
+    return out;
 }
 
 // The hierarchy/geometry split of a level block is estimated at the coder's byte count when the
@@ -103,8 +118,11 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
 
     // Chunks (FORMAT.md 3.11): more than one makes a version-7 file, whose chunks code the forest on
     // several threads; the hierarchy coder then runs over the roots alone, for its header's sake.
-    const uint64_t faces = options.chunks == 1 ? 0 : leaf_face_count(h);
-    const std::vector<RootRange> chunks = balanced_chunks(nodes_per_root(h), chunk_count_for(options, faces));
+    const bool one_chunk = options.chunk_roots.empty() ? options.chunks == 1 : options.chunk_roots.size() == 1;
+    const uint64_t faces = one_chunk ? 0 : leaf_face_count(h);
+    const std::vector<RootRange> chunks = options.chunk_roots.empty()
+                                              ? balanced_chunks(nodes_per_root(h), chunk_count_for(options, faces))
+                                              : explicit_chunks(options.chunk_roots, h.root_count());
     // The mixing mode (FORMAT.md 2.1) codes the forest as one stream: one chunk.
     const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
     const bool chunked = !mixed && chunks.size() > 1;

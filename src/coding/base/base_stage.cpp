@@ -47,6 +47,7 @@ TriangleMesh base_as_decoded(const Hierarchy& h, const Quantizer* quantizer) {
 // of 92 for the canonical order), so with one the encoder makes version 4's single try.
 BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const EncodeOptions& options) {
     const TriangleMesh base = base_as_decoded(h, quantizer);
+    if (options.keep_base_order) return encode_base_connectivity(base, BaseConnectivityMode::explicit_triangles);
     if (options.numbering != nullptr && options.store_numbering) {
         try {
             return encode_base_connectivity(base, BaseConnectivityMode::angle, false);
