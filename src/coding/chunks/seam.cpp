@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
+#include <string>
 
 namespace amc {
 
@@ -81,6 +83,53 @@ Seam::Seam(const Hierarchy& h, const std::vector<uint32_t>& chunk_of_root, std::
         const NodeId q = h.neighbor(t, e);
         walk(walk, t, e, q, h.neighbor_edge(t, e), 0);
     }
+}
+
+Seam Seam::from_splits(const TriangleMesh& base, const std::vector<uint32_t>& chunk_of_root, std::vector<SeamSplit> splits) {
+    Seam seam;
+    seam.base_vertices_ = uint32_t(base.positions.size());
+    seam.single_precision_ = base.single_precision;
+    auto before = [](const SeamSplit& x, const SeamSplit& y) { return x.edge != y.edge ? x.edge < y.edge : x.segment < y.segment; };
+    std::sort(splits.begin(), splits.end(), before);
+    auto same_bits = [](double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; };
+    for (size_t i = 1; i < splits.size(); ++i) {
+        const SeamSplit& x = splits[i - 1];
+        const SeamSplit& y = splits[i];
+        AMC_REQUIRE(before(x, y) || (same_bits(x.position.x, y.position.x) && same_bits(x.position.y, y.position.y) &&
+                                     same_bits(x.position.z, y.position.z)),
+                    invalid_input,
+                    "the two sides of seam edge " + std::to_string(x.edge) + " give the vertex of its segment " +
+                        std::to_string(x.segment) + " different positions");
+    }
+    std::vector<Vec3> key_positions(base.positions);  // by key: base vertices, then seam vertices
+    size_t next = 0;                                   // the first split of the current edge not yet consumed
+    auto walk = [&](auto& self, uint32_t edge, uint64_t segment, uint32_t a, uint32_t b, int level) -> void {
+        const SeamSplit probe{edge, segment, {}};
+        const auto it = std::lower_bound(splits.begin() + std::ptrdiff_t(next), splits.end(), probe, before);
+        const bool split = it != splits.end() && it->edge == edge && it->segment == segment;
+        Segment s{split, uint8_t(level), key_positions[a], key_positions[b], 0};
+        if (!split) {
+            seam.segments_[segment_key(a, b)] = kUnsplit;
+            seam.trace_.push_back(s);
+            return;
+        }
+        AMC_REQUIRE(level < kMaxLevel, invalid_input, "a seam segment of level " + std::to_string(level) + " is split");
+        s.vertex = uint32_t(seam.positions_.size());
+        const uint32_t m = seam.base_vertices_ + s.vertex;
+        seam.segments_[segment_key(a, b)] = int32_t(s.vertex);
+        seam.positions_.push_back(it->position);
+        key_positions.push_back(it->position);
+        seam.trace_.push_back(s);
+        self(self, edge, 2 * segment, a, m, level + 1);
+        self(self, edge, 2 * segment + 1, m, b, level + 1);
+    };
+    const std::vector<std::pair<uint32_t, int>> edges = seam_edges(base, chunk_of_root);
+    for (uint32_t i = 0; i < edges.size(); ++i) {
+        while (next < splits.size() && splits[next].edge < i) ++next;
+        const Triangle& t = base.triangles[edges[i].first];
+        walk(walk, i, 1, t[edges[i].second], t[(edges[i].second + 1) % 3], 0);
+    }
+    return seam;
 }
 
 std::vector<uint8_t> Seam::encode(CoordinateSpace space) const {

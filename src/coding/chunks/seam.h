@@ -24,6 +24,16 @@ namespace amc {
 // triangles, triangles in order, edges 0, 1, 2: the order of the seam block.
 std::vector<std::pair<uint32_t, int>> seam_edges(const TriangleMesh& base, const std::vector<uint32_t>& chunk_of_root);
 
+// A split seam segment, as one side of the seam sees it (an MPI rank's roots, amc/mpi.h): seam edge
+// `edge` (an index into seam_edges), segment `segment` of its tree numbered as in a binary heap (1:
+// the whole edge from its first end, 2s and 2s + 1 the halves of s from that end), and the position
+// of the vertex that splitting it created.
+struct SeamSplit {
+    uint32_t edge = 0;
+    uint64_t segment = 1;
+    Vec3 position;
+};
+
 class Seam {
 public:
     static constexpr int32_t kNotSeam = -1;     // the segment lies on no seam edge
@@ -33,6 +43,9 @@ public:
     // The seam of `h` (the encoder's, in decoder base order): `key_of_vertex` receives each vertex
     // id's key (kNoVertex for vertices that are neither base nor seam vertices).
     Seam(const Hierarchy& h, const std::vector<uint32_t>& chunk_of_root, std::vector<uint32_t>& key_of_vertex);
+    // The same seam from the splits of every side, in any order (a split made by both sides may be
+    // listed twice). Throws Error (invalid_input) when two give one vertex different positions.
+    static Seam from_splits(const TriangleMesh& base, const std::vector<uint32_t>& chunk_of_root, std::vector<SeamSplit> splits);
     // The seam block's payload (FORMAT.md 3.13).
     std::vector<uint8_t> encode(CoordinateSpace space) const;
     // Reads a seam block. `max_vertices` bounds the seam vertices (the file's refinement vertices);
