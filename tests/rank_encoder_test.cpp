@@ -85,8 +85,13 @@ TEST(RankEncoder, RootRangesThatDoNotCutTheBaseAreRefused) {
     EXPECT_THROW(rank_layout(10, {{0, 5}, {4, 6}}), Error);  // an overlap
     EXPECT_THROW(rank_layout(10, {{0, 5}, {5, 4}}), Error);  // too few
     EXPECT_THROW(rank_layout(10, {{0, 5}, {5, 6}}), Error);  // too many
+    EXPECT_THROW(rank_layout(0, {{0, 0}}), Error);           // nothing to write
     const RankLayout ok = rank_layout(10, {{6, 4}, {0, 0}, {0, 6}});  // any rank order, empty ranks
     EXPECT_EQ(ok.chunk_of_rank, (std::vector<int32_t>{1, -1, 0}));
+    // A rank without roots passes an empty forest, whatever the base's precision.
+    TriangleMesh single = make_square(2);
+    single.single_precision = true;
+    EXPECT_EQ(rank_chunk(single, 8, Hierarchy(TriangleMesh{}), "rank 1").chunk.root_count(), 0u);
 }
 
 TEST(RankEncoder, ForestsThatDoNotMatchTheBaseAreRefused) {

@@ -49,11 +49,11 @@ RankChunk rank_chunk(const TriangleMesh& base, uint32_t first_root, const Hierar
     AMC_REQUIRE(first_root <= base.triangles.size() && count <= base.triangles.size() - first_root, invalid_input,
                 what + ": roots " + std::to_string(first_root) + " to " + std::to_string(first_root + count) +
                     " (exclusive) are not in the base mesh, which has " + std::to_string(base.triangles.size()) + " triangles");
-    AMC_REQUIRE(local.single_precision == base.single_precision, invalid_input,
-                what + ": the forest's base and the whole base differ in precision (float32 against float64)");
     RankChunk out;
     out.first_root = first_root;
     if (count == 0) return out;
+    AMC_REQUIRE(local.single_precision == base.single_precision, invalid_input,
+                what + ": the forest's base and the whole base differ in precision (float32 against float64)");
     check_before_writing(forest, what, true);
     std::vector<VertexId> global(local.positions.size(), kNoVertex), local_of(base.positions.size(), kNoVertex);
     for (uint32_t i = 0; i < count; ++i) {
@@ -86,6 +86,7 @@ RankChunk rank_chunk(const TriangleMesh& base, uint32_t first_root, const Hierar
 }
 
 RankLayout rank_layout(uint32_t roots, const std::vector<RootRange>& ranges) {
+    AMC_REQUIRE(roots > 0, invalid_input, "the base mesh has no triangles");
     RankLayout out;
     out.chunk_of_rank.assign(ranges.size(), -1);
     std::vector<uint32_t> ranks;
