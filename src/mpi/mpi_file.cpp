@@ -102,8 +102,8 @@ bool write_all(MPI_Comm comm, MPI_File file, uint64_t offset, const std::vector<
 }
 
 // Reads are independent (each rank its own ranges): Open MPI 4.1.4's collective reads
-// (MPI_File_read_at_all, OMPIO) returned wrong bytes to a rank whose range overlapped other ranks'
-// ranges in tests/mpi (3 ranks).
+// (MPI_File_read_at_all with its OMPIO component; ROMIO is right) return a wrong byte to a rank
+// whose range overlaps other ranks' ranges (docs/MPI.md, "Not done").
 bool read_all(MPI_Comm comm, MPI_File file, uint64_t offset, uint8_t* out, uint64_t size) {
     return in_pieces(comm, size, [&](uint64_t at, int n) {
         MPI_Status status;
