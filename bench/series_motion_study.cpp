@@ -8,7 +8,7 @@
 //     (frame k-1 against k-2: the decoder can do that itself, nothing sent);
 //   - the depth extrapolated linearly from the two previous frames (2 d(k-1) - d(k-2));
 //   - either block motion replaced by one affine map a frame fitted to its moving blocks' vectors
-//     (six numbers to send, or none for the extrapolated one);
+//     (six numbers to send, or none for the extrapolated one), plainly or robustly (outliers dropped);
 //   - for reference, the previous frame displaced by the front's own motion, exactly (an oracle:
 //     the best any motion model could do).
 // The previous frames are seen as depth images: the level of the leaf covering each pixel (a
@@ -174,13 +174,14 @@ double gamma_bits(int v) {
 struct Affine {
     double a[3] = {0, 0, 0}, b[3] = {0, 0, 0};  // vx = a0 x + a1 y + a2, vy = b0 x + b1 y + b2
 };
-Affine fit_affine(const Motion& m) {
+Affine fit_affine(const Motion& m, const std::vector<uint8_t>* use = nullptr) {
     double n[3][3] = {}, rx[3] = {}, ry[3] = {};
     int count = 0;
     for (int by = 0; by < m.bh; ++by)
         for (int bx = 0; bx < m.bw; ++bx) {
             const size_t i = size_t(by) * size_t(m.bw) + size_t(bx);
             if (m.vx.empty() || (m.vx[i] == 0 && m.vy[i] == 0)) continue;
+            if (use && !(*use)[i]) continue;
             const double f[3] = {(bx + 0.5) * m.block, (by + 0.5) * m.block, 1.0};
             for (int r = 0; r < 3; ++r) {
                 for (int c = 0; c < 3; ++c) n[r][c] += f[r] * f[c];
@@ -209,6 +210,31 @@ Affine fit_affine(const Motion& m) {
     return out;
 }
 
+// The same fit, robust: three rounds, each dropping the blocks whose vector is more than twice
+// the median distance from the previous round's map.
+Affine fit_affine_robust(const Motion& m) {
+    Affine f = fit_affine(m);
+    std::vector<uint8_t> use(m.vx.size(), 1);
+    for (int round = 0; round < 3; ++round) {
+        std::vector<double> r(m.vx.size(), -1);
+        std::vector<double> sorted;
+        for (int by = 0; by < m.bh; ++by)
+            for (int bx = 0; bx < m.bw; ++bx) {
+                const size_t i = size_t(by) * size_t(m.bw) + size_t(bx);
+                if (m.vx[i] == 0 && m.vy[i] == 0) continue;
+                const double x = (bx + 0.5) * m.block, y = (by + 0.5) * m.block;
+                r[i] = std::hypot(m.vx[i] - (f.a[0] * x + f.a[1] * y + f.a[2]), m.vy[i] - (f.b[0] * x + f.b[1] * y + f.b[2]));
+                sorted.push_back(r[i]);
+            }
+        if (sorted.size() < 6) return f;
+        std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
+        const double limit = std::max(0.5, 2 * sorted[sorted.size() / 2]);
+        for (size_t i = 0; i < r.size(); ++i) use[i] = r[i] >= 0 && r[i] <= limit;
+        f = fit_affine(m, &use);
+    }
+    return f;
+}
+
 struct Prediction {
     // relative depth codes at the centroid and min / max over the centroid and the three
     // corner midpoints: 0 outside, 1: depth - level <= -1, 2: 0, 3: 1, 4: >= 2.
@@ -218,7 +244,7 @@ struct Prediction {
 struct Symbol {
     uint16_t frame;
     uint8_t level, cls, border, dec_changed, dec_refined, parent_area, bit;
-    Prediction none, sent, extra, linear, oracle, fitted, fitted_extra;
+    Prediction none, sent, extra, linear, oracle, fitted, fitted_extra, robust, robust_extra;
 };
 
 uint8_t rel_code(int depth, int level) {
@@ -303,6 +329,8 @@ void collect(int frame, const Hierarchy& prev, const Hierarchy& h, const Lookup 
                 s.oracle = predict(lookups[4], pos, s.level);
                 s.fitted = predict(lookups[5], pos, s.level);
                 s.fitted_extra = predict(lookups[6], pos, s.level);
+                s.robust = predict(lookups[7], pos, s.level);
+                s.robust_extra = predict(lookups[8], pos, s.level);
                 s.bit = refined;
                 out.push_back(s);
             }
@@ -359,6 +387,7 @@ int main(int argc, char** argv) {
     uint64_t alone_total = 0, alone_first = 0;
     double sent_bits_zero = 0, sent_bits_temporal = 0, sent_bits_vs_extrapolated = 0;
     uint64_t moving_blocks = 0;
+    double moving_length = 0;
     std::vector<int> prev_vx, prev_vy;
     for (size_t k = 1; k < seq.size(); ++k) {
         images[k % 3] = rasterize(seq[k], 0, 0, px, w, w);
@@ -370,6 +399,7 @@ int main(int argc, char** argv) {
         for (size_t i = 0; i < sent.vx.size(); ++i) {
             const bool moving = sent.vx[i] != 0 || sent.vy[i] != 0;
             moving_blocks += moving;
+            if (moving) moving_length += std::hypot(double(sent.vx[i]), double(sent.vy[i]));
             sent_bits_zero += 1 + (moving ? gamma_bits(sent.vx[i]) + gamma_bits(sent.vy[i]) : 0);
             const int px0 = prev_vx.empty() ? 0 : prev_vx[i], py0 = prev_vy.empty() ? 0 : prev_vy[i];
             sent_bits_temporal += gamma_bits(sent.vx[i] - px0) + gamma_bits(sent.vy[i] - py0);
@@ -382,12 +412,13 @@ int main(int argc, char** argv) {
             iy = int(std::floor((y - b.y0) / b.h));
         };
         const Affine fitted = fit_affine(sent), fitted_extra = k >= 2 ? fit_affine(extra) : Affine{};
+        const Affine robust = fit_affine_robust(sent), robust_extra = k >= 2 ? fit_affine_robust(extra) : Affine{};
         auto affine_lookup = [&](const Affine& f, double x, double y) {
             const double fx = (x - b.x0) / b.h, fy = (y - b.y0) / b.h;
             const double vx = f.a[0] * fx + f.a[1] * fy + f.a[2], vy = f.b[0] * fx + f.b[1] * fy + f.b[2];
             return b.at(int(std::floor(fx - vx)), int(std::floor(fy - vy)));
         };
-        const Lookup lookups[7] = {
+        const Lookup lookups[9] = {
             [&](double x, double y) { int ix, iy; pix(x, y, ix, iy); return b.at(ix, iy); },
             [&](double x, double y) {
                 int ix, iy;
@@ -422,6 +453,8 @@ int main(int argc, char** argv) {
             },
             [&](double x, double y) { return affine_lookup(fitted, x, y); },
             [&](double x, double y) { return affine_lookup(fitted_extra, x, y); },
+            [&](double x, double y) { return affine_lookup(robust, x, y); },
+            [&](double x, double y) { return affine_lookup(robust_extra, x, y); },
         };
         collect(int(k), seq[k - 1], seq[k], lookups, symbols);
         const uint64_t alone = encode_hierarchy(seq[k]).size();
@@ -440,9 +473,9 @@ int main(int argc, char** argv) {
                 (unsigned long long)alone_first, double(alone_total + alone_first) / 5);
     std::printf("# motion vectors (blocks of %d px, %d blocks a frame, %.1f moving on average): Elias-gamma "
                 "estimate %.0f bytes coded against zero, %.0f against the previous frame's, %.0f against the "
-                "decoder's extrapolation\n",
+                "decoder's extrapolation; the moving blocks' vectors are %.2f pixels long on average\n",
                 block, int(prev_vx.size()), double(moving_blocks) / double(seq.size() - 1), sent_bits_zero / 8,
-                sent_bits_temporal / 8, sent_bits_vs_extrapolated / 8);
+                sent_bits_temporal / 8, sent_bits_vs_extrapolated / 8, moving_length / double(std::max<uint64_t>(moving_blocks, 1)));
     auto cap = [](int v, int m) { return std::min(v, m); };
     auto v3 = [&](const Symbol& s) { return ((s.cls * 3 + s.border) * 3 + cap(s.dec_changed, 2)) * 2 + s.parent_area; };
     const std::vector<Design> designs = {
@@ -463,6 +496,8 @@ int main(int argc, char** argv) {
         {"extrapolated motion: c/min/max + v3", [&](const Symbol& s) { return pcode(s.extra) * 100 + v3(s); }},
         {"affine fit of the sent vectors: c/min/max + v3", [&](const Symbol& s) { return pcode(s.fitted) * 100 + v3(s); }},
         {"affine fit of the extrapolated vectors: c/min/max + v3", [&](const Symbol& s) { return pcode(s.fitted_extra) * 100 + v3(s); }},
+        {"robust affine fit of the sent vectors: c/min/max + v3", [&](const Symbol& s) { return pcode(s.robust) * 100 + v3(s); }},
+        {"robust affine fit of the extrapolated vectors: c/min/max + v3", [&](const Symbol& s) { return pcode(s.robust_extra) * 100 + v3(s); }},
         {"the front's exact motion: depth at centroid", [&](const Symbol& s) { return s.oracle.c; }},
         {"the front's exact motion: c/min/max", [&](const Symbol& s) { return pcode(s.oracle); }},
         {"the front's exact motion: c/min/max + decided nbrs refined", [&](const Symbol& s) { return pcode(s.oracle) * 4 + s.dec_refined; }},
