@@ -94,8 +94,9 @@ void add_level_stats(EncodeStats& stats, size_t nodes, size_t new_vertices, size
 
 std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options, EncodeStats* stats_out) {
     EncodeStats stats;
+    const unsigned threads = resolve_thread_count(options.threads);
     // Whatever is encoded decodes: the decoder's checks first (base mesh, structure, positions).
-    check_before_writing(input, "encode", true);
+    check_before_writing(input, "encode", true, threads);
     const bool quantized = options.quantize_bits != 0;
     // Quantized coordinates are reconstructed as doubles on the grid, whatever the input precision.
     const Precision precision = input.single_precision() && !quantized ? Precision::float32 : Precision::float64;
@@ -119,7 +120,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     // Chunks (FORMAT.md 3.11): more than one makes a version-7 file, whose chunks code the forest on
     // several threads; the hierarchy coder then runs over the roots alone, for its header's sake.
     const bool one_chunk = options.chunk_roots.empty() ? options.chunks == 1 : options.chunk_roots.size() == 1;
-    const uint64_t faces = one_chunk ? 0 : leaf_face_count(h);
+    const uint64_t faces = one_chunk ? 0 : leaf_face_count(h, threads);
     const std::vector<RootRange> chunks = options.chunk_roots.empty()
                                               ? balanced_chunks(nodes_per_root(h), chunk_count_for(options, faces))
                                               : explicit_chunks(options.chunk_roots, h.root_count());
@@ -152,7 +153,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
 
     bool static_geometry = false;
     if (chunked) {
-        ChunkedBlocks parts = encode_chunked(h, chunks, options, space, resolve_thread_count(options.threads), stats);
+        ChunkedBlocks parts = encode_chunked(h, chunks, options, space, threads, stats);
         static_geometry = parts.static_geometry;
         for (auto& block : parts.blocks) blocks.push_back(std::move(block));
     }
@@ -250,7 +251,7 @@ Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const T
     }
     AMC_REQUIRE(block.type == BlockType::end, corrupt, std::string("unexpected ") + block_type_name(uint8_t(block.type)) + " block after the chunks");
     AMC_REQUIRE(h.node_count() == meta.nodes && h.vertex_count() == meta.vertices && uint64_t(h.depth() + 1) == meta.levels &&
-                    leaf_face_count(h) == meta.faces,
+                    leaf_face_count(h, resolve_thread_count(options.threads)) == meta.faces,
                 corrupt, "decoded hierarchy does not match the metadata");
     if (partial != nullptr) {
         partial->complete = true;

@@ -4,9 +4,11 @@
 
 #include "common/check.h"
 #include "common/exact_float.h"
+#include "common/parallel.h"
 
 #include <amc/hierarchy.h>
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <sstream>
@@ -28,12 +30,16 @@ std::string node_text(const Hierarchy& h, NodeId n) {
     return s.str();
 }
 
-}  // namespace
-
-std::string check_invariants(const Hierarchy& h) {
+// What check_invariants finds in the nodes [begin, end): the first problem, the live nodes and
+// the split edges counted at their lower-numbered refined node.
+struct RangeCheck {
+    std::string problem;
     uint32_t nodes = 0;
     uint64_t split_edges = 0;
-    for (NodeId n = 0; n < h.node_capacity(); ++n) {
+};
+
+std::string check_node_range(const Hierarchy& h, NodeId begin, NodeId end, uint32_t& nodes, uint64_t& split_edges) {
+    for (NodeId n = begin; n < end; ++n) {
         if (!h.is_alive(n)) continue;
         ++nodes;
         for (int e = 0; e < 3; ++e) {
@@ -89,6 +95,30 @@ std::string check_invariants(const Hierarchy& h) {
             }
         }
     }
+    return "";
+}
+
+}  // namespace
+
+std::string check_invariants(const Hierarchy& h) { return check_invariants(h, 1); }
+
+std::string check_invariants(const Hierarchy& h, unsigned threads) {
+    // Ranges of nodes checked independently; the first problem in node order is reported, so the
+    // message does not depend on the threads.
+    constexpr NodeId kRange = NodeId(1) << 16;
+    std::vector<RangeCheck> ranges((size_t(h.node_capacity()) + kRange - 1) / kRange);
+    parallel_for(ranges.size(), threads, [&](size_t i) {
+        RangeCheck& r = ranges[i];
+        const NodeId begin = NodeId(i) * kRange, end = std::min<NodeId>(h.node_capacity(), begin + kRange);
+        r.problem = check_node_range(h, begin, end, r.nodes, r.split_edges);
+    });
+    uint32_t nodes = 0;
+    uint64_t split_edges = 0;
+    for (const RangeCheck& r : ranges) {
+        if (!r.problem.empty()) return r.problem;
+        nodes += r.nodes;
+        split_edges += r.split_edges;
+    }
     if (nodes != h.node_count()) return "node count " + std::to_string(h.node_count()) + " but " + std::to_string(nodes) + " live nodes";
     if (h.vertex_count() != h.base().positions.size() + split_edges)
         return "vertex count " + std::to_string(h.vertex_count()) + " != base vertices + split edges (" +
@@ -111,9 +141,9 @@ std::string check_positions(const Hierarchy& h) {
     return "";
 }
 
-void check_before_writing(const Hierarchy& h, const std::string& what, bool positions) {
+void check_before_writing(const Hierarchy& h, const std::string& what, bool positions, unsigned threads) {
     validate_triangle_mesh(h.base(), what + ": base mesh");
-    const std::string problem = check_invariants(h);
+    const std::string problem = check_invariants(h, threads);
     AMC_REQUIRE(problem.empty(), invalid_input, what + ": invalid hierarchy: " + problem);
     if (!positions) return;
     const std::string position_problem = check_positions(h);

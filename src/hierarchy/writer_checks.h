@@ -12,6 +12,10 @@ namespace amc {
 // degenerate or repeated triangle, finite positions), the structure (check_invariants) and, with
 // `positions`, check_positions. Throws Error naming `what` and the first problem, in the words
 // the reader would use.
-void check_before_writing(const Hierarchy& h, const std::string& what, bool positions);
+// The structural checks run on up to `threads` threads; the first problem in node order is named.
+void check_before_writing(const Hierarchy& h, const std::string& what, bool positions, unsigned threads = 1);
+
+// check_invariants on up to `threads` threads (the same answer as with one).
+std::string check_invariants(const Hierarchy& h, unsigned threads);
 
 }  // namespace amc

@@ -4,6 +4,7 @@
 #include "coding/base/base_angle_border.h"
 #include "coding/base/base_angle_coder.h"
 #include "coding/base/base_mesh_closing.h"
+#include "common/parallel.h"
 
 #include <algorithm>
 #include <iterator>
@@ -400,32 +401,38 @@ std::vector<Start> search_candidates(uint32_t real_triangles, size_t closed_tria
 
 }  // namespace
 
-std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, bool search) {
+std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, bool search, unsigned threads) {
     const ClosedMesh cm = make_closed(mesh);
-    std::vector<uint8_t> best;
     std::vector<Start> candidates = search_candidates(cm.real_triangles, cm.triangles.size());
     if (!search) candidates.resize(1);
-    for (const Start& start : candidates) {
-        for (int set = 0; set < angle_mode::kContextSets; ++set) {
-            BaseMeshCode candidate;
-            std::vector<uint8_t> bytes;
-            try {
-                Encoder e(mesh, cm, set, start.radius, start.first, start.rotation);
-                bytes = e.run(candidate);
-            } catch (const EncoderGaveUp&) {
-                continue;  // this start does not fit (a walk over the budget, say): try the others
-            }
-            if (best.empty() || bytes.size() < best.size()) {
-                best = std::move(bytes);
-                code.vertex_order = std::move(candidate.vertex_order);
-                code.triangle_order = std::move(candidate.triangle_order);
-                code.triangle_rotation = std::move(candidate.triangle_rotation);
-                code.stencils = std::move(candidate.stencils);
-            }
+    // Every (start, context set) is coded on its own, on up to `threads` threads; the shortest
+    // wins, the earliest among equals, so the choice does not depend on the threads.
+    struct Tried {
+        std::vector<uint8_t> bytes;
+        BaseMeshCode code;
+        bool fits = false;
+    };
+    std::vector<Tried> tried(candidates.size() * angle_mode::kContextSets);
+    parallel_for(tried.size(), threads, [&](size_t i) {
+        const Start& start = candidates[i / angle_mode::kContextSets];
+        const int set = int(i % angle_mode::kContextSets);
+        try {
+            Encoder e(mesh, cm, set, start.radius, start.first, start.rotation);
+            tried[i].bytes = e.run(tried[i].code);
+            tried[i].fits = true;
+        } catch (const EncoderGaveUp&) {
+            // this start does not fit (a walk over the budget, say): the others may
         }
-    }
-    if (best.empty()) throw EncoderGaveUp{};
-    return best;
+    });
+    const Tried* best = nullptr;
+    for (const Tried& t : tried)
+        if (t.fits && (best == nullptr || t.bytes.size() < best->bytes.size())) best = &t;
+    if (best == nullptr) throw EncoderGaveUp{};
+    code.vertex_order = best->code.vertex_order;
+    code.triangle_order = best->code.triangle_order;
+    code.triangle_rotation = best->code.triangle_rotation;
+    code.stencils = best->code.stencils;
+    return best->bytes;
 }
 
 }  // namespace amc

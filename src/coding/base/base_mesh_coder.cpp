@@ -73,13 +73,14 @@ std::vector<BaseStencil> cut_border_stencils(const TriangleMesh& mesh, const Bas
 
 // Codes with one mode; false when the mode does not fit the mesh. The encoders track what the
 // decoder will do (orders, stencils); tests/base_mesh_coder_test.cpp decodes every mode's
-// streams and compares.
-bool try_mode(const TriangleMesh& mesh, BaseConnectivityMode mode, BaseMeshCode& code, bool search = true) {
+// streams and compares. Mode 2's search runs on up to `threads` threads.
+bool try_mode(const TriangleMesh& mesh, BaseConnectivityMode mode, BaseMeshCode& code, bool search = true,
+              unsigned threads = 1) {
     try {
         code = BaseMeshCode{};
         code.mode = mode;
         switch (mode) {
-            case BaseConnectivityMode::angle: code.bytes = encode_angle_mode(mesh, code, search); break;
+            case BaseConnectivityMode::angle: code.bytes = encode_angle_mode(mesh, code, search, threads); break;
             case BaseConnectivityMode::cut_border: code.bytes = encode_cut_border(mesh, code); break;
             case BaseConnectivityMode::explicit_triangles: code.bytes = encode_explicit(mesh, code); break;
         }
@@ -103,10 +104,10 @@ void check_encodable(const TriangleMesh& mesh) {
 
 }  // namespace
 
-BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh) {
+BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh, unsigned threads) {
     check_encodable(mesh);
     BaseMeshCode code;
-    if (try_mode(mesh, BaseConnectivityMode::angle, code)) return code;
+    if (try_mode(mesh, BaseConnectivityMode::angle, code, true, threads)) return code;
     if (!try_mode(mesh, BaseConnectivityMode::explicit_triangles, code))
         throw Error("base mesh coder: the explicit mode failed");
     return code;

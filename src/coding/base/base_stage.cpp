@@ -6,6 +6,7 @@
 #include "coding/hierarchy/hierarchy_level_coder.h"
 #include "common/check.h"
 #include "common/exact_float.h"
+#include "common/parallel.h"
 
 #include <cmath>
 #include <string>
@@ -54,7 +55,7 @@ BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const 
         } catch (const Error&) {  // mode 2 does not fit this start: the usual choice
         }
     }
-    return encode_base_connectivity(base);
+    return encode_base_connectivity(base, resolve_thread_count(options.threads));
 }
 
 // The base coder may rotate each triangle's vertices. The default diagonal rule does not care, but

@@ -18,10 +18,17 @@ uint32_t chunk_count_for(const EncodeOptions& options, uint64_t faces) {
     return uint32_t(std::max<uint64_t>(1, std::min<uint64_t>(faces / per_chunk, UINT32_MAX)));
 }
 
-uint64_t leaf_face_count(const Hierarchy& h) {
-    uint64_t faces = 0;
-    for (NodeId n : h.leaves()) faces += 1 + uint64_t(h.hanging_node_count(n));
-    return faces;
+uint64_t leaf_face_count(const Hierarchy& h, unsigned threads) {
+    constexpr NodeId kRange = NodeId(1) << 16;  // nodes counted per task
+    std::vector<uint64_t> faces((size_t(h.node_capacity()) + kRange - 1) / kRange, 0);
+    parallel_for(faces.size(), threads, [&](size_t i) {
+        const NodeId begin = NodeId(i) * kRange, end = std::min<NodeId>(h.node_capacity(), begin + kRange);
+        for (NodeId n = begin; n < end; ++n)
+            if (h.is_alive(n) && h.is_leaf(n)) faces[i] += 1 + uint64_t(h.hanging_node_count(n));
+    });
+    uint64_t sum = 0;
+    for (uint64_t f : faces) sum += f;
+    return sum;
 }
 
 ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<RootRange>& ranges, const EncodeOptions& options,

@@ -18,8 +18,8 @@ namespace amc {
 // The chunk count EncodeOptions ask for a hierarchy of `faces` leaf faces.
 uint32_t chunk_count_for(const EncodeOptions& options, uint64_t faces);
 
-// Faces of the conforming leaf mesh (1 + hanging nodes per leaf).
-uint64_t leaf_face_count(const Hierarchy& h);
+// Faces of the conforming leaf mesh (1 + hanging nodes per leaf), counted on up to `threads` threads.
+uint64_t leaf_face_count(const Hierarchy& h, unsigned threads = 1);
 
 struct ChunkedBlocks {
     std::vector<std::pair<BlockType, std::vector<uint8_t>>> blocks;  // chunk table, seam, chunks
