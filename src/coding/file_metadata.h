@@ -30,6 +30,12 @@ std::vector<uint8_t> write_metadata(const Metadata& m, bool quantized);
 // Throws Error on unknown options, bad quantization parameters and counts no hierarchy has.
 Metadata read_metadata(const Block& block, bool quantized);
 
+// Nodes a decoder may allocate up front per byte of the file: more than real files hold (about one
+// node per byte; a finite-element hierarchy with exact midpoints about 100), so that they are
+// decoded in memory of their final size, while a small file that announces a large hierarchy gets
+// no more than its bytes warrant before it is decoded (more grows as the levels are built).
+constexpr uint64_t kReservedNodesPerFileByte = 128;
+
 // Checks the metadata's counts against the `bytes_after` bytes of the file that follow it, before
 // anything is allocated for them: every vertex costs at least max_decodable_positions' share of a
 // payload, every base triangle at least half a symbol (FORMAT.md, 3.7), so a file can announce no

@@ -194,12 +194,6 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
 
 namespace {
 
-// Nodes reserved up front per byte of the file: more than real files hold (about one node per
-// byte; a finite-element hierarchy with exact midpoints about 100), so that they are decoded in
-// memory of their final size, while a small file that announces a large hierarchy gets no more
-// than its bytes warrant before it is decoded (more grows as the levels are built).
-constexpr uint64_t kReservedNodesPerFileByte = 128;
-
 // How far a partial file got (decode_partial); null for a whole file.
 struct PartialProgress {
     int levels_decoded = 0, levels_in_file = 0;

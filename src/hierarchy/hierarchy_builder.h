@@ -5,6 +5,7 @@
 #include <amc/hierarchy.h>
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace amc {
@@ -35,23 +36,36 @@ struct HierarchyBuilder {
     // ever refined), child k of parents[i] gets id node_capacity() + 4 * i + k, node_capacity()
     // taken before the call.
     static void split_level(Hierarchy& h, const LevelSplits& level) { h.split_level(level); }
-    // One piece of a hierarchy to stitch (stitch below): a hierarchy over some of the roots, and
-    // where its nodes and vertices go in the whole.
+    // Stitching hierarchies of disjoint root sets into one (hierarchy_stitch.cpp): the decoder of
+    // chunked files decodes each chunk alone and copies it into its slice of the whole at once,
+    // in these steps.
+    // One piece: a hierarchy over some of the whole's roots, and where its nodes and vertices go.
     struct StitchPart {
         const Hierarchy* part = nullptr;
         NodeId first_root = 0;  // its root i becomes root first_root + i
         NodeId first_node = 0;  // its node root_count() + j becomes node first_node + j (a multiple of 4 past the roots)
         const VertexId* vertex_id = nullptr;  // its vertex v becomes vertex vertex_id[v]
     };
-    // The hierarchy over `base` made of `parts` (their roots cover base's triangles once; their
-    // nodes fill first_node.. without gaps; positions[v] is vertex v's position, base vertices
-    // first): each part's nodes copied with their ids mapped (on up to `threads` threads, parts
-    // being disjoint), then the parts linked across the edges between them, where each had a
-    // boundary: the halves of two refined neighbours are linked as split() links them. Throws
-    // Error (corrupt) where parts do not fit: a refined node next to a coarser region of another
-    // part, a leaf with three hanging nodes.
-    static Hierarchy stitch(const TriangleMesh& base, std::vector<Vec3> positions, const std::vector<StitchPart>& parts,
-                            unsigned threads);
+    // 1. The whole over `base`: its roots, linked across every base edge, and room for `nodes`
+    //    nodes, not yet written (each part's copy writes, and so first touches, its own slice).
+    static Hierarchy stitch_frame(const TriangleMesh& base, size_t nodes);
+    // 2. Copies part p into the whole: its nodes to first_node.., ids mapped. Parts write disjoint
+    //    nodes: several may be copied at once.
+    static void stitch_part(Hierarchy& whole, const StitchPart& p);
+    // 3. Renames the vertex ids of the nodes in [begin, end): v becomes rename(v).
+    template <class Rename>
+    static void stitch_rename_vertices(Hierarchy& whole, NodeId begin, NodeId end, Rename rename) {
+        for (NodeId n = begin; n < end; ++n) {
+            Hierarchy::Node& node = whole.nodes_[n];
+            for (int e = 0; e < 3; ++e) node.v[e] = rename(node.v[e]);
+        }
+    }
+    // 4. Completes the whole, once every part is in: its positions (base vertices first), and the
+    //    seams linked: `seam` lists the root edges (root, edge) that a part saw as boundary and the
+    //    whole does not; the halves of two refined neighbours are linked as split() links them,
+    //    level by level. Throws Error (corrupt) where parts do not fit: a refined node next to a
+    //    coarser region of another part, a leaf with three hanging nodes.
+    static void stitch_seams(Hierarchy& whole, std::vector<Vec3> positions, std::vector<std::pair<NodeId, int>> seam);
     // Hints the processor to fetch node n (for traversals that know their next nodes early).
     static void prefetch(const Hierarchy& h, NodeId n) { __builtin_prefetch(h.nodes_.data() + n); }
 };

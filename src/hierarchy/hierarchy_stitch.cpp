@@ -1,63 +1,63 @@
 // Stitching hierarchies of disjoint root sets into one (hierarchy_builder.h): the decoder of
-// chunked .amc files builds each chunk alone, then copies them into the whole and links the seams.
+// chunked .amc files copies each chunk into its slice of the whole as soon as it is decoded, then
+// renames the vertices the chunks could not number alone and links the seams.
 #include "hierarchy/hierarchy_builder.h"
 
 #include "common/check.h"
-#include "common/parallel.h"
+#include "common/huge_pages.h"
 
 #include <utility>
 
 namespace amc {
 
-Hierarchy HierarchyBuilder::stitch(const TriangleMesh& base, std::vector<Vec3> positions, const std::vector<StitchPart>& parts,
-                                   unsigned threads) {
+Hierarchy HierarchyBuilder::stitch_frame(const TriangleMesh& base, size_t nodes) {
     Hierarchy h(base);  // the roots, linked across every base edge
     const size_t roots = h.root_count();
-    size_t nodes = roots;
-    for (const StitchPart& p : parts) nodes += p.part->node_capacity() - p.part->root_count();
-    AMC_REQUIRE(positions.size() >= base.positions.size() && positions.size() < kNoVertex && nodes < kNoNode, corrupt,
-                "hierarchy too large to stitch");
-    h.reserve(nodes, positions.size());
-    h.nodes_.resize(nodes);
+    AMC_REQUIRE(nodes >= roots && (nodes - roots) % 4 == 0 && nodes < kNoNode, corrupt, "hierarchy too large to stitch");
+    reserve_huge(h.nodes_, nodes);
+    h.nodes_.resize(nodes);  // Node() writes nothing: the parts' copies are the first writes
+    reserve_huge(h.block_parent_, (nodes - roots) / 4);
     h.block_parent_.resize((nodes - roots) / 4);
+    return h;
+}
+
+void HierarchyBuilder::stitch_part(Hierarchy& h, const StitchPart& p) {
+    const Hierarchy& s = *p.part;
+    const NodeId r = s.root_count(), roots = h.root_count();
+    auto id = [&](NodeId n) { return n == kNoNode ? kNoNode : n < r ? p.first_root + n : p.first_node + (n - r); };
+    for (NodeId i = 0; i < r; ++i) {  // the roots keep the whole base's links
+        Hierarchy::Node& root = h.nodes_[p.first_root + i];
+        root.first_child = id(s.nodes_[i].first_child);
+        root.flags = uint8_t((root.flags & 7u) | (s.nodes_[i].flags & 8u));
+    }
+    for (NodeId j = r; j < s.node_capacity(); ++j) {
+        const Hierarchy::Node& from = s.nodes_[j];
+        Hierarchy::Node& to = h.nodes_[p.first_node + (j - r)];
+        for (int e = 0; e < 3; ++e) {
+            to.v[e] = p.vertex_id[from.v[e]];
+            to.nbr[e] = id(from.nbr[e]);
+        }
+        to.first_child = id(from.first_child);
+        to.nbr_edge = from.nbr_edge;
+        to.level = from.level;
+        to.flags = from.flags;  // seam edges are still boundary edges: linked by stitch_seams
+        to.reserved = 0;
+    }
+    const size_t first_block = (p.first_node - roots) / 4;
+    for (size_t b = 0; b < s.block_parent_.size(); ++b) h.block_parent_[first_block + b] = id(s.block_parent_[b]);
+}
+
+void HierarchyBuilder::stitch_seams(Hierarchy& h, std::vector<Vec3> positions, std::vector<std::pair<NodeId, int>> seam) {
+    AMC_REQUIRE(positions.size() >= h.base().positions.size() && positions.size() < kNoVertex, corrupt,
+                "hierarchy too large to stitch");
     for (const Vec3& p : positions) h.far_positions_ |= Hierarchy::is_far(p);
     h.positions_ = std::move(positions);
-    h.live_nodes_ = uint32_t(nodes);
+    h.live_nodes_ = uint32_t(h.nodes_.size());
     h.live_vertices_ = uint32_t(h.positions_.size());
 
-    parallel_for(parts.size(), threads, [&](size_t k) {
-        const StitchPart& p = parts[k];
-        const Hierarchy& s = *p.part;
-        const NodeId r = s.root_count();
-        auto id = [&](NodeId n) { return n == kNoNode ? kNoNode : n < r ? p.first_root + n : p.first_node + (n - r); };
-        for (NodeId i = 0; i < r; ++i) {  // the roots keep the whole base's links
-            Hierarchy::Node& root = h.nodes_[p.first_root + i];
-            root.first_child = id(s.nodes_[i].first_child);
-            root.flags = uint8_t((root.flags & 7u) | (s.nodes_[i].flags & 8u));
-        }
-        for (NodeId j = r; j < s.node_capacity(); ++j) {
-            const Hierarchy::Node& from = s.nodes_[j];
-            Hierarchy::Node& to = h.nodes_[p.first_node + (j - r)];
-            for (int e = 0; e < 3; ++e) {
-                to.v[e] = p.vertex_id[from.v[e]];
-                to.nbr[e] = id(from.nbr[e]);
-            }
-            to.first_child = id(from.first_child);
-            to.nbr_edge = from.nbr_edge;
-            to.level = from.level;
-            to.flags = from.flags;  // seam edges are still boundary edges: linked below
-            to.reserved = 0;
-        }
-        for (size_t b = 0; b < s.block_parent_.size(); ++b) h.block_parent_[(p.first_node - roots) / 4 + b] = id(s.block_parent_[b]);
-    });
-
-    // The seams: the root edges that a part saw as boundary and the whole does not, then the halves
-    // of each, level by level (a node's links are complete before its children are linked).
-    std::vector<std::pair<NodeId, int>> seam, next;
-    for (const StitchPart& p : parts)
-        for (NodeId i = 0; i < p.part->root_count(); ++i)
-            for (int e = 0; e < 3; ++e)
-                if (p.part->is_boundary_edge(i, e) && !h.is_boundary_edge(p.first_root + i, e)) seam.emplace_back(p.first_root + i, e);
+    // The root edges on the seams, then the halves of each, level by level (a node's links are
+    // complete before its children are linked).
+    std::vector<std::pair<NodeId, int>> next;
     while (!seam.empty()) {
         next.clear();
         for (const auto& seam_edge : seam) {
@@ -84,7 +84,6 @@ Hierarchy HierarchyBuilder::stitch(const TriangleMesh& base, std::vector<Vec3> p
         }
         std::swap(seam, next);
     }
-    return h;
 }
 
 }  // namespace amc

@@ -83,9 +83,9 @@ ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& s
     return out;
 }
 
-Hierarchy decode_chunk(const uint8_t* data, size_t size, const TriangleMesh& base, const std::vector<VertexId>& base_vertex,
-                       const Seam& seam, CoordinateSpace space, const ChunkDecodeLimits& limits, const std::string& what,
-                       VertexKeys& keys) {
+Hierarchy& decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, size_t size, const TriangleMesh& base,
+                        const std::vector<VertexId>& base_vertex, const Seam& seam, CoordinateSpace space,
+                        const ChunkDecodeLimits& limits, const std::string& what, VertexKeys& keys) {
     PayloadReader in(data, size, "chunk block");
     const uint64_t header_size = in.varint();
     AMC_REQUIRE(header_size <= in.remaining(), corrupt, what + ": hierarchy header is longer than the block");
@@ -93,7 +93,7 @@ Hierarchy decode_chunk(const uint8_t* data, size_t size, const TriangleMesh& bas
     for (uint64_t i = 0; i < header_size; ++i) in.u8();
     const uint64_t levels = in.varint();
     AMC_REQUIRE(levels >= 1 && levels <= kMaxLevel + 1, corrupt, what + ": bad level count");
-    HierarchyLevelDecoder hierarchy(base, header, size_t(header_size), limits.stream_version, limits.max_nodes);
+    hierarchy.restart(base, header, size_t(header_size), limits.stream_version, limits.max_nodes);
     Hierarchy& h = hierarchy.hierarchy();
     keys.assign(base_vertex.begin(), base_vertex.end());
     PositionCoder positions(space);
@@ -131,11 +131,11 @@ Hierarchy decode_chunk(const uint8_t* data, size_t size, const TriangleMesh& bas
         decode_level_geometry(h, created, parts, decoder, positions, space, int(level), where);
     }
     keys.resize(h.positions().size(), kNoVertex);
-    if (stopped) return std::move(h);
+    if (stopped) return h;
     AMC_REQUIRE(hierarchy.done(), corrupt, what + ": ends before its hierarchy's last level");
     AMC_REQUIRE(in.remaining() == 0, corrupt, what + ": bytes after the last level");
     hierarchy.finish();
-    return std::move(h);
+    return h;
 }
 
 }  // namespace amc

@@ -8,6 +8,7 @@
 #include "coding/chunks/seam.h"
 #include "coding/format_version.h"
 #include "coding/geometry/float_coder.h"  // CoordinateSpace
+#include "coding/hierarchy/hierarchy_level_coder.h"
 
 #include <amc/codec.h>
 
@@ -38,11 +39,12 @@ struct ChunkDecodeLimits {
 };
 
 // Decodes a chunk block's payload over `base` (base_of_roots of the chunk's roots) whose vertex i
-// is the whole base's vertex base_vertex[i]. Throws Error naming `what` on a corrupt chunk.
-// `keys` receives the seam keys of the result's vertex ids (base and seam vertices; kNoVertex for the
-// chunk's own).
-Hierarchy decode_chunk(const uint8_t* data, size_t size, const TriangleMesh& base, const std::vector<VertexId>& base_vertex,
-                       const Seam& seam, CoordinateSpace space, const ChunkDecodeLimits& limits, const std::string& what,
-                       VertexKeys& keys);
+// is the whole base's vertex base_vertex[i], in `decoder` (restarted: the result is its
+// hierarchy(), until the next restart; a decoder used again keeps its memory). Throws Error naming
+// `what` on a corrupt chunk. `keys` receives the seam keys of the result's vertex ids (base and
+// seam vertices; kNoVertex for the chunk's own).
+Hierarchy& decode_chunk(HierarchyLevelDecoder& decoder, const uint8_t* data, size_t size, const TriangleMesh& base,
+                        const std::vector<VertexId>& base_vertex, const Seam& seam, CoordinateSpace space,
+                        const ChunkDecodeLimits& limits, const std::string& what, VertexKeys& keys);
 
 }  // namespace amc

@@ -3,11 +3,15 @@
 
 #include "coding/chunks/chunk_coder.h"
 #include "coding/chunks/seam.h"
+#include "coding/file_metadata.h"
 #include "common/check.h"
 #include "common/parallel.h"
 #include "hierarchy/hierarchy_builder.h"
 
 #include <algorithm>
+#include <cstddef>
+#include <memory>
+#include <mutex>
 #include <string>
 
 namespace amc {
@@ -120,7 +124,8 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
     const TriangleMesh& base = *input.base;
     Block block{};
     AMC_REQUIRE(reader.next(block) && block.type == BlockType::chunk_table, corrupt, "expected a chunk table block");
-    const ChunkTable table = read_chunk_table(block, base.triangles.size(), nodes, block.offset + kBlockOverhead + block.size + reader.remaining());
+    const size_t file_size = block.offset + kBlockOverhead + block.size + reader.remaining();
+    const ChunkTable table = read_chunk_table(block, base.triangles.size(), nodes, file_size);
     AMC_REQUIRE(reader.next(block) && block.type == BlockType::seam, corrupt, "expected a seam block");
     AMC_REQUIRE(block.offset + kBlockOverhead + block.size == table.end + table.offsets[0], corrupt,
                 "chunk table block: chunk 0 does not start after the seam block");
@@ -148,29 +153,12 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
                     "chunk table block: no chunk block at the offset of chunk " + std::to_string(chunks[i]));
     }
     if (table_out != nullptr) *table_out = table;
-    // Each chunk alone, in parallel; then the whole (or the selected chunks) stitched together.
+
+    // The result: the base of the selected roots; their nodes in chunk order, each chunk's in a
+    // slice as long as the chunk table says; its vertices the base, the seam vertices the chunks
+    // use (in seam order), then each chunk's own vertices.
     const unsigned threads = resolve_thread_count(input.options.threads);
     const size_t n = chunks.size();
-    std::vector<Hierarchy> decoded(n);
-    std::vector<VertexKeys> keys(n);
-    std::vector<uint32_t> own(n);  // vertices that are neither base nor seam vertices
-    parallel_for(n, threads, [&](size_t i) {
-        const uint32_t c = chunks[i];
-        std::vector<VertexId> base_vertex;
-        const TriangleMesh chunk_base = base_of_roots(base, {table.roots[c]}, base_vertex);
-        ChunkDecodeLimits limits;
-        limits.max_nodes = std::min(table.nodes[c], input.options.max_nodes);
-        limits.max_level = input.options.max_level;
-        limits.file_version = input.version;
-        limits.stream_version = hierarchy_stream_version_of_file(input.version);
-        decoded[i] = decode_chunk(blocks[i].payload, blocks[i].size, chunk_base, base_vertex, seam, input.space, limits,
-                                  "chunk " + std::to_string(c), keys[i]);
-        AMC_REQUIRE(input.options.max_level >= 0 || decoded[i].node_count() == table.nodes[c], corrupt,
-                    "chunk " + std::to_string(c) + " does not hold the nodes the chunk table says");
-        for (uint32_t key : keys[i]) own[i] += key == kNoVertex;
-    });
-    // The result's vertices: the base of the selected roots, the seam vertices they use (in seam
-    // order), then each chunk's own vertices.
     std::vector<RootRange> ranges;
     for (uint32_t c : chunks) ranges.push_back(table.roots[c]);
     std::vector<VertexId> union_vertex;  // result base vertex -> file base vertex
@@ -180,51 +168,137 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
     if (selected == nullptr)
         for (VertexId v = 0; v < base_id.size(); ++v) base_id[v] = v;
     const uint32_t file_base = uint32_t(base.positions.size());
-    std::vector<VertexId> seam_id(seam.vertex_count(), kNoVertex);
-    for (size_t i = 0; i < n; ++i)
-        for (uint32_t key : keys[i])
-            if (key != kNoVertex && key >= file_base) seam_id[key - file_base] = 0;
-    uint64_t next = union_base.positions.size();
-    std::vector<Vec3> positions(union_base.positions);
-    for (uint32_t s = 0; s < seam_id.size(); ++s) {
-        if (seam_id[s] == kNoVertex) continue;
-        seam_id[s] = VertexId(next++);
-        positions.push_back(seam.position(s));
-    }
-    std::vector<uint64_t> first_own(n);
-    for (size_t i = 0; i < n; ++i) {
-        first_own[i] = next;
-        next += own[i];
-    }
-    AMC_REQUIRE(next < kNoVertex, limit_exceeded, "too many vertices");
-    positions.resize(size_t(next));
-    std::vector<std::vector<VertexId>> vertex_id(n);
+    // Until every chunk is decoded, a chunk names seam vertex s seam_start + s and its own vertex
+    // k own_start + k; rename below makes them final.
+    const uint64_t seam_start = union_base.positions.size(), own_start = seam_start + seam.vertex_count();
     std::vector<HierarchyBuilder::StitchPart> parts(n);
-    NodeId first_root = 0, first_node = NodeId(union_base.triangles.size());
+    std::vector<NodeId> slice_end(n);
+    uint64_t whole_nodes = union_base.triangles.size();
     for (size_t i = 0; i < n; ++i) {
-        parts[i].part = &decoded[i];
-        parts[i].first_root = first_root;
-        parts[i].first_node = first_node;
-        first_root += decoded[i].root_count();
-        first_node += decoded[i].node_capacity() - decoded[i].root_count();
+        parts[i].first_root = i == 0 ? 0 : parts[i - 1].first_root + table.roots[chunks[i - 1]].count;
+        parts[i].first_node = NodeId(whole_nodes);
+        whole_nodes += table.nodes[chunks[i]] - table.roots[chunks[i]].count;
+        slice_end[i] = NodeId(std::min<uint64_t>(whole_nodes, kNoNode));
     }
-    parallel_for(n, threads, [&](size_t i) {
-        const Hierarchy& h = decoded[i];
-        std::vector<VertexId>& id = vertex_id[i];
-        id.resize(keys[i].size());
-        VertexId own_id = VertexId(first_own[i]);
+    // The whole is made first, so that each chunk is copied into it as soon as it is decoded and
+    // the chunk's memory serves the next one; the table's counts are trusted that far only when
+    // they are no more than a whole file's decoder reserves up front for the file's size. Beyond
+    // that (a file of uniform levels, or a crafted one), and when a progressive decode stops
+    // early, every chunk is decoded first and the whole is made from what they hold.
+    const bool whole_first = input.options.max_level < 0 &&
+                             whole_nodes <= union_base.triangles.size() + kReservedNodesPerFileByte * uint64_t(file_size);
+    Hierarchy whole;
+    if (whole_first) whole = HierarchyBuilder::stitch_frame(union_base, size_t(whole_nodes));
+
+    std::vector<std::unique_ptr<HierarchyLevelDecoder>> decoder_of(n), idle;
+    std::mutex idle_mutex;
+    std::vector<VertexKeys> keys(n);
+    std::vector<uint32_t> own(n);                    // vertices that are neither base nor seam vertices
+    std::vector<std::vector<Vec3>> own_positions(n);  // their positions, until the whole's are made
+    std::vector<std::vector<uint32_t>> seam_used(n);  // the seam vertices each chunk holds
+    std::vector<uint32_t> live(n);                    // nodes past the roots
+    // Chunk i into the whole (its nodes), its positions and seam vertices aside.
+    auto copy_into_whole = [&](size_t i) {
+        const Hierarchy& h = decoder_of[i]->hierarchy();
+        std::vector<VertexId> id(keys[i].size());
+        own_positions[i].reserve(size_t(std::count(keys[i].begin(), keys[i].end(), kNoVertex)));
         for (size_t v = 0; v < id.size(); ++v) {
             const uint32_t key = keys[i][v];
             if (key == kNoVertex) {
-                id[v] = own_id++;
-                positions[id[v]] = h.position(VertexId(v));
+                id[v] = VertexId(own_start + own[i]++);
+                own_positions[i].push_back(h.position(VertexId(v)));
+            } else if (key < file_base) {
+                id[v] = base_id[key];
             } else {
-                id[v] = key < file_base ? base_id[key] : seam_id[key - file_base];
+                id[v] = VertexId(seam_start + (key - file_base));
+                seam_used[i].push_back(key - file_base);
             }
         }
+        AMC_REQUIRE(own_start + own[i] < kNoVertex, limit_exceeded, "too many vertices");
+        parts[i].part = &h;
         parts[i].vertex_id = id.data();
+        live[i] = h.node_capacity() - h.root_count();
+        AMC_REQUIRE(parts[i].first_node + live[i] == slice_end[i], corrupt,
+                    "chunk " + std::to_string(chunks[i]) + " does not hold the nodes the chunk table says");
+        HierarchyBuilder::stitch_part(whole, parts[i]);
+        parts[i].part = nullptr;
+        parts[i].vertex_id = nullptr;
+        VertexKeys().swap(keys[i]);
+        std::lock_guard<std::mutex> lock(idle_mutex);
+        idle.push_back(std::move(decoder_of[i]));
+    };
+    parallel_for(n, threads, [&](size_t i) {
+        const uint32_t c = chunks[i];
+        {
+            std::lock_guard<std::mutex> lock(idle_mutex);
+            if (!idle.empty()) {
+                decoder_of[i] = std::move(idle.back());
+                idle.pop_back();
+            }
+        }
+        if (decoder_of[i] == nullptr) decoder_of[i] = std::make_unique<HierarchyLevelDecoder>();
+        std::vector<VertexId> base_vertex;
+        const TriangleMesh chunk_base = base_of_roots(base, {table.roots[c]}, base_vertex);
+        ChunkDecodeLimits limits;
+        limits.max_nodes = std::min(table.nodes[c], input.options.max_nodes);
+        limits.max_level = input.options.max_level;
+        limits.file_version = input.version;
+        limits.stream_version = hierarchy_stream_version_of_file(input.version);
+        const Hierarchy& h = decode_chunk(*decoder_of[i], blocks[i].payload, blocks[i].size, chunk_base, base_vertex, seam,
+                                          input.space, limits, "chunk " + std::to_string(c), keys[i]);
+        AMC_REQUIRE(input.options.max_level >= 0 || h.node_count() == table.nodes[c], corrupt,
+                    "chunk " + std::to_string(c) + " does not hold the nodes the chunk table says");
+        if (whole_first) copy_into_whole(i);
     });
-    return HierarchyBuilder::stitch(union_base, std::move(positions), parts, threads);
+    if (!whole_first) {  // slices as long as the chunks are
+        whole_nodes = union_base.triangles.size();
+        for (size_t i = 0; i < n; ++i) {
+            const Hierarchy& h = decoder_of[i]->hierarchy();
+            parts[i].first_node = NodeId(whole_nodes);
+            whole_nodes += h.node_capacity() - h.root_count();
+            AMC_REQUIRE(whole_nodes < kNoNode, limit_exceeded, "too many nodes");
+            slice_end[i] = NodeId(whole_nodes);
+        }
+        whole = HierarchyBuilder::stitch_frame(union_base, size_t(whole_nodes));
+        parallel_for(n, threads, copy_into_whole);
+    }
+    idle.clear();
+
+    // The final vertex ids: the seam vertices some chunk holds, then each chunk's own.
+    std::vector<VertexId> seam_id(seam.vertex_count(), kNoVertex);
+    for (const std::vector<uint32_t>& used : seam_used)
+        for (uint32_t s : used) seam_id[s] = 0;
+    std::vector<Vec3> positions(union_base.positions);
+    for (uint32_t s = 0; s < seam_id.size(); ++s) {
+        if (seam_id[s] == kNoVertex) continue;
+        seam_id[s] = VertexId(positions.size());
+        positions.push_back(seam.position(s));
+    }
+    std::vector<uint64_t> first_own(n);
+    uint64_t vertices = positions.size();
+    for (size_t i = 0; i < n; ++i) {
+        first_own[i] = vertices;
+        vertices += own[i];
+    }
+    AMC_REQUIRE(vertices < kNoVertex, limit_exceeded, "too many vertices");
+    positions.resize(size_t(vertices));
+    parallel_for(n, threads, [&](size_t i) {
+        std::copy(own_positions[i].begin(), own_positions[i].end(), positions.begin() + ptrdiff_t(first_own[i]));
+        std::vector<Vec3>().swap(own_positions[i]);
+        HierarchyBuilder::stitch_rename_vertices(whole, parts[i].first_node, parts[i].first_node + live[i], [&](VertexId v) {
+            return v < seam_start ? v : v < own_start ? seam_id[v - seam_start] : VertexId(first_own[i] + (v - own_start));
+        });
+    });
+    // The root edges between two chunks: boundary edges to each chunk, not to the whole.
+    std::vector<uint32_t> part_of_root(union_base.triangles.size());
+    for (size_t i = 0; i < n; ++i)
+        for (NodeId r = 0; r < table.roots[chunks[i]].count; ++r) part_of_root[parts[i].first_root + r] = uint32_t(i);
+    std::vector<std::pair<NodeId, int>> seam_edges;
+    for (NodeId r = 0; r < part_of_root.size(); ++r)
+        for (int e = 0; e < 3; ++e)
+            if (!whole.is_boundary_edge(r, e) && part_of_root[whole.neighbor(r, e)] != part_of_root[r]) seam_edges.emplace_back(r, e);
+    HierarchyBuilder::stitch_seams(whole, std::move(positions), std::move(seam_edges));
+    return whole;
 }
 
 }  // namespace amc

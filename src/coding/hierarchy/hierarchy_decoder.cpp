@@ -77,6 +77,11 @@ HierarchyLevelDecoder::HierarchyLevelDecoder(const TriangleMesh& base, const Hie
     restart(base, header, max_nodes);
 }
 
+void HierarchyLevelDecoder::restart(const TriangleMesh& base, const uint8_t* header, size_t header_size,
+                                    uint8_t stream_version, uint64_t max_nodes) {
+    restart(base, parse_header(header, header_size, stream_version), max_nodes);
+}
+
 void HierarchyLevelDecoder::restart(const TriangleMesh& base, const HierarchyStreamHeader& header, uint64_t max_nodes) {
     header_ = header;
     max_nodes_ = max_nodes;

@@ -130,6 +130,9 @@ public:
     // Starts on another stream as the constructor does, keeping the working memory and the
     // memory of hierarchy() (rebuilt over `base`).
     void restart(const TriangleMesh& base, const HierarchyStreamHeader& header, uint64_t max_nodes);
+    // The same with the header's bytes, as the first constructor takes them.
+    void restart(const TriangleMesh& base, const uint8_t* header, size_t header_size, uint8_t stream_version,
+                 uint64_t max_nodes);
     bool done() const { return level_.empty(); }
     int level() const { return level_index_; }
     // Nodes of the current level (ids in hierarchy()) in canonical order.
