@@ -194,9 +194,39 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
     std::mutex idle_mutex;
     std::vector<VertexKeys> keys(n);
     std::vector<uint32_t> own(n);                    // vertices that are neither base nor seam vertices
-    std::vector<std::vector<Vec3>> own_positions(n);  // their positions, until the whole's are made
+    std::vector<std::vector<Vec3>> own_positions(n);  // their positions, until their place is known
     std::vector<std::vector<uint32_t>> seam_used(n);  // the seam vertices each chunk holds
     std::vector<uint32_t> live(n);                    // nodes past the roots
+    // The whole's positions: the base's, the seam's, then each chunk's own vertices in chunk order.
+    // A whole file uses every seam vertex and has the metadata's vertex count, so each chunk's own
+    // positions go to their place as soon as the chunks before it are in; otherwise (some chunks,
+    // or the whole made late) once all are, after the seam vertices they use.
+    const bool positions_first = whole_first && selected == nullptr;
+    std::vector<Vec3> positions;
+    std::vector<uint64_t> first_own(n);
+    std::vector<uint8_t> copied(n, 0);
+    size_t placed = 0;  // chunks whose own positions are in `positions`
+    uint64_t next_own = own_start;
+    std::mutex placed_mutex;
+    auto place_own_positions = [&](size_t i) {  // under placed_mutex
+        copied[i] = 1;
+        for (; placed < n && copied[placed]; ++placed) {
+            std::vector<Vec3>& own_of = own_positions[placed];
+            first_own[placed] = next_own;
+            next_own += own_of.size();
+            AMC_REQUIRE(next_own <= positions.size(), corrupt, "the chunks hold more vertices than the metadata says");
+            std::copy(own_of.begin(), own_of.end(), positions.begin() + ptrdiff_t(first_own[placed]));
+            std::vector<Vec3>().swap(own_of);
+        }
+    };
+    if (positions_first) {
+        AMC_REQUIRE(input.vertices >= own_start && input.vertices < kNoVertex, corrupt,
+                    "the metadata's vertex count does not fit the base and the seam");
+        positions.reserve(size_t(input.vertices));
+        positions = union_base.positions;
+        for (uint32_t s = 0; s < seam.vertex_count(); ++s) positions.push_back(seam.position(s));
+        positions.resize(size_t(input.vertices));
+    }
     // Chunk i into the whole (its nodes), its positions and seam vertices aside.
     auto copy_into_whole = [&](size_t i) {
         const Hierarchy& h = decoder_of[i]->hierarchy();
@@ -224,8 +254,14 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
         parts[i].part = nullptr;
         parts[i].vertex_id = nullptr;
         VertexKeys().swap(keys[i]);
-        std::lock_guard<std::mutex> lock(idle_mutex);
-        idle.push_back(std::move(decoder_of[i]));
+        {
+            std::lock_guard<std::mutex> lock(idle_mutex);
+            idle.push_back(std::move(decoder_of[i]));
+        }
+        if (positions_first) {
+            std::lock_guard<std::mutex> lock(placed_mutex);
+            place_own_positions(i);
+        }
     };
     parallel_for(n, threads, [&](size_t i) {
         const uint32_t c = chunks[i];
@@ -268,23 +304,27 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
     std::vector<VertexId> seam_id(seam.vertex_count(), kNoVertex);
     for (const std::vector<uint32_t>& used : seam_used)
         for (uint32_t s : used) seam_id[s] = 0;
-    std::vector<Vec3> positions(union_base.positions);
-    for (uint32_t s = 0; s < seam_id.size(); ++s) {
-        if (seam_id[s] == kNoVertex) continue;
-        seam_id[s] = VertexId(positions.size());
-        positions.push_back(seam.position(s));
+    if (positions_first) {
+        for (uint32_t s = 0; s < seam_id.size(); ++s) {
+            AMC_REQUIRE(seam_id[s] == 0, corrupt, "seam block: vertex " + std::to_string(s) + " is in no chunk");
+            seam_id[s] = VertexId(seam_start + s);
+        }
+        AMC_REQUIRE(placed == n && next_own == positions.size(), corrupt, "the chunks hold fewer vertices than the metadata says");
+    } else {
+        positions = union_base.positions;
+        for (uint32_t s = 0; s < seam_id.size(); ++s) {
+            if (seam_id[s] == kNoVertex) continue;
+            seam_id[s] = VertexId(positions.size());
+            positions.push_back(seam.position(s));
+        }
+        uint64_t vertices = positions.size();
+        for (size_t i = 0; i < n; ++i) vertices += own[i];
+        AMC_REQUIRE(vertices < kNoVertex, limit_exceeded, "too many vertices");
+        next_own = positions.size();
+        positions.resize(size_t(vertices));
+        for (size_t i = 0; i < n; ++i) place_own_positions(i);
     }
-    std::vector<uint64_t> first_own(n);
-    uint64_t vertices = positions.size();
-    for (size_t i = 0; i < n; ++i) {
-        first_own[i] = vertices;
-        vertices += own[i];
-    }
-    AMC_REQUIRE(vertices < kNoVertex, limit_exceeded, "too many vertices");
-    positions.resize(size_t(vertices));
     parallel_for(n, threads, [&](size_t i) {
-        std::copy(own_positions[i].begin(), own_positions[i].end(), positions.begin() + ptrdiff_t(first_own[i]));
-        std::vector<Vec3>().swap(own_positions[i]);
         HierarchyBuilder::stitch_rename_vertices(whole, parts[i].first_node, parts[i].first_node + live[i], [&](VertexId v) {
             return v < seam_start ? v : v < own_start ? seam_id[v - seam_start] : VertexId(first_own[i] + (v - own_start));
         });

@@ -1,0 +1,158 @@
+// Peak memory of one encode or decode, amcodec against Draco (docs/BENCHMARKS.md, "Memory"). Each
+// mode is its own process: it makes its input, resets the kernel's peak counter (clear_refs), then
+// does the one step and prints, in MiB, the resident set before it, after it (the result still
+// held) and at the peak, and the step's peak over the nodes and the faces. Linux only.
+//
+//   memory_peak prepare BITS model.amh PREFIX       writes PREFIX.amc (default options) and
+//                                                   PREFIX.drc (Draco's default speed 5; BITS 0:
+//                                                   positions as they are)
+//   memory_peak decode-amc PREFIX.amc THREADS      decode() of the file (read into memory first)
+//   memory_peak decode-draco PREFIX.drc            Draco's DecodeMeshFromBuffer of the file
+//   memory_peak encode-amc BITS THREADS model.amh  encode() of the hierarchy
+//   memory_peak encode-draco BITS model.amh        Draco's EncodeMeshToBuffer of the leaf mesh
+#include "compare_draco.h"
+
+#include <amc/codec.h>
+#include <amc/hierarchy.h>
+
+#include <draco/compression/decode.h>
+#include <draco/compression/encode.h>
+#include <draco/mesh/mesh.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+namespace {
+
+// A field of /proc/self/status in KiB (VmRSS: now, VmHWM: the peak since the last reset).
+double status_mib(const char* field) {
+    std::ifstream in("/proc/self/status");
+    std::string line;
+    const size_t length = std::strlen(field);
+    while (std::getline(in, line))
+        if (line.compare(0, length, field) == 0 && line[length] == ':') return std::atof(line.c_str() + length + 1) / 1024.0;
+    return -1;
+}
+
+// Sets the peak to what is resident now (Linux 4.0 and later).
+void reset_peak() {
+    std::ofstream clear("/proc/self/clear_refs");
+    clear << "5";
+}
+
+std::vector<char> read_file(const char* path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        std::fprintf(stderr, "memory_peak: can not read %s\n", path);
+        std::exit(1);
+    }
+    return std::vector<char>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void write_file(const std::string& path, const char* data, size_t size) {
+    std::ofstream(path + ".tmp", std::ios::binary).write(data, std::streamsize(size));
+    std::rename((path + ".tmp").c_str(), path.c_str());
+}
+
+// Runs `step` between the peak's reset and the report; step returns the nodes and faces it holds.
+template <class Step>
+int measure(const char* what, Step&& step) {
+    reset_peak();
+    const double before = status_mib("VmRSS");
+    uint64_t nodes = 0, faces = 0;
+    step(nodes, faces);
+    const double after = status_mib("VmRSS"), peak = status_mib("VmHWM");
+    const double step_bytes = (peak - before) * 1024 * 1024;
+    std::printf("%s: before %.1f MiB, after %.1f MiB, peak %.1f MiB; the step's peak %.1f MiB = %.1f bytes per node "
+                "(%llu nodes), %.1f bytes per face (%llu faces)\n",
+                what, before, after, peak, peak - before, nodes ? step_bytes / double(nodes) : 0.0, (unsigned long long)nodes,
+                faces ? step_bytes / double(faces) : 0.0, (unsigned long long)faces);
+    return 0;
+}
+
+draco::Encoder draco_encoder(int bits) {
+    draco::Encoder encoder;
+    encoder.SetSpeedOptions(5, 5);
+    if (bits > 0) encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, bits);
+    return encoder;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const std::string mode = argc > 1 ? argv[1] : "";
+    if (mode == "prepare" && argc == 5) {
+        const int bits = std::atoi(argv[2]);
+        const amc::Hierarchy h = amc::read_hierarchy(argv[3]);
+        amc::EncodeOptions options;
+        options.quantize_bits = bits;
+        const std::vector<uint8_t> amc_bytes = amc::encode(h, options);
+        write_file(std::string(argv[4]) + ".amc", reinterpret_cast<const char*>(amc_bytes.data()), amc_bytes.size());
+        const auto mesh = amc_bench::make_draco_mesh(amc::extract_leaf_mesh(h).mesh, bits == 0);
+        draco::EncoderBuffer buffer;
+        if (!draco_encoder(bits).EncodeMeshToBuffer(*mesh, &buffer).ok()) return 1;
+        write_file(std::string(argv[4]) + ".drc", buffer.data(), buffer.size());
+        return 0;
+    }
+    if (mode == "decode-amc" && argc == 4) {
+        const std::vector<char> bytes = read_file(argv[2]);
+        amc::DecodeOptions options;
+        options.threads = unsigned(std::atoi(argv[3]));
+        amc::Hierarchy h;
+        const uint8_t* data = reinterpret_cast<const uint8_t*>(bytes.data());
+        const uint64_t faces = amc::inspect(data, bytes.size()).faces;
+        return measure("decode amc", [&](uint64_t& nodes, uint64_t& face_count) {
+            h = amc::decode(data, bytes.size(), options);
+            nodes = h.node_count();
+            face_count = faces;
+        });
+    }
+    if (mode == "decode-draco" && argc == 3) {
+        const std::vector<char> bytes = read_file(argv[2]);
+        std::unique_ptr<draco::Mesh> mesh;
+        return measure("decode draco", [&](uint64_t&, uint64_t& faces) {
+            draco::DecoderBuffer buffer;
+            buffer.Init(bytes.data(), bytes.size());
+            draco::Decoder decoder;
+            auto result = decoder.DecodeMeshFromBuffer(&buffer);
+            if (!result.ok()) std::exit(1);
+            mesh = std::move(result).value();
+            faces = mesh->num_faces();
+        });
+    }
+    if (mode == "encode-amc" && argc == 5) {
+        const amc::Hierarchy h = amc::read_hierarchy(argv[4]);
+        amc::EncodeOptions options;
+        options.quantize_bits = std::atoi(argv[2]);
+        options.threads = unsigned(std::atoi(argv[3]));
+        std::vector<uint8_t> bytes;
+        return measure("encode amc", [&](uint64_t& nodes, uint64_t& faces) {
+            amc::EncodeStats stats;
+            bytes = amc::encode(h, options, &stats);
+            nodes = h.node_count();
+            faces = stats.faces;
+        });
+    }
+    if (mode == "encode-draco" && argc == 4) {
+        const int bits = std::atoi(argv[2]);
+        std::shared_ptr<const draco::Mesh> mesh;
+        {
+            const amc::Hierarchy h = amc::read_hierarchy(argv[3]);
+            mesh = amc_bench::make_draco_mesh(amc::extract_leaf_mesh(h).mesh, bits == 0);
+        }
+        draco::EncoderBuffer buffer;
+        return measure("encode draco", [&](uint64_t&, uint64_t& faces) {
+            if (!draco_encoder(bits).EncodeMeshToBuffer(*mesh, &buffer).ok()) std::exit(1);
+            faces = mesh->num_faces();
+        });
+    }
+    std::fprintf(stderr,
+                 "usage: memory_peak prepare BITS model.amh PREFIX | decode-amc FILE.amc THREADS | decode-draco FILE.drc |\n"
+                 "       encode-amc BITS THREADS model.amh | encode-draco BITS model.amh\n");
+    return 2;
+}
