@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# What share of an encode and a decode runs outside the threads' tasks (docs/BENCHMARKS.md, "Threads
+# and memory"): bench/chunks_bench repeats one operation on ONE thread under `perf record` with
+# call graphs; a sample is parallel work when its call chain passes through a parallel_for task
+# (a lambda taking the task index, `{lambda(unsigned long)`) or through a function whose whole work
+# is one parallel_for (its small task is inlined into it: leaf_face_count, check_invariants), and
+# serial otherwise. CPU-time samples: the shares do not depend on the machine's load. Amdahl's law
+# then bounds the speed-up on T threads by 1 / (serial + (1 - serial) / T).
+# Usage: scripts/serial_fraction.sh model.amh [build-dir] [runs]   (needs perf; BITS 0 and 12)
+set -euo pipefail
+model=$1
+build=${2:-$(cd "$(dirname "$0")/.." && pwd)/build-bench}
+runs=${3:-5}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+for bits in 0 12; do
+  for what in encode decode; do
+    perf record -q --call-graph=dwarf,16384 -F 999 -o "$tmp/perf.data" \
+      "$build/bench/chunks_bench" repeat "$what" "$runs" 1 "$bits" "$model" > /dev/null 2>&1
+    perf script -i "$tmp/perf.data" 2> /dev/null > "$tmp/perf.txt"
+    python3 - "$tmp/perf.txt" "$what" "$bits" <<'PY'
+import collections, re, sys
+path, what, bits = sys.argv[1], sys.argv[2], sys.argv[3]
+inlined_parallel = ("amc::leaf_face_count", "amc::check_invariants")
+entry = "amc::" + what
+samples = parallel = 0
+serial = collections.Counter()
+def name(frame):
+    parts = frame.split(None, 1)
+    return re.sub(r"\+0x[0-9a-f]+.*$", "", parts[1]) if len(parts) > 1 else ""
+def short(symbol):
+    return re.sub(r"\((?!anonymous).*", "", symbol).replace("(anonymous namespace)::", "")
+def sample(stack):
+    global samples, parallel
+    names = [name(f) for f in stack]
+    top = next((i for i in range(len(names) - 1, -1, -1) if names[i] == entry or names[i].startswith(entry + "(")), None)
+    if top is None:
+        return  # reading the model, the first encode
+    inner = names[:top]
+    samples += 1
+    if any("{lambda(unsigned long)" in s or s.startswith(inlined_parallel) for s in inner):
+        parallel += 1
+    else:
+        serial[" > ".join(short(s) for s in inner[max(0, len(inner) - 2):][::-1]) or "(itself)"] += 1
+stack = []
+for line in open(path, errors="replace"):
+    if not line.strip():
+        if stack: sample(stack)
+        stack = []
+    elif line[0] in " \t":
+        stack.append(line.strip())
+if stack: sample(stack)
+share = 1 - parallel / max(samples, 1)
+print(f"{what}, {bits} bits: {samples} samples, serial {100 * share:.1f} %: at most {1 / (share + (1 - share) / 2):.2f}x on 2 threads")
+for stage, count in serial.most_common(6):
+    print(f"    {100 * count / samples:5.1f} %  {stage}")
+PY
+  done
+done
