@@ -9,6 +9,11 @@
 //                                                  interleaved; median [min - max] and the ratio of
 //                                                  each run's pair (on a shared machine the load
 //                                                  moves: pairs taken a second apart compare best)
+//   chunks_bench repeat encode|decode RUNS THREADS BITS model.amh
+//                                                  encodes the model once (default options), then
+//                                                  encodes or decodes it RUNS times on THREADS
+//                                                  threads: the process to profile
+//                                                  (scripts/serial_fraction.sh)
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
 
@@ -121,6 +126,26 @@ int speed(int runs, int bits, uint32_t chunks, const char* path) {
     return 0;
 }
 
+int repeat(const std::string& what, int runs, unsigned threads, int bits, const char* path) {
+    const amc::Hierarchy h = amc::read_hierarchy(path);
+    amc::EncodeOptions options;
+    options.quantize_bits = bits;
+    options.threads = threads;
+    std::vector<uint8_t> bytes = amc::encode(h, options);
+    uint64_t check = 0;
+    for (int r = 0; r < runs; ++r) {
+        if (what == "encode") {
+            check += amc::encode(h, options).size();
+        } else {
+            amc::DecodeOptions d;
+            d.threads = threads;
+            check += amc::decode(bytes.data(), bytes.size(), d).node_count();
+        }
+    }
+    std::printf("%s: %d %ss on %u threads (%llu)\n", name_of(path).c_str(), runs, what.c_str(), threads, (unsigned long long)check);
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -128,6 +153,9 @@ int main(int argc, char** argv) {
     if (mode == "sizes" && argc >= 4) return sizes(std::atoi(argv[2]), argc - 3, argv + 3);
     if (mode == "speed" && argc == 6)
         return speed(std::max(1, std::atoi(argv[2])), std::atoi(argv[3]), uint32_t(std::atoi(argv[4])), argv[5]);
-    std::fprintf(stderr, "usage: chunks_bench sizes BITS model.amh ...\n       chunks_bench speed RUNS BITS CHUNKS model.amh\n");
+    if (mode == "repeat" && argc == 7 && (std::string(argv[2]) == "encode" || std::string(argv[2]) == "decode"))
+        return repeat(argv[2], std::max(1, std::atoi(argv[3])), unsigned(std::atoi(argv[4])), std::atoi(argv[5]), argv[6]);
+    std::fprintf(stderr, "usage: chunks_bench sizes BITS model.amh ...\n       chunks_bench speed RUNS BITS CHUNKS model.amh\n"
+                         "       chunks_bench repeat encode|decode RUNS THREADS BITS model.amh\n");
     return 2;
 }
