@@ -2,6 +2,9 @@
 #include "hierarchy_checks.h"
 
 #include "coding/hierarchy/hierarchy_level_coder.h"
+#include "hierarchy/hierarchy_builder.h"
+
+#include <cstring>
 
 #include <algorithm>
 #include <array>
@@ -62,6 +65,101 @@ TEST(BaseOrder, ReorderedHierarchyHasTheSameElements) {
         EXPECT_GT(direct.leaves, 0u) << name;
         EXPECT_EQ(tallied.leaves, direct.leaves) << name;
         for (int r = 0; r < kDiagonalRuleCount; ++r) EXPECT_EQ(tallied.by_rule[r], direct.by_rule[r]) << name << " rule " << r;
+    }
+}
+
+// What reorder_base promises, done the plain way: the forest replayed breadth-first with split(),
+// each node's children in the rotated order, positions copied.
+Hierarchy replayed(const Hierarchy& h, const std::vector<uint32_t>& vertex_order, const std::vector<uint32_t>& triangle_order,
+                   const std::vector<uint8_t>& rotation, std::vector<VertexId>& vertex_map) {
+    std::vector<uint32_t> new_id(vertex_order.size());
+    for (uint32_t i = 0; i < vertex_order.size(); ++i) new_id[vertex_order[i]] = i;
+    TriangleMesh base;
+    base.single_precision = h.base().single_precision;
+    for (uint32_t v : vertex_order) base.positions.push_back(h.base().positions[v]);
+    for (uint32_t t = 0; t < triangle_order.size(); ++t) {
+        Triangle tri;
+        for (int i = 0; i < 3; ++i) tri[i] = new_id[h.base().triangles[triangle_order[t]][(i + rotation[t]) % 3]];
+        base.triangles.push_back(tri);
+    }
+    Hierarchy out(base);
+    vertex_map.assign(h.positions().size(), kNoVertex);
+    out.set_vertex_placer([](void*, Vec3 a, Vec3) { return a; }, nullptr);
+    std::vector<std::pair<NodeId, NodeId>> queue;
+    std::vector<uint8_t> turn;
+    for (uint32_t t = 0; t < triangle_order.size(); ++t) {
+        queue.push_back({triangle_order[t], t});
+        turn.push_back(rotation[t]);
+    }
+    for (size_t i = 0; i < queue.size(); ++i) {
+        const NodeId old_node = queue[i].first, new_node = queue[i].second;
+        const int r = turn[i];
+        out.set_diagonal_flipped(new_node, h.diagonal_flipped(old_node));
+        for (int k = 0; k < 3; ++k) vertex_map[h.vertex(old_node, (k + r) % 3)] = out.vertex(new_node, k);
+        if (h.is_leaf(old_node)) continue;
+        out.split(new_node);
+        for (int e = 0; e < 3; ++e) out.set_position(out.midpoint(new_node, e), h.position(h.midpoint(old_node, (e + r) % 3)));
+        for (int k = 0; k < 4; ++k) {
+            queue.push_back({h.child(old_node, red_split::kRotatedChild[r][k]), out.child(new_node, k)});
+            turn.push_back(uint8_t(r));
+        }
+    }
+    out.set_vertex_placer(nullptr, nullptr);
+    return out;
+}
+
+// Node for node and vertex for vertex the same hierarchy: ids, links, flags, positions' bits.
+bool same_ids(const Hierarchy& a, const Hierarchy& b) {
+    if (a.node_capacity() != b.node_capacity() || a.node_count() != b.node_count() || a.positions().size() != b.positions().size())
+        return false;
+    for (NodeId n = 0; n < a.node_capacity(); ++n) {
+        if (a.is_alive(n) != b.is_alive(n)) return false;
+        if (!a.is_alive(n)) continue;
+        if (a.level(n) != b.level(n) || a.is_leaf(n) != b.is_leaf(n) || a.parent(n) != b.parent(n) ||
+            a.diagonal_flipped(n) != b.diagonal_flipped(n) || (!a.is_leaf(n) && a.child(n, 0) != b.child(n, 0)))
+            return false;
+        for (int e = 0; e < 3; ++e)
+            if (a.vertex(n, e) != b.vertex(n, e) || a.neighbor(n, e) != b.neighbor(n, e) ||
+                a.is_boundary_edge(n, e) != b.is_boundary_edge(n, e) ||
+                (a.neighbor(n, e) != kNoNode && a.neighbor_edge(n, e) != b.neighbor_edge(n, e)))
+                return false;
+    }
+    return std::memcmp(a.positions().data(), b.positions().data(), a.positions().size() * sizeof(Vec3)) == 0;
+}
+
+TEST(BaseOrder, ReorderingGivesTheIdsOfAReplayOnAnyThreads) {
+    uint64_t state = 11;
+    auto next = [&] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return uint32_t(state >> 33);
+    };
+    for (const auto& [name, mesh] : testing::fixture_meshes()) {
+        Hierarchy h(mesh);
+        refine_randomly(h, 3000, 6, 7);
+        for (NodeId n : h.leaves()) {  // some nodes removed again: dead ids and vertices in the input
+            const NodeId p = h.parent(n);
+            if (p != kNoNode && h.is_alive(n) && !h.is_leaf(p) && next() % 7 == 0) h.coarsen(p);
+        }
+        for (NodeId n : h.leaves())
+            if (h.hanging_node_count(n) == 2 && next() % 2) h.set_diagonal_flipped(n, true);
+        for (VertexId v = 0; v < h.positions().size(); ++v)  // positions off the midpoints
+            h.set_position(v, Vec3{h.position(v).x + 1e-3 * (next() % 100), h.position(v).y, h.position(v).z});
+        std::vector<uint32_t> vertex_order(mesh.positions.size()), triangle_order(mesh.triangles.size());
+        std::iota(vertex_order.begin(), vertex_order.end(), 0u);
+        std::iota(triangle_order.begin(), triangle_order.end(), 0u);
+        for (size_t i = vertex_order.size(); i > 1; --i) std::swap(vertex_order[i - 1], vertex_order[next() % i]);
+        for (size_t i = triangle_order.size(); i > 1; --i) std::swap(triangle_order[i - 1], triangle_order[next() % i]);
+        std::vector<uint8_t> rotation(triangle_order.size());
+        for (uint8_t& r : rotation) r = uint8_t(next() % 3);
+        std::vector<VertexId> expected_map;
+        const Hierarchy expected = replayed(h, vertex_order, triangle_order, rotation, expected_map);
+        for (unsigned threads : {1u, 3u}) {
+            std::vector<VertexId> map;
+            const Hierarchy moved = HierarchyBuilder::reorder_base(h, vertex_order, triangle_order, rotation, &map, threads);
+            EXPECT_TRUE(same_ids(moved, expected)) << name << ", " << threads << " threads";
+            EXPECT_EQ(map, expected_map) << name << ", " << threads << " threads";
+            EXPECT_EQ(check_invariants(moved), "") << name;
+        }
     }
 }
 

@@ -106,7 +106,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
 
     // II-B: code the base mesh first and express the forest in the decoder's base order.
     const BaseMeshCode base_code = base_code_of(input, space.quantizer, options);
-    ReorderedInput reordered = in_base_code_order(input, base_code, options.numbering != nullptr);
+    ReorderedInput reordered = in_base_code_order(input, base_code, options.numbering != nullptr, threads);
     Hierarchy& h = reordered.hierarchy;
     const bool store_numbering = options.numbering != nullptr && options.store_numbering;
     if (options.numbering != nullptr)

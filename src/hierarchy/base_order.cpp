@@ -1,7 +1,13 @@
 // Re-expresses a hierarchy over a reordered base mesh (paper, II-B: the forest is matched to the
 // base-mesh coder's deterministic output order, so no bits are spent on the order).
+#include "hierarchy/hierarchy_builder.h"
+
+#include "common/check.h"
+#include "common/parallel.h"
+
 #include <amc/hierarchy.h>
 
+#include <algorithm>
 #include <string>
 
 namespace amc {
@@ -9,6 +15,12 @@ namespace amc {
 Hierarchy reorder_base(const Hierarchy& h, const std::vector<uint32_t>& vertex_order,
                        const std::vector<uint32_t>& triangle_order, const std::vector<uint8_t>& rotation,
                        std::vector<VertexId>* vertex_map) {
+    return HierarchyBuilder::reorder_base(h, vertex_order, triangle_order, rotation, vertex_map, 1);
+}
+
+Hierarchy HierarchyBuilder::reorder_base(const Hierarchy& h, const std::vector<uint32_t>& vertex_order,
+                                         const std::vector<uint32_t>& triangle_order, const std::vector<uint8_t>& rotation,
+                                         std::vector<VertexId>* vertex_map, unsigned threads) {
     const TriangleMesh& old_base = h.base();
     if (vertex_order.size() != old_base.positions.size() || triangle_order.size() != old_base.triangles.size() ||
         rotation.size() != triangle_order.size())
@@ -32,35 +44,111 @@ Hierarchy reorder_base(const Hierarchy& h, const std::vector<uint32_t>& vertex_o
         for (int i = 0; i < 3; ++i) base.triangles[t][i] = new_id[old_base.triangles[o][(i + rotation[t]) % 3]];
     }
 
-    // Replay the forest breadth-first. A node rotated by r has as child k the old node's child
-    // red_split::kRotatedChild[r][k], rotated by r as well. The default
-    // diagonal rule is cyclic, so diagonal flags carry over unchanged.
+    return reordered(h, std::move(base), triangle_order, rotation, new_id, vertex_map, threads);
+}
+
+// What replaying the forest breadth-first with split() gives (each node's children in the rotated
+// order, each split creating the midpoints its earlier-split neighbours have not), made directly
+// and in parallel: the replay's order fixes every id, so each node is written on its own. A node
+// rotated by r has as child k the old node's child red_split::kRotatedChild[r][k], rotated by r
+// as well; its edge e is the old node's edge (e + r) % 3. The default diagonal rule is cyclic, so
+// diagonal flags carry over unchanged.
+Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, const std::vector<uint32_t>& triangle_order,
+                                      const std::vector<uint8_t>& rotation, const std::vector<uint32_t>& base_vertex_id,
+                                      std::vector<VertexId>* vertex_map_out, unsigned threads) {
     Hierarchy out(std::move(base));
-    out.reserve(h.node_count(), h.vertex_count());  // grown once, not by doubling split by split
-    if (vertex_map != nullptr) vertex_map->assign(h.positions().size(), kNoVertex);
-    out.set_vertex_placer([](void*, Vec3 a, Vec3) { return a; }, nullptr);  // positions copied below
-    std::vector<std::pair<NodeId, NodeId>> queue;  // (old node, new node)
-    std::vector<uint8_t> node_rotation;
+    const NodeId roots = out.root_count();
+    // The replay's order: node j of the result is old node old_of[j] turned by turn[j].
+    std::vector<NodeId> old_of, first_child;
+    std::vector<uint8_t> turn;
+    old_of.reserve(h.node_count());
+    turn.reserve(h.node_count());
+    first_child.reserve(h.node_count());
+    std::vector<NodeId> new_of(h.node_capacity(), kNoNode);
     for (uint32_t t = 0; t < triangle_order.size(); ++t) {
-        queue.push_back({triangle_order[t], t});
-        node_rotation.push_back(rotation[t]);
+        old_of.push_back(triangle_order[t]);
+        turn.push_back(rotation[t]);
     }
-    for (size_t i = 0; i < queue.size(); ++i) {
-        const auto [old_node, new_node] = queue[i];
-        const int r = node_rotation[i];
-        out.set_diagonal_flipped(new_node, h.diagonal_flipped(old_node));
-        if (vertex_map != nullptr) {
-            for (int i = 0; i < 3; ++i) (*vertex_map)[h.vertex(old_node, (i + r) % 3)] = out.vertex(new_node, i);
+    for (size_t j = 0; j < old_of.size(); ++j) {
+        const NodeId o = old_of[j];
+        new_of[o] = NodeId(j);
+        if (h.is_leaf(o)) {
+            first_child.push_back(kNoNode);
+            continue;
         }
-        if (h.is_leaf(old_node)) continue;
-        out.split(new_node);
-        for (int e = 0; e < 3; ++e) out.set_position(out.midpoint(new_node, e), h.position(h.midpoint(old_node, (e + r) % 3)));
+        first_child.push_back(NodeId(old_of.size()));
         for (int k = 0; k < 4; ++k) {
-            queue.push_back({h.child(old_node, red_split::kRotatedChild[r][k]), out.child(new_node, k)});
-            node_rotation.push_back(uint8_t(r));
+            old_of.push_back(h.child(o, red_split::kRotatedChild[turn[j]][k]));
+            turn.push_back(turn[j]);
         }
     }
-    out.set_vertex_placer(nullptr, nullptr);
+    const size_t n = old_of.size();
+    // Split node j creates the midpoint of its edge e unless its same-level neighbour there was
+    // split before it (split() then takes the neighbour's).
+    auto creates = [&](size_t j, int e) {
+        const NodeId q = h.neighbor(old_of[j], (e + turn[j]) % 3);
+        return q == kNoNode || h.is_leaf(q) || new_of[q] > j;
+    };
+    constexpr size_t kRange = size_t(1) << 16;  // nodes per task
+    const size_t ranges = (n + kRange - 1) / kRange;
+    std::vector<uint64_t> first_vertex(ranges + 1, 0);
+    parallel_for(ranges, threads, [&](size_t i) {
+        for (size_t j = i * kRange; j < std::min(n, (i + 1) * kRange); ++j)
+            if (first_child[j] != kNoNode)
+                for (int e = 0; e < 3; ++e) first_vertex[i + 1] += creates(j, e);
+    });
+    first_vertex[0] = out.positions_.size();
+    for (size_t i = 0; i < ranges; ++i) first_vertex[i + 1] += first_vertex[i];
+    AMC_REQUIRE(first_vertex[ranges] < kNoVertex, limit_exceeded, "reorder_base: too many vertices");
+    std::vector<VertexId> own_map;
+    std::vector<VertexId>& vertex_map = vertex_map_out != nullptr ? *vertex_map_out : own_map;
+    vertex_map.assign(h.positions().size(), kNoVertex);
+    for (size_t v = 0; v < base_vertex_id.size(); ++v) vertex_map[v] = base_vertex_id[v];
+    out.positions_.resize(size_t(first_vertex[ranges]));
+    // The midpoints, numbered in the replay's order; each written by the node that creates it.
+    parallel_for(ranges, threads, [&](size_t i) {
+        VertexId next = VertexId(first_vertex[i]);
+        for (size_t j = i * kRange; j < std::min(n, (i + 1) * kRange); ++j) {
+            if (first_child[j] == kNoNode) continue;
+            for (int e = 0; e < 3; ++e) {
+                if (!creates(j, e)) continue;
+                const VertexId old = h.midpoint(old_of[j], (e + turn[j]) % 3);
+                vertex_map[old] = next;
+                out.positions_[next++] = h.position(old);
+            }
+        }
+    });
+    out.nodes_.resize(n);  // Node() writes nothing: each is written whole below
+    out.block_parent_.assign((n - roots) / 4, kNoNode);
+    parallel_for(ranges, threads, [&](size_t i) {
+        for (size_t j = i * kRange; j < std::min(n, (i + 1) * kRange); ++j) {
+            const NodeId o = old_of[j];
+            const int r = turn[j];
+            Hierarchy::Node& node = out.nodes_[j];
+            if (first_child[j] != kNoNode) out.block_parent_[(first_child[j] - roots) / 4] = NodeId(j);
+            node.first_child = first_child[j];
+            if (j < roots) {  // the constructor linked the roots
+                node.flags = uint8_t((node.flags & 7u) | (h.diagonal_flipped(o) ? 8u : 0u));
+                continue;
+            }
+            node.nbr_edge = 0;
+            node.flags = h.diagonal_flipped(o) ? 8u : 0u;
+            for (int e = 0; e < 3; ++e) {
+                const int old_edge = (e + r) % 3;
+                node.v[e] = vertex_map[h.vertex(o, old_edge)];
+                const NodeId q = h.neighbor(o, old_edge);
+                node.nbr[e] = q == kNoNode ? kNoNode : new_of[q];
+                if (q != kNoNode)
+                    node.nbr_edge |= uint8_t(((h.neighbor_edge(o, old_edge) + 3 - turn[new_of[q]]) % 3) << (2 * e));
+                if (h.is_boundary_edge(o, old_edge)) node.flags |= uint8_t(1u << e);
+            }
+            node.level = uint8_t(h.level(o));
+            node.reserved = 0;
+        }
+    });
+    for (const Vec3& p : out.positions_) out.far_positions_ |= Hierarchy::is_far(p);
+    out.live_nodes_ = uint32_t(n);
+    out.live_vertices_ = uint32_t(out.positions_.size());
     return out;
 }
 

@@ -66,6 +66,15 @@ struct HierarchyBuilder {
     //    level by level. Throws Error (corrupt) where parts do not fit: a refined node next to a
     //    coarser region of another part, a leaf with three hanging nodes.
     static void stitch_seams(Hierarchy& whole, std::vector<Vec3> positions, std::vector<std::pair<NodeId, int>> seam);
+    // reorder_base (hierarchy.h) on up to `threads` threads: the same ids whatever their number.
+    static Hierarchy reorder_base(const Hierarchy& h, const std::vector<uint32_t>& vertex_order,
+                                  const std::vector<uint32_t>& triangle_order, const std::vector<uint8_t>& rotation,
+                                  std::vector<VertexId>* vertex_map, unsigned threads);
+    // Its work once the orders are checked: the result over `base` (the reordered base mesh), old
+    // base vertex v being base_vertex_id[v].
+    static Hierarchy reordered(const Hierarchy& h, TriangleMesh base, const std::vector<uint32_t>& triangle_order,
+                               const std::vector<uint8_t>& rotation, const std::vector<uint32_t>& base_vertex_id,
+                               std::vector<VertexId>* vertex_map, unsigned threads);
     // Hints the processor to fetch node n (for traversals that know their next nodes early).
     static void prefetch(const Hierarchy& h, NodeId n) { __builtin_prefetch(h.nodes_.data() + n); }
 };

@@ -7,6 +7,7 @@
 #include "common/check.h"
 #include "common/exact_float.h"
 #include "common/parallel.h"
+#include "hierarchy/hierarchy_builder.h"
 
 #include <cmath>
 #include <string>
@@ -62,7 +63,8 @@ BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const 
 // hierarchies made under a rule of absolute local indices would pay orientation bits: then storing
 // each root's rotation (log2 3 bits) to keep the input's local order may be cheaper.
 // Both readings are tallied on the input, so the hierarchy is reordered once.
-ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& base_code, bool want_vertex_map) {
+ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& base_code, bool want_vertex_map,
+                                  unsigned threads) {
     std::vector<uint8_t> rotation_of_root(input.root_count(), 0);
     for (size_t t = 0; t < base_code.triangle_order.size() && t < base_code.triangle_rotation.size(); ++t)
         if (base_code.triangle_order[t] < rotation_of_root.size())
@@ -78,10 +80,10 @@ ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& ba
                                  rounded(kRotationBits * double(base_code.triangle_order.size()));
         r.keep_rotations = kept_bits < rotated_bits;
     }
-    r.hierarchy = reorder_base(input, base_code.vertex_order, base_code.triangle_order,
-                               r.keep_rotations ? std::vector<uint8_t>(base_code.triangle_order.size(), 0)
-                                                : base_code.triangle_rotation,
-                               want_vertex_map ? &r.vertex_map : nullptr);
+    r.hierarchy = HierarchyBuilder::reorder_base(input, base_code.vertex_order, base_code.triangle_order,
+                                                 r.keep_rotations ? std::vector<uint8_t>(base_code.triangle_order.size(), 0)
+                                                                  : base_code.triangle_rotation,
+                                                 want_vertex_map ? &r.vertex_map : nullptr, threads);
     return r;
 }
 

@@ -26,7 +26,9 @@ struct ReorderedInput {
     bool keep_rotations = false;     // the roots keep the input's local vertex order (kOptionRootRotations)
     std::vector<VertexId> vertex_map;  // input vertex id -> id in hierarchy, when asked for
 };
-ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& base_code, bool want_vertex_map);
+// Reorders on up to `threads` threads (the result does not depend on them).
+ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& base_code, bool want_vertex_map,
+                                  unsigned threads = 1);
 
 // The base geometry block of h (in base code order, positions as the decoder reconstructs them).
 std::vector<uint8_t> encode_base_geometry(const Hierarchy& h, const BaseMeshCode& base_code, bool keep_rotations,
