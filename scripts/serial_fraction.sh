@@ -2,9 +2,8 @@
 # What share of an encode and a decode runs outside the threads' tasks (docs/BENCHMARKS.md, "Threads
 # and memory"): bench/chunks_bench repeats one operation on ONE thread under `perf record` with
 # call graphs; a sample is parallel work when its call chain passes through a parallel_for task
-# (a lambda taking the task index, `{lambda(unsigned long)`) or through a function whose whole work
-# is one parallel_for (its small task is inlined into it: leaf_face_count, check_invariants), and
-# serial otherwise. CPU-time samples: the shares do not depend on the machine's load. Amdahl's law
+# (run_task, never inlined, names the task's lambda, which takes the task index:
+# `{lambda(unsigned long)`), and serial otherwise. CPU-time samples: the shares do not depend on the machine's load. Amdahl's law
 # then bounds the speed-up on T threads by 1 / (serial + (1 - serial) / T).
 # Usage: scripts/serial_fraction.sh model.amh [build-dir] [runs]   (needs perf; BITS 0 and 12)
 set -euo pipefail
@@ -21,7 +20,6 @@ for bits in 0 12; do
     python3 - "$tmp/perf.txt" "$what" "$bits" <<'PY'
 import collections, re, sys
 path, what, bits = sys.argv[1], sys.argv[2], sys.argv[3]
-inlined_parallel = ("amc::leaf_face_count", "amc::check_invariants")
 entry = "amc::" + what
 samples = parallel = 0
 serial = collections.Counter()
@@ -38,7 +36,7 @@ def sample(stack):
         return  # reading the model, the first encode
     inner = names[:top]
     samples += 1
-    if any("{lambda(unsigned long)" in s or s.startswith(inlined_parallel) for s in inner):
+    if any("{lambda(unsigned long)" in s for s in inner):
         parallel += 1
     else:
         serial[" > ".join(short(s) for s in inner[max(0, len(inner) - 2):][::-1]) or "(itself)"] += 1

@@ -21,6 +21,13 @@ inline unsigned resolve_thread_count(unsigned threads) {
     return cores == 0 ? 1 : cores;
 }
 
+// Calls task(i), never inlined: every task is a frame of its own in a profile (the lambda's type
+// names it), also on one thread (scripts/serial_fraction.sh counts what runs outside tasks).
+template <class Task>
+[[gnu::noinline]] void run_task(Task& task, size_t i) {
+    task(i);
+}
+
 // Calls task(i) for i in [0, count) on up to `threads` threads (the caller's thread is one of
 // them). The first exception a task throws is rethrown here once every thread has stopped; the
 // tasks not started by then are skipped.
@@ -28,7 +35,7 @@ template <class Task>
 void parallel_for(size_t count, unsigned threads, Task&& task) {
     const size_t workers = std::min<size_t>(count, std::max(1u, threads));
     if (workers <= 1) {
-        for (size_t i = 0; i < count; ++i) task(i);
+        for (size_t i = 0; i < count; ++i) run_task(task, i);
         return;
     }
     std::atomic<size_t> next{0};
@@ -38,7 +45,7 @@ void parallel_for(size_t count, unsigned threads, Task&& task) {
     auto work = [&] {
         for (size_t i = next++; i < count && !failed; i = next++) {
             try {
-                task(i);
+                run_task(task, i);
             } catch (...) {
                 std::lock_guard<std::mutex> lock(error_mutex);
                 if (!error) error = std::current_exception();
