@@ -41,3 +41,28 @@ LIST
   "$amc" -f refine --model random --faces 150000 --seed 7 -o "$corpus/random.amh" > /dev/null || return 1
   corpus_models+=("$corpus/lshape.amh" "$corpus"/front_*.amh "$corpus/uniform.amh" "$corpus/random.amh")
 }
+
+# Held-out models (issue 30): the meshes of DATA_DIR the corpus above does not use, remeshed the
+# same way (about 100,000 faces, base of about 500 triangles, up to level 5, mean and Gauss
+# curvature), for checking on unseen meshes what was tuned on the corpus. make_heldout_corpus AMC
+# DATA_DIR CORPUS_DIR lists them in heldout_models; AMC_REUSE_CORPUS=1 as above.
+make_heldout_corpus() {
+  local amc=$1 data=$2 corpus=$3 model file criterion
+  heldout_models=()
+  mkdir -p "$corpus"
+  while read -r model file; do
+    for criterion in mean gauss; do
+      if [[ ${AMC_REUSE_CORPUS:-0} != 1 || ! -s $corpus/${model}_$criterion.amh ]]; then
+        "$amc" -f refine --input "$data/$file" --criterion "$criterion" --faces 100000 --base-faces 500 --max-level 5 \
+          -o "$corpus/${model}_$criterion.amh" > /dev/null || return 1
+      fi
+      heldout_models+=("$corpus/${model}_$criterion.amh")
+    done
+  done <<'LIST'
+bunny          bunny.obj
+elephant       elephant-sr-l2.obj
+bunny-sr       bunny-sr-l3.obj
+venus-coarse   venus-coarse.off
+rabbit-coarse  rabbit-coarse.off
+LIST
+}

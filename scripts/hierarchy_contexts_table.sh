@@ -3,7 +3,8 @@
 # (scripts/corpus.sh) encoded bit-exactly with the paper's contexts and with the mixing mode
 # (.amc version 8), the hierarchy bytes of each (amc encode -v), the change, and the best of
 # `runs` whole-file decode times of each. Sizes are exact and the same on every run; times are not.
-# Usage: scripts/hierarchy_contexts_table.sh [build-dir] [runs]   (AMC_REUSE_CORPUS=1 keeps a corpus)
+# Usage: scripts/hierarchy_contexts_table.sh [build-dir] [runs]   (AMC_REUSE_CORPUS=1 keeps a corpus;
+# AMC_HELDOUT=1: the held-out models of scripts/corpus.sh, make_heldout_corpus, instead)
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-$here/build}
@@ -13,7 +14,13 @@ corpus=$build/bench-corpus
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 source "$here/scripts/corpus.sh"
-make_corpus "$build/amc" "$data" "$corpus"
+if [[ ${AMC_HELDOUT:-0} == 1 ]]; then
+  # The held-out models (meshes the mixing mode was not tuned on): make_heldout_corpus.
+  make_heldout_corpus "$build/amc" "$data" "$build/heldout-corpus"
+  corpus_models=("${heldout_models[@]}")
+else
+  make_corpus "$build/amc" "$data" "$corpus"
+fi
 
 # Best wall time of `runs` decodes, in milliseconds.
 best_decode_ms() {

@@ -269,6 +269,66 @@ TEST(Golden, MixedContextsFilesDecodeAndPinTheEncoder) {
     }
 }
 
+// Version 9 (level geometry mode 4, FORMAT.md 5.7): the projected sphere of version 6 at 12 bits
+// with the automatic choice and grid contexts, at 16 bits with mode 4 forced in every level, at 5
+// bits (few tokens), at 12 bits forced in four chunks, and at 12 bits under the mixing mode.
+std::vector<GoldenCase> grid_geometry_cases() {
+    std::vector<GoldenCase> cases;
+    for (GoldenCase& c : static_geometry_cases()) {
+        if (c.name != "sphere_random") continue;
+        EncodeOptions grid;
+        grid.quantize_bits = 12;
+        grid.grid_contexts = true;
+        cases.push_back({"sphere_random_q12_grid", c.hierarchy, grid});
+        EncodeOptions forced;
+        forced.quantize_bits = 16;
+        forced.predictor = GeometryPredictor::normal_frame_grid;
+        cases.push_back({"sphere_random_q16_grid_forced", c.hierarchy, forced});
+        forced.quantize_bits = 5;
+        cases.push_back({"sphere_random_q5_grid_forced", c.hierarchy, forced});
+        EncodeOptions chunked = grid;
+        chunked.chunks = 4;
+        chunked.predictor = GeometryPredictor::normal_frame_grid;  // small chunks: the automatic choice keeps mode 3
+        cases.push_back({"sphere_random_q12_grid_forced_chunks4", c.hierarchy, chunked});
+        EncodeOptions mixed = grid;
+        mixed.hierarchy_contexts = HierarchyContexts::mixed;
+        cases.push_back({"sphere_random_q12_grid_mixed", c.hierarchy, mixed});
+    }
+    return cases;
+}
+
+TEST(Golden, GridGeometryFilesDecodeAndPinTheEncoder) {
+    const bool update = std::getenv("AMC_UPDATE_GOLDEN") != nullptr;
+    const std::vector<GoldenCase> cases = grid_geometry_cases();
+    ASSERT_EQ(cases.size(), 5u);
+    for (const GoldenCase& c : cases) {
+        EncodeStats stats;
+        const std::vector<uint8_t> bytes = encode(c.hierarchy, c.options, &stats);
+        const std::string path = golden_path(kGridGeometryVersion, c.name);
+        SCOPED_TRACE(path);
+        if (update && !std::filesystem::exists(path)) {
+            std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+            std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+        }
+        const std::vector<uint8_t> golden = read_golden(path);
+        ASSERT_FALSE(golden.empty()) << path << " is missing";
+        EXPECT_EQ(bytes, golden) << "the bitstream changed (a new format version: FORMAT.md, Versions)";
+        const FileInfo info = inspect(golden.data(), golden.size());
+        EXPECT_EQ(info.version, kGridGeometryVersion);
+        EXPECT_EQ(info.chunks.size(), c.options.chunks > 1 ? size_t(c.options.chunks) : size_t(0));
+        EXPECT_TRUE(std::any_of(stats.per_level.begin(), stats.per_level.end(),
+                                [](const LevelStats& l) { return l.predictor == GeometryPredictor::normal_frame_grid; }))
+            << "the case exercises geometry mode 4";
+        const Hierarchy back = decode(golden.data(), golden.size());
+        EXPECT_TRUE(decodes_to_one_of(back, expected_decodings(c.hierarchy, c.options, kGridGeometryVersion)));
+        for (int l = 0; l < int(stats.levels); ++l) {
+            DecodeOptions prefix;
+            prefix.max_level = l;
+            EXPECT_EQ(decode(golden.data(), golden.size(), prefix).depth(), std::min(l, back.depth())) << "level " << l;
+        }
+    }
+}
+
 TEST(Golden, FilesOfEveryVersionDecodeToTheirHierarchies) {
     for (const int version : kVersionsOfTheCases) {
         for (const GoldenCase& c : golden_cases()) {

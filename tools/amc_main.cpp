@@ -84,7 +84,8 @@ int main(int argc, char** argv) {
     encode_cmd->add_option("--map", encode.map, "Write the map from the input's numbering to the decoded mesh (text)");
     encode_cmd->add_option("--quantize", encode.quantize_bits, "Quantize coordinates to BITS per axis (lossy; 0 = bit-exact)")
         ->check(CLI::Range(0, 30));
-    encode_cmd->add_option("--predictor", encode.predictor, "auto | midpoint | butterfly | normal")->capture_default_str();
+    encode_cmd->add_option("--predictor", encode.predictor, "auto | midpoint | butterfly | normal | grid (normal, --quantize only)")
+        ->capture_default_str();
     encode_cmd->add_option("--chunks", encode.chunks,
                            "Cut the forest into this many chunks, each decodable alone (0: one per --chunk-faces faces)")
         ->check(CLI::Range(0u, 1u << 30));
@@ -96,6 +97,11 @@ int main(int argc, char** argv) {
     encode_cmd->add_option("--hierarchy-contexts", encode.hierarchy_contexts,
                            "paper (fastest decode) | mixed (smaller connectivity, slower decode, one chunk; .amc version 8)")
         ->check(CLI::IsMember({"paper", "mixed"}))
+        ->capture_default_str();
+    encode_cmd->add_option("--geometry-contexts", encode.geometry_contexts,
+                           "roles | grid (with --quantize: tables also split by where the prediction falls between grid "
+                           "points, smaller geometry; .amc version 9)")
+        ->check(CLI::IsMember({"roles", "grid"}))
         ->capture_default_str();
     encode_cmd->add_flag("--series", encode.series, "The input is a series (as 'amc series encode'; implied by a .pvd input)");
 

@@ -25,6 +25,7 @@ const char* predictor_name(GeometryPredictor p) {
     return p == GeometryPredictor::butterfly      ? "butterfly"
            : p == GeometryPredictor::midpoint     ? "midpoint"
            : p == GeometryPredictor::normal_frame ? "normal"
+           : p == GeometryPredictor::normal_frame_grid ? "grid"
                                                   : "automatic";
 }
 
@@ -33,7 +34,8 @@ GeometryPredictor parse_predictor(const std::string& name) {
     if (name == "midpoint") return GeometryPredictor::midpoint;
     if (name == "butterfly") return GeometryPredictor::butterfly;
     if (name == "normal") return GeometryPredictor::normal_frame;
-    throw UsageError("--predictor: unknown predictor '" + name + "' (auto, midpoint, butterfly, normal)");
+    if (name == "grid") return GeometryPredictor::normal_frame_grid;
+    throw UsageError("--predictor: unknown predictor '" + name + "' (auto, midpoint, butterfly, normal, grid)");
 }
 
 // "0,3-5" -> 0, 3, 4, 5 (increasing, each once).
@@ -95,8 +97,9 @@ void print_encode_stats(std::FILE* out, const std::string& name, const EncodeSta
 void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     if (command.series || is_pvd(command.input)) {
         if (command.keep_numbering || !command.map.empty() || command.quantize_bits != 0 || command.predictor != "auto" ||
-            command.hierarchy_contexts != "paper")
-            throw UsageError("--keep-numbering, --map, --quantize, --predictor and --hierarchy-contexts do not apply to a series");
+            command.hierarchy_contexts != "paper" || command.geometry_contexts != "roles")
+            throw UsageError("--keep-numbering, --map, --quantize, --predictor, --hierarchy-contexts and --geometry-contexts do not "
+                             "apply to a series");
         SeriesEncodeCommand series;
         series.inputs = {command.input};
         series.output = command.output;
@@ -123,6 +126,9 @@ void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     EncodeOptions options;
     options.quantize_bits = command.quantize_bits;
     options.predictor = parse_predictor(command.predictor);
+    options.grid_contexts = command.geometry_contexts == "grid";
+    if ((options.grid_contexts || options.predictor == GeometryPredictor::normal_frame_grid) && options.quantize_bits == 0)
+        throw UsageError("--geometry-contexts grid and --predictor grid need --quantize (grid points exist only on a grid)");
     options.chunks = command.chunks;
     options.chunk_faces = command.chunk_faces;
     options.threads = command.threads;

@@ -13,9 +13,10 @@ namespace amc {
 // numbering block, else version 2. Version 5 holds version 4's streams; its encoder searches the
 // start triangle and gate radius of mode 2 (FORMAT.md 4.16), so it writes other bytes. Version 6 for files with a level in geometry
 // mode 3 (normal frame, static tables, rANS). Version 8 for files whose hierarchy symbols are in
-// the mixing mode (metadata option bit 2; FORMAT.md 2.1).
+// the mixing mode (metadata option bit 2; FORMAT.md 2.1). Version 9 for files with a level in
+// geometry mode 4 (whether chunked, mixed or neither).
 constexpr uint8_t kOldestReadableVersion = 1;
-constexpr uint8_t kNewestVersion = 8;
+constexpr uint8_t kNewestVersion = 9;
 constexpr uint8_t kBaseVersion = 2;       // everything but the numbering block and mode 2
 constexpr uint8_t kNumberingVersion = 3;  // the first version with a numbering block
 constexpr uint8_t kAngleBaseVersion = 4;  // the first version with base connectivity mode 2
@@ -25,6 +26,9 @@ constexpr uint8_t kStaticGeometryVersion = 6;  // the first version with level g
 // blocks): written only for files of more than one chunk.
 constexpr uint8_t kChunkedVersion = 7;
 constexpr uint8_t kMixedContextsVersion = 8;   // the first version with the hierarchy coder's mixing mode
+// The first version with level geometry mode 4 (the normal frame's tables split by where the
+// prediction falls between grid points; quantized files, level blocks or chunks).
+constexpr uint8_t kGridGeometryVersion = 9;
 
 // The hierarchy stream (FORMAT.md section 2).
 constexpr uint8_t kHierarchyStreamVersion = 2;
@@ -45,6 +49,7 @@ constexpr uint8_t hierarchy_stream_version_of_file(uint8_t file_version) {
         case 6: return 2;
         case 7: return 2;
         case 8: return 2;
+        case 9: return 2;
     }
     return 0;
 }

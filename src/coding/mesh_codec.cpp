@@ -50,9 +50,10 @@ Quantizer quantizer_of(const Hierarchy& input, int bits, double& max_error) {
 }
 
 // The lowest version that holds what the file holds (format_version.h).
-uint8_t file_version(bool mixed_contexts, bool chunked, bool static_geometry, BaseConnectivityMode base_mode,
+uint8_t file_version(bool grid_geometry, bool mixed_contexts, bool chunked, bool static_geometry, BaseConnectivityMode base_mode,
                      bool store_numbering) {
-    return mixed_contexts                                ? kMixedContextsVersion
+    return grid_geometry                                 ? kGridGeometryVersion
+           : mixed_contexts                              ? kMixedContextsVersion
            : chunked                                     ? kChunkedVersion
            : static_geometry                             ? kStaticGeometryVersion
            : base_mode == BaseConnectivityMode::angle ? kSearchedBaseVersion
@@ -151,20 +152,22 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     blocks.emplace_back(BlockType::base_geometry, encode_base_geometry(h, base_code, reordered.keep_rotations, positions));
     stats.base_geometry_bytes = blocks.back().second.size();
 
-    bool static_geometry = false;
+    bool static_geometry = false, grid_geometry = false;
     if (chunked) {
         ChunkedBlocks parts = encode_chunked(h, chunks, options, space, threads, stats);
         static_geometry = parts.static_geometry;
+        grid_geometry = parts.grid_geometry;
         for (auto& block : parts.blocks) blocks.push_back(std::move(block));
     }
     for (int l = 0; !chunked && l < hierarchy.level_count(); ++l) {
         const NewVertices& created = hierarchy.new_vertices(l);
-        const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, options.predictor);
+        const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, options.predictor, options.grid_contexts);
         ArithmeticEncoder encoder;
         hierarchy.encode_level(l, encoder);
         const size_t hierarchy_part = encoder.bytes_so_far();
         std::vector<uint8_t> payload = finish_level_payload(h, created, geometry, positions, encoder);
         static_geometry |= geometry.predictor == GeometryPredictor::normal_frame;
+        grid_geometry |= geometry.predictor == GeometryPredictor::normal_frame_grid;
         add_level_stats(stats, hierarchy.level_nodes(l).size(), created.size(), hierarchy_part, payload);
         blocks.emplace_back(BlockType::level, std::move(payload));
     }
@@ -173,7 +176,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
         stats.numbering_bytes = blocks.back().second.size();
         stats.framing_bytes += kBlockOverhead;
     }
-    BlockWriter writer(file_version(mixed, chunked, static_geometry, base_code.mode, store_numbering),
+    BlockWriter writer(file_version(grid_geometry, mixed, chunked, static_geometry, base_code.mode, store_numbering),
                        uint8_t((precision == Precision::float32 ? kFlagSinglePrecision : 0) | (quantized ? kFlagQuantized : 0)));
     for (const auto& block : blocks) writer.add(block.first, block.second);
     std::vector<uint8_t> out = writer.finish();
@@ -313,15 +316,17 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
             continue;
         }
         AMC_REQUIRE(!has_numbering, corrupt, "level block after the numbering block");
-        // Level blocks: every version before chunks, and the unchunked files of the mixing mode.
+        // Level blocks: every version before chunks, and the unchunked files of the mixing mode and
+        // of version 9 on.
         AMC_REQUIRE(block.type == BlockType::level &&
-                        (reader.version() < kChunkedVersion || (meta.options & kOptionMixedContexts)),
+                        (reader.version() < kChunkedVersion || (meta.options & kOptionMixedContexts) ||
+                         reader.version() >= kGridGeometryVersion),
                     corrupt,
                     "unexpected block between level blocks");
         AMC_REQUIRE(!hierarchy.done(), corrupt, "level block after the last level");
         if (options.max_level >= 0 && level >= options.max_level) return std::move(h);  // progressive: stop here
         const std::string where = "level " + std::to_string(level) + " block";
-        const LevelBlockParts parts = split_level_block(block, reader.version(), where);
+        const LevelBlockParts parts = split_level_block(block, reader.version(), space.quantizer != nullptr, where);
         ArithmeticDecoder decoder(parts.arithmetic, parts.arithmetic_size);
         // The refined nodes R of a level create at least 1.5 R vertices, whose positions are in
         // this block: it bounds R before the next level is allocated.

@@ -45,7 +45,7 @@ void for_each_seam_closure(const Hierarchy& h, const std::vector<NodeId>& level,
 }  // namespace
 
 ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& seam, const HierarchyCoderOptions& options,
-                       GeometryPredictor fixed_predictor, CoordinateSpace space) {
+                       GeometryPredictor fixed_predictor, CoordinateSpace space, bool grid_contexts) {
     ChunkCode out;
     HierarchyLevelEncoder hierarchy(h, options);
     const std::vector<uint8_t>& header = hierarchy.header();
@@ -60,13 +60,14 @@ ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& s
         for (auto [n, e] : hierarchy.new_vertices(l))
             if (seam_vertex(h, keys, seam, n, e) < 0) created.emplace_back(n, e);
         // The predictor, as the whole file's encoder picks it (FORMAT.md 3.9, 5.6).
-        const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, fixed_predictor);
+        const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, fixed_predictor, grid_contexts);
         ArithmeticEncoder encoder;
         hierarchy.encode_level(l, encoder);
         for_each_seam_closure(h, level, keys, seam, [&](NodeId n) { encoder.encode(h.diagonal_flipped(n), flipped); });
         const size_t hierarchy_part = encoder.bytes_so_far();
         const std::vector<uint8_t> payload = finish_level_payload(h, created, geometry, positions, encoder);
         out.static_geometry |= geometry.predictor == GeometryPredictor::normal_frame;
+        out.grid_geometry |= geometry.predictor == GeometryPredictor::normal_frame_grid;
         const uint64_t hierarchy_bytes = std::min<uint64_t>(hierarchy_part, payload.size() - 1);
         out.hierarchy_bytes += hierarchy_bytes;
         out.geometry_bytes += payload.size() - 1 - hierarchy_bytes;
@@ -109,7 +110,7 @@ Hierarchy& decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, s
         AMC_REQUIRE(length >= 1 && length <= in.remaining(), corrupt, where + ": bad length");
         const Block level_block{BlockType::level, in.rest(), size_t(length), 0};
         for (uint64_t i = 0; i < length; ++i) in.u8();
-        const LevelBlockParts parts = split_level_block(level_block, limits.file_version, where);
+        const LevelBlockParts parts = split_level_block(level_block, limits.file_version, space.quantizer != nullptr, where);
         ArithmeticDecoder decoder(parts.arithmetic, parts.arithmetic_size);
         const std::vector<NodeId> nodes = hierarchy.level_nodes();
         hierarchy.decode_level(decoder);

@@ -24,6 +24,7 @@ uint64_t leaf_face_count(const Hierarchy& h, unsigned threads = 1);
 struct ChunkedBlocks {
     std::vector<std::pair<BlockType, std::vector<uint8_t>>> blocks;  // chunk table, seam, chunks
     bool static_geometry = false;  // some chunk level uses geometry mode 3
+    bool grid_geometry = false;    // some chunk level uses geometry mode 4
     int levels = 0;                // of the deepest chunk
 };
 

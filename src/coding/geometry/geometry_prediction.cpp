@@ -87,17 +87,28 @@ Vec3 exact_cross(Vec3 u, Vec3 v) {
             rounded(u.x * v.y) - rounded(u.y * v.x)};
 }
 
+// v scaled to unit length: each coordinate times 1 / L, L the correctly rounded square root of
+// exact_dot(v, v), each product rounded; the zero vector when L is 0 or not finite.
+Vec3 exact_unit(Vec3 v) {
+    const double length = std::sqrt(exact_dot(v, v));
+    if (!(length > 0) || !std::isfinite(length)) return {0, 0, 0};
+    return rounded_scaled(1.0 / length, v);
+}
+
 }  // namespace
 
-NormalFrame normal_frame(const Hierarchy& h, NodeId n, int e) {
+NormalFrame normal_frame(const Hierarchy& h, NodeId n, int e, bool unit_normals) {
     NormalFrame f;
     f.midpoint = predict_midpoint(h, n, e);
     const Vec3 a = h.position(h.vertex(n, e));
     const Vec3 b = h.position(h.vertex(n, (e + 1) % 3));
     const Vec3 c = h.position(h.vertex(n, (e + 2) % 3));
-    f.normal = exact_cross(b - a, c - a);
+    // Mode 4 sums unit normals (the remesher's direction, vertex_placement.cpp), mode 3 the cross
+    // products themselves (each weighted by its triangle's area).
+    const auto scaled = [unit_normals](Vec3 v) { return unit_normals ? exact_unit(v) : v; };
+    f.normal = scaled(exact_cross(b - a, c - a));
     const NodeId q = h.neighbor(n, e);
-    if (q != kNoNode) f.normal = f.normal + exact_cross(a - b, opposite(h, q, h.neighbor_edge(n, e)) - b);
+    if (q != kNoNode) f.normal = f.normal + scaled(exact_cross(a - b, opposite(h, q, h.neighbor_edge(n, e)) - b));
     for (int i = 1; i < 3; ++i)
         if (std::fabs(component(f.normal, i)) > std::fabs(component(f.normal, f.axis))) f.axis = i;
     const double largest = std::fabs(component(f.normal, f.axis));

@@ -57,7 +57,9 @@ struct NormalFrame {
     // The other coordinates' prediction once the first axis's value is known.
     Vec3 predict(double first_axis_value) const;
 };
-NormalFrame normal_frame(const Hierarchy& h, NodeId n, int e);
+// unit_normals (geometry mode 4, FORMAT.md 5.7): N is the sum of the two triangles' unit normals
+// instead, the direction along which the surface remesher places the vertex.
+NormalFrame normal_frame(const Hierarchy& h, NodeId n, int e, bool unit_normals = false);
 
 // Parallelogram rule over already decoded positions: a + b - c when all three indices are valid
 // (>= 0 and < decoded.size()), else a when a is valid, else the zero vector.

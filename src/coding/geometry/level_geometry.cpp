@@ -3,6 +3,7 @@
 
 #include "coding/geometry/geometry_prediction.h"
 #include "common/check.h"
+#include "coding/format_version.h"
 
 #include <cmath>
 #include <cstdint>
@@ -24,12 +25,16 @@ void encode_adaptive(const Hierarchy& h, const NewVertices& created, GeometryPre
 }  // namespace
 
 LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& created, const PositionCoder& positions,
-                                        CoordinateSpace space, GeometryPredictor choice) {
+                                        CoordinateSpace space, GeometryPredictor choice, bool grid_contexts) {
     const bool automatic = choice == GeometryPredictor::automatic;
     LevelGeometryCode code;
     code.predictor = automatic ? GeometryPredictor::midpoint : choice;
+    if (code.predictor == GeometryPredictor::normal_frame_grid && space.quantizer == nullptr)
+        throw Error("geometry mode 4 (normal_frame_grid) needs quantized coordinates");
     if (code.predictor == GeometryPredictor::normal_frame || (automatic && !created.empty()))
         code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space);
+    if (code.predictor == GeometryPredictor::normal_frame_grid)
+        code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space, true);
     if (!automatic || created.empty()) return code;
     size_t best = SIZE_MAX;
     for (GeometryPredictor candidate : {GeometryPredictor::midpoint, GeometryPredictor::butterfly}) {
@@ -42,14 +47,24 @@ LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& c
             code.predictor = candidate;
         }
     }
-    if (code.static_code->estimated_bytes() < best) code.predictor = GeometryPredictor::normal_frame;
+    if (code.static_code->estimated_bytes() < best) {
+        best = code.static_code->estimated_bytes();
+        code.predictor = GeometryPredictor::normal_frame;
+    }
+    if (grid_contexts && space.quantizer != nullptr) {
+        auto grid = std::make_unique<StaticLevelEncoder>(h, created, space, true);
+        if (grid->estimated_bytes() < best) {
+            code.predictor = GeometryPredictor::normal_frame_grid;
+            code.static_code = std::move(grid);
+        }
+    }
     return code;
 }
 
 std::vector<uint8_t> finish_level_payload(const Hierarchy& h, const NewVertices& created, const LevelGeometryCode& code,
                                           PositionCoder& positions, ArithmeticEncoder& encoder) {
     std::vector<uint8_t> payload{uint8_t(code.predictor)};
-    if (code.predictor == GeometryPredictor::normal_frame) {
+    if (is_static_mode(code.predictor)) {
         const StaticLevelEncoder& static_code = *code.static_code;
         static_code.write_tables(encoder);
         const std::vector<uint8_t> coded = encoder.finish();
@@ -66,16 +81,17 @@ std::vector<uint8_t> finish_level_payload(const Hierarchy& h, const NewVertices&
     return payload;
 }
 
-LevelBlockParts split_level_block(const Block& block, uint8_t file_version, const std::string& where) {
-    const uint8_t last_predictor = uint8_t(file_version >= kStaticGeometryVersion ? GeometryPredictor::normal_frame
-                                                                                  : GeometryPredictor::butterfly);
+LevelBlockParts split_level_block(const Block& block, uint8_t file_version, bool quantized, const std::string& where) {
+    const uint8_t last_predictor = uint8_t(file_version >= kGridGeometryVersion && quantized ? GeometryPredictor::normal_frame_grid
+                                           : file_version >= kStaticGeometryVersion          ? GeometryPredictor::normal_frame
+                                                                                             : GeometryPredictor::butterfly);
     AMC_REQUIRE(block.size >= 1 && block.payload[0] >= uint8_t(GeometryPredictor::midpoint) && block.payload[0] <= last_predictor,
                 corrupt, "level block: bad predictor");
     LevelBlockParts parts;
     parts.predictor = GeometryPredictor(block.payload[0]);
     PayloadReader in(block.payload + 1, block.size - 1, "level block");
     size_t arithmetic_size = block.size - 1;
-    if (parts.predictor == GeometryPredictor::normal_frame) {
+    if (is_static_mode(parts.predictor)) {
         const uint64_t size = in.varint();
         AMC_REQUIRE(size <= in.remaining(), corrupt, where + ": arithmetic part is longer than the block");
         arithmetic_size = size_t(size);
@@ -89,16 +105,18 @@ LevelBlockParts split_level_block(const Block& block, uint8_t file_version, cons
 
 void decode_level_geometry(Hierarchy& h, const NewVertices& created, const LevelBlockParts& parts, ArithmeticDecoder& decoder,
                            PositionCoder& positions, CoordinateSpace space, int level, const std::string& where) {
-    if (parts.predictor == GeometryPredictor::normal_frame) {
+    if (is_static_mode(parts.predictor)) {
+        const bool grid_bins = parts.predictor == GeometryPredictor::normal_frame_grid;
         StaticTables tables;
-        AMC_REQUIRE(read_static_tables(decoder, space, tables) && !decoder.overran(), corrupt, where + ": bad geometry tables");
+        AMC_REQUIRE(read_static_tables(decoder, space, grid_bins, tables) && !decoder.overran(), corrupt,
+                    where + ": bad geometry tables");
         PayloadReader in(parts.after_arithmetic, parts.after_arithmetic_size, "level block");
         const uint64_t rans_size = in.varint();
         AMC_REQUIRE(rans_size <= in.remaining(), corrupt, where + ": rANS stream is longer than the block");
         const uint8_t* rans = in.rest();
         const uint8_t* raw = rans + rans_size;
         const size_t raw_size = in.remaining() - size_t(rans_size);
-        AMC_REQUIRE(decode_static_positions(h, created, space, tables, rans, size_t(rans_size), raw, raw_size), corrupt,
+        AMC_REQUIRE(decode_static_positions(h, created, space, grid_bins, tables, rans, size_t(rans_size), raw, raw_size), corrupt,
                     where + " is truncated or corrupt (positions)");
     } else {
         for (auto [n, e] : created) {

@@ -27,14 +27,20 @@ using NewVertices = std::vector<std::pair<NodeId, int>>;
 // A level's geometry code, chosen before the level block is written.
 struct LevelGeometryCode {
     GeometryPredictor predictor = GeometryPredictor::midpoint;
-    std::unique_ptr<StaticLevelEncoder> static_code;  // mode 3's streams, when it was considered
+    std::unique_ptr<StaticLevelEncoder> static_code;  // mode 3's or 4's streams, when chosen
 };
 
 // The predictor of the level that creates `created` (positions set in h as the decoder will have
 // them): `choice`, or when it is automatic the one that codes the level in the fewest bytes, each
-// adaptive predictor tried on a copy of `positions`' models.
+// adaptive predictor tried on a copy of `positions`' models; mode 4 is a candidate only with
+// grid_contexts in a quantized space.
 LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& created, const PositionCoder& positions,
-                                        CoordinateSpace space, GeometryPredictor choice);
+                                        CoordinateSpace space, GeometryPredictor choice, bool grid_contexts = false);
+
+// Modes 3 and 4: the static modes (tables, rANS, raw bits).
+constexpr bool is_static_mode(GeometryPredictor p) {
+    return p == GeometryPredictor::normal_frame || p == GeometryPredictor::normal_frame_grid;
+}
 
 // The payload of a level block whose hierarchy part `encoder` holds: the predictor byte, then the
 // arithmetic code finished with the level's geometry (and mode 3's streams).
@@ -52,9 +58,9 @@ struct LevelBlockParts {
     size_t after_arithmetic_size = 0;
 };
 
-// Throws Error on a predictor the file's version does not have and on a mode-3 arithmetic length
-// beyond the block. `where` names the block in messages.
-LevelBlockParts split_level_block(const Block& block, uint8_t file_version, const std::string& where);
+// Throws Error on a predictor the file's version does not have (mode 4 also in a file that is not
+// quantized) and on a mode-3 or mode-4 arithmetic length beyond the block. `where` names the block in messages.
+LevelBlockParts split_level_block(const Block& block, uint8_t file_version, bool quantized, const std::string& where);
 
 // Decodes the positions of `created` (the level `level` just decoded from `decoder`) and sets them
 // in h. Throws Error on a corrupt or truncated block.

@@ -3,6 +3,7 @@
 
 #include "coding/geometry/geometry_prediction.h"
 #include "common/bits.h"
+#include "common/exact_float.h"
 
 #include <cmath>
 
@@ -69,6 +70,51 @@ bool value_of(CoordinateSpace space, int axis, double predicted, Residual r, dou
     const uint64_t p = ordered_bits(coder_prediction(predicted, space.precision), space.precision);
     value = from_ordered_bits((r.negative ? p - r.magnitude : p + r.magnitude) & mask, space.precision);
     return std::isfinite(value);
+}
+
+// ---- mode 4: where the prediction falls between grid points ---------------------------------------
+
+// The grid coordinate p = round(t) of a prediction (quantize_coordinate's), t = (x - origin) / step
+// in grid steps, and its table bin: 1 when |t - p| >= 1/4, else 0. `turn` when t < p: the residual
+// is then coded negated, so that positive points towards the second-nearest grid point. A clamped
+// prediction (t <= 0, t >= 2^bits - 1, NaN) has bin 0 and no turn.
+struct GridPrediction {
+    uint32_t p;
+    int bin;
+    bool turn;
+};
+
+#if defined(__GNUC__)
+#define AMC_GRID_INLINE __attribute__((always_inline)) inline
+#else
+#define AMC_GRID_INLINE inline
+#endif
+
+// Inlined: returned through memory, the small struct stalls the decoder's loop on a store forward.
+AMC_GRID_INLINE GridPrediction grid_prediction(const Quantizer& quantizer, int axis, double x) {
+    // quantize_coordinate's steps, its t kept for the bin.
+    const double t = rounded((x - component(quantizer.origin, axis)) / quantizer.step);
+    if (!(t > 0.0)) return {0, 0, false};  // also NaN
+    if (t >= static_cast<double>(quantizer.max_coordinate())) return {quantizer.max_coordinate(), 0, false};
+    GridPrediction g{static_cast<uint32_t>(std::floor(t + 0.5)), 0, false};
+    const double f = rounded(t - static_cast<double>(g.p));
+    g.turn = f < 0.0;
+    g.bin = (f >= 0.25 || f <= -0.25) ? 1 : 0;
+    return g;
+}
+
+AMC_GRID_INLINE Residual grid_residual(const Quantizer& quantizer, int axis, double actual, const GridPrediction& g) {
+    const int64_t d = int64_t(quantize_coordinate(quantizer, axis, actual)) - int64_t(g.p);
+    const int64_t s = g.turn ? -d : d;
+    return {s < 0, uint64_t(s < 0 ? -s : s)};
+}
+
+AMC_GRID_INLINE bool grid_value(const Quantizer& quantizer, int axis, const GridPrediction& g, Residual r, double& value) {
+    const int64_t s = r.negative ? -int64_t(r.magnitude) : int64_t(r.magnitude);  // magnitude < 2^bits
+    const int64_t q = int64_t(g.p) + (g.turn ? -s : s);
+    if (q < 0 || q > int64_t(quantizer.max_coordinate())) return false;
+    value = dequantize_coordinate(quantizer, axis, uint32_t(q));
+    return true;
 }
 
 int token_of(Residual r) {
@@ -165,41 +211,52 @@ bool get_table(ArithmeticDecoder& decoder, TableModels& models, int limit, RansT
 }  // namespace
 
 StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created,
-                                       CoordinateSpace space) {
-    std::vector<std::array<int, kStaticRoles>> tokens;
+                                       CoordinateSpace space, bool grid_bins)
+    : table_count_(static_table_count(grid_bins)) {
+    if (grid_bins && space.quantizer == nullptr) throw Error("geometry mode 4 needs quantized coordinates");
+    std::vector<std::array<int, kStaticRoles>> tokens, table_of;
     std::vector<std::array<Residual, kStaticRoles>> residuals;
     tokens.reserve(created.size());
+    table_of.reserve(created.size());
     residuals.reserve(created.size());
-    std::array<std::vector<uint64_t>, kStaticRoles> counts;
+    std::array<std::vector<uint64_t>, kMaxStaticTables> counts;
     for (auto [n, e] : created) {
-        const NormalFrame frame = normal_frame(h, n, e);
+        const NormalFrame frame = normal_frame(h, n, e, grid_bins);
         const std::array<int, 3> axes = role_axes(frame);
         const Vec3 actual = h.position(h.midpoint(n, e));
         const Vec3 others = frame.predict(component(actual, axes[0]));
-        std::array<int, kStaticRoles> t{};
+        std::array<int, kStaticRoles> t{}, table{};
         std::array<Residual, kStaticRoles> r{};
         for (int role = 0; role < kStaticRoles; ++role) {
             const int axis = axes[size_t(role)];
             const double predicted = role == 0 ? component(frame.midpoint, axis) : component(others, axis);
-            r[size_t(role)] = residual_of(space, axis, component(actual, axis), predicted);
+            if (grid_bins) {
+                const GridPrediction g = grid_prediction(*space.quantizer, axis, predicted);
+                r[size_t(role)] = grid_residual(*space.quantizer, axis, component(actual, axis), g);
+                table[size_t(role)] = kGridBins * role + g.bin;
+            } else {
+                r[size_t(role)] = residual_of(space, axis, component(actual, axis), predicted);
+                table[size_t(role)] = role;
+            }
             t[size_t(role)] = token_of(r[size_t(role)]);
-            std::vector<uint64_t>& c = counts[size_t(role)];
+            std::vector<uint64_t>& c = counts[size_t(table[size_t(role)])];
             if (c.size() <= size_t(t[size_t(role)])) c.resize(size_t(t[size_t(role)]) + 1, 0);
             ++c[size_t(t[size_t(role)])];
         }
         tokens.push_back(t);
+        table_of.push_back(table);
         residuals.push_back(r);
     }
-    for (int role = 0; role < kStaticRoles; ++role) {
-        std::vector<uint64_t>& c = counts[size_t(role)];
+    for (int i = 0; i < table_count_; ++i) {
+        std::vector<uint64_t>& c = counts[size_t(i)];
         if (c.empty()) c.push_back(1);
-        tables_[size_t(role)] = RansTable::from_counts(c);
+        tables_[size_t(i)] = RansTable::from_counts(c);
     }
     RansEncoder rans;
     RawBitWriter raw;
     for (size_t i = 0; i < tokens.size(); ++i) {
         for (int role = 0; role < kStaticRoles; ++role) {
-            rans.put(tables_[size_t(role)], tokens[i][size_t(role)]);
+            rans.put(tables_[size_t(table_of[i][size_t(role)])], tokens[i][size_t(role)]);
             put_raw(raw, residuals[i][size_t(role)]);
         }
     }
@@ -209,7 +266,7 @@ StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std
 
 void StaticLevelEncoder::write_tables(ArithmeticEncoder& encoder) const {
     TableModels models;
-    for (const RansTable& table : tables_) put_table(encoder, models, table);
+    for (int i = 0; i < table_count_; ++i) put_table(encoder, models, tables_[size_t(i)]);
 }
 
 size_t StaticLevelEncoder::estimated_bytes() const {
@@ -220,18 +277,40 @@ size_t StaticLevelEncoder::estimated_bytes() const {
     return tables.finish().size() + varint + rans_.size() + raw_.size();
 }
 
-bool read_static_tables(ArithmeticDecoder& decoder, CoordinateSpace space, StaticTables& tables) {
+bool read_static_tables(ArithmeticDecoder& decoder, CoordinateSpace space, bool grid_bins, StaticTables& tables) {
+    if (grid_bins && space.quantizer == nullptr) return false;
     TableModels models;
-    for (RansTable& table : tables)
-        if (!get_table(decoder, models, token_limit(space), table)) return false;
+    for (int i = 0; i < static_table_count(grid_bins); ++i)
+        if (!get_table(decoder, models, token_limit(space), tables[size_t(i)])) return false;
     return true;
 }
 
 bool decode_static_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
-                             const StaticTables& tables, const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data,
-                             size_t raw_size) {
+                             bool grid_bins, const StaticTables& tables, const uint8_t* rans_data, size_t rans_size,
+                             const uint8_t* raw_data, size_t raw_size) {
     RansDecoder rans(rans_data, rans_size);
     RawBitReader raw(raw_data, raw_size);
+    if (grid_bins) {
+        if (space.quantizer == nullptr) return false;
+        const Quantizer& quantizer = *space.quantizer;
+        for (auto [n, e] : created) {
+            const NormalFrame frame = normal_frame(h, n, e, true);
+            const std::array<int, 3> axes = role_axes(frame);
+            Vec3 p;
+            GridPrediction g = grid_prediction(quantizer, axes[0], component(frame.midpoint, axes[0]));
+            if (!grid_value(quantizer, axes[0], g, take(rans.get(tables[size_t(g.bin)]), raw), component_ref(p, axes[0])))
+                return false;
+            const Vec3 others = frame.predict(component(p, axes[0]));
+            for (int role = 1; role < kStaticRoles; ++role) {
+                const int axis = axes[size_t(role)];
+                g = grid_prediction(quantizer, axis, component(others, axis));
+                const Residual r = take(rans.get(tables[size_t(kGridBins * role + g.bin)]), raw);
+                if (!grid_value(quantizer, axis, g, r, component_ref(p, axis))) return false;
+            }
+            h.set_position(h.midpoint(n, e), p);
+        }
+        return rans.ended_cleanly() && raw.ended_cleanly();
+    }
     for (auto [n, e] : created) {
         const NormalFrame frame = normal_frame(h, n, e);
         const std::array<int, 3> axes = role_axes(frame);
