@@ -94,6 +94,7 @@ void round_trip(const uint8_t* data, size_t size) {
     const uint8_t q = in.u8();
     options.quantize_bits = q < 160 ? 0 : 1 + q % 30;
     options.predictor = GeometryPredictor(in.u8() % 3);
+    options.grid_contexts = options.quantize_bits != 0 && (q & 1);  // geometry mode 4 (version 9)
     options.hierarchy = coder_options_from_switches(in.u8() % kCoderSwitchCombinations);
     if (flags & 16) options.hierarchy_contexts = HierarchyContexts::mixed;
     if (flags & 32) options.chunks = 2 + in.u8() % 7;

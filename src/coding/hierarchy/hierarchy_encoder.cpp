@@ -32,6 +32,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
     std::vector<NodeId> ids, next_ids;
     std::vector<uint8_t> refined;
     RefinedNumbering numbering;
+    LevelNormals normals;  // mixing mode
     root_level(h, level, options.cull_one_regularity);
     ids.resize(h.root_count());
     for (NodeId r = 0; r < h.root_count(); ++r) ids[r] = r;
@@ -69,6 +70,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
                         std::to_string(kMaxLevel));
         if (options.cull_one_regularity && !uniform) stats.culled_one_regularity += level.incomplete_count;
         const uint8_t* truth = refined.data();
+        if (mixed_) normals.start_level(n);
         traversal.run(
             level, uniform,
             [&](uint32_t i, int group) {
@@ -76,7 +78,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
                 if (mixed_) {
                     if (event_feature_.size() < events_.size() + 1) event_feature_.resize(events_.size() + 1);
                     event_feature_[events_.size()] = uint32_t(mixed_features_.size());
-                    mixed_features_.push_back(mixed_features(h, ids[i], level, i, group));
+                    mixed_features_.push_back(mixed_features(h, ids[i], level, i, group, normals));
                 }
                 events_.push_back({uint8_t(group), uint8_t(r)});
                 if (trace != nullptr) trace->push_back({ids[i], uint8_t(group), r});

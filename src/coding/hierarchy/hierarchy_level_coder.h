@@ -185,6 +185,7 @@ private:
     int level_index_ = 0;
     uint64_t node_count_ = 0, vertex_count_ = 0, symbols_read_ = 0;
     std::unique_ptr<MixedHierarchyModel> mixed_model_;  // the mixing mode's state, or null
+    LevelNormals mixed_normals_;                        // the mixing mode's normals of the level
 };
 
 }  // namespace amc

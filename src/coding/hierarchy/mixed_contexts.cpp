@@ -57,7 +57,27 @@ double relative_displacement2(const Hierarchy& h, NodeId p, int e) {
 
 }  // namespace
 
-MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, uint32_t i, int group) {
+void LevelNormals::start_level(size_t nodes) {
+    if (++current_ == 0) {  // wrapped: no stamp may look current
+        std::fill(stamp_.begin(), stamp_.end(), 0u);
+        current_ = 1;
+    }
+    if (normal_.size() < nodes) {
+        normal_.resize(nodes);
+        stamp_.resize(nodes, 0u);
+    }
+}
+
+Vec3 LevelNormals::get(const Hierarchy& h, NodeId node, uint32_t local) {
+    if (local >= normal_.size()) return unit_normal(h, node);
+    if (stamp_[local] != current_) {
+        normal_[local] = unit_normal(h, node);
+        stamp_[local] = current_;
+    }
+    return normal_[local];
+}
+
+MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, uint32_t i, int group, LevelNormals& normals) {
     MixedFeatures f{};
     f.group = uint8_t(group);
     const int l = h.level(n);
@@ -116,7 +136,7 @@ MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, u
     // Bending towards the same-level neighbours: chords between unit normals (2 sin of half the
     // angle), summed; and a discrete mean curvature, sum of chord * edge length / (4 area), times
     // the longest edge.
-    const Vec3 normal = unit_normal(h, n);
+    const Vec3 normal = normals.get(h, n, i);
     const Vec3 a = h.position(h.vertex(n, 0)), b = h.position(h.vertex(n, 1)), c = h.position(h.vertex(n, 2));
     const double twice_area = exact_length(exact_cross(b - a, c - a));
     const Vec3 corner[3] = {a, b, c};
@@ -126,7 +146,8 @@ MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, u
         longest = std::max(longest, len);
         const NodeId q = h.neighbor(n, e);
         if (q == kNoNode) continue;
-        const double chord = exact_length(normal - unit_normal(h, q));
+        // nbr.nbr[e] is q's local index (the level's neighbour across e, as h's).
+        const double chord = exact_length(normal - (nbr.nbr[e] != kNoLocal ? normals.get(h, q, nbr.nbr[e]) : unit_normal(h, q)));
         chord_sum += chord;
         weighted += rounded(chord * len);
     }

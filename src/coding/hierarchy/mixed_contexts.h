@@ -33,10 +33,27 @@ struct MixedFeatures {
     uint8_t mean_curv;    // log bin of a discrete mean curvature times the longest edge, 0..63
 };
 
+// The unit normals of one level's nodes by local index, each computed once: the bending features
+// read the normal of every coded node and of its same-level neighbours, so without this each
+// normal was computed up to four times. start_level forgets the previous level's (the decoder
+// reuses node ids from stream to stream).
+class LevelNormals {
+public:
+    void start_level(size_t nodes);
+    // The unit normal of node `node` (local index `local` of the current level); zero for a
+    // degenerate triangle.
+    Vec3 get(const Hierarchy& h, NodeId node, uint32_t local);
+
+private:
+    std::vector<Vec3> normal_;
+    std::vector<uint32_t> stamp_;  // normal_[i] is this level's when stamp_[i] == current_
+    uint32_t current_ = 0;
+};
+
 // The features of node `n` of `h` (coarser levels whole, n's corners placed) that do not depend
 // on the traversal, and those that do from the level's state bytes: `i` is n's local index in
-// `level`, whose neighbours' states are as decided so far.
-MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, uint32_t i, int group);
+// `level`, whose neighbours' states are as decided so far. `normals` is started on `level`.
+MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, uint32_t i, int group, LevelNormals& normals);
 
 // The models, mixer and probability map of the mixing mode; one per stream, persisting from level
 // to level.
