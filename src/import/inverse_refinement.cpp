@@ -738,12 +738,17 @@ private:
     void hold(uint32_t id, bool on) {
         const Patch& patch = patches_[id];
         std::vector<Side> sides;
+        // Read with the patch's id on its blocks (the triangles it holds carry that id, so a
+        // release reads its closures as such), then set.
+        for (uint32_t i = patch.first; i < patch.end; ++i) {
+            if (blocks_[i].alive) blocks_[i].patch = id;
+        }
         for (uint32_t i = patch.first; i < patch.end; ++i) {
             if (!blocks_[i].alive) continue;
-            blocks_[i].patch = on ? id : kNoIndex;
             for (int e = 0; e < 3; ++e) {
                 sides.push_back(classify(i, e));
             }
+            if (!on) blocks_[i].patch = kNoIndex;
         }
         for (const Side& side : sides) {
             if (side.kind != Side::green) continue;
