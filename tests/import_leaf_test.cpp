@@ -220,7 +220,7 @@ TEST(ImportLeafMesh, RandomHierarchiesWithScatteredVerticesImportOrAreRefused) {
         ++imported;
     }
     std::printf("[import_leaf_mesh] random hierarchies, vertices scattered: %d of 200 imported\n", imported);
-    EXPECT_GE(imported, 75);
+    EXPECT_GE(imported, 77);  // 75 until a released patch freed its closures (2026-12-02)
 }
 
 // ---- bad input: every kind refused with an error naming the culprit ----------------------------
