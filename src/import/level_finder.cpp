@@ -1,0 +1,337 @@
+// The inverse step's patch search: growing patches from seeds, committing them best first,
+// improving them, and the coarser level they leave.
+#include "import/level_finder.h"
+
+#include "common/no_index.h"
+
+#include <algorithm>
+
+namespace amc::detail::inverse {
+
+size_t LevelFinder::commit(const std::vector<uint8_t>* active) {
+    const size_t first = patches_.size();
+    std::vector<uint32_t> seeds;
+    for (uint32_t t = 0; t < tri_.size(); ++t) {
+        if (!active || (*active)[t]) seeds.push_back(t);
+    }
+    if (active) seeds = free_near(std::move(seeds), 2);
+    for (int round = 0; round < 4 && !seeds.empty(); ++round) {
+        const size_t before = patches_.size();
+        if (commit_best_first(seeds) == 0) break;
+        // The next round seeds only near what this one committed.
+        seeds = free_triangles_near(before);
+    }
+    improve_patches(first);
+    return patches_.size();
+}
+
+uint32_t LevelFinder::removed_by(size_t id) const {
+    uint32_t removed = 0;
+    const Patch& patch = patches_[id];
+    for (uint32_t i = patch.first; i < patch.end; ++i) {
+        if (!blocks_[i].alive) continue;
+        for (uint32_t m : blocks_[i].m) removed += midpoint_block_[m][0] / 3 == i || midpoint_block_[m][0] / 3 < patch.first;
+    }
+    return removed;
+}
+
+bool LevelFinder::could_be_in_block(uint32_t t) {
+    uint32_t centers[4] = {t, kNoIndex, kNoIndex, kNoIndex};
+    for (int e = 0; e < 3; ++e) {
+        const uint32_t h = adjacency_.twin(3 * t + uint32_t(e));
+        if (h != kNoHalfEdge) centers[e + 1] = h / 3;
+    }
+    for (uint32_t c : centers) {
+        if (c == kNoIndex) continue;
+        const uint32_t start = uint32_t(blocks_.size());
+        if (!place_block(c)) continue;
+        roll_back(start);
+        return true;
+    }
+    return false;
+}
+
+void LevelFinder::release_patch(size_t id) {
+    hold(uint32_t(id), false);
+    for (uint32_t i = patches_[id].first; i < patches_[id].end; ++i) {
+        if (blocks_[i].alive) deferred_[blocks_[i].center] = 1;
+    }
+    for (uint32_t i = patches_[id].first; i < patches_[id].end; ++i) {
+        if (blocks_[i].alive) release(i);
+    }
+}
+
+std::vector<uint32_t> LevelFinder::parents_of(size_t id, const std::vector<uint32_t>& parent_of_block) const {
+    std::vector<uint32_t> parents;
+    for (uint32_t i = patches_[id].first; i < patches_[id].end; ++i) {
+        if (blocks_[i].alive) parents.push_back(parent_of_block[i]);
+    }
+    return parents;
+}
+
+CoarserLevel LevelFinder::coarser_level(std::vector<uint32_t>* parent_of_block) const {
+    CoarserLevel out;
+    if (parent_of_block) parent_of_block->assign(blocks_.size(), kNoIndex);
+    std::vector<uint8_t> merged(tri_.size(), 0);
+    for (uint32_t index = 0; index < blocks_.size(); ++index) {
+        const Block& b = blocks_[index];
+        if (!b.alive) continue;
+        ++out.red_blocks;
+        if (parent_of_block) (*parent_of_block)[index] = uint32_t(out.triangles.size());
+        out.triangles.push_back({b.v[0], b.v[1], b.v[2]});
+        out.splits.push_back({b.v[0], b.v[1], b.v[2], b.m[0], b.m[1], b.m[2]});
+        out.refined.push_back(1);
+        out.changed.push_back(1);
+        merged[b.center] = 1;
+        for (int k = 0; k < 3; ++k) merged[b.corner[size_t(k)]] = 1;
+        for (int i = 0; i < 3; ++i) {
+            const Side side = classify(index, i);
+            if (side.kind == Side::green && side.emits) {
+                ++out.green_groups;
+                out.triangles.push_back(side.coarse);
+                out.refined.push_back(0);
+                out.changed.push_back(1);
+                for (int k = 0; k < side.count; ++k) merged[side.group[k]] = 1;
+            }
+        }
+    }
+    if (out.red_blocks == 0) return CoarserLevel{};
+    for (uint32_t t = 0; t < tri_.size(); ++t) {
+        if (merged[t]) continue;
+        out.triangles.push_back(tri_[t]);
+        out.refined.push_back(refined_[t]);
+        out.changed.push_back(deferred_[t]);
+    }
+    for (uint32_t v = 0; v < midpoint_count_.size(); ++v) out.removed_vertices += midpoint_count_[v] != 0;
+    return out;
+}
+
+uint32_t LevelFinder::grow_patch(uint32_t t, Preference preference, bool exploring) {
+    constexpr int kRepairs = 4;
+    std::vector<uint32_t> banned, suspects;
+    uint32_t removed = 0;
+    for (int attempt = 0;; ++attempt) {
+        suspects.clear();
+        removed = grow_patch_once(t, preference, exploring, attempt < kRepairs ? &suspects : nullptr);
+        if (removed != 0 || suspects.empty()) break;
+        const size_t before = banned.size();
+        for (uint32_t c : suspects) {
+            if (!repair_banned_[c]) repair_banned_[c] = 1, banned.push_back(c);
+        }
+        if (banned.size() == before) break;  // nothing new to take away: the same growth again
+    }
+    for (uint32_t c : banned) repair_banned_[c] = 0;
+    return removed;
+}
+
+void LevelFinder::collect_suspects(uint32_t start, std::vector<uint32_t>& suspects) const {
+    constexpr size_t kRepairableShare = 16;  // at most one block in 16 invalid
+    std::vector<uint32_t> invalid;
+    for (uint32_t i = start; i < blocks_.size(); ++i) {
+        if (sides_valid(i)) continue;
+        invalid.push_back(blocks_[i].center);
+        for (int e = 0; e < 3; ++e) {
+            if (classify(i, e).kind != Side::invalid) continue;
+            const Fan fan = walk_fan(blocks_[i], e);
+            if (fan.kind != Fan::triangles) continue;
+            for (int k = 0; k < fan.size; ++k) {
+                const uint32_t owner = block_of_[fan.triangle[k]];
+                if (owner != kNoIndex && owner != i) suspects.push_back(blocks_[owner].center);
+            }
+            Block across;
+            if (fan.size != 3 || !read_block(fan.triangle[1], across)) continue;
+            for (uint32_t v : across.v) {
+                for (uint8_t k = 0; k < midpoint_count_[v]; ++k) suspects.push_back(blocks_[midpoint_block_[v][k] / 3].center);
+            }
+        }
+    }
+    // Many invalid blocks: a wrong reading, not a true one with a few wrong turns.
+    if (invalid.size() * kRepairableShare > blocks_.size() - start) {
+        suspects.clear();
+        return;
+    }
+    if (suspects.empty()) suspects = std::move(invalid);
+}
+
+uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool exploring, std::vector<uint32_t>* suspects) {
+    constexpr uint32_t kRepairable = 16;  // blocks: smaller patches are taken or dropped whole
+    const uint32_t start = uint32_t(blocks_.size());
+    if (!place_block(t)) return 0;
+    for (uint32_t next = start; next < blocks_.size(); ++next) {
+        for (int i = 0; i < 3; ++i) {
+            const Fan fan = walk_fan(blocks_[next], i);
+            if (fan.kind != Fan::triangles || block_of_[fan.triangle[1]] != kNoIndex) continue;
+            if (preference == Preference::closure_first) {
+                const uint32_t partner = closure_partner(blocks_[next], i, fan);
+                if (partner != kNoIndex && place_block(partner)) continue;
+                if (fan.size == 3) place_block(fan.triangle[1]);
+            } else if (fan.size == 3 && !place_block(fan.triangle[1])) {
+                const uint32_t partner = closure_partner(blocks_[next], i, fan);
+                if (partner != kNoIndex) place_block(partner);
+            }
+        }
+    }
+    // Growth from any center of this patch would give the same patch under this preference:
+    // those centers need not seed again (this keeps the search linear).
+    if (exploring) {
+        const uint8_t bit = uint8_t(1u << int(preference));
+        for (uint32_t i = start; i < blocks_.size(); ++i) covered_[blocks_[i].center] |= bit;
+    }
+    for (uint32_t i = start; i < blocks_.size(); ++i) {
+        if (!sides_valid(i)) {
+            if (suspects && blocks_.size() - start >= kRepairable) collect_suspects(start, *suspects);
+            roll_back(start);
+            return 0;
+        }
+    }
+    // A valid patch: no other reading needs to seed inside it.
+    if (exploring) {
+        for (uint32_t i = start; i < blocks_.size(); ++i) {
+            covered_[blocks_[i].center] = 3;
+            for (uint32_t c : blocks_[i].corner) covered_[c] = 3;
+        }
+    }
+    uint32_t removed = 0;
+    for (uint32_t i = start; i < blocks_.size(); ++i) {
+        for (int e = 0; e < 3; ++e) {
+            const auto& slots = midpoint_block_[blocks_[i].m[size_t(e)]];
+            removed += slots[0] / 3 == i || (slots[0] / 3 < start && slots[1] / 3 == i);  // count each once
+        }
+    }
+    return removed;
+}
+
+Candidate LevelFinder::best_patch(uint32_t t, bool exploring) {
+    Candidate best{0, t, Preference::closure_first};
+    for (Preference preference : {Preference::closure_first, Preference::block_first}) {
+        if (exploring && (covered_[t] >> int(preference)) & 1) continue;
+        const uint32_t start = uint32_t(blocks_.size());
+        const uint32_t removed = grow_patch(t, preference, exploring);
+        roll_back(start);
+        if (removed > best.removed) best = {removed, t, preference};
+    }
+    return best;
+}
+
+uint32_t LevelFinder::commit_best_first(const std::vector<uint32_t>& seeds) {
+    std::vector<Candidate> queue;
+    for (uint32_t t : seeds) covered_[t] = 0;
+    for (uint32_t t : seeds) {
+        if (covered_[t] == 3 || block_of_[t] != kNoIndex) continue;
+        const Candidate c = best_patch(t, true);
+        if (c.removed > 0) queue.push_back(c);
+    }
+    std::make_heap(queue.begin(), queue.end());
+    uint32_t total = 0;
+    while (!queue.empty()) {
+        std::pop_heap(queue.begin(), queue.end());
+        Candidate c = queue.back();
+        queue.pop_back();
+        const uint32_t start = uint32_t(blocks_.size());
+        c.removed = grow_patch(c.center, c.preference);
+        if (c.removed > 0 && (queue.empty() || !(c < queue.front()))) {
+            patches_.push_back({start, uint32_t(blocks_.size())});
+            hold(uint32_t(patches_.size() - 1), true);
+            total += c.removed;
+            continue;
+        }
+        roll_back(start);
+        if (c.removed == 0) c = best_patch(c.center, false);
+        if (c.removed == 0) {
+            deferred_[c.center] = 1;  // valid once: worth a seed in the next step
+            continue;
+        }
+        queue.push_back(c);
+        std::push_heap(queue.begin(), queue.end());
+    }
+    return total;
+}
+
+std::vector<uint32_t> LevelFinder::free_triangles_near(size_t first) {
+    std::vector<uint32_t> ring;
+    for (size_t id = first; id < patches_.size(); ++id) {
+        for (uint32_t i = patches_[id].first; i < patches_[id].end; ++i) {
+            if (!blocks_[i].alive) continue;
+            ring.push_back(blocks_[i].center);
+            for (uint32_t c : blocks_[i].corner) ring.push_back(c);
+        }
+    }
+    return free_near(std::move(ring), 2);
+}
+
+std::vector<uint32_t> LevelFinder::free_near(std::vector<uint32_t> ring, int rings) const {
+    for (int step = 0; step < rings; ++step) {
+        const size_t count = ring.size();
+        for (size_t k = 0; k < count; ++k) {
+            for (int e = 0; e < 3; ++e) {
+                const uint32_t h = adjacency_.twin(3 * ring[k] + uint32_t(e));
+                if (h != kNoHalfEdge) ring.push_back(h / 3);
+            }
+        }
+        std::sort(ring.begin(), ring.end());
+        ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+    }
+    ring.erase(std::remove_if(ring.begin(), ring.end(), [&](uint32_t t) { return taken(t); }), ring.end());
+    return ring;
+}
+
+void LevelFinder::hold(uint32_t id, bool on) {
+    const Patch& patch = patches_[id];
+    std::vector<Side> sides;
+    // Read with the patch's id on its blocks (the triangles it holds carry that id, so a
+    // release reads its closures as such), then set.
+    for (uint32_t i = patch.first; i < patch.end; ++i) {
+        if (blocks_[i].alive) blocks_[i].patch = id;
+    }
+    for (uint32_t i = patch.first; i < patch.end; ++i) {
+        if (!blocks_[i].alive) continue;
+        for (int e = 0; e < 3; ++e) {
+            sides.push_back(classify(i, e));
+        }
+        if (!on) blocks_[i].patch = kNoIndex;
+    }
+    for (const Side& side : sides) {
+        if (side.kind != Side::green) continue;
+        for (int k = 0; k < side.count; ++k) closure_of_[side.group[k]] = on ? id : kNoIndex;
+        for (uint32_t v : side.coarse) on ? ++pinned_old_[v] : --pinned_old_[v];
+    }
+}
+
+void LevelFinder::improve_patches(size_t first) {
+    const size_t count = patches_.size();
+    for (size_t r = first; r < count; ++r) {
+        const Patch patch = patches_[r];
+        uint32_t before = 0;
+        std::vector<uint32_t> seeds, taken;
+        for (uint32_t i = patch.first; i < patch.end; ++i) {
+            const Block& b = blocks_[i];
+            if (!b.alive) continue;
+            taken.push_back(i);
+            for (uint32_t t : {b.center, b.corner[0], b.corner[1], b.corner[2]}) {
+                seeds.push_back(t);
+                for (int e = 0; e < 3; ++e) {
+                    const uint32_t h = adjacency_.twin(3 * t + uint32_t(e));
+                    if (h != kNoHalfEdge) seeds.push_back(h / 3);
+                }
+            }
+            for (uint32_t m : b.m) before += midpoint_block_[m][0] / 3 == i || midpoint_block_[m][0] / 3 < patch.first;
+        }
+        if (taken.empty() || taken.size() > 64) continue;  // large patches have no rival nearby
+        std::sort(seeds.begin(), seeds.end());
+        seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
+        hold(uint32_t(r), false);
+        for (uint32_t i : taken) release(i), banned_[blocks_[i].center] = 1;
+        const uint32_t start = uint32_t(blocks_.size());
+        const size_t patches_before = patches_.size();
+        const uint32_t after = commit_best_first(seeds);
+        for (uint32_t i : taken) banned_[blocks_[i].center] = 0;
+        if (after > before) continue;
+        for (size_t k = patches_.size(); k-- > patches_before;) hold(uint32_t(k), false);
+        roll_back(start);
+        patches_.resize(patches_before);
+        for (uint32_t i : taken) claim(i);
+        hold(uint32_t(r), true);
+    }
+}
+
+}  // namespace amc::detail::inverse
