@@ -49,7 +49,9 @@ TEST_P(FuzzRegressions, EveryFoundInputPasses) {
         const auto start = std::chrono::steady_clock::now();
         target.run(bytes.data(), bytes.size());
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        if (i < found_inputs) EXPECT_LT(seconds, 5.0) << "slow input (a found input runs in milliseconds)";
+        if (i < found_inputs) {
+            EXPECT_LT(seconds, 5.0) << "slow input (a found input runs in milliseconds)";
+        }
     }
 }
 
