@@ -36,24 +36,20 @@ std::vector<std::array<double, 9>> geometric_triangles(const Hierarchy& h) {
 }
 
 TEST(BaseOrder, ReorderedHierarchyHasTheSameElements) {
-    uint64_t state = 5;
-    auto next = [&] {
-        state = state * 6364136223846793005ull + 1442695040888963407ull;
-        return uint32_t(state >> 33);
-    };
+    testing::Random random{5};
     for (const auto& [name, mesh] : testing::fixture_meshes()) {
         Hierarchy h(mesh);
         refine_randomly(h, 2000, 5, 3);
         for (NodeId n : h.leaves()) {
-            if (h.hanging_node_count(n) == 2 && next() % 2) h.set_diagonal_flipped(n, true);
+            if (h.hanging_node_count(n) == 2 && random.next() % 2) h.set_diagonal_flipped(n, true);
         }
         std::vector<uint32_t> vertex_order(mesh.positions.size()), triangle_order(mesh.triangles.size());
         std::iota(vertex_order.begin(), vertex_order.end(), 0u);
         std::iota(triangle_order.begin(), triangle_order.end(), 0u);
-        for (size_t i = vertex_order.size(); i > 1; --i) std::swap(vertex_order[i - 1], vertex_order[next() % i]);
-        for (size_t i = triangle_order.size(); i > 1; --i) std::swap(triangle_order[i - 1], triangle_order[next() % i]);
+        for (size_t i = vertex_order.size(); i > 1; --i) std::swap(vertex_order[i - 1], vertex_order[random.next() % i]);
+        for (size_t i = triangle_order.size(); i > 1; --i) std::swap(triangle_order[i - 1], triangle_order[random.next() % i]);
         std::vector<uint8_t> rotation(triangle_order.size());
-        for (uint8_t& r : rotation) r = uint8_t(next() % 3);
+        for (uint8_t& r : rotation) r = uint8_t(random.next() % 3);
         const Hierarchy moved = reorder_base(h, vertex_order, triangle_order, rotation);
         EXPECT_TRUE(testing::hierarchy_is_valid(moved)) << name;
         EXPECT_EQ(moved.node_count(), h.node_count()) << name;
@@ -128,29 +124,25 @@ bool same_ids(const Hierarchy& a, const Hierarchy& b) {
 }
 
 TEST(BaseOrder, ReorderingGivesTheIdsOfAReplayOnAnyThreads) {
-    uint64_t state = 11;
-    auto next = [&] {
-        state = state * 6364136223846793005ull + 1442695040888963407ull;
-        return uint32_t(state >> 33);
-    };
+    testing::Random random{11};
     for (const auto& [name, mesh] : testing::fixture_meshes()) {
         Hierarchy h(mesh);
         refine_randomly(h, 3000, 6, 7);
         for (NodeId n : h.leaves()) {  // some nodes removed again: dead ids and vertices in the input
             const NodeId p = h.parent(n);
-            if (p != kNoNode && h.is_alive(n) && !h.is_leaf(p) && next() % 7 == 0) h.coarsen(p);
+            if (p != kNoNode && h.is_alive(n) && !h.is_leaf(p) && random.next() % 7 == 0) h.coarsen(p);
         }
         for (NodeId n : h.leaves())
-            if (h.hanging_node_count(n) == 2 && next() % 2) h.set_diagonal_flipped(n, true);
+            if (h.hanging_node_count(n) == 2 && random.next() % 2) h.set_diagonal_flipped(n, true);
         for (VertexId v = 0; v < h.positions().size(); ++v)  // positions off the midpoints
-            h.set_position(v, Vec3{h.position(v).x + 1e-3 * (next() % 100), h.position(v).y, h.position(v).z});
+            h.set_position(v, Vec3{h.position(v).x + 1e-3 * (random.next() % 100), h.position(v).y, h.position(v).z});
         std::vector<uint32_t> vertex_order(mesh.positions.size()), triangle_order(mesh.triangles.size());
         std::iota(vertex_order.begin(), vertex_order.end(), 0u);
         std::iota(triangle_order.begin(), triangle_order.end(), 0u);
-        for (size_t i = vertex_order.size(); i > 1; --i) std::swap(vertex_order[i - 1], vertex_order[next() % i]);
-        for (size_t i = triangle_order.size(); i > 1; --i) std::swap(triangle_order[i - 1], triangle_order[next() % i]);
+        for (size_t i = vertex_order.size(); i > 1; --i) std::swap(vertex_order[i - 1], vertex_order[random.next() % i]);
+        for (size_t i = triangle_order.size(); i > 1; --i) std::swap(triangle_order[i - 1], triangle_order[random.next() % i]);
         std::vector<uint8_t> rotation(triangle_order.size());
-        for (uint8_t& r : rotation) r = uint8_t(next() % 3);
+        for (uint8_t& r : rotation) r = uint8_t(random.next() % 3);
         std::vector<VertexId> expected_map;
         const Hierarchy expected = replayed(h, vertex_order, triangle_order, rotation, expected_map);
         for (unsigned threads : {1u, 3u}) {
