@@ -226,7 +226,8 @@ Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const T
     }
     const ChunkedDecodeInput input{&base, space, reader.version(), meta.vertices, options};
     ChunkTable table;
-    Hierarchy h = decode_chunked(reader, input, meta.nodes, request != nullptr ? &request->chunks : nullptr, &table);
+    uint64_t faces = 0;
+    Hierarchy h = decode_chunked(reader, input, meta.nodes, request != nullptr ? &request->chunks : nullptr, &table, &faces);
     if (request != nullptr) {
         for (uint32_t c : request->chunks)
             for (uint32_t r = table.roots[c].first; r < table.roots[c].first + table.roots[c].count; ++r)
@@ -248,7 +249,7 @@ Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const T
     }
     AMC_REQUIRE(block.type == BlockType::end, corrupt, std::string("unexpected ") + block_type_name(uint8_t(block.type)) + " block after the chunks");
     AMC_REQUIRE(h.node_count() == meta.nodes && h.vertex_count() == meta.vertices && uint64_t(h.depth() + 1) == meta.levels &&
-                    leaf_face_count(h, resolve_thread_count(options.threads)) == meta.faces,
+                    faces == meta.faces,
                 corrupt, "decoded hierarchy does not match the metadata");
     if (partial != nullptr) {
         partial->complete = true;

@@ -23,23 +23,30 @@ int32_t seam_vertex(const Hierarchy& h, const VertexKeys& keys, const Seam& seam
     return seam.find(a, b);
 }
 
-// The hanging nodes of a leaf in the whole hierarchy: its own chunk's, and one on each seam edge
-// that the seam splits (refined on the other side, since the leaf is not).
-int whole_hanging_count(const Hierarchy& h, const VertexKeys& keys, const Seam& seam, NodeId leaf) {
-    int count = h.hanging_node_count(leaf);
+// The hanging nodes the seam adds to a leaf of a chunk: one on each of its edges that the seam
+// splits (refined on the other side, since the leaf is not). Only boundary edges can lie on the
+// seam; testing for them first spares most leaves the lookup of their neighbours.
+int seam_hanging_count(const Hierarchy& h, const VertexKeys& keys, const Seam& seam, NodeId leaf) {
+    if (!h.is_boundary_edge(leaf, 0) && !h.is_boundary_edge(leaf, 1) && !h.is_boundary_edge(leaf, 2)) return 0;
+    int count = 0;
     for (int e = 0; e < 3; ++e) count += seam_vertex(h, keys, seam, leaf, e) >= 0;
     return count;
 }
 
-// The leaves among `level` (a level's nodes, decided) whose diagonal the chunk's own hierarchy
-// stream does not code: two hanging nodes in the whole hierarchy, fewer in the chunk's.
+// Whether the chunk's own hierarchy stream leaves leaf n's diagonal to the chunk block: two
+// hanging nodes in the whole hierarchy, fewer in the chunk's (`seam_hanging` of them the seam's).
+bool is_seam_closure(const Hierarchy& h, NodeId n, int seam_hanging) {
+    if (seam_hanging == 0) return false;
+    const int own = h.hanging_node_count(n);
+    return own < 2 && own + seam_hanging == 2;
+}
+
+// The leaves among `level` (a level's nodes, decided) that are seam closures, in level order.
 template <class F>
 void for_each_seam_closure(const Hierarchy& h, const std::vector<NodeId>& level, const VertexKeys& keys, const Seam& seam,
                            F&& f) {
-    for (NodeId n : level) {
-        if (!h.is_leaf(n) || h.hanging_node_count(n) >= 2) continue;
-        if (whole_hanging_count(h, keys, seam, n) == 2) f(n);
-    }
+    for (NodeId n : level)
+        if (h.is_leaf(n) && is_seam_closure(h, n, seam_hanging_count(h, keys, seam, n))) f(n);
 }
 
 }  // namespace
@@ -80,13 +87,13 @@ ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& s
         put_varint(out.bytes, payload.size());
         out.bytes.insert(out.bytes.end(), payload.begin(), payload.end());
     }
-    for (NodeId n : h.leaves()) out.faces += 1 + uint64_t(whole_hanging_count(h, keys, seam, n));
+    for (NodeId n : h.leaves()) out.faces += 1 + uint64_t(h.hanging_node_count(n) + seam_hanging_count(h, keys, seam, n));
     return out;
 }
 
 Hierarchy& decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, size_t size, const TriangleMesh& base,
                         const std::vector<VertexId>& base_vertex, const Seam& seam, CoordinateSpace space,
-                        const ChunkDecodeLimits& limits, const std::string& what, VertexKeys& keys) {
+                        const ChunkDecodeLimits& limits, const std::string& what, VertexKeys& keys, uint64_t& faces) {
     PayloadReader in(data, size, "chunk block");
     const uint64_t header_size = in.varint();
     AMC_REQUIRE(header_size <= in.remaining(), corrupt, what + ": hierarchy header is longer than the block");
@@ -101,6 +108,7 @@ Hierarchy& decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, s
     BitModel flipped;
     std::vector<std::pair<NodeId, int>> created;
     bool stopped = false;
+    uint64_t seam_faces = 0;  // the seam's hanging nodes on the chunk's leaves
     for (uint64_t level = 0; level < levels; ++level) {
         AMC_REQUIRE(!hierarchy.done(), corrupt, what + ": more levels than its hierarchy has");
         stopped = limits.max_level >= 0 && int(level) >= limits.max_level;
@@ -112,9 +120,14 @@ Hierarchy& decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, s
         for (uint64_t i = 0; i < length; ++i) in.u8();
         const LevelBlockParts parts = split_level_block(level_block, limits.file_version, space.quantizer != nullptr, where);
         ArithmeticDecoder decoder(parts.arithmetic, parts.arithmetic_size);
-        const std::vector<NodeId> nodes = hierarchy.level_nodes();
+        const NodeId first = hierarchy.level_first(), end = first + NodeId(hierarchy.level_size());
         hierarchy.decode_level(decoder);
-        for_each_seam_closure(h, nodes, keys, seam, [&](NodeId n) { h.set_diagonal_flipped(n, decoder.decode(flipped)); });
+        for (NodeId n = first; n < end; ++n) {
+            if (!h.is_leaf(n)) continue;
+            const int seam_hanging = seam_hanging_count(h, keys, seam, n);
+            seam_faces += uint64_t(seam_hanging);
+            if (is_seam_closure(h, n, seam_hanging)) h.set_diagonal_flipped(n, decoder.decode(flipped));
+        }
         AMC_REQUIRE(!decoder.overran(), corrupt, where + ": hierarchy part is truncated or corrupt");
         keys.resize(h.positions().size(), kNoVertex);
         created.clear();
@@ -132,6 +145,7 @@ Hierarchy& decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, s
         decode_level_geometry(h, created, parts, decoder, positions, space, int(level), where);
     }
     keys.resize(h.positions().size(), kNoVertex);
+    faces = hierarchy.leaf_faces() + seam_faces;
     if (stopped) return h;
     AMC_REQUIRE(hierarchy.done(), corrupt, what + ": ends before its hierarchy's last level");
     AMC_REQUIRE(in.remaining() == 0, corrupt, what + ": bytes after the last level");

@@ -43,9 +43,10 @@ struct ChunkDecodeLimits {
 // is the whole base's vertex base_vertex[i], in `decoder` (restarted: the result is its
 // hierarchy(), until the next restart; a decoder used again keeps its memory). Throws Error naming
 // `what` on a corrupt chunk. `keys` receives the seam keys of the result's vertex ids (base and
-// seam vertices; kNoVertex for the chunk's own).
+// seam vertices; kNoVertex for the chunk's own), `faces` the faces its leaves have in the whole
+// leaf mesh (ChunkCode::faces; meaningful when every level is decoded).
 Hierarchy& decode_chunk(HierarchyLevelDecoder& decoder, const uint8_t* data, size_t size, const TriangleMesh& base,
                         const std::vector<VertexId>& base_vertex, const Seam& seam, CoordinateSpace space,
-                        const ChunkDecodeLimits& limits, const std::string& what, VertexKeys& keys);
+                        const ChunkDecodeLimits& limits, const std::string& what, VertexKeys& keys, uint64_t& faces);
 
 }  // namespace amc

@@ -121,7 +121,7 @@ ChunkTable read_chunk_table(const Block& block, uint64_t base_triangles, uint64_
 }
 
 Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, uint64_t nodes,
-                         const std::vector<uint32_t>* selected, ChunkTable* table_out) {
+                         const std::vector<uint32_t>* selected, ChunkTable* table_out, uint64_t* faces_out) {
     const TriangleMesh& base = *input.base;
     Block block{};
     AMC_REQUIRE(reader.next(block) && block.type == BlockType::chunk_table, corrupt, "expected a chunk table block");
@@ -198,6 +198,7 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
     std::vector<std::vector<Vec3>> own_positions(n);  // their positions, until their place is known
     std::vector<std::vector<uint32_t>> seam_used(n);  // the seam vertices each chunk holds
     std::vector<uint32_t> live(n);                    // nodes past the roots
+    std::vector<uint64_t> faces(n);                   // of each chunk's leaves in the whole leaf mesh
     // The whole's positions: the base's, the seam's, then each chunk's own vertices in chunk order.
     // A whole file uses every seam vertex and has the metadata's vertex count, so each chunk's own
     // positions go to their place as soon as the chunks before it are in; otherwise (some chunks,
@@ -282,7 +283,7 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
         limits.file_version = input.version;
         limits.stream_version = hierarchy_stream_version_of_file(input.version);
         const Hierarchy& h = decode_chunk(*decoder_of[i], blocks[i].payload, blocks[i].size, chunk_base, base_vertex, seam,
-                                          input.space, limits, "chunk " + std::to_string(c), keys[i]);
+                                          input.space, limits, "chunk " + std::to_string(c), keys[i], faces[i]);
         AMC_REQUIRE(input.options.max_level >= 0 || h.node_count() == table.nodes[c], corrupt,
                     "chunk " + std::to_string(c) + " does not hold the nodes the chunk table says");
         if (whole_first) copy_into_whole(i);
@@ -339,6 +340,10 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
         for (int e = 0; e < 3; ++e)
             if (!whole.is_boundary_edge(r, e) && part_of_root[whole.neighbor(r, e)] != part_of_root[r]) seam_edges.emplace_back(r, e);
     HierarchyBuilder::stitch_seams(whole, std::move(positions), std::move(seam_edges));
+    if (faces_out != nullptr) {
+        *faces_out = 0;
+        for (uint64_t f : faces) *faces_out += f;
+    }
     return whole;
 }
 

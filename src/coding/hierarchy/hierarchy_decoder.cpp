@@ -105,10 +105,11 @@ void HierarchyLevelDecoder::restart(const TriangleMesh& base, const HierarchyStr
     node_count_ = h_.root_count();
     vertex_count_ = base.positions.size();
     symbols_read_ = 0;
+    leaf_faces_ = 0;
 }
 
 std::vector<NodeId> HierarchyLevelDecoder::level_nodes() const {
-    const size_t n = decided_.empty() ? level_.size() : decided_.front().size();
+    const size_t n = level_size();
     std::vector<NodeId> ids(n);
     for (size_t i = 0; i < n; ++i) ids[i] = level_base_ + NodeId(i);
     return ids;
@@ -231,6 +232,7 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder, uint64_t ma
 
 void HierarchyLevelDecoder::finish_level() {
     node_count_ += uint64_t(4) * level_.refined_count;
+    leaf_faces_ += leaf_faces_of_level(level_);
     vertex_count_ += derive_next_level(level_, numbering_, next_, header_.options.cull_one_regularity);
     decided_.push_back(std::move(level_));
     level_ = std::move(next_);

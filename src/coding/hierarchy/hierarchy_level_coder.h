@@ -157,6 +157,13 @@ public:
     void build_decided_levels();
     uint64_t node_count() const { return node_count_; }
     uint64_t vertex_count() const { return vertex_count_; }
+    // Faces of the conforming leaf mesh that the leaves of the decided levels have (1 + hanging
+    // nodes each): after the last level, the leaf mesh's face count, without a pass over the nodes.
+    uint64_t leaf_faces() const { return leaf_faces_; }
+    // The current level's nodes are ids level_first() .. level_first() + level_size() - 1
+    // (level_nodes() without the list).
+    NodeId level_first() const { return level_base_; }
+    size_t level_size() const { return decided_.empty() ? level_.size() : decided_.front().size(); }
     // After the last level: every announced symbol must have been used.
     void finish() const;
     Hierarchy& hierarchy() { return h_; }
@@ -183,7 +190,7 @@ private:
     ScratchArray<uint32_t> closures_;  // the leaves with two or three hanging nodes
     NodeId level_base_ = 0;  // node id of local index 0 of the oldest level not yet built
     int level_index_ = 0;
-    uint64_t node_count_ = 0, vertex_count_ = 0, symbols_read_ = 0;
+    uint64_t node_count_ = 0, vertex_count_ = 0, symbols_read_ = 0, leaf_faces_ = 0;
     std::unique_ptr<MixedHierarchyModel> mixed_model_;  // the mixing mode's state, or null
     LevelNormals mixed_normals_;                        // the mixing mode's normals of the level
 };

@@ -85,6 +85,31 @@ DecidedLevelScan scan_decided_level(Level& level, RefinedNumbering& numbering, u
     return scan;
 }
 
+uint64_t leaf_faces_of_level(const Level& level) {
+    const uint32_t n = static_cast<uint32_t>(level.size());
+    const uint8_t* state = level.state();
+    uint64_t faces = 0;
+    uint32_t i = 0;
+#if AMC_SSE2
+    // Per byte: 1 + refined neighbours for a leaf, 0 for a refined node; summed 16 bytes at a time.
+    const __m128i zero = _mm_setzero_si128(), refined_bit = _mm_set1_epi8(char(kRefined)),
+                  count_bits = _mm_set1_epi8(char(kRefinedNeighborMask >> 2)), one = _mm_set1_epi8(1);
+    __m128i sums = zero;
+    for (; i + 16 <= n; i += 16) {
+        const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(state + i));
+        const __m128i leaf = _mm_cmpeq_epi8(_mm_and_si128(v, refined_bit), zero);
+        const __m128i per_node = _mm_add_epi8(_mm_and_si128(_mm_srli_epi16(v, 2), count_bits), one);
+        sums = _mm_add_epi64(sums, _mm_sad_epu8(_mm_and_si128(per_node, leaf), zero));
+    }
+    uint64_t halves[2];
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(halves), sums);
+    faces = halves[0] + halves[1];
+#endif
+    for (; i < n; ++i)
+        if (!(state[i] & kRefined)) faces += 1 + uint64_t(refined_neighbors(state[i]));
+    return faces;
+}
+
 uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering, Level& next,
                            bool cull_one_regularity) {
     const uint32_t count = level.refined_count;

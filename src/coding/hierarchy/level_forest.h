@@ -178,6 +178,10 @@ void root_level(const Hierarchy& h, Level& level, bool cull_one_regularity);
 // time as bit masks and only the set bits are visited.
 DecidedLevelScan scan_decided_level(Level& level, RefinedNumbering& numbering, uint32_t* closures);
 
+// The faces a decided level's leaves have in the conforming leaf mesh: one each, plus one per
+// refined neighbour (the green closure's split). Read off the state bytes, so no links are loaded.
+uint64_t leaf_faces_of_level(const Level& level);
+
 // Level l+1 from level l (every node decided and numbered): the children of the refined nodes in
 // canonical order, linked exactly as Hierarchy::split links them. Returns the number of vertices
 // the splits create: one per edge of a refined node, shared where the neighbour is refined too.
