@@ -591,7 +591,7 @@ TEST(HierarchyCoder, StreamsFollowTheFormatText) {
 // decoder would refuse it. The encoder says so, under every switch combination.
 // The level coders hand the geometry coder each level's new vertices: the same list, in the same
 // order, as a walk of the level's nodes in the hierarchy finds.
-TEST(HierarchyCoder, LevelCodersListTheNewVerticesOfEachLevel) {
+TEST(HierarchyCoder, LevelCodersListTheNewVerticesAndLeafFacesOfEachLevel) {
     for (uint64_t seed = 1; seed <= 200; ++seed) {
         const Hierarchy h = random_hierarchy(seed);
         const HierarchyCoderOptions options = options_from_bits(int(seed % kOptionCombinations));
@@ -610,9 +610,13 @@ TEST(HierarchyCoder, LevelCodersListTheNewVerticesOfEachLevel) {
         ArithmeticDecoder in(payload.data(), payload.size());
         while (!decoder.done()) {
             const std::vector<NodeId> nodes = decoder.level_nodes();
+            ASSERT_EQ(nodes.size(), decoder.level_size());
+            ASSERT_EQ(nodes.front(), decoder.level_first());
             decoder.decode_level(in);
             ASSERT_EQ(decoder.new_vertices(), new_vertices_of_level(decoder.hierarchy(), nodes)) << "seed " << seed;
         }
+        // The faces counted off the levels' state bytes are the leaf mesh's.
+        ASSERT_EQ(decoder.leaf_faces(), extract_leaf_mesh(decoder.hierarchy()).mesh.triangles.size()) << "seed " << seed;
     }
 }
 
