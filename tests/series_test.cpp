@@ -7,7 +7,9 @@
 #include <amc/simulation.h>
 
 #include "series/frame_connectivity.h"
+#include "coding/container.h"
 #include "series/series_format.h"
+#include "series/series_framing.h"
 
 #include <gtest/gtest.h>
 #include <xxhash.h>
@@ -86,6 +88,36 @@ TEST(HeatSimulation, FramesAreValidAndCarryTheSolversFields) {
         EXPECT_TRUE(identical(frames[k].h, again[k].h));
         expect_same_fields(frames[k].fields, again[k].fields, k);
     }
+}
+
+TEST(SeriesFraming, RandomAccessStartsAtTheKeyframeOrAfterTheFrameHeld) {
+    struct Info {
+        bool keyframe;
+    };
+    const std::vector<Info> frames = {{true}, {false}, {false}, {true}, {false}, {false}};
+    EXPECT_EQ(first_frame_to_decode(frames, 2, -1), 0u);
+    EXPECT_EQ(first_frame_to_decode(frames, 5, -1), 3u);
+    EXPECT_EQ(first_frame_to_decode(frames, 3, 2), 3u);  // a keyframe needs nothing before it
+    EXPECT_EQ(first_frame_to_decode(frames, 5, 4), 5u);
+    EXPECT_EQ(first_frame_to_decode(frames, 5, 5), 6u);  // held already: nothing to decode
+    EXPECT_EQ(first_frame_to_decode(frames, 4, 1), 3u);  // held before the keyframe: start there
+    EXPECT_EQ(first_frame_to_decode(frames, 1, 4), 0u);  // held after k: start over
+}
+
+TEST(SeriesFraming, PayloadBytesAreTakenInPlaceOrRefusedAsTruncated) {
+    const std::vector<uint8_t> payload = {3, 'a', 'b', 'c', 9};
+    PayloadReader in(payload.data(), payload.size(), "frame");
+    const uint64_t length = in.varint();
+    const uint8_t* name = in.bytes(length);
+    EXPECT_EQ(std::string(reinterpret_cast<const char*>(name), size_t(length)), "abc");
+    EXPECT_EQ(in.remaining(), 1u);
+    try {
+        in.bytes(2);
+        FAIL() << "two bytes taken from one";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::truncated);
+    }
+    EXPECT_EQ(in.u8(), 9);
 }
 
 TEST(Series, HeatRunRoundTripsFrameByFrame) {

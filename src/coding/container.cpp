@@ -169,6 +169,13 @@ uint8_t PayloadReader::u8() {
     return data_[pos_++];
 }
 
+const uint8_t* PayloadReader::bytes(uint64_t count) {
+    if (count > size_ - pos_) fail(ErrorCode::truncated, "truncated");
+    const uint8_t* start = data_ + pos_;
+    pos_ += size_t(count);
+    return start;
+}
+
 double PayloadReader::f64() {
     if (size_ - pos_ < 8) fail(ErrorCode::truncated, "truncated");
     uint64_t bits = 0;

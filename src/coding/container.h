@@ -112,6 +112,8 @@ public:
     uint64_t varint();
     uint8_t u8();
     double f64();
+    // The next `count` bytes, which the caller then reads in place.
+    const uint8_t* bytes(uint64_t count);
     size_t position() const { return pos_; }
     const uint8_t* rest() const { return data_ + pos_; }
     size_t remaining() const { return size_ - pos_; }

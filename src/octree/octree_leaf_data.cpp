@@ -120,8 +120,7 @@ Field read_leaf_field(const uint8_t* data, size_t size, const std::vector<Octant
     const uint64_t name_size = in.varint();
     AMC_REQUIRE(name_size >= 1 && name_size <= kMaxLeafFieldName && name_size <= in.remaining(), corrupt,
                 "leaf field block: a name of " + std::to_string(name_size) + " bytes");
-    f.name.assign(reinterpret_cast<const char*>(in.rest()), size_t(name_size));
-    for (uint64_t k = 0; k < name_size; ++k) in.u8();
+    f.name.assign(reinterpret_cast<const char*>(in.bytes(name_size)), size_t(name_size));
     const std::string what = field_what(f.name);
     const uint8_t type = in.u8();
     AMC_REQUIRE(type <= uint8_t(FieldType::float64), corrupt, what + ": unknown type " + std::to_string(type));

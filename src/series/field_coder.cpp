@@ -326,8 +326,7 @@ Field decode_field(PayloadReader& in, const FieldFrame& frame) {
     const uint64_t name_length = in.varint();
     AMC_REQUIRE(name_length >= 1 && name_length <= kMaxNameLength && name_length <= in.remaining(), corrupt,
                 "field record: name length " + std::to_string(name_length) + " out of range");
-    f.name.assign(reinterpret_cast<const char*>(in.rest()), size_t(name_length));
-    for (uint64_t i = 0; i < name_length; ++i) in.u8();
+    f.name.assign(reinterpret_cast<const char*>(in.bytes(name_length)), size_t(name_length));
     const std::string what = "field \"" + f.name + "\"";
     const uint8_t association = in.u8(), type = in.u8();
     AMC_REQUIRE(association <= 1, corrupt, what + ": unknown association " + std::to_string(association));
@@ -360,8 +359,7 @@ Field decode_field(PayloadReader& in, const FieldFrame& frame) {
     AMC_REQUIRE(uint64_t(tuples) * f.components <= max_decodable_symbols(length) / kMinSymbolsPerValue, corrupt,
                 what + ": " + std::to_string(uint64_t(tuples) * f.components) + " values can not fit in " +
                     std::to_string(length) + " bytes");
-    const uint8_t* data = in.rest();
-    for (uint64_t i = 0; i < length; ++i) in.u8();
+    const uint8_t* data = in.bytes(length);
     const std::vector<uint32_t> prev_cell =
         (ref && f.association == FieldAssociation::cell) ? previous_cells(frame) : std::vector<uint32_t>{};
     if (!is_float || mode == kBounded) {

@@ -82,8 +82,7 @@ Field read_temporal(const uint8_t* data, size_t size, const ForestFieldFrame& fr
     const uint64_t name_size = in.varint();
     AMC_REQUIRE(name_size >= 1 && name_size <= kMaxName && name_size <= in.remaining(), corrupt,
                 "leaf field: a name of " + std::to_string(name_size) + " bytes");
-    f.name.assign(reinterpret_cast<const char*>(in.rest()), size_t(name_size));
-    for (uint64_t k = 0; k < name_size; ++k) in.u8();
+    f.name.assign(reinterpret_cast<const char*>(in.bytes(name_size)), size_t(name_size));
     const std::string what = "leaf field \"" + f.name + "\"";
     const uint8_t type = in.u8();
     AMC_REQUIRE(type <= uint8_t(FieldType::float64), corrupt, what + ": unknown type " + std::to_string(type));
@@ -172,8 +171,7 @@ Field decode_forest_field(PayloadReader& in, const ForestFieldFrame& frame, uint
     AMC_REQUIRE(mode <= uint8_t(ForestFieldMode::temporal), corrupt, "leaf field: unknown mode " + std::to_string(mode));
     const uint64_t length = in.varint();
     AMC_REQUIRE(length <= in.remaining(), truncated, "leaf field: longer than the frame");
-    const uint8_t* data = in.rest();
-    for (uint64_t k = 0; k < length; ++k) in.u8();
+    const uint8_t* data = in.bytes(length);
     if (mode == uint8_t(ForestFieldMode::spatial)) return read_leaf_field(data, size_t(length), frame.next->leaves, max_values);
     AMC_REQUIRE(frame.prev != nullptr, corrupt, "leaf field: coded against the frame before in a keyframe");
     return read_temporal(data, size_t(length), frame, max_values);

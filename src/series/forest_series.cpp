@@ -273,13 +273,10 @@ void ForestSeriesReader::decode_next(size_t k) {
     try {
         PayloadReader in(bytes_.data() + info.offset + 5, info.size - kSeriesBlockOverhead, "frame");
         const ForestFrameHeader fh = read_forest_frame_header(in, state_->conn);
-        AMC_REQUIRE(fh.octants <= options_.max_nodes, limit_exceeded,
-                    std::to_string(fh.octants) + " octants, more than the limit (" + std::to_string(options_.max_nodes) + ")");
-        check_nodes_per_byte(fh.octants, info.size, options_.max_nodes_per_byte, "octants");
+        check_frame_nodes(fh.octants, info.size, options_.max_nodes, options_.max_nodes_per_byte, "octants");
         const uint64_t length = in.varint();
         AMC_REQUIRE(length <= in.remaining(), truncated, "connectivity longer than the frame");
-        const uint8_t* connectivity = in.rest();
-        for (uint64_t i = 0; i < length; ++i) in.u8();
+        const uint8_t* connectivity = in.bytes(length);
         ForestState next;
         if (ref) next.models = ref->models;
         next.levels.reset(new OctreeLevels(decode_forest_connectivity(state_->conn, ref ? ref->levels.get() : nullptr, next.models,
@@ -311,11 +308,7 @@ void ForestSeriesReader::decode_next(size_t k) {
 ForestSeriesFrame ForestSeriesReader::frame(size_t k) {
     if (k >= frames_.size())
         throw std::out_of_range("forest series frame " + std::to_string(k) + " of " + std::to_string(frames_.size()));
-    size_t start = k;
-    while (!frames_[start].keyframe) --start;
-    size_t from = start;
-    if (state_->current_index >= (long long)start && state_->current_index <= (long long)k) from = size_t(state_->current_index) + 1;
-    for (size_t i = from; i <= k; ++i) decode_next(i);
+    for (size_t i = first_frame_to_decode(frames_, k, state_->current_index); i <= k; ++i) decode_next(i);
     return {state_->current.forest, frames_[k].time};
 }
 

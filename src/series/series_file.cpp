@@ -394,13 +394,10 @@ void SeriesReader::decode_next(size_t k) {
     try {
         PayloadReader in(payload, length, "frame");
         const FrameHeader fh = read_frame_header(in, base.positions.size(), base.triangles.size(), what);
-        AMC_REQUIRE(fh.nodes <= options_.max_nodes, limit_exceeded,
-                    std::to_string(fh.nodes) + " nodes, more than the limit (" + std::to_string(options_.max_nodes) + ")");
-        check_nodes_per_byte(fh.nodes, info.size, options_.max_nodes_per_byte, "nodes");
+        check_frame_nodes(fh.nodes, info.size, options_.max_nodes, options_.max_nodes_per_byte, "nodes");
         uint64_t connectivity_length = in.varint();
         AMC_REQUIRE(connectivity_length <= in.remaining(), truncated, "connectivity longer than the frame");
-        const uint8_t* connectivity = in.rest();
-        for (uint64_t i = 0; i < connectivity_length; ++i) in.u8();
+        const uint8_t* connectivity = in.bytes(connectivity_length);
         FrameState next;
         Counterparts cp;
         if (info.keyframe) {
@@ -439,8 +436,7 @@ void SeriesReader::decode_next(size_t k) {
                     "the forest does not match the counts of the frame header");
         const uint64_t geometry_length = in.varint();
         AMC_REQUIRE(geometry_length <= in.remaining(), truncated, "geometry longer than the frame");
-        const uint8_t* geometry = in.rest();
-        for (uint64_t i = 0; i < geometry_length; ++i) in.u8();
+        const uint8_t* geometry = in.bytes(geometry_length);
         const std::vector<FrameVertex> order = frame_vertex_order(next.h, ref.h, cp);
         decode_frame_geometry(ref.h, order, geometry, size_t(geometry_length), version_, next.h);
         index_frame(next);
@@ -469,12 +465,7 @@ void SeriesReader::decode_next(size_t k) {
 
 SeriesFrame SeriesReader::frame(size_t k) {
     if (k >= frames_.size()) throw std::out_of_range("series frame " + std::to_string(k) + " of " + std::to_string(frames_.size()));
-    size_t start = k;
-    while (!frames_[start].keyframe) --start;
-    size_t from = start;
-    if (state_->current_index >= (long long)start && state_->current_index <= (long long)k) from = size_t(state_->current_index) + 1;
-    if (state_->current_index == (long long)k) from = k + 1;
-    for (size_t i = from; i <= k; ++i) decode_next(i);
+    for (size_t i = first_frame_to_decode(frames_, k, state_->current_index); i <= k; ++i) decode_next(i);
     SeriesFrame out;
     out.hierarchy = state_->current.h;
     out.time = frames_[k].time;

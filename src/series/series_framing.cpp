@@ -124,4 +124,10 @@ void check_nodes_per_byte(uint64_t nodes, uint64_t bytes, uint64_t per_byte, con
                     std::to_string(per_byte) + " per byte (unpadded files written before 2026-12-02: max_nodes_per_byte = 0)");
 }
 
+void check_frame_nodes(uint64_t nodes, uint64_t bytes, uint64_t max, uint64_t per_byte, const std::string& what) {
+    AMC_REQUIRE(nodes <= max, limit_exceeded,
+                std::to_string(nodes) + " " + what + ", more than the limit (" + std::to_string(max) + ")");
+    check_nodes_per_byte(nodes, bytes, per_byte, what);
+}
+
 }  // namespace amc

@@ -53,4 +53,18 @@ std::vector<uint8_t> padded_frame_payload(const std::vector<uint8_t>& head, std:
 // `per_byte` nodes per byte (0: no bound). `what` names the nodes ("nodes", "octants", "trees").
 void check_nodes_per_byte(uint64_t nodes, uint64_t bytes, uint64_t per_byte, const std::string& what);
 
+// A frame's node count (`what`: "nodes", "octants") against the reader's limits: at most `max`, and
+// at most `per_byte` per byte of the frame's `bytes`.
+void check_frame_nodes(uint64_t nodes, uint64_t bytes, uint64_t max, uint64_t per_byte, const std::string& what);
+
+// Where a reader starts decoding to reach frame `k`: the keyframe at or before it, or the frame after
+// `current` (the frame the reader holds, -1 none) when that lies between the two.
+template <class FrameInfo>
+size_t first_frame_to_decode(const std::vector<FrameInfo>& frames, size_t k, long long current) {
+    size_t keyframe = k;
+    while (!frames[keyframe].keyframe) --keyframe;
+    if (current >= (long long)keyframe && current <= (long long)k) return size_t(current) + 1;
+    return keyframe;
+}
+
 }  // namespace amc
