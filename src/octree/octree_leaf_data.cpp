@@ -2,6 +2,7 @@
 #include "octree/octree_leaf_data.h"
 
 #include "coding/container.h"
+#include "coding/field_words.h"
 #include "coding/geometry/float_coder.h"
 #include "common/check.h"
 
@@ -24,28 +25,6 @@ constexpr int kLeafFieldContexts = 12;
 int value_context(uint32_t component, const Octant* before, const Octant& leaf) {
     const int step = before == nullptr || before->level == leaf.level ? 0 : leaf.level > before->level ? 1 : 2;
     return step * 4 + int(std::min<uint32_t>(component, 3));
-}
-
-bool in_range(int64_t v, FieldType t) {
-    switch (t) {
-        case FieldType::int8: return v >= INT8_MIN && v <= INT8_MAX;
-        case FieldType::uint8: return v >= 0 && v <= UINT8_MAX;
-        case FieldType::int16: return v >= INT16_MIN && v <= INT16_MAX;
-        case FieldType::uint16: return v >= 0 && v <= UINT16_MAX;
-        case FieldType::int32: return v >= INT32_MIN && v <= INT32_MAX;
-        case FieldType::uint32: return v >= 0 && v <= int64_t(UINT32_MAX);
-        default: return true;
-    }
-}
-
-// Values as N-bit words whose differences are coded: integers as themselves (N = 64), floats as
-// their ordered bits (float_coder.h; N = 32 or 64).
-int word_bits(FieldType t) { return t == FieldType::float32 ? 32 : 64; }
-uint64_t word_mask(FieldType t) { return word_bits(t) == 32 ? 0xFFFFFFFFull : ~uint64_t{0}; }
-uint64_t word_of(const Field& f, size_t k) {
-    if (f.type == FieldType::float32) return ordered_bits(f.values[k], Precision::float32);
-    if (f.type == FieldType::float64) return ordered_bits(f.values[k], Precision::float64);
-    return uint64_t(f.integers[k]);
 }
 
 std::string field_what(const std::string& name) { return "leaf field \"" + name + "\""; }
@@ -80,7 +59,7 @@ void validate_leaf_fields(const std::vector<Field>& fields, uint64_t leaves, con
         AMC_REQUIRE(f.value_count() == leaves * f.components && (is_float ? f.integers.empty() : f.values.empty()), invalid_input,
                     where + ": " + std::to_string(f.value_count()) + " values for " + std::to_string(leaves) + " leaves of " +
                         std::to_string(f.components) + " components");
-        for (int64_t v : f.integers) AMC_REQUIRE(in_range(v, f.type), invalid_input, where + ": a value out of the type's range");
+        for (int64_t v : f.integers) AMC_REQUIRE(integer_in_range(v, f.type), invalid_input, where + ": a value out of the type's range");
         if (f.type == FieldType::float32)
             for (double v : f.values)  // beyond the float range the conversion is undefined: checked first
                 AMC_REQUIRE(!std::isfinite(v) || (std::fabs(v) <= FLT_MAX && double(float(v)) == v), invalid_input,
@@ -137,7 +116,7 @@ Field read_leaf_field(const uint8_t* data, size_t size, const std::vector<Octant
     if (is_float) f.values.resize(values);
     else f.integers.resize(values);
     const uint64_t mask = word_mask(f.type);
-    const Precision precision = f.type == FieldType::float32 ? Precision::float32 : Precision::float64;
+    const Precision precision = precision_of(f.type);
     FloatResidualModels models(kLeafFieldContexts);
     ArithmeticDecoder decoder(in.rest(), in.remaining());
     uint64_t bad_range = 0;
@@ -155,7 +134,7 @@ Field read_leaf_field(const uint8_t* data, size_t size, const std::vector<Octant
                 f.values[k] = from_ordered_bits(w, precision);
             } else {
                 f.integers[k] = int64_t(w);
-                bad_range += !in_range(f.integers[k], f.type);
+                bad_range += !integer_in_range(f.integers[k], f.type);
             }
         }
     }

@@ -1,6 +1,7 @@
 // Fields of a series frame; see field_coder.h and docs/FORMAT.md, section 7.7.
 #include "series/field_coder.h"
 
+#include "coding/field_words.h"
 #include "coding/geometry/float_coder.h"
 #include "common/bits.h"
 #include "common/exact_float.h"
@@ -31,19 +32,6 @@ int64_t grid_index(double x, double step) { return on_grid(x, step) ? std::llrou
 double grid_value(int64_t q, double step, FieldType type) {
     const double x = rounded(double(q) * step);
     return type == FieldType::float32 ? rounded_to_float(x) : x;
-}
-
-// Integer range of each type (as int64; uint64 holds any bit pattern).
-bool in_range(int64_t v, FieldType t) {
-    switch (t) {
-        case FieldType::int8: return v >= INT8_MIN && v <= INT8_MAX;
-        case FieldType::uint8: return v >= 0 && v <= UINT8_MAX;
-        case FieldType::int16: return v >= INT16_MIN && v <= INT16_MAX;
-        case FieldType::uint16: return v >= 0 && v <= UINT16_MAX;
-        case FieldType::int32: return v >= INT32_MIN && v <= INT32_MAX;
-        case FieldType::uint32: return v >= 0 && v <= int64_t(UINT32_MAX);
-        default: return true;
-    }
 }
 
 // ---- value domains: what predictions are computed in and residuals taken of ----------------
@@ -254,7 +242,7 @@ void encode_field(const Field& field, double bound, const FieldFrame& frame, std
                 what + ": " + std::to_string(field.value_count()) + " values for " + std::to_string(tuples) + " " +
                     (field.association == FieldAssociation::point ? "points" : "cells") + " of " +
                     std::to_string(field.components) + " components");
-    for (int64_t v : field.integers) AMC_REQUIRE(in_range(v, field.type), invalid_input, what + ": a value out of the type's range");
+    for (int64_t v : field.integers) AMC_REQUIRE(integer_in_range(v, field.type), invalid_input, what + ": a value out of the type's range");
     if (field.type == FieldType::float32)
         for (double v : field.values)
             AMC_REQUIRE(std::isnan(v) || rounded_to_float(v) == v, invalid_input, what + ": a Float32 value that is not a float");
@@ -307,7 +295,7 @@ void encode_field(const Field& field, double bound, const FieldFrame& frame, std
             }
     } else {
         FloatDomain d;
-        d.precision = field.type == FieldType::float32 ? Precision::float32 : Precision::float64;
+        d.precision = precision_of(field.type);
         Predictions<FloatDomain> predict{frame, ref, field.association, field.components, d, prev_cell};
         payload = encode_values(predict, field.values, tuples, frame.levels, allowed, predictors);
     }
@@ -372,12 +360,12 @@ Field decode_field(PayloadReader& in, const FieldFrame& frame) {
             f.values.resize(w.size());
             for (size_t i = 0; i < w.size(); ++i) f.values[i] = grid_value(w[i], d.step, f.type);
         } else {
-            for (int64_t v : w) AMC_REQUIRE(in_range(v, f.type), corrupt, what + ": a value out of the type's range");
+            for (int64_t v : w) AMC_REQUIRE(integer_in_range(v, f.type), corrupt, what + ": a value out of the type's range");
             f.integers = std::move(w);
         }
     } else {
         FloatDomain d;
-        d.precision = f.type == FieldType::float32 ? Precision::float32 : Precision::float64;
+        d.precision = precision_of(f.type);
         Predictions<FloatDomain> predict{frame, ref, f.association, f.components, d, prev_cell};
         f.values = decode_values(predict, tuples, predictors, data, size_t(length), what);
     }

@@ -1,6 +1,7 @@
 // Forest series leaf fields (docs/FORMAT.md 7.12).
 #include "series/forest_fields.h"
 
+#include "coding/field_words.h"
 #include "coding/geometry/float_coder.h"
 #include "common/check.h"
 #include "octree/octree_leaf_data.h"
@@ -23,26 +24,6 @@ uint64_t morton(const Octant& o, int dim) {
         key = (key << 1) | ((uint32_t(o.x) >> b) & 1);
     }
     return key;
-}
-
-// Values as words whose differences are coded (octree_leaf_data.cpp's convention).
-int word_bits(FieldType t) { return t == FieldType::float32 ? 32 : 64; }
-uint64_t word_mask(FieldType t) { return word_bits(t) == 32 ? 0xFFFFFFFFull : ~uint64_t{0}; }
-Precision precision_of(FieldType t) { return t == FieldType::float32 ? Precision::float32 : Precision::float64; }
-uint64_t word_of(const Field& f, size_t k) {
-    return is_float_type(f.type) ? ordered_bits(f.values[k], precision_of(f.type)) : uint64_t(f.integers[k]);
-}
-
-bool integer_in_range(int64_t v, FieldType t) {
-    switch (t) {
-        case FieldType::int8: return v >= INT8_MIN && v <= INT8_MAX;
-        case FieldType::uint8: return v >= 0 && v <= UINT8_MAX;
-        case FieldType::int16: return v >= INT16_MIN && v <= INT16_MAX;
-        case FieldType::uint16: return v >= 0 && v <= UINT16_MAX;
-        case FieldType::int32: return v >= INT32_MIN && v <= INT32_MAX;
-        case FieldType::uint32: return v >= 0 && v <= int64_t(UINT32_MAX);
-        default: return true;
-    }
 }
 
 const Field* previous_field(const ForestFieldFrame& frame, const std::string& name) {
