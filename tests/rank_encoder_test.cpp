@@ -3,12 +3,16 @@
 // numbering each rank gives its base vertices, and inputs that do not fit together are refused.
 // The same steps under mpirun, with MPI moving the bytes: tests/mpi/.
 #include "coding/distributed/rank_encoder.h"
+#include "coding/distributed/rank_grid.h"
 #include "coding/format_version.h"
 #include "rank_fixtures.h"
 
 #include <amc/codec.h>
 
+#include <algorithm>
+#include <cmath>
 #include <numeric>
+#include <optional>
 
 namespace amc {
 namespace {
@@ -29,6 +33,14 @@ std::vector<uint8_t> write_by_ranks(const TriangleMesh& base, const std::vector<
         ranges.push_back({ranks[r].first_root, ranks[r].forest.root_count()});
     }
     const RankLayout layout = rank_layout(uint32_t(base.triangles.size()), ranges);
+    std::optional<Quantizer> grid;
+    if (options.quantize_bits != 0) {
+        std::vector<RankBox> boxes;
+        for (const RankChunk& part : parts) boxes.push_back(rank_box(base, part));
+        std::reverse(boxes.begin(), boxes.end());  // in any order
+        grid = grid_of_ranks(boxes, options.quantize_bits, "ranks");
+    }
+    const Quantizer* grid_or_null = grid ? &*grid : nullptr;
     if (layout.chunks.size() == 1) {  // one rank owns every root: a file without chunks
         EncodeOptions whole = options;
         whole.keep_base_order = true;
@@ -41,14 +53,16 @@ std::vector<uint8_t> write_by_ranks(const TriangleMesh& base, const std::vector<
         const std::vector<SeamSplit> mine = seam_splits(part, base, layout);
         splits.insert(splits.end(), mine.begin(), mine.end());
     }
-    const Seam seam = Seam::from_splits(base, layout.chunk_of_root, splits);
+    const Seam seam = rank_seam(base, layout, splits, grid_or_null);
     std::vector<RankCode> codes(layout.chunks.size());
-    for (size_t r = 0; r < ranks.size(); ++r)
+    for (size_t r = 0; r < ranks.size(); ++r) {
+        if (grid) snap_to_grid(parts[r], *grid);
         if (layout.chunk_of_rank[r] >= 0)
-            codes[size_t(layout.chunk_of_rank[r])] = encode_rank_chunk(parts[r], seam, options, "rank " + std::to_string(r));
+            codes[size_t(layout.chunk_of_rank[r])] = encode_rank_chunk(parts[r], seam, options, grid_or_null, "rank " + std::to_string(r));
+    }
     std::vector<ChunkSummary> summaries;
     for (const RankCode& code : codes) summaries.push_back(code.summary);
-    std::vector<uint8_t> file = chunked_file_head(base, seam, summaries, options);
+    std::vector<uint8_t> file = chunked_file_head(base, seam, summaries, options, grid_or_null);
     for (const RankCode& code : codes) file.insert(file.end(), code.block.begin(), code.block.end());
     const std::vector<uint8_t> end = end_block();
     file.insert(file.end(), end.begin(), end.end());
@@ -78,6 +92,82 @@ TEST(RankEncoder, RanksWriteTheSerialEncodersBytes) {
         }
     }
     EXPECT_EQ(files, 24 * 7);
+}
+
+// The serial encoder's options for the file the ranks write with `counts` roots.
+EncodeOptions serial_options(EncodeOptions options, const std::vector<uint32_t>& counts) {
+    options.keep_base_order = true;
+    for (uint32_t c : counts)
+        if (c > 0) options.chunk_roots.push_back(c);
+    return options;
+}
+
+TEST(RankEncoder, RanksWriteTheSerialEncodersQuantizedBytes) {
+    int files = 0, grid_files = 0;
+    for (uint64_t seed = 0; seed < 12; ++seed) {
+        SCOPED_TRACE("seed " + std::to_string(seed));
+        const Hierarchy h = adaptive_hierarchy(seed);
+        for (uint32_t p : {1u, 2u, 3u, 5u}) {
+            const std::vector<uint32_t> counts = cut(h.root_count(), p, seed + p, p == 3);
+            EncodeOptions options;
+            options.quantize_bits = int(4 + (seed * 5 + p) % 20);
+            options.grid_contexts = seed % 2 == 0;  // the automatic predictor may take mode 4
+            options.predictor = seed % 3 == 0 ? GeometryPredictor::normal_frame_grid : seed % 3 == 1 ? GeometryPredictor::automatic : GeometryPredictor(seed % 4);
+            const std::vector<uint8_t> bytes = write_by_ranks(h.base(), ranks_of(h, counts, seed), options);
+            ASSERT_EQ(bytes, encode(h, serial_options(options, counts))) << p << " ranks, " << options.quantize_bits << " bits";
+            grid_files += bytes[4] == kGridGeometryVersion;
+            ++files;
+        }
+    }
+    EXPECT_EQ(files, 12 * 4);
+    EXPECT_GT(grid_files, 0);  // level geometry mode 4 in some chunk: a version-9 file
+    // A surface remesh (vertices on the unit sphere), where the automatic predictor takes mode 4.
+    Hierarchy sphere(make_icosahedron());
+    refine_randomly(sphere, 20000, 7, 5);
+    for (VertexId v = 0; v < sphere.positions().size(); ++v) {
+        const Vec3 p = sphere.position(v);
+        sphere.set_position(v, (1.0 / std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z)) * p);
+    }
+    EncodeOptions options;
+    options.quantize_bits = 12;
+    options.grid_contexts = true;
+    const std::vector<uint32_t> counts{7, 6, 7};
+    const std::vector<uint8_t> bytes = write_by_ranks(sphere.base(), ranks_of(sphere, counts, 1), options);
+    EXPECT_EQ(bytes[4], kGridGeometryVersion);
+    EXPECT_EQ(bytes, encode(sphere, serial_options(options, counts)));
+}
+
+// Both zeros at the bottom of the box: the grid's origin keeps the first in canonical vertex
+// order, as the serial encoder does for the whole hierarchy numbered that way.
+TEST(RankEncoder, TheGridsOriginKeepsTheSerialEncodersZero) {
+    int negative = 0, positive = 0;
+    for (int pattern = 0; pattern < 8; ++pattern) {
+        SCOPED_TRACE("pattern " + std::to_string(pattern));
+        // Odd patterns: the base's z at +0 and -0, so a base vertex decides; even ones: the base at
+        // z = 1, so the first midpoint at a zero decides, wherever it lies.
+        TriangleMesh base = make_square(2);
+        for (VertexId v = 0; v < base.positions.size(); ++v) base.positions[v].z = pattern % 2 == 0 ? 1.0 : v % 3 == 2 ? 0.0 : -0.0;
+        Hierarchy h(base);
+        refine_uniformly(h, 2);
+        for (VertexId v = VertexId(base.positions.size()); v < h.positions().size(); ++v) {
+            Vec3 p = h.position(v);
+            const uint32_t k = (v * 7 + uint32_t(pattern)) % 5;
+            p.z = k == 0 ? 0.5 : k == 1 || k == 3 ? -0.0 : 0.0;
+            h.set_position(v, p);
+        }
+        const Hierarchy canonical = extract_roots(h, {RootRange{0, h.root_count()}});
+        const std::vector<uint32_t> order = canonical_vertex_order(canonical);
+        for (uint32_t v = 0; v < order.size(); ++v) ASSERT_EQ(order[v], v);
+        for (const std::vector<uint32_t>& counts : {std::vector<uint32_t>{8}, {3, 5}, {2, 0, 3, 3}, {1, 1, 1, 5}}) {
+            EncodeOptions options;
+            options.quantize_bits = 10;
+            const std::vector<uint8_t> bytes = write_by_ranks(base, ranks_of(h, counts, uint64_t(pattern)), options);
+            ASSERT_EQ(bytes, encode(canonical, serial_options(options, counts))) << counts.size() << " ranks";
+        }
+        ++(std::signbit(make_quantizer(canonical_positions(canonical), 10).origin.z) ? negative : positive);
+    }
+    EXPECT_GT(negative, 0);  // both zeros end up in the origin
+    EXPECT_GT(positive, 0);
 }
 
 TEST(RankEncoder, RootRangesThatDoNotCutTheBaseAreRefused) {
@@ -137,8 +227,8 @@ TEST(RankEncoder, RanksThatDoNotFitAcrossTheSeamAreRefused) {
         std::vector<SeamSplit> splits = seam_splits(a, base, layout), far = seam_splits(b, base, layout);
         splits.insert(splits.end(), far.begin(), far.end());
         const Seam seam = Seam::from_splits(base, layout.chunk_of_root, splits);
-        encode_rank_chunk(a, seam, {}, "rank 0");
-        encode_rank_chunk(b, seam, {}, "rank 1");
+        encode_rank_chunk(a, seam, {}, nullptr, "rank 0");
+        encode_rank_chunk(b, seam, {}, nullptr, "rank 1");
     };
     EXPECT_NO_THROW(write(fine, fine));
     // Two levels of refinement against unrefined roots: not balanced across the seam.

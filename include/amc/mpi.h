@@ -27,6 +27,7 @@ struct WriteStats {
     uint64_t file_bytes = 0;     // the whole file
     uint64_t rank_bytes = 0;     // what this rank wrote
     uint64_t seam_vertices = 0;  // vertices on edges between ranks, stored once in the seam block
+    double max_error = 0;        // quantized files: the largest coordinate error of any rank (0: bit-exact)
     double encode_seconds = 0;   // this rank: checks, seam, its chunk (wall clock)
     double write_seconds = 0;    // the exchanges of sizes and the collective write, renaming included
 };
@@ -44,8 +45,9 @@ struct WriteStats {
 //   sides create on a shared edge. A leaf's diagonal flag must be the whole hierarchy's: a leaf
 //   next to the boundary whose green closure has a hanging node of the other side keeps the flag
 //   that closure has (HIERARCHY.md), though its own forest does not show that node.
-// - `options`: hierarchy coder switches and predictor as for encode(); keep_base_order and
-//   chunk_roots are implied; quantize_bits, a numbering and mixed contexts are refused.
+// - `options`: as for encode(): hierarchy coder switches, predictor, quantize_bits (the grid spans
+//   every rank's positions; the ranks agree on it) and grid_contexts; keep_base_order and
+//   chunk_roots are implied; a numbering and mixed contexts are refused (docs/MPI.md says why).
 // Written to a temporary name next to `path` and renamed by rank 0 once every rank has written.
 // Throws Error on every rank when any rank's input is refused (the message names the rank and the
 // problem; nothing is written) or the file can not be written (ErrorCode::io).
@@ -68,7 +70,10 @@ struct Share {
 // rank).
 Share read(MPI_Comm comm, const std::string& path, uint32_t first_root, uint32_t root_count, const DecodeOptions& options = {});
 
-// The same with the file's roots cut evenly: rank r of Q reads roots T r / Q .. T (r + 1) / Q - 1.
+// The same with the file cut along its chunks: each rank reads a run of whole chunks, the runs
+// balanced by the chunk table's node counts, so that no two ranks decode one chunk. Ranks past the
+// chunk count read no roots (first_root = the file's root count); a file without chunks is one
+// chunk, read by rank 0.
 Share read(MPI_Comm comm, const std::string& path, const DecodeOptions& options = {});
 
 }  // namespace amc::mpi

@@ -7,6 +7,7 @@
 #include "coding/chunks/chunked_file.h"
 #include "coding/container.h"
 #include "coding/distributed/rank_encoder.h"
+#include "coding/distributed/rank_grid.h"
 #include "coding/file_metadata.h"
 #include "common/check.h"
 
@@ -20,6 +21,7 @@
 #include <cstring>
 #include <functional>
 #include <memory>
+#include <optional>
 
 namespace amc::mpi {
 
@@ -186,10 +188,11 @@ private:
 uint32_t u32_at(const uint8_t* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
 
 // Where the head of a file ends (rank 0, independent reads): after the seam block of a chunked
-// file; the whole file otherwise, and whenever the framing looks wrong (then the decoder, which
-// checks everything, says what).
+// file; after the metadata block of a file without chunks (a rank reads the rest only when it
+// reads roots); the whole file whenever the framing looks wrong (then the decoder, which checks
+// everything, says what).
 uint64_t head_end(MPI_File file, uint64_t size) {
-    uint64_t at = kFileHeaderSize;
+    uint64_t at = kFileHeaderSize, metadata_end = size;
     const uint8_t expected[5] = {uint8_t(BlockType::metadata), uint8_t(BlockType::base_connectivity),
                                  uint8_t(BlockType::base_geometry), uint8_t(BlockType::chunk_table), uint8_t(BlockType::seam)};
     for (uint8_t type : expected) {
@@ -197,7 +200,9 @@ uint64_t head_end(MPI_File file, uint64_t size) {
         if (size < 5 || at > size - 5) return size;
         if (MPI_File_read_at(file, MPI_Offset(at), framing, 5, MPI_BYTE, MPI_STATUS_IGNORE) != MPI_SUCCESS) return size;
         const uint64_t end = at + kBlockOverhead + u32_at(framing + 1);
+        if (type == uint8_t(BlockType::chunk_table) && framing[0] != type) return metadata_end;
         if (framing[0] != type || end > size) return size;
+        if (type == uint8_t(BlockType::metadata)) metadata_end = end;
         if (type == uint8_t(BlockType::seam)) return end;
         at = end;
     }
@@ -208,6 +213,7 @@ uint64_t head_end(MPI_File file, uint64_t size) {
 struct FileChunks {
     uint32_t roots = 0;
     std::vector<RootRange> ranges;
+    std::vector<uint64_t> nodes;    // of each chunk
     std::vector<uint64_t> offsets;  // file offsets of the chunk blocks
 };
 
@@ -221,20 +227,29 @@ FileChunks chunks_of(const uint8_t* data, uint64_t size, uint64_t head) {
     out.roots = uint32_t(meta.base_triangles);
     if (!(meta.options & kOptionChunked)) {
         out.ranges.push_back({0, out.roots});
+        out.nodes.push_back(meta.nodes);
         return out;
     }
     for (int skip = 0; skip < 2; ++skip) AMC_REQUIRE(reader.next(block), corrupt, "file ends in its base mesh");
     AMC_REQUIRE(reader.next(block) && block.type == BlockType::chunk_table, corrupt, "expected a chunk table block");
     const ChunkTable table = read_chunk_table(block, meta.base_triangles, meta.nodes, size_t(size));
     out.ranges = table.roots;
+    out.nodes = table.nodes;
     for (uint64_t offset : table.offsets) out.offsets.push_back(table.end + offset);
     return out;
 }
 
 struct RunRequest {
-    bool even = false;  // rank r of Q: roots T r / Q .. T (r + 1) / Q - 1
+    bool along_chunks = false;  // whole chunks, balanced by nodes (read(comm, path))
     uint32_t first = 0, count = 0;
 };
+
+// The chunks of rank `rank` of `ranks`: runs of whole chunks balanced by node count, as the
+// encoder balances roots into chunks; the ranks past the chunk count get none.
+RootRange chunks_of_rank(const FileChunks& chunks, int rank, int ranks) {
+    const std::vector<RootRange> runs = balanced_chunks(chunks.nodes, uint32_t(ranks));
+    return size_t(rank) < runs.size() ? runs[size_t(rank)] : RootRange{uint32_t(chunks.ranges.size()), 0};
+}
 
 Share read_run(MPI_Comm comm, const std::string& path, RunRequest run, const DecodeOptions& options) {
     const auto start = std::chrono::steady_clock::now();
@@ -268,9 +283,11 @@ Share read_run(MPI_Comm comm, const std::string& path, RunRequest run, const Dec
                 throw e.prefixed(path);
             }
             share.file_roots = chunks.roots;
-            if (run.even) {
-                run.first = uint32_t(uint64_t(chunks.roots) * uint64_t(rank) / uint64_t(ranks));
-                run.count = uint32_t(uint64_t(chunks.roots) * uint64_t(rank + 1) / uint64_t(ranks)) - run.first;
+            if (run.along_chunks) {
+                const RootRange mine = chunks_of_rank(chunks, rank, ranks);
+                run.first = mine.count == 0 ? chunks.roots : chunks.ranges[mine.first].first;
+                run.count = 0;
+                for (uint32_t c = mine.first; c < mine.first + mine.count; ++c) run.count += chunks.ranges[c].count;
             }
             AMC_REQUIRE(run.first <= chunks.roots && run.count <= chunks.roots - run.first, invalid_input,
                         what + ": roots " + std::to_string(run.first) + " to " + std::to_string(uint64_t(run.first) + run.count) +
@@ -282,9 +299,13 @@ Share read_run(MPI_Comm comm, const std::string& path, RunRequest run, const Dec
         });
         share.first_root = run.first;
         // The chunk blocks, one run of bytes: up to the next chunk's block, or to the end of the last
-        // block, whose length its framing tells.
+        // block, whose length its framing tells; the rest of a file without chunks.
         uint64_t begin = 0, end = 0;
         const bool chunked = !chunks.offsets.empty();
+        if (!chunked && !wanted.empty()) {
+            begin = head;
+            end = size;
+        }
         if (chunked && !wanted.empty()) {
             begin = chunks.offsets[wanted.front()];
             end = wanted.back() + 1 < chunks.offsets.size() ? chunks.offsets[wanted.back() + 1] : begin;
@@ -347,6 +368,15 @@ void write(MPI_Comm comm, const std::string& path, const TriangleMesh& base, uin
             throw e.prefixed(path);
         }
     });
+    // Quantized files: the grid over every rank's box.
+    std::optional<Quantizer> grid;
+    if (options.quantize_bits != 0) {
+        std::vector<RankBox> boxes(static_cast<size_t>(ranks));
+        const RankBox box = rank_box(base, part);
+        MPI_Allgather(&box, sizeof(RankBox), MPI_BYTE, boxes.data(), sizeof(RankBox), MPI_BYTE, comm);
+        collectively(comm, [&] { grid = grid_of_ranks(boxes, options.quantize_bits, path); });
+    }
+    const Quantizer* grid_or_null = grid ? &*grid : nullptr;
     // What each rank writes, and where.
     std::vector<uint8_t> head, block, end;
     uint64_t block_offset = 0, file_bytes = 0;
@@ -357,7 +387,9 @@ void write(MPI_Comm comm, const std::string& path, const TriangleMesh& base, uin
             EncodeOptions whole = options;
             whole.keep_base_order = true;
             whole.chunk_roots = {uint32_t(base.triangles.size())};
-            block = encode(part.chunk, whole);
+            EncodeStats encoded;
+            block = encode(part.chunk, whole, &encoded);
+            stats.max_error = encoded.max_error;
         });
         file_bytes = block.size();
         MPI_Allreduce(MPI_IN_PLACE, &file_bytes, 1, MPI_UINT64_T, MPI_SUM, comm);
@@ -369,11 +401,12 @@ void write(MPI_Comm comm, const std::string& path, const TriangleMesh& base, uin
         RankCode code;
         collectively(comm, [&] {
             try {
-                seam = Seam::from_splits(base, layout.chunk_of_root, every_split);
+                seam = rank_seam(base, layout, every_split, grid_or_null);
             } catch (const Error& e) {
                 throw e.prefixed(path);
             }
-            if (chunk >= 0) code = encode_rank_chunk(part, seam, options, what);
+            if (grid) stats.max_error = snap_to_grid(part, *grid);
+            if (chunk >= 0) code = encode_rank_chunk(part, seam, options, grid_or_null, what);
         });
         std::vector<ChunkSummary> by_rank(static_cast<size_t>(ranks)), summaries(layout.chunks.size());
         MPI_Allgather(&code.summary, sizeof(ChunkSummary), MPI_BYTE, by_rank.data(), sizeof(ChunkSummary), MPI_BYTE, comm);
@@ -382,7 +415,7 @@ void write(MPI_Comm comm, const std::string& path, const TriangleMesh& base, uin
         uint64_t head_bytes = 0;
         collectively(comm, [&] {
             if (rank != 0) return;
-            head = chunked_file_head(base, seam, summaries, options);
+            head = chunked_file_head(base, seam, summaries, options, grid_or_null);
             end = end_block();
             head_bytes = head.size();
         });
@@ -425,6 +458,7 @@ void write(MPI_Comm comm, const std::string& path, const TriangleMesh& base, uin
         if (rank == 0) std::remove(temporary.c_str());
         throw Error(ErrorCode::io, path + ": can not be written (renaming " + temporary + " failed)");
     }
+    MPI_Allreduce(MPI_IN_PLACE, &stats.max_error, 1, MPI_DOUBLE, MPI_MAX, comm);
     stats.file_bytes = file_bytes;
     stats.rank_bytes = head.size() + block.size() + end.size();
     stats.write_seconds = seconds_since(start) - stats.encode_seconds;

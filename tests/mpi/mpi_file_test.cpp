@@ -87,6 +87,10 @@ TEST(Mpi, RanksWriteTheSerialEncodersFile) {
             const std::string path = dir.file("h" + std::to_string(seed) + (empty ? "e" : "") + ".amc");
             EncodeOptions options;
             options.predictor = GeometryPredictor(seed % 4);
+            if (empty) {  // quantized, the grid agreed on by the ranks
+                options.quantize_bits = int(6 + seed);
+                options.grid_contexts = seed % 2 == 0;
+            }
             mpi::WriteStats stats;
             write_with(MPI_COMM_WORLD, path, h, counts, seed, options, &stats);
             // Every rank checks the file the serial way.
@@ -98,8 +102,12 @@ TEST(Mpi, RanksWriteTheSerialEncodersFile) {
             ASSERT_EQ(bytes, encode(h, options));
             const FileInfo info = inspect(bytes.data(), bytes.size());
             EXPECT_EQ(info.chunks.size(), options.chunk_roots.size() > 1 ? options.chunk_roots.size() : 0u);
-            const Hierarchy back = decode(bytes.data(), bytes.size());
-            ASSERT_TRUE(identical(back, h));
+            if (options.quantize_bits != 0) {
+                EXPECT_GT(stats.max_error, 0.0);
+            } else {
+                const Hierarchy back = decode(bytes.data(), bytes.size());
+                ASSERT_TRUE(identical(back, h));
+            }
             ++files;
         }
     }
@@ -122,6 +130,46 @@ void expect_share(const mpi::Share& share, const Hierarchy& h, uint32_t first, u
     EXPECT_TRUE(identical(share.hierarchy, extract_roots(h, {RootRange{first, count}})));
 }
 
+// read(comm, path): the ranks' shares, in rank order, cut the file's roots along its chunks
+// (a file without chunks is one), each rank reading the head and its own chunks' blocks only.
+void expect_along_chunks(MPI_Comm comm, const mpi::Share& share, const Hierarchy& h, const std::vector<uint8_t>& bytes) {
+    int q = 0, me = 0;
+    MPI_Comm_size(comm, &q);
+    MPI_Comm_rank(comm, &me);
+    const uint32_t count = share.hierarchy.root_count();
+    uint32_t mine[2] = {share.first_root, count};
+    std::vector<uint32_t> all(2 * size_t(q));
+    MPI_Allgather(mine, 2, MPI_UINT32_T, all.data(), 2, MPI_UINT32_T, comm);
+    FileInfo info = inspect(bytes.data(), bytes.size());
+    if (info.chunks.empty()) info.chunks.push_back({0, h.root_count(), h.node_count(), 0, 0});
+    uint32_t next = 0, chunks_read = 0;
+    uint64_t chunk_bytes = 0;
+    for (int k = 0; k < q; ++k) {
+        const uint32_t first = all[2 * size_t(k)], roots = all[2 * size_t(k) + 1];
+        EXPECT_EQ(first, roots == 0 ? h.root_count() : next) << "rank " << k;
+        next += roots;
+        for (const ChunkInfo& c : info.chunks) {
+            const bool inside = c.first_root >= first && c.first_root + c.roots <= first + roots;
+            const bool outside = c.first_root + c.roots <= first || c.first_root >= first + roots;
+            EXPECT_TRUE(inside || outside) << "rank " << k << " cuts a chunk";
+            if (inside && roots > 0 && k == me) {
+                ++chunks_read;
+                chunk_bytes += c.size;
+            }
+        }
+    }
+    EXPECT_EQ(next, h.root_count());
+    expect_share(share, h, share.first_root, count);
+    if (info.chunks.size() == size_t(q)) {
+        EXPECT_EQ(chunks_read, 1u);  // as many readers as chunks: one each
+    }
+    if (info.chunks.front().size == 0) {  // no chunks: the metadata alone, or all of it
+        EXPECT_EQ(share.bytes_read == bytes.size(), count > 0);
+    } else {
+        EXPECT_EQ(share.bytes_read, info.chunks.front().offset + chunk_bytes);  // the head, then its chunks
+    }
+}
+
 TEST(Mpi, FilesOfPRanksAreReadByQRanks) {
     const SharedDirectory dir;
     const int ranks = world_size();
@@ -141,11 +189,8 @@ TEST(Mpi, FilesOfPRanksAreReadByQRanks) {
                 const FirstRanks readers(q);
                 if (readers.comm == MPI_COMM_NULL) continue;
                 const int r = world_rank();
-                // Even shares.
-                const uint32_t first = uint32_t(uint64_t(h.root_count()) * uint64_t(r) / uint64_t(q));
-                const uint32_t last = uint32_t(uint64_t(h.root_count()) * uint64_t(r + 1) / uint64_t(q));
-                const mpi::Share even = mpi::read(readers.comm, path);
-                expect_share(even, h, first, last - first);
+                const mpi::Share along = mpi::read(readers.comm, path);
+                expect_along_chunks(readers.comm, along, h, file_bytes(path));
                 // Runs of any length, overlapping, one of them empty.
                 const uint32_t count = r == 1 ? 0 : 1 + uint32_t((seed + uint64_t(r)) % (h.root_count() - 1));
                 const uint32_t start = count == 0 ? 0 : uint32_t((seed * 7 + uint64_t(r)) % (h.root_count() - count + 1));
@@ -190,11 +235,20 @@ TEST(Mpi, BadInputFailsOnEveryRankAndWritesNothing) {
     message = error_of([&] { mpi::write(MPI_COMM_WORLD, path, r == 1 ? other : h.base(), first, forest); });
     EXPECT_NE(message.find("rank 1"), std::string::npos) << message;
     EXPECT_NE(message.find("base mesh"), std::string::npos) << message;
-    // Quantized coordinates.
-    EncodeOptions quantized;
-    quantized.quantize_bits = 12;
-    message = error_of([&] { mpi::write(MPI_COMM_WORLD, path, h.base(), first, forest, quantized); });
-    EXPECT_NE(message.find("quantized"), std::string::npos) << message;
+    // The mixing mode, a numbering, a grid of too many bits.
+    EncodeOptions mixed;
+    mixed.hierarchy_contexts = HierarchyContexts::mixed;
+    message = error_of([&] { mpi::write(MPI_COMM_WORLD, path, h.base(), first, forest, mixed); });
+    EXPECT_NE(message.find("mixing mode"), std::string::npos) << message;
+    const LeafNumbering numbering;
+    EncodeOptions numbered;
+    numbered.numbering = &numbering;
+    message = error_of([&] { mpi::write(MPI_COMM_WORLD, path, h.base(), first, forest, numbered); });
+    EXPECT_NE(message.find("numbering"), std::string::npos) << message;
+    EncodeOptions too_fine;
+    too_fine.quantize_bits = 31;
+    message = error_of([&] { mpi::write(MPI_COMM_WORLD, path, h.base(), first, forest, too_fine); });
+    EXPECT_NE(message.find("bad.amc: quantize_bits 31"), std::string::npos) << message;
     // Rank 0 refined twice next to unrefined roots of rank 1 (square: rows of roots meet at a line).
     const TriangleMesh square = make_square(2);
     Hierarchy fine(square);

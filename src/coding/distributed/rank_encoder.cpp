@@ -3,6 +3,7 @@
 
 #include "coding/base/base_stage.h"
 #include "coding/container.h"
+#include "coding/distributed/rank_grid.h"
 #include "coding/file_metadata.h"
 #include "coding/format_version.h"
 #include "coding/geometry/position_coder.h"
@@ -22,8 +23,9 @@ bool same_bits(Vec3 a, Vec3 b) { return std::memcmp(&a.x, &b.x, sizeof(double)) 
 
 uint64_t directed(uint32_t a, uint32_t b) { return (uint64_t(a) << 32) | b; }
 
-CoordinateSpace space_of(const TriangleMesh& base) {
-    return CoordinateSpace{base.single_precision ? Precision::float32 : Precision::float64, nullptr};
+// Quantized coordinates are float64 on the grid, whatever the input precision (as in encode()).
+CoordinateSpace space_of(const TriangleMesh& base, const Quantizer* grid) {
+    return CoordinateSpace{base.single_precision && grid == nullptr ? Precision::float32 : Precision::float64, grid};
 }
 
 // A block framed as BlockWriter frames it: type, length, payload, checksum.
@@ -37,10 +39,16 @@ std::vector<uint8_t> framed(BlockType type, const std::vector<uint8_t>& payload)
 }  // namespace
 
 void check_rank_options(const EncodeOptions& options, const std::string& what) {
-    AMC_REQUIRE(options.quantize_bits == 0, invalid_input, what + ": quantized coordinates are not written by ranks (bit-exact only)");
-    AMC_REQUIRE(options.numbering == nullptr, invalid_input, what + ": a numbering is not written by ranks");
+    AMC_REQUIRE(options.quantize_bits == 0 || (options.quantize_bits >= kMinQuantizationBits && options.quantize_bits <= kMaxQuantizationBits),
+                invalid_input,
+                what + ": quantize_bits " + std::to_string(options.quantize_bits) + " is not 0 (bit-exact) or " +
+                    std::to_string(kMinQuantizationBits) + " to " + std::to_string(kMaxQuantizationBits));
+    AMC_REQUIRE(options.numbering == nullptr, invalid_input,
+                what + ": a numbering is not written by ranks (its block codes one permutation of the whole leaf mesh, "
+                       "which no rank holds; docs/MPI.md)");
     AMC_REQUIRE(options.hierarchy_contexts == HierarchyContexts::paper, invalid_input,
-                what + ": the mixing mode codes the forest as one piece, ranks write chunks");
+                what + ": the mixing mode is not written by ranks (it codes the whole forest as one stream, "
+                       "ranks write one chunk each; docs/MPI.md)");
 }
 
 RankChunk rank_chunk(const TriangleMesh& base, uint32_t first_root, const Hierarchy& forest, const std::string& what) {
@@ -145,7 +153,15 @@ std::vector<SeamSplit> seam_splits(const RankChunk& part, const TriangleMesh& ba
     return out;
 }
 
-RankCode encode_rank_chunk(const RankChunk& part, const Seam& seam, const EncodeOptions& options, const std::string& what) {
+Seam rank_seam(const TriangleMesh& base, const RankLayout& layout, std::vector<SeamSplit> splits, const Quantizer* grid) {
+    if (grid == nullptr) return Seam::from_splits(base, layout.chunk_of_root, std::move(splits));
+    Seam::from_splits(base, layout.chunk_of_root, splits);  // the two sides agree before snapping
+    snap_to_grid(splits, *grid);
+    return Seam::from_splits(snapped_base(base, *grid), layout.chunk_of_root, std::move(splits));
+}
+
+RankCode encode_rank_chunk(const RankChunk& part, const Seam& seam, const EncodeOptions& options, const Quantizer* grid,
+                           const std::string& what) {
     const Hierarchy& h = part.chunk;
     const uint32_t base_vertices = seam.base_vertex_count();
     // Seam keys (seam.h), level by level as the decoder assigns them.
@@ -178,8 +194,7 @@ RankCode encode_rank_chunk(const RankChunk& part, const Seam& seam, const Encode
         }
         AMC_REQUIRE(hanging < 3, invalid_input, where + " has three hanging nodes with those of its neighbours across the seam");
     }
-    const CoordinateSpace space = space_of(h.base());
-    ChunkCode code = encode_chunk(h, keys, seam, options.hierarchy, options.predictor, space);
+    ChunkCode code = encode_chunk(h, keys, seam, options.hierarchy, options.predictor, space_of(h.base(), grid), options.grid_contexts);
     RankCode out;
     out.block = framed(BlockType::chunk, code.bytes);
     out.summary.roots = h.root_count();
@@ -189,16 +204,17 @@ RankCode encode_rank_chunk(const RankChunk& part, const Seam& seam, const Encode
     out.summary.block_bytes = out.block.size();
     out.summary.levels = uint32_t(h.depth() + 1);
     out.summary.static_geometry = code.static_geometry;
+    out.summary.grid_geometry = code.grid_geometry;
     return out;
 }
 
 std::vector<uint8_t> chunked_file_head(const TriangleMesh& base, const Seam& seam, const std::vector<ChunkSummary>& chunks,
-                                       const EncodeOptions& options) {
-    const Hierarchy roots(base);
+                                       const EncodeOptions& options, const Quantizer* grid) {
     EncodeOptions base_options = options;
     base_options.keep_base_order = true;
-    const BaseMeshCode base_code = base_code_of(roots, nullptr, base_options);
-    const CoordinateSpace space = space_of(base);
+    const BaseMeshCode base_code = base_code_of(Hierarchy(base), grid, base_options);
+    const Hierarchy roots(grid != nullptr ? snapped_base(base, *grid) : base);  // as encode() codes the base's positions
+    const CoordinateSpace space = space_of(base, grid);
     Metadata meta;
     meta.base_vertices = base.positions.size();
     meta.base_triangles = base.triangles.size();
@@ -210,6 +226,9 @@ std::vector<uint8_t> chunked_file_head(const TriangleMesh& base, const Seam& sea
         meta.levels = std::max<uint64_t>(meta.levels, c.levels);
     }
     meta.options = kOptionChunked;
+    bool grid_geometry = false;
+    for (const ChunkSummary& c : chunks) grid_geometry |= c.grid_geometry != 0;
+    if (grid != nullptr) meta.quantizer = *grid;
     PositionCoder positions(space);
     std::vector<uint8_t> seam_bytes = seam.encode(space);
     std::vector<uint8_t> table;
@@ -221,8 +240,9 @@ std::vector<uint8_t> chunked_file_head(const TriangleMesh& base, const Seam& sea
         put_varint(table, offset);
         offset += c.block_bytes;
     }
-    BlockWriter writer(kChunkedVersion, base.single_precision ? kFlagSinglePrecision : 0);
-    writer.add(BlockType::metadata, write_metadata(meta, false));
+    BlockWriter writer(grid_geometry ? kGridGeometryVersion : kChunkedVersion,
+                       grid != nullptr ? kFlagQuantized : base.single_precision ? kFlagSinglePrecision : 0);
+    writer.add(BlockType::metadata, write_metadata(meta, grid != nullptr));
     writer.add(BlockType::base_connectivity, base_code.bytes);
     writer.add(BlockType::base_geometry, encode_base_geometry(roots, base_code, false, positions));
     writer.add(BlockType::chunk_table, table);

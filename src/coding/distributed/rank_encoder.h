@@ -5,12 +5,15 @@
 //
 // Each rank holds the whole base mesh and the trees of one run of roots. The file is exactly what
 // encode() writes for the whole hierarchy with EncodeOptions::keep_base_order and chunk_roots set
-// to the ranks' root counts: one chunk per rank that owns roots, in root order.
+// to the ranks' root counts: one chunk per rank that owns roots, in root order (quantized files:
+// for one case of signed zeros, of the whole numbered canonically; rank_grid.h).
 //   1. rank_chunk: the rank's forest checked against the base and expressed as the serial
 //      encoder's chunk of those roots.
 //   2. (exchange every rank's root range) rank_layout: the chunks, and which rank holds which.
+//   2b. Quantized files only: (exchange every rank's box) the grid (rank_grid.h); each rank snaps
+//      its positions to it.
 //   3. seam_splits: the splits the rank's trees make on the edges between chunks, with their
-//      vertices' positions. (exchange them all) Seam::from_splits: the same seam on every rank.
+//      vertices' positions. (exchange them all) rank_seam: the same seam on every rank.
 //   4. encode_rank_chunk: the rank's chunk block, after checking that its trees fit the seam
 //      (balance and closure across it, which no single rank can check alone).
 //   5. (exchange the summaries) chunked_file_head: the bytes before the first chunk block; each
@@ -29,8 +32,8 @@
 
 namespace amc {
 
-// The refusals of what a rank-wise file can not hold (quantized coordinates, a numbering, the
-// mixing mode): Error (invalid_input) naming `what`.
+// The refusals of what a rank-wise file can not hold (a numbering, the mixing mode; docs/MPI.md
+// says why): Error (invalid_input) naming `what`.
 void check_rank_options(const EncodeOptions& options, const std::string& what);
 
 struct RankChunk {
@@ -58,10 +61,15 @@ RankLayout rank_layout(uint32_t roots, const std::vector<RootRange>& ranges);
 // The splits `part` makes on the seam edges of `layout` that its roots touch.
 std::vector<SeamSplit> seam_splits(const RankChunk& part, const TriangleMesh& base, const RankLayout& layout);
 
+// The seam from every rank's splits (Seam::from_splits), the two sides' positions compared as the
+// ranks gave them; on `grid` (quantized files; null: bit-exact) the seam then holds them snapped,
+// over the snapped base, as the serial encoder's seam does.
+Seam rank_seam(const TriangleMesh& base, const RankLayout& layout, std::vector<SeamSplit> splits, const Quantizer* grid);
+
 // What every rank tells the others about its chunk (plain data: it travels as bytes).
 struct ChunkSummary {
     uint64_t roots = 0, nodes = 0, own_vertices = 0, faces = 0, block_bytes = 0;
-    uint32_t levels = 0, static_geometry = 0;
+    uint32_t levels = 0, static_geometry = 0, grid_geometry = 0;
 };
 
 struct RankCode {
@@ -69,14 +77,17 @@ struct RankCode {
     ChunkSummary summary;
 };
 // Checks that the rank's trees fit the seam (no node refined next to a coarser leaf across it, no
-// leaf with three hanging nodes) and codes its chunk block. Throws Error (invalid_input) naming
-// `what` when they do not.
-RankCode encode_rank_chunk(const RankChunk& part, const Seam& seam, const EncodeOptions& options, const std::string& what);
+// leaf with three hanging nodes) and codes its chunk block, its positions on `grid` (quantized
+// files, already snapped to it; null: bit-exact). Throws Error (invalid_input) naming `what` when
+// they do not.
+RankCode encode_rank_chunk(const RankChunk& part, const Seam& seam, const EncodeOptions& options, const Quantizer* grid,
+                           const std::string& what);
 
 // The bytes before the first chunk block: header, metadata, base mesh, chunk table and seam block.
 // `chunks` in root order; only the seam's splits and the summaries vary between ranks' files.
+// `grid` as for encode_rank_chunk; `base` as the ranks hold it (not snapped).
 std::vector<uint8_t> chunked_file_head(const TriangleMesh& base, const Seam& seam, const std::vector<ChunkSummary>& chunks,
-                                       const EncodeOptions& options);
+                                       const EncodeOptions& options, const Quantizer* grid);
 // The END block, the file's last 9 bytes.
 std::vector<uint8_t> end_block();
 
