@@ -23,7 +23,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
@@ -51,7 +50,13 @@ std::vector<char> read_file(const char* path) {
         std::fprintf(stderr, "memory_peak: can not read %s\n", path);
         std::exit(1);
     }
-    return std::vector<char>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    // Exactly the file's size, as amc's read_whole_file reserves it: a vector grown by doubling
+    // would leave slack and raise glibc's threshold for mapping large blocks, and so the peaks.
+    in.seekg(0, std::ios::end);
+    std::vector<char> bytes(size_t(in.tellg()));
+    in.seekg(0);
+    in.read(bytes.data(), std::streamsize(bytes.size()));
+    return bytes;
 }
 
 void write_file(const std::string& path, const char* data, size_t size) {

@@ -27,6 +27,9 @@ std::string read_whole_file(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(ErrorCode::io, path + ": cannot open file (" + std::strerror(errno) + ")");
     std::string bytes;
+    // Room for the size the file has now, so that a large file is not copied as the string grows.
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    if (!ec) bytes.reserve(size_t(size));
     char buffer[1 << 16];
     while (in.read(buffer, sizeof buffer) || in.gcount() > 0) bytes.append(buffer, in.gcount());
     if (in.bad()) throw Error(ErrorCode::io, path + ": read error");

@@ -9,12 +9,29 @@
 #include "hierarchy/hierarchy_builder.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <memory>
 #include <mutex>
 #include <string>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 namespace amc {
+
+namespace {
+
+// Returns the free pages of the heap to the system: glibc keeps blocks below its mapping
+// threshold (which grows as large blocks are freed) in the process after they are freed.
+void give_back_free_memory() {
+#if defined(__GLIBC__)
+    malloc_trim(0);
+#endif
+}
+
+}  // namespace
 
 uint32_t chunk_count_for(const EncodeOptions& options, uint64_t faces) {
     if (options.chunks != 0) return options.chunks;
@@ -193,32 +210,39 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
 
     std::vector<std::unique_ptr<HierarchyLevelDecoder>> decoder_of(n), idle;
     std::mutex idle_mutex;
+    // Each decoder builds its chunks in room for the largest one, reserved once: no growth and no
+    // slack (the table's counts are trusted as far as the whole's are).
+    uint64_t largest_chunk = 0;
+    for (uint32_t c : chunks) largest_chunk = std::max(largest_chunk, table.nodes[c]);
+    std::atomic<size_t> started{0};  // chunks whose decoding has begun
     std::vector<VertexKeys> keys(n);
     std::vector<uint32_t> own(n);                    // vertices that are neither base nor seam vertices
-    std::vector<std::vector<Vec3>> own_positions(n);  // their positions, until their place is known
+    std::vector<std::vector<Vec3>> own_positions(n);  // their positions, when their place is not known yet
     std::vector<std::vector<uint32_t>> seam_used(n);  // the seam vertices each chunk holds
     std::vector<uint32_t> live(n);                    // nodes past the roots
     std::vector<uint64_t> faces(n);                   // of each chunk's leaves in the whole leaf mesh
     // The whole's positions: the base's, the seam's, then each chunk's own vertices in chunk order.
     // A whole file uses every seam vertex and has the metadata's vertex count, so each chunk's own
-    // positions go to their place as soon as the chunks before it are in; otherwise (some chunks,
-    // or the whole made late) once all are, after the seam vertices they use.
+    // positions have their place once the chunks before it are counted: written there directly
+    // (always on one thread), or set aside until then. Otherwise (some chunks, or the whole made
+    // late) all are set aside and placed once every chunk is in, after the seam vertices they use.
     const bool positions_first = whole_first && selected == nullptr;
     std::vector<Vec3> positions;
     std::vector<uint64_t> first_own(n);
-    std::vector<uint8_t> copied(n, 0);
-    size_t placed = 0;  // chunks whose own positions are in `positions`
+    std::vector<uint8_t> counted(n, 0), aside(n, 0);
+    size_t placed = 0;  // chunks whose place in `positions` is known
     uint64_t next_own = own_start;
     std::mutex placed_mutex;
-    auto place_own_positions = [&](size_t i) {  // under placed_mutex
-        copied[i] = 1;
-        for (; placed < n && copied[placed]; ++placed) {
-            std::vector<Vec3>& own_of = own_positions[placed];
+    auto place_counted = [&] {  // under placed_mutex: the places of the chunks counted in order
+        for (; placed < n && counted[placed]; ++placed) {
             first_own[placed] = next_own;
-            next_own += own_of.size();
+            next_own += own[placed];
             AMC_REQUIRE(next_own <= positions.size(), corrupt, "the chunks hold more vertices than the metadata says");
-            std::copy(own_of.begin(), own_of.end(), positions.begin() + ptrdiff_t(first_own[placed]));
-            std::vector<Vec3>().swap(own_of);
+            if (aside[placed]) {
+                std::vector<Vec3>& own_of = own_positions[placed];
+                std::copy(own_of.begin(), own_of.end(), positions.begin() + ptrdiff_t(first_own[placed]));
+                std::vector<Vec3>().swap(own_of);
+            }
         }
     };
     if (positions_first) {
@@ -229,24 +253,36 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
         for (uint32_t s = 0; s < seam.vertex_count(); ++s) positions.push_back(seam.position(s));
         positions.resize(size_t(input.vertices));
     }
-    // Chunk i into the whole (its nodes), its positions and seam vertices aside.
-    auto copy_into_whole = [&](size_t i) {
-        const Hierarchy& h = decoder_of[i]->hierarchy();
-        std::vector<VertexId> id(keys[i].size());
-        own_positions[i].reserve(size_t(std::count(keys[i].begin(), keys[i].end(), kNoVertex)));
+    // Chunk i, decoded into h, into the whole (its nodes and positions; its seam vertices noted).
+    auto copy_into_whole = [&](size_t i, const Hierarchy& h) {
+        const VertexKeys& key = keys[i];
+        own[i] = uint32_t(std::count(key.begin(), key.end(), kNoVertex));
+        AMC_REQUIRE(own_start + own[i] < kNoVertex, limit_exceeded, "too many vertices");
+        bool direct = false;
+        if (positions_first) {
+            std::lock_guard<std::mutex> lock(placed_mutex);
+            counted[i] = 1;
+            place_counted();
+            direct = placed > i;
+        }
+        if (!direct) own_positions[i].reserve(own[i]);
+        std::vector<VertexId> id(key.size());
+        uint32_t k = 0;
         for (size_t v = 0; v < id.size(); ++v) {
-            const uint32_t key = keys[i][v];
-            if (key == kNoVertex) {
-                id[v] = VertexId(own_start + own[i]++);
-                own_positions[i].push_back(h.position(VertexId(v)));
-            } else if (key < file_base) {
-                id[v] = base_id[key];
+            if (key[v] == kNoVertex) {
+                id[v] = VertexId(own_start + k);
+                if (direct)
+                    positions[size_t(first_own[i] + k)] = h.position(VertexId(v));
+                else
+                    own_positions[i].push_back(h.position(VertexId(v)));
+                ++k;
+            } else if (key[v] < file_base) {
+                id[v] = base_id[key[v]];
             } else {
-                id[v] = VertexId(seam_start + (key - file_base));
-                seam_used[i].push_back(key - file_base);
+                id[v] = VertexId(seam_start + (key[v] - file_base));
+                seam_used[i].push_back(key[v] - file_base);
             }
         }
-        AMC_REQUIRE(own_start + own[i] < kNoVertex, limit_exceeded, "too many vertices");
         parts[i].part = &h;
         parts[i].vertex_id = id.data();
         live[i] = h.node_capacity() - h.root_count();
@@ -256,16 +292,17 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
         parts[i].part = nullptr;
         parts[i].vertex_id = nullptr;
         VertexKeys().swap(keys[i]);
-        {
-            std::lock_guard<std::mutex> lock(idle_mutex);
-            idle.push_back(std::move(decoder_of[i]));
-        }
-        if (positions_first) {
+        if (!direct) {
             std::lock_guard<std::mutex> lock(placed_mutex);
-            place_own_positions(i);
+            aside[i] = 1;
+            if (placed > i) {  // placed meanwhile, before its positions were aside
+                std::copy(own_positions[i].begin(), own_positions[i].end(), positions.begin() + ptrdiff_t(first_own[i]));
+                std::vector<Vec3>().swap(own_positions[i]);
+            }
         }
     };
     parallel_for(n, threads, [&](size_t i) {
+        ++started;
         const uint32_t c = chunks[i];
         {
             std::lock_guard<std::mutex> lock(idle_mutex);
@@ -274,7 +311,10 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
                 idle.pop_back();
             }
         }
-        if (decoder_of[i] == nullptr) decoder_of[i] = std::make_unique<HierarchyLevelDecoder>();
+        if (decoder_of[i] == nullptr) {
+            decoder_of[i] = std::make_unique<HierarchyLevelDecoder>();
+            if (whole_first) decoder_of[i]->hierarchy().reserve(size_t(largest_chunk), 0);
+        }
         std::vector<VertexId> base_vertex;
         const TriangleMesh chunk_base = base_of_roots(base, {table.roots[c]}, base_vertex);
         ChunkDecodeLimits limits;
@@ -282,11 +322,22 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
         limits.max_level = input.options.max_level;
         limits.file_version = input.version;
         limits.stream_version = hierarchy_stream_version_of_file(input.version);
-        const Hierarchy& h = decode_chunk(*decoder_of[i], blocks[i].payload, blocks[i].size, chunk_base, base_vertex, seam,
-                                          input.space, limits, "chunk " + std::to_string(c), keys[i], faces[i]);
+        Hierarchy& h = decode_chunk(*decoder_of[i], blocks[i].payload, blocks[i].size, chunk_base, base_vertex, seam,
+                                    input.space, limits, "chunk " + std::to_string(c), keys[i], faces[i]);
         AMC_REQUIRE(input.options.max_level >= 0 || h.node_count() == table.nodes[c], corrupt,
                     "chunk " + std::to_string(c) + " does not hold the nodes the chunk table says");
-        if (whole_first) copy_into_whole(i);
+        if (!whole_first) return;
+        if (started.load() < n) {  // a chunk still to begin takes this decoder, memory and all
+            copy_into_whole(i, h);
+            std::lock_guard<std::mutex> lock(idle_mutex);
+            idle.push_back(std::move(decoder_of[i]));
+            return;
+        }
+        // None will: its working memory goes before the copy, which is where the decode peaks.
+        const Hierarchy last = std::move(h);
+        decoder_of[i].reset();
+        give_back_free_memory();
+        copy_into_whole(i, last);
     });
     if (!whole_first) {  // slices as long as the chunks are
         whole_nodes = union_base.triangles.size();
@@ -298,7 +349,10 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
             slice_end[i] = NodeId(whole_nodes);
         }
         whole = HierarchyBuilder::stitch_frame(union_base, size_t(whole_nodes));
-        parallel_for(n, threads, copy_into_whole);
+        parallel_for(n, threads, [&](size_t i) {
+            copy_into_whole(i, decoder_of[i]->hierarchy());
+            decoder_of[i].reset();
+        });
     }
     idle.clear();
 
@@ -324,7 +378,8 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
         AMC_REQUIRE(vertices < kNoVertex, limit_exceeded, "too many vertices");
         next_own = positions.size();
         positions.resize(size_t(vertices));
-        for (size_t i = 0; i < n; ++i) place_own_positions(i);
+        std::fill(counted.begin(), counted.end(), uint8_t(1));
+        place_counted();
     }
     parallel_for(n, threads, [&](size_t i) {
         HierarchyBuilder::stitch_rename_vertices(whole, parts[i].first_node, parts[i].first_node + live[i], [&](VertexId v) {

@@ -233,15 +233,16 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder, uint64_t ma
 void HierarchyLevelDecoder::finish_level() {
     node_count_ += uint64_t(4) * level_.refined_count;
     leaf_faces_ += leaf_faces_of_level(level_);
-    vertex_count_ += derive_next_level(level_, numbering_, next_, header_.options.cull_one_regularity);
-    decided_.push_back(std::move(level_));
-    level_ = std::move(next_);
-    if (spare_.empty()) {
-        next_ = Level();
-    } else {
-        next_ = std::move(spare_.back());
+    // The next level takes a spare level's memory only now, once the level before was built and
+    // given back: decoded one level at a time, two levels' memory take turns.
+    Level next;
+    if (!spare_.empty()) {
+        next = std::move(spare_.back());
         spare_.pop_back();
     }
+    vertex_count_ += derive_next_level(level_, numbering_, next, header_.options.cull_one_regularity);
+    decided_.push_back(std::move(level_));
+    level_ = std::move(next);
     ++level_index_;
 }
 

@@ -182,7 +182,7 @@ private:
     Hierarchy h_;
     HierarchyModels models_;
     LevelTraversal traversal_;
-    Level level_, next_;
+    Level level_;
     std::vector<Level> decided_;  // decided levels not yet built, oldest first
     std::vector<Level> spare_;    // built levels, whose memory the next levels reuse
     RefinedNumbering numbering_;     // of the level being decided
