@@ -11,6 +11,7 @@
 //   memory_peak encode-amc BITS THREADS model.amh  encode() of the hierarchy
 //   memory_peak encode-draco BITS model.amh        Draco's EncodeMeshToBuffer of the leaf mesh
 #include "compare_draco.h"
+#include "process_memory.h"
 
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
@@ -21,43 +22,11 @@
 
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <fstream>
 #include <string>
 #include <vector>
 
 namespace {
-
-// A field of /proc/self/status in KiB (VmRSS: now, VmHWM: the peak since the last reset).
-double status_mib(const char* field) {
-    std::ifstream in("/proc/self/status");
-    std::string line;
-    const size_t length = std::strlen(field);
-    while (std::getline(in, line))
-        if (line.compare(0, length, field) == 0 && line[length] == ':') return std::atof(line.c_str() + length + 1) / 1024.0;
-    return -1;
-}
-
-// Sets the peak to what is resident now (Linux 4.0 and later).
-void reset_peak() {
-    std::ofstream clear("/proc/self/clear_refs");
-    clear << "5";
-}
-
-std::vector<char> read_file(const char* path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        std::fprintf(stderr, "memory_peak: can not read %s\n", path);
-        std::exit(1);
-    }
-    // Exactly the file's size, as amc's read_whole_file reserves it: a vector grown by doubling
-    // would leave slack and raise glibc's threshold for mapping large blocks, and so the peaks.
-    in.seekg(0, std::ios::end);
-    std::vector<char> bytes(size_t(in.tellg()));
-    in.seekg(0);
-    in.read(bytes.data(), std::streamsize(bytes.size()));
-    return bytes;
-}
 
 void write_file(const std::string& path, const char* data, size_t size) {
     std::ofstream(path + ".tmp", std::ios::binary).write(data, std::streamsize(size));
@@ -105,7 +74,7 @@ int main(int argc, char** argv) {
         return 0;
     }
     if (mode == "decode-amc" && argc == 4) {
-        const std::vector<char> bytes = read_file(argv[2]);
+        const std::vector<char> bytes = read_exact(argv[2]);
         amc::DecodeOptions options;
         options.threads = unsigned(std::atoi(argv[3]));
         amc::Hierarchy h;
@@ -118,7 +87,7 @@ int main(int argc, char** argv) {
         });
     }
     if (mode == "decode-draco" && argc == 3) {
-        const std::vector<char> bytes = read_file(argv[2]);
+        const std::vector<char> bytes = read_exact(argv[2]);
         std::unique_ptr<draco::Mesh> mesh;
         return measure("decode draco", [&](uint64_t&, uint64_t& faces) {
             draco::DecoderBuffer buffer;

@@ -1,0 +1,110 @@
+// Encode and decode at growing sizes (docs/BENCHMARKS.md, "Scaling"; scripts/scaling_table.sh):
+// one step per process, repeated RUNS times on THREADS threads, with its wall and CPU time and
+// its memory peak. Public API only; Linux (the peak is read from /proc/self/status).
+//
+//   scaling_bench encode BITS RUNS THREADS model.amh OUT.amc   encodes (default options, BITS 0:
+//                                                              lossless) and writes OUT.amc
+//   scaling_bench decode RUNS THREADS FILE.amc                 decodes the file
+//
+// Prints one line of fields `name=value`: nodes, faces, bytes, bits per face, the median and the
+// range of the wall and CPU seconds, M faces/s (CPU), the step's peak (the first run's: the peak
+// over what was resident before it) in MiB and bytes per node, and the process's peak in MiB.
+#include "bench_common.h"
+#include "process_memory.h"
+
+#include <amc/codec.h>
+#include <amc/hierarchy.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <string>
+#include <vector>
+
+namespace {
+
+double cpu_seconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+struct Timings {
+    std::vector<double> wall, cpu;
+    double step_peak = 0, process_peak = 0;  // MiB, of the first run
+};
+
+// Runs step() `runs` times, each after an untimed clear() that drops the run before's result; the
+// peak is the first run's (later runs may find memory the runs before left to the allocator).
+template <class Clear, class Step>
+Timings run(int runs, Clear&& clear, Step&& step) {
+    Timings t;
+    for (int r = 0; r < runs; ++r) {
+        clear();
+        if (r == 0) reset_peak();
+        const double before = status_mib("VmRSS");
+        const Clock::time_point start = Clock::now();
+        const double cpu_start = cpu_seconds();
+        step();
+        t.cpu.push_back(cpu_seconds() - cpu_start);
+        t.wall.push_back(seconds_since(start));
+        if (r == 0) {
+            t.process_peak = status_mib("VmHWM");
+            t.step_peak = t.process_peak - before;
+        }
+    }
+    return t;
+}
+
+void print(const char* step, uint64_t nodes, uint64_t faces, size_t bytes, const Timings& t) {
+    auto low = [](std::vector<double> v) { return *std::min_element(v.begin(), v.end()); };
+    auto high = [](std::vector<double> v) { return *std::max_element(v.begin(), v.end()); };
+    const double cpu = median(t.cpu);
+    std::printf("step=%s nodes=%llu faces=%llu bytes=%zu bits_per_face=%.3f runs=%zu wall=%.3f wall_low=%.3f "
+                "wall_high=%.3f cpu=%.3f cpu_low=%.3f cpu_high=%.3f mfaces_per_s=%.2f step_peak_mib=%.1f "
+                "bytes_per_node=%.1f process_peak_mib=%.1f\n",
+                step, (unsigned long long)nodes, (unsigned long long)faces, bytes, 8.0 * double(bytes) / double(faces),
+                t.cpu.size(), median(t.wall), low(t.wall), high(t.wall), cpu, low(t.cpu), high(t.cpu),
+                double(faces) / cpu / 1e6, t.step_peak, t.step_peak * 1024 * 1024 / double(nodes), t.process_peak);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const std::string mode = argc > 1 ? argv[1] : "";
+    if (mode == "encode" && argc == 7) {
+        const amc::Hierarchy h = amc::read_hierarchy(argv[5]);
+        amc::EncodeOptions options;
+        options.quantize_bits = std::atoi(argv[2]);
+        options.threads = unsigned(std::atoi(argv[4]));
+        std::vector<uint8_t> bytes;
+        amc::EncodeStats stats;
+        const Timings t = run(
+            std::atoi(argv[3]), [&] { std::vector<uint8_t>().swap(bytes); }, [&] { bytes = amc::encode(h, options, &stats); });
+        const std::string out = argv[6], temporary = out + ".tmp";
+        std::FILE* f = std::fopen(temporary.c_str(), "wb");
+        if (f == nullptr || std::fwrite(bytes.data(), 1, bytes.size(), f) != bytes.size() || std::fclose(f) != 0 ||
+            std::rename(temporary.c_str(), out.c_str()) != 0) {
+            std::fprintf(stderr, "scaling_bench: can not write %s\n", out.c_str());
+            return 1;
+        }
+        print("encode", h.node_count(), stats.faces, bytes.size(), t);
+        return 0;
+    }
+    if (mode == "decode" && argc == 5) {
+        const std::vector<char> file = read_exact(argv[4]);
+        const uint8_t* data = reinterpret_cast<const uint8_t*>(file.data());
+        const amc::FileInfo info = amc::inspect(data, file.size());
+        amc::DecodeOptions options;
+        options.threads = unsigned(std::atoi(argv[3]));
+        options.max_nodes = UINT64_MAX;  // the largest models pass the default limit
+        amc::Hierarchy h;
+        const Timings t = run(
+            std::atoi(argv[2]), [&] { h = amc::Hierarchy(); }, [&] { h = amc::decode(data, file.size(), options); });
+        print("decode", h.node_count(), info.faces, file.size(), t);
+        return 0;
+    }
+    std::fprintf(stderr, "usage: scaling_bench encode BITS RUNS THREADS model.amh OUT.amc | decode RUNS THREADS FILE.amc\n");
+    return 2;
+}
