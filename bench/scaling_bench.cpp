@@ -2,6 +2,9 @@
 // one step per process, repeated RUNS times on THREADS threads, with its wall and CPU time and
 // its memory peak. Public API only; Linux (the peak is read from /proc/self/status).
 //
+//   scaling_bench make LEAVES OUT.amh                          a model of any size in linear time:
+//                                                              random leaves of a torus refined,
+//                                                              new vertices on a bumpy torus
 //   scaling_bench encode BITS RUNS THREADS model.amh OUT.amc   encodes (default options, BITS 0:
 //                                                              lossless) and writes OUT.amc
 //   scaling_bench decode RUNS THREADS FILE.amc                 decodes the file
@@ -14,8 +17,10 @@
 
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
+#include <amc/refinement.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
@@ -28,6 +33,17 @@ double cpu_seconds() {
     timespec t{};
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
     return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+// The midpoint of a and b moved onto a torus (radii 1 and 0.35 about the z axis, as make_torus
+// makes it) whose tube radius varies smoothly: coordinates with all their bits in use, as a
+// remesh of a scanned surface has them.
+amc::Vec3 on_bumpy_torus(void*, amc::Vec3 a, amc::Vec3 b) {
+    const amc::Vec3 m = 0.5 * (a + b);
+    const double u = std::atan2(m.y, m.x), cu = std::cos(u), su = std::sin(u);
+    const double radial = m.x * cu + m.y * su - 1.0, v = std::atan2(m.z, radial);
+    const double tube = 0.35 * (1 + 0.08 * std::sin(7 * u) * std::sin(5 * v) + 0.03 * std::sin(23 * u + 11 * v));
+    return {(1.0 + tube * std::cos(v)) * cu, (1.0 + tube * std::cos(v)) * su, tube * std::sin(v)};
 }
 
 struct Timings {
@@ -73,6 +89,13 @@ void print(const char* step, uint64_t nodes, uint64_t faces, size_t bytes, const
 
 int main(int argc, char** argv) {
     const std::string mode = argc > 1 ? argv[1] : "";
+    if (mode == "make" && argc == 4) {
+        amc::Hierarchy h(amc::make_torus(16, 24, 1.0, 0.35));
+        h.set_vertex_placer(on_bumpy_torus, nullptr);
+        amc::refine_randomly(h, uint32_t(std::strtoul(argv[2], nullptr, 10)), 14, 1);
+        amc::write_hierarchy(argv[3], h);
+        return 0;
+    }
     if (mode == "encode" && argc == 7) {
         const amc::Hierarchy h = amc::read_hierarchy(argv[5]);
         amc::EncodeOptions options;
@@ -105,6 +128,6 @@ int main(int argc, char** argv) {
         print("decode", h.node_count(), info.faces, file.size(), t);
         return 0;
     }
-    std::fprintf(stderr, "usage: scaling_bench encode BITS RUNS THREADS model.amh OUT.amc | decode RUNS THREADS FILE.amc\n");
+    std::fprintf(stderr, "usage: scaling_bench make LEAVES OUT.amh | encode BITS RUNS THREADS model.amh OUT.amc | decode RUNS THREADS FILE.amc\n");
     return 2;
 }

@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
-# The scaling table of docs/BENCHMARKS.md ("Scaling"): feline remeshed by mean curvature (as in
-# scripts/chunks_table.sh) at 10^4 .. 5*10^7 leaf faces, each encoded and decoded lossless and at
-# 12 bits by bench/scaling_bench on one thread, RUNS times (default 3): file size, bits per face,
-# median CPU time and M faces/s, and each step's memory peak over what was resident before it (MiB
-# and bytes per node). Sizes are exact; times are CPU seconds (wall clock on a shared machine
-# says little). The 5*10^7-face remesh takes about 12 GB and many CPU minutes: set
-# AMC_SCALING_SIZES to choose the sizes, AMC_REUSE_MODELS=1 to keep models made before.
+# The scaling tables of docs/BENCHMARKS.md ("Scaling"): models of 10^4 .. 5*10^7 leaf faces, each
+# encoded and decoded lossless and at 12 bits by bench/scaling_bench on one thread, RUNS times
+# (default 3): file size, bits per face, median CPU time [range] and M faces/s, and each step's
+# memory peak over what was resident before it (MiB, and bytes per node). Sizes are exact; times
+# are CPU seconds (wall clock on a shared machine says little).
+# Models (AMC_SCALING_MODEL): torus (default): random leaves of a torus refined, new vertices on a
+# bumpy torus (scaling_bench make: linear time, any size); feline: feline remeshed by mean
+# curvature as in scripts/chunks_table.sh (needs ../shared/data; the remesher takes minutes at
+# 10^7 faces). AMC_SCALING_SIZES chooses the face counts, AMC_REUSE_MODELS=1 keeps models made
+# before. The 5*10^7-face torus takes about 6 GB to make and to encode.
 # Usage: scripts/scaling_table.sh [build-dir] [runs]
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -13,8 +16,9 @@ build=${1:-$here/build-bench}
 runs=${2:-3}
 data=$here/../shared/data
 sizes=${AMC_SCALING_SIZES:-"10000 100000 1000000 10000000 50000000"}
+kind=${AMC_SCALING_MODEL:-torus}
 models=$build/scaling-models
-if [[ ! -f $data/feline.off ]]; then
+if [[ $kind == feline && ! -f $data/feline.off ]]; then
   echo "scaling_table.sh: $data/feline.off is absent" >&2
   exit 1
 fi
@@ -33,13 +37,17 @@ field() { tr ' ' '\n' <<< "$1" | sed -n "s/^$2=//p"; }
 echo "| faces | nodes | bits | bytes | bits/face | encode CPU s [range] | encode M faces/s | encode peak MiB (B/node) | decode CPU s [range] | decode M faces/s | decode peak MiB (B/node) |"
 echo "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
 for faces in $sizes; do
-  model=$models/feline_$faces.amh
+  model=$models/${kind}_$faces.amh
   if [[ ${AMC_REUSE_MODELS:-0} != 1 || ! -s $model ]]; then
-    "$build/amc" -f -q refine --input "$data/feline.off" --criterion mean --faces "$faces" --base-faces 500 \
-      --max-level "$(max_level_for "$faces")" --no-measure -o "$model"
+    if [[ $kind == feline ]]; then
+      "$build/amc" -f -q refine --input "$data/feline.off" --criterion mean --faces "$faces" --base-faces 500 \
+        --max-level "$(max_level_for "$faces")" --no-measure -o "$model"
+    else
+      "$build/bench/scaling_bench" make $((faces * 3 / 4)) "$model"  # about 4 faces for 3 leaves
+    fi
   fi
   for bits in 0 12; do
-    file=$models/feline_${faces}_$bits.amc
+    file=$models/${kind}_${faces}_$bits.amc
     e=$("$build/bench/scaling_bench" encode "$bits" "$runs" 1 "$model" "$file")
     d=$("$build/bench/scaling_bench" decode "$runs" 1 "$file")
     printf "| %s | %s | %s | %s | %s | %s [%s-%s] | %s | %s (%s) | %s [%s-%s] | %s | %s (%s) |\n" \

@@ -119,5 +119,29 @@ TEST(HierarchyFile, UnbalancedForestIsRejected) {
     }
 }
 
+// The node count is checked against the refinement bits before the forest is built in room made
+// for that many nodes.
+TEST(HierarchyFile, NodeCountMustMatchTheRefinementBits) {
+    Hierarchy h(make_icosahedron());
+    h.refine(0);
+    std::string bytes = serialize_hierarchy(h);
+    uint32_t nodes = 0;
+    std::memcpy(&nodes, &bytes[20], 4);
+    const uint32_t claimed = nodes + 4;  // one more refined node than the bits say
+    std::memcpy(&bytes[20], &claimed, 4);
+    const size_t bits_at = 32 + 12 * 3 * 8 + 20 * 12;
+    if ((claimed + 7) / 8 > (nodes + 7) / 8) bytes.insert(bits_at + (nodes + 7) / 8, std::string(1, '\0'));
+    try {
+        deserialize_hierarchy(bytes, "n.amh");
+        FAIL() << "accepted a node count the refinement bits do not make";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::corrupt);
+        EXPECT_NE(std::string(e.what()).find("announces " + std::to_string(claimed) + " nodes but the refinement bits make " +
+                                             std::to_string(nodes)),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
 }  // namespace
 }  // namespace amc

@@ -176,6 +176,14 @@ Hierarchy parse_hierarchy(const std::string& bytes, const std::string& what) {
 
     // Replay the refinement bits breadth-first; every split must keep balance.
     const uint8_t* bits = reinterpret_cast<const uint8_t*>(in.take((uint64_t(node_count) + 7) / 8));
+    // Each refined node adds four: with the counts consistent, the forest is built in room made
+    // once for it (at most 8 nodes a byte of the file), not in vectors grown to twice its size.
+    uint64_t refined = 0;
+    for (uint32_t i = 0; i < node_count; ++i) refined += (bits[i / 8] >> (i % 8)) & 1;
+    if (uint64_t(base_triangles) + 4 * refined != node_count)
+        in.fail("header announces " + std::to_string(node_count) + " nodes but the refinement bits make " +
+                std::to_string(uint64_t(base_triangles) + 4 * refined));
+    h.reserve(node_count, uint64_t(base_vertices) + new_vertices);
     std::vector<NodeId> order;
     order.reserve(node_count);
     for (NodeId r = 0; r < h.root_count(); ++r) order.push_back(r);

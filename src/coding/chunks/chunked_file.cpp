@@ -68,6 +68,7 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<RootRange>& r
         for (size_t v = 0; v < vertex_of.size(); ++v)
             if (vertex_of[v] != kNoVertex) keys[v] = key_of_vertex[vertex_of[v]];
         codes[c] = encode_chunk(chunk, keys, seam, options.hierarchy, options.predictor, space, options.grid_contexts);
+        codes[c].bytes.shrink_to_fit();  // held until the file is written: without the slack of its growth
         nodes[c] = chunk.node_count();
     });
     ChunkedBlocks out;
