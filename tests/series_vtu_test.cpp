@@ -89,6 +89,17 @@ TEST(SeriesVtu, PvdCollectionsRoundTripAndBadOnesAreRefused) {
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("bad.pvd:2"), std::string::npos) << e.what();
     }
+    // As ParaView and meshio write them too: comments, single quotes, character references.
+    std::ofstream(dir + "/other.pvd") << "<?xml version=\"1.0\"?>\n<!-- <DataSet file=\"ghost.vtu\"/> -->\n"
+                                         "<VTKFile type='Collection' version='0.1'>\n<Collection>\n"
+                                         "<DataSet timestep='2.5' part='0' file='a&#38;b.vtu'/>\n<DataSet file=\"c.vtu\"/>\n"
+                                         "</Collection>\n</VTKFile>\n";
+    const std::vector<PvdEntry> other = read_pvd(dir + "/other.pvd");
+    ASSERT_EQ(other.size(), 2u);
+    EXPECT_EQ(other[0].file, "a&b.vtu");
+    EXPECT_EQ(other[0].time, 2.5);
+    EXPECT_EQ(other[1].file, "c.vtu");
+    EXPECT_EQ(other[1].time, 1.0);  // no timestep: the entry's index
     std::ofstream(dir + "/empty.pvd") << "<VTKFile type=\"Collection\"><Collection></Collection></VTKFile>";
     EXPECT_THROW(read_pvd(dir + "/empty.pvd"), Error);
     std::ofstream(dir + "/not.pvd") << "hello";

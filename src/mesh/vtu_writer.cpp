@@ -11,6 +11,7 @@
 
 #include "mesh/text_number.h"
 #include "mesh/vtk_types.h"
+#include "mesh/xml_tokenizer.h"
 #include "mesh/zlib_blocks.h"
 
 namespace amc {
@@ -71,26 +72,9 @@ void check_sizes(const std::vector<DataArray>& arrays, std::size_t tuples, const
     }
 }
 
-std::string escape_attribute(const std::string& s) {
-    std::string out;
-    for (char c : s) {
-        switch (c) {
-            case '&': out += "&amp;"; break;
-            case '<': out += "&lt;"; break;
-            case '>': out += "&gt;"; break;
-            case '"': out += "&quot;"; break;
-            case '\n': out += "&#10;"; break;
-            case '\t': out += "&#9;"; break;
-            case '\r': out += "&#13;"; break;
-            default: out += c;
-        }
-    }
-    return out;
-}
-
 std::string array_tag(const DataArray& a, const std::string& format_attributes) {
     std::string tag = "        <DataArray type=\"" + std::string(vtk_type_name(a.type())) + "\" Name=\"" +
-                      escape_attribute(a.name) + "\"";
+                      escape_xml_attribute(a.name) + "\"";
     if (a.components != 1) tag += " NumberOfComponents=\"" + std::to_string(a.components) + "\"";
     return tag + " " + format_attributes;
 }

@@ -1,7 +1,8 @@
 // A small pull tokenizer for the XML of VTK files: tags with attributes, and the text between
 // them, over a whole file held in memory. Declarations, processing instructions, comments and
 // DOCTYPE are skipped; attribute values have the five predefined entities and character
-// references decoded. Not a validating parser: nesting is the caller's business.
+// references decoded. Not a validating parser: nesting is the caller's business. The writers'
+// side is escape_xml_attribute.
 #pragma once
 
 #include <cstddef>
@@ -28,6 +29,10 @@ struct XmlToken {
     // The value of an attribute, or null when the tag has none of that name.
     const std::string* attribute(std::string_view attribute_name) const;
 };
+
+// `value` escaped to stand between double quotes as an attribute value (what the tokenizer decodes
+// back; line breaks and tabs as character references, so they survive attribute normalisation).
+std::string escape_xml_attribute(std::string_view value);
 
 class XmlTokenizer {
 public:

@@ -5,6 +5,8 @@
 #include <amc/series.h>
 
 #include "common/check.h"
+#include "common/file_io.h"
+#include "mesh/xml_tokenizer.h"
 
 #include <algorithm>
 #include <cmath>
@@ -17,66 +19,6 @@
 namespace amc {
 
 namespace {
-
-// The value of attribute `name` in one XML start tag (between its '<' and '>'), or "" if absent.
-std::string attribute(const std::string& tag, const std::string& name, bool& found) {
-    size_t pos = 0;
-    found = false;
-    while ((pos = tag.find(name, pos)) != std::string::npos) {
-        const bool starts_word = pos > 0 && (tag[pos - 1] == ' ' || tag[pos - 1] == '\t' || tag[pos - 1] == '\n' || tag[pos - 1] == '\r');
-        size_t p = pos + name.size();
-        while (p < tag.size() && (tag[p] == ' ' || tag[p] == '\t')) ++p;
-        if (starts_word && p < tag.size() && tag[p] == '=') {
-            ++p;
-            while (p < tag.size() && (tag[p] == ' ' || tag[p] == '\t')) ++p;
-            if (p < tag.size() && (tag[p] == '"' || tag[p] == '\'')) {
-                const size_t end = tag.find(tag[p], p + 1);
-                if (end != std::string::npos) {
-                    found = true;
-                    return tag.substr(p + 1, end - p - 1);
-                }
-            }
-        }
-        pos += name.size();
-    }
-    return "";
-}
-
-std::string xml_escape(const std::string& s) {
-    std::string out;
-    for (char c : s) {
-        switch (c) {
-            case '&': out += "&amp;"; break;
-            case '<': out += "&lt;"; break;
-            case '>': out += "&gt;"; break;
-            case '"': out += "&quot;"; break;
-            default: out += c;
-        }
-    }
-    return out;
-}
-
-std::string xml_unescape(const std::string& s) {
-    std::string out;
-    for (size_t i = 0; i < s.size(); ++i) {
-        if (s[i] != '&') {
-            out += s[i];
-            continue;
-        }
-        static const std::pair<const char*, char> entities[] = {{"&amp;", '&'}, {"&lt;", '<'}, {"&gt;", '>'},
-                                                                {"&quot;", '"'}, {"&apos;", '\''}};
-        bool matched = false;
-        for (const auto& [entity, c] : entities)
-            if (s.compare(i, std::strlen(entity), entity) == 0) {
-                out += c;
-                i += std::strlen(entity) - 1;
-                matched = true;
-                break;
-            }
-        if (!matched) out += '&';
-    }
-    return out;
-}
 
 template <class T>
 void copy_values(const std::vector<T>& in, Field& f) {
@@ -107,35 +49,32 @@ Field permuted(const Field& in, const std::vector<uint32_t>& map) {
 }  // namespace
 
 std::vector<PvdEntry> read_pvd(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    AMC_REQUIRE(in.good(), io, path + ": can not open");
-    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    AMC_REQUIRE(text.find("<VTKFile") != std::string::npos && text.find("Collection") != std::string::npos, bad_magic,
-                path + ": not a ParaView collection (.pvd): no <VTKFile type=\"Collection\">");
+    const std::string text = read_whole_file(path);
+    XmlTokenizer xml(text, path);
+    bool collection = false;
     std::vector<PvdEntry> entries;
-    size_t pos = 0;
-    while ((pos = text.find("<DataSet", pos)) != std::string::npos) {
-        const size_t end = text.find('>', pos);
-        const size_t line = 1 + size_t(std::count(text.begin(), text.begin() + long(pos), '\n'));
-        const std::string where = path + ":" + std::to_string(line) + ": ";
-        AMC_REQUIRE(end != std::string::npos, truncated, where + "unterminated <DataSet");
-        const std::string tag = text.substr(pos, end - pos);
-        bool has_file = false, has_time = false;
+    for (XmlToken tag = xml.next(); tag.kind != XmlToken::Kind::end_of_input; tag = xml.next()) {
+        if (tag.kind != XmlToken::Kind::start_tag) continue;
+        if (tag.name == "VTKFile") {
+            const std::string* type = tag.attribute("type");
+            collection = type && *type == "Collection";
+        }
+        if (tag.name != "DataSet" || !collection) continue;
+        const std::string where = path + ":" + std::to_string(xml.line_of(tag.begin)) + ": ";
+        const std::string* file = tag.attribute("file");
+        AMC_REQUIRE(file && !file->empty(), invalid_input, where + "a DataSet without a file");
         PvdEntry e;
-        e.file = xml_unescape(attribute(tag, "file", has_file));
-        const std::string time = attribute(tag, "timestep", has_time);
-        AMC_REQUIRE(has_file && !e.file.empty(), invalid_input, where + "a DataSet without a file");
-        if (has_time) {
+        e.file = *file;
+        e.time = double(entries.size());
+        if (const std::string* time = tag.attribute("timestep")) {
             char* stop = nullptr;
-            e.time = std::strtod(time.c_str(), &stop);
-            AMC_REQUIRE(stop != time.c_str() && *stop == '\0' && std::isfinite(e.time), invalid_input,
-                        where + "timestep \"" + time + "\" is not a number");
-        } else {
-            e.time = double(entries.size());
+            e.time = std::strtod(time->c_str(), &stop);
+            AMC_REQUIRE(stop != time->c_str() && *stop == '\0' && std::isfinite(e.time), invalid_input,
+                        where + "timestep \"" + *time + "\" is not a number");
         }
         entries.push_back(e);
-        pos = end;
     }
+    AMC_REQUIRE(collection, bad_magic, path + ": not a ParaView collection (.pvd): no <VTKFile type=\"Collection\">");
     AMC_REQUIRE(!entries.empty(), invalid_input, path + ": the collection lists no DataSet");
     return entries;
 }
@@ -146,7 +85,7 @@ void write_pvd(const std::string& path, const std::vector<PvdEntry>& entries) {
     out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
            "  <Collection>\n";
     for (const PvdEntry& e : entries)
-        out << "    <DataSet timestep=\"" << e.time << "\" group=\"\" part=\"0\" file=\"" << xml_escape(e.file) << "\"/>\n";
+        out << "    <DataSet timestep=\"" << e.time << "\" group=\"\" part=\"0\" file=\"" << escape_xml_attribute(e.file) << "\"/>\n";
     out << "  </Collection>\n</VTKFile>\n";
     write_file_atomically(path, out.str());
 }
