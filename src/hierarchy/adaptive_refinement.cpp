@@ -2,6 +2,8 @@
 // remesher is in surface_remeshing.cpp.
 #include <amc/refinement.h>
 
+#include "hierarchy/node_shape.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -20,19 +22,6 @@ struct Random {
     }
     size_t below(size_t n) { return size_t(next() % n); }
 };
-
-Vec3 centroid(const Hierarchy& h, NodeId n) {
-    return (1.0 / 3.0) * (h.position(h.vertex(n, 0)) + h.position(h.vertex(n, 1)) + h.position(h.vertex(n, 2)));
-}
-
-double diameter(const Hierarchy& h, NodeId n) {
-    double longest = 0;
-    for (int e = 0; e < 3; ++e) {
-        Vec3 d = h.position(h.vertex(n, e)) - h.position(h.vertex(n, (e + 1) % 3));
-        longest = std::max(longest, dot(d, d));
-    }
-    return std::sqrt(longest);
-}
 
 void push_children(const Hierarchy& h, const std::vector<NodeId>& split, std::vector<NodeId>& out) {
     for (NodeId s : split) {
@@ -80,7 +69,7 @@ void refine_to_size(Hierarchy& h, const std::function<double(Vec3)>& size_at, in
         const NodeId n = todo.back();
         todo.pop_back();
         if (!h.is_alive(n) || !h.is_leaf(n) || h.level(n) >= max_level) continue;
-        if (diameter(h, n) <= size_at(centroid(h, n))) continue;
+        if (node_diameter(h, n) <= size_at(node_centroid(h, n))) continue;
         split.clear();
         h.refine(n, &split);
         push_children(h, split, todo);
@@ -97,13 +86,26 @@ void coarsen_to_size(Hierarchy& h, const std::function<double(Vec3)>& size_at) {
         std::vector<NodeId> order = h.breadth_first_order();
         for (auto it = order.rbegin(); it != order.rend(); ++it) {
             const NodeId n = *it;
-            if (h.is_alive(n) && !h.is_leaf(n) && diameter(h, n) <= size_at(centroid(h, n)) && h.coarsen(n))
+            if (h.is_alive(n) && !h.is_leaf(n) && node_diameter(h, n) <= size_at(node_centroid(h, n)) && h.coarsen(n))
                 changed = true;
         }
     }
 }
 
 }  // namespace
+
+Vec3 node_centroid(const Hierarchy& h, NodeId n) {
+    return (1.0 / 3.0) * (h.position(h.vertex(n, 0)) + h.position(h.vertex(n, 1)) + h.position(h.vertex(n, 2)));
+}
+
+double node_diameter(const Hierarchy& h, NodeId n) {
+    double longest = 0;
+    for (int e = 0; e < 3; ++e) {
+        Vec3 d = h.position(h.vertex(n, e)) - h.position(h.vertex(n, (e + 1) % 3));
+        longest = std::max(longest, dot(d, d));
+    }
+    return std::sqrt(longest);
+}
 
 Hierarchy make_l_shape_model(int max_level, double size_scale) {
     Hierarchy h(make_l_shape(4));

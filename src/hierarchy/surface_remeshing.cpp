@@ -8,6 +8,7 @@
 #include "geometry/reference_surface.h"
 #include "geometry/shape_improvement.h"
 #include "geometry/surface_quality.h"
+#include "hierarchy/node_shape.h"
 #include "hierarchy/vertex_placement.h"
 
 #include <meshoptimizer.h>
@@ -42,19 +43,6 @@ constexpr uint64_t kSmallestBase = 50;
 constexpr double kSharpDegrees = 90.0;
 
 Vec3 round_to_float(Vec3 p) { return {double(float(p.x)), double(float(p.y)), double(float(p.z))}; }
-
-Vec3 centroid(const Hierarchy& h, NodeId n) {
-    return (1.0 / 3.0) * (h.position(h.vertex(n, 0)) + h.position(h.vertex(n, 1)) + h.position(h.vertex(n, 2)));
-}
-
-double diameter(const Hierarchy& h, NodeId n) {
-    double longest = 0;
-    for (int e = 0; e < 3; ++e) {
-        Vec3 d = h.position(h.vertex(n, e)) - h.position(h.vertex(n, (e + 1) % 3));
-        longest = std::max(longest, dot(d, d));
-    }
-    return std::sqrt(longest);
-}
 
 // ---- the base -------------------------------------------------------------------------------
 
@@ -333,9 +321,9 @@ Hierarchy remesh_adaptively(const TriangleMesh& reference, const SurfaceRemeshOp
     // Priority of a leaf: how far the flat element is from the surface, either measured (distance
     // of its centroid from the reference) or predicted (curvature times size).
     auto priority = [&](NodeId n) {
-        const auto hit = surface.faces().closest(centroid(h, n));
+        const auto hit = surface.faces().closest(node_centroid(h, n));
         if (options.criterion == RefinementCriterion::approximation_error) return std::sqrt(hit.distance_squared);
-        return std::fabs(interpolate_at(reference, curvature, hit)) * diameter(h, n);
+        return std::fabs(interpolate_at(reference, curvature, hit)) * node_diameter(h, n);
     };
 
     std::vector<NodeId> split;
