@@ -235,6 +235,11 @@ TEST(Mpi, BadInputFailsOnEveryRankAndWritesNothing) {
     message = error_of([&] { mpi::write(MPI_COMM_WORLD, path, r == 1 ? other : h.base(), first, forest); });
     EXPECT_NE(message.find("rank 1"), std::string::npos) << message;
     EXPECT_NE(message.find("base mesh"), std::string::npos) << message;
+    // A base vertex no triangle uses: refused as encode() refuses it (a chunked file would not decode).
+    TriangleMesh isolated = h.base();
+    isolated.positions.push_back({0.0, 0.0, -5.0});
+    message = error_of([&] { mpi::write(MPI_COMM_WORLD, path, isolated, first, forest); });
+    EXPECT_NE(message.find("not used by any triangle"), std::string::npos) << message;
     // The mixing mode, a numbering, a grid of too many bits.
     EncodeOptions mixed;
     mixed.hierarchy_contexts = HierarchyContexts::mixed;
