@@ -52,8 +52,8 @@ Quantizer quantizer_of(const Hierarchy& input, int bits, double& max_error) {
 // The lowest version that holds what the file holds (format_version.h).
 uint8_t file_version(bool grid_geometry, bool mixed_contexts, bool chunked, bool static_geometry, BaseConnectivityMode base_mode,
                      bool store_numbering) {
-    return grid_geometry                                 ? kGridGeometryVersion
-           : mixed_contexts                              ? kMixedContextsVersion
+    return mixed_contexts                                ? kSecondMixingVersion
+           : grid_geometry                               ? kGridGeometryVersion
            : chunked                                     ? kChunkedVersion
            : static_geometry                             ? kStaticGeometryVersion
            : base_mode == BaseConnectivityMode::angle ? kSearchedBaseVersion
@@ -298,7 +298,8 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     HierarchyLevelDecoder hierarchy(base, meta.hierarchy_header.data(), meta.hierarchy_header.size(),
                                     hierarchy_stream_version_of_file(reader.version()),
                                     std::min<uint64_t>(meta.nodes, options.max_nodes));
-    if (meta.options & kOptionMixedContexts) hierarchy.use_mixed_contexts();
+    if (meta.options & kOptionMixedContexts)
+        hierarchy.use_mixed_contexts(reader.version() >= kSecondMixingVersion ? MixingModel::second : MixingModel::first);
     Hierarchy& h = hierarchy.hierarchy();
     // The metadata's counts let the hierarchy grow in place, as far as the file's size warrants.
     const uint64_t reserved_nodes = std::min<uint64_t>(meta.nodes, meta.base_triangles + kReservedNodesPerFileByte * size);

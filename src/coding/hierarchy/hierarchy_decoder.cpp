@@ -162,8 +162,9 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder, uint64_t ma
         AMC_REQUIRE(h_.node_capacity() == level_base_ + n, invalid_input,
                     "hierarchy stream: the mixing mode decodes one level at a time");
         MixedHierarchyModel& mixed = *mixed_model_;
-        LevelNormals& normals = mixed_normals_;
-        normals.start_level(n);
+        LevelShapes& shapes = mixed_shapes_;
+        shapes.start_level(n);
+        const MixingModel model = mixed.model();
         const Hierarchy& h = h_;
         const NodeId base = level_base_;
         const Level& current = level_;
@@ -172,7 +173,7 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder, uint64_t ma
             [&](uint32_t i, int group) {
                 if (symbols_read == symbol_limit) return false;
                 ++symbols_read;
-                const bool bit = d.decode_with_probability(mixed.p16(mixed_features(h, base + i, current, i, group, normals)));
+                const bool bit = d.decode_with_probability(mixed.p16(mixed_features(h, base + i, current, i, group, shapes, model)));
                 mixed.update(bit);
                 return bit;
             },

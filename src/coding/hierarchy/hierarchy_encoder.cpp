@@ -32,7 +32,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
     std::vector<NodeId> ids, next_ids;
     std::vector<uint8_t> refined;
     RefinedNumbering numbering;
-    LevelNormals normals;  // mixing mode
+    LevelShapes shapes;  // mixing mode
     root_level(h, level, options.cull_one_regularity);
     ids.resize(h.root_count());
     for (NodeId r = 0; r < h.root_count(); ++r) ids[r] = r;
@@ -70,7 +70,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
                         std::to_string(kMaxLevel));
         if (options.cull_one_regularity && !uniform) stats.culled_one_regularity += level.incomplete_count;
         const uint8_t* truth = refined.data();
-        if (mixed_) normals.start_level(n);
+        if (mixed_) shapes.start_level(n);
         traversal.run(
             level, uniform,
             [&](uint32_t i, int group) {
@@ -78,7 +78,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
                 if (mixed_) {
                     if (event_feature_.size() < events_.size() + 1) event_feature_.resize(events_.size() + 1);
                     event_feature_[events_.size()] = uint32_t(mixed_features_.size());
-                    mixed_features_.push_back(mixed_features(h, ids[i], level, i, group, normals));
+                    mixed_features_.push_back(mixed_features(h, ids[i], level, i, group, shapes, kWrittenMixingModel));
                 }
                 events_.push_back({uint8_t(group), uint8_t(r)});
                 if (trace != nullptr) trace->push_back({ids[i], uint8_t(group), r});
@@ -156,7 +156,7 @@ void HierarchyLevelEncoder::encode_level(int l, ArithmeticEncoder& encoder) {
     ++next_level_;
     const size_t begin = l == 0 ? 0 : level_end_[size_t(l) - 1];
     if (mixed_) {
-        if (mixed_model_ == nullptr) mixed_model_ = std::make_unique<MixedHierarchyModel>();
+        if (mixed_model_ == nullptr) mixed_model_ = std::make_unique<MixedHierarchyModel>(kWrittenMixingModel);
         for_each_mixed(begin, level_end_[size_t(l)], models_, *mixed_model_, symbols_written_,
                        [&](BitModel* model, uint32_t p16, Event e) {
                            if (model != nullptr) encoder.encode_with_limit<kHierarchyModelLimit>(e.bit, *model);
@@ -167,6 +167,17 @@ void HierarchyLevelEncoder::encode_level(int l, ArithmeticEncoder& encoder) {
     for_each_coded(begin, level_end_[size_t(l)], models_, symbols_written_, [&](BitModel& model, Event e, size_t) {
         encoder.encode_with_limit<kHierarchyModelLimit>(e.bit, model);
     });
+}
+
+std::vector<std::pair<MixedFeatures, bool>> HierarchyLevelEncoder::mixed_symbols() const {
+    std::vector<std::pair<MixedFeatures, bool>> out;
+    if (!mixed_) return out;
+    HierarchyModels models;
+    uint64_t symbols = 0;
+    for_each_coded(0, events_.size(), models, symbols, [&](BitModel&, Event e, size_t k) {
+        if (e.group != kOrientationEvent) out.emplace_back(mixed_features_[event_feature_[k]], e.bit != 0);
+    });
+    return out;
 }
 
 HierarchyCodeStats HierarchyLevelEncoder::stats() const {
@@ -189,7 +200,7 @@ HierarchyCodeStats HierarchyLevelEncoder::stats() const {
         group.coded_bits += bits;
     };
     if (mixed_) {
-        MixedHierarchyModel mixed;
+        MixedHierarchyModel mixed(kWrittenMixingModel);
         for_each_mixed(0, end, models, mixed, symbols, [&](BitModel* model, uint32_t p16, Event e) {
             if (model != nullptr) {
                 tally(model->cost_bits(e.bit), e);

@@ -30,6 +30,9 @@ struct CodedSymbol {
     bool refined;
 };
 
+// The mixing mode's model that encoders write (.amc version 10).
+constexpr MixingModel kWrittenMixingModel = MixingModel::second;
+
 class HierarchyLevelEncoder {
 public:
     // Decides every node (first pass): fixes the uniform levels, the diagonal rule and the number
@@ -37,9 +40,9 @@ public:
     // older hierarchy stream version may be written for tests of the decoder's older paths.
     // `trace`, if given, receives every symbol the first pass decides by coding, in order (the
     // stream keeps the first stats().coded of them).
-    // `mixed`: the mixing mode (.amc version 8; FORMAT.md 2.1): symbols coded by
-    // MixedHierarchyModel from features of h's structure and positions, which must be the ones
-    // the decoder will have.
+    // `mixed`: the mixing mode (FORMAT.md 2.1-2.2): symbols coded by MixedHierarchyModel, in its
+    // newest model (kWrittenMixingModel), from features of h's structure and positions, which must
+    // be the ones the decoder will have.
     HierarchyLevelEncoder(const Hierarchy& h, const HierarchyCoderOptions& options,
                           uint8_t stream_version = kHierarchyStreamVersion, std::vector<CodedSymbol>* trace = nullptr,
                           bool mixed = false);
@@ -56,6 +59,8 @@ public:
     // Statistics of everything coded so far (all of it after the last level). payload_bytes and
     // header_bytes are left to the caller, who owns the arithmetic coder.
     HierarchyCodeStats stats() const;
+    // The mixing mode's coded symbols in order, each with its features (bench/mixing_study).
+    std::vector<std::pair<MixedFeatures, bool>> mixed_symbols() const;
 
 private:
     struct Event {
@@ -145,10 +150,10 @@ public:
     // The vertices the last decode_level created, as (node, edge) in canonical order at their
     // first appearance (new_vertices_of_level of its level's nodes), positions not yet set.
     const std::vector<std::pair<NodeId, int>>& new_vertices() const { return new_vertices_; }
-    // Switches to the mixing mode (.amc version 8; FORMAT.md 2.1) before the first level. Its
-    // features read the positions of hierarchy(): decode_level only, each level's new positions
-    // set before the next level is decoded.
-    void use_mixed_contexts() { mixed_model_ = std::make_unique<MixedHierarchyModel>(); }
+    // Switches to the mixing mode (FORMAT.md 2.1: `model` first for .amc versions 8-9, second from
+    // version 10) before the first level. Its features read the positions of hierarchy():
+    // decode_level only, each level's new positions set before the next level is decoded.
+    void use_mixed_contexts(MixingModel model) { mixed_model_ = std::make_unique<MixedHierarchyModel>(model); }
     // decode_level in two halves, for callers that want every decision before building: decide
     // the current level and move to the next (hierarchy() is not touched); then split every
     // decided level in hierarchy(). In between, node_count() and vertex_count() tell the size
@@ -192,7 +197,7 @@ private:
     int level_index_ = 0;
     uint64_t node_count_ = 0, vertex_count_ = 0, symbols_read_ = 0, leaf_faces_ = 0;
     std::unique_ptr<MixedHierarchyModel> mixed_model_;  // the mixing mode's state, or null
-    LevelNormals mixed_normals_;                        // the mixing mode's normals of the level
+    LevelShapes mixed_shapes_;                          // the mixing mode's normals and bending of the level
 };
 
 }  // namespace amc

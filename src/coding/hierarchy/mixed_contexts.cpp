@@ -57,18 +57,21 @@ double relative_displacement2(const Hierarchy& h, NodeId p, int e) {
 
 }  // namespace
 
-void LevelNormals::start_level(size_t nodes) {
+void LevelShapes::start_level(size_t nodes) {
     if (++current_ == 0) {  // wrapped: no stamp may look current
         std::fill(stamp_.begin(), stamp_.end(), 0u);
+        std::fill(bending_stamp_.begin(), bending_stamp_.end(), 0u);
         current_ = 1;
     }
     if (normal_.size() < nodes) {
         normal_.resize(nodes);
+        bending_.resize(nodes);
         stamp_.resize(nodes, 0u);
+        bending_stamp_.resize(nodes, 0u);
     }
 }
 
-Vec3 LevelNormals::get(const Hierarchy& h, NodeId node, uint32_t local) {
+Vec3 LevelShapes::normal(const Hierarchy& h, NodeId node, uint32_t local) {
     if (local >= normal_.size()) return unit_normal(h, node);
     if (stamp_[local] != current_) {
         normal_[local] = unit_normal(h, node);
@@ -77,7 +80,36 @@ Vec3 LevelNormals::get(const Hierarchy& h, NodeId node, uint32_t local) {
     return normal_[local];
 }
 
-MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, uint32_t i, int group, LevelNormals& normals) {
+LevelShapes::Bending LevelShapes::bending(const Hierarchy& h, NodeId n, uint32_t local, const Level& level) {
+    if (local < bending_.size() && bending_stamp_[local] == current_) return bending_[local];
+    // Chords between unit normals (2 sin of half the angle) times the edge lengths, over 4 times
+    // the area: a discrete mean curvature; times the longest edge.
+    const Neighbors nbr = with_links(level, [local](auto links) { return links.neighbors(local); });
+    const Vec3 own = normal(h, n, local);
+    const Vec3 a = h.position(h.vertex(n, 0)), b = h.position(h.vertex(n, 1)), c = h.position(h.vertex(n, 2));
+    const double twice_area = exact_length(exact_cross(b - a, c - a));
+    const Vec3 corner[3] = {a, b, c};
+    double chord_sum = 0, weighted = 0, longest = 0;
+    for (int e = 0; e < 3; ++e) {
+        const double len = exact_length(corner[(e + 1) % 3] - corner[e]);
+        longest = std::max(longest, len);
+        const NodeId q = h.neighbor(n, e);
+        if (q == kNoNode) continue;
+        // nbr.nbr[e] is q's local index (the level's neighbour across e, as h's).
+        const double chord = exact_length(own - (nbr.nbr[e] != kNoLocal ? normal(h, q, nbr.nbr[e]) : unit_normal(h, q)));
+        chord_sum += chord;
+        weighted += rounded(chord * len);
+    }
+    const Bending value{chord_sum, twice_area > 0 ? rounded(weighted * longest) / (2 * twice_area) : 0};
+    if (local < bending_.size()) {
+        bending_[local] = value;
+        bending_stamp_[local] = current_;
+    }
+    return value;
+}
+
+MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, uint32_t i, int group, LevelShapes& shapes,
+                             MixingModel model) {
     MixedFeatures f{};
     f.group = uint8_t(group);
     const int l = h.level(n);
@@ -133,26 +165,26 @@ MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, u
         f.disp = uint8_t(half_octave_bin(near, 34, 23));
         f.disp_parent = uint8_t(half_octave_bin(all, 34, 23));
     }
-    // Bending towards the same-level neighbours: chords between unit normals (2 sin of half the
-    // angle), summed; and a discrete mean curvature, sum of chord * edge length / (4 area), times
-    // the longest edge.
-    const Vec3 normal = normals.get(h, n, i);
-    const Vec3 a = h.position(h.vertex(n, 0)), b = h.position(h.vertex(n, 1)), c = h.position(h.vertex(n, 2));
-    const double twice_area = exact_length(exact_cross(b - a, c - a));
-    const Vec3 corner[3] = {a, b, c};
-    double chord_sum = 0, weighted = 0, longest = 0;
-    for (int e = 0; e < 3; ++e) {
-        const double len = exact_length(corner[(e + 1) % 3] - corner[e]);
-        longest = std::max(longest, len);
-        const NodeId q = h.neighbor(n, e);
-        if (q == kNoNode) continue;
-        // nbr.nbr[e] is q's local index (the level's neighbour across e, as h's).
-        const double chord = exact_length(normal - (nbr.nbr[e] != kNoLocal ? normals.get(h, q, nbr.nbr[e]) : unit_normal(h, q)));
-        chord_sum += chord;
-        weighted += rounded(chord * len);
+    // Bending towards the same-level neighbours (LevelShapes::bending).
+    const LevelShapes::Bending bending = shapes.bending(h, n, i, level);
+    f.bend_sum = uint8_t(half_octave_bin(bending.chord_sum, 30, 31));
+    const double curvature = bending.curvature;
+    f.mean_curv = uint8_t(quarter_octave_bin(curvature, 40, 63));
+    if (model == MixingModel::second) {
+        // The same over the node and its same-level neighbours in the level: largest and mean.
+        double largest = curvature, sum = curvature;
+        int count = 1;
+        for (int e = 0; e < 3; ++e) {
+            const NodeId q = h.neighbor(n, e);
+            if (q == kNoNode || nbr.nbr[e] == kNoLocal) continue;
+            const double c = shapes.bending(h, q, nbr.nbr[e], level).curvature;
+            largest = std::max(largest, c);
+            sum += c;
+            ++count;
+        }
+        f.ring_max = uint8_t(quarter_octave_bin(largest, 40, 63));
+        f.ring_mean = uint8_t(quarter_octave_bin(sum / count, 40, 63));
     }
-    f.bend_sum = uint8_t(half_octave_bin(chord_sum, 30, 31));
-    f.mean_curv = twice_area > 0 ? uint8_t(quarter_octave_bin(rounded(weighted * longest) / (2 * twice_area), 40, 63)) : 0;
     return f;
 }
 
@@ -164,52 +196,115 @@ constexpr int kMapRate = 7;
 constexpr uint32_t kContextSizes[MixedHierarchyModel::kInputs] = {10,  40,   40,   80,   50,  120,
                                                                     240, 960, 1920, 2560, 640, 10240, 3840, 200, 400, 480};
 
+// The second model's (FORMAT.md 2.2): direct models 16-20 and the bit histories' maps.
+constexpr uint32_t kSecondContextSizes[MixedHierarchyModel::kHistoryInputs + MixedHierarchyModel::kRingInputs] = {
+    160, 640, 2560, 640, 5120};
+constexpr int kIndirectOf[MixedHierarchyModel::kIndirectInputs] = {1, 4, 11};  // the direct contexts with bit histories
+constexpr int kHistoryMapLog2 = 6;
+constexpr int kMapContexts[MixedHierarchyModel::kMaps] = {kContextGroupCount * 4, kContextGroupCount * 64, 24 * 8,
+                                                          kContextGroupCount * 256, kContextGroupCount * 5 * 4};
+
+// A context's bit history after `bit`: its last bits, at most 7, below a leading 1.
+uint8_t next_history(uint8_t history, bool bit) {
+    const int shifted = history * 2 + int(bit);
+    return uint8_t(history < 128 ? shifted : 128 + (shifted & 127));
+}
+
 }  // namespace
 
-MixedHierarchyModel::MixedHierarchyModel()
-    : mixer_(kInputs + 1, kContextGroupCount, kMixerRate),
-      by_level_(kInputs + 1, 16, kMixerRate),
-      by_displacement_(kInputs + 1, 24, kMixerRate),
-      apm_(kContextGroupCount * 4, kMapRate) {
+MixedHierarchyModel::MixedHierarchyModel(MixingModel model)
+    : model_(model),
+      mixer_a_((model == MixingModel::first ? kInputs : kSecondInputs) + 1, kContextGroupCount, kMixerRate),
+      mixer_b_((model == MixingModel::first ? kInputs : kSecondInputs) + 1, 16, kMixerRate),
+      mixer_c_((model == MixingModel::first ? kInputs : kSecondInputs) + 1, model == MixingModel::first ? 24 : kContextGroupCount * 16,
+             kMixerRate) {
     for (int j = 0; j < kInputs; ++j) models_[size_t(j)].assign(kContextSizes[j], BitModel(kModelWindowLog2));
+    if (model == MixingModel::first) {
+        maps_.emplace_back(kContextGroupCount * 4, kMapRate);
+        return;
+    }
+    for (int j = kInputs; j < kDirect; ++j) models_[size_t(j)].assign(kSecondContextSizes[j - kInputs], BitModel(kModelWindowLog2));
+    for (int k = 0; k < kIndirectInputs; ++k) {
+        histories_[size_t(k)].assign(kContextSizes[kIndirectOf[k]], uint8_t{1});
+        history_maps_[size_t(k)].assign(size_t(kContextGroupCount) * 256, BitModel(kHistoryMapLog2));
+    }
+    for (int m = 0; m < kMaps; ++m) maps_.emplace_back(kMapContexts[m], kMapRate);
 }
 
 uint32_t MixedHierarchyModel::p16(const MixedFeatures& f) {
     const uint32_t g = f.group;
-    slot_ = {g,
-             g * 4 + f.inner,
-             g * 4 + f.parent_nbrs,
-             g * 8 + f.level,
-             g * 5 + f.ring2,
-             (g * 3 + f.parent_far) * 4 + f.parent_sibs,
-             g * 24 + f.disp,
-             (g * 24 + f.disp_parent) * 4 + f.inner,
-             (g * 24 + f.disp) * 8 + f.level,
-             (g * 32 + f.bend_sum) * 8 + f.level,
-             g * 64 + f.mean_curv,
-             ((g * 64 + f.mean_curv) * 8 + f.level) * 2 + f.center,
-             (g * 24 + f.disp) * 16 + f.mean_curv / 4u,
-             (g * 5 + f.ring2) * 4 + f.inner,
-             (g * 5 + f.ring2) * 8 + f.level,
-             ((g * 4 + f.parent_nbrs) * 3 + f.parent_far) * 4 + f.inner};
+    std::copy_n(std::array<uint32_t, kInputs>{g,
+                                              g * 4 + f.inner,
+                                              g * 4 + f.parent_nbrs,
+                                              g * 8 + f.level,
+                                              g * 5 + f.ring2,
+                                              (g * 3 + f.parent_far) * 4 + f.parent_sibs,
+                                              g * 24 + f.disp,
+                                              (g * 24 + f.disp_parent) * 4 + f.inner,
+                                              (g * 24 + f.disp) * 8 + f.level,
+                                              (g * 32 + f.bend_sum) * 8 + f.level,
+                                              g * 64 + f.mean_curv,
+                                              ((g * 64 + f.mean_curv) * 8 + f.level) * 2 + f.center,
+                                              (g * 24 + f.disp) * 16 + f.mean_curv / 4u,
+                                              (g * 5 + f.ring2) * 4 + f.inner,
+                                              (g * 5 + f.ring2) * 8 + f.level,
+                                              ((g * 4 + f.parent_nbrs) * 3 + f.parent_far) * 4 + f.inner}
+                    .begin(),
+                kInputs, slot_.begin());
     for (int j = 0; j < kInputs; ++j) st_[size_t(j)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
+    if (model_ == MixingModel::second) return uint32_t(second_model_p12(f)) << 4;
     st_[kInputs] = 256;  // bias
     // Three weight sets chosen by different contexts, averaged in the stretched domain.
-    const int s1 = mixing::stretch(mixer_.mix(st_.data(), int(g)));
-    const int s2 = mixing::stretch(by_level_.mix(st_.data(), f.level * 2 + f.center));
-    const int s3 = mixing::stretch(by_displacement_.mix(st_.data(), f.disp));
+    const int s1 = mixing::stretch(mixer_a_.mix(st_.data(), int(g)));
+    const int s2 = mixing::stretch(mixer_b_.mix(st_.data(), f.level * 2 + f.center));
+    const int s3 = mixing::stretch(mixer_c_.mix(st_.data(), f.disp));
     p_mix_ = mixing::squash((s1 + s2 + s3) / 3);
-    const int refined = apm_.refine(p_mix_, int(g * 4 + f.inner));
+    map_context_[0] = int(g * 4 + f.inner);
+    const int refined = maps_[0].refine(p_mix_, map_context_[0]);
     const int p = std::clamp((p_mix_ * 2 + refined * 2 + 2) >> 2, 1, 4095);
     return uint32_t(p) << 4;
 }
 
+int MixedHierarchyModel::second_model_p12(const MixedFeatures& f) {
+    const uint32_t g = f.group;
+    const uint32_t last4 = last_bits_ & 15;
+    slot_[kInputs] = g * 16 + last4;
+    slot_[kInputs + 1] = (g * 4 + f.inner) * 16 + last4;
+    slot_[kInputs + 2] = (g * 64 + f.mean_curv) * 4 + (last_bits_ & 3);
+    slot_[kInputs + 3] = g * 64 + f.ring_max;
+    slot_[kInputs + 4] = (g * 64 + f.ring_mean) * 8 + f.level;
+    for (int j = kInputs; j < kDirect; ++j) st_[size_t(j)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
+    for (int k = 0; k < kIndirectInputs; ++k) {
+        history_context_[size_t(k)] = slot_[size_t(kIndirectOf[k])];
+        history_map_slot_[size_t(k)] = g * 256 + histories_[size_t(k)][history_context_[size_t(k)]];
+        st_[size_t(kDirect + k)] = mixing::stretch(mixing::p12_of(history_maps_[size_t(k)][history_map_slot_[size_t(k)]]));
+    }
+    st_[kSecondInputs] = 256;  // bias
+    const int s1 = mixing::stretch(mixer_a_.mix(st_.data(), int(g)));
+    const int s2 = mixing::stretch(mixer_b_.mix(st_.data(), f.ring_mean / 4));
+    const int s3 = mixing::stretch(mixer_c_.mix(st_.data(), int(g * 16 + last4)));
+    p_mix_ = mixing::squash((s1 + s2 + s3) / 3);
+    map_context_ = {int(g * 4 + f.inner), int(g * 64 + f.mean_curv), int(f.disp * 8 + f.level), int(g * 256 + (last_bits_ & 255)),
+                    int((g * 5 + f.ring2) * 4 + f.parent_nbrs)};
+    int refined = 0;
+    for (int m = 0; m < kMaps; ++m) refined += maps_[size_t(m)].refine(p_mix_, map_context_[size_t(m)]);
+    return std::clamp((p_mix_ + (refined / kMaps) * 3 + 2) >> 2, 1, 4095);
+}
+
 void MixedHierarchyModel::update(bool bit) {
-    mixer_.update(st_.data(), bit);
-    by_level_.update(st_.data(), bit);
-    by_displacement_.update(st_.data(), bit);
-    apm_.update(bit);
-    for (int j = 0; j < kInputs; ++j) models_[size_t(j)][slot_[size_t(j)]].update(bit);
+    mixer_a_.update(st_.data(), bit);
+    mixer_b_.update(st_.data(), bit);
+    mixer_c_.update(st_.data(), bit);
+    for (mixing::ProbabilityMap& map : maps_) map.update(bit);
+    const int direct = model_ == MixingModel::first ? kInputs : kDirect;
+    for (int j = 0; j < direct; ++j) models_[size_t(j)][slot_[size_t(j)]].update(bit);
+    if (model_ == MixingModel::first) return;
+    for (int k = 0; k < kIndirectInputs; ++k) {
+        history_maps_[size_t(k)][history_map_slot_[size_t(k)]].update(bit);
+        uint8_t& history = histories_[size_t(k)][history_context_[size_t(k)]];
+        history = next_history(history, bit);
+    }
+    last_bits_ = (last_bits_ << 1) | uint32_t(bit);
 }
 
 }  // namespace amc

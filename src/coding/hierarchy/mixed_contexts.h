@@ -1,8 +1,9 @@
-// The hierarchy coder's mixing mode (.amc version 8, docs/FORMAT.md section 2.1): each coded
-// symbol's probability comes from twelve adaptive models under contexts richer than the paper's
-// groups — the node's structure one level up, its decided neighbours and their neighbours, and
-// the decoded geometry around it — mixed by logistic mixing (context_mixing.h) and refined by an
-// adaptive probability map. Measured in docs/HIERARCHY_CODER.md, "Contexts beyond Table 2".
+// The hierarchy coder's mixing mode (.amc version 8, docs/FORMAT.md section 2.1; its second model,
+// version 10, section 2.2): each coded symbol's probability comes from adaptive models under
+// contexts richer than the paper's groups — the node's structure one level up, its decided
+// neighbours and their neighbours, and the decoded geometry around it — mixed by logistic mixing
+// (context_mixing.h) and refined by adaptive probability maps. Measured in
+// docs/HIERARCHY_CODER.md, "Contexts beyond Table 2".
 #pragma once
 
 #include "coding/entropy/arithmetic_coder.h"
@@ -16,6 +17,10 @@
 #include <vector>
 
 namespace amc {
+
+// Which model of the mixing mode a stream is coded with: version 8's (FORMAT.md 2.1), or version
+// 10's (2.2), which adds the last coded bits, bit histories and the curvature of the neighbours.
+enum class MixingModel : uint8_t { first = 1, second = 2 };
 
 // What the decoder knows of a node when its symbol comes.
 struct MixedFeatures {
@@ -31,46 +36,76 @@ struct MixedFeatures {
     uint8_t disp_parent;  // the same over the parent's three midpoints
     uint8_t bend_sum;     // log bin of the summed normal chords to the same-level neighbours, 0..31
     uint8_t mean_curv;    // log bin of a discrete mean curvature times the longest edge, 0..63
+    uint8_t ring_max;     // second model: the largest of mean_curv's value over the node and its neighbours, binned alike
+    uint8_t ring_mean;    // second model: their mean, binned alike
 };
 
-// The unit normals of one level's nodes by local index, each computed once: the bending features
-// read the normal of every coded node and of its same-level neighbours, so without this each
-// normal was computed up to four times. start_level forgets the previous level's (the decoder
-// reuses node ids from stream to stream).
-class LevelNormals {
+// The unit normals and curvatures of one level's nodes by local index, each computed once: the
+// bending features read the normal of every coded node and of its same-level neighbours, so
+// without this each normal was computed up to four times (and the second model's ring features
+// read the neighbours' curvatures). start_level forgets the previous level's (the decoder reuses
+// node ids from stream to stream).
+class LevelShapes {
 public:
     void start_level(size_t nodes);
     // The unit normal of node `node` (local index `local` of the current level); zero for a
     // degenerate triangle.
-    Vec3 get(const Hierarchy& h, NodeId node, uint32_t local);
+    Vec3 normal(const Hierarchy& h, NodeId node, uint32_t local);
+    // bend_sum's and mean_curv's values before binning (mixed_features): the summed chords
+    // between the node's unit normal and its same-level neighbours', and a discrete mean curvature
+    // of the node times its longest edge (0 for a degenerate triangle).
+    struct Bending {
+        double chord_sum, curvature;
+    };
+    Bending bending(const Hierarchy& h, NodeId node, uint32_t local, const Level& level);
 
 private:
     std::vector<Vec3> normal_;
-    std::vector<uint32_t> stamp_;  // normal_[i] is this level's when stamp_[i] == current_
+    std::vector<Bending> bending_;
+    std::vector<uint32_t> stamp_, bending_stamp_;  // normal_[i] is this level's when stamp_[i] == current_
     uint32_t current_ = 0;
 };
 
 // The features of node `n` of `h` (coarser levels whole, n's corners placed) that do not depend
 // on the traversal, and those that do from the level's state bytes: `i` is n's local index in
-// `level`, whose neighbours' states are as decided so far. `normals` is started on `level`.
-MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, uint32_t i, int group, LevelNormals& normals);
+// `level`, whose neighbours' states are as decided so far. `shapes` is started on `level`. The
+// ring features are computed for the second model only.
+MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, uint32_t i, int group, LevelShapes& shapes,
+                             MixingModel model);
 
 // The models, mixer and probability map of the mixing mode; one per stream, persisting from level
 // to level.
 class MixedHierarchyModel {
 public:
-    static constexpr int kInputs = 16;
-    MixedHierarchyModel();
+    static constexpr int kInputs = 16;         // the first model's direct models
+    static constexpr int kHistoryInputs = 3;   // the second model's direct models of the last coded bits
+    static constexpr int kRingInputs = 2;      // and of the neighbours' curvature
+    static constexpr int kDirect = kInputs + kHistoryInputs + kRingInputs;
+    static constexpr int kIndirectInputs = 3;  // bit histories of three direct contexts
+    static constexpr int kSecondInputs = kDirect + kIndirectInputs;
+    static constexpr int kMaps = 5;            // the second model's probability maps
+    explicit MixedHierarchyModel(MixingModel model = MixingModel::first);
+    MixingModel model() const { return model_; }
     // The 16-bit probability of a one for a symbol with these features (remembered for update).
     uint32_t p16(const MixedFeatures& f);
     void update(bool bit);
 
 private:
-    std::array<std::vector<BitModel>, kInputs> models_;
-    std::array<uint32_t, kInputs> slot_{};
-    std::array<int, kInputs + 1> st_{};
-    mixing::Mixer mixer_, by_level_, by_displacement_;
-    mixing::ProbabilityMap apm_;
+    int second_model_p12(const MixedFeatures& f);
+
+    MixingModel model_;
+    std::array<std::vector<BitModel>, kDirect> models_;
+    std::array<uint32_t, kDirect> slot_{};
+    std::array<int, kSecondInputs + 1> st_{};  // stretched inputs, then the bias
+    // Second model: per context of direct models 1, 4 and 11 its last bits (up to 7, led by a 1),
+    // and per such input an adaptive probability of each group x history.
+    std::array<std::vector<uint8_t>, kIndirectInputs> histories_;
+    std::array<std::vector<BitModel>, kIndirectInputs> history_maps_;
+    std::array<uint32_t, kIndirectInputs> history_context_{}, history_map_slot_{};
+    uint32_t last_bits_ = 0;  // the stream's coded bits, the newest lowest
+    mixing::Mixer mixer_a_, mixer_b_, mixer_c_;  // FORMAT.md's mixers A, B, C
+    std::vector<mixing::ProbabilityMap> maps_;
+    std::array<int, kMaps> map_context_{};
     int p_mix_ = 2048;
 };
 
