@@ -6,8 +6,9 @@
 //     (base connectivity + hierarchy stream of the .amc file) against the true hierarchy's.
 // Prints a Markdown table. Exit status 1 if any import with the base is not identical.
 //
-// Usage: import_corpus [--move X] [--with-base-only] corpus/*.amh   (scripts/import_corpus.sh makes
-// the corpus; --with-base-only skips import_mesh and leaves its columns empty)
+// Usage: import_corpus [--move X] [--with-base-only] [--hash] corpus/*.amh   (scripts/import_corpus.sh
+// makes the corpus; --with-base-only skips import_mesh and leaves its columns empty; --hash prints,
+// to stderr, a hash of each detected hierarchy's .amc file, to tell a changed search's output apart)
 #include "user_leaf_mesh.h"
 
 #include <amc/codec.h>
@@ -28,6 +29,13 @@ double thread_seconds() {
     return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
+// FNV-1a of a byte string.
+uint64_t fnv1a(const std::vector<uint8_t>& bytes) {
+    uint64_t hash = 14695981039346656037ull;
+    for (uint8_t byte : bytes) hash = (hash ^ byte) * 1099511628211ull;
+    return hash;
+}
+
 uint64_t connectivity_bytes(const amc::Hierarchy& h) {
     amc::EncodeStats stats;
     amc::encode(h, {}, &stats);
@@ -38,7 +46,7 @@ uint64_t connectivity_bytes(const amc::Hierarchy& h) {
 
 int main(int argc, char** argv) {
     double move = 0.3;
-    bool detect = true;
+    bool detect = true, hash = false;
     std::vector<std::string> files;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
@@ -46,6 +54,8 @@ int main(int argc, char** argv) {
             move = std::atof(argv[++i]);
         } else if (arg == "--with-base-only") {
             detect = false;
+        } else if (arg == "--hash") {
+            hash = true;
         } else {
             files.push_back(arg);
         }
@@ -97,6 +107,7 @@ int main(int argc, char** argv) {
         const amc::ImportedHierarchy detected = amc::import_mesh(user);
         const double detect_seconds = thread_seconds() - start;
         const uint64_t truth = connectivity_bytes(h), found = connectivity_bytes(detected.hierarchy);
+        if (hash) std::fprintf(stderr, "%s %016llx\n", name.c_str(), (unsigned long long)fnv1a(amc::encode(detected.hierarchy)));
         std::printf("| %s | %zu | %zu | %s | %.2f | %s | %u | %llu | %llu | %.3f | %.2f |\n", name.c_str(),
                     leaf.mesh.triangles.size(), h.base().triangles.size(), with_base.c_str(), with_base_seconds, rate,
                     detected.hierarchy.root_count(), (unsigned long long)truth, (unsigned long long)found,
