@@ -8,6 +8,18 @@
 
 namespace amc::detail::inverse {
 
+namespace {
+
+// More than one invalid block in this many: a wrong reading, not a true patch with a few wrong
+// turns. Such a patch is not repaired, and a growth that shows that share is given up.
+constexpr uint32_t kRepairableShare = 16;
+// Settled blocks before a growth is judged by its share: a smaller sample misjudges.
+constexpr uint32_t kJudgedAfter = 512;
+// Settled blocks before an exploring growth is judged by its seed block.
+constexpr uint32_t kSeedJudgedAfter = 128;
+
+}  // namespace
+
 size_t LevelFinder::commit(const std::vector<uint8_t>* active) {
     const size_t first = patches_.size();
     std::vector<uint32_t> seeds;
@@ -125,7 +137,6 @@ uint32_t LevelFinder::grow_patch(uint32_t t, Preference preference, bool explori
 }
 
 void LevelFinder::collect_suspects(uint32_t start, std::vector<uint32_t>& suspects) const {
-    constexpr size_t kRepairableShare = 16;  // at most one block in 16 invalid
     std::vector<uint32_t> invalid;
     for (uint32_t i = start; i < blocks_.size(); ++i) {
         if (sides_valid(i)) continue;
@@ -157,7 +168,14 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
     constexpr uint32_t kRepairable = 16;  // blocks: smaller patches are taken or dropped whole
     const uint32_t start = uint32_t(blocks_.size());
     if (!place_block(t)) return 0;
+    uint32_t settled = start, settled_invalid = 0;
     for (uint32_t next = start; next < blocks_.size(); ++next) {
+        while (settled < start + (next - start) / 2) settled_invalid += !sides_valid(settled++);
+        if (hopeless(start, settled, settled_invalid, exploring)) {
+            mark_explored(start, preference, exploring);
+            roll_back(start);
+            return 0;
+        }
         for (int i = 0; i < 3; ++i) {
             const Fan fan = walk_fan(blocks_[next], i);
             if (fan.kind != Fan::triangles || block_of_[fan.triangle[1]] != kNoIndex) continue;
@@ -171,12 +189,7 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
             }
         }
     }
-    // Growth from any center of this patch would give the same patch under this preference:
-    // those centers need not seed again (this keeps the search linear).
-    if (exploring) {
-        const uint8_t bit = uint8_t(1u << int(preference));
-        for (uint32_t i = start; i < blocks_.size(); ++i) covered_[blocks_[i].center] |= bit;
-    }
+    mark_explored(start, preference, exploring);
     for (uint32_t i = start; i < blocks_.size(); ++i) {
         if (!sides_valid(i)) {
             if (suspects && blocks_.size() - start >= kRepairable) collect_suspects(start, *suspects);
@@ -199,6 +212,21 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
         }
     }
     return removed;
+}
+
+bool LevelFinder::hopeless(uint32_t start, uint32_t settled, uint32_t settled_invalid, bool exploring) const {
+    const uint32_t count = settled - start;
+    if (count >= kJudgedAfter && settled_invalid * kRepairableShare > count) return true;
+    // An invalid seed block: this seed misreads a patch that seeds inside it read right.
+    return exploring && count == kSeedJudgedAfter && !sides_valid(start);
+}
+
+void LevelFinder::mark_explored(uint32_t start, Preference preference, bool exploring) {
+    // Growth from any center of this patch would give the same patch under this preference:
+    // those centers need not seed again (this keeps the seeds linear).
+    if (!exploring) return;
+    const uint8_t bit = uint8_t(1u << int(preference));
+    for (uint32_t i = start; i < blocks_.size(); ++i) covered_[blocks_[i].center] |= bit;
 }
 
 Candidate LevelFinder::best_patch(uint32_t t, bool exploring) {

@@ -196,12 +196,23 @@ private:
     // (docs/IMPORT.md, "Bottom-up, measured against the truth"): the blocks that stand where the
     // invalid sides need a block of their own are banned as centers and the patch is grown again
     // from the same seed, at most kRepairs times, so a seed costs at most kRepairs + 1 growths.
+    // A growth is given up as soon as it is hopeless, so most wrong readings stop after a few
+    // hundred to a few thousand blocks instead of covering the level.
     uint32_t grow_patch(uint32_t t, Preference preference, bool exploring = false);
 
     // The blocks of an invalid patch [start, end) that stand in the way of its invalid sides: the
     // blocks holding a triangle of the fan across an invalid side, and those that made a vertex
     // of the block that would fit across it a midpoint; failing those, the invalid blocks.
     void collect_suspects(uint32_t start, std::vector<uint32_t>& suspects) const;
+
+    // Whether a growth from blocks_[start] is sure enough to fail that growing it further is
+    // wasted: of its `settled` blocks (the first half of those placed, whose sides the breadth-
+    // first front has passed, so they rarely read differently later), too many are invalid, or,
+    // exploring, the seed block itself is. docs/IMPORT.md, "Why import_mesh was slow".
+    bool hopeless(uint32_t start, uint32_t settled, uint32_t settled_invalid, bool exploring) const;
+
+    // Marks the centers of the growth from blocks_[start] as explored under `preference`.
+    void mark_explored(uint32_t start, Preference preference, bool exploring);
 
     uint32_t grow_patch_once(uint32_t t, Preference preference, bool exploring, std::vector<uint32_t>* suspects);
 
