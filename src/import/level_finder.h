@@ -208,7 +208,7 @@ private:
     // Whether a growth from blocks_[start] is sure enough to fail that growing it further is
     // wasted: of its `settled` blocks (the first half of those placed, whose sides the breadth-
     // first front has passed, so they rarely read differently later), too many are invalid, or,
-    // exploring, the seed block itself is. docs/IMPORT.md, "Why import_mesh was slow".
+    // exploring, the seed block itself is. docs/IMPORT.md, "Hopeless growths given up".
     bool hopeless(uint32_t start, uint32_t settled, uint32_t settled_invalid, bool exploring) const;
 
     // Marks the centers of the growth from blocks_[start] as explored under `preference`.
