@@ -136,6 +136,10 @@ private:
     uint32_t step_one_corner(uint32_t t);
     bool flatten(NodeId node, std::vector<uint8_t>& moved);
     std::vector<uint32_t> follow_stepped();
+    // The stepped vertices on edges that end at `id` may now be off their step.
+    void unsettle_dependents(VertexId id) {
+        for (uint32_t i = dependent_start_[id]; i < dependent_start_[id + 1]; ++i) unsettled_.insert(dependents_[i]);
+    }
 
     Hierarchy& h_;
     Placements& placements_;
@@ -149,6 +153,9 @@ private:
     std::vector<Vec3> flat_;                // every leaf vertex in the flat subdivision of the base
     std::unordered_map<Vec3, uint32_t, PositionHash> count_at_;
     std::set<VertexId> stepped_;            // placed vertices with a step, coarse to fine
+    std::vector<uint32_t> dependent_start_;  // the placed vertices on edges that end at each vertex
+    std::vector<VertexId> dependents_;
+    std::set<VertexId> unsettled_;  // vertices that may be off their step: flattened, or an edge end moved
 };
 
 LeafCorrection::LeafCorrection(Hierarchy& h, Placements& placements, const ReferenceSurface& surface, double min_quality)
@@ -191,6 +198,20 @@ LeafCorrection::LeafCorrection(Hierarchy& h, Placements& placements, const Refer
     }
     flat_.resize(id_of_.size());
     for (uint32_t v = 0; v < id_of_.size(); ++v) flat_[v] = flat_by_id[id_of_[v]];
+    dependent_start_.assign(h.positions().size() + 1, 0);
+    for (VertexId id = 0; id < h.positions().size(); ++id)
+        if (placements_.is_placed(id)) {
+            ++dependent_start_[placements_.end_a[id] + 1];
+            ++dependent_start_[placements_.end_b[id] + 1];
+        }
+    for (size_t id = 0; id + 1 < dependent_start_.size(); ++id) dependent_start_[id + 1] += dependent_start_[id];
+    dependents_.resize(dependent_start_.back());
+    std::vector<uint32_t> next(dependent_start_.begin(), dependent_start_.end() - 1);
+    for (VertexId id = 0; id < h.positions().size(); ++id)
+        if (placements_.is_placed(id)) {
+            dependents_[next[placements_.end_a[id]]++] = id;
+            dependents_[next[placements_.end_b[id]]++] = id;
+        }
 }
 
 CorrectionResult LeafCorrection::run() {
@@ -361,6 +382,7 @@ uint32_t LeafCorrection::step_one_corner(uint32_t t) {
     placements_.step[id] = uint8_t(best_step);
     stepped_.insert(id);
     move(best_vertex, stepped_position(id, best_step));
+    unsettle_dependents(id);
     return best_vertex;
 }
 
@@ -373,6 +395,7 @@ bool LeafCorrection::flatten(NodeId node, std::vector<uint8_t>& moved) {
             if (!movable(id)) continue;
             placements_.step[id] = Placements::kSteps;
             stepped_.insert(id);
+            unsettled_.insert(id);
             moved[id] = 1;
             any = true;
         }
@@ -382,15 +405,19 @@ bool LeafCorrection::flatten(NodeId node, std::vector<uint8_t>& moved) {
 }
 
 // Puts every stepped vertex at its step from its edge's midpoint as the edge is now, coarse to
-// fine; returns the leaf vertices that moved.
+// fine (an id is larger than its edge's ends'); returns the leaf vertices that moved. Only the
+// unsettled ones can be off their step, so the pass costs what moved, not every stepped vertex.
 std::vector<uint32_t> LeafCorrection::follow_stepped() {
     std::vector<uint32_t> changed;
-    for (VertexId id : stepped_) {
-        if (leaf_index_[id] == kNoIndex) continue;
+    while (!unsettled_.empty()) {
+        const VertexId id = *unsettled_.begin();
+        unsettled_.erase(unsettled_.begin());
+        if (!stepped_.count(id) || leaf_index_[id] == kNoIndex) continue;
         const Vec3 p = stepped_position(id, placements_.step[id]);
         if (p == h_.position(id)) continue;
         move(leaf_index_[id], p);
         changed.push_back(leaf_index_[id]);
+        unsettle_dependents(id);
     }
     return changed;
 }
