@@ -40,8 +40,8 @@ Metadata read_metadata(const Block& block, bool quantized) {
     AMC_REQUIRE(!(m.options & ~(kOptionRootRotations | kOptionChunked | kOptionMixedContexts)), corrupt, "metadata block: unknown options");
     const uint64_t header_size = in.varint();
     AMC_REQUIRE(header_size <= in.remaining(), truncated, "metadata block: hierarchy header is truncated");
-    m.hierarchy_header.assign(in.rest(), in.rest() + header_size);
-    for (uint64_t i = 0; i < header_size; ++i) in.u8();
+    const uint8_t* header = in.bytes(header_size);
+    m.hierarchy_header.assign(header, header + header_size);
     if (quantized) {
         m.quantizer.bits = in.u8();
         m.quantizer.origin = {in.f64(), in.f64(), in.f64()};

@@ -97,8 +97,7 @@ Hierarchy& decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, s
     PayloadReader in(data, size, "chunk block");
     const uint64_t header_size = in.varint();
     AMC_REQUIRE(header_size <= in.remaining(), corrupt, what + ": hierarchy header is longer than the block");
-    const uint8_t* header = in.rest();
-    for (uint64_t i = 0; i < header_size; ++i) in.u8();
+    const uint8_t* header = in.bytes(header_size);
     const uint64_t levels = in.varint();
     AMC_REQUIRE(levels >= 1 && levels <= kMaxLevel + 1, corrupt, what + ": bad level count");
     hierarchy.restart(base, header, size_t(header_size), limits.stream_version, limits.max_nodes);
@@ -116,8 +115,7 @@ Hierarchy& decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, s
         const std::string where = what + ", level " + std::to_string(level);
         const uint64_t length = in.varint();
         AMC_REQUIRE(length >= 1 && length <= in.remaining(), corrupt, where + ": bad length");
-        const Block level_block{BlockType::level, in.rest(), size_t(length), 0};
-        for (uint64_t i = 0; i < length; ++i) in.u8();
+        const Block level_block{BlockType::level, in.bytes(length), size_t(length), 0};
         const LevelBlockParts parts = split_level_block(level_block, limits.file_version, space.quantizer != nullptr, where);
         ArithmeticDecoder decoder(parts.arithmetic, parts.arithmetic_size);
         const NodeId first = hierarchy.level_first(), end = first + NodeId(hierarchy.level_size());

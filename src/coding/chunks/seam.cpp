@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <unordered_map>
 
 namespace amc {
 
@@ -30,6 +31,31 @@ Vec3 midpoint_prediction(Vec3 a, Vec3 b, bool single_precision) {
 uint64_t directed(uint32_t a, uint32_t b) { return (uint64_t(a) << 32) | b; }
 
 }  // namespace
+
+size_t Seam::SegmentTable::slot_of(uint64_t key) const {
+    const size_t mask = slots_.size() - 1;
+    size_t i = size_t((key * 0x9E3779B97F4A7C15ull) >> 32) & mask;  // Fibonacci hashing
+    while (slots_[i].first != key && slots_[i].first != kEmpty) i = (i + 1) & mask;
+    return i;
+}
+
+void Seam::SegmentTable::set(uint64_t key, int32_t value) {
+    if (2 * (used_ + 1) > slots_.size()) {  // at most half full, so probes stay short
+        std::vector<std::pair<uint64_t, int32_t>> old(std::max<size_t>(16, 2 * slots_.size()), {kEmpty, 0});
+        old.swap(slots_);
+        for (const auto& slot : old)
+            if (slot.first != kEmpty) slots_[slot_of(slot.first)] = slot;
+    }
+    std::pair<uint64_t, int32_t>& slot = slots_[slot_of(key)];
+    used_ += slot.first == kEmpty;
+    slot = {key, value};
+}
+
+int32_t Seam::SegmentTable::find(uint64_t key) const {
+    if (slots_.empty()) return kNotSeam;
+    const std::pair<uint64_t, int32_t>& slot = slots_[slot_of(key)];
+    return slot.first == key && key != kEmpty ? slot.second : kNotSeam;
+}
 
 std::vector<std::pair<uint32_t, int>> seam_edges(const TriangleMesh& base, const std::vector<uint32_t>& chunk_of_root) {
     std::unordered_map<uint64_t, uint32_t> triangle_of_edge;
@@ -63,13 +89,13 @@ Seam::Seam(const Hierarchy& h, const std::vector<uint32_t>& chunk_of_root, std::
         Segment segment{n_split || q_split, uint8_t(level), h.position(a), h.position(b), 0};
         const uint64_t key = segment_key(key_of_vertex[a], key_of_vertex[b]);
         if (!segment.split) {
-            segments_[key] = kUnsplit;
+            segments_.set(key, kUnsplit);
             trace_.push_back(segment);
             return;
         }
         const VertexId m = n_split ? h.midpoint(n, e) : h.midpoint(q, eq);
         segment.vertex = uint32_t(positions_.size());
-        segments_[key] = int32_t(segment.vertex);
+        segments_.set(key, int32_t(segment.vertex));
         key_of_vertex[m] = base_vertices_ + segment.vertex;
         positions_.push_back(h.position(m));
         trace_.push_back(segment);
@@ -109,14 +135,14 @@ Seam Seam::from_splits(const TriangleMesh& base, const std::vector<uint32_t>& ch
         const bool split = it != splits.end() && it->edge == edge && it->segment == segment;
         Segment s{split, uint8_t(level), key_positions[a], key_positions[b], 0};
         if (!split) {
-            seam.segments_[segment_key(a, b)] = kUnsplit;
+            seam.segments_.set(segment_key(a, b), kUnsplit);
             seam.trace_.push_back(s);
             return;
         }
         AMC_REQUIRE(level < kMaxLevel, invalid_input, "a seam segment of level " + std::to_string(level) + " is split");
         s.vertex = uint32_t(seam.positions_.size());
         const uint32_t m = seam.base_vertices_ + s.vertex;
-        seam.segments_[segment_key(a, b)] = int32_t(s.vertex);
+        seam.segments_.set(segment_key(a, b), int32_t(s.vertex));
         seam.positions_.push_back(it->position);
         key_positions.push_back(it->position);
         seam.trace_.push_back(s);
@@ -161,7 +187,7 @@ Seam Seam::decode(const uint8_t* data, size_t size, const TriangleMesh& base, co
         AMC_REQUIRE(!decoder.overran(), corrupt, "seam block is truncated or corrupt");
         const uint64_t key = segment_key(a, b);
         if (!decoder.decode(split_model(models, level))) {
-            seam.segments_[key] = kUnsplit;
+            seam.segments_.set(key, kUnsplit);
             return;
         }
         AMC_REQUIRE(level < kMaxLevel, corrupt, "seam block splits a segment of level " + std::to_string(level));
@@ -172,7 +198,7 @@ Seam Seam::decode(const uint8_t* data, size_t size, const TriangleMesh& base, co
         AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
                     "seam block is corrupt (non-finite coordinate)");
         const uint32_t m = seam.base_vertices_ + uint32_t(seam.positions_.size());
-        seam.segments_[key] = int32_t(seam.positions_.size());
+        seam.segments_.set(key, int32_t(seam.positions_.size()));
         seam.positions_.push_back(p);
         key_positions.push_back(p);
         self(self, a, m, level + 1);

@@ -14,7 +14,6 @@
 #include <amc/hierarchy.h>
 
 #include <cstdint>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -57,18 +56,29 @@ public:
     uint32_t vertex_count() const { return uint32_t(positions_.size()); }
     Vec3 position(uint32_t s) const { return positions_[s]; }
     // The seam vertex splitting segment (a, b) (keys), kUnsplit, or kNotSeam.
-    int32_t find(uint32_t a, uint32_t b) const {
-        const auto it = segments_.find(segment_key(a, b));
-        return it == segments_.end() ? kNotSeam : it->second;
-    }
+    int32_t find(uint32_t a, uint32_t b) const { return segments_.find(segment_key(a, b)); }
 
 private:
+    // Segment key -> seam vertex or kUnsplit, by open addressing: a lookup reads one or two
+    // neighbouring slots, where std::unordered_map's node chains missed the cache on every new
+    // vertex a chunk's decoder puts on its boundary.
+    class SegmentTable {
+    public:
+        void set(uint64_t key, int32_t value);
+        int32_t find(uint64_t key) const;  // kNotSeam when absent
+
+    private:
+        static constexpr uint64_t kEmpty = ~uint64_t{0};  // no segment's key: its two ends differ
+        size_t slot_of(uint64_t key) const;
+        std::vector<std::pair<uint64_t, int32_t>> slots_;
+        size_t used_ = 0;
+    };
     static uint64_t segment_key(uint32_t a, uint32_t b) {
         return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a;
     }
     uint32_t base_vertices_ = 0;
     std::vector<Vec3> positions_;  // of the seam vertices, in block order
-    std::unordered_map<uint64_t, int32_t> segments_;
+    SegmentTable segments_;
     // The encoder's trees in block order (pre-order): each segment, and its midpoint when split.
     struct Segment {
         bool split;
