@@ -9,3 +9,11 @@
 #else
 #define AMC_NOIPA __attribute__((noinline))
 #endif
+
+// Inlines a small function into its hot loop even where GCC's size heuristics would not (a small
+// struct returned through memory stalls the loop on a store forward).
+#if defined(__GNUC__)
+#define AMC_ALWAYS_INLINE __attribute__((always_inline)) inline
+#else
+#define AMC_ALWAYS_INLINE inline
+#endif

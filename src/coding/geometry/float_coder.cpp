@@ -15,9 +15,6 @@ namespace amc {
 
 namespace {
 
-constexpr uint64_t kSign64 = uint64_t{1} << 63;
-constexpr uint32_t kSign32 = uint32_t{1} << 31;
-
 int width_bits(Precision precision) { return precision == Precision::float32 ? 32 : 64; }
 uint64_t width_mask(Precision precision) {
     return precision == Precision::float32 ? 0xFFFFFFFFull : ~uint64_t{0};
@@ -27,8 +24,6 @@ int tree_depth(Precision precision) { return precision == Precision::float32 ? 6
 constexpr int kQuantizedTreeDepth = 5;  // k = 0 .. 30 < 32
 static_assert(kMinSymbolsPerCoordinate <= kQuantizedTreeDepth && kQuantizedTreeDepth < 6,
               "kMinSymbolsPerCoordinate is the shallowest tree");
-
-double finite_or_zero(double x) { return std::isfinite(x) ? x : 0.0; }
 
 // A residual as sign and magnitude; magnitude has at most kMaxLength bits.
 void encode_residual(ArithmeticEncoder& encoder, FloatResidualModels::Context& ctx, int depth,
@@ -103,8 +98,6 @@ void check_bits(int bits, const char* where) {
     }
 }
 
-double axis_value(Vec3 p, int axis) { return axis == 0 ? p.x : axis == 1 ? p.y : p.z; }
-
 }  // namespace
 
 void encode_signed_residual(ArithmeticEncoder& encoder, FloatResidualModels::Context& context, bool negative,
@@ -119,42 +112,6 @@ void decode_signed_residual(ArithmeticDecoder& decoder, FloatResidualModels& mod
 
 // ---- the monotone map ------------------------------------------------------------------------
 
-uint64_t ordered_bits(double x, Precision precision) {
-    if (precision == Precision::float32) {
-        const float f = static_cast<float>(x);
-        uint32_t b;
-        std::memcpy(&b, &f, sizeof b);
-        return (b & kSign32) ? uint32_t(~b) : (b | kSign32);
-    }
-    uint64_t b;
-    std::memcpy(&b, &x, sizeof b);
-    return (b & kSign64) ? ~b : (b | kSign64);
-}
-
-double from_ordered_bits(uint64_t u, Precision precision) {
-    if (precision == Precision::float32) {
-        const uint32_t v = static_cast<uint32_t>(u);
-        const uint32_t b = (v & kSign32) ? (v & ~kSign32) : ~v;
-        float f;
-        std::memcpy(&f, &b, sizeof f);
-        return static_cast<double>(f);
-    }
-    const uint64_t b = (u & kSign64) ? (u & ~kSign64) : ~u;
-    double x;
-    std::memcpy(&x, &b, sizeof x);
-    return x;
-}
-
-double coder_prediction(double predicted, Precision precision) {
-    double p = finite_or_zero(predicted);
-    if (precision == Precision::float32) {
-        if (p > FLT_MAX) p = FLT_MAX;
-        if (p < -FLT_MAX) p = -FLT_MAX;
-        p = rounded_to_float(p);
-    }
-    return p;
-}
-
 // ---- models -----------------------------------------------------------------------------------
 
 FloatResidualModels::FloatResidualModels(int contexts) {
@@ -166,12 +123,8 @@ FloatResidualModels::FloatResidualModels(int contexts) {
     contexts_.assign(static_cast<size_t>(contexts), Context{});
 }
 
-FloatResidualModels::Context& FloatResidualModels::context(int c) {
-    if (c < 0 || c >= context_count()) {
-        throw Error("FloatResidualModels: context " + std::to_string(c) + " outside [0, " +
-                    std::to_string(context_count()) + ")");
-    }
-    return contexts_[static_cast<size_t>(c)];
+void FloatResidualModels::context_out_of_range(int c) const {
+    throw Error("FloatResidualModels: context " + std::to_string(c) + " outside [0, " + std::to_string(context_count()) + ")");
 }
 
 // ---- floating-point residuals -------------------------------------------------------------------
@@ -232,7 +185,7 @@ Quantizer make_quantizer(Vec3 box_min, Vec3 box_max, int bits) {
     check_bits(bits, "make_quantizer");
     double extent = 0.0;
     for (int axis = 0; axis < 3; ++axis) {
-        const double lo = axis_value(box_min, axis), hi = axis_value(box_max, axis);
+        const double lo = axis_coordinate(box_min, axis), hi = axis_coordinate(box_max, axis);
         if (!std::isfinite(lo) || !std::isfinite(hi) || !(lo <= hi)) {
             throw Error("make_quantizer: invalid bounding box");
         }
@@ -261,28 +214,6 @@ Quantizer make_quantizer(const std::vector<Vec3>& points, int bits) {
         hi = {std::fmax(hi.x, p.x), std::fmax(hi.y, p.y), std::fmax(hi.z, p.z)};
     }
     return make_quantizer(lo, hi, bits);
-}
-
-uint32_t quantize_coordinate(const Quantizer& quantizer, int axis, double x) {
-    const double t = (x - axis_value(quantizer.origin, axis)) / quantizer.step;
-    const double top = static_cast<double>(quantizer.max_coordinate());
-    if (!(t > 0.0)) return 0;  // also NaN
-    if (t >= top) return quantizer.max_coordinate();
-    return static_cast<uint32_t>(std::floor(t + 0.5));
-}
-
-GridPoint quantize(const Quantizer& quantizer, Vec3 p) {
-    return {quantize_coordinate(quantizer, 0, p.x), quantize_coordinate(quantizer, 1, p.y),
-            quantize_coordinate(quantizer, 2, p.z)};
-}
-
-double dequantize_coordinate(const Quantizer& quantizer, int axis, uint32_t q) {
-    return axis_value(quantizer.origin, axis) + rounded(static_cast<double>(q) * quantizer.step);
-}
-
-Vec3 dequantize(const Quantizer& quantizer, GridPoint q) {
-    return {dequantize_coordinate(quantizer, 0, q[0]), dequantize_coordinate(quantizer, 1, q[1]),
-            dequantize_coordinate(quantizer, 2, q[2])};
 }
 
 GridPoint snap_to_grid(const Quantizer& quantizer, Vec3 p) {

@@ -30,11 +30,15 @@
 #pragma once
 
 #include "coding/entropy/arithmetic_coder.h"
+#include "common/exact_float.h"
 
 #include <amc/mesh.h>
 
 #include <array>
+#include <cfloat>
+#include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 namespace amc {
@@ -42,14 +46,49 @@ namespace amc {
 // Written to streams: values are frozen.
 enum class Precision : uint8_t { float32 = 0, float64 = 1 };
 
+constexpr uint64_t kFloatSign64 = uint64_t{1} << 63;
+constexpr uint32_t kFloatSign32 = uint32_t{1} << 31;
+inline double axis_coordinate(Vec3 p, int axis) { return axis == 0 ? p.x : axis == 1 ? p.y : p.z; }
+
+// Defined inline (here and for the quantizer below): the decoders call them for every coordinate.
 // Monotone map of the IEEE bits of x to an unsigned integer (N significant bits). For float32, x
 // must be a float value (it is converted to float; callers pass exactly representable values).
-uint64_t ordered_bits(double x, Precision precision);
+inline uint64_t ordered_bits(double x, Precision precision) {
+    if (precision == Precision::float32) {
+        const float f = static_cast<float>(x);
+        uint32_t b;
+        std::memcpy(&b, &f, sizeof b);
+        return (b & kFloatSign32) ? uint32_t(~b) : (b | kFloatSign32);
+    }
+    uint64_t b;
+    std::memcpy(&b, &x, sizeof b);
+    return (b & kFloatSign64) ? ~b : (b | kFloatSign64);
+}
 // Inverse of ordered_bits (u is taken modulo 2^N).
-double from_ordered_bits(uint64_t u, Precision precision);
+inline double from_ordered_bits(uint64_t u, Precision precision) {
+    if (precision == Precision::float32) {
+        const uint32_t v = static_cast<uint32_t>(u);
+        const uint32_t b = (v & kFloatSign32) ? (v & ~kFloatSign32) : ~v;
+        float f;
+        std::memcpy(&f, &b, sizeof f);
+        return static_cast<double>(f);
+    }
+    const uint64_t b = (u & kFloatSign64) ? (u & ~kFloatSign64) : ~u;
+    double x;
+    std::memcpy(&x, &b, sizeof x);
+    return x;
+}
 // The prediction both coder sides actually use: non-finite -> 0; float32: clamped to
 // [-FLT_MAX, FLT_MAX] and rounded to float.
-double coder_prediction(double predicted, Precision precision);
+inline double coder_prediction(double predicted, Precision precision) {
+    double p = std::isfinite(predicted) ? predicted : 0.0;
+    if (precision == Precision::float32) {
+        if (p > FLT_MAX) p = FLT_MAX;
+        if (p < -FLT_MAX) p = -FLT_MAX;
+        p = rounded_to_float(p);
+    }
+    return p;
+}
 
 // Adaptive models for `contexts` independent contexts.
 class FloatResidualModels {
@@ -70,7 +109,10 @@ public:
 
     int context_count() const { return static_cast<int>(contexts_.size()); }
     // Throws Error for a context outside [0, context_count()).
-    Context& context(int c);
+    Context& context(int c) {
+        if (c < 0 || c >= context_count()) context_out_of_range(c);
+        return contexts_[static_cast<size_t>(c)];
+    }
 
     // Set by the decoding functions when they met a symbol an encoder cannot produce (a bit
     // length too large for the precision, a grid coordinate out of range): the stream is
@@ -79,6 +121,7 @@ public:
     void mark_invalid() { invalid_ = true; }
 
 private:
+    [[noreturn]] void context_out_of_range(int c) const;
     std::vector<Context> contexts_;
     bool invalid_ = false;
 };
@@ -142,10 +185,23 @@ Quantizer make_quantizer(Vec3 box_min, Vec3 box_max, int bits);
 Quantizer make_quantizer(const std::vector<Vec3>& points, int bits);
 
 // Grid coordinate of x on axis 0, 1, 2 (NaN -> 0; out-of-box values clamp to the grid).
-uint32_t quantize_coordinate(const Quantizer& quantizer, int axis, double x);
-GridPoint quantize(const Quantizer& quantizer, Vec3 p);
-double dequantize_coordinate(const Quantizer& quantizer, int axis, uint32_t q);
-Vec3 dequantize(const Quantizer& quantizer, GridPoint q);
+inline uint32_t quantize_coordinate(const Quantizer& quantizer, int axis, double x) {
+    const double t = (x - axis_coordinate(quantizer.origin, axis)) / quantizer.step;
+    const double top = static_cast<double>(quantizer.max_coordinate());
+    if (!(t > 0.0)) return 0;  // also NaN
+    if (t >= top) return quantizer.max_coordinate();
+    return static_cast<uint32_t>(std::floor(t + 0.5));
+}
+inline GridPoint quantize(const Quantizer& quantizer, Vec3 p) {
+    return {quantize_coordinate(quantizer, 0, p.x), quantize_coordinate(quantizer, 1, p.y), quantize_coordinate(quantizer, 2, p.z)};
+}
+inline double dequantize_coordinate(const Quantizer& quantizer, int axis, uint32_t q) {
+    return axis_coordinate(quantizer.origin, axis) + rounded(static_cast<double>(q) * quantizer.step);
+}
+inline Vec3 dequantize(const Quantizer& quantizer, GridPoint q) {
+    return {dequantize_coordinate(quantizer, 0, q[0]), dequantize_coordinate(quantizer, 1, q[1]),
+            dequantize_coordinate(quantizer, 2, q[2])};
+}
 // The grid point the encoder stores for a position: quantize()'s, one step lower on an axis where
 // that would reconstruct beyond the largest double (a box that reaches DBL_MAX), so that every
 // reconstruction is finite.

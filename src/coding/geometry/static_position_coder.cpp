@@ -1,8 +1,11 @@
 // The static geometry mode of a level; see static_position_coder.h and docs/FORMAT.md 5.6.
 #include "coding/geometry/static_position_coder.h"
 
+#include "common/compiler.h"
+
 #include "coding/geometry/geometry_prediction.h"
 #include "common/bits.h"
+#include "common/compiler.h"
 #include "common/exact_float.h"
 
 #include <cmath>
@@ -58,7 +61,7 @@ Residual residual_of(CoordinateSpace space, int axis, double actual, double pred
 }
 
 // The value a residual gives, or false if it leaves the grid.
-bool value_of(CoordinateSpace space, int axis, double predicted, Residual r, double& value) {
+AMC_ALWAYS_INLINE bool value_of(CoordinateSpace space, int axis, double predicted, Residual r, double& value) {
     if (space.quantizer != nullptr) {
         const int64_t p = quantize_coordinate(*space.quantizer, axis, predicted);
         const int64_t q = r.negative ? p - int64_t(r.magnitude) : p + int64_t(r.magnitude);
@@ -84,14 +87,8 @@ struct GridPrediction {
     bool turn;
 };
 
-#if defined(__GNUC__)
-#define AMC_GRID_INLINE __attribute__((always_inline)) inline
-#else
-#define AMC_GRID_INLINE inline
-#endif
-
 // Inlined: returned through memory, the small struct stalls the decoder's loop on a store forward.
-AMC_GRID_INLINE GridPrediction grid_prediction(const Quantizer& quantizer, int axis, double x) {
+AMC_ALWAYS_INLINE GridPrediction grid_prediction(const Quantizer& quantizer, int axis, double x) {
     // quantize_coordinate's steps, its t kept for the bin.
     const double t = rounded((x - component(quantizer.origin, axis)) / quantizer.step);
     if (!(t > 0.0)) return {0, 0, false};  // also NaN
@@ -103,13 +100,13 @@ AMC_GRID_INLINE GridPrediction grid_prediction(const Quantizer& quantizer, int a
     return g;
 }
 
-AMC_GRID_INLINE Residual grid_residual(const Quantizer& quantizer, int axis, double actual, const GridPrediction& g) {
+AMC_ALWAYS_INLINE Residual grid_residual(const Quantizer& quantizer, int axis, double actual, const GridPrediction& g) {
     const int64_t d = int64_t(quantize_coordinate(quantizer, axis, actual)) - int64_t(g.p);
     const int64_t s = g.turn ? -d : d;
     return {s < 0, uint64_t(s < 0 ? -s : s)};
 }
 
-AMC_GRID_INLINE bool grid_value(const Quantizer& quantizer, int axis, const GridPrediction& g, Residual r, double& value) {
+AMC_ALWAYS_INLINE bool grid_value(const Quantizer& quantizer, int axis, const GridPrediction& g, Residual r, double& value) {
     const int64_t s = r.negative ? -int64_t(r.magnitude) : int64_t(r.magnitude);  // magnitude < 2^bits
     const int64_t q = int64_t(g.p) + (g.turn ? -s : s);
     if (q < 0 || q > int64_t(quantizer.max_coordinate())) return false;
@@ -136,7 +133,7 @@ void put_raw(RawBitWriter& raw, Residual r) {
     }
 }
 
-Residual take(int token, RawBitReader& raw) {
+AMC_ALWAYS_INLINE Residual take(int token, RawBitReader& raw) {
     if (token < kDirectTokens) return {token != 0 && token % 2 == 0, uint64_t(token + 1) / 2};
     const int k = 4 + (token - kDirectTokens) / 4;
     const int low = k - 3;
