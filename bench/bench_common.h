@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <ctime>
 #include <vector>
 
 enum class BenchModel { surface = 0, random = 1, fe = 2 };
@@ -45,10 +46,26 @@ using Clock = std::chrono::steady_clock;
 // Seconds from `start` to now.
 inline double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
+// Seconds of CPU time this process has used, all its threads together.
+inline double cpu_seconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
 // The median of the samples (the mean of the middle two for an even count); 0 for none.
 inline double median(std::vector<double> samples) {
     if (samples.empty()) return 0;
     std::sort(samples.begin(), samples.end());
     const size_t n = samples.size();
     return n % 2 ? samples[n / 2] : 0.5 * (samples[n / 2 - 1] + samples[n / 2]);
+}
+
+// The median of non-empty samples, and their extremes.
+struct Range {
+    double median, low, high;
+};
+inline Range range_of(std::vector<double> samples) {
+    std::sort(samples.begin(), samples.end());
+    return {median(samples), samples.front(), samples.back()};
 }

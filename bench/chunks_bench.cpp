@@ -17,6 +17,8 @@
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
 
+#include "bench_common.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -28,16 +30,6 @@
 namespace {
 
 double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
-
-struct Range {
-    double median, low, high;
-};
-
-Range range_of(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return {n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]), v.front(), v.back()};
-}
 
 std::string name_of(const char* path) { return std::filesystem::path(path).stem().string(); }
 

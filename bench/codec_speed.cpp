@@ -12,6 +12,8 @@
 #include <amc/hierarchy.h>
 #include <amc/hierarchy_coder.h>
 
+#include "bench_common.h"
+
 #include <algorithm>
 #include <ctime>
 #include <cstdio>
@@ -21,23 +23,6 @@
 #include <vector>
 
 namespace {
-
-// Seconds of CPU time this process has used.
-double cpu_seconds() {
-    timespec t{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
-struct Range {
-    double median, low, high;
-};
-
-Range range_of(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return {n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]), v.front(), v.back()};
-}
 
 }  // namespace
 

@@ -11,6 +11,7 @@
 //   one_core_speed decode RUNS file.amc     only decodes the file RUNS times on one thread: the
 //                                           process to profile or count instructions of
 #include "compare_draco.h"
+#include "bench_common.h"
 
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
@@ -31,22 +32,6 @@
 #include <vector>
 
 namespace {
-
-double cpu_seconds() {
-    timespec t{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
-struct Range {
-    double median, low, high;
-};
-
-Range range_of(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return {n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]), v.front(), v.back()};
-}
 
 draco::Encoder draco_default_encoder(int bits) {
     draco::Encoder encoder;

@@ -29,12 +29,6 @@
 
 namespace {
 
-double cpu_seconds() {
-    timespec t{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
 // The midpoint of a and b moved onto a torus (radii 1 and 0.35 about the z axis, as make_torus
 // makes it) whose tube radius varies smoothly: coordinates with all their bits in use, as a
 // remesh of a scanned surface has them.

@@ -7,6 +7,8 @@
 #include <amc/mesh.h>
 #include <amc/mesh_io.h>
 
+#include "bench_common.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <ctime>
@@ -17,13 +19,7 @@ using namespace amc;
 
 namespace {
 
-double cpu_seconds() {
-    timespec t;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return t.tv_sec + 1e-9 * t.tv_nsec;
-}
-
-struct Range {
+struct MinMax {
     double min = 1e300, max = 0;
     void add(double x) { min = std::min(min, x), max = std::max(max, x); }
 };
@@ -44,7 +40,7 @@ int main(int argc, char** argv) {
                 leaf.mesh.single_precision ? "single" : "double", runs);
     for (VtuEncoding encoding : {VtuEncoding::binary_zlib, VtuEncoding::ascii}) {
         const std::string path = dir + "/vtu_io_bench.vtu";
-        Range write, read;
+        MinMax write, read;
         for (int r = 0; r < runs; ++r) {
             double t0 = cpu_seconds();
             write_vtu(path, vtu, encoding);
