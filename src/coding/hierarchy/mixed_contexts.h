@@ -84,7 +84,7 @@ public:
     static constexpr int kIndirectInputs = 3;  // bit histories of three direct contexts
     static constexpr int kSecondInputs = kDirect + kIndirectInputs;
     static constexpr int kMaps = 5;            // the second model's probability maps
-    explicit MixedHierarchyModel(MixingModel model = MixingModel::first);
+    explicit MixedHierarchyModel(MixingModel model);
     MixingModel model() const { return model_; }
     // The 16-bit probability of a one for a symbol with these features (remembered for update).
     uint32_t p16(const MixedFeatures& f);
