@@ -238,22 +238,7 @@ public:
 private:
     int p12(const MixedFeatures& f) {
         const uint32_t g = f.group;
-        slot_ = {g,
-                 g * 4 + f.inner,
-                 g * 4 + f.parent_nbrs,
-                 g * 8 + f.level,
-                 g * 5 + f.ring2,
-                 (g * 3 + f.parent_far) * 4 + f.parent_sibs,
-                 g * 24 + f.disp,
-                 (g * 24 + f.disp_parent) * 4 + f.inner,
-                 (g * 24 + f.disp) * 8 + f.level,
-                 (g * 32 + f.bend_sum) * 8 + f.level,
-                 g * 64 + f.mean_curv,
-                 ((g * 64 + f.mean_curv) * 8 + f.level) * 2 + f.center,
-                 (g * 24 + f.disp) * 16 + f.mean_curv / 4u,
-                 (g * 5 + f.ring2) * 4 + f.inner,
-                 (g * 5 + f.ring2) * 8 + f.level,
-                 ((g * 4 + f.parent_nbrs) * 3 + f.parent_far) * 4 + f.inner};
+        slot_ = MixedHierarchyModel::direct_slots(f);
         int k = 0;
         for (int j = 0; j < kBase; ++j) st_[size_t(k++)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
         for (auto& [j, m] : fast_) st_[size_t(k++)] = mixing::stretch(mixing::p12_of(m[slot_[size_t(j)]]));

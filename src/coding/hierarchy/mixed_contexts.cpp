@@ -231,26 +231,30 @@ MixedHierarchyModel::MixedHierarchyModel(MixingModel model)
     for (int m = 0; m < kMaps; ++m) maps_.emplace_back(kMapContexts[m], kMapRate);
 }
 
+std::array<uint32_t, MixedHierarchyModel::kInputs> MixedHierarchyModel::direct_slots(const MixedFeatures& f) {
+    const uint32_t g = f.group;
+    return {g,
+            g * 4 + f.inner,
+            g * 4 + f.parent_nbrs,
+            g * 8 + f.level,
+            g * 5 + f.ring2,
+            (g * 3 + f.parent_far) * 4 + f.parent_sibs,
+            g * 24 + f.disp,
+            (g * 24 + f.disp_parent) * 4 + f.inner,
+            (g * 24 + f.disp) * 8 + f.level,
+            (g * 32 + f.bend_sum) * 8 + f.level,
+            g * 64 + f.mean_curv,
+            ((g * 64 + f.mean_curv) * 8 + f.level) * 2 + f.center,
+            (g * 24 + f.disp) * 16 + f.mean_curv / 4u,
+            (g * 5 + f.ring2) * 4 + f.inner,
+            (g * 5 + f.ring2) * 8 + f.level,
+            ((g * 4 + f.parent_nbrs) * 3 + f.parent_far) * 4 + f.inner};
+}
+
 uint32_t MixedHierarchyModel::p16(const MixedFeatures& f) {
     const uint32_t g = f.group;
-    std::copy_n(std::array<uint32_t, kInputs>{g,
-                                              g * 4 + f.inner,
-                                              g * 4 + f.parent_nbrs,
-                                              g * 8 + f.level,
-                                              g * 5 + f.ring2,
-                                              (g * 3 + f.parent_far) * 4 + f.parent_sibs,
-                                              g * 24 + f.disp,
-                                              (g * 24 + f.disp_parent) * 4 + f.inner,
-                                              (g * 24 + f.disp) * 8 + f.level,
-                                              (g * 32 + f.bend_sum) * 8 + f.level,
-                                              g * 64 + f.mean_curv,
-                                              ((g * 64 + f.mean_curv) * 8 + f.level) * 2 + f.center,
-                                              (g * 24 + f.disp) * 16 + f.mean_curv / 4u,
-                                              (g * 5 + f.ring2) * 4 + f.inner,
-                                              (g * 5 + f.ring2) * 8 + f.level,
-                                              ((g * 4 + f.parent_nbrs) * 3 + f.parent_far) * 4 + f.inner}
-                    .begin(),
-                kInputs, slot_.begin());
+    const std::array<uint32_t, kInputs> direct = direct_slots(f);
+    std::copy_n(direct.begin(), kInputs, slot_.begin());
     for (int j = 0; j < kInputs; ++j) st_[size_t(j)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
     if (model_ == MixingModel::second) return uint32_t(second_model_p12(f)) << 4;
     st_[kInputs] = 256;  // bias

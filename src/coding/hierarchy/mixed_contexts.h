@@ -89,6 +89,8 @@ public:
     // The 16-bit probability of a one for a symbol with these features (remembered for update).
     uint32_t p16(const MixedFeatures& f);
     void update(bool bit);
+    // The slots of the first model's direct models for these features (FORMAT.md 2.1).
+    static std::array<uint32_t, kInputs> direct_slots(const MixedFeatures& f);
 
 private:
     int second_model_p12(const MixedFeatures& f);
