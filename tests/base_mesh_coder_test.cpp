@@ -260,6 +260,33 @@ TEST(BaseMeshCoder, ModeTwoSearchNeverLoses) {
     EXPECT_GT(elsewhere, 0) << "the search never started elsewhere";
 }
 
+// The search codes no more candidates than its budget allows: below five candidates' worth it is
+// the single try; a larger budget never codes longer than a smaller one (its candidates come
+// first in the same order); and the kept code does not depend on the threads.
+TEST(BaseMeshCoder, ModeTwoSearchFollowsItsBudget) {
+    const std::vector<std::pair<std::string, TriangleMesh>> meshes = {
+        {"flipped-sphere", randomly_flipped(make_bumpy_sphere(2), 200, 4)},
+        {"flipped-torus", randomly_flipped(make_torus(16, 12, 2.0, 0.7), 300, 1)},
+        {"icosahedron+torus", concatenate(make_icosahedron(), make_torus(6, 5, 2.0, 0.7))},
+    };
+    int budget_mattered = 0;
+    for (const auto& [name, mesh] : meshes) {
+        const BaseMeshCode single = encode_base_connectivity(mesh, BaseConnectivityMode::angle, false);
+        EXPECT_EQ(encode_base_connectivity(mesh, 1, 0).bytes, single.bytes) << name;
+        const uint64_t closed = mesh.triangles.size();  // at least; a few candidates' worth of it
+        const BaseMeshCode few = encode_base_connectivity(mesh, 1, 3 * closed * 8);
+        const BaseMeshCode full = encode_base_connectivity(mesh, 1);
+        EXPECT_LE(few.bytes.size(), single.bytes.size()) << name;
+        EXPECT_LE(full.bytes.size(), few.bytes.size()) << name;
+        budget_mattered += full.bytes.size() < few.bytes.size();
+        const BaseMeshCode threaded = encode_base_connectivity(mesh, 2);
+        EXPECT_EQ(threaded.bytes, full.bytes) << name;
+        EXPECT_EQ(threaded.triangle_order, full.triangle_order) << name;
+        EXPECT_EQ(threaded.vertex_order, full.vertex_order) << name;
+    }
+    EXPECT_GT(budget_mattered, 0) << "a few candidates did as well as the full search everywhere";
+}
+
 // A mode-2 stream whose header claims more than the mesh can hold is refused before anything is
 // sized by it (FORMAT.md 4.10), quickly.
 TEST(BaseMeshCoder, HugeCountsAreRefused) {

@@ -27,11 +27,11 @@
 namespace amc {
 
 // The whole stream, mode bits included; fills the code's orders. With `search`, the shortest of
-// several start triangles and gate radii (FORMAT.md 4.16), tried on up to `threads` threads (the
-// result does not depend on them), else version 4's single try. Throws EncoderGaveUp when the
-// mesh does not fit the mode.
-std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, bool search = true,
-                                       unsigned threads = 1);
+// several start triangles and gate radii (FORMAT.md 4.16), as many as `search_budget` (triangles
+// coded in all) allows, tried on up to `threads` threads (the result does not depend on them),
+// else version 4's single try. Throws EncoderGaveUp when the mesh does not fit the mode.
+std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, bool search,
+                                       unsigned threads, uint64_t search_budget);
 
 // Decodes the rest of a mode-2 stream (after the two mode bits) of `size` bytes, reading the
 // positions from `source` as vertices are created. Throws Error.

@@ -7,7 +7,9 @@
 #include "common/parallel.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <iterator>
+#include <mutex>
 
 namespace amc {
 
@@ -370,9 +372,8 @@ private:
 // with several gate radii, each with every context set, and the shortest is kept. The decoder
 // reads whichever was chosen. Measured (docs/BASE_CODER.md): 3-12 % on the coarse bases.
 // The first candidate is what version 4's encoder wrote.
-constexpr uint32_t kSearchStarts = 16;                          // start triangles spread over the input order
-constexpr uint32_t kSearchRadii[] = {5, 3, 4, 6, 7};            // 5 first: the best single radius
-constexpr uint64_t kSearchBudget = uint64_t{1} << 20;           // closed triangles coded in all, about 0.15 s
+constexpr uint32_t kSearchStarts = 16;                // start triangles spread over the input order
+constexpr uint32_t kSearchRadii[] = {5, 3, 4, 6, 7};  // 5 first: the best single radius
 
 struct Start {
     uint32_t first, rotation, radius;
@@ -380,11 +381,11 @@ struct Start {
 
 // The candidates in the order they are tried, as many as the budget allows (at least one: the
 // first triangle in input order, radius 5).
-std::vector<Start> search_candidates(uint32_t real_triangles, size_t closed_triangles) {
+std::vector<Start> search_candidates(uint32_t real_triangles, size_t closed_triangles, uint64_t budget) {
     const uint64_t per_candidate = uint64_t(angle_mode::kContextSets) * std::max<size_t>(closed_triangles, 1);
     // A mesh too large to try every radius from one start is written as from the first start
     // alone: on the large meshes the search gained nothing (docs/BASE_CODER.md).
-    uint64_t allowed = kSearchBudget / per_candidate;
+    uint64_t allowed = budget / per_candidate;
     if (allowed < std::size(kSearchRadii)) allowed = 1;
     std::vector<Start> out;
     for (uint32_t k = 0; k < kSearchStarts; ++k) {
@@ -401,38 +402,45 @@ std::vector<Start> search_candidates(uint32_t real_triangles, size_t closed_tria
 
 }  // namespace
 
-std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, bool search, unsigned threads) {
+std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, bool search, unsigned threads,
+                                       uint64_t search_budget) {
     const ClosedMesh cm = make_closed(mesh);
-    std::vector<Start> candidates = search_candidates(cm.real_triangles, cm.triangles.size());
+    std::vector<Start> candidates = search_candidates(cm.real_triangles, cm.triangles.size(), search_budget);
     if (!search) candidates.resize(1);
     // Every (start, context set) is coded on its own, on up to `threads` threads; the shortest
-    // wins, the earliest among equals, so the choice does not depend on the threads.
-    struct Tried {
+    // wins, the earliest among equals, so the choice does not depend on the threads. Only the
+    // best so far is kept: holding every candidate's code cost 10 MiB on a base of 768 triangles.
+    struct Best {
         std::vector<uint8_t> bytes;
         BaseMeshCode code;
-        bool fits = false;
-    };
-    std::vector<Tried> tried(candidates.size() * angle_mode::kContextSets);
-    parallel_for(tried.size(), threads, [&](size_t i) {
+        size_t index = SIZE_MAX;
+    } best;
+    std::mutex best_mutex;
+    parallel_for(candidates.size() * angle_mode::kContextSets, threads, [&](size_t i) {
         const Start& start = candidates[i / angle_mode::kContextSets];
         const int set = int(i % angle_mode::kContextSets);
+        BaseMeshCode tried;
+        std::vector<uint8_t> bytes;
         try {
             Encoder e(mesh, cm, set, start.radius, start.first, start.rotation);
-            tried[i].bytes = e.run(tried[i].code);
-            tried[i].fits = true;
+            bytes = e.run(tried);
         } catch (const EncoderGaveUp&) {
-            // this start does not fit (a walk over the budget, say): the others may
+            return;  // this start does not fit (a walk over the budget, say): the others may
         }
+        const std::lock_guard<std::mutex> lock(best_mutex);
+        const bool shorter = best.index == SIZE_MAX || bytes.size() < best.bytes.size() ||
+                             (bytes.size() == best.bytes.size() && i < best.index);
+        if (!shorter) return;
+        best.bytes = std::move(bytes);
+        best.code = std::move(tried);
+        best.index = i;
     });
-    const Tried* best = nullptr;
-    for (const Tried& t : tried)
-        if (t.fits && (best == nullptr || t.bytes.size() < best->bytes.size())) best = &t;
-    if (best == nullptr) throw EncoderGaveUp{};
-    code.vertex_order = best->code.vertex_order;
-    code.triangle_order = best->code.triangle_order;
-    code.triangle_rotation = best->code.triangle_rotation;
-    code.stencils = best->code.stencils;
-    return best->bytes;
+    if (best.index == SIZE_MAX) throw EncoderGaveUp{};
+    code.vertex_order = std::move(best.code.vertex_order);
+    code.triangle_order = std::move(best.code.triangle_order);
+    code.triangle_rotation = std::move(best.code.triangle_rotation);
+    code.stencils = std::move(best.code.stencils);
+    return best.bytes;
 }
 
 }  // namespace amc

@@ -75,12 +75,12 @@ std::vector<BaseStencil> cut_border_stencils(const TriangleMesh& mesh, const Bas
 // decoder will do (orders, stencils); tests/base_mesh_coder_test.cpp decodes every mode's
 // streams and compares. Mode 2's search runs on up to `threads` threads.
 bool try_mode(const TriangleMesh& mesh, BaseConnectivityMode mode, BaseMeshCode& code, bool search = true,
-              unsigned threads = 1) {
+              unsigned threads = 1, uint64_t search_budget = kFullBaseSearch) {
     try {
         code = BaseMeshCode{};
         code.mode = mode;
         switch (mode) {
-            case BaseConnectivityMode::angle: code.bytes = encode_angle_mode(mesh, code, search, threads); break;
+            case BaseConnectivityMode::angle: code.bytes = encode_angle_mode(mesh, code, search, threads, search_budget); break;
             case BaseConnectivityMode::cut_border: code.bytes = encode_cut_border(mesh, code); break;
             case BaseConnectivityMode::explicit_triangles: code.bytes = encode_explicit(mesh, code); break;
         }
@@ -104,10 +104,10 @@ void check_encodable(const TriangleMesh& mesh) {
 
 }  // namespace
 
-BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh, unsigned threads) {
+BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh, unsigned threads, uint64_t search_budget) {
     check_encodable(mesh);
     BaseMeshCode code;
-    if (try_mode(mesh, BaseConnectivityMode::angle, code, true, threads)) return code;
+    if (try_mode(mesh, BaseConnectivityMode::angle, code, true, threads, search_budget)) return code;
     if (!try_mode(mesh, BaseConnectivityMode::explicit_triangles, code))
         throw Error("base mesh coder: the explicit mode failed");
     return code;

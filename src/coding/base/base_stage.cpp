@@ -9,6 +9,7 @@
 #include "common/parallel.h"
 #include "hierarchy/hierarchy_builder.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -41,6 +42,15 @@ TriangleMesh base_as_decoded(const Hierarchy& h, const Quantizer* quantizer) {
     return base;
 }
 
+// Mode 2's search gets 8 triangles a hierarchy node (one takes about a tenth of a node's coding
+// time), so that encoding stays linear in the hierarchy's size down to small ones (BENCHMARKS.md,
+// Scaling); the floor keeps the whole search on bases of up to about 90 triangles.
+uint64_t base_search_budget(const Hierarchy& h) {
+    constexpr uint64_t kSearchTrianglesPerNode = 8;
+    constexpr uint64_t kSmallestBudget = uint64_t{1} << 16;
+    return std::clamp(kSearchTrianglesPerNode * h.node_count(), kSmallestBudget, kFullBaseSearch);
+}
+
 }  // namespace
 
 // The base connectivity of a file. Mode 2's search (FORMAT.md 4.16) starts the conquest away from
@@ -56,7 +66,7 @@ BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const 
         } catch (const Error&) {  // mode 2 does not fit this start: the usual choice
         }
     }
-    return encode_base_connectivity(base, resolve_thread_count(options.threads));
+    return encode_base_connectivity(base, resolve_thread_count(options.threads), base_search_budget(h));
 }
 
 // The base coder may rotate each triangle's vertices. The default diagonal rule does not care, but
