@@ -1,6 +1,7 @@
 // Base mesh connectivity coder (paper II-B): exact round trips over meshes of every topology the
 // coder must handle, compression rates on the shared base meshes, and corrupt streams.
 #include "coding/base/base_mesh_coder.h"
+#include "coding/base/base_stage.h"
 
 #include "coding/entropy/arithmetic_coder.h"
 #include "coding/container.h"
@@ -285,6 +286,23 @@ TEST(BaseMeshCoder, ModeTwoSearchFollowsItsBudget) {
         EXPECT_EQ(threaded.vertex_order, full.vertex_order) << name;
     }
     EXPECT_GT(budget_mattered, 0) << "a few candidates did as well as the full search everywhere";
+}
+
+// Inside an .amc encode the search gets one triangle per hierarchy node, between 2^16 and the full
+// budget, and an unrefined mesh (all base) the full one.
+TEST(BaseMeshCoder, SearchBudgetFollowsTheHierarchy) {
+    Hierarchy unrefined(make_torus(40, 30, 2.0, 0.7));
+    EXPECT_EQ(base_search_budget(unrefined), kFullBaseSearch);
+    Hierarchy small(make_icosahedron());
+    refine_uniformly(small, 2);
+    EXPECT_EQ(base_search_budget(small), uint64_t{1} << 16);
+    Hierarchy medium(make_icosahedron());
+    refine_uniformly(medium, 7);
+    ASSERT_EQ(medium.node_count(), 20u * (1u + 4 + 16 + 64 + 256 + 1024 + 4096 + 16384));
+    EXPECT_EQ(base_search_budget(medium), medium.node_count());
+    Hierarchy large(make_icosahedron());
+    refine_uniformly(large, 8);
+    EXPECT_EQ(base_search_budget(large), kFullBaseSearch);
 }
 
 // A mode-2 stream whose header claims more than the mesh can hold is refused before anything is

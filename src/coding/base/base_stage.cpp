@@ -42,16 +42,18 @@ TriangleMesh base_as_decoded(const Hierarchy& h, const Quantizer* quantizer) {
     return base;
 }
 
-// Mode 2's search gets 8 triangles a hierarchy node (one takes about a tenth of a node's coding
-// time), so that encoding stays linear in the hierarchy's size down to small ones (BENCHMARKS.md,
-// Scaling); the floor keeps the whole search on bases of up to about 90 triangles.
+}  // namespace
+
+// Mode 2's search codes one triangle per hierarchy node (a searched triangle costs about a third
+// of a node's coding): on the corpus's hierarchies the whole search gained nothing over that
+// (docs/BASE_CODER.md, Encode time) while taking half of a 12-bit encode. The floor keeps the
+// whole search on bases of up to about 90 triangles; an unrefined mesh is all base and gets it all.
 uint64_t base_search_budget(const Hierarchy& h) {
-    constexpr uint64_t kSearchTrianglesPerNode = 8;
+    if (h.node_count() == h.root_count()) return kFullBaseSearch;
+    constexpr uint64_t kSearchTrianglesPerNode = 1;
     constexpr uint64_t kSmallestBudget = uint64_t{1} << 16;
     return std::clamp(kSearchTrianglesPerNode * h.node_count(), kSmallestBudget, kFullBaseSearch);
 }
-
-}  // namespace
 
 // The base connectivity of a file. Mode 2's search (FORMAT.md 4.16) starts the conquest away from
 // the input's first triangle, which moves the decoder's base order away from the input's; a stored

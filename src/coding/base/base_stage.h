@@ -16,6 +16,9 @@
 
 namespace amc {
 
+// Triangles mode 2's search may code for the base of `h` (FORMAT.md 4.16).
+uint64_t base_search_budget(const Hierarchy& h);
+
 // The base connectivity code of the input (positions as the decoder reconstructs them: on the
 // grid when `quantizer` is set).
 BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const EncodeOptions& options);
