@@ -27,6 +27,11 @@ struct LevelSplits {
     const NodeId* parents = nullptr;
     uint32_t count = 0;
     const Neighbors* children = nullptr;
+    // When set, asked for the vertex splitting each boundary edge (a, b) of a parent: an
+    // existing vertex's id (placed already: no new vertex), or kNoVertex for a new one. The
+    // chunk decoder's seam vertices (chunk_coder.h).
+    VertexId (*boundary_vertex)(void* context, VertexId a, VertexId b) = nullptr;
+    void* boundary_context = nullptr;
 };
 
 struct HierarchyBuilder {
@@ -37,22 +42,36 @@ struct HierarchyBuilder {
     // taken before the call.
     static void split_level(Hierarchy& h, const LevelSplits& level) { h.split_level(level); }
     // Stitching hierarchies of disjoint root sets into one (hierarchy_stitch.cpp): the decoder of
-    // chunked files decodes each chunk alone and copies it into its slice of the whole at once,
-    // in these steps.
-    // One piece: a hierarchy over some of the whole's roots, and where its nodes and vertices go.
+    // chunked files decodes the chunks of the whole over its roots, each as if its roots were the
+    // whole base (their links to other chunks cut), or alone and copied into its slice.
+    // Appends vertices at `positions` (ids vertex_count() on), placed before any split.
+    static void append_vertices(Hierarchy& h, const std::vector<Vec3>& positions);
+    // A link between two roots across their edges ea and eb.
+    struct RootLink {
+        NodeId a;
+        int ea;
+        NodeId b;
+        int eb;
+    };
+    // Cuts the root edges `edges` (root, edge; both sides listed): boundary edges without
+    // neighbour, as a hierarchy over part of the base sees them. Returns the links cut, once each.
+    static std::vector<RootLink> cut_root_links(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& edges);
+    // Restores links that cut_root_links cut.
+    static void relink_roots(Hierarchy& h, const std::vector<RootLink>& links);
+    // One piece decoded alone: a hierarchy over some of the whole's roots, and where its nodes and vertices go.
     struct StitchPart {
         const Hierarchy* part = nullptr;
         NodeId first_root = 0;  // its root i becomes root first_root + i
         NodeId first_node = 0;  // its node root_count() + j becomes node first_node + j (a multiple of 4 past the roots)
         const VertexId* vertex_id = nullptr;  // its vertex v becomes vertex vertex_id[v]
     };
-    // 1. The whole over `base`: its roots, linked across every base edge, and room for `nodes`
-    //    nodes, not yet written (each part's copy writes, and so first touches, its own slice).
+    // The whole over `base`: its roots, linked across every base edge, and room for `nodes`
+    // nodes, not yet written (each part's copy writes, and so first touches, its own slice).
     static Hierarchy stitch_frame(const TriangleMesh& base, size_t nodes);
-    // 2. Copies part p into the whole: its nodes to first_node.., ids mapped. Parts write disjoint
-    //    nodes: several may be copied at once.
+    // Copies part p into the whole: its nodes to first_node.., ids mapped. Parts write disjoint
+    // nodes: several may be copied at once.
     static void stitch_part(Hierarchy& whole, const StitchPart& p);
-    // 3. Renames the vertex ids of the nodes in [begin, end): v becomes rename(v).
+    // Renames the vertex ids of the nodes in [begin, end): v becomes rename(v).
     template <class Rename>
     static void stitch_rename_vertices(Hierarchy& whole, NodeId begin, NodeId end, Rename rename) {
         for (NodeId n = begin; n < end; ++n) {
@@ -60,12 +79,14 @@ struct HierarchyBuilder {
             for (int e = 0; e < 3; ++e) node.v[e] = rename(node.v[e]);
         }
     }
-    // 4. Completes the whole, once every part is in: its positions (base vertices first), and the
-    //    seams linked: `seam` lists the root edges (root, edge) that a part saw as boundary and the
-    //    whole does not; the halves of two refined neighbours are linked as split() links them,
-    //    level by level. Throws Error (corrupt) where parts do not fit: a refined node next to a
-    //    coarser region of another part, a leaf with three hanging nodes.
-    static void stitch_seams(Hierarchy& whole, std::vector<Vec3> positions, std::vector<std::pair<NodeId, int>> seam);
+    // The whole's positions (base vertices first), replacing those it has, once every part is in.
+    static void stitch_positions(Hierarchy& whole, std::vector<Vec3> positions);
+    // Completes the whole once every part is in and the root links across the seams are there:
+    // `seam` lists the root edges (root, edge) that a part saw as boundary and the whole does not;
+    // the halves of two refined neighbours are linked as split() links them, level by level.
+    // Throws Error (corrupt) where parts do not fit: a refined node next to a coarser region of
+    // another part, a leaf with three hanging nodes.
+    static void stitch_seams(Hierarchy& whole, std::vector<std::pair<NodeId, int>> seam);
     // reorder_base (hierarchy.h) on up to `threads` threads: the same ids whatever their number.
     static Hierarchy reorder_base(const Hierarchy& h, const std::vector<uint32_t>& vertex_order,
                                   const std::vector<uint32_t>& triangle_order, const std::vector<uint8_t>& rotation,

@@ -1,6 +1,7 @@
 // Stitching hierarchies of disjoint root sets into one (hierarchy_builder.h): the decoder of
-// chunked .amc files copies each chunk into its slice of the whole as soon as it is decoded, then
-// renames the vertices the chunks could not number alone and links the seams.
+// chunked .amc files decodes the chunks over the whole's roots with the links between chunks cut,
+// or each alone, copied into its slice of the whole as soon as it is decoded, its vertices renamed
+// once all are in; then links the seams.
 #include "hierarchy/hierarchy_builder.h"
 
 #include "common/check.h"
@@ -47,13 +48,49 @@ void HierarchyBuilder::stitch_part(Hierarchy& h, const StitchPart& p) {
     for (size_t b = 0; b < s.block_parent_.size(); ++b) h.block_parent_[first_block + b] = id(s.block_parent_[b]);
 }
 
-void HierarchyBuilder::stitch_seams(Hierarchy& h, std::vector<Vec3> positions, std::vector<std::pair<NodeId, int>> seam) {
+void HierarchyBuilder::append_vertices(Hierarchy& h, const std::vector<Vec3>& positions) {
+    AMC_REQUIRE(h.positions_.size() + positions.size() < kNoVertex, limit_exceeded, "too many vertices");
+    for (const Vec3& p : positions) h.far_positions_ |= Hierarchy::is_far(p);
+    h.positions_.insert(h.positions_.end(), positions.begin(), positions.end());
+    h.live_vertices_ = uint32_t(h.positions_.size());
+}
+
+std::vector<HierarchyBuilder::RootLink> HierarchyBuilder::cut_root_links(Hierarchy& h,
+                                                                        const std::vector<std::pair<NodeId, int>>& edges) {
+    std::vector<RootLink> links;
+    for (const auto& edge : edges) {
+        const NodeId a = edge.first, b = h.nodes_[a].nbr[edge.second];
+        if (b == kNoNode) continue;  // its other side was listed first
+        const int eb = h.neighbor_edge(a, edge.second);
+        links.push_back({a, edge.second, b, eb});
+        for (const auto& [n, e] : {std::pair<NodeId, int>(a, edge.second), std::pair<NodeId, int>(b, eb)}) {
+            Hierarchy::Node& node = h.nodes_[n];
+            node.nbr[e] = kNoNode;
+            node.nbr_edge = uint8_t(node.nbr_edge & ~(3u << (2 * e)));  // as Hierarchy(base) leaves an edge without neighbour
+            node.flags = uint8_t(node.flags | (1u << e));
+        }
+    }
+    return links;
+}
+
+void HierarchyBuilder::relink_roots(Hierarchy& h, const std::vector<RootLink>& links) {
+    for (const RootLink& l : links) {
+        h.link(l.a, l.ea, l.b, l.eb);
+        h.nodes_[l.a].flags = uint8_t(h.nodes_[l.a].flags & ~(1u << l.ea));
+        h.nodes_[l.b].flags = uint8_t(h.nodes_[l.b].flags & ~(1u << l.eb));
+    }
+}
+
+void HierarchyBuilder::stitch_positions(Hierarchy& h, std::vector<Vec3> positions) {
     AMC_REQUIRE(positions.size() >= h.base().positions.size() && positions.size() < kNoVertex, corrupt,
                 "hierarchy too large to stitch");
     for (const Vec3& p : positions) h.far_positions_ |= Hierarchy::is_far(p);
     h.positions_ = std::move(positions);
-    h.live_nodes_ = uint32_t(h.nodes_.size());
     h.live_vertices_ = uint32_t(h.positions_.size());
+}
+
+void HierarchyBuilder::stitch_seams(Hierarchy& h, std::vector<std::pair<NodeId, int>> seam) {
+    h.live_nodes_ = uint32_t(h.nodes_.size());
 
     // The root edges on the seams, then the halves of each, level by level (a node's links are
     // complete before its children are linked).

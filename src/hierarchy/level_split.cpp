@@ -187,10 +187,14 @@ void Hierarchy::split_level(const LevelSplits& splits) {
     if (new_nodes > nodes_.capacity()) reserve(std::max(new_nodes, nodes_.capacity() + nodes_.capacity() / 2), 0);
     if (positions_.size() + size_t(3) * count > positions_.capacity()) {
         // Maybe not enough room: count exactly. Edge e of parent i gets a new vertex unless an
-        // earlier parent across it made one.
+        // earlier parent across it made one, or boundary_vertex has one.
         size_t new_vertices = 0;
         for (uint32_t i = 0; i < count; ++i) {
-            for (int e = 0; e < 3; ++e) new_vertices += !(first_half(i, e) / 4 < i);
+            const Node& parent = nodes_[parents[i]];
+            for (int e = 0; e < 3; ++e)
+                new_vertices += !(first_half(i, e) / 4 < i) &&
+                                !(splits.boundary_vertex != nullptr && ((parent.flags >> e) & 1u) &&
+                                  splits.boundary_vertex(splits.boundary_context, parent.v[e], parent.v[(e + 1) % 3]) != kNoVertex);
         }
         const size_t vertices = positions_.size() + new_vertices;
         if (vertices > positions_.capacity()) reserve(0, std::max(vertices, positions_.capacity() + positions_.capacity() / 2));
@@ -210,6 +214,7 @@ void Hierarchy::split_level(const LevelSplits& splits) {
     // The parents are fetched 16 parents early (what else was tried: HIERARCHY_CODER.md, Speed, item 13).
     constexpr uint32_t kParentsAhead = 16;
     const uint32_t offset = uint32_t(c0);
+    const auto boundary_vertex = splits.boundary_vertex;
     for (uint32_t chunk = 0; chunk < count; chunk += kChunk) {
         const uint32_t chunk_end = std::min(count, chunk + kChunk);
         uint32_t new_vertices = 0;
@@ -227,8 +232,16 @@ void Hierarchy::split_level(const LevelSplits& splits) {
                     const unsigned eq = (parent.nbr_edge >> (2 * e)) & 3u;
                     m[e] = nodes[c0 + (t & ~3u) + red_split::kCenter].v[red_split::kCenterVertexOfMidpoint[eq]];
                 } else {
-                    ends[new_vertices++] = {parent.v[e], parent.v[e == 2 ? 0 : e + 1]};
-                    m[e] = next_vertex++;
+                    const VertexId a = parent.v[e], b = parent.v[e == 2 ? 0 : e + 1];
+                    const VertexId existing = boundary_vertex != nullptr && ((parent.flags >> e) & 1u)
+                                                  ? boundary_vertex(splits.boundary_context, a, b)
+                                                  : kNoVertex;
+                    if (existing != kNoVertex) {
+                        m[e] = existing;
+                    } else {
+                        ends[new_vertices++] = {a, b};
+                        m[e] = next_vertex++;
+                    }
                 }
             }
             // The children's edges (red_split::kChildEdges): linked outer edges take the parent's neighbour

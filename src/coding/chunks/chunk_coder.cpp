@@ -16,7 +16,8 @@ namespace {
 
 // The seam vertex splitting edge e of n, or Seam::kNotSeam / kUnsplit. Only boundary edges of a
 // chunk can lie on the seam; their ends are base or seam vertices, which have keys.
-int32_t seam_vertex(const Hierarchy& h, const VertexKeys& keys, const Seam& seam, NodeId n, int e) {
+template <class Keys>
+int32_t seam_vertex(const Hierarchy& h, const Keys& keys, const Seam& seam, NodeId n, int e) {
     if (!h.is_boundary_edge(n, e)) return Seam::kNotSeam;
     const uint32_t a = keys[h.vertex(n, e)], b = keys[h.vertex(n, (e + 1) % 3)];
     if (a == kNoVertex || b == kNoVertex) return Seam::kNotSeam;
@@ -26,7 +27,8 @@ int32_t seam_vertex(const Hierarchy& h, const VertexKeys& keys, const Seam& seam
 // The hanging nodes the seam adds to a leaf of a chunk: one on each of its edges that the seam
 // splits (refined on the other side, since the leaf is not). Only boundary edges can lie on the
 // seam; testing for them first spares most leaves the lookup of their neighbours.
-int seam_hanging_count(const Hierarchy& h, const VertexKeys& keys, const Seam& seam, NodeId leaf) {
+template <class Keys>
+int seam_hanging_count(const Hierarchy& h, const Keys& keys, const Seam& seam, NodeId leaf) {
     if (!h.is_boundary_edge(leaf, 0) && !h.is_boundary_edge(leaf, 1) && !h.is_boundary_edge(leaf, 2)) return 0;
     int count = 0;
     for (int e = 0; e < 3; ++e) count += seam_vertex(h, keys, seam, leaf, e) >= 0;
@@ -91,18 +93,51 @@ ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& s
     return out;
 }
 
-Hierarchy& decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, size_t size, const TriangleMesh& base,
-                        const std::vector<VertexId>& base_vertex, const Seam& seam, CoordinateSpace space,
-                        const ChunkDecodeLimits& limits, const std::string& what, VertexKeys& keys, uint64_t& faces) {
+namespace {
+
+// ChunkVertexKeys::key as an index, like the encoder's VertexKeys.
+struct KeysOf {
+    const ChunkVertexKeys& keys;
+    uint32_t operator[](VertexId v) const { return keys.key(v); }
+};
+
+// The seam vertex that splits boundary segment (a, b) of a chunk being decoded (LevelSplits::boundary_vertex).
+struct SeamSplits {
+    const ChunkVertexKeys& keys;
+    const Seam& seam;
+    uint8_t* used;
+    const std::string* where;
+    static VertexId find(void* context, VertexId a, VertexId b) {
+        const SeamSplits& self = *static_cast<const SeamSplits*>(context);
+        const uint32_t ka = self.keys.key(a), kb = self.keys.key(b);
+        if (ka == kNoVertex || kb == kNoVertex) return kNoVertex;
+        const int32_t s = self.seam.find(ka, kb);
+        AMC_REQUIRE(s != Seam::kUnsplit, corrupt, *self.where + ": refines a seam segment the seam block leaves unsplit");
+        if (s == Seam::kNotSeam) return kNoVertex;
+        self.used[s] = 1;
+        return self.keys.seam_first + VertexId(s);
+    }
+};
+
+}  // namespace
+
+void decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, size_t size, const ChunkPlace& place,
+                  const Seam& seam, CoordinateSpace space, const ChunkDecodeLimits& limits, const std::string& what,
+                  uint64_t& faces) {
     PayloadReader in(data, size, "chunk block");
     const uint64_t header_size = in.varint();
     AMC_REQUIRE(header_size <= in.remaining(), corrupt, what + ": hierarchy header is longer than the block");
     const uint8_t* header = in.bytes(header_size);
     const uint64_t levels = in.varint();
     AMC_REQUIRE(levels >= 1 && levels <= kMaxLevel + 1, corrupt, what + ": bad level count");
-    hierarchy.restart(base, header, size_t(header_size), limits.stream_version, limits.max_nodes);
-    Hierarchy& h = hierarchy.hierarchy();
-    keys.assign(base_vertex.begin(), base_vertex.end());
+    Hierarchy& h = *place.target;
+    hierarchy.restart_in(h, place.first_root, place.roots, header, size_t(header_size), limits.stream_version,
+                         limits.max_nodes);
+    const KeysOf keys{place.keys};
+    std::string where = what;
+    SeamSplits seam_splits{place.keys, seam, place.seam_used, &where};
+    hierarchy.set_boundary_vertices(&SeamSplits::find, &seam_splits);
+    const VertexId seam_first = place.keys.seam_first, seam_count = place.keys.seam_count;
     PositionCoder positions(space);
     BitModel flipped;
     std::vector<std::pair<NodeId, int>> created;
@@ -112,14 +147,14 @@ Hierarchy& decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, s
         AMC_REQUIRE(!hierarchy.done(), corrupt, what + ": more levels than its hierarchy has");
         stopped = limits.max_level >= 0 && int(level) >= limits.max_level;
         if (stopped) break;  // progressive: stop here
-        const std::string where = what + ", level " + std::to_string(level);
+        where = what + ", level " + std::to_string(level);
         const uint64_t length = in.varint();
         AMC_REQUIRE(length >= 1 && length <= in.remaining(), corrupt, where + ": bad length");
         const Block level_block{BlockType::level, in.bytes(length), size_t(length), 0};
         const LevelBlockParts parts = split_level_block(level_block, limits.file_version, space.quantizer != nullptr, where);
         ArithmeticDecoder decoder(parts.arithmetic, parts.arithmetic_size);
         const NodeId first = hierarchy.level_first(), end = first + NodeId(hierarchy.level_size());
-        hierarchy.decode_level(decoder);
+        hierarchy.decode_level(decoder);  // the seam vertices it splits off placed already (SeamSplits)
         for (NodeId n = first; n < end; ++n) {
             if (!h.is_leaf(n)) continue;
             const int seam_hanging = seam_hanging_count(h, keys, seam, n);
@@ -127,28 +162,17 @@ Hierarchy& decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, s
             if (is_seam_closure(h, n, seam_hanging)) h.set_diagonal_flipped(n, decoder.decode(flipped));
         }
         AMC_REQUIRE(!decoder.overran(), corrupt, where + ": hierarchy part is truncated or corrupt");
-        keys.resize(h.positions().size(), kNoVertex);
         created.clear();
-        for (auto [n, e] : hierarchy.new_vertices()) {
-            const int32_t s = seam_vertex(h, keys, seam, n, e);
-            AMC_REQUIRE(s != Seam::kUnsplit, corrupt, where + ": refines a seam segment the seam block leaves unsplit");
-            if (s == Seam::kNotSeam) {
-                created.emplace_back(n, e);
-                continue;
-            }
-            const VertexId m = h.midpoint(n, e);
-            h.set_position(m, seam.position(uint32_t(s)));
-            keys[m] = seam.base_vertex_count() + uint32_t(s);
-        }
+        for (auto [n, e] : hierarchy.new_vertices())
+            if (h.midpoint(n, e) - seam_first >= seam_count) created.emplace_back(n, e);
         decode_level_geometry(h, created, parts, decoder, positions, space, int(level), where);
     }
-    keys.resize(h.positions().size(), kNoVertex);
+    hierarchy.set_boundary_vertices(nullptr, nullptr);
     faces = hierarchy.leaf_faces() + seam_faces;
-    if (stopped) return h;
+    if (stopped) return;
     AMC_REQUIRE(hierarchy.done(), corrupt, what + ": ends before its hierarchy's last level");
     AMC_REQUIRE(in.remaining() == 0, corrupt, what + ": bytes after the last level");
     hierarchy.finish();
-    return h;
 }
 
 }  // namespace amc

@@ -39,14 +39,34 @@ struct ChunkDecodeLimits {
     uint8_t stream_version = kHierarchyStreamVersion;
 };
 
-// Decodes a chunk block's payload over `base` (base_of_roots of the chunk's roots) whose vertex i
-// is the whole base's vertex base_vertex[i], in `decoder` (restarted: the result is its
-// hierarchy(), until the next restart; a decoder used again keeps its memory). Throws Error naming
-// `what` on a corrupt chunk. `keys` receives the seam keys of the result's vertex ids (base and
-// seam vertices; kNoVertex for the chunk's own), `faces` the faces its leaves have in the whole
-// leaf mesh (ChunkCode::faces; meaningful when every level is decoded).
-Hierarchy& decode_chunk(HierarchyLevelDecoder& decoder, const uint8_t* data, size_t size, const TriangleMesh& base,
-                        const std::vector<VertexId>& base_vertex, const Seam& seam, CoordinateSpace space,
-                        const ChunkDecodeLimits& limits, const std::string& what, VertexKeys& keys, uint64_t& faces);
+// Where a chunk is decoded: the `roots` roots of `target` from `first_root`, unrefined and linked
+// among themselves only (its links to other chunks cut), their descendants appended to `target`.
+// `keys` tells the seam keys of target's vertex ids: its base vertex v is key base_keys[v], and
+// every seam vertex s is placed already, as vertex seam_first + s.
+struct ChunkVertexKeys {
+    const std::vector<VertexId>* base_keys = nullptr;
+    VertexId seam_first = 0;
+    uint32_t seam_count = 0;
+    uint32_t seam_base_vertices = 0;  // the seam's keys of seam vertices start here (Seam::base_vertex_count)
+    uint32_t key(VertexId v) const {
+        if (v < base_keys->size()) return (*base_keys)[v];
+        return v - seam_first < seam_count ? seam_base_vertices + (v - seam_first) : kNoVertex;
+    }
+};
+struct ChunkPlace {
+    Hierarchy* target = nullptr;
+    NodeId first_root = 0;
+    uint32_t roots = 0;
+    ChunkVertexKeys keys;
+    uint8_t* seam_used = nullptr;  // seam_used[s] set to 1 when the chunk splits off seam vertex s
+};
+
+// Decodes a chunk block's payload into `place` with `decoder` (restarted; a decoder used again
+// keeps its working memory). Throws Error naming `what` on a corrupt chunk. `faces` receives the
+// faces its leaves have in the whole leaf mesh (ChunkCode::faces; meaningful when every level is
+// decoded).
+void decode_chunk(HierarchyLevelDecoder& decoder, const uint8_t* data, size_t size, const ChunkPlace& place,
+                  const Seam& seam, CoordinateSpace space, const ChunkDecodeLimits& limits, const std::string& what,
+                  uint64_t& faces);
 
 }  // namespace amc

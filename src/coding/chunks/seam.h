@@ -55,6 +55,7 @@ public:
     uint32_t base_vertex_count() const { return base_vertices_; }
     uint32_t vertex_count() const { return uint32_t(positions_.size()); }
     Vec3 position(uint32_t s) const { return positions_[s]; }
+    const std::vector<Vec3>& positions() const { return positions_; }
     // The seam vertex splitting segment (a, b) (keys), kUnsplit, or kNotSeam.
     int32_t find(uint32_t a, uint32_t b) const { return segments_.find(segment_key(a, b)); }
 

@@ -83,11 +83,26 @@ void HierarchyLevelDecoder::restart(const TriangleMesh& base, const uint8_t* hea
 }
 
 void HierarchyLevelDecoder::restart(const TriangleMesh& base, const HierarchyStreamHeader& header, uint64_t max_nodes) {
+    h_ = &own_;
+    own_.reset(base);
+    start(0, own_.root_count(), header, max_nodes);
+}
+
+void HierarchyLevelDecoder::restart_in(Hierarchy& target, NodeId first_root, uint32_t roots, const uint8_t* header,
+                                       size_t header_size, uint8_t stream_version, uint64_t max_nodes) {
+    AMC_REQUIRE(uint64_t(first_root) + roots <= target.root_count(), invalid_input, "hierarchy decoder: roots out of range");
+    h_ = &target;
+    start(first_root, roots, parse_header(header, header_size, stream_version), max_nodes);
+}
+
+void HierarchyLevelDecoder::start(NodeId first_root, uint32_t roots, const HierarchyStreamHeader& header,
+                                  uint64_t max_nodes) {
     header_ = header;
     max_nodes_ = max_nodes;
-    h_.reset(base);
-    // Uniform levels alone would build root_count * (4^(U+1) - 1) / 3 nodes: check before.
-    uint64_t uniform_nodes = base.triangles.size(), level_nodes = base.triangles.size();
+    boundary_vertex_ = nullptr;
+    boundary_context_ = nullptr;
+    // Uniform levels alone would build roots * (4^(U+1) - 1) / 3 nodes: check before.
+    uint64_t uniform_nodes = roots, level_nodes = roots;
     for (int l = 0; l < header_.uniform_levels && uniform_nodes <= max_nodes_; ++l) {
         level_nodes *= 4;
         uniform_nodes += level_nodes;
@@ -99,11 +114,11 @@ void HierarchyLevelDecoder::restart(const TriangleMesh& base, const HierarchyStr
     traversal_.configure(header.options, header.version);
     for (Level& level : decided_) spare_.push_back(std::move(level));
     decided_.clear();
-    root_level(h_, level_, header.options.cull_one_regularity);
+    root_level(*h_, first_root, roots, level_, header.options.cull_one_regularity);
     level_index_ = 0;
-    level_base_ = 0;
-    node_count_ = h_.root_count();
-    vertex_count_ = base.positions.size();
+    level_base_ = first_root;
+    node_count_ = roots;
+    vertex_count_ = h_->positions().size();
     symbols_read_ = 0;
     leaf_faces_ = 0;
 }
@@ -121,7 +136,7 @@ void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder, uint64_t ma
     // Node ids are consecutive level by level: the decided level's nodes come right before its
     // children, the last nodes counted.
     const Level& level = decided_.back();
-    const NodeId first = NodeId(node_count_ - uint64_t(4) * level.refined_count - level.size());
+    const NodeId first = level_base_;
     new_vertices_.clear();
     new_vertices_.reserve(vertex_count_ - vertices_before);  // once per level, not doubling vertex by vertex
     for_each_new_vertex(level, numbering_, [&](uint32_t i, int e) { new_vertices_.emplace_back(first + i, e); });
@@ -157,15 +172,14 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder, uint64_t ma
     // nothing is tested or masked per symbol. Marked likely and group_mask defined above: GCC's
     // register allocation around this path is fragile (HIERARCHY_CODER.md, Speed, item 29).
     if (mixed_model_ != nullptr) {
-        // The mixing mode (FORMAT.md 2.1): the features read this level's nodes in h_, built by
+        // The mixing mode (FORMAT.md 2.1): the features read this level's nodes in *h_, built by
         // decode_level with their corners placed; node id = level_base_ + local index.
-        AMC_REQUIRE(h_.node_capacity() == level_base_ + n, invalid_input,
-                    "hierarchy stream: the mixing mode decodes one level at a time");
+        AMC_REQUIRE(decided_.empty(), invalid_input, "hierarchy stream: the mixing mode decodes one level at a time");
         MixedHierarchyModel& mixed = *mixed_model_;
         LevelShapes& shapes = mixed_shapes_;
         shapes.start_level(n);
         const MixingModel model = mixed.model();
-        const Hierarchy& h = h_;
+        const Hierarchy& h = *h_;
         const NodeId base = level_base_;
         const Level& current = level_;
         traversal_.run_newest(
@@ -255,12 +269,12 @@ void HierarchyLevelDecoder::build_decided_levels() {
         // the children of each level are numbered consecutively (no ids are ever freed). The
         // next level's links are the children's links, so the whole level splits in one pass,
         // in canonical order.
-        for (const uint32_t i : level.flipped) h_.set_diagonal_flipped(level_base_ + i, true);
+        for (const uint32_t i : level.flipped) h_->set_diagonal_flipped(level_base_ + i, true);
         const uint32_t count = level.refined_count;
         uint32_t* parents = level.refined.data();
         for (uint32_t b = 0; b < count; ++b) parents[b] += level_base_;
-        const NodeId first_child = h_.node_capacity();
-        HierarchyBuilder::split_level(h_, LevelSplits{parents, count, children.nbr.data()});
+        const NodeId first_child = h_->node_capacity();
+        HierarchyBuilder::split_level(*h_, LevelSplits{parents, count, children.nbr.data(), boundary_vertex_, boundary_context_});
         level_base_ = first_child;
     }
     // Their memory serves the levels to come.

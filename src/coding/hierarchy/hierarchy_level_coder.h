@@ -132,12 +132,26 @@ public:
     HierarchyLevelDecoder(const TriangleMesh& base, const HierarchyStreamHeader& header, uint64_t max_nodes);
     // A decoder with no stream yet (done() until restart).
     HierarchyLevelDecoder() : traversal_(HierarchyCoderOptions{}, kHierarchyStreamVersion) {}
+    HierarchyLevelDecoder(const HierarchyLevelDecoder&) = delete;  // h_ may point at own_
+    HierarchyLevelDecoder& operator=(const HierarchyLevelDecoder&) = delete;
     // Starts on another stream as the constructor does, keeping the working memory and the
     // memory of hierarchy() (rebuilt over `base`).
     void restart(const TriangleMesh& base, const HierarchyStreamHeader& header, uint64_t max_nodes);
     // The same with the header's bytes, as the first constructor takes them.
     void restart(const TriangleMesh& base, const uint8_t* header, size_t header_size, uint8_t stream_version,
                  uint64_t max_nodes);
+    // Starts on a stream of the `roots` roots of `target` from `first_root`, which must be linked
+    // among themselves only and unrefined: their levels are built in `target` (hierarchy() until
+    // the next restart), their nodes appended to it. `max_nodes` counts these roots and their
+    // descendants.
+    void restart_in(Hierarchy& target, NodeId first_root, uint32_t roots, const uint8_t* header, size_t header_size,
+                    uint8_t stream_version, uint64_t max_nodes);
+    // Until the next restart, the new vertex on each boundary edge of a split node is asked of
+    // `split.boundary_vertex` (LevelSplits, hierarchy_builder.h).
+    void set_boundary_vertices(VertexId (*boundary_vertex)(void*, VertexId, VertexId), void* context) {
+        boundary_vertex_ = boundary_vertex;
+        boundary_context_ = context;
+    }
     bool done() const { return level_.empty(); }
     int level() const { return level_index_; }
     // Nodes of the current level (ids in hierarchy()) in canonical order.
@@ -171,9 +185,11 @@ public:
     size_t level_size() const { return decided_.empty() ? level_.size() : decided_.front().size(); }
     // After the last level: every announced symbol must have been used.
     void finish() const;
-    Hierarchy& hierarchy() { return h_; }
+    Hierarchy& hierarchy() { return *h_; }
 
 private:
+    // Starts on the stream over the roots [first_root, first_root + roots) of *h_.
+    void start(NodeId first_root, uint32_t roots, const HierarchyStreamHeader& header, uint64_t max_nodes);
     // Counts the decided level's splits (level_.refined, numbered in numbering_) and the vertices
     // they create, and moves to the next level.
     void finish_level();
@@ -184,7 +200,10 @@ private:
 
     HierarchyStreamHeader header_;
     uint64_t max_nodes_ = 0;
-    Hierarchy h_;
+    Hierarchy own_;
+    Hierarchy* h_ = &own_;  // the hierarchy built: own_, or restart_in's target
+    VertexId (*boundary_vertex_)(void*, VertexId, VertexId) = nullptr;
+    void* boundary_context_ = nullptr;
     HierarchyModels models_;
     LevelTraversal traversal_;
     Level level_;

@@ -2,6 +2,7 @@
 #include "coding/hierarchy/level_forest.h"
 
 #include "coding/hierarchy/level_tables.h"
+#include "common/check.h"
 #include "common/simd.h"
 #include "hierarchy/red_split_kernels.h"
 
@@ -10,7 +11,10 @@
 namespace amc {
 
 void root_level(const Hierarchy& h, Level& level, bool cull_one_regularity) {
-    const uint32_t n = h.root_count();
+    root_level(h, 0, h.root_count(), level, cull_one_regularity);
+}
+
+void root_level(const Hierarchy& h, NodeId first, uint32_t n, Level& level, bool cull_one_regularity) {
     level.flipped.clear();
     level.refined_count = 0;
     level.roots.resize(n);
@@ -21,9 +25,11 @@ void root_level(const Hierarchy& h, Level& level, bool cull_one_regularity) {
         LevelLinks& node = level.roots[r];
         uint8_t boundary = 0, edges = 0;
         for (int e = 0; e < 3; ++e) {
-            node.nbr[e] = h.neighbor(r, e);
-            if (node.nbr[e] != kNoNode) edges = uint8_t(edges | (h.neighbor_edge(r, e) << (2 * e)));
-            boundary = uint8_t(boundary | (int(h.is_boundary_edge(r, e)) << e));
+            const NodeId q = h.neighbor(first + r, e);
+            AMC_REQUIRE(q == kNoNode || q - first < n, invalid_input, "root_level: a root is linked outside its range");
+            node.nbr[e] = q == kNoNode ? kNoNode : q - first;
+            if (q != kNoNode) edges = uint8_t(edges | (h.neighbor_edge(first + r, e) << (2 * e)));
+            boundary = uint8_t(boundary | (int(h.is_boundary_edge(first + r, e)) << e));
         }
         node.nbr_edge = edges;
         node.flags = boundary;

@@ -171,6 +171,9 @@ struct DecidedLevelScan {
 // incomplete roots are decided (not refined) and their neighbours' priorities lowered, as in
 // derive_next_level.
 void root_level(const Hierarchy& h, Level& level, bool cull_one_regularity);
+// The same over the `count` roots from `first` (local index = id - first), linked among
+// themselves only (a chunk's roots in the whole, their links to other chunks cut).
+void root_level(const Hierarchy& h, NodeId first, uint32_t count, Level& level, bool cull_one_regularity);
 
 // Numbers the refined nodes of a decided level: level.refined (canonical order) and the
 // numbering. When `closures` is given, lists there the leaves with two or three hanging nodes.

@@ -1,0 +1,42 @@
+// Decoding the chunks of a chunked .amc file into one hierarchy, the whole over their roots
+// (chunked_file.h): on one thread each chunk straight into the whole, in chunk order; on several,
+// each chunk alone, copied into its slice of the whole as soon as it is decoded.
+#pragma once
+
+#include "coding/chunks/chunk_coder.h"
+#include "coding/chunks/chunk_layout.h"
+#include "coding/chunks/seam.h"
+
+#include <amc/codec.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace amc {
+
+// One chunk to decode: its block's payload and the chunk table's entry.
+struct ChunkJob {
+    uint32_t chunk = 0;
+    const uint8_t* data = nullptr;
+    size_t size = 0;
+    RootRange roots;
+    uint64_t nodes = 0;
+};
+
+struct ChunkMergeInput {
+    const TriangleMesh* base = nullptr;  // the file's base mesh
+    const Seam* seam = nullptr;
+    CoordinateSpace space;
+    uint8_t file_version = 0;
+    bool whole_file = true;  // every chunk, in order
+    uint64_t vertices = 0;   // the file's vertex count (metadata)
+    size_t file_size = 0;
+    DecodeOptions options;
+};
+
+// Decodes `jobs` (chunks in increasing order) and merges them: the hierarchy over base_of_roots of
+// their roots, its vertices the base's, the seam vertices the chunks hold (in seam order), then
+// each chunk's own. `faces` receives the faces of its leaf mesh as the chunks counted them.
+Hierarchy decode_and_merge_chunks(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& input, uint64_t& faces);
+
+}  // namespace amc
