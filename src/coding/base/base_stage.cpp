@@ -44,15 +44,17 @@ TriangleMesh base_as_decoded(const Hierarchy& h, const Quantizer* quantizer) {
 
 }  // namespace
 
-// Mode 2's search codes one triangle per hierarchy node (a searched triangle costs about a third
-// of a node's coding): on the corpus's hierarchies the whole search gained nothing over that
-// (docs/BASE_CODER.md, Encode time) while taking half of a 12-bit encode. The floor keeps the
-// whole search on bases of up to about 90 triangles; an unrefined mesh is all base and gets it all.
+// Mode 2's search codes one triangle per hierarchy node, at most 2^18 (a searched triangle costs
+// about a third of a node's coding): on the corpus's hierarchies the whole search gained nothing
+// over that (docs/BASE_CODER.md, Encode time) while taking half of a 12-bit encode. The floor keeps
+// the whole search on bases of up to about 90 triangles; an unrefined mesh is all base and gets
+// the full budget.
 uint64_t base_search_budget(const Hierarchy& h) {
     if (h.node_count() == h.root_count()) return kFullBaseSearch;
     constexpr uint64_t kSearchTrianglesPerNode = 1;
     constexpr uint64_t kSmallestBudget = uint64_t{1} << 16;
-    return std::clamp(kSearchTrianglesPerNode * h.node_count(), kSmallestBudget, kFullBaseSearch);
+    constexpr uint64_t kLargestBudget = uint64_t{1} << 18;
+    return std::clamp(kSearchTrianglesPerNode * h.node_count(), kSmallestBudget, kLargestBudget);
 }
 
 // The base connectivity of a file. Mode 2's search (FORMAT.md 4.16) starts the conquest away from
