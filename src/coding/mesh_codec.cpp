@@ -226,8 +226,8 @@ Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const T
     }
     const ChunkedDecodeInput input{&base, space, reader.version(), meta.vertices, options};
     ChunkTable table;
-    uint64_t faces = 0;
-    Hierarchy h = decode_chunked(reader, input, meta.nodes, request != nullptr ? &request->chunks : nullptr, &table, &faces);
+    MergedCounts counts;
+    Hierarchy h = decode_chunked(reader, input, meta.nodes, request != nullptr ? &request->chunks : nullptr, &table, &counts);
     if (request != nullptr) {
         for (uint32_t c : request->chunks)
             for (uint32_t r = table.roots[c].first; r < table.roots[c].first + table.roots[c].count; ++r)
@@ -248,8 +248,8 @@ Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const T
         AMC_REQUIRE(reader.next(block), corrupt, "file ends after its numbering block");
     }
     AMC_REQUIRE(block.type == BlockType::end, corrupt, std::string("unexpected ") + block_type_name(uint8_t(block.type)) + " block after the chunks");
-    AMC_REQUIRE(h.node_count() == meta.nodes && h.vertex_count() == meta.vertices && uint64_t(h.depth() + 1) == meta.levels &&
-                    faces == meta.faces,
+    AMC_REQUIRE(h.node_count() == meta.nodes && h.vertex_count() == meta.vertices && uint64_t(counts.depth + 1) == meta.levels &&
+                    counts.faces == meta.faces,
                 corrupt, "decoded hierarchy does not match the metadata");
     if (partial != nullptr) {
         partial->complete = true;

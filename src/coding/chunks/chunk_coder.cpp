@@ -123,7 +123,7 @@ struct SeamSplits {
 
 void decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, size_t size, const ChunkPlace& place,
                   const Seam& seam, CoordinateSpace space, const ChunkDecodeLimits& limits, const std::string& what,
-                  uint64_t& faces) {
+                  ChunkCounts& counts) {
     PayloadReader in(data, size, "chunk block");
     const uint64_t header_size = in.varint();
     AMC_REQUIRE(header_size <= in.remaining(), corrupt, what + ": hierarchy header is longer than the block");
@@ -168,7 +168,8 @@ void decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, size_t 
         decode_level_geometry(h, created, parts, decoder, positions, space, int(level), where);
     }
     hierarchy.set_boundary_vertices(nullptr, nullptr);
-    faces = hierarchy.leaf_faces() + seam_faces;
+    counts.faces = hierarchy.leaf_faces() + seam_faces;
+    counts.depth = int(levels) - 1;  // the last level refines nothing (checked below)
     if (stopped) return;
     AMC_REQUIRE(hierarchy.done(), corrupt, what + ": ends before its hierarchy's last level");
     AMC_REQUIRE(in.remaining() == 0, corrupt, what + ": bytes after the last level");

@@ -61,12 +61,17 @@ struct ChunkPlace {
     uint8_t* seam_used = nullptr;  // seam_used[s] set to 1 when the chunk splits off seam vertex s
 };
 
+// What a chunk's decoder knows of its trees once every level is decoded.
+struct ChunkCounts {
+    uint64_t faces = 0;  // its leaves' faces in the whole leaf mesh (ChunkCode::faces)
+    int depth = 0;       // its finest level
+};
+
 // Decodes a chunk block's payload into `place` with `decoder` (restarted; a decoder used again
-// keeps its working memory). Throws Error naming `what` on a corrupt chunk. `faces` receives the
-// faces its leaves have in the whole leaf mesh (ChunkCode::faces; meaningful when every level is
-// decoded).
+// keeps its working memory). Throws Error naming `what` on a corrupt chunk. `counts` receives its
+// counts (meaningful when every level is decoded).
 void decode_chunk(HierarchyLevelDecoder& decoder, const uint8_t* data, size_t size, const ChunkPlace& place,
                   const Seam& seam, CoordinateSpace space, const ChunkDecodeLimits& limits, const std::string& what,
-                  uint64_t& faces);
+                  ChunkCounts& counts);
 
 }  // namespace amc

@@ -138,7 +138,7 @@ void finish_vertices(Hierarchy& whole, const MergePlan& plan, const std::vector<
 // One thread: each chunk decoded straight into the whole, in chunk order, so that its nodes and
 // its own vertices come out where the whole keeps them. No chunk hierarchy, no copy.
 Hierarchy merge_in_order(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& input, MergePlan& plan,
-                         std::vector<uint64_t>& faces) {
+                         std::vector<ChunkCounts>& counts) {
     Hierarchy whole(plan.base);
     if (plan.trusted) whole.reserve(size_t(plan.nodes), plan.full ? size_t(input.vertices) : 0);
     HierarchyBuilder::append_vertices(whole, input.seam->positions());
@@ -150,7 +150,7 @@ Hierarchy merge_in_order(const std::vector<ChunkJob>& jobs, const ChunkMergeInpu
         const ChunkJob& job = jobs[i];
         const ChunkPlace place{&whole, plan.first_root[i], job.roots.count, plan.keys_in_whole(), seam_used.data()};
         decode_chunk(decoder, job.data, job.size, place, *input.seam, input.space, limits_of(job, input), chunk_name(job),
-                     faces[i]);
+                     counts[i]);
         AMC_REQUIRE(input.options.max_level >= 0 || decoder.node_count() == job.nodes, corrupt,
                     chunk_name(job) + " does not hold the nodes the chunk table says");
         AMC_REQUIRE(!plan.full || whole.positions().size() <= input.vertices, corrupt,
@@ -165,7 +165,7 @@ Hierarchy merge_in_order(const std::vector<ChunkJob>& jobs, const ChunkMergeInpu
 // Several threads: each chunk decoded alone (over its own roots, the seam vertices placed after
 // its base vertices) and copied into its slice of the whole.
 Hierarchy merge_copies(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& input, MergePlan& plan,
-                       std::vector<uint64_t>& faces, unsigned threads) {
+                       std::vector<ChunkCounts>& counts, unsigned threads) {
     const size_t n = jobs.size();
     std::vector<HierarchyBuilder::StitchPart> parts(n);
     std::vector<NodeId> slice_end(n);
@@ -281,7 +281,7 @@ Hierarchy merge_copies(const std::vector<ChunkJob>& jobs, const ChunkMergeInput&
                                {&base_keys[i], VertexId(base_keys[i].size()), plan.seam_count, plan.file_base_vertices},
                                seam_used[i].data()};
         decode_chunk(*decoder_of[i], job.data, job.size, place, *input.seam, input.space, limits_of(job, input),
-                     chunk_name(job), faces[i]);
+                     chunk_name(job), counts[i]);
         AMC_REQUIRE(input.options.max_level >= 0 || h.node_count() == job.nodes, corrupt,
                     chunk_name(job) + " does not hold the nodes the chunk table says");
         if (!whole_first) return;
@@ -340,14 +340,17 @@ Hierarchy merge_copies(const std::vector<ChunkJob>& jobs, const ChunkMergeInput&
 
 }  // namespace
 
-Hierarchy decode_and_merge_chunks(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& input, uint64_t& faces) {
+Hierarchy decode_and_merge_chunks(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& input, MergedCounts& counts) {
     MergePlan plan = plan_merge(jobs, input);
-    std::vector<uint64_t> chunk_faces(jobs.size(), 0);  // of each chunk's leaves in the whole leaf mesh
+    std::vector<ChunkCounts> chunk_counts(jobs.size());
     const unsigned threads = std::min<unsigned>(resolve_thread_count(input.options.threads), unsigned(jobs.size()));
-    Hierarchy whole = threads <= 1 ? merge_in_order(jobs, input, plan, chunk_faces)
-                                   : merge_copies(jobs, input, plan, chunk_faces, threads);
-    faces = 0;
-    for (uint64_t f : chunk_faces) faces += f;
+    Hierarchy whole = threads <= 1 ? merge_in_order(jobs, input, plan, chunk_counts)
+                                   : merge_copies(jobs, input, plan, chunk_counts, threads);
+    counts = MergedCounts();
+    for (const ChunkCounts& c : chunk_counts) {
+        counts.faces += c.faces;
+        counts.depth = std::max(counts.depth, c.depth);
+    }
     return whole;
 }
 

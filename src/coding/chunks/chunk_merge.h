@@ -34,9 +34,15 @@ struct ChunkMergeInput {
     DecodeOptions options;
 };
 
+// What the chunks' decoders know of the merged hierarchy, when every level is decoded.
+struct MergedCounts {
+    uint64_t faces = 0;  // of its leaf mesh (leaf_face_count)
+    int depth = 0;       // Hierarchy::depth
+};
+
 // Decodes `jobs` (chunks in increasing order) and merges them: the hierarchy over base_of_roots of
 // their roots, its vertices the base's, the seam vertices the chunks hold (in seam order), then
-// each chunk's own. `faces` receives the faces of its leaf mesh as the chunks counted them.
-Hierarchy decode_and_merge_chunks(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& input, uint64_t& faces);
+// each chunk's own.
+Hierarchy decode_and_merge_chunks(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& input, MergedCounts& counts);
 
 }  // namespace amc

@@ -120,7 +120,7 @@ ChunkTable read_chunk_table(const Block& block, uint64_t base_triangles, uint64_
 }
 
 Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, uint64_t nodes,
-                         const std::vector<uint32_t>* selected, ChunkTable* table_out, uint64_t* faces_out) {
+                         const std::vector<uint32_t>* selected, ChunkTable* table_out, MergedCounts* counts_out) {
     const TriangleMesh& base = *input.base;
     Block block{};
     AMC_REQUIRE(reader.next(block) && block.type == BlockType::chunk_table, corrupt, "expected a chunk table block");
@@ -168,9 +168,9 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
     merge.vertices = input.vertices;
     merge.file_size = file_size;
     merge.options = input.options;
-    uint64_t faces = 0;
-    Hierarchy whole = decode_and_merge_chunks(jobs, merge, faces);
-    if (faces_out != nullptr) *faces_out = faces;
+    MergedCounts counts;
+    Hierarchy whole = decode_and_merge_chunks(jobs, merge, counts);
+    if (counts_out != nullptr) *counts_out = counts;
     return whole;
 }
 

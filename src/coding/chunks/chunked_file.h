@@ -4,6 +4,7 @@
 #pragma once
 
 #include "coding/chunks/chunk_layout.h"
+#include "coding/chunks/chunk_merge.h"
 #include "coding/container.h"
 #include "coding/geometry/float_coder.h"  // CoordinateSpace
 
@@ -54,10 +55,11 @@ struct ChunkedDecodeInput {
 // Reads the chunk table and seam blocks at the reader's position and decodes the chunks in
 // `selected` (indices in increasing order; all of them when null), seeking to each through the
 // table, then merges them: the hierarchy over base_of_roots of their roots. Leaves the reader
-// after the last chunk block when all are decoded. `faces_out` receives the faces of the merged
-// hierarchy's leaf mesh as the chunks counted them (leaf_face_count of the result, for the
-// metadata check, without a pass over its nodes), when every level is decoded.
+// after the last chunk block when all are decoded. `counts_out` receives the merged hierarchy's
+// counts as the chunks' decoders know them (for the metadata check, without a pass over its
+// nodes), when every level is decoded.
 Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, uint64_t nodes,
-                         const std::vector<uint32_t>* selected, ChunkTable* table_out = nullptr, uint64_t* faces_out = nullptr);
+                         const std::vector<uint32_t>* selected, ChunkTable* table_out = nullptr,
+                         MergedCounts* counts_out = nullptr);
 
 }  // namespace amc
