@@ -44,17 +44,13 @@ TriangleMesh base_as_decoded(const Hierarchy& h, const Quantizer* quantizer) {
 
 }  // namespace
 
-// Mode 2's search codes one triangle per hierarchy node, at most 2^18 (a searched triangle costs
-// about a third of a node's coding): on the corpus's hierarchies the whole search gained nothing
-// over that (docs/BASE_CODER.md, Encode time) while taking half of a 12-bit encode. The floor keeps
-// the whole search on bases of up to about 90 triangles; an unrefined mesh is all base and gets
-// the full budget.
+// The base of a refined hierarchy gets a small search: on the corpus the full one (2^20
+// triangles) took half of a 12-bit encode and gained nothing, the base order it picks moving the
+// rest of the file by as much as it saves in the base (docs/BASE_CODER.md, Encode time). That still
+// searches bases of up to about 90 triangles whole; an unrefined mesh is all base and gets it all.
 uint64_t base_search_budget(const Hierarchy& h) {
-    if (h.node_count() == h.root_count()) return kFullBaseSearch;
-    constexpr uint64_t kSearchTrianglesPerNode = 1;
-    constexpr uint64_t kSmallestBudget = uint64_t{1} << 16;
-    constexpr uint64_t kLargestBudget = uint64_t{1} << 18;
-    return std::clamp(kSearchTrianglesPerNode * h.node_count(), kSmallestBudget, kLargestBudget);
+    constexpr uint64_t kRefinedBudget = uint64_t{1} << 16;
+    return h.node_count() == h.root_count() ? kFullBaseSearch : kRefinedBudget;
 }
 
 // The base connectivity of a file. Mode 2's search (FORMAT.md 4.16) starts the conquest away from
