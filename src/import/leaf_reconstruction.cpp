@@ -216,14 +216,7 @@ private:
         // From the connectivity alone where it tells: the halves of the edge are leaf edges.
         const uint32_t common = only_unmatched_common_neighbor(a, b);
         if (common != kNoIndex) return common;
-        if (!nearest_) {
-            double total = 0;
-            for (const Triangle& t : leaf_.triangles) {
-                const Vec3 d = leaf_.positions[t[0]] - leaf_.positions[t[1]];
-                total += std::sqrt(dot(d, d));
-            }
-            nearest_ = std::make_unique<NearestVertex>(leaf_.positions, total / double(leaf_.triangles.size()));
-        }
+        if (!nearest_) nearest_ = std::make_unique<NearestVertex>(leaf_.positions);
         // The midpoint's leaf neighbours lie in the children of n and of the element across that
         // touch it: of the vertices matched so far, only a, b and those elements' midpoints.
         uint32_t allowed[8] = {a, b, kNoIndex, kNoIndex, kNoIndex, kNoIndex, kNoIndex, kNoIndex};

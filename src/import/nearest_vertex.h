@@ -1,70 +1,73 @@
-// Nearest not-yet-used vertex to a point (a uniform hash grid over the leaf vertices).
+// Nearest vertex to a point among those a predicate accepts: a k-d tree over the leaf vertices,
+// which adapts to the density of an adaptive mesh (a uniform grid scans hundreds of vertices per
+// cell where the mesh is fine and many empty cells where it is coarse).
 #pragma once
 
 #include "common/no_index.h"
 
 #include <amc/mesh.h>
 
-#include <algorithm>
 #include <cstdint>
-#include <cstdlib>
 #include <vector>
 
 namespace amc {
 
 class NearestVertex {
 public:
+    explicit NearestVertex(const std::vector<Vec3>& positions);
 
-    // `cell` is the grid spacing (about an edge length).
-    NearestVertex(const std::vector<Vec3>& positions, double cell);
-
-    // The vertex nearest to p among those for which usable(v) holds, searching up to
-    // `max_rings` rings of cells around p; kNoIndex when none is found.
+    // The vertex nearest to p among those for which usable(v) holds (tested only on vertices
+    // nearer than the best so far: it may cost more than a distance); kNoIndex when none is.
     template <class Usable>
-    uint32_t find(Vec3 p, Usable usable, int max_rings = 64) const {
-        const int64_t c[3] = {cell_of(p.x), cell_of(p.y), cell_of(p.z)};
-        uint32_t best = kNoIndex;
-        double best_distance = 0;
-        int found_ring = -1;
-        for (int r = 0; r <= max_rings; ++r) {
-            if (found_ring >= 0 && r > found_ring + 1) break;
-            for (int64_t i = -r; i <= r; ++i)
-                for (int64_t j = -r; j <= r; ++j)
-                    for (int64_t k = -r; k <= r; ++k) {
-                        if (std::max(std::llabs(i), std::max(std::llabs(j), std::llabs(k))) != r) continue;
-                        for (uint32_t v : cell_vertices(c[0] + i, c[1] + j, c[2] + k)) {
-                            const Vec3 d = positions_[v] - p;
-                            const double distance = dot(d, d);
-                            // usable() last: it may cost more than the distance.
-                            if ((best == kNoIndex || distance < best_distance) && usable(v)) {
-                                best = v;
-                                best_distance = distance;
-                                if (found_ring < 0) found_ring = r;
-                            }
-                        }
-                    }
-        }
-        return best;
+    uint32_t find(Vec3 p, Usable usable) const {
+        Best best;
+        if (!points_.empty()) search(p, usable, 0, 0, uint32_t(points_.size()), best);
+        return best.vertex;
     }
 
 private:
-    struct Range {
-        const uint32_t* begin_;
-        const uint32_t* end_;
-        const uint32_t* begin() const { return begin_; }
-        const uint32_t* end() const { return end_; }
+    static constexpr uint32_t kBucket = 16;  // points in a leaf of the tree
+    struct Point {
+        double x[3];
+        uint32_t vertex;
     };
-    int64_t cell_of(double x) const;
-    size_t slot_of(int64_t i, int64_t j, int64_t k) const;
-    Range cell_vertices(int64_t i, int64_t j, int64_t k) const;
+    struct Best {
+        uint32_t vertex = kNoIndex;
+        double distance = 0;  // squared
+    };
 
-    const std::vector<Vec3>& positions_;
-    double inverse_cell_;
-    size_t mask_ = 0;
-    // Hash table of cells: cell keys and the start of each cell's vertices in `vertices_`.
-    std::vector<int64_t> keys_;  // 3 per slot; slot empty when start_[slot] == start_[slot + 1]
-    std::vector<uint32_t> start_;
-    std::vector<uint32_t> vertices_;
+    void build(uint32_t node, uint32_t lo, uint32_t hi);
+
+    template <class Usable>
+    void search(Vec3 p, Usable& usable, uint32_t node, uint32_t lo, uint32_t hi, Best& best) const {
+        if (hi - lo <= kBucket) {
+            for (uint32_t i = lo; i < hi; ++i) {
+                const Point& q = points_[i];
+                const double dx = q.x[0] - p.x, dy = q.x[1] - p.y, dz = q.x[2] - p.z;
+                const double distance = dx * dx + dy * dy + dz * dz;
+                if ((best.vertex == kNoIndex || distance < best.distance) && usable(q.vertex)) {
+                    best.vertex = q.vertex;
+                    best.distance = distance;
+                }
+            }
+            return;
+        }
+        const uint32_t mid = lo + (hi - lo) / 2;
+        const int axis = axis_[node];
+        const double coordinate = axis == 0 ? p.x : axis == 1 ? p.y : p.z;
+        const double offset = coordinate - split_[node];
+        // Points left of mid lie at or below its coordinate on the axis, points from mid on at or above.
+        const bool left_first = offset < 0;
+        search(p, usable, 2 * node + (left_first ? 1 : 2), left_first ? lo : mid, left_first ? mid : hi, best);
+        if (best.vertex == kNoIndex || offset * offset < best.distance)
+            search(p, usable, 2 * node + (left_first ? 2 : 1), left_first ? mid : lo, left_first ? hi : mid, best);
+    }
+
+    std::vector<Point> points_;  // in tree order
+    // Split axis and coordinate of each inner node, heap-numbered (children 2i+1, 2i+2); the
+    // children's builds reorder the points, so the split point's coordinate is kept here.
+    std::vector<uint8_t> axis_;
+    std::vector<double> split_;
 };
 
 }  // namespace amc
