@@ -6,6 +6,7 @@
 #include "geometry/closest_point.h"
 #include "import/nearest_vertex.h"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -256,10 +257,6 @@ private:
         return m;
     }
 
-    bool adjacent(uint32_t u, uint32_t v) const {
-        return he_.face(u, v) != kNoIndex || he_.face(v, u) != kNoIndex;
-    }
-
     // Calls f on every leaf-mesh neighbour of u (some twice).
     template <class F>
     void for_each_neighbor(uint32_t u, F f) const {
@@ -273,11 +270,17 @@ private:
     // neighbour of a and b, and the only unmatched one: inside the two elements on the edge, a's
     // leaf edges stay in the corner child at a and b's in the corner child at b, which meet only
     // at the midpoint. kNoIndex unless exactly one exists (the final check guards the rest).
-    uint32_t only_unmatched_common_neighbor(uint32_t a, uint32_t b) const {
+    uint32_t only_unmatched_common_neighbor(uint32_t a, uint32_t b) {
+        // b's unmatched neighbours listed once, so a's are tested without reading their own
+        // edge lists (a cache miss each in a shuffled mesh).
+        around_b_.clear();
+        for_each_neighbor(b, [&](uint32_t x) {
+            if (vertex_of_leaf_[x] == kNoIndex) around_b_.push_back(x);
+        });
         uint32_t found = kNoIndex;
         bool ambiguous = false;
         for_each_neighbor(a, [&](uint32_t x) {
-            if (vertex_of_leaf_[x] != kNoIndex || x == found || !adjacent(x, b)) return;
+            if (x == found || std::find(around_b_.begin(), around_b_.end(), x) == around_b_.end()) return;
             if (found != kNoIndex) ambiguous = true;
             found = x;
         });
@@ -293,6 +296,7 @@ private:
     std::vector<uint32_t> leaf_of_vertex_;
     std::vector<uint32_t> vertex_of_leaf_;
     std::vector<Reveal> reveals_;
+    std::vector<uint32_t> around_b_;  // scratch of only_unmatched_common_neighbor
     std::vector<UnsplitEdge> unsplit_edges_;
     std::unique_ptr<NearestVertex> nearest_;
     std::unique_ptr<ClosestPointQuery> surface_;
