@@ -15,6 +15,7 @@
 // --naive codes the models with the naive (canonical order) traversal instead of the improved
 // one (the default): what the priority order costs to decode.
 #include "bench_common.h"
+#include "cpu_counters.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
 
 #include <amc/hierarchy_coder.h>
@@ -27,56 +28,7 @@
 #include <string>
 #include <vector>
 
-#if defined(__linux__)
-#include <linux/perf_event.h>
-#include <sys/syscall.h>
-#include <unistd.h>
-#endif
-
 namespace {
-
-constexpr int kCounters = 3;
-const char* const kCounterNames[kCounters] = {"cycles", "instructions", "branch misses"};
-
-// The user-space counters of this thread, or none where perf events are not available.
-class Counters {
-public:
-    Counters() {
-#if defined(__linux__)
-        const uint64_t configs[kCounters] = {PERF_COUNT_HW_CPU_CYCLES, PERF_COUNT_HW_INSTRUCTIONS,
-                                             PERF_COUNT_HW_BRANCH_MISSES};
-        for (int k = 0; k < kCounters; ++k) {
-            perf_event_attr attr{};
-            attr.type = PERF_TYPE_HARDWARE;
-            attr.size = sizeof(attr);
-            attr.config = configs[k];
-            attr.exclude_kernel = 1;
-            attr.exclude_hv = 1;
-            fd_[k] = int(syscall(SYS_perf_event_open, &attr, 0, -1, -1, 0));
-        }
-#endif
-    }
-    ~Counters() {
-#if defined(__linux__)
-        for (int fd : fd_) {
-            if (fd >= 0) close(fd);
-        }
-#endif
-    }
-    bool available() const { return fd_[0] >= 0; }
-    void read_all(double out[kCounters]) const {
-        for (int k = 0; k < kCounters; ++k) {
-            uint64_t value = 0;
-#if defined(__linux__)
-            if (fd_[k] < 0 || read(fd_[k], &value, sizeof(value)) != sizeof(value)) value = 0;
-#endif
-            out[k] = double(value);
-        }
-    }
-
-private:
-    int fd_[kCounters] = {-1, -1, -1};
-};
 
 struct Sample {
     double ms[2];                    // decide, build

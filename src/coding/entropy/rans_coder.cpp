@@ -71,12 +71,21 @@ bool RansTable::assign(const std::vector<uint32_t>& frequencies) {
 
 void RansTable::build() {
     start_.assign(frequency_.size(), 0);
-    slots_.resize(kRansScale);
+    entries_.clear();
     uint32_t start = 0;
     for (size_t s = 0; s < frequency_.size(); ++s) {
         start_[s] = start;
-        for (uint32_t i = 0; i < frequency_[s]; ++i) slots_[start + i] = {uint16_t(s), uint16_t(frequency_[s]), uint16_t(i)};
+        if (frequency_[s] != 0) entries_.push_back({uint16_t(s), uint16_t(frequency_[s]), uint16_t(start)});
         start += frequency_[s];
+    }
+    narrow_ = entries_.size() <= 256;
+    narrow_index_.assign(narrow_ ? kRansScale : 0, 0);
+    wide_index_.assign(narrow_ ? 0 : kRansScale, 0);
+    for (size_t i = 0; i < entries_.size(); ++i) {
+        for (uint32_t slot = entries_[i].start; slot < uint32_t(entries_[i].start) + entries_[i].frequency; ++slot) {
+            if (narrow_) narrow_index_[slot] = uint8_t(i);
+            else wide_index_[slot] = uint16_t(i);
+        }
     }
 }
 
@@ -104,17 +113,6 @@ std::vector<uint8_t> RansEncoder::finish() {
         for (int shift = 24; shift >= 0; shift -= 8) reversed.push_back(uint8_t(state[s] >> shift));
     queue_.clear();
     return std::vector<uint8_t>(reversed.rbegin(), reversed.rend());
-}
-
-RansDecoder::RansDecoder(const uint8_t* data, size_t size) : data_(data), size_(size) {
-    for (uint32_t& x : state_) {
-        x = 0;
-        for (int shift = 0; shift < 32; shift += 8) x |= next_byte() << shift;
-        if (x < kRansLow) {  // no encoder ends below L; from there a run of zero bytes would never renormalise
-            overran_ = true;
-            x = kRansLow;
-        }
-    }
 }
 
 std::vector<uint8_t> RawBitWriter::finish() {

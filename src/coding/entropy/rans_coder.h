@@ -54,16 +54,24 @@ public:
     // -log2 of the symbol's probability (its code length in bits); the symbol must have a frequency.
     double cost_bits(int symbol) const;
 
-    // The decoder's view: per slot of [0, M), the symbol, its frequency and slot - start.
-    struct Slot {
-        uint16_t symbol, frequency, offset;
+    // The decoder's view: the symbols of nonzero frequency in increasing order, and per slot of
+    // [0, M) the index of the one whose range holds it, in a byte where a table has at most 256 such
+    // symbols (every quantized residual's table), else in two: a level's six tables of bytes (24 KB)
+    // stay in the processor's first-level cache, where six-byte slots (144 KB) did not.
+    struct Entry {
+        uint16_t symbol, frequency, start;
     };
-    const Slot* slots() const { return slots_.data(); }
+    const Entry& entry_of_slot(uint32_t slot) const {
+        return entries_[narrow_ ? size_t(narrow_index_[slot]) : size_t(wide_index_[slot])];
+    }
 
 private:
     void build();
     std::vector<uint32_t> frequency_, start_;
-    std::vector<Slot> slots_;
+    std::vector<Entry> entries_;
+    bool narrow_ = true;
+    std::vector<uint8_t> narrow_index_;
+    std::vector<uint16_t> wide_index_;
 };
 
 class RansEncoder {
@@ -84,15 +92,32 @@ private:
 class RansDecoder {
 public:
     // Reads at most `size` bytes; fewer than kRansStateBytes is an overrun at once.
-    RansDecoder(const uint8_t* data, size_t size);
+    RansDecoder(const uint8_t* data, size_t size) : data_(data), size_(size) {
+        for (uint32_t& x : state_) {
+            x = 0;
+            for (int shift = 0; shift < 32; shift += 8) x |= next_byte() << shift;
+            if (x < kRansLow) {  // no encoder ends below L; from there a run of zero bytes would never renormalise
+                overran_ = true;
+                x = kRansLow;
+            }
+        }
+    }
 
+    // The next symbol (symbol i of the stream with state i mod 2).
     int get(const RansTable& table) {
-        uint32_t& x = state_[which_];
         which_ ^= 1;
-        const RansTable::Slot slot = table.slots()[x & (kRansScale - 1)];
-        x = uint32_t(slot.frequency) * (x >> kRansScaleBits) + slot.offset;
+        return which_ == 1 ? get_with<0>(table) : get_with<1>(table);
+    }
+    // The next symbol when the caller knows it is coded with state `State` (symbol i: i mod 2). A
+    // loop that names the state keeps both in registers; a decoder uses get() or get_with only.
+    template <int State>
+    int get_with(const RansTable& table) {
+        uint32_t& x = state_[State];
+        const uint32_t slot = x & (kRansScale - 1);
+        const RansTable::Entry& e = table.entry_of_slot(slot);
+        x = uint32_t(e.frequency) * (x >> kRansScaleBits) + slot - e.start;
         while (x < kRansLow) x = (x << 8) | next_byte();
-        return slot.symbol;
+        return e.symbol;
     }
 
     // True once the decoder needed bytes past the end: the stream is truncated or corrupt.

@@ -190,7 +190,7 @@ inline uint32_t quantize_coordinate(const Quantizer& quantizer, int axis, double
     const double top = static_cast<double>(quantizer.max_coordinate());
     if (!(t > 0.0)) return 0;  // also NaN
     if (t >= top) return quantizer.max_coordinate();
-    return static_cast<uint32_t>(std::floor(t + 0.5));
+    return static_cast<uint32_t>(t + 0.5);  // floor: t + 0.5 is positive, and conversion truncates
 }
 inline GridPoint quantize(const Quantizer& quantizer, Vec3 p) {
     return {quantize_coordinate(quantizer, 0, p.x), quantize_coordinate(quantizer, 1, p.y), quantize_coordinate(quantizer, 2, p.z)};

@@ -9,9 +9,13 @@
 // vertex of level l reads only corners of level-l nodes, which exist before level l is refined.
 #pragma once
 
+#include "coding/geometry/float_coder.h"
+#include "common/exact_float.h"
+
 #include <amc/hierarchy.h>
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -55,11 +59,26 @@ struct NormalFrame {
     int axis = 0;
     bool has_normal = false;
     // The other coordinates' prediction once the first axis's value is known.
-    Vec3 predict(double first_axis_value) const;
+    Vec3 predict(double first_axis_value) const {
+        if (!has_normal) return midpoint;
+        const double t = rounded((first_axis_value - axis_coordinate(midpoint, axis)) / axis_coordinate(normal, axis));
+        Vec3 p = midpoint + rounded_scaled(t, normal);
+        (axis == 0 ? p.x : axis == 1 ? p.y : p.z) = first_axis_value;
+        return p;
+    }
 };
 // unit_normals (geometry mode 4, FORMAT.md 5.7): N is the sum of the two triangles' unit normals
 // instead, the direction along which the surface remesher places the vertex.
 NormalFrame normal_frame(const Hierarchy& h, NodeId n, int e, bool unit_normals = false);
+// normal_frame in two steps, for decoders that gather many vertices' corners (and prefetch their
+// positions) before computing their frames: the corners a frame reads, a, b, c of node n (edge e
+// runs a -> b) and d, the vertex opposite the edge in the same-level neighbour (kNoVertex at a
+// boundary); then the frame from their positions.
+struct FrameCorners {
+    VertexId a, b, c, d;
+};
+FrameCorners frame_corners(const Hierarchy& h, NodeId n, int e);
+NormalFrame frame_of(const Hierarchy& h, const FrameCorners& corners, bool unit_normals);
 
 // Parallelogram rule over already decoded positions: a + b - c when all three indices are valid
 // (>= 0 and < decoded.size()), else a when a is valid, else the zero vector.

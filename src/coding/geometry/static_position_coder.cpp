@@ -8,6 +8,7 @@
 #include "common/compiler.h"
 #include "common/exact_float.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace amc {
@@ -30,13 +31,12 @@ int token_limit(CoordinateSpace space) {
 }
 static_assert(kTokensFor64Bits <= kRansMaxSymbols, "every token fits a table");
 
-double component(Vec3 p, int axis) { return axis == 0 ? p.x : axis == 1 ? p.y : p.z; }
 double& component_ref(Vec3& p, int axis) { return axis == 0 ? p.x : axis == 1 ? p.y : p.z; }
 
 // The axes in coding order: the frame's axis, then the two others in increasing order.
 std::array<int, 3> role_axes(const NormalFrame& f) {
-    if (!f.has_normal) return {0, 1, 2};
-    return {f.axis, f.axis == 0 ? 1 : 0, f.axis == 2 ? 1 : 2};
+    static constexpr std::array<std::array<int, 3>, 3> kByAxis{{{0, 1, 2}, {1, 0, 2}, {2, 0, 1}}};
+    return kByAxis[f.has_normal ? size_t(f.axis) : 0];
 }
 
 struct Residual {
@@ -60,11 +60,18 @@ Residual residual_of(CoordinateSpace space, int axis, double actual, double pred
     return {negative, negative ? (uint64_t{0} - r) & mask : r};
 }
 
+// Branch-free: residual signs are coin flips, which a branch would mispredict half the time.
+AMC_ALWAYS_INLINE int64_t negated_if(int64_t x, bool negate) {
+    const int64_t m = -int64_t(negate);
+    return (x ^ m) - m;
+}
+// A quantized residual as a signed number (its magnitude is below 2^30).
+AMC_ALWAYS_INLINE int64_t signed_value(Residual r) { return negated_if(int64_t(r.magnitude), r.negative); }
+
 // The value a residual gives, or false if it leaves the grid.
 AMC_ALWAYS_INLINE bool value_of(CoordinateSpace space, int axis, double predicted, Residual r, double& value) {
     if (space.quantizer != nullptr) {
-        const int64_t p = quantize_coordinate(*space.quantizer, axis, predicted);
-        const int64_t q = r.negative ? p - int64_t(r.magnitude) : p + int64_t(r.magnitude);
+        const int64_t q = int64_t(quantize_coordinate(*space.quantizer, axis, predicted)) + signed_value(r);
         if (q < 0 || q > int64_t(space.quantizer->max_coordinate())) return false;
         value = dequantize_coordinate(*space.quantizer, axis, uint32_t(q));
         return true;
@@ -90,13 +97,13 @@ struct GridPrediction {
 // Inlined: returned through memory, the small struct stalls the decoder's loop on a store forward.
 AMC_ALWAYS_INLINE GridPrediction grid_prediction(const Quantizer& quantizer, int axis, double x) {
     // quantize_coordinate's steps, its t kept for the bin.
-    const double t = rounded((x - component(quantizer.origin, axis)) / quantizer.step);
+    const double t = rounded((x - axis_coordinate(quantizer.origin, axis)) / quantizer.step);
     if (!(t > 0.0)) return {0, 0, false};  // also NaN
     if (t >= static_cast<double>(quantizer.max_coordinate())) return {quantizer.max_coordinate(), 0, false};
-    GridPrediction g{static_cast<uint32_t>(std::floor(t + 0.5)), 0, false};
+    GridPrediction g{static_cast<uint32_t>(t + 0.5), 0, false};  // floor, as in quantize_coordinate
     const double f = rounded(t - static_cast<double>(g.p));
     g.turn = f < 0.0;
-    g.bin = (f >= 0.25 || f <= -0.25) ? 1 : 0;
+    g.bin = std::fabs(f) >= 0.25 ? 1 : 0;  // f is finite: f >= 1/4 or f <= -1/4
     return g;
 }
 
@@ -107,8 +114,7 @@ AMC_ALWAYS_INLINE Residual grid_residual(const Quantizer& quantizer, int axis, d
 }
 
 AMC_ALWAYS_INLINE bool grid_value(const Quantizer& quantizer, int axis, const GridPrediction& g, Residual r, double& value) {
-    const int64_t s = r.negative ? -int64_t(r.magnitude) : int64_t(r.magnitude);  // magnitude < 2^bits
-    const int64_t q = int64_t(g.p) + (g.turn ? -s : s);
+    const int64_t q = int64_t(g.p) + negated_if(signed_value(r), g.turn);  // magnitude < 2^bits
     if (q < 0 || q > int64_t(quantizer.max_coordinate())) return false;
     value = dequantize_coordinate(quantizer, axis, uint32_t(q));
     return true;
@@ -134,7 +140,7 @@ void put_raw(RawBitWriter& raw, Residual r) {
 }
 
 AMC_ALWAYS_INLINE Residual take(int token, RawBitReader& raw) {
-    if (token < kDirectTokens) return {token != 0 && token % 2 == 0, uint64_t(token + 1) / 2};
+    if (token < kDirectTokens) return {bool((token != 0) & (token % 2 == 0)), uint64_t(token + 1) / 2};
     const int k = 4 + (token - kDirectTokens) / 4;
     const int low = k - 3;
     Residual r;
@@ -221,18 +227,18 @@ StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std
         const NormalFrame frame = normal_frame(h, n, e, grid_bins);
         const std::array<int, 3> axes = role_axes(frame);
         const Vec3 actual = h.position(h.midpoint(n, e));
-        const Vec3 others = frame.predict(component(actual, axes[0]));
+        const Vec3 others = frame.predict(axis_coordinate(actual, axes[0]));
         std::array<int, kStaticRoles> t{}, table{};
         std::array<Residual, kStaticRoles> r{};
         for (int role = 0; role < kStaticRoles; ++role) {
             const int axis = axes[size_t(role)];
-            const double predicted = role == 0 ? component(frame.midpoint, axis) : component(others, axis);
+            const double predicted = role == 0 ? axis_coordinate(frame.midpoint, axis) : axis_coordinate(others, axis);
             if (grid_bins) {
                 const GridPrediction g = grid_prediction(*space.quantizer, axis, predicted);
-                r[size_t(role)] = grid_residual(*space.quantizer, axis, component(actual, axis), g);
+                r[size_t(role)] = grid_residual(*space.quantizer, axis, axis_coordinate(actual, axis), g);
                 table[size_t(role)] = kGridBins * role + g.bin;
             } else {
-                r[size_t(role)] = residual_of(space, axis, component(actual, axis), predicted);
+                r[size_t(role)] = residual_of(space, axis, axis_coordinate(actual, axis), predicted);
                 table[size_t(role)] = role;
             }
             t[size_t(role)] = token_of(r[size_t(role)]);
@@ -282,47 +288,107 @@ bool read_static_tables(ArithmeticDecoder& decoder, CoordinateSpace space, bool 
     return true;
 }
 
+namespace {
+
+// The decoder works in chunks of vertices: first the nodes' corners of a whole chunk, in a short
+// loop whose iterations the processor runs many at once, and prefetches of their positions; then
+// the chunk's frames (and in mode 4 role 0's grid prediction), which depend only on earlier levels'
+// positions, not on the streams; then the chunk's coordinates from the streams. Frame by frame,
+// each vertex waited for its cache misses, then the streams' chain of dependent values waited for
+// the frame's square roots and divisions.
+constexpr size_t kChunk = 64;  // even: each chunk starts with rANS state 0
+
+struct Chunk {
+    size_t begin = 0, count = 0;
+    std::array<FrameCorners, kChunk> corners;
+    std::array<VertexId, kChunk> vertices;
+    std::array<NormalFrame, kChunk> frames;
+    std::array<std::array<int, 3>, kChunk> axes;
+    std::array<GridPrediction, kChunk> first;  // mode 4: role 0's
+};
+
+void gather_chunk(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, Chunk& c) {
+    c.begin = begin;
+    c.count = begin < created.size() ? std::min(kChunk, created.size() - begin) : 0;
+    for (size_t i = 0; i < c.count; ++i) {
+        const auto [n, e] = created[begin + i];
+        c.corners[i] = frame_corners(h, n, e);
+        c.vertices[i] = h.midpoint(n, e);
+    }
+    for (size_t i = 0; i < c.count; ++i)
+        for (VertexId v : {c.corners[i].a, c.corners[i].b, c.corners[i].c, c.corners[i].d})
+            if (v != kNoVertex) __builtin_prefetch(&h.positions()[v]);
+}
+
+template <bool Grid>
+AMC_ALWAYS_INLINE void frame_vertex(const Hierarchy& h, const Quantizer* grid, Chunk& c, size_t i) {
+    c.frames[i] = frame_of(h, c.corners[i], Grid);
+    c.axes[i] = role_axes(c.frames[i]);
+    if (Grid) c.first[i] = grid_prediction(*grid, c.axes[i][0], axis_coordinate(c.frames[i].midpoint, c.axes[i][0]));
+}
+
+// One vertex's three coordinates; its first token is coded with rANS state `State` (token j of the
+// level with state j mod 2), its second with the other, its third with `State` again.
+template <int State, bool Grid>
+AMC_ALWAYS_INLINE bool decode_vertex(const Chunk& b, size_t i, CoordinateSpace space, const StaticTables& tables,
+                                     RansDecoder& rans, RawBitReader& raw, Vec3& p) {    const std::array<int, 3>& axes = b.axes[i];
+    const NormalFrame& frame = b.frames[i];
+    if (Grid) {
+        const Quantizer& quantizer = *space.quantizer;
+        const GridPrediction& first = b.first[i];
+        if (!grid_value(quantizer, axes[0], first, take(rans.get_with<State>(tables[size_t(first.bin)]), raw), component_ref(p, axes[0])))
+            return false;
+        const Vec3 others = frame.predict(axis_coordinate(p, axes[0]));
+        const GridPrediction g1 = grid_prediction(quantizer, axes[1], axis_coordinate(others, axes[1]));
+        const GridPrediction g2 = grid_prediction(quantizer, axes[2], axis_coordinate(others, axes[2]));
+        const Residual r1 = take(rans.get_with<1 - State>(tables[size_t(kGridBins + g1.bin)]), raw);
+        if (!grid_value(quantizer, axes[1], g1, r1, component_ref(p, axes[1]))) return false;
+        const Residual r2 = take(rans.get_with<State>(tables[size_t(2 * kGridBins + g2.bin)]), raw);
+        return grid_value(quantizer, axes[2], g2, r2, component_ref(p, axes[2]));
+    }
+    double& value = component_ref(p, axes[0]);
+    if (!value_of(space, axes[0], axis_coordinate(frame.midpoint, axes[0]), take(rans.get_with<State>(tables[0]), raw), value))
+        return false;
+    const Vec3 others = frame.predict(value);
+    if (!value_of(space, axes[1], axis_coordinate(others, axes[1]), take(rans.get_with<1 - State>(tables[1]), raw),
+                  component_ref(p, axes[1])))
+        return false;
+    return value_of(space, axes[2], axis_coordinate(others, axes[2]), take(rans.get_with<State>(tables[2]), raw),
+                    component_ref(p, axes[2]));
+}
+
+// The decoders own their rANS decoder and raw bit reader, so that the compiler keeps the two rANS
+// states in registers.
+template <bool Grid>
+bool decode_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
+                      const StaticTables& tables, const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data,
+                      size_t raw_size) {
+    RansDecoder rans(rans_data, rans_size);
+    RawBitReader raw(raw_data, raw_size);
+    const Quantizer* grid = Grid ? space.quantizer : nullptr;
+    Chunk c;
+    for (size_t begin = 0; begin < created.size(); begin += kChunk) {
+        gather_chunk(h, created, begin, c);
+        for (size_t i = 0; i < c.count; ++i) frame_vertex<Grid>(h, grid, c, i);
+        for (size_t i = 0; i < c.count; i += 2) {
+            Vec3 p;
+            if (!decode_vertex<0, Grid>(c, i, space, tables, rans, raw, p)) return false;
+            h.set_position(c.vertices[i], p);
+            if (i + 1 == c.count) break;
+            if (!decode_vertex<1, Grid>(c, i + 1, space, tables, rans, raw, p)) return false;
+            h.set_position(c.vertices[i + 1], p);
+        }
+    }
+    return rans.ended_cleanly() && raw.ended_cleanly();
+}
+
+}  // namespace
+
 bool decode_static_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
                              bool grid_bins, const StaticTables& tables, const uint8_t* rans_data, size_t rans_size,
                              const uint8_t* raw_data, size_t raw_size) {
-    RansDecoder rans(rans_data, rans_size);
-    RawBitReader raw(raw_data, raw_size);
-    if (grid_bins) {
-        if (space.quantizer == nullptr) return false;
-        const Quantizer& quantizer = *space.quantizer;
-        for (auto [n, e] : created) {
-            const NormalFrame frame = normal_frame(h, n, e, true);
-            const std::array<int, 3> axes = role_axes(frame);
-            Vec3 p;
-            GridPrediction g = grid_prediction(quantizer, axes[0], component(frame.midpoint, axes[0]));
-            if (!grid_value(quantizer, axes[0], g, take(rans.get(tables[size_t(g.bin)]), raw), component_ref(p, axes[0])))
-                return false;
-            const Vec3 others = frame.predict(component(p, axes[0]));
-            for (int role = 1; role < kStaticRoles; ++role) {
-                const int axis = axes[size_t(role)];
-                g = grid_prediction(quantizer, axis, component(others, axis));
-                const Residual r = take(rans.get(tables[size_t(kGridBins * role + g.bin)]), raw);
-                if (!grid_value(quantizer, axis, g, r, component_ref(p, axis))) return false;
-            }
-            h.set_position(h.midpoint(n, e), p);
-        }
-        return rans.ended_cleanly() && raw.ended_cleanly();
-    }
-    for (auto [n, e] : created) {
-        const NormalFrame frame = normal_frame(h, n, e);
-        const std::array<int, 3> axes = role_axes(frame);
-        Vec3 p;
-        double& first = component_ref(p, axes[0]);
-        if (!value_of(space, axes[0], component(frame.midpoint, axes[0]), take(rans.get(tables[0]), raw), first)) return false;
-        const Vec3 others = frame.predict(first);
-        for (int role = 1; role < kStaticRoles; ++role) {
-            const int axis = axes[size_t(role)];
-            if (!value_of(space, axis, component(others, axis), take(rans.get(tables[size_t(role)]), raw), component_ref(p, axis)))
-                return false;
-        }
-        h.set_position(h.midpoint(n, e), p);
-    }
-    return rans.ended_cleanly() && raw.ended_cleanly();
+    if (!grid_bins) return decode_positions<false>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size);
+    return space.quantizer != nullptr && decode_positions<true>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size);
 }
 
 }  // namespace amc
