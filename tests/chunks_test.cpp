@@ -45,6 +45,7 @@ EncodeOptions with_chunks(uint32_t chunks, unsigned threads = 0, int bits = 0) {
     options.chunks = chunks;
     options.threads = threads;
     options.quantize_bits = bits;
+    options.grid_contexts = false;  // geometry mode 3 inside chunks: files of one chunk stay below version 7
     return options;
 }
 

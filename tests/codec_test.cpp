@@ -143,6 +143,7 @@ TEST(Codec, NormalFrameModeRoundTripsAndWinsOnSurfaces) {
             }
             EncodeOptions options;
             options.quantize_bits = bits;
+            options.grid_contexts = false;  // mode 3 against the adaptive modes (mode 4: grid_geometry_test)
             size_t sizes[4] = {};
             for (GeometryPredictor p : {GeometryPredictor::automatic, GeometryPredictor::midpoint, GeometryPredictor::butterfly,
                                         GeometryPredictor::normal_frame}) {

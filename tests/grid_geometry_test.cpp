@@ -138,6 +138,7 @@ TEST(GridGeometry, SmallerOnFlatAndCurvedSurfaces) {
         for (const Hierarchy* h : std::vector<const Hierarchy*>{&plane, &sphere}) {
             EncodeOptions roles;
             roles.quantize_bits = bits;
+            roles.grid_contexts = false;
             EncodeOptions grid = roles;
             grid.grid_contexts = true;
             EncodeStats a, b;
@@ -157,6 +158,7 @@ TEST(GridGeometry, WithoutTheOptionTheBytesAreModeThrees) {
     const Hierarchy h = projected_sphere(1500, 5, 9);
     EncodeOptions options;
     options.quantize_bits = 12;
+    options.grid_contexts = false;
     EncodeStats stats;
     const std::vector<uint8_t> bytes = encode(h, options, &stats);
     EXPECT_FALSE(uses(stats, GeometryPredictor::normal_frame_grid));
@@ -175,6 +177,26 @@ TEST(GridGeometry, EncoderRefusesItWithoutAGrid) {
     const std::vector<uint8_t> bytes = encode(h, automatic, &stats);
     EXPECT_FALSE(uses(stats, GeometryPredictor::normal_frame_grid));
     EXPECT_LT(bytes[4], kGridGeometryVersion);
+}
+
+// Grid contexts are the encoder's default for quantized files (the automatic choice tries mode 4
+// on every level); bit-exact files have no grid and code as with the option off.
+TEST(GridGeometry, QuantizedFilesTryModeFourByDefault) {
+    const Hierarchy h = projected_sphere(800, 5, 3);
+    EncodeOptions defaults;
+    defaults.quantize_bits = 12;
+    EncodeOptions roles = defaults;
+    roles.grid_contexts = false;
+    EncodeStats stats, roles_stats;
+    const std::vector<uint8_t> bytes = encode(h, defaults, &stats);
+    const std::vector<uint8_t> roles_bytes = encode(h, roles, &roles_stats);
+    EXPECT_TRUE(uses(stats, GeometryPredictor::normal_frame_grid));
+    EXPECT_EQ(bytes[4], kGridGeometryVersion);
+    EXPECT_FALSE(uses(roles_stats, GeometryPredictor::normal_frame_grid));
+    EXPECT_LT(bytes.size(), roles_bytes.size());
+    EncodeOptions exact, exact_roles;
+    exact_roles.grid_contexts = false;
+    EXPECT_EQ(encode(h, exact), encode(h, exact_roles));
 }
 
 TEST(GridGeometry, DecoderRefusesModeFourWhereTheFormatHasNone) {

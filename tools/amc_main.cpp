@@ -99,9 +99,9 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"paper", "mixed"}))
         ->capture_default_str();
     encode_cmd->add_option("--geometry-contexts", encode.geometry_contexts,
-                           "roles | grid (with --quantize: tables also split by where the prediction falls between grid "
-                           "points, smaller geometry; .amc version 9)")
-        ->check(CLI::IsMember({"roles", "grid"}))
+                           "grid | roles (with --quantize: grid also tries tables split by where the prediction falls "
+                           "between grid points on every level, smaller geometry, .amc version 9; roles keeps mode 3)")
+        ->check(CLI::IsMember({"grid", "roles"}))
         ->capture_default_str();
     encode_cmd->add_flag("--series", encode.series, "The input is a series (as 'amc series encode'; implied by a .pvd input)");
 

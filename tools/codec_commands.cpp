@@ -97,7 +97,7 @@ void print_encode_stats(std::FILE* out, const std::string& name, const EncodeSta
 void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     if (command.series || is_pvd(command.input)) {
         if (command.keep_numbering || !command.map.empty() || command.quantize_bits != 0 || command.predictor != "auto" ||
-            command.hierarchy_contexts != "paper" || command.geometry_contexts != "roles")
+            command.hierarchy_contexts != "paper" || command.geometry_contexts != "grid")
             throw UsageError("--keep-numbering, --map, --quantize, --predictor, --hierarchy-contexts and --geometry-contexts do not "
                              "apply to a series");
         SeriesEncodeCommand series;
@@ -126,9 +126,9 @@ void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     EncodeOptions options;
     options.quantize_bits = command.quantize_bits;
     options.predictor = parse_predictor(command.predictor);
-    options.grid_contexts = command.geometry_contexts == "grid";
-    if ((options.grid_contexts || options.predictor == GeometryPredictor::normal_frame_grid) && options.quantize_bits == 0)
-        throw UsageError("--geometry-contexts grid and --predictor grid need --quantize (grid points exist only on a grid)");
+    options.grid_contexts = command.geometry_contexts == "grid";  // bit-exact files have no grid: ignored there
+    if (options.predictor == GeometryPredictor::normal_frame_grid && options.quantize_bits == 0)
+        throw UsageError("--predictor grid needs --quantize (grid points exist only on a grid)");
     options.chunks = command.chunks;
     options.chunk_faces = command.chunk_faces;
     options.threads = command.threads;

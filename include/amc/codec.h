@@ -42,8 +42,9 @@ struct EncodeOptions {
     int quantize_bits = 0;
     GeometryPredictor predictor = GeometryPredictor::automatic;
     // Quantized files: the automatic predictor also tries geometry mode 4 (normal_frame_grid) on
-    // every level and keeps it where it codes smaller. Off by default (such files are version 9).
-    bool grid_contexts = false;
+    // every level and keeps it where it codes smaller (such files are version 9). Bit-exact files
+    // have no grid and ignore it; false keeps quantized files at mode 3 (version 6 or 7).
+    bool grid_contexts = true;
     // The caller's numbering of the input's leaf mesh (leaf_numbering()), or null. The encoder
     // re-expresses it against the leaf mesh the decoder rebuilds (EncodeStats::numbering) and,
     // with store_numbering, stores it in the file so that decode returns it (docs/FORMAT.md,
