@@ -14,6 +14,10 @@ namespace amc {
 
 namespace {
 
+bool has_boundary_edge(const Hierarchy& h, NodeId n) {
+    return h.is_boundary_edge(n, 0) || h.is_boundary_edge(n, 1) || h.is_boundary_edge(n, 2);
+}
+
 // The seam vertex splitting edge e of n, or Seam::kNotSeam / kUnsplit. Only boundary edges of a
 // chunk can lie on the seam; their ends are base or seam vertices, which have keys.
 template <class Keys>
@@ -29,7 +33,7 @@ int32_t seam_vertex(const Hierarchy& h, const Keys& keys, const Seam& seam, Node
 // seam; testing for them first spares most leaves the lookup of their neighbours.
 template <class Keys>
 int seam_hanging_count(const Hierarchy& h, const Keys& keys, const Seam& seam, NodeId leaf) {
-    if (!h.is_boundary_edge(leaf, 0) && !h.is_boundary_edge(leaf, 1) && !h.is_boundary_edge(leaf, 2)) return 0;
+    if (!has_boundary_edge(h, leaf)) return 0;
     int count = 0;
     for (int e = 0; e < 3; ++e) count += seam_vertex(h, keys, seam, leaf, e) >= 0;
     return count;
@@ -107,14 +111,16 @@ struct SeamSplits {
     const Seam& seam;
     uint8_t* used;
     const std::string* where;
+    bool found = false;  // some seam vertex was taken since it was last cleared
     static VertexId find(void* context, VertexId a, VertexId b) {
-        const SeamSplits& self = *static_cast<const SeamSplits*>(context);
+        SeamSplits& self = *static_cast<SeamSplits*>(context);
         const uint32_t ka = self.keys.key(a), kb = self.keys.key(b);
         if (ka == kNoVertex || kb == kNoVertex) return kNoVertex;
         const int32_t s = self.seam.find(ka, kb);
         AMC_REQUIRE(s != Seam::kUnsplit, corrupt, *self.where + ": refines a seam segment the seam block leaves unsplit");
         if (s == Seam::kNotSeam) return kNoVertex;
         self.used[s] = 1;
+        self.found = true;
         return self.keys.seam_first + VertexId(s);
     }
 };
@@ -141,6 +147,11 @@ void decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, size_t 
     PositionCoder positions(space);
     BitModel flipped;
     std::vector<std::pair<NodeId, int>> created;
+    // The level's nodes with a boundary edge, in id order: only they can meet the seam, and
+    // their children with a boundary edge are the next level's.
+    std::vector<NodeId> boundary, next_boundary;
+    for (NodeId r = place.first_root; r < place.first_root + place.roots; ++r)
+        if (has_boundary_edge(h, r)) boundary.push_back(r);
     bool stopped = false;
     uint64_t seam_faces = 0;  // the seam's hanging nodes on the chunk's leaves
     for (uint64_t level = 0; level < levels; ++level) {
@@ -153,15 +164,25 @@ void decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, size_t 
         const Block level_block{BlockType::level, in.bytes(length), size_t(length), 0};
         const LevelBlockParts parts = split_level_block(level_block, limits.file_version, space.quantizer != nullptr, where);
         ArithmeticDecoder decoder(parts.arithmetic, parts.arithmetic_size);
-        const NodeId first = hierarchy.level_first(), end = first + NodeId(hierarchy.level_size());
+        seam_splits.found = false;
         hierarchy.decode_level(decoder);  // the seam vertices it splits off placed already (SeamSplits)
-        for (NodeId n = first; n < end; ++n) {
-            if (!h.is_leaf(n)) continue;
+        next_boundary.clear();
+        for (const NodeId n : boundary) {
+            if (!h.is_leaf(n)) {
+                for (int k = 0; k < 4; ++k)
+                    if (has_boundary_edge(h, h.child(n, k))) next_boundary.push_back(h.child(n, k));
+                continue;
+            }
             const int seam_hanging = seam_hanging_count(h, keys, seam, n);
             seam_faces += uint64_t(seam_hanging);
             if (is_seam_closure(h, n, seam_hanging)) h.set_diagonal_flipped(n, decoder.decode(flipped));
         }
+        boundary.swap(next_boundary);
         AMC_REQUIRE(!decoder.overran(), corrupt, where + ": hierarchy part is truncated or corrupt");
+        if (!seam_splits.found) {  // every new vertex is the chunk's own
+            decode_level_geometry(h, hierarchy.new_vertices(), parts, decoder, positions, space, int(level), where);
+            continue;
+        }
         created.clear();
         for (auto [n, e] : hierarchy.new_vertices())
             if (h.midpoint(n, e) - seam_first >= seam_count) created.emplace_back(n, e);

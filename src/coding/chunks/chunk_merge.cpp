@@ -221,8 +221,9 @@ Hierarchy merge_copies(const std::vector<ChunkJob>& jobs, const ChunkMergeInput&
     positions = plan.base.positions;
     positions.insert(positions.end(), input.seam->positions().begin(), input.seam->positions().end());
     if (positions_first) positions.resize(size_t(input.vertices));
+    std::vector<uint8_t> named(n, 0);  // chunks whose own vertices have their final ids
     // Chunk i, decoded into h, into the whole (its nodes and own positions); its own vertices
-    // named own_start() + k until every chunk is counted.
+    // named own_start() + k until every chunk is counted, unless their place is known already.
     auto copy_into_whole = [&](size_t i, const Hierarchy& h) {
         const VertexId local_base = VertexId(base_keys[i].size()), local_own = local_base + plan.seam_count;
         own[i] = uint32_t(h.positions().size() - local_own);
@@ -242,7 +243,9 @@ Hierarchy merge_copies(const std::vector<ChunkJob>& jobs, const ChunkMergeInput&
         std::vector<VertexId> id(h.positions().size());
         for (VertexId v = 0; v < local_base; ++v) id[v] = plan.base_id[base_keys[i][v]];
         for (uint32_t s = 0; s < plan.seam_count; ++s) id[local_base + s] = plan.seam_start + s;
-        for (uint32_t k = 0; k < own[i]; ++k) id[local_own + k] = plan.own_start() + k;
+        const VertexId own_id = VertexId(direct ? first_own[i] : plan.own_start());
+        for (uint32_t k = 0; k < own[i]; ++k) id[local_own + k] = own_id + k;
+        named[i] = direct;
         parts[i].part = &h;
         parts[i].vertex_id = id.data();
         live[i] = h.node_capacity() - h.root_count();
@@ -323,6 +326,7 @@ Hierarchy merge_copies(const std::vector<ChunkJob>& jobs, const ChunkMergeInput&
     }
     AMC_REQUIRE(placed == n && next_own == positions.size(), corrupt, "the chunks hold fewer vertices than the metadata says");
     parallel_for(n, threads, [&](size_t i) {
+        if (named[i]) return;
         const VertexId own_start = plan.own_start();
         HierarchyBuilder::stitch_rename_vertices(whole, parts[i].first_node, parts[i].first_node + live[i], [&](VertexId v) {
             return v < own_start ? v : VertexId(first_own[i] + (v - own_start));
