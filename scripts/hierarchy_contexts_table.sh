@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# The tables of docs/HIERARCHY_CODER.md, "The mixing mode" and "The second model": every model of
-# the benchmark corpus (scripts/corpus.sh) encoded bit-exactly with the paper's contexts and with
-# the mixing mode (the model encoders write: .amc version 10), the hierarchy bytes of each
-# (amc encode -v; the paper's in one chunk, as the mixing mode always is), the change, and the least of `runs` whole-file decode CPU times (user + system,
-# five decodes a round) of each. With AMC_FIRST_MODEL=path-to-an-older-amc (a build of a commit that writes version 8),
-# also the first model's bytes and decode time, both decoded by this build. Sizes are exact and the
-# same on every run; times are not.
+# The tables of docs/HIERARCHY_CODER.md, "The mixing mode", "The second model" and "The third
+# model": every model of the benchmark corpus (scripts/corpus.sh) encoded bit-exactly with the
+# paper's contexts and with the mixing mode (the model encoders write: .amc version 11), the
+# hierarchy bytes of each (amc encode -v; the paper's in one chunk, as the mixing mode always is),
+# the change, and the least of `runs` whole-file decode CPU times (user + system, five decodes a
+# round) of each. With AMC_PREVIOUS_MODEL=path-to-an-older-amc (a build of a commit that writes an
+# older model, e.g. version 10 before 2026-12-02 evening), also that model's bytes and decode time,
+# both decoded by this build. Sizes are exact and the same on every run; times are not.
 # Usage: scripts/hierarchy_contexts_table.sh [build-dir] [runs]   (AMC_REUSE_CORPUS=1 keeps a corpus;
 # AMC_HELDOUT=1: the held-out models of scripts/corpus.sh, make_heldout_corpus, instead)
 set -euo pipefail
@@ -14,7 +15,7 @@ build=${1:-$here/build}
 runs=${2:-3}
 data=$here/../shared/data
 corpus=$build/bench-corpus
-first=${AMC_FIRST_MODEL:-}
+first=${AMC_PREVIOUS_MODEL:-}
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 source "$here/scripts/corpus.sh"
@@ -42,7 +43,7 @@ hierarchy_bytes() { sed -n 's/.*hierarchy \([0-9]*\)).*/\1/p' <<< "$1"; }
 change() { awk -v a="$1" -v b="$2" 'BEGIN { if (a > 0) printf "%+.1f%%", 100 * (b - a) / a; else print "" }'; }
 
 if [[ -n $first ]]; then
-  echo "| model | faces | hierarchy bytes, paper | first model (v8) | change | second model (v10) | change | decode ms, paper | v8 | v10 |"
+  echo "| model | faces | hierarchy bytes, paper | older model | change | newest model | change | decode ms, paper | older | newest |"
   echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
 else
   echo "| model | faces | hierarchy bytes, paper | mixing mode | change | decode ms, paper | mixing mode |"

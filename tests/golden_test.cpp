@@ -261,7 +261,7 @@ std::vector<GoldenCase> mixed_contexts_cases() {
     return cases;
 }
 
-// Version 8's files hold the mixing mode's first model, which encoders no longer write (version 10
+// Version 8's files hold the mixing mode's first model, which encoders no longer write (version 11
 // pins the encoder on the same cases, below): they decode.
 TEST(Golden, MixedContextsFilesOfTheFirstModelDecode) {
     for (const GoldenCase& c : mixed_contexts_cases()) {
@@ -312,7 +312,7 @@ TEST(Golden, GridGeometryFilesDecodeAndPinTheEncoder) {
         const std::string path = golden_path(kGridGeometryVersion, c.name);
         SCOPED_TRACE(path);
         if (c.options.hierarchy_contexts == HierarchyContexts::mixed) {
-            // The mixing mode's first model: encoders write version 10 now (pinned below).
+            // The mixing mode's first model: encoders write version 11 now (pinned below).
             const std::vector<uint8_t> golden = read_golden(path);
             ASSERT_FALSE(golden.empty()) << path << " is missing";
             EXPECT_EQ(inspect(golden.data(), golden.size()).version, kGridGeometryVersion);
@@ -342,21 +342,25 @@ TEST(Golden, GridGeometryFilesDecodeAndPinTheEncoder) {
     }
 }
 
-// Version 10 (the mixing mode's second model, FORMAT.md 2.2): version 8's cases and the projected
-// sphere at 12 bits in geometry mode 4 under the mixing mode (version 9's mixed case).
-std::vector<GoldenCase> second_mixing_cases() {
+// Versions 10 and 11 (the mixing mode's second and third models, FORMAT.md 2.2-2.3): version 8's
+// cases and the projected sphere at 12 bits in geometry mode 4 under the mixing mode (version 9's
+// mixed case).
+std::vector<GoldenCase> later_mixing_cases() {
     std::vector<GoldenCase> cases = mixed_contexts_cases();
     for (const GoldenCase& c : grid_geometry_cases())
         if (c.options.hierarchy_contexts == HierarchyContexts::mixed) cases.push_back(c);
     return cases;
 }
 
-TEST(Golden, SecondMixingModelFilesDecodeAndPinTheEncoder) {
-    const std::vector<GoldenCase> cases = second_mixing_cases();
+// Version 10's files hold the second model, which encoders no longer write (version 11 pins the
+// encoder on the same cases, below): they decode, and are not first-model files.
+TEST(Golden, SecondMixingModelFilesDecode) {
+    const std::vector<GoldenCase> cases = later_mixing_cases();
     ASSERT_EQ(cases.size(), 6u);
     for (const GoldenCase& c : cases) {
-        SCOPED_TRACE(golden_path(kSecondMixingVersion, c.name));
-        const std::vector<uint8_t> golden = pinned_encoding(c, kSecondMixingVersion);
+        const std::string path = golden_path(kSecondMixingVersion, c.name);
+        SCOPED_TRACE(path);
+        const std::vector<uint8_t> golden = read_golden(path);
         ASSERT_FALSE(golden.empty()) << "missing";
         EXPECT_EQ(inspect(golden.data(), golden.size()).version, kSecondMixingVersion);
         check_decodes(golden, c, kSecondMixingVersion);
@@ -364,6 +368,22 @@ TEST(Golden, SecondMixingModelFilesDecodeAndPinTheEncoder) {
         const std::vector<uint8_t> first = read_golden(golden_path(c.options.grid_contexts && c.options.quantize_bits != 0 ? kGridGeometryVersion : kMixedContextsVersion, c.name));
         ASSERT_FALSE(first.empty());
         EXPECT_NE(first, golden);
+    }
+}
+
+TEST(Golden, ThirdMixingModelFilesDecodeAndPinTheEncoder) {
+    const std::vector<GoldenCase> cases = later_mixing_cases();
+    ASSERT_EQ(cases.size(), 6u);
+    for (const GoldenCase& c : cases) {
+        SCOPED_TRACE(golden_path(kThirdMixingVersion, c.name));
+        const std::vector<uint8_t> golden = pinned_encoding(c, kThirdMixingVersion);
+        ASSERT_FALSE(golden.empty()) << "missing";
+        EXPECT_EQ(inspect(golden.data(), golden.size()).version, kThirdMixingVersion);
+        check_decodes(golden, c, kThirdMixingVersion);
+        // Not a second-model file: version 10's file of the case holds other bytes.
+        const std::vector<uint8_t> second = read_golden(golden_path(kSecondMixingVersion, c.name));
+        ASSERT_FALSE(second.empty());
+        EXPECT_NE(second, golden);
     }
 }
 

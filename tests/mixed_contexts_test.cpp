@@ -90,7 +90,7 @@ TEST(MixedContexts, RandomHierarchiesRoundTripBitExactlyUnderEverySwitch) {
         }
         options.predictor = GeometryPredictor(random.next() % 4);
         const std::vector<uint8_t> bytes = encode(h, options);
-        ASSERT_EQ(bytes[4], kSecondMixingVersion) << trial;
+        ASSERT_EQ(bytes[4], kThirdMixingVersion) << trial;
         const Hierarchy back = decode(bytes.data(), bytes.size());
         Hierarchy expected = in_decoder_order(h, options);
         if (options.quantize_bits != 0) {

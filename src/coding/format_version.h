@@ -16,8 +16,9 @@ namespace amc {
 // the mixing mode (metadata option bit 2; FORMAT.md 2.1). Version 9 for files with a level in
 // geometry mode 4 (whether chunked, mixed or neither). Version 10 for files in the mixing mode's
 // second model (FORMAT.md 2.2; whatever their geometry modes): versions 8 and 9 hold the first.
+// Version 11 for files in its third model (FORMAT.md 2.3), which encoders write since.
 constexpr uint8_t kOldestReadableVersion = 1;
-constexpr uint8_t kNewestVersion = 10;
+constexpr uint8_t kNewestVersion = 11;
 constexpr uint8_t kBaseVersion = 2;       // everything but the numbering block and mode 2
 constexpr uint8_t kNumberingVersion = 3;  // the first version with a numbering block
 constexpr uint8_t kAngleBaseVersion = 4;  // the first version with base connectivity mode 2
@@ -31,6 +32,7 @@ constexpr uint8_t kMixedContextsVersion = 8;   // the first version with the hie
 // prediction falls between grid points; quantized files, level blocks or chunks).
 constexpr uint8_t kGridGeometryVersion = 9;
 constexpr uint8_t kSecondMixingVersion = 10;  // the first version whose mixing mode is the second model
+constexpr uint8_t kThirdMixingVersion = 11;   // the first version whose mixing mode is the third model
 
 // The hierarchy stream (FORMAT.md section 2).
 constexpr uint8_t kHierarchyStreamVersion = 2;
@@ -53,6 +55,7 @@ constexpr uint8_t hierarchy_stream_version_of_file(uint8_t file_version) {
         case 8: return 2;
         case 9: return 2;
         case 10: return 2;
+        case 11: return 2;
     }
     return 0;
 }

@@ -52,7 +52,7 @@ Quantizer quantizer_of(const Hierarchy& input, int bits, double& max_error) {
 // The lowest version that holds what the file holds (format_version.h).
 uint8_t file_version(bool grid_geometry, bool mixed_contexts, bool chunked, bool static_geometry, BaseConnectivityMode base_mode,
                      bool store_numbering) {
-    return mixed_contexts                                ? kSecondMixingVersion
+    return mixed_contexts                                ? kThirdMixingVersion
            : grid_geometry                               ? kGridGeometryVersion
            : chunked                                     ? kChunkedVersion
            : static_geometry                             ? kStaticGeometryVersion
@@ -299,7 +299,9 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
                                     hierarchy_stream_version_of_file(reader.version()),
                                     std::min<uint64_t>(meta.nodes, options.max_nodes));
     if (meta.options & kOptionMixedContexts)
-        hierarchy.use_mixed_contexts(reader.version() >= kSecondMixingVersion ? MixingModel::second : MixingModel::first);
+        hierarchy.use_mixed_contexts(reader.version() >= kThirdMixingVersion    ? MixingModel::third
+                                     : reader.version() >= kSecondMixingVersion ? MixingModel::second
+                                                                                : MixingModel::first);
     Hierarchy& h = hierarchy.hierarchy();
     // The metadata's counts let the hierarchy grow in place, as far as the file's size warrants.
     const uint64_t reserved_nodes = std::min<uint64_t>(meta.nodes, meta.base_triangles + kReservedNodesPerFileByte * size);

@@ -57,6 +57,10 @@ inline int p12_of(const BitModel& m) { return std::clamp(int(m.p16() >> 4), 1, 4
 class Mixer {
 public:
     Mixer(int inputs, int sets, int rate) : n_(inputs), rate_(rate), w_(size_t(inputs) * size_t(sets), (1 << 16) / inputs) {}
+    // The same, every set starting at the `inputs` weights `start`.
+    Mixer(int inputs, int sets, int rate, const int32_t* start) : n_(inputs), rate_(rate), w_(size_t(inputs) * size_t(sets)) {
+        for (size_t s = 0; s < size_t(sets); ++s) std::copy_n(start, inputs, &w_[s * size_t(inputs)]);
+    }
     // The mixed 12-bit probability of the stretched inputs `st` under weight set `set`.
     int mix(const int* st, int set) {
         set_ = set;

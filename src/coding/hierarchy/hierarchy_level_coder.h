@@ -30,8 +30,8 @@ struct CodedSymbol {
     bool refined;
 };
 
-// The mixing mode's model that encoders write (.amc version 10).
-constexpr MixingModel kWrittenMixingModel = MixingModel::second;
+// The mixing mode's model that encoders write (.amc version 11).
+constexpr MixingModel kWrittenMixingModel = MixingModel::third;
 
 class HierarchyLevelEncoder {
 public:
@@ -164,8 +164,8 @@ public:
     // The vertices the last decode_level created, as (node, edge) in canonical order at their
     // first appearance (new_vertices_of_level of its level's nodes), positions not yet set.
     const std::vector<std::pair<NodeId, int>>& new_vertices() const { return new_vertices_; }
-    // Switches to the mixing mode (FORMAT.md 2.1: `model` first for .amc versions 8-9, second from
-    // version 10) before the first level. Its features read the positions of hierarchy():
+    // Switches to the mixing mode (FORMAT.md 2.1: `model` first for .amc versions 8-9, second for
+    // version 10, third from version 11) before the first level. Its features read the positions of hierarchy():
     // decode_level only, each level's new positions set before the next level is decoded.
     void use_mixed_contexts(MixingModel model) { mixed_model_ = std::make_unique<MixedHierarchyModel>(model); }
     // decode_level in two halves, for callers that want every decision before building: decide

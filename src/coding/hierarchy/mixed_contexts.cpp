@@ -90,22 +90,44 @@ LevelShapes::Bending LevelShapes::bending(const Hierarchy& h, NodeId n, uint32_t
     const double twice_area = exact_length(exact_cross(b - a, c - a));
     const Vec3 corner[3] = {a, b, c};
     double chord_sum = 0, weighted = 0, longest = 0;
+    Vec3 around[3];
+    int neighbours = 0;
     for (int e = 0; e < 3; ++e) {
         const double len = exact_length(corner[(e + 1) % 3] - corner[e]);
         longest = std::max(longest, len);
         const NodeId q = h.neighbor(n, e);
         if (q == kNoNode) continue;
         // nbr.nbr[e] is q's local index (the level's neighbour across e, as h's).
-        const double chord = exact_length(own - (nbr.nbr[e] != kNoLocal ? normal(h, q, nbr.nbr[e]) : unit_normal(h, q)));
+        around[e] = nbr.nbr[e] != kNoLocal ? normal(h, q, nbr.nbr[e]) : unit_normal(h, q);
+        ++neighbours;
+        const double chord = exact_length(own - around[e]);
         chord_sum += chord;
         weighted += rounded(chord * len);
     }
-    const Bending value{chord_sum, twice_area > 0 ? rounded(weighted * longest) / (2 * twice_area) : 0};
+    // The neighbours' normals span a solid angle about the Gauss curvature times the area.
+    double gauss = 0;
+    if (neighbours == 3 && twice_area > 0)
+        gauss = rounded(std::fabs(exact_dot(around[0], exact_cross(around[1], around[2]))) * rounded(longest * longest)) / twice_area;
+    const Bending value{chord_sum, twice_area > 0 ? rounded(weighted * longest) / (2 * twice_area) : 0, longest, gauss};
     if (local < bending_.size()) {
         bending_[local] = value;
         bending_stamp_[local] = current_;
     }
     return value;
+}
+
+double LevelShapes::base_edge(const Hierarchy& h) {
+    if (base_edge_ < 0) {
+        double sum = 0;
+        for (NodeId r = 0; r < NodeId(h.root_count()); ++r) {
+            const Vec3 c[3] = {h.position(h.vertex(r, 0)), h.position(h.vertex(r, 1)), h.position(h.vertex(r, 2))};
+            double longest = 0;
+            for (int e = 0; e < 3; ++e) longest = std::max(longest, exact_length(c[(e + 1) % 3] - c[e]));
+            sum += longest;
+        }
+        base_edge_ = h.root_count() > 0 ? sum / double(h.root_count()) : 0;
+    }
+    return base_edge_;
 }
 
 MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, uint32_t i, int group, LevelShapes& shapes,
@@ -170,7 +192,7 @@ MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, u
     f.bend_sum = uint8_t(half_octave_bin(bending.chord_sum, 30, 31));
     const double curvature = bending.curvature;
     f.mean_curv = uint8_t(quarter_octave_bin(curvature, 40, 63));
-    if (model == MixingModel::second) {
+    if (model != MixingModel::first) {
         // The same over the node and its same-level neighbours in the level: largest and mean.
         double largest = curvature, sum = curvature;
         int count = 1;
@@ -184,6 +206,11 @@ MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, u
         }
         f.ring_max = uint8_t(quarter_octave_bin(largest, 40, 63));
         f.ring_mean = uint8_t(quarter_octave_bin(sum / count, 40, 63));
+    }
+    if (model == MixingModel::third) {
+        const double unit = shapes.base_edge(h);
+        f.size = uint8_t(unit > 0 ? quarter_octave_bin(std::ldexp(bending.longest, l) / unit, 28, 63) : 0);
+        f.gauss = uint8_t(quarter_octave_bin(bending.gauss, 46, 63));
     }
     return f;
 }
@@ -201,6 +228,20 @@ constexpr uint32_t kSecondContextSizes[MixedHierarchyModel::kHistoryInputs + Mix
     160, 640, 2560, 640, 5120};
 constexpr int kIndirectOf[MixedHierarchyModel::kIndirectInputs] = {1, 4, 11};  // the direct contexts with bit histories
 constexpr int kHistoryMapLog2 = 6;
+// The third model's (FORMAT.md 2.3): direct models 21-24, mixer D's sets, the mixers' rate and
+// their start weights, one row a mixer (the weights the corpus's models end with, averaged:
+// bench/model_study, docs/HIERARCHY_CODER.md).
+constexpr uint32_t kThirdContextSizes[MixedHierarchyModel::kSizeInputs] = {5120, 1024, 1024, 16384};
+constexpr int kThirdMixerRate = 16;
+constexpr int32_t kThirdStartWeights[4][MixedHierarchyModel::kThirdInputs + 1] = {
+    {-7175, 1455, -3168, -7918, 9409, 6132, 4309, 10091, 2515, 5506, 2802, 284, 1641, 14454, 10366,
+     5135, 3181, 8408, 3283, 4805, 3267, -10110, -6345, -7740, 13069, 1994, 6224, 10058, 1524},
+    {-6364, -1912, -1706, -5835, 8484, 5389, 1223, 7186, -359, 3153, 559, -2070, -252, 12334, 10866,
+     4665, 4605, 10099, 2373, 1188, 350, 968, 5894, -830, 11111, -64, 6101, 5962, 4867},
+    {-1878, 2409, -77, -2088, 7274, 4270, 4100, 7297, 3311, 4805, 3052, 1554, 2595, 10469, 7575,
+     4001, -2448, 2742, 2901, 5320, 4654, -4493, -2988, -3507, 8433, 2874, 5502, 9095, 1997},
+    {-2915, 1231, -1166, -3132, 7789, 3497, 3891, 7928, 2948, 5379, 2671, 1048, 2382, 10671, 8498,
+     3163, 3379, 6474, 3899, 4952, 4732, -3768, -988, -3442, 1813, 724, 6746, 7379, 1957}};
 constexpr int kMapContexts[MixedHierarchyModel::kMaps] = {kContextGroupCount * 4, kContextGroupCount * 64, 24 * 8,
                                                           kContextGroupCount * 256, kContextGroupCount * 5 * 4};
 
@@ -212,18 +253,33 @@ uint8_t next_history(uint8_t history, bool bit) {
 
 }  // namespace
 
+namespace {
+
+// A mixer of `model` with `sets` weight sets: the third model's start at row `row` of its trained
+// weights, the others' at 1/n each.
+mixing::Mixer model_mixer(MixingModel model, int sets, int row) {
+    if (model == MixingModel::third)
+        return mixing::Mixer(MixedHierarchyModel::kThirdInputs + 1, sets, kThirdMixerRate, kThirdStartWeights[row]);
+    return mixing::Mixer((model == MixingModel::first ? MixedHierarchyModel::kInputs : MixedHierarchyModel::kSecondInputs) + 1, sets,
+                         kMixerRate);
+}
+
+}  // namespace
+
 MixedHierarchyModel::MixedHierarchyModel(MixingModel model)
     : model_(model),
-      mixer_a_((model == MixingModel::first ? kInputs : kSecondInputs) + 1, kContextGroupCount, kMixerRate),
-      mixer_b_((model == MixingModel::first ? kInputs : kSecondInputs) + 1, 16, kMixerRate),
-      mixer_c_((model == MixingModel::first ? kInputs : kSecondInputs) + 1, model == MixingModel::first ? 24 : kContextGroupCount * 16,
-             kMixerRate) {
+      mixer_a_(model_mixer(model, kContextGroupCount, 0)),
+      mixer_b_(model_mixer(model, 16, 1)),
+      mixer_c_(model_mixer(model, model == MixingModel::first ? 24 : kContextGroupCount * 16, 2)),
+      mixer_d_(model_mixer(model, model == MixingModel::third ? kContextGroupCount * 16 : 1, 3)) {
     for (int j = 0; j < kInputs; ++j) models_[size_t(j)].assign(kContextSizes[j], BitModel(kModelWindowLog2));
     if (model == MixingModel::first) {
         maps_.emplace_back(kContextGroupCount * 4, kMapRate);
         return;
     }
     for (int j = kInputs; j < kDirect; ++j) models_[size_t(j)].assign(kSecondContextSizes[j - kInputs], BitModel(kModelWindowLog2));
+    if (model == MixingModel::third)
+        for (int j = kDirect; j < kThirdDirect; ++j) models_[size_t(j)].assign(kThirdContextSizes[j - kDirect], BitModel(kModelWindowLog2));
     for (int k = 0; k < kIndirectInputs; ++k) {
         histories_[size_t(k)].assign(kContextSizes[kIndirectOf[k]], uint8_t{1});
         history_maps_[size_t(k)].assign(size_t(kContextGroupCount) * 256, BitModel(kHistoryMapLog2));
@@ -256,7 +312,7 @@ uint32_t MixedHierarchyModel::p16(const MixedFeatures& f) {
     const std::array<uint32_t, kInputs> direct = direct_slots(f);
     std::copy_n(direct.begin(), kInputs, slot_.begin());
     for (int j = 0; j < kInputs; ++j) st_[size_t(j)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
-    if (model_ == MixingModel::second) return uint32_t(second_model_p12(f)) << 4;
+    if (model_ != MixingModel::first) return uint32_t(later_model_p12(f)) << 4;
     st_[kInputs] = 256;  // bias
     // Three weight sets chosen by different contexts, averaged in the stretched domain.
     const int s1 = mixing::stretch(mixer_a_.mix(st_.data(), int(g)));
@@ -269,7 +325,7 @@ uint32_t MixedHierarchyModel::p16(const MixedFeatures& f) {
     return uint32_t(p) << 4;
 }
 
-int MixedHierarchyModel::second_model_p12(const MixedFeatures& f) {
+int MixedHierarchyModel::later_model_p12(const MixedFeatures& f) {
     const uint32_t g = f.group;
     const uint32_t last4 = last_bits_ & 15;
     slot_[kInputs] = g * 16 + last4;
@@ -283,11 +339,23 @@ int MixedHierarchyModel::second_model_p12(const MixedFeatures& f) {
         history_map_slot_[size_t(k)] = g * 256 + histories_[size_t(k)][history_context_[size_t(k)]];
         st_[size_t(kDirect + k)] = mixing::stretch(mixing::p12_of(history_maps_[size_t(k)][history_map_slot_[size_t(k)]]));
     }
-    st_[kSecondInputs] = 256;  // bias
+    const bool third = model_ == MixingModel::third;
+    if (third) {
+        slot_[kDirect] = (g * 64 + f.size) * 8 + f.level;
+        // Tables 22-24 without the group: shared by all groups, they learn faster.
+        slot_[kDirect + 1] = f.mean_curv * 16u + f.size / 4u;
+        slot_[kDirect + 2] = f.gauss * 16u + f.mean_curv / 4u;
+        slot_[kDirect + 3] = (f.ring_mean * 32u + f.size / 2u) * 8 + f.level;
+        for (int j = kDirect; j < kThirdDirect; ++j)
+            st_[size_t(j + kIndirectInputs)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
+    }
+    const int inputs = third ? kThirdInputs : kSecondInputs;
+    st_[size_t(inputs)] = 256;  // bias
     const int s1 = mixing::stretch(mixer_a_.mix(st_.data(), int(g)));
     const int s2 = mixing::stretch(mixer_b_.mix(st_.data(), f.ring_mean / 4));
     const int s3 = mixing::stretch(mixer_c_.mix(st_.data(), int(g * 16 + last4)));
-    p_mix_ = mixing::squash((s1 + s2 + s3) / 3);
+    p_mix_ = third ? mixing::squash((s1 + s2 + s3 + mixing::stretch(mixer_d_.mix(st_.data(), int(g * 16 + f.size / 4u)))) / 4)
+                   : mixing::squash((s1 + s2 + s3) / 3);
     map_context_ = {int(g * 4 + f.inner), int(g * 64 + f.mean_curv), int(f.disp * 8 + f.level), int(g * 256 + (last_bits_ & 255)),
                     int((g * 5 + f.ring2) * 4 + f.parent_nbrs)};
     int refined = 0;
@@ -299,8 +367,9 @@ void MixedHierarchyModel::update(bool bit) {
     mixer_a_.update(st_.data(), bit);
     mixer_b_.update(st_.data(), bit);
     mixer_c_.update(st_.data(), bit);
+    if (model_ == MixingModel::third) mixer_d_.update(st_.data(), bit);
     for (mixing::ProbabilityMap& map : maps_) map.update(bit);
-    const int direct = model_ == MixingModel::first ? kInputs : kDirect;
+    const int direct = model_ == MixingModel::first ? kInputs : model_ == MixingModel::second ? kDirect : kThirdDirect;
     for (int j = 0; j < direct; ++j) models_[size_t(j)][slot_[size_t(j)]].update(bit);
     if (model_ == MixingModel::first) return;
     for (int k = 0; k < kIndirectInputs; ++k) {

@@ -1,5 +1,5 @@
 // The hierarchy coder's mixing mode (.amc version 8, docs/FORMAT.md section 2.1; its second model,
-// version 10, section 2.2): each coded symbol's probability comes from adaptive models under
+// version 10, section 2.2; its third, version 11, section 2.3): each coded symbol's probability comes from adaptive models under
 // contexts richer than the paper's groups — the node's structure one level up, its decided
 // neighbours and their neighbours, and the decoded geometry around it — mixed by logistic mixing
 // (context_mixing.h) and refined by adaptive probability maps. Measured in
@@ -18,9 +18,11 @@
 
 namespace amc {
 
-// Which model of the mixing mode a stream is coded with: version 8's (FORMAT.md 2.1), or version
-// 10's (2.2), which adds the last coded bits, bit histories and the curvature of the neighbours.
-enum class MixingModel : uint8_t { first = 1, second = 2 };
+// Which model of the mixing mode a stream is coded with: version 8's (FORMAT.md 2.1), version 10's
+// (2.2), which adds the last coded bits, bit histories and the curvature of the neighbours, or
+// version 11's (2.3), which adds the node's size and a Gauss curvature, a fourth mixer and mixers
+// that start from trained weights.
+enum class MixingModel : uint8_t { first = 1, second = 2, third = 3 };
 
 // What the decoder knows of a node when its symbol comes.
 struct MixedFeatures {
@@ -38,6 +40,8 @@ struct MixedFeatures {
     uint8_t mean_curv;    // log bin of a discrete mean curvature times the longest edge, 0..63
     uint8_t ring_max;     // second model: the largest of mean_curv's value over the node and its neighbours, binned alike
     uint8_t ring_mean;    // second model: their mean, binned alike
+    uint8_t size;         // third model: log bin of the longest edge times 2^level over the base's mean longest edge, 0..63
+    uint8_t gauss;        // third model: log bin of the neighbours' normals' spread (a Gauss curvature) times the longest edge^2, 0..63
 };
 
 // The unit normals and curvatures of one level's nodes by local index, each computed once: the
@@ -51,25 +55,31 @@ public:
     // The unit normal of node `node` (local index `local` of the current level); zero for a
     // degenerate triangle.
     Vec3 normal(const Hierarchy& h, NodeId node, uint32_t local);
-    // bend_sum's and mean_curv's values before binning (mixed_features): the summed chords
-    // between the node's unit normal and its same-level neighbours', and a discrete mean curvature
-    // of the node times its longest edge (0 for a degenerate triangle).
+    // bend_sum's, mean_curv's and gauss's values before binning (mixed_features): the summed
+    // chords between the node's unit normal and its same-level neighbours', a discrete mean
+    // curvature of the node times its longest edge (0 for a degenerate triangle), the longest
+    // edge, and |det| of the three neighbours' unit normals times the longest edge squared over
+    // twice the area (0 without three neighbours or for a degenerate triangle).
     struct Bending {
-        double chord_sum, curvature;
+        double chord_sum, curvature, longest, gauss;
     };
     Bending bending(const Hierarchy& h, NodeId node, uint32_t local, const Level& level);
+    // The mean of the roots' longest edges (in root order), computed on first use: the third
+    // model's unit of size.
+    double base_edge(const Hierarchy& h);
 
 private:
     std::vector<Vec3> normal_;
     std::vector<Bending> bending_;
     std::vector<uint32_t> stamp_, bending_stamp_;  // normal_[i] is this level's when stamp_[i] == current_
     uint32_t current_ = 0;
+    double base_edge_ = -1;
 };
 
 // The features of node `n` of `h` (coarser levels whole, n's corners placed) that do not depend
 // on the traversal, and those that do from the level's state bytes: `i` is n's local index in
 // `level`, whose neighbours' states are as decided so far. `shapes` is started on `level`. The
-// ring features are computed for the second model only.
+// ring features are computed for the second and third models, size and gauss for the third only.
 MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, uint32_t i, int group, LevelShapes& shapes,
                              MixingModel model);
 
@@ -84,6 +94,9 @@ public:
     static constexpr int kIndirectInputs = 3;  // bit histories of three direct contexts
     static constexpr int kSecondInputs = kDirect + kIndirectInputs;
     static constexpr int kMaps = 5;            // the second model's probability maps
+    static constexpr int kSizeInputs = 4;      // the third model's direct models of size and Gauss curvature
+    static constexpr int kThirdDirect = kDirect + kSizeInputs;
+    static constexpr int kThirdInputs = kSecondInputs + kSizeInputs;
     explicit MixedHierarchyModel(MixingModel model);
     MixingModel model() const { return model_; }
     // The 16-bit probability of a one for a symbol with these features (remembered for update).
@@ -93,19 +106,22 @@ public:
     static std::array<uint32_t, kInputs> direct_slots(const MixedFeatures& f);
 
 private:
-    int second_model_p12(const MixedFeatures& f);
+    // The second and third models' probability (FORMAT.md 2.2, 2.3), 12 bits.
+    int later_model_p12(const MixedFeatures& f);
 
     MixingModel model_;
-    std::array<std::vector<BitModel>, kDirect> models_;
-    std::array<uint32_t, kDirect> slot_{};
-    std::array<int, kSecondInputs + 1> st_{};  // stretched inputs, then the bias
+    std::array<std::vector<BitModel>, kThirdDirect> models_;
+    std::array<uint32_t, kThirdDirect> slot_{};
+    // Stretched inputs: the direct models 0-20, the bit histories, the third model's direct
+    // models 21-24, then the bias.
+    std::array<int, kThirdInputs + 1> st_{};
     // Second model: per context of direct models 1, 4 and 11 its last bits (up to 7, led by a 1),
     // and per such input an adaptive probability of each group x history.
     std::array<std::vector<uint8_t>, kIndirectInputs> histories_;
     std::array<std::vector<BitModel>, kIndirectInputs> history_maps_;
     std::array<uint32_t, kIndirectInputs> history_context_{}, history_map_slot_{};
     uint32_t last_bits_ = 0;  // the stream's coded bits, the newest lowest
-    mixing::Mixer mixer_a_, mixer_b_, mixer_c_;  // FORMAT.md's mixers A, B, C
+    mixing::Mixer mixer_a_, mixer_b_, mixer_c_, mixer_d_;  // FORMAT.md's mixers A, B, C, D (D: third model)
     std::vector<mixing::ProbabilityMap> maps_;
     std::array<int, kMaps> map_context_{};
     int p_mix_ = 2048;

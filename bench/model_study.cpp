@@ -1,0 +1,540 @@
+// Designs beyond the mixing mode's second model (issue 30; docs/HIERARCHY_CODER.md, "The third
+// model"): each model's coded symbols with the coder's features (mixed_symbols.h), coded again by
+// the second model (.amc version 10, FORMAT.md 2.2) re-implemented here with switches and with
+// study-only features (Extra); exact adaptive code lengths, so one run gives the table. The first
+// row is the coder's own newest model (the third, version 11); the re-implementation's default must
+// equal the coder's second model (checked). ONLY=text runs only the designs whose name holds it;
+// CACHE_DIR as bench/mixing_study; WEIGHTS_OUT=prefix writes the mixers' weights the models end
+// with (averaged over the models) for each design with trained start weights, WEIGHTS_IN=prefix
+// starts those designs from such files instead of leaving each model out of its own start.
+//   [CACHE_DIR=dir] [ONLY=text] [WEIGHTS_OUT=prefix | WEIGHTS_IN=prefix] model_study model.amh ...
+#include "mixed_symbols.h"
+
+#include "coding/hierarchy/context_mixing.h"
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace amc;
+using mixed_study::ModelData;
+using mixed_study::Symbol;
+
+// Study-only features of each coded symbol's node n, all known to a decoder when the symbol comes.
+struct Extra {
+    uint8_t parent_curv = 0;  // the curvature feature of n's parent at its level, quarter octaves
+    uint8_t gauss = 0;        // |det| of the neighbours' unit normals times the longest edge^2 over the area, quarter octaves
+    uint8_t size = 0;         // n's longest edge over the level's mean longest edge, quarter octaves around 32
+    uint8_t grand_curv = 0;   // the grandparent's curvature feature
+    uint8_t base_size = 0;    // n's longest edge times 2^level over the base's mean longest edge, quarter octaves around 32
+};
+
+Vec3 unit_normal_of(const Hierarchy& h, NodeId m, double* twice_area = nullptr) {
+    const Vec3 a = h.position(h.vertex(m, 0)), u = h.position(h.vertex(m, 1)) - a, v = h.position(h.vertex(m, 2)) - a;
+    const Vec3 x{u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x};
+    const double len = std::sqrt(dot(x, x));
+    if (twice_area) *twice_area = len;
+    return len > 0 ? (1.0 / len) * x : Vec3{0, 0, 0};
+}
+
+double longest_edge(const Hierarchy& h, NodeId m) {
+    double longest = 0;
+    for (int e = 0; e < 3; ++e) {
+        const Vec3 d = h.position(h.vertex(m, (e + 1) % 3)) - h.position(h.vertex(m, e));
+        longest = std::max(longest, std::sqrt(dot(d, d)));
+    }
+    return longest;
+}
+
+std::vector<Extra> extra_features(const std::string& path, const std::filesystem::path& cache, size_t count) {
+    const std::filesystem::path file = cache / (std::filesystem::path(path).stem().string() + ".x2");
+    std::vector<Extra> out(count);
+    if (std::ifstream in{file, std::ios::binary}) {
+        in.read(reinterpret_cast<char*>(out.data()), std::streamsize(count * sizeof(Extra)));
+        if (in) return out;
+    }
+    const Hierarchy h = read_hierarchy(path);
+    std::vector<CodedSymbol> trace;
+    const HierarchyLevelEncoder mixed(h, HierarchyCoderOptions{}, kHierarchyStreamVersion, &trace, true);
+    std::vector<double> level_sum(64, 0), level_count(64, 0);
+    for (NodeId n = 0; n < NodeId(h.node_count()); ++n) {
+        const int l = std::min(h.level(n), 63);
+        level_sum[size_t(l)] += longest_edge(h, n);
+        level_count[size_t(l)] += 1;
+    }
+    for (size_t i = 0; i < count && i < trace.size(); ++i) {
+        const NodeId n = trace[i].node;
+        Extra& x = out[i];
+        const NodeId p = h.parent(n);
+        if (p != kNoNode) {
+            x.parent_curv = uint8_t(mixed_study::quarter_bin(mixed_study::raw_curvature(h, p)));
+            const NodeId g = h.parent(p);
+            if (g != kNoNode) x.grand_curv = uint8_t(mixed_study::quarter_bin(mixed_study::raw_curvature(h, g)));
+        }
+        double twice_area = 0;
+        unit_normal_of(h, n, &twice_area);
+        Vec3 nn[3] = {};
+        bool all = true;
+        for (int e = 0; e < 3; ++e) {
+            const NodeId q = h.neighbor(n, e);
+            if (q == kNoNode) all = false;
+            else nn[e] = unit_normal_of(h, q);
+        }
+        const double longest = longest_edge(h, n);
+        if (all && twice_area > 0) {
+            const Vec3 c{nn[1].y * nn[2].z - nn[1].z * nn[2].y, nn[1].z * nn[2].x - nn[1].x * nn[2].z, nn[1].x * nn[2].y - nn[1].y * nn[2].x};
+            x.gauss = uint8_t(std::clamp(mixed_study::quarter_bin(std::abs(dot(nn[0], c)) * longest * longest / twice_area) + 10, 0, 63));
+            if (std::abs(dot(nn[0], c)) == 0) x.gauss = 0;
+        }
+        const int l = std::min(h.level(n), 63);
+        const double mean = level_sum[size_t(l)] / std::max(1.0, level_count[size_t(l)]);
+        if (longest > 0 && mean > 0) x.size = uint8_t(std::clamp(int(std::floor(4 * std::log2(longest / mean))) + 32, 1, 63));
+        if (longest > 0 && level_sum[0] > 0)
+            x.base_size = uint8_t(std::clamp(int(std::floor(4 * std::log2(std::ldexp(longest, h.level(n)) / (level_sum[0] / level_count[0])))) + 32, 1, 63));
+    }
+    std::ofstream(file, std::ios::binary).write(reinterpret_cast<const char*>(out.data()), std::streamsize(count * sizeof(Extra)));
+    return out;
+}
+
+struct Options {
+    int window_log2 = 8;       // direct models
+    int history_log2 = 6;      // the bit histories' models
+    int mixer_rate = 24;
+    int map_rate = 7;
+    int boost = 0;             // mixer rate rate + boost * 64 / (uses of the set + 64): faster while a set is young
+    int boost_span = 64;
+    bool inherit_sets = false; // a weight set of mixers B and C starts, on first use, as mixer A's set g
+    int inherit_models = 0;    // a direct model of tables 1..20 starts, on first use, at table 0's p with this count
+    int level_cap = -1;        // at a new level every direct model's count is capped here (faster adaptation)
+    int level_map = 0;         // 1: a sixth map by 8g + level; 2: the same as a chain after the mean
+    int map_share = 3;         // of 4
+    bool prime = false;        // code the symbols twice, count the second pass (the learning cost's bound)
+    bool trained_start = false;  // mixers start at the weights the other models ended with (leave one out)
+    std::array<std::vector<int32_t>, 4> start;  // mixers A, B, C, D (D: B's when not trained with D)
+    // Extra direct models (window 2^8), each one more mixer input: their contexts.
+    std::vector<std::function<uint32_t(const MixedFeatures&, const Extra&)>> extra;
+    int mixer_d = 0;  // a fourth mixer: 1 set by base size / 4 x level, 2 by curvature / 4 x level, 3 by gauss / 4 x level
+    int extra_set_b = 0;  // 1: mixer B's set by parent_curv / 4 instead of ring_mean / 4
+};
+
+class Mixer {
+public:
+    Mixer(int inputs, int sets) : n_(inputs), w_(size_t(inputs) * size_t(sets), (1 << 16) / inputs), uses_(size_t(sets), 0) {}
+    bool fresh(int set) const { return uses_[size_t(set)] == 0; }
+    // Every set's weights as `w`.
+    void start_at(const std::vector<int32_t>& w) {
+        for (size_t s = 0; s < uses_.size(); ++s) std::copy_n(w.begin(), n_, &w_[s * size_t(n_)]);
+    }
+    // The sets' weights averaged, each by its uses.
+    std::vector<double> mean_weights() const {
+        std::vector<double> m(size_t(n_), 0);
+        double total = 0;
+        for (size_t s = 0; s < uses_.size(); ++s) {
+            total += uses_[s];
+            for (int i = 0; i < n_; ++i) m[size_t(i)] += double(uses_[s]) * w_[s * size_t(n_) + size_t(i)];
+        }
+        for (double& x : m) x /= std::max(1.0, total);
+        return m;
+    }
+    void copy_set(int to, const Mixer& from, int set) {
+        std::copy_n(&from.w_[size_t(set) * size_t(n_)], n_, &w_[size_t(to) * size_t(n_)]);
+    }
+    int mix(const int* st, int set) {
+        set_ = set;
+        const int32_t* w = &w_[size_t(set) * size_t(n_)];
+        int64_t dot = 0;
+        for (int i = 0; i < n_; ++i) dot += int64_t(w[i]) * st[i];
+        p_ = mixing::squash(int(std::clamp<int64_t>(dot >> 16, -mixing::kStretchLimit, mixing::kStretchLimit)));
+        return p_;
+    }
+    void update(const int* st, bool bit, const Options& o) {
+        uint32_t& uses = uses_[size_t(set_)];
+        const int rate = o.mixer_rate + (o.boost ? o.boost * o.boost_span / int(std::min<uint32_t>(uses, 1 << 20) + uint32_t(o.boost_span)) : 0);
+        ++uses;
+        const int err = ((int(bit) << 12) - p_) * rate;
+        int32_t* w = &w_[size_t(set_) * size_t(n_)];
+        for (int i = 0; i < n_; ++i) w[i] += (st[i] * err + (1 << 15)) >> 16;
+    }
+
+private:
+    int n_, set_ = 0, p_ = 2048;
+    std::vector<int32_t> w_;
+    std::vector<uint32_t> uses_;
+};
+
+class Study {
+public:
+    static constexpr int kBase = MixedHierarchyModel::kInputs;
+    static constexpr int kDirect = MixedHierarchyModel::kDirect;
+    static constexpr int kFixedInputs = MixedHierarchyModel::kSecondInputs;
+    explicit Study(const Options& o)
+        : o_(o), inputs_(kFixedInputs + int(o.extra.size()) + 1), a_(inputs_, 10), b_(inputs_, 16), c_(inputs_, 160), d_(inputs_, 256), st_(size_t(inputs_)) {
+        extra_models_.assign(o.extra.size(), std::vector<BitModel>(1 << 16, BitModel(8)));
+        extra_slot_.resize(o.extra.size());
+        static constexpr uint32_t kSizes[kDirect] = {10,  40,  40,   80,   50,  120, 240, 960, 1920, 2560, 640,
+                                                     10240, 3840, 200, 400, 480, 160, 640, 2560, 640, 5120};
+        for (int j = 0; j < kDirect; ++j) models_[size_t(j)].assign(kSizes[j], BitModel(o.window_log2));
+        for (int k = 0; k < 3; ++k) {
+            histories_[size_t(k)].assign(kSizes[kIndirectOf[k]], uint8_t{1});
+            history_maps_[size_t(k)].assign(2560, BitModel(o.history_log2));
+        }
+        for (int rows : {40, 640, 192, 2560, 200, 80}) maps_.emplace_back(rows, o.map_rate);
+        if (!o.start[0].empty()) a_.start_at(o.start[0]), b_.start_at(o.start[1]), c_.start_at(o.start[2]), d_.start_at(o.start[o.mixer_d && !o.start[3].empty() ? 3 : 1]);
+    }
+    std::array<std::vector<double>, 4> mean_weights() const {
+        return {a_.mean_weights(), b_.mean_weights(), c_.mean_weights(), o_.mixer_d ? d_.mean_weights() : std::vector<double>{}};
+    }
+
+    std::array<double, 8> level_bits{}, level_symbols{}, level_ones{};
+    double code(const std::vector<Symbol>& symbols, const std::vector<Extra>& extra) {
+        double bits = 0;
+        for (int pass = 0; pass < (o_.prime ? 2 : 1); ++pass) {
+            bits = 0;
+            for (size_t i = 0; i < symbols.size(); ++i) {
+                const Symbol& s = symbols[i];
+                const int p = p12(s.f, extra[i]);
+                const double b = -std::log2(s.bit ? p / 4096.0 : 1 - p / 4096.0);
+                bits += b;
+                level_bits[s.f.level] += b, level_symbols[s.f.level] += 1, level_ones[s.f.level] += s.bit;
+                update(s.bit);
+            }
+        }
+        return bits;
+    }
+
+private:
+    static constexpr int kIndirectOf[3] = {1, 4, 11};
+
+    int p12(const MixedFeatures& f, const Extra& x) {
+        const uint32_t g = f.group;
+        if (f.level != level_) {
+            level_ = f.level;
+            if (o_.level_cap >= 0)
+                for (auto& table : models_)
+                    for (BitModel& m : table) m.n = uint16_t(std::min<int>(m.n, o_.level_cap));
+        }
+        const std::array<uint32_t, kBase> direct = MixedHierarchyModel::direct_slots(f);
+        std::copy(direct.begin(), direct.end(), slot_.begin());
+        const uint32_t last4 = last_ & 15;
+        slot_[kBase] = g * 16 + last4;
+        slot_[kBase + 1] = (g * 4 + f.inner) * 16 + last4;
+        slot_[kBase + 2] = (g * 64 + f.mean_curv) * 4 + (last_ & 3);
+        slot_[kBase + 3] = g * 64 + f.ring_max;
+        slot_[kBase + 4] = (g * 64 + f.ring_mean) * 8 + f.level;
+        for (int j = 0; j < kDirect; ++j) {
+            BitModel& m = models_[size_t(j)][slot_[size_t(j)]];
+            if (o_.inherit_models && j > 0 && m.n == 0 && m.p == (uint32_t{1} << 31)) {
+                m.p = models_[0][g].p;
+                m.n = uint16_t(o_.inherit_models);
+            }
+            st_[size_t(j)] = mixing::stretch(mixing::p12_of(m));
+        }
+        for (int k = 0; k < 3; ++k) {
+            hctx_[size_t(k)] = slot_[size_t(kIndirectOf[k])];
+            hslot_[size_t(k)] = g * 256 + histories_[size_t(k)][hctx_[size_t(k)]];
+            st_[size_t(kDirect + k)] = mixing::stretch(mixing::p12_of(history_maps_[size_t(k)][hslot_[size_t(k)]]));
+        }
+        for (size_t e = 0; e < o_.extra.size(); ++e) {
+            extra_slot_[e] = o_.extra[e](f, x) & 0xffff;
+            st_[size_t(kFixedInputs) + e] = mixing::stretch(mixing::p12_of(extra_models_[e][extra_slot_[e]]));
+        }
+        st_[size_t(inputs_ - 1)] = 256;
+        const int set_b = o_.extra_set_b == 1 ? x.parent_curv / 4 : o_.extra_set_b == 2 ? x.base_size / 4 : f.ring_mean / 4, set_c = int(g * 16 + last4);
+        if (o_.inherit_sets) {
+            if (b_.fresh(set_b)) b_.copy_set(set_b, a_, int(g));
+            if (c_.fresh(set_c)) c_.copy_set(set_c, a_, int(g));
+        }
+        const int s1 = mixing::stretch(a_.mix(st_.data(), int(g)));
+        const int s2 = mixing::stretch(b_.mix(st_.data(), set_b));
+        const int s3 = mixing::stretch(c_.mix(st_.data(), set_c));
+        int p_mix = mixing::squash((s1 + s2 + s3) / 3);
+        if (o_.mixer_d) {
+            const int set = o_.mixer_d == 6 ? int(g) * 16 + f.size / 4 : o_.mixer_d == 4 ? x.base_size / 2 * 8 + f.level : o_.mixer_d == 5 ? int(g) * 16 + x.base_size / 4 : (o_.mixer_d == 1 ? x.base_size : o_.mixer_d == 2 ? f.mean_curv : x.gauss) / 4 * 8 + f.level;
+            p_mix = mixing::squash((s1 + s2 + s3 + mixing::stretch(d_.mix(st_.data(), set))) / 4);
+        }
+        const int rows[6] = {int(g * 4 + f.inner), int(g * 64 + f.mean_curv), int(f.disp * 8 + f.level), int(g * 256 + (last_ & 255)),
+                             int((g * 5 + f.ring2) * 4 + f.parent_nbrs), int(g * 8 + f.level)};
+        const int maps = o_.level_map == 1 ? 6 : 5;
+        int refined = 0;
+        for (int m = 0; m < maps; ++m) refined += maps_[size_t(m)].refine(p_mix, rows[m]);
+        int p = std::clamp((p_mix * (4 - o_.map_share) + (refined / maps) * o_.map_share + 2) >> 2, 1, 4095);
+        used_maps_ = maps;
+        if (o_.level_map == 2) {
+            p = std::clamp((p + maps_[5].refine(p, rows[5]) + 1) >> 1, 1, 4095);
+            used_maps_ = 6;
+        }
+        return p;
+    }
+
+    void update(bool bit) {
+        a_.update(st_.data(), bit, o_);
+        b_.update(st_.data(), bit, o_);
+        c_.update(st_.data(), bit, o_);
+        if (o_.mixer_d) d_.update(st_.data(), bit, o_);
+        for (int m = 0; m < used_maps_; ++m) maps_[size_t(m)].update(bit);
+        for (int j = 0; j < kDirect; ++j) models_[size_t(j)][slot_[size_t(j)]].update(bit);
+        for (size_t e = 0; e < extra_slot_.size(); ++e) extra_models_[e][extra_slot_[e]].update(bit);
+        for (int k = 0; k < 3; ++k) {
+            history_maps_[size_t(k)][hslot_[size_t(k)]].update(bit);
+            uint8_t& h = histories_[size_t(k)][hctx_[size_t(k)]];
+            h = uint8_t(h < 128 ? h * 2 + bit : 128 + ((h * 2 + bit) & 127));
+        }
+        last_ = (last_ << 1) | uint32_t(bit);
+    }
+
+    Options o_;
+    int inputs_;
+    std::array<std::vector<BitModel>, kDirect> models_;
+    std::vector<std::vector<BitModel>> extra_models_;
+    std::vector<uint32_t> extra_slot_;
+    std::array<std::vector<uint8_t>, 3> histories_;
+    std::array<std::vector<BitModel>, 3> history_maps_;
+    std::array<uint32_t, 3> hctx_{}, hslot_{};
+    std::array<uint32_t, kDirect> slot_{};
+    Mixer a_, b_, c_, d_;
+    std::vector<int> st_;
+    std::vector<mixing::ProbabilityMap> maps_;
+    int used_maps_ = 5;
+    uint32_t last_ = 0;
+    int level_ = -1;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const std::filesystem::path cache = std::getenv("CACHE_DIR") ? std::getenv("CACHE_DIR") : "/tmp/mixing_study";
+    std::vector<ModelData> data;
+    std::vector<std::vector<Extra>> extras;
+    for (int a = 1; a < argc; ++a) {
+        data.push_back(mixed_study::load(argv[a], cache));
+        extras.push_back(extra_features(argv[a], cache, data.back().symbols.size()));
+    }
+    struct Design {
+        std::string name;
+        Options o;
+    };
+    std::vector<Design> designs;
+    auto add = [&](const std::string& name, const std::function<void(Options&)>& change) {
+        Options o;
+        change(o);
+        designs.push_back({name, o});
+    };
+    add("second model (v10), re-implemented", [](Options&) {});
+    add("learning cost bound: symbols coded twice, second pass", [](Options& o) { o.prime = true; });
+    for (int w : {7, 9}) add("direct window 2^" + std::to_string(w), [w](Options& o) { o.window_log2 = w; });
+    for (int w : {5, 7}) add("history window 2^" + std::to_string(w), [w](Options& o) { o.history_log2 = w; });
+    for (int r : {16, 32}) add("mixer rate " + std::to_string(r), [r](Options& o) { o.mixer_rate = r; });
+    for (int r : {6, 8}) add("map rate " + std::to_string(r), [r](Options& o) { o.map_rate = r; });
+    for (int b : {24, 72, 200}) add("mixer boost " + std::to_string(b), [b](Options& o) { o.boost = b; });
+    add("mixer boost 72, span 512", [](Options& o) { o.boost = 72, o.boost_span = 512; });
+    add("sets B, C inherit A's", [](Options& o) { o.inherit_sets = true; });
+    for (int n : {1, 4}) add("models inherit group's p, count " + std::to_string(n), [n](Options& o) { o.inherit_models = n; });
+    for (int c : {16, 62}) add("level cap " + std::to_string(c), [c](Options& o) { o.level_cap = c; });
+    add("map by group x level", [](Options& o) { o.level_map = 1; });
+    add("map chain by group x level", [](Options& o) { o.level_map = 2; });
+    using F = const MixedFeatures&;
+    using X = const Extra&;
+    auto extra = [&](const std::string& name, std::function<uint32_t(F, X)> context) {
+        add(name, [context](Options& o) { o.extra.push_back(context); });
+    };
+    extra("+ parent's curvature x level", [](F f, X x) { return (f.group * 64u + x.parent_curv) * 8 + f.level; });
+    extra("+ curvature x parent's curvature", [](F f, X x) { return (f.group * 64u + f.mean_curv) * 16 + x.parent_curv / 4u; });
+    extra("+ grandparent's curvature x level", [](F f, X x) { return (f.group * 64u + x.grand_curv) * 8 + f.level; });
+    extra("+ gauss x level", [](F f, X x) { return (f.group * 64u + x.gauss) * 8 + f.level; });
+    extra("+ gauss x curvature", [](F f, X x) { return (f.group * 64u + x.gauss) * 16 + f.mean_curv / 4u; });
+    extra("+ size x level", [](F f, X x) { return (f.group * 64u + x.size) * 8 + f.level; });
+    extra("+ curvature x size", [](F f, X x) { return (f.group * 64u + f.mean_curv) * 16 + x.size / 4u; });
+    add("trained start weights (leave one out)", [](Options& o) { o.trained_start = true; });
+    extra("+ curvature x base size", [](F f, X x) { return (f.group * 64u + f.mean_curv) * 16 + x.base_size / 4u; });
+    extra("+ base size x level", [](F f, X x) { return (f.group * 64u + x.base_size) * 8 + f.level; });
+    auto both = [](Options& o) {
+        o.extra.push_back([](F f, X x) { return (f.group * 64u + f.mean_curv) * 16 + x.size / 4u; });
+        o.extra.push_back([](F f, X x) { return (f.group * 64u + x.gauss) * 16 + f.mean_curv / 4u; });
+    };
+    add("combo: + curvature x size, gauss x curvature", both);
+    add("combo: the same, trained start", [&](Options& o) { both(o), o.trained_start = true; });
+    add("combo: the same, trained start, rate 16", [&](Options& o) { both(o), o.trained_start = true, o.mixer_rate = 16; });
+    add("combo: base size instead, trained start", [&](Options& o) {
+        o.extra.push_back([](F f, X x) { return (f.group * 64u + f.mean_curv) * 16 + x.base_size / 4u; });
+        o.extra.push_back([](F f, X x) { return (f.group * 64u + x.gauss) * 16 + f.mean_curv / 4u; });
+        o.trained_start = true;
+    });
+    auto sized = [](Options& o) {
+        o.extra.push_back([](F f, X x) { return (f.group * 64u + x.base_size) * 8 + f.level; });
+        o.extra.push_back([](F f, X x) { return (f.group * 64u + f.mean_curv) * 16 + x.base_size / 4u; });
+    };
+    add("S: base size x level, curvature x base size", sized);
+    add("S: the same + gauss x curvature", [&](Options& o) { sized(o), o.extra.push_back([](F f, X x) { return (f.group * 64u + x.gauss) * 16 + f.mean_curv / 4u; }); });
+    add("S: the same, trained start", [&](Options& o) { sized(o), o.trained_start = true; });
+    extra("S: base size x level x center x inner", [](F f, X x) { return ((f.group * 64u + x.base_size) * 8 + f.level) * 8 + f.center * 4 + f.inner; });
+    extra("S: base size x ring max / 4 x level", [](F f, X x) { return ((f.group * 64u + x.base_size) * 16 + f.ring_max / 4u) * 8 + f.level; });
+    extra("S: base size x disp x level", [](F f, X x) { return ((f.group * 64u + x.base_size) * 24 + f.disp) * 8 + f.level; });
+    extra("S: level size x level x ring2", [](F f, X x) { return ((f.group * 64u + x.size) * 8 + f.level) * 5 + f.ring2; });
+    add("T: S + curvature x base size / 2 x level", [&](Options& o) { sized(o), o.extra.push_back([](F f, X x) { return ((f.group * 64u + f.mean_curv) * 32 + x.base_size / 2u) * 8 + f.level; }); });
+    add("T: S + ring mean x base size / 2 x level", [&](Options& o) { sized(o), o.extra.push_back([](F f, X x) { return ((f.group * 64u + f.ring_mean) * 32 + x.base_size / 2u) * 8 + f.level; }); });
+    add("T: S, mixer B by base size / 4", [&](Options& o) { sized(o), o.extra_set_b = 2; });
+    add("T: S + gauss x level x base size / 4", [&](Options& o) { sized(o), o.extra.push_back([](F f, X x) { return ((f.group * 64u + x.gauss) * 16 + x.base_size / 4u) * 8 + f.level; }); });
+    auto v11 = [&](Options& o) {
+        sized(o);
+        o.extra.push_back([](F f, X x) { return (f.group * 64u + x.gauss) * 16 + f.mean_curv / 4u; });
+        o.extra.push_back([](F f, X x) { return ((f.group * 64u + f.ring_mean) * 32 + x.base_size / 2u) * 8 + f.level; });
+    };
+    add("U: size, gauss, ring mean x size", v11);
+    add("U: the same, trained start", [&](Options& o) { v11(o), o.trained_start = true; });
+    add("U: the same, trained start, rate 16", [&](Options& o) { v11(o), o.trained_start = true, o.mixer_rate = 16; });
+    for (int r : {8, 12}) add("V: U, trained start, rate " + std::to_string(r), [&, r](Options& o) { v11(o), o.trained_start = true, o.mixer_rate = r; });
+    add("V: U + ring max x base size / 2 x level, trained, rate 16", [&](Options& o) {
+        v11(o), o.trained_start = true, o.mixer_rate = 16;
+        o.extra.push_back([](F f, X x) { return ((f.group * 64u + f.ring_max) * 32 + x.base_size / 2u) * 8 + f.level; });
+    });
+    add("V: U + gauss x base size / 2 x level, trained, rate 16", [&](Options& o) {
+        v11(o), o.trained_start = true, o.mixer_rate = 16;
+        o.extra.push_back([](F f, X x) { return ((f.group * 64u + x.gauss) * 32 + x.base_size / 2u) * 8 + f.level; });
+    });
+    add("V: U + base size x inner x center x level, trained, rate 16", [&](Options& o) {
+        v11(o), o.trained_start = true, o.mixer_rate = 16;
+        o.extra.push_back([](F f, X x) { return ((f.group * 64u + x.base_size) * 8 + f.level) * 8 + f.center * 4 + f.inner; });
+    });
+    add("V: U, trained, rate 16, window 2^9", [&](Options& o) { v11(o), o.trained_start = true, o.mixer_rate = 16, o.window_log2 = 9; });
+    for (int d = 1; d <= 3; ++d)
+        add("W: U, trained, rate 16, mixer D " + std::to_string(d), [&, d](Options& o) { v11(o), o.trained_start = true, o.mixer_rate = 16, o.mixer_d = d; });
+    add("X: D1, rate 12", [&](Options& o) { v11(o), o.trained_start = true, o.mixer_rate = 12, o.mixer_d = 1; });
+    add("X: D4, rate 16", [&](Options& o) { v11(o), o.trained_start = true, o.mixer_rate = 16, o.mixer_d = 4; });
+    add("X: D5, rate 16", [&](Options& o) { v11(o), o.trained_start = true, o.mixer_rate = 16, o.mixer_d = 5; });
+    add("X: D1, rate 16, + gauss x base size / 2 x level", [&](Options& o) {
+        v11(o), o.trained_start = true, o.mixer_rate = 16, o.mixer_d = 1;
+        o.extra.push_back([](F f, X x) { return ((f.group * 64u + x.gauss) * 32 + x.base_size / 2u) * 8 + f.level; });
+    });
+    add("X: D1, rate 16, map share 2", [&](Options& o) { v11(o), o.trained_start = true, o.mixer_rate = 16, o.mixer_d = 1, o.map_share = 2; });
+    add("Y: third model (v11)", [&](Options& o) { v11(o), o.trained_start = true, o.mixer_rate = 16, o.mixer_d = 5; });
+    // The third model on the coder's own size and gauss features (FORMAT.md 2.3).
+    auto coded = [](int gauss_floor) {
+        return [gauss_floor](Options& o) {
+            o.extra.push_back([](F f, X) { return (f.group * 64u + f.size) * 8 + f.level; });
+            o.extra.push_back([](F f, X) { return (f.group * 64u + f.mean_curv) * 16 + f.size / 4u; });
+            o.extra.push_back([gauss_floor](F f, X) { return (f.group * 64u + (f.gauss ? std::max<uint32_t>(f.gauss, gauss_floor) : 0u)) * 16 + f.mean_curv / 4u; });
+            o.extra.push_back([](F f, X) { return ((f.group * 64u + f.ring_mean) * 32 + f.size / 2u) * 8 + f.level; });
+            o.trained_start = true, o.mixer_rate = 16, o.mixer_d = 6;
+        };
+    };
+    add("Z: third model on the coder's features", coded(0));
+    add("Z: the same, table 24 without the group", [&](Options& o) {
+        coded(0)(o);
+        o.extra[3] = [](F f, X) { return (f.ring_mean * 32u + f.size / 2u) * 8 + f.level; };
+    });
+    add("Z: the same, table 24 by group / 4 (16-bit mask in the study)", [&](Options& o) {
+        coded(0)(o);
+        o.extra[3] = [](F f, X) { return (((f.group & 3u) * 64 + f.ring_mean) * 32u + f.size / 2u) * 8 + f.level; };
+    });
+    add("Z: the same, table 24 by center instead of the group", [&](Options& o) {
+        coded(0)(o);
+        o.extra[3] = [](F f, X) { return ((f.center * 64u + f.ring_mean) * 32u + f.size / 2u) * 8 + f.level; };
+    });
+    auto no_group = [&](Options& o) {
+        coded(0)(o);
+        o.extra[3] = [](F f, X) { return (f.ring_mean * 32u + f.size / 2u) * 8 + f.level; };
+    };
+    add("Z2: 24 and 21 without the group", [&](Options& o) { no_group(o), o.extra[0] = [](F f, X) { return f.size * 8u + f.level; }; });
+    add("Z2: 24 and 22 without the group", [&](Options& o) { no_group(o), o.extra[1] = [](F f, X) { return f.mean_curv * 16u + f.size / 4u; }; });
+    add("Z2: 24 and 23 without the group", [&](Options& o) { no_group(o), o.extra[2] = [](F f, X) { return f.gauss * 16u + f.mean_curv / 4u; }; });
+    add("Z2: 24 without the group, mixer D by size x level", [&](Options& o) { no_group(o), o.mixer_d = 1; });
+    add("Z3: 22, 23 and 24 without the group", [&](Options& o) {
+        no_group(o);
+        o.extra[1] = [](F f, X) { return f.mean_curv * 16u + f.size / 4u; };
+        o.extra[2] = [](F f, X) { return f.gauss * 16u + f.mean_curv / 4u; };
+    });
+    add("Z: the same, Gauss bins from 11", coded(11));
+    add("Z: the same, Gauss bins from 21", coded(21));
+    add("Z: the same, rate 12", [&](Options& o) { coded(0)(o), o.mixer_rate = 12; });
+    add("mixer B by parent's curvature", [](Options& o) { o.extra_set_b = 1; });
+    const char* only = std::getenv("ONLY");
+
+    std::printf("| design | all | mean per model |");
+    for (const ModelData& d : data) std::printf(" %s |", d.name.c_str());
+    std::printf("\n|---|---:|---:|");
+    for (size_t m = 0; m < data.size(); ++m) std::printf("---:|");
+    std::printf("\n");
+    double paper_total = 0;
+    for (const ModelData& d : data) paper_total += d.paper_bits;
+    auto row = [&](const std::string& name, const std::vector<double>& bits) {
+        double total = 0, mean = 0;
+        std::printf("| %s |", name.c_str());
+        for (size_t m = 0; m < data.size(); ++m) total += bits[m], mean += (bits[m] - data[m].paper_bits) / data[m].paper_bits;
+        std::printf(" %+.2f%% | %+.2f%% |", 100.0 * (total - paper_total) / paper_total, 100.0 * mean / double(data.size()));
+        for (size_t m = 0; m < data.size(); ++m) std::printf(" %+.2f%% |", 100.0 * (bits[m] - data[m].paper_bits) / data[m].paper_bits);
+        std::printf("\n");
+        std::fflush(stdout);
+    };
+    std::vector<double> library;
+    for (const ModelData& d : data) library.push_back(d.library_bits);
+    row("the coder's mixing mode (third model, version 11)", library);
+    for (const Design& design : designs) {
+        if (only && design.name.find(only) == std::string::npos && &design != &designs[0]) continue;
+        std::vector<double> bits;
+        std::vector<std::array<std::vector<double>, 4>> ended;
+        if (design.o.trained_start)
+            for (size_t m = 0; m < data.size(); ++m) {
+                Options plain = design.o;
+                plain.trained_start = false;
+                Study study(plain);
+                study.code(data[m].symbols, extras[m]);
+                ended.push_back(study.mean_weights());
+            }
+        const char* weights_in = std::getenv("WEIGHTS_IN");
+        const char* weights_out = std::getenv("WEIGHTS_OUT");
+        const std::string weights_file = "-" + std::to_string(&design - &designs[0]) + ".w";
+        std::array<std::vector<int32_t>, 4> given;
+        const size_t mixers = design.o.mixer_d ? 4 : 3;
+        if (design.o.trained_start && weights_in) {
+            std::ifstream in(std::string(weights_in) + weights_file);
+            for (size_t k = 0; k < mixers; ++k) {
+                std::vector<int32_t>& w = given[k];
+                w.resize(size_t(MixedHierarchyModel::kSecondInputs + 1 + design.o.extra.size()));
+                for (int32_t& x : w) in >> x;
+            }
+        }
+        if (design.o.trained_start && weights_out) {
+            std::ofstream out(std::string(weights_out) + weights_file);
+            for (size_t k = 0; k < mixers; ++k) {
+                for (size_t i = 0; i < ended[0][k].size(); ++i) {
+                    double sum = 0;
+                    for (const auto& e : ended) sum += e[k][i] / double(ended.size());
+                    out << std::lround(sum) << (i + 1 < ended[0][k].size() ? ' ' : '\n');
+                }
+            }
+        }
+        for (size_t m = 0; m < data.size(); ++m) {
+            Options o = design.o;
+            if (o.trained_start && weights_in) o.start = given;
+            else if (o.trained_start)
+                for (size_t k = 0; k < mixers; ++k) {
+                    std::vector<double> sum(ended[0][size_t(k)].size(), 0);
+                    for (size_t other = 0; other < data.size(); ++other)
+                        if (other != m)
+                            for (size_t i = 0; i < sum.size(); ++i) sum[i] += ended[other][size_t(k)][i] / double(data.size() - 1);
+                    o.start[size_t(k)].assign(sum.begin(), sum.end());
+                }
+            Study study(o);
+            bits.push_back(study.code(data[m].symbols, extras[m]));
+            if (std::getenv("PER_LEVEL") && &design == &designs[0]) {
+                std::fprintf(stderr, "%s:", data[m].name.c_str());
+                for (int l = 0; l < 8; ++l)
+                    std::fprintf(stderr, " L%d %.0f sym %.0f%% ones %.0f bits", l, study.level_symbols[size_t(l)],
+                                 100 * study.level_ones[size_t(l)] / std::max(1.0, study.level_symbols[size_t(l)]), study.level_bits[size_t(l)]);
+                std::fprintf(stderr, "\n");
+            }
+        }
+        if (&design == &designs[0])
+            for (size_t m = 0; m < data.size(); ++m)
+                if (std::abs(bits[m] - data[m].second_bits) > 1e-6 * data[m].second_bits)
+                    std::fprintf(stderr, "%s: re-implementation %.1f bits, coder's second model %.1f\n", data[m].name.c_str(), bits[m],
+                                 data[m].second_bits);
+        row(design.name, bits);
+    }
+    return 0;
+}
