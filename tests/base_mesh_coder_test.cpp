@@ -289,10 +289,14 @@ TEST(BaseMeshCoder, ModeTwoSearchFollowsItsBudget) {
 }
 
 // Inside an .amc encode the search of a refined hierarchy's base codes at most 2^16 triangles,
-// whatever the hierarchy's size; an unrefined mesh (all base) gets the full budget.
+// whatever the hierarchy's size; a hierarchy that is at least half base gets the full budget.
 TEST(BaseMeshCoder, SearchBudgetFollowsTheHierarchy) {
     Hierarchy unrefined(make_torus(40, 30, 2.0, 0.7));
     EXPECT_EQ(base_search_budget(unrefined), kFullBaseSearch);
+    Hierarchy mostly_base(make_torus(40, 30, 2.0, 0.7));
+    for (NodeId root = 0; root < 100; ++root) mostly_base.refine(root);
+    ASSERT_GT(mostly_base.node_count(), mostly_base.root_count());
+    EXPECT_EQ(base_search_budget(mostly_base), kFullBaseSearch);
     Hierarchy small(make_icosahedron());
     refine_uniformly(small, 2);
     EXPECT_EQ(base_search_budget(small), uint64_t{1} << 16);

@@ -47,10 +47,11 @@ TriangleMesh base_as_decoded(const Hierarchy& h, const Quantizer* quantizer) {
 // The base of a refined hierarchy gets a small search: on the corpus the full one (2^20
 // triangles) took half of a 12-bit encode and gained nothing, the base order it picks moving the
 // rest of the file by as much as it saves in the base (docs/BASE_CODER.md, Encode time). That still
-// searches bases of up to about 90 triangles whole; an unrefined mesh is all base and gets it all.
+// searches bases of up to about 90 triangles whole; a hierarchy of which the base is at least half
+// (a plain mesh imported over nearly itself, say) is mostly base and gets it all.
 uint64_t base_search_budget(const Hierarchy& h) {
     constexpr uint64_t kRefinedBudget = uint64_t{1} << 16;
-    return h.node_count() == h.root_count() ? kFullBaseSearch : kRefinedBudget;
+    return 2 * uint64_t{h.root_count()} >= h.node_count() ? kFullBaseSearch : kRefinedBudget;
 }
 
 // The base connectivity of a file. Mode 2's search (FORMAT.md 4.16) starts the conquest away from
