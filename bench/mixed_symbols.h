@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -149,6 +150,19 @@ inline ModelData load(const std::string& path, const std::filesystem::path& cach
     out.write(reinterpret_cast<const char*>(&n), sizeof n);
     out.write(reinterpret_cast<const char*>(d.symbols.data()), std::streamsize(n * sizeof(Symbol)));
     return d;
+}
+
+// The head of a study's markdown table (a design per row, a column per model); returns the
+// paper's bits over all models, the rows' reference.
+inline double print_design_table_head(const std::vector<ModelData>& data) {
+    std::printf("| design | all | mean per model |");
+    for (const ModelData& d : data) std::printf(" %s |", d.name.c_str());
+    std::printf("\n|---|---:|---:|");
+    for (size_t m = 0; m < data.size(); ++m) std::printf("---:|");
+    std::printf("\n");
+    double paper_total = 0;
+    for (const ModelData& d : data) paper_total += d.paper_bits;
+    return paper_total;
 }
 
 }  // namespace mixed_study

@@ -289,13 +289,7 @@ int main(int argc, char** argv) {
     add("third set by group x history", [](Options& o) { o.third_set = 3; });
     add("set 1 by confidence", [](Options& o) { o.confidence = true; });
     for (int c = 0; c < 10; ++c) add("extra input " + std::to_string(c), [c](Options& o) { o.extra_inputs = 1 << c; });
-    std::printf("| design | all | mean per model |");
-    for (const ModelData& d : data) std::printf(" %s |", d.name.c_str());
-    std::printf("\n|---|---:|---:|");
-    for (size_t m = 0; m < data.size(); ++m) std::printf("---:|");
-    std::printf("\n");
-    double paper_total = 0;
-    for (const ModelData& d : data) paper_total += d.paper_bits;
+    const double paper_total = mixed_study::print_design_table_head(data);
     {
         double total = 0, mean = 0;
         std::vector<double> change;

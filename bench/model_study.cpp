@@ -454,13 +454,7 @@ int main(int argc, char** argv) {
     add("mixer B by parent's curvature", [](Options& o) { o.extra_set_b = 1; });
     const char* only = std::getenv("ONLY");
 
-    std::printf("| design | all | mean per model |");
-    for (const ModelData& d : data) std::printf(" %s |", d.name.c_str());
-    std::printf("\n|---|---:|---:|");
-    for (size_t m = 0; m < data.size(); ++m) std::printf("---:|");
-    std::printf("\n");
-    double paper_total = 0;
-    for (const ModelData& d : data) paper_total += d.paper_bits;
+    const double paper_total = mixed_study::print_design_table_head(data);
     auto row = [&](const std::string& name, const std::vector<double>& bits) {
         double total = 0, mean = 0;
         std::printf("| %s |", name.c_str());
