@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace amc {
@@ -130,7 +131,8 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     const LeafHalfedges halfedges(leaf);
     ImportedHierarchy out;
     std::vector<uint32_t> leaf_of_vertex;
-    // Six ways in, cheapest first; the first whose result is exactly the leaf mesh wins.
+    // Six ways in, cheapest first, then three again (below); the first whose result is exactly the
+    // leaf mesh wins.
     enum class Way {
         exact_midpoints,  // new vertices at edge midpoints (as amcodec writes them): found by position
         uniform,          // a uniform refinement (semi-regular remeshes): read off the connectivity as grids
@@ -140,7 +142,9 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
         anchored,         // levels undone bottom-up from the connectivity alone, the base vertices kept
                           // (positions anywhere; not every adaptive mesh yet, docs/IMPORT.md)
     };
-    auto attempt = [&](Way way) {
+    // The anchored way's undo steps, kept for the guided ways' second round.
+    std::vector<uint8_t> undo_step;
+    auto attempt = [&](Way way, bool by_undo_steps) {
         out.hierarchy = Hierarchy(hierarchy_base);
         // A leaf mesh of F faces comes from at most F leaves, so from at most 4F/3 + roots nodes.
         out.hierarchy.reserve(leaf.triangles.size() * 4 / 3 + base.triangles.size() + 4, leaf.positions.size());
@@ -149,7 +153,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
             if (leaf_of_vertex.empty()) throw Error(what + ": not a uniform refinement");
         } else if (way == Way::anchored) {
             validate_triangle_mesh(leaf, what);  // the inverse step needs an oriented manifold
-            leaf_of_vertex = reconstruct_anchored(out.hierarchy, leaf_of_base, leaf, what);
+            leaf_of_vertex = reconstruct_anchored(out.hierarchy, leaf_of_base, leaf, what, &undo_step);
             if (leaf_of_vertex.empty()) throw Error(what + ": anchored inverse refinement did not reach the base");
         } else {
             const MidpointGuide guide = way == Way::exact_midpoints ? MidpointGuide::exact
@@ -157,20 +161,27 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
                                         : way == Way::subdivision   ? MidpointGuide::subdivision
                                                                     : MidpointGuide::surface;
             leaf_of_vertex = reconstruct_hierarchy(out.hierarchy, leaf_of_base, leaf, halfedges, guide,
-                                                   leaf_positions, what);
+                                                   leaf_positions, what, by_undo_steps ? &undo_step : nullptr);
         }
         verify_leaf_mesh(out.hierarchy, leaf_of_vertex, leaf, halfedges, what);
     };
     // The subdivision-guided way's error is the one reported: it goes furthest on most bad input.
+    // The guided ways run a second time, their picks decided by the anchored way's undo steps,
+    // when the anchored way has not reached the base (it has steps only for a manifold leaf mesh).
     std::string first_error;
     bool done = false;
-    for (Way way : {Way::exact_midpoints, Way::uniform, Way::leaf_midpoint, Way::subdivision, Way::surface, Way::anchored}) {
+    const std::pair<Way, bool> ways[] = {
+        {Way::exact_midpoints, false}, {Way::uniform, false}, {Way::leaf_midpoint, false}, {Way::subdivision, false},
+        {Way::surface, false},         {Way::anchored, false}, {Way::leaf_midpoint, true},  {Way::subdivision, true},
+        {Way::surface, true}};
+    for (const auto& [way, by_undo_steps] : ways) {
+        if (by_undo_steps && undo_step.empty()) break;
         try {
-            attempt(way);
+            attempt(way, by_undo_steps);
             done = true;
             break;
         } catch (const Error& e) {
-            if (way == Way::subdivision) first_error = e.what();
+            if (way == Way::subdivision && !by_undo_steps) first_error = e.what();
         }
     }
     if (!done) {

@@ -7,6 +7,7 @@
 #include "import/nearest_vertex.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cmath>
 #include <memory>
 
@@ -22,8 +23,8 @@ class Reconstruction {
 public:
     Reconstruction(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base, const TriangleMesh& leaf,
                    const LeafHalfedges& halfedges, MidpointGuide guide, const PositionIndex& positions,
-                   const std::string& what)
-        : h_(h), leaf_(leaf), he_(halfedges), guide_(guide), positions_(positions), what_(what) {
+                   const std::string& what, const std::vector<uint8_t>* undo_step)
+        : h_(h), leaf_(leaf), he_(halfedges), guide_(guide), positions_(positions), what_(what), undo_step_(undo_step) {
         leaf_of_vertex_.assign(h.positions().size(), kNoIndex);
         vertex_of_leaf_.assign(leaf.positions.size(), kNoIndex);
         for (VertexId v = 0; v < leaf_of_base.size(); ++v) assign(v, leaf_of_base[v]);
@@ -237,8 +238,23 @@ private:
             });
             return fits;
         };
-        const uint32_t found = nearest_->find(guide_position(n, e), may_be_midpoint);
+        const uint32_t found = undo_step_ ? latest_undone_of_nearest(guide_position(n, e), may_be_midpoint)
+                                          : nearest_->find(guide_position(n, e), may_be_midpoint);
         if (found == kNoIndex) fail("no vertex left to split the edge (" + edge_text(n, e) + ")");
+        return found;
+    }
+
+    // Of the nearest candidates, the one the anchored inverse refinement undid last (ties: the
+    // nearest). A true split is undone only after every vertex inside the two elements on the
+    // edge, so the midpoint outlasts its finer neighbours, which are what a wrong pick takes.
+    template <class Usable>
+    uint32_t latest_undone_of_nearest(Vec3 p, Usable& usable) const {
+        uint32_t nearest[NearestVertex::kMaxCount];
+        const uint32_t count = nearest_->find_nearest(p, usable, kCandidates, nearest);
+        uint32_t found = kNoIndex;
+        for (uint32_t i = 0; i < count; ++i) {
+            if (found == kNoIndex || (*undo_step_)[nearest[i]] > (*undo_step_)[found]) found = nearest[i];
+        }
         return found;
     }
 
@@ -293,6 +309,8 @@ private:
     const MidpointGuide guide_;
     const PositionIndex& positions_;
     const std::string& what_;
+    const std::vector<uint8_t>* undo_step_;
+    const uint32_t kCandidates = std::getenv("AMC_CANDIDATES") ? uint32_t(std::atoi(std::getenv("AMC_CANDIDATES"))) : 4;
     std::vector<uint32_t> leaf_of_vertex_;
     std::vector<uint32_t> vertex_of_leaf_;
     std::vector<Reveal> reveals_;
@@ -307,8 +325,8 @@ private:
 std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
                                             const TriangleMesh& leaf, const LeafHalfedges& halfedges,
                                             MidpointGuide guide, const PositionIndex& positions,
-                                            const std::string& what) {
-    return Reconstruction(h, leaf_of_base, leaf, halfedges, guide, positions, what).run();
+                                            const std::string& what, const std::vector<uint8_t>* undo_step) {
+    return Reconstruction(h, leaf_of_base, leaf, halfedges, guide, positions, what, undo_step).run();
 }
 
 }  // namespace amc

@@ -20,9 +20,21 @@ public:
     // nearer than the best so far: it may cost more than a distance); kNoIndex when none is.
     template <class Usable>
     uint32_t find(Vec3 p, Usable usable) const {
-        Best best;
+        Nearest best(1);
         if (!points_.empty()) search(p, usable, 0, 0, uint32_t(points_.size()), best);
-        return best.vertex;
+        return best.count == 0 ? kNoIndex : best.vertex[0];
+    }
+
+    static constexpr uint32_t kMaxCount = 8;
+
+    // The up to `count` (at most kMaxCount) usable vertices nearest to p, nearest first, into
+    // `out`; returns how many there are.
+    template <class Usable>
+    uint32_t find_nearest(Vec3 p, Usable usable, uint32_t count, uint32_t* out) const {
+        Nearest best(count < kMaxCount ? count : kMaxCount);
+        if (!points_.empty() && best.wanted > 0) search(p, usable, 0, 0, uint32_t(points_.size()), best);
+        for (uint32_t i = 0; i < best.count; ++i) out[i] = best.vertex[i];
+        return best.count;
     }
 
 private:
@@ -31,24 +43,34 @@ private:
         double x[3];
         uint32_t vertex;
     };
-    struct Best {
-        uint32_t vertex = kNoIndex;
-        double distance = 0;  // squared
+    // The nearest usable vertices found so far, nearest first (squared distances).
+    struct Nearest {
+        explicit Nearest(uint32_t n) : wanted(n) {}
+        uint32_t wanted, count = 0;
+        uint32_t vertex[kMaxCount];
+        double distance[kMaxCount];
+        bool improves(double d) const { return count < wanted || d < distance[count - 1]; }
+        void insert(uint32_t v, double d) {
+            uint32_t i = count < wanted ? count++ : count - 1;
+            for (; i > 0 && distance[i - 1] > d; --i) {
+                vertex[i] = vertex[i - 1];
+                distance[i] = distance[i - 1];
+            }
+            vertex[i] = v;
+            distance[i] = d;
+        }
     };
 
     void build(uint32_t node, uint32_t lo, uint32_t hi);
 
     template <class Usable>
-    void search(Vec3 p, Usable& usable, uint32_t node, uint32_t lo, uint32_t hi, Best& best) const {
+    void search(Vec3 p, Usable& usable, uint32_t node, uint32_t lo, uint32_t hi, Nearest& best) const {
         if (hi - lo <= kBucket) {
             for (uint32_t i = lo; i < hi; ++i) {
                 const Point& q = points_[i];
                 const double dx = q.x[0] - p.x, dy = q.x[1] - p.y, dz = q.x[2] - p.z;
                 const double distance = dx * dx + dy * dy + dz * dz;
-                if ((best.vertex == kNoIndex || distance < best.distance) && usable(q.vertex)) {
-                    best.vertex = q.vertex;
-                    best.distance = distance;
-                }
+                if (best.improves(distance) && usable(q.vertex)) best.insert(q.vertex, distance);
             }
             return;
         }
@@ -59,7 +81,7 @@ private:
         // Points left of mid lie at or below its coordinate on the axis, points from mid on at or above.
         const bool left_first = offset < 0;
         search(p, usable, 2 * node + (left_first ? 1 : 2), left_first ? lo : mid, left_first ? mid : hi, best);
-        if (best.vertex == kNoIndex || offset * offset < best.distance)
+        if (best.improves(offset * offset))
             search(p, usable, 2 * node + (left_first ? 2 : 1), left_first ? mid : lo, left_first ? hi : mid, best);
     }
 
