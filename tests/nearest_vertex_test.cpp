@@ -4,8 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numeric>
 #include <vector>
 
 namespace {
@@ -50,6 +52,32 @@ TEST(NearestVertex, FindsTheNearestUsableVertexAsABruteForceScanDoes) {
                 EXPECT_EQ(nearest.find(p, [&](uint32_t v) { return v % skip_every != 0; }),
                           brute_force(points, p, skip_every))
                     << count << " points, graded " << graded << ", query " << query;
+            }
+        }
+    }
+}
+
+TEST(NearestVertex, FindsTheKNearestUsableVerticesInOrderAsASortDoes) {
+    Lcg random{11};
+    for (size_t count : {size_t(2), size_t(9), size_t(300), size_t(5000)}) {
+        std::vector<amc::Vec3> points(count);
+        for (amc::Vec3& p : points) p = {random.unit(), random.unit(), 0.01 * random.unit()};
+        const amc::NearestVertex nearest(points);
+        for (int query = 0; query < 200; ++query) {
+            const amc::Vec3 p = {random.unit(), random.unit(), 0.01 * random.unit()};
+            auto usable = [](uint32_t v) { return v % 4 != 1; };
+            std::vector<uint32_t> sorted;
+            for (uint32_t v = 0; v < count; ++v) {
+                if (usable(v)) sorted.push_back(v);
+            }
+            std::stable_sort(sorted.begin(), sorted.end(), [&](uint32_t a, uint32_t b) {
+                return amc::dot(points[a] - p, points[a] - p) < amc::dot(points[b] - p, points[b] - p);
+            });
+            for (uint32_t k : {1u, 2u, 4u, amc::NearestVertex::kMaxCount}) {
+                uint32_t found[amc::NearestVertex::kMaxCount];
+                const uint32_t n = nearest.find_nearest(p, usable, k, found);
+                ASSERT_EQ(n, std::min<size_t>(k, sorted.size())) << count << " points, k " << k;
+                for (uint32_t i = 0; i < n; ++i) EXPECT_EQ(found[i], sorted[i]) << count << " points, k " << k << ", rank " << i;
             }
         }
     }

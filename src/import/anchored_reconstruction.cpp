@@ -19,7 +19,7 @@ Triangle normalized(Triangle t) {
 
 std::vector<uint32_t> reconstruct_anchored(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
                                            const TriangleMesh& leaf, const std::string& what,
-                                           std::vector<uint8_t>* undo_step) {
+                                           UndoSteps* steps) {
     const uint32_t vertex_count = uint32_t(leaf.positions.size());
     std::vector<uint8_t> kept(vertex_count, 0);
     for (uint32_t l : leaf_of_base) kept[l] = 1;
@@ -41,13 +41,14 @@ std::vector<uint32_t> reconstruct_anchored(Hierarchy& h, const std::vector<uint3
         detected.levels.push_back(std::move(level));
         triangles = &detected.levels.back().triangles;
     }
-    if (undo_step) {
-        undo_step->assign(vertex_count, kNeverUndone);
+    if (steps) {
+        steps->step.assign(vertex_count, kNeverUndone);
         for (size_t step = 0; step < detected.levels.size(); ++step) {
             for (const std::array<uint32_t, 6>& split : detected.levels[step].splits) {
-                for (int k = 3; k < 6; ++k) (*undo_step)[split[size_t(k)]] = uint8_t(step + 1);
+                for (int k = 3; k < 6; ++k) steps->step[split[size_t(k)]] = uint8_t(step + 1);
             }
         }
+        steps->remaining = *triangles;
     }
     if (triangles->size() != base_triangles) return {};
     std::vector<Triangle> found, wanted;

@@ -6,6 +6,8 @@
 
 #include <amc/hierarchy.h>
 
+#include "import/undo_steps.h"
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -16,13 +18,10 @@ namespace amc {
 // leaf_of_base[i]. On success builds its forest and returns the leaf vertex of every vertex of h
 // (0xffffffff for none); returns an empty vector when the undone levels do not end at the base
 // triangles (the caller tries another way, then reports the error). The caller verifies the
-// whole leaf mesh afterwards. If `undo_step` is given, it receives, reached the base or not, for
-// every leaf vertex the step (1 for the first) whose splits removed it, kNeverUndone for a vertex
-// no step removed.
+// whole leaf mesh afterwards. `steps` (if given) receives, whether the base was reached or not,
+// what the levels undone say (undo_steps.h).
 std::vector<uint32_t> reconstruct_anchored(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
                                            const TriangleMesh& leaf, const std::string& what,
-                                           std::vector<uint8_t>* undo_step = nullptr);
-
-constexpr uint8_t kNeverUndone = 0xff;
+                                           UndoSteps* steps = nullptr);
 
 }  // namespace amc

@@ -142,8 +142,8 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
         anchored,         // levels undone bottom-up from the connectivity alone, the base vertices kept
                           // (positions anywhere; not every adaptive mesh yet, docs/IMPORT.md)
     };
-    // The anchored way's undo steps, kept for the guided ways' second round.
-    std::vector<uint8_t> undo_step;
+    // What the anchored way undid, kept for the guided ways' second round.
+    UndoSteps steps;
     auto attempt = [&](Way way, bool by_undo_steps) {
         out.hierarchy = Hierarchy(hierarchy_base);
         // A leaf mesh of F faces comes from at most F leaves, so from at most 4F/3 + roots nodes.
@@ -153,7 +153,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
             if (leaf_of_vertex.empty()) throw Error(what + ": not a uniform refinement");
         } else if (way == Way::anchored) {
             validate_triangle_mesh(leaf, what);  // the inverse step needs an oriented manifold
-            leaf_of_vertex = reconstruct_anchored(out.hierarchy, leaf_of_base, leaf, what, &undo_step);
+            leaf_of_vertex = reconstruct_anchored(out.hierarchy, leaf_of_base, leaf, what, &steps);
             if (leaf_of_vertex.empty()) throw Error(what + ": anchored inverse refinement did not reach the base");
         } else {
             const MidpointGuide guide = way == Way::exact_midpoints ? MidpointGuide::exact
@@ -161,7 +161,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
                                         : way == Way::subdivision   ? MidpointGuide::subdivision
                                                                     : MidpointGuide::surface;
             leaf_of_vertex = reconstruct_hierarchy(out.hierarchy, leaf_of_base, leaf, halfedges, guide,
-                                                   leaf_positions, what, by_undo_steps ? &undo_step : nullptr);
+                                                   leaf_positions, what, by_undo_steps ? &steps : nullptr);
         }
         verify_leaf_mesh(out.hierarchy, leaf_of_vertex, leaf, halfedges, what);
     };
@@ -175,7 +175,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
         {Way::surface, false},         {Way::anchored, false}, {Way::leaf_midpoint, true},  {Way::subdivision, true},
         {Way::surface, true}};
     for (const auto& [way, by_undo_steps] : ways) {
-        if (by_undo_steps && undo_step.empty()) break;
+        if (by_undo_steps && steps.step.empty()) break;
         try {
             attempt(way, by_undo_steps);
             done = true;

@@ -7,7 +7,6 @@
 #include "import/nearest_vertex.h"
 
 #include <algorithm>
-#include <cstdlib>
 #include <cmath>
 #include <memory>
 
@@ -23,8 +22,9 @@ class Reconstruction {
 public:
     Reconstruction(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base, const TriangleMesh& leaf,
                    const LeafHalfedges& halfedges, MidpointGuide guide, const PositionIndex& positions,
-                   const std::string& what, const std::vector<uint8_t>* undo_step)
-        : h_(h), leaf_(leaf), he_(halfedges), guide_(guide), positions_(positions), what_(what), undo_step_(undo_step) {
+                   const std::string& what, const UndoSteps* steps)
+        : h_(h), leaf_(leaf), he_(halfedges), guide_(guide), positions_(positions), what_(what) {
+        if (steps) choice_ = std::make_unique<UndoStepChoice>(*steps);
         leaf_of_vertex_.assign(h.positions().size(), kNoIndex);
         vertex_of_leaf_.assign(leaf.positions.size(), kNoIndex);
         for (VertexId v = 0; v < leaf_of_base.size(); ++v) assign(v, leaf_of_base[v]);
@@ -238,23 +238,15 @@ private:
             });
             return fits;
         };
-        const uint32_t found = undo_step_ ? latest_undone_of_nearest(guide_position(n, e), may_be_midpoint)
-                                          : nearest_->find(guide_position(n, e), may_be_midpoint);
-        if (found == kNoIndex) fail("no vertex left to split the edge (" + edge_text(n, e) + ")");
-        return found;
-    }
-
-    // Of the nearest candidates, the one the anchored inverse refinement undid last (ties: the
-    // nearest). A true split is undone only after every vertex inside the two elements on the
-    // edge, so the midpoint outlasts its finer neighbours, which are what a wrong pick takes.
-    template <class Usable>
-    uint32_t latest_undone_of_nearest(Vec3 p, Usable& usable) const {
-        uint32_t nearest[NearestVertex::kMaxCount];
-        const uint32_t count = nearest_->find_nearest(p, usable, kCandidates, nearest);
-        uint32_t found = kNoIndex;
-        for (uint32_t i = 0; i < count; ++i) {
-            if (found == kNoIndex || (*undo_step_)[nearest[i]] > (*undo_step_)[found]) found = nearest[i];
+        uint32_t found;
+        if (choice_) {
+            uint32_t nearest[kCandidates];
+            const uint32_t count = nearest_->find_nearest(guide_position(n, e), may_be_midpoint, kCandidates, nearest);
+            found = choice_->choose(nearest, count, a, b, vertex_of_leaf_);
+        } else {
+            found = nearest_->find(guide_position(n, e), may_be_midpoint);
         }
+        if (found == kNoIndex) fail("no vertex left to split the edge (" + edge_text(n, e) + ")");
         return found;
     }
 
@@ -309,8 +301,9 @@ private:
     const MidpointGuide guide_;
     const PositionIndex& positions_;
     const std::string& what_;
-    const std::vector<uint8_t>* undo_step_;
-    const uint32_t kCandidates = std::getenv("AMC_CANDIDATES") ? uint32_t(std::atoi(std::getenv("AMC_CANDIDATES"))) : 4;
+    // The true vertex is among the four nearest for most wrong nearest picks (docs/IMPORT.md);
+    // more candidates let farther ones, outside the two elements on the edge, win.
+    static constexpr uint32_t kCandidates = 4;
     std::vector<uint32_t> leaf_of_vertex_;
     std::vector<uint32_t> vertex_of_leaf_;
     std::vector<Reveal> reveals_;
@@ -318,6 +311,7 @@ private:
     std::vector<UnsplitEdge> unsplit_edges_;
     std::unique_ptr<NearestVertex> nearest_;
     std::unique_ptr<ClosestPointQuery> surface_;
+    std::unique_ptr<UndoStepChoice> choice_;
 };
 
 }  // namespace
@@ -325,8 +319,8 @@ private:
 std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
                                             const TriangleMesh& leaf, const LeafHalfedges& halfedges,
                                             MidpointGuide guide, const PositionIndex& positions,
-                                            const std::string& what, const std::vector<uint8_t>* undo_step) {
-    return Reconstruction(h, leaf_of_base, leaf, halfedges, guide, positions, what, undo_step).run();
+                                            const std::string& what, const UndoSteps* steps) {
+    return Reconstruction(h, leaf_of_base, leaf, halfedges, guide, positions, what, steps).run();
 }
 
 }  // namespace amc

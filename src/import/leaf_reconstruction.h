@@ -6,6 +6,7 @@
 
 #include "import/leaf_halfedges.h"
 #include "import/position_index.h"
+#include "import/undo_steps.h"
 
 #include <string>
 #include <vector>
@@ -26,14 +27,13 @@ enum class MidpointGuide {
 // vertex leaf_of_base[i]) so that its leaf mesh is `leaf`; returns the leaf vertex of every
 // vertex of `h` (0xffffffff for none). With `exact_midpoints`, the vertex an edge split creates is
 // looked up at the edge's midpoint (the fast path for unmoved meshes); without, it is found from
-// the connectivity alone. With `undo_step` (per leaf vertex, the step of the anchored inverse
-// refinement that removed it: anchored_reconstruction.h), a guided pick takes, of the nearest
-// candidates, the one undone last (docs/IMPORT.md, "Undo steps decide between the nearest").
-// Throws Error when the leaf mesh does not fit; the caller verifies the whole leaf mesh afterwards.
+// the connectivity alone. With `steps` (what the anchored inverse refinement undid), a guided pick
+// is chosen among the nearest candidates by them (undo_steps.h). Throws Error when the leaf mesh
+// does not fit; the caller verifies the whole leaf mesh afterwards.
 std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
                                             const TriangleMesh& leaf, const LeafHalfedges& halfedges,
                                             MidpointGuide guide, const PositionIndex& positions,
                                             const std::string& what,
-                                            const std::vector<uint8_t>* undo_step = nullptr);
+                                            const UndoSteps* steps = nullptr);
 
 }  // namespace amc
