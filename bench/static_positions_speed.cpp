@@ -28,6 +28,8 @@ using namespace amc;
 
 constexpr int kRepeat = 10;
 
+GeometryPredictor mode_of(bool grid_bins) { return grid_bins ? GeometryPredictor::normal_frame_grid : GeometryPredictor::normal_frame; }
+
 struct CodedLevel {
     std::vector<std::pair<NodeId, int>> created;
     StaticTables tables;
@@ -40,12 +42,12 @@ std::vector<CodedLevel> code_levels(const Hierarchy& h, CoordinateSpace space, b
         CodedLevel level;
         level.created = new_vertices_of_level(h, nodes);
         if (level.created.empty()) continue;
-        const StaticLevelEncoder code(h, level.created, space, grid_bins);
+        const StaticLevelEncoder code(h, level.created, space, mode_of(grid_bins));
         ArithmeticEncoder encoder;
         code.write_tables(encoder);
         const std::vector<uint8_t> tables = encoder.finish();
         ArithmeticDecoder decoder(tables.data(), tables.size());
-        if (!read_static_tables(decoder, space, grid_bins, level.tables)) throw Error("tables do not read back");
+        if (!read_static_tables(decoder, space, mode_of(grid_bins), level.tables)) throw Error("tables do not read back");
         level.rans = code.rans_bytes();
         level.raw = code.raw_bytes();
         levels.push_back(std::move(level));
@@ -57,7 +59,7 @@ std::vector<CodedLevel> code_levels(const Hierarchy& h, CoordinateSpace space, b
 double decode_all(Hierarchy& h, const std::vector<CodedLevel>& levels, CoordinateSpace space, bool grid_bins) {
     const double start = cpu_seconds();
     for (const CodedLevel& l : levels) {
-        if (!decode_static_positions(h, l.created, space, grid_bins, l.tables, l.rans.data(), l.rans.size(), l.raw.data(),
+        if (!decode_static_positions(h, l.created, space, mode_of(grid_bins), l.tables, l.rans.data(), l.rans.size(), l.raw.data(),
                                      l.raw.size()))
             throw Error("a level does not decode");
     }

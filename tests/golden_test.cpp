@@ -180,7 +180,9 @@ std::vector<GoldenCase> static_geometry_cases() {
         const Vec3 p = sphere.position(v);
         sphere.set_position(v, (1.0 / std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z)) * p);
     }
-    cases.push_back({"sphere_random", sphere, {}});
+    EncodeOptions exact;
+    exact.unit_normals = false;  // version 6's encoder: geometry mode 5 is not a candidate
+    cases.push_back({"sphere_random", sphere, exact});
     EncodeOptions quantized;
     quantized.quantize_bits = 12;
     quantized.grid_contexts = false;  // version 6's encoder: geometry mode 4 is not a candidate
@@ -384,6 +386,48 @@ TEST(Golden, ThirdMixingModelFilesDecodeAndPinTheEncoder) {
         const std::vector<uint8_t> second = read_golden(golden_path(kSecondMixingVersion, c.name));
         ASSERT_FALSE(second.empty());
         EXPECT_NE(second, golden);
+    }
+}
+
+// Version 12 (level geometry mode 5, the normal frame of unit normals with three tables): the
+// projected sphere bit-exact and under the mixing mode with the automatic choice (which takes mode
+// 5), at 12 bits and in four chunks with mode 5 forced, and the float32 random hierarchy forced.
+std::vector<GoldenCase> unit_frame_cases() {
+    std::vector<GoldenCase> cases;
+    for (const GoldenCase& c : static_geometry_cases()) {
+        EncodeOptions forced;
+        forced.predictor = GeometryPredictor::unit_normal_frame;
+        if (c.name == "bumpy_random_float32_normal") cases.push_back({"bumpy_random_float32_unit", c.hierarchy, forced});
+        if (c.name != "sphere_random") continue;
+        cases.push_back({"sphere_random_unit", c.hierarchy, {}});
+        EncodeOptions quantized = forced;
+        quantized.quantize_bits = 12;
+        cases.push_back({"sphere_random_q12_unit", c.hierarchy, quantized});
+        EncodeOptions chunked = forced;
+        chunked.chunks = 4;
+        cases.push_back({"sphere_random_unit_chunks4", c.hierarchy, chunked});
+        EncodeOptions mixed;
+        mixed.hierarchy_contexts = HierarchyContexts::mixed;
+        cases.push_back({"sphere_random_unit_mixed", c.hierarchy, mixed});
+    }
+    return cases;
+}
+
+TEST(Golden, UnitFrameFilesDecodeAndPinTheEncoder) {
+    const std::vector<GoldenCase> cases = unit_frame_cases();
+    ASSERT_EQ(cases.size(), 5u);
+    for (const GoldenCase& c : cases) {
+        SCOPED_TRACE(golden_path(kUnitFrameVersion, c.name));
+        EncodeStats stats;
+        const std::vector<uint8_t> golden = pinned_encoding(c, kUnitFrameVersion, &stats);
+        ASSERT_FALSE(golden.empty()) << "missing";
+        const FileInfo info = inspect(golden.data(), golden.size());
+        EXPECT_EQ(info.version, kUnitFrameVersion);
+        EXPECT_EQ(info.chunks.size(), c.options.chunks > 1 ? size_t(c.options.chunks) : size_t(0));
+        EXPECT_TRUE(std::any_of(stats.per_level.begin(), stats.per_level.end(),
+                                [](const LevelStats& l) { return l.predictor == GeometryPredictor::unit_normal_frame; }))
+            << "the case exercises geometry mode 5";
+        check_decodes(golden, c, kUnitFrameVersion);
     }
 }
 

@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
     encode_cmd->add_option("--map", encode.map, "Write the map from the input's numbering to the decoded mesh (text)");
     encode_cmd->add_option("--quantize", encode.quantize_bits, "Quantize coordinates to BITS per axis (lossy; 0 = bit-exact)")
         ->check(CLI::Range(0, 30));
-    encode_cmd->add_option("--predictor", encode.predictor, "auto | midpoint | butterfly | normal | grid (normal, --quantize only)")
+    encode_cmd->add_option("--predictor", encode.predictor, "auto | midpoint | butterfly | normal | grid (normal, --quantize only) | unit (normal frame of unit normals)")
         ->capture_default_str();
     encode_cmd->add_option("--chunks", encode.chunks,
                            "Cut the forest into this many chunks, each decodable alone (0: one per --chunk-faces faces)")
@@ -100,7 +100,8 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     encode_cmd->add_option("--geometry-contexts", encode.geometry_contexts,
                            "grid | roles (with --quantize: grid also tries tables split by where the prediction falls "
-                           "between grid points on every level, smaller geometry, .amc version 9; roles keeps mode 3)")
+                           "between grid points on every level, smaller geometry, .amc version 9; bit-exact: grid also tries the frame of "
+                           "unit normals, .amc version 12; roles keeps mode 3)")
         ->check(CLI::IsMember({"grid", "roles"}))
         ->capture_default_str();
     encode_cmd->add_flag("--series", encode.series, "The input is a series (as 'amc series encode'; implied by a .pvd input)");

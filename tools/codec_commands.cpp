@@ -26,6 +26,7 @@ const char* predictor_name(GeometryPredictor p) {
            : p == GeometryPredictor::midpoint     ? "midpoint"
            : p == GeometryPredictor::normal_frame ? "normal"
            : p == GeometryPredictor::normal_frame_grid ? "grid"
+           : p == GeometryPredictor::unit_normal_frame ? "unit"
                                                   : "automatic";
 }
 
@@ -35,7 +36,8 @@ GeometryPredictor parse_predictor(const std::string& name) {
     if (name == "butterfly") return GeometryPredictor::butterfly;
     if (name == "normal") return GeometryPredictor::normal_frame;
     if (name == "grid") return GeometryPredictor::normal_frame_grid;
-    throw UsageError("--predictor: unknown predictor '" + name + "' (auto, midpoint, butterfly, normal, grid)");
+    if (name == "unit") return GeometryPredictor::unit_normal_frame;
+    throw UsageError("--predictor: unknown predictor '" + name + "' (auto, midpoint, butterfly, normal, grid, unit)");
 }
 
 // "0,3-5" -> 0, 3, 4, 5 (increasing, each once).
@@ -127,6 +129,7 @@ void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     options.quantize_bits = command.quantize_bits;
     options.predictor = parse_predictor(command.predictor);
     options.grid_contexts = command.geometry_contexts == "grid";  // bit-exact files have no grid: ignored there
+    options.unit_normals = command.geometry_contexts == "grid";   // quantized files ignore it
     if (options.predictor == GeometryPredictor::normal_frame_grid && options.quantize_bits == 0)
         throw UsageError("--predictor grid needs --quantize (grid points exist only on a grid)");
     options.chunks = command.chunks;

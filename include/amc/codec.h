@@ -23,6 +23,10 @@ enum class GeometryPredictor : uint8_t {
     // the prediction falls between two grid points (docs/FORMAT.md 5.7): 11-12 % smaller geometry
     // at 12 bits, 3-4 % at 16 bits on the surface remeshes; files that use it are .amc version 9.
     normal_frame_grid = 4,
+    // The normal frame of mode 4 (the two triangles' unit normals summed, the surface remesher's
+    // direction) with mode 3's three tables (docs/FORMAT.md 5.8): bit-exact remeshes' new vertices
+    // lie on that line up to rounding; files that use it are .amc version 12.
+    unit_normal_frame = 5,
 };
 
 // How the hierarchy symbols of an .amc file are modelled (docs/HIERARCHY_CODER.md).
@@ -45,6 +49,10 @@ struct EncodeOptions {
     // every level and keeps it where it codes smaller (such files are version 9). Bit-exact files
     // have no grid and ignore it; false keeps quantized files at mode 3 (version 6 or 7).
     bool grid_contexts = true;
+    // The automatic predictor also tries geometry mode 5 (unit_normal_frame) on every level of a
+    // bit-exact file and keeps it where it codes smaller (such files are version 12); false keeps
+    // the choices of version 11's encoder.
+    bool unit_normals = true;
     // The caller's numbering of the input's leaf mesh (leaf_numbering()), or null. The encoder
     // re-expresses it against the leaf mesh the decoder rebuilds (EncodeStats::numbering) and,
     // with store_numbering, stores it in the file so that decode returns it (docs/FORMAT.md,

@@ -16,9 +16,11 @@ namespace amc {
 // the mixing mode (metadata option bit 2; FORMAT.md 2.1). Version 9 for files with a level in
 // geometry mode 4 (whether chunked, mixed or neither). Version 10 for files in the mixing mode's
 // second model (FORMAT.md 2.2; whatever their geometry modes): versions 8 and 9 hold the first.
-// Version 11 for files in its third model (FORMAT.md 2.3), which encoders write since.
+// Version 11 for files in its third model (FORMAT.md 2.3), which encoders write since. Version 12
+// for files with a level in geometry mode 5 (the unit-normal frame with three tables; whatever else
+// they hold).
 constexpr uint8_t kOldestReadableVersion = 1;
-constexpr uint8_t kNewestVersion = 11;
+constexpr uint8_t kNewestVersion = 12;
 constexpr uint8_t kBaseVersion = 2;       // everything but the numbering block and mode 2
 constexpr uint8_t kNumberingVersion = 3;  // the first version with a numbering block
 constexpr uint8_t kAngleBaseVersion = 4;  // the first version with base connectivity mode 2
@@ -33,6 +35,7 @@ constexpr uint8_t kMixedContextsVersion = 8;   // the first version with the hie
 constexpr uint8_t kGridGeometryVersion = 9;
 constexpr uint8_t kSecondMixingVersion = 10;  // the first version whose mixing mode is the second model
 constexpr uint8_t kThirdMixingVersion = 11;   // the first version whose mixing mode is the third model
+constexpr uint8_t kUnitFrameVersion = 12;     // the first version with level geometry mode 5 (unit-normal frame)
 
 // The hierarchy stream (FORMAT.md section 2).
 constexpr uint8_t kHierarchyStreamVersion = 2;
@@ -56,6 +59,7 @@ constexpr uint8_t hierarchy_stream_version_of_file(uint8_t file_version) {
         case 9: return 2;
         case 10: return 2;
         case 11: return 2;
+        case 12: return 2;
     }
     return 0;
 }

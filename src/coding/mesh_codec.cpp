@@ -50,9 +50,10 @@ Quantizer quantizer_of(const Hierarchy& input, int bits, double& max_error) {
 }
 
 // The lowest version that holds what the file holds (format_version.h).
-uint8_t file_version(bool grid_geometry, bool mixed_contexts, bool chunked, bool static_geometry, BaseConnectivityMode base_mode,
-                     bool store_numbering) {
-    return mixed_contexts                                ? kThirdMixingVersion
+uint8_t file_version(bool unit_geometry, bool grid_geometry, bool mixed_contexts, bool chunked, bool static_geometry,
+                     BaseConnectivityMode base_mode, bool store_numbering) {
+    return unit_geometry                                 ? kUnitFrameVersion
+           : mixed_contexts                              ? kThirdMixingVersion
            : grid_geometry                               ? kGridGeometryVersion
            : chunked                                     ? kChunkedVersion
            : static_geometry                             ? kStaticGeometryVersion
@@ -152,22 +153,25 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     blocks.emplace_back(BlockType::base_geometry, encode_base_geometry(h, base_code, reordered.keep_rotations, positions));
     stats.base_geometry_bytes = blocks.back().second.size();
 
-    bool static_geometry = false, grid_geometry = false;
+    bool static_geometry = false, grid_geometry = false, unit_geometry = false;
     if (chunked) {
         ChunkedBlocks parts = encode_chunked(h, chunks, options, space, threads, stats);
         static_geometry = parts.static_geometry;
         grid_geometry = parts.grid_geometry;
+        unit_geometry = parts.unit_geometry;
         for (auto& block : parts.blocks) blocks.push_back(std::move(block));
     }
     for (int l = 0; !chunked && l < hierarchy.level_count(); ++l) {
         const NewVertices& created = hierarchy.new_vertices(l);
-        const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, options.predictor, options.grid_contexts);
+        const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, options.predictor, options.grid_contexts,
+                                                                 options.unit_normals);
         ArithmeticEncoder encoder;
         hierarchy.encode_level(l, encoder);
         const size_t hierarchy_part = encoder.bytes_so_far();
         std::vector<uint8_t> payload = finish_level_payload(h, created, geometry, positions, encoder);
         static_geometry |= geometry.predictor == GeometryPredictor::normal_frame;
         grid_geometry |= geometry.predictor == GeometryPredictor::normal_frame_grid;
+        unit_geometry |= geometry.predictor == GeometryPredictor::unit_normal_frame;
         add_level_stats(stats, hierarchy.level_nodes(l).size(), created.size(), hierarchy_part, payload);
         blocks.emplace_back(BlockType::level, std::move(payload));
     }
@@ -176,7 +180,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
         stats.numbering_bytes = blocks.back().second.size();
         stats.framing_bytes += kBlockOverhead;
     }
-    BlockWriter writer(file_version(grid_geometry, mixed, chunked, static_geometry, base_code.mode, store_numbering),
+    BlockWriter writer(file_version(unit_geometry, grid_geometry, mixed, chunked, static_geometry, base_code.mode, store_numbering),
                        uint8_t((precision == Precision::float32 ? kFlagSinglePrecision : 0) | (quantized ? kFlagQuantized : 0)));
     for (const auto& block : blocks) writer.add(block.first, block.second);
     std::vector<uint8_t> out = writer.finish();

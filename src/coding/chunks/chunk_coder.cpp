@@ -58,7 +58,7 @@ void for_each_seam_closure(const Hierarchy& h, const std::vector<NodeId>& level,
 }  // namespace
 
 ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& seam, const HierarchyCoderOptions& options,
-                       GeometryPredictor fixed_predictor, CoordinateSpace space, bool grid_contexts) {
+                       GeometryPredictor fixed_predictor, CoordinateSpace space, bool grid_contexts, bool unit_normals) {
     ChunkCode out;
     HierarchyLevelEncoder hierarchy(h, options);
     const std::vector<uint8_t>& header = hierarchy.header();
@@ -73,7 +73,7 @@ ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& s
         for (auto [n, e] : hierarchy.new_vertices(l))
             if (seam_vertex(h, keys, seam, n, e) < 0) created.emplace_back(n, e);
         // The predictor, as the whole file's encoder picks it (FORMAT.md 3.9, 5.6).
-        const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, fixed_predictor, grid_contexts);
+        const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, fixed_predictor, grid_contexts, unit_normals);
         ArithmeticEncoder encoder;
         hierarchy.encode_level(l, encoder);
         for_each_seam_closure(h, level, keys, seam, [&](NodeId n) { encoder.encode(h.diagonal_flipped(n), flipped); });
@@ -81,6 +81,7 @@ ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& s
         const std::vector<uint8_t> payload = finish_level_payload(h, created, geometry, positions, encoder);
         out.static_geometry |= geometry.predictor == GeometryPredictor::normal_frame;
         out.grid_geometry |= geometry.predictor == GeometryPredictor::normal_frame_grid;
+        out.unit_geometry |= geometry.predictor == GeometryPredictor::unit_normal_frame;
         const uint64_t hierarchy_bytes = std::min<uint64_t>(hierarchy_part, payload.size() - 1);
         out.hierarchy_bytes += hierarchy_bytes;
         out.geometry_bytes += payload.size() - 1 - hierarchy_bytes;

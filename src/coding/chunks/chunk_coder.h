@@ -24,13 +24,15 @@ struct ChunkCode {
     uint64_t faces = 0;               // faces of the whole leaf mesh that belong to the chunk's leaves
     bool static_geometry = false;     // a level uses geometry mode 3 (predictor 3)
     bool grid_geometry = false;       // a level uses geometry mode 4 (predictor 4)
+    bool unit_geometry = false;       // a level uses geometry mode 5 (predictor 5)
     std::vector<LevelStats> levels;
 };
 
 // Codes `chunk` (extract_roots of the whole hierarchy, positions as the decoder will have them).
 // `keys` holds the seam keys of the chunk's vertex ids (seam.h).
 ChunkCode encode_chunk(const Hierarchy& chunk, const VertexKeys& keys, const Seam& seam, const HierarchyCoderOptions& options,
-                       GeometryPredictor predictor, CoordinateSpace space, bool grid_contexts = false);
+                       GeometryPredictor predictor, CoordinateSpace space, bool grid_contexts = false,
+                       bool unit_normals = false);
 
 struct ChunkDecodeLimits {
     uint64_t max_nodes = 0;     // the chunk's node count from the chunk table (within the caller's limit)

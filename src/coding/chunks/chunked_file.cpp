@@ -48,7 +48,7 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<RootRange>& r
         VertexKeys keys(vertex_of.size(), kNoVertex);
         for (size_t v = 0; v < vertex_of.size(); ++v)
             if (vertex_of[v] != kNoVertex) keys[v] = key_of_vertex[vertex_of[v]];
-        codes[c] = encode_chunk(chunk, keys, seam, options.hierarchy, options.predictor, space, options.grid_contexts);
+        codes[c] = encode_chunk(chunk, keys, seam, options.hierarchy, options.predictor, space, options.grid_contexts, options.unit_normals);
         codes[c].bytes.shrink_to_fit();  // held until the file is written: without the slack of its growth
         nodes[c] = chunk.node_count();
     });
@@ -73,6 +73,7 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<RootRange>& r
     for (ChunkCode& code : codes) {
         out.static_geometry |= code.static_geometry;
         out.grid_geometry |= code.grid_geometry;
+        out.unit_geometry |= code.unit_geometry;
         out.levels = std::max(out.levels, int(code.levels.size()));
         stats.hierarchy_bytes += code.hierarchy_bytes;
         stats.geometry_bytes += code.geometry_bytes;

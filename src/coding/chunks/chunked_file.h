@@ -26,6 +26,7 @@ struct ChunkedBlocks {
     std::vector<std::pair<BlockType, std::vector<uint8_t>>> blocks;  // chunk table, seam, chunks
     bool static_geometry = false;  // some chunk level uses geometry mode 3
     bool grid_geometry = false;    // some chunk level uses geometry mode 4
+    bool unit_geometry = false;    // some chunk level uses geometry mode 5
     int levels = 0;                // of the deepest chunk
 };
 

@@ -194,7 +194,7 @@ RankCode encode_rank_chunk(const RankChunk& part, const Seam& seam, const Encode
         }
         AMC_REQUIRE(hanging < 3, invalid_input, where + " has three hanging nodes with those of its neighbours across the seam");
     }
-    ChunkCode code = encode_chunk(h, keys, seam, options.hierarchy, options.predictor, space_of(h.base(), grid), options.grid_contexts);
+    ChunkCode code = encode_chunk(h, keys, seam, options.hierarchy, options.predictor, space_of(h.base(), grid), options.grid_contexts, options.unit_normals);
     RankCode out;
     out.block = framed(BlockType::chunk, code.bytes);
     out.summary.roots = h.root_count();
@@ -205,6 +205,7 @@ RankCode encode_rank_chunk(const RankChunk& part, const Seam& seam, const Encode
     out.summary.levels = uint32_t(h.depth() + 1);
     out.summary.static_geometry = code.static_geometry;
     out.summary.grid_geometry = code.grid_geometry;
+    out.summary.unit_geometry = code.unit_geometry;
     return out;
 }
 
@@ -226,8 +227,11 @@ std::vector<uint8_t> chunked_file_head(const TriangleMesh& base, const Seam& sea
         meta.levels = std::max<uint64_t>(meta.levels, c.levels);
     }
     meta.options = kOptionChunked;
-    bool grid_geometry = false;
-    for (const ChunkSummary& c : chunks) grid_geometry |= c.grid_geometry != 0;
+    bool grid_geometry = false, unit_geometry = false;
+    for (const ChunkSummary& c : chunks) {
+        grid_geometry |= c.grid_geometry != 0;
+        unit_geometry |= c.unit_geometry != 0;
+    }
     if (grid != nullptr) meta.quantizer = *grid;
     PositionCoder positions(space);
     std::vector<uint8_t> seam_bytes = seam.encode(space);
@@ -240,7 +244,7 @@ std::vector<uint8_t> chunked_file_head(const TriangleMesh& base, const Seam& sea
         put_varint(table, offset);
         offset += c.block_bytes;
     }
-    BlockWriter writer(grid_geometry ? kGridGeometryVersion : kChunkedVersion,
+    BlockWriter writer(unit_geometry ? kUnitFrameVersion : grid_geometry ? kGridGeometryVersion : kChunkedVersion,
                        grid != nullptr ? kFlagQuantized : base.single_precision ? kFlagSinglePrecision : 0);
     writer.add(BlockType::metadata, write_metadata(meta, grid != nullptr));
     writer.add(BlockType::base_connectivity, base_code.bytes);

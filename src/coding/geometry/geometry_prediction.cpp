@@ -3,7 +3,6 @@
 #include "coding/geometry/geometry_prediction.h"
 
 #include "common/exact_float.h"
-#include "common/simd.h"
 
 #include <algorithm>
 #include <cmath>
@@ -79,79 +78,15 @@ Vec3 predict_butterfly(const Hierarchy& h, NodeId n, int e) {
     return round_if_single(h, p);
 }
 
-namespace {
-
-// u x v with every product rounded before the subtraction (no fused multiply-add).
-Vec3 exact_cross(Vec3 u, Vec3 v) {
-    return {rounded(u.y * v.z) - rounded(u.z * v.y), rounded(u.z * v.x) - rounded(u.x * v.z),
-            rounded(u.x * v.y) - rounded(u.y * v.x)};
-}
-
-// 1 / L for the lengths L = sqrt(squared) of two vectors, each correctly rounded, and whether L is
-// positive and finite (else the unit vector is the zero vector). With SSE2 both square roots and
-// both divisions are one instruction each: they are most of mode 4's frame.
-struct InverseLengths {
-    double r[2];
-    bool valid[2];
-};
-InverseLengths inverse_lengths(double squared0, double squared1) {
-    double length[2];
-    InverseLengths out;
-#if AMC_SSE2
-    const __m128d l = _mm_sqrt_pd(_mm_set_pd(squared1, squared0));
-    _mm_storeu_pd(length, l);
-    _mm_storeu_pd(out.r, _mm_div_pd(_mm_set1_pd(1.0), l));
-#else
-    for (int k = 0; k < 2; ++k) {
-        length[k] = std::sqrt(k == 0 ? squared0 : squared1);
-        out.r[k] = 1.0 / length[k];
-    }
-#endif
-    for (int k = 0; k < 2; ++k) out.valid[k] = length[k] > 0 && std::isfinite(length[k]);
-    return out;
-}
-
-// v scaled to unit length: each coordinate times 1 / L, L the correctly rounded square root of
-// exact_dot(v, v), each product rounded; the zero vector when L is 0 or not finite.
-Vec3 scaled_unit(Vec3 v, double r, bool valid) { return valid ? rounded_scaled(r, v) : Vec3{0, 0, 0}; }
-
-}  // namespace
-
 FrameCorners frame_corners(const Hierarchy& h, NodeId n, int e) {
     const NodeId q = h.neighbor(n, e);
     return {h.vertex(n, e), h.vertex(n, (e + 1) % 3), h.vertex(n, (e + 2) % 3),
             q == kNoNode ? kNoVertex : h.vertex(q, (h.neighbor_edge(n, e) + 2) % 3)};
 }
 
-NormalFrame frame_of(const Hierarchy& h, const FrameCorners& corners, bool unit_normals) {
-    NormalFrame f;
-    const Vec3 a = h.position(corners.a), b = h.position(corners.b), c = h.position(corners.c);
-    f.midpoint = round_if_single(h, rounded_scaled(0.5, a + b));  // predict_midpoint's
-    const bool has_d = corners.d != kNoVertex;
-    const Vec3 n1 = exact_cross(b - a, c - a);
-    const Vec3 n2 = has_d ? exact_cross(a - b, h.position(corners.d) - b) : Vec3{};
-    if (unit_normals) {
-        // Mode 4 sums unit normals (the remesher's direction, vertex_placement.cpp).
-        const InverseLengths r = inverse_lengths(exact_dot(n1, n1), exact_dot(n2, n2));
-        f.normal = scaled_unit(n1, r.r[0], r.valid[0]);
-        if (has_d) f.normal = f.normal + scaled_unit(n2, r.r[1], r.valid[1]);
-    } else {
-        // Mode 3 sums the cross products themselves (each weighted by its triangle's area).
-        f.normal = has_d ? n1 + n2 : n1;
-    }
-    // The first axis of largest |N_i|, without branches (the axis is a coin flip on curved surfaces).
-    const double x = std::fabs(f.normal.x), y = std::fabs(f.normal.y), z = std::fabs(f.normal.z);
-    const bool y_wins = y > x;
-    const double best = y_wins ? y : x;
-    const bool z_wins = z > best;
-    f.axis = z_wins ? 2 : int(y_wins);
-    const double largest = z_wins ? z : best;
-    f.has_normal = largest > 0 && std::isfinite(largest);
-    return f;
-}
-
 NormalFrame normal_frame(const Hierarchy& h, NodeId n, int e, bool unit_normals) {
-    return frame_of(h, frame_corners(h, n, e), unit_normals);
+    const FrameCorners corners = frame_corners(h, n, e);
+    return unit_normals ? frame_of<true>(h, corners) : frame_of<false>(h, corners);
 }
 
 Vec3 predict_parallelogram(const std::vector<Vec3>& decoded, std::array<int32_t, 3> stencil) {

@@ -10,11 +10,14 @@
 #pragma once
 
 #include "coding/geometry/float_coder.h"
+#include "common/compiler.h"
 #include "common/exact_float.h"
+#include "common/simd.h"
 
 #include <amc/hierarchy.h>
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <utility>
@@ -67,7 +70,7 @@ struct NormalFrame {
         return p;
     }
 };
-// unit_normals (geometry mode 4, FORMAT.md 5.7): N is the sum of the two triangles' unit normals
+// unit_normals (geometry modes 4 and 5, FORMAT.md 5.7, 5.8): N is the sum of the two triangles' unit normals
 // instead, the direction along which the surface remesher places the vertex.
 NormalFrame normal_frame(const Hierarchy& h, NodeId n, int e, bool unit_normals = false);
 // normal_frame in two steps, for decoders that gather many vertices' corners (and prefetch their
@@ -78,10 +81,79 @@ struct FrameCorners {
     VertexId a, b, c, d;
 };
 FrameCorners frame_corners(const Hierarchy& h, NodeId n, int e);
-NormalFrame frame_of(const Hierarchy& h, const FrameCorners& corners, bool unit_normals);
+// frame_of<UnitNormals>(h, corners): below, inline.
 
 // Parallelogram rule over already decoded positions: a + b - c when all three indices are valid
 // (>= 0 and < decoded.size()), else a when a is valid, else the zero vector.
 Vec3 predict_parallelogram(const std::vector<Vec3>& decoded, std::array<int32_t, 3> stencil);
+
+// ---- the frame, inline: the static decoders compute one per vertex ---------------------------------
+
+namespace frame_detail {
+
+// u x v with every product rounded before the subtraction (no fused multiply-add).
+AMC_ALWAYS_INLINE Vec3 exact_cross(Vec3 u, Vec3 v) {
+    return {rounded(u.y * v.z) - rounded(u.z * v.y), rounded(u.z * v.x) - rounded(u.x * v.z),
+            rounded(u.x * v.y) - rounded(u.y * v.x)};
+}
+
+// 1 / L for the lengths L = sqrt(squared) of two vectors, each correctly rounded, and whether L is
+// positive and finite (else the unit vector is the zero vector). With SSE2 both square roots and
+// both divisions are one instruction each: they are most of the unit-normal frame.
+struct InverseLengths {
+    double r[2];
+    bool valid[2];
+};
+AMC_ALWAYS_INLINE InverseLengths inverse_lengths(double squared0, double squared1) {
+    double length[2];
+    InverseLengths out;
+#if AMC_SSE2
+    const __m128d l = _mm_sqrt_pd(_mm_set_pd(squared1, squared0));
+    _mm_storeu_pd(length, l);
+    _mm_storeu_pd(out.r, _mm_div_pd(_mm_set1_pd(1.0), l));
+#else
+    for (int k = 0; k < 2; ++k) {
+        length[k] = std::sqrt(k == 0 ? squared0 : squared1);
+        out.r[k] = 1.0 / length[k];
+    }
+#endif
+    for (int k = 0; k < 2; ++k) out.valid[k] = length[k] > 0 && std::isfinite(length[k]);
+    return out;
+}
+
+// v scaled to unit length: each coordinate times 1 / L, each product rounded; the zero vector when
+// L is 0 or not finite.
+AMC_ALWAYS_INLINE Vec3 scaled_unit(Vec3 v, double r, bool valid) { return valid ? rounded_scaled(r, v) : Vec3{0, 0, 0}; }
+
+}  // namespace frame_detail
+
+template <bool UnitNormals>
+AMC_ALWAYS_INLINE NormalFrame frame_of(const Hierarchy& h, const FrameCorners& corners) {
+    NormalFrame f;
+    const Vec3 a = h.position(corners.a), b = h.position(corners.b), c = h.position(corners.c);
+    f.midpoint = rounded_scaled(0.5, a + b);  // predict_midpoint's
+    if (h.single_precision()) f.midpoint = rounded_to_float(f.midpoint);
+    const bool has_d = corners.d != kNoVertex;
+    const Vec3 n1 = frame_detail::exact_cross(b - a, c - a);
+    const Vec3 n2 = has_d ? frame_detail::exact_cross(a - b, h.position(corners.d) - b) : Vec3{};
+    if (UnitNormals) {
+        // Modes 4 and 5 sum unit normals (the remesher's direction, vertex_placement.cpp).
+        const frame_detail::InverseLengths r = frame_detail::inverse_lengths(exact_dot(n1, n1), exact_dot(n2, n2));
+        f.normal = frame_detail::scaled_unit(n1, r.r[0], r.valid[0]);
+        if (has_d) f.normal = f.normal + frame_detail::scaled_unit(n2, r.r[1], r.valid[1]);
+    } else {
+        // Mode 3 sums the cross products themselves (each weighted by its triangle's area).
+        f.normal = has_d ? n1 + n2 : n1;
+    }
+    // The first axis of largest |N_i|, without branches (the axis is a coin flip on curved surfaces).
+    const double x = std::fabs(f.normal.x), y = std::fabs(f.normal.y), z = std::fabs(f.normal.z);
+    const bool y_wins = y > x;
+    const double best = y_wins ? y : x;
+    const bool z_wins = z > best;
+    f.axis = z_wins ? 2 : int(y_wins);
+    const double largest = z_wins ? z : best;
+    f.has_normal = largest > 0 && std::isfinite(largest);
+    return f;
+}
 
 }  // namespace amc

@@ -12,6 +12,18 @@ namespace amc {
 
 namespace {
 
+// The predictors a level block of a file of `file_version` may hold (FORMAT.md 3.6).
+bool predictor_allowed(uint8_t predictor, uint8_t file_version, bool quantized) {
+    switch (GeometryPredictor(predictor)) {
+        case GeometryPredictor::midpoint:
+        case GeometryPredictor::butterfly: return true;
+        case GeometryPredictor::normal_frame: return file_version >= kStaticGeometryVersion;
+        case GeometryPredictor::normal_frame_grid: return file_version >= kGridGeometryVersion && quantized;
+        case GeometryPredictor::unit_normal_frame: return file_version >= kUnitFrameVersion;
+        default: return false;
+    }
+}
+
 Vec3 predict(const Hierarchy& h, GeometryPredictor predictor, NodeId n, int e) {
     return predictor == GeometryPredictor::butterfly ? predict_butterfly(h, n, e) : predict_midpoint(h, n, e);
 }
@@ -25,16 +37,16 @@ void encode_adaptive(const Hierarchy& h, const NewVertices& created, GeometryPre
 }  // namespace
 
 LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& created, const PositionCoder& positions,
-                                        CoordinateSpace space, GeometryPredictor choice, bool grid_contexts) {
+                                        CoordinateSpace space, GeometryPredictor choice, bool grid_contexts, bool unit_normals) {
     const bool automatic = choice == GeometryPredictor::automatic;
     LevelGeometryCode code;
     code.predictor = automatic ? GeometryPredictor::midpoint : choice;
     if (code.predictor == GeometryPredictor::normal_frame_grid && space.quantizer == nullptr)
         throw Error("geometry mode 4 (normal_frame_grid) needs quantized coordinates");
-    if (code.predictor == GeometryPredictor::normal_frame || (automatic && !created.empty()))
+    if (automatic && !created.empty())
         code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space);
-    if (code.predictor == GeometryPredictor::normal_frame_grid)
-        code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space, true);
+    else if (is_static_mode(code.predictor))
+        code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space, code.predictor);
     if (!automatic || created.empty()) return code;
     size_t best = SIZE_MAX;
     for (GeometryPredictor candidate : {GeometryPredictor::midpoint, GeometryPredictor::butterfly}) {
@@ -52,10 +64,18 @@ LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& c
         code.predictor = GeometryPredictor::normal_frame;
     }
     if (grid_contexts && space.quantizer != nullptr) {
-        auto grid = std::make_unique<StaticLevelEncoder>(h, created, space, true);
+        auto grid = std::make_unique<StaticLevelEncoder>(h, created, space, GeometryPredictor::normal_frame_grid);
         if (grid->estimated_bytes() < best) {
+            best = grid->estimated_bytes();
             code.predictor = GeometryPredictor::normal_frame_grid;
             code.static_code = std::move(grid);
+        }
+    }
+    if (unit_normals && space.quantizer == nullptr) {
+        auto unit = std::make_unique<StaticLevelEncoder>(h, created, space, GeometryPredictor::unit_normal_frame);
+        if (unit->estimated_bytes() < best) {
+            code.predictor = GeometryPredictor::unit_normal_frame;
+            code.static_code = std::move(unit);
         }
     }
     return code;
@@ -82,11 +102,8 @@ std::vector<uint8_t> finish_level_payload(const Hierarchy& h, const NewVertices&
 }
 
 LevelBlockParts split_level_block(const Block& block, uint8_t file_version, bool quantized, const std::string& where) {
-    const uint8_t last_predictor = uint8_t(file_version >= kGridGeometryVersion && quantized ? GeometryPredictor::normal_frame_grid
-                                           : file_version >= kStaticGeometryVersion          ? GeometryPredictor::normal_frame
-                                                                                             : GeometryPredictor::butterfly);
-    AMC_REQUIRE(block.size >= 1 && block.payload[0] >= uint8_t(GeometryPredictor::midpoint) && block.payload[0] <= last_predictor,
-                corrupt, "level block: bad predictor");
+    AMC_REQUIRE(block.size >= 1 && predictor_allowed(block.payload[0], file_version, quantized), corrupt,
+                "level block: bad predictor");
     LevelBlockParts parts;
     parts.predictor = GeometryPredictor(block.payload[0]);
     PayloadReader in(block.payload + 1, block.size - 1, "level block");
@@ -106,9 +123,8 @@ LevelBlockParts split_level_block(const Block& block, uint8_t file_version, bool
 void decode_level_geometry(Hierarchy& h, const NewVertices& created, const LevelBlockParts& parts, ArithmeticDecoder& decoder,
                            PositionCoder& positions, CoordinateSpace space, int level, const std::string& where) {
     if (is_static_mode(parts.predictor)) {
-        const bool grid_bins = parts.predictor == GeometryPredictor::normal_frame_grid;
         StaticTables tables;
-        AMC_REQUIRE(read_static_tables(decoder, space, grid_bins, tables) && !decoder.overran(), corrupt,
+        AMC_REQUIRE(read_static_tables(decoder, space, parts.predictor, tables) && !decoder.overran(), corrupt,
                     where + ": bad geometry tables");
         PayloadReader in(parts.after_arithmetic, parts.after_arithmetic_size, "level block");
         const uint64_t rans_size = in.varint();
@@ -116,7 +132,7 @@ void decode_level_geometry(Hierarchy& h, const NewVertices& created, const Level
         const uint8_t* rans = in.rest();
         const uint8_t* raw = rans + rans_size;
         const size_t raw_size = in.remaining() - size_t(rans_size);
-        AMC_REQUIRE(decode_static_positions(h, created, space, grid_bins, tables, rans, size_t(rans_size), raw, raw_size), corrupt,
+        AMC_REQUIRE(decode_static_positions(h, created, space, parts.predictor, tables, rans, size_t(rans_size), raw, raw_size), corrupt,
                     where + " is truncated or corrupt (positions)");
     } else {
         for (auto [n, e] : created) {

@@ -27,20 +27,16 @@ using NewVertices = std::vector<std::pair<NodeId, int>>;
 // A level's geometry code, chosen before the level block is written.
 struct LevelGeometryCode {
     GeometryPredictor predictor = GeometryPredictor::midpoint;
-    std::unique_ptr<StaticLevelEncoder> static_code;  // mode 3's or 4's streams, when chosen
+    std::unique_ptr<StaticLevelEncoder> static_code;  // mode 3's, 4's or 5's streams, when chosen
 };
 
 // The predictor of the level that creates `created` (positions set in h as the decoder will have
 // them): `choice`, or when it is automatic the one that codes the level in the fewest bytes, each
 // adaptive predictor tried on a copy of `positions`' models; mode 4 is a candidate only with
-// grid_contexts in a quantized space.
+// grid_contexts in a quantized space, mode 5 only with unit_normals in a bit-exact one.
 LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& created, const PositionCoder& positions,
-                                        CoordinateSpace space, GeometryPredictor choice, bool grid_contexts = false);
-
-// Modes 3 and 4: the static modes (tables, rANS, raw bits).
-constexpr bool is_static_mode(GeometryPredictor p) {
-    return p == GeometryPredictor::normal_frame || p == GeometryPredictor::normal_frame_grid;
-}
+                                        CoordinateSpace space, GeometryPredictor choice, bool grid_contexts = false,
+                                        bool unit_normals = false);
 
 // The payload of a level block whose hierarchy part `encoder` holds: the predictor byte, then the
 // arithmetic code finished with the level's geometry (and mode 3's streams).

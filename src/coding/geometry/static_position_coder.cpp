@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace amc {
 
@@ -120,13 +121,6 @@ AMC_ALWAYS_INLINE bool grid_value(const Quantizer& quantizer, int axis, const Gr
     return true;
 }
 
-int token_of(Residual r) {
-    if (r.magnitude == 0) return 0;
-    if (r.magnitude < 8) return int(2 * r.magnitude - 1 + (r.negative ? 1 : 0));
-    const int k = bit_length(r.magnitude);
-    return kDirectTokens + 4 * (k - 4) + int((r.magnitude >> (k - 3)) & 3);
-}
-
 void put_raw(RawBitWriter& raw, Residual r) {
     if (r.magnitude < 8) return;
     const int low = bit_length(r.magnitude) - 3;
@@ -213,9 +207,20 @@ bool get_table(ArithmeticDecoder& decoder, TableModels& models, int limit, RansT
 
 }  // namespace
 
+int static_token(bool negative, uint64_t magnitude) {
+    if (magnitude == 0) return 0;
+    if (magnitude < 8) return int(2 * magnitude - 1 + (negative ? 1 : 0));
+    const int k = bit_length(magnitude);
+    return kDirectTokens + 4 * (k - 4) + int((magnitude >> (k - 3)) & 3);
+}
+
+int static_raw_bit_count(uint64_t magnitude) { return magnitude < 8 ? 0 : 1 + bit_length(magnitude) - 3; }
+
 StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created,
-                                       CoordinateSpace space, bool grid_bins)
-    : table_count_(static_table_count(grid_bins)) {
+                                       CoordinateSpace space, GeometryPredictor mode)
+    : table_count_(static_table_count(mode)) {
+    if (!is_static_mode(mode)) throw Error("StaticLevelEncoder: geometry mode " + std::to_string(int(mode)) + " is not a static mode");
+    const bool grid_bins = has_grid_bins(mode);
     if (grid_bins && space.quantizer == nullptr) throw Error("geometry mode 4 needs quantized coordinates");
     std::vector<std::array<int, kStaticRoles>> tokens, table_of;
     std::vector<std::array<Residual, kStaticRoles>> residuals;
@@ -224,7 +229,7 @@ StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std
     residuals.reserve(created.size());
     std::array<std::vector<uint64_t>, kMaxStaticTables> counts;
     for (auto [n, e] : created) {
-        const NormalFrame frame = normal_frame(h, n, e, grid_bins);
+        const NormalFrame frame = normal_frame(h, n, e, has_unit_normals(mode));
         const std::array<int, 3> axes = role_axes(frame);
         const Vec3 actual = h.position(h.midpoint(n, e));
         const Vec3 others = frame.predict(axis_coordinate(actual, axes[0]));
@@ -241,7 +246,7 @@ StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std
                 r[size_t(role)] = residual_of(space, axis, axis_coordinate(actual, axis), predicted);
                 table[size_t(role)] = role;
             }
-            t[size_t(role)] = token_of(r[size_t(role)]);
+            t[size_t(role)] = static_token(r[size_t(role)].negative, r[size_t(role)].magnitude);
             std::vector<uint64_t>& c = counts[size_t(table[size_t(role)])];
             if (c.size() <= size_t(t[size_t(role)])) c.resize(size_t(t[size_t(role)]) + 1, 0);
             ++c[size_t(t[size_t(role)])];
@@ -280,10 +285,10 @@ size_t StaticLevelEncoder::estimated_bytes() const {
     return tables.finish().size() + varint + rans_.size() + raw_.size();
 }
 
-bool read_static_tables(ArithmeticDecoder& decoder, CoordinateSpace space, bool grid_bins, StaticTables& tables) {
-    if (grid_bins && space.quantizer == nullptr) return false;
+bool read_static_tables(ArithmeticDecoder& decoder, CoordinateSpace space, GeometryPredictor mode, StaticTables& tables) {
+    if (!is_static_mode(mode) || (has_grid_bins(mode) && space.quantizer == nullptr)) return false;
     TableModels models;
-    for (int i = 0; i < static_table_count(grid_bins); ++i)
+    for (int i = 0; i < static_table_count(mode); ++i)
         if (!get_table(decoder, models, token_limit(space), tables[size_t(i)])) return false;
     return true;
 }
@@ -320,9 +325,9 @@ void gather_chunk(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>&
             if (v != kNoVertex) __builtin_prefetch(&h.positions()[v]);
 }
 
-template <bool Grid>
+template <bool Grid, bool UnitNormals>
 AMC_ALWAYS_INLINE void frame_vertex(const Hierarchy& h, const Quantizer* grid, Chunk& c, size_t i) {
-    c.frames[i] = frame_of(h, c.corners[i], Grid);
+    c.frames[i] = frame_of<UnitNormals>(h, c.corners[i]);
     c.axes[i] = role_axes(c.frames[i]);
     if (Grid) c.first[i] = grid_prediction(*grid, c.axes[i][0], axis_coordinate(c.frames[i].midpoint, c.axes[i][0]));
 }
@@ -359,7 +364,7 @@ AMC_ALWAYS_INLINE bool decode_vertex(const Chunk& b, size_t i, CoordinateSpace s
 
 // The decoders own their rANS decoder and raw bit reader, so that the compiler keeps the two rANS
 // states in registers.
-template <bool Grid>
+template <bool Grid, bool UnitNormals>
 bool decode_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
                       const StaticTables& tables, const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data,
                       size_t raw_size) {
@@ -369,7 +374,7 @@ bool decode_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& c
     Chunk c;
     for (size_t begin = 0; begin < created.size(); begin += kChunk) {
         gather_chunk(h, created, begin, c);
-        for (size_t i = 0; i < c.count; ++i) frame_vertex<Grid>(h, grid, c, i);
+        for (size_t i = 0; i < c.count; ++i) frame_vertex<Grid, UnitNormals>(h, grid, c, i);
         for (size_t i = 0; i < c.count; i += 2) {
             Vec3 p;
             if (!decode_vertex<0, Grid>(c, i, space, tables, rans, raw, p)) return false;
@@ -385,10 +390,19 @@ bool decode_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& c
 }  // namespace
 
 bool decode_static_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
-                             bool grid_bins, const StaticTables& tables, const uint8_t* rans_data, size_t rans_size,
+                             GeometryPredictor mode, const StaticTables& tables, const uint8_t* rans_data, size_t rans_size,
                              const uint8_t* raw_data, size_t raw_size) {
-    if (!grid_bins) return decode_positions<false>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size);
-    return space.quantizer != nullptr && decode_positions<true>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size);
+    switch (mode) {
+        case GeometryPredictor::normal_frame:
+            return decode_positions<false, false>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size);
+        case GeometryPredictor::unit_normal_frame:
+            return decode_positions<false, true>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size);
+        case GeometryPredictor::normal_frame_grid:
+            return space.quantizer != nullptr &&
+                   decode_positions<true, true>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size);
+        default:
+            return false;
+    }
 }
 
 }  // namespace amc

@@ -24,6 +24,7 @@
 #include "coding/entropy/rans_coder.h"
 #include "coding/geometry/float_coder.h"
 
+#include <amc/codec.h>
 #include <amc/hierarchy.h>
 
 #include <array>
@@ -39,17 +40,31 @@ constexpr int kMaxStaticTables = kStaticRoles * kGridBins;
 // Mode 3 uses the first three (one per role), mode 4 all six (table 2 role + bin).
 using StaticTables = std::array<RansTable, kMaxStaticTables>;
 
-// The number of tables of a static mode: 3 (mode 3) or 6 (mode 4, `grid_bins`).
-constexpr int static_table_count(bool grid_bins) { return grid_bins ? kMaxStaticTables : kStaticRoles; }
+// The static modes: 3 (normal_frame), 4 (normal_frame_grid) and 5 (unit_normal_frame).
+constexpr bool is_static_mode(GeometryPredictor p) {
+    return p == GeometryPredictor::normal_frame || p == GeometryPredictor::normal_frame_grid ||
+           p == GeometryPredictor::unit_normal_frame;
+}
+// Mode 4 splits each role's table by grid position.
+constexpr bool has_grid_bins(GeometryPredictor mode) { return mode == GeometryPredictor::normal_frame_grid; }
+// Modes 4 and 5 sum unit normals for the frame (mode 3 sums cross products).
+constexpr bool has_unit_normals(GeometryPredictor mode) { return mode != GeometryPredictor::normal_frame; }
+// The number of tables of a static mode: 3, or 6 in mode 4.
+constexpr int static_table_count(GeometryPredictor mode) { return has_grid_bins(mode) ? kMaxStaticTables : kStaticRoles; }
 
 // The code of one level's new positions in the static mode. `created` are the level's new
 // vertices (new_vertices_of_level) with their positions set in h (the decoder's values: on the grid
 // when quantized).
+// The token of a residual of sign `negative` (1 = negative) and magnitude m (the map above), and how
+// many raw bits follow it: the sign and the k - 3 low bits when m >= 8, else none.
+int static_token(bool negative, uint64_t magnitude);
+int static_raw_bit_count(uint64_t magnitude);
+
 class StaticLevelEncoder {
 public:
-    // grid_bins: mode 4 (space must be quantized), else mode 3.
+    // mode: a static mode (is_static_mode); mode 4 needs a quantized space. Throws Error otherwise.
     StaticLevelEncoder(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
-                       bool grid_bins = false);
+                       GeometryPredictor mode = GeometryPredictor::normal_frame);
     // The tables (three, or six in mode 4), into the level's arithmetic payload after the hierarchy part.
     void write_tables(ArithmeticEncoder& encoder) const;
     const std::vector<uint8_t>& rans_bytes() const { return rans_; }
@@ -64,15 +79,16 @@ private:
     std::vector<uint8_t> rans_, raw_;
 };
 
-// Reads the tables (three, or six with grid_bins); false when they are not valid for `space` (a
-// frequency sum other than 2^12, a token larger than the space's residuals can be).
-bool read_static_tables(ArithmeticDecoder& decoder, CoordinateSpace space, bool grid_bins, StaticTables& tables);
+// Reads the tables of static mode `mode` (three, or six in mode 4); false when they are not valid
+// for `space` (a frequency sum other than 2^12, a token larger than the space's residuals can be)
+// or the mode is not a static mode the space allows.
+bool read_static_tables(ArithmeticDecoder& decoder, CoordinateSpace space, GeometryPredictor mode, StaticTables& tables);
 
 // Decodes the positions of `created` (in order) and sets them in h. False when the streams are
 // corrupt: a grid coordinate out of range, a non-finite coordinate, an overrun, or streams that do
 // not end where the last coordinate ends.
 bool decode_static_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
-                             bool grid_bins, const StaticTables& tables, const uint8_t* rans, size_t rans_size, const uint8_t* raw,
+                             GeometryPredictor mode, const StaticTables& tables, const uint8_t* rans, size_t rans_size, const uint8_t* raw,
                              size_t raw_size);
 
 }  // namespace amc
