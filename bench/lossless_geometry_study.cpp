@@ -7,7 +7,10 @@
 //   area       mode 3: the frame's normal sums the two triangles' cross products;
 //   unit       the normal sums their unit normals (mode 4's frame, the remesher's direction);
 //   unit+bfly  unit, role 0 predicted by the butterfly's coordinate instead of the midpoint's;
-//   unit+r0class  unit, roles 1 and 2 split by the bit length of role 0's residual (3 classes).
+//   unit+r0class  unit, roles 1 and 2 split by the bit length of role 0's residual (3 classes);
+//   unit+near  unit, role 0 predicted by the midpoint moved along N by the mean offset of the level's
+//              vertices coded before in the same node and in its neighbour across the edge, each
+//              offset t (FORMAT.md 5.5) divided by its edge's squared length and scaled by this one's.
 // Residuals in the hierarchy's precision (float32 remeshes of float32 references, else float64).
 //   lossless_geometry_study model.amh ...
 #include <amc/codec.h>
@@ -31,8 +34,8 @@ namespace {
 
 using namespace amc;
 
-constexpr int kDesigns = 4;
-const char* const kDesignNames[kDesigns] = {"area", "unit", "unit+bfly", "unit+r0class"};
+constexpr int kDesigns = 5;
+const char* const kDesignNames[kDesigns] = {"area", "unit", "unit+bfly", "unit+r0class", "unit+near"};
 constexpr int kTablesPerDesign = 12;
 
 double gamma_bits(double v) { return 2.0 * std::floor(std::log2(v)) + 1; }
@@ -86,12 +89,32 @@ void study_level(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& 
     std::array<std::array<Table, kTablesPerDesign>, kDesigns> tables;
     const Precision precision = h.single_precision() ? Precision::float32 : Precision::float64;
     const int width = precision == Precision::float32 ? 32 : 64;
+    std::map<NodeId, std::pair<double, int>> offsets;  // unit+near: per node, sum and count of t / |ab|^2
     for (auto [n, e] : created) {
         const Vec3 actual = h.position(h.midpoint(n, e));
+        const NodeId across = h.neighbor(n, e);
+        const Vec3 edge = h.position(h.vertex(n, (e + 1) % 3)) - h.position(h.vertex(n, e));
+        const double squared_length = exact_dot(edge, edge);
         for (int d = 0; d < kDesigns; ++d) {
             const NormalFrame frame = normal_frame(h, n, e, d != 0);
             const std::array<int, 3> axes = role_axes(frame);
-            const Vec3 first_prediction = d == 2 ? predict_butterfly(h, n, e) : frame.midpoint;
+            Vec3 first_prediction = d == 2 ? predict_butterfly(h, n, e) : frame.midpoint;
+            if (d == 4 && frame.has_normal) {
+                double sum = 0;
+                int count = 0;
+                for (NodeId m : {n, across}) {
+                    const auto it = offsets.find(m);
+                    if (it != offsets.end()) sum += it->second.first, count += it->second.second;
+                }
+                if (count > 0) first_prediction = frame.midpoint + rounded_scaled(sum / count * squared_length, frame.normal);
+                const double t = (axis_coordinate(actual, frame.axis) - axis_coordinate(frame.midpoint, frame.axis)) /
+                                 axis_coordinate(frame.normal, frame.axis);
+                for (NodeId m : {n, across}) {
+                    if (m == kNoNode || !(squared_length > 0)) continue;
+                    offsets[m].first += t / squared_length;
+                    ++offsets[m].second;
+                }
+            }
             const Vec3 others = frame.predict(axis_coordinate(actual, axes[0]));
             int r0_class = 0;
             for (int role = 0; role < 3; ++role) {
