@@ -22,8 +22,8 @@ class Reconstruction {
 public:
     Reconstruction(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base, const TriangleMesh& leaf,
                    const LeafHalfedges& halfedges, MidpointGuide guide, const PositionIndex& positions,
-                   const std::string& what, const UndoSteps* steps)
-        : h_(h), leaf_(leaf), he_(halfedges), guide_(guide), positions_(positions), what_(what) {
+                   const std::string& what, const UndoSteps* steps, const PickReferee* referee)
+        : h_(h), leaf_(leaf), he_(halfedges), guide_(guide), positions_(positions), what_(what), referee_(referee) {
         if (steps) choice_ = std::make_unique<UndoStepChoice>(*steps);
         leaf_of_vertex_.assign(h.positions().size(), kNoIndex);
         vertex_of_leaf_.assign(leaf.positions.size(), kNoIndex);
@@ -246,6 +246,7 @@ private:
         } else {
             found = nearest_->find(guide_position(n, e), may_be_midpoint);
         }
+        if (referee_ && found != kNoIndex) found = (*referee_)(h_.level(n), a, b, found);
         if (found == kNoIndex) fail("no vertex left to split the edge (" + edge_text(n, e) + ")");
         return found;
     }
@@ -301,6 +302,7 @@ private:
     const MidpointGuide guide_;
     const PositionIndex& positions_;
     const std::string& what_;
+    const PickReferee* referee_;
     // The true vertex is among the four nearest for most wrong nearest picks (docs/IMPORT.md);
     // more candidates let farther ones, outside the two elements on the edge, win.
     static constexpr uint32_t kCandidates = 4;
@@ -319,8 +321,9 @@ private:
 std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
                                             const TriangleMesh& leaf, const LeafHalfedges& halfedges,
                                             MidpointGuide guide, const PositionIndex& positions,
-                                            const std::string& what, const UndoSteps* steps) {
-    return Reconstruction(h, leaf_of_base, leaf, halfedges, guide, positions, what, steps).run();
+                                            const std::string& what, const UndoSteps* steps,
+                                            const PickReferee* referee) {
+    return Reconstruction(h, leaf_of_base, leaf, halfedges, guide, positions, what, steps, referee).run();
 }
 
 }  // namespace amc

@@ -8,6 +8,7 @@
 #include "import/position_index.h"
 #include "import/undo_steps.h"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -23,17 +24,24 @@ enum class MidpointGuide {
                     // midpoint of the edge's end vertices (meshes projected onto a surface)
 };
 
+// Sees every position-guided pick of the vertex that splits the edge (a, b) of a level's node
+// and returns the vertex to go on with: a bench that knows the true hierarchy counts the wrong
+// picks and goes on with the true vertex (bench/import_picks.cpp).
+using PickReferee = std::function<uint32_t(int level, uint32_t a, uint32_t b, uint32_t picked)>;
+
 // Builds the forest of `h` (a hierarchy of unrefined roots over the base, whose vertex i is leaf
 // vertex leaf_of_base[i]) so that its leaf mesh is `leaf`; returns the leaf vertex of every
 // vertex of `h` (0xffffffff for none). With `exact_midpoints`, the vertex an edge split creates is
 // looked up at the edge's midpoint (the fast path for unmoved meshes); without, it is found from
 // the connectivity alone. With `steps` (what the anchored inverse refinement undid), a guided pick
-// is chosen among the nearest candidates by them (undo_steps.h). Throws Error when the leaf mesh
+// is chosen among the nearest candidates by them (undo_steps.h); `referee` (if given) sees each
+// such pick. Throws Error when the leaf mesh
 // does not fit; the caller verifies the whole leaf mesh afterwards.
 std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
                                             const TriangleMesh& leaf, const LeafHalfedges& halfedges,
                                             MidpointGuide guide, const PositionIndex& positions,
                                             const std::string& what,
-                                            const UndoSteps* steps = nullptr);
+                                            const UndoSteps* steps = nullptr,
+                                            const PickReferee* referee = nullptr);
 
 }  // namespace amc

@@ -1,0 +1,129 @@
+// Position-guided picks against the true hierarchy (docs/IMPORT.md, "Undo steps decide between
+// the nearest"): for every corpus hierarchy, its leaf mesh as a user holds it (as import_corpus
+// makes it), the top-down reconstruction with the base run with each guide twice: picking the
+// nearest candidate (ways 3 and 4 of import_leaf_mesh) and choosing among the nearest by the
+// anchored way's undo steps (way 5). Every pick is compared with the true hierarchy's vertex and
+// the reconstruction goes on with the true one, so each pick is judged on a correct past.
+// Prints a Markdown table: guided picks, wrong ones of each rule, per level for the second.
+//
+// Usage: import_picks [--move X] corpus/*.amh
+#include "user_leaf_mesh.h"
+
+#include "import/anchored_reconstruction.h"
+#include "import/leaf_halfedges.h"
+#include "import/leaf_reconstruction.h"
+#include "import/position_index.h"
+
+#include <amc/hierarchy.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace {
+
+struct Count {
+    long picks = 0, wrong = 0;
+    std::vector<long> wrong_per_level;
+    bool failed = false;  // a misfit no pick explains (the reconstruction threw)
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    double move = 0.3;
+    std::vector<std::string> files;
+    for (int i = 1; i < argc; ++i) {
+        const std::string arg = argv[i];
+        if (arg == "--move" && i + 1 < argc) {
+            move = std::atof(argv[++i]);
+        } else {
+            files.push_back(arg);
+        }
+    }
+    if (files.empty()) {
+        std::fprintf(stderr, "usage: import_picks [--move X] hierarchy.amh...\n");
+        return 2;
+    }
+    const amc::MidpointGuide guides[] = {amc::MidpointGuide::leaf_midpoint, amc::MidpointGuide::subdivision,
+                                         amc::MidpointGuide::surface};
+    const char* guide_names[] = {"leaf midpoint", "subdivision", "surface"};
+    std::printf("| model | guide | guided picks | wrong: the nearest | wrong: undo steps | of them per level 0, 1, ... |\n");
+    std::printf("|---|---|---:|---:|---:|---|\n");
+    for (const std::string& file : files) {
+        const amc::Hierarchy h = amc::read_hierarchy(file);
+        const amc::LeafMesh leaf = amc::extract_leaf_mesh(h);
+        const uint32_t base_vertices = uint32_t(h.base().positions.size());
+        std::vector<uint32_t> user_of_leaf;
+        const amc::TriangleMesh user = bench::user_leaf_mesh(leaf.mesh, base_vertices, move, 23, &user_of_leaf);
+        const std::vector<uint32_t> canonical = amc::canonical_vertex_order(h);
+        auto user_vertex = [&](amc::VertexId v) { return user_of_leaf[canonical[v]]; };
+        // The true vertex of every split edge, both directions.
+        std::unordered_map<uint64_t, uint32_t> truth;
+        for (amc::NodeId n = 0; n < h.node_capacity(); ++n) {
+            if (!h.is_alive(n) || h.is_leaf(n)) continue;
+            for (int e = 0; e < 3; ++e) {
+                const uint32_t a = user_vertex(h.vertex(n, e)), b = user_vertex(h.vertex(n, (e + 1) % 3));
+                const uint32_t m = user_vertex(h.midpoint(n, e));
+                truth[(uint64_t(a) << 32) | b] = m;
+                truth[(uint64_t(b) << 32) | a] = m;
+            }
+        }
+        std::vector<uint32_t> leaf_of_base(base_vertices);
+        amc::TriangleMesh base;
+        base.triangles = h.base().triangles;
+        base.single_precision = user.single_precision;
+        for (uint32_t b = 0; b < base_vertices; ++b) {
+            leaf_of_base[b] = user_vertex(b);
+            base.positions.push_back(user.positions[leaf_of_base[b]]);
+        }
+        const amc::LeafHalfedges halfedges(user);
+        const amc::PositionIndex positions(user.positions);
+        auto fresh = [&] {
+            amc::Hierarchy out(base);
+            out.reserve(user.triangles.size() * 4 / 3 + base.triangles.size() + 4, user.positions.size());
+            return out;
+        };
+        amc::UndoSteps steps;
+        {
+            amc::Hierarchy anchored = fresh();
+            amc::reconstruct_anchored(anchored, leaf_of_base, user, file, &steps);
+        }
+        const std::string name = std::filesystem::path(file).stem().string();
+        for (int g = 0; g < 3; ++g) {
+            Count counts[2];
+            for (int rule = 0; rule < 2; ++rule) {
+                Count& c = counts[rule];
+                const amc::PickReferee referee = [&](int level, uint32_t a, uint32_t b, uint32_t picked) {
+                    const auto it = truth.find((uint64_t(a) << 32) | b);
+                    if (it == truth.end()) return picked;  // an edge the true hierarchy does not split
+                    ++c.picks;
+                    if (picked != it->second) {
+                        ++c.wrong;
+                        if (c.wrong_per_level.size() <= size_t(level)) c.wrong_per_level.resize(size_t(level) + 1, 0);
+                        ++c.wrong_per_level[size_t(level)];
+                    }
+                    return it->second;
+                };
+                amc::Hierarchy reconstructed = fresh();
+                try {
+                    amc::reconstruct_hierarchy(reconstructed, leaf_of_base, user, halfedges, guides[g], positions, file,
+                                               rule == 1 ? &steps : nullptr, &referee);
+                } catch (const amc::Error&) {
+                    c.failed = true;
+                }
+            }
+            std::string levels;
+            for (size_t l = 0; l < counts[1].wrong_per_level.size(); ++l)
+                levels += (l ? ", " : "") + std::to_string(counts[1].wrong_per_level[l]);
+            std::printf("| %s | %s | %ld | %ld%s | %ld%s | %s |\n", name.c_str(), guide_names[g], counts[0].picks,
+                        counts[0].wrong, counts[0].failed ? " (stopped)" : "", counts[1].wrong,
+                        counts[1].failed ? " (stopped)" : "", levels.c_str());
+            std::fflush(stdout);
+        }
+    }
+    return 0;
+}
