@@ -4,7 +4,7 @@
 // neighbours' states -> context -> model -> bit -> pushes -> next node; docs/HIERARCHY_CODER.md,
 // "Speed"); two streams' chains do not depend on each other, so the processor could overlap them.
 //
-//   traversal_lanes [--nodes N] [--runs R] [--model surface|random|fe] [--mode all|ref|seq|lock]
+//   traversal_lanes [--nodes N] [--runs R] [--model surface|random|fe] [--mode all|ref|seq|lock|lib]
 //
 // Each lane decides one stream of the model (lane B a second copy of the same stream, or with
 // --model random a random model of another seed): every level's traversal, arithmetic decoding,
@@ -13,6 +13,7 @@
 //   ref   the library's traversal (LevelTraversal::run_newest), lane A's level, then lane B's
 //   seq   this program's stepper: lane A's level, then lane B's
 //   lock  the same stepper: one node of A, one node of B, until both levels are decided
+//   lib   the library's decoder (HierarchyLevelDecoder::decide_level): stream A, then stream B
 // seq and lock run the same code, so their difference is the overlap alone. Each lane's result is
 // checked against the library's decode (node count, symbols read). --mode X runs X alone (for
 // valgrind --tool=callgrind, whose instruction counts are exact).
@@ -152,7 +153,7 @@ struct Stepper {
     }
 };
 
-enum class Mode { ref, seq, lock };
+enum class Mode { ref, seq, lock, lib };
 
 // This thread's CPU time in milliseconds: on a shared machine, the time it was not running
 // does not count (wall time there measures the other jobs).
@@ -251,6 +252,20 @@ public:
     }
     const Level& level() const { return level_; }
 
+    // The whole stream by the library's decoder (HierarchyLevelDecoder::decide_level, its fast
+    // and general paths), without the build.
+    void decide_all_by_decoder() {
+        header_size_ = read_standalone_stream_header(stream_.data(), stream_.size(), header_);
+        library_.restart(roots_.base(), header_, HierarchyDecodeOptions().max_nodes);
+        ArithmeticDecoder d(stream_.data() + header_size_, stream_.size() - header_size_);
+        while (!library_.done()) library_.decide_level(d);
+        library_.finish();
+        if (library_.node_count() != expected_nodes_) {
+            std::fprintf(stderr, "traversal_lanes: the library decided %llu nodes\n", (unsigned long long)library_.node_count());
+            std::exit(1);
+        }
+    }
+
     // decide_level's tail: the numbering, the closures' orientation bits, the next level.
     void end_level() {
         uint32_t* const closures = closures_.reserve(level_.size());
@@ -289,6 +304,7 @@ private:
     RefinedNumbering numbering_;
     ScratchArray<uint32_t> closures_;
     BucketQueue buckets_;
+    HierarchyLevelDecoder library_;
     int l_ = 0;
     uint64_t nodes_ = 0, expected_nodes_ = 0, symbols_read_ = 0, symbol_limit_ = 0;
 };
@@ -343,7 +359,12 @@ void decide_pair(Lane& a, Lane* b, Mode mode, Links la, Links lb) {
     b->take_back(sb);
 }
 
-void decide_all(Lane& a, Lane& b, Mode mode) {
+AMC_NOIPA void decide_all(Lane& a, Lane& b, Mode mode) {
+    if (mode == Mode::lib) {
+        a.decide_all_by_decoder();
+        b.decide_all_by_decoder();
+        return;
+    }
     a.start();
     b.start();
     while (!a.done() || !b.done()) {
@@ -393,7 +414,7 @@ int main(int argc, char** argv) {
             mode_name = argv[++k];
         } else {
             std::fprintf(stderr, "usage: traversal_lanes [--nodes N] [--runs R] [--model surface|random|fe] "
-                                 "[--mode all|ref|seq|lock]\n");
+                                 "[--mode all|ref|seq|lock|lib]\n");
             return 2;
         }
     }
@@ -412,8 +433,9 @@ int main(int argc, char** argv) {
     if (mode_name == "all" || mode_name == "ref") modes.push_back(Mode::ref);
     if (mode_name == "all" || mode_name == "seq") modes.push_back(Mode::seq);
     if (mode_name == "all" || mode_name == "lock") modes.push_back(Mode::lock);
-    const char* const names[3] = {"ref", "seq", "lock"};
-    std::vector<std::vector<double>> ms(3);
+    if (mode_name == "all" || mode_name == "lib") modes.push_back(Mode::lib);
+    const char* const names[4] = {"ref", "seq", "lock", "lib"};
+    std::vector<std::vector<double>> ms(4);
     for (int r = 0; r < runs; ++r) {
         for (const Mode m : modes) {
             const double t0 = thread_cpu_ms();
