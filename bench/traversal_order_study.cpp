@@ -14,6 +14,7 @@
 //   child 1230     every block's child 1, 2, 3, then child 0 (the center child, whose three
 //                  neighbours are its siblings, last)
 //   two passes     every block's children with an even canonical block index, then the odd ones
+//   blocks 1230    block by block in canonical order, each block's children 1, 2, 3, then 0
 // Orientation bits and the header are the same in every order and are not counted. Prints bytes
 // per order and the ratio to the improved traversal's.
 #include "coding/entropy/arithmetic_coder.h"
@@ -35,9 +36,10 @@ struct Symbol {
     bool bit;
 };
 
-enum class Order { improved, naive, canonical, child_0123, child_1230, two_passes };
-constexpr int kOrders = 6;
-const char* const kOrderNames[kOrders] = {"improved", "naive", "canonical", "child 0123", "child 1230", "two passes"};
+enum class Order { improved, naive, canonical, child_0123, child_1230, two_passes, blocks_1230 };
+constexpr int kOrders = 7;
+const char* const kOrderNames[kOrders] = {"improved",   "naive",      "canonical", "child 0123",
+                                          "child 1230", "two passes", "blocks 1230"};
 
 int context_group(const Neighbors& node, const uint8_t* state) {
     unsigned code = 0;
@@ -121,6 +123,11 @@ std::vector<Symbol> symbols_in_order(const Hierarchy& h, Order order) {
                         for (uint32_t b = parity; b < blocks; b += 2) {
                             for (uint32_t k = 0; k < 4; ++k) visit(4 * b + k);
                         }
+                    }
+                    break;
+                case Order::blocks_1230:
+                    for (uint32_t b = 0; b < blocks; ++b) {
+                        for (uint32_t k = 1; k <= 4; ++k) visit(4 * b + (k & 3));
                     }
                     break;
                 default:
