@@ -24,6 +24,7 @@
 #include <amc/hierarchy_coder.h>
 
 #include <cstdio>
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -167,7 +168,13 @@ int main(int argc, char** argv) {
     std::printf("\n");
     for (int a = 1; a < argc; ++a) {
         const std::string path = argv[a];
-        const Hierarchy h = read_hierarchy(path);
+        Hierarchy h;
+        try {
+            h = read_hierarchy(path);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "traversal_order_study: %s: %s\n", path.c_str(), e.what());
+            return 1;
+        }
         std::string name = path.substr(path.find_last_of('/') + 1);
         name = name.substr(0, name.find_last_of('.'));
         std::printf("| %s | %u |", name.c_str(), h.node_count());
