@@ -2,6 +2,7 @@
 // success and throws Error (exit code 1) or UsageError (exit code 2).
 #pragma once
 
+#include <amc/codec.h>
 #include <amc/mesh.h>
 #include <amc/mesh_io.h>
 #include <amc/refinement.h>
@@ -27,8 +28,8 @@ struct EncodeCommand {
     std::string map;              // write the numbering map (input -> decoded) here
     int quantize_bits = 0;
     std::string predictor = "auto";
-    uint32_t chunks = 0;          // 0: one per chunk_faces faces
-    uint64_t chunk_faces = 100000;
+    uint32_t chunks = 0;          // 0: one per chunk_faces faces, fewer for a small code (EncodeOptions)
+    uint64_t chunk_faces = EncodeOptions{}.chunk_faces;
     unsigned threads = 0;         // 0: every core
     std::string hierarchy_contexts = "paper";
     std::string geometry_contexts = "grid";  // grid (mode 4 where smaller in quantized files, mode 5 in bit-exact ones) | roles (mode 3 only)

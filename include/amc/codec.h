@@ -61,10 +61,14 @@ struct EncodeOptions {
     bool store_numbering = true;
     // Chunks (docs/FORMAT.md 3.11): the forest cut into runs of roots, each decodable on its own,
     // coded and decoded on several threads. 0: one chunk per `chunk_faces` faces of the leaf mesh
-    // (at least one). A file of one chunk is written as before chunks existed (version 6 or
-    // lower, byte for byte); more chunks make a version-7 file.
+    // (at least one), and fewer when that code holds less than `min_chunk_bytes` per chunk (it is
+    // then coded again in one chunk per min_chunk_bytes; 0: never): each chunk costs some bytes of
+    // its own, which weigh about 1 % in a chunk of 64 KiB (docs/CODEC.md, "Chunks"). A file of one
+    // chunk is written as before chunks existed (version 6 or lower, byte for byte); more chunks
+    // make a version-7 file.
     uint32_t chunks = 0;
-    uint64_t chunk_faces = 100000;
+    uint64_t chunk_faces = 500000;
+    uint64_t min_chunk_bytes = 65536;
     // Explicit chunks instead: the number of roots of each chunk, in file order (the input's own
     // order with keep_base_order), adding up to the root count; `chunks` and `chunk_faces` are then
     // ignored. One entry writes a file without chunks. A file written by MPI ranks (amc/mpi.h) is

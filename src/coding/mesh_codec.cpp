@@ -6,6 +6,7 @@
 #include <amc/codec.h>
 
 #include "coding/base/base_stage.h"
+#include "coding/chunks/chunk_policy.h"
 #include "coding/chunks/chunked_file.h"
 #include "coding/container.h"
 #include "coding/file_metadata.h"
@@ -92,6 +93,58 @@ void add_level_stats(EncodeStats& stats, size_t nodes, size_t new_vertices, size
     stats.per_level.push_back(level_stats);
 }
 
+// The forest after the base mesh: one level block per level, or, in two chunks or more, the chunk
+// table, the seam and the chunk blocks (a version-7 file).
+struct ForestCode {
+    std::vector<std::pair<BlockType, std::vector<uint8_t>>> blocks;
+    uint64_t bytes = 0;  // of the blocks, framing included
+    bool chunked = false, static_geometry = false, grid_geometry = false, unit_geometry = false;
+    uint64_t faces = 0, levels = 0;          // the metadata's
+    std::vector<uint8_t> hierarchy_header;  // the metadata's (none with chunks)
+    EncodeStats stats;  // header (the chunk table), hierarchy, geometry and framing bytes, levels, hierarchy
+};
+
+// Codes the forest of `h` (decoder base order, positions as the decoder will have them) in
+// `chunks`; `faces` is the leaf face count when there are several. `positions` holds the models as
+// the base geometry left them. The mixing mode (FORMAT.md 2.1) codes the forest as one stream.
+ForestCode code_forest(const Hierarchy& h, const std::vector<RootRange>& chunks, uint64_t faces, const EncodeOptions& options,
+                       CoordinateSpace space, PositionCoder positions, unsigned threads, bool want_hierarchy_stats) {
+    ForestCode out;
+    const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
+    out.chunked = !mixed && chunks.size() > 1;
+    if (out.chunked) {
+        ChunkedBlocks parts = encode_chunked(h, chunks, options, space, threads, out.stats);
+        out.static_geometry = parts.static_geometry;
+        out.grid_geometry = parts.grid_geometry;
+        out.unit_geometry = parts.unit_geometry;
+        out.faces = faces;
+        out.levels = uint64_t(h.depth() + 1);
+        out.blocks = std::move(parts.blocks);
+    } else {
+        HierarchyLevelEncoder hierarchy(h, options.hierarchy, kHierarchyStreamVersion, nullptr, mixed);
+        out.faces = hierarchy.stats().faces;  // counted by the coder's first pass
+        out.levels = uint64_t(hierarchy.level_count());
+        out.hierarchy_header = hierarchy.header();
+        for (int l = 0; l < hierarchy.level_count(); ++l) {
+            const NewVertices& created = hierarchy.new_vertices(l);
+            const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, options.predictor,
+                                                                     options.grid_contexts, options.unit_normals);
+            ArithmeticEncoder encoder;
+            hierarchy.encode_level(l, encoder);
+            const size_t hierarchy_part = encoder.bytes_so_far();
+            std::vector<uint8_t> payload = finish_level_payload(h, created, geometry, positions, encoder);
+            out.static_geometry |= geometry.predictor == GeometryPredictor::normal_frame;
+            out.grid_geometry |= geometry.predictor == GeometryPredictor::normal_frame_grid;
+            out.unit_geometry |= geometry.predictor == GeometryPredictor::unit_normal_frame;
+            add_level_stats(out.stats, hierarchy.level_nodes(l).size(), created.size(), hierarchy_part, payload);
+            out.blocks.emplace_back(BlockType::level, std::move(payload));
+        }
+        if (want_hierarchy_stats) out.stats.hierarchy = hierarchy.stats();  // replays the coded symbols: only when asked for
+    }
+    for (const auto& block : out.blocks) out.bytes += kBlockOverhead + block.second.size();
+    return out;
+}
+
 }  // namespace
 
 std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options, EncodeStats* stats_out) {
@@ -119,68 +172,58 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
         for (VertexId v = 0; v < h.positions().size(); ++v) h.set_position(v, dequantize(quantizer, snap_to_grid(quantizer, h.position(v))));
     }
 
-    // Chunks (FORMAT.md 3.11): more than one makes a version-7 file, whose chunks code the forest on
-    // several threads; the hierarchy coder then runs over the roots alone, for its header's sake.
+    // The forest (FORMAT.md 3.6, 3.11), after the base geometry, whose adaptive models the level
+    // blocks go on with. Chunks the caller leaves to the encoder are tried first at chunk_faces
+    // faces each, then fewer if that code is too small for them (chunk_policy.h).
+    PositionCoder positions(space);
+    std::vector<uint8_t> base_geometry = encode_base_geometry(h, base_code, reordered.keep_rotations, positions);
+    const bool automatic = options.chunk_roots.empty() && options.chunks == 0;
     const bool one_chunk = options.chunk_roots.empty() ? options.chunks == 1 : options.chunk_roots.size() == 1;
     const uint64_t faces = one_chunk ? 0 : leaf_face_count(h, threads);
+    const std::vector<uint64_t> root_nodes = options.chunk_roots.empty() ? nodes_per_root(h) : std::vector<uint64_t>();
     const std::vector<RootRange> chunks = options.chunk_roots.empty()
-                                              ? balanced_chunks(nodes_per_root(h), chunk_count_for(options, faces))
+                                              ? balanced_chunks(root_nodes, chunk_count_for(options, faces))
                                               : explicit_chunks(options.chunk_roots, h.root_count());
-    // The mixing mode (FORMAT.md 2.1) codes the forest as one stream: one chunk.
-    const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
-    const bool chunked = !mixed && chunks.size() > 1;
-    const Hierarchy roots_only = chunked ? Hierarchy(h.base()) : Hierarchy();
-    HierarchyLevelEncoder hierarchy(chunked ? roots_only : h, options.hierarchy, kHierarchyStreamVersion, nullptr, mixed);
+    const bool want_hierarchy_stats = stats_out != nullptr;
+    ForestCode forest = code_forest(h, chunks, faces, options, space, positions, threads, want_hierarchy_stats);
+    const uint32_t fewer = automatic && forest.chunked ? chunk_count_for_size(options, uint32_t(chunks.size()), forest.bytes)
+                                                       : uint32_t(chunks.size());
+    if (fewer < chunks.size())
+        forest = code_forest(h, balanced_chunks(root_nodes, fewer), faces, options, space, positions, threads, want_hierarchy_stats);
+
     Metadata meta;
     meta.base_vertices = h.base().positions.size();
     meta.base_triangles = h.root_count();
     meta.nodes = h.node_count();
     meta.vertices = h.vertex_count();
-    meta.faces = chunked ? faces : hierarchy.stats().faces;  // counted by the coder's first pass
-    meta.levels = uint64_t(chunked ? h.depth() + 1 : hierarchy.level_count());
-    if (!chunked) meta.hierarchy_header = hierarchy.header();
+    meta.faces = forest.faces;
+    meta.levels = forest.levels;
+    meta.hierarchy_header = forest.hierarchy_header;
     meta.quantizer = quantizer;
-    meta.options = (reordered.keep_rotations ? kOptionRootRotations : 0) | (chunked ? kOptionChunked : 0) |
+    const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
+    meta.options = (reordered.keep_rotations ? kOptionRootRotations : 0) | (forest.chunked ? kOptionChunked : 0) |
                    (mixed ? kOptionMixedContexts : 0);
 
-    // The blocks are made first: the version in the header depends on the level modes chosen.
+    // The version in the header depends on the level modes chosen.
     std::vector<std::pair<BlockType, std::vector<uint8_t>>> blocks;
     blocks.emplace_back(BlockType::metadata, write_metadata(meta, quantized));
-    stats.header_bytes = kFileHeaderSize + kBlockOverhead + blocks.back().second.size();
+    stats.header_bytes = kFileHeaderSize + kBlockOverhead + blocks.back().second.size() + forest.stats.header_bytes;
     blocks.emplace_back(BlockType::base_connectivity, base_code.bytes);
     stats.base_connectivity_bytes = base_code.bytes.size();
-    PositionCoder positions(space);
-    blocks.emplace_back(BlockType::base_geometry, encode_base_geometry(h, base_code, reordered.keep_rotations, positions));
-    stats.base_geometry_bytes = blocks.back().second.size();
-
-    bool static_geometry = false, grid_geometry = false, unit_geometry = false;
-    if (chunked) {
-        ChunkedBlocks parts = encode_chunked(h, chunks, options, space, threads, stats);
-        static_geometry = parts.static_geometry;
-        grid_geometry = parts.grid_geometry;
-        unit_geometry = parts.unit_geometry;
-        for (auto& block : parts.blocks) blocks.push_back(std::move(block));
-    }
-    for (int l = 0; !chunked && l < hierarchy.level_count(); ++l) {
-        const NewVertices& created = hierarchy.new_vertices(l);
-        const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, options.predictor, options.grid_contexts,
-                                                                 options.unit_normals);
-        ArithmeticEncoder encoder;
-        hierarchy.encode_level(l, encoder);
-        const size_t hierarchy_part = encoder.bytes_so_far();
-        std::vector<uint8_t> payload = finish_level_payload(h, created, geometry, positions, encoder);
-        static_geometry |= geometry.predictor == GeometryPredictor::normal_frame;
-        grid_geometry |= geometry.predictor == GeometryPredictor::normal_frame_grid;
-        unit_geometry |= geometry.predictor == GeometryPredictor::unit_normal_frame;
-        add_level_stats(stats, hierarchy.level_nodes(l).size(), created.size(), hierarchy_part, payload);
-        blocks.emplace_back(BlockType::level, std::move(payload));
-    }
+    stats.base_geometry_bytes = base_geometry.size();
+    blocks.emplace_back(BlockType::base_geometry, std::move(base_geometry));
+    stats.hierarchy_bytes = forest.stats.hierarchy_bytes;
+    stats.geometry_bytes = forest.stats.geometry_bytes;
+    stats.framing_bytes = forest.stats.framing_bytes;
+    stats.per_level = std::move(forest.stats.per_level);
+    for (auto& block : forest.blocks) blocks.push_back(std::move(block));
     if (store_numbering) {
         blocks.emplace_back(BlockType::numbering, encode_numbering(stats.numbering, extract_leaf_mesh(h).mesh.triangles));
         stats.numbering_bytes = blocks.back().second.size();
         stats.framing_bytes += kBlockOverhead;
     }
-    BlockWriter writer(file_version(unit_geometry, grid_geometry, mixed, chunked, static_geometry, base_code.mode, store_numbering),
+    BlockWriter writer(file_version(forest.unit_geometry, forest.grid_geometry, mixed, forest.chunked, forest.static_geometry,
+                                    base_code.mode, store_numbering),
                        uint8_t((precision == Precision::float32 ? kFlagSinglePrecision : 0) | (quantized ? kFlagQuantized : 0)));
     for (const auto& block : blocks) writer.add(block.first, block.second);
     std::vector<uint8_t> out = writer.finish();
@@ -193,7 +236,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     stats.base_triangles = meta.base_triangles;
     stats.levels = int(meta.levels);
     if (stats_out != nullptr) {
-        if (!chunked) stats.hierarchy = hierarchy.stats();  // replays the coded symbols: only when asked for
+        stats.hierarchy = forest.stats.hierarchy;
         *stats_out = stats;
     }
     return out;

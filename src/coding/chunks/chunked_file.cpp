@@ -14,12 +14,6 @@
 
 namespace amc {
 
-uint32_t chunk_count_for(const EncodeOptions& options, uint64_t faces) {
-    if (options.chunks != 0) return options.chunks;
-    const uint64_t per_chunk = std::max<uint64_t>(1, options.chunk_faces);
-    return uint32_t(std::max<uint64_t>(1, std::min<uint64_t>(faces / per_chunk, UINT32_MAX)));
-}
-
 uint64_t leaf_face_count(const Hierarchy& h, unsigned threads) {
     constexpr NodeId kRange = NodeId(1) << 16;  // nodes counted per task
     std::vector<uint64_t> faces((size_t(h.node_capacity()) + kRange - 1) / kRange, 0);

@@ -16,9 +16,6 @@
 
 namespace amc {
 
-// The chunk count EncodeOptions ask for a hierarchy of `faces` leaf faces.
-uint32_t chunk_count_for(const EncodeOptions& options, uint64_t faces);
-
 // Faces of the conforming leaf mesh (1 + hanging nodes per leaf), counted on up to `threads` threads.
 uint64_t leaf_face_count(const Hierarchy& h, unsigned threads = 1);
 
