@@ -164,6 +164,7 @@ TEST(Chunks, DefaultsKeepSmallFilesUnchangedAndChunkLargeOnes) {
     EXPECT_EQ(encode(h, EncodeOptions{}), encode(h, unchunked)) << "fewer faces than chunk_faces: one chunk";
     EncodeOptions small_chunks;
     small_chunks.chunk_faces = 100;
+    small_chunks.min_chunk_bytes = 0;  // keeps chunks this small (chunk_policy_test.cpp tests the fallback)
     EncodeStats stats;
     const std::vector<uint8_t> bytes = encode(h, small_chunks, &stats);
     const FileInfo info = inspect(bytes.data(), bytes.size());
