@@ -174,12 +174,7 @@ constexpr int kCurrentVersionOfTheCases = kSearchedBaseVersion;
 // forced.
 std::vector<GoldenCase> static_geometry_cases() {
     std::vector<GoldenCase> cases;
-    Hierarchy sphere(make_icosahedron());
-    refine_randomly(sphere, 1200, 4, 7);
-    for (VertexId v = 0; v < sphere.positions().size(); ++v) {
-        const Vec3 p = sphere.position(v);
-        sphere.set_position(v, (1.0 / std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z)) * p);
-    }
+    const Hierarchy sphere = testing::projected_sphere(1200, 4, 7);
     EncodeOptions exact;
     exact.unit_normals = false;  // version 6's encoder: geometry mode 5 is not a candidate
     cases.push_back({"sphere_random", sphere, exact});

@@ -18,17 +18,7 @@
 namespace amc {
 namespace {
 
-// A random refinement of the icosahedron with every vertex on the unit sphere (new vertices off
-// their edge's midpoint along the normal, as in a surface remesh).
-Hierarchy projected_sphere(uint32_t splits, int depth, uint64_t seed) {
-    Hierarchy h(make_icosahedron());
-    refine_randomly(h, splits, depth, seed);
-    for (VertexId v = 0; v < h.positions().size(); ++v) {
-        const Vec3 p = h.position(v);
-        h.set_position(v, (1.0 / std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z)) * p);
-    }
-    return h;
-}
+using testing::projected_sphere;
 
 bool uses(const EncodeStats& stats, GeometryPredictor p) {
     return std::any_of(stats.per_level.begin(), stats.per_level.end(), [p](const LevelStats& l) { return l.predictor == p; });

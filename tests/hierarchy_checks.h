@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <string>
 #include <utility>
@@ -23,6 +24,18 @@ struct Random {
         return state >> 33;
     }
 };
+
+// A random refinement of the icosahedron with every vertex projected onto the unit sphere (new
+// vertices off their edge's midpoint along the normal, as in a surface remesh).
+inline Hierarchy projected_sphere(uint32_t target_leaves, int max_level, uint64_t seed) {
+    Hierarchy h(make_icosahedron());
+    refine_randomly(h, target_leaves, max_level, seed);
+    for (VertexId v = 0; v < h.positions().size(); ++v) {
+        const Vec3 p = h.position(v);
+        h.set_position(v, (1.0 / std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z)) * p);
+    }
+    return h;
+}
 
 // The mesh with its vertices renumbered, its triangles reordered and each rotated, at random
 // (positions unchanged); new_index, if given, receives the new number of every old vertex.

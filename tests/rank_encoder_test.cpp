@@ -20,6 +20,7 @@ namespace {
 using testing::Random;
 using testing::adaptive_hierarchy;
 using testing::cut;
+using testing::projected_sphere;
 using testing::ranks_of;
 
 using Rank = testing::RankForest;
@@ -102,17 +103,6 @@ EncodeOptions serial_options(EncodeOptions options, const std::vector<uint32_t>&
     return options;
 }
 
-// A random refinement of the icosahedron with every vertex on the unit sphere.
-Hierarchy projected_sphere() {
-    Hierarchy sphere(make_icosahedron());
-    refine_randomly(sphere, 20000, 7, 5);
-    for (VertexId v = 0; v < sphere.positions().size(); ++v) {
-        const Vec3 p = sphere.position(v);
-        sphere.set_position(v, (1.0 / std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z)) * p);
-    }
-    return sphere;
-}
-
 TEST(RankEncoder, RanksWriteTheSerialEncodersQuantizedBytes) {
     int files = 0, grid_files = 0;
     for (uint64_t seed = 0; seed < 12; ++seed) {
@@ -133,7 +123,7 @@ TEST(RankEncoder, RanksWriteTheSerialEncodersQuantizedBytes) {
     EXPECT_EQ(files, 12 * 4);
     EXPECT_GT(grid_files, 0);  // level geometry mode 4 in some chunk: a version-9 file
     // A surface remesh (vertices on the unit sphere), where the automatic predictor takes mode 4.
-    const Hierarchy sphere = projected_sphere();
+    const Hierarchy sphere = projected_sphere(20000, 7, 5);
     EncodeOptions options;
     options.quantize_bits = 12;
     options.grid_contexts = true;
@@ -145,7 +135,7 @@ TEST(RankEncoder, RanksWriteTheSerialEncodersQuantizedBytes) {
 
 // Bit-exact chunks in geometry mode 5 (FORMAT.md 5.8): the ranks' file is version 12, as the serial one.
 TEST(RankEncoder, RanksWriteTheSerialEncodersUnitFrameBytes) {
-    const Hierarchy sphere = projected_sphere();
+    const Hierarchy sphere = projected_sphere(20000, 7, 5);
     EncodeOptions options;
     options.predictor = GeometryPredictor::unit_normal_frame;
     const std::vector<uint32_t> counts{7, 6, 7};
