@@ -6,24 +6,41 @@
 // the reconstruction goes on with the true one, so each pick is judged on a correct past.
 // Prints a Markdown table: guided picks, wrong ones of each rule, per level for the second.
 //
-// Usage: import_picks [--move X] corpus/*.amh
+// With --classify, every wrong pick of the kept rule with the leaf-midpoint guide is listed: the
+// true vertex's rank among the candidates, the undo steps of both, whether the pick is a leaf-mesh
+// neighbour of the true vertex, whether it lies on the true chain of the edge, how much finer it
+// is, and how many levels below the pick the reconstruction fails when that pick alone is wrong.
+//
+// Usage: import_picks [--move X] [--classify] corpus/*.amh
 #include "user_leaf_mesh.h"
 
 #include "import/anchored_reconstruction.h"
 #include "import/leaf_halfedges.h"
 #include "import/leaf_reconstruction.h"
 #include "import/position_index.h"
+#include "common/no_index.h"
 
 #include <amc/hierarchy.h>
 
 #include <cstdio>
 #include <cstdlib>
+#include <algorithm>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
 namespace {
+
+struct WrongPick {
+    int level;
+    uint32_t a, b, picked, truth;
+    int truth_rank;  // 1 for the nearest; 0: not among the candidates
+    int picked_step, truth_step;
+    bool adjacent, on_chain;
+    int finer_by;  // the pick's level of creation minus the true vertex's
+};
 
 struct Count {
     long picks = 0, wrong = 0;
@@ -35,11 +52,14 @@ struct Count {
 
 int main(int argc, char** argv) {
     double move = 0.3;
+    bool classify = false;
     std::vector<std::string> files;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         if (arg == "--move" && i + 1 < argc) {
             move = std::atof(argv[++i]);
+        } else if (arg == "--classify") {
+            classify = true;
         } else {
             files.push_back(arg);
         }
@@ -72,6 +92,21 @@ int main(int argc, char** argv) {
                 truth[(uint64_t(b) << 32) | a] = m;
             }
         }
+        // The level at which each vertex was created (0: base).
+        std::vector<int> created(user.positions.size(), 0);
+        for (amc::NodeId n = 0; n < h.node_capacity(); ++n) {
+            if (!h.is_alive(n) || h.is_leaf(n)) continue;
+            for (int e = 0; e < 3; ++e) {
+                int& c = created[user_vertex(h.midpoint(n, e))];
+                c = c == 0 ? h.level(n) + 1 : std::min(c, h.level(n) + 1);
+            }
+        }
+        std::function<bool(uint32_t, uint32_t, uint32_t)> on_chain = [&](uint32_t a, uint32_t b, uint32_t x) {
+            const auto it = truth.find((uint64_t(a) << 32) | b);
+            if (it == truth.end()) return false;
+            return it->second == x || on_chain(a, it->second, x) || on_chain(it->second, b, x);
+        };
+        std::vector<WrongPick> wrong_picks;
         std::vector<uint32_t> leaf_of_base(base_vertices);
         amc::TriangleMesh base;
         base.triangles = h.base().triangles;
@@ -87,6 +122,17 @@ int main(int argc, char** argv) {
             out.reserve(user.triangles.size() * 4 / 3 + base.triangles.size() + 4, user.positions.size());
             return out;
         };
+        auto classify_pick = [&](const amc::GuidedPick& pick, uint32_t truth_vertex) {
+            WrongPick w{pick.level, pick.a, pick.b, pick.picked, truth_vertex, 0, 0, 0, false, false, 0};
+            for (uint32_t i = 0; i < pick.candidate_count; ++i) {
+                if (pick.candidates[i] == truth_vertex) w.truth_rank = int(i) + 1;
+            }
+            w.adjacent = halfedges.face(pick.picked, truth_vertex) != amc::kNoIndex ||
+                         halfedges.face(truth_vertex, pick.picked) != amc::kNoIndex;
+            w.on_chain = on_chain(pick.a, pick.b, pick.picked);
+            w.finer_by = created[pick.picked] - created[truth_vertex];
+            return w;
+        };
         amc::UndoSteps steps;
         {
             amc::Hierarchy anchored = fresh();
@@ -97,14 +143,17 @@ int main(int argc, char** argv) {
             Count counts[2];
             for (int rule = 0; rule < 2; ++rule) {
                 Count& c = counts[rule];
-                const amc::PickReferee referee = [&](int level, uint32_t a, uint32_t b, uint32_t picked) {
-                    const auto it = truth.find((uint64_t(a) << 32) | b);
-                    if (it == truth.end()) return picked;  // an edge the true hierarchy does not split
+                const amc::PickReferee referee = [&](const amc::GuidedPick& pick) {
+                    const auto it = truth.find((uint64_t(pick.a) << 32) | pick.b);
+                    if (it == truth.end()) return pick.picked;  // an edge the true hierarchy does not split
                     ++c.picks;
-                    if (picked != it->second) {
+                    if (pick.picked != it->second) {
                         ++c.wrong;
-                        if (c.wrong_per_level.size() <= size_t(level)) c.wrong_per_level.resize(size_t(level) + 1, 0);
-                        ++c.wrong_per_level[size_t(level)];
+                        const size_t level = size_t(pick.level);
+                        if (c.wrong_per_level.size() <= level) c.wrong_per_level.resize(level + 1, 0);
+                        ++c.wrong_per_level[level];
+                        if (classify && g == 0 && rule == 1)
+                            wrong_picks.push_back(classify_pick(pick, it->second));
                     }
                     return it->second;
                 };
@@ -124,6 +173,34 @@ int main(int argc, char** argv) {
                         counts[1].failed ? " (stopped)" : "", levels.c_str());
             std::fflush(stdout);
         }
+        if (!classify) continue;
+        std::printf("\n| %s: level | truth's rank | undo step: pick, truth | adjacent | on the chain | finer by | "
+                    "fails at level (pick alone wrong) |\n|---:|---:|---|---|---|---:|---|\n",
+                    name.c_str());
+        for (const WrongPick& w : wrong_picks) {
+            int last_level = -1;
+            const amc::PickReferee inject = [&](const amc::GuidedPick& pick) {
+                last_level = std::max(last_level, pick.level);
+                if (pick.a == w.a && pick.b == w.b) return w.picked;
+                const auto it = truth.find((uint64_t(pick.a) << 32) | pick.b);
+                return it == truth.end() ? pick.picked : it->second;
+            };
+            amc::Hierarchy reconstructed = fresh();
+            std::string outcome = "none (final check)";
+            try {
+                amc::reconstruct_hierarchy(reconstructed, leaf_of_base, user, halfedges, guides[0], positions, file,
+                                           &steps, &inject);
+            } catch (const amc::Error& e) {
+                const std::string message = e.what();
+                outcome = "+" + std::to_string(last_level + 1 - w.level) + ": " +
+                          message.substr(file.size() + 2, 60);
+            }
+            auto step_text = [](int s) { return s == amc::kNeverUndone ? std::string("never") : std::to_string(s); };
+            std::printf("| %d | %d | %s, %s | %s | %s | %d | %s |\n", w.level, w.truth_rank,
+                        step_text(steps.step[w.picked]).c_str(), step_text(steps.step[w.truth]).c_str(),
+                        w.adjacent ? "yes" : "no", w.on_chain ? "yes" : "no", w.finer_by, outcome.c_str());
+        }
+        std::fflush(stdout);
     }
     return 0;
 }

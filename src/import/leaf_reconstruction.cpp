@@ -239,14 +239,17 @@ private:
             return fits;
         };
         uint32_t found;
+        uint32_t nearest[kCandidates];
+        uint32_t count = 0;
         if (choice_) {
-            uint32_t nearest[kCandidates];
-            const uint32_t count = nearest_->find_nearest(guide_position(n, e), may_be_midpoint, kCandidates, nearest);
+            count = nearest_->find_nearest(guide_position(n, e), may_be_midpoint, kCandidates, nearest);
             found = choice_->choose(nearest, count, a, b, vertex_of_leaf_);
         } else {
             found = nearest_->find(guide_position(n, e), may_be_midpoint);
+            nearest[0] = found;
+            count = found != kNoIndex;
         }
-        if (referee_ && found != kNoIndex) found = (*referee_)(h_.level(n), a, b, found);
+        if (referee_ && found != kNoIndex) found = (*referee_)(GuidedPick{h_.level(n), a, b, found, nearest, count});
         if (found == kNoIndex) fail("no vertex left to split the edge (" + edge_text(n, e) + ")");
         return found;
     }

@@ -24,10 +24,18 @@ enum class MidpointGuide {
                     // midpoint of the edge's end vertices (meshes projected onto a surface)
 };
 
-// Sees every position-guided pick of the vertex that splits the edge (a, b) of a level's node
-// and returns the vertex to go on with: a bench that knows the true hierarchy counts the wrong
-// picks and goes on with the true vertex (bench/import_picks.cpp).
-using PickReferee = std::function<uint32_t(int level, uint32_t a, uint32_t b, uint32_t picked)>;
+// A position-guided pick of the vertex that splits the edge (a, b) of a node of `level`: the
+// candidates the choice saw (nearest first; only the pick when no choice was made) and the pick.
+struct GuidedPick {
+    int level;
+    uint32_t a, b, picked;
+    const uint32_t* candidates;
+    uint32_t candidate_count;
+};
+
+// Sees every position-guided pick and returns the vertex to go on with: a bench that knows the
+// true hierarchy counts the wrong picks and goes on with the true vertex (bench/import_picks.cpp).
+using PickReferee = std::function<uint32_t(const GuidedPick&)>;
 
 // Builds the forest of `h` (a hierarchy of unrefined roots over the base, whose vertex i is leaf
 // vertex leaf_of_base[i]) so that its leaf mesh is `leaf`; returns the leaf vertex of every
