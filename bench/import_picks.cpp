@@ -1,12 +1,14 @@
 // Position-guided picks against the true hierarchy (docs/IMPORT.md, "Undo steps decide between
-// the nearest"): for every corpus hierarchy, its leaf mesh as a user holds it (as import_corpus
-// makes it), the top-down reconstruction with the base run with each guide twice: picking the
-// nearest candidate (ways 3 and 4 of import_leaf_mesh) and choosing among the nearest by the
-// anchored way's undo steps (way 5). Every pick is compared with the true hierarchy's vertex and
-// the reconstruction goes on with the true one, so each pick is judged on a correct past.
-// Prints a Markdown table: guided picks, wrong ones of each rule, per level for the second.
+// the nearest" and "The children repair the picks"): for every corpus hierarchy, its leaf mesh as
+// a user holds it (as import_corpus makes it), the top-down reconstruction with the base run with
+// each guide three times: picking the nearest candidate (ways 3 and 4 of import_leaf_mesh), then
+// way 5's choice (undo steps and, at the fine levels, the shortest chains), judged when the pick
+// is made and again after the level's repair (as import_leaf_mesh runs it). Every pick is compared
+// with the true hierarchy's vertex and the reconstruction goes on with the true one, so each pick
+// is judged on a correct past. Prints a Markdown table: guided picks, wrong ones of each rule, per
+// level, and how many wrong picks the repair fixed and right ones it broke.
 //
-// With --classify, every wrong pick of the kept rule with the leaf-midpoint guide is listed: the
+// With --classify, every wrong pick of way 5's choice (before the repair) with the leaf-midpoint guide is listed: the
 // true vertex's rank among the candidates, the undo steps of both, whether the pick is a leaf-mesh
 // neighbour of the true vertex, whether it lies on the true chain of the edge, how much finer it
 // is, and how many levels below the pick the reconstruction fails when that pick alone is wrong.
@@ -44,6 +46,7 @@ struct WrongPick {
 
 struct Count {
     long picks = 0, wrong = 0;
+    long fixed = 0, broken = 0;  // by the repair
     std::vector<long> wrong_per_level;
     bool failed = false;  // a misfit no pick explains (the reconstruction threw)
 };
@@ -71,8 +74,9 @@ int main(int argc, char** argv) {
     const amc::MidpointGuide guides[] = {amc::MidpointGuide::leaf_midpoint, amc::MidpointGuide::subdivision,
                                          amc::MidpointGuide::surface};
     const char* guide_names[] = {"leaf midpoint", "subdivision", "surface"};
-    std::printf("| model | guide | guided picks | wrong: the nearest | wrong: undo steps | of them per level 0, 1, ... |\n");
-    std::printf("|---|---|---:|---:|---:|---|\n");
+    std::printf("| model | guide | guided picks | wrong: the nearest | wrong: undo steps and chains | of them per level "
+                "0, 1, ... | wrong after the children's repair | of them per level | repair: fixed / broken |\n");
+    std::printf("|---|---|---:|---:|---:|---|---:|---|---|\n");
     for (const std::string& file : files) {
         const amc::Hierarchy h = amc::read_hierarchy(file);
         const amc::LeafMesh leaf = amc::extract_leaf_mesh(h);
@@ -140,11 +144,20 @@ int main(int argc, char** argv) {
         }
         const std::string name = std::filesystem::path(file).stem().string();
         for (int g = 0; g < 3; ++g) {
-            Count counts[2];
-            for (int rule = 0; rule < 2; ++rule) {
+            Count counts[3];
+            std::unordered_map<uint64_t, uint32_t> first_pick;
+            for (int rule = 0; rule < 3; ++rule) {
                 Count& c = counts[rule];
                 const amc::PickReferee referee = [&](const amc::GuidedPick& pick) {
+                    // Rule 2 judges the picks after the level's repair, the others when made.
                     const auto it = truth.find((uint64_t(pick.a) << 32) | pick.b);
+                    if (rule == 2 && !pick.repaired && it != truth.end()) first_pick[it->first] = pick.picked;
+                    if (rule == 2 && pick.repaired && it != truth.end()) {
+                        const bool was_right = first_pick[it->first] == it->second;
+                        c.fixed += !was_right && pick.picked == it->second;
+                        c.broken += was_right && pick.picked != it->second;
+                    }
+                    if (pick.repaired != (rule == 2)) return pick.picked;
                     if (it == truth.end()) return pick.picked;  // an edge the true hierarchy does not split
                     ++c.picks;
                     if (pick.picked != it->second) {
@@ -160,33 +173,39 @@ int main(int argc, char** argv) {
                 amc::Hierarchy reconstructed = fresh();
                 try {
                     amc::reconstruct_hierarchy(reconstructed, leaf_of_base, user, halfedges, guides[g], positions, file,
-                                               rule == 1 ? &steps : nullptr, &referee);
+                                               rule >= 1 ? &steps : nullptr, &referee);
                 } catch (const amc::Error&) {
                     c.failed = true;
                 }
             }
-            std::string levels;
-            for (size_t l = 0; l < counts[1].wrong_per_level.size(); ++l)
-                levels += (l ? ", " : "") + std::to_string(counts[1].wrong_per_level[l]);
-            std::printf("| %s | %s | %ld | %ld%s | %ld%s | %s |\n", name.c_str(), guide_names[g], counts[0].picks,
-                        counts[0].wrong, counts[0].failed ? " (stopped)" : "", counts[1].wrong,
-                        counts[1].failed ? " (stopped)" : "", levels.c_str());
+            auto levels = [](const Count& c) {
+                std::string text;
+                for (size_t l = 0; l < c.wrong_per_level.size(); ++l)
+                    text += (l ? ", " : "") + std::to_string(c.wrong_per_level[l]);
+                return text;
+            };
+            std::printf("| %s | %s | %ld | %ld%s | %ld%s | %s | %ld%s | %s | %ld / %ld |\n", name.c_str(), guide_names[g],
+                        counts[0].picks, counts[0].wrong, counts[0].failed ? " (stopped)" : "", counts[1].wrong,
+                        counts[1].failed ? " (stopped)" : "", levels(counts[1]).c_str(), counts[2].wrong,
+                        counts[2].failed ? " (stopped)" : "", levels(counts[2]).c_str(), counts[2].fixed,
+                        counts[2].broken);
             std::fflush(stdout);
         }
         if (!classify) continue;
         std::printf("\n| %s: level | truth's rank | undo step: pick, truth | adjacent | on the chain | finer by | "
-                    "fails at level (pick alone wrong) |\n|---:|---:|---|---|---|---:|---|\n",
+                    "fails at level (pick alone wrong, then repaired) |\n|---:|---:|---|---|---|---:|---|\n",
                     name.c_str());
         for (const WrongPick& w : wrong_picks) {
             int last_level = -1;
             const amc::PickReferee inject = [&](const amc::GuidedPick& pick) {
                 last_level = std::max(last_level, pick.level);
+                if (pick.repaired) return pick.picked;  // the repair may take the wrong pick back
                 if (pick.a == w.a && pick.b == w.b) return w.picked;
                 const auto it = truth.find((uint64_t(pick.a) << 32) | pick.b);
                 return it == truth.end() ? pick.picked : it->second;
             };
             amc::Hierarchy reconstructed = fresh();
-            std::string outcome = "none (final check)";
+            std::string outcome = "completes";
             try {
                 amc::reconstruct_hierarchy(reconstructed, leaf_of_base, user, halfedges, guides[0], positions, file,
                                            &steps, &inject);

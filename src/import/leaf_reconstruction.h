@@ -25,16 +25,19 @@ enum class MidpointGuide {
 };
 
 // A position-guided pick of the vertex that splits the edge (a, b) of a node of `level`: the
-// candidates the choice saw (nearest first; only the pick when no choice was made) and the pick.
+// candidates the choice saw (nearest first; only the pick when no choice was made) and the pick;
+// `repaired`: seen again after the level's children have had their say (no candidates then).
 struct GuidedPick {
     int level;
     uint32_t a, b, picked;
     const uint32_t* candidates;
     uint32_t candidate_count;
+    bool repaired;
 };
 
-// Sees every position-guided pick and returns the vertex to go on with: a bench that knows the
-// true hierarchy counts the wrong picks and goes on with the true vertex (bench/import_picks.cpp).
+// Sees every position-guided pick, when it is made and again after the level's repair, and
+// returns the vertex to go on with: a bench that knows the true hierarchy counts the wrong picks
+// and goes on with the true vertex (bench/import_picks.cpp).
 using PickReferee = std::function<uint32_t(const GuidedPick&)>;
 
 // Builds the forest of `h` (a hierarchy of unrefined roots over the base, whose vertex i is leaf

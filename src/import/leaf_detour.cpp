@@ -1,0 +1,38 @@
+#include "import/leaf_detour.h"
+
+namespace amc {
+
+LeafDetour::LeafDetour(const LeafHalfedges& halfedges)
+    : he_(halfedges), hops_a_(halfedges.vertex_count(), -1), hops_b_(halfedges.vertex_count(), -1) {}
+
+// Breadth-first over the leaf mesh from `source`, up to max_hops; clears the previous search.
+void LeafDetour::search(uint32_t source, std::vector<int>& hops, std::vector<uint32_t>& reached, int max_hops) {
+    for (uint32_t x : reached) hops[x] = -1;
+    reached.assign(1, source);
+    hops[source] = 0;
+    for (size_t i = 0; i < reached.size(); ++i) {
+        const uint32_t u = reached[i];
+        if (hops[u] == max_hops) continue;
+        for (uint32_t j = 0, d = he_.degree(u); j < d; ++j) {
+            for (uint32_t x : {he_.out_vertex(u, j), he_.out_apex(u, j)}) {
+                if (hops[x] >= 0) continue;
+                hops[x] = hops[u] + 1;
+                reached.push_back(x);
+            }
+        }
+    }
+}
+
+bool LeafDetour::measure(uint32_t a, uint32_t b, int max_hops) {
+    search(a, hops_a_, reached_a_, max_hops);
+    if (hops_a_[b] < 0) return false;
+    shortest_ = hops_a_[b];
+    search(b, hops_b_, reached_b_, max_hops);
+    return true;
+}
+
+int LeafDetour::detour(uint32_t c) const {
+    return hops_a_[c] < 0 || hops_b_[c] < 0 ? kFar : hops_a_[c] + hops_b_[c] - shortest_;
+}
+
+}  // namespace amc

@@ -1,0 +1,33 @@
+// How far a candidate for the vertex that splits a short edge (a, b) lies off the shortest paths
+// from a to b in the leaf mesh (docs/IMPORT.md, "The chain decides the fine levels"): the true
+// vertex lies on the chain of leaf edges along (a, b), which at the fine levels is a shortest
+// path or one hop longer.
+#pragma once
+
+#include "import/leaf_halfedges.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace amc {
+
+class LeafDetour {
+public:
+    explicit LeafDetour(const LeafHalfedges& halfedges);
+
+    // Measures from a and b, up to max_hops; false when b is farther than that from a.
+    bool measure(uint32_t a, uint32_t b, int max_hops);
+    // hops(a, c) + hops(c, b) - hops(a, b) after measure(a, b, ...), or kFar when c is farther.
+    int detour(uint32_t c) const;
+    static constexpr int kFar = 1 << 20;
+
+private:
+    void search(uint32_t source, std::vector<int>& hops, std::vector<uint32_t>& reached, int max_hops);
+
+    const LeafHalfedges& he_;
+    std::vector<int> hops_a_, hops_b_;  // -1: not reached
+    std::vector<uint32_t> reached_a_, reached_b_;
+    int shortest_ = 0;
+};
+
+}  // namespace amc

@@ -1,0 +1,239 @@
+// The top-down reconstruction of a hierarchy from its leaf mesh (docs/IMPORT.md, section 1), its
+// state shared by the levels (leaf_reconstruction.cpp) and the repair of guided picks that the
+// next level contradicts (pick_repair.cpp). Internal to leaf_reconstruction.h's function.
+#pragma once
+
+#include "common/no_index.h"
+#include "geometry/closest_point.h"
+#include "import/leaf_detour.h"
+#include "import/leaf_reconstruction.h"
+#include "import/nearest_vertex.h"
+
+#include <algorithm>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace amc {
+
+class Reconstruction {
+public:
+    Reconstruction(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base, const TriangleMesh& leaf,
+                   const LeafHalfedges& halfedges, MidpointGuide guide, const PositionIndex& positions,
+                   const std::string& what, const UndoSteps* steps, const PickReferee* referee)
+        : h_(h), leaf_(leaf), he_(halfedges), guide_(guide), positions_(positions), what_(what), referee_(referee) {
+        if (steps) choice_ = std::make_unique<UndoStepChoice>(*steps);
+        leaf_of_vertex_.assign(h.positions().size(), kNoIndex);
+        vertex_of_leaf_.assign(leaf.positions.size(), kNoIndex);
+        for (VertexId v = 0; v < leaf_of_base.size(); ++v) assign(v, leaf_of_base[v]);
+    }
+
+    std::vector<uint32_t> run();
+
+private:
+    struct UnsplitEdge {
+        NodeId node;
+        int edge;
+    };
+    struct Reveal {
+        NodeId node;
+        int edge;
+        uint32_t leaf_vertex;
+    };
+    struct GuidedSlot {
+        NodeId node;
+        int edge;
+    };
+
+    [[noreturn]] void fail(const std::string& message) const { throw Error(what_ + ": " + message); }
+
+    uint32_t corner(NodeId n, int i) const { return leaf_of_vertex_[h_.vertex(n, i)]; }
+
+    std::string edge_text(NodeId n, int e) const {
+        return std::to_string(corner(n, e)) + "," + std::to_string(corner(n, (e + 1) % 3));
+    }
+
+    [[noreturn]] void fail_node(NodeId n, const std::string& message) const {
+        // A base triangle that does not fit points at the base rather than at the leaf mesh.
+        const std::string which = h_.level(n) == 0 ? "the base triangle " + std::to_string(n) + " on vertices ("
+                                                   : "the element on vertices (";
+        fail(which + std::to_string(corner(n, 0)) + ", " + std::to_string(corner(n, 1)) + ", " +
+             std::to_string(corner(n, 2)) + ") " + message + (h_.level(n) == 0 ? " (wrong base?)" : ""));
+    }
+
+    void unassign(VertexId v) {
+        vertex_of_leaf_[leaf_of_vertex_[v]] = kNoIndex;
+        leaf_of_vertex_[v] = kNoIndex;
+    }
+
+    void assign(VertexId v, uint32_t l) {
+        if (l == kNoIndex) fail("internal: no leaf vertex for hierarchy vertex " + std::to_string(v));
+        if (vertex_of_leaf_[l] != kNoIndex)
+            fail("vertex " + std::to_string(l) + " would be used twice by the refinement (not a red-green refinement)");
+        leaf_of_vertex_[v] = l;
+        vertex_of_leaf_[l] = v;
+    }
+
+    // What the leaf mesh says of a node whose corners are the leaf vertices p: refined (no leaf
+    // edge between its corners), or a leaf with its unsplit edges, the hanging nodes they reveal
+    // and its diagonal, or a fault. Reads nothing else, so a pick can be tried and taken back.
+    struct Reading {
+        enum Fault { none, edge_across, not_a_face, two_vertices, no_bisection, no_closure } fault = none;
+        int unsplit_count = 0;
+        bool unsplit[3] = {false, false, false};
+        int reveal_count = 0;
+        int reveal_edge[2] = {0, 0};
+        uint32_t reveal_vertex[2] = {kNoIndex, kNoIndex};
+        bool flipped = false;
+        int fault_edge = 0;
+        uint32_t fault_detail[2] = {kNoIndex, kNoIndex};  // edge_across: the face; two_vertices: both
+        bool refined() const { return fault == none && unsplit_count == 0; }
+    };
+
+    // Whether an unmatched leaf vertex may split edge e of n: the midpoint's leaf neighbours lie
+    // in the children of n and of the element across that touch it, so of the vertices matched
+    // so far, only a, b and those elements' midpoints.
+    class MidpointTest {
+    public:
+        // With `swaps`, a vertex that another guided pick of this level holds passes too.
+        MidpointTest(const Reconstruction& r, NodeId n, int e, bool swaps = false) : r_(r), swaps_(swaps) {
+            const Hierarchy& h = r.h_;
+            allowed_[0] = r.corner(n, e);
+            allowed_[1] = r.corner(n, (e + 1) % 3);
+            const NodeId q = h.neighbor(n, e);
+            for (int k = 0; k < 3; ++k) {
+                allowed_[2 + k] = r.leaf_of_vertex_[h.midpoint(n, k)];
+                allowed_[5 + k] = q != kNoNode && !h.is_leaf(q) ? r.leaf_of_vertex_[h.midpoint(q, k)] : kNoIndex;
+            }
+        }
+        bool operator()(uint32_t v) const {
+            const uint32_t owner = r_.vertex_of_leaf_[v];
+            if (owner != kNoIndex && !(swaps_ && r_.guided(owner))) return false;
+            bool fits = true;
+            r_.for_each_neighbor(v, [&](uint32_t w) {
+                if (r_.vertex_of_leaf_[w] == kNoIndex) return;
+                bool listed = false;
+                for (uint32_t x : allowed_) listed |= x == w;
+                fits &= listed;
+            });
+            return fits;
+        }
+
+    private:
+        const Reconstruction& r_;
+        const bool swaps_;
+        uint32_t allowed_[8];
+    };
+
+    bool guided(VertexId v) const { return v < guided_of_vertex_.size() && guided_of_vertex_[v] != kNoIndex; }
+
+    static void add_once(std::vector<NodeId>& list, NodeId y) {
+        if (y != kNoNode && std::find(list.begin(), list.end(), y) == list.end()) list.push_back(y);
+    }
+
+    // Guided pick v given leaf vertex `to`, the guided pick holding `to` (if any) v's old one.
+    struct Move {
+        VertexId v = kNoIndex;
+        uint32_t from = kNoIndex, to = kNoIndex;
+        int gain = 0;  // misfits removed
+    };
+    void take_back(const Move& m) { make(Move{m.v, m.to, m.from, 0}); }
+
+    // Calls f on every leaf-mesh neighbour of u (some twice).
+    template <class F>
+    void for_each_neighbor(uint32_t u, F f) const {
+        for (uint32_t i = 0, d = he_.degree(u); i < d; ++i) {
+            f(he_.out_vertex(u, i));
+            f(he_.out_apex(u, i));
+        }
+    }
+
+    Reading read(const uint32_t p[3]) const;
+    // Reads a level's nodes (classify) and checks them against each other before anything is
+    // split: balance, T-junctions, hanging nodes. Throws on the first misfit.
+    void read_level(const std::vector<NodeId>& level, std::vector<NodeId>& refined);
+    // read_level; on a misfit, the previous level's guided picks are repaired first and the level
+    // read again (the guided picks are final after this).
+    void read_level_or_repair(const std::vector<NodeId>& level, std::vector<NodeId>& refined);
+    // Decides whether node n (all corners known) is refined. A leaf keeps at least one edge
+    // unsplit (closure), and that edge is then a leaf edge with n on its left; a refined node has
+    // none. For a leaf, checks its red or green triangles and notes the hanging nodes, which are
+    // the midpoints of the refined neighbours' edges.
+    bool classify(NodeId n);
+    // A child whose faces do not fit often means that its parent, split on all three edges, was
+    // closed by green triangles instead of being split red (closure): a leaf edge then joins a
+    // midpoint of the parent to the opposite corner, as bisections and diagonals do.
+    void explain_misfit(NodeId n) const;
+    // The leaf vertex that splits edge e of refined node n, which no green neighbour revealed.
+    uint32_t find_midpoint(NodeId n, int e);
+    // Where a and b are a few hops apart (the fine levels), keeps (in order, at the front) the
+    // candidates with the least detour off the shortest paths from a to b; returns how many.
+    uint32_t on_shortest_chains(uint32_t* candidates, uint32_t count, uint32_t a, uint32_t b);
+    // Where the guide expects the vertex that splits edge e of n: where midpoint subdivision of
+    // the base puts it (the hierarchy's default placer has computed it), or the midpoint of the
+    // edge as the leaf mesh places its ends (which follows projected and moved ends; the surface
+    // guide then projects it onto the mesh).
+    Vec3 guide_position(NodeId n, int e);
+    // When the children along an edge (a, b) keep their halves unsplit, its midpoint is a common
+    // neighbour of a and b, and the only unmatched one: inside the two elements on the edge, a's
+    // leaf edges stay in the corner child at a and b's in the corner child at b, which meet only
+    // at the midpoint. kNoIndex unless exactly one exists (the final check guards the rest).
+    uint32_t only_unmatched_common_neighbor(uint32_t a, uint32_t b);
+    // A guided pick made in this level, which a misfit of the children may take back.
+    void note_guided(VertexId m, NodeId n, int e);
+    // Whether child x of this level's refined nodes reads as the leaf mesh allows, as far as it
+    // and its neighbours tell (what the next level's classify and reveals will check): the
+    // guided picks among the corners of the nodes involved go to `suspects`.
+    bool fits(NodeId x, std::vector<VertexId>* suspects) const;
+    // Takes back guided picks of this level that its children (the next level) contradict:
+    // for a child that does not fit, each guided pick among the corners involved is replaced by
+    // the candidate that leaves the fewest children around it misfitting, if that is fewer.
+    void repair_picks();
+    // The guided picks are final (the next level has read them).
+    void guided_clear();
+    // The referee's answers for the repaired picks, applied together (one may free another's);
+    // whether it changed any.
+    bool referee_after_repair();
+    // The children that the leaf vertex of v can change: those of the two elements on its edge
+    // and the same-level neighbours whose checks read them.
+    void add_around(VertexId v);
+    // Makes the move (v takes `to`; the guided pick holding `to`, if any, takes v's old vertex).
+    void make(const Move& m);
+    // Of the candidates for guided pick v (the nearest eight, also those another guided pick of
+    // this level holds: then the two swap), the one that leaves the fewest children around
+    // misfitting. Swaps undo the picks of neighbouring edges that took each other's vertex
+    // (measured: most wrong picks of the finest levels).
+    Move best_move(VertexId v, NodeId misfit);
+
+    Hierarchy& h_;
+    const TriangleMesh& leaf_;
+    const LeafHalfedges& he_;
+    const MidpointGuide guide_;
+    const PositionIndex& positions_;
+    const std::string& what_;
+    const PickReferee* referee_;
+    // The true vertex is among the four nearest for most wrong nearest picks (docs/IMPORT.md);
+    // more candidates let farther ones, outside the two elements on the edge, win.
+    static constexpr uint32_t kCandidates = 4;
+    // A misfit's repair looks further: the true vertex is among the eight nearest for most wrong
+    // picks (docs/IMPORT.md), and only a candidate that fits the children better replaces a pick.
+    static constexpr uint32_t kRepairCandidates = 8;
+    static constexpr int kRepairPasses = 3;
+    static constexpr int kChainHops = 4;  // "a few hops": the edges of the finest levels
+    std::unique_ptr<LeafDetour> detour_;
+    std::vector<GuidedSlot> guided_;          // the guided picks of the level last split, until the next reads
+    std::vector<uint32_t> guided_of_vertex_;  // per hierarchy vertex: its index in guided_, or kNoIndex
+    std::vector<VertexId> suspects_;          // scratch of repair_picks
+    std::vector<NodeId> around_;              // scratch of best_move
+    std::vector<uint32_t> leaf_of_vertex_;
+    std::vector<uint32_t> vertex_of_leaf_;
+    std::vector<Reveal> reveals_;
+    std::vector<uint32_t> around_b_;  // scratch of only_unmatched_common_neighbor
+    std::vector<UnsplitEdge> unsplit_edges_;
+    std::vector<uint8_t> refined_mark_;  // per node: read refined in the level being read
+    std::unique_ptr<NearestVertex> nearest_;
+    std::unique_ptr<ClosestPointQuery> surface_;
+    std::unique_ptr<UndoStepChoice> choice_;
+};
+
+}  // namespace amc
