@@ -5,8 +5,10 @@
 #include "common/check.h"
 #include "coding/format_version.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 
 namespace amc {
 
@@ -34,6 +36,18 @@ void encode_adaptive(const Hierarchy& h, const NewVertices& created, GeometryPre
         positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)), predict(h, predictor, n, e));
 }
 
+// The bytes `predictor` codes the level's positions in (from the models in `positions`), or
+// SIZE_MAX once the code so far passes `limit` bytes: a finished code is never shorter.
+size_t adaptive_bytes(const Hierarchy& h, const NewVertices& created, GeometryPredictor predictor, PositionCoder positions,
+                      size_t limit) {
+    ArithmeticEncoder encoder;
+    for (auto [n, e] : created) {
+        positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)), predict(h, predictor, n, e));
+        if (encoder.bytes_so_far() > limit) return SIZE_MAX;
+    }
+    return encoder.finish().size();
+}
+
 }  // namespace
 
 LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& created, const PositionCoder& positions,
@@ -48,35 +62,38 @@ LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& c
     else if (is_static_mode(code.predictor))
         code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space, code.predictor);
     if (!automatic || created.empty()) return code;
-    size_t best = SIZE_MAX;
-    for (GeometryPredictor candidate : {GeometryPredictor::midpoint, GeometryPredictor::butterfly}) {
-        PositionCoder trial = positions;
-        ArithmeticEncoder encoder;
-        encode_adaptive(h, created, candidate, trial, encoder);
-        const size_t size = encoder.finish().size();
-        if (size < best) {
-            best = size;
-            code.predictor = candidate;
-        }
+    // The first of the smallest in the order midpoint, butterfly, normal frame, grid, unit frame.
+    // The static modes' sizes come first, so that an adaptive trial stops as soon as its code so
+    // far shows it can not be that (the choice is the same as with every trial run to its end).
+    std::unique_ptr<StaticLevelEncoder> grid, unit;
+    if (grid_contexts && space.quantizer != nullptr)
+        grid = std::make_unique<StaticLevelEncoder>(h, created, space, GeometryPredictor::normal_frame_grid);
+    if (unit_normals && space.quantizer == nullptr)
+        unit = std::make_unique<StaticLevelEncoder>(h, created, space, GeometryPredictor::unit_normal_frame);
+    size_t best_static = code.static_code->estimated_bytes();
+    if (grid != nullptr) best_static = std::min(best_static, grid->estimated_bytes());
+    if (unit != nullptr) best_static = std::min(best_static, unit->estimated_bytes());
+    const size_t midpoint = adaptive_bytes(h, created, GeometryPredictor::midpoint, positions, best_static);
+    // The butterfly must be smaller than the midpoint, and no larger than a static mode.
+    const size_t butterfly_limit = midpoint == SIZE_MAX ? best_static : std::min(midpoint - 1, best_static);
+    const size_t butterfly = adaptive_bytes(h, created, GeometryPredictor::butterfly, positions, butterfly_limit);
+    size_t best = midpoint;
+    if (butterfly < best) {
+        best = butterfly;
+        code.predictor = GeometryPredictor::butterfly;
     }
     if (code.static_code->estimated_bytes() < best) {
         best = code.static_code->estimated_bytes();
         code.predictor = GeometryPredictor::normal_frame;
     }
-    if (grid_contexts && space.quantizer != nullptr) {
-        auto grid = std::make_unique<StaticLevelEncoder>(h, created, space, GeometryPredictor::normal_frame_grid);
-        if (grid->estimated_bytes() < best) {
-            best = grid->estimated_bytes();
-            code.predictor = GeometryPredictor::normal_frame_grid;
-            code.static_code = std::move(grid);
-        }
+    if (grid != nullptr && grid->estimated_bytes() < best) {
+        best = grid->estimated_bytes();
+        code.predictor = GeometryPredictor::normal_frame_grid;
+        code.static_code = std::move(grid);
     }
-    if (unit_normals && space.quantizer == nullptr) {
-        auto unit = std::make_unique<StaticLevelEncoder>(h, created, space, GeometryPredictor::unit_normal_frame);
-        if (unit->estimated_bytes() < best) {
-            code.predictor = GeometryPredictor::unit_normal_frame;
-            code.static_code = std::move(unit);
-        }
+    if (unit != nullptr && unit->estimated_bytes() < best) {
+        code.predictor = GeometryPredictor::unit_normal_frame;
+        code.static_code = std::move(unit);
     }
     return code;
 }
