@@ -5,6 +5,7 @@
 #include "common/bits.h"
 #include "common/exact_float.h"
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <cstring>
@@ -91,6 +92,21 @@ void decode_residual(ArithmeticDecoder& decoder, FloatResidualModels& models,
     }
 }
 
+// encode_residual's raw bits: those below the leading one and the two modelled after it.
+int raw_bit_count(uint64_t magnitude) { return std::max(0, bit_length(magnitude) - 3); }
+
+// A coordinate's residual: the ordered bits' difference as sign and magnitude.
+struct CoordinateResidual {
+    bool negative;
+    uint64_t magnitude;
+};
+CoordinateResidual coordinate_residual(Precision precision, double actual, double predicted) {
+    const uint64_t mask = width_mask(precision);
+    const uint64_t r = (ordered_bits(actual, precision) - ordered_bits(coder_prediction(predicted, precision), precision)) & mask;
+    const bool negative = (r & (uint64_t{1} << (width_bits(precision) - 1))) != 0;
+    return {negative, negative ? ((uint64_t{0} - r) & mask) : r};
+}
+
 void check_bits(int bits, const char* where) {
     if (bits < kMinQuantizationBits || bits > kMaxQuantizationBits) {
         throw Error(std::string(where) + ": quantization bits " + std::to_string(bits) +
@@ -140,14 +156,8 @@ void encode_coordinate(ArithmeticEncoder& encoder, FloatResidualModels& models, 
                         " is not a single precision value");
         }
     }
-    const uint64_t mask = width_mask(precision);
-    const uint64_t a = ordered_bits(actual, precision);
-    const uint64_t p = ordered_bits(coder_prediction(predicted, precision), precision);
-    const uint64_t r = (a - p) & mask;
-    const uint64_t top = uint64_t{1} << (width_bits(precision) - 1);
-    const bool negative = (r & top) != 0;
-    const uint64_t magnitude = negative ? ((uint64_t{0} - r) & mask) : r;
-    encode_residual(encoder, ctx, tree_depth(precision), negative, magnitude);
+    const CoordinateResidual r = coordinate_residual(precision, actual, predicted);
+    encode_residual(encoder, ctx, tree_depth(precision), r.negative, r.magnitude);
 }
 
 double decode_coordinate(ArithmeticDecoder& decoder, FloatResidualModels& models, int context,
@@ -168,6 +178,12 @@ void encode_position(ArithmeticEncoder& encoder, FloatResidualModels& models, in
     encode_coordinate(encoder, models, first_context + 0, precision, actual.x, predicted.x);
     encode_coordinate(encoder, models, first_context + 1, precision, actual.y, predicted.y);
     encode_coordinate(encoder, models, first_context + 2, precision, actual.z, predicted.z);
+}
+
+uint64_t position_raw_bits(Precision precision, Vec3 actual, Vec3 predicted) {
+    return uint64_t(raw_bit_count(coordinate_residual(precision, actual.x, predicted.x).magnitude)) +
+           uint64_t(raw_bit_count(coordinate_residual(precision, actual.y, predicted.y).magnitude)) +
+           uint64_t(raw_bit_count(coordinate_residual(precision, actual.z, predicted.z).magnitude));
 }
 
 Vec3 decode_position(ArithmeticDecoder& decoder, FloatResidualModels& models, int first_context,
@@ -256,6 +272,10 @@ void encode_quantized(ArithmeticEncoder& encoder, FloatResidualModels& models, i
     const bool negative = actual < predicted;
     const uint64_t magnitude = negative ? predicted - actual : actual - predicted;
     encode_residual(encoder, ctx, kQuantizedTreeDepth, negative, magnitude);
+}
+
+int quantized_raw_bits(uint32_t actual, uint32_t predicted) {
+    return raw_bit_count(actual < predicted ? predicted - actual : actual - predicted);
 }
 
 uint32_t decode_quantized(ArithmeticDecoder& decoder, FloatResidualModels& models, int context,

@@ -139,6 +139,10 @@ void encode_position(ArithmeticEncoder& encoder, FloatResidualModels& models, in
 Vec3 decode_position(ArithmeticDecoder& decoder, FloatResidualModels& models, int first_context,
                      Precision precision, Vec3 predicted);
 
+// The bits encode_position codes at probability 1/2 (below the two modelled bits under each
+// residual's leading one): a code of them takes at least this many bits, whatever its models.
+uint64_t position_raw_bits(Precision precision, Vec3 actual, Vec3 predicted);
+
 // The residual layout above for any sign and magnitude of up to 64 bits, with the 7-level
 // bit-length tree: the building block of the series file's field coder (docs/FORMAT.md, series
 // section), which codes integer differences and ordered-bit differences with it. The decoder
@@ -219,5 +223,7 @@ void encode_quantized(ArithmeticEncoder& encoder, FloatResidualModels& models, i
                       int bits, uint32_t actual, uint32_t predicted);
 uint32_t decode_quantized(ArithmeticDecoder& decoder, FloatResidualModels& models, int context,
                           int bits, uint32_t predicted);
+// The bits encode_quantized codes at probability 1/2 (as position_raw_bits).
+int quantized_raw_bits(uint32_t actual, uint32_t predicted);
 
 }  // namespace amc

@@ -37,13 +37,25 @@ void encode_adaptive(const Hierarchy& h, const NewVertices& created, GeometryPre
 }
 
 // The bytes `predictor` codes the level's positions in (from the models in `positions`), or
-// SIZE_MAX once the code so far passes `limit` bytes: a finished code is never shorter.
+// SIZE_MAX once they are known to pass `limit` bytes. Bounds: an arithmetic code of R bits at
+// probability 1/2 takes more than R / 8 - 5 bytes (its interval shrinks by 2^-R and grows 256-fold
+// a byte, and finish() drops at most 4 zero bytes); a finished code is never much shorter than
+// the bytes it committed on the way (8 bytes of margin).
 size_t adaptive_bytes(const Hierarchy& h, const NewVertices& created, GeometryPredictor predictor, PositionCoder positions,
                       size_t limit) {
+    std::vector<Vec3> predicted(created.size());
+    uint64_t raw_bits = 0;
+    for (size_t i = 0; i < created.size(); ++i) {
+        const auto [n, e] = created[i];
+        predicted[i] = predict(h, predictor, n, e);
+        raw_bits += positions.raw_bits(h.position(h.midpoint(n, e)), predicted[i]);
+    }
+    if (raw_bits / 8 > limit + 6) return SIZE_MAX;
     ArithmeticEncoder encoder;
-    for (auto [n, e] : created) {
-        positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)), predict(h, predictor, n, e));
-        if (encoder.bytes_so_far() > limit) return SIZE_MAX;
+    for (size_t i = 0; i < created.size(); ++i) {
+        const auto [n, e] = created[i];
+        positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)), predicted[i]);
+        if (encoder.bytes_so_far() > limit + 8) return SIZE_MAX;
     }
     return encoder.finish().size();
 }

@@ -38,6 +38,14 @@ public:
         return dequantize(quantizer_, a);
     }
     bool saw_invalid_symbol() const { return models_.saw_invalid_symbol(); }
+    // The bits encode() codes at probability 1/2: a lower bound of its code, whatever the models.
+    uint64_t raw_bits(Vec3 actual, Vec3 predicted) const {
+        if (!quantized_) return position_raw_bits(precision_, actual, predicted);
+        const GridPoint a = quantize(quantizer_, actual), p = quantize(quantizer_, predicted);
+        uint64_t bits = 0;
+        for (int axis = 0; axis < 3; ++axis) bits += uint64_t(quantized_raw_bits(a[axis], p[axis]));
+        return bits;
+    }
 
 private:
     Precision precision_;
