@@ -79,6 +79,7 @@ public:
     // Queues one symbol (it must have a nonzero frequency in `table`, which must outlive finish()).
     void put(const RansTable& table, int symbol) { queue_.push_back({table.start(symbol), table.frequency(symbol)}); }
     size_t symbols() const { return queue_.size(); }
+    void reserve(size_t symbols) { queue_.reserve(symbols); }
     // Codes the queued symbols; the encoder is empty again afterwards.
     std::vector<uint8_t> finish();
 

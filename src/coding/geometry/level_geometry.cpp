@@ -41,11 +41,12 @@ void encode_adaptive(const Hierarchy& h, const NewVertices& created, GeometryPre
 // probability 1/2 takes more than R / 8 - 5 bytes (its interval shrinks by 2^-R and grows 256-fold
 // a byte, and finish() drops at most 4 zero bytes); a finished code is never much shorter than
 // the bytes it committed on the way (8 bytes of margin).
+// Only bit-exact coordinates have raw bits enough to be worth the pass that counts them.
 size_t adaptive_bytes(const Hierarchy& h, const NewVertices& created, GeometryPredictor predictor, PositionCoder positions,
-                      size_t limit) {
-    std::vector<Vec3> predicted(created.size());
+                      size_t limit, bool count_raw_bits) {
+    std::vector<Vec3> predicted(count_raw_bits ? created.size() : 0);
     uint64_t raw_bits = 0;
-    for (size_t i = 0; i < created.size(); ++i) {
+    for (size_t i = 0; i < predicted.size(); ++i) {
         const auto [n, e] = created[i];
         predicted[i] = predict(h, predictor, n, e);
         raw_bits += positions.raw_bits(h.position(h.midpoint(n, e)), predicted[i]);
@@ -54,7 +55,8 @@ size_t adaptive_bytes(const Hierarchy& h, const NewVertices& created, GeometryPr
     ArithmeticEncoder encoder;
     for (size_t i = 0; i < created.size(); ++i) {
         const auto [n, e] = created[i];
-        positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)), predicted[i]);
+        positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)),
+                         count_raw_bits ? predicted[i] : predict(h, predictor, n, e));
         if (encoder.bytes_so_far() > limit + 8) return SIZE_MAX;
     }
     return encoder.finish().size();
@@ -85,10 +87,11 @@ LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& c
     size_t best_static = code.static_code->estimated_bytes();
     if (grid != nullptr) best_static = std::min(best_static, grid->estimated_bytes());
     if (unit != nullptr) best_static = std::min(best_static, unit->estimated_bytes());
-    const size_t midpoint = adaptive_bytes(h, created, GeometryPredictor::midpoint, positions, best_static);
+    const bool count_raw_bits = space.quantizer == nullptr;
+    const size_t midpoint = adaptive_bytes(h, created, GeometryPredictor::midpoint, positions, best_static, count_raw_bits);
     // The butterfly must be smaller than the midpoint, and no larger than a static mode.
     const size_t butterfly_limit = midpoint == SIZE_MAX ? best_static : std::min(midpoint - 1, best_static);
-    const size_t butterfly = adaptive_bytes(h, created, GeometryPredictor::butterfly, positions, butterfly_limit);
+    const size_t butterfly = adaptive_bytes(h, created, GeometryPredictor::butterfly, positions, butterfly_limit, count_raw_bits);
     size_t best = midpoint;
     if (butterfly < best) {
         best = butterfly;

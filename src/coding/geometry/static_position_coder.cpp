@@ -261,6 +261,7 @@ StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std
         tables_[size_t(i)] = RansTable::from_counts(c);
     }
     RansEncoder rans;
+    rans.reserve(kStaticRoles * tokens.size());
     RawBitWriter raw;
     for (size_t i = 0; i < tokens.size(); ++i) {
         for (int role = 0; role < kStaticRoles; ++role) {
