@@ -18,6 +18,7 @@
 #include "hierarchy/writer_checks.h"
 
 #include <algorithm>
+#include <cstddef>
 #include <memory>
 #include <string>
 
@@ -26,13 +27,18 @@ namespace amc {
 namespace {
 
 // The live vertices' positions in id order (the order fixes which of two equal-valued zeros
-// std::fmin keeps in the grid's origin, so it stays as files were written).
+// std::fmin keeps in the grid's origin, so it stays as files were written). Live: the base's
+// vertices and the midpoints of the refined live nodes.
 std::vector<Vec3> live_positions(const Hierarchy& h) {
+    std::vector<uint8_t> live(h.positions().size(), 0);
+    std::fill(live.begin(), live.begin() + std::ptrdiff_t(h.base().positions.size()), uint8_t{1});
+    for (NodeId n = 0; n < h.node_capacity(); ++n)
+        if (h.is_alive(n) && !h.is_leaf(n))
+            for (int e = 0; e < 3; ++e) live[h.midpoint(n, e)] = 1;
     std::vector<Vec3> points;
-    const std::vector<uint32_t> canonical = canonical_vertex_order(h);
-    for (size_t v = 0; v < canonical.size(); ++v) {
-        if (canonical[v] != kNoVertex) points.push_back(h.position(VertexId(v)));
-    }
+    points.reserve(h.vertex_count());
+    for (size_t v = 0; v < live.size(); ++v)
+        if (live[v] != 0) points.push_back(h.position(VertexId(v)));
     return points;
 }
 
