@@ -72,21 +72,35 @@ LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& c
     if (code.predictor == GeometryPredictor::normal_frame_grid && space.quantizer == nullptr)
         throw Error("geometry mode 4 (normal_frame_grid) needs quantized coordinates");
     if (automatic && !created.empty())
-        code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space);
+        code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space, GeometryPredictor::normal_frame, false);
     else if (is_static_mode(code.predictor))
         code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space, code.predictor);
     if (!automatic || created.empty()) return code;
-    // The first of the smallest in the order midpoint, butterfly, normal frame, grid, unit frame.
-    // The static modes' sizes come first, so that an adaptive trial stops as soon as its code so
-    // far shows it can not be that (the choice is the same as with every trial run to its end).
+    // The first of the smallest in the order midpoint, butterfly, normal frame, grid, unit frame,
+    // as if every mode were coded to its end. The static modes come first, each coded only when its
+    // lower bound leaves it a chance (smallest bound first), so that an adaptive trial stops as soon
+    // as its code so far shows it can not be the smallest.
     std::unique_ptr<StaticLevelEncoder> grid, unit;
     if (grid_contexts && space.quantizer != nullptr)
-        grid = std::make_unique<StaticLevelEncoder>(h, created, space, GeometryPredictor::normal_frame_grid);
+        grid = std::make_unique<StaticLevelEncoder>(h, created, space, GeometryPredictor::normal_frame_grid, false);
     if (unit_normals && space.quantizer == nullptr)
-        unit = std::make_unique<StaticLevelEncoder>(h, created, space, GeometryPredictor::unit_normal_frame);
-    size_t best_static = code.static_code->estimated_bytes();
-    if (grid != nullptr) best_static = std::min(best_static, grid->estimated_bytes());
-    if (unit != nullptr) best_static = std::min(best_static, unit->estimated_bytes());
+        unit = std::make_unique<StaticLevelEncoder>(h, created, space, GeometryPredictor::unit_normal_frame, false);
+    StaticLevelEncoder* statics[] = {code.static_code.get(), grid.get(), unit.get()};  // in the order of the choice
+    size_t static_size[] = {SIZE_MAX, SIZE_MAX, SIZE_MAX}, bound[] = {SIZE_MAX, SIZE_MAX, SIZE_MAX};
+    for (int i = 0; i < 3; ++i)
+        if (statics[i] != nullptr) bound[i] = statics[i]->lower_bound_bytes();
+    size_t best_static = SIZE_MAX;
+    for (int tries = 0; tries < 3; ++tries) {
+        int next = -1;  // the untried mode of smallest bound
+        for (int i = 0; i < 3; ++i)
+            if (statics[i] != nullptr && static_size[i] == SIZE_MAX && bound[i] != SIZE_MAX && (next < 0 || bound[i] < bound[next]))
+                next = i;
+        if (next < 0 || bound[next] > best_static) break;  // larger than a size known: never the smallest
+        statics[next]->code_streams();
+        static_size[next] = statics[next]->estimated_bytes();
+        best_static = std::min(best_static, static_size[next]);
+        bound[next] = SIZE_MAX;
+    }
     const bool count_raw_bits = space.quantizer == nullptr;
     const size_t midpoint = adaptive_bytes(h, created, GeometryPredictor::midpoint, positions, best_static, count_raw_bits);
     // The butterfly must be smaller than the midpoint, and no larger than a static mode.
@@ -97,16 +111,16 @@ LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& c
         best = butterfly;
         code.predictor = GeometryPredictor::butterfly;
     }
-    if (code.static_code->estimated_bytes() < best) {
-        best = code.static_code->estimated_bytes();
+    if (static_size[0] < best) {
+        best = static_size[0];
         code.predictor = GeometryPredictor::normal_frame;
     }
-    if (grid != nullptr && grid->estimated_bytes() < best) {
-        best = grid->estimated_bytes();
+    if (static_size[1] < best) {
+        best = static_size[1];
         code.predictor = GeometryPredictor::normal_frame_grid;
         code.static_code = std::move(grid);
     }
-    if (unit != nullptr && unit->estimated_bytes() < best) {
+    if (static_size[2] < best) {
         code.predictor = GeometryPredictor::unit_normal_frame;
         code.static_code = std::move(unit);
     }

@@ -40,10 +40,7 @@ std::array<int, 3> role_axes(const NormalFrame& f) {
     return kByAxis[f.has_normal ? size_t(f.axis) : 0];
 }
 
-struct Residual {
-    bool negative;
-    uint64_t magnitude;
-};
+using Residual = StaticResidual;
 
 // ---- one coordinate: residual against a prediction, and back -----------------------------------
 
@@ -217,16 +214,14 @@ int static_token(bool negative, uint64_t magnitude) {
 int static_raw_bit_count(uint64_t magnitude) { return magnitude < 8 ? 0 : 1 + bit_length(magnitude) - 3; }
 
 StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created,
-                                       CoordinateSpace space, GeometryPredictor mode)
+                                       CoordinateSpace space, GeometryPredictor mode, bool streams)
     : table_count_(static_table_count(mode)) {
     if (!is_static_mode(mode)) throw Error("StaticLevelEncoder: geometry mode " + std::to_string(int(mode)) + " is not a static mode");
     const bool grid_bins = has_grid_bins(mode);
     if (grid_bins && space.quantizer == nullptr) throw Error("geometry mode 4 needs quantized coordinates");
-    std::vector<std::array<int, kStaticRoles>> tokens, table_of;
-    std::vector<std::array<Residual, kStaticRoles>> residuals;
-    tokens.reserve(created.size());
-    table_of.reserve(created.size());
-    residuals.reserve(created.size());
+    tokens_.reserve(created.size());
+    table_of_.reserve(created.size());
+    residuals_.reserve(created.size());
     std::array<std::vector<uint64_t>, kMaxStaticTables> counts;
     for (auto [n, e] : created) {
         const NormalFrame frame = normal_frame(h, n, e, has_unit_normals(mode));
@@ -247,30 +242,46 @@ StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std
                 table[size_t(role)] = role;
             }
             t[size_t(role)] = static_token(r[size_t(role)].negative, r[size_t(role)].magnitude);
+            raw_bits_ += uint64_t(static_raw_bit_count(r[size_t(role)].magnitude));
             std::vector<uint64_t>& c = counts[size_t(table[size_t(role)])];
             if (c.size() <= size_t(t[size_t(role)])) c.resize(size_t(t[size_t(role)]) + 1, 0);
             ++c[size_t(t[size_t(role)])];
         }
-        tokens.push_back(t);
-        table_of.push_back(table);
-        residuals.push_back(r);
+        tokens_.push_back(t);
+        table_of_.push_back(table);
+        residuals_.push_back(r);
     }
     for (int i = 0; i < table_count_; ++i) {
         std::vector<uint64_t>& c = counts[size_t(i)];
-        if (c.empty()) c.push_back(1);
+        const bool used = !c.empty();
+        if (!used) c.push_back(1);  // a table no token uses still needs a symbol
         tables_[size_t(i)] = RansTable::from_counts(c);
+        for (size_t t = 0; used && t < c.size(); ++t) {
+            if (c[t] == 0) continue;
+            token_bits_ += double(c[t]) * tables_[size_t(i)].cost_bits(int(t));
+            token_count_ += c[t];
+        }
     }
+    if (streams) code_streams();
+}
+
+void StaticLevelEncoder::code_streams() {
+    if (coded_) return;
     RansEncoder rans;
-    rans.reserve(kStaticRoles * tokens.size());
+    rans.reserve(kStaticRoles * tokens_.size());
     RawBitWriter raw;
-    for (size_t i = 0; i < tokens.size(); ++i) {
+    for (size_t i = 0; i < tokens_.size(); ++i) {
         for (int role = 0; role < kStaticRoles; ++role) {
-            rans.put(tables_[size_t(table_of[i][size_t(role)])], tokens[i][size_t(role)]);
-            put_raw(raw, residuals[i][size_t(role)]);
+            rans.put(tables_[size_t(table_of_[i][size_t(role)])], tokens_[i][size_t(role)]);
+            put_raw(raw, residuals_[i][size_t(role)]);
         }
     }
     rans_ = rans.finish();
     raw_ = raw.finish();
+    tokens_ = {};
+    table_of_ = {};
+    residuals_ = {};
+    coded_ = true;
 }
 
 void StaticLevelEncoder::write_tables(ArithmeticEncoder& encoder) const {
@@ -279,11 +290,25 @@ void StaticLevelEncoder::write_tables(ArithmeticEncoder& encoder) const {
 }
 
 size_t StaticLevelEncoder::estimated_bytes() const {
+    if (!coded_) throw Error("StaticLevelEncoder::estimated_bytes: the streams are not coded yet (code_streams)");
     ArithmeticEncoder tables;
     write_tables(tables);
     size_t varint = 1;
     for (size_t n = rans_.size(); n >= 128; n >>= 7) ++varint;
     return tables.finish().size() + varint + rans_.size() + raw_.size();
+}
+
+// The rANS stream's bound. Each of its two states starts at L = 2^23 and ends below 256 L; coding
+// a symbol of frequency f multiplies x by at least (M / f)(1 - 2^-11) (x / f >= 2^11 there), and
+// a byte written divides it by at most 256 / (1 - 2^-11) (x >= 2^19 then). So with H the bits
+// sum of log2(M / f) over its N symbols, the K bytes written satisfy 8 K >= H - 16 - 0.001 (N + K),
+// and the stream is K + 8 bytes.
+size_t StaticLevelEncoder::lower_bound_bytes() const {
+    ArithmeticEncoder tables;
+    write_tables(tables);
+    const double rans_bits = token_bits_ - 16 - 0.001 * double(token_count_);
+    const size_t rans = kRansStateBytes + (rans_bits > 0 ? size_t(rans_bits / 8.01) : 0);
+    return tables.finish().size() + 1 + rans + size_t(raw_bits_ / 8);
 }
 
 bool read_static_tables(ArithmeticDecoder& decoder, CoordinateSpace space, GeometryPredictor mode, StaticTables& tables) {

@@ -60,22 +60,41 @@ constexpr int static_table_count(GeometryPredictor mode) { return has_grid_bins(
 int static_token(bool negative, uint64_t magnitude);
 int static_raw_bit_count(uint64_t magnitude);
 
+// A residual of the static modes as sign and magnitude.
+struct StaticResidual {
+    bool negative;
+    uint64_t magnitude;
+};
+
 class StaticLevelEncoder {
 public:
     // mode: a static mode (is_static_mode); mode 4 needs a quantized space. Throws Error otherwise.
+    // With `streams` false only the tokens and tables are made, until code_streams(): an encoder
+    // weighing modes asks lower_bound_bytes() first.
     StaticLevelEncoder(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
-                       GeometryPredictor mode = GeometryPredictor::normal_frame);
+                       GeometryPredictor mode = GeometryPredictor::normal_frame, bool streams = true);
+    // Codes the rANS and raw streams (once).
+    void code_streams();
     // The tables (three, or six in mode 4), into the level's arithmetic payload after the hierarchy part.
     void write_tables(ArithmeticEncoder& encoder) const;
     const std::vector<uint8_t>& rans_bytes() const { return rans_; }
     const std::vector<uint8_t>& raw_bytes() const { return raw_; }
     // The bytes this mode costs the level's positions: tables (coded alone), both streams and the
-    // varint of the rANS length.
+    // varint of the rANS length. Needs the streams.
     size_t estimated_bytes() const;
+    // At most estimated_bytes(), known before the streams: the tables, the raw bits and the rANS
+    // stream's entropy under its tables (the bound's derivation is in the .cpp).
+    size_t lower_bound_bytes() const;
 
 private:
     StaticTables tables_;
     int table_count_ = kStaticRoles;
+    double token_bits_ = 0;  // the tokens' cost under the tables, sum of log2(M / f)
+    uint64_t token_count_ = 0;
+    std::vector<std::array<int, kStaticRoles>> tokens_, table_of_;  // until the streams are coded
+    std::vector<std::array<StaticResidual, kStaticRoles>> residuals_;
+    uint64_t raw_bits_ = 0;
+    bool coded_ = false;
     std::vector<uint8_t> rans_, raw_;
 };
 
