@@ -8,7 +8,7 @@
 // is judged on a correct past. Prints a Markdown table: guided picks, wrong ones of each rule, per
 // level, and how many wrong picks the repair fixed and right ones it broke.
 //
-// With --classify, every wrong pick of way 5's choice (before the repair) with the leaf-midpoint guide is listed: the
+// With --classify, every wrong pick of way 5's choice (when made, and after the repair) with the leaf-midpoint guide is listed: the
 // true vertex's rank among the candidates, the undo steps of both, whether the pick is a leaf-mesh
 // neighbour of the true vertex, whether it lies on the true chain of the edge, how much finer it
 // is, and how many levels below the pick the reconstruction fails when that pick alone is wrong.
@@ -39,9 +39,10 @@ struct WrongPick {
     int level;
     uint32_t a, b, picked, truth;
     int truth_rank;  // 1 for the nearest; 0: not among the candidates
-    int picked_step, truth_step;
     bool adjacent, on_chain;
     int finer_by;  // the pick's level of creation minus the true vertex's
+    bool after_repair = false;     // judged after the level's repair (else when made)
+    bool right_when_made = false;  // after_repair: the repair broke it
 };
 
 struct Count {
@@ -127,7 +128,7 @@ int main(int argc, char** argv) {
             return out;
         };
         auto classify_pick = [&](const amc::GuidedPick& pick, uint32_t truth_vertex) {
-            WrongPick w{pick.level, pick.a, pick.b, pick.picked, truth_vertex, 0, 0, 0, false, false, 0};
+            WrongPick w{pick.level, pick.a, pick.b, pick.picked, truth_vertex, 0, false, false, 0};
             for (uint32_t i = 0; i < pick.candidate_count; ++i) {
                 if (pick.candidates[i] == truth_vertex) w.truth_rank = int(i) + 1;
             }
@@ -165,8 +166,12 @@ int main(int argc, char** argv) {
                         const size_t level = size_t(pick.level);
                         if (c.wrong_per_level.size() <= level) c.wrong_per_level.resize(level + 1, 0);
                         ++c.wrong_per_level[level];
-                        if (classify && g == 0 && rule == 1)
-                            wrong_picks.push_back(classify_pick(pick, it->second));
+                        if (classify && g == 0 && rule >= 1) {
+                            WrongPick w = classify_pick(pick, it->second);
+                            w.after_repair = rule == 2;
+                            w.right_when_made = rule == 2 && first_pick[it->first] == it->second;
+                            wrong_picks.push_back(w);
+                        }
                     }
                     return it->second;
                 };
@@ -192,8 +197,8 @@ int main(int argc, char** argv) {
             std::fflush(stdout);
         }
         if (!classify) continue;
-        std::printf("\n| %s: level | truth's rank | undo step: pick, truth | adjacent | on the chain | finer by | "
-                    "fails at level (pick alone wrong, then repaired) |\n|---:|---:|---|---|---|---:|---|\n",
+        std::printf("\n| %s: judged | level | truth's rank | undo step: pick, truth | adjacent | on the chain | finer by | "
+                    "fails at level (pick alone wrong, then repaired) |\n|---|---:|---:|---|---|---|---:|---|\n",
                     name.c_str());
         for (const WrongPick& w : wrong_picks) {
             int last_level = -1;
@@ -215,7 +220,9 @@ int main(int argc, char** argv) {
                           message.substr(file.size() + 2, 60);
             }
             auto step_text = [](int s) { return s == amc::kNeverUndone ? std::string("never") : std::to_string(s); };
-            std::printf("| %d | %d | %s, %s | %s | %s | %d | %s |\n", w.level, w.truth_rank,
+            const char* judged = !w.after_repair ? "when made" : w.right_when_made ? "after repair (broken)" : "after repair";
+            std::printf("| %s | %d | %s | %s, %s | %s | %s | %d | %s |\n", judged, w.level,
+                        w.after_repair ? "-" : std::to_string(w.truth_rank).c_str(),
                         step_text(steps.step[w.picked]).c_str(), step_text(steps.step[w.truth]).c_str(),
                         w.adjacent ? "yes" : "no", w.on_chain ? "yes" : "no", w.finer_by, outcome.c_str());
         }
