@@ -216,6 +216,19 @@ void round_trip_seeds() {
     }
 }
 
+// Every combination of the flags (moved, anywhere, index map, leaf mesh alone, damaged, shuffled)
+// over random refinements of every stream base.
+void leaf_import_seeds() {
+    fuzz::Random random{11};
+    for (int k = 0; k < 64; ++k) {
+        std::vector<uint8_t> seed(64 + random.next() % 1500);
+        for (uint8_t& b : seed) b = uint8_t(random.next());
+        seed[0] = uint8_t(k);
+        seed[1] = uint8_t(k % fuzz::stream_bases().size());
+        write_seed("leaf_import", seed);
+    }
+}
+
 // Small series of the heat run: keyframes or not, lossless or bounded fields, a base in single
 // precision, an unfinished file (no END block), one without fields.
 void series_seeds() {
@@ -310,6 +323,7 @@ int main(int argc, char** argv) {
     geometry_seeds();
     mesh_seeds(hierarchies);
     round_trip_seeds();
+    leaf_import_seeds();
     series_seeds();
     forest_series_seeds();
     octree_seeds();

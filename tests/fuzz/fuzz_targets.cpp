@@ -24,6 +24,7 @@ const std::vector<Target>& targets() {
         {"series_read", series_read},
         {"forest_series_read", forest_series_read},
         {"octree_decode", octree_decode},
+        {"leaf_import", leaf_import},
     };
     return all;
 }

@@ -35,6 +35,7 @@ void round_trip(const uint8_t* data, size_t size);         // random hierarchy -
 void series_read(const uint8_t* data, size_t size);        // .amcs reader, every frame, written again
 void forest_series_read(const uint8_t* data, size_t size); // .amcs forest series reader, every frame, written again
 void octree_decode(const uint8_t* data, size_t size);      // .amq decode: whole, progressive, encoded again
+void leaf_import(const uint8_t* data, size_t size);        // leaf mesh (damaged or not) -> hierarchy, with the base or alone
 
 // Input layouts of the stream targets, which fuzz_seeds writes too.
 //   hierarchy_stream: u8 base (index into stream_bases()), u8 max_level + 1 (0: all levels), the stream.
