@@ -62,4 +62,22 @@ std::vector<uint8_t> with_valid_checksums(const uint8_t* data, size_t size, size
     return out;
 }
 
+void refine_at_random(Hierarchy& h, ByteReader& in, uint32_t max_nodes, int max_level, bool flip_diagonals) {
+    const int operations = in.u8() % 64;
+    for (int i = 0; i < operations && h.node_count() < max_nodes; ++i) {
+        const NodeId n = in.u32() % h.node_capacity();
+        const uint8_t op = in.u8();
+        if (!h.is_alive(n)) continue;
+        if (op % 4 != 0) {
+            if (h.is_leaf(n) && h.level(n) < max_level) h.refine(n);
+        } else if (!h.is_leaf(n)) {
+            h.coarsen(n);
+        }
+    }
+    for (NodeId n = 0; n < h.node_capacity(); ++n) {
+        if (h.is_alive(n) && h.is_leaf(n) && h.hanging_node_count(n) == 2 && flip_diagonals && (in.u8() & 1))
+            h.set_diagonal_flipped(n, true);
+    }
+}
+
 }  // namespace amc::fuzz

@@ -6,6 +6,7 @@
 // target checks (FUZZ_CHECK: round trips, invariants of what was decoded), which aborts.
 #pragma once
 
+#include <amc/hierarchy.h>
 #include <amc/mesh.h>
 
 #include <cstddef>
@@ -91,6 +92,11 @@ const std::vector<Target>& targets();
 constexpr size_t kAmcHeaderSize = 12;    // also .amq's
 constexpr size_t kSeriesHeaderSize = 16;
 std::vector<uint8_t> with_valid_checksums(const uint8_t* data, size_t size, size_t header_size = kAmcHeaderSize);
+
+// Grows a random red-green hierarchy from the input: up to 63 refinements and coarsenings of nodes
+// it picks (no refinement past max_level, none once the hierarchy has max_nodes), then, with
+// flip_diagonals, the flipped diagonal of the two-hanging-node leaves it picks.
+void refine_at_random(Hierarchy& h, ByteReader& in, uint32_t max_nodes, int max_level, bool flip_diagonals);
 
 }  // namespace amc::fuzz
 

@@ -105,20 +105,7 @@ void leaf_import(const uint8_t* data, size_t size) {
     const TriangleMesh& base = bases[in.u8() % bases.size()];
 
     Hierarchy h(base);
-    const int operations = in.u8() % 64;
-    for (int i = 0; i < operations && h.node_count() < kMaxNodes; ++i) {
-        const NodeId n = in.u32() % h.node_capacity();
-        const uint8_t op = in.u8();
-        if (!h.is_alive(n)) continue;
-        if (op % 4 != 0) {
-            if (h.is_leaf(n) && h.level(n) < kMaxRefinedLevel) h.refine(n);
-        } else if (!h.is_leaf(n)) {
-            h.coarsen(n);
-        }
-    }
-    for (NodeId n = 0; n < h.node_capacity(); ++n) {
-        if (h.is_alive(n) && h.is_leaf(n) && h.hanging_node_count(n) == 2 && (in.u8() & 1)) h.set_diagonal_flipped(n, true);
-    }
+    refine_at_random(h, in, kMaxNodes, kMaxRefinedLevel, true);
 
     // The leaf mesh lists the base's vertices first, in the base's order.
     TriangleMesh input = extract_leaf_mesh(h).mesh;

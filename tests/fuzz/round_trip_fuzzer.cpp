@@ -68,21 +68,7 @@ void round_trip(const uint8_t* data, size_t size) {
     }
 
     Hierarchy h(base);
-    const int operations = in.u8() % 64;
-    for (int i = 0; i < operations && h.node_count() < kMaxNodes; ++i) {
-        const NodeId n = in.u32() % h.node_capacity();
-        const uint8_t op = in.u8();
-        if (!h.is_alive(n)) continue;
-        if (op % 4 != 0) {
-            if (h.is_leaf(n) && h.level(n) < kMaxRefinedLevel) h.refine(n);
-        } else if (!h.is_leaf(n)) {
-            h.coarsen(n);
-        }
-    }
-    for (NodeId n = 0; n < h.node_capacity(); ++n) {
-        if (h.is_alive(n) && h.is_leaf(n) && h.hanging_node_count(n) == 2 && (flags & 8) && (in.u8() & 1))
-            h.set_diagonal_flipped(n, true);
-    }
+    refine_at_random(h, in, kMaxNodes, kMaxRefinedLevel, flags & 8);
     if (wild) {
         const std::vector<uint32_t> order = canonical_vertex_order(h);
         for (VertexId v = 0; v < order.size(); ++v)
