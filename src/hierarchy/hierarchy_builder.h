@@ -17,6 +17,14 @@ struct Neighbors {
 };
 static_assert(sizeof(Neighbors) == 12, "split_level reads four siblings' Neighbors as twelve words");
 
+// The four vertices the normal frame of a new vertex reads (coding/geometry/geometry_prediction.h):
+// a and b, the ends of the split edge e of node n (a = v[e], b = v[(e + 1) % 3]), c, n's vertex
+// opposite the edge, and d, the vertex opposite the edge in n's same-level neighbour across it
+// (kNoVertex when there is none).
+struct FrameCorners {
+    VertexId a, b, c, d;
+};
+
 // A whole level's splits: the distinct splittable leaves parents[0..count) of one level, whose
 // same-level neighbours are not refined yet, in the order they are split, and the links of the
 // nodes they make: children[4 * i + k] for child k of parents[i], with local index 4 * j + k'
@@ -32,6 +40,13 @@ struct LevelSplits {
     // chunk decoder's seam vertices (chunk_coder.h).
     VertexId (*boundary_vertex)(void* context, VertexId a, VertexId b) = nullptr;
     void* boundary_context = nullptr;
+    // When set, new vertex k of the call (id positions().size() + k taken before it; boundary_vertex's
+    // vertices are not new) gets its frame corners written to new_vertex_corners[k]: room for
+    // 3 * count.
+    FrameCorners* new_vertex_corners = nullptr;
+    // False: the new vertices' positions are left at zero, for a decoder that sets every one of
+    // them next (their midpoints would be read and computed for nothing).
+    bool place_new_vertices = true;
 };
 
 struct HierarchyBuilder {

@@ -2,6 +2,7 @@
 // whole level's splits in one pass, with the links the decoder's level forest already knows.
 #include <amc/hierarchy.h>
 
+#include "common/check.h"
 #include "common/huge_pages.h"
 #include "common/simd.h"
 #include "hierarchy/hierarchy_builder.h"
@@ -175,6 +176,8 @@ void Hierarchy::split_level(const LevelSplits& splits) {
     const uint32_t count = splits.count;
     if (!free_blocks_.empty() || !free_vertices_.empty()) {
         // Reused ids: take the general path (the decoders never get here).
+        AMC_REQUIRE(splits.new_vertex_corners == nullptr && splits.place_new_vertices, invalid_input,
+                    "split_level: listed corners need a hierarchy that was only ever refined");
         for (uint32_t i = 0; i < count; ++i) split(parents[i]);
         return;
     }
@@ -215,6 +218,7 @@ void Hierarchy::split_level(const LevelSplits& splits) {
     constexpr uint32_t kParentsAhead = 16;
     const uint32_t offset = uint32_t(c0);
     const auto boundary_vertex = splits.boundary_vertex;
+    FrameCorners* const corners = splits.new_vertex_corners;
     for (uint32_t chunk = 0; chunk < count; chunk += kChunk) {
         const uint32_t chunk_end = std::min(count, chunk + kChunk);
         uint32_t new_vertices = 0;
@@ -239,6 +243,13 @@ void Hierarchy::split_level(const LevelSplits& splits) {
                     if (existing != kNoVertex) {
                         m[e] = existing;
                     } else {
+                        if (corners != nullptr) {
+                            // frame_corners' (geometry_prediction.cpp), from the parent at hand.
+                            const NodeId q = parent.nbr[e];
+                            const unsigned eq = (parent.nbr_edge >> (2 * e)) & 3u;
+                            corners[next_vertex - v0] = {a, b, parent.v[e == 0 ? 2 : e - 1],
+                                                         q == kNoNode ? kNoVertex : nodes[q].v[eq == 0 ? 2 : eq - 1]};
+                        }
                         ends[new_vertices++] = {a, b};
                         m[e] = next_vertex++;
                     }
@@ -256,6 +267,10 @@ void Hierarchy::split_level(const LevelSplits& splits) {
             const ChildTails& tails = kChildTails.of[outer | (boundary & 7u) << 6];
             for (int k = 0; k < 4; ++k) write_tail(child[k], tails.word[k] | level);
             parent.first_child = c;
+        }
+        if (!splits.place_new_vertices) {
+            positions_.resize(positions_.size() + new_vertices);
+            continue;
         }
         // Within the reserved capacity: no reallocation, so `positions` stays valid. One loop a
         // vertex placer, so that the default ones are inlined.

@@ -166,6 +166,10 @@ void decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, size_t 
         const LevelBlockParts parts = split_level_block(level_block, limits.file_version, space.quantizer != nullptr, where);
         ArithmeticDecoder decoder(parts.arithmetic, parts.arithmetic_size);
         seam_splits.found = false;
+        // Every new vertex gets its decoded position below; a static mode's decoder takes their
+        // frame corners from the split, without reading the nodes again.
+        const bool listed = is_static_mode(parts.predictor);
+        hierarchy.set_new_vertex_listing(listed, false);
         hierarchy.decode_level(decoder);  // the seam vertices it splits off placed already (SeamSplits)
         next_boundary.clear();
         for (const NodeId n : boundary) {
@@ -180,6 +184,11 @@ void decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, size_t 
         }
         boundary.swap(next_boundary);
         AMC_REQUIRE(!decoder.overran(), corrupt, where + ": hierarchy part is truncated or corrupt");
+        if (listed) {  // the seam's vertices are not new: not listed
+            decode_listed_level_geometry(h, hierarchy.new_vertex_corners(), hierarchy.new_vertex_count(),
+                                         hierarchy.new_vertex_first(), parts, decoder, space, where);
+            continue;
+        }
         if (!seam_splits.found) {  // every new vertex is the chunk's own
             decode_level_geometry(h, hierarchy.new_vertices(), parts, decoder, positions, space, int(level), where);
             continue;

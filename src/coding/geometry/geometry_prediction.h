@@ -13,6 +13,7 @@
 #include "common/compiler.h"
 #include "common/exact_float.h"
 #include "common/simd.h"
+#include "hierarchy/hierarchy_builder.h"
 
 #include <amc/hierarchy.h>
 
@@ -77,9 +78,7 @@ NormalFrame normal_frame(const Hierarchy& h, NodeId n, int e, bool unit_normals 
 // positions) before computing their frames: the corners a frame reads, a, b, c of node n (edge e
 // runs a -> b) and d, the vertex opposite the edge in the same-level neighbour (kNoVertex at a
 // boundary); then the frame from their positions.
-struct FrameCorners {
-    VertexId a, b, c, d;
-};
+// (FrameCorners: hierarchy_builder.h, where split_level lists them for the decoders.)
 FrameCorners frame_corners(const Hierarchy& h, NodeId n, int e);
 // frame_of<UnitNormals>(h, corners): below, inline.
 

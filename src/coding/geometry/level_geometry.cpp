@@ -166,29 +166,56 @@ LevelBlockParts split_level_block(const Block& block, uint8_t file_version, bool
     return parts;
 }
 
+namespace {
+
+// A static mode's tables and streams; `decode(tables, rans, rans_size, raw, raw_size)` decodes the
+// positions from them (decode_static_positions).
+template <class Decode>
+void decode_static_level(const LevelBlockParts& parts, ArithmeticDecoder& decoder, CoordinateSpace space,
+                         const std::string& where, Decode&& decode) {
+    StaticTables tables;
+    AMC_REQUIRE(read_static_tables(decoder, space, parts.predictor, tables) && !decoder.overran(), corrupt,
+                where + ": bad geometry tables");
+    PayloadReader in(parts.after_arithmetic, parts.after_arithmetic_size, "level block");
+    const uint64_t rans_size = in.varint();
+    AMC_REQUIRE(rans_size <= in.remaining(), corrupt, where + ": rANS stream is longer than the block");
+    const uint8_t* rans = in.rest();
+    const uint8_t* raw = rans + rans_size;
+    const size_t raw_size = in.remaining() - size_t(rans_size);
+    AMC_REQUIRE(decode(tables, rans, size_t(rans_size), raw, raw_size), corrupt, where + " is truncated or corrupt (positions)");
+    AMC_REQUIRE(!decoder.overran(), corrupt, where + " is truncated or corrupt");
+}
+
+}  // namespace
+
+void decode_listed_level_geometry(Hierarchy& h, const FrameCorners* corners, size_t count, VertexId first,
+                                  const LevelBlockParts& parts, ArithmeticDecoder& decoder, CoordinateSpace space,
+                                  const std::string& where) {
+    AMC_REQUIRE(is_static_mode(parts.predictor), invalid_input, where + ": listed corners need a static geometry mode");
+    decode_static_level(parts, decoder, space, where,
+                        [&](const StaticTables& tables, const uint8_t* rans, size_t rans_size, const uint8_t* raw, size_t raw_size) {
+                            return decode_static_positions(h, corners, count, first, space, parts.predictor, tables, rans,
+                                                           rans_size, raw, raw_size);
+                        });
+}
+
 void decode_level_geometry(Hierarchy& h, const NewVertices& created, const LevelBlockParts& parts, ArithmeticDecoder& decoder,
                            PositionCoder& positions, CoordinateSpace space, int level, const std::string& where) {
     if (is_static_mode(parts.predictor)) {
-        StaticTables tables;
-        AMC_REQUIRE(read_static_tables(decoder, space, parts.predictor, tables) && !decoder.overran(), corrupt,
-                    where + ": bad geometry tables");
-        PayloadReader in(parts.after_arithmetic, parts.after_arithmetic_size, "level block");
-        const uint64_t rans_size = in.varint();
-        AMC_REQUIRE(rans_size <= in.remaining(), corrupt, where + ": rANS stream is longer than the block");
-        const uint8_t* rans = in.rest();
-        const uint8_t* raw = rans + rans_size;
-        const size_t raw_size = in.remaining() - size_t(rans_size);
-        AMC_REQUIRE(decode_static_positions(h, created, space, parts.predictor, tables, rans, size_t(rans_size), raw, raw_size), corrupt,
-                    where + " is truncated or corrupt (positions)");
-    } else {
-        for (auto [n, e] : created) {
-            const Vec3 p = positions.decode(decoder, level_context(h.level(n)), predict(h, parts.predictor, n, e));
-            AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
-                        "level " + std::to_string(level) + " geometry is corrupt (non-finite coordinate)");
-            h.set_position(h.midpoint(n, e), p);
-        }
-        AMC_REQUIRE(!positions.saw_invalid_symbol(), corrupt, where + " is truncated or corrupt");
+        decode_static_level(parts, decoder, space, where,
+                            [&](const StaticTables& tables, const uint8_t* rans, size_t rans_size, const uint8_t* raw, size_t raw_size) {
+                                return decode_static_positions(h, created, space, parts.predictor, tables, rans, rans_size,
+                                                               raw, raw_size);
+                            });
+        return;
     }
+    for (auto [n, e] : created) {
+        const Vec3 p = positions.decode(decoder, level_context(h.level(n)), predict(h, parts.predictor, n, e));
+        AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
+                    "level " + std::to_string(level) + " geometry is corrupt (non-finite coordinate)");
+        h.set_position(h.midpoint(n, e), p);
+    }
+    AMC_REQUIRE(!positions.saw_invalid_symbol(), corrupt, where + " is truncated or corrupt");
     AMC_REQUIRE(!decoder.overran(), corrupt, where + " is truncated or corrupt");
 }
 

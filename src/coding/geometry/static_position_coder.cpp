@@ -338,14 +338,34 @@ struct Chunk {
     std::array<GridPrediction, kChunk> first;  // mode 4: role 0's
 };
 
-void gather_chunk(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, Chunk& c) {
-    c.begin = begin;
-    c.count = begin < created.size() ? std::min(kChunk, created.size() - begin) : 0;
-    for (size_t i = 0; i < c.count; ++i) {
-        const auto [n, e] = created[begin + i];
-        c.corners[i] = frame_corners(h, n, e);
-        c.vertices[i] = h.midpoint(n, e);
+// Where the vertices and their frame corners come from: (node, edge) pairs, read in the hierarchy,
+// or split_level's list (vertices first, first + 1, ...).
+struct FromNodes {
+    const Hierarchy& h;
+    const std::vector<std::pair<NodeId, int>>& created;
+    size_t size() const { return created.size(); }
+    void get(size_t k, FrameCorners& corners, VertexId& vertex) const {
+        const auto [n, e] = created[k];
+        corners = frame_corners(h, n, e);
+        vertex = h.midpoint(n, e);
     }
+};
+struct FromList {
+    const FrameCorners* corners;
+    size_t count;
+    VertexId first;
+    size_t size() const { return count; }
+    void get(size_t k, FrameCorners& c, VertexId& vertex) const {
+        c = corners[k];
+        vertex = first + VertexId(k);
+    }
+};
+
+template <class Source>
+void gather_chunk(const Hierarchy& h, const Source& source, size_t begin, Chunk& c) {
+    c.begin = begin;
+    c.count = begin < source.size() ? std::min(kChunk, source.size() - begin) : 0;
+    for (size_t i = 0; i < c.count; ++i) source.get(begin + i, c.corners[i], c.vertices[i]);
     for (size_t i = 0; i < c.count; ++i)
         for (VertexId v : {c.corners[i].a, c.corners[i].b, c.corners[i].c, c.corners[i].d})
             if (v != kNoVertex) __builtin_prefetch(&h.positions()[v]);
@@ -390,10 +410,9 @@ AMC_ALWAYS_INLINE bool decode_vertex(const Chunk& b, size_t i, CoordinateSpace s
 
 // The decoders own their rANS decoder and raw bit reader, so that the compiler keeps the two rANS
 // states in registers.
-template <bool Grid, bool UnitNormals>
-bool decode_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
-                      const StaticTables& tables, const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data,
-                      size_t raw_size) {
+template <bool Grid, bool UnitNormals, class Source>
+bool decode_positions(Hierarchy& h, const Source& created, CoordinateSpace space, const StaticTables& tables,
+                      const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
     RansDecoder rans(rans_data, rans_size);
     RawBitReader raw(raw_data, raw_size);
     const Quantizer* grid = Grid ? space.quantizer : nullptr;
@@ -413,11 +432,9 @@ bool decode_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& c
     return rans.ended_cleanly() && raw.ended_cleanly();
 }
 
-}  // namespace
-
-bool decode_static_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
-                             GeometryPredictor mode, const StaticTables& tables, const uint8_t* rans_data, size_t rans_size,
-                             const uint8_t* raw_data, size_t raw_size) {
+template <class Source>
+bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, GeometryPredictor mode, const StaticTables& tables,
+                   const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
     switch (mode) {
         case GeometryPredictor::normal_frame:
             return decode_positions<false, false>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size);
@@ -429,6 +446,20 @@ bool decode_static_positions(Hierarchy& h, const std::vector<std::pair<NodeId, i
         default:
             return false;
     }
+}
+
+}  // namespace
+
+bool decode_static_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
+                             GeometryPredictor mode, const StaticTables& tables, const uint8_t* rans_data, size_t rans_size,
+                             const uint8_t* raw_data, size_t raw_size) {
+    return decode_static(h, FromNodes{h, created}, space, mode, tables, rans_data, rans_size, raw_data, raw_size);
+}
+
+bool decode_static_positions(Hierarchy& h, const FrameCorners* corners, size_t count, VertexId first, CoordinateSpace space,
+                             GeometryPredictor mode, const StaticTables& tables, const uint8_t* rans_data, size_t rans_size,
+                             const uint8_t* raw_data, size_t raw_size) {
+    return decode_static(h, FromList{corners, count, first}, space, mode, tables, rans_data, rans_size, raw_data, raw_size);
 }
 
 }  // namespace amc

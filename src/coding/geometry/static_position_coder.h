@@ -23,6 +23,7 @@
 #include "coding/entropy/arithmetic_coder.h"
 #include "coding/entropy/rans_coder.h"
 #include "coding/geometry/float_coder.h"
+#include "hierarchy/hierarchy_builder.h"
 
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
@@ -109,5 +110,10 @@ bool read_static_tables(ArithmeticDecoder& decoder, CoordinateSpace space, Geome
 bool decode_static_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
                              GeometryPredictor mode, const StaticTables& tables, const uint8_t* rans, size_t rans_size, const uint8_t* raw,
                              size_t raw_size);
+// The same for `count` vertices first, first + 1, ... whose frame corners split_level listed
+// (LevelSplits::new_vertex_corners): no node is read.
+bool decode_static_positions(Hierarchy& h, const FrameCorners* corners, size_t count, VertexId first, CoordinateSpace space,
+                             GeometryPredictor mode, const StaticTables& tables, const uint8_t* rans, size_t rans_size,
+                             const uint8_t* raw, size_t raw_size);
 
 }  // namespace amc

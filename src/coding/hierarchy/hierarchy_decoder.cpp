@@ -101,6 +101,8 @@ void HierarchyLevelDecoder::start(NodeId first_root, uint32_t roots, const Hiera
     max_nodes_ = max_nodes;
     boundary_vertex_ = nullptr;
     boundary_context_ = nullptr;
+    list_corners_ = false;
+    place_new_vertices_ = true;
     // Uniform levels alone would build roots * (4^(U+1) - 1) / 3 nodes: check before.
     uint64_t uniform_nodes = roots, level_nodes = roots;
     for (int l = 0; l < header_.uniform_levels && uniform_nodes <= max_nodes_; ++l) {
@@ -138,9 +140,13 @@ void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder, uint64_t ma
     const Level& level = decided_.back();
     const NodeId first = level_base_;
     new_vertices_.clear();
-    new_vertices_.reserve(vertex_count_ - vertices_before);  // once per level, not doubling vertex by vertex
-    for_each_new_vertex(level, numbering_, [&](uint32_t i, int e) { new_vertices_.emplace_back(first + i, e); });
+    new_vertex_first_ = VertexId(h_->positions().size());
+    if (!list_corners_) {
+        new_vertices_.reserve(vertex_count_ - vertices_before);  // once per level, not doubling vertex by vertex
+        for_each_new_vertex(level, numbering_, [&](uint32_t i, int e) { new_vertices_.emplace_back(first + i, e); });
+    }
     build_decided_levels();
+    new_vertex_count_ = h_->positions().size() - new_vertex_first_;
 }
 
 void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder, uint64_t max_refined) {
@@ -274,7 +280,14 @@ void HierarchyLevelDecoder::build_decided_levels() {
         uint32_t* parents = level.refined.data();
         for (uint32_t b = 0; b < count; ++b) parents[b] += level_base_;
         const NodeId first_child = h_->node_capacity();
-        HierarchyBuilder::split_level(*h_, LevelSplits{parents, count, children.nbr.data(), boundary_vertex_, boundary_context_});
+        LevelSplits splits{parents, count, children.nbr.data(), boundary_vertex_, boundary_context_};
+        // Listed or left unplaced for decode_level's caller, which takes one level at a time.
+        if (list_corners_ || !place_new_vertices_) {
+            AMC_REQUIRE(decided_.size() == 1, invalid_input, "hierarchy decoder: listed new vertices need decode_level");
+            splits.new_vertex_corners = list_corners_ ? corners_.reserve(size_t(3) * count) : nullptr;
+            splits.place_new_vertices = place_new_vertices_;
+        }
+        HierarchyBuilder::split_level(*h_, splits);
         level_base_ = first_child;
     }
     // Their memory serves the levels to come.

@@ -152,6 +152,14 @@ public:
         boundary_vertex_ = boundary_vertex;
         boundary_context_ = context;
     }
+    // Until the next restart, how decode_level hands over the vertices it creates: with
+    // `corners`, as their frame corners (new_vertex_corners()) instead of new_vertices(), which
+    // stays empty; with `placed` false, their positions left at zero for the caller to set (a
+    // decoder whose geometry sets every one of them).
+    void set_new_vertex_listing(bool corners, bool placed) {
+        list_corners_ = corners;
+        place_new_vertices_ = placed;
+    }
     bool done() const { return level_.empty(); }
     int level() const { return level_index_; }
     // Nodes of the current level (ids in hierarchy()) in canonical order.
@@ -164,6 +172,11 @@ public:
     // The vertices the last decode_level created, as (node, edge) in canonical order at their
     // first appearance (new_vertices_of_level of its level's nodes), positions not yet set.
     const std::vector<std::pair<NodeId, int>>& new_vertices() const { return new_vertices_; }
+    // With set_new_vertex_listing(true, ...): the frame corners of the vertices the last
+    // decode_level created, vertex new_vertex_first() + k at index k, new_vertex_count() of them.
+    const FrameCorners* new_vertex_corners() const { return corners_.data(); }
+    VertexId new_vertex_first() const { return new_vertex_first_; }
+    size_t new_vertex_count() const { return new_vertex_count_; }
     // Switches to the mixing mode (FORMAT.md 2.1: `model` first for .amc versions 8-9, second for
     // version 10, third from version 11) before the first level. Its features read the positions of hierarchy():
     // decode_level only, each level's new positions set before the next level is decoded.
@@ -211,6 +224,10 @@ private:
     std::vector<Level> spare_;    // built levels, whose memory the next levels reuse
     RefinedNumbering numbering_;     // of the level being decided
     std::vector<std::pair<NodeId, int>> new_vertices_;  // of the last decode_level
+    bool list_corners_ = false, place_new_vertices_ = true;  // set_new_vertex_listing
+    ScratchArray<FrameCorners> corners_;  // of the last decode_level, when listed
+    VertexId new_vertex_first_ = 0;
+    size_t new_vertex_count_ = 0;
     ScratchArray<uint32_t> closures_;  // the leaves with two or three hanging nodes
     NodeId level_base_ = 0;  // node id of local index 0 of the oldest level not yet built
     int level_index_ = 0;
