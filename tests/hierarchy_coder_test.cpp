@@ -359,6 +359,49 @@ TEST(HierarchyCoder, DecodedVerticesArePlacedByTheHierarchysPlacer) {
     }
 }
 
+// The complete decoder's listing (set_new_vertex_listing): each new vertex's frame corners as
+// frame_corners reads them in the built hierarchy, ids in listing order, positions left at zero
+// for the geometry; the same hierarchy as the decoder that lists (node, edge) pairs.
+TEST(HierarchyCoder, ListedNewVerticesCarryTheirFrameCorners) {
+    size_t listed = 0, with_far_corner = 0;
+    for (uint64_t seed = 1; seed <= 30; ++seed) {
+        const Hierarchy h = random_hierarchy(seed);
+        const std::vector<uint8_t> bytes = encode_hierarchy(h, HierarchyCoderOptions{});
+        HierarchyStreamHeader header;
+        const size_t header_size = read_standalone_stream_header(bytes.data(), bytes.size(), header);
+        HierarchyLevelDecoder pairs(h.base(), header, UINT64_MAX), corners(h.base(), header, UINT64_MAX);
+        corners.set_new_vertex_listing(true, false);
+        ArithmeticDecoder pairs_decoder(bytes.data() + header_size, bytes.size() - header_size);
+        ArithmeticDecoder corners_decoder(bytes.data() + header_size, bytes.size() - header_size);
+        while (!pairs.done()) {
+            ASSERT_FALSE(corners.done());
+            pairs.decode_level(pairs_decoder);
+            corners.decode_level(corners_decoder);
+            const Hierarchy& a = pairs.hierarchy();
+            const Hierarchy& b = corners.hierarchy();
+            ASSERT_TRUE(corners.new_vertices().empty());
+            ASSERT_EQ(corners.new_vertex_count(), pairs.new_vertices().size()) << "seed " << seed;
+            ASSERT_EQ(corners.new_vertex_first() + corners.new_vertex_count(), b.positions().size());
+            for (size_t k = 0; k < corners.new_vertex_count(); ++k) {
+                const auto [n, e] = pairs.new_vertices()[k];
+                const FrameCorners expected = frame_corners(a, n, e), got = corners.new_vertex_corners()[k];
+                ASSERT_TRUE(expected.a == got.a && expected.b == got.b && expected.c == got.c && expected.d == got.d)
+                    << "seed " << seed << ", vertex " << k;
+                ASSERT_EQ(a.midpoint(n, e), corners.new_vertex_first() + k) << "seed " << seed;
+                const Vec3 p = b.position(corners.new_vertex_first() + VertexId(k));
+                ASSERT_TRUE(p.x == 0 && p.y == 0 && p.z == 0) << "seed " << seed << ", vertex " << k;
+                ++listed;
+                with_far_corner += got.d != kNoVertex;
+            }
+        }
+        ASSERT_TRUE(corners.done());
+        EXPECT_TRUE(same_connectivity(pairs.hierarchy(), corners.hierarchy())) << "seed " << seed;
+    }
+    // Vertices inside the mesh (a neighbour across the edge) and on its boundary.
+    EXPECT_GT(with_far_corner, listed / 2);
+    EXPECT_LT(with_far_corner, listed);
+}
+
 // The improved traversal's starting states (FORMAT.md, section 2): with the 1-regularity rule,
 // a level's incomplete nodes are decided (not refined) before its traversal, and every other node
 // starts in bucket max(1, 4 - its incomplete neighbours). derive_next_level makes them from

@@ -135,14 +135,12 @@ AMC_ALWAYS_INLINE Residual take(int token, RawBitReader& raw) {
     const int k = 4 + (token - kDirectTokens) / 4;
     const int low = k - 3;
     Residual r;
-    r.negative = raw.get(1) != 0;
-    uint64_t bits;
-    if (low > 32) {
-        bits = raw.get(low - 32) << 32;
-        bits |= raw.get(32);
-    } else {
-        bits = raw.get(low);
-    }
+    // The sign and the first value in one read: they follow each other, low bit first.
+    const int first = low > 32 ? low - 32 : low;
+    const uint64_t sign_and_first = raw.get(1 + first);
+    r.negative = (sign_and_first & 1) != 0;
+    uint64_t bits = sign_and_first >> 1;
+    if (low > 32) bits = bits << 32 | raw.get(32);
     r.magnitude = (uint64_t(4 | ((token - kDirectTokens) & 3)) << low) | bits;
     return r;
 }
