@@ -32,8 +32,6 @@ int token_limit(CoordinateSpace space) {
 }
 static_assert(kTokensFor64Bits <= kRansMaxSymbols, "every token fits a table");
 
-double& component_ref(Vec3& p, int axis) { return axis == 0 ? p.x : axis == 1 ? p.y : p.z; }
-
 // The axes in coding order: the frame's axis, then the two others in increasing order.
 std::array<int, 3> role_axes(const NormalFrame& f) {
     static constexpr std::array<std::array<int, 3>, 3> kByAxis{{{0, 1, 2}, {1, 0, 2}, {2, 0, 1}}};
@@ -93,9 +91,10 @@ struct GridPrediction {
 };
 
 // Inlined: returned through memory, the small struct stalls the decoder's loop on a store forward.
-AMC_ALWAYS_INLINE GridPrediction grid_prediction(const Quantizer& quantizer, int axis, double x) {
+// `origin`: the quantizer's origin on the axis.
+AMC_ALWAYS_INLINE GridPrediction grid_prediction_at(const Quantizer& quantizer, double origin, double x) {
     // quantize_coordinate's steps, its t kept for the bin.
-    const double t = rounded((x - axis_coordinate(quantizer.origin, axis)) / quantizer.step);
+    const double t = rounded((x - origin) / quantizer.step);
     if (!(t > 0.0)) return {0, 0, false};  // also NaN
     if (t >= static_cast<double>(quantizer.max_coordinate())) return {quantizer.max_coordinate(), 0, false};
     GridPrediction g{static_cast<uint32_t>(t + 0.5), 0, false};  // floor, as in quantize_coordinate
@@ -104,6 +103,9 @@ AMC_ALWAYS_INLINE GridPrediction grid_prediction(const Quantizer& quantizer, int
     g.bin = std::fabs(f) >= 0.25 ? 1 : 0;  // f is finite: f >= 1/4 or f <= -1/4
     return g;
 }
+AMC_ALWAYS_INLINE GridPrediction grid_prediction(const Quantizer& quantizer, int axis, double x) {
+    return grid_prediction_at(quantizer, axis_coordinate(quantizer.origin, axis), x);
+}
 
 AMC_ALWAYS_INLINE Residual grid_residual(const Quantizer& quantizer, int axis, double actual, const GridPrediction& g) {
     const int64_t d = int64_t(quantize_coordinate(quantizer, axis, actual)) - int64_t(g.p);
@@ -111,10 +113,11 @@ AMC_ALWAYS_INLINE Residual grid_residual(const Quantizer& quantizer, int axis, d
     return {s < 0, uint64_t(s < 0 ? -s : s)};
 }
 
-AMC_ALWAYS_INLINE bool grid_value(const Quantizer& quantizer, int axis, const GridPrediction& g, Residual r, double& value) {
+// `origin`: the quantizer's origin on the axis (dequantize_coordinate's).
+AMC_ALWAYS_INLINE bool grid_value(const Quantizer& quantizer, double origin, const GridPrediction& g, Residual r, double& value) {
     const int64_t q = int64_t(g.p) + negated_if(signed_value(r), g.turn);  // magnitude < 2^bits
     if (q < 0 || q > int64_t(quantizer.max_coordinate())) return false;
-    value = dequantize_coordinate(quantizer, axis, uint32_t(q));
+    value = origin + rounded(static_cast<double>(q) * quantizer.step);
     return true;
 }
 
@@ -327,12 +330,19 @@ namespace {
 // the frame's square roots and divisions.
 constexpr size_t kChunk = 64;  // even: each chunk starts with rANS state 0
 
+// A vertex's frame in role order (role r is axis axes[r]), with the quantizer's origin on those
+// axes: the coordinate loop indexes nothing by axis but the vertex it writes.
+struct RoleFrame {
+    double midpoint[3], normal[3], origin[3];
+    int axes[3];
+    bool has_normal;
+};
+
 struct Chunk {
     size_t begin = 0, count = 0;
     std::array<FrameCorners, kChunk> corners;
     std::array<VertexId, kChunk> vertices;
-    std::array<NormalFrame, kChunk> frames;
-    std::array<std::array<int, 3>, kChunk> axes;
+    std::array<RoleFrame, kChunk> frames;
     std::array<GridPrediction, kChunk> first;  // mode 4: role 0's
 };
 
@@ -370,40 +380,61 @@ void gather_chunk(const Hierarchy& h, const Source& source, size_t begin, Chunk&
 }
 
 template <bool Grid, bool UnitNormals>
-AMC_ALWAYS_INLINE void frame_vertex(const Hierarchy& h, const Quantizer* grid, Chunk& c, size_t i) {
-    c.frames[i] = frame_of<UnitNormals>(h, c.corners[i]);
-    c.axes[i] = role_axes(c.frames[i]);
-    if (Grid) c.first[i] = grid_prediction(*grid, c.axes[i][0], axis_coordinate(c.frames[i].midpoint, c.axes[i][0]));
+AMC_ALWAYS_INLINE void frame_vertex(const Hierarchy& h, const Quantizer* quantizer, Chunk& c, size_t i) {
+    const NormalFrame frame = frame_of<UnitNormals>(h, c.corners[i]);
+    const std::array<int, 3> axes = role_axes(frame);
+    RoleFrame& f = c.frames[i];
+    for (int r = 0; r < 3; ++r) {
+        f.axes[r] = axes[size_t(r)];
+        f.midpoint[r] = axis_coordinate(frame.midpoint, axes[size_t(r)]);
+        f.normal[r] = axis_coordinate(frame.normal, axes[size_t(r)]);
+        f.origin[r] = quantizer != nullptr ? axis_coordinate(quantizer->origin, axes[size_t(r)]) : 0.0;
+    }
+    f.has_normal = frame.has_normal;
+    if (Grid) c.first[i] = grid_prediction_at(*quantizer, f.origin[0], f.midpoint[0]);
+}
+
+// NormalFrame::predict in role order: roles 1 and 2's predictions once role 0's value is known.
+AMC_ALWAYS_INLINE void predict_others(const RoleFrame& f, double first_value, double& second, double& third) {
+    if (!f.has_normal) {
+        second = f.midpoint[1];
+        third = f.midpoint[2];
+        return;
+    }
+    const double t = rounded((first_value - f.midpoint[0]) / f.normal[0]);
+    second = f.midpoint[1] + rounded(t * f.normal[1]);
+    third = f.midpoint[2] + rounded(t * f.normal[2]);
 }
 
 // One vertex's three coordinates; its first token is coded with rANS state `State` (token j of the
 // level with state j mod 2), its second with the other, its third with `State` again.
 template <int State, bool Grid>
 AMC_ALWAYS_INLINE bool decode_vertex(const Chunk& b, size_t i, CoordinateSpace space, const StaticTables& tables,
-                                     RansDecoder& rans, RawBitReader& raw, Vec3& p) {    const std::array<int, 3>& axes = b.axes[i];
-    const NormalFrame& frame = b.frames[i];
+                                     RansDecoder& rans, RawBitReader& raw, Vec3& p) {
+    const RoleFrame& f = b.frames[i];
+    double value[3], second, third;
     if (Grid) {
         const Quantizer& quantizer = *space.quantizer;
         const GridPrediction& first = b.first[i];
-        if (!grid_value(quantizer, axes[0], first, take(rans.get_with<State>(tables[size_t(first.bin)]), raw), component_ref(p, axes[0])))
+        if (!grid_value(quantizer, f.origin[0], first, take(rans.get_with<State>(tables[size_t(first.bin)]), raw), value[0]))
             return false;
-        const Vec3 others = frame.predict(axis_coordinate(p, axes[0]));
-        const GridPrediction g1 = grid_prediction(quantizer, axes[1], axis_coordinate(others, axes[1]));
-        const GridPrediction g2 = grid_prediction(quantizer, axes[2], axis_coordinate(others, axes[2]));
+        predict_others(f, value[0], second, third);
+        const GridPrediction g1 = grid_prediction_at(quantizer, f.origin[1], second);
+        const GridPrediction g2 = grid_prediction_at(quantizer, f.origin[2], third);
         const Residual r1 = take(rans.get_with<1 - State>(tables[size_t(kGridBins + g1.bin)]), raw);
-        if (!grid_value(quantizer, axes[1], g1, r1, component_ref(p, axes[1]))) return false;
+        if (!grid_value(quantizer, f.origin[1], g1, r1, value[1])) return false;
         const Residual r2 = take(rans.get_with<State>(tables[size_t(2 * kGridBins + g2.bin)]), raw);
-        return grid_value(quantizer, axes[2], g2, r2, component_ref(p, axes[2]));
+        if (!grid_value(quantizer, f.origin[2], g2, r2, value[2])) return false;
+    } else {
+        if (!value_of(space, f.axes[0], f.midpoint[0], take(rans.get_with<State>(tables[0]), raw), value[0])) return false;
+        predict_others(f, value[0], second, third);
+        if (!value_of(space, f.axes[1], second, take(rans.get_with<1 - State>(tables[1]), raw), value[1])) return false;
+        if (!value_of(space, f.axes[2], third, take(rans.get_with<State>(tables[2]), raw), value[2])) return false;
     }
-    double& value = component_ref(p, axes[0]);
-    if (!value_of(space, axes[0], axis_coordinate(frame.midpoint, axes[0]), take(rans.get_with<State>(tables[0]), raw), value))
-        return false;
-    const Vec3 others = frame.predict(value);
-    if (!value_of(space, axes[1], axis_coordinate(others, axes[1]), take(rans.get_with<1 - State>(tables[1]), raw),
-                  component_ref(p, axes[1])))
-        return false;
-    return value_of(space, axes[2], axis_coordinate(others, axes[2]), take(rans.get_with<State>(tables[2]), raw),
-                    component_ref(p, axes[2]));
+    double xyz[3];
+    for (int r = 0; r < 3; ++r) xyz[f.axes[r]] = value[r];
+    p = {xyz[0], xyz[1], xyz[2]};
+    return true;
 }
 
 // The decoders own their rANS decoder and raw bit reader, so that the compiler keeps the two rANS
@@ -413,18 +444,18 @@ bool decode_positions(Hierarchy& h, const Source& created, CoordinateSpace space
                       const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
     RansDecoder rans(rans_data, rans_size);
     RawBitReader raw(raw_data, raw_size);
-    const Quantizer* grid = Grid ? space.quantizer : nullptr;
+    const Quantizer* quantizer = space.quantizer;
     Chunk c;
     for (size_t begin = 0; begin < created.size(); begin += kChunk) {
         gather_chunk(h, created, begin, c);
-        for (size_t i = 0; i < c.count; ++i) frame_vertex<Grid, UnitNormals>(h, grid, c, i);
+        for (size_t i = 0; i < c.count; ++i) frame_vertex<Grid, UnitNormals>(h, quantizer, c, i);
         for (size_t i = 0; i < c.count; i += 2) {
             Vec3 p;
             if (!decode_vertex<0, Grid>(c, i, space, tables, rans, raw, p)) return false;
-            h.set_position(c.vertices[i], p);
+            HierarchyBuilder::set_new_vertex_position(h, c.vertices[i], p);
             if (i + 1 == c.count) break;
             if (!decode_vertex<1, Grid>(c, i + 1, space, tables, rans, raw, p)) return false;
-            h.set_position(c.vertices[i + 1], p);
+            HierarchyBuilder::set_new_vertex_position(h, c.vertices[i + 1], p);
         }
     }
     return rans.ended_cleanly() && raw.ended_cleanly();
