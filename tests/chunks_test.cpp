@@ -64,7 +64,7 @@ TEST(Chunks, ChunkedFilesDecodeToWhatUnchunkedFilesDo) {
             const std::vector<uint8_t> bytes = encode(h, options);
             const FileInfo info = inspect(bytes.data(), bytes.size());
             if (h.root_count() >= 2) {
-                ASSERT_EQ(info.version, kChunkedVersion);
+                ASSERT_EQ(info.version, kChunkVerticesVersion);
                 ASSERT_EQ(info.chunks.size(), std::min<size_t>(chunks, h.root_count()));
                 ++chunked_files;
             }
@@ -239,6 +239,62 @@ TEST(Chunks, EveryTruncationAndCorruptionIsAnError) {
         }
     }
     EXPECT_LT(decoded, 3000);
+}
+
+// `bytes` (a chunked file of version 13) with its chunk table's own vertex counts changed: chunk
+// k's by delta[k].
+std::vector<uint8_t> with_vertex_counts(const std::vector<uint8_t>& bytes, const std::vector<int64_t>& delta) {
+    BlockReader reader(bytes.data(), bytes.size());
+    BlockWriter writer(reader.version(), reader.flags());
+    Block block;
+    while (reader.next(block) && block.type != BlockType::end) {
+        std::vector<uint8_t> payload(block.payload, block.payload + block.size);
+        if (block.type == BlockType::chunk_table) {
+            PayloadReader in(block.payload, block.size, "chunk table block");
+            payload.clear();
+            const uint64_t count = in.varint();
+            put_varint(payload, count);
+            for (uint64_t c = 0; c < count; ++c) {
+                put_varint(payload, in.varint());  // roots
+                put_varint(payload, in.varint());  // nodes
+                put_varint(payload, uint64_t(int64_t(in.varint()) + (c < delta.size() ? delta[c] : 0)));
+                put_varint(payload, in.varint());  // offset, from the table's end
+            }
+        }
+        writer.add(block.type, payload);
+    }
+    return writer.finish();
+}
+
+// The chunk table's vertex counts (version 13) are checked on every thread count, before the
+// whole is made: a file decodes on several threads exactly when it decodes on one.
+TEST(Chunks, CraftedVertexCountsAreClearErrors) {
+    const Hierarchy h = random_hierarchy(16, false);
+    const std::vector<uint8_t> bytes = encode(h, with_chunks(3));
+    ASSERT_EQ(inspect(bytes.data(), bytes.size()).version, kChunkVerticesVersion);
+    EXPECT_EQ(with_vertex_counts(bytes, {}), bytes);
+    struct Crafted {
+        std::vector<int64_t> delta;
+        std::string error;
+    };
+    const Crafted cases[] = {
+        {{1, -1, 0}, "chunk 0 does not hold the vertices the chunk table says"},  // the sum still right
+        {{0, 2, -2}, "chunk 1 does not hold the vertices the chunk table says"},
+        {{0, 0, 1}, "the chunk table's vertex counts do not add up to the metadata's vertex count"},
+        {{-1, 0, 0}, "the chunk table's vertex counts do not add up to the metadata's vertex count"},
+        {{0, 1 << 30, 0}, "chunk table block: chunk 1 has inconsistent counts"},  // more than 3 per split
+    };
+    for (const Crafted& c : cases) {
+        const std::vector<uint8_t> file = with_vertex_counts(bytes, c.delta);
+        for (unsigned threads : {1u, 2u, 3u}) {
+            DecodeOptions options;
+            options.threads = threads;
+            const DecodeResult r = try_decode(file.data(), file.size(), options);
+            EXPECT_FALSE(r.ok) << threads << " threads";
+            EXPECT_EQ(r.code, ErrorCode::corrupt) << r.error;
+            EXPECT_NE(r.error.find(c.error), std::string::npos) << threads << " threads: " << r.error;
+        }
+    }
 }
 
 }  // namespace

@@ -57,7 +57,7 @@ TEST(ExplicitChunks, ChunksAreCutWhereTheCallerSays) {
             options.chunk_roots = random_cut(h.root_count(), chunks, seed);
             const std::vector<uint8_t> bytes = encode(h, options);
             const FileInfo info = inspect(bytes.data(), bytes.size());
-            ASSERT_EQ(info.version, kChunkedVersion);
+            ASSERT_EQ(info.version, kChunkVerticesVersion);
             ASSERT_EQ(info.chunks.size(), chunks);
             uint32_t first = 0;
             for (uint32_t c = 0; c < chunks; ++c) {

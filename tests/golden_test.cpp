@@ -223,15 +223,29 @@ std::vector<GoldenCase> chunked_cases() {
     return cases;
 }
 
-TEST(Golden, ChunkedFilesDecodeAndPinTheEncoder) {
+// A chunked golden file decodes to the same hierarchy on 1, 2 and 3 threads (the decoder's two
+// ways of putting chunks together).
+void check_decodes_on_threads(const std::vector<uint8_t>& golden) {
+    const Hierarchy one = decode(golden.data(), golden.size());
+    for (unsigned threads : {2u, 3u}) {
+        DecodeOptions options;
+        options.threads = threads;
+        EXPECT_TRUE(identical(decode(golden.data(), golden.size(), options), one)) << threads << " threads";
+    }
+}
+
+// Encoders write chunked files as version 13 now (pinned below): version 7's files still decode.
+TEST(Golden, ChunkedFilesOfVersion7Decode) {
     for (const GoldenCase& c : chunked_cases()) {
-        SCOPED_TRACE(golden_path(kChunkedVersion, c.name));
-        const std::vector<uint8_t> golden = pinned_encoding(c, kChunkedVersion);
+        const std::string path = golden_path(kChunkedVersion, c.name);
+        SCOPED_TRACE(path);
+        const std::vector<uint8_t> golden = read_golden(path);
         ASSERT_FALSE(golden.empty()) << "missing";
         const FileInfo info = inspect(golden.data(), golden.size());
         EXPECT_EQ(info.version, kChunkedVersion);
         EXPECT_EQ(info.chunks.size(), size_t(c.options.chunks));
         check_decodes(golden, c, kChunkedVersion);
+        check_decodes_on_threads(golden);
     }
 }
 
@@ -308,8 +322,9 @@ TEST(Golden, GridGeometryFilesDecodeAndPinTheEncoder) {
         const std::vector<uint8_t> bytes = encode(c.hierarchy, c.options, &stats);
         const std::string path = golden_path(kGridGeometryVersion, c.name);
         SCOPED_TRACE(path);
-        if (c.options.hierarchy_contexts == HierarchyContexts::mixed) {
-            // The mixing mode's first model: encoders write version 11 now (pinned below).
+        if (c.options.hierarchy_contexts == HierarchyContexts::mixed || c.options.chunks > 1) {
+            // The mixing mode's first model: encoders write version 11 now (pinned below); chunks:
+            // version 13 (pinned below).
             const std::vector<uint8_t> golden = read_golden(path);
             ASSERT_FALSE(golden.empty()) << path << " is missing";
             EXPECT_EQ(inspect(golden.data(), golden.size()).version, kGridGeometryVersion);
@@ -414,7 +429,13 @@ TEST(Golden, UnitFrameFilesDecodeAndPinTheEncoder) {
     for (const GoldenCase& c : cases) {
         SCOPED_TRACE(golden_path(kUnitFrameVersion, c.name));
         EncodeStats stats;
-        const std::vector<uint8_t> golden = pinned_encoding(c, kUnitFrameVersion, &stats);
+        std::vector<uint8_t> golden;
+        if (c.options.chunks > 1) {  // encoders write chunks as version 13 now (pinned below); this file still decodes
+            encode(c.hierarchy, c.options, &stats);
+            golden = read_golden(golden_path(kUnitFrameVersion, c.name));
+        } else {
+            golden = pinned_encoding(c, kUnitFrameVersion, &stats);
+        }
         ASSERT_FALSE(golden.empty()) << "missing";
         const FileInfo info = inspect(golden.data(), golden.size());
         EXPECT_EQ(info.version, kUnitFrameVersion);
@@ -423,6 +444,31 @@ TEST(Golden, UnitFrameFilesDecodeAndPinTheEncoder) {
                                 [](const LevelStats& l) { return l.predictor == GeometryPredictor::unit_normal_frame; }))
             << "the case exercises geometry mode 5";
         check_decodes(golden, c, kUnitFrameVersion);
+    }
+}
+
+// Version 13 (the chunk table lists each chunk's own vertices): every chunked case of versions 7, 9
+// and 12, pinned, and decoded on 1, 2 and 3 threads.
+std::vector<GoldenCase> chunk_vertices_cases() {
+    std::vector<GoldenCase> cases = chunked_cases();
+    for (const std::vector<GoldenCase>& more : {grid_geometry_cases(), unit_frame_cases()})
+        for (const GoldenCase& c : more)
+            if (c.options.chunks > 1) cases.push_back(c);
+    return cases;
+}
+
+TEST(Golden, ChunkVerticesFilesDecodeAndPinTheEncoder) {
+    const std::vector<GoldenCase> cases = chunk_vertices_cases();
+    ASSERT_EQ(cases.size(), 10u);
+    for (const GoldenCase& c : cases) {
+        SCOPED_TRACE(golden_path(kChunkVerticesVersion, c.name));
+        const std::vector<uint8_t> golden = pinned_encoding(c, kChunkVerticesVersion);
+        ASSERT_FALSE(golden.empty()) << "missing";
+        const FileInfo info = inspect(golden.data(), golden.size());
+        EXPECT_EQ(info.version, kChunkVerticesVersion);
+        EXPECT_EQ(info.chunks.size(), size_t(c.options.chunks));
+        check_decodes(golden, c, kChunkVerticesVersion);
+        check_decodes_on_threads(golden);
     }
 }
 

@@ -121,7 +121,7 @@ TEST(RankEncoder, RanksWriteTheSerialEncodersQuantizedBytes) {
         }
     }
     EXPECT_EQ(files, 12 * 4);
-    EXPECT_GT(grid_files, 0);  // level geometry mode 4 in some chunk: a version-9 file
+    EXPECT_GT(grid_files, 0);  // level geometry mode 4 in a file of one rank: version 9 (chunked files are version 13)
     // A surface remesh (vertices on the unit sphere), where the automatic predictor takes mode 4.
     const Hierarchy sphere = projected_sphere(20000, 7, 5);
     EncodeOptions options;
@@ -129,18 +129,18 @@ TEST(RankEncoder, RanksWriteTheSerialEncodersQuantizedBytes) {
     options.grid_contexts = true;
     const std::vector<uint32_t> counts{7, 6, 7};
     const std::vector<uint8_t> bytes = write_by_ranks(sphere.base(), ranks_of(sphere, counts, 1), options);
-    EXPECT_EQ(bytes[4], kGridGeometryVersion);
+    EXPECT_EQ(bytes[4], kChunkVerticesVersion);
     EXPECT_EQ(bytes, encode(sphere, serial_options(options, counts)));
 }
 
-// Bit-exact chunks in geometry mode 5 (FORMAT.md 5.8): the ranks' file is version 12, as the serial one.
+// Bit-exact chunks in geometry mode 5 (FORMAT.md 5.8): the ranks' file is version 13 (chunks), as the serial one.
 TEST(RankEncoder, RanksWriteTheSerialEncodersUnitFrameBytes) {
     const Hierarchy sphere = projected_sphere(20000, 7, 5);
     EncodeOptions options;
     options.predictor = GeometryPredictor::unit_normal_frame;
     const std::vector<uint32_t> counts{7, 6, 7};
     const std::vector<uint8_t> bytes = write_by_ranks(sphere.base(), ranks_of(sphere, counts, 1), options);
-    EXPECT_EQ(bytes[4], kUnitFrameVersion);
+    EXPECT_EQ(bytes[4], kChunkVerticesVersion);
     EXPECT_EQ(bytes, encode(sphere, serial_options(options, counts)));
     const Hierarchy back = decode(bytes.data(), bytes.size());
     EXPECT_TRUE(identical(back, sphere));

@@ -117,12 +117,12 @@ TEST(UnitFrameGeometry, AutomaticChoiceAndTheOptionThatKeepsTheOldChoices) {
     EncodeStats q;
     EXPECT_LT(encode(h, quantized, &q)[4], kUnitFrameVersion);
     EXPECT_FALSE(uses(q, GeometryPredictor::unit_normal_frame));
-    // Chunked files carry it too (version 12 with the chunk option).
+    // Chunked files carry it too (version 13: chunks, whatever their geometry modes).
     EncodeOptions chunked;
     chunked.chunks = 3;
     EncodeStats c;
     const std::vector<uint8_t> chunked_bytes = encode(h, chunked, &c);
-    EXPECT_EQ(chunked_bytes[4], kUnitFrameVersion);
+    EXPECT_EQ(chunked_bytes[4], kChunkVerticesVersion);
     EXPECT_EQ(inspect(chunked_bytes.data(), chunked_bytes.size()).chunks.size(), 3u);
     EXPECT_TRUE(identical(decode(chunked_bytes.data(), chunked_bytes.size()), decode(bytes.data(), bytes.size())));
 }

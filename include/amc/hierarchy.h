@@ -14,6 +14,7 @@
 #include <amc/mesh.h>
 #include <amc/red_split.h>
 
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -103,7 +104,7 @@ public:
     void set_position(VertexId v, Vec3 p) {
         positions_[v] = p;
         if (v < base_.positions.size()) base_.positions[v] = p;
-        far_positions_ |= is_far(p);
+        far_positions_.raise_if(is_far(p));
     }
     bool single_precision() const { return base_.single_precision; }
     // Declares the coordinates float32 (new midpoints rounded to float) or float64; restores the
@@ -183,8 +184,25 @@ private:
     void* placer_context_ = nullptr;
     // Some position may lie beyond DBL_MAX / 2 (or be NaN), where 0.5 * (a + b) overflows: the
     // default placer then takes its overflow-safe path in split_level too. (Midpoints lie within
-    // their ends' range, so only set_position and other placers can set it.)
-    bool far_positions_ = false;
+    // their ends' range, so only set_position and other placers can set it.) Decoders of chunks
+    // set positions of one hierarchy on several threads: an atomic flag, read and set relaxed.
+    class FarFlag {
+    public:
+        FarFlag() = default;
+        FarFlag(const FarFlag& other) noexcept : far_(other.get()) {}
+        FarFlag& operator=(const FarFlag& other) noexcept {
+            far_.store(other.get(), std::memory_order_relaxed);
+            return *this;
+        }
+        bool get() const { return far_.load(std::memory_order_relaxed); }
+        void raise_if(bool far) {
+            if (far) far_.store(true, std::memory_order_relaxed);
+        }
+
+    private:
+        std::atomic<bool> far_{false};
+    };
+    FarFlag far_positions_;
     static bool is_far(Vec3 p) {
         constexpr double kHalfMax = 8.98846567431157953865e307;  // DBL_MAX / 2
         return !(p.x <= kHalfMax && p.x >= -kHalfMax && p.y <= kHalfMax && p.y >= -kHalfMax && p.z <= kHalfMax &&

@@ -18,9 +18,10 @@ namespace amc {
 // second model (FORMAT.md 2.2; whatever their geometry modes): versions 8 and 9 hold the first.
 // Version 11 for files in its third model (FORMAT.md 2.3), which encoders write since. Version 12
 // for files with a level in geometry mode 5 (the unit-normal frame with three tables; whatever else
-// they hold).
+// they hold). Version 13 for chunked files (whatever else they hold): its chunk table lists each
+// chunk's own vertices.
 constexpr uint8_t kOldestReadableVersion = 1;
-constexpr uint8_t kNewestVersion = 12;
+constexpr uint8_t kNewestVersion = 13;
 constexpr uint8_t kBaseVersion = 2;       // everything but the numbering block and mode 2
 constexpr uint8_t kNumberingVersion = 3;  // the first version with a numbering block
 constexpr uint8_t kAngleBaseVersion = 4;  // the first version with base connectivity mode 2
@@ -36,6 +37,9 @@ constexpr uint8_t kGridGeometryVersion = 9;
 constexpr uint8_t kSecondMixingVersion = 10;  // the first version whose mixing mode is the second model
 constexpr uint8_t kThirdMixingVersion = 11;   // the first version whose mixing mode is the third model
 constexpr uint8_t kUnitFrameVersion = 12;     // the first version with level geometry mode 5 (unit-normal frame)
+// The first version whose chunk table gives each chunk's own vertex count (FORMAT.md 3.12), so that
+// chunks decode straight into their places in the whole on several threads.
+constexpr uint8_t kChunkVerticesVersion = 13;
 
 // The hierarchy stream (FORMAT.md section 2).
 constexpr uint8_t kHierarchyStreamVersion = 2;
@@ -60,6 +64,7 @@ constexpr uint8_t hierarchy_stream_version_of_file(uint8_t file_version) {
         case 10: return 2;
         case 11: return 2;
         case 12: return 2;
+        case 13: return 2;
     }
     return 0;
 }

@@ -59,10 +59,10 @@ Quantizer quantizer_of(const Hierarchy& input, int bits, double& max_error) {
 // The lowest version that holds what the file holds (format_version.h).
 uint8_t file_version(bool unit_geometry, bool grid_geometry, bool mixed_contexts, bool chunked, bool static_geometry,
                      BaseConnectivityMode base_mode, bool store_numbering) {
-    return unit_geometry                                 ? kUnitFrameVersion
+    return chunked                                       ? kChunkVerticesVersion
+           : unit_geometry                               ? kUnitFrameVersion
            : mixed_contexts                              ? kThirdMixingVersion
            : grid_geometry                               ? kGridGeometryVersion
-           : chunked                                     ? kChunkedVersion
            : static_geometry                             ? kStaticGeometryVersion
            : base_mode == BaseConnectivityMode::angle ? kSearchedBaseVersion
            : store_numbering                          ? kNumberingVersion
@@ -495,7 +495,7 @@ FileInfo inspect(const uint8_t* data, size_t size) {
         }
         if (block.type == BlockType::level) entry.level = level++;
         if (block.type == BlockType::chunk_table) {
-            const ChunkTable table = read_chunk_table(block, info.base_triangles, info.nodes, size);
+            const ChunkTable table = read_chunk_table(block, info.version, info.base_triangles, info.nodes, size);
             for (size_t c = 0; c < table.roots.size(); ++c)
                 info.chunks.push_back({table.roots[c].first, table.roots[c].count, table.nodes[c], table.end + table.offsets[c], 0});
         }

@@ -146,7 +146,7 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
             node.reserved = 0;
         }
     });
-    for (const Vec3& p : out.positions_) out.far_positions_ |= Hierarchy::is_far(p);
+    for (const Vec3& p : out.positions_) out.far_positions_.raise_if(Hierarchy::is_far(p));
     out.live_nodes_ = uint32_t(n);
     out.live_vertices_ = uint32_t(out.positions_.size());
     return out;

@@ -23,7 +23,7 @@ Hierarchy::Hierarchy(TriangleMesh base) : base_(std::move(base)) {
     const uint32_t f0 = root_count();
     nodes_.resize(f0);
     positions_ = base_.positions;
-    for (const Vec3& p : positions_) far_positions_ |= is_far(p);
+    for (const Vec3& p : positions_) far_positions_.raise_if(is_far(p));
     live_nodes_ = f0;
     live_vertices_ = static_cast<uint32_t>(positions_.size());
 
@@ -130,11 +130,11 @@ VertexId Hierarchy::new_vertex(Vec3 p) {
         VertexId v = free_vertices_.back();
         free_vertices_.pop_back();
         positions_[v] = p;
-        far_positions_ |= is_far(p);
+        far_positions_.raise_if(is_far(p));
         return v;
     }
     positions_.push_back(p);
-    far_positions_ |= is_far(p);
+    far_positions_.raise_if(is_far(p));
     return static_cast<VertexId>(positions_.size() - 1);
 }
 

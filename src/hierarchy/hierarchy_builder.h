@@ -5,6 +5,7 @@
 #include <amc/hierarchy.h>
 
 #include <cstdint>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -25,6 +26,15 @@ struct FrameCorners {
     VertexId a, b, c, d;
 };
 
+// Where split_level writes when decoders of several chunks build one hierarchy at once, each on
+// its own thread: the chunk's run of node ids and of vertex ids, made beforehand (open_slices),
+// filled from the front; the hierarchy's sizes and counts stay as open_slices set them.
+struct HierarchySlice {
+    NodeId next_node = 0, node_end = 0;
+    VertexId next_vertex = 0, vertex_end = 0;
+    std::string owner = "a chunk";  // what fills it, in errors
+};
+
 // A whole level's splits: the distinct splittable leaves parents[0..count) of one level, whose
 // same-level neighbours are not refined yet, in the order they are split, and the links of the
 // nodes they make: children[4 * i + k] for child k of parents[i], with local index 4 * j + k'
@@ -40,13 +50,16 @@ struct LevelSplits {
     // chunk decoder's seam vertices (chunk_coder.h).
     VertexId (*boundary_vertex)(void* context, VertexId a, VertexId b) = nullptr;
     void* boundary_context = nullptr;
-    // When set, new vertex k of the call (id positions().size() + k taken before it; boundary_vertex's
-    // vertices are not new) gets its frame corners written to new_vertex_corners[k]: room for
-    // 3 * count.
+    // When set, new vertex k of the call (id positions().size() + k taken before it, or the slice's
+    // next vertex + k; boundary_vertex's vertices are not new) gets its frame corners written to
+    // new_vertex_corners[k]: room for 3 * count.
     FrameCorners* new_vertex_corners = nullptr;
     // False: the new vertices' positions are left at zero, for a decoder that sets every one of
     // them next (their midpoints would be read and computed for nothing).
     bool place_new_vertices = true;
+    // When set, the children and new vertices go to the slice's next ids (throws Error when they
+    // do not fit), not to the end of the hierarchy.
+    HierarchySlice* slice = nullptr;
 };
 
 struct HierarchyBuilder {
@@ -58,7 +71,7 @@ struct HierarchyBuilder {
     static void split_level(Hierarchy& h, const LevelSplits& level) { h.split_level(level); }
     // Stitching hierarchies of disjoint root sets into one (hierarchy_stitch.cpp): the decoder of
     // chunked files decodes the chunks of the whole over its roots, each as if its roots were the
-    // whole base (their links to other chunks cut), or alone and copied into its slice.
+    // whole base (their links to other chunks cut), in order or each into its slice at once.
     // Appends vertices at `positions` (ids vertex_count() on), placed before any split.
     static void append_vertices(Hierarchy& h, const std::vector<Vec3>& positions);
     // A link between two roots across their edges ea and eb.
@@ -73,19 +86,10 @@ struct HierarchyBuilder {
     static std::vector<RootLink> cut_root_links(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& edges);
     // Restores links that cut_root_links cut.
     static void relink_roots(Hierarchy& h, const std::vector<RootLink>& links);
-    // One piece decoded alone: a hierarchy over some of the whole's roots, and where its nodes and vertices go.
-    struct StitchPart {
-        const Hierarchy* part = nullptr;
-        NodeId first_root = 0;  // its root i becomes root first_root + i
-        NodeId first_node = 0;  // its node root_count() + j becomes node first_node + j (a multiple of 4 past the roots)
-        const VertexId* vertex_id = nullptr;  // its vertex v becomes vertex vertex_id[v]
-    };
-    // The whole over `base`: its roots, linked across every base edge, and room for `nodes`
-    // nodes, not yet written (each part's copy writes, and so first touches, its own slice).
-    static Hierarchy stitch_frame(const TriangleMesh& base, size_t nodes);
-    // Copies part p into the whole: its nodes to first_node.., ids mapped. Parts write disjoint
-    // nodes: several may be copied at once.
-    static void stitch_part(Hierarchy& whole, const StitchPart& p);
+    // Gives `h` (roots and vertices, nothing split) `nodes` nodes and `vertices` vertices, those
+    // past its own not yet written: the slices (HierarchySlice) of decoders that fill them on
+    // several threads, each writing, and so first touching, its own.
+    static void open_slices(Hierarchy& h, size_t nodes, size_t vertices);
     // Renames the vertex ids of the nodes in [begin, end): v becomes rename(v).
     template <class Rename>
     static void stitch_rename_vertices(Hierarchy& whole, NodeId begin, NodeId end, Rename rename) {
@@ -115,7 +119,7 @@ struct HierarchyBuilder {
     // loops (set_position's base test and call cost them 4 % of a decode's instructions).
     static void set_new_vertex_position(Hierarchy& h, VertexId v, Vec3 p) {
         h.positions_[v] = p;
-        h.far_positions_ |= Hierarchy::is_far(p);
+        h.far_positions_.raise_if(Hierarchy::is_far(p));
     }
     // Hints the processor to fetch node n (for traversals that know their next nodes early).
     static void prefetch(const Hierarchy& h, NodeId n) { __builtin_prefetch(h.nodes_.data() + n); }

@@ -1,7 +1,6 @@
 // Stitching hierarchies of disjoint root sets into one (hierarchy_builder.h): the decoder of
 // chunked .amc files decodes the chunks over the whole's roots with the links between chunks cut,
-// or each alone, copied into its slice of the whole as soon as it is decoded, its vertices renamed
-// once all are in; then links the seams.
+// one after the other or each into its slice of the whole at once; then links the seams.
 #include "hierarchy/hierarchy_builder.h"
 
 #include "common/check.h"
@@ -11,46 +10,26 @@
 
 namespace amc {
 
-Hierarchy HierarchyBuilder::stitch_frame(const TriangleMesh& base, size_t nodes) {
-    Hierarchy h(base);  // the roots, linked across every base edge
+void HierarchyBuilder::open_slices(Hierarchy& h, size_t nodes, size_t vertices) {
     const size_t roots = h.root_count();
-    AMC_REQUIRE(nodes >= roots && (nodes - roots) % 4 == 0 && nodes < kNoNode, corrupt, "hierarchy too large to stitch");
+    AMC_REQUIRE(h.nodes_.size() == roots && h.free_blocks_.empty() && h.free_vertices_.empty(), invalid_input,
+                "open_slices: the hierarchy is refined already");
+    AMC_REQUIRE(nodes >= roots && (nodes - roots) % 4 == 0 && nodes < kNoNode && vertices >= h.positions_.size() &&
+                    vertices < kNoVertex,
+                corrupt, "hierarchy too large to decode in slices");
     reserve_huge(h.nodes_, nodes);
-    h.nodes_.resize(nodes);  // Node() writes nothing: the parts' copies are the first writes
+    h.nodes_.resize(nodes);  // Node() writes nothing: the slices' decoders are the first to write
     reserve_huge(h.block_parent_, (nodes - roots) / 4);
     h.block_parent_.resize((nodes - roots) / 4);
-    return h;
-}
-
-void HierarchyBuilder::stitch_part(Hierarchy& h, const StitchPart& p) {
-    const Hierarchy& s = *p.part;
-    const NodeId r = s.root_count(), roots = h.root_count();
-    auto id = [&](NodeId n) { return n == kNoNode ? kNoNode : n < r ? p.first_root + n : p.first_node + (n - r); };
-    for (NodeId i = 0; i < r; ++i) {  // the roots keep the whole base's links
-        Hierarchy::Node& root = h.nodes_[p.first_root + i];
-        root.first_child = id(s.nodes_[i].first_child);
-        root.flags = uint8_t((root.flags & 7u) | (s.nodes_[i].flags & 8u));
-    }
-    for (NodeId j = r; j < s.node_capacity(); ++j) {
-        const Hierarchy::Node& from = s.nodes_[j];
-        Hierarchy::Node& to = h.nodes_[p.first_node + (j - r)];
-        for (int e = 0; e < 3; ++e) {
-            to.v[e] = p.vertex_id[from.v[e]];
-            to.nbr[e] = id(from.nbr[e]);
-        }
-        to.first_child = id(from.first_child);
-        to.nbr_edge = from.nbr_edge;
-        to.level = from.level;
-        to.flags = from.flags;  // seam edges are still boundary edges: linked by stitch_seams
-        to.reserved = 0;
-    }
-    const size_t first_block = (p.first_node - roots) / 4;
-    for (size_t b = 0; b < s.block_parent_.size(); ++b) h.block_parent_[first_block + b] = id(s.block_parent_[b]);
+    reserve_huge(h.positions_, vertices);
+    h.positions_.resize(vertices);
+    h.live_nodes_ = uint32_t(nodes);
+    h.live_vertices_ = uint32_t(vertices);
 }
 
 void HierarchyBuilder::append_vertices(Hierarchy& h, const std::vector<Vec3>& positions) {
     AMC_REQUIRE(h.positions_.size() + positions.size() < kNoVertex, limit_exceeded, "too many vertices");
-    for (const Vec3& p : positions) h.far_positions_ |= Hierarchy::is_far(p);
+    for (const Vec3& p : positions) h.far_positions_.raise_if(Hierarchy::is_far(p));
     h.positions_.insert(h.positions_.end(), positions.begin(), positions.end());
     h.live_vertices_ = uint32_t(h.positions_.size());
 }
@@ -84,7 +63,7 @@ void HierarchyBuilder::relink_roots(Hierarchy& h, const std::vector<RootLink>& l
 void HierarchyBuilder::stitch_positions(Hierarchy& h, std::vector<Vec3> positions) {
     AMC_REQUIRE(positions.size() >= h.base().positions.size() && positions.size() < kNoVertex, corrupt,
                 "hierarchy too large to stitch");
-    for (const Vec3& p : positions) h.far_positions_ |= Hierarchy::is_far(p);
+    for (const Vec3& p : positions) h.far_positions_.raise_if(Hierarchy::is_far(p));
     h.positions_ = std::move(positions);
     h.live_vertices_ = uint32_t(h.positions_.size());
 }

@@ -185,10 +185,17 @@ void Hierarchy::split_level(const LevelSplits& splits) {
     auto first_half = [children = splits.children](uint32_t i, int e) {
         return children[size_t(4) * i + red_split::kFirstHalfChild[e]].nbr[e];
     };
-    const size_t c0 = nodes_.size();
+    HierarchySlice* const slice = splits.slice;
+    const size_t c0 = slice != nullptr ? slice->next_node : nodes_.size();
     const size_t new_nodes = c0 + size_t(4) * count;
-    if (new_nodes > nodes_.capacity()) reserve(std::max(new_nodes, nodes_.capacity() + nodes_.capacity() / 2), 0);
-    if (positions_.size() + size_t(3) * count > positions_.capacity()) {
+    const size_t v0 = slice != nullptr ? slice->next_vertex : positions_.size();
+    const size_t vertex_room = slice != nullptr ? slice->vertex_end : positions_.capacity();
+    if (slice != nullptr) {
+        AMC_REQUIRE(new_nodes <= slice->node_end, corrupt, slice->owner + " does not hold the nodes the chunk table says");
+    } else if (new_nodes > nodes_.capacity()) {
+        reserve(std::max(new_nodes, nodes_.capacity() + nodes_.capacity() / 2), 0);
+    }
+    if (v0 + size_t(3) * count > vertex_room) {
         // Maybe not enough room: count exactly. Edge e of parent i gets a new vertex unless an
         // earlier parent across it made one, or boundary_vertex has one.
         size_t new_vertices = 0;
@@ -199,15 +206,20 @@ void Hierarchy::split_level(const LevelSplits& splits) {
                                 !(splits.boundary_vertex != nullptr && ((parent.flags >> e) & 1u) &&
                                   splits.boundary_vertex(splits.boundary_context, parent.v[e], parent.v[(e + 1) % 3]) != kNoVertex);
         }
-        const size_t vertices = positions_.size() + new_vertices;
-        if (vertices > positions_.capacity()) reserve(0, std::max(vertices, positions_.capacity() + positions_.capacity() / 2));
+        const size_t vertices = v0 + new_vertices;
+        if (slice != nullptr)
+            AMC_REQUIRE(vertices <= vertex_room, corrupt, slice->owner + " does not hold the vertices the chunk table says");
+        else if (vertices > vertex_room)
+            reserve(0, std::max(vertices, positions_.capacity() + positions_.capacity() / 2));
     }
-    nodes_.resize(new_nodes);
-    block_parent_.resize((new_nodes - root_count()) / 4);
+    if (slice == nullptr) {
+        nodes_.resize(new_nodes);
+        block_parent_.resize((new_nodes - root_count()) / 4);
+    }
     NodeId* const block_parent = block_parent_.data() + (c0 - root_count()) / 4;
-    const size_t v0 = positions_.size();
     Node* nodes = nodes_.data();
     VertexId next_vertex = VertexId(v0);
+    size_t positions_written = v0;
     const bool default_placer = placer_ == midpoint_placer;
     // The parents go in chunks: first their children and links, listing the end points of the
     // new vertices, then the new vertices' positions. Apart, the position loads (which miss the
@@ -269,26 +281,36 @@ void Hierarchy::split_level(const LevelSplits& splits) {
             parent.first_child = c;
         }
         if (!splits.place_new_vertices) {
-            positions_.resize(positions_.size() + new_vertices);
+            if (slice == nullptr) positions_.resize(positions_.size() + new_vertices);  // a slice's are there already
+            positions_written += new_vertices;
             continue;
         }
         // Within the reserved capacity: no reallocation, so `positions` stays valid. One loop a
         // vertex placer, so that the default ones are inlined.
         const Vec3* positions = positions_.data();
+        const size_t first = positions_written;
         auto append = [&](auto place) {
             using Made = NewPositions<decltype(place)>;
-            positions_.insert(positions_.end(), Made(ends, ends + new_vertices, positions, place),
-                              Made(ends + new_vertices, ends + new_vertices, positions, place));
+            const Made from(ends, ends + new_vertices, positions, place), to(ends + new_vertices, ends + new_vertices, positions, place);
+            if (slice != nullptr)
+                std::copy(from, to, positions_.begin() + std::ptrdiff_t(first));
+            else
+                positions_.insert(positions_.end(), from, to);
         };
-        if (!default_placer || far_positions_) {
-            const size_t first = positions_.size();
+        positions_written += new_vertices;
+        if (!default_placer || far_positions_.get()) {
             append([placer = placer_, context = placer_context_](Vec3 a, Vec3 b) { return placer(context, a, b); });
-            for (size_t v = first; v < positions_.size(); ++v) far_positions_ |= is_far(positions_[v]);
+            for (size_t v = first; v < positions_written; ++v) far_positions_.raise_if(is_far(positions_[v]));
         } else if (placer_context_ != nullptr) {
             append([context = placer_context_](Vec3 a, Vec3 b) { return near_midpoint_placer(context, a, b); });
         } else {
             append([](Vec3 a, Vec3 b) { return near_midpoint_placer(nullptr, a, b); });
         }
+    }
+    if (slice != nullptr) {
+        slice->next_node = NodeId(new_nodes);
+        slice->next_vertex = next_vertex;
+        return;
     }
     live_nodes_ += 4 * count;
     live_vertices_ += uint32_t(next_vertex - v0);

@@ -232,7 +232,7 @@ FileChunks chunks_of(const uint8_t* data, uint64_t size, uint64_t head) {
     }
     for (int skip = 0; skip < 2; ++skip) AMC_REQUIRE(reader.next(block), corrupt, "file ends in its base mesh");
     AMC_REQUIRE(reader.next(block) && block.type == BlockType::chunk_table, corrupt, "expected a chunk table block");
-    const ChunkTable table = read_chunk_table(block, meta.base_triangles, meta.nodes, size_t(size));
+    const ChunkTable table = read_chunk_table(block, reader.version(), meta.base_triangles, meta.nodes, size_t(size));
     out.ranges = table.roots;
     out.nodes = table.nodes;
     for (uint64_t offset : table.offsets) out.offsets.push_back(table.end + offset);

@@ -87,7 +87,7 @@ void amc_seeds(const std::vector<Hierarchy>& hierarchies) {
         options.predictor = GeometryPredictor(k % 3);
         options.grid_contexts = k % 8 == 1;  // quantized: geometry mode 4 where it codes smaller (version 9)
         options.hierarchy = coder_options_from_switches(k % 2 ? 63 : (k * 7) % kCoderSwitchCombinations);
-        if (k % 3 == 2) options.chunks = 3;  // a chunked file (version 7): chunk table, seam, chunks
+        if (k % 3 == 2) options.chunks = 3;  // a chunked file (version 13): chunk table, seam, chunks
         Hierarchy input = h;
         if (k % 4 == 2) {  // a forest over the base in single precision
             TriangleMesh base = h.base();

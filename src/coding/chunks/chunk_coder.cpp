@@ -144,6 +144,7 @@ void decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, size_t 
     std::string where = what;
     SeamSplits seam_splits{place.keys, seam, place.seam_used, &where};
     hierarchy.set_boundary_vertices(&SeamSplits::find, &seam_splits);
+    hierarchy.set_slice(place.slice);
     const VertexId seam_first = place.keys.seam_first, seam_count = place.keys.seam_count;
     PositionCoder positions(space);
     BitModel flipped;

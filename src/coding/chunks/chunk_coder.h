@@ -42,7 +42,8 @@ struct ChunkDecodeLimits {
 };
 
 // Where a chunk is decoded: the `roots` roots of `target` from `first_root`, unrefined and linked
-// among themselves only (its links to other chunks cut), their descendants appended to `target`.
+// among themselves only (its links to other chunks cut), their descendants appended to `target`
+// or written into `slice` of it.
 // `keys` tells the seam keys of target's vertex ids: its base vertex v is key base_keys[v], and
 // every seam vertex s is placed already, as vertex seam_first + s.
 struct ChunkVertexKeys {
@@ -61,6 +62,7 @@ struct ChunkPlace {
     uint32_t roots = 0;
     ChunkVertexKeys keys;
     uint8_t* seam_used = nullptr;  // seam_used[s] set to 1 when the chunk splits off seam vertex s
+    HierarchySlice* slice = nullptr;  // where its nodes and own vertices go; null: appended to target
 };
 
 // What a chunk's decoder knows of its trees once every level is decoded.

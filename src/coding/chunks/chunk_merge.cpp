@@ -7,28 +7,16 @@
 #include "hierarchy/hierarchy_builder.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cstddef>
+#include <exception>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <utility>
 
-#if defined(__GLIBC__)
-#include <malloc.h>
-#endif
-
 namespace amc {
 
 namespace {
-
-// Returns the free pages of the heap to the system: glibc keeps blocks below its mapping
-// threshold (which grows as large blocks are freed) in the process after they are freed.
-void give_back_free_memory() {
-#if defined(__GLIBC__)
-    malloc_trim(0);
-#endif
-}
 
 // What both ways of merging know before the first chunk is decoded. The whole's vertices are
 // the base's, then every seam vertex (seam order), then each chunk's own in chunk order, until
@@ -42,6 +30,9 @@ struct MergePlan {
     uint64_t nodes = 0;               // of the whole, by the chunk table
     bool trusted = false;             // the table's node counts may be reserved up front
     bool full = false;                // every level of every chunk of the file: the metadata's counts hold
+    // Each chunk's nodes and own vertices known and trusted, every level decoded (a progressive
+    // decode would leave slices part empty): chunks may decode into their slices at once.
+    bool slices = false;
     VertexId seam_start = 0;
     uint32_t seam_count = 0;
     std::vector<std::pair<NodeId, int>> seam_edges;  // root edges between two chunks, both sides
@@ -79,6 +70,16 @@ MergePlan plan_merge(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& i
     AMC_REQUIRE(uint64_t(plan.seam_start) + plan.seam_count < kNoVertex, limit_exceeded, "too many vertices");
     AMC_REQUIRE(!plan.full || (input.vertices >= plan.own_start() && input.vertices < kNoVertex), corrupt,
                 "the metadata's vertex count does not fit the base and the seam");
+    // The table's own vertex counts (version 13 on): with the base and the seam, the file's.
+    uint64_t own_vertices = 0;
+    bool counts_known = true;
+    for (const ChunkJob& job : jobs) {
+        counts_known &= job.own_vertices != kUnknownVertices;
+        own_vertices += counts_known ? job.own_vertices : 0;  // each at most 3/4 of its nodes (read_chunk_table)
+    }
+    AMC_REQUIRE(!plan.full || !counts_known || plan.own_start() + own_vertices == input.vertices, corrupt,
+                "the chunk table's vertex counts do not add up to the metadata's vertex count");
+    plan.slices = counts_known && plan.trusted;
     plan.file_base_vertices = input.seam->base_vertex_count();
     plan.base_id.assign(input.base->positions.size(), kNoVertex);
     for (VertexId v = 0; v < plan.base_keys.size(); ++v) plan.base_id[plan.base_keys[v]] = v;
@@ -135,8 +136,9 @@ void finish_vertices(Hierarchy& whole, const MergePlan& plan, const std::vector<
     HierarchyBuilder::stitch_positions(whole, std::move(positions));
 }
 
-// One thread: each chunk decoded straight into the whole, in chunk order, so that its nodes and
-// its own vertices come out where the whole keeps them. No chunk hierarchy, no copy.
+// One thread (or a chunk table without vertex counts, or a progressive decode): each chunk decoded
+// straight into the whole, in chunk order, its nodes and own vertices appended where the whole
+// keeps them.
 Hierarchy merge_in_order(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& input, MergePlan& plan,
                          std::vector<ChunkCounts>& counts) {
     Hierarchy whole(plan.base);
@@ -148,11 +150,15 @@ Hierarchy merge_in_order(const std::vector<ChunkJob>& jobs, const ChunkMergeInpu
     HierarchyLevelDecoder decoder;
     for (size_t i = 0; i < jobs.size(); ++i) {
         const ChunkJob& job = jobs[i];
+        const size_t vertices_before = whole.positions().size();
         const ChunkPlace place{&whole, plan.first_root[i], job.roots.count, plan.keys_in_whole(), seam_used.data()};
         decode_chunk(decoder, job.data, job.size, place, *input.seam, input.space, limits_of(job, input), chunk_name(job),
                      counts[i]);
         AMC_REQUIRE(input.options.max_level >= 0 || decoder.node_count() == job.nodes, corrupt,
                     chunk_name(job) + " does not hold the nodes the chunk table says");
+        AMC_REQUIRE(input.options.max_level >= 0 || job.own_vertices == kUnknownVertices ||
+                        whole.positions().size() - vertices_before == job.own_vertices,
+                    corrupt, chunk_name(job) + " does not hold the vertices the chunk table says");
         AMC_REQUIRE(!plan.full || whole.positions().size() <= input.vertices, corrupt,
                     "the chunks hold more vertices than the metadata says");
     }
@@ -162,182 +168,70 @@ Hierarchy merge_in_order(const std::vector<ChunkJob>& jobs, const ChunkMergeInpu
     return whole;
 }
 
-// Several threads: each chunk decoded alone (over its own roots, the seam vertices placed after
-// its base vertices) and copied into its slice of the whole.
-Hierarchy merge_copies(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& input, MergePlan& plan,
-                       std::vector<ChunkCounts>& counts, unsigned threads) {
+// Several threads: every chunk straight into its slice of the whole, made first from the chunk
+// table's counts, so that the whole comes out as merge_in_order makes it. Each thread reuses one
+// decoder's working memory for the chunks it takes.
+Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& input, MergePlan& plan,
+                          std::vector<ChunkCounts>& counts, unsigned threads) {
     const size_t n = jobs.size();
-    std::vector<HierarchyBuilder::StitchPart> parts(n);
-    std::vector<NodeId> slice_end(n);
-    uint64_t whole_nodes = plan.base.triangles.size();
+    Hierarchy whole(plan.base);
+    HierarchyBuilder::append_vertices(whole, input.seam->positions());
+    std::vector<HierarchySlice> slices(n);
+    uint64_t node = plan.base.triangles.size(), vertex = plan.own_start();
     for (size_t i = 0; i < n; ++i) {
-        parts[i].first_root = plan.first_root[i];
-        parts[i].first_node = NodeId(whole_nodes);
-        whole_nodes += jobs[i].nodes - jobs[i].roots.count;
-        slice_end[i] = NodeId(std::min<uint64_t>(whole_nodes, kNoNode));
+        slices[i].next_node = NodeId(node);
+        slices[i].next_vertex = VertexId(std::min<uint64_t>(vertex, kNoVertex));
+        node += jobs[i].nodes - jobs[i].roots.count;
+        vertex += jobs[i].own_vertices;  // each at most 3/4 of its nodes (read_chunk_table)
+        slices[i].node_end = NodeId(std::min<uint64_t>(node, kNoNode));
+        slices[i].vertex_end = VertexId(std::min<uint64_t>(vertex, kNoVertex));
+        slices[i].owner = chunk_name(jobs[i]);
     }
-    // The whole is made first when its size is trusted, so that each chunk is copied into it as
-    // soon as it is decoded and the chunk's memory serves the next one. Otherwise (and when a
-    // progressive decode stops early) every chunk is decoded first and the whole is made from
-    // what they hold.
-    const bool whole_first = plan.trusted;
-    Hierarchy whole;
-    if (whole_first) whole = HierarchyBuilder::stitch_frame(plan.base, size_t(whole_nodes));
-
-    std::vector<std::unique_ptr<HierarchyLevelDecoder>> decoder_of(n), idle;
-    std::mutex idle_mutex;
-    // Each decoder builds its chunks in room for the largest one, reserved once.
-    uint64_t largest_chunk = 0;
-    for (const ChunkJob& job : jobs) largest_chunk = std::max(largest_chunk, job.nodes);
-    std::atomic<size_t> started{0};  // chunks whose decoding has begun
-    std::vector<std::vector<VertexId>> base_keys(n);  // each chunk's base vertex -> the file's
+    AMC_REQUIRE(vertex < kNoVertex, limit_exceeded, "too many vertices");
+    HierarchyBuilder::open_slices(whole, size_t(node), size_t(vertex));
+    find_seam_edges(plan, whole, n);
+    const std::vector<HierarchyBuilder::RootLink> cut = HierarchyBuilder::cut_root_links(whole, plan.seam_edges);
     std::vector<std::vector<uint8_t>> seam_used(n, std::vector<uint8_t>(plan.seam_count, 0));
-    std::vector<uint32_t> own(n);                     // vertices that are neither base nor seam vertices
-    std::vector<std::vector<Vec3>> own_positions(n);  // their positions, when their place is not known yet
-    std::vector<uint32_t> live(n);                    // nodes past the roots
-    // The whole's positions: the base's, the seam's, then each chunk's own vertices in chunk order.
-    // A whole file has the metadata's vertex count, so each chunk's own positions have their place
-    // once the chunks before it are counted: written there directly, or set aside until then.
-    // Otherwise all are set aside and placed once every chunk is in.
-    const bool positions_first = whole_first && plan.full;
-    std::vector<Vec3> positions;
-    std::vector<uint64_t> first_own(n);
-    std::vector<uint8_t> counted(n, 0), aside(n, 0);
-    size_t placed = 0;  // chunks whose place in `positions` is known
-    uint64_t next_own = plan.own_start();
-    std::mutex placed_mutex;
-    auto place_counted = [&] {  // under placed_mutex: the places of the chunks counted in order
-        for (; placed < n && counted[placed]; ++placed) {
-            first_own[placed] = next_own;
-            next_own += own[placed];
-            AMC_REQUIRE(next_own <= positions.size(), corrupt, "the chunks hold more vertices than the metadata says");
-            if (aside[placed]) {
-                std::vector<Vec3>& own_of = own_positions[placed];
-                std::copy(own_of.begin(), own_of.end(), positions.begin() + ptrdiff_t(first_own[placed]));
-                std::vector<Vec3>().swap(own_of);
-            }
-        }
-    };
-    positions = plan.base.positions;
-    positions.insert(positions.end(), input.seam->positions().begin(), input.seam->positions().end());
-    if (positions_first) positions.resize(size_t(input.vertices));
-    std::vector<uint8_t> named(n, 0);  // chunks whose own vertices have their final ids
-    // Chunk i, decoded into h, into the whole (its nodes and own positions); its own vertices
-    // named own_start() + k until every chunk is counted, unless their place is known already.
-    auto copy_into_whole = [&](size_t i, const Hierarchy& h) {
-        const VertexId local_base = VertexId(base_keys[i].size()), local_own = local_base + plan.seam_count;
-        own[i] = uint32_t(h.positions().size() - local_own);
-        AMC_REQUIRE(plan.own_start() + uint64_t(own[i]) < kNoVertex, limit_exceeded, "too many vertices");
-        bool direct = false;
-        if (positions_first) {
-            std::lock_guard<std::mutex> lock(placed_mutex);
-            counted[i] = 1;
-            place_counted();
-            direct = placed > i;
-        }
-        const Vec3* own_of = h.positions().data() + local_own;
-        if (direct)
-            std::copy(own_of, own_of + own[i], positions.begin() + ptrdiff_t(first_own[i]));
-        else
-            own_positions[i].assign(own_of, own_of + own[i]);
-        std::vector<VertexId> id(h.positions().size());
-        for (VertexId v = 0; v < local_base; ++v) id[v] = plan.base_id[base_keys[i][v]];
-        for (uint32_t s = 0; s < plan.seam_count; ++s) id[local_base + s] = plan.seam_start + s;
-        const VertexId own_id = VertexId(direct ? first_own[i] : plan.own_start());
-        for (uint32_t k = 0; k < own[i]; ++k) id[local_own + k] = own_id + k;
-        named[i] = direct;
-        parts[i].part = &h;
-        parts[i].vertex_id = id.data();
-        live[i] = h.node_capacity() - h.root_count();
-        AMC_REQUIRE(parts[i].first_node + live[i] == slice_end[i], corrupt,
-                    chunk_name(jobs[i]) + " does not hold the nodes the chunk table says");
-        HierarchyBuilder::stitch_part(whole, parts[i]);
-        parts[i].part = nullptr;
-        parts[i].vertex_id = nullptr;
-        if (!direct) {
-            std::lock_guard<std::mutex> lock(placed_mutex);
-            aside[i] = 1;
-            if (placed > i) {  // placed meanwhile, before its positions were aside
-                std::copy(own_positions[i].begin(), own_positions[i].end(), positions.begin() + ptrdiff_t(first_own[i]));
-                std::vector<Vec3>().swap(own_positions[i]);
-            }
-        }
-    };
-    parallel_for(n, threads, [&](size_t i) {
-        ++started;
-        const ChunkJob& job = jobs[i];
+    std::vector<std::unique_ptr<HierarchyLevelDecoder>> idle;
+    std::mutex idle_mutex;
+    auto decode_into_slice = [&](size_t i) {
+        std::unique_ptr<HierarchyLevelDecoder> decoder;
         {
             std::lock_guard<std::mutex> lock(idle_mutex);
             if (!idle.empty()) {
-                decoder_of[i] = std::move(idle.back());
+                decoder = std::move(idle.back());
                 idle.pop_back();
             }
         }
-        if (decoder_of[i] == nullptr) {
-            decoder_of[i] = std::make_unique<HierarchyLevelDecoder>();
-            if (whole_first) decoder_of[i]->hierarchy().reserve(size_t(largest_chunk), 0);
-        }
-        Hierarchy& h = decoder_of[i]->hierarchy();
-        h.reset(base_of_roots(*input.base, {job.roots}, base_keys[i]));
-        HierarchyBuilder::append_vertices(h, input.seam->positions());
-        const ChunkPlace place{&h, 0, job.roots.count,
-                               {&base_keys[i], VertexId(base_keys[i].size()), plan.seam_count, plan.file_base_vertices},
-                               seam_used[i].data()};
-        decode_chunk(*decoder_of[i], job.data, job.size, place, *input.seam, input.space, limits_of(job, input),
-                     chunk_name(job), counts[i]);
-        AMC_REQUIRE(input.options.max_level >= 0 || h.node_count() == job.nodes, corrupt,
+        if (decoder == nullptr) decoder = std::make_unique<HierarchyLevelDecoder>();
+        const ChunkJob& job = jobs[i];
+        const ChunkPlace place{&whole, plan.first_root[i], job.roots.count, plan.keys_in_whole(), seam_used[i].data(), &slices[i]};
+        decode_chunk(*decoder, job.data, job.size, place, *input.seam, input.space, limits_of(job, input), chunk_name(job),
+                     counts[i]);
+        AMC_REQUIRE(slices[i].next_node == slices[i].node_end, corrupt,
                     chunk_name(job) + " does not hold the nodes the chunk table says");
-        if (!whole_first) return;
-        if (started.load() < n) {  // a chunk still to begin takes this decoder, memory and all
-            copy_into_whole(i, h);
-            std::lock_guard<std::mutex> lock(idle_mutex);
-            idle.push_back(std::move(decoder_of[i]));
-            return;
-        }
-        // None will: its working memory goes before the copy, which is where the decode peaks.
-        const Hierarchy last = std::move(h);
-        decoder_of[i].reset();
-        give_back_free_memory();
-        copy_into_whole(i, last);
-    });
-    if (!whole_first) {  // slices as long as the chunks are
-        whole_nodes = plan.base.triangles.size();
-        for (size_t i = 0; i < n; ++i) {
-            const Hierarchy& h = decoder_of[i]->hierarchy();
-            parts[i].first_node = NodeId(whole_nodes);
-            whole_nodes += h.node_capacity() - h.root_count();
-            AMC_REQUIRE(whole_nodes < kNoNode, limit_exceeded, "too many nodes");
-            slice_end[i] = NodeId(whole_nodes);
-        }
-        whole = HierarchyBuilder::stitch_frame(plan.base, size_t(whole_nodes));
-        parallel_for(n, threads, [&](size_t i) {
-            copy_into_whole(i, decoder_of[i]->hierarchy());
-            decoder_of[i].reset();
-        });
-    }
-    idle.clear();
-    if (!positions_first) {
-        uint64_t vertices = positions.size();
-        for (size_t i = 0; i < n; ++i) vertices += own[i];
-        AMC_REQUIRE(vertices < kNoVertex, limit_exceeded, "too many vertices");
-        positions.resize(size_t(vertices));
-        std::fill(counted.begin(), counted.end(), uint8_t(1));
-        place_counted();
-    }
-    AMC_REQUIRE(placed == n && next_own == positions.size(), corrupt, "the chunks hold fewer vertices than the metadata says");
+        AMC_REQUIRE(slices[i].next_vertex == slices[i].vertex_end, corrupt,
+                    chunk_name(job) + " does not hold the vertices the chunk table says");
+        std::lock_guard<std::mutex> lock(idle_mutex);
+        idle.push_back(std::move(decoder));
+    };
+    // A corrupt file fails with its first bad chunk's error, as on one thread in chunk order.
+    std::vector<std::exception_ptr> error(n);
     parallel_for(n, threads, [&](size_t i) {
-        if (named[i]) return;
-        const VertexId own_start = plan.own_start();
-        HierarchyBuilder::stitch_rename_vertices(whole, parts[i].first_node, parts[i].first_node + live[i], [&](VertexId v) {
-            return v < own_start ? v : VertexId(first_own[i] + (v - own_start));
-        });
+        try {
+            decode_into_slice(i);
+        } catch (...) {
+            error[i] = std::current_exception();
+        }
     });
-    HierarchyBuilder::stitch_positions(whole, std::move(positions));
+    for (const std::exception_ptr& e : error)
+        if (e) std::rethrow_exception(e);
+    idle.clear();
+    HierarchyBuilder::relink_roots(whole, cut);
     std::vector<uint8_t> used(plan.seam_count, 0);
     for (const std::vector<uint8_t>& chunk_used : seam_used)
         for (uint32_t s = 0; s < plan.seam_count; ++s) used[s] |= chunk_used[s];
     finish_vertices(whole, plan, used, input);
-    find_seam_edges(plan, whole, n);
     HierarchyBuilder::stitch_seams(whole, plan.seam_edges);
     return whole;
 }
@@ -348,8 +242,8 @@ Hierarchy decode_and_merge_chunks(const std::vector<ChunkJob>& jobs, const Chunk
     MergePlan plan = plan_merge(jobs, input);
     std::vector<ChunkCounts> chunk_counts(jobs.size());
     const unsigned threads = std::min<unsigned>(resolve_thread_count(input.options.threads), unsigned(jobs.size()));
-    Hierarchy whole = threads <= 1 ? merge_in_order(jobs, input, plan, chunk_counts)
-                                   : merge_copies(jobs, input, plan, chunk_counts, threads);
+    Hierarchy whole = threads > 1 && plan.slices ? merge_in_slices(jobs, input, plan, chunk_counts, threads)
+                                                 : merge_in_order(jobs, input, plan, chunk_counts);
     counts = MergedCounts();
     for (const ChunkCounts& c : chunk_counts) {
         counts.faces += c.faces;

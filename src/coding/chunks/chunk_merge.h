@@ -1,6 +1,7 @@
 // Decoding the chunks of a chunked .amc file into one hierarchy, the whole over their roots
-// (chunked_file.h): on one thread each chunk straight into the whole, in chunk order; on several,
-// each chunk alone, copied into its slice of the whole as soon as it is decoded.
+// (chunked_file.h), each chunk straight into the whole: on one thread in chunk order; on several,
+// when the chunk table gives each chunk's nodes and own vertices (version 13 on), each into its
+// slice of the whole's nodes and vertices at once.
 #pragma once
 
 #include "coding/chunks/chunk_coder.h"
@@ -14,6 +15,8 @@
 
 namespace amc {
 
+constexpr uint64_t kUnknownVertices = UINT64_MAX;  // a chunk table before version 13
+
 // One chunk to decode: its block's payload and the chunk table's entry.
 struct ChunkJob {
     uint32_t chunk = 0;
@@ -21,6 +24,7 @@ struct ChunkJob {
     size_t size = 0;
     RootRange roots;
     uint64_t nodes = 0;
+    uint64_t own_vertices = kUnknownVertices;  // neither base nor seam vertices
 };
 
 struct ChunkMergeInput {

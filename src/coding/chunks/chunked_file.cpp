@@ -35,7 +35,7 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<RootRange>& r
     std::vector<uint32_t> key_of_vertex;
     const Seam seam(h, chunk_of_root, key_of_vertex);
     std::vector<ChunkCode> codes(ranges.size());
-    std::vector<uint64_t> nodes(ranges.size());
+    std::vector<uint64_t> nodes(ranges.size()), own_vertices(ranges.size());
     parallel_for(ranges.size(), threads, [&](size_t c) {
         std::vector<VertexId> vertex_of;
         const Hierarchy chunk = extract_roots(h, {ranges[c]}, &vertex_of);
@@ -45,17 +45,19 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<RootRange>& r
         codes[c] = encode_chunk(chunk, keys, seam, options.hierarchy, options.predictor, space, options.grid_contexts, options.unit_normals);
         codes[c].bytes.shrink_to_fit();  // held until the file is written: without the slack of its growth
         nodes[c] = chunk.node_count();
+        own_vertices[c] = uint64_t(std::count(keys.begin(), keys.end(), kNoVertex));  // neither base nor seam vertices
     });
     ChunkedBlocks out;
     std::vector<uint8_t> seam_bytes = seam.encode(space);
-    // Table: count, then per chunk its roots, nodes and where its block starts, counted from the
-    // end of the table block (so the table's own size does not matter).
+    // Table: count, then per chunk its roots, nodes, own vertices and where its block starts,
+    // counted from the end of the table block (so the table's own size does not matter).
     std::vector<uint8_t> table;
     put_varint(table, ranges.size());
     uint64_t offset = kBlockOverhead + seam_bytes.size();
     for (size_t c = 0; c < ranges.size(); ++c) {
         put_varint(table, ranges[c].count);
         put_varint(table, nodes[c]);
+        put_varint(table, own_vertices[c]);
         put_varint(table, offset);
         offset += kBlockOverhead + codes[c].bytes.size();
     }
@@ -85,7 +87,7 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<RootRange>& r
     return out;
 }
 
-ChunkTable read_chunk_table(const Block& block, uint64_t base_triangles, uint64_t nodes, size_t file_size) {
+ChunkTable read_chunk_table(const Block& block, uint8_t version, uint64_t base_triangles, uint64_t nodes, size_t file_size) {
     PayloadReader in(block.payload, block.size, "chunk table block");
     ChunkTable table;
     table.end = block.offset + kBlockOverhead + block.size;
@@ -93,16 +95,20 @@ ChunkTable read_chunk_table(const Block& block, uint64_t base_triangles, uint64_
     // Every chunk block takes kBlockOverhead bytes or more of what follows the table.
     AMC_REQUIRE(count >= 2 && count <= base_triangles && count <= (file_size - table.end) / kBlockOverhead, corrupt,
                 "chunk table block: bad chunk count " + std::to_string(count));
+    const bool lists_vertices = version >= kChunkVerticesVersion;
     uint64_t roots = 0, node_sum = 0, previous_end = 0;
     for (uint64_t c = 0; c < count; ++c) {
-        const uint64_t r = in.varint(), n = in.varint(), offset = in.varint();
-        AMC_REQUIRE(r >= 1 && r <= base_triangles - roots && n >= r && (n - r) % 4 == 0 && n <= nodes - node_sum, corrupt,
-                    "chunk table block: chunk " + std::to_string(c) + " has inconsistent counts");
+        const uint64_t r = in.varint(), n = in.varint(), v = lists_vertices ? in.varint() : 0, offset = in.varint();
+        // Each split makes at most three vertices.
+        AMC_REQUIRE(r >= 1 && r <= base_triangles - roots && n >= r && (n - r) % 4 == 0 && n <= nodes - node_sum &&
+                        v <= (n - r) / 4 * 3,
+                    corrupt, "chunk table block: chunk " + std::to_string(c) + " has inconsistent counts");
         // Chunk blocks follow the seam block in order: each starts past the end of the one before.
         AMC_REQUIRE(offset >= previous_end + kBlockOverhead && offset <= file_size - table.end - kBlockOverhead, corrupt,
                     "chunk table block: chunk " + std::to_string(c) + " has a bad offset");
         table.roots.push_back({uint32_t(roots), uint32_t(r)});
         table.nodes.push_back(n);
+        if (lists_vertices) table.own_vertices.push_back(v);
         table.offsets.push_back(offset);
         roots += r;
         node_sum += n;
@@ -120,7 +126,7 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
     Block block{};
     AMC_REQUIRE(reader.next(block) && block.type == BlockType::chunk_table, corrupt, "expected a chunk table block");
     const size_t file_size = block.offset + kBlockOverhead + block.size + reader.remaining();
-    const ChunkTable table = read_chunk_table(block, base.triangles.size(), nodes, file_size);
+    const ChunkTable table = read_chunk_table(block, input.version, base.triangles.size(), nodes, file_size);
     AMC_REQUIRE(reader.next(block) && block.type == BlockType::seam, corrupt, "expected a seam block");
     AMC_REQUIRE(block.offset + kBlockOverhead + block.size == table.end + table.offsets[0], corrupt,
                 "chunk table block: chunk 0 does not start after the seam block");
@@ -152,7 +158,8 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
     std::vector<ChunkJob> jobs(chunks.size());
     for (size_t i = 0; i < chunks.size(); ++i) {
         const uint32_t c = chunks[i];
-        jobs[i] = {c, blocks[i].payload, blocks[i].size, table.roots[c], table.nodes[c]};
+        jobs[i] = {c, blocks[i].payload, blocks[i].size, table.roots[c], table.nodes[c],
+                   table.own_vertices.empty() ? kUnknownVertices : table.own_vertices[c]};
     }
     ChunkMergeInput merge;
     merge.base = &base;

@@ -33,14 +33,16 @@ struct ChunkedBlocks {
 ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<RootRange>& ranges, const EncodeOptions& options,
                              CoordinateSpace space, unsigned threads, EncodeStats& stats);
 
-// The chunk table, read and checked against the base (root counts) and the file's node count.
+// The chunk table of a file of `version`, read and checked against the base (root counts) and
+// the file's node count.
 struct ChunkTable {
     std::vector<RootRange> roots;
     std::vector<uint64_t> nodes;
+    std::vector<uint64_t> own_vertices;  // vertices neither base nor seam vertices (version 13 on; else empty)
     std::vector<uint64_t> offsets;  // of each chunk block from the end of the table block
     size_t end = 0;                 // file offset of the end of the table block
 };
-ChunkTable read_chunk_table(const Block& block, uint64_t base_triangles, uint64_t nodes, size_t file_size);
+ChunkTable read_chunk_table(const Block& block, uint8_t version, uint64_t base_triangles, uint64_t nodes, size_t file_size);
 
 struct ChunkedDecodeInput {
     const TriangleMesh* base = nullptr;  // the decoded base mesh

@@ -227,11 +227,6 @@ std::vector<uint8_t> chunked_file_head(const TriangleMesh& base, const Seam& sea
         meta.levels = std::max<uint64_t>(meta.levels, c.levels);
     }
     meta.options = kOptionChunked;
-    bool grid_geometry = false, unit_geometry = false;
-    for (const ChunkSummary& c : chunks) {
-        grid_geometry |= c.grid_geometry != 0;
-        unit_geometry |= c.unit_geometry != 0;
-    }
     if (grid != nullptr) meta.quantizer = *grid;
     PositionCoder positions(space);
     std::vector<uint8_t> seam_bytes = seam.encode(space);
@@ -241,11 +236,11 @@ std::vector<uint8_t> chunked_file_head(const TriangleMesh& base, const Seam& sea
     for (const ChunkSummary& c : chunks) {
         put_varint(table, c.roots);
         put_varint(table, c.nodes);
+        put_varint(table, c.own_vertices);
         put_varint(table, offset);
         offset += c.block_bytes;
     }
-    BlockWriter writer(unit_geometry ? kUnitFrameVersion : grid_geometry ? kGridGeometryVersion : kChunkedVersion,
-                       grid != nullptr ? kFlagQuantized : base.single_precision ? kFlagSinglePrecision : 0);
+    BlockWriter writer(kChunkVerticesVersion, grid != nullptr ? kFlagQuantized : base.single_precision ? kFlagSinglePrecision : 0);
     writer.add(BlockType::metadata, write_metadata(meta, grid != nullptr));
     writer.add(BlockType::base_connectivity, base_code.bytes);
     writer.add(BlockType::base_geometry, encode_base_geometry(roots, base_code, false, positions));

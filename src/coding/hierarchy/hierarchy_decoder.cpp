@@ -103,6 +103,7 @@ void HierarchyLevelDecoder::start(NodeId first_root, uint32_t roots, const Hiera
     boundary_context_ = nullptr;
     list_corners_ = false;
     place_new_vertices_ = true;
+    slice_ = nullptr;
     // Uniform levels alone would build roots * (4^(U+1) - 1) / 3 nodes: check before.
     uint64_t uniform_nodes = roots, level_nodes = roots;
     for (int l = 0; l < header_.uniform_levels && uniform_nodes <= max_nodes_; ++l) {
@@ -140,13 +141,13 @@ void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder, uint64_t ma
     const Level& level = decided_.back();
     const NodeId first = level_base_;
     new_vertices_.clear();
-    new_vertex_first_ = VertexId(h_->positions().size());
+    new_vertex_first_ = slice_ != nullptr ? slice_->next_vertex : VertexId(h_->positions().size());
     if (!list_corners_) {
         new_vertices_.reserve(vertex_count_ - vertices_before);  // once per level, not doubling vertex by vertex
         for_each_new_vertex(level, numbering_, [&](uint32_t i, int e) { new_vertices_.emplace_back(first + i, e); });
     }
     build_decided_levels();
-    new_vertex_count_ = h_->positions().size() - new_vertex_first_;
+    new_vertex_count_ = (slice_ != nullptr ? slice_->next_vertex : h_->positions().size()) - new_vertex_first_;
 }
 
 void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder, uint64_t max_refined) {
@@ -279,8 +280,9 @@ void HierarchyLevelDecoder::build_decided_levels() {
         const uint32_t count = level.refined_count;
         uint32_t* parents = level.refined.data();
         for (uint32_t b = 0; b < count; ++b) parents[b] += level_base_;
-        const NodeId first_child = h_->node_capacity();
+        const NodeId first_child = slice_ != nullptr ? slice_->next_node : h_->node_capacity();
         LevelSplits splits{parents, count, children.nbr.data(), boundary_vertex_, boundary_context_};
+        splits.slice = slice_;
         // Listed or left unplaced for decode_level's caller, which takes one level at a time.
         if (list_corners_ || !place_new_vertices_) {
             AMC_REQUIRE(decided_.size() == 1, invalid_input, "hierarchy decoder: listed new vertices need decode_level");

@@ -160,6 +160,9 @@ public:
         list_corners_ = corners;
         place_new_vertices_ = placed;
     }
+    // Until the next restart, the levels are built in `slice` of hierarchy() (HierarchySlice,
+    // hierarchy_builder.h), not at its end: decoders of chunks building one hierarchy at once.
+    void set_slice(HierarchySlice* slice) { slice_ = slice; }
     bool done() const { return level_.empty(); }
     int level() const { return level_index_; }
     // Nodes of the current level (ids in hierarchy()) in canonical order.
@@ -217,6 +220,7 @@ private:
     Hierarchy* h_ = &own_;  // the hierarchy built: own_, or restart_in's target
     VertexId (*boundary_vertex_)(void*, VertexId, VertexId) = nullptr;
     void* boundary_context_ = nullptr;
+    HierarchySlice* slice_ = nullptr;
     HierarchyModels models_;
     LevelTraversal traversal_;
     Level level_;
