@@ -4,8 +4,8 @@
 //   chunks_bench sizes BITS model.amh ...          bytes with 1 chunk, the default chunks, and 2, 4, 8
 //                                                  chunks; every chunked file checked to decode
 //                                                  identical to the unchunked one
-//   chunks_bench speed RUNS BITS CHUNKS model.amh  wall time of encode and decode with 1 and with 2
-//                                                  threads (CHUNKS 0: the default count), runs
+//   chunks_bench speed RUNS BITS CHUNKS model.amh  wall and CPU time of encode and decode with 1 and
+//                                                  with 2 threads (CHUNKS 0: the default count), runs
 //                                                  interleaved; median [min - max] and the ratio of
 //                                                  each run's pair (on a shared machine the load
 //                                                  moves: pairs taken a second apart compare best)
@@ -75,15 +75,16 @@ int speed(int runs, int bits, uint32_t chunks, const char* path) {
     amc::EncodeStats stats;
     const std::vector<uint8_t> bytes = amc::encode(h, options, &stats);
     const amc::FileInfo info = amc::inspect(bytes.data(), bytes.size());
-    std::vector<double> encode_time[2], decode_time[2], encode_ratio, decode_ratio;
+    std::vector<double> encode_time[2], decode_time[2], encode_cpu[2], decode_cpu[2], encode_ratio, decode_ratio;
     for (int r = 0; r < runs; ++r) {
-        double seconds[2][2];
+        double seconds[2][2], cpu[2][2];
         for (unsigned threads : {1u, 2u}) {
             amc::EncodeOptions o = options;
             o.threads = threads;
-            double start = now();
+            double start = now(), cpu_start = cpu_seconds();
             const std::vector<uint8_t> again = amc::encode(h, o);
             seconds[threads - 1][0] = now() - start;
+            cpu[threads - 1][0] = cpu_seconds() - cpu_start;
             if (again != bytes) {
                 std::fprintf(stderr, "%s: %u threads wrote other bytes\n", path, threads);
                 return 1;
@@ -91,30 +92,36 @@ int speed(int runs, int bits, uint32_t chunks, const char* path) {
             amc::DecodeOptions d;
             d.threads = threads;
             start = now();
+            cpu_start = cpu_seconds();
             {
                 const amc::Hierarchy back = amc::decode(bytes.data(), bytes.size(), d);
                 seconds[threads - 1][1] = now() - start;
+                cpu[threads - 1][1] = cpu_seconds() - cpu_start;
                 if (back.node_count() != h.node_count()) return 1;
             }
         }
         for (int t = 0; t < 2; ++t) {
             encode_time[t].push_back(seconds[t][0]);
             decode_time[t].push_back(seconds[t][1]);
+            encode_cpu[t].push_back(cpu[t][0]);
+            decode_cpu[t].push_back(cpu[t][1]);
         }
         encode_ratio.push_back(seconds[0][0] / seconds[1][0]);
         decode_ratio.push_back(seconds[0][1] / seconds[1][1]);
     }
     std::printf("%s: %lu faces, %zu bytes, %zu chunks, %d runs (wall time, seconds: median [min - max])\n", name_of(path).c_str(),
                 (unsigned long)stats.faces, bytes.size(), std::max<size_t>(1, info.chunks.size()), runs);
-    auto line = [&](const char* what, std::vector<double>* time, const std::vector<double>& ratio) {
+    auto line = [&](const char* what, std::vector<double>* time, std::vector<double>* cpu, const std::vector<double>& ratio) {
         const Range one = range_of(time[0]), two = range_of(time[1]), r = range_of(ratio);
+        const Range cpu_one = range_of(cpu[0]), cpu_two = range_of(cpu[1]);
         std::printf("  %s: 1 thread %.3f [%.3f - %.3f] (%.2f M faces/s), 2 threads %.3f [%.3f - %.3f] (%.2f M faces/s); "
-                    "speed-up per run %.2f [%.2f - %.2f]\n",
+                    "speed-up per run %.2f [%.2f - %.2f]; CPU time 1 thread %.3f [%.3f - %.3f], 2 threads %.3f [%.3f - %.3f]\n",
                     what, one.median, one.low, one.high, stats.faces / one.median / 1e6, two.median, two.low, two.high,
-                    stats.faces / two.median / 1e6, r.median, r.low, r.high);
+                    stats.faces / two.median / 1e6, r.median, r.low, r.high, cpu_one.median, cpu_one.low, cpu_one.high,
+                    cpu_two.median, cpu_two.low, cpu_two.high);
     };
-    line("encode", encode_time, encode_ratio);
-    line("decode", decode_time, decode_ratio);
+    line("encode", encode_time, encode_cpu, encode_ratio);
+    line("decode", decode_time, decode_cpu, decode_ratio);
     return 0;
 }
 
