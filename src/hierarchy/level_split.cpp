@@ -236,6 +236,12 @@ void Hierarchy::split_level(const LevelSplits& splits) {
         uint32_t new_vertices = 0;
         for (uint32_t i = chunk; i < chunk_end; ++i) {
             if (i + kParentsAhead < count) __builtin_prefetch(nodes + parents[i + kParentsAhead]);
+            if (corners != nullptr && i + kParentsAhead / 2 < count) {
+                // The neighbours whose far vertices the corners take (a missing one, kNoNode, is
+                // fetched from nowhere: prefetches do not fault).
+                const Node& ahead = nodes[parents[i + kParentsAhead / 2]];
+                for (int e = 0; e < 3; ++e) __builtin_prefetch(nodes + ahead.nbr[e]);
+            }
             const NodeId n = parents[i];
             Node& parent = nodes[n];
             const NodeId c = NodeId(c0 + size_t(4) * i);
