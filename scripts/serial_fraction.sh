@@ -1,21 +1,23 @@
 #!/usr/bin/env bash
 # What share of an encode and a decode runs outside the threads' tasks (docs/BENCHMARKS.md, "Threads
-# and memory"): bench/chunks_bench repeats one operation on ONE thread under `perf record` with
-# call graphs; a sample is parallel work when its call chain passes through a parallel_for task
+# and memory"): bench/chunks_bench repeats one operation on THREADS threads (default 2: a decode on
+# one thread takes the chunks in order, without tasks) under `perf record` with call graphs; a
+# sample is parallel work when its call chain passes through a parallel_for task
 # (run_task, never inlined, names the task's lambda, which takes the task index:
 # `{lambda(unsigned long)`), and serial otherwise. CPU-time samples: the shares do not depend on the machine's load. Amdahl's law
 # then bounds the speed-up on T threads by 1 / (serial + (1 - serial) / T).
-# Usage: scripts/serial_fraction.sh model.amh [build-dir] [runs]   (needs perf; BITS 0 and 12)
+# Usage: scripts/serial_fraction.sh model.amh [build-dir] [runs]   (needs perf; BITS 0 and 12; THREADS=2)
 set -euo pipefail
 model=$1
 build=${2:-$(cd "$(dirname "$0")/.." && pwd)/build-bench}
 runs=${3:-5}
+threads=${THREADS:-2}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 for bits in 0 12; do
   for what in encode decode; do
     perf record -q --call-graph=dwarf,16384 -F 999 -o "$tmp/perf.data" \
-      "$build/bench/chunks_bench" repeat "$what" "$runs" 1 "$bits" "$model" > /dev/null 2>&1
+      "$build/bench/chunks_bench" repeat "$what" "$runs" "$threads" "$bits" "$model" > /dev/null 2>&1
     perf script -i "$tmp/perf.data" 2> /dev/null > "$tmp/perf.txt"
     python3 - "$tmp/perf.txt" "$what" "$bits" <<'PY'
 import collections, re, sys
@@ -33,7 +35,10 @@ def sample(stack):
     names = [name(f) for f in stack]
     top = next((i for i in range(len(names) - 1, -1, -1) if names[i] == entry or names[i].startswith(entry + "(")), None)
     if top is None:
-        return  # reading the model, the first encode
+        if any("{lambda(unsigned long)" in s for s in names):  # another thread's task
+            samples += 1
+            parallel += 1
+        return  # else reading the model, the first encode (on one thread)
     inner = names[:top]
     samples += 1
     if any("{lambda(unsigned long)" in s for s in inner):
