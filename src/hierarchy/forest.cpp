@@ -2,6 +2,8 @@
 // coarsening, and the canonical breadth-first order (the decoders' bulk split: level_split.cpp).
 #include <amc/hierarchy.h>
 
+#include "hierarchy/hierarchy_builder.h"
+
 #include "common/huge_pages.h"
 #include "hierarchy/midpoint_placers.h"
 #include "mesh/vertex_buckets.h"
@@ -287,11 +289,13 @@ std::vector<NodeId> Hierarchy::leaves() const {
     return result;
 }
 
-std::vector<uint32_t> canonical_vertex_order(const Hierarchy& h) {
+std::vector<uint32_t> canonical_vertex_order(const Hierarchy& h) { return canonical_vertex_order(h, h.breadth_first_order()); }
+
+std::vector<uint32_t> canonical_vertex_order(const Hierarchy& h, const std::vector<NodeId>& breadth_first) {
     std::vector<uint32_t> order(h.positions().size(), kNoVertex);
     uint32_t next = 0;
     for (uint32_t v = 0; v < h.base().positions.size(); ++v) order[v] = next++;
-    for (NodeId n : h.breadth_first_order()) {
+    for (NodeId n : breadth_first) {
         if (h.is_leaf(n)) continue;
         for (int e = 0; e < 3; ++e) {
             VertexId m = h.midpoint(n, e);

@@ -62,6 +62,10 @@ struct LevelSplits {
     HierarchySlice* slice = nullptr;
 };
 
+// canonical_vertex_order (hierarchy.h) over h.breadth_first_order() made already, for callers
+// that walk that order too (the leaf mesh): one pass over the nodes instead of two.
+std::vector<uint32_t> canonical_vertex_order(const Hierarchy& h, const std::vector<NodeId>& breadth_first);
+
 struct HierarchyBuilder {
     // Splits level.parents in order with the result of calling split() on each in turn (same
     // node ids, vertex ids and links), in one pass: the bulk form for decoders that replay a

@@ -1,10 +1,13 @@
 // The conforming leaf mesh: red leaves as they are, green closure of hanging nodes (paper, Fig. 3).
 #include <amc/hierarchy.h>
 
+#include "hierarchy/hierarchy_builder.h"
+
 namespace amc {
 
 LeafMesh extract_leaf_mesh(const Hierarchy& h, int max_level) {
-    const std::vector<uint32_t> canonical = canonical_vertex_order(h);
+    const std::vector<NodeId> breadth_first = h.breadth_first_order();
+    const std::vector<uint32_t> canonical = canonical_vertex_order(h, breadth_first);
     const bool cut = max_level >= 0;
     LeafMesh out;
     out.mesh.single_precision = h.single_precision();
@@ -17,7 +20,7 @@ LeafMesh extract_leaf_mesh(const Hierarchy& h, int max_level) {
         out.source.push_back(n);
     };
 
-    for (NodeId n : h.breadth_first_order()) {
+    for (NodeId n : breadth_first) {
         const bool at_cut = cut && h.level(n) >= max_level;
         if (cut && h.level(n) > max_level) break;  // breadth-first: all later nodes are finer
         if (!h.is_leaf(n) && !at_cut) continue;
