@@ -9,6 +9,8 @@
 //                                                  interleaved; median [min - max] and the ratio of
 //                                                  each run's pair (on a shared machine the load
 //                                                  moves: pairs taken a second apart compare best)
+//   chunks_bench decode-speed RUNS BITS model.amh  decodes only: RUNS pairs of a 1- and a 2-thread
+//                                                  decode, 0.2 s apart (for chrt -f: see decode_speed)
 //   chunks_bench repeat encode|decode RUNS THREADS BITS model.amh
 //                                                  encodes the model once (default options), then
 //                                                  encodes or decodes it RUNS times on THREADS
@@ -25,6 +27,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace {
@@ -125,6 +128,41 @@ int speed(int runs, int bits, uint32_t chunks, const char* path) {
     return 0;
 }
 
+// Decodes only, RUNS pairs of a 1- and a 2-thread decode, each after a pause of 0.2 s: under a
+// real-time policy (chrt -f, so that other sessions' load does not take the cores) the pauses keep
+// the process within the kernel's real-time budget (95 % of each second by default), which would
+// otherwise stop it for tens of milliseconds in the middle of a run.
+int decode_speed(int runs, int bits, const char* path) {
+    const amc::Hierarchy h = amc::read_hierarchy(path);
+    amc::EncodeOptions options;
+    options.quantize_bits = bits;
+    const std::vector<uint8_t> bytes = amc::encode(h, options);
+    const amc::FileInfo info = amc::inspect(bytes.data(), bytes.size());
+    std::vector<double> wall[2], cpu[2], ratio;
+    for (int r = 0; r < runs; ++r) {
+        double seconds[2];
+        for (unsigned threads : {1u, 2u}) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(200));
+            amc::DecodeOptions d;
+            d.threads = threads;
+            const double start = now(), cpu_start = cpu_seconds();
+            const amc::Hierarchy back = amc::decode(bytes.data(), bytes.size(), d);
+            seconds[threads - 1] = now() - start;
+            wall[threads - 1].push_back(seconds[threads - 1]);
+            cpu[threads - 1].push_back(cpu_seconds() - cpu_start);
+            if (back.node_count() != h.node_count()) return 1;
+        }
+        ratio.push_back(seconds[0] / seconds[1]);
+    }
+    const Range one = range_of(wall[0]), two = range_of(wall[1]), r = range_of(ratio);
+    const Range cpu_one = range_of(cpu[0]), cpu_two = range_of(cpu[1]);
+    std::printf("%s, %d bits: %zu bytes, %zu chunks, %d pairs of decodes: wall 1 thread %.4f [%.4f - %.4f] s, 2 threads %.4f "
+                "[%.4f - %.4f] s, speed-up per pair %.2f [%.2f - %.2f]; CPU 1 thread %.4f, 2 threads %.4f s (medians)\n",
+                name_of(path).c_str(), bits, bytes.size(), std::max<size_t>(1, info.chunks.size()), runs, one.median, one.low,
+                one.high, two.median, two.low, two.high, r.median, r.low, r.high, cpu_one.median, cpu_two.median);
+    return 0;
+}
+
 int repeat(const std::string& what, int runs, unsigned threads, int bits, const char* path) {
     const amc::Hierarchy h = amc::read_hierarchy(path);
     amc::EncodeOptions options;
@@ -152,9 +190,11 @@ int main(int argc, char** argv) {
     if (mode == "sizes" && argc >= 4) return sizes(std::atoi(argv[2]), argc - 3, argv + 3);
     if (mode == "speed" && argc == 6)
         return speed(std::max(1, std::atoi(argv[2])), std::atoi(argv[3]), uint32_t(std::atoi(argv[4])), argv[5]);
+    if (mode == "decode-speed" && argc == 5) return decode_speed(std::max(1, std::atoi(argv[2])), std::atoi(argv[3]), argv[4]);
     if (mode == "repeat" && argc == 7 && (std::string(argv[2]) == "encode" || std::string(argv[2]) == "decode"))
         return repeat(argv[2], std::max(1, std::atoi(argv[3])), unsigned(std::atoi(argv[4])), std::atoi(argv[5]), argv[6]);
     std::fprintf(stderr, "usage: chunks_bench sizes BITS model.amh ...\n       chunks_bench speed RUNS BITS CHUNKS model.amh\n"
+                         "       chunks_bench decode-speed RUNS BITS model.amh\n"
                          "       chunks_bench repeat encode|decode RUNS THREADS BITS model.amh\n");
     return 2;
 }
