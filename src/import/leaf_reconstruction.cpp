@@ -13,34 +13,53 @@
 namespace amc {
 
 std::vector<uint32_t> Reconstruction::run() {
-    std::vector<NodeId> level;
+    std::vector<NodeId> level, next;
     for (NodeId r = 0; r < h_.root_count(); ++r) level.push_back(r);
-    std::vector<NodeId> refined, next;
+    int depth = 0;
     while (!level.empty()) {
-        read_level_or_repair(level, refined);
-        for (NodeId n : refined) h_.split(n);
-        leaf_of_vertex_.resize(h_.positions().size(), kNoIndex);
-        for (const Reveal& r : reveals_) {
-            const NodeId q = h_.neighbor(r.node, r.edge);
-            const VertexId m = h_.midpoint(q, h_.neighbor_edge(r.node, r.edge));
-            if (leaf_of_vertex_[m] == kNoIndex) {
-                assign(m, r.leaf_vertex);
-            } else if (leaf_of_vertex_[m] != r.leaf_vertex) {
-                fail("vertices " + std::to_string(leaf_of_vertex_[m]) + " and " + std::to_string(r.leaf_vertex) +
-                     " both split the edge (" + edge_text(q, h_.neighbor_edge(r.node, r.edge)) + ")");
-            }
+        remember(depth, level);
+        try {
+            reconstruct_level(level, next);
+        } catch (const Error& e) {
+            if (!choice_ || guide_ != MidpointGuide::leaf_midpoint || referee_) throw;  // way 5's first (docs/IMPORT.md)
+            if (!backtrack(depth, level, read_failed_, e.what())) throw Error(first_error_);
+            continue;
         }
-        next.clear();
-        for (NodeId n : refined) {
-            for (int e = 0; e < 3; ++e) {
-                const VertexId m = h_.midpoint(n, e);
-                if (leaf_of_vertex_[m] == kNoIndex) assign(m, find_midpoint(n, e));
-            }
-            for (int k = 0; k < 4; ++k) next.push_back(h_.child(n, k));
-        }
+        level_done(depth);
         level.swap(next);
+        ++depth;
     }
     return leaf_of_vertex_;
+}
+
+void Reconstruction::reconstruct_level(std::vector<NodeId>& level, std::vector<NodeId>& next) {
+    std::vector<NodeId>& refined = refined_;
+    read_failed_ = true;
+    read_level_or_repair(level, refined);
+    read_failed_ = false;
+    for (NodeId n : refined) h_.split(n);
+    leaf_of_vertex_.resize(h_.positions().size(), kNoIndex);
+    for (const Reveal& r : reveals_) {
+        const NodeId q = h_.neighbor(r.node, r.edge);
+        const VertexId m = h_.midpoint(q, h_.neighbor_edge(r.node, r.edge));
+        failed_node_ = r.node;
+        if (leaf_of_vertex_[m] == kNoIndex) {
+            assign(m, r.leaf_vertex);
+        } else if (leaf_of_vertex_[m] != r.leaf_vertex) {
+            fail("vertices " + std::to_string(leaf_of_vertex_[m]) + " and " + std::to_string(r.leaf_vertex) +
+                 " both split the edge (" + edge_text(q, h_.neighbor_edge(r.node, r.edge)) + ")");
+        }
+    }
+    next.clear();
+    for (NodeId n : refined) {
+        failed_node_ = n;
+        for (int e = 0; e < 3; ++e) {
+            const VertexId m = h_.midpoint(n, e);
+            if (leaf_of_vertex_[m] == kNoIndex) assign(m, find_midpoint(n, e));
+        }
+        for (int k = 0; k < 4; ++k) next.push_back(h_.child(n, k));
+    }
+    failed_node_ = kNoNode;
 }
 
 void Reconstruction::read_level_or_repair(const std::vector<NodeId>& level, std::vector<NodeId>& refined) {
@@ -219,6 +238,13 @@ uint32_t Reconstruction::find_midpoint(NodeId n, int e) {
         if (found == kNoIndex) fail("no vertex at the midpoint of edge (" + edge_text(n, e) + ")");
         return found;
     }
+    if (!forced_.empty()) {  // a retry's vertex (pick_backtrack.cpp), while it is free
+        const auto it = forced_.find(edge_key(a, b));
+        if (it != forced_.end() && vertex_of_leaf_[it->second] == kNoIndex) {
+            note_pick(h_.midpoint(n, e), n, e);
+            return it->second;
+        }
+    }
     // From the connectivity alone where it tells: the halves of the edge are leaf edges.
     const uint32_t common = only_unmatched_common_neighbor(a, b);
     if (common != kNoIndex) return common;
@@ -239,6 +265,7 @@ uint32_t Reconstruction::find_midpoint(NodeId n, int e) {
     if (referee_ && found != kNoIndex) found = (*referee_)(GuidedPick{h_.level(n), a, b, found, nearest, count, false});
     if (found == kNoIndex) fail("no vertex left to split the edge (" + edge_text(n, e) + ")");
     note_guided(h_.midpoint(n, e), n, e);
+    note_pick(h_.midpoint(n, e), n, e);
     return found;
 }
 

@@ -1,6 +1,7 @@
 // The top-down reconstruction of a hierarchy from its leaf mesh (docs/IMPORT.md, section 1), its
-// state shared by the levels (leaf_reconstruction.cpp) and the repair of guided picks that the
-// next level contradicts (pick_repair.cpp). Internal to leaf_reconstruction.h's function.
+// state shared by the levels (leaf_reconstruction.cpp), the repair of guided picks that the
+// next level contradicts (pick_repair.cpp) and the return to an earlier level when a level further
+// down contradicts them (pick_backtrack.cpp). Internal to leaf_reconstruction.h's function.
 #pragma once
 
 #include "common/no_index.h"
@@ -12,6 +13,8 @@
 #include <algorithm>
 #include <memory>
 #include <string>
+#include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 namespace amc {
@@ -43,6 +46,29 @@ private:
     struct GuidedSlot {
         NodeId node;
         int edge;
+    };
+    // The reconstruction as it stood before a level was read (pick_backtrack.cpp).
+    struct LevelState {
+        Hierarchy h;
+        std::vector<uint32_t> leaf_of_vertex, vertex_of_leaf, guided_of_vertex;
+        std::vector<GuidedSlot> guided;
+        std::vector<int8_t> pick_level;
+        std::vector<uint64_t> pick_edge;
+        std::vector<NodeId> level;
+    };
+    // Another vertex for the edge (a, b) of a node of `level`, tried by going back to that level;
+    // when another pick of the level holds it, that pick's edge gets the vertex (a, b) had.
+    struct Retry {
+        int level;
+        uint32_t a, b, vertex;
+        uint64_t swap_edge;  // 0: none
+        uint32_t swap_vertex;
+    };
+    // The forced vertices a retry replaced (kNoIndex: none), to put back.
+    struct ForcedBefore {
+        uint64_t edge[2] = {0, 0};
+        uint32_t vertex[2] = {0, 0};
+        int count = 0;
     };
 
     [[noreturn]] void fail(const std::string& message) const { throw Error(what_ + ": " + message); }
@@ -149,6 +175,50 @@ private:
     }
 
     Reading read(const uint32_t p[3]) const;
+    // One level: read (repairing the previous level's picks), split, its midpoints found; `next`
+    // gets the children.
+    void reconstruct_level(std::vector<NodeId>& level, std::vector<NodeId>& next);
+    // Keeps the state before level `depth` is read (from the first failure on; before that only
+    // level 0's, to start again from).
+    void remember(int depth, const std::vector<NodeId>& level);
+    void restore(int depth, std::vector<NodeId>& level);
+    // After level `depth` failed (in its reading, or after it) with `error`: goes back to an
+    // earlier level with another vertex for one of the guided picks above the first misfit
+    // (restoring `depth` and `level`), judging the retry made before, if any, by this failure.
+    // False when no retry is left within the budget.
+    bool backtrack(int& depth, std::vector<NodeId>& level, bool read_failed, const std::string& error);
+    // A retry that gets past the level it was made for is kept.
+    void level_done(int depth) {
+        if (depth == retry_depth_) retry_open_ = false, retry_depth_ = -1;
+    }
+    // The retries for the guided picks above misfit x of level `depth`, nearest levels first.
+    void plan_retries(int depth, NodeId x);
+    bool start_next_retry(int& depth, std::vector<NodeId>& level);
+    int misfit_count(const std::vector<NodeId>& level) const;
+    // From the state before level `from`, reconstructs only the descendants of `region` (nodes of
+    // that level) down to level `depth`, leniently, and counts the misfits among those of its
+    // first `inner` nodes.
+    int local_misfits(int from, int depth, const std::vector<NodeId>& region, size_t inner);
+    // Notes that hierarchy vertex m, the midpoint of edge e of n, was picked by position or by a
+    // retry.
+    void note_pick(VertexId m, NodeId n, int e) {
+        if (pick_level_.size() <= m) {
+            pick_level_.resize(h_.positions().size(), -1);
+            pick_edge_.resize(h_.positions().size(), 0);
+        }
+        pick_level_[m] = int8_t(h_.level(n));
+        pick_edge_[m] = edge_key(corner(n, e), corner(n, (e + 1) % 3));
+    }
+    ForcedBefore force(const Retry& r);
+    void put_back(const ForcedBefore& before);
+    static uint64_t edge_key(uint32_t a, uint32_t b) {
+        return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a;
+    }
+    // A hash of an edge and a vertex (a retry made; a misfit by its corners): a collision only
+    // skips a retry.
+    static uint64_t retry_key(uint32_t a, uint32_t b, uint32_t v) {
+        return edge_key(a, b) ^ (uint64_t(v) * 0x9e3779b97f4a7c15ull);
+    }
     // Reads a level's nodes (classify) and checks them against each other before anything is
     // split: balance, T-junctions, hanging nodes. Throws on the first misfit.
     void read_level(const std::vector<NodeId>& level, std::vector<NodeId>& refined);
@@ -220,6 +290,33 @@ private:
     static constexpr uint32_t kRepairCandidates = 8;
     static constexpr int kRepairPasses = 3;
     static constexpr int kChainHops = 4;  // "a few hops": the edges of the finest levels
+    // Backtracking (pick_backtrack.cpp): how far up a contradiction is traced; the retries per
+    // failure; and the work allowed, in node and vertex records copied or read, per leaf face (a
+    // whole reconstruction that keeps its levels copies about ten per face).
+    static constexpr int kBacktrackLevels = 3;
+    static constexpr int kRetriesPerFailure = 8;
+    static constexpr uint64_t kWorkPerFace = 256;
+    static constexpr int kMaxMisfits = 16;  // a level misfitting more is given up
+    uint64_t work_ = 0;
+    std::vector<NodeId> local_level_;  // scratch of local_misfits
+    bool over_budget() const { return work_ > kWorkPerFace * leaf_.triangles.size(); }
+    uint64_t state_size() const { return h_.node_capacity() + leaf_.positions.size(); }
+    bool keep_levels_ = false;                 // snapshots of every level (after a first failure)
+    std::vector<LevelState> states_;          // per depth, while kept
+    std::vector<int8_t> pick_level_;          // per hierarchy vertex: level of its guided pick, or -1
+    std::vector<uint64_t> pick_edge_;         // and its edge (edge_key)
+    std::unordered_map<uint64_t, uint32_t> forced_;  // edge -> the vertex a retry gives it
+    std::unordered_set<uint64_t> tried_;             // retry_key of the retries made
+    std::unordered_set<uint64_t> planned_;            // misfits (their corners) retries were planned for
+    bool kept_since_round_ = false;                  // a retry kept since planned_ was cleared
+    std::vector<Retry> retries_;                      // those planned for the failure being worked on
+    size_t next_retry_ = 0;
+    int plan_floor_ = 0;       // the highest level the plan's retries restored
+    int retry_depth_ = -1;     // the failing level the planned retries must get past (-1: none)
+    int retry_misfits_ = 0;    // its misfits before the retries
+    bool retry_open_ = false;  // a retry is applied and not judged yet
+    ForcedBefore open_before_;  // of the retry applied
+    std::string first_error_;  // reported when the retries do not help
     std::unique_ptr<LeafDetour> detour_;
     std::vector<GuidedSlot> guided_;          // the guided picks of the level last split, until the next reads
     std::vector<uint32_t> guided_of_vertex_;  // per hierarchy vertex: its index in guided_, or kNoIndex
@@ -230,6 +327,9 @@ private:
     std::vector<Reveal> reveals_;
     std::vector<uint32_t> around_b_;  // scratch of only_unmatched_common_neighbor
     std::vector<UnsplitEdge> unsplit_edges_;
+    std::vector<NodeId> refined_;        // scratch of reconstruct_level
+    bool read_failed_ = false;           // reconstruct_level failed while reading its level
+    NodeId failed_node_ = kNoNode;       // else the node of the level whose vertices did not fit
     std::vector<uint8_t> refined_mark_;  // per node: read refined in the level being read
     std::unique_ptr<NearestVertex> nearest_;
     std::unique_ptr<ClosestPointQuery> surface_;
