@@ -3,6 +3,7 @@
 #include <amc/hierarchy.h>
 
 #include "common/check.h"
+#include "common/compiler.h"
 #include "common/huge_pages.h"
 #include "common/simd.h"
 #include "hierarchy/hierarchy_builder.h"
@@ -130,7 +131,13 @@ struct ChildTailTable {
 };
 constexpr ChildTailTable kChildTails{};
 
-void Hierarchy::write_tail(Node& node, uint32_t word) {
+namespace {
+
+// The bodies of write_tail and write_neighbors, inlined into split_level: the library is compiled
+// position-independent, where GCC does not inline a global function into another (it might be
+// interposed), and a call per parent cost the build 3 % of its instructions.
+template <class Node>
+AMC_ALWAYS_INLINE void store_tail(Node& node, uint32_t word) {
     // Bytes nbr_edge, level, flags, reserved in that order (little endian word).
 #if AMC_LITTLE_ENDIAN
     std::memcpy(&node.nbr_edge, &word, 4);
@@ -142,10 +149,8 @@ void Hierarchy::write_tail(Node& node, uint32_t word) {
 #endif
 }
 
-// The neighbours of four new siblings from their local links; a local index becomes the id
-// offset + index, kNoNode stays. Each child's store also fills its last four bytes, which
-// write_tail writes afterwards.
-void Hierarchy::write_neighbors(Node* child, const Neighbors* siblings, uint32_t offset) {
+template <class Node>
+AMC_ALWAYS_INLINE void store_neighbors(Node* child, const Neighbors* siblings, uint32_t offset) {
     const uint32_t* links = siblings[0].nbr;  // word 3k + e: child k, edge e (Neighbors' static_assert)
 #if AMC_SSE2
     const __m128i all_ones = _mm_set1_epi32(-1);
@@ -169,6 +174,17 @@ void Hierarchy::write_neighbors(Node* child, const Neighbors* siblings, uint32_t
         }
     }
 #endif
+}
+
+}  // namespace
+
+void Hierarchy::write_tail(Node& node, uint32_t word) { store_tail(node, word); }
+
+// The neighbours of four new siblings from their local links; a local index becomes the id
+// offset + index, kNoNode stays. Each child's store also fills its last four bytes, which
+// write_tail writes afterwards.
+void Hierarchy::write_neighbors(Node* child, const Neighbors* siblings, uint32_t offset) {
+    store_neighbors(child, siblings, offset);
 }
 
 void Hierarchy::split_level(const LevelSplits& splits) {
@@ -279,11 +295,11 @@ void Hierarchy::split_level(const LevelSplits& splits) {
             const uint32_t level = uint32_t(parent.level + 1) << 8;
             const unsigned boundary = parent.flags;
             Node* child = nodes + c;
-            write_vertices(child, parent.v, m);
-            write_neighbors(child, splits.children + size_t(4) * i, offset);
+            red_split_kernels::write_child_vertices(child, parent.v, m);  // write_vertices' (split() shares it)
+            store_neighbors(child, splits.children + size_t(4) * i, offset);
             block_parent[i] = n;
             const ChildTails& tails = kChildTails.of[outer | (boundary & 7u) << 6];
-            for (int k = 0; k < 4; ++k) write_tail(child[k], tails.word[k] | level);
+            for (int k = 0; k < 4; ++k) store_tail(child[k], tails.word[k] | level);
             parent.first_child = c;
         }
         if (!splits.place_new_vertices) {
