@@ -1,5 +1,6 @@
 // Re-expresses a hierarchy over a reordered base mesh (paper, II-B: the forest is matched to the
-// base-mesh coder's deterministic output order, so no bits are spent on the order).
+// base-mesh coder's deterministic output order, so no bits are spent on the order), or over the
+// base triangles of some of its roots (the encoder's chunks).
 #include "hierarchy/hierarchy_builder.h"
 
 #include "common/check.h"
@@ -149,6 +150,81 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
     for (const Vec3& p : out.positions_) out.far_positions_.raise_if(Hierarchy::is_far(p));
     out.live_nodes_ = uint32_t(n);
     out.live_vertices_ = uint32_t(out.positions_.size());
+    return out;
+}
+
+// Written in the replay's order, so that each node finds its parent's vertices and midpoints made.
+Hierarchy HierarchyBuilder::subforest(const Hierarchy& h, TriangleMesh base, const std::vector<NodeId>& roots,
+                                      const std::vector<VertexId>& base_vertex, const std::vector<uint32_t>& root_of,
+                                      const std::vector<uint8_t>& root_in, NodeId* local, std::vector<VertexId>* vertex_of_out) {
+    Hierarchy out(std::move(base));
+    const NodeId root_count = out.root_count();
+    // Node j of the result is node old_of[j] of h.
+    std::vector<NodeId> old_of(roots);
+    for (size_t j = 0; j < old_of.size(); ++j) {
+        const NodeId o = old_of[j];
+        local[o] = NodeId(j);
+        if (!h.is_leaf(o))
+            for (int k = 0; k < 4; ++k) old_of.push_back(h.child(o, k));
+    }
+    const size_t n = old_of.size();
+    auto taken = [&](NodeId q) { return q != kNoNode && root_in[root_of[q]] != 0; };
+    // Split node j creates the midpoint of its edge e unless its neighbour there was split before
+    // it (split() then takes the neighbour's); mid[3 * j + e] is that midpoint's id.
+    std::vector<VertexId> mid(3 * n, kNoVertex);
+    std::vector<VertexId> vertex_of(base_vertex);
+    for (size_t j = 0; j < n; ++j) {
+        const NodeId o = old_of[j];
+        if (h.is_leaf(o)) continue;
+        for (int e = 0; e < 3; ++e) {
+            const NodeId q = h.neighbor(o, e);
+            if (taken(q) && !h.is_leaf(q) && local[q] < j) {
+                mid[3 * j + size_t(e)] = mid[3 * size_t(local[q]) + size_t(h.neighbor_edge(o, e))];
+            } else {
+                mid[3 * j + size_t(e)] = VertexId(vertex_of.size());
+                vertex_of.push_back(h.midpoint(o, e));
+            }
+        }
+    }
+    out.positions_.resize(vertex_of.size());
+    for (size_t v = base_vertex.size(); v < vertex_of.size(); ++v) {
+        out.positions_[v] = h.position(vertex_of[v]);
+        out.far_positions_ |= Hierarchy::is_far(out.positions_[v]);
+    }
+    out.nodes_.resize(n);  // the roots stay as the constructor made them
+    out.block_parent_.assign((n - root_count) / 4, kNoNode);
+    NodeId next_child = root_count;
+    for (size_t j = 0; j < n; ++j) {
+        const NodeId o = old_of[j];
+        Hierarchy::Node& node = out.nodes_[j];
+        if (j >= root_count) {
+            const NodeId p = out.block_parent_[(j - root_count) / 4];
+            const int k = int((j - root_count) % 4);
+            const Hierarchy::Node& parent = out.nodes_[p];
+            const VertexId points[6] = {parent.v[0], parent.v[1], parent.v[2], mid[3 * size_t(p)], mid[3 * size_t(p) + 1],
+                                        mid[3 * size_t(p) + 2]};
+            for (int i = 0; i < 3; ++i) node.v[i] = points[red_split::kChildPoints[k][i]];
+            node.nbr_edge = 0;
+            for (int e = 0; e < 3; ++e) {
+                const NodeId q = h.neighbor(o, e);
+                node.nbr[e] = taken(q) ? local[q] : kNoNode;
+                if (node.nbr[e] != kNoNode) node.nbr_edge |= uint8_t(h.neighbor_edge(o, e) << (2 * e));
+            }
+            node.level = uint8_t(parent.level + 1);
+            node.flags = uint8_t(parent.flags & red_split::kChildEdges[k].boundary);
+            node.reserved = 0;
+        }
+        const bool leaf = h.is_leaf(o);
+        node.flags = uint8_t((node.flags & 7u) | (leaf && h.diagonal_flipped(o) ? 8u : 0u));
+        node.first_child = leaf ? kNoNode : next_child;
+        if (!leaf) {
+            out.block_parent_[(next_child - root_count) / 4] = NodeId(j);
+            next_child += 4;
+        }
+    }
+    out.live_nodes_ = uint32_t(n);
+    out.live_vertices_ = uint32_t(out.positions_.size());
+    if (vertex_of_out != nullptr) *vertex_of_out = std::move(vertex_of);
     return out;
 }
 

@@ -125,6 +125,16 @@ struct HierarchyBuilder {
         h.positions_[v] = p;
         h.far_positions_.raise_if(Hierarchy::is_far(p));
     }
+    // The trees of `roots` (ids in h, in this order) as a hierarchy of their own over `base`, their
+    // triangles in that order (its vertex i being h's base_vertex[i]), as replaying their splits
+    // breadth-first with split() makes it: the same node and vertex ids, links and boundary flags,
+    // diagonal flags on leaves. root_of[q] is the root of h's node q and root_in[r] marks the
+    // roots taken; local[q] (one word per node of h) receives the result's id of each node taken
+    // and is read only for them, so calls on disjoint roots may share it at once. `vertex_of`
+    // receives each vertex's id in h.
+    static Hierarchy subforest(const Hierarchy& h, TriangleMesh base, const std::vector<NodeId>& roots,
+                               const std::vector<VertexId>& base_vertex, const std::vector<uint32_t>& root_of,
+                               const std::vector<uint8_t>& root_in, NodeId* local, std::vector<VertexId>* vertex_of);
     // Hints the processor to fetch node n (for traversals that know their next nodes early).
     static void prefetch(const Hierarchy& h, NodeId n) { __builtin_prefetch(h.nodes_.data() + n); }
 };

@@ -2,27 +2,32 @@
 #include "coding/chunks/chunk_layout.h"
 
 #include "common/check.h"
+#include "hierarchy/hierarchy_builder.h"
 
 #include <utility>
 
 namespace amc {
 
-namespace {
-
-// A node of a chunk hierarchy and the same node in the whole one.
-struct NodePair {
-    NodeId chunk, whole;
-};
-
-}  // namespace
+std::vector<uint32_t> root_of_nodes(const Hierarchy& h) {
+    std::vector<uint32_t> root_of(h.node_capacity(), kNoNode);
+    // A forest only ever refined numbers parents before their children: one pass.
+    bool parents_first = true;
+    for (NodeId n = 0; n < h.node_capacity() && parents_first; ++n) {
+        if (!h.is_alive(n)) continue;
+        const NodeId p = h.parent(n);
+        parents_first = p == kNoNode || p < n;
+        root_of[n] = p == kNoNode ? n : root_of[p];
+    }
+    if (!parents_first)
+        for (NodeId n : h.breadth_first_order()) root_of[n] = n < h.root_count() ? n : root_of[h.parent(n)];
+    return root_of;
+}
 
 std::vector<uint64_t> nodes_per_root(const Hierarchy& h) {
-    std::vector<uint32_t> root_of(h.node_capacity(), 0);
+    const std::vector<uint32_t> root_of = root_of_nodes(h);
     std::vector<uint64_t> count(h.root_count(), 0);
-    for (NodeId n : h.breadth_first_order()) {  // parents before children
-        root_of[n] = n < h.root_count() ? n : root_of[h.parent(n)];
-        ++count[root_of[n]];
-    }
+    for (NodeId n = 0; n < h.node_capacity(); ++n)
+        if (h.is_alive(n)) ++count[root_of[n]];
     return count;
 }
 
@@ -71,33 +76,22 @@ TriangleMesh base_of_roots(const TriangleMesh& base, const std::vector<RootRange
 }
 
 Hierarchy extract_roots(const Hierarchy& h, const std::vector<RootRange>& roots, std::vector<VertexId>* vertex_of) {
+    std::vector<NodeId> local(h.node_capacity());
+    return extract_roots(h, roots, root_of_nodes(h), local.data(), vertex_of);
+}
+
+Hierarchy extract_roots(const Hierarchy& h, const std::vector<RootRange>& roots, const std::vector<uint32_t>& root_of,
+                        NodeId* local, std::vector<VertexId>* vertex_of) {
     std::vector<VertexId> base_vertex;
-    Hierarchy out(base_of_roots(h.base(), roots, base_vertex));
-    std::vector<VertexId> ids = base_vertex;
-    std::vector<NodePair> level, next;
-    NodeId local = 0;
+    TriangleMesh base = base_of_roots(h.base(), roots, base_vertex);
+    std::vector<NodeId> root_ids;
+    std::vector<uint8_t> root_in(h.root_count(), 0);
     for (const RootRange& range : roots)
-        for (uint32_t r = range.first; r < range.first + range.count; ++r) level.push_back({local++, r});
-    while (!level.empty()) {
-        next.clear();
-        for (const NodePair p : level) {
-            if (h.is_leaf(p.whole)) {
-                out.set_diagonal_flipped(p.chunk, h.diagonal_flipped(p.whole));
-                continue;
-            }
-            out.split(p.chunk);  // balanced: its neighbours in the chunk are those of the whole
-            if (ids.size() < out.positions().size()) ids.resize(out.positions().size(), kNoVertex);
-            for (int e = 0; e < 3; ++e) {
-                const VertexId m = out.midpoint(p.chunk, e), whole = h.midpoint(p.whole, e);
-                out.set_position(m, h.position(whole));
-                ids[m] = whole;
-            }
-            for (int k = 0; k < 4; ++k) next.push_back({out.child(p.chunk, k), h.child(p.whole, k)});
+        for (uint32_t r = range.first; r < range.first + range.count; ++r) {
+            root_ids.push_back(r);
+            root_in[r] = 1;
         }
-        std::swap(level, next);
-    }
-    if (vertex_of != nullptr) *vertex_of = std::move(ids);
-    return out;
+    return HierarchyBuilder::subforest(h, std::move(base), root_ids, base_vertex, root_of, root_in, local, vertex_of);
 }
 
 }  // namespace amc

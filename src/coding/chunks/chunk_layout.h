@@ -16,6 +16,9 @@ struct RootRange {
     uint32_t first = 0, count = 0;
 };
 
+// The root of each live node's tree (kNoNode for unused ids).
+std::vector<uint32_t> root_of_nodes(const Hierarchy& h);
+
 // Live nodes of each root's tree.
 std::vector<uint64_t> nodes_per_root(const Hierarchy& h);
 
@@ -31,5 +34,9 @@ TriangleMesh base_of_roots(const TriangleMesh& base, const std::vector<RootRange
 // The trees of `roots` as a hierarchy of their own over base_of_roots: same forest, positions and
 // diagonal flags. `vertex_of` receives, for each vertex id of the result, the id in h.
 Hierarchy extract_roots(const Hierarchy& h, const std::vector<RootRange>& roots, std::vector<VertexId>* vertex_of = nullptr);
+// The same with root_of_nodes(h) made once by the caller and `local` (h.node_capacity() words) as
+// scratch: calls on disjoint roots may share both and run at once.
+Hierarchy extract_roots(const Hierarchy& h, const std::vector<RootRange>& roots, const std::vector<uint32_t>& root_of,
+                        NodeId* local, std::vector<VertexId>* vertex_of);
 
 }  // namespace amc

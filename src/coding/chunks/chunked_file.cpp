@@ -36,9 +36,11 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<RootRange>& r
     const Seam seam(h, chunk_of_root, key_of_vertex);
     std::vector<ChunkCode> codes(ranges.size());
     std::vector<uint64_t> nodes(ranges.size()), own_vertices(ranges.size());
+    const std::vector<uint32_t> root_of = root_of_nodes(h);
+    std::vector<NodeId> local(h.node_capacity());  // shared: the chunks' nodes are disjoint
     parallel_for(ranges.size(), threads, [&](size_t c) {
         std::vector<VertexId> vertex_of;
-        const Hierarchy chunk = extract_roots(h, {ranges[c]}, &vertex_of);
+        const Hierarchy chunk = extract_roots(h, {ranges[c]}, root_of, local.data(), &vertex_of);
         VertexKeys keys(vertex_of.size(), kNoVertex);
         for (size_t v = 0; v < vertex_of.size(); ++v)
             if (vertex_of[v] != kNoVertex) keys[v] = key_of_vertex[vertex_of[v]];
