@@ -1,6 +1,8 @@
 // The .amh hierarchy file: exact round trips and validation of every field.
 #include "hierarchy_checks.h"
 
+#include <amc/codec.h>
+
 #include <cstring>
 
 namespace amc {
@@ -25,6 +27,25 @@ TEST(HierarchyFile, RoundTripIsIdentical) {
     EXPECT_TRUE(testing::hierarchy_is_valid(back));
     EXPECT_EQ(serialize_hierarchy(back), bytes) << "the file is canonical";
     EXPECT_EQ(extract_leaf_mesh(back).mesh.triangles, extract_leaf_mesh(h).mesh.triangles);
+}
+
+// A hierarchy read from a file has had its structure checked, so writers skip that check, until
+// the forest changes: a split that leaves a neighbour with three hanging nodes is refused again.
+TEST(HierarchyFile, WritersCheckAgainOnceTheForestChanges) {
+    const Hierarchy read = deserialize_hierarchy(serialize_hierarchy(sample_hierarchy()), "memory");
+    EXPECT_FALSE(encode(read, EncodeOptions{}).empty());
+    bool broken = false;
+    for (NodeId n : read.leaves()) {
+        if (!read.can_split(n)) continue;
+        Hierarchy h = read;
+        h.split(n);
+        if (check_invariants(h).empty()) continue;
+        EXPECT_THROW(serialize_hierarchy(h), Error);
+        EXPECT_THROW(encode(h, EncodeOptions{}), Error);
+        broken = true;
+        break;
+    }
+    EXPECT_TRUE(broken) << "no split broke the closure";
 }
 
 TEST(HierarchyFile, IdenticalNoticesDifferences) {

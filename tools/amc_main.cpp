@@ -105,6 +105,12 @@ int main(int argc, char** argv) {
                            "unit normals, .amc version 12; roles keeps mode 3)")
         ->check(CLI::IsMember({"grid", "roles"}))
         ->capture_default_str();
+    encode_cmd->add_option("--effort", encode.effort,
+                           "How hard each level's geometry mode is sought: " + std::to_string(kMaxEffort) +
+                               " codes every candidate until it can not be the smallest; lower judges the adaptive "
+                               "predictors from a sample of the level (faster, slightly larger)")
+        ->check(CLI::Range(0, kMaxEffort))
+        ->capture_default_str();
     encode_cmd->add_flag("--series", encode.series, "The input is a series (as 'amc series encode'; implied by a .pvd input)");
 
     DecodeCommand decode;

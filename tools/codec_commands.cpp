@@ -132,6 +132,7 @@ void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     options.unit_normals = command.geometry_contexts == "grid";   // quantized files ignore it
     if (options.predictor == GeometryPredictor::normal_frame_grid && options.quantize_bits == 0)
         throw UsageError("--predictor grid needs --quantize (grid points exist only on a grid)");
+    options.effort = command.effort;
     options.chunks = command.chunks;
     options.chunk_faces = command.chunk_faces;
     options.threads = command.threads;

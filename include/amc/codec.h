@@ -38,6 +38,9 @@ enum class HierarchyContexts : uint8_t {
     mixed = 1,
 };
 
+constexpr int kMaxEffort = 2;
+constexpr int kDefaultEffort = 2;
+
 struct EncodeOptions {
     HierarchyCoderOptions hierarchy;  // the connectivity coder's switches (defaults: the full method)
     HierarchyContexts hierarchy_contexts = HierarchyContexts::paper;
@@ -53,6 +56,11 @@ struct EncodeOptions {
     // bit-exact file and keeps it where it codes smaller (such files are version 12); false keeps
     // the choices of version 11's encoder.
     bool unit_normals = true;
+    // How hard the automatic predictor weighs each level's geometry modes (docs/CODEC.md, "Encode
+    // effort"): kMaxEffort codes every candidate until it is the smallest or can not be; lower
+    // efforts judge the adaptive predictors from a sample of the level first (faster encodes,
+    // slightly larger files). The decoder reads every choice alike.
+    int effort = kDefaultEffort;
     // The caller's numbering of the input's leaf mesh (leaf_numbering()), or null. The encoder
     // re-expresses it against the leaf mesh the decoder rebuilds (EncodeStats::numbering) and,
     // with store_numbering, stores it in the file so that decode returns it (docs/FORMAT.md,

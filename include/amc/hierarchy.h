@@ -203,6 +203,10 @@ private:
         std::atomic<bool> far_{false};
     };
     FarFlag far_positions_;
+    // The forest passed a reader's checks (HierarchyBuilder::mark_structure_checked): split(),
+    // coarsen() and reset() clear it; other changes to the forest are the internal builders',
+    // which make hierarchies of their own.
+    bool structure_checked_ = false;
     static bool is_far(Vec3 p) {
         constexpr double kHalfMax = 8.98846567431157953865e307;  // DBL_MAX / 2
         return !(p.x <= kHalfMax && p.x >= -kHalfMax && p.y <= kHalfMax && p.y >= -kHalfMax && p.z <= kHalfMax &&

@@ -18,6 +18,7 @@
 #include "hierarchy/writer_checks.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <memory>
 #include <string>
@@ -42,18 +43,26 @@ std::vector<Vec3> live_positions(const Hierarchy& h) {
     return points;
 }
 
-// The grid of `bits` over the input's positions; its largest error in `max_error`.
-Quantizer quantizer_of(const Hierarchy& input, int bits, double& max_error) {
-    const std::vector<Vec3> points = live_positions(input);
-    Quantizer quantizer;
+// The grid of `bits` over the input's positions.
+Quantizer quantizer_of(const Hierarchy& input, int bits) {
     try {
-        quantizer = make_quantizer(points, bits);
+        return make_quantizer(live_positions(input), bits);
     } catch (const Error& e) {
         throw_error(e.code(), std::string("encode: ") + e.what() +
                                   " (positions that span more than the double range can only be stored bit-exact)");
     }
-    max_error = max_quantization_error(quantizer, points);
-    return quantizer;
+}
+
+// Moves every position of h to the grid point the decoder reconstructs (the predictions are made
+// from those: a closed loop); returns the largest coordinate error, max_quantization_error's.
+double snap_positions(Hierarchy& h, const Quantizer& quantizer) {
+    double worst = 0.0;
+    for (VertexId v = 0; v < h.positions().size(); ++v) {
+        const Vec3 p = h.position(v), r = dequantize(quantizer, snap_to_grid(quantizer, p));
+        worst = std::fmax(worst, std::fmax(std::fabs(r.x - p.x), std::fmax(std::fabs(r.y - p.y), std::fabs(r.z - p.z))));
+        h.set_position(v, r);
+    }
+    return worst;
 }
 
 // The lowest version that holds what the file holds (format_version.h).
@@ -134,7 +143,7 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<RootRange>& chunks,
         for (int l = 0; l < hierarchy.level_count(); ++l) {
             const NewVertices& created = hierarchy.new_vertices(l);
             const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, options.predictor,
-                                                                     options.grid_contexts, options.unit_normals);
+                                                                     options.grid_contexts, options.unit_normals, options.effort);
             ArithmeticEncoder encoder;
             hierarchy.encode_level(l, encoder);
             const size_t hierarchy_part = encoder.bytes_so_far();
@@ -162,7 +171,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     // Quantized coordinates are reconstructed as doubles on the grid, whatever the input precision.
     const Precision precision = input.single_precision() && !quantized ? Precision::float32 : Precision::float64;
     Quantizer quantizer;
-    if (quantized) quantizer = quantizer_of(input, options.quantize_bits, stats.max_error);
+    if (quantized) quantizer = quantizer_of(input, options.quantize_bits);
     const CoordinateSpace space{precision, quantized ? &quantizer : nullptr};
 
     // II-B: code the base mesh first and express the forest in the decoder's base order.
@@ -174,8 +183,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
         stats.numbering = numbering_after_reorder(input, *options.numbering, h, reordered.vertex_map);
     if (quantized) {
         h.set_single_precision(false);
-        // Closed loop: predictions are made from what the decoder will have.
-        for (VertexId v = 0; v < h.positions().size(); ++v) h.set_position(v, dequantize(quantizer, snap_to_grid(quantizer, h.position(v))));
+        stats.max_error = snap_positions(h, quantizer);  // h holds exactly the input's live positions
     }
 
     // The forest (FORMAT.md 3.6, 3.11), after the base geometry, whose adaptive models the level

@@ -88,6 +88,7 @@ void Hierarchy::reset(TriangleMesh base) {
     base_ = std::move(roots.base_);
     live_nodes_ = roots.live_nodes_;
     live_vertices_ = roots.live_vertices_;
+    structure_checked_ = false;
     set_vertex_placer(nullptr, nullptr);
 }
 
@@ -155,6 +156,7 @@ NodeId Hierarchy::allocate_children(NodeId parent) {
 }
 
 void Hierarchy::split(NodeId n) {
+    structure_checked_ = false;
     VertexId m[3];
     for (int e = 0; e < 3; ++e) {
         NodeId q = nodes_[n].nbr[e];
@@ -249,6 +251,7 @@ bool Hierarchy::can_coarsen(NodeId n) const {
 
 bool Hierarchy::coarsen(NodeId n) {
     if (!can_coarsen(n)) return false;
+    structure_checked_ = false;
     const NodeId c = nodes_[n].first_child;
     for (int e = 0; e < 3; ++e) {
         NodeId q = nodes_[n].nbr[e];

@@ -72,7 +72,10 @@ struct HierarchyBuilder {
     // stored forest level by level. When no ids are free for reuse (a hierarchy that was only
     // ever refined), child k of parents[i] gets id node_capacity() + 4 * i + k, node_capacity()
     // taken before the call.
-    static void split_level(Hierarchy& h, const LevelSplits& level) { h.split_level(level); }
+    static void split_level(Hierarchy& h, const LevelSplits& level) {
+        h.structure_checked_ = false;
+        h.split_level(level);
+    }
     // Stitching hierarchies of disjoint root sets into one (hierarchy_stitch.cpp): the decoder of
     // chunked files decodes the chunks of the whole over its roots, each as if its roots were the
     // whole base (their links to other chunks cut), in order or each into its slice at once.
@@ -135,6 +138,11 @@ struct HierarchyBuilder {
     static Hierarchy subforest(const Hierarchy& h, TriangleMesh base, const std::vector<NodeId>& roots,
                                const std::vector<VertexId>& base_vertex, const std::vector<uint32_t>& root_of,
                                const std::vector<uint8_t>& root_in, NodeId* local, std::vector<VertexId>* vertex_of);
+    // The reader of a hierarchy file has made every structural check check_invariants makes (its
+    // forest replayed with split() under can_split, the closure checked): writers may skip them
+    // while nothing changes the forest (writer_checks.h).
+    static void mark_structure_checked(Hierarchy& h) { h.structure_checked_ = true; }
+    static bool structure_checked(const Hierarchy& h) { return h.structure_checked_; }
     // Hints the processor to fetch node n (for traversals that know their next nodes early).
     static void prefetch(const Hierarchy& h, NodeId n) { __builtin_prefetch(h.nodes_.data() + n); }
 };

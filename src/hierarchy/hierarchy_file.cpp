@@ -6,6 +6,7 @@
 
 #include "common/check.h"
 #include "common/file_io.h"
+#include "hierarchy/hierarchy_builder.h"
 
 #include <cmath>
 #include <cstring>
@@ -236,6 +237,7 @@ Hierarchy parse_hierarchy(const std::string& bytes, const std::string& what) {
             h.set_position(VertexId(v), refinement_positions[canonical[v] - base_vertices]);
     }
     h.set_vertex_placer(nullptr, nullptr);
+    HierarchyBuilder::mark_structure_checked(h);  // replayed under can_split, closure checked above
     return h;
 }
 

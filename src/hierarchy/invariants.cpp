@@ -5,6 +5,7 @@
 #include "common/check.h"
 #include "common/exact_float.h"
 #include "common/parallel.h"
+#include "hierarchy/hierarchy_builder.h"
 
 #include <amc/hierarchy.h>
 
@@ -143,8 +144,10 @@ std::string check_positions(const Hierarchy& h) {
 
 void check_before_writing(const Hierarchy& h, const std::string& what, bool positions, unsigned threads) {
     validate_triangle_mesh(h.base(), what + ": base mesh");
-    const std::string problem = check_invariants(h, threads);
-    AMC_REQUIRE(problem.empty(), invalid_input, what + ": invalid hierarchy: " + problem);
+    if (!HierarchyBuilder::structure_checked(h)) {
+        const std::string problem = check_invariants(h, threads);
+        AMC_REQUIRE(problem.empty(), invalid_input, what + ": invalid hierarchy: " + problem);
+    }
     if (!positions) return;
     const std::string position_problem = check_positions(h);
     AMC_REQUIRE(position_problem.empty(), invalid_input, what + ": " + position_problem);

@@ -11,7 +11,8 @@ namespace amc {
 // The base mesh (validate_triangle_mesh: manifold, consistently oriented, no unused vertex, no
 // degenerate or repeated triangle, finite positions), the structure (check_invariants) and, with
 // `positions`, check_positions. Throws Error naming `what` and the first problem, in the words
-// the reader would use.
+// the reader would use. The structure is taken as checked when a reader has checked it and
+// nothing has changed it since (HierarchyBuilder::structure_checked).
 // The structural checks run on up to `threads` threads; the first problem in node order is named.
 void check_before_writing(const Hierarchy& h, const std::string& what, bool positions, unsigned threads = 1);
 

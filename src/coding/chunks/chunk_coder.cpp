@@ -58,7 +58,8 @@ void for_each_seam_closure(const Hierarchy& h, const std::vector<NodeId>& level,
 }  // namespace
 
 ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& seam, const HierarchyCoderOptions& options,
-                       GeometryPredictor fixed_predictor, CoordinateSpace space, bool grid_contexts, bool unit_normals) {
+                       GeometryPredictor fixed_predictor, CoordinateSpace space, bool grid_contexts, bool unit_normals,
+                       int effort) {
     ChunkCode out;
     HierarchyLevelEncoder hierarchy(h, options);
     const std::vector<uint8_t>& header = hierarchy.header();
@@ -73,7 +74,7 @@ ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& s
         for (auto [n, e] : hierarchy.new_vertices(l))
             if (seam_vertex(h, keys, seam, n, e) < 0) created.emplace_back(n, e);
         // The predictor, as the whole file's encoder picks it (FORMAT.md 3.9, 5.6).
-        const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, fixed_predictor, grid_contexts, unit_normals);
+        const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, fixed_predictor, grid_contexts, unit_normals, effort);
         ArithmeticEncoder encoder;
         hierarchy.encode_level(l, encoder);
         for_each_seam_closure(h, level, keys, seam, [&](NodeId n) { encoder.encode(h.diagonal_flipped(n), flipped); });

@@ -32,7 +32,7 @@ struct ChunkCode {
 // `keys` holds the seam keys of the chunk's vertex ids (seam.h).
 ChunkCode encode_chunk(const Hierarchy& chunk, const VertexKeys& keys, const Seam& seam, const HierarchyCoderOptions& options,
                        GeometryPredictor predictor, CoordinateSpace space, bool grid_contexts = false,
-                       bool unit_normals = false);
+                       bool unit_normals = false, int effort = kMaxEffort);
 
 struct ChunkDecodeLimits {
     uint64_t max_nodes = 0;     // the chunk's node count from the chunk table (within the caller's limit)

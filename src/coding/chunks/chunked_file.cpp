@@ -44,7 +44,8 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<RootRange>& r
         VertexKeys keys(vertex_of.size(), kNoVertex);
         for (size_t v = 0; v < vertex_of.size(); ++v)
             if (vertex_of[v] != kNoVertex) keys[v] = key_of_vertex[vertex_of[v]];
-        codes[c] = encode_chunk(chunk, keys, seam, options.hierarchy, options.predictor, space, options.grid_contexts, options.unit_normals);
+        codes[c] = encode_chunk(chunk, keys, seam, options.hierarchy, options.predictor, space, options.grid_contexts, options.unit_normals,
+                                options.effort);
         codes[c].bytes.shrink_to_fit();  // held until the file is written: without the slack of its growth
         nodes[c] = chunk.node_count();
         own_vertices[c] = uint64_t(std::count(keys.begin(), keys.end(), kNoVertex));  // neither base nor seam vertices

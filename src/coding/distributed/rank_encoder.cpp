@@ -194,7 +194,7 @@ RankCode encode_rank_chunk(const RankChunk& part, const Seam& seam, const Encode
         }
         AMC_REQUIRE(hanging < 3, invalid_input, where + " has three hanging nodes with those of its neighbours across the seam");
     }
-    ChunkCode code = encode_chunk(h, keys, seam, options.hierarchy, options.predictor, space_of(h.base(), grid), options.grid_contexts, options.unit_normals);
+    ChunkCode code = encode_chunk(h, keys, seam, options.hierarchy, options.predictor, space_of(h.base(), grid), options.grid_contexts, options.unit_normals, options.effort);
     RankCode out;
     out.block = framed(BlockType::chunk, code.bytes);
     out.summary.roots = h.root_count();

@@ -14,6 +14,13 @@ namespace amc {
 
 namespace {
 
+// Effort below kMaxEffort: an adaptive trial is judged on its first 1/kSampleShare of the level
+// (when that is kMinSample vertices or more) and dropped when, scaled, it passes the smallest
+// static mode by 1/8.
+constexpr size_t kSampleShare = 8;
+constexpr size_t kMinSample = 2048;
+constexpr double kSampleMargin = 1.125;
+
 // The predictors a level block of a file of `file_version` may hold (FORMAT.md 3.6).
 bool predictor_allowed(uint8_t predictor, uint8_t file_version, bool quantized) {
     switch (GeometryPredictor(predictor)) {
@@ -42,8 +49,11 @@ void encode_adaptive(const Hierarchy& h, const NewVertices& created, GeometryPre
 // a byte, and finish() drops at most 4 zero bytes); a finished code is never much shorter than
 // the bytes it committed on the way (8 bytes of margin).
 // Only bit-exact coordinates have raw bits enough to be worth the pass that counts them.
+// With a `sample` of fewer vertices than the level, the trial also stops when the bytes of the
+// first `sample` vertices, scaled to the level, pass the limit by kSampleMargin: on a guess, for
+// the models learn as they go, so a level's start codes longer than its rest.
 size_t adaptive_bytes(const Hierarchy& h, const NewVertices& created, GeometryPredictor predictor, PositionCoder positions,
-                      size_t limit, bool count_raw_bits) {
+                      size_t limit, bool count_raw_bits, size_t sample) {
     std::vector<Vec3> predicted(count_raw_bits ? created.size() : 0);
     uint64_t raw_bits = 0;
     for (size_t i = 0; i < predicted.size(); ++i) {
@@ -58,6 +68,9 @@ size_t adaptive_bytes(const Hierarchy& h, const NewVertices& created, GeometryPr
         positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)),
                          count_raw_bits ? predicted[i] : predict(h, predictor, n, e));
         if (encoder.bytes_so_far() > limit + 8) return SIZE_MAX;
+        if (i + 1 == sample && limit != SIZE_MAX &&
+            double(encoder.bytes_so_far()) * double(created.size()) > kSampleMargin * double(sample) * double(limit))
+            return SIZE_MAX;
     }
     return encoder.finish().size();
 }
@@ -65,7 +78,8 @@ size_t adaptive_bytes(const Hierarchy& h, const NewVertices& created, GeometryPr
 }  // namespace
 
 LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& created, const PositionCoder& positions,
-                                        CoordinateSpace space, GeometryPredictor choice, bool grid_contexts, bool unit_normals) {
+                                        CoordinateSpace space, GeometryPredictor choice, bool grid_contexts, bool unit_normals,
+                                        int effort) {
     const bool automatic = choice == GeometryPredictor::automatic;
     LevelGeometryCode code;
     code.predictor = automatic ? GeometryPredictor::midpoint : choice;
@@ -101,11 +115,14 @@ LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& c
         best_static = std::min(best_static, static_size[next]);
         bound[next] = SIZE_MAX;
     }
-    const bool count_raw_bits = space.quantizer == nullptr;
-    const size_t midpoint = adaptive_bytes(h, created, GeometryPredictor::midpoint, positions, best_static, count_raw_bits);
+    const size_t sample = effort >= kMaxEffort || created.size() / kSampleShare < kMinSample ? SIZE_MAX : created.size() / kSampleShare;
+    // A sample judges sooner than the pass over the whole level that counts raw bits.
+    const bool count_raw_bits = space.quantizer == nullptr && sample == SIZE_MAX;
+    const size_t midpoint = adaptive_bytes(h, created, GeometryPredictor::midpoint, positions, best_static, count_raw_bits, sample);
     // The butterfly must be smaller than the midpoint, and no larger than a static mode.
     const size_t butterfly_limit = midpoint == SIZE_MAX ? best_static : std::min(midpoint - 1, best_static);
-    const size_t butterfly = adaptive_bytes(h, created, GeometryPredictor::butterfly, positions, butterfly_limit, count_raw_bits);
+    const size_t butterfly =
+        adaptive_bytes(h, created, GeometryPredictor::butterfly, positions, butterfly_limit, count_raw_bits, sample);
     size_t best = midpoint;
     if (butterfly < best) {
         best = butterfly;

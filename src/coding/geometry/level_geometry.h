@@ -33,10 +33,11 @@ struct LevelGeometryCode {
 // The predictor of the level that creates `created` (positions set in h as the decoder will have
 // them): `choice`, or when it is automatic the one that codes the level in the fewest bytes, each
 // adaptive predictor tried on a copy of `positions`' models; mode 4 is a candidate only with
-// grid_contexts in a quantized space, mode 5 only with unit_normals in a bit-exact one.
+// grid_contexts in a quantized space, mode 5 only with unit_normals in a bit-exact one. Below
+// kMaxEffort an adaptive predictor may be judged from a sample (EncodeOptions::effort).
 LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& created, const PositionCoder& positions,
                                         CoordinateSpace space, GeometryPredictor choice, bool grid_contexts = false,
-                                        bool unit_normals = false);
+                                        bool unit_normals = false, int effort = kMaxEffort);
 
 // The payload of a level block whose hierarchy part `encoder` holds: the predictor byte, then the
 // arithmetic code finished with the level's geometry (and mode 3's streams).
