@@ -8,7 +8,7 @@ amc=$1 bits=$2
 shift 2
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-max=$("$amc" encode --help | sed -n 's/.*--effort.*\[\([0-9]*\)\].*/\1/p' | head -n 1)
+max=$("$amc" encode --help | sed -n 's/.*--effort INT:INT in \[0 - \([0-9]*\)\].*/\1/p' | head -n 1)
 max=${max:-2}
 printf '| model | bits |'
 e=$max

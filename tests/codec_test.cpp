@@ -179,6 +179,32 @@ TEST(Codec, NormalFrameModeRoundTripsAndWinsOnSurfaces) {
     }
 }
 
+// Lower efforts judge the geometry modes of large levels on a sample of them (EncodeOptions::effort):
+// the choices may differ, the decoded hierarchy does not, and the sizes stay within 2 % of the
+// highest effort's.
+TEST(Codec, EveryEffortDecodesToTheSameHierarchy) {
+    Hierarchy h(make_icosahedron());
+    refine_uniformly(h, 6);  // the last level creates 30720 vertices: enough to be judged on a sample
+    testing::Random random{3};
+    for (VertexId v = 0; v < h.positions().size(); ++v) {
+        const Vec3 p = h.position(v);
+        h.set_position(v, (1.0 + 1e-3 * double(random.next() % 1000) / 1000.0) / std::sqrt(dot(p, p)) * p);
+    }
+    for (int bits : {0, 12}) {
+        EncodeOptions options;
+        options.quantize_bits = bits;
+        options.effort = kMaxEffort;
+        const std::vector<uint8_t> best = encode(h, options);
+        const Hierarchy expected = decode(best.data(), best.size());
+        for (int effort = 0; effort < kMaxEffort; ++effort) {
+            options.effort = effort;
+            const std::vector<uint8_t> bytes = encode(h, options);
+            EXPECT_TRUE(identical(decode(bytes.data(), bytes.size()), expected)) << "bits " << bits << ", effort " << effort;
+            EXPECT_LE(double(bytes.size()), 1.02 * double(best.size())) << "bits " << bits << ", effort " << effort;
+        }
+    }
+}
+
 TEST(Codec, ProgressiveDecodingGivesEveryLevelMesh) {
     Hierarchy h(make_icosahedron());
     refine_randomly(h, 5000, 6, 21);

@@ -39,7 +39,7 @@ enum class HierarchyContexts : uint8_t {
 };
 
 constexpr int kMaxEffort = 2;
-constexpr int kDefaultEffort = 2;
+constexpr int kDefaultEffort = 1;
 
 struct EncodeOptions {
     HierarchyCoderOptions hierarchy;  // the connectivity coder's switches (defaults: the full method)

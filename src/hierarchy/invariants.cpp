@@ -128,9 +128,11 @@ std::string check_invariants(const Hierarchy& h, unsigned threads) {
 }
 
 std::string check_positions(const Hierarchy& h) {
-    const std::vector<uint32_t> canonical = canonical_vertex_order(h);
-    for (VertexId v = 0; v < canonical.size(); ++v) {
-        if (canonical[v] == kNoVertex) continue;
+    // Without removed ids every id is a live vertex: no need to find them.
+    const bool all_live = h.vertex_count() == h.positions().size();
+    const std::vector<uint32_t> canonical = all_live ? std::vector<uint32_t>() : canonical_vertex_order(h);
+    for (VertexId v = 0; v < h.positions().size(); ++v) {
+        if (!all_live && canonical[v] == kNoVertex) continue;
         const Vec3 p = h.position(v);
         for (const double x : {p.x, p.y, p.z}) {
             if (!std::isfinite(x)) return "vertex " + std::to_string(v) + " has a non-finite coordinate";

@@ -4,19 +4,22 @@
 #include "common/check.h"
 #include "hierarchy/hierarchy_builder.h"
 
+#include <algorithm>
 #include <utility>
 
 namespace amc {
 
 std::vector<uint32_t> root_of_nodes(const Hierarchy& h) {
     std::vector<uint32_t> root_of(h.node_capacity(), kNoNode);
-    // A forest only ever refined numbers parents before their children: one pass.
+    for (NodeId r = 0; r < h.root_count(); ++r) root_of[r] = r;
+    // A forest only ever refined numbers parents before their children: one pass over the blocks
+    // of four siblings (alive or removed together).
     bool parents_first = true;
-    for (NodeId n = 0; n < h.node_capacity() && parents_first; ++n) {
-        if (!h.is_alive(n)) continue;
-        const NodeId p = h.parent(n);
-        parents_first = p == kNoNode || p < n;
-        root_of[n] = p == kNoNode ? n : root_of[p];
+    for (NodeId c = h.root_count(); c < h.node_capacity() && parents_first; c += 4) {
+        if (!h.is_alive(c)) continue;
+        const NodeId p = h.parent(c);
+        parents_first = p < c;
+        std::fill(root_of.begin() + c, root_of.begin() + c + 4, parents_first ? root_of[p] : kNoNode);
     }
     if (!parents_first)
         for (NodeId n : h.breadth_first_order()) root_of[n] = n < h.root_count() ? n : root_of[h.parent(n)];

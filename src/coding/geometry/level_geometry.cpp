@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 
@@ -14,12 +15,31 @@ namespace amc {
 
 namespace {
 
-// Effort below kMaxEffort: an adaptive trial is judged on its first 1/kSampleShare of the level
-// (when that is kMinSample vertices or more) and dropped when, scaled, it passes the smallest
-// static mode by 1/8.
+// Effort below kMaxEffort, on levels of kSampleShare * kMinSample new vertices or more: the
+// static modes are weighed on the first 1/kSampleShare of the level, and only those within
+// kStaticMargin of the smallest bound there are made for the whole level; an adaptive trial is
+// dropped when its first 1/kSampleShare, scaled to the level, passes what it must beat by 1/8.
+// Both keep kSampleSlack bytes of room besides, for levels that code to almost nothing.
 constexpr size_t kSampleShare = 8;
 constexpr size_t kMinSample = 2048;
 constexpr double kSampleMargin = 1.125;
+constexpr double kSampleSlack = 64;
+constexpr double kStaticMargin = 1.02;
+
+// Clears candidate[i] for the static modes whose lower bound on the first `sample` vertices of
+// the level passes the smallest by more than kStaticMargin (and kSampleSlack bytes).
+void keep_likely_static_modes(const Hierarchy& h, const NewVertices& created, CoordinateSpace space, size_t sample,
+                              const GeometryPredictor modes[3], bool candidate[3]) {
+    const NewVertices first(created.begin(), created.begin() + std::ptrdiff_t(sample));
+    size_t bound[3] = {SIZE_MAX, SIZE_MAX, SIZE_MAX}, smallest = SIZE_MAX;
+    for (int i = 0; i < 3; ++i) {
+        if (!candidate[i]) continue;
+        bound[i] = StaticLevelEncoder(h, first, space, modes[i], false).lower_bound_bytes();
+        smallest = std::min(smallest, bound[i]);
+    }
+    for (int i = 0; i < 3; ++i)
+        candidate[i] = candidate[i] && double(bound[i]) <= kStaticMargin * double(smallest) + kSampleSlack;
+}
 
 // The predictors a level block of a file of `file_version` may hold (FORMAT.md 3.6).
 bool predictor_allowed(uint8_t predictor, uint8_t file_version, bool quantized) {
@@ -49,28 +69,35 @@ void encode_adaptive(const Hierarchy& h, const NewVertices& created, GeometryPre
 // a byte, and finish() drops at most 4 zero bytes); a finished code is never much shorter than
 // the bytes it committed on the way (8 bytes of margin).
 // Only bit-exact coordinates have raw bits enough to be worth the pass that counts them.
-// With a `sample` of fewer vertices than the level, the trial also stops when the bytes of the
-// first `sample` vertices, scaled to the level, pass the limit by kSampleMargin: on a guess, for
-// the models learn as they go, so a level's start codes longer than its rest.
+// With a `sample` of fewer vertices than the level, that pass covers the sample only, and the
+// trial stops when the sample's raw bits scaled to the level, or its bytes with the rest of the
+// level at the rate of the sample's second half (the models learn as they go), pass the limit by
+// kSampleMargin: a guess.
 size_t adaptive_bytes(const Hierarchy& h, const NewVertices& created, GeometryPredictor predictor, PositionCoder positions,
                       size_t limit, bool count_raw_bits, size_t sample) {
-    std::vector<Vec3> predicted(count_raw_bits ? created.size() : 0);
+    const size_t judged = std::min(sample, created.size());
+    auto past_limit = [&](double bytes) { return limit != SIZE_MAX && bytes > kSampleMargin * double(limit) + kSampleSlack; };
+    size_t half_sample_bytes = 0;
+    std::vector<Vec3> predicted(count_raw_bits ? judged : 0);
     uint64_t raw_bits = 0;
     for (size_t i = 0; i < predicted.size(); ++i) {
         const auto [n, e] = created[i];
         predicted[i] = predict(h, predictor, n, e);
         raw_bits += positions.raw_bits(h.position(h.midpoint(n, e)), predicted[i]);
     }
-    if (raw_bits / 8 > limit + 6) return SIZE_MAX;
+    if (judged == created.size() ? raw_bits / 8 > limit + 6 : past_limit(double(raw_bits / 8) * double(created.size()) / double(judged)))
+        return SIZE_MAX;
     ArithmeticEncoder encoder;
     for (size_t i = 0; i < created.size(); ++i) {
         const auto [n, e] = created[i];
         positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)),
-                         count_raw_bits ? predicted[i] : predict(h, predictor, n, e));
+                         i < predicted.size() ? predicted[i] : predict(h, predictor, n, e));
         if (encoder.bytes_so_far() > limit + 8) return SIZE_MAX;
-        if (i + 1 == sample && limit != SIZE_MAX &&
-            double(encoder.bytes_so_far()) * double(created.size()) > kSampleMargin * double(sample) * double(limit))
-            return SIZE_MAX;
+        if (i + 1 == sample / 2) half_sample_bytes = encoder.bytes_so_far();
+        if (i + 1 == sample) {
+            const double rate = double(encoder.bytes_so_far() - half_sample_bytes) / double(sample - sample / 2);
+            if (past_limit(double(encoder.bytes_so_far()) + rate * double(created.size() - sample))) return SIZE_MAX;
+        }
     }
     return encoder.finish().size();
 }
@@ -85,20 +112,23 @@ LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& c
     code.predictor = automatic ? GeometryPredictor::midpoint : choice;
     if (code.predictor == GeometryPredictor::normal_frame_grid && space.quantizer == nullptr)
         throw Error("geometry mode 4 (normal_frame_grid) needs quantized coordinates");
-    if (automatic && !created.empty())
-        code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space, GeometryPredictor::normal_frame, false);
-    else if (is_static_mode(code.predictor))
-        code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space, code.predictor);
-    if (!automatic || created.empty()) return code;
+    if (!automatic || created.empty()) {
+        if (is_static_mode(code.predictor)) code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space, code.predictor);
+        return code;
+    }
     // The first of the smallest in the order midpoint, butterfly, normal frame, grid, unit frame,
     // as if every mode were coded to its end. The static modes come first, each coded only when its
     // lower bound leaves it a chance (smallest bound first), so that an adaptive trial stops as soon
     // as its code so far shows it can not be the smallest.
+    const size_t sample = effort >= kMaxEffort || created.size() / kSampleShare < kMinSample ? SIZE_MAX : created.size() / kSampleShare;
+    const GeometryPredictor static_modes[] = {GeometryPredictor::normal_frame, GeometryPredictor::normal_frame_grid,
+                                              GeometryPredictor::unit_normal_frame};
+    bool candidate[] = {true, grid_contexts && space.quantizer != nullptr, unit_normals && space.quantizer == nullptr};
+    if (sample != SIZE_MAX) keep_likely_static_modes(h, created, space, sample, static_modes, candidate);
     std::unique_ptr<StaticLevelEncoder> grid, unit;
-    if (grid_contexts && space.quantizer != nullptr)
-        grid = std::make_unique<StaticLevelEncoder>(h, created, space, GeometryPredictor::normal_frame_grid, false);
-    if (unit_normals && space.quantizer == nullptr)
-        unit = std::make_unique<StaticLevelEncoder>(h, created, space, GeometryPredictor::unit_normal_frame, false);
+    if (candidate[0]) code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space, static_modes[0], false);
+    if (candidate[1]) grid = std::make_unique<StaticLevelEncoder>(h, created, space, static_modes[1], false);
+    if (candidate[2]) unit = std::make_unique<StaticLevelEncoder>(h, created, space, static_modes[2], false);
     StaticLevelEncoder* statics[] = {code.static_code.get(), grid.get(), unit.get()};  // in the order of the choice
     size_t static_size[] = {SIZE_MAX, SIZE_MAX, SIZE_MAX}, bound[] = {SIZE_MAX, SIZE_MAX, SIZE_MAX};
     for (int i = 0; i < 3; ++i)
@@ -115,14 +145,17 @@ LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& c
         best_static = std::min(best_static, static_size[next]);
         bound[next] = SIZE_MAX;
     }
-    const size_t sample = effort >= kMaxEffort || created.size() / kSampleShare < kMinSample ? SIZE_MAX : created.size() / kSampleShare;
-    // A sample judges sooner than the pass over the whole level that counts raw bits.
-    const bool count_raw_bits = space.quantizer == nullptr && sample == SIZE_MAX;
-    const size_t midpoint = adaptive_bytes(h, created, GeometryPredictor::midpoint, positions, best_static, count_raw_bits, sample);
+    const bool count_raw_bits = space.quantizer == nullptr;
+    // Effort 0 takes a static mode for a sampled level without trying the adaptive predictors.
+    const bool adaptive_trials = effort > 0 || sample == SIZE_MAX || best_static == SIZE_MAX;
+    const size_t midpoint = adaptive_trials
+                                ? adaptive_bytes(h, created, GeometryPredictor::midpoint, positions, best_static, count_raw_bits, sample)
+                                : SIZE_MAX;
     // The butterfly must be smaller than the midpoint, and no larger than a static mode.
     const size_t butterfly_limit = midpoint == SIZE_MAX ? best_static : std::min(midpoint - 1, best_static);
     const size_t butterfly =
-        adaptive_bytes(h, created, GeometryPredictor::butterfly, positions, butterfly_limit, count_raw_bits, sample);
+        adaptive_trials ? adaptive_bytes(h, created, GeometryPredictor::butterfly, positions, butterfly_limit, count_raw_bits, sample)
+                        : SIZE_MAX;
     size_t best = midpoint;
     if (butterfly < best) {
         best = butterfly;
