@@ -10,10 +10,11 @@
 //   one_core_speed RUNS BITS model.amh ...
 //   one_core_speed decode RUNS file.amc     only decodes the file RUNS times on one thread: the
 //                                           process to profile or count instructions of
-//   one_core_speed encode RUNS BITS model.amh  only encodes the model RUNS times on one thread
-//                                           (default options), and prints the file's size and
-//                                           FNV-1a hash: the process to profile; 0 runs reads
-//                                           the model only
+//   one_core_speed encode RUNS BITS model.amh [EFFORT]
+//                                           only encodes the model RUNS times on one thread
+//                                           (default options, or EncodeOptions::effort EFFORT),
+//                                           and prints the file's size and FNV-1a hash: the
+//                                           process to profile; 0 runs reads the model only
 #include "compare_draco.h"
 #include "bench_common.h"
 
@@ -66,10 +67,11 @@ int decode_only(int runs, const char* path) {
     return 0;
 }
 
-int encode_only(int runs, int bits, const char* path) {
+int encode_only(int runs, int bits, const char* path, int effort) {
     const amc::Hierarchy h = amc::read_hierarchy(path);
     amc::EncodeOptions options;
     options.quantize_bits = bits;
+    options.effort = effort;
     options.threads = 1;
     std::vector<double> rate;
     std::vector<uint8_t> bytes;
@@ -88,11 +90,12 @@ int encode_only(int runs, int bits, const char* path) {
 
 int main(int argc, char** argv) {
     if (argc == 4 && std::strcmp(argv[1], "decode") == 0) return decode_only(std::max(1, std::atoi(argv[2])), argv[3]);
-    if (argc == 5 && std::strcmp(argv[1], "encode") == 0)
-        return encode_only(std::max(0, std::atoi(argv[2])), std::atoi(argv[3]), argv[4]);
+    if ((argc == 5 || argc == 6) && std::strcmp(argv[1], "encode") == 0)
+        return encode_only(std::max(0, std::atoi(argv[2])), std::atoi(argv[3]), argv[4],
+                           argc == 6 ? std::atoi(argv[5]) : amc::kDefaultEffort);
     if (argc < 4) {
         std::fprintf(stderr, "usage: one_core_speed RUNS BITS model.amh ... | one_core_speed decode RUNS file.amc | "
-                             "one_core_speed encode RUNS BITS model.amh\n");
+                             "one_core_speed encode RUNS BITS model.amh [EFFORT]\n");
         return 2;
     }
     const int runs = std::max(1, std::atoi(argv[1]));
