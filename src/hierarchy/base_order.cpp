@@ -189,7 +189,7 @@ Hierarchy HierarchyBuilder::subforest(const Hierarchy& h, TriangleMesh base, con
     out.positions_.resize(vertex_of.size());
     for (size_t v = base_vertex.size(); v < vertex_of.size(); ++v) {
         out.positions_[v] = h.position(vertex_of[v]);
-        out.far_positions_ |= Hierarchy::is_far(out.positions_[v]);
+        out.far_positions_.raise_if(Hierarchy::is_far(out.positions_[v]));
     }
     out.nodes_.resize(n);  // the roots stay as the constructor made them
     out.block_parent_.assign((n - root_count) / 4, kNoNode);
