@@ -73,7 +73,9 @@ struct HierarchyBuilder {
     // ever refined), child k of parents[i] gets id node_capacity() + 4 * i + k, node_capacity()
     // taken before the call.
     static void split_level(Hierarchy& h, const LevelSplits& level) {
-        h.structure_checked_ = false;
+        // Written only when set: threads that fill slices of one hierarchy at once (never a
+        // checked one) only read it.
+        if (h.structure_checked_) h.structure_checked_ = false;
         h.split_level(level);
     }
     // Stitching hierarchies of disjoint root sets into one (hierarchy_stitch.cpp): the decoder of
