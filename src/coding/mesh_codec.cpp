@@ -43,9 +43,10 @@ std::vector<Vec3> live_positions(const Hierarchy& h) {
     return points;
 }
 
-// The grid of `bits` over the input's positions.
+// The grid of `bits` over the input's positions (checked: without removed ids every id is live).
 Quantizer quantizer_of(const Hierarchy& input, int bits) {
     try {
+        if (input.vertex_count() == input.positions().size()) return make_quantizer(input.positions(), bits);
         return make_quantizer(live_positions(input), bits);
     } catch (const Error& e) {
         throw_error(e.code(), std::string("encode: ") + e.what() +
