@@ -165,8 +165,6 @@ private:
     };
     void link(NodeId a, int ea, NodeId b, int eb);
     static void write_vertices(Node* child, const VertexId corner[3], const VertexId m[3]);
-    static void write_neighbors(Node* child, const Neighbors* links, uint32_t offset);
-    static void write_tail(Node& node, uint32_t word);
     VertexId new_vertex(Vec3 p);
     NodeId allocate_children(NodeId parent);
 

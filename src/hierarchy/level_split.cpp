@@ -133,9 +133,8 @@ constexpr ChildTailTable kChildTails{};
 
 namespace {
 
-// The bodies of write_tail and write_neighbors, inlined into split_level: the library is compiled
-// position-independent, where GCC does not inline a global function into another (it might be
-// interposed), and a call per parent cost the build 3 % of its instructions.
+// A child's tail (its last four bytes) and its neighbours, written per parent by split_level
+// (forced inline: a call per parent cost 3 % of a decode's instructions).
 template <class Node>
 AMC_ALWAYS_INLINE void store_tail(Node& node, uint32_t word) {
     // Bytes nbr_edge, level, flags, reserved in that order (little endian word).
@@ -149,6 +148,9 @@ AMC_ALWAYS_INLINE void store_tail(Node& node, uint32_t word) {
 #endif
 }
 
+// The neighbours of four new siblings from their local links; a local index becomes the id
+// offset + index, kNoNode stays. Each child's store also fills its tail, which store_tail writes
+// afterwards.
 template <class Node>
 AMC_ALWAYS_INLINE void store_neighbors(Node* child, const Neighbors* siblings, uint32_t offset) {
     const uint32_t* links = siblings[0].nbr;  // word 3k + e: child k, edge e (Neighbors' static_assert)
@@ -177,15 +179,6 @@ AMC_ALWAYS_INLINE void store_neighbors(Node* child, const Neighbors* siblings, u
 }
 
 }  // namespace
-
-void Hierarchy::write_tail(Node& node, uint32_t word) { store_tail(node, word); }
-
-// The neighbours of four new siblings from their local links; a local index becomes the id
-// offset + index, kNoNode stays. Each child's store also fills its last four bytes, which
-// write_tail writes afterwards.
-void Hierarchy::write_neighbors(Node* child, const Neighbors* siblings, uint32_t offset) {
-    store_neighbors(child, siblings, offset);
-}
 
 void Hierarchy::split_level(const LevelSplits& splits) {
     const NodeId* const parents = splits.parents;
