@@ -216,16 +216,35 @@ int static_raw_bit_count(uint64_t magnitude) { return magnitude < 8 ? 0 : 1 + bi
 
 StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created,
                                        CoordinateSpace space, GeometryPredictor mode, bool streams)
-    : table_count_(static_table_count(mode)) {
+    : StaticLevelEncoder(h, created, created.size(), space, mode) {
+    if (streams) code_streams();
+}
+
+StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t count,
+                                       CoordinateSpace space, GeometryPredictor mode)
+    : mode_(mode), space_(space), table_count_(static_table_count(mode)) {
     if (!is_static_mode(mode)) throw Error("StaticLevelEncoder: geometry mode " + std::to_string(int(mode)) + " is not a static mode");
-    const bool grid_bins = has_grid_bins(mode);
-    if (grid_bins && space.quantizer == nullptr) throw Error("geometry mode 4 needs quantized coordinates");
-    tokens_.reserve(created.size());
-    table_of_.reserve(created.size());
-    residuals_.reserve(created.size());
-    std::array<std::vector<uint64_t>, kMaxStaticTables> counts;
-    for (auto [n, e] : created) {
-        const NormalFrame frame = normal_frame(h, n, e, has_unit_normals(mode));
+    if (has_grid_bins(mode) && space.quantizer == nullptr) throw Error("geometry mode 4 needs quantized coordinates");
+    count = std::min(count, created.size());
+    add(h, created, 0, count);
+    make_tables();
+}
+
+void StaticLevelEncoder::extend(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created) {
+    if (coded_) throw Error("StaticLevelEncoder::extend: the streams are coded already");
+    add(h, created, tokens_.size(), created.size());
+    make_tables();
+}
+
+void StaticLevelEncoder::add(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end) {
+    const bool grid_bins = has_grid_bins(mode_);
+    const CoordinateSpace space = space_;
+    tokens_.reserve(end);
+    table_of_.reserve(end);
+    residuals_.reserve(end);
+    for (size_t i = begin; i < end; ++i) {
+        const auto [n, e] = created[i];
+        const NormalFrame frame = normal_frame(h, n, e, has_unit_normals(mode_));
         const std::array<int, 3> axes = role_axes(frame);
         const Vec3 actual = h.position(h.midpoint(n, e));
         const Vec3 others = frame.predict(axis_coordinate(actual, axes[0]));
@@ -244,7 +263,7 @@ StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std
             }
             t[size_t(role)] = static_token(r[size_t(role)].negative, r[size_t(role)].magnitude);
             raw_bits_ += uint64_t(static_raw_bit_count(r[size_t(role)].magnitude));
-            std::vector<uint64_t>& c = counts[size_t(table[size_t(role)])];
+            std::vector<uint64_t>& c = counts_[size_t(table[size_t(role)])];
             if (c.size() <= size_t(t[size_t(role)])) c.resize(size_t(t[size_t(role)]) + 1, 0);
             ++c[size_t(t[size_t(role)])];
         }
@@ -252,8 +271,13 @@ StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std
         table_of_.push_back(table);
         residuals_.push_back(r);
     }
+}
+
+void StaticLevelEncoder::make_tables() {
+    token_bits_ = 0;
+    token_count_ = 0;
     for (int i = 0; i < table_count_; ++i) {
-        std::vector<uint64_t>& c = counts[size_t(i)];
+        std::vector<uint64_t> c = counts_[size_t(i)];
         const bool used = !c.empty();
         if (!used) c.push_back(1);  // a table no token uses still needs a symbol
         tables_[size_t(i)] = RansTable::from_counts(c);
@@ -263,7 +287,6 @@ StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std
             token_count_ += c[t];
         }
     }
-    if (streams) code_streams();
 }
 
 void StaticLevelEncoder::code_streams() {
