@@ -98,6 +98,8 @@ public:
 private:
     // Tokens, residuals and counts of created[begin, end).
     void add(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
+    template <bool UnitNormals, bool GridBins>
+    void add_vertices(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
     // The tables from the counts, and the tokens' cost under them.
     void make_tables();
 
@@ -105,7 +107,7 @@ private:
     CoordinateSpace space_;
     StaticTables tables_;
     int table_count_ = kStaticRoles;
-    std::array<std::vector<uint64_t>, kMaxStaticTables> counts_;  // per table, of each token
+    std::array<std::vector<uint64_t>, kMaxStaticTables> counts_;  // per table, of each possible token
     double token_bits_ = 0;  // the tokens' cost under the tables, sum of log2(M / f)
     uint64_t token_count_ = 0;
     std::vector<std::array<int, kStaticRoles>> tokens_, table_of_;  // until the streams are coded
