@@ -45,23 +45,21 @@ public:
     }
     uint32_t u32() {
         need(4);
-        uint32_t v = 0;
-        for (int i = 0; i < 4; ++i) v |= uint32_t(uint8_t(bytes_[pos_ + i])) << (8 * i);
+        const uint32_t v = le32(at());
         pos_ += 4;
         return v;
     }
-    double coordinate(bool single) {
-        if (single) {
-            uint32_t bits = u32();
-            float f;
-            std::memcpy(&f, &bits, 4);
-            return f;
+    // `count` points of three coordinates, the room for all of them checked once.
+    void points(Vec3* out, size_t count, bool single) {
+        const size_t size = single ? 4 : 8;
+        if (count > remaining() / (3 * size)) fail("file is truncated", ErrorCode::truncated);
+        const unsigned char* p = at();
+        for (size_t i = 0; i < count; ++i, p += 3 * size) {
+            out[i].x = coordinate(p, single);
+            out[i].y = coordinate(p + size, single);
+            out[i].z = coordinate(p + 2 * size, single);
         }
-        uint64_t lo = u32(), hi = u32();
-        uint64_t bits = lo | (hi << 32);
-        double d;
-        std::memcpy(&d, &bits, 8);
-        return d;
+        pos_ += count * 3 * size;
     }
     const char* take(size_t n) {
         need(n);
@@ -72,6 +70,22 @@ public:
     size_t remaining() const { return bytes_.size() - pos_; }
 
 private:
+    const unsigned char* at() const { return reinterpret_cast<const unsigned char*>(bytes_.data()) + pos_; }
+    static uint32_t le32(const unsigned char* p) {
+        return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+    }
+    static double coordinate(const unsigned char* p, bool single) {
+        if (single) {
+            const uint32_t bits = le32(p);
+            float f;
+            std::memcpy(&f, &bits, 4);
+            return f;
+        }
+        const uint64_t bits = le32(p) | uint64_t(le32(p + 4)) << 32;
+        double d;
+        std::memcpy(&d, &bits, 8);
+        return d;
+    }
     void need(size_t n) const {
         if (bytes_.size() - pos_ < n) fail("file is truncated", ErrorCode::truncated);
     }
@@ -158,11 +172,7 @@ Hierarchy parse_hierarchy(const std::string& bytes, const std::string& what) {
     TriangleMesh base;
     base.single_precision = single;
     base.positions.resize(base_vertices);
-    for (Vec3& p : base.positions) {
-        p.x = in.coordinate(single);
-        p.y = in.coordinate(single);
-        p.z = in.coordinate(single);
-    }
+    in.points(base.positions.data(), base_vertices, single);
     base.triangles.resize(base_triangles);
     for (Triangle& t : base.triangles) {
         for (uint32_t& v : t) v = in.u32();
@@ -222,13 +232,11 @@ Hierarchy parse_hierarchy(const std::string& bytes, const std::string& what) {
     if (h.vertex_count() - h.base().positions.size() != new_vertices)
         in.fail("header announces " + std::to_string(new_vertices) + " refinement vertices but the forest makes " +
                 std::to_string(h.vertex_count() - h.base().positions.size()));
-    const std::vector<uint32_t> canonical = canonical_vertex_order(h);
+    const std::vector<uint32_t> canonical = canonical_vertex_order(h, order);  // order is breadth-first
     std::vector<Vec3> refinement_positions(new_vertices);
+    in.points(refinement_positions.data(), new_vertices, single);
     for (uint32_t i = 0; i < new_vertices; ++i) {
-        Vec3& p = refinement_positions[i];
-        p.x = in.coordinate(single);
-        p.y = in.coordinate(single);
-        p.z = in.coordinate(single);
+        const Vec3& p = refinement_positions[i];
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
             in.fail("refinement vertex " + std::to_string(i) + " has a non-finite coordinate");
     }
