@@ -379,9 +379,9 @@ void gather_chunk(const Hierarchy& h, const Source& source, size_t begin, Chunk&
             if (v != kNoVertex) __builtin_prefetch(&h.positions()[v]);
 }
 
-template <bool Grid, bool UnitNormals>
-AMC_ALWAYS_INLINE void frame_vertex(const Hierarchy& h, const Quantizer* quantizer, Chunk& c, size_t i) {
-    const NormalFrame frame = frame_of<UnitNormals>(h, c.corners[i]);
+// Vertex i's frame in role order.
+template <bool Grid>
+AMC_ALWAYS_INLINE void role_frame(const NormalFrame& frame, const Quantizer* quantizer, Chunk& c, size_t i) {
     const std::array<int, 3> axes = role_axes(frame);
     RoleFrame& f = c.frames[i];
     for (int r = 0; r < 3; ++r) {
@@ -392,6 +392,23 @@ AMC_ALWAYS_INLINE void frame_vertex(const Hierarchy& h, const Quantizer* quantiz
     }
     f.has_normal = frame.has_normal;
     if (Grid) c.first[i] = grid_prediction_at(*quantizer, f.origin[0], f.midpoint[0]);
+}
+
+// The chunk's frames in role order, two at a time where SSE2 computes two frames at once.
+template <bool Grid, bool UnitNormals>
+AMC_ALWAYS_INLINE void frame_chunk(const Hierarchy& h, const Quantizer* quantizer, Chunk& c) {
+    size_t i = 0;
+#if AMC_SSE2
+    if (!h.single_precision()) {
+        for (; i + 1 < c.count; i += 2) {
+            NormalFrame f0, f1;
+            frame_pair_of<UnitNormals>(h, c.corners[i], c.corners[i + 1], f0, f1);
+            role_frame<Grid>(f0, quantizer, c, i);
+            role_frame<Grid>(f1, quantizer, c, i + 1);
+        }
+    }
+#endif
+    for (; i < c.count; ++i) role_frame<Grid>(frame_of<UnitNormals>(h, c.corners[i]), quantizer, c, i);
 }
 
 // NormalFrame::predict in role order: roles 1 and 2's predictions once role 0's value is known.
@@ -448,7 +465,7 @@ bool decode_positions(Hierarchy& h, const Source& created, CoordinateSpace space
     Chunk c;
     for (size_t begin = 0; begin < created.size(); begin += kChunk) {
         gather_chunk(h, created, begin, c);
-        for (size_t i = 0; i < c.count; ++i) frame_vertex<Grid, UnitNormals>(h, quantizer, c, i);
+        frame_chunk<Grid, UnitNormals>(h, quantizer, c);
         for (size_t i = 0; i < c.count; i += 2) {
             Vec3 p;
             if (!decode_vertex<0, Grid>(c, i, space, tables, rans, raw, p)) return false;
