@@ -82,6 +82,11 @@ int Reconstruction::local_misfits(int from, int depth, const std::vector<NodeId>
         unsplit_edges_.clear();
         std::vector<std::pair<NodeId, bool>> split;
         for (const auto& node : nodes) {
+            uint32_t p[3];
+            if (!known_corners(node.first, p)) {  // under a midpoint not found: no reading
+                misfits += node.second;
+                continue;
+            }
             bool refined = false;
             try {
                 refined = classify(node.first);

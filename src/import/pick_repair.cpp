@@ -16,10 +16,6 @@ void Reconstruction::note_guided(VertexId m, NodeId n, int e) {
 }
 
 bool Reconstruction::fits(NodeId x, std::vector<VertexId>* suspects) const {
-    auto corners = [&](NodeId y, uint32_t p[3]) {
-        for (int i = 0; i < 3; ++i) p[i] = corner(y, i);
-        return p[0] != kNoIndex && p[1] != kNoIndex && p[2] != kNoIndex;
-    };
     auto blame = [&](NodeId y) {
         for (int i = 0; suspects && y != kNoNode && i < 3; ++i) {
             if (guided(h_.vertex(y, i))) suspects->push_back(h_.vertex(y, i));
@@ -27,10 +23,10 @@ bool Reconstruction::fits(NodeId x, std::vector<VertexId>* suspects) const {
     };
     auto refined = [&](NodeId y) {
         uint32_t p[3];
-        return y != kNoNode && corners(y, p) && read(p).refined();
+        return y != kNoNode && known_corners(y, p) && read(p).refined();
     };
     uint32_t p[3];
-    if (!corners(x, p)) return true;
+    if (!known_corners(x, p)) return true;
     const Reading r = read(p);
     // A refined node needs a same-level neighbour across every inner edge (2:1 balance).
     bool ok = r.fault == Reading::none && !(r.refined() && !h_.has_all_neighbors(x));

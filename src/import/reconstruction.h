@@ -74,6 +74,11 @@ private:
     [[noreturn]] void fail(const std::string& message) const { throw Error(what_ + ": " + message); }
 
     uint32_t corner(NodeId n, int i) const { return leaf_of_vertex_[h_.vertex(n, i)]; }
+    // n's corners as leaf vertices; false if one has none yet (a midpoint above it was not found).
+    bool known_corners(NodeId n, uint32_t p[3]) const {
+        for (int i = 0; i < 3; ++i) p[i] = corner(n, i);
+        return p[0] != kNoIndex && p[1] != kNoIndex && p[2] != kNoIndex;
+    }
 
     std::string edge_text(NodeId n, int e) const {
         return std::to_string(corner(n, e)) + "," + std::to_string(corner(n, (e + 1) % 3));

@@ -95,7 +95,9 @@ ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& s
         put_varint(out.bytes, payload.size());
         out.bytes.insert(out.bytes.end(), payload.begin(), payload.end());
     }
-    for (NodeId n : h.leaves()) out.faces += 1 + uint64_t(h.hanging_node_count(n) + seam_hanging_count(h, keys, seam, n));
+    // A sum over the leaves in id order: no breadth-first list of them needed.
+    for (NodeId n = 0; n < h.node_capacity(); ++n)
+        if (h.is_alive(n) && h.is_leaf(n)) out.faces += 1 + uint64_t(h.hanging_node_count(n) + seam_hanging_count(h, keys, seam, n));
     return out;
 }
 

@@ -27,18 +27,22 @@ constexpr double kSampleSlack = 64;
 constexpr double kStaticMargin = 1.02;
 
 // Clears candidate[i] for the static modes whose lower bound on the first `sample` vertices of
-// the level passes the smallest by more than kStaticMargin (and kSampleSlack bytes).
+// the level passes the smallest by more than kStaticMargin (and kSampleSlack bytes); the sample's
+// encoders of those left go to on_sample[i], for the whole level to carry on from.
 void keep_likely_static_modes(const Hierarchy& h, const NewVertices& created, CoordinateSpace space, size_t sample,
-                              const GeometryPredictor modes[3], bool candidate[3]) {
-    const NewVertices first(created.begin(), created.begin() + std::ptrdiff_t(sample));
+                              const GeometryPredictor modes[3], bool candidate[3],
+                              std::unique_ptr<StaticLevelEncoder> on_sample[3]) {
     size_t bound[3] = {SIZE_MAX, SIZE_MAX, SIZE_MAX}, smallest = SIZE_MAX;
     for (int i = 0; i < 3; ++i) {
         if (!candidate[i]) continue;
-        bound[i] = StaticLevelEncoder(h, first, space, modes[i], false).lower_bound_bytes();
+        on_sample[i] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, modes[i]);
+        bound[i] = on_sample[i]->lower_bound_bytes();
         smallest = std::min(smallest, bound[i]);
     }
-    for (int i = 0; i < 3; ++i)
+    for (int i = 0; i < 3; ++i) {
         candidate[i] = candidate[i] && double(bound[i]) <= kStaticMargin * double(smallest) + kSampleSlack;
+        if (!candidate[i]) on_sample[i].reset();
+    }
 }
 
 // The predictors a level block of a file of `file_version` may hold (FORMAT.md 3.6).
@@ -124,11 +128,17 @@ LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& c
     const GeometryPredictor static_modes[] = {GeometryPredictor::normal_frame, GeometryPredictor::normal_frame_grid,
                                               GeometryPredictor::unit_normal_frame};
     bool candidate[] = {true, grid_contexts && space.quantizer != nullptr, unit_normals && space.quantizer == nullptr};
-    if (sample != SIZE_MAX) keep_likely_static_modes(h, created, space, sample, static_modes, candidate);
+    std::unique_ptr<StaticLevelEncoder> on_sample[3];
+    if (sample != SIZE_MAX) keep_likely_static_modes(h, created, space, sample, static_modes, candidate, on_sample);
+    auto whole_level = [&](int i) {
+        if (on_sample[i] == nullptr) return std::make_unique<StaticLevelEncoder>(h, created, space, static_modes[i], false);
+        on_sample[i]->extend(h, created);
+        return std::move(on_sample[i]);
+    };
     std::unique_ptr<StaticLevelEncoder> grid, unit;
-    if (candidate[0]) code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space, static_modes[0], false);
-    if (candidate[1]) grid = std::make_unique<StaticLevelEncoder>(h, created, space, static_modes[1], false);
-    if (candidate[2]) unit = std::make_unique<StaticLevelEncoder>(h, created, space, static_modes[2], false);
+    if (candidate[0]) code.static_code = whole_level(0);
+    if (candidate[1]) grid = whole_level(1);
+    if (candidate[2]) unit = whole_level(2);
     StaticLevelEncoder* statics[] = {code.static_code.get(), grid.get(), unit.get()};  // in the order of the choice
     size_t static_size[] = {SIZE_MAX, SIZE_MAX, SIZE_MAX}, bound[] = {SIZE_MAX, SIZE_MAX, SIZE_MAX};
     for (int i = 0; i < 3; ++i)

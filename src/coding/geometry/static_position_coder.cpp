@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <string>
 
 namespace amc {
@@ -231,25 +232,58 @@ int static_raw_bit_count(uint64_t magnitude) { return magnitude < 8 ? 0 : 1 + bi
 
 StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created,
                                        CoordinateSpace space, GeometryPredictor mode, bool streams)
-    : table_count_(static_table_count(mode)) {
+    : StaticLevelEncoder(h, created, created.size(), space, mode) {
+    if (streams) code_streams();
+}
+
+StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t count,
+                                       CoordinateSpace space, GeometryPredictor mode)
+    : mode_(mode), space_(space), table_count_(static_table_count(mode)) {
     if (!is_static_mode(mode)) throw Error("StaticLevelEncoder: geometry mode " + std::to_string(int(mode)) + " is not a static mode");
-    const bool grid_bins = has_grid_bins(mode);
-    if (grid_bins && space.quantizer == nullptr) throw Error("geometry mode 4 needs quantized coordinates");
-    tokens_.reserve(created.size());
-    table_of_.reserve(created.size());
-    residuals_.reserve(created.size());
-    std::array<std::vector<uint64_t>, kMaxStaticTables> counts;
-    for (auto [n, e] : created) {
-        const NormalFrame frame = normal_frame(h, n, e, has_unit_normals(mode));
+    if (has_grid_bins(mode) && space.quantizer == nullptr) throw Error("geometry mode 4 needs quantized coordinates");
+    count = std::min(count, created.size());
+    add(h, created, 0, count);
+    make_tables();
+}
+
+void StaticLevelEncoder::extend(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created) {
+    if (coded_) throw Error("StaticLevelEncoder::extend: the streams are coded already");
+    add(h, created, tokens_.size(), created.size());
+    make_tables();
+}
+
+void StaticLevelEncoder::add(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end) {
+    if (counts_[0].empty())
+        for (int i = 0; i < table_count_; ++i) counts_[size_t(i)].assign(size_t(token_limit(space_)), 0);
+    tokens_.resize(end);
+    table_of_.resize(end);
+    residuals_.resize(end);
+    switch (mode_) {
+        case GeometryPredictor::normal_frame: add_vertices<false, false>(h, created, begin, end); break;
+        case GeometryPredictor::normal_frame_grid: add_vertices<true, true>(h, created, begin, end); break;
+        default: add_vertices<true, false>(h, created, begin, end); break;
+    }
+}
+
+// The loop of add() for one mode: the frame's kind and the table split known when it is compiled.
+template <bool UnitNormals, bool GridBins>
+void StaticLevelEncoder::add_vertices(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin,
+                                      size_t end) {
+    const CoordinateSpace space = space_;
+    uint64_t raw_bits = 0;
+    for (size_t i = begin; i < end; ++i) {
+        const auto [n, e] = created[i];
+        const NormalFrame frame = frame_of<UnitNormals>(h, frame_corners(h, n, e));
         const std::array<int, 3> axes = role_axes(frame);
         const Vec3 actual = h.position(h.midpoint(n, e));
         const Vec3 others = frame.predict(axis_coordinate(actual, axes[0]));
-        std::array<int, kStaticRoles> t{}, table{};
-        std::array<Residual, kStaticRoles> r{};
+        std::array<int, kStaticRoles>& t = tokens_[i];
+        std::array<int, kStaticRoles>& table = table_of_[i];
+        std::array<Residual, kStaticRoles>& r = residuals_[i];
         for (int role = 0; role < kStaticRoles; ++role) {
             const int axis = axes[size_t(role)];
             const double predicted = role == 0 ? axis_coordinate(frame.midpoint, axis) : axis_coordinate(others, axis);
-            if (grid_bins) {
+            if (GridBins) {
                 const GridPrediction g = grid_prediction(*space.quantizer, axis, predicted);
                 r[size_t(role)] = grid_residual(*space.quantizer, axis, axis_coordinate(actual, axis), g);
                 table[size_t(role)] = kGridBins * role + g.bin;
@@ -258,17 +292,22 @@ StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std
                 table[size_t(role)] = role;
             }
             t[size_t(role)] = static_token(r[size_t(role)].negative, r[size_t(role)].magnitude);
-            raw_bits_ += uint64_t(static_raw_bit_count(r[size_t(role)].magnitude));
-            std::vector<uint64_t>& c = counts[size_t(table[size_t(role)])];
-            if (c.size() <= size_t(t[size_t(role)])) c.resize(size_t(t[size_t(role)]) + 1, 0);
-            ++c[size_t(t[size_t(role)])];
+            raw_bits += uint64_t(static_raw_bit_count(r[size_t(role)].magnitude));
+            ++counts_[size_t(table[size_t(role)])][size_t(t[size_t(role)])];
         }
-        tokens_.push_back(t);
-        table_of_.push_back(table);
-        residuals_.push_back(r);
     }
+    raw_bits_ += raw_bits;
+}
+
+void StaticLevelEncoder::make_tables() {
+    token_bits_ = 0;
+    token_count_ = 0;
     for (int i = 0; i < table_count_; ++i) {
-        std::vector<uint64_t>& c = counts[size_t(i)];
+        // The counts up to the largest token seen: the table's size.
+        const std::vector<uint64_t>& all = counts_[size_t(i)];
+        size_t size = all.size();
+        while (size > 0 && all[size - 1] == 0) --size;
+        std::vector<uint64_t> c(all.begin(), all.begin() + std::ptrdiff_t(size));
         const bool used = !c.empty();
         if (!used) c.push_back(1);  // a table no token uses still needs a symbol
         tables_[size_t(i)] = RansTable::from_counts(c);
@@ -278,7 +317,6 @@ StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std
             token_count_ += c[t];
         }
     }
-    if (streams) code_streams();
 }
 
 void StaticLevelEncoder::code_streams() {

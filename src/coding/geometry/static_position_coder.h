@@ -74,6 +74,14 @@ public:
     // weighing modes asks lower_bound_bytes() first.
     StaticLevelEncoder(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
                        GeometryPredictor mode = GeometryPredictor::normal_frame, bool streams = true);
+    // Over the first `count` of `created` only (no streams): an encoder weighing modes on a sample
+    // of a level, which extend() may then carry on over the whole level.
+    StaticLevelEncoder(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t count,
+                       CoordinateSpace space, GeometryPredictor mode);
+    // Adds the rest of `created` (the vector the encoder was made over the first part of) and
+    // remakes the tables: the encoder made over all of `created`, without its first part's frames
+    // computed again. Before code_streams() only.
+    void extend(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created);
     // Codes the rANS and raw streams (once).
     void code_streams();
     // The tables (three, or six in mode 4), into the level's arithmetic payload after the hierarchy part.
@@ -88,8 +96,18 @@ public:
     size_t lower_bound_bytes() const;
 
 private:
+    // Tokens, residuals and counts of created[begin, end).
+    void add(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
+    template <bool UnitNormals, bool GridBins>
+    void add_vertices(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
+    // The tables from the counts, and the tokens' cost under them.
+    void make_tables();
+
+    GeometryPredictor mode_;
+    CoordinateSpace space_;
     StaticTables tables_;
     int table_count_ = kStaticRoles;
+    std::array<std::vector<uint64_t>, kMaxStaticTables> counts_;  // per table, of each possible token
     double token_bits_ = 0;  // the tokens' cost under the tables, sum of log2(M / f)
     uint64_t token_count_ = 0;
     std::vector<std::array<int, kStaticRoles>> tokens_, table_of_;  // until the streams are coded

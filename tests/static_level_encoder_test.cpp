@@ -1,0 +1,61 @@
+// The static geometry modes' level encoder (coding/geometry/static_position_coder.h): an encoder
+// made over a sample of a level and extended to the whole level codes the level as one made over
+// the whole level does (the encode's mode choice relies on it: docs/CODEC.md, "Encode effort").
+#include "hierarchy_checks.h"
+
+#include "coding/geometry/geometry_prediction.h"
+#include "coding/geometry/level_geometry.h"
+#include "coding/geometry/static_position_coder.h"
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace amc {
+namespace {
+
+using testing::projected_sphere;
+
+// The level with the most new vertices.
+NewVertices largest_level(const Hierarchy& h) {
+    NewVertices largest;
+    for (const std::vector<NodeId>& level : nodes_by_level(h)) {
+        NewVertices created = new_vertices_of_level(h, level);
+        if (created.size() > largest.size()) largest = std::move(created);
+    }
+    return largest;
+}
+
+void expect_extended_codes_as_whole(const Hierarchy& h, CoordinateSpace space, GeometryPredictor mode) {
+    const NewVertices created = largest_level(h);
+    ASSERT_GT(created.size(), 100u);
+    StaticLevelEncoder whole(h, created, space, mode, false);
+    const size_t whole_bound = whole.lower_bound_bytes();
+    whole.code_streams();
+    for (size_t sample : {size_t(0), size_t(1), created.size() / 8, created.size() - 1, created.size()}) {
+        SCOPED_TRACE("mode " + std::to_string(int(mode)) + ", sample " + std::to_string(sample));
+        StaticLevelEncoder extended(h, created, sample, space, mode);
+        if (sample > 0 && sample < created.size() / 2) {
+            EXPECT_NE(extended.lower_bound_bytes(), whole_bound);  // the sample's own tables
+        }
+        extended.extend(h, created);
+        EXPECT_EQ(extended.lower_bound_bytes(), whole_bound);
+        extended.code_streams();
+        EXPECT_EQ(extended.rans_bytes(), whole.rans_bytes());
+        EXPECT_EQ(extended.raw_bytes(), whole.raw_bytes());
+        EXPECT_EQ(extended.estimated_bytes(), whole.estimated_bytes());
+        EXPECT_THROW(extended.extend(h, created), Error);  // the streams are coded
+    }
+}
+
+TEST(StaticLevelEncoder, ExtendedFromASampleCodesAsMadeOverTheWholeLevel) {
+    const Hierarchy h = projected_sphere(6000, 6, 11);
+    const Quantizer quantizer = make_quantizer(h.positions(), 12);
+    expect_extended_codes_as_whole(h, {Precision::float64, &quantizer}, GeometryPredictor::normal_frame);
+    expect_extended_codes_as_whole(h, {Precision::float64, &quantizer}, GeometryPredictor::normal_frame_grid);
+    expect_extended_codes_as_whole(h, {Precision::float64, nullptr}, GeometryPredictor::normal_frame);
+    expect_extended_codes_as_whole(h, {Precision::float64, nullptr}, GeometryPredictor::unit_normal_frame);
+}
+
+}  // namespace
+}  // namespace amc
