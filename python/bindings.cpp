@@ -265,21 +265,24 @@ PYBIND11_MODULE(_amcodec, m) {
                  return mesh_dict(leaf.mesh, leaf.cells, nullptr);
              }, py::arg("level") = -1,
              "The conforming leaf mesh (or the mesh of one level): dict with points, triangles, level, green.")
-        .def("encode", [](const Hierarchy& h, int quantize) {
+        .def("encode", [](const Hierarchy& h, int quantize, int effort) {
                  EncodeOptions options;
                  options.quantize_bits = quantize;
+                 options.effort = effort;
                  std::vector<uint8_t> data;
                  {
                      py::gil_scoped_release release;
                      data = encode(h, options);
                  }
                  return to_bytes(data);
-             }, py::arg("quantize") = 0, "Compresses to .amc bytes (quantize: 0 bit-exact, else bits per axis).")
+             }, py::arg("quantize") = 0, py::arg("effort") = kDefaultEffort,
+             "Compresses to .amc bytes (quantize: 0 bit-exact, else bits per axis; effort 0 to 2: how hard each\n"
+             "level's geometry mode is sought, as amc encode --effort).")
         .def("identical", [](const Hierarchy& a, const Hierarchy& b) { return identical(a, b); }, py::arg("other"),
              "Same base, forest, diagonals and bit-identical positions (canonical order).");
 
     m.def("encode", [](const py::array& points, const py::array& triangles, const py::object& base, bool keep_numbering,
-                       int quantize, bool return_stats) -> py::object {
+                       int quantize, bool return_stats, int effort) -> py::object {
               const TriangleMesh mesh = mesh_from_arrays(points, triangles, "mesh");
               ImportedHierarchy imported = import_arrays(mesh, base);
               EncodeStats stats;
@@ -289,6 +292,7 @@ PYBIND11_MODULE(_amcodec, m) {
                   const LeafNumbering numbering = leaf_numbering(imported.hierarchy, mesh, imported.vertex_of_input);
                   EncodeOptions options;
                   options.quantize_bits = quantize;
+                  options.effort = effort;
                   options.numbering = &numbering;
                   options.store_numbering = keep_numbering;
                   data = encode(imported.hierarchy, options, &stats);
@@ -303,10 +307,11 @@ PYBIND11_MODULE(_amcodec, m) {
               return py::make_tuple(to_bytes(data), s);
           },
           py::arg("points"), py::arg("triangles"), py::arg("base") = py::none(), py::arg("keep_numbering") = false,
-          py::arg("quantize") = 0, py::arg("return_stats") = false,
+          py::arg("quantize") = 0, py::arg("return_stats") = false, py::arg("effort") = kDefaultEffort,
           "Compresses a triangle mesh to .amc bytes. The mesh is imported over `base` (a (points, triangles) pair) or\n"
           "over the coarsest base found in it. keep_numbering stores the mesh's own vertex and face numbering, so\n"
-          "that decode returns it; return_stats also returns a dict of sizes and the numbering map.");
+          "that decode returns it; return_stats also returns a dict of sizes and the numbering map; effort (0 to 2)\n"
+          "as amc encode --effort.");
 
     m.def("decode", [](py::bytes data, int level, bool canonical, bool partial) {
               const std::string bytes = data;

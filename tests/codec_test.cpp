@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <string>
 
 namespace amc {
 namespace {
@@ -201,6 +202,22 @@ TEST(Codec, EveryEffortDecodesToTheSameHierarchy) {
             const std::vector<uint8_t> bytes = encode(h, options);
             EXPECT_TRUE(identical(decode(bytes.data(), bytes.size()), expected)) << "bits " << bits << ", effort " << effort;
             EXPECT_LE(double(bytes.size()), 1.02 * double(best.size())) << "bits " << bits << ", effort " << effort;
+        }
+    }
+}
+
+TEST(Codec, EffortOutsideItsRangeIsRefused) {
+    Hierarchy h(make_icosahedron());
+    refine_uniformly(h, 1);
+    for (int effort : {-1, kMaxEffort + 1}) {
+        EncodeOptions options;
+        options.effort = effort;
+        try {
+            encode(h, options);
+            ADD_FAILURE() << "effort " << effort << " was taken";
+        } catch (const Error& e) {
+            EXPECT_EQ(e.code(), ErrorCode::invalid_input);
+            EXPECT_NE(std::string(e.what()).find("effort " + std::to_string(effort)), std::string::npos) << e.what();
         }
     }
 }

@@ -243,8 +243,9 @@ void run_decode(const DecodeCommand& command, const GlobalOptions& global) {
         h = decode_input(input, options, &numbering);
     }
     const double seconds = seconds_since(start);
+    const int depth = h.depth();  // a pass over every node: once
     if (partial_note.empty())  // a partial file gives what has arrived
-        check_level(input.name, command.level, h.depth());
+        check_level(input.name, command.level, depth);
     if (!command.map.empty() && numbering.empty())
         throw Error(input.name + ": the file stores no numbering (encode a mesh with --keep-numbering, or keep the map "
                     "that encode --map writes)");
@@ -268,7 +269,7 @@ void run_decode(const DecodeCommand& command, const GlobalOptions& global) {
     progress.finish();
     if (global.verbosity > 0)
         std::fprintf(report_stream(output), "%s: %u nodes, %u vertices, depth %d%s -> %s%s (%.3f s)\n", input.name.c_str(),
-                     h.node_count(), h.vertex_count(), h.depth(), partial_note.c_str(),
+                     h.node_count(), h.vertex_count(), depth, partial_note.c_str(),
                      output == "-" ? "stdout" : output.c_str(), renumbered ? " in the input's numbering" : "", seconds);
 }
 

@@ -59,7 +59,8 @@ struct EncodeOptions {
     // How hard the automatic predictor weighs each level's geometry modes (docs/CODEC.md, "Encode
     // effort"): kMaxEffort codes every candidate until it is the smallest or can not be; lower
     // efforts judge the adaptive predictors from a sample of the level first (faster encodes,
-    // slightly larger files). The decoder reads every choice alike.
+    // slightly larger files). The decoder reads every choice alike. encode() refuses an effort
+    // outside 0..kMaxEffort (invalid_input).
     int effort = kDefaultEffort;
     // The caller's numbering of the input's leaf mesh (leaf_numbering()), or null. The encoder
     // re-expresses it against the leaf mesh the decoder rebuilds (EncodeStats::numbering) and,

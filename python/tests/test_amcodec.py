@@ -139,3 +139,19 @@ def test_meshio_file_in_and_out(tmp_path):
     assert np.array_equal(back.points, mesh.points)
     assert np.array_equal(back.cells[0].data, mesh.cells[0].data)
     meshio.write(tmp_path / "back.vtu", back)
+
+
+def test_every_effort_decodes_alike_and_others_are_refused():
+    h, points, triangles = adaptive_leaf_mesh(3)
+    expected = amcodec.decode_hierarchy(h.encode(quantize=12)).leaf_mesh()
+    for effort in (0, 1, 2):
+        back = amcodec.decode_hierarchy(h.encode(quantize=12, effort=effort)).leaf_mesh()
+        assert np.array_equal(back["points"], expected["points"])
+        assert np.array_equal(back["triangles"], expected["triangles"])
+        mesh = amcodec.decode(amcodec.encode(points, triangles, keep_numbering=True, effort=effort))
+        assert np.array_equal(mesh["points"], points)
+    for effort in (-1, 3):
+        with pytest.raises(Exception, match="effort"):
+            h.encode(effort=effort)
+        with pytest.raises(Exception, match="effort"):
+            amcodec.encode(points, triangles, effort=effort)

@@ -179,6 +179,13 @@ void check_counts(const Header& header, std::size_t data_bytes, const std::strin
     }
 }
 
+// Where a value is read, for messages ("vertex 12"): composed only when one is written.
+struct ItemPlace {
+    const std::string& element;
+    uint64_t item;
+    std::string text() const { return element + " " + std::to_string(item); }
+};
+
 // Reads the values of one encoding as doubles (exact for every PLY type).
 class ValueReader {
 public:
@@ -189,33 +196,23 @@ public:
         for (std::size_t i = 0; i < offset; ++i) header_lines_ += bytes[i] == '\n';
     }
 
-    // `context` says where we are, for messages ("vertex 12").
-    double read(Type type, const std::string& context) {
-        if (encoding_ == Encoding::ascii) return read_ascii(type, context);
-        const std::size_t size = type_size(type);
-        if (bytes_.size() - pos_ < size) fail(what_, "truncated data in " + context, ErrorCode::truncated);
-        unsigned char b[8];
-        std::memcpy(b, bytes_.data() + pos_, size);
-        pos_ += size;
-        if (encoding_ == Encoding::binary_big_endian) {
-            for (std::size_t i = 0; i < size / 2; ++i) std::swap(b[i], b[size - 1 - i]);
-        }
-        uint64_t u = 0;  // little-endian bytes to an unsigned integer
-        for (std::size_t i = 0; i < size; ++i) u |= uint64_t(b[i]) << (8 * i);
+    double read(Type type, const ItemPlace& place) {
+        if (encoding_ == Encoding::ascii) return read_ascii(type, place);
         switch (type) {
-            case Type::int8: return static_cast<int8_t>(static_cast<uint8_t>(u));
-            case Type::uint8: return static_cast<uint8_t>(u);
-            case Type::int16: return static_cast<int16_t>(static_cast<uint16_t>(u));
-            case Type::uint16: return static_cast<uint16_t>(u);
-            case Type::int32: return static_cast<int32_t>(static_cast<uint32_t>(u));
-            case Type::uint32: return static_cast<uint32_t>(u);
+            case Type::int8: return static_cast<int8_t>(take<uint8_t>(place));
+            case Type::uint8: return take<uint8_t>(place);
+            case Type::int16: return static_cast<int16_t>(take<uint16_t>(place));
+            case Type::uint16: return take<uint16_t>(place);
+            case Type::int32: return static_cast<int32_t>(take<uint32_t>(place));
+            case Type::uint32: return take<uint32_t>(place);
             case Type::float32: {
-                uint32_t u32 = static_cast<uint32_t>(u);
+                const uint32_t u = take<uint32_t>(place);
                 float f;
-                std::memcpy(&f, &u32, 4);
+                std::memcpy(&f, &u, 4);
                 return f;
             }
             case Type::float64: {
+                const uint64_t u = take<uint64_t>(place);
                 double d;
                 std::memcpy(&d, &u, 8);
                 return d;
@@ -225,54 +222,69 @@ public:
     }
 
     // Skips `count` values of one type.
-    void skip(Type type, uint64_t count, const std::string& context) {
+    void skip(Type type, uint64_t count, const ItemPlace& place) {
         if (encoding_ == Encoding::ascii) {
-            for (uint64_t i = 0; i < count; ++i) read_ascii(type, context);
+            for (uint64_t i = 0; i < count; ++i) read_ascii(type, place);
             return;
         }
         const uint64_t size = type_size(type);
-        if (count > (bytes_.size() - pos_) / size) fail(what_, "truncated data in " + context, ErrorCode::truncated);
+        if (count > (bytes_.size() - pos_) / size) fail(what_, "truncated data in " + place.text(), ErrorCode::truncated);
         pos_ += count * size;
     }
 
     // A list count or an index: an integer value in [0, limit].
-    uint64_t read_index(Type type, uint64_t limit, const std::string& context, const char* name) {
-        const double v = read(type, context);
+    uint64_t read_index(Type type, uint64_t limit, const ItemPlace& place, const char* name) {
+        const double v = read(type, place);
         if (!(v >= 0 && v <= static_cast<double>(limit)) ||
             v != static_cast<double>(static_cast<uint64_t>(v))) {
-            fail(what_, context + " has a bad " + name + " " + format(v));
+            fail(what_, place.text() + " has a bad " + name + " " + format(v));
         }
         return static_cast<uint64_t>(v);
     }
 
 private:
+    // The next binary value's bits, in the file's byte order.
+    template <typename U>
+    U take(const ItemPlace& place) {
+        if (bytes_.size() - pos_ < sizeof(U)) fail(what_, "truncated data in " + place.text(), ErrorCode::truncated);
+        const auto* b = reinterpret_cast<const unsigned char*>(bytes_.data() + pos_);
+        pos_ += sizeof(U);
+        U u = 0;
+        if (encoding_ == Encoding::binary_big_endian) {
+            for (std::size_t i = 0; i < sizeof(U); ++i) u = U(uint64_t(u) << 8 | b[i]);
+        } else {
+            for (std::size_t i = 0; i < sizeof(U); ++i) u = U(u | uint64_t(b[i]) << (8 * i));
+        }
+        return u;
+    }
+
     static std::string format(double v) {
         std::string s;
         text::append_real(s, v);
         return s;
     }
 
-    double read_ascii(Type type, const std::string& context) {
+    double read_ascii(Type type, const ItemPlace& place) {
         std::string_view token = tokens_.next();
-        if (token.empty()) fail(what_, "truncated data in " + context, ErrorCode::truncated);
-        const std::string at = " (line " + std::to_string(tokens_.line() + header_lines_) + ")";
+        if (token.empty()) fail(what_, "truncated data in " + place.text(), ErrorCode::truncated);
+        auto at = [&] { return " (line " + std::to_string(tokens_.line() + header_lines_) + ")"; };
         if (type == Type::float32) {
             float f;
             if (!text::parse_real(token, f)) {
-                fail(what_, context + " has a malformed value " + text::quote_token(token) + at);
+                fail(what_, place.text() + " has a malformed value " + text::quote_token(token) + at());
             }
             return f;
         }
         if (type == Type::float64) {
             double d;
             if (!text::parse_real(token, d)) {
-                fail(what_, context + " has a malformed value " + text::quote_token(token) + at);
+                fail(what_, place.text() + " has a malformed value " + text::quote_token(token) + at());
             }
             return d;
         }
         int64_t i = 0;
         if (!text::parse_int(token, i)) {
-            fail(what_, context + " has a malformed integer " + text::quote_token(token) + at);
+            fail(what_, place.text() + " has a malformed integer " + text::quote_token(token) + at());
         }
         int64_t lo = 0, hi = 0;
         switch (type) {
@@ -284,8 +296,8 @@ private:
             default: lo = 0, hi = UINT32_MAX; break;
         }
         if (i < lo || i > hi) {
-            fail(what_, context + " has value " + std::to_string(i) +
-                            " out of the range of its type" + at);
+            fail(what_, place.text() + " has value " + std::to_string(i) +
+                            " out of the range of its type" + at());
         }
         return static_cast<double>(i);
     }
@@ -346,11 +358,11 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& what) {
     for (const Element& e : header.elements) {
         const bool is_vertex = &e == vertex_element, is_face = &e == face_element;
         for (uint64_t item = 0; item < e.count; ++item) {
-            const std::string context = e.name + " " + std::to_string(item);
+            const ItemPlace place{e.name, item};
             for (std::size_t pi = 0; pi < e.properties.size(); ++pi) {
                 const Property& p = e.properties[pi];
                 if (p.is_list) {
-                    const uint64_t n = in.read_index(p.count_type, UINT32_MAX, context, "list size");
+                    const uint64_t n = in.read_index(p.count_type, UINT32_MAX, place, "list size");
                     if (is_face && static_cast<int>(pi) == corner_property) {
                         if (n != 3) {
                             fail(what, "face " + std::to_string(item) + " has " +
@@ -359,10 +371,10 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& what) {
                         }
                         for (uint32_t& index : mesh.triangles[item]) {
                             index = static_cast<uint32_t>(
-                                in.read_index(p.type, UINT32_MAX, context, "vertex index"));
+                                in.read_index(p.type, UINT32_MAX, place, "vertex index"));
                         }
                     } else {
-                        in.skip(p.type, n, context);
+                        in.skip(p.type, n, place);
                     }
                 } else if (is_vertex && (static_cast<int>(pi) == xyz[0] ||
                                          static_cast<int>(pi) == xyz[1] ||
@@ -371,9 +383,9 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& what) {
                     double* coordinate = static_cast<int>(pi) == xyz[0]   ? &pos.x
                                          : static_cast<int>(pi) == xyz[1] ? &pos.y
                                                                           : &pos.z;
-                    *coordinate = in.read(p.type, context);
+                    *coordinate = in.read(p.type, place);
                 } else {
-                    in.skip(p.type, 1, context);
+                    in.skip(p.type, 1, place);
                 }
             }
         }
@@ -391,9 +403,11 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& what) {
 
 namespace {
 
+// Stores value's bytes least significant first at `at` (the compiler makes it one store on
+// little-endian machines); returns the end.
 template <typename T>
-void append_le(std::string& out, T value) {
-    static_assert(sizeof(T) <= 8, "scalar");
+char* put_le(char* at, T value) {
+    static_assert(sizeof(T) == 1 || sizeof(T) == 4 || sizeof(T) == 8, "scalar");
     uint64_t u = 0;
     if constexpr (sizeof(T) == 8) {
         std::memcpy(&u, &value, 8);
@@ -406,7 +420,8 @@ void append_le(std::string& out, T value) {
         std::memcpy(&u8, &value, 1);
         u = u8;
     }
-    for (std::size_t i = 0; i < sizeof(T); ++i) out += static_cast<char>((u >> (8 * i)) & 0xff);
+    for (std::size_t i = 0; i < sizeof(T); ++i) at[i] = static_cast<char>((u >> (8 * i)) & 0xff);
+    return at + sizeof(T);
 }
 
 }  // namespace
@@ -462,19 +477,28 @@ std::string format_ply(const TriangleMesh& mesh, const CellData* cells, MeshEnco
 
     const std::size_t real_size = mesh.single_precision ? 4 : 8;
     out.reserve(out.size() + mesh.positions.size() * 3 * real_size + mesh.triangles.size() * 13);
+    // Values go through a small block: no per-byte appends, no zero fill of the whole.
+    char block[1 << 12];
+    char* at = block;
+    auto make_room = [&](std::size_t bytes) {
+        if (at + bytes <= block + sizeof block) return;
+        out.append(block, std::size_t(at - block));
+        at = block;
+    };
     for (const Vec3& p : mesh.positions) {
-        for (double c : {p.x, p.y, p.z}) {
-            if (mesh.single_precision) {
-                append_le(out, static_cast<float>(c));
-            } else {
-                append_le(out, c);
-            }
+        make_room(3 * 8);
+        if (mesh.single_precision) {
+            at = put_le(put_le(put_le(at, static_cast<float>(p.x)), static_cast<float>(p.y)), static_cast<float>(p.z));
+        } else {
+            at = put_le(put_le(put_le(at, p.x), p.y), p.z);
         }
     }
     for (const auto& tri : mesh.triangles) {
-        out += static_cast<char>(3);
-        for (uint32_t v : tri) append_le(out, v);
+        make_room(13);
+        at = put_le(at, uint8_t{3});
+        for (uint32_t v : tri) at = put_le(at, v);
     }
+    out.append(block, std::size_t(at - block));
     return out;
 }
 
