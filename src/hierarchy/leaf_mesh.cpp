@@ -11,7 +11,15 @@ LeafMesh extract_leaf_mesh(const Hierarchy& h, int max_level) {
     const bool cut = max_level >= 0;
     LeafMesh out;
     out.mesh.single_precision = h.single_precision();
-    uint32_t used_vertices = static_cast<uint32_t>(h.base().positions.size());
+    // Uncut, every vertex is a corner of a leaf or the hanging node of a green closure.
+    uint32_t used_vertices = cut ? static_cast<uint32_t>(h.base().positions.size()) : h.vertex_count();
+    // A leaf gives one triangle, or two or three when closed: room for a quarter of them closed
+    // without growing (the vectors double once where more are).
+    const size_t room = size_t(h.leaf_count()) + h.leaf_count() / 4;
+    out.mesh.triangles.reserve(room);
+    out.cells.level.reserve(room);
+    out.cells.is_green.reserve(room);
+    out.source.reserve(room);
 
     auto emit = [&](NodeId n, VertexId a, VertexId b, VertexId c, bool green) {
         out.mesh.triangles.push_back({canonical[a], canonical[b], canonical[c]});
@@ -31,12 +39,13 @@ LeafMesh extract_leaf_mesh(const Hierarchy& h, int max_level) {
             hanging[e] = !at_cut && h.has_hanging_node(n, e);
             if (hanging[e]) {
                 mid[e] = h.midpoint(h.neighbor(n, e), h.neighbor_edge(n, e));
-                used_vertices = std::max(used_vertices, canonical[mid[e]] + 1);
+                if (cut) used_vertices = std::max(used_vertices, canonical[mid[e]] + 1);
                 ++count;
             }
         }
         const VertexId v[3] = {h.vertex(n, 0), h.vertex(n, 1), h.vertex(n, 2)};
-        for (int i = 0; i < 3; ++i) used_vertices = std::max(used_vertices, canonical[v[i]] + 1);
+        if (cut)
+            for (int i = 0; i < 3; ++i) used_vertices = std::max(used_vertices, canonical[v[i]] + 1);
         if (count == 0) {
             emit(n, v[0], v[1], v[2], false);
         } else if (count == 1) {
