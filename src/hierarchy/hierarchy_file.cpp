@@ -19,22 +19,26 @@ constexpr char kMagic[4] = {'A', 'M', 'C', 'H'};
 constexpr uint32_t kVersion = 1;
 constexpr uint32_t kFlagSinglePrecision = 1;
 
-void put_u32(std::string& out, uint32_t v) {
-    for (int i = 0; i < 4; ++i) out.push_back(char((v >> (8 * i)) & 0xff));
+// Stores v's bytes least significant first; returns the end.
+unsigned char* put_u32(unsigned char* at, uint32_t v) {
+    for (int i = 0; i < 4; ++i) at[i] = uint8_t(v >> (8 * i));
+    return at + 4;
 }
 
-void put_coordinate(std::string& out, double x, bool single) {
+unsigned char* put_coordinate(unsigned char* at, double x, bool single) {
     if (single) {
-        float f = float(x);
+        const float f = float(x);
         uint32_t bits;
         std::memcpy(&bits, &f, 4);
-        put_u32(out, bits);
-    } else {
-        uint64_t bits;
-        std::memcpy(&bits, &x, 8);
-        put_u32(out, uint32_t(bits));
-        put_u32(out, uint32_t(bits >> 32));
+        return put_u32(at, bits);
     }
+    uint64_t bits;
+    std::memcpy(&bits, &x, 8);
+    return put_u32(put_u32(at, uint32_t(bits)), uint32_t(bits >> 32));
+}
+
+unsigned char* put_point(unsigned char* at, const Vec3& p, bool single) {
+    return put_coordinate(put_coordinate(put_coordinate(at, p.x, single), p.y, single), p.z, single);
 }
 
 class Reader {
@@ -45,23 +49,21 @@ public:
     }
     uint32_t u32() {
         need(4);
-        uint32_t v = 0;
-        for (int i = 0; i < 4; ++i) v |= uint32_t(uint8_t(bytes_[pos_ + i])) << (8 * i);
+        const uint32_t v = le32(at());
         pos_ += 4;
         return v;
     }
-    double coordinate(bool single) {
-        if (single) {
-            uint32_t bits = u32();
-            float f;
-            std::memcpy(&f, &bits, 4);
-            return f;
+    // `count` points of three coordinates, the room for all of them checked once.
+    void points(Vec3* out, size_t count, bool single) {
+        const size_t size = single ? 4 : 8;
+        if (count > remaining() / (3 * size)) fail("file is truncated", ErrorCode::truncated);
+        const unsigned char* p = at();
+        for (size_t i = 0; i < count; ++i, p += 3 * size) {
+            out[i].x = coordinate(p, single);
+            out[i].y = coordinate(p + size, single);
+            out[i].z = coordinate(p + 2 * size, single);
         }
-        uint64_t lo = u32(), hi = u32();
-        uint64_t bits = lo | (hi << 32);
-        double d;
-        std::memcpy(&d, &bits, 8);
-        return d;
+        pos_ += count * 3 * size;
     }
     const char* take(size_t n) {
         need(n);
@@ -72,6 +74,22 @@ public:
     size_t remaining() const { return bytes_.size() - pos_; }
 
 private:
+    const unsigned char* at() const { return reinterpret_cast<const unsigned char*>(bytes_.data()) + pos_; }
+    static uint32_t le32(const unsigned char* p) {
+        return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+    }
+    static double coordinate(const unsigned char* p, bool single) {
+        if (single) {
+            const uint32_t bits = le32(p);
+            float f;
+            std::memcpy(&f, &bits, 4);
+            return f;
+        }
+        const uint64_t bits = le32(p) | uint64_t(le32(p + 4)) << 32;
+        double d;
+        std::memcpy(&d, &bits, 8);
+        return d;
+    }
     void need(size_t n) const {
         if (bytes_.size() - pos_ < n) fail("file is truncated", ErrorCode::truncated);
     }
@@ -94,33 +112,33 @@ std::string serialize_hierarchy(const Hierarchy& h) {
     const uint32_t base_vertices = uint32_t(h.base().positions.size());
     const uint32_t new_vertices = h.vertex_count() - base_vertices;
 
-    std::string out(kMagic, 4);
-    put_u32(out, kVersion);
-    put_u32(out, single ? kFlagSinglePrecision : 0);
-    put_u32(out, base_vertices);
-    put_u32(out, h.root_count());
-    put_u32(out, uint32_t(order.size()));
-    put_u32(out, uint32_t(flipped.size()));
-    put_u32(out, new_vertices);
-    for (const Vec3& p : h.base().positions) {
-        put_coordinate(out, p.x, single);
-        put_coordinate(out, p.y, single);
-        put_coordinate(out, p.z, single);
-    }
+    // The file is written in place: its size is known from the counts.
+    const size_t point_size = 3 * (single ? 4 : 8);
+    const size_t bit_bytes = (order.size() + 7) / 8;
+    const size_t header_size = 4 + 7 * 4;
+    std::string out(header_size + size_t(base_vertices) * point_size + size_t(h.root_count()) * 12 + bit_bytes +
+                        flipped.size() * 4 + size_t(new_vertices) * point_size,
+                    '\0');
+    unsigned char* at = reinterpret_cast<unsigned char*>(&out[0]);
+    std::memcpy(at, kMagic, 4);
+    at += 4;
+    for (uint32_t field : {kVersion, single ? kFlagSinglePrecision : 0, base_vertices, h.root_count(),
+                           uint32_t(order.size()), uint32_t(flipped.size()), new_vertices})
+        at = put_u32(at, field);
+    for (const Vec3& p : h.base().positions) at = put_point(at, p, single);
     for (const Triangle& t : h.base().triangles) {
-        for (uint32_t v : t) put_u32(out, v);
+        for (uint32_t v : t) at = put_u32(at, v);
     }
-    std::string bits((order.size() + 7) / 8, '\0');
     for (size_t i = 0; i < order.size(); ++i) {
-        if (!h.is_leaf(order[i])) bits[i / 8] = char(uint8_t(bits[i / 8]) | (1u << (i % 8)));
+        if (!h.is_leaf(order[i])) at[i / 8] = uint8_t(at[i / 8] | (1u << (i % 8)));
     }
-    out += bits;
-    for (uint32_t i : flipped) put_u32(out, i);
-    const std::vector<Vec3> positions = canonical_positions(h);  // base vertices first
-    for (size_t i = base_vertices; i < positions.size(); ++i) {
-        put_coordinate(out, positions[i].x, single);
-        put_coordinate(out, positions[i].y, single);
-        put_coordinate(out, positions[i].z, single);
+    at += bit_bytes;
+    for (uint32_t i : flipped) at = put_u32(at, i);
+    // Refinement vertices in canonical order (base vertices are numbered first).
+    const std::vector<uint32_t> canonical = canonical_vertex_order(h, order);
+    for (size_t v = 0; v < canonical.size(); ++v) {
+        if (canonical[v] != kNoVertex && canonical[v] >= base_vertices)
+            put_point(at + size_t(canonical[v] - base_vertices) * point_size, h.position(VertexId(v)), single);
     }
     return out;
 }
@@ -158,11 +176,7 @@ Hierarchy parse_hierarchy(const std::string& bytes, const std::string& what) {
     TriangleMesh base;
     base.single_precision = single;
     base.positions.resize(base_vertices);
-    for (Vec3& p : base.positions) {
-        p.x = in.coordinate(single);
-        p.y = in.coordinate(single);
-        p.z = in.coordinate(single);
-    }
+    in.points(base.positions.data(), base_vertices, single);
     base.triangles.resize(base_triangles);
     for (Triangle& t : base.triangles) {
         for (uint32_t& v : t) v = in.u32();
@@ -222,13 +236,11 @@ Hierarchy parse_hierarchy(const std::string& bytes, const std::string& what) {
     if (h.vertex_count() - h.base().positions.size() != new_vertices)
         in.fail("header announces " + std::to_string(new_vertices) + " refinement vertices but the forest makes " +
                 std::to_string(h.vertex_count() - h.base().positions.size()));
-    const std::vector<uint32_t> canonical = canonical_vertex_order(h);
+    const std::vector<uint32_t> canonical = canonical_vertex_order(h, order);  // order is breadth-first
     std::vector<Vec3> refinement_positions(new_vertices);
+    in.points(refinement_positions.data(), new_vertices, single);
     for (uint32_t i = 0; i < new_vertices; ++i) {
-        Vec3& p = refinement_positions[i];
-        p.x = in.coordinate(single);
-        p.y = in.coordinate(single);
-        p.z = in.coordinate(single);
+        const Vec3& p = refinement_positions[i];
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
             in.fail("refinement vertex " + std::to_string(i) + " has a non-finite coordinate");
     }
