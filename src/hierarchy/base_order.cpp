@@ -203,25 +203,19 @@ Hierarchy HierarchyBuilder::subforest(const Hierarchy& h, TriangleMesh base, con
     }
     out.nodes_.resize(n);  // the roots stay as the constructor made them
     out.block_parent_.assign((n - root_count) / 4, kNoNode);
+    // A split node writes its four children's vertices, level and boundary flags (its corners and
+    // midpoints at hand once for all four); each node then its links, flags and first child.
     NodeId next_child = root_count;
     for (size_t j = 0; j < n; ++j) {
         const NodeId o = old_of[j];
         Hierarchy::Node& node = out.nodes_[j];
         if (j >= root_count) {
-            const NodeId p = out.block_parent_[(j - root_count) / 4];
-            const int k = int((j - root_count) % 4);
-            const Hierarchy::Node& parent = out.nodes_[p];
-            const VertexId points[6] = {parent.v[0], parent.v[1], parent.v[2], mid[3 * size_t(p)], mid[3 * size_t(p) + 1],
-                                        mid[3 * size_t(p) + 2]};
-            for (int i = 0; i < 3; ++i) node.v[i] = points[red_split::kChildPoints[k][i]];
             node.nbr_edge = 0;
             for (int e = 0; e < 3; ++e) {
                 const NodeId q = h.neighbor(o, e);
                 node.nbr[e] = taken(q) ? local[q] : kNoNode;
                 if (node.nbr[e] != kNoNode) node.nbr_edge |= uint8_t(h.neighbor_edge(o, e) << (2 * e));
             }
-            node.level = uint8_t(parent.level + 1);
-            node.flags = uint8_t(parent.flags & red_split::kChildEdges[k].boundary);
             node.reserved = 0;
         }
         const bool leaf = h.is_leaf(o);
@@ -229,6 +223,13 @@ Hierarchy HierarchyBuilder::subforest(const Hierarchy& h, TriangleMesh base, con
         node.first_child = leaf ? kNoNode : next_child;
         if (!leaf) {
             out.block_parent_[(next_child - root_count) / 4] = NodeId(j);
+            const VertexId points[6] = {node.v[0], node.v[1], node.v[2], mid[3 * j], mid[3 * j + 1], mid[3 * j + 2]};
+            for (int k = 0; k < 4; ++k) {
+                Hierarchy::Node& child = out.nodes_[next_child + NodeId(k)];
+                for (int i = 0; i < 3; ++i) child.v[i] = points[red_split::kChildPoints[k][i]];
+                child.level = uint8_t(node.level + 1);
+                child.flags = uint8_t(node.flags & red_split::kChildEdges[k].boundary);
+            }
             next_child += 4;
         }
     }
