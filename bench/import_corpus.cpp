@@ -6,8 +6,9 @@
 //     (base connectivity + hierarchy stream of the .amc file) against the true hierarchy's.
 // Prints a Markdown table. Exit status 1 if any import with the base is not identical.
 //
-// Usage: import_corpus [--move X] [--with-base-only] [--hash] corpus/*.amh   (scripts/import_corpus.sh
-// makes the corpus; --with-base-only skips import_mesh and leaves its columns empty; --hash prints,
+// Usage: import_corpus [--move X] [--with-base-only | --without-base-only] [--hash] corpus/*.amh
+// (scripts/import_corpus.sh makes the corpus; --with-base-only skips import_mesh and leaves its
+// columns empty, --without-base-only skips import_leaf_mesh likewise; --hash prints,
 // to stderr, a hash of each detected hierarchy's .amc file, to tell a changed search's output apart)
 #include "user_leaf_mesh.h"
 
@@ -46,7 +47,7 @@ uint64_t connectivity_bytes(const amc::Hierarchy& h) {
 
 int main(int argc, char** argv) {
     double move = 0.3;
-    bool detect = true, hash = false;
+    bool detect = true, with_base_import = true, hash = false;
     std::vector<std::string> files;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
@@ -54,6 +55,8 @@ int main(int argc, char** argv) {
             move = std::atof(argv[++i]);
         } else if (arg == "--with-base-only") {
             detect = false;
+        } else if (arg == "--without-base-only") {
+            with_base_import = false;
         } else if (arg == "--hash") {
             hash = true;
         } else {
@@ -61,7 +64,7 @@ int main(int argc, char** argv) {
         }
     }
     if (files.empty()) {
-        std::fprintf(stderr, "usage: import_corpus [--move X] [--with-base-only] hierarchy.amh...\n");
+        std::fprintf(stderr, "usage: import_corpus [--move X] [--with-base-only | --without-base-only] hierarchy.amh...\n");
         return 2;
     }
     std::printf("| model | leaf faces | base triangles | with base | s | M faces/s | base found (triangles) | connectivity bytes, true | found | found / true | s |\n");
@@ -81,15 +84,17 @@ int main(int argc, char** argv) {
         }
         std::string with_base;
         double start = thread_seconds();
-        try {
-            const amc::ImportedHierarchy imported = amc::import_leaf_mesh(h.base(), user);
-            with_base = amc::identical(imported.hierarchy, expected) ? "identical" : "DIFFERENT";
-        } catch (const amc::Error& e) {
-            with_base = std::string("refused: ") + e.what();
-            if (with_base.size() > 70) with_base = with_base.substr(0, 67) + "...";
+        if (with_base_import) {
+            try {
+                const amc::ImportedHierarchy imported = amc::import_leaf_mesh(h.base(), user);
+                with_base = amc::identical(imported.hierarchy, expected) ? "identical" : "DIFFERENT";
+            } catch (const amc::Error& e) {
+                with_base = std::string("refused: ") + e.what();
+                if (with_base.size() > 70) with_base = with_base.substr(0, 67) + "...";
+            }
         }
         const double with_base_seconds = thread_seconds() - start;
-        if (with_base != "identical") ++not_identical;
+        if (with_base_import && with_base != "identical") ++not_identical;
 
         const std::string name = std::filesystem::path(file).stem().string();
         // Import speed only where the import succeeded: a refusal's time says when it gave up.

@@ -9,9 +9,14 @@
 //     same-level neighbour (no midpoint stays: the model of undo_refinement_level's patches);
 //   * partial: the same, but a node may be undone while a neighbour stays refined (the node turns
 //     green, the shared midpoint stays a vertex; fewer than three such neighbours).
-// Prints a Markdown table, and with --steps every step.
+// Prints a Markdown table, and with --steps every step. With --ready, every free step is also
+// compared with what it could have undone: the true nodes "ready" before it (refined, every child
+// a leaf or undone by an earlier step), split into those whose refined same-level neighbours are all
+// ready too ("closed": the whole-patch model could undo them now) and the others ("waiting"), with
+// how many of each the step undid and the sizes of the closed groups it left (docs/IMPORT.md,
+// "A refined node across a closure").
 //
-// Usage: import_levels [--steps] corpus/*.amh
+// Usage: import_levels [--steps] [--ready] corpus/*.amh
 #include "user_leaf_mesh.h"
 
 #include "import/inverse_refinement.h"
@@ -22,6 +27,7 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -86,6 +92,9 @@ std::vector<size_t> ideal_steps(amc::Hierarchy h, bool partial) {
     return steps;
 }
 
+// Called after each step with the splits it undid.
+using StepObserver = std::function<void(int step, const std::vector<std::array<uint32_t, 6>>& splits)>;
+
 struct Detection {
     std::vector<std::array<size_t, 2>> steps;  // true, wrong blocks per step
     size_t true_blocks = 0, wrong_blocks = 0, triangles_left = 0;
@@ -93,7 +102,7 @@ struct Detection {
 };
 
 Detection detect(const amc::TriangleMesh& mesh, const std::map<Key, int>& level_of_split, int finest,
-                 const std::vector<uint8_t>* kept) {
+                 const std::vector<uint8_t>* kept, const StepObserver& observe = {}) {
     Detection out;
     const uint32_t vertex_count = uint32_t(mesh.positions.size());
     std::vector<std::vector<amc::Triangle>> levels;
@@ -110,6 +119,7 @@ Detection detect(const amc::TriangleMesh& mesh, const std::map<Key, int>& level_
             if (step == 0 && it != level_of_split.end() && it->second == finest) ++out.first_step_finest;
         }
         out.steps.push_back(counts);
+        if (observe) observe(step, coarser.splits);
         out.true_blocks += counts[0];
         out.wrong_blocks += counts[1];
         refined = std::move(coarser.refined);
@@ -121,6 +131,78 @@ Detection detect(const amc::TriangleMesh& mesh, const std::map<Key, int>& level_
     return out;
 }
 
+// The --ready comparison: the true nodes undone so far, and per step what was ready.
+class ReadyTrace {
+public:
+    ReadyTrace(const amc::Hierarchy& h, std::map<Key, NodeId> node_of_split)
+        : h_(h), node_of_split_(std::move(node_of_split)), undone_(h.node_capacity(), 0) {}
+
+    void step(int step, const std::vector<std::array<uint32_t, 6>>& splits) {
+        std::vector<uint8_t> got(h_.node_capacity(), 0);
+        size_t wrong = 0;
+        for (const auto& s : splits) {
+            const auto it = node_of_split_.find(sorted_key(s[3], s[4], s[5]));
+            if (it == node_of_split_.end()) {
+                ++wrong;
+            } else {
+                got[it->second] = 1;
+            }
+        }
+        size_t closed = 0, closed_undone = 0, waiting = 0, waiting_undone = 0;
+        std::map<size_t, size_t> missed_groups;  // closed groups left, by size class (1, 2, 3, 4+, 16+, 256+)
+        for (const std::vector<NodeId>& group : same_level_groups()) {
+            size_t ready = 0, undone = 0;
+            for (NodeId n : group) ready += is_ready(n), undone += got[n];
+            if (ready == group.size()) {
+                closed += ready, closed_undone += undone;
+                if (undone < group.size()) ++missed_groups[size_class(group.size())];
+            } else {
+                waiting += ready, waiting_undone += undone;
+            }
+        }
+        std::printf("|   step %d: closed ready %zu, undone %zu; waiting %zu, undone %zu; wrong %zu; closed groups left by size:",
+                    step + 1, closed, closed_undone, waiting, waiting_undone, wrong);
+        for (const auto& [size, count] : missed_groups) std::printf(" %zu+: %zu", size, count);
+        std::printf(" | | | | | | | |\n");
+        for (NodeId n = 0; n < h_.node_capacity(); ++n) undone_[n] |= got[n];
+    }
+
+private:
+    static size_t size_class(size_t size) { return size < 4 ? size : size < 16 ? 4 : size < 256 ? 16 : 256; }
+    bool is_refined(NodeId n) const { return h_.is_alive(n) && !h_.is_leaf(n) && !undone_[n]; }
+    bool is_ready(NodeId n) const {
+        if (!is_refined(n)) return false;
+        for (int k = 0; k < 4; ++k) {
+            if (is_refined(h_.child(n, k))) return false;
+        }
+        return true;
+    }
+    // The refined nodes not undone yet, grouped by same-level adjacency (what a patch joins).
+    std::vector<std::vector<NodeId>> same_level_groups() const {
+        std::vector<uint8_t> seen(h_.node_capacity(), 0);
+        std::vector<std::vector<NodeId>> groups;
+        for (NodeId n = 0; n < h_.node_capacity(); ++n) {
+            if (!is_refined(n) || seen[n]) continue;
+            std::vector<NodeId> group{n};
+            seen[n] = 1;
+            for (size_t k = 0; k < group.size(); ++k) {
+                for (int e = 0; e < 3; ++e) {
+                    const NodeId m = h_.neighbor(group[k], e);
+                    if (m == amc::kNoNode || seen[m] || !is_refined(m) || h_.level(m) != h_.level(n)) continue;
+                    seen[m] = 1;
+                    group.push_back(m);
+                }
+            }
+            groups.push_back(std::move(group));
+        }
+        return groups;
+    }
+
+    const amc::Hierarchy& h_;
+    std::map<Key, NodeId> node_of_split_;
+    std::vector<uint8_t> undone_;
+};
+
 std::string list(const std::vector<size_t>& v) {
     std::string s;
     for (size_t x : v) s += (s.empty() ? "" : ", ") + std::to_string(x);
@@ -130,18 +212,20 @@ std::string list(const std::vector<size_t>& v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    bool print_steps = false;
+    bool print_steps = false, print_ready = false;
     std::vector<std::string> files;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         if (arg == "--steps") {
             print_steps = true;
+        } else if (arg == "--ready") {
+            print_ready = true;
         } else {
             files.push_back(arg);
         }
     }
     if (files.empty()) {
-        std::fprintf(stderr, "usage: import_levels [--steps] hierarchy.amh...\n");
+        std::fprintf(stderr, "usage: import_levels [--steps] [--ready] hierarchy.amh...\n");
         return 2;
     }
     std::printf("| model | depth | refined nodes | ideal, whole patches: undone per step | ideal, partial | finest level's nodes found in step 1 | free: true / wrong blocks, triangles left | anchored: true / wrong, triangles left (base) |\n");
@@ -155,18 +239,24 @@ int main(int argc, char** argv) {
         const std::vector<uint32_t> canonical = amc::canonical_vertex_order(h);
         auto user_vertex = [&](amc::VertexId v) { return user_of_leaf[canonical[v]]; };
         std::map<Key, int> level_of_split;
+        std::map<Key, NodeId> node_of_split;
         int finest = -1;
         size_t at_finest = 0;
         for (NodeId n : h.breadth_first_order()) {
             if (h.is_leaf(n)) continue;
-            level_of_split[sorted_key(user_vertex(h.midpoint(n, 0)), user_vertex(h.midpoint(n, 1)),
-                                      user_vertex(h.midpoint(n, 2)))] = h.level(n);
+            const Key key = sorted_key(user_vertex(h.midpoint(n, 0)), user_vertex(h.midpoint(n, 1)),
+                                       user_vertex(h.midpoint(n, 2)));
+            level_of_split[key] = h.level(n);
+            node_of_split[key] = n;
             finest = std::max(finest, h.level(n));
         }
         for (const auto& entry : level_of_split) at_finest += entry.second == finest;
         std::vector<uint8_t> kept(user.positions.size(), 0);
         for (amc::VertexId v = 0; v < h.base().positions.size(); ++v) kept[user_vertex(v)] = 1;
-        const Detection free = detect(user, level_of_split, finest, nullptr);
+        ReadyTrace ready(h, std::move(node_of_split));
+        StepObserver observe;
+        if (print_ready) observe = [&](int step, const std::vector<std::array<uint32_t, 6>>& splits) { ready.step(step, splits); };
+        const Detection free = detect(user, level_of_split, finest, nullptr, observe);
         const Detection anchored = detect(user, level_of_split, finest, &kept);
         const std::string name = std::filesystem::path(file).stem().string();
         std::printf("| %s | %d | %zu | %s | %s | %zu / %zu | %zu / %zu, %zu | %zu / %zu, %zu (%u) |\n", name.c_str(),

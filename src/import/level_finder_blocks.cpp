@@ -287,8 +287,12 @@ Side LevelFinder::classify(uint32_t index, int i) const {
     }
     const Triangle& q = side.coarse;
     if (q[0] == q[1] || q[1] == q[2] || q[2] == q[0]) return side;
-    // The coarse triangle is a leaf without other hanging nodes, and the block's children
-    // beside it have no same-level neighbour there: no refinement inside or around the group.
+    // No refinement inside the group, and none around it that balance forbids: the block's
+    // children beside it have no same-level neighbour there, and the coarse triangle keeps at most
+    // two hanging nodes. A refined triangle across a whole edge of the coarse triangle is a
+    // same-level node undone in an earlier step (its midpoint is the closure's second hanging
+    // node), which a closure of one hanging node can take on its other two edges, once.
+    bool refined_across = false;
     for (int k = 0; k < side.count; ++k) {
         const uint32_t g = side.group[k];
         if (refined_[g]) return side;
@@ -296,7 +300,11 @@ Side LevelFinder::classify(uint32_t index, int i) const {
             const uint32_t h = adjacency_.twin(3 * g + uint32_t(e));
             if (h == kNoHalfEdge) continue;
             const uint32_t n = h / 3;
-            if (refined_[n] && std::find(side.group, side.group + side.count, n) == side.group + side.count) return side;
+            if (!refined_[n] || std::find(side.group, side.group + side.count, n) != side.group + side.count) continue;
+            const uint32_t x = tri_[g][size_t(e)], y = tri_[g][size_t(e + 1) % 3];
+            const bool whole_other_edge = (x == q[1] && y == q[2]) || (x == q[2] && y == q[0]);
+            if (side.count != 2 || !whole_other_edge || refined_across) return side;
+            refined_across = true;
         }
     }
     side.kind = Side::green;
