@@ -481,6 +481,52 @@ TEST(GeometryPrediction, ButterflyReproducesAffineAndQuadraticData) {
     EXPECT_GT(full_stencils, 1000);
 }
 
+#if AMC_SSE2
+// The static decoders' two-lane frames (frame_pair_of) against frame_of, bit for bit, in both
+// static normal sums: random corners over positions that include zeros of both signs, subnormals,
+// values near overflow, infinities, NaN and repeated points (zero normals), d missing in a fifth.
+TEST(GeometryPrediction, FramePairsEqualSingleFramesBitForBit) {
+    std::mt19937_64 rng(29);
+    Hierarchy h(make_l_shape(3));
+    refine_randomly(h, 400, 4, 29, 0.2);
+    std::vector<double> values = interesting_doubles(rng, 40);
+    for (double x : {HUGE_VAL, -HUGE_VAL, std::nan("")}) values.push_back(x);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    const VertexId vertices = VertexId(h.positions().size());
+    for (VertexId v = 0; v < vertices; ++v) {
+        if (v % 3 == 0) {  // a few special coordinates among ordinary ones
+            h.set_position(v, {values[rng() % values.size()], unit(rng), values[rng() % values.size()]});
+        } else if (v % 3 == 1) {
+            h.set_position(v, h.position(v / 2));  // repeated points
+        } else {
+            h.set_position(v, {unit(rng), unit(rng), unit(rng)});
+        }
+    }
+    auto same = [](double x, double y) { return bits_of(x) == bits_of(y) || (std::isnan(x) && std::isnan(y)); };
+    auto same_frame = [&](const NormalFrame& x, const NormalFrame& y) {
+        return same(x.midpoint.x, y.midpoint.x) && same(x.midpoint.y, y.midpoint.y) && same(x.midpoint.z, y.midpoint.z) &&
+               same(x.normal.x, y.normal.x) && same(x.normal.y, y.normal.y) && same(x.normal.z, y.normal.z) &&
+               x.axis == y.axis && x.has_normal == y.has_normal;
+    };
+    auto corners = [&] {
+        const VertexId d = rng() % 5 == 0 ? kNoVertex : VertexId(rng() % vertices);
+        return FrameCorners{VertexId(rng() % vertices), VertexId(rng() % vertices), VertexId(rng() % vertices), d};
+    };
+    size_t with_normal = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        const FrameCorners k0 = corners(), k1 = corners();
+        NormalFrame p0, p1;
+        frame_pair_of<true>(h, k0, k1, p0, p1);
+        ASSERT_TRUE(same_frame(p0, frame_of<true>(h, k0)) && same_frame(p1, frame_of<true>(h, k1))) << "trial " << trial;
+        frame_pair_of<false>(h, k0, k1, p0, p1);
+        ASSERT_TRUE(same_frame(p0, frame_of<false>(h, k0)) && same_frame(p1, frame_of<false>(h, k1))) << "trial " << trial;
+        with_normal += p0.has_normal;
+    }
+    EXPECT_GT(with_normal, 1000u);  // the cases above are not all degenerate
+    EXPECT_LT(with_normal, 20000u);
+}
+#endif
+
 TEST(GeometryPrediction, Parallelogram) {
     const std::vector<Vec3> decoded = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     EXPECT_EQ(predict_parallelogram(decoded, {0, 1, 2}), (Vec3{1, 1, -1}));

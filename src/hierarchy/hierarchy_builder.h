@@ -2,6 +2,8 @@
 // level in one pass, and fetch nodes ahead. Internal: not part of the installed headers.
 #pragma once
 
+#include "common/compiler.h"
+
 #include <amc/hierarchy.h>
 
 #include <cstdint>
@@ -125,8 +127,9 @@ struct HierarchyBuilder {
                                const std::vector<uint8_t>& rotation, const std::vector<uint32_t>& base_vertex_id,
                                std::vector<VertexId>* vertex_map, unsigned threads);
     // set_position for a vertex that is not a base vertex, inlined into the geometry decoders'
-    // loops (set_position's base test and call cost them 4 % of a decode's instructions).
-    static void set_new_vertex_position(Hierarchy& h, VertexId v, Vec3 p) {
+    // loops (set_position's base test and call cost them 4 % of a decode's instructions; GCC left
+    // the static decoder's second call per pair out of line).
+    AMC_ALWAYS_INLINE static void set_new_vertex_position(Hierarchy& h, VertexId v, Vec3 p) {
         h.positions_[v] = p;
         h.far_positions_.raise_if(Hierarchy::is_far(p));
     }

@@ -114,9 +114,11 @@ AMC_ALWAYS_INLINE Residual grid_residual(const Quantizer& quantizer, int axis, d
     return {s < 0, uint64_t(s < 0 ? -s : s)};
 }
 
-// `origin`: the quantizer's origin on the axis (dequantize_coordinate's).
-AMC_ALWAYS_INLINE bool grid_value(const Quantizer& quantizer, double origin, const GridPrediction& g, Residual r, double& value) {
-    const int64_t q = int64_t(g.p) + negated_if(signed_value(r), g.turn);  // magnitude < 2^bits
+// `origin`: the quantizer's origin on the axis (dequantize_coordinate's); `residual` signed
+// (|residual| < 2^bits).
+AMC_ALWAYS_INLINE bool grid_value(const Quantizer& quantizer, double origin, const GridPrediction& g, int64_t residual,
+                                  double& value) {
+    const int64_t q = int64_t(g.p) + negated_if(residual, g.turn);
     if (q < 0 || q > int64_t(quantizer.max_coordinate())) return false;
     value = origin + rounded(static_cast<double>(q) * quantizer.step);
     return true;
@@ -134,8 +136,8 @@ void put_raw(RawBitWriter& raw, Residual r) {
     }
 }
 
-AMC_ALWAYS_INLINE Residual take(int token, RawBitReader& raw) {
-    if (token < kDirectTokens) return {bool((token != 0) & (token % 2 == 0)), uint64_t(token + 1) / 2};
+// A token from kDirectTokens on, with its raw bits.
+AMC_ALWAYS_INLINE Residual take_large(int token, RawBitReader& raw) {
     const int k = 4 + (token - kDirectTokens) / 4;
     const int low = k - 3;
     Residual r;
@@ -147,6 +149,19 @@ AMC_ALWAYS_INLINE Residual take(int token, RawBitReader& raw) {
     if (low > 32) bits = bits << 32 | raw.get(32);
     r.magnitude = (uint64_t(4 | ((token - kDirectTokens) & 3)) << low) | bits;
     return r;
+}
+
+AMC_ALWAYS_INLINE Residual take(int token, RawBitReader& raw) {
+    if (token < kDirectTokens) return {bool((token != 0) & (token % 2 == 0)), uint64_t(token + 1) / 2};
+    return take_large(token, raw);
+}
+
+// take's residual as a signed number, for quantized coordinates (magnitudes below 2^30): the
+// direct tokens' values from a table.
+constexpr int8_t kDirectValues[kDirectTokens] = {0, 1, -1, 2, -2, 3, -3, 4, -4, 5, -5, 6, -6, 7, -7};
+AMC_ALWAYS_INLINE int64_t take_signed(int token, RawBitReader& raw) {
+    if (token < kDirectTokens) return kDirectValues[token];
+    return signed_value(take_large(token, raw));
 }
 
 // ---- tables ------------------------------------------------------------------------------------
@@ -417,19 +432,41 @@ void gather_chunk(const Hierarchy& h, const Source& source, size_t begin, Chunk&
             if (v != kNoVertex) __builtin_prefetch(&h.positions()[v]);
 }
 
-template <bool Grid, bool UnitNormals>
-AMC_ALWAYS_INLINE void frame_vertex(const Hierarchy& h, const Quantizer* quantizer, Chunk& c, size_t i) {
-    const NormalFrame frame = frame_of<UnitNormals>(h, c.corners[i]);
+// Vertex i's frame in role order.
+template <bool Grid>
+AMC_ALWAYS_INLINE void role_frame(const NormalFrame& frame, const Quantizer* quantizer, Chunk& c, size_t i) {
     const std::array<int, 3> axes = role_axes(frame);
     RoleFrame& f = c.frames[i];
+    // Indexed by axis, without axis_coordinate's selects.
+    const double midpoint[3] = {frame.midpoint.x, frame.midpoint.y, frame.midpoint.z};
+    const double normal[3] = {frame.normal.x, frame.normal.y, frame.normal.z};
+    const double origin[3] = {quantizer != nullptr ? quantizer->origin.x : 0.0, quantizer != nullptr ? quantizer->origin.y : 0.0,
+                              quantizer != nullptr ? quantizer->origin.z : 0.0};
     for (int r = 0; r < 3; ++r) {
         f.axes[r] = axes[size_t(r)];
-        f.midpoint[r] = axis_coordinate(frame.midpoint, axes[size_t(r)]);
-        f.normal[r] = axis_coordinate(frame.normal, axes[size_t(r)]);
-        f.origin[r] = quantizer != nullptr ? axis_coordinate(quantizer->origin, axes[size_t(r)]) : 0.0;
+        f.midpoint[r] = midpoint[axes[size_t(r)]];
+        f.normal[r] = normal[axes[size_t(r)]];
+        f.origin[r] = origin[axes[size_t(r)]];
     }
     f.has_normal = frame.has_normal;
     if (Grid) c.first[i] = grid_prediction_at(*quantizer, f.origin[0], f.midpoint[0]);
+}
+
+// The chunk's frames in role order, two at a time where SSE2 computes two frames at once.
+template <bool Grid, bool UnitNormals>
+AMC_ALWAYS_INLINE void frame_chunk(const Hierarchy& h, const Quantizer* quantizer, Chunk& c) {
+    size_t i = 0;
+#if AMC_SSE2
+    if (!h.single_precision()) {
+        for (; i + 1 < c.count; i += 2) {
+            NormalFrame f0, f1;
+            frame_pair_of<UnitNormals>(h, c.corners[i], c.corners[i + 1], f0, f1);
+            role_frame<Grid>(f0, quantizer, c, i);
+            role_frame<Grid>(f1, quantizer, c, i + 1);
+        }
+    }
+#endif
+    for (; i < c.count; ++i) role_frame<Grid>(frame_of<UnitNormals>(h, c.corners[i]), quantizer, c, i);
 }
 
 // NormalFrame::predict in role order: roles 1 and 2's predictions once role 0's value is known.
@@ -454,14 +491,14 @@ AMC_ALWAYS_INLINE bool decode_vertex(const Chunk& b, size_t i, CoordinateSpace s
     if (Grid) {
         const Quantizer& quantizer = *space.quantizer;
         const GridPrediction& first = b.first[i];
-        if (!grid_value(quantizer, f.origin[0], first, take(rans.get_with<State>(tables[size_t(first.bin)]), raw), value[0]))
+        if (!grid_value(quantizer, f.origin[0], first, take_signed(rans.get_with<State>(tables[size_t(first.bin)]), raw), value[0]))
             return false;
         predict_others(f, value[0], second, third);
         const GridPrediction g1 = grid_prediction_at(quantizer, f.origin[1], second);
         const GridPrediction g2 = grid_prediction_at(quantizer, f.origin[2], third);
-        const Residual r1 = take(rans.get_with<1 - State>(tables[size_t(kGridBins + g1.bin)]), raw);
+        const int64_t r1 = take_signed(rans.get_with<1 - State>(tables[size_t(kGridBins + g1.bin)]), raw);
         if (!grid_value(quantizer, f.origin[1], g1, r1, value[1])) return false;
-        const Residual r2 = take(rans.get_with<State>(tables[size_t(2 * kGridBins + g2.bin)]), raw);
+        const int64_t r2 = take_signed(rans.get_with<State>(tables[size_t(2 * kGridBins + g2.bin)]), raw);
         if (!grid_value(quantizer, f.origin[2], g2, r2, value[2])) return false;
     } else {
         if (!value_of(space, f.axes[0], f.midpoint[0], take(rans.get_with<State>(tables[0]), raw), value[0])) return false;
@@ -482,11 +519,18 @@ bool decode_positions(Hierarchy& h, const Source& created, CoordinateSpace space
                       const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
     RansDecoder rans(rans_data, rans_size);
     RawBitReader raw(raw_data, raw_size);
+    // The quantizer copied here: no store to the positions can change it, so its fields stay in
+    // registers.
+    Quantizer local_quantizer;
+    if (space.quantizer != nullptr) {
+        local_quantizer = *space.quantizer;
+        space.quantizer = &local_quantizer;
+    }
     const Quantizer* quantizer = space.quantizer;
     Chunk c;
     for (size_t begin = 0; begin < created.size(); begin += kChunk) {
         gather_chunk(h, created, begin, c);
-        for (size_t i = 0; i < c.count; ++i) frame_vertex<Grid, UnitNormals>(h, quantizer, c, i);
+        frame_chunk<Grid, UnitNormals>(h, quantizer, c);
         for (size_t i = 0; i < c.count; i += 2) {
             Vec3 p;
             if (!decode_vertex<0, Grid>(c, i, space, tables, rans, raw, p)) return false;
