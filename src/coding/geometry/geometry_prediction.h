@@ -124,6 +124,18 @@ AMC_ALWAYS_INLINE InverseLengths inverse_lengths(double squared0, double squared
 // L is 0 or not finite.
 AMC_ALWAYS_INLINE Vec3 scaled_unit(Vec3 v, double r, bool valid) { return valid ? rounded_scaled(r, v) : Vec3{0, 0, 0}; }
 
+// The first axis of largest |N_i|, without branches (the axis is a coin flip on curved surfaces),
+// and whether the normal is usable.
+AMC_ALWAYS_INLINE void set_axis(NormalFrame& f) {
+    const double x = std::fabs(f.normal.x), y = std::fabs(f.normal.y), z = std::fabs(f.normal.z);
+    const bool y_wins = y > x;
+    const double best = y_wins ? y : x;
+    const bool z_wins = z > best;
+    f.axis = z_wins ? 2 : int(y_wins);
+    const double largest = z_wins ? z : best;
+    f.has_normal = largest > 0 && std::isfinite(largest);
+}
+
 }  // namespace frame_detail
 
 template <bool UnitNormals>
@@ -144,14 +156,7 @@ AMC_ALWAYS_INLINE NormalFrame frame_of(const Hierarchy& h, const FrameCorners& c
         // Mode 3 sums the cross products themselves (each weighted by its triangle's area).
         f.normal = has_d ? n1 + n2 : n1;
     }
-    // The first axis of largest |N_i|, without branches (the axis is a coin flip on curved surfaces).
-    const double x = std::fabs(f.normal.x), y = std::fabs(f.normal.y), z = std::fabs(f.normal.z);
-    const bool y_wins = y > x;
-    const double best = y_wins ? y : x;
-    const bool z_wins = z > best;
-    f.axis = z_wins ? 2 : int(y_wins);
-    const double largest = z_wins ? z : best;
-    f.has_normal = largest > 0 && std::isfinite(largest);
+    frame_detail::set_axis(f);
     return f;
 }
 
@@ -222,14 +227,7 @@ AMC_ALWAYS_INLINE void frame_pair_of(const Hierarchy& h, const FrameCorners& k0,
         NormalFrame& f = *out[k];
         f.midpoint = {mx[k], my[k], mz[k]};
         f.normal = {nx[k], ny[k], nz[k]};
-        // frame_of's axis and has_normal.
-        const double x = std::fabs(nx[k]), y = std::fabs(ny[k]), z = std::fabs(nz[k]);
-        const bool y_wins = y > x;
-        const double best = y_wins ? y : x;
-        const bool z_wins = z > best;
-        f.axis = z_wins ? 2 : int(y_wins);
-        const double largest = z_wins ? z : best;
-        f.has_normal = largest > 0 && std::isfinite(largest);
+        frame_detail::set_axis(f);
     }
 }
 #endif
