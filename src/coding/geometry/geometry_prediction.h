@@ -195,6 +195,8 @@ AMC_ALWAYS_INLINE void frame_pair_of(const Hierarchy& h, const FrameCorners& k0,
     const Lanes n1 = cross(sub(b, a), sub(c, a));
     const Lanes n2 = cross(sub(a, b), sub(d, b));
     const __m128d has_d = _mm_castsi128_pd(_mm_set_epi64x(-int64_t(has_d1), -int64_t(has_d0)));
+    // u + v in the lanes that have a d, u alone in the others.
+    auto pick = [has_d](__m128d u, __m128d v) { return _mm_or_pd(_mm_and_pd(has_d, _mm_add_pd(u, v)), _mm_andnot_pd(has_d, u)); };
     Lanes n;
     if (UnitNormals) {
         const __m128d zero = _mm_setzero_pd(), infinity = _mm_set1_pd(HUGE_VAL), one = _mm_set1_pd(1.0);
@@ -208,11 +210,9 @@ AMC_ALWAYS_INLINE void frame_pair_of(const Hierarchy& h, const FrameCorners& k0,
                          _mm_and_pd(valid, _mm_mul_pd(r, u.z))};
         };
         const Lanes u1 = unit(n1, r1, v1), u2 = unit(n2, r2, v2);
-        // With d: u1 + u2 (frame_of adds even an invalid u2's +0); without: u1 alone.
-        auto pick = [has_d](__m128d u, __m128d v) { return _mm_or_pd(_mm_and_pd(has_d, _mm_add_pd(u, v)), _mm_andnot_pd(has_d, u)); };
+        // frame_of adds even an invalid u2's +0 where there is a d.
         n = Lanes{pick(u1.x, u2.x), pick(u1.y, u2.y), pick(u1.z, u2.z)};
     } else {
-        auto pick = [has_d](__m128d u, __m128d v) { return _mm_or_pd(_mm_and_pd(has_d, _mm_add_pd(u, v)), _mm_andnot_pd(has_d, u)); };
         n = Lanes{pick(n1.x, n2.x), pick(n1.y, n2.y), pick(n1.z, n2.z)};
     }
     double mx[2], my[2], mz[2], nx[2], ny[2], nz[2];
