@@ -124,18 +124,19 @@ struct ForestCode {
 // Codes the forest of `h` (decoder base order, positions as the decoder will have them) in
 // `chunks`; `faces` is the leaf face count when there are several. `positions` holds the models as
 // the base geometry left them. The mixing mode (FORMAT.md 2.1) codes the forest as one stream.
-ForestCode code_forest(const Hierarchy& h, const std::vector<RootRange>& chunks, uint64_t faces, const EncodeOptions& options,
-                       CoordinateSpace space, PositionCoder positions, unsigned threads, bool want_hierarchy_stats) {
+ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<RootRange>& chunks, uint64_t faces,
+                       const EncodeOptions& options, CoordinateSpace space, PositionCoder positions, unsigned threads,
+                       bool want_hierarchy_stats) {
     ForestCode out;
     const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
     out.chunked = !mixed && chunks.size() > 1;
     if (out.chunked) {
-        ChunkedBlocks parts = encode_chunked(h, chunks, options, space, threads, out.stats);
+        ChunkedBlocks parts = encode_chunked(h, root_of, chunks, options, space, threads, out.stats);
         out.static_geometry = parts.static_geometry;
         out.grid_geometry = parts.grid_geometry;
         out.unit_geometry = parts.unit_geometry;
         out.faces = faces;
-        out.levels = uint64_t(h.depth() + 1);
+        out.levels = uint64_t(parts.levels);  // the deepest chunk's: the forest's
         out.blocks = std::move(parts.blocks);
     } else {
         HierarchyLevelEncoder hierarchy(h, options.hierarchy, kHierarchyStreamVersion, nullptr, mixed);
@@ -198,16 +199,18 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     const bool automatic = options.chunk_roots.empty() && options.chunks == 0;
     const bool one_chunk = options.chunk_roots.empty() ? options.chunks == 1 : options.chunk_roots.size() == 1;
     const uint64_t faces = one_chunk ? 0 : leaf_face_count(h, threads);
-    const std::vector<uint64_t> root_nodes = options.chunk_roots.empty() ? nodes_per_root(h) : std::vector<uint64_t>();
+    const std::vector<uint32_t> root_of = root_of_nodes(h);
+    const std::vector<uint64_t> root_nodes = options.chunk_roots.empty() ? nodes_per_root(h, root_of) : std::vector<uint64_t>();
     const std::vector<RootRange> chunks = options.chunk_roots.empty()
                                               ? balanced_chunks(root_nodes, chunk_count_for(options, faces))
                                               : explicit_chunks(options.chunk_roots, h.root_count());
     const bool want_hierarchy_stats = stats_out != nullptr;
-    ForestCode forest = code_forest(h, chunks, faces, options, space, positions, threads, want_hierarchy_stats);
+    ForestCode forest = code_forest(h, root_of, chunks, faces, options, space, positions, threads, want_hierarchy_stats);
     const uint32_t fewer = automatic && forest.chunked ? chunk_count_for_size(options, uint32_t(chunks.size()), forest.bytes)
                                                        : uint32_t(chunks.size());
     if (fewer < chunks.size())
-        forest = code_forest(h, balanced_chunks(root_nodes, fewer), faces, options, space, positions, threads, want_hierarchy_stats);
+        forest = code_forest(h, root_of, balanced_chunks(root_nodes, fewer), faces, options, space, positions, threads,
+                             want_hierarchy_stats);
 
     Metadata meta;
     meta.base_vertices = h.base().positions.size();
