@@ -140,7 +140,7 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
         out.blocks = std::move(parts.blocks);
     } else {
         HierarchyLevelEncoder hierarchy(h, options.hierarchy, kHierarchyStreamVersion, nullptr, mixed);
-        out.faces = hierarchy.stats().faces;  // counted by the coder's first pass
+        out.faces = hierarchy.faces();
         out.levels = uint64_t(hierarchy.level_count());
         out.hierarchy_header = hierarchy.header();
         for (int l = 0; l < hierarchy.level_count(); ++l) {
