@@ -178,20 +178,22 @@ AMC_ALWAYS_INLINE void frame_pair_of(const Hierarchy& h, const FrameCorners& k0,
         return Lanes{_mm_unpacklo_pd(xy0, xy1), _mm_unpackhi_pd(xy0, xy1), _mm_loadh_pd(_mm_load_sd(&p.z), &q.z)};
     };
     auto sub = [](const Lanes& u, const Lanes& v) { return Lanes{_mm_sub_pd(u.x, v.x), _mm_sub_pd(u.y, v.y), _mm_sub_pd(u.z, v.z)}; };
-    auto cross = [](const Lanes& u, const Lanes& v) {  // frame_detail::exact_cross
-        return Lanes{_mm_sub_pd(_mm_mul_pd(u.y, v.z), _mm_mul_pd(u.z, v.y)), _mm_sub_pd(_mm_mul_pd(u.z, v.x), _mm_mul_pd(u.x, v.z)),
-                     _mm_sub_pd(_mm_mul_pd(u.x, v.y), _mm_mul_pd(u.y, v.x))};
+    // GCC's intrinsics are vector arithmetic: a product fed to an add fuses into an FMA under
+    // -ffp-contract=fast unless it goes through `rounded`, as in the scalar frame_of.
+    auto mul = [](__m128d u, __m128d v) { return rounded(_mm_mul_pd(u, v)); };
+    auto cross = [mul](const Lanes& u, const Lanes& v) {  // frame_detail::exact_cross
+        return Lanes{_mm_sub_pd(mul(u.y, v.z), mul(u.z, v.y)), _mm_sub_pd(mul(u.z, v.x), mul(u.x, v.z)),
+                     _mm_sub_pd(mul(u.x, v.y), mul(u.y, v.x))};
     };
-    auto dot = [](const Lanes& u) {  // exact_dot(u, u)
-        return _mm_add_pd(_mm_add_pd(_mm_mul_pd(u.x, u.x), _mm_mul_pd(u.y, u.y)), _mm_mul_pd(u.z, u.z));
+    auto dot = [mul](const Lanes& u) {  // exact_dot(u, u)
+        return _mm_add_pd(_mm_add_pd(mul(u.x, u.x), mul(u.y, u.y)), mul(u.z, u.z));
     };
     const bool has_d0 = k0.d != kNoVertex, has_d1 = k1.d != kNoVertex;
     const Lanes a = load(k0.a, k1.a), b = load(k0.b, k1.b), c = load(k0.c, k1.c);
     // A missing d reads a's position: its lane's n2 is computed and then not used.
     const Lanes d = load(has_d0 ? k0.d : k0.a, has_d1 ? k1.d : k1.a);
     const __m128d half = _mm_set1_pd(0.5);
-    const Lanes mid{_mm_mul_pd(_mm_add_pd(a.x, b.x), half), _mm_mul_pd(_mm_add_pd(a.y, b.y), half),
-                    _mm_mul_pd(_mm_add_pd(a.z, b.z), half)};
+    const Lanes mid{mul(_mm_add_pd(a.x, b.x), half), mul(_mm_add_pd(a.y, b.y), half), mul(_mm_add_pd(a.z, b.z), half)};
     const Lanes n1 = cross(sub(b, a), sub(c, a));
     const Lanes n2 = cross(sub(a, b), sub(d, b));
     const __m128d has_d = _mm_castsi128_pd(_mm_set_epi64x(-int64_t(has_d1), -int64_t(has_d0)));
@@ -205,9 +207,8 @@ AMC_ALWAYS_INLINE void frame_pair_of(const Hierarchy& h, const FrameCorners& k0,
         // inverse_lengths' validity: L > 0 and finite (false for NaN); an invalid unit vector is +0.
         const __m128d v1 = _mm_and_pd(_mm_cmpgt_pd(l1, zero), _mm_cmplt_pd(l1, infinity));
         const __m128d v2 = _mm_and_pd(_mm_cmpgt_pd(l2, zero), _mm_cmplt_pd(l2, infinity));
-        auto unit = [](const Lanes& u, __m128d r, __m128d valid) {
-            return Lanes{_mm_and_pd(valid, _mm_mul_pd(r, u.x)), _mm_and_pd(valid, _mm_mul_pd(r, u.y)),
-                         _mm_and_pd(valid, _mm_mul_pd(r, u.z))};
+        auto unit = [mul](const Lanes& u, __m128d r, __m128d valid) {
+            return Lanes{_mm_and_pd(valid, mul(r, u.x)), _mm_and_pd(valid, mul(r, u.y)), _mm_and_pd(valid, mul(r, u.z))};
         };
         const Lanes u1 = unit(n1, r1, v1), u2 = unit(n2, r2, v2);
         // frame_of adds even an invalid u2's +0 where there is a d.

@@ -315,7 +315,8 @@ void StaticLevelEncoder::make_tables() {
         tables_[size_t(i)] = RansTable::from_counts(c);
         for (size_t t = 0; used && t < c.size(); ++t) {
             if (c[t] == 0) continue;
-            token_bits_ += double(c[t]) * tables_[size_t(i)].cost_bits(int(t));
+            // Rounded before the sum: a fused multiply-add could tip the mode choice between builds.
+            token_bits_ += rounded(double(c[t]) * tables_[size_t(i)].cost_bits(int(t)));
             token_count_ += c[t];
         }
     }
