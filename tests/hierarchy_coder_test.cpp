@@ -402,6 +402,59 @@ TEST(HierarchyCoder, ListedNewVerticesCarryTheirFrameCorners) {
     EXPECT_LT(with_far_corner, listed);
 }
 
+// A lean decoder (set_lean) gives its working memory back as soon as nothing reads it any more;
+// anything given back too early would read as zeros and build wrong levels. Every level decoded
+// lean against a plain decoder, listing corners and (node, edge) pairs, on hierarchies whose
+// levels span many pages of working memory.
+TEST(HierarchyCoder, LeanDecoderBuildsWhatThePlainOneBuilds) {
+    for (uint64_t seed = 1; seed <= 4; ++seed) {
+        const Hierarchy h = testing::projected_sphere(60000, 7, seed);
+        const std::vector<uint8_t> bytes = encode_hierarchy(h, HierarchyCoderOptions{});
+        HierarchyStreamHeader header;
+        const size_t header_size = read_standalone_stream_header(bytes.data(), bytes.size(), header);
+        HierarchyLevelDecoder plain(h.base(), header, UINT64_MAX), lean(h.base(), header, UINT64_MAX);
+        const bool listed = seed % 2 == 1;
+        plain.set_new_vertex_listing(listed, true);
+        lean.set_new_vertex_listing(listed, true);
+        ArithmeticDecoder plain_decoder(bytes.data() + header_size, bytes.size() - header_size);
+        ArithmeticDecoder lean_decoder(bytes.data() + header_size, bytes.size() - header_size);
+        size_t largest_level = 0;
+        while (!plain.done()) {
+            ASSERT_FALSE(lean.done());
+            largest_level = std::max(largest_level, plain.level_size());
+            lean.set_lean(true);
+            plain.decode_level(plain_decoder);
+            lean.decode_level(lean_decoder);
+            ASSERT_EQ(lean.new_vertex_count(), plain.new_vertex_count()) << "seed " << seed;
+            ASSERT_TRUE(lean.new_vertices() == plain.new_vertices()) << "seed " << seed;
+            for (size_t k = 0; listed && k < plain.new_vertex_count(); ++k) {
+                const FrameCorners a = plain.new_vertex_corners()[k], b = lean.new_vertex_corners()[k];
+                ASSERT_TRUE(a.a == b.a && a.b == b.b && a.c == b.c && a.d == b.d) << "seed " << seed << ", vertex " << k;
+            }
+        }
+        ASSERT_TRUE(lean.done());
+        lean.finish();
+        EXPECT_TRUE(identical(plain.hierarchy(), lean.hierarchy())) << "seed " << seed;
+        EXPECT_TRUE(same_connectivity(h, lean.hierarchy())) << "seed " << seed;
+        EXPECT_GT(largest_level, size_t(20000)) << "seed " << seed;  // links of many pages
+    }
+}
+
+#if defined(__linux__)
+// What set_lean relies on: the pages of working memory given back hold nothing of what was
+// written there (they read as zeros), and the elements before them are kept.
+TEST(HierarchyCoder, ReleasedWorkingMemoryIsGivenBack) {
+    constexpr size_t n = size_t(1) << 20, kept = n / 2;
+    ScratchArray<uint32_t> scratch;
+    uint32_t* words = scratch.reserve(n);
+    std::fill(words, words + n, 0xffffffffu);
+    scratch.release_from(kept);
+    EXPECT_TRUE(std::all_of(words, words + kept, [](uint32_t w) { return w == 0xffffffffu; }));
+    const size_t page_words = 65536 / sizeof(uint32_t);  // past any page size Linux uses
+    EXPECT_TRUE(std::all_of(words + kept + page_words, words + n - page_words, [](uint32_t w) { return w == 0; }));
+}
+#endif
+
 // The improved traversal's starting states (FORMAT.md, section 2): with the 1-regularity rule,
 // a level's incomplete nodes are decided (not refined) before its traversal, and every other node
 // starts in bucket max(1, 4 - its incomplete neighbours). derive_next_level makes them from

@@ -2,24 +2,13 @@
 #include "coding/container.h"
 
 #include "common/check.h"
+#include "common/little_endian.h"
 
 #include <xxhash.h>
 
 #include <cstring>
 
 namespace amc {
-
-namespace {
-
-void put_u32(std::vector<uint8_t>& out, uint32_t v) {
-    for (int i = 0; i < 4; ++i) out.push_back(uint8_t(v >> (8 * i)));
-}
-
-uint32_t get_u32(const uint8_t* p) {
-    return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
-}
-
-}  // namespace
 
 const char* block_type_name(uint8_t type) {
     switch (BlockType(type)) {
@@ -53,7 +42,7 @@ BlockWriter::BlockWriter(const FileFraming& framing, uint8_t version, uint8_t fl
     out_.push_back(flags);
     out_.push_back(0);
     out_.push_back(0);
-    put_u32(out_, XXH32(out_.data(), 8, 0));
+    append_le32(out_, XXH32(out_.data(), 8, 0));
 }
 
 void BlockWriter::add(uint8_t type, const std::vector<uint8_t>& payload) {
@@ -61,10 +50,10 @@ void BlockWriter::add(uint8_t type, const std::vector<uint8_t>& payload) {
                 std::string(framing_->block_name(type)) + " block is larger than 4 GiB");
     const size_t start = out_.size();
     out_.push_back(uint8_t(type));
-    put_u32(out_, uint32_t(payload.size()));
+    append_le32(out_, uint32_t(payload.size()));
     out_.insert(out_.end(), payload.begin(), payload.end());
     // The checksum covers the type, the length and the payload.
-    put_u32(out_, XXH32(out_.data() + start, out_.size() - start, 0));
+    append_le32(out_, XXH32(out_.data() + start, out_.size() - start, 0));
 }
 
 std::vector<uint8_t> BlockWriter::finish() {
@@ -84,14 +73,14 @@ BlockReader::BlockReader(const uint8_t* data, size_t size, const FileFraming& fr
                     std::to_string(framing.oldest_version) + " to " + std::to_string(framing.newest_version) + ")");
     AMC_REQUIRE(version_ >= framing.oldest_version, corrupt, "unknown " + ext + " version " + std::to_string(version_));
     AMC_REQUIRE(size >= kFileHeaderSize, truncated, "file is truncated (header)");
-    AMC_REQUIRE(XXH32(data, 8, 0) == get_u32(data + 8), checksum, "checksum mismatch in the file header");
+    AMC_REQUIRE(XXH32(data, 8, 0) == load_le32(data + 8), checksum, "checksum mismatch in the file header");
     flags_ = data[5];
     AMC_REQUIRE(!(flags_ & ~framing.known_flags), corrupt, "unknown flags in the file header");
     AMC_REQUIRE(data[6] == 0 && data[7] == 0, corrupt, "reserved header bytes are not zero");
 }
 
 bool BlockReader::next_block_arrived() const {
-    return size_ - pos_ >= kBlockOverhead && get_u32(data_ + pos_ + 1) <= size_ - pos_ - kBlockOverhead;
+    return size_ - pos_ >= kBlockOverhead && load_le32(data_ + pos_ + 1) <= size_ - pos_ - kBlockOverhead;
 }
 
 bool BlockReader::next(Block& block) {
@@ -99,11 +88,11 @@ bool BlockReader::next(Block& block) {
     AMC_REQUIRE(size_ - pos_ >= kBlockOverhead, truncated,
                 "file is truncated (block header at byte " + std::to_string(pos_) + ")");
     const uint8_t type = data_[pos_];
-    const uint32_t length = get_u32(data_ + pos_ + 1);
+    const uint32_t length = load_le32(data_ + pos_ + 1);
     AMC_REQUIRE(length <= size_ - pos_ - kBlockOverhead, truncated,
                 "file is truncated (" + std::string(framing_->block_name(type)) + " block at byte " +
                     std::to_string(pos_) + " announces " + std::to_string(length) + " bytes)");
-    const uint32_t stored = get_u32(data_ + pos_ + 5 + length);
+    const uint32_t stored = load_le32(data_ + pos_ + 5 + length);
     AMC_REQUIRE(XXH32(data_ + pos_, 5 + size_t(length), 0) == stored, checksum,
                 "checksum mismatch in the " + std::string(framing_->block_name(type)) + " block at byte " +
                     std::to_string(pos_));
@@ -132,11 +121,7 @@ void put_varint(std::vector<uint8_t>& out, uint64_t value) {
     } while (value != 0);
 }
 
-void put_f64(std::vector<uint8_t>& out, double value) {
-    uint64_t bits;
-    std::memcpy(&bits, &value, 8);
-    for (int i = 0; i < 8; ++i) out.push_back(uint8_t(bits >> (8 * i)));
-}
+void put_f64(std::vector<uint8_t>& out, double value) { append_le64(out, double_bits(value)); }
 
 void PayloadReader::fail(ErrorCode code, const std::string& problem) const {
     throw_error(code, std::string(what_) + ": " + problem);
@@ -178,11 +163,8 @@ const uint8_t* PayloadReader::bytes(uint64_t count) {
 
 double PayloadReader::f64() {
     if (size_ - pos_ < 8) fail(ErrorCode::truncated, "truncated");
-    uint64_t bits = 0;
-    for (int i = 0; i < 8; ++i) bits |= uint64_t(data_[pos_ + i]) << (8 * i);
+    const double value = double_from_bits(load_le64(data_ + pos_));
     pos_ += 8;
-    double value;
-    std::memcpy(&value, &bits, 8);
     return value;
 }
 

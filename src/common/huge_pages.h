@@ -9,6 +9,7 @@
 
 #if defined(__linux__)
 #include <sys/mman.h>
+#include <unistd.h>
 #endif
 
 namespace amc {
@@ -20,6 +21,21 @@ inline void advise_huge_pages(const void* begin, size_t bytes) {
     const uintptr_t a = (reinterpret_cast<uintptr_t>(begin) + kHuge - 1) & ~(kHuge - 1);
     const uintptr_t b = (reinterpret_cast<uintptr_t>(begin) + bytes) & ~(kHuge - 1);
     if (b > a) madvise(reinterpret_cast<void*>(a), b - a, MADV_HUGEPAGE);
+#else
+    (void)begin;
+    (void)bytes;
+#endif
+}
+
+// Gives the whole pages inside [begin, begin + bytes) back to the system (Linux; elsewhere
+// nothing): they stop counting as resident until written again, and then read as zeros. For
+// working memory whose contents are dead, so that what a decoder writes next does not add to it.
+inline void release_pages(void* begin, size_t bytes) {
+#if defined(__linux__) && defined(MADV_DONTNEED)
+    static const uintptr_t page = uintptr_t(sysconf(_SC_PAGESIZE));
+    const uintptr_t a = (reinterpret_cast<uintptr_t>(begin) + page - 1) & ~(page - 1);
+    const uintptr_t b = (reinterpret_cast<uintptr_t>(begin) + bytes) & ~(page - 1);
+    if (b > a) madvise(reinterpret_cast<void*>(a), b - a, MADV_DONTNEED);
 #else
     (void)begin;
     (void)bytes;
@@ -70,6 +86,10 @@ public:
     }
     T* data() { return data_.get(); }
     const T* data() const { return data_.get(); }
+    // Gives the pages past element n back to the system (release_pages); the capacity stays.
+    void release_from(size_t n) {
+        if (n < capacity_) release_pages(data_.get() + n, (capacity_ - n) * sizeof(T));
+    }
 
 private:
     std::unique_ptr<T[]> data_;

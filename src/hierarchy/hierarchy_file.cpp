@@ -6,6 +6,7 @@
 
 #include "common/check.h"
 #include "common/file_io.h"
+#include "common/little_endian.h"
 #include "hierarchy/hierarchy_builder.h"
 
 #include <cmath>
@@ -19,22 +20,8 @@ constexpr char kMagic[4] = {'A', 'M', 'C', 'H'};
 constexpr uint32_t kVersion = 1;
 constexpr uint32_t kFlagSinglePrecision = 1;
 
-// Stores v's bytes least significant first; returns the end.
-unsigned char* put_u32(unsigned char* at, uint32_t v) {
-    for (int i = 0; i < 4; ++i) at[i] = uint8_t(v >> (8 * i));
-    return at + 4;
-}
-
 unsigned char* put_coordinate(unsigned char* at, double x, bool single) {
-    if (single) {
-        const float f = float(x);
-        uint32_t bits;
-        std::memcpy(&bits, &f, 4);
-        return put_u32(at, bits);
-    }
-    uint64_t bits;
-    std::memcpy(&bits, &x, 8);
-    return put_u32(put_u32(at, uint32_t(bits)), uint32_t(bits >> 32));
+    return single ? store_le32(at, float_bits(float(x))) : store_le64(at, double_bits(x));
 }
 
 unsigned char* put_point(unsigned char* at, const Vec3& p, bool single) {
@@ -49,7 +36,7 @@ public:
     }
     uint32_t u32() {
         need(4);
-        const uint32_t v = le32(at());
+        const uint32_t v = load_le32(at());
         pos_ += 4;
         return v;
     }
@@ -75,20 +62,8 @@ public:
 
 private:
     const unsigned char* at() const { return reinterpret_cast<const unsigned char*>(bytes_.data()) + pos_; }
-    static uint32_t le32(const unsigned char* p) {
-        return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
-    }
     static double coordinate(const unsigned char* p, bool single) {
-        if (single) {
-            const uint32_t bits = le32(p);
-            float f;
-            std::memcpy(&f, &bits, 4);
-            return f;
-        }
-        const uint64_t bits = le32(p) | uint64_t(le32(p + 4)) << 32;
-        double d;
-        std::memcpy(&d, &bits, 8);
-        return d;
+        return single ? double(float_from_bits(load_le32(p))) : double_from_bits(load_le64(p));
     }
     void need(size_t n) const {
         if (bytes_.size() - pos_ < n) fail("file is truncated", ErrorCode::truncated);
@@ -124,16 +99,16 @@ std::string serialize_hierarchy(const Hierarchy& h) {
     at += 4;
     for (uint32_t field : {kVersion, single ? kFlagSinglePrecision : 0, base_vertices, h.root_count(),
                            uint32_t(order.size()), uint32_t(flipped.size()), new_vertices})
-        at = put_u32(at, field);
+        at = store_le32(at, field);
     for (const Vec3& p : h.base().positions) at = put_point(at, p, single);
     for (const Triangle& t : h.base().triangles) {
-        for (uint32_t v : t) at = put_u32(at, v);
+        for (uint32_t v : t) at = store_le32(at, v);
     }
     for (size_t i = 0; i < order.size(); ++i) {
         if (!h.is_leaf(order[i])) at[i / 8] = uint8_t(at[i / 8] | (1u << (i % 8)));
     }
     at += bit_bytes;
-    for (uint32_t i : flipped) at = put_u32(at, i);
+    for (uint32_t i : flipped) at = store_le32(at, i);
     // Refinement vertices in canonical order (base vertices are numbered first).
     const std::vector<uint32_t> canonical = canonical_vertex_order(h, order);
     for (size_t v = 0; v < canonical.size(); ++v) {

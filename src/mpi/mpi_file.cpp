@@ -10,6 +10,7 @@
 #include "coding/distributed/rank_grid.h"
 #include "coding/file_metadata.h"
 #include "common/check.h"
+#include "common/little_endian.h"
 
 #include <sys/mman.h>
 #include <unistd.h>
@@ -185,8 +186,6 @@ private:
     uint8_t* data_ = nullptr;
 };
 
-uint32_t u32_at(const uint8_t* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
-
 // Where the head of a file ends (rank 0, independent reads): after the seam block of a chunked
 // file; after the metadata block of a file without chunks (a rank reads the rest only when it
 // reads roots); the whole file whenever the framing looks wrong (then the decoder, which checks
@@ -199,7 +198,7 @@ uint64_t head_end(MPI_File file, uint64_t size) {
         uint8_t framing[5];
         if (size < 5 || at > size - 5) return size;
         if (MPI_File_read_at(file, MPI_Offset(at), framing, 5, MPI_BYTE, MPI_STATUS_IGNORE) != MPI_SUCCESS) return size;
-        const uint64_t end = at + kBlockOverhead + u32_at(framing + 1);
+        const uint64_t end = at + kBlockOverhead + load_le32(framing + 1);
         if (type == uint8_t(BlockType::chunk_table) && framing[0] != type) return metadata_end;
         if (framing[0] != type || end > size) return size;
         if (type == uint8_t(BlockType::metadata)) metadata_end = end;
@@ -314,7 +313,7 @@ Share read_run(MPI_Comm comm, const std::string& path, RunRequest run, const Dec
         const uint64_t last_block = last ? chunks.offsets.back() : 0;
         AMC_REQUIRE(all_ok(comm, read_all(comm, file, last_block, bytes->data() + last_block, last ? 5 : 0)), io,
                     path + ": can not be read");
-        if (last) end = std::min<uint64_t>(size, last_block + kBlockOverhead + u32_at(bytes->data() + last_block + 1));
+        if (last) end = std::min<uint64_t>(size, last_block + kBlockOverhead + load_le32(bytes->data() + last_block + 1));
         AMC_REQUIRE(all_ok(comm, read_all(comm, file, begin, bytes->data() + begin, end - begin)), io, path + ": can not be read");
         share.bytes_read += end - begin;
         collectively(comm, [&] {

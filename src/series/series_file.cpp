@@ -7,6 +7,7 @@
 #include "coding/container.h"
 #include "common/check.h"
 #include "common/file_io.h"
+#include "common/little_endian.h"
 #include "series/field_coder.h"
 #include "series/frame_connectivity.h"
 #include "series/frame_geometry.h"
@@ -15,15 +16,12 @@
 #include "series/series_framing.h"
 
 #include <cmath>
-#include <cstring>
 #include <iterator>
 
 namespace amc {
 
 namespace {
 
-void put_u32(std::vector<uint8_t>& out, uint32_t v) { put_series_u32(out, v); }
-uint32_t get_u32(const uint8_t* p) { return get_series_u32(p); }
 
 std::vector<uint8_t> block(SeriesBlock type, const std::vector<uint8_t>& payload) {
     return series_block(uint8_t(type), payload);
@@ -38,10 +36,7 @@ std::vector<uint8_t> base_payload(const TriangleMesh& base) {
     for (const Vec3& p : base.positions)
         for (double x : {p.x, p.y, p.z}) {
             if (base.single_precision) {
-                const float f = float(x);
-                uint32_t bits;
-                std::memcpy(&bits, &f, 4);
-                put_u32(out, bits);
+                append_le32(out, float_bits(float(x)));
             } else {
                 put_f64(out, x);
             }
@@ -73,14 +68,10 @@ TriangleMesh read_base(const uint8_t* data, size_t size, bool single_precision, 
         double xyz[3];
         for (double& x : xyz) {
             if (single_precision) {
-                const uint32_t bits = get_u32(p);
-                float f;
-                std::memcpy(&f, &bits, 4);
-                x = f;
+                x = float_from_bits(load_le32(p));
                 p += 4;
             } else {
-                uint64_t bits = uint64_t(get_u32(p)) | uint64_t(get_u32(p + 4)) << 32;
-                std::memcpy(&x, &bits, 8);
+                x = double_from_bits(load_le64(p));
                 p += 8;
             }
         }

@@ -3,6 +3,7 @@
 
 #include "coding/container.h"
 #include "common/check.h"
+#include "common/little_endian.h"
 #include "series/series_format.h"
 
 #include <xxhash.h>
@@ -13,22 +14,14 @@
 
 namespace amc {
 
-void put_series_u32(std::vector<uint8_t>& out, uint32_t v) {
-    for (int i = 0; i < 4; ++i) out.push_back(uint8_t(v >> (8 * i)));
-}
-
-uint32_t get_series_u32(const uint8_t* p) {
-    return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
-}
-
 std::vector<uint8_t> series_header(uint8_t version, uint8_t flags, uint32_t keyframe_interval) {
     std::vector<uint8_t> out(kSeriesMagic, kSeriesMagic + 4);
     out.push_back(version);
     out.push_back(flags);
     out.push_back(0);
     out.push_back(0);
-    put_series_u32(out, keyframe_interval);
-    put_series_u32(out, XXH32(out.data(), 12, 0));
+    append_le32(out, keyframe_interval);
+    append_le32(out, XXH32(out.data(), 12, 0));
     return out;
 }
 
@@ -37,9 +30,9 @@ std::vector<uint8_t> series_block(uint8_t type, const std::vector<uint8_t>& payl
     std::vector<uint8_t> out;
     out.reserve(payload.size() + kSeriesBlockOverhead);
     out.push_back(type);
-    put_series_u32(out, uint32_t(payload.size()));
+    append_le32(out, uint32_t(payload.size()));
     out.insert(out.end(), payload.begin(), payload.end());
-    put_series_u32(out, XXH32(out.data(), out.size(), 0));
+    append_le32(out, XXH32(out.data(), out.size(), 0));
     return out;
 }
 
@@ -54,12 +47,12 @@ SeriesScan scan_series_file(const std::vector<uint8_t>& bytes, const std::string
                 what + ": unsupported series version " + std::to_string(data[4]) +
                     " (newer than this build, which reads version 1 to " + std::to_string(kNewestSeriesVersion) + ")");
     AMC_REQUIRE(size >= kSeriesHeaderSize, truncated, what + ": truncated header");
-    AMC_REQUIRE(XXH32(data, 12, 0) == get_series_u32(data + 12), checksum, what + ": checksum mismatch in the header");
+    AMC_REQUIRE(XXH32(data, 12, 0) == load_le32(data + 12), checksum, what + ": checksum mismatch in the header");
     AMC_REQUIRE((data[5] & ~allowed_flags) == 0 && data[6] == 0 && data[7] == 0, corrupt, what + ": reserved header bits set");
     SeriesScan scan;
     scan.version = data[4];
     scan.flags = data[5];
-    scan.keyframe_interval = get_series_u32(data + 8);
+    scan.keyframe_interval = load_le32(data + 8);
     size_t pos = kSeriesHeaderSize;
     while (true) {
         const bool have_base = !scan.blocks.empty();
@@ -72,7 +65,7 @@ SeriesScan scan_series_file(const std::vector<uint8_t>& bytes, const std::string
                             " complete frames (the writer did not close it; read with allow_unfinished / --partial)");
             break;
         }
-        const bool fits = size - pos >= kSeriesBlockOverhead && get_series_u32(data + pos + 1) <= size - pos - kSeriesBlockOverhead;
+        const bool fits = size - pos >= kSeriesBlockOverhead && load_le32(data + pos + 1) <= size - pos - kSeriesBlockOverhead;
         if (!fits) {
             AMC_REQUIRE(allow_unfinished && have_base, truncated,
                         what + ": truncated in " + (have_base ? "frame " + std::to_string(frames) : std::string("the base block")) +
@@ -82,8 +75,8 @@ SeriesScan scan_series_file(const std::vector<uint8_t>& bytes, const std::string
             break;
         }
         const uint8_t type = data[pos];
-        const uint32_t length = get_series_u32(data + pos + 1);
-        AMC_REQUIRE(XXH32(data + pos, 5 + size_t(length), 0) == get_series_u32(data + pos + 5 + length), checksum,
+        const uint32_t length = load_le32(data + pos + 1);
+        AMC_REQUIRE(XXH32(data + pos, 5 + size_t(length), 0) == load_le32(data + pos + 5 + length), checksum,
                     what + ": checksum mismatch in the block at byte " + std::to_string(pos) +
                         (have_base ? " (frame " + std::to_string(frames) + ")" : std::string()));
         AMC_REQUIRE(type <= max_type, corrupt, what + ": unknown block type " + std::to_string(type) + " at byte " + std::to_string(pos));

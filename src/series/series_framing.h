@@ -10,9 +10,6 @@
 
 namespace amc {
 
-void put_series_u32(std::vector<uint8_t>& out, uint32_t v);
-uint32_t get_series_u32(const uint8_t* p);
-
 // The 16-byte header of a file of `version`.
 std::vector<uint8_t> series_header(uint8_t version, uint8_t flags, uint32_t keyframe_interval);
 // One block: type, length, payload, XXH32 of the three.

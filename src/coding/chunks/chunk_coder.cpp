@@ -180,6 +180,10 @@ void decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, size_t 
         // frame corners from the split, without reading the nodes again.
         const bool listed = is_static_mode(parts.predictor);
         hierarchy.set_new_vertex_listing(listed, false);
+        // The decoder's last chunk writes the decode's last nodes and positions; over its last
+        // three levels (the largest, in adaptive hierarchies) its working memory goes back as it
+        // dies instead of staying under them (docs/BENCHMARKS.md, "Threads and memory").
+        hierarchy.set_lean(place.last && level + 3 >= levels);
         hierarchy.decode_level(decoder);  // the seam vertices it splits off placed already (SeamSplits)
         next_boundary.clear();
         for (const NodeId n : boundary) {

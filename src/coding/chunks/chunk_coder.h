@@ -63,6 +63,7 @@ struct ChunkPlace {
     ChunkVertexKeys keys;
     uint8_t* seam_used = nullptr;  // seam_used[s] set to 1 when the chunk splits off seam vertex s
     HierarchySlice* slice = nullptr;  // where its nodes and own vertices go; null: appended to target
+    bool last = false;  // no chunk follows on its decoder (its working memory need not be kept warm)
 };
 
 // What a chunk's decoder knows of its trees once every level is decoded.

@@ -151,7 +151,8 @@ Hierarchy merge_in_order(const std::vector<ChunkJob>& jobs, const ChunkMergeInpu
     for (size_t i = 0; i < jobs.size(); ++i) {
         const ChunkJob& job = jobs[i];
         const size_t vertices_before = whole.positions().size();
-        const ChunkPlace place{&whole, plan.first_root[i], job.roots.count, plan.keys_in_whole(), seam_used.data()};
+        const ChunkPlace place{&whole, plan.first_root[i], job.roots.count, plan.keys_in_whole(), seam_used.data(), nullptr,
+                               i + 1 == jobs.size()};
         decode_chunk(decoder, job.data, job.size, place, *input.seam, input.space, limits_of(job, input), chunk_name(job),
                      counts[i]);
         AMC_REQUIRE(input.options.max_level >= 0 || decoder.node_count() == job.nodes, corrupt,
@@ -205,7 +206,9 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
         }
         if (decoder == nullptr) decoder = std::make_unique<HierarchyLevelDecoder>();
         const ChunkJob& job = jobs[i];
-        const ChunkPlace place{&whole, plan.first_root[i], job.roots.count, plan.keys_in_whole(), seam_used[i].data(), &slices[i]};
+        // Handed out in order (parallel_for): the last `threads` chunks are the last of their decoders.
+        const ChunkPlace place{&whole, plan.first_root[i], job.roots.count, plan.keys_in_whole(), seam_used[i].data(),
+                               &slices[i], i + threads >= n};
         decode_chunk(*decoder, job.data, job.size, place, *input.seam, input.space, limits_of(job, input), chunk_name(job),
                      counts[i]);
         AMC_REQUIRE(slices[i].next_node == slices[i].node_end, corrupt,

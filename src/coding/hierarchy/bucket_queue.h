@@ -53,6 +53,11 @@ public:
         return n;
     }
 
+    // Gives the buckets' pages back to the system (release_pages) until the next reset.
+    void release() {
+        for (ScratchArray<uint32_t>& stack : stacks_) stack.release_from(0);
+    }
+
 private:
     std::array<ScratchArray<uint32_t>, 4> stacks_;
 };

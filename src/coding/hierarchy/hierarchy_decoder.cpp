@@ -103,6 +103,7 @@ void HierarchyLevelDecoder::start(NodeId first_root, uint32_t roots, const Hiera
     boundary_context_ = nullptr;
     list_corners_ = false;
     place_new_vertices_ = true;
+    lean_ = false;
     slice_ = nullptr;
     // Uniform levels alone would build roots * (4^(U+1) - 1) / 3 nodes: check before.
     uint64_t uniform_nodes = roots, level_nodes = roots;
@@ -146,7 +147,11 @@ void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder, uint64_t ma
         new_vertices_.reserve(vertex_count_ - vertices_before);  // once per level, not doubling vertex by vertex
         for_each_new_vertex(level, numbering_, [&](uint32_t i, int e) { new_vertices_.emplace_back(first + i, e); });
     }
+    if (lean_) release_before_build(size_t(vertex_count_ - vertices_before));
     build_decided_levels();
+    if (lean_) {
+        for (Level& built : spare_) built.refined.release_from(0);
+    }
     new_vertex_count_ = (slice_ != nullptr ? slice_->next_vertex : h_->positions().size()) - new_vertex_first_;
 }
 
@@ -266,6 +271,24 @@ void HierarchyLevelDecoder::finish_level() {
     decided_.push_back(std::move(level_));
     level_ = std::move(next);
     ++level_index_;
+}
+
+void HierarchyLevelDecoder::release_before_build(size_t new_vertices) {
+    auto release_links = [](Level& level, size_t keep) {
+        level.nbr.release_from(keep);
+        level.edges.release_from(keep / 4);
+        level.lowered.release_from(0);  // derive_next_level's alone
+    };
+    for (Level& decided : decided_) release_links(decided, 0);
+    for (Level& spare : spare_) {
+        release_links(spare, 0);
+        spare.refined.release_from(0);
+    }
+    release_links(level_, level_.size());
+    numbering_.release();
+    closures_.release_from(0);
+    traversal_.release_working_memory();
+    corners_.release_from(new_vertices);
 }
 
 void HierarchyLevelDecoder::build_decided_levels() {

@@ -163,6 +163,11 @@ public:
         list_corners_ = corners;
         place_new_vertices_ = placed;
     }
+    // While set (restart clears it), decode_level gives working memory back to the system
+    // (release_pages) as soon as no later step reads it, and each level faults its own in again:
+    // for the last levels a decoder decodes, whose nodes and positions would otherwise come on top
+    // of the working memory of the levels before them (the peak of a decode).
+    void set_lean(bool lean) { lean_ = lean; }
     // Until the next restart, the levels are built in `slice` of hierarchy() (HierarchySlice,
     // hierarchy_builder.h), not at its end: decoders of chunks building one hierarchy at once.
     void set_slice(HierarchySlice* slice) { slice_ = slice; }
@@ -212,6 +217,10 @@ private:
     // Counts the decided level's splits (level_.refined, numbered in numbering_) and the vertices
     // they create, and moves to the next level.
     void finish_level();
+    // set_lean's release once the decided level is derived and its new vertices listed, before it
+    // is built: everything but the level's refined nodes, the next level's links and the room for
+    // `new_vertices` corners.
+    void release_before_build(size_t new_vertices);
     // decide_level for a stream of the newest version, or of version 1 (kVersion1).
     template <bool kVersion1>
     void decide_level_of(ArithmeticDecoder& decoder);
@@ -232,6 +241,7 @@ private:
     RefinedNumbering numbering_;     // of the level being decided
     std::vector<std::pair<NodeId, int>> new_vertices_;  // of the last decode_level
     bool list_corners_ = false, place_new_vertices_ = true;  // set_new_vertex_listing
+    bool lean_ = false;                                      // set_lean
     ScratchArray<FrameCorners> corners_;  // of the last decode_level, when listed
     VertexId new_vertex_first_ = 0;
     size_t new_vertex_count_ = 0;

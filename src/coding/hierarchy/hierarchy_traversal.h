@@ -45,6 +45,9 @@ public:
         }
     }
 
+    // Gives the working memory's pages back to the system until the next level (release_pages).
+    void release_working_memory() { buckets_.release(); }
+
     // Decides every node of `level` (undecided, canonical order) and records the decisions in
     // the nodes' state; afterwards each state's refined-neighbour count is exact.
     //   code(uint32_t i, int context_group) -> bool   the node's symbol (coded by the caller)

@@ -148,6 +148,8 @@ inline uint8_t complete_state(const uint32_t nbr[3], uint8_t boundary) {
 // read for a missing neighbour as block_of()[int32_t(kNoLocal)].
 class RefinedNumbering {
 public:
+    // Gives its pages back to the system (release_pages) until the next reset.
+    void release() { blocks_.release_from(0); }
     // Null before the first reset (a level decided without a scan refines nothing: never read).
     const uint32_t* block_of() const { return blocks_.data() == nullptr ? nullptr : blocks_.data() + 1; }
     // Room for n nodes, all kNoLocal.
