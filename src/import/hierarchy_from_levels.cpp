@@ -3,28 +3,65 @@
 #include "common/no_index.h"
 
 #include <algorithm>
-#include <unordered_map>
-#include <unordered_set>
+#include <utility>
+#include <vector>
 
 namespace amc {
 namespace {
 
 
 // A triangle's vertex set as a key (the three ids sorted, 21 bits each would not do for large
-// meshes, so two words).
+// meshes, so two words; no triangle has three equal ids, so the empty key cannot occur).
 struct TripleKey {
     uint64_t low, high;
     bool operator==(const TripleKey& o) const { return low == o.low && high == o.high; }
 };
-struct TripleHash {
-    size_t operator()(const TripleKey& k) const { return std::hash<uint64_t>()(k.low * 0x9e3779b97f4a7c15ull ^ k.high); }
-};
+constexpr TripleKey kEmptyTriple{~0ull, ~0ull};
 TripleKey triple_key(uint32_t a, uint32_t b, uint32_t c) {
     if (a > b) std::swap(a, b);
     if (b > c) std::swap(b, c);
     if (a > b) std::swap(a, b);
     return {(uint64_t(a) << 32) | b, c};
 }
+size_t hash_of(TripleKey k) {
+    const uint64_t h = (k.low * 0x9e3779b97f4a7c15ull ^ k.high) * 0xbf58476d1ce4e5b9ull;
+    return size_t(h ^ (h >> 31));
+}
+size_t hash_of(uint64_t k) {
+    const uint64_t h = k * 0x9e3779b97f4a7c15ull;
+    return size_t(h ^ (h >> 29));
+}
+
+// Open addressing with linear probing, sized once for at most `count` keys: the node and edge
+// tables here hold a few entries per leaf face, and a node-based map spent most of this file's
+// time allocating.
+template <typename Key, typename Value>
+class FlatMap {
+public:
+    FlatMap(size_t count, Key empty) : empty_(empty) {
+        size_t capacity = 16;
+        while (capacity < 2 * count) capacity *= 2;
+        slots_.assign(capacity, {empty, Value{}});
+    }
+    Value& operator[](Key key) {
+        std::pair<Key, Value>& slot = slots_[probe(key)];
+        slot.first = key;
+        return slot.second;
+    }
+    const Value* find(Key key) const {
+        const std::pair<Key, Value>& slot = slots_[probe(key)];
+        return slot.first == empty_ ? nullptr : &slot.second;
+    }
+
+private:
+    size_t probe(Key key) const {
+        size_t s = hash_of(key) & (slots_.size() - 1);
+        while (!(slots_[s].first == empty_) && !(slots_[s].first == key)) s = (s + 1) & (slots_.size() - 1);
+        return s;
+    }
+    Key empty_;
+    std::vector<std::pair<Key, Value>> slots_;
+};
 
 uint64_t directed(uint32_t a, uint32_t b) { return (uint64_t(a) << 32) | b; }
 
@@ -44,17 +81,19 @@ ImportedHierarchy hierarchy_from_levels(const TriangleMesh& mesh, const Detected
     Hierarchy& h = out.hierarchy;
     h = Hierarchy(detected.base);
     std::vector<uint32_t> input_of = detected.leaf_vertex_of_base;  // hierarchy vertex -> input vertex
-    std::unordered_map<TripleKey, NodeId, TripleHash> node_of;
+    size_t node_count = h.root_count();
+    for (const DetectedLevel& level : detected.levels) node_count += 4 * level.splits.size();
+    FlatMap<TripleKey, NodeId> node_of(node_count, kEmptyTriple);
     auto key_of = [&](NodeId n) { return triple_key(input_of[h.vertex(n, 0)], input_of[h.vertex(n, 1)], input_of[h.vertex(n, 2)]); };
     for (NodeId root = 0; root < h.root_count(); ++root) node_of[key_of(root)] = root;
 
     for (size_t level = detected.levels.size(); level-- > 0;) {
         for (const auto& s : detected.levels[level].splits) {
-            const auto it = node_of.find(triple_key(s[0], s[1], s[2]));
-            if (it == node_of.end() || !h.is_leaf(it->second)) {
+            const NodeId* found = node_of.find(triple_key(s[0], s[1], s[2]));
+            if (found == nullptr || !h.is_leaf(*found)) {
                 fail("level " + std::to_string(level) + " splits a triangle that is not a leaf");
             }
-            const NodeId n = it->second;
+            const NodeId n = *found;
             int r = 0;
             while (r < 3 && input_of[h.vertex(n, r)] != s[0]) ++r;
             if (r == 3 || input_of[h.vertex(n, (r + 1) % 3)] != s[1] || input_of[h.vertex(n, (r + 2) % 3)] != s[2]) {
@@ -79,17 +118,16 @@ ImportedHierarchy hierarchy_from_levels(const TriangleMesh& mesh, const Detected
 
     // Diagonals of two-hanging-node leaves: the default one joins m_{u+1} and v_u (a triangle
     // (v_u, m_{u+1}, m_{u+2}) exists), the other m_{u+2} and v_{u+1}.
-    std::unordered_set<uint64_t> edges;
-    edges.reserve(mesh.triangles.size() * 3);
+    FlatMap<uint64_t, uint8_t> edges(mesh.triangles.size() * 3, ~0ull);  // directed edges of the input
     for (const Triangle& t : mesh.triangles) {
-        for (int e = 0; e < 3; ++e) edges.insert(directed(t[size_t(e)], t[size_t(e + 1) % 3]));
+        for (int e = 0; e < 3; ++e) edges[directed(t[size_t(e)], t[size_t(e + 1) % 3])] = 1;
     }
     for (NodeId n : h.leaves()) {
         if (h.hanging_node_count(n) != 2) continue;
         const int u = !h.has_hanging_node(n, 0) ? 0 : !h.has_hanging_node(n, 1) ? 1 : 2;
         const int e1 = (u + 1) % 3;
         const VertexId m1 = h.midpoint(h.neighbor(n, e1), h.neighbor_edge(n, e1));
-        h.set_diagonal_flipped(n, !edges.count(directed(input_of[h.vertex(n, u)], input_of[m1])));
+        h.set_diagonal_flipped(n, edges.find(directed(input_of[h.vertex(n, u)], input_of[m1])) == nullptr);
     }
 
     // The check: every input vertex used once, the same triangles, a valid hierarchy.

@@ -5,6 +5,7 @@
 #include "common/no_index.h"
 
 #include <algorithm>
+#include <utility>
 
 namespace amc::detail::inverse {
 
@@ -136,14 +137,11 @@ uint32_t LevelFinder::grow_patch(uint32_t t, Preference preference, bool explori
     return removed;
 }
 
-void LevelFinder::collect_suspects(uint32_t start, std::vector<uint32_t>& suspects) const {
-    std::vector<uint32_t> invalid;
-    for (uint32_t i = start; i < blocks_.size(); ++i) {
-        if (sides_valid(i)) continue;
-        invalid.push_back(blocks_[i].center);
+void LevelFinder::collect_suspects(const std::vector<uint32_t>& invalid, std::vector<uint32_t>& suspects) const {
+    for (uint32_t i : invalid) {
         for (int e = 0; e < 3; ++e) {
             if (classify(i, e).kind != Side::invalid) continue;
-            const Fan fan = walk_fan(blocks_[i], e);
+            const Fan& fan = blocks_[i].fan[size_t(e)];
             if (fan.kind != Fan::triangles) continue;
             for (int k = 0; k < fan.size; ++k) {
                 const uint32_t owner = block_of_[fan.triangle[k]];
@@ -156,12 +154,9 @@ void LevelFinder::collect_suspects(uint32_t start, std::vector<uint32_t>& suspec
             }
         }
     }
-    // Many invalid blocks: a wrong reading, not a true one with a few wrong turns.
-    if (invalid.size() * kRepairableShare > blocks_.size() - start) {
-        suspects.clear();
-        return;
+    if (suspects.empty()) {
+        for (uint32_t i : invalid) suspects.push_back(blocks_[i].center);
     }
-    if (suspects.empty()) suspects = std::move(invalid);
 }
 
 uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool exploring, std::vector<uint32_t>* suspects) {
@@ -177,7 +172,7 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
             return 0;
         }
         for (int i = 0; i < 3; ++i) {
-            const Fan fan = walk_fan(blocks_[next], i);
+            const Fan fan = blocks_[next].fan[size_t(i)];  // a copy: placing blocks moves blocks_
             if (fan.kind != Fan::triangles || block_of_[fan.triangle[1]] != kNoIndex) continue;
             if (preference == Preference::closure_first) {
                 const uint32_t partner = closure_partner(blocks_[next], i, fan);
@@ -190,12 +185,20 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
         }
     }
     mark_explored(start, preference, exploring);
+    // A patch with invalid blocks is dropped; a large one with few is repaired (its suspects
+    // collected), one with many is a wrong reading, not a true one with a few wrong turns.
+    const uint32_t size = uint32_t(blocks_.size()) - start;
+    const bool repairable = suspects && size >= kRepairable;
+    std::vector<uint32_t> invalid;
     for (uint32_t i = start; i < blocks_.size(); ++i) {
-        if (!sides_valid(i)) {
-            if (suspects && blocks_.size() - start >= kRepairable) collect_suspects(start, *suspects);
-            roll_back(start);
-            return 0;
-        }
+        if (sides_valid(i)) continue;
+        invalid.push_back(i);
+        if (!repairable || invalid.size() * kRepairableShare > size) break;
+    }
+    if (!invalid.empty()) {
+        if (repairable && invalid.size() * kRepairableShare <= size) collect_suspects(invalid, *suspects);
+        roll_back(start);
+        return 0;
     }
     // A valid patch: no other reading needs to seed inside it.
     if (exploring) {
@@ -288,18 +291,22 @@ std::vector<uint32_t> LevelFinder::free_triangles_near(size_t first) {
 }
 
 std::vector<uint32_t> LevelFinder::free_near(std::vector<uint32_t> ring, int rings) const {
-    for (int step = 0; step < rings; ++step) {
-        const size_t count = ring.size();
-        for (size_t k = 0; k < count; ++k) {
+    // Marks instead of sorting the rings: the triangles come out ascending all the same.
+    std::vector<uint8_t> reached(tri_.size(), 0);
+    for (uint32_t t : ring) reached[t] = 1;
+    for (size_t step = 0, begin = 0; step < size_t(rings); ++step) {
+        const size_t end = ring.size();
+        for (size_t k = std::exchange(begin, end); k < end; ++k) {
             for (int e = 0; e < 3; ++e) {
                 const uint32_t h = adjacency_.twin(3 * ring[k] + uint32_t(e));
-                if (h != kNoHalfEdge) ring.push_back(h / 3);
+                if (h != kNoHalfEdge && !reached[h / 3]) reached[h / 3] = 1, ring.push_back(h / 3);
             }
         }
-        std::sort(ring.begin(), ring.end());
-        ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
     }
-    ring.erase(std::remove_if(ring.begin(), ring.end(), [&](uint32_t t) { return taken(t); }), ring.end());
+    ring.clear();
+    for (uint32_t t = 0; t < tri_.size(); ++t) {
+        if (reached[t] && !taken(t)) ring.push_back(t);
+    }
     return ring;
 }
 

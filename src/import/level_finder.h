@@ -37,16 +37,6 @@ namespace amc::detail::inverse {
 // each becomes is red_split.h's business (the hierarchy is built from the splits' points).
 
 
-struct Block {
-    uint32_t center;
-    std::array<uint32_t, 3> corner;       // corner k holds parent vertex v_k
-    std::array<uint32_t, 3> v, m;         // parent vertices, midpoints (m_i on v_i -> v_{i+1})
-    std::array<uint32_t, 3> first_half;   // half-edge v_i -> m_i (in corner i)
-    std::array<uint32_t, 3> second_half;  // half-edge m_i -> v_{i+1} (in corner i+1)
-    bool alive;
-    uint32_t patch;  // the committed patch it belongs to, or kNoIndex while growing
-};
-
 // The triangles around midpoint m_i outside its block, walked from v_{i+1} to v_i.
 struct Fan {
     enum Kind : uint8_t { invalid, boundary, triangles } kind = invalid;
@@ -54,6 +44,17 @@ struct Fan {
     uint32_t triangle[3] = {};
     uint32_t entry[3] = {};  // the half-edge by which the walk entered each (x -> m)
     uint32_t inner[2] = {};  // the vertices between consecutive fan triangles
+};
+
+struct Block {
+    uint32_t center;
+    std::array<uint32_t, 3> corner;       // corner k holds parent vertex v_k
+    std::array<uint32_t, 3> v, m;         // parent vertices, midpoints (m_i on v_i -> v_{i+1})
+    std::array<uint32_t, 3> first_half;   // half-edge v_i -> m_i (in corner i)
+    std::array<uint32_t, 3> second_half;  // half-edge m_i -> v_{i+1} (in corner i+1)
+    std::array<Fan, 3> fan;               // around m_i, set when placed (the mesh alone decides it)
+    bool alive;
+    uint32_t patch;  // the committed patch it belongs to, or kNoIndex while growing
 };
 
 // What lies across a block's edge, once labels are known.
@@ -85,7 +86,7 @@ public:
                 const std::vector<uint8_t>* kept)
         : tri_(fine), refined_(refined), adjacency_(fine, vertex_count), forced_old_(vertex_count, 0),
           midpoint_count_(vertex_count, 0), corner_count_(vertex_count, 0),
-          midpoint_block_(vertex_count, {kNoIndex, kNoIndex}), block_of_(fine.size(), kNoIndex), closure_of_(fine.size(), kNoIndex),
+          midpoint_block_(vertex_count, {kNoIndex, kNoIndex}), first_coarse_edge_(vertex_count), block_of_(fine.size(), kNoIndex), closure_of_(fine.size(), kNoIndex),
           pinned_old_(vertex_count, 0), covered_(fine.size(), 0),
           banned_(fine.size(), 0), repair_banned_(fine.size(), 0), deferred_(fine.size(), 0) {
         // A midpoint has its block's three triangles on one side and the boundary, another block
@@ -200,10 +201,10 @@ private:
     // hundred to a few thousand blocks instead of covering the level.
     uint32_t grow_patch(uint32_t t, Preference preference, bool exploring = false);
 
-    // The blocks of an invalid patch [start, end) that stand in the way of its invalid sides: the
-    // blocks holding a triangle of the fan across an invalid side, and those that made a vertex
-    // of the block that would fit across it a midpoint; failing those, the invalid blocks.
-    void collect_suspects(uint32_t start, std::vector<uint32_t>& suspects) const;
+    // The blocks that stand in the way of the invalid sides of the `invalid` blocks: those holding
+    // a triangle of the fan across an invalid side, and those that made a vertex of the block that
+    // would fit across it a midpoint; failing those, the invalid blocks themselves (as centers).
+    void collect_suspects(const std::vector<uint32_t>& invalid, std::vector<uint32_t>& suspects) const;
 
     // Whether a growth from blocks_[start] is sure enough to fail that growing it further is
     // wasted: of its `settled` blocks (the first half of those placed, whose sides the breadth-
@@ -246,6 +247,7 @@ private:
     std::vector<uint8_t> midpoint_count_;  // per vertex: blocks it is a midpoint of (0-2)
     std::vector<uint32_t> corner_count_;   // per vertex: blocks it is a parent vertex of
     std::vector<std::array<uint32_t, 2>> midpoint_block_;  // block * 3 + edge, per midpoint role
+    std::vector<std::pair<uint32_t, uint32_t>> first_coarse_edge_;  // coarse_edge(midpoint_block_[v][0])
     std::vector<uint32_t> block_of_;       // per triangle
     std::vector<uint32_t> closure_of_;     // per triangle: block * 3 + side of a committed closure
     std::vector<uint32_t> pinned_old_;     // per vertex: closures of committed patches it is a corner of

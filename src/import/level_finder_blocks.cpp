@@ -82,12 +82,18 @@ bool LevelFinder::fits(const Block& b) const {
 }
 
 bool LevelFinder::has_other_midpoint(uint32_t a, uint32_t b, uint32_t m) const {
+    auto splits_ab = [&](uint32_t w) {
+        if (w == m || midpoint_count_[w] == 0) return false;
+        const auto [s, t] = first_coarse_edge_[w];
+        return (s == a && t == b) || (s == b && t == a);
+    };
+    for (const uint32_t* w = adjacency_.ends_begin(a); w != adjacency_.ends_end(a); ++w) {
+        if (splits_ab(*w)) return true;
+    }
+    if (!adjacency_.on_boundary(a)) return false;
+    // The neighbour before a along the boundary is only the third vertex of one of its triangles.
     for (const uint32_t* h = adjacency_.outgoing_begin(a); h != adjacency_.outgoing_end(a); ++h) {
-        for (uint32_t w : {vertex_at(*h, 1), vertex_at(*h, 2)}) {
-            if (w == m || midpoint_count_[w] == 0) continue;
-            const auto [s, t] = coarse_edge(midpoint_block_[w][0]);
-            if ((s == a && t == b) || (s == b && t == a)) return true;
-        }
+        if (splits_ab(vertex_at(*h, 2))) return true;
     }
     return false;
 }
@@ -95,11 +101,12 @@ bool LevelFinder::has_other_midpoint(uint32_t a, uint32_t b, uint32_t m) const {
 bool LevelFinder::place_block(uint32_t t) {
     Block b;
     if (!read_block(t, b) || !fits(b)) return false;
+    for (int i = 0; i < 3; ++i) b.fan[size_t(i)] = walk_fan(b, i);
     const uint32_t index = uint32_t(blocks_.size());
     blocks_.push_back(b);
     claim(index);
     for (int i = 0; i < 3; ++i) {
-        const Fan fan = walk_fan(blocks_[index], i);
+        const Fan& fan = b.fan[size_t(i)];
         // Neither a block nor a two-hanging-node closure fits two old vertices there.
         if (fan.kind == Fan::invalid ||
             (fan.size == 3 && is_old(fan.inner[0]) && is_old(fan.inner[1]))) {
@@ -119,6 +126,7 @@ void LevelFinder::claim(uint32_t index) {
         block_of_[b.corner[size_t(k)]] = index;
         const uint32_t m = b.m[size_t(k)];
         midpoint_block_[m][midpoint_count_[m]++] = index * 3 + uint32_t(k);
+        if (midpoint_count_[m] == 1) first_coarse_edge_[m] = {b.v[size_t(k)], b.v[size_t(k + 1) % 3]};
         ++corner_count_[b.v[size_t(k)]];
     }
 }
@@ -133,7 +141,7 @@ void LevelFinder::release(uint32_t index) {
         auto& slots = midpoint_block_[m];
         if (slots[0] / 3 == index) slots[0] = slots[1];
         slots[1] = kNoIndex;
-        --midpoint_count_[m];
+        if (--midpoint_count_[m] != 0) first_coarse_edge_[m] = coarse_edge(slots[0]);
         --corner_count_[b.v[size_t(k)]];
     }
 }
@@ -218,7 +226,7 @@ std::pair<uint32_t, uint32_t> LevelFinder::coarse_edge(uint32_t role) const {
 Side LevelFinder::classify(uint32_t index, int i) const {
     const Block& b = blocks_[index];
     Side side;
-    const Fan fan = walk_fan(b, i);
+    const Fan& fan = b.fan[size_t(i)];
     if (fan.kind == Fan::boundary) {
         side.kind = Side::boundary;
         return side;

@@ -54,7 +54,13 @@ TriangleAdjacency::TriangleAdjacency(const std::vector<Triangle>& triangles, uin
 uint32_t TriangleAdjacency::find(uint32_t from, uint32_t to) const {
     const uint32_t* first = out_end_.data() + out_start_[from];
     const uint32_t* last = out_end_.data() + out_start_[from + 1];
-    const uint32_t* it = std::lower_bound(first, last, to);
+    // A vertex has about six half-edges: a scan beats a binary search; a large fan is searched.
+    const uint32_t* it = first;
+    if (last - first > 16) {
+        it = std::lower_bound(first, last, to);
+    } else {
+        while (it != last && *it < to) ++it;
+    }
     return it != last && *it == to ? out_half_edge_[size_t(it - out_end_.data())] : kNoHalfEdge;
 }
 

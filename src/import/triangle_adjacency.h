@@ -26,9 +26,15 @@ public:
     uint32_t star_size(uint32_t v) const { return out_start_[v + 1] - out_start_[v]; }
     const uint32_t* outgoing_begin(uint32_t v) const { return out_half_edge_.data() + out_start_[v]; }
     const uint32_t* outgoing_end(uint32_t v) const { return out_half_edge_.data() + out_start_[v + 1]; }
+    // Their end vertices, ascending: every neighbour of v but, on the boundary, the one before v.
+    const uint32_t* ends_begin(uint32_t v) const { return out_end_.data() + out_start_[v]; }
+    const uint32_t* ends_end(uint32_t v) const { return out_end_.data() + out_start_[v + 1]; }
     bool on_boundary(uint32_t v) const { return boundary_[v] != 0; }
     // Whether some triangle has the edge a-b (in either direction).
-    bool has_edge(uint32_t a, uint32_t b) const { return find(a, b) != kNoHalfEdge || find(b, a) != kNoHalfEdge; }
+    // (Around an inner vertex every neighbour is the end of an outgoing half-edge.)
+    bool has_edge(uint32_t a, uint32_t b) const {
+        return find(a, b) != kNoHalfEdge || (boundary_[a] && find(b, a) != kNoHalfEdge);
+    }
 
 private:
     uint32_t find(uint32_t from, uint32_t to) const;  // the half-edge from -> to, or kNoHalfEdge
