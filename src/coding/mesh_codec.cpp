@@ -167,8 +167,7 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
 
 std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options, EncodeStats* stats_out) {
     EncodeStats stats;
-    AMC_REQUIRE(options.effort >= 0 && options.effort <= kMaxEffort, invalid_input,
-                "encode: effort " + std::to_string(options.effort) + " is not in 0.." + std::to_string(kMaxEffort));
+    check_effort(options.effort, "encode");
     const unsigned threads = resolve_thread_count(options.threads);
     // Whatever is encoded decodes: the decoder's checks first (base mesh, structure, positions).
     check_before_writing(input, "encode", true, threads);
