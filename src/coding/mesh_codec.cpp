@@ -59,9 +59,11 @@ Quantizer quantizer_of(const Hierarchy& input, int bits) {
 // from those: a closed loop); returns the largest coordinate error, max_quantization_error's.
 double snap_positions(Hierarchy& h, const Quantizer& quantizer) {
     double worst = 0.0;
+    // std::fmax inline (a NaN loses to a number); its choice between +0 and -0 never arises, fabs gives +0.
+    auto larger = [](double a, double b) { return b > a || std::isnan(a) ? b : a; };
     for (VertexId v = 0; v < h.positions().size(); ++v) {
         const Vec3 p = h.position(v), r = dequantize(quantizer, snap_to_grid(quantizer, p));
-        worst = std::fmax(worst, std::fmax(std::fabs(r.x - p.x), std::fmax(std::fabs(r.y - p.y), std::fabs(r.z - p.z))));
+        worst = larger(worst, larger(std::fabs(r.x - p.x), larger(std::fabs(r.y - p.y), std::fabs(r.z - p.z))));
         h.set_position(v, r);
     }
     return worst;

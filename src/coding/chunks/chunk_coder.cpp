@@ -79,6 +79,7 @@ ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& s
     for (int l = 0; l < hierarchy.level_count(); ++l) {
         const std::vector<NodeId>& level = hierarchy.level_nodes(l);
         std::vector<std::pair<NodeId, int>> created;  // the chunk's own new vertices
+        created.reserve(hierarchy.new_vertices(l).size());
         for (auto [n, e] : hierarchy.new_vertices(l))
             if (seam_vertex(h, keys, seam, n, e) < 0) created.emplace_back(n, e);
         // The predictor, as the whole file's encoder picks it (FORMAT.md 3.9, 5.6).
