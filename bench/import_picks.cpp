@@ -121,6 +121,7 @@ int main(int argc, char** argv) {
             base.positions.push_back(user.positions[leaf_of_base[b]]);
         }
         const amc::LeafHalfedges halfedges(user);
+        amc::LeafSearch search(user);
         const amc::PositionIndex positions(user.positions);
         auto fresh = [&] {
             amc::Hierarchy out(base);
@@ -177,7 +178,7 @@ int main(int argc, char** argv) {
                 };
                 amc::Hierarchy reconstructed = fresh();
                 try {
-                    amc::reconstruct_hierarchy(reconstructed, leaf_of_base, user, halfedges, guides[g], positions, file,
+                    amc::reconstruct_hierarchy(reconstructed, leaf_of_base, user, halfedges, guides[g], positions, search, file,
                                                rule >= 1 ? &steps : nullptr, &referee);
                 } catch (const amc::Error&) {
                     c.failed = true;
@@ -212,7 +213,7 @@ int main(int argc, char** argv) {
             amc::Hierarchy reconstructed = fresh();
             std::string outcome = "completes";
             try {
-                amc::reconstruct_hierarchy(reconstructed, leaf_of_base, user, halfedges, guides[0], positions, file,
+                amc::reconstruct_hierarchy(reconstructed, leaf_of_base, user, halfedges, guides[0], positions, search, file,
                                            &steps, &inject);
             } catch (const amc::Error& e) {
                 const std::string message = e.what();

@@ -144,6 +144,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     };
     // What the anchored way undid, kept for the guided ways' second round.
     UndoSteps steps;
+    LeafSearch search(leaf);
     auto attempt = [&](Way way, bool by_undo_steps) {
         out.hierarchy = Hierarchy(hierarchy_base);
         // A leaf mesh of F faces comes from at most F leaves, so from at most 4F/3 + roots nodes.
@@ -161,7 +162,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
                                         : way == Way::subdivision   ? MidpointGuide::subdivision
                                                                     : MidpointGuide::surface;
             leaf_of_vertex = reconstruct_hierarchy(out.hierarchy, leaf_of_base, leaf, halfedges, guide,
-                                                   leaf_positions, what, by_undo_steps ? &steps : nullptr);
+                                                   leaf_positions, search, what, by_undo_steps ? &steps : nullptr);
         }
         verify_leaf_mesh(out.hierarchy, leaf_of_vertex, leaf, halfedges, what);
     };

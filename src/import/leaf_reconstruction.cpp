@@ -12,6 +12,19 @@
 
 namespace amc {
 
+LeafSearch::LeafSearch(const TriangleMesh& leaf) : leaf_(leaf) {}
+LeafSearch::~LeafSearch() = default;
+
+const NearestVertex& LeafSearch::nearest() {
+    if (!nearest_) nearest_ = std::make_unique<NearestVertex>(leaf_.positions);
+    return *nearest_;
+}
+
+const ClosestPointQuery& LeafSearch::surface() {
+    if (!surface_) surface_ = std::make_unique<ClosestPointQuery>(leaf_);
+    return *surface_;
+}
+
 std::vector<uint32_t> Reconstruction::run() {
     std::vector<NodeId> level, next;
     for (NodeId r = 0; r < h_.root_count(); ++r) level.push_back(r);
@@ -248,17 +261,17 @@ uint32_t Reconstruction::find_midpoint(NodeId n, int e) {
     // From the connectivity alone where it tells: the halves of the edge are leaf edges.
     const uint32_t common = only_unmatched_common_neighbor(a, b);
     if (common != kNoIndex) return common;
-    if (!nearest_) nearest_ = std::make_unique<NearestVertex>(leaf_.positions);
+    const NearestVertex& nearest_vertex = search_.nearest();
     const MidpointTest may_be_midpoint(*this, n, e);
     uint32_t found;
     uint32_t nearest[kCandidates];
     uint32_t count = 0;
     if (choice_) {
-        count = nearest_->find_nearest(guide_position(n, e), may_be_midpoint, kCandidates, nearest);
+        count = nearest_vertex.find_nearest(guide_position(n, e), may_be_midpoint, kCandidates, nearest);
         const uint32_t kept = on_shortest_chains(nearest, count, a, b);
         found = choice_->choose(nearest, kept, a, b, vertex_of_leaf_);
     } else {
-        found = nearest_->find(guide_position(n, e), may_be_midpoint);
+        found = nearest_vertex.find(guide_position(n, e), may_be_midpoint);
         nearest[0] = found;
         count = found != kNoIndex;
     }
@@ -286,8 +299,7 @@ Vec3 Reconstruction::guide_position(NodeId n, int e) {
     Vec3 m = guide_ == MidpointGuide::subdivision ? h_.position(h_.midpoint(n, e))
                                                  : 0.5 * (leaf_.positions[a] + leaf_.positions[b]);
     if (guide_ == MidpointGuide::surface) {
-        if (!surface_) surface_ = std::make_unique<ClosestPointQuery>(leaf_);
-        m = surface_->closest(m).point;
+        m = search_.surface().closest(m).point;
     }
     return m;
 }
@@ -312,9 +324,9 @@ uint32_t Reconstruction::only_unmatched_common_neighbor(uint32_t a, uint32_t b) 
 std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
                                             const TriangleMesh& leaf, const LeafHalfedges& halfedges,
                                             MidpointGuide guide, const PositionIndex& positions,
-                                            const std::string& what, const UndoSteps* steps,
+                                            LeafSearch& search, const std::string& what, const UndoSteps* steps,
                                             const PickReferee* referee) {
-    return Reconstruction(h, leaf_of_base, leaf, halfedges, guide, positions, what, steps, referee).run();
+    return Reconstruction(h, leaf_of_base, leaf, halfedges, guide, positions, search, what, steps, referee).run();
 }
 
 }  // namespace amc

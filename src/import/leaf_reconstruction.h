@@ -9,10 +9,30 @@
 #include "import/undo_steps.h"
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace amc {
+
+class ClosestPointQuery;
+class NearestVertex;
+
+// The search trees over the leaf mesh that the position-guided ways use, each built when first
+// needed and then shared by every way of one import (a k-d tree costs about as much to build as a
+// reconstruction's nearest-vertex queries; a refusal runs six guided ways).
+class LeafSearch {
+public:
+    explicit LeafSearch(const TriangleMesh& leaf);
+    ~LeafSearch();
+    const NearestVertex& nearest();
+    const ClosestPointQuery& surface();
+
+private:
+    const TriangleMesh& leaf_;
+    std::unique_ptr<NearestVertex> nearest_;
+    std::unique_ptr<ClosestPointQuery> surface_;
+};
 
 // How the reconstruction finds a vertex that no green neighbour reveals (docs/IMPORT.md).
 enum class MidpointGuide {
@@ -51,7 +71,7 @@ using PickReferee = std::function<uint32_t(const GuidedPick&)>;
 std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
                                             const TriangleMesh& leaf, const LeafHalfedges& halfedges,
                                             MidpointGuide guide, const PositionIndex& positions,
-                                            const std::string& what,
+                                            LeafSearch& search, const std::string& what,
                                             const UndoSteps* steps = nullptr,
                                             const PickReferee* referee = nullptr);
 

@@ -167,7 +167,7 @@ void Reconstruction::plan_retries(int depth, NodeId x) {
                 });
                 return fits_above;
             };
-            const uint32_t found = nearest_->find_nearest(guide_position(ancestor, e), usable, kRepairCandidates,
+            const uint32_t found = search_.nearest().find_nearest(guide_position(ancestor, e), usable, kRepairCandidates,
                                                           s.candidates);
             for (uint32_t i = 0; i < found; ++i) {
                 if (!tried_.count(retry_key(s.a, s.b, s.candidates[i])))

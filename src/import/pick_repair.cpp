@@ -141,7 +141,7 @@ Reconstruction::Move Reconstruction::best_move(VertexId v, NodeId misfit) {
     const uint32_t original = leaf_of_vertex_[v];
     uint32_t candidates[kRepairCandidates];
     unassign(v);
-    const uint32_t found = nearest_->find_nearest(guide_position(s.node, s.edge),
+    const uint32_t found = search_.nearest().find_nearest(guide_position(s.node, s.edge),
                                                   MidpointTest(*this, s.node, s.edge, true), kRepairCandidates,
                                                   candidates);
     assign(v, original);

@@ -23,8 +23,9 @@ class Reconstruction {
 public:
     Reconstruction(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base, const TriangleMesh& leaf,
                    const LeafHalfedges& halfedges, MidpointGuide guide, const PositionIndex& positions,
-                   const std::string& what, const UndoSteps* steps, const PickReferee* referee)
-        : h_(h), leaf_(leaf), he_(halfedges), guide_(guide), positions_(positions), what_(what), referee_(referee) {
+                   LeafSearch& search, const std::string& what, const UndoSteps* steps, const PickReferee* referee)
+        : h_(h), leaf_(leaf), he_(halfedges), guide_(guide), positions_(positions), search_(search), what_(what),
+          referee_(referee) {
         if (steps) choice_ = std::make_unique<UndoStepChoice>(*steps);
         leaf_of_vertex_.assign(h.positions().size(), kNoIndex);
         vertex_of_leaf_.assign(leaf.positions.size(), kNoIndex);
@@ -285,6 +286,7 @@ private:
     const LeafHalfedges& he_;
     const MidpointGuide guide_;
     const PositionIndex& positions_;
+    LeafSearch& search_;
     const std::string& what_;
     const PickReferee* referee_;
     // The true vertex is among the four nearest for most wrong nearest picks (docs/IMPORT.md);
@@ -336,8 +338,6 @@ private:
     bool read_failed_ = false;           // reconstruct_level failed while reading its level
     NodeId failed_node_ = kNoNode;       // else the node of the level whose vertices did not fit
     std::vector<uint8_t> refined_mark_;  // per node: read refined in the level being read
-    std::unique_ptr<NearestVertex> nearest_;
-    std::unique_ptr<ClosestPointQuery> surface_;
     std::unique_ptr<UndoStepChoice> choice_;
 };
 

@@ -33,12 +33,15 @@ UndoStepChoice::UndoStepChoice(const UndoSteps& steps) : steps_(steps) {
     hops_from_b_.assign(vertex_count, -1);
 }
 
-// Breadth-first over the remaining mesh from `source`, through unmatched vertices only.
-void UndoStepChoice::measure_from(uint32_t source, std::vector<int>& hops, const std::vector<uint32_t>& vertex_of_leaf) {
+// Breadth-first over the remaining mesh from `source`, through unmatched vertices only, until
+// both `targets` have their hop counts (breadth-first order makes them final when set).
+void UndoStepChoice::measure_from(uint32_t source, const uint32_t targets[2], std::vector<int>& hops,
+                                  const std::vector<uint32_t>& vertex_of_leaf) {
     queue_.assign(1, source);
     hops[source] = 0;
     reached_.push_back(source);
     for (size_t i = 0; i < queue_.size(); ++i) {
+        if (hops[targets[0]] >= 0 && hops[targets[1]] >= 0) return;
         const uint32_t u = queue_[i];
         if (hops[u] == kMaxHops || (u != source && vertex_of_leaf[u] != kNoIndex)) continue;
         for (uint32_t j = first_neighbor_[u]; j < first_neighbor_[u + 1]; ++j) {
@@ -65,18 +68,15 @@ uint32_t UndoStepChoice::choose(const uint32_t* candidates, uint32_t count, uint
     }
     if (never_count < 2) return found;
     // Where the steps stopped, the midpoint lies on the chain of edges from a to b, which in the
-    // remaining mesh is (nearly always) a shortest path between them.
-    measure_from(a, hops_from_a_, vertex_of_leaf);
-    measure_from(b, hops_from_b_, vertex_of_leaf);
-    int shortest = 1 << 20;
-    for (uint32_t x : reached_) {
-        if (hops_from_a_[x] >= 0 && hops_from_b_[x] >= 0 && vertex_of_leaf[x] == kNoIndex)
-            shortest = std::min(shortest, hops_from_a_[x] + hops_from_b_[x]);
-    }
-    auto detour = [&](uint32_t c) {
-        return hops_from_a_[c] < 0 || hops_from_b_[c] < 0 ? 1 << 21 : hops_from_a_[c] + hops_from_b_[c] - shortest;
+    // remaining mesh is (nearly always) a shortest path between them: the candidate with the
+    // smaller detour d(a, c) + d(c, b) - d(a, b) wins, the nearer on a tie. d(a, b) is common to
+    // both, so only the two candidates' distances are needed.
+    measure_from(a, never, hops_from_a_, vertex_of_leaf);
+    measure_from(b, never, hops_from_b_, vertex_of_leaf);
+    auto path_length = [&](uint32_t c) {
+        return hops_from_a_[c] < 0 || hops_from_b_[c] < 0 ? 1 << 21 : hops_from_a_[c] + hops_from_b_[c];
     };
-    found = detour(never[1]) < detour(never[0]) ? never[1] : never[0];
+    found = path_length(never[1]) < path_length(never[0]) ? never[1] : never[0];
     for (uint32_t x : reached_) hops_from_a_[x] = hops_from_b_[x] = -1;
     reached_.clear();
     return found;

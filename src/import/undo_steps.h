@@ -30,7 +30,8 @@ public:
                     const std::vector<uint32_t>& vertex_of_leaf);
 
 private:
-    void measure_from(uint32_t source, std::vector<int>& hops, const std::vector<uint32_t>& vertex_of_leaf);
+    void measure_from(uint32_t source, const uint32_t targets[2], std::vector<int>& hops,
+                      const std::vector<uint32_t>& vertex_of_leaf);
 
     const UndoSteps& steps_;
     std::vector<uint32_t> first_neighbor_, neighbors_;  // the remaining mesh's vertex neighbours

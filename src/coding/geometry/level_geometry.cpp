@@ -3,6 +3,7 @@
 
 #include "coding/geometry/geometry_prediction.h"
 #include "common/check.h"
+#include "common/exact_float.h"
 #include "coding/format_version.h"
 
 #include <algorithm>
@@ -20,6 +21,7 @@ namespace {
 // kStaticMargin of the smallest bound there are made for the whole level; an adaptive trial is
 // dropped when its first 1/kSampleShare, scaled to the level, passes what it must beat by 1/8.
 // Both keep kSampleSlack bytes of room besides, for levels that code to almost nothing.
+// Their products are rounded(): a fused multiply-add would make the choice, so the bytes, depend on the build.
 constexpr size_t kSampleShare = 8;
 constexpr size_t kMinSample = 2048;
 constexpr double kSampleMargin = 1.125;
@@ -40,7 +42,7 @@ void keep_likely_static_modes(const Hierarchy& h, const NewVertices& created, Co
         smallest = std::min(smallest, bound[i]);
     }
     for (int i = 0; i < 3; ++i) {
-        candidate[i] = candidate[i] && double(bound[i]) <= kStaticMargin * double(smallest) + kSampleSlack;
+        candidate[i] = candidate[i] && double(bound[i]) <= rounded(kStaticMargin * double(smallest)) + kSampleSlack;
         if (!candidate[i]) on_sample[i].reset();
     }
 }
@@ -80,7 +82,7 @@ void encode_adaptive(const Hierarchy& h, const NewVertices& created, GeometryPre
 size_t adaptive_bytes(const Hierarchy& h, const NewVertices& created, GeometryPredictor predictor, PositionCoder positions,
                       size_t limit, bool count_raw_bits, size_t sample) {
     const size_t judged = std::min(sample, created.size());
-    auto past_limit = [&](double bytes) { return limit != SIZE_MAX && bytes > kSampleMargin * double(limit) + kSampleSlack; };
+    auto past_limit = [&](double bytes) { return limit != SIZE_MAX && bytes > rounded(kSampleMargin * double(limit)) + kSampleSlack; };
     size_t half_sample_bytes = 0;
     std::vector<Vec3> predicted(count_raw_bits ? judged : 0);
     uint64_t raw_bits = 0;
@@ -100,7 +102,7 @@ size_t adaptive_bytes(const Hierarchy& h, const NewVertices& created, GeometryPr
         if (i + 1 == sample / 2) half_sample_bytes = encoder.bytes_so_far();
         if (i + 1 == sample) {
             const double rate = double(encoder.bytes_so_far() - half_sample_bytes) / double(sample - sample / 2);
-            if (past_limit(double(encoder.bytes_so_far()) + rate * double(created.size() - sample))) return SIZE_MAX;
+            if (past_limit(double(encoder.bytes_so_far()) + rounded(rate * double(created.size() - sample)))) return SIZE_MAX;
         }
     }
     return encoder.finish().size();
