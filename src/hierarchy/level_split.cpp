@@ -221,11 +221,13 @@ void Hierarchy::split_level(const LevelSplits& splits) {
         else if (vertices > vertex_room)
             reserve(0, std::max(vertices, positions_.capacity() + positions_.capacity() / 2));
     }
+    // Block i's parent is parents[i]: copied whole, not zero-filled and then written parent by parent.
     if (slice == nullptr) {
         nodes_.resize(new_nodes);
-        block_parent_.resize((new_nodes - root_count()) / 4);
+        block_parent_.insert(block_parent_.end(), parents, parents + count);
+    } else {
+        std::copy(parents, parents + count, block_parent_.begin() + std::ptrdiff_t((c0 - root_count()) / 4));
     }
-    NodeId* const block_parent = block_parent_.data() + (c0 - root_count()) / 4;
     Node* nodes = nodes_.data();
     VertexId next_vertex = VertexId(v0);
     size_t positions_written = v0;
@@ -290,7 +292,6 @@ void Hierarchy::split_level(const LevelSplits& splits) {
             Node* child = nodes + c;
             red_split_kernels::write_child_vertices(child, parent.v, m);  // write_vertices' (split() shares it)
             store_neighbors(child, splits.children + size_t(4) * i, offset);
-            block_parent[i] = n;
             const ChildTails& tails = kChildTails.of[outer | (boundary & 7u) << 6];
             for (int k = 0; k < 4; ++k) store_tail(child[k], tails.word[k] | level);
             parent.first_child = c;

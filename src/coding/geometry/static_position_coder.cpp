@@ -394,7 +394,8 @@ struct RoleFrame {
 
 struct Chunk {
     size_t begin = 0, count = 0;
-    std::array<FrameCorners, kChunk> corners;
+    const FrameCorners* corners = nullptr;  // the chunk's: `own`, or the source's list itself
+    std::array<FrameCorners, kChunk> own;
     std::array<VertexId, kChunk> vertices;
     std::array<RoleFrame, kChunk> frames;
     std::array<GridPrediction, kChunk> first;  // mode 4: role 0's
@@ -402,14 +403,18 @@ struct Chunk {
 
 // Where the vertices and their frame corners come from: (node, edge) pairs, read in the hierarchy,
 // or split_level's list (vertices first, first + 1, ...).
+// get(c) sets the corners and vertices of chunk c's c.count vertices from c.begin.
 struct FromNodes {
     const Hierarchy& h;
     const std::vector<std::pair<NodeId, int>>& created;
     size_t size() const { return created.size(); }
-    void get(size_t k, FrameCorners& corners, VertexId& vertex) const {
-        const auto [n, e] = created[k];
-        corners = frame_corners(h, n, e);
-        vertex = h.midpoint(n, e);
+    void get(Chunk& c) const {
+        for (size_t i = 0; i < c.count; ++i) {
+            const auto [n, e] = created[c.begin + i];
+            c.own[i] = frame_corners(h, n, e);
+            c.vertices[i] = h.midpoint(n, e);
+        }
+        c.corners = c.own.data();
     }
 };
 struct FromList {
@@ -417,9 +422,9 @@ struct FromList {
     size_t count;
     VertexId first;
     size_t size() const { return count; }
-    void get(size_t k, FrameCorners& c, VertexId& vertex) const {
-        c = corners[k];
-        vertex = first + VertexId(k);
+    void get(Chunk& c) const {
+        c.corners = corners + c.begin;  // read where they are: no copy
+        for (size_t i = 0; i < c.count; ++i) c.vertices[i] = first + VertexId(c.begin + i);
     }
 };
 
@@ -427,7 +432,7 @@ template <class Source>
 void gather_chunk(const Hierarchy& h, const Source& source, size_t begin, Chunk& c) {
     c.begin = begin;
     c.count = begin < source.size() ? std::min(kChunk, source.size() - begin) : 0;
-    for (size_t i = 0; i < c.count; ++i) source.get(begin + i, c.corners[i], c.vertices[i]);
+    source.get(c);
     for (size_t i = 0; i < c.count; ++i)
         for (VertexId v : {c.corners[i].a, c.corners[i].b, c.corners[i].c, c.corners[i].d})
             if (v != kNoVertex) __builtin_prefetch(&h.positions()[v]);
