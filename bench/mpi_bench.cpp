@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
     const std::string out = argv[3];
     try {
         const amc::Hierarchy h = amc::read_hierarchy(argv[2]);
-        const std::vector<amc::RootRange> parts = amc::balanced_chunks(amc::nodes_per_root(h), uint32_t(ranks));
+        const std::vector<amc::RootRange> parts = amc::balanced_chunks(amc::nodes_per_root(h, amc::root_of_nodes(h)), uint32_t(ranks));
         const amc::RootRange mine = size_t(rank) < parts.size() ? parts[size_t(rank)] : amc::RootRange{h.root_count(), 0};
         const amc::Hierarchy forest = amc::extract_roots(h, {mine});
         amc::EncodeOptions options;

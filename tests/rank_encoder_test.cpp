@@ -179,6 +179,26 @@ TEST(RankEncoder, TheGridsOriginKeepsTheSerialEncodersZero) {
     EXPECT_GT(positive, 0);
 }
 
+// The ranks' writer checks its options as encode() does (mpi_file.cpp calls check_rank_options first).
+TEST(RankEncoder, EffortOutsideItsRangeIsRefused) {
+    for (int effort : {-1, kMaxEffort + 1}) {
+        EncodeOptions options;
+        options.effort = effort;
+        try {
+            check_rank_options(options, "ranks.amc");
+            ADD_FAILURE() << "effort " << effort << " was taken";
+        } catch (const Error& e) {
+            EXPECT_EQ(e.code(), ErrorCode::invalid_input);
+            EXPECT_NE(std::string(e.what()).find("ranks.amc: effort " + std::to_string(effort)), std::string::npos) << e.what();
+        }
+    }
+    for (int effort = 0; effort <= kMaxEffort; ++effort) {
+        EncodeOptions options;
+        options.effort = effort;
+        EXPECT_NO_THROW(check_rank_options(options, "ranks.amc")) << "effort " << effort;
+    }
+}
+
 TEST(RankEncoder, RootRangesThatDoNotCutTheBaseAreRefused) {
     EXPECT_THROW(rank_layout(10, {{0, 4}, {5, 5}}), Error);  // a gap
     EXPECT_THROW(rank_layout(10, {{0, 5}, {4, 6}}), Error);  // an overlap

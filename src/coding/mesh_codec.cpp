@@ -59,9 +59,11 @@ Quantizer quantizer_of(const Hierarchy& input, int bits) {
 // from those: a closed loop); returns the largest coordinate error, max_quantization_error's.
 double snap_positions(Hierarchy& h, const Quantizer& quantizer) {
     double worst = 0.0;
+    // std::fmax inline (a NaN loses to a number); its choice between +0 and -0 never arises, fabs gives +0.
+    auto larger = [](double a, double b) { return b > a || std::isnan(a) ? b : a; };
     for (VertexId v = 0; v < h.positions().size(); ++v) {
         const Vec3 p = h.position(v), r = dequantize(quantizer, snap_to_grid(quantizer, p));
-        worst = std::fmax(worst, std::fmax(std::fabs(r.x - p.x), std::fmax(std::fabs(r.y - p.y), std::fabs(r.z - p.z))));
+        worst = larger(worst, larger(std::fabs(r.x - p.x), larger(std::fabs(r.y - p.y), std::fabs(r.z - p.z))));
         h.set_position(v, r);
     }
     return worst;
@@ -124,22 +126,23 @@ struct ForestCode {
 // Codes the forest of `h` (decoder base order, positions as the decoder will have them) in
 // `chunks`; `faces` is the leaf face count when there are several. `positions` holds the models as
 // the base geometry left them. The mixing mode (FORMAT.md 2.1) codes the forest as one stream.
-ForestCode code_forest(const Hierarchy& h, const std::vector<RootRange>& chunks, uint64_t faces, const EncodeOptions& options,
-                       CoordinateSpace space, PositionCoder positions, unsigned threads, bool want_hierarchy_stats) {
+ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<RootRange>& chunks, uint64_t faces,
+                       const EncodeOptions& options, CoordinateSpace space, PositionCoder positions, unsigned threads,
+                       bool want_hierarchy_stats) {
     ForestCode out;
     const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
     out.chunked = !mixed && chunks.size() > 1;
     if (out.chunked) {
-        ChunkedBlocks parts = encode_chunked(h, chunks, options, space, threads, out.stats);
+        ChunkedBlocks parts = encode_chunked(h, root_of, chunks, options, space, threads, out.stats);
         out.static_geometry = parts.static_geometry;
         out.grid_geometry = parts.grid_geometry;
         out.unit_geometry = parts.unit_geometry;
         out.faces = faces;
-        out.levels = uint64_t(h.depth() + 1);
+        out.levels = uint64_t(parts.levels);  // the deepest chunk's: the forest's
         out.blocks = std::move(parts.blocks);
     } else {
         HierarchyLevelEncoder hierarchy(h, options.hierarchy, kHierarchyStreamVersion, nullptr, mixed);
-        out.faces = hierarchy.stats().faces;  // counted by the coder's first pass
+        out.faces = hierarchy.faces();
         out.levels = uint64_t(hierarchy.level_count());
         out.hierarchy_header = hierarchy.header();
         for (int l = 0; l < hierarchy.level_count(); ++l) {
@@ -166,8 +169,7 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<RootRange>& chunks,
 
 std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options, EncodeStats* stats_out) {
     EncodeStats stats;
-    AMC_REQUIRE(options.effort >= 0 && options.effort <= kMaxEffort, invalid_input,
-                "encode: effort " + std::to_string(options.effort) + " is not in 0.." + std::to_string(kMaxEffort));
+    check_effort(options.effort, "encode");
     const unsigned threads = resolve_thread_count(options.threads);
     // Whatever is encoded decodes: the decoder's checks first (base mesh, structure, positions).
     check_before_writing(input, "encode", true, threads);
@@ -198,16 +200,18 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     const bool automatic = options.chunk_roots.empty() && options.chunks == 0;
     const bool one_chunk = options.chunk_roots.empty() ? options.chunks == 1 : options.chunk_roots.size() == 1;
     const uint64_t faces = one_chunk ? 0 : leaf_face_count(h, threads);
-    const std::vector<uint64_t> root_nodes = options.chunk_roots.empty() ? nodes_per_root(h) : std::vector<uint64_t>();
+    const std::vector<uint32_t> root_of = root_of_nodes(h);
+    const std::vector<uint64_t> root_nodes = options.chunk_roots.empty() ? nodes_per_root(h, root_of) : std::vector<uint64_t>();
     const std::vector<RootRange> chunks = options.chunk_roots.empty()
                                               ? balanced_chunks(root_nodes, chunk_count_for(options, faces))
                                               : explicit_chunks(options.chunk_roots, h.root_count());
     const bool want_hierarchy_stats = stats_out != nullptr;
-    ForestCode forest = code_forest(h, chunks, faces, options, space, positions, threads, want_hierarchy_stats);
+    ForestCode forest = code_forest(h, root_of, chunks, faces, options, space, positions, threads, want_hierarchy_stats);
     const uint32_t fewer = automatic && forest.chunked ? chunk_count_for_size(options, uint32_t(chunks.size()), forest.bytes)
                                                        : uint32_t(chunks.size());
     if (fewer < chunks.size())
-        forest = code_forest(h, balanced_chunks(root_nodes, fewer), faces, options, space, positions, threads, want_hierarchy_stats);
+        forest = code_forest(h, root_of, balanced_chunks(root_nodes, fewer), faces, options, space, positions, threads,
+                             want_hierarchy_stats);
 
     Metadata meta;
     meta.base_vertices = h.base().positions.size();

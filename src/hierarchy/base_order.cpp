@@ -179,59 +179,57 @@ Hierarchy HierarchyBuilder::subforest(const Hierarchy& h, TriangleMesh base, con
     }
     const size_t n = old_of.size();
     auto taken = [&](NodeId q) { return q != kNoNode && root_in[root_of[q]] != 0; };
-    // Split node j creates the midpoint of its edge e unless its neighbour there was split before
-    // it (split() then takes the neighbour's); mid[3 * j + e] is that midpoint's id.
-    std::vector<VertexId> mid(3 * n, kNoVertex);
     std::vector<VertexId> vertex_of(base_vertex);
-    for (size_t j = 0; j < n; ++j) {
-        const NodeId o = old_of[j];
-        if (h.is_leaf(o)) continue;
-        for (int e = 0; e < 3; ++e) {
-            const NodeId q = h.neighbor(o, e);
-            if (taken(q) && !h.is_leaf(q) && local[q] < j) {
-                mid[3 * j + size_t(e)] = mid[3 * size_t(local[q]) + size_t(h.neighbor_edge(o, e))];
-            } else {
-                mid[3 * j + size_t(e)] = VertexId(vertex_of.size());
-                vertex_of.push_back(h.midpoint(o, e));
-            }
-        }
-    }
-    out.positions_.resize(vertex_of.size());
-    for (size_t v = base_vertex.size(); v < vertex_of.size(); ++v) {
-        out.positions_[v] = h.position(vertex_of[v]);
-        out.far_positions_.raise_if(Hierarchy::is_far(out.positions_[v]));
-    }
     out.nodes_.resize(n);  // the roots stay as the constructor made them
     out.block_parent_.assign((n - root_count) / 4, kNoNode);
-    // A split node writes its four children's vertices, level and boundary flags (its corners and
-    // midpoints at hand once for all four); each node then its links, flags and first child.
+    // One pass in the replay's order: node j's links, flags and first child; when it is split, its
+    // midpoints (a new vertex unless its neighbour there was split before it: split() then takes
+    // the neighbour's, read from the neighbour's children written already) and its four
+    // children's vertices, level and boundary flags.
     NodeId next_child = root_count;
     for (size_t j = 0; j < n; ++j) {
         const NodeId o = old_of[j];
         Hierarchy::Node& node = out.nodes_[j];
+        NodeId q[3], link[3];  // the neighbours in h, and in the result (kNoNode when not taken)
+        for (int e = 0; e < 3; ++e) {
+            q[e] = h.neighbor(o, e);
+            link[e] = taken(q[e]) ? local[q[e]] : kNoNode;
+        }
         if (j >= root_count) {
             node.nbr_edge = 0;
             for (int e = 0; e < 3; ++e) {
-                const NodeId q = h.neighbor(o, e);
-                node.nbr[e] = taken(q) ? local[q] : kNoNode;
-                if (node.nbr[e] != kNoNode) node.nbr_edge |= uint8_t(h.neighbor_edge(o, e) << (2 * e));
+                node.nbr[e] = link[e];
+                if (link[e] != kNoNode) node.nbr_edge |= uint8_t(h.neighbor_edge(o, e) << (2 * e));
             }
             node.reserved = 0;
         }
         const bool leaf = h.is_leaf(o);
         node.flags = uint8_t((node.flags & 7u) | (leaf && h.diagonal_flipped(o) ? 8u : 0u));
         node.first_child = leaf ? kNoNode : next_child;
-        if (!leaf) {
-            out.block_parent_[(next_child - root_count) / 4] = NodeId(j);
-            const VertexId points[6] = {node.v[0], node.v[1], node.v[2], mid[3 * j], mid[3 * j + 1], mid[3 * j + 2]};
-            for (int k = 0; k < 4; ++k) {
-                Hierarchy::Node& child = out.nodes_[next_child + NodeId(k)];
-                for (int i = 0; i < 3; ++i) child.v[i] = points[red_split::kChildPoints[k][i]];
-                child.level = uint8_t(node.level + 1);
-                child.flags = uint8_t(node.flags & red_split::kChildEdges[k].boundary);
+        if (leaf) continue;
+        VertexId mid[3];
+        for (int e = 0; e < 3; ++e) {
+            if (link[e] != kNoNode && link[e] < j && !h.is_leaf(q[e])) {
+                mid[e] = out.midpoint(link[e], h.neighbor_edge(o, e));
+            } else {
+                mid[e] = VertexId(vertex_of.size());
+                vertex_of.push_back(h.midpoint(o, e));
             }
-            next_child += 4;
         }
+        out.block_parent_[(next_child - root_count) / 4] = NodeId(j);
+        const VertexId points[6] = {node.v[0], node.v[1], node.v[2], mid[0], mid[1], mid[2]};
+        for (int k = 0; k < 4; ++k) {
+            Hierarchy::Node& child = out.nodes_[next_child + NodeId(k)];
+            for (int i = 0; i < 3; ++i) child.v[i] = points[red_split::kChildPoints[k][i]];
+            child.level = uint8_t(node.level + 1);
+            child.flags = uint8_t(node.flags & red_split::kChildEdges[k].boundary);
+        }
+        next_child += 4;
+    }
+    out.positions_.resize(vertex_of.size());
+    for (size_t v = base_vertex.size(); v < vertex_of.size(); ++v) {
+        out.positions_[v] = h.position(vertex_of[v]);
+        out.far_positions_.raise_if(Hierarchy::is_far(out.positions_[v]));
     }
     out.live_nodes_ = uint32_t(n);
     out.live_vertices_ = uint32_t(out.positions_.size());

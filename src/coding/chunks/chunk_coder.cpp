@@ -47,12 +47,19 @@ bool is_seam_closure(const Hierarchy& h, NodeId n, int seam_hanging) {
     return own < 2 && own + seam_hanging == 2;
 }
 
-// The leaves among `level` (a level's nodes, decided) that are seam closures, in level order.
+// Calls f on the leaves among `level` (a level's nodes, decided) that are seam closures, in level
+// order; returns the hanging nodes the seam adds to the level's leaves.
 template <class F>
-void for_each_seam_closure(const Hierarchy& h, const std::vector<NodeId>& level, const VertexKeys& keys, const Seam& seam,
-                           F&& f) {
-    for (NodeId n : level)
-        if (h.is_leaf(n) && is_seam_closure(h, n, seam_hanging_count(h, keys, seam, n))) f(n);
+uint64_t for_each_seam_closure(const Hierarchy& h, const std::vector<NodeId>& level, const VertexKeys& keys, const Seam& seam,
+                               F&& f) {
+    uint64_t seam_hanging = 0;
+    for (NodeId n : level) {
+        if (!h.is_leaf(n)) continue;
+        const int hanging = seam_hanging_count(h, keys, seam, n);
+        seam_hanging += uint64_t(hanging);
+        if (is_seam_closure(h, n, hanging)) f(n);
+    }
+    return seam_hanging;
 }
 
 }  // namespace
@@ -68,16 +75,18 @@ ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& s
     put_varint(out.bytes, uint64_t(hierarchy.level_count()));
     PositionCoder positions(space);
     BitModel flipped;  // the seam closures' diagonal flags
+    uint64_t seam_hanging = 0;  // hanging nodes the seam adds to the chunk's leaves
     for (int l = 0; l < hierarchy.level_count(); ++l) {
         const std::vector<NodeId>& level = hierarchy.level_nodes(l);
         std::vector<std::pair<NodeId, int>> created;  // the chunk's own new vertices
+        created.reserve(hierarchy.new_vertices(l).size());
         for (auto [n, e] : hierarchy.new_vertices(l))
             if (seam_vertex(h, keys, seam, n, e) < 0) created.emplace_back(n, e);
         // The predictor, as the whole file's encoder picks it (FORMAT.md 3.9, 5.6).
         const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, fixed_predictor, grid_contexts, unit_normals, effort);
         ArithmeticEncoder encoder;
         hierarchy.encode_level(l, encoder);
-        for_each_seam_closure(h, level, keys, seam, [&](NodeId n) { encoder.encode(h.diagonal_flipped(n), flipped); });
+        seam_hanging += for_each_seam_closure(h, level, keys, seam, [&](NodeId n) { encoder.encode(h.diagonal_flipped(n), flipped); });
         const size_t hierarchy_part = encoder.bytes_so_far();
         const std::vector<uint8_t> payload = finish_level_payload(h, created, geometry, positions, encoder);
         out.static_geometry |= geometry.predictor == GeometryPredictor::normal_frame;
@@ -95,9 +104,7 @@ ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& s
         put_varint(out.bytes, payload.size());
         out.bytes.insert(out.bytes.end(), payload.begin(), payload.end());
     }
-    // A sum over the leaves in id order: no breadth-first list of them needed.
-    for (NodeId n = 0; n < h.node_capacity(); ++n)
-        if (h.is_alive(n) && h.is_leaf(n)) out.faces += 1 + uint64_t(h.hanging_node_count(n) + seam_hanging_count(h, keys, seam, n));
+    out.faces = hierarchy.faces() + seam_hanging;
     return out;
 }
 

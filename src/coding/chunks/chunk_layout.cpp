@@ -26,8 +26,7 @@ std::vector<uint32_t> root_of_nodes(const Hierarchy& h) {
     return root_of;
 }
 
-std::vector<uint64_t> nodes_per_root(const Hierarchy& h) {
-    const std::vector<uint32_t> root_of = root_of_nodes(h);
+std::vector<uint64_t> nodes_per_root(const Hierarchy& h, const std::vector<uint32_t>& root_of) {
     std::vector<uint64_t> count(h.root_count(), 0);
     for (NodeId n = 0; n < h.node_capacity(); ++n)
         if (h.is_alive(n)) ++count[root_of[n]];

@@ -19,8 +19,8 @@ struct RootRange {
 // The root of each live node's tree (kNoNode for unused ids).
 std::vector<uint32_t> root_of_nodes(const Hierarchy& h);
 
-// Live nodes of each root's tree.
-std::vector<uint64_t> nodes_per_root(const Hierarchy& h);
+// Live nodes of each root's tree; `root_of` is root_of_nodes(h).
+std::vector<uint64_t> nodes_per_root(const Hierarchy& h, const std::vector<uint32_t>& root_of);
 
 // `chunks` runs of consecutive roots (fewer when there are fewer roots), each closing once the
 // nodes so far reach its share of the total: chunk k ends at the first root where the running

@@ -27,8 +27,8 @@ uint64_t leaf_face_count(const Hierarchy& h, unsigned threads) {
     return sum;
 }
 
-ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<RootRange>& ranges, const EncodeOptions& options,
-                             CoordinateSpace space, unsigned threads, EncodeStats& stats) {
+ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<RootRange>& ranges,
+                             const EncodeOptions& options, CoordinateSpace space, unsigned threads, EncodeStats& stats) {
     std::vector<uint32_t> chunk_of_root(h.root_count());
     for (uint32_t c = 0; c < ranges.size(); ++c)
         for (uint32_t r = ranges[c].first; r < ranges[c].first + ranges[c].count; ++r) chunk_of_root[r] = c;
@@ -36,7 +36,6 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<RootRange>& r
     const Seam seam(h, chunk_of_root, key_of_vertex);
     std::vector<ChunkCode> codes(ranges.size());
     std::vector<uint64_t> nodes(ranges.size()), own_vertices(ranges.size());
-    const std::vector<uint32_t> root_of = root_of_nodes(h);
     std::vector<NodeId> local(h.node_capacity());  // shared: the chunks' nodes are disjoint
     parallel_for(ranges.size(), threads, [&](size_t c) {
         std::vector<VertexId> vertex_of;

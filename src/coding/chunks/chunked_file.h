@@ -28,10 +28,10 @@ struct ChunkedBlocks {
 };
 
 // Codes `h` (decoder base order, positions as the decoder will have them) in the chunks `ranges`
-// on up to `threads` threads. Adds the hierarchy and geometry bytes and the level statistics
-// (summed over chunks) to `stats`.
-ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<RootRange>& ranges, const EncodeOptions& options,
-                             CoordinateSpace space, unsigned threads, EncodeStats& stats);
+// on up to `threads` threads; `root_of` is root_of_nodes(h). Adds the hierarchy and geometry bytes
+// and the level statistics (summed over chunks) to `stats`.
+ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<RootRange>& ranges,
+                             const EncodeOptions& options, CoordinateSpace space, unsigned threads, EncodeStats& stats);
 
 // The chunk table of a file of `version`, read and checked against the base (root counts) and
 // the file's node count.

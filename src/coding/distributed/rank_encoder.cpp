@@ -6,6 +6,7 @@
 #include "coding/distributed/rank_grid.h"
 #include "coding/file_metadata.h"
 #include "coding/format_version.h"
+#include "coding/geometry/level_geometry.h"
 #include "coding/geometry/position_coder.h"
 #include "common/check.h"
 #include "hierarchy/writer_checks.h"
@@ -49,6 +50,7 @@ void check_rank_options(const EncodeOptions& options, const std::string& what) {
     AMC_REQUIRE(options.hierarchy_contexts == HierarchyContexts::paper, invalid_input,
                 what + ": the mixing mode is not written by ranks (it codes the whole forest as one stream, "
                        "ranks write one chunk each; docs/MPI.md)");
+    check_effort(options.effort, what);
 }
 
 RankChunk rank_chunk(const TriangleMesh& base, uint32_t first_root, const Hierarchy& forest, const std::string& what) {

@@ -78,12 +78,6 @@ Vec3 predict_butterfly(const Hierarchy& h, NodeId n, int e) {
     return round_if_single(h, p);
 }
 
-FrameCorners frame_corners(const Hierarchy& h, NodeId n, int e) {
-    const NodeId q = h.neighbor(n, e);
-    return {h.vertex(n, e), h.vertex(n, (e + 1) % 3), h.vertex(n, (e + 2) % 3),
-            q == kNoNode ? kNoVertex : h.vertex(q, (h.neighbor_edge(n, e) + 2) % 3)};
-}
-
 NormalFrame normal_frame(const Hierarchy& h, NodeId n, int e, bool unit_normals) {
     const FrameCorners corners = frame_corners(h, n, e);
     return unit_normals ? frame_of<true>(h, corners) : frame_of<false>(h, corners);

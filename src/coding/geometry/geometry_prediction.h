@@ -79,7 +79,13 @@ NormalFrame normal_frame(const Hierarchy& h, NodeId n, int e, bool unit_normals 
 // runs a -> b) and d, the vertex opposite the edge in the same-level neighbour (kNoVertex at a
 // boundary); then the frame from their positions.
 // (FrameCorners: hierarchy_builder.h, where split_level lists them for the decoders.)
-FrameCorners frame_corners(const Hierarchy& h, NodeId n, int e);
+// Inline: the static coders ask it once a vertex.
+inline FrameCorners frame_corners(const Hierarchy& h, NodeId n, int e) {
+    static constexpr int kNext[5] = {1, 2, 0, 1, 2};  // (i + 1) % 3 at i, (i + 2) % 3 at i + 1, for i in 0..2
+    const NodeId q = h.neighbor(n, e);
+    return {h.vertex(n, e), h.vertex(n, kNext[e]), h.vertex(n, kNext[e + 1]),
+            q == kNoNode ? kNoVertex : h.vertex(q, kNext[h.neighbor_edge(n, e) + 1])};
+}
 // frame_of<UnitNormals>(h, corners): below, inline.
 
 // Parallelogram rule over already decoded positions: a + b - c when all three indices are valid

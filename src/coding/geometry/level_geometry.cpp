@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <string>
 
 namespace amc {
 
@@ -187,6 +188,11 @@ LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& c
         code.static_code = std::move(unit);
     }
     return code;
+}
+
+void check_effort(int effort, const std::string& what) {
+    AMC_REQUIRE(effort >= 0 && effort <= kMaxEffort, invalid_input,
+                what + ": effort " + std::to_string(effort) + " is not in 0.." + std::to_string(kMaxEffort));
 }
 
 std::vector<uint8_t> finish_level_payload(const Hierarchy& h, const NewVertices& created, const LevelGeometryCode& code,

@@ -39,6 +39,10 @@ LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& c
                                         CoordinateSpace space, GeometryPredictor choice, bool grid_contexts = false,
                                         bool unit_normals = false, int effort = kMaxEffort);
 
+// Throws invalid_input, naming `what`, unless 0 <= effort <= kMaxEffort: what every encoder of
+// levels checks before it starts (encode(), the ranks' writer).
+void check_effort(int effort, const std::string& what);
+
 // The payload of a level block whose hierarchy part `encoder` holds: the predictor byte, then the
 // arithmetic code finished with the level's geometry (and mode 3's streams).
 std::vector<uint8_t> finish_level_payload(const Hierarchy& h, const NewVertices& created, const LevelGeometryCode& code,

@@ -20,6 +20,9 @@ namespace {
 constexpr int kDirectTokens = 15;     // tokens 0 .. 14: magnitudes 0 .. 7 with their sign
 constexpr int kMaxGammaLength = 12;   // table values are below 2^13
 constexpr int kTokensFor64Bits = kDirectTokens + 4 * (64 - 4) + 4;
+// StaticLevelEncoder's symbol words: the table above the token's bits.
+constexpr int kTokenBits = 9;
+static_assert(kTokensFor64Bits <= (1 << kTokenBits) && kMaxStaticTables << kTokenBits <= 0xFFFF, "a symbol fits 16 bits");
 
 // The largest bit length a residual can have in the space.
 int max_residual_bits(CoordinateSpace space) {
@@ -248,16 +251,14 @@ StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std
 
 void StaticLevelEncoder::extend(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created) {
     if (coded_) throw Error("StaticLevelEncoder::extend: the streams are coded already");
-    add(h, created, tokens_.size(), created.size());
+    add(h, created, symbols_.size(), created.size());
     make_tables();
 }
 
 void StaticLevelEncoder::add(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end) {
     if (counts_[0].empty())
         for (int i = 0; i < table_count_; ++i) counts_[size_t(i)].assign(size_t(token_limit(space_)), 0);
-    tokens_.resize(end);
-    table_of_.resize(end);
-    residuals_.resize(end);
+    symbols_.resize(end);
     switch (mode_) {
         case GeometryPredictor::normal_frame: add_vertices<false, false>(h, created, begin, end); break;
         case GeometryPredictor::normal_frame_grid: add_vertices<true, true>(h, created, begin, end); break;
@@ -277,23 +278,24 @@ void StaticLevelEncoder::add_vertices(const Hierarchy& h, const std::vector<std:
         const std::array<int, 3> axes = role_axes(frame);
         const Vec3 actual = h.position(h.midpoint(n, e));
         const Vec3 others = frame.predict(axis_coordinate(actual, axes[0]));
-        std::array<int, kStaticRoles>& t = tokens_[i];
-        std::array<int, kStaticRoles>& table = table_of_[i];
-        std::array<Residual, kStaticRoles>& r = residuals_[i];
+        std::array<uint16_t, kStaticRoles>& symbols = symbols_[i];
         for (int role = 0; role < kStaticRoles; ++role) {
             const int axis = axes[size_t(role)];
             const double predicted = role == 0 ? axis_coordinate(frame.midpoint, axis) : axis_coordinate(others, axis);
+            Residual r;
+            int table = role;
             if (GridBins) {
                 const GridPrediction g = grid_prediction(*space.quantizer, axis, predicted);
-                r[size_t(role)] = grid_residual(*space.quantizer, axis, axis_coordinate(actual, axis), g);
-                table[size_t(role)] = kGridBins * role + g.bin;
+                r = grid_residual(*space.quantizer, axis, axis_coordinate(actual, axis), g);
+                table = kGridBins * role + g.bin;
             } else {
-                r[size_t(role)] = residual_of(space, axis, axis_coordinate(actual, axis), predicted);
-                table[size_t(role)] = role;
+                r = residual_of(space, axis, axis_coordinate(actual, axis), predicted);
             }
-            t[size_t(role)] = static_token(r[size_t(role)].negative, r[size_t(role)].magnitude);
-            raw_bits += uint64_t(static_raw_bit_count(r[size_t(role)].magnitude));
-            ++counts_[size_t(table[size_t(role)])][size_t(t[size_t(role)])];
+            const int token = static_token(r.negative, r.magnitude);
+            if (token >= kDirectTokens) large_.push_back(r);
+            symbols[size_t(role)] = uint16_t(table << kTokenBits | token);
+            raw_bits += uint64_t(static_raw_bit_count(r.magnitude));
+            ++counts_[size_t(table)][size_t(token)];
         }
     }
     raw_bits_ += raw_bits;
@@ -323,19 +325,20 @@ void StaticLevelEncoder::make_tables() {
 void StaticLevelEncoder::code_streams() {
     if (coded_) return;
     RansEncoder rans;
-    rans.reserve(kStaticRoles * tokens_.size());
+    rans.reserve(kStaticRoles * symbols_.size());
     RawBitWriter raw;
-    for (size_t i = 0; i < tokens_.size(); ++i) {
-        for (int role = 0; role < kStaticRoles; ++role) {
-            rans.put(tables_[size_t(table_of_[i][size_t(role)])], tokens_[i][size_t(role)]);
-            put_raw(raw, residuals_[i][size_t(role)]);
+    size_t next_large = 0;
+    for (const std::array<uint16_t, kStaticRoles>& symbols : symbols_) {
+        for (uint16_t symbol : symbols) {
+            const int token = symbol & ((1 << kTokenBits) - 1);
+            rans.put(tables_[size_t(symbol >> kTokenBits)], token);
+            if (token >= kDirectTokens) put_raw(raw, large_[next_large++]);
         }
     }
     rans_ = rans.finish();
     raw_ = raw.finish();
-    tokens_ = {};
-    table_of_ = {};
-    residuals_ = {};
+    symbols_ = {};
+    large_ = {};
     coded_ = true;
 }
 

@@ -110,8 +110,10 @@ private:
     std::array<std::vector<uint64_t>, kMaxStaticTables> counts_;  // per table, of each possible token
     double token_bits_ = 0;  // the tokens' cost under the tables, sum of log2(M / f)
     uint64_t token_count_ = 0;
-    std::vector<std::array<int, kStaticRoles>> tokens_, table_of_;  // until the streams are coded
-    std::vector<std::array<StaticResidual, kStaticRoles>> residuals_;
+    // Until the streams are coded: each coordinate's table and token in one word (table_shifted |
+    // token), and the residuals of the tokens that have raw bits (from kDirectTokens on), in order.
+    std::vector<std::array<uint16_t, kStaticRoles>> symbols_;
+    std::vector<StaticResidual> large_;
     uint64_t raw_bits_ = 0;
     bool coded_ = false;
     std::vector<uint8_t> rans_, raw_;

@@ -59,6 +59,9 @@ public:
     // Statistics of everything coded so far (all of it after the last level). payload_bytes and
     // header_bytes are left to the caller, who owns the arithmetic coder.
     HierarchyCodeStats stats() const;
+    // Faces of the leaf mesh (1 + hanging nodes per leaf), counted by the first pass: stats().faces
+    // without its replay of the symbols.
+    uint64_t faces() const { return stats_.faces; }
     // The mixing mode's coded symbols in order, each with its features (bench/mixing_study).
     std::vector<std::pair<MixedFeatures, bool>> mixed_symbols() const;
 
