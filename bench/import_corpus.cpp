@@ -45,7 +45,10 @@ uint64_t connectivity_bytes(const amc::Hierarchy& h) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+constexpr const char* kUsage =
+    "usage: import_corpus [--move X] [--with-base-only | --without-base-only] [--hash] hierarchy.amh...\n";
+
+int run(int argc, char** argv) {
     double move = 0.3;
     bool detect = true, with_base_import = true, hash = false;
     std::vector<std::string> files;
@@ -59,12 +62,18 @@ int main(int argc, char** argv) {
             with_base_import = false;
         } else if (arg == "--hash") {
             hash = true;
+        } else if (arg == "--help" || arg == "-h") {
+            std::printf("%s", kUsage);
+            return 0;
+        } else if (!arg.empty() && arg[0] == '-') {
+            std::fprintf(stderr, "import_corpus: unknown option %s\n%s", arg.c_str(), kUsage);
+            return 2;
         } else {
             files.push_back(arg);
         }
     }
     if (files.empty()) {
-        std::fprintf(stderr, "usage: import_corpus [--move X] [--with-base-only | --without-base-only] hierarchy.amh...\n");
+        std::fprintf(stderr, "%s", kUsage);
         return 2;
     }
     std::printf("| model | leaf faces | base triangles | with base | s | M faces/s | base found (triangles) | connectivity bytes, true | found | found / true | s |\n");
@@ -120,4 +129,13 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
     }
     return not_identical == 0 ? 0 : 1;
+}
+
+int main(int argc, char** argv) {
+    try {
+        return run(argc, argv);
+    } catch (const amc::Error& e) {  // an unreadable input file
+        std::fprintf(stderr, "import_corpus: %s\n", e.what());
+        return 1;
+    }
 }
