@@ -121,7 +121,7 @@ void put_varint(std::vector<uint8_t>& out, uint64_t value) {
     } while (value != 0);
 }
 
-void put_f64(std::vector<uint8_t>& out, double value) { append_le64(out, double_bits(value)); }
+void put_f64(std::vector<uint8_t>& out, double value) { append_le64(out, bit_cast<uint64_t>(value)); }
 
 void PayloadReader::fail(ErrorCode code, const std::string& problem) const {
     throw_error(code, std::string(what_) + ": " + problem);
@@ -163,7 +163,7 @@ const uint8_t* PayloadReader::bytes(uint64_t count) {
 
 double PayloadReader::f64() {
     if (size_ - pos_ < 8) fail(ErrorCode::truncated, "truncated");
-    const double value = double_from_bits(load_le64(data_ + pos_));
+    const double value = bit_cast<double>(load_le64(data_ + pos_));
     pos_ += 8;
     return value;
 }

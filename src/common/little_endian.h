@@ -34,26 +34,14 @@ inline void append_le64(std::vector<uint8_t>& out, uint64_t v) {
     out.insert(out.end(), bytes, bytes + 8);
 }
 
-// The bits of IEEE floats, for storing them as the integers above.
-inline uint32_t float_bits(float f) {
-    uint32_t bits;
-    std::memcpy(&bits, &f, 4);
-    return bits;
-}
-inline uint64_t double_bits(double d) {
-    uint64_t bits;
-    std::memcpy(&bits, &d, 8);
-    return bits;
-}
-inline float float_from_bits(uint32_t bits) {
-    float f;
-    std::memcpy(&f, &bits, 4);
-    return f;
-}
-inline double double_from_bits(uint64_t bits) {
-    double d;
-    std::memcpy(&d, &bits, 8);
-    return d;
+// The same bits as another type of the same size (C++20's std::bit_cast): IEEE floats to the
+// integers above and back.
+template <class To, class From>
+inline To bit_cast(const From& from) {
+    static_assert(sizeof(To) == sizeof(From), "bit_cast between types of one size");
+    To to;
+    std::memcpy(&to, &from, sizeof(To));
+    return to;
 }
 
 }  // namespace amc

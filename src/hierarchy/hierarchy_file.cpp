@@ -21,7 +21,7 @@ constexpr uint32_t kVersion = 1;
 constexpr uint32_t kFlagSinglePrecision = 1;
 
 unsigned char* put_coordinate(unsigned char* at, double x, bool single) {
-    return single ? store_le32(at, float_bits(float(x))) : store_le64(at, double_bits(x));
+    return single ? store_le32(at, bit_cast<uint32_t>(float(x))) : store_le64(at, bit_cast<uint64_t>(x));
 }
 
 unsigned char* put_point(unsigned char* at, const Vec3& p, bool single) {
@@ -63,7 +63,7 @@ public:
 private:
     const unsigned char* at() const { return reinterpret_cast<const unsigned char*>(bytes_.data()) + pos_; }
     static double coordinate(const unsigned char* p, bool single) {
-        return single ? double(float_from_bits(load_le32(p))) : double_from_bits(load_le64(p));
+        return single ? double(bit_cast<float>(load_le32(p))) : bit_cast<double>(load_le64(p));
     }
     void need(size_t n) const {
         if (bytes_.size() - pos_ < n) fail("file is truncated", ErrorCode::truncated);

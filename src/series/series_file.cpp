@@ -36,7 +36,7 @@ std::vector<uint8_t> base_payload(const TriangleMesh& base) {
     for (const Vec3& p : base.positions)
         for (double x : {p.x, p.y, p.z}) {
             if (base.single_precision) {
-                append_le32(out, float_bits(float(x)));
+                append_le32(out, bit_cast<uint32_t>(float(x)));
             } else {
                 put_f64(out, x);
             }
@@ -68,10 +68,10 @@ TriangleMesh read_base(const uint8_t* data, size_t size, bool single_precision, 
         double xyz[3];
         for (double& x : xyz) {
             if (single_precision) {
-                x = float_from_bits(load_le32(p));
+                x = bit_cast<float>(load_le32(p));
                 p += 4;
             } else {
-                x = double_from_bits(load_le64(p));
+                x = bit_cast<double>(load_le64(p));
                 p += 8;
             }
         }
