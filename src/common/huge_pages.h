@@ -14,13 +14,21 @@
 
 namespace amc {
 
+#if defined(__linux__)
+namespace detail {
+// madvise(advice) on the whole `alignment`-aligned blocks inside [begin, begin + bytes).
+inline void advise_aligned(const void* begin, size_t bytes, uintptr_t alignment, int advice) {
+    const uintptr_t a = (reinterpret_cast<uintptr_t>(begin) + alignment - 1) & ~(alignment - 1);
+    const uintptr_t b = (reinterpret_cast<uintptr_t>(begin) + bytes) & ~(alignment - 1);
+    if (b > a) madvise(reinterpret_cast<void*>(a), b - a, advice);
+}
+}  // namespace detail
+#endif
+
 inline void advise_huge_pages(const void* begin, size_t bytes) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
     constexpr uintptr_t kHuge = uintptr_t(2) << 20;
-    if (bytes < 4 * kHuge) return;
-    const uintptr_t a = (reinterpret_cast<uintptr_t>(begin) + kHuge - 1) & ~(kHuge - 1);
-    const uintptr_t b = (reinterpret_cast<uintptr_t>(begin) + bytes) & ~(kHuge - 1);
-    if (b > a) madvise(reinterpret_cast<void*>(a), b - a, MADV_HUGEPAGE);
+    if (bytes >= 4 * kHuge) detail::advise_aligned(begin, bytes, kHuge, MADV_HUGEPAGE);
 #else
     (void)begin;
     (void)bytes;
@@ -33,9 +41,7 @@ inline void advise_huge_pages(const void* begin, size_t bytes) {
 inline void release_pages(void* begin, size_t bytes) {
 #if defined(__linux__) && defined(MADV_DONTNEED)
     static const uintptr_t page = uintptr_t(sysconf(_SC_PAGESIZE));
-    const uintptr_t a = (reinterpret_cast<uintptr_t>(begin) + page - 1) & ~(page - 1);
-    const uintptr_t b = (reinterpret_cast<uintptr_t>(begin) + bytes) & ~(page - 1);
-    if (b > a) madvise(reinterpret_cast<void*>(a), b - a, MADV_DONTNEED);
+    detail::advise_aligned(begin, bytes, page, MADV_DONTNEED);
 #else
     (void)begin;
     (void)bytes;
