@@ -109,6 +109,14 @@ ChunkDecodeLimits limits_of(const ChunkJob& job, const ChunkMergeInput& input) {
 
 std::string chunk_name(const ChunkJob& job) { return "chunk " + std::to_string(job.chunk); }
 
+// Checks the job's block, then decodes it into `place`.
+void decode_job(HierarchyLevelDecoder& decoder, const ChunkJob& job, const ChunkPlace& place, const ChunkMergeInput& input,
+                ChunkCounts& counts) {
+    input.reader->check_checksum(job.block);
+    decode_chunk(decoder, job.block.payload, job.block.size, place, *input.seam, input.space, limits_of(job, input),
+                 chunk_name(job), counts);
+}
+
 // Once every chunk is in: checks the whole file's vertices against the metadata, or drops the
 // seam vertices that no decoded chunk holds.
 void finish_vertices(Hierarchy& whole, const MergePlan& plan, const std::vector<uint8_t>& seam_used,
@@ -153,8 +161,7 @@ Hierarchy merge_in_order(const std::vector<ChunkJob>& jobs, const ChunkMergeInpu
         const size_t vertices_before = whole.positions().size();
         const ChunkPlace place{&whole, plan.first_root[i], job.roots.count, plan.keys_in_whole(), seam_used.data(), nullptr,
                                i + 1 == jobs.size()};
-        decode_chunk(decoder, job.data, job.size, place, *input.seam, input.space, limits_of(job, input), chunk_name(job),
-                     counts[i]);
+        decode_job(decoder, job, place, input, counts[i]);
         AMC_REQUIRE(input.options.max_level >= 0 || decoder.node_count() == job.nodes, corrupt,
                     chunk_name(job) + " does not hold the nodes the chunk table says");
         AMC_REQUIRE(input.options.max_level >= 0 || job.own_vertices == kUnknownVertices ||
@@ -209,8 +216,7 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
         // Handed out in order (parallel_for): the last `threads` chunks are the last of their decoders.
         const ChunkPlace place{&whole, plan.first_root[i], job.roots.count, plan.keys_in_whole(), seam_used[i].data(),
                                &slices[i], i + threads >= n};
-        decode_chunk(*decoder, job.data, job.size, place, *input.seam, input.space, limits_of(job, input), chunk_name(job),
-                     counts[i]);
+        decode_job(*decoder, job, place, input, counts[i]);
         AMC_REQUIRE(slices[i].next_node == slices[i].node_end, corrupt,
                     chunk_name(job) + " does not hold the nodes the chunk table says");
         AMC_REQUIRE(slices[i].next_vertex == slices[i].vertex_end, corrupt,

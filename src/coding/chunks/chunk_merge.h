@@ -7,6 +7,7 @@
 #include "coding/chunks/chunk_coder.h"
 #include "coding/chunks/chunk_layout.h"
 #include "coding/chunks/seam.h"
+#include "coding/container.h"
 
 #include <amc/codec.h>
 
@@ -17,17 +18,17 @@ namespace amc {
 
 constexpr uint64_t kUnknownVertices = UINT64_MAX;  // a chunk table before version 13
 
-// One chunk to decode: its block's payload and the chunk table's entry.
+// One chunk to decode: its block (checksum not yet checked) and the chunk table's entry.
 struct ChunkJob {
     uint32_t chunk = 0;
-    const uint8_t* data = nullptr;
-    size_t size = 0;
+    Block block{};
     RootRange roots;
     uint64_t nodes = 0;
     uint64_t own_vertices = kUnknownVertices;  // neither base nor seam vertices
 };
 
 struct ChunkMergeInput {
+    const BlockReader* reader = nullptr;  // of the file: checks each chunk block before it is decoded
     const TriangleMesh* base = nullptr;  // the file's base mesh
     const Seam* seam = nullptr;
     CoordinateSpace space;
