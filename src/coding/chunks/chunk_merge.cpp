@@ -3,6 +3,7 @@
 
 #include "coding/file_metadata.h"
 #include "common/check.h"
+#include "common/huge_pages.h"
 #include "common/parallel.h"
 #include "hierarchy/hierarchy_builder.h"
 
@@ -12,6 +13,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <system_error>
 #include <utility>
 
 namespace amc {
@@ -196,7 +198,9 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
         slices[i].owner = chunk_name(jobs[i]);
     }
     AMC_REQUIRE(vertex < kNoVertex, limit_exceeded, "too many vertices");
-    HierarchyBuilder::open_slices(whole, size_t(node), size_t(vertex));
+    std::vector<Vec3> zeroed;
+    if (input.zeroed_positions != nullptr && input.zeroed_positions->valid()) zeroed = input.zeroed_positions->get();
+    HierarchyBuilder::open_slices(whole, size_t(node), size_t(vertex), std::move(zeroed));
     find_seam_edges(plan, whole, n);
     const std::vector<HierarchyBuilder::RootLink> cut = HierarchyBuilder::cut_root_links(whole, plan.seam_edges);
     std::vector<std::vector<uint8_t>> seam_used(n, std::vector<uint8_t>(plan.seam_count, 0));
@@ -246,6 +250,19 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
 }
 
 }  // namespace
+
+std::future<std::vector<Vec3>> start_zeroed_positions(size_t count) {
+    try {
+        return std::async(std::launch::async, [count] {
+            std::vector<Vec3> positions;
+            reserve_huge(positions, count);
+            positions.resize(count);
+            return positions;
+        });
+    } catch (const std::system_error&) {  // no thread to be had: open_slices zeroes them
+        return {};
+    }
+}
 
 Hierarchy decode_and_merge_chunks(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& input, MergedCounts& counts) {
     MergePlan plan = plan_merge(jobs, input);

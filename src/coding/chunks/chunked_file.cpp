@@ -176,6 +176,7 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
     merge.vertices = input.vertices;
     merge.file_size = file_size;
     merge.options = input.options;
+    merge.zeroed_positions = input.zeroed_positions;
     MergedCounts counts;
     Hierarchy whole = decode_and_merge_chunks(jobs, merge, counts);
     if (counts_out != nullptr) *counts_out = counts;
