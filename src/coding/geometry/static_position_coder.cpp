@@ -486,7 +486,7 @@ size_t StaticLevelEncoder::estimated_bytes() const {
 size_t StaticLevelEncoder::lower_bound_bytes() const {
     ArithmeticEncoder tables;
     write_tables(tables);
-    const double rans_bits = token_bits_ - 16 - 0.001 * double(token_count_);
+    const double rans_bits = token_bits_ - 16 - rounded(0.001 * double(token_count_));
     const size_t rans = kRansStateBytes + (rans_bits > 0 ? size_t(rans_bits / 8.01) : 0);
     return tables.finish().size() + 1 + rans + size_t(raw_bits_ / 8);
 }
