@@ -32,6 +32,7 @@ const Column kConnectivityColumns[] = {
     {"amc-paper-naive", "paper, naive trav."},
     {"amc-paper-improved", "paper, improved trav."},
     {"amc-best", "amcodec best"},
+    {"amc-mixed", "amcodec mixed"},
     {"amc-imported", "amcodec, leaf mesh only"},
 };
 
@@ -203,6 +204,8 @@ void ratio_table(FILE* f, const Index& index) {
     const Ratio ratios[] = {
         {"Draco best / amcodec best", "draco-best", "amc-best"},
         {"Draco default / amcodec best", "draco-default", "amc-best"},
+        {"Draco best / amcodec mixed", "draco-best", "amc-mixed"},
+        {"paper improved / amcodec mixed", "amc-paper-improved", "amc-mixed"},
         {"Draco best / paper improved", "draco-best", "amc-paper-improved"},
         {"Draco best / paper naive", "draco-best", "amc-paper-naive"},
         {"meshopt + zstd / amcodec best", "meshopt+zstd", "amc-best"},
@@ -329,7 +332,7 @@ void connectivity_speed_table(FILE* f, const Index& index) {
     std::vector<std::string> columns;
     std::vector<const Column*> timed;
     for (const Column& c : kConnectivityColumns) {
-        if (std::string(c.coder) == "raw" || std::string(c.coder) == "one-bit-per-node") continue;
+        if (std::string(c.coder) == "raw" || std::string(c.coder) == "one-bit-per-node" || std::string(c.coder) == "amc-mixed") continue;
         timed.push_back(&c);
         columns.push_back(c.label);
     }

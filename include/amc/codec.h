@@ -34,7 +34,7 @@ enum class HierarchyContexts : uint8_t {
     paper = 0,  // the paper's ten context groups, one adaptive model each (the fastest to decode)
     // Sixteen models under richer contexts (structure one level up, decided neighbours' neighbours,
     // decoded geometry) mixed logistically: 5-33% smaller hierarchy code on the corpus, slower to
-    // decode; files that use it are .amc version 8, one chunk.
+    // decode; files that use it are .amc version 11 (FORMAT.md 2.3), one chunk.
     mixed = 1,
 };
 

@@ -198,13 +198,18 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     PositionCoder positions(space);
     std::vector<uint8_t> base_geometry = encode_base_geometry(h, base_code, reordered.keep_rotations, positions);
     const bool automatic = options.chunk_roots.empty() && options.chunks == 0;
-    const bool one_chunk = options.chunk_roots.empty() ? options.chunks == 1 : options.chunk_roots.size() == 1;
+    // A leaf has at most four faces (itself and three hanging nodes): fewer than two chunks' faces,
+    // so one chunk (chunk_count_for), known without the passes over the nodes that count faces and
+    // nodes per root.
+    const bool few_leaves = automatic && uint64_t(h.leaf_count()) * 2 < std::max<uint64_t>(1, options.chunk_faces);
+    const bool one_chunk = options.chunk_roots.empty() ? options.chunks == 1 || few_leaves : options.chunk_roots.size() == 1;
     const uint64_t faces = one_chunk ? 0 : leaf_face_count(h, threads);
-    const std::vector<uint32_t> root_of = root_of_nodes(h);
-    const std::vector<uint64_t> root_nodes = options.chunk_roots.empty() ? nodes_per_root(h, root_of) : std::vector<uint64_t>();
-    const std::vector<RootRange> chunks = options.chunk_roots.empty()
-                                              ? balanced_chunks(root_nodes, chunk_count_for(options, faces))
-                                              : explicit_chunks(options.chunk_roots, h.root_count());
+    const std::vector<uint32_t> root_of = one_chunk ? std::vector<uint32_t>() : root_of_nodes(h);
+    const std::vector<uint64_t> root_nodes =
+        options.chunk_roots.empty() && !one_chunk ? nodes_per_root(h, root_of) : std::vector<uint64_t>();
+    const std::vector<RootRange> chunks = !options.chunk_roots.empty() ? explicit_chunks(options.chunk_roots, h.root_count())
+                                          : one_chunk ? std::vector<RootRange>{RootRange{0, h.root_count()}}
+                                                      : balanced_chunks(root_nodes, chunk_count_for(options, faces));
     const bool want_hierarchy_stats = stats_out != nullptr;
     ForestCode forest = code_forest(h, root_of, chunks, faces, options, space, positions, threads, want_hierarchy_stats);
     const uint32_t fewer = automatic && forest.chunked ? chunk_count_for_size(options, uint32_t(chunks.size()), forest.bytes)

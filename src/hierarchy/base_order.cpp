@@ -76,7 +76,10 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
         old_of.push_back(triangle_order[t]);
         turn.push_back(rotation[t]);
     }
+    // Each pass reads the old nodes in the replay's order, which jumps about h: fetched kAhead early.
+    constexpr size_t kAhead = 16;
     for (size_t j = 0; j < old_of.size(); ++j) {
+        if (j + kAhead < old_of.size()) prefetch(h, old_of[j + kAhead]);
         const NodeId o = old_of[j];
         new_of[o] = NodeId(j);
         if (h.is_leaf(o)) {
@@ -98,6 +101,7 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
     std::vector<uint64_t> first_vertex(ranges + 1, 0);
     parallel_for(ranges, threads, [&](size_t i) {
         for (size_t j = i * kRange; j < std::min(n, (i + 1) * kRange); ++j) {
+            if (j + kAhead < n) prefetch(h, old_of[j + kAhead]);
             if (first_child[j] == kNoNode) continue;
             for (int e = 0; e < 3; ++e) {
                 const NodeId q = h.neighbor(old_of[j], kEdgeMod3[e + turn[j]]);
@@ -120,6 +124,7 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
     parallel_for(ranges, threads, [&](size_t i) {
         VertexId next = VertexId(first_vertex[i]);
         for (size_t j = i * kRange; j < std::min(n, (i + 1) * kRange); ++j) {
+            if (j + kAhead < n && creates[j + kAhead] != 0) prefetch(h, old_of[j + kAhead]);
             if (first_child[j] == kNoNode) continue;
             for (int e = 0; e < 3; ++e) {
                 if (!((creates[j] >> e) & 1)) continue;
@@ -133,6 +138,7 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
     out.block_parent_.assign((n - roots) / 4, kNoNode);
     parallel_for(ranges, threads, [&](size_t i) {
         for (size_t j = i * kRange; j < std::min(n, (i + 1) * kRange); ++j) {
+            if (j + kAhead < n) prefetch(h, old_of[j + kAhead]);
             const NodeId o = old_of[j];
             const int r = turn[j];
             Hierarchy::Node& node = out.nodes_[j];

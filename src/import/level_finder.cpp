@@ -18,6 +18,8 @@ constexpr uint32_t kRepairableShare = 16;
 constexpr uint32_t kJudgedAfter = 512;
 // Settled blocks before an exploring growth is judged by its seed block.
 constexpr uint32_t kSeedJudgedAfter = 128;
+// Blocks of the patches the last sweep looks for (commit_small_patches).
+constexpr uint32_t kSmallPatch = 16;
 
 }  // namespace
 
@@ -28,14 +30,26 @@ size_t LevelFinder::commit(const std::vector<uint8_t>* active) {
         if (!active || (*active)[t]) seeds.push_back(t);
     }
     if (active) seeds = free_near(std::move(seeds), 2);
+    const std::vector<uint32_t> region = seeds;
     for (int round = 0; round < 4 && !seeds.empty(); ++round) {
         const size_t before = patches_.size();
         if (commit_best_first(seeds) == 0) break;
         // The next round seeds only near what this one committed.
         seeds = free_triangles_near(before);
     }
+    commit_small_patches(region);
     improve_patches(first);
     return patches_.size();
+}
+
+void LevelFinder::commit_small_patches(const std::vector<uint32_t>& region) {
+    std::vector<uint32_t> seeds;
+    for (uint32_t t : region) {
+        if (!taken(t)) seeds.push_back(t);
+    }
+    growth_limit_ = kSmallPatch;
+    commit_best_first(seeds);
+    growth_limit_ = kNoIndex;
 }
 
 uint32_t LevelFinder::removed_by(size_t id) const {
@@ -218,6 +232,7 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
 }
 
 bool LevelFinder::hopeless(uint32_t start, uint32_t settled, uint32_t settled_invalid, bool exploring) const {
+    if (blocks_.size() - start > growth_limit_) return true;
     const uint32_t count = settled - start;
     if (count >= kJudgedAfter && settled_invalid * kRepairableShare > count) return true;
     // An invalid seed block: this seed misreads a patch that seeds inside it read right.

@@ -209,7 +209,8 @@ private:
     // Whether a growth from blocks_[start] is sure enough to fail that growing it further is
     // wasted: of its `settled` blocks (the first half of those placed, whose sides the breadth-
     // first front has passed, so they rarely read differently later), too many are invalid, or,
-    // exploring, the seed block itself is. docs/IMPORT.md, "Hopeless growths given up".
+    // exploring, the seed block itself is; or it has more blocks than growth_limit_.
+    // docs/IMPORT.md, "Hopeless growths given up".
     bool hopeless(uint32_t start, uint32_t settled, uint32_t settled_invalid, bool exploring) const;
 
     // Marks the centers of the growth from blocks_[start] as explored under `preference`.
@@ -223,6 +224,12 @@ private:
     // Grows a patch from every seed not reached by an earlier one, then commits them best first;
     // a patch that earlier commits changed goes back into the queue with its new count.
     uint32_t commit_best_first(const std::vector<uint32_t>& seeds);
+
+    // Seeds every free triangle of `region` (where this step sought patches) once more, for
+    // patches of at most kSmallPatch blocks: a growth that failed marks the centers it passed as
+    // explored, so a small true patch that a wrong reading reached (and failed with) may never
+    // have seeded itself. docs/IMPORT.md, "Small patches sought again".
+    void commit_small_patches(const std::vector<uint32_t>& region);
 
     // The triangles within two edge-rings of the blocks of patches [first, end) that no block or
     // closure has taken.
@@ -257,6 +264,7 @@ private:
     std::vector<uint8_t> deferred_;        // per triangle: center of a valid patch left for later
     std::vector<Block> blocks_;
     std::vector<Patch> patches_;
+    uint32_t growth_limit_ = kNoIndex;      // blocks: a growth larger than this is given up
 };
 
 }  // namespace amc::detail::inverse

@@ -3,6 +3,7 @@
 // cell where the mesh is fine and many empty cells where it is coarse).
 #pragma once
 
+#include "common/exact_float.h"
 #include "common/no_index.h"
 
 #include <amc/mesh.h>
@@ -69,7 +70,7 @@ private:
             for (uint32_t i = lo; i < hi; ++i) {
                 const Point& q = points_[i];
                 const double dx = q.x[0] - p.x, dy = q.x[1] - p.y, dz = q.x[2] - p.z;
-                const double distance = dx * dx + dy * dy + dz * dz;
+                const double distance = exact_dot({dx, dy, dz}, {dx, dy, dz});  // the same pick in every build
                 if (best.improves(distance) && usable(q.vertex)) best.insert(q.vertex, distance);
             }
             return;

@@ -3,6 +3,7 @@
 #include "octree/octree_levels.h"
 
 #include "common/check.h"
+#include "common/exact_float.h"
 #include "octree/octree_leaf_data.h"
 
 #include <algorithm>
@@ -112,8 +113,8 @@ Vec3 tree_point(const TreeConnectivity& conn, uint32_t tree, double u, double v,
     const int corners = 1 << conn.dim;
     Vec3 p;
     for (int c = 0; c < corners; ++c) {
-        const double weight = ((c & 1) ? u : 1 - u) * ((c & 2) ? v : 1 - v) * (conn.dim == 3 ? ((c & 4) ? w : 1 - w) : 1.0);
-        p = p + weight * conn.vertices[conn.tree_to_vertex[size_t(tree) * corners + c]];
+        const double weight = rounded(rounded(((c & 1) ? u : 1 - u) * ((c & 2) ? v : 1 - v)) * (conn.dim == 3 ? ((c & 4) ? w : 1 - w) : 1.0));
+        p = p + rounded_scaled(weight, conn.vertices[conn.tree_to_vertex[size_t(tree) * corners + c]]);
     }
     return p;
 }
@@ -125,8 +126,8 @@ int octant_corners(const TreeConnectivity& conn, uint32_t tree, const Octant& o,
     const int d = conn.dim, root = octree_root_log2(d);
     const double scale = std::ldexp(1.0, -root), len = std::ldexp(1.0, -o.level);
     for (int c = 0; c < (1 << d); ++c)
-        out[c] = tree_point(conn, tree, o.x * scale + ((c & 1) ? len : 0), o.y * scale + ((c & 2) ? len : 0),
-                            o.z * scale + ((c & 4) ? len : 0));
+        out[c] = tree_point(conn, tree, rounded(o.x * scale) + ((c & 1) ? len : 0), rounded(o.y * scale) + ((c & 2) ? len : 0),
+                            rounded(o.z * scale) + ((c & 4) ? len : 0));
     return 1 << d;
 }
 
@@ -148,8 +149,8 @@ OctreeForest sphere_octree_forest(const TreeConnectivity& conn, Vec3 center, dou
                                     const Vec3 far{std::abs(center.x - lo.x) > std::abs(center.x - hi.x) ? lo.x : hi.x,
                                                    std::abs(center.y - lo.y) > std::abs(center.y - hi.y) ? lo.y : hi.y,
                                                    std::abs(center.z - lo.z) > std::abs(center.z - hi.z) ? lo.z : hi.z};
-                                    const double dn = std::sqrt(dot(near - center, near - center));
-                                    const double df = std::sqrt(dot(far - center, far - center));
+                                    const double dn = std::sqrt(exact_dot(near - center, near - center));
+                                    const double df = std::sqrt(exact_dot(far - center, far - center));
                                     return dn <= radius && radius <= df;
                                 },
                                 max_level);
@@ -161,10 +162,10 @@ OctreeForest front_octree_forest(const TreeConnectivity& conn, double t, int max
                                     Vec3 p[8];
                                     const int n = octant_corners(conn, tree, o, p);
                                     Vec3 mid;
-                                    for (int i = 0; i < n; ++i) mid = mid + (1.0 / n) * p[i];
+                                    for (int i = 0; i < n; ++i) mid = mid + rounded_scaled(1.0 / n, p[i]);
                                     const Vec3 diag = p[n - 1] - p[0];
-                                    const double size = std::sqrt(dot(diag, diag));
-                                    const double phi = mid.x + 0.3 * std::sin(4 * mid.y) + 0.2 * std::cos(3 * mid.z) - t;
+                                    const double size = std::sqrt(exact_dot(diag, diag));
+                                    const double phi = mid.x + rounded(0.3 * std::sin(4 * mid.y)) + rounded(0.2 * std::cos(3 * mid.z)) - t;
                                     // A band of about two octants at every level: graded towards the front.
                                     return std::abs(phi) < 1.2 * size;
                                 },

@@ -3,6 +3,7 @@
 #include "series/frame_connectivity.h"
 
 #include "common/check.h"
+#include "common/exact_float.h"
 
 #include <algorithm>
 #include <cmath>
@@ -287,7 +288,7 @@ int32_t indicator_level(double q) {
 Indicator indicator_levels(const Hierarchy& prev, const std::vector<uint32_t>& first_cell,
                            const std::vector<double>& values) {
     double mean = 0;
-    for (double x : values) mean += x * x;
+    for (double x : values) mean += rounded(x * x);  // both sides take the indicator's levels from it
     mean /= double(std::max<size_t>(values.size(), 1));
     std::vector<double> largest(prev.node_capacity(), -1.0);
     for (NodeId n : prev.breadth_first_order()) {

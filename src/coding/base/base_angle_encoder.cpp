@@ -1,6 +1,7 @@
 // Encoder of mode 2, the angle-guided cut-border coder (FORMAT.md 4.10-4.16; base_angle_coder.h).
 // It runs the decoder's border and models (base_angle_border.h) on the closed mesh, reads each op
-// off the mesh and codes it at once; once per context set, keeping the shortest stream.
+// off the mesh and codes it at once, in every context set (the conquest does not depend on the
+// set), keeping the shortest stream.
 #include "coding/base/base_angle_border.h"
 #include "coding/base/base_angle_coder.h"
 #include "coding/base/base_mesh_closing.h"
@@ -20,44 +21,55 @@ namespace {
 
 class Encoder {
 public:
-    Encoder(const TriangleMesh& mesh, const ClosedMesh& cm, int set, uint32_t gate_radius, uint32_t first,
-            uint32_t rotation)
-        : mesh_(mesh), cm_(cm), set_(set), first_(first), rotation_(rotation), models_(set) {
+    Encoder(const TriangleMesh& mesh, const ClosedMesh& cm, uint32_t gate_radius, uint32_t first, uint32_t rotation)
+        : mesh_(mesh), cm_(cm), first_(first), rotation_(rotation) {
         border_.gate_radius = gate_radius;
+        for (int set = 0; set < angle_mode::kContextSets; ++set) streams_.emplace_back(set);
     }
 
-    std::vector<uint8_t> run(BaseMeshCode& code) {
+    // The stream of each context set, in set order.
+    std::vector<std::vector<uint8_t>> run(BaseMeshCode& code) {
         count_vertices();
         count_components_and_merges();
-        enc_.encode_bits_raw(uint32_t(BaseConnectivityMode::angle), 2);
-        enc_.encode_bits_raw(static_cast<uint32_t>(set_), 2);
-        enc_.encode_bits_raw(border_.gate_radius, 3);
         const uint32_t isolated = static_cast<uint32_t>(mesh_.positions.size()) - used_;
         const bool plain = isolated == 0 && cm_.dummies == 0 && copies_ == 0 && components_ == 1 && merges_ == 0;
-        enc_.encode_bits_raw(plain ? 1 : 0, 1);
-        if (!plain) {
-            put_count(enc_, isolated);
-            put_count(enc_, cm_.dummies);
-            put_count(enc_, copies_);
-            put_count(enc_, components_);
-            put_count(enc_, merges_);
+        for (SetStream& s : streams_) {
+            s.enc.encode_bits_raw(uint32_t(BaseConnectivityMode::angle), 2);
+            s.enc.encode_bits_raw(static_cast<uint32_t>(s.set), 2);
+            s.enc.encode_bits_raw(border_.gate_radius, 3);
+            s.enc.encode_bits_raw(plain ? 1 : 0, 1);
+            if (!plain) {
+                put_count(s.enc, isolated);
+                put_count(s.enc, cm_.dummies);
+                put_count(s.enc, copies_);
+                put_count(s.enc, components_);
+                put_count(s.enc, merges_);
+            }
         }
         traverse();
         if (triangles_.size() != cm_.triangles.size() || cm_of_.size() != cm_.original.size() ||
             merges_seen_ != merges_)
             throw EncoderGaveUp{};
         fill_orders(code);
-        return enc_.finish();
+        std::vector<std::vector<uint8_t>> out;
+        for (SetStream& s : streams_) out.push_back(s.enc.finish());
+        return out;
     }
 
 private:
+    // The coder of one context set.
+    struct SetStream {
+        explicit SetStream(int s) : set(s), models(s) {}
+        int set;
+        Models models;
+        ArithmeticEncoder enc;
+    };
+
     const TriangleMesh& mesh_;
     const ClosedMesh& cm_;
-    const int set_;
     const uint32_t first_, rotation_;  // the first component's start triangle and its first corner
     uint32_t used_ = 0, copies_ = 0, components_ = 0, merges_ = 0, merges_seen_ = 0;
-    ArithmeticEncoder enc_;
-    Models models_;
+    std::vector<SetStream> streams_;
     Border border_;
     // Closed vertices: decoder numbering (creation order) and the closed mesh's.
     std::vector<uint32_t> decoder_id_, cm_of_;
@@ -111,7 +123,14 @@ private:
         merges_ = static_cast<uint32_t>(four_m / 4);
     }
 
-    void put_bit(BitModel& model, bool bit) { enc_.encode(bit, model); }
+    // A bit in every set's stream, with the model `model_of` picks from that set's models.
+    template <class ModelOf>
+    void put_bit(bool bit, ModelOf model_of) {
+        for (SetStream& s : streams_) s.enc.encode(bit, model_of(s.set, s.models));
+    }
+    void put_index_all(uint32_t value, uint32_t range) {
+        for (SetStream& s : streams_) put_index(s.enc, value, range);
+    }
     void charge_walk(uint64_t nodes) {
         walked_ += nodes;
         if (walked_ > angle_mode::walk_budget(cm_.triangles.size())) throw EncoderGaveUp{};
@@ -142,12 +161,12 @@ private:
         const uint32_t original = cm_.original[x];
         const bool dummy = original == kNoVertex;
         if (dummy && !may_be_dummy) throw EncoderGaveUp{};
-        if (may_be_dummy && cm_.dummies > 0) put_bit(models_.dummy, dummy);
+        if (may_be_dummy && cm_.dummies > 0) put_bit(dummy, [](int, Models& m) -> BitModel& { return m.dummy; });
         if (!dummy) {
             const uint32_t target = final_of_original_[original];
             if (copies_ > 0 && finals_ > 0) {
-                put_bit(models_.copy, target != kNoVertex);
-                if (target != kNoVertex) put_index(enc_, target, finals_);
+                put_bit(target != kNoVertex, [](int, Models& m) -> BitModel& { return m.copy; });
+                if (target != kNoVertex) put_index_all(target, finals_);
             } else if (target != kNoVertex) {
                 throw EncoderGaveUp{};
             }
@@ -258,7 +277,11 @@ private:
 
         const bool right = n == p;
         // A closed vertex has at least three triangles (else the decoder's rule fails: give up).
-        if (b.degree(u) >= 2) put_bit(models_.close_u[Models::closing_context(set_, b.corner(g), b.degree(u))], right);
+        if (b.degree(u) >= 2) {
+            const angle_mode::CornerClass corner = b.corner(g);
+            const uint32_t degree = b.degree(u);
+            put_bit(right, [&](int set, Models& m) -> BitModel& { return m.close_u[Models::closing_context(set, corner, degree)]; });
+        }
         else if (right) throw EncoderGaveUp{};
         if (right) {
             visit_triangle(he);
@@ -274,7 +297,11 @@ private:
         }
         if (loop.length > 3) {
             const bool left = n == b.next(nv);
-            if (b.degree(v) >= 2) put_bit(models_.close_v[Models::closing_context(set_, b.corner(nv), b.degree(v))], left);
+            if (b.degree(v) >= 2) {
+                const angle_mode::CornerClass corner = b.corner(nv);
+                const uint32_t degree = b.degree(v);
+                put_bit(left, [&](int set, Models& m) -> BitModel& { return m.close_v[Models::closing_context(set, corner, degree)]; });
+            }
             else if (left) throw EncoderGaveUp{};
             if (left) {
                 visit_triangle(he);
@@ -285,7 +312,10 @@ private:
             }
         }
         const bool can_split = loop.length >= 5, can_merge = b.stack.size() >= 2;
-        if (can_split || can_merge) put_bit(models_.new_vertex[set_ == 0 ? Models::new_vertex_context(b.corner(g)) : 0], is_new);
+        if (can_split || can_merge) {
+            const int context0 = Models::new_vertex_context(b.corner(g));
+            put_bit(is_new, [&](int set, Models& m) -> BitModel& { return m.new_vertex[set == 0 ? context0 : 0]; });
+        }
         else if (!is_new) throw EncoderGaveUp{};
         if (is_new) {
             const uint32_t w = create_vertex(w_closed, true, {int32_t(u), int32_t(v), int32_t(b.opp(g))});
@@ -302,7 +332,7 @@ private:
         const bool split = k < loop.length;
         if (split && (k < 2 || k + 3 > loop.length)) throw EncoderGaveUp{};
         if ((split && !can_split) || (!split && !can_merge)) throw EncoderGaveUp{};
-        if (can_split && can_merge) put_bit(models_.split, split);
+        if (can_split && can_merge) put_bit(split, [](int, Models& m) -> BitModel& { return m.split; });
         uint32_t nw;
         if (split) {
             encode_split_tip(g, nv, n, k, loop.length);
@@ -324,8 +354,8 @@ private:
             if (index == b.stack.size()) throw EncoderGaveUp{};
             ++merges_seen_;
             const uint32_t length = b.stack[index].length;
-            put_index(enc_, static_cast<uint32_t>(b.stack.size() - 2 - index), static_cast<uint32_t>(b.stack.size() - 1));
-            put_index(enc_, offset, length);
+            put_index_all(static_cast<uint32_t>(b.stack.size() - 2 - index), static_cast<uint32_t>(b.stack.size() - 1));
+            put_index_all(offset, length);
             charge_walk(std::min(offset, length - offset));
             visit_triangle(he);
             nw = b.op_merge(n, index);
@@ -340,10 +370,10 @@ private:
         const Border::NearestTip tip = border_.nearest_tip(g, nv, length);
         if (tip.predicted) charge_walk(length - 4);
         if (tip.node != angle_mode::kNoBorderNode) {
-            put_bit(models_.nearest, tip.node == n);
+            put_bit(tip.node == n, [](int, Models& m) -> BitModel& { return m.nearest; });
             if (tip.node == n) return;
         }
-        put_split_offset(enc_, models_.split_offset, k - 2, length - 4);
+        for (SetStream& s : streams_) put_split_offset(s.enc, s.models.split_offset, k - 2, length - 4);
         charge_walk(std::min(k + 1, length - k - 1));
     }
 
@@ -407,33 +437,38 @@ std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& c
     const ClosedMesh cm = make_closed(mesh);
     std::vector<Start> candidates = search_candidates(cm.real_triangles, cm.triangles.size(), search_budget);
     if (!search) candidates.resize(1);
-    // Every (start, context set) is coded on its own, on up to `threads` threads; the shortest
-    // wins, the earliest among equals, so the choice does not depend on the threads. Only the
-    // best so far is kept: holding every candidate's code cost 10 MiB on a base of 768 triangles.
+    // Every start is coded on its own, in every context set at once, on up to `threads` threads;
+    // the shortest (start, set) wins, the earliest among equals, so the choice does not depend on
+    // the threads. Only the best so far is kept: holding every candidate's code cost 10 MiB on a
+    // base of 768 triangles.
     struct Best {
         std::vector<uint8_t> bytes;
         BaseMeshCode code;
         size_t index = SIZE_MAX;
     } best;
     std::mutex best_mutex;
-    parallel_for(candidates.size() * angle_mode::kContextSets, threads, [&](size_t i) {
-        const Start& start = candidates[i / angle_mode::kContextSets];
-        const int set = int(i % angle_mode::kContextSets);
+    parallel_for(candidates.size(), threads, [&](size_t c) {
+        const Start& start = candidates[c];
         BaseMeshCode tried;
-        std::vector<uint8_t> bytes;
+        std::vector<std::vector<uint8_t>> streams;
         try {
-            Encoder e(mesh, cm, set, start.radius, start.first, start.rotation);
-            bytes = e.run(tried);
+            Encoder e(mesh, cm, start.radius, start.first, start.rotation);
+            streams = e.run(tried);
         } catch (const EncoderGaveUp&) {
             return;  // this start does not fit (a walk over the budget, say): the others may
         }
         const std::lock_guard<std::mutex> lock(best_mutex);
-        const bool shorter = best.index == SIZE_MAX || bytes.size() < best.bytes.size() ||
-                             (bytes.size() == best.bytes.size() && i < best.index);
-        if (!shorter) return;
-        best.bytes = std::move(bytes);
-        best.code = std::move(tried);
-        best.index = i;
+        bool won = false;
+        for (size_t set = 0; set < streams.size(); ++set) {
+            const size_t i = c * angle_mode::kContextSets + set;
+            const bool shorter = best.index == SIZE_MAX || streams[set].size() < best.bytes.size() ||
+                                 (streams[set].size() == best.bytes.size() && i < best.index);
+            if (!shorter) continue;
+            best.bytes = std::move(streams[set]);
+            best.index = i;
+            won = true;
+        }
+        if (won) best.code = std::move(tried);  // the same orders in every set
     });
     if (best.index == SIZE_MAX) throw EncoderGaveUp{};
     code.vertex_order = std::move(best.code.vertex_order);

@@ -245,8 +245,8 @@ double quantization_error_bound(const Quantizer& quantizer) {
     // largest magnitude involved.
     const Vec3 o = quantizer.origin;
     const double magnitude = std::fmax(std::fabs(o.x), std::fmax(std::fabs(o.y), std::fabs(o.z))) +
-                             static_cast<double>(quantizer.max_coordinate() + 1.0) * quantizer.step;
-    return 0.5 * quantizer.step + 4.0 * DBL_EPSILON * magnitude;
+                             rounded(static_cast<double>(quantizer.max_coordinate() + 1.0) * quantizer.step);
+    return rounded(0.5 * quantizer.step) + rounded(4.0 * DBL_EPSILON * magnitude);
 }
 
 double max_quantization_error(const Quantizer& quantizer, const std::vector<Vec3>& points) {

@@ -222,6 +222,120 @@ bool get_table(ArithmeticDecoder& decoder, TableModels& models, int limit, RansT
     return table.assign(frequencies);
 }
 
+// ---- chunks of vertices: corners, frames --------------------------------------------------------
+
+// Both sides work in chunks of vertices: first the nodes' corners of a whole chunk, in a short
+// loop whose iterations the processor runs many at once, and prefetches of their positions; then
+// the chunk's frames (and in mode 4 role 0's grid prediction), which depend only on earlier levels'
+// positions, not on the streams; then the chunk's coordinates, from the streams or into tokens.
+// Frame by frame, each vertex waited for its cache misses, then the decoder's chain of dependent
+// values waited for the frame's square roots and divisions.
+constexpr size_t kChunk = 64;  // even: each chunk starts with rANS state 0
+
+// A vertex's frame in role order (role r is axis axes[r]), with the quantizer's origin on those
+// axes: the coordinate loop indexes nothing by axis but the vertex it writes.
+struct RoleFrame {
+    double midpoint[3], normal[3], origin[3];
+    int axes[3];
+    bool has_normal;
+};
+
+struct Chunk {
+    size_t begin = 0, count = 0;
+    const FrameCorners* corners = nullptr;  // the chunk's: `own`, or the source's list itself
+    std::array<FrameCorners, kChunk> own;
+    std::array<VertexId, kChunk> vertices;
+    std::array<RoleFrame, kChunk> frames;
+    std::array<GridPrediction, kChunk> first;  // mode 4: role 0's
+};
+
+// Where the vertices and their frame corners come from: (node, edge) pairs, read in the hierarchy,
+// or split_level's list (vertices first, first + 1, ...).
+// get(c) sets the corners and vertices of chunk c's c.count vertices from c.begin.
+struct FromNodes {
+    const Hierarchy& h;
+    const std::vector<std::pair<NodeId, int>>& created;
+    size_t size() const { return created.size(); }
+    void get(Chunk& c) const {
+        for (size_t i = 0; i < c.count; ++i) {
+            const auto [n, e] = created[c.begin + i];
+            c.own[i] = frame_corners(h, n, e);
+            c.vertices[i] = h.midpoint(n, e);
+        }
+        c.corners = c.own.data();
+    }
+};
+struct FromList {
+    const FrameCorners* corners;
+    size_t count;
+    VertexId first;
+    size_t size() const { return count; }
+    void get(Chunk& c) const {
+        c.corners = corners + c.begin;  // read where they are: no copy
+        for (size_t i = 0; i < c.count; ++i) c.vertices[i] = first + VertexId(c.begin + i);
+    }
+};
+
+// Chunk c: vertices begin .. end - 1 of `source`, at most kChunk.
+template <class Source>
+void gather_chunk(const Hierarchy& h, const Source& source, size_t begin, size_t end, Chunk& c) {
+    c.begin = begin;
+    c.count = begin < end ? std::min(kChunk, end - begin) : 0;
+    source.get(c);
+    for (size_t i = 0; i < c.count; ++i)
+        for (VertexId v : {c.corners[i].a, c.corners[i].b, c.corners[i].c, c.corners[i].d})
+            if (v != kNoVertex) __builtin_prefetch(&h.positions()[v]);
+}
+
+// Vertex i's frame in role order.
+template <bool Grid>
+AMC_ALWAYS_INLINE void role_frame(const NormalFrame& frame, const Quantizer* quantizer, Chunk& c, size_t i) {
+    const std::array<int, 3> axes = role_axes(frame);
+    RoleFrame& f = c.frames[i];
+    // Indexed by axis, without axis_coordinate's selects.
+    const double midpoint[3] = {frame.midpoint.x, frame.midpoint.y, frame.midpoint.z};
+    const double normal[3] = {frame.normal.x, frame.normal.y, frame.normal.z};
+    const double origin[3] = {quantizer != nullptr ? quantizer->origin.x : 0.0, quantizer != nullptr ? quantizer->origin.y : 0.0,
+                              quantizer != nullptr ? quantizer->origin.z : 0.0};
+    for (int r = 0; r < 3; ++r) {
+        f.axes[r] = axes[size_t(r)];
+        f.midpoint[r] = midpoint[axes[size_t(r)]];
+        f.normal[r] = normal[axes[size_t(r)]];
+        f.origin[r] = origin[axes[size_t(r)]];
+    }
+    f.has_normal = frame.has_normal;
+    if (Grid) c.first[i] = grid_prediction_at(*quantizer, f.origin[0], f.midpoint[0]);
+}
+
+// The chunk's frames in role order, two at a time where SSE2 computes two frames at once.
+template <bool Grid, bool UnitNormals>
+AMC_ALWAYS_INLINE void frame_chunk(const Hierarchy& h, const Quantizer* quantizer, Chunk& c) {
+    size_t i = 0;
+#if AMC_SSE2
+    if (!h.single_precision()) {
+        for (; i + 1 < c.count; i += 2) {
+            NormalFrame f0, f1;
+            frame_pair_of<UnitNormals>(h, c.corners[i], c.corners[i + 1], f0, f1);
+            role_frame<Grid>(f0, quantizer, c, i);
+            role_frame<Grid>(f1, quantizer, c, i + 1);
+        }
+    }
+#endif
+    for (; i < c.count; ++i) role_frame<Grid>(frame_of<UnitNormals>(h, c.corners[i]), quantizer, c, i);
+}
+
+// NormalFrame::predict in role order: roles 1 and 2's predictions once role 0's value is known.
+AMC_ALWAYS_INLINE void predict_others(const RoleFrame& f, double first_value, double& second, double& third) {
+    if (!f.has_normal) {
+        second = f.midpoint[1];
+        third = f.midpoint[2];
+        return;
+    }
+    const double t = rounded((first_value - f.midpoint[0]) / f.normal[0]);
+    second = f.midpoint[1] + rounded(t * f.normal[1]);
+    third = f.midpoint[2] + rounded(t * f.normal[2]);
+}
+
 }  // namespace
 
 int static_token(bool negative, uint64_t magnitude) {
@@ -267,35 +381,43 @@ void StaticLevelEncoder::add(const Hierarchy& h, const std::vector<std::pair<Nod
 }
 
 // The loop of add() for one mode: the frame's kind and the table split known when it is compiled.
+// A chunk's corners and frames as the decoder makes them (gather_chunk, frame_chunk), then each
+// vertex's residuals in role order.
 template <bool UnitNormals, bool GridBins>
 void StaticLevelEncoder::add_vertices(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin,
                                       size_t end) {
     const CoordinateSpace space = space_;
+    const Quantizer* quantizer = space.quantizer;
     uint64_t raw_bits = 0;
-    for (size_t i = begin; i < end; ++i) {
-        const auto [n, e] = created[i];
-        const NormalFrame frame = frame_of<UnitNormals>(h, frame_corners(h, n, e));
-        const std::array<int, 3> axes = role_axes(frame);
-        const Vec3 actual = h.position(h.midpoint(n, e));
-        const Vec3 others = frame.predict(axis_coordinate(actual, axes[0]));
-        std::array<uint16_t, kStaticRoles>& symbols = symbols_[i];
-        for (int role = 0; role < kStaticRoles; ++role) {
-            const int axis = axes[size_t(role)];
-            const double predicted = role == 0 ? axis_coordinate(frame.midpoint, axis) : axis_coordinate(others, axis);
-            Residual r;
-            int table = role;
-            if (GridBins) {
-                const GridPrediction g = grid_prediction(*space.quantizer, axis, predicted);
-                r = grid_residual(*space.quantizer, axis, axis_coordinate(actual, axis), g);
-                table = kGridBins * role + g.bin;
-            } else {
-                r = residual_of(space, axis, axis_coordinate(actual, axis), predicted);
+    Chunk c;
+    for (size_t first = begin; first < end; first += kChunk) {
+        gather_chunk(h, FromNodes{h, created}, first, end, c);
+        for (size_t i = 0; i < c.count; ++i) __builtin_prefetch(&h.positions()[c.vertices[i]]);
+        frame_chunk<GridBins, UnitNormals>(h, quantizer, c);
+        for (size_t i = 0; i < c.count; ++i) {
+            const RoleFrame& f = c.frames[i];
+            const Vec3 p = h.position(c.vertices[i]);
+            const double actual[3] = {p.x, p.y, p.z};
+            double predicted[3] = {f.midpoint[0], 0, 0};
+            predict_others(f, actual[f.axes[0]], predicted[1], predicted[2]);
+            std::array<uint16_t, kStaticRoles>& symbols = symbols_[first + i];
+            for (int role = 0; role < kStaticRoles; ++role) {
+                const int axis = f.axes[role];
+                Residual r;
+                int table = role;
+                if (GridBins) {
+                    const GridPrediction g = role == 0 ? c.first[i] : grid_prediction_at(*quantizer, f.origin[role], predicted[role]);
+                    r = grid_residual(*quantizer, axis, actual[axis], g);
+                    table = kGridBins * role + g.bin;
+                } else {
+                    r = residual_of(space, axis, actual[axis], predicted[role]);
+                }
+                const int token = static_token(r.negative, r.magnitude);
+                if (token >= kDirectTokens) large_.push_back(r);
+                symbols[size_t(role)] = uint16_t(table << kTokenBits | token);
+                raw_bits += uint64_t(static_raw_bit_count(r.magnitude));
+                ++counts_[size_t(table)][size_t(token)];
             }
-            const int token = static_token(r.negative, r.magnitude);
-            if (token >= kDirectTokens) large_.push_back(r);
-            symbols[size_t(role)] = uint16_t(table << kTokenBits | token);
-            raw_bits += uint64_t(static_raw_bit_count(r.magnitude));
-            ++counts_[size_t(table)][size_t(token)];
         }
     }
     raw_bits_ += raw_bits;
@@ -364,7 +486,7 @@ size_t StaticLevelEncoder::estimated_bytes() const {
 size_t StaticLevelEncoder::lower_bound_bytes() const {
     ArithmeticEncoder tables;
     write_tables(tables);
-    const double rans_bits = token_bits_ - 16 - 0.001 * double(token_count_);
+    const double rans_bits = token_bits_ - 16 - rounded(0.001 * double(token_count_));
     const size_t rans = kRansStateBytes + (rans_bits > 0 ? size_t(rans_bits / 8.01) : 0);
     return tables.finish().size() + 1 + rans + size_t(raw_bits_ / 8);
 }
@@ -378,117 +500,6 @@ bool read_static_tables(ArithmeticDecoder& decoder, CoordinateSpace space, Geome
 }
 
 namespace {
-
-// The decoder works in chunks of vertices: first the nodes' corners of a whole chunk, in a short
-// loop whose iterations the processor runs many at once, and prefetches of their positions; then
-// the chunk's frames (and in mode 4 role 0's grid prediction), which depend only on earlier levels'
-// positions, not on the streams; then the chunk's coordinates from the streams. Frame by frame,
-// each vertex waited for its cache misses, then the streams' chain of dependent values waited for
-// the frame's square roots and divisions.
-constexpr size_t kChunk = 64;  // even: each chunk starts with rANS state 0
-
-// A vertex's frame in role order (role r is axis axes[r]), with the quantizer's origin on those
-// axes: the coordinate loop indexes nothing by axis but the vertex it writes.
-struct RoleFrame {
-    double midpoint[3], normal[3], origin[3];
-    int axes[3];
-    bool has_normal;
-};
-
-struct Chunk {
-    size_t begin = 0, count = 0;
-    const FrameCorners* corners = nullptr;  // the chunk's: `own`, or the source's list itself
-    std::array<FrameCorners, kChunk> own;
-    std::array<VertexId, kChunk> vertices;
-    std::array<RoleFrame, kChunk> frames;
-    std::array<GridPrediction, kChunk> first;  // mode 4: role 0's
-};
-
-// Where the vertices and their frame corners come from: (node, edge) pairs, read in the hierarchy,
-// or split_level's list (vertices first, first + 1, ...).
-// get(c) sets the corners and vertices of chunk c's c.count vertices from c.begin.
-struct FromNodes {
-    const Hierarchy& h;
-    const std::vector<std::pair<NodeId, int>>& created;
-    size_t size() const { return created.size(); }
-    void get(Chunk& c) const {
-        for (size_t i = 0; i < c.count; ++i) {
-            const auto [n, e] = created[c.begin + i];
-            c.own[i] = frame_corners(h, n, e);
-            c.vertices[i] = h.midpoint(n, e);
-        }
-        c.corners = c.own.data();
-    }
-};
-struct FromList {
-    const FrameCorners* corners;
-    size_t count;
-    VertexId first;
-    size_t size() const { return count; }
-    void get(Chunk& c) const {
-        c.corners = corners + c.begin;  // read where they are: no copy
-        for (size_t i = 0; i < c.count; ++i) c.vertices[i] = first + VertexId(c.begin + i);
-    }
-};
-
-template <class Source>
-void gather_chunk(const Hierarchy& h, const Source& source, size_t begin, Chunk& c) {
-    c.begin = begin;
-    c.count = begin < source.size() ? std::min(kChunk, source.size() - begin) : 0;
-    source.get(c);
-    for (size_t i = 0; i < c.count; ++i)
-        for (VertexId v : {c.corners[i].a, c.corners[i].b, c.corners[i].c, c.corners[i].d})
-            if (v != kNoVertex) __builtin_prefetch(&h.positions()[v]);
-}
-
-// Vertex i's frame in role order.
-template <bool Grid>
-AMC_ALWAYS_INLINE void role_frame(const NormalFrame& frame, const Quantizer* quantizer, Chunk& c, size_t i) {
-    const std::array<int, 3> axes = role_axes(frame);
-    RoleFrame& f = c.frames[i];
-    // Indexed by axis, without axis_coordinate's selects.
-    const double midpoint[3] = {frame.midpoint.x, frame.midpoint.y, frame.midpoint.z};
-    const double normal[3] = {frame.normal.x, frame.normal.y, frame.normal.z};
-    const double origin[3] = {quantizer != nullptr ? quantizer->origin.x : 0.0, quantizer != nullptr ? quantizer->origin.y : 0.0,
-                              quantizer != nullptr ? quantizer->origin.z : 0.0};
-    for (int r = 0; r < 3; ++r) {
-        f.axes[r] = axes[size_t(r)];
-        f.midpoint[r] = midpoint[axes[size_t(r)]];
-        f.normal[r] = normal[axes[size_t(r)]];
-        f.origin[r] = origin[axes[size_t(r)]];
-    }
-    f.has_normal = frame.has_normal;
-    if (Grid) c.first[i] = grid_prediction_at(*quantizer, f.origin[0], f.midpoint[0]);
-}
-
-// The chunk's frames in role order, two at a time where SSE2 computes two frames at once.
-template <bool Grid, bool UnitNormals>
-AMC_ALWAYS_INLINE void frame_chunk(const Hierarchy& h, const Quantizer* quantizer, Chunk& c) {
-    size_t i = 0;
-#if AMC_SSE2
-    if (!h.single_precision()) {
-        for (; i + 1 < c.count; i += 2) {
-            NormalFrame f0, f1;
-            frame_pair_of<UnitNormals>(h, c.corners[i], c.corners[i + 1], f0, f1);
-            role_frame<Grid>(f0, quantizer, c, i);
-            role_frame<Grid>(f1, quantizer, c, i + 1);
-        }
-    }
-#endif
-    for (; i < c.count; ++i) role_frame<Grid>(frame_of<UnitNormals>(h, c.corners[i]), quantizer, c, i);
-}
-
-// NormalFrame::predict in role order: roles 1 and 2's predictions once role 0's value is known.
-AMC_ALWAYS_INLINE void predict_others(const RoleFrame& f, double first_value, double& second, double& third) {
-    if (!f.has_normal) {
-        second = f.midpoint[1];
-        third = f.midpoint[2];
-        return;
-    }
-    const double t = rounded((first_value - f.midpoint[0]) / f.normal[0]);
-    second = f.midpoint[1] + rounded(t * f.normal[1]);
-    third = f.midpoint[2] + rounded(t * f.normal[2]);
-}
 
 // One vertex's three coordinates; its first token is coded with rANS state `State` (token j of the
 // level with state j mod 2), its second with the other, its third with `State` again.
@@ -538,7 +549,7 @@ bool decode_positions(Hierarchy& h, const Source& created, CoordinateSpace space
     const Quantizer* quantizer = space.quantizer;
     Chunk c;
     for (size_t begin = 0; begin < created.size(); begin += kChunk) {
-        gather_chunk(h, created, begin, c);
+        gather_chunk(h, created, begin, created.size(), c);
         frame_chunk<Grid, UnitNormals>(h, quantizer, c);
         for (size_t i = 0; i < c.count; i += 2) {
             Vec3 p;

@@ -50,7 +50,7 @@ int quarter_octave_bin(double x, int offset, int top) {
 double relative_displacement2(const Hierarchy& h, NodeId p, int e) {
     const Vec3 a = h.position(h.vertex(p, e)), b = h.position(h.vertex(p, (e + 1) % 3));
     const Vec3 m = h.position(h.midpoint(p, e));
-    const Vec3 middle{rounded(a.x + b.x) * 0.5, rounded(a.y + b.y) * 0.5, rounded(a.z + b.z) * 0.5};
+    const Vec3 middle{rounded(rounded(a.x + b.x) * 0.5), rounded(rounded(a.y + b.y) * 0.5), rounded(rounded(a.z + b.z) * 0.5)};
     const double l2 = exact_dot(b - a, b - a);
     return l2 > 0 ? exact_dot(m - middle, m - middle) / l2 : 0;
 }
