@@ -18,6 +18,8 @@ constexpr uint32_t kRepairableShare = 16;
 constexpr uint32_t kJudgedAfter = 512;
 // Settled blocks before an exploring growth is judged by its seed block.
 constexpr uint32_t kSeedJudgedAfter = 128;
+// Blocks: smaller patches are taken or dropped whole (not repaired, their seed not questioned).
+constexpr uint32_t kRepairable = 16;
 // Blocks of the patches the last sweep looks for (commit_small_patches).
 constexpr uint32_t kSmallPatch = 16;
 
@@ -174,7 +176,6 @@ void LevelFinder::collect_suspects(const std::vector<uint32_t>& invalid, std::ve
 }
 
 uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool exploring, std::vector<uint32_t>* suspects) {
-    constexpr uint32_t kRepairable = 16;  // blocks: smaller patches are taken or dropped whole
     const uint32_t start = uint32_t(blocks_.size());
     if (!place_block(t)) return 0;
     uint32_t settled = start, settled_invalid = 0;
@@ -231,6 +232,26 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
     return removed;
 }
 
+std::pair<uint32_t, uint32_t> LevelFinder::without_glued_seed(uint32_t start, Preference preference, uint32_t removed) {
+    const uint32_t seed = blocks_[start].center;
+    for (uint32_t m : blocks_[start].m) {
+        if (midpoint_count_[m] > 1) return {seed, removed};  // joined by a midpoint: not glued
+    }
+    std::vector<uint32_t> rest;
+    for (uint32_t i = start + 1; i < blocks_.size(); ++i) rest.push_back(blocks_[i].center);
+    roll_back(start);
+    repair_banned_[seed] = 1;
+    const uint32_t without = grow_patch(rest.front(), preference);
+    repair_banned_[seed] = 0;
+    bool same = without > 0 && blocks_.size() - start == rest.size();
+    for (size_t k = 0; same && k < rest.size(); ++k) {
+        same = block_of_[rest[k]] != kNoIndex && blocks_[block_of_[rest[k]]].center == rest[k];
+    }
+    if (same) return {rest.front(), without};
+    roll_back(start);
+    return {seed, grow_patch(seed, preference)};
+}
+
 bool LevelFinder::hopeless(uint32_t start, uint32_t settled, uint32_t settled_invalid, bool exploring) const {
     if (blocks_.size() - start > growth_limit_) return true;
     const uint32_t count = settled - start;
@@ -275,6 +296,10 @@ uint32_t LevelFinder::commit_best_first(const std::vector<uint32_t>& seeds) {
         queue.pop_back();
         const uint32_t start = uint32_t(blocks_.size());
         c.removed = grow_patch(c.center, c.preference);
+        if (c.removed > 0 && blocks_.size() - start >= kRepairable) {
+            const auto [seed, removed] = without_glued_seed(start, c.preference, c.removed);
+            c = {removed, seed, c.preference};
+        }
         if (c.removed > 0 && (queue.empty() || !(c < queue.front()))) {
             patches_.push_back({start, uint32_t(blocks_.size())});
             hold(uint32_t(patches_.size() - 1), true);

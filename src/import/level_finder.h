@@ -221,6 +221,14 @@ private:
     // The best patch grown from t under either preference, or none; the patch is not kept.
     Candidate best_patch(uint32_t t, bool exploring);
 
+    // The patch grown from blocks_[start] (placed, removing `removed` vertices) without its seed
+    // when the seed is glued onto it: joined to the other blocks only through closures (no
+    // shared midpoint), and the others, grown again from the next block with the seed banned,
+    // are the same blocks and valid. A wrong seed read into a true patch that way makes it
+    // remove more vertices than the true patch, so best-first would commit it (docs/IMPORT.md,
+    // "Glued seeds left out"). Returns the seed and vertices removed of the patch left placed.
+    std::pair<uint32_t, uint32_t> without_glued_seed(uint32_t start, Preference preference, uint32_t removed);
+
     // Grows a patch from every seed not reached by an earlier one, then commits them best first;
     // a patch that earlier commits changed goes back into the queue with its new count.
     uint32_t commit_best_first(const std::vector<uint32_t>& seeds);
