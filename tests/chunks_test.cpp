@@ -292,6 +292,36 @@ TEST(Chunks, EveryTruncationAndCorruptionIsAnError) {
     EXPECT_LT(decoded, 3000);
 }
 
+// Chunk blocks are checked by the threads that decode them: a changed byte of one, anywhere
+// but its length, is still a checksum error naming the block, on one thread and on several.
+TEST(Chunks, ChangedChunkBlocksAreChecksumErrorsOnEveryThreadCount) {
+    const Hierarchy h = random_hierarchy(18, false);
+    const std::vector<uint8_t> bytes = encode(h, with_chunks(4));
+    BlockReader reader(bytes.data(), bytes.size());
+    Block block;
+    std::vector<Block> chunks;
+    while (reader.next(block))
+        if (block.type == BlockType::chunk) chunks.push_back(block);
+    ASSERT_EQ(chunks.size(), 4u);
+    for (const Block& chunk : chunks) {
+        const size_t end = chunk.offset + kBlockOverhead + chunk.size;
+        // The type, the first, a middle and the last payload byte, the checksum's last byte.
+        for (size_t at : {chunk.offset, chunk.offset + 5, chunk.offset + 5 + chunk.size / 2, end - 5, end - 1}) {
+            std::vector<uint8_t> changed = bytes;
+            changed[at] ^= 0x24;
+            for (unsigned threads : {1u, 2u, 3u}) {
+                DecodeOptions options;
+                options.threads = threads;
+                const DecodeResult r = try_decode(changed.data(), changed.size(), options);
+                EXPECT_EQ(r.code, ErrorCode::checksum) << "byte " << at << ", " << threads << " threads: " << r.error;
+                if (at != chunk.offset) {
+                    EXPECT_EQ(r.error, "checksum mismatch in the chunk block at byte " + std::to_string(chunk.offset));
+                }
+            }
+        }
+    }
+}
+
 // `bytes` (a chunked file of version 13) with its chunk table's own vertex counts changed: chunk
 // k's by delta[k].
 std::vector<uint8_t> with_vertex_counts(const std::vector<uint8_t>& bytes, const std::vector<int64_t>& delta) {

@@ -83,7 +83,18 @@ bool BlockReader::next_block_arrived() const {
     return size_ - pos_ >= kBlockOverhead && load_le32(data_ + pos_ + 1) <= size_ - pos_ - kBlockOverhead;
 }
 
-bool BlockReader::next(Block& block) {
+bool BlockReader::next(Block& block) { return read(block, true); }
+
+bool BlockReader::next_unchecked(Block& block) { return read(block, false); }
+
+void BlockReader::check_checksum(const Block& block) const {
+    const uint8_t* header = data_ + block.offset;
+    AMC_REQUIRE(XXH32(header, 5 + block.size, 0) == load_le32(header + 5 + block.size), checksum,
+                "checksum mismatch in the " + std::string(framing_->block_name(uint8_t(block.type))) + " block at byte " +
+                    std::to_string(block.offset));
+}
+
+bool BlockReader::read(Block& block, bool checked) {
     if (ended_) return false;
     AMC_REQUIRE(size_ - pos_ >= kBlockOverhead, truncated,
                 "file is truncated (block header at byte " + std::to_string(pos_) + ")");
@@ -92,12 +103,12 @@ bool BlockReader::next(Block& block) {
     AMC_REQUIRE(length <= size_ - pos_ - kBlockOverhead, truncated,
                 "file is truncated (" + std::string(framing_->block_name(type)) + " block at byte " +
                     std::to_string(pos_) + " announces " + std::to_string(length) + " bytes)");
-    const uint32_t stored = load_le32(data_ + pos_ + 5 + length);
-    AMC_REQUIRE(XXH32(data_ + pos_, 5 + size_t(length), 0) == stored, checksum,
-                "checksum mismatch in the " + std::string(framing_->block_name(type)) + " block at byte " +
-                    std::to_string(pos_));
-    AMC_REQUIRE(type <= framing_->last_block_type(version_), corrupt, "unknown block type " + std::to_string(type));
     block = {BlockType(type), data_ + pos_ + 5, length, pos_};
+    // A bad checksum is the problem to name, before what the bad bytes seem to say.
+    const bool malformed = type > framing_->last_block_type(version_) ||
+                           (type == uint8_t(BlockType::end) && (length != 0 || pos_ + kBlockOverhead != size_));
+    if (checked || malformed) check_checksum(block);
+    AMC_REQUIRE(type <= framing_->last_block_type(version_), corrupt, "unknown block type " + std::to_string(type));
     pos_ += kBlockOverhead + length;
     if (block.type == BlockType::end) {
         ended_ = true;

@@ -79,6 +79,11 @@ public:
     // The next block; throws Error on truncation, a bad checksum, an unknown type, or bytes after
     // END. Returns false after END.
     bool next(Block& block);
+    // The same without the checksum, which the caller checks with check_checksum before it reads
+    // the payload: chunk blocks are checked by the thread that decodes them.
+    bool next_unchecked(Block& block);
+    // Throws Error when `block` (of this file) does not match its checksum.
+    void check_checksum(const Block& block) const;
     // Bytes after the blocks read so far.
     size_t remaining() const { return size_ - pos_; }
     // Whether the bytes left hold the next block whole (header, payload and checksum): false in
@@ -89,6 +94,8 @@ public:
     void seek(size_t offset);
 
 private:
+    bool read(Block& block, bool checked);
+
     const FileFraming* framing_;
     const uint8_t* data_;
     size_t size_;

@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <future>
 #include <memory>
 #include <string>
 
@@ -287,7 +288,7 @@ struct ChunkRequest {
 // block, if any, and END.
 Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const TriangleMesh& base, CoordinateSpace space,
                               const DecodeOptions& options, LeafNumbering* numbering, PartialProgress* partial,
-                              const ChunkRequest* request) {
+                              const ChunkRequest* request, std::future<std::vector<Vec3>>* zeroed_positions) {
     AMC_REQUIRE(reader.version() >= kChunkedVersion, corrupt, "metadata block: chunks in a version-" + std::to_string(reader.version()) + " file");
     if (partial != nullptr) {
         partial->levels_in_file = int(meta.levels);
@@ -298,7 +299,7 @@ Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const T
         while (!complete && probe.next_block_arrived() && probe.next(block)) complete = block.type == BlockType::end;
         if (!complete) return Hierarchy(base);
     }
-    const ChunkedDecodeInput input{&base, space, reader.version(), meta.vertices, options};
+    const ChunkedDecodeInput input{&base, space, reader.version(), meta.vertices, options, zeroed_positions};
     ChunkTable table;
     MergedCounts counts;
     Hierarchy h = decode_chunked(reader, input, meta.nodes, request != nullptr ? &request->chunks : nullptr, &table, &counts);
@@ -351,6 +352,12 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     };
     const Metadata meta = read_metadata(expect(BlockType::metadata), quantized);
     check_counts_against_size(meta, reader.remaining(), options);
+    // Several threads decode a whole chunked file into slices of its hierarchy, whose positions
+    // another thread zeroes meanwhile (the metadata's count is bounded by the file's size).
+    std::future<std::vector<Vec3>> zeroed_positions;
+    if ((meta.options & kOptionChunked) && reader.version() >= kChunkVerticesVersion && partial == nullptr &&
+        request == nullptr && options.max_level < 0 && resolve_thread_count(options.threads) > 1)
+        zeroed_positions = start_zeroed_positions(size_t(meta.vertices));
     const Block connectivity_block = expect(BlockType::base_connectivity);
     const Block geometry_block = expect(BlockType::base_geometry);
     const CoordinateSpace space{precision, quantized ? &meta.quantizer : nullptr};
@@ -361,7 +368,8 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
                 "metadata block: mixed hierarchy contexts in a version-" + std::to_string(reader.version()) + " file");
     AMC_REQUIRE(!((meta.options & kOptionMixedContexts) && (meta.options & kOptionChunked)), corrupt,
                 "metadata block: mixed hierarchy contexts in a chunked file");
-    if (meta.options & kOptionChunked) return decode_chunked_file(reader, meta, base, space, options, numbering, partial, request);
+    if (meta.options & kOptionChunked)
+        return decode_chunked_file(reader, meta, base, space, options, numbering, partial, request, &zeroed_positions);
     if (request != nullptr) {  // a file without chunks is one chunk
         AMC_REQUIRE(request->chunks.size() == 1 && request->chunks[0] == 0, invalid_input,
                     "the file has no chunks: only chunk 0, the whole file, can be decoded");

@@ -99,8 +99,10 @@ struct HierarchyBuilder {
     static void relink_roots(Hierarchy& h, const std::vector<RootLink>& links);
     // Gives `h` (roots and vertices, nothing split) `nodes` nodes and `vertices` vertices, those
     // past its own not yet written: the slices (HierarchySlice) of decoders that fill them on
-    // several threads, each writing, and so first touching, its own.
-    static void open_slices(Hierarchy& h, size_t nodes, size_t vertices);
+    // several threads, each writing, and so first touching, its own. `zeroed`, when it holds
+    // `vertices` positions (made on another thread), becomes the positions' storage; otherwise
+    // they are zeroed here.
+    static void open_slices(Hierarchy& h, size_t nodes, size_t vertices, std::vector<Vec3> zeroed = {});
     // Renames the vertex ids of the nodes in [begin, end): v becomes rename(v).
     template <class Rename>
     static void stitch_rename_vertices(Hierarchy& whole, NodeId begin, NodeId end, Rename rename) {

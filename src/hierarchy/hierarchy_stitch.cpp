@@ -6,11 +6,12 @@
 #include "common/check.h"
 #include "common/huge_pages.h"
 
+#include <algorithm>
 #include <utility>
 
 namespace amc {
 
-void HierarchyBuilder::open_slices(Hierarchy& h, size_t nodes, size_t vertices) {
+void HierarchyBuilder::open_slices(Hierarchy& h, size_t nodes, size_t vertices, std::vector<Vec3> zeroed) {
     const size_t roots = h.root_count();
     AMC_REQUIRE(h.nodes_.size() == roots && h.free_blocks_.empty() && h.free_vertices_.empty(), invalid_input,
                 "open_slices: the hierarchy is refined already");
@@ -21,8 +22,13 @@ void HierarchyBuilder::open_slices(Hierarchy& h, size_t nodes, size_t vertices) 
     h.nodes_.resize(nodes);  // Node() writes nothing: the slices' decoders are the first to write
     reserve_huge(h.block_parent_, (nodes - roots) / 4);
     h.block_parent_.resize((nodes - roots) / 4);
-    reserve_huge(h.positions_, vertices);
-    h.positions_.resize(vertices);
+    if (zeroed.size() == vertices) {
+        std::copy(h.positions_.begin(), h.positions_.end(), zeroed.begin());
+        h.positions_.swap(zeroed);
+    } else {
+        reserve_huge(h.positions_, vertices);
+        h.positions_.resize(vertices);
+    }
     h.live_nodes_ = uint32_t(nodes);
     h.live_vertices_ = uint32_t(vertices);
 }

@@ -3,6 +3,7 @@
 
 #include "coding/file_metadata.h"
 #include "common/check.h"
+#include "common/huge_pages.h"
 #include "common/parallel.h"
 #include "hierarchy/hierarchy_builder.h"
 
@@ -12,6 +13,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <system_error>
 #include <utility>
 
 namespace amc {
@@ -109,6 +111,14 @@ ChunkDecodeLimits limits_of(const ChunkJob& job, const ChunkMergeInput& input) {
 
 std::string chunk_name(const ChunkJob& job) { return "chunk " + std::to_string(job.chunk); }
 
+// Checks the job's block, then decodes it into `place`.
+void decode_job(HierarchyLevelDecoder& decoder, const ChunkJob& job, const ChunkPlace& place, const ChunkMergeInput& input,
+                ChunkCounts& counts) {
+    input.reader->check_checksum(job.block);
+    decode_chunk(decoder, job.block.payload, job.block.size, place, *input.seam, input.space, limits_of(job, input),
+                 chunk_name(job), counts);
+}
+
 // Once every chunk is in: checks the whole file's vertices against the metadata, or drops the
 // seam vertices that no decoded chunk holds.
 void finish_vertices(Hierarchy& whole, const MergePlan& plan, const std::vector<uint8_t>& seam_used,
@@ -153,8 +163,7 @@ Hierarchy merge_in_order(const std::vector<ChunkJob>& jobs, const ChunkMergeInpu
         const size_t vertices_before = whole.positions().size();
         const ChunkPlace place{&whole, plan.first_root[i], job.roots.count, plan.keys_in_whole(), seam_used.data(), nullptr,
                                i + 1 == jobs.size()};
-        decode_chunk(decoder, job.data, job.size, place, *input.seam, input.space, limits_of(job, input), chunk_name(job),
-                     counts[i]);
+        decode_job(decoder, job, place, input, counts[i]);
         AMC_REQUIRE(input.options.max_level >= 0 || decoder.node_count() == job.nodes, corrupt,
                     chunk_name(job) + " does not hold the nodes the chunk table says");
         AMC_REQUIRE(input.options.max_level >= 0 || job.own_vertices == kUnknownVertices ||
@@ -189,7 +198,9 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
         slices[i].owner = chunk_name(jobs[i]);
     }
     AMC_REQUIRE(vertex < kNoVertex, limit_exceeded, "too many vertices");
-    HierarchyBuilder::open_slices(whole, size_t(node), size_t(vertex));
+    std::vector<Vec3> zeroed;
+    if (input.zeroed_positions != nullptr && input.zeroed_positions->valid()) zeroed = input.zeroed_positions->get();
+    HierarchyBuilder::open_slices(whole, size_t(node), size_t(vertex), std::move(zeroed));
     find_seam_edges(plan, whole, n);
     const std::vector<HierarchyBuilder::RootLink> cut = HierarchyBuilder::cut_root_links(whole, plan.seam_edges);
     std::vector<std::vector<uint8_t>> seam_used(n, std::vector<uint8_t>(plan.seam_count, 0));
@@ -209,8 +220,7 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
         // Handed out in order (parallel_for): the last `threads` chunks are the last of their decoders.
         const ChunkPlace place{&whole, plan.first_root[i], job.roots.count, plan.keys_in_whole(), seam_used[i].data(),
                                &slices[i], i + threads >= n};
-        decode_chunk(*decoder, job.data, job.size, place, *input.seam, input.space, limits_of(job, input), chunk_name(job),
-                     counts[i]);
+        decode_job(*decoder, job, place, input, counts[i]);
         AMC_REQUIRE(slices[i].next_node == slices[i].node_end, corrupt,
                     chunk_name(job) + " does not hold the nodes the chunk table says");
         AMC_REQUIRE(slices[i].next_vertex == slices[i].vertex_end, corrupt,
@@ -240,6 +250,19 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
 }
 
 }  // namespace
+
+std::future<std::vector<Vec3>> start_zeroed_positions(size_t count) {
+    try {
+        return std::async(std::launch::async, [count] {
+            std::vector<Vec3> positions;
+            reserve_huge(positions, count);
+            positions.resize(count);
+            return positions;
+        });
+    } catch (const std::system_error&) {  // no thread to be had: open_slices zeroes them
+        return {};
+    }
+}
 
 Hierarchy decode_and_merge_chunks(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& input, MergedCounts& counts) {
     MergePlan plan = plan_merge(jobs, input);

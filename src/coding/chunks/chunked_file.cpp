@@ -147,12 +147,15 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
     } else {
         for (uint32_t c = 0; c < table.roots.size(); ++c) chunks.push_back(c);
     }
-    // Find every chunk's block through the table (the whole file: one after the other).
+    // Find every chunk's block through the table (the whole file: one after the other). Their
+    // checksums are checked by the threads that decode them.
     std::vector<Block> blocks(chunks.size());
     for (size_t i = 0; i < chunks.size(); ++i) {
         const size_t offset = table.end + size_t(table.offsets[chunks[i]]);
         if (selected != nullptr) reader.seek(offset);
-        AMC_REQUIRE(reader.next(blocks[i]) && blocks[i].type == BlockType::chunk && blocks[i].offset == offset, corrupt,
+        const bool found = reader.next_unchecked(blocks[i]);
+        if (found && (blocks[i].type != BlockType::chunk || blocks[i].offset != offset)) reader.check_checksum(blocks[i]);
+        AMC_REQUIRE(found && blocks[i].type == BlockType::chunk && blocks[i].offset == offset, corrupt,
                     "chunk table block: no chunk block at the offset of chunk " + std::to_string(chunks[i]));
     }
     if (table_out != nullptr) *table_out = table;
@@ -160,10 +163,11 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
     std::vector<ChunkJob> jobs(chunks.size());
     for (size_t i = 0; i < chunks.size(); ++i) {
         const uint32_t c = chunks[i];
-        jobs[i] = {c, blocks[i].payload, blocks[i].size, table.roots[c], table.nodes[c],
+        jobs[i] = {c, blocks[i], table.roots[c], table.nodes[c],
                    table.own_vertices.empty() ? kUnknownVertices : table.own_vertices[c]};
     }
     ChunkMergeInput merge;
+    merge.reader = &reader;
     merge.base = &base;
     merge.seam = &seam;
     merge.space = input.space;
@@ -172,6 +176,7 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
     merge.vertices = input.vertices;
     merge.file_size = file_size;
     merge.options = input.options;
+    merge.zeroed_positions = input.zeroed_positions;
     MergedCounts counts;
     Hierarchy whole = decode_and_merge_chunks(jobs, merge, counts);
     if (counts_out != nullptr) *counts_out = counts;

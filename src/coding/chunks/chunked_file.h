@@ -11,6 +11,7 @@
 #include <amc/codec.h>
 
 #include <cstdint>
+#include <future>
 #include <utility>
 #include <vector>
 
@@ -50,6 +51,7 @@ struct ChunkedDecodeInput {
     uint8_t version = kChunkedVersion;
     uint64_t vertices = 0;  // the file's vertex count (metadata)
     DecodeOptions options;
+    std::future<std::vector<Vec3>>* zeroed_positions = nullptr;  // ChunkMergeInput's
 };
 
 // Reads the chunk table and seam blocks at the reader's position and decodes the chunks in

@@ -5,13 +5,13 @@
 #include "coding/geometry/position_coder.h"
 #include "common/check.h"
 #include "common/exact_float.h"
+#include "mesh/vertex_buckets.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
 #include <string>
-#include <unordered_map>
 
 namespace amc {
 
@@ -27,8 +27,6 @@ Vec3 midpoint_prediction(Vec3 a, Vec3 b, bool single_precision) {
     const Vec3 m = rounded_scaled(0.5, a + b);
     return single_precision ? rounded_to_float(m) : m;
 }
-
-uint64_t directed(uint32_t a, uint32_t b) { return (uint64_t(a) << 32) | b; }
 
 }  // namespace
 
@@ -58,18 +56,27 @@ int32_t Seam::SegmentTable::find(uint64_t key) const {
 }
 
 std::vector<std::pair<uint32_t, int>> seam_edges(const TriangleMesh& base, const std::vector<uint32_t>& chunk_of_root) {
-    std::unordered_map<uint64_t, uint32_t> triangle_of_edge;
-    triangle_of_edge.reserve(3 * base.triangles.size());
-    for (uint32_t t = 0; t < base.triangles.size(); ++t)
-        for (int e = 0; e < 3; ++e) triangle_of_edge.emplace(directed(base.triangles[t][e], base.triangles[t][(e + 1) % 3]), t);
+    // The directed edges grouped by their first vertex, each as (second vertex, triangle), in
+    // triangle order: the neighbour across (a, b) is the first triangle with (b, a), found among
+    // the few edges leaving b (a valid base mesh uses an edge at most once per direction).
+    struct Leaving {
+        uint32_t to, triangle;
+    };
+    size_t vertex_end = 0;
+    for (const auto& t : base.triangles)
+        for (uint32_t v : t) vertex_end = std::max(vertex_end, size_t(v) + 1);
+    std::vector<Leaving> leaving;
+    const std::vector<size_t> start = bucket_by_vertex(
+        vertex_end, 3 * base.triangles.size(), [&](size_t h) { return base.triangles[h / 3][h % 3]; },
+        [&](size_t h) { return Leaving{base.triangles[h / 3][(h % 3 + 1) % 3], uint32_t(h / 3)}; }, leaving);
     std::vector<std::pair<uint32_t, int>> edges;
     for (uint32_t t = 0; t < base.triangles.size(); ++t) {
         for (int e = 0; e < 3; ++e) {
-            // The neighbour holds the edge the other way round (a valid base mesh uses an edge at
-            // most once per direction).
-            const auto it = triangle_of_edge.find(directed(base.triangles[t][(e + 1) % 3], base.triangles[t][e]));
-            if (it == triangle_of_edge.end() || it->second <= t) continue;
-            if (chunk_of_root[it->second] != chunk_of_root[t]) edges.emplace_back(t, e);
+            const uint32_t a = base.triangles[t][e], b = base.triangles[t][(e + 1) % 3];
+            size_t k = start[b];
+            while (k < start[b + 1] && leaving[k].to != a) ++k;
+            if (k == start[b + 1] || leaving[k].triangle <= t) continue;
+            if (chunk_of_root[leaving[k].triangle] != chunk_of_root[t]) edges.emplace_back(t, e);
         }
     }
     return edges;

@@ -57,7 +57,8 @@ DecidedLevelScan scan_decided_level(Level& level, RefinedNumbering& numbering, u
     DecidedLevelScan scan;
     uint32_t bad = 0;
     // Masks of 16 nodes from i: refined (bit 1 of the state), complete (bit 4), two or more
-    // refined neighbours (bit 3).
+    // refined neighbours (bit 3). The pass writes every node's block: kNoLocal, then the refined
+    // ones' numbers (no separate fill of the numbering).
     auto visit = [&](uint32_t i, uint32_t is_refined, uint32_t complete, uint32_t two_hanging) {
         bad |= is_refined & ~complete;
         for (uint32_t r = is_refined; r != 0; r &= r - 1) {
@@ -70,7 +71,10 @@ DecidedLevelScan scan_decided_level(Level& level, RefinedNumbering& numbering, u
     };
     uint32_t i = 0;
 #if AMC_SSE2
+    const __m128i none = _mm_set1_epi32(-1);
+    static_assert(kNoLocal == 0xffffffffu, "the scan writes kNoLocal as all ones");
     for (; i + 16 <= n; i += 16) {
+        for (uint32_t k = 0; k < 16; k += 4) _mm_storeu_si128(reinterpret_cast<__m128i*>(block + i + k), none);
         const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(state + i));
         // Shifting 16-bit lanes moves bit b of each byte to bit 7 of the same byte.
         visit(i, uint32_t(_mm_movemask_epi8(_mm_slli_epi16(v, 6))), uint32_t(_mm_movemask_epi8(_mm_slli_epi16(v, 3))),
@@ -80,6 +84,7 @@ DecidedLevelScan scan_decided_level(Level& level, RefinedNumbering& numbering, u
     for (; i < n; i += 16) {
         uint32_t r = 0, c = 0, h = 0;
         for (uint32_t k = 0; k < 16 && i + k < n; ++k) {
+            block[i + k] = kNoLocal;
             r |= uint32_t((state[i + k] >> 1) & 1) << k;
             c |= uint32_t((state[i + k] >> 4) & 1) << k;
             h |= uint32_t((state[i + k] >> 3) & 1) << k;

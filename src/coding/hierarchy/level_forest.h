@@ -152,10 +152,11 @@ public:
     void release() { blocks_.release_from(0); }
     // Null before the first reset (a level decided without a scan refines nothing: never read).
     const uint32_t* block_of() const { return blocks_.data() == nullptr ? nullptr : blocks_.data() + 1; }
-    // Room for n nodes, all kNoLocal.
+    // Room for n nodes, which the caller fills (their contents are unspecified; the entry in
+    // front is kNoLocal).
     uint32_t* reset(size_t n) {
         uint32_t* blocks = blocks_.reserve(n + 1);
-        std::fill(blocks, blocks + n + 1, kNoLocal);
+        blocks[0] = kNoLocal;
         return blocks + 1;
     }
 
