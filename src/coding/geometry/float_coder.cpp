@@ -3,6 +3,7 @@
 #include "coding/geometry/float_coder.h"
 
 #include "common/bits.h"
+#include "common/compiler.h"
 #include "common/exact_float.h"
 
 #include <algorithm>
@@ -107,11 +108,12 @@ CoordinateResidual coordinate_residual(Precision precision, double actual, doubl
     return {negative, negative ? ((uint64_t{0} - r) & mask) : r};
 }
 
-void check_bits(int bits, const char* where) {
-    if (bits < kMinQuantizationBits || bits > kMaxQuantizationBits) {
-        throw Error(std::string(where) + ": quantization bits " + std::to_string(bits) +
-                    " outside [1, 30]");
-    }
+[[noreturn]] AMC_NOIPA void refuse_bits(int bits, const char* where) {
+    throw Error(std::string(where) + ": quantization bits " + std::to_string(bits) + " outside [1, 30]");
+}
+// Inline, with the message out of line: the coders check once a coordinate.
+inline void check_bits(int bits, const char* where) {
+    if (bits < kMinQuantizationBits || bits > kMaxQuantizationBits) refuse_bits(bits, where);
 }
 
 }  // namespace
