@@ -57,6 +57,18 @@ TEST(RansTable, NormalisesCountsToTheScale) {
     EXPECT_THROW(RansTable::from_counts(std::vector<uint64_t>(kRansMaxSymbols + 1, 1)), Error);
 }
 
+TEST(RansTable, EncodersTableHasTheSameFrequenciesAndStarts) {
+    const std::vector<std::vector<uint64_t>> cases = {{5, 0, 1000000, 1, 3}, {0, 0, 7}, {9}, counts_of(skewed_symbols(5000, 60, 5), 60)};
+    for (const std::vector<uint64_t>& counts : cases) {
+        const RansTable both = RansTable::from_counts(counts), encoding = RansTable::for_encoding(counts);
+        ASSERT_EQ(encoding.size(), both.size());
+        for (int s = 0; s < both.size(); ++s) {
+            EXPECT_EQ(encoding.frequency(s), both.frequency(s)) << s;
+            EXPECT_EQ(encoding.start(s), both.start(s)) << s;
+        }
+    }
+}
+
 TEST(RansTable, AssignChecksTheFrequencies) {
     RansTable t;
     EXPECT_TRUE(t.assign({kRansScale - 1, 1}));

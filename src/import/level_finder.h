@@ -88,7 +88,8 @@ public:
           midpoint_count_(vertex_count, 0), corner_count_(vertex_count, 0),
           midpoint_block_(vertex_count, {kNoIndex, kNoIndex}), first_coarse_edge_(vertex_count), block_of_(fine.size(), kNoIndex), closure_of_(fine.size(), kNoIndex),
           pinned_old_(vertex_count, 0), covered_(fine.size(), 0),
-          banned_(fine.size(), 0), repair_banned_(fine.size(), 0), deferred_(fine.size(), 0) {
+          banned_(fine.size(), 0), repair_banned_(fine.size(), 0), deferred_(fine.size(), 0),
+          center_shape_(fine.size(), ShapeKnown::not_yet) {
         // A midpoint has its block's three triangles on one side and the boundary, another block
         // (three) or a green closure (two or three triangles around it) on the other.
         for (uint32_t v = 0; v < vertex_count; ++v) {
@@ -133,12 +134,17 @@ private:
     // The block whose center is t, read off the mesh (no labels consulted), or false.
     bool read_block(uint32_t t, Block& b) const;
 
+    // read_block, and false too when the mesh alone rules the block out (a midpoint whose star
+    // cannot be one's, a coarse edge already an edge); the verdict is kept per triangle, as a
+    // growth reads the same triangles again and again.
+    bool read_possible_block(uint32_t t, Block& b) const;
+
     Fan walk_fan(const Block& b, int i) const;
 
     // ---- placing blocks ----------------------------------------------------------------------
-    // Whether the block centered at t fits the labels (its midpoints not old, its apexes not
-    // new) and the mesh (its coarse edges are not edges already; that they are not coarse edges
-    // of other blocks is checked with the sides, once the patch is grown).
+    // Whether a block read by read_possible_block fits the labels (its midpoints not old, its
+    // apexes not new); that its coarse edges are not coarse edges of other blocks is checked with
+    // the sides, once the patch is grown.
     bool fits(const Block& b) const;
 
     // Whether a midpoint other than m already splits the coarse edge a-b. It would be a neighbour
@@ -270,6 +276,8 @@ private:
     std::vector<uint8_t> banned_;          // per triangle: not a center (while a patch is improved)
     std::vector<uint8_t> repair_banned_;   // per triangle: not a center (while a patch is grown again)
     std::vector<uint8_t> deferred_;        // per triangle: center of a valid patch left for later
+    enum class ShapeKnown : uint8_t { not_yet, possible, impossible };
+    mutable std::vector<ShapeKnown> center_shape_;  // per triangle: read_possible_block's verdict
     std::vector<Block> blocks_;
     std::vector<Patch> patches_;
     uint32_t growth_limit_ = kNoIndex;      // blocks: a growth larger than this is given up

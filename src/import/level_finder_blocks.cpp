@@ -39,6 +39,21 @@ bool LevelFinder::read_block(uint32_t t, Block& b) const {
     return true;
 }
 
+bool LevelFinder::read_possible_block(uint32_t t, Block& b) const {
+    if (center_shape_[t] == ShapeKnown::impossible) return false;
+    if (!read_block(t, b)) {
+        center_shape_[t] = ShapeKnown::impossible;
+        return false;
+    }
+    if (center_shape_[t] == ShapeKnown::possible) return true;
+    bool possible = true;
+    for (int i = 0; i < 3 && possible; ++i) {
+        possible = !forced_old_[b.m[size_t(i)]] && !adjacency_.has_edge(b.v[size_t(i)], b.v[size_t(i + 1) % 3]);
+    }
+    center_shape_[t] = possible ? ShapeKnown::possible : ShapeKnown::impossible;
+    return possible;
+}
+
 Fan LevelFinder::walk_fan(const Block& b, int i) const {
     Fan fan;
     const uint32_t a = b.v[size_t(i)], m = b.m[size_t(i)];
@@ -74,10 +89,6 @@ bool LevelFinder::fits(const Block& b) const {
         const uint32_t m = b.m[size_t(k)];
         if (is_old(m) || is_new(b.v[size_t(k)]) || midpoint_count_[m] > 1) return false;
     }
-    for (int i = 0; i < 3; ++i) {
-        const uint32_t a = b.v[size_t(i)], c = b.v[size_t(i + 1) % 3];
-        if (adjacency_.has_edge(a, c)) return false;
-    }
     return true;
 }
 
@@ -100,7 +111,7 @@ bool LevelFinder::has_other_midpoint(uint32_t a, uint32_t b, uint32_t m) const {
 
 bool LevelFinder::place_block(uint32_t t) {
     Block b;
-    if (!read_block(t, b) || !fits(b)) return false;
+    if (!read_possible_block(t, b) || !fits(b)) return false;
     for (int i = 0; i < 3; ++i) b.fan[size_t(i)] = walk_fan(b, i);
     const uint32_t index = uint32_t(blocks_.size());
     blocks_.push_back(b);
@@ -170,7 +181,7 @@ uint32_t LevelFinder::middle_of_three(uint32_t h, bool ccw, uint32_t last) const
 
 bool LevelFinder::partner_fits(uint32_t t, uint32_t v, uint32_t from, uint32_t to) const {
     Block z;
-    if (!read_block(t, z) || !fits(z)) return false;
+    if (!read_possible_block(t, z) || !fits(z)) return false;
     for (int e = 0; e < 3; ++e) {
         if (z.m[size_t(e)] == v) return z.v[size_t(e)] == from && z.v[size_t(e + 1) % 3] == to;
     }

@@ -6,10 +6,17 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 
 namespace amc {
 
 RansTable RansTable::from_counts(const std::vector<uint64_t>& counts) {
+    RansTable table = for_encoding(counts);
+    table.build_slots();
+    return table;
+}
+
+RansTable RansTable::for_encoding(const std::vector<uint64_t>& counts) {
     if (counts.empty() || counts.size() > size_t(kRansMaxSymbols)) {
         throw Error("RansTable: " + std::to_string(counts.size()) + " symbols (1 to " + std::to_string(kRansMaxSymbols) + ")");
     }
@@ -52,7 +59,8 @@ RansTable RansTable::from_counts(const std::vector<uint64_t>& counts) {
         }
     }
     RansTable table;
-    table.assign(f);
+    table.frequency_ = std::move(f);  // what assign() accepts: the sum is M, none above the largest frequency
+    table.set_starts();
     return table;
 }
 
@@ -65,19 +73,24 @@ bool RansTable::assign(const std::vector<uint32_t>& frequencies) {
     }
     if (sum != kRansScale) return false;
     frequency_ = frequencies;
-    build();
+    set_starts();
+    build_slots();
     return true;
 }
 
-void RansTable::build() {
+void RansTable::set_starts() {
     start_.assign(frequency_.size(), 0);
-    entries_.clear();
     uint32_t start = 0;
     for (size_t s = 0; s < frequency_.size(); ++s) {
         start_[s] = start;
-        if (frequency_[s] != 0) entries_.push_back({uint16_t(s), uint16_t(frequency_[s]), uint16_t(start)});
         start += frequency_[s];
     }
+}
+
+void RansTable::build_slots() {
+    entries_.clear();
+    for (size_t s = 0; s < frequency_.size(); ++s)
+        if (frequency_[s] != 0) entries_.push_back({uint16_t(s), uint16_t(frequency_[s]), uint16_t(start_[s])});
     narrow_ = entries_.size() <= 256;
     narrow_index_.assign(narrow_ ? kRansScale : 0, 0);
     wide_index_.assign(narrow_ ? 0 : kRansScale, 0);

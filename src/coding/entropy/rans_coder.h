@@ -46,6 +46,9 @@ public:
     // kRansScale - 1 nonzero) to frequencies: every symbol with a nonzero count gets at least 1,
     // the rest in proportion. Throws Error otherwise.
     static RansTable from_counts(const std::vector<uint64_t>& counts);
+    // from_counts' frequencies for a RansEncoder only: without the decoder's slot index
+    // (entry_of_slot; 4096 slots filled per table), which an encoder weighing modes never reads.
+    static RansTable for_encoding(const std::vector<uint64_t>& counts);
     // Takes frequencies as they are; returns false (table unchanged) unless they sum to
     // kRansScale, none exceeds kRansMaxFrequency, and there are at most kRansMaxSymbols.
     bool assign(const std::vector<uint32_t>& frequencies);
@@ -69,7 +72,8 @@ public:
     }
 
 private:
-    void build();
+    void set_starts();
+    void build_slots();
     std::vector<uint32_t> frequency_, start_;
     std::vector<Entry> entries_;
     bool narrow_ = true;

@@ -434,7 +434,7 @@ void StaticLevelEncoder::make_tables() {
         std::vector<uint64_t> c(all.begin(), all.begin() + std::ptrdiff_t(size));
         const bool used = !c.empty();
         if (!used) c.push_back(1);  // a table no token uses still needs a symbol
-        tables_[size_t(i)] = RansTable::from_counts(c);
+        tables_[size_t(i)] = RansTable::for_encoding(c);
         for (size_t t = 0; used && t < c.size(); ++t) {
             if (c[t] == 0) continue;
             // Rounded before the sum: a fused multiply-add could tip the mode choice between builds.
