@@ -107,9 +107,6 @@ AMC_ALWAYS_INLINE GridPrediction grid_prediction_at(const Quantizer& quantizer, 
     g.bin = std::fabs(f) >= 0.25 ? 1 : 0;  // f is finite: f >= 1/4 or f <= -1/4
     return g;
 }
-AMC_ALWAYS_INLINE GridPrediction grid_prediction(const Quantizer& quantizer, int axis, double x) {
-    return grid_prediction_at(quantizer, axis_coordinate(quantizer.origin, axis), x);
-}
 
 AMC_ALWAYS_INLINE Residual grid_residual(const Quantizer& quantizer, int axis, double actual, const GridPrediction& g) {
     const int64_t d = int64_t(quantize_coordinate(quantizer, axis, actual)) - int64_t(g.p);
