@@ -279,9 +279,14 @@ void gather_chunk(const Hierarchy& h, const Source& source, size_t begin, size_t
     c.begin = begin;
     c.count = begin < end ? std::min(kChunk, end - begin) : 0;
     source.get(c);
-    for (size_t i = 0; i < c.count; ++i)
-        for (VertexId v : {c.corners[i].a, c.corners[i].b, c.corners[i].c, c.corners[i].d})
-            if (v != kNoVertex) __builtin_prefetch(&h.positions()[v]);
+    const Vec3* positions = h.positions().data();
+    for (size_t i = 0; i < c.count; ++i) {  // a, b and c are always vertices
+        const FrameCorners& k = c.corners[i];
+        __builtin_prefetch(positions + k.a);
+        __builtin_prefetch(positions + k.b);
+        __builtin_prefetch(positions + k.c);
+        if (k.d != kNoVertex) __builtin_prefetch(positions + k.d);
+    }
 }
 
 // Vertex i's frame in role order.
@@ -544,6 +549,15 @@ bool decode_positions(Hierarchy& h, const Source& created, CoordinateSpace space
         space.quantizer = &local_quantizer;
     }
     const Quantizer* quantizer = space.quantizer;
+    // A grid value origin + rounded(q * step), 0 <= q <= max, lies between the box's corners
+    // (both operations round monotonically): when they are near, every position is.
+    const bool near = quantizer != nullptr && !HierarchyBuilder::is_far(quantizer->origin) &&
+                      !HierarchyBuilder::is_far(dequantize(*quantizer, {quantizer->max_coordinate(), quantizer->max_coordinate(),
+                                                                        quantizer->max_coordinate()}));
+    auto set = [&h, near](VertexId v, Vec3 p) {
+        if (near) HierarchyBuilder::set_near_vertex_position(h, v, p);
+        else HierarchyBuilder::set_new_vertex_position(h, v, p);
+    };
     Chunk c;
     for (size_t begin = 0; begin < created.size(); begin += kChunk) {
         gather_chunk(h, created, begin, created.size(), c);
@@ -551,10 +565,10 @@ bool decode_positions(Hierarchy& h, const Source& created, CoordinateSpace space
         for (size_t i = 0; i < c.count; i += 2) {
             Vec3 p;
             if (!decode_vertex<0, Grid>(c, i, space, tables, rans, raw, p)) return false;
-            HierarchyBuilder::set_new_vertex_position(h, c.vertices[i], p);
+            set(c.vertices[i], p);
             if (i + 1 == c.count) break;
             if (!decode_vertex<1, Grid>(c, i + 1, space, tables, rans, raw, p)) return false;
-            HierarchyBuilder::set_new_vertex_position(h, c.vertices[i + 1], p);
+            set(c.vertices[i + 1], p);
         }
     }
     return rans.ended_cleanly() && raw.ended_cleanly();
