@@ -52,7 +52,7 @@ struct Block {
     std::array<uint32_t, 3> v, m;         // parent vertices, midpoints (m_i on v_i -> v_{i+1})
     std::array<uint32_t, 3> first_half;   // half-edge v_i -> m_i (in corner i)
     std::array<uint32_t, 3> second_half;  // half-edge m_i -> v_{i+1} (in corner i+1)
-    std::array<Fan, 3> fan;               // around m_i, set when placed (the mesh alone decides it)
+    std::array<Fan, 3> fan;               // around m_i (the mesh alone decides it)
     bool alive;
     uint32_t patch;  // the committed patch it belongs to, or kNoIndex while growing
 };
@@ -89,7 +89,7 @@ public:
           midpoint_block_(vertex_count, {kNoIndex, kNoIndex}), first_coarse_edge_(vertex_count), block_of_(fine.size(), kNoIndex), closure_of_(fine.size(), kNoIndex),
           pinned_old_(vertex_count, 0), covered_(fine.size(), 0),
           banned_(fine.size(), 0), repair_banned_(fine.size(), 0), deferred_(fine.size(), 0),
-          center_shape_(fine.size(), ShapeKnown::not_yet) {
+          shape_of_(fine.size(), kNotRead) {
         // A midpoint has its block's three triangles on one side and the boundary, another block
         // (three) or a green closure (two or three triangles around it) on the other.
         for (uint32_t v = 0; v < vertex_count; ++v) {
@@ -134,15 +134,17 @@ private:
     // The block whose center is t, read off the mesh (no labels consulted), or false.
     bool read_block(uint32_t t, Block& b) const;
 
-    // read_block, and false too when the mesh alone rules the block out (a midpoint whose star
-    // cannot be one's, a coarse edge already an edge); the verdict is kept per triangle, as a
-    // growth reads the same triangles again and again.
-    bool read_possible_block(uint32_t t, Block& b) const;
+    // The block centered at t as read_block reads it, with its fans walked, or nullptr when
+    // read_block fails or the mesh alone rules the block out (a midpoint whose star cannot be
+    // one's, a coarse edge already an edge). The mesh alone decides it, and growths read the same
+    // triangles again and again, so it is read once per triangle and kept. The pointer lasts
+    // until the next call.
+    const Block* possible_block(uint32_t t) const;
 
     Fan walk_fan(const Block& b, int i) const;
 
     // ---- placing blocks ----------------------------------------------------------------------
-    // Whether a block read by read_possible_block fits the labels (its midpoints not old, its
+    // Whether a block read by possible_block fits the labels (its midpoints not old, its
     // apexes not new); that its coarse edges are not coarse edges of other blocks is checked with
     // the sides, once the patch is grown.
     bool fits(const Block& b) const;
@@ -276,8 +278,9 @@ private:
     std::vector<uint8_t> banned_;          // per triangle: not a center (while a patch is improved)
     std::vector<uint8_t> repair_banned_;   // per triangle: not a center (while a patch is grown again)
     std::vector<uint8_t> deferred_;        // per triangle: center of a valid patch left for later
-    enum class ShapeKnown : uint8_t { not_yet, possible, impossible };
-    mutable std::vector<ShapeKnown> center_shape_;  // per triangle: read_possible_block's verdict
+    static constexpr uint32_t kNotRead = kNoIndex, kImpossible = kNoIndex - 1;
+    mutable std::vector<uint32_t> shape_of_;  // per triangle: kNotRead, kImpossible or its index in shapes_
+    mutable std::vector<Block> shapes_;       // the blocks possible_block has read
     std::vector<Block> blocks_;
     std::vector<Patch> patches_;
     uint32_t growth_limit_ = kNoIndex;      // blocks: a growth larger than this is given up
