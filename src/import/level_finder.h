@@ -86,7 +86,7 @@ public:
                 const std::vector<uint8_t>* kept)
         : tri_(fine), refined_(refined), adjacency_(fine, vertex_count), forced_old_(vertex_count, 0),
           midpoint_count_(vertex_count, 0), corner_count_(vertex_count, 0),
-          midpoint_block_(vertex_count, {kNoIndex, kNoIndex}), first_coarse_edge_(vertex_count), block_of_(fine.size(), kNoIndex), closure_of_(fine.size(), kNoIndex),
+          midpoint_block_(vertex_count, {kNoIndex, kNoIndex}), first_coarse_edge_(vertex_count, kNoEdge), block_of_(fine.size(), kNoIndex), closure_of_(fine.size(), kNoIndex),
           pinned_old_(vertex_count, 0), covered_(fine.size(), 0),
           banned_(fine.size(), 0), repair_banned_(fine.size(), 0), deferred_(fine.size(), 0),
           shape_of_(fine.size(), kNotRead) {
@@ -270,7 +270,10 @@ private:
     std::vector<uint8_t> midpoint_count_;  // per vertex: blocks it is a midpoint of (0-2)
     std::vector<uint32_t> corner_count_;   // per vertex: blocks it is a parent vertex of
     std::vector<std::array<uint32_t, 2>> midpoint_block_;  // block * 3 + edge, per midpoint role
-    std::vector<std::pair<uint32_t, uint32_t>> first_coarse_edge_;  // coarse_edge(midpoint_block_[v][0])
+    // Per vertex: coarse_edge(midpoint_block_[v][0]), or kNoEdge when v is no midpoint (one load
+    // tells has_other_midpoint both, which scans every neighbour of a vertex).
+    static constexpr std::pair<uint32_t, uint32_t> kNoEdge{kNoIndex, kNoIndex};
+    std::vector<std::pair<uint32_t, uint32_t>> first_coarse_edge_;
     std::vector<uint32_t> block_of_;       // per triangle
     std::vector<uint32_t> closure_of_;     // per triangle: block * 3 + side of a committed closure
     std::vector<uint32_t> pinned_old_;     // per vertex: closures of committed patches it is a corner of

@@ -98,8 +98,8 @@ bool LevelFinder::fits(const Block& b) const {
 
 bool LevelFinder::has_other_midpoint(uint32_t a, uint32_t b, uint32_t m) const {
     auto splits_ab = [&](uint32_t w) {
-        if (w == m || midpoint_count_[w] == 0) return false;
-        const auto [s, t] = first_coarse_edge_[w];
+        if (w == m) return false;
+        const auto [s, t] = first_coarse_edge_[w];  // (kNoIndex, kNoIndex) unless w is a midpoint
         return (s == a && t == b) || (s == b && t == a);
     };
     for (const uint32_t* w = adjacency_.ends_begin(a); w != adjacency_.ends_end(a); ++w) {
@@ -156,7 +156,7 @@ void LevelFinder::release(uint32_t index) {
         auto& slots = midpoint_block_[m];
         if (slots[0] / 3 == index) slots[0] = slots[1];
         slots[1] = kNoIndex;
-        if (--midpoint_count_[m] != 0) first_coarse_edge_[m] = coarse_edge(slots[0]);
+        first_coarse_edge_[m] = --midpoint_count_[m] != 0 ? coarse_edge(slots[0]) : kNoEdge;
         --corner_count_[b.v[size_t(k)]];
     }
 }
