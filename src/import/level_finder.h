@@ -72,7 +72,6 @@ enum class Preference : uint8_t { closure_first, block_first };
 struct Candidate {
     uint32_t removed, center;
     Preference preference;
-    bool operator<(const Candidate& o) const { return removed != o.removed ? removed < o.removed : center > o.center; }
 };
 
 // Blocks committed together: blocks_[first, end).
@@ -82,9 +81,14 @@ struct Patch {
 
 class LevelFinder {
 public:
+    // `fine`, `refined` and every triangle index in this interface are the caller's; inside,
+    // the triangles are numbered for locality (local_order), and wherever the caller's order
+    // decides (the order of seeds, ties between candidates, the coarser level's order) it is
+    // looked up, so the numbering changes no result.
     LevelFinder(const std::vector<Triangle>& fine, const std::vector<uint8_t>& refined, uint32_t vertex_count,
                 const std::vector<uint8_t>* kept)
-        : tri_(fine), refined_(refined), adjacency_(fine, vertex_count), forced_old_(vertex_count, 0),
+        : caller_of_(local_order(fine, vertex_count)), local_of_(inverse(caller_of_)), tri_(permuted(fine, caller_of_)),
+          refined_(permuted(refined, caller_of_)), adjacency_(tri_, vertex_count), forced_old_(vertex_count, 0),
           midpoint_count_(vertex_count, 0), corner_count_(vertex_count, 0),
           midpoint_block_(vertex_count, {kNoIndex, kNoIndex}), first_coarse_edge_(vertex_count, kNoEdge), block_of_(fine.size(), kNoIndex), closure_of_(fine.size(), kNoIndex),
           pinned_old_(vertex_count, 0), covered_(fine.size(), 0),
@@ -124,6 +128,25 @@ public:
     CoarserLevel coarser_level(std::vector<uint32_t>* parent_of_block = nullptr) const;
 
 private:
+    // ---- numbering -----------------------------------------------------------------------------
+    // The caller's triangle indices ordered by each triangle's smallest vertex id: base
+    // detection numbers the vertices breadth-first, so triangles that a growth reads together
+    // share cache lines, where the caller's order (a shuffled input's) would make each read a miss.
+    static std::vector<uint32_t> local_order(const std::vector<Triangle>& fine, uint32_t vertex_count);
+    static std::vector<uint32_t> inverse(const std::vector<uint32_t>& order);
+    template <typename T>
+    static std::vector<T> permuted(const std::vector<T>& values, const std::vector<uint32_t>& order) {
+        std::vector<T> out;
+        out.reserve(order.size());
+        for (uint32_t i : order) out.push_back(values[i]);
+        return out;
+    }
+    // Whether candidate a is worse than b: fewer vertices removed, or as many and a center later
+    // in the caller's order.
+    bool worse(const Candidate& a, const Candidate& b) const {
+        return a.removed != b.removed ? a.removed < b.removed : caller_of_[a.center] > caller_of_[b.center];
+    }
+
     // ---- reading the fine mesh ---------------------------------------------------------------
     uint32_t vertex_at(uint32_t half_edge, int offset) const;
     static uint32_t next_half_edge(uint32_t half_edge, int offset);
@@ -263,8 +286,10 @@ private:
     // glued at an old vertex).
     void improve_patches(size_t first);
 
-    const std::vector<Triangle>& tri_;
-    const std::vector<uint8_t>& refined_;
+    std::vector<uint32_t> caller_of_;  // per triangle: its index in the caller's numbering
+    std::vector<uint32_t> local_of_;   // per caller's index: the triangle
+    std::vector<Triangle> tri_;
+    std::vector<uint8_t> refined_;
     TriangleAdjacency adjacency_;
     std::vector<uint8_t> forced_old_;      // per vertex: its star rules out being a midpoint
     std::vector<uint8_t> midpoint_count_;  // per vertex: blocks it is a midpoint of (0-2)
