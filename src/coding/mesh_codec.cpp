@@ -160,7 +160,7 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
             add_level_stats(out.stats, hierarchy.level_nodes(l).size(), created.size(), hierarchy_part, payload);
             out.blocks.emplace_back(BlockType::level, std::move(payload));
         }
-        if (want_hierarchy_stats) out.stats.hierarchy = hierarchy.stats();  // replays the coded symbols: only when asked for
+        if (want_hierarchy_stats) out.stats.hierarchy = hierarchy.stats();
     }
     for (const auto& block : out.blocks) out.bytes += kBlockOverhead + block.second.size();
     return out;
@@ -211,7 +211,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     const std::vector<RootRange> chunks = !options.chunk_roots.empty() ? explicit_chunks(options.chunk_roots, h.root_count())
                                           : one_chunk ? std::vector<RootRange>{RootRange{0, h.root_count()}}
                                                       : balanced_chunks(root_nodes, chunk_count_for(options, faces));
-    const bool want_hierarchy_stats = stats_out != nullptr;
+    const bool want_hierarchy_stats = stats_out != nullptr && options.hierarchy_statistics;
     ForestCode forest = code_forest(h, root_of, chunks, faces, options, space, positions, threads, want_hierarchy_stats);
     const uint32_t fewer = automatic && forest.chunked ? chunk_count_for_size(options, uint32_t(chunks.size()), forest.bytes)
                                                        : uint32_t(chunks.size());
@@ -414,10 +414,18 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
         const std::string where = "level " + std::to_string(level) + " block";
         const LevelBlockParts parts = split_level_block(block, reader.version(), space.quantizer != nullptr, where);
         ArithmeticDecoder decoder(parts.arithmetic, parts.arithmetic_size);
+        // Every new vertex gets its decoded position below; a static mode's decoder takes their
+        // frame corners from the split, without reading the nodes again.
+        const bool listed = is_static_mode(parts.predictor);
+        hierarchy.set_new_vertex_listing(listed, false);
         // The refined nodes R of a level create at least 1.5 R vertices, whose positions are in
         // this block: it bounds R before the next level is allocated.
         hierarchy.decode_level(decoder, 2 * max_decodable_positions(block.size - 1) / 3);
-        decode_level_geometry(h, hierarchy.new_vertices(), parts, decoder, positions, space, level, where);
+        if (listed)
+            decode_listed_level_geometry(h, hierarchy.new_vertex_corners(), hierarchy.new_vertex_count(),
+                                         hierarchy.new_vertex_first(), parts, decoder, space, where);
+        else
+            decode_level_geometry(h, hierarchy.new_vertices(), parts, decoder, positions, space, level, where);
         ++level;
         if (partial != nullptr) partial->levels_decoded = level;
     }
