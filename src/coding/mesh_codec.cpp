@@ -24,6 +24,7 @@
 #include <future>
 #include <memory>
 #include <string>
+#include <utility>
 
 namespace amc {
 
@@ -45,10 +46,40 @@ std::vector<Vec3> live_positions(const Hierarchy& h) {
     return points;
 }
 
+// Vertices per task of the passes over all positions below.
+constexpr size_t kPositionRange = size_t(1) << 16;
+
+// make_quantizer(points)'s bounding box, the points' ranges on `threads` threads: each range's
+// fold of std::fmin / std::fmax, then the ranges' in order, which is the one fold over all points
+// (whichever of two equal-valued zeros std::fmin keeps, it keeps the same one here).
+std::pair<Vec3, Vec3> bounding_box(const std::vector<Vec3>& points, unsigned threads) {
+    const size_t ranges = (points.size() + kPositionRange - 1) / kPositionRange;
+    std::vector<std::pair<Vec3, Vec3>> boxes(ranges);
+    parallel_for(ranges, threads, [&](size_t i) {
+        const size_t begin = i * kPositionRange, end = std::min(points.size(), begin + kPositionRange);
+        Vec3 lo = points[begin], hi = points[begin];
+        for (size_t v = begin; v < end; ++v) {
+            const Vec3 p = points[v];
+            lo = {std::fmin(lo.x, p.x), std::fmin(lo.y, p.y), std::fmin(lo.z, p.z)};
+            hi = {std::fmax(hi.x, p.x), std::fmax(hi.y, p.y), std::fmax(hi.z, p.z)};
+        }
+        boxes[i] = {lo, hi};
+    });
+    Vec3 lo = boxes[0].first, hi = boxes[0].second;
+    for (const auto& box : boxes) {
+        lo = {std::fmin(lo.x, box.first.x), std::fmin(lo.y, box.first.y), std::fmin(lo.z, box.first.z)};
+        hi = {std::fmax(hi.x, box.second.x), std::fmax(hi.y, box.second.y), std::fmax(hi.z, box.second.z)};
+    }
+    return {lo, hi};
+}
+
 // The grid of `bits` over the input's positions (checked: without removed ids every id is live).
-Quantizer quantizer_of(const Hierarchy& input, int bits) {
+Quantizer quantizer_of(const Hierarchy& input, int bits, unsigned threads) {
     try {
-        if (input.vertex_count() == input.positions().size()) return make_quantizer(input.positions(), bits);
+        if (input.vertex_count() == input.positions().size() && !input.positions().empty()) {
+            const auto [lo, hi] = bounding_box(input.positions(), threads);
+            return make_quantizer(lo, hi, bits);
+        }
         return make_quantizer(live_positions(input), bits);
     } catch (const Error& e) {
         throw_error(e.code(), std::string("encode: ") + e.what() +
@@ -58,15 +89,23 @@ Quantizer quantizer_of(const Hierarchy& input, int bits) {
 
 // Moves every position of h to the grid point the decoder reconstructs (the predictions are made
 // from those: a closed loop); returns the largest coordinate error, max_quantization_error's.
-double snap_positions(Hierarchy& h, const Quantizer& quantizer) {
-    double worst = 0.0;
+// On `threads` threads, each range of vertices with its own largest error.
+double snap_positions(Hierarchy& h, const Quantizer& quantizer, unsigned threads) {
     // std::fmax inline (a NaN loses to a number); its choice between +0 and -0 never arises, fabs gives +0.
     auto larger = [](double a, double b) { return b > a || std::isnan(a) ? b : a; };
-    for (VertexId v = 0; v < h.positions().size(); ++v) {
-        const Vec3 p = h.position(v), r = dequantize(quantizer, snap_to_grid(quantizer, p));
-        worst = larger(worst, larger(std::fabs(r.x - p.x), larger(std::fabs(r.y - p.y), std::fabs(r.z - p.z))));
-        h.set_position(v, r);
-    }
+    const size_t vertices = h.positions().size();
+    std::vector<double> worst_in((vertices + kPositionRange - 1) / kPositionRange, 0.0);
+    parallel_for(worst_in.size(), threads, [&](size_t i) {
+        double worst = 0.0;
+        for (size_t v = i * kPositionRange; v < std::min(vertices, (i + 1) * kPositionRange); ++v) {
+            const Vec3 p = h.position(VertexId(v)), r = dequantize(quantizer, snap_to_grid(quantizer, p));
+            worst = larger(worst, larger(std::fabs(r.x - p.x), larger(std::fabs(r.y - p.y), std::fabs(r.z - p.z))));
+            h.set_position(VertexId(v), r);
+        }
+        worst_in[i] = worst;
+    });
+    double worst = 0.0;
+    for (double w : worst_in) worst = larger(worst, w);
     return worst;
 }
 
@@ -178,7 +217,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     // Quantized coordinates are reconstructed as doubles on the grid, whatever the input precision.
     const Precision precision = input.single_precision() && !quantized ? Precision::float32 : Precision::float64;
     Quantizer quantizer;
-    if (quantized) quantizer = quantizer_of(input, options.quantize_bits);
+    if (quantized) quantizer = quantizer_of(input, options.quantize_bits, threads);
     const CoordinateSpace space{precision, quantized ? &quantizer : nullptr};
 
     // II-B: code the base mesh first and express the forest in the decoder's base order.
@@ -190,7 +229,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
         stats.numbering = numbering_after_reorder(input, *options.numbering, h, reordered.vertex_map);
     if (quantized) {
         h.set_single_precision(false);
-        stats.max_error = snap_positions(h, quantizer);  // h holds exactly the input's live positions
+        stats.max_error = snap_positions(h, quantizer, threads);  // h holds exactly the input's live positions
     }
 
     // The forest (FORMAT.md 3.6, 3.11), after the base geometry, whose adaptive models the level
