@@ -143,9 +143,11 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
     vertex_map.assign(h.positions().size(), kNoVertex);
     for (size_t v = 0; v < base_vertex_id.size(); ++v) vertex_map[v] = base_vertex_id[v];
     out.positions_.resize(size_t(first_vertex[ranges]));
-    // The midpoints, numbered in the replay's order; each written by the node that creates it.
+    // The midpoints, numbered in the replay's order; each written by the node that creates it. (The
+    // constructor marked far base positions.)
     parallel_for(ranges, threads, [&](size_t i) {
         VertexId next = VertexId(first_vertex[i]);
+        bool far = false;
         for (size_t j = i * kRange; j < std::min(n, (i + 1) * kRange); ++j) {
             if (j + kAhead < n && creates[j + kAhead] != 0) prefetch(h, old_of[j + kAhead]);
             if (first_child[j] == kNoNode) continue;
@@ -153,9 +155,11 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
                 if (!((creates[j] >> e) & 1)) continue;
                 const VertexId old = h.midpoint(old_of[j], kEdgeMod3[e + turn[j]]);
                 vertex_map[old] = next;
-                out.positions_[next++] = h.position(old);
+                out.positions_[next] = h.position(old);
+                far |= Hierarchy::is_far(out.positions_[next++]);
             }
         }
+        out.far_positions_.raise_if(far);
     });
     out.nodes_.resize(n);  // Node() writes nothing: each is written whole below
     out.block_parent_.assign((n - roots) / 4, kNoNode);
@@ -186,7 +190,6 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
             node.reserved = 0;
         }
     });
-    for (const Vec3& p : out.positions_) out.far_positions_.raise_if(Hierarchy::is_far(p));
     out.live_nodes_ = uint32_t(n);
     out.live_vertices_ = uint32_t(out.positions_.size());
     return out;
