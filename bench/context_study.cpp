@@ -177,7 +177,7 @@ double integer_mixed_code_length(const std::vector<Features>& features, const st
     std::vector<std::vector<BitModel>> models(k);
     mixing::Mixer mixer(int(k) + 1, mix.sets, mix.rate);
     mixing::ProbabilityMap apm(std::max(1, mix.apm_contexts), mix.apm_rate);
-    std::vector<int> st(k + 1);
+    std::vector<int> st(size_t(mixing::Mixer::padded(int(k) + 1)));
     std::vector<size_t> c(k);
     double total = 0;
     for (size_t i = 0; i < bits.size(); ++i) {

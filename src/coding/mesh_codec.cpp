@@ -453,10 +453,18 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
         const std::string where = "level " + std::to_string(level) + " block";
         const LevelBlockParts parts = split_level_block(block, reader.version(), space.quantizer != nullptr, where);
         ArithmeticDecoder decoder(parts.arithmetic, parts.arithmetic_size);
+        // Every new vertex gets its decoded position below; a static mode's decoder takes their
+        // frame corners from the split, without reading the nodes again.
+        const bool listed = is_static_mode(parts.predictor);
+        hierarchy.set_new_vertex_listing(listed, false);
         // The refined nodes R of a level create at least 1.5 R vertices, whose positions are in
         // this block: it bounds R before the next level is allocated.
         hierarchy.decode_level(decoder, 2 * max_decodable_positions(block.size - 1) / 3);
-        decode_level_geometry(h, hierarchy.new_vertices(), parts, decoder, positions, space, level, where);
+        if (listed)
+            decode_listed_level_geometry(h, hierarchy.new_vertex_corners(), hierarchy.new_vertex_count(),
+                                         hierarchy.new_vertex_first(), parts, decoder, space, where);
+        else
+            decode_level_geometry(h, hierarchy.new_vertices(), parts, decoder, positions, space, level, where);
         ++level;
         if (partial != nullptr) partial->levels_decoded = level;
     }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <string>
 #include <utility>
 
@@ -94,11 +95,11 @@ void RansTable::build_slots() {
     narrow_ = entries_.size() <= 256;
     narrow_index_.assign(narrow_ ? kRansScale : 0, 0);
     wide_index_.assign(narrow_ ? 0 : kRansScale, 0);
+    // Each symbol's run of slots in one fill (a decoder builds a table per level and role).
     for (size_t i = 0; i < entries_.size(); ++i) {
-        for (uint32_t slot = entries_[i].start; slot < uint32_t(entries_[i].start) + entries_[i].frequency; ++slot) {
-            if (narrow_) narrow_index_[slot] = uint8_t(i);
-            else wide_index_[slot] = uint16_t(i);
-        }
+        const size_t start = entries_[i].start, frequency = entries_[i].frequency;
+        if (narrow_) std::fill_n(narrow_index_.begin() + std::ptrdiff_t(start), frequency, uint8_t(i));
+        else std::fill_n(wide_index_.begin() + std::ptrdiff_t(start), frequency, uint16_t(i));
     }
 }
 

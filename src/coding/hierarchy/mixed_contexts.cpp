@@ -5,6 +5,7 @@
 
 #include "coding/hierarchy/context_groups.h"
 #include "common/exact_float.h"
+#include "common/little_endian.h"
 
 #include <algorithm>
 #include <cmath>
@@ -29,11 +30,20 @@ Vec3 unit_normal(const Hierarchy& h, NodeId n) {
     return {x.x / len, x.y / len, x.z / len};
 }
 
+// std::frexp for finite x > 0: x = m 2^e with m in [0.5, 1); read from the bits where x is normal.
+double mantissa_exponent(double x, int* e) {
+    const uint64_t bits = bit_cast<uint64_t>(x);
+    const int biased = int(bits >> 52);  // the sign bit is 0
+    if (biased == 0) return std::frexp(x, e);
+    *e = biased - 1022;
+    return bit_cast<double>((bits & ((uint64_t{1} << 52) - 1)) | (uint64_t{1022} << 52));
+}
+
 // floor(2 log2 x) + offset for x > 0 (half octaves), clamped to [1, top]; 0 for x <= 0 or NaN.
 int half_octave_bin(double x, int offset, int top) {
     if (!(x > 0) || !std::isfinite(x)) return 0;
     int e = 0;
-    const double m = std::frexp(x, &e);  // x = m 2^e, m in [0.5, 1)
+    const double m = mantissa_exponent(x, &e);
     return std::clamp(2 * e + (m >= 0.70710678118654752) + offset, 1, top);
 }
 
@@ -41,7 +51,7 @@ int half_octave_bin(double x, int offset, int top) {
 int quarter_octave_bin(double x, int offset, int top) {
     if (!(x > 0) || !std::isfinite(x)) return 0;
     int e = 0;
-    const double m = std::frexp(x, &e);
+    const double m = mantissa_exponent(x, &e);
     const int q = (m >= 0.59460355750136054) + (m >= 0.70710678118654752) + (m >= 0.84089641525371454);
     return std::clamp(4 * e + q + offset, 1, top);
 }
@@ -358,8 +368,9 @@ int MixedHierarchyModel::later_model_p12(const MixedFeatures& f) {
                    : mixing::squash((s1 + s2 + s3) / 3);
     map_context_ = {int(g * 4 + f.inner), int(g * 64 + f.mean_curv), int(f.disp * 8 + f.level), int(g * 256 + (last_bits_ & 255)),
                     int((g * 5 + f.ring2) * 4 + f.parent_nbrs)};
+    const int stretched = mixing::stretch(p_mix_);
     int refined = 0;
-    for (int m = 0; m < kMaps; ++m) refined += maps_[size_t(m)].refine(p_mix_, map_context_[size_t(m)]);
+    for (int m = 0; m < kMaps; ++m) refined += maps_[size_t(m)].refine_stretched(stretched, map_context_[size_t(m)]);
     return std::clamp((p_mix_ + (refined / kMaps) * 3 + 2) >> 2, 1, 4095);
 }
 
@@ -370,10 +381,10 @@ void MixedHierarchyModel::update(bool bit) {
     if (model_ == MixingModel::third) mixer_d_.update(st_.data(), bit);
     for (mixing::ProbabilityMap& map : maps_) map.update(bit);
     const int direct = model_ == MixingModel::first ? kInputs : model_ == MixingModel::second ? kDirect : kThirdDirect;
-    for (int j = 0; j < direct; ++j) models_[size_t(j)][slot_[size_t(j)]].update(bit);
+    for (int j = 0; j < direct; ++j) models_[size_t(j)][slot_[size_t(j)]].update_with_limit(bit, kModelWindowLog2);
     if (model_ == MixingModel::first) return;
     for (int k = 0; k < kIndirectInputs; ++k) {
-        history_maps_[size_t(k)][history_map_slot_[size_t(k)]].update(bit);
+        history_maps_[size_t(k)][history_map_slot_[size_t(k)]].update_with_limit(bit, kHistoryMapLog2);
         uint8_t& history = histories_[size_t(k)][history_context_[size_t(k)]];
         history = next_history(history, bit);
     }

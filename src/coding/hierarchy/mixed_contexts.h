@@ -114,7 +114,7 @@ private:
     std::array<uint32_t, kThirdDirect> slot_{};
     // Stretched inputs: the direct models 0-20, the bit histories, the third model's direct
     // models 21-24, then the bias.
-    std::array<int, kThirdInputs + 1> st_{};
+    std::array<int, mixing::Mixer::padded(kThirdInputs + 1)> st_{};
     // Second model: per context of direct models 1, 4 and 11 its last bits (up to 7, led by a 1),
     // and per such input an adaptive probability of each group x history.
     std::array<std::vector<uint8_t>, kIndirectInputs> histories_;
