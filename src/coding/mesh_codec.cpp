@@ -50,25 +50,26 @@ std::vector<Vec3> live_positions(const Hierarchy& h) {
 constexpr size_t kPositionRange = size_t(1) << 16;
 
 // make_quantizer(points)'s bounding box, the points' ranges on `threads` threads: each range's
-// fold of std::fmin / std::fmax, then the ranges' in order, which is the one fold over all points
-// (whichever of two equal-valued zeros std::fmin keeps, it keeps the same one here).
+// fold, then the ranges' in order, which is the one fold over all points. Inline, for finite
+// points what std::fmin / std::fmax give (of two equal values, the first: glibc keeps lo's zero).
 std::pair<Vec3, Vec3> bounding_box(const std::vector<Vec3>& points, unsigned threads) {
+    auto lower = [](Vec3 lo, Vec3 p) { return Vec3{p.x < lo.x ? p.x : lo.x, p.y < lo.y ? p.y : lo.y, p.z < lo.z ? p.z : lo.z}; };
+    auto higher = [](Vec3 hi, Vec3 p) { return Vec3{p.x > hi.x ? p.x : hi.x, p.y > hi.y ? p.y : hi.y, p.z > hi.z ? p.z : hi.z}; };
     const size_t ranges = (points.size() + kPositionRange - 1) / kPositionRange;
     std::vector<std::pair<Vec3, Vec3>> boxes(ranges);
     parallel_for(ranges, threads, [&](size_t i) {
         const size_t begin = i * kPositionRange, end = std::min(points.size(), begin + kPositionRange);
         Vec3 lo = points[begin], hi = points[begin];
         for (size_t v = begin; v < end; ++v) {
-            const Vec3 p = points[v];
-            lo = {std::fmin(lo.x, p.x), std::fmin(lo.y, p.y), std::fmin(lo.z, p.z)};
-            hi = {std::fmax(hi.x, p.x), std::fmax(hi.y, p.y), std::fmax(hi.z, p.z)};
+            lo = lower(lo, points[v]);
+            hi = higher(hi, points[v]);
         }
         boxes[i] = {lo, hi};
     });
     Vec3 lo = boxes[0].first, hi = boxes[0].second;
     for (const auto& box : boxes) {
-        lo = {std::fmin(lo.x, box.first.x), std::fmin(lo.y, box.first.y), std::fmin(lo.z, box.first.z)};
-        hi = {std::fmax(hi.x, box.second.x), std::fmax(hi.y, box.second.y), std::fmax(hi.z, box.second.z)};
+        lo = lower(lo, box.first);
+        hi = higher(hi, box.second);
     }
     return {lo, hi};
 }
