@@ -85,14 +85,19 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
     for (size_t begin = 0, end = roots; begin < end;) {
         const size_t level_ranges = (end - begin + kRange - 1) / kRange;
         split_before.assign(level_ranges + 1, 0);
+        // (Through local pointers and counts: a store through a uint8_t may alias anything, and made
+        // the compiler reload the vectors' pointers after each.)
         parallel_for(level_ranges, threads, [&](size_t i) {  // first_child[j]: the old node's, for now
-            for (size_t j = begin + i * kRange; j < std::min(end, begin + (i + 1) * kRange); ++j) {
-                if (j + kAhead < end) prefetch(h, old_of[j + kAhead]);
-                const NodeId o = old_of[j];
-                new_of[o] = NodeId(j);
-                first_child[j] = h.is_leaf(o) ? kNoNode : h.child(o, 0);
-                split_before[i + 1] += first_child[j] != kNoNode;
+            const NodeId* old = old_of.data();
+            NodeId* first = first_child.data();
+            uint64_t split = 0;
+            for (size_t j = begin + i * kRange, stop = std::min(end, begin + (i + 1) * kRange); j < stop; ++j) {
+                if (j + kAhead < end) prefetch(h, old[j + kAhead]);
+                new_of[old[j]] = NodeId(j);
+                first[j] = h.is_leaf(old[j]) ? kNoNode : h.child(old[j], 0);
+                split += first[j] != kNoNode;
             }
+            split_before[i + 1] = split;
         });
         for (size_t i = 0; i < level_ranges; ++i) split_before[i + 1] += split_before[i];
         const size_t next_end = end + 4 * size_t(split_before[level_ranges]);
@@ -101,14 +106,18 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
         turn.resize(next_end);
         first_child.resize(next_end);
         parallel_for(level_ranges, threads, [&](size_t i) {
+            NodeId* old = old_of.data();
+            NodeId* first = first_child.data();
+            uint8_t* turned = turn.data();
             size_t next = end + 4 * size_t(split_before[i]);
-            for (size_t j = begin + i * kRange; j < std::min(end, begin + (i + 1) * kRange); ++j) {
-                const NodeId old_first = first_child[j];
+            for (size_t j = begin + i * kRange, stop = std::min(end, begin + (i + 1) * kRange); j < stop; ++j) {
+                const NodeId old_first = first[j];
                 if (old_first == kNoNode) continue;
-                first_child[j] = NodeId(next);
+                first[j] = NodeId(next);
+                const uint8_t r = turned[j];
                 for (int k = 0; k < 4; ++k) {
-                    old_of[next + size_t(k)] = old_first + NodeId(red_split::kRotatedChild[turn[j]][k]);
-                    turn[next + size_t(k)] = turn[j];
+                    old[next + size_t(k)] = old_first + NodeId(red_split::kRotatedChild[r][k]);
+                    turned[next + size_t(k)] = r;
                 }
                 next += 4;
             }
