@@ -9,6 +9,7 @@
 #include <amc/hierarchy.h>
 
 #include <algorithm>
+#include <memory>
 #include <string>
 
 namespace amc {
@@ -73,7 +74,9 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
     old_of.reserve(h.node_count());
     first_child.reserve(h.node_count());
     turn.reserve(h.node_count());
-    std::vector<NodeId> new_of(h.node_capacity(), kNoNode);
+    // Left unset: only live nodes are reached and looked up, and their entries are written by the
+    // threads' first pass (which takes the first touch of its pages off the serial part too).
+    const std::unique_ptr<NodeId[]> new_of(new NodeId[h.node_capacity()]);
     for (uint32_t t = 0; t < triangle_order.size(); ++t) {
         old_of[t] = triangle_order[t];
         turn[t] = rotation[t];
