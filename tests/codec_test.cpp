@@ -495,7 +495,10 @@ TEST(Codec, DiagonalRulesOfAbsoluteLocalIndicesStayCheap) {
         h.set_diagonal_flipped(n, diagonal_flag_by_rule(DiagonalRule::lower_local_index, u));
     }
     EncodeStats stats;
-    const std::vector<uint8_t> bytes = encode(h, {}, &stats);
+    EncodeOptions with_statistics;
+    with_statistics.hierarchy_statistics = true;
+    const std::vector<uint8_t> bytes = encode(h, with_statistics, &stats);
+    EXPECT_GT(stats.hierarchy.coded, 0u);
     EXPECT_EQ(stats.hierarchy.diagonal_exceptions, 0u);
     EXPECT_TRUE(identical(decode(bytes.data(), bytes.size()), in_decoder_order(h)));
     Hierarchy by_default = h;

@@ -187,6 +187,17 @@ TEST(VtuWriter, BinaryLayoutIsVtks) {
     EXPECT_GT(header[3], 8u);  // 8 bytes do not shrink under zlib
 }
 
+TEST(VtuWriter, ThreadsChangeNoByte) {
+    // 400 x 400 quads: 3.9 MB of Float64 points and 3.8 MB of connectivity, several runs of zlib
+    // blocks (1 MiB each) for the threads to share.
+    VtuMesh vtu;
+    vtu.mesh = grid(400, 400, false);
+    const std::string one = format_vtu(vtu.mesh, {}, {}, VtuEncoding::binary_zlib, 1);
+    EXPECT_EQ(format_vtu(vtu.mesh, {}, {}, VtuEncoding::binary_zlib, 3), one);
+    EXPECT_EQ(format_vtu(vtu.mesh, {}, {}, VtuEncoding::binary_zlib, 0), one);
+    expect_same(parse_vtu(one, "threads.vtu"), vtu);
+}
+
 TEST(VtuWriter, WriteMeshWritesLevelAndGreenAndReadsBack) {
     const std::string path = temp_path("leaf.VTU");
     const TriangleMesh mesh = grid(3, 2, false);

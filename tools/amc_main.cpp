@@ -127,7 +127,7 @@ int main(int argc, char** argv) {
                          "Accept a file still arriving (cut anywhere after the base mesh): decode its complete levels");
     decode_cmd->add_option("--map", decode.map, "Write the stored numbering map (input's numbering -> canonical)");
     add_max_nodes(decode_cmd, decode.max_nodes);
-    decode_cmd->add_option("--threads", decode.threads, "Threads that decode chunks at once (0: every core)")
+    decode_cmd->add_option("--threads", decode.threads, "Threads that decode chunks at once and compress a VTU output (0: every core)")
         ->check(CLI::Range(0u, 4096u));
     decode_cmd->add_option("--chunks", decode.chunks,
                            "Decode only these chunks (amc info lists them), e.g. 0,3-5: their roots' trees alone");

@@ -259,10 +259,10 @@ void run_decode(const DecodeCommand& command, const GlobalOptions& global) {
         if (!numbering.empty() && !command.canonical) {
             CellData cells;
             const TriangleMesh mesh = renumber_leaf_mesh(leaf, numbering, &cells);
-            write_output(output, format_mesh(mesh, &cells, mesh_format, global.mesh_encoding), global.force);
+            write_output(output, format_mesh(mesh, &cells, mesh_format, global.mesh_encoding, command.threads), global.force);
             renumbered = true;
         } else {
-            write_output(output, format_mesh(leaf.mesh, &leaf.cells, mesh_format, global.mesh_encoding), global.force);
+            write_output(output, format_mesh(leaf.mesh, &leaf.cells, mesh_format, global.mesh_encoding, command.threads), global.force);
         }
     }
     if (!command.map.empty()) write_output(command.map, format_numbering_map(numbering), global.force);

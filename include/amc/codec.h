@@ -90,6 +90,10 @@ struct EncodeOptions {
     bool keep_base_order = false;
     // Threads that code chunks at once; 0: every core. The bytes do not depend on it.
     unsigned threads = 0;
+    // Fill EncodeStats::hierarchy (the hierarchy coder's own statistics, for files of one chunk):
+    // the coded symbols are replayed through the models, about 4 % of a default encode and the
+    // whole model again in the mixing mode, so only when asked for. The bytes do not depend on it.
+    bool hierarchy_statistics = false;
 };
 
 struct LevelStats {
@@ -112,7 +116,7 @@ struct EncodeStats {
     int levels = 0;
     double max_error = 0;                   // largest coordinate error (0 unless quantized)
     std::vector<LevelStats> per_level;
-    HierarchyCodeStats hierarchy;           // the hierarchy coder's own statistics
+    HierarchyCodeStats hierarchy;           // the hierarchy coder's own statistics (EncodeOptions::hierarchy_statistics)
     // EncodeOptions::numbering against extract_leaf_mesh of the decoded hierarchy (empty without
     // one): the map a caller keeps when the file does not store it.
     LeafNumbering numbering;

@@ -33,13 +33,14 @@ enum class MeshEncoding { binary, ascii };
 
 // Writes a mesh; format from the extension. Cell data is written where the format can hold it
 // and its readers read it (VTU cell arrays; ASCII PLY face properties, see format_ply) and
-// ignored otherwise; binary VTU is VtuEncoding::binary_zlib. The file is written to a temporary
-// name and renamed, so it is never half-written. Throws Error.
+// ignored otherwise; binary VTU is VtuEncoding::binary_zlib, its zlib blocks compressed on up to
+// `threads` threads (0: every core; the bytes do not depend on it). The file is written to a
+// temporary name and renamed, so it is never half-written. Throws Error.
 void write_mesh(const std::string& path, const TriangleMesh& mesh, const CellData* cells = nullptr,
-                MeshEncoding encoding = MeshEncoding::binary);
+                MeshEncoding encoding = MeshEncoding::binary, unsigned threads = 0);
 // The bytes write_mesh would write, for a format chosen by the caller (output to a stream).
 std::string format_mesh(const TriangleMesh& mesh, const CellData* cells, MeshFormat format,
-                        MeshEncoding encoding = MeshEncoding::binary);
+                        MeshEncoding encoding = MeshEncoding::binary, unsigned threads = 0);
 
 // Reads a .vtu file as VTK, ParaView, meshio and DUNE write it: inline ascii or base64
 // ("binary"), or appended raw or base64 data; UInt32 or UInt64 headers; zlib-compressed
@@ -57,9 +58,10 @@ enum class VtuEncoding {
 
 // Writes a .vtu file: Points as Float32 when mesh.single_precision, else Float64; cells as
 // triangles; every array of point_data and cell_data (sizes must match the vertex and triangle
-// counts). Through a temporary file and a rename. Throws Error.
+// counts); zlib blocks on up to `threads` threads (0: every core). Through a temporary file and a
+// rename. Throws Error.
 void write_vtu(const std::string& path, const VtuMesh& vtu,
-               VtuEncoding encoding = VtuEncoding::binary_zlib);
+               VtuEncoding encoding = VtuEncoding::binary_zlib, unsigned threads = 0);
 
 // ---- files that name or hold meshes ------------------------------------------------------------
 

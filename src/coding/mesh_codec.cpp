@@ -200,7 +200,7 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
             add_level_stats(out.stats, hierarchy.level_nodes(l).size(), created.size(), hierarchy_part, payload);
             out.blocks.emplace_back(BlockType::level, std::move(payload));
         }
-        if (want_hierarchy_stats) out.stats.hierarchy = hierarchy.stats();  // replays the coded symbols: only when asked for
+        if (want_hierarchy_stats) out.stats.hierarchy = hierarchy.stats();
     }
     for (const auto& block : out.blocks) out.bytes += kBlockOverhead + block.second.size();
     return out;
@@ -251,7 +251,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     const std::vector<RootRange> chunks = !options.chunk_roots.empty() ? explicit_chunks(options.chunk_roots, h.root_count())
                                           : one_chunk ? std::vector<RootRange>{RootRange{0, h.root_count()}}
                                                       : balanced_chunks(root_nodes, chunk_count_for(options, faces));
-    const bool want_hierarchy_stats = stats_out != nullptr;
+    const bool want_hierarchy_stats = stats_out != nullptr && options.hierarchy_statistics;
     ForestCode forest = code_forest(h, root_of, chunks, faces, options, space, positions, threads, want_hierarchy_stats);
     const uint32_t fewer = automatic && forest.chunked ? chunk_count_for_size(options, uint32_t(chunks.size()), forest.bytes)
                                                        : uint32_t(chunks.size());

@@ -70,24 +70,24 @@ TriangleMesh read_mesh(const std::string& path) {
 }
 
 std::string format_mesh(const TriangleMesh& mesh, const CellData* cells, MeshFormat format,
-                        MeshEncoding encoding) {
+                        MeshEncoding encoding, unsigned threads) {
     switch (format) {
         case MeshFormat::obj: return format_obj(mesh);
         case MeshFormat::off: return format_off(mesh);
         case MeshFormat::ply: return format_ply(mesh, cells, encoding);
         case MeshFormat::vtu:
             return format_vtu(mesh, {}, cells ? cell_data_arrays(*cells) : std::vector<DataArray>{},
-                              encoding == MeshEncoding::ascii ? VtuEncoding::ascii : VtuEncoding::binary_zlib);
+                              encoding == MeshEncoding::ascii ? VtuEncoding::ascii : VtuEncoding::binary_zlib, threads);
     }
     return {};
 }
 
 void write_mesh(const std::string& path, const TriangleMesh& mesh, const CellData* cells,
-                MeshEncoding encoding) {
+                MeshEncoding encoding, unsigned threads) {
     const MeshFormat format = mesh_format_from_path(path);
     std::string bytes;
     try {
-        bytes = format_mesh(mesh, cells, format, encoding);
+        bytes = format_mesh(mesh, cells, format, encoding, threads);
     } catch (const Error& e) {
         throw e.prefixed(path);
     }
@@ -101,10 +101,10 @@ VtuMesh read_vtu(const std::string& path) {
     return vtu;
 }
 
-void write_vtu(const std::string& path, const VtuMesh& vtu, VtuEncoding encoding) {
+void write_vtu(const std::string& path, const VtuMesh& vtu, VtuEncoding encoding, unsigned threads) {
     std::string bytes;
     try {
-        bytes = format_vtu(vtu.mesh, vtu.point_data, vtu.cell_data, encoding);
+        bytes = format_vtu(vtu.mesh, vtu.point_data, vtu.cell_data, encoding, threads);
     } catch (const Error& e) {
         throw e.prefixed(path);
     }

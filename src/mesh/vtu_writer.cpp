@@ -118,7 +118,7 @@ void append_ascii_values(std::string& out, const DataArray& a) {
 // their text (ascii).
 class ArrayWriter {
 public:
-    ArrayWriter(std::string& xml, VtuEncoding encoding) : xml_(xml), encoding_(encoding) {}
+    ArrayWriter(std::string& xml, VtuEncoding encoding, unsigned threads) : xml_(xml), encoding_(encoding), threads_(threads) {}
 
     void write(const DataArray& a) {
         if (encoding_ == VtuEncoding::ascii) {
@@ -129,7 +129,7 @@ public:
         }
         xml_ += array_tag(a, "format=\"appended\" offset=\"" + std::to_string(appended_.size()) + "\"/>\n");
         const auto [data, size] = raw_bytes(a);
-        const CompressedBlocks blocks = compress_zlib_blocks(data, size, kVtkBlockSize, kZlibLevel);
+        const CompressedBlocks blocks = compress_zlib_blocks(data, size, kVtkBlockSize, kZlibLevel, threads_);
         const uint64_t count = blocks.compressed_sizes.size();
         const uint64_t last = size % kVtkBlockSize;
         append_word(count);
@@ -151,22 +151,23 @@ private:
 
     std::string& xml_;
     VtuEncoding encoding_;
+    unsigned threads_;
     std::string appended_;
 };
 
 }  // namespace
 
 std::string format_vtu(const TriangleMesh& mesh, const std::vector<DataArray>& point_data,
-                       const std::vector<DataArray>& cell_data, VtuEncoding encoding) {
+                       const std::vector<DataArray>& cell_data, VtuEncoding encoding, unsigned threads) {
     static_assert(sizeof(Triangle) == 3 * sizeof(uint32_t), "triangles are three packed indices");
     const VtuCells triangles{mesh.triangles.empty() ? nullptr : mesh.triangles[0].data(), mesh.triangles.size(), 3,
                              static_cast<uint8_t>(kVtkTriangle)};
-    return format_vtu_cells(mesh.positions, mesh.single_precision, triangles, point_data, cell_data, encoding);
+    return format_vtu_cells(mesh.positions, mesh.single_precision, triangles, point_data, cell_data, encoding, threads);
 }
 
 std::string format_vtu_cells(const std::vector<Vec3>& positions, bool single_precision, const VtuCells& cells,
                              const std::vector<DataArray>& point_data, const std::vector<DataArray>& cell_data,
-                             VtuEncoding encoding) {
+                             VtuEncoding encoding, unsigned threads) {
     check_sizes(point_data, positions.size(), "point data");
     check_sizes(cell_data, cells.count, "cell data");
     const GeometryArrays geometry = geometry_arrays(positions, single_precision, cells);
@@ -182,7 +183,7 @@ std::string format_vtu_cells(const std::vector<Vec3>& positions, bool single_pre
     xml += ">\n  <UnstructuredGrid>\n";
     xml += "    <Piece NumberOfPoints=\"" + std::to_string(positions.size()) + "\" NumberOfCells=\"" +
            std::to_string(cells.count) + "\">\n";
-    ArrayWriter arrays(xml, encoding);
+    ArrayWriter arrays(xml, encoding, threads);
     if (!point_data.empty()) {
         xml += "      <PointData>\n";
         for (const DataArray& a : point_data) arrays.write(a);

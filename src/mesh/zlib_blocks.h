@@ -23,9 +23,10 @@ struct CompressedBlocks {
     std::string bytes;                       // the blocks, one after another
 };
 
-// Compresses `size` bytes in blocks of `block_size`. Throws Error if zlib fails.
+// Compresses `size` bytes in blocks of `block_size`, on up to `threads` threads (0: every core;
+// the bytes do not depend on it). Throws Error if zlib fails.
 CompressedBlocks compress_zlib_blocks(const uint8_t* data, std::size_t size, std::size_t block_size,
-                                      int level);
+                                      int level, unsigned threads = 1);
 
 // Inflates one block: true only if `in` is exactly one complete zlib stream of `out_size` bytes.
 bool inflate_zlib_block(const uint8_t* in, std::size_t in_size, uint8_t* out, std::size_t out_size);
