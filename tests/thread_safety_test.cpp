@@ -6,6 +6,7 @@
 #include <amc/codec.h>
 #include <amc/hierarchy_coder.h>
 #include <amc/mesh.h>
+#include <amc/mesh_io.h>
 #include <amc/octree.h>
 #include <amc/series.h>
 #include <amc/simulation.h>
@@ -110,6 +111,24 @@ TEST(ThreadSafety, ConcurrentSeriesAndOctreeCodingGivesTheSerialResults) {
 
 // Threads writing the same path at once: every write is whole, the last rename wins, no temporary
 // file is left (write_file_atomically's names are unique per call).
+// The VTU writer compresses runs of zlib blocks on several threads (docs/VTU.md): arrays of several
+// MiB, so that the runs are shared out, give the bytes of one thread.
+TEST(ThreadSafety, VtuWriterThreadsGiveTheSerialBytes) {
+    TriangleMesh mesh;
+    constexpr uint32_t kSide = 300;
+    for (uint32_t j = 0; j <= kSide; ++j)
+        for (uint32_t i = 0; i <= kSide; ++i) mesh.positions.push_back({i * 0.1, j * 0.3, double(i * j % 17)});
+    for (uint32_t j = 0; j < kSide; ++j) {
+        for (uint32_t i = 0; i < kSide; ++i) {
+            const uint32_t a = j * (kSide + 1) + i;
+            mesh.triangles.push_back({a, a + 1, a + kSide + 2});
+            mesh.triangles.push_back({a, a + kSide + 2, a + kSide + 1});
+        }
+    }
+    const std::string one = format_mesh(mesh, nullptr, MeshFormat::vtu, MeshEncoding::binary, 1);
+    EXPECT_EQ(format_mesh(mesh, nullptr, MeshFormat::vtu, MeshEncoding::binary, kThreads), one);
+}
+
 TEST(ThreadSafety, ConcurrentAtomicWritesOfOnePathLeaveOneWholeFile) {
     const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("amc_threads_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);

@@ -135,6 +135,10 @@ struct HierarchyBuilder {
         h.positions_[v] = p;
         h.far_positions_.raise_if(Hierarchy::is_far(p));
     }
+    // The same for a position that a decoder knows to be near (not Hierarchy::is_far): a grid
+    // point of a box whose corners are near. Without the test, a sixth of a grid level's stores.
+    AMC_ALWAYS_INLINE static void set_near_vertex_position(Hierarchy& h, VertexId v, Vec3 p) { h.positions_[v] = p; }
+    static bool is_far(Vec3 p) { return Hierarchy::is_far(p); }
     // The trees of `roots` (ids in h, in this order) as a hierarchy of their own over `base`, their
     // triangles in that order (its vertex i being h's base_vertex[i]), as replaying their splits
     // breadth-first with split() makes it: the same node and vertex ids, links and boundary flags,

@@ -68,19 +68,17 @@ void check_repeated_triangles(const TriangleMesh& mesh, const std::string& what)
             return mid != o.mid ? mid < o.mid : high != o.high ? high < o.high : index < o.index;
         }
     };
-    auto sorted = [&](std::size_t t) {
-        Triangle s = mesh.triangles[t];
-        std::sort(s.begin(), s.end());
-        return s;
-    };
+    // Each triangle's vertices sorted once (bucket_by_vertex reads an item twice, then makes it).
+    std::vector<Triangle> sorted(mesh.triangles.size());
+    for (std::size_t t = 0; t < sorted.size(); ++t) {
+        const Triangle& tri = mesh.triangles[t];
+        const uint32_t lo = std::min(tri[0], tri[1]), hi = std::max(tri[0], tri[1]);
+        sorted[t] = {std::min(lo, tri[2]), std::max(lo, std::min(hi, tri[2])), std::max(hi, tri[2])};
+    }
     std::vector<Key> keys;
     const std::vector<std::size_t> start = bucket_by_vertex(
-        mesh.positions.size(), mesh.triangles.size(), [&](std::size_t t) { return sorted(t)[0]; },
-        [&](std::size_t t) {
-            Triangle s = sorted(t);
-            return Key{s[1], s[2], static_cast<uint32_t>(t)};
-        },
-        keys);
+        mesh.positions.size(), mesh.triangles.size(), [&](std::size_t t) { return sorted[t][0]; },
+        [&](std::size_t t) { return Key{sorted[t][1], sorted[t][2], static_cast<uint32_t>(t)}; }, keys);
     // Report the repeat with the smallest index, so the message does not depend on the order.
     std::size_t best_first = 0, best_repeat = SIZE_MAX;
     for (std::size_t v = 0; v + 1 < start.size(); ++v) {
@@ -113,21 +111,20 @@ void check_edges(const TriangleMesh& mesh, const std::string& what) {
             return high != o.high ? high < o.high : face < o.face;
         }
     };
-    auto ends = [&](std::size_t h) {
-        const Triangle& tri = mesh.triangles[h / 3];
-        return std::pair<uint32_t, uint32_t>(tri[h % 3], tri[(h + 1) % 3]);
-    };
+    // Each half-edge's lower vertex and entry made once (bucket_by_vertex reads an item twice).
+    std::vector<uint32_t> low(mesh.triangles.size() * 3);
+    std::vector<HalfEdge> made(low.size());
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+        const Triangle& tri = mesh.triangles[t];
+        for (int i = 0; i < 3; ++i) {
+            const uint32_t a = tri[i], b = tri[i == 2 ? 0 : i + 1];
+            low[3 * t + i] = std::min(a, b);
+            made[3 * t + i] = HalfEdge{std::max(a, b), static_cast<uint32_t>(t), a < b};
+        }
+    }
     std::vector<HalfEdge> edges;
     const std::vector<std::size_t> start = bucket_by_vertex(
-        mesh.positions.size(), mesh.triangles.size() * 3,
-        [&](std::size_t h) {
-            auto [a, b] = ends(h);
-            return std::min(a, b);
-        },
-        [&](std::size_t h) {
-            auto [a, b] = ends(h);
-            return HalfEdge{std::max(a, b), static_cast<uint32_t>(h / 3), a < b};
-        },
+        mesh.positions.size(), low.size(), [&](std::size_t h) { return low[h]; }, [&](std::size_t h) { return made[h]; },
         edges);
     for (std::size_t lo = 0; lo + 1 < start.size(); ++lo) {
         const auto first = edges.begin() + start[lo], last = edges.begin() + start[lo + 1];

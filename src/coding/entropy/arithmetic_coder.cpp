@@ -1,8 +1,10 @@
 // LZMA-style binary range coder; see arithmetic_coder.h for the bitstream and the model.
 #include "coding/entropy/arithmetic_coder.h"
 
+#include "common/bits.h"
 #include "common/exact_float.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -101,11 +103,18 @@ uint32_t ArithmeticDecoder::decode_bits_raw(int count) {
     check_raw_count(count, "ArithmeticDecoder::decode_bits_raw");
     uint32_t value = 0;
     uint32_t range = range_, code = code_;  // in registers, as in the encoder
-    for (int i = 0; i < count; ++i) {
-        range >>= 1;
-        const uint32_t bit = code >= range ? 1u : 0u;
-        code -= range & (0u - bit);  // without a branch, as in the encoder
-        value = (value << 1) | bit;
+    for (int left = count; left > 0;) {
+        // A range of bit_length B >= 25 halves B - 25 times and stays at kTop or above; the next
+        // halving takes it below. So that many bits and one more go without the test, then the
+        // byte shifts: the same steps as a test after every bit.
+        const int run = std::min(left, bit_length(range) - 24);
+        for (int i = 0; i < run; ++i) {
+            range >>= 1;
+            const uint32_t bit = code >= range ? 1u : 0u;
+            code -= range & (0u - bit);  // without a branch, as in the encoder
+            value = (value << 1) | bit;
+        }
+        left -= run;
         while (range < kTop) {
             range <<= 8;
             code = (code << 8) | next_byte();

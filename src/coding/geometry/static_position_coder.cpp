@@ -94,13 +94,25 @@ struct GridPrediction {
     bool turn;
 };
 
+// The grid as the predictions read it, made once a level: the step and the largest grid
+// coordinate, also as a double (from Quantizer::bits at every use, a shift, a subtraction and a
+// conversion a coordinate). Zero without a quantizer.
+struct GridScale {
+    double step = 0.0, top = 0.0;
+    uint32_t max = 0;
+};
+GridScale grid_scale(const Quantizer* quantizer) {
+    if (quantizer == nullptr) return {};
+    return {quantizer->step, static_cast<double>(quantizer->max_coordinate()), quantizer->max_coordinate()};
+}
+
 // Inlined: returned through memory, the small struct stalls the decoder's loop on a store forward.
 // `origin`: the quantizer's origin on the axis.
-AMC_ALWAYS_INLINE GridPrediction grid_prediction_at(const Quantizer& quantizer, double origin, double x) {
+AMC_ALWAYS_INLINE GridPrediction grid_prediction_at(const GridScale& grid, double origin, double x) {
     // quantize_coordinate's steps, its t kept for the bin.
-    const double t = rounded((x - origin) / quantizer.step);
+    const double t = rounded((x - origin) / grid.step);
     if (!(t > 0.0)) return {0, 0, false};  // also NaN
-    if (t >= static_cast<double>(quantizer.max_coordinate())) return {quantizer.max_coordinate(), 0, false};
+    if (t >= grid.top) return {grid.max, 0, false};
     GridPrediction g{static_cast<uint32_t>(t + 0.5), 0, false};  // floor, as in quantize_coordinate
     const double f = rounded(t - static_cast<double>(g.p));
     g.turn = f < 0.0;
@@ -116,11 +128,11 @@ AMC_ALWAYS_INLINE Residual grid_residual(const Quantizer& quantizer, int axis, d
 
 // `origin`: the quantizer's origin on the axis (dequantize_coordinate's); `residual` signed
 // (|residual| < 2^bits).
-AMC_ALWAYS_INLINE bool grid_value(const Quantizer& quantizer, double origin, const GridPrediction& g, int64_t residual,
+AMC_ALWAYS_INLINE bool grid_value(const GridScale& grid, double origin, const GridPrediction& g, int64_t residual,
                                   double& value) {
     const int64_t q = int64_t(g.p) + negated_if(residual, g.turn);
-    if (q < 0 || q > int64_t(quantizer.max_coordinate())) return false;
-    value = origin + rounded(static_cast<double>(q) * quantizer.step);
+    if (q < 0 || q > int64_t(grid.max)) return false;
+    value = origin + rounded(static_cast<double>(q) * grid.step);
     return true;
 }
 
@@ -279,14 +291,20 @@ void gather_chunk(const Hierarchy& h, const Source& source, size_t begin, size_t
     c.begin = begin;
     c.count = begin < end ? std::min(kChunk, end - begin) : 0;
     source.get(c);
-    for (size_t i = 0; i < c.count; ++i)
-        for (VertexId v : {c.corners[i].a, c.corners[i].b, c.corners[i].c, c.corners[i].d})
-            if (v != kNoVertex) __builtin_prefetch(&h.positions()[v]);
+    const Vec3* positions = h.positions().data();
+    for (size_t i = 0; i < c.count; ++i) {  // a, b and c are always vertices
+        const FrameCorners& k = c.corners[i];
+        __builtin_prefetch(positions + k.a);
+        __builtin_prefetch(positions + k.b);
+        __builtin_prefetch(positions + k.c);
+        if (k.d != kNoVertex) __builtin_prefetch(positions + k.d);
+    }
 }
 
 // Vertex i's frame in role order.
 template <bool Grid>
-AMC_ALWAYS_INLINE void role_frame(const NormalFrame& frame, const Quantizer* quantizer, Chunk& c, size_t i) {
+AMC_ALWAYS_INLINE void role_frame(const NormalFrame& frame, const Quantizer* quantizer, const GridScale& grid, Chunk& c,
+                                  size_t i) {
     const std::array<int, 3> axes = role_axes(frame);
     RoleFrame& f = c.frames[i];
     // Indexed by axis, without axis_coordinate's selects.
@@ -301,24 +319,24 @@ AMC_ALWAYS_INLINE void role_frame(const NormalFrame& frame, const Quantizer* qua
         f.origin[r] = origin[axes[size_t(r)]];
     }
     f.has_normal = frame.has_normal;
-    if (Grid) c.first[i] = grid_prediction_at(*quantizer, f.origin[0], f.midpoint[0]);
+    if (Grid) c.first[i] = grid_prediction_at(grid, f.origin[0], f.midpoint[0]);
 }
 
 // The chunk's frames in role order, two at a time where SSE2 computes two frames at once.
 template <bool Grid, bool UnitNormals>
-AMC_ALWAYS_INLINE void frame_chunk(const Hierarchy& h, const Quantizer* quantizer, Chunk& c) {
+AMC_ALWAYS_INLINE void frame_chunk(const Hierarchy& h, const Quantizer* quantizer, const GridScale& grid, Chunk& c) {
     size_t i = 0;
 #if AMC_SSE2
     if (!h.single_precision()) {
         for (; i + 1 < c.count; i += 2) {
             NormalFrame f0, f1;
             frame_pair_of<UnitNormals>(h, c.corners[i], c.corners[i + 1], f0, f1);
-            role_frame<Grid>(f0, quantizer, c, i);
-            role_frame<Grid>(f1, quantizer, c, i + 1);
+            role_frame<Grid>(f0, quantizer, grid, c, i);
+            role_frame<Grid>(f1, quantizer, grid, c, i + 1);
         }
     }
 #endif
-    for (; i < c.count; ++i) role_frame<Grid>(frame_of<UnitNormals>(h, c.corners[i]), quantizer, c, i);
+    for (; i < c.count; ++i) role_frame<Grid>(frame_of<UnitNormals>(h, c.corners[i]), quantizer, grid, c, i);
 }
 
 // NormalFrame::predict in role order: roles 1 and 2's predictions once role 0's value is known.
@@ -385,12 +403,13 @@ void StaticLevelEncoder::add_vertices(const Hierarchy& h, const std::vector<std:
                                       size_t end) {
     const CoordinateSpace space = space_;
     const Quantizer* quantizer = space.quantizer;
+    const GridScale grid = grid_scale(quantizer);
     uint64_t raw_bits = 0;
     Chunk c;
     for (size_t first = begin; first < end; first += kChunk) {
         gather_chunk(h, FromNodes{h, created}, first, end, c);
         for (size_t i = 0; i < c.count; ++i) __builtin_prefetch(&h.positions()[c.vertices[i]]);
-        frame_chunk<GridBins, UnitNormals>(h, quantizer, c);
+        frame_chunk<GridBins, UnitNormals>(h, quantizer, grid, c);
         for (size_t i = 0; i < c.count; ++i) {
             const RoleFrame& f = c.frames[i];
             const Vec3 p = h.position(c.vertices[i]);
@@ -403,7 +422,7 @@ void StaticLevelEncoder::add_vertices(const Hierarchy& h, const std::vector<std:
                 Residual r;
                 int table = role;
                 if (GridBins) {
-                    const GridPrediction g = role == 0 ? c.first[i] : grid_prediction_at(*quantizer, f.origin[role], predicted[role]);
+                    const GridPrediction g = role == 0 ? c.first[i] : grid_prediction_at(grid, f.origin[role], predicted[role]);
                     r = grid_residual(*quantizer, axis, actual[axis], g);
                     table = kGridBins * role + g.bin;
                 } else {
@@ -501,22 +520,21 @@ namespace {
 // One vertex's three coordinates; its first token is coded with rANS state `State` (token j of the
 // level with state j mod 2), its second with the other, its third with `State` again.
 template <int State, bool Grid>
-AMC_ALWAYS_INLINE bool decode_vertex(const Chunk& b, size_t i, CoordinateSpace space, const StaticTables& tables,
-                                     RansDecoder& rans, RawBitReader& raw, Vec3& p) {
+AMC_ALWAYS_INLINE bool decode_vertex(const Chunk& b, size_t i, CoordinateSpace space, const GridScale& grid,
+                                     const StaticTables& tables, RansDecoder& rans, RawBitReader& raw, Vec3& p) {
     const RoleFrame& f = b.frames[i];
     double value[3], second, third;
     if (Grid) {
-        const Quantizer& quantizer = *space.quantizer;
         const GridPrediction& first = b.first[i];
-        if (!grid_value(quantizer, f.origin[0], first, take_signed(rans.get_with<State>(tables[size_t(first.bin)]), raw), value[0]))
+        if (!grid_value(grid, f.origin[0], first, take_signed(rans.get_with<State>(tables[size_t(first.bin)]), raw), value[0]))
             return false;
         predict_others(f, value[0], second, third);
-        const GridPrediction g1 = grid_prediction_at(quantizer, f.origin[1], second);
-        const GridPrediction g2 = grid_prediction_at(quantizer, f.origin[2], third);
+        const GridPrediction g1 = grid_prediction_at(grid, f.origin[1], second);
+        const GridPrediction g2 = grid_prediction_at(grid, f.origin[2], third);
         const int64_t r1 = take_signed(rans.get_with<1 - State>(tables[size_t(kGridBins + g1.bin)]), raw);
-        if (!grid_value(quantizer, f.origin[1], g1, r1, value[1])) return false;
+        if (!grid_value(grid, f.origin[1], g1, r1, value[1])) return false;
         const int64_t r2 = take_signed(rans.get_with<State>(tables[size_t(2 * kGridBins + g2.bin)]), raw);
-        if (!grid_value(quantizer, f.origin[2], g2, r2, value[2])) return false;
+        if (!grid_value(grid, f.origin[2], g2, r2, value[2])) return false;
     } else {
         if (!value_of(space, f.axes[0], f.midpoint[0], take(rans.get_with<State>(tables[0]), raw), value[0])) return false;
         predict_others(f, value[0], second, third);
@@ -544,17 +562,27 @@ bool decode_positions(Hierarchy& h, const Source& created, CoordinateSpace space
         space.quantizer = &local_quantizer;
     }
     const Quantizer* quantizer = space.quantizer;
+    const GridScale grid = grid_scale(quantizer);
+    // A grid value origin + rounded(q * step), 0 <= q <= max, lies between the box's corners
+    // (both operations round monotonically): when they are near, every position is.
+    const bool near = quantizer != nullptr && !HierarchyBuilder::is_far(quantizer->origin) &&
+                      !HierarchyBuilder::is_far(dequantize(*quantizer, {quantizer->max_coordinate(), quantizer->max_coordinate(),
+                                                                        quantizer->max_coordinate()}));
+    auto set = [&h, near](VertexId v, Vec3 p) {
+        if (near) HierarchyBuilder::set_near_vertex_position(h, v, p);
+        else HierarchyBuilder::set_new_vertex_position(h, v, p);
+    };
     Chunk c;
     for (size_t begin = 0; begin < created.size(); begin += kChunk) {
         gather_chunk(h, created, begin, created.size(), c);
-        frame_chunk<Grid, UnitNormals>(h, quantizer, c);
+        frame_chunk<Grid, UnitNormals>(h, quantizer, grid, c);
         for (size_t i = 0; i < c.count; i += 2) {
             Vec3 p;
-            if (!decode_vertex<0, Grid>(c, i, space, tables, rans, raw, p)) return false;
-            HierarchyBuilder::set_new_vertex_position(h, c.vertices[i], p);
+            if (!decode_vertex<0, Grid>(c, i, space, grid, tables, rans, raw, p)) return false;
+            set(c.vertices[i], p);
             if (i + 1 == c.count) break;
-            if (!decode_vertex<1, Grid>(c, i + 1, space, tables, rans, raw, p)) return false;
-            HierarchyBuilder::set_new_vertex_position(h, c.vertices[i + 1], p);
+            if (!decode_vertex<1, Grid>(c, i + 1, space, grid, tables, rans, raw, p)) return false;
+            set(c.vertices[i + 1], p);
         }
     }
     return rans.ended_cleanly() && raw.ended_cleanly();
