@@ -1,6 +1,8 @@
 // The red-green forest: known answers for refinement, balance, closure and coarsening.
 #include "hierarchy_checks.h"
 
+#include "hierarchy/hierarchy_builder.h"
+
 namespace amc {
 namespace {
 
@@ -139,6 +141,58 @@ TEST(Forest, ResetGivesTheFreshHierarchy) {
         EXPECT_TRUE(identical(h, fresh)) << name;
         EXPECT_TRUE(hierarchy_is_valid(h)) << name;
     }
+}
+
+// The same nodes under the same ids: what the import's trials need of undo_splits, since they go on
+// splitting after it as if the undone splits had never been made.
+::testing::AssertionResult same_ids(const Hierarchy& a, const Hierarchy& b) {
+    if (a.node_capacity() != b.node_capacity() || a.positions().size() != b.positions().size() ||
+        a.node_count() != b.node_count() || a.vertex_count() != b.vertex_count())
+        return ::testing::AssertionFailure() << "sizes differ";
+    for (NodeId n = 0; n < a.node_capacity(); ++n) {
+        if (a.is_leaf(n) != b.is_leaf(n) || (!a.is_leaf(n) && a.child(n, 0) != b.child(n, 0)) ||
+            a.diagonal_flipped(n) != b.diagonal_flipped(n))
+            return ::testing::AssertionFailure() << "node " << n << " differs";
+        for (int e = 0; e < 3; ++e) {
+            if (a.vertex(n, e) != b.vertex(n, e) || a.neighbor(n, e) != b.neighbor(n, e) ||
+                (a.neighbor(n, e) != kNoNode && a.neighbor_edge(n, e) != b.neighbor_edge(n, e)))
+                return ::testing::AssertionFailure() << "node " << n << " edge " << e << " differs";
+        }
+    }
+    return ::testing::AssertionSuccess();
+}
+
+TEST(Forest, UndoSplitsRestoresTheIdsBeforeThem) {
+    for (const auto& [name, mesh] : fixture_meshes()) {
+        Hierarchy h(mesh);
+        refine_randomly(h, h.root_count() + 120, 4, 5);
+        const Hierarchy before = h;
+        std::vector<NodeId> splits;
+        for (NodeId n : before.leaves()) {
+            if (splits.size() >= 40) break;
+            if (h.is_leaf(n)) h.refine(n, &splits);
+        }
+        ASSERT_GT(splits.size(), 0u) << name;
+        ASSERT_FALSE(same_ids(h, before)) << name;
+        HierarchyBuilder::undo_splits(h, splits, 0);
+        EXPECT_TRUE(same_ids(h, before)) << name;
+        EXPECT_TRUE(hierarchy_is_valid(h)) << name;
+        // Refined again the same way, both give the same ids.
+        Hierarchy again = before;
+        refine_randomly(h, h.root_count() + 300, 5, 8);
+        refine_randomly(again, again.root_count() + 300, 5, 8);
+        EXPECT_TRUE(same_ids(h, again)) << name;
+    }
+}
+
+TEST(Forest, UndoSplitsRefusesIdsFreeForReuse) {
+    Hierarchy h(make_icosahedron());
+    std::vector<NodeId> splits;
+    h.refine(0, &splits);
+    h.refine(h.child(0, 0), &splits);
+    ASSERT_TRUE(h.coarsen(h.child(0, 0)));
+    splits.pop_back();
+    EXPECT_THROW(HierarchyBuilder::undo_splits(h, splits, 0), Error);
 }
 
 TEST(Forest, CoarsenRefusesWhatBalanceForbids) {

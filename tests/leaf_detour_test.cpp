@@ -32,6 +32,31 @@ TEST(LeafDetour, CountsTheHopsOffTheShortestPaths) {
     EXPECT_EQ(detour.detour(1), 1);  // 3-1, 1-2-5 or 1-4-5
 }
 
+TEST(LeafDetour, TargetsAloneGetTheFullSearchesDetours) {
+    const amc::TriangleMesh mesh = strip();
+    const amc::LeafHalfedges halfedges(mesh);
+    amc::LeafDetour full(halfedges), targeted(halfedges);
+    for (uint32_t a = 0; a < 7; ++a) {
+        for (uint32_t b = 0; b < 7; ++b) {
+            for (uint32_t c = 0; c < 7; ++c) {
+                const uint32_t targets[2] = {c, (c + 3) % 7};
+                for (int hops = 1; hops <= 4; ++hops) {
+                    const bool measured = full.measure(a, b, hops);
+                    ASSERT_EQ(targeted.measure(a, b, hops, targets, 2), measured) << a << " " << b << " " << hops;
+                    if (!measured) continue;
+                    EXPECT_EQ(targeted.detour(targets[0]), full.detour(targets[0])) << a << " " << b << " " << c;
+                    EXPECT_EQ(targeted.detour(targets[1]), full.detour(targets[1])) << a << " " << b << " " << c;
+                }
+            }
+        }
+    }
+    // Stopped early: 6 is three hops from 0 and not asked for, so not reached.
+    const uint32_t near[1] = {3};
+    ASSERT_TRUE(targeted.measure(0, 1, 4, near, 1));
+    EXPECT_EQ(targeted.detour(3), 1);  // 0-3-1 against 0-1
+    EXPECT_EQ(targeted.detour(6), amc::LeafDetour::kFar);
+}
+
 TEST(LeafDetour, EndsFartherThanTheBoundAreNotMeasured) {
     const amc::TriangleMesh mesh = strip();
     const amc::LeafHalfedges halfedges(mesh);

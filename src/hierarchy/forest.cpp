@@ -4,6 +4,7 @@
 
 #include "hierarchy/hierarchy_builder.h"
 
+#include "common/check.h"
 #include "common/huge_pages.h"
 #include "hierarchy/midpoint_placers.h"
 #include "mesh/vertex_buckets.h"
@@ -196,6 +197,35 @@ void Hierarchy::split(NodeId n) {
     nodes_[n].first_child = c;
 }
 
+void HierarchyBuilder::undo_splits(Hierarchy& h, const std::vector<NodeId>& parents, size_t from) {
+    AMC_REQUIRE(h.free_blocks_.empty() && h.free_vertices_.empty(), invalid_input,
+                "undo_splits: the hierarchy has ids free for reuse");
+    for (size_t i = parents.size(); i-- > from;) {
+        const NodeId n = parents[i];
+        const NodeId c = h.nodes_[n].first_child;
+        AMC_REQUIRE(c != kNoNode && size_t(c) + 4 == h.nodes_.size(), invalid_input,
+                    "undo_splits: node " + std::to_string(n) + " is not the last one split");
+        // Edges 2, 1, 0: split() made their new vertices in the order 0, 1, 2.
+        for (int e = 2; e >= 0; --e) {
+            const NodeId q = h.nodes_[n].nbr[e];
+            if (q != kNoNode && !h.is_leaf(q)) {
+                const int eq = h.neighbor_edge(n, e);
+                h.nodes_[h.child(q, red_split::kFirstHalfChild[eq])].nbr[eq] = kNoNode;
+                h.nodes_[h.child(q, red_split::kSecondHalfChild[eq])].nbr[eq] = kNoNode;
+            } else {
+                AMC_REQUIRE(size_t(h.midpoint(n, e)) + 1 == h.positions_.size(), invalid_input,
+                            "undo_splits: a midpoint of node " + std::to_string(n) + " is not the last vertex");
+                h.positions_.pop_back();
+                --h.live_vertices_;
+            }
+        }
+        h.nodes_.resize(c);
+        h.block_parent_.pop_back();
+        h.live_nodes_ -= 4;
+        h.nodes_[n].first_child = kNoNode;
+    }
+    h.structure_checked_ = false;
+}
 
 uint32_t Hierarchy::refine(NodeId n, std::vector<NodeId>* split_nodes) {
     if (!is_leaf(n)) return 0;

@@ -154,6 +154,12 @@ struct HierarchyBuilder {
     // while nothing changes the forest (writer_checks.h).
     static void mark_structure_checked(Hierarchy& h) { h.structure_checked_ = true; }
     static bool structure_checked(const Hierarchy& h) { return h.structure_checked_; }
+    // Takes back the splits of parents[from..] (in the order split() made them, the last first)
+    // in a hierarchy that was only ever split (no ids free for reuse, so each split's children and
+    // new vertices are the last ids): the same nodes, vertices, links and sizes as before them.
+    // The import's local trials (src/import/pick_backtrack.cpp) undo their splits this way
+    // instead of restoring a copy of the hierarchy.
+    static void undo_splits(Hierarchy& h, const std::vector<NodeId>& parents, size_t from);
     // Hints the processor to fetch node n (for traversals that know their next nodes early).
     static void prefetch(const Hierarchy& h, NodeId n) { __builtin_prefetch(h.nodes_.data() + n); }
 };

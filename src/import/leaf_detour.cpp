@@ -6,11 +6,25 @@ LeafDetour::LeafDetour(const LeafHalfedges& halfedges)
     : he_(halfedges), hops_a_(halfedges.vertex_count(), -1), hops_b_(halfedges.vertex_count(), -1) {}
 
 // Breadth-first over the leaf mesh from `source`, up to max_hops; clears the previous search.
-void LeafDetour::search(uint32_t source, std::vector<int>& hops, std::vector<uint32_t>& reached, int max_hops) {
+void LeafDetour::search(uint32_t source, std::vector<int>& hops, std::vector<uint32_t>& reached, int max_hops,
+                        uint32_t* pending, uint32_t pending_count) {
     for (uint32_t x : reached) hops[x] = -1;
     reached.assign(1, source);
     hops[source] = 0;
+    // A vertex is final when first reached: once every pending one is, nothing asked changes.
+    auto settle = [&](uint32_t x) {
+        for (uint32_t i = 0; i < pending_count;) {
+            if (pending[i] == x) {
+                pending[i] = pending[--pending_count];
+            } else {
+                ++i;
+            }
+        }
+    };
+    const bool stops = pending_count > 0;
+    settle(source);
     for (size_t i = 0; i < reached.size(); ++i) {
+        if (stops && pending_count == 0) return;
         const uint32_t u = reached[i];
         if (hops[u] == max_hops) continue;
         for (uint32_t j = 0, d = he_.degree(u); j < d; ++j) {
@@ -18,6 +32,7 @@ void LeafDetour::search(uint32_t source, std::vector<int>& hops, std::vector<uin
                 if (hops[x] >= 0) continue;
                 hops[x] = hops[u] + 1;
                 reached.push_back(x);
+                settle(x);
             }
         }
     }
@@ -28,6 +43,26 @@ bool LeafDetour::measure(uint32_t a, uint32_t b, int max_hops) {
     if (hops_a_[b] < 0) return false;
     shortest_ = hops_a_[b];
     search(b, hops_b_, reached_b_, max_hops);
+    return true;
+}
+
+bool LeafDetour::measure(uint32_t a, uint32_t b, int max_hops, const uint32_t* targets, uint32_t count) {
+    // Whether b is within max_hops at all, from two balls of half the radius that meet: most
+    // edges of the coarse levels are longer, and the whole ball around a is several times larger.
+    search(a, hops_a_, reached_a_, (max_hops + 1) / 2);
+    search(b, hops_b_, reached_b_, max_hops / 2);
+    bool meet = false;
+    for (uint32_t x : reached_b_) meet |= hops_a_[x] >= 0;
+    if (!meet) return false;
+    uint32_t pending[kMaxTargets + 1];
+    count = count < kMaxTargets ? count : kMaxTargets;
+    for (uint32_t i = 0; i < count; ++i) pending[i] = targets[i];
+    pending[count] = b;
+    search(a, hops_a_, reached_a_, max_hops, pending, count + 1);
+    if (hops_a_[b] < 0) return false;
+    shortest_ = hops_a_[b];
+    for (uint32_t i = 0; i < count; ++i) pending[i] = targets[i];
+    search(b, hops_b_, reached_b_, max_hops, pending, count);
     return true;
 }
 

@@ -17,12 +17,18 @@ public:
 
     // Measures from a and b, up to max_hops; false when b is farther than that from a.
     bool measure(uint32_t a, uint32_t b, int max_hops);
+    // The same for the detours of `targets` (at most kMaxTargets) only: each search stops once
+    // it has reached them (and b), which at the fine levels is long before max_hops.
+    bool measure(uint32_t a, uint32_t b, int max_hops, const uint32_t* targets, uint32_t count);
+    static constexpr uint32_t kMaxTargets = 8;
     // hops(a, c) + hops(c, b) - hops(a, b) after measure(a, b, ...), or kFar when c is farther.
     int detour(uint32_t c) const;
     static constexpr int kFar = 1 << 20;
 
 private:
-    void search(uint32_t source, std::vector<int>& hops, std::vector<uint32_t>& reached, int max_hops);
+    // Breadth-first from source up to max_hops, or until every one of `pending` is reached.
+    void search(uint32_t source, std::vector<int>& hops, std::vector<uint32_t>& reached, int max_hops,
+                uint32_t* pending = nullptr, uint32_t pending_count = 0);
 
     const LeafHalfedges& he_;
     std::vector<int> hops_a_, hops_b_;  // -1: not reached

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -31,10 +32,11 @@ std::vector<uint32_t> Reconstruction::run() {
     int depth = 0;
     while (!level.empty()) {
         remember(depth, level);
+        if (judges_picks() && certify_picks(depth, level)) continue;
         try {
             reconstruct_level(level, next);
         } catch (const Error& e) {
-            if (!choice_ || guide_ != MidpointGuide::leaf_midpoint || referee_) throw;  // way 5's first (docs/IMPORT.md)
+            if (!judges_picks()) throw;
             if (!backtrack(depth, level, read_failed_, e.what())) throw Error(first_error_);
             continue;
         }
@@ -267,7 +269,11 @@ uint32_t Reconstruction::find_midpoint(NodeId n, int e) {
     uint32_t nearest[kCandidates];
     uint32_t count = 0;
     if (choice_) {
-        count = nearest_vertex.find_nearest(guide_position(n, e), may_be_midpoint, kCandidates, nearest);
+        // A judgement's reconstruction (local_misfits) looks no farther than the edge is long: under
+        // a wrong pick, edges whose vertices are all taken would each search the whole tree.
+        const Vec3 ab = leaf_.positions[b] - leaf_.positions[a];
+        const double limit = judging_ ? exact_dot(ab, ab) : std::numeric_limits<double>::infinity();
+        count = nearest_vertex.find_nearest(guide_position(n, e), may_be_midpoint, kCandidates, nearest, limit);
         const uint32_t kept = on_shortest_chains(nearest, count, a, b);
         found = choice_->choose(nearest, kept, a, b, vertex_of_leaf_);
     } else {
@@ -284,7 +290,7 @@ uint32_t Reconstruction::find_midpoint(NodeId n, int e) {
 
 uint32_t Reconstruction::on_shortest_chains(uint32_t* candidates, uint32_t count, uint32_t a, uint32_t b) {
     if (!detour_) detour_ = std::make_unique<LeafDetour>(he_);
-    if (count < 2 || !detour_->measure(a, b, kChainHops)) return count;
+    if (count < 2 || !detour_->measure(a, b, kChainHops, candidates, count)) return count;
     int least = LeafDetour::kFar;
     for (uint32_t i = 0; i < count; ++i) least = std::min(least, detour_->detour(candidates[i]));
     uint32_t kept = 0;

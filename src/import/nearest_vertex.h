@@ -9,6 +9,7 @@
 #include <amc/mesh.h>
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace amc {
@@ -30,9 +31,13 @@ public:
 
     // The up to `count` (at most kMaxCount) usable vertices nearest to p, nearest first, into
     // `out`; returns how many there are.
+    // Only vertices nearer than sqrt(max_squared_distance) count: where none is usable, the
+    // search stops there instead of visiting the whole tree.
     template <class Usable>
-    uint32_t find_nearest(Vec3 p, Usable usable, uint32_t count, uint32_t* out) const {
+    uint32_t find_nearest(Vec3 p, Usable usable, uint32_t count, uint32_t* out,
+                          double max_squared_distance = std::numeric_limits<double>::infinity()) const {
         Nearest best(count < kMaxCount ? count : kMaxCount);
+        best.limit = max_squared_distance;
         if (!points_.empty() && best.wanted > 0) search(p, usable, 0, 0, uint32_t(points_.size()), best);
         for (uint32_t i = 0; i < best.count; ++i) out[i] = best.vertex[i];
         return best.count;
@@ -48,9 +53,10 @@ private:
     struct Nearest {
         explicit Nearest(uint32_t n) : wanted(n) {}
         uint32_t wanted, count = 0;
+        double limit = std::numeric_limits<double>::infinity();
         uint32_t vertex[kMaxCount];
         double distance[kMaxCount];
-        bool improves(double d) const { return count < wanted || d < distance[count - 1]; }
+        bool improves(double d) const { return count < wanted ? d < limit : d < distance[count - 1]; }
         void insert(uint32_t v, double d) {
             uint32_t i = count < wanted ? count++ : count - 1;
             for (; i > 0 && distance[i - 1] > d; --i) {

@@ -5,6 +5,8 @@
 // if the failing level then misfits less.
 #include "import/reconstruction.h"
 
+#include "hierarchy/hierarchy_builder.h"
+
 #include <algorithm>
 #include <string>
 #include <utility>
@@ -13,10 +15,10 @@
 namespace amc {
 
 void Reconstruction::remember(int depth, const std::vector<NodeId>& level) {
-    if (depth > 0 && !keep_levels_) return;
+    if (depth > 0 && !keep_levels_ && !(judges_picks() && depth <= kCertifiedLevels)) return;
     if (states_.size() <= size_t(depth)) states_.resize(size_t(depth) + 1);
     // Levels more than kBacktrackLevels up are not gone back to: their memory is given back.
-    if (depth > kBacktrackLevels) states_[size_t(depth - kBacktrackLevels - 1)] = LevelState();
+    if (keep_levels_ && depth > kBacktrackLevels) states_[size_t(depth - kBacktrackLevels - 1)] = LevelState();
     LevelState& s = states_[size_t(depth)];
     if (keep_levels_) work_ += state_size();
     s.h = h_;
@@ -72,63 +74,118 @@ int Reconstruction::misfit_count(const std::vector<NodeId>& level) const {
     return count;
 }
 
-int Reconstruction::local_misfits(int from, int depth, const std::vector<NodeId>& region, size_t inner) {
-    restore(from, local_level_);
-    std::vector<std::pair<NodeId, bool>> nodes, next;
-    for (size_t i = 0; i < region.size(); ++i) nodes.push_back({region[i], i < inner});
+int Reconstruction::local_misfits(int from, int depth, const std::vector<NodeId>& region, size_t inner, int cap,
+                                  std::vector<int>* per_inner) {
+    LocalUndo& undo = local_undo_;
+    undo.splits.clear();
+    undo.flags.clear();
+    undo.matched.clear();
+    undo.nodes = h_.node_capacity();
+    undo.vertices = leaf_of_vertex_.size();
+    undo.guided = guided_.size();
+    undo.guided_of_vertex = guided_of_vertex_.size();
+    undo.picks = pick_level_.size();
+    // Each node with the index of its inner ancestor in `region` (kNoIndex: the context).
+    std::vector<std::pair<NodeId, uint32_t>> nodes, next;
+    for (size_t i = 0; i < region.size(); ++i) nodes.push_back({region[i], i < inner ? uint32_t(i) : kNoIndex});
+    if (per_inner) per_inner->assign(inner, 0);
     int misfits = 0;
-    for (int d = from; d < depth; ++d) {
-        reveals_.clear();
-        unsplit_edges_.clear();
-        std::vector<std::pair<NodeId, bool>> split;
-        for (const auto& node : nodes) {
-            uint32_t p[3];
-            if (!known_corners(node.first, p)) {  // under a midpoint not found: no reading
-                misfits += node.second;
-                continue;
-            }
-            bool refined = false;
-            try {
-                refined = classify(node.first);
-            } catch (const Error&) {
-                misfits += node.second;
-            }
-            if (!refined) continue;
-            if (h_.can_split(node.first)) {
-                h_.split(node.first);
-                split.push_back(node);
-            } else {
-                misfits += node.second;
-            }
-        }
-        leaf_of_vertex_.resize(h_.positions().size(), kNoIndex);
-        for (const Reveal& r : reveals_) {
-            const NodeId q = h_.neighbor(r.node, r.edge);
-            if (q == kNoNode || h_.is_leaf(q)) continue;
-            const VertexId m = h_.midpoint(q, h_.neighbor_edge(r.node, r.edge));
-            if (leaf_of_vertex_[m] == kNoIndex && vertex_of_leaf_[r.leaf_vertex] == kNoIndex) assign(m, r.leaf_vertex);
-        }
-        next.clear();
-        for (const auto& node : split) {
-            for (int e = 0; e < 3; ++e) {
-                const VertexId m = h_.midpoint(node.first, e);
-                if (leaf_of_vertex_[m] != kNoIndex) continue;
-                try {
-                    const uint32_t found = find_midpoint(node.first, e);
-                    if (vertex_of_leaf_[found] == kNoIndex) {
-                        assign(m, found);
-                        continue;
-                    }
-                } catch (const Error&) {
+    judging_ = true;
+    auto miss = [&](uint32_t owner) {
+        if (owner == kNoIndex) return;
+        ++misfits;
+        if (per_inner) ++(*per_inner)[owner];
+    };
+    try {
+        for (int d = from; d < depth && !nodes.empty() && misfits < cap; ++d) {
+            reveals_.clear();
+            unsplit_edges_.clear();
+            std::vector<std::pair<NodeId, uint32_t>> split;
+            // The count only grows: once it reaches the cap, the rest is not read.
+            for (const auto& node : nodes) {
+                if (misfits >= cap) break;
+                uint32_t p[3];
+                if (!known_corners(node.first, p)) {  // under a midpoint not found: no reading
+                    miss(node.second);
+                    continue;
                 }
-                misfits += node.second;
+                if (node.first < undo.nodes) undo.flags.push_back({node.first, h_.diagonal_flipped(node.first)});
+                bool refined = false;
+                try {
+                    refined = classify(node.first);
+                } catch (const Error&) {
+                    miss(node.second);
+                }
+                if (!refined) continue;
+                if (h_.can_split(node.first)) {
+                    h_.split(node.first);
+                    undo.splits.push_back(node.first);
+                    split.push_back(node);
+                } else {
+                    miss(node.second);
+                }
             }
-            for (int k = 0; k < 4; ++k) next.push_back({h_.child(node.first, k), node.second});
+            if (misfits >= cap) break;
+            leaf_of_vertex_.resize(h_.positions().size(), kNoIndex);
+            auto match = [&](VertexId m, uint32_t l) {
+                assign(m, l);
+                undo.matched.push_back({m, l});
+            };
+            for (const Reveal& r : reveals_) {
+                const NodeId q = h_.neighbor(r.node, r.edge);
+                if (q == kNoNode || h_.is_leaf(q)) continue;
+                const VertexId m = h_.midpoint(q, h_.neighbor_edge(r.node, r.edge));
+                if (leaf_of_vertex_[m] == kNoIndex && vertex_of_leaf_[r.leaf_vertex] == kNoIndex) match(m, r.leaf_vertex);
+            }
+            next.clear();
+            for (const auto& node : split) {
+                if (misfits >= cap) break;
+                for (int e = 0; e < 3; ++e) {
+                    const VertexId m = h_.midpoint(node.first, e);
+                    if (leaf_of_vertex_[m] != kNoIndex) continue;
+                    try {
+                        const uint32_t found = find_midpoint(node.first, e);
+                        if (vertex_of_leaf_[found] == kNoIndex) {
+                            match(m, found);
+                            continue;
+                        }
+                    } catch (const Error&) {
+                    }
+                    miss(node.second);
+                }
+                for (int k = 0; k < 4; ++k) next.push_back({h_.child(node.first, k), node.second});
+            }
+            if (misfits >= cap) break;
+            nodes.swap(next);
+            for (size_t i = 0; i < nodes.size() && misfits < cap; ++i) {
+                if (nodes[i].second != kNoIndex && !fits(nodes[i].first, nullptr)) miss(nodes[i].second);
+            }
         }
-        nodes.swap(next);
-        for (const auto& node : nodes) misfits += node.second && !fits(node.first, nullptr);
+    } catch (...) {
+        judging_ = false;
+        undo_local();
+        throw;
     }
+    judging_ = false;
+    undo_local();
     return misfits;
+}
+
+void Reconstruction::undo_local() {
+    LocalUndo& undo = local_undo_;
+    // Every vertex and leaf vertex it matched was free before.
+    for (const auto& m : undo.matched) {
+        leaf_of_vertex_[m.first] = kNoIndex;
+        vertex_of_leaf_[m.second] = kNoIndex;
+    }
+    for (size_t i = undo.flags.size(); i-- > 0;) h_.set_diagonal_flipped(undo.flags[i].first, undo.flags[i].second);
+    work_ += 4 * undo.splits.size() + undo.matched.size();
+    HierarchyBuilder::undo_splits(h_, undo.splits, 0);
+    leaf_of_vertex_.resize(undo.vertices);
+    guided_.resize(undo.guided);
+    guided_of_vertex_.resize(undo.guided_of_vertex);
+    pick_level_.resize(undo.picks);
+    pick_edge_.resize(undo.picks);
 }
 
 void Reconstruction::plan_retries(int depth, NodeId x) {
@@ -144,6 +201,7 @@ void Reconstruction::plan_retries(int depth, NodeId x) {
         int edge;
         uint32_t a, b, picked, count;
         uint32_t candidates[kRepairCandidates];
+        uint64_t swap_edge[kRepairCandidates];  // the edge of the pick of the level holding it, or 0
     };
     std::vector<Suspect> suspects;
     NodeId ancestor = x;
@@ -156,7 +214,7 @@ void Reconstruction::plan_retries(int depth, NodeId x) {
             const VertexId m = h_.midpoint(ancestor, e);
             if (m >= pick_level_.size() || pick_level_[m] != level) continue;
             const uint32_t picked = leaf_of_vertex_[m];
-            Suspect s{level, ancestor, e, corner(ancestor, e), corner(ancestor, (e + 1) % 3), picked, 0, {}};
+            Suspect s{level, ancestor, e, corner(ancestor, e), corner(ancestor, (e + 1) % 3), picked, 0, {}, {}};
             auto usable = [&](uint32_t v) {
                 const uint32_t owner = vertex_of_leaf_[v];
                 if (v == picked || (owner != kNoIndex && owner < known_before)) return false;
@@ -170,8 +228,13 @@ void Reconstruction::plan_retries(int depth, NodeId x) {
             const uint32_t found = search_.nearest().find_nearest(guide_position(ancestor, e), usable, kRepairCandidates,
                                                           s.candidates);
             for (uint32_t i = 0; i < found; ++i) {
-                if (!tried_.count(retry_key(s.a, s.b, s.candidates[i])))
-                    s.candidates[s.count++] = s.candidates[i];
+                if (tried_.count(retry_key(s.a, s.b, s.candidates[i]))) continue;
+                // A candidate another pick of the level holds: the two would swap.
+                const uint32_t holder = vertex_of_leaf_[s.candidates[i]];
+                s.swap_edge[s.count] = holder != kNoIndex && holder < pick_level_.size() && pick_level_[holder] == level
+                                           ? pick_edge_[holder]
+                                           : 0;
+                s.candidates[s.count++] = s.candidates[i];
             }
             if (s.count > 0) suspects.push_back(s);
         }
@@ -182,6 +245,7 @@ void Reconstruction::plan_retries(int depth, NodeId x) {
     std::vector<std::pair<int, Retry>> better;
     for (const Suspect& s : suspects) {
         if (over_budget()) break;
+        restore(s.level, local_level_);
         std::vector<NodeId> region;
         add_once(region, s.node);
         add_once(region, h_.neighbor(s.node, s.edge));
@@ -191,13 +255,7 @@ void Reconstruction::plan_retries(int depth, NodeId x) {
         }
         const int before = local_misfits(s.level, depth, region, inner);
         for (uint32_t i = 0; i < s.count; ++i) {
-            Retry retry{s.level, s.a, s.b, s.candidates[i], 0, 0};
-            // A candidate another pick of the level holds: the two swap.
-            const uint32_t holder = vertex_of_leaf_[retry.vertex];
-            if (holder != kNoIndex && holder < pick_level_.size() && pick_level_[holder] == s.level) {
-                retry.swap_edge = pick_edge_[holder];
-                retry.swap_vertex = s.picked;
-            }
+            const Retry retry{s.level, s.a, s.b, s.candidates[i], s.swap_edge[i], s.swap_edge[i] ? s.picked : 0};
             const ForcedBefore forced_before = force(retry);
             const int after = local_misfits(s.level, depth, region, inner);
             put_back(forced_before);

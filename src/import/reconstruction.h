@@ -184,8 +184,8 @@ private:
     // One level: read (repairing the previous level's picks), split, its midpoints found; `next`
     // gets the children.
     void reconstruct_level(std::vector<NodeId>& level, std::vector<NodeId>& next);
-    // Keeps the state before level `depth` is read (from the first failure on; before that only
-    // level 0's, to start again from).
+    // Keeps the state before level `depth` is read (from the first failure on; before that
+    // level 0's, to start again from, and those the certification of picks goes back to).
     void remember(int depth, const std::vector<NodeId>& level);
     void restore(int depth, std::vector<NodeId>& level);
     // After level `depth` failed (in its reading, or after it) with `error`: goes back to an
@@ -201,10 +201,51 @@ private:
     void plan_retries(int depth, NodeId x);
     bool start_next_retry(int& depth, std::vector<NodeId>& level);
     int misfit_count(const std::vector<NodeId>& level) const;
-    // From the state before level `from`, reconstructs only the descendants of `region` (nodes of
-    // that level) down to level `depth`, leniently, and counts the misfits among those of its
-    // first `inner` nodes.
-    int local_misfits(int from, int depth, const std::vector<NodeId>& region, size_t inner);
+    // After level depth - 1 (one of the first kCertifiedLevels) is split: its guided picks judged
+    // by their subtrees (pick_certify.cpp); a pick whose subtree does not close while another
+    // candidate's does is forced to that candidate and the level made again (depth set back,
+    // true). At most kCertifyRounds times per level.
+    bool certify_picks(int& depth, std::vector<NodeId>& level);
+    // The nodes a judgement reconstructs: the first `inner` of `region` and every node around
+    // their corners (a fan cut short stalls the corner children: no same-level neighbour).
+    void add_corner_fans(std::vector<NodeId>& region, size_t inner) const;
+    static constexpr int kCertifiedLevels = 4;  // levels 0-3: the wrong picks that go unseen
+    static constexpr int kCertifyRounds = 4;
+    static constexpr int kCertifyHorizon = 5;   // levels judged below a pick (the corpus's depth)
+    static constexpr size_t kMaxJudgedRegion = 96;
+    // The certification's work (as work_ counts it) per leaf face: the corpus's surface models
+    // take 15-20; where most picks misfit (vertices placed anywhere) single changes repair little.
+    static constexpr uint64_t kCertifyWorkPerFace = 32;
+    uint64_t certify_work_ = 0;
+    bool certify_over_budget(uint64_t more) const {
+        return certify_work_ + more > kCertifyWorkPerFace * leaf_.triangles.size();
+    }
+    std::vector<int> certify_rounds_;           // per level
+    int certifying_level_ = -1;
+    std::vector<uint64_t> judged_picks_;    // retry_key of the picks judged alone in its rounds, sorted
+    std::vector<NodeId> changed_regions_;   // the two elements of each of the last round's changes
+    std::vector<NodeId> misfits_of_level_;  // the level's nodes, in the order of level_misfits_
+    std::vector<int> level_misfits_;        // per node: misfits under it in the last whole reconstruction
+    // From the state before level `from` (the caller's, restored), reconstructs only the
+    // descendants of `region` (nodes of that level) down to level `depth`, leniently, and counts
+    // the misfits among those of its first `inner` nodes (in `per_inner` by inner node, when
+    // given), stopping once they reach `cap`; then takes back everything it changed (undo_local),
+    // so trials from one state need one restore.
+    int local_misfits(int from, int depth, const std::vector<NodeId>& region, size_t inner, int cap = kNoCap,
+                      std::vector<int>* per_inner = nullptr);
+    static constexpr int kNoCap = 1 << 30;
+    // What a local reconstruction changed, to take back: the nodes it split (in order), the
+    // diagonal flags of older nodes it read, the leaf vertices it matched, the sizes before.
+    struct LocalUndo {
+        std::vector<NodeId> splits;
+        std::vector<std::pair<NodeId, bool>> flags;
+        std::vector<std::pair<VertexId, uint32_t>> matched;  // hierarchy vertex, leaf vertex
+        NodeId nodes = 0;
+        size_t vertices = 0, guided = 0, guided_of_vertex = 0, picks = 0;
+    };
+    void undo_local();
+    LocalUndo local_undo_;
+    bool judging_ = false;  // in local_misfits
     // Notes that hierarchy vertex m, the midpoint of edge e of n, was picked by position or by a
     // retry.
     void note_pick(VertexId m, NodeId n, int e) {
@@ -306,6 +347,9 @@ private:
     static constexpr int kMaxMisfits = 16;  // a level misfitting more is given up
     uint64_t work_ = 0;
     std::vector<NodeId> local_level_;  // scratch of local_misfits
+    // Way 5's first attempt (docs/IMPORT.md) certifies its coarse picks and returns to the level
+    // of a pick that a level further down contradicts.
+    bool judges_picks() const { return choice_ && guide_ == MidpointGuide::leaf_midpoint && !referee_; }
     bool over_budget() const { return work_ > kWorkPerFace * leaf_.triangles.size(); }
     uint64_t state_size() const { return h_.node_capacity() + leaf_.positions.size(); }
     bool keep_levels_ = false;                 // snapshots of every level (after a first failure)
