@@ -4,7 +4,8 @@
 # one thread takes the chunks in order, without tasks) under `perf record` with call graphs; a
 # sample is parallel work when its call chain passes through a parallel_for task
 # (run_task, never inlined, names the task's lambda, which takes the task index:
-# `{lambda(unsigned long)`), and serial otherwise. CPU-time samples: the shares do not depend on the machine's load. Amdahl's law
+# `{lambda(unsigned long)`, or `<lambda(size_t)>` in a frame perf unwinds as inlined from the
+# debug info of a -g build), and serial otherwise. CPU-time samples: the shares do not depend on the machine's load. Amdahl's law
 # then bounds the speed-up on T threads by 1 / (serial + (1 - serial) / T).
 # Usage: scripts/serial_fraction.sh model.amh [build-dir] [runs]   (needs perf; BITS 0 and 12; THREADS=2)
 set -euo pipefail
@@ -28,6 +29,8 @@ serial = collections.Counter()
 def name(frame):
     parts = frame.split(None, 1)
     return re.sub(r"\+0x[0-9a-f]+.*$", "", parts[1]) if len(parts) > 1 else ""
+def is_task(symbol):
+    return "{lambda(unsigned long)" in symbol or ("run_task<" in symbol and "<lambda(size_t)>" in symbol)
 def short(symbol):
     return re.sub(r"\((?!anonymous).*", "", symbol).replace("(anonymous namespace)::", "")
 def sample(stack):
@@ -35,13 +38,13 @@ def sample(stack):
     names = [name(f) for f in stack]
     top = next((i for i in range(len(names) - 1, -1, -1) if names[i] == entry or names[i].startswith(entry + "(")), None)
     if top is None:
-        if any("{lambda(unsigned long)" in s for s in names):  # another thread's task
+        if any(is_task(s) for s in names):  # another thread's task
             samples += 1
             parallel += 1
         return  # else reading the model, the first encode (on one thread)
     inner = names[:top]
     samples += 1
-    if any("{lambda(unsigned long)" in s for s in inner):
+    if any(is_task(s) for s in inner):
         parallel += 1
     else:
         serial[" > ".join(short(s) for s in inner[max(0, len(inner) - 2):][::-1]) or "(itself)"] += 1

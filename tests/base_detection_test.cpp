@@ -3,6 +3,7 @@
 // of the shared data.
 #include "hierarchy_checks.h"
 #include "import/base_detection.h"
+#include "import/hierarchy_from_levels.h"
 
 #include <amc/import.h>
 #include <amc/mesh_io.h>
@@ -122,6 +123,24 @@ TEST(ImportMesh, RefusesInvalidMeshesNamingThem) {
         FAIL() << "a flipped face was accepted";
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("flipped.obj"), std::string::npos) << e.what();
+    }
+}
+
+// The build's final check: a base whose vertices name the wrong input vertices (two swapped)
+// builds a valid hierarchy whose leaf mesh is not the input, which is refused, naming the input.
+TEST(ImportMesh, HierarchyFromLevelsRefusesALeafMeshThatDiffers) {
+    Hierarchy h(make_icosahedron());
+    refine_uniformly(h, 1);
+    const TriangleMesh input = shuffled(extract_leaf_mesh(h).mesh, 7);
+    DetectedBase detected = truncated(input, detect_base(input), 0);
+    EXPECT_TRUE(reproduces(hierarchy_from_levels(input, detected, "leaf.obj"), input));
+    std::swap(detected.leaf_vertex_of_base[0], detected.leaf_vertex_of_base[1]);
+    try {
+        hierarchy_from_levels(input, detected, "leaf.obj");
+        FAIL() << "a leaf mesh that differs from the input was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("leaf.obj"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("differs from the input"), std::string::npos) << e.what();
     }
 }
 

@@ -155,6 +155,40 @@ TEST(BaseOrder, ReorderingGivesTheIdsOfAReplayOnAnyThreads) {
     }
 }
 
+// Levels of more than one task's nodes (2^16): the reorder and the diagonal tally split them into
+// ranges, which several threads take in any order.
+TEST(BaseOrder, LevelsOfSeveralRangesGiveTheSameResultOnAnyThreads) {
+    testing::Random random{5};
+    Hierarchy h(make_torus(6, 5, 2.0, 0.7));
+    refine_randomly(h, 250000, 9, 3);
+    for (NodeId n : h.leaves())
+        if (h.hanging_node_count(n) == 2 && random.next() % 2) h.set_diagonal_flipped(n, true);
+    std::vector<size_t> level_size(size_t(h.depth()) + 1, 0);
+    for (NodeId n : h.breadth_first_order()) ++level_size[size_t(h.level(n))];
+    ASSERT_GT(*std::max_element(level_size.begin(), level_size.end()), size_t(1) << 16);
+    std::vector<uint32_t> vertex_order(h.base().positions.size()), triangle_order(h.root_count());
+    std::iota(vertex_order.begin(), vertex_order.end(), 0u);
+    std::iota(triangle_order.begin(), triangle_order.end(), 0u);
+    for (size_t i = triangle_order.size(); i > 1; --i) std::swap(triangle_order[i - 1], triangle_order[random.next() % i]);
+    std::vector<uint8_t> rotation(triangle_order.size()), rotation_of_root(triangle_order.size());
+    for (uint8_t& r : rotation) r = uint8_t(random.next() % 3);
+    for (size_t t = 0; t < triangle_order.size(); ++t) rotation_of_root[triangle_order[t]] = rotation[t];
+    std::vector<VertexId> expected_map;
+    const Hierarchy expected = replayed(h, vertex_order, triangle_order, rotation, expected_map);
+    const DiagonalExceptions expected_tally = diagonal_exceptions(expected);
+    EXPECT_GT(expected_tally.leaves, 0u);
+    for (unsigned threads : {1u, 2u, 3u}) {
+        std::vector<VertexId> map;
+        const Hierarchy moved = HierarchyBuilder::reorder_base(h, vertex_order, triangle_order, rotation, &map, threads);
+        EXPECT_TRUE(same_ids(moved, expected)) << threads << " threads";
+        EXPECT_EQ(map, expected_map) << threads << " threads";
+        for (const DiagonalExceptions& tally : {diagonal_exceptions(h, rotation_of_root, threads), diagonal_exceptions(moved, threads)}) {
+            EXPECT_EQ(tally.leaves, expected_tally.leaves) << threads << " threads";
+            for (int r = 0; r < kDiagonalRuleCount; ++r) EXPECT_EQ(tally.by_rule[r], expected_tally.by_rule[r]) << threads << " threads, rule " << r;
+        }
+    }
+}
+
 TEST(BaseOrder, BadOrdersAreRefused) {
     Hierarchy h(make_icosahedron());
     std::vector<uint32_t> vertices(12, 0), triangles(20);

@@ -304,6 +304,21 @@ TEST(EncodeDecode, DefaultPlacerIsFiniteAndUnchangedWhereItWasFinite) {
     EXPECT_TRUE(identical(decode_hierarchy(h.base(), stream.data(), stream.size()), h));
 }
 
+// The writer checks positions in ranges of 2^16 vertices on the encode's threads; the message
+// names the first bad vertex, whichever range a thread finished first.
+TEST(EncodeDecode, TheFirstBadPositionIsNamedOnAnyThreads) {
+    Hierarchy h(make_icosahedron());
+    refine_uniformly(h, 7);
+    ASSERT_GT(h.positions().size(), size_t(2) << 16);
+    h.set_position(150000, {0, 0, NAN});
+    h.set_position(70000, {INFINITY, 0, 0});
+    for (unsigned threads : {1u, 2u, 3u}) {
+        EncodeOptions options;
+        options.threads = threads;
+        EXPECT_EQ(encode_error(h, options), "encode: vertex 70000 has a non-finite coordinate") << threads << " threads";
+    }
+}
+
 TEST(EncodeDecode, KnownCasesAreRefusedWithTheDecodersWords) {
     // A base with an unused vertex, a flipped triangle: the decoder's validate_triangle_mesh text.
     TriangleMesh unused = make_icosahedron();

@@ -111,9 +111,10 @@ TEST(ThreadSafety, ConcurrentSeriesAndOctreeCodingGivesTheSerialResults) {
 
 // Threads writing the same path at once: every write is whole, the last rename wins, no temporary
 // file is left (write_file_atomically's names are unique per call).
-// The VTU writer compresses runs of zlib blocks on several threads (docs/VTU.md): arrays of several
-// MiB, so that the runs are shared out, give the bytes of one thread.
-TEST(ThreadSafety, VtuWriterThreadsGiveTheSerialBytes) {
+// The VTU writer compresses and the reader inflates runs of zlib blocks on several threads
+// (docs/VTU.md): arrays of several MiB, so that the runs are shared out, give the bytes and the
+// mesh of one thread.
+TEST(ThreadSafety, VtuWriterAndReaderThreadsGiveTheSerialResults) {
     TriangleMesh mesh;
     constexpr uint32_t kSide = 300;
     for (uint32_t j = 0; j <= kSide; ++j)
@@ -127,6 +128,27 @@ TEST(ThreadSafety, VtuWriterThreadsGiveTheSerialBytes) {
     }
     const std::string one = format_mesh(mesh, nullptr, MeshFormat::vtu, MeshEncoding::binary, 1);
     EXPECT_EQ(format_mesh(mesh, nullptr, MeshFormat::vtu, MeshEncoding::binary, kThreads), one);
+
+    // The reader inflates runs of the same blocks on several threads: threads reading the file
+    // at once, each on several threads, read the mesh of one thread.
+    const std::string path =
+        (std::filesystem::temp_directory_path() / ("amc_threads_read_" + std::to_string(::getpid()) + ".vtu")).string();
+    {
+        std::ofstream(path, std::ios::binary) << one;
+    }
+    const VtuMesh serial = read_vtu(path, 1);
+    EXPECT_EQ(serial.mesh.triangles, mesh.triangles);
+    std::atomic<int> same{0};
+    std::vector<std::thread> readers;
+    for (int t = 0; t < kThreads; ++t) {
+        readers.emplace_back([&] {
+            const VtuMesh vtu = read_vtu(path, kThreads);
+            if (vtu.mesh.positions == serial.mesh.positions && vtu.mesh.triangles == serial.mesh.triangles) ++same;
+        });
+    }
+    for (std::thread& reader : readers) reader.join();
+    std::filesystem::remove(path);
+    EXPECT_EQ(same.load(), kThreads);
 }
 
 TEST(ThreadSafety, ConcurrentAtomicWritesOfOnePathLeaveOneWholeFile) {

@@ -352,6 +352,104 @@ TEST(VtuReader, RefusesHandMadeDefectsNamingThem) {
     refuse(two, "piece 1's cell data array 'v' does not match piece 0's 'u'");
 }
 
+// A cell array of 4 MiB in 32 KiB zlib blocks: runs of blocks inflate on several threads
+// (docs/VTU.md). Every thread count reads the same values, and a bad file gives the error that
+// the block-by-block order of checks names first, appended raw or inline base64.
+TEST(VtuReader, ZlibBlocksReadTheSameOnEveryThreadCount) {
+    constexpr uint32_t kValues = 1 << 19;  // Float64: 4 MiB, 128 blocks
+    std::vector<double> values(kValues);
+    std::mt19937_64 random(7);
+    for (uint32_t i = 0; i < kValues; ++i) values[i] = double(random() % 1000) * 0.25;
+    const std::string data = le_bytes(values);
+    const CompressedBlocks blocks =
+        compress_zlib_blocks(reinterpret_cast<const uint8_t*>(data.data()), data.size(), kVtkBlockSize, 1);
+    const std::size_t count = blocks.compressed_sizes.size();
+    ASSERT_EQ(count, 128u);
+    const auto start_of = [&](std::size_t b) {
+        uint64_t at = 0;
+        for (std::size_t k = 0; k < b; ++k) at += blocks.compressed_sizes[k];
+        return at;
+    };
+    // The file with the given compressed-size words and block bytes.
+    const auto file = [&](const std::vector<uint64_t>& sizes, const std::string& bytes, bool base64_inline) {
+        std::string header = u64(count) + u64(kVtkBlockSize) + u64(0);
+        for (uint64_t c : sizes) header += u64(c);
+        const std::string array = "<CellData><DataArray type=\"Float64\" Name=\"big\" NumberOfComponents=\"" +
+                                  std::to_string(kValues) + "\" format=\"";
+        const std::string root = "header_type=\"UInt64\" compressor=\"vtkZLibDataCompressor\"";
+        if (base64_inline) {
+            return one_piece(root, kAsciiPoints, kAsciiCells,
+                             array + "binary\">" + base64(header + bytes) + "</DataArray></CellData>");
+        }
+        return one_piece(root, kAsciiPoints, kAsciiCells, array + "appended\" offset=\"0\"/></CellData>",
+                         "<AppendedData encoding=\"raw\">\n _" + header + bytes + "\n</AppendedData></VTKFile>");
+    };
+    const auto error_of = [](const std::string& bytes, unsigned threads) {
+        try {
+            parse_vtu(bytes, "h.vtu", threads);
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    const std::string where = "h.vtu: cell data 'big' (line 8): ";
+    const std::string late_bad = "compressed block 100 of 128 is not valid zlib data of 32768 bytes";
+    const std::string size_bad = "compressed block 110 declares 32768 bytes, more than its 10 compressed bytes can hold";
+    for (bool inline_base64 : {false, true}) {
+        SCOPED_TRACE(inline_base64 ? "inline base64" : "appended raw");
+        const std::string good = file(blocks.compressed_sizes, blocks.bytes, inline_base64);
+        for (unsigned threads : {1u, 2u, 5u, 0u}) {
+            const VtuMesh vtu = parse_vtu(good, "h.vtu", threads);
+            ASSERT_EQ(vtu.cell_data.size(), 1u);
+            EXPECT_TRUE(vtu.cell_data[0].values == DataArray::Values(values)) << threads << " threads";
+        }
+        // A late block's bytes corrupt: its error, on every thread count.
+        std::string corrupt = blocks.bytes;
+        corrupt[start_of(100) + 5] ^= 0x55;
+        std::vector<uint64_t> sizes = blocks.compressed_sizes;
+        // A later block whose declared size its 10 bytes cannot hold: checked before any
+        // allocation, but the serial loop meets the corrupt block first.
+        sizes[110] = 10;
+        const std::string cases[][2] = {
+            {file(blocks.compressed_sizes, corrupt, inline_base64), late_bad},
+            {file(sizes, corrupt, inline_base64), late_bad},
+            {file(sizes, blocks.bytes, inline_base64), size_bad},
+        };
+        for (const auto& c : cases) {
+            for (unsigned threads : {1u, 3u, 0u}) EXPECT_EQ(error_of(c[0], threads), where + c[1]) << threads << " threads";
+        }
+        // A corrupt block after the one that fails the size check is never reached.
+        corrupt = blocks.bytes;
+        corrupt[start_of(120) + 5] ^= 0x55;
+        for (unsigned threads : {1u, 4u}) EXPECT_EQ(error_of(file(sizes, corrupt, inline_base64), threads), where + size_bad);
+    }
+    // Base64 broken inside block 105: a corrupt earlier block is still the first error; alone,
+    // the base64 error is.
+    const std::size_t header_bytes = 8 * (3 + count);
+    const std::size_t quantum = (header_bytes + start_of(105) + 100) / 3;  // a 4-character quantum inside block 105
+    const auto broken = [&](const std::string& bytes) {
+        std::string f = file(blocks.compressed_sizes, bytes, true);
+        const std::size_t text = f.find("binary\">") + 8;
+        f[text + 4 * quantum + 1] = '!';
+        return f;
+    };
+    std::string corrupt = blocks.bytes;
+    corrupt[start_of(100) + 5] ^= 0x55;
+    for (unsigned threads : {1u, 4u}) {
+        EXPECT_EQ(error_of(broken(corrupt), threads), where + late_bad);
+        EXPECT_EQ(error_of(broken(blocks.bytes), threads), where + "the data holds a character that is not base64");
+    }
+    // A block of no bytes in base64 is reported as the data ending (take of nothing into an
+    // empty buffer), as the block-by-block loop always did.
+    const std::string empty_block = one_piece("compressor=\"vtkZLibDataCompressor\"",
+                                              "<DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"binary\">" +
+                                                  base64(u32(1) + u32(36) + u32(36) + u32(0)) + "</DataArray>",
+                                              kAsciiCells);
+    for (unsigned threads : {1u, 4u}) {
+        EXPECT_EQ(error_of(empty_block, threads), "h.vtu: Points array (line 6): the data ends early (truncated?)");
+    }
+}
+
 // Thousands of pieces (one triangle each, point data in each): concatenated in order. Messages
 // name lines, and the line numbers are counted once over the file, not once per tag.
 TEST(VtuReader, ManyPiecesConcatenateInOrder) {

@@ -48,8 +48,9 @@ std::string format_mesh(const TriangleMesh& mesh, const CellData* cells, MeshFor
 // type 5, or a polygon of 3 points); Points as Float32 set single_precision. A file of several
 // Pieces reads as their concatenation (points of later pieces numbered after earlier ones, as
 // VTK's reader does); their point and cell arrays must match in name, type and components.
-// The mesh is validated with validate_triangle_mesh. Throws Error naming the file.
-VtuMesh read_vtu(const std::string& path);
+// The mesh is validated with validate_triangle_mesh. zlib blocks inflate on up to `threads`
+// threads (0: every core; the result and errors do not depend on it). Throws Error naming the file.
+VtuMesh read_vtu(const std::string& path, unsigned threads = 0);
 
 enum class VtuEncoding {
     binary_zlib,  // appended raw data, zlib-compressed blocks, UInt64 headers (VTK's default)

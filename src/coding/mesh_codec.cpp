@@ -24,6 +24,7 @@
 #include <future>
 #include <memory>
 #include <string>
+#include <utility>
 
 namespace amc {
 
@@ -45,10 +46,41 @@ std::vector<Vec3> live_positions(const Hierarchy& h) {
     return points;
 }
 
+// Vertices per task of the passes over all positions below.
+constexpr size_t kPositionRange = size_t(1) << 16;
+
+// make_quantizer(points)'s bounding box, the points' ranges on `threads` threads: each range's
+// fold, then the ranges' in order, which is the one fold over all points. Inline, for finite
+// points what std::fmin / std::fmax give (of two equal values, the first: glibc keeps lo's zero).
+std::pair<Vec3, Vec3> bounding_box(const std::vector<Vec3>& points, unsigned threads) {
+    auto lower = [](Vec3 lo, Vec3 p) { return Vec3{p.x < lo.x ? p.x : lo.x, p.y < lo.y ? p.y : lo.y, p.z < lo.z ? p.z : lo.z}; };
+    auto higher = [](Vec3 hi, Vec3 p) { return Vec3{p.x > hi.x ? p.x : hi.x, p.y > hi.y ? p.y : hi.y, p.z > hi.z ? p.z : hi.z}; };
+    const size_t ranges = (points.size() + kPositionRange - 1) / kPositionRange;
+    std::vector<std::pair<Vec3, Vec3>> boxes(ranges);
+    parallel_for(ranges, threads, [&](size_t i) {
+        const size_t begin = i * kPositionRange, end = std::min(points.size(), begin + kPositionRange);
+        Vec3 lo = points[begin], hi = points[begin];
+        for (size_t v = begin; v < end; ++v) {
+            lo = lower(lo, points[v]);
+            hi = higher(hi, points[v]);
+        }
+        boxes[i] = {lo, hi};
+    });
+    Vec3 lo = boxes[0].first, hi = boxes[0].second;
+    for (const auto& box : boxes) {
+        lo = lower(lo, box.first);
+        hi = higher(hi, box.second);
+    }
+    return {lo, hi};
+}
+
 // The grid of `bits` over the input's positions (checked: without removed ids every id is live).
-Quantizer quantizer_of(const Hierarchy& input, int bits) {
+Quantizer quantizer_of(const Hierarchy& input, int bits, unsigned threads) {
     try {
-        if (input.vertex_count() == input.positions().size()) return make_quantizer(input.positions(), bits);
+        if (input.vertex_count() == input.positions().size() && !input.positions().empty()) {
+            const auto [lo, hi] = bounding_box(input.positions(), threads);
+            return make_quantizer(lo, hi, bits);
+        }
         return make_quantizer(live_positions(input), bits);
     } catch (const Error& e) {
         throw_error(e.code(), std::string("encode: ") + e.what() +
@@ -58,15 +90,23 @@ Quantizer quantizer_of(const Hierarchy& input, int bits) {
 
 // Moves every position of h to the grid point the decoder reconstructs (the predictions are made
 // from those: a closed loop); returns the largest coordinate error, max_quantization_error's.
-double snap_positions(Hierarchy& h, const Quantizer& quantizer) {
-    double worst = 0.0;
+// On `threads` threads, each range of vertices with its own largest error.
+double snap_positions(Hierarchy& h, const Quantizer& quantizer, unsigned threads) {
     // std::fmax inline (a NaN loses to a number); its choice between +0 and -0 never arises, fabs gives +0.
     auto larger = [](double a, double b) { return b > a || std::isnan(a) ? b : a; };
-    for (VertexId v = 0; v < h.positions().size(); ++v) {
-        const Vec3 p = h.position(v), r = dequantize(quantizer, snap_to_grid(quantizer, p));
-        worst = larger(worst, larger(std::fabs(r.x - p.x), larger(std::fabs(r.y - p.y), std::fabs(r.z - p.z))));
-        h.set_position(v, r);
-    }
+    const size_t vertices = h.positions().size();
+    std::vector<double> worst_in((vertices + kPositionRange - 1) / kPositionRange, 0.0);
+    parallel_for(worst_in.size(), threads, [&](size_t i) {
+        double worst = 0.0;
+        for (size_t v = i * kPositionRange; v < std::min(vertices, (i + 1) * kPositionRange); ++v) {
+            const Vec3 p = h.position(VertexId(v)), r = dequantize(quantizer, snap_to_grid(quantizer, p));
+            worst = larger(worst, larger(std::fabs(r.x - p.x), larger(std::fabs(r.y - p.y), std::fabs(r.z - p.z))));
+            h.set_position(VertexId(v), r);
+        }
+        worst_in[i] = worst;
+    });
+    double worst = 0.0;
+    for (double w : worst_in) worst = larger(worst, w);
     return worst;
 }
 
@@ -178,7 +218,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     // Quantized coordinates are reconstructed as doubles on the grid, whatever the input precision.
     const Precision precision = input.single_precision() && !quantized ? Precision::float32 : Precision::float64;
     Quantizer quantizer;
-    if (quantized) quantizer = quantizer_of(input, options.quantize_bits);
+    if (quantized) quantizer = quantizer_of(input, options.quantize_bits, threads);
     const CoordinateSpace space{precision, quantized ? &quantizer : nullptr};
 
     // II-B: code the base mesh first and express the forest in the decoder's base order.
@@ -190,7 +230,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
         stats.numbering = numbering_after_reorder(input, *options.numbering, h, reordered.vertex_map);
     if (quantized) {
         h.set_single_precision(false);
-        stats.max_error = snap_positions(h, quantizer);  // h holds exactly the input's live positions
+        stats.max_error = snap_positions(h, quantizer, threads);  // h holds exactly the input's live positions
     }
 
     // The forest (FORMAT.md 3.6, 3.11), after the base geometry, whose adaptive models the level

@@ -9,6 +9,7 @@
 #include <amc/hierarchy.h>
 
 #include <algorithm>
+#include <memory>
 #include <string>
 
 namespace amc {
@@ -65,38 +66,72 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
                                       std::vector<VertexId>* vertex_map_out, unsigned threads) {
     Hierarchy out(std::move(base));
     const NodeId roots = out.root_count();
-    // The replay's order: node j of the result is old node old_of[j] turned by turn[j].
-    std::vector<NodeId> old_of, first_child;
-    std::vector<uint8_t> turn;
+    // The replay's order: node j of the result is old node old_of[j] turned by turn[j]. It is
+    // breadth-first, so made a level at a time: each level's nodes in ranges on `threads` threads,
+    // the split ones counted first, then their children placed after the level in that order.
+    std::vector<NodeId> old_of(roots), first_child(roots);
+    std::vector<uint8_t> turn(roots);
     old_of.reserve(h.node_count());
-    turn.reserve(h.node_count());
     first_child.reserve(h.node_count());
-    std::vector<NodeId> new_of(h.node_capacity(), kNoNode);
+    turn.reserve(h.node_count());
+    // Left unset: only live nodes are reached and looked up, and their entries are written by the
+    // threads' first pass (which takes the first touch of its pages off the serial part too).
+    const std::unique_ptr<NodeId[]> new_of(new NodeId[h.node_capacity()]);
     for (uint32_t t = 0; t < triangle_order.size(); ++t) {
-        old_of.push_back(triangle_order[t]);
-        turn.push_back(rotation[t]);
+        old_of[t] = triangle_order[t];
+        turn[t] = rotation[t];
     }
     // Each pass reads the old nodes in the replay's order, which jumps about h: fetched kAhead early.
     constexpr size_t kAhead = 16;
-    for (size_t j = 0; j < old_of.size(); ++j) {
-        if (j + kAhead < old_of.size()) prefetch(h, old_of[j + kAhead]);
-        const NodeId o = old_of[j];
-        new_of[o] = NodeId(j);
-        if (h.is_leaf(o)) {
-            first_child.push_back(kNoNode);
-            continue;
-        }
-        first_child.push_back(NodeId(old_of.size()));
-        for (int k = 0; k < 4; ++k) {
-            old_of.push_back(h.child(o, red_split::kRotatedChild[turn[j]][k]));
-            turn.push_back(turn[j]);
-        }
+    constexpr size_t kRange = size_t(1) << 16;  // nodes per task
+    std::vector<uint64_t> split_before;  // per range of the level: its split nodes, then the ranges' before it
+    for (size_t begin = 0, end = roots; begin < end;) {
+        const size_t level_ranges = (end - begin + kRange - 1) / kRange;
+        split_before.assign(level_ranges + 1, 0);
+        // (Through local pointers and counts: a store through a uint8_t may alias anything, and made
+        // the compiler reload the vectors' pointers after each.)
+        parallel_for(level_ranges, threads, [&](size_t i) {  // first_child[j]: the old node's, for now
+            const NodeId* old = old_of.data();
+            NodeId* first = first_child.data();
+            uint64_t split = 0;
+            for (size_t j = begin + i * kRange, stop = std::min(end, begin + (i + 1) * kRange); j < stop; ++j) {
+                if (j + kAhead < end) prefetch(h, old[j + kAhead]);
+                new_of[old[j]] = NodeId(j);
+                first[j] = h.is_leaf(old[j]) ? kNoNode : h.child(old[j], 0);
+                split += first[j] != kNoNode;
+            }
+            split_before[i + 1] = split;
+        });
+        for (size_t i = 0; i < level_ranges; ++i) split_before[i + 1] += split_before[i];
+        const size_t next_end = end + 4 * size_t(split_before[level_ranges]);
+        AMC_REQUIRE(next_end <= h.node_capacity(), limit_exceeded, "reorder_base: more nodes than the hierarchy holds");
+        old_of.resize(next_end);
+        turn.resize(next_end);
+        first_child.resize(next_end);
+        parallel_for(level_ranges, threads, [&](size_t i) {
+            NodeId* old = old_of.data();
+            NodeId* first = first_child.data();
+            uint8_t* turned = turn.data();
+            size_t next = end + 4 * size_t(split_before[i]);
+            for (size_t j = begin + i * kRange, stop = std::min(end, begin + (i + 1) * kRange); j < stop; ++j) {
+                const NodeId old_first = first[j];
+                if (old_first == kNoNode) continue;
+                first[j] = NodeId(next);
+                const uint8_t r = turned[j];
+                for (int k = 0; k < 4; ++k) {
+                    old[next + size_t(k)] = old_first + NodeId(red_split::kRotatedChild[r][k]);
+                    turned[next + size_t(k)] = r;
+                }
+                next += 4;
+            }
+        });
+        begin = end;
+        end = next_end;
     }
     const size_t n = old_of.size();
     // Split node j creates the midpoint of its edge e unless its same-level neighbour there was
     // split before it (split() then takes the neighbour's): bit e of creates[j].
     std::vector<uint8_t> creates(n, 0);
-    constexpr size_t kRange = size_t(1) << 16;  // nodes per task
     const size_t ranges = (n + kRange - 1) / kRange;
     std::vector<uint64_t> first_vertex(ranges + 1, 0);
     parallel_for(ranges, threads, [&](size_t i) {
@@ -120,9 +155,11 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
     vertex_map.assign(h.positions().size(), kNoVertex);
     for (size_t v = 0; v < base_vertex_id.size(); ++v) vertex_map[v] = base_vertex_id[v];
     out.positions_.resize(size_t(first_vertex[ranges]));
-    // The midpoints, numbered in the replay's order; each written by the node that creates it.
+    // The midpoints, numbered in the replay's order; each written by the node that creates it. (The
+    // constructor marked far base positions.)
     parallel_for(ranges, threads, [&](size_t i) {
         VertexId next = VertexId(first_vertex[i]);
+        bool far = false;
         for (size_t j = i * kRange; j < std::min(n, (i + 1) * kRange); ++j) {
             if (j + kAhead < n && creates[j + kAhead] != 0) prefetch(h, old_of[j + kAhead]);
             if (first_child[j] == kNoNode) continue;
@@ -130,9 +167,11 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
                 if (!((creates[j] >> e) & 1)) continue;
                 const VertexId old = h.midpoint(old_of[j], kEdgeMod3[e + turn[j]]);
                 vertex_map[old] = next;
-                out.positions_[next++] = h.position(old);
+                out.positions_[next] = h.position(old);
+                far |= Hierarchy::is_far(out.positions_[next++]);
             }
         }
+        out.far_positions_.raise_if(far);
     });
     out.nodes_.resize(n);  // Node() writes nothing: each is written whole below
     out.block_parent_.assign((n - roots) / 4, kNoNode);
@@ -163,7 +202,6 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
             node.reserved = 0;
         }
     });
-    for (const Vec3& p : out.positions_) out.far_positions_.raise_if(Hierarchy::is_far(p));
     out.live_nodes_ = uint32_t(n);
     out.live_vertices_ = uint32_t(out.positions_.size());
     return out;

@@ -127,12 +127,12 @@ std::string check_invariants(const Hierarchy& h, unsigned threads) {
     return "";
 }
 
-std::string check_positions(const Hierarchy& h) {
-    // Without removed ids every id is a live vertex: no need to find them.
-    const bool all_live = h.vertex_count() == h.positions().size();
-    const std::vector<uint32_t> canonical = all_live ? std::vector<uint32_t>() : canonical_vertex_order(h);
-    for (VertexId v = 0; v < h.positions().size(); ++v) {
-        if (!all_live && canonical[v] == kNoVertex) continue;
+namespace {
+
+// The first problem of the positions of vertices [begin, end), or "".
+std::string check_position_range(const Hierarchy& h, const std::vector<uint32_t>& canonical, VertexId begin, VertexId end) {
+    for (VertexId v = begin; v < end; ++v) {
+        if (!canonical.empty() && canonical[v] == kNoVertex) continue;
         const Vec3 p = h.position(v);
         for (const double x : {p.x, p.y, p.z}) {
             if (!std::isfinite(x)) return "vertex " + std::to_string(v) + " has a non-finite coordinate";
@@ -144,6 +144,27 @@ std::string check_positions(const Hierarchy& h) {
     return "";
 }
 
+// Ranges of vertices checked on `threads` threads; the first problem in vertex order is reported.
+std::string check_positions(const Hierarchy& h, unsigned threads) {
+    // Without removed ids every id is a live vertex: no need to find them.
+    const bool all_live = h.vertex_count() == h.positions().size();
+    const std::vector<uint32_t> canonical = all_live ? std::vector<uint32_t>() : canonical_vertex_order(h);
+    constexpr VertexId kRange = VertexId(1) << 16;
+    const VertexId vertices = VertexId(h.positions().size());
+    std::vector<std::string> problems((size_t(vertices) + kRange - 1) / kRange);
+    parallel_for(problems.size(), threads, [&](size_t i) {
+        const VertexId begin = VertexId(i) * kRange;
+        problems[i] = check_position_range(h, canonical, begin, std::min<VertexId>(vertices, begin + kRange));
+    });
+    for (const std::string& problem : problems)
+        if (!problem.empty()) return problem;
+    return "";
+}
+
+}  // namespace
+
+std::string check_positions(const Hierarchy& h) { return check_positions(h, 1); }
+
 void check_before_writing(const Hierarchy& h, const std::string& what, bool positions, unsigned threads) {
     validate_triangle_mesh(h.base(), what + ": base mesh");
     if (!HierarchyBuilder::structure_checked(h)) {
@@ -151,7 +172,7 @@ void check_before_writing(const Hierarchy& h, const std::string& what, bool posi
         AMC_REQUIRE(problem.empty(), invalid_input, what + ": invalid hierarchy: " + problem);
     }
     if (!positions) return;
-    const std::string position_problem = check_positions(h);
+    const std::string position_problem = check_positions(h, threads);
     AMC_REQUIRE(position_problem.empty(), invalid_input, what + ": " + position_problem);
 }
 

@@ -10,8 +10,9 @@ namespace amc {
 namespace {
 
 
-// A triangle's vertex set as a key (the three ids sorted, 21 bits each would not do for large
-// meshes, so two words; no triangle has three equal ids, so the empty key cannot occur).
+// Three vertex ids as a key: a triangle's vertex set (triple_key, the ids sorted) or an oriented
+// triangle (the final check). 21 bits each would not do for large meshes, so two words; no
+// triangle has three equal ids, so the empty key cannot occur.
 struct TripleKey {
     uint64_t low, high;
     bool operator==(const TripleKey& o) const { return low == o.low && high == o.high; }
@@ -148,16 +149,23 @@ ImportedHierarchy hierarchy_from_levels(const TriangleMesh& mesh, const Detected
     for (VertexId v = 0; v < canonical.size(); ++v) {
         if (canonical[v] < input_of_canonical.size()) input_of_canonical[canonical[v]] = input_of[v];
     }
-    std::vector<Triangle> built, given;
-    built.reserve(leaf.mesh.triangles.size());
-    for (const Triangle& t : leaf.mesh.triangles) {
-        built.push_back(normalized({input_of_canonical[t[0]], input_of_canonical[t[1]], input_of_canonical[t[2]]}));
+    // The same triangles as a multiset: each built one takes one given one of its key (the
+    // oriented triangle, smallest id first), and there are as many of each.
+    FlatMap<TripleKey, uint32_t> given(mesh.triangles.size(), kEmptyTriple);
+    auto oriented_key = [](const Triangle& t) {
+        const Triangle n = normalized(t);
+        return TripleKey{(uint64_t(n[0]) << 32) | n[1], n[2]};
+    };
+    for (const Triangle& t : mesh.triangles) ++given[oriented_key(t)];
+    bool same = leaf.mesh.triangles.size() == mesh.triangles.size();
+    for (size_t i = 0; same && i < leaf.mesh.triangles.size(); ++i) {
+        const Triangle& t = leaf.mesh.triangles[i];
+        const TripleKey key = oriented_key({input_of_canonical[t[0]], input_of_canonical[t[1]], input_of_canonical[t[2]]});
+        const uint32_t* count = given.find(key);
+        same = count != nullptr && *count != 0;
+        if (same) --given[key];
     }
-    given.reserve(mesh.triangles.size());
-    for (const Triangle& t : mesh.triangles) given.push_back(normalized(t));
-    std::sort(built.begin(), built.end());
-    std::sort(given.begin(), given.end());
-    if (built != given) fail("the hierarchy's leaf mesh differs from the input");
+    if (!same) fail("the hierarchy's leaf mesh differs from the input");
     return out;
 }
 

@@ -25,11 +25,28 @@ constexpr uint32_t kSmallPatch = 16;
 
 }  // namespace
 
+std::vector<uint32_t> LevelFinder::local_order(const std::vector<Triangle>& fine, uint32_t vertex_count) {
+    // A counting sort by smallest vertex, stable.
+    std::vector<uint32_t> start(size_t(vertex_count) + 1, 0);
+    auto smallest = [&](uint32_t t) { return std::min({fine[t][0], fine[t][1], fine[t][2]}); };
+    for (uint32_t t = 0; t < fine.size(); ++t) ++start[smallest(t) + 1];
+    for (uint32_t v = 0; v < vertex_count; ++v) start[v + 1] += start[v];
+    std::vector<uint32_t> order(fine.size());
+    for (uint32_t t = 0; t < fine.size(); ++t) order[start[smallest(t)]++] = t;
+    return order;
+}
+
+std::vector<uint32_t> LevelFinder::inverse(const std::vector<uint32_t>& order) {
+    std::vector<uint32_t> out(order.size());
+    for (uint32_t i = 0; i < order.size(); ++i) out[order[i]] = i;
+    return out;
+}
+
 size_t LevelFinder::commit(const std::vector<uint8_t>* active) {
     const size_t first = patches_.size();
     std::vector<uint32_t> seeds;
-    for (uint32_t t = 0; t < tri_.size(); ++t) {
-        if (!active || (*active)[t]) seeds.push_back(t);
+    for (uint32_t c = 0; c < local_of_.size(); ++c) {
+        if (!active || (*active)[c]) seeds.push_back(local_of_[c]);
     }
     if (active) seeds = free_near(std::move(seeds), 2);
     const std::vector<uint32_t> region = seeds;
@@ -64,7 +81,8 @@ uint32_t LevelFinder::removed_by(size_t id) const {
     return removed;
 }
 
-bool LevelFinder::could_be_in_block(uint32_t t) {
+bool LevelFinder::could_be_in_block(uint32_t caller_t) {
+    const uint32_t t = local_of_[caller_t];
     uint32_t centers[4] = {t, kNoIndex, kNoIndex, kNoIndex};
     for (int e = 0; e < 3; ++e) {
         const uint32_t h = adjacency_.twin(3 * t + uint32_t(e));
@@ -125,7 +143,7 @@ CoarserLevel LevelFinder::coarser_level(std::vector<uint32_t>* parent_of_block) 
         }
     }
     if (out.red_blocks == 0) return CoarserLevel{};
-    for (uint32_t t = 0; t < tri_.size(); ++t) {
+    for (uint32_t t : local_of_) {
         if (merged[t]) continue;
         out.triangles.push_back(tri_[t]);
         out.refined.push_back(refined_[t]);
@@ -288,10 +306,11 @@ uint32_t LevelFinder::commit_best_first(const std::vector<uint32_t>& seeds) {
         const Candidate c = best_patch(t, true);
         if (c.removed > 0) queue.push_back(c);
     }
-    std::make_heap(queue.begin(), queue.end());
+    auto worse = [this](const Candidate& a, const Candidate& b) { return this->worse(a, b); };
+    std::make_heap(queue.begin(), queue.end(), worse);
     uint32_t total = 0;
     while (!queue.empty()) {
-        std::pop_heap(queue.begin(), queue.end());
+        std::pop_heap(queue.begin(), queue.end(), worse);
         Candidate c = queue.back();
         queue.pop_back();
         const uint32_t start = uint32_t(blocks_.size());
@@ -300,7 +319,7 @@ uint32_t LevelFinder::commit_best_first(const std::vector<uint32_t>& seeds) {
             const auto [seed, removed] = without_glued_seed(start, c.preference, c.removed);
             c = {removed, seed, c.preference};
         }
-        if (c.removed > 0 && (queue.empty() || !(c < queue.front()))) {
+        if (c.removed > 0 && (queue.empty() || !worse(c, queue.front()))) {
             patches_.push_back({start, uint32_t(blocks_.size())});
             hold(uint32_t(patches_.size() - 1), true);
             total += c.removed;
@@ -313,7 +332,7 @@ uint32_t LevelFinder::commit_best_first(const std::vector<uint32_t>& seeds) {
             continue;
         }
         queue.push_back(c);
-        std::push_heap(queue.begin(), queue.end());
+        std::push_heap(queue.begin(), queue.end(), worse);
     }
     return total;
 }
@@ -331,9 +350,12 @@ std::vector<uint32_t> LevelFinder::free_triangles_near(size_t first) {
 }
 
 std::vector<uint32_t> LevelFinder::free_near(std::vector<uint32_t> ring, int rings) const {
-    // Marks instead of sorting the rings: the triangles come out ascending all the same.
     std::vector<uint8_t> reached(tri_.size(), 0);
-    for (uint32_t t : ring) reached[t] = 1;
+    std::vector<uint32_t> unique;
+    for (uint32_t t : ring) {
+        if (!reached[t]) reached[t] = 1, unique.push_back(t);
+    }
+    ring = std::move(unique);
     for (size_t step = 0, begin = 0; step < size_t(rings); ++step) {
         const size_t end = ring.size();
         for (size_t k = std::exchange(begin, end); k < end; ++k) {
@@ -343,11 +365,20 @@ std::vector<uint32_t> LevelFinder::free_near(std::vector<uint32_t> ring, int rin
             }
         }
     }
-    ring.clear();
-    for (uint32_t t = 0; t < tri_.size(); ++t) {
-        if (reached[t] && !taken(t)) ring.push_back(t);
+    // In the caller's order: a scan of every triangle when the rings cover most of them, else a
+    // sort of those reached (a scan in the caller's order reads the local arrays at random).
+    std::vector<uint32_t> free;
+    if (ring.size() * 8 > tri_.size()) {
+        for (uint32_t t : local_of_) {
+            if (reached[t] && !taken(t)) free.push_back(t);
+        }
+        return free;
     }
-    return ring;
+    for (uint32_t t : ring) {
+        if (!taken(t)) free.push_back(t);
+    }
+    std::sort(free.begin(), free.end(), [&](uint32_t a, uint32_t b) { return caller_of_[a] < caller_of_[b]; });
+    return free;
 }
 
 void LevelFinder::hold(uint32_t id, bool on) {
@@ -392,7 +423,7 @@ void LevelFinder::improve_patches(size_t first) {
             for (uint32_t m : b.m) before += midpoint_block_[m][0] / 3 == i || midpoint_block_[m][0] / 3 < patch.first;
         }
         if (taken.empty() || taken.size() > 64) continue;  // large patches have no rival nearby
-        std::sort(seeds.begin(), seeds.end());
+        std::sort(seeds.begin(), seeds.end(), [&](uint32_t a, uint32_t b) { return caller_of_[a] < caller_of_[b]; });
         seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
         hold(uint32_t(r), false);
         for (uint32_t i : taken) release(i), banned_[blocks_[i].center] = 1;

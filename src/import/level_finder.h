@@ -52,7 +52,7 @@ struct Block {
     std::array<uint32_t, 3> v, m;         // parent vertices, midpoints (m_i on v_i -> v_{i+1})
     std::array<uint32_t, 3> first_half;   // half-edge v_i -> m_i (in corner i)
     std::array<uint32_t, 3> second_half;  // half-edge m_i -> v_{i+1} (in corner i+1)
-    std::array<Fan, 3> fan;               // around m_i, set when placed (the mesh alone decides it)
+    std::array<Fan, 3> fan;               // around m_i (the mesh alone decides it)
     bool alive;
     uint32_t patch;  // the committed patch it belongs to, or kNoIndex while growing
 };
@@ -72,7 +72,6 @@ enum class Preference : uint8_t { closure_first, block_first };
 struct Candidate {
     uint32_t removed, center;
     Preference preference;
-    bool operator<(const Candidate& o) const { return removed != o.removed ? removed < o.removed : center > o.center; }
 };
 
 // Blocks committed together: blocks_[first, end).
@@ -82,14 +81,19 @@ struct Patch {
 
 class LevelFinder {
 public:
+    // `fine`, `refined` and every triangle index in this interface are the caller's; inside,
+    // the triangles are numbered for locality (local_order), and wherever the caller's order
+    // decides (the order of seeds, ties between candidates, the coarser level's order) it is
+    // looked up, so the numbering changes no result.
     LevelFinder(const std::vector<Triangle>& fine, const std::vector<uint8_t>& refined, uint32_t vertex_count,
                 const std::vector<uint8_t>* kept)
-        : tri_(fine), refined_(refined), adjacency_(fine, vertex_count), forced_old_(vertex_count, 0),
+        : caller_of_(local_order(fine, vertex_count)), local_of_(inverse(caller_of_)), tri_(permuted(fine, caller_of_)),
+          refined_(permuted(refined, caller_of_)), adjacency_(tri_, vertex_count), forced_old_(vertex_count, 0),
           midpoint_count_(vertex_count, 0), corner_count_(vertex_count, 0),
-          midpoint_block_(vertex_count, {kNoIndex, kNoIndex}), first_coarse_edge_(vertex_count), block_of_(fine.size(), kNoIndex), closure_of_(fine.size(), kNoIndex),
+          midpoint_block_(vertex_count, {kNoIndex, kNoIndex}), first_coarse_edge_(vertex_count, kNoEdge), block_of_(fine.size(), kNoIndex), closure_of_(fine.size(), kNoIndex),
           pinned_old_(vertex_count, 0), covered_(fine.size(), 0),
           banned_(fine.size(), 0), repair_banned_(fine.size(), 0), deferred_(fine.size(), 0),
-          center_shape_(fine.size(), ShapeKnown::not_yet) {
+          shape_of_(fine.size(), kNotRead) {
         // A midpoint has its block's three triangles on one side and the boundary, another block
         // (three) or a green closure (two or three triangles around it) on the other.
         for (uint32_t v = 0; v < vertex_count; ++v) {
@@ -124,6 +128,25 @@ public:
     CoarserLevel coarser_level(std::vector<uint32_t>* parent_of_block = nullptr) const;
 
 private:
+    // ---- numbering -----------------------------------------------------------------------------
+    // The caller's triangle indices ordered by each triangle's smallest vertex id: base
+    // detection numbers the vertices breadth-first, so triangles that a growth reads together
+    // share cache lines, where the caller's order (a shuffled input's) would make each read a miss.
+    static std::vector<uint32_t> local_order(const std::vector<Triangle>& fine, uint32_t vertex_count);
+    static std::vector<uint32_t> inverse(const std::vector<uint32_t>& order);
+    template <typename T>
+    static std::vector<T> permuted(const std::vector<T>& values, const std::vector<uint32_t>& order) {
+        std::vector<T> out;
+        out.reserve(order.size());
+        for (uint32_t i : order) out.push_back(values[i]);
+        return out;
+    }
+    // Whether candidate a is worse than b: fewer vertices removed, or as many and a center later
+    // in the caller's order.
+    bool worse(const Candidate& a, const Candidate& b) const {
+        return a.removed != b.removed ? a.removed < b.removed : caller_of_[a.center] > caller_of_[b.center];
+    }
+
     // ---- reading the fine mesh ---------------------------------------------------------------
     uint32_t vertex_at(uint32_t half_edge, int offset) const;
     static uint32_t next_half_edge(uint32_t half_edge, int offset);
@@ -134,15 +157,17 @@ private:
     // The block whose center is t, read off the mesh (no labels consulted), or false.
     bool read_block(uint32_t t, Block& b) const;
 
-    // read_block, and false too when the mesh alone rules the block out (a midpoint whose star
-    // cannot be one's, a coarse edge already an edge); the verdict is kept per triangle, as a
-    // growth reads the same triangles again and again.
-    bool read_possible_block(uint32_t t, Block& b) const;
+    // The block centered at t as read_block reads it, with its fans walked, or nullptr when
+    // read_block fails or the mesh alone rules the block out (a midpoint whose star cannot be
+    // one's, a coarse edge already an edge). The mesh alone decides it, and growths read the same
+    // triangles again and again, so it is read once per triangle and kept. The pointer lasts
+    // until the next call.
+    const Block* possible_block(uint32_t t) const;
 
     Fan walk_fan(const Block& b, int i) const;
 
     // ---- placing blocks ----------------------------------------------------------------------
-    // Whether a block read by read_possible_block fits the labels (its midpoints not old, its
+    // Whether a block read by possible_block fits the labels (its midpoints not old, its
     // apexes not new); that its coarse edges are not coarse edges of other blocks is checked with
     // the sides, once the patch is grown.
     bool fits(const Block& b) const;
@@ -261,14 +286,19 @@ private:
     // glued at an old vertex).
     void improve_patches(size_t first);
 
-    const std::vector<Triangle>& tri_;
-    const std::vector<uint8_t>& refined_;
+    std::vector<uint32_t> caller_of_;  // per triangle: its index in the caller's numbering
+    std::vector<uint32_t> local_of_;   // per caller's index: the triangle
+    std::vector<Triangle> tri_;
+    std::vector<uint8_t> refined_;
     TriangleAdjacency adjacency_;
     std::vector<uint8_t> forced_old_;      // per vertex: its star rules out being a midpoint
     std::vector<uint8_t> midpoint_count_;  // per vertex: blocks it is a midpoint of (0-2)
     std::vector<uint32_t> corner_count_;   // per vertex: blocks it is a parent vertex of
     std::vector<std::array<uint32_t, 2>> midpoint_block_;  // block * 3 + edge, per midpoint role
-    std::vector<std::pair<uint32_t, uint32_t>> first_coarse_edge_;  // coarse_edge(midpoint_block_[v][0])
+    // Per vertex: coarse_edge(midpoint_block_[v][0]), or kNoEdge when v is no midpoint (one load
+    // tells has_other_midpoint both, which scans every neighbour of a vertex).
+    static constexpr std::pair<uint32_t, uint32_t> kNoEdge{kNoIndex, kNoIndex};
+    std::vector<std::pair<uint32_t, uint32_t>> first_coarse_edge_;
     std::vector<uint32_t> block_of_;       // per triangle
     std::vector<uint32_t> closure_of_;     // per triangle: block * 3 + side of a committed closure
     std::vector<uint32_t> pinned_old_;     // per vertex: closures of committed patches it is a corner of
@@ -276,8 +306,9 @@ private:
     std::vector<uint8_t> banned_;          // per triangle: not a center (while a patch is improved)
     std::vector<uint8_t> repair_banned_;   // per triangle: not a center (while a patch is grown again)
     std::vector<uint8_t> deferred_;        // per triangle: center of a valid patch left for later
-    enum class ShapeKnown : uint8_t { not_yet, possible, impossible };
-    mutable std::vector<ShapeKnown> center_shape_;  // per triangle: read_possible_block's verdict
+    static constexpr uint32_t kNotRead = kNoIndex, kImpossible = kNoIndex - 1;
+    mutable std::vector<uint32_t> shape_of_;  // per triangle: kNotRead, kImpossible or its index in shapes_
+    mutable std::vector<Block> shapes_;       // the blocks possible_block has read
     std::vector<Block> blocks_;
     std::vector<Patch> patches_;
     uint32_t growth_limit_ = kNoIndex;      // blocks: a growth larger than this is given up

@@ -39,19 +39,23 @@ bool LevelFinder::read_block(uint32_t t, Block& b) const {
     return true;
 }
 
-bool LevelFinder::read_possible_block(uint32_t t, Block& b) const {
-    if (center_shape_[t] == ShapeKnown::impossible) return false;
-    if (!read_block(t, b)) {
-        center_shape_[t] = ShapeKnown::impossible;
-        return false;
-    }
-    if (center_shape_[t] == ShapeKnown::possible) return true;
-    bool possible = true;
+const Block* LevelFinder::possible_block(uint32_t t) const {
+    const uint32_t known = shape_of_[t];
+    if (known == kImpossible) return nullptr;
+    if (known != kNotRead) return &shapes_[known];
+    Block b;
+    bool possible = read_block(t, b);
     for (int i = 0; i < 3 && possible; ++i) {
         possible = !forced_old_[b.m[size_t(i)]] && !adjacency_.has_edge(b.v[size_t(i)], b.v[size_t(i + 1) % 3]);
     }
-    center_shape_[t] = possible ? ShapeKnown::possible : ShapeKnown::impossible;
-    return possible;
+    if (!possible) {
+        shape_of_[t] = kImpossible;
+        return nullptr;
+    }
+    for (int i = 0; i < 3; ++i) b.fan[size_t(i)] = walk_fan(b, i);
+    shape_of_[t] = uint32_t(shapes_.size());
+    shapes_.push_back(b);
+    return &shapes_.back();
 }
 
 Fan LevelFinder::walk_fan(const Block& b, int i) const {
@@ -94,8 +98,8 @@ bool LevelFinder::fits(const Block& b) const {
 
 bool LevelFinder::has_other_midpoint(uint32_t a, uint32_t b, uint32_t m) const {
     auto splits_ab = [&](uint32_t w) {
-        if (w == m || midpoint_count_[w] == 0) return false;
-        const auto [s, t] = first_coarse_edge_[w];
+        if (w == m) return false;
+        const auto [s, t] = first_coarse_edge_[w];  // (kNoIndex, kNoIndex) unless w is a midpoint
         return (s == a && t == b) || (s == b && t == a);
     };
     for (const uint32_t* w = adjacency_.ends_begin(a); w != adjacency_.ends_end(a); ++w) {
@@ -110,17 +114,17 @@ bool LevelFinder::has_other_midpoint(uint32_t a, uint32_t b, uint32_t m) const {
 }
 
 bool LevelFinder::place_block(uint32_t t) {
-    Block b;
-    if (!read_possible_block(t, b) || !fits(b)) return false;
-    for (int i = 0; i < 3; ++i) b.fan[size_t(i)] = walk_fan(b, i);
+    const Block* shape = possible_block(t);
+    if (shape == nullptr || !fits(*shape)) return false;
+    for (const Fan& fan : shape->fan) {
+        if (fan.kind == Fan::invalid) return false;
+    }
     const uint32_t index = uint32_t(blocks_.size());
-    blocks_.push_back(b);
+    blocks_.push_back(*shape);
     claim(index);
-    for (int i = 0; i < 3; ++i) {
-        const Fan& fan = b.fan[size_t(i)];
+    for (const Fan& fan : blocks_[index].fan) {
         // Neither a block nor a two-hanging-node closure fits two old vertices there.
-        if (fan.kind == Fan::invalid ||
-            (fan.size == 3 && is_old(fan.inner[0]) && is_old(fan.inner[1]))) {
+        if (fan.size == 3 && is_old(fan.inner[0]) && is_old(fan.inner[1])) {
             release(index);
             blocks_.pop_back();
             return false;
@@ -152,7 +156,7 @@ void LevelFinder::release(uint32_t index) {
         auto& slots = midpoint_block_[m];
         if (slots[0] / 3 == index) slots[0] = slots[1];
         slots[1] = kNoIndex;
-        if (--midpoint_count_[m] != 0) first_coarse_edge_[m] = coarse_edge(slots[0]);
+        first_coarse_edge_[m] = --midpoint_count_[m] != 0 ? coarse_edge(slots[0]) : kNoEdge;
         --corner_count_[b.v[size_t(k)]];
     }
 }
@@ -180,10 +184,10 @@ uint32_t LevelFinder::middle_of_three(uint32_t h, bool ccw, uint32_t last) const
 }
 
 bool LevelFinder::partner_fits(uint32_t t, uint32_t v, uint32_t from, uint32_t to) const {
-    Block z;
-    if (!read_possible_block(t, z) || !fits(z)) return false;
+    const Block* z = possible_block(t);
+    if (z == nullptr || !fits(*z)) return false;
     for (int e = 0; e < 3; ++e) {
-        if (z.m[size_t(e)] == v) return z.v[size_t(e)] == from && z.v[size_t(e + 1) % 3] == to;
+        if (z->m[size_t(e)] == v) return z->v[size_t(e)] == from && z->v[size_t(e + 1) % 3] == to;
     }
     return false;
 }

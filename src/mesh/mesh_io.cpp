@@ -94,9 +94,9 @@ void write_mesh(const std::string& path, const TriangleMesh& mesh, const CellDat
     write_file_atomically(path, bytes);
 }
 
-VtuMesh read_vtu(const std::string& path) {
+VtuMesh read_vtu(const std::string& path, unsigned threads) {
     const std::string bytes = read_whole_file(path);
-    VtuMesh vtu = parse_vtu(bytes, path);
+    VtuMesh vtu = parse_vtu(bytes, path, threads);
     validate_triangle_mesh(vtu.mesh, path);
     return vtu;
 }

@@ -1,6 +1,7 @@
 // One DataArray of a VTU file: see vtu_arrays.h.
 #include "mesh/vtu_arrays.h"
 
+#include "common/parallel.h"
 #include "mesh/base64.h"
 #include "mesh/text_number.h"
 #include "mesh/zlib_blocks.h"
@@ -124,7 +125,8 @@ bool parse_value(std::string_view token, T& out) {
 
 class ArrayDecoder {
 public:
-    ArrayDecoder(const Layout& layout, const std::string& what) : layout_(layout), what_(what) {}
+    ArrayDecoder(const Layout& layout, const std::string& what, unsigned threads)
+        : layout_(layout), what_(what), threads_(threads) {}
 
     // The array's values, which must be `tuples` tuples of its components. `piece` prefixes
     // messages ("piece 2: " or "").
@@ -268,38 +270,109 @@ private:
             fail(what_, where + ": the compressed blocks need " + std::to_string(compressed_total) +
                             " bytes, but only " + std::to_string(source.max_remaining()) + " remain (truncated?)", ErrorCode::truncated);
         }
-        // The output grows block by block, each block first checked against what zlib can
-        // expand its bytes to: no allocation is larger than the input can back.
-        std::vector<uint8_t> out;
-        for (uint64_t b = 0; b < blocks; ++b) {
-            const uint64_t size = (b + 1 == blocks && last_size) ? last_size : block_size;
-            if (size > compressed[b] * kZlibMaxExpansion + 64) {
-                fail(what_, where + ": compressed block " + std::to_string(b) + " declares " +
-                                std::to_string(size) + " bytes, more than its " + std::to_string(compressed[b]) +
-                                " compressed bytes can hold");
+        return inflate_blocks(source, compressed, block_size, last_size, where);
+    }
+
+    // The blocks inflated one after another into one buffer, each first checked against what
+    // zlib can expand its bytes to, so no allocation is larger than the input can back. Runs of
+    // blocks (about 1 MiB of output each) inflate on several threads; the error is the one the
+    // block-by-block loop (inflate_serially) reports first.
+    std::vector<uint8_t> inflate_blocks(ByteSource& source, const std::vector<uint64_t>& compressed,
+                                        uint64_t block_size, uint64_t last_size, const std::string& where) const {
+        const uint64_t blocks = compressed.size();
+        // The blocks before the first one that fails the size check are all inflated: an inflate
+        // failure among them comes first in the serial loop.
+        uint64_t checked = 0, in_size = 0, out_size = 0;
+        bool empty_block = false;
+        while (checked < blocks && block_fits(compressed, checked, block_size, last_size)) {
+            in_size += compressed[checked];
+            out_size += block_bytes(blocks, checked, block_size, last_size);
+            empty_block |= compressed[checked] == 0;
+            ++checked;
+        }
+        // Their bytes are consecutive: one take, as base64 decodes into the reused scratch.
+        const ByteSource start = source;
+        std::vector<uint8_t> scratch;
+        const uint8_t* in = empty_block ? nullptr : source.take(in_size, scratch);
+        if (!in) {
+            // Base64 that breaks inside the blocks (is an earlier block's inflate failure or the
+            // base64 error first?) or a block of no bytes (never valid; base64's take(0) into an
+            // empty scratch reports the data ending): the serial loop says which error comes first.
+            ByteSource again = start;
+            return inflate_serially(again, compressed, block_size, last_size, where);
+        }
+        std::vector<uint8_t> out(out_size);
+        std::vector<uint64_t> in_at(checked + 1, 0), out_at(checked + 1, 0);
+        for (uint64_t b = 0; b < checked; ++b) {
+            in_at[b + 1] = in_at[b] + compressed[b];
+            out_at[b + 1] = out_at[b] + block_bytes(blocks, b, block_size, last_size);
+        }
+        const uint64_t per_task = std::max<uint64_t>(1, (uint64_t{1} << 20) / block_size);
+        const std::size_t tasks = static_cast<std::size_t>((checked + per_task - 1) / per_task);
+        std::vector<uint64_t> first_bad(tasks, checked);  // per task: its first block that fails
+        parallel_for(tasks, resolve_thread_count(threads_), [&](std::size_t t) {
+            for (uint64_t b = t * per_task; b < std::min(checked, (t + 1) * per_task); ++b) {
+                if (!inflate_zlib_block(in + in_at[b], compressed[b], out.data() + out_at[b], out_at[b + 1] - out_at[b])) {
+                    first_bad[t] = b;
+                    return;
+                }
             }
+        });
+        for (const uint64_t b : first_bad) {
+            if (b < checked) fail_inflate(blocks, b, block_bytes(blocks, b, block_size, last_size), where);
+        }
+        if (checked < blocks) fail_size(compressed, checked, block_size, last_size, where);
+        return out;
+    }
+
+    // The reference order of checks: size, bytes, inflate, block by block.
+    std::vector<uint8_t> inflate_serially(ByteSource& source, const std::vector<uint64_t>& compressed,
+                                          uint64_t block_size, uint64_t last_size, const std::string& where) const {
+        const uint64_t blocks = compressed.size();
+        std::vector<uint8_t> scratch, out;
+        for (uint64_t b = 0; b < blocks; ++b) {
+            const uint64_t size = block_bytes(blocks, b, block_size, last_size);
+            if (!block_fits(compressed, b, block_size, last_size)) fail_size(compressed, b, block_size, last_size, where);
             const uint8_t* p = source.take(compressed[b], scratch);
             if (!p) fail_source(source, where, "");
             const std::size_t at = out.size();
             out.resize(at + size);
-            if (!inflate_zlib_block(p, compressed[b], out.data() + at, size)) {
-                fail(what_, where + ": compressed block " + std::to_string(b) + " of " +
-                                std::to_string(blocks) + " is not valid zlib data of " +
-                                std::to_string(size) + " bytes");
-            }
+            if (!inflate_zlib_block(p, compressed[b], out.data() + at, size)) fail_inflate(blocks, b, size, where);
         }
         return out;
     }
 
+    static uint64_t block_bytes(uint64_t blocks, uint64_t b, uint64_t block_size, uint64_t last_size) {
+        return (b + 1 == blocks && last_size) ? last_size : block_size;
+    }
+
+    static bool block_fits(const std::vector<uint64_t>& compressed, uint64_t b, uint64_t block_size,
+                           uint64_t last_size) {
+        return block_bytes(compressed.size(), b, block_size, last_size) <= compressed[b] * kZlibMaxExpansion + 64;
+    }
+
+    [[noreturn]] void fail_size(const std::vector<uint64_t>& compressed, uint64_t b, uint64_t block_size,
+                                uint64_t last_size, const std::string& where) const {
+        fail(what_, where + ": compressed block " + std::to_string(b) + " declares " +
+                        std::to_string(block_bytes(compressed.size(), b, block_size, last_size)) + " bytes, more than its " +
+                        std::to_string(compressed[b]) + " compressed bytes can hold");
+    }
+
+    [[noreturn]] void fail_inflate(uint64_t blocks, uint64_t b, uint64_t size, const std::string& where) const {
+        fail(what_, where + ": compressed block " + std::to_string(b) + " of " + std::to_string(blocks) +
+                        " is not valid zlib data of " + std::to_string(size) + " bytes");
+    }
+
     const Layout& layout_;
     const std::string& what_;
+    unsigned threads_;
 };
 
 }  // namespace
 
 DataArray decode_array(const Layout& layout, const ArrayElement& a, uint64_t tuples, const std::string& piece,
-                       const std::string& what) {
-    return ArrayDecoder(layout, what).decode(a, tuples, piece);
+                       const std::string& what, unsigned threads) {
+    return ArrayDecoder(layout, what, threads).decode(a, tuples, piece);
 }
 
 }  // namespace amc::vtu

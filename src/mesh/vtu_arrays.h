@@ -16,8 +16,9 @@ namespace amc::vtu {
 std::string describe(const ArrayElement& a, const std::string& piece);
 
 // The array's values, which must be `tuples` tuples of its components. `piece` prefixes
-// messages ("piece 2: " or ""), `what` names the file. Throws Error.
+// messages ("piece 2: " or ""), `what` names the file. zlib blocks inflate on up to `threads`
+// threads (0: every core; the values and errors do not depend on it). Throws Error.
 DataArray decode_array(const Layout& layout, const ArrayElement& a, uint64_t tuples, const std::string& piece,
-                       const std::string& what);
+                       const std::string& what, unsigned threads);
 
 }  // namespace amc::vtu

@@ -90,7 +90,7 @@ const ArrayElement* find_cells_array(const PieceElement& piece, const char* name
 
 }  // namespace
 
-VtuMesh parse_vtu(std::string_view bytes, const std::string& what) {
+VtuMesh parse_vtu(std::string_view bytes, const std::string& what, unsigned threads) {
     const Layout layout = vtu::read_layout(bytes, what);
     VtuMesh out;
     out.mesh.single_precision = true;
@@ -113,7 +113,7 @@ VtuMesh parse_vtu(std::string_view bytes, const std::string& what) {
                                " with " + std::to_string(a.components) +
                                " components; one integer per cell is needed", ErrorCode::invalid_input);
             }
-            return vtu::decode_array(layout, a, tuples, prefix, what);
+            return vtu::decode_array(layout, a, tuples, prefix, what, threads);
         };
 
         // Types first, so that a mesh of quads is refused as such, whatever its offsets say.
@@ -151,7 +151,7 @@ VtuMesh parse_vtu(std::string_view bytes, const std::string& what) {
                 fail(what, describe(*points, prefix) + ": has " + std::to_string(points->components) +
                                " components; points need 3", ErrorCode::invalid_input);
             }
-            const DataArray coordinates = vtu::decode_array(layout, *points, piece.points, prefix, what);
+            const DataArray coordinates = vtu::decode_array(layout, *points, piece.points, prefix, what, threads);
             if (points->type != ValueType::float32) out.mesh.single_precision = false;
             out.mesh.positions.reserve(first_point + piece.points);
             std::visit(
@@ -176,8 +176,8 @@ VtuMesh parse_vtu(std::string_view bytes, const std::string& what) {
 
         std::vector<DataArray> point_data, cell_data;
         for (const ArrayElement& a : piece.arrays) {
-            if (a.section == Section::point_data) point_data.push_back(vtu::decode_array(layout, a, piece.points, prefix, what));
-            if (a.section == Section::cell_data) cell_data.push_back(vtu::decode_array(layout, a, piece.cells, prefix, what));
+            if (a.section == Section::point_data) point_data.push_back(vtu::decode_array(layout, a, piece.points, prefix, what, threads));
+            if (a.section == Section::cell_data) cell_data.push_back(vtu::decode_array(layout, a, piece.cells, prefix, what, threads));
         }
         append_data(out.point_data, std::move(point_data), k == 0, "point data", k, what);
         append_data(out.cell_data, std::move(cell_data), k == 0, "cell data", k, what);

@@ -12,7 +12,8 @@ namespace amc {
 
 // Parses the bytes of a .vtu file; `what` names the source in messages. Only triangles (and
 // polygons of 3 points) are read; several Pieces are concatenated. Does not validate the mesh
-// (read_vtu does). Throws Error.
-VtuMesh parse_vtu(std::string_view bytes, const std::string& what);
+// (read_vtu does). zlib blocks inflate on up to `threads` threads (0: every core; the result and
+// errors do not depend on it). Throws Error.
+VtuMesh parse_vtu(std::string_view bytes, const std::string& what, unsigned threads = 0);
 
 }  // namespace amc

@@ -81,10 +81,10 @@ ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& ba
         if (base_code.triangle_order[t] < rotation_of_root.size())
             rotation_of_root[base_code.triangle_order[t]] = base_code.triangle_rotation[t];
     ReorderedInput r;
-    const DiagonalExceptions rotated = diagonal_exceptions(input, rotation_of_root);
+    const DiagonalExceptions rotated = diagonal_exceptions(input, rotation_of_root, threads);
     if (rotated.fewest() != 0) {
         // Without rotations every node keeps its local vertex order: the input's exceptions.
-        const DiagonalExceptions unrotated = diagonal_exceptions(input);
+        const DiagonalExceptions unrotated = diagonal_exceptions(input, threads);
         const double rotated_bits = binary_entropy_bits(rotated.fewest(), rotated.leaves);
         // Products rounded (exact_float.h): however it is compiled, the encoder makes the same choice.
         const double kept_bits = binary_entropy_bits(unrotated.fewest(), unrotated.leaves) +

@@ -14,9 +14,11 @@ std::vector<uint32_t> root_of_nodes(const Hierarchy& h) {
     for (NodeId r = 0; r < h.root_count(); ++r) root_of[r] = r;
     // A forest only ever refined numbers parents before their children: one pass over the blocks
     // of four siblings (alive or removed together).
+    // Without unused ids (the encoder's reordered forest) no node is read, only the parents.
+    const bool all_alive = h.node_count() == h.node_capacity();
     bool parents_first = true;
     for (NodeId c = h.root_count(); c < h.node_capacity() && parents_first; c += 4) {
-        if (!h.is_alive(c)) continue;
+        if (!all_alive && !h.is_alive(c)) continue;
         const NodeId p = h.parent(c);
         parents_first = p < c;
         std::fill(root_of.begin() + c, root_of.begin() + c + 4, parents_first ? root_of[p] : kNoNode);
@@ -27,9 +29,11 @@ std::vector<uint32_t> root_of_nodes(const Hierarchy& h) {
 }
 
 std::vector<uint64_t> nodes_per_root(const Hierarchy& h, const std::vector<uint32_t>& root_of) {
-    std::vector<uint64_t> count(h.root_count(), 0);
-    for (NodeId n = 0; n < h.node_capacity(); ++n)
-        if (h.is_alive(n)) ++count[root_of[n]];
+    // By blocks of four siblings (alive or removed together), from root_of alone: unused ids have no
+    // root there, and its 4 bytes a node are read instead of the nodes themselves.
+    std::vector<uint64_t> count(h.root_count(), 1);
+    for (NodeId c = h.root_count(); c < h.node_capacity(); c += 4)
+        if (root_of[c] != kNoNode) count[root_of[c]] += 4;
     return count;
 }
 

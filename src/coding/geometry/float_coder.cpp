@@ -27,6 +27,10 @@ constexpr int kQuantizedTreeDepth = 5;  // k = 0 .. 30 < 32
 static_assert(kMinSymbolsPerCoordinate <= kQuantizedTreeDepth && kQuantizedTreeDepth < 6,
               "kMinSymbolsPerCoordinate is the shallowest tree");
 
+// Every model of FloatResidualModels has the default window (its contexts are made from
+// Context{}): the coders fold it into their code (BitModel::update_with_limit).
+constexpr int kWindowLog2 = BitModel::kDefaultLimitLog2;
+
 // A residual as sign and magnitude; magnitude has at most kMaxLength bits.
 void encode_residual(ArithmeticEncoder& encoder, FloatResidualModels::Context& ctx, int depth,
                      bool negative, uint64_t magnitude) {
@@ -34,19 +38,19 @@ void encode_residual(ArithmeticEncoder& encoder, FloatResidualModels::Context& c
     int node = 1;
     for (int i = depth - 1; i >= 0; --i) {
         const int bit = (k >> i) & 1;
-        encoder.encode(bit != 0, ctx.length[node]);
+        encoder.encode_with_limit<kWindowLog2>(bit != 0, ctx.length[node]);
         node = 2 * node + bit;
     }
     if (k == 0) return;
-    encoder.encode(negative, ctx.sign);
+    encoder.encode_with_limit<kWindowLog2>(negative, ctx.sign);
     int remaining = k - 1;  // bits below the leading one
     if (remaining > 0) {
         const bool first = (magnitude >> (remaining - 1)) & 1;
-        encoder.encode(first, ctx.high[k][0]);
+        encoder.encode_with_limit<kWindowLog2>(first, ctx.high[k][0]);
         --remaining;
         if (remaining > 0) {
             const bool second = (magnitude >> (remaining - 1)) & 1;
-            encoder.encode(second, ctx.high[k][1 + int(first)]);
+            encoder.encode_with_limit<kWindowLog2>(second, ctx.high[k][1 + int(first)]);
             --remaining;
         }
     }
@@ -64,7 +68,7 @@ void decode_residual(ArithmeticDecoder& decoder, FloatResidualModels& models,
                      FloatResidualModels::Context& ctx, int depth, int max_length,
                      bool& negative, uint64_t& magnitude) {
     int node = 1;
-    for (int i = 0; i < depth; ++i) node = 2 * node + int(decoder.decode(ctx.length[node]));
+    for (int i = 0; i < depth; ++i) node = 2 * node + int(decoder.decode_with_limit<kWindowLog2>(ctx.length[node]));
     int k = node - (1 << depth);
     negative = false;
     magnitude = 0;
@@ -73,15 +77,15 @@ void decode_residual(ArithmeticDecoder& decoder, FloatResidualModels& models,
         k = max_length;
     }
     if (k == 0) return;
-    negative = decoder.decode(ctx.sign);
+    negative = decoder.decode_with_limit<kWindowLog2>(ctx.sign);
     magnitude = 1;
     int remaining = k - 1;
     if (remaining > 0) {
-        const bool first = decoder.decode(ctx.high[k][0]);
+        const bool first = decoder.decode_with_limit<kWindowLog2>(ctx.high[k][0]);
         magnitude = (magnitude << 1) | uint64_t(first);
         --remaining;
         if (remaining > 0) {
-            const bool second = decoder.decode(ctx.high[k][1 + int(first)]);
+            const bool second = decoder.decode_with_limit<kWindowLog2>(ctx.high[k][1 + int(first)]);
             magnitude = (magnitude << 1) | uint64_t(second);
             --remaining;
         }

@@ -2,6 +2,11 @@
 // context-group naming shared by the coder and its statistics.
 #include "coding/hierarchy/context_groups.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
+#include "common/parallel.h"
+
+#include <algorithm>
+#include <array>
+#include <vector>
 
 namespace amc {
 
@@ -30,28 +35,47 @@ DiagonalRule DiagonalExceptions::best() const {
 
 namespace {
 
+// Leaves closed by two hanging nodes, by unrefined edge (after the rotation) and diagonal flag,
+// counted over node ranges on `threads` threads; the rules' exceptions follow from the six counts.
 template <class RotationOf>
-DiagonalExceptions tally_exceptions(const Hierarchy& h, RotationOf rotation_of) {
+DiagonalExceptions tally_exceptions(const Hierarchy& h, RotationOf rotation_of, unsigned threads) {
+    constexpr NodeId kRange = NodeId(1) << 16;  // nodes per task
+    const size_t ranges = (size_t(h.node_capacity()) + kRange - 1) / kRange;
+    std::vector<std::array<uint64_t, 6>> counts(ranges, std::array<uint64_t, 6>{});
+    parallel_for(ranges, threads, [&](size_t i) {
+        std::array<uint64_t, 6> count{};  // [2 * unrefined edge + flipped]
+        const NodeId end = std::min<NodeId>(h.node_capacity(), NodeId(i + 1) * kRange);
+        for (NodeId n = NodeId(i) * kRange; n < end; ++n) {
+            if (!h.is_alive(n) || !h.is_leaf(n) || h.hanging_node_count(n) != 2) continue;
+            const int unrefined = !h.has_hanging_node(n, 0) ? 0 : !h.has_hanging_node(n, 1) ? 1 : 2;
+            ++count[size_t(2 * ((unrefined + 3 - rotation_of(n)) % 3) + int(h.diagonal_flipped(n)))];
+        }
+        counts[i] = count;
+    });
     DiagonalExceptions tally;
-    for (NodeId n = 0; n < h.node_capacity(); ++n) {
-        if (!h.is_alive(n) || !h.is_leaf(n) || h.hanging_node_count(n) != 2) continue;
-        const int unrefined = !h.has_hanging_node(n, 0) ? 0 : !h.has_hanging_node(n, 1) ? 1 : 2;
-        tally.add((unrefined + 3 - rotation_of(n)) % 3, h.diagonal_flipped(n));
-    }
+    for (const auto& count : counts)
+        for (int k = 0; k < 6; ++k) {
+            tally.leaves += count[size_t(k)];
+            for (int r = 0; r < kDiagonalRuleCount; ++r)
+                tally.by_rule[r] += diagonal_flag_by_rule(DiagonalRule(r), k / 2) != bool(k % 2) ? count[size_t(k)] : 0;
+        }
     return tally;
 }
 
 }  // namespace
 
-DiagonalExceptions diagonal_exceptions(const Hierarchy& h) {
-    return tally_exceptions(h, [](NodeId) { return 0; });
+DiagonalExceptions diagonal_exceptions(const Hierarchy& h, unsigned threads) {
+    return tally_exceptions(h, [](NodeId) { return 0; }, threads);
 }
 
-DiagonalExceptions diagonal_exceptions(const Hierarchy& h, const std::vector<uint8_t>& root_rotation) {
-    return tally_exceptions(h, [&](NodeId n) {
-        while (n >= h.root_count()) n = h.parent(n);
-        return int(root_rotation[n]);
-    });
+DiagonalExceptions diagonal_exceptions(const Hierarchy& h, const std::vector<uint8_t>& root_rotation, unsigned threads) {
+    return tally_exceptions(
+        h,
+        [&](NodeId n) {
+            while (n >= h.root_count()) n = h.parent(n);
+            return int(root_rotation[n]);
+        },
+        threads);
 }
 
 int context_group_index(int refined, int unrefined, int unknown) {

@@ -17,11 +17,11 @@
 namespace amc {
 
 // The diagonal flags of h's leaves closed by two hanging nodes against every rule (what the
-// encoder would choose, without coding anything).
-DiagonalExceptions diagonal_exceptions(const Hierarchy& h);
+// encoder would choose, without coding anything), counted on `threads` threads.
+DiagonalExceptions diagonal_exceptions(const Hierarchy& h, unsigned threads = 1);
 // The same for h with each root r and its descendants rotated by root_rotation[r] (0-2), as
 // reorder_base rotates them: edge e of a rotated node is edge (e + rotation) % 3 of h's node.
-DiagonalExceptions diagonal_exceptions(const Hierarchy& h, const std::vector<uint8_t>& root_rotation);
+DiagonalExceptions diagonal_exceptions(const Hierarchy& h, const std::vector<uint8_t>& root_rotation, unsigned threads = 1);
 
 // One coded hierarchy symbol in the coder's order, for studies of its contexts (bench/context_study).
 struct CodedSymbol {
