@@ -1,6 +1,6 @@
-// VTU output and input of a leaf mesh: file size and CPU seconds to write and read (read_vtu,
-// validation included), binary (zlib) and ASCII, min-max over runs. CPU time, not wall time, so
-// that a shared machine's load counts less.
+// VTU output and input of a leaf mesh: file size, and CPU and wall seconds to write and read
+// (read_vtu, validation included), binary (zlib) on one thread and on every core, and ASCII;
+// median [min-max] over runs, the thread counts alternating within each run.
 //   amc refine --model random --faces 1100000 --max-level 9 -o big.amh
 //   vtu_io_bench big.amh [runs=3] [dir=/tmp]
 #include <amc/hierarchy.h>
@@ -14,17 +14,9 @@
 #include <ctime>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 using namespace amc;
-
-namespace {
-
-struct MinMax {
-    double min = 1e300, max = 0;
-    void add(double x) { min = std::min(min, x), max = std::max(max, x); }
-};
-
-}  // namespace
 
 int main(int argc, char** argv) {
     if (argc < 2) {
@@ -35,30 +27,46 @@ int main(int argc, char** argv) {
     const std::string dir = argc > 3 ? argv[3] : "/tmp";
     const LeafMesh leaf = extract_leaf_mesh(read_hierarchy(argv[1]));
     const VtuMesh vtu{leaf.mesh, {}, cell_data_arrays(leaf.cells)};
-    std::printf("%zu triangles, %zu vertices, %s precision, %d runs (CPU seconds, min-max)\n",
+    std::printf("%zu triangles, %zu vertices, %s precision, %d runs (seconds, median [min-max])\n",
                 leaf.mesh.triangles.size(), leaf.mesh.positions.size(),
                 leaf.mesh.single_precision ? "single" : "double", runs);
-    for (VtuEncoding encoding : {VtuEncoding::binary_zlib, VtuEncoding::ascii}) {
-        const std::string path = dir + "/vtu_io_bench.vtu";
-        MinMax write, read;
-        for (int r = 0; r < runs; ++r) {
-            double t0 = cpu_seconds();
-            write_vtu(path, vtu, encoding);
-            double t1 = cpu_seconds();
-            const VtuMesh back = read_vtu(path);
-            double t2 = cpu_seconds();
+    struct Way {
+        const char* name;
+        VtuEncoding encoding;
+        unsigned threads;
+        std::vector<double> write_cpu, write_wall, read_cpu, read_wall;
+        uintmax_t bytes = 0;
+    };
+    Way ways[] = {{"binary_zlib, 1 thread", VtuEncoding::binary_zlib, 1, {}, {}, {}, {}},
+                  {"binary_zlib, all cores", VtuEncoding::binary_zlib, 0, {}, {}, {}, {}},
+                  {"ascii", VtuEncoding::ascii, 1, {}, {}, {}, {}}};
+    const std::string path = dir + "/vtu_io_bench.vtu";
+    for (int r = 0; r < runs; ++r) {
+        for (Way& way : ways) {
+            const double c0 = cpu_seconds();
+            const Clock::time_point w0 = Clock::now();
+            write_vtu(path, vtu, way.encoding, way.threads);
+            way.write_wall.push_back(seconds_since(w0));
+            const double c1 = cpu_seconds();
+            const Clock::time_point w1 = Clock::now();
+            const VtuMesh back = read_vtu(path, way.threads);
+            way.read_wall.push_back(seconds_since(w1));
+            way.read_cpu.push_back(cpu_seconds() - c1);
+            way.write_cpu.push_back(c1 - c0);
+            way.bytes = std::filesystem::file_size(path);
             if (back.mesh.triangles != vtu.mesh.triangles) {
                 std::fprintf(stderr, "read back differs\n");
                 return 1;
             }
-            write.add(t1 - t0);
-            read.add(t2 - t1);
         }
-        std::printf("%-11s %11ju bytes  write %.2f-%.2f s  read %.2f-%.2f s\n",
-                    encoding == VtuEncoding::ascii ? "ascii" : "binary_zlib",
-                    static_cast<uintmax_t>(std::filesystem::file_size(path)), write.min, write.max, read.min,
-                    read.max);
-        std::filesystem::remove(path);
+    }
+    std::filesystem::remove(path);
+    for (const Way& way : ways) {
+        const Range wc = range_of(way.write_cpu), ww = range_of(way.write_wall);
+        const Range rc = range_of(way.read_cpu), rw = range_of(way.read_wall);
+        std::printf("%-22s %11ju bytes  write CPU %.3f [%.3f-%.3f] wall %.3f [%.3f-%.3f]  read CPU %.3f [%.3f-%.3f] wall %.3f [%.3f-%.3f]\n",
+                    way.name, way.bytes, wc.median, wc.low, wc.high, ww.median, ww.low, ww.high, rc.median, rc.low, rc.high,
+                    rw.median, rw.low, rw.high);
     }
     return 0;
 }
