@@ -6,7 +6,8 @@ and each build decodes its own file with `amc info` (inspect plus a whole decode
 exact sizes, the instructions callgrind counts (all threads; independent of the machine's load)
 and the median CPU seconds (user + sys of the process) over ROUNDS runs, old and new alternating.
 
-  scripts/decode_work_table.py [--rounds 7] [--no-callgrind] [--new-args "--chunks 1"] OLD/amc NEW/amc -- corpus/*.amh
+  scripts/decode_work_table.py [--rounds 7] [--no-callgrind] [--args "--hierarchy-contexts mixed"]
+      [--new-args "--chunks 1"] OLD/amc NEW/amc -- corpus/*.amh
 """
 import argparse
 import os
@@ -41,6 +42,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=7)
     parser.add_argument("--no-callgrind", action="store_true")
+    parser.add_argument("--args", default="", help="extra encode options for both builds")
     parser.add_argument("--new-args", default="", help="extra encode options for the new build")
     parser.add_argument("old")
     parser.add_argument("new")
@@ -48,7 +50,7 @@ def main():
     args = parser.parse_args()
     models = [m for m in args.models if m != "--"]
     callgrind = not args.no_callgrind and shutil.which("valgrind")
-    builds = ((args.old, []), (args.new, args.new_args.split()))
+    builds = ((args.old, args.args.split()), (args.new, args.args.split() + args.new_args.split()))
 
     with tempfile.TemporaryDirectory() as out:
         files = []
