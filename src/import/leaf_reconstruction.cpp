@@ -250,7 +250,8 @@ uint32_t Reconstruction::find_midpoint(NodeId n, int e) {
         Vec3 m = rounded_scaled(0.5, leaf_.positions[a] + leaf_.positions[b]);  // as the placer computes it
         if (leaf_.single_precision) m = rounded_to_float(m);
         const uint32_t found = positions_.find(m);
-        if (found == kNoIndex) fail("no vertex at the midpoint of edge (" + edge_text(n, e) + ")");
+        if (found == kNoIndex)
+            throw MidpointNotFound(what_ + ": no vertex at the midpoint of edge (" + edge_text(n, e) + ")");
         return found;
     }
     if (!forced_.empty()) {  // a retry's vertex (pick_backtrack.cpp), while it is free
