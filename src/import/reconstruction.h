@@ -285,7 +285,6 @@ private:
     static constexpr uint64_t kJointWorkPerFace = 20;
     uint64_t joint_work_ = 0;
     bool joint_over_budget() const { return joint_work_ > kJointWorkPerFace * leaf_.triangles.size(); }
-    bool judging_ = false;  // in local_misfits
     // Notes that hierarchy vertex m, the midpoint of edge e of n, was picked by position or by a
     // retry.
     void note_pick(VertexId m, NodeId n, int e) {
