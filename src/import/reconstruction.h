@@ -281,7 +281,7 @@ private:
     static constexpr int kJointMoves = 4;        // a candidate and up to three blamed picks
     static constexpr int kJointSuspects = 3;     // blamed picks tried per move, most blamed first
     static constexpr uint32_t kMaxJointCandidates = NearestVertex::kMaxCount + 16;
-    // Their own work (as work_ counts it) per leaf face: fandisk_gauss takes 16; a refusal spends it all.
+    // Their own work (as work_ counts it) per leaf face: fandisk_gauss takes about 15; a refusal spends it all.
     static constexpr uint64_t kJointWorkPerFace = 20;
     uint64_t joint_work_ = 0;
     bool joint_over_budget() const { return joint_work_ > kJointWorkPerFace * leaf_.triangles.size(); }
