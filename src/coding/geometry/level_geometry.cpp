@@ -18,32 +18,35 @@ namespace amc {
 namespace {
 
 // Effort below kMaxEffort, on levels of kSampleShare * kMinSample new vertices or more: the
-// static modes are weighed on the first 1/kSampleShare of the level, and only those within
-// kStaticMargin of the smallest bound there are made for the whole level; an adaptive trial is
+// static modes are weighed on the first 1/kSampleShare of the level, and only those whose bound
+// projected to the level is within kStaticMargin of the smallest are made for the whole level (the
+// sample's own bounds favoured mode 3: its three tables against mode 4's six); an adaptive trial is
 // dropped when its first 1/kSampleShare, scaled to the level, passes what it must beat by 1/8.
 // Both keep kSampleSlack bytes of room besides, for levels that code to almost nothing.
 // Their products are rounded(): a fused multiply-add would make the choice, so the bytes, depend on the build.
 constexpr size_t kSampleShare = 8;
-constexpr size_t kMinSample = 2048;
+constexpr size_t kMinSample = 256;
 constexpr double kSampleMargin = 1.125;
 constexpr double kSampleSlack = 64;
 constexpr double kStaticMargin = 1.02;
 
 // Clears candidate[i] for the static modes whose lower bound on the first `sample` vertices of
-// the level passes the smallest by more than kStaticMargin (and kSampleSlack bytes); the sample's
+// the level, its streams scaled to the level, passes the smallest by more than kStaticMargin (and
+// kSampleSlack bytes); the sample's
 // encoders of those left go to on_sample[i], for the whole level to carry on from.
 void keep_likely_static_modes(const Hierarchy& h, const NewVertices& created, CoordinateSpace space, size_t sample,
                               const GeometryPredictor modes[3], bool candidate[3],
                               std::unique_ptr<StaticLevelEncoder> on_sample[3]) {
-    size_t bound[3] = {SIZE_MAX, SIZE_MAX, SIZE_MAX}, smallest = SIZE_MAX;
+    const double scale = double(created.size()) / double(sample);
+    double bound[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, smallest = HUGE_VAL;
     for (int i = 0; i < 3; ++i) {
         if (!candidate[i]) continue;
         on_sample[i] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, modes[i]);
-        bound[i] = on_sample[i]->lower_bound_bytes();
+        bound[i] = on_sample[i]->projected_bound_bytes(scale);
         smallest = std::min(smallest, bound[i]);
     }
     for (int i = 0; i < 3; ++i) {
-        candidate[i] = candidate[i] && double(bound[i]) <= rounded(kStaticMargin * double(smallest)) + kSampleSlack;
+        candidate[i] = candidate[i] && bound[i] <= rounded(kStaticMargin * smallest) + kSampleSlack;
         if (!candidate[i]) on_sample[i].reset();
     }
 }
