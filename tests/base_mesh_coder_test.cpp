@@ -289,7 +289,8 @@ TEST(BaseMeshCoder, ModeTwoSearchFollowsItsBudget) {
 }
 
 // Inside an .amc encode the search of a refined hierarchy's base codes at most 2^16 triangles,
-// whatever the hierarchy's size; a hierarchy that is at least half base gets the full budget.
+// whatever the hierarchy's size, and nothing beyond the single try when that can not try one start
+// in every rotation and radius; a hierarchy that is at least half base gets the full budget.
 TEST(BaseMeshCoder, SearchBudgetFollowsTheHierarchy) {
     Hierarchy unrefined(make_torus(40, 30, 2.0, 0.7));
     EXPECT_EQ(base_search_budget(unrefined), kFullBaseSearch);
@@ -303,6 +304,12 @@ TEST(BaseMeshCoder, SearchBudgetFollowsTheHierarchy) {
     Hierarchy large(make_icosahedron());
     refine_uniformly(large, 7);
     EXPECT_EQ(base_search_budget(large), uint64_t{1} << 16);
+    Hierarchy large_base(make_torus(40, 30, 2.0, 0.7));  // 2,400 triangles
+    refine_uniformly(large_base, 1);
+    ASSERT_GT(one_start_search_budget(large_base.root_count()), uint64_t{1} << 16);
+    EXPECT_EQ(base_search_budget(large_base), 0u);
+    const BaseMeshCode single = encode_base_connectivity(large_base.base(), BaseConnectivityMode::angle, false);
+    EXPECT_EQ(encode_base_connectivity(large_base.base(), 1, base_search_budget(large_base)).bytes, single.bytes);
 }
 
 // A mode-2 stream whose header claims more than the mesh can hold is refused before anything is
