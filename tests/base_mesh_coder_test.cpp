@@ -207,6 +207,22 @@ TEST(BaseMeshCoder, TinyAndNonManifold) {
     check_round_trip(empty, "empty");
 }
 
+// Mode 2 closes a mesh whose edges each have at most one halfedge per direction (fans split, holes
+// filled); a halfedge twice (two triangles on an edge in the same direction) leaves it the explicit mode.
+TEST(BaseMeshCoder, ModeTwoNeedsConsistentlyOrientedEdges) {
+    TriangleMesh bowtie;
+    bowtie.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}};
+    bowtie.triangles = {{0, 1, 2}, {0, 3, 4}};
+    EXPECT_EQ(encode_base_connectivity(bowtie).mode, BaseConnectivityMode::angle);
+    TriangleMesh flipped;
+    flipped.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, -1, 0}};
+    flipped.triangles = {{0, 1, 2}, {0, 1, 3}};
+    EXPECT_THROW(encode_base_connectivity(flipped, BaseConnectivityMode::angle), Error);
+    EXPECT_EQ(encode_base_connectivity(flipped).mode, BaseConnectivityMode::explicit_triangles);
+    flipped.triangles[1] = {1, 0, 3};  // oriented: a strip of two
+    EXPECT_EQ(encode_base_connectivity(flipped).mode, BaseConnectivityMode::angle);
+}
+
 // Mode 0 (what format versions 1-3 wrote) and the explicit mode still round-trip: their
 // decoders stay.
 TEST(BaseMeshCoder, EveryModeRoundTrips) {
