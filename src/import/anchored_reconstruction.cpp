@@ -15,19 +15,13 @@ Triangle normalized(Triangle t) {
     return {t[size_t(r)], t[size_t(r + 1) % 3], t[size_t(r + 2) % 3]};
 }
 
-}  // namespace
-
-std::vector<uint32_t> reconstruct_anchored(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
-                                           const TriangleMesh& leaf, const std::string& what,
-                                           UndoSteps* steps) {
-    const uint32_t vertex_count = uint32_t(leaf.positions.size());
-    std::vector<uint8_t> kept(vertex_count, 0);
-    for (uint32_t l : leaf_of_base) kept[l] = 1;
+// Levels undone from `triangles` until the base's count is left or nothing more can be undone.
+DetectedBase undo_levels(const std::vector<Triangle>& leaf_triangles, uint32_t vertex_count, size_t base_triangles,
+                         const std::vector<uint8_t>& kept) {
     DetectedBase detected;
-    const std::vector<Triangle>* triangles = &leaf.triangles;
-    std::vector<uint8_t> refined(leaf.triangles.size(), 0);
+    const std::vector<Triangle>* triangles = &leaf_triangles;
+    std::vector<uint8_t> refined(leaf_triangles.size(), 0);
     std::vector<uint8_t> changed;
-    const size_t base_triangles = h.base().triangles.size();
     while (detected.levels.size() < size_t(kMaxLevel) && triangles->size() > base_triangles) {
         detail::CoarserLevel coarser = detail::undo_refinement_level(
             *triangles, refined, vertex_count, detected.levels.empty() ? nullptr : &changed, &kept);
@@ -41,26 +35,67 @@ std::vector<uint32_t> reconstruct_anchored(Hierarchy& h, const std::vector<uint3
         detected.levels.push_back(std::move(level));
         triangles = &detected.levels.back().triangles;
     }
-    if (steps) {
+    return detected;
+}
+
+const std::vector<Triangle>& remaining(const DetectedBase& detected, const std::vector<Triangle>& leaf_triangles) {
+    return detected.levels.empty() ? leaf_triangles : detected.levels.back().triangles;
+}
+
+bool ends_at_base(const std::vector<Triangle>& triangles, const Hierarchy& h, const std::vector<uint32_t>& leaf_of_base) {
+    const size_t base_triangles = h.base().triangles.size();
+    if (triangles.size() != base_triangles) return false;
+    std::vector<Triangle> found, wanted;
+    found.reserve(base_triangles);
+    wanted.reserve(base_triangles);
+    for (const Triangle& t : triangles) found.push_back(normalized(t));
+    for (const Triangle& t : h.base().triangles) {
+        wanted.push_back(normalized({leaf_of_base[t[0]], leaf_of_base[t[1]], leaf_of_base[t[2]]}));
+    }
+    std::sort(found.begin(), found.end());
+    std::sort(wanted.begin(), wanted.end());
+    return found == wanted;
+}
+
+// The leaf triangles in the `k`th fixed other order: reversed, then shuffled by a fixed seed.
+std::vector<Triangle> reordered(const std::vector<Triangle>& triangles, int k) {
+    std::vector<Triangle> out(triangles.rbegin(), triangles.rend());
+    uint64_t state = 0x9e3779b97f4a7c15ull * uint64_t(k);
+    for (size_t i = out.size(); k > 1 && i > 1; --i) {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        std::swap(out[i - 1], out[(state >> 33) % i]);
+    }
+    return out;
+}
+
+}  // namespace
+
+std::vector<uint32_t> reconstruct_anchored(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
+                                           const TriangleMesh& leaf, const std::string& what,
+                                           UndoSteps* steps) {
+    const uint32_t vertex_count = uint32_t(leaf.positions.size());
+    std::vector<uint8_t> kept(vertex_count, 0);
+    for (uint32_t l : leaf_of_base) kept[l] = 1;
+    const size_t base_triangles = h.base().triangles.size();
+    DetectedBase detected = undo_levels(leaf.triangles, vertex_count, base_triangles, kept);
+    if (steps) {  // the given order's, whatever the other orders below find
         steps->step.assign(vertex_count, kNeverUndone);
         for (size_t step = 0; step < detected.levels.size(); ++step) {
             for (const std::array<uint32_t, 6>& split : detected.levels[step].splits) {
                 for (int k = 3; k < 6; ++k) steps->step[split[size_t(k)]] = uint8_t(step + 1);
             }
         }
-        steps->remaining = *triangles;
+        steps->remaining = remaining(detected, leaf.triangles);
     }
-    if (triangles->size() != base_triangles) return {};
-    std::vector<Triangle> found, wanted;
-    found.reserve(base_triangles);
-    wanted.reserve(base_triangles);
-    for (const Triangle& t : *triangles) found.push_back(normalized(t));
-    for (const Triangle& t : h.base().triangles) {
-        wanted.push_back(normalized({leaf_of_base[t[0]], leaf_of_base[t[1]], leaf_of_base[t[2]]}));
+    // The inverse step's search depends on the face order (where its growths seed): one order
+    // may commit a wrong block and stop short of the base where another reaches it.
+    constexpr int kOtherOrders = 3;
+    for (int k = 1; k <= kOtherOrders && !ends_at_base(remaining(detected, leaf.triangles), h, leaf_of_base); ++k) {
+        const std::vector<Triangle> triangles = reordered(leaf.triangles, k);
+        detected = undo_levels(triangles, vertex_count, base_triangles, kept);
+        if (detected.levels.empty()) break;  // no order undoes anything: none will
     }
-    std::sort(found.begin(), found.end());
-    std::sort(wanted.begin(), wanted.end());
-    if (found != wanted) return {};
+    if (!ends_at_base(remaining(detected, leaf.triangles), h, leaf_of_base)) return {};
     detected.base = h.base();
     detected.leaf_vertex_of_base = leaf_of_base;
     ImportedHierarchy built = hierarchy_from_levels(leaf, detected, what);
