@@ -3,7 +3,8 @@
 // faces shuffled, with new vertices at their midpoints (the exact path) or moved off them (the
 // connectivity paths); and the semi-regular bunny of ../shared/data when it is there.
 //
-// Usage: import_bench [repetitions]   (default 5; prints the median and the range of the runs)
+// Usage: import_bench [repetitions [filter]]   (default 5; prints the median and the range of the
+// runs; with a filter, only the cases whose name holds it)
 // Times are the thread's CPU time, which the other jobs on a shared machine disturb less.
 #include "bench_common.h"
 #include "user_leaf_mesh.h"
@@ -52,20 +53,26 @@ void run(const char* name, const amc::TriangleMesh& base, const amc::TriangleMes
 
 int main(int argc, char** argv) {
     const int repetitions = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
+    const std::string filter = argc > 2 ? argv[2] : "";
+    auto wanted = [&](const std::string& name) { return name.find(filter) != std::string::npos; };
     const char* names[] = {"surface", "random", "fe"};
     for (int64_t nodes : {int64_t(100000), int64_t(1000000)}) {
         for (int model = 0; model < 3; ++model) {
+            const std::string model_name = std::string(names[model]) + " " + std::to_string(nodes / 1000) + "k nodes";
+            if (!wanted(model_name + ", midpoints") && !wanted(model_name + ", moved")) continue;
             const amc::Hierarchy h = make_bench_hierarchy(BenchModel(model), nodes);
             const amc::LeafMesh leaf = amc::extract_leaf_mesh(h);
             const uint32_t v0 = uint32_t(h.base().positions.size());
             for (double move : {0.0, 0.3}) {
                 const std::string name = std::string(names[model]) + " " + std::to_string(nodes / 1000) + "k nodes" +
                                          (move > 0 ? ", moved" : ", midpoints");
+                if (!wanted(name)) continue;
                 run(name.c_str(), h.base(), bench::user_leaf_mesh(leaf.mesh, v0, move, 17), repetitions);
             }
         }
     }
     const std::string data = std::string(AMC_SHARED_DATA_DIR);
+    if (!wanted("bunny-sr-l3 (uniform, projected)")) return 0;
     if (std::filesystem::exists(data + "/bunny-sr-l3.obj")) {
         const amc::TriangleMesh base = amc::read_mesh(data + "/bunny-sr-l0.obj");
         const amc::TriangleMesh leaf = amc::read_mesh(data + "/bunny-sr-l3.obj");

@@ -32,6 +32,11 @@ struct Extra {
     uint8_t size = 0;         // n's longest edge over the level's mean longest edge, quarter octaves around 32
     uint8_t grand_curv = 0;   // the grandparent's curvature feature
     uint8_t base_size = 0;    // n's longest edge times 2^level over the base's mean longest edge, quarter octaves around 32
+    // Known only if each split's new vertices were coded right after its symbol (not so in any
+    // format yet): the largest displacement of a midpoint on n's edges from its chord's midpoint,
+    // over its length, among same-level neighbours split before n's symbol; and how many there are.
+    uint8_t nb_disp = 0;
+    uint8_t nb_known = 0;
 };
 
 Vec3 unit_normal_of(const Hierarchy& h, NodeId m, double* twice_area = nullptr) {
@@ -67,9 +72,22 @@ std::vector<Extra> extra_features(const std::string& path, const std::filesystem
         level_sum[size_t(l)] += longest_edge(h, n);
         level_count[size_t(l)] += 1;
     }
+    std::vector<size_t> symbol_of(h.node_count(), SIZE_MAX);
+    for (size_t i = 0; i < trace.size(); ++i) symbol_of[trace[i].node] = std::min(symbol_of[trace[i].node], i);
     for (size_t i = 0; i < count && i < trace.size(); ++i) {
         const NodeId n = trace[i].node;
         Extra& x = out[i];
+        double largest = 0;
+        for (int e = 0; e < 3; ++e) {
+            const NodeId q = h.neighbor(n, e);
+            if (q == kNoNode || h.is_leaf(q) || symbol_of[q] >= i) continue;
+            const Vec3 a = h.position(h.vertex(n, e)), b = h.position(h.vertex(n, (e + 1) % 3));
+            const Vec3 d = h.position(h.midpoint(q, h.neighbor_edge(n, e))) - 0.5 * (a + b);
+            const Vec3 chord = b - a;
+            largest = std::max(largest, std::sqrt(dot(d, d) / dot(chord, chord)));
+            ++x.nb_known;
+        }
+        if (x.nb_known) x.nb_disp = uint8_t(std::max(1, mixed_study::quarter_bin(largest)));
         const NodeId p = h.parent(n);
         if (p != kNoNode) {
             x.parent_curv = uint8_t(mixed_study::quarter_bin(mixed_study::raw_curvature(h, p)));
@@ -452,6 +470,22 @@ int main(int argc, char** argv) {
     add("Z: the same, Gauss bins from 21", coded(21));
     add("Z: the same, rate 12", [&](Options& o) { coded(0)(o), o.mixer_rate = 12; });
     add("mixer B by parent's curvature", [](Options& o) { o.extra_set_b = 1; });
+    auto third = [&](Options& o) {
+        no_group(o);
+        o.extra[1] = [](F f, X) { return f.mean_curv * 16u + f.size / 4u; };
+        o.extra[2] = [](F f, X) { return f.gauss * 16u + f.mean_curv / 4u; };
+    };
+    add("N: third + neighbours' midpoint displacement x level", [&](Options& o) {
+        third(o), o.extra.push_back([](F f, X x) { return (f.group * 64u + x.nb_disp) * 8 + f.level; });
+    });
+    add("N: third + nb displacement x size / 2 x level", [&](Options& o) {
+        third(o), o.extra.push_back([](F f, X x) { return (x.nb_disp * 32u + f.size / 2u) * 8 + f.level; });
+    });
+    add("N: third + nb displacement x known x size / 4 x level, + nb displacement x curvature / 4", [&](Options& o) {
+        third(o);
+        o.extra.push_back([](F f, X x) { return ((x.nb_disp * 4u + x.nb_known) * 16 + f.size / 4u) * 8 + f.level; });
+        o.extra.push_back([](F f, X x) { return (f.group * 64u + x.nb_disp) * 16 + f.mean_curv / 4u; });
+    });
     const char* only = std::getenv("ONLY");
 
     const double paper_total = mixed_study::print_design_table_head(data);

@@ -207,6 +207,9 @@ TEST(ImportLeafMesh, ManyRandomHierarchiesWithMovedVerticesRoundTrip) {
 // How many of 200 random hierarchies (every fixture, depth 1 to 7, 20 to 2,000 leaves, both
 // diagonals), their vertices placed as `placement` says, import; each import must be the
 // identical hierarchy (never a wrong one), the others are refused with an error.
+// What a refusal adds when the input's midpoints had to be guessed (leaf_import.cpp).
+const char* const kGuessedMidpointsHint = "too far from their edges' midpoints for the import to find it";
+
 int imported_of_200(Placement placement) {
     int imported = 0;
     for (uint64_t seed = 1; seed <= 200; ++seed) {
@@ -214,7 +217,10 @@ int imported_of_200(Placement placement) {
         const UserLeafMesh user = user_leaf_mesh(h, seed, placement);
         try {
             import_leaf_mesh(h.base(), user.mesh, user.leaf_of_base);
-        } catch (const Error&) {
+        } catch (const Error& e) {
+            // The input is valid: a refusal must say that the import, not only the input, may be at fault.
+            EXPECT_NE(std::string(e.what()).find(kGuessedMidpointsHint), std::string::npos) << "seed " << seed << ": "
+                                                                                           << e.what();
             continue;
         }
         EXPECT_TRUE(imports_back(h, user, true)) << "seed " << seed;
@@ -242,8 +248,9 @@ TEST(ImportLeafMesh, RandomHierarchiesWithScatteredVerticesImportOrAreRefused) {
 TEST(ImportLeafMesh, RandomHierarchiesMovedFarImportOrAreRefused) {
     const int imported = imported_of_200(Placement::moved_far);
     std::printf("[import_leaf_mesh] random hierarchies, vertices moved by 0.5: %d of 200 imported\n", imported);
-    EXPECT_GE(imported, 171);  // 166 before the picks certified by their subtrees, 165 before a refined node across a
-                               // closure (ccaea41), 153 before the return to the level of a pick, 104 before the
+    EXPECT_GE(imported, 172);  // 171 before the position searches were bounded, 166 before the picks certified by
+                               // their subtrees, 165 before a refined node across a closure (ccaea41), 153 before
+                               // the return to the level of a pick, 104 before the
                                // children repaired the picks, 82 without the undo steps
 }
 
@@ -305,6 +312,19 @@ TEST(ImportLeafMesh, RefusesMissingFace) {
     f.user.mesh.triangles.erase(f.user.mesh.triangles.begin() + 17);
     const std::string message = f.error();
     EXPECT_NE(message.find("missing face"), std::string::npos) << message;
+}
+
+// With every new vertex at its midpoint nothing is guessed: the fault found is the input's alone.
+TEST(ImportLeafMesh, RefusalWithExactMidpointsBlamesTheInputAlone) {
+    const Hierarchy h = random_hierarchy(make_square(3), 300, 5, 11, true, false);
+    UserLeafMesh user = user_leaf_mesh(h, 5, Placement::midpoints);
+    user.mesh.triangles.erase(user.mesh.triangles.begin() + 17);
+    const std::string message = import_error(h.base(), user.mesh, user.leaf_of_base);
+    EXPECT_NE(message.find("missing face"), std::string::npos) << message;
+    EXPECT_EQ(message.find(kGuessedMidpointsHint), std::string::npos) << message;
+    BadInputFixture moved;  // the same fault among moved vertices: the import may be the one at fault
+    moved.user.mesh.triangles.erase(moved.user.mesh.triangles.begin() + 17);
+    EXPECT_NE(moved.error().find(kGuessedMidpointsHint), std::string::npos) << moved.error();
 }
 
 TEST(ImportLeafMesh, RefusesExtraFace) {

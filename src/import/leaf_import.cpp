@@ -170,6 +170,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     // The guided ways run a second time, their picks decided by the anchored way's undo steps,
     // when the anchored way has not reached the base (it has steps only for a manifold leaf mesh).
     std::string first_error;
+    bool midpoints_guessed = false;
     bool done = false;
     const std::pair<Way, bool> ways[] = {
         {Way::exact_midpoints, false}, {Way::uniform, false}, {Way::leaf_midpoint, false}, {Way::subdivision, false},
@@ -181,6 +182,8 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
             attempt(way, by_undo_steps);
             done = true;
             break;
+        } catch (const MidpointNotFound&) {
+            midpoints_guessed = true;
         } catch (const Error& e) {
             if (way == Way::subdivision && !by_undo_steps) first_error = e.what();
         }
@@ -188,6 +191,12 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     if (!done) {
         if (first != kNoIndex) refuse_duplicate(first, second);
         validate_triangle_mesh(leaf, what);  // a structural fault has the clearer message
+        // Where midpoints were guessed, the fault found may be a wrong guess's, not the input's.
+        if (midpoints_guessed)
+            throw Error(first_error + "; or the leaf mesh is a red-green refinement of the base whose new vertices lie "
+                                      "too far from their edges' midpoints for the import to find it (docs/IMPORT.md, "
+                                      "\"Limitations\"): imported without the base (amc encode without --base), it "
+                                      "is compressed all the same");
         throw Error(first_error);
     }
 

@@ -250,7 +250,8 @@ uint32_t Reconstruction::find_midpoint(NodeId n, int e) {
         Vec3 m = rounded_scaled(0.5, leaf_.positions[a] + leaf_.positions[b]);  // as the placer computes it
         if (leaf_.single_precision) m = rounded_to_float(m);
         const uint32_t found = positions_.find(m);
-        if (found == kNoIndex) fail("no vertex at the midpoint of edge (" + edge_text(n, e) + ")");
+        if (found == kNoIndex)
+            throw MidpointNotFound(what_ + ": no vertex at the midpoint of edge (" + edge_text(n, e) + ")");
         return found;
     }
     if (!forced_.empty()) {  // a retry's vertex (pick_backtrack.cpp), while it is free
@@ -268,18 +269,18 @@ uint32_t Reconstruction::find_midpoint(NodeId n, int e) {
     uint32_t found;
     uint32_t nearest[kCandidates];
     uint32_t count = 0;
+    // No farther than twice the edge's length: where too few vertices pass the test (every vertex
+    // taken under a wrong pick, or a fine region's vertices around a coarse edge), an unbounded
+    // search visits the whole tree, which made large graded meshes quadratic.
+    const Vec3 ab = leaf_.positions[b] - leaf_.positions[a];
+    const double limit = 4 * exact_dot(ab, ab);
     if (choice_) {
-        // A judgement's reconstruction (local_misfits) looks no farther than the edge is long: under
-        // a wrong pick, edges whose vertices are all taken would each search the whole tree.
-        const Vec3 ab = leaf_.positions[b] - leaf_.positions[a];
-        const double limit = judging_ ? exact_dot(ab, ab) : std::numeric_limits<double>::infinity();
         count = nearest_vertex.find_nearest(guide_position(n, e), may_be_midpoint, kCandidates, nearest, limit);
         const uint32_t kept = on_shortest_chains(nearest, count, a, b);
         found = choice_->choose(nearest, kept, a, b, vertex_of_leaf_);
     } else {
-        found = nearest_vertex.find(guide_position(n, e), may_be_midpoint);
-        nearest[0] = found;
-        count = found != kNoIndex;
+        count = nearest_vertex.find_nearest(guide_position(n, e), may_be_midpoint, 1, nearest, limit);
+        found = count ? nearest[0] : kNoIndex;
     }
     if (referee_ && found != kNoIndex) found = (*referee_)(GuidedPick{h_.level(n), a, b, found, nearest, count, false});
     if (found == kNoIndex) fail("no vertex left to split the edge (" + edge_text(n, e) + ")");

@@ -44,6 +44,13 @@ enum class MidpointGuide {
                     // midpoint of the edge's end vertices (meshes projected onto a surface)
 };
 
+// The exact way's refusal when a split edge's midpoint holds no leaf vertex: the input's new
+// vertices are not all at midpoints, so the other ways had to guess them.
+class MidpointNotFound : public Error {
+public:
+    using Error::Error;
+};
+
 // A position-guided pick of the vertex that splits the edge (a, b) of a node of `level`: the
 // candidates the choice saw (nearest first; only the pick when no choice was made) and the pick;
 // `repaired`: seen again after the level's children have had their say (no candidates then).

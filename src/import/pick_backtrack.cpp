@@ -90,7 +90,6 @@ int Reconstruction::local_misfits(int from, int depth, const std::vector<NodeId>
     for (size_t i = 0; i < region.size(); ++i) nodes.push_back({region[i], i < inner ? uint32_t(i) : kNoIndex});
     if (per_inner) per_inner->assign(inner, 0);
     int misfits = 0;
-    judging_ = true;
     auto miss = [&](uint32_t owner) {
         if (owner == kNoIndex) return;
         ++misfits;
@@ -162,11 +161,9 @@ int Reconstruction::local_misfits(int from, int depth, const std::vector<NodeId>
             }
         }
     } catch (...) {
-        judging_ = false;
         undo_local();
         throw;
     }
-    judging_ = false;
     undo_local();
     return misfits;
 }

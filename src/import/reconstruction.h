@@ -245,7 +245,6 @@ private:
     };
     void undo_local();
     LocalUndo local_undo_;
-    bool judging_ = false;  // in local_misfits
     // Notes that hierarchy vertex m, the midpoint of edge e of n, was picked by position or by a
     // retry.
     void note_pick(VertexId m, NodeId n, int e) {

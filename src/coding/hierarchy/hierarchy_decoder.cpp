@@ -115,6 +115,7 @@ void HierarchyLevelDecoder::start(NodeId first_root, uint32_t roots, const Hiera
                 "hierarchy stream would build more than " + std::to_string(max_nodes_) + " nodes");
     models_ = HierarchyModels();
     mixed_model_.reset();
+    mixed_shapes_ = LevelShapes();  // it keeps the base's edge length once computed
     traversal_.configure(header.options, header.version);
     for (Level& level : decided_) spare_.push_back(std::move(level));
     decided_.clear();
