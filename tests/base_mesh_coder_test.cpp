@@ -207,6 +207,22 @@ TEST(BaseMeshCoder, TinyAndNonManifold) {
     check_round_trip(empty, "empty");
 }
 
+// Mode 2 closes a mesh whose edges each have at most one halfedge per direction (fans split, holes
+// filled); a halfedge twice (two triangles on an edge in the same direction) leaves it the explicit mode.
+TEST(BaseMeshCoder, ModeTwoNeedsConsistentlyOrientedEdges) {
+    TriangleMesh bowtie;
+    bowtie.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}};
+    bowtie.triangles = {{0, 1, 2}, {0, 3, 4}};
+    EXPECT_EQ(encode_base_connectivity(bowtie).mode, BaseConnectivityMode::angle);
+    TriangleMesh flipped;
+    flipped.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, -1, 0}};
+    flipped.triangles = {{0, 1, 2}, {0, 1, 3}};
+    EXPECT_THROW(encode_base_connectivity(flipped, BaseConnectivityMode::angle), Error);
+    EXPECT_EQ(encode_base_connectivity(flipped).mode, BaseConnectivityMode::explicit_triangles);
+    flipped.triangles[1] = {1, 0, 3};  // oriented: a strip of two
+    EXPECT_EQ(encode_base_connectivity(flipped).mode, BaseConnectivityMode::angle);
+}
+
 // Mode 0 (what format versions 1-3 wrote) and the explicit mode still round-trip: their
 // decoders stay.
 TEST(BaseMeshCoder, EveryModeRoundTrips) {
@@ -289,7 +305,8 @@ TEST(BaseMeshCoder, ModeTwoSearchFollowsItsBudget) {
 }
 
 // Inside an .amc encode the search of a refined hierarchy's base codes at most 2^16 triangles,
-// whatever the hierarchy's size; a hierarchy that is at least half base gets the full budget.
+// whatever the hierarchy's size, and nothing beyond the single try when that can not try one start
+// in every rotation and radius; a hierarchy that is at least half base gets the full budget.
 TEST(BaseMeshCoder, SearchBudgetFollowsTheHierarchy) {
     Hierarchy unrefined(make_torus(40, 30, 2.0, 0.7));
     EXPECT_EQ(base_search_budget(unrefined), kFullBaseSearch);
@@ -303,6 +320,12 @@ TEST(BaseMeshCoder, SearchBudgetFollowsTheHierarchy) {
     Hierarchy large(make_icosahedron());
     refine_uniformly(large, 7);
     EXPECT_EQ(base_search_budget(large), uint64_t{1} << 16);
+    Hierarchy large_base(make_torus(40, 30, 2.0, 0.7));  // 2,400 triangles
+    refine_uniformly(large_base, 1);
+    ASSERT_GT(one_start_search_budget(large_base.root_count()), uint64_t{1} << 16);
+    EXPECT_EQ(base_search_budget(large_base), 0u);
+    const BaseMeshCode single = encode_base_connectivity(large_base.base(), BaseConnectivityMode::angle, false);
+    EXPECT_EQ(encode_base_connectivity(large_base.base(), 1, base_search_budget(large_base)).bytes, single.bytes);
 }
 
 // A mode-2 stream whose header claims more than the mesh can hold is refused before anything is

@@ -175,35 +175,6 @@ TEST(Chunks, ThreadCountChangesNeitherBytesNorResults) {
     }
 }
 
-// Several threads take their chunk decoders from a pool that keeps them between decodes
-// (decoder_pool.h): a decoder used on one file, or on a file whose decode failed, decodes the next
-// exactly as a fresh one does.
-TEST(Chunks, PooledDecodersDecodeEachFileAsFreshOnesDo) {
-    std::vector<std::vector<uint8_t>> files;
-    std::vector<Hierarchy> expected;
-    for (uint64_t seed = 120; seed < 126; ++seed) {
-        files.push_back(encode(random_hierarchy(seed, seed % 3 == 0), with_chunks(2 + uint32_t(seed % 4), 1, seed % 2 ? 12 : 0)));
-        expected.push_back(decode(files.back().data(), files.back().size(), DecodeOptions{-1, 1ull << 26, 1}));
-    }
-    // The last chunk changed: the other chunks' decoders finish and go back to the pool.
-    std::vector<uint8_t> corrupt = files[0];
-    BlockReader reader(corrupt.data(), corrupt.size());
-    Block block, last_chunk{};
-    while (reader.next(block))
-        if (block.type == BlockType::chunk) last_chunk = block;
-    ASSERT_EQ(last_chunk.type, BlockType::chunk);
-    corrupt[last_chunk.offset + 5 + last_chunk.size / 2] ^= 0x5a;
-    for (int round = 0; round < 2; ++round) {
-        for (size_t f = 0; f < files.size(); ++f) {
-            for (unsigned threads : {2u, 3u}) {
-                EXPECT_EQ(try_decode(corrupt.data(), corrupt.size(), DecodeOptions{-1, 1ull << 26, threads}).code, ErrorCode::checksum);
-                const Hierarchy back = decode(files[f].data(), files[f].size(), DecodeOptions{-1, 1ull << 26, threads});
-                EXPECT_TRUE(same_ids(back, expected[f])) << "file " << f << ", " << threads << " threads, round " << round;
-            }
-        }
-    }
-}
-
 TEST(Chunks, ChunkSubsetsDecodeToExactlyTheirRootsTrees) {
     for (uint64_t seed = 200; seed < 230; ++seed) {
         SCOPED_TRACE("seed " + std::to_string(seed));

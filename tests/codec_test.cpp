@@ -86,23 +86,6 @@ TEST(Codec, ThousandRandomHierarchiesRoundTripBitExactly) {
     }
 }
 
-// Level decoders are kept between decodes (src/coding/hierarchy/decoder_pool.h): after a
-// progressive decode, a failed one or one of the mixing mode, the next file decodes exactly.
-TEST(Codec, DecodersKeptBetweenDecodesDecodeEachFileExactly) {
-    for (uint64_t seed = 1; seed <= 12; ++seed) {
-        const Hierarchy a = random_hierarchy(seed, false), b = random_hierarchy(seed + 100, seed % 2 == 0);
-        EncodeOptions options;
-        options.hierarchy_contexts = seed % 3 == 0 ? HierarchyContexts::mixed : HierarchyContexts::paper;
-        const std::vector<uint8_t> bytes_a = encode(a, options), bytes_b = encode(b, options);
-        DecodeOptions first_level;
-        first_level.max_level = 1;
-        decode(bytes_a.data(), bytes_a.size(), first_level);
-        EXPECT_TRUE(identical(decode(bytes_b.data(), bytes_b.size()), expected_decoding(b))) << "seed " << seed;
-        EXPECT_FALSE(try_decode(bytes_b.data(), bytes_b.size() - 9).ok);
-        EXPECT_TRUE(identical(decode(bytes_a.data(), bytes_a.size()), expected_decoding(a))) << "seed " << seed;
-    }
-}
-
 TEST(Codec, ExactMidpointsCostAlmostNothing) {
     Hierarchy h(make_l_shape(4));
     refine_randomly(h, 50000, 9, 3);

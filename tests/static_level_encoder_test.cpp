@@ -38,6 +38,15 @@ void expect_extended_codes_as_whole(const Hierarchy& h, CoordinateSpace space, G
         if (sample > 0 && sample < created.size() / 2) {
             EXPECT_NE(extended.lower_bound_bytes(), whole_bound);  // the sample's own tables
         }
+        // The projection scales the streams' part of the bound, not the tables'.
+        const double tables = extended.projected_bound_bytes(0.0);
+        EXPECT_GT(tables, 1.0);
+        EXPECT_EQ(extended.projected_bound_bytes(1.0), double(extended.lower_bound_bytes()));
+        EXPECT_EQ(extended.projected_bound_bytes(8.0) - tables, 8.0 * (double(extended.lower_bound_bytes()) - tables));
+        if (sample == created.size() / 8) {  // a smooth surface: an eighth tells the level's size
+            const double projected = extended.projected_bound_bytes(double(created.size()) / double(sample));
+            EXPECT_NEAR(projected, double(whole_bound), 0.1 * double(whole_bound));
+        }
         extended.extend(h, created);
         EXPECT_EQ(extended.lower_bound_bytes(), whole_bound);
         extended.code_streams();

@@ -11,7 +11,6 @@
 #include "coding/container.h"
 #include "coding/file_metadata.h"
 #include "coding/geometry/level_geometry.h"
-#include "coding/hierarchy/decoder_pool.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
 #include "coding/numbering/numbering_coder.h"
 #include "common/check.h"
@@ -418,11 +417,9 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
         for (uint32_t v = 0; v < base.positions.size(); ++v) request->result->base_vertices.push_back(v);
     }
 
-    // The level decoder's working memory is kept for the next decode (decoder_pool.h).
-    PooledDecoder pooled(meta.nodes <= kPooledChunkNodes);
-    HierarchyLevelDecoder& hierarchy = *pooled;
-    hierarchy.restart(base, meta.hierarchy_header.data(), meta.hierarchy_header.size(),
-                      hierarchy_stream_version_of_file(reader.version()), std::min<uint64_t>(meta.nodes, options.max_nodes));
+    HierarchyLevelDecoder hierarchy(base, meta.hierarchy_header.data(), meta.hierarchy_header.size(),
+                                    hierarchy_stream_version_of_file(reader.version()),
+                                    std::min<uint64_t>(meta.nodes, options.max_nodes));
     if (meta.options & kOptionMixedContexts)
         hierarchy.use_mixed_contexts(reader.version() >= kThirdMixingVersion    ? MixingModel::third
                                      : reader.version() >= kSecondMixingVersion ? MixingModel::second

@@ -432,6 +432,10 @@ std::vector<Start> search_candidates(uint32_t real_triangles, size_t closed_tria
 
 }  // namespace
 
+uint64_t one_start_search_budget(uint64_t triangles) {
+    return uint64_t(angle_mode::kContextSets) * 3 * std::size(kSearchRadii) * triangles;
+}
+
 std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, bool search, unsigned threads,
                                        uint64_t search_budget) {
     const ClosedMesh cm = make_closed(mesh);

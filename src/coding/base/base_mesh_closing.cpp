@@ -1,13 +1,51 @@
 // The closed, manifold version of a base mesh; see base_mesh_closing.h.
 #include "coding/base/base_mesh_closing.h"
 
+#include <algorithm>
 #include <numeric>
-#include <unordered_map>
 
 namespace amc {
 namespace {
 
-uint64_t edge_key(uint32_t a, uint32_t b) { return (uint64_t{a} << 32) | b; }
+// The halfedges of a triangle list by their first vertex (counting sort), each with its second:
+// a halfedge (a, b) is found among a's few, where a hash map of all of them cost the closing
+// most of its time.
+class HalfedgeIndex {
+public:
+    // False when two halfedges are equal (the mesh is not edge-manifold and consistently oriented).
+    bool build(const std::vector<Triangle>& triangles) {
+        uint32_t vertex_count = 0;
+        for (const Triangle& t : triangles)
+            for (uint32_t v : t) vertex_count = std::max(vertex_count, v + 1);
+        first_.assign(size_t{vertex_count} + 1, 0);
+        for (const Triangle& t : triangles)
+            for (uint32_t v : t) ++first_[v + 1];
+        std::partial_sum(first_.begin(), first_.end(), first_.begin());
+        entries_.assign(3 * triangles.size(), Entry{});
+        std::vector<uint32_t> next(first_.begin(), first_.end() - 1);
+        for (uint32_t t = 0; t < triangles.size(); ++t)
+            for (int k = 0; k < 3; ++k) {
+                const uint32_t a = triangles[t][k], b = triangles[t][(k + 1) % 3];
+                if (find(a, b) != kNoVertex) return false;
+                entries_[next[a]++] = {b, 3 * t + uint32_t(k)};
+            }
+        return true;
+    }
+    // The halfedge (a, b), or kNoVertex.
+    uint32_t find(uint32_t a, uint32_t b) const {
+        if (size_t{a} + 1 >= first_.size()) return kNoVertex;
+        for (uint32_t i = first_[a]; i < first_[a + 1]; ++i)
+            if (entries_[i].to == b) return entries_[i].halfedge;
+        return kNoVertex;
+    }
+
+private:
+    struct Entry {
+        uint32_t to = kNoVertex, halfedge = kNoVertex;
+    };
+    std::vector<uint32_t> first_;  // vertex a's halfedges are entries_[first_[a] .. first_[a + 1])
+    std::vector<Entry> entries_;
+};
 
 uint32_t find_root(std::vector<uint32_t>& parent, uint32_t x) {
     while (parent[x] != x) {
@@ -23,24 +61,17 @@ ClosedMesh make_closed(const TriangleMesh& mesh) {
     const uint32_t f = static_cast<uint32_t>(mesh.triangles.size());
     ClosedMesh cm;
     cm.real_triangles = f;
-    std::unordered_map<uint64_t, uint32_t> halfedge;
-    halfedge.reserve(3 * size_t{f});
-    for (uint32_t t = 0; t < f; ++t) {
-        for (int k = 0; k < 3; ++k) {
-            const Triangle& tri = mesh.triangles[t];
-            if (!halfedge.emplace(edge_key(tri[k], tri[(k + 1) % 3]), 3 * t + k).second)
-                throw EncoderGaveUp{};
-        }
-    }
+    HalfedgeIndex halfedge;
+    if (!halfedge.build(mesh.triangles)) throw EncoderGaveUp{};
     // Corners of one vertex sharing an edge belong to one fan.
     std::vector<uint32_t> parent(3 * size_t{f});
     std::iota(parent.begin(), parent.end(), 0u);
     for (uint32_t t = 0; t < f; ++t) {
         const Triangle& tri = mesh.triangles[t];
         for (int k = 0; k < 3; ++k) {
-            const auto it = halfedge.find(edge_key(tri[(k + 1) % 3], tri[k]));
-            if (it == halfedge.end()) continue;
-            const uint32_t other = it->second / 3 * 3 + (it->second % 3 + 1) % 3;  // corner of tri[k]
+            const uint32_t opposite = halfedge.find(tri[(k + 1) % 3], tri[k]);
+            if (opposite == kNoVertex) continue;
+            const uint32_t other = opposite / 3 * 3 + (opposite % 3 + 1) % 3;  // corner of tri[k]
             parent[find_root(parent, 3 * t + k)] = find_root(parent, other);
         }
     }
@@ -55,17 +86,13 @@ ClosedMesh make_closed(const TriangleMesh& mesh) {
         cm.triangles[c / 3][c % 3] = closed_of_root[r];
     }
     // Boundary loops, closed by dummy fans.
-    halfedge.clear();
-    for (uint32_t t = 0; t < f; ++t)
-        for (int k = 0; k < 3; ++k)
-            if (!halfedge.emplace(edge_key(cm.triangles[t][k], cm.triangles[t][(k + 1) % 3]), 3 * t + k).second)
-                throw EncoderGaveUp{};
+    if (!halfedge.build(cm.triangles)) throw EncoderGaveUp{};
     const uint32_t used = static_cast<uint32_t>(cm.original.size());
     std::vector<uint32_t> boundary_next(used, kNoVertex);
     for (uint32_t t = 0; t < f; ++t) {
         for (int k = 0; k < 3; ++k) {
             const uint32_t a = cm.triangles[t][k], b = cm.triangles[t][(k + 1) % 3];
-            if (halfedge.count(edge_key(b, a))) continue;
+            if (halfedge.find(b, a) != kNoVertex) continue;
             if (boundary_next[a] != kNoVertex) throw EncoderGaveUp{};
             boundary_next[a] = b;
         }
@@ -88,18 +115,14 @@ ClosedMesh make_closed(const TriangleMesh& mesh) {
         if (a != start) throw EncoderGaveUp{};
     }
     // Twins; every halfedge must have one now.
-    halfedge.clear();
+    if (!halfedge.build(cm.triangles)) throw EncoderGaveUp{};
     const uint32_t fc = static_cast<uint32_t>(cm.triangles.size());
-    for (uint32_t t = 0; t < fc; ++t)
-        for (int k = 0; k < 3; ++k)
-            if (!halfedge.emplace(edge_key(cm.triangles[t][k], cm.triangles[t][(k + 1) % 3]), 3 * t + k).second)
-                throw EncoderGaveUp{};
     cm.twin.assign(3 * size_t{fc}, kNoVertex);
     for (uint32_t t = 0; t < fc; ++t) {
         for (int k = 0; k < 3; ++k) {
-            const auto it = halfedge.find(edge_key(cm.triangles[t][(k + 1) % 3], cm.triangles[t][k]));
-            if (it == halfedge.end()) throw EncoderGaveUp{};
-            cm.twin[3 * t + k] = it->second;
+            const uint32_t opposite = halfedge.find(cm.triangles[t][(k + 1) % 3], cm.triangles[t][k]);
+            if (opposite == kNoVertex) throw EncoderGaveUp{};
+            cm.twin[3 * t + k] = opposite;
         }
     }
     return cm;

@@ -49,6 +49,9 @@ struct BaseMeshCode {
 // Mode 2's search runs on up to `threads` threads; the code does not depend on them. It codes at
 // most `search_budget` triangles in all (the first candidate always), about 0.15 s at the full budget.
 constexpr uint64_t kFullBaseSearch = uint64_t{1} << 20;
+// The budget that tries one start triangle of a mesh of `triangles` in every rotation and gate
+// radius: below five radii' worth the search is the single try.
+uint64_t one_start_search_budget(uint64_t triangles);
 BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh, unsigned threads = 1,
                                       uint64_t search_budget = kFullBaseSearch);
 

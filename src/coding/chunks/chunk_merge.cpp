@@ -2,7 +2,6 @@
 #include "coding/chunks/chunk_merge.h"
 
 #include "coding/file_metadata.h"
-#include "coding/hierarchy/decoder_pool.h"
 #include "common/check.h"
 #include "common/huge_pages.h"
 #include "common/parallel.h"
@@ -181,7 +180,7 @@ Hierarchy merge_in_order(const std::vector<ChunkJob>& jobs, const ChunkMergeInpu
 
 // Several threads: every chunk straight into its slice of the whole, made first from the chunk
 // table's counts, so that the whole comes out as merge_in_order makes it. Each thread reuses one
-// decoder's working memory for the chunks it takes, a decoder from the pool.
+// decoder's working memory for the chunks it takes.
 Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& input, MergePlan& plan,
                           std::vector<ChunkCounts>& counts, unsigned threads) {
     const size_t n = jobs.size();
@@ -205,11 +204,6 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
     find_seam_edges(plan, whole, n);
     const std::vector<HierarchyBuilder::RootLink> cut = HierarchyBuilder::cut_root_links(whole, plan.seam_edges);
     std::vector<std::vector<uint8_t>> seam_used(n, std::vector<uint8_t>(plan.seam_count, 0));
-    uint64_t largest_chunk = 0;
-    for (const ChunkJob& job : jobs) largest_chunk = std::max(largest_chunk, job.nodes);
-    // Decoders that go back to the pool stay warm for the next decode (decoder_pool.h); the
-    // others give their working memory back over their last chunk's last levels (ChunkPlace::last).
-    const bool pooled = largest_chunk <= kPooledChunkNodes;
     std::vector<std::unique_ptr<HierarchyLevelDecoder>> idle;
     std::mutex idle_mutex;
     auto decode_into_slice = [&](size_t i) {
@@ -221,11 +215,11 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
                 idle.pop_back();
             }
         }
-        if (decoder == nullptr) decoder = take_pooled_decoder();
+        if (decoder == nullptr) decoder = std::make_unique<HierarchyLevelDecoder>();
         const ChunkJob& job = jobs[i];
         // Handed out in order (parallel_for): the last `threads` chunks are the last of their decoders.
         const ChunkPlace place{&whole, plan.first_root[i], job.roots.count, plan.keys_in_whole(), seam_used[i].data(),
-                               &slices[i], !pooled && i + threads >= n};
+                               &slices[i], i + threads >= n};
         decode_job(*decoder, job, place, input, counts[i]);
         AMC_REQUIRE(slices[i].next_node == slices[i].node_end, corrupt,
                     chunk_name(job) + " does not hold the nodes the chunk table says");
@@ -243,10 +237,9 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
             error[i] = std::current_exception();
         }
     });
-    if (pooled)
-        for (std::unique_ptr<HierarchyLevelDecoder>& decoder : idle) return_pooled_decoder(std::move(decoder));
     for (const std::exception_ptr& e : error)
         if (e) std::rethrow_exception(e);
+    idle.clear();
     HierarchyBuilder::relink_roots(whole, cut);
     std::vector<uint8_t> used(plan.seam_count, 0);
     for (const std::vector<uint8_t>& chunk_used : seam_used)

@@ -18,32 +18,37 @@ namespace amc {
 namespace {
 
 // Effort below kMaxEffort, on levels of kSampleShare * kMinSample new vertices or more: the
-// static modes are weighed on the first 1/kSampleShare of the level, and only those within
-// kStaticMargin of the smallest bound there are made for the whole level; an adaptive trial is
-// dropped when its first 1/kSampleShare, scaled to the level, passes what it must beat by 1/8.
+// static modes are weighed on the first 1/kSampleShare of the level, and only those whose bound
+// projected to the level is within kStaticMargin of the smallest are made for the whole level (the
+// sample's own bounds favoured mode 3: its three tables against mode 4's six); an adaptive trial is
+// dropped when its first 1/kSampleShare, scaled to the level, passes what it must beat by 1/8
+// (or its first half by 1/4).
 // Both keep kSampleSlack bytes of room besides, for levels that code to almost nothing.
 // Their products are rounded(): a fused multiply-add would make the choice, so the bytes, depend on the build.
 constexpr size_t kSampleShare = 8;
-constexpr size_t kMinSample = 2048;
+constexpr size_t kMinSample = 256;
 constexpr double kSampleMargin = 1.125;
 constexpr double kSampleSlack = 64;
 constexpr double kStaticMargin = 1.02;
+constexpr double kEarlyMargin = 1.25;
 
 // Clears candidate[i] for the static modes whose lower bound on the first `sample` vertices of
-// the level passes the smallest by more than kStaticMargin (and kSampleSlack bytes); the sample's
+// the level, its streams scaled to the level, passes the smallest by more than kStaticMargin (and
+// kSampleSlack bytes); the sample's
 // encoders of those left go to on_sample[i], for the whole level to carry on from.
 void keep_likely_static_modes(const Hierarchy& h, const NewVertices& created, CoordinateSpace space, size_t sample,
                               const GeometryPredictor modes[3], bool candidate[3],
                               std::unique_ptr<StaticLevelEncoder> on_sample[3]) {
-    size_t bound[3] = {SIZE_MAX, SIZE_MAX, SIZE_MAX}, smallest = SIZE_MAX;
+    const double scale = double(created.size()) / double(sample);
+    double bound[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, smallest = HUGE_VAL;
     for (int i = 0; i < 3; ++i) {
         if (!candidate[i]) continue;
         on_sample[i] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, modes[i]);
-        bound[i] = on_sample[i]->lower_bound_bytes();
+        bound[i] = on_sample[i]->projected_bound_bytes(scale);
         smallest = std::min(smallest, bound[i]);
     }
     for (int i = 0; i < 3; ++i) {
-        candidate[i] = candidate[i] && double(bound[i]) <= rounded(kStaticMargin * double(smallest)) + kSampleSlack;
+        candidate[i] = candidate[i] && bound[i] <= rounded(kStaticMargin * smallest) + kSampleSlack;
         if (!candidate[i]) on_sample[i].reset();
     }
 }
@@ -79,12 +84,12 @@ void encode_adaptive(const Hierarchy& h, const NewVertices& created, GeometryPre
 // With a `sample` of fewer vertices than the level, that pass covers the sample only, and the
 // trial stops when the sample's raw bits scaled to the level, or its bytes with the rest of the
 // level at the rate of the sample's second half (the models learn as they go), pass the limit by
-// kSampleMargin: a guess.
+// kSampleMargin: a guess; halfway through the sample the same at the rate of its second quarter,
+// by kEarlyMargin (most adaptive trials of large levels lose by more than half, and stop there).
 size_t adaptive_bytes(const Hierarchy& h, const NewVertices& created, GeometryPredictor predictor, PositionCoder positions,
                       size_t limit, bool count_raw_bits, size_t sample) {
     const size_t judged = std::min(sample, created.size());
-    auto past_limit = [&](double bytes) { return limit != SIZE_MAX && bytes > rounded(kSampleMargin * double(limit)) + kSampleSlack; };
-    size_t half_sample_bytes = 0;
+    size_t half_sample_bytes = 0, quarter_sample_bytes = 0;
     std::vector<Vec3> predicted(count_raw_bits ? judged : 0);
     uint64_t raw_bits = 0;
     for (size_t i = 0; i < predicted.size(); ++i) {
@@ -92,19 +97,29 @@ size_t adaptive_bytes(const Hierarchy& h, const NewVertices& created, GeometryPr
         predicted[i] = predict(h, predictor, n, e);
         raw_bits += positions.raw_bits(h.position(h.midpoint(n, e)), predicted[i]);
     }
-    if (judged == created.size() ? raw_bits / 8 > limit + 6 : past_limit(double(raw_bits / 8) * double(created.size()) / double(judged)))
+    const double raw_projected = double(raw_bits / 8) * double(created.size()) / double(judged);
+    if (judged == created.size() ? raw_bits / 8 > limit + 6
+                                 : limit != SIZE_MAX && raw_projected > rounded(kSampleMargin * double(limit)) + kSampleSlack)
         return SIZE_MAX;
     ArithmeticEncoder encoder;
+    // The level's bytes from those of its first `done` vertices and the rate since vertex `since`
+    // (`bytes_since` bytes then) pass the limit by `margin`.
+    auto projected_past = [&](size_t done, size_t since, size_t bytes_since, double margin) {
+        const double rate = double(encoder.bytes_so_far() - bytes_since) / double(done - since);
+        return limit != SIZE_MAX && double(encoder.bytes_so_far()) + rounded(rate * double(created.size() - done)) >
+                                        rounded(margin * double(limit)) + kSampleSlack;
+    };
     for (size_t i = 0; i < created.size(); ++i) {
         const auto [n, e] = created[i];
         positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)),
                          i < predicted.size() ? predicted[i] : predict(h, predictor, n, e));
         if (encoder.bytes_so_far() > limit + 8) return SIZE_MAX;
-        if (i + 1 == sample / 2) half_sample_bytes = encoder.bytes_so_far();
-        if (i + 1 == sample) {
-            const double rate = double(encoder.bytes_so_far() - half_sample_bytes) / double(sample - sample / 2);
-            if (past_limit(double(encoder.bytes_so_far()) + rounded(rate * double(created.size() - sample)))) return SIZE_MAX;
+        if (i + 1 == sample / 4) quarter_sample_bytes = encoder.bytes_so_far();
+        if (i + 1 == sample / 2) {
+            if (projected_past(i + 1, sample / 4, quarter_sample_bytes, kEarlyMargin)) return SIZE_MAX;
+            half_sample_bytes = encoder.bytes_so_far();
         }
+        if (i + 1 == sample && projected_past(i + 1, sample / 2, half_sample_bytes, kSampleMargin)) return SIZE_MAX;
     }
     return encoder.finish().size();
 }

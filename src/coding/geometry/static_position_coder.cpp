@@ -502,9 +502,19 @@ size_t StaticLevelEncoder::estimated_bytes() const {
 size_t StaticLevelEncoder::lower_bound_bytes() const {
     ArithmeticEncoder tables;
     write_tables(tables);
+    return tables.finish().size() + 1 + stream_bound_bytes();
+}
+
+size_t StaticLevelEncoder::stream_bound_bytes() const {
     const double rans_bits = token_bits_ - 16 - rounded(0.001 * double(token_count_));
     const size_t rans = kRansStateBytes + (rans_bits > 0 ? size_t(rans_bits / 8.01) : 0);
-    return tables.finish().size() + 1 + rans + size_t(raw_bits_ / 8);
+    return rans + size_t(raw_bits_ / 8);
+}
+
+double StaticLevelEncoder::projected_bound_bytes(double scale) const {
+    ArithmeticEncoder tables;
+    write_tables(tables);
+    return double(tables.finish().size() + 1) + rounded(scale * double(stream_bound_bytes()));
 }
 
 bool read_static_tables(ArithmeticDecoder& decoder, CoordinateSpace space, GeometryPredictor mode, StaticTables& tables) {

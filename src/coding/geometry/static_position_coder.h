@@ -94,12 +94,17 @@ public:
     // At most estimated_bytes(), known before the streams: the tables, the raw bits and the rANS
     // stream's entropy under its tables (the bound's derivation is in the .cpp).
     size_t lower_bound_bytes() const;
+    // lower_bound_bytes() with its streams' part scaled by `scale` (the tables not): an encoder
+    // made over a sample of a level projects the level's bound with the level's size over the sample's.
+    double projected_bound_bytes(double scale) const;
 
 private:
     // Tokens, residuals and counts of created[begin, end).
     void add(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
     template <bool UnitNormals, bool GridBins>
     void add_vertices(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
+    // lower_bound_bytes()' rANS and raw streams.
+    size_t stream_bound_bytes() const;
     // The tables from the counts, and the tokens' cost under them.
     void make_tables();
 
