@@ -547,5 +547,21 @@ TEST(ImportLeafMeshSharedData, ElephantSemiRegularLevel2OverLevel0) {
     expect_semi_regular("elephant-sr-l0.obj", "elephant-sr-l2.obj", 2);
 }
 
+// The corpus's fandisk_gauss (docs/IMPORT.md, section 4, as scripts/corpus.sh and import_corpus make
+// it): fandisk remeshed by Gauss curvature, its leaf mesh shuffled and moved by 0.3. Its last wrong
+// picks hold each other in place (a level-0 truth whose subtree misfits through finer picks, three
+// level-3 picks along a lattice line); the joint moves of "Picks certified by their subtrees" import it.
+TEST(ImportLeafMeshSharedData, FandiskGaussRemeshMovedImportsWithItsBase) {
+    const std::string dir = AMC_SHARED_DATA_DIR;
+    if (!std::ifstream(dir + "/fandisk.obj").good()) GTEST_SKIP() << "shared data not found (" << dir << ")";
+    SurfaceRemeshOptions options;
+    options.criterion = RefinementCriterion::gauss_curvature;
+    options.base_triangles = 500;
+    options.target_faces = 100000;
+    options.max_level = 5;
+    const Hierarchy h = remesh_adaptively(read_mesh(dir + "/fandisk.obj"), options);
+    EXPECT_TRUE(imports_back(h, user_leaf_mesh(h, 23, Placement::moved), false));
+}
+
 }  // namespace
 }  // namespace amc

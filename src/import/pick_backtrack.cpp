@@ -114,6 +114,7 @@ int Reconstruction::local_misfits(int from, int depth, const std::vector<NodeId>
                     refined = classify(node.first);
                 } catch (const Error&) {
                     miss(node.second);
+                    blame_node(node.second, node.first);
                 }
                 if (!refined) continue;
                 if (h_.can_split(node.first)) {
@@ -122,6 +123,7 @@ int Reconstruction::local_misfits(int from, int depth, const std::vector<NodeId>
                     split.push_back(node);
                 } else {
                     miss(node.second);
+                    blame_node(node.second, node.first);
                 }
             }
             if (misfits >= cap) break;
@@ -151,13 +153,23 @@ int Reconstruction::local_misfits(int from, int depth, const std::vector<NodeId>
                     } catch (const Error&) {
                     }
                     miss(node.second);
+                    blame_node(node.second, node.first);
                 }
                 for (int k = 0; k < 4; ++k) next.push_back({h_.child(node.first, k), node.second});
             }
             if (misfits >= cap) break;
             nodes.swap(next);
             for (size_t i = 0; i < nodes.size() && misfits < cap; ++i) {
-                if (nodes[i].second != kNoIndex && !fits(nodes[i].first, nullptr)) miss(nodes[i].second);
+                if (nodes[i].second == kNoIndex) continue;
+                if (!blames_) {
+                    if (!fits(nodes[i].first, nullptr)) miss(nodes[i].second);
+                    continue;
+                }
+                blamed_.clear();
+                if (fits(nodes[i].first, &blamed_)) continue;
+                miss(nodes[i].second);
+                for (VertexId v : blamed_) blame_vertex(v);
+                blame_node(nodes[i].second, nodes[i].first);
             }
         }
     } catch (...) {

@@ -170,14 +170,24 @@ bool Reconstruction::certify_picks(int& depth, std::vector<NodeId>& level) {
         // The first candidate whose subtree closes replaces the pick if the pick's own does not
         // close here (a failing candidate stops at its first misfit, a closing pick runs to the
         // horizon: the pick is judged last, and only when it matters).
+        const Retry as_made{picked_level, s.a, s.b, s.picked, 0, 0};
+        Retry retries[kRepairCandidates];
+        bool decided = false;  // a candidate replaced the pick, or the pick closed after all
         for (uint32_t i = 0; i < s.count; ++i) {
-            const Retry retry{picked_level, s.a, s.b, s.candidates[i], s.swap_edge[i], s.swap_edge[i] ? s.picked : 0};
-            if (!closes(retry, true)) continue;
-            if (closes(Retry{picked_level, s.a, s.b, s.picked, 0, 0}, false)) break;
-            changes.push_back(retry);
+            retries[i] = Retry{picked_level, s.a, s.b, s.candidates[i], s.swap_edge[i], s.swap_edge[i] ? s.picked : 0};
+            if (decided || !closes(retries[i], true)) continue;
+            decided = true;
+            if (closes(as_made, false)) continue;
+            changes.push_back(retries[i]);
             changed_regions.insert(changed_regions.end(), region.begin(), region.begin() + long(inner));
-            break;
         }
+        if (decided || joint_over_budget()) continue;
+        // No candidate closes alone: the best one may close with other picks moved too.
+        const uint64_t joint_before = work_;
+        if (joint_move(picked_level, region, inner, as_made, retries, s.count, changes))
+            changed_regions.insert(changed_regions.end(), region.begin(), region.begin() + long(inner));
+        joint_work_ += work_ - joint_before;
+        work_ = joint_before;  // the certification's budget counts its own work
     }
     certify_work_ += work_ - work_before;
     work_ = work_before;

@@ -245,6 +245,46 @@ private:
     };
     void undo_local();
     LocalUndo local_undo_;
+    // Joint moves (pick_joint.cpp): a judged pick's candidate forced together with other picks
+    // that its subtree's misfits blame (of the level and below), certified by the same
+    // zero-misfit test. The guided pick (of level blame_from_ or finer) a misfit blames, with
+    // how many misfits blame it; collected by local_misfits while blames_ is set.
+    struct Blame {
+        int level;
+        uint32_t a, b, vertex;
+        int count;
+    };
+    std::vector<Blame>* blames_ = nullptr;
+    int blame_from_ = 0;
+    std::vector<VertexId> blamed_;  // scratch
+    void blame_vertex(VertexId v);
+    // The guided corners of misfitting node n (under inner node `owner`; the context is not blamed).
+    void blame_node(uint32_t owner, NodeId n) {
+        if (!blames_ || owner == kNoIndex) return;
+        for (int i = 0; i < 3; ++i) blame_vertex(h_.vertex(n, i));
+    }
+    // Whether `first` (a candidate for a pick of `level` whose own subtree misfits) and at most
+    // kJointMoves - 1 more moves of blamed picks close the subtree of region's first `inner`
+    // nodes; `moves` gets them. `misfits` is first's count. Forces nothing on return.
+    bool closes_jointly(int level, const std::vector<NodeId>& region, size_t inner, const Retry& first, int misfits,
+                        std::vector<Retry>& moves);
+    // For a judged pick of `level` (as_made) none of whose candidates (`retries`) closes alone:
+    // the candidate leaving the fewest misfits (fewer than the pick, at most kJointMisfits) and
+    // the moves closes_jointly adds to it; when the group closes while the pick as made does not,
+    // even with the same search, its moves of `level` are appended to `changes` (true).
+    bool joint_move(int level, const std::vector<NodeId>& region, size_t inner, const Retry& as_made,
+                    const Retry* retries, uint32_t count, std::vector<Retry>& changes);
+    // Other vertices for a pick of edge (a, b) holding `vertex`: the nearest free ones to the
+    // edge's midpoint and the pick's free leaf-mesh neighbours.
+    uint32_t joint_candidates(uint32_t a, uint32_t b, uint32_t vertex, uint32_t* out);
+    static constexpr int kJointMisfits = 16;     // a candidate leaving more is not moved jointly
+    static constexpr int kJointMoves = 4;        // a candidate and up to three blamed picks
+    static constexpr int kJointSuspects = 3;     // blamed picks tried per move, most blamed first
+    static constexpr uint32_t kMaxJointCandidates = NearestVertex::kMaxCount + 16;
+    // Their own work (as work_ counts it) per leaf face: fandisk_gauss takes about 15; a refusal spends it all.
+    static constexpr uint64_t kJointWorkPerFace = 20;
+    uint64_t joint_work_ = 0;
+    bool joint_over_budget() const { return joint_work_ > kJointWorkPerFace * leaf_.triangles.size(); }
     // Notes that hierarchy vertex m, the midpoint of edge e of n, was picked by position or by a
     // retry.
     void note_pick(VertexId m, NodeId n, int e) {
