@@ -30,11 +30,20 @@
 #include <thread>
 #include <vector>
 
+#include <sys/resource.h>
+
 namespace {
 
 double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 std::string name_of(const char* path) { return std::filesystem::path(path).stem().string(); }
+
+// Minor page faults of the whole process so far (every thread's): a decode's fresh memory.
+double minor_faults() {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return double(usage.ru_minflt);
+}
 
 int sizes(int bits, int argc, char** argv) {
     std::printf("| model | faces | 1 chunk bytes | default: chunks | bytes | cost | 2 chunks | 4 chunks | 8 chunks |\n"
@@ -78,7 +87,8 @@ int speed(int runs, int bits, uint32_t chunks, const char* path) {
     amc::EncodeStats stats;
     const std::vector<uint8_t> bytes = amc::encode(h, options, &stats);
     const amc::FileInfo info = amc::inspect(bytes.data(), bytes.size());
-    std::vector<double> encode_time[2], decode_time[2], encode_cpu[2], decode_cpu[2], encode_ratio, decode_ratio;
+    std::vector<double> encode_time[2], decode_time[2], encode_cpu[2], decode_cpu[2], encode_ratio, decode_ratio,
+        decode_faults[2];
     for (int r = 0; r < runs; ++r) {
         double seconds[2][2], cpu[2][2];
         for (unsigned threads : {1u, 2u}) {
@@ -96,10 +106,12 @@ int speed(int runs, int bits, uint32_t chunks, const char* path) {
             d.threads = threads;
             start = now();
             cpu_start = cpu_seconds();
+            const double faults_start = minor_faults();
             {
                 const amc::Hierarchy back = amc::decode(bytes.data(), bytes.size(), d);
                 seconds[threads - 1][1] = now() - start;
                 cpu[threads - 1][1] = cpu_seconds() - cpu_start;
+                decode_faults[threads - 1].push_back(minor_faults() - faults_start);
                 if (back.node_count() != h.node_count()) return 1;
             }
         }
@@ -125,6 +137,9 @@ int speed(int runs, int bits, uint32_t chunks, const char* path) {
     };
     line("encode", encode_time, encode_cpu, encode_ratio);
     line("decode", decode_time, decode_cpu, decode_ratio);
+    std::printf("  minor page faults per decode: 1 thread %.0f [%.0f - %.0f], 2 threads %.0f [%.0f - %.0f] (median [min - max])\n",
+                range_of(decode_faults[0]).median, range_of(decode_faults[0]).low, range_of(decode_faults[0]).high,
+                range_of(decode_faults[1]).median, range_of(decode_faults[1]).low, range_of(decode_faults[1]).high);
     return 0;
 }
 
@@ -138,18 +153,19 @@ int decode_speed(int runs, int bits, const char* path) {
     options.quantize_bits = bits;
     const std::vector<uint8_t> bytes = amc::encode(h, options);
     const amc::FileInfo info = amc::inspect(bytes.data(), bytes.size());
-    std::vector<double> wall[2], cpu[2], ratio;
+    std::vector<double> wall[2], cpu[2], ratio, faults[2];
     for (int r = 0; r < runs; ++r) {
         double seconds[2];
         for (unsigned threads : {1u, 2u}) {
             std::this_thread::sleep_for(std::chrono::milliseconds(200));
             amc::DecodeOptions d;
             d.threads = threads;
-            const double start = now(), cpu_start = cpu_seconds();
+            const double start = now(), cpu_start = cpu_seconds(), faults_start = minor_faults();
             const amc::Hierarchy back = amc::decode(bytes.data(), bytes.size(), d);
             seconds[threads - 1] = now() - start;
             wall[threads - 1].push_back(seconds[threads - 1]);
             cpu[threads - 1].push_back(cpu_seconds() - cpu_start);
+            faults[threads - 1].push_back(minor_faults() - faults_start);
             if (back.node_count() != h.node_count()) return 1;
         }
         ratio.push_back(seconds[0] / seconds[1]);
@@ -157,9 +173,11 @@ int decode_speed(int runs, int bits, const char* path) {
     const Range one = range_of(wall[0]), two = range_of(wall[1]), r = range_of(ratio);
     const Range cpu_one = range_of(cpu[0]), cpu_two = range_of(cpu[1]);
     std::printf("%s, %d bits: %zu bytes, %zu chunks, %d pairs of decodes: wall 1 thread %.4f [%.4f - %.4f] s, 2 threads %.4f "
-                "[%.4f - %.4f] s, speed-up per pair %.2f [%.2f - %.2f]; CPU 1 thread %.4f, 2 threads %.4f s (medians)\n",
+                "[%.4f - %.4f] s, speed-up per pair %.2f [%.2f - %.2f]; CPU 1 thread %.4f, 2 threads %.4f s; minor page faults 1 "
+                "thread %.0f, 2 threads %.0f (medians)\n",
                 name_of(path).c_str(), bits, bytes.size(), std::max<size_t>(1, info.chunks.size()), runs, one.median, one.low,
-                one.high, two.median, two.low, two.high, r.median, r.low, r.high, cpu_one.median, cpu_two.median);
+                one.high, two.median, two.low, two.high, r.median, r.low, r.high, cpu_one.median, cpu_two.median,
+                median(faults[0]), median(faults[1]));
     return 0;
 }
 

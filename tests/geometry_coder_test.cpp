@@ -307,6 +307,26 @@ TEST(Quantizer, EdgeCases) {
     EXPECT_THROW(encode_quantized(encoder, models, 0, 4, 16, 0), Error);
 }
 
+// GridSnap is snap_to_grid: quantize() on a grid whose every point is finite, snap_to_grid's
+// steps down where the grid reaches past the largest double.
+TEST(Quantizer, GridSnapIsSnapToGrid) {
+    std::mt19937_64 rng(7);
+    auto coordinate = [&] { return double(rng() % 2001) / 100.0 - 12.0; };
+    const Quantizer q = make_quantizer(Vec3{-10, -3, 0.5}, Vec3{7, 4, 2}, 12);
+    const GridSnap snap(q);
+    for (int i = 0; i < 1000; ++i) {
+        const Vec3 p{coordinate(), coordinate(), coordinate()};
+        EXPECT_EQ(snap(p), snap_to_grid(q, p));
+    }
+    Quantizer far;  // its top reconstructs beyond DBL_MAX on x
+    far.origin = {1.5e308, 0, 0};
+    far.step = 1e306;
+    far.bits = 8;
+    const Vec3 p{DBL_MAX, 1e300, -1};
+    EXPECT_NE(snap_to_grid(far, p), quantize(far, p));
+    EXPECT_EQ(GridSnap(far)(p), snap_to_grid(far, p));
+}
+
 // ---- predictions over hierarchies ---------------------------------------------------------------
 
 struct GeometryCost {

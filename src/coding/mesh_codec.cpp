@@ -96,10 +96,11 @@ double snap_positions(Hierarchy& h, const Quantizer& quantizer, unsigned threads
     auto larger = [](double a, double b) { return b > a || std::isnan(a) ? b : a; };
     const size_t vertices = h.positions().size();
     std::vector<double> worst_in((vertices + kPositionRange - 1) / kPositionRange, 0.0);
+    const GridSnap snap(quantizer);
     parallel_for(worst_in.size(), threads, [&](size_t i) {
         double worst = 0.0;
         for (size_t v = i * kPositionRange; v < std::min(vertices, (i + 1) * kPositionRange); ++v) {
-            const Vec3 p = h.position(VertexId(v)), r = dequantize(quantizer, snap_to_grid(quantizer, p));
+            const Vec3 p = h.position(VertexId(v)), r = dequantize(quantizer, snap(p));
             worst = larger(worst, larger(std::fabs(r.x - p.x), larger(std::fabs(r.y - p.y), std::fabs(r.z - p.z))));
             h.set_position(VertexId(v), r);
         }

@@ -22,6 +22,11 @@ constexpr uint32_t kSeedJudgedAfter = 128;
 constexpr uint32_t kRepairable = 16;
 // Blocks of the patches the last sweep looks for (commit_small_patches).
 constexpr uint32_t kSmallPatch = 16;
+// Blocks: improve_patches solves again around patches of at most kImproved blocks; a growth
+// there larger than kRivalGrowth is no local rival but the large reading of a level not ready
+// yet, which fails again at every step (docs/IMPORT.md, "Rivals of small patches bounded").
+constexpr uint32_t kImproved = 64;
+constexpr uint32_t kRivalGrowth = 256;
 
 }  // namespace
 
@@ -422,14 +427,16 @@ void LevelFinder::improve_patches(size_t first) {
             }
             for (uint32_t m : b.m) before += midpoint_block_[m][0] / 3 == i || midpoint_block_[m][0] / 3 < patch.first;
         }
-        if (taken.empty() || taken.size() > 64) continue;  // large patches have no rival nearby
+        if (taken.empty() || taken.size() > kImproved) continue;  // large patches have no rival nearby
         std::sort(seeds.begin(), seeds.end(), [&](uint32_t a, uint32_t b) { return caller_of_[a] < caller_of_[b]; });
         seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
         hold(uint32_t(r), false);
         for (uint32_t i : taken) release(i), banned_[blocks_[i].center] = 1;
         const uint32_t start = uint32_t(blocks_.size());
         const size_t patches_before = patches_.size();
+        growth_limit_ = kRivalGrowth;
         const uint32_t after = commit_best_first(seeds);
+        growth_limit_ = kNoIndex;
         for (uint32_t i : taken) banned_[blocks_[i].center] = 0;
         if (after > before) continue;
         for (size_t k = patches_.size(); k-- > patches_before;) hold(uint32_t(k), false);

@@ -281,9 +281,9 @@ private:
     // so that later patches cannot change how its sides read.
     void hold(uint32_t id, bool on);
 
-    // Takes each patch out and solves its neighbourhood again without its centers; keeps the
-    // alternative when it removes more vertices (two true isolated blocks beat one wrong pair
-    // glued at an old vertex).
+    // Takes each patch of at most 64 blocks out and solves its neighbourhood again without its
+    // centers, with growths bounded (a rival is local); keeps the alternative when it removes
+    // more vertices (two true isolated blocks beat one wrong pair glued at an old vertex).
     void improve_patches(size_t first);
 
     std::vector<uint32_t> caller_of_;  // per triangle: its index in the caller's numbering

@@ -210,6 +210,21 @@ inline Vec3 dequantize(const Quantizer& quantizer, GridPoint q) {
 // that would reconstruct beyond the largest double (a box that reaches DBL_MAX), so that every
 // reconstruction is finite.
 GridPoint snap_to_grid(const Quantizer& quantizer, Vec3 p);
+// snap_to_grid for many points of one quantizer: on a grid whose largest point is finite on every
+// axis (make_quantizer's), every grid point is (origin + rounded(q * step) grows with q), and the
+// snap is quantize() without a finiteness test per coordinate.
+class GridSnap {
+public:
+    explicit GridSnap(const Quantizer& quantizer) : quantizer_(quantizer) {
+        for (int axis = 0; axis < 3; ++axis)
+            finite_ = finite_ && std::isfinite(dequantize_coordinate(quantizer, axis, quantizer.max_coordinate()));
+    }
+    GridPoint operator()(Vec3 p) const { return finite_ ? quantize(quantizer_, p) : snap_to_grid(quantizer_, p); }
+
+private:
+    Quantizer quantizer_;
+    bool finite_ = true;
+};
 // A bound on |x - dequantize(quantize(x))| for every x inside the quantizer's box: step / 2
 // plus the rounding of the arithmetic.
 double quantization_error_bound(const Quantizer& quantizer);
