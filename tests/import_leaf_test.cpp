@@ -548,19 +548,26 @@ TEST(ImportLeafMeshSharedData, ElephantSemiRegularLevel2OverLevel0) {
     expect_semi_regular("elephant-sr-l0.obj", "elephant-sr-l2.obj", 2);
 }
 
-// The corpus's fandisk_gauss (docs/IMPORT.md, section 4, as scripts/corpus.sh and import_corpus make
-// it): fandisk remeshed by Gauss curvature, its leaf mesh shuffled and moved by 0.3. Its last wrong
-// picks hold each other in place (a level-0 truth whose subtree misfits through finer picks, three
-// level-3 picks along a lattice line); the joint moves of "Picks certified by their subtrees" import it.
-TEST(ImportLeafMeshSharedData, FandiskGaussRemeshMovedImportsWithItsBase) {
+// fandisk remeshed as scripts/corpus.sh makes the corpus's fandisk models (500 base triangles, 10^5
+// faces, level 5), or an empty hierarchy when the shared data is missing.
+Hierarchy corpus_fandisk_remesh(RefinementCriterion criterion) {
     const std::string dir = AMC_SHARED_DATA_DIR;
-    if (!std::ifstream(dir + "/fandisk.obj").good()) GTEST_SKIP() << "shared data not found (" << dir << ")";
+    if (!std::ifstream(dir + "/fandisk.obj").good()) return Hierarchy();
     SurfaceRemeshOptions options;
-    options.criterion = RefinementCriterion::gauss_curvature;
+    options.criterion = criterion;
     options.base_triangles = 500;
     options.target_faces = 100000;
     options.max_level = 5;
-    const Hierarchy h = remesh_adaptively(read_mesh(dir + "/fandisk.obj"), options);
+    return remesh_adaptively(read_mesh(dir + "/fandisk.obj"), options);
+}
+
+// The corpus's fandisk_gauss (docs/IMPORT.md, section 4, as scripts/corpus.sh and import_corpus make
+// it): its leaf mesh shuffled and moved by 0.3. Its last wrong picks hold each other in place (a
+// level-0 truth whose subtree misfits through finer picks, three level-3 picks along a lattice
+// line); the joint moves of "Picks certified by their subtrees" import it.
+TEST(ImportLeafMeshSharedData, FandiskGaussRemeshMovedImportsWithItsBase) {
+    const Hierarchy h = corpus_fandisk_remesh(RefinementCriterion::gauss_curvature);
+    if (h.node_count() == 0) GTEST_SKIP() << "shared data not found (" << AMC_SHARED_DATA_DIR << ")";
     EXPECT_TRUE(imports_back(h, user_leaf_mesh(h, 23, Placement::moved), false));
 }
 
@@ -569,14 +576,8 @@ TEST(ImportLeafMeshSharedData, FandiskGaussRemeshMovedImportsWithItsBase) {
 // base in this face order (three levels undone) and reaches it in others; import_corpus --move 0
 // refused it before the anchored way tried other orders ("no vertex left to split the edge").
 TEST(ImportLeafMeshSharedData, FandiskMeanRemeshUnmovedImportsWithItsBase) {
-    const std::string dir = AMC_SHARED_DATA_DIR;
-    if (!std::ifstream(dir + "/fandisk.obj").good()) GTEST_SKIP() << "shared data not found (" << dir << ")";
-    SurfaceRemeshOptions options;
-    options.criterion = RefinementCriterion::mean_curvature;
-    options.base_triangles = 500;
-    options.target_faces = 100000;
-    options.max_level = 5;
-    const Hierarchy h = remesh_adaptively(read_mesh(dir + "/fandisk.obj"), options);
+    const Hierarchy h = corpus_fandisk_remesh(RefinementCriterion::mean_curvature);
+    if (h.node_count() == 0) GTEST_SKIP() << "shared data not found (" << AMC_SHARED_DATA_DIR << ")";
     EXPECT_TRUE(imports_back(h, user_leaf_mesh(h, 23, Placement::midpoints), false));
 }
 
