@@ -269,11 +269,7 @@ uint32_t Reconstruction::find_midpoint(NodeId n, int e) {
     uint32_t found;
     uint32_t nearest[kCandidates];
     uint32_t count = 0;
-    // No farther than twice the edge's length: where too few vertices pass the test (every vertex
-    // taken under a wrong pick, or a fine region's vertices around a coarse edge), an unbounded
-    // search visits the whole tree, which made large graded meshes quadratic.
-    const Vec3 ab = leaf_.positions[b] - leaf_.positions[a];
-    const double limit = 4 * exact_dot(ab, ab);
+    const double limit = pick_search_limit(a, b);
     if (choice_) {
         count = nearest_vertex.find_nearest(guide_position(n, e), may_be_midpoint, kCandidates, nearest, limit);
         const uint32_t kept = on_shortest_chains(nearest, count, a, b);

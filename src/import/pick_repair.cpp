@@ -141,12 +141,9 @@ Reconstruction::Move Reconstruction::best_move(VertexId v, NodeId misfit) {
     const uint32_t original = leaf_of_vertex_[v];
     uint32_t candidates[kRepairCandidates];
     unassign(v);
-    // No farther than twice the edge's length (as find_midpoint looks): where fewer than
-    // kRepairCandidates vertices pass the test, an unbounded search visits the whole tree.
-    const Vec3 ab = leaf_.positions[corner(s.node, (s.edge + 1) % 3)] - leaf_.positions[corner(s.node, s.edge)];
-    const uint32_t found = search_.nearest().find_nearest(guide_position(s.node, s.edge),
-                                                  MidpointTest(*this, s.node, s.edge, true), kRepairCandidates,
-                                                  candidates, 4 * exact_dot(ab, ab));
+    const uint32_t found = search_.nearest().find_nearest(
+        guide_position(s.node, s.edge), MidpointTest(*this, s.node, s.edge, true), kRepairCandidates, candidates,
+        pick_search_limit(corner(s.node, s.edge), corner(s.node, (s.edge + 1) % 3)));
     assign(v, original);
     auto misfits = [&] {
         int m = 0;

@@ -81,6 +81,15 @@ private:
         return p[0] != kNoIndex && p[1] != kNoIndex && p[2] != kNoIndex;
     }
 
+    // The squared distance from the guide within which a guided pick of the edge (a, b) is sought:
+    // twice the edge's length. Where too few vertices pass the midpoint test (every vertex taken
+    // under a wrong pick, or a fine region's vertices around a coarse edge), an unbounded search
+    // visits the whole tree, which made large graded meshes quadratic.
+    double pick_search_limit(uint32_t a, uint32_t b) const {
+        const Vec3 ab = leaf_.positions[b] - leaf_.positions[a];
+        return 4 * exact_dot(ab, ab);
+    }
+
     std::string edge_text(NodeId n, int e) const {
         return std::to_string(corner(n, e)) + "," + std::to_string(corner(n, (e + 1) % 3));
     }

@@ -499,10 +499,12 @@ size_t StaticLevelEncoder::estimated_bytes() const {
 // a byte written divides it by at most 256 / (1 - 2^-11) (x >= 2^19 then). So with H the bits
 // sum of log2(M / f) over its N symbols, the K bytes written satisfy 8 K >= H - 16 - 0.001 (N + K),
 // and the stream is K + 8 bytes.
-size_t StaticLevelEncoder::lower_bound_bytes() const {
+size_t StaticLevelEncoder::lower_bound_bytes() const { return table_bytes() + stream_bound_bytes(); }
+
+size_t StaticLevelEncoder::table_bytes() const {
     ArithmeticEncoder tables;
     write_tables(tables);
-    return tables.finish().size() + 1 + stream_bound_bytes();
+    return tables.finish().size() + 1;
 }
 
 size_t StaticLevelEncoder::stream_bound_bytes() const {
@@ -512,9 +514,7 @@ size_t StaticLevelEncoder::stream_bound_bytes() const {
 }
 
 double StaticLevelEncoder::projected_bound_bytes(double scale) const {
-    ArithmeticEncoder tables;
-    write_tables(tables);
-    return double(tables.finish().size() + 1) + rounded(scale * double(stream_bound_bytes()));
+    return double(table_bytes()) + rounded(scale * double(stream_bound_bytes()));
 }
 
 bool read_static_tables(ArithmeticDecoder& decoder, CoordinateSpace space, GeometryPredictor mode, StaticTables& tables) {

@@ -103,7 +103,8 @@ private:
     void add(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
     template <bool UnitNormals, bool GridBins>
     void add_vertices(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
-    // lower_bound_bytes()' rANS and raw streams.
+    // lower_bound_bytes()' parts: the coded tables, and the rANS and raw streams.
+    size_t table_bytes() const;
     size_t stream_bound_bytes() const;
     // The tables from the counts, and the tokens' cost under them.
     void make_tables();
