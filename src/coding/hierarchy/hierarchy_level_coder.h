@@ -33,6 +33,16 @@ struct CodedSymbol {
 // The mixing mode's model that encoders write (.amc version 11).
 constexpr MixingModel kWrittenMixingModel = MixingModel::third;
 
+// A hierarchy read in another base order without copying it (reorder_base's result, as a view):
+// root t of the coded forest is h's root old_root[t] with its local indices turned by turn[t] (its
+// edge e is h's edge (e + turn[t]) % 3, its child k h's child red_split::kRotatedChild[turn[t]][k],
+// turned alike), and `roots` is the base in that order (its roots linked as the coded forest's).
+struct TurnedRoots {
+    const Hierarchy* roots;
+    const std::vector<uint32_t>* old_root;
+    const std::vector<uint8_t>* turn;
+};
+
 class HierarchyLevelEncoder {
 public:
     // Decides every node (first pass): fixes the uniform levels, the diagonal rule and the number
@@ -43,9 +53,11 @@ public:
     // `mixed`: the mixing mode (FORMAT.md 2.1-2.2): symbols coded by MixedHierarchyModel, in its
     // newest model (kWrittenMixingModel), from features of h's structure and positions, which must
     // be the ones the decoder will have.
+    // With `turned`, the forest coded is h in that base order (not with `mixed`); level_nodes and
+    // new_vertices are then h's nodes and edges.
     HierarchyLevelEncoder(const Hierarchy& h, const HierarchyCoderOptions& options,
                           uint8_t stream_version = kHierarchyStreamVersion, std::vector<CodedSymbol>* trace = nullptr,
-                          bool mixed = false);
+                          bool mixed = false, const TurnedRoots* turned = nullptr);
     bool mixed() const { return mixed_; }
     const std::vector<uint8_t>& header() const { return header_; }
     int level_count() const { return int(level_ids_.size()); }
