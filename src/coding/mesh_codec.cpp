@@ -165,13 +165,13 @@ struct ForestCode {
     EncodeStats stats;  // header (the chunk table), hierarchy, geometry and framing bytes, levels, hierarchy
 };
 
-// Codes the forest of `h` (decoder base order, or h read in it through `turned` when one chunk;
-// positions as the decoder will have them) in `chunks`; `faces` is the leaf face count when there
-// are several. `positions` holds the models as
+// Codes the forest of `h` (decoder base order, or h read in it by `first_pass`, the one chunk's
+// hierarchy coder made over TurnedRoots; positions as the decoder will have them) in `chunks`;
+// `faces` is the leaf face count when there are several. `positions` holds the models as
 // the base geometry left them. The mixing mode (FORMAT.md 2.1) codes the forest as one stream.
 ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<RootRange>& chunks, uint64_t faces,
                        const EncodeOptions& options, CoordinateSpace space, PositionCoder positions, unsigned threads,
-                       bool want_hierarchy_stats, const TurnedRoots* turned) {
+                       bool want_hierarchy_stats, HierarchyLevelEncoder* first_pass) {
     ForestCode out;
     const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
     out.chunked = !mixed && chunks.size() > 1;
@@ -184,7 +184,10 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
         out.levels = uint64_t(parts.levels);  // the deepest chunk's: the forest's
         out.blocks = std::move(parts.blocks);
     } else {
-        HierarchyLevelEncoder hierarchy(h, options.hierarchy, kHierarchyStreamVersion, nullptr, mixed, turned);
+        std::unique_ptr<HierarchyLevelEncoder> own;
+        if (first_pass == nullptr)
+            own = std::make_unique<HierarchyLevelEncoder>(h, options.hierarchy, kHierarchyStreamVersion, nullptr, mixed);
+        HierarchyLevelEncoder& hierarchy = first_pass != nullptr ? *first_pass : *own;
         out.faces = hierarchy.faces();
         out.levels = uint64_t(hierarchy.level_count());
         out.hierarchy_header = hierarchy.header();
@@ -241,21 +244,36 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     ReorderedInput reordered;  // the whole in base code order, or with turned_input its base alone
     BaseCodeOrder order;
     Hierarchy snapped;  // with turned_input and quantized: the input on the grid
+    const TurnedRoots turned{&reordered.hierarchy, &base_code.triangle_order, &order.rotation};
+    std::unique_ptr<HierarchyLevelEncoder> first_pass;  // with turned_input: the hierarchy coder's
     if (turned_input) {
-        order = base_code_order(input, base_code, threads);
-        reordered.keep_rotations = order.keep_rotations;
-        std::vector<uint32_t> base_vertex_id;
-        TriangleMesh base = HierarchyBuilder::reordered_base_mesh(input.base(), base_code.vertex_order, base_code.triangle_order,
-                                                                  order.rotation, base_vertex_id);
         if (quantized) {
-            const GridSnap snap(quantizer);
-            for (Vec3& p : base.positions) p = dequantize(quantizer, snap(p));
             snapped = input;
             snapped.set_single_precision(false);
             stats.max_error = snap_positions(snapped, quantizer, threads);  // every id is live
         }
-        reordered.hierarchy = Hierarchy(std::move(base));
-        if (quantized) reordered.hierarchy.set_single_precision(false);
+        // The first pass reads the forest turned by the base coder's rotations and tallies the
+        // diagonal flags both ways (base_code_order's choice); when the roots keep the input's
+        // order instead (a rule of absolute local indices), it runs again unturned.
+        auto read_in_order = [&](bool keep_rotations) {
+            order = base_code_order(base_code, keep_rotations);
+            reordered.keep_rotations = keep_rotations;
+            std::vector<uint32_t> base_vertex_id;
+            TriangleMesh base = HierarchyBuilder::reordered_base_mesh(input.base(), base_code.vertex_order,
+                                                                      base_code.triangle_order, order.rotation, base_vertex_id);
+            if (quantized) {
+                const GridSnap snap(quantizer);
+                for (Vec3& p : base.positions) p = dequantize(quantizer, snap(p));
+            }
+            reordered.hierarchy = Hierarchy(std::move(base));
+            if (quantized) reordered.hierarchy.set_single_precision(false);
+            first_pass = std::make_unique<HierarchyLevelEncoder>(input, options.hierarchy, kHierarchyStreamVersion, nullptr,
+                                                                 false, &turned);
+        };
+        read_in_order(false);
+        if (keeps_rotations(first_pass->diagonal_exceptions(), first_pass->unturned_diagonal_exceptions(),
+                            base_code.triangle_order.size()))
+            read_in_order(true);
     } else {
         reordered = in_base_code_order(input, base_code, options.numbering != nullptr, threads);
         if (options.numbering != nullptr)
@@ -266,7 +284,6 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
         }
     }
     const Hierarchy& h = !turned_input ? reordered.hierarchy : quantized ? snapped : input;
-    const TurnedRoots turned{&reordered.hierarchy, &base_code.triangle_order, &order.rotation};
     const bool store_numbering = options.numbering != nullptr && options.store_numbering;
 
     // The forest (FORMAT.md 3.6, 3.11), after the base geometry, whose adaptive models the level
@@ -283,7 +300,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
                                                       : balanced_chunks(root_nodes, chunk_count_for(options, faces));
     const bool want_hierarchy_stats = stats_out != nullptr && options.hierarchy_statistics;
     ForestCode forest = code_forest(h, root_of, chunks, faces, options, space, positions, threads, want_hierarchy_stats,
-                                    turned_input ? &turned : nullptr);
+                                    first_pass.get());
     const uint32_t fewer = automatic && forest.chunked ? chunk_count_for_size(options, uint32_t(chunks.size()), forest.bytes)
                                                        : uint32_t(chunks.size());
     if (fewer < chunks.size())

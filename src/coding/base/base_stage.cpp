@@ -74,24 +74,30 @@ BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const 
     return encode_base_connectivity(base, resolve_thread_count(options.threads), base_search_budget(h));
 }
 
-// Whether the rotations are kept: the orientation bits of both readings against log2 3 bits a root.
+bool keeps_rotations(const DiagonalExceptions& rotated, const DiagonalExceptions& unrotated, size_t triangles) {
+    if (rotated.fewest() == 0) return false;
+    const double rotated_bits = binary_entropy_bits(rotated.fewest(), rotated.leaves);
+    // Products rounded (exact_float.h): however it is compiled, the encoder makes the same choice.
+    const double kept_bits = binary_entropy_bits(unrotated.fewest(), unrotated.leaves) + rounded(kRotationBits * double(triangles));
+    return kept_bits < rotated_bits;
+}
+
 BaseCodeOrder base_code_order(const Hierarchy& input, const BaseMeshCode& base_code, unsigned threads) {
     std::vector<uint8_t> rotation_of_root(input.root_count(), 0);
     for (size_t t = 0; t < base_code.triangle_order.size() && t < base_code.triangle_rotation.size(); ++t)
         if (base_code.triangle_order[t] < rotation_of_root.size())
             rotation_of_root[base_code.triangle_order[t]] = base_code.triangle_rotation[t];
-    BaseCodeOrder order;
     const DiagonalExceptions rotated = diagonal_exceptions(input, rotation_of_root, threads);
-    if (rotated.fewest() != 0) {
-        // Without rotations every node keeps its local vertex order: the input's exceptions.
-        const DiagonalExceptions unrotated = diagonal_exceptions(input, threads);
-        const double rotated_bits = binary_entropy_bits(rotated.fewest(), rotated.leaves);
-        // Products rounded (exact_float.h): however it is compiled, the encoder makes the same choice.
-        const double kept_bits = binary_entropy_bits(unrotated.fewest(), unrotated.leaves) +
-                                 rounded(kRotationBits * double(base_code.triangle_order.size()));
-        order.keep_rotations = kept_bits < rotated_bits;
-    }
-    order.rotation = order.keep_rotations ? std::vector<uint8_t>(base_code.triangle_order.size(), 0) : base_code.triangle_rotation;
+    // Without rotations every node keeps its local vertex order: the input's exceptions.
+    const bool keep = rotated.fewest() != 0 &&
+                      keeps_rotations(rotated, diagonal_exceptions(input, threads), base_code.triangle_order.size());
+    return base_code_order(base_code, keep);
+}
+
+BaseCodeOrder base_code_order(const BaseMeshCode& base_code, bool keep_rotations) {
+    BaseCodeOrder order;
+    order.keep_rotations = keep_rotations;
+    order.rotation = keep_rotations ? std::vector<uint8_t>(base_code.triangle_order.size(), 0) : base_code.triangle_rotation;
     return order;
 }
 

@@ -11,6 +11,7 @@
 
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
+#include <amc/hierarchy_coder.h>
 
 #include <vector>
 
@@ -32,6 +33,11 @@ struct BaseCodeOrder {
     std::vector<uint8_t> rotation;  // of each triangle in code order: the base coder's, or none when kept
 };
 BaseCodeOrder base_code_order(const Hierarchy& input, const BaseMeshCode& base_code, unsigned threads = 1);
+// The order with the choice made: the rotations kept or the base coder's.
+BaseCodeOrder base_code_order(const BaseMeshCode& base_code, bool keep_rotations);
+// The choice from the diagonal flags' exceptions as the rotated forest and the input read them:
+// whether log2 3 bits a triangle cost less than the orientation bits the rotations add.
+bool keeps_rotations(const DiagonalExceptions& rotated, const DiagonalExceptions& unrotated, size_t triangles);
 
 // The input with its base mesh in the base coder's order.
 struct ReorderedInput {

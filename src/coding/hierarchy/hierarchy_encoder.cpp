@@ -28,6 +28,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
     // the level forest (hierarchy_traversal.h); `ids` maps a level's local indices to h's nodes.
     events_.reserve(h.node_count());
     std::vector<std::pair<int, bool>> two_hanging;  // (unrefined edge, flag) in stream order
+    static constexpr int kTurnedEdge[6] = {0, 1, 2, 0, 1, 2};  // (e + turn) % 3
     std::vector<size_t> orientation_slots;         // event index of each two_hanging entry
     LevelTraversal traversal(options, stream_version);
     Level level, next;
@@ -109,7 +110,10 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
                             " has three hanging nodes but is not refined (the hierarchy is not closed)");
             faces += 1 + uint64_t(hanging);
             if (hanging == 2) {
-                two_hanging.push_back({unrefined_edge(level, i), h.diagonal_flipped(ids[i])});
+                const int unrefined = unrefined_edge(level, i);
+                const bool flipped = h.diagonal_flipped(ids[i]);
+                two_hanging.push_back({unrefined, flipped});
+                unturned_exceptions_.add(kTurnedEdge[unrefined + turn(i)], flipped);
                 orientation_slots.push_back(events_.size());
                 events_.push_back({kOrientationEvent, 0});
             }
@@ -120,7 +124,6 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         const uint64_t created_count = derive_next_level(level, numbering, next, options.cull_one_regularity);
         std::vector<std::pair<NodeId, int>>& created = new_vertices_.emplace_back();
         created.reserve(created_count);
-        static constexpr int kTurnedEdge[6] = {0, 1, 2, 0, 1, 2};  // (e + turn) % 3
         for_each_new_vertex(level, numbering, [&](uint32_t i, int e) { created.emplace_back(ids[i], kTurnedEdge[e + turn(i)]); });
         std::swap(level, next);
         level_ids_.push_back(ids);
@@ -131,7 +134,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
     stats.faces = faces;
 
     // The diagonal rule that leaves the fewest exceptions; orientation bits only if any.
-    DiagonalExceptions tally;
+    DiagonalExceptions& tally = exceptions_;
     for (auto [edge, flag] : two_hanging) tally.add(edge, flag);
     stats.diagonal_rule = tally.best();
     stats.two_hanging_leaves = tally.leaves;
