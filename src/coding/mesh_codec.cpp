@@ -165,12 +165,13 @@ struct ForestCode {
     EncodeStats stats;  // header (the chunk table), hierarchy, geometry and framing bytes, levels, hierarchy
 };
 
-// Codes the forest of `h` (decoder base order, positions as the decoder will have them) in
-// `chunks`; `faces` is the leaf face count when there are several. `positions` holds the models as
+// Codes the forest of `h` (decoder base order, or h read in it by `first_pass`, the one chunk's
+// hierarchy coder made over TurnedRoots; positions as the decoder will have them) in `chunks`;
+// `faces` is the leaf face count when there are several. `positions` holds the models as
 // the base geometry left them. The mixing mode (FORMAT.md 2.1) codes the forest as one stream.
 ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<RootRange>& chunks, uint64_t faces,
                        const EncodeOptions& options, CoordinateSpace space, PositionCoder positions, unsigned threads,
-                       bool want_hierarchy_stats) {
+                       bool want_hierarchy_stats, HierarchyLevelEncoder* first_pass) {
     ForestCode out;
     const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
     out.chunked = !mixed && chunks.size() > 1;
@@ -183,7 +184,10 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
         out.levels = uint64_t(parts.levels);  // the deepest chunk's: the forest's
         out.blocks = std::move(parts.blocks);
     } else {
-        HierarchyLevelEncoder hierarchy(h, options.hierarchy, kHierarchyStreamVersion, nullptr, mixed);
+        std::unique_ptr<HierarchyLevelEncoder> own;
+        if (first_pass == nullptr)
+            own = std::make_unique<HierarchyLevelEncoder>(h, options.hierarchy, kHierarchyStreamVersion, nullptr, mixed);
+        HierarchyLevelEncoder& hierarchy = first_pass != nullptr ? *first_pass : *own;
         out.faces = hierarchy.faces();
         out.levels = uint64_t(hierarchy.level_count());
         out.hierarchy_header = hierarchy.header();
@@ -222,29 +226,71 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     if (quantized) quantizer = quantizer_of(input, options.quantize_bits, threads);
     const CoordinateSpace space{precision, quantized ? &quantizer : nullptr};
 
-    // II-B: code the base mesh first and express the forest in the decoder's base order.
+    const bool automatic = options.chunk_roots.empty() && options.chunks == 0;
+    // A leaf has at most four faces (itself and three hanging nodes): fewer than two chunks' faces,
+    // so one chunk (chunk_count_for), known without the passes over the nodes that count faces and
+    // nodes per root.
+    const bool few_leaves = automatic && uint64_t(input.leaf_count()) * 2 < std::max<uint64_t>(1, options.chunk_faces);
+    const bool one_chunk = options.chunk_roots.empty() ? options.chunks == 1 || few_leaves : options.chunk_roots.size() == 1;
+    const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
+
+    // II-B: code the base mesh first and express the forest in the decoder's base order. One chunk
+    // is coded from the input read in that order (TurnedRoots): reorder_base's copy was a quarter
+    // of a 10^5-face encode. Chunks are cut from the reordered copy, and a numbering is mapped
+    // through it; a forest with free ids (none after reading a file) is copied too.
     const BaseMeshCode base_code = base_code_of(input, space.quantizer, options);
-    ReorderedInput reordered = in_base_code_order(input, base_code, options.numbering != nullptr, threads);
-    Hierarchy& h = reordered.hierarchy;
-    const bool store_numbering = options.numbering != nullptr && options.store_numbering;
-    if (options.numbering != nullptr)
-        stats.numbering = numbering_after_reorder(input, *options.numbering, h, reordered.vertex_map);
-    if (quantized) {
-        h.set_single_precision(false);
-        stats.max_error = snap_positions(h, quantizer, threads);  // h holds exactly the input's live positions
+    const bool turned_input = one_chunk && !mixed && options.numbering == nullptr && input.node_count() == input.node_capacity() &&
+                              input.vertex_count() == input.positions().size();
+    ReorderedInput reordered;  // the whole in base code order, or with turned_input its base alone
+    BaseCodeOrder order;
+    Hierarchy snapped;  // with turned_input and quantized: the input on the grid
+    const TurnedRoots turned{&reordered.hierarchy, &base_code.triangle_order, &order.rotation};
+    std::unique_ptr<HierarchyLevelEncoder> first_pass;  // with turned_input: the hierarchy coder's
+    if (turned_input) {
+        if (quantized) {
+            snapped = input;
+            snapped.set_single_precision(false);
+            stats.max_error = snap_positions(snapped, quantizer, threads);  // every id is live
+        }
+        // The first pass reads the forest turned by the base coder's rotations and tallies the
+        // diagonal flags both ways (base_code_order's choice); when the roots keep the input's
+        // order instead (a rule of absolute local indices), it runs again unturned.
+        auto read_in_order = [&](bool keep_rotations) {
+            order = base_code_order(base_code, keep_rotations);
+            reordered.keep_rotations = keep_rotations;
+            std::vector<uint32_t> base_vertex_id;
+            TriangleMesh base = HierarchyBuilder::reordered_base_mesh(input.base(), base_code.vertex_order,
+                                                                      base_code.triangle_order, order.rotation, base_vertex_id);
+            if (quantized) {
+                const GridSnap snap(quantizer);
+                for (Vec3& p : base.positions) p = dequantize(quantizer, snap(p));
+            }
+            reordered.hierarchy = Hierarchy(std::move(base));
+            if (quantized) reordered.hierarchy.set_single_precision(false);
+            first_pass = std::make_unique<HierarchyLevelEncoder>(input, options.hierarchy, kHierarchyStreamVersion, nullptr,
+                                                                 false, &turned);
+        };
+        read_in_order(false);
+        if (keeps_rotations(first_pass->diagonal_exceptions(), first_pass->unturned_diagonal_exceptions(),
+                            base_code.triangle_order.size()))
+            read_in_order(true);
+    } else {
+        reordered = in_base_code_order(input, base_code, options.numbering != nullptr, threads);
+        if (options.numbering != nullptr)
+            stats.numbering = numbering_after_reorder(input, *options.numbering, reordered.hierarchy, reordered.vertex_map);
+        if (quantized) {
+            reordered.hierarchy.set_single_precision(false);
+            stats.max_error = snap_positions(reordered.hierarchy, quantizer, threads);  // it holds exactly the input's live positions
+        }
     }
+    const Hierarchy& h = !turned_input ? reordered.hierarchy : quantized ? snapped : input;
+    const bool store_numbering = options.numbering != nullptr && options.store_numbering;
 
     // The forest (FORMAT.md 3.6, 3.11), after the base geometry, whose adaptive models the level
     // blocks go on with. Chunks the caller leaves to the encoder are tried first at chunk_faces
     // faces each, then fewer if that code is too small for them (chunk_policy.h).
     PositionCoder positions(space);
-    std::vector<uint8_t> base_geometry = encode_base_geometry(h, base_code, reordered.keep_rotations, positions);
-    const bool automatic = options.chunk_roots.empty() && options.chunks == 0;
-    // A leaf has at most four faces (itself and three hanging nodes): fewer than two chunks' faces,
-    // so one chunk (chunk_count_for), known without the passes over the nodes that count faces and
-    // nodes per root.
-    const bool few_leaves = automatic && uint64_t(h.leaf_count()) * 2 < std::max<uint64_t>(1, options.chunk_faces);
-    const bool one_chunk = options.chunk_roots.empty() ? options.chunks == 1 || few_leaves : options.chunk_roots.size() == 1;
+    std::vector<uint8_t> base_geometry = encode_base_geometry(reordered.hierarchy, base_code, reordered.keep_rotations, positions);
     const uint64_t faces = one_chunk ? 0 : leaf_face_count(h, threads);
     const std::vector<uint32_t> root_of = one_chunk ? std::vector<uint32_t>() : root_of_nodes(h);
     const std::vector<uint64_t> root_nodes =
@@ -253,12 +299,13 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
                                           : one_chunk ? std::vector<RootRange>{RootRange{0, h.root_count()}}
                                                       : balanced_chunks(root_nodes, chunk_count_for(options, faces));
     const bool want_hierarchy_stats = stats_out != nullptr && options.hierarchy_statistics;
-    ForestCode forest = code_forest(h, root_of, chunks, faces, options, space, positions, threads, want_hierarchy_stats);
+    ForestCode forest = code_forest(h, root_of, chunks, faces, options, space, positions, threads, want_hierarchy_stats,
+                                    first_pass.get());
     const uint32_t fewer = automatic && forest.chunked ? chunk_count_for_size(options, uint32_t(chunks.size()), forest.bytes)
                                                        : uint32_t(chunks.size());
     if (fewer < chunks.size())
         forest = code_forest(h, root_of, balanced_chunks(root_nodes, fewer), faces, options, space, positions, threads,
-                             want_hierarchy_stats);
+                             want_hierarchy_stats, nullptr);
 
     Metadata meta;
     meta.base_vertices = h.base().positions.size();
@@ -269,7 +316,6 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     meta.levels = forest.levels;
     meta.hierarchy_header = forest.hierarchy_header;
     meta.quantizer = quantizer;
-    const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
     meta.options = (reordered.keep_rotations ? kOptionRootRotations : 0) | (forest.chunked ? kOptionChunked : 0) |
                    (mixed ? kOptionMixedContexts : 0);
 
