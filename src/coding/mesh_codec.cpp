@@ -375,7 +375,8 @@ struct ChunkRequest {
 // block, if any, and END.
 Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const TriangleMesh& base, CoordinateSpace space,
                               const DecodeOptions& options, LeafNumbering* numbering, PartialProgress* partial,
-                              const ChunkRequest* request, std::future<std::vector<Vec3>>* zeroed_positions) {
+                              const ChunkRequest* request, std::future<std::vector<Vec3>>* zeroed_positions,
+                              ChunkDecoders* kept_decoders) {
     AMC_REQUIRE(reader.version() >= kChunkedVersion, corrupt, "metadata block: chunks in a version-" + std::to_string(reader.version()) + " file");
     if (partial != nullptr) {
         partial->levels_in_file = int(meta.levels);
@@ -386,7 +387,7 @@ Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const T
         while (!complete && probe.next_block_arrived() && probe.next(block)) complete = block.type == BlockType::end;
         if (!complete) return Hierarchy(base);
     }
-    const ChunkedDecodeInput input{&base, space, reader.version(), meta.vertices, options, zeroed_positions};
+    const ChunkedDecodeInput input{&base, space, reader.version(), meta.vertices, options, zeroed_positions, kept_decoders};
     ChunkTable table;
     MergedCounts counts;
     Hierarchy h = decode_chunked(reader, input, meta.nodes, request != nullptr ? &request->chunks : nullptr, &table, &counts);
@@ -421,7 +422,8 @@ Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const T
 }
 
 Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& options, LeafNumbering* numbering,
-                      PartialProgress* partial = nullptr, const ChunkRequest* request = nullptr) {
+                      PartialProgress* partial = nullptr, const ChunkRequest* request = nullptr,
+                      ChunkDecoders* kept_decoders = nullptr) {
     if (numbering != nullptr) *numbering = {};
     AMC_REQUIRE(data != nullptr || size == 0, invalid_input, "no data");
     BlockReader reader(data, size);
@@ -456,7 +458,8 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     AMC_REQUIRE(!((meta.options & kOptionMixedContexts) && (meta.options & kOptionChunked)), corrupt,
                 "metadata block: mixed hierarchy contexts in a chunked file");
     if (meta.options & kOptionChunked)
-        return decode_chunked_file(reader, meta, base, space, options, numbering, partial, request, &zeroed_positions);
+        return decode_chunked_file(reader, meta, base, space, options, numbering, partial, request, &zeroed_positions,
+                                   kept_decoders);
     if (request != nullptr) {  // a file without chunks is one chunk
         AMC_REQUIRE(request->chunks.size() == 1 && request->chunks[0] == 0, invalid_input,
                     "the file has no chunks: only chunk 0, the whole file, can be decoded");
@@ -538,6 +541,29 @@ Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options,
     // Decoders build only what balance and closure allow, and the amc_decode fuzz target holds
     // every decoded hierarchy to check_invariants: writers need not walk it again.
     HierarchyBuilder::mark_structure_checked(h);
+    return h;
+}
+
+struct DecodeContext::Kept {
+    ChunkDecoders chunk_decoders;
+};
+
+DecodeContext::DecodeContext() : kept_(std::make_unique<Kept>()) {}
+DecodeContext::~DecodeContext() = default;
+DecodeContext::DecodeContext(DecodeContext&&) noexcept = default;
+DecodeContext& DecodeContext::operator=(DecodeContext&&) noexcept = default;
+
+void DecodeContext::release() {
+    if (kept_ != nullptr) kept_->chunk_decoders.clear();
+}
+
+Hierarchy decode(DecodeContext& context, const uint8_t* data, size_t size, const DecodeOptions& options,
+                 LeafNumbering* numbering) {
+    if (context.kept_ == nullptr) context.kept_ = std::make_unique<DecodeContext::Kept>();  // moved from
+    ChunkDecoders* kept = &context.kept_->chunk_decoders;
+    Hierarchy h = with_allocation_errors_as_limits(
+        "decode", [&] { return decode_file(data, size, options, numbering, nullptr, nullptr, kept); });
+    HierarchyBuilder::mark_structure_checked(h);  // as decode without a context
     return h;
 }
 
