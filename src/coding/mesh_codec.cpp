@@ -231,7 +231,11 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     // so one chunk (chunk_count_for), known without the passes over the nodes that count faces and
     // nodes per root.
     const bool few_leaves = automatic && uint64_t(input.leaf_count()) * 2 < std::max<uint64_t>(1, options.chunk_faces);
-    const bool one_chunk = options.chunk_roots.empty() ? options.chunks == 1 || few_leaves : options.chunk_roots.size() == 1;
+    const bool one_chunk_asked = options.chunk_roots.empty() ? options.chunks == 1 || few_leaves : options.chunk_roots.size() == 1;
+    // Leaf faces do not depend on the order: counted on the input, so that automatic chunks of
+    // fewer faces than two chunks' are known to be one before the order is chosen.
+    const uint64_t faces = one_chunk_asked ? 0 : leaf_face_count(input, threads);
+    const bool one_chunk = one_chunk_asked || (automatic && chunk_count_for(options, faces) == 1);
     const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
 
     // II-B: code the base mesh first and express the forest in the decoder's base order. One chunk
@@ -291,7 +295,6 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     // faces each, then fewer if that code is too small for them (chunk_policy.h).
     PositionCoder positions(space);
     std::vector<uint8_t> base_geometry = encode_base_geometry(reordered.hierarchy, base_code, reordered.keep_rotations, positions);
-    const uint64_t faces = one_chunk ? 0 : leaf_face_count(h, threads);
     const std::vector<uint32_t> root_of = one_chunk ? std::vector<uint32_t>() : root_of_nodes(h);
     const std::vector<uint64_t> root_nodes =
         options.chunk_roots.empty() && !one_chunk ? nodes_per_root(h, root_of) : std::vector<uint64_t>();
