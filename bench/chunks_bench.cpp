@@ -4,7 +4,8 @@
 //   chunks_bench sizes BITS model.amh ...          bytes with 1 chunk, the default chunks, and 2, 4, 8
 //                                                  chunks; every chunked file checked to decode
 //                                                  identical to the unchunked one
-//   chunks_bench speed RUNS BITS CHUNKS model.amh  wall and CPU time of encode and decode with 1 and
+//   chunks_bench speed RUNS BITS CHUNKS model.amh  wall and CPU time of encode and decode (without and
+//                                                  through a DecodeContext) with 1 and
 //                                                  with 2 threads (CHUNKS 0: the default count), runs
 //                                                  interleaved; median [min - max] and the ratio of
 //                                                  each run's pair (on a shared machine the load
@@ -98,9 +99,10 @@ int speed(int runs, int bits, uint32_t chunks, const char* path) {
     const std::vector<uint8_t> bytes = amc::encode(h, options, &stats);
     const amc::FileInfo info = amc::inspect(bytes.data(), bytes.size());
     std::vector<double> encode_time[2], decode_time[2], encode_cpu[2], decode_cpu[2], encode_ratio, decode_ratio,
-        decode_faults[2];
+        decode_faults[2], kept_time[2], kept_cpu[2], kept_ratio, kept_faults[2];
+    amc::DecodeContext contexts[2];  // one a thread count, kept through the runs
     for (int r = 0; r < runs; ++r) {
-        double seconds[2][2], cpu[2][2];
+        double seconds[2][3], cpu[2][3];
         for (unsigned threads : {1u, 2u}) {
             amc::EncodeOptions o = options;
             o.threads = threads;
@@ -124,15 +126,28 @@ int speed(int runs, int bits, uint32_t chunks, const char* path) {
                 decode_faults[threads - 1].push_back(minor_faults() - faults_start);
                 if (back.node_count() != h.node_count()) return 1;
             }
+            start = now();
+            cpu_start = cpu_seconds();
+            const double kept_faults_start = minor_faults();
+            {
+                const amc::Hierarchy back = amc::decode(contexts[threads - 1], bytes.data(), bytes.size(), d);
+                seconds[threads - 1][2] = now() - start;
+                cpu[threads - 1][2] = cpu_seconds() - cpu_start;
+                kept_faults[threads - 1].push_back(minor_faults() - kept_faults_start);
+                if (back.node_count() != h.node_count()) return 1;
+            }
         }
         for (int t = 0; t < 2; ++t) {
             encode_time[t].push_back(seconds[t][0]);
             decode_time[t].push_back(seconds[t][1]);
             encode_cpu[t].push_back(cpu[t][0]);
             decode_cpu[t].push_back(cpu[t][1]);
+            kept_time[t].push_back(seconds[t][2]);
+            kept_cpu[t].push_back(cpu[t][2]);
         }
         encode_ratio.push_back(seconds[0][0] / seconds[1][0]);
         decode_ratio.push_back(seconds[0][1] / seconds[1][1]);
+        kept_ratio.push_back(seconds[0][2] / seconds[1][2]);
     }
     std::printf("%s: %lu faces, %zu bytes, %zu chunks, %d runs (wall time, seconds: median [min - max])\n", name_of(path).c_str(),
                 (unsigned long)stats.faces, bytes.size(), std::max<size_t>(1, info.chunks.size()), runs);
@@ -147,9 +162,14 @@ int speed(int runs, int bits, uint32_t chunks, const char* path) {
     };
     line("encode", encode_time, encode_cpu, encode_ratio);
     line("decode", decode_time, decode_cpu, decode_ratio);
-    std::printf("  minor page faults per decode: 1 thread %.0f [%.0f - %.0f], 2 threads %.0f [%.0f - %.0f] (median [min - max])\n",
-                range_of(decode_faults[0]).median, range_of(decode_faults[0]).low, range_of(decode_faults[0]).high,
-                range_of(decode_faults[1]).median, range_of(decode_faults[1]).low, range_of(decode_faults[1]).high);
+    line("decode through a DecodeContext", kept_time, kept_cpu, kept_ratio);
+    auto faults_line = [](const char* what, std::vector<double>* faults) {
+        const Range one = range_of(faults[0]), two = range_of(faults[1]);
+        std::printf("  minor page faults per %s: 1 thread %.0f [%.0f - %.0f], 2 threads %.0f [%.0f - %.0f] (median [min - max])\n",
+                    what, one.median, one.low, one.high, two.median, two.low, two.high);
+    };
+    faults_line("decode", decode_faults);
+    faults_line("decode through a DecodeContext", kept_faults);
     return 0;
 }
 
