@@ -4,18 +4,26 @@
 //   chunks_bench sizes BITS model.amh ...          bytes with 1 chunk, the default chunks, and 2, 4, 8
 //                                                  chunks; every chunked file checked to decode
 //                                                  identical to the unchunked one
-//   chunks_bench speed RUNS BITS CHUNKS model.amh  wall and CPU time of encode and decode with 1 and
+//   chunks_bench speed RUNS BITS CHUNKS model.amh  wall and CPU time of encode and decode (without and
+//                                                  through a DecodeContext) with 1 and
 //                                                  with 2 threads (CHUNKS 0: the default count), runs
 //                                                  interleaved; median [min - max] and the ratio of
 //                                                  each run's pair (on a shared machine the load
 //                                                  moves: pairs taken a second apart compare best)
 //   chunks_bench decode-speed RUNS BITS model.amh  decodes only: RUNS pairs of a 1- and a 2-thread
-//                                                  decode, 0.2 s apart (for chrt -f: see decode_speed)
+//                                                  decode, 0.2 s apart (for chrt -f: see decode_speed),
+//                                                  without and with a DecodeContext
 //   chunks_bench repeat encode|decode RUNS THREADS BITS model.amh
 //                                                  encodes the model once (default options), then
 //                                                  encodes or decodes it RUNS times on THREADS
 //                                                  threads: the process to profile
 //                                                  (scripts/serial_fraction.sh)
+//   chunks_bench decode-file RUNS THREADS [context] file.amc
+//                                                  decodes the file RUNS times on THREADS threads
+//                                                  (through one DecodeContext with `context`) and
+//                                                  prints an FNV-1a hash of the decoded nodes and
+//                                                  positions (equal on every thread count): the
+//                                                  process to count instructions of (callgrind)
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
 
@@ -23,9 +31,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <thread>
 #include <vector>
@@ -88,9 +99,10 @@ int speed(int runs, int bits, uint32_t chunks, const char* path) {
     const std::vector<uint8_t> bytes = amc::encode(h, options, &stats);
     const amc::FileInfo info = amc::inspect(bytes.data(), bytes.size());
     std::vector<double> encode_time[2], decode_time[2], encode_cpu[2], decode_cpu[2], encode_ratio, decode_ratio,
-        decode_faults[2];
+        decode_faults[2], kept_time[2], kept_cpu[2], kept_ratio, kept_faults[2];
+    amc::DecodeContext contexts[2];  // one a thread count, kept through the runs
     for (int r = 0; r < runs; ++r) {
-        double seconds[2][2], cpu[2][2];
+        double seconds[2][3], cpu[2][3];
         for (unsigned threads : {1u, 2u}) {
             amc::EncodeOptions o = options;
             o.threads = threads;
@@ -114,15 +126,28 @@ int speed(int runs, int bits, uint32_t chunks, const char* path) {
                 decode_faults[threads - 1].push_back(minor_faults() - faults_start);
                 if (back.node_count() != h.node_count()) return 1;
             }
+            start = now();
+            cpu_start = cpu_seconds();
+            const double kept_faults_start = minor_faults();
+            {
+                const amc::Hierarchy back = amc::decode(contexts[threads - 1], bytes.data(), bytes.size(), d);
+                seconds[threads - 1][2] = now() - start;
+                cpu[threads - 1][2] = cpu_seconds() - cpu_start;
+                kept_faults[threads - 1].push_back(minor_faults() - kept_faults_start);
+                if (back.node_count() != h.node_count()) return 1;
+            }
         }
         for (int t = 0; t < 2; ++t) {
             encode_time[t].push_back(seconds[t][0]);
             decode_time[t].push_back(seconds[t][1]);
             encode_cpu[t].push_back(cpu[t][0]);
             decode_cpu[t].push_back(cpu[t][1]);
+            kept_time[t].push_back(seconds[t][2]);
+            kept_cpu[t].push_back(cpu[t][2]);
         }
         encode_ratio.push_back(seconds[0][0] / seconds[1][0]);
         decode_ratio.push_back(seconds[0][1] / seconds[1][1]);
+        kept_ratio.push_back(seconds[0][2] / seconds[1][2]);
     }
     std::printf("%s: %lu faces, %zu bytes, %zu chunks, %d runs (wall time, seconds: median [min - max])\n", name_of(path).c_str(),
                 (unsigned long)stats.faces, bytes.size(), std::max<size_t>(1, info.chunks.size()), runs);
@@ -137,47 +162,59 @@ int speed(int runs, int bits, uint32_t chunks, const char* path) {
     };
     line("encode", encode_time, encode_cpu, encode_ratio);
     line("decode", decode_time, decode_cpu, decode_ratio);
-    std::printf("  minor page faults per decode: 1 thread %.0f [%.0f - %.0f], 2 threads %.0f [%.0f - %.0f] (median [min - max])\n",
-                range_of(decode_faults[0]).median, range_of(decode_faults[0]).low, range_of(decode_faults[0]).high,
-                range_of(decode_faults[1]).median, range_of(decode_faults[1]).low, range_of(decode_faults[1]).high);
+    line("decode through a DecodeContext", kept_time, kept_cpu, kept_ratio);
+    auto faults_line = [](const char* what, std::vector<double>* faults) {
+        const Range one = range_of(faults[0]), two = range_of(faults[1]);
+        std::printf("  minor page faults per %s: 1 thread %.0f [%.0f - %.0f], 2 threads %.0f [%.0f - %.0f] (median [min - max])\n",
+                    what, one.median, one.low, one.high, two.median, two.low, two.high);
+    };
+    faults_line("decode", decode_faults);
+    faults_line("decode through a DecodeContext", kept_faults);
     return 0;
 }
 
-// Decodes only, RUNS pairs of a 1- and a 2-thread decode, each after a pause of 0.2 s: under a
-// real-time policy (chrt -f, so that other sessions' load does not take the cores) the pauses keep
-// the process within the kernel's real-time budget (95 % of each second by default), which would
-// otherwise stop it for tens of milliseconds in the middle of a run.
+// Decodes only, RUNS rounds of a 1- and a 2-thread decode without a context, then a 1- and a
+// 2-thread decode each through its own DecodeContext (kept from round to round), each after a
+// pause of 0.2 s: under a real-time policy (chrt -f, so that other sessions' load does not take
+// the cores) the pauses keep the process within the kernel's real-time budget (95 % of each
+// second by default), which would otherwise stop it for tens of milliseconds in the middle of a run.
 int decode_speed(int runs, int bits, const char* path) {
     const amc::Hierarchy h = amc::read_hierarchy(path);
     amc::EncodeOptions options;
     options.quantize_bits = bits;
     const std::vector<uint8_t> bytes = amc::encode(h, options);
     const amc::FileInfo info = amc::inspect(bytes.data(), bytes.size());
-    std::vector<double> wall[2], cpu[2], ratio, faults[2];
+    amc::DecodeContext contexts[2];
+    std::vector<double> wall[2][2], cpu[2][2], ratio[2], faults[2][2];
     for (int r = 0; r < runs; ++r) {
-        double seconds[2];
-        for (unsigned threads : {1u, 2u}) {
-            std::this_thread::sleep_for(std::chrono::milliseconds(200));
-            amc::DecodeOptions d;
-            d.threads = threads;
-            const double start = now(), cpu_start = cpu_seconds(), faults_start = minor_faults();
-            const amc::Hierarchy back = amc::decode(bytes.data(), bytes.size(), d);
-            seconds[threads - 1] = now() - start;
-            wall[threads - 1].push_back(seconds[threads - 1]);
-            cpu[threads - 1].push_back(cpu_seconds() - cpu_start);
-            faults[threads - 1].push_back(minor_faults() - faults_start);
-            if (back.node_count() != h.node_count()) return 1;
+        for (int kept : {0, 1}) {
+            double seconds[2];
+            for (unsigned threads : {1u, 2u}) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(200));
+                amc::DecodeOptions d;
+                d.threads = threads;
+                const double start = now(), cpu_start = cpu_seconds(), faults_start = minor_faults();
+                const amc::Hierarchy back = kept ? amc::decode(contexts[threads - 1], bytes.data(), bytes.size(), d)
+                                                 : amc::decode(bytes.data(), bytes.size(), d);
+                seconds[threads - 1] = now() - start;
+                wall[kept][threads - 1].push_back(seconds[threads - 1]);
+                cpu[kept][threads - 1].push_back(cpu_seconds() - cpu_start);
+                faults[kept][threads - 1].push_back(minor_faults() - faults_start);
+                if (back.node_count() != h.node_count()) return 1;
+            }
+            ratio[kept].push_back(seconds[0] / seconds[1]);
         }
-        ratio.push_back(seconds[0] / seconds[1]);
     }
-    const Range one = range_of(wall[0]), two = range_of(wall[1]), r = range_of(ratio);
-    const Range cpu_one = range_of(cpu[0]), cpu_two = range_of(cpu[1]);
-    std::printf("%s, %d bits: %zu bytes, %zu chunks, %d pairs of decodes: wall 1 thread %.4f [%.4f - %.4f] s, 2 threads %.4f "
-                "[%.4f - %.4f] s, speed-up per pair %.2f [%.2f - %.2f]; CPU 1 thread %.4f, 2 threads %.4f s; minor page faults 1 "
-                "thread %.0f, 2 threads %.0f (medians)\n",
-                name_of(path).c_str(), bits, bytes.size(), std::max<size_t>(1, info.chunks.size()), runs, one.median, one.low,
-                one.high, two.median, two.low, two.high, r.median, r.low, r.high, cpu_one.median, cpu_two.median,
-                median(faults[0]), median(faults[1]));
+    for (int kept : {0, 1}) {
+        const Range one = range_of(wall[kept][0]), two = range_of(wall[kept][1]), r = range_of(ratio[kept]);
+        std::printf("%s, %d bits, %s: %zu bytes, %zu chunks, %d pairs of decodes: wall 1 thread %.4f [%.4f - %.4f] s, 2 threads "
+                    "%.4f [%.4f - %.4f] s, speed-up per pair %.2f [%.2f - %.2f]; CPU 1 thread %.4f, 2 threads %.4f s; minor page "
+                    "faults 1 thread %.0f, 2 threads %.0f (medians)\n",
+                    name_of(path).c_str(), bits, kept ? "with a DecodeContext" : "no context", bytes.size(),
+                    std::max<size_t>(1, info.chunks.size()), runs, one.median, one.low, one.high, two.median, two.low, two.high,
+                    r.median, r.low, r.high, median(cpu[kept][0]), median(cpu[kept][1]), median(faults[kept][0]),
+                    median(faults[kept][1]));
+    }
     return 0;
 }
 
@@ -203,16 +240,63 @@ int repeat(const std::string& what, int runs, unsigned threads, int bits, const 
 
 }  // namespace
 
+// FNV-1a over every node's level, vertices, neighbours, neighbour edges, flags and children, then
+// every position's bits: two decodes that agree on it built the same hierarchy.
+uint64_t hierarchy_hash(const amc::Hierarchy& h) {
+    uint64_t hash = 14695981039346656037ull;
+    auto add = [&](const void* data, size_t size) {
+        for (size_t i = 0; i < size; ++i) hash = (hash ^ static_cast<const uint8_t*>(data)[i]) * 1099511628211ull;
+    };
+    for (amc::NodeId n = 0; n < h.node_capacity(); ++n) {
+        const int32_t level = h.is_alive(n) ? h.level(n) : -1;
+        add(&level, sizeof level);
+        if (level < 0) continue;
+        for (int i = 0; i < 3; ++i) {
+            const uint32_t words[3] = {h.vertex(n, i), h.neighbor(n, i), uint32_t(h.neighbor_edge(n, i))};
+            add(words, sizeof words);
+        }
+        const uint32_t more[3] = {uint32_t(h.is_leaf(n) ? amc::kNoNode : h.child(n, 0)), uint32_t(h.diagonal_flipped(n)),
+                                  uint32_t(h.is_boundary_edge(n, 0) | h.is_boundary_edge(n, 1) << 1 | h.is_boundary_edge(n, 2) << 2)};
+        add(more, sizeof more);
+    }
+    add(h.positions().data(), h.positions().size() * sizeof(amc::Vec3));
+    return hash;
+}
+
+int decode_file(int runs, unsigned threads, bool kept, const char* path) {
+    std::ifstream in(path, std::ios::binary);
+    const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    amc::DecodeOptions d;
+    d.threads = threads;
+    amc::DecodeContext context;
+    uint64_t hash = 0;
+    for (int r = 0; r < runs; ++r) {
+        const uint64_t h = hierarchy_hash(kept ? amc::decode(context, bytes.data(), bytes.size(), d)
+                                               : amc::decode(bytes.data(), bytes.size(), d));
+        if (r > 0 && h != hash) {
+            std::fprintf(stderr, "%s: decode %d built another hierarchy\n", path, r + 1);
+            return 1;
+        }
+        hash = h;
+    }
+    std::printf("%s: %d decodes on %u threads%s, hierarchy FNV-1a %016llx\n", name_of(path).c_str(), runs, threads,
+                kept ? " through one DecodeContext" : "", (unsigned long long)hash);
+    return 0;
+}
+
 int main(int argc, char** argv) {
     const std::string mode = argc > 1 ? argv[1] : "";
     if (mode == "sizes" && argc >= 4) return sizes(std::atoi(argv[2]), argc - 3, argv + 3);
     if (mode == "speed" && argc == 6)
         return speed(std::max(1, std::atoi(argv[2])), std::atoi(argv[3]), uint32_t(std::atoi(argv[4])), argv[5]);
     if (mode == "decode-speed" && argc == 5) return decode_speed(std::max(1, std::atoi(argv[2])), std::atoi(argv[3]), argv[4]);
+    if (mode == "decode-file" && (argc == 5 || (argc == 6 && std::string(argv[4]) == "context")))
+        return decode_file(std::max(1, std::atoi(argv[2])), unsigned(std::atoi(argv[3])), argc == 6, argv[argc - 1]);
     if (mode == "repeat" && argc == 7 && (std::string(argv[2]) == "encode" || std::string(argv[2]) == "decode"))
         return repeat(argv[2], std::max(1, std::atoi(argv[3])), unsigned(std::atoi(argv[4])), std::atoi(argv[5]), argv[6]);
     std::fprintf(stderr, "usage: chunks_bench sizes BITS model.amh ...\n       chunks_bench speed RUNS BITS CHUNKS model.amh\n"
                          "       chunks_bench decode-speed RUNS BITS model.amh\n"
+                         "       chunks_bench decode-file RUNS THREADS [context] file.amc\n"
                          "       chunks_bench repeat encode|decode RUNS THREADS BITS model.amh\n");
     return 2;
 }

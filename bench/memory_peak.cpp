@@ -7,6 +7,10 @@
 //                                                   PREFIX.drc (Draco's default speed 5; BITS 0:
 //                                                   positions as they are)
 //   memory_peak decode-amc PREFIX.amc THREADS      decode() of the file (read into memory first)
+//   memory_peak decode-amc-context PREFIX.amc THREADS
+//                                                  the second decode() of the file through one
+//                                                  DecodeContext: the step starts with the memory
+//                                                  the context kept from the first (printed too)
 //   memory_peak decode-draco PREFIX.drc            Draco's DecodeMeshFromBuffer of the file
 //   memory_peak encode-amc BITS THREADS model.amh  encode() of the hierarchy
 //   memory_peak encode-draco BITS model.amh        Draco's EncodeMeshToBuffer of the leaf mesh
@@ -82,6 +86,23 @@ int main(int argc, char** argv) {
         const uint64_t faces = amc::inspect(data, bytes.size()).faces;
         return measure("decode amc", [&](uint64_t& nodes, uint64_t& face_count) {
             h = amc::decode(data, bytes.size(), options);
+            nodes = h.node_count();
+            face_count = faces;
+        });
+    }
+    if (mode == "decode-amc-context" && argc == 4) {
+        const std::vector<char> bytes = read_exact(argv[2]);
+        amc::DecodeOptions options;
+        options.threads = unsigned(std::atoi(argv[3]));
+        const uint8_t* data = reinterpret_cast<const uint8_t*>(bytes.data());
+        const uint64_t faces = amc::inspect(data, bytes.size()).faces;
+        amc::DecodeContext context;
+        const double without = status_mib("VmRSS");
+        amc::decode(context, data, bytes.size(), options);  // the result freed: what stays is the context's
+        std::printf("kept by the context after a decode: %.1f MiB\n", status_mib("VmRSS") - without);
+        amc::Hierarchy h;
+        return measure("decode amc through the context", [&](uint64_t& nodes, uint64_t& face_count) {
+            h = amc::decode(context, data, bytes.size(), options);
             nodes = h.node_count();
             face_count = faces;
         });

@@ -378,5 +378,64 @@ TEST(Chunks, CraftedVertexCountsAreClearErrors) {
     }
 }
 
+// `bytes` with the payload byte in the middle of its last chunk block changed and the checksums
+// made right again: a chunk whose decoder stops in the middle of a level, or decodes garbage.
+std::vector<uint8_t> with_last_chunk_changed(const std::vector<uint8_t>& bytes) {
+    BlockReader reader(bytes.data(), bytes.size());
+    BlockWriter writer(reader.version(), reader.flags());
+    std::vector<std::pair<BlockType, std::vector<uint8_t>>> blocks;
+    Block block;
+    while (reader.next(block) && block.type != BlockType::end)
+        blocks.emplace_back(block.type, std::vector<uint8_t>(block.payload, block.payload + block.size));
+    for (size_t i = blocks.size(); i-- > 0;)
+        if (blocks[i].first == BlockType::chunk) {
+            blocks[i].second[blocks[i].second.size() / 2] ^= 0x5a;
+            break;
+        }
+    for (const auto& b : blocks) writer.add(b.first, b.second);
+    return writer.finish();
+}
+
+// A DecodeContext's decoders keep their working memory, and any state a restart forgot, from one
+// decode to the next: files of other sizes, chunk counts and geometry modes, with corrupt ones
+// in between, must still decode exactly as without a context, on every thread count.
+TEST(Chunks, DecodesThroughAContextAreThoseWithoutOne) {
+    std::vector<std::vector<uint8_t>> files;
+    for (uint64_t seed = 200; seed < 212; ++seed) {
+        EncodeOptions options = with_chunks(2 + uint32_t(seed % 4), 1, seed % 3 == 1 ? 12 : 0);
+        options.grid_contexts = seed % 2 == 0;
+        options.unit_normals = seed % 4 == 2;
+        files.push_back(encode(random_hierarchy(seed, seed % 5 == 0), options));
+    }
+    for (unsigned threads : {1u, 2u, 3u}) {
+        const DecodeOptions options{-1, 1ull << 26, threads};
+        DecodeContext context;
+        int failed = 0;
+        for (int pass = 0; pass < 2; ++pass) {
+            for (size_t f = 0; f < files.size(); ++f) {
+                const std::vector<uint8_t>& bytes = files[f];
+                SCOPED_TRACE("file " + std::to_string(f) + ", " + std::to_string(threads) + " threads, pass " + std::to_string(pass));
+                ASSERT_GT(inspect(bytes.data(), bytes.size()).chunks.size(), 1u);
+                EXPECT_TRUE(same_ids(decode(context, bytes.data(), bytes.size(), options),
+                                     decode(bytes.data(), bytes.size(), DecodeOptions{-1, 1ull << 26, 1})));
+                const std::vector<uint8_t> corrupt = with_last_chunk_changed(bytes);
+                const DecodeResult without = try_decode(corrupt.data(), corrupt.size(), options);
+                try {
+                    const Hierarchy h = decode(context, corrupt.data(), corrupt.size(), options);
+                    EXPECT_TRUE(without.ok && same_ids(h, without.hierarchy));
+                } catch (const Error& e) {
+                    EXPECT_EQ(std::string(e.what()), without.error);
+                    ++failed;
+                }
+            }
+            if (pass == 0) context.release();
+        }
+        EXPECT_GT(failed, 0);
+        DecodeContext moved = std::move(context);
+        EXPECT_TRUE(same_ids(decode(moved, files[0].data(), files[0].size(), options), decode(files[0].data(), files[0].size())));
+        EXPECT_TRUE(same_ids(decode(context, files[1].data(), files[1].size(), options), decode(files[1].data(), files[1].size())));
+    }
+}
+
 }  // namespace
 }  // namespace amc

@@ -3,6 +3,7 @@
 // property test over random hierarchies, corrupted in every way the public API allows, with
 // positions anywhere in the double range, float32 and float64, quantized or not; and the known
 // cases one by one.
+#include "coding/base/base_stage.h"
 #include "coding/hierarchy/coder_switches.h"
 #include "coding/geometry/float_coder.h"
 #include "hierarchy_checks.h"
@@ -417,6 +418,51 @@ TEST(EncodeDecode, NodeLimitMessageSaysHowToRaiseIt) {
                        "DecodeOptions::max_nodes)");
     small.max_nodes = 420;
     EXPECT_TRUE(try_decode(bytes.data(), bytes.size(), small).ok);
+}
+
+// One chunk is coded from the input read in the base coder's order (TurnedRoots); an input with
+// free ids is reordered into a copy first. Both ways give the same bytes: the same forest with
+// free ids, and compacted without them (reorder_base with the identity orders), encoded at 12
+// bits and bit-exact. The fixture meshes flip diagonals at random; the torus follows a rule of
+// absolute local indices, which the base coder's rotations would break, so its roots keep the
+// input's order (Codec.DiagonalRulesOfAbsoluteLocalIndicesStayCheap).
+TEST(EncodeDecode, InputReadInBaseOrderCodesAsItsReorderedCopy) {
+    Random random{29};
+    auto meshes = testing::fixture_meshes();
+    meshes.push_back({"torus by rule", make_torus(4, 3, 2.0, 0.7)});
+    int cases = 0, kept_rotations = 0;
+    for (const auto& [name, mesh] : meshes) {
+        const bool by_rule = name == "torus by rule";
+        Hierarchy h(mesh);
+        refine_randomly(h, h.root_count() + (by_rule ? 3000 : 300), by_rule ? 5 : 4, 7);
+        for (NodeId n = 0; n < h.node_capacity(); ++n)
+            if (h.is_alive(n) && !h.is_leaf(n) && h.level(n) >= 2 && random.next() % 8 == 0) h.coarsen(n);
+        for (NodeId n : h.leaves()) {
+            if (h.hanging_node_count(n) != 2) continue;
+            const int unrefined = !h.has_hanging_node(n, 0) ? 0 : !h.has_hanging_node(n, 1) ? 1 : 2;
+            h.set_diagonal_flipped(n, by_rule ? diagonal_flag_by_rule(DiagonalRule::lower_local_index, unrefined)
+                                              : random.next() % 3 == 0);
+        }
+        ASSERT_LT(h.node_count(), h.node_capacity()) << name << ": nothing coarsened, no free ids";
+        std::vector<uint32_t> vertex_order(h.base().positions.size()), triangle_order(h.root_count());
+        for (uint32_t i = 0; i < vertex_order.size(); ++i) vertex_order[i] = i;
+        for (uint32_t i = 0; i < triangle_order.size(); ++i) triangle_order[i] = i;
+        const Hierarchy compact = reorder_base(h, vertex_order, triangle_order, std::vector<uint8_t>(triangle_order.size(), 0));
+        ASSERT_EQ(compact.node_count(), compact.node_capacity()) << name;
+        kept_rotations += base_code_order(compact, base_code_of(compact, nullptr, EncodeOptions())).keep_rotations;
+        for (int bits : {12, 0}) {
+            // Also with leaves enough for two chunks but faces for one (counted before the order).
+            for (uint64_t chunk_faces : {EncodeOptions().chunk_faces, uint64_t(h.leaf_count()) + 1}) {
+                EncodeOptions options;
+                options.quantize_bits = bits;
+                options.chunk_faces = chunk_faces;
+                EXPECT_EQ(encode(h, options), encode(compact, options)) << name << ", " << bits << " bits, " << chunk_faces;
+                ++cases;
+            }
+        }
+    }
+    EXPECT_GE(cases, 16);
+    EXPECT_EQ(kept_rotations, 1);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <amc/numbering.h>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -147,6 +148,30 @@ struct DecodeOptions {
 // extract_leaf_mesh of the result); it is left empty otherwise, and always when max_level cuts
 // the decoding short (a numbering describes the whole leaf mesh).
 Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options = {},
+                 LeafNumbering* numbering = nullptr);
+
+// Working memory that decodes through it keep for the next one, as zstd's ZSTD_DCtx: the chunk
+// decoders of every thread a decode of a chunked file used (about 15 bytes a node of the largest
+// chunk each), kept after the decode returns until release() or the context's end, so that the
+// next decode does not allocate and fault them in again (a new worker thread's memory is fresh
+// at every decode). decode() without a context keeps nothing. A context serves one decode at a
+// time; the results are those of decode() without it.
+class DecodeContext {
+public:
+    DecodeContext();
+    ~DecodeContext();
+    DecodeContext(DecodeContext&&) noexcept;
+    DecodeContext& operator=(DecodeContext&&) noexcept;
+    DecodeContext(const DecodeContext&) = delete;
+    DecodeContext& operator=(const DecodeContext&) = delete;
+    void release();  // frees the kept memory (the next decode allocates it again)
+
+private:
+    struct Kept;
+    std::unique_ptr<Kept> kept_;
+    friend Hierarchy decode(DecodeContext&, const uint8_t*, size_t, const DecodeOptions&, LeafNumbering*);
+};
+Hierarchy decode(DecodeContext& context, const uint8_t* data, size_t size, const DecodeOptions& options = {},
                  LeafNumbering* numbering = nullptr);
 
 // The same without exceptions, for callers that prefer status values.

@@ -165,12 +165,13 @@ struct ForestCode {
     EncodeStats stats;  // header (the chunk table), hierarchy, geometry and framing bytes, levels, hierarchy
 };
 
-// Codes the forest of `h` (decoder base order, positions as the decoder will have them) in
-// `chunks`; `faces` is the leaf face count when there are several. `positions` holds the models as
+// Codes the forest of `h` (decoder base order, or h read in it by `first_pass`, the one chunk's
+// hierarchy coder made over TurnedRoots; positions as the decoder will have them) in `chunks`;
+// `faces` is the leaf face count when there are several. `positions` holds the models as
 // the base geometry left them. The mixing mode (FORMAT.md 2.1) codes the forest as one stream.
 ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<RootRange>& chunks, uint64_t faces,
                        const EncodeOptions& options, CoordinateSpace space, PositionCoder positions, unsigned threads,
-                       bool want_hierarchy_stats) {
+                       bool want_hierarchy_stats, HierarchyLevelEncoder* first_pass) {
     ForestCode out;
     const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
     out.chunked = !mixed && chunks.size() > 1;
@@ -183,7 +184,10 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
         out.levels = uint64_t(parts.levels);  // the deepest chunk's: the forest's
         out.blocks = std::move(parts.blocks);
     } else {
-        HierarchyLevelEncoder hierarchy(h, options.hierarchy, kHierarchyStreamVersion, nullptr, mixed);
+        std::unique_ptr<HierarchyLevelEncoder> own;
+        if (first_pass == nullptr)
+            own = std::make_unique<HierarchyLevelEncoder>(h, options.hierarchy, kHierarchyStreamVersion, nullptr, mixed);
+        HierarchyLevelEncoder& hierarchy = first_pass != nullptr ? *first_pass : *own;
         out.faces = hierarchy.faces();
         out.levels = uint64_t(hierarchy.level_count());
         out.hierarchy_header = hierarchy.header();
@@ -222,30 +226,75 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     if (quantized) quantizer = quantizer_of(input, options.quantize_bits, threads);
     const CoordinateSpace space{precision, quantized ? &quantizer : nullptr};
 
-    // II-B: code the base mesh first and express the forest in the decoder's base order.
+    const bool automatic = options.chunk_roots.empty() && options.chunks == 0;
+    // A leaf has at most four faces (itself and three hanging nodes): fewer than two chunks' faces,
+    // so one chunk (chunk_count_for), known without the passes over the nodes that count faces and
+    // nodes per root.
+    const bool few_leaves = automatic && uint64_t(input.leaf_count()) * 2 < std::max<uint64_t>(1, options.chunk_faces);
+    const bool one_chunk_asked = options.chunk_roots.empty() ? options.chunks == 1 || few_leaves : options.chunk_roots.size() == 1;
+    // Leaf faces do not depend on the order: counted on the input, so that automatic chunks of
+    // fewer faces than two chunks' are known to be one before the order is chosen.
+    const uint64_t faces = one_chunk_asked ? 0 : leaf_face_count(input, threads);
+    const bool one_chunk = one_chunk_asked || (automatic && chunk_count_for(options, faces) == 1);
+    const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
+
+    // II-B: code the base mesh first and express the forest in the decoder's base order. One chunk
+    // is coded from the input read in that order (TurnedRoots): reorder_base's copy was a quarter
+    // of a 10^5-face encode. Chunks are cut from the reordered copy, and a numbering is mapped
+    // through it; a forest with free ids (none after reading a file) is copied too.
     const BaseMeshCode base_code = base_code_of(input, space.quantizer, options);
-    ReorderedInput reordered = in_base_code_order(input, base_code, options.numbering != nullptr, threads);
-    Hierarchy& h = reordered.hierarchy;
-    const bool store_numbering = options.numbering != nullptr && options.store_numbering;
-    if (options.numbering != nullptr)
-        stats.numbering = numbering_after_reorder(input, *options.numbering, h, reordered.vertex_map);
-    if (quantized) {
-        h.set_single_precision(false);
-        stats.max_error = snap_positions(h, quantizer, threads);  // h holds exactly the input's live positions
+    const bool turned_input = one_chunk && !mixed && options.numbering == nullptr && input.node_count() == input.node_capacity() &&
+                              input.vertex_count() == input.positions().size();
+    ReorderedInput reordered;  // the whole in base code order, or with turned_input its base alone
+    BaseCodeOrder order;
+    Hierarchy snapped;  // with turned_input and quantized: the input on the grid
+    const TurnedRoots turned{&reordered.hierarchy, &base_code.triangle_order, &order.rotation};
+    std::unique_ptr<HierarchyLevelEncoder> first_pass;  // with turned_input: the hierarchy coder's
+    if (turned_input) {
+        if (quantized) {
+            snapped = input;
+            snapped.set_single_precision(false);
+            stats.max_error = snap_positions(snapped, quantizer, threads);  // every id is live
+        }
+        // The first pass reads the forest turned by the base coder's rotations and tallies the
+        // diagonal flags both ways (base_code_order's choice); when the roots keep the input's
+        // order instead (a rule of absolute local indices), it runs again unturned.
+        auto read_in_order = [&](bool keep_rotations) {
+            order = base_code_order(base_code, keep_rotations);
+            reordered.keep_rotations = keep_rotations;
+            std::vector<uint32_t> base_vertex_id;
+            TriangleMesh base = HierarchyBuilder::reordered_base_mesh(input.base(), base_code.vertex_order,
+                                                                      base_code.triangle_order, order.rotation, base_vertex_id);
+            if (quantized) {
+                const GridSnap snap(quantizer);
+                for (Vec3& p : base.positions) p = dequantize(quantizer, snap(p));
+            }
+            reordered.hierarchy = Hierarchy(std::move(base));
+            if (quantized) reordered.hierarchy.set_single_precision(false);
+            first_pass = std::make_unique<HierarchyLevelEncoder>(input, options.hierarchy, kHierarchyStreamVersion, nullptr,
+                                                                 false, &turned);
+        };
+        read_in_order(false);
+        if (keeps_rotations(first_pass->diagonal_exceptions(), first_pass->unturned_diagonal_exceptions(),
+                            base_code.triangle_order.size()))
+            read_in_order(true);
+    } else {
+        reordered = in_base_code_order(input, base_code, options.numbering != nullptr, threads);
+        if (options.numbering != nullptr)
+            stats.numbering = numbering_after_reorder(input, *options.numbering, reordered.hierarchy, reordered.vertex_map);
+        if (quantized) {
+            reordered.hierarchy.set_single_precision(false);
+            stats.max_error = snap_positions(reordered.hierarchy, quantizer, threads);  // it holds exactly the input's live positions
+        }
     }
+    const Hierarchy& h = !turned_input ? reordered.hierarchy : quantized ? snapped : input;
+    const bool store_numbering = options.numbering != nullptr && options.store_numbering;
 
     // The forest (FORMAT.md 3.6, 3.11), after the base geometry, whose adaptive models the level
     // blocks go on with. Chunks the caller leaves to the encoder are tried first at chunk_faces
     // faces each, then fewer if that code is too small for them (chunk_policy.h).
     PositionCoder positions(space);
-    std::vector<uint8_t> base_geometry = encode_base_geometry(h, base_code, reordered.keep_rotations, positions);
-    const bool automatic = options.chunk_roots.empty() && options.chunks == 0;
-    // A leaf has at most four faces (itself and three hanging nodes): fewer than two chunks' faces,
-    // so one chunk (chunk_count_for), known without the passes over the nodes that count faces and
-    // nodes per root.
-    const bool few_leaves = automatic && uint64_t(h.leaf_count()) * 2 < std::max<uint64_t>(1, options.chunk_faces);
-    const bool one_chunk = options.chunk_roots.empty() ? options.chunks == 1 || few_leaves : options.chunk_roots.size() == 1;
-    const uint64_t faces = one_chunk ? 0 : leaf_face_count(h, threads);
+    std::vector<uint8_t> base_geometry = encode_base_geometry(reordered.hierarchy, base_code, reordered.keep_rotations, positions);
     const std::vector<uint32_t> root_of = one_chunk ? std::vector<uint32_t>() : root_of_nodes(h);
     const std::vector<uint64_t> root_nodes =
         options.chunk_roots.empty() && !one_chunk ? nodes_per_root(h, root_of) : std::vector<uint64_t>();
@@ -253,12 +302,13 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
                                           : one_chunk ? std::vector<RootRange>{RootRange{0, h.root_count()}}
                                                       : balanced_chunks(root_nodes, chunk_count_for(options, faces));
     const bool want_hierarchy_stats = stats_out != nullptr && options.hierarchy_statistics;
-    ForestCode forest = code_forest(h, root_of, chunks, faces, options, space, positions, threads, want_hierarchy_stats);
+    ForestCode forest = code_forest(h, root_of, chunks, faces, options, space, positions, threads, want_hierarchy_stats,
+                                    first_pass.get());
     const uint32_t fewer = automatic && forest.chunked ? chunk_count_for_size(options, uint32_t(chunks.size()), forest.bytes)
                                                        : uint32_t(chunks.size());
     if (fewer < chunks.size())
         forest = code_forest(h, root_of, balanced_chunks(root_nodes, fewer), faces, options, space, positions, threads,
-                             want_hierarchy_stats);
+                             want_hierarchy_stats, nullptr);
 
     Metadata meta;
     meta.base_vertices = h.base().positions.size();
@@ -269,7 +319,6 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     meta.levels = forest.levels;
     meta.hierarchy_header = forest.hierarchy_header;
     meta.quantizer = quantizer;
-    const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
     meta.options = (reordered.keep_rotations ? kOptionRootRotations : 0) | (forest.chunked ? kOptionChunked : 0) |
                    (mixed ? kOptionMixedContexts : 0);
 
@@ -329,7 +378,8 @@ struct ChunkRequest {
 // block, if any, and END.
 Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const TriangleMesh& base, CoordinateSpace space,
                               const DecodeOptions& options, LeafNumbering* numbering, PartialProgress* partial,
-                              const ChunkRequest* request, std::future<std::vector<Vec3>>* zeroed_positions) {
+                              const ChunkRequest* request, std::future<std::vector<Vec3>>* zeroed_positions,
+                              ChunkDecoders* kept_decoders) {
     AMC_REQUIRE(reader.version() >= kChunkedVersion, corrupt, "metadata block: chunks in a version-" + std::to_string(reader.version()) + " file");
     if (partial != nullptr) {
         partial->levels_in_file = int(meta.levels);
@@ -340,7 +390,7 @@ Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const T
         while (!complete && probe.next_block_arrived() && probe.next(block)) complete = block.type == BlockType::end;
         if (!complete) return Hierarchy(base);
     }
-    const ChunkedDecodeInput input{&base, space, reader.version(), meta.vertices, options, zeroed_positions};
+    const ChunkedDecodeInput input{&base, space, reader.version(), meta.vertices, options, zeroed_positions, kept_decoders};
     ChunkTable table;
     MergedCounts counts;
     Hierarchy h = decode_chunked(reader, input, meta.nodes, request != nullptr ? &request->chunks : nullptr, &table, &counts);
@@ -375,7 +425,8 @@ Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const T
 }
 
 Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& options, LeafNumbering* numbering,
-                      PartialProgress* partial = nullptr, const ChunkRequest* request = nullptr) {
+                      PartialProgress* partial = nullptr, const ChunkRequest* request = nullptr,
+                      ChunkDecoders* kept_decoders = nullptr) {
     if (numbering != nullptr) *numbering = {};
     AMC_REQUIRE(data != nullptr || size == 0, invalid_input, "no data");
     BlockReader reader(data, size);
@@ -410,7 +461,8 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     AMC_REQUIRE(!((meta.options & kOptionMixedContexts) && (meta.options & kOptionChunked)), corrupt,
                 "metadata block: mixed hierarchy contexts in a chunked file");
     if (meta.options & kOptionChunked)
-        return decode_chunked_file(reader, meta, base, space, options, numbering, partial, request, &zeroed_positions);
+        return decode_chunked_file(reader, meta, base, space, options, numbering, partial, request, &zeroed_positions,
+                                   kept_decoders);
     if (request != nullptr) {  // a file without chunks is one chunk
         AMC_REQUIRE(request->chunks.size() == 1 && request->chunks[0] == 0, invalid_input,
                     "the file has no chunks: only chunk 0, the whole file, can be decoded");
@@ -492,6 +544,29 @@ Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options,
     // Decoders build only what balance and closure allow, and the amc_decode fuzz target holds
     // every decoded hierarchy to check_invariants: writers need not walk it again.
     HierarchyBuilder::mark_structure_checked(h);
+    return h;
+}
+
+struct DecodeContext::Kept {
+    ChunkDecoders chunk_decoders;
+};
+
+DecodeContext::DecodeContext() : kept_(std::make_unique<Kept>()) {}
+DecodeContext::~DecodeContext() = default;
+DecodeContext::DecodeContext(DecodeContext&&) noexcept = default;
+DecodeContext& DecodeContext::operator=(DecodeContext&&) noexcept = default;
+
+void DecodeContext::release() {
+    if (kept_ != nullptr) kept_->chunk_decoders.clear();
+}
+
+Hierarchy decode(DecodeContext& context, const uint8_t* data, size_t size, const DecodeOptions& options,
+                 LeafNumbering* numbering) {
+    if (context.kept_ == nullptr) context.kept_ = std::make_unique<DecodeContext::Kept>();  // moved from
+    ChunkDecoders* kept = &context.kept_->chunk_decoders;
+    Hierarchy h = with_allocation_errors_as_limits(
+        "decode", [&] { return decode_file(data, size, options, numbering, nullptr, nullptr, kept); });
+    HierarchyBuilder::mark_structure_checked(h);  // as decode without a context
     return h;
 }
 

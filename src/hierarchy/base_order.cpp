@@ -29,11 +29,18 @@ Hierarchy reorder_base(const Hierarchy& h, const std::vector<uint32_t>& vertex_o
 Hierarchy HierarchyBuilder::reorder_base(const Hierarchy& h, const std::vector<uint32_t>& vertex_order,
                                          const std::vector<uint32_t>& triangle_order, const std::vector<uint8_t>& rotation,
                                          std::vector<VertexId>* vertex_map, unsigned threads) {
-    const TriangleMesh& old_base = h.base();
+    std::vector<uint32_t> new_id;
+    TriangleMesh base = reordered_base_mesh(h.base(), vertex_order, triangle_order, rotation, new_id);
+    return reordered(h, std::move(base), triangle_order, rotation, new_id, vertex_map, threads);
+}
+
+TriangleMesh HierarchyBuilder::reordered_base_mesh(const TriangleMesh& old_base, const std::vector<uint32_t>& vertex_order,
+                                                   const std::vector<uint32_t>& triangle_order,
+                                                   const std::vector<uint8_t>& rotation, std::vector<uint32_t>& new_id) {
     if (vertex_order.size() != old_base.positions.size() || triangle_order.size() != old_base.triangles.size() ||
         rotation.size() != triangle_order.size())
         throw Error("reorder_base: orders do not match the base mesh");
-    std::vector<uint32_t> new_id(vertex_order.size(), kNoVertex);
+    new_id.assign(vertex_order.size(), kNoVertex);
     for (uint32_t i = 0; i < vertex_order.size(); ++i) {
         if (vertex_order[i] >= new_id.size() || new_id[vertex_order[i]] != kNoVertex)
             throw Error("reorder_base: vertex order is not a permutation");
@@ -51,8 +58,7 @@ Hierarchy HierarchyBuilder::reorder_base(const Hierarchy& h, const std::vector<u
         seen[o] = 1;
         for (int i = 0; i < 3; ++i) base.triangles[t][i] = new_id[old_base.triangles[o][(i + rotation[t]) % 3]];
     }
-
-    return reordered(h, std::move(base), triangle_order, rotation, new_id, vertex_map, threads);
+    return base;
 }
 
 // What replaying the forest breadth-first with split() gives (each node's children in the rotated

@@ -123,6 +123,12 @@ struct HierarchyBuilder {
     static Hierarchy reorder_base(const Hierarchy& h, const std::vector<uint32_t>& vertex_order,
                                   const std::vector<uint32_t>& triangle_order, const std::vector<uint8_t>& rotation,
                                   std::vector<VertexId>* vertex_map, unsigned threads);
+    // Its base mesh: vertex i is old vertex vertex_order[i] (new_id receives the inverse), triangle
+    // t old triangle triangle_order[t] turned by rotation[t]. Throws Error when the orders are not
+    // permutations of the base's.
+    static TriangleMesh reordered_base_mesh(const TriangleMesh& old_base, const std::vector<uint32_t>& vertex_order,
+                                            const std::vector<uint32_t>& triangle_order, const std::vector<uint8_t>& rotation,
+                                            std::vector<uint32_t>& new_id);
     // Its work once the orders are checked: the result over `base` (the reordered base mesh), old
     // base vertex v being base_vertex_id[v].
     static Hierarchy reordered(const Hierarchy& h, TriangleMesh base, const std::vector<uint32_t>& triangle_order,

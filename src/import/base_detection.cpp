@@ -3,6 +3,9 @@
 #include "common/no_index.h"
 #include "import/inverse_refinement.h"
 
+#include <algorithm>
+#include <array>
+#include <map>
 #include <utility>
 #include <vector>
 
@@ -63,10 +66,104 @@ std::vector<uint32_t> breadth_first_vertices(const std::vector<Triangle>& triang
     return order;
 }
 
+// One run of the search: the levels it undid and, per level, what the next step needs (the
+// refined and changed triangles) and the blockers its step reported.
+struct SearchRun {
+    std::vector<DetectedLevel> levels;
+    std::vector<std::vector<uint8_t>> refined, changed;
+    std::vector<std::vector<Triangle>> blockers;
+};
+
 void renumber(std::vector<Triangle>& triangles, const std::vector<uint32_t>& id) {
     for (Triangle& t : triangles) {
         for (uint32_t& v : t) v = id[v];
     }
+}
+
+// The levels undone from step `from` on, the earlier ones of `run` standing; in step s the
+// vertices marked in kept[s] (if any) stay.
+void undo_levels_from(const std::vector<Triangle>& triangles, uint32_t vertex_count, size_t from,
+                      const std::vector<std::vector<uint8_t>>& kept, SearchRun& run) {
+    run.levels.resize(from);
+    run.refined.resize(from);
+    run.changed.resize(from);
+    run.blockers.resize(from);
+    const std::vector<uint8_t> unrefined(triangles.size(), 0);
+    // Each level undone adds one to the depth of the hierarchy, which kMaxLevel caps.
+    while (run.levels.size() < size_t(kMaxLevel)) {
+        const size_t s = run.levels.size();
+        const bool has_kept = s < kept.size() && !kept[s].empty();
+        detail::CoarserLevel coarser = detail::undo_refinement_level(
+            s == 0 ? triangles : run.levels[s - 1].triangles, s == 0 ? unrefined : run.refined[s - 1], vertex_count,
+            s == 0 ? nullptr : &run.changed[s - 1], has_kept ? &kept[s] : nullptr);
+        if (coarser.red_blocks == 0) break;
+        DetectedLevel level;
+        level.splits = std::move(coarser.splits);
+        level.closures = coarser.green_groups;
+        level.triangles = std::move(coarser.triangles);
+        run.levels.push_back(std::move(level));
+        run.refined.push_back(std::move(coarser.refined));
+        run.changed.push_back(std::move(coarser.changed));
+        run.blockers.push_back(std::move(coarser.blockers));
+    }
+}
+
+size_t base_size(const SearchRun& run, size_t leaf_triangles) {
+    return run.levels.empty() ? leaf_triangles : run.levels.back().triangles.size();
+}
+
+std::array<uint32_t, 3> vertex_set(uint32_t a, uint32_t b, uint32_t c) {
+    std::array<uint32_t, 3> key{a, b, c};
+    std::sort(key.begin(), key.end());
+    return key;
+}
+
+// The earliest step of `run` with a one-block patch (a split sharing no midpoint with the
+// step's other splits) whose parent a later step reported as a blocker, and in `kept` (per step,
+// empty or per vertex) the vertices that leave that step's such patches out: their midpoints,
+// kept from that step until the one that reported them (which needed the parent unrefined there,
+// most likely because they are hanging nodes of its patch). Returns false when there is none.
+bool wrong_single_blocks(const SearchRun& run, uint32_t vertex_count, size_t& step,
+                         std::vector<std::vector<uint8_t>>& kept) {
+    size_t reports = 0;
+    for (const auto& blockers : run.blockers) reports += blockers.size();
+    if (reports == 0) return false;
+    // Per parent (vertex set): the step and index of its split when that split is a one-block patch.
+    std::map<std::array<uint32_t, 3>, std::pair<size_t, size_t>> single;
+    std::vector<uint8_t> midpoint_uses(vertex_count, 0);
+    for (size_t s = 0; s < run.levels.size(); ++s) {
+        const auto& splits = run.levels[s].splits;
+        for (const auto& split : splits) {
+            for (int k = 3; k < 6; ++k) midpoint_uses[split[size_t(k)]] = uint8_t(std::min(2, midpoint_uses[split[size_t(k)]] + 1));
+        }
+        for (size_t i = 0; i < splits.size(); ++i) {
+            const auto& split = splits[i];
+            if (midpoint_uses[split[3]] == 1 && midpoint_uses[split[4]] == 1 && midpoint_uses[split[5]] == 1)
+                single[vertex_set(split[0], split[1], split[2])] = {s, i};
+        }
+        for (const auto& split : splits) {
+            for (int k = 3; k < 6; ++k) midpoint_uses[split[size_t(k)]] = 0;
+        }
+    }
+    // (step of the split, its index, step of the report)
+    std::vector<std::array<size_t, 3>> found;
+    for (size_t k = 0; k < run.blockers.size(); ++k) {
+        for (const Triangle& t : run.blockers[k]) {
+            const auto it = single.find(vertex_set(t[0], t[1], t[2]));
+            if (it != single.end() && it->second.first < k) found.push_back({it->second.first, it->second.second, k});
+        }
+    }
+    if (found.empty()) return false;
+    step = (*std::min_element(found.begin(), found.end()))[0];
+    for (const auto& [s, i, k] : found) {
+        if (s != step) continue;
+        for (size_t j = s; j < k; ++j) {
+            if (kept.size() <= j) kept.resize(j + 1);
+            if (kept[j].empty()) kept[j].assign(vertex_count, 0);
+            for (int m = 3; m < 6; ++m) kept[j][run.levels[s].splits[i][size_t(m)]] = 1;
+        }
+    }
+    return true;
 }
 
 }  // namespace
@@ -82,23 +179,24 @@ DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what) {
     for (uint32_t v = 0; v < vertex_count; ++v) search_of[input_of[v]] = v;
     std::vector<Triangle> renumbered = mesh.triangles;
     renumber(renumbered, search_of);
-    const std::vector<Triangle>* triangles = &renumbered;
-    std::vector<uint8_t> refined(mesh.triangles.size(), 0);
-    std::vector<uint8_t> changed;
-    // Each level undone adds one to the depth of the hierarchy, which kMaxLevel caps.
-    while (out.levels.size() < size_t(kMaxLevel)) {
-        detail::CoarserLevel coarser =
-            detail::undo_refinement_level(*triangles, refined, vertex_count, out.levels.empty() ? nullptr : &changed);
-        if (coarser.red_blocks == 0) break;
-        DetectedLevel level;
-        level.splits = std::move(coarser.splits);
-        level.closures = coarser.green_groups;
-        level.triangles = std::move(coarser.triangles);
-        refined = std::move(coarser.refined);
-        changed = std::move(coarser.changed);
-        out.levels.push_back(std::move(level));
-        triangles = &out.levels.back().triangles;
+    SearchRun run;
+    undo_levels_from(renumbered, vertex_count, 0, {}, run);
+    // A one-block patch can be a wrong reading that its step cannot tell from a true one; a later
+    // step then finds its parent in the way of a large patch. Such patches are left out and the
+    // search run again from their step, once; the run that ends at the coarser base stands
+    // (docs/IMPORT.md, "One-block patches taken back").
+    size_t step = 0;
+    std::vector<std::vector<uint8_t>> kept;
+    if (wrong_single_blocks(run, vertex_count, step, kept)) {
+        SearchRun trial;
+        trial.levels.assign(run.levels.begin(), run.levels.begin() + std::ptrdiff_t(step));
+        trial.refined.assign(run.refined.begin(), run.refined.begin() + std::ptrdiff_t(step));
+        trial.changed.assign(run.changed.begin(), run.changed.begin() + std::ptrdiff_t(step));
+        trial.blockers.assign(run.blockers.begin(), run.blockers.begin() + std::ptrdiff_t(step));
+        undo_levels_from(renumbered, vertex_count, step, kept, trial);
+        if (base_size(trial, renumbered.size()) < base_size(run, renumbered.size())) run = std::move(trial);
     }
+    out.levels = std::move(run.levels);
     for (DetectedLevel& level : out.levels) {
         renumber(level.triangles, input_of);
         for (auto& split : level.splits) {

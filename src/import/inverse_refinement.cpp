@@ -25,7 +25,11 @@ CoarserLevel undo_refinement_level(const std::vector<Triangle>& fine, const std:
     for (size_t id = 0; id < all; ++id) {
         if (finder.removed_by(id) < kLarge) small.push_back(id);
     }
-    if (small.empty()) return finder.coarser_level();
+    if (small.empty()) {
+        CoarserLevel out = finder.coarser_level();
+        out.blockers = finder.blockers();
+        return out;
+    }
     std::vector<uint32_t> parent_of_block;
     CoarserLevel trial = finder.coarser_level(&parent_of_block);
     LevelFinder next(trial.triangles, trial.refined, vertex_count, kept);
@@ -39,11 +43,16 @@ CoarserLevel undo_refinement_level(const std::vector<Triangle>& fine, const std:
         }
     }
     // Nothing confirmed and nothing large: the small patches are all there is (the top level).
-    if (all == small.size() && std::count(confirmed.begin(), confirmed.end(), 1) == 0) return trial;
+    if (all == small.size() && std::count(confirmed.begin(), confirmed.end(), 1) == 0) {
+        trial.blockers = finder.blockers();
+        return trial;
+    }
     for (size_t k = 0; k < small.size(); ++k) {
         if (!confirmed[k]) finder.release_patch(small[k]);
     }
-    return finder.coarser_level();
+    CoarserLevel out = finder.coarser_level();
+    out.blockers = finder.blockers();
+    return out;
 }
 
 }  // namespace amc::detail

@@ -31,6 +31,9 @@ struct CoarserLevel {
     uint32_t removed_vertices = 0;
     // Every undone split: its parent (v0, v1, v2) and midpoints (m0 on v0 -> v1, m1, m2).
     std::vector<std::array<uint32_t, 6>> splits;
+    // Refined triangles that stood in the way of a large patch (a side across them invalid):
+    // where an earlier step's small patch made them, that patch may be wrong.
+    std::vector<Triangle> blockers;
 };
 
 // `fine` is edge-manifold and consistently oriented over vertex ids below vertex_count;

@@ -27,6 +27,10 @@ constexpr uint32_t kSmallPatch = 16;
 // yet, which fails again at every step (docs/IMPORT.md, "Rivals of small patches bounded").
 constexpr uint32_t kImproved = 64;
 constexpr uint32_t kRivalGrowth = 256;
+// A growth of at least kBlockedGrowth blocks that fails on at most kFewInvalid: a true patch whose
+// invalid sides may run across the parent of an earlier step's wrong block (LevelFinder::blockers).
+constexpr uint32_t kBlockedGrowth = 256;
+constexpr size_t kFewInvalid = 4;
 
 }  // namespace
 
@@ -158,6 +162,15 @@ CoarserLevel LevelFinder::coarser_level(std::vector<uint32_t>* parent_of_block) 
     return out;
 }
 
+std::vector<Triangle> LevelFinder::blockers() const {
+    std::vector<uint32_t> sorted = blockers_;
+    std::sort(sorted.begin(), sorted.end(), [&](uint32_t a, uint32_t b) { return caller_of_[a] < caller_of_[b]; });
+    sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+    std::vector<Triangle> out;
+    for (uint32_t t : sorted) out.push_back(tri_[t]);
+    return out;
+}
+
 uint32_t LevelFinder::grow_patch(uint32_t t, Preference preference, bool exploring) {
     constexpr int kRepairs = 4;
     std::vector<uint32_t> banned, suspects;
@@ -231,9 +244,29 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
     for (uint32_t i = start; i < blocks_.size(); ++i) {
         if (sides_valid(i)) continue;
         invalid.push_back(i);
-        if (!repairable || invalid.size() * kRepairableShare > size) break;
+        const bool counting = repairable ? invalid.size() * kRepairableShare <= size
+                                         : size >= kBlockedGrowth && invalid.size() <= kFewInvalid;
+        if (!counting) break;
     }
     if (!invalid.empty()) {
+        // A large growth held by a few blocks: what refined triangles stood in their way.
+        if (size >= kBlockedGrowth && invalid.size() <= kFewInvalid) {
+            for (uint32_t i : invalid) {
+                for (int e = 0; e < 3; ++e) {
+                    if (classify(i, e).kind != Side::invalid) continue;
+                    const Fan& fan = blocks_[i].fan[size_t(e)];
+                    if (fan.kind != Fan::triangles) continue;
+                    for (int k = 0; k < fan.size; ++k) {
+                        const uint32_t g = fan.triangle[k];
+                        if (refined_[g]) blockers_.push_back(g);
+                        for (int f = 0; f < 3; ++f) {
+                            const uint32_t h = adjacency_.twin(3 * g + uint32_t(f));
+                            if (h != kNoHalfEdge && refined_[h / 3] && block_of_[h / 3] != i) blockers_.push_back(h / 3);
+                        }
+                    }
+                }
+            }
+        }
         if (repairable && invalid.size() * kRepairableShare <= size) collect_suspects(invalid, *suspects);
         roll_back(start);
         return 0;

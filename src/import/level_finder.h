@@ -127,6 +127,12 @@ public:
     // `parent_of_block` (if given) receives, per block, the index of its parent in the result.
     CoarserLevel coarser_level(std::vector<uint32_t>* parent_of_block = nullptr) const;
 
+    // The refined triangles beside the invalid sides of the large growths that failed on a few
+    // blocks (in the fans across those sides, or across their edges), in the caller's order: the
+    // parents of earlier steps' blocks that stood in the way (docs/IMPORT.md, "One-block patches
+    // taken back").
+    std::vector<Triangle> blockers() const;
+
 private:
     // ---- numbering -----------------------------------------------------------------------------
     // The caller's triangle indices ordered by each triangle's smallest vertex id: base
@@ -312,6 +318,7 @@ private:
     std::vector<Block> blocks_;
     std::vector<Patch> patches_;
     uint32_t growth_limit_ = kNoIndex;      // blocks: a growth larger than this is given up
+    std::vector<uint32_t> blockers_;        // see blockers()
 };
 
 }  // namespace amc::detail::inverse

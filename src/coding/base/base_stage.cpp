@@ -74,30 +74,39 @@ BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const 
     return encode_base_connectivity(base, resolve_thread_count(options.threads), base_search_budget(h));
 }
 
-// The base coder may rotate each triangle's vertices. The default diagonal rule does not care, but
-// hierarchies made under a rule of absolute local indices would pay orientation bits: then storing
-// each root's rotation (log2 3 bits) to keep the input's local order may be cheaper.
-// Both readings are tallied on the input, so the hierarchy is reordered once.
-ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& base_code, bool want_vertex_map,
-                                  unsigned threads) {
+bool keeps_rotations(const DiagonalExceptions& rotated, const DiagonalExceptions& unrotated, size_t triangles) {
+    if (rotated.fewest() == 0) return false;
+    const double rotated_bits = binary_entropy_bits(rotated.fewest(), rotated.leaves);
+    // Products rounded (exact_float.h): however it is compiled, the encoder makes the same choice.
+    const double kept_bits = binary_entropy_bits(unrotated.fewest(), unrotated.leaves) + rounded(kRotationBits * double(triangles));
+    return kept_bits < rotated_bits;
+}
+
+BaseCodeOrder base_code_order(const Hierarchy& input, const BaseMeshCode& base_code, unsigned threads) {
     std::vector<uint8_t> rotation_of_root(input.root_count(), 0);
     for (size_t t = 0; t < base_code.triangle_order.size() && t < base_code.triangle_rotation.size(); ++t)
         if (base_code.triangle_order[t] < rotation_of_root.size())
             rotation_of_root[base_code.triangle_order[t]] = base_code.triangle_rotation[t];
-    ReorderedInput r;
     const DiagonalExceptions rotated = diagonal_exceptions(input, rotation_of_root, threads);
-    if (rotated.fewest() != 0) {
-        // Without rotations every node keeps its local vertex order: the input's exceptions.
-        const DiagonalExceptions unrotated = diagonal_exceptions(input, threads);
-        const double rotated_bits = binary_entropy_bits(rotated.fewest(), rotated.leaves);
-        // Products rounded (exact_float.h): however it is compiled, the encoder makes the same choice.
-        const double kept_bits = binary_entropy_bits(unrotated.fewest(), unrotated.leaves) +
-                                 rounded(kRotationBits * double(base_code.triangle_order.size()));
-        r.keep_rotations = kept_bits < rotated_bits;
-    }
-    r.hierarchy = HierarchyBuilder::reorder_base(input, base_code.vertex_order, base_code.triangle_order,
-                                                 r.keep_rotations ? std::vector<uint8_t>(base_code.triangle_order.size(), 0)
-                                                                  : base_code.triangle_rotation,
+    // Without rotations every node keeps its local vertex order: the input's exceptions.
+    const bool keep = rotated.fewest() != 0 &&
+                      keeps_rotations(rotated, diagonal_exceptions(input, threads), base_code.triangle_order.size());
+    return base_code_order(base_code, keep);
+}
+
+BaseCodeOrder base_code_order(const BaseMeshCode& base_code, bool keep_rotations) {
+    BaseCodeOrder order;
+    order.keep_rotations = keep_rotations;
+    order.rotation = keep_rotations ? std::vector<uint8_t>(base_code.triangle_order.size(), 0) : base_code.triangle_rotation;
+    return order;
+}
+
+ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& base_code, bool want_vertex_map,
+                                  unsigned threads) {
+    BaseCodeOrder order = base_code_order(input, base_code, threads);
+    ReorderedInput r;
+    r.keep_rotations = order.keep_rotations;
+    r.hierarchy = HierarchyBuilder::reorder_base(input, base_code.vertex_order, base_code.triangle_order, order.rotation,
                                                  want_vertex_map ? &r.vertex_map : nullptr, threads);
     return r;
 }

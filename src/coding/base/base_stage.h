@@ -11,6 +11,7 @@
 
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
+#include <amc/hierarchy_coder.h>
 
 #include <vector>
 
@@ -22,6 +23,21 @@ uint64_t base_search_budget(const Hierarchy& h);
 // The base connectivity code of the input (positions as the decoder reconstructs them: on the
 // grid when `quantizer` is set).
 BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const EncodeOptions& options);
+
+// The base coder may rotate each triangle's vertices. The default diagonal rule does not care, but
+// hierarchies made under a rule of absolute local indices would pay orientation bits: then storing
+// each root's rotation (log2 3 bits) to keep the input's local order may be cheaper. Both readings
+// are tallied on the input.
+struct BaseCodeOrder {
+    bool keep_rotations = false;   // the roots keep the input's local vertex order (kOptionRootRotations)
+    std::vector<uint8_t> rotation;  // of each triangle in code order: the base coder's, or none when kept
+};
+BaseCodeOrder base_code_order(const Hierarchy& input, const BaseMeshCode& base_code, unsigned threads = 1);
+// The order with the choice made: the rotations kept or the base coder's.
+BaseCodeOrder base_code_order(const BaseMeshCode& base_code, bool keep_rotations);
+// The choice from the diagonal flags' exceptions as the rotated forest and the input read them:
+// whether log2 3 bits a triangle cost less than the orientation bits the rotations add.
+bool keeps_rotations(const DiagonalExceptions& rotated, const DiagonalExceptions& unrotated, size_t triangles);
 
 // The input with its base mesh in the base coder's order.
 struct ReorderedInput {

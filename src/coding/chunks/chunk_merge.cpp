@@ -157,14 +157,16 @@ Hierarchy merge_in_order(const std::vector<ChunkJob>& jobs, const ChunkMergeInpu
     find_seam_edges(plan, whole, jobs.size());
     const std::vector<HierarchyBuilder::RootLink> cut = HierarchyBuilder::cut_root_links(whole, plan.seam_edges);
     std::vector<uint8_t> seam_used(plan.seam_count, 0);
-    HierarchyLevelDecoder decoder;
+    ChunkDecoders own;
+    ChunkDecoders& decoders = input.kept_decoders != nullptr ? *input.kept_decoders : own;
+    std::unique_ptr<HierarchyLevelDecoder> decoder = decoders.take();
     for (size_t i = 0; i < jobs.size(); ++i) {
         const ChunkJob& job = jobs[i];
         const size_t vertices_before = whole.positions().size();
         const ChunkPlace place{&whole, plan.first_root[i], job.roots.count, plan.keys_in_whole(), seam_used.data(), nullptr,
-                               i + 1 == jobs.size()};
-        decode_job(decoder, job, place, input, counts[i]);
-        AMC_REQUIRE(input.options.max_level >= 0 || decoder.node_count() == job.nodes, corrupt,
+                               input.kept_decoders == nullptr && i + 1 == jobs.size()};
+        decode_job(*decoder, job, place, input, counts[i]);
+        AMC_REQUIRE(input.options.max_level >= 0 || decoder->node_count() == job.nodes, corrupt,
                     chunk_name(job) + " does not hold the nodes the chunk table says");
         AMC_REQUIRE(input.options.max_level >= 0 || job.own_vertices == kUnknownVertices ||
                         whole.positions().size() - vertices_before == job.own_vertices,
@@ -172,6 +174,7 @@ Hierarchy merge_in_order(const std::vector<ChunkJob>& jobs, const ChunkMergeInpu
         AMC_REQUIRE(!plan.full || whole.positions().size() <= input.vertices, corrupt,
                     "the chunks hold more vertices than the metadata says");
     }
+    decoders.give_back(std::move(decoder));
     HierarchyBuilder::relink_roots(whole, cut);
     finish_vertices(whole, plan, seam_used, input);
     HierarchyBuilder::stitch_seams(whole, plan.seam_edges);
@@ -180,7 +183,7 @@ Hierarchy merge_in_order(const std::vector<ChunkJob>& jobs, const ChunkMergeInpu
 
 // Several threads: every chunk straight into its slice of the whole, made first from the chunk
 // table's counts, so that the whole comes out as merge_in_order makes it. Each thread reuses one
-// decoder's working memory for the chunks it takes.
+// decoder's working memory for the chunks it takes (the caller's, when it keeps them).
 Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& input, MergePlan& plan,
                           std::vector<ChunkCounts>& counts, unsigned threads) {
     const size_t n = jobs.size();
@@ -204,29 +207,20 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
     find_seam_edges(plan, whole, n);
     const std::vector<HierarchyBuilder::RootLink> cut = HierarchyBuilder::cut_root_links(whole, plan.seam_edges);
     std::vector<std::vector<uint8_t>> seam_used(n, std::vector<uint8_t>(plan.seam_count, 0));
-    std::vector<std::unique_ptr<HierarchyLevelDecoder>> idle;
-    std::mutex idle_mutex;
+    ChunkDecoders own;
+    ChunkDecoders& decoders = input.kept_decoders != nullptr ? *input.kept_decoders : own;
     auto decode_into_slice = [&](size_t i) {
-        std::unique_ptr<HierarchyLevelDecoder> decoder;
-        {
-            std::lock_guard<std::mutex> lock(idle_mutex);
-            if (!idle.empty()) {
-                decoder = std::move(idle.back());
-                idle.pop_back();
-            }
-        }
-        if (decoder == nullptr) decoder = std::make_unique<HierarchyLevelDecoder>();
+        std::unique_ptr<HierarchyLevelDecoder> decoder = decoders.take();
         const ChunkJob& job = jobs[i];
         // Handed out in order (parallel_for): the last `threads` chunks are the last of their decoders.
         const ChunkPlace place{&whole, plan.first_root[i], job.roots.count, plan.keys_in_whole(), seam_used[i].data(),
-                               &slices[i], i + threads >= n};
+                               &slices[i], input.kept_decoders == nullptr && i + threads >= n};
         decode_job(*decoder, job, place, input, counts[i]);
         AMC_REQUIRE(slices[i].next_node == slices[i].node_end, corrupt,
                     chunk_name(job) + " does not hold the nodes the chunk table says");
         AMC_REQUIRE(slices[i].next_vertex == slices[i].vertex_end, corrupt,
                     chunk_name(job) + " does not hold the vertices the chunk table says");
-        std::lock_guard<std::mutex> lock(idle_mutex);
-        idle.push_back(std::move(decoder));
+        decoders.give_back(std::move(decoder));
     };
     // A corrupt file fails with its first bad chunk's error, as on one thread in chunk order.
     std::vector<std::exception_ptr> error(n);
@@ -239,7 +233,6 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
     });
     for (const std::exception_ptr& e : error)
         if (e) std::rethrow_exception(e);
-    idle.clear();
     HierarchyBuilder::relink_roots(whole, cut);
     std::vector<uint8_t> used(plan.seam_count, 0);
     for (const std::vector<uint8_t>& chunk_used : seam_used)
@@ -250,6 +243,28 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
 }
 
 }  // namespace
+
+std::unique_ptr<HierarchyLevelDecoder> ChunkDecoders::take() {
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!idle_.empty()) {
+            std::unique_ptr<HierarchyLevelDecoder> decoder = std::move(idle_.back());
+            idle_.pop_back();
+            return decoder;
+        }
+    }
+    return std::make_unique<HierarchyLevelDecoder>();
+}
+
+void ChunkDecoders::give_back(std::unique_ptr<HierarchyLevelDecoder> decoder) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    idle_.push_back(std::move(decoder));
+}
+
+void ChunkDecoders::clear() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    idle_.clear();
+}
 
 std::future<std::vector<Vec3>> start_zeroed_positions(size_t count) {
     try {

@@ -13,6 +13,8 @@
 
 #include <cstdint>
 #include <future>
+#include <memory>
+#include <mutex>
 #include <vector>
 
 namespace amc {
@@ -28,6 +30,23 @@ struct ChunkJob {
     uint64_t own_vertices = kUnknownVertices;  // neither base nor seam vertices
 };
 
+// Idle chunk decoders, each keeping the working memory of the chunks it decoded. A decode takes
+// one a thread and gives it back after its chunks; a DecodeContext keeps its set between decodes,
+// so that a worker thread's decoder is not freed into that thread's malloc arena, trimmed, and
+// faulted in again by the next decode (docs/BENCHMARKS.md, "Threads and memory"). Thread-safe.
+class ChunkDecoders {
+public:
+    // An idle decoder, or a new one when none is idle. Restart it before use.
+    std::unique_ptr<HierarchyLevelDecoder> take();
+    // A decoder whose chunks all decoded; one whose decode threw is dropped instead (not given back).
+    void give_back(std::unique_ptr<HierarchyLevelDecoder> decoder);
+    void clear();
+
+private:
+    std::mutex mutex_;
+    std::vector<std::unique_ptr<HierarchyLevelDecoder>> idle_;
+};
+
 struct ChunkMergeInput {
     const BlockReader* reader = nullptr;  // of the file: checks each chunk block before it is decoded
     const TriangleMesh* base = nullptr;  // the file's base mesh
@@ -40,6 +59,9 @@ struct ChunkMergeInput {
     DecodeOptions options;
     // The whole's positions, being zeroed on another thread (start_zeroed_positions); may be null.
     std::future<std::vector<Vec3>>* zeroed_positions = nullptr;
+    // The caller's decoders, kept warm after the decode (DecodeContext); null: decoders made for
+    // this decode, which give their working memory back over their last chunk (ChunkPlace::last).
+    ChunkDecoders* kept_decoders = nullptr;
 };
 
 // What the chunks' decoders know of the merged hierarchy, when every level is decoded.

@@ -177,6 +177,7 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
     merge.file_size = file_size;
     merge.options = input.options;
     merge.zeroed_positions = input.zeroed_positions;
+    merge.kept_decoders = input.kept_decoders;
     MergedCounts counts;
     Hierarchy whole = decode_and_merge_chunks(jobs, merge, counts);
     if (counts_out != nullptr) *counts_out = counts;

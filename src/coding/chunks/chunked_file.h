@@ -52,6 +52,7 @@ struct ChunkedDecodeInput {
     uint64_t vertices = 0;  // the file's vertex count (metadata)
     DecodeOptions options;
     std::future<std::vector<Vec3>>* zeroed_positions = nullptr;  // ChunkMergeInput's
+    ChunkDecoders* kept_decoders = nullptr;                       // ChunkMergeInput's
 };
 
 // Reads the chunk table and seam blocks at the reader's position and decodes the chunks in

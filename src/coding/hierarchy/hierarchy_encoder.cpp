@@ -12,10 +12,12 @@
 namespace amc {
 
 HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const HierarchyCoderOptions& options,
-                                             uint8_t stream_version, std::vector<CodedSymbol>* trace, bool mixed)
+                                             uint8_t stream_version, std::vector<CodedSymbol>* trace, bool mixed,
+                                             const TurnedRoots* turned)
     : options_(options), mixed_(mixed) {
     AMC_REQUIRE(!mixed || stream_version == kHierarchyStreamVersion, invalid_input,
                 "the hierarchy coder's mixing mode needs the newest hierarchy stream version");
+    AMC_REQUIRE(!mixed || turned == nullptr, invalid_input, "the hierarchy coder's mixing mode reads no turned roots");
     HierarchyCodeStats& stats = stats_;
     // Levels 0..U-1 with every node refined (counted on the way: a level is uniform when it and
     // all coarser levels are refined everywhere).
@@ -26,6 +28,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
     // the level forest (hierarchy_traversal.h); `ids` maps a level's local indices to h's nodes.
     events_.reserve(h.node_count());
     std::vector<std::pair<int, bool>> two_hanging;  // (unrefined edge, flag) in stream order
+    static constexpr int kTurnedEdge[6] = {0, 1, 2, 0, 1, 2};  // (e + turn) % 3
     std::vector<size_t> orientation_slots;         // event index of each two_hanging entry
     LevelTraversal traversal(options, stream_version);
     Level level, next;
@@ -33,14 +36,19 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
     std::vector<uint8_t> refined;
     RefinedNumbering numbering;
     LevelShapes shapes;  // mixing mode
-    root_level(h, level, options.cull_one_regularity);
+    // Each node's turn (none without `turned`).
+    std::vector<uint8_t> turns, next_turns;
+    root_level(turned != nullptr ? *turned->roots : h, level, options.cull_one_regularity);
     ids.resize(h.root_count());
-    for (NodeId r = 0; r < h.root_count(); ++r) ids[r] = r;
+    for (NodeId r = 0; r < h.root_count(); ++r) ids[r] = turned != nullptr ? (*turned->old_root)[r] : r;
+    if (turned != nullptr) turns = *turned->turn;
+    auto turn = [&](uint32_t i) { return turned != nullptr ? turns[i] : 0; };
     for (int l = 0; !level.empty(); ++l) {
         const uint32_t n = static_cast<uint32_t>(level.size());
         stats.nodes += n;
         refined.resize(n);
         next_ids.clear();
+        next_turns.clear();
         bool all_refined = true;
         // A refined node needs all its neighbours (Hierarchy::can_split); no stream could say
         // otherwise, and with the 1-regularity rule such nodes start decided as leaves.
@@ -58,6 +66,19 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
             if (r) {
                 const NodeId c = h.child(id, 0);
                 next_ids.insert(next_ids.end(), {c, c + 1, c + 2, c + 3});
+            }
+        }
+        if (turned != nullptr) {  // the children in their turned order, turned alike (apart: no cost without turns)
+            NodeId* children = next_ids.data();
+            for (uint32_t i = 0; i < n; ++i) {
+                if (!refined[i]) continue;
+                const uint8_t* child = red_split::kRotatedChild[turns[i]];
+                const NodeId c = children[0];
+                for (int k = 0; k < 4; ++k) {
+                    children[k] = c + child[k];
+                    next_turns.push_back(turns[i]);
+                }
+                children += 4;
             }
         }
         const bool uniform = options.uniform_levels && all_refined && l == uniform_levels && l < kMaxUniformLevels;
@@ -100,7 +121,10 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
                             " has three hanging nodes but is not refined (the hierarchy is not closed)");
             faces += 1 + uint64_t(hanging);
             if (hanging == 2) {
-                two_hanging.push_back({unrefined_edge(level, i), h.diagonal_flipped(ids[i])});
+                const int unrefined = unrefined_edge(level, i);
+                const bool flipped = h.diagonal_flipped(ids[i]);
+                two_hanging.push_back({unrefined, flipped});
+                unturned_exceptions_.add(kTurnedEdge[unrefined + turn(i)], flipped);
                 orientation_slots.push_back(events_.size());
                 events_.push_back({kOrientationEvent, 0});
             }
@@ -111,16 +135,20 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         const uint64_t created_count = derive_next_level(level, numbering, next, options.cull_one_regularity);
         std::vector<std::pair<NodeId, int>>& created = new_vertices_.emplace_back();
         created.reserve(created_count);
-        for_each_new_vertex(level, numbering, [&](uint32_t i, int e) { created.emplace_back(ids[i], e); });
+        if (turned != nullptr)
+            for_each_new_vertex(level, numbering, [&](uint32_t i, int e) { created.emplace_back(ids[i], kTurnedEdge[e + turns[i]]); });
+        else
+            for_each_new_vertex(level, numbering, [&](uint32_t i, int e) { created.emplace_back(ids[i], e); });
         std::swap(level, next);
         level_ids_.push_back(ids);
         ids.swap(next_ids);
+        turns.swap(next_turns);
     }
     stats.uniform_levels = uniform_levels;
     stats.faces = faces;
 
     // The diagonal rule that leaves the fewest exceptions; orientation bits only if any.
-    DiagonalExceptions tally;
+    DiagonalExceptions& tally = exceptions_;
     for (auto [edge, flag] : two_hanging) tally.add(edge, flag);
     stats.diagonal_rule = tally.best();
     stats.two_hanging_leaves = tally.leaves;

@@ -33,6 +33,16 @@ struct CodedSymbol {
 // The mixing mode's model that encoders write (.amc version 11).
 constexpr MixingModel kWrittenMixingModel = MixingModel::third;
 
+// A hierarchy read in another base order without copying it (reorder_base's result, as a view):
+// root t of the coded forest is h's root old_root[t] with its local indices turned by turn[t] (its
+// edge e is h's edge (e + turn[t]) % 3, its child k h's child red_split::kRotatedChild[turn[t]][k],
+// turned alike), and `roots` is the base in that order (its roots linked as the coded forest's).
+struct TurnedRoots {
+    const Hierarchy* roots;
+    const std::vector<uint32_t>* old_root;
+    const std::vector<uint8_t>* turn;
+};
+
 class HierarchyLevelEncoder {
 public:
     // Decides every node (first pass): fixes the uniform levels, the diagonal rule and the number
@@ -43,9 +53,11 @@ public:
     // `mixed`: the mixing mode (FORMAT.md 2.1-2.2): symbols coded by MixedHierarchyModel, in its
     // newest model (kWrittenMixingModel), from features of h's structure and positions, which must
     // be the ones the decoder will have.
+    // With `turned`, the forest coded is h in that base order (not with `mixed`); level_nodes and
+    // new_vertices are then h's nodes and edges.
     HierarchyLevelEncoder(const Hierarchy& h, const HierarchyCoderOptions& options,
                           uint8_t stream_version = kHierarchyStreamVersion, std::vector<CodedSymbol>* trace = nullptr,
-                          bool mixed = false);
+                          bool mixed = false, const TurnedRoots* turned = nullptr);
     bool mixed() const { return mixed_; }
     const std::vector<uint8_t>& header() const { return header_; }
     int level_count() const { return int(level_ids_.size()); }
@@ -62,6 +74,11 @@ public:
     // Faces of the leaf mesh (1 + hanging nodes per leaf), counted by the first pass: stats().faces
     // without its replay of the symbols.
     uint64_t faces() const { return stats_.faces; }
+    // The diagonal flags' exceptions to every rule as the coded forest reads them, and as h reads
+    // them in its own local order (without `turned`'s turns, diagonal_exceptions(h)): the
+    // encoder's choice of keeping the roots' rotations, without passes of its own over h.
+    const DiagonalExceptions& diagonal_exceptions() const { return exceptions_; }
+    const DiagonalExceptions& unturned_diagonal_exceptions() const { return unturned_exceptions_; }
     // The mixing mode's coded symbols in order, each with its features (bench/mixing_study).
     std::vector<std::pair<MixedFeatures, bool>> mixed_symbols() const;
 
@@ -105,6 +122,7 @@ private:
 
     HierarchyCoderOptions options_;
     HierarchyCodeStats stats_;
+    DiagonalExceptions exceptions_, unturned_exceptions_;
     std::vector<Event> events_;
     std::vector<size_t> level_end_;  // events of level l end at level_end_[l]
     std::vector<std::vector<NodeId>> level_ids_;
