@@ -460,6 +460,22 @@ TEST(EncodeDecode, InputReadInBaseOrderCodesAsItsReorderedCopy) {
                 ++cases;
             }
         }
+        // A float32 input quantized: the turned way reads its nodes with grid points apart from
+        // them (HierarchyOnGrid), which are doubles as in the reordered copy (at 30 bits most
+        // predictions rounded to float would move to another grid point).
+        auto as_float32 = [](Hierarchy x) {
+            for (VertexId v = 0; v < x.positions().size(); ++v) {
+                const Vec3 p = x.position(v);
+                x.set_position(v, {double(float(p.x)), double(float(p.y)), double(float(p.z))});
+            }
+            x.set_single_precision(true);
+            return x;
+        };
+        for (int bits : {12, 30}) {
+            EncodeOptions options;
+            options.quantize_bits = bits;
+            EXPECT_EQ(encode(as_float32(h), options), encode(as_float32(compact), options)) << name << ", float32, " << bits << " bits";
+        }
     }
     EXPECT_GE(cases, 16);
     EXPECT_EQ(kept_rotations, 1);

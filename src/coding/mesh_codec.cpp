@@ -10,6 +10,7 @@
 #include "coding/chunks/chunked_file.h"
 #include "coding/container.h"
 #include "coding/file_metadata.h"
+#include "coding/geometry/hierarchy_on_grid.h"
 #include "coding/geometry/level_geometry.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
 #include "coding/numbering/numbering_coder.h"
@@ -88,10 +89,11 @@ Quantizer quantizer_of(const Hierarchy& input, int bits, unsigned threads) {
     }
 }
 
-// Moves every position of h to the grid point the decoder reconstructs (the predictions are made
-// from those: a closed loop); returns the largest coordinate error, max_quantization_error's.
-// On `threads` threads, each range of vertices with its own largest error.
-double snap_positions(Hierarchy& h, const Quantizer& quantizer, unsigned threads) {
+// Gives every position of h to `set(v, r)` as r, the grid point the decoder reconstructs (the
+// predictions are made from those: a closed loop); returns the largest coordinate error,
+// max_quantization_error's. On `threads` threads, each range of vertices with its own largest error.
+template <class Set>
+double snap_positions(const Hierarchy& h, const Quantizer& quantizer, unsigned threads, Set&& set) {
     // std::fmax inline (a NaN loses to a number); its choice between +0 and -0 never arises, fabs gives +0.
     auto larger = [](double a, double b) { return b > a || std::isnan(a) ? b : a; };
     const size_t vertices = h.positions().size();
@@ -102,7 +104,7 @@ double snap_positions(Hierarchy& h, const Quantizer& quantizer, unsigned threads
         for (size_t v = i * kPositionRange; v < std::min(vertices, (i + 1) * kPositionRange); ++v) {
             const Vec3 p = h.position(VertexId(v)), r = dequantize(quantizer, snap(p));
             worst = larger(worst, larger(std::fabs(r.x - p.x), larger(std::fabs(r.y - p.y), std::fabs(r.z - p.z))));
-            h.set_position(VertexId(v), r);
+            set(VertexId(v), r);
         }
         worst_in[i] = worst;
     });
@@ -166,12 +168,13 @@ struct ForestCode {
 };
 
 // Codes the forest of `h` (decoder base order, or h read in it by `first_pass`, the one chunk's
-// hierarchy coder made over TurnedRoots; positions as the decoder will have them) in `chunks`;
+// hierarchy coder made over TurnedRoots; positions as the decoder will have them, or those of
+// `on_grid` when given: one chunk's input nodes with their grid points) in `chunks`;
 // `faces` is the leaf face count when there are several. `positions` holds the models as
 // the base geometry left them. The mixing mode (FORMAT.md 2.1) codes the forest as one stream.
 ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<RootRange>& chunks, uint64_t faces,
                        const EncodeOptions& options, CoordinateSpace space, PositionCoder positions, unsigned threads,
-                       bool want_hierarchy_stats, HierarchyLevelEncoder* first_pass) {
+                       bool want_hierarchy_stats, HierarchyLevelEncoder* first_pass, const HierarchyOnGrid* on_grid) {
     ForestCode out;
     const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
     out.chunked = !mixed && chunks.size() > 1;
@@ -191,19 +194,25 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
         out.faces = hierarchy.faces();
         out.levels = uint64_t(hierarchy.level_count());
         out.hierarchy_header = hierarchy.header();
-        for (int l = 0; l < hierarchy.level_count(); ++l) {
+        auto code_level = [&](int l, const auto& geometry_of) {
             const NewVertices& created = hierarchy.new_vertices(l);
-            const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, options.predictor,
+            const LevelGeometryCode geometry = choose_level_geometry(geometry_of, created, positions, space, options.predictor,
                                                                      options.grid_contexts, options.unit_normals, options.effort);
             ArithmeticEncoder encoder;
             hierarchy.encode_level(l, encoder);
             const size_t hierarchy_part = encoder.bytes_so_far();
-            std::vector<uint8_t> payload = finish_level_payload(h, created, geometry, positions, encoder);
+            std::vector<uint8_t> payload = finish_level_payload(geometry_of, created, geometry, positions, encoder);
             out.static_geometry |= geometry.predictor == GeometryPredictor::normal_frame;
             out.grid_geometry |= geometry.predictor == GeometryPredictor::normal_frame_grid;
             out.unit_geometry |= geometry.predictor == GeometryPredictor::unit_normal_frame;
             add_level_stats(out.stats, hierarchy.level_nodes(l).size(), created.size(), hierarchy_part, payload);
             out.blocks.emplace_back(BlockType::level, std::move(payload));
+        };
+        for (int l = 0; l < hierarchy.level_count(); ++l) {
+            if (on_grid != nullptr)
+                code_level(l, *on_grid);
+            else
+                code_level(l, h);
         }
         if (want_hierarchy_stats) out.stats.hierarchy = hierarchy.stats();
     }
@@ -247,14 +256,14 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
                               input.vertex_count() == input.positions().size();
     ReorderedInput reordered;  // the whole in base code order, or with turned_input its base alone
     BaseCodeOrder order;
-    Hierarchy snapped;  // with turned_input and quantized: the input on the grid
+    std::vector<Vec3> grid_positions;  // with turned_input and quantized: the input's on the grid, by vertex id
+    const HierarchyOnGrid on_grid(input, grid_positions);
     const TurnedRoots turned{&reordered.hierarchy, &base_code.triangle_order, &order.rotation};
     std::unique_ptr<HierarchyLevelEncoder> first_pass;  // with turned_input: the hierarchy coder's
     if (turned_input) {
         if (quantized) {
-            snapped = input;
-            snapped.set_single_precision(false);
-            stats.max_error = snap_positions(snapped, quantizer, threads);  // every id is live
+            grid_positions.resize(input.positions().size());
+            stats.max_error = snap_positions(input, quantizer, threads, [&](VertexId v, Vec3 r) { grid_positions[v] = r; });
         }
         // The first pass reads the forest turned by the base coder's rotations and tallies the
         // diagonal flags both ways (base_code_order's choice); when the roots keep the input's
@@ -284,10 +293,11 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
             stats.numbering = numbering_after_reorder(input, *options.numbering, reordered.hierarchy, reordered.vertex_map);
         if (quantized) {
             reordered.hierarchy.set_single_precision(false);
-            stats.max_error = snap_positions(reordered.hierarchy, quantizer, threads);  // it holds exactly the input's live positions
+            Hierarchy& h = reordered.hierarchy;  // it holds exactly the input's live positions
+            stats.max_error = snap_positions(h, quantizer, threads, [&h](VertexId v, Vec3 r) { h.set_position(v, r); });
         }
     }
-    const Hierarchy& h = !turned_input ? reordered.hierarchy : quantized ? snapped : input;
+    const Hierarchy& h = !turned_input ? reordered.hierarchy : input;
     const bool store_numbering = options.numbering != nullptr && options.store_numbering;
 
     // The forest (FORMAT.md 3.6, 3.11), after the base geometry, whose adaptive models the level
@@ -303,12 +313,12 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
                                                       : balanced_chunks(root_nodes, chunk_count_for(options, faces));
     const bool want_hierarchy_stats = stats_out != nullptr && options.hierarchy_statistics;
     ForestCode forest = code_forest(h, root_of, chunks, faces, options, space, positions, threads, want_hierarchy_stats,
-                                    first_pass.get());
+                                    first_pass.get(), turned_input && quantized ? &on_grid : nullptr);
     const uint32_t fewer = automatic && forest.chunked ? chunk_count_for_size(options, uint32_t(chunks.size()), forest.bytes)
                                                        : uint32_t(chunks.size());
     if (fewer < chunks.size())
         forest = code_forest(h, root_of, balanced_chunks(root_nodes, fewer), faces, options, space, positions, threads,
-                             want_hierarchy_stats, nullptr);
+                             want_hierarchy_stats, nullptr, nullptr);
 
     Metadata meta;
     meta.base_vertices = h.base().positions.size();

@@ -2,6 +2,7 @@
 // see geometry_prediction.h.
 #include "coding/geometry/geometry_prediction.h"
 
+#include "coding/geometry/hierarchy_on_grid.h"
 #include "common/exact_float.h"
 
 #include <algorithm>
@@ -11,13 +12,16 @@ namespace amc {
 
 namespace {
 
-Vec3 round_if_single(const Hierarchy& h, Vec3 p) { return h.single_precision() ? rounded_to_float(p) : p; }
+template <class Mesh>
+Vec3 round_if_single(const Mesh& h, Vec3 p) { return h.single_precision() ? rounded_to_float(p) : p; }
 
 // The vertex of node m opposite its edge f.
-Vec3 opposite(const Hierarchy& h, NodeId m, int f) { return h.position(h.vertex(m, (f + 2) % 3)); }
+template <class Mesh>
+Vec3 opposite(const Mesh& h, NodeId m, int f) { return h.position(h.vertex(m, (f + 2) % 3)); }
 
 // Vertex opposite edge f of node m in the same-level neighbour across f, or `fallback`.
-Vec3 wing(const Hierarchy& h, NodeId m, int f, Vec3 fallback) {
+template <class Mesh>
+Vec3 wing(const Mesh& h, NodeId m, int f, Vec3 fallback) {
     const NodeId r = h.neighbor(m, f);
     return r == kNoNode ? fallback : opposite(h, r, h.neighbor_edge(m, f));
 }
@@ -53,13 +57,15 @@ std::vector<std::pair<NodeId, int>> new_vertices_of_level(const Hierarchy& h,
     return out;
 }
 
-Vec3 predict_midpoint(const Hierarchy& h, NodeId n, int e) {
+template <class Mesh>
+Vec3 predict_midpoint(const Mesh& h, NodeId n, int e) {
     const Vec3 a = h.position(h.vertex(n, e));
     const Vec3 b = h.position(h.vertex(n, (e + 1) % 3));
     return round_if_single(h, rounded_scaled(0.5, a + b));  // FORMAT.md 5.5 (forest.cpp's placer where a + b is finite)
 }
 
-Vec3 predict_butterfly(const Hierarchy& h, NodeId n, int e) {
+template <class Mesh>
+Vec3 predict_butterfly(const Mesh& h, NodeId n, int e) {
     const NodeId q = h.neighbor(n, e);
     if (q == kNoNode) return predict_midpoint(h, n, e);
     const int e1 = (e + 1) % 3, e2 = (e + 2) % 3;
@@ -77,6 +83,11 @@ Vec3 predict_butterfly(const Hierarchy& h, NodeId n, int e) {
                    rounded_scaled(0.0625, (w_bc + w_ca) + (w_ad + w_db));
     return round_if_single(h, p);
 }
+
+template Vec3 predict_midpoint(const Hierarchy&, NodeId, int);
+template Vec3 predict_midpoint(const HierarchyOnGrid&, NodeId, int);
+template Vec3 predict_butterfly(const Hierarchy&, NodeId, int);
+template Vec3 predict_butterfly(const HierarchyOnGrid&, NodeId, int);
 
 NormalFrame normal_frame(const Hierarchy& h, NodeId n, int e, bool unit_normals) {
     const FrameCorners corners = frame_corners(h, n, e);

@@ -37,7 +37,9 @@ std::vector<std::pair<NodeId, int>> new_vertices_of_level(const Hierarchy& h,
 // Midpoint of edge e of node n, 0.5 * (a + b) (rounded to float for single-precision
 // hierarchies), as FORMAT.md 5.5 fixes it: the hierarchy's default vertex placer wherever a + b
 // does not overflow, so exact finite-element midpoints predict with residual 0.
-Vec3 predict_midpoint(const Hierarchy& h, NodeId n, int e);
+// Mesh: Hierarchy or HierarchyOnGrid (the encoder's grid points), here and below.
+template <class Mesh>
+Vec3 predict_midpoint(const Mesh& h, NodeId n, int e);
 
 // The 8-point butterfly stencil (Dyn, Levin, Gregory 1990) for edge e of node n on n's level:
 //   1/2 (a + b) + 1/8 (c + d) - 1/16 (w_bc + w_ca + w_ad + w_db)
@@ -48,7 +50,8 @@ Vec3 predict_midpoint(const Hierarchy& h, NodeId n, int e);
 // (w_bc = b + c - a, and so on), which keeps the stencil affine and exact for planar data; when
 // q is missing (boundary edge) the prediction is the midpoint. Rounded to float for
 // single-precision hierarchies.
-Vec3 predict_butterfly(const Hierarchy& h, NodeId n, int e);
+template <class Mesh>
+Vec3 predict_butterfly(const Mesh& h, NodeId n, int e);
 
 // The frame of the normal-frame predictor (FORMAT.md 5.5): the midpoint of edge e of node n, the
 // summed normals N of n and of its same-level neighbour across e (cross products of edge vectors,
@@ -80,7 +83,8 @@ NormalFrame normal_frame(const Hierarchy& h, NodeId n, int e, bool unit_normals 
 // boundary); then the frame from their positions.
 // (FrameCorners: hierarchy_builder.h, where split_level lists them for the decoders.)
 // Inline: the static coders ask it once a vertex.
-inline FrameCorners frame_corners(const Hierarchy& h, NodeId n, int e) {
+template <class Mesh>
+inline FrameCorners frame_corners(const Mesh& h, NodeId n, int e) {
     static constexpr int kNext[5] = {1, 2, 0, 1, 2};  // (i + 1) % 3 at i, (i + 2) % 3 at i + 1, for i in 0..2
     const NodeId q = h.neighbor(n, e);
     return {h.vertex(n, e), h.vertex(n, kNext[e]), h.vertex(n, kNext[e + 1]),
@@ -144,8 +148,8 @@ AMC_ALWAYS_INLINE void set_axis(NormalFrame& f) {
 
 }  // namespace frame_detail
 
-template <bool UnitNormals>
-AMC_ALWAYS_INLINE NormalFrame frame_of(const Hierarchy& h, const FrameCorners& corners) {
+template <bool UnitNormals, class Mesh>
+AMC_ALWAYS_INLINE NormalFrame frame_of(const Mesh& h, const FrameCorners& corners) {
     NormalFrame f;
     const Vec3 a = h.position(corners.a), b = h.position(corners.b), c = h.position(corners.c);
     f.midpoint = rounded_scaled(0.5, a + b);  // predict_midpoint's
@@ -170,8 +174,8 @@ AMC_ALWAYS_INLINE NormalFrame frame_of(const Hierarchy& h, const FrameCorners& c
 // frame_of for two vertices at once, each in one lane of every SSE2 operation: the same IEEE
 // operations in the same order, so the same bits. Half the arithmetic instructions of two
 // frame_of calls. Not for single-precision hierarchies (their midpoints are rounded to float).
-template <bool UnitNormals>
-AMC_ALWAYS_INLINE void frame_pair_of(const Hierarchy& h, const FrameCorners& k0, const FrameCorners& k1, NormalFrame& f0,
+template <bool UnitNormals, class Mesh>
+AMC_ALWAYS_INLINE void frame_pair_of(const Mesh& h, const FrameCorners& k0, const FrameCorners& k1, NormalFrame& f0,
                                      NormalFrame& f1) {
     struct Lanes {  // a Vec3 of each vertex: x, y, z, each holding (first vertex, second vertex)
         __m128d x, y, z;

@@ -2,6 +2,7 @@
 #include "coding/geometry/level_geometry.h"
 
 #include "coding/geometry/geometry_prediction.h"
+#include "coding/geometry/hierarchy_on_grid.h"
 #include "common/check.h"
 #include "common/exact_float.h"
 #include "coding/format_version.h"
@@ -36,7 +37,8 @@ constexpr double kEarlyMargin = 1.25;
 // the level, its streams scaled to the level, passes the smallest by more than kStaticMargin (and
 // kSampleSlack bytes); the sample's
 // encoders of those left go to on_sample[i], for the whole level to carry on from.
-void keep_likely_static_modes(const Hierarchy& h, const NewVertices& created, CoordinateSpace space, size_t sample,
+template <class Mesh>
+void keep_likely_static_modes(const Mesh& h, const NewVertices& created, CoordinateSpace space, size_t sample,
                               const GeometryPredictor modes[3], bool candidate[3],
                               std::unique_ptr<StaticLevelEncoder> on_sample[3]) {
     const double scale = double(created.size()) / double(sample);
@@ -65,11 +67,13 @@ bool predictor_allowed(uint8_t predictor, uint8_t file_version, bool quantized) 
     }
 }
 
-Vec3 predict(const Hierarchy& h, GeometryPredictor predictor, NodeId n, int e) {
+template <class Mesh>
+Vec3 predict(const Mesh& h, GeometryPredictor predictor, NodeId n, int e) {
     return predictor == GeometryPredictor::butterfly ? predict_butterfly(h, n, e) : predict_midpoint(h, n, e);
 }
 
-void encode_adaptive(const Hierarchy& h, const NewVertices& created, GeometryPredictor predictor, PositionCoder& positions,
+template <class Mesh>
+void encode_adaptive(const Mesh& h, const NewVertices& created, GeometryPredictor predictor, PositionCoder& positions,
                      ArithmeticEncoder& encoder) {
     for (auto [n, e] : created)
         positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)), predict(h, predictor, n, e));
@@ -86,7 +90,8 @@ void encode_adaptive(const Hierarchy& h, const NewVertices& created, GeometryPre
 // level at the rate of the sample's second half (the models learn as they go), pass the limit by
 // kSampleMargin: a guess; halfway through the sample the same at the rate of its second quarter,
 // by kEarlyMargin (most adaptive trials of large levels lose by more than half, and stop there).
-size_t adaptive_bytes(const Hierarchy& h, const NewVertices& created, GeometryPredictor predictor, PositionCoder positions,
+template <class Mesh>
+size_t adaptive_bytes(const Mesh& h, const NewVertices& created, GeometryPredictor predictor, PositionCoder positions,
                       size_t limit, bool count_raw_bits, size_t sample) {
     const size_t judged = std::min(sample, created.size());
     size_t half_sample_bytes = 0, quarter_sample_bytes = 0;
@@ -126,7 +131,8 @@ size_t adaptive_bytes(const Hierarchy& h, const NewVertices& created, GeometryPr
 
 }  // namespace
 
-LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& created, const PositionCoder& positions,
+template <class Mesh>
+LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& created, const PositionCoder& positions,
                                         CoordinateSpace space, GeometryPredictor choice, bool grid_contexts, bool unit_normals,
                                         int effort) {
     const bool automatic = choice == GeometryPredictor::automatic;
@@ -210,7 +216,8 @@ void check_effort(int effort, const std::string& what) {
                 what + ": effort " + std::to_string(effort) + " is not in 0.." + std::to_string(kMaxEffort));
 }
 
-std::vector<uint8_t> finish_level_payload(const Hierarchy& h, const NewVertices& created, const LevelGeometryCode& code,
+template <class Mesh>
+std::vector<uint8_t> finish_level_payload(const Mesh& h, const NewVertices& created, const LevelGeometryCode& code,
                                           PositionCoder& positions, ArithmeticEncoder& encoder) {
     std::vector<uint8_t> payload{uint8_t(code.predictor)};
     if (is_static_mode(code.predictor)) {
@@ -229,6 +236,15 @@ std::vector<uint8_t> finish_level_payload(const Hierarchy& h, const NewVertices&
     payload.insert(payload.end(), coded.begin(), coded.end());
     return payload;
 }
+
+template LevelGeometryCode choose_level_geometry(const Hierarchy&, const NewVertices&, const PositionCoder&, CoordinateSpace,
+                                                 GeometryPredictor, bool, bool, int);
+template LevelGeometryCode choose_level_geometry(const HierarchyOnGrid&, const NewVertices&, const PositionCoder&,
+                                                 CoordinateSpace, GeometryPredictor, bool, bool, int);
+template std::vector<uint8_t> finish_level_payload(const Hierarchy&, const NewVertices&, const LevelGeometryCode&,
+                                                   PositionCoder&, ArithmeticEncoder&);
+template std::vector<uint8_t> finish_level_payload(const HierarchyOnGrid&, const NewVertices&, const LevelGeometryCode&,
+                                                   PositionCoder&, ArithmeticEncoder&);
 
 LevelBlockParts split_level_block(const Block& block, uint8_t file_version, bool quantized, const std::string& where) {
     AMC_REQUIRE(block.size >= 1 && predictor_allowed(block.payload[0], file_version, quantized), corrupt,

@@ -35,7 +35,9 @@ struct LevelGeometryCode {
 // adaptive predictor tried on a copy of `positions`' models; mode 4 is a candidate only with
 // grid_contexts in a quantized space, mode 5 only with unit_normals in a bit-exact one. Below
 // kMaxEffort an adaptive predictor may be judged from a sample (EncodeOptions::effort).
-LevelGeometryCode choose_level_geometry(const Hierarchy& h, const NewVertices& created, const PositionCoder& positions,
+// Mesh: Hierarchy or HierarchyOnGrid (hierarchy_on_grid.h: the input's nodes with their grid points).
+template <class Mesh>
+LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& created, const PositionCoder& positions,
                                         CoordinateSpace space, GeometryPredictor choice, bool grid_contexts = false,
                                         bool unit_normals = false, int effort = kMaxEffort);
 
@@ -45,7 +47,8 @@ void check_effort(int effort, const std::string& what);
 
 // The payload of a level block whose hierarchy part `encoder` holds: the predictor byte, then the
 // arithmetic code finished with the level's geometry (and mode 3's streams).
-std::vector<uint8_t> finish_level_payload(const Hierarchy& h, const NewVertices& created, const LevelGeometryCode& code,
+template <class Mesh>
+std::vector<uint8_t> finish_level_payload(const Mesh& h, const NewVertices& created, const LevelGeometryCode& code,
                                           PositionCoder& positions, ArithmeticEncoder& encoder);
 
 // ---- decoder ------------------------------------------------------------------------------------

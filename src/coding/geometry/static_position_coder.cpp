@@ -4,6 +4,7 @@
 #include "common/compiler.h"
 
 #include "coding/geometry/geometry_prediction.h"
+#include "coding/geometry/hierarchy_on_grid.h"
 #include "common/bits.h"
 #include "common/compiler.h"
 #include "common/exact_float.h"
@@ -271,8 +272,9 @@ struct Chunk {
 // Where the vertices and their frame corners come from: (node, edge) pairs, read in the hierarchy,
 // or split_level's list (vertices first, first + 1, ...).
 // get(c) sets the corners and vertices of chunk c's c.count vertices from c.begin.
+template <class Mesh>
 struct FromNodes {
-    const Hierarchy& h;
+    const Mesh& h;
     const std::vector<std::pair<NodeId, int>>& created;
     size_t size() const { return created.size(); }
     void get(Chunk& c) const {
@@ -296,8 +298,8 @@ struct FromList {
 };
 
 // Chunk c: vertices begin .. end - 1 of `source`, at most kChunk.
-template <class Source>
-void gather_chunk(const Hierarchy& h, const Source& source, size_t begin, size_t end, Chunk& c) {
+template <class Mesh, class Source>
+void gather_chunk(const Mesh& h, const Source& source, size_t begin, size_t end, Chunk& c) {
     c.begin = begin;
     c.count = begin < end ? std::min(kChunk, end - begin) : 0;
     source.get(c);
@@ -333,8 +335,8 @@ AMC_ALWAYS_INLINE void role_frame(const NormalFrame& frame, const Quantizer* qua
 }
 
 // The chunk's frames in role order, two at a time where SSE2 computes two frames at once.
-template <bool Grid, bool UnitNormals>
-AMC_ALWAYS_INLINE void frame_chunk(const Hierarchy& h, const Quantizer* quantizer, const GridScale& grid, Chunk& c) {
+template <bool Grid, bool UnitNormals, class Mesh>
+AMC_ALWAYS_INLINE void frame_chunk(const Mesh& h, const Quantizer* quantizer, const GridScale& grid, Chunk& c) {
     size_t i = 0;
 #if AMC_SSE2
     if (!h.single_precision()) {
@@ -372,13 +374,15 @@ int static_token(bool negative, uint64_t magnitude) {
 
 int static_raw_bit_count(uint64_t magnitude) { return magnitude < 8 ? 0 : 1 + bit_length(magnitude) - 3; }
 
-StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created,
+template <class Mesh>
+StaticLevelEncoder::StaticLevelEncoder(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created,
                                        CoordinateSpace space, GeometryPredictor mode, bool streams)
     : StaticLevelEncoder(h, created, created.size(), space, mode) {
     if (streams) code_streams();
 }
 
-StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t count,
+template <class Mesh>
+StaticLevelEncoder::StaticLevelEncoder(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t count,
                                        CoordinateSpace space, GeometryPredictor mode)
     : mode_(mode), space_(space), table_count_(static_table_count(mode)) {
     if (!is_static_mode(mode)) throw Error("StaticLevelEncoder: geometry mode " + std::to_string(int(mode)) + " is not a static mode");
@@ -388,13 +392,15 @@ StaticLevelEncoder::StaticLevelEncoder(const Hierarchy& h, const std::vector<std
     make_tables();
 }
 
-void StaticLevelEncoder::extend(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created) {
+template <class Mesh>
+void StaticLevelEncoder::extend(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created) {
     if (coded_) throw Error("StaticLevelEncoder::extend: the streams are coded already");
     add(h, created, symbols_.size(), created.size());
     make_tables();
 }
 
-void StaticLevelEncoder::add(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end) {
+template <class Mesh>
+void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end) {
     if (counts_[0].empty())
         for (int i = 0; i < table_count_; ++i) counts_[size_t(i)].assign(size_t(token_limit(space_)), 0);
     symbols_.resize(end);
@@ -408,8 +414,8 @@ void StaticLevelEncoder::add(const Hierarchy& h, const std::vector<std::pair<Nod
 // The loop of add() for one mode: the frame's kind and the table split known when it is compiled.
 // A chunk's corners and frames as the decoder makes them (gather_chunk, frame_chunk), then each
 // vertex's residuals in role order.
-template <bool UnitNormals, bool GridBins>
-void StaticLevelEncoder::add_vertices(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin,
+template <bool UnitNormals, bool GridBins, class Mesh>
+void StaticLevelEncoder::add_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin,
                                       size_t end) {
     const CoordinateSpace space = space_;
     const Quantizer* quantizer = space.quantizer;
@@ -417,7 +423,7 @@ void StaticLevelEncoder::add_vertices(const Hierarchy& h, const std::vector<std:
     uint64_t raw_bits = 0;
     Chunk c;
     for (size_t first = begin; first < end; first += kChunk) {
-        gather_chunk(h, FromNodes{h, created}, first, end, c);
+        gather_chunk(h, FromNodes<Mesh>{h, created}, first, end, c);
         for (size_t i = 0; i < c.count; ++i) __builtin_prefetch(&h.positions()[c.vertices[i]]);
         frame_chunk<GridBins, UnitNormals>(h, quantizer, grid, c);
         for (size_t i = 0; i < c.count; ++i) {
@@ -448,6 +454,18 @@ void StaticLevelEncoder::add_vertices(const Hierarchy& h, const std::vector<std:
     }
     raw_bits_ += raw_bits;
 }
+
+// The encoder reads a hierarchy or the input's nodes with its grid points (hierarchy_on_grid.h).
+template StaticLevelEncoder::StaticLevelEncoder(const Hierarchy&, const std::vector<std::pair<NodeId, int>>&, CoordinateSpace,
+                                                GeometryPredictor, bool);
+template StaticLevelEncoder::StaticLevelEncoder(const HierarchyOnGrid&, const std::vector<std::pair<NodeId, int>>&,
+                                                CoordinateSpace, GeometryPredictor, bool);
+template StaticLevelEncoder::StaticLevelEncoder(const Hierarchy&, const std::vector<std::pair<NodeId, int>>&, size_t,
+                                                CoordinateSpace, GeometryPredictor);
+template StaticLevelEncoder::StaticLevelEncoder(const HierarchyOnGrid&, const std::vector<std::pair<NodeId, int>>&, size_t,
+                                                CoordinateSpace, GeometryPredictor);
+template void StaticLevelEncoder::extend(const Hierarchy&, const std::vector<std::pair<NodeId, int>>&);
+template void StaticLevelEncoder::extend(const HierarchyOnGrid&, const std::vector<std::pair<NodeId, int>>&);
 
 void StaticLevelEncoder::make_tables() {
     token_bits_ = 0;
@@ -629,7 +647,7 @@ bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, G
 bool decode_static_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
                              GeometryPredictor mode, const StaticTables& tables, const uint8_t* rans_data, size_t rans_size,
                              const uint8_t* raw_data, size_t raw_size) {
-    return decode_static(h, FromNodes{h, created}, space, mode, tables, rans_data, rans_size, raw_data, raw_size);
+    return decode_static(h, FromNodes<Hierarchy>{h, created}, space, mode, tables, rans_data, rans_size, raw_data, raw_size);
 }
 
 bool decode_static_positions(Hierarchy& h, const FrameCorners* corners, size_t count, VertexId first, CoordinateSpace space,

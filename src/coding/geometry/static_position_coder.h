@@ -72,16 +72,20 @@ public:
     // mode: a static mode (is_static_mode); mode 4 needs a quantized space. Throws Error otherwise.
     // With `streams` false only the tokens and tables are made, until code_streams(): an encoder
     // weighing modes asks lower_bound_bytes() first.
-    StaticLevelEncoder(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
+    // Mesh: Hierarchy or HierarchyOnGrid (hierarchy_on_grid.h), here and below.
+    template <class Mesh>
+    StaticLevelEncoder(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
                        GeometryPredictor mode = GeometryPredictor::normal_frame, bool streams = true);
     // Over the first `count` of `created` only (no streams): an encoder weighing modes on a sample
     // of a level, which extend() may then carry on over the whole level.
-    StaticLevelEncoder(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t count,
+    template <class Mesh>
+    StaticLevelEncoder(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t count,
                        CoordinateSpace space, GeometryPredictor mode);
     // Adds the rest of `created` (the vector the encoder was made over the first part of) and
     // remakes the tables: the encoder made over all of `created`, without its first part's frames
     // computed again. Before code_streams() only.
-    void extend(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created);
+    template <class Mesh>
+    void extend(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created);
     // Codes the rANS and raw streams (once).
     void code_streams();
     // The tables (three, or six in mode 4), into the level's arithmetic payload after the hierarchy part.
@@ -100,9 +104,10 @@ public:
 
 private:
     // Tokens, residuals and counts of created[begin, end).
-    void add(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
-    template <bool UnitNormals, bool GridBins>
-    void add_vertices(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
+    template <class Mesh>
+    void add(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
+    template <bool UnitNormals, bool GridBins, class Mesh>
+    void add_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
     // lower_bound_bytes()' parts: the coded tables, and the rANS and raw streams.
     size_t table_bytes() const;
     size_t stream_bound_bytes() const;
