@@ -165,6 +165,10 @@ public:
     DecodeContext(const DecodeContext&) = delete;
     DecodeContext& operator=(const DecodeContext&) = delete;
     void release();  // frees the kept memory (the next decode allocates it again)
+    // Gives back a hierarchy the caller is done with (an earlier result, say): the next decode of
+    // a chunked file through the context builds its result in that memory, already resident,
+    // instead of having fresh pages faulted in and zeroed by the system. Kept until then.
+    void recycle(Hierarchy&& done);
 
 private:
     struct Kept;
