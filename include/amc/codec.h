@@ -178,7 +178,7 @@ private:
 Hierarchy decode(DecodeContext& context, const uint8_t* data, size_t size, const DecodeOptions& options = {},
                  LeafNumbering* numbering = nullptr);
 
-// The same without exceptions, for callers that prefer status values.
+// decode() without a context and without exceptions, for callers that prefer status values.
 struct DecodeResult {
     bool ok = false;
     ErrorCode code = ErrorCode::invalid_input;  // when !ok: the kind of problem
