@@ -42,7 +42,6 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
     ids.resize(h.root_count());
     for (NodeId r = 0; r < h.root_count(); ++r) ids[r] = turned != nullptr ? (*turned->old_root)[r] : r;
     if (turned != nullptr) turns = *turned->turn;
-    auto turn = [&](uint32_t i) { return turned != nullptr ? turns[i] : 0; };
     for (int l = 0; !level.empty(); ++l) {
         const uint32_t n = static_cast<uint32_t>(level.size());
         stats.nodes += n;
@@ -124,7 +123,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
                 const int unrefined = unrefined_edge(level, i);
                 const bool flipped = h.diagonal_flipped(ids[i]);
                 two_hanging.push_back({unrefined, flipped});
-                unturned_exceptions_.add(kTurnedEdge[unrefined + turn(i)], flipped);
+                if (turned != nullptr) unturned_exceptions_.add(kTurnedEdge[unrefined + turns[i]], flipped);
                 orientation_slots.push_back(events_.size());
                 events_.push_back({kOrientationEvent, 0});
             }
