@@ -389,7 +389,7 @@ struct ChunkRequest {
 Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const TriangleMesh& base, CoordinateSpace space,
                               const DecodeOptions& options, LeafNumbering* numbering, PartialProgress* partial,
                               const ChunkRequest* request, std::future<std::vector<Vec3>>* zeroed_positions,
-                              ChunkDecoders* kept_decoders) {
+                              ChunkDecoders* kept_decoders, Hierarchy* spare) {
     AMC_REQUIRE(reader.version() >= kChunkedVersion, corrupt, "metadata block: chunks in a version-" + std::to_string(reader.version()) + " file");
     if (partial != nullptr) {
         partial->levels_in_file = int(meta.levels);
@@ -400,7 +400,8 @@ Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const T
         while (!complete && probe.next_block_arrived() && probe.next(block)) complete = block.type == BlockType::end;
         if (!complete) return Hierarchy(base);
     }
-    const ChunkedDecodeInput input{&base, space, reader.version(), meta.vertices, options, zeroed_positions, kept_decoders};
+    const ChunkedDecodeInput input{&base, space, reader.version(), meta.vertices, options, zeroed_positions,
+                                   kept_decoders, spare};
     ChunkTable table;
     MergedCounts counts;
     Hierarchy h = decode_chunked(reader, input, meta.nodes, request != nullptr ? &request->chunks : nullptr, &table, &counts);
@@ -436,7 +437,7 @@ Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const T
 
 Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& options, LeafNumbering* numbering,
                       PartialProgress* partial = nullptr, const ChunkRequest* request = nullptr,
-                      ChunkDecoders* kept_decoders = nullptr) {
+                      ChunkDecoders* kept_decoders = nullptr, Hierarchy* spare = nullptr) {
     if (numbering != nullptr) *numbering = {};
     AMC_REQUIRE(data != nullptr || size == 0, invalid_input, "no data");
     BlockReader reader(data, size);
@@ -472,7 +473,7 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
                 "metadata block: mixed hierarchy contexts in a chunked file");
     if (meta.options & kOptionChunked)
         return decode_chunked_file(reader, meta, base, space, options, numbering, partial, request, &zeroed_positions,
-                                   kept_decoders);
+                                   kept_decoders, spare);
     if (request != nullptr) {  // a file without chunks is one chunk
         AMC_REQUIRE(request->chunks.size() == 1 && request->chunks[0] == 0, invalid_input,
                     "the file has no chunks: only chunk 0, the whole file, can be decoded");
@@ -559,6 +560,7 @@ Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options,
 
 struct DecodeContext::Kept {
     ChunkDecoders chunk_decoders;
+    Hierarchy spare;  // recycle()'s: its storage taken by the next decode
 };
 
 DecodeContext::DecodeContext() : kept_(std::make_unique<Kept>()) {}
@@ -567,15 +569,23 @@ DecodeContext::DecodeContext(DecodeContext&&) noexcept = default;
 DecodeContext& DecodeContext::operator=(DecodeContext&&) noexcept = default;
 
 void DecodeContext::release() {
-    if (kept_ != nullptr) kept_->chunk_decoders.clear();
+    if (kept_ == nullptr) return;
+    kept_->chunk_decoders.clear();
+    kept_->spare = Hierarchy();
+}
+
+void DecodeContext::recycle(Hierarchy&& done) {
+    if (kept_ == nullptr) kept_ = std::make_unique<Kept>();  // moved from
+    kept_->spare = std::move(done);
 }
 
 Hierarchy decode(DecodeContext& context, const uint8_t* data, size_t size, const DecodeOptions& options,
                  LeafNumbering* numbering) {
     if (context.kept_ == nullptr) context.kept_ = std::make_unique<DecodeContext::Kept>();  // moved from
     ChunkDecoders* kept = &context.kept_->chunk_decoders;
+    Hierarchy* spare = &context.kept_->spare;
     Hierarchy h = with_allocation_errors_as_limits(
-        "decode", [&] { return decode_file(data, size, options, numbering, nullptr, nullptr, kept); });
+        "decode", [&] { return decode_file(data, size, options, numbering, nullptr, nullptr, kept, spare); });
     HierarchyBuilder::mark_structure_checked(h);  // as decode without a context
     return h;
 }
