@@ -4,7 +4,8 @@
 //   chunks_bench sizes BITS model.amh ...          bytes with 1 chunk, the default chunks, and 2, 4, 8
 //                                                  chunks; every chunked file checked to decode
 //                                                  identical to the unchunked one
-//   chunks_bench speed RUNS BITS CHUNKS model.amh  wall and CPU time of encode and decode with 1 and
+//   chunks_bench speed RUNS BITS CHUNKS model.amh  wall and CPU time of encode and decode (without and
+//                                                  through a DecodeContext) with 1 and
 //                                                  with 2 threads (CHUNKS 0: the default count), runs
 //                                                  interleaved; median [min - max] and the ratio of
 //                                                  each run's pair (on a shared machine the load
@@ -12,6 +13,10 @@
 //   chunks_bench decode-speed RUNS BITS model.amh  decodes only: RUNS pairs of a 1- and a 2-thread
 //                                                  decode, 0.2 s apart (for chrt -f: see decode_speed),
 //                                                  without and with a DecodeContext
+//   chunks_bench decode-rusage RUNS recycle|keep file.amc
+//                                                  RUNS pairs of a 1- and a 2-thread decode through
+//                                                  a DecodeContext each (results recycled or not):
+//                                                  wall, user and system time and faults per decode
 //   chunks_bench repeat encode|decode RUNS THREADS BITS model.amh
 //                                                  encodes the model once (default options), then
 //                                                  encodes or decodes it RUNS times on THREADS
@@ -19,7 +24,8 @@
 //                                                  (scripts/serial_fraction.sh)
 //   chunks_bench decode-file RUNS THREADS [context] file.amc
 //                                                  decodes the file RUNS times on THREADS threads
-//                                                  (through one DecodeContext with `context`) and
+//                                                  (through one DecodeContext with `context`, each
+//                                                  result recycled into it) and
 //                                                  prints an FNV-1a hash of the decoded nodes and
 //                                                  positions (equal on every thread count): the
 //                                                  process to count instructions of (callgrind)
@@ -98,9 +104,10 @@ int speed(int runs, int bits, uint32_t chunks, const char* path) {
     const std::vector<uint8_t> bytes = amc::encode(h, options, &stats);
     const amc::FileInfo info = amc::inspect(bytes.data(), bytes.size());
     std::vector<double> encode_time[2], decode_time[2], encode_cpu[2], decode_cpu[2], encode_ratio, decode_ratio,
-        decode_faults[2];
+        decode_faults[2], kept_time[2], kept_cpu[2], kept_ratio, kept_faults[2];
+    amc::DecodeContext contexts[2];  // one a thread count, kept through the runs
     for (int r = 0; r < runs; ++r) {
-        double seconds[2][2], cpu[2][2];
+        double seconds[2][3], cpu[2][3];
         for (unsigned threads : {1u, 2u}) {
             amc::EncodeOptions o = options;
             o.threads = threads;
@@ -124,15 +131,28 @@ int speed(int runs, int bits, uint32_t chunks, const char* path) {
                 decode_faults[threads - 1].push_back(minor_faults() - faults_start);
                 if (back.node_count() != h.node_count()) return 1;
             }
+            start = now();
+            cpu_start = cpu_seconds();
+            const double kept_faults_start = minor_faults();
+            {
+                const amc::Hierarchy back = amc::decode(contexts[threads - 1], bytes.data(), bytes.size(), d);
+                seconds[threads - 1][2] = now() - start;
+                cpu[threads - 1][2] = cpu_seconds() - cpu_start;
+                kept_faults[threads - 1].push_back(minor_faults() - kept_faults_start);
+                if (back.node_count() != h.node_count()) return 1;
+            }
         }
         for (int t = 0; t < 2; ++t) {
             encode_time[t].push_back(seconds[t][0]);
             decode_time[t].push_back(seconds[t][1]);
             encode_cpu[t].push_back(cpu[t][0]);
             decode_cpu[t].push_back(cpu[t][1]);
+            kept_time[t].push_back(seconds[t][2]);
+            kept_cpu[t].push_back(cpu[t][2]);
         }
         encode_ratio.push_back(seconds[0][0] / seconds[1][0]);
         decode_ratio.push_back(seconds[0][1] / seconds[1][1]);
+        kept_ratio.push_back(seconds[0][2] / seconds[1][2]);
     }
     std::printf("%s: %lu faces, %zu bytes, %zu chunks, %d runs (wall time, seconds: median [min - max])\n", name_of(path).c_str(),
                 (unsigned long)stats.faces, bytes.size(), std::max<size_t>(1, info.chunks.size()), runs);
@@ -147,9 +167,14 @@ int speed(int runs, int bits, uint32_t chunks, const char* path) {
     };
     line("encode", encode_time, encode_cpu, encode_ratio);
     line("decode", decode_time, decode_cpu, decode_ratio);
-    std::printf("  minor page faults per decode: 1 thread %.0f [%.0f - %.0f], 2 threads %.0f [%.0f - %.0f] (median [min - max])\n",
-                range_of(decode_faults[0]).median, range_of(decode_faults[0]).low, range_of(decode_faults[0]).high,
-                range_of(decode_faults[1]).median, range_of(decode_faults[1]).low, range_of(decode_faults[1]).high);
+    line("decode through a DecodeContext", kept_time, kept_cpu, kept_ratio);
+    auto faults_line = [](const char* what, std::vector<double>* faults) {
+        const Range one = range_of(faults[0]), two = range_of(faults[1]);
+        std::printf("  minor page faults per %s: 1 thread %.0f [%.0f - %.0f], 2 threads %.0f [%.0f - %.0f] (median [min - max])\n",
+                    what, one.median, one.low, one.high, two.median, two.low, two.high);
+    };
+    faults_line("decode", decode_faults);
+    faults_line("decode through a DecodeContext", kept_faults);
     return 0;
 }
 
@@ -195,6 +220,44 @@ int decode_speed(int runs, int bits, const char* path) {
                     r.median, r.low, r.high, median(cpu[kept][0]), median(cpu[kept][1]), median(faults[kept][0]),
                     median(faults[kept][1]));
     }
+    return 0;
+}
+
+// RUNS pairs of a 1- and a 2-thread decode of the file, each through its own DecodeContext, 0.2 s
+// apart (for chrt -f), with every result recycled into its context or not: each decode's wall,
+// user and system time and minor faults, then the medians and the per-pair speed-up.
+int decode_rusage(int runs, bool recycle, const char* path) {
+    std::ifstream in(path, std::ios::binary);
+    const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    amc::DecodeContext contexts[2];
+    std::vector<double> wall[2], user[2], system[2], faults[2], ratio;
+    auto seconds = [](const timeval& t) { return double(t.tv_sec) + 1e-6 * double(t.tv_usec); };
+    for (int r = 0; r < runs; ++r) {
+        for (unsigned threads : {1u, 2u}) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(200));
+            amc::DecodeOptions d;
+            d.threads = threads;
+            rusage before{}, after{};
+            getrusage(RUSAGE_SELF, &before);
+            const double start = now();
+            amc::Hierarchy back = amc::decode(contexts[threads - 1], bytes.data(), bytes.size(), d);
+            wall[threads - 1].push_back(now() - start);
+            getrusage(RUSAGE_SELF, &after);
+            user[threads - 1].push_back(seconds(after.ru_utime) - seconds(before.ru_utime));
+            system[threads - 1].push_back(seconds(after.ru_stime) - seconds(before.ru_stime));
+            faults[threads - 1].push_back(double(after.ru_minflt - before.ru_minflt));
+            std::printf("%u thread%s: wall %.4f s, user %.4f s, system %.4f s, %.0f minor faults\n", threads, threads > 1 ? "s" : "",
+                        wall[threads - 1].back(), user[threads - 1].back(), system[threads - 1].back(), faults[threads - 1].back());
+            if (recycle) contexts[threads - 1].recycle(std::move(back));
+        }
+        ratio.push_back(wall[0].back() / wall[1].back());
+    }
+    for (int t = 0; t < 2; ++t)
+        std::printf("%s, %d thread%s%s: medians wall %.4f s, user %.4f s, system %.4f s, %.0f minor faults\n", name_of(path).c_str(),
+                    t + 1, t ? "s" : "", recycle ? ", results recycled" : "", median(wall[t]), median(user[t]), median(system[t]),
+                    median(faults[t]));
+    const Range r = range_of(ratio);
+    std::printf("speed-up per pair %.2f [%.2f - %.2f]\n", r.median, r.low, r.high);
     return 0;
 }
 
@@ -251,8 +314,9 @@ int decode_file(int runs, unsigned threads, bool kept, const char* path) {
     amc::DecodeContext context;
     uint64_t hash = 0;
     for (int r = 0; r < runs; ++r) {
-        const uint64_t h = hierarchy_hash(kept ? amc::decode(context, bytes.data(), bytes.size(), d)
-                                               : amc::decode(bytes.data(), bytes.size(), d));
+        amc::Hierarchy back = kept ? amc::decode(context, bytes.data(), bytes.size(), d) : amc::decode(bytes.data(), bytes.size(), d);
+        const uint64_t h = hierarchy_hash(back);
+        if (kept) context.recycle(std::move(back));
         if (r > 0 && h != hash) {
             std::fprintf(stderr, "%s: decode %d built another hierarchy\n", path, r + 1);
             return 1;
@@ -272,11 +336,14 @@ int main(int argc, char** argv) {
     if (mode == "decode-speed" && argc == 5) return decode_speed(std::max(1, std::atoi(argv[2])), std::atoi(argv[3]), argv[4]);
     if (mode == "decode-file" && (argc == 5 || (argc == 6 && std::string(argv[4]) == "context")))
         return decode_file(std::max(1, std::atoi(argv[2])), unsigned(std::atoi(argv[3])), argc == 6, argv[argc - 1]);
+    if (mode == "decode-rusage" && argc == 5 && (std::string(argv[3]) == "recycle" || std::string(argv[3]) == "keep"))
+        return decode_rusage(std::max(1, std::atoi(argv[2])), std::string(argv[3]) == "recycle", argv[4]);
     if (mode == "repeat" && argc == 7 && (std::string(argv[2]) == "encode" || std::string(argv[2]) == "decode"))
         return repeat(argv[2], std::max(1, std::atoi(argv[3])), unsigned(std::atoi(argv[4])), std::atoi(argv[5]), argv[6]);
     std::fprintf(stderr, "usage: chunks_bench sizes BITS model.amh ...\n       chunks_bench speed RUNS BITS CHUNKS model.amh\n"
                          "       chunks_bench decode-speed RUNS BITS model.amh\n"
                          "       chunks_bench decode-file RUNS THREADS [context] file.amc\n"
+                         "       chunks_bench decode-rusage RUNS recycle|keep file.amc\n"
                          "       chunks_bench repeat encode|decode RUNS THREADS BITS model.amh\n");
     return 2;
 }

@@ -451,13 +451,17 @@ TEST(EncodeDecode, InputReadInBaseOrderCodesAsItsReorderedCopy) {
         ASSERT_EQ(compact.node_count(), compact.node_capacity()) << name;
         kept_rotations += base_code_order(compact, base_code_of(compact, nullptr, EncodeOptions())).keep_rotations;
         for (int bits : {12, 0}) {
-            EncodeOptions options;
-            options.quantize_bits = bits;
-            EXPECT_EQ(encode(h, options), encode(compact, options)) << name << ", " << bits << " bits";
-            ++cases;
+            // Also with leaves enough for two chunks but faces for one (counted before the order).
+            for (uint64_t chunk_faces : {EncodeOptions().chunk_faces, uint64_t(h.leaf_count()) + 1}) {
+                EncodeOptions options;
+                options.quantize_bits = bits;
+                options.chunk_faces = chunk_faces;
+                EXPECT_EQ(encode(h, options), encode(compact, options)) << name << ", " << bits << " bits, " << chunk_faces;
+                ++cases;
+            }
         }
     }
-    EXPECT_GE(cases, 8);
+    EXPECT_GE(cases, 16);
     EXPECT_EQ(kept_rotations, 1);
 }
 

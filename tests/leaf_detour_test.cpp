@@ -57,6 +57,48 @@ TEST(LeafDetour, TargetsAloneGetTheFullSearchesDetours) {
     EXPECT_EQ(targeted.detour(6), amc::LeafDetour::kFar);
 }
 
+// A hexagon of six triangles around 0 (ring 1-2-3-4-5-6): 0's fan is closed, the ring's open.
+amc::TriangleMesh hexagon() {
+    amc::TriangleMesh m;
+    for (int i = 0; i < 7; ++i) m.positions.push_back({double(i), 0, 0});
+    for (uint32_t i = 1; i <= 6; ++i) m.triangles.push_back({0, i, i % 6 + 1});
+    return m;
+}
+
+TEST(LeafDetour, AClosedFansCenterReachesEveryNeighbour) {
+    const amc::TriangleMesh mesh = hexagon();
+    const amc::LeafHalfedges halfedges(mesh);
+    amc::LeafDetour detour(halfedges);
+    for (uint32_t a = 1; a <= 6; ++a) {
+        const uint32_t b = (a + 2) % 6 + 1;  // across the center
+        ASSERT_TRUE(detour.measure(a, b, 2)) << a;
+        EXPECT_EQ(detour.detour(0), 0) << a;
+        EXPECT_EQ(detour.detour(a % 6 + 1), 1) << a;  // a-x, x-0-b
+        ASSERT_TRUE(detour.measure(0, a, 2)) << a;
+        EXPECT_EQ(detour.detour(b), 2) << a;  // 0-b, b-0-a
+    }
+}
+
+TEST(LeafDetour, TargetsAloneGetTheFullSearchesDetoursInAClosedMesh) {
+    amc::TriangleMesh mesh;  // an octahedron: every fan closed
+    for (int i = 0; i < 6; ++i) mesh.positions.push_back({double(i), 0, 0});
+    mesh.triangles = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 1}, {5, 2, 1}, {5, 3, 2}, {5, 4, 3}, {5, 1, 4}};
+    const amc::LeafHalfedges halfedges(mesh);
+    amc::LeafDetour full(halfedges), targeted(halfedges);
+    for (uint32_t a = 0; a < 6; ++a) {
+        for (uint32_t b = 0; b < 6; ++b) {
+            for (uint32_t c = 0; c < 6; ++c) {
+                const uint32_t targets[1] = {c};
+                ASSERT_TRUE(full.measure(a, b, 2));
+                ASSERT_TRUE(targeted.measure(a, b, 2, targets, 1));
+                EXPECT_EQ(targeted.detour(c), full.detour(c)) << a << " " << b << " " << c;
+            }
+        }
+    }
+    ASSERT_TRUE(full.measure(0, 5, 2));  // opposite poles: every other vertex is on a shortest path
+    for (uint32_t c = 1; c <= 4; ++c) EXPECT_EQ(full.detour(c), 0) << c;
+}
+
 TEST(LeafDetour, EndsFartherThanTheBoundAreNotMeasured) {
     const amc::TriangleMesh mesh = strip();
     const amc::LeafHalfedges halfedges(mesh);

@@ -165,6 +165,10 @@ public:
     DecodeContext(const DecodeContext&) = delete;
     DecodeContext& operator=(const DecodeContext&) = delete;
     void release();  // frees the kept memory (the next decode allocates it again)
+    // Gives back a hierarchy the caller is done with (an earlier result, say): the next decode of
+    // a chunked file through the context builds its result in that memory, already resident,
+    // instead of having fresh pages faulted in and zeroed by the system. Kept until then.
+    void recycle(Hierarchy&& done);
 
 private:
     struct Kept;
@@ -174,7 +178,7 @@ private:
 Hierarchy decode(DecodeContext& context, const uint8_t* data, size_t size, const DecodeOptions& options = {},
                  LeafNumbering* numbering = nullptr);
 
-// The same without exceptions, for callers that prefer status values.
+// decode() without a context and without exceptions, for callers that prefer status values.
 struct DecodeResult {
     bool ok = false;
     ErrorCode code = ErrorCode::invalid_input;  // when !ok: the kind of problem

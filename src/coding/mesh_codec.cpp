@@ -231,7 +231,11 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     // so one chunk (chunk_count_for), known without the passes over the nodes that count faces and
     // nodes per root.
     const bool few_leaves = automatic && uint64_t(input.leaf_count()) * 2 < std::max<uint64_t>(1, options.chunk_faces);
-    const bool one_chunk = options.chunk_roots.empty() ? options.chunks == 1 || few_leaves : options.chunk_roots.size() == 1;
+    const bool one_chunk_asked = options.chunk_roots.empty() ? options.chunks == 1 || few_leaves : options.chunk_roots.size() == 1;
+    // Leaf faces do not depend on the order: counted on the input, so that automatic chunks of
+    // fewer faces than two chunks' are known to be one before the order is chosen.
+    const uint64_t faces = one_chunk_asked ? 0 : leaf_face_count(input, threads);
+    const bool one_chunk = one_chunk_asked || (automatic && chunk_count_for(options, faces) == 1);
     const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
 
     // II-B: code the base mesh first and express the forest in the decoder's base order. One chunk
@@ -291,7 +295,6 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     // faces each, then fewer if that code is too small for them (chunk_policy.h).
     PositionCoder positions(space);
     std::vector<uint8_t> base_geometry = encode_base_geometry(reordered.hierarchy, base_code, reordered.keep_rotations, positions);
-    const uint64_t faces = one_chunk ? 0 : leaf_face_count(h, threads);
     const std::vector<uint32_t> root_of = one_chunk ? std::vector<uint32_t>() : root_of_nodes(h);
     const std::vector<uint64_t> root_nodes =
         options.chunk_roots.empty() && !one_chunk ? nodes_per_root(h, root_of) : std::vector<uint64_t>();
@@ -376,7 +379,7 @@ struct ChunkRequest {
 Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const TriangleMesh& base, CoordinateSpace space,
                               const DecodeOptions& options, LeafNumbering* numbering, PartialProgress* partial,
                               const ChunkRequest* request, std::future<std::vector<Vec3>>* zeroed_positions,
-                              ChunkDecoders* kept_decoders) {
+                              ChunkDecoders* kept_decoders, Hierarchy* spare) {
     AMC_REQUIRE(reader.version() >= kChunkedVersion, corrupt, "metadata block: chunks in a version-" + std::to_string(reader.version()) + " file");
     if (partial != nullptr) {
         partial->levels_in_file = int(meta.levels);
@@ -387,7 +390,8 @@ Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const T
         while (!complete && probe.next_block_arrived() && probe.next(block)) complete = block.type == BlockType::end;
         if (!complete) return Hierarchy(base);
     }
-    const ChunkedDecodeInput input{&base, space, reader.version(), meta.vertices, options, zeroed_positions, kept_decoders};
+    const ChunkedDecodeInput input{&base, space, reader.version(), meta.vertices, options, zeroed_positions,
+                                   kept_decoders, spare};
     ChunkTable table;
     MergedCounts counts;
     Hierarchy h = decode_chunked(reader, input, meta.nodes, request != nullptr ? &request->chunks : nullptr, &table, &counts);
@@ -423,7 +427,7 @@ Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const T
 
 Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& options, LeafNumbering* numbering,
                       PartialProgress* partial = nullptr, const ChunkRequest* request = nullptr,
-                      ChunkDecoders* kept_decoders = nullptr) {
+                      ChunkDecoders* kept_decoders = nullptr, Hierarchy* spare = nullptr) {
     if (numbering != nullptr) *numbering = {};
     AMC_REQUIRE(data != nullptr || size == 0, invalid_input, "no data");
     BlockReader reader(data, size);
@@ -459,7 +463,7 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
                 "metadata block: mixed hierarchy contexts in a chunked file");
     if (meta.options & kOptionChunked)
         return decode_chunked_file(reader, meta, base, space, options, numbering, partial, request, &zeroed_positions,
-                                   kept_decoders);
+                                   kept_decoders, spare);
     if (request != nullptr) {  // a file without chunks is one chunk
         AMC_REQUIRE(request->chunks.size() == 1 && request->chunks[0] == 0, invalid_input,
                     "the file has no chunks: only chunk 0, the whole file, can be decoded");
@@ -546,6 +550,7 @@ Hierarchy decode(const uint8_t* data, size_t size, const DecodeOptions& options,
 
 struct DecodeContext::Kept {
     ChunkDecoders chunk_decoders;
+    Hierarchy spare;  // recycle()'s: its storage taken by the next decode
 };
 
 DecodeContext::DecodeContext() : kept_(std::make_unique<Kept>()) {}
@@ -554,15 +559,23 @@ DecodeContext::DecodeContext(DecodeContext&&) noexcept = default;
 DecodeContext& DecodeContext::operator=(DecodeContext&&) noexcept = default;
 
 void DecodeContext::release() {
-    if (kept_ != nullptr) kept_->chunk_decoders.clear();
+    if (kept_ == nullptr) return;
+    kept_->chunk_decoders.clear();
+    kept_->spare = Hierarchy();
+}
+
+void DecodeContext::recycle(Hierarchy&& done) {
+    if (kept_ == nullptr) kept_ = std::make_unique<Kept>();  // moved from
+    kept_->spare = std::move(done);
 }
 
 Hierarchy decode(DecodeContext& context, const uint8_t* data, size_t size, const DecodeOptions& options,
                  LeafNumbering* numbering) {
     if (context.kept_ == nullptr) context.kept_ = std::make_unique<DecodeContext::Kept>();  // moved from
     ChunkDecoders* kept = &context.kept_->chunk_decoders;
+    Hierarchy* spare = &context.kept_->spare;
     Hierarchy h = with_allocation_errors_as_limits(
-        "decode", [&] { return decode_file(data, size, options, numbering, nullptr, nullptr, kept); });
+        "decode", [&] { return decode_file(data, size, options, numbering, nullptr, nullptr, kept, spare); });
     HierarchyBuilder::mark_structure_checked(h);  // as decode without a context
     return h;
 }

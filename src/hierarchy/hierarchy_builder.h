@@ -103,6 +103,10 @@ struct HierarchyBuilder {
     // `vertices` positions (made on another thread), becomes the positions' storage; otherwise
     // they are zeroed here.
     static void open_slices(Hierarchy& h, size_t nodes, size_t vertices, std::vector<Vec3> zeroed = {});
+    // Gives `h` (its roots only, as constructed) the node, block and position arrays of `spare`, a
+    // hierarchy its owner is done with, where they hold more: a decode into `h` then writes memory
+    // that is resident already instead of faulting fresh pages in. `spare` is left empty.
+    static void adopt_storage(Hierarchy& h, Hierarchy&& spare);
     // Renames the vertex ids of the nodes in [begin, end): v becomes rename(v).
     template <class Rename>
     static void stitch_rename_vertices(Hierarchy& whole, NodeId begin, NodeId end, Rename rename) {

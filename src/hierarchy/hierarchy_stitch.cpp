@@ -33,6 +33,20 @@ void HierarchyBuilder::open_slices(Hierarchy& h, size_t nodes, size_t vertices, 
     h.live_vertices_ = uint32_t(vertices);
 }
 
+void HierarchyBuilder::adopt_storage(Hierarchy& h, Hierarchy&& spare) {
+    AMC_REQUIRE(h.nodes_.size() == h.root_count() && h.free_blocks_.empty() && h.free_vertices_.empty(), invalid_input,
+                "adopt_storage: the hierarchy is refined already");
+    auto adopt = [](auto& into, auto& from) {
+        if (from.capacity() <= into.capacity()) return;
+        from.assign(into.begin(), into.end());
+        into.swap(from);
+    };
+    adopt(h.nodes_, spare.nodes_);
+    adopt(h.block_parent_, spare.block_parent_);
+    adopt(h.positions_, spare.positions_);
+    spare = Hierarchy();
+}
+
 void HierarchyBuilder::append_vertices(Hierarchy& h, const std::vector<Vec3>& positions) {
     AMC_REQUIRE(h.positions_.size() + positions.size() < kNoVertex, limit_exceeded, "too many vertices");
     for (const Vec3& p : positions) h.far_positions_.raise_if(Hierarchy::is_far(p));

@@ -30,7 +30,14 @@ private:
     void search(uint32_t source, std::vector<int>& hops, std::vector<uint32_t>& reached, int max_hops,
                 uint32_t* pending = nullptr, uint32_t pending_count = 0);
 
+    // Calls f on every neighbour of u: the ends of its out-edges, and where some apex of its faces
+    // is none of them (an open fan: the mesh boundary, or a broken input), the apexes too.
+    template <class F>
+    void for_each_neighbor(uint32_t u, F f);
+
     const LeafHalfedges& he_;
+    std::vector<uint8_t> fan_;  // per vertex: 0 not looked at yet, kClosedFan, kOpenFan
+    static constexpr uint8_t kClosedFan = 1, kOpenFan = 2;
     std::vector<int> hops_a_, hops_b_;  // -1: not reached
     std::vector<uint32_t> reached_a_, reached_b_;
     int shortest_ = 0;

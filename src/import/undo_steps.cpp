@@ -29,6 +29,18 @@ UndoStepChoice::UndoStepChoice(const UndoSteps& steps) : steps_(steps) {
             neighbors_[next[t[k]]++] = t[(k + 2) % 3];
         }
     }
+    // Each neighbour once (two faces list most of them): a search then looks each up once.
+    uint32_t kept = 0;
+    for (size_t v = 0; v < vertex_count; ++v) {
+        const auto begin = neighbors_.begin() + first_neighbor_[v], end = neighbors_.begin() + first_neighbor_[v + 1];
+        std::sort(begin, end);
+        const uint32_t count = uint32_t(std::unique(begin, end) - begin);
+        first_neighbor_[v] = kept;
+        std::copy(begin, begin + count, neighbors_.begin() + kept);
+        kept += count;
+    }
+    first_neighbor_[vertex_count] = kept;
+    neighbors_.resize(kept);
     hops_from_a_.assign(vertex_count, -1);
     hops_from_b_.assign(vertex_count, -1);
 }

@@ -1,5 +1,5 @@
-// Fuzz targets of the .amc file: decode (whole, every prefix of levels, and encoded again) and
-// inspect, each on the input as it is and with its checksums made valid, so that mutations reach
+// Fuzz targets of the .amc file: decode (whole, through a kept DecodeContext, every prefix of
+// levels, and encoded again) and inspect, each on the input as it is and with its checksums made valid, so that mutations reach
 // the payload decoders behind the checksums.
 #include "fuzz_targets.h"
 
@@ -28,6 +28,22 @@ void check_one_chunk(const uint8_t* data, size_t size, const Hierarchy& whole, c
     FUZZ_CHECK(identical(part.hierarchy, extract_roots(whole, roots)));
 }
 
+// A DecodeContext kept from input to input (as a caller decoding many files keeps one): what it
+// carries from one decode to the next must change no result and no refusal.
+void check_through_context(const uint8_t* data, size_t size, const DecodeOptions& options, const Hierarchy* whole,
+                           const LeafNumbering& numbering, ErrorCode refused) {
+    static DecodeContext context;
+    LeafNumbering kept_numbering;
+    try {
+        const Hierarchy h = decode(context, data, size, options, &kept_numbering);
+        FUZZ_CHECK(whole != nullptr && identical(h, *whole));
+        FUZZ_CHECK(kept_numbering.vertex == numbering.vertex && kept_numbering.face == numbering.face &&
+                   kept_numbering.rotation == numbering.rotation);
+    } catch (const Error& e) {
+        FUZZ_CHECK(whole == nullptr && e.code() == refused);
+    }
+}
+
 void decode_file(const uint8_t* data, size_t size) {
     DecodeOptions options;
     options.max_nodes = kMaxNodes;
@@ -36,7 +52,8 @@ void decode_file(const uint8_t* data, size_t size) {
     Hierarchy h;
     try {
         h = decode(data, size, options, &numbering);
-    } catch (const Error&) {
+    } catch (const Error& e) {
+        check_through_context(data, size, options, nullptr, numbering, e.code());
         // Refused whole, its first levels may still decode (or be refused as well).
         options.max_level = int(size % 5);
         try {
@@ -45,6 +62,7 @@ void decode_file(const uint8_t* data, size_t size) {
         }
         return;
     }
+    check_through_context(data, size, options, &h, numbering, ErrorCode{});
     FUZZ_CHECK(check_invariants(h).empty());
     check_one_chunk(data, size, h, options);
     if (!numbering.empty()) {

@@ -152,6 +152,7 @@ void finish_vertices(Hierarchy& whole, const MergePlan& plan, const std::vector<
 Hierarchy merge_in_order(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& input, MergePlan& plan,
                          std::vector<ChunkCounts>& counts) {
     Hierarchy whole(plan.base);
+    if (input.spare != nullptr) HierarchyBuilder::adopt_storage(whole, std::move(*input.spare));
     if (plan.trusted) whole.reserve(size_t(plan.nodes), plan.full ? size_t(input.vertices) : 0);
     HierarchyBuilder::append_vertices(whole, input.seam->positions());
     find_seam_edges(plan, whole, jobs.size());
@@ -188,6 +189,7 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
                           std::vector<ChunkCounts>& counts, unsigned threads) {
     const size_t n = jobs.size();
     Hierarchy whole(plan.base);
+    if (input.spare != nullptr) HierarchyBuilder::adopt_storage(whole, std::move(*input.spare));
     HierarchyBuilder::append_vertices(whole, input.seam->positions());
     std::vector<HierarchySlice> slices(n);
     uint64_t node = plan.base.triangles.size(), vertex = plan.own_start();

@@ -62,6 +62,9 @@ struct ChunkMergeInput {
     // The caller's decoders, kept warm after the decode (DecodeContext); null: decoders made for
     // this decode, which give their working memory back over their last chunk (ChunkPlace::last).
     ChunkDecoders* kept_decoders = nullptr;
+    // A hierarchy the caller is done with (DecodeContext::recycle), or null: the whole is built in
+    // its memory (HierarchyBuilder::adopt_storage), which is left empty.
+    Hierarchy* spare = nullptr;
 };
 
 // What the chunks' decoders know of the merged hierarchy, when every level is decoded.

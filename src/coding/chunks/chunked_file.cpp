@@ -178,6 +178,7 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
     merge.options = input.options;
     merge.zeroed_positions = input.zeroed_positions;
     merge.kept_decoders = input.kept_decoders;
+    merge.spare = input.spare;
     MergedCounts counts;
     Hierarchy whole = decode_and_merge_chunks(jobs, merge, counts);
     if (counts_out != nullptr) *counts_out = counts;

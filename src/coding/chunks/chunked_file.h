@@ -53,6 +53,7 @@ struct ChunkedDecodeInput {
     DecodeOptions options;
     std::future<std::vector<Vec3>>* zeroed_positions = nullptr;  // ChunkMergeInput's
     ChunkDecoders* kept_decoders = nullptr;                       // ChunkMergeInput's
+    Hierarchy* spare = nullptr;                                   // ChunkMergeInput's
 };
 
 // Reads the chunk table and seam blocks at the reader's position and decodes the chunks in

@@ -120,8 +120,18 @@ AMC_ALWAYS_INLINE GridPrediction grid_prediction_at(const GridScale& grid, doubl
     return g;
 }
 
-AMC_ALWAYS_INLINE Residual grid_residual(const Quantizer& quantizer, int axis, double actual, const GridPrediction& g) {
-    const int64_t d = int64_t(quantize_coordinate(quantizer, axis, actual)) - int64_t(g.p);
+// quantize_coordinate's grid point of x with the level's GridScale (`origin`: the quantizer's on
+// the axis): the encoder's actual positions, without the axis selects and Quantizer::bits.
+AMC_ALWAYS_INLINE uint32_t grid_point_at(const GridScale& grid, double origin, double x) {
+    const double t = (x - origin) / grid.step;
+    if (!(t > 0.0)) return 0;  // also NaN
+    if (t >= grid.top) return grid.max;
+    return static_cast<uint32_t>(t + 0.5);
+}
+
+// The residual of an actual grid point against a prediction's.
+AMC_ALWAYS_INLINE Residual grid_residual(uint32_t actual, const GridPrediction& g) {
+    const int64_t d = int64_t(actual) - int64_t(g.p);
     const int64_t s = g.turn ? -d : d;
     return {s < 0, uint64_t(s < 0 ? -s : s)};
 }
@@ -423,7 +433,7 @@ void StaticLevelEncoder::add_vertices(const Hierarchy& h, const std::vector<std:
                 int table = role;
                 if (GridBins) {
                     const GridPrediction g = role == 0 ? c.first[i] : grid_prediction_at(grid, f.origin[role], predicted[role]);
-                    r = grid_residual(*quantizer, axis, actual[axis], g);
+                    r = grid_residual(grid_point_at(grid, f.origin[role], actual[axis]), g);
                     table = kGridBins * role + g.bin;
                 } else {
                     r = residual_of(space, axis, actual[axis], predicted[role]);

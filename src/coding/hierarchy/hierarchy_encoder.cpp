@@ -42,7 +42,6 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
     ids.resize(h.root_count());
     for (NodeId r = 0; r < h.root_count(); ++r) ids[r] = turned != nullptr ? (*turned->old_root)[r] : r;
     if (turned != nullptr) turns = *turned->turn;
-    auto turn = [&](uint32_t i) { return turned != nullptr ? turns[i] : 0; };
     for (int l = 0; !level.empty(); ++l) {
         const uint32_t n = static_cast<uint32_t>(level.size());
         stats.nodes += n;
@@ -65,9 +64,20 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
             if (r && !(state[i] & kComplete) && unbalanced == n) unbalanced = i;
             if (r) {
                 const NodeId c = h.child(id, 0);
-                const uint8_t* child = red_split::kRotatedChild[turn(i)];
-                next_ids.insert(next_ids.end(), {c + child[0], c + child[1], c + child[2], c + child[3]});
-                if (turned != nullptr) next_turns.insert(next_turns.end(), 4, turns[i]);
+                next_ids.insert(next_ids.end(), {c, c + 1, c + 2, c + 3});
+            }
+        }
+        if (turned != nullptr) {  // the children in their turned order, turned alike (apart: no cost without turns)
+            NodeId* children = next_ids.data();
+            for (uint32_t i = 0; i < n; ++i) {
+                if (!refined[i]) continue;
+                const uint8_t* child = red_split::kRotatedChild[turns[i]];
+                const NodeId c = children[0];
+                for (int k = 0; k < 4; ++k) {
+                    children[k] = c + child[k];
+                    next_turns.push_back(turns[i]);
+                }
+                children += 4;
             }
         }
         const bool uniform = options.uniform_levels && all_refined && l == uniform_levels && l < kMaxUniformLevels;
@@ -113,7 +123,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
                 const int unrefined = unrefined_edge(level, i);
                 const bool flipped = h.diagonal_flipped(ids[i]);
                 two_hanging.push_back({unrefined, flipped});
-                unturned_exceptions_.add(kTurnedEdge[unrefined + turn(i)], flipped);
+                if (turned != nullptr) unturned_exceptions_.add(kTurnedEdge[unrefined + turns[i]], flipped);
                 orientation_slots.push_back(events_.size());
                 events_.push_back({kOrientationEvent, 0});
             }
@@ -124,7 +134,10 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         const uint64_t created_count = derive_next_level(level, numbering, next, options.cull_one_regularity);
         std::vector<std::pair<NodeId, int>>& created = new_vertices_.emplace_back();
         created.reserve(created_count);
-        for_each_new_vertex(level, numbering, [&](uint32_t i, int e) { created.emplace_back(ids[i], kTurnedEdge[e + turn(i)]); });
+        if (turned != nullptr)
+            for_each_new_vertex(level, numbering, [&](uint32_t i, int e) { created.emplace_back(ids[i], kTurnedEdge[e + turns[i]]); });
+        else
+            for_each_new_vertex(level, numbering, [&](uint32_t i, int e) { created.emplace_back(ids[i], e); });
         std::swap(level, next);
         level_ids_.push_back(ids);
         ids.swap(next_ids);

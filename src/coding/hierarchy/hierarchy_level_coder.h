@@ -74,9 +74,9 @@ public:
     // Faces of the leaf mesh (1 + hanging nodes per leaf), counted by the first pass: stats().faces
     // without its replay of the symbols.
     uint64_t faces() const { return stats_.faces; }
-    // The diagonal flags' exceptions to every rule as the coded forest reads them, and as h reads
-    // them in its own local order (without `turned`'s turns, diagonal_exceptions(h)): the
-    // encoder's choice of keeping the roots' rotations, without passes of its own over h.
+    // The diagonal flags' exceptions to every rule as the coded forest reads them, and with
+    // `turned` as h reads them in its own local order (without the turns, diagonal_exceptions(h)):
+    // the encoder's choice of keeping the roots' rotations, without passes of its own over h.
     const DiagonalExceptions& diagonal_exceptions() const { return exceptions_; }
     const DiagonalExceptions& unturned_diagonal_exceptions() const { return unturned_exceptions_; }
     // The mixing mode's coded symbols in order, each with its features (bench/mixing_study).
