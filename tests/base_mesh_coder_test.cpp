@@ -1,5 +1,6 @@
 // Base mesh connectivity coder (paper II-B): exact round trips over meshes of every topology the
 // coder must handle, compression rates on the shared base meshes, and corrupt streams.
+#include "coding/base/base_mesh_closing.h"
 #include "coding/base/base_mesh_coder.h"
 #include "coding/base/base_stage.h"
 
@@ -205,6 +206,43 @@ TEST(BaseMeshCoder, TinyAndNonManifold) {
     check_round_trip(fans, "fans");
     TriangleMesh empty;
     check_round_trip(empty, "empty");
+}
+
+// The closed mesh the cut-border coders walk: every halfedge has a twin running the other way, the
+// input's triangles keep their corners (as fan copies), one dummy vertex per boundary loop.
+void check_closed(const TriangleMesh& mesh, uint32_t loops, const std::string& name) {
+    const ClosedMesh cm = make_closed(mesh);
+    ASSERT_EQ(cm.real_triangles, mesh.triangles.size()) << name;
+    ASSERT_EQ(cm.twin.size(), 3 * cm.triangles.size()) << name;
+    EXPECT_EQ(cm.dummies, loops) << name;
+    EXPECT_EQ(uint32_t(std::count(cm.original.begin(), cm.original.end(), kNoVertex)), loops) << name;
+    for (uint32_t t = 0; t < cm.real_triangles; ++t)
+        for (int k = 0; k < 3; ++k) EXPECT_EQ(cm.original[cm.triangles[t][k]], mesh.triangles[t][k]) << name;
+    for (uint32_t h = 0; h < cm.twin.size(); ++h) {
+        const uint32_t twin = cm.twin[h];
+        ASSERT_LT(twin, cm.twin.size()) << name << " halfedge " << h;
+        EXPECT_EQ(cm.twin[twin], h) << name << " halfedge " << h;
+        EXPECT_EQ(cm.corner_vertex(twin), cm.corner_vertex(ClosedMesh::next_halfedge(h))) << name << " halfedge " << h;
+        EXPECT_EQ(cm.corner_vertex(ClosedMesh::next_halfedge(twin)), cm.corner_vertex(h)) << name << " halfedge " << h;
+    }
+}
+
+TEST(BaseMeshCoder, ClosingGivesEveryHalfedgeItsTwin) {
+    check_closed(make_icosahedron(), 0, "icosahedron");
+    check_closed(make_square(3), 1, "square");
+    check_closed(remove_triangles(make_torus(12, 8, 2.0, 0.7), {5, 40, 41, 90}), 3, "torus-three-holes");
+    TriangleMesh one;
+    one.positions.resize(3);
+    one.triangles = {{0, 1, 2}};
+    check_closed(one, 1, "single-triangle");
+    TriangleMesh fans;  // three fans around vertex 0: two boundary loops through its copies
+    fans.positions.resize(7);
+    fans.triangles = {{0, 1, 2}, {0, 3, 4}, {0, 5, 6}, {0, 2, 3}};
+    check_closed(fans, 2, "fans");
+    TriangleMesh flipped;  // a halfedge twice
+    flipped.positions.resize(4);
+    flipped.triangles = {{0, 1, 2}, {0, 1, 3}};
+    EXPECT_THROW(make_closed(flipped), EncoderGaveUp);
 }
 
 // Mode 2 closes a mesh whose edges each have at most one halfedge per direction (fans split, holes

@@ -20,6 +20,32 @@ TEST(Forest, RootsMatchTheBaseMesh) {
     }
 }
 
+// Root neighbours by known answers: a strip of two, a boundary elsewhere, and over an edge used
+// twice the same way (not a valid base: a Hierarchy still links) the last triangle with (b, a).
+TEST(Forest, RootNeighboursAcrossEachEdge) {
+    TriangleMesh strip;
+    strip.positions.resize(4);
+    strip.triangles = {{0, 1, 2}, {2, 1, 3}};
+    const Hierarchy h(strip);
+    EXPECT_EQ(h.neighbor(0, 1), 1u);
+    EXPECT_EQ(h.neighbor_edge(0, 1), 0);
+    EXPECT_EQ(h.neighbor(1, 0), 0u);
+    EXPECT_EQ(h.neighbor_edge(1, 0), 1);
+    for (int e : {0, 2}) {
+        EXPECT_TRUE(h.is_boundary_edge(0, e));
+        EXPECT_EQ(h.neighbor(0, e), kNoNode);
+    }
+    EXPECT_FALSE(h.is_boundary_edge(0, 1));
+    TriangleMesh twice = strip;  // (2, 1) in triangles 1 and 2
+    twice.positions.resize(5);
+    twice.triangles.push_back({4, 2, 1});
+    const Hierarchy g(twice);
+    EXPECT_EQ(g.neighbor(0, 1), 2u);
+    EXPECT_EQ(g.neighbor_edge(0, 1), 1);
+    EXPECT_EQ(g.neighbor(2, 1), 0u);
+    EXPECT_EQ(g.neighbor(1, 0), 0u);
+}
+
 TEST(Forest, UniformRefinementGivesFourToTheKTimesFaces) {
     for (const auto& [name, mesh] : fixture_meshes()) {
         for (int k = 0; k <= 4; ++k) {

@@ -592,6 +592,11 @@ TEST(Validation, RejectsEachDefectNamingTheFirstOffender) {
     mesh.triangles.push_back({0, 1, 2});  // triangle 0 reversed
     expect_invalid(mesh, "triangle 4 repeats triangle 2");
 
+    TriangleMesh pillow;  // two triangles, opposite orientations: every edge used once each way
+    pillow.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    pillow.triangles = {{0, 1, 2}, {0, 2, 1}};
+    expect_invalid(pillow, "triangle 1 repeats triangle 0");
+
     mesh = tetrahedron();
     mesh.positions.push_back({5, 5, 5});
     mesh.triangles.push_back({0, 1, 4});
@@ -608,6 +613,53 @@ TEST(Validation, RejectsEachDefectNamingTheFirstOffender) {
         for (uint32_t& v : t) v += v >= 2;
     }
     expect_invalid(mesh, "vertex 2 is not used by any triangle");
+}
+
+// The linear check's verdict against the definition, pair by pair, on random small triangle sets
+// (pillows, repeated half-edges, edges of three triangles, fans, valid patches).
+TEST(Validation, AgreesWithTheDefinitionOnRandomTriangleSets) {
+    std::mt19937 rng(29);
+    int invalid = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+        TriangleMesh mesh;
+        const uint32_t n = 3 + rng() % 5;
+        mesh.positions.assign(n, Vec3{0, 0, 0});
+        for (uint32_t t = 0, count = 1 + rng() % 6; t < count; ++t) {
+            const uint32_t a = rng() % n, b = (a + 1 + rng() % (n - 1)) % n;
+            uint32_t c = rng() % n;
+            while (c == a || c == b) c = rng() % n;
+            mesh.triangles.push_back({a, b, c});
+        }
+        std::vector<bool> used(n, false);
+        for (const Triangle& t : mesh.triangles)
+            for (uint32_t v : t) used[v] = true;
+        if (std::find(used.begin(), used.end(), false) != used.end()) continue;  // another check's fault
+        bool expect_fault = false;
+        for (size_t i = 0; i < mesh.triangles.size(); ++i)
+            for (size_t j = i + 1; j < mesh.triangles.size(); ++j) {
+                Triangle x = mesh.triangles[i], y = mesh.triangles[j];
+                for (int k = 0; k < 3; ++k)
+                    for (int m = 0; m < 3; ++m)  // the same directed edge twice
+                        expect_fault |= x[k] == y[m] && x[(k + 1) % 3] == y[(m + 1) % 3];
+                std::sort(x.begin(), x.end());
+                std::sort(y.begin(), y.end());
+                expect_fault |= x == y;  // a repeated triangle
+            }
+        invalid += expect_fault;
+        bool threw = false;
+        try {
+            validate_triangle_mesh(mesh, "random");
+        } catch (const Error& e) {
+            threw = true;
+            const std::string message = e.what();
+            EXPECT_TRUE(message.find("repeats triangle") != std::string::npos ||
+                        message.find("non-manifold") != std::string::npos ||
+                        message.find("inconsistent orientation") != std::string::npos)
+                << message;
+        }
+        EXPECT_EQ(threw, expect_fault) << "trial " << trial;
+    }
+    EXPECT_GT(invalid, 100);
 }
 
 TEST(Validation, MillionTrianglesIsFast) {

@@ -57,12 +57,15 @@ uint32_t find_root(std::vector<uint32_t>& parent, uint32_t x) {
 
 }  // namespace
 
+// One halfedge index, of the input: splitting a vertex into its fans keeps every twin (a twin pair
+// joins the corners at both of its ends), and the dummy fans' twins follow from their loops.
 ClosedMesh make_closed(const TriangleMesh& mesh) {
     const uint32_t f = static_cast<uint32_t>(mesh.triangles.size());
     ClosedMesh cm;
     cm.real_triangles = f;
     HalfedgeIndex halfedge;
     if (!halfedge.build(mesh.triangles)) throw EncoderGaveUp{};
+    cm.twin.assign(3 * size_t{f}, kNoVertex);
     // Corners of one vertex sharing an edge belong to one fan.
     std::vector<uint32_t> parent(3 * size_t{f});
     std::iota(parent.begin(), parent.end(), 0u);
@@ -71,6 +74,7 @@ ClosedMesh make_closed(const TriangleMesh& mesh) {
         for (int k = 0; k < 3; ++k) {
             const uint32_t opposite = halfedge.find(tri[(k + 1) % 3], tri[k]);
             if (opposite == kNoVertex) continue;
+            cm.twin[3 * t + k] = opposite;
             const uint32_t other = opposite / 3 * 3 + (opposite % 3 + 1) % 3;  // corner of tri[k]
             parent[find_root(parent, 3 * t + k)] = find_root(parent, other);
         }
@@ -85,45 +89,42 @@ ClosedMesh make_closed(const TriangleMesh& mesh) {
         }
         cm.triangles[c / 3][c % 3] = closed_of_root[r];
     }
-    // Boundary loops, closed by dummy fans.
-    if (!halfedge.build(cm.triangles)) throw EncoderGaveUp{};
+    // Boundary loops (the halfedges without a twin), closed by dummy fans.
     const uint32_t used = static_cast<uint32_t>(cm.original.size());
-    std::vector<uint32_t> boundary_next(used, kNoVertex);
-    for (uint32_t t = 0; t < f; ++t) {
-        for (int k = 0; k < 3; ++k) {
-            const uint32_t a = cm.triangles[t][k], b = cm.triangles[t][(k + 1) % 3];
-            if (halfedge.find(b, a) != kNoVertex) continue;
-            if (boundary_next[a] != kNoVertex) throw EncoderGaveUp{};
-            boundary_next[a] = b;
-        }
+    std::vector<uint32_t> boundary_from(used, kNoVertex);  // per closed vertex: its boundary halfedge
+    for (uint32_t h = 0; h < 3 * f; ++h) {
+        if (cm.twin[h] != kNoVertex) continue;
+        const uint32_t a = cm.corner_vertex(h);
+        if (boundary_from[a] != kNoVertex) throw EncoderGaveUp{};
+        boundary_from[a] = h;
     }
     std::vector<uint8_t> done(used, 0);
     for (uint32_t start = 0; start < used; ++start) {
-        if (boundary_next[start] == kNoVertex || done[start]) continue;
+        if (boundary_from[start] == kNoVertex || done[start]) continue;
         const uint32_t d = static_cast<uint32_t>(cm.original.size());
         cm.original.push_back(kNoVertex);
         ++cm.dummies;
+        const uint32_t first = static_cast<uint32_t>(cm.triangles.size());
         uint32_t a = start;
         for (uint32_t steps = 0; !done[a]; ++steps) {
             if (steps > used) throw EncoderGaveUp{};
             done[a] = 1;
-            const uint32_t b = boundary_next[a];
-            if (b == kNoVertex) throw EncoderGaveUp{};
+            const uint32_t h = boundary_from[a];
+            if (h == kNoVertex) throw EncoderGaveUp{};
+            const uint32_t b = cm.corner_vertex(ClosedMesh::next_halfedge(h));
+            const uint32_t t = static_cast<uint32_t>(cm.triangles.size());
             cm.triangles.push_back({b, a, d});
+            cm.twin[h] = 3 * t;
+            cm.twin.push_back(h);           // (b, a)
+            cm.twin.push_back(3 * t - 1);   // (a, d): the previous dummy triangle's (d, a)
+            cm.twin.push_back(3 * t + 4);   // (d, b): the next one's (b, d)
             a = b;
         }
         if (a != start) throw EncoderGaveUp{};
-    }
-    // Twins; every halfedge must have one now.
-    if (!halfedge.build(cm.triangles)) throw EncoderGaveUp{};
-    const uint32_t fc = static_cast<uint32_t>(cm.triangles.size());
-    cm.twin.assign(3 * size_t{fc}, kNoVertex);
-    for (uint32_t t = 0; t < fc; ++t) {
-        for (int k = 0; k < 3; ++k) {
-            const uint32_t opposite = halfedge.find(cm.triangles[t][(k + 1) % 3], cm.triangles[t][k]);
-            if (opposite == kNoVertex) throw EncoderGaveUp{};
-            cm.twin[3 * t + k] = opposite;
-        }
+        // The loop closes: its first and last dummy triangles are neighbours.
+        const uint32_t last = static_cast<uint32_t>(cm.triangles.size()) - 1;
+        cm.twin[3 * first + 1] = 3 * last + 2;
+        cm.twin[3 * last + 2] = 3 * first + 1;
     }
     return cm;
 }
