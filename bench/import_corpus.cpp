@@ -6,10 +6,11 @@
 //     (base connectivity + hierarchy stream of the .amc file) against the true hierarchy's.
 // Prints a Markdown table. Exit status 1 if any import with the base is not identical.
 //
-// Usage: import_corpus [--move X] [--with-base-only | --without-base-only] [--hash] corpus/*.amh
+// Usage: import_corpus [--move X] [--seed N] [--with-base-only | --without-base-only] [--hash] corpus/*.amh
 // (scripts/import_corpus.sh makes the corpus; --with-base-only skips import_mesh and leaves its
 // columns empty, --without-base-only skips import_leaf_mesh likewise; --hash prints,
-// to stderr, a hash of each detected hierarchy's .amc file, to tell a changed search's output apart)
+// to stderr, a hash of each detected hierarchy's .amc file, to tell a changed search's output apart;
+// --seed N shuffles and moves with another seed than 23, to see how the results depend on the order)
 #include "user_leaf_mesh.h"
 
 #include <amc/codec.h>
@@ -46,16 +47,19 @@ uint64_t connectivity_bytes(const amc::Hierarchy& h) {
 }  // namespace
 
 constexpr const char* kUsage =
-    "usage: import_corpus [--move X] [--with-base-only | --without-base-only] [--hash] hierarchy.amh...\n";
+    "usage: import_corpus [--move X] [--seed N] [--with-base-only | --without-base-only] [--hash] hierarchy.amh...\n";
 
 int run(int argc, char** argv) {
     double move = 0.3;
+    uint64_t seed = 23;
     bool detect = true, with_base_import = true, hash = false;
     std::vector<std::string> files;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         if (arg == "--move" && i + 1 < argc) {
             move = std::atof(argv[++i]);
+        } else if (arg == "--seed" && i + 1 < argc) {
+            seed = std::strtoull(argv[++i], nullptr, 10);
         } else if (arg == "--with-base-only") {
             detect = false;
         } else if (arg == "--without-base-only") {
@@ -84,7 +88,7 @@ int run(int argc, char** argv) {
         const amc::LeafMesh leaf = amc::extract_leaf_mesh(h);
         std::vector<uint32_t> user_of_leaf;
         const amc::TriangleMesh user =
-            bench::user_leaf_mesh(leaf.mesh, uint32_t(h.base().positions.size()), move, 23, &user_of_leaf);
+            bench::user_leaf_mesh(leaf.mesh, uint32_t(h.base().positions.size()), move, seed, &user_of_leaf);
         // The hierarchy the import must give: h with the user's positions.
         amc::Hierarchy expected = h;
         const std::vector<uint32_t> canonical = amc::canonical_vertex_order(h);

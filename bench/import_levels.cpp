@@ -16,7 +16,7 @@
 // how many of each the step undid and the sizes of the closed groups it left (docs/IMPORT.md,
 // "A refined node across a closure").
 //
-// Usage: import_levels [--steps] [--ready] corpus/*.amh
+// Usage: import_levels [--steps] [--ready] [--seed N] corpus/*.amh   (--seed: the shuffle's, 23 by default)
 #include "user_leaf_mesh.h"
 
 #include "import/inverse_refinement.h"
@@ -213,11 +213,14 @@ std::string list(const std::vector<size_t>& v) {
 
 int main(int argc, char** argv) {
     bool print_steps = false, print_ready = false;
+    uint64_t seed = 23;
     std::vector<std::string> files;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         if (arg == "--steps") {
             print_steps = true;
+        } else if (arg == "--seed" && i + 1 < argc) {
+            seed = std::strtoull(argv[++i], nullptr, 10);
         } else if (arg == "--ready") {
             print_ready = true;
         } else {
@@ -225,7 +228,7 @@ int main(int argc, char** argv) {
         }
     }
     if (files.empty()) {
-        std::fprintf(stderr, "usage: import_levels [--steps] [--ready] hierarchy.amh...\n");
+        std::fprintf(stderr, "usage: import_levels [--steps] [--ready] [--seed N] hierarchy.amh...\n");
         return 2;
     }
     std::printf("| model | depth | refined nodes | ideal, whole patches: undone per step | ideal, partial | finest level's nodes found in step 1 | free: true / wrong blocks, triangles left | anchored: true / wrong, triangles left (base) |\n");
@@ -235,7 +238,7 @@ int main(int argc, char** argv) {
         const amc::LeafMesh leaf = amc::extract_leaf_mesh(h);
         std::vector<uint32_t> user_of_leaf;
         const amc::TriangleMesh user =
-            bench::user_leaf_mesh(leaf.mesh, uint32_t(h.base().positions.size()), 0.3, 23, &user_of_leaf);
+            bench::user_leaf_mesh(leaf.mesh, uint32_t(h.base().positions.size()), 0.3, seed, &user_of_leaf);
         const std::vector<uint32_t> canonical = amc::canonical_vertex_order(h);
         auto user_vertex = [&](amc::VertexId v) { return user_of_leaf[canonical[v]]; };
         std::map<Key, int> level_of_split;
