@@ -190,22 +190,17 @@ uint32_t LevelFinder::grow_patch(uint32_t t, Preference preference, bool explori
 }
 
 void LevelFinder::collect_suspects(const std::vector<uint32_t>& invalid, std::vector<uint32_t>& suspects) const {
-    for (uint32_t i : invalid) {
-        for (int e = 0; e < 3; ++e) {
-            if (classify(i, e).kind != Side::invalid) continue;
-            const Fan& fan = blocks_[i].fan[size_t(e)];
-            if (fan.kind != Fan::triangles) continue;
-            for (int k = 0; k < fan.size; ++k) {
-                const uint32_t owner = block_of_[fan.triangle[k]];
-                if (owner != kNoIndex && owner != i) suspects.push_back(blocks_[owner].center);
-            }
-            Block across;
-            if (fan.size != 3 || !read_block(fan.triangle[1], across)) continue;
-            for (uint32_t v : across.v) {
-                for (uint8_t k = 0; k < midpoint_count_[v]; ++k) suspects.push_back(blocks_[midpoint_block_[v][k] / 3].center);
-            }
+    for_each_invalid_fan(invalid, [&](uint32_t i, const Fan& fan) {
+        for (int k = 0; k < fan.size; ++k) {
+            const uint32_t owner = block_of_[fan.triangle[k]];
+            if (owner != kNoIndex && owner != i) suspects.push_back(blocks_[owner].center);
         }
-    }
+        Block across;
+        if (fan.size != 3 || !read_block(fan.triangle[1], across)) return;
+        for (uint32_t v : across.v) {
+            for (uint8_t k = 0; k < midpoint_count_[v]; ++k) suspects.push_back(blocks_[midpoint_block_[v][k] / 3].center);
+        }
+    });
     if (suspects.empty()) {
         for (uint32_t i : invalid) suspects.push_back(blocks_[i].center);
     }
@@ -251,21 +246,16 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
     if (!invalid.empty()) {
         // A large growth held by a few blocks: what refined triangles stood in their way.
         if (size >= kBlockedGrowth && invalid.size() <= kFewInvalid) {
-            for (uint32_t i : invalid) {
-                for (int e = 0; e < 3; ++e) {
-                    if (classify(i, e).kind != Side::invalid) continue;
-                    const Fan& fan = blocks_[i].fan[size_t(e)];
-                    if (fan.kind != Fan::triangles) continue;
-                    for (int k = 0; k < fan.size; ++k) {
-                        const uint32_t g = fan.triangle[k];
-                        if (refined_[g]) blockers_.push_back(g);
-                        for (int f = 0; f < 3; ++f) {
-                            const uint32_t h = adjacency_.twin(3 * g + uint32_t(f));
-                            if (h != kNoHalfEdge && refined_[h / 3] && block_of_[h / 3] != i) blockers_.push_back(h / 3);
-                        }
+            for_each_invalid_fan(invalid, [&](uint32_t i, const Fan& fan) {
+                for (int k = 0; k < fan.size; ++k) {
+                    const uint32_t g = fan.triangle[k];
+                    if (refined_[g]) blockers_.push_back(g);
+                    for (int f = 0; f < 3; ++f) {
+                        const uint32_t h = adjacency_.twin(3 * g + uint32_t(f));
+                        if (h != kNoHalfEdge && refined_[h / 3] && block_of_[h / 3] != i) blockers_.push_back(h / 3);
                     }
                 }
-            }
+            });
         }
         if (repairable && invalid.size() * kRepairableShare <= size) collect_suspects(invalid, *suspects);
         roll_back(start);

@@ -242,6 +242,15 @@ private:
     // a triangle of the fan across an invalid side, and those that made a vertex of the block that
     // would fit across it a midpoint; failing those, the invalid blocks themselves (as centers).
     void collect_suspects(const std::vector<uint32_t>& invalid, std::vector<uint32_t>& suspects) const;
+    // visit(i, fan) for every side of the blocks `invalid` that classify() finds invalid and whose
+    // fan is made of triangles.
+    template <class Visit>
+    void for_each_invalid_fan(const std::vector<uint32_t>& invalid, Visit visit) const {
+        for (uint32_t i : invalid)
+            for (int e = 0; e < 3; ++e)
+                if (classify(i, e).kind == Side::invalid && blocks_[i].fan[size_t(e)].kind == Fan::triangles)
+                    visit(i, blocks_[i].fan[size_t(e)]);
+    }
 
     // Whether a growth from blocks_[start] is sure enough to fail that growing it further is
     // wasted: of its `settled` blocks (the first half of those placed, whose sides the breadth-
