@@ -16,9 +16,12 @@
 // how many of each the step undid and the sizes of the closed groups it left (docs/IMPORT.md,
 // "A refined node across a closure").
 //
-// Usage: import_levels [--steps] [--ready] [--seed N] corpus/*.amh   (--seed: the shuffle's, 23 by default)
+// With --detect, also what detect_base (import_mesh's search, its rerun included) undid per level.
+//
+// Usage: import_levels [--steps] [--ready] [--detect] [--seed N] corpus/*.amh   (--seed: the shuffle's, 23 by default)
 #include "user_leaf_mesh.h"
 
+#include "import/base_detection.h"
 #include "import/inverse_refinement.h"
 
 #include <amc/hierarchy.h>
@@ -212,7 +215,7 @@ std::string list(const std::vector<size_t>& v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    bool print_steps = false, print_ready = false;
+    bool print_steps = false, print_ready = false, print_detected = false;
     uint64_t seed = 23;
     std::vector<std::string> files;
     for (int i = 1; i < argc; ++i) {
@@ -223,12 +226,14 @@ int main(int argc, char** argv) {
             seed = std::strtoull(argv[++i], nullptr, 10);
         } else if (arg == "--ready") {
             print_ready = true;
+        } else if (arg == "--detect") {
+            print_detected = true;
         } else {
             files.push_back(arg);
         }
     }
     if (files.empty()) {
-        std::fprintf(stderr, "usage: import_levels [--steps] [--ready] [--seed N] hierarchy.amh...\n");
+        std::fprintf(stderr, "usage: import_levels [--steps] [--ready] [--detect] [--seed N] hierarchy.amh...\n");
         return 2;
     }
     std::printf("| model | depth | refined nodes | ideal, whole patches: undone per step | ideal, partial | finest level's nodes found in step 1 | free: true / wrong blocks, triangles left | anchored: true / wrong, triangles left (base) |\n");
@@ -273,6 +278,17 @@ int main(int argc, char** argv) {
                 for (const auto& s : d->steps) std::printf("%zu/%zu ", s[0], s[1]);
                 std::printf("| | | | | | | |\n");
             }
+        }
+        if (print_detected) {
+            // What import_mesh's base detection commits (with its rerun), per level.
+            const amc::DetectedBase detected = amc::detect_base(user, name);
+            std::printf("|   detect_base (true/wrong): ");
+            for (const amc::DetectedLevel& level : detected.levels) {
+                size_t wrong = 0;
+                for (const auto& s : level.splits) wrong += level_of_split.count(sorted_key(s[3], s[4], s[5])) == 0;
+                std::printf("%zu/%zu ", level.splits.size() - wrong, wrong);
+            }
+            std::printf("-> %zu triangles | | | | | | | |\n", detected.base.triangles.size());
         }
         std::fflush(stdout);
     }

@@ -17,7 +17,7 @@ constexpr uint32_t kNoHalfEdge = kNoIndex;
 class TriangleAdjacency {
 public:
     // Linear in triangles + vertex_count: half-edges are grouped by start vertex with a counting
-    // sort, and each vertex's few half-edges are sorted by their end vertex.
+    // sort; a vertex's half-edges are sorted by their end vertex only when they are many.
     TriangleAdjacency(const std::vector<Triangle>& triangles, uint32_t vertex_count);
 
     // The opposite half-edge, or kNoHalfEdge on the boundary.
@@ -26,7 +26,8 @@ public:
     uint32_t star_size(uint32_t v) const { return out_start_[v + 1] - out_start_[v]; }
     const uint32_t* outgoing_begin(uint32_t v) const { return out_half_edge_.data() + out_start_[v]; }
     const uint32_t* outgoing_end(uint32_t v) const { return out_half_edge_.data() + out_start_[v + 1]; }
-    // Their end vertices, ascending: every neighbour of v but, on the boundary, the one before v.
+    // Their end vertices, in no particular order: every neighbour of v but, on the boundary, the
+    // one before v.
     const uint32_t* ends_begin(uint32_t v) const { return out_end_.data() + out_start_[v]; }
     const uint32_t* ends_end(uint32_t v) const { return out_end_.data() + out_start_[v + 1]; }
     bool on_boundary(uint32_t v) const { return boundary_[v] != 0; }
@@ -37,11 +38,12 @@ public:
     }
 
 private:
+    static constexpr uint32_t kScanned = 16;  // half-edges of a vertex that find scans (more: sorted)
     uint32_t find(uint32_t from, uint32_t to) const;  // the half-edge from -> to, or kNoHalfEdge
 
     std::vector<uint32_t> twin_;
     std::vector<uint32_t> out_start_;      // half-edges by start vertex: [out_start_[v], out_start_[v+1])
-    std::vector<uint32_t> out_end_;        // their end vertices, ascending within a vertex
+    std::vector<uint32_t> out_end_;        // their end vertices (ascending for more than kScanned)
     std::vector<uint32_t> out_half_edge_;  // their ids
     std::vector<uint8_t> boundary_;
 };
