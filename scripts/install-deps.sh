@@ -2,7 +2,7 @@
 # Installs the Debian packages amcodec builds with, skipping those already present.
 set -euo pipefail
 packages=(g++ cmake make pkg-config libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
-          libtinyobjloader-dev libmeshoptimizer-dev libxxhash-dev zlib1g-dev
+          libmeshoptimizer-dev libxxhash-dev zlib1g-dev
           pybind11-dev python3-dev python3-numpy python3-pytest python3-meshio python3-vtk9)
 # --bench: the peers of bench/compare_bench; --p4est: octree interoperability; --mpi: Open MPI for
 # amcodec_mpi; --fuzz: clang and its libFuzzer runtime (tests/fuzz).

@@ -349,6 +349,18 @@ TEST(ObjReader, RejectsPolygonsOutOfRangeAndMalformedCoordinates) {
     expect_error_containing([&] { parse_obj(v + "f 0 1 2\n", "z.obj"); }, "z.obj: OBJ parse error");
 }
 
+TEST(ObjReader, ChecksEveryPartOfAFaceCorner) {
+    const std::string v = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    EXPECT_EQ(parse_obj(v + "f 1/2 2//3 3/-1/-2\n", "t.obj").triangles, (std::vector<Triangle>{{0, 1, 2}}));
+    // A face may name a vertex that a later line defines; a relative index counts lines read so far.
+    EXPECT_EQ(parse_obj("v 0 0 0\nv 1 0 0\nf -2 -1 3\nv 0 1 0\n", "t.obj").triangles,
+              (std::vector<Triangle>{{0, 1, 2}}));
+    for (const char* face : {"f 1/0 2 3\n", "f 1// 2 3\n", "f 1/ 2 3\n", "f 1/2/3/4 2 3\n", "f x 2 3\n",
+                             "f 1 2 3.0\n", "f 1//0 2 3\n", "f 99999999999999999999 2 3\n"}) {
+        expect_error_containing([&] { parse_obj(v + face, "m.obj"); }, "m.obj: OBJ parse error: face 0 (line 4)");
+    }
+}
+
 TEST(OffReader, AcceptsCommentsTabsColoursAndTrailingWhitespace) {
     const std::string text =
         "OFF # header comment\n# a comment line\n\t4  4\t0 \r\n0 0 0\n\t1 0 0  # x axis\n"

@@ -1,5 +1,5 @@
 // Mesh files in other programs' formats (OBJ, OFF, PLY, VTU) and the files that name them: the
-// readers and writers of the library amcodec_extras (tinyobjloader, zlib), which the CLI, the
+// readers and writers of the library amcodec_extras (zlib), which the CLI, the
 // Python module, the tests and the benchmarks link. The codec library amcodec, which installs,
 // works on meshes in memory (<amc/mesh.h>) and does not read these formats.
 #pragma once

@@ -24,12 +24,10 @@ enum class FloatText {
     distinctive,  // the shortest decimal of a float, 8 or 9 digits: only float data prints these
 };
 
-// Digits from the first to the last non-zero one of the shortest decimal of `value`.
-inline int significant_digits(double value) {
-    char buf[32];
-    const auto printed = std::to_chars(buf, buf + sizeof buf, value);
+// Digits from the first to the last non-zero one of a printed decimal ("1.25e-07": 3).
+inline int significant_digits(const char* begin, const char* end) {
     int first = -1, last = -1, position = 0;
-    for (const char* c = buf; c != printed.ptr && *c != 'e'; ++c) {
+    for (const char* c = begin; c != end && *c != 'e'; ++c) {
         if (*c < '0' || *c > '9') continue;
         if (*c != '0') {
             if (first < 0) first = position;
@@ -52,7 +50,10 @@ inline FloatText classify_float_text(double value, float& as_float) {
     double back = 0;
     const auto parsed = std::from_chars(buf, printed.ptr, back);
     if (printed.ec != std::errc() || parsed.ec != std::errc() || back != value) return FloatText::not_float;
-    return significant_digits(value) >= kDigitsOnlyFloatsPrint ? FloatText::distinctive : FloatText::ambiguous;
+    // The float's shortest decimal reads back as `value`, so it is also the double's shortest: a
+    // shorter decimal that close would differ from it by at least 10^-9 relatively.
+    return significant_digits(buf, printed.ptr) >= kDigitsOnlyFloatsPrint ? FloatText::distinctive
+                                                                            : FloatText::ambiguous;
 }
 
 // The double that the shortest decimal of `f` reads as.
