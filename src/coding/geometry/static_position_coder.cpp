@@ -61,6 +61,14 @@ Residual residual_of(CoordinateSpace space, int axis, double actual, double pred
     return {negative, negative ? (uint64_t{0} - r) & mask : r};
 }
 
+// residual_of's for float64 coordinates, inline in the encoder's loop (bit-exact files' modes 3 and 5).
+AMC_ALWAYS_INLINE Residual float64_residual(double actual, double predicted) {
+    const uint64_t r = ordered_bits(actual, Precision::float64) -
+                       ordered_bits(std::isfinite(predicted) ? predicted : 0.0, Precision::float64);
+    const bool negative = (r >> 63) != 0;
+    return {negative, negative ? uint64_t{0} - r : r};
+}
+
 // Branch-free: residual signs are coin flips, which a branch would mispredict half the time.
 AMC_ALWAYS_INLINE int64_t negated_if(int64_t x, bool negate) {
     const int64_t m = -int64_t(negate);
@@ -404,17 +412,24 @@ void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, 
     if (counts_[0].empty())
         for (int i = 0; i < table_count_; ++i) counts_[size_t(i)].assign(size_t(token_limit(space_)), 0);
     symbols_.resize(end);
+    const bool float64 = space_.quantizer == nullptr && space_.precision == Precision::float64;
     switch (mode_) {
-        case GeometryPredictor::normal_frame: add_vertices<false, false>(h, created, begin, end); break;
-        case GeometryPredictor::normal_frame_grid: add_vertices<true, true>(h, created, begin, end); break;
-        default: add_vertices<true, false>(h, created, begin, end); break;
+        case GeometryPredictor::normal_frame:
+            if (float64) add_vertices<false, false, true>(h, created, begin, end);
+            else add_vertices<false, false, false>(h, created, begin, end);
+            break;
+        case GeometryPredictor::normal_frame_grid: add_vertices<true, true, false>(h, created, begin, end); break;
+        default:
+            if (float64) add_vertices<true, false, true>(h, created, begin, end);
+            else add_vertices<true, false, false>(h, created, begin, end);
+            break;
     }
 }
 
-// The loop of add() for one mode: the frame's kind and the table split known when it is compiled.
+// The loop of add() for one mode: the frame's kind, the table split and float64 residuals known when it is compiled.
 // A chunk's corners and frames as the decoder makes them (gather_chunk, frame_chunk), then each
 // vertex's residuals in role order.
-template <bool UnitNormals, bool GridBins, class Mesh>
+template <bool UnitNormals, bool GridBins, bool Float64, class Mesh>
 void StaticLevelEncoder::add_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin,
                                       size_t end) {
     const CoordinateSpace space = space_;
@@ -441,6 +456,8 @@ void StaticLevelEncoder::add_vertices(const Mesh& h, const std::vector<std::pair
                     const GridPrediction g = role == 0 ? c.first[i] : grid_prediction_at(grid, f.origin[role], predicted[role]);
                     r = grid_residual(grid_point_at(grid, f.origin[role], actual[axis]), g);
                     table = kGridBins * role + g.bin;
+                } else if (Float64) {
+                    r = float64_residual(actual[axis], predicted[role]);
                 } else {
                     r = residual_of(space, axis, actual[axis], predicted[role]);
                 }

@@ -106,7 +106,7 @@ private:
     // Tokens, residuals and counts of created[begin, end).
     template <class Mesh>
     void add(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
-    template <bool UnitNormals, bool GridBins, class Mesh>
+    template <bool UnitNormals, bool GridBins, bool Float64, class Mesh>
     void add_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
     // lower_bound_bytes()' parts: the coded tables, and the rANS and raw streams.
     size_t table_bytes() const;
