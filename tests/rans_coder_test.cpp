@@ -98,6 +98,20 @@ TEST(Rans, RoundTripsSeveralTablesInterleaved) {
     }
 }
 
+TEST(Rans, EncoderStepWithoutDivisionIsTheDivision) {
+    // RansTable::Coding's reciprocal step against the definition, for every frequency, at the ends
+    // of the states the encoder codes from ([x_max / 256, x_max) after renormalisation) and between.
+    std::mt19937_64 rng(11);
+    for (uint32_t f = 1; f < kRansScale; ++f) {
+        const uint32_t start = kRansScale - f;
+        const RansTable::Coding c = RansTable::coding_of(start, f);
+        ASSERT_EQ(c.x_max, ((kRansLow >> kRansScaleBits) << 8) * f);
+        std::vector<uint32_t> xs = {c.x_max - 1, c.x_max / 256, c.x_max / 256 + 1, c.x_max / 2};
+        for (int i = 0; i < 64; ++i) xs.push_back(c.x_max / 256 + uint32_t(rng() % (c.x_max - c.x_max / 256)));
+        for (uint32_t x : xs) ASSERT_EQ(c.code(x), (x / f) * kRansScale + x % f + start) << f << " " << x;
+    }
+}
+
 TEST(Rans, CodeLengthIsTheTablesEntropy) {
     const std::vector<int> s = skewed_symbols(200000, 60, 3);
     const RansTable t = RansTable::from_counts(counts_of(s, 60));

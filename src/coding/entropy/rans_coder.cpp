@@ -81,11 +81,34 @@ bool RansTable::assign(const std::vector<uint32_t>& frequencies) {
 
 void RansTable::set_starts() {
     start_.assign(frequency_.size(), 0);
+    coding_.assign(frequency_.size(), Coding{});
     uint32_t start = 0;
     for (size_t s = 0; s < frequency_.size(); ++s) {
         start_[s] = start;
+        if (frequency_[s] != 0) coding_[s] = coding_of(start, frequency_[s]);
         start += frequency_[s];
     }
+}
+
+RansTable::Coding RansTable::coding_of(uint32_t start, uint32_t frequency) {
+    Coding c;
+    // The largest state that stays below 256 L after coding: ((L / M) << 8) * f.
+    c.x_max = ((kRansLow >> kRansScaleBits) << 8) * frequency;
+    c.complement = kRansScale - frequency;
+    if (frequency < 2) {
+        // 1 has no reciprocal below 1: q = x - 1 (from 2^32 - 1, no shift), and the bias makes up
+        // for it: x + bias + (x - 1)(M - 1) = x M + start.
+        c.reciprocal = ~uint32_t{0};
+        c.shift = 32;
+        c.bias = start + kRansScale - 1;
+        return c;
+    }
+    uint32_t bits = 0;  // ceil(log2 f)
+    while (frequency > (uint32_t{1} << bits)) ++bits;
+    c.reciprocal = uint32_t(((uint64_t{1} << (bits + 31)) + frequency - 1) / frequency);
+    c.shift = 32 + bits - 1;
+    c.bias = start;
+    return c;
 }
 
 void RansTable::build_slots() {
@@ -108,31 +131,33 @@ double RansTable::cost_bits(int symbol) const {
 }
 
 std::vector<uint8_t> RansEncoder::finish() {
-    // Built back to front, reversed at the end.
-    std::vector<uint8_t> reversed;
-    reversed.reserve(queue_.size() / 2 + 16);
+    // Built back to front: a symbol writes at most two bytes (x < 2^31 before, x_max >= 2^19).
+    std::vector<uint8_t> out(2 * queue_.size() + kRansStateBytes);
+    uint8_t* const end = out.data() + out.size();
+    uint8_t* p = end;
     uint32_t state[2] = {kRansLow, kRansLow};
     for (size_t i = queue_.size(); i-- > 0;) {
         uint32_t& x = state[i & 1];
-        const Queued q = queue_[i];
-        // The largest state that stays below 256 L after coding: ((L / M) << 8) * f.
-        const uint32_t limit = ((kRansLow >> kRansScaleBits) << 8) * q.frequency;
-        while (x >= limit) {
-            reversed.push_back(uint8_t(x));
+        const RansTable::Coding& c = *queue_[i];
+        while (x >= c.x_max) {
+            *--p = uint8_t(x);
             x >>= 8;
         }
-        x = ((x / q.frequency) << kRansScaleBits) + (x % q.frequency) + q.start;
+        x = c.code(x);
     }
     for (int s = 1; s >= 0; --s)
-        for (int shift = 24; shift >= 0; shift -= 8) reversed.push_back(uint8_t(state[s] >> shift));
+        for (int shift = 24; shift >= 0; shift -= 8) *--p = uint8_t(state[s] >> shift);
     queue_.clear();
-    return std::vector<uint8_t>(reversed.rbegin(), reversed.rend());
+    out.erase(out.begin(), out.begin() + (p - out.data()));
+    return out;
 }
 
 std::vector<uint8_t> RawBitWriter::finish() {
+    bytes_.resize(used_);
     if (filled_ > 0) bytes_.push_back(uint8_t(buffer_));
     buffer_ = 0;
     filled_ = 0;
+    used_ = 0;
     std::vector<uint8_t> out;
     out.swap(bytes_);
     return out;

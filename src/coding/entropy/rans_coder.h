@@ -21,6 +21,7 @@
 
 #include "common/simd.h"
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -57,6 +58,18 @@ public:
     uint32_t frequency(int symbol) const { return frequency_[size_t(symbol)]; }
     uint32_t start(int symbol) const { return start_[size_t(symbol)]; }
     const std::vector<uint32_t>& frequencies() const { return frequency_; }
+    // The encoder's step for one symbol without a division (F. Giesen's ryg_rans after Alverson,
+    // "Integer division using reciprocals"): x -> (x / f) M + x mod f + start as x + bias + q (M - f),
+    // q = x / f from a 32-bit reciprocal, exact for every x below 2^31 (the encoder's x < x_max).
+    struct Coding {
+        uint32_t x_max = 0, reciprocal = 0, bias = 0, complement = 0, shift = 0;
+        uint32_t code(uint32_t x) const {
+            const uint32_t q = uint32_t((uint64_t(x) * reciprocal) >> shift);
+            return x + bias + q * complement;
+        }
+    };
+    static Coding coding_of(uint32_t start, uint32_t frequency);
+    const Coding& coding(int symbol) const { return coding_[size_t(symbol)]; }
     // -log2 of the symbol's probability (its code length in bits); the symbol must have a frequency.
     double cost_bits(int symbol) const;
 
@@ -75,6 +88,7 @@ private:
     void set_starts();
     void build_slots();
     std::vector<uint32_t> frequency_, start_;
+    std::vector<Coding> coding_;
     std::vector<Entry> entries_;
     bool narrow_ = true;
     std::vector<uint8_t> narrow_index_;
@@ -84,17 +98,14 @@ private:
 class RansEncoder {
 public:
     // Queues one symbol (it must have a nonzero frequency in `table`, which must outlive finish()).
-    void put(const RansTable& table, int symbol) { queue_.push_back({table.start(symbol), table.frequency(symbol)}); }
+    void put(const RansTable& table, int symbol) { queue_.push_back(&table.coding(symbol)); }
     size_t symbols() const { return queue_.size(); }
     void reserve(size_t symbols) { queue_.reserve(symbols); }
     // Codes the queued symbols; the encoder is empty again afterwards.
     std::vector<uint8_t> finish();
 
 private:
-    struct Queued {
-        uint32_t start, frequency;
-    };
-    std::vector<Queued> queue_;
+    std::vector<const RansTable::Coding*> queue_;
 };
 
 class RansDecoder {
@@ -152,18 +163,31 @@ public:
     void put(uint64_t value, int count) {
         buffer_ |= (count == 0 ? 0 : value & (~uint64_t{0} >> (64 - count))) << filled_;
         filled_ += count;
-        while (filled_ >= 8) {
-            bytes_.push_back(uint8_t(buffer_));
-            buffer_ >>= 8;
-            filled_ -= 8;
-        }
+        if (filled_ >= 8) flush_whole_bytes();
     }
-    size_t bits() const { return bytes_.size() * 8 + size_t(filled_); }
+    // Room for `bits` more bits without growing on the way.
+    void reserve_bits(uint64_t bits) { bytes_.reserve(used_ + size_t(bits / 8) + 8); }
+    size_t bits() const { return used_ * 8 + size_t(filled_); }
     // Pads the last byte with zero bits and returns the bytes; the writer is empty again.
     std::vector<uint8_t> finish();
 
 private:
-    std::vector<uint8_t> bytes_;
+    // The buffer's whole bytes (1..8) out at once: a byte at a time was a push_back each.
+    void flush_whole_bytes() {
+        const int whole = filled_ >> 3;
+        if (bytes_.size() < used_ + 8) bytes_.resize(std::max(bytes_.capacity(), used_ + 8));
+#if AMC_LITTLE_ENDIAN
+        std::memcpy(bytes_.data() + used_, &buffer_, 8);  // the bytes past `whole` are written again later
+#else
+        for (int i = 0; i < whole; ++i) bytes_[used_ + size_t(i)] = uint8_t(buffer_ >> (8 * i));
+#endif
+        used_ += size_t(whole);
+        buffer_ = whole == 8 ? 0 : buffer_ >> (8 * whole);
+        filled_ -= 8 * whole;
+    }
+
+    std::vector<uint8_t> bytes_;  // the first used_ are written
+    size_t used_ = 0;
     uint64_t buffer_ = 0;
     int filled_ = 0;
 };

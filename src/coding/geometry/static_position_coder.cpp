@@ -158,12 +158,14 @@ AMC_ALWAYS_INLINE bool grid_value(const GridScale& grid, double origin, const Gr
 void put_raw(RawBitWriter& raw, Residual r) {
     if (r.magnitude < 8) return;
     const int low = bit_length(r.magnitude) - 3;
-    raw.put(r.negative ? 1 : 0, 1);
+    // The sign and the first value in one put (take_large reads them in one get); put's mask drops
+    // the magnitude's three leading bits, which the token holds.
+    const uint64_t sign = r.negative ? 1 : 0;
     if (low > 32) {
-        raw.put(r.magnitude >> 32, low - 32);
+        raw.put((r.magnitude >> 32) << 1 | sign, low - 31);
         raw.put(r.magnitude & 0xFFFFFFFFull, 32);
     } else {
-        raw.put(r.magnitude, low);
+        raw.put(r.magnitude << 1 | sign, low + 1);
     }
 }
 
@@ -510,6 +512,7 @@ void StaticLevelEncoder::code_streams() {
     RansEncoder rans;
     rans.reserve(kStaticRoles * symbols_.size());
     RawBitWriter raw;
+    raw.reserve_bits(raw_bits_);
     size_t next_large = 0;
     for (const std::array<uint16_t, kStaticRoles>& symbols : symbols_) {
         for (uint16_t symbol : symbols) {
