@@ -33,6 +33,8 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
     LevelTraversal traversal(options, stream_version);
     Level level, next;
     std::vector<NodeId> ids, next_ids;
+    // Per node of the level: bit 0 refined, bit 1 its diagonal flag, both read while its node is in
+    // the cache (the pass over the leaves below missed it again on large levels).
     std::vector<uint8_t> refined;
     RefinedNumbering numbering;
     LevelShapes shapes;  // mixing mode
@@ -47,6 +49,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         stats.nodes += n;
         refined.resize(n);
         next_ids.clear();
+        next_ids.reserve(4 * size_t(n));  // at most four children a node
         next_turns.clear();
         bool all_refined = true;
         // A refined node needs all its neighbours (Hierarchy::can_split); no stream could say
@@ -59,7 +62,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
             if (i + kAhead < n) HierarchyBuilder::prefetch(h, ids[i + kAhead]);
             const NodeId id = ids[i];
             const bool r = !h.is_leaf(id);
-            refined[i] = r;
+            refined[i] = uint8_t(r | h.diagonal_flipped(id) << 1);
             all_refined &= r;
             if (r && !(state[i] & kComplete) && unbalanced == n) unbalanced = i;
             if (r) {
@@ -70,7 +73,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         if (turned != nullptr) {  // the children in their turned order, turned alike (apart: no cost without turns)
             NodeId* children = next_ids.data();
             for (uint32_t i = 0; i < n; ++i) {
-                if (!refined[i]) continue;
+                if (!(refined[i] & 1)) continue;
                 const uint8_t* child = red_split::kRotatedChild[turns[i]];
                 const NodeId c = children[0];
                 for (int k = 0; k < 4; ++k) {
@@ -94,7 +97,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         traversal.run(
             level, uniform,
             [&](uint32_t i, int group) {
-                const bool r = truth[i] != 0;
+                const bool r = (truth[i] & 1) != 0;
                 if (mixed_) {
                     if (event_feature_.size() < events_.size() + 1) event_feature_.resize(events_.size() + 1);
                     event_feature_[events_.size()] = uint32_t(mixed_features_.size());
@@ -110,7 +113,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
                     case Fate::hanging_nodes: ++stats.culled_hanging_nodes; break;
                     case Fate::coded: break;
                 }
-                return truth[i] != 0;
+                return (truth[i] & 1) != 0;
             });
         for (uint32_t i = 0; i < n; ++i) {
             if (state[i] & kRefined) continue;
@@ -121,7 +124,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
             faces += 1 + uint64_t(hanging);
             if (hanging == 2) {
                 const int unrefined = unrefined_edge(level, i);
-                const bool flipped = h.diagonal_flipped(ids[i]);
+                const bool flipped = (truth[i] >> 1) != 0;
                 two_hanging.push_back({unrefined, flipped});
                 if (turned != nullptr) unturned_exceptions_.add(kTurnedEdge[unrefined + turns[i]], flipped);
                 orientation_slots.push_back(events_.size());
@@ -139,8 +142,9 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         else
             for_each_new_vertex(level, numbering, [&](uint32_t i, int e) { created.emplace_back(ids[i], e); });
         std::swap(level, next);
-        level_ids_.push_back(ids);
-        ids.swap(next_ids);
+        level_ids_.push_back(std::move(ids));  // kept whole: no copy of the level's ids
+        ids = std::move(next_ids);
+        next_ids = std::vector<NodeId>();
         turns.swap(next_turns);
     }
     stats.uniform_levels = uniform_levels;
