@@ -414,24 +414,31 @@ void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, 
     if (counts_[0].empty())
         for (int i = 0; i < table_count_; ++i) counts_[size_t(i)].assign(size_t(token_limit(space_)), 0);
     symbols_.resize(end);
+    // Room for the residuals with raw bits, grown by doubling they were copied again and again: in
+    // float spaces nearly every coordinate has them, on a grid as many as on the part before.
+    const size_t more = space_.quantizer == nullptr ? kStaticRoles * (end - begin)
+                        : begin == 0                 ? 0
+                                                     : size_t(double(large_.size()) * double(end - begin) / double(begin));
+    large_.reserve(large_.size() + more);
     const bool float64 = space_.quantizer == nullptr && space_.precision == Precision::float64;
     switch (mode_) {
         case GeometryPredictor::normal_frame:
-            if (float64) add_vertices<false, false, true>(h, created, begin, end);
-            else add_vertices<false, false, false>(h, created, begin, end);
+            if (space_.quantizer != nullptr) add_vertices<false, false, kGridResiduals>(h, created, begin, end);
+            else if (float64) add_vertices<false, false, kFloat64Residuals>(h, created, begin, end);
+            else add_vertices<false, false, kAnyResiduals>(h, created, begin, end);
             break;
-        case GeometryPredictor::normal_frame_grid: add_vertices<true, true, false>(h, created, begin, end); break;
+        case GeometryPredictor::normal_frame_grid: add_vertices<true, true, kGridResiduals>(h, created, begin, end); break;
         default:
-            if (float64) add_vertices<true, false, true>(h, created, begin, end);
-            else add_vertices<true, false, false>(h, created, begin, end);
+            if (float64) add_vertices<true, false, kFloat64Residuals>(h, created, begin, end);
+            else add_vertices<true, false, kAnyResiduals>(h, created, begin, end);
             break;
     }
 }
 
-// The loop of add() for one mode: the frame's kind, the table split and float64 residuals known when it is compiled.
+// The loop of add() for one mode: the frame's kind, the table split and the residuals' kind known when it is compiled.
 // A chunk's corners and frames as the decoder makes them (gather_chunk, frame_chunk), then each
 // vertex's residuals in role order.
-template <bool UnitNormals, bool GridBins, bool Float64, class Mesh>
+template <bool UnitNormals, bool GridBins, int Residuals, class Mesh>
 void StaticLevelEncoder::add_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin,
                                       size_t end) {
     const CoordinateSpace space = space_;
@@ -458,8 +465,12 @@ void StaticLevelEncoder::add_vertices(const Mesh& h, const std::vector<std::pair
                     const GridPrediction g = role == 0 ? c.first[i] : grid_prediction_at(grid, f.origin[role], predicted[role]);
                     r = grid_residual(grid_point_at(grid, f.origin[role], actual[axis]), g);
                     table = kGridBins * role + g.bin;
-                } else if (Float64) {
+                } else if (Residuals == kFloat64Residuals) {
                     r = float64_residual(actual[axis], predicted[role]);
+                } else if (Residuals == kGridResiduals) {  // residual_of's grid points, with the level's GridScale
+                    const uint32_t a = grid_point_at(grid, f.origin[role], actual[axis]);
+                    const uint32_t q = grid_point_at(grid, f.origin[role], predicted[role]);
+                    r = {a < q, a < q ? uint64_t(q - a) : uint64_t(a - q)};
                 } else {
                     r = residual_of(space, axis, actual[axis], predicted[role]);
                 }

@@ -106,7 +106,9 @@ private:
     // Tokens, residuals and counts of created[begin, end).
     template <class Mesh>
     void add(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
-    template <bool UnitNormals, bool GridBins, bool Float64, class Mesh>
+    // How add_vertices takes the residuals of modes 3 and 5: residual_of, float64 inline, or grid points inline.
+    static constexpr int kAnyResiduals = 0, kFloat64Residuals = 1, kGridResiduals = 2;
+    template <bool UnitNormals, bool GridBins, int Residuals, class Mesh>
     void add_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
     // lower_bound_bytes()' parts: the coded tables, and the rANS and raw streams.
     size_t table_bytes() const;
