@@ -1,8 +1,12 @@
 // How far a candidate lies off the shortest paths between an edge's ends in the leaf mesh
-// (src/import/leaf_detour.h): known answers on a strip of six triangles.
+// (src/import/leaf_detour.h): known answers on a strip of six triangles; and the neighbour lists
+// of the directed-edge index (src/import/leaf_halfedges.h) both search it with.
 #include "import/leaf_detour.h"
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <vector>
 
 namespace {
 
@@ -97,6 +101,38 @@ TEST(LeafDetour, TargetsAloneGetTheFullSearchesDetoursInAClosedMesh) {
     }
     ASSERT_TRUE(full.measure(0, 5, 2));  // opposite poles: every other vertex is on a shortest path
     for (uint32_t c = 1; c <= 4; ++c) EXPECT_EQ(full.detour(c), 0) << c;
+}
+
+// LeafHalfedges::for_each_neighbor_once, which the reconstruction's order-free tests use: every
+// neighbour once, in closed fans (the ends alone) and open ones (an apex that is no end too).
+TEST(LeafHalfedges, ListEachNeighbourOnce) {
+    const amc::TriangleMesh meshes[2] = {hexagon(), strip()};
+    for (const amc::TriangleMesh& mesh : meshes) {
+        const amc::LeafHalfedges halfedges(mesh);
+        for (uint32_t u = 0; u < mesh.positions.size(); ++u) {
+            std::vector<uint32_t> expected, listed;
+            for (const amc::Triangle& t : mesh.triangles) {
+                for (int k = 0; k < 3; ++k) {
+                    if (t[k] != u) continue;
+                    expected.push_back(t[(k + 1) % 3]);
+                    expected.push_back(t[(k + 2) % 3]);
+                }
+            }
+            std::sort(expected.begin(), expected.end());
+            expected.erase(std::unique(expected.begin(), expected.end()), expected.end());
+            halfedges.for_each_neighbor_once(u, [&](uint32_t x) { listed.push_back(x); });
+            std::sort(listed.begin(), listed.end());
+            EXPECT_EQ(listed, expected) << u;  // sorted with its repeats: each exactly once
+            EXPECT_EQ(halfedges.face(u, u), amc::kNoIndex);
+        }
+        // The flag bit kept out of the faces the index reports.
+        for (uint32_t f = 0; f < mesh.triangles.size(); ++f) {
+            const amc::Triangle& t = mesh.triangles[f];
+            EXPECT_EQ(halfedges.face(t[0], t[1]), f);
+            EXPECT_EQ(halfedges.edge(t[1], t[2]).face, f);
+            EXPECT_EQ(halfedges.edge(t[1], t[2]).apex, t[0]);
+        }
+    }
 }
 
 TEST(LeafDetour, EndsFartherThanTheBoundAreNotMeasured) {

@@ -1,7 +1,10 @@
-// The conforming leaf mesh: red leaves as they are, green closure of hanging nodes (paper, Fig. 3).
+// The conforming leaf mesh, numbered canonically (its triangles: hierarchy/leaf_triangles.h).
 #include <amc/hierarchy.h>
 
 #include "hierarchy/hierarchy_builder.h"
+#include "hierarchy/leaf_triangles.h"
+
+#include <algorithm>
 
 namespace amc {
 
@@ -21,55 +24,14 @@ LeafMesh extract_leaf_mesh(const Hierarchy& h, int max_level) {
     out.cells.is_green.reserve(room);
     out.source.reserve(room);
 
-    auto emit = [&](NodeId n, VertexId a, VertexId b, VertexId c, bool green) {
+    for_each_leaf_triangle(h, breadth_first, max_level, [&](NodeId n, VertexId a, VertexId b, VertexId c, bool green) {
         out.mesh.triangles.push_back({canonical[a], canonical[b], canonical[c]});
         out.cells.level.push_back(uint8_t(h.level(n)));
         out.cells.is_green.push_back(green ? 1 : 0);
         out.source.push_back(n);
-    };
-
-    for (NodeId n : breadth_first) {
-        const bool at_cut = cut && h.level(n) >= max_level;
-        if (cut && h.level(n) > max_level) break;  // breadth-first: all later nodes are finer
-        if (!h.is_leaf(n) && !at_cut) continue;
-        bool hanging[3];
-        VertexId mid[3];
-        int count = 0;
-        for (int e = 0; e < 3; ++e) {
-            hanging[e] = !at_cut && h.has_hanging_node(n, e);
-            if (hanging[e]) {
-                mid[e] = h.midpoint(h.neighbor(n, e), h.neighbor_edge(n, e));
-                if (cut) used_vertices = std::max(used_vertices, canonical[mid[e]] + 1);
-                ++count;
-            }
-        }
-        const VertexId v[3] = {h.vertex(n, 0), h.vertex(n, 1), h.vertex(n, 2)};
-        if (cut)
-            for (int i = 0; i < 3; ++i) used_vertices = std::max(used_vertices, canonical[v[i]] + 1);
-        if (count == 0) {
-            emit(n, v[0], v[1], v[2], false);
-        } else if (count == 1) {
-            const int e = hanging[0] ? 0 : hanging[1] ? 1 : 2;
-            const VertexId a = v[e], b = v[(e + 1) % 3], c = v[(e + 2) % 3];
-            emit(n, a, mid[e], c, true);
-            emit(n, mid[e], b, c, true);
-        } else if (count == 2) {
-            const int u = !hanging[0] ? 0 : !hanging[1] ? 1 : 2;  // the unrefined edge
-            const VertexId a = v[u], b = v[(u + 1) % 3], c = v[(u + 2) % 3];
-            const VertexId m1 = mid[(u + 1) % 3], m2 = mid[(u + 2) % 3];
-            emit(n, m2, m1, c, true);
-            if (!h.diagonal_flipped(n)) {  // default diagonal m_{u+1} -- v_u
-                emit(n, a, b, m1, true);
-                emit(n, a, m1, m2, true);
-            } else {  // flipped diagonal m_{u+2} -- v_{u+1}
-                emit(n, a, b, m2, true);
-                emit(n, b, m1, m2, true);
-            }
-        } else {
-            throw Error("leaf mesh: node " + std::to_string(n) +
-                        " has three hanging nodes (closure violated)");
-        }
-    }
+        // Cut, the vertices used are those of the triangles: every corner and hanging node is one's.
+        if (cut) used_vertices = std::max({used_vertices, canonical[a] + 1, canonical[b] + 1, canonical[c] + 1});
+    });
     out.mesh.positions.resize(used_vertices);
     for (size_t v = 0; v < canonical.size(); ++v) {
         if (canonical[v] < used_vertices) out.mesh.positions[canonical[v]] = h.position(VertexId(v));

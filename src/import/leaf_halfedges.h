@@ -20,27 +20,48 @@ public:
     // The face that holds the directed edge u->v, or kNoIndex.
     uint32_t face(uint32_t u, uint32_t v) const {
         const Entry* e = find(u, v);
-        return e == nullptr ? kNoIndex : e->face;
+        return e == nullptr ? kNoIndex : e->face & kFaceBits;
     }
     // The third vertex of that face, or kNoIndex.
     uint32_t apex(uint32_t u, uint32_t v) const {
         const Entry* e = find(u, v);
         return e == nullptr ? kNoIndex : e->apex;
     }
+    // The face on the left of a directed edge and its third vertex (kNoIndex for both: no face).
+    struct Edge {
+        uint32_t face = kNoIndex, apex = kNoIndex;
+    };
+    // The edge u->v: face() and apex() in one lookup.
+    Edge edge(uint32_t u, uint32_t v) const {
+        const Entry* e = find(u, v);
+        return e == nullptr ? Edge{} : Edge{e->face & kFaceBits, e->apex};
+    }
     // Number of faces around u (the directed edges leaving u).
     uint32_t degree(uint32_t u) const { return start_[u + 1] - start_[u]; }
     // The i-th directed edge leaving u (in no particular order): its end and its face.
     uint32_t out_vertex(uint32_t u, uint32_t i) const { return entries_[start_[u] + i].to; }
-    uint32_t out_face(uint32_t u, uint32_t i) const { return entries_[start_[u] + i].face; }
+    uint32_t out_face(uint32_t u, uint32_t i) const { return entries_[start_[u] + i].face & kFaceBits; }
     // The third vertex of that face (out ends and out apexes together are all of u's neighbours,
     // also on the boundary).
     uint32_t out_apex(uint32_t u, uint32_t i) const { return entries_[start_[u] + i].apex; }
     uint32_t vertex_count() const { return uint32_t(start_.size() - 1); }
+    // Calls f on every neighbour of u, each once (the out ends, and the apexes that are not also
+    // an out end: in a closed fan none is), in no particular order. Half the lookups of visiting
+    // ends and apexes, for the callers whose answer does not depend on the order.
+    template <class F>
+    void for_each_neighbor_once(uint32_t u, F f) const {
+        for (uint32_t i = start_[u], end = start_[u + 1]; i < end; ++i) {
+            f(entries_[i].to);
+            if (!(entries_[i].face & kApexIsEnd)) f(entries_[i].apex);
+        }
+    }
 
 private:
     struct Entry {
-        uint32_t to, apex, face;
+        uint32_t to, apex, face;  // face: its top bit kApexIsEnd (faces are fewer than 2^30)
     };
+    static constexpr uint32_t kApexIsEnd = 0x80000000u;  // the apex is also the end of an out-edge of u
+    static constexpr uint32_t kFaceBits = ~kApexIsEnd;
     const Entry* find(uint32_t u, uint32_t v) const {
         for (uint32_t i = start_[u], end = start_[u + 1]; i < end; ++i) {
             if (entries_[i].to == v) return &entries_[i];

@@ -4,6 +4,7 @@
 #include <amc/import.h>
 
 #include "common/no_index.h"
+#include "hierarchy/leaf_triangles.h"
 #include "import/anchored_reconstruction.h"
 #include "import/leaf_halfedges.h"
 #include "import/leaf_reconstruction.h"
@@ -60,26 +61,22 @@ std::vector<uint32_t> match_base_vertices(const TriangleMesh& base, const Triang
     return match;
 }
 
-// extract_leaf_mesh(h) must be the input: every extracted triangle an input face with the same
-// orientation, every input face extracted once.
+// extract_leaf_mesh(h) must be the input: every leaf triangle an input face with the same
+// orientation, every input face one leaf triangle. Read in hierarchy vertex ids, in
+// extract_leaf_mesh's order, without its canonical numbering and copies (a tenth of a 10^6-face
+// import's instructions and pages).
 void verify_leaf_mesh(const Hierarchy& h, const std::vector<uint32_t>& leaf_of_vertex, const TriangleMesh& leaf,
                       const LeafHalfedges& halfedges, const std::string& what) {
-    const LeafMesh extracted = extract_leaf_mesh(h);
-    const std::vector<uint32_t> canonical = canonical_vertex_order(h);
-    std::vector<uint32_t> leaf_of_canonical(extracted.mesh.positions.size(), kNoIndex);
-    for (size_t v = 0; v < canonical.size(); ++v) {
-        if (canonical[v] < leaf_of_canonical.size()) leaf_of_canonical[canonical[v]] = leaf_of_vertex[v];
-    }
     std::vector<uint8_t> used(leaf.triangles.size(), 0);
-    for (size_t t = 0; t < extracted.mesh.triangles.size(); ++t) {
-        const Triangle& tri = extracted.mesh.triangles[t];
-        const uint32_t a = leaf_of_canonical[tri[0]], b = leaf_of_canonical[tri[1]], c = leaf_of_canonical[tri[2]];
+    auto leaf_vertex = [&](VertexId v) { return v < leaf_of_vertex.size() ? leaf_of_vertex[v] : kNoIndex; };
+    for_each_leaf_triangle(h, h.breadth_first_order(), -1, [&](NodeId, VertexId x, VertexId y, VertexId z, bool) {
+        const uint32_t a = leaf_vertex(x), b = leaf_vertex(y), c = leaf_vertex(z);
         const uint32_t f = (a == kNoIndex || b == kNoIndex) ? kNoIndex : halfedges.face(a, b);
         if (f == kNoIndex || halfedges.apex(a, b) != c || used[f])
             fail(what, "the reconstruction has a triangle (" + std::to_string(a) + ", " + std::to_string(b) + ", " +
                            std::to_string(c) + ") that is not a face of the leaf mesh");
         used[f] = 1;
-    }
+    });
     for (size_t f = 0; f < used.size(); ++f) {
         if (!used[f]) fail(what, "face " + std::to_string(f) + " is not part of a red-green refinement of the base");
     }

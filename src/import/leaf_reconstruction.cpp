@@ -135,8 +135,10 @@ void Reconstruction::read_level(const std::vector<NodeId>& level, std::vector<No
 
 Reconstruction::Reading Reconstruction::read(const uint32_t p[3]) const {
     Reading r;
+    LeafHalfedges::Edge ahead[3];  // p[e] -> p[e+1], looked up once for the tests below
     for (int e = 0; e < 3; ++e) {
-        r.unsplit[e] = he_.face(p[e], p[(e + 1) % 3]) != kNoIndex;
+        ahead[e] = he_.edge(p[e], p[(e + 1) % 3]);
+        r.unsplit[e] = ahead[e].face != kNoIndex;
         r.unsplit_count += r.unsplit[e];
     }
     auto reveal = [&](int e, uint32_t v) {
@@ -155,11 +157,11 @@ Reconstruction::Reading Reconstruction::read(const uint32_t p[3]) const {
             }
         }
     } else if (r.unsplit_count == 3) {
-        if (he_.apex(p[0], p[1]) != p[2]) r.fault = Reading::not_a_face;
+        if (ahead[0].apex != p[2]) r.fault = Reading::not_a_face;
     } else if (r.unsplit_count == 2) {
         const int e = !r.unsplit[0] ? 0 : !r.unsplit[1] ? 1 : 2;  // the split edge
-        const uint32_t m = he_.apex(p[(e + 1) % 3], p[(e + 2) % 3]);
-        const uint32_t m_other = he_.apex(p[(e + 2) % 3], p[e]);
+        const uint32_t m = ahead[(e + 1) % 3].apex;
+        const uint32_t m_other = ahead[(e + 2) % 3].apex;
         r.fault_edge = e;
         if (m == kNoIndex || m_other != m) {
             r.fault = m != kNoIndex && m_other != kNoIndex ? Reading::two_vertices : Reading::no_bisection;
@@ -171,7 +173,7 @@ Reconstruction::Reading Reconstruction::read(const uint32_t p[3]) const {
     } else {
         const int u = r.unsplit[0] ? 0 : r.unsplit[1] ? 1 : 2;  // the unsplit edge
         const uint32_t a = p[u], b = p[(u + 1) % 3], c = p[(u + 2) % 3];
-        const uint32_t w = he_.apex(a, b);
+        const uint32_t w = ahead[u].apex;
         // Default diagonal m_{u+1}--v_u: (a, b, m1), (a, m1, m2), (m2, m1, c).
         const uint32_t x = he_.apex(a, w);
         const bool as_default = x != kNoIndex && he_.apex(x, w) == c;
@@ -311,12 +313,12 @@ uint32_t Reconstruction::only_unmatched_common_neighbor(uint32_t a, uint32_t b) 
     // b's unmatched neighbours listed once, so a's are tested without reading their own
     // edge lists (a cache miss each in a shuffled mesh).
     around_b_.clear();
-    for_each_neighbor(b, [&](uint32_t x) {
+    he_.for_each_neighbor_once(b, [&](uint32_t x) {
         if (vertex_of_leaf_[x] == kNoIndex) around_b_.push_back(x);
     });
     uint32_t found = kNoIndex;
     bool ambiguous = false;
-    for_each_neighbor(a, [&](uint32_t x) {
+    he_.for_each_neighbor_once(a, [&](uint32_t x) {
         if (x == found || std::find(around_b_.begin(), around_b_.end(), x) == around_b_.end()) return;
         if (found != kNoIndex) ambiguous = true;
         found = x;

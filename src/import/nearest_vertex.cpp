@@ -1,11 +1,14 @@
 #include "import/nearest_vertex.h"
 
+#include "common/huge_pages.h"
+
 #include <algorithm>
 
 namespace amc {
 
 NearestVertex::NearestVertex(const std::vector<Vec3>& positions) {
     points_.reserve(positions.size());
+    advise_huge_pages(points_.data(), points_.capacity() * sizeof(Point));  // each query reads a few buckets at random
     for (uint32_t v = 0; v < positions.size(); ++v) points_.push_back({{positions[v].x, positions[v].y, positions[v].z}, v});
     size_t inner = 1;
     while (inner * kBucket < points_.size()) inner *= 2;

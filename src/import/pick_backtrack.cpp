@@ -228,7 +228,7 @@ void Reconstruction::plan_retries(int depth, NodeId x) {
                 const uint32_t owner = vertex_of_leaf_[v];
                 if (v == picked || (owner != kNoIndex && owner < known_before)) return false;
                 bool fits_above = true;
-                for_each_neighbor(v, [&](uint32_t w) {
+                he_.for_each_neighbor_once(v, [&](uint32_t w) {
                     const uint32_t o = vertex_of_leaf_[w];
                     fits_above &= o == kNoIndex || o >= known_before || w == s.a || w == s.b;
                 });

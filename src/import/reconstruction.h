@@ -151,7 +151,7 @@ private:
             const uint32_t owner = r_.vertex_of_leaf_[v];
             if (owner != kNoIndex && !(swaps_ && r_.guided(owner))) return false;
             bool fits = true;
-            r_.for_each_neighbor(v, [&](uint32_t w) {
+            r_.he_.for_each_neighbor_once(v, [&](uint32_t w) {
                 if (r_.vertex_of_leaf_[w] == kNoIndex) return;
                 bool listed = false;
                 for (uint32_t x : allowed_) listed |= x == w;
@@ -180,7 +180,8 @@ private:
     };
     void take_back(const Move& m) { make(Move{m.v, m.to, m.from, 0}); }
 
-    // Calls f on every leaf-mesh neighbour of u (some twice).
+    // Calls f on every leaf-mesh neighbour of u (some twice), in the index's order: joint_candidates
+    // keeps them in the order first met (the others call he_.for_each_neighbor_once).
     template <class F>
     void for_each_neighbor(uint32_t u, F f) const {
         for (uint32_t i = 0, d = he_.degree(u); i < d; ++i) {
