@@ -19,9 +19,10 @@ namespace amc {
 // Version 11 for files in its third model (FORMAT.md 2.3), which encoders write since. Version 12
 // for files with a level in geometry mode 5 (the unit-normal frame with three tables; whatever else
 // they hold). Version 13 for chunked files (whatever else they hold): its chunk table lists each
-// chunk's own vertices.
+// chunk's own vertices. Version 14 for bit-exact files with a level (of the file or of a chunk) in
+// an adaptive geometry mode (midpoint, butterfly): such a level's raw bits are in a side stream.
 constexpr uint8_t kOldestReadableVersion = 1;
-constexpr uint8_t kNewestVersion = 13;
+constexpr uint8_t kNewestVersion = 14;
 constexpr uint8_t kBaseVersion = 2;       // everything but the numbering block and mode 2
 constexpr uint8_t kNumberingVersion = 3;  // the first version with a numbering block
 constexpr uint8_t kAngleBaseVersion = 4;  // the first version with base connectivity mode 2
@@ -40,6 +41,9 @@ constexpr uint8_t kUnitFrameVersion = 12;     // the first version with level ge
 // The first version whose chunk table gives each chunk's own vertex count (FORMAT.md 3.12), so that
 // chunks decode straight into their places in the whole on several threads.
 constexpr uint8_t kChunkVerticesVersion = 13;
+// The first version whose adaptive level blocks (predictors 1, 2) in bit-exact files carry the
+// coordinates' raw bits in a byte-aligned side stream after the arithmetic code (FORMAT.md 3.6, 5.2).
+constexpr uint8_t kRawSideVersion = 14;
 
 // The hierarchy stream (FORMAT.md section 2).
 constexpr uint8_t kHierarchyStreamVersion = 2;
@@ -65,6 +69,7 @@ constexpr uint8_t hierarchy_stream_version_of_file(uint8_t file_version) {
         case 11: return 2;
         case 12: return 2;
         case 13: return 2;
+        case 14: return 2;
     }
     return 0;
 }

@@ -114,9 +114,10 @@ double snap_positions(const Hierarchy& h, const Quantizer& quantizer, unsigned t
 }
 
 // The lowest version that holds what the file holds (format_version.h).
-uint8_t file_version(bool unit_geometry, bool grid_geometry, bool mixed_contexts, bool chunked, bool static_geometry,
+uint8_t file_version(bool raw_side, bool unit_geometry, bool grid_geometry, bool mixed_contexts, bool chunked, bool static_geometry,
                      BaseConnectivityMode base_mode, bool store_numbering) {
-    return chunked                                       ? kChunkVerticesVersion
+    return raw_side                                      ? kRawSideVersion
+           : chunked                                     ? kChunkVerticesVersion
            : unit_geometry                               ? kUnitFrameVersion
            : mixed_contexts                              ? kThirdMixingVersion
            : grid_geometry                               ? kGridGeometryVersion
@@ -152,7 +153,7 @@ void add_level_stats(EncodeStats& stats, size_t nodes, size_t new_vertices, size
     level_stats.nodes = nodes;
     level_stats.new_vertices = new_vertices;
     level_stats.bytes = kBlockOverhead + payload.size();
-    level_stats.predictor = GeometryPredictor(payload[0]);
+    level_stats.predictor = GeometryPredictor(payload[0] & ~kRawSideFlag);
     stats.per_level.push_back(level_stats);
 }
 
@@ -161,7 +162,7 @@ void add_level_stats(EncodeStats& stats, size_t nodes, size_t new_vertices, size
 struct ForestCode {
     std::vector<std::pair<BlockType, std::vector<uint8_t>>> blocks;
     uint64_t bytes = 0;  // of the blocks, framing included
-    bool chunked = false, static_geometry = false, grid_geometry = false, unit_geometry = false;
+    bool chunked = false, static_geometry = false, grid_geometry = false, unit_geometry = false, raw_side = false;
     uint64_t faces = 0, levels = 0;          // the metadata's
     std::vector<uint8_t> hierarchy_header;  // the metadata's (none with chunks)
     EncodeStats stats;  // header (the chunk table), hierarchy, geometry and framing bytes, levels, hierarchy
@@ -183,6 +184,7 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
         out.static_geometry = parts.static_geometry;
         out.grid_geometry = parts.grid_geometry;
         out.unit_geometry = parts.unit_geometry;
+        out.raw_side = parts.raw_side;
         out.faces = faces;
         out.levels = uint64_t(parts.levels);  // the deepest chunk's: the forest's
         out.blocks = std::move(parts.blocks);
@@ -205,6 +207,7 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
             out.static_geometry |= geometry.predictor == GeometryPredictor::normal_frame;
             out.grid_geometry |= geometry.predictor == GeometryPredictor::normal_frame_grid;
             out.unit_geometry |= geometry.predictor == GeometryPredictor::unit_normal_frame;
+            out.raw_side |= has_raw_side(payload);
             add_level_stats(out.stats, hierarchy.level_nodes(l).size(), created.size(), hierarchy_part, payload);
             out.blocks.emplace_back(BlockType::level, std::move(payload));
         };
@@ -350,7 +353,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
         stats.numbering_bytes = blocks.back().second.size();
         stats.framing_bytes += kBlockOverhead;
     }
-    BlockWriter writer(file_version(forest.unit_geometry, forest.grid_geometry, mixed, forest.chunked, forest.static_geometry,
+    BlockWriter writer(file_version(forest.raw_side, forest.unit_geometry, forest.grid_geometry, mixed, forest.chunked, forest.static_geometry,
                                     base_code.mode, store_numbering),
                        uint8_t((precision == Precision::float32 ? kFlagSinglePrecision : 0) | (quantized ? kFlagQuantized : 0)));
     for (const auto& block : blocks) writer.add(block.first, block.second);

@@ -92,6 +92,7 @@ ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& s
         out.static_geometry |= geometry.predictor == GeometryPredictor::normal_frame;
         out.grid_geometry |= geometry.predictor == GeometryPredictor::normal_frame_grid;
         out.unit_geometry |= geometry.predictor == GeometryPredictor::unit_normal_frame;
+        out.raw_side |= has_raw_side(payload);
         const uint64_t hierarchy_bytes = std::min<uint64_t>(hierarchy_part, payload.size() - 1);
         out.hierarchy_bytes += hierarchy_bytes;
         out.geometry_bytes += payload.size() - 1 - hierarchy_bytes;

@@ -25,6 +25,7 @@ struct ChunkCode {
     bool static_geometry = false;     // a level uses geometry mode 3 (predictor 3)
     bool grid_geometry = false;       // a level uses geometry mode 4 (predictor 4)
     bool unit_geometry = false;       // a level uses geometry mode 5 (predictor 5)
+    bool raw_side = false;            // a level's raw bits are in a side stream (kRawSideFlag: version 14)
     std::vector<LevelStats> levels;
 };
 

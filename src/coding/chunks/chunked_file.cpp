@@ -72,6 +72,7 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& ro
         out.static_geometry |= code.static_geometry;
         out.grid_geometry |= code.grid_geometry;
         out.unit_geometry |= code.unit_geometry;
+        out.raw_side |= code.raw_side;
         out.levels = std::max(out.levels, int(code.levels.size()));
         stats.hierarchy_bytes += code.hierarchy_bytes;
         stats.geometry_bytes += code.geometry_bytes;

@@ -25,6 +25,7 @@ struct ChunkedBlocks {
     bool static_geometry = false;  // some chunk level uses geometry mode 3
     bool grid_geometry = false;    // some chunk level uses geometry mode 4
     bool unit_geometry = false;    // some chunk level uses geometry mode 5
+    bool raw_side = false;         // some chunk level has its raw bits in a side stream (version 14)
     int levels = 0;                // of the deepest chunk
 };
 

@@ -2,6 +2,7 @@
 // float_coder.h for the bitstream.
 #include "coding/geometry/float_coder.h"
 
+#include "coding/entropy/rans_coder.h"
 #include "common/bits.h"
 #include "common/compiler.h"
 #include "common/exact_float.h"
@@ -31,9 +32,28 @@ static_assert(kMinSymbolsPerCoordinate <= kQuantizedTreeDepth && kQuantizedTreeD
 // Context{}): the coders fold it into their code (BitModel::update_with_limit).
 constexpr int kWindowLog2 = BitModel::kDefaultLimitLog2;
 
+// The `count` (1 .. 61) low bits of `magnitude` in a side stream: one value of up to 32 bits, or
+// the bits above the low 32 and then the low 32 (as geometry mode 3's raw bits, FORMAT.md 5.6).
+void put_side_raw_bits(RawBitWriter& raw, uint64_t magnitude, int count) {
+    if (count > 32) {
+        raw.put(magnitude >> 32, count - 32);
+        raw.put(magnitude & 0xFFFFFFFFull, 32);
+    } else {
+        raw.put(magnitude, count);
+    }
+}
+AMC_ALWAYS_INLINE uint64_t get_side_raw_bits(RawBitReader& raw, int count) {
+    if (count > 32) {
+        const uint64_t high = raw.get(count - 32);
+        return high << 32 | raw.get(32);
+    }
+    return raw.get(count);
+}
+
 // A residual as sign and magnitude; magnitude has at most kMaxLength bits.
+// The raw bits go to `raw` when given (FORMAT.md 5.2: version 14's side stream), else to the coder.
 void encode_residual(ArithmeticEncoder& encoder, FloatResidualModels::Context& ctx, int depth,
-                     bool negative, uint64_t magnitude) {
+                     bool negative, uint64_t magnitude, RawBitWriter* raw = nullptr) {
     const int k = bit_length(magnitude);
     int node = 1;
     for (int i = depth - 1; i >= 0; --i) {
@@ -54,6 +74,10 @@ void encode_residual(ArithmeticEncoder& encoder, FloatResidualModels::Context& c
             --remaining;
         }
     }
+    if (raw != nullptr && remaining > 0) {
+        put_side_raw_bits(*raw, magnitude, remaining);
+        return;
+    }
     while (remaining > 0) {
         const int chunk = remaining > 32 ? remaining - 32 : remaining;  // high chunk first
         remaining -= chunk;
@@ -66,7 +90,7 @@ void encode_residual(ArithmeticEncoder& encoder, FloatResidualModels::Context& c
 // Decodes sign and magnitude; k is clamped to max_length (marking the stream invalid).
 void decode_residual(ArithmeticDecoder& decoder, FloatResidualModels& models,
                      FloatResidualModels::Context& ctx, int depth, int max_length,
-                     bool& negative, uint64_t& magnitude) {
+                     bool& negative, uint64_t& magnitude, RawBitReader* raw = nullptr) {
     int node = 1;
     for (int i = 0; i < depth; ++i) node = 2 * node + int(decoder.decode_with_limit<kWindowLog2>(ctx.length[node]));
     int k = node - (1 << depth);
@@ -89,6 +113,10 @@ void decode_residual(ArithmeticDecoder& decoder, FloatResidualModels& models,
             magnitude = (magnitude << 1) | uint64_t(second);
             --remaining;
         }
+    }
+    if (raw != nullptr && remaining > 0) {
+        magnitude = (magnitude << remaining) | get_side_raw_bits(*raw, remaining);
+        return;
     }
     while (remaining > 0) {
         const int chunk = remaining > 32 ? remaining - 32 : remaining;
@@ -152,7 +180,7 @@ void FloatResidualModels::context_out_of_range(int c) const {
 // ---- floating-point residuals -------------------------------------------------------------------
 
 void encode_coordinate(ArithmeticEncoder& encoder, FloatResidualModels& models, int context,
-                       Precision precision, double actual, double predicted) {
+                       Precision precision, double actual, double predicted, RawBitWriter* raw) {
     FloatResidualModels::Context& ctx = models.context(context);
     if (precision == Precision::float32 && !std::isnan(actual)) {
         const bool in_range = !std::isfinite(actual) || std::fabs(actual) <= FLT_MAX;
@@ -163,16 +191,16 @@ void encode_coordinate(ArithmeticEncoder& encoder, FloatResidualModels& models, 
         }
     }
     const CoordinateResidual r = coordinate_residual(precision, actual, predicted);
-    encode_residual(encoder, ctx, tree_depth(precision), r.negative, r.magnitude);
+    encode_residual(encoder, ctx, tree_depth(precision), r.negative, r.magnitude, raw);
 }
 
 double decode_coordinate(ArithmeticDecoder& decoder, FloatResidualModels& models, int context,
-                         Precision precision, double predicted) {
+                         Precision precision, double predicted, RawBitReader* raw) {
     FloatResidualModels::Context& ctx = models.context(context);
     bool negative;
     uint64_t magnitude;
     decode_residual(decoder, models, ctx, tree_depth(precision), width_bits(precision), negative,
-                    magnitude);
+                    magnitude, raw);
     const uint64_t mask = width_mask(precision);
     const uint64_t p = ordered_bits(coder_prediction(predicted, precision), precision);
     const uint64_t a = (negative ? p - magnitude : p + magnitude) & mask;
@@ -180,10 +208,10 @@ double decode_coordinate(ArithmeticDecoder& decoder, FloatResidualModels& models
 }
 
 void encode_position(ArithmeticEncoder& encoder, FloatResidualModels& models, int first_context,
-                     Precision precision, Vec3 actual, Vec3 predicted) {
-    encode_coordinate(encoder, models, first_context + 0, precision, actual.x, predicted.x);
-    encode_coordinate(encoder, models, first_context + 1, precision, actual.y, predicted.y);
-    encode_coordinate(encoder, models, first_context + 2, precision, actual.z, predicted.z);
+                     Precision precision, Vec3 actual, Vec3 predicted, RawBitWriter* raw) {
+    encode_coordinate(encoder, models, first_context + 0, precision, actual.x, predicted.x, raw);
+    encode_coordinate(encoder, models, first_context + 1, precision, actual.y, predicted.y, raw);
+    encode_coordinate(encoder, models, first_context + 2, precision, actual.z, predicted.z, raw);
 }
 
 uint64_t position_raw_bits(Precision precision, Vec3 actual, Vec3 predicted) {
@@ -193,11 +221,11 @@ uint64_t position_raw_bits(Precision precision, Vec3 actual, Vec3 predicted) {
 }
 
 Vec3 decode_position(ArithmeticDecoder& decoder, FloatResidualModels& models, int first_context,
-                     Precision precision, Vec3 predicted) {
+                     Precision precision, Vec3 predicted, RawBitReader* raw) {
     Vec3 p;
-    p.x = decode_coordinate(decoder, models, first_context + 0, precision, predicted.x);
-    p.y = decode_coordinate(decoder, models, first_context + 1, precision, predicted.y);
-    p.z = decode_coordinate(decoder, models, first_context + 2, precision, predicted.z);
+    p.x = decode_coordinate(decoder, models, first_context + 0, precision, predicted.x, raw);
+    p.y = decode_coordinate(decoder, models, first_context + 1, precision, predicted.y, raw);
+    p.z = decode_coordinate(decoder, models, first_context + 2, precision, predicted.z, raw);
     return p;
 }
 

@@ -12,7 +12,10 @@
 //   2. if k > 0 the sign of r (1 = negative), one BitModel per context;
 //   3. the k - 1 bits of |r| below its leading one: the top kModelledBits of them with adaptive
 //      models per context and k (a two-level binary tree), the rest as raw bits, most
-//      significant first, in chunks of at most 32.
+//      significant first, in chunks of at most 32; or, when the caller gives a side stream
+//      (RawBitWriter / RawBitReader: the adaptive levels of bit-exact files from .amc version 14),
+//      there, as one value (two above 32 bits), read by a plain bit reader instead of the range
+//      coder (about 21 instructions a bit there).
 // The decoder adds the residual to map(P) modulo 2^N and maps back: the value is bit-identical
 // (signed zeros, denormals, any finite magnitude). Infinities and NaNs are outside the contract
 // (inputs are validated finite) but neither side crashes on them.
@@ -42,6 +45,9 @@
 #include <vector>
 
 namespace amc {
+
+class RawBitWriter;
+class RawBitReader;
 
 // Written to streams: values are frozen.
 enum class Precision : uint8_t { float32 = 0, float64 = 1 };
@@ -127,17 +133,18 @@ private:
 };
 
 // Codes `actual` given `predicted`. In float32, actual must be exactly representable as float
-// (throws Error otherwise); the decoded value is then double(float) of the same bits.
+// (throws Error otherwise); the decoded value is then double(float) of the same bits. With `raw`,
+// the raw bits go to (come from) that side stream instead of the arithmetic code.
 void encode_coordinate(ArithmeticEncoder& encoder, FloatResidualModels& models, int context,
-                       Precision precision, double actual, double predicted);
+                       Precision precision, double actual, double predicted, RawBitWriter* raw = nullptr);
 double decode_coordinate(ArithmeticDecoder& decoder, FloatResidualModels& models, int context,
-                         Precision precision, double predicted);
+                         Precision precision, double predicted, RawBitReader* raw = nullptr);
 
 // The three coordinates with contexts first_context + 0, 1, 2 (x, y, z).
 void encode_position(ArithmeticEncoder& encoder, FloatResidualModels& models, int first_context,
-                     Precision precision, Vec3 actual, Vec3 predicted);
+                     Precision precision, Vec3 actual, Vec3 predicted, RawBitWriter* raw = nullptr);
 Vec3 decode_position(ArithmeticDecoder& decoder, FloatResidualModels& models, int first_context,
-                     Precision precision, Vec3 predicted);
+                     Precision precision, Vec3 predicted, RawBitReader* raw = nullptr);
 
 // The bits encode_position codes at probability 1/2 (below the two modelled bits under each
 // residual's leading one): a code of them takes at least this many bits, whatever its models.

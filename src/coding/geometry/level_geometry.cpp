@@ -3,6 +3,7 @@
 
 #include "coding/geometry/geometry_prediction.h"
 #include "coding/geometry/hierarchy_on_grid.h"
+#include "coding/entropy/rans_coder.h"
 #include "common/check.h"
 #include "common/exact_float.h"
 #include "coding/format_version.h"
@@ -67,6 +68,15 @@ bool predictor_allowed(uint8_t predictor, uint8_t file_version, bool quantized) 
     }
 }
 
+size_t varint_size(uint64_t value) {
+    size_t bytes = 1;
+    while (value >= 0x80) {
+        value >>= 7;
+        ++bytes;
+    }
+    return bytes;
+}
+
 template <class Mesh>
 Vec3 predict(const Mesh& h, GeometryPredictor predictor, NodeId n, int e) {
     return predictor == GeometryPredictor::butterfly ? predict_butterfly(h, n, e) : predict_midpoint(h, n, e);
@@ -74,9 +84,9 @@ Vec3 predict(const Mesh& h, GeometryPredictor predictor, NodeId n, int e) {
 
 template <class Mesh>
 void encode_adaptive(const Mesh& h, const NewVertices& created, GeometryPredictor predictor, PositionCoder& positions,
-                     ArithmeticEncoder& encoder) {
+                     ArithmeticEncoder& encoder, RawBitWriter* raw) {
     for (auto [n, e] : created)
-        positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)), predict(h, predictor, n, e));
+        positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)), predict(h, predictor, n, e), raw);
 }
 
 // The bytes `predictor` codes the level's positions in (from the models in `positions`), or
@@ -107,26 +117,31 @@ size_t adaptive_bytes(const Mesh& h, const NewVertices& created, GeometryPredict
                                  : limit != SIZE_MAX && raw_projected > rounded(kSampleMargin * double(limit)) + kSampleSlack)
         return SIZE_MAX;
     ArithmeticEncoder encoder;
+    // Bit-exact levels: the raw bits in the side stream (finish_level_payload's layout).
+    RawBitWriter raw;
+    RawBitWriter* side = positions.quantized() ? nullptr : &raw;
+    auto bytes_so_far = [&] { return encoder.bytes_so_far() + raw.bits() / 8; };
     // The level's bytes from those of its first `done` vertices and the rate since vertex `since`
     // (`bytes_since` bytes then) pass the limit by `margin`.
     auto projected_past = [&](size_t done, size_t since, size_t bytes_since, double margin) {
-        const double rate = double(encoder.bytes_so_far() - bytes_since) / double(done - since);
-        return limit != SIZE_MAX && double(encoder.bytes_so_far()) + rounded(rate * double(created.size() - done)) >
+        const double rate = double(bytes_so_far() - bytes_since) / double(done - since);
+        return limit != SIZE_MAX && double(bytes_so_far()) + rounded(rate * double(created.size() - done)) >
                                         rounded(margin * double(limit)) + kSampleSlack;
     };
     for (size_t i = 0; i < created.size(); ++i) {
         const auto [n, e] = created[i];
         positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)),
-                         i < predicted.size() ? predicted[i] : predict(h, predictor, n, e));
-        if (encoder.bytes_so_far() > limit + 8) return SIZE_MAX;
-        if (i + 1 == sample / 4) quarter_sample_bytes = encoder.bytes_so_far();
+                         i < predicted.size() ? predicted[i] : predict(h, predictor, n, e), side);
+        if (bytes_so_far() > limit + 8) return SIZE_MAX;
+        if (i + 1 == sample / 4) quarter_sample_bytes = bytes_so_far();
         if (i + 1 == sample / 2) {
             if (projected_past(i + 1, sample / 4, quarter_sample_bytes, kEarlyMargin)) return SIZE_MAX;
-            half_sample_bytes = encoder.bytes_so_far();
+            half_sample_bytes = bytes_so_far();
         }
         if (i + 1 == sample && projected_past(i + 1, sample / 2, half_sample_bytes, kSampleMargin)) return SIZE_MAX;
     }
-    return encoder.finish().size();
+    const size_t coded = encoder.finish().size();
+    return side == nullptr ? coded : coded + varint_size(coded) + (raw.bits() + 7) / 8;
 }
 
 }  // namespace
@@ -231,9 +246,26 @@ std::vector<uint8_t> finish_level_payload(const Mesh& h, const NewVertices& crea
         payload.insert(payload.end(), static_code.raw_bytes().begin(), static_code.raw_bytes().end());
         return payload;
     }
-    encode_adaptive(h, created, code.predictor, positions, encoder);
+    if (positions.quantized()) {
+        encode_adaptive(h, created, code.predictor, positions, encoder, nullptr);
+        const std::vector<uint8_t> coded = encoder.finish();
+        payload.insert(payload.end(), coded.begin(), coded.end());
+        return payload;
+    }
+    if (created.empty()) {  // nothing raw: the layout of every version
+        const std::vector<uint8_t> coded = encoder.finish();
+        payload.insert(payload.end(), coded.begin(), coded.end());
+        return payload;
+    }
+    // Bit-exact (version 14): the flag, the arithmetic part's length, the arithmetic part, the raw bits.
+    payload[0] |= kRawSideFlag;
+    RawBitWriter raw;
+    encode_adaptive(h, created, code.predictor, positions, encoder, &raw);
     const std::vector<uint8_t> coded = encoder.finish();
+    put_varint(payload, coded.size());
     payload.insert(payload.end(), coded.begin(), coded.end());
+    const std::vector<uint8_t> raw_bytes = raw.finish();
+    payload.insert(payload.end(), raw_bytes.begin(), raw_bytes.end());
     return payload;
 }
 
@@ -247,13 +279,17 @@ template std::vector<uint8_t> finish_level_payload(const HierarchyOnGrid&, const
                                                    PositionCoder&, ArithmeticEncoder&);
 
 LevelBlockParts split_level_block(const Block& block, uint8_t file_version, bool quantized, const std::string& where) {
-    AMC_REQUIRE(block.size >= 1 && predictor_allowed(block.payload[0], file_version, quantized), corrupt,
-                "level block: bad predictor");
+    AMC_REQUIRE(block.size >= 1, corrupt, "level block: bad predictor");
     LevelBlockParts parts;
-    parts.predictor = GeometryPredictor(block.payload[0]);
+    parts.raw_side = (block.payload[0] & kRawSideFlag) != 0;
+    const uint8_t predictor = block.payload[0] & uint8_t(~kRawSideFlag);
+    AMC_REQUIRE(predictor_allowed(predictor, file_version, quantized) &&
+                    (!parts.raw_side || (file_version >= kRawSideVersion && !quantized && !is_static_mode(GeometryPredictor(predictor)))),
+                corrupt, "level block: bad predictor");
+    parts.predictor = GeometryPredictor(predictor);
     PayloadReader in(block.payload + 1, block.size - 1, "level block");
     size_t arithmetic_size = block.size - 1;
-    if (is_static_mode(parts.predictor)) {
+    if (is_static_mode(parts.predictor) || parts.raw_side) {
         const uint64_t size = in.varint();
         AMC_REQUIRE(size <= in.remaining(), corrupt, where + ": arithmetic part is longer than the block");
         arithmetic_size = size_t(size);
@@ -308,14 +344,17 @@ void decode_level_geometry(Hierarchy& h, const NewVertices& created, const Level
                             });
         return;
     }
+    RawBitReader raw(parts.after_arithmetic, parts.after_arithmetic_size);
+    RawBitReader* side = parts.raw_side ? &raw : nullptr;
     for (auto [n, e] : created) {
-        const Vec3 p = positions.decode(decoder, level_context(h.level(n)), predict(h, parts.predictor, n, e));
+        const Vec3 p = positions.decode(decoder, level_context(h.level(n)), predict(h, parts.predictor, n, e), side);
         AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
                     "level " + std::to_string(level) + " geometry is corrupt (non-finite coordinate)");
         h.set_position(h.midpoint(n, e), p);
     }
     AMC_REQUIRE(!positions.saw_invalid_symbol(), corrupt, where + " is truncated or corrupt");
     AMC_REQUIRE(!decoder.overran(), corrupt, where + " is truncated or corrupt");
+    AMC_REQUIRE(side == nullptr || raw.ended_cleanly(), corrupt, where + ": raw bits are truncated or left over");
 }
 
 }  // namespace amc

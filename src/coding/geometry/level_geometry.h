@@ -1,7 +1,8 @@
 // The geometry of a level block (docs/FORMAT.md 3.6, 5.5, 5.6): the predictor byte that opens the
 // block, then, after the level's hierarchy part in the same arithmetic code, the positions of the
 // vertices the level creates. Modes 1 and 2 (midpoint, butterfly) code them adaptively in that
-// arithmetic code; mode 3 (normal frame) puts its tables there and the positions in a rANS stream
+// arithmetic code (from version 14, in bit-exact files, with their raw bits in a side stream after
+// it: [predictor | kRawSideFlag, arithmetic length, arithmetic payload, raw bits]); mode 3 (normal frame) puts its tables there and the positions in a rANS stream
 // and raw bits behind it: [predictor, arithmetic length, arithmetic payload, rANS length, rANS
 // stream, raw bits].
 #pragma once
@@ -18,6 +19,12 @@
 #include <vector>
 
 namespace amc {
+
+// Set in the predictor byte of an adaptive level block (predictor 1 or 2) of a bit-exact file, from
+// version 14: the coordinates' raw bits follow the arithmetic part, in a side stream (FORMAT.md 3.6).
+constexpr uint8_t kRawSideFlag = 0x80;
+// Whether a level payload (finish_level_payload's) has its raw bits in a side stream: a version-14 file.
+inline bool has_raw_side(const std::vector<uint8_t>& payload) { return !payload.empty() && (payload[0] & kRawSideFlag) != 0; }
 
 // The vertices a level creates, as (node, edge) in canonical order (new_vertices_of_level).
 using NewVertices = std::vector<std::pair<NodeId, int>>;
@@ -58,8 +65,9 @@ struct LevelBlockParts {
     GeometryPredictor predictor = GeometryPredictor::midpoint;
     const uint8_t* arithmetic = nullptr;  // hierarchy part, then geometry (or mode 3's tables)
     size_t arithmetic_size = 0;
-    const uint8_t* after_arithmetic = nullptr;  // mode 3: rANS length, rANS stream, raw bits
+    const uint8_t* after_arithmetic = nullptr;  // mode 3: rANS length, rANS stream, raw bits; raw_side: raw bits
     size_t after_arithmetic_size = 0;
+    bool raw_side = false;  // an adaptive level of a bit-exact file of version 14 or later
 };
 
 // Throws Error on a predictor the file's version does not have (mode 4 also in a file that is not

@@ -22,21 +22,23 @@ public:
         : precision_(space.precision), quantized_(space.quantizer != nullptr), models_(kGeometryContexts) {
         if (space.quantizer != nullptr) quantizer_ = *space.quantizer;
     }
-    void encode(ArithmeticEncoder& encoder, int context, Vec3 actual, Vec3 predicted) {
+    // `raw`: the side stream of bit-exact raw bits (float_coder.h); unused when quantized.
+    void encode(ArithmeticEncoder& encoder, int context, Vec3 actual, Vec3 predicted, RawBitWriter* raw = nullptr) {
         if (!quantized_) {
-            encode_position(encoder, models_, context, precision_, actual, predicted);
+            encode_position(encoder, models_, context, precision_, actual, predicted, raw);
             return;
         }
         const GridPoint a = quantize(quantizer_, actual), p = quantize(quantizer_, predicted);
         for (int axis = 0; axis < 3; ++axis) encode_quantized(encoder, models_, context + axis, quantizer_.bits, a[axis], p[axis]);
     }
-    Vec3 decode(ArithmeticDecoder& decoder, int context, Vec3 predicted) {
-        if (!quantized_) return decode_position(decoder, models_, context, precision_, predicted);
+    Vec3 decode(ArithmeticDecoder& decoder, int context, Vec3 predicted, RawBitReader* raw = nullptr) {
+        if (!quantized_) return decode_position(decoder, models_, context, precision_, predicted, raw);
         const GridPoint p = quantize(quantizer_, predicted);
         GridPoint a;
         for (int axis = 0; axis < 3; ++axis) a[axis] = decode_quantized(decoder, models_, context + axis, quantizer_.bits, p[axis]);
         return dequantize(quantizer_, a);
     }
+    bool quantized() const { return quantized_; }
     bool saw_invalid_symbol() const { return models_.saw_invalid_symbol(); }
     // The bits encode() codes at probability 1/2: a lower bound of its code, whatever the models.
     uint64_t raw_bits(Vec3 actual, Vec3 predicted) const {
