@@ -93,13 +93,22 @@ public:
           midpoint_block_(vertex_count, {kNoIndex, kNoIndex}), first_coarse_edge_(vertex_count, kNoEdge), block_of_(fine.size(), kNoIndex), closure_of_(fine.size(), kNoIndex),
           pinned_old_(vertex_count, 0), covered_(fine.size(), 0),
           banned_(fine.size(), 0), repair_banned_(fine.size(), 0), deferred_(fine.size(), 0),
-          shape_of_(fine.size(), kNotRead) {
+          shape_of_(fine.size(), kNotRead), refined_near_(tri_.size(), 0) {
         // A midpoint has its block's three triangles on one side and the boundary, another block
         // (three) or a green closure (two or three triangles around it) on the other.
         for (uint32_t v = 0; v < vertex_count; ++v) {
             const uint32_t s = adjacency_.star_size(v);
             const bool can_be_midpoint = adjacency_.on_boundary(v) ? s == 3 : (s == 5 || s == 6);
             forced_old_[v] = !can_be_midpoint || (kept && (*kept)[v]);
+        }
+        // A closure's triangles need their neighbours' refinement checked only near refined ones.
+        for (uint32_t t = 0; t < tri_.size(); ++t) {
+            if (!refined_[t]) continue;
+            refined_near_[t] = 1;
+            for (uint32_t e = 0; e < 3; ++e) {
+                const uint32_t h = adjacency_.twin(3 * t + e);
+                if (h != kNoHalfEdge) refined_near_[h / 3] = 1;
+            }
         }
     }
 
@@ -324,6 +333,7 @@ private:
     static constexpr uint32_t kNotRead = kNoIndex, kImpossible = kNoIndex - 1;
     mutable std::vector<uint32_t> shape_of_;  // per triangle: kNotRead, kImpossible or its index in shapes_
     mutable std::vector<Block> shapes_;       // the blocks possible_block has read
+    std::vector<uint8_t> refined_near_;       // per triangle: it or a neighbour across an edge is refined
     std::vector<Block> blocks_;
     std::vector<Patch> patches_;
     uint32_t growth_limit_ = kNoIndex;      // blocks: a growth larger than this is given up

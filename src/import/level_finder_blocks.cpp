@@ -318,6 +318,7 @@ Side LevelFinder::classify(uint32_t index, int i) const {
     bool refined_across = false;
     for (int k = 0; k < side.count; ++k) {
         const uint32_t g = side.group[k];
+        if (!refined_near_[g]) continue;
         if (refined_[g]) return side;
         for (int e = 0; e < 3; ++e) {
             const uint32_t h = adjacency_.twin(3 * g + uint32_t(e));
