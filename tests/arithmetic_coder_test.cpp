@@ -424,6 +424,50 @@ TEST(ArithmeticDecoder, GarbageInputTerminates) {
     }
 }
 
+// The header's raw bit, read literally: range >>= 1, a one takes the upper half (code >= range,
+// which then loses it), then the byte shifts while range < 2^24; bytes past the end read as 0.
+struct LiteralRawReader {
+    const std::vector<uint8_t>& bytes;
+    size_t pos = 0;
+    uint32_t range = 0xFFFFFFFFu, code = 0;
+    explicit LiteralRawReader(const std::vector<uint8_t>& b) : bytes(b) {
+        for (int i = 0; i < 4; ++i) code = (code << 8) | next();
+    }
+    uint32_t next() { return pos < bytes.size() ? bytes[pos++] : 0u; }
+    uint32_t bits(int count) {
+        uint32_t value = 0;
+        for (int i = 0; i < count; ++i) {
+            range >>= 1;
+            const bool one = code >= range;
+            if (one) code -= range;
+            value = (value << 1) | uint32_t(one);
+            while (range < (uint32_t{1} << 24)) {
+                range <<= 8;
+                code = (code << 8) | next();
+            }
+        }
+        return value;
+    }
+};
+
+// decode_bits_raw takes runs of bits between byte shifts at once (unrolled, without branches):
+// every count from any state gives the bits of the literal reading, on random bytes (which is
+// what coded raw bits are) and on runs of 0xFF (where code exceeds range); each read starts where
+// the literal one left off.
+TEST(ArithmeticDecoder, RawBitsEqualTheLiteralReading) {
+    BitSource src(0.5, 29);
+    for (int trial = 0; trial < 200; ++trial) {
+        std::vector<uint8_t> bytes(src.next_u32() % 400);
+        for (auto& b : bytes) b = static_cast<uint8_t>(trial % 5 == 0 ? 0xFF : src.next_u32());
+        ArithmeticDecoder decoder(bytes.data(), bytes.size());
+        LiteralRawReader literal(bytes);
+        for (int read = 0; read < 300; ++read) {
+            const int count = int(src.next_u32() % 33);
+            ASSERT_EQ(decoder.decode_bits_raw(count), literal.bits(count)) << "trial " << trial << ", read " << read;
+        }
+    }
+}
+
 TEST(ArithmeticDecoder, DecodingPastTheEndOfAValidStreamIsReported) {
     const std::vector<Symbol> s = bernoulli(5000, 0.5, 21);
     const Coded coded = encode_symbols(s, 1, 12);

@@ -7,7 +7,10 @@
 #include "coding/geometry/level_geometry.h"
 #include "coding/geometry/static_position_coder.h"
 
+#include <cmath>
 #include <cstddef>
+#include <cstring>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -64,6 +67,50 @@ TEST(StaticLevelEncoder, ExtendedFromASampleCodesAsMadeOverTheWholeLevel) {
     expect_extended_codes_as_whole(h, {Precision::float64, &quantizer}, GeometryPredictor::normal_frame_grid);
     expect_extended_codes_as_whole(h, {Precision::float64, nullptr}, GeometryPredictor::normal_frame);
     expect_extended_codes_as_whole(h, {Precision::float64, nullptr}, GeometryPredictor::unit_normal_frame);
+}
+
+// Bit-exact residuals of every bit length (0 to 64 bits of ordered float64 bits) decode to the
+// positions coded: the raw bits below a large token (a sign and up to 61 bits, in one value or
+// two) as the decoder reads them, one read where they fit 57 bits, two beyond.
+TEST(StaticLevelEncoder, ResidualsOfEveryBitLengthDecodeBitExactly) {
+    Hierarchy h = projected_sphere(6000, 6, 12);
+    const NewVertices created = largest_level(h);
+    ASSERT_GT(created.size(), 200u);
+    std::mt19937_64 rng(5);
+    for (size_t i = 0; i < created.size(); ++i) {
+        const VertexId v = h.midpoint(created[i].first, created[i].second);
+        const Vec3 p = h.position(v);
+        double xyz[3] = {p.x, p.y, p.z};
+        for (int axis = 0; axis < 3; ++axis) {
+            const int length = int((3 * i + size_t(axis)) % 65);  // the offset's bit length
+            const uint64_t offset = length == 0 ? 0 : (uint64_t{1} << (length - 1)) | (rng() & ((uint64_t{1} << (length - 1)) - 1));
+            const uint64_t bits = ordered_bits(xyz[axis], Precision::float64);
+            const double moved = from_ordered_bits(rng() & 1 ? bits + offset : bits - offset, Precision::float64);
+            if (std::isfinite(moved)) xyz[axis] = moved;
+        }
+        h.set_position(v, {xyz[0], xyz[1], xyz[2]});
+    }
+    const CoordinateSpace space{Precision::float64, nullptr};
+    for (GeometryPredictor mode : {GeometryPredictor::normal_frame, GeometryPredictor::unit_normal_frame}) {
+        SCOPED_TRACE("mode " + std::to_string(int(mode)));
+        StaticLevelEncoder encoder(h, created, space, mode);
+        ArithmeticEncoder tables_out;
+        encoder.write_tables(tables_out);
+        const std::vector<uint8_t> table_bytes = tables_out.finish();
+        Hierarchy decoded = h;
+        for (const auto& [n, e] : created) decoded.set_position(decoded.midpoint(n, e), Vec3{});
+        ArithmeticDecoder tables_in(table_bytes.data(), table_bytes.size());
+        StaticTables tables;
+        ASSERT_TRUE(read_static_tables(tables_in, space, mode, tables));
+        const std::vector<uint8_t>& rans = encoder.rans_bytes();
+        const std::vector<uint8_t>& raw = encoder.raw_bytes();
+        ASSERT_TRUE(decode_static_positions(decoded, created, space, mode, tables, rans.data(), rans.size(), raw.data(), raw.size()));
+        for (const auto& [n, e] : created) {
+            const VertexId v = h.midpoint(n, e);
+            const Vec3 a = h.position(v), b = decoded.position(v);
+            ASSERT_TRUE(std::memcmp(&a, &b, sizeof a) == 0) << "vertex " << v;
+        }
+    }
 }
 
 }  // namespace

@@ -107,12 +107,25 @@ uint32_t ArithmeticDecoder::decode_bits_raw(int count) {
         // A range of bit_length B >= 25 halves B - 25 times and stays at kTop or above; the next
         // halving takes it below. So that many bits and one more go without the test, then the
         // byte shifts: the same steps as a test after every bit.
-        const int run = std::min(left, bit_length(range) - 24);
-        for (int i = 0; i < run; ++i) {
+        const int run = std::min(left, bit_length(range) - 24);  // 1..8
+        // One bit without a branch (raw bits are noise): a compare, a conditional move and an
+        // add. The run's bits enter the unrolled steps at their count: no test per bit.
+        auto bit = [&range, &code, &value] {
             range >>= 1;
-            const uint32_t bit = code >= range ? 1u : 0u;
-            code -= range & (0u - bit);  // without a branch, as in the encoder
-            value = (value << 1) | bit;
+            const uint32_t rest = code - range;
+            const bool one = code >= range;
+            code = one ? rest : code;
+            value = value + value + uint32_t(one);
+        };
+        switch (run) {
+            case 8: bit(); [[fallthrough]];
+            case 7: bit(); [[fallthrough]];
+            case 6: bit(); [[fallthrough]];
+            case 5: bit(); [[fallthrough]];
+            case 4: bit(); [[fallthrough]];
+            case 3: bit(); [[fallthrough]];
+            case 2: bit(); [[fallthrough]];
+            default: bit();
         }
         left -= run;
         while (range < kTop) {

@@ -174,12 +174,19 @@ AMC_ALWAYS_INLINE Residual take_large(int token, RawBitReader& raw) {
     const int k = 4 + (token - kDirectTokens) / 4;
     const int low = k - 3;
     Residual r;
-    // The sign and the first value in one read: they follow each other, low bit first.
-    const int first = low > 32 ? low - 32 : low;
-    const uint64_t sign_and_first = raw.get(1 + first);
-    r.negative = (sign_and_first & 1) != 0;
-    uint64_t bits = sign_and_first >> 1;
-    if (low > 32) bits = bits << 32 | raw.get(32);
+    uint64_t bits;
+    if (low <= 56) {
+        // The sign and both values in one read (at most 57 bits): they follow each other, low bit
+        // first, the value of low - 32 bits before the value of 32 when low > 32.
+        const uint64_t all = raw.get(1 + low);
+        r.negative = (all & 1) != 0;
+        bits = all >> 1;
+        if (low > 32) bits = (bits & ((uint64_t{1} << (low - 32)) - 1)) << 32 | bits >> (low - 32);
+    } else {
+        const uint64_t sign_and_first = raw.get(1 + low - 32);
+        r.negative = (sign_and_first & 1) != 0;
+        bits = (sign_and_first >> 1) << 32 | raw.get(32);
+    }
     r.magnitude = (uint64_t(4 | ((token - kDirectTokens) & 3)) << low) | bits;
     return r;
 }
