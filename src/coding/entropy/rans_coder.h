@@ -83,6 +83,16 @@ public:
     const Entry& entry_of_slot(uint32_t slot) const {
         return entries_[narrow_ ? size_t(narrow_index_[slot]) : size_t(wide_index_[slot])];
     }
+    // The decoder's view of a table made by assign() whose slots index in a byte: a decoder whose
+    // tables are all narrow (every quantized and float32 residual's) reads each symbol's entry
+    // without the width's test and the table's two vectors. Null pointers for a wide table.
+    struct NarrowView {
+        const uint8_t* index = nullptr;
+        const Entry* entries = nullptr;
+    };
+    NarrowView narrow_view() const {
+        return narrow_ && !narrow_index_.empty() ? NarrowView{narrow_index_.data(), entries_.data()} : NarrowView{};
+    }
 
 private:
     void set_starts();
@@ -134,6 +144,17 @@ public:
         uint32_t& x = state_[State];
         const uint32_t slot = x & (kRansScale - 1);
         const RansTable::Entry& e = table.entry_of_slot(slot);
+        x = uint32_t(e.frequency) * (x >> kRansScaleBits) + slot - e.start;
+        while (x < kRansLow) x = (x << 8) | next_byte();
+        return e.symbol;
+    }
+
+    // get_with for a narrow table's view (RansTable::narrow_view).
+    template <int State>
+    int get_with(const RansTable::NarrowView& table) {
+        uint32_t& x = state_[State];
+        const uint32_t slot = x & (kRansScale - 1);
+        const RansTable::Entry& e = table.entries[table.index[slot]];
         x = uint32_t(e.frequency) * (x >> kRansScaleBits) + slot - e.start;
         while (x < kRansLow) x = (x << 8) | next_byte();
         return e.symbol;

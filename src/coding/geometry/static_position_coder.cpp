@@ -595,9 +595,10 @@ namespace {
 
 // One vertex's three coordinates; its first token is coded with rANS state `State` (token j of the
 // level with state j mod 2), its second with the other, its third with `State` again.
-template <int State, bool Grid>
+// Tables: StaticTables, or NarrowTables where every table is narrow.
+template <int State, bool Grid, class Tables>
 AMC_ALWAYS_INLINE bool decode_vertex(const Chunk& b, size_t i, CoordinateSpace space, const GridScale& grid,
-                                     const StaticTables& tables, RansDecoder& rans, RawBitReader& raw, Vec3& p) {
+                                     const Tables& tables, RansDecoder& rans, RawBitReader& raw, Vec3& p) {
     const RoleFrame& f = b.frames[i];
     double value[3], second, third;
     if (Grid) {
@@ -625,8 +626,8 @@ AMC_ALWAYS_INLINE bool decode_vertex(const Chunk& b, size_t i, CoordinateSpace s
 
 // The decoders own their rANS decoder and raw bit reader, so that the compiler keeps the two rANS
 // states in registers.
-template <bool Grid, bool UnitNormals, class Source>
-bool decode_positions(Hierarchy& h, const Source& created, CoordinateSpace space, const StaticTables& tables,
+template <bool Grid, bool UnitNormals, class Source, class Tables>
+bool decode_positions(Hierarchy& h, const Source& created, CoordinateSpace space, const Tables& tables,
                       const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
     RansDecoder rans(rans_data, rans_size);
     RawBitReader raw(raw_data, raw_size);
@@ -664,9 +665,11 @@ bool decode_positions(Hierarchy& h, const Source& created, CoordinateSpace space
     return rans.ended_cleanly() && raw.ended_cleanly();
 }
 
-template <class Source>
-bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, GeometryPredictor mode, const StaticTables& tables,
-                   const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
+using NarrowTables = std::array<RansTable::NarrowView, kMaxStaticTables>;
+
+template <class Source, class Tables>
+bool decode_static_with(Hierarchy& h, const Source& created, CoordinateSpace space, GeometryPredictor mode, const Tables& tables,
+                        const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
     switch (mode) {
         case GeometryPredictor::normal_frame:
             return decode_positions<false, false>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size);
@@ -678,6 +681,20 @@ bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, G
         default:
             return false;
     }
+}
+
+template <class Source>
+bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, GeometryPredictor mode, const StaticTables& tables,
+                   const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
+    if (!is_static_mode(mode)) return false;
+    NarrowTables narrow;
+    bool all_narrow = true;
+    for (int i = 0; i < static_table_count(mode); ++i) {
+        narrow[size_t(i)] = tables[size_t(i)].narrow_view();
+        all_narrow = all_narrow && narrow[size_t(i)].index != nullptr;
+    }
+    if (all_narrow) return decode_static_with(h, created, space, mode, narrow, rans_data, rans_size, raw_data, raw_size);
+    return decode_static_with(h, created, space, mode, tables, rans_data, rans_size, raw_data, raw_size);
 }
 
 }  // namespace
