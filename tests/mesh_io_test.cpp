@@ -21,6 +21,7 @@
 #include "mesh/obj_io.h"
 #include "mesh/off_io.h"
 #include "mesh/ply_io.h"
+#include "mesh/text_number.h"
 
 namespace fs = std::filesystem;
 using namespace amc;
@@ -347,6 +348,41 @@ TEST(ObjReader, RejectsPolygonsOutOfRangeAndMalformedCoordinates) {
                             "c.obj: vertex 0 (line 1) has fewer than 3 coordinates");
     expect_error_containing([&] { parse_obj("v 0 0 1x\n", "c.obj"); }, "malformed coordinate '1x'");
     expect_error_containing([&] { parse_obj(v + "f 0 1 2\n", "z.obj"); }, "z.obj: OBJ parse error");
+}
+
+// parse_int is hand-written for speed: it must accept and give what std::from_chars does (plus
+// a leading '+'), at the ends of the range and on random tokens.
+TEST(TextNumber, ParseIntAgreesWithFromChars) {
+    auto reference = [](std::string_view token, int64_t& out) {
+        std::string_view digits = token;
+        if (!digits.empty() && digits[0] == '+') {
+            digits.remove_prefix(1);
+            if (!digits.empty() && (digits[0] == '+' || digits[0] == '-')) return false;
+        }
+        const char* last = digits.data() + digits.size();
+        auto [ptr, ec] = std::from_chars(digits.data(), last, out, 10);
+        return ec == std::errc() && ptr == last;
+    };
+    std::vector<std::string> tokens = {"", "+", "-", "+-1", "-+1", "0", "-0", "+0", "007", "12a", "1 ",
+                                       "9223372036854775807", "9223372036854775808", "-9223372036854775808",
+                                       "-9223372036854775809", "+9223372036854775807", "18446744073709551616",
+                                       "99999999999999999999", "1e3", "0x1f", "--1"};
+    std::mt19937_64 random(7);
+    const std::string alphabet = "0123456789+- x";
+    for (int trial = 0; trial < 20000; ++trial) {
+        std::string token;
+        const int length = int(random() % 22);
+        for (int k = 0; k < length; ++k) token += alphabet[random() % (trial % 2 ? 10 : alphabet.size())];
+        tokens.push_back(token);
+    }
+    for (const std::string& token : tokens) {
+        int64_t expected = -1, got = -1;
+        const bool ok = reference(token, expected);
+        ASSERT_EQ(text::parse_int(token, got), ok) << "'" << token << "'";
+        if (ok) {
+            ASSERT_EQ(got, expected) << "'" << token << "'";
+        }
+    }
 }
 
 TEST(ObjReader, ChecksEveryPartOfAFaceCorner) {
