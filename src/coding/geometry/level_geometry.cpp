@@ -246,13 +246,8 @@ std::vector<uint8_t> finish_level_payload(const Mesh& h, const NewVertices& crea
         payload.insert(payload.end(), static_code.raw_bytes().begin(), static_code.raw_bytes().end());
         return payload;
     }
-    if (positions.quantized()) {
+    if (positions.quantized() || created.empty()) {  // no raw bits: the layout of every version
         encode_adaptive(h, created, code.predictor, positions, encoder, nullptr);
-        const std::vector<uint8_t> coded = encoder.finish();
-        payload.insert(payload.end(), coded.begin(), coded.end());
-        return payload;
-    }
-    if (created.empty()) {  // nothing raw: the layout of every version
         const std::vector<uint8_t> coded = encoder.finish();
         payload.insert(payload.end(), coded.begin(), coded.end());
         return payload;
