@@ -505,6 +505,7 @@ template void StaticLevelEncoder::extend(const Hierarchy&, const std::vector<std
 template void StaticLevelEncoder::extend(const HierarchyOnGrid&, const std::vector<std::pair<NodeId, int>>&);
 
 void StaticLevelEncoder::make_tables() {
+    coded_table_bytes_ = SIZE_MAX;
     token_bits_ = 0;
     token_count_ = 0;
     for (int i = 0; i < table_count_; ++i) {
@@ -553,11 +554,9 @@ void StaticLevelEncoder::write_tables(ArithmeticEncoder& encoder) const {
 
 size_t StaticLevelEncoder::estimated_bytes() const {
     if (!coded_) throw Error("StaticLevelEncoder::estimated_bytes: the streams are not coded yet (code_streams)");
-    ArithmeticEncoder tables;
-    write_tables(tables);
     size_t varint = 1;
     for (size_t n = rans_.size(); n >= 128; n >>= 7) ++varint;
-    return tables.finish().size() + varint + rans_.size() + raw_.size();
+    return coded_table_bytes() + varint + rans_.size() + raw_.size();
 }
 
 // The rANS stream's bound. Each of its two states starts at L = 2^23 and ends below 256 L; coding
@@ -567,10 +566,15 @@ size_t StaticLevelEncoder::estimated_bytes() const {
 // and the stream is K + 8 bytes.
 size_t StaticLevelEncoder::lower_bound_bytes() const { return table_bytes() + stream_bound_bytes(); }
 
-size_t StaticLevelEncoder::table_bytes() const {
-    ArithmeticEncoder tables;
-    write_tables(tables);
-    return tables.finish().size() + 1;
+size_t StaticLevelEncoder::table_bytes() const { return coded_table_bytes() + 1; }
+
+size_t StaticLevelEncoder::coded_table_bytes() const {
+    if (coded_table_bytes_ == SIZE_MAX) {
+        ArithmeticEncoder tables;
+        write_tables(tables);
+        coded_table_bytes_ = tables.finish().size();
+    }
+    return coded_table_bytes_;
 }
 
 size_t StaticLevelEncoder::stream_bound_bytes() const {

@@ -112,6 +112,8 @@ private:
     void add_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
     // lower_bound_bytes()' parts: the coded tables, and the rANS and raw streams.
     size_t table_bytes() const;
+    // The tables coded alone, made once per make_tables() (the bounds and the size ask it up to three times).
+    size_t coded_table_bytes() const;
     size_t stream_bound_bytes() const;
     // The tables from the counts, and the tokens' cost under them.
     void make_tables();
@@ -128,6 +130,7 @@ private:
     std::vector<std::array<uint16_t, kStaticRoles>> symbols_;
     std::vector<StaticResidual> large_;
     uint64_t raw_bits_ = 0;
+    mutable size_t coded_table_bytes_ = SIZE_MAX;  // coded_table_bytes(), or SIZE_MAX until asked
     bool coded_ = false;
     std::vector<uint8_t> rans_, raw_;
 };
