@@ -7,7 +7,10 @@
 // CACHE_DIR as bench/mixing_study; WEIGHTS_OUT=prefix writes the mixers' weights the models end
 // with (averaged over the models) for each design with trained start weights, WEIGHTS_IN=prefix
 // starts those designs from such files instead of leaving each model out of its own start.
-//   [CACHE_DIR=dir] [ONLY=text] [WEIGHTS_OUT=prefix | WEIGHTS_IN=prefix] model_study model.amh ...
+// Designs with trained initial states ("P:") count each model table's slots over the training
+// models: TRAIN=stem,stem,... names them, else each model trains on the other meshes' models.
+// LAW_DIR=dir reads the random refinement's law posterior (bench/random_refinement_bound --dump).
+//   [CACHE_DIR=dir] [ONLY=text] [WEIGHTS_OUT=prefix | WEIGHTS_IN=prefix] [TRAIN=...] [LAW_DIR=dir] model_study model.amh ...
 #include "mixed_symbols.h"
 
 #include "coding/hierarchy/context_mixing.h"
@@ -37,6 +40,10 @@ struct Extra {
     // over its length, among same-level neighbours split before n's symbol; and how many there are.
     uint8_t nb_disp = 0;
     uint8_t nb_known = 0;
+    // The random refinement only: its generator's law's posterior of the node's split (bench/
+    // random_refinement_bound --dump, read from LAW_DIR/<model>.law), half-octave odds bins, 1..32
+    // (0: none).
+    uint8_t law = 0;
 };
 
 Vec3 unit_normal_of(const Hierarchy& h, NodeId m, double* twice_area = nullptr) {
@@ -74,9 +81,18 @@ std::vector<Extra> extra_features(const std::string& path, const std::filesystem
     }
     std::vector<size_t> symbol_of(h.node_count(), SIZE_MAX);
     for (size_t i = 0; i < trace.size(); ++i) symbol_of[trace[i].node] = std::min(symbol_of[trace[i].node], i);
+    std::vector<uint8_t> law_of(h.node_capacity(), 0);
+    if (const char* dir = std::getenv("LAW_DIR")) {
+        std::ifstream in(std::filesystem::path(dir) / (std::filesystem::path(path).stem().string() + ".law"), std::ios::binary);
+        uint32_t node = 0;
+        float q = 0;
+        while (in.read(reinterpret_cast<char*>(&node), 4) && in.read(reinterpret_cast<char*>(&q), 4))
+            if (node < law_of.size()) law_of[node] = uint8_t(std::clamp(int(std::floor(2 * std::log2(q / (1 - q)))) + 17, 1, 32));
+    }
     for (size_t i = 0; i < count && i < trace.size(); ++i) {
         const NodeId n = trace[i].node;
         Extra& x = out[i];
+        x.law = law_of[n];
         double largest = 0;
         for (int e = 0; e < 3; ++e) {
             const NodeId q = h.neighbor(n, e);
@@ -119,6 +135,8 @@ std::vector<Extra> extra_features(const std::string& path, const std::filesystem
     return out;
 }
 
+struct Counts;
+
 struct Options {
     int window_log2 = 8;       // direct models
     int history_log2 = 6;      // the bit histories' models
@@ -138,6 +156,25 @@ struct Options {
     std::vector<std::function<uint32_t(const MixedFeatures&, const Extra&)>> extra;
     int mixer_d = 0;  // a fourth mixer: 1 set by base size / 4 x level, 2 by curvature / 4 x level, 3 by gauss / 4 x level
     int extra_set_b = 0;  // 1: mixer B's set by parent_curv / 4 instead of ring_mean / 4
+    // Trained initial states (as CABAC's init tables): every direct, extra and history-map model
+    // starts at the ones' share its slot had over the training models' symbols, with count
+    // min(prior_count, symbols seen there); prior_count 0: flat starts.
+    int prior_count = 0;
+    bool prior_maps = true;  // also the history maps (else the direct and extra models only)
+    const Counts* priors = nullptr;
+};
+
+// Ones and symbols per slot of every model table of a Study (direct, extra, history maps).
+struct Counts {
+    std::vector<std::vector<std::array<uint32_t, 2>>> tables;
+    void add(const Counts& o) {
+        if (tables.empty()) {
+            tables = o.tables;
+            return;
+        }
+        for (size_t t = 0; t < tables.size(); ++t)
+            for (size_t i = 0; i < tables[t].size(); ++i) tables[t][i][0] += o.tables[t][i][0], tables[t][i][1] += o.tables[t][i][1];
+    }
 };
 
 class Mixer {
@@ -203,7 +240,30 @@ public:
         }
         for (int rows : {40, 640, 192, 2560, 200, 80}) maps_.emplace_back(rows, o.map_rate);
         if (!o.start[0].empty()) a_.start_at(o.start[0]), b_.start_at(o.start[1]), c_.start_at(o.start[2]), d_.start_at(o.start[o.mixer_d && !o.start[3].empty() ? 3 : 1]);
+        for (std::vector<BitModel>* t : tables()) counts_.tables.emplace_back(t->size(), std::array<uint32_t, 2>{0, 0});
+        if (o.priors && o.prior_count > 0) {
+            const std::vector<std::vector<BitModel>*> all = tables();
+            const size_t last = o.prior_maps ? all.size() : all.size() - 3;
+            for (size_t t = 0; t < last; ++t)
+                for (size_t i = 0; i < all[t]->size(); ++i) {
+                    const auto [ones, n] = o.priors->tables[t][i];
+                    if (n == 0) continue;
+                    BitModel& m = (*all[t])[i];
+                    const double p = (ones + 0.4) / (n + 0.8);
+                    m.p = uint32_t(std::clamp(p * 4294967296.0, 65536.0, 4294967296.0 - 65536.0));
+                    m.n = uint16_t(std::min<uint32_t>(uint32_t(o.prior_count), n));
+                }
+        }
     }
+    // The model tables in a fixed order: direct, extra, history maps.
+    std::vector<std::vector<BitModel>*> tables() {
+        std::vector<std::vector<BitModel>*> all;
+        for (auto& t : models_) all.push_back(&t);
+        for (auto& t : extra_models_) all.push_back(&t);
+        for (auto& t : history_maps_) all.push_back(&t);
+        return all;
+    }
+    Counts counts_;
     std::array<std::vector<double>, 4> mean_weights() const {
         return {a_.mean_weights(), b_.mean_weights(), c_.mean_weights(), o_.mixer_d ? d_.mean_weights() : std::vector<double>{}};
     }
@@ -290,6 +350,12 @@ private:
     }
 
     void update(bool bit) {
+        {
+            size_t t = 0;
+            for (int j = 0; j < kDirect; ++j, ++t) counts_.tables[t][slot_[size_t(j)]][0] += bit, ++counts_.tables[t][slot_[size_t(j)]][1];
+            for (size_t e = 0; e < extra_slot_.size(); ++e, ++t) counts_.tables[t][extra_slot_[e]][0] += bit, ++counts_.tables[t][extra_slot_[e]][1];
+            for (int k = 0; k < 3; ++k, ++t) counts_.tables[t][hslot_[size_t(k)]][0] += bit, ++counts_.tables[t][hslot_[size_t(k)]][1];
+        }
         a_.update(st_.data(), bit, o_);
         b_.update(st_.data(), bit, o_);
         c_.update(st_.data(), bit, o_);
@@ -486,6 +552,23 @@ int main(int argc, char** argv) {
         o.extra.push_back([](F f, X x) { return ((x.nb_disp * 4u + x.nb_known) * 16 + f.size / 4u) * 8 + f.level; });
         o.extra.push_back([](F f, X x) { return (f.group * 64u + x.nb_disp) * 16 + f.mean_curv / 4u; });
     });
+    add("P: third model (start weights: leave one model out)", third);
+    add("Q: third model, symbols coded twice, second pass (its learning cost's bound)", [&](Options& o) { third(o), o.prime = true; });
+    for (int c : {2, 4, 8, 16, 32, 64})
+        add("P: third + trained initial states, count " + std::to_string(c), [&, c](Options& o) { third(o), o.prior_count = c; });
+    for (int c : {8, 32})
+        add("P: third + trained initial states of direct models only, count " + std::to_string(c), [&, c](Options& o) {
+            third(o), o.prior_count = c, o.prior_maps = false;
+        });
+    add("R: third + the law's posterior x group", [&](Options& o) {
+        third(o);
+        o.extra.push_back([](F f, X x) { return f.group * 33u + x.law; });
+    });
+    add("R: third + the law's posterior x group, + x level", [&](Options& o) {
+        third(o);
+        o.extra.push_back([](F f, X x) { return f.group * 33u + x.law; });
+        o.extra.push_back([](F f, X x) { return x.law * 8u + f.level; });
+    });
     const char* only = std::getenv("ONLY");
 
     const double paper_total = mixed_study::print_design_table_head(data);
@@ -536,6 +619,26 @@ int main(int argc, char** argv) {
                 }
             }
         }
+        // Trained initial states: TRAIN=stem,stem,... names the training models (each model is
+        // coded with the others' counts if it is one of them); without TRAIN, each model is coded
+        // with the counts of the models of other meshes (leave one mesh out).
+        std::vector<Counts> counted;
+        if (design.o.prior_count > 0)
+            for (size_t m = 0; m < data.size(); ++m) {
+                Options plain = design.o;
+                plain.prior_count = 0;
+                Study study(plain);
+                study.code(data[m].symbols, extras[m]);
+                counted.push_back(study.counts_);
+            }
+        auto mesh_of = [](const std::string& name) { return name.substr(0, name.rfind('_')); };
+        auto trains = [&](size_t m, size_t other) {
+            if (other == m) return false;
+            const char* train = std::getenv("TRAIN");
+            if (!train) return mesh_of(data[other].name) != mesh_of(data[m].name);
+            const std::string list = std::string(",") + train + ",";
+            return list.find("," + data[other].name + ",") != std::string::npos;
+        };
         for (size_t m = 0; m < data.size(); ++m) {
             Options o = design.o;
             if (o.trained_start && weights_in) o.start = given;
@@ -547,6 +650,13 @@ int main(int argc, char** argv) {
                             for (size_t i = 0; i < sum.size(); ++i) sum[i] += ended[other][size_t(k)][i] / double(data.size() - 1);
                     o.start[size_t(k)].assign(sum.begin(), sum.end());
                 }
+            Counts prior;
+            if (o.prior_count > 0) {
+                for (size_t other = 0; other < data.size(); ++other)
+                    if (trains(m, other)) prior.add(counted[other]);
+                if (prior.tables.empty()) o.prior_count = 0;
+                o.priors = &prior;
+            }
             Study study(o);
             bits.push_back(study.code(data[m].symbols, extras[m]));
             if (std::getenv("PER_LEVEL") && &design == &designs[0]) {
