@@ -94,19 +94,23 @@ Quantizer quantizer_of(const Hierarchy& input, int bits, unsigned threads) {
 // max_quantization_error's. On `threads` threads, each range of vertices with its own largest error.
 template <class Set>
 double snap_positions(const Hierarchy& h, const Quantizer& quantizer, unsigned threads, Set&& set) {
-    // std::fmax inline (a NaN loses to a number); its choice between +0 and -0 never arises, fabs gives +0.
-    auto larger = [](double a, double b) { return b > a || std::isnan(a) ? b : a; };
+    // std::fmax's result: no error is NaN (check_positions passed: p and r are finite) and fabs
+    // gives +0, so the largest is one value whatever the order. Each axis on its own, as maxsd
+    // without branches: the nested comparisons' branches were coin flips (8 % of a 12-bit encode).
+    auto larger = [](double a, double b) { return b > a ? b : a; };
     const size_t vertices = h.positions().size();
     std::vector<double> worst_in((vertices + kPositionRange - 1) / kPositionRange, 0.0);
     const GridSnap snap(quantizer);
     parallel_for(worst_in.size(), threads, [&](size_t i) {
-        double worst = 0.0;
+        double worst_x = 0.0, worst_y = 0.0, worst_z = 0.0;
         for (size_t v = i * kPositionRange; v < std::min(vertices, (i + 1) * kPositionRange); ++v) {
             const Vec3 p = h.position(VertexId(v)), r = dequantize(quantizer, snap(p));
-            worst = larger(worst, larger(std::fabs(r.x - p.x), larger(std::fabs(r.y - p.y), std::fabs(r.z - p.z))));
+            worst_x = larger(worst_x, std::fabs(r.x - p.x));
+            worst_y = larger(worst_y, std::fabs(r.y - p.y));
+            worst_z = larger(worst_z, std::fabs(r.z - p.z));
             set(VertexId(v), r);
         }
-        worst_in[i] = worst;
+        worst_in[i] = larger(worst_x, larger(worst_y, worst_z));
     });
     double worst = 0.0;
     for (double w : worst_in) worst = larger(worst, w);
@@ -277,10 +281,9 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
             std::vector<uint32_t> base_vertex_id;
             TriangleMesh base = HierarchyBuilder::reordered_base_mesh(input.base(), base_code.vertex_order,
                                                                       base_code.triangle_order, order.rotation, base_vertex_id);
-            if (quantized) {
-                const GridSnap snap(quantizer);
-                for (Vec3& p : base.positions) p = dequantize(quantizer, snap(p));
-            }
+            // Base vertex i is the input's vertex_order[i], already on the grid in grid_positions.
+            if (quantized)
+                for (size_t i = 0; i < base.positions.size(); ++i) base.positions[i] = grid_positions[base_code.vertex_order[i]];
             reordered.hierarchy = Hierarchy(std::move(base));
             if (quantized) reordered.hierarchy.set_single_precision(false);
             first_pass = std::make_unique<HierarchyLevelEncoder>(input, options.hierarchy, kHierarchyStreamVersion, nullptr,
