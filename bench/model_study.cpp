@@ -161,6 +161,7 @@ struct Options {
     // min(prior_count, symbols seen there); prior_count 0: flat starts.
     int prior_count = 0;
     bool prior_maps = true;  // also the history maps (else the direct and extra models only)
+    bool prior_geometric_only = false;  // only the tables whose context holds a geometric feature
     const Counts* priors = nullptr;
 };
 
@@ -244,8 +245,11 @@ public:
         if (o.priors && o.prior_count > 0) {
             const std::vector<std::vector<BitModel>*> all = tables();
             const size_t last = o.prior_maps ? all.size() : all.size() - 3;
+            // Direct tables 6-12 and 18-20 and the extra tables read displacement, bending,
+            // curvature, size or Gauss bins.
+            auto geometric = [&](size_t t) { return (t >= 6 && t <= 12) || (t >= 18 && t < all.size() - 3); };
             for (size_t t = 0; t < last; ++t)
-                for (size_t i = 0; i < all[t]->size(); ++i) {
+                for (size_t i = 0; i < all[t]->size() && (!o.prior_geometric_only || geometric(t)); ++i) {
                     const auto [ones, n] = o.priors->tables[t][i];
                     if (n == 0) continue;
                     BitModel& m = (*all[t])[i];
@@ -556,6 +560,10 @@ int main(int argc, char** argv) {
     add("Q: third model, symbols coded twice, second pass (its learning cost's bound)", [&](Options& o) { third(o), o.prime = true; });
     for (int c : {2, 4, 8, 16, 32, 64})
         add("P: third + trained initial states, count " + std::to_string(c), [&, c](Options& o) { third(o), o.prior_count = c; });
+    for (int c : {2, 4, 8})
+        add("P: third + trained initial states of geometric tables only, count " + std::to_string(c), [&, c](Options& o) {
+            third(o), o.prior_count = c, o.prior_geometric_only = true;
+        });
     for (int c : {8, 32})
         add("P: third + trained initial states of direct models only, count " + std::to_string(c), [&, c](Options& o) {
             third(o), o.prior_count = c, o.prior_maps = false;
