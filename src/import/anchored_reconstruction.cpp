@@ -74,28 +74,46 @@ std::vector<uint32_t> reconstruct_anchored(Hierarchy& h, const std::vector<uint3
                                            const TriangleMesh& leaf, const std::string& what,
                                            UndoSteps* steps) {
     const uint32_t vertex_count = uint32_t(leaf.positions.size());
+    // The search runs on base detection's breadth-first numbering (its reads then share cache
+    // lines; it never compares vertex ids); what it found is given back in leaf ids.
+    const std::vector<uint32_t> leaf_of = detail::breadth_first_vertices(leaf.triangles, vertex_count);
+    std::vector<uint32_t> search_of(vertex_count);
+    for (uint32_t v = 0; v < vertex_count; ++v) search_of[leaf_of[v]] = v;
+    std::vector<Triangle> search_triangles = leaf.triangles;
+    detail::renumber(search_triangles, search_of);
+    std::vector<uint32_t> search_of_base(leaf_of_base.size());
     std::vector<uint8_t> kept(vertex_count, 0);
-    for (uint32_t l : leaf_of_base) kept[l] = 1;
+    for (size_t b = 0; b < leaf_of_base.size(); ++b) {
+        search_of_base[b] = search_of[leaf_of_base[b]];
+        kept[search_of_base[b]] = 1;
+    }
     const size_t base_triangles = h.base().triangles.size();
-    DetectedBase detected = undo_levels(leaf.triangles, vertex_count, base_triangles, kept);
+    DetectedBase detected = undo_levels(search_triangles, vertex_count, base_triangles, kept);
     if (steps) {  // the given order's, whatever the other orders below find
         steps->step.assign(vertex_count, kNeverUndone);
         for (size_t step = 0; step < detected.levels.size(); ++step) {
             for (const std::array<uint32_t, 6>& split : detected.levels[step].splits) {
-                for (int k = 3; k < 6; ++k) steps->step[split[size_t(k)]] = uint8_t(step + 1);
+                for (int k = 3; k < 6; ++k) steps->step[leaf_of[split[size_t(k)]]] = uint8_t(step + 1);
             }
         }
-        steps->remaining = remaining(detected, leaf.triangles);
+        steps->remaining = remaining(detected, search_triangles);
+        detail::renumber(steps->remaining, leaf_of);
     }
     // The inverse step's search depends on the face order (where its growths seed): one order
     // may commit a wrong block and stop short of the base where another reaches it.
     constexpr int kOtherOrders = 3;
-    for (int k = 1; k <= kOtherOrders && !ends_at_base(remaining(detected, leaf.triangles), h, leaf_of_base); ++k) {
-        const std::vector<Triangle> triangles = reordered(leaf.triangles, k);
+    for (int k = 1; k <= kOtherOrders && !ends_at_base(remaining(detected, search_triangles), h, search_of_base); ++k) {
+        const std::vector<Triangle> triangles = reordered(search_triangles, k);
         detected = undo_levels(triangles, vertex_count, base_triangles, kept);
         if (detected.levels.empty()) break;  // no order undoes anything: none will
     }
-    if (!ends_at_base(remaining(detected, leaf.triangles), h, leaf_of_base)) return {};
+    if (!ends_at_base(remaining(detected, search_triangles), h, search_of_base)) return {};
+    for (DetectedLevel& level : detected.levels) {
+        detail::renumber(level.triangles, leaf_of);
+        for (auto& split : level.splits) {
+            for (uint32_t& v : split) v = leaf_of[v];
+        }
+    }
     detected.base = h.base();
     detected.leaf_vertex_of_base = leaf_of_base;
     ImportedHierarchy built = hierarchy_from_levels(leaf, detected, what);

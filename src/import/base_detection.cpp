@@ -33,39 +33,6 @@ void set_base(const TriangleMesh& mesh, const std::vector<Triangle>& triangles, 
     for (const Triangle& t : triangles) out.base.triangles.push_back({base_index[t[0]], base_index[t[1]], base_index[t[2]]});
 }
 
-// The vertices in breadth-first order over the triangles (input ids; unused vertices last). The
-// search reads the labels of a vertex's neighbours at every step: numbered this way they share
-// cache lines, where a shuffled input's numbering makes each read a miss. The search never
-// compares vertex ids, so the numbering changes no result.
-std::vector<uint32_t> breadth_first_vertices(const std::vector<Triangle>& triangles, uint32_t vertex_count) {
-    std::vector<uint32_t> first(size_t(vertex_count) + 1, 0), around(triangles.size() * 3);
-    for (const Triangle& t : triangles) {
-        for (uint32_t v : t) ++first[v + 1];
-    }
-    for (uint32_t v = 0; v < vertex_count; ++v) first[v + 1] += first[v];
-    std::vector<uint32_t> fill(first.begin(), first.end() - 1);
-    for (uint32_t t = 0; t < triangles.size(); ++t) {
-        for (uint32_t v : triangles[t]) around[fill[v]++] = t;
-    }
-    std::vector<uint32_t> order;
-    order.reserve(vertex_count);
-    std::vector<uint8_t> seen(vertex_count, 0);
-    for (uint32_t root = 0; root < vertex_count; ++root) {
-        if (seen[root]) continue;
-        seen[root] = 1;
-        order.push_back(root);
-        for (size_t next = order.size() - 1; next < order.size(); ++next) {
-            const uint32_t v = order[next];
-            for (uint32_t k = first[v]; k < first[v + 1]; ++k) {
-                for (uint32_t w : triangles[around[k]]) {
-                    if (!seen[w]) seen[w] = 1, order.push_back(w);
-                }
-            }
-        }
-    }
-    return order;
-}
-
 // One run of the search: the levels it undid and, per level, what the next step needs (the
 // refined and changed triangles) and the blockers its step reported.
 struct SearchRun {
@@ -73,12 +40,6 @@ struct SearchRun {
     std::vector<std::vector<uint8_t>> refined, changed;
     std::vector<std::vector<Triangle>> blockers;
 };
-
-void renumber(std::vector<Triangle>& triangles, const std::vector<uint32_t>& id) {
-    for (Triangle& t : triangles) {
-        for (uint32_t& v : t) v = id[v];
-    }
-}
 
 // The levels undone from step `from` on, the earlier ones of `run` standing; in step s the
 // vertices marked in kept[s] (if any) stay.
@@ -168,17 +129,56 @@ bool wrong_single_blocks(const SearchRun& run, uint32_t vertex_count, size_t& st
 
 }  // namespace
 
+namespace detail {
+
+std::vector<uint32_t> breadth_first_vertices(const std::vector<Triangle>& triangles, uint32_t vertex_count) {
+    std::vector<uint32_t> first(size_t(vertex_count) + 1, 0), around(triangles.size() * 3);
+    for (const Triangle& t : triangles) {
+        for (uint32_t v : t) ++first[v + 1];
+    }
+    for (uint32_t v = 0; v < vertex_count; ++v) first[v + 1] += first[v];
+    std::vector<uint32_t> fill(first.begin(), first.end() - 1);
+    for (uint32_t t = 0; t < triangles.size(); ++t) {
+        for (uint32_t v : triangles[t]) around[fill[v]++] = t;
+    }
+    std::vector<uint32_t> order;
+    order.reserve(vertex_count);
+    std::vector<uint8_t> seen(vertex_count, 0);
+    for (uint32_t root = 0; root < vertex_count; ++root) {
+        if (seen[root]) continue;
+        seen[root] = 1;
+        order.push_back(root);
+        for (size_t next = order.size() - 1; next < order.size(); ++next) {
+            const uint32_t v = order[next];
+            for (uint32_t k = first[v]; k < first[v + 1]; ++k) {
+                for (uint32_t w : triangles[around[k]]) {
+                    if (!seen[w]) seen[w] = 1, order.push_back(w);
+                }
+            }
+        }
+    }
+    return order;
+}
+
+void renumber(std::vector<Triangle>& triangles, const std::vector<uint32_t>& id) {
+    for (Triangle& t : triangles) {
+        for (uint32_t& v : t) v = id[v];
+    }
+}
+
+}  // namespace detail
+
 DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what) {
     validate_triangle_mesh(mesh, what);
     const uint32_t vertex_count = uint32_t(mesh.positions.size());
     DetectedBase out;
     // The search runs on its own vertex numbering (breadth_first_vertices); the levels it found
     // are given back in input ids.
-    const std::vector<uint32_t> input_of = breadth_first_vertices(mesh.triangles, vertex_count);
+    const std::vector<uint32_t> input_of = detail::breadth_first_vertices(mesh.triangles, vertex_count);
     std::vector<uint32_t> search_of(vertex_count);
     for (uint32_t v = 0; v < vertex_count; ++v) search_of[input_of[v]] = v;
     std::vector<Triangle> renumbered = mesh.triangles;
-    renumber(renumbered, search_of);
+    detail::renumber(renumbered, search_of);
     SearchRun run;
     undo_levels_from(renumbered, vertex_count, 0, {}, run);
     // A one-block patch can be a wrong reading that its step cannot tell from a true one; a later
@@ -198,7 +198,7 @@ DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what) {
     }
     out.levels = std::move(run.levels);
     for (DetectedLevel& level : out.levels) {
-        renumber(level.triangles, input_of);
+        detail::renumber(level.triangles, input_of);
         for (auto& split : level.splits) {
             for (uint32_t& v : split) v = input_of[v];
         }

@@ -33,4 +33,17 @@ DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what = "me
 // The base of `mesh` after undoing only its first `levels` detected levels (0: the mesh itself).
 DetectedBase truncated(const TriangleMesh& mesh, DetectedBase detected, size_t levels);
 
+namespace detail {
+
+// The vertices in breadth-first order over the triangles (input ids; unused vertices last). The
+// inverse step reads the labels of a vertex's neighbours at every step: numbered this way they
+// share cache lines, where a shuffled input's numbering makes each read a miss. The search never
+// compares vertex ids, so the numbering changes no result.
+std::vector<uint32_t> breadth_first_vertices(const std::vector<Triangle>& triangles, uint32_t vertex_count);
+
+// Every vertex v of `triangles` replaced by id[v].
+void renumber(std::vector<Triangle>& triangles, const std::vector<uint32_t>& id);
+
+}  // namespace detail
+
 }  // namespace amc
