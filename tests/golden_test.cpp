@@ -131,53 +131,6 @@ bool decodes_to_one_of(const Hierarchy& back, const std::vector<Hierarchy>& cand
     return false;
 }
 
-// The version-14 file of c (AMC_UPDATE_GOLDEN writes it when missing) equals the encoder's bytes,
-// decodes to c's hierarchy (every prefix of levels too) and has a level with its raw bits in a
-// side stream; the cases pinned by older versions' tests that encoders now write as version 14.
-void pin_raw_side_encoding(const GoldenCase& c, const std::vector<uint8_t>& bytes) {
-    const std::string path = golden_path(kRawSideVersion, c.name);
-    SCOPED_TRACE(path);
-    if (std::getenv("AMC_UPDATE_GOLDEN") != nullptr && !std::filesystem::exists(path)) {
-        std::filesystem::create_directories(std::filesystem::path(path).parent_path());
-        std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-    }
-    const std::vector<uint8_t> golden = read_golden(path);
-    ASSERT_FALSE(golden.empty()) << "missing";
-    EXPECT_EQ(bytes, golden) << path << ": the bitstream changed (a new format version: FORMAT.md, Versions)";
-    const FileInfo info = inspect(golden.data(), golden.size());
-    EXPECT_EQ(info.version, kRawSideVersion);
-    const Hierarchy back = decode(golden.data(), golden.size());
-    EXPECT_TRUE(decodes_to_one_of(back, expected_decodings(c.hierarchy, c.options, kRawSideVersion)));
-    for (int l = 0; l < info.levels; ++l) {
-        DecodeOptions prefix;
-        prefix.max_level = l;
-        EXPECT_EQ(decode(golden.data(), golden.size(), prefix).depth(), std::min(l, back.depth())) << "level " << l;
-    }
-}
-
-// c's golden file of `version`, which the encoder must reproduce byte for byte (empty when it is
-// missing). AMC_UPDATE_GOLDEN writes a missing file first; it never overwrites one. A bit-exact
-// case with an adaptive level is written as version 14 now (raw bits in a side stream, FORMAT.md
-// 3.6): its bytes are pinned by the version-14 file of the case, and `version`'s file is returned
-// for the caller to decode.
-std::vector<uint8_t> pinned_encoding(const GoldenCase& c, int version, EncodeStats* stats = nullptr) {
-    const std::vector<uint8_t> bytes = encode(c.hierarchy, c.options, stats);
-    if (version < kRawSideVersion && bytes.size() > 4 && bytes[4] == kRawSideVersion) {
-        pin_raw_side_encoding(c, bytes);
-        return read_golden(golden_path(version, c.name));
-    }
-    const std::string path = golden_path(version, c.name);
-    if (std::getenv("AMC_UPDATE_GOLDEN") != nullptr && !std::filesystem::exists(path)) {
-        std::filesystem::create_directories(std::filesystem::path(path).parent_path());
-        std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-    }
-    const std::vector<uint8_t> golden = read_golden(path);
-    if (!golden.empty()) {
-        EXPECT_EQ(bytes, golden) << path << ": the bitstream changed (a new format version: FORMAT.md, Versions)";
-    }
-    return golden;
-}
-
 // A golden file of `version` decodes to c's hierarchy, and every prefix of its levels to that
 // level (progressive decoding).
 void check_decodes(const std::vector<uint8_t>& golden, const GoldenCase& c, int version) {
@@ -189,6 +142,53 @@ void check_decodes(const std::vector<uint8_t>& golden, const GoldenCase& c, int 
         prefix.max_level = l;
         EXPECT_EQ(decode(golden.data(), golden.size(), prefix).depth(), std::min(l, back.depth())) << "level " << l;
     }
+}
+
+// Writes `bytes` as c's file of `version` when AMC_UPDATE_GOLDEN is set and the file is missing
+// (never over an existing one); returns the file (empty when missing).
+std::vector<uint8_t> golden_file(const GoldenCase& c, int version, const std::vector<uint8_t>& bytes) {
+    const std::string path = golden_path(version, c.name);
+    if (std::getenv("AMC_UPDATE_GOLDEN") != nullptr && !std::filesystem::exists(path)) {
+        std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+        std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    }
+    return read_golden(path);
+}
+
+// The file of c in the version its bytes say (14: an adaptive level of a bit-exact file with its
+// raw bits in a side stream; 15: a level of a bit-exact file in geometry mode 6 or 7) equals the
+// encoder's bytes and decodes to c's hierarchy (every prefix of levels too); the cases pinned by
+// older versions' tests that encoders now write as one of those versions. A version-14 file of a
+// case written as version 15 now still decodes.
+void pin_newer_encoding(const GoldenCase& c, const std::vector<uint8_t>& bytes) {
+    const int written = bytes[4];
+    SCOPED_TRACE(golden_path(written, c.name));
+    const std::vector<uint8_t> golden = golden_file(c, written, bytes);
+    ASSERT_FALSE(golden.empty()) << "missing";
+    EXPECT_EQ(bytes, golden) << "the bitstream changed (a new format version: FORMAT.md, Versions)";
+    EXPECT_EQ(inspect(golden.data(), golden.size()).version, written);
+    check_decodes(golden, c, written);
+    for (int version = kRawSideVersion; version < written; ++version) {
+        const std::vector<uint8_t> older = read_golden(golden_path(version, c.name));
+        if (!older.empty()) check_decodes(older, c, version);
+    }
+}
+
+// c's golden file of `version`, which the encoder must reproduce byte for byte (empty when it is
+// missing). AMC_UPDATE_GOLDEN writes a missing file first; it never overwrites one. A bit-exact
+// case written as version 14 or 15 now (pin_newer_encoding) has its bytes pinned by its file of
+// that version, and `version`'s file is returned for the caller to decode.
+std::vector<uint8_t> pinned_encoding(const GoldenCase& c, int version, EncodeStats* stats = nullptr) {
+    const std::vector<uint8_t> bytes = encode(c.hierarchy, c.options, stats);
+    if (version < kRawSideVersion && bytes.size() > 4 && bytes[4] >= kRawSideVersion) {
+        pin_newer_encoding(c, bytes);
+        return read_golden(golden_path(version, c.name));
+    }
+    const std::vector<uint8_t> golden = golden_file(c, version, bytes);
+    if (!golden.empty()) {
+        EXPECT_EQ(bytes, golden) << golden_path(version, c.name) << ": the bitstream changed (a new format version: FORMAT.md, Versions)";
+    }
+    return golden;
 }
 
 // The versions with these cases: version 3 adds only the numbering block, whose golden files
@@ -500,6 +500,44 @@ TEST(Golden, ChunkVerticesFilesDecodeAndPinTheEncoder) {
         EXPECT_EQ(info.chunks.size(), size_t(c.options.chunks));
         check_decodes(golden, c, kChunkVerticesVersion);
         check_decodes_on_threads(golden);
+    }
+}
+
+// Version 15 (level geometry modes 6 and 7: the midpoint's and the butterfly's predictions under
+// static tables per axis, FORMAT.md 5.9; bit-exact files): a bumpy torus whose coordinates use all
+// their bits with the automatic choice, with mode 6 forced, in float32 with mode 7 forced, and in
+// three chunks with mode 7 forced.
+std::vector<GoldenCase> stencil_tables_cases() {
+    std::vector<GoldenCase> cases;
+    const Hierarchy torus = testing::bumpy_torus(false);
+    cases.push_back({"torus_bumpy", testing::bumpy_torus(false, 6000, 5), {}});  // levels large enough for the tables
+    EncodeOptions midpoint;
+    midpoint.predictor = GeometryPredictor::midpoint_static;
+    cases.push_back({"torus_bumpy_midpoint_static", torus, midpoint});
+    EncodeOptions butterfly;
+    butterfly.predictor = GeometryPredictor::butterfly_static;
+    cases.push_back({"torus_bumpy_float32_butterfly_static", testing::bumpy_torus(true), butterfly});
+    butterfly.chunks = 3;
+    cases.push_back({"torus_bumpy_butterfly_static_chunks3", torus, butterfly});
+    return cases;
+}
+
+TEST(Golden, StencilTablesFilesDecodeAndPinTheEncoder) {
+    for (const GoldenCase& c : stencil_tables_cases()) {
+        SCOPED_TRACE(golden_path(kStencilTablesVersion, c.name));
+        EncodeStats stats;
+        const std::vector<uint8_t> bytes = encode(c.hierarchy, c.options, &stats);
+        const std::vector<uint8_t> golden = golden_file(c, kStencilTablesVersion, bytes);
+        ASSERT_FALSE(golden.empty()) << "missing";
+        EXPECT_EQ(bytes, golden) << "the bitstream changed (a new format version: FORMAT.md, Versions)";
+        const FileInfo info = inspect(golden.data(), golden.size());
+        EXPECT_EQ(info.version, kStencilTablesVersion);
+        EXPECT_EQ(info.chunks.size(), c.options.chunks > 1 ? size_t(c.options.chunks) : size_t(0));
+        EXPECT_TRUE(std::any_of(stats.per_level.begin(), stats.per_level.end(), [](const LevelStats& l) {
+            return l.predictor == GeometryPredictor::midpoint_static || l.predictor == GeometryPredictor::butterfly_static;
+        })) << "the case exercises geometry mode 6 or 7";
+        check_decodes(golden, c, kStencilTablesVersion);
+        if (c.options.chunks > 1) check_decodes_on_threads(golden);
     }
 }
 

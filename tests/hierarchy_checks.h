@@ -37,6 +37,21 @@ inline Hierarchy projected_sphere(uint32_t target_leaves, int max_level, uint64_
     return h;
 }
 
+// A torus refined at random, every vertex moved off its place by smooth bumps (new vertices off
+// their midpoints, every coordinate bit in use), optionally rounded to float32.
+inline Hierarchy bumpy_torus(bool single_precision, uint32_t target_leaves = 600, int max_level = 4) {
+    Hierarchy h(make_torus(8, 6, 2.0, 0.7));
+    refine_randomly(h, target_leaves, max_level, 3);
+    for (VertexId v = 0; v < h.positions().size(); ++v) {
+        const Vec3 p = h.position(v);
+        Vec3 q{p.x * (1 + 0.01 * std::sin(7 * p.y)), p.y * (1 + 0.01 * std::cos(5 * p.z)), p.z + 0.003 * std::sin(3 * p.x)};
+        if (single_precision) q = {double(float(q.x)), double(float(q.y)), double(float(q.z))};
+        h.set_position(v, q);
+    }
+    h.set_single_precision(single_precision);
+    return h;
+}
+
 // The mesh with its vertices renumbered, its triangles reordered and each rotated, at random
 // (positions unchanged); new_index, if given, receives the new number of every old vertex.
 inline TriangleMesh shuffled(const TriangleMesh& mesh, uint64_t seed, std::vector<uint32_t>* new_index = nullptr) {

@@ -42,19 +42,7 @@ std::vector<uint8_t> rewritten(const std::vector<uint8_t>& bytes, uint8_t versio
     return writer.finish();
 }
 
-// A torus refined at random, new vertices moved off their midpoints (every coordinate bit in use).
-Hierarchy bumpy_torus(bool single_precision) {
-    Hierarchy h(make_torus(8, 6, 2.0, 0.7));
-    refine_randomly(h, 600, 4, 3);
-    for (VertexId v = 0; v < h.positions().size(); ++v) {
-        const Vec3 p = h.position(v);
-        Vec3 q{p.x * (1 + 0.01 * std::sin(7 * p.y)), p.y * (1 + 0.01 * std::cos(5 * p.z)), p.z + 0.003 * std::sin(3 * p.x)};
-        if (single_precision) q = {double(float(q.x)), double(float(q.y)), double(float(q.z))};
-        h.set_position(v, q);
-    }
-    h.set_single_precision(single_precision);
-    return h;
-}
+using testing::bumpy_torus;
 
 TEST(RawSideStream, BitExactAdaptiveLevelsRoundTripAsVersion14) {
     for (bool single : {false, true}) {

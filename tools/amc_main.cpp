@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
     encode_cmd->add_option("--map", encode.map, "Write the map from the input's numbering to the decoded mesh (text)");
     encode_cmd->add_option("--quantize", encode.quantize_bits, "Quantize coordinates to BITS per axis (lossy; 0 = bit-exact)")
         ->check(CLI::Range(0, 30));
-    encode_cmd->add_option("--predictor", encode.predictor, "auto | midpoint | butterfly | normal | grid (normal, --quantize only) | unit (normal frame of unit normals)")
+    encode_cmd->add_option("--predictor", encode.predictor, "auto | midpoint | butterfly | normal | grid (normal, --quantize only) | unit (normal frame of unit normals) | midpoint-static | butterfly-static (static tables, bit-exact only)")
         ->capture_default_str();
     encode_cmd->add_option("--chunks", encode.chunks,
                            "Cut the forest into this many chunks, each decodable alone (0: one per --chunk-faces faces, fewer when a chunk would code to less than " +

@@ -27,6 +27,8 @@ const char* predictor_name(GeometryPredictor p) {
            : p == GeometryPredictor::normal_frame ? "normal"
            : p == GeometryPredictor::normal_frame_grid ? "grid"
            : p == GeometryPredictor::unit_normal_frame ? "unit"
+           : p == GeometryPredictor::midpoint_static ? "midpoint-static"
+           : p == GeometryPredictor::butterfly_static ? "butterfly-static"
                                                   : "automatic";
 }
 
@@ -37,7 +39,10 @@ GeometryPredictor parse_predictor(const std::string& name) {
     if (name == "normal") return GeometryPredictor::normal_frame;
     if (name == "grid") return GeometryPredictor::normal_frame_grid;
     if (name == "unit") return GeometryPredictor::unit_normal_frame;
-    throw UsageError("--predictor: unknown predictor '" + name + "' (auto, midpoint, butterfly, normal, grid, unit)");
+    if (name == "midpoint-static") return GeometryPredictor::midpoint_static;
+    if (name == "butterfly-static") return GeometryPredictor::butterfly_static;
+    throw UsageError("--predictor: unknown predictor '" + name +
+                     "' (auto, midpoint, butterfly, normal, grid, unit, midpoint-static, butterfly-static)");
 }
 
 // "0,3-5" -> 0, 3, 4, 5 (increasing, each once).
@@ -132,6 +137,9 @@ void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     options.unit_normals = command.geometry_contexts == "grid";   // quantized files ignore it
     if (options.predictor == GeometryPredictor::normal_frame_grid && options.quantize_bits == 0)
         throw UsageError("--predictor grid needs --quantize (grid points exist only on a grid)");
+    if ((options.predictor == GeometryPredictor::midpoint_static || options.predictor == GeometryPredictor::butterfly_static) &&
+        options.quantize_bits != 0)
+        throw UsageError("--predictor midpoint-static and butterfly-static are for bit-exact files (without --quantize)");
     options.effort = command.effort;
     options.chunks = command.chunks;
     options.chunk_faces = command.chunk_faces;

@@ -14,7 +14,7 @@
 namespace amc {
 
 enum class GeometryPredictor : uint8_t {
-    automatic = 0,  // per level, whichever of the three codes smaller
+    automatic = 0,  // per level, whichever of the candidates codes smaller
     midpoint = 1,
     butterfly = 2,
     // The normal frame with static tables and rANS (docs/FORMAT.md 5.6): faster to decode, and
@@ -28,6 +28,11 @@ enum class GeometryPredictor : uint8_t {
     // direction) with mode 3's three tables (docs/FORMAT.md 5.8): bit-exact remeshes' new vertices
     // lie on that line up to rounding; files that use it are .amc version 12.
     unit_normal_frame = 5,
+    // Bit-exact files only: the midpoint's and the butterfly's predictions with mode 3's residual
+    // tokens, three static tables (one per axis), rANS and raw bits (docs/FORMAT.md 5.9): the
+    // adaptive predictors' sizes at a fraction of their decode; files that use them are .amc version 15.
+    midpoint_static = 6,
+    butterfly_static = 7,
 };
 
 // How the hierarchy symbols of an .amc file are modelled (docs/HIERARCHY_CODER.md).

@@ -21,8 +21,10 @@ namespace amc {
 // they hold). Version 13 for chunked files (whatever else they hold): its chunk table lists each
 // chunk's own vertices. Version 14 for bit-exact files with a level (of the file or of a chunk) in
 // an adaptive geometry mode (midpoint, butterfly): such a level's raw bits are in a side stream.
+// Version 15 for bit-exact files with a level in geometry mode 6 or 7 (the midpoint's or the
+// butterfly's predictions under static tables, rANS and raw bits).
 constexpr uint8_t kOldestReadableVersion = 1;
-constexpr uint8_t kNewestVersion = 14;
+constexpr uint8_t kNewestVersion = 15;
 constexpr uint8_t kBaseVersion = 2;       // everything but the numbering block and mode 2
 constexpr uint8_t kNumberingVersion = 3;  // the first version with a numbering block
 constexpr uint8_t kAngleBaseVersion = 4;  // the first version with base connectivity mode 2
@@ -44,6 +46,9 @@ constexpr uint8_t kChunkVerticesVersion = 13;
 // The first version whose adaptive level blocks (predictors 1, 2) in bit-exact files carry the
 // coordinates' raw bits in a byte-aligned side stream after the arithmetic code (FORMAT.md 3.6, 5.2).
 constexpr uint8_t kRawSideVersion = 14;
+// The first version with level geometry modes 6 and 7 (midpoint_static, butterfly_static; bit-exact
+// files, FORMAT.md 5.9).
+constexpr uint8_t kStencilTablesVersion = 15;
 
 // The hierarchy stream (FORMAT.md section 2).
 constexpr uint8_t kHierarchyStreamVersion = 2;
@@ -70,6 +75,7 @@ constexpr uint8_t hierarchy_stream_version_of_file(uint8_t file_version) {
         case 12: return 2;
         case 13: return 2;
         case 14: return 2;
+        case 15: return 2;
     }
     return 0;
 }

@@ -118,9 +118,10 @@ double snap_positions(const Hierarchy& h, const Quantizer& quantizer, unsigned t
 }
 
 // The lowest version that holds what the file holds (format_version.h).
-uint8_t file_version(bool raw_side, bool unit_geometry, bool grid_geometry, bool mixed_contexts, bool chunked, bool static_geometry,
+uint8_t file_version(bool stencil_tables, bool raw_side, bool unit_geometry, bool grid_geometry, bool mixed_contexts, bool chunked, bool static_geometry,
                      BaseConnectivityMode base_mode, bool store_numbering) {
-    return raw_side                                      ? kRawSideVersion
+    return stencil_tables                                ? kStencilTablesVersion
+           : raw_side                                    ? kRawSideVersion
            : chunked                                     ? kChunkVerticesVersion
            : unit_geometry                               ? kUnitFrameVersion
            : mixed_contexts                              ? kThirdMixingVersion
@@ -166,7 +167,7 @@ void add_level_stats(EncodeStats& stats, size_t nodes, size_t new_vertices, size
 struct ForestCode {
     std::vector<std::pair<BlockType, std::vector<uint8_t>>> blocks;
     uint64_t bytes = 0;  // of the blocks, framing included
-    bool chunked = false, static_geometry = false, grid_geometry = false, unit_geometry = false, raw_side = false;
+    bool chunked = false, static_geometry = false, grid_geometry = false, unit_geometry = false, raw_side = false, stencil_tables = false;
     uint64_t faces = 0, levels = 0;          // the metadata's
     std::vector<uint8_t> hierarchy_header;  // the metadata's (none with chunks)
     EncodeStats stats;  // header (the chunk table), hierarchy, geometry and framing bytes, levels, hierarchy
@@ -189,6 +190,7 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
         out.grid_geometry = parts.grid_geometry;
         out.unit_geometry = parts.unit_geometry;
         out.raw_side = parts.raw_side;
+        out.stencil_tables = parts.stencil_tables;
         out.faces = faces;
         out.levels = uint64_t(parts.levels);  // the deepest chunk's: the forest's
         out.blocks = std::move(parts.blocks);
@@ -212,6 +214,7 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
             out.grid_geometry |= geometry.predictor == GeometryPredictor::normal_frame_grid;
             out.unit_geometry |= geometry.predictor == GeometryPredictor::unit_normal_frame;
             out.raw_side |= has_raw_side(payload);
+            out.stencil_tables |= has_stencil_tables(geometry.predictor);
             add_level_stats(out.stats, hierarchy.level_nodes(l).size(), created.size(), hierarchy_part, payload);
             out.blocks.emplace_back(BlockType::level, std::move(payload));
         };
@@ -356,7 +359,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
         stats.numbering_bytes = blocks.back().second.size();
         stats.framing_bytes += kBlockOverhead;
     }
-    BlockWriter writer(file_version(forest.raw_side, forest.unit_geometry, forest.grid_geometry, mixed, forest.chunked, forest.static_geometry,
+    BlockWriter writer(file_version(forest.stencil_tables, forest.raw_side, forest.unit_geometry, forest.grid_geometry, mixed, forest.chunked, forest.static_geometry,
                                     base_code.mode, store_numbering),
                        uint8_t((precision == Precision::float32 ? kFlagSinglePrecision : 0) | (quantized ? kFlagQuantized : 0)));
     for (const auto& block : blocks) writer.add(block.first, block.second);
@@ -524,9 +527,9 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
         const std::string where = "level " + std::to_string(level) + " block";
         const LevelBlockParts parts = split_level_block(block, reader.version(), space.quantizer != nullptr, where);
         ArithmeticDecoder decoder(parts.arithmetic, parts.arithmetic_size);
-        // Every new vertex gets its decoded position below; a static mode's decoder takes their
+        // Every new vertex gets its decoded position below; a static mode with a frame takes their
         // frame corners from the split, without reading the nodes again.
-        const bool listed = is_static_mode(parts.predictor);
+        const bool listed = has_frame(parts.predictor);
         hierarchy.set_new_vertex_listing(listed, false);
         // The refined nodes R of a level create at least 1.5 R vertices, whose positions are in
         // this block: it bounds R before the next level is allocated.

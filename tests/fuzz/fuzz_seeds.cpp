@@ -88,6 +88,9 @@ void amc_seeds(const std::vector<Hierarchy>& hierarchies) {
         options.grid_contexts = k % 8 == 1;  // quantized: geometry mode 4 where it codes smaller (version 9)
         options.hierarchy = coder_options_from_switches(k % 2 ? 63 : (k * 7) % kCoderSwitchCombinations);
         if (k % 3 == 2) options.chunks = 3;  // a chunked file (version 13): chunk table, seam, chunks
+        // Bit-exact files in geometry modes 6 and 7 (version 15): static tables over the stencils.
+        if (options.quantize_bits == 0 && k % 6 == 4) options.predictor = k % 12 == 4 ? GeometryPredictor::midpoint_static
+                                                                                       : GeometryPredictor::butterfly_static;
         Hierarchy input = h;
         if (k % 4 == 2) {  // a forest over the base in single precision
             TriangleMesh base = h.base();

@@ -93,6 +93,7 @@ ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& s
         out.grid_geometry |= geometry.predictor == GeometryPredictor::normal_frame_grid;
         out.unit_geometry |= geometry.predictor == GeometryPredictor::unit_normal_frame;
         out.raw_side |= has_raw_side(payload);
+        out.stencil_tables |= has_stencil_tables(geometry.predictor);
         const uint64_t hierarchy_bytes = std::min<uint64_t>(hierarchy_part, payload.size() - 1);
         out.hierarchy_bytes += hierarchy_bytes;
         out.geometry_bytes += payload.size() - 1 - hierarchy_bytes;
@@ -178,9 +179,9 @@ void decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, size_t 
         const LevelBlockParts parts = split_level_block(level_block, limits.file_version, space.quantizer != nullptr, where);
         ArithmeticDecoder decoder(parts.arithmetic, parts.arithmetic_size);
         seam_splits.found = false;
-        // Every new vertex gets its decoded position below; a static mode's decoder takes their
+        // Every new vertex gets its decoded position below; a static mode with a frame takes their
         // frame corners from the split, without reading the nodes again.
-        const bool listed = is_static_mode(parts.predictor);
+        const bool listed = has_frame(parts.predictor);
         hierarchy.set_new_vertex_listing(listed, false);
         // The decoder's last chunk writes the decode's last nodes and positions; over its last
         // three levels (the largest, in adaptive hierarchies) its working memory goes back as it

@@ -26,6 +26,7 @@ struct ChunkCode {
     bool grid_geometry = false;       // a level uses geometry mode 4 (predictor 4)
     bool unit_geometry = false;       // a level uses geometry mode 5 (predictor 5)
     bool raw_side = false;            // a level's raw bits are in a side stream (kRawSideFlag: version 14)
+    bool stencil_tables = false;      // a level uses geometry mode 6 or 7 (version 15)
     std::vector<LevelStats> levels;
 };
 

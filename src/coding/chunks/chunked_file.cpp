@@ -73,6 +73,7 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& ro
         out.grid_geometry |= code.grid_geometry;
         out.unit_geometry |= code.unit_geometry;
         out.raw_side |= code.raw_side;
+        out.stencil_tables |= code.stencil_tables;
         out.levels = std::max(out.levels, int(code.levels.size()));
         stats.hierarchy_bytes += code.hierarchy_bytes;
         stats.geometry_bytes += code.geometry_bytes;

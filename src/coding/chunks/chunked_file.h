@@ -26,6 +26,7 @@ struct ChunkedBlocks {
     bool grid_geometry = false;    // some chunk level uses geometry mode 4
     bool unit_geometry = false;    // some chunk level uses geometry mode 5
     bool raw_side = false;         // some chunk level has its raw bits in a side stream (version 14)
+    bool stencil_tables = false;   // some chunk level uses geometry mode 6 or 7 (version 15)
     int levels = 0;                // of the deepest chunk
 };
 

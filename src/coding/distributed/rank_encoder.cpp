@@ -209,6 +209,7 @@ RankCode encode_rank_chunk(const RankChunk& part, const Seam& seam, const Encode
     out.summary.grid_geometry = code.grid_geometry;
     out.summary.unit_geometry = code.unit_geometry;
     out.summary.raw_side = code.raw_side;
+    out.summary.stencil_tables = code.stencil_tables;
     return out;
 }
 
@@ -243,9 +244,12 @@ std::vector<uint8_t> chunked_file_head(const TriangleMesh& base, const Seam& sea
         put_varint(table, offset);
         offset += c.block_bytes;
     }
-    bool raw_side = false;
-    for (const ChunkSummary& c : chunks) raw_side |= c.raw_side != 0;
-    BlockWriter writer(raw_side ? kRawSideVersion : kChunkVerticesVersion, grid != nullptr ? kFlagQuantized : base.single_precision ? kFlagSinglePrecision : 0);
+    bool raw_side = false, stencil_tables = false;
+    for (const ChunkSummary& c : chunks) {
+        raw_side |= c.raw_side != 0;
+        stencil_tables |= c.stencil_tables != 0;
+    }
+    BlockWriter writer(stencil_tables ? kStencilTablesVersion : raw_side ? kRawSideVersion : kChunkVerticesVersion, grid != nullptr ? kFlagQuantized : base.single_precision ? kFlagSinglePrecision : 0);
     writer.add(BlockType::metadata, write_metadata(meta, grid != nullptr));
     writer.add(BlockType::base_connectivity, base_code.bytes);
     writer.add(BlockType::base_geometry, encode_base_geometry(roots, base_code, false, positions));

@@ -69,7 +69,7 @@ Seam rank_seam(const TriangleMesh& base, const RankLayout& layout, std::vector<S
 // What every rank tells the others about its chunk (plain data: it travels as bytes).
 struct ChunkSummary {
     uint64_t roots = 0, nodes = 0, own_vertices = 0, faces = 0, block_bytes = 0;
-    uint32_t levels = 0, static_geometry = 0, grid_geometry = 0, unit_geometry = 0, raw_side = 0;
+    uint32_t levels = 0, static_geometry = 0, grid_geometry = 0, unit_geometry = 0, raw_side = 0, stencil_tables = 0;
 };
 
 struct RankCode {

@@ -34,23 +34,36 @@ constexpr double kSampleSlack = 64;
 constexpr double kStaticMargin = 1.02;
 constexpr double kEarlyMargin = 1.25;
 
+// The static modes the automatic choice weighs, in the order of the choice (after the adaptive
+// midpoint and butterfly).
+constexpr int kStaticCandidates = 5;
+constexpr GeometryPredictor kStaticModes[kStaticCandidates] = {
+    GeometryPredictor::normal_frame, GeometryPredictor::normal_frame_grid, GeometryPredictor::unit_normal_frame,
+    GeometryPredictor::midpoint_static, GeometryPredictor::butterfly_static};
+
+// An adaptive predictor (1, 2) is taken over a static stencil mode (6, 7) only when it codes the
+// level in fewer bytes than the stencil mode's divided by this: a stencil mode decodes the scaling
+// torus's coordinates in under half the instructions, for its tables' bytes (CODEC.md, "Geometry
+// modes 6 and 7").
+constexpr double kStencilPreference = 1.01;
+
 // Clears candidate[i] for the static modes whose lower bound on the first `sample` vertices of
 // the level, its streams scaled to the level, passes the smallest by more than kStaticMargin (and
 // kSampleSlack bytes); the sample's
 // encoders of those left go to on_sample[i], for the whole level to carry on from.
 template <class Mesh>
 void keep_likely_static_modes(const Mesh& h, const NewVertices& created, CoordinateSpace space, size_t sample,
-                              const GeometryPredictor modes[3], bool candidate[3],
-                              std::unique_ptr<StaticLevelEncoder> on_sample[3]) {
+                              bool candidate[kStaticCandidates], std::unique_ptr<StaticLevelEncoder> on_sample[kStaticCandidates]) {
     const double scale = double(created.size()) / double(sample);
-    double bound[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, smallest = HUGE_VAL;
-    for (int i = 0; i < 3; ++i) {
+    double bound[kStaticCandidates], smallest = HUGE_VAL;
+    for (int i = 0; i < kStaticCandidates; ++i) {
+        bound[i] = HUGE_VAL;
         if (!candidate[i]) continue;
-        on_sample[i] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, modes[i]);
+        on_sample[i] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, kStaticModes[i]);
         bound[i] = on_sample[i]->projected_bound_bytes(scale);
         smallest = std::min(smallest, bound[i]);
     }
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < kStaticCandidates; ++i) {
         candidate[i] = candidate[i] && bound[i] <= rounded(kStaticMargin * smallest) + kSampleSlack;
         if (!candidate[i]) on_sample[i].reset();
     }
@@ -64,6 +77,8 @@ bool predictor_allowed(uint8_t predictor, uint8_t file_version, bool quantized) 
         case GeometryPredictor::normal_frame: return file_version >= kStaticGeometryVersion;
         case GeometryPredictor::normal_frame_grid: return file_version >= kGridGeometryVersion && quantized;
         case GeometryPredictor::unit_normal_frame: return file_version >= kUnitFrameVersion;
+        case GeometryPredictor::midpoint_static:
+        case GeometryPredictor::butterfly_static: return file_version >= kStencilTablesVersion && !quantized;
         default: return false;
     }
 }
@@ -160,32 +175,31 @@ LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& create
         return code;
     }
     // The first of the smallest in the order midpoint, butterfly, normal frame, grid, unit frame,
-    // as if every mode were coded to its end. The static modes come first, each coded only when its
-    // lower bound leaves it a chance (smallest bound first), so that an adaptive trial stops as soon
-    // as its code so far shows it can not be the smallest.
+    // static midpoint, static butterfly, as if every mode were coded to its end. The static modes
+    // come first, each coded only when its lower bound leaves it a chance (smallest bound first), so
+    // that an adaptive trial stops as soon as its code so far shows it can not be the smallest.
     const size_t sample = effort >= kMaxEffort || created.size() / kSampleShare < kMinSample ? SIZE_MAX : created.size() / kSampleShare;
-    const GeometryPredictor static_modes[] = {GeometryPredictor::normal_frame, GeometryPredictor::normal_frame_grid,
-                                              GeometryPredictor::unit_normal_frame};
-    bool candidate[] = {true, grid_contexts && space.quantizer != nullptr, unit_normals && space.quantizer == nullptr};
-    std::unique_ptr<StaticLevelEncoder> on_sample[3];
-    if (sample != SIZE_MAX) keep_likely_static_modes(h, created, space, sample, static_modes, candidate, on_sample);
-    auto whole_level = [&](int i) {
-        if (on_sample[i] == nullptr) return std::make_unique<StaticLevelEncoder>(h, created, space, static_modes[i], false);
-        on_sample[i]->extend(h, created);
-        return std::move(on_sample[i]);
-    };
-    std::unique_ptr<StaticLevelEncoder> grid, unit;
-    if (candidate[0]) code.static_code = whole_level(0);
-    if (candidate[1]) grid = whole_level(1);
-    if (candidate[2]) unit = whole_level(2);
-    StaticLevelEncoder* statics[] = {code.static_code.get(), grid.get(), unit.get()};  // in the order of the choice
-    size_t static_size[] = {SIZE_MAX, SIZE_MAX, SIZE_MAX}, bound[] = {SIZE_MAX, SIZE_MAX, SIZE_MAX};
-    for (int i = 0; i < 3; ++i)
-        if (statics[i] != nullptr) bound[i] = statics[i]->lower_bound_bytes();
+    const bool exact = space.quantizer == nullptr;
+    bool candidate[kStaticCandidates] = {true, grid_contexts && !exact, unit_normals && exact, exact, exact};
+    std::unique_ptr<StaticLevelEncoder> on_sample[kStaticCandidates];
+    if (sample != SIZE_MAX) keep_likely_static_modes(h, created, space, sample, candidate, on_sample);
+    std::unique_ptr<StaticLevelEncoder> statics[kStaticCandidates];  // in the order of the choice
+    size_t static_size[kStaticCandidates], bound[kStaticCandidates];
+    for (int i = 0; i < kStaticCandidates; ++i) {
+        static_size[i] = bound[i] = SIZE_MAX;
+        if (!candidate[i]) continue;
+        if (on_sample[i] == nullptr) {
+            statics[i] = std::make_unique<StaticLevelEncoder>(h, created, space, kStaticModes[i], false);
+        } else {
+            on_sample[i]->extend(h, created);
+            statics[i] = std::move(on_sample[i]);
+        }
+        bound[i] = statics[i]->lower_bound_bytes();
+    }
     size_t best_static = SIZE_MAX;
-    for (int tries = 0; tries < 3; ++tries) {
+    for (int tries = 0; tries < kStaticCandidates; ++tries) {
         int next = -1;  // the untried mode of smallest bound
-        for (int i = 0; i < 3; ++i)
+        for (int i = 0; i < kStaticCandidates; ++i)
             if (statics[i] != nullptr && static_size[i] == SIZE_MAX && bound[i] != SIZE_MAX && (next < 0 || bound[i] < bound[next]))
                 next = i;
         if (next < 0 || bound[next] > best_static) break;  // larger than a size known: never the smallest
@@ -194,14 +208,23 @@ LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& create
         best_static = std::min(best_static, static_size[next]);
         bound[next] = SIZE_MAX;
     }
-    const bool count_raw_bits = space.quantizer == nullptr;
+    const bool count_raw_bits = exact;
+    // The smallest static mode (the first of the smallest), and the size an adaptive predictor must
+    // stay below to beat it: a stencil mode's size shrunk by kStencilPreference.
+    int chosen = -1;
+    for (int i = 0; i < kStaticCandidates; ++i)
+        if (static_size[i] != SIZE_MAX && (chosen < 0 || static_size[i] < static_size[chosen])) chosen = i;
+    const size_t to_beat = chosen < 0 ? SIZE_MAX
+                           : has_stencil_tables(kStaticModes[chosen])
+                               ? size_t(double(static_size[chosen]) / kStencilPreference)
+                               : static_size[chosen];
     // Effort 0 takes a static mode for a sampled level without trying the adaptive predictors.
     const bool adaptive_trials = effort > 0 || sample == SIZE_MAX || best_static == SIZE_MAX;
     const size_t midpoint = adaptive_trials
-                                ? adaptive_bytes(h, created, GeometryPredictor::midpoint, positions, best_static, count_raw_bits, sample)
+                                ? adaptive_bytes(h, created, GeometryPredictor::midpoint, positions, to_beat, count_raw_bits, sample)
                                 : SIZE_MAX;
-    // The butterfly must be smaller than the midpoint, and no larger than a static mode.
-    const size_t butterfly_limit = midpoint == SIZE_MAX ? best_static : std::min(midpoint - 1, best_static);
+    // The butterfly must be smaller than the midpoint, and than what beats the static mode.
+    const size_t butterfly_limit = midpoint == SIZE_MAX ? to_beat : std::min(midpoint - 1, to_beat);
     const size_t butterfly =
         adaptive_trials ? adaptive_bytes(h, created, GeometryPredictor::butterfly, positions, butterfly_limit, count_raw_bits, sample)
                         : SIZE_MAX;
@@ -210,18 +233,13 @@ LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& create
         best = butterfly;
         code.predictor = GeometryPredictor::butterfly;
     }
-    if (static_size[0] < best) {
-        best = static_size[0];
-        code.predictor = GeometryPredictor::normal_frame;
-    }
-    if (static_size[1] < best) {
-        best = static_size[1];
-        code.predictor = GeometryPredictor::normal_frame_grid;
-        code.static_code = std::move(grid);
-    }
-    if (static_size[2] < best) {
-        code.predictor = GeometryPredictor::unit_normal_frame;
-        code.static_code = std::move(unit);
+    // Ties go to the earlier mode: the adaptive ones.
+    const bool static_wins = chosen >= 0 && (has_stencil_tables(kStaticModes[chosen])
+                                                 ? double(static_size[chosen]) < rounded(double(best) * kStencilPreference)
+                                                 : static_size[chosen] < best);
+    if (static_wins) {
+        code.predictor = kStaticModes[chosen];
+        code.static_code = std::move(statics[chosen]);
     }
     return code;
 }

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstddef>
 #include <string>
+#include <type_traits>
 
 namespace amc {
 
@@ -404,6 +405,8 @@ StaticLevelEncoder::StaticLevelEncoder(const Mesh& h, const std::vector<std::pai
     : mode_(mode), space_(space), table_count_(static_table_count(mode)) {
     if (!is_static_mode(mode)) throw Error("StaticLevelEncoder: geometry mode " + std::to_string(int(mode)) + " is not a static mode");
     if (has_grid_bins(mode) && space.quantizer == nullptr) throw Error("geometry mode 4 needs quantized coordinates");
+    if (has_stencil_tables(mode) && space.quantizer != nullptr)
+        throw Error("geometry modes 6 and 7 need bit-exact coordinates");
     count = std::min(count, created.size());
     add(h, created, 0, count);
     make_tables();
@@ -435,6 +438,14 @@ void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, 
             else add_vertices<false, false, kAnyResiduals>(h, created, begin, end);
             break;
         case GeometryPredictor::normal_frame_grid: add_vertices<true, true, kGridResiduals>(h, created, begin, end); break;
+        case GeometryPredictor::midpoint_static:
+            if (float64) add_stencil_vertices<false, kFloat64Residuals>(h, created, begin, end);
+            else add_stencil_vertices<false, kAnyResiduals>(h, created, begin, end);
+            break;
+        case GeometryPredictor::butterfly_static:
+            if (float64) add_stencil_vertices<true, kFloat64Residuals>(h, created, begin, end);
+            else add_stencil_vertices<true, kAnyResiduals>(h, created, begin, end);
+            break;
         default:
             if (float64) add_vertices<true, false, kFloat64Residuals>(h, created, begin, end);
             else add_vertices<true, false, kAnyResiduals>(h, created, begin, end);
@@ -487,6 +498,29 @@ void StaticLevelEncoder::add_vertices(const Mesh& h, const std::vector<std::pair
                 raw_bits += uint64_t(static_raw_bit_count(r.magnitude));
                 ++counts_[size_t(table)][size_t(token)];
             }
+        }
+    }
+    raw_bits_ += raw_bits;
+}
+
+template <bool Butterfly, int Residuals, class Mesh>
+void StaticLevelEncoder::add_stencil_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin,
+                                              size_t end) {
+    uint64_t raw_bits = 0;
+    for (size_t i = begin; i < end; ++i) {
+        const auto [n, e] = created[i];
+        const Vec3 q = Butterfly ? predict_butterfly(h, n, e) : predict_midpoint(h, n, e);
+        const Vec3 p = h.position(h.midpoint(n, e));
+        const double actual[3] = {p.x, p.y, p.z}, predicted[3] = {q.x, q.y, q.z};
+        std::array<uint16_t, kStaticRoles>& symbols = symbols_[i];
+        for (int axis = 0; axis < 3; ++axis) {
+            const Residual r = Residuals == kFloat64Residuals ? float64_residual(actual[axis], predicted[axis])
+                                                              : residual_of(space_, axis, actual[axis], predicted[axis]);
+            const int token = static_token(r.negative, r.magnitude);
+            if (token >= kDirectTokens) large_.push_back(r);
+            symbols[size_t(axis)] = uint16_t(axis << kTokenBits | token);
+            raw_bits += uint64_t(static_raw_bit_count(r.magnitude));
+            ++counts_[size_t(axis)][size_t(token)];
         }
     }
     raw_bits_ += raw_bits;
@@ -671,6 +705,70 @@ bool decode_positions(Hierarchy& h, const Source& created, CoordinateSpace space
 
 using NarrowTables = std::array<RansTable::NarrowView, kMaxStaticTables>;
 
+// Modes 6 and 7: one coordinate against its prediction, with the table of its axis.
+template <int State, bool Float64, class Tables>
+AMC_ALWAYS_INLINE bool decode_axis(CoordinateSpace space, int axis, double predicted, const Tables& tables, RansDecoder& rans,
+                                   RawBitReader& raw, double& value) {
+    const Residual r = take(rans.get_with<State>(tables[size_t(axis)]), raw);
+    if (!Float64) return value_of(space, axis, predicted, r, value);
+    // value_of's bit-exact path for float64, without its tests of the precision.
+    const uint64_t p = ordered_bits(std::isfinite(predicted) ? predicted : 0.0, Precision::float64);
+    value = from_ordered_bits(r.negative ? p - r.magnitude : p + r.magnitude, Precision::float64);
+    return std::isfinite(value);
+}
+
+// Vertex i of a chunk: x with rANS state `State` (token j of the level with state j mod 2), y with
+// the other, z with `State` again.
+template <int State, bool Float64, class Tables>
+AMC_ALWAYS_INLINE bool decode_stencil_vertex(CoordinateSpace space, Vec3 predicted, const Tables& tables, RansDecoder& rans,
+                                             RawBitReader& raw, Vec3& p) {
+    return decode_axis<State, Float64>(space, 0, predicted.x, tables, rans, raw, p.x) &&
+           decode_axis<1 - State, Float64>(space, 1, predicted.y, tables, rans, raw, p.y) &&
+           decode_axis<State, Float64>(space, 2, predicted.z, tables, rans, raw, p.z);
+}
+
+// Modes 6 and 7 over (node, edge) pairs, in chunks: first the chunk's predictions (their stencils'
+// loads, independent of the streams), then its coordinates from the streams.
+template <bool Butterfly, bool Float64, class Tables>
+bool decode_stencil_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
+                              const Tables& tables, const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data,
+                              size_t raw_size) {
+    RansDecoder rans(rans_data, rans_size);
+    RawBitReader raw(raw_data, raw_size);
+    std::array<Vec3, kChunk> predicted;
+    std::array<VertexId, kChunk> vertices;
+    for (size_t begin = 0; begin < created.size(); begin += kChunk) {
+        const size_t count = std::min(kChunk, created.size() - begin);
+        for (size_t i = 0; i < count; ++i) {
+            const auto [n, e] = created[begin + i];
+            predicted[i] = Butterfly ? predict_butterfly(h, n, e) : predict_midpoint(h, n, e);
+            vertices[i] = h.midpoint(n, e);
+        }
+        for (size_t i = 0; i < count; i += 2) {
+            Vec3 p;
+            if (!decode_stencil_vertex<0, Float64>(space, predicted[i], tables, rans, raw, p)) return false;
+            HierarchyBuilder::set_new_vertex_position(h, vertices[i], p);
+            if (i + 1 == count) break;
+            if (!decode_stencil_vertex<1, Float64>(space, predicted[i + 1], tables, rans, raw, p)) return false;
+            HierarchyBuilder::set_new_vertex_position(h, vertices[i + 1], p);
+        }
+    }
+    return rans.ended_cleanly() && raw.ended_cleanly();
+}
+
+template <class Tables>
+bool decode_stencil_with(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
+                         GeometryPredictor mode, const Tables& tables, const uint8_t* rans_data, size_t rans_size,
+                         const uint8_t* raw_data, size_t raw_size) {
+    if (space.quantizer != nullptr) return false;  // bit-exact files only (FORMAT.md 5.9)
+    const bool butterfly = mode == GeometryPredictor::butterfly_static;
+    if (space.precision == Precision::float64)
+        return butterfly ? decode_stencil_positions<true, true>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size)
+                         : decode_stencil_positions<false, true>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size);
+    return butterfly ? decode_stencil_positions<true, false>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size)
+                     : decode_stencil_positions<false, false>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size);
+}
+
 template <class Source, class Tables>
 bool decode_static_with(Hierarchy& h, const Source& created, CoordinateSpace space, GeometryPredictor mode, const Tables& tables,
                         const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
@@ -696,6 +794,15 @@ bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, G
     for (int i = 0; i < static_table_count(mode); ++i) {
         narrow[size_t(i)] = tables[size_t(i)].narrow_view();
         all_narrow = all_narrow && narrow[size_t(i)].index != nullptr;
+    }
+    if constexpr (std::is_same_v<Source, FromNodes<Hierarchy>>) {
+        if (has_stencil_tables(mode)) {
+            if (all_narrow)
+                return decode_stencil_with(h, created.created, space, mode, narrow, rans_data, rans_size, raw_data, raw_size);
+            return decode_stencil_with(h, created.created, space, mode, tables, rans_data, rans_size, raw_data, raw_size);
+        }
+    } else if (has_stencil_tables(mode)) {
+        return false;  // a listed level has frame corners, not the stencils' nodes
     }
     if (all_narrow) return decode_static_with(h, created, space, mode, narrow, rans_data, rans_size, raw_data, raw_size);
     return decode_static_with(h, created, space, mode, tables, rans_data, rans_size, raw_data, raw_size);

@@ -41,11 +41,17 @@ constexpr int kMaxStaticTables = kStaticRoles * kGridBins;
 // Mode 3 uses the first three (one per role), mode 4 all six (table 2 role + bin).
 using StaticTables = std::array<RansTable, kMaxStaticTables>;
 
-// The static modes: 3 (normal_frame), 4 (normal_frame_grid) and 5 (unit_normal_frame).
-constexpr bool is_static_mode(GeometryPredictor p) {
+// The static modes: 3 (normal_frame), 4 (normal_frame_grid) and 5 (unit_normal_frame), which
+// predict in a frame, and 6 and 7 (midpoint_static, butterfly_static), which predict each axis by
+// the adaptive predictors' stencils and code it with the table of its axis (FORMAT.md 5.9).
+constexpr bool has_frame(GeometryPredictor p) {
     return p == GeometryPredictor::normal_frame || p == GeometryPredictor::normal_frame_grid ||
            p == GeometryPredictor::unit_normal_frame;
 }
+constexpr bool has_stencil_tables(GeometryPredictor p) {
+    return p == GeometryPredictor::midpoint_static || p == GeometryPredictor::butterfly_static;
+}
+constexpr bool is_static_mode(GeometryPredictor p) { return has_frame(p) || has_stencil_tables(p); }
 // Mode 4 splits each role's table by grid position.
 constexpr bool has_grid_bins(GeometryPredictor mode) { return mode == GeometryPredictor::normal_frame_grid; }
 // Modes 4 and 5 sum unit normals for the frame (mode 3 sums cross products).
@@ -69,7 +75,8 @@ struct StaticResidual {
 
 class StaticLevelEncoder {
 public:
-    // mode: a static mode (is_static_mode); mode 4 needs a quantized space. Throws Error otherwise.
+    // mode: a static mode (is_static_mode); mode 4 needs a quantized space, modes 6 and 7 a
+    // bit-exact one. Throws Error otherwise.
     // With `streams` false only the tokens and tables are made, until code_streams(): an encoder
     // weighing modes asks lower_bound_bytes() first.
     // Mesh: Hierarchy or HierarchyOnGrid (hierarchy_on_grid.h), here and below.
@@ -110,6 +117,9 @@ private:
     static constexpr int kAnyResiduals = 0, kFloat64Residuals = 1, kGridResiduals = 2;
     template <bool UnitNormals, bool GridBins, int Residuals, class Mesh>
     void add_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
+    // Modes 6 and 7: each axis against the stencil's prediction, with the table of its axis.
+    template <bool Butterfly, int Residuals, class Mesh>
+    void add_stencil_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
     // lower_bound_bytes()' parts: the coded tables, and the rANS and raw streams.
     size_t table_bytes() const;
     // The tables coded alone, made once per make_tables() (the bounds and the size ask it up to three times).
@@ -147,7 +157,7 @@ bool decode_static_positions(Hierarchy& h, const std::vector<std::pair<NodeId, i
                              GeometryPredictor mode, const StaticTables& tables, const uint8_t* rans, size_t rans_size, const uint8_t* raw,
                              size_t raw_size);
 // The same for `count` vertices first, first + 1, ... whose frame corners split_level listed
-// (LevelSplits::new_vertex_corners): no node is read.
+// (LevelSplits::new_vertex_corners): no node is read. Modes with a frame only (has_frame).
 bool decode_static_positions(Hierarchy& h, const FrameCorners* corners, size_t count, VertexId first, CoordinateSpace space,
                              GeometryPredictor mode, const StaticTables& tables, const uint8_t* rans, size_t rans_size,
                              const uint8_t* raw, size_t raw_size);

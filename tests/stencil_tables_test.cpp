@@ -1,0 +1,147 @@
+// .amc version 15 (docs/FORMAT.md 5.9): geometry modes 6 and 7, the midpoint's and the butterfly's
+// predictions with static tables per axis, rANS and raw bits, in bit-exact files. Round trips
+// (float64 and float32, level blocks and chunks), the version they make, the automatic choice on
+// coordinates that use all their bits, and the errors a decoder reports for the modes where the
+// format has none and for streams cut short.
+#include "hierarchy_checks.h"
+
+#include "coding/container.h"
+#include "coding/format_version.h"
+
+#include <amc/codec.h>
+#include <amc/refinement.h>
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace amc {
+namespace {
+
+std::string decode_error(const std::vector<uint8_t>& bytes) {
+    const DecodeResult r = try_decode(bytes.data(), bytes.size());
+    return r.ok ? "" : r.error;
+}
+
+// The file's blocks rewritten with `version` (checksums made anew), each level block passed
+// through `edit`.
+template <class Edit>
+std::vector<uint8_t> rewritten(const std::vector<uint8_t>& bytes, uint8_t version, Edit&& edit) {
+    BlockReader reader(bytes.data(), bytes.size());
+    BlockWriter writer(version, bytes[5]);
+    Block block;
+    while (reader.next(block)) {
+        if (block.type == BlockType::end) break;
+        std::vector<uint8_t> payload(block.payload, block.payload + block.size);
+        if (block.type == BlockType::level) edit(payload);
+        writer.add(block.type, payload);
+    }
+    return writer.finish();
+}
+
+using testing::bumpy_torus;
+
+bool uses(const EncodeStats& stats, GeometryPredictor p) {
+    for (const LevelStats& l : stats.per_level)
+        if (l.predictor == p) return true;
+    return false;
+}
+
+TEST(StencilTables, ForcedModesRoundTripAsVersion15) {
+    for (bool single : {false, true}) {
+        const Hierarchy h = bumpy_torus(single);
+        for (GeometryPredictor p : {GeometryPredictor::midpoint_static, GeometryPredictor::butterfly_static}) {
+            SCOPED_TRACE(std::string(single ? "float32 " : "float64 ") + std::to_string(int(p)));
+            EncodeOptions options;
+            options.predictor = p;
+            EncodeStats stats;
+            const std::vector<uint8_t> bytes = encode(h, options, &stats);
+            ASSERT_EQ(bytes[4], kStencilTablesVersion);
+            EXPECT_TRUE(uses(stats, p));
+            const Hierarchy back = decode(bytes.data(), bytes.size());
+            EXPECT_TRUE(identical(back, in_decoder_order(h, options)));
+            // Every prefix of levels (progressive decoding).
+            for (int l = 0; l < h.depth(); ++l) {
+                DecodeOptions prefix;
+                prefix.max_level = l;
+                EXPECT_EQ(decode(bytes.data(), bytes.size(), prefix).depth(), l);
+            }
+            // In chunks too (a version-15 file holds chunks as version 13 does), on 1 and 2 threads.
+            options.chunks = 3;
+            const std::vector<uint8_t> chunked = encode(h, options);
+            ASSERT_EQ(chunked[4], kStencilTablesVersion);
+            EXPECT_EQ(inspect(chunked.data(), chunked.size()).chunks.size(), 3u);
+            for (unsigned threads : {1u, 2u}) {
+                DecodeOptions on;
+                on.threads = threads;
+                EXPECT_TRUE(identical(decode(chunked.data(), chunked.size(), on), back));
+            }
+        }
+    }
+}
+
+// Coordinates that use all their bits: the automatic choice takes a static stencil mode on the
+// large levels, at most 1 % above the adaptive predictors' bytes.
+TEST(StencilTables, AutomaticChoiceTakesThemWhereSmallest) {
+    const Hierarchy h = bumpy_torus(false, 6000, 5);
+    EncodeStats stats;
+    const std::vector<uint8_t> bytes = encode(h, {}, &stats);
+    ASSERT_EQ(bytes[4], kStencilTablesVersion);
+    EXPECT_TRUE(uses(stats, GeometryPredictor::midpoint_static) || uses(stats, GeometryPredictor::butterfly_static));
+    EXPECT_TRUE(identical(decode(bytes.data(), bytes.size()), in_decoder_order(h, {})));
+    for (GeometryPredictor p : {GeometryPredictor::midpoint, GeometryPredictor::butterfly}) {
+        EncodeOptions adaptive;
+        adaptive.predictor = p;
+        // Each level at most 1 % above its smallest adaptive code (kStencilPreference).
+        EXPECT_LE(double(bytes.size()), 1.01 * double(encode(h, adaptive).size()));
+    }
+}
+
+TEST(StencilTables, QuantizedFilesRefuseThem) {
+    const Hierarchy h = bumpy_torus(false);
+    EncodeOptions quantized;
+    quantized.quantize_bits = 16;
+    EXPECT_LT(encode(h, quantized)[4], kStencilTablesVersion);  // not candidates there
+    quantized.predictor = GeometryPredictor::butterfly_static;
+    EXPECT_THROW(encode(h, quantized), Error);
+}
+
+TEST(StencilTables, DecoderRefusesThemWhereTheFormatHasNoneAndCutStreams) {
+    const Hierarchy h = bumpy_torus(false);
+    EncodeOptions options;
+    options.predictor = GeometryPredictor::butterfly_static;
+    const std::vector<uint8_t> bytes = encode(h, options);
+    ASSERT_EQ(bytes[4], kStencilTablesVersion);
+    auto same = [](std::vector<uint8_t>&) {};
+    EXPECT_EQ(decode_error(rewritten(bytes, kStencilTablesVersion, same)), "");
+    // Version 14 and older have no predictors 6 and 7, nor a side-stream flag on them.
+    EXPECT_NE(decode_error(rewritten(bytes, kRawSideVersion, same)).find("bad predictor"), std::string::npos);
+    EXPECT_NE(decode_error(rewritten(bytes, kStencilTablesVersion, [](std::vector<uint8_t>& p) { p[0] |= 0x80; }))
+                  .find("bad predictor"),
+              std::string::npos);
+    // Mode 6's stream read as mode 7's decodes other positions or fails, never crashes.
+    (void)decode_error(rewritten(bytes, kStencilTablesVersion, [](std::vector<uint8_t>& p) { p[0] = 6; }));
+    // In a quantized file they are errors.
+    EncodeOptions quantized;
+    quantized.quantize_bits = 12;
+    quantized.predictor = GeometryPredictor::normal_frame;
+    const std::vector<uint8_t> q = encode(h, quantized);
+    EXPECT_NE(decode_error(rewritten(q, kStencilTablesVersion, [](std::vector<uint8_t>& p) { p[0] = 7; })).find("bad predictor"),
+              std::string::npos);
+    // Raw bits one byte short, or one byte too long, are errors.
+    auto cut = [](bool shorter) {
+        return [shorter](std::vector<uint8_t>& p) {
+            if (p.size() < 64) return;
+            if (shorter) p.pop_back();
+            else p.push_back(0);
+        };
+    };
+    EXPECT_NE(decode_error(rewritten(bytes, kStencilTablesVersion, cut(true))), "");
+    EXPECT_NE(decode_error(rewritten(bytes, kStencilTablesVersion, cut(false))), "");
+    // Every truncation of the file is an error.
+    for (size_t n = 0; n < bytes.size(); n += 1 + n / 50) EXPECT_FALSE(try_decode(bytes.data(), n).ok) << n;
+}
+
+}  // namespace
+}  // namespace amc
