@@ -15,15 +15,19 @@ namespace {
 template <class Mesh>
 Vec3 round_if_single(const Mesh& h, Vec3 p) { return h.single_precision() ? rounded_to_float(p) : p; }
 
+// (i + 1) % 3 at i and (i + 2) % 3 at i + 1, for i in 0..2: local indices without a division.
+constexpr int kNext[5] = {1, 2, 0, 1, 2};
+
 // The vertex of node m opposite its edge f.
 template <class Mesh>
-Vec3 opposite(const Mesh& h, NodeId m, int f) { return h.position(h.vertex(m, (f + 2) % 3)); }
+Vec3 opposite(const Mesh& h, NodeId m, int f) { return h.position(h.vertex(m, kNext[f + 1])); }
 
-// Vertex opposite edge f of node m in the same-level neighbour across f, or `fallback`.
+// Vertex opposite edge f of node m in the same-level neighbour across f, or the reflection
+// (x + y) - z where there is none (computed only then).
 template <class Mesh>
-Vec3 wing(const Mesh& h, NodeId m, int f, Vec3 fallback) {
+Vec3 wing(const Mesh& h, NodeId m, int f, Vec3 x, Vec3 y, Vec3 z) {
     const NodeId r = h.neighbor(m, f);
-    return r == kNoNode ? fallback : opposite(h, r, h.neighbor_edge(m, f));
+    return r == kNoNode ? x + y - z : opposite(h, r, h.neighbor_edge(m, f));
 }
 
 }  // namespace
@@ -60,7 +64,7 @@ std::vector<std::pair<NodeId, int>> new_vertices_of_level(const Hierarchy& h,
 template <class Mesh>
 Vec3 predict_midpoint(const Mesh& h, NodeId n, int e) {
     const Vec3 a = h.position(h.vertex(n, e));
-    const Vec3 b = h.position(h.vertex(n, (e + 1) % 3));
+    const Vec3 b = h.position(h.vertex(n, kNext[e]));
     return round_if_single(h, rounded_scaled(0.5, a + b));  // FORMAT.md 5.5 (forest.cpp's placer where a + b is finite)
 }
 
@@ -68,16 +72,16 @@ template <class Mesh>
 Vec3 predict_butterfly(const Mesh& h, NodeId n, int e) {
     const NodeId q = h.neighbor(n, e);
     if (q == kNoNode) return predict_midpoint(h, n, e);
-    const int e1 = (e + 1) % 3, e2 = (e + 2) % 3;
+    const int e1 = kNext[e], e2 = kNext[e + 1];
     const Vec3 a = h.position(h.vertex(n, e));
     const Vec3 b = h.position(h.vertex(n, e1));
     const Vec3 c = h.position(h.vertex(n, e2));
     const int eq = h.neighbor_edge(n, e);  // q's edge eq runs b -> a
     const Vec3 d = opposite(h, q, eq);
-    const Vec3 w_bc = wing(h, n, e1, b + c - a);
-    const Vec3 w_ca = wing(h, n, e2, c + a - b);
-    const Vec3 w_ad = wing(h, q, (eq + 1) % 3, a + d - b);
-    const Vec3 w_db = wing(h, q, (eq + 2) % 3, d + b - a);
+    const Vec3 w_bc = wing(h, n, e1, b, c, a);
+    const Vec3 w_ca = wing(h, n, e2, c, a, b);
+    const Vec3 w_ad = wing(h, q, kNext[eq], a, d, b);
+    const Vec3 w_db = wing(h, q, kNext[eq + 1], d, b, a);
     // Every product rounded before it is added (common/exact_float.h): the decoder computes the same.
     const Vec3 p = rounded_scaled(0.5, a + b) + rounded_scaled(0.125, c + d) -
                    rounded_scaled(0.0625, (w_bc + w_ca) + (w_ad + w_db));
