@@ -402,6 +402,28 @@ TEST(HierarchyCoder, ListedNewVerticesCarryTheirFrameCorners) {
     EXPECT_LT(with_far_corner, listed);
 }
 
+// split_level reserves a level's vertex room by the level decoder's count (LevelSplits::
+// new_vertex_count, derive_next_level's) instead of counting again: the count is the number of
+// vertices the level's splits make, level by level, listed or not.
+TEST(HierarchyCoder, LevelDecoderCountsTheVerticesSplitLevelMakes) {
+    for (uint64_t seed = 1; seed <= 30; ++seed) {
+        const Hierarchy h = random_hierarchy(seed);
+        const std::vector<uint8_t> bytes = encode_hierarchy(h, HierarchyCoderOptions{});
+        HierarchyStreamHeader header;
+        const size_t header_size = read_standalone_stream_header(bytes.data(), bytes.size(), header);
+        HierarchyLevelDecoder coder(h.base(), header, UINT64_MAX);
+        coder.set_new_vertex_listing(seed % 2 == 1, seed % 2 == 0);
+        ArithmeticDecoder decoder(bytes.data() + header_size, bytes.size() - header_size);
+        while (!coder.done()) {
+            const size_t before = coder.hierarchy().positions().size();
+            coder.decode_level(decoder);
+            ASSERT_EQ(coder.vertex_count(), coder.hierarchy().positions().size()) << "seed " << seed;
+            ASSERT_EQ(coder.hierarchy().positions().size() - before, coder.new_vertex_count()) << "seed " << seed;
+        }
+        EXPECT_EQ(coder.hierarchy().vertex_count(), h.vertex_count()) << "seed " << seed;
+    }
+}
+
 // A lean decoder (set_lean) gives its working memory back as soon as nothing reads it any more;
 // anything given back too early would read as zeros and build wrong levels. Every level decoded
 // lean against a plain decoder, listing corners and (node, edge) pairs, on hierarchies whose

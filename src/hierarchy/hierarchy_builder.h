@@ -59,6 +59,11 @@ struct LevelSplits {
     // False: the new vertices' positions are left at zero, for a decoder that sets every one of
     // them next (their midpoints would be read and computed for nothing).
     bool place_new_vertices = true;
+    // When known, the number of new vertices the splits create (used without boundary_vertex): a
+    // level decoder counted them already. A hint for the room to reserve: a hierarchy's end grows
+    // as it must anyway; a slice's room is checked by counting.
+    uint64_t new_vertex_count = kUnknownCount;
+    static constexpr uint64_t kUnknownCount = ~uint64_t{0};
     // When set, the children and new vertices go to the slice's next ids (throws Error when they
     // do not fit), not to the end of the hierarchy.
     HierarchySlice* slice = nullptr;

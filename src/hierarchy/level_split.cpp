@@ -205,10 +205,12 @@ void Hierarchy::split_level(const LevelSplits& splits) {
         reserve(std::max(new_nodes, nodes_.capacity() + nodes_.capacity() / 2), 0);
     }
     if (v0 + size_t(3) * count > vertex_room) {
-        // Maybe not enough room: count exactly. Edge e of parent i gets a new vertex unless an
-        // earlier parent across it made one, or boundary_vertex has one.
-        size_t new_vertices = 0;
-        for (uint32_t i = 0; i < count; ++i) {
+        // Maybe not enough room: count exactly, unless the caller did. Edge e of parent i gets a
+        // new vertex unless an earlier parent across it made one, or boundary_vertex has one.
+        const bool known = slice == nullptr && splits.boundary_vertex == nullptr &&
+                           splits.new_vertex_count != LevelSplits::kUnknownCount;
+        size_t new_vertices = known ? size_t(splits.new_vertex_count) : 0;
+        for (uint32_t i = 0; !known && i < count; ++i) {
             const Node& parent = nodes_[parents[i]];
             for (int e = 0; e < 3; ++e)
                 new_vertices += !(first_half(i, e) / 4 < i) &&

@@ -268,7 +268,8 @@ void HierarchyLevelDecoder::finish_level() {
         next = std::move(spare_.back());
         spare_.pop_back();
     }
-    vertex_count_ += derive_next_level(level_, numbering_, next, header_.options.cull_one_regularity);
+    level_.new_vertices = derive_next_level(level_, numbering_, next, header_.options.cull_one_regularity);
+    vertex_count_ += level_.new_vertices;
     decided_.push_back(std::move(level_));
     level_ = std::move(next);
     ++level_index_;
@@ -307,6 +308,7 @@ void HierarchyLevelDecoder::build_decided_levels() {
         const NodeId first_child = slice_ != nullptr ? slice_->next_node : h_->node_capacity();
         LevelSplits splits{parents, count, children.nbr.data(), boundary_vertex_, boundary_context_};
         splits.slice = slice_;
+        splits.new_vertex_count = level.new_vertices;
         // Listed or left unplaced for decode_level's caller, which takes one level at a time.
         if (list_corners_ || !place_new_vertices_) {
             AMC_REQUIRE(decided_.size() == 1, invalid_input, "hierarchy decoder: listed new vertices need decode_level");

@@ -83,6 +83,8 @@ struct Level {
     ScratchArray<uint32_t> refined;
     uint32_t refined_count = 0;
     std::vector<uint32_t> flipped;
+    // The vertices their splits create (derive_next_level's count).
+    uint64_t new_vertices = 0;
 
     size_t size() const { return states_.empty() ? 0 : states_.size() - 1; }
     bool empty() const { return size() == 0; }
