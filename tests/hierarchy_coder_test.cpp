@@ -404,7 +404,9 @@ TEST(HierarchyCoder, ListedNewVerticesCarryTheirFrameCorners) {
 
 // split_level reserves a level's vertex room by the level decoder's count (LevelSplits::
 // new_vertex_count, derive_next_level's) instead of counting again: the count is the number of
-// vertices the level's splits make, level by level, listed or not.
+// vertices the level's splits make, level by level, listed or not. With appended positions
+// (set_new_vertex_listing's third argument) the level leaves them to the caller, who appends
+// exactly that many.
 TEST(HierarchyCoder, LevelDecoderCountsTheVerticesSplitLevelMakes) {
     for (uint64_t seed = 1; seed <= 30; ++seed) {
         const Hierarchy h = random_hierarchy(seed);
@@ -412,11 +414,19 @@ TEST(HierarchyCoder, LevelDecoderCountsTheVerticesSplitLevelMakes) {
         HierarchyStreamHeader header;
         const size_t header_size = read_standalone_stream_header(bytes.data(), bytes.size(), header);
         HierarchyLevelDecoder coder(h.base(), header, UINT64_MAX);
-        coder.set_new_vertex_listing(seed % 2 == 1, seed % 2 == 0);
+        const bool appended = seed % 3 == 0;
+        coder.set_new_vertex_listing(seed % 2 == 1 || appended, seed % 2 == 0 && !appended, appended);
         ArithmeticDecoder decoder(bytes.data() + header_size, bytes.size() - header_size);
         while (!coder.done()) {
             const size_t before = coder.hierarchy().positions().size();
             coder.decode_level(decoder);
+            if (appended) {
+                ASSERT_EQ(coder.hierarchy().positions().size(), before) << "seed " << seed;
+                ASSERT_EQ(coder.new_vertex_first(), before) << "seed " << seed;
+                const std::vector<Vec3> made(coder.new_vertex_count(), Vec3{1, 2, 3});
+                HierarchyBuilder::append_positions(coder.hierarchy(), made.data(), made.size(), true);
+            }
+            ASSERT_EQ(coder.vertex_count(), coder.hierarchy().vertex_count()) << "seed " << seed;
             ASSERT_EQ(coder.vertex_count(), coder.hierarchy().positions().size()) << "seed " << seed;
             ASSERT_EQ(coder.hierarchy().positions().size() - before, coder.new_vertex_count()) << "seed " << seed;
         }

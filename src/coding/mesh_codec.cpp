@@ -530,7 +530,7 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
         // Every new vertex gets its decoded position below; a static mode with a frame takes their
         // frame corners from the split, without reading the nodes again.
         const bool listed = has_frame(parts.predictor);
-        hierarchy.set_new_vertex_listing(listed, false);
+        hierarchy.set_new_vertex_listing(listed, false, listed);
         // The refined nodes R of a level create at least 1.5 R vertices, whose positions are in
         // this block: it bounds R before the next level is allocated.
         hierarchy.decode_level(decoder, 2 * max_decodable_positions(block.size - 1) / 3);

@@ -59,6 +59,10 @@ struct LevelSplits {
     // False: the new vertices' positions are left at zero, for a decoder that sets every one of
     // them next (their midpoints would be read and computed for nothing).
     bool place_new_vertices = true;
+    // With place_new_vertices false and no slice: not even zeroed. positions() keeps its size
+    // until the caller appends the new vertices' positions in id order (append_positions), before
+    // anything reads them: zeroing a level's positions to overwrite them wrote each twice.
+    bool append_new_positions = false;
     // When known, the number of new vertices the splits create (used without boundary_vertex): a
     // level decoder counted them already. A hint for the room to reserve: a hierarchy's end grows
     // as it must anyway; a slice's room is checked by counting.
@@ -84,6 +88,13 @@ struct HierarchyBuilder {
         // checked one) only read it.
         if (h.structure_checked_) h.structure_checked_ = false;
         h.split_level(level);
+    }
+    // The next `count` positions of vertices split_level made with append_new_positions (ids
+    // positions().size() on), within the room it reserved. `near`: none is Hierarchy::is_far.
+    static void append_positions(Hierarchy& h, const Vec3* positions, size_t count, bool near) {
+        h.positions_.insert(h.positions_.end(), positions, positions + count);
+        if (!near)
+            for (size_t k = 0; k < count; ++k) h.far_positions_.raise_if(Hierarchy::is_far(positions[k]));
     }
     // Stitching hierarchies of disjoint root sets into one (hierarchy_stitch.cpp): the decoder of
     // chunked files decodes the chunks of the whole over its roots, each as if its roots were the

@@ -299,7 +299,8 @@ void Hierarchy::split_level(const LevelSplits& splits) {
             parent.first_child = c;
         }
         if (!splits.place_new_vertices) {
-            if (slice == nullptr) positions_.resize(positions_.size() + new_vertices);  // a slice's are there already
+            // A slice's are there already.
+            if (slice == nullptr && !splits.append_new_positions) positions_.resize(positions_.size() + new_vertices);
             positions_written += new_vertices;
             continue;
         }

@@ -295,6 +295,7 @@ struct FromNodes {
     const Mesh& h;
     const std::vector<std::pair<NodeId, int>>& created;
     size_t size() const { return created.size(); }
+    bool appends(const Hierarchy&) const { return false; }
     void get(Chunk& c) const {
         for (size_t i = 0; i < c.count; ++i) {
             const auto [n, e] = created[c.begin + i];
@@ -309,6 +310,8 @@ struct FromList {
     size_t count;
     VertexId first;
     size_t size() const { return count; }
+    // The positions do not exist yet (HierarchyBuilder::append_positions).
+    bool appends(const Hierarchy& h) const { return first == h.positions().size(); }
     void get(Chunk& c) const {
         c.corners = corners + c.begin;  // read where they are: no copy
         for (size_t i = 0; i < c.count; ++i) c.vertices[i] = first + VertexId(c.begin + i);
@@ -687,18 +690,27 @@ bool decode_positions(Hierarchy& h, const Source& created, CoordinateSpace space
         if (near) HierarchyBuilder::set_near_vertex_position(h, v, p);
         else HierarchyBuilder::set_new_vertex_position(h, v, p);
     };
+    // A listed level's positions made as they are decoded, a chunk at a time (split_level did not
+    // zero them first), or set where they are.
+    const bool append = created.appends(h);
+    Vec3 decoded[kChunk];
     Chunk c;
+    auto put = [&](size_t i, Vec3 p) {
+        if (append) decoded[i] = p;
+        else set(c.vertices[i], p);
+    };
     for (size_t begin = 0; begin < created.size(); begin += kChunk) {
         gather_chunk(h, created, begin, created.size(), c);
         frame_chunk<Grid, UnitNormals>(h, quantizer, grid, c);
         for (size_t i = 0; i < c.count; i += 2) {
             Vec3 p;
             if (!decode_vertex<0, Grid>(c, i, space, grid, tables, rans, raw, p)) return false;
-            set(c.vertices[i], p);
+            put(i, p);
             if (i + 1 == c.count) break;
             if (!decode_vertex<1, Grid>(c, i + 1, space, grid, tables, rans, raw, p)) return false;
-            set(c.vertices[i + 1], p);
+            put(i + 1, p);
         }
+        if (append) HierarchyBuilder::append_positions(h, decoded, c.count, near);
     }
     return rans.ended_cleanly() && raw.ended_cleanly();
 }

@@ -103,6 +103,7 @@ void HierarchyLevelDecoder::start(NodeId first_root, uint32_t roots, const Hiera
     boundary_context_ = nullptr;
     list_corners_ = false;
     place_new_vertices_ = true;
+    append_new_positions_ = false;
     lean_ = false;
     slice_ = nullptr;
     // Uniform levels alone would build roots * (4^(U+1) - 1) / 3 nodes: check before.
@@ -153,7 +154,8 @@ void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder, uint64_t ma
     if (lean_) {
         for (Level& built : spare_) built.refined.release_from(0);
     }
-    new_vertex_count_ = (slice_ != nullptr ? slice_->next_vertex : h_->positions().size()) - new_vertex_first_;
+    new_vertex_count_ = appending_positions() ? size_t(vertex_count_ - vertices_before)
+                                              : (slice_ != nullptr ? slice_->next_vertex : h_->positions().size()) - new_vertex_first_;
 }
 
 void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder, uint64_t max_refined) {
@@ -314,6 +316,7 @@ void HierarchyLevelDecoder::build_decided_levels() {
             AMC_REQUIRE(decided_.size() == 1, invalid_input, "hierarchy decoder: listed new vertices need decode_level");
             splits.new_vertex_corners = list_corners_ ? corners_.reserve(size_t(3) * count) : nullptr;
             splits.place_new_vertices = place_new_vertices_;
+            splits.append_new_positions = appending_positions();
         }
         HierarchyBuilder::split_level(*h_, splits);
         level_base_ = first_child;

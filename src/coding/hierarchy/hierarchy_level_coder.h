@@ -176,10 +176,13 @@ public:
     // Until the next restart, how decode_level hands over the vertices it creates: with
     // `corners`, as their frame corners (new_vertex_corners()) instead of new_vertices(), which
     // stays empty; with `placed` false, their positions left at zero for the caller to set (a
-    // decoder whose geometry sets every one of them).
-    void set_new_vertex_listing(bool corners, bool placed) {
+    // decoder whose geometry sets every one of them); with `appended` too, where the level is
+    // built at the hierarchy's end without seam vertices, not even made: the caller appends them
+    // in id order (HierarchyBuilder::append_positions) before the next level.
+    void set_new_vertex_listing(bool corners, bool placed, bool appended = false) {
         list_corners_ = corners;
         place_new_vertices_ = placed;
+        append_new_positions_ = appended;
     }
     // While set (restart clears it), decode_level gives working memory back to the system
     // (release_pages) as soon as no later step reads it, and each level faults its own in again:
@@ -258,8 +261,11 @@ private:
     std::vector<Level> spare_;    // built levels, whose memory the next levels reuse
     RefinedNumbering numbering_;     // of the level being decided
     std::vector<std::pair<NodeId, int>> new_vertices_;  // of the last decode_level
-    bool list_corners_ = false, place_new_vertices_ = true;  // set_new_vertex_listing
+    bool list_corners_ = false, place_new_vertices_ = true, append_new_positions_ = false;  // set_new_vertex_listing
     bool lean_ = false;                                      // set_lean
+    bool appending_positions() const {
+        return append_new_positions_ && !place_new_vertices_ && slice_ == nullptr && boundary_vertex_ == nullptr;
+    }
     ScratchArray<FrameCorners> corners_;  // of the last decode_level, when listed
     VertexId new_vertex_first_ = 0;
     size_t new_vertex_count_ = 0;
