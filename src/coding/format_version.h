@@ -50,6 +50,12 @@ constexpr uint8_t kRawSideVersion = 14;
 // files, FORMAT.md 5.9).
 constexpr uint8_t kStencilTablesVersion = 15;
 
+// The lowest version a file's newest features need, 0 if it has none of them (older features then
+// decide): the one rule for encode()'s files and the chunked file head the MPI ranks write.
+constexpr uint8_t newest_features_version(bool stencil_tables, bool raw_side, bool chunked) {
+    return stencil_tables ? kStencilTablesVersion : raw_side ? kRawSideVersion : chunked ? kChunkVerticesVersion : 0;
+}
+
 // The hierarchy stream (FORMAT.md section 2).
 constexpr uint8_t kHierarchyStreamVersion = 2;
 constexpr uint8_t kOldestHierarchyStreamVersion = 1;

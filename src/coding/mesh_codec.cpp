@@ -120,10 +120,8 @@ double snap_positions(const Hierarchy& h, const Quantizer& quantizer, unsigned t
 // The lowest version that holds what the file holds (format_version.h).
 uint8_t file_version(bool stencil_tables, bool raw_side, bool unit_geometry, bool grid_geometry, bool mixed_contexts, bool chunked, bool static_geometry,
                      BaseConnectivityMode base_mode, bool store_numbering) {
-    return stencil_tables                                ? kStencilTablesVersion
-           : raw_side                                    ? kRawSideVersion
-           : chunked                                     ? kChunkVerticesVersion
-           : unit_geometry                               ? kUnitFrameVersion
+    if (const uint8_t newest = newest_features_version(stencil_tables, raw_side, chunked)) return newest;
+    return unit_geometry                                 ? kUnitFrameVersion
            : mixed_contexts                              ? kThirdMixingVersion
            : grid_geometry                               ? kGridGeometryVersion
            : static_geometry                             ? kStaticGeometryVersion

@@ -249,7 +249,7 @@ std::vector<uint8_t> chunked_file_head(const TriangleMesh& base, const Seam& sea
         raw_side |= c.raw_side != 0;
         stencil_tables |= c.stencil_tables != 0;
     }
-    BlockWriter writer(stencil_tables ? kStencilTablesVersion : raw_side ? kRawSideVersion : kChunkVerticesVersion, grid != nullptr ? kFlagQuantized : base.single_precision ? kFlagSinglePrecision : 0);
+    BlockWriter writer(newest_features_version(stencil_tables, raw_side, true), grid != nullptr ? kFlagQuantized : base.single_precision ? kFlagSinglePrecision : 0);
     writer.add(BlockType::metadata, write_metadata(meta, grid != nullptr));
     writer.add(BlockType::base_connectivity, base_code.bytes);
     writer.add(BlockType::base_geometry, encode_base_geometry(roots, base_code, false, positions));
