@@ -4,6 +4,7 @@
 // made, the size against the same symbols in the arithmetic code, and the errors a decoder reports
 // for a flag where the format has none and for a side stream cut short or overlong.
 #include "hierarchy_checks.h"
+#include "level_block_rewrite.h"
 
 #include "coding/container.h"
 #include "coding/entropy/rans_coder.h"
@@ -21,27 +22,8 @@
 namespace amc {
 namespace {
 
-std::string decode_error(const std::vector<uint8_t>& bytes) {
-    const DecodeResult r = try_decode(bytes.data(), bytes.size());
-    return r.ok ? "" : r.error;
-}
-
-// The file's blocks rewritten with `version` and `flags` (checksums made anew), each level block
-// passed through `edit`.
-template <class Edit>
-std::vector<uint8_t> rewritten(const std::vector<uint8_t>& bytes, uint8_t version, uint8_t flags, Edit&& edit) {
-    BlockReader reader(bytes.data(), bytes.size());
-    BlockWriter writer(version, flags);
-    Block block;
-    while (reader.next(block)) {
-        if (block.type == BlockType::end) break;
-        std::vector<uint8_t> payload(block.payload, block.payload + block.size);
-        if (block.type == BlockType::level) edit(payload);
-        writer.add(block.type, payload);
-    }
-    return writer.finish();
-}
-
+using testing::decode_error;
+using testing::rewritten;
 using testing::bumpy_torus;
 
 TEST(RawSideStream, BitExactAdaptiveLevelsRoundTripAsVersion14) {

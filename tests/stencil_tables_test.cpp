@@ -4,6 +4,7 @@
 // coordinates that use all their bits, and the errors a decoder reports for the modes where the
 // format has none and for streams cut short.
 #include "hierarchy_checks.h"
+#include "level_block_rewrite.h"
 
 #include "coding/container.h"
 #include "coding/format_version.h"
@@ -19,27 +20,8 @@
 namespace amc {
 namespace {
 
-std::string decode_error(const std::vector<uint8_t>& bytes) {
-    const DecodeResult r = try_decode(bytes.data(), bytes.size());
-    return r.ok ? "" : r.error;
-}
-
-// The file's blocks rewritten with `version` (checksums made anew), each level block passed
-// through `edit`.
-template <class Edit>
-std::vector<uint8_t> rewritten(const std::vector<uint8_t>& bytes, uint8_t version, Edit&& edit) {
-    BlockReader reader(bytes.data(), bytes.size());
-    BlockWriter writer(version, bytes[5]);
-    Block block;
-    while (reader.next(block)) {
-        if (block.type == BlockType::end) break;
-        std::vector<uint8_t> payload(block.payload, block.payload + block.size);
-        if (block.type == BlockType::level) edit(payload);
-        writer.add(block.type, payload);
-    }
-    return writer.finish();
-}
-
+using testing::decode_error;
+using testing::rewritten;
 using testing::bumpy_torus;
 
 bool uses(const EncodeStats& stats, GeometryPredictor p) {
@@ -114,20 +96,20 @@ TEST(StencilTables, DecoderRefusesThemWhereTheFormatHasNoneAndCutStreams) {
     const std::vector<uint8_t> bytes = encode(h, options);
     ASSERT_EQ(bytes[4], kStencilTablesVersion);
     auto same = [](std::vector<uint8_t>&) {};
-    EXPECT_EQ(decode_error(rewritten(bytes, kStencilTablesVersion, same)), "");
+    EXPECT_EQ(decode_error(rewritten(bytes, kStencilTablesVersion, bytes[5], same)), "");
     // Version 14 and older have no predictors 6 and 7, nor a side-stream flag on them.
-    EXPECT_NE(decode_error(rewritten(bytes, kRawSideVersion, same)).find("bad predictor"), std::string::npos);
-    EXPECT_NE(decode_error(rewritten(bytes, kStencilTablesVersion, [](std::vector<uint8_t>& p) { p[0] |= 0x80; }))
+    EXPECT_NE(decode_error(rewritten(bytes, kRawSideVersion, bytes[5], same)).find("bad predictor"), std::string::npos);
+    EXPECT_NE(decode_error(rewritten(bytes, kStencilTablesVersion, bytes[5], [](std::vector<uint8_t>& p) { p[0] |= 0x80; }))
                   .find("bad predictor"),
               std::string::npos);
     // Mode 6's stream read as mode 7's decodes other positions or fails, never crashes.
-    (void)decode_error(rewritten(bytes, kStencilTablesVersion, [](std::vector<uint8_t>& p) { p[0] = 6; }));
+    (void)decode_error(rewritten(bytes, kStencilTablesVersion, bytes[5], [](std::vector<uint8_t>& p) { p[0] = 6; }));
     // In a quantized file they are errors.
     EncodeOptions quantized;
     quantized.quantize_bits = 12;
     quantized.predictor = GeometryPredictor::normal_frame;
     const std::vector<uint8_t> q = encode(h, quantized);
-    EXPECT_NE(decode_error(rewritten(q, kStencilTablesVersion, [](std::vector<uint8_t>& p) { p[0] = 7; })).find("bad predictor"),
+    EXPECT_NE(decode_error(rewritten(q, kStencilTablesVersion, q[5], [](std::vector<uint8_t>& p) { p[0] = 7; })).find("bad predictor"),
               std::string::npos);
     // Raw bits one byte short, or one byte too long, are errors.
     auto cut = [](bool shorter) {
@@ -137,8 +119,8 @@ TEST(StencilTables, DecoderRefusesThemWhereTheFormatHasNoneAndCutStreams) {
             else p.push_back(0);
         };
     };
-    EXPECT_NE(decode_error(rewritten(bytes, kStencilTablesVersion, cut(true))), "");
-    EXPECT_NE(decode_error(rewritten(bytes, kStencilTablesVersion, cut(false))), "");
+    EXPECT_NE(decode_error(rewritten(bytes, kStencilTablesVersion, bytes[5], cut(true))), "");
+    EXPECT_NE(decode_error(rewritten(bytes, kStencilTablesVersion, bytes[5], cut(false))), "");
     // Every truncation of the file is an error.
     for (size_t n = 0; n < bytes.size(); n += 1 + n / 50) EXPECT_FALSE(try_decode(bytes.data(), n).ok) << n;
 }
