@@ -426,6 +426,13 @@ int main(int argc, char** argv) {
         for (int k = 0; k < generate; ++k) {
             const uint64_t seed = k == 0 ? 7 : 1000 + uint64_t(k);
             const GeneratorRun run = run_generator(uint32_t(150000), file.depth(), seed);
+            Hierarchy library_run(make_icosahedron());  // the copy above must stay refine_randomly's loop
+            refine_randomly(library_run, uint32_t(150000), file.depth(), seed);
+            if (!identical(run.h, library_run)) {
+                std::fprintf(stderr, "random_refinement_bound: the generator copy no longer matches refine_randomly (seed %llu)\n",
+                             (unsigned long long)seed);
+                return 1;
+            }
             std::printf("generator, seed %llu%s: %zu picks, %zu splits (%zu forced), %zu split nodes a rule could force;"
                         " sum log2 E_t %.0f bits, log2 |I| + log2 N(X, m) <= %.0f bits, so H(X) >= %.0f bits = %.0f bytes\n",
                         (unsigned long long)seed, k == 0 ? (identical(run.h, file) ? " (= FILE)" : " (differs from FILE)") : "",
