@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets of tests/fuzz (clang, ASan + UBSan, every finding fatal) and runs
-# them one after the other under nice -n 19, each for --seconds (default an hour).
+# them under nice -n 19, each for --seconds (default an hour), --parallel at a time (default 1).
 #
-#   scripts/fuzz.sh [--seconds N] [--runs N] [--timeout S] [--seed S] [--build DIR] [--corpus DIR] [--no-build] [TARGET ...]
+#   scripts/fuzz.sh [--seconds N] [--runs N] [--timeout S] [--seed S] [--parallel N] [--build DIR] [--corpus DIR] [--no-build] [TARGET ...]
 #   scripts/fuzz.sh --totals [--markdown] [--corpus DIR]
 #
 # Each target stops after --seconds or --runs executions, whichever comes first. --seed fixes
@@ -20,14 +20,16 @@
 # two differ a lot), coverage (libFuzzer's cov and ft at the end), corpus size, new findings.
 # --totals sums that file per target (executions and CPU seconds over every run, the last run's
 # coverage); with --markdown as docs/FUZZING.md's table, saying which targets are below 10^7.
-# --no-build runs the binaries already in DIR. Exits 1 when any target found something. .ci/run
-# runs every target briefly.
+# --no-build runs the binaries already in DIR. --parallel N runs N targets at once (one core
+# each; lines print as targets finish). Exits 1 when any target found something. .ci/run runs
+# every target briefly, two at a time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=3600
 runs=-1
 timeout=25
 seed=0
+parallel=1
 build=build-fuzz
 corpus=
 do_build=1
@@ -40,12 +42,13 @@ while (($#)); do
     --runs) runs="$2"; shift 2 ;;
     --timeout) timeout="$2"; shift 2 ;;
     --seed) seed="$2"; shift 2 ;;
+    --parallel) parallel="$2"; shift 2 ;;
     --build) build="$2"; shift 2 ;;
     --corpus) corpus="$2"; shift 2 ;;
     --no-build) do_build=0; shift ;;
     --totals) totals=1; shift ;;
     --markdown) markdown=1; shift ;;
-    -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,25p' "$0"; exit 0 ;;
     *) targets+=("$1"); shift ;;
   esac
 done
@@ -79,20 +82,26 @@ rm -rf "$build/seeds"
 "$bin/fuzz_seeds" tests/data "$build/seeds" > /dev/null
 ((${#targets[@]})) || mapfile -t targets < <("$bin/fuzz_seeds" --list)
 
-status=0
+[[ $parallel =~ ^[1-9][0-9]*$ ]] || { echo "fuzz.sh: --parallel wants a positive count, not '$parallel'" >&2; exit 2; }
 printf '%-18s %12s %8s %8s %7s %7s %7s %8s\n' target executions seconds cpu_s cov ft corpus findings
 TIMEFORMAT='%3U %3S'
-for t in "${targets[@]}"; do
-  mkdir -p "$corpus/$t" "$corpus/findings/$t" "$build/logs"
-  log="$build/logs/$t.log"
+mkdir -p "$build/logs"
+# One target's run; prints its line, appends it to the summary and leaves its count of new
+# findings in logs/TARGET.findings (the lines are short, so concurrent appends stay whole).
+fuzz_target() {
+  local t=$1
+  mkdir -p "$corpus/$t" "$corpus/findings/$t"
+  local log="$build/logs/$t.log"
   # libFuzzer also saves slow-unit-* (over 10 s of wall-clock time, which on a loaded machine says
   # little): not findings; a hang is a timeout-* (-timeout).
+  local before start
   before=$(find "$corpus/findings/$t" -type f ! -name 'slow-unit-*' | wc -l)
   start=$(date +%s)
   # The first folder collects the new inputs; the seeds are read only.
   { time nice -n 19 "$bin/fuzz_$t" -max_total_time="$seconds" -runs="$runs" -rss_limit_mb=2048 -timeout="$timeout" -seed="$seed" \
     -print_final_stats=1 -artifact_prefix="$corpus/findings/$t/" "$corpus/$t" "$build/seeds/$t" > "$log" 2>&1; } \
     2> "$build/logs/$t.time" || true
+  local cpu elapsed executions last cov ft inputs findings line
   cpu=$(awk '{printf "%.0f", $1 + $2}' "$build/logs/$t.time")
   elapsed=$(($(date +%s) - start))
   executions=$(grep -o 'stat::number_of_executed_units: [0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
@@ -102,11 +111,24 @@ for t in "${targets[@]}"; do
   inputs=$(find "$corpus/$t" -type f | wc -l)
   findings=$(($(find "$corpus/findings/$t" -type f ! -name 'slow-unit-*' | wc -l) - before))  # new in this run
   line=$(printf '%-18s %12s %8s %8s %7s %7s %7s %8s' "$t" "${executions:-0}" "$elapsed" "${cpu:-0}" "${cov:-0}" "${ft:-0}" "$inputs" "$findings")
-  echo "$line"
-  echo "$(date -u +%FT%TZ) $line" >> "$corpus/fuzz-summary.txt"
+  echo "$findings" > "$build/logs/$t.findings"
   if ((findings > 0)); then
-    status=1
-    grep -E 'ERROR|SUMMARY|violated|what\(\)' "$log" | head -5 | sed 's/^/    /' || true
+    line+=$'\n'$(grep -E 'ERROR|SUMMARY|violated|what\(\)' "$log" | head -5 | sed 's/^/    /' || true)
   fi
+  echo "$line"
+  echo "$(date -u +%FT%TZ) ${line%%$'\n'*}" >> "$corpus/fuzz-summary.txt"
+}
+
+for t in "${targets[@]}"; do
+  rm -f "$build/logs/$t.findings"
+  while (($(jobs -rp | wc -l) >= parallel)); do wait -n || true; done
+  fuzz_target "$t" &
+done
+wait
+status=0
+for t in "${targets[@]}"; do
+  # A target that left no count stopped before counting: say so rather than pass it.
+  [[ -s $build/logs/$t.findings ]] || { echo "fuzz.sh: $t did not finish (see $build/logs/$t.log)" >&2; status=1; continue; }
+  (($(cat "$build/logs/$t.findings") == 0)) || status=1
 done
 exit $status
