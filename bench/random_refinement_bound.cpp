@@ -19,6 +19,7 @@
 //    law itself (no forced splits), each coded by the same recursion; the mean code length is the
 //    entropy, what no coder of such forests beats on average.
 #include "coding/entropy/arithmetic_coder.h"
+#include "common/mixing.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
 
 #include <amc/hierarchy.h>
@@ -173,16 +174,7 @@ struct GeneratorRun {
 };
 
 GeneratorRun run_generator(uint32_t target_leaves, int max_level, uint64_t seed) {
-    struct Random {  // as adaptive_refinement.cpp
-        uint64_t state;
-        uint64_t next() {
-            uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-            z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-            z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-            return z ^ (z >> 31);
-        }
-        size_t below(size_t n) { return size_t(next() % n); }
-    } random{seed};
+    SplitMix64 random{seed};  // as adaptive_refinement.cpp
     GeneratorRun run;
     Hierarchy& h = run.h;
     h.reset(make_icosahedron());

@@ -2,6 +2,7 @@
 // remesher is in surface_remeshing.cpp.
 #include <amc/refinement.h>
 
+#include "common/mixing.h"
 #include "hierarchy/node_shape.h"
 
 #include <algorithm>
@@ -10,18 +11,6 @@
 namespace amc {
 
 namespace {
-
-// splitmix64: a tiny generator whose output is the same on every platform.
-struct Random {
-    uint64_t state;
-    uint64_t next() {
-        uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-        return z ^ (z >> 31);
-    }
-    size_t below(size_t n) { return size_t(next() % n); }
-};
 
 void push_children(const Hierarchy& h, const std::vector<NodeId>& split, std::vector<NodeId>& out) {
     for (NodeId s : split) {
@@ -38,7 +27,7 @@ void refine_uniformly(Hierarchy& h, int levels) {
 }
 
 void refine_randomly(Hierarchy& h, uint32_t target_leaves, int max_level, uint64_t seed, double coarsen_ratio) {
-    Random random{seed};
+    SplitMix64 random{seed};
     std::vector<NodeId> candidates = h.leaves();
     std::vector<NodeId> split;
     while (h.leaf_count() < target_leaves && !candidates.empty()) {

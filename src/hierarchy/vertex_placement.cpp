@@ -1,6 +1,7 @@
 // Placing the remesher's new vertices on the reference, and correcting them on the leaf mesh.
 #include "hierarchy/vertex_placement.h"
 
+#include "common/mixing.h"
 #include "common/no_index.h"
 #include "geometry/surface_quality.h"
 
@@ -438,10 +439,7 @@ size_t PositionHash::operator()(Vec3 p) const {
         std::memcpy(&u, &x, sizeof u);
         return u;
     };
-    uint64_t h = bits(p.x) * 0x9e3779b97f4a7c15ull;
-    h = (h ^ (h >> 29) ^ bits(p.y)) * 0xbf58476d1ce4e5b9ull;
-    h = (h ^ (h >> 31) ^ bits(p.z)) * 0x94d049bb133111ebull;
-    return size_t(h ^ (h >> 32));
+    return size_t(hash_words(bits(p.x), bits(p.y), bits(p.z)));
 }
 
 VertexPlacement::VertexPlacement(Hierarchy& h, const ReferenceSurface& surface)

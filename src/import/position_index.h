@@ -2,6 +2,7 @@
 // vertices to leaf vertices, finding duplicate vertices, and the exact-midpoint fast path.
 #pragma once
 
+#include "common/mixing.h"
 #include "common/no_index.h"
 
 #include <amc/mesh.h>
@@ -62,10 +63,7 @@ private:
     size_t slot_of(Vec3 p) const {
         uint64_t bits[3];
         std::memcpy(bits, &p, sizeof bits);
-        uint64_t h = bits[0] * 0x9e3779b97f4a7c15ull;
-        h = (h ^ (h >> 29) ^ bits[1]) * 0xbf58476d1ce4e5b9ull;
-        h = (h ^ (h >> 31) ^ bits[2]) * 0x94d049bb133111ebull;
-        return size_t(h ^ (h >> 32)) & (slots_.size() - 1);
+        return size_t(hash_words(bits[0], bits[1], bits[2])) & (slots_.size() - 1);
     }
     const std::vector<Vec3>& positions_;
     std::vector<uint32_t> slots_;

@@ -7,6 +7,7 @@
 // in space, so that the mesh is conforming across the gluing and still drawn where it lies.
 #pragma once
 
+#include "common/mixing.h"
 #include "common/no_index.h"
 #include "octree/tree_corners.h"
 #include "octree/tree_faces.h"
@@ -54,10 +55,7 @@ private:
         Point point;
     };
     static uint64_t hash(const Key& k) {
-        uint64_t x = k.coords ^ (uint64_t(k.tree) * 0x9e3779b97f4a7c15ull);
-        x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-        x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-        return x ^ (x >> 31);
+        return splitmix64_mix(k.coords ^ (uint64_t(k.tree) * kGoldenGamma));
     }
     struct Place {
         uint32_t tree;

@@ -4,6 +4,7 @@
 
 #include "common/check.h"
 #include "common/exact_float.h"
+#include "common/mixing.h"
 #include "octree/octree_leaf_data.h"
 
 #include <algorithm>
@@ -173,15 +174,9 @@ OctreeForest front_octree_forest(const TreeConnectivity& conn, double t, int max
 }
 
 OctreeForest random_octree_forest(const TreeConnectivity& conn, uint64_t seed, double p, int min_level, int max_level) {
-    uint64_t state = seed * 0x9E3779B97F4A7C15ull + 1;
-    auto next = [&state]() {  // splitmix64: the same numbers on every platform
-        uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
-    };
+    SplitMix64 random{seed * kGoldenGamma + 1};
     return refine_octree_forest(uniform_octree_forest(conn, 0),
-                                [&](uint32_t, const Octant& o) { return o.level < min_level || double(next() >> 11) * 0x1.0p-53 < p; },
+                                [&](uint32_t, const Octant& o) { return o.level < min_level || random.unit() < p; },
                                 max_level);
 }
 
