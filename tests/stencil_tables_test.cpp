@@ -8,10 +8,12 @@
 
 #include "coding/container.h"
 #include "coding/format_version.h"
+#include "common/little_endian.h"
 
 #include <amc/codec.h>
 #include <amc/refinement.h>
 
+#include <cfloat>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -60,6 +62,34 @@ TEST(StencilTables, ForcedModesRoundTripAsVersion15) {
                 EXPECT_TRUE(identical(decode(chunked.data(), chunked.size(), on), back));
             }
         }
+    }
+}
+
+// Coordinates of any exponent and sign, some past DBL_MAX / 2 (Hierarchy::is_far), on levels of
+// thousands of vertices: residuals whose raw bits take two reads (bit length above 59), every
+// branch of the float64 level decoder (streams read with and without bounds tests, missing
+// butterfly wings), and the decoded hierarchy's far flag.
+TEST(StencilTables, WildFloat64CoordinatesRoundTrip) {
+    Hierarchy h = bumpy_torus(false, 6000, 6);
+    testing::Random random{29};
+    auto any_bits = [&random] { return random.next() << 33 ^ random.next() << 2 ^ random.next(); };  // next() has 31 bits
+    for (VertexId v = 0; v < h.positions().size(); ++v) {
+        if (v % 3 != 0) continue;
+        double xyz[3];
+        for (double& c : xyz) {
+            do c = bit_cast<double>(any_bits()); while (!std::isfinite(c));
+        }
+        if (v % 7 == 0) xyz[1] = 0.9 * DBL_MAX;
+        h.set_position(v, {xyz[0], xyz[1], xyz[2]});
+    }
+    for (GeometryPredictor p : {GeometryPredictor::midpoint_static, GeometryPredictor::butterfly_static}) {
+        SCOPED_TRACE(int(p));
+        EncodeOptions options;
+        options.predictor = p;
+        EncodeStats stats;
+        const std::vector<uint8_t> bytes = encode(h, options, &stats);
+        ASSERT_TRUE(uses(stats, p));
+        EXPECT_TRUE(identical(decode(bytes.data(), bytes.size()), in_decoder_order(h, options)));
     }
 }
 

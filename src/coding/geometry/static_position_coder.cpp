@@ -8,6 +8,7 @@
 #include "common/bits.h"
 #include "common/compiler.h"
 #include "common/exact_float.h"
+#include "common/little_endian.h"
 
 #include <algorithm>
 #include <cmath>
@@ -768,6 +769,288 @@ bool decode_stencil_positions(Hierarchy& h, const std::vector<std::pair<NodeId, 
     return rans.ended_cleanly() && raw.ended_cleanly();
 }
 
+// ---- modes 6 and 7 over float64 coordinates: the level decoder's fast path ------------------------
+//
+// The same stencils, tokens and streams as decode_stencil_positions, decoded with the streams'
+// state in the loop's own variables: a token's rANS range and what it gives the residual in one
+// table entry (no arithmetic on the token), the raw bits read by one unaligned load at a bit
+// position, without a bounds test where the chunk cannot reach the streams' ends, and the
+// coordinates' finiteness and farness taken once a chunk from their largest exponent.
+
+// A token of one table: its rANS range, and the residual it gives from the raw bits r (sign in
+// bit 0, then the low bits): magnitude = high | v >> rot | (v & rot_mask) << 32 with v = r >> 1
+// (take_large's two raw values swapped back when low > 32), negative = (r & 1) | negative.
+struct StencilEntry {
+    uint64_t high;      // the leading one and the two bits below it; a direct token's magnitude
+    uint64_t raw_mask;  // 2^raw_count - 1
+    uint64_t rot_mask;  // 2^rot - 1
+    uint16_t frequency, start;
+    uint8_t raw_count;  // the sign and the low bits; above kMaxRawRead: two reads (take_large's else)
+    uint8_t rot;        // low - 32 when low > 32, else 0
+    uint8_t negative;   // a direct token's sign
+};
+constexpr int kMaxRawRead = 57;
+struct StencilTable {
+    const uint8_t* index;  // per slot, the entry (RansTable::narrow_view's)
+    std::array<StencilEntry, 256> entries;
+};
+
+// From a narrow table (narrow_view().index != nullptr): its entries are its nonzero frequencies
+// in symbol order (RansTable::build_slots).
+void make_stencil_table(const RansTable& table, StencilTable& out) {
+    out.index = table.narrow_view().index;
+    size_t i = 0;
+    for (int token = 0; token < table.size(); ++token) {
+        if (table.frequency(token) == 0) continue;
+        StencilEntry& e = out.entries[i++];
+        e.frequency = uint16_t(table.frequency(token));
+        e.start = uint16_t(table.start(token));
+        if (token < kDirectTokens) {
+            // take()'s direct tokens: magnitude (token + 1) / 2, negative when even and not 0.
+            e = {uint64_t(token + 1) / 2, 0, 0, e.frequency, e.start, 0, 0, uint8_t(token != 0 && token % 2 == 0)};
+            continue;
+        }
+        const int low = 4 + (token - kDirectTokens) / 4 - 3;
+        const int rot = low > 32 ? low - 32 : 0;
+        e.high = uint64_t(4 | ((token - kDirectTokens) & 3)) << low;
+        e.raw_count = uint8_t(1 + low);
+        e.raw_mask = 1 + low <= kMaxRawRead ? (uint64_t{1} << (1 + low)) - 1 : 0;
+        e.rot = uint8_t(rot);
+        e.rot_mask = (uint64_t{1} << rot) - 1;
+        e.negative = 0;
+    }
+}
+
+// The rANS and raw streams of a level. Safe: every byte read is tested against the end (bytes
+// past it read as 0 and make the level corrupt); else the caller knows the reads stay inside.
+struct StencilStreams {
+    uint32_t x[2];
+    const uint8_t* rans;
+    const uint8_t* rans_end;
+    const uint8_t* raw;
+    uint64_t raw_bits_read = 0;
+    size_t raw_size;
+    bool overran = false;
+
+    template <bool Safe>
+    AMC_ALWAYS_INLINE uint32_t rans_byte() {
+        if (!Safe || rans < rans_end) return *rans++;
+        overran = true;
+        return 0;
+    }
+    // count <= kMaxRawRead bits, mask 2^count - 1.
+    template <bool Safe>
+    AMC_ALWAYS_INLINE uint64_t raw_get(int count, uint64_t mask) {
+        const size_t at = size_t(raw_bits_read >> 3);
+        uint64_t word;
+        if (!Safe || at + 8 <= raw_size) {
+            word = load_le64(raw + at);
+        } else {
+            word = 0;
+            for (size_t k = 0; k < 8 && at + k < raw_size; ++k) word |= uint64_t(raw[at + k]) << (8 * k);
+        }
+        raw_bits_read += uint64_t(count);
+        return (word >> ((raw_bits_read - uint64_t(count)) & 7)) & mask;
+    }
+    // The next token of state State, under `table`, as the ordered bits of the value it gives
+    // against the prediction's ordered bits p.
+    template <int State, bool Safe>
+    AMC_ALWAYS_INLINE uint64_t ordered_value(const StencilTable& table, uint64_t p) {
+        uint32_t& s = x[State];
+        const uint32_t slot = s & (kRansScale - 1);
+        const StencilEntry& e = table.entries[table.index[slot]];
+        s = uint32_t(e.frequency) * (s >> kRansScaleBits) + slot - e.start;
+        // At most two bytes: s >= 2^11 here (s >= L before, a frequency >= 1).
+        if (s < kRansLow) {
+            s = (s << 8) | rans_byte<Safe>();
+            if (s < kRansLow) s = (s << 8) | rans_byte<Safe>();
+        }
+        uint64_t negative, magnitude;
+        if (e.raw_count <= kMaxRawRead) {
+            const uint64_t r = raw_get<Safe>(e.raw_count, e.raw_mask);
+            negative = (r & 1) | e.negative;
+            const uint64_t v = r >> 1;
+            magnitude = e.high | v >> e.rot | (v & e.rot_mask) << 32;
+        } else {  // take_large's two reads
+            const int first = e.raw_count - 32;
+            const uint64_t sign_and_first = raw_get<Safe>(first, (uint64_t{1} << first) - 1);
+            negative = sign_and_first & 1;
+            magnitude = e.high | (sign_and_first >> 1) << 32 | raw_get<Safe>(32, 0xFFFFFFFFull);
+        }
+        return p + ((magnitude ^ (0 - negative)) + negative);  // p - magnitude when negative
+    }
+    bool ended_cleanly() const {
+        return !overran && x[0] == kRansLow && x[1] == kRansLow && rans == rans_end &&
+               raw_bits_read <= uint64_t(raw_size) * 8 && uint64_t(raw_size) * 8 - raw_bits_read < 8;
+    }
+};
+
+constexpr uint64_t kSign64 = uint64_t{1} << 63;
+constexpr uint64_t kExponent64 = uint64_t{0x7FF} << 52;
+// ordered_bits and from_ordered_bits for float64 without branches (the signs are coin flips).
+AMC_ALWAYS_INLINE uint64_t ordered_of(uint64_t b) { return b ^ (uint64_t(int64_t(b) >> 63) | kSign64); }
+AMC_ALWAYS_INLINE uint64_t double_bits_of(uint64_t u) { return u ^ (~uint64_t(int64_t(u) >> 63) | kSign64); }
+
+// Vertex i of a level's chunk: its stencil's vertices, read from the nodes before any position.
+// d == kNoVertex: no neighbour across the edge (the midpoint predicts); a wing kNoVertex: its
+// reflection (predict_butterfly's).
+struct StencilIds {
+    VertexId a, b, c, d, w[4];  // w_bc, w_ca, w_ad, w_db
+};
+
+template <bool Butterfly>
+AMC_ALWAYS_INLINE void stencil_ids(const Hierarchy& h, NodeId n, int e, StencilIds& s) {
+    static constexpr int kNext[5] = {1, 2, 0, 1, 2};
+    const int e1 = kNext[e], e2 = kNext[e + 1];
+    s.a = h.vertex(n, e);
+    s.b = h.vertex(n, e1);
+    if (!Butterfly) return;
+    const NodeId q = h.neighbor(n, e);
+    if (q == kNoNode) {
+        s.d = kNoVertex;
+        return;
+    }
+    s.c = h.vertex(n, e2);
+    const int eq = h.neighbor_edge(n, e);
+    s.d = h.vertex(q, kNext[eq + 1]);
+    // The vertex opposite edge f of node m in the neighbour across it (wing(), geometry_prediction.cpp).
+    auto far_vertex = [&h](NodeId m, int f) {
+        const NodeId r = h.neighbor(m, f);
+        return r == kNoNode ? kNoVertex : h.vertex(r, kNext[h.neighbor_edge(m, f) + 1]);
+    };
+    s.w[0] = far_vertex(n, e1);
+    s.w[1] = far_vertex(n, e2);
+    s.w[2] = far_vertex(q, kNext[eq]);
+    s.w[3] = far_vertex(q, kNext[eq + 1]);
+}
+
+// The ordered bits of predict_butterfly's (or predict_midpoint's) prediction, its non-finite
+// coordinates taken as 0 (coder_prediction), for a float64 hierarchy.
+#if AMC_SSE2
+// x and y in one SSE2 register, z in the low lane of another: the same IEEE operations in the
+// same order as predict_butterfly's Vec3 arithmetic, each lane rounded alike.
+struct Lanes {
+    __m128d xy, z;
+};
+AMC_ALWAYS_INLINE Lanes lanes_at(const Vec3* positions, VertexId v) {
+    const Vec3& p = positions[v];
+    return {_mm_loadu_pd(&p.x), _mm_load_sd(&p.z)};
+}
+AMC_ALWAYS_INLINE Lanes operator+(Lanes u, Lanes v) { return {_mm_add_pd(u.xy, v.xy), _mm_add_pd(u.z, v.z)}; }
+AMC_ALWAYS_INLINE Lanes operator-(Lanes u, Lanes v) { return {_mm_sub_pd(u.xy, v.xy), _mm_sub_pd(u.z, v.z)}; }
+// s * v, each product rounded (no fused multiply-add with the sum it feeds: exact_float.h).
+AMC_ALWAYS_INLINE Lanes scaled(double s, Lanes v) {
+    const __m128d k = _mm_set1_pd(s);
+    return {rounded(_mm_mul_pd(k, v.xy)), rounded(_mm_mul_pd(k, v.z))};
+}
+// ordered_of of each lane, 0 taken for a non-finite one.
+AMC_ALWAYS_INLINE __m128i ordered_lanes(__m128d v) {
+    const __m128d magnitude = _mm_andnot_pd(_mm_set1_pd(-0.0), v);
+    const __m128d finite = _mm_cmplt_pd(magnitude, _mm_set1_pd(HUGE_VAL));  // false for NaN
+    const __m128i b = _mm_castpd_si128(_mm_and_pd(v, finite));
+    // Each lane's sign spread over its 64 bits: its high word shifted arithmetically, then copied
+    // to both words (0xF5: words 1, 1, 3, 3).
+    const __m128i negative = _mm_shuffle_epi32(_mm_srai_epi32(b, 31), 0xF5);
+    return _mm_xor_si128(b, _mm_or_si128(negative, _mm_set1_epi64x(int64_t(kSign64))));
+}
+template <bool Butterfly>
+AMC_ALWAYS_INLINE void stencil_prediction(const Vec3* positions, const StencilIds& s, uint64_t (&p)[3]) {
+    const Lanes a = lanes_at(positions, s.a), b = lanes_at(positions, s.b);
+    Lanes predicted = scaled(0.5, a + b);
+    if (Butterfly && s.d != kNoVertex) {
+        const Lanes c = lanes_at(positions, s.c), d = lanes_at(positions, s.d);
+        const Lanes w_bc = s.w[0] != kNoVertex ? lanes_at(positions, s.w[0]) : b + c - a;
+        const Lanes w_ca = s.w[1] != kNoVertex ? lanes_at(positions, s.w[1]) : c + a - b;
+        const Lanes w_ad = s.w[2] != kNoVertex ? lanes_at(positions, s.w[2]) : a + d - b;
+        const Lanes w_db = s.w[3] != kNoVertex ? lanes_at(positions, s.w[3]) : d + b - a;
+        predicted = predicted + scaled(0.125, c + d) - scaled(0.0625, (w_bc + w_ca) + (w_ad + w_db));
+    }
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(p), ordered_lanes(predicted.xy));
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(p + 2), ordered_lanes(predicted.z));
+}
+#else
+template <bool Butterfly>
+AMC_ALWAYS_INLINE void stencil_prediction(const Vec3* positions, const StencilIds& s, uint64_t (&p)[3]) {
+    Vec3 predicted;
+    const Vec3 a = positions[s.a], b = positions[s.b];
+    if (!Butterfly || s.d == kNoVertex) {
+        predicted = rounded_scaled(0.5, a + b);
+    } else {
+        const Vec3 c = positions[s.c], d = positions[s.d];
+        const Vec3 w_bc = s.w[0] != kNoVertex ? positions[s.w[0]] : b + c - a;
+        const Vec3 w_ca = s.w[1] != kNoVertex ? positions[s.w[1]] : c + a - b;
+        const Vec3 w_ad = s.w[2] != kNoVertex ? positions[s.w[2]] : a + d - b;
+        const Vec3 w_db = s.w[3] != kNoVertex ? positions[s.w[3]] : d + b - a;
+        predicted = rounded_scaled(0.5, a + b) + rounded_scaled(0.125, c + d) -
+                    rounded_scaled(0.0625, (w_bc + w_ca) + (w_ad + w_db));
+    }
+    const double xyz[3] = {predicted.x, predicted.y, predicted.z};
+    for (int k = 0; k < 3; ++k) p[k] = ordered_of(bit_cast<uint64_t>(std::isfinite(xyz[k]) ? xyz[k] : 0.0));
+}
+#endif
+
+template <bool Butterfly>
+bool decode_stencil_float64(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, const StaticTables& tables,
+                            const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
+    std::array<StencilTable, 3> t;
+    for (size_t k = 0; k < 3; ++k) make_stencil_table(tables[k], t[k]);
+    StencilStreams s{{0, 0}, rans_data, rans_data + rans_size, raw_data, 0, raw_size};
+    if (rans_size < kRansStateBytes) return false;
+    for (uint32_t& x : s.x) {
+        x = load_le32(s.rans);
+        s.rans += 4;
+        if (x < kRansLow) return false;  // RansDecoder's: no encoder ends below L
+    }
+    // What a chunk reads at most: two rANS bytes and the sign and 64 bits per coordinate.
+    constexpr size_t kChunkRans = 2 * 3 * kChunk, kChunkRaw = 3 * kChunk * 65 / 8 + 8;
+    std::array<StencilIds, kChunk> ids;
+    uint64_t predicted[kChunk][3];
+    std::array<VertexId, kChunk> vertices;
+    for (size_t begin = 0; begin < created.size(); begin += kChunk) {
+        const size_t count = std::min(kChunk, created.size() - begin);
+        for (size_t i = 0; i < count; ++i) {
+            const auto [n, e] = created[begin + i];
+            stencil_ids<Butterfly>(h, n, e, ids[i]);
+            vertices[i] = h.midpoint(n, e);
+        }
+        const Vec3* positions = h.positions().data();
+        for (size_t i = 0; i < count; ++i) stencil_prediction<Butterfly>(positions, ids[i], predicted[i]);
+        uint64_t largest_exponent = 0;
+        auto run = [&](auto safe) {
+            constexpr bool Safe = decltype(safe)::value;
+            for (size_t i = 0; i < count; ++i) {
+                uint64_t bits[3];
+                // Token j of the level with state j mod 2: x and z with the vertex's parity, y with the other.
+                if (i % 2 == 0) {
+                    bits[0] = s.ordered_value<0, Safe>(t[0], predicted[i][0]);
+                    bits[1] = s.ordered_value<1, Safe>(t[1], predicted[i][1]);
+                    bits[2] = s.ordered_value<0, Safe>(t[2], predicted[i][2]);
+                } else {
+                    bits[0] = s.ordered_value<1, Safe>(t[0], predicted[i][0]);
+                    bits[1] = s.ordered_value<0, Safe>(t[1], predicted[i][1]);
+                    bits[2] = s.ordered_value<1, Safe>(t[2], predicted[i][2]);
+                }
+                Vec3 p;
+                double* xyz[3] = {&p.x, &p.y, &p.z};
+                for (int k = 0; k < 3; ++k) {
+                    const uint64_t b = double_bits_of(bits[k]);
+                    largest_exponent = std::max(largest_exponent, b & kExponent64);
+                    *xyz[k] = bit_cast<double>(b);
+                }
+                HierarchyBuilder::set_near_vertex_position(h, vertices[i], p);
+            }
+        };
+        const bool inside = size_t(s.rans_end - s.rans) >= kChunkRans && raw_size - std::min<size_t>(raw_size, size_t(s.raw_bits_read >> 3)) >= kChunkRaw;
+        if (inside) run(std::false_type{});
+        else run(std::true_type{});
+        // Hierarchy::is_far: a coordinate of magnitude above DBL_MAX / 2, exponent 0x7FE.
+        if (largest_exponent == kExponent64) return false;  // not finite
+        if (largest_exponent >= (uint64_t{0x7FE} << 52))
+            for (size_t i = 0; i < count; ++i) HierarchyBuilder::set_new_vertex_position(h, vertices[i], h.position(vertices[i]));
+    }
+    return s.ended_cleanly();
+}
+
 template <class Tables>
 bool decode_stencil_with(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
                          GeometryPredictor mode, const Tables& tables, const uint8_t* rans_data, size_t rans_size,
@@ -809,6 +1092,12 @@ bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, G
     }
     if constexpr (std::is_same_v<Source, FromNodes<Hierarchy>>) {
         if (has_stencil_tables(mode)) {
+            if (all_narrow && space.quantizer == nullptr && space.precision == Precision::float64 && !h.single_precision()) {
+                const std::vector<std::pair<NodeId, int>>& c = created.created;
+                return mode == GeometryPredictor::butterfly_static
+                           ? decode_stencil_float64<true>(h, c, tables, rans_data, rans_size, raw_data, raw_size)
+                           : decode_stencil_float64<false>(h, c, tables, rans_data, rans_size, raw_data, raw_size);
+            }
             if (all_narrow)
                 return decode_stencil_with(h, created.created, space, mode, narrow, rans_data, rans_size, raw_data, raw_size);
             return decode_stencil_with(h, created.created, space, mode, tables, rans_data, rans_size, raw_data, raw_size);
