@@ -210,8 +210,11 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
     const uint32_t start = uint32_t(blocks_.size());
     if (!place_block(t)) return 0;
     uint32_t settled = start, settled_invalid = 0;
+    // A growth bounded below 2 * kJudgedAfter blocks is never judged by its share of invalid
+    // settled blocks (there are never kJudgedAfter of them): they need not be counted.
+    const bool judged = growth_limit_ >= 2 * kJudgedAfter;
     for (uint32_t next = start; next < blocks_.size(); ++next) {
-        while (settled < start + (next - start) / 2) settled_invalid += !sides_valid(settled++);
+        for (; settled < start + (next - start) / 2; ++settled) settled_invalid += judged && !sides_valid(settled);
         if (hopeless(start, settled, settled_invalid, exploring)) {
             mark_explored(start, preference, exploring);
             roll_back(start);
@@ -222,7 +225,19 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
             if (fan.kind != Fan::triangles || block_of_[fan.triangle[1]] != kNoIndex) continue;
             if (preference == Preference::closure_first) {
                 const uint32_t partner = closure_partner(blocks_[next], i, fan);
-                if (partner != kNoIndex && place_block(partner)) continue;
+                if (partner != kNoIndex) {
+                    // Block first places no partner across two triangles, and across three
+                    // places the block across instead where it fits: then the growths differ.
+                    bool across_fits = false;
+                    if (!preference_mattered_ && fan.size == 3) {
+                        const uint32_t size = uint32_t(blocks_.size());
+                        if (place_block(fan.triangle[1])) across_fits = true, roll_back(size);
+                    }
+                    if (place_block(partner)) {
+                        if (fan.size == 2 || across_fits) preference_mattered_ = true;
+                        continue;
+                    }
+                }
                 if (fan.size == 3) place_block(fan.triangle[1]);
             } else if (fan.size == 3 && !place_block(fan.triangle[1])) {
                 const uint32_t partner = closure_partner(blocks_[next], i, fan);
@@ -285,6 +300,7 @@ std::pair<uint32_t, uint32_t> LevelFinder::without_glued_seed(uint32_t start, Pr
     }
     std::vector<uint32_t> rest;
     for (uint32_t i = start + 1; i < blocks_.size(); ++i) rest.push_back(blocks_[i].center);
+    const std::vector<Block> grown(blocks_.begin() + start, blocks_.end());
     roll_back(start);
     repair_banned_[seed] = 1;
     const uint32_t without = grow_patch(rest.front(), preference);
@@ -295,7 +311,13 @@ std::pair<uint32_t, uint32_t> LevelFinder::without_glued_seed(uint32_t start, Pr
     }
     if (same) return {rest.front(), without};
     roll_back(start);
-    return {seed, grow_patch(seed, preference)};
+    // The patch as grown before (claimed in the same order, so the labels are the same as if it
+    // were grown again from the seed, at a fraction of the cost).
+    for (const Block& b : grown) {
+        blocks_.push_back(b);
+        claim(uint32_t(blocks_.size() - 1));
+    }
+    return {seed, removed};
 }
 
 bool LevelFinder::hopeless(uint32_t start, uint32_t settled, uint32_t settled_invalid, bool exploring) const {
@@ -311,17 +333,32 @@ void LevelFinder::mark_explored(uint32_t start, Preference preference, bool expl
     // those centers need not seed again (this keeps the seeds linear).
     if (!exploring) return;
     const uint8_t bit = uint8_t(1u << int(preference));
-    for (uint32_t i = start; i < blocks_.size(); ++i) covered_[blocks_[i].center] |= bit;
+    for (uint32_t i = start; i < blocks_.size(); ++i) {
+        covered_[blocks_[i].center] |= bit;
+        explored_.push_back(blocks_[i].center);
+    }
 }
 
-Candidate LevelFinder::best_patch(uint32_t t, bool exploring) {
+Candidate LevelFinder::best_patch(uint32_t t, bool exploring, uint8_t failed) {
     Candidate best{0, t, Preference::closure_first};
+    bool same_either_way = false;  // the closure-first growth met no side that block first reads otherwise
     for (Preference preference : {Preference::closure_first, Preference::block_first}) {
+        if ((failed >> int(preference)) & 1) continue;
         if (exploring && (covered_[t] >> int(preference)) & 1) continue;
+        if (same_either_way) {
+            // Block first would grow the same blocks: the same answer, the same centers explored.
+            const uint8_t bit = uint8_t(1u << int(preference));
+            for (uint32_t c : explored_) covered_[c] |= bit;
+            continue;
+        }
+        preference_mattered_ = false;
+        explored_.clear();
         const uint32_t start = uint32_t(blocks_.size());
         const uint32_t removed = grow_patch(t, preference, exploring);
         roll_back(start);
         if (removed > best.removed) best = {removed, t, preference};
+        same_either_way = preference == Preference::closure_first && !preference_mattered_;
+        preference_mattered_ = true;  // other growths need not ask
     }
     return best;
 }
@@ -354,7 +391,8 @@ uint32_t LevelFinder::commit_best_first(const std::vector<uint32_t>& seeds) {
             continue;
         }
         roll_back(start);
-        if (c.removed == 0) c = best_patch(c.center, false);
+        // The labels are as they were for the growth that just failed: it would fail again.
+        if (c.removed == 0) c = best_patch(c.center, false, uint8_t(1u << int(c.preference)));
         if (c.removed == 0) {
             deferred_[c.center] = 1;  // valid once: worth a seed in the next step
             continue;

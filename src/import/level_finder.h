@@ -222,8 +222,10 @@ private:
     uint32_t closure_partner(const Block& x, int i, const Fan& fan) const;
 
     // ---- sides -------------------------------------------------------------------------------
-    // The midpoint role of v: block index * 3 + edge, when v is the midpoint of exactly one block.
-    uint32_t only_midpoint_role(uint32_t v) const { return midpoint_count_[v] == 1 ? midpoint_block_[v][0] : kNoIndex; }
+    // The coarse edge that v splits when v is the midpoint of exactly one block, else kNoEdge.
+    std::pair<uint32_t, uint32_t> only_coarse_edge(uint32_t v) const {
+        return midpoint_count_[v] == 1 ? first_coarse_edge_[v] : kNoEdge;
+    }
     std::pair<uint32_t, uint32_t> coarse_edge(uint32_t role) const;
 
     // What lies across side i of a block, with the labels as they are.
@@ -273,8 +275,9 @@ private:
 
     uint32_t grow_patch_once(uint32_t t, Preference preference, bool exploring, std::vector<uint32_t>* suspects);
 
-    // The best patch grown from t under either preference, or none; the patch is not kept.
-    Candidate best_patch(uint32_t t, bool exploring);
+    // The best patch grown from t under either preference (but those of bit mask `failed`, known
+    // to fail), or none; the patch is not kept.
+    Candidate best_patch(uint32_t t, bool exploring, uint8_t failed = 0);
 
     // The patch grown from blocks_[start] (placed, removing `removed` vertices) without its seed
     // when the seed is glued onto it: joined to the other blocks only through closures (no
@@ -320,7 +323,7 @@ private:
     std::vector<uint32_t> corner_count_;   // per vertex: blocks it is a parent vertex of
     std::vector<std::array<uint32_t, 2>> midpoint_block_;  // block * 3 + edge, per midpoint role
     // Per vertex: coarse_edge(midpoint_block_[v][0]), or kNoEdge when v is no midpoint (one load
-    // tells has_other_midpoint both, which scans every neighbour of a vertex).
+    // tells has_other_midpoint, which scans every neighbour of a vertex, and classify both).
     static constexpr std::pair<uint32_t, uint32_t> kNoEdge{kNoIndex, kNoIndex};
     std::vector<std::pair<uint32_t, uint32_t>> first_coarse_edge_;
     std::vector<uint32_t> block_of_;       // per triangle
@@ -338,6 +341,10 @@ private:
     std::vector<Patch> patches_;
     uint32_t growth_limit_ = kNoIndex;      // blocks: a growth larger than this is given up
     std::vector<uint32_t> blockers_;        // see blockers()
+    // While best_patch grows closure first: whether a side met could take the block across as well
+    // as the closure partner (block first would grow otherwise), and the centers explored.
+    bool preference_mattered_ = true;
+    std::vector<uint32_t> explored_;
 };
 
 }  // namespace amc::detail::inverse

@@ -154,9 +154,15 @@ void LevelFinder::release(uint32_t index) {
         block_of_[b.corner[size_t(k)]] = kNoIndex;
         const uint32_t m = b.m[size_t(k)];
         auto& slots = midpoint_block_[m];
-        if (slots[0] / 3 == index) slots[0] = slots[1];
+        const bool was_first = slots[0] / 3 == index;
+        if (was_first) slots[0] = slots[1];
         slots[1] = kNoIndex;
-        first_coarse_edge_[m] = --midpoint_count_[m] != 0 ? coarse_edge(slots[0]) : kNoEdge;
+        // first_coarse_edge_ is slots[0]'s coarse edge: it changes only with slots[0].
+        if (--midpoint_count_[m] == 0) {
+            first_coarse_edge_[m] = kNoEdge;
+        } else if (was_first) {
+            first_coarse_edge_[m] = coarse_edge(slots[0]);
+        }
         --corner_count_[b.v[size_t(k)]];
     }
 }
@@ -265,9 +271,8 @@ Side LevelFinder::classify(uint32_t index, int i) const {
             side.coarse = {bb, a, p};
             side.emits = true;
         } else {
-            const uint32_t role = only_midpoint_role(p);
-            if (role == kNoIndex) return side;
-            const auto [s, t] = coarse_edge(role);
+            const auto [s, t] = only_coarse_edge(p);
+            if (s == kNoIndex) return side;
             uint32_t across, apex;
             if (t == a) {
                 // m is m1 of a flipped closure (A, B=b, C=a): the third triangle (A, b, p)
@@ -295,14 +300,12 @@ Side LevelFinder::classify(uint32_t index, int i) const {
         const uint32_t p1 = fan.inner[0], p2 = fan.inner[1];
         if (!is_new(p1) && is_new(p2)) {
             // m is m1 of a default closure (A=p1, B=b, C=a); p2 is m2 on edge C -> A.
-            const uint32_t role = only_midpoint_role(p2);
-            if (role == kNoIndex || coarse_edge(role) != std::make_pair(p1, a)) return side;
+            if (only_coarse_edge(p2) != std::make_pair(p1, a)) return side;
             side.coarse = {p1, bb, a};
             side.emits = true;
         } else if (is_new(p1) && !is_new(p2)) {
             // m is m2 of a flipped closure (A=a, B=p2, C=b); p1 is m1 on edge B -> C.
-            const uint32_t role = only_midpoint_role(p1);
-            if (role == kNoIndex || coarse_edge(role) != std::make_pair(bb, p2)) return side;
+            if (only_coarse_edge(p1) != std::make_pair(bb, p2)) return side;
             side.coarse = {a, p2, bb};
         } else {
             return side;
