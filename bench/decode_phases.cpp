@@ -4,9 +4,10 @@
 // instructions, branch misses) where Linux allows it: unlike time, they hardly move when other
 // virtual machines load the host, so two builds can be compared with few runs.
 //
-//   decode_phases [--nodes N] [--runs R] [--reuse] [--naive] [--model surface|random|fe]
+//   decode_phases [--nodes N] [--runs R] [--reuse] [--naive] [--model surface|random|fe] [FILE.amh...]
 //
-// Without --model: surface, random and fe, in that order (see make_bench_hierarchy).
+// Without --model: surface, random and fe, in that order (see make_bench_hierarchy). Hierarchy
+// files named instead (the corpus of docs/BENCHMARKS.md) are decoded in place of the models.
 //
 // --reuse keeps one decoder, and the hierarchy it decodes into, from run to run (as
 // amc::HierarchyDecoder does): no fresh memory. Without it every run starts from nothing and
@@ -18,6 +19,7 @@
 #include "cpu_counters.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
 
+#include <amc/hierarchy.h>
 #include <amc/hierarchy_coder.h>
 
 #include <algorithm>
@@ -112,6 +114,7 @@ int main(int argc, char** argv) {
     bool reuse = false;
     amc::HierarchyCoderOptions options;
     std::string model;  // all three when empty
+    std::vector<std::string> files;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         if (arg == "--reuse") {
@@ -132,13 +135,19 @@ int main(int argc, char** argv) {
             }
             if (arg == "--nodes") nodes = std::min(value, 20000000L);  // a few GB at most
             else runs = int(std::min(value, 1000L));
+        } else if (!arg.empty() && arg[0] != '-') {
+            files.push_back(arg);
         } else {
-            std::fprintf(stderr, "usage: decode_phases [--nodes N] [--runs R] [--reuse] [--naive] [--model surface|random|fe]\n");
+            std::fprintf(stderr, "usage: decode_phases [--nodes N] [--runs R] [--reuse] [--naive] [--model surface|random|fe] [FILE.amh...]\n");
             return 2;
         }
     }
     const Counters counters;
     if (!counters.available()) std::printf("(no hardware counters here: wall time only)\n");
+    if (!files.empty()) {
+        for (const std::string& file : files) report(file.c_str(), amc::read_hierarchy(file), runs, reuse, options, counters);
+        return 0;
+    }
     // The models of coder_bench.
     if (model.empty() || model == "surface")
         report("surface", make_bench_hierarchy(BenchModel::surface, nodes), runs, reuse, options, counters);
