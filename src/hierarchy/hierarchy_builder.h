@@ -186,6 +186,9 @@ struct HierarchyBuilder {
     // The import's local trials (src/import/pick_backtrack.cpp) undo their splits this way
     // instead of restoring a copy of the hierarchy.
     static void undo_splits(Hierarchy& h, const std::vector<NodeId>& parents, size_t from);
+    // Node n's neighbour edge indices, 2 bits per edge (Hierarchy::neighbor_edge's), in one byte:
+    // a decoder that reads several of them looks them up by the byte.
+    static unsigned neighbor_edges(const Hierarchy& h, NodeId n) { return h.nodes_[n].nbr_edge; }
     // Hints the processor to fetch node n (for traversals that know their next nodes early).
     static void prefetch(const Hierarchy& h, NodeId n) { __builtin_prefetch(h.nodes_.data() + n); }
 };

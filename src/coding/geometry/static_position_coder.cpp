@@ -842,6 +842,8 @@ struct StencilStreams {
     template <bool Safe>
     AMC_ALWAYS_INLINE uint64_t raw_get(int count, uint64_t mask) {
         const size_t at = size_t(raw_bits_read >> 3);
+        const unsigned shift = unsigned(raw_bits_read & 7);
+        raw_bits_read += uint64_t(count);
         uint64_t word;
         if (!Safe || at + 8 <= raw_size) {
             word = load_le64(raw + at);
@@ -849,13 +851,12 @@ struct StencilStreams {
             word = 0;
             for (size_t k = 0; k < 8 && at + k < raw_size; ++k) word |= uint64_t(raw[at + k]) << (8 * k);
         }
-        raw_bits_read += uint64_t(count);
-        return (word >> ((raw_bits_read - uint64_t(count)) & 7)) & mask;
+        return (word >> shift) & mask;
     }
-    // The next token of state State, under `table`, as the ordered bits of the value it gives
-    // against the prediction's ordered bits p.
+    // The next token of state State, under `table`, as the residual it gives modulo 2^64: what
+    // it adds to the prediction's ordered bits.
     template <int State, bool Safe>
-    AMC_ALWAYS_INLINE uint64_t ordered_value(const StencilTable& table, uint64_t p) {
+    AMC_ALWAYS_INLINE uint64_t residual(const StencilTable& table) {
         uint32_t& s = x[State];
         const uint32_t slot = s & (kRansScale - 1);
         const StencilEntry& e = table.entries[table.index[slot]];
@@ -877,7 +878,7 @@ struct StencilStreams {
             negative = sign_and_first & 1;
             magnitude = e.high | (sign_and_first >> 1) << 32 | raw_get<Safe>(32, 0xFFFFFFFFull);
         }
-        return p + ((magnitude ^ (0 - negative)) + negative);  // p - magnitude when negative
+        return (magnitude ^ (0 - negative)) + negative;  // -magnitude when negative
     }
     bool ended_cleanly() const {
         return !overran && x[0] == kRansLow && x[1] == kRansLow && rans == rans_end &&
@@ -886,10 +887,20 @@ struct StencilStreams {
 };
 
 constexpr uint64_t kSign64 = uint64_t{1} << 63;
-constexpr uint64_t kExponent64 = uint64_t{0x7FF} << 52;
 // ordered_bits and from_ordered_bits for float64 without branches (the signs are coin flips).
 AMC_ALWAYS_INLINE uint64_t ordered_of(uint64_t b) { return b ^ (uint64_t(int64_t(b) >> 63) | kSign64); }
 AMC_ALWAYS_INLINE uint64_t double_bits_of(uint64_t u) { return u ^ (~uint64_t(int64_t(u) >> 63) | kSign64); }
+// Hierarchy::is_far's bound.
+constexpr double kHalfMax = 8.98846567431157953865e307;  // DBL_MAX / 2
+#if AMC_SSE2
+// double_bits_of in each lane: the high word's sign shifted arithmetically over the lane
+// (0xF5: words 1, 1, 3, 3); a lane of sign 1 loses it, one of sign 0 is inverted.
+AMC_ALWAYS_INLINE __m128d double_lanes_of(__m128i u) {
+    const __m128i negative = _mm_shuffle_epi32(_mm_srai_epi32(u, 31), 0xF5);
+    const __m128i flip = _mm_andnot_si128(negative, _mm_set1_epi32(-1));  // ~negative: ones where the sign is 0
+    return _mm_castsi128_pd(_mm_xor_si128(u, _mm_or_si128(flip, _mm_set1_epi64x(int64_t(kSign64)))));
+}
+#endif
 
 // Vertex i of a level's chunk: its stencil's vertices, read from the nodes before any position.
 // d == kNoVertex: no neighbour across the edge (the midpoint predicts); a wing kNoVertex: its
@@ -897,6 +908,18 @@ AMC_ALWAYS_INLINE uint64_t double_bits_of(uint64_t u) { return u ^ (~uint64_t(in
 struct StencilIds {
     VertexId a, b, c, d, w[4];  // w_bc, w_ca, w_ad, w_db
 };
+
+// Per byte of a node's neighbour edge indices (HierarchyBuilder::neighbor_edges) and edge f: the
+// local index of the vertex opposite edge f in the neighbour across it (wing(), geometry_prediction.cpp).
+struct OppositeIndices {
+    uint8_t of[256][4];
+    constexpr OppositeIndices() : of() {
+        constexpr int kNext[5] = {1, 2, 0, 1, 2};
+        for (int byte = 0; byte < 256; ++byte)
+            for (int f = 0; f < 3; ++f) of[byte][f] = uint8_t(kNext[((byte >> (2 * f)) & 3) + 1]);
+    }
+};
+constexpr OppositeIndices kOpposite;
 
 template <bool Butterfly>
 AMC_ALWAYS_INLINE void stencil_ids(const Hierarchy& h, NodeId n, int e, StencilIds& s) {
@@ -911,17 +934,19 @@ AMC_ALWAYS_INLINE void stencil_ids(const Hierarchy& h, NodeId n, int e, StencilI
         return;
     }
     s.c = h.vertex(n, e2);
+    const uint8_t* const n_opposite = kOpposite.of[HierarchyBuilder::neighbor_edges(h, n)];
+    const uint8_t* const q_opposite = kOpposite.of[HierarchyBuilder::neighbor_edges(h, q)];
     const int eq = h.neighbor_edge(n, e);
-    s.d = h.vertex(q, kNext[eq + 1]);
-    // The vertex opposite edge f of node m in the neighbour across it (wing(), geometry_prediction.cpp).
-    auto far_vertex = [&h](NodeId m, int f) {
+    s.d = h.vertex(q, n_opposite[e]);
+    // The vertex opposite edge f of node m in the neighbour across it, kNoVertex without one.
+    auto far_vertex = [&h](NodeId m, int f, const uint8_t* opposite) {
         const NodeId r = h.neighbor(m, f);
-        return r == kNoNode ? kNoVertex : h.vertex(r, kNext[h.neighbor_edge(m, f) + 1]);
+        return r == kNoNode ? kNoVertex : h.vertex(r, opposite[f]);
     };
-    s.w[0] = far_vertex(n, e1);
-    s.w[1] = far_vertex(n, e2);
-    s.w[2] = far_vertex(q, kNext[eq]);
-    s.w[3] = far_vertex(q, kNext[eq + 1]);
+    s.w[0] = far_vertex(n, e1, n_opposite);
+    s.w[1] = far_vertex(n, e2, n_opposite);
+    s.w[2] = far_vertex(q, kNext[eq], q_opposite);
+    s.w[3] = far_vertex(q, kNext[eq + 1], q_opposite);
 }
 
 // The ordered bits of predict_butterfly's (or predict_midpoint's) prediction, its non-finite
@@ -1006,47 +1031,82 @@ bool decode_stencil_float64(Hierarchy& h, const std::vector<std::pair<NodeId, in
     std::array<StencilIds, kChunk> ids;
     uint64_t predicted[kChunk][3];
     std::array<VertexId, kChunk> vertices;
+    // split_level numbers a level's new vertices in the order `created` lists them (the listed
+    // frame modes read them so too), seam vertices aside: a chunk whose first and last vertex
+    // are where that puts them has all of its vertices there.
+    auto midpoint = [&h, &created](size_t i) { return h.midpoint(created[i].first, created[i].second); };
+    const VertexId first = created.empty() ? 0 : midpoint(0);
     for (size_t begin = 0; begin < created.size(); begin += kChunk) {
         const size_t count = std::min(kChunk, created.size() - begin);
+        const bool consecutive = midpoint(begin) == first + begin && midpoint(begin + count - 1) == first + begin + count - 1;
         for (size_t i = 0; i < count; ++i) {
             const auto [n, e] = created[begin + i];
             stencil_ids<Butterfly>(h, n, e, ids[i]);
-            vertices[i] = h.midpoint(n, e);
+            vertices[i] = consecutive ? VertexId(first + begin + i) : h.midpoint(n, e);
         }
         const Vec3* positions = h.positions().data();
         for (size_t i = 0; i < count; ++i) stencil_prediction<Butterfly>(positions, ids[i], predicted[i]);
-        uint64_t largest_exponent = 0;
+        // Whether every coordinate of the chunk is at most DBL_MAX / 2 in magnitude (not
+        // Hierarchy::is_far, and finite), in the bits of each lane.
+#if AMC_SSE2
+        __m128d near_xy = _mm_castsi128_pd(_mm_set1_epi32(-1)), near_z = near_xy;
+        const __m128d half_max = _mm_set1_pd(kHalfMax);
+#else
+        uint64_t largest_magnitude = 0;
+#endif
         auto run = [&](auto safe) {
             constexpr bool Safe = decltype(safe)::value;
             for (size_t i = 0; i < count; ++i) {
-                uint64_t bits[3];
+                uint64_t r[3];
                 // Token j of the level with state j mod 2: x and z with the vertex's parity, y with the other.
                 if (i % 2 == 0) {
-                    bits[0] = s.ordered_value<0, Safe>(t[0], predicted[i][0]);
-                    bits[1] = s.ordered_value<1, Safe>(t[1], predicted[i][1]);
-                    bits[2] = s.ordered_value<0, Safe>(t[2], predicted[i][2]);
+                    r[0] = s.residual<0, Safe>(t[0]);
+                    r[1] = s.residual<1, Safe>(t[1]);
+                    r[2] = s.residual<0, Safe>(t[2]);
                 } else {
-                    bits[0] = s.ordered_value<1, Safe>(t[0], predicted[i][0]);
-                    bits[1] = s.ordered_value<0, Safe>(t[1], predicted[i][1]);
-                    bits[2] = s.ordered_value<1, Safe>(t[2], predicted[i][2]);
+                    r[0] = s.residual<1, Safe>(t[0]);
+                    r[1] = s.residual<0, Safe>(t[1]);
+                    r[2] = s.residual<1, Safe>(t[2]);
                 }
                 Vec3 p;
+#if AMC_SSE2
+                // from_ordered_bits of prediction + residual, x and y in one register.
+                const __m128i u_xy = _mm_add_epi64(_mm_loadu_si128(reinterpret_cast<const __m128i*>(predicted[i])),
+                                                   _mm_set_epi64x(int64_t(r[1]), int64_t(r[0])));
+                const __m128i u_z = _mm_add_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(predicted[i] + 2)),
+                                                  _mm_cvtsi64_si128(int64_t(r[2])));
+                const __m128d xy = double_lanes_of(u_xy), z = double_lanes_of(u_z);
+                const __m128d sign = _mm_set1_pd(-0.0);
+                near_xy = _mm_and_pd(near_xy, _mm_cmple_pd(_mm_andnot_pd(sign, xy), half_max));
+                near_z = _mm_and_pd(near_z, _mm_cmple_pd(_mm_andnot_pd(sign, z), half_max));
+                _mm_storeu_pd(&p.x, xy);
+                _mm_store_sd(&p.z, z);
+#else
                 double* xyz[3] = {&p.x, &p.y, &p.z};
                 for (int k = 0; k < 3; ++k) {
-                    const uint64_t b = double_bits_of(bits[k]);
-                    largest_exponent = std::max(largest_exponent, b & kExponent64);
+                    const uint64_t b = double_bits_of(predicted[i][k] + r[k]);
+                    largest_magnitude = std::max(largest_magnitude, b & ~kSign64);
                     *xyz[k] = bit_cast<double>(b);
                 }
+#endif
                 HierarchyBuilder::set_near_vertex_position(h, vertices[i], p);
             }
         };
         const bool inside = size_t(s.rans_end - s.rans) >= kChunkRans && raw_size - std::min<size_t>(raw_size, size_t(s.raw_bits_read >> 3)) >= kChunkRaw;
         if (inside) run(std::false_type{});
         else run(std::true_type{});
-        // Hierarchy::is_far: a coordinate of magnitude above DBL_MAX / 2, exponent 0x7FE.
-        if (largest_exponent == kExponent64) return false;  // not finite
-        if (largest_exponent >= (uint64_t{0x7FE} << 52))
-            for (size_t i = 0; i < count; ++i) HierarchyBuilder::set_new_vertex_position(h, vertices[i], h.position(vertices[i]));
+#if AMC_SSE2
+        const bool near = _mm_movemask_pd(near_xy) == 3 && (_mm_movemask_pd(near_z) & 1) != 0;  // z's lane 1 is not a coordinate
+#else
+        const bool near = largest_magnitude <= bit_cast<uint64_t>(kHalfMax);
+#endif
+        if (!near) {  // rare: which coordinates, then
+            for (size_t i = 0; i < count; ++i) {
+                const Vec3 p = h.position(vertices[i]);
+                if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return false;
+                HierarchyBuilder::set_new_vertex_position(h, vertices[i], p);  // Hierarchy::is_far's flag
+            }
+        }
     }
     return s.ended_cleanly();
 }
