@@ -34,6 +34,14 @@ void LeafDetour::search(uint32_t source, std::vector<int>& hops, std::vector<uin
     for (uint32_t x : reached) hops[x] = -1;
     reached.assign(1, source);
     hops[source] = 0;
+    extend(hops, reached, 0, max_hops, pending, pending_count);
+}
+
+// Continues a search that has reached, in `reached`, every vertex within `radius` hops (those at
+// `radius` not yet looked around), out to max_hops: the hop counts are a new search's, without
+// walking the ball again.
+void LeafDetour::extend(std::vector<int>& hops, std::vector<uint32_t>& reached, int radius, int max_hops,
+                        uint32_t* pending, uint32_t pending_count) {
     // A vertex is final when first reached: once every pending one is, nothing asked changes.
     auto settle = [&](uint32_t x) {
         for (uint32_t i = 0; i < pending_count;) {
@@ -45,8 +53,16 @@ void LeafDetour::search(uint32_t source, std::vector<int>& hops, std::vector<uin
         }
     };
     const bool stops = pending_count > 0;
-    settle(source);
-    for (size_t i = 0; i < reached.size(); ++i) {
+    for (uint32_t i = 0; i < pending_count;) {  // those the ball has reached already
+        if (hops[pending[i]] >= 0) {
+            pending[i] = pending[--pending_count];
+        } else {
+            ++i;
+        }
+    }
+    size_t first = 0;  // the first vertex not looked around yet
+    while (first < reached.size() && hops[reached[first]] < radius) ++first;
+    for (size_t i = first; i < reached.size(); ++i) {
         if (stops && pending_count == 0) return;
         const uint32_t u = reached[i];
         if (hops[u] == max_hops) continue;
@@ -79,11 +95,11 @@ bool LeafDetour::measure(uint32_t a, uint32_t b, int max_hops, const uint32_t* t
     count = count < kMaxTargets ? count : kMaxTargets;
     for (uint32_t i = 0; i < count; ++i) pending[i] = targets[i];
     pending[count] = b;
-    search(a, hops_a_, reached_a_, max_hops, pending, count + 1);
+    extend(hops_a_, reached_a_, (max_hops + 1) / 2, max_hops, pending, count + 1);
     if (hops_a_[b] < 0) return false;
     shortest_ = hops_a_[b];
     for (uint32_t i = 0; i < count; ++i) pending[i] = targets[i];
-    search(b, hops_b_, reached_b_, max_hops, pending, count);
+    extend(hops_b_, reached_b_, max_hops / 2, max_hops, pending, count);
     return true;
 }
 

@@ -29,6 +29,9 @@ private:
     // Breadth-first from source up to max_hops, or until every one of `pending` is reached.
     void search(uint32_t source, std::vector<int>& hops, std::vector<uint32_t>& reached, int max_hops,
                 uint32_t* pending = nullptr, uint32_t pending_count = 0);
+    // Goes on with the last search, which reached every vertex within `radius` hops, out to max_hops.
+    void extend(std::vector<int>& hops, std::vector<uint32_t>& reached, int radius, int max_hops,
+                uint32_t* pending, uint32_t pending_count);
 
     // Calls f on every neighbour of u: the ends of its out-edges, and where some apex of its faces
     // is none of them (an open fan: the mesh boundary, or a broken input), the apexes too.
