@@ -140,6 +140,30 @@ TEST(HierarchyFile, UnbalancedForestIsRejected) {
     }
 }
 
+// A leaf whose three neighbours are refined (a root of the icosahedron with its three neighbour
+// roots split) is not a closed forest.
+TEST(HierarchyFile, LeafWithThreeHangingNodesIsRejected) {
+    const Hierarchy unrefined(make_icosahedron());
+    std::string bytes = serialize_hierarchy(unrefined);
+    const uint32_t nodes = 20 + 3 * 4, vertices = 3 * 3;  // the three neighbours share no edge
+    std::memcpy(&bytes[20], &nodes, 4);
+    std::memcpy(&bytes[28], &vertices, 4);
+    const size_t bits_at = 32 + 12 * 3 * 8 + 20 * 12;
+    bytes.insert(bits_at + 3, std::string(1, '\0'));  // 32 bits need 4 bytes, 20 needed 3
+    for (int e = 0; e < 3; ++e) {
+        const NodeId q = unrefined.neighbor(0, e);
+        bytes[bits_at + q / 8] = char(uint8_t(bytes[bits_at + q / 8]) | (1u << (q % 8)));
+    }
+    bytes += std::string(size_t(vertices) * 3 * 8, '\0');
+    try {
+        deserialize_hierarchy(bytes, "c.amh");
+        FAIL() << "accepted a leaf with three hanging nodes";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::corrupt);
+        EXPECT_NE(std::string(e.what()).find("element 0 has three hanging nodes"), std::string::npos) << e.what();
+    }
+}
+
 // The node count is checked against the refinement bits before the forest is built in room made
 // for that many nodes.
 TEST(HierarchyFile, NodeCountMustMatchTheRefinementBits) {

@@ -7,8 +7,10 @@
 #include "common/check.h"
 #include "common/file_io.h"
 #include "common/little_endian.h"
+#include "coding/hierarchy/level_forest.h"
 #include "hierarchy/hierarchy_builder.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -162,9 +164,8 @@ Hierarchy parse_hierarchy(const std::string& bytes, const std::string& what) {
         throw_error(ErrorCode::corrupt, e.what());  // a file whose base breaks the rules is corrupt
     }
     Hierarchy h(std::move(base));
-    h.set_vertex_placer([](void*, Vec3 a, Vec3) { return a; }, nullptr);  // positions follow
 
-    // Replay the refinement bits breadth-first; every split must keep balance.
+    // Replay the refinement bits; every split must keep balance.
     const uint8_t* bits = reinterpret_cast<const uint8_t*>(in.take((uint64_t(node_count) + 7) / 8));
     // Each refined node adds four: with the counts consistent, the forest is built in room made
     // once for it (at most 8 nodes a byte of the file), not in vectors grown to twice its size.
@@ -174,36 +175,68 @@ Hierarchy parse_hierarchy(const std::string& bytes, const std::string& what) {
         in.fail("header announces " + std::to_string(node_count) + " nodes but the refinement bits make " +
                 std::to_string(uint64_t(base_triangles) + 4 * refined));
     h.reserve(node_count, uint64_t(base_vertices) + new_vertices);
-    std::vector<NodeId> order;
-    order.reserve(node_count);
-    for (NodeId r = 0; r < h.root_count(); ++r) order.push_back(r);
-    for (size_t i = 0; i < order.size(); ++i) {
-        if (i >= node_count) in.fail("refinement bits end before the forest is complete");
-        if (!((bits[i / 8] >> (i % 8)) & 1)) continue;
-        const NodeId n = order[i];
-        if (!h.can_split(n))
-            in.fail("node " + std::to_string(i) + " (level " + std::to_string(h.level(n)) +
-                    ") is refined next to a coarser element: the hierarchy is not balanced");
-        h.split(n);
-        for (int k = 0; k < 4; ++k) order.push_back(h.child(n, k));
+    // Breadth-first order is level order, each level in canonical order: level by level, the
+    // hierarchy coder's level forest (level_forest.h) links the children and a whole level splits
+    // in one pass (HierarchyBuilder::split_level, as the decoder builds), with the node and vertex
+    // ids split() gives node at a time: node ids in breadth-first order, vertex ids in canonical
+    // order. Node at a time, the splits were half of a read.
+    Level level, next;
+    RefinedNumbering numbering;
+    std::vector<uint32_t> closures;
+    root_level(h, level, false);
+    uint64_t first = 0;                    // the level's first node: its breadth-first index and id
+    uint64_t three_hanging = UINT64_MAX;  // the first unrefined node with three hanging nodes
+    for (int l = 0; !level.empty(); ++l) {
+        const uint32_t n = uint32_t(level.size());
+        const uint32_t in_file = uint32_t(std::min<uint64_t>(n, node_count - first));
+        uint8_t* state = level.state();
+        for (uint32_t i = 0; i < in_file; ++i) {
+            const uint64_t k = first + i;
+            const bool split = (bits[k / 8] >> (k % 8)) & 1;
+            // Hierarchy::can_split: every neighbour there, below the level cap.
+            if (split && (!(state[i] & kComplete) || l >= kMaxLevel))
+                in.fail("node " + std::to_string(k) + " (level " + std::to_string(l) +
+                        ") is refined next to a coarser element: the hierarchy is not balanced");
+            state[i] = uint8_t(state[i] | kDecided | (split ? kRefined : 0));
+        }
+        if (in_file < n) in.fail("refinement bits end before the forest is complete");
+        // Each node's refined neighbours (the closure check's hanging nodes).
+        with_links(level, [&](auto links) {
+            for (uint32_t i = 0; i < n; ++i) {
+                if (!(state[i] & kRefined)) continue;
+                const Neighbors q = links.neighbors(i);
+                for (int e = 0; e < 3; ++e)
+                    if (q.nbr[e] != kNoLocal) state[q.nbr[e]] = uint8_t(state[q.nbr[e]] + kRefinedNeighbor);
+            }
+        });
+        closures.resize(n);
+        const DecidedLevelScan scan = scan_decided_level(level, numbering, closures.data());
+        for (uint32_t c = 0; c < scan.closures && three_hanging == UINT64_MAX; ++c)
+            if (refined_neighbors(state[closures[c]]) == 3) three_hanging = first + closures[c];
+        const uint64_t made = derive_next_level(level, numbering, next, false);
+        uint32_t* parents = level.refined.data();
+        for (uint32_t b = 0; b < level.refined_count; ++b) parents[b] += uint32_t(first);
+        LevelSplits splits{parents, level.refined_count, next.nbr.data()};
+        splits.place_new_vertices = false;  // the file's positions follow
+        splits.new_vertex_count = made;
+        HierarchyBuilder::split_level(h, splits);
+        first += n;
+        std::swap(level, next);
     }
-    if (order.size() != node_count)
-        in.fail("header announces " + std::to_string(node_count) + " nodes but the forest has " +
-                std::to_string(order.size()));
+    if (first != node_count)
+        in.fail("header announces " + std::to_string(node_count) + " nodes but the forest has " + std::to_string(first));
     for (size_t i = node_count; i < (uint64_t(node_count) + 7) / 8 * 8; ++i) {
         if ((bits[i / 8] >> (i % 8)) & 1) in.fail("padding bits after the forest are not zero");
     }
-    for (NodeId n : order) {
-        if (h.is_leaf(n) && h.hanging_node_count(n) == 3)
-            in.fail("element " + std::to_string(n) + " has three hanging nodes but is not refined (closure)");
-    }
+    if (three_hanging != UINT64_MAX)
+        in.fail("element " + std::to_string(three_hanging) + " has three hanging nodes but is not refined (closure)");
     int64_t previous = -1;
     for (uint32_t i = 0; i < flip_count; ++i) {
         const uint32_t index = in.u32();
         if (int64_t(index) <= previous || index >= node_count)
             in.fail("diagonal override " + std::to_string(i) + " is out of order or range");
         previous = index;
-        const NodeId n = order[index];
+        const NodeId n = NodeId(index);  // node ids are breadth-first indices
         if (!h.is_leaf(n) || h.hanging_node_count(n) != 2)
             in.fail("diagonal override on node " + std::to_string(index) + ", which is not closed by two hanging nodes");
         h.set_diagonal_flipped(n, true);
@@ -211,19 +244,15 @@ Hierarchy parse_hierarchy(const std::string& bytes, const std::string& what) {
     if (h.vertex_count() - h.base().positions.size() != new_vertices)
         in.fail("header announces " + std::to_string(new_vertices) + " refinement vertices but the forest makes " +
                 std::to_string(h.vertex_count() - h.base().positions.size()));
-    const std::vector<uint32_t> canonical = canonical_vertex_order(h, order);  // order is breadth-first
+    // Refinement vertices in canonical order, which is their id order.
     std::vector<Vec3> refinement_positions(new_vertices);
     in.points(refinement_positions.data(), new_vertices, single);
     for (uint32_t i = 0; i < new_vertices; ++i) {
         const Vec3& p = refinement_positions[i];
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
             in.fail("refinement vertex " + std::to_string(i) + " has a non-finite coordinate");
+        h.set_position(VertexId(base_vertices + i), p);
     }
-    for (size_t v = 0; v < canonical.size(); ++v) {
-        if (canonical[v] != kNoVertex && canonical[v] >= base_vertices)
-            h.set_position(VertexId(v), refinement_positions[canonical[v] - base_vertices]);
-    }
-    h.set_vertex_placer(nullptr, nullptr);
     HierarchyBuilder::mark_structure_checked(h);  // replayed under can_split, closure checked above
     return h;
 }
