@@ -10,6 +10,9 @@
 // Designs with trained initial states ("P:") count each model table's slots over the training
 // models: TRAIN=stem,stem,... names them, else each model trains on the other meshes' models.
 // LAW_DIR=dir reads the random refinement's law posterior (bench/random_refinement_bound --dump).
+// Designs "T:" to "Q:" (2026-12-04 evening): local thresholds, the quadric's curvatures and the
+// fourth model (docs/HIERARCHY_CODER.md, "The fourth model"); "Q:" equals the coder's fourth model
+// with WEIGHTS_IN of its own WEIGHTS_OUT.
 //   [CACHE_DIR=dir] [ONLY=text] [WEIGHTS_OUT=prefix | WEIGHTS_IN=prefix] [TRAIN=...] [LAW_DIR=dir] model_study model.amh ...
 #include "mixed_symbols.h"
 
@@ -44,7 +47,55 @@ struct Extra {
     // random_refinement_bound --dump, read from LAW_DIR/<model>.law), half-octave odds bins, 1..32
     // (0: none).
     uint8_t law = 0;
+    // Local threshold: n's estimated priority (its curvature feature: curvature times longest edge)
+    // against those of same-level neighbours whose symbol came before n's, refined (the least of
+    // them) and not refined (the largest): half-octave bins of the ratio around 16, 0 for none.
+    // *2: over the neighbours and their neighbours; p: the parent's coded same-level neighbours;
+    // g: the same on the Gauss estimate (sqrt of gauss' value).
+    uint8_t thr_ref = 0, thr_unref = 0, thr_ref2 = 0, thr_unref2 = 0, thr_pref = 0, thr_punref = 0, g_ref = 0, g_unref = 0;
+    // A quadric z(x, y) through n's corners and its neighbours' far corners, in n's frame: |H| L,
+    // sqrt|K| L and the larger principal curvature times L, quarter octaves around 40.
+    uint8_t quad_h = 0, quad_k = 0, quad_max = 0;
+    // |signed dihedral mean curvature| times L (each edge's chord signed by the neighbour's far
+    // corner above or below n's plane), quarter octaves; threshold bins on quad H's estimate.
+    uint8_t sdh = 0, qthr_ref2 = 0, qthr_unref2 = 0;
+    // quad_h and quad_k without the slope terms: (A + C) L, sqrt|4AC - B^2| L.
+    uint8_t flat_h = 0, flat_k = 0;
 };
+
+// sqrt of the Gauss estimate of node m (|det| of its neighbours' unit normals times L^2 over the
+// twice area), 0 without three neighbours.
+double gauss_estimate(const Hierarchy& h, NodeId m);
+
+// The half-octave bin of a / b around 16, 1..31; 0 when b is not > 0 (no comparison).
+uint8_t ratio_bin(double a, double b) {
+    if (!(b > 0)) return 0;
+    if (!(a > 0)) return 1;
+    return uint8_t(std::clamp(int(std::floor(2 * std::log2(a / b))) + 16, 1, 31));
+}
+
+// Solves the 6x6 system m x = r by elimination with partial pivoting; false when singular.
+bool solve6(double m[6][6], double r[6], double x[6]) {
+    for (int c = 0; c < 6; ++c) {
+        int best = c;
+        for (int i = c + 1; i < 6; ++i)
+            if (std::fabs(m[i][c]) > std::fabs(m[best][c])) best = i;
+        if (!(std::fabs(m[best][c]) > 1e-300)) return false;
+        std::swap(m[c], m[best]);
+        std::swap(r[c], r[best]);
+        for (int i = c + 1; i < 6; ++i) {
+            const double f = m[i][c] / m[c][c];
+            for (int j = c; j < 6; ++j) m[i][j] -= f * m[c][j];
+            r[i] -= f * r[c];
+        }
+    }
+    for (int i = 5; i >= 0; --i) {
+        double v = r[i];
+        for (int j = i + 1; j < 6; ++j) v -= m[i][j] * x[j];
+        x[i] = v / m[i][i];
+    }
+    return true;
+}
 
 Vec3 unit_normal_of(const Hierarchy& h, NodeId m, double* twice_area = nullptr) {
     const Vec3 a = h.position(h.vertex(m, 0)), u = h.position(h.vertex(m, 1)) - a, v = h.position(h.vertex(m, 2)) - a;
@@ -63,8 +114,71 @@ double longest_edge(const Hierarchy& h, NodeId m) {
     return longest;
 }
 
+double gauss_estimate(const Hierarchy& h, NodeId m) {
+    double twice_area = 0;
+    unit_normal_of(h, m, &twice_area);
+    Vec3 nn[3] = {};
+    for (int e = 0; e < 3; ++e) {
+        const NodeId q = h.neighbor(m, e);
+        if (q == kNoNode) return 0;
+        nn[e] = unit_normal_of(h, q);
+    }
+    if (!(twice_area > 0)) return 0;
+    const double L = longest_edge(h, m);
+    const Vec3 c{nn[1].y * nn[2].z - nn[1].z * nn[2].y, nn[1].z * nn[2].x - nn[1].x * nn[2].z, nn[1].x * nn[2].y - nn[1].y * nn[2].x};
+    return std::sqrt(std::abs(dot(nn[0], c)) * L * L / twice_area);
+}
+
+bool quadric_curvatures(const Hierarchy& h, NodeId n, double* Hout, double* Kout, double* flat = nullptr) {
+    Vec3 pts[6];
+    for (int e = 0; e < 3; ++e) {
+        pts[e] = h.position(h.vertex(n, e));
+        const NodeId q = h.neighbor(n, e);
+        if (q == kNoNode) return false;
+        pts[3 + e] = h.position(h.vertex(q, (h.neighbor_edge(n, e) + 2) % 3));
+    }
+    double twice_area = 0;
+    const Vec3 nrm = unit_normal_of(h, n, &twice_area);
+    if (!(twice_area > 0)) return false;
+    const Vec3 c = (1.0 / 3.0) * (pts[0] + pts[1] + pts[2]);
+    Vec3 u = pts[1] - pts[0];
+    u = (1.0 / std::sqrt(dot(u, u))) * u;
+    const Vec3 w{nrm.y * u.z - nrm.z * u.y, nrm.z * u.x - nrm.x * u.z, nrm.x * u.y - nrm.y * u.x};
+    double m[6][6], r[6], sol[6];
+    for (int k = 0; k < 6; ++k) {
+        const Vec3 d = pts[k] - c;
+        const double px = dot(d, u), py = dot(d, w);
+        m[k][0] = px * px, m[k][1] = px * py, m[k][2] = py * py, m[k][3] = px, m[k][4] = py, m[k][5] = 1;
+        r[k] = dot(d, nrm);
+    }
+    if (!solve6(m, r, sol)) return false;
+    const double A = sol[0], B = sol[1], C = sol[2], D = sol[3], E = sol[4];
+    const double g2 = 1 + D * D + E * E;
+    if (flat) flat[0] = A + C, flat[1] = 4 * A * C - B * B;
+    *Hout = ((1 + E * E) * A - D * E * B + (1 + D * D) * C) / std::pow(g2, 1.5);
+    *Kout = (4 * A * C - B * B) / (g2 * g2);
+    return std::isfinite(*Hout) && std::isfinite(*Kout);
+}
+
+double signed_dihedral(const Hierarchy& h, NodeId n) {
+    double twice_area = 0;
+    const Vec3 own = unit_normal_of(h, n, &twice_area);
+    if (!(twice_area > 0)) return 0;
+    double sum = 0;
+    for (int e = 0; e < 3; ++e) {
+        const Vec3 a = h.position(h.vertex(n, e)), b = h.position(h.vertex(n, (e + 1) % 3));
+        const NodeId q = h.neighbor(n, e);
+        if (q == kNoNode) continue;
+        const Vec3 far = h.position(h.vertex(q, (h.neighbor_edge(n, e) + 2) % 3));
+        const Vec3 c = own - unit_normal_of(h, q);
+        const double chord = std::sqrt(dot(c, c)), len = std::sqrt(dot(b - a, b - a));
+        sum += (dot(own, far - a) > 0 ? 1 : -1) * chord * len;
+    }
+    return std::fabs(sum) * longest_edge(h, n) / (2 * twice_area);
+}
+
 std::vector<Extra> extra_features(const std::string& path, const std::filesystem::path& cache, size_t count) {
-    const std::filesystem::path file = cache / (std::filesystem::path(path).stem().string() + ".x2");
+    const std::filesystem::path file = cache / (std::filesystem::path(path).stem().string() + ".x5");
     std::vector<Extra> out(count);
     if (std::ifstream in{file, std::ios::binary}) {
         in.read(reinterpret_cast<char*>(out.data()), std::streamsize(count * sizeof(Extra)));
@@ -104,6 +218,72 @@ std::vector<Extra> extra_features(const std::string& path, const std::filesystem
             ++x.nb_known;
         }
         if (x.nb_known) x.nb_disp = uint8_t(std::max(1, mixed_study::quarter_bin(largest)));
+        {
+            // Local threshold comparisons against coded same-level nodes decided before n.
+            const double own = mixed_study::raw_curvature(h, n), own_g = gauss_estimate(h, n);
+            double min_ref = -1, max_unref = -1, min_ref2 = -1, max_unref2 = -1, gmin_ref = -1, gmax_unref = -1;
+            auto take = [&](NodeId q, bool ring1) {
+                if (q == kNoNode || q == n || symbol_of[q] >= i) return;
+                const double c = mixed_study::raw_curvature(h, q), g = gauss_estimate(h, q);
+                if (!h.is_leaf(q)) {
+                    if (ring1) min_ref = min_ref < 0 ? c : std::min(min_ref, c), gmin_ref = gmin_ref < 0 ? g : std::min(gmin_ref, g);
+                    min_ref2 = min_ref2 < 0 ? c : std::min(min_ref2, c);
+                } else {
+                    if (ring1) max_unref = std::max(max_unref, c), gmax_unref = std::max(gmax_unref, g);
+                    max_unref2 = std::max(max_unref2, c);
+                }
+            };
+            for (int e = 0; e < 3; ++e) {
+                const NodeId q = h.neighbor(n, e);
+                if (q == kNoNode) continue;
+                take(q, true);
+                for (int f = 0; f < 3; ++f) take(h.neighbor(q, f), false);
+            }
+            x.thr_ref = ratio_bin(own, min_ref), x.thr_unref = ratio_bin(own, max_unref);
+            x.thr_ref2 = ratio_bin(own, min_ref2), x.thr_unref2 = ratio_bin(own, max_unref2);
+            x.g_ref = ratio_bin(own_g, gmin_ref), x.g_unref = ratio_bin(own_g, gmax_unref);
+            const NodeId par = h.parent(n);
+            if (par != kNoNode) {
+                double pmin = -1, pmax = -1;
+                for (int e = 0; e < 3; ++e) {
+                    const NodeId q = h.neighbor(par, e);
+                    if (q == kNoNode || symbol_of[q] == SIZE_MAX) continue;
+                    const double c = mixed_study::raw_curvature(h, q);
+                    if (!h.is_leaf(q)) pmin = pmin < 0 ? c : std::min(pmin, c);
+                    else pmax = std::max(pmax, c);
+                }
+                x.thr_pref = ratio_bin(own, pmin), x.thr_punref = ratio_bin(own, pmax);
+            }
+        }
+        {
+            double H = 0, K = 0, flat[2] = {0, 0};
+            if (quadric_curvatures(h, n, &H, &K, flat)) {
+                x.flat_h = uint8_t(mixed_study::quarter_bin(std::fabs(flat[0]) * longest_edge(h, n)));
+                x.flat_k = uint8_t(mixed_study::quarter_bin(std::sqrt(std::fabs(flat[1])) * longest_edge(h, n)));
+                const double L = longest_edge(h, n);
+                x.quad_h = uint8_t(mixed_study::quarter_bin(std::fabs(H) * L));
+                x.quad_k = uint8_t(mixed_study::quarter_bin(std::sqrt(std::fabs(K)) * L));
+                x.quad_max = uint8_t(mixed_study::quarter_bin((std::fabs(H) + std::sqrt(std::max(H * H - K, 0.0))) * L));
+            }
+            x.sdh = uint8_t(mixed_study::quarter_bin(signed_dihedral(h, n)));
+            double min_ref = -1, max_unref = -1;
+            const double own = std::fabs(H) * longest_edge(h, n);
+            auto take = [&](NodeId q) {
+                if (q == kNoNode || q == n || symbol_of[q] >= i) return;
+                double qh = 0, qk = 0;
+                quadric_curvatures(h, q, &qh, &qk);
+                const double c = std::fabs(qh) * longest_edge(h, q);
+                if (!h.is_leaf(q)) min_ref = min_ref < 0 ? c : std::min(min_ref, c);
+                else max_unref = std::max(max_unref, c);
+            };
+            for (int e = 0; e < 3; ++e) {
+                const NodeId q = h.neighbor(n, e);
+                if (q == kNoNode) continue;
+                take(q);
+                for (int f = 0; f < 3; ++f) take(h.neighbor(q, f));
+            }
+            x.qthr_ref2 = ratio_bin(own, min_ref), x.qthr_unref2 = ratio_bin(own, max_unref);
+        }
         const NodeId p = h.parent(n);
         if (p != kNoNode) {
             x.parent_curv = uint8_t(mixed_study::quarter_bin(mixed_study::raw_curvature(h, p)));
@@ -163,6 +343,9 @@ struct Options {
     bool prior_maps = true;  // also the history maps (else the direct and extra models only)
     bool prior_geometric_only = false;  // only the tables whose context holds a geometric feature
     const Counts* priors = nullptr;
+    uint64_t drop = 0;  // inputs (bit j: mixer input j) held at 0, as if removed
+    int mixers_off = 0;  // bit 0..3: mixer A..D left out of the mean
+    int maps_off = 0;    // bit m: probability map m left out of the mean
 };
 
 // Ones and symbols per slot of every model table of a Study (direct, extra, history maps).
@@ -325,6 +508,8 @@ private:
             extra_slot_[e] = o_.extra[e](f, x) & 0xffff;
             st_[size_t(kFixedInputs) + e] = mixing::stretch(mixing::p12_of(extra_models_[e][extra_slot_[e]]));
         }
+        for (int j = 0; j < inputs_ - 1; ++j)
+            if (o_.drop >> j & 1) st_[size_t(j)] = 0;
         st_[size_t(inputs_ - 1)] = 256;
         const int set_b = o_.extra_set_b == 1 ? x.parent_curv / 4 : o_.extra_set_b == 2 ? x.base_size / 4 : f.ring_mean / 4, set_c = int(g * 16 + last4);
         if (o_.inherit_sets) {
@@ -337,14 +522,25 @@ private:
         int p_mix = mixing::squash((s1 + s2 + s3) / 3);
         if (o_.mixer_d) {
             const int set = o_.mixer_d == 6 ? int(g) * 16 + f.size / 4 : o_.mixer_d == 4 ? x.base_size / 2 * 8 + f.level : o_.mixer_d == 5 ? int(g) * 16 + x.base_size / 4 : (o_.mixer_d == 1 ? x.base_size : o_.mixer_d == 2 ? f.mean_curv : x.gauss) / 4 * 8 + f.level;
-            p_mix = mixing::squash((s1 + s2 + s3 + mixing::stretch(d_.mix(st_.data(), set))) / 4);
+            const int s4 = mixing::stretch(d_.mix(st_.data(), set));
+            p_mix = mixing::squash((s1 + s2 + s3 + s4) / 4);
+            if (o_.mixers_off) {
+                const int all[4] = {s1, s2, s3, s4};
+                int sum = 0, n = 0;
+                for (int k = 0; k < 4; ++k)
+                    if (!(o_.mixers_off >> k & 1)) sum += all[k], ++n;
+                p_mix = mixing::squash(sum / n);
+            }
         }
         const int rows[6] = {int(g * 4 + f.inner), int(g * 64 + f.mean_curv), int(f.disp * 8 + f.level), int(g * 256 + (last_ & 255)),
                              int((g * 5 + f.ring2) * 4 + f.parent_nbrs), int(g * 8 + f.level)};
         const int maps = o_.level_map == 1 ? 6 : 5;
-        int refined = 0;
-        for (int m = 0; m < maps; ++m) refined += maps_[size_t(m)].refine(p_mix, rows[m]);
-        int p = std::clamp((p_mix * (4 - o_.map_share) + (refined / maps) * o_.map_share + 2) >> 2, 1, 4095);
+        int refined = 0, active = 0;
+        for (int m = 0; m < maps; ++m) {
+            const int r = maps_[size_t(m)].refine(p_mix, rows[m]);
+            if (!(o_.maps_off >> m & 1)) refined += r, ++active;
+        }
+        int p = std::clamp((p_mix * (4 - o_.map_share) + (refined / active) * o_.map_share + 2) >> 2, 1, 4095);
         used_maps_ = maps;
         if (o_.level_map == 2) {
             p = std::clamp((p + maps_[5].refine(p, rows[5]) + 1) >> 1, 1, 4095);
@@ -577,6 +773,140 @@ int main(int argc, char** argv) {
         o.extra.push_back([](F f, X x) { return f.group * 33u + x.law; });
         o.extra.push_back([](F f, X x) { return x.law * 8u + f.level; });
     });
+    // Session of 2026-12-04 evening: local threshold comparisons and quadric curvatures.
+    auto third_plus = [&](const std::string& name, std::vector<std::function<uint32_t(F, X)>> contexts) {
+        add("T: third + " + name, [&, contexts](Options& o) {
+            third(o);
+            for (const auto& c : contexts) o.extra.push_back(c);
+        });
+    };
+    third_plus("ref x unref x group", {[](F f, X x) { return (f.group * 32u + x.thr_ref) * 32 + x.thr_unref; }});
+    third_plus("ref x unref x level", {[](F f, X x) { return (f.level * 32u + x.thr_ref) * 32 + x.thr_unref; }});
+    third_plus("ref x group, unref x group", {[](F f, X x) { return f.group * 32u + x.thr_ref; }, [](F f, X x) { return f.group * 32u + x.thr_unref; }});
+    third_plus("ref2 x unref2 x group", {[](F f, X x) { return (f.group * 32u + x.thr_ref2) * 32 + x.thr_unref2; }});
+    third_plus("pref x punref x level", {[](F f, X x) { return (f.level * 32u + x.thr_pref) * 32 + x.thr_punref; }});
+    third_plus("gref x gunref x group", {[](F f, X x) { return (f.group * 32u + x.g_ref) * 32 + x.g_unref; }});
+    third_plus("ref x unref x group, ref2 x unref2 x level, pref x punref x level", {
+        [](F f, X x) { return (f.group * 32u + x.thr_ref) * 32 + x.thr_unref; },
+        [](F f, X x) { return (f.level * 32u + x.thr_ref2) * 32 + x.thr_unref2; },
+        [](F f, X x) { return (f.level * 32u + x.thr_pref) * 32 + x.thr_punref; }});
+    third_plus("quad H x level", {[](F f, X x) { return (f.group * 64u + x.quad_h) * 8 + f.level; }});
+    third_plus("quad K x level", {[](F f, X x) { return (f.group * 64u + x.quad_k) * 8 + f.level; }});
+    third_plus("quad max x level", {[](F f, X x) { return (f.group * 64u + x.quad_max) * 8 + f.level; }});
+    third_plus("quad H x size, quad K x size", {[](F f, X x) { return (x.quad_h * 32u + f.size / 2u) * 8 + f.level; },
+                                              [](F f, X x) { return (x.quad_k * 32u + f.size / 2u) * 8 + f.level; }});
+    third_plus("sdh x level", {[](F f, X x) { return (f.group * 64u + x.sdh) * 8 + f.level; }});
+    third_plus("sdh x size", {[](F f, X x) { return (x.sdh * 32u + f.size / 2u) * 8 + f.level; }});
+    third_plus("qthr ref2 x unref2 x group", {[](F f, X x) { return (f.group * 32u + x.qthr_ref2) * 32 + x.qthr_unref2; }});
+    third_plus("quad H x level, quad H x size, quad K x size", {[](F f, X x) { return (f.group * 64u + x.quad_h) * 8 + f.level; },
+        [](F f, X x) { return (x.quad_h * 32u + f.size / 2u) * 8 + f.level; },
+        [](F f, X x) { return (x.quad_k * 32u + f.size / 2u) * 8 + f.level; }});
+    third_plus("quad H x size, quad K x size, qthr ref2 x unref2 x group", {
+        [](F f, X x) { return (x.quad_h * 32u + f.size / 2u) * 8 + f.level; },
+        [](F f, X x) { return (x.quad_k * 32u + f.size / 2u) * 8 + f.level; },
+        [](F f, X x) { return (f.group * 32u + x.qthr_ref2) * 32 + x.qthr_unref2; }});
+    third_plus("quad H x size, quad K x size, ref2 x unref2 x group", {
+        [](F f, X x) { return (x.quad_h * 32u + f.size / 2u) * 8 + f.level; },
+        [](F f, X x) { return (x.quad_k * 32u + f.size / 2u) * 8 + f.level; },
+        [](F f, X x) { return (f.group * 32u + x.thr_ref2) * 32 + x.thr_unref2; }});
+    third_plus("sdh x size, quad K x size", {[](F f, X x) { return (x.sdh * 32u + f.size / 2u) * 8 + f.level; },
+        [](F f, X x) { return (x.quad_k * 32u + f.size / 2u) * 8 + f.level; }});
+    auto quad2 = [&](Options& o) {
+        third(o);
+        o.extra.push_back([](F f, X x) { return (x.quad_h * 32u + f.size / 2u) * 8 + f.level; });
+        o.extra.push_back([](F f, X x) { return (x.quad_k * 32u + f.size / 2u) * 8 + f.level; });
+    };
+    add("F: third + flat H x size, flat K x size", [&](Options& o) {
+        third(o);
+        o.extra.push_back([](F f, X x) { return (x.flat_h * 32u + f.size / 2u) * 8 + f.level; });
+        o.extra.push_back([](F f, X x) { return (x.flat_k * 32u + f.size / 2u) * 8 + f.level; });
+    });
+    add("F: third + flat H x size x level, flat K x size x level, flat H x group x level", [&](Options& o) {
+        third(o);
+        o.extra.push_back([](F f, X x) { return (x.flat_h * 32u + f.size / 2u) * 8 + f.level; });
+        o.extra.push_back([](F f, X x) { return (x.flat_k * 32u + f.size / 2u) * 8 + f.level; });
+        o.extra.push_back([](F f, X x) { return (f.group * 64u + x.flat_h) * 8 + f.level; });
+    });
+    add("F: third + flat H x size x level, flat K x size x level, flat H x flat K", [&](Options& o) {
+        third(o);
+        o.extra.push_back([](F f, X x) { return (x.flat_h * 32u + f.size / 2u) * 8 + f.level; });
+        o.extra.push_back([](F f, X x) { return (x.flat_k * 32u + f.size / 2u) * 8 + f.level; });
+        o.extra.push_back([](F f, X x) { return (f.group * 64u + x.flat_h) * 16 + x.flat_k / 4u; });
+    });
+    auto flat3 = [&](Options& o) {
+        third(o);
+        o.extra.push_back([](F f, X x) { return (x.flat_h * 32u + f.size / 2u) * 8 + f.level; });
+        o.extra.push_back([](F f, X x) { return (x.flat_k * 32u + f.size / 2u) * 8 + f.level; });
+        o.extra.push_back([](F f, X x) { return (f.group * 64u + x.flat_h) * 16 + x.flat_k / 4u; });
+    };
+    auto drops = [](std::initializer_list<int> list) {
+        uint64_t d = 0;
+        for (int j : list) d |= uint64_t{1} << j;
+        return d;
+    };
+    add("G: flat3 without 8 10 11 12 18", [&](Options& o) { flat3(o), o.drop = drops({8, 10, 11, 12, 18}); });
+    add("G: flat3 without 8 10 11 12", [&](Options& o) { flat3(o), o.drop = drops({8, 10, 11, 12}); });
+    add("G: flat3 without 1 6 8 10 11 12 18", [&](Options& o) { flat3(o), o.drop = drops({1, 6, 8, 10, 11, 12, 18}); });
+    add("G: flat3 without 8 11 12", [&](Options& o) { flat3(o), o.drop = drops({8, 11, 12}); });
+    add("G: flat3 + ref2 x unref2, without 8 10 11 12 18", [&](Options& o) {
+        flat3(o), o.drop = drops({8, 10, 11, 12, 18});
+        o.extra.push_back([](F f, X x) { return (f.group * 32u + x.thr_ref2) * 32 + x.thr_unref2; });
+    });
+    add("K: fourth model on the coder's features", [&](Options& o) {
+        third(o);
+        o.extra.push_back([](F f, X) { return (f.quad_mean * 32u + f.size / 2u) * 8 + f.level; });
+        o.extra.push_back([](F f, X) { return (f.quad_gauss * 32u + f.size / 2u) * 8 + f.level; });
+        o.extra.push_back([](F f, X) { return (f.group * 64u + f.quad_mean) * 16 + f.quad_gauss / 4u; });
+        o.drop = drops({1, 6, 8, 10, 11, 12, 18});
+    });
+    auto fourth = [&](Options& o) {
+        third(o);
+        o.extra.push_back([](F f, X) { return (f.quad_mean * 32u + f.size / 2u) * 8 + f.level; });
+        o.extra.push_back([](F f, X) { return (f.quad_gauss * 32u + f.size / 2u) * 8 + f.level; });
+        o.extra.push_back([](F f, X) { return (f.group * 64u + f.quad_mean) * 16 + f.quad_gauss / 4u; });
+        o.drop = drops({1, 6, 8, 10, 11, 12, 18});
+    };
+    auto m = [&](const std::string& name, int mixers_off, int maps_off, std::initializer_list<int> more) {
+        const uint64_t extra_drops = drops(more);
+        add("M: fourth" + name, [&, mixers_off, maps_off, extra_drops](Options& o) {
+            fourth(o), o.mixers_off = mixers_off, o.maps_off = maps_off, o.drop |= extra_drops;
+        });
+    };
+    m(", maps 1 2 off", 0, 6, {});
+    m(", maps 1 2 off, without 9", 0, 6, {9});
+    m(", maps 1 2 off, without 2 9 15 25", 0, 6, {2, 9, 15, 25});
+    m(", maps 1 2 off, without 5 9 15 20", 0, 6, {5, 9, 15, 20});
+    m(", maps 1 2 off, without 2 5 9 15", 0, 6, {2, 5, 9, 15});
+    m(", mixer A off, maps 1 2 off", 1, 6, {});
+    m(", mixer A off, maps 1 2 off, without 2 9 15 25", 1, 6, {2, 9, 15, 25});
+    m(", maps 0 1 2 off", 0, 7, {});
+    for (int j : {9, 15, 25, 20, 2, 5, 0, 3})
+        add("N: fourth, maps 0 1 2 off, without " + std::to_string(j), [&, j](Options& o) { fourth(o), o.maps_off = 7, o.drop |= uint64_t{1} << j; });
+    auto pdesign = [&](std::initializer_list<int> dropped) {
+        const uint64_t d = drops(dropped);
+        std::string name = "P4: fourth, maps 0 1 2 off, without";
+        for (int j : dropped) name += " " + std::to_string(j);
+        add(name, [&, d](Options& o) { fourth(o), o.maps_off = 7, o.drop = d; });
+    };
+    add("Q: fourth model as coded (version 16)", [&](Options& o) { fourth(o), o.maps_off = 7, o.drop = drops({1, 6, 8, 10, 11, 12, 18, 25}); });
+    pdesign({2, 8, 9, 10, 11, 12, 15, 18});
+    pdesign({2, 8, 10, 11, 12, 15, 18, 25});
+    pdesign({8, 9, 10, 11, 12, 15, 18, 20});
+    pdesign({2, 8, 9, 10, 11, 12, 18, 20});
+    pdesign({2, 6, 8, 10, 11, 12, 15, 18});
+    pdesign({1, 2, 8, 10, 11, 12, 15, 18});
+    pdesign({2, 6, 8, 9, 10, 11, 12, 18});
+    add("N: fourth, maps 0 1 2 4 off", [&](Options& o) { fourth(o), o.maps_off = 23; });
+    for (int j : {0, 2, 3, 4, 5, 7, 9, 13, 14, 15, 16, 17, 19, 20, 21, 22, 23, 24, 25, 26, 27, 28, 29, 30})
+        add("L: fourth without input " + std::to_string(j), [&, j](Options& o) { fourth(o), o.drop |= uint64_t{1} << j; });
+    for (int k = 0; k < 4; ++k) add("L: fourth without mixer " + std::to_string(k), [&, k](Options& o) { fourth(o), o.mixers_off = 1 << k; });
+    for (int k = 0; k < 5; ++k) add("L: fourth without map " + std::to_string(k), [&, k](Options& o) { fourth(o), o.maps_off = 1 << k; });
+    add("H: flat3 without 0 1 3 6 8 10 11 12 18", [&](Options& o) { flat3(o), o.drop = drops({0, 1, 3, 6, 8, 10, 11, 12, 18}); });
+    add("H: flat3 without 1 6 8 10 11 12 16 18", [&](Options& o) { flat3(o), o.drop = drops({1, 6, 8, 10, 11, 12, 16, 18}); });
+    add("H: flat3 without 1 2 6 8 10 11 12 18", [&](Options& o) { flat3(o), o.drop = drops({1, 2, 6, 8, 10, 11, 12, 18}); });
+    add("H: flat3 without 1 6 8 10 11 12 18 22", [&](Options& o) { flat3(o), o.drop = drops({1, 6, 8, 10, 11, 12, 18, 22}); });
+    add("H: flat3 without 1 6 8 10 11 12 18, mixer rate 12", [&](Options& o) { flat3(o), o.drop = drops({1, 6, 8, 10, 11, 12, 18}), o.mixer_rate = 12; });
+    for (int j = 0; j < 28; ++j) add("D: quad2 without input " + std::to_string(j), [&, j](Options& o) { quad2(o), o.drop = uint64_t{1} << j; });
     const char* only = std::getenv("ONLY");
 
     const double paper_total = mixed_study::print_design_table_head(data);
@@ -591,7 +921,7 @@ int main(int argc, char** argv) {
     };
     std::vector<double> library;
     for (const ModelData& d : data) library.push_back(d.library_bits);
-    row("the coder's mixing mode (third model, version 11)", library);
+    row("the coder's mixing mode (fourth model, version 16)", library);
     for (const Design& design : designs) {
         if (only && design.name.find(only) == std::string::npos && &design != &designs[0]) continue;
         std::vector<double> bits;

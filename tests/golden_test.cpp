@@ -156,10 +156,10 @@ std::vector<uint8_t> golden_file(const GoldenCase& c, int version, const std::ve
 }
 
 // The file of c in the version its bytes say (14: an adaptive level of a bit-exact file with its
-// raw bits in a side stream; 15: a level of a bit-exact file in geometry mode 6 or 7) equals the
-// encoder's bytes and decodes to c's hierarchy (every prefix of levels too); the cases pinned by
-// older versions' tests that encoders now write as one of those versions. A version-14 file of a
-// case written as version 15 now still decodes.
+// raw bits in a side stream; 15: a level of a bit-exact file in geometry mode 6 or 7; 16: the
+// mixing mode's fourth model) equals the encoder's bytes and decodes to c's hierarchy (every prefix
+// of levels too); the cases pinned by older versions' tests that encoders now write as one of those
+// versions. The files of versions 14 to the written one's of the case still decode.
 void pin_newer_encoding(const GoldenCase& c, const std::vector<uint8_t>& bytes) {
     const int written = bytes[4];
     SCOPED_TRACE(golden_path(written, c.name));
@@ -175,12 +175,12 @@ void pin_newer_encoding(const GoldenCase& c, const std::vector<uint8_t>& bytes) 
 }
 
 // c's golden file of `version`, which the encoder must reproduce byte for byte (empty when it is
-// missing). AMC_UPDATE_GOLDEN writes a missing file first; it never overwrites one. A bit-exact
-// case written as version 14 or 15 now (pin_newer_encoding) has its bytes pinned by its file of
-// that version, and `version`'s file is returned for the caller to decode.
+// missing). AMC_UPDATE_GOLDEN writes a missing file first; it never overwrites one. A case written
+// as a newer version of 14 on now (pin_newer_encoding) has its bytes pinned by its file of that
+// version, and `version`'s file is returned for the caller to decode.
 std::vector<uint8_t> pinned_encoding(const GoldenCase& c, int version, EncodeStats* stats = nullptr) {
     const std::vector<uint8_t> bytes = encode(c.hierarchy, c.options, stats);
-    if (version < kRawSideVersion && bytes.size() > 4 && bytes[4] >= kRawSideVersion) {
+    if (bytes.size() > 4 && bytes[4] > version && bytes[4] >= kRawSideVersion) {
         pin_newer_encoding(c, bytes);
         return read_golden(golden_path(version, c.name));
     }
@@ -428,6 +428,29 @@ TEST(Golden, ThirdMixingModelFilesDecodeAndPinTheEncoder) {
         ASSERT_FALSE(second.empty());
         EXPECT_NE(second, golden);
     }
+}
+
+// Version 16 (the mixing mode's fourth model, FORMAT.md 2.4): the encoder writes it unless the
+// third model codes the file smaller, so no case grows against the file the third model made
+// (its newest golden file of versions 11-15; the test above pins the bytes, in v16/ where 16).
+TEST(Golden, FourthMixingModelFilesAreNoLargerThanTheThirds) {
+    int fourth = 0;
+    for (const GoldenCase& c : later_mixing_cases()) {
+        SCOPED_TRACE(c.name);
+        const std::vector<uint8_t> bytes = encode(c.hierarchy, c.options);
+        std::vector<uint8_t> third;
+        for (int version = kStencilTablesVersion; version >= kThirdMixingVersion && third.empty(); --version)
+            third = read_golden(golden_path(version, c.name));
+        ASSERT_FALSE(third.empty());
+        EXPECT_LE(bytes.size(), third.size());
+        if (bytes[4] == kFourthMixingVersion) {
+            fourth += bytes.size() < third.size();
+            check_decodes(bytes, c, kFourthMixingVersion);
+        } else {
+            EXPECT_EQ(bytes, third) << "the third model's file, as before";
+        }
+    }
+    EXPECT_GE(fourth, 1) << "the quadric's curvatures code some case smaller";
 }
 
 // Version 12 (level geometry mode 5, the normal frame of unit normals with three tables): the

@@ -5,6 +5,7 @@
 #include "coding/format_version.h"
 #include "coding/hierarchy/coder_switches.h"
 #include "coding/hierarchy/context_mixing.h"
+#include "coding/hierarchy/mixed_contexts.h"
 #include "hierarchy_checks.h"
 
 #include <amc/codec.h>
@@ -59,6 +60,46 @@ TEST(MixedContexts, SquashAndStretchAreMonotoneInverses) {
     EXPECT_EQ(mixing::stretch(2047), 0);
 }
 
+// The fourth model's quadric (FORMAT.md 2.4) on a bowl and a saddle of the same principal
+// curvatures' sizes: it tells them apart by the mean curvature, where the dihedral angles cannot.
+TEST(MixedContexts, QuadricCurvaturesTellABowlFromASaddle) {
+    for (double sign : {1.0, -1.0}) {
+        Hierarchy h(make_square(8));
+        refine_uniformly(h, 2);
+        for (VertexId v = 0; v < VertexId(h.vertex_count()); ++v) {
+            const Vec3 p = h.position(v);
+            const double x = p.x - 0.5, y = p.y - 0.5;
+            h.set_position(v, {p.x, p.y, 0.5 * (x * x + sign * y * y)});  // principal curvatures 1 and `sign`
+        }
+        int checked = 0;
+        for (NodeId n = 0; n < NodeId(h.node_count()); ++n) {
+            if (h.level(n) != 2) continue;
+            Vec3 c{0, 0, 0};
+            double longest = 0;
+            for (int e = 0; e < 3; ++e) {
+                const Vec3 a = h.position(h.vertex(n, e)), b = h.position(h.vertex(n, (e + 1) % 3));
+                c = c + (1.0 / 3.0) * a;
+                longest = std::max(longest, std::sqrt(dot(b - a, b - a)));
+            }
+            if (std::fabs(c.x - 0.5) > 0.1 || std::fabs(c.y - 0.5) > 0.1) continue;
+            const std::array<double, 2> k = quadric_curvatures(h, n, longest);
+            // Bowl: |H| = 1, sqrt|K| = 1; saddle: H = 0, sqrt|K| = 1 (times the longest edge).
+            EXPECT_NEAR(k[0] / longest, sign > 0 ? 1.0 : 0.0, 0.05) << n;
+            EXPECT_NEAR(k[1] / longest, 1.0, 0.05) << n;
+            ++checked;
+        }
+        EXPECT_GE(checked, 8);
+        // A flat square's nodes have none; a node on the boundary (a missing neighbour) none either.
+        Hierarchy flat(make_square(4));
+        refine_uniformly(flat, 1);
+        for (NodeId n = 0; n < NodeId(flat.node_count()); ++n) {
+            const std::array<double, 2> k = quadric_curvatures(flat, n, 1.0);
+            EXPECT_EQ(k[0], 0.0);
+            EXPECT_EQ(k[1], 0.0);
+        }
+    }
+}
+
 TEST(MixedContexts, RandomHierarchiesRoundTripBitExactlyUnderEverySwitch) {
     Random random{77};
     const auto meshes = testing::fixture_meshes();
@@ -90,8 +131,11 @@ TEST(MixedContexts, RandomHierarchiesRoundTripBitExactlyUnderEverySwitch) {
         }
         options.predictor = GeometryPredictor(random.next() % 4);
         const std::vector<uint8_t> bytes = encode(h, options);
-        // Version 14 where a bit-exact level is adaptive (its raw bits in a side stream).
-        ASSERT_TRUE(bytes[4] == kThirdMixingVersion || (options.quantize_bits == 0 && bytes[4] == kRawSideVersion)) << trial;
+        // The fourth model's version, or the third's where it codes smaller (14 where a bit-exact
+        // level is adaptive, its raw bits in a side stream).
+        ASSERT_TRUE(bytes[4] == kFourthMixingVersion || bytes[4] == kThirdMixingVersion ||
+                    (options.quantize_bits == 0 && bytes[4] == kRawSideVersion))
+            << trial;
         const Hierarchy back = decode(bytes.data(), bytes.size());
         Hierarchy expected = in_decoder_order(h, options);
         if (options.quantize_bits != 0) {

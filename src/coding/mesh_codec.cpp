@@ -118,8 +118,11 @@ double snap_positions(const Hierarchy& h, const Quantizer& quantizer, unsigned t
 }
 
 // The lowest version that holds what the file holds (format_version.h).
-uint8_t file_version(bool stencil_tables, bool raw_side, bool unit_geometry, bool grid_geometry, bool mixed_contexts, bool chunked, bool static_geometry,
-                     BaseConnectivityMode base_mode, bool store_numbering) {
+// `fourth_model`: the mixing mode's fourth model, only in version 16 (never chunked; it holds every
+// geometry mode); the third is in versions 11-15.
+uint8_t file_version(bool stencil_tables, bool raw_side, bool unit_geometry, bool grid_geometry, bool mixed_contexts, bool fourth_model,
+                     bool chunked, bool static_geometry, BaseConnectivityMode base_mode, bool store_numbering) {
+    if (mixed_contexts && fourth_model) return kFourthMixingVersion;
     if (const uint8_t newest = newest_features_version(stencil_tables, raw_side, chunked)) return newest;
     return unit_geometry                                 ? kUnitFrameVersion
            : mixed_contexts                              ? kThirdMixingVersion
@@ -166,6 +169,7 @@ struct ForestCode {
     std::vector<std::pair<BlockType, std::vector<uint8_t>>> blocks;
     uint64_t bytes = 0;  // of the blocks, framing included
     bool chunked = false, static_geometry = false, grid_geometry = false, unit_geometry = false, raw_side = false, stencil_tables = false;
+    bool fourth_model = false;               // the mixing mode's hierarchy in its fourth model (else the third)
     uint64_t faces = 0, levels = 0;          // the metadata's
     std::vector<uint8_t> hierarchy_header;  // the metadata's (none with chunks)
     EncodeStats stats;  // header (the chunk table), hierarchy, geometry and framing bytes, levels, hierarchy
@@ -178,7 +182,8 @@ struct ForestCode {
 // the base geometry left them. The mixing mode (FORMAT.md 2.1) codes the forest as one stream.
 ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<RootRange>& chunks, uint64_t faces,
                        const EncodeOptions& options, CoordinateSpace space, PositionCoder positions, unsigned threads,
-                       bool want_hierarchy_stats, HierarchyLevelEncoder* first_pass, const HierarchyOnGrid* on_grid) {
+                       bool want_hierarchy_stats, HierarchyLevelEncoder* first_pass, const HierarchyOnGrid* on_grid,
+                       MixingModel mixing = kWrittenMixingModel) {
     ForestCode out;
     const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
     out.chunked = !mixed && chunks.size() > 1;
@@ -197,6 +202,8 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
         if (first_pass == nullptr)
             own = std::make_unique<HierarchyLevelEncoder>(h, options.hierarchy, kHierarchyStreamVersion, nullptr, mixed);
         HierarchyLevelEncoder& hierarchy = first_pass != nullptr ? *first_pass : *own;
+        hierarchy.set_mixing_model(mixing);
+        out.fourth_model = mixed && mixing == MixingModel::fourth;
         out.faces = hierarchy.faces();
         out.levels = uint64_t(hierarchy.level_count());
         out.hierarchy_header = hierarchy.header();
@@ -326,6 +333,13 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     if (fewer < chunks.size())
         forest = code_forest(h, root_of, balanced_chunks(root_nodes, fewer), faces, options, space, positions, threads,
                              want_hierarchy_stats, nullptr, nullptr);
+    if (mixed) {
+        // The mixing mode's third model where it codes the file smaller (a few creased or flat
+        // models, by a few bytes): every file at most as large as the third model's.
+        ForestCode third = code_forest(h, root_of, chunks, faces, options, space, positions, threads, want_hierarchy_stats, nullptr,
+                                       nullptr, MixingModel::third);
+        if (third.bytes < forest.bytes) forest = std::move(third);
+    }
 
     Metadata meta;
     meta.base_vertices = h.base().positions.size();
@@ -357,7 +371,8 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
         stats.numbering_bytes = blocks.back().second.size();
         stats.framing_bytes += kBlockOverhead;
     }
-    BlockWriter writer(file_version(forest.stencil_tables, forest.raw_side, forest.unit_geometry, forest.grid_geometry, mixed, forest.chunked, forest.static_geometry,
+    BlockWriter writer(file_version(forest.stencil_tables, forest.raw_side, forest.unit_geometry, forest.grid_geometry, mixed, forest.fourth_model,
+                                    forest.chunked, forest.static_geometry,
                                     base_code.mode, store_numbering),
                        uint8_t((precision == Precision::float32 ? kFlagSinglePrecision : 0) | (quantized ? kFlagQuantized : 0)));
     for (const auto& block : blocks) writer.add(block.first, block.second);
@@ -492,7 +507,8 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
                                     hierarchy_stream_version_of_file(reader.version()),
                                     std::min<uint64_t>(meta.nodes, options.max_nodes));
     if (meta.options & kOptionMixedContexts)
-        hierarchy.use_mixed_contexts(reader.version() >= kThirdMixingVersion    ? MixingModel::third
+        hierarchy.use_mixed_contexts(reader.version() >= kFourthMixingVersion   ? MixingModel::fourth
+                                     : reader.version() >= kThirdMixingVersion  ? MixingModel::third
                                      : reader.version() >= kSecondMixingVersion ? MixingModel::second
                                                                                 : MixingModel::first);
     Hierarchy& h = hierarchy.hierarchy();

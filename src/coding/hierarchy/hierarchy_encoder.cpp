@@ -187,7 +187,7 @@ void HierarchyLevelEncoder::encode_level(int l, ArithmeticEncoder& encoder) {
     ++next_level_;
     const size_t begin = l == 0 ? 0 : level_end_[size_t(l) - 1];
     if (mixed_) {
-        if (mixed_model_ == nullptr) mixed_model_ = std::make_unique<MixedHierarchyModel>(kWrittenMixingModel);
+        if (mixed_model_ == nullptr) mixed_model_ = std::make_unique<MixedHierarchyModel>(mixing_model_);
         for_each_mixed(begin, level_end_[size_t(l)], models_, *mixed_model_, symbols_written_,
                        [&](BitModel* model, uint32_t p16, Event e) {
                            if (model != nullptr) encoder.encode_with_limit<kHierarchyModelLimit>(e.bit, *model);
@@ -231,7 +231,7 @@ HierarchyCodeStats HierarchyLevelEncoder::stats() const {
         group.coded_bits += bits;
     };
     if (mixed_) {
-        MixedHierarchyModel mixed(kWrittenMixingModel);
+        MixedHierarchyModel mixed(mixing_model_);
         for_each_mixed(0, end, models, mixed, symbols, [&](BitModel* model, uint32_t p16, Event e) {
             if (model != nullptr) {
                 tally(model->cost_bits(e.bit), e);

@@ -30,8 +30,9 @@ struct CodedSymbol {
     bool refined;
 };
 
-// The mixing mode's model that encoders write (.amc version 11).
-constexpr MixingModel kWrittenMixingModel = MixingModel::third;
+// The mixing mode's newest model (.amc version 16): its features hold every older model's, so an
+// encoder computes them once and may code with the third model too (the smaller file is written).
+constexpr MixingModel kWrittenMixingModel = MixingModel::fourth;
 
 // A hierarchy read in another base order without copying it (reorder_base's result, as a view):
 // root t of the coded forest is h's root old_root[t] with its local indices turned by turn[t] (its
@@ -59,6 +60,10 @@ public:
                           uint8_t stream_version = kHierarchyStreamVersion, std::vector<CodedSymbol>* trace = nullptr,
                           bool mixed = false, const TurnedRoots* turned = nullptr);
     bool mixed() const { return mixed_; }
+    // The mixing mode's model encode_level and stats use (kWrittenMixingModel unless set before
+    // the first level; the third or the fourth).
+    void set_mixing_model(MixingModel model) { mixing_model_ = model; }
+    MixingModel mixing_model() const { return mixing_model_; }
     const std::vector<uint8_t>& header() const { return header_; }
     int level_count() const { return int(level_ids_.size()); }
     // Nodes of level l (ids in the encoded hierarchy) in canonical order.
@@ -132,6 +137,7 @@ private:
     uint64_t kept_symbols_ = 0, symbols_written_ = 0;
     int next_level_ = 0;
     bool mixed_ = false;
+    MixingModel mixing_model_ = kWrittenMixingModel;
     std::vector<MixedFeatures> mixed_features_;  // mixing mode: per hierarchy symbol event
     std::vector<uint32_t> event_feature_;        // mixing mode: event index -> mixed_features_ index
     std::unique_ptr<MixedHierarchyModel> mixed_model_;  // the mixing mode's state, or null

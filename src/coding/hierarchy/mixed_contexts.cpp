@@ -67,6 +67,47 @@ double relative_displacement2(const Hierarchy& h, NodeId p, int e) {
 
 }  // namespace
 
+// The remesher ranks by the input's |mean| or root |Gauss| curvature times size, which this signed
+// fit estimates where the dihedral angles (curv) cannot tell a saddle from a bump.
+std::array<double, 2> quadric_curvatures(const Hierarchy& h, NodeId n, double longest) {
+    const Vec3 v0 = h.position(h.vertex(n, 0));
+    const Vec3 e1 = h.position(h.vertex(n, 1)) - v0, e2 = h.position(h.vertex(n, 2)) - v0;
+    const Vec3 x = exact_cross(e1, e2);
+    const double a2 = exact_dot(x, x);
+    if (!(a2 > 0)) return {0, 0};
+    // The gradients of b_1 and b_2 in n's plane (b_0's is minus their sum) and the unit normal.
+    const Vec3 c1 = exact_cross(e2, x), c2 = exact_cross(x, e1);
+    const Vec3 g1{c1.x / a2, c1.y / a2, c1.z / a2}, g2{c2.x / a2, c2.y / a2, c2.z / a2};
+    const double area = std::sqrt(a2);
+    const Vec3 unit{x.x / area, x.y / area, x.z / area};
+    double m[3][3], t[3];
+    for (int e = 0; e < 3; ++e) {
+        const NodeId q = h.neighbor(n, e);
+        if (q == kNoNode) return {0, 0};
+        const Vec3 r = h.position(h.vertex(q, (h.neighbor_edge(n, e) + 2) % 3)) - v0;
+        const double b1 = exact_dot(r, g1), b2 = exact_dot(r, g2);
+        const double b0 = (1 - b1) - b2;
+        m[e][0] = rounded(b0 * b1), m[e][1] = rounded(b1 * b2), m[e][2] = rounded(b2 * b0);
+        t[e] = exact_dot(r, unit);
+    }
+    // a = m^-1 t by the cofactors c[i][j] of m.
+    auto minor = [&m](int i0, int j0, int i1, int j1) { return rounded(m[i0][j0] * m[i1][j1]) - rounded(m[i0][j1] * m[i1][j0]); };
+    const double c[3][3] = {{minor(1, 1, 2, 2), -minor(1, 0, 2, 2), minor(1, 0, 2, 1)},
+                            {-minor(0, 1, 2, 2), minor(0, 0, 2, 2), -minor(0, 0, 2, 1)},
+                            {minor(0, 1, 1, 2), -minor(0, 0, 1, 2), minor(0, 0, 1, 1)}};
+    const double det = (rounded(m[0][0] * c[0][0]) + rounded(m[0][1] * c[0][1])) + rounded(m[0][2] * c[0][2]);
+    if (!(det != 0) || !std::isfinite(det)) return {0, 0};
+    double a[3];
+    for (int k = 0; k < 3; ++k) a[k] = ((rounded(c[0][k] * t[0]) + rounded(c[1][k] * t[1])) + rounded(c[2][k] * t[2])) / det;
+    // The Hessian: P g1 g1' + Q (g1 g2' + g2 g1') + R g2 g2'. Mean curvature: half its trace;
+    // Gauss: its determinant in the plane, (P R - Q^2) times |g1 x g2|^2 = 1 / a2.
+    const double p = -2 * a[0], r = -2 * a[2], qq = (a[1] - a[0]) - a[2];
+    const double cross_term = rounded(qq * exact_dot(g1, g2));  // added twice, not doubled: no product meets a sum
+    const double mean = ((rounded(p * exact_dot(g1, g1)) + (cross_term + cross_term)) + rounded(r * exact_dot(g2, g2))) * 0.5;
+    const double gauss = (rounded(p * r) - rounded(qq * qq)) / a2;
+    return {rounded(std::fabs(mean) * longest), rounded(std::sqrt(std::fabs(gauss)) * longest)};
+}
+
 void LevelShapes::start_level(size_t nodes) {
     if (++current_ == 0) {  // wrapped: no stamp may look current
         std::fill(stamp_.begin(), stamp_.end(), 0u);
@@ -217,10 +258,15 @@ MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, u
         f.ring_max = uint8_t(quarter_octave_bin(largest, 40, 63));
         f.ring_mean = uint8_t(quarter_octave_bin(sum / count, 40, 63));
     }
-    if (model == MixingModel::third) {
+    if (model == MixingModel::third || model == MixingModel::fourth) {
         const double unit = shapes.base_edge(h);
         f.size = uint8_t(unit > 0 ? quarter_octave_bin(std::ldexp(bending.longest, l) / unit, 28, 63) : 0);
         f.gauss = uint8_t(quarter_octave_bin(bending.gauss, 46, 63));
+    }
+    if (model == MixingModel::fourth) {
+        const std::array<double, 2> quadric = quadric_curvatures(h, n, bending.longest);
+        f.quad_mean = uint8_t(quarter_octave_bin(quadric[0], 40, 63));
+        f.quad_gauss = uint8_t(quarter_octave_bin(quadric[1], 40, 63));
     }
     return f;
 }
@@ -252,6 +298,19 @@ constexpr int32_t kThirdStartWeights[4][MixedHierarchyModel::kThirdInputs + 1] =
      4001, -2448, 2742, 2901, 5320, 4654, -4493, -2988, -3507, 8433, 2874, 5502, 9095, 1997},
     {-2915, 1231, -1166, -3132, 7789, 3497, 3891, 7928, 2948, 5379, 2671, 1048, 2382, 10671, 8498,
      3163, 3379, 6474, 3899, 4952, 4732, -3768, -988, -3442, 1813, 724, 6746, 7379, 1957}};
+// The fourth model's (FORMAT.md 2.4): the direct tables of 0-20 it keeps, in input order (the
+// others gain nothing beside the quadric's curvatures: docs/HIERARCHY_CODER.md, "The fourth
+// model"), direct tables 25-27 and the mixers' start weights, one row a mixer (the weights the
+// corpus's models end with, averaged: bench/model_study).
+constexpr int kFourthKeptTables[MixedHierarchyModel::kFourthKept] = {0, 2, 3, 4, 5, 7, 9, 13, 14, 15, 16, 17, 19, 20};
+constexpr int kFourthLaterTables[MixedHierarchyModel::kFourthLater] = {21, 23, 24, 25, 26, 27};
+constexpr int kFourthMaps[2] = {3, 4};  // of the second model's five
+constexpr uint32_t kFourthContextSizes[MixedHierarchyModel::kQuadricInputs] = {16384, 16384, 10240};
+constexpr int32_t kFourthStartWeights[4][MixedHierarchyModel::kFourthInputs + 1] = {
+    {-6926, -3141, -7757, 9242, 5837, 11814, 4996, 14338, 10374, 4572, 4383, 9511, 5815, 4373, -8133, -4389, -6420, 10966, 3231, 7736, 8317, 3532, 6809, 1848},
+    {-6996, -2620, -6687, 8506, 4386, 7175, 1322, 12247, 11007, 3546, 5409, 10621, 1060, 957, 1017, 6127, -1110, 9007, 2092, 3740, 5936, 1195, 5596, 6413},
+    {-1301, 379, -1544, 7386, 4548, 8698, 5308, 10606, 7666, 4286, -1927, 3141, 6197, 5582, -3374, -1802, -2329, 7563, 4216, 7532, 7133, 3719, 6823, 2024},
+    {-2549, -912, -2838, 7924, 3527, 9199, 5298, 10744, 8715, 3049, 4343, 7336, 5730, 5487, -2727, 117, -2427, 1501, 4550, 6302, 6986, 2464, 6740, 2100}};
 constexpr int kMapContexts[MixedHierarchyModel::kMaps] = {kContextGroupCount * 4, kContextGroupCount * 64, 24 * 8,
                                                           kContextGroupCount * 256, kContextGroupCount * 5 * 4};
 
@@ -268,6 +327,8 @@ namespace {
 // A mixer of `model` with `sets` weight sets: the third model's start at row `row` of its trained
 // weights, the others' at 1/n each.
 mixing::Mixer model_mixer(MixingModel model, int sets, int row) {
+    if (model == MixingModel::fourth)
+        return mixing::Mixer(MixedHierarchyModel::kFourthInputs + 1, sets, kThirdMixerRate, kFourthStartWeights[row]);
     if (model == MixingModel::third)
         return mixing::Mixer(MixedHierarchyModel::kThirdInputs + 1, sets, kThirdMixerRate, kThirdStartWeights[row]);
     return mixing::Mixer((model == MixingModel::first ? MixedHierarchyModel::kInputs : MixedHierarchyModel::kSecondInputs) + 1, sets,
@@ -281,18 +342,32 @@ MixedHierarchyModel::MixedHierarchyModel(MixingModel model)
       mixer_a_(model_mixer(model, kContextGroupCount, 0)),
       mixer_b_(model_mixer(model, 16, 1)),
       mixer_c_(model_mixer(model, model == MixingModel::first ? 24 : kContextGroupCount * 16, 2)),
-      mixer_d_(model_mixer(model, model == MixingModel::third ? kContextGroupCount * 16 : 1, 3)) {
-    for (int j = 0; j < kInputs; ++j) models_[size_t(j)].assign(kContextSizes[j], BitModel(kModelWindowLog2));
+      mixer_d_(model_mixer(model, model >= MixingModel::third ? kContextGroupCount * 16 : 1, 3)) {
+    const bool fourth = model == MixingModel::fourth;
+    if (fourth) {
+        for (int j : kFourthKeptTables)
+            models_[size_t(j)].assign(j < kInputs ? kContextSizes[j] : kSecondContextSizes[j - kInputs], BitModel(kModelWindowLog2));
+        for (int j : kFourthLaterTables)
+            models_[size_t(j)].assign(j < kThirdDirect ? kThirdContextSizes[j - kDirect] : kFourthContextSizes[j - kThirdDirect],
+                                      BitModel(kModelWindowLog2));
+    } else {
+        for (int j = 0; j < kInputs; ++j) models_[size_t(j)].assign(kContextSizes[j], BitModel(kModelWindowLog2));
+    }
     if (model == MixingModel::first) {
         maps_.emplace_back(kContextGroupCount * 4, kMapRate);
         return;
     }
-    for (int j = kInputs; j < kDirect; ++j) models_[size_t(j)].assign(kSecondContextSizes[j - kInputs], BitModel(kModelWindowLog2));
+    if (!fourth)
+        for (int j = kInputs; j < kDirect; ++j) models_[size_t(j)].assign(kSecondContextSizes[j - kInputs], BitModel(kModelWindowLog2));
     if (model == MixingModel::third)
         for (int j = kDirect; j < kThirdDirect; ++j) models_[size_t(j)].assign(kThirdContextSizes[j - kDirect], BitModel(kModelWindowLog2));
     for (int k = 0; k < kIndirectInputs; ++k) {
         histories_[size_t(k)].assign(kContextSizes[kIndirectOf[k]], uint8_t{1});
         history_maps_[size_t(k)].assign(size_t(kContextGroupCount) * 256, BitModel(kHistoryMapLog2));
+    }
+    if (fourth) {
+        for (int m : kFourthMaps) maps_.emplace_back(kMapContexts[m], kMapRate);
+        return;
     }
     for (int m = 0; m < kMaps; ++m) maps_.emplace_back(kMapContexts[m], kMapRate);
 }
@@ -321,6 +396,7 @@ uint32_t MixedHierarchyModel::p16(const MixedFeatures& f) {
     const uint32_t g = f.group;
     const std::array<uint32_t, kInputs> direct = direct_slots(f);
     std::copy_n(direct.begin(), kInputs, slot_.begin());
+    if (model_ == MixingModel::fourth) return uint32_t(fourth_model_p12(f)) << 4;
     for (int j = 0; j < kInputs; ++j) st_[size_t(j)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
     if (model_ != MixingModel::first) return uint32_t(later_model_p12(f)) << 4;
     st_[kInputs] = 256;  // bias
@@ -344,11 +420,7 @@ int MixedHierarchyModel::later_model_p12(const MixedFeatures& f) {
     slot_[kInputs + 3] = g * 64 + f.ring_max;
     slot_[kInputs + 4] = (g * 64 + f.ring_mean) * 8 + f.level;
     for (int j = kInputs; j < kDirect; ++j) st_[size_t(j)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
-    for (int k = 0; k < kIndirectInputs; ++k) {
-        history_context_[size_t(k)] = slot_[size_t(kIndirectOf[k])];
-        history_map_slot_[size_t(k)] = g * 256 + histories_[size_t(k)][history_context_[size_t(k)]];
-        st_[size_t(kDirect + k)] = mixing::stretch(mixing::p12_of(history_maps_[size_t(k)][history_map_slot_[size_t(k)]]));
-    }
+    history_inputs(g, kDirect);
     const bool third = model_ == MixingModel::third;
     if (third) {
         slot_[kDirect] = (g * 64 + f.size) * 8 + f.level;
@@ -374,14 +446,59 @@ int MixedHierarchyModel::later_model_p12(const MixedFeatures& f) {
     return std::clamp((p_mix_ + (refined / kMaps) * 3 + 2) >> 2, 1, 4095);
 }
 
+void MixedHierarchyModel::history_inputs(uint32_t g, int first) {
+    for (int k = 0; k < kIndirectInputs; ++k) {
+        history_context_[size_t(k)] = slot_[size_t(kIndirectOf[k])];
+        history_map_slot_[size_t(k)] = g * 256 + histories_[size_t(k)][history_context_[size_t(k)]];
+        st_[size_t(first + k)] = mixing::stretch(mixing::p12_of(history_maps_[size_t(k)][history_map_slot_[size_t(k)]]));
+    }
+}
+
+int MixedHierarchyModel::fourth_model_p12(const MixedFeatures& f) {
+    const uint32_t g = f.group;
+    const uint32_t last4 = last_bits_ & 15;
+    slot_[kInputs] = g * 16 + last4;
+    slot_[kInputs + 1] = (g * 4 + f.inner) * 16 + last4;
+    slot_[kInputs + 3] = g * 64 + f.ring_max;
+    slot_[kInputs + 4] = (g * 64 + f.ring_mean) * 8 + f.level;
+    slot_[kDirect] = (g * 64 + f.size) * 8 + f.level;
+    slot_[kDirect + 2] = f.gauss * 16u + f.mean_curv / 4u;
+    slot_[kDirect + 3] = (f.ring_mean * 32u + f.size / 2u) * 8 + f.level;
+    // Tables 25 and 26 without the group, as 23 and 24.
+    slot_[kThirdDirect] = (f.quad_mean * 32u + f.size / 2u) * 8 + f.level;
+    slot_[kThirdDirect + 1] = (f.quad_gauss * 32u + f.size / 2u) * 8 + f.level;
+    slot_[kThirdDirect + 2] = (g * 64 + f.quad_mean) * 16 + f.quad_gauss / 4u;
+    int input = 0;
+    for (int j : kFourthKeptTables) st_[size_t(input++)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
+    history_inputs(g, input);
+    input += kIndirectInputs;
+    for (int j : kFourthLaterTables) st_[size_t(input++)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
+    st_[size_t(input)] = 256;  // bias
+    const int s1 = mixing::stretch(mixer_a_.mix(st_.data(), int(g)));
+    const int s2 = mixing::stretch(mixer_b_.mix(st_.data(), f.ring_mean / 4));
+    const int s3 = mixing::stretch(mixer_c_.mix(st_.data(), int(g * 16 + last4)));
+    const int s4 = mixing::stretch(mixer_d_.mix(st_.data(), int(g * 16 + f.size / 4u)));
+    p_mix_ = mixing::squash((s1 + s2 + s3 + s4) / 4);
+    // The second model's maps 3 and 4 (the others gain nothing here).
+    const int stretched = mixing::stretch(p_mix_);
+    const int refined = maps_[0].refine_stretched(stretched, int(g * 256 + (last_bits_ & 255))) +
+                        maps_[1].refine_stretched(stretched, int((g * 5 + f.ring2) * 4 + f.parent_nbrs));
+    return std::clamp((p_mix_ + (refined / 2) * 3 + 2) >> 2, 1, 4095);
+}
+
 void MixedHierarchyModel::update(bool bit) {
     mixer_a_.update(st_.data(), bit);
     mixer_b_.update(st_.data(), bit);
     mixer_c_.update(st_.data(), bit);
-    if (model_ == MixingModel::third) mixer_d_.update(st_.data(), bit);
+    if (model_ >= MixingModel::third) mixer_d_.update(st_.data(), bit);
     for (mixing::ProbabilityMap& map : maps_) map.update(bit);
-    const int direct = model_ == MixingModel::first ? kInputs : model_ == MixingModel::second ? kDirect : kThirdDirect;
-    for (int j = 0; j < direct; ++j) models_[size_t(j)][slot_[size_t(j)]].update_with_limit(bit, kModelWindowLog2);
+    if (model_ == MixingModel::fourth) {
+        for (int j : kFourthKeptTables) models_[size_t(j)][slot_[size_t(j)]].update_with_limit(bit, kModelWindowLog2);
+        for (int j : kFourthLaterTables) models_[size_t(j)][slot_[size_t(j)]].update_with_limit(bit, kModelWindowLog2);
+    } else {
+        const int direct = model_ == MixingModel::first ? kInputs : model_ == MixingModel::second ? kDirect : kThirdDirect;
+        for (int j = 0; j < direct; ++j) models_[size_t(j)][slot_[size_t(j)]].update_with_limit(bit, kModelWindowLog2);
+    }
     if (model_ == MixingModel::first) return;
     for (int k = 0; k < kIndirectInputs; ++k) {
         history_maps_[size_t(k)][history_map_slot_[size_t(k)]].update_with_limit(bit, kHistoryMapLog2);

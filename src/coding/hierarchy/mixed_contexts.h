@@ -1,5 +1,5 @@
 // The hierarchy coder's mixing mode (.amc version 8, docs/FORMAT.md section 2.1; its second model,
-// version 10, section 2.2; its third, version 11, section 2.3): each coded symbol's probability comes from adaptive models under
+// version 10, section 2.2; its third, version 11, section 2.3; its fourth, version 16, section 2.4): each coded symbol's probability comes from adaptive models under
 // contexts richer than the paper's groups — the node's structure one level up, its decided
 // neighbours and their neighbours, and the decoded geometry around it — mixed by logistic mixing
 // (context_mixing.h) and refined by adaptive probability maps. Measured in
@@ -19,10 +19,11 @@
 namespace amc {
 
 // Which model of the mixing mode a stream is coded with: version 8's (FORMAT.md 2.1), version 10's
-// (2.2), which adds the last coded bits, bit histories and the curvature of the neighbours, or
+// (2.2), which adds the last coded bits, bit histories and the curvature of the neighbours,
 // version 11's (2.3), which adds the node's size and a Gauss curvature, a fourth mixer and mixers
-// that start from trained weights.
-enum class MixingModel : uint8_t { first = 1, second = 2, third = 3 };
+// that start from trained weights, or version 16's (2.4), which adds the curvatures of a quadric
+// through the node's corners and its neighbours' far corners and leaves out seven direct inputs.
+enum class MixingModel : uint8_t { first = 1, second = 2, third = 3, fourth = 4 };
 
 // What the decoder knows of a node when its symbol comes.
 struct MixedFeatures {
@@ -42,6 +43,8 @@ struct MixedFeatures {
     uint8_t ring_mean;    // second model: their mean, binned alike
     uint8_t size;         // third model: log bin of the longest edge times 2^level over the base's mean longest edge, 0..63
     uint8_t gauss;        // third model: log bin of the neighbours' normals' spread (a Gauss curvature) times the longest edge^2, 0..63
+    uint8_t quad_mean;    // fourth model: log bin of |mean curvature| times the longest edge of the quadric through the corners and the neighbours' far corners, 0..63
+    uint8_t quad_gauss;   // fourth model: the same of the root of its |Gauss curvature|, 0..63
 };
 
 // The unit normals and curvatures of one level's nodes by local index, each computed once: the
@@ -76,10 +79,17 @@ private:
     double base_edge_ = -1;
 };
 
+// The fourth model's quadric (FORMAT.md 2.4): the height over node n's plane that vanishes at n's
+// corners and passes through the corner of each same-level neighbour away from n; its |mean
+// curvature| and the root of its |Gauss curvature| at second order (the slope left out), each
+// times `longest`. {0, 0} without three neighbours or for a degenerate fit.
+std::array<double, 2> quadric_curvatures(const Hierarchy& h, NodeId n, double longest);
+
 // The features of node `n` of `h` (coarser levels whole, n's corners placed) that do not depend
 // on the traversal, and those that do from the level's state bytes: `i` is n's local index in
 // `level`, whose neighbours' states are as decided so far. `shapes` is started on `level`. The
-// ring features are computed for the second and third models, size and gauss for the third only.
+// ring features are computed for the second and later models, size and gauss for the third and
+// fourth, quad_mean and quad_gauss for the fourth.
 MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, uint32_t i, int group, LevelShapes& shapes,
                              MixingModel model);
 
@@ -97,6 +107,11 @@ public:
     static constexpr int kSizeInputs = 4;      // the third model's direct models of size and Gauss curvature
     static constexpr int kThirdDirect = kDirect + kSizeInputs;
     static constexpr int kThirdInputs = kSecondInputs + kSizeInputs;
+    static constexpr int kQuadricInputs = 3;   // the fourth model's direct models of the quadric's curvatures
+    static constexpr int kFourthDirect = kThirdDirect + kQuadricInputs;
+    static constexpr int kFourthKept = 14;     // the fourth model's direct models of tables 0-20
+    static constexpr int kFourthLater = 6;     // and of tables 21-27
+    static constexpr int kFourthInputs = kFourthKept + kIndirectInputs + kFourthLater;
     explicit MixedHierarchyModel(MixingModel model);
     MixingModel model() const { return model_; }
     // The 16-bit probability of a one for a symbol with these features (remembered for update).
@@ -108,12 +123,17 @@ public:
 private:
     // The second and third models' probability (FORMAT.md 2.2, 2.3), 12 bits.
     int later_model_p12(const MixedFeatures& f);
+    // The fourth model's (FORMAT.md 2.4), 12 bits.
+    int fourth_model_p12(const MixedFeatures& f);
+    // The bit histories' inputs into st_ from `first` on (second and later models).
+    void history_inputs(uint32_t group, int first);
 
     MixingModel model_;
-    std::array<std::vector<BitModel>, kThirdDirect> models_;
-    std::array<uint32_t, kThirdDirect> slot_{};
+    std::array<std::vector<BitModel>, kFourthDirect> models_;
+    std::array<uint32_t, kFourthDirect> slot_{};
     // Stretched inputs: the direct models 0-20, the bit histories, the third model's direct
-    // models 21-24, then the bias.
+    // models 21-24, then the bias (fourth model: the kept direct models of 0-20, the bit
+    // histories, direct models 21-27, the bias).
     std::array<int, mixing::Mixer::padded(kThirdInputs + 1)> st_{};
     // Second model: per context of direct models 1, 4 and 11 its last bits (up to 7, led by a 1),
     // and per such input an adaptive probability of each group x history.
