@@ -102,8 +102,9 @@ std::array<double, 2> quadric_curvatures(const Hierarchy& h, NodeId n, double lo
     // The Hessian: P g1 g1' + Q (g1 g2' + g2 g1') + R g2 g2'. Mean curvature: half its trace;
     // Gauss: its determinant in the plane, (P R - Q^2) times |g1 x g2|^2 = 1 / a2.
     const double p = -2 * a[0], r = -2 * a[2], qq = (a[1] - a[0]) - a[2];
-    const double cross_term = rounded(qq * exact_dot(g1, g2));  // added twice, not doubled: no product meets a sum
-    const double mean = ((rounded(p * exact_dot(g1, g1)) + (cross_term + cross_term)) + rounded(r * exact_dot(g2, g2))) * 0.5;
+    // Doubled apart from the sum: compilers turn x + x into 2 x, which would meet the sum as an FMA.
+    const double twice_cross_term = rounded(2 * rounded(qq * exact_dot(g1, g2)));
+    const double mean = ((rounded(p * exact_dot(g1, g1)) + twice_cross_term) + rounded(r * exact_dot(g2, g2))) * 0.5;
     const double gauss = (rounded(p * r) - rounded(qq * qq)) / a2;
     return {rounded(std::fabs(mean) * longest), rounded(std::sqrt(std::fabs(gauss)) * longest)};
 }
