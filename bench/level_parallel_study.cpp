@@ -134,6 +134,23 @@ struct Levels {
     std::vector<std::pair<int, bool>> roots;  // (group, bit)
 };
 
+// The true refinement bits of a level's n nodes (ids) and the next level's ids; whether all split.
+bool read_level(const Hierarchy& h, const std::vector<NodeId>& ids, uint32_t n, std::vector<uint8_t>& truth,
+                std::vector<NodeId>& next_ids) {
+    truth.assign(n, 0);
+    bool all_refined = true;
+    next_ids.clear();
+    for (uint32_t i = 0; i < n; ++i) {
+        truth[i] = !h.is_leaf(ids[i]);
+        all_refined &= truth[i] != 0;
+        if (truth[i]) {
+            const NodeId c = h.child(ids[i], 0);
+            next_ids.insert(next_ids.end(), {c, c + 1, c + 2, c + 3});
+        }
+    }
+    return all_refined;
+}
+
 Levels collect(const Hierarchy& h) {
     const HierarchyCoderOptions options;
     Levels out;
@@ -148,17 +165,8 @@ Levels collect(const Hierarchy& h) {
     while (!level.empty()) {
         const uint32_t n = uint32_t(level.size());
         uint8_t* state = level.state();
-        std::vector<uint8_t> truth(n);
-        bool all_refined = true;
-        next_ids.clear();
-        for (uint32_t i = 0; i < n; ++i) {
-            truth[i] = !h.is_leaf(ids[i]);
-            all_refined &= truth[i] != 0;
-            if (truth[i]) {
-                const NodeId c = h.child(ids[i], 0);
-                next_ids.insert(next_ids.end(), {c, c + 1, c + 2, c + 3});
-            }
-        }
+        std::vector<uint8_t> truth;
+        const bool all_refined = read_level(h, ids, n, truth, next_ids);
         const bool uniform = uniform_so_far && all_refined;
         uniform_so_far = uniform;
         grand.assign(n, 0);
@@ -231,17 +239,8 @@ size_t improved_bytes(const Hierarchy& h) {
     bool uniform_so_far = true;
     while (!level.empty()) {
         const uint32_t n = uint32_t(level.size());
-        std::vector<uint8_t> truth(n);
-        bool all_refined = true;
-        next_ids.clear();
-        for (uint32_t i = 0; i < n; ++i) {
-            truth[i] = !h.is_leaf(ids[i]);
-            all_refined &= truth[i] != 0;
-            if (truth[i]) {
-                const NodeId c = h.child(ids[i], 0);
-                next_ids.insert(next_ids.end(), {c, c + 1, c + 2, c + 3});
-            }
-        }
+        std::vector<uint8_t> truth;
+        const bool all_refined = read_level(h, ids, n, truth, next_ids);
         const bool uniform = uniform_so_far && all_refined;
         uniform_so_far = uniform;
         traversal.run(
