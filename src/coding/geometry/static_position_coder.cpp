@@ -887,9 +887,12 @@ struct StencilStreams {
 };
 
 constexpr uint64_t kSign64 = uint64_t{1} << 63;
-// ordered_bits and from_ordered_bits for float64 without branches (the signs are coin flips).
+// ordered_bits and from_ordered_bits for float64 without branches (the signs are coin flips);
+// the SSE2 paths below compute the same per lane, so only the scalar twins call these.
+#if !AMC_SSE2
 AMC_ALWAYS_INLINE uint64_t ordered_of(uint64_t b) { return b ^ (uint64_t(int64_t(b) >> 63) | kSign64); }
 AMC_ALWAYS_INLINE uint64_t double_bits_of(uint64_t u) { return u ^ (~uint64_t(int64_t(u) >> 63) | kSign64); }
+#endif
 // Hierarchy::is_far's bound.
 constexpr double kHalfMax = 8.98846567431157953865e307;  // DBL_MAX / 2
 #if AMC_SSE2
