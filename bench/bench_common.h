@@ -1,5 +1,5 @@
 // What the benchmark programs share: the hierarchies coder_bench and decode_phases time, the
-// clock and the median of repeated timings.
+// clock and the median of repeated timings, reading the hierarchy files the studies are given.
 #pragma once
 
 #include <amc/hierarchy.h>
@@ -9,8 +9,28 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <ctime>
+#include <exception>
+#include <optional>
+#include <string>
 #include <vector>
+
+// A hierarchy file's model name: its file name without directory and extension.
+inline std::string model_name(const std::string& path) {
+    const std::string file = path.substr(path.find_last_of('/') + 1);
+    return file.substr(0, file.find_last_of('.'));
+}
+
+// The hierarchy in path, or nothing after the reading error on stderr under the program's name.
+inline std::optional<amc::Hierarchy> read_hierarchy_or_report(const char* program, const std::string& path) {
+    try {
+        return amc::read_hierarchy(path);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "%s: %s: %s\n", program, path.c_str(), e.what());
+        return std::nullopt;
+    }
+}
 
 enum class BenchModel { surface = 0, random = 1, fe = 2 };
 

@@ -488,15 +488,10 @@ int main(int argc, char** argv) {
     }
     for (int a = first; a < argc; ++a) {
         const std::string path = argv[a];
-        Hierarchy h;
-        try {
-            h = read_hierarchy(path);
-        } catch (const std::exception& e) {
-            std::fprintf(stderr, "level_parallel_study: %s: %s\n", path.c_str(), e.what());
-            return 1;
-        }
-        std::string name = path.substr(path.find_last_of('/') + 1);
-        name = name.substr(0, name.find_last_of('.'));
+        std::optional<Hierarchy> read = read_hierarchy_or_report("level_parallel_study", path);
+        if (!read) return 1;
+        Hierarchy& h = *read;
+        const std::string name = model_name(path);
         if (speed_runs == 0) {
             const Levels data = collect(h);
             const size_t improved = improved_bytes(h);

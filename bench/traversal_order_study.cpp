@@ -17,6 +17,7 @@
 //   blocks 1230    block by block in canonical order, each block's children 1, 2, 3, then 0
 // Orientation bits and the header are the same in every order and are not counted. Prints bytes
 // per order and the ratio to the improved traversal's.
+#include "bench_common.h"
 #include "coding/entropy/arithmetic_coder.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
 
@@ -168,15 +169,10 @@ int main(int argc, char** argv) {
     std::printf("\n");
     for (int a = 1; a < argc; ++a) {
         const std::string path = argv[a];
-        Hierarchy h;
-        try {
-            h = read_hierarchy(path);
-        } catch (const std::exception& e) {
-            std::fprintf(stderr, "traversal_order_study: %s: %s\n", path.c_str(), e.what());
-            return 1;
-        }
-        std::string name = path.substr(path.find_last_of('/') + 1);
-        name = name.substr(0, name.find_last_of('.'));
+        std::optional<Hierarchy> read = read_hierarchy_or_report("traversal_order_study", path);
+        if (!read) return 1;
+        Hierarchy& h = *read;
+        const std::string name = model_name(path);
         std::printf("| %s | %u |", name.c_str(), h.node_count());
         size_t improved = 0;
         for (int o = 0; o < kOrders; ++o) {
