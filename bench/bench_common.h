@@ -16,6 +16,24 @@
 #include <string>
 #include <vector>
 
+// The true refinement bits of a level's n nodes (their ids, in the coder's level order) and the
+// next level's ids, for studies that replay the coder's levels; whether every node split.
+inline bool read_level(const amc::Hierarchy& h, const std::vector<amc::NodeId>& ids, uint32_t n, std::vector<uint8_t>& truth,
+                std::vector<amc::NodeId>& next_ids) {
+    truth.assign(n, 0);
+    bool all_refined = true;
+    next_ids.clear();
+    for (uint32_t i = 0; i < n; ++i) {
+        truth[i] = !h.is_leaf(ids[i]);
+        all_refined &= truth[i] != 0;
+        if (truth[i]) {
+            const amc::NodeId c = h.child(ids[i], 0);
+            next_ids.insert(next_ids.end(), {c, c + 1, c + 2, c + 3});
+        }
+    }
+    return all_refined;
+}
+
 // A hierarchy file's model name: its file name without directory and extension.
 inline std::string model_name(const std::string& path) {
     const std::string file = path.substr(path.find_last_of('/') + 1);

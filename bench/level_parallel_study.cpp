@@ -134,23 +134,6 @@ struct Levels {
     std::vector<std::pair<int, bool>> roots;  // (group, bit)
 };
 
-// The true refinement bits of a level's n nodes (ids) and the next level's ids; whether all split.
-bool read_level(const Hierarchy& h, const std::vector<NodeId>& ids, uint32_t n, std::vector<uint8_t>& truth,
-                std::vector<NodeId>& next_ids) {
-    truth.assign(n, 0);
-    bool all_refined = true;
-    next_ids.clear();
-    for (uint32_t i = 0; i < n; ++i) {
-        truth[i] = !h.is_leaf(ids[i]);
-        all_refined &= truth[i] != 0;
-        if (truth[i]) {
-            const NodeId c = h.child(ids[i], 0);
-            next_ids.insert(next_ids.end(), {c, c + 1, c + 2, c + 3});
-        }
-    }
-    return all_refined;
-}
-
 Levels collect(const Hierarchy& h) {
     const HierarchyCoderOptions options;
     Levels out;

@@ -83,17 +83,7 @@ std::vector<Symbol> symbols_in_order(const Hierarchy& h, Order order) {
     bool uniform_so_far = true;
     while (!level.empty()) {
         const uint32_t n = uint32_t(level.size());
-        truth.resize(n);
-        next_ids.clear();
-        bool all_refined = true;
-        for (uint32_t i = 0; i < n; ++i) {
-            truth[i] = !h.is_leaf(ids[i]);
-            all_refined &= truth[i] != 0;
-            if (truth[i]) {
-                const NodeId c = h.child(ids[i], 0);
-                next_ids.insert(next_ids.end(), {c, c + 1, c + 2, c + 3});
-            }
-        }
+        const bool all_refined = read_level(h, ids, n, truth, next_ids);
         const bool uniform = uniform_so_far && all_refined;  // levels below the header's U
         uniform_so_far = uniform;
         if (uniform || order == Order::improved || order == Order::naive || level.is_root_level()) {
