@@ -15,9 +15,6 @@ namespace amc {
 
 namespace {
 
-constexpr size_t kMaxLeafFieldName = 1024;
-constexpr uint32_t kMaxLeafFieldComponents = 1024;
-constexpr int kMinSymbolsPerValue = 7;  // the bit-length tree of encode_signed_residual
 // Contexts: component (0, 1, 2, 3 and more) x the leaf's level against the leaf before it
 // (same, finer, coarser).
 constexpr int kLeafFieldContexts = 12;
@@ -27,9 +24,9 @@ int value_context(uint32_t component, const Octant* before, const Octant& leaf) 
     return step * 4 + int(std::min<uint32_t>(component, 3));
 }
 
-std::string field_what(const std::string& name) { return "leaf field \"" + name + "\""; }
-
 }  // namespace
+
+std::string field_what(const std::string& name) { return "leaf field \"" + name + "\""; }
 
 size_t field_type_bytes(FieldType type) {
     switch (type) {
@@ -50,11 +47,11 @@ void validate_leaf_fields(const std::vector<Field>& fields, uint64_t leaves, con
     std::set<std::string> names;
     for (const Field& f : fields) {
         const std::string where = what + ": " + field_what(f.name);
-        AMC_REQUIRE(!f.name.empty() && f.name.size() <= kMaxLeafFieldName, invalid_input, where + ": a name of 1 to 1024 bytes is required");
+        AMC_REQUIRE(!f.name.empty() && f.name.size() <= kMaxFieldNameBytes, invalid_input, where + ": a name of 1 to 1024 bytes is required");
         AMC_REQUIRE(names.insert(f.name).second, invalid_input, where + ": the name is used twice");
         AMC_REQUIRE(f.association == FieldAssociation::cell, invalid_input, where + ": leaf data are cell fields (one tuple per leaf)");
         AMC_REQUIRE(uint8_t(f.type) <= uint8_t(FieldType::float64), invalid_input, where + ": unknown type");
-        AMC_REQUIRE(f.components >= 1 && f.components <= kMaxLeafFieldComponents, invalid_input, where + ": components must be 1 to 1024");
+        AMC_REQUIRE(f.components >= 1 && f.components <= kMaxFieldComponents, invalid_input, where + ": components must be 1 to 1024");
         const bool is_float = is_float_type(f.type);
         AMC_REQUIRE(f.value_count() == leaves * f.components && (is_float ? f.integers.empty() : f.values.empty()), invalid_input,
                     where + ": " + std::to_string(f.value_count()) + " values for " + std::to_string(leaves) + " leaves of " +
@@ -67,26 +64,51 @@ void validate_leaf_fields(const std::vector<Field>& fields, uint64_t leaves, con
     }
 }
 
-std::vector<uint8_t> write_leaf_field(const Field& field, const std::vector<Octant>& leaves) {
-    std::vector<uint8_t> out;
+void write_leaf_field_head(const Field& field, std::vector<uint8_t>& out) {
     put_varint(out, field.name.size());
     out.insert(out.end(), field.name.begin(), field.name.end());
     out.push_back(uint8_t(field.type));
     put_varint(out, field.components);
+}
+
+Field read_leaf_field_head(PayloadReader& in, const std::string& block) {
+    Field f;
+    f.association = FieldAssociation::cell;
+    const uint64_t name_size = in.varint();
+    AMC_REQUIRE(name_size >= 1 && name_size <= kMaxFieldNameBytes && name_size <= in.remaining(), corrupt,
+                block + ": a name of " + std::to_string(name_size) + " bytes");
+    f.name.assign(reinterpret_cast<const char*>(in.bytes(name_size)), size_t(name_size));
+    const std::string what = field_what(f.name);
+    const uint8_t type = in.u8();
+    AMC_REQUIRE(type <= uint8_t(FieldType::float64), corrupt, what + ": unknown type " + std::to_string(type));
+    f.type = FieldType(type);
+    const uint64_t comps = in.varint();
+    AMC_REQUIRE(comps >= 1 && comps <= kMaxFieldComponents, corrupt, what + ": " + std::to_string(comps) + " components");
+    f.components = uint32_t(comps);
+    return f;
+}
+
+void size_leaf_field(Field& f, uint64_t tuples, uint64_t max_values, uint64_t bytes_left) {
+    const std::string what = field_what(f.name);
+    const uint64_t values = tuples * f.components;
+    AMC_REQUIRE(values <= max_values, limit_exceeded,
+                what + ": " + std::to_string(values) + " values, more than the limit " + std::to_string(max_values));
+    AMC_REQUIRE(values <= max_decodable_symbols(bytes_left) / kMinSymbolsPerSignedResidual, corrupt,
+                what + ": " + std::to_string(values) + " values do not fit in " + std::to_string(bytes_left) + " bytes");
+    if (is_float_type(f.type)) f.values.resize(values);
+    else f.integers.resize(values);
+}
+
+std::vector<uint8_t> write_leaf_field(const Field& field, const std::vector<Octant>& leaves) {
+    std::vector<uint8_t> out;
+    write_leaf_field_head(field, out);
     const uint32_t comps = field.components;
-    const uint64_t mask = word_mask(field.type);
-    const int top = word_bits(field.type) - 1;
     FloatResidualModels models(kLeafFieldContexts);
     ArithmeticEncoder encoder;
-    for (size_t i = 0; i < leaves.size(); ++i) {
-        for (uint32_t c = 0; c < comps; ++c) {
-            const uint64_t predicted = i > 0 ? word_of(field, (i - 1) * comps + c) : 0;
-            const uint64_t d = (word_of(field, i * comps + c) - predicted) & mask;
-            const bool negative = (d >> top) & 1;
-            encode_signed_residual(encoder, models.context(value_context(c, i > 0 ? &leaves[i - 1] : nullptr, leaves[i])), negative,
-                                   negative ? (~d + 1) & mask : d);
-        }
-    }
+    for (size_t i = 0; i < leaves.size(); ++i)
+        for (uint32_t c = 0; c < comps; ++c)
+            encode_word(encoder, models.context(value_context(c, i > 0 ? &leaves[i - 1] : nullptr, leaves[i])), field.type,
+                        word_of(field, i * comps + c), i > 0 ? word_of(field, (i - 1) * comps + c) : 0);
     const std::vector<uint8_t> stream = encoder.finish();
     out.insert(out.end(), stream.begin(), stream.end());
     return out;
@@ -94,50 +116,20 @@ std::vector<uint8_t> write_leaf_field(const Field& field, const std::vector<Octa
 
 Field read_leaf_field(const uint8_t* data, size_t size, const std::vector<Octant>& leaves, uint64_t max_values) {
     PayloadReader in(data, size, "leaf field block");
-    Field f;
-    f.association = FieldAssociation::cell;
-    const uint64_t name_size = in.varint();
-    AMC_REQUIRE(name_size >= 1 && name_size <= kMaxLeafFieldName && name_size <= in.remaining(), corrupt,
-                "leaf field block: a name of " + std::to_string(name_size) + " bytes");
-    f.name.assign(reinterpret_cast<const char*>(in.bytes(name_size)), size_t(name_size));
+    Field f = read_leaf_field_head(in, "leaf field block");
+    size_leaf_field(f, leaves.size(), max_values, in.remaining());
     const std::string what = field_what(f.name);
-    const uint8_t type = in.u8();
-    AMC_REQUIRE(type <= uint8_t(FieldType::float64), corrupt, what + ": unknown type " + std::to_string(type));
-    f.type = FieldType(type);
-    const uint64_t comps = in.varint();
-    AMC_REQUIRE(comps >= 1 && comps <= kMaxLeafFieldComponents, corrupt, what + ": " + std::to_string(comps) + " components");
-    f.components = uint32_t(comps);
-    const uint64_t values = uint64_t(leaves.size()) * comps;
-    AMC_REQUIRE(values <= max_values, limit_exceeded,
-                what + ": " + std::to_string(values) + " values, more than the limit " + std::to_string(max_values));
-    AMC_REQUIRE(values <= max_decodable_symbols(in.remaining()) / kMinSymbolsPerValue, corrupt,
-                what + ": " + std::to_string(values) + " values do not fit in " + std::to_string(in.remaining()) + " bytes");
-    const bool is_float = is_float_type(f.type);
-    if (is_float) f.values.resize(values);
-    else f.integers.resize(values);
-    const uint64_t mask = word_mask(f.type);
-    const Precision precision = precision_of(f.type);
+    const uint32_t comps = f.components;
     FloatResidualModels models(kLeafFieldContexts);
     ArithmeticDecoder decoder(in.rest(), in.remaining());
     uint64_t bad_range = 0;
     std::vector<uint64_t> previous(comps, 0);
-    for (size_t i = 0; i < leaves.size(); ++i) {
+    for (size_t i = 0; i < leaves.size(); ++i)
         for (uint32_t c = 0; c < comps; ++c) {
-            bool negative;
-            uint64_t magnitude;
-            decode_signed_residual(decoder, models, models.context(value_context(c, i > 0 ? &leaves[i - 1] : nullptr, leaves[i])), negative,
-                                   magnitude);
-            const uint64_t w = (negative ? previous[c] - magnitude : previous[c] + magnitude) & mask;
-            previous[c] = w;
-            const size_t k = i * comps + c;
-            if (is_float) {
-                f.values[k] = from_ordered_bits(w, precision);
-            } else {
-                f.integers[k] = int64_t(w);
-                bad_range += !integer_in_range(f.integers[k], f.type);
-            }
+            previous[c] = decode_word(decoder, models, models.context(value_context(c, i > 0 ? &leaves[i - 1] : nullptr, leaves[i])),
+                                      f.type, previous[c]);
+            bad_range += !set_word(f, i * comps + c, previous[c]);
         }
-    }
     AMC_REQUIRE(!decoder.overran(), truncated, what + ": the values run past the end of the block");
     AMC_REQUIRE(!models.saw_invalid_symbol(), corrupt, what + ": an invalid residual");
     AMC_REQUIRE(bad_range == 0, corrupt, what + ": " + std::to_string(bad_range) + " values out of the type's range");

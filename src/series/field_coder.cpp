@@ -19,10 +19,7 @@ namespace {
 
 constexpr uint8_t kSpatial = 1, kTemporal = 2, kHybrid = 3;
 constexpr uint8_t kExact = 0, kBounded = 1;
-constexpr uint32_t kMaxComponents = 1024;
-constexpr size_t kMaxNameLength = 1024;
 constexpr int kFieldContexts = 32;
-constexpr int kMinSymbolsPerValue = 7;  // the bit-length tree of encode_signed_residual
 int value_context(int level, uint32_t component) { return std::min(level, 7) * 4 + int(std::min<uint32_t>(component, 3)); }
 
 // The grid of an error-bounded field: value q * step, step = 2 * bound.
@@ -228,9 +225,9 @@ FieldFrame::FieldFrame(const FrameState& prev_, const FrameState& next_, const C
 void encode_field(const Field& field, double bound, const FieldFrame& frame, std::vector<uint8_t>& out,
                   Field& decoded, FieldCodeStats* stats) {
     const std::string what = "field \"" + field.name + "\"";
-    AMC_REQUIRE(!field.name.empty() && field.name.size() <= kMaxNameLength, invalid_input,
+    AMC_REQUIRE(!field.name.empty() && field.name.size() <= kMaxFieldNameBytes, invalid_input,
                 what + ": a name of 1 to 1024 bytes is required");
-    AMC_REQUIRE(field.components >= 1 && field.components <= kMaxComponents, invalid_input,
+    AMC_REQUIRE(field.components >= 1 && field.components <= kMaxFieldComponents, invalid_input,
                 what + ": components must be 1 to 1024");
     AMC_REQUIRE(uint8_t(field.type) <= uint8_t(FieldType::float64) && uint8_t(field.association) <= 1, invalid_input,
                 what + ": unknown type or association");
@@ -312,7 +309,7 @@ void encode_field(const Field& field, double bound, const FieldFrame& frame, std
 Field decode_field(PayloadReader& in, const FieldFrame& frame) {
     Field f;
     const uint64_t name_length = in.varint();
-    AMC_REQUIRE(name_length >= 1 && name_length <= kMaxNameLength && name_length <= in.remaining(), corrupt,
+    AMC_REQUIRE(name_length >= 1 && name_length <= kMaxFieldNameBytes && name_length <= in.remaining(), corrupt,
                 "field record: name length " + std::to_string(name_length) + " out of range");
     f.name.assign(reinterpret_cast<const char*>(in.bytes(name_length)), size_t(name_length));
     const std::string what = "field \"" + f.name + "\"";
@@ -322,7 +319,7 @@ Field decode_field(PayloadReader& in, const FieldFrame& frame) {
     f.association = FieldAssociation(association);
     f.type = FieldType(type);
     const uint64_t components = in.varint();
-    AMC_REQUIRE(components >= 1 && components <= kMaxComponents, corrupt,
+    AMC_REQUIRE(components >= 1 && components <= kMaxFieldComponents, corrupt,
                 what + ": " + std::to_string(components) + " components (1 to 1024 allowed)");
     f.components = uint32_t(components);
     const uint8_t mode = in.u8();
@@ -344,7 +341,7 @@ Field decode_field(PayloadReader& in, const FieldFrame& frame) {
     const uint64_t length = in.varint();
     AMC_REQUIRE(length <= in.remaining(), truncated, what + ": payload longer than the frame");
     const size_t tuples = frame.tuples(f.association);
-    AMC_REQUIRE(uint64_t(tuples) * f.components <= max_decodable_symbols(length) / kMinSymbolsPerValue, corrupt,
+    AMC_REQUIRE(uint64_t(tuples) * f.components <= max_decodable_symbols(length) / kMinSymbolsPerSignedResidual, corrupt,
                 what + ": " + std::to_string(uint64_t(tuples) * f.components) + " values can not fit in " +
                     std::to_string(length) + " bytes");
     const uint8_t* data = in.bytes(length);

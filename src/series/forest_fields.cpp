@@ -13,8 +13,6 @@ namespace amc {
 namespace {
 
 constexpr int kTemporalContexts = 12;  // relation (3) x component (0, 1, 2, 3 and more)
-constexpr int kMinSymbolsPerValue = 7;  // as in the .amq leaf field
-constexpr uint64_t kMaxName = 1024, kMaxComponents = 1024;
 
 uint64_t morton(const Octant& o, int dim) {
     uint64_t key = 0;
@@ -33,24 +31,20 @@ const Field* previous_field(const ForestFieldFrame& frame, const std::string& na
     return nullptr;
 }
 
+int temporal_context(const ForestFieldFrame& frame, size_t leaf, uint32_t component) {
+    return frame.relation[leaf] * 4 + int(std::min<uint32_t>(component, 3));
+}
+
 std::vector<uint8_t> temporal_payload(const Field& field, const Field& before, const ForestFieldFrame& frame) {
     std::vector<uint8_t> out;
-    put_varint(out, field.name.size());
-    out.insert(out.end(), field.name.begin(), field.name.end());
-    out.push_back(uint8_t(field.type));
-    put_varint(out, field.components);
+    write_leaf_field_head(field, out);
     const uint32_t comps = field.components;
-    const uint64_t mask = word_mask(field.type);
-    const int top = word_bits(field.type) - 1;
     FloatResidualModels models(kTemporalContexts);
     ArithmeticEncoder encoder;
     for (size_t i = 0; i < frame.prev_leaf.size(); ++i)
-        for (uint32_t c = 0; c < comps; ++c) {
-            const uint64_t d = (word_of(field, i * comps + c) - word_of(before, frame.prev_leaf[i] * comps + c)) & mask;
-            const bool negative = (d >> top) & 1;
-            encode_signed_residual(encoder, models.context(frame.relation[i] * 4 + int(std::min<uint32_t>(c, 3))), negative,
-                                   negative ? (~d + 1) & mask : d);
-        }
+        for (uint32_t c = 0; c < comps; ++c)
+            encode_word(encoder, models.context(temporal_context(frame, i, c)), field.type, word_of(field, i * comps + c),
+                        word_of(before, frame.prev_leaf[i] * comps + c));
     const std::vector<uint8_t> stream = encoder.finish();
     out.insert(out.end(), stream.begin(), stream.end());
     return out;
@@ -58,49 +52,21 @@ std::vector<uint8_t> temporal_payload(const Field& field, const Field& before, c
 
 Field read_temporal(const uint8_t* data, size_t size, const ForestFieldFrame& frame, uint64_t max_values) {
     PayloadReader in(data, size, "leaf field");
-    Field f;
-    f.association = FieldAssociation::cell;
-    const uint64_t name_size = in.varint();
-    AMC_REQUIRE(name_size >= 1 && name_size <= kMaxName && name_size <= in.remaining(), corrupt,
-                "leaf field: a name of " + std::to_string(name_size) + " bytes");
-    f.name.assign(reinterpret_cast<const char*>(in.bytes(name_size)), size_t(name_size));
-    const std::string what = "leaf field \"" + f.name + "\"";
-    const uint8_t type = in.u8();
-    AMC_REQUIRE(type <= uint8_t(FieldType::float64), corrupt, what + ": unknown type " + std::to_string(type));
-    f.type = FieldType(type);
-    const uint64_t comps = in.varint();
-    AMC_REQUIRE(comps >= 1 && comps <= kMaxComponents, corrupt, what + ": " + std::to_string(comps) + " components");
-    f.components = uint32_t(comps);
+    Field f = read_leaf_field_head(in, "leaf field");
+    const std::string what = field_what(f.name);
     const Field* before = previous_field(frame, f.name);
     AMC_REQUIRE(before && before->type == f.type && before->components == f.components, corrupt,
                 what + ": coded against the frame before, which has no field of that name, type and components");
-    const uint64_t values = uint64_t(frame.prev_leaf.size()) * comps;
-    AMC_REQUIRE(values <= max_values, limit_exceeded,
-                what + ": " + std::to_string(values) + " values, more than the limit " + std::to_string(max_values));
-    AMC_REQUIRE(values <= max_decodable_symbols(in.remaining()) / kMinSymbolsPerValue, corrupt,
-                what + ": " + std::to_string(values) + " values do not fit in " + std::to_string(in.remaining()) + " bytes");
-    const bool is_float = is_float_type(f.type);
-    if (is_float) f.values.resize(values);
-    else f.integers.resize(values);
-    const uint64_t mask = word_mask(f.type);
+    size_leaf_field(f, frame.prev_leaf.size(), max_values, in.remaining());
+    const uint32_t comps = f.components;
     FloatResidualModels models(kTemporalContexts);
     ArithmeticDecoder decoder(in.rest(), in.remaining());
     uint64_t bad_range = 0;
     for (size_t i = 0; i < frame.prev_leaf.size(); ++i)
         for (uint32_t c = 0; c < comps; ++c) {
-            bool negative;
-            uint64_t magnitude;
-            decode_signed_residual(decoder, models, models.context(frame.relation[i] * 4 + int(std::min<uint32_t>(c, 3))), negative,
-                                   magnitude);
-            const uint64_t p = word_of(*before, frame.prev_leaf[i] * comps + c);
-            const uint64_t w = (negative ? p - magnitude : p + magnitude) & mask;
-            const size_t k = i * comps + c;
-            if (is_float) {
-                f.values[k] = from_ordered_bits(w, precision_of(f.type));
-            } else {
-                f.integers[k] = int64_t(w);
-                bad_range += !integer_in_range(f.integers[k], f.type);
-            }
+            const uint64_t w = decode_word(decoder, models, models.context(temporal_context(frame, i, c)), f.type,
+                                           word_of(*before, frame.prev_leaf[i] * comps + c));
+            bad_range += !set_word(f, i * comps + c, w);
         }
     AMC_REQUIRE(!decoder.overran(), truncated, what + ": the values run past the end of the field");
     AMC_REQUIRE(!models.saw_invalid_symbol(), corrupt, what + ": an invalid residual");

@@ -158,6 +158,9 @@ void encode_signed_residual(ArithmeticEncoder& encoder, FloatResidualModels::Con
                             uint64_t magnitude);
 void decode_signed_residual(ArithmeticDecoder& decoder, FloatResidualModels& models,
                             FloatResidualModels::Context& context, bool& negative, uint64_t& magnitude);
+// The fewest symbols a signed residual costs (the bit-length tree's depth): decoders bound value
+// counts by the bytes with it.
+constexpr int kMinSymbolsPerSignedResidual = 7;
 
 // ---- quantized mode ---------------------------------------------------------------------------
 
