@@ -905,13 +905,6 @@ AMC_ALWAYS_INLINE __m128d double_lanes_of(__m128i u) {
 }
 #endif
 
-// Vertex i of a level's chunk: its stencil's vertices, read from the nodes before any position.
-// d == kNoVertex: no neighbour across the edge (the midpoint predicts); a wing kNoVertex: its
-// reflection (predict_butterfly's).
-struct StencilIds {
-    VertexId a, b, c, d, w[4];  // w_bc, w_ca, w_ad, w_db
-};
-
 // Per byte of a node's neighbour edge indices (HierarchyBuilder::neighbor_edges) and edge f: the
 // local index of the vertex opposite edge f in the neighbour across it (wing(), geometry_prediction.cpp).
 struct OppositeIndices {
@@ -924,43 +917,14 @@ struct OppositeIndices {
 };
 constexpr OppositeIndices kOpposite;
 
-template <bool Butterfly>
-AMC_ALWAYS_INLINE void stencil_ids(const Hierarchy& h, NodeId n, int e, StencilIds& s) {
-    static constexpr int kNext[5] = {1, 2, 0, 1, 2};
-    const int e1 = kNext[e], e2 = kNext[e + 1];
-    s.a = h.vertex(n, e);
-    s.b = h.vertex(n, e1);
-    if (!Butterfly) return;
-    const NodeId q = h.neighbor(n, e);
-    if (q == kNoNode) {
-        s.d = kNoVertex;
-        return;
-    }
-    s.c = h.vertex(n, e2);
-    const uint8_t* const n_opposite = kOpposite.of[HierarchyBuilder::neighbor_edges(h, n)];
-    const uint8_t* const q_opposite = kOpposite.of[HierarchyBuilder::neighbor_edges(h, q)];
-    const int eq = h.neighbor_edge(n, e);
-    s.d = h.vertex(q, n_opposite[e]);
-    // The vertex opposite edge f of node m in the neighbour across it, kNoVertex without one.
-    auto far_vertex = [&h](NodeId m, int f, const uint8_t* opposite) {
-        const NodeId r = h.neighbor(m, f);
-        return r == kNoNode ? kNoVertex : h.vertex(r, opposite[f]);
-    };
-    s.w[0] = far_vertex(n, e1, n_opposite);
-    s.w[1] = far_vertex(n, e2, n_opposite);
-    s.w[2] = far_vertex(q, kNext[eq], q_opposite);
-    s.w[3] = far_vertex(q, kNext[eq + 1], q_opposite);
-}
-
-// The ordered bits of predict_butterfly's (or predict_midpoint's) prediction, its non-finite
-// coordinates taken as 0 (coder_prediction), for a float64 hierarchy.
+// A stencil point's three coordinates, and the same IEEE operations in the same order as
+// predict_butterfly's Vec3 arithmetic.
 #if AMC_SSE2
-// x and y in one SSE2 register, z in the low lane of another: the same IEEE operations in the
-// same order as predict_butterfly's Vec3 arithmetic, each lane rounded alike.
+// x and y in one SSE2 register, z in the low lane of another, each lane rounded alike.
 struct Lanes {
     __m128d xy, z;
 };
-AMC_ALWAYS_INLINE Lanes lanes_at(const Vec3* positions, VertexId v) {
+AMC_ALWAYS_INLINE Lanes point_at(const Vec3* positions, VertexId v) {
     const Vec3& p = positions[v];
     return {_mm_loadu_pd(&p.x), _mm_load_sd(&p.z)};
 }
@@ -981,41 +945,50 @@ AMC_ALWAYS_INLINE __m128i ordered_lanes(__m128d v) {
     const __m128i negative = _mm_shuffle_epi32(_mm_srai_epi32(b, 31), 0xF5);
     return _mm_xor_si128(b, _mm_or_si128(negative, _mm_set1_epi64x(int64_t(kSign64))));
 }
-template <bool Butterfly>
-AMC_ALWAYS_INLINE void stencil_prediction(const Vec3* positions, const StencilIds& s, uint64_t (&p)[3]) {
-    const Lanes a = lanes_at(positions, s.a), b = lanes_at(positions, s.b);
-    Lanes predicted = scaled(0.5, a + b);
-    if (Butterfly && s.d != kNoVertex) {
-        const Lanes c = lanes_at(positions, s.c), d = lanes_at(positions, s.d);
-        const Lanes w_bc = s.w[0] != kNoVertex ? lanes_at(positions, s.w[0]) : b + c - a;
-        const Lanes w_ca = s.w[1] != kNoVertex ? lanes_at(positions, s.w[1]) : c + a - b;
-        const Lanes w_ad = s.w[2] != kNoVertex ? lanes_at(positions, s.w[2]) : a + d - b;
-        const Lanes w_db = s.w[3] != kNoVertex ? lanes_at(positions, s.w[3]) : d + b - a;
-        predicted = predicted + scaled(0.125, c + d) - scaled(0.0625, (w_bc + w_ca) + (w_ad + w_db));
-    }
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(p), ordered_lanes(predicted.xy));
-    _mm_storel_epi64(reinterpret_cast<__m128i*>(p + 2), ordered_lanes(predicted.z));
+AMC_ALWAYS_INLINE void store_ordered(Lanes v, uint64_t (&p)[3]) {
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(p), ordered_lanes(v.xy));
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(p + 2), ordered_lanes(v.z));
 }
 #else
-template <bool Butterfly>
-AMC_ALWAYS_INLINE void stencil_prediction(const Vec3* positions, const StencilIds& s, uint64_t (&p)[3]) {
-    Vec3 predicted;
-    const Vec3 a = positions[s.a], b = positions[s.b];
-    if (!Butterfly || s.d == kNoVertex) {
-        predicted = rounded_scaled(0.5, a + b);
-    } else {
-        const Vec3 c = positions[s.c], d = positions[s.d];
-        const Vec3 w_bc = s.w[0] != kNoVertex ? positions[s.w[0]] : b + c - a;
-        const Vec3 w_ca = s.w[1] != kNoVertex ? positions[s.w[1]] : c + a - b;
-        const Vec3 w_ad = s.w[2] != kNoVertex ? positions[s.w[2]] : a + d - b;
-        const Vec3 w_db = s.w[3] != kNoVertex ? positions[s.w[3]] : d + b - a;
-        predicted = rounded_scaled(0.5, a + b) + rounded_scaled(0.125, c + d) -
-                    rounded_scaled(0.0625, (w_bc + w_ca) + (w_ad + w_db));
-    }
-    const double xyz[3] = {predicted.x, predicted.y, predicted.z};
+using Lanes = Vec3;
+AMC_ALWAYS_INLINE Vec3 point_at(const Vec3* positions, VertexId v) { return positions[v]; }
+AMC_ALWAYS_INLINE Vec3 scaled(double s, Vec3 v) { return rounded_scaled(s, v); }
+AMC_ALWAYS_INLINE void store_ordered(Vec3 v, uint64_t (&p)[3]) {
+    const double xyz[3] = {v.x, v.y, v.z};
     for (int k = 0; k < 3; ++k) p[k] = ordered_of(bit_cast<uint64_t>(std::isfinite(xyz[k]) ? xyz[k] : 0.0));
 }
 #endif
+
+// The ordered bits of predict_butterfly's (or predict_midpoint's) prediction for edge e of node n,
+// its non-finite coordinates taken as 0 (coder_prediction), for a float64 hierarchy. Each stencil
+// vertex is read from the nodes as it is needed; a wing whose neighbour is missing is its
+// reflection (predict_butterfly's), the midpoint predicts where n has no neighbour across e.
+template <bool Butterfly>
+AMC_ALWAYS_INLINE void stencil_prediction(const Hierarchy& h, const Vec3* positions, NodeId n, int e, uint64_t (&p)[3]) {
+    static constexpr int kNext[5] = {1, 2, 0, 1, 2};
+    const int e1 = kNext[e], e2 = kNext[e + 1];
+    const VertexId a = h.vertex(n, e), b = h.vertex(n, e1);
+    Lanes predicted = scaled(0.5, point_at(positions, a) + point_at(positions, b));
+    const NodeId q = Butterfly ? h.neighbor(n, e) : kNoNode;
+    if (q != kNoNode) {
+        const uint8_t* const n_opposite = kOpposite.of[HierarchyBuilder::neighbor_edges(h, n)];
+        const uint8_t* const q_opposite = kOpposite.of[HierarchyBuilder::neighbor_edges(h, q)];
+        const int eq = h.neighbor_edge(n, e);
+        const VertexId c = h.vertex(n, e2), d = h.vertex(q, n_opposite[e]);
+        const Lanes cd = point_at(positions, c) + point_at(positions, d);
+        // The vertex opposite edge f of node m in the neighbour across it, else x + y - z (read
+        // again there: few registers stay live over the wings).
+        auto wing = [&](NodeId m, int f, const uint8_t* opposite, VertexId x, VertexId y, VertexId z) {
+            const NodeId r = h.neighbor(m, f);
+            if (r != kNoNode) return point_at(positions, h.vertex(r, opposite[f]));
+            return point_at(positions, x) + point_at(positions, y) - point_at(positions, z);
+        };
+        const Lanes wings_n = wing(n, e1, n_opposite, b, c, a) + wing(n, e2, n_opposite, c, a, b);
+        const Lanes wings_q = wing(q, kNext[eq], q_opposite, a, d, b) + wing(q, kNext[eq + 1], q_opposite, d, b, a);
+        predicted = predicted + scaled(0.125, cd) - scaled(0.0625, wings_n + wings_q);
+    }
+    store_ordered(predicted, p);
+}
 
 template <bool Butterfly>
 bool decode_stencil_float64(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, const StaticTables& tables,
@@ -1031,7 +1004,6 @@ bool decode_stencil_float64(Hierarchy& h, const std::vector<std::pair<NodeId, in
     }
     // What a chunk reads at most: two rANS bytes and the sign and 64 bits per coordinate.
     constexpr size_t kChunkRans = 2 * 3 * kChunk, kChunkRaw = 3 * kChunk * 65 / 8 + 8;
-    std::array<StencilIds, kChunk> ids;
     uint64_t predicted[kChunk][3];
     std::array<VertexId, kChunk> vertices;
     // split_level numbers a level's new vertices in the order `created` lists them (the listed
@@ -1042,13 +1014,12 @@ bool decode_stencil_float64(Hierarchy& h, const std::vector<std::pair<NodeId, in
     for (size_t begin = 0; begin < created.size(); begin += kChunk) {
         const size_t count = std::min(kChunk, created.size() - begin);
         const bool consecutive = midpoint(begin) == first + begin && midpoint(begin + count - 1) == first + begin + count - 1;
+        const Vec3* positions = h.positions().data();
         for (size_t i = 0; i < count; ++i) {
             const auto [n, e] = created[begin + i];
-            stencil_ids<Butterfly>(h, n, e, ids[i]);
+            stencil_prediction<Butterfly>(h, positions, n, e, predicted[i]);
             vertices[i] = consecutive ? VertexId(first + begin + i) : h.midpoint(n, e);
         }
-        const Vec3* positions = h.positions().data();
-        for (size_t i = 0; i < count; ++i) stencil_prediction<Butterfly>(positions, ids[i], predicted[i]);
         // Whether every coordinate of the chunk is at most DBL_MAX / 2 in magnitude (not
         // Hierarchy::is_far, and finite), in the bits of each lane.
 #if AMC_SSE2
