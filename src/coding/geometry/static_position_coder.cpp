@@ -777,47 +777,51 @@ bool decode_stencil_positions(Hierarchy& h, const std::vector<std::pair<NodeId, 
 // position, without a bounds test where the chunk cannot reach the streams' ends, and the
 // coordinates' finiteness and farness taken once a chunk from their largest exponent.
 
-// A token of one table: its rANS range, and the residual it gives from the raw bits r (sign in
-// bit 0, then the low bits): magnitude = high | v >> rot | (v & rot_mask) << 32 with v = r >> 1
-// (take_large's two raw values swapped back when low > 32), negative = (r & 1) | negative.
+// A token of one table: its rANS range, and the residual it gives from the raw bits w at the
+// stream's position (sign in bit 0, then the low bits): magnitude = high | (w >> shift) & low_mask
+// | (w << 31) & swapped_mask, negative = w & sign_mask. The last term is take_large's two raw values
+// swapped back when low > 32: the rot = low - 32 bits after the sign are the magnitude's bits 32 and
+// up, shift = 1 + rot. A direct token reads no bits (all masks 0) and its high is its residual.
 struct StencilEntry {
-    uint64_t high;      // the leading one and the two bits below it; a direct token's magnitude
-    uint64_t raw_mask;  // 2^raw_count - 1
-    uint64_t rot_mask;  // 2^rot - 1
+    uint64_t high;          // the leading one and the two bits below it; a direct token's residual
+    uint64_t low_mask;      // 2^min(low, 32) - 1
+    uint64_t swapped_mask;  // (2^rot - 1) << 32
     uint16_t frequency, start;
     uint8_t raw_count;  // the sign and the low bits; above kMaxRawRead: two reads (take_large's else)
-    uint8_t rot;        // low - 32 when low > 32, else 0
-    uint8_t negative;   // a direct token's sign
+    uint8_t shift;      // 1 + rot
+    uint8_t sign_mask;  // 1, or 0 for a direct token
 };
 constexpr int kMaxRawRead = 57;
 struct StencilTable {
-    const uint8_t* index;  // per slot, the entry (RansTable::narrow_view's)
     std::array<StencilEntry, 256> entries;
+    std::array<uint8_t, kRansScale> index;  // per slot, the entry (RansTable::narrow_view's), copied beside them
 };
 
 // From a narrow table (narrow_view().index != nullptr): its entries are its nonzero frequencies
 // in symbol order (RansTable::build_slots).
 void make_stencil_table(const RansTable& table, StencilTable& out) {
-    out.index = table.narrow_view().index;
+    std::copy_n(table.narrow_view().index, kRansScale, out.index.begin());
     size_t i = 0;
     for (int token = 0; token < table.size(); ++token) {
         if (table.frequency(token) == 0) continue;
         StencilEntry& e = out.entries[i++];
-        e.frequency = uint16_t(table.frequency(token));
-        e.start = uint16_t(table.start(token));
+        const uint16_t frequency = uint16_t(table.frequency(token)), start = uint16_t(table.start(token));
         if (token < kDirectTokens) {
             // take()'s direct tokens: magnitude (token + 1) / 2, negative when even and not 0.
-            e = {uint64_t(token + 1) / 2, 0, 0, e.frequency, e.start, 0, 0, uint8_t(token != 0 && token % 2 == 0)};
+            const uint64_t magnitude = uint64_t(token + 1) / 2;
+            e = {token != 0 && token % 2 == 0 ? 0 - magnitude : magnitude, 0, 0, frequency, start, 0, 0, 0};
             continue;
         }
         const int low = 4 + (token - kDirectTokens) / 4 - 3;
         const int rot = low > 32 ? low - 32 : 0;
         e.high = uint64_t(4 | ((token - kDirectTokens) & 3)) << low;
+        e.low_mask = (uint64_t{1} << std::min(low, 32)) - 1;
+        e.swapped_mask = ((uint64_t{1} << rot) - 1) << 32;
+        e.frequency = frequency;
+        e.start = start;
         e.raw_count = uint8_t(1 + low);
-        e.raw_mask = 1 + low <= kMaxRawRead ? (uint64_t{1} << (1 + low)) - 1 : 0;
-        e.rot = uint8_t(rot);
-        e.rot_mask = (uint64_t{1} << rot) - 1;
-        e.negative = 0;
+        e.shift = uint8_t(1 + rot);
+        e.sign_mask = 1;
     }
 }
 
@@ -838,12 +842,11 @@ struct StencilStreams {
         overran = true;
         return 0;
     }
-    // count <= kMaxRawRead bits, mask 2^count - 1.
+    // kMaxRawRead bits or more from bit `position` of the raw stream on (bit 0 first).
     template <bool Safe>
-    AMC_ALWAYS_INLINE uint64_t raw_get(int count, uint64_t mask) {
-        const size_t at = size_t(raw_bits_read >> 3);
-        const unsigned shift = unsigned(raw_bits_read & 7);
-        raw_bits_read += uint64_t(count);
+    AMC_ALWAYS_INLINE uint64_t raw_peek(uint64_t position) const {
+        const size_t at = size_t(position >> 3);
+        const unsigned shift = unsigned(position & 7);
         uint64_t word;
         if (!Safe || at + 8 <= raw_size) {
             word = load_le64(raw + at);
@@ -851,7 +854,7 @@ struct StencilStreams {
             word = 0;
             for (size_t k = 0; k < 8 && at + k < raw_size; ++k) word |= uint64_t(raw[at + k]) << (8 * k);
         }
-        return (word >> shift) & mask;
+        return word >> shift;
     }
     // The next token of state State, under `table`, as the residual it gives modulo 2^64: what
     // it adds to the prediction's ordered bits.
@@ -866,17 +869,18 @@ struct StencilStreams {
             s = (s << 8) | rans_byte<Safe>();
             if (s < kRansLow) s = (s << 8) | rans_byte<Safe>();
         }
+        const uint64_t at = raw_bits_read;
+        const uint64_t w = raw_peek<Safe>(at);
+        raw_bits_read += e.raw_count;
         uint64_t negative, magnitude;
         if (e.raw_count <= kMaxRawRead) {
-            const uint64_t r = raw_get<Safe>(e.raw_count, e.raw_mask);
-            negative = (r & 1) | e.negative;
-            const uint64_t v = r >> 1;
-            magnitude = e.high | v >> e.rot | (v & e.rot_mask) << 32;
-        } else {  // take_large's two reads
+            negative = w & e.sign_mask;
+            magnitude = e.high | ((w >> e.shift) & e.low_mask) | ((w << 31) & e.swapped_mask);
+        } else {  // take_large's two reads: the sign and low - 32 bits, then 32 bits
             const int first = e.raw_count - 32;
-            const uint64_t sign_and_first = raw_get<Safe>(first, (uint64_t{1} << first) - 1);
-            negative = sign_and_first & 1;
-            magnitude = e.high | (sign_and_first >> 1) << 32 | raw_get<Safe>(32, 0xFFFFFFFFull);
+            negative = w & 1;
+            magnitude = e.high | ((w >> 1) & ((uint64_t{1} << (first - 1)) - 1)) << 32 |
+                        (raw_peek<Safe>(at + uint64_t(first)) & 0xFFFFFFFFull);
         }
         return (magnitude ^ (0 - negative)) + negative;  // -magnitude when negative
     }
@@ -990,16 +994,39 @@ AMC_ALWAYS_INLINE void stencil_prediction(const Hierarchy& h, const Vec3* positi
     store_ordered(predicted, p);
 }
 
+// Adds the residuals of `count` vertices to their predictions' ordered bits, token j of the level
+// with state j mod 2: x and z with the vertex's parity, y with the other.
+template <bool Safe>
+AMC_ALWAYS_INLINE void add_residuals(StencilStreams& streams, const std::array<StencilTable, 3>& t, uint64_t (*predicted)[3],
+                                     size_t count) {
+    StencilStreams s = streams;  // a local copy: its fields stay in registers
+    size_t i = 0;
+    for (; i + 1 < count; i += 2) {
+        predicted[i][0] += s.residual<0, Safe>(t[0]);
+        predicted[i][1] += s.residual<1, Safe>(t[1]);
+        predicted[i][2] += s.residual<0, Safe>(t[2]);
+        predicted[i + 1][0] += s.residual<1, Safe>(t[0]);
+        predicted[i + 1][1] += s.residual<0, Safe>(t[1]);
+        predicted[i + 1][2] += s.residual<1, Safe>(t[2]);
+    }
+    if (i < count) {
+        predicted[i][0] += s.residual<0, Safe>(t[0]);
+        predicted[i][1] += s.residual<1, Safe>(t[1]);
+        predicted[i][2] += s.residual<0, Safe>(t[2]);
+    }
+    streams = s;
+}
+
 template <bool Butterfly>
 bool decode_stencil_float64(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, const StaticTables& tables,
                             const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
     std::array<StencilTable, 3> t;
     for (size_t k = 0; k < 3; ++k) make_stencil_table(tables[k], t[k]);
-    StencilStreams s{{0, 0}, rans_data, rans_data + rans_size, raw_data, 0, raw_size};
+    StencilStreams streams{{0, 0}, rans_data, rans_data + rans_size, raw_data, 0, raw_size};
     if (rans_size < kRansStateBytes) return false;
-    for (uint32_t& x : s.x) {
-        x = load_le32(s.rans);
-        s.rans += 4;
+    for (uint32_t& x : streams.x) {
+        x = load_le32(streams.rans);
+        streams.rans += 4;
         if (x < kRansLow) return false;  // RansDecoder's: no encoder ends below L
     }
     // What a chunk reads at most: two rANS bytes and the sign and 64 bits per coordinate.
@@ -1020,55 +1047,37 @@ bool decode_stencil_float64(Hierarchy& h, const std::vector<std::pair<NodeId, in
             stencil_prediction<Butterfly>(h, positions, n, e, predicted[i]);
             vertices[i] = consecutive ? VertexId(first + begin + i) : h.midpoint(n, e);
         }
-        // Whether every coordinate of the chunk is at most DBL_MAX / 2 in magnitude (not
-        // Hierarchy::is_far, and finite), in the bits of each lane.
 #if AMC_SSE2
         __m128d near_xy = _mm_castsi128_pd(_mm_set1_epi32(-1)), near_z = near_xy;
         const __m128d half_max = _mm_set1_pd(kHalfMax);
 #else
         uint64_t largest_magnitude = 0;
 #endif
-        auto run = [&](auto safe) {
-            constexpr bool Safe = decltype(safe)::value;
-            for (size_t i = 0; i < count; ++i) {
-                uint64_t r[3];
-                // Token j of the level with state j mod 2: x and z with the vertex's parity, y with the other.
-                if (i % 2 == 0) {
-                    r[0] = s.residual<0, Safe>(t[0]);
-                    r[1] = s.residual<1, Safe>(t[1]);
-                    r[2] = s.residual<0, Safe>(t[2]);
-                } else {
-                    r[0] = s.residual<1, Safe>(t[0]);
-                    r[1] = s.residual<0, Safe>(t[1]);
-                    r[2] = s.residual<1, Safe>(t[2]);
-                }
-                Vec3 p;
+        const bool inside = size_t(streams.rans_end - streams.rans) >= kChunkRans && raw_size - std::min<size_t>(raw_size, size_t(streams.raw_bits_read >> 3)) >= kChunkRaw;
+        if (inside) add_residuals<false>(streams, t, predicted, count);
+        else add_residuals<true>(streams, t, predicted, count);
+        // from_ordered_bits of each sum, and whether every coordinate of the chunk is at most
+        // DBL_MAX / 2 in magnitude (not Hierarchy::is_far, and finite), in the bits of each lane.
+        for (size_t i = 0; i < count; ++i) {
+            Vec3 p;
 #if AMC_SSE2
-                // from_ordered_bits of prediction + residual, x and y in one register.
-                const __m128i u_xy = _mm_add_epi64(_mm_loadu_si128(reinterpret_cast<const __m128i*>(predicted[i])),
-                                                   _mm_set_epi64x(int64_t(r[1]), int64_t(r[0])));
-                const __m128i u_z = _mm_add_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(predicted[i] + 2)),
-                                                  _mm_cvtsi64_si128(int64_t(r[2])));
-                const __m128d xy = double_lanes_of(u_xy), z = double_lanes_of(u_z);
-                const __m128d sign = _mm_set1_pd(-0.0);
-                near_xy = _mm_and_pd(near_xy, _mm_cmple_pd(_mm_andnot_pd(sign, xy), half_max));
-                near_z = _mm_and_pd(near_z, _mm_cmple_pd(_mm_andnot_pd(sign, z), half_max));
-                _mm_storeu_pd(&p.x, xy);
-                _mm_store_sd(&p.z, z);
+            const __m128d xy = double_lanes_of(_mm_loadu_si128(reinterpret_cast<const __m128i*>(predicted[i])));
+            const __m128d z = double_lanes_of(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(predicted[i] + 2)));
+            const __m128d sign = _mm_set1_pd(-0.0);
+            near_xy = _mm_and_pd(near_xy, _mm_cmple_pd(_mm_andnot_pd(sign, xy), half_max));
+            near_z = _mm_and_pd(near_z, _mm_cmple_pd(_mm_andnot_pd(sign, z), half_max));
+            _mm_storeu_pd(&p.x, xy);
+            _mm_store_sd(&p.z, z);
 #else
-                double* xyz[3] = {&p.x, &p.y, &p.z};
-                for (int k = 0; k < 3; ++k) {
-                    const uint64_t b = double_bits_of(predicted[i][k] + r[k]);
-                    largest_magnitude = std::max(largest_magnitude, b & ~kSign64);
-                    *xyz[k] = bit_cast<double>(b);
-                }
-#endif
-                HierarchyBuilder::set_near_vertex_position(h, vertices[i], p);
+            double* xyz[3] = {&p.x, &p.y, &p.z};
+            for (int k = 0; k < 3; ++k) {
+                const uint64_t b = double_bits_of(predicted[i][k]);
+                largest_magnitude = std::max(largest_magnitude, b & ~kSign64);
+                *xyz[k] = bit_cast<double>(b);
             }
-        };
-        const bool inside = size_t(s.rans_end - s.rans) >= kChunkRans && raw_size - std::min<size_t>(raw_size, size_t(s.raw_bits_read >> 3)) >= kChunkRaw;
-        if (inside) run(std::false_type{});
-        else run(std::true_type{});
+#endif
+            HierarchyBuilder::set_near_vertex_position(h, vertices[i], p);
+        }
 #if AMC_SSE2
         const bool near = _mm_movemask_pd(near_xy) == 3 && (_mm_movemask_pd(near_z) & 1) != 0;  // z's lane 1 is not a coordinate
 #else
@@ -1082,7 +1091,7 @@ bool decode_stencil_float64(Hierarchy& h, const std::vector<std::pair<NodeId, in
             }
         }
     }
-    return s.ended_cleanly();
+    return streams.ended_cleanly();
 }
 
 template <class Tables>
