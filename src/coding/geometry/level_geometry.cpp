@@ -111,15 +111,12 @@ void encode_adaptive(const Mesh& h, const NewVertices& created, GeometryPredicto
 // the bytes it committed on the way (8 bytes of margin).
 // Only bit-exact coordinates have raw bits enough to be worth the pass that counts them.
 // With a `sample` of fewer vertices than the level, that pass covers the sample only, and the
-// trial stops when the sample's raw bits scaled to the level, or its bytes with the rest of the
-// level at the rate of the sample's second half (the models learn as they go), pass the limit by
-// kSampleMargin: a guess; halfway through the sample the same at the rate of its second quarter,
-// by kEarlyMargin (most adaptive trials of large levels lose by more than half, and stop there).
+// trial stops when the sample's raw bits scaled to the level pass the limit by kSampleMargin, or
+// when AdaptiveTrialJudge says so.
 template <class Mesh>
 size_t adaptive_bytes(const Mesh& h, const NewVertices& created, GeometryPredictor predictor, PositionCoder positions,
                       size_t limit, bool count_raw_bits, size_t sample) {
     const size_t judged = std::min(sample, created.size());
-    size_t half_sample_bytes = 0, quarter_sample_bytes = 0;
     std::vector<Vec3> predicted(count_raw_bits ? judged : 0);
     uint64_t raw_bits = 0;
     for (size_t i = 0; i < predicted.size(); ++i) {
@@ -135,31 +132,42 @@ size_t adaptive_bytes(const Mesh& h, const NewVertices& created, GeometryPredict
     // Bit-exact levels: the raw bits in the side stream (finish_level_payload's layout).
     RawBitWriter raw;
     RawBitWriter* side = positions.quantized() ? nullptr : &raw;
-    auto bytes_so_far = [&] { return encoder.bytes_so_far() + raw.bits() / 8; };
-    // The level's bytes from those of its first `done` vertices and the rate since vertex `since`
-    // (`bytes_since` bytes then) pass the limit by `margin`.
-    auto projected_past = [&](size_t done, size_t since, size_t bytes_since, double margin) {
-        const double rate = double(bytes_so_far() - bytes_since) / double(done - since);
-        return limit != SIZE_MAX && double(bytes_so_far()) + rounded(rate * double(created.size() - done)) >
-                                        rounded(margin * double(limit)) + kSampleSlack;
-    };
+    AdaptiveTrialJudge judge(created.size(), sample, limit);
     for (size_t i = 0; i < created.size(); ++i) {
         const auto [n, e] = created[i];
         positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)),
                          i < predicted.size() ? predicted[i] : predict(h, predictor, n, e), side);
-        if (bytes_so_far() > limit + 8) return SIZE_MAX;
-        if (i + 1 == sample / 4) quarter_sample_bytes = bytes_so_far();
-        if (i + 1 == sample / 2) {
-            if (projected_past(i + 1, sample / 4, quarter_sample_bytes, kEarlyMargin)) return SIZE_MAX;
-            half_sample_bytes = bytes_so_far();
-        }
-        if (i + 1 == sample && projected_past(i + 1, sample / 2, half_sample_bytes, kSampleMargin)) return SIZE_MAX;
+        if (judge.stops(i + 1, encoder.bytes_so_far() + raw.bits() / 8)) return SIZE_MAX;
     }
     const size_t coded = encoder.finish().size();
     return side == nullptr ? coded : coded + varint_size(coded) + (raw.bits() + 7) / 8;
 }
 
 }  // namespace
+
+bool AdaptiveTrialJudge::checkpoint(size_t done, size_t bytes) {
+    // The level's bytes from those of its first `done` vertices at the rate since since_ pass
+    // the limit by `margin` (the sample's second quarter, then its second half, then each
+    // further sample's length: the models learn as they go).
+    auto projected_past = [&](double margin) {
+        const double rate = double(bytes - since_bytes_) / double(done - since_);
+        return limit_ != SIZE_MAX &&
+               double(bytes) + rounded(rate * double(count_ - done)) > rounded(margin * double(limit_)) + kSampleSlack;
+    };
+    bool stop = false;
+    if (done == sample_ / 4) {
+        next_ = sample_ / 2;
+    } else if (done == sample_ / 2) {
+        stop = projected_past(kEarlyMargin);
+        next_ = sample_;
+    } else {
+        stop = projected_past(kSampleMargin);
+        next_ = done + sample_;
+    }
+    since_ = done;
+    since_bytes_ = bytes;
+    return stop;
+}
 
 template <class Mesh>
 LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& created, const PositionCoder& positions,

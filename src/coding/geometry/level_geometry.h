@@ -13,6 +13,8 @@
 
 #include <amc/codec.h>
 
+#include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <utility>
@@ -47,6 +49,31 @@ template <class Mesh>
 LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& created, const PositionCoder& positions,
                                         CoordinateSpace space, GeometryPredictor choice, bool grid_contexts = false,
                                         bool unit_normals = false, int effort = kMaxEffort);
+
+// When an adaptive trial of a level of `count` new vertices stops, from the bytes its code has
+// committed after each vertex: once they pass `limit` (SIZE_MAX: none) by 8 bytes (exact: a
+// finished code is never much shorter), and, with a `sample` of fewer vertices than the level
+// (SIZE_MAX: none), when the level's bytes projected at a recent rate pass the limit by a margin
+// (a guess): halfway through the sample at the rate of its second quarter, at the sample's end
+// at the rate of its second half, then at the end of every further sample's length at the rate
+// of the last one (the surfaces' trials that passed the sample all lost, after coding 60-80 % of
+// their level: BENCHMARKS.md, "One-core encode, twelfth step").
+class AdaptiveTrialJudge {
+public:
+    AdaptiveTrialJudge(size_t count, size_t sample, size_t limit)
+        : count_(count), sample_(sample), limit_(limit), next_(sample == SIZE_MAX ? SIZE_MAX : sample / 4) {}
+    // After the trial's first `done` vertices, `bytes` committed: whether it stops there.
+    bool stops(size_t done, size_t bytes) {
+        if (bytes > limit_ + 8) return true;
+        return done == next_ && checkpoint(done, bytes);
+    }
+
+private:
+    bool checkpoint(size_t done, size_t bytes);
+    size_t count_, sample_, limit_;
+    size_t next_;              // the next vertex count with a test (or a rate's start)
+    size_t since_ = 0, since_bytes_ = 0;  // where the rate of the next test starts
+};
 
 // Throws invalid_input, naming `what`, unless 0 <= effort <= kMaxEffort: what every encoder of
 // levels checks before it starts (encode(), the ranks' writer).

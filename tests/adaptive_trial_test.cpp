@@ -1,0 +1,59 @@
+// When an adaptive geometry trial stops (AdaptiveTrialJudge, coding/geometry/level_geometry.h):
+// the exact limit always; the sample's projections, and past the sample one more projection at
+// the end of every further sample's length.
+#include "coding/geometry/level_geometry.h"
+
+#include <gtest/gtest.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+
+namespace amc {
+namespace {
+
+// The first vertex count after which the judge stops a trial whose code has committed
+// bytes(done) bytes after `done` vertices, or 0 if it runs to the level's end.
+size_t stopped_at(size_t count, size_t sample, size_t limit, const std::function<size_t(size_t)>& bytes) {
+    AdaptiveTrialJudge judge(count, sample, limit);
+    for (size_t done = 1; done <= count; ++done)
+        if (judge.stops(done, bytes(done))) return done;
+    return 0;
+}
+
+// 0.1 bytes a vertex for the first `switch_at` vertices, then `later` a vertex.
+std::function<size_t(size_t)> two_rates(size_t switch_at, double later) {
+    return [=](size_t done) {
+        const double first = 0.1 * double(std::min(done, switch_at));
+        return size_t(first + later * double(done > switch_at ? done - switch_at : 0));
+    };
+}
+
+TEST(AdaptiveTrial, RunsOnWhileItsProjectionStaysBelowTheLimit) {
+    // 819 bytes for the level against a limit of 1,000: every projection says it may win.
+    EXPECT_EQ(stopped_at(8192, 1024, 1000, two_rates(8192, 0.0)), 0u);
+}
+
+TEST(AdaptiveTrial, StopsAtTheEndOfTheSampleLengthWhereItsRateRose) {
+    // The sample projects 816 bytes; from there the rate doubles, and the end of the next
+    // sample's length projects 1,536 bytes, past 1.125 times the limit and the slack: the trial
+    // stops there, not at 5,557 vertices where its bytes pass the limit.
+    EXPECT_EQ(stopped_at(8192, 1024, 1000, two_rates(1024, 0.2)), 2048u);
+    // The rate rises late: the test after it stops the trial.
+    EXPECT_EQ(stopped_at(8192, 1024, 1000, two_rates(3500, 0.4)), 4096u);
+}
+
+TEST(AdaptiveTrial, WithoutASampleOnlyTheLimitStopsIt) {
+    // The same bytes: they pass the limit by more than 8 bytes after 5,557 vertices.
+    EXPECT_EQ(stopped_at(8192, SIZE_MAX, 1000, two_rates(1024, 0.2)), 5557u);
+    EXPECT_EQ(stopped_at(8192, SIZE_MAX, 1000, two_rates(8192, 0.0)), 0u);
+}
+
+TEST(AdaptiveTrial, HalfwayThroughTheSampleALargeRateStopsIt) {
+    // 0.4 bytes a vertex from vertex 256 on: halfway (512) the projection is 3,098 bytes, past
+    // 1.25 times the limit.
+    EXPECT_EQ(stopped_at(8192, 1024, 1000, [](size_t done) { return done <= 256 ? done / 10 : 25 + (done - 256) * 2 / 5; }), 512u);
+}
+
+}  // namespace
+}  // namespace amc
