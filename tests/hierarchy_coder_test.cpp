@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <utility>
 
 namespace amc {
@@ -663,6 +664,33 @@ std::vector<std::pair<int, bool>> symbols_as_specified(const Hierarchy& h, int v
         }
     }
     return symbols;
+}
+
+// fork(): a coder of the same first pass, before any level is coded, codes as a coder made
+// afresh (in the mixing mode in another model: the encoder's two files from one first pass).
+TEST(HierarchyCoder, AForkCodesAsAFreshCoder) {
+    auto payload_of = [](HierarchyLevelEncoder& coder) {
+        ArithmeticEncoder encoder;
+        for (int l = 0; l < coder.level_count(); ++l) coder.encode_level(l, encoder);
+        return encoder.finish();
+    };
+    for (uint64_t seed = 1; seed <= 20; ++seed) {
+        const Hierarchy h = random_hierarchy(seed);
+        for (const bool mixed : {false, true}) {
+            HierarchyLevelEncoder coder(h, HierarchyCoderOptions{}, kHierarchyStreamVersion, nullptr, mixed);
+            const std::unique_ptr<HierarchyLevelEncoder> fork = coder.fork();
+            HierarchyLevelEncoder fresh(h, HierarchyCoderOptions{}, kHierarchyStreamVersion, nullptr, mixed);
+            if (mixed) {
+                fork->set_mixing_model(MixingModel::third);
+                fresh.set_mixing_model(MixingModel::third);
+            }
+            ASSERT_EQ(fork->header(), fresh.header()) << "seed " << seed;
+            ASSERT_EQ(payload_of(*fork), payload_of(fresh)) << "seed " << seed << (mixed ? ", mixed" : "");
+            HierarchyLevelEncoder written(h, HierarchyCoderOptions{}, kHierarchyStreamVersion, nullptr, mixed);
+            ASSERT_EQ(payload_of(coder), payload_of(written)) << "seed " << seed << (mixed ? ", mixed" : "");
+            EXPECT_THROW(coder.fork(), Error);  // its levels are coded
+        }
+    }
 }
 
 // A hierarchy stream of `version` (the header's fields and the payload, without the tag).

@@ -179,11 +179,14 @@ struct ForestCode {
 // hierarchy coder made over TurnedRoots; positions as the decoder will have them, or those of
 // `on_grid` when given: one chunk's input nodes with their grid points) in `chunks`;
 // `faces` is the leaf face count when there are several. `positions` holds the models as
-// the base geometry left them. The mixing mode (FORMAT.md 2.1) codes the forest as one stream.
+// the base geometry left them. The mixing mode (FORMAT.md 2.1) codes the forest as one stream, in
+// its written model, and with `third` also in its third model into `third`: the same first pass
+// and the same geometry (which does not depend on the hierarchy's model; each level's chosen
+// once), the hierarchy parts in the models' own arithmetic codes.
 ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<RootRange>& chunks, uint64_t faces,
                        const EncodeOptions& options, CoordinateSpace space, PositionCoder positions, unsigned threads,
                        bool want_hierarchy_stats, HierarchyLevelEncoder* first_pass, const HierarchyOnGrid* on_grid,
-                       MixingModel mixing = kWrittenMixingModel) {
+                       ForestCode* third = nullptr) {
     ForestCode out;
     const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
     out.chunked = !mixed && chunks.size() > 1;
@@ -202,26 +205,38 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
         if (first_pass == nullptr)
             own = std::make_unique<HierarchyLevelEncoder>(h, options.hierarchy, kHierarchyStreamVersion, nullptr, mixed);
         HierarchyLevelEncoder& hierarchy = first_pass != nullptr ? *first_pass : *own;
-        hierarchy.set_mixing_model(mixing);
-        out.fourth_model = mixed && mixing == MixingModel::fourth;
-        out.faces = hierarchy.faces();
-        out.levels = uint64_t(hierarchy.level_count());
-        out.hierarchy_header = hierarchy.header();
+        const std::unique_ptr<HierarchyLevelEncoder> third_hierarchy = mixed && third != nullptr ? hierarchy.fork() : nullptr;
+        PositionCoder third_positions = positions;  // the same models level after level
+        hierarchy.set_mixing_model(kWrittenMixingModel);
+        if (third_hierarchy != nullptr) third_hierarchy->set_mixing_model(MixingModel::third);
+        auto start = [&](ForestCode& code, const HierarchyLevelEncoder& coder) {
+            code.fourth_model = mixed && coder.mixing_model() == MixingModel::fourth;
+            code.faces = coder.faces();
+            code.levels = uint64_t(coder.level_count());
+            code.hierarchy_header = coder.header();
+        };
+        start(out, hierarchy);
+        if (third_hierarchy != nullptr) start(*third, *third_hierarchy);
+        auto add_level = [&](ForestCode& code, HierarchyLevelEncoder& coder, int l, const auto& geometry_of, const NewVertices& created,
+                             const LevelGeometryCode& geometry, PositionCoder& models) {
+            ArithmeticEncoder encoder;
+            coder.encode_level(l, encoder);
+            const size_t hierarchy_part = encoder.bytes_so_far();
+            std::vector<uint8_t> payload = finish_level_payload(geometry_of, created, geometry, models, encoder);
+            code.static_geometry |= geometry.predictor == GeometryPredictor::normal_frame;
+            code.grid_geometry |= geometry.predictor == GeometryPredictor::normal_frame_grid;
+            code.unit_geometry |= geometry.predictor == GeometryPredictor::unit_normal_frame;
+            code.raw_side |= has_raw_side(payload);
+            code.stencil_tables |= has_stencil_tables(geometry.predictor);
+            add_level_stats(code.stats, coder.level_nodes(l).size(), created.size(), hierarchy_part, payload);
+            code.blocks.emplace_back(BlockType::level, std::move(payload));
+        };
         auto code_level = [&](int l, const auto& geometry_of) {
             const NewVertices& created = hierarchy.new_vertices(l);
             const LevelGeometryCode geometry = choose_level_geometry(geometry_of, created, positions, space, options.predictor,
                                                                      options.grid_contexts, options.unit_normals, options.effort);
-            ArithmeticEncoder encoder;
-            hierarchy.encode_level(l, encoder);
-            const size_t hierarchy_part = encoder.bytes_so_far();
-            std::vector<uint8_t> payload = finish_level_payload(geometry_of, created, geometry, positions, encoder);
-            out.static_geometry |= geometry.predictor == GeometryPredictor::normal_frame;
-            out.grid_geometry |= geometry.predictor == GeometryPredictor::normal_frame_grid;
-            out.unit_geometry |= geometry.predictor == GeometryPredictor::unit_normal_frame;
-            out.raw_side |= has_raw_side(payload);
-            out.stencil_tables |= has_stencil_tables(geometry.predictor);
-            add_level_stats(out.stats, hierarchy.level_nodes(l).size(), created.size(), hierarchy_part, payload);
-            out.blocks.emplace_back(BlockType::level, std::move(payload));
+            add_level(out, hierarchy, l, geometry_of, created, geometry, positions);
+            if (third_hierarchy != nullptr) add_level(*third, *third_hierarchy, l, geometry_of, created, geometry, third_positions);
         };
         for (int l = 0; l < hierarchy.level_count(); ++l) {
             if (on_grid != nullptr)
@@ -230,8 +245,11 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
                 code_level(l, h);
         }
         if (want_hierarchy_stats) out.stats.hierarchy = hierarchy.stats();
+        if (want_hierarchy_stats && third_hierarchy != nullptr) third->stats.hierarchy = third_hierarchy->stats();
     }
     for (const auto& block : out.blocks) out.bytes += kBlockOverhead + block.second.size();
+    if (third != nullptr)
+        for (const auto& block : third->blocks) third->bytes += kBlockOverhead + block.second.size();
     return out;
 }
 
@@ -326,20 +344,17 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
                                           : one_chunk ? std::vector<RootRange>{RootRange{0, h.root_count()}}
                                                       : balanced_chunks(root_nodes, chunk_count_for(options, faces));
     const bool want_hierarchy_stats = stats_out != nullptr && options.hierarchy_statistics;
+    ForestCode third;  // the mixing mode's forest in its third model
     ForestCode forest = code_forest(h, root_of, chunks, faces, options, space, positions, threads, want_hierarchy_stats,
-                                    first_pass.get(), turned_input && quantized ? &on_grid : nullptr);
+                                    first_pass.get(), turned_input && quantized ? &on_grid : nullptr, mixed ? &third : nullptr);
     const uint32_t fewer = automatic && forest.chunked ? chunk_count_for_size(options, uint32_t(chunks.size()), forest.bytes)
                                                        : uint32_t(chunks.size());
     if (fewer < chunks.size())
         forest = code_forest(h, root_of, balanced_chunks(root_nodes, fewer), faces, options, space, positions, threads,
                              want_hierarchy_stats, nullptr, nullptr);
-    if (mixed) {
-        // The mixing mode's third model where it codes the file smaller (a few creased or flat
-        // models, by a few bytes): every file at most as large as the third model's.
-        ForestCode third = code_forest(h, root_of, chunks, faces, options, space, positions, threads, want_hierarchy_stats, nullptr,
-                                       nullptr, MixingModel::third);
-        if (third.bytes < forest.bytes) forest = std::move(third);
-    }
+    // The mixing mode's third model where it codes the file smaller (a few creased or flat
+    // models, by a few bytes): every file at most as large as the third model's.
+    if (mixed && third.bytes < forest.bytes) forest = std::move(third);
 
     Metadata meta;
     meta.base_vertices = h.base().positions.size();

@@ -182,12 +182,17 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
     header_ = write_hierarchy_stream_header(header);
 }
 
+std::unique_ptr<HierarchyLevelEncoder> HierarchyLevelEncoder::fork() const {
+    if (next_level_ != 0) throw Error("HierarchyLevelEncoder::fork: a level is coded already");
+    return std::unique_ptr<HierarchyLevelEncoder>(new HierarchyLevelEncoder(*this));
+}
+
 void HierarchyLevelEncoder::encode_level(int l, ArithmeticEncoder& encoder) {
     if (l != next_level_) throw Error("hierarchy levels must be encoded in order");
     ++next_level_;
     const size_t begin = l == 0 ? 0 : level_end_[size_t(l) - 1];
     if (mixed_) {
-        if (mixed_model_ == nullptr) mixed_model_ = std::make_unique<MixedHierarchyModel>(mixing_model_);
+        if (mixed_model_ == nullptr) mixed_model_ = std::make_shared<MixedHierarchyModel>(mixing_model_);
         for_each_mixed(begin, level_end_[size_t(l)], models_, *mixed_model_, symbols_written_,
                        [&](BitModel* model, uint32_t p16, Event e) {
                            if (model != nullptr) encoder.encode_with_limit<kHierarchyModelLimit>(e.bit, *model);

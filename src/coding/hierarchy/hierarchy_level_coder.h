@@ -60,6 +60,10 @@ public:
                           uint8_t stream_version = kHierarchyStreamVersion, std::vector<CodedSymbol>* trace = nullptr,
                           bool mixed = false, const TurnedRoots* turned = nullptr);
     bool mixed() const { return mixed_; }
+    // A coder of the same first pass that has coded no level yet (Error once this one has): the
+    // encoder codes the mixing mode's forest in two models from one first pass.
+    std::unique_ptr<HierarchyLevelEncoder> fork() const;
+    HierarchyLevelEncoder& operator=(const HierarchyLevelEncoder&) = delete;
     // The mixing mode's model encode_level and stats use (kWrittenMixingModel unless set before
     // the first level; the third or the fourth).
     void set_mixing_model(MixingModel model) { mixing_model_ = model; }
@@ -140,7 +144,11 @@ private:
     MixingModel mixing_model_ = kWrittenMixingModel;
     std::vector<MixedFeatures> mixed_features_;  // mixing mode: per hierarchy symbol event
     std::vector<uint32_t> event_feature_;        // mixing mode: event index -> mixed_features_ index
-    std::unique_ptr<MixedHierarchyModel> mixed_model_;  // the mixing mode's state, or null
+    // The mixing mode's state, made at the first level coded: null until then, so that fork()'s
+    // copy shares none.
+    std::shared_ptr<MixedHierarchyModel> mixed_model_;
+
+    HierarchyLevelEncoder(const HierarchyLevelEncoder&) = default;  // fork()'s
 };
 
 // Decides `level` of a version-1 stream (hierarchy_decoder_v1.cpp) as the decoder's general path
