@@ -7,6 +7,7 @@
 #include "coding/geometry/level_geometry.h"
 #include "coding/geometry/static_position_coder.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
@@ -110,6 +111,70 @@ TEST(StaticLevelEncoder, ResidualsOfEveryBitLengthDecodeBitExactly) {
             const Vec3 a = h.position(v), b = decoded.position(v);
             ASSERT_TRUE(std::memcmp(&a, &b, sizeof a) == 0) << "vertex " << v;
         }
+    }
+}
+
+// Mode 4's decoder of split_level's list (the whole-file and chunk decoders' path) and its decoder
+// of (node, edge) pairs decode the same positions, with grid residuals of every bit length on a
+// 30-bit grid (raw bits up to 28 a coordinate, the list decoder's bound on a chunk's reads), and
+// both refuse the streams cut short.
+TEST(StaticLevelEncoder, GridLevelsDecodeAlikeFromTheListAndFromTheNodes) {
+    Hierarchy h = projected_sphere(6000, 6, 13);
+    const Quantizer quantizer = make_quantizer(h.positions(), 30);
+    for (VertexId v = 0; v < h.vertex_count(); ++v) h.set_position(v, dequantize(quantizer, snap_to_grid(quantizer, h.position(v))));
+    const NewVertices created = largest_level(h);
+    ASSERT_GT(created.size(), 200u);
+    std::mt19937_64 rng(7);
+    const int64_t top = int64_t(quantizer.max_coordinate());
+    for (size_t i = 0; i < created.size(); ++i) {
+        const VertexId v = h.midpoint(created[i].first, created[i].second);
+        GridPoint q = snap_to_grid(quantizer, h.position(v));
+        for (int axis = 0; axis < 3; ++axis) {
+            const int length = int((3 * i + size_t(axis)) % 31);  // the offset's bit length, 0..30
+            const int64_t offset = length == 0 ? 0 : int64_t((uint64_t{1} << (length - 1)) | (rng() & ((uint64_t{1} << (length - 1)) - 1)));
+            const int64_t moved = rng() & 1 ? int64_t(q[size_t(axis)]) + offset : int64_t(q[size_t(axis)]) - offset;
+            q[size_t(axis)] = uint32_t(std::min(top, std::max<int64_t>(0, moved)));
+        }
+        h.set_position(v, dequantize(quantizer, q));
+    }
+    // The list decoder appends vertex i's position as vertex first + i, as after split_level (the
+    // frames read earlier levels' vertices only).
+    const VertexId first = VertexId(h.positions().size());
+    std::vector<FrameCorners> corners;
+    for (const auto& [n, e] : created) corners.push_back(frame_corners(h, n, e));
+    const CoordinateSpace space{Precision::float64, &quantizer};
+    const GeometryPredictor mode = GeometryPredictor::normal_frame_grid;
+    StaticLevelEncoder encoder(h, created, space, mode);
+    ArithmeticEncoder tables_out;
+    encoder.write_tables(tables_out);
+    const std::vector<uint8_t> table_bytes = tables_out.finish();
+    ArithmeticDecoder tables_in(table_bytes.data(), table_bytes.size());
+    StaticTables tables;
+    ASSERT_TRUE(read_static_tables(tables_in, space, mode, tables));
+    const std::vector<uint8_t>& rans = encoder.rans_bytes();
+    const std::vector<uint8_t>& raw = encoder.raw_bytes();
+    ASSERT_GT(raw.size(), 1000u);
+    Hierarchy zeroed = h;
+    for (const auto& [n, e] : created) zeroed.set_position(zeroed.midpoint(n, e), Vec3{});
+    auto decode = [&](bool listed, size_t rans_size, size_t raw_size, Hierarchy& out) {
+        out = zeroed;
+        return listed ? decode_static_positions(out, corners.data(), corners.size(), first, space, mode, tables, rans.data(), rans_size,
+                                                raw.data(), raw_size)
+                      : decode_static_positions(out, created, space, mode, tables, rans.data(), rans_size, raw.data(), raw_size);
+    };
+    for (bool listed : {false, true}) {
+        SCOPED_TRACE(listed ? "listed" : "nodes");
+        Hierarchy decoded;
+        ASSERT_TRUE(decode(listed, rans.size(), raw.size(), decoded));
+        ASSERT_EQ(decoded.positions().size(), listed ? first + created.size() : first);
+        for (size_t i = 0; i < created.size(); ++i) {
+            const VertexId v = h.midpoint(created[i].first, created[i].second);
+            const Vec3 a = h.position(v), b = decoded.positions()[listed ? first + i : v];
+            ASSERT_TRUE(std::memcmp(&a, &b, sizeof a) == 0) << "vertex " << v;
+        }
+        EXPECT_FALSE(decode(listed, rans.size() - 1, raw.size(), decoded));
+        EXPECT_FALSE(decode(listed, rans.size(), raw.size() - 1, decoded));
+        EXPECT_FALSE(decode(listed, rans.size(), raw.size() / 2, decoded));
     }
 }
 

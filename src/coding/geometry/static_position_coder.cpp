@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <string>
 #include <type_traits>
 
@@ -1094,6 +1095,194 @@ bool decode_stencil_float64(Hierarchy& h, const std::vector<std::pair<NodeId, in
     return streams.ended_cleanly();
 }
 
+// ---- mode 4 over split_level's list: the level decoder's fast path --------------------------------
+//
+// decode_positions<true, true> for a listed level whose tables are narrow (every quantized level),
+// decoded with the float64 decoder's streams (StencilStreams: rANS states in the loop's variables,
+// raw bits by one load, bounds tests only near the streams' ends) and a table entry per token that
+// holds a direct token's signed residual. Each frame stays in axis order, its roles' axes indexed
+// per coordinate, instead of being copied into role order. The same tokens, operations and bits.
+
+// A token of a quantized table: its rANS range, and its residual: `value` for a direct token
+// (raw_count 0), else the magnitude's leading bits, the sign and the low bits following in the raw
+// stream (raw_count of them; magnitudes are below 2^kMaxQuantizationBits).
+struct GridEntry {
+    int32_t value;
+    uint16_t frequency, start;
+    uint32_t raw_mask;
+    uint32_t raw_count;
+};
+struct GridTable {
+    const uint8_t* index;  // per slot, the entry (RansTable::narrow_view's)
+    std::array<GridEntry, 256> entries;
+};
+
+// From a narrow table whose tokens fit a quantized space (read_static_tables' token_limit).
+void make_grid_table(const RansTable& table, GridTable& out) {
+    out.index = table.narrow_view().index;
+    size_t i = 0;
+    for (int token = 0; token < table.size(); ++token) {
+        if (table.frequency(token) == 0) continue;
+        GridEntry& e = out.entries[i++];
+        e.frequency = uint16_t(table.frequency(token));
+        e.start = uint16_t(table.start(token));
+        if (token < kDirectTokens) {
+            e.value = kDirectValues[token];
+            e.raw_count = 0;
+            e.raw_mask = 0;
+        } else {  // take_large's, with low <= kMaxQuantizationBits - 3
+            const int low = 4 + (token - kDirectTokens) / 4 - 3;
+            e.value = int32_t(uint32_t(4 | ((token - kDirectTokens) & 3)) << low);
+            e.raw_count = uint32_t(1 + low);
+            e.raw_mask = (uint32_t{1} << (1 + low)) - 1;
+        }
+    }
+}
+
+// The next token of state State under `table`, as its signed residual.
+template <int State, bool Safe>
+AMC_ALWAYS_INLINE int64_t grid_token(StencilStreams& s, const GridTable& table) {
+    uint32_t& x = s.x[State];
+    const uint32_t slot = x & (kRansScale - 1);
+    const GridEntry& e = table.entries[table.index[slot]];
+    x = uint32_t(e.frequency) * (x >> kRansScaleBits) + slot - e.start;
+    if (x < kRansLow) {  // at most two bytes (StencilStreams::residual)
+        x = (x << 8) | s.rans_byte<Safe>();
+        if (x < kRansLow) x = (x << 8) | s.rans_byte<Safe>();
+    }
+    if (e.raw_count == 0) return e.value;  // most quantized tokens: the branch predicts well
+    const uint64_t r = s.raw_peek<Safe>(s.raw_bits_read) & e.raw_mask;
+    s.raw_bits_read += e.raw_count;
+    return negated_if(int64_t(uint64_t(uint32_t(e.value)) | r >> 1), (r & 1) != 0);
+}
+
+// A vertex's frame as the fast path reads it: midpoint and normal in axis order, the frame's axis
+// (0 without a normal: role_axes') and role 0's grid prediction.
+struct GridFrame {
+    double midpoint[3], normal[3];
+    GridPrediction first;
+    int axis;
+    bool has_normal;
+};
+
+AMC_ALWAYS_INLINE void set_grid_frame(const NormalFrame& f, const GridScale& grid, const double* origin, GridFrame& g) {
+    g.midpoint[0] = f.midpoint.x;
+    g.midpoint[1] = f.midpoint.y;
+    g.midpoint[2] = f.midpoint.z;
+    g.normal[0] = f.normal.x;
+    g.normal[1] = f.normal.y;
+    g.normal[2] = f.normal.z;
+    g.has_normal = f.has_normal;
+    g.axis = f.has_normal ? f.axis : 0;
+    g.first = grid_prediction_at(grid, origin[g.axis], g.midpoint[g.axis]);
+}
+
+// Coordinate `axis` of `p`, written through its object representation (Vec3 is three doubles).
+AMC_ALWAYS_INLINE void set_coordinate(Vec3& p, int axis, double value) {
+    std::memcpy(reinterpret_cast<unsigned char*>(&p) + sizeof(double) * size_t(axis), &value, sizeof(double));
+}
+static_assert(sizeof(Vec3) == 3 * sizeof(double) && offsetof(Vec3, y) == sizeof(double) && offsetof(Vec3, z) == 2 * sizeof(double),
+              "Vec3 is x, y, z");
+
+// decode_vertex<State, true> over a GridFrame: role r's axis is the frame's axis, then the two
+// others in increasing order.
+template <int State, bool Safe>
+AMC_ALWAYS_INLINE bool decode_grid_vertex(StencilStreams& s, const GridTable* t, const GridFrame& f, const GridScale& grid,
+                                          const double* origin, Vec3& p) {
+    const int a0 = f.axis, a1 = a0 == 0 ? 1 : 0, a2 = a0 == 2 ? 1 : 2;
+    const int64_t q0 = int64_t(f.first.p) + negated_if(grid_token<State, Safe>(s, t[f.first.bin]), f.first.turn);
+    if (uint64_t(q0) > grid.max) return false;  // also q0 < 0
+    const double v0 = origin[a0] + rounded(static_cast<double>(q0) * grid.step);
+    double second = f.midpoint[a1], third = f.midpoint[a2];
+    if (f.has_normal) {  // predict_others'
+        const double u = rounded((v0 - f.midpoint[a0]) / f.normal[a0]);
+        second = second + rounded(u * f.normal[a1]);
+        third = third + rounded(u * f.normal[a2]);
+    }
+    const GridPrediction g1 = grid_prediction_at(grid, origin[a1], second);
+    const GridPrediction g2 = grid_prediction_at(grid, origin[a2], third);
+    const int64_t q1 = int64_t(g1.p) + negated_if(grid_token<1 - State, Safe>(s, t[kGridBins + g1.bin]), g1.turn);
+    if (uint64_t(q1) > grid.max) return false;
+    const int64_t q2 = int64_t(g2.p) + negated_if(grid_token<State, Safe>(s, t[2 * kGridBins + g2.bin]), g2.turn);
+    if (uint64_t(q2) > grid.max) return false;
+    set_coordinate(p, a0, v0);
+    set_coordinate(p, a1, origin[a1] + rounded(static_cast<double>(q1) * grid.step));
+    set_coordinate(p, a2, origin[a2] + rounded(static_cast<double>(q2) * grid.step));
+    return true;
+}
+
+// The fast path's condition: a double-precision hierarchy (every quantized one) and narrow tables.
+bool decode_grid_listed(Hierarchy& h, const FromList& created, const Quantizer& quantizer, const StaticTables& tables,
+                        const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
+    std::array<GridTable, kMaxStaticTables> t;
+    for (size_t k = 0; k < t.size(); ++k) make_grid_table(tables[k], t[k]);
+    StencilStreams s{{0, 0}, rans_data, rans_data + rans_size, raw_data, 0, raw_size};
+    if (rans_size < kRansStateBytes) return false;
+    for (uint32_t& x : s.x) {
+        x = load_le32(s.rans);
+        s.rans += 4;
+        if (x < kRansLow) return false;  // RansDecoder's: no encoder ends below L
+    }
+    const GridScale grid = grid_scale(&quantizer);
+    const double origin[3] = {quantizer.origin.x, quantizer.origin.y, quantizer.origin.z};
+    // decode_positions': every grid value lies between the box's corners.
+    const bool near = !HierarchyBuilder::is_far(quantizer.origin) &&
+                      !HierarchyBuilder::is_far(dequantize(quantizer, {quantizer.max_coordinate(), quantizer.max_coordinate(),
+                                                                       quantizer.max_coordinate()}));
+    const bool append = created.appends(h);
+    // What a chunk reads at most: two rANS bytes and the sign and low bits per coordinate, and the
+    // 8 bytes of the last raw load.
+    constexpr size_t kChunkRans = 2 * 3 * kChunk, kChunkRaw = 3 * kChunk * (kMaxQuantizationBits - 2) / 8 + 16;
+    std::array<GridFrame, kChunk> frames;
+    Vec3 decoded[kChunk];
+    for (size_t begin = 0; begin < created.count; begin += kChunk) {
+        const size_t count = std::min(kChunk, created.count - begin);
+        const FrameCorners* corners = created.corners + begin;
+        const Vec3* positions = h.positions().data();
+        for (size_t i = 0; i < count; ++i) {  // a, b and c are always vertices
+            const FrameCorners& k = corners[i];
+            __builtin_prefetch(positions + k.a);
+            __builtin_prefetch(positions + k.b);
+            __builtin_prefetch(positions + k.c);
+            if (k.d != kNoVertex) __builtin_prefetch(positions + k.d);
+        }
+        size_t i = 0;
+#if AMC_SSE2
+        for (; i + 1 < count; i += 2) {
+            NormalFrame f0, f1;
+            frame_pair_of<true>(h, corners[i], corners[i + 1], f0, f1);
+            set_grid_frame(f0, grid, origin, frames[i]);
+            set_grid_frame(f1, grid, origin, frames[i + 1]);
+        }
+#endif
+        for (; i < count; ++i) set_grid_frame(frame_of<true>(h, corners[i]), grid, origin, frames[i]);
+        auto run = [&](auto safe) {
+            constexpr bool Safe = decltype(safe)::value;
+            StencilStreams local = s;  // the chunk's copy, which the compiler keeps in registers
+            bool ok = true;
+            for (size_t k = 0; k < count && ok; k += 2) {  // token j of the level with state j mod 2
+                ok = decode_grid_vertex<0, Safe>(local, t.data(), frames[k], grid, origin, decoded[k]) &&
+                     (k + 1 == count || decode_grid_vertex<1, Safe>(local, t.data(), frames[k + 1], grid, origin, decoded[k + 1]));
+            }
+            s = local;
+            return ok;
+        };
+        const bool inside = size_t(s.rans_end - s.rans) >= kChunkRans &&
+                            raw_size - std::min<size_t>(raw_size, size_t(s.raw_bits_read >> 3)) >= kChunkRaw;
+        if (!(inside ? run(std::false_type{}) : run(std::true_type{}))) return false;
+        if (append) {
+            HierarchyBuilder::append_positions(h, decoded, count, near);
+        } else {
+            for (size_t k = 0; k < count; ++k) {
+                const VertexId v = created.first + VertexId(begin + k);
+                if (near) HierarchyBuilder::set_near_vertex_position(h, v, decoded[k]);
+                else HierarchyBuilder::set_new_vertex_position(h, v, decoded[k]);
+            }
+        }
+    }
+    return s.ended_cleanly();
+}
+
 template <class Tables>
 bool decode_stencil_with(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
                          GeometryPredictor mode, const Tables& tables, const uint8_t* rans_data, size_t rans_size,
@@ -1147,6 +1336,10 @@ bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, G
         }
     } else if (has_stencil_tables(mode)) {
         return false;  // a listed level has frame corners, not the stencils' nodes
+    }
+    if constexpr (std::is_same_v<Source, FromList>) {
+        if (all_narrow && mode == GeometryPredictor::normal_frame_grid && space.quantizer != nullptr && !h.single_precision())
+            return decode_grid_listed(h, created, *space.quantizer, tables, rans_data, rans_size, raw_data, raw_size);
     }
     if (all_narrow) return decode_static_with(h, created, space, mode, narrow, rans_data, rans_size, raw_data, raw_size);
     return decode_static_with(h, created, space, mode, tables, rans_data, rans_size, raw_data, raw_size);
