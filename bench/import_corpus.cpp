@@ -6,11 +6,14 @@
 //     (base connectivity + hierarchy stream of the .amc file) against the true hierarchy's.
 // Prints a Markdown table. Exit status 1 if any import with the base is not identical.
 //
-// Usage: import_corpus [--move X] [--seed N] [--with-base-only | --without-base-only] [--hash] corpus/*.amh
+// Usage: import_corpus [--move X] [--seed N] [--with-base-only | --without-base-only] [--hash]
+//                      [--full-messages] corpus/*.amh
 // (scripts/import_corpus.sh makes the corpus; --with-base-only skips import_mesh and leaves its
 // columns empty, --without-base-only skips import_leaf_mesh likewise; --hash prints,
 // to stderr, a hash of each detected hierarchy's .amc file, to tell a changed search's output apart;
-// --seed N shuffles and moves with another seed than 23, to see how the results depend on the order)
+// --seed N shuffles and moves with another seed than 23, to see how the results depend on the order;
+// --full-messages prints refusals whole instead of their first 67 characters, to tell a changed
+// import's answers apart)
 #include "user_leaf_mesh.h"
 
 #include <amc/codec.h>
@@ -47,12 +50,13 @@ uint64_t connectivity_bytes(const amc::Hierarchy& h) {
 }  // namespace
 
 constexpr const char* kUsage =
-    "usage: import_corpus [--move X] [--seed N] [--with-base-only | --without-base-only] [--hash] hierarchy.amh...\n";
+    "usage: import_corpus [--move X] [--seed N] [--with-base-only | --without-base-only] [--hash] [--full-messages] "
+    "hierarchy.amh...\n";
 
 int run(int argc, char** argv) {
     double move = 0.3;
     uint64_t seed = 23;
-    bool detect = true, with_base_import = true, hash = false;
+    bool detect = true, with_base_import = true, hash = false, full_messages = false;
     std::vector<std::string> files;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
@@ -66,6 +70,8 @@ int run(int argc, char** argv) {
             with_base_import = false;
         } else if (arg == "--hash") {
             hash = true;
+        } else if (arg == "--full-messages") {
+            full_messages = true;
         } else if (arg == "--help" || arg == "-h") {
             std::printf("%s", kUsage);
             return 0;
@@ -103,7 +109,7 @@ int run(int argc, char** argv) {
                 with_base = amc::identical(imported.hierarchy, expected) ? "identical" : "DIFFERENT";
             } catch (const amc::Error& e) {
                 with_base = std::string("refused: ") + e.what();
-                if (with_base.size() > 70) with_base = with_base.substr(0, 67) + "...";
+                if (!full_messages && with_base.size() > 70) with_base = with_base.substr(0, 67) + "...";
             }
         }
         const double with_base_seconds = thread_seconds() - start;

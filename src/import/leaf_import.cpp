@@ -6,6 +6,7 @@
 #include "common/no_index.h"
 #include "hierarchy/leaf_triangles.h"
 #include "import/anchored_reconstruction.h"
+#include "import/base_detection.h"
 #include "import/leaf_halfedges.h"
 #include "import/leaf_reconstruction.h"
 #include "import/position_index.h"
@@ -14,6 +15,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -60,6 +62,48 @@ std::vector<uint32_t> match_base_vertices(const TriangleMesh& base, const Triang
     }
     return match;
 }
+
+std::vector<uint32_t> inverse(const std::vector<uint32_t>& order) {
+    std::vector<uint32_t> out(order.size());
+    for (uint32_t i = 0; i < order.size(); ++i) out[order[i]] = i;
+    return out;
+}
+
+TriangleMesh renumbered(const TriangleMesh& leaf, const std::vector<uint32_t>& input_of,
+                        const std::vector<uint32_t>& import_of) {
+    TriangleMesh out;
+    out.single_precision = leaf.single_precision;
+    out.positions.resize(input_of.size());
+    for (uint32_t v = 0; v < input_of.size(); ++v) out.positions[v] = leaf.positions[input_of[v]];
+    out.triangles = leaf.triangles;
+    detail::renumber(out.triangles, import_of);
+    return out;
+}
+
+// The leaf mesh on base detection's breadth-first vertex numbering, for the ways a refusal spends
+// its time in (the anchored way, then the guided ways with its undo steps): on a user's shuffled
+// ids nearly every lookup of a large mesh misses the cache. The faces keep their order (the
+// anchored way's search depends on it); the position index and the k-d tree take the vertices in
+// the input's order (which of two equal candidates is first), so the answers are the input
+// numbering's, and messages name the input's vertices (input_of).
+struct RenumberedLeaf {
+    RenumberedLeaf(const TriangleMesh& leaf, const std::vector<uint32_t>& input_leaf_of_base)
+        : input_of(detail::breadth_first_vertices(leaf.triangles, uint32_t(leaf.positions.size()))),
+          import_of(inverse(input_of)),
+          mesh(renumbered(leaf, input_of, import_of)),
+          halfedges(mesh),
+          positions(mesh.positions, nullptr, nullptr, &import_of),
+          search(mesh, &import_of) {
+        leaf_of_base.reserve(input_leaf_of_base.size());
+        for (uint32_t l : input_leaf_of_base) leaf_of_base.push_back(import_of[l]);
+    }
+    const std::vector<uint32_t> input_of, import_of;  // import id -> input id, and back
+    const TriangleMesh mesh;
+    const LeafHalfedges halfedges;
+    const PositionIndex positions;
+    LeafSearch search;
+    std::vector<uint32_t> leaf_of_base;
+};
 
 // extract_leaf_mesh(h) must be the input: every leaf triangle an input face with the same
 // orientation, every input face one leaf triangle. Read in hierarchy vertex ids, in
@@ -139,9 +183,16 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
         anchored,         // levels undone bottom-up from the connectivity alone, the base vertices kept
                           // (positions anywhere; not every adaptive mesh yet, docs/IMPORT.md)
     };
-    // What the anchored way undid, kept for the guided ways' second round.
+    // What the anchored way undid, kept for the guided ways' second round (in renumbered's ids).
     UndoSteps steps;
     LeafSearch search(leaf);
+    std::unique_ptr<RenumberedLeaf> renumbered;  // made for the anchored way
+    auto guide_of = [](Way way) {
+        return way == Way::exact_midpoints ? MidpointGuide::exact
+               : way == Way::leaf_midpoint ? MidpointGuide::leaf_midpoint
+               : way == Way::subdivision   ? MidpointGuide::subdivision
+                                           : MidpointGuide::surface;
+    };
     auto attempt = [&](Way way, bool by_undo_steps) {
         out.hierarchy = Hierarchy(hierarchy_base);
         // A leaf mesh of F faces comes from at most F leaves, so from at most 4F/3 + roots nodes.
@@ -149,17 +200,23 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
         if (way == Way::uniform) {
             leaf_of_vertex = reconstruct_uniform(out.hierarchy, leaf_of_base, leaf, halfedges);
             if (leaf_of_vertex.empty()) throw Error(what + ": not a uniform refinement");
-        } else if (way == Way::anchored) {
-            validate_triangle_mesh(leaf, what);  // the inverse step needs an oriented manifold
-            leaf_of_vertex = reconstruct_anchored(out.hierarchy, leaf_of_base, leaf, what, &steps);
-            if (leaf_of_vertex.empty()) throw Error(what + ": anchored inverse refinement did not reach the base");
+        } else if (way == Way::anchored || by_undo_steps) {
+            if (way == Way::anchored) validate_triangle_mesh(leaf, what);  // the inverse step needs an oriented manifold
+            if (!renumbered) renumbered = std::make_unique<RenumberedLeaf>(leaf, leaf_of_base);
+            RenumberedLeaf& r = *renumbered;
+            if (way == Way::anchored) {
+                leaf_of_vertex = reconstruct_anchored(out.hierarchy, r.leaf_of_base, r.mesh, what, &steps);
+                if (leaf_of_vertex.empty()) throw Error(what + ": anchored inverse refinement did not reach the base");
+            } else {
+                leaf_of_vertex = reconstruct_hierarchy(out.hierarchy, r.leaf_of_base, r.mesh, r.halfedges, guide_of(way),
+                                                       r.positions, r.search, what, &steps, nullptr, &r.input_of);
+            }
+            for (uint32_t& l : leaf_of_vertex) {
+                if (l != kNoIndex) l = r.input_of[l];
+            }
         } else {
-            const MidpointGuide guide = way == Way::exact_midpoints ? MidpointGuide::exact
-                                        : way == Way::leaf_midpoint ? MidpointGuide::leaf_midpoint
-                                        : way == Way::subdivision   ? MidpointGuide::subdivision
-                                                                    : MidpointGuide::surface;
-            leaf_of_vertex = reconstruct_hierarchy(out.hierarchy, leaf_of_base, leaf, halfedges, guide,
-                                                   leaf_positions, search, what, by_undo_steps ? &steps : nullptr);
+            leaf_of_vertex = reconstruct_hierarchy(out.hierarchy, leaf_of_base, leaf, halfedges, guide_of(way),
+                                                   leaf_positions, search, what);
         }
         verify_leaf_mesh(out.hierarchy, leaf_of_vertex, leaf, halfedges, what);
     };

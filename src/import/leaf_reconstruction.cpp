@@ -13,11 +13,12 @@
 
 namespace amc {
 
-LeafSearch::LeafSearch(const TriangleMesh& leaf) : leaf_(leaf) {}
+LeafSearch::LeafSearch(const TriangleMesh& leaf, const std::vector<uint32_t>* insertion_order)
+    : leaf_(leaf), insertion_order_(insertion_order) {}
 LeafSearch::~LeafSearch() = default;
 
 const NearestVertex& LeafSearch::nearest() {
-    if (!nearest_) nearest_ = std::make_unique<NearestVertex>(leaf_.positions);
+    if (!nearest_) nearest_ = std::make_unique<NearestVertex>(leaf_.positions, insertion_order_);
     return *nearest_;
 }
 
@@ -61,7 +62,7 @@ void Reconstruction::reconstruct_level(std::vector<NodeId>& level, std::vector<N
         if (leaf_of_vertex_[m] == kNoIndex) {
             assign(m, r.leaf_vertex);
         } else if (leaf_of_vertex_[m] != r.leaf_vertex) {
-            fail("vertices " + std::to_string(leaf_of_vertex_[m]) + " and " + std::to_string(r.leaf_vertex) +
+            fail("vertices " + vertex_text(leaf_of_vertex_[m]) + " and " + vertex_text(r.leaf_vertex) +
                  " both split the edge (" + edge_text(q, h_.neighbor_edge(r.node, r.edge)) + ")");
         }
     }
@@ -118,12 +119,12 @@ void Reconstruction::read_level(const std::vector<NodeId>& level, std::vector<No
         for (const Reveal& r : reveals_) {
             if (!is_refined(h_.neighbor(r.node, r.edge))) {
                 explain_misfit(r.node);
-                fail(std::string("vertex ") + std::to_string(r.leaf_vertex) +
+                fail(std::string("vertex ") + vertex_text(r.leaf_vertex) +
                      " lies on an edge whose other side is not refined (T-junction)" +
                      (h_.level(r.node) == 0 ? " (wrong base?)" : ""));
             }
             if (vertex_of_leaf_[r.leaf_vertex] != kNoIndex)
-                fail("vertex " + std::to_string(r.leaf_vertex) +
+                fail("vertex " + vertex_text(r.leaf_vertex) +
                      " would be used twice by the refinement (not a red-green refinement)");
         }
     } catch (const Error&) {
@@ -203,17 +204,17 @@ bool Reconstruction::classify(NodeId n) {
             break;
         case Reading::edge_across:
             fail("edge (" + edge_text(n, r.fault_edge) + ") of face " + std::to_string(r.fault_detail[0]) +
-                 " has nothing on its other side, where the element (" + std::to_string(p[0]) + ", " +
-                 std::to_string(p[1]) + ", " + std::to_string(p[2]) +
+                 " has nothing on its other side, where the element (" + vertex_text(p[0]) + ", " +
+                 vertex_text(p[1]) + ", " + vertex_text(p[2]) +
                  ") is split: a missing face, or a T-junction in face " + std::to_string(r.fault_detail[0]) +
                  (h_.level(n) == 0 ? " (wrong base?)" : ""));
         case Reading::not_a_face:
             fail_node(n, "is not a face of the leaf mesh, nor split by it");
         case Reading::two_vertices:
             explain_misfit(n);
-            fail("the edge (" + edge_text(n, r.fault_edge) + ") of the element (" + std::to_string(p[0]) + ", " +
-                 std::to_string(p[1]) + ", " + std::to_string(p[2]) + ") carries more than one vertex (" +
-                 std::to_string(r.fault_detail[0]) + ", " + std::to_string(r.fault_detail[1]) +
+            fail("the edge (" + edge_text(n, r.fault_edge) + ") of the element (" + vertex_text(p[0]) + ", " +
+                 vertex_text(p[1]) + ", " + vertex_text(p[2]) + ") carries more than one vertex (" +
+                 vertex_text(r.fault_detail[0]) + ", " + vertex_text(r.fault_detail[1]) +
                  "): the elements across are more than one level finer (2:1 balance violated)");
         case Reading::no_bisection:
             explain_misfit(n);
@@ -330,8 +331,9 @@ std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint
                                             const TriangleMesh& leaf, const LeafHalfedges& halfedges,
                                             MidpointGuide guide, const PositionIndex& positions,
                                             LeafSearch& search, const std::string& what, const UndoSteps* steps,
-                                            const PickReferee* referee) {
-    return Reconstruction(h, leaf_of_base, leaf, halfedges, guide, positions, search, what, steps, referee).run();
+                                            const PickReferee* referee, const std::vector<uint32_t>* input_of) {
+    return Reconstruction(h, leaf_of_base, leaf, halfedges, guide, positions, search, what, steps, referee, input_of)
+        .run();
 }
 
 }  // namespace amc

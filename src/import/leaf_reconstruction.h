@@ -23,13 +23,15 @@ class NearestVertex;
 // reconstruction's nearest-vertex queries; a refusal runs six guided ways).
 class LeafSearch {
 public:
-    explicit LeafSearch(const TriangleMesh& leaf);
+    // The k-d tree takes the vertices in `insertion_order` (NearestVertex), if given.
+    explicit LeafSearch(const TriangleMesh& leaf, const std::vector<uint32_t>* insertion_order = nullptr);
     ~LeafSearch();
     const NearestVertex& nearest();
     const ClosestPointQuery& surface();
 
 private:
     const TriangleMesh& leaf_;
+    const std::vector<uint32_t>* insertion_order_;
     std::unique_ptr<NearestVertex> nearest_;
     std::unique_ptr<ClosestPointQuery> surface_;
 };
@@ -74,12 +76,14 @@ using PickReferee = std::function<uint32_t(const GuidedPick&)>;
 // the connectivity alone. With `steps` (what the anchored inverse refinement undid), a guided pick
 // is chosen among the nearest candidates by them (undo_steps.h); `referee` (if given) sees each
 // such pick. Throws Error when the leaf mesh
-// does not fit; the caller verifies the whole leaf mesh afterwards.
+// does not fit, naming leaf vertex l as input_of[l] when input_of is given (the caller's numbering
+// of a renumbered leaf mesh); the caller verifies the whole leaf mesh afterwards.
 std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
                                             const TriangleMesh& leaf, const LeafHalfedges& halfedges,
                                             MidpointGuide guide, const PositionIndex& positions,
                                             LeafSearch& search, const std::string& what,
                                             const UndoSteps* steps = nullptr,
-                                            const PickReferee* referee = nullptr);
+                                            const PickReferee* referee = nullptr,
+                                            const std::vector<uint32_t>* input_of = nullptr);
 
 }  // namespace amc

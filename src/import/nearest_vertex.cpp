@@ -6,10 +6,13 @@
 
 namespace amc {
 
-NearestVertex::NearestVertex(const std::vector<Vec3>& positions) {
+NearestVertex::NearestVertex(const std::vector<Vec3>& positions, const std::vector<uint32_t>* insertion_order) {
     points_.reserve(positions.size());
     advise_huge_pages(points_.data(), points_.capacity() * sizeof(Point));  // each query reads a few buckets at random
-    for (uint32_t v = 0; v < positions.size(); ++v) points_.push_back({{positions[v].x, positions[v].y, positions[v].z}, v});
+    for (uint32_t i = 0; i < positions.size(); ++i) {
+        const uint32_t v = insertion_order ? (*insertion_order)[i] : i;
+        points_.push_back({{positions[v].x, positions[v].y, positions[v].z}, v});
+    }
     size_t inner = 1;
     while (inner * kBucket < points_.size()) inner *= 2;
     axis_.assign(2 * inner, 0);

@@ -16,16 +16,19 @@ namespace amc {
 class PositionIndex {
 public:
 
-    // Indexes every position; `duplicate_of` receives, when not null, the first pair (earlier,
-    // later) of vertices with the same position, or {kNoIndex, kNoIndex}.
+    // Indexes every position, in the order of `insertion_order` (vertex ids; null: 0, 1, ...), so
+    // that find() answers "first" in that order; `duplicate_of` receives, when not null, the first
+    // pair (earlier, later) of vertices with the same position, or {kNoIndex, kNoIndex}.
     explicit PositionIndex(const std::vector<Vec3>& positions, uint32_t* first_duplicate = nullptr,
-                           uint32_t* second_duplicate = nullptr)
+                           uint32_t* second_duplicate = nullptr,
+                           const std::vector<uint32_t>* insertion_order = nullptr)
         : positions_(positions) {
         size_t capacity = 16;
         while (capacity < 2 * positions.size()) capacity *= 2;
         slots_.assign(capacity, kNoIndex);
         if (first_duplicate != nullptr) *first_duplicate = *second_duplicate = kNoIndex;
-        for (uint32_t v = 0; v < positions.size(); ++v) {
+        for (uint32_t i = 0; i < positions.size(); ++i) {
+            const uint32_t v = insertion_order ? (*insertion_order)[i] : i;
             size_t s = slot_of(positions[v]);
             while (slots_[s] != kNoIndex && !same(positions[slots_[s]], positions[v])) s = (s + 1) & (slots_.size() - 1);
             if (slots_[s] == kNoIndex) {

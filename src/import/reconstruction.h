@@ -23,9 +23,10 @@ class Reconstruction {
 public:
     Reconstruction(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base, const TriangleMesh& leaf,
                    const LeafHalfedges& halfedges, MidpointGuide guide, const PositionIndex& positions,
-                   LeafSearch& search, const std::string& what, const UndoSteps* steps, const PickReferee* referee)
+                   LeafSearch& search, const std::string& what, const UndoSteps* steps, const PickReferee* referee,
+                   const std::vector<uint32_t>* input_of)
         : h_(h), leaf_(leaf), he_(halfedges), guide_(guide), positions_(positions), search_(search), what_(what),
-          referee_(referee) {
+          referee_(referee), input_of_(input_of) {
         if (steps) choice_ = std::make_unique<UndoStepChoice>(*steps);
         leaf_of_vertex_.assign(h.positions().size(), kNoIndex);
         vertex_of_leaf_.assign(leaf.positions.size(), kNoIndex);
@@ -90,16 +91,20 @@ private:
         return 4 * exact_dot(ab, ab);
     }
 
+    // Leaf vertex l as the caller numbers it (messages name the input's vertices).
+    std::string vertex_text(uint32_t l) const {
+        return std::to_string(input_of_ && l != kNoIndex ? (*input_of_)[l] : l);
+    }
     std::string edge_text(NodeId n, int e) const {
-        return std::to_string(corner(n, e)) + "," + std::to_string(corner(n, (e + 1) % 3));
+        return vertex_text(corner(n, e)) + "," + vertex_text(corner(n, (e + 1) % 3));
     }
 
     [[noreturn]] void fail_node(NodeId n, const std::string& message) const {
         // A base triangle that does not fit points at the base rather than at the leaf mesh.
         const std::string which = h_.level(n) == 0 ? "the base triangle " + std::to_string(n) + " on vertices ("
                                                    : "the element on vertices (";
-        fail(which + std::to_string(corner(n, 0)) + ", " + std::to_string(corner(n, 1)) + ", " +
-             std::to_string(corner(n, 2)) + ") " + message + (h_.level(n) == 0 ? " (wrong base?)" : ""));
+        fail(which + vertex_text(corner(n, 0)) + ", " + vertex_text(corner(n, 1)) + ", " +
+             vertex_text(corner(n, 2)) + ") " + message + (h_.level(n) == 0 ? " (wrong base?)" : ""));
     }
 
     void unassign(VertexId v) {
@@ -110,7 +115,7 @@ private:
     void assign(VertexId v, uint32_t l) {
         if (l == kNoIndex) fail("internal: no leaf vertex for hierarchy vertex " + std::to_string(v));
         if (vertex_of_leaf_[l] != kNoIndex)
-            fail("vertex " + std::to_string(l) + " would be used twice by the refinement (not a red-green refinement)");
+            fail("vertex " + vertex_text(l) + " would be used twice by the refinement (not a red-green refinement)");
         leaf_of_vertex_[v] = l;
         vertex_of_leaf_[l] = v;
     }
@@ -379,6 +384,7 @@ private:
     LeafSearch& search_;
     const std::string& what_;
     const PickReferee* referee_;
+    const std::vector<uint32_t>* input_of_;  // the caller's number of each leaf vertex (null: the same)
     // The true vertex is among the four nearest for most wrong nearest picks (docs/IMPORT.md);
     // more candidates let farther ones, outside the two elements on the edge, win.
     static constexpr uint32_t kCandidates = 4;
