@@ -71,13 +71,28 @@ size_t LevelFinder::commit(const std::vector<uint8_t>* active) {
 }
 
 void LevelFinder::commit_small_patches(const std::vector<uint32_t>& region) {
-    std::vector<uint32_t> seeds;
+    // Most red-readable sides first, the caller's order among equals (a stable counting sort).
+    std::array<std::vector<uint32_t>, 5> by_sides;
     for (uint32_t t : region) {
-        if (!taken(t)) seeds.push_back(t);
+        if (!taken(t)) by_sides[4 - readable_sides(t)].push_back(t);
     }
+    std::vector<uint32_t> seeds;
+    for (const std::vector<uint32_t>& bucket : by_sides) seeds.insert(seeds.end(), bucket.begin(), bucket.end());
     growth_limit_ = kSmallPatch;
     commit_best_first(seeds);
     growth_limit_ = kNoIndex;
+}
+
+uint32_t LevelFinder::readable_sides(uint32_t t) const {
+    const Block* b = possible_block(t);
+    if (b == nullptr) return 0;
+    const std::array<Fan, 3> fans = b->fan;  // a copy: possible_block below moves shapes_
+    uint32_t count = 1;
+    for (const Fan& fan : fans) {
+        count += fan.kind == Fan::boundary ||
+                 (fan.kind == Fan::triangles && fan.size == 3 && possible_block(fan.triangle[1]) != nullptr);
+    }
+    return count;
 }
 
 uint32_t LevelFinder::removed_by(size_t id) const {

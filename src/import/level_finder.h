@@ -294,8 +294,14 @@ private:
     // Seeds every free triangle of `region` (where this step sought patches) once more, for
     // patches of at most kSmallPatch blocks: a growth that failed marks the centers it passed as
     // explored, so a small true patch that a wrong reading reached (and failed with) may never
-    // have seeded itself. docs/IMPORT.md, "Small patches sought again".
+    // have seeded itself. docs/IMPORT.md, "Small patches sought again". The seeds whose block
+    // reads most like the inside of a level go first, so that they, not wrong readings seeded
+    // before them, mark the centers they pass explored ("Sweep seeds ordered").
     void commit_small_patches(const std::vector<uint32_t>& region);
+
+    // 0 when no block can be centered at t (possible_block), else 1 + the sides of that block
+    // whose fan is the boundary or three triangles around the center of another possible block.
+    uint32_t readable_sides(uint32_t t) const;
 
     // The triangles within two edge-rings of the blocks of patches [first, end) that no block or
     // closure has taken.
