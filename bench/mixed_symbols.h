@@ -83,7 +83,7 @@ inline double model_bits(MixingModel model, const std::vector<Symbol>& symbols) 
 inline ModelData load(const std::string& path, const std::filesystem::path& cache) {
     ModelData d;
     d.name = std::filesystem::path(path).stem().string();
-    const std::filesystem::path file = cache / (d.name + ".mf6");
+    const std::filesystem::path file = cache / (d.name + ".mf7");
     if (std::ifstream in{file, std::ios::binary}) {
         uint64_t n = 0;
         in.read(reinterpret_cast<char*>(&d.paper_bits), sizeof d.paper_bits);

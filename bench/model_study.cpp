@@ -12,7 +12,9 @@
 // LAW_DIR=dir reads the random refinement's law posterior (bench/random_refinement_bound --dump).
 // Designs "T:" to "Q:" (2026-12-04 evening): local thresholds, the quadric's curvatures and the
 // fourth model (docs/HIERARCHY_CODER.md, "The fourth model"); "Q:" equals the coder's fourth model
-// with WEIGHTS_IN of its own WEIGHTS_OUT.
+// with WEIGHTS_IN of its own WEIGHTS_OUT. Designs "E:" to "Y:" (2026-12-04 night): the local
+// threshold against coded nodes, SSE stages, a fifth mixer and the fifth model ("The fifth model");
+// "W:" equals the coder's fifth model with WEIGHTS_IN of the third "Y:" design's WEIGHTS_OUT.
 //   [CACHE_DIR=dir] [ONLY=text] [WEIGHTS_OUT=prefix | WEIGHTS_IN=prefix] [TRAIN=...] [LAW_DIR=dir] model_study model.amh ...
 #include "mixed_symbols.h"
 
@@ -61,6 +63,11 @@ struct Extra {
     uint8_t sdh = 0, qthr_ref2 = 0, qthr_unref2 = 0;
     // quad_h and quad_k without the slope terms: (A + C) L, sqrt|4AC - B^2| L.
     uint8_t flat_h = 0, flat_k = 0;
+    // Session of 2026-12-04 night: the ring-2 local threshold on the quadric's sqrt|K| L (as
+    // qthr_*2 on |H| L), and on |H| L and sqrt|K| L over the ring-1 coded neighbours only.
+    uint8_t kthr_ref2 = 0, kthr_unref2 = 0, qthr_ref = 0, qthr_unref = 0;
+    // How many coded ring-2 nodes are refined / not (capped at 7).
+    uint8_t coded_ref2 = 0, coded_unref2 = 0;
 };
 
 // sqrt of the Gauss estimate of node m (|det| of its neighbours' unit normals times L^2 over the
@@ -178,7 +185,7 @@ double signed_dihedral(const Hierarchy& h, NodeId n) {
 }
 
 std::vector<Extra> extra_features(const std::string& path, const std::filesystem::path& cache, size_t count) {
-    const std::filesystem::path file = cache / (std::filesystem::path(path).stem().string() + ".x5");
+    const std::filesystem::path file = cache / (std::filesystem::path(path).stem().string() + ".x6");
     std::vector<Extra> out(count);
     if (std::ifstream in{file, std::ios::binary}) {
         in.read(reinterpret_cast<char*>(out.data()), std::streamsize(count * sizeof(Extra)));
@@ -266,23 +273,32 @@ std::vector<Extra> extra_features(const std::string& path, const std::filesystem
                 x.quad_max = uint8_t(mixed_study::quarter_bin((std::fabs(H) + std::sqrt(std::max(H * H - K, 0.0))) * L));
             }
             x.sdh = uint8_t(mixed_study::quarter_bin(signed_dihedral(h, n)));
-            double min_ref = -1, max_unref = -1;
-            const double own = std::fabs(H) * longest_edge(h, n);
-            auto take = [&](NodeId q) {
+            double min_ref = -1, max_unref = -1, kmin_ref = -1, kmax_unref = -1, min_ref1 = -1, max_unref1 = -1;
+            int nref = 0, nunref = 0;
+            const double own = std::fabs(H) * longest_edge(h, n), own_k = std::sqrt(std::fabs(K)) * longest_edge(h, n);
+            auto take = [&](NodeId q, bool ring1) {
                 if (q == kNoNode || q == n || symbol_of[q] >= i) return;
                 double qh = 0, qk = 0;
                 quadric_curvatures(h, q, &qh, &qk);
-                const double c = std::fabs(qh) * longest_edge(h, q);
-                if (!h.is_leaf(q)) min_ref = min_ref < 0 ? c : std::min(min_ref, c);
-                else max_unref = std::max(max_unref, c);
+                const double c = std::fabs(qh) * longest_edge(h, q), ck = std::sqrt(std::fabs(qk)) * longest_edge(h, q);
+                if (!h.is_leaf(q)) {
+                    min_ref = min_ref < 0 ? c : std::min(min_ref, c), kmin_ref = kmin_ref < 0 ? ck : std::min(kmin_ref, ck), ++nref;
+                    if (ring1) min_ref1 = min_ref1 < 0 ? c : std::min(min_ref1, c);
+                } else {
+                    max_unref = std::max(max_unref, c), kmax_unref = std::max(kmax_unref, ck), ++nunref;
+                    if (ring1) max_unref1 = std::max(max_unref1, c);
+                }
             };
             for (int e = 0; e < 3; ++e) {
                 const NodeId q = h.neighbor(n, e);
                 if (q == kNoNode) continue;
-                take(q);
-                for (int f = 0; f < 3; ++f) take(h.neighbor(q, f));
+                take(q, true);
+                for (int f = 0; f < 3; ++f) take(h.neighbor(q, f), false);
             }
             x.qthr_ref2 = ratio_bin(own, min_ref), x.qthr_unref2 = ratio_bin(own, max_unref);
+            x.kthr_ref2 = ratio_bin(own_k, kmin_ref), x.kthr_unref2 = ratio_bin(own_k, kmax_unref);
+            x.qthr_ref = ratio_bin(own, min_ref1), x.qthr_unref = ratio_bin(own, max_unref1);
+            x.coded_ref2 = uint8_t(std::min(nref, 7)), x.coded_unref2 = uint8_t(std::min(nunref, 7));
         }
         const NodeId p = h.parent(n);
         if (p != kNoNode) {
@@ -346,6 +362,11 @@ struct Options {
     uint64_t drop = 0;  // inputs (bit j: mixer input j) held at 0, as if removed
     int mixers_off = 0;  // bit 0..3: mixer A..D left out of the mean
     int maps_off = 0;    // bit m: probability map m left out of the mean
+    // More probability maps in the mean (SSE stages keyed by a feature): row function, rows.
+    std::vector<std::pair<std::function<uint32_t(const MixedFeatures&, const Extra&)>, int>> extra_maps;
+    // A fifth mixer (needs mixer_d), weight sets chosen by this function (< mixer_e_sets); starts at A's weights.
+    std::function<uint32_t(const MixedFeatures&, const Extra&)> mixer_e;
+    int mixer_e_sets = 1;
 };
 
 // Ones and symbols per slot of every model table of a Study (direct, extra, history maps).
@@ -412,7 +433,7 @@ public:
     static constexpr int kDirect = MixedHierarchyModel::kDirect;
     static constexpr int kFixedInputs = MixedHierarchyModel::kSecondInputs;
     explicit Study(const Options& o)
-        : o_(o), inputs_(kFixedInputs + int(o.extra.size()) + 1), a_(inputs_, 10), b_(inputs_, 16), c_(inputs_, 160), d_(inputs_, 256), st_(size_t(inputs_)) {
+        : o_(o), inputs_(kFixedInputs + int(o.extra.size()) + 1), a_(inputs_, 10), b_(inputs_, 16), c_(inputs_, 160), d_(inputs_, 256), e_(inputs_, o.mixer_e_sets), st_(size_t(inputs_)) {
         extra_models_.assign(o.extra.size(), std::vector<BitModel>(1 << 16, BitModel(8)));
         extra_slot_.resize(o.extra.size());
         static constexpr uint32_t kSizes[kDirect] = {10,  40,  40,   80,   50,  120, 240, 960, 1920, 2560, 640,
@@ -423,7 +444,8 @@ public:
             history_maps_[size_t(k)].assign(2560, BitModel(o.history_log2));
         }
         for (int rows : {40, 640, 192, 2560, 200, 80}) maps_.emplace_back(rows, o.map_rate);
-        if (!o.start[0].empty()) a_.start_at(o.start[0]), b_.start_at(o.start[1]), c_.start_at(o.start[2]), d_.start_at(o.start[o.mixer_d && !o.start[3].empty() ? 3 : 1]);
+        for (const auto& m : o.extra_maps) maps_.emplace_back(m.second, o.map_rate);
+        if (!o.start[0].empty()) a_.start_at(o.start[0]), b_.start_at(o.start[1]), c_.start_at(o.start[2]), d_.start_at(o.start[o.mixer_d && !o.start[3].empty() ? 3 : 1]), e_.start_at(o.start[0]);
         for (std::vector<BitModel>* t : tables()) counts_.tables.emplace_back(t->size(), std::array<uint32_t, 2>{0, 0});
         if (o.priors && o.prior_count > 0) {
             const std::vector<std::vector<BitModel>*> all = tables();
@@ -524,6 +546,7 @@ private:
             const int set = o_.mixer_d == 6 ? int(g) * 16 + f.size / 4 : o_.mixer_d == 4 ? x.base_size / 2 * 8 + f.level : o_.mixer_d == 5 ? int(g) * 16 + x.base_size / 4 : (o_.mixer_d == 1 ? x.base_size : o_.mixer_d == 2 ? f.mean_curv : x.gauss) / 4 * 8 + f.level;
             const int s4 = mixing::stretch(d_.mix(st_.data(), set));
             p_mix = mixing::squash((s1 + s2 + s3 + s4) / 4);
+            if (o_.mixer_e) p_mix = mixing::squash((s1 + s2 + s3 + s4 + mixing::stretch(e_.mix(st_.data(), int(o_.mixer_e(f, x))))) / 5);
             if (o_.mixers_off) {
                 const int all[4] = {s1, s2, s3, s4};
                 int sum = 0, n = 0;
@@ -540,6 +563,7 @@ private:
             const int r = maps_[size_t(m)].refine(p_mix, rows[m]);
             if (!(o_.maps_off >> m & 1)) refined += r, ++active;
         }
+        for (size_t m = 0; m < o_.extra_maps.size(); ++m) refined += maps_[6 + m].refine(p_mix, int(o_.extra_maps[m].first(f, x))), ++active;
         int p = std::clamp((p_mix * (4 - o_.map_share) + (refined / active) * o_.map_share + 2) >> 2, 1, 4095);
         used_maps_ = maps;
         if (o_.level_map == 2) {
@@ -560,7 +584,9 @@ private:
         b_.update(st_.data(), bit, o_);
         c_.update(st_.data(), bit, o_);
         if (o_.mixer_d) d_.update(st_.data(), bit, o_);
+        if (o_.mixer_e) e_.update(st_.data(), bit, o_);
         for (int m = 0; m < used_maps_; ++m) maps_[size_t(m)].update(bit);
+        for (size_t m = 0; m < o_.extra_maps.size(); ++m) maps_[6 + m].update(bit);
         for (int j = 0; j < kDirect; ++j) models_[size_t(j)][slot_[size_t(j)]].update(bit);
         for (size_t e = 0; e < extra_slot_.size(); ++e) extra_models_[e][extra_slot_[e]].update(bit);
         for (int k = 0; k < 3; ++k) {
@@ -580,7 +606,7 @@ private:
     std::array<std::vector<BitModel>, 3> history_maps_;
     std::array<uint32_t, 3> hctx_{}, hslot_{};
     std::array<uint32_t, kDirect> slot_{};
-    Mixer a_, b_, c_, d_;
+    Mixer a_, b_, c_, d_, e_;
     std::vector<int> st_;
     std::vector<mixing::ProbabilityMap> maps_;
     int used_maps_ = 5;
@@ -906,6 +932,102 @@ int main(int argc, char** argv) {
     add("H: flat3 without 1 2 6 8 10 11 12 18", [&](Options& o) { flat3(o), o.drop = drops({1, 2, 6, 8, 10, 11, 12, 18}); });
     add("H: flat3 without 1 6 8 10 11 12 18 22", [&](Options& o) { flat3(o), o.drop = drops({1, 6, 8, 10, 11, 12, 18, 22}); });
     add("H: flat3 without 1 6 8 10 11 12 18, mixer rate 12", [&](Options& o) { flat3(o), o.drop = drops({1, 6, 8, 10, 11, 12, 18}), o.mixer_rate = 12; });
+    // Session of 2026-12-04 night (docs/HIERARCHY_CODER.md, "The fifth model"): the fourth
+    // model plus local thresholds, SSE stages and a fifth mixer.
+    auto fourth_coded = [&](Options& o) { fourth(o), o.maps_off = 7, o.drop = drops({1, 6, 8, 10, 11, 12, 18, 25}); };
+    auto e_plus = [&](const std::string& name, std::vector<std::function<uint32_t(F, X)>> contexts) {
+        add("E: fourth + " + name, [&, contexts](Options& o) {
+            fourth_coded(o);
+            for (const auto& c : contexts) o.extra.push_back(c);
+        });
+    };
+    e_plus("ref2 x unref2 x group", {[](F f, X x) { return (f.group * 32u + x.thr_ref2) * 32 + x.thr_unref2; }});
+    e_plus("ref2 x unref2 x level", {[](F f, X x) { return (f.level * 32u + x.thr_ref2) * 32 + x.thr_unref2; }});
+    e_plus("qref2 x qunref2 x group", {[](F f, X x) { return (f.group * 32u + x.qthr_ref2) * 32 + x.qthr_unref2; }});
+    e_plus("kref2 x kunref2 x group", {[](F f, X x) { return (f.group * 32u + x.kthr_ref2) * 32 + x.kthr_unref2; }});
+    e_plus("qref x qunref x group", {[](F f, X x) { return (f.group * 32u + x.qthr_ref) * 32 + x.qthr_unref; }});
+    e_plus("ref2 x unref2 x group, kref2 x kunref2 x group", {[](F f, X x) { return (f.group * 32u + x.thr_ref2) * 32 + x.thr_unref2; },
+        [](F f, X x) { return (f.group * 32u + x.kthr_ref2) * 32 + x.kthr_unref2; }});
+    e_plus("qref2 x qunref2 x group, kref2 x kunref2 x group", {[](F f, X x) { return (f.group * 32u + x.qthr_ref2) * 32 + x.qthr_unref2; },
+        [](F f, X x) { return (f.group * 32u + x.kthr_ref2) * 32 + x.kthr_unref2; }});
+    e_plus("coded ref2 x unref2 x group x level", {[](F f, X x) { return ((f.group * 8u + x.coded_ref2) * 8 + x.coded_unref2) * 8 + f.level; }});
+    auto thr_level = [](F f, X x) { return (f.level * 32u + x.thr_ref2) * 32 + x.thr_unref2; };
+    auto coded_counts = [](F f, X x) { return ((f.group * 8u + x.coded_ref2) * 8 + x.coded_unref2) * 8 + f.level; };
+    e_plus("C1: ref2 x unref2 x level, coded ref2 x unref2 x group x level", {thr_level, coded_counts});
+    e_plus("C3: C1 + kref2 x kunref2 x group", {thr_level, coded_counts, [](F f, X x) { return (f.group * 32u + x.kthr_ref2) * 32 + x.kthr_unref2; }});
+    e_plus("C6: ref2 x unref2 x coded ref2 x unref2 (no group, no level)", {[](F, X x) { return ((x.thr_ref2 * 32u + x.thr_unref2) * 8 + x.coded_ref2) * 8 + x.coded_unref2; }});
+    e_plus("C7: ref2 x unref2 x level, coded ref2 x unref2 x group", {thr_level, [](F f, X x) { return (f.group * 8u + x.coded_ref2) * 8 + x.coded_unref2; }});
+    e_plus("C8: ref2 x unref2 x level, coded ref2 x unref2 x group x level, ref2 x unref2 x size / 4", {thr_level, coded_counts,
+        [](F f, X x) { return (f.size / 4u * 32 + x.thr_ref2) * 32 + x.thr_unref2; }});
+    auto coded_group = [](F f, X x) { return (f.group * 8u + x.coded_ref2) * 8 + x.coded_unref2; };
+    auto fifth_without = [&](std::initializer_list<int> dropped) {
+        const uint64_t d = drops(dropped);
+        std::string name = "F: fourth + C7 without";
+        for (int j : dropped) name += " " + std::to_string(j);
+        add(name, [&, d](Options& o) { fourth_coded(o), o.extra.push_back(thr_level), o.extra.push_back(coded_group), o.drop |= d; });
+    };
+    fifth_without({4, 14});
+    fifth_without({13, 14});
+    fifth_without({14, 16});
+    fifth_without({4, 13, 14});
+    fifth_without({2, 4, 14});
+    fifth_without({4, 14, 15});
+    add("F: fourth + C7 + coded ref2 x unref2 x group x inner, without 4 13 14", [&](Options& o) {
+        fourth_coded(o), o.extra.push_back(thr_level), o.extra.push_back(coded_group), o.drop |= drops({4, 13, 14});
+        o.extra.push_back([](F f, X x) { return ((f.group * 8u + x.coded_ref2) * 8 + x.coded_unref2) * 4 + f.inner; });
+    });
+    auto coded_inner = [](F f, X x) { return ((f.group * 8u + x.coded_ref2) * 8 + x.coded_unref2) * 4 + f.inner; };
+    add("V: fifth model as coded (version 17)", [&](Options& o) {
+        fourth_coded(o), o.extra.push_back(thr_level), o.extra.push_back(coded_group), o.extra.push_back(coded_inner);
+        o.drop |= drops({4, 13, 14});
+    });
+    add("V: fifth without coded x group (22 inputs)", [&](Options& o) {
+        fourth_coded(o), o.extra.push_back(thr_level), o.extra.push_back(coded_inner);
+        o.drop |= drops({4, 13, 14});
+    });
+    auto fifth_coded = [&](Options& o) {
+        fourth_coded(o);
+        o.extra.push_back(thr_level), o.extra.push_back(coded_group), o.extra.push_back(coded_inner);
+        o.drop |= drops({4, 13, 14});
+    };
+    for (auto dropped : {std::vector<int>{0, 2, 15, 16}, std::vector<int>{0, 2, 5, 16}, std::vector<int>{2, 9, 15, 16}, std::vector<int>{0, 2, 16}}) {
+        uint64_t d = 0;
+        std::string name = "Y: fifth without";
+        for (int j : dropped) d |= uint64_t{1} << j, name += " " + std::to_string(j);
+        add(name, [&, d](Options& o) { fifth_coded(o), o.drop |= d; });
+    }
+    for (int j : {0, 2, 3, 5, 7, 9, 15, 16, 17, 19, 20, 21, 22, 23, 24, 26, 27, 28, 29, 30, 31, 32, 33})
+        add("X: fifth without input " + std::to_string(j), [&, j](Options& o) { fifth_coded(o), o.drop |= uint64_t{1} << j; });
+    // The fifth model on the coder's own threshold features: with WEIGHTS_IN of the third Y
+    // design's WEIGHTS_OUT (copied to this design's index) it equals the coder's.
+    add("W: fifth model on the coder's features", [&](Options& o) {
+        fourth_coded(o);
+        o.extra.push_back([](F f, X) { return (f.level * 32u + f.thr_refined) * 32 + f.thr_unrefined; });
+        o.extra.push_back([](F f, X) { return (f.group * 8u + f.coded_refined) * 8 + f.coded_unrefined; });
+        o.extra.push_back([](F f, X) { return ((f.group * 8u + f.coded_refined) * 8 + f.coded_unrefined) * 4 + f.inner; });
+        o.drop |= drops({2, 4, 9, 13, 14, 15, 16});
+    });
+    add("E: fourth + C5: C1 + mixer E by ref2 / 4 x unref2 / 4", [&](Options& o) {
+        fourth_coded(o), o.extra.push_back(thr_level), o.extra.push_back(coded_counts);
+        o.mixer_e = [](F, X x) { return x.thr_ref2 / 4u * 8 + x.thr_unref2 / 4u; }, o.mixer_e_sets = 64;
+    });
+    for (int j : {0, 2, 3, 4, 5, 7, 9, 13, 14, 15, 16, 17, 19, 20})
+        add("E: fourth + C1 without input " + std::to_string(j), [&, j](Options& o) {
+            fourth_coded(o), o.extra.push_back(thr_level), o.extra.push_back(coded_counts), o.drop |= uint64_t{1} << j;
+        });
+    auto e_map = [&](const std::string& name, std::function<uint32_t(F, X)> row, int rows) {
+        add("E: fourth + SSE by " + name, [&, row, rows](Options& o) { fourth_coded(o), o.extra_maps.push_back({row, rows}); });
+    };
+    e_map("quad H x size / 2", [](F f, X) { return f.quad_mean * 32u + f.size / 2u; }, 2048);
+    e_map("group x quad K", [](F f, X) { return f.group * 64u + f.quad_gauss; }, 640);
+    e_map("ref2 x unref2", [](F, X x) { return x.thr_ref2 * 32u + x.thr_unref2; }, 1024);
+    e_map("level x size", [](F f, X) { return f.level * 64u + f.size; }, 512);
+    auto e_mix = [&](const std::string& name, std::function<uint32_t(F, X)> set, int sets) {
+        add("E: fourth + mixer E by " + name, [&, set, sets](Options& o) { fourth_coded(o), o.mixer_e = set, o.mixer_e_sets = sets; });
+    };
+    e_mix("ref2 / 4 x unref2 / 4", [](F, X x) { return x.thr_ref2 / 4u * 8 + x.thr_unref2 / 4u; }, 64);
+    e_mix("quad H / 4 x level", [](F f, X) { return f.quad_mean / 4u * 8 + f.level; }, 128);
+    e_mix("group x quad K / 4", [](F f, X) { return f.group * 16u + f.quad_gauss / 4u; }, 160);
     for (int j = 0; j < 28; ++j) add("D: quad2 without input " + std::to_string(j), [&, j](Options& o) { quad2(o), o.drop = uint64_t{1} << j; });
     const char* only = std::getenv("ONLY");
 
@@ -921,7 +1043,7 @@ int main(int argc, char** argv) {
     };
     std::vector<double> library;
     for (const ModelData& d : data) library.push_back(d.library_bits);
-    row("the coder's mixing mode (fourth model, version 16)", library);
+    row("the coder's mixing mode (fifth model, version 17)", library);
     for (const Design& design : designs) {
         if (only && design.name.find(only) == std::string::npos && &design != &designs[0]) continue;
         std::vector<double> bits;

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The tables of docs/HIERARCHY_CODER.md, "The mixing mode", "The second model", "The third model"
 # and "The fourth model": every model of the benchmark corpus (scripts/corpus.sh) encoded bit-exactly
-# with the paper's contexts and with the mixing mode (the model encoders write: .amc version 16, or
-# the third model's 11-15 where that codes the file smaller), the
+# with the paper's contexts and with the mixing mode (the model encoders write: .amc version 17, or
+# the fourth model's 16 or the third's 11-15 where that codes the file smaller), the
 # hierarchy bytes of each (amc encode -v; the paper's in one chunk, as the mixing mode always is),
 # the change, and the least of `runs` whole-file decode CPU times (user + system, five decodes a
 # round) of each. With AMC_PREVIOUS_MODEL=path-to-an-older-amc (a build of a commit that writes an

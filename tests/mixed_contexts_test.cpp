@@ -4,7 +4,9 @@
 #include "coding/container.h"
 #include "coding/format_version.h"
 #include "coding/hierarchy/coder_switches.h"
+#include "coding/entropy/arithmetic_coder.h"
 #include "coding/hierarchy/context_mixing.h"
+#include "coding/hierarchy/hierarchy_level_coder.h"
 #include "coding/hierarchy/mixed_contexts.h"
 #include "hierarchy_checks.h"
 
@@ -131,9 +133,9 @@ TEST(MixedContexts, RandomHierarchiesRoundTripBitExactlyUnderEverySwitch) {
         }
         options.predictor = GeometryPredictor(random.next() % 4);
         const std::vector<uint8_t> bytes = encode(h, options);
-        // The fourth model's version, or the third's where it codes smaller (14 where a bit-exact
-        // level is adaptive, its raw bits in a side stream).
-        ASSERT_TRUE(bytes[4] == kFourthMixingVersion || bytes[4] == kThirdMixingVersion ||
+        // The fifth model's version, or the fourth's or third's where they code smaller (14 where a
+        // bit-exact level is adaptive, its raw bits in a side stream).
+        ASSERT_TRUE(bytes[4] == kFifthMixingVersion || bytes[4] == kFourthMixingVersion || bytes[4] == kThirdMixingVersion ||
                     (options.quantize_bits == 0 && bytes[4] == kRawSideVersion))
             << trial;
         const Hierarchy back = decode(bytes.data(), bytes.size());
@@ -175,6 +177,53 @@ TEST(MixedContexts, SmallerThanThePapersContextsOnACurvedRemesh) {
     paper_options.unit_normals = false;
     std::vector<uint8_t> plain = encode(h, paper_options);
     EXPECT_TRUE(plain[4] < kMixedContextsVersion || plain[4] == kRawSideVersion);  // 14: adaptive levels' raw side streams
+}
+
+// The coded symbols' code length under `model` (the hierarchy's own features, as the encoder
+// computes them).
+double mixing_model_bits(const Hierarchy& h, MixingModel model) {
+    HierarchyLevelEncoder coder(h, HierarchyCoderOptions{}, kHierarchyStreamVersion, nullptr, true);
+    coder.set_mixing_model(model);
+    ArithmeticEncoder sink;
+    for (int l = 0; l < coder.level_count(); ++l) coder.encode_level(l, sink);
+    double bits = 0;
+    for (const ContextGroupStats& g : coder.stats().groups) bits += g.coded_bits;
+    return bits;
+}
+
+// The fifth model's local threshold (FORMAT.md 2.5): the features see only nodes coded before, and
+// they make a curved remesh's code smaller than the fourth model's.
+TEST(MixedContexts, TheLocalThresholdCodesACurvedRemeshSmallerThanTheFourthModel) {
+    SurfaceRemeshOptions remesh;
+    remesh.base_triangles = 200;
+    remesh.max_level = 5;
+    remesh.target_faces = 20000;
+    const Hierarchy h = remesh_adaptively(make_bumpy_sphere(4), remesh);
+    const HierarchyLevelEncoder coder(h, HierarchyCoderOptions{}, kHierarchyStreamVersion, nullptr, true);
+    int compared = 0, first_of_level = 0, level = -1;
+    for (const auto& [f, bit] : coder.mixed_symbols()) {
+        if (f.level != level) {
+            level = f.level;
+            ++first_of_level;
+            // The first symbol of a level: no node of the level is coded yet.
+            EXPECT_EQ(f.coded_refined + f.coded_unrefined, 0);
+            EXPECT_EQ(f.thr_refined + f.thr_unrefined, 0);
+        }
+        EXPECT_LE(f.coded_refined, 7);
+        EXPECT_LE(f.thr_refined, 31);
+        EXPECT_LE(f.thr_unrefined, 31);
+        if (f.coded_refined == 0) {
+            EXPECT_EQ(f.thr_refined, 0);
+        }
+        if (f.coded_unrefined == 0) {
+            EXPECT_EQ(f.thr_unrefined, 0);
+        }
+        compared += f.thr_refined != 0 && f.thr_unrefined != 0;
+    }
+    EXPECT_GE(first_of_level, 3);
+    EXPECT_GT(compared, 1000);
+    const double fourth = mixing_model_bits(h, MixingModel::fourth), fifth = mixing_model_bits(h, MixingModel::fifth);
+    EXPECT_LT(fifth, fourth);
 }
 
 TEST(MixedContexts, TheModeIsRefusedInOlderVersions) {

@@ -23,10 +23,11 @@ namespace amc {
 // an adaptive geometry mode (midpoint, butterfly): such a level's raw bits are in a side stream.
 // Version 15 for bit-exact files with a level in geometry mode 6 or 7 (the midpoint's or the
 // butterfly's predictions under static tables, rANS and raw bits). Version 16 for files in the
-// mixing mode's fourth model (FORMAT.md 2.4; whatever their geometry modes), which encoders write
-// since: versions 11-15 hold the third.
+// mixing mode's fourth model (FORMAT.md 2.4; whatever their geometry modes). Version 17 for files
+// in its fifth model (FORMAT.md 2.5; whatever their geometry modes), which encoders write since:
+// versions 11-15 hold the third, 16 the fourth.
 constexpr uint8_t kOldestReadableVersion = 1;
-constexpr uint8_t kNewestVersion = 16;
+constexpr uint8_t kNewestVersion = 17;
 constexpr uint8_t kBaseVersion = 2;       // everything but the numbering block and mode 2
 constexpr uint8_t kNumberingVersion = 3;  // the first version with a numbering block
 constexpr uint8_t kAngleBaseVersion = 4;  // the first version with base connectivity mode 2
@@ -53,6 +54,8 @@ constexpr uint8_t kRawSideVersion = 14;
 constexpr uint8_t kStencilTablesVersion = 15;
 // The first version whose mixing mode is the fourth model (the quadric's curvatures, FORMAT.md 2.4).
 constexpr uint8_t kFourthMixingVersion = 16;
+// The first version whose mixing mode is the fifth model (the local threshold, FORMAT.md 2.5).
+constexpr uint8_t kFifthMixingVersion = 17;
 
 // The lowest version a file's newest features need, 0 if it has none of them (older features then
 // decide): the one rule for encode()'s files and the chunked file head the MPI ranks write.
@@ -87,6 +90,7 @@ constexpr uint8_t hierarchy_stream_version_of_file(uint8_t file_version) {
         case 14: return 2;
         case 15: return 2;
         case 16: return 2;
+        case 17: return 2;
     }
     return 0;
 }

@@ -118,11 +118,12 @@ double snap_positions(const Hierarchy& h, const Quantizer& quantizer, unsigned t
 }
 
 // The lowest version that holds what the file holds (format_version.h).
-// `fourth_model`: the mixing mode's fourth model, only in version 16 (never chunked; it holds every
-// geometry mode); the third is in versions 11-15.
-uint8_t file_version(bool stencil_tables, bool raw_side, bool unit_geometry, bool grid_geometry, bool mixed_contexts, bool fourth_model,
+// `mixing`: the mixing mode's model; the fifth only in version 17, the fourth only in 16 (never
+// chunked; they hold every geometry mode); the third is in versions 11-15.
+uint8_t file_version(bool stencil_tables, bool raw_side, bool unit_geometry, bool grid_geometry, bool mixed_contexts, MixingModel mixing,
                      bool chunked, bool static_geometry, BaseConnectivityMode base_mode, bool store_numbering) {
-    if (mixed_contexts && fourth_model) return kFourthMixingVersion;
+    if (mixed_contexts && mixing == MixingModel::fifth) return kFifthMixingVersion;
+    if (mixed_contexts && mixing == MixingModel::fourth) return kFourthMixingVersion;
     if (const uint8_t newest = newest_features_version(stencil_tables, raw_side, chunked)) return newest;
     return unit_geometry                                 ? kUnitFrameVersion
            : mixed_contexts                              ? kThirdMixingVersion
@@ -169,7 +170,7 @@ struct ForestCode {
     std::vector<std::pair<BlockType, std::vector<uint8_t>>> blocks;
     uint64_t bytes = 0;  // of the blocks, framing included
     bool chunked = false, static_geometry = false, grid_geometry = false, unit_geometry = false, raw_side = false, stencil_tables = false;
-    bool fourth_model = false;               // the mixing mode's hierarchy in its fourth model (else the third)
+    MixingModel mixing = MixingModel::third;  // the mixing mode's model (when the file is mixed)
     uint64_t faces = 0, levels = 0;          // the metadata's
     std::vector<uint8_t> hierarchy_header;  // the metadata's (none with chunks)
     EncodeStats stats;  // header (the chunk table), hierarchy, geometry and framing bytes, levels, hierarchy
@@ -180,13 +181,13 @@ struct ForestCode {
 // `on_grid` when given: one chunk's input nodes with their grid points) in `chunks`;
 // `faces` is the leaf face count when there are several. `positions` holds the models as
 // the base geometry left them. The mixing mode (FORMAT.md 2.1) codes the forest as one stream, in
-// its written model, and with `third` also in its third model into `third`: the same first pass
+// its written model, and also in each model of `older` into its ForestCode: the same first pass
 // and the same geometry (which does not depend on the hierarchy's model; each level's chosen
 // once), the hierarchy parts in the models' own arithmetic codes.
 ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<RootRange>& chunks, uint64_t faces,
                        const EncodeOptions& options, CoordinateSpace space, PositionCoder positions, unsigned threads,
                        bool want_hierarchy_stats, HierarchyLevelEncoder* first_pass, const HierarchyOnGrid* on_grid,
-                       ForestCode* third = nullptr) {
+                       const std::vector<std::pair<MixingModel, ForestCode*>>& older = {}) {
     ForestCode out;
     const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
     out.chunked = !mixed && chunks.size() > 1;
@@ -205,18 +206,23 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
         if (first_pass == nullptr)
             own = std::make_unique<HierarchyLevelEncoder>(h, options.hierarchy, kHierarchyStreamVersion, nullptr, mixed);
         HierarchyLevelEncoder& hierarchy = first_pass != nullptr ? *first_pass : *own;
-        const std::unique_ptr<HierarchyLevelEncoder> third_hierarchy = mixed && third != nullptr ? hierarchy.fork() : nullptr;
-        PositionCoder third_positions = positions;  // the same models level after level
+        std::vector<std::unique_ptr<HierarchyLevelEncoder>> older_hierarchies;
+        std::vector<PositionCoder> older_positions;  // the same models level after level
+        if (mixed)
+            for (const auto& [model, code] : older) {
+                older_hierarchies.push_back(hierarchy.fork());
+                older_hierarchies.back()->set_mixing_model(model);
+                older_positions.push_back(positions);
+            }
         hierarchy.set_mixing_model(kWrittenMixingModel);
-        if (third_hierarchy != nullptr) third_hierarchy->set_mixing_model(MixingModel::third);
         auto start = [&](ForestCode& code, const HierarchyLevelEncoder& coder) {
-            code.fourth_model = mixed && coder.mixing_model() == MixingModel::fourth;
+            code.mixing = coder.mixing_model();
             code.faces = coder.faces();
             code.levels = uint64_t(coder.level_count());
             code.hierarchy_header = coder.header();
         };
         start(out, hierarchy);
-        if (third_hierarchy != nullptr) start(*third, *third_hierarchy);
+        for (size_t k = 0; k < older_hierarchies.size(); ++k) start(*older[k].second, *older_hierarchies[k]);
         auto add_level = [&](ForestCode& code, HierarchyLevelEncoder& coder, int l, const auto& geometry_of, const NewVertices& created,
                              const LevelGeometryCode& geometry, PositionCoder& models) {
             ArithmeticEncoder encoder;
@@ -236,7 +242,8 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
             const LevelGeometryCode geometry = choose_level_geometry(geometry_of, created, positions, space, options.predictor,
                                                                      options.grid_contexts, options.unit_normals, options.effort);
             add_level(out, hierarchy, l, geometry_of, created, geometry, positions);
-            if (third_hierarchy != nullptr) add_level(*third, *third_hierarchy, l, geometry_of, created, geometry, third_positions);
+            for (size_t k = 0; k < older_hierarchies.size(); ++k)
+                add_level(*older[k].second, *older_hierarchies[k], l, geometry_of, created, geometry, older_positions[k]);
         };
         for (int l = 0; l < hierarchy.level_count(); ++l) {
             if (on_grid != nullptr)
@@ -245,11 +252,12 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
                 code_level(l, h);
         }
         if (want_hierarchy_stats) out.stats.hierarchy = hierarchy.stats();
-        if (want_hierarchy_stats && third_hierarchy != nullptr) third->stats.hierarchy = third_hierarchy->stats();
+        if (want_hierarchy_stats)
+            for (size_t k = 0; k < older_hierarchies.size(); ++k) older[k].second->stats.hierarchy = older_hierarchies[k]->stats();
     }
     for (const auto& block : out.blocks) out.bytes += kBlockOverhead + block.second.size();
-    if (third != nullptr)
-        for (const auto& block : third->blocks) third->bytes += kBlockOverhead + block.second.size();
+    for (const auto& [model, code] : older)
+        for (const auto& block : code->blocks) code->bytes += kBlockOverhead + block.second.size();
     return out;
 }
 
@@ -344,17 +352,23 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
                                           : one_chunk ? std::vector<RootRange>{RootRange{0, h.root_count()}}
                                                       : balanced_chunks(root_nodes, chunk_count_for(options, faces));
     const bool want_hierarchy_stats = stats_out != nullptr && options.hierarchy_statistics;
-    ForestCode third;  // the mixing mode's forest in its third model
+    ForestCode fourth, third;  // the mixing mode's forest in its fourth and third models
+    const std::vector<std::pair<MixingModel, ForestCode*>> older =
+        mixed ? std::vector<std::pair<MixingModel, ForestCode*>>{{MixingModel::fourth, &fourth}, {MixingModel::third, &third}}
+              : std::vector<std::pair<MixingModel, ForestCode*>>{};
     ForestCode forest = code_forest(h, root_of, chunks, faces, options, space, positions, threads, want_hierarchy_stats,
-                                    first_pass.get(), turned_input && quantized ? &on_grid : nullptr, mixed ? &third : nullptr);
+                                    first_pass.get(), turned_input && quantized ? &on_grid : nullptr, older);
     const uint32_t fewer = automatic && forest.chunked ? chunk_count_for_size(options, uint32_t(chunks.size()), forest.bytes)
                                                        : uint32_t(chunks.size());
     if (fewer < chunks.size())
         forest = code_forest(h, root_of, balanced_chunks(root_nodes, fewer), faces, options, space, positions, threads,
                              want_hierarchy_stats, nullptr, nullptr);
-    // The mixing mode's third model where it codes the file smaller (a few creased or flat
-    // models, by a few bytes): every file at most as large as the third model's.
-    if (mixed && third.bytes < forest.bytes) forest = std::move(third);
+    // The mixing mode's fourth or third model where it codes the file smaller (small files, whose
+    // new tables have little to learn from, or creased ones, by a few bytes): every file at most as
+    // large as each older model's. A tie keeps the newer model (fewer instructions).
+    if (mixed)
+        for (ForestCode* other : {&fourth, &third})
+            if (other->bytes < forest.bytes) forest = std::move(*other);
 
     Metadata meta;
     meta.base_vertices = h.base().positions.size();
@@ -386,7 +400,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
         stats.numbering_bytes = blocks.back().second.size();
         stats.framing_bytes += kBlockOverhead;
     }
-    BlockWriter writer(file_version(forest.stencil_tables, forest.raw_side, forest.unit_geometry, forest.grid_geometry, mixed, forest.fourth_model,
+    BlockWriter writer(file_version(forest.stencil_tables, forest.raw_side, forest.unit_geometry, forest.grid_geometry, mixed, forest.mixing,
                                     forest.chunked, forest.static_geometry,
                                     base_code.mode, store_numbering),
                        uint8_t((precision == Precision::float32 ? kFlagSinglePrecision : 0) | (quantized ? kFlagQuantized : 0)));
@@ -522,7 +536,8 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
                                     hierarchy_stream_version_of_file(reader.version()),
                                     std::min<uint64_t>(meta.nodes, options.max_nodes));
     if (meta.options & kOptionMixedContexts)
-        hierarchy.use_mixed_contexts(reader.version() >= kFourthMixingVersion   ? MixingModel::fourth
+        hierarchy.use_mixed_contexts(reader.version() >= kFifthMixingVersion    ? MixingModel::fifth
+                                     : reader.version() >= kFourthMixingVersion ? MixingModel::fourth
                                      : reader.version() >= kThirdMixingVersion  ? MixingModel::third
                                      : reader.version() >= kSecondMixingVersion ? MixingModel::second
                                                                                 : MixingModel::first);

@@ -30,9 +30,9 @@ struct CodedSymbol {
     bool refined;
 };
 
-// The mixing mode's newest model (.amc version 16): its features hold every older model's, so an
+// The mixing mode's newest model (.amc version 17): its features hold every older model's, so an
 // encoder computes them once and may code with the third model too (the smaller file is written).
-constexpr MixingModel kWrittenMixingModel = MixingModel::fourth;
+constexpr MixingModel kWrittenMixingModel = MixingModel::fifth;
 
 // A hierarchy read in another base order without copying it (reorder_base's result, as a view):
 // root t of the coded forest is h's root old_root[t] with its local indices turned by turn[t] (its
@@ -65,7 +65,7 @@ public:
     std::unique_ptr<HierarchyLevelEncoder> fork() const;
     HierarchyLevelEncoder& operator=(const HierarchyLevelEncoder&) = delete;
     // The mixing mode's model encode_level and stats use (kWrittenMixingModel unless set before
-    // the first level; the third or the fourth).
+    // the first level; the third, the fourth or the fifth).
     void set_mixing_model(MixingModel model) { mixing_model_ = model; }
     MixingModel mixing_model() const { return mixing_model_; }
     const std::vector<uint8_t>& header() const { return header_; }

@@ -47,6 +47,15 @@ int half_octave_bin(double x, int offset, int top) {
     return std::clamp(2 * e + (m >= 0.70710678118654752) + offset, 1, top);
 }
 
+// The fifth model's local threshold: half octaves of own / other around 16, 1..31; 0 when other is
+// not > 0 (no such node), 1 when own is not > 0.
+int threshold_bin(double own, double other) {
+    if (!(other > 0)) return 0;
+    if (!(own > 0)) return 1;
+    const double ratio = own / other;
+    return std::isfinite(ratio) ? half_octave_bin(ratio, 16, 31) : 31;
+}
+
 // floor(4 log2 x) + offset (quarter octaves), as half_octave_bin.
 int quarter_octave_bin(double x, int offset, int top) {
     if (!(x > 0) || !std::isfinite(x)) return 0;
@@ -121,6 +130,7 @@ void LevelShapes::start_level(size_t nodes) {
         stamp_.resize(nodes, 0u);
         bending_stamp_.resize(nodes, 0u);
     }
+    coded_curvature_.assign(nodes, kUncoded);
 }
 
 Vec3 LevelShapes::normal(const Hierarchy& h, NodeId node, uint32_t local) {
@@ -204,15 +214,36 @@ MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, u
         f.parent_far = far != kNoNode && !h.is_leaf(far) ? 0 : 1;
     }
     int ring2 = 0;
+    // Fifth model: the coded nodes one and two edges away (a node as often as it is reached), the
+    // least curvature of the refined ones, the largest of the others, and their counts. The
+    // remesher refines above one threshold of its priority, so the neighbours' decisions against
+    // their estimates place the threshold locally, where the estimates' errors are alike.
+    const bool fifth = model == MixingModel::fifth;
+    double least_refined = -1, most_unrefined = -1;
+    int coded_refined = 0, coded_unrefined = 0;
+    const double* coded = shapes.coded_curvatures();
+    auto take_coded = [&](uint32_t r) {
+        const double c = coded[r];
+        if (c == LevelShapes::kUncoded) return;
+        if (state[r] & kRefined) {
+            least_refined = least_refined < 0 ? c : std::min(least_refined, c);
+            ++coded_refined;
+        } else {
+            most_unrefined = std::max(most_unrefined, c);
+            ++coded_unrefined;
+        }
+    };
     for (int e = 0; e < 3; ++e) {
         const uint32_t q = nbr.nbr[e];
         if (q == kNoLocal) continue;
+        if (fifth) take_coded(q);
         const Neighbors qn = with_links(level, [q](auto links) { return links.neighbors(q); });
         for (int eq = 0; eq < 3; ++eq) {
             const uint32_t r = qn.nbr[eq];
             if (r == i || r == kNoLocal) continue;
             const uint8_t s = state[r];
             ring2 += (s & kDecided) && (s & kRefined);
+            if (fifth) take_coded(r);
         }
     }
     f.ring2 = uint8_t(std::min(ring2, 4));
@@ -259,15 +290,24 @@ MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, u
         f.ring_max = uint8_t(quarter_octave_bin(largest, 40, 63));
         f.ring_mean = uint8_t(quarter_octave_bin(sum / count, 40, 63));
     }
-    if (model == MixingModel::third || model == MixingModel::fourth) {
+    if (model >= MixingModel::third) {
         const double unit = shapes.base_edge(h);
-        f.size = uint8_t(unit > 0 ? quarter_octave_bin(std::ldexp(bending.longest, l) / unit, 28, 63) : 0);
+        // Times 2^l as a product (exact, as std::ldexp, for 0 <= l <= kMaxLevel) without libm's call.
+        const double scaled = bending.longest * bit_cast<double>(uint64_t(1023 + l) << 52);
+        f.size = uint8_t(unit > 0 ? quarter_octave_bin(scaled / unit, 28, 63) : 0);
         f.gauss = uint8_t(quarter_octave_bin(bending.gauss, 46, 63));
     }
-    if (model == MixingModel::fourth) {
+    if (model >= MixingModel::fourth) {
         const std::array<double, 2> quadric = quadric_curvatures(h, n, bending.longest);
         f.quad_mean = uint8_t(quarter_octave_bin(quadric[0], 40, 63));
         f.quad_gauss = uint8_t(quarter_octave_bin(quadric[1], 40, 63));
+    }
+    if (fifth) {
+        f.thr_refined = uint8_t(threshold_bin(curvature, least_refined));
+        f.thr_unrefined = uint8_t(threshold_bin(curvature, most_unrefined));
+        f.coded_refined = uint8_t(std::min(coded_refined, 7));
+        f.coded_unrefined = uint8_t(std::min(coded_unrefined, 7));
+        shapes.mark_coded(i, curvature);
     }
     return f;
 }
@@ -312,6 +352,29 @@ constexpr int32_t kFourthStartWeights[4][MixedHierarchyModel::kFourthInputs + 1]
     {-6996, -2620, -6687, 8506, 4386, 7175, 1322, 12247, 11007, 3546, 5409, 10621, 1060, 957, 1017, 6127, -1110, 9007, 2092, 3740, 5936, 1195, 5596, 6413},
     {-1301, 379, -1544, 7386, 4548, 8698, 5308, 10606, 7666, 4286, -1927, 3141, 6197, 5582, -3374, -1802, -2329, 7563, 4216, 7532, 7133, 3719, 6823, 2024},
     {-2549, -912, -2838, 7924, 3527, 9199, 5298, 10744, 8715, 3049, 4343, 7336, 5730, 5487, -2727, 117, -2427, 1501, 4550, 6302, 6986, 2464, 6740, 2100}};
+// The fifth model's (FORMAT.md 2.5): the direct tables of 0-20 it keeps (tables 4, 13 and 14, of the
+// decided refined nodes two edges away, gain nothing beside the coded nodes' counts; 2, 9, 15 and 16
+// little, and they pay for the walk's instructions), those of 21-30 and the mixers' start weights
+// (bench/model_study's design "Y: fifth without 2 9 15 16", averaged).
+constexpr int kFifthKeptTables[MixedHierarchyModel::kFifthKept] = {0, 3, 5, 7, 17, 19, 20};
+constexpr int kFifthLaterTables[MixedHierarchyModel::kFifthLater] = {21, 23, 24, 25, 26, 27, 28, 29, 30};
+constexpr uint32_t kFifthContextSizes[MixedHierarchyModel::kThresholdInputs] = {8192, 640, 2560};
+constexpr int32_t kFifthStartWeights[4][MixedHierarchyModel::kFifthInputs + 1] = {
+    {-6099, -6636, 6129, 12162, 9007, 5892, 4881, -5277, -2335, -4993, 10713, 3027, 7408, 7761, 3097, 6935, 10325, 13158, 15886, 1774},
+    {-5766, -5268, 4345, 7188, 10042, 1418, 969, 2127, 6186, -443, 8905, 1324, 3324, 5320, 708, 5433, 8958, 12558, 16418, 6688},
+    {-958, -1085, 4644, 8960, 3058, 6308, 5801, -2061, -907, -1490, 7298, 4163, 7307, 6690, 3322, 6890, 10119, 9277, 11352, 1931},
+    {-1595, -1760, 4018, 9631, 7089, 6043, 6041, -1164, 1175, -1313, 1865, 4445, 6044, 6482, 2109, 6964, 10163, 10840, 12650, 1857}};
+// The direct tables the fourth or fifth model reads, of 0-20 and of 21 on.
+template <bool kFifth>
+constexpr const auto& kept_tables() {
+    if constexpr (kFifth) return kFifthKeptTables;
+    else return kFourthKeptTables;
+}
+template <bool kFifth>
+constexpr const auto& later_tables() {
+    if constexpr (kFifth) return kFifthLaterTables;
+    else return kFourthLaterTables;
+}
 constexpr int kMapContexts[MixedHierarchyModel::kMaps] = {kContextGroupCount * 4, kContextGroupCount * 64, 24 * 8,
                                                           kContextGroupCount * 256, kContextGroupCount * 5 * 4};
 
@@ -328,6 +391,8 @@ namespace {
 // A mixer of `model` with `sets` weight sets: the third model's start at row `row` of its trained
 // weights, the others' at 1/n each.
 mixing::Mixer model_mixer(MixingModel model, int sets, int row) {
+    if (model == MixingModel::fifth)
+        return mixing::Mixer(MixedHierarchyModel::kFifthInputs + 1, sets, kThirdMixerRate, kFifthStartWeights[row]);
     if (model == MixingModel::fourth)
         return mixing::Mixer(MixedHierarchyModel::kFourthInputs + 1, sets, kThirdMixerRate, kFourthStartWeights[row]);
     if (model == MixingModel::third)
@@ -344,13 +409,19 @@ MixedHierarchyModel::MixedHierarchyModel(MixingModel model)
       mixer_b_(model_mixer(model, 16, 1)),
       mixer_c_(model_mixer(model, model == MixingModel::first ? 24 : kContextGroupCount * 16, 2)),
       mixer_d_(model_mixer(model, model >= MixingModel::third ? kContextGroupCount * 16 : 1, 3)) {
-    const bool fourth = model == MixingModel::fourth;
+    const bool fourth = model >= MixingModel::fourth;
     if (fourth) {
-        for (int j : kFourthKeptTables)
-            models_[size_t(j)].assign(j < kInputs ? kContextSizes[j] : kSecondContextSizes[j - kInputs], BitModel(kModelWindowLog2));
-        for (int j : kFourthLaterTables)
-            models_[size_t(j)].assign(j < kThirdDirect ? kThirdContextSizes[j - kDirect] : kFourthContextSizes[j - kThirdDirect],
-                                      BitModel(kModelWindowLog2));
+        auto assign = [this](const auto& kept, const auto& later) {
+            for (int j : kept)
+                models_[size_t(j)].assign(j < kInputs ? kContextSizes[j] : kSecondContextSizes[j - kInputs], BitModel(kModelWindowLog2));
+            for (int j : later)
+                models_[size_t(j)].assign(j < kThirdDirect    ? kThirdContextSizes[j - kDirect]
+                                          : j < kFourthDirect ? kFourthContextSizes[j - kThirdDirect]
+                                                              : kFifthContextSizes[j - kFourthDirect],
+                                          BitModel(kModelWindowLog2));
+        };
+        if (model == MixingModel::fifth) assign(kept_tables<true>(), later_tables<true>());
+        else assign(kept_tables<false>(), later_tables<false>());
     } else {
         for (int j = 0; j < kInputs; ++j) models_[size_t(j)].assign(kContextSizes[j], BitModel(kModelWindowLog2));
     }
@@ -397,7 +468,8 @@ uint32_t MixedHierarchyModel::p16(const MixedFeatures& f) {
     const uint32_t g = f.group;
     const std::array<uint32_t, kInputs> direct = direct_slots(f);
     std::copy_n(direct.begin(), kInputs, slot_.begin());
-    if (model_ == MixingModel::fourth) return uint32_t(fourth_model_p12(f)) << 4;
+    if (model_ == MixingModel::fifth) return uint32_t(fourth_model_p12<true>(f)) << 4;
+    if (model_ == MixingModel::fourth) return uint32_t(fourth_model_p12<false>(f)) << 4;
     for (int j = 0; j < kInputs; ++j) st_[size_t(j)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
     if (model_ != MixingModel::first) return uint32_t(later_model_p12(f)) << 4;
     st_[kInputs] = 256;  // bias
@@ -455,6 +527,7 @@ void MixedHierarchyModel::history_inputs(uint32_t g, int first) {
     }
 }
 
+template <bool kFifth>
 int MixedHierarchyModel::fourth_model_p12(const MixedFeatures& f) {
     const uint32_t g = f.group;
     const uint32_t last4 = last_bits_ & 15;
@@ -469,11 +542,19 @@ int MixedHierarchyModel::fourth_model_p12(const MixedFeatures& f) {
     slot_[kThirdDirect] = (f.quad_mean * 32u + f.size / 2u) * 8 + f.level;
     slot_[kThirdDirect + 1] = (f.quad_gauss * 32u + f.size / 2u) * 8 + f.level;
     slot_[kThirdDirect + 2] = (g * 64 + f.quad_mean) * 16 + f.quad_gauss / 4u;
+    if constexpr (kFifth) {
+        // Tables 28-30: the local threshold by level, the coded nodes' counts by group and by
+        // group and inner.
+        const uint32_t counts = (g * 8 + f.coded_refined) * 8 + f.coded_unrefined;
+        slot_[kFourthDirect] = (f.level * 32u + f.thr_refined) * 32 + f.thr_unrefined;
+        slot_[kFourthDirect + 1] = counts;
+        slot_[kFourthDirect + 2] = counts * 4 + f.inner;
+    }
     int input = 0;
-    for (int j : kFourthKeptTables) st_[size_t(input++)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
+    for (int j : kept_tables<kFifth>()) st_[size_t(input++)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
     history_inputs(g, input);
     input += kIndirectInputs;
-    for (int j : kFourthLaterTables) st_[size_t(input++)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
+    for (int j : later_tables<kFifth>()) st_[size_t(input++)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
     st_[size_t(input)] = 256;  // bias
     const int s1 = mixing::stretch(mixer_a_.mix(st_.data(), int(g)));
     const int s2 = mixing::stretch(mixer_b_.mix(st_.data(), f.ring_mean / 4));
@@ -487,15 +568,22 @@ int MixedHierarchyModel::fourth_model_p12(const MixedFeatures& f) {
     return std::clamp((p_mix_ + (refined / 2) * 3 + 2) >> 2, 1, 4095);
 }
 
+template <bool kFifth>
+void MixedHierarchyModel::update_fourth_tables(bool bit) {
+    for (int j : kept_tables<kFifth>()) models_[size_t(j)][slot_[size_t(j)]].update_with_limit(bit, kModelWindowLog2);
+    for (int j : later_tables<kFifth>()) models_[size_t(j)][slot_[size_t(j)]].update_with_limit(bit, kModelWindowLog2);
+}
+
 void MixedHierarchyModel::update(bool bit) {
     mixer_a_.update(st_.data(), bit);
     mixer_b_.update(st_.data(), bit);
     mixer_c_.update(st_.data(), bit);
     if (model_ >= MixingModel::third) mixer_d_.update(st_.data(), bit);
     for (mixing::ProbabilityMap& map : maps_) map.update(bit);
-    if (model_ == MixingModel::fourth) {
-        for (int j : kFourthKeptTables) models_[size_t(j)][slot_[size_t(j)]].update_with_limit(bit, kModelWindowLog2);
-        for (int j : kFourthLaterTables) models_[size_t(j)][slot_[size_t(j)]].update_with_limit(bit, kModelWindowLog2);
+    if (model_ == MixingModel::fifth) {
+        update_fourth_tables<true>(bit);
+    } else if (model_ == MixingModel::fourth) {
+        update_fourth_tables<false>(bit);
     } else {
         const int direct = model_ == MixingModel::first ? kInputs : model_ == MixingModel::second ? kDirect : kThirdDirect;
         for (int j = 0; j < direct; ++j) models_[size_t(j)][slot_[size_t(j)]].update_with_limit(bit, kModelWindowLog2);

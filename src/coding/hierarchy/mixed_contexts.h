@@ -1,5 +1,6 @@
 // The hierarchy coder's mixing mode (.amc version 8, docs/FORMAT.md section 2.1; its second model,
-// version 10, section 2.2; its third, version 11, section 2.3; its fourth, version 16, section 2.4): each coded symbol's probability comes from adaptive models under
+// version 10, section 2.2; its third, version 11, section 2.3; its fourth, version 16, section 2.4; its fifth, version 17,
+// section 2.5): each coded symbol's probability comes from adaptive models under
 // contexts richer than the paper's groups — the node's structure one level up, its decided
 // neighbours and their neighbours, and the decoded geometry around it — mixed by logistic mixing
 // (context_mixing.h) and refined by adaptive probability maps. Measured in
@@ -22,8 +23,9 @@ namespace amc {
 // (2.2), which adds the last coded bits, bit histories and the curvature of the neighbours,
 // version 11's (2.3), which adds the node's size and a Gauss curvature, a fourth mixer and mixers
 // that start from trained weights, or version 16's (2.4), which adds the curvatures of a quadric
-// through the node's corners and its neighbours' far corners and leaves out seven direct inputs.
-enum class MixingModel : uint8_t { first = 1, second = 2, third = 3, fourth = 4 };
+// through the node's corners and its neighbours' far corners and leaves out seven direct inputs,
+// or version 17's (2.5), which adds the local threshold against the coded nodes two rings around.
+enum class MixingModel : uint8_t { first = 1, second = 2, third = 3, fourth = 4, fifth = 5 };
 
 // What the decoder knows of a node when its symbol comes.
 struct MixedFeatures {
@@ -45,6 +47,10 @@ struct MixedFeatures {
     uint8_t gauss;        // third model: log bin of the neighbours' normals' spread (a Gauss curvature) times the longest edge^2, 0..63
     uint8_t quad_mean;    // fourth model: log bin of |mean curvature| times the longest edge of the quadric through the corners and the neighbours' far corners, 0..63
     uint8_t quad_gauss;   // fourth model: the same of the root of its |Gauss curvature|, 0..63
+    // Fifth model, over the same-level nodes one and two edges away whose symbols came before this
+    // node's: half-octave bins of mean_curv's value against the least of the refined ones' and the
+    // largest of the others' (0..31, 0 for none), and how many of each (at most 7).
+    uint8_t thr_refined, thr_unrefined, coded_refined, coded_unrefined;
 };
 
 // The unit normals and curvatures of one level's nodes by local index, each computed once: the
@@ -70,11 +76,20 @@ public:
     // The mean of the roots' longest edges (in root order), computed on first use: the third
     // model's unit of size.
     double base_edge(const Hierarchy& h);
+    // Fifth model: node `local` of the level had its symbol coded, with mean_curv's value `curvature`.
+    void mark_coded(uint32_t local, double curvature) {
+        if (local < coded_curvature_.size()) coded_curvature_[local] = curvature;
+    }
+    // Per local index of the level, mean_curv's value of a coded node, kUncoded for the others
+    // (a value is >= 0 or NaN).
+    static constexpr double kUncoded = -1.0;
+    const double* coded_curvatures() const { return coded_curvature_.data(); }
 
 private:
     std::vector<Vec3> normal_;
     std::vector<Bending> bending_;
-    std::vector<uint32_t> stamp_, bending_stamp_;  // normal_[i] is this level's when stamp_[i] == current_
+    std::vector<uint32_t> stamp_, bending_stamp_;
+    std::vector<double> coded_curvature_;  // normal_[i] is this level's when stamp_[i] == current_
     uint32_t current_ = 0;
     double base_edge_ = -1;
 };
@@ -89,7 +104,8 @@ std::array<double, 2> quadric_curvatures(const Hierarchy& h, NodeId n, double lo
 // on the traversal, and those that do from the level's state bytes: `i` is n's local index in
 // `level`, whose neighbours' states are as decided so far. `shapes` is started on `level`. The
 // ring features are computed for the second and later models, size and gauss for the third and
-// fourth, quad_mean and quad_gauss for the fourth.
+// later, quad_mean and quad_gauss for the fourth and fifth, the thresholds for the fifth (which
+// marks n coded in `shapes`).
 MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, uint32_t i, int group, LevelShapes& shapes,
                              MixingModel model);
 
@@ -112,6 +128,11 @@ public:
     static constexpr int kFourthKept = 14;     // the fourth model's direct models of tables 0-20
     static constexpr int kFourthLater = 6;     // and of tables 21-27
     static constexpr int kFourthInputs = kFourthKept + kIndirectInputs + kFourthLater;
+    static constexpr int kThresholdInputs = 3;  // the fifth model's direct models of the local threshold
+    static constexpr int kFifthDirect = kFourthDirect + kThresholdInputs;
+    static constexpr int kFifthKept = 7;        // the fifth model's direct models of tables 0-20
+    static constexpr int kFifthLater = 9;       // and of tables 21-30
+    static constexpr int kFifthInputs = kFifthKept + kIndirectInputs + kFifthLater;
     explicit MixedHierarchyModel(MixingModel model);
     MixingModel model() const { return model_; }
     // The 16-bit probability of a one for a symbol with these features (remembered for update).
@@ -123,14 +144,18 @@ public:
 private:
     // The second and third models' probability (FORMAT.md 2.2, 2.3), 12 bits.
     int later_model_p12(const MixedFeatures& f);
-    // The fourth model's (FORMAT.md 2.4), 12 bits.
+    // The fourth and fifth models' (FORMAT.md 2.4, 2.5), 12 bits, and their direct models' update
+    // (templates: each model's table lists are constants, as the loops over them are unrolled).
+    template <bool kFifth>
     int fourth_model_p12(const MixedFeatures& f);
+    template <bool kFifth>
+    void update_fourth_tables(bool bit);
     // The bit histories' inputs into st_ from `first` on (second and later models).
     void history_inputs(uint32_t group, int first);
 
     MixingModel model_;
-    std::array<std::vector<BitModel>, kFourthDirect> models_;
-    std::array<uint32_t, kFourthDirect> slot_{};
+    std::array<std::vector<BitModel>, kFifthDirect> models_;
+    std::array<uint32_t, kFifthDirect> slot_{};
     // Stretched inputs: the direct models 0-20, the bit histories, the third model's direct
     // models 21-24, then the bias (fourth model: the kept direct models of 0-20, the bit
     // histories, direct models 21-27, the bias).
