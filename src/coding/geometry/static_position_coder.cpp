@@ -1059,29 +1059,44 @@ bool decode_stencil_float64(Hierarchy& h, const std::vector<std::pair<NodeId, in
         else add_residuals<true>(streams, t, predicted, count);
         // from_ordered_bits of each sum, and whether every coordinate of the chunk is at most
         // DBL_MAX / 2 in magnitude (not Hierarchy::is_far, and finite), in the bits of each lane.
+#if AMC_SSE2
+        // Two vertices at a time: their z in one register.
+        const __m128d sign = _mm_set1_pd(-0.0);
+        auto near_lanes = [&](__m128d v) { return _mm_cmple_pd(_mm_andnot_pd(sign, v), half_max); };
+        auto xy_at = [&](size_t i) { return double_lanes_of(_mm_loadu_si128(reinterpret_cast<const __m128i*>(predicted[i]))); };
+        auto put = [&](size_t i, __m128d xy, double z) {
+            Vec3 p;
+            _mm_storeu_pd(&p.x, xy);
+            p.z = z;
+            HierarchyBuilder::set_near_vertex_position(h, vertices[i], p);
+        };
+        size_t i = 0;
+        for (; i + 1 < count; i += 2) {
+            const __m128d xy0 = xy_at(i), xy1 = xy_at(i + 1);
+            const __m128d z = double_lanes_of(_mm_set_epi64x(int64_t(predicted[i + 1][2]), int64_t(predicted[i][2])));
+            near_xy = _mm_and_pd(near_xy, _mm_and_pd(near_lanes(xy0), near_lanes(xy1)));
+            near_z = _mm_and_pd(near_z, near_lanes(z));
+            put(i, xy0, _mm_cvtsd_f64(z));
+            put(i + 1, xy1, _mm_cvtsd_f64(_mm_unpackhi_pd(z, z)));
+        }
+        if (i < count) {
+            const __m128d xy = xy_at(i), z = double_lanes_of(_mm_set1_epi64x(int64_t(predicted[i][2])));
+            near_xy = _mm_and_pd(near_xy, near_lanes(xy));
+            near_z = _mm_and_pd(near_z, near_lanes(z));
+            put(i, xy, _mm_cvtsd_f64(z));
+        }
+        const bool near = _mm_movemask_pd(_mm_and_pd(near_xy, near_z)) == 3;
+#else
         for (size_t i = 0; i < count; ++i) {
             Vec3 p;
-#if AMC_SSE2
-            const __m128d xy = double_lanes_of(_mm_loadu_si128(reinterpret_cast<const __m128i*>(predicted[i])));
-            const __m128d z = double_lanes_of(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(predicted[i] + 2)));
-            const __m128d sign = _mm_set1_pd(-0.0);
-            near_xy = _mm_and_pd(near_xy, _mm_cmple_pd(_mm_andnot_pd(sign, xy), half_max));
-            near_z = _mm_and_pd(near_z, _mm_cmple_pd(_mm_andnot_pd(sign, z), half_max));
-            _mm_storeu_pd(&p.x, xy);
-            _mm_store_sd(&p.z, z);
-#else
             double* xyz[3] = {&p.x, &p.y, &p.z};
             for (int k = 0; k < 3; ++k) {
                 const uint64_t b = double_bits_of(predicted[i][k]);
                 largest_magnitude = std::max(largest_magnitude, b & ~kSign64);
                 *xyz[k] = bit_cast<double>(b);
             }
-#endif
             HierarchyBuilder::set_near_vertex_position(h, vertices[i], p);
         }
-#if AMC_SSE2
-        const bool near = _mm_movemask_pd(near_xy) == 3 && (_mm_movemask_pd(near_z) & 1) != 0;  // z's lane 1 is not a coordinate
-#else
         const bool near = largest_magnitude <= bit_cast<uint64_t>(kHalfMax);
 #endif
         if (!near) {  // rare: which coordinates, then
