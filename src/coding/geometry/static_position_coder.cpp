@@ -1046,7 +1046,7 @@ bool decode_stencil_float64(Hierarchy& h, const std::vector<std::pair<NodeId, in
         for (size_t i = 0; i < count; ++i) {
             const auto [n, e] = created[begin + i];
             stencil_prediction<Butterfly>(h, positions, n, e, predicted[i]);
-            vertices[i] = consecutive ? VertexId(first + begin + i) : h.midpoint(n, e);
+            if (!consecutive) vertices[i] = h.midpoint(n, e);
         }
 #if AMC_SSE2
         __m128d near_xy = _mm_castsi128_pd(_mm_set1_epi32(-1)), near_z = near_xy;
@@ -1059,6 +1059,7 @@ bool decode_stencil_float64(Hierarchy& h, const std::vector<std::pair<NodeId, in
         else add_residuals<true>(streams, t, predicted, count);
         // from_ordered_bits of each sum, and whether every coordinate of the chunk is at most
         // DBL_MAX / 2 in magnitude (not Hierarchy::is_far, and finite), in the bits of each lane.
+        auto vertex = [&](size_t i) { return consecutive ? VertexId(first + begin + i) : vertices[i]; };
 #if AMC_SSE2
         // Two vertices at a time: their z in one register.
         const __m128d sign = _mm_set1_pd(-0.0);
@@ -1068,7 +1069,7 @@ bool decode_stencil_float64(Hierarchy& h, const std::vector<std::pair<NodeId, in
             Vec3 p;
             _mm_storeu_pd(&p.x, xy);
             p.z = z;
-            HierarchyBuilder::set_near_vertex_position(h, vertices[i], p);
+            HierarchyBuilder::set_near_vertex_position(h, vertex(i), p);
         };
         size_t i = 0;
         for (; i + 1 < count; i += 2) {
@@ -1095,15 +1096,15 @@ bool decode_stencil_float64(Hierarchy& h, const std::vector<std::pair<NodeId, in
                 largest_magnitude = std::max(largest_magnitude, b & ~kSign64);
                 *xyz[k] = bit_cast<double>(b);
             }
-            HierarchyBuilder::set_near_vertex_position(h, vertices[i], p);
+            HierarchyBuilder::set_near_vertex_position(h, vertex(i), p);
         }
         const bool near = largest_magnitude <= bit_cast<uint64_t>(kHalfMax);
 #endif
         if (!near) {  // rare: which coordinates, then
             for (size_t i = 0; i < count; ++i) {
-                const Vec3 p = h.position(vertices[i]);
+                const Vec3 p = h.position(vertex(i));
                 if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return false;
-                HierarchyBuilder::set_new_vertex_position(h, vertices[i], p);  // Hierarchy::is_far's flag
+                HierarchyBuilder::set_new_vertex_position(h, vertex(i), p);  // Hierarchy::is_far's flag
             }
         }
     }
