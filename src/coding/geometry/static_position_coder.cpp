@@ -929,9 +929,13 @@ constexpr OppositeIndices kOpposite;
 struct Lanes {
     __m128d xy, z;
 };
+// The positions read as an array of doubles: GCC then forms the index 3v once and addresses both
+// loads from it (from &positions[v], it makes the address twice).
+static_assert(sizeof(Vec3) == 3 * sizeof(double), "a Vec3 is its three coordinates");
 AMC_ALWAYS_INLINE Lanes point_at(const Vec3* positions, VertexId v) {
-    const Vec3& p = positions[v];
-    return {_mm_loadu_pd(&p.x), _mm_load_sd(&p.z)};
+    const double* coordinates = &positions->x;
+    const size_t k = size_t(v) * 3;
+    return {_mm_loadu_pd(coordinates + k), _mm_load_sd(coordinates + k + 2)};
 }
 AMC_ALWAYS_INLINE Lanes operator+(Lanes u, Lanes v) { return {_mm_add_pd(u.xy, v.xy), _mm_add_pd(u.z, v.z)}; }
 AMC_ALWAYS_INLINE Lanes operator-(Lanes u, Lanes v) { return {_mm_sub_pd(u.xy, v.xy), _mm_sub_pd(u.z, v.z)}; }
