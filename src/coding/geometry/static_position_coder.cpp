@@ -891,6 +891,20 @@ struct StencilStreams {
     }
 };
 
+// The streams of a level with both rANS states read; false where the level is too short for them
+// or a state is below L (no encoder ends there).
+bool open_stencil_streams(const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size,
+                          StencilStreams& s) {
+    s = StencilStreams{{0, 0}, rans_data, rans_data + rans_size, raw_data, 0, raw_size};
+    if (rans_size < kRansStateBytes) return false;
+    for (uint32_t& x : s.x) {
+        x = load_le32(s.rans);
+        s.rans += 4;
+        if (x < kRansLow) return false;
+    }
+    return true;
+}
+
 constexpr uint64_t kSign64 = uint64_t{1} << 63;
 // ordered_bits and from_ordered_bits for float64 without branches (the signs are coin flips);
 // the SSE2 paths below compute the same per lane, so only the scalar twins call these.
@@ -1027,13 +1041,8 @@ bool decode_stencil_float64(Hierarchy& h, const std::vector<std::pair<NodeId, in
                             const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
     std::array<StencilTable, 3> t;
     for (size_t k = 0; k < 3; ++k) make_stencil_table(tables[k], t[k]);
-    StencilStreams streams{{0, 0}, rans_data, rans_data + rans_size, raw_data, 0, raw_size};
-    if (rans_size < kRansStateBytes) return false;
-    for (uint32_t& x : streams.x) {
-        x = load_le32(streams.rans);
-        streams.rans += 4;
-        if (x < kRansLow) return false;  // RansDecoder's: no encoder ends below L
-    }
+    StencilStreams streams;
+    if (!open_stencil_streams(rans_data, rans_size, raw_data, raw_size, streams)) return false;
     // What a chunk reads at most: two rANS bytes and the sign and 64 bits per coordinate.
     constexpr size_t kChunkRans = 2 * 3 * kChunk, kChunkRaw = 3 * kChunk * 65 / 8 + 8;
     uint64_t predicted[kChunk][3];
@@ -1236,13 +1245,8 @@ bool decode_grid_listed(Hierarchy& h, const FromList& created, const Quantizer& 
                         const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
     std::array<GridTable, kMaxStaticTables> t;
     for (size_t k = 0; k < t.size(); ++k) make_grid_table(tables[k], t[k]);
-    StencilStreams s{{0, 0}, rans_data, rans_data + rans_size, raw_data, 0, raw_size};
-    if (rans_size < kRansStateBytes) return false;
-    for (uint32_t& x : s.x) {
-        x = load_le32(s.rans);
-        s.rans += 4;
-        if (x < kRansLow) return false;  // RansDecoder's: no encoder ends below L
-    }
+    StencilStreams s;
+    if (!open_stencil_streams(rans_data, rans_size, raw_data, raw_size, s)) return false;
     const GridScale grid = grid_scale(&quantizer);
     const double origin[3] = {quantizer.origin.x, quantizer.origin.y, quantizer.origin.z};
     // decode_positions': every grid value lies between the box's corners.
