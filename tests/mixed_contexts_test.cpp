@@ -157,12 +157,17 @@ TEST(MixedContexts, RandomHierarchiesRoundTripBitExactlyUnderEverySwitch) {
     }
 }
 
-TEST(MixedContexts, SmallerThanThePapersContextsOnACurvedRemesh) {
+// A curvature-adaptive remesh of 20,000 faces over 200 base triangles.
+Hierarchy curved_remesh() {
     SurfaceRemeshOptions remesh;
     remesh.base_triangles = 200;
     remesh.max_level = 5;
     remesh.target_faces = 20000;
-    const Hierarchy h = remesh_adaptively(make_bumpy_sphere(4), remesh);
+    return remesh_adaptively(make_bumpy_sphere(4), remesh);
+}
+
+TEST(MixedContexts, SmallerThanThePapersContextsOnACurvedRemesh) {
+    const Hierarchy h = curved_remesh();
     EncodeStats paper, mixed;
     encode(h, {}, &paper);
     EncodeOptions options;
@@ -194,11 +199,7 @@ double mixing_model_bits(const Hierarchy& h, MixingModel model) {
 // The fifth model's local threshold (FORMAT.md 2.5): the features see only nodes coded before, and
 // they make a curved remesh's code smaller than the fourth model's.
 TEST(MixedContexts, TheLocalThresholdCodesACurvedRemeshSmallerThanTheFourthModel) {
-    SurfaceRemeshOptions remesh;
-    remesh.base_triangles = 200;
-    remesh.max_level = 5;
-    remesh.target_faces = 20000;
-    const Hierarchy h = remesh_adaptively(make_bumpy_sphere(4), remesh);
+    const Hierarchy h = curved_remesh();
     const HierarchyLevelEncoder coder(h, HierarchyCoderOptions{}, kHierarchyStreamVersion, nullptr, true);
     int compared = 0, first_of_level = 0, level = -1;
     for (const auto& [f, bit] : coder.mixed_symbols()) {
