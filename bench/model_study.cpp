@@ -800,12 +800,16 @@ int main(int argc, char** argv) {
         o.extra.push_back([](F f, X x) { return x.law * 8u + f.level; });
     });
     // Session of 2026-12-04 evening: local threshold comparisons and quadric curvatures.
-    auto third_plus = [&](const std::string& name, std::vector<std::function<uint32_t(F, X)>> contexts) {
-        add("T: third + " + name, [&, contexts](Options& o) {
-            third(o);
-            for (const auto& c : contexts) o.extra.push_back(c);
-        });
+    // A design: `base`'s options plus `contexts` as extra tables, named "`label` + `name`".
+    auto plus = [&](const std::string& label, std::function<void(Options&)> base) {
+        return [&, label, base](const std::string& name, std::vector<std::function<uint32_t(F, X)>> contexts) {
+            add(label + " + " + name, [base, contexts](Options& o) {
+                base(o);
+                for (const auto& c : contexts) o.extra.push_back(c);
+            });
+        };
     };
+    auto third_plus = plus("T: third", third);
     third_plus("ref x unref x group", {[](F f, X x) { return (f.group * 32u + x.thr_ref) * 32 + x.thr_unref; }});
     third_plus("ref x unref x level", {[](F f, X x) { return (f.level * 32u + x.thr_ref) * 32 + x.thr_unref; }});
     third_plus("ref x group, unref x group", {[](F f, X x) { return f.group * 32u + x.thr_ref; }, [](F f, X x) { return f.group * 32u + x.thr_unref; }});
@@ -935,12 +939,7 @@ int main(int argc, char** argv) {
     // Session of 2026-12-04 night (docs/HIERARCHY_CODER.md, "The fifth model"): the fourth
     // model plus local thresholds, SSE stages and a fifth mixer.
     auto fourth_coded = [&](Options& o) { fourth(o), o.maps_off = 7, o.drop = drops({1, 6, 8, 10, 11, 12, 18, 25}); };
-    auto e_plus = [&](const std::string& name, std::vector<std::function<uint32_t(F, X)>> contexts) {
-        add("E: fourth + " + name, [&, contexts](Options& o) {
-            fourth_coded(o);
-            for (const auto& c : contexts) o.extra.push_back(c);
-        });
-    };
+    auto e_plus = plus("E: fourth", fourth_coded);
     e_plus("ref2 x unref2 x group", {[](F f, X x) { return (f.group * 32u + x.thr_ref2) * 32 + x.thr_unref2; }});
     e_plus("ref2 x unref2 x level", {[](F f, X x) { return (f.level * 32u + x.thr_ref2) * 32 + x.thr_unref2; }});
     e_plus("qref2 x qunref2 x group", {[](F f, X x) { return (f.group * 32u + x.qthr_ref2) * 32 + x.qthr_unref2; }});
