@@ -1,6 +1,7 @@
 // When an adaptive geometry trial stops (AdaptiveTrialJudge, coding/geometry/level_geometry.h):
-// the exact limit always; the sample's projections, and past the sample one more projection at
-// the end of every further sample's length.
+// the exact limit always; the sample's projections (from its first eighth on, the first two only
+// from rates over enough committed bytes), and past the sample one more projection at the end of
+// every further sample's length.
 #include "coding/geometry/level_geometry.h"
 
 #include <gtest/gtest.h>
@@ -53,6 +54,19 @@ TEST(AdaptiveTrial, HalfwayThroughTheSampleALargeRateStopsIt) {
     // 0.4 bytes a vertex from vertex 256 on: halfway (512) the projection is 3,098 bytes, past
     // 1.25 times the limit.
     EXPECT_EQ(stopped_at(8192, 1024, 1000, [](size_t done) { return done <= 256 ? done / 10 : 25 + (done - 256) * 2 / 5; }), 512u);
+}
+
+TEST(AdaptiveTrial, AfterTheSamplesFirstEighthALargeRateStopsIt) {
+    // 0.4 bytes a vertex from the start: after 128 vertices (an eighth of the sample) the rate of
+    // the sixteenth before rests on 26 bytes and projects 3,327 bytes, past 1.25 times the limit.
+    EXPECT_EQ(stopped_at(8192, 1024, 1000, [](size_t done) { return done * 2 / 5; }), 128u);
+}
+
+TEST(AdaptiveTrial, AnEarlyRateFromFewCommittedBytesDoesNotStopIt) {
+    // 0.1 bytes a vertex for the first 256 vertices, then none: the first eighth's and quarter's
+    // rates (6 and 13 committed bytes) would project 768 and 831 bytes against a limit of 100,
+    // but rest on too few bytes; halfway the rate is 0, and the level codes in 25 bytes.
+    EXPECT_EQ(stopped_at(8192, 1024, 100, two_rates(256, 0.0)), 0u);
 }
 
 }  // namespace

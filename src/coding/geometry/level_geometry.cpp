@@ -24,7 +24,8 @@ namespace {
 // projected to the level is within kStaticMargin of the smallest are made for the whole level (the
 // sample's own bounds favoured mode 3: its three tables against mode 4's six); an adaptive trial is
 // dropped when its first 1/kSampleShare, scaled to the level, passes what it must beat by 1/8
-// (or its first half by 1/4).
+// (or its first eighth, quarter or half by 1/4: AdaptiveTrialJudge, whose earliest two tests
+// need kMinRateBytes committed in the part they take the rate from).
 // Both keep kSampleSlack bytes of room besides, for levels that code to almost nothing.
 // Their products are rounded(): a fused multiply-add would make the choice, so the bytes, depend on the build.
 constexpr size_t kSampleShare = 8;
@@ -33,6 +34,7 @@ constexpr double kSampleMargin = 1.125;
 constexpr double kSampleSlack = 64;
 constexpr double kStaticMargin = 1.02;
 constexpr double kEarlyMargin = 1.25;
+constexpr size_t kMinRateBytes = 16;
 
 // The static modes the automatic choice weighs, in the order of the choice (after the adaptive
 // midpoint and butterfly).
@@ -147,16 +149,21 @@ size_t adaptive_bytes(const Mesh& h, const NewVertices& created, GeometryPredict
 
 bool AdaptiveTrialJudge::checkpoint(size_t done, size_t bytes) {
     // The level's bytes from those of its first `done` vertices at the rate since since_ pass
-    // the limit by `margin` (the sample's second quarter, then its second half, then each
-    // further sample's length: the models learn as they go).
+    // the limit by `margin` (the sample's second sixteenth, its second eighth, its second quarter,
+    // then its second half, then each further sample's length: the models learn as they go).
     auto projected_past = [&](double margin) {
         const double rate = double(bytes - since_bytes_) / double(done - since_);
         return limit_ != SIZE_MAX &&
                double(bytes) + rounded(rate * double(count_ - done)) > rounded(margin * double(limit_)) + kSampleSlack;
     };
     bool stop = false;
-    if (done == sample_ / 4) {
-        next_ = sample_ / 2;
+    if (done == sample_ / 16) {
+        next_ = sample_ / 8;
+    } else if (done == sample_ / 8 || done == sample_ / 4) {
+        // The first tests' rates come from few committed bytes: a level that codes to almost
+        // nothing (exact midpoints, 1-3 bytes per sixteenth) would project from its next byte.
+        stop = bytes - since_bytes_ >= kMinRateBytes && projected_past(kEarlyMargin);
+        next_ = done == sample_ / 8 ? sample_ / 4 : sample_ / 2;
     } else if (done == sample_ / 2) {
         stop = projected_past(kEarlyMargin);
         next_ = sample_;

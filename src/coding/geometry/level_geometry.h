@@ -54,14 +54,17 @@ LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& create
 // committed after each vertex: once they pass `limit` (SIZE_MAX: none) by 8 bytes (exact: a
 // finished code is never much shorter), and, with a `sample` of fewer vertices than the level
 // (SIZE_MAX: none), when the level's bytes projected at a recent rate pass the limit by a margin
-// (a guess): halfway through the sample at the rate of its second quarter, at the sample's end
-// at the rate of its second half, then at the end of every further sample's length at the rate
-// of the last one (the surfaces' trials that passed the sample all lost, after coding 60-80 % of
-// their level: BENCHMARKS.md, "One-core encode, twelfth step").
+// (a guess): after the sample's first eighth and first quarter at the rate of the sixteenth
+// (eighth) before, when that rate rests on 16 committed bytes or more, halfway through the sample
+// at the rate of its second quarter, at the sample's end at the rate of its second half, then at
+// the end of every further sample's length at the rate of the last one (the surfaces' trials that
+// passed the sample all lost, after coding 60-80 % of their level: BENCHMARKS.md, "One-core
+// encode, twelfth step"; those that stopped halfway mostly projected past the margin already
+// after the first eighth: fourteenth step).
 class AdaptiveTrialJudge {
 public:
     AdaptiveTrialJudge(size_t count, size_t sample, size_t limit)
-        : count_(count), sample_(sample), limit_(limit), next_(sample == SIZE_MAX ? SIZE_MAX : sample / 4) {}
+        : count_(count), sample_(sample), limit_(limit), next_(sample == SIZE_MAX ? SIZE_MAX : sample / 16) {}
     // After the trial's first `done` vertices, `bytes` committed: whether it stops there.
     bool stops(size_t done, size_t bytes) {
         if (bytes > limit_ + 8) return true;
