@@ -342,9 +342,10 @@ TEST(BaseMeshCoder, ModeTwoSearchFollowsItsBudget) {
     EXPECT_GT(budget_mattered, 0) << "a few candidates did as well as the full search everywhere";
 }
 
-// Inside an .amc encode the search of a refined hierarchy's base codes at most 2^16 triangles,
+// Inside an .amc encode the search of a refined hierarchy's base codes at most 2^13 triangles,
 // whatever the hierarchy's size, and nothing beyond the single try when that can not try one start
-// in every rotation and radius; a hierarchy that is at least half base gets the full budget.
+// in every rotation and radius (above about 180 triangles, such as a base of 600); a hierarchy that
+// is at least half base gets the full budget.
 TEST(BaseMeshCoder, SearchBudgetFollowsTheHierarchy) {
     Hierarchy unrefined(make_torus(40, 30, 2.0, 0.7));
     EXPECT_EQ(base_search_budget(unrefined), kFullBaseSearch);
@@ -354,13 +355,17 @@ TEST(BaseMeshCoder, SearchBudgetFollowsTheHierarchy) {
     EXPECT_EQ(base_search_budget(mostly_base), kFullBaseSearch);
     Hierarchy small(make_icosahedron());
     refine_uniformly(small, 2);
-    EXPECT_EQ(base_search_budget(small), uint64_t{1} << 16);
+    EXPECT_EQ(base_search_budget(small), uint64_t{1} << 13);
     Hierarchy large(make_icosahedron());
     refine_uniformly(large, 7);
-    EXPECT_EQ(base_search_budget(large), uint64_t{1} << 16);
+    EXPECT_EQ(base_search_budget(large), uint64_t{1} << 13);
+    Hierarchy medium_base(make_torus(20, 15, 2.0, 0.7));  // 600 triangles
+    refine_uniformly(medium_base, 1);
+    ASSERT_GT(one_start_search_budget(medium_base.root_count()), uint64_t{1} << 13);
+    EXPECT_EQ(base_search_budget(medium_base), 0u);
     Hierarchy large_base(make_torus(40, 30, 2.0, 0.7));  // 2,400 triangles
     refine_uniformly(large_base, 1);
-    ASSERT_GT(one_start_search_budget(large_base.root_count()), uint64_t{1} << 16);
+    ASSERT_GT(one_start_search_budget(large_base.root_count()), uint64_t{1} << 13);
     EXPECT_EQ(base_search_budget(large_base), 0u);
     const BaseMeshCode single = encode_base_connectivity(large_base.base(), BaseConnectivityMode::angle, false);
     EXPECT_EQ(encode_base_connectivity(large_base.base(), 1, base_search_budget(large_base)).bytes, single.bytes);
