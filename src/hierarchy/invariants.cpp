@@ -144,6 +144,27 @@ std::string check_position_range(const Hierarchy& h, const std::vector<uint32_t>
     return "";
 }
 
+// Whether every coordinate of vertices [begin, end) passes check_position_range's tests: one pass
+// without branches or messages (every encode checks its whole input), the messages only for a
+// range that fails. Out-of-range values are not converted to float (a select, not a branch).
+bool positions_pass(const Hierarchy& h, VertexId begin, VertexId end) {
+    const Vec3* positions = h.positions().data();
+    bool bad = false;
+    if (h.single_precision()) {
+        for (VertexId v = begin; v < end; ++v) {
+            for (const double x : {positions[v].x, positions[v].y, positions[v].z}) {
+                const bool in_range = std::fabs(x) <= FLT_MAX;  // false for NaN too
+                const double y = in_range ? x : 0.0;
+                bad |= !in_range | (rounded_to_float(y) != y);
+            }
+        }
+    } else {
+        for (VertexId v = begin; v < end; ++v)
+            for (const double x : {positions[v].x, positions[v].y, positions[v].z}) bad |= !(std::fabs(x) <= DBL_MAX);
+    }
+    return !bad;
+}
+
 // Ranges of vertices checked on `threads` threads; the first problem in vertex order is reported.
 std::string check_positions(const Hierarchy& h, unsigned threads) {
     // Without removed ids every id is a live vertex: no need to find them.
@@ -153,8 +174,8 @@ std::string check_positions(const Hierarchy& h, unsigned threads) {
     const VertexId vertices = VertexId(h.positions().size());
     std::vector<std::string> problems((size_t(vertices) + kRange - 1) / kRange);
     parallel_for(problems.size(), threads, [&](size_t i) {
-        const VertexId begin = VertexId(i) * kRange;
-        problems[i] = check_position_range(h, canonical, begin, std::min<VertexId>(vertices, begin + kRange));
+        const VertexId begin = VertexId(i) * kRange, end = std::min<VertexId>(vertices, begin + kRange);
+        if (!all_live || !positions_pass(h, begin, end)) problems[i] = check_position_range(h, canonical, begin, end);
     });
     for (const std::string& problem : problems)
         if (!problem.empty()) return problem;

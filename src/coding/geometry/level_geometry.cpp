@@ -120,16 +120,21 @@ size_t adaptive_bytes(const Mesh& h, const NewVertices& created, GeometryPredict
                       size_t limit, bool count_raw_bits, size_t sample) {
     const size_t judged = std::min(sample, created.size());
     std::vector<Vec3> predicted(count_raw_bits ? judged : 0);
+    auto too_many_raw_bits = [&](uint64_t raw_bits) {
+        const double raw_projected = double(raw_bits / 8) * double(created.size()) / double(judged);
+        return judged == created.size() ? raw_bits / 8 > limit + 6
+                                        : limit != SIZE_MAX && raw_projected > rounded(kSampleMargin * double(limit)) + kSampleSlack;
+    };
     uint64_t raw_bits = 0;
     for (size_t i = 0; i < predicted.size(); ++i) {
         const auto [n, e] = created[i];
         predicted[i] = predict(h, predictor, n, e);
         raw_bits += positions.raw_bits(h.position(h.midpoint(n, e)), predicted[i]);
+        // The count only grows: once the first vertices' bits fail the test, all of them do
+        // (bit-exact surface levels: after about half of the sample).
+        if (i % 64 == 63 && too_many_raw_bits(raw_bits)) return SIZE_MAX;
     }
-    const double raw_projected = double(raw_bits / 8) * double(created.size()) / double(judged);
-    if (judged == created.size() ? raw_bits / 8 > limit + 6
-                                 : limit != SIZE_MAX && raw_projected > rounded(kSampleMargin * double(limit)) + kSampleSlack)
-        return SIZE_MAX;
+    if (too_many_raw_bits(raw_bits)) return SIZE_MAX;
     ArithmeticEncoder encoder;
     // Bit-exact levels: the raw bits in the side stream (finish_level_payload's layout).
     RawBitWriter raw;
