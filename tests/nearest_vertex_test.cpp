@@ -83,6 +83,35 @@ TEST(NearestVertex, FindsTheKNearestUsableVerticesInOrderAsASortDoes) {
     }
 }
 
+// The import's renumbered leaf mesh takes the input's tree with its ids renamed instead of a build
+// over the renumbered points inserted in the input's order: both must answer alike, ties included
+// (lattice points: many vertices equally near a query).
+TEST(NearestVertex, RenamedTreeAnswersAsABuildOverTheRenumberedPoints) {
+    Lcg random{23};
+    std::vector<amc::Vec3> points;
+    for (int i = 0; i < 40; ++i) {
+        for (int j = 0; j < 40; ++j) points.push_back({double(i), double(j), double((i * 7 + j * 3) % 5)});
+    }
+    std::vector<uint32_t> new_id(points.size());  // input id -> renumbered id
+    std::iota(new_id.begin(), new_id.end(), 0u);
+    for (size_t i = new_id.size(); i > 1; --i) std::swap(new_id[i - 1], new_id[size_t(random.unit() * double(i))]);
+    std::vector<amc::Vec3> renumbered(points.size());
+    for (uint32_t v = 0; v < points.size(); ++v) renumbered[new_id[v]] = points[v];
+    const amc::NearestVertex input(points);
+    const amc::NearestVertex built(renumbered, &new_id);
+    const amc::NearestVertex renamed(input, new_id);
+    auto usable = [](uint32_t v) { return v % 5 != 2; };
+    for (int query = 0; query < 300; ++query) {
+        const amc::Vec3 p = {std::floor(41 * random.unit()) - 0.5 * (query % 2), std::floor(41 * random.unit()), 2.0};
+        uint32_t a[amc::NearestVertex::kMaxCount], b[amc::NearestVertex::kMaxCount];
+        const uint32_t na = built.find_nearest(p, usable, amc::NearestVertex::kMaxCount, a);
+        const uint32_t nb = renamed.find_nearest(p, usable, amc::NearestVertex::kMaxCount, b);
+        ASSERT_EQ(na, nb) << "query " << query;
+        for (uint32_t i = 0; i < na; ++i) EXPECT_EQ(a[i], b[i]) << "query " << query << ", rank " << i;
+        EXPECT_EQ(built.find(p, usable), renamed.find(p, usable)) << "query " << query;
+    }
+}
+
 TEST(NearestVertex, NoUsableVertexIsNoIndex) {
     const std::vector<amc::Vec3> points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
     const amc::NearestVertex nearest(points);

@@ -83,17 +83,17 @@ TriangleMesh renumbered(const TriangleMesh& leaf, const std::vector<uint32_t>& i
 // The leaf mesh on base detection's breadth-first vertex numbering, for the ways a refusal spends
 // its time in (the anchored way, then the guided ways with its undo steps): on a user's shuffled
 // ids nearly every lookup of a large mesh misses the cache. The faces keep their order (the
-// anchored way's search depends on it); the position index and the k-d tree take the vertices in
-// the input's order (which of two equal candidates is first), so the answers are the input
-// numbering's, and messages name the input's vertices (input_of).
+// anchored way's search depends on it); the position index takes the vertices in the input's
+// order and the k-d tree is the input's, renamed (which of two equal candidates is first), so the
+// answers are the input numbering's, and messages name the input's vertices (input_of).
 struct RenumberedLeaf {
-    RenumberedLeaf(const TriangleMesh& leaf, const std::vector<uint32_t>& input_leaf_of_base)
+    RenumberedLeaf(const TriangleMesh& leaf, const std::vector<uint32_t>& input_leaf_of_base, LeafSearch& input_search)
         : input_of(detail::breadth_first_vertices(leaf.triangles, uint32_t(leaf.positions.size()))),
           import_of(inverse(input_of)),
           mesh(renumbered(leaf, input_of, import_of)),
           halfedges(mesh),
           positions(mesh.positions, nullptr, nullptr, &import_of),
-          search(mesh, &import_of) {
+          search(input_search, import_of) {
         leaf_of_base.reserve(input_leaf_of_base.size());
         for (uint32_t l : input_leaf_of_base) leaf_of_base.push_back(import_of[l]);
     }
@@ -115,8 +115,9 @@ void verify_leaf_mesh(const Hierarchy& h, const std::vector<uint32_t>& leaf_of_v
     auto leaf_vertex = [&](VertexId v) { return v < leaf_of_vertex.size() ? leaf_of_vertex[v] : kNoIndex; };
     for_each_leaf_triangle(h, h.breadth_first_order(), -1, [&](NodeId, VertexId x, VertexId y, VertexId z, bool) {
         const uint32_t a = leaf_vertex(x), b = leaf_vertex(y), c = leaf_vertex(z);
-        const uint32_t f = (a == kNoIndex || b == kNoIndex) ? kNoIndex : halfedges.face(a, b);
-        if (f == kNoIndex || halfedges.apex(a, b) != c || used[f])
+        const LeafHalfedges::Edge e = (a == kNoIndex || b == kNoIndex) ? LeafHalfedges::Edge{} : halfedges.edge(a, b);
+        const uint32_t f = e.face;
+        if (f == kNoIndex || e.apex != c || used[f])
             fail(what, "the reconstruction has a triangle (" + std::to_string(a) + ", " + std::to_string(b) + ", " +
                            std::to_string(c) + ") that is not a face of the leaf mesh");
         used[f] = 1;
@@ -202,7 +203,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
             if (leaf_of_vertex.empty()) throw Error(what + ": not a uniform refinement");
         } else if (way == Way::anchored || by_undo_steps) {
             if (way == Way::anchored) validate_triangle_mesh(leaf, what);  // the inverse step needs an oriented manifold
-            if (!renumbered) renumbered = std::make_unique<RenumberedLeaf>(leaf, leaf_of_base);
+            if (!renumbered) renumbered = std::make_unique<RenumberedLeaf>(leaf, leaf_of_base, search);
             RenumberedLeaf& r = *renumbered;
             if (way == Way::anchored) {
                 leaf_of_vertex = reconstruct_anchored(out.hierarchy, r.leaf_of_base, r.mesh, what, &steps);

@@ -15,14 +15,20 @@ namespace amc {
 
 LeafSearch::LeafSearch(const TriangleMesh& leaf, const std::vector<uint32_t>* insertion_order)
     : leaf_(leaf), insertion_order_(insertion_order) {}
+LeafSearch::LeafSearch(LeafSearch& input, const std::vector<uint32_t>& new_id)
+    : leaf_(input.leaf_), insertion_order_(nullptr), input_(&input), new_id_(&new_id) {}
 LeafSearch::~LeafSearch() = default;
 
 const NearestVertex& LeafSearch::nearest() {
-    if (!nearest_) nearest_ = std::make_unique<NearestVertex>(leaf_.positions, insertion_order_);
+    if (!nearest_) {
+        nearest_ = input_ ? std::make_unique<NearestVertex>(input_->nearest(), *new_id_)
+                          : std::make_unique<NearestVertex>(leaf_.positions, insertion_order_);
+    }
     return *nearest_;
 }
 
 const ClosestPointQuery& LeafSearch::surface() {
+    if (input_) return input_->surface();
     if (!surface_) surface_ = std::make_unique<ClosestPointQuery>(leaf_);
     return *surface_;
 }

@@ -25,6 +25,11 @@ class LeafSearch {
 public:
     // The k-d tree takes the vertices in `insertion_order` (NearestVertex), if given.
     explicit LeafSearch(const TriangleMesh& leaf, const std::vector<uint32_t>* insertion_order = nullptr);
+    // The searches of `input` on its mesh renumbered (`new_id`: input id -> this numbering, the
+    // positions and faces otherwise the same): the surface tree is input's (closest points do not
+    // depend on the numbering), the k-d tree input's with its ids mapped (the same points in the
+    // same order answer the same); neither is built a second time.
+    LeafSearch(LeafSearch& input, const std::vector<uint32_t>& new_id);
     ~LeafSearch();
     const NearestVertex& nearest();
     const ClosestPointQuery& surface();
@@ -32,6 +37,8 @@ public:
 private:
     const TriangleMesh& leaf_;
     const std::vector<uint32_t>* insertion_order_;
+    LeafSearch* input_ = nullptr;                 // the searches this one renumbers, if any
+    const std::vector<uint32_t>* new_id_ = nullptr;
     std::unique_ptr<NearestVertex> nearest_;
     std::unique_ptr<ClosestPointQuery> surface_;
 };

@@ -20,6 +20,13 @@ NearestVertex::NearestVertex(const std::vector<Vec3>& positions, const std::vect
     build(0, 0, uint32_t(points_.size()));
 }
 
+NearestVertex::NearestVertex(const NearestVertex& other, const std::vector<uint32_t>& new_id)
+    : axis_(other.axis_), split_(other.split_) {
+    points_.reserve(other.points_.size());
+    advise_huge_pages(points_.data(), points_.capacity() * sizeof(Point));
+    for (const Point& p : other.points_) points_.push_back({{p.x[0], p.x[1], p.x[2]}, new_id[p.vertex]});
+}
+
 // Splits [lo, hi) at its median along the axis of its largest extent.
 void NearestVertex::build(uint32_t node, uint32_t lo, uint32_t hi) {
     if (hi - lo <= kBucket) return;

@@ -19,6 +19,9 @@ public:
     // The tree is built from the points in `insertion_order` (vertex ids; null: 0, 1, ...): its
     // shape, and so which of two equally near vertices is found first, follows that order.
     explicit NearestVertex(const std::vector<Vec3>& positions, const std::vector<uint32_t>* insertion_order = nullptr);
+    // `other`'s tree with every vertex v named new_id[v]: what a build over the same positions
+    // renumbered, inserted in other's order, makes, without the build.
+    NearestVertex(const NearestVertex& other, const std::vector<uint32_t>& new_id);
 
     // The vertex nearest to p among those for which usable(v) holds (tested only on vertices
     // nearer than the best so far: it may cost more than a distance); kNoIndex when none is.
