@@ -60,7 +60,7 @@ double decode_all(Hierarchy& h, const std::vector<CodedLevel>& levels, Coordinat
     const double start = cpu_seconds();
     for (const CodedLevel& l : levels) {
         if (!decode_static_positions(h, l.created, space, mode_of(grid_bins), l.tables, l.rans.data(), l.rans.size(), l.raw.data(),
-                                     l.raw.size()))
+                                     l.raw.size(), StaticOrder::grouped))
             throw Error("a level does not decode");
     }
     return cpu_seconds() - start;

@@ -73,7 +73,7 @@ TEST(GridGeometry, RoundTripsOnEveryGridAsModeThreeDoes) {
                 EXPECT_TRUE(grid);
             }
             if (grid) {
-                EXPECT_EQ(bytes[4], kGridGeometryVersion) << "mode 4 makes version 9";
+                EXPECT_EQ(bytes[4], kGroupedGridVersion) << "mode 4 makes version 18 (the grouped order)";
             } else {
                 EXPECT_LT(bytes[4], kGridGeometryVersion);
             }
@@ -181,7 +181,7 @@ TEST(GridGeometry, QuantizedFilesTryModeFourByDefault) {
     const std::vector<uint8_t> bytes = encode(h, defaults, &stats);
     const std::vector<uint8_t> roles_bytes = encode(h, roles, &roles_stats);
     EXPECT_TRUE(uses(stats, GeometryPredictor::normal_frame_grid));
-    EXPECT_EQ(bytes[4], kGridGeometryVersion);
+    EXPECT_EQ(bytes[4], kGroupedGridVersion);
     EXPECT_FALSE(uses(roles_stats, GeometryPredictor::normal_frame_grid));
     EXPECT_LT(bytes.size(), roles_bytes.size());
     EncodeOptions exact, exact_roles;
@@ -195,8 +195,13 @@ TEST(GridGeometry, DecoderRefusesModeFourWhereTheFormatHasNone) {
     options.quantize_bits = 12;
     options.predictor = GeometryPredictor::normal_frame_grid;
     const std::vector<uint8_t> bytes = encode(h, options);
-    ASSERT_EQ(bytes[4], kGridGeometryVersion);
-    EXPECT_EQ(decode_error(with_first_predictor(bytes, kGridGeometryVersion, 4)), "");
+    ASSERT_EQ(bytes[4], kGroupedGridVersion);
+    EXPECT_EQ(decode_error(with_first_predictor(bytes, kGroupedGridVersion, 4)), "");
+    // Versions 9-17 read mode 4's tokens vertex after vertex: the grouped file's bytes as version 17
+    // are another hierarchy or corrupt.
+    const std::vector<uint8_t> as_17 = with_first_predictor(bytes, kFifthMixingVersion, 4);
+    const DecodeResult per_vertex = try_decode(as_17.data(), as_17.size());
+    EXPECT_TRUE(!per_vertex.ok || !identical(per_vertex.hierarchy, decode(bytes.data(), bytes.size())));
     // A version-6 file has no predictor 4 (nor has any version before 9).
     EXPECT_NE(decode_error(with_first_predictor(bytes, kStaticGeometryVersion, 4)).find("bad predictor"), std::string::npos);
     EXPECT_EQ(decode_error(with_first_predictor(bytes, kStaticGeometryVersion, 3)).find("bad predictor"), std::string::npos);

@@ -116,12 +116,12 @@ TEST(RankEncoder, RanksWriteTheSerialEncodersQuantizedBytes) {
             options.predictor = seed % 3 == 0 ? GeometryPredictor::normal_frame_grid : seed % 3 == 1 ? GeometryPredictor::automatic : GeometryPredictor(seed % 4);
             const std::vector<uint8_t> bytes = write_by_ranks(h.base(), ranks_of(h, counts, seed), options);
             ASSERT_EQ(bytes, encode(h, serial_options(options, counts))) << p << " ranks, " << options.quantize_bits << " bits";
-            grid_files += bytes[4] == kGridGeometryVersion;
+            grid_files += bytes[4] == kGroupedGridVersion;
             ++files;
         }
     }
     EXPECT_EQ(files, 12 * 4);
-    EXPECT_GT(grid_files, 0);  // level geometry mode 4 in a file of one rank: version 9 (chunked files are version 13)
+    EXPECT_GT(grid_files, 0);  // level geometry mode 4 (in the grouped order): version 18, chunked or not
     // A surface remesh (vertices on the unit sphere), where the automatic predictor takes mode 4.
     const Hierarchy sphere = projected_sphere(20000, 7, 5);
     EncodeOptions options;
@@ -129,7 +129,7 @@ TEST(RankEncoder, RanksWriteTheSerialEncodersQuantizedBytes) {
     options.grid_contexts = true;
     const std::vector<uint32_t> counts{7, 6, 7};
     const std::vector<uint8_t> bytes = write_by_ranks(sphere.base(), ranks_of(sphere, counts, 1), options);
-    EXPECT_EQ(bytes[4], kChunkVerticesVersion);
+    EXPECT_EQ(bytes[4], kGroupedGridVersion);  // chunks with mode 4 in the grouped order
     EXPECT_EQ(bytes, encode(sphere, serial_options(options, counts)));
 }
 

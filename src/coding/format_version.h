@@ -25,9 +25,11 @@ namespace amc {
 // butterfly's predictions under static tables, rANS and raw bits). Version 16 for files in the
 // mixing mode's fourth model (FORMAT.md 2.4; whatever their geometry modes). Version 17 for files
 // in its fifth model (FORMAT.md 2.5; whatever their geometry modes), which encoders write since:
-// versions 11-15 hold the third, 16 the fourth.
+// versions 11-15 hold the third, 16 the fourth. Version 18 for files with a level in geometry mode
+// 4 whose hierarchy symbols are not in the mixing mode (chunked or not): mode 4's tokens in the
+// grouped order (FORMAT.md 5.7); mixed files keep the per-vertex order in versions 9-17.
 constexpr uint8_t kOldestReadableVersion = 1;
-constexpr uint8_t kNewestVersion = 17;
+constexpr uint8_t kNewestVersion = 18;
 constexpr uint8_t kBaseVersion = 2;       // everything but the numbering block and mode 2
 constexpr uint8_t kNumberingVersion = 3;  // the first version with a numbering block
 constexpr uint8_t kAngleBaseVersion = 4;  // the first version with base connectivity mode 2
@@ -56,11 +58,20 @@ constexpr uint8_t kStencilTablesVersion = 15;
 constexpr uint8_t kFourthMixingVersion = 16;
 // The first version whose mixing mode is the fifth model (the local threshold, FORMAT.md 2.5).
 constexpr uint8_t kFifthMixingVersion = 17;
+// The first version whose mode-4 levels code their tokens in the grouped order (StaticOrder::grouped,
+// FORMAT.md 5.7): a run of 64 vertices' role-0 tokens, then their roles 1 and 2.
+constexpr uint8_t kGroupedGridVersion = 18;
 
 // The lowest version a file's newest features need, 0 if it has none of them (older features then
 // decide): the one rule for encode()'s files and the chunked file head the MPI ranks write.
-constexpr uint8_t newest_features_version(bool stencil_tables, bool raw_side, bool chunked) {
-    return stencil_tables ? kStencilTablesVersion : raw_side ? kRawSideVersion : chunked ? kChunkVerticesVersion : 0;
+// `grouped_grid`: a mode-4 level in the grouped order (only quantized files have one; stencil
+// tables and raw side streams only bit-exact ones).
+constexpr uint8_t newest_features_version(bool grouped_grid, bool stencil_tables, bool raw_side, bool chunked) {
+    return grouped_grid     ? kGroupedGridVersion
+           : stencil_tables ? kStencilTablesVersion
+           : raw_side       ? kRawSideVersion
+           : chunked        ? kChunkVerticesVersion
+                            : 0;
 }
 
 // The hierarchy stream (FORMAT.md section 2).
@@ -91,6 +102,7 @@ constexpr uint8_t hierarchy_stream_version_of_file(uint8_t file_version) {
         case 15: return 2;
         case 16: return 2;
         case 17: return 2;
+        case 18: return 2;
     }
     return 0;
 }

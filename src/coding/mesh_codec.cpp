@@ -124,7 +124,9 @@ uint8_t file_version(bool stencil_tables, bool raw_side, bool unit_geometry, boo
                      bool chunked, bool static_geometry, BaseConnectivityMode base_mode, bool store_numbering) {
     if (mixed_contexts && mixing == MixingModel::fifth) return kFifthMixingVersion;
     if (mixed_contexts && mixing == MixingModel::fourth) return kFourthMixingVersion;
-    if (const uint8_t newest = newest_features_version(stencil_tables, raw_side, chunked)) return newest;
+    // Mixed files keep mode 4's per-vertex order (code_forest): only the others hold the grouped one.
+    if (const uint8_t newest = newest_features_version(grid_geometry && !mixed_contexts, stencil_tables, raw_side, chunked))
+        return newest;
     return unit_geometry                                 ? kUnitFrameVersion
            : mixed_contexts                              ? kThirdMixingVersion
            : grid_geometry                               ? kGridGeometryVersion
@@ -239,8 +241,11 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
         };
         auto code_level = [&](int l, const auto& geometry_of) {
             const NewVertices& created = hierarchy.new_vertices(l);
-            const LevelGeometryCode geometry = choose_level_geometry(geometry_of, created, positions, space, options.predictor,
-                                                                     options.grid_contexts, options.unit_normals, options.effort);
+            // The mixing mode's files share each level's geometry across its models' versions (11-17,
+            // which hold mode 4 in the per-vertex order).
+            const LevelGeometryCode geometry =
+                choose_level_geometry(geometry_of, created, positions, space, options.predictor, options.grid_contexts,
+                                      options.unit_normals, options.effort, mixed ? StaticOrder::per_vertex : StaticOrder::grouped);
             add_level(out, hierarchy, l, geometry_of, created, geometry, positions);
             for (size_t k = 0; k < older_hierarchies.size(); ++k)
                 add_level(*older[k].second, *older_hierarchies[k], l, geometry_of, created, geometry, older_positions[k]);

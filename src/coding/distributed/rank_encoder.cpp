@@ -244,12 +244,13 @@ std::vector<uint8_t> chunked_file_head(const TriangleMesh& base, const Seam& sea
         put_varint(table, offset);
         offset += c.block_bytes;
     }
-    bool raw_side = false, stencil_tables = false;
+    bool raw_side = false, stencil_tables = false, grid_geometry = false;
     for (const ChunkSummary& c : chunks) {
         raw_side |= c.raw_side != 0;
         stencil_tables |= c.stencil_tables != 0;
+        grid_geometry |= c.grid_geometry != 0;  // chunks code mode 4 in the grouped order
     }
-    BlockWriter writer(newest_features_version(stencil_tables, raw_side, true), grid != nullptr ? kFlagQuantized : base.single_precision ? kFlagSinglePrecision : 0);
+    BlockWriter writer(newest_features_version(grid_geometry, stencil_tables, raw_side, true), grid != nullptr ? kFlagQuantized : base.single_precision ? kFlagSinglePrecision : 0);
     writer.add(BlockType::metadata, write_metadata(meta, grid != nullptr));
     writer.add(BlockType::base_connectivity, base_code.bytes);
     writer.add(BlockType::base_geometry, encode_base_geometry(roots, base_code, false, positions));

@@ -55,13 +55,14 @@ constexpr double kStencilPreference = 1.01;
 // encoders of those left go to on_sample[i], for the whole level to carry on from.
 template <class Mesh>
 void keep_likely_static_modes(const Mesh& h, const NewVertices& created, CoordinateSpace space, size_t sample,
-                              bool candidate[kStaticCandidates], std::unique_ptr<StaticLevelEncoder> on_sample[kStaticCandidates]) {
+                              bool candidate[kStaticCandidates], std::unique_ptr<StaticLevelEncoder> on_sample[kStaticCandidates],
+                              StaticOrder grid_order) {
     const double scale = double(created.size()) / double(sample);
     double bound[kStaticCandidates], smallest = HUGE_VAL;
     for (int i = 0; i < kStaticCandidates; ++i) {
         bound[i] = HUGE_VAL;
         if (!candidate[i]) continue;
-        on_sample[i] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, kStaticModes[i]);
+        on_sample[i] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, kStaticModes[i], grid_order);
         bound[i] = on_sample[i]->projected_bound_bytes(scale);
         smallest = std::min(smallest, bound[i]);
     }
@@ -184,14 +185,15 @@ bool AdaptiveTrialJudge::checkpoint(size_t done, size_t bytes) {
 template <class Mesh>
 LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& created, const PositionCoder& positions,
                                         CoordinateSpace space, GeometryPredictor choice, bool grid_contexts, bool unit_normals,
-                                        int effort) {
+                                        int effort, StaticOrder grid_order) {
     const bool automatic = choice == GeometryPredictor::automatic;
     LevelGeometryCode code;
     code.predictor = automatic ? GeometryPredictor::midpoint : choice;
     if (code.predictor == GeometryPredictor::normal_frame_grid && space.quantizer == nullptr)
         throw Error("geometry mode 4 (normal_frame_grid) needs quantized coordinates");
     if (!automatic || created.empty()) {
-        if (is_static_mode(code.predictor)) code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space, code.predictor);
+        if (is_static_mode(code.predictor))
+            code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space, code.predictor, true, grid_order);
         return code;
     }
     // The first of the smallest in the order midpoint, butterfly, normal frame, grid, unit frame,
@@ -202,14 +204,14 @@ LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& create
     const bool exact = space.quantizer == nullptr;
     bool candidate[kStaticCandidates] = {true, grid_contexts && !exact, unit_normals && exact, exact, exact};
     std::unique_ptr<StaticLevelEncoder> on_sample[kStaticCandidates];
-    if (sample != SIZE_MAX) keep_likely_static_modes(h, created, space, sample, candidate, on_sample);
+    if (sample != SIZE_MAX) keep_likely_static_modes(h, created, space, sample, candidate, on_sample, grid_order);
     std::unique_ptr<StaticLevelEncoder> statics[kStaticCandidates];  // in the order of the choice
     size_t static_size[kStaticCandidates], bound[kStaticCandidates];
     for (int i = 0; i < kStaticCandidates; ++i) {
         static_size[i] = bound[i] = SIZE_MAX;
         if (!candidate[i]) continue;
         if (on_sample[i] == nullptr) {
-            statics[i] = std::make_unique<StaticLevelEncoder>(h, created, space, kStaticModes[i], false);
+            statics[i] = std::make_unique<StaticLevelEncoder>(h, created, space, kStaticModes[i], false, grid_order);
         } else {
             on_sample[i]->extend(h, created);
             statics[i] = std::move(on_sample[i]);
@@ -303,9 +305,9 @@ std::vector<uint8_t> finish_level_payload(const Mesh& h, const NewVertices& crea
 }
 
 template LevelGeometryCode choose_level_geometry(const Hierarchy&, const NewVertices&, const PositionCoder&, CoordinateSpace,
-                                                 GeometryPredictor, bool, bool, int);
+                                                 GeometryPredictor, bool, bool, int, StaticOrder);
 template LevelGeometryCode choose_level_geometry(const HierarchyOnGrid&, const NewVertices&, const PositionCoder&,
-                                                 CoordinateSpace, GeometryPredictor, bool, bool, int);
+                                                 CoordinateSpace, GeometryPredictor, bool, bool, int, StaticOrder);
 template std::vector<uint8_t> finish_level_payload(const Hierarchy&, const NewVertices&, const LevelGeometryCode&,
                                                    PositionCoder&, ArithmeticEncoder&);
 template std::vector<uint8_t> finish_level_payload(const HierarchyOnGrid&, const NewVertices&, const LevelGeometryCode&,
@@ -320,6 +322,7 @@ LevelBlockParts split_level_block(const Block& block, uint8_t file_version, bool
                     (!parts.raw_side || (file_version >= kRawSideVersion && !quantized && !is_static_mode(GeometryPredictor(predictor)))),
                 corrupt, "level block: bad predictor");
     parts.predictor = GeometryPredictor(predictor);
+    parts.order = file_version >= kGroupedGridVersion ? StaticOrder::grouped : StaticOrder::per_vertex;
     PayloadReader in(block.payload + 1, block.size - 1, "level block");
     size_t arithmetic_size = block.size - 1;
     if (is_static_mode(parts.predictor) || parts.raw_side) {
@@ -363,7 +366,7 @@ void decode_listed_level_geometry(Hierarchy& h, const FrameCorners* corners, siz
     decode_static_level(parts, decoder, space, where,
                         [&](const StaticTables& tables, const uint8_t* rans, size_t rans_size, const uint8_t* raw, size_t raw_size) {
                             return decode_static_positions(h, corners, count, first, space, parts.predictor, tables, rans,
-                                                           rans_size, raw, raw_size);
+                                                           rans_size, raw, raw_size, parts.order);
                         });
 }
 
@@ -373,7 +376,7 @@ void decode_level_geometry(Hierarchy& h, const NewVertices& created, const Level
         decode_static_level(parts, decoder, space, where,
                             [&](const StaticTables& tables, const uint8_t* rans, size_t rans_size, const uint8_t* raw, size_t raw_size) {
                                 return decode_static_positions(h, created, space, parts.predictor, tables, rans, rans_size,
-                                                               raw, raw_size);
+                                                               raw, raw_size, parts.order);
                             });
         return;
     }

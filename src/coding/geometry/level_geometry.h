@@ -43,12 +43,14 @@ struct LevelGeometryCode {
 // them): `choice`, or when it is automatic the one that codes the level in the fewest bytes, each
 // adaptive predictor tried on a copy of `positions`' models; mode 4 is a candidate only with
 // grid_contexts in a quantized space, mode 5 only with unit_normals in a bit-exact one. Below
-// kMaxEffort an adaptive predictor may be judged from a sample (EncodeOptions::effort).
+// kMaxEffort an adaptive predictor may be judged from a sample (EncodeOptions::effort). Mode 4's
+// tokens go in `grid_order` (grouped: a version-18 file; per_vertex: versions 9-17).
 // Mesh: Hierarchy or HierarchyOnGrid (hierarchy_on_grid.h: the input's nodes with their grid points).
 template <class Mesh>
 LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& created, const PositionCoder& positions,
                                         CoordinateSpace space, GeometryPredictor choice, bool grid_contexts = false,
-                                        bool unit_normals = false, int effort = kMaxEffort);
+                                        bool unit_normals = false, int effort = kMaxEffort,
+                                        StaticOrder grid_order = StaticOrder::grouped);
 
 // When an adaptive trial of a level of `count` new vertices stops, from the bytes its code has
 // committed after each vertex: once they pass `limit` (SIZE_MAX: none) by 8 bytes (exact: a
@@ -98,6 +100,7 @@ struct LevelBlockParts {
     const uint8_t* after_arithmetic = nullptr;  // mode 3: rANS length, rANS stream, raw bits; raw_side: raw bits
     size_t after_arithmetic_size = 0;
     bool raw_side = false;  // an adaptive level of a bit-exact file of version 14 or later
+    StaticOrder order = StaticOrder::per_vertex;  // mode 4's token order: grouped from version 18
 };
 
 // Throws Error on a predictor the file's version does not have (mode 4 also in a file that is not

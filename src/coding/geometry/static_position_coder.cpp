@@ -271,6 +271,7 @@ bool get_table(ArithmeticDecoder& decoder, TableModels& models, int limit, RansT
 // Frame by frame, each vertex waited for its cache misses, then the decoder's chain of dependent
 // values waited for the frame's square roots and divisions.
 constexpr size_t kChunk = 64;  // even: each chunk starts with rANS state 0
+static_assert(kChunk == kGridGroup, "the decoder's chunks are mode 4's groups");
 
 // A vertex's frame in role order (role r is axis axes[r]), with the quantizer's origin on those
 // axes: the coordinate loop indexes nothing by axis but the vertex it writes.
@@ -399,15 +400,16 @@ int static_raw_bit_count(uint64_t magnitude) { return magnitude < 8 ? 0 : 1 + bi
 
 template <class Mesh>
 StaticLevelEncoder::StaticLevelEncoder(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created,
-                                       CoordinateSpace space, GeometryPredictor mode, bool streams)
-    : StaticLevelEncoder(h, created, created.size(), space, mode) {
+                                       CoordinateSpace space, GeometryPredictor mode, bool streams, StaticOrder order)
+    : StaticLevelEncoder(h, created, created.size(), space, mode, order) {
     if (streams) code_streams();
 }
 
 template <class Mesh>
 StaticLevelEncoder::StaticLevelEncoder(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t count,
-                                       CoordinateSpace space, GeometryPredictor mode)
-    : mode_(mode), space_(space), table_count_(static_table_count(mode)) {
+                                       CoordinateSpace space, GeometryPredictor mode, StaticOrder order)
+    : mode_(mode), grouped_(has_grid_bins(mode) && order == StaticOrder::grouped), space_(space),
+      table_count_(static_table_count(mode)) {
     if (!is_static_mode(mode)) throw Error("StaticLevelEncoder: geometry mode " + std::to_string(int(mode)) + " is not a static mode");
     if (has_grid_bins(mode) && space.quantizer == nullptr) throw Error("geometry mode 4 needs quantized coordinates");
     if (has_stencil_tables(mode) && space.quantizer != nullptr)
@@ -533,13 +535,13 @@ void StaticLevelEncoder::add_stencil_vertices(const Mesh& h, const std::vector<s
 
 // The encoder reads a hierarchy or the input's nodes with its grid points (hierarchy_on_grid.h).
 template StaticLevelEncoder::StaticLevelEncoder(const Hierarchy&, const std::vector<std::pair<NodeId, int>>&, CoordinateSpace,
-                                                GeometryPredictor, bool);
+                                                GeometryPredictor, bool, StaticOrder);
 template StaticLevelEncoder::StaticLevelEncoder(const HierarchyOnGrid&, const std::vector<std::pair<NodeId, int>>&,
-                                                CoordinateSpace, GeometryPredictor, bool);
+                                                CoordinateSpace, GeometryPredictor, bool, StaticOrder);
 template StaticLevelEncoder::StaticLevelEncoder(const Hierarchy&, const std::vector<std::pair<NodeId, int>>&, size_t,
-                                                CoordinateSpace, GeometryPredictor);
+                                                CoordinateSpace, GeometryPredictor, StaticOrder);
 template StaticLevelEncoder::StaticLevelEncoder(const HierarchyOnGrid&, const std::vector<std::pair<NodeId, int>>&, size_t,
-                                                CoordinateSpace, GeometryPredictor);
+                                                CoordinateSpace, GeometryPredictor, StaticOrder);
 template void StaticLevelEncoder::extend(const Hierarchy&, const std::vector<std::pair<NodeId, int>>&);
 template void StaticLevelEncoder::extend(const HierarchyOnGrid&, const std::vector<std::pair<NodeId, int>>&);
 
@@ -572,11 +574,29 @@ void StaticLevelEncoder::code_streams() {
     RawBitWriter raw;
     raw.reserve_bits(raw_bits_);
     size_t next_large = 0;
-    for (const std::array<uint16_t, kStaticRoles>& symbols : symbols_) {
-        for (uint16_t symbol : symbols) {
-            const int token = symbol & ((1 << kTokenBits) - 1);
-            rans.put(tables_[size_t(symbol >> kTokenBits)], token);
-            if (token >= kDirectTokens) put_raw(raw, large_[next_large++]);
+    auto put = [&](uint16_t symbol, size_t large) {
+        const int token = symbol & ((1 << kTokenBits) - 1);
+        rans.put(tables_[size_t(symbol >> kTokenBits)], token);
+        if (token >= kDirectTokens) put_raw(raw, large_[large]);
+    };
+    if (!grouped_) {
+        for (const std::array<uint16_t, kStaticRoles>& symbols : symbols_)
+            for (uint16_t symbol : symbols) {
+                put(symbol, next_large);
+                next_large += (symbol & ((1 << kTokenBits) - 1)) >= kDirectTokens;
+            }
+    } else {
+        for (size_t begin = 0; begin < symbols_.size(); begin += kGridGroup) {
+            const size_t count = std::min(kGridGroup, symbols_.size() - begin);
+            size_t large[kGridGroup][kStaticRoles];  // each token's residual in large_, read in the per-vertex order
+            for (size_t i = 0; i < count; ++i)
+                for (int role = 0; role < kStaticRoles; ++role) {
+                    large[i][role] = next_large;
+                    next_large += (symbols_[begin + i][size_t(role)] & ((1 << kTokenBits) - 1)) >= kDirectTokens;
+                }
+            for (size_t i = 0; i < count; ++i) put(symbols_[begin + i][0], large[i][0]);
+            for (size_t i = 0; i < count; ++i)
+                for (int role = 1; role < kStaticRoles; ++role) put(symbols_[begin + i][size_t(role)], large[i][role]);
         }
     }
     rans_ = rans.finish();
@@ -667,11 +687,45 @@ AMC_ALWAYS_INLINE bool decode_vertex(const Chunk& b, size_t i, CoordinateSpace s
     return true;
 }
 
+// Mode 4's chunk b in the grouped order (version 18, FORMAT.md 5.7): the role-0 tokens of its
+// vertices (vertex i with state i mod 2), then each vertex's roles 1 and 2 (states b.count mod 2
+// and the other). Into p[0 .. b.count).
+template <class Tables>
+bool decode_grid_chunk_grouped(const Chunk& b, const GridScale& grid, const Tables& tables, RansDecoder& rans,
+                               RawBitReader& raw, Vec3* p) {
+    double value[kChunk][3];  // role order
+    for (size_t i = 0; i < b.count; ++i) {
+        const GridPrediction& first = b.first[i];
+        const int token = i % 2 == 0 ? rans.get_with<0>(tables[size_t(first.bin)]) : rans.get_with<1>(tables[size_t(first.bin)]);
+        if (!grid_value(grid, b.frames[i].origin[0], first, take_signed(token, raw), value[i][0])) return false;
+    }
+    const bool odd = b.count % 2 != 0;
+    for (size_t i = 0; i < b.count; ++i) {
+        const RoleFrame& f = b.frames[i];
+        double second, third;
+        predict_others(f, value[i][0], second, third);
+        const GridPrediction g1 = grid_prediction_at(grid, f.origin[1], second);
+        const GridPrediction g2 = grid_prediction_at(grid, f.origin[2], third);
+        const auto& t1 = tables[size_t(kGridBins + g1.bin)];
+        const auto& t2 = tables[size_t(2 * kGridBins + g2.bin)];
+        const int token1 = odd ? rans.get_with<1>(t1) : rans.get_with<0>(t1);
+        const int64_t r1 = take_signed(token1, raw);
+        if (!grid_value(grid, f.origin[1], g1, r1, value[i][1])) return false;
+        const int token2 = odd ? rans.get_with<0>(t2) : rans.get_with<1>(t2);
+        const int64_t r2 = take_signed(token2, raw);
+        if (!grid_value(grid, f.origin[2], g2, r2, value[i][2])) return false;
+        double xyz[3];
+        for (int r = 0; r < 3; ++r) xyz[f.axes[r]] = value[i][r];
+        p[i] = {xyz[0], xyz[1], xyz[2]};
+    }
+    return true;
+}
+
 // The decoders own their rANS decoder and raw bit reader, so that the compiler keeps the two rANS
-// states in registers.
+// states in registers. `grouped`: mode 4's tokens in the grouped order (version 18).
 template <bool Grid, bool UnitNormals, class Source, class Tables>
 bool decode_positions(Hierarchy& h, const Source& created, CoordinateSpace space, const Tables& tables,
-                      const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
+                      const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size, bool grouped) {
     RansDecoder rans(rans_data, rans_size);
     RawBitReader raw(raw_data, raw_size);
     // The quantizer copied here: no store to the positions can change it, so its fields stay in
@@ -704,6 +758,13 @@ bool decode_positions(Hierarchy& h, const Source& created, CoordinateSpace space
     for (size_t begin = 0; begin < created.size(); begin += kChunk) {
         gather_chunk(h, created, begin, created.size(), c);
         frame_chunk<Grid, UnitNormals>(h, quantizer, grid, c);
+        if (Grid && grouped) {
+            Vec3 p[kChunk];
+            if (!decode_grid_chunk_grouped(c, grid, tables, rans, raw, p)) return false;
+            for (size_t i = 0; i < c.count; ++i) put(i, p[i]);
+            if (append) HierarchyBuilder::append_positions(h, decoded, c.count, near);
+            continue;
+        }
         for (size_t i = 0; i < c.count; i += 2) {
             Vec3 p;
             if (!decode_vertex<0, Grid>(c, i, space, grid, tables, rans, raw, p)) return false;
@@ -1240,7 +1301,66 @@ AMC_ALWAYS_INLINE bool decode_grid_vertex(StencilStreams& s, const GridTable* t,
     return true;
 }
 
+// The grouped order's vertex between its role-0 token and its roles 1 and 2: role 0's grid
+// coordinate, then roles 1 and 2's grid predictions.
+struct GridSecond {
+    GridPrediction g1, g2;
+};
+
+// decode_grid_vertex's work in the grouped order (version 18, FORMAT.md 5.7) over a chunk of
+// `count` vertices: their role-0 tokens (vertex i with state i mod 2) into q0, then the frames'
+// predictions of roles 1 and 2 from those values (no stream: the processor overlaps the
+// vertices' divisions), then each vertex's roles 1 and 2 (states count mod 2 and the other).
+// The chain from one token to the next is then the rANS state's alone.
+template <bool Safe>
+AMC_ALWAYS_INLINE bool decode_grid_grouped(StencilStreams& s, const GridTable* t, const GridFrame* frames, size_t count,
+                                           const GridScale& grid, const double* origin, Vec3* decoded) {
+    int64_t q0[kChunk];
+    size_t k = 0;
+    for (; k + 1 < count; k += 2) {
+        const GridPrediction& f0 = frames[k].first;
+        const GridPrediction& f1 = frames[k + 1].first;
+        q0[k] = int64_t(f0.p) + negated_if(grid_token<0, Safe>(s, t[f0.bin]), f0.turn);
+        q0[k + 1] = int64_t(f1.p) + negated_if(grid_token<1, Safe>(s, t[f1.bin]), f1.turn);
+    }
+    if (k < count) q0[k] = int64_t(frames[k].first.p) + negated_if(grid_token<0, Safe>(s, t[frames[k].first.bin]), frames[k].first.turn);
+    GridSecond second[kChunk];
+    uint64_t out_of_range = 0;
+    for (k = 0; k < count; ++k) {
+        const GridFrame& f = frames[k];
+        const int a0 = f.axis, a1 = a0 == 0 ? 1 : 0, a2 = a0 == 2 ? 1 : 2;
+        out_of_range |= uint64_t(q0[k]) > grid.max;  // also q0 < 0
+        const double v0 = origin[a0] + rounded(static_cast<double>(q0[k]) * grid.step);
+        double p1 = f.midpoint[a1], p2 = f.midpoint[a2];
+        if (f.has_normal) {  // predict_others'
+            const double u = rounded((v0 - f.midpoint[a0]) / f.normal[a0]);
+            p1 = p1 + rounded(u * f.normal[a1]);
+            p2 = p2 + rounded(u * f.normal[a2]);
+        }
+        second[k] = {grid_prediction_at(grid, origin[a1], p1), grid_prediction_at(grid, origin[a2], p2)};
+        set_coordinate(decoded[k], a0, v0);
+    }
+    if (out_of_range != 0) return false;
+    auto roles_1_2 = [&](auto odd) {
+        constexpr int S = decltype(odd)::value ? 1 : 0;  // role 1's state: count mod 2
+        for (size_t i = 0; i < count; ++i) {
+            const GridSecond& g = second[i];
+            const int64_t q1 = int64_t(g.g1.p) + negated_if(grid_token<S, Safe>(s, t[kGridBins + g.g1.bin]), g.g1.turn);
+            const int64_t q2 = int64_t(g.g2.p) + negated_if(grid_token<1 - S, Safe>(s, t[2 * kGridBins + g.g2.bin]), g.g2.turn);
+            if ((uint64_t(q1) > grid.max) | (uint64_t(q2) > grid.max)) return false;
+            const int a0 = frames[i].axis, a1 = a0 == 0 ? 1 : 0, a2 = a0 == 2 ? 1 : 2;
+            set_coordinate(decoded[i], a1, origin[a1] + rounded(static_cast<double>(q1) * grid.step));
+            set_coordinate(decoded[i], a2, origin[a2] + rounded(static_cast<double>(q2) * grid.step));
+        }
+        return true;
+    };
+    return count % 2 == 0 ? roles_1_2(std::false_type{}) : roles_1_2(std::true_type{});
+}
+
 // The fast path's condition: a double-precision hierarchy (every quantized one) and narrow tables.
+// Grouped: the tokens in the grouped order (version 18), else vertex after vertex (one loop each,
+// so that either compiles as if alone).
+template <bool Grouped>
 bool decode_grid_listed(Hierarchy& h, const FromList& created, const Quantizer& quantizer, const StaticTables& tables,
                         const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
     std::array<GridTable, kMaxStaticTables> t;
@@ -1284,6 +1404,11 @@ bool decode_grid_listed(Hierarchy& h, const FromList& created, const Quantizer& 
             constexpr bool Safe = decltype(safe)::value;
             StencilStreams local = s;  // the chunk's copy, which the compiler keeps in registers
             bool ok = true;
+            if (Grouped) {
+                ok = decode_grid_grouped<Safe>(local, t.data(), frames.data(), count, grid, origin, decoded);
+                s = local;
+                return ok;
+            }
             for (size_t k = 0; k < count && ok; k += 2) {  // token j of the level with state j mod 2
                 ok = decode_grid_vertex<0, Safe>(local, t.data(), frames[k], grid, origin, decoded[k]) &&
                      (k + 1 == count || decode_grid_vertex<1, Safe>(local, t.data(), frames[k + 1], grid, origin, decoded[k + 1]));
@@ -1322,15 +1447,15 @@ bool decode_stencil_with(Hierarchy& h, const std::vector<std::pair<NodeId, int>>
 
 template <class Source, class Tables>
 bool decode_static_with(Hierarchy& h, const Source& created, CoordinateSpace space, GeometryPredictor mode, const Tables& tables,
-                        const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
+                        const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size, bool grouped) {
     switch (mode) {
         case GeometryPredictor::normal_frame:
-            return decode_positions<false, false>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size);
+            return decode_positions<false, false>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size, false);
         case GeometryPredictor::unit_normal_frame:
-            return decode_positions<false, true>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size);
+            return decode_positions<false, true>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size, false);
         case GeometryPredictor::normal_frame_grid:
             return space.quantizer != nullptr &&
-                   decode_positions<true, true>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size);
+                   decode_positions<true, true>(h, created, space, tables, rans_data, rans_size, raw_data, raw_size, grouped);
         default:
             return false;
     }
@@ -1338,7 +1463,7 @@ bool decode_static_with(Hierarchy& h, const Source& created, CoordinateSpace spa
 
 template <class Source>
 bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, GeometryPredictor mode, const StaticTables& tables,
-                   const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
+                   const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size, bool grouped) {
     if (!is_static_mode(mode)) return false;
     NarrowTables narrow;
     bool all_narrow = true;
@@ -1363,24 +1488,27 @@ bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, G
     }
     if constexpr (std::is_same_v<Source, FromList>) {
         if (all_narrow && mode == GeometryPredictor::normal_frame_grid && space.quantizer != nullptr && !h.single_precision())
-            return decode_grid_listed(h, created, *space.quantizer, tables, rans_data, rans_size, raw_data, raw_size);
+            return grouped ? decode_grid_listed<true>(h, created, *space.quantizer, tables, rans_data, rans_size, raw_data, raw_size)
+                           : decode_grid_listed<false>(h, created, *space.quantizer, tables, rans_data, rans_size, raw_data, raw_size);
     }
-    if (all_narrow) return decode_static_with(h, created, space, mode, narrow, rans_data, rans_size, raw_data, raw_size);
-    return decode_static_with(h, created, space, mode, tables, rans_data, rans_size, raw_data, raw_size);
+    if (all_narrow) return decode_static_with(h, created, space, mode, narrow, rans_data, rans_size, raw_data, raw_size, grouped);
+    return decode_static_with(h, created, space, mode, tables, rans_data, rans_size, raw_data, raw_size, grouped);
 }
 
 }  // namespace
 
 bool decode_static_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
                              GeometryPredictor mode, const StaticTables& tables, const uint8_t* rans_data, size_t rans_size,
-                             const uint8_t* raw_data, size_t raw_size) {
-    return decode_static(h, FromNodes<Hierarchy>{h, created}, space, mode, tables, rans_data, rans_size, raw_data, raw_size);
+                             const uint8_t* raw_data, size_t raw_size, StaticOrder order) {
+    return decode_static(h, FromNodes<Hierarchy>{h, created}, space, mode, tables, rans_data, rans_size, raw_data, raw_size,
+                         order == StaticOrder::grouped);
 }
 
 bool decode_static_positions(Hierarchy& h, const FrameCorners* corners, size_t count, VertexId first, CoordinateSpace space,
                              GeometryPredictor mode, const StaticTables& tables, const uint8_t* rans_data, size_t rans_size,
-                             const uint8_t* raw_data, size_t raw_size) {
-    return decode_static(h, FromList{corners, count, first}, space, mode, tables, rans_data, rans_size, raw_data, raw_size);
+                             const uint8_t* raw_data, size_t raw_size, StaticOrder order) {
+    return decode_static(h, FromList{corners, count, first}, space, mode, tables, rans_data, rans_size, raw_data, raw_size,
+                         order == StaticOrder::grouped);
 }
 
 }  // namespace amc

@@ -41,6 +41,14 @@ constexpr int kMaxStaticTables = kStaticRoles * kGridBins;
 // Mode 3 uses the first three (one per role), mode 4 all six (table 2 role + bin).
 using StaticTables = std::array<RansTable, kMaxStaticTables>;
 
+// The order of a mode-4 level's tokens (FORMAT.md 5.7): vertex after vertex, each vertex's roles
+// 0, 1, 2 (versions 9-17), or grouped by runs of kGridGroup vertices, the run's role-0 tokens first,
+// then each vertex's roles 1 and 2 (version 18 on): roles 1 and 2's tables depend on role 0's value,
+// so in the per-vertex order each token waits for the previous vertex's divisions. Every other mode
+// keeps the per-vertex order.
+enum class StaticOrder : uint8_t { per_vertex, grouped };
+constexpr size_t kGridGroup = 64;
+
 // The static modes: 3 (normal_frame), 4 (normal_frame_grid) and 5 (unit_normal_frame), which
 // predict in a frame, and 6 and 7 (midpoint_static, butterfly_static), which predict each axis by
 // the adaptive predictors' stencils and code it with the table of its axis (FORMAT.md 5.9).
@@ -81,13 +89,15 @@ public:
     // weighing modes asks lower_bound_bytes() first.
     // Mesh: Hierarchy or HierarchyOnGrid (hierarchy_on_grid.h), here and below.
     template <class Mesh>
+    // `order`: mode 4's token order (the other modes have one).
     StaticLevelEncoder(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
-                       GeometryPredictor mode = GeometryPredictor::normal_frame, bool streams = true);
+                       GeometryPredictor mode = GeometryPredictor::normal_frame, bool streams = true,
+                       StaticOrder order = StaticOrder::grouped);
     // Over the first `count` of `created` only (no streams): an encoder weighing modes on a sample
     // of a level, which extend() may then carry on over the whole level.
     template <class Mesh>
     StaticLevelEncoder(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t count,
-                       CoordinateSpace space, GeometryPredictor mode);
+                       CoordinateSpace space, GeometryPredictor mode, StaticOrder order = StaticOrder::grouped);
     // Adds the rest of `created` (the vector the encoder was made over the first part of) and
     // remakes the tables: the encoder made over all of `created`, without its first part's frames
     // computed again. Before code_streams() only.
@@ -129,6 +139,7 @@ private:
     void make_tables();
 
     GeometryPredictor mode_;
+    bool grouped_;  // mode 4 in StaticOrder::grouped
     CoordinateSpace space_;
     StaticTables tables_;
     int table_count_ = kStaticRoles;
@@ -153,13 +164,14 @@ bool read_static_tables(ArithmeticDecoder& decoder, CoordinateSpace space, Geome
 // Decodes the positions of `created` (in order) and sets them in h. False when the streams are
 // corrupt: a grid coordinate out of range, a non-finite coordinate, an overrun, or streams that do
 // not end where the last coordinate ends.
+// `order`: mode 4's token order (the file's version's: grouped from version 18).
 bool decode_static_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
                              GeometryPredictor mode, const StaticTables& tables, const uint8_t* rans, size_t rans_size, const uint8_t* raw,
-                             size_t raw_size);
+                             size_t raw_size, StaticOrder order);
 // The same for `count` vertices first, first + 1, ... whose frame corners split_level listed
 // (LevelSplits::new_vertex_corners): no node is read. Modes with a frame only (has_frame).
 bool decode_static_positions(Hierarchy& h, const FrameCorners* corners, size_t count, VertexId first, CoordinateSpace space,
                              GeometryPredictor mode, const StaticTables& tables, const uint8_t* rans, size_t rans_size,
-                             const uint8_t* raw, size_t raw_size);
+                             const uint8_t* raw, size_t raw_size, StaticOrder order);
 
 }  // namespace amc
