@@ -168,8 +168,8 @@ TEST(ImportMesh, RandomHierarchiesRoundTrip) {
     }
     std::printf("[import_mesh] random hierarchies: base as coarse as the true one in %d of %d; %lu base triangles found, %lu true\n",
                 at_most_true, total, (unsigned long)found, (unsigned long)truth);
-    EXPECT_GE(at_most_true, 61);
-    EXPECT_LE(found, 84337u);
+    EXPECT_GE(at_most_true, 65);
+    EXPECT_LE(found, 78686u);
 }
 
 // ---- the shared data -------------------------------------------------------------------------
@@ -212,9 +212,9 @@ TEST(ImportMesh, SharedDataIrregularMeshesAreMostlyTheirOwnBase) {
 // triangles, 10^5 faces, level 5), shuffled. Its first step takes one wrong one-block patch that
 // it cannot tell from the true ones; the parent of that block stands in the way of the true patch
 // of the seventh step. Taken back and the search run again, it reaches the true base
-// (docs/IMPORT.md, "One-block patches taken back"; before: 19,556 base triangles). With the last
-// sweep's seeds ordered ("Sweep seeds ordered") the face orders of seeds 2-5 reach it (before:
-// 1 and 2; 3 and 4 stopped at about 48,500, as 1 and 6 do now). Three of them are checked.
+// (docs/IMPORT.md, "One-block patches taken back"). The face orders of seeds 1 and 6 stop at about
+// 48,500 triangles in their own order and reach the base in reverse order ("Searched twice");
+// seed 2 reaches it in its own.
 TEST(ImportMesh, SharedDataFandiskMeanRemeshFindsItsBase) {
     if (!std::filesystem::is_regular_file(shared_data() / "fandisk.obj")) GTEST_SKIP() << "no shared data at " << shared_data();
     SurfaceRemeshOptions options;
@@ -224,7 +224,7 @@ TEST(ImportMesh, SharedDataFandiskMeanRemeshFindsItsBase) {
     options.max_level = 5;
     const Hierarchy h = remesh_adaptively(read_mesh((shared_data() / "fandisk.obj").string()), options);
     ASSERT_EQ(h.root_count(), 500u);
-    for (uint64_t seed : {2, 3, 4}) {
+    for (uint64_t seed : {1, 2, 6}) {
         const TriangleMesh input = shuffled(extract_leaf_mesh(h).mesh, seed);
         const ImportedHierarchy imported = import_mesh(input, "fandisk_mean");
         EXPECT_EQ(imported.hierarchy.root_count(), 500u) << "seed " << seed;

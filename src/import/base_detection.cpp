@@ -69,6 +69,10 @@ void undo_levels_from(const std::vector<Triangle>& triangles, uint32_t vertex_co
     }
 }
 
+// A search whose base keeps more than 1/kSearchedAgainBelow of the leaf triangles is run again in
+// another order (detect_base).
+constexpr size_t kSearchedAgainBelow = 16;
+
 size_t base_size(const SearchRun& run, size_t leaf_triangles) {
     return run.levels.empty() ? leaf_triangles : run.levels.back().triangles.size();
 }
@@ -127,6 +131,29 @@ bool wrong_single_blocks(const SearchRun& run, uint32_t vertex_count, size_t& st
     return true;
 }
 
+// The levels undone from the leaf mesh `triangles` (search ids), with the rerun of "One-block
+// patches taken back".
+SearchRun search_levels(const std::vector<Triangle>& triangles, uint32_t vertex_count) {
+    SearchRun run;
+    undo_levels_from(triangles, vertex_count, 0, {}, run);
+    // A one-block patch can be a wrong reading that its step cannot tell from a true one; a later
+    // step then finds its parent in the way of a large patch. Such patches are left out and the
+    // search run again from their step, once; the run that ends at the coarser base stands
+    // (docs/IMPORT.md, "One-block patches taken back").
+    size_t step = 0;
+    std::vector<std::vector<uint8_t>> kept;
+    if (wrong_single_blocks(run, vertex_count, step, kept)) {
+        SearchRun trial;
+        trial.levels.assign(run.levels.begin(), run.levels.begin() + std::ptrdiff_t(step));
+        trial.refined.assign(run.refined.begin(), run.refined.begin() + std::ptrdiff_t(step));
+        trial.changed.assign(run.changed.begin(), run.changed.begin() + std::ptrdiff_t(step));
+        trial.blockers.assign(run.blockers.begin(), run.blockers.begin() + std::ptrdiff_t(step));
+        undo_levels_from(triangles, vertex_count, step, kept, trial);
+        if (base_size(trial, triangles.size()) < base_size(run, triangles.size())) run = std::move(trial);
+    }
+    return run;
+}
+
 }  // namespace
 
 namespace detail {
@@ -179,22 +206,15 @@ DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what) {
     for (uint32_t v = 0; v < vertex_count; ++v) search_of[input_of[v]] = v;
     std::vector<Triangle> renumbered = mesh.triangles;
     detail::renumber(renumbered, search_of);
-    SearchRun run;
-    undo_levels_from(renumbered, vertex_count, 0, {}, run);
-    // A one-block patch can be a wrong reading that its step cannot tell from a true one; a later
-    // step then finds its parent in the way of a large patch. Such patches are left out and the
-    // search run again from their step, once; the run that ends at the coarser base stands
-    // (docs/IMPORT.md, "One-block patches taken back").
-    size_t step = 0;
-    std::vector<std::vector<uint8_t>> kept;
-    if (wrong_single_blocks(run, vertex_count, step, kept)) {
-        SearchRun trial;
-        trial.levels.assign(run.levels.begin(), run.levels.begin() + std::ptrdiff_t(step));
-        trial.refined.assign(run.refined.begin(), run.refined.begin() + std::ptrdiff_t(step));
-        trial.changed.assign(run.changed.begin(), run.changed.begin() + std::ptrdiff_t(step));
-        trial.blockers.assign(run.blockers.begin(), run.blockers.begin() + std::ptrdiff_t(step));
-        undo_levels_from(renumbered, vertex_count, step, kept, trial);
-        if (base_size(trial, renumbered.size()) < base_size(run, renumbered.size())) run = std::move(trial);
+    // The search takes the triangles' order wherever two readings tie, and in some orders a few
+    // wrong early readings keep it far from the base: a search that leaves many triangles is run
+    // again over them in reverse order, and the coarser base stands (docs/IMPORT.md, "Searched
+    // twice").
+    SearchRun run = search_levels(renumbered, vertex_count);
+    if (base_size(run, renumbered.size()) * kSearchedAgainBelow > renumbered.size()) {
+        const std::vector<Triangle> reversed(renumbered.rbegin(), renumbered.rend());
+        SearchRun other = search_levels(reversed, vertex_count);
+        if (base_size(other, renumbered.size()) < base_size(run, renumbered.size())) run = std::move(other);
     }
     out.levels = std::move(run.levels);
     for (DetectedLevel& level : out.levels) {
