@@ -83,7 +83,7 @@ inline double model_bits(MixingModel model, const std::vector<Symbol>& symbols) 
 inline ModelData load(const std::string& path, const std::filesystem::path& cache) {
     ModelData d;
     d.name = std::filesystem::path(path).stem().string();
-    const std::filesystem::path file = cache / (d.name + ".mf7");
+    const std::filesystem::path file = cache / (d.name + ".mf8");
     if (std::ifstream in{file, std::ios::binary}) {
         uint64_t n = 0;
         in.read(reinterpret_cast<char*>(&d.paper_bits), sizeof d.paper_bits);
@@ -91,8 +91,10 @@ inline ModelData load(const std::string& path, const std::filesystem::path& cach
         in.read(reinterpret_cast<char*>(&n), sizeof n);
         d.symbols.resize(n);
         in.read(reinterpret_cast<char*>(d.symbols.data()), std::streamsize(n * sizeof(Symbol)));
-        d.second_bits = model_bits(MixingModel::second, d.symbols);
-        if (in) return d;
+        if (in) {
+            d.second_bits = model_bits(MixingModel::second, d.symbols);
+            return d;
+        }
         d.symbols.clear();
     }
     const Hierarchy h = read_hierarchy(path);

@@ -15,6 +15,9 @@
 // with WEIGHTS_IN of its own WEIGHTS_OUT. Designs "E:" to "Y:" (2026-12-04 night): the local
 // threshold against coded nodes, SSE stages, a fifth mixer and the fifth model ("The fifth model");
 // "W:" equals the coder's fifth model with WEIGHTS_IN of the third "Y:" design's WEIGHTS_OUT.
+// Designs "S:", "K6:", "G6:", "C6" (2026-12-05): wider quadrics (least squares over two rings, the
+// quadric's ring means), SSE after the final mean, mixer sets by level band, the refinement two
+// levels up, and the sixth model ("C6h: C6d without 0 5"; docs/HIERARCHY_CODER.md, "The sixth model").
 //   [CACHE_DIR=dir] [ONLY=text] [WEIGHTS_OUT=prefix | WEIGHTS_IN=prefix] [TRAIN=...] [LAW_DIR=dir] model_study model.amh ...
 #include "mixed_symbols.h"
 
@@ -68,6 +71,21 @@ struct Extra {
     uint8_t kthr_ref2 = 0, kthr_unref2 = 0, qthr_ref = 0, qthr_unref = 0;
     // How many coded ring-2 nodes are refined / not (capped at 7).
     uint8_t coded_ref2 = 0, coded_unref2 = 0;
+    // Session of 2026-12-05: a least-squares quadric over the corners of the same-level nodes up
+    // to two edges away (about 12 points, slope included), |H| L and sqrt|K| L, quarter octaves;
+    // the ring-2 local threshold on its |H| L; the refinement one and two levels up: the
+    // grandparent's refined neighbours (0..3, 4 none), the refined share of the parent's and the
+    // grandparent's same-level nodes up to two edges away (1..9, 0 none).
+    uint8_t star_h = 0, star_k = 0, sthr_ref2 = 0, sthr_unref2 = 0, gp_nbrs = 4, p_ring = 0, g_ring = 0;
+    // The same fit over three rings (star3_*), and the coder's constrained form over two (cstar_*)
+    // and three (cstar3_*).
+    uint8_t star3_h = 0, star3_k = 0, cstar_h = 0, cstar_k = 0, cstar3_h = 0, cstar3_k = 0;
+    // The 6-point quadric's |H| L and sqrt|K| L (each node's own L) averaged over n and the nodes
+    // one edge away (qr1_*) or up to two (qr2_*); and the constrained 6-point form (the coder's
+    // quad_mean) likewise (cq1_*, cq2_*).
+    uint8_t qr1_h = 0, qr1_k = 0, qr2_h = 0, qr2_k = 0, cq1_h = 0, cq1_k = 0, cq2_h = 0, cq2_k = 0;
+    // The ring-2 local threshold on cq1's |H| L value (as thr_ref2 on the curvature feature).
+    uint8_t cthr_ref2 = 0, cthr_unref2 = 0;
 };
 
 // sqrt of the Gauss estimate of node m (|det| of its neighbours' unit normals times L^2 over the
@@ -184,8 +202,109 @@ double signed_dihedral(const Hierarchy& h, NodeId n) {
     return std::fabs(sum) * longest_edge(h, n) / (2 * twice_area);
 }
 
+// The same-level nodes up to `depth` edges from n (n first, each once).
+std::vector<NodeId> rings(const Hierarchy& h, NodeId n, int depth) {
+    std::vector<NodeId> seen = {n};
+    size_t begin = 0;
+    for (int d = 0; d < depth; ++d) {
+        const size_t end = seen.size();
+        for (size_t k = begin; k < end; ++k)
+            for (int e = 0; e < 3; ++e) {
+                const NodeId q = h.neighbor(seen[k], e);
+                if (q != kNoNode && std::find(seen.begin(), seen.end(), q) == seen.end()) seen.push_back(q);
+            }
+        begin = end;
+    }
+    return seen;
+}
+std::vector<NodeId> two_rings(const Hierarchy& h, NodeId n) { return rings(h, n, 2); }
+
+// |H| L and sqrt|K| L of a least-squares quadric over the corners of rings(n, depth), L n's
+// longest edge: `constrained` the coder's form (a height over n's plane vanishing at n's corners,
+// three unknowns), else z = A x^2 + B xy + C y^2 + D x + E y + F in n's frame (slope included);
+// false with too few points or a singular fit.
+bool star_fit(const Hierarchy& h, NodeId n, int depth, bool constrained, double* hl, double* kl) {
+    std::vector<VertexId> pts;
+    for (NodeId m : rings(h, n, depth))
+        for (int c = 0; c < 3; ++c)
+            if (std::find(pts.begin(), pts.end(), h.vertex(m, c)) == pts.end()) pts.push_back(h.vertex(m, c));
+    double twice_area = 0;
+    const Vec3 nrm = unit_normal_of(h, n, &twice_area);
+    const double L = longest_edge(h, n);
+    if (!(twice_area > 0) || !(L > 0)) return false;
+    if (constrained) {
+        if (pts.size() < 6) return false;
+        const Vec3 v0 = h.position(h.vertex(n, 0));
+        const Vec3 e1 = h.position(h.vertex(n, 1)) - v0, e2 = h.position(h.vertex(n, 2)) - v0;
+        const Vec3 x{e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x};
+        const double a2 = dot(x, x);
+        const Vec3 c1{e2.y * x.z - e2.z * x.y, e2.z * x.x - e2.x * x.z, e2.x * x.y - e2.y * x.x};
+        const Vec3 c2{x.y * e1.z - x.z * e1.y, x.z * e1.x - x.x * e1.z, x.x * e1.y - x.y * e1.x};
+        const Vec3 g1 = (1.0 / a2) * c1, g2 = (1.0 / a2) * c2;
+        double m[3][3] = {}, t[3] = {};
+        for (VertexId v : pts) {
+            const Vec3 r = h.position(v) - v0;
+            const double b1 = dot(r, g1), b2 = dot(r, g2), b0 = 1 - b1 - b2;
+            const double row[3] = {b0 * b1, b1 * b2, b2 * b0}, z = dot(r, nrm);
+            for (int i = 0; i < 3; ++i) {
+                for (int j = 0; j < 3; ++j) m[i][j] += row[i] * row[j];
+                t[i] += row[i] * z;
+            }
+        }
+        const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+        if (!(std::fabs(det) > 0)) return false;
+        double a[3];
+        for (int k = 0; k < 3; ++k) {
+            double mk[3][3];
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) mk[i][j] = j == k ? t[i] : m[i][j];
+            a[k] = (mk[0][0] * (mk[1][1] * mk[2][2] - mk[1][2] * mk[2][1]) - mk[0][1] * (mk[1][0] * mk[2][2] - mk[1][2] * mk[2][0]) +
+                    mk[0][2] * (mk[1][0] * mk[2][1] - mk[1][1] * mk[2][0])) / det;
+        }
+        const double P = -2 * a[0], R = -2 * a[2], Q = (a[1] - a[0]) - a[2];
+        const double mean = (P * dot(g1, g1) + 2 * Q * dot(g1, g2) + R * dot(g2, g2)) * 0.5;
+        const double gauss = (P * R - Q * Q) / a2;
+        if (!std::isfinite(mean) || !std::isfinite(gauss)) return false;
+        *hl = std::fabs(mean) * L, *kl = std::sqrt(std::fabs(gauss)) * L;
+        return true;
+    }
+    if (pts.size() < 7) return false;
+    const Vec3 c = (1.0 / 3.0) * (h.position(h.vertex(n, 0)) + h.position(h.vertex(n, 1)) + h.position(h.vertex(n, 2)));
+    Vec3 u = h.position(h.vertex(n, 1)) - h.position(h.vertex(n, 0));
+    u = (1.0 / std::sqrt(dot(u, u))) * u;
+    const Vec3 w{nrm.y * u.z - nrm.z * u.y, nrm.z * u.x - nrm.x * u.z, nrm.x * u.y - nrm.y * u.x};
+    double m[6][6] = {}, r[6] = {}, sol[6];
+    for (VertexId v : pts) {
+        const Vec3 d = (1.0 / L) * (h.position(v) - c);
+        const double px = dot(d, u), py = dot(d, w), z = dot(d, nrm);
+        const double row[6] = {px * px, px * py, py * py, px, py, 1};
+        for (int i = 0; i < 6; ++i) {
+            for (int j = 0; j < 6; ++j) m[i][j] += row[i] * row[j];
+            r[i] += row[i] * z;
+        }
+    }
+    if (!solve6(m, r, sol)) return false;
+    const double A = sol[0], B = sol[1], C = sol[2], D = sol[3], E = sol[4];
+    const double g2 = 1 + D * D + E * E;
+    const double H = ((1 + E * E) * A - D * E * B + (1 + D * D) * C) / std::pow(g2, 1.5);
+    const double K = (4 * A * C - B * B) / (g2 * g2);
+    if (!std::isfinite(H) || !std::isfinite(K)) return false;
+    *hl = std::fabs(H), *kl = std::sqrt(std::fabs(K));
+    return true;
+}
+bool star_quadric(const Hierarchy& h, NodeId n, double* hl, double* kl) { return star_fit(h, n, 2, false, hl, kl); }
+
+// 1 + 8 x the refined share of two_rings(m) without m (all decided: a coarser level), 0 for none.
+uint8_t refined_share(const Hierarchy& h, NodeId m) {
+    int refined = 0, total = 0;
+    for (NodeId q : two_rings(h, m))
+        if (q != m) refined += !h.is_leaf(q), ++total;
+    return total ? uint8_t(1 + (8 * refined + total / 2) / total) : 0;
+}
+
 std::vector<Extra> extra_features(const std::string& path, const std::filesystem::path& cache, size_t count) {
-    const std::filesystem::path file = cache / (std::filesystem::path(path).stem().string() + ".x6");
+    const std::filesystem::path file = cache / (std::filesystem::path(path).stem().string() + ".x10");
     std::vector<Extra> out(count);
     if (std::ifstream in{file, std::ios::binary}) {
         in.read(reinterpret_cast<char*>(out.data()), std::streamsize(count * sizeof(Extra)));
@@ -203,6 +322,9 @@ std::vector<Extra> extra_features(const std::string& path, const std::filesystem
     std::vector<size_t> symbol_of(h.node_count(), SIZE_MAX);
     for (size_t i = 0; i < trace.size(); ++i) symbol_of[trace[i].node] = std::min(symbol_of[trace[i].node], i);
     std::vector<uint8_t> law_of(h.node_capacity(), 0);
+    std::vector<double> star_h(h.node_capacity(), std::nan(""));
+    std::vector<double> cq1_of(h.node_capacity(), 0);
+    std::vector<std::array<double, 4>> quad_memo(h.node_capacity(), {std::nan(""), 0, 0, 0});
     if (const char* dir = std::getenv("LAW_DIR")) {
         std::ifstream in(std::filesystem::path(dir) / (std::filesystem::path(path).stem().string() + ".law"), std::ios::binary);
         uint32_t node = 0;
@@ -300,6 +422,86 @@ std::vector<Extra> extra_features(const std::string& path, const std::filesystem
             x.qthr_ref = ratio_bin(own, min_ref1), x.qthr_unref = ratio_bin(own, max_unref1);
             x.coded_ref2 = uint8_t(std::min(nref, 7)), x.coded_unref2 = uint8_t(std::min(nunref, 7));
         }
+        {
+            auto star_h_of = [&](NodeId m) {
+                if (std::isnan(star_h[m])) {
+                    double hl = 0, kl = 0;
+                    if (!star_quadric(h, m, &hl, &kl)) hl = 0;
+                    star_h[m] = hl;
+                }
+                return star_h[m];
+            };
+            double hl = 0, kl = 0;
+            if (star_fit(h, n, 3, false, &hl, &kl)) x.star3_h = uint8_t(mixed_study::quarter_bin(hl)), x.star3_k = uint8_t(mixed_study::quarter_bin(kl));
+            if (star_fit(h, n, 2, true, &hl, &kl)) x.cstar_h = uint8_t(mixed_study::quarter_bin(hl)), x.cstar_k = uint8_t(mixed_study::quarter_bin(kl));
+            if (star_fit(h, n, 3, true, &hl, &kl)) x.cstar3_h = uint8_t(mixed_study::quarter_bin(hl)), x.cstar3_k = uint8_t(mixed_study::quarter_bin(kl));
+            if (star_quadric(h, n, &hl, &kl)) {
+                x.star_h = uint8_t(mixed_study::quarter_bin(hl));
+                x.star_k = uint8_t(mixed_study::quarter_bin(kl));
+                star_h[n] = hl;
+            } else {
+                star_h[n] = 0;
+            }
+            double min_ref = -1, max_unref = -1;
+            for (NodeId q : two_rings(h, n)) {
+                if (q == n || symbol_of[q] >= i) continue;
+                const double cq = star_h_of(q);
+                if (!h.is_leaf(q)) min_ref = min_ref < 0 ? cq : std::min(min_ref, cq);
+                else max_unref = std::max(max_unref, cq);
+            }
+            x.sthr_ref2 = ratio_bin(star_h[n], min_ref), x.sthr_unref2 = ratio_bin(star_h[n], max_unref);
+            {
+                double sums[4][2] = {};
+                int counts[2] = {0, 0};
+                const std::vector<NodeId> around = two_rings(h, n);
+                for (size_t k = 0; k < around.size(); ++k) {
+                    const NodeId q = around[k];
+                    if (std::isnan(quad_memo[q][0])) {
+                        double qh = 0, qk = 0;
+                        if (!quadric_curvatures(h, q, &qh, &qk)) qh = qk = 0;
+                        const double L = longest_edge(h, q);
+                        quad_memo[q][0] = std::fabs(qh) * L, quad_memo[q][1] = std::sqrt(std::fabs(qk)) * L;
+                        double ch = 0, ck = 0;
+                        if (!star_fit(h, q, 1, true, &ch, &ck)) ch = ck = 0;
+                        quad_memo[q][2] = ch, quad_memo[q][3] = ck;
+                    }
+                    const bool ring1 = k <= 3 && (k == 0 || h.neighbor(n, 0) == q || h.neighbor(n, 1) == q || h.neighbor(n, 2) == q);
+                    for (int j = 0; j < 4; ++j) {
+                        if (ring1) sums[j][0] += quad_memo[q][size_t(j)];
+                        sums[j][1] += quad_memo[q][size_t(j)];
+                    }
+                    counts[0] += ring1, counts[1] += 1;
+                }
+                auto bin = [](double v) { return uint8_t(mixed_study::quarter_bin(v)); };
+                x.qr1_h = bin(sums[0][0] / counts[0]), x.qr1_k = bin(sums[1][0] / counts[0]);
+                x.qr2_h = bin(sums[0][1] / counts[1]), x.qr2_k = bin(sums[1][1] / counts[1]);
+                x.cq1_h = bin(sums[2][0] / counts[0]), x.cq1_k = bin(sums[3][0] / counts[0]);
+                x.cq2_h = bin(sums[2][1] / counts[1]), x.cq2_k = bin(sums[3][1] / counts[1]);
+                cq1_of[n] = sums[2][0] / counts[0];
+                double min_ref = -1, max_unref = -1;
+                for (NodeId q : around) {
+                    if (q == n || symbol_of[q] >= i) continue;
+                    const double cq = cq1_of[q];  // coded before n: computed then
+                    if (!h.is_leaf(q)) min_ref = min_ref < 0 ? cq : std::min(min_ref, cq);
+                    else max_unref = std::max(max_unref, cq);
+                }
+                x.cthr_ref2 = ratio_bin(cq1_of[n], min_ref), x.cthr_unref2 = ratio_bin(cq1_of[n], max_unref);
+            }
+            const NodeId par = h.parent(n);
+            if (par != kNoNode) {
+                x.p_ring = refined_share(h, par);
+                const NodeId gp = h.parent(par);
+                if (gp != kNoNode) {
+                    x.g_ring = refined_share(h, gp);
+                    int r = 0;
+                    for (int e = 0; e < 3; ++e) {
+                        const NodeId q = h.neighbor(gp, e);
+                        r += q != kNoNode && !h.is_leaf(q);
+                    }
+                    x.gp_nbrs = uint8_t(r);
+                }
+            }
+        }
         const NodeId p = h.parent(n);
         if (p != kNoNode) {
             x.parent_curv = uint8_t(mixed_study::quarter_bin(mixed_study::raw_curvature(h, p)));
@@ -367,6 +569,11 @@ struct Options {
     // A fifth mixer (needs mixer_d), weight sets chosen by this function (< mixer_e_sets); starts at A's weights.
     std::function<uint32_t(const MixedFeatures&, const Extra&)> mixer_e;
     int mixer_e_sets = 1;
+    // Session of 2026-12-05: an SSE stage after the final mean, rows by this function: p becomes
+    // (p (4 - final_share) + map(p) final_share) / 4.
+    std::function<uint32_t(const MixedFeatures&, const Extra&)> final_map;
+    int final_rows = 0, final_share = 2;
+    int a_band = 0;  // mixer A's sets by group x level band: 1: levels 0-2 / 3-4 / 5-7; 2: each level
 };
 
 // Ones and symbols per slot of every model table of a Study (direct, extra, history maps).
@@ -433,7 +640,7 @@ public:
     static constexpr int kDirect = MixedHierarchyModel::kDirect;
     static constexpr int kFixedInputs = MixedHierarchyModel::kSecondInputs;
     explicit Study(const Options& o)
-        : o_(o), inputs_(kFixedInputs + int(o.extra.size()) + 1), a_(inputs_, 10), b_(inputs_, 16), c_(inputs_, 160), d_(inputs_, 256), e_(inputs_, o.mixer_e_sets), st_(size_t(inputs_)) {
+        : o_(o), inputs_(kFixedInputs + int(o.extra.size()) + 1), a_(inputs_, 80), b_(inputs_, 16), c_(inputs_, 160), d_(inputs_, 256), e_(inputs_, o.mixer_e_sets), st_(size_t(inputs_)) {
         extra_models_.assign(o.extra.size(), std::vector<BitModel>(1 << 16, BitModel(8)));
         extra_slot_.resize(o.extra.size());
         static constexpr uint32_t kSizes[kDirect] = {10,  40,  40,   80,   50,  120, 240, 960, 1920, 2560, 640,
@@ -445,6 +652,7 @@ public:
         }
         for (int rows : {40, 640, 192, 2560, 200, 80}) maps_.emplace_back(rows, o.map_rate);
         for (const auto& m : o.extra_maps) maps_.emplace_back(m.second, o.map_rate);
+        if (o.final_map) maps_.emplace_back(o.final_rows, o.map_rate);
         if (!o.start[0].empty()) a_.start_at(o.start[0]), b_.start_at(o.start[1]), c_.start_at(o.start[2]), d_.start_at(o.start[o.mixer_d && !o.start[3].empty() ? 3 : 1]), e_.start_at(o.start[0]);
         for (std::vector<BitModel>* t : tables()) counts_.tables.emplace_back(t->size(), std::array<uint32_t, 2>{0, 0});
         if (o.priors && o.prior_count > 0) {
@@ -533,12 +741,13 @@ private:
         for (int j = 0; j < inputs_ - 1; ++j)
             if (o_.drop >> j & 1) st_[size_t(j)] = 0;
         st_[size_t(inputs_ - 1)] = 256;
-        const int set_b = o_.extra_set_b == 1 ? x.parent_curv / 4 : o_.extra_set_b == 2 ? x.base_size / 4 : f.ring_mean / 4, set_c = int(g * 16 + last4);
+        const int set_b = o_.extra_set_b == 4 ? x.cq1_h / 4 : o_.extra_set_b == 3 ? x.star_h / 4 : o_.extra_set_b == 1 ? x.parent_curv / 4 : o_.extra_set_b == 2 ? x.base_size / 4 : f.ring_mean / 4, set_c = int(g * 16 + last4);
         if (o_.inherit_sets) {
             if (b_.fresh(set_b)) b_.copy_set(set_b, a_, int(g));
             if (c_.fresh(set_c)) c_.copy_set(set_c, a_, int(g));
         }
-        const int s1 = mixing::stretch(a_.mix(st_.data(), int(g)));
+        const int band = o_.a_band == 2 ? f.level : o_.a_band == 1 ? (f.level <= 2 ? 0 : f.level <= 4 ? 1 : 2) : 0;
+        const int s1 = mixing::stretch(a_.mix(st_.data(), int(g) + 10 * band));
         const int s2 = mixing::stretch(b_.mix(st_.data(), set_b));
         const int s3 = mixing::stretch(c_.mix(st_.data(), set_c));
         int p_mix = mixing::squash((s1 + s2 + s3) / 3);
@@ -566,6 +775,10 @@ private:
         for (size_t m = 0; m < o_.extra_maps.size(); ++m) refined += maps_[6 + m].refine(p_mix, int(o_.extra_maps[m].first(f, x))), ++active;
         int p = std::clamp((p_mix * (4 - o_.map_share) + (refined / active) * o_.map_share + 2) >> 2, 1, 4095);
         used_maps_ = maps;
+        if (o_.final_map) {
+            const int r = maps_[6 + o_.extra_maps.size()].refine(p, int(o_.final_map(f, x)));
+            p = std::clamp((p * (4 - o_.final_share) + r * o_.final_share + 2) >> 2, 1, 4095);
+        }
         if (o_.level_map == 2) {
             p = std::clamp((p + maps_[5].refine(p, rows[5]) + 1) >> 1, 1, 4095);
             used_maps_ = 6;
@@ -587,6 +800,7 @@ private:
         if (o_.mixer_e) e_.update(st_.data(), bit, o_);
         for (int m = 0; m < used_maps_; ++m) maps_[size_t(m)].update(bit);
         for (size_t m = 0; m < o_.extra_maps.size(); ++m) maps_[6 + m].update(bit);
+        if (o_.final_map) maps_[6 + o_.extra_maps.size()].update(bit);
         for (int j = 0; j < kDirect; ++j) models_[size_t(j)][slot_[size_t(j)]].update(bit);
         for (size_t e = 0; e < extra_slot_.size(); ++e) extra_models_[e][extra_slot_[e]].update(bit);
         for (int k = 0; k < 3; ++k) {
@@ -1027,6 +1241,114 @@ int main(int argc, char** argv) {
     e_mix("ref2 / 4 x unref2 / 4", [](F, X x) { return x.thr_ref2 / 4u * 8 + x.thr_unref2 / 4u; }, 64);
     e_mix("quad H / 4 x level", [](F f, X) { return f.quad_mean / 4u * 8 + f.level; }, 128);
     e_mix("group x quad K / 4", [](F f, X) { return f.group * 16u + f.quad_gauss / 4u; }, 160);
+    // Session of 2026-12-05 (docs/HIERARCHY_CODER.md, "Beyond the fifth model"): the fifth model
+    // as coded plus a wider quadric, the refinement two levels up, final SSE stages, mixer A by
+    // level band, young mixers' faster rates.
+    auto fifth_y = [&](Options& o) { fifth_coded(o), o.drop |= drops({2, 9, 15, 16}); };
+    add("S: fifth model as coded (leave one out)", fifth_y);
+    auto s_plus = plus("S: fifth", fifth_y);
+    s_plus("star H x size / 2 x level", {[](F f, X x) { return (x.star_h * 32u + f.size / 2u) * 8 + f.level; }});
+    s_plus("star K x size / 2 x level", {[](F f, X x) { return (x.star_k * 32u + f.size / 2u) * 8 + f.level; }});
+    s_plus("star H x size / 2 x level, star K x size / 2 x level", {[](F f, X x) { return (x.star_h * 32u + f.size / 2u) * 8 + f.level; },
+        [](F f, X x) { return (x.star_k * 32u + f.size / 2u) * 8 + f.level; }});
+    auto hk = [](auto hf, auto kf) {
+        return std::vector<std::function<uint32_t(F, X)>>{[hf](F f, X x) { return (uint32_t(hf(x)) * 32u + f.size / 2u) * 8 + f.level; },
+                                                          [kf](F f, X x) { return (uint32_t(kf(x)) * 32u + f.size / 2u) * 8 + f.level; }};
+    };
+    s_plus("star3 H, K x size / 2 x level", hk([](X x) { return x.star3_h; }, [](X x) { return x.star3_k; }));
+    s_plus("cstar H, K x size / 2 x level", hk([](X x) { return x.cstar_h; }, [](X x) { return x.cstar_k; }));
+    s_plus("cstar3 H, K x size / 2 x level", hk([](X x) { return x.cstar3_h; }, [](X x) { return x.cstar3_k; }));
+    auto s_replace = [&](const std::string& name, std::vector<std::function<uint32_t(F, X)>> contexts, std::initializer_list<int> dropped) {
+        const uint64_t d = drops(dropped);
+        std::string label = "S: fifth without";
+        for (int j : dropped) label += " " + std::to_string(j);
+        add(label + " + " + name, [&, contexts, d](Options& o) {
+            fifth_y(o), o.drop |= d;
+            for (const auto& c : contexts) o.extra.push_back(c);
+        });
+    };
+    s_replace("star H, K x size / 2 x level", hk([](X x) { return x.star_h; }, [](X x) { return x.star_k; }), {28, 29});
+    s_replace("star H, K x size / 2 x level", hk([](X x) { return x.star_h; }, [](X x) { return x.star_k; }), {28, 29, 30});
+    s_replace("cstar H, K x size / 2 x level", hk([](X x) { return x.cstar_h; }, [](X x) { return x.cstar_k; }), {28, 29, 30});
+    s_replace("cstar3 H, K x size / 2 x level", hk([](X x) { return x.cstar3_h; }, [](X x) { return x.cstar3_k; }), {28, 29, 30});
+    s_plus("star H, K x size / 2 x level, sthr ref2 x unref2 x level", {[](F f, X x) { return (x.star_h * 32u + f.size / 2u) * 8 + f.level; },
+        [](F f, X x) { return (x.star_k * 32u + f.size / 2u) * 8 + f.level; },
+        [](F f, X x) { return (f.level * 32u + x.sthr_ref2) * 32 + x.sthr_unref2; }});
+    s_plus("star H, K x size / 2 x level, star H x group x star K / 4", {[](F f, X x) { return (x.star_h * 32u + f.size / 2u) * 8 + f.level; },
+        [](F f, X x) { return (x.star_k * 32u + f.size / 2u) * 8 + f.level; },
+        [](F f, X x) { return (f.group * 64u + x.star_h) * 16 + x.star_k / 4u; }});
+    auto star_h_size = [](F f, X x) { return (x.star_h * 32u + f.size / 2u) * 8 + f.level; };
+    auto star_k_size = [](F f, X x) { return (x.star_k * 32u + f.size / 2u) * 8 + f.level; };
+    auto star_hk_group = [](F f, X x) { return (f.group * 64u + x.star_h) * 16 + x.star_k / 4u; };
+    auto sthr_level = [](F f, X x) { return (f.level * 32u + x.sthr_ref2) * 32 + x.sthr_unref2; };
+    s_replace("star H, K x size / 2 x level, star H x group x star K / 4", {star_h_size, star_k_size, star_hk_group}, {28, 29, 30});
+    s_replace("star H, K x size / 2 x level, star H x group x star K / 4", {star_h_size, star_k_size, star_hk_group}, {28, 29});
+    s_replace("star H, K x size / 2 x level, sthr ref2 x unref2 x level", {star_h_size, star_k_size, sthr_level}, {31});
+    s_plus("B2: star H, K x size / 2 x level, sthr, star H x group x star K / 4", {star_h_size, star_k_size, sthr_level, star_hk_group});
+    auto sixth_design = [&](Options& o) {
+        fifth_y(o);
+        o.extra.push_back(star_h_size), o.extra.push_back(star_k_size);
+        o.extra.push_back(sthr_level), o.extra.push_back(star_hk_group);
+    };
+    s_plus("qr1 H, K x size / 2 x level", hk([](X x) { return x.qr1_h; }, [](X x) { return x.qr1_k; }));
+    s_plus("qr2 H, K x size / 2 x level", hk([](X x) { return x.qr2_h; }, [](X x) { return x.qr2_k; }));
+    s_plus("cq1 H, K x size / 2 x level", hk([](X x) { return x.cq1_h; }, [](X x) { return x.cq1_k; }));
+    s_plus("cq2 H, K x size / 2 x level", hk([](X x) { return x.cq2_h; }, [](X x) { return x.cq2_k; }));
+    add("G6: B2 without the bending's tables 19 20 26 27 31, mixer B by star H / 4", [&](Options& o) {
+        sixth_design(o), o.drop |= drops({19, 20, 26, 27, 31}), o.extra_set_b = 3;
+    });
+    add("G6: B2 without the bending's tables 19 20 26 27 31 and the quadric's 28 29 30, mixer B by star H / 4", [&](Options& o) {
+        sixth_design(o), o.drop |= drops({19, 20, 26, 27, 31, 28, 29, 30}), o.extra_set_b = 3;
+    });
+    add("G6: B2 without the quadric's 28 29 30", [&](Options& o) { sixth_design(o), o.drop |= drops({28, 29, 30}); });
+    add("G6: B2, mixer B by star H / 4", [&](Options& o) { sixth_design(o), o.extra_set_b = 3; });
+    auto cq1_h_size = [](F f, X x) { return (x.cq1_h * 32u + f.size / 2u) * 8 + f.level; };
+    auto cq1_k_size = [](F f, X x) { return (x.cq1_k * 32u + f.size / 2u) * 8 + f.level; };
+    auto cq1_hk_group = [](F f, X x) { return (f.group * 64u + x.cq1_h) * 16 + x.cq1_k / 4u; };
+    auto cthr_level = [](F f, X x) { return (f.level * 32u + x.cthr_ref2) * 32 + x.cthr_unref2; };
+    auto c6 = [&](Options& o, int variant) {
+        fifth_y(o);
+        o.extra.push_back(cq1_h_size), o.extra.push_back(cq1_k_size);
+        if (variant >= 1) o.extra.push_back(cq1_hk_group);
+        if (variant >= 2) o.extra.push_back(cthr_level);
+    };
+    add("C6a: fifth + cq1 H, K x size / 2 x level", [&](Options& o) { c6(o, 0); });
+    add("C6b: fifth + cq1 H, K x size / 2 x level, cq1 H x group x K / 4", [&](Options& o) { c6(o, 1); });
+    add("C6c: C6b + cthr ref2 x unref2 x level", [&](Options& o) { c6(o, 2); });
+    add("C6d: C6c without the ring's 19 20 27, mixer B by cq1 H / 4", [&](Options& o) { c6(o, 2), o.drop |= drops({19, 20, 27}), o.extra_set_b = 4; });
+    add("C6e: C6c, mixer B by cq1 H / 4", [&](Options& o) { c6(o, 2), o.extra_set_b = 4; });
+    add("C6f: C6c without 19 20 27 (mixer B by ring mean)", [&](Options& o) { c6(o, 2), o.drop |= drops({19, 20, 27}); });
+    add("C6g: C6d without 0 3 5", [&](Options& o) { c6(o, 2), o.drop |= drops({19, 20, 27, 0, 3, 5}), o.extra_set_b = 4; });
+    for (auto dropped : {std::vector<int>{0}, std::vector<int>{3}, std::vector<int>{5}, std::vector<int>{0, 5}, std::vector<int>{0, 3}, std::vector<int>{7}, std::vector<int>{17}, std::vector<int>{24}}) {
+        uint64_t d = drops({19, 20, 27});
+        std::string name = "C6h: C6d without";
+        for (int j : dropped) d |= uint64_t{1} << j, name += " " + std::to_string(j);
+        add(name, [&, d](Options& o) { c6(o, 2), o.drop |= d, o.extra_set_b = 4; });
+    }
+    add("K6: sixth (B2)", sixth_design);
+    add("K6: sixth (B2) without 0 3 5", [&](Options& o) { sixth_design(o), o.drop |= drops({0, 3, 5}); });
+    add("K6: sixth (B2) without 0 3 5 20", [&](Options& o) { sixth_design(o), o.drop |= drops({0, 3, 5, 20}); });
+    for (int j : {0, 3, 5, 7, 17, 19, 20, 21, 22, 23, 24, 26, 27, 28, 29, 30, 31, 32, 33})
+        s_replace("star H, K x size / 2 x level, sthr ref2 x unref2 x level (ablation)", {star_h_size, star_k_size, sthr_level}, {j});
+    s_plus("star H x group x star K / 4", {[](F f, X x) { return (f.group * 64u + x.star_h) * 16 + x.star_k / 4u; }});
+    s_plus("star H x quad H / 4 x level", {[](F f, X x) { return (x.star_h * 16u + f.quad_mean / 4u) * 8 + f.level; }});
+    s_plus("sthr ref2 x unref2 x level", {[](F f, X x) { return (f.level * 32u + x.sthr_ref2) * 32 + x.sthr_unref2; }});
+    s_plus("grandparent nbrs x parent ring x group", {[](F f, X x) { return (f.group * 5u + x.gp_nbrs) * 10 + x.p_ring; }});
+    s_plus("parent ring x grandparent ring x level", {[](F f, X x) { return (x.p_ring * 10u + x.g_ring) * 8 + f.level; }});
+    s_plus("parent ring x group x inner", {[](F f, X x) { return (f.group * 10u + x.p_ring) * 4 + f.inner; }});
+    auto s_final = [&](const std::string& name, std::function<uint32_t(F, X)> row, int rows, int share) {
+        add("S: fifth + final SSE (share " + std::to_string(share) + "/4) by " + name, [&, row, rows, share](Options& o) {
+            fifth_y(o), o.final_map = row, o.final_rows = rows, o.final_share = share;
+        });
+    };
+    s_final("group x quad H", [](F f, X) { return f.group * 64u + f.quad_mean; }, 640, 2);
+    s_final("group x quad H", [](F f, X) { return f.group * 64u + f.quad_mean; }, 640, 1);
+    s_final("level x thr ref x thr unref / 4", [](F f, X) { return (f.level * 32u + f.thr_refined) * 8 + f.thr_unrefined / 4u; }, 2048, 1);
+    s_final("size x level", [](F f, X) { return f.size * 8u + f.level; }, 512, 1);
+    s_final("group x coded counts", [](F f, X) { return (f.group * 8u + f.coded_refined) * 8 + f.coded_unrefined; }, 640, 1);
+    for (int band : {1, 2}) add("S: fifth, mixer A by group x level band " + std::to_string(band), [&, band](Options& o) { fifth_y(o), o.a_band = band; });
+    for (int b : {8, 24}) add("S: fifth, mixer boost " + std::to_string(b), [&, b](Options& o) { fifth_y(o), o.boost = b; });
+    for (int r : {12, 20}) add("S: fifth, mixer rate " + std::to_string(r), [&, r](Options& o) { fifth_y(o), o.mixer_rate = r; });
     for (int j = 0; j < 28; ++j) add("D: quad2 without input " + std::to_string(j), [&, j](Options& o) { quad2(o), o.drop = uint64_t{1} << j; });
     const char* only = std::getenv("ONLY");
 

@@ -133,9 +133,10 @@ TEST(MixedContexts, RandomHierarchiesRoundTripBitExactlyUnderEverySwitch) {
         }
         options.predictor = GeometryPredictor(random.next() % 4);
         const std::vector<uint8_t> bytes = encode(h, options);
-        // The fifth model's version, or the fourth's or third's where they code smaller (14 where a
-        // bit-exact level is adaptive, its raw bits in a side stream).
-        ASSERT_TRUE(bytes[4] == kFifthMixingVersion || bytes[4] == kFourthMixingVersion || bytes[4] == kThirdMixingVersion ||
+        // The sixth model's version, or the fifth's, fourth's or third's where they code smaller (14
+        // where a bit-exact level is adaptive, its raw bits in a side stream).
+        ASSERT_TRUE(bytes[4] == kSixthMixingVersion || bytes[4] == kFifthMixingVersion || bytes[4] == kFourthMixingVersion ||
+                    bytes[4] == kThirdMixingVersion ||
                     (options.quantize_bits == 0 && bytes[4] == kRawSideVersion))
             << trial;
         const Hierarchy back = decode(bytes.data(), bytes.size());
@@ -225,6 +226,35 @@ TEST(MixedContexts, TheLocalThresholdCodesACurvedRemeshSmallerThanTheFourthModel
     EXPECT_GT(compared, 1000);
     const double fourth = mixing_model_bits(h, MixingModel::fourth), fifth = mixing_model_bits(h, MixingModel::fifth);
     EXPECT_LT(fifth, fourth);
+}
+
+// The sixth model's ring means of the quadric (FORMAT.md 2.6): they average the node's quadric
+// curvature with its neighbours', their local threshold sees only nodes coded before, and they make
+// a curved remesh's code smaller than the fifth model's.
+TEST(MixedContexts, TheQuadricsRingMeansCodeACurvedRemeshSmallerThanTheFifthModel) {
+    const Hierarchy h = curved_remesh();
+    const HierarchyLevelEncoder coder(h, HierarchyCoderOptions{}, kHierarchyStreamVersion, nullptr, true);
+    int level = -1, averaged = 0, compared = 0;
+    for (const auto& [f, bit] : coder.mixed_symbols()) {
+        if (f.level != level) {
+            level = f.level;
+            EXPECT_EQ(f.quad_refined + f.quad_unrefined, 0) << "the first symbol of a level: no node of it is coded yet";
+        }
+        if (f.coded_refined == 0) {
+            EXPECT_EQ(f.quad_refined, 0);
+        }
+        if (f.coded_unrefined == 0) {
+            EXPECT_EQ(f.quad_unrefined, 0);
+        }
+        EXPECT_LE(f.ring_quad_mean, 63);
+        EXPECT_LE(f.quad_refined, 31);
+        averaged += f.ring_quad_mean != f.quad_mean;
+        compared += f.quad_refined != 0 && f.quad_unrefined != 0;
+    }
+    EXPECT_GT(averaged, 1000);
+    EXPECT_GT(compared, 1000);
+    const double fifth = mixing_model_bits(h, MixingModel::fifth), sixth = mixing_model_bits(h, MixingModel::sixth);
+    EXPECT_LT(sixth, fifth);
 }
 
 TEST(MixedContexts, TheModeIsRefusedInOlderVersions) {

@@ -24,12 +24,13 @@ namespace amc {
 // Version 15 for bit-exact files with a level in geometry mode 6 or 7 (the midpoint's or the
 // butterfly's predictions under static tables, rANS and raw bits). Version 16 for files in the
 // mixing mode's fourth model (FORMAT.md 2.4; whatever their geometry modes). Version 17 for files
-// in its fifth model (FORMAT.md 2.5; whatever their geometry modes), which encoders write since:
-// versions 11-15 hold the third, 16 the fourth. Version 18 for files with a level in geometry mode
-// 4 whose hierarchy symbols are not in the mixing mode (chunked or not): mode 4's tokens in the
-// grouped order (FORMAT.md 5.7); mixed files keep the per-vertex order in versions 9-17.
+// in its fifth model (FORMAT.md 2.5; whatever their geometry modes): versions 11-15 hold the third,
+// 16 the fourth. Version 18 for files with a level in geometry mode 4 whose hierarchy symbols are
+// not in the mixing mode (chunked or not): mode 4's tokens in the grouped order (FORMAT.md 5.7);
+// mixed files keep the per-vertex order (versions 9-17 and 19). Version 19 for files in the mixing
+// mode's sixth model (FORMAT.md 2.6), which encoders write since; 17 keeps the fifth.
 constexpr uint8_t kOldestReadableVersion = 1;
-constexpr uint8_t kNewestVersion = 18;
+constexpr uint8_t kNewestVersion = 19;
 constexpr uint8_t kBaseVersion = 2;       // everything but the numbering block and mode 2
 constexpr uint8_t kNumberingVersion = 3;  // the first version with a numbering block
 constexpr uint8_t kAngleBaseVersion = 4;  // the first version with base connectivity mode 2
@@ -61,6 +62,15 @@ constexpr uint8_t kFifthMixingVersion = 17;
 // The first version whose mode-4 levels code their tokens in the grouped order (StaticOrder::grouped,
 // FORMAT.md 5.7): a run of 64 vertices' role-0 tokens, then their roles 1 and 2.
 constexpr uint8_t kGroupedGridVersion = 18;
+// The first version whose mixing mode is the sixth model (the quadric's ring means, FORMAT.md 2.6);
+// its level blocks are version 17's (mode 4 in the per-vertex order).
+constexpr uint8_t kSixthMixingVersion = 19;
+
+// Whether a file of `file_version` codes mode 4's tokens in the grouped order: version 18, whose
+// files are never mixed; the mixing mode's files keep the per-vertex order (versions 9-17 and 19).
+constexpr bool grouped_grid_order(uint8_t file_version) {
+    return file_version >= kGroupedGridVersion && file_version != kSixthMixingVersion;
+}
 
 // The lowest version a file's newest features need, 0 if it has none of them (older features then
 // decide): the one rule for encode()'s files and the chunked file head the MPI ranks write.
@@ -103,6 +113,7 @@ constexpr uint8_t hierarchy_stream_version_of_file(uint8_t file_version) {
         case 16: return 2;
         case 17: return 2;
         case 18: return 2;
+        case 19: return 2;
     }
     return 0;
 }

@@ -118,10 +118,11 @@ double snap_positions(const Hierarchy& h, const Quantizer& quantizer, unsigned t
 }
 
 // The lowest version that holds what the file holds (format_version.h).
-// `mixing`: the mixing mode's model; the fifth only in version 17, the fourth only in 16 (never
-// chunked; they hold every geometry mode); the third is in versions 11-15.
+// `mixing`: the mixing mode's model; the sixth only in version 19, the fifth only in 17, the fourth
+// only in 16 (never chunked; they hold every geometry mode); the third is in versions 11-15.
 uint8_t file_version(bool stencil_tables, bool raw_side, bool unit_geometry, bool grid_geometry, bool mixed_contexts, MixingModel mixing,
                      bool chunked, bool static_geometry, BaseConnectivityMode base_mode, bool store_numbering) {
+    if (mixed_contexts && mixing == MixingModel::sixth) return kSixthMixingVersion;
     if (mixed_contexts && mixing == MixingModel::fifth) return kFifthMixingVersion;
     if (mixed_contexts && mixing == MixingModel::fourth) return kFourthMixingVersion;
     // Mixed files keep mode 4's per-vertex order (code_forest): only the others hold the grouped one.
@@ -357,9 +358,9 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
                                           : one_chunk ? std::vector<RootRange>{RootRange{0, h.root_count()}}
                                                       : balanced_chunks(root_nodes, chunk_count_for(options, faces));
     const bool want_hierarchy_stats = stats_out != nullptr && options.hierarchy_statistics;
-    ForestCode fourth, third;  // the mixing mode's forest in its fourth and third models
+    ForestCode fifth, fourth, third;  // the mixing mode's forest in its fifth, fourth and third models
     const std::vector<std::pair<MixingModel, ForestCode*>> older =
-        mixed ? std::vector<std::pair<MixingModel, ForestCode*>>{{MixingModel::fourth, &fourth}, {MixingModel::third, &third}}
+        mixed ? std::vector<std::pair<MixingModel, ForestCode*>>{{MixingModel::fifth, &fifth}, {MixingModel::fourth, &fourth}, {MixingModel::third, &third}}
               : std::vector<std::pair<MixingModel, ForestCode*>>{};
     ForestCode forest = code_forest(h, root_of, chunks, faces, options, space, positions, threads, want_hierarchy_stats,
                                     first_pass.get(), turned_input && quantized ? &on_grid : nullptr, older);
@@ -368,11 +369,11 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     if (fewer < chunks.size())
         forest = code_forest(h, root_of, balanced_chunks(root_nodes, fewer), faces, options, space, positions, threads,
                              want_hierarchy_stats, nullptr, nullptr);
-    // The mixing mode's fourth or third model where it codes the file smaller (small files, whose
-    // new tables have little to learn from, or creased ones, by a few bytes): every file at most as
-    // large as each older model's. A tie keeps the newer model (fewer instructions).
+    // The mixing mode's fifth, fourth or third model where it codes the file smaller (small files,
+    // whose new tables have little to learn from, or creased ones, by a few bytes): every file at
+    // most as large as each older model's. A tie keeps the newer model.
     if (mixed)
-        for (ForestCode* other : {&fourth, &third})
+        for (ForestCode* other : {&fifth, &fourth, &third})
             if (other->bytes < forest.bytes) forest = std::move(*other);
 
     Metadata meta;
@@ -541,7 +542,8 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
                                     hierarchy_stream_version_of_file(reader.version()),
                                     std::min<uint64_t>(meta.nodes, options.max_nodes));
     if (meta.options & kOptionMixedContexts)
-        hierarchy.use_mixed_contexts(reader.version() >= kFifthMixingVersion    ? MixingModel::fifth
+        hierarchy.use_mixed_contexts(reader.version() >= kSixthMixingVersion    ? MixingModel::sixth
+                                     : reader.version() >= kFifthMixingVersion  ? MixingModel::fifth
                                      : reader.version() >= kFourthMixingVersion ? MixingModel::fourth
                                      : reader.version() >= kThirdMixingVersion  ? MixingModel::third
                                      : reader.version() >= kSecondMixingVersion ? MixingModel::second

@@ -322,7 +322,7 @@ LevelBlockParts split_level_block(const Block& block, uint8_t file_version, bool
                     (!parts.raw_side || (file_version >= kRawSideVersion && !quantized && !is_static_mode(GeometryPredictor(predictor)))),
                 corrupt, "level block: bad predictor");
     parts.predictor = GeometryPredictor(predictor);
-    parts.order = file_version >= kGroupedGridVersion ? StaticOrder::grouped : StaticOrder::per_vertex;
+    parts.order = grouped_grid_order(file_version) ? StaticOrder::grouped : StaticOrder::per_vertex;
     PayloadReader in(block.payload + 1, block.size - 1, "level block");
     size_t arithmetic_size = block.size - 1;
     if (is_static_mode(parts.predictor) || parts.raw_side) {

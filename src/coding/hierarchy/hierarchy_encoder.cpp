@@ -101,7 +101,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
                 if (mixed_) {
                     if (event_feature_.size() < events_.size() + 1) event_feature_.resize(events_.size() + 1);
                     event_feature_[events_.size()] = uint32_t(mixed_features_.size());
-                    mixed_features_.push_back(mixed_features(h, ids[i], level, i, group, shapes, kWrittenMixingModel));
+                    mixed_features_.push_back(mixed_features(h, ids[i], level, i, group, shapes, kWrittenMixingModel, true));
                 }
                 events_.push_back({uint8_t(group), uint8_t(r)});
                 if (trace != nullptr) trace->push_back({ids[i], uint8_t(group), r});

@@ -21,6 +21,13 @@ Vec3 exact_cross(Vec3 a, Vec3 b) {
 
 double exact_length(Vec3 a) { return std::sqrt(exact_dot(a, a)); }
 
+// The longest edge of node n, as LevelShapes::bending measures it (a correctly rounded root keeps
+// the order of the squares, so one root of the largest is the largest root).
+double longest_edge(const Hierarchy& h, NodeId n) {
+    const Vec3 a = h.position(h.vertex(n, 0)), b = h.position(h.vertex(n, 1)), c = h.position(h.vertex(n, 2));
+    return std::sqrt(std::max(std::max(exact_dot(b - a, b - a), exact_dot(c - b, c - b)), exact_dot(a - c, a - c)));
+}
+
 // The unit normal of node n (zero for a degenerate triangle).
 Vec3 unit_normal(const Hierarchy& h, NodeId n) {
     const Vec3 a = h.position(h.vertex(n, 0));
@@ -122,15 +129,19 @@ void LevelShapes::start_level(size_t nodes) {
     if (++current_ == 0) {  // wrapped: no stamp may look current
         std::fill(stamp_.begin(), stamp_.end(), 0u);
         std::fill(bending_stamp_.begin(), bending_stamp_.end(), 0u);
+        std::fill(quadric_stamp_.begin(), quadric_stamp_.end(), 0u);
         current_ = 1;
     }
     if (normal_.size() < nodes) {
         normal_.resize(nodes);
         bending_.resize(nodes);
+        quadric_.resize(nodes);
         stamp_.resize(nodes, 0u);
         bending_stamp_.resize(nodes, 0u);
+        quadric_stamp_.resize(nodes, 0u);
     }
     coded_curvature_.assign(nodes, kUncoded);
+    coded_quad_.assign(nodes, 0.0);
 }
 
 Vec3 LevelShapes::normal(const Hierarchy& h, NodeId node, uint32_t local) {
@@ -178,6 +189,15 @@ LevelShapes::Bending LevelShapes::bending(const Hierarchy& h, NodeId n, uint32_t
     return value;
 }
 
+std::array<double, 2> LevelShapes::new_quadric(const Hierarchy& h, NodeId node, uint32_t local, double longest) {
+    const std::array<double, 2> value = quadric_curvatures(h, node, longest >= 0 ? longest : longest_edge(h, node));
+    if (local < quadric_.size()) {
+        quadric_[local] = value;
+        quadric_stamp_[local] = current_;
+    }
+    return value;
+}
+
 double LevelShapes::base_edge(const Hierarchy& h) {
     if (base_edge_ < 0) {
         double sum = 0;
@@ -193,8 +213,11 @@ double LevelShapes::base_edge(const Hierarchy& h) {
 }
 
 MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, uint32_t i, int group, LevelShapes& shapes,
-                             MixingModel model) {
+                             MixingModel model, bool older_too) {
     MixedFeatures f{};
+    // The sixth model leaves out what only older models read (bend_sum, disp, parent_sibs and the
+    // curvature's ring), unless they are wanted too.
+    const bool every = model != MixingModel::sixth || older_too;
     f.group = uint8_t(group);
     const int l = h.level(n);
     f.level = uint8_t(std::min(l, 7));
@@ -218,18 +241,22 @@ MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, u
     // least curvature of the refined ones, the largest of the others, and their counts. The
     // remesher refines above one threshold of its priority, so the neighbours' decisions against
     // their estimates place the threshold locally, where the estimates' errors are alike.
-    const bool fifth = model == MixingModel::fifth;
-    double least_refined = -1, most_unrefined = -1;
+    const bool fifth = model >= MixingModel::fifth;
+    double least_refined = -1, most_unrefined = -1, least_quad = -1, most_quad = -1;
     int coded_refined = 0, coded_unrefined = 0;
     const double* coded = shapes.coded_curvatures();
+    const double* quads = shapes.coded_quads();
     auto take_coded = [&](uint32_t r) {
         const double c = coded[r];
         if (c == LevelShapes::kUncoded) return;
+        const double quad = quads[r];
         if (state[r] & kRefined) {
             least_refined = least_refined < 0 ? c : std::min(least_refined, c);
+            least_quad = least_quad < 0 ? quad : std::min(least_quad, quad);
             ++coded_refined;
         } else {
             most_unrefined = std::max(most_unrefined, c);
+            most_quad = std::max(most_quad, quad);
             ++coded_unrefined;
         }
     };
@@ -253,7 +280,7 @@ MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, u
             f.parent_nbrs = uint8_t(f.parent_nbrs + (q != kNoNode && !h.is_leaf(q)));
         }
         const NodeId g = h.parent(p);
-        if (g != kNoNode) {
+        if (g != kNoNode && every) {  // parent_sibs: not the sixth model's
             for (int c = 0; c < 4; ++c) {
                 const NodeId s = h.child(g, c);
                 f.parent_sibs = uint8_t(f.parent_sibs + (s != p && !h.is_leaf(s)));
@@ -267,15 +294,15 @@ MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, u
             // its corners are all three midpoints.
             if (k == red_split::kCenter || e == k || e == (k + 2) % 3) near = std::max(near, r2);
         }
-        f.disp = uint8_t(half_octave_bin(near, 34, 23));
+        if (every) f.disp = uint8_t(half_octave_bin(near, 34, 23));
         f.disp_parent = uint8_t(half_octave_bin(all, 34, 23));
     }
     // Bending towards the same-level neighbours (LevelShapes::bending).
     const LevelShapes::Bending bending = shapes.bending(h, n, i, level);
-    f.bend_sum = uint8_t(half_octave_bin(bending.chord_sum, 30, 31));
+    if (every) f.bend_sum = uint8_t(half_octave_bin(bending.chord_sum, 30, 31));
     const double curvature = bending.curvature;
     f.mean_curv = uint8_t(quarter_octave_bin(curvature, 40, 63));
-    if (model != MixingModel::first) {
+    if (model != MixingModel::first && every) {
         // The same over the node and its same-level neighbours in the level: largest and mean.
         double largest = curvature, sum = curvature;
         int count = 1;
@@ -297,17 +324,41 @@ MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, u
         f.size = uint8_t(unit > 0 ? quarter_octave_bin(scaled / unit, 28, 63) : 0);
         f.gauss = uint8_t(quarter_octave_bin(bending.gauss, 46, 63));
     }
+    double ring_quad[2] = {0, 0};
     if (model >= MixingModel::fourth) {
-        const std::array<double, 2> quadric = quadric_curvatures(h, n, bending.longest);
+        const std::array<double, 2> quadric =
+            model == MixingModel::sixth ? shapes.quadric(h, n, i, bending.longest) : quadric_curvatures(h, n, bending.longest);
         f.quad_mean = uint8_t(quarter_octave_bin(quadric[0], 40, 63));
         f.quad_gauss = uint8_t(quarter_octave_bin(quadric[1], 40, 63));
+        if (model == MixingModel::sixth) {
+            // The same over the node and its same-level neighbours, averaged: the remesher's
+            // curvature is the input's, smoother at the node's scale than six points tell.
+            double sum_mean = quadric[0], sum_gauss = quadric[1];
+            int count = 1;
+            for (int e = 0; e < 3; ++e) {
+                const NodeId q = h.neighbor(n, e);
+                if (q == kNoNode || nbr.nbr[e] == kNoLocal) continue;
+                const std::array<double, 2> c = shapes.quadric(h, q, nbr.nbr[e]);
+                sum_mean += c[0];
+                sum_gauss += c[1];
+                ++count;
+            }
+            ring_quad[0] = sum_mean / count;
+            ring_quad[1] = sum_gauss / count;
+            f.ring_quad_mean = uint8_t(quarter_octave_bin(ring_quad[0], 40, 63));
+            f.ring_quad_gauss = uint8_t(quarter_octave_bin(ring_quad[1], 40, 63));
+        }
     }
     if (fifth) {
         f.thr_refined = uint8_t(threshold_bin(curvature, least_refined));
         f.thr_unrefined = uint8_t(threshold_bin(curvature, most_unrefined));
         f.coded_refined = uint8_t(std::min(coded_refined, 7));
         f.coded_unrefined = uint8_t(std::min(coded_unrefined, 7));
-        shapes.mark_coded(i, curvature);
+        if (model == MixingModel::sixth) {
+            f.quad_refined = uint8_t(threshold_bin(ring_quad[0], least_quad));
+            f.quad_unrefined = uint8_t(threshold_bin(ring_quad[0], most_quad));
+        }
+        shapes.mark_coded(i, curvature, ring_quad[0]);
     }
     return f;
 }
@@ -364,15 +415,30 @@ constexpr int32_t kFifthStartWeights[4][MixedHierarchyModel::kFifthInputs + 1] =
     {-5766, -5268, 4345, 7188, 10042, 1418, 969, 2127, 6186, -443, 8905, 1324, 3324, 5320, 708, 5433, 8958, 12558, 16418, 6688},
     {-958, -1085, 4644, 8960, 3058, 6308, 5801, -2061, -907, -1490, 7298, 4163, 7307, 6690, 3322, 6890, 10119, 9277, 11352, 1931},
     {-1595, -1760, 4018, 9631, 7089, 6043, 6041, -1164, 1175, -1313, 1865, 4445, 6044, 6482, 2109, 6964, 10163, 10840, 12650, 1857}};
-// The direct tables the fourth or fifth model reads, of 0-20 and of 21 on.
-template <bool kFifth>
+// The sixth model's (FORMAT.md 2.6): the fifth's tables less the three of the curvature's ring
+// (19, 20, 24: the quadric's ring means carry them, and the neighbours' bending is not computed)
+// and tables 0 and 5 (0.05 points, for one group of mixer weights fewer), four more of the
+// quadric's ring means and the mixers' start weights (bench/model_study's design "C6h: C6d
+// without 0 5", averaged).
+constexpr int kSixthKeptTables[MixedHierarchyModel::kSixthKept] = {3, 7, 17};
+constexpr int kSixthLaterTables[MixedHierarchyModel::kSixthLater] = {21, 23, 25, 26, 27, 28, 29, 30, 31, 32, 33, 34};
+constexpr uint32_t kSixthContextSizes[MixedHierarchyModel::kRingQuadricInputs] = {16384, 16384, 10240, 8192};
+constexpr int32_t kSixthStartWeights[4][MixedHierarchyModel::kSixthInputs + 1] = {
+    {-5060, 10717, 9618, -3972, -1687, -2905, 10571, 4946, 3758, 694, 5492, 6964, 10791, 13757, 6780, 6799, 6622, 8787, 1202},
+    {-3180, 5352, 10073, 2318, 5356, 1891, 7416, 4136, 128, -963, 3173, 6363, 9757, 13360, 2608, 6357, 3214, 7938, 2571},
+    {247, 8542, 4194, -1056, -309, 223, 7544, 4989, 3318, 1475, 5822, 7197, 7859, 9860, 7145, 6694, 7477, 8633, 1623},
+    {-397, 8843, 7362, -228, 1626, 492, 2647, 5534, 2954, 342, 5681, 7106, 9221, 10937, 6266, 5708, 7845, 9042, 1378}};
+// The direct tables the fourth, fifth or sixth model reads, of 0-20 and of 21 on.
+template <MixingModel kModel>
 constexpr const auto& kept_tables() {
-    if constexpr (kFifth) return kFifthKeptTables;
+    if constexpr (kModel == MixingModel::sixth) return kSixthKeptTables;
+    else if constexpr (kModel == MixingModel::fifth) return kFifthKeptTables;
     else return kFourthKeptTables;
 }
-template <bool kFifth>
+template <MixingModel kModel>
 constexpr const auto& later_tables() {
-    if constexpr (kFifth) return kFifthLaterTables;
+    if constexpr (kModel == MixingModel::sixth) return kSixthLaterTables;
+    else if constexpr (kModel == MixingModel::fifth) return kFifthLaterTables;
     else return kFourthLaterTables;
 }
 constexpr int kMapContexts[MixedHierarchyModel::kMaps] = {kContextGroupCount * 4, kContextGroupCount * 64, 24 * 8,
@@ -391,6 +457,8 @@ namespace {
 // A mixer of `model` with `sets` weight sets: the third model's start at row `row` of its trained
 // weights, the others' at 1/n each.
 mixing::Mixer model_mixer(MixingModel model, int sets, int row) {
+    if (model == MixingModel::sixth)
+        return mixing::Mixer(MixedHierarchyModel::kSixthInputs + 1, sets, kThirdMixerRate, kSixthStartWeights[row]);
     if (model == MixingModel::fifth)
         return mixing::Mixer(MixedHierarchyModel::kFifthInputs + 1, sets, kThirdMixerRate, kFifthStartWeights[row]);
     if (model == MixingModel::fourth)
@@ -417,11 +485,13 @@ MixedHierarchyModel::MixedHierarchyModel(MixingModel model)
             for (int j : later)
                 models_[size_t(j)].assign(j < kThirdDirect    ? kThirdContextSizes[j - kDirect]
                                           : j < kFourthDirect ? kFourthContextSizes[j - kThirdDirect]
-                                                              : kFifthContextSizes[j - kFourthDirect],
+                                          : j < kFifthDirect  ? kFifthContextSizes[j - kFourthDirect]
+                                                              : kSixthContextSizes[j - kFifthDirect],
                                           BitModel(kModelWindowLog2));
         };
-        if (model == MixingModel::fifth) assign(kept_tables<true>(), later_tables<true>());
-        else assign(kept_tables<false>(), later_tables<false>());
+        if (model == MixingModel::sixth) assign(kept_tables<MixingModel::sixth>(), later_tables<MixingModel::sixth>());
+        else if (model == MixingModel::fifth) assign(kept_tables<MixingModel::fifth>(), later_tables<MixingModel::fifth>());
+        else assign(kept_tables<MixingModel::fourth>(), later_tables<MixingModel::fourth>());
     } else {
         for (int j = 0; j < kInputs; ++j) models_[size_t(j)].assign(kContextSizes[j], BitModel(kModelWindowLog2));
     }
@@ -466,10 +536,20 @@ std::array<uint32_t, MixedHierarchyModel::kInputs> MixedHierarchyModel::direct_s
 
 uint32_t MixedHierarchyModel::p16(const MixedFeatures& f) {
     const uint32_t g = f.group;
+    if (model_ == MixingModel::sixth) {
+        // Only the slots the sixth model reads of tables 0-15 (3, 7, and 1, 4, 11 for the bit
+        // histories), as direct_slots gives them.
+        slot_[1] = g * 4 + f.inner;
+        slot_[3] = g * 8 + f.level;
+        slot_[4] = g * 5 + f.ring2;
+        slot_[7] = (g * 24 + f.disp_parent) * 4 + f.inner;
+        slot_[11] = ((g * 64 + f.mean_curv) * 8 + f.level) * 2 + f.center;
+        return uint32_t(fourth_model_p12<MixingModel::sixth>(f)) << 4;
+    }
     const std::array<uint32_t, kInputs> direct = direct_slots(f);
     std::copy_n(direct.begin(), kInputs, slot_.begin());
-    if (model_ == MixingModel::fifth) return uint32_t(fourth_model_p12<true>(f)) << 4;
-    if (model_ == MixingModel::fourth) return uint32_t(fourth_model_p12<false>(f)) << 4;
+    if (model_ == MixingModel::fifth) return uint32_t(fourth_model_p12<MixingModel::fifth>(f)) << 4;
+    if (model_ == MixingModel::fourth) return uint32_t(fourth_model_p12<MixingModel::fourth>(f)) << 4;
     for (int j = 0; j < kInputs; ++j) st_[size_t(j)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
     if (model_ != MixingModel::first) return uint32_t(later_model_p12(f)) << 4;
     st_[kInputs] = 256;  // bias
@@ -527,22 +607,24 @@ void MixedHierarchyModel::history_inputs(uint32_t g, int first) {
     }
 }
 
-template <bool kFifth>
+template <MixingModel kModel>
 int MixedHierarchyModel::fourth_model_p12(const MixedFeatures& f) {
     const uint32_t g = f.group;
     const uint32_t last4 = last_bits_ & 15;
     slot_[kInputs] = g * 16 + last4;
     slot_[kInputs + 1] = (g * 4 + f.inner) * 16 + last4;
-    slot_[kInputs + 3] = g * 64 + f.ring_max;
-    slot_[kInputs + 4] = (g * 64 + f.ring_mean) * 8 + f.level;
+    if constexpr (kModel != MixingModel::sixth) {  // tables 19, 20 and 24: not the sixth's
+        slot_[kInputs + 3] = g * 64 + f.ring_max;
+        slot_[kInputs + 4] = (g * 64 + f.ring_mean) * 8 + f.level;
+        slot_[kDirect + 3] = (f.ring_mean * 32u + f.size / 2u) * 8 + f.level;
+    }
     slot_[kDirect] = (g * 64 + f.size) * 8 + f.level;
     slot_[kDirect + 2] = f.gauss * 16u + f.mean_curv / 4u;
-    slot_[kDirect + 3] = (f.ring_mean * 32u + f.size / 2u) * 8 + f.level;
     // Tables 25 and 26 without the group, as 23 and 24.
     slot_[kThirdDirect] = (f.quad_mean * 32u + f.size / 2u) * 8 + f.level;
     slot_[kThirdDirect + 1] = (f.quad_gauss * 32u + f.size / 2u) * 8 + f.level;
     slot_[kThirdDirect + 2] = (g * 64 + f.quad_mean) * 16 + f.quad_gauss / 4u;
-    if constexpr (kFifth) {
+    if constexpr (kModel >= MixingModel::fifth) {
         // Tables 28-30: the local threshold by level, the coded nodes' counts by group and by
         // group and inner.
         const uint32_t counts = (g * 8 + f.coded_refined) * 8 + f.coded_unrefined;
@@ -550,14 +632,22 @@ int MixedHierarchyModel::fourth_model_p12(const MixedFeatures& f) {
         slot_[kFourthDirect + 1] = counts;
         slot_[kFourthDirect + 2] = counts * 4 + f.inner;
     }
+    if constexpr (kModel == MixingModel::sixth) {
+        // Tables 31-34: the quadric's ring means by size and level (no group, as 25 and 26), both
+        // by group, and the local threshold on the mean by level.
+        slot_[kFifthDirect] = (f.ring_quad_mean * 32u + f.size / 2u) * 8 + f.level;
+        slot_[kFifthDirect + 1] = (f.ring_quad_gauss * 32u + f.size / 2u) * 8 + f.level;
+        slot_[kFifthDirect + 2] = (g * 64 + f.ring_quad_mean) * 16 + f.ring_quad_gauss / 4u;
+        slot_[kFifthDirect + 3] = (f.level * 32u + f.quad_refined) * 32 + f.quad_unrefined;
+    }
     int input = 0;
-    for (int j : kept_tables<kFifth>()) st_[size_t(input++)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
+    for (int j : kept_tables<kModel>()) st_[size_t(input++)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
     history_inputs(g, input);
     input += kIndirectInputs;
-    for (int j : later_tables<kFifth>()) st_[size_t(input++)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
+    for (int j : later_tables<kModel>()) st_[size_t(input++)] = mixing::stretch(mixing::p12_of(models_[size_t(j)][slot_[size_t(j)]]));
     st_[size_t(input)] = 256;  // bias
     const int s1 = mixing::stretch(mixer_a_.mix(st_.data(), int(g)));
-    const int s2 = mixing::stretch(mixer_b_.mix(st_.data(), f.ring_mean / 4));
+    const int s2 = mixing::stretch(mixer_b_.mix(st_.data(), kModel == MixingModel::sixth ? f.ring_quad_mean / 4 : f.ring_mean / 4));
     const int s3 = mixing::stretch(mixer_c_.mix(st_.data(), int(g * 16 + last4)));
     const int s4 = mixing::stretch(mixer_d_.mix(st_.data(), int(g * 16 + f.size / 4u)));
     p_mix_ = mixing::squash((s1 + s2 + s3 + s4) / 4);
@@ -568,10 +658,10 @@ int MixedHierarchyModel::fourth_model_p12(const MixedFeatures& f) {
     return std::clamp((p_mix_ + (refined / 2) * 3 + 2) >> 2, 1, 4095);
 }
 
-template <bool kFifth>
+template <MixingModel kModel>
 void MixedHierarchyModel::update_fourth_tables(bool bit) {
-    for (int j : kept_tables<kFifth>()) models_[size_t(j)][slot_[size_t(j)]].update_with_limit(bit, kModelWindowLog2);
-    for (int j : later_tables<kFifth>()) models_[size_t(j)][slot_[size_t(j)]].update_with_limit(bit, kModelWindowLog2);
+    for (int j : kept_tables<kModel>()) models_[size_t(j)][slot_[size_t(j)]].update_with_limit(bit, kModelWindowLog2);
+    for (int j : later_tables<kModel>()) models_[size_t(j)][slot_[size_t(j)]].update_with_limit(bit, kModelWindowLog2);
 }
 
 void MixedHierarchyModel::update(bool bit) {
@@ -580,10 +670,12 @@ void MixedHierarchyModel::update(bool bit) {
     mixer_c_.update(st_.data(), bit);
     if (model_ >= MixingModel::third) mixer_d_.update(st_.data(), bit);
     for (mixing::ProbabilityMap& map : maps_) map.update(bit);
-    if (model_ == MixingModel::fifth) {
-        update_fourth_tables<true>(bit);
+    if (model_ == MixingModel::sixth) {
+        update_fourth_tables<MixingModel::sixth>(bit);
+    } else if (model_ == MixingModel::fifth) {
+        update_fourth_tables<MixingModel::fifth>(bit);
     } else if (model_ == MixingModel::fourth) {
-        update_fourth_tables<false>(bit);
+        update_fourth_tables<MixingModel::fourth>(bit);
     } else {
         const int direct = model_ == MixingModel::first ? kInputs : model_ == MixingModel::second ? kDirect : kThirdDirect;
         for (int j = 0; j < direct; ++j) models_[size_t(j)][slot_[size_t(j)]].update_with_limit(bit, kModelWindowLog2);

@@ -24,8 +24,9 @@ namespace amc {
 // version 11's (2.3), which adds the node's size and a Gauss curvature, a fourth mixer and mixers
 // that start from trained weights, or version 16's (2.4), which adds the curvatures of a quadric
 // through the node's corners and its neighbours' far corners and leaves out seven direct inputs,
-// or version 17's (2.5), which adds the local threshold against the coded nodes two rings around.
-enum class MixingModel : uint8_t { first = 1, second = 2, third = 3, fourth = 4, fifth = 5 };
+// or version 17's (2.5), which adds the local threshold against the coded nodes two rings around,
+// or version 19's (2.6), which adds a least-squares quadric over the nodes two edges around.
+enum class MixingModel : uint8_t { first = 1, second = 2, third = 3, fourth = 4, fifth = 5, sixth = 6 };
 
 // What the decoder knows of a node when its symbol comes.
 struct MixedFeatures {
@@ -51,6 +52,10 @@ struct MixedFeatures {
     // node's: half-octave bins of mean_curv's value against the least of the refined ones' and the
     // largest of the others' (0..31, 0 for none), and how many of each (at most 7).
     uint8_t thr_refined, thr_unrefined, coded_refined, coded_unrefined;
+    // Sixth model: quarter-octave bins of the fourth model's quadric's |mean curvature| and root of
+    // |Gauss curvature| times the longest edge, each averaged over the node and its same-level
+    // neighbours (0..63), and the fifth model's local threshold on that mean (0..31).
+    uint8_t ring_quad_mean, ring_quad_gauss, quad_refined, quad_unrefined;
 };
 
 // The unit normals and curvatures of one level's nodes by local index, each computed once: the
@@ -76,20 +81,30 @@ public:
     // The mean of the roots' longest edges (in root order), computed on first use: the third
     // model's unit of size.
     double base_edge(const Hierarchy& h);
-    // Fifth model: node `local` of the level had its symbol coded, with mean_curv's value `curvature`.
-    void mark_coded(uint32_t local, double curvature) {
-        if (local < coded_curvature_.size()) coded_curvature_[local] = curvature;
+    // The fourth model's quadric_curvatures of node `node` (local index `local`), computed once;
+    // `longest` its longest edge if known (else negative).
+    std::array<double, 2> quadric(const Hierarchy& h, NodeId node, uint32_t local, double longest = -1) {
+        if (local < quadric_.size() && quadric_stamp_[local] == current_) return quadric_[local];
+        return new_quadric(h, node, local, longest);
+    }
+    // Fifth model: node `local` of the level had its symbol coded, with mean_curv's value `curvature`
+    // (and, sixth model, ring_quad_mean's value `quad`).
+    void mark_coded(uint32_t local, double curvature, double quad = 0) {
+        if (local < coded_curvature_.size()) coded_curvature_[local] = curvature, coded_quad_[local] = quad;
     }
     // Per local index of the level, mean_curv's value of a coded node, kUncoded for the others
     // (a value is >= 0 or NaN).
     static constexpr double kUncoded = -1.0;
     const double* coded_curvatures() const { return coded_curvature_.data(); }
+    const double* coded_quads() const { return coded_quad_.data(); }
 
 private:
+    std::array<double, 2> new_quadric(const Hierarchy& h, NodeId node, uint32_t local, double longest);
     std::vector<Vec3> normal_;
     std::vector<Bending> bending_;
-    std::vector<uint32_t> stamp_, bending_stamp_;
-    std::vector<double> coded_curvature_;  // normal_[i] is this level's when stamp_[i] == current_
+    std::vector<std::array<double, 2>> quadric_;
+    std::vector<uint32_t> stamp_, bending_stamp_, quadric_stamp_;
+    std::vector<double> coded_curvature_, coded_quad_;  // normal_[i] is this level's when stamp_[i] == current_
     uint32_t current_ = 0;
     double base_edge_ = -1;
 };
@@ -100,14 +115,16 @@ private:
 // times `longest`. {0, 0} without three neighbours or for a degenerate fit.
 std::array<double, 2> quadric_curvatures(const Hierarchy& h, NodeId n, double longest);
 
+
 // The features of node `n` of `h` (coarser levels whole, n's corners placed) that do not depend
 // on the traversal, and those that do from the level's state bytes: `i` is n's local index in
 // `level`, whose neighbours' states are as decided so far. `shapes` is started on `level`. The
 // ring features are computed for the second and later models, size and gauss for the third and
-// later, quad_mean and quad_gauss for the fourth and fifth, the thresholds for the fifth (which
-// marks n coded in `shapes`).
+// later, quad_mean and quad_gauss for the fourth and later, the thresholds for the fifth and sixth
+// (which mark n coded in `shapes`), the quadric's ring means for the sixth (which leaves out the
+// ring features unless `older_too`: an encoder's features serve every older model as well).
 MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, uint32_t i, int group, LevelShapes& shapes,
-                             MixingModel model);
+                             MixingModel model, bool older_too = false);
 
 // The models, mixer and probability map of the mixing mode; one per stream, persisting from level
 // to level.
@@ -133,6 +150,11 @@ public:
     static constexpr int kFifthKept = 7;        // the fifth model's direct models of tables 0-20
     static constexpr int kFifthLater = 9;       // and of tables 21-30
     static constexpr int kFifthInputs = kFifthKept + kIndirectInputs + kFifthLater;
+    static constexpr int kRingQuadricInputs = 4;        // the sixth model's direct models of the quadric's ring means
+    static constexpr int kSixthDirect = kFifthDirect + kRingQuadricInputs;
+    static constexpr int kSixthKept = 3;         // the sixth model's direct models of tables 0-20
+    static constexpr int kSixthLater = 12;       // and of tables 21-34
+    static constexpr int kSixthInputs = kSixthKept + kIndirectInputs + kSixthLater;
     explicit MixedHierarchyModel(MixingModel model);
     MixingModel model() const { return model_; }
     // The 16-bit probability of a one for a symbol with these features (remembered for update).
@@ -144,18 +166,18 @@ public:
 private:
     // The second and third models' probability (FORMAT.md 2.2, 2.3), 12 bits.
     int later_model_p12(const MixedFeatures& f);
-    // The fourth and fifth models' (FORMAT.md 2.4, 2.5), 12 bits, and their direct models' update
-    // (templates: each model's table lists are constants, as the loops over them are unrolled).
-    template <bool kFifth>
+    // The fourth, fifth and sixth models' (FORMAT.md 2.4-2.6), 12 bits, and their direct models'
+    // update (templates: each model's table lists are constants, as the loops over them are unrolled).
+    template <MixingModel kModel>
     int fourth_model_p12(const MixedFeatures& f);
-    template <bool kFifth>
+    template <MixingModel kModel>
     void update_fourth_tables(bool bit);
     // The bit histories' inputs into st_ from `first` on (second and later models).
     void history_inputs(uint32_t group, int first);
 
     MixingModel model_;
-    std::array<std::vector<BitModel>, kFifthDirect> models_;
-    std::array<uint32_t, kFifthDirect> slot_{};
+    std::array<std::vector<BitModel>, kSixthDirect> models_;
+    std::array<uint32_t, kSixthDirect> slot_{};
     // Stretched inputs: the direct models 0-20, the bit histories, the third model's direct
     // models 21-24, then the bias (fourth model: the kept direct models of 0-20, the bit
     // histories, direct models 21-27, the bias).
