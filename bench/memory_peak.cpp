@@ -1,7 +1,9 @@
 // Peak memory of one encode or decode, amcodec against Draco (docs/BENCHMARKS.md, "Memory"). Each
 // mode is its own process: it makes its input, resets the kernel's peak counter (clear_refs), then
 // does the one step and prints, in MiB, the resident set before it, after it (the result still
-// held) and at the peak, and the step's peak over the nodes and the faces. Linux only.
+// held) and at the peak, and the step's peak over the nodes and the faces; then the resident set
+// before and after split into anonymous memory (heap, results) and file pages (the code and
+// libraries the step ran, mapped as it faults them in). Linux only.
 //
 //   memory_peak prepare BITS model.amh PREFIX       writes PREFIX.amc (default options) and
 //                                                   PREFIX.drc (Draco's default speed 5; BITS 0:
@@ -41,15 +43,18 @@ void write_file(const std::string& path, const char* data, size_t size) {
 template <class Step>
 int measure(const char* what, Step&& step) {
     reset_peak();
-    const double before = status_mib("VmRSS");
+    const double before = status_mib("VmRSS"), anon_before = status_mib("RssAnon"), file_before = status_mib("RssFile");
     uint64_t nodes = 0, faces = 0;
     step(nodes, faces);
     const double after = status_mib("VmRSS"), peak = status_mib("VmHWM");
+    const double anon_after = status_mib("RssAnon"), file_after = status_mib("RssFile");
     const double step_bytes = (peak - before) * 1024 * 1024;
     std::printf("%s: before %.1f MiB, after %.1f MiB, peak %.1f MiB; the step's peak %.1f MiB = %.1f bytes per node "
                 "(%llu nodes), %.1f bytes per face (%llu faces)\n",
                 what, before, after, peak, peak - before, nodes ? step_bytes / double(nodes) : 0.0, (unsigned long long)nodes,
                 faces ? step_bytes / double(faces) : 0.0, (unsigned long long)faces);
+    std::printf("  resident before / after: anonymous %.2f / %.2f MiB, files (code, libraries) %.2f / %.2f MiB\n", anon_before,
+                anon_after, file_before, file_after);
     return 0;
 }
 
