@@ -1274,6 +1274,23 @@ AMC_ALWAYS_INLINE void set_coordinate(Vec3& p, int axis, double value) {
 static_assert(sizeof(Vec3) == 3 * sizeof(double) && offsetof(Vec3, y) == sizeof(double) && offsetof(Vec3, z) == 2 * sizeof(double),
               "Vec3 is x, y, z");
 
+// Role 0's coordinate from its grid value q0, and where roles 1 and 2 are predicted from it
+// (predict_others' line along the frame's normal); a0, a1, a2 are the roles' axes.
+struct GridFirstRole {
+    double value, second, third;
+};
+
+AMC_ALWAYS_INLINE GridFirstRole grid_first_role(const GridFrame& f, int64_t q0, const GridScale& grid,
+                                                const double* origin, int a0, int a1, int a2) {
+    GridFirstRole r{origin[a0] + rounded(static_cast<double>(q0) * grid.step), f.midpoint[a1], f.midpoint[a2]};
+    if (f.has_normal) {
+        const double u = rounded((r.value - f.midpoint[a0]) / f.normal[a0]);
+        r.second = r.second + rounded(u * f.normal[a1]);
+        r.third = r.third + rounded(u * f.normal[a2]);
+    }
+    return r;
+}
+
 // decode_vertex<State, true> over a GridFrame: role r's axis is the frame's axis, then the two
 // others in increasing order.
 template <int State, bool Safe>
@@ -1282,15 +1299,10 @@ AMC_ALWAYS_INLINE bool decode_grid_vertex(StencilStreams& s, const GridTable* t,
     const int a0 = f.axis, a1 = a0 == 0 ? 1 : 0, a2 = a0 == 2 ? 1 : 2;
     const int64_t q0 = int64_t(f.first.p) + negated_if(grid_token<State, Safe>(s, t[f.first.bin]), f.first.turn);
     if (uint64_t(q0) > grid.max) return false;  // also q0 < 0
-    const double v0 = origin[a0] + rounded(static_cast<double>(q0) * grid.step);
-    double second = f.midpoint[a1], third = f.midpoint[a2];
-    if (f.has_normal) {  // predict_others'
-        const double u = rounded((v0 - f.midpoint[a0]) / f.normal[a0]);
-        second = second + rounded(u * f.normal[a1]);
-        third = third + rounded(u * f.normal[a2]);
-    }
-    const GridPrediction g1 = grid_prediction_at(grid, origin[a1], second);
-    const GridPrediction g2 = grid_prediction_at(grid, origin[a2], third);
+    const GridFirstRole first = grid_first_role(f, q0, grid, origin, a0, a1, a2);
+    const double v0 = first.value;
+    const GridPrediction g1 = grid_prediction_at(grid, origin[a1], first.second);
+    const GridPrediction g2 = grid_prediction_at(grid, origin[a2], first.third);
     const int64_t q1 = int64_t(g1.p) + negated_if(grid_token<1 - State, Safe>(s, t[kGridBins + g1.bin]), g1.turn);
     if (uint64_t(q1) > grid.max) return false;
     const int64_t q2 = int64_t(g2.p) + negated_if(grid_token<State, Safe>(s, t[2 * kGridBins + g2.bin]), g2.turn);
@@ -1327,15 +1339,9 @@ AMC_ALWAYS_INLINE bool decode_grid_grouped(StencilStreams& s, const GridTable* t
         const int64_t q0 = int64_t(f.first.p) + negated_if(grid_token<State, Safe>(s, t[f.first.bin]), f.first.turn);
         const int a0 = f.axis, a1 = a0 == 0 ? 1 : 0, a2 = a0 == 2 ? 1 : 2;
         out_of_range |= uint64_t(q0) > grid.max;  // also q0 < 0
-        const double v0 = origin[a0] + rounded(static_cast<double>(q0) * grid.step);
-        double p1 = f.midpoint[a1], p2 = f.midpoint[a2];
-        if (f.has_normal) {  // predict_others'
-            const double u = rounded((v0 - f.midpoint[a0]) / f.normal[a0]);
-            p1 = p1 + rounded(u * f.normal[a1]);
-            p2 = p2 + rounded(u * f.normal[a2]);
-        }
-        second[k] = {grid_prediction_at(grid, origin[a1], p1), grid_prediction_at(grid, origin[a2], p2)};
-        set_coordinate(decoded[k], a0, v0);
+        const GridFirstRole role0 = grid_first_role(f, q0, grid, origin, a0, a1, a2);
+        second[k] = {grid_prediction_at(grid, origin[a1], role0.second), grid_prediction_at(grid, origin[a2], role0.third)};
+        set_coordinate(decoded[k], a0, role0.value);
     };
     size_t k = 0;
     for (; k + 1 < count; k += 2) {
