@@ -197,6 +197,17 @@ double mixing_model_bits(const Hierarchy& h, MixingModel model) {
     return bits;
 }
 
+// A local threshold against the coded nodes of the level (refined / unrefined) stays 0 while no
+// such node is coded.
+void expect_zero_until_coded(const MixedFeatures& f, int refined, int unrefined) {
+    if (f.coded_refined == 0) {
+        EXPECT_EQ(refined, 0);
+    }
+    if (f.coded_unrefined == 0) {
+        EXPECT_EQ(unrefined, 0);
+    }
+}
+
 // The fifth model's local threshold (FORMAT.md 2.5): the features see only nodes coded before, and
 // they make a curved remesh's code smaller than the fourth model's.
 TEST(MixedContexts, TheLocalThresholdCodesACurvedRemeshSmallerThanTheFourthModel) {
@@ -214,12 +225,7 @@ TEST(MixedContexts, TheLocalThresholdCodesACurvedRemeshSmallerThanTheFourthModel
         EXPECT_LE(f.coded_refined, 7);
         EXPECT_LE(f.thr_refined, 31);
         EXPECT_LE(f.thr_unrefined, 31);
-        if (f.coded_refined == 0) {
-            EXPECT_EQ(f.thr_refined, 0);
-        }
-        if (f.coded_unrefined == 0) {
-            EXPECT_EQ(f.thr_unrefined, 0);
-        }
+        expect_zero_until_coded(f, f.thr_refined, f.thr_unrefined);
         compared += f.thr_refined != 0 && f.thr_unrefined != 0;
     }
     EXPECT_GE(first_of_level, 3);
@@ -240,12 +246,7 @@ TEST(MixedContexts, TheQuadricsRingMeansCodeACurvedRemeshSmallerThanTheFifthMode
             level = f.level;
             EXPECT_EQ(f.quad_refined + f.quad_unrefined, 0) << "the first symbol of a level: no node of it is coded yet";
         }
-        if (f.coded_refined == 0) {
-            EXPECT_EQ(f.quad_refined, 0);
-        }
-        if (f.coded_unrefined == 0) {
-            EXPECT_EQ(f.quad_unrefined, 0);
-        }
+        expect_zero_until_coded(f, f.quad_refined, f.quad_unrefined);
         EXPECT_LE(f.ring_quad_mean, 63);
         EXPECT_LE(f.quad_refined, 31);
         averaged += f.ring_quad_mean != f.quad_mean;
