@@ -117,14 +117,31 @@ double snap_positions(const Hierarchy& h, const Quantizer& quantizer, unsigned t
     return worst;
 }
 
+// The mixing mode's models, newest first, each with the first file version that holds it
+// (format_version.h): a mixed file of version v is in the newest model whose version is <= v.
+constexpr std::pair<MixingModel, uint8_t> kMixingModelVersions[] = {
+    {MixingModel::sixth, kSixthMixingVersion},   {MixingModel::fifth, kFifthMixingVersion},
+    {MixingModel::fourth, kFourthMixingVersion}, {MixingModel::third, kThirdMixingVersion},
+    {MixingModel::second, kSecondMixingVersion}, {MixingModel::first, kMixedContextsVersion}};
+
+MixingModel mixing_model_of_file(uint8_t file_version) {
+    for (const auto& [model, version] : kMixingModelVersions)
+        if (file_version >= version) return model;
+    return MixingModel::first;
+}
+
+uint8_t first_version_of(MixingModel model) {
+    for (const auto& [m, version] : kMixingModelVersions)
+        if (m == model) return version;
+    return kMixedContextsVersion;
+}
+
 // The lowest version that holds what the file holds (format_version.h).
 // `mixing`: the mixing mode's model; the sixth only in version 19, the fifth only in 17, the fourth
 // only in 16 (never chunked; they hold every geometry mode); the third is in versions 11-15.
 uint8_t file_version(bool stencil_tables, bool raw_side, bool unit_geometry, bool grid_geometry, bool mixed_contexts, MixingModel mixing,
                      bool chunked, bool static_geometry, BaseConnectivityMode base_mode, bool store_numbering) {
-    if (mixed_contexts && mixing == MixingModel::sixth) return kSixthMixingVersion;
-    if (mixed_contexts && mixing == MixingModel::fifth) return kFifthMixingVersion;
-    if (mixed_contexts && mixing == MixingModel::fourth) return kFourthMixingVersion;
+    if (mixed_contexts && mixing >= MixingModel::fourth) return first_version_of(mixing);
     // Mixed files keep mode 4's per-vertex order (code_forest): only the others hold the grouped one.
     if (const uint8_t newest = newest_features_version(grid_geometry && !mixed_contexts, stencil_tables, raw_side, chunked))
         return newest;
@@ -542,12 +559,7 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
                                     hierarchy_stream_version_of_file(reader.version()),
                                     std::min<uint64_t>(meta.nodes, options.max_nodes));
     if (meta.options & kOptionMixedContexts)
-        hierarchy.use_mixed_contexts(reader.version() >= kSixthMixingVersion    ? MixingModel::sixth
-                                     : reader.version() >= kFifthMixingVersion  ? MixingModel::fifth
-                                     : reader.version() >= kFourthMixingVersion ? MixingModel::fourth
-                                     : reader.version() >= kThirdMixingVersion  ? MixingModel::third
-                                     : reader.version() >= kSecondMixingVersion ? MixingModel::second
-                                                                                : MixingModel::first);
+        hierarchy.use_mixed_contexts(mixing_model_of_file(reader.version()));
     Hierarchy& h = hierarchy.hierarchy();
     // The metadata's counts let the hierarchy grow in place, as far as the file's size warrants.
     const uint64_t reserved_nodes = std::min<uint64_t>(meta.nodes, meta.base_triangles + kReservedNodesPerFileByte * size);
