@@ -290,6 +290,10 @@ struct Chunk {
     std::array<GridPrediction, kChunk> first;  // mode 4: role 0's
 };
 
+// Hints the processor to fetch node n of the hierarchy the mesh reads.
+AMC_ALWAYS_INLINE void prefetch_node(const Hierarchy& h, NodeId n) { HierarchyBuilder::prefetch(h, n); }
+AMC_ALWAYS_INLINE void prefetch_node(const HierarchyOnGrid& h, NodeId n) { HierarchyBuilder::prefetch(h.nodes(), n); }
+
 // Where the vertices and their frame corners come from: (node, edge) pairs, read in the hierarchy,
 // or split_level's list (vertices first, first + 1, ...).
 // get(c) sets the corners and vertices of chunk c's c.count vertices from c.begin.
@@ -299,7 +303,19 @@ struct FromNodes {
     const std::vector<std::pair<NodeId, int>>& created;
     size_t size() const { return created.size(); }
     bool appends(const Hierarchy&) const { return false; }
+    // The encoder visits a level's nodes in the base coder's root order, which is not the input's:
+    // nearly every node read misses the cache. So the reads go in stages, each over the whole chunk:
+    // the next chunk's nodes are fetched ahead, then this chunk's centre children and neighbours
+    // (known from its nodes), then their vertices are read, many misses in flight at once.
     void get(Chunk& c) const {
+        const size_t next_end = std::min(created.size(), c.begin + 2 * kChunk);
+        for (size_t i = c.begin + c.count; i < next_end; ++i) prefetch_node(h, created[i].first);
+        for (size_t i = 0; i < c.count; ++i) {
+            const auto [n, e] = created[c.begin + i];
+            prefetch_node(h, h.child(n, red_split::kCenter));
+            const NodeId q = h.neighbor(n, e);
+            if (q != kNoNode) prefetch_node(h, q);
+        }
         for (size_t i = 0; i < c.count; ++i) {
             const auto [n, e] = created[c.begin + i];
             c.own[i] = frame_corners(h, n, e);
