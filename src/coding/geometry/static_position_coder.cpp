@@ -1267,6 +1267,67 @@ AMC_ALWAYS_INLINE void set_grid_frame(const NormalFrame& f, const GridScale& gri
     g.first = grid_prediction_at(grid, origin[g.axis], g.midpoint[g.axis]);
 }
 
+// The grouped order's vertex between its role-0 token and its roles 1 and 2: their grid
+// predictions.
+struct GridSecond {
+    GridPrediction g1, g2;
+};
+
+#if AMC_SSE2
+// grid_prediction_at in each lane: lane k of `x` on the axis whose origin is lane k of `origin`.
+AMC_ALWAYS_INLINE GridSecond grid_prediction_pair(const GridScale& grid, __m128d origin, __m128d x) {
+    const __m128d zero = _mm_setzero_pd();
+    const __m128d t = rounded(_mm_div_pd(_mm_sub_pd(x, origin), _mm_set1_pd(grid.step)));
+    const __m128d high = _mm_cmpge_pd(t, _mm_set1_pd(grid.top));
+    const __m128d inside = _mm_andnot_pd(high, _mm_cmpgt_pd(t, zero));  // not NaN either
+    // Where inside, 0 < t + 0.5 < 2^31 (kMaxQuantizationBits): the truncation is uint32_t's floor.
+    const __m128i p = _mm_cvttpd_epi32(rounded(_mm_add_pd(t, _mm_set1_pd(0.5))));
+    const __m128d f = rounded(_mm_sub_pd(t, _mm_cvtepi32_pd(p)));
+    const int in = _mm_movemask_pd(inside), above = _mm_movemask_pd(high);
+    const int turn = _mm_movemask_pd(_mm_and_pd(inside, _mm_cmplt_pd(f, zero)));
+    const int bin = _mm_movemask_pd(_mm_and_pd(inside, _mm_cmpge_pd(_mm_andnot_pd(_mm_set1_pd(-0.0), f), _mm_set1_pd(0.25))));
+    const int32_t p0 = _mm_cvtsi128_si32(p), p1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(p, 1));
+    return {{in & 1 ? uint32_t(p0) : above & 1 ? grid.max : 0, bin & 1, (turn & 1) != 0},
+            {in & 2 ? uint32_t(p1) : above & 2 ? grid.max : 0, bin >> 1, (turn & 2) != 0}};
+}
+
+// set_grid_frame for two vertices at once from frame_pair_lanes (each vertex in one lane):
+// set_axis's choice by lane masks, the coordinates stored from the lanes, role 0's grid
+// predictions in one pair. The same operations on the same values, so the same frames.
+AMC_ALWAYS_INLINE void set_grid_frame_pair(const FramePairLanes& l, const GridScale& grid, const double* origin, GridFrame& g0,
+                                           GridFrame& g1) {
+    _mm_storel_pd(&g0.midpoint[0], l.mx);
+    _mm_storeh_pd(&g1.midpoint[0], l.mx);
+    _mm_storel_pd(&g0.midpoint[1], l.my);
+    _mm_storeh_pd(&g1.midpoint[1], l.my);
+    _mm_storel_pd(&g0.midpoint[2], l.mz);
+    _mm_storeh_pd(&g1.midpoint[2], l.mz);
+    _mm_storel_pd(&g0.normal[0], l.nx);
+    _mm_storeh_pd(&g1.normal[0], l.nx);
+    _mm_storel_pd(&g0.normal[1], l.ny);
+    _mm_storeh_pd(&g1.normal[1], l.ny);
+    _mm_storel_pd(&g0.normal[2], l.nz);
+    _mm_storeh_pd(&g1.normal[2], l.nz);
+    // set_axis: the first axis of largest |N_i|, and whether it is positive and finite.
+    const __m128d sign = _mm_set1_pd(-0.0);
+    const __m128d x = _mm_andnot_pd(sign, l.nx), y = _mm_andnot_pd(sign, l.ny), z = _mm_andnot_pd(sign, l.nz);
+    const __m128d y_wins = _mm_cmpgt_pd(y, x);
+    const __m128d best = _mm_max_pd(y, x);  // maxpd: y where y > x, else x (NaN as set_axis)
+    const __m128d z_wins = _mm_cmpgt_pd(z, best);
+    const __m128d largest = _mm_max_pd(z, best);  // z where z > best, else best
+    const int has = _mm_movemask_pd(_mm_and_pd(_mm_cmpgt_pd(largest, _mm_setzero_pd()), _mm_cmplt_pd(largest, _mm_set1_pd(HUGE_VAL))));
+    const int ys = _mm_movemask_pd(y_wins), zs = _mm_movemask_pd(z_wins);
+    g0.has_normal = (has & 1) != 0;
+    g1.has_normal = (has & 2) != 0;
+    g0.axis = has & 1 ? (zs & 1 ? 2 : ys & 1) : 0;
+    g1.axis = has & 2 ? (zs & 2 ? 2 : (ys >> 1) & 1) : 0;
+    const GridSecond first = grid_prediction_pair(grid, _mm_loadh_pd(_mm_load_sd(origin + g0.axis), origin + g1.axis),
+                                                  _mm_loadh_pd(_mm_load_sd(g0.midpoint + g0.axis), g1.midpoint + g1.axis));
+    g0.first = first.g1;
+    g1.first = first.g2;
+}
+#endif
+
 // Coordinate `axis` of `p`, written through its object representation (Vec3 is three doubles).
 AMC_ALWAYS_INLINE void set_coordinate(Vec3& p, int axis, double value) {
     std::memcpy(reinterpret_cast<unsigned char*>(&p) + sizeof(double) * size_t(axis), &value, sizeof(double));
@@ -1274,21 +1335,37 @@ AMC_ALWAYS_INLINE void set_coordinate(Vec3& p, int axis, double value) {
 static_assert(sizeof(Vec3) == 3 * sizeof(double) && offsetof(Vec3, y) == sizeof(double) && offsetof(Vec3, z) == 2 * sizeof(double),
               "Vec3 is x, y, z");
 
-// Role 0's coordinate from its grid value q0, and where roles 1 and 2 are predicted from it
-// (predict_others' line along the frame's normal); a0, a1, a2 are the roles' axes.
-struct GridFirstRole {
-    double value, second, third;
-};
-
-AMC_ALWAYS_INLINE GridFirstRole grid_first_role(const GridFrame& f, int64_t q0, const GridScale& grid,
-                                                const double* origin, int a0, int a1, int a2) {
-    GridFirstRole r{origin[a0] + rounded(static_cast<double>(q0) * grid.step), f.midpoint[a1], f.midpoint[a2]};
+// Role 0's grid value q0 of a frame whose roles 1 and 2 are the axes a1 and a2: its coordinate,
+// written to `p`, and roles 1 and 2's grid predictions (predict_others' line along the normal).
+AMC_ALWAYS_INLINE GridSecond grid_first_role(const GridFrame& f, int64_t q0, const GridScale& grid, const double* origin,
+                                             int a1, int a2, Vec3& p) {
+    const int a0 = f.axis;
+    const double value = origin[a0] + rounded(static_cast<double>(q0) * grid.step);
+    set_coordinate(p, a0, value);
+#if AMC_SSE2
+    __m128d predicted = _mm_loadh_pd(_mm_load_sd(f.midpoint + a1), f.midpoint + a2);
     if (f.has_normal) {
-        const double u = rounded((r.value - f.midpoint[a0]) / f.normal[a0]);
-        r.second = r.second + rounded(u * f.normal[a1]);
-        r.third = r.third + rounded(u * f.normal[a2]);
+        const double u = rounded((value - f.midpoint[a0]) / f.normal[a0]);
+        const __m128d normal = _mm_loadh_pd(_mm_load_sd(f.normal + a1), f.normal + a2);
+        predicted = _mm_add_pd(predicted, rounded(_mm_mul_pd(_mm_set1_pd(u), normal)));
     }
-    return r;
+    return grid_prediction_pair(grid, _mm_loadh_pd(_mm_load_sd(origin + a1), origin + a2), predicted);
+#else
+    double second = f.midpoint[a1], third = f.midpoint[a2];
+    if (f.has_normal) {
+        const double u = rounded((value - f.midpoint[a0]) / f.normal[a0]);
+        second = second + rounded(u * f.normal[a1]);
+        third = third + rounded(u * f.normal[a2]);
+    }
+    return {grid_prediction_at(grid, origin[a1], second), grid_prediction_at(grid, origin[a2], third)};
+#endif
+}
+
+// Roles 1 and 2's coordinates (axes a1 and a2) from their grid values.
+AMC_ALWAYS_INLINE void set_other_roles(int64_t q1, int64_t q2, const GridScale& grid, const double* origin, int a1, int a2,
+                                       Vec3& p) {
+    set_coordinate(p, a1, origin[a1] + rounded(static_cast<double>(q1) * grid.step));
+    set_coordinate(p, a2, origin[a2] + rounded(static_cast<double>(q2) * grid.step));
 }
 
 // decode_vertex<State, true> over a GridFrame: role r's axis is the frame's axis, then the two
@@ -1296,28 +1373,17 @@ AMC_ALWAYS_INLINE GridFirstRole grid_first_role(const GridFrame& f, int64_t q0, 
 template <int State, bool Safe>
 AMC_ALWAYS_INLINE bool decode_grid_vertex(StencilStreams& s, const GridTable* t, const GridFrame& f, const GridScale& grid,
                                           const double* origin, Vec3& p) {
-    const int a0 = f.axis, a1 = a0 == 0 ? 1 : 0, a2 = a0 == 2 ? 1 : 2;
     const int64_t q0 = int64_t(f.first.p) + negated_if(grid_token<State, Safe>(s, t[f.first.bin]), f.first.turn);
     if (uint64_t(q0) > grid.max) return false;  // also q0 < 0
-    const GridFirstRole first = grid_first_role(f, q0, grid, origin, a0, a1, a2);
-    const double v0 = first.value;
-    const GridPrediction g1 = grid_prediction_at(grid, origin[a1], first.second);
-    const GridPrediction g2 = grid_prediction_at(grid, origin[a2], first.third);
-    const int64_t q1 = int64_t(g1.p) + negated_if(grid_token<1 - State, Safe>(s, t[kGridBins + g1.bin]), g1.turn);
+    const int a1 = f.axis == 0 ? 1 : 0, a2 = f.axis == 2 ? 1 : 2;
+    const GridSecond g = grid_first_role(f, q0, grid, origin, a1, a2, p);
+    const int64_t q1 = int64_t(g.g1.p) + negated_if(grid_token<1 - State, Safe>(s, t[kGridBins + g.g1.bin]), g.g1.turn);
     if (uint64_t(q1) > grid.max) return false;
-    const int64_t q2 = int64_t(g2.p) + negated_if(grid_token<State, Safe>(s, t[2 * kGridBins + g2.bin]), g2.turn);
+    const int64_t q2 = int64_t(g.g2.p) + negated_if(grid_token<State, Safe>(s, t[2 * kGridBins + g.g2.bin]), g.g2.turn);
     if (uint64_t(q2) > grid.max) return false;
-    set_coordinate(p, a0, v0);
-    set_coordinate(p, a1, origin[a1] + rounded(static_cast<double>(q1) * grid.step));
-    set_coordinate(p, a2, origin[a2] + rounded(static_cast<double>(q2) * grid.step));
+    set_other_roles(q1, q2, grid, origin, a1, a2, p);
     return true;
 }
-
-// The grouped order's vertex between its role-0 token and its roles 1 and 2: role 0's grid
-// coordinate, then roles 1 and 2's grid predictions.
-struct GridSecond {
-    GridPrediction g1, g2;
-};
 
 // decode_grid_vertex's work in the grouped order (version 18, FORMAT.md 5.7) over a chunk of
 // `count` vertices: their role-0 tokens (vertex i with state i mod 2), each followed by its
@@ -1337,11 +1403,8 @@ AMC_ALWAYS_INLINE bool decode_grid_grouped(StencilStreams& s, const GridTable* t
         constexpr int State = decltype(state)::value;
         const GridFrame& f = frames[k];
         const int64_t q0 = int64_t(f.first.p) + negated_if(grid_token<State, Safe>(s, t[f.first.bin]), f.first.turn);
-        const int a0 = f.axis, a1 = a0 == 0 ? 1 : 0, a2 = a0 == 2 ? 1 : 2;
         out_of_range |= uint64_t(q0) > grid.max;  // also q0 < 0
-        const GridFirstRole role0 = grid_first_role(f, q0, grid, origin, a0, a1, a2);
-        second[k] = {grid_prediction_at(grid, origin[a1], role0.second), grid_prediction_at(grid, origin[a2], role0.third)};
-        set_coordinate(decoded[k], a0, role0.value);
+        second[k] = grid_first_role(f, q0, grid, origin, f.axis == 0 ? 1 : 0, f.axis == 2 ? 1 : 2, decoded[k]);
     };
     size_t k = 0;
     for (; k + 1 < count; k += 2) {
@@ -1357,9 +1420,8 @@ AMC_ALWAYS_INLINE bool decode_grid_grouped(StencilStreams& s, const GridTable* t
             const int64_t q1 = int64_t(g.g1.p) + negated_if(grid_token<S, Safe>(s, t[kGridBins + g.g1.bin]), g.g1.turn);
             const int64_t q2 = int64_t(g.g2.p) + negated_if(grid_token<1 - S, Safe>(s, t[2 * kGridBins + g.g2.bin]), g.g2.turn);
             if ((uint64_t(q1) > grid.max) | (uint64_t(q2) > grid.max)) return false;
-            const int a0 = frames[i].axis, a1 = a0 == 0 ? 1 : 0, a2 = a0 == 2 ? 1 : 2;
-            set_coordinate(decoded[i], a1, origin[a1] + rounded(static_cast<double>(q1) * grid.step));
-            set_coordinate(decoded[i], a2, origin[a2] + rounded(static_cast<double>(q2) * grid.step));
+            const int a0 = frames[i].axis;
+            set_other_roles(q1, q2, grid, origin, a0 == 0 ? 1 : 0, a0 == 2 ? 1 : 2, decoded[i]);
         }
         return true;
     };
@@ -1401,12 +1463,8 @@ bool decode_grid_listed(Hierarchy& h, const FromList& created, const Quantizer& 
         }
         size_t i = 0;
 #if AMC_SSE2
-        for (; i + 1 < count; i += 2) {
-            NormalFrame f0, f1;
-            frame_pair_of<true>(h, corners[i], corners[i + 1], f0, f1);
-            set_grid_frame(f0, grid, origin, frames[i]);
-            set_grid_frame(f1, grid, origin, frames[i + 1]);
-        }
+        for (; i + 1 < count; i += 2)
+            set_grid_frame_pair(frame_pair_lanes<true>(h, corners[i], corners[i + 1]), grid, origin, frames[i], frames[i + 1]);
 #endif
         for (; i < count; ++i) set_grid_frame(frame_of<true>(h, corners[i]), grid, origin, frames[i]);
         auto run = [&](auto safe) {
