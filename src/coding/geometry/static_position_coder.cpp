@@ -1246,11 +1246,69 @@ AMC_ALWAYS_INLINE int64_t grid_token(StencilStreams& s, const GridTable& table) 
     return negated_if(int64_t(uint64_t(uint32_t(e.value)) | r >> 1), (r & 1) != 0);
 }
 
+// A grid prediction as the fast path uses it (grid_prediction_at's, made ready for its token): the
+// grid point, its bin's table as a byte offset from the role's first table, and all ones where
+// the residual is coded negated (the turn).
+struct GridPoint {
+    uint64_t point;
+    uint64_t table_offset;
+    int64_t turn_mask;
+};
+
+AMC_ALWAYS_INLINE GridPoint grid_point_of(const GridPrediction& g) {
+    return {g.p, uint64_t(g.bin) * sizeof(GridTable), -int64_t(g.turn)};
+}
+
+// The grid value of a prediction and the next token of state State under its table, among the
+// role's tables from `role_tables`.
+template <int State, bool Safe>
+AMC_ALWAYS_INLINE int64_t grid_point_value(StencilStreams& s, const GridTable* role_tables, uint64_t point, uint64_t table_offset,
+                                           int64_t turn_mask) {
+    const GridTable& table = *reinterpret_cast<const GridTable*>(reinterpret_cast<const unsigned char*>(role_tables) + table_offset);
+    const int64_t r = grid_token<State, Safe>(s, table);
+    return int64_t(point) + ((r ^ turn_mask) - turn_mask);  // negated_if(r, turn)
+}
+
+// Two grid predictions side by side (SSE2's lanes): roles 1 and 2 of a vertex, or role 0 of two
+// vertices.
+struct GridPointPair {
+    uint64_t point[2];
+    uint64_t table_offset[2];
+    int64_t turn_mask[2];
+};
+
+AMC_ALWAYS_INLINE GridPointPair grid_point_pair(const GridScale& grid, double origin0, double x0, double origin1, double x1) {
+#if AMC_SSE2
+    // grid_prediction_at in each lane, its fields made as masks.
+    const __m128d zero = _mm_setzero_pd();
+    const __m128d t = rounded(_mm_div_pd(_mm_sub_pd(_mm_set_pd(x1, x0), _mm_set_pd(origin1, origin0)), _mm_set1_pd(grid.step)));
+    const __m128d high = _mm_cmpge_pd(t, _mm_set1_pd(grid.top));
+    const __m128d inside = _mm_andnot_pd(high, _mm_cmpgt_pd(t, zero));  // not NaN either
+    // Where inside, 0 < t + 0.5 < 2^31 (kMaxQuantizationBits): the truncation is uint32_t's floor.
+    const __m128i p = _mm_cvttpd_epi32(rounded(_mm_add_pd(t, _mm_set1_pd(0.5))));
+    const __m128d f = rounded(_mm_sub_pd(t, _mm_cvtepi32_pd(p)));
+    const __m128d bin = _mm_and_pd(inside, _mm_cmpge_pd(_mm_andnot_pd(_mm_set1_pd(-0.0), f), _mm_set1_pd(0.25)));
+    const __m128d turn = _mm_and_pd(inside, _mm_cmplt_pd(f, zero));
+    const __m128i point = _mm_or_si128(_mm_and_si128(_mm_castpd_si128(inside), _mm_unpacklo_epi32(p, _mm_setzero_si128())),
+                                       _mm_and_si128(_mm_castpd_si128(high), _mm_set1_epi64x(int64_t(grid.max))));
+    GridPointPair out;
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out.point), point);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out.table_offset),
+                     _mm_and_si128(_mm_castpd_si128(bin), _mm_set1_epi64x(int64_t(sizeof(GridTable)))));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out.turn_mask), _mm_castpd_si128(turn));
+    return out;
+#else
+    const GridPoint g0 = grid_point_of(grid_prediction_at(grid, origin0, x0));
+    const GridPoint g1 = grid_point_of(grid_prediction_at(grid, origin1, x1));
+    return {{g0.point, g1.point}, {g0.table_offset, g1.table_offset}, {g0.turn_mask, g1.turn_mask}};
+#endif
+}
+
 // A vertex's frame as the fast path reads it: midpoint and normal in axis order, the frame's axis
 // (0 without a normal: role_axes') and role 0's grid prediction.
 struct GridFrame {
     double midpoint[3], normal[3];
-    GridPrediction first;
+    GridPoint first;
     int axis;
     bool has_normal;
 };
@@ -1264,33 +1322,10 @@ AMC_ALWAYS_INLINE void set_grid_frame(const NormalFrame& f, const GridScale& gri
     g.normal[2] = f.normal.z;
     g.has_normal = f.has_normal;
     g.axis = f.has_normal ? f.axis : 0;
-    g.first = grid_prediction_at(grid, origin[g.axis], g.midpoint[g.axis]);
+    g.first = grid_point_of(grid_prediction_at(grid, origin[g.axis], g.midpoint[g.axis]));
 }
-
-// The grouped order's vertex between its role-0 token and its roles 1 and 2: their grid
-// predictions.
-struct GridSecond {
-    GridPrediction g1, g2;
-};
 
 #if AMC_SSE2
-// grid_prediction_at in each lane: lane k of `x` on the axis whose origin is lane k of `origin`.
-AMC_ALWAYS_INLINE GridSecond grid_prediction_pair(const GridScale& grid, __m128d origin, __m128d x) {
-    const __m128d zero = _mm_setzero_pd();
-    const __m128d t = rounded(_mm_div_pd(_mm_sub_pd(x, origin), _mm_set1_pd(grid.step)));
-    const __m128d high = _mm_cmpge_pd(t, _mm_set1_pd(grid.top));
-    const __m128d inside = _mm_andnot_pd(high, _mm_cmpgt_pd(t, zero));  // not NaN either
-    // Where inside, 0 < t + 0.5 < 2^31 (kMaxQuantizationBits): the truncation is uint32_t's floor.
-    const __m128i p = _mm_cvttpd_epi32(rounded(_mm_add_pd(t, _mm_set1_pd(0.5))));
-    const __m128d f = rounded(_mm_sub_pd(t, _mm_cvtepi32_pd(p)));
-    const int in = _mm_movemask_pd(inside), above = _mm_movemask_pd(high);
-    const int turn = _mm_movemask_pd(_mm_and_pd(inside, _mm_cmplt_pd(f, zero)));
-    const int bin = _mm_movemask_pd(_mm_and_pd(inside, _mm_cmpge_pd(_mm_andnot_pd(_mm_set1_pd(-0.0), f), _mm_set1_pd(0.25))));
-    const int32_t p0 = _mm_cvtsi128_si32(p), p1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(p, 1));
-    return {{in & 1 ? uint32_t(p0) : above & 1 ? grid.max : 0, bin & 1, (turn & 1) != 0},
-            {in & 2 ? uint32_t(p1) : above & 2 ? grid.max : 0, bin >> 1, (turn & 2) != 0}};
-}
-
 // set_grid_frame for two vertices at once from frame_pair_lanes (each vertex in one lane):
 // set_axis's choice by lane masks, the coordinates stored from the lanes, role 0's grid
 // predictions in one pair. The same operations on the same values, so the same frames.
@@ -1321,10 +1356,9 @@ AMC_ALWAYS_INLINE void set_grid_frame_pair(const FramePairLanes& l, const GridSc
     g1.has_normal = (has & 2) != 0;
     g0.axis = has & 1 ? (zs & 1 ? 2 : ys & 1) : 0;
     g1.axis = has & 2 ? (zs & 2 ? 2 : (ys >> 1) & 1) : 0;
-    const GridSecond first = grid_prediction_pair(grid, _mm_loadh_pd(_mm_load_sd(origin + g0.axis), origin + g1.axis),
-                                                  _mm_loadh_pd(_mm_load_sd(g0.midpoint + g0.axis), g1.midpoint + g1.axis));
-    g0.first = first.g1;
-    g1.first = first.g2;
+    const GridPointPair first = grid_point_pair(grid, origin[g0.axis], g0.midpoint[g0.axis], origin[g1.axis], g1.midpoint[g1.axis]);
+    g0.first = {first.point[0], first.table_offset[0], first.turn_mask[0]};
+    g1.first = {first.point[1], first.table_offset[1], first.turn_mask[1]};
 }
 #endif
 
@@ -1337,28 +1371,18 @@ static_assert(sizeof(Vec3) == 3 * sizeof(double) && offsetof(Vec3, y) == sizeof(
 
 // Role 0's grid value q0 of a frame whose roles 1 and 2 are the axes a1 and a2: its coordinate,
 // written to `p`, and roles 1 and 2's grid predictions (predict_others' line along the normal).
-AMC_ALWAYS_INLINE GridSecond grid_first_role(const GridFrame& f, int64_t q0, const GridScale& grid, const double* origin,
-                                             int a1, int a2, Vec3& p) {
+AMC_ALWAYS_INLINE GridPointPair grid_first_role(const GridFrame& f, int64_t q0, const GridScale& grid, const double* origin,
+                                                int a1, int a2, Vec3& p) {
     const int a0 = f.axis;
     const double value = origin[a0] + rounded(static_cast<double>(q0) * grid.step);
     set_coordinate(p, a0, value);
-#if AMC_SSE2
-    __m128d predicted = _mm_loadh_pd(_mm_load_sd(f.midpoint + a1), f.midpoint + a2);
-    if (f.has_normal) {
-        const double u = rounded((value - f.midpoint[a0]) / f.normal[a0]);
-        const __m128d normal = _mm_loadh_pd(_mm_load_sd(f.normal + a1), f.normal + a2);
-        predicted = _mm_add_pd(predicted, rounded(_mm_mul_pd(_mm_set1_pd(u), normal)));
-    }
-    return grid_prediction_pair(grid, _mm_loadh_pd(_mm_load_sd(origin + a1), origin + a2), predicted);
-#else
     double second = f.midpoint[a1], third = f.midpoint[a2];
     if (f.has_normal) {
         const double u = rounded((value - f.midpoint[a0]) / f.normal[a0]);
         second = second + rounded(u * f.normal[a1]);
         third = third + rounded(u * f.normal[a2]);
     }
-    return {grid_prediction_at(grid, origin[a1], second), grid_prediction_at(grid, origin[a2], third)};
-#endif
+    return grid_point_pair(grid, origin[a1], second, origin[a2], third);
 }
 
 // Roles 1 and 2's coordinates (axes a1 and a2) from their grid values.
@@ -1373,13 +1397,13 @@ AMC_ALWAYS_INLINE void set_other_roles(int64_t q1, int64_t q2, const GridScale& 
 template <int State, bool Safe>
 AMC_ALWAYS_INLINE bool decode_grid_vertex(StencilStreams& s, const GridTable* t, const GridFrame& f, const GridScale& grid,
                                           const double* origin, Vec3& p) {
-    const int64_t q0 = int64_t(f.first.p) + negated_if(grid_token<State, Safe>(s, t[f.first.bin]), f.first.turn);
+    const int64_t q0 = grid_point_value<State, Safe>(s, t, f.first.point, f.first.table_offset, f.first.turn_mask);
     if (uint64_t(q0) > grid.max) return false;  // also q0 < 0
     const int a1 = f.axis == 0 ? 1 : 0, a2 = f.axis == 2 ? 1 : 2;
-    const GridSecond g = grid_first_role(f, q0, grid, origin, a1, a2, p);
-    const int64_t q1 = int64_t(g.g1.p) + negated_if(grid_token<1 - State, Safe>(s, t[kGridBins + g.g1.bin]), g.g1.turn);
+    const GridPointPair g = grid_first_role(f, q0, grid, origin, a1, a2, p);
+    const int64_t q1 = grid_point_value<1 - State, Safe>(s, t + kGridBins, g.point[0], g.table_offset[0], g.turn_mask[0]);
     if (uint64_t(q1) > grid.max) return false;
-    const int64_t q2 = int64_t(g.g2.p) + negated_if(grid_token<State, Safe>(s, t[2 * kGridBins + g.g2.bin]), g.g2.turn);
+    const int64_t q2 = grid_point_value<State, Safe>(s, t + 2 * kGridBins, g.point[1], g.table_offset[1], g.turn_mask[1]);
     if (uint64_t(q2) > grid.max) return false;
     set_other_roles(q1, q2, grid, origin, a1, a2, p);
     return true;
@@ -1395,14 +1419,14 @@ AMC_ALWAYS_INLINE bool decode_grid_vertex(StencilStreams& s, const GridTable* t,
 template <bool Safe>
 AMC_ALWAYS_INLINE bool decode_grid_grouped(StencilStreams& s, const GridTable* t, const GridFrame* frames, size_t count,
                                            const GridScale& grid, const double* origin, Vec3* decoded) {
-    GridSecond second[kChunk];
+    GridPointPair second[kChunk];
     uint64_t out_of_range = 0;
     // Role 0's token of vertex k with state `State`, then its value and roles 1 and 2's
     // predictions, which the next token does not wait for.
     auto first = [&](auto state, size_t k) {
         constexpr int State = decltype(state)::value;
         const GridFrame& f = frames[k];
-        const int64_t q0 = int64_t(f.first.p) + negated_if(grid_token<State, Safe>(s, t[f.first.bin]), f.first.turn);
+        const int64_t q0 = grid_point_value<State, Safe>(s, t, f.first.point, f.first.table_offset, f.first.turn_mask);
         out_of_range |= uint64_t(q0) > grid.max;  // also q0 < 0
         second[k] = grid_first_role(f, q0, grid, origin, f.axis == 0 ? 1 : 0, f.axis == 2 ? 1 : 2, decoded[k]);
     };
@@ -1416,9 +1440,9 @@ AMC_ALWAYS_INLINE bool decode_grid_grouped(StencilStreams& s, const GridTable* t
     auto roles_1_2 = [&](auto odd) {
         constexpr int S = decltype(odd)::value ? 1 : 0;  // role 1's state: count mod 2
         for (size_t i = 0; i < count; ++i) {
-            const GridSecond& g = second[i];
-            const int64_t q1 = int64_t(g.g1.p) + negated_if(grid_token<S, Safe>(s, t[kGridBins + g.g1.bin]), g.g1.turn);
-            const int64_t q2 = int64_t(g.g2.p) + negated_if(grid_token<1 - S, Safe>(s, t[2 * kGridBins + g.g2.bin]), g.g2.turn);
+            const GridPointPair& g = second[i];
+            const int64_t q1 = grid_point_value<S, Safe>(s, t + kGridBins, g.point[0], g.table_offset[0], g.turn_mask[0]);
+            const int64_t q2 = grid_point_value<1 - S, Safe>(s, t + 2 * kGridBins, g.point[1], g.table_offset[1], g.turn_mask[1]);
             if ((uint64_t(q1) > grid.max) | (uint64_t(q2) > grid.max)) return false;
             const int a0 = frames[i].axis;
             set_other_roles(q1, q2, grid, origin, a0 == 0 ? 1 : 0, a0 == 2 ? 1 : 2, decoded[i]);
