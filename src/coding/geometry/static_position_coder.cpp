@@ -418,14 +418,15 @@ AMC_ALWAYS_INLINE void predict_others(const RoleFrame& f, double first_value, do
 
 }  // namespace
 
+// Both without branches: whether a residual is 0, small or large is a coin flip on surfaces.
 int static_token(bool negative, uint64_t magnitude) {
-    if (magnitude == 0) return 0;
-    if (magnitude < 8) return int(2 * magnitude - 1 + (negative ? 1 : 0));
-    const int k = bit_length(magnitude);
-    return kDirectTokens + 4 * (k - 4) + int((magnitude >> (k - 3)) & 3);
+    const int small = int(2 * magnitude - 1 + (negative ? 1 : 0)) & -int(magnitude != 0);
+    const int k = bit_length(magnitude | 8);
+    const int large = kDirectTokens + 4 * (k - 4) + int((magnitude >> (k - 3)) & 3);
+    return magnitude < 8 ? small : large;
 }
 
-int static_raw_bit_count(uint64_t magnitude) { return magnitude < 8 ? 0 : 1 + bit_length(magnitude) - 3; }
+int static_raw_bit_count(uint64_t magnitude) { return magnitude < 8 ? 0 : bit_length(magnitude) - 2; }
 
 template <class Mesh>
 StaticLevelEncoder::StaticLevelEncoder(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created,
