@@ -641,6 +641,9 @@ struct Options {
     // second model's three), a prior learnt from every slot for the slots seen a few times.
     std::vector<int> extra_history;
     int prior_last_extras = 0;  // > 0: trained initial states only for the last this many extra tables
+    // > 0: a direct or extra model coded for the first time starts, before its update, at the
+    // probability the symbol was coded with, as if it had seen this many symbols (an online prior).
+    int fresh_from_final = 0;
 };
 
 // Ones and symbols per slot of every model table of a Study (direct, extra, history maps).
@@ -741,7 +744,9 @@ public:
                                    (o.prior_last_extras == 0 || (t + 3 + size_t(o.prior_last_extras) >= all.size() && t + 3 < all.size()));
                      ++i) {
                     const auto [ones, n] = o.priors->tables[t][i];
+                    ++prior_slots_[0];
                     if (n == 0) continue;
+                    ++prior_slots_[1];
                     BitModel& m = (*all[t])[i];
                     const double p = (ones + 0.4) / (n + 0.8);
                     m.p = uint32_t(std::clamp(p * 4294967296.0, 65536.0, 4294967296.0 - 65536.0));
@@ -758,6 +763,7 @@ public:
         return all;
     }
     Counts counts_;
+    std::array<size_t, 2> prior_slots_{};  // slots of the tables with trained initial states, and those the training reached
     std::array<std::vector<double>, 4> mean_weights() const {
         return {a_.mean_weights(), b_.mean_weights(), c_.mean_weights(), o_.mixer_d ? d_.mean_weights() : std::vector<double>{}};
     }
@@ -891,10 +897,18 @@ private:
             p = std::clamp((p + maps_[5].refine(p, rows[5]) + 1) >> 1, 1, 4095);
             used_maps_ = 6;
         }
+        p_final_ = p;
         return p;
     }
 
     void update(bool bit) {
+        if (o_.fresh_from_final > 0) {
+            auto start = [&](BitModel& m) {
+                if (m.n == 0) m.p = uint32_t(p_final_) << 20, m.n = uint16_t(o_.fresh_from_final);
+            };
+            for (int j = 0; j < kDirect; ++j) start(models_[size_t(j)][slot_[size_t(j)]]);
+            for (size_t e = 0; e < extra_slot_.size(); ++e) start(extra_models_[e][extra_slot_[e]]);
+        }
         {
             size_t t = 0;
             for (int j = 0; j < kDirect; ++j, ++t) counts_.tables[t][slot_[size_t(j)]][0] += bit, ++counts_.tables[t][slot_[size_t(j)]][1];
@@ -940,6 +954,7 @@ private:
     std::vector<int> st_;
     std::vector<mixing::ProbabilityMap> maps_;
     int used_maps_ = 5;
+    int p_final_ = 2048;
     uint32_t last_ = 0;
     int level_ = -1;
 };
@@ -1476,6 +1491,18 @@ int main(int argc, char** argv) {
         o.prior_count = 4, o.prior_geometric_only = true;
     });
     add("R7: sixth + trained initial states of the geometric tables, count 2", [&](Options& o) { sixth_coded(o), o.prior_count = 2, o.prior_geometric_only = true; });
+    for (int c : {1, 2, 4}) add("R7: sixth, fresh slots start at the coded probability, count " + std::to_string(c), [&, c](Options& o) { sixth_coded(o), o.fresh_from_final = c; });
+    add("R7: sixth, tables 31 32 coarser (ring quadric / 2 x size / 4 x level)", [&](Options& o) {
+        sixth_coded(o);
+        const size_t k = o.extra.size() - 4;
+        o.extra[k] = [](F f, X x) { return (x.cq1_h / 2u * 16u + f.size / 4u) * 8 + f.level; };
+        o.extra[k + 1] = [](F f, X x) { return (x.cq1_k / 2u * 16u + f.size / 4u) * 8 + f.level; };
+    });
+    add("R7: sixth + tables 31 32 coarser beside them", [&](Options& o) {
+        sixth_coded(o);
+        o.extra.push_back([](F f, X x) { return (x.cq1_h / 2u * 16u + f.size / 4u) * 8 + f.level; });
+        o.extra.push_back([](F f, X x) { return (x.cq1_k / 2u * 16u + f.size / 4u) * 8 + f.level; });
+    });
     add("R7: sixth + mixer E by z x count", [&](Options& o) {
         sixth_coded(o), o.mixer_e = [](F, X x) { return x.dyn_z * 8u + x.dyn_count; }, o.mixer_e_sets = 128;
     });
@@ -1604,6 +1631,9 @@ int main(int argc, char** argv) {
             }
             Study study(o);
             bits.push_back(study.code(data[m].symbols, extras[m], &links[m]));
+            if (std::getenv("PRIOR_SLOTS") && o.prior_count > 0)
+                std::fprintf(stderr, "%s: %s: %zu slots with trained initial states, %zu reached by the training\n", design.name.c_str(),
+                             data[m].name.c_str(), study.prior_slots_[0], study.prior_slots_[1]);
             if (std::getenv("PER_LEVEL") && (&design == &designs[0] || design.name == std::getenv("PER_LEVEL"))) {
                 std::fprintf(stderr, "%s:", data[m].name.c_str());
                 for (int l = 0; l < 8; ++l)
