@@ -224,8 +224,11 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
                : way == Way::subdivision   ? MidpointGuide::subdivision
                                            : MidpointGuide::surface;
     };
+    // Each attempt starts from a copy of the roots: copied into the last attempt's storage, whose
+    // pages are already mapped (a fresh 10^6-face hierarchy faults in about 60 MB).
+    const Hierarchy roots(hierarchy_base);
     auto attempt = [&](Way way, bool by_undo_steps) {
-        out.hierarchy = Hierarchy(hierarchy_base);
+        out.hierarchy = roots;
         // A leaf mesh of F faces comes from at most F leaves, so from at most 4F/3 + roots nodes.
         out.hierarchy.reserve(leaf.triangles.size() * 4 / 3 + base.triangles.size() + 4, leaf.positions.size());
         if (way == Way::uniform) {
@@ -288,9 +291,8 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     out.vertex_of_input.assign(leaf.positions.size(), kNoIndex);
     for (VertexId v = 0; v < leaf_of_vertex.size(); ++v) {
         if (leaf_of_vertex[v] == kNoIndex) continue;
-        const uint32_t l = input_of[leaf_of_vertex[v]];
-        out.vertex_of_input[l] = v;
-        out.hierarchy.set_position(v, leaf.positions[l]);
+        out.vertex_of_input[input_of[leaf_of_vertex[v]]] = v;
+        out.hierarchy.set_position(v, spatial.positions[leaf_of_vertex[v]]);  // the same position, read in order
     }
     for (uint32_t l = 0; l < leaf.positions.size(); ++l) {
         if (out.vertex_of_input[l] == kNoIndex) validate_triangle_mesh(leaf, what);  // an unused vertex
