@@ -171,12 +171,18 @@ AMC_ALWAYS_INLINE NormalFrame frame_of(const Mesh& h, const FrameCorners& corner
 }
 
 #if AMC_SSE2
+// Two vertices' frames before their axes, each vertex in one lane: the midpoints' and the
+// normals' coordinates (frame_pair_lanes).
+struct FramePairLanes {
+    __m128d mx, my, mz, nx, ny, nz;
+};
+
 // frame_of for two vertices at once, each in one lane of every SSE2 operation: the same IEEE
 // operations in the same order, so the same bits. Half the arithmetic instructions of two
 // frame_of calls. Not for single-precision hierarchies (their midpoints are rounded to float).
+// The midpoints and normals in lanes; frame_pair_of below makes the two frames of them.
 template <bool UnitNormals, class Mesh>
-AMC_ALWAYS_INLINE void frame_pair_of(const Mesh& h, const FrameCorners& k0, const FrameCorners& k1, NormalFrame& f0,
-                                     NormalFrame& f1) {
+AMC_ALWAYS_INLINE FramePairLanes frame_pair_lanes(const Mesh& h, const FrameCorners& k0, const FrameCorners& k1) {
     struct Lanes {  // a Vec3 of each vertex: x, y, z, each holding (first vertex, second vertex)
         __m128d x, y, z;
     };
@@ -226,13 +232,20 @@ AMC_ALWAYS_INLINE void frame_pair_of(const Mesh& h, const FrameCorners& k0, cons
     } else {
         n = Lanes{pick(n1.x, n2.x), pick(n1.y, n2.y), pick(n1.z, n2.z)};
     }
+    return {mid.x, mid.y, mid.z, n.x, n.y, n.z};
+}
+
+template <bool UnitNormals, class Mesh>
+AMC_ALWAYS_INLINE void frame_pair_of(const Mesh& h, const FrameCorners& k0, const FrameCorners& k1, NormalFrame& f0,
+                                     NormalFrame& f1) {
+    const FramePairLanes l = frame_pair_lanes<UnitNormals>(h, k0, k1);
     double mx[2], my[2], mz[2], nx[2], ny[2], nz[2];
-    _mm_storeu_pd(mx, mid.x);
-    _mm_storeu_pd(my, mid.y);
-    _mm_storeu_pd(mz, mid.z);
-    _mm_storeu_pd(nx, n.x);
-    _mm_storeu_pd(ny, n.y);
-    _mm_storeu_pd(nz, n.z);
+    _mm_storeu_pd(mx, l.mx);
+    _mm_storeu_pd(my, l.my);
+    _mm_storeu_pd(mz, l.mz);
+    _mm_storeu_pd(nx, l.nx);
+    _mm_storeu_pd(ny, l.ny);
+    _mm_storeu_pd(nz, l.nz);
     NormalFrame* out[2] = {&f0, &f1};
     for (int k = 0; k < 2; ++k) {
         NormalFrame& f = *out[k];

@@ -112,10 +112,11 @@ struct GridPrediction {
 struct GridScale {
     double step = 0.0, top = 0.0;
     uint32_t max = 0;
+    double inverse_step = 0.0;  // 1 / step, for grid_point_of_grid_value
 };
 GridScale grid_scale(const Quantizer* quantizer) {
     if (quantizer == nullptr) return {};
-    return {quantizer->step, static_cast<double>(quantizer->max_coordinate()), quantizer->max_coordinate()};
+    return {quantizer->step, static_cast<double>(quantizer->max_coordinate()), quantizer->max_coordinate(), 1.0 / quantizer->step};
 }
 
 // Inlined: returned through memory, the small struct stalls the decoder's loop on a store forward.
@@ -141,11 +142,23 @@ AMC_ALWAYS_INLINE uint32_t grid_point_at(const GridScale& grid, double origin, d
     return static_cast<uint32_t>(t + 0.5);
 }
 
-// The residual of an actual grid point against a prediction's.
+// grid_point_at of an x that is a grid value, origin + rounded(q * step) (the encoder's actual
+// positions): q, with a product in place of the division (a fifth of the encoder's coordinate
+// loop waited on it). t is then q within a few ulps, far from the half-way points where the two
+// could round apart.
+AMC_ALWAYS_INLINE uint32_t grid_point_of_grid_value(const GridScale& grid, double origin, double x) {
+    const double t = (x - origin) * grid.inverse_step;
+    if (!(t > 0.0)) return 0;
+    if (t >= grid.top) return grid.max;
+    return static_cast<uint32_t>(t + 0.5);
+}
+
+// The residual of an actual grid point against a prediction's. Without branches: turns and signs
+// are coin flips.
 AMC_ALWAYS_INLINE Residual grid_residual(uint32_t actual, const GridPrediction& g) {
-    const int64_t d = int64_t(actual) - int64_t(g.p);
-    const int64_t s = g.turn ? -d : d;
-    return {s < 0, uint64_t(s < 0 ? -s : s)};
+    const int64_t s = negated_if(int64_t(actual) - int64_t(g.p), g.turn);
+    const int64_t sign = s >> 63;
+    return {sign != 0, uint64_t((s ^ sign) - sign)};
 }
 
 // `origin`: the quantizer's origin on the axis (dequantize_coordinate's); `residual` signed
@@ -290,6 +303,10 @@ struct Chunk {
     std::array<GridPrediction, kChunk> first;  // mode 4: role 0's
 };
 
+// Hints the processor to fetch node n of the hierarchy the mesh reads.
+AMC_ALWAYS_INLINE void prefetch_node(const Hierarchy& h, NodeId n) { HierarchyBuilder::prefetch(h, n); }
+AMC_ALWAYS_INLINE void prefetch_node(const HierarchyOnGrid& h, NodeId n) { HierarchyBuilder::prefetch(h.nodes(), n); }
+
 // Where the vertices and their frame corners come from: (node, edge) pairs, read in the hierarchy,
 // or split_level's list (vertices first, first + 1, ...).
 // get(c) sets the corners and vertices of chunk c's c.count vertices from c.begin.
@@ -299,7 +316,19 @@ struct FromNodes {
     const std::vector<std::pair<NodeId, int>>& created;
     size_t size() const { return created.size(); }
     bool appends(const Hierarchy&) const { return false; }
+    // The encoder visits a level's nodes in the base coder's root order, which is not the input's:
+    // nearly every node read misses the cache. So the reads go in stages, each over the whole chunk:
+    // the next chunk's nodes are fetched ahead, then this chunk's centre children and neighbours
+    // (known from its nodes), then their vertices are read, many misses in flight at once.
     void get(Chunk& c) const {
+        const size_t next_end = std::min(created.size(), c.begin + 2 * kChunk);
+        for (size_t i = c.begin + c.count; i < next_end; ++i) prefetch_node(h, created[i].first);
+        for (size_t i = 0; i < c.count; ++i) {
+            const auto [n, e] = created[c.begin + i];
+            prefetch_node(h, h.child(n, red_split::kCenter));
+            const NodeId q = h.neighbor(n, e);
+            if (q != kNoNode) prefetch_node(h, q);
+        }
         for (size_t i = 0; i < c.count; ++i) {
             const auto [n, e] = created[c.begin + i];
             c.own[i] = frame_corners(h, n, e);
@@ -488,12 +517,12 @@ void StaticLevelEncoder::add_vertices(const Mesh& h, const std::vector<std::pair
                 int table = role;
                 if (GridBins) {
                     const GridPrediction g = role == 0 ? c.first[i] : grid_prediction_at(grid, f.origin[role], predicted[role]);
-                    r = grid_residual(grid_point_at(grid, f.origin[role], actual[axis]), g);
+                    r = grid_residual(grid_point_of_grid_value(grid, f.origin[role], actual[axis]), g);
                     table = kGridBins * role + g.bin;
                 } else if (Residuals == kFloat64Residuals) {
                     r = float64_residual(actual[axis], predicted[role]);
                 } else if (Residuals == kGridResiduals) {  // residual_of's grid points, with the level's GridScale
-                    const uint32_t a = grid_point_at(grid, f.origin[role], actual[axis]);
+                    const uint32_t a = grid_point_of_grid_value(grid, f.origin[role], actual[axis]);
                     const uint32_t q = grid_point_at(grid, f.origin[role], predicted[role]);
                     r = {a < q, a < q ? uint64_t(q - a) : uint64_t(a - q)};
                 } else {
@@ -1246,11 +1275,69 @@ AMC_ALWAYS_INLINE int64_t grid_token(StencilStreams& s, const GridTable& table) 
     return negated_if(int64_t(uint64_t(uint32_t(e.value)) | r >> 1), (r & 1) != 0);
 }
 
+// A grid prediction as the fast path uses it (grid_prediction_at's, made ready for its token): the
+// grid point, its bin's table as a byte offset from the role's first table, and all ones where
+// the residual is coded negated (the turn).
+struct GridPoint {
+    uint64_t point;
+    uint64_t table_offset;
+    int64_t turn_mask;
+};
+
+AMC_ALWAYS_INLINE GridPoint grid_point_of(const GridPrediction& g) {
+    return {g.p, uint64_t(g.bin) * sizeof(GridTable), -int64_t(g.turn)};
+}
+
+// The grid value of a prediction and the next token of state State under its table, among the
+// role's tables from `role_tables`.
+template <int State, bool Safe>
+AMC_ALWAYS_INLINE int64_t grid_point_value(StencilStreams& s, const GridTable* role_tables, uint64_t point, uint64_t table_offset,
+                                           int64_t turn_mask) {
+    const GridTable& table = *reinterpret_cast<const GridTable*>(reinterpret_cast<const unsigned char*>(role_tables) + table_offset);
+    const int64_t r = grid_token<State, Safe>(s, table);
+    return int64_t(point) + ((r ^ turn_mask) - turn_mask);  // negated_if(r, turn)
+}
+
+// Two grid predictions side by side (SSE2's lanes): roles 1 and 2 of a vertex, or role 0 of two
+// vertices.
+struct GridPointPair {
+    uint64_t point[2];
+    uint64_t table_offset[2];
+    int64_t turn_mask[2];
+};
+
+AMC_ALWAYS_INLINE GridPointPair grid_point_pair(const GridScale& grid, double origin0, double x0, double origin1, double x1) {
+#if AMC_SSE2
+    // grid_prediction_at in each lane, its fields made as masks.
+    const __m128d zero = _mm_setzero_pd();
+    const __m128d t = rounded(_mm_div_pd(_mm_sub_pd(_mm_set_pd(x1, x0), _mm_set_pd(origin1, origin0)), _mm_set1_pd(grid.step)));
+    const __m128d high = _mm_cmpge_pd(t, _mm_set1_pd(grid.top));
+    const __m128d inside = _mm_andnot_pd(high, _mm_cmpgt_pd(t, zero));  // not NaN either
+    // Where inside, 0 < t + 0.5 < 2^31 (kMaxQuantizationBits): the truncation is uint32_t's floor.
+    const __m128i p = _mm_cvttpd_epi32(rounded(_mm_add_pd(t, _mm_set1_pd(0.5))));
+    const __m128d f = rounded(_mm_sub_pd(t, _mm_cvtepi32_pd(p)));
+    const __m128d bin = _mm_and_pd(inside, _mm_cmpge_pd(_mm_andnot_pd(_mm_set1_pd(-0.0), f), _mm_set1_pd(0.25)));
+    const __m128d turn = _mm_and_pd(inside, _mm_cmplt_pd(f, zero));
+    const __m128i point = _mm_or_si128(_mm_and_si128(_mm_castpd_si128(inside), _mm_unpacklo_epi32(p, _mm_setzero_si128())),
+                                       _mm_and_si128(_mm_castpd_si128(high), _mm_set1_epi64x(int64_t(grid.max))));
+    GridPointPair out;
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out.point), point);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out.table_offset),
+                     _mm_and_si128(_mm_castpd_si128(bin), _mm_set1_epi64x(int64_t(sizeof(GridTable)))));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out.turn_mask), _mm_castpd_si128(turn));
+    return out;
+#else
+    const GridPoint g0 = grid_point_of(grid_prediction_at(grid, origin0, x0));
+    const GridPoint g1 = grid_point_of(grid_prediction_at(grid, origin1, x1));
+    return {{g0.point, g1.point}, {g0.table_offset, g1.table_offset}, {g0.turn_mask, g1.turn_mask}};
+#endif
+}
+
 // A vertex's frame as the fast path reads it: midpoint and normal in axis order, the frame's axis
 // (0 without a normal: role_axes') and role 0's grid prediction.
 struct GridFrame {
     double midpoint[3], normal[3];
-    GridPrediction first;
+    GridPoint first;
     int axis;
     bool has_normal;
 };
@@ -1264,8 +1351,45 @@ AMC_ALWAYS_INLINE void set_grid_frame(const NormalFrame& f, const GridScale& gri
     g.normal[2] = f.normal.z;
     g.has_normal = f.has_normal;
     g.axis = f.has_normal ? f.axis : 0;
-    g.first = grid_prediction_at(grid, origin[g.axis], g.midpoint[g.axis]);
+    g.first = grid_point_of(grid_prediction_at(grid, origin[g.axis], g.midpoint[g.axis]));
 }
+
+#if AMC_SSE2
+// set_grid_frame for two vertices at once from frame_pair_lanes (each vertex in one lane):
+// set_axis's choice by lane masks, the coordinates stored from the lanes, role 0's grid
+// predictions in one pair. The same operations on the same values, so the same frames.
+AMC_ALWAYS_INLINE void set_grid_frame_pair(const FramePairLanes& l, const GridScale& grid, const double* origin, GridFrame& g0,
+                                           GridFrame& g1) {
+    _mm_storel_pd(&g0.midpoint[0], l.mx);
+    _mm_storeh_pd(&g1.midpoint[0], l.mx);
+    _mm_storel_pd(&g0.midpoint[1], l.my);
+    _mm_storeh_pd(&g1.midpoint[1], l.my);
+    _mm_storel_pd(&g0.midpoint[2], l.mz);
+    _mm_storeh_pd(&g1.midpoint[2], l.mz);
+    _mm_storel_pd(&g0.normal[0], l.nx);
+    _mm_storeh_pd(&g1.normal[0], l.nx);
+    _mm_storel_pd(&g0.normal[1], l.ny);
+    _mm_storeh_pd(&g1.normal[1], l.ny);
+    _mm_storel_pd(&g0.normal[2], l.nz);
+    _mm_storeh_pd(&g1.normal[2], l.nz);
+    // set_axis: the first axis of largest |N_i|, and whether it is positive and finite.
+    const __m128d sign = _mm_set1_pd(-0.0);
+    const __m128d x = _mm_andnot_pd(sign, l.nx), y = _mm_andnot_pd(sign, l.ny), z = _mm_andnot_pd(sign, l.nz);
+    const __m128d y_wins = _mm_cmpgt_pd(y, x);
+    const __m128d best = _mm_max_pd(y, x);  // maxpd: y where y > x, else x (NaN as set_axis)
+    const __m128d z_wins = _mm_cmpgt_pd(z, best);
+    const __m128d largest = _mm_max_pd(z, best);  // z where z > best, else best
+    const int has = _mm_movemask_pd(_mm_and_pd(_mm_cmpgt_pd(largest, _mm_setzero_pd()), _mm_cmplt_pd(largest, _mm_set1_pd(HUGE_VAL))));
+    const int ys = _mm_movemask_pd(y_wins), zs = _mm_movemask_pd(z_wins);
+    g0.has_normal = (has & 1) != 0;
+    g1.has_normal = (has & 2) != 0;
+    g0.axis = has & 1 ? (zs & 1 ? 2 : ys & 1) : 0;
+    g1.axis = has & 2 ? (zs & 2 ? 2 : (ys >> 1) & 1) : 0;
+    const GridPointPair first = grid_point_pair(grid, origin[g0.axis], g0.midpoint[g0.axis], origin[g1.axis], g1.midpoint[g1.axis]);
+    g0.first = {first.point[0], first.table_offset[0], first.turn_mask[0]};
+    g1.first = {first.point[1], first.table_offset[1], first.turn_mask[1]};
+}
+#endif
 
 // Coordinate `axis` of `p`, written through its object representation (Vec3 is three doubles).
 AMC_ALWAYS_INLINE void set_coordinate(Vec3& p, int axis, double value) {
@@ -1274,21 +1398,27 @@ AMC_ALWAYS_INLINE void set_coordinate(Vec3& p, int axis, double value) {
 static_assert(sizeof(Vec3) == 3 * sizeof(double) && offsetof(Vec3, y) == sizeof(double) && offsetof(Vec3, z) == 2 * sizeof(double),
               "Vec3 is x, y, z");
 
-// Role 0's coordinate from its grid value q0, and where roles 1 and 2 are predicted from it
-// (predict_others' line along the frame's normal); a0, a1, a2 are the roles' axes.
-struct GridFirstRole {
-    double value, second, third;
-};
-
-AMC_ALWAYS_INLINE GridFirstRole grid_first_role(const GridFrame& f, int64_t q0, const GridScale& grid,
-                                                const double* origin, int a0, int a1, int a2) {
-    GridFirstRole r{origin[a0] + rounded(static_cast<double>(q0) * grid.step), f.midpoint[a1], f.midpoint[a2]};
+// Role 0's grid value q0 of a frame whose roles 1 and 2 are the axes a1 and a2: its coordinate,
+// written to `p`, and roles 1 and 2's grid predictions (predict_others' line along the normal).
+AMC_ALWAYS_INLINE GridPointPair grid_first_role(const GridFrame& f, int64_t q0, const GridScale& grid, const double* origin,
+                                                int a1, int a2, Vec3& p) {
+    const int a0 = f.axis;
+    const double value = origin[a0] + rounded(static_cast<double>(q0) * grid.step);
+    set_coordinate(p, a0, value);
+    double second = f.midpoint[a1], third = f.midpoint[a2];
     if (f.has_normal) {
-        const double u = rounded((r.value - f.midpoint[a0]) / f.normal[a0]);
-        r.second = r.second + rounded(u * f.normal[a1]);
-        r.third = r.third + rounded(u * f.normal[a2]);
+        const double u = rounded((value - f.midpoint[a0]) / f.normal[a0]);
+        second = second + rounded(u * f.normal[a1]);
+        third = third + rounded(u * f.normal[a2]);
     }
-    return r;
+    return grid_point_pair(grid, origin[a1], second, origin[a2], third);
+}
+
+// Roles 1 and 2's coordinates (axes a1 and a2) from their grid values.
+AMC_ALWAYS_INLINE void set_other_roles(int64_t q1, int64_t q2, const GridScale& grid, const double* origin, int a1, int a2,
+                                       Vec3& p) {
+    set_coordinate(p, a1, origin[a1] + rounded(static_cast<double>(q1) * grid.step));
+    set_coordinate(p, a2, origin[a2] + rounded(static_cast<double>(q2) * grid.step));
 }
 
 // decode_vertex<State, true> over a GridFrame: role r's axis is the frame's axis, then the two
@@ -1296,28 +1426,17 @@ AMC_ALWAYS_INLINE GridFirstRole grid_first_role(const GridFrame& f, int64_t q0, 
 template <int State, bool Safe>
 AMC_ALWAYS_INLINE bool decode_grid_vertex(StencilStreams& s, const GridTable* t, const GridFrame& f, const GridScale& grid,
                                           const double* origin, Vec3& p) {
-    const int a0 = f.axis, a1 = a0 == 0 ? 1 : 0, a2 = a0 == 2 ? 1 : 2;
-    const int64_t q0 = int64_t(f.first.p) + negated_if(grid_token<State, Safe>(s, t[f.first.bin]), f.first.turn);
+    const int64_t q0 = grid_point_value<State, Safe>(s, t, f.first.point, f.first.table_offset, f.first.turn_mask);
     if (uint64_t(q0) > grid.max) return false;  // also q0 < 0
-    const GridFirstRole first = grid_first_role(f, q0, grid, origin, a0, a1, a2);
-    const double v0 = first.value;
-    const GridPrediction g1 = grid_prediction_at(grid, origin[a1], first.second);
-    const GridPrediction g2 = grid_prediction_at(grid, origin[a2], first.third);
-    const int64_t q1 = int64_t(g1.p) + negated_if(grid_token<1 - State, Safe>(s, t[kGridBins + g1.bin]), g1.turn);
+    const int a1 = f.axis == 0 ? 1 : 0, a2 = f.axis == 2 ? 1 : 2;
+    const GridPointPair g = grid_first_role(f, q0, grid, origin, a1, a2, p);
+    const int64_t q1 = grid_point_value<1 - State, Safe>(s, t + kGridBins, g.point[0], g.table_offset[0], g.turn_mask[0]);
     if (uint64_t(q1) > grid.max) return false;
-    const int64_t q2 = int64_t(g2.p) + negated_if(grid_token<State, Safe>(s, t[2 * kGridBins + g2.bin]), g2.turn);
+    const int64_t q2 = grid_point_value<State, Safe>(s, t + 2 * kGridBins, g.point[1], g.table_offset[1], g.turn_mask[1]);
     if (uint64_t(q2) > grid.max) return false;
-    set_coordinate(p, a0, v0);
-    set_coordinate(p, a1, origin[a1] + rounded(static_cast<double>(q1) * grid.step));
-    set_coordinate(p, a2, origin[a2] + rounded(static_cast<double>(q2) * grid.step));
+    set_other_roles(q1, q2, grid, origin, a1, a2, p);
     return true;
 }
-
-// The grouped order's vertex between its role-0 token and its roles 1 and 2: role 0's grid
-// coordinate, then roles 1 and 2's grid predictions.
-struct GridSecond {
-    GridPrediction g1, g2;
-};
 
 // decode_grid_vertex's work in the grouped order (version 18, FORMAT.md 5.7) over a chunk of
 // `count` vertices: their role-0 tokens (vertex i with state i mod 2), each followed by its
@@ -1329,19 +1448,16 @@ struct GridSecond {
 template <bool Safe>
 AMC_ALWAYS_INLINE bool decode_grid_grouped(StencilStreams& s, const GridTable* t, const GridFrame* frames, size_t count,
                                            const GridScale& grid, const double* origin, Vec3* decoded) {
-    GridSecond second[kChunk];
+    GridPointPair second[kChunk];
     uint64_t out_of_range = 0;
     // Role 0's token of vertex k with state `State`, then its value and roles 1 and 2's
     // predictions, which the next token does not wait for.
     auto first = [&](auto state, size_t k) {
         constexpr int State = decltype(state)::value;
         const GridFrame& f = frames[k];
-        const int64_t q0 = int64_t(f.first.p) + negated_if(grid_token<State, Safe>(s, t[f.first.bin]), f.first.turn);
-        const int a0 = f.axis, a1 = a0 == 0 ? 1 : 0, a2 = a0 == 2 ? 1 : 2;
+        const int64_t q0 = grid_point_value<State, Safe>(s, t, f.first.point, f.first.table_offset, f.first.turn_mask);
         out_of_range |= uint64_t(q0) > grid.max;  // also q0 < 0
-        const GridFirstRole role0 = grid_first_role(f, q0, grid, origin, a0, a1, a2);
-        second[k] = {grid_prediction_at(grid, origin[a1], role0.second), grid_prediction_at(grid, origin[a2], role0.third)};
-        set_coordinate(decoded[k], a0, role0.value);
+        second[k] = grid_first_role(f, q0, grid, origin, f.axis == 0 ? 1 : 0, f.axis == 2 ? 1 : 2, decoded[k]);
     };
     size_t k = 0;
     for (; k + 1 < count; k += 2) {
@@ -1353,13 +1469,12 @@ AMC_ALWAYS_INLINE bool decode_grid_grouped(StencilStreams& s, const GridTable* t
     auto roles_1_2 = [&](auto odd) {
         constexpr int S = decltype(odd)::value ? 1 : 0;  // role 1's state: count mod 2
         for (size_t i = 0; i < count; ++i) {
-            const GridSecond& g = second[i];
-            const int64_t q1 = int64_t(g.g1.p) + negated_if(grid_token<S, Safe>(s, t[kGridBins + g.g1.bin]), g.g1.turn);
-            const int64_t q2 = int64_t(g.g2.p) + negated_if(grid_token<1 - S, Safe>(s, t[2 * kGridBins + g.g2.bin]), g.g2.turn);
+            const GridPointPair& g = second[i];
+            const int64_t q1 = grid_point_value<S, Safe>(s, t + kGridBins, g.point[0], g.table_offset[0], g.turn_mask[0]);
+            const int64_t q2 = grid_point_value<1 - S, Safe>(s, t + 2 * kGridBins, g.point[1], g.table_offset[1], g.turn_mask[1]);
             if ((uint64_t(q1) > grid.max) | (uint64_t(q2) > grid.max)) return false;
-            const int a0 = frames[i].axis, a1 = a0 == 0 ? 1 : 0, a2 = a0 == 2 ? 1 : 2;
-            set_coordinate(decoded[i], a1, origin[a1] + rounded(static_cast<double>(q1) * grid.step));
-            set_coordinate(decoded[i], a2, origin[a2] + rounded(static_cast<double>(q2) * grid.step));
+            const int a0 = frames[i].axis;
+            set_other_roles(q1, q2, grid, origin, a0 == 0 ? 1 : 0, a0 == 2 ? 1 : 2, decoded[i]);
         }
         return true;
     };
@@ -1401,12 +1516,8 @@ bool decode_grid_listed(Hierarchy& h, const FromList& created, const Quantizer& 
         }
         size_t i = 0;
 #if AMC_SSE2
-        for (; i + 1 < count; i += 2) {
-            NormalFrame f0, f1;
-            frame_pair_of<true>(h, corners[i], corners[i + 1], f0, f1);
-            set_grid_frame(f0, grid, origin, frames[i]);
-            set_grid_frame(f1, grid, origin, frames[i + 1]);
-        }
+        for (; i + 1 < count; i += 2)
+            set_grid_frame_pair(frame_pair_lanes<true>(h, corners[i], corners[i + 1]), grid, origin, frames[i], frames[i + 1]);
 #endif
         for (; i < count; ++i) set_grid_frame(frame_of<true>(h, corners[i]), grid, origin, frames[i]);
         auto run = [&](auto safe) {
