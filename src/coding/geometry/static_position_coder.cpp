@@ -1418,16 +1418,17 @@ AMC_ALWAYS_INLINE bool decode_grid_vertex(StencilStreams& s, const GridTable* t,
 // 1.5 % fewer instructions, 1-9 % more time; the chain then runs with nothing beside it.)
 template <bool Safe>
 AMC_ALWAYS_INLINE bool decode_grid_grouped(StencilStreams& s, const GridTable* t, const GridFrame* frames, size_t count,
-                                           const GridScale& grid, const double* origin, Vec3* decoded) {
+                                           const GridScale& level_grid, const double* origin, Vec3* decoded) {
+    const GridScale grid = level_grid;  // a local copy: the stores to `decoded` could alias the caller's
     GridPointPair second[kChunk];
-    uint64_t out_of_range = 0;
+    uint64_t largest = 0;  // of the role-0 grid values, as unsigned: a negative one is larger than any
     // Role 0's token of vertex k with state `State`, then its value and roles 1 and 2's
     // predictions, which the next token does not wait for.
     auto first = [&](auto state, size_t k) {
         constexpr int State = decltype(state)::value;
         const GridFrame& f = frames[k];
         const int64_t q0 = grid_point_value<State, Safe>(s, t, f.first.point, f.first.table_offset, f.first.turn_mask);
-        out_of_range |= uint64_t(q0) > grid.max;  // also q0 < 0
+        largest = std::max(largest, uint64_t(q0));
         second[k] = grid_first_role(f, q0, grid, origin, f.axis == 0 ? 1 : 0, f.axis == 2 ? 1 : 2, decoded[k]);
     };
     size_t k = 0;
@@ -1436,7 +1437,7 @@ AMC_ALWAYS_INLINE bool decode_grid_grouped(StencilStreams& s, const GridTable* t
         first(std::integral_constant<int, 1>{}, k + 1);
     }
     if (k < count) first(std::integral_constant<int, 0>{}, k);
-    if (out_of_range != 0) return false;
+    if (largest > grid.max) return false;  // also a q0 < 0
     auto roles_1_2 = [&](auto odd) {
         constexpr int S = decltype(odd)::value ? 1 : 0;  // role 1's state: count mod 2
         for (size_t i = 0; i < count; ++i) {
