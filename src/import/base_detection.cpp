@@ -69,10 +69,6 @@ void undo_levels_from(const std::vector<Triangle>& triangles, uint32_t vertex_co
     }
 }
 
-// A search whose base keeps more than 1/kSearchedAgainBelow of the leaf triangles is run again in
-// another order (detect_base).
-constexpr size_t kSearchedAgainBelow = 16;
-
 size_t base_size(const SearchRun& run, size_t leaf_triangles) {
     return run.levels.empty() ? leaf_triangles : run.levels.back().triangles.size();
 }
@@ -195,6 +191,11 @@ void renumber(std::vector<Triangle>& triangles, const std::vector<uint32_t>& id)
 
 }  // namespace detail
 
+bool searched_again(size_t base, size_t leaf, size_t levels) {
+    constexpr size_t kFarFromBase = 16, kReadMuch = 10;  // base > leaf / 16; base <= leaf * 9 / 10
+    return base * kFarFromBase > leaf && (base * kReadMuch <= leaf * (kReadMuch - 1) || levels == 0);
+}
+
 DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what) {
     validate_triangle_mesh(mesh, what);
     const uint32_t vertex_count = uint32_t(mesh.positions.size());
@@ -207,11 +208,10 @@ DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what) {
     std::vector<Triangle> renumbered = mesh.triangles;
     detail::renumber(renumbered, search_of);
     // The search takes the triangles' order wherever two readings tie, and in some orders a few
-    // wrong early readings keep it far from the base: a search that leaves many triangles is run
-    // again over them in reverse order, and the coarser base stands (docs/IMPORT.md, "Searched
-    // twice").
+    // wrong early readings keep it far from the base: such a search is run again over the
+    // triangles in reverse order, and the coarser base stands (docs/IMPORT.md, "Searched twice").
     SearchRun run = search_levels(renumbered, vertex_count);
-    if (base_size(run, renumbered.size()) * kSearchedAgainBelow > renumbered.size()) {
+    if (searched_again(base_size(run, renumbered.size()), renumbered.size(), run.levels.size())) {
         const std::vector<Triangle> reversed(renumbered.rbegin(), renumbered.rend());
         SearchRun other = search_levels(reversed, vertex_count);
         if (base_size(other, renumbered.size()) < base_size(run, renumbered.size())) run = std::move(other);
