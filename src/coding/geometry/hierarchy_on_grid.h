@@ -20,6 +20,8 @@ public:
     NodeId neighbor(NodeId n, int e) const { return h_.neighbor(n, e); }
     int neighbor_edge(NodeId n, int e) const { return h_.neighbor_edge(n, e); }
     VertexId midpoint(NodeId n, int e) const { return h_.midpoint(n, e); }
+    NodeId child(NodeId n, int k) const { return h_.child(n, k); }
+    const Hierarchy& nodes() const { return h_; }
 
     const std::vector<Vec3>& positions() const { return positions_; }
     Vec3 position(VertexId v) const { return positions_[v]; }

@@ -112,10 +112,11 @@ struct GridPrediction {
 struct GridScale {
     double step = 0.0, top = 0.0;
     uint32_t max = 0;
+    double inverse_step = 0.0;  // 1 / step, for grid_point_of_grid_value
 };
 GridScale grid_scale(const Quantizer* quantizer) {
     if (quantizer == nullptr) return {};
-    return {quantizer->step, static_cast<double>(quantizer->max_coordinate()), quantizer->max_coordinate()};
+    return {quantizer->step, static_cast<double>(quantizer->max_coordinate()), quantizer->max_coordinate(), 1.0 / quantizer->step};
 }
 
 // Inlined: returned through memory, the small struct stalls the decoder's loop on a store forward.
@@ -141,11 +142,23 @@ AMC_ALWAYS_INLINE uint32_t grid_point_at(const GridScale& grid, double origin, d
     return static_cast<uint32_t>(t + 0.5);
 }
 
-// The residual of an actual grid point against a prediction's.
+// grid_point_at of an x that is a grid value, origin + rounded(q * step) (the encoder's actual
+// positions): q, with a product in place of the division (a fifth of the encoder's coordinate
+// loop waited on it). t is then q within a few ulps, far from the half-way points where the two
+// could round apart.
+AMC_ALWAYS_INLINE uint32_t grid_point_of_grid_value(const GridScale& grid, double origin, double x) {
+    const double t = (x - origin) * grid.inverse_step;
+    if (!(t > 0.0)) return 0;
+    if (t >= grid.top) return grid.max;
+    return static_cast<uint32_t>(t + 0.5);
+}
+
+// The residual of an actual grid point against a prediction's. Without branches: turns and signs
+// are coin flips.
 AMC_ALWAYS_INLINE Residual grid_residual(uint32_t actual, const GridPrediction& g) {
-    const int64_t d = int64_t(actual) - int64_t(g.p);
-    const int64_t s = g.turn ? -d : d;
-    return {s < 0, uint64_t(s < 0 ? -s : s)};
+    const int64_t s = negated_if(int64_t(actual) - int64_t(g.p), g.turn);
+    const int64_t sign = s >> 63;
+    return {sign != 0, uint64_t((s ^ sign) - sign)};
 }
 
 // `origin`: the quantizer's origin on the axis (dequantize_coordinate's); `residual` signed
@@ -290,6 +303,10 @@ struct Chunk {
     std::array<GridPrediction, kChunk> first;  // mode 4: role 0's
 };
 
+// Hints the processor to fetch node n of the hierarchy the mesh reads.
+AMC_ALWAYS_INLINE void prefetch_node(const Hierarchy& h, NodeId n) { HierarchyBuilder::prefetch(h, n); }
+AMC_ALWAYS_INLINE void prefetch_node(const HierarchyOnGrid& h, NodeId n) { HierarchyBuilder::prefetch(h.nodes(), n); }
+
 // Where the vertices and their frame corners come from: (node, edge) pairs, read in the hierarchy,
 // or split_level's list (vertices first, first + 1, ...).
 // get(c) sets the corners and vertices of chunk c's c.count vertices from c.begin.
@@ -299,7 +316,19 @@ struct FromNodes {
     const std::vector<std::pair<NodeId, int>>& created;
     size_t size() const { return created.size(); }
     bool appends(const Hierarchy&) const { return false; }
+    // The encoder visits a level's nodes in the base coder's root order, which is not the input's:
+    // nearly every node read misses the cache. So the reads go in stages, each over the whole chunk:
+    // the next chunk's nodes are fetched ahead, then this chunk's centre children and neighbours
+    // (known from its nodes), then their vertices are read, many misses in flight at once.
     void get(Chunk& c) const {
+        const size_t next_end = std::min(created.size(), c.begin + 2 * kChunk);
+        for (size_t i = c.begin + c.count; i < next_end; ++i) prefetch_node(h, created[i].first);
+        for (size_t i = 0; i < c.count; ++i) {
+            const auto [n, e] = created[c.begin + i];
+            prefetch_node(h, h.child(n, red_split::kCenter));
+            const NodeId q = h.neighbor(n, e);
+            if (q != kNoNode) prefetch_node(h, q);
+        }
         for (size_t i = 0; i < c.count; ++i) {
             const auto [n, e] = created[c.begin + i];
             c.own[i] = frame_corners(h, n, e);
@@ -488,12 +517,12 @@ void StaticLevelEncoder::add_vertices(const Mesh& h, const std::vector<std::pair
                 int table = role;
                 if (GridBins) {
                     const GridPrediction g = role == 0 ? c.first[i] : grid_prediction_at(grid, f.origin[role], predicted[role]);
-                    r = grid_residual(grid_point_at(grid, f.origin[role], actual[axis]), g);
+                    r = grid_residual(grid_point_of_grid_value(grid, f.origin[role], actual[axis]), g);
                     table = kGridBins * role + g.bin;
                 } else if (Residuals == kFloat64Residuals) {
                     r = float64_residual(actual[axis], predicted[role]);
                 } else if (Residuals == kGridResiduals) {  // residual_of's grid points, with the level's GridScale
-                    const uint32_t a = grid_point_at(grid, f.origin[role], actual[axis]);
+                    const uint32_t a = grid_point_of_grid_value(grid, f.origin[role], actual[axis]);
                     const uint32_t q = grid_point_at(grid, f.origin[role], predicted[role]);
                     r = {a < q, a < q ? uint64_t(q - a) : uint64_t(a - q)};
                 } else {
