@@ -3,7 +3,7 @@
 // the second model (.amc version 10, FORMAT.md 2.2) re-implemented here with switches and with
 // study-only features (Extra); exact adaptive code lengths, so one run gives the table. The first
 // row is the coder's own newest model (the third, version 11); the re-implementation's default must
-// equal the coder's second model (checked). ONLY=text runs only the designs whose name holds it;
+// equal the coder's second model (checked). ONLY=text runs only the designs whose name holds it (or one of a|b|c);
 // CACHE_DIR as bench/mixing_study; WEIGHTS_OUT=prefix writes the mixers' weights the models end
 // with (averaged over the models) for each design with trained start weights, WEIGHTS_IN=prefix
 // starts those designs from such files instead of leaving each model out of its own start.
@@ -18,6 +18,11 @@
 // Designs "S:", "K6:", "G6:", "C6" (2026-12-05): wider quadrics (least squares over two rings, the
 // quadric's ring means), SSE after the final mean, mixer sets by level band, the refinement two
 // levels up, and the sixth model ("C6h: C6d without 0 5"; docs/HIERARCHY_CODER.md, "The sixth model").
+// Designs "R7:" (2026-12-05 morning): the sixth model plus its own errors as contexts (the
+// probability it gave the parent's symbol, the residuals of the coded nodes two edges around,
+// filled while coding from Links), slower or confidence-scaled fresh slots, trained initial states
+// and its learning-cost bound ("Beyond the sixth model"). PER_LEVEL=name prints that design's bits
+// per level to stderr.
 //   [CACHE_DIR=dir] [ONLY=text] [WEIGHTS_OUT=prefix | WEIGHTS_IN=prefix] [TRAIN=...] [LAW_DIR=dir] model_study model.amh ...
 #include "mixed_symbols.h"
 
@@ -86,7 +91,24 @@ struct Extra {
     uint8_t qr1_h = 0, qr1_k = 0, qr2_h = 0, qr2_k = 0, cq1_h = 0, cq1_k = 0, cq2_h = 0, cq2_k = 0;
     // The ring-2 local threshold on cq1's |H| L value (as thr_ref2 on the curvature feature).
     uint8_t cthr_ref2 = 0, cthr_unref2 = 0;
+    // Session of 2026-12-05 morning (designs "R7:"): the model's own errors as contexts, filled
+    // while coding (Study::code; not in the cache): the stretched probability the study's model
+    // gave n's parent's symbol (1..16, 0 when the parent was not coded), and over the same-level
+    // nodes up to two edges away coded before n: the summed residual (bit - p) in half units
+    // around 8 (1..15, 0 for none), the same over its deviation (z), the residual over the nodes
+    // one edge away alone, and how many (at most 7).
+    uint8_t dyn_parent = 0, dyn_resid = 0, dyn_z = 0, dyn_resid1 = 0, dyn_count = 0;
 };
+
+// Which earlier symbols a symbol's dynamic features read: its parent's and those of the coded
+// same-level nodes up to two edges away (ring-1 ones first), by symbol index.
+struct Links {
+    int32_t parent = -1;
+    uint8_t ring1 = 0, all = 0;
+    int32_t earlier[12] = {};
+};
+
+constexpr size_t kCachedExtra = offsetof(Extra, dyn_parent);
 
 // sqrt of the Gauss estimate of node m (|det| of its neighbours' unit normals times L^2 over the
 // twice area), 0 without three neighbours.
@@ -307,7 +329,7 @@ std::vector<Extra> extra_features(const std::string& path, const std::filesystem
     const std::filesystem::path file = cache / (std::filesystem::path(path).stem().string() + ".x10");
     std::vector<Extra> out(count);
     if (std::ifstream in{file, std::ios::binary}) {
-        in.read(reinterpret_cast<char*>(out.data()), std::streamsize(count * sizeof(Extra)));
+        for (Extra& x : out) in.read(reinterpret_cast<char*>(&x), std::streamsize(kCachedExtra));
         if (in) return out;
     }
     const Hierarchy h = read_hierarchy(path);
@@ -529,7 +551,42 @@ std::vector<Extra> extra_features(const std::string& path, const std::filesystem
         if (longest > 0 && level_sum[0] > 0)
             x.base_size = uint8_t(std::clamp(int(std::floor(4 * std::log2(std::ldexp(longest, h.level(n)) / (level_sum[0] / level_count[0])))) + 32, 1, 63));
     }
-    std::ofstream(file, std::ios::binary).write(reinterpret_cast<const char*>(out.data()), std::streamsize(count * sizeof(Extra)));
+    std::ofstream cached(file, std::ios::binary);
+    for (const Extra& x : out) cached.write(reinterpret_cast<const char*>(&x), std::streamsize(kCachedExtra));
+    return out;
+}
+
+// The Links of each coded symbol (cached as <stem>.lk7).
+std::vector<Links> links_of(const std::string& path, const std::filesystem::path& cache, size_t count) {
+    const std::filesystem::path file = cache / (std::filesystem::path(path).stem().string() + ".lk7");
+    std::vector<Links> out(count);
+    if (std::ifstream in{file, std::ios::binary}) {
+        in.read(reinterpret_cast<char*>(out.data()), std::streamsize(count * sizeof(Links)));
+        if (in) return out;
+    }
+    const Hierarchy h = read_hierarchy(path);
+    std::vector<CodedSymbol> trace;
+    const HierarchyLevelEncoder mixed(h, HierarchyCoderOptions{}, kHierarchyStreamVersion, &trace, true);
+    std::vector<size_t> symbol_of(h.node_capacity(), SIZE_MAX);
+    for (size_t i = 0; i < trace.size(); ++i) symbol_of[trace[i].node] = std::min(symbol_of[trace[i].node], i);
+    for (size_t i = 0; i < count && i < trace.size(); ++i) {
+        const NodeId n = trace[i].node;
+        Links& k = out[i];
+        const NodeId p = h.parent(n);
+        if (p != kNoNode && symbol_of[p] < i) k.parent = int32_t(symbol_of[p]);
+        std::vector<NodeId> around = two_rings(h, n);
+        auto take = [&](NodeId q) {
+            if (q == n || symbol_of[q] >= i || k.all >= 12) return;
+            for (int j = 0; j < k.all; ++j)
+                if (k.earlier[j] == int32_t(symbol_of[q])) return;
+            k.earlier[k.all++] = int32_t(symbol_of[q]);
+        };
+        for (int e = 0; e < 3; ++e)
+            if (h.neighbor(n, e) != kNoNode) take(h.neighbor(n, e));
+        k.ring1 = k.all;
+        for (NodeId q : around) take(q);
+    }
+    std::ofstream(file, std::ios::binary).write(reinterpret_cast<const char*>(out.data()), std::streamsize(count * sizeof(Links)));
     return out;
 }
 
@@ -574,6 +631,19 @@ struct Options {
     std::function<uint32_t(const MixedFeatures&, const Extra&)> final_map;
     int final_rows = 0, final_share = 2;
     int a_band = 0;  // mixer A's sets by group x level band: 1: levels 0-2 / 3-4 / 5-7; 2: each level
+    // Session of 2026-12-05 morning (learning cost): every direct and extra model starts as if it
+    // had seen flat_count symbols at p = 1/2 (a slower KT ramp); confidence k > 0: a direct or
+    // extra model's stretched input is scaled by n / (n + k), n the symbols its slot has seen.
+    int flat_count = 0;
+    int confidence = 0;
+    // Bit histories of these extra tables (indices into `extra`), each one more input: the slot's
+    // last up to 7 bits, mapped to a probability by an adaptive table per group x history (as the
+    // second model's three), a prior learnt from every slot for the slots seen a few times.
+    std::vector<int> extra_history;
+    int prior_last_extras = 0;  // > 0: trained initial states only for the last this many extra tables
+    // > 0: a direct or extra model coded for the first time starts, before its update, at the
+    // probability the symbol was coded with, as if it had seen this many symbols (an online prior).
+    int fresh_from_final = 0;
 };
 
 // Ones and symbols per slot of every model table of a Study (direct, extra, history maps).
@@ -640,9 +710,12 @@ public:
     static constexpr int kDirect = MixedHierarchyModel::kDirect;
     static constexpr int kFixedInputs = MixedHierarchyModel::kSecondInputs;
     explicit Study(const Options& o)
-        : o_(o), inputs_(kFixedInputs + int(o.extra.size()) + 1), a_(inputs_, 80), b_(inputs_, 16), c_(inputs_, 160), d_(inputs_, 256), e_(inputs_, o.mixer_e_sets), st_(size_t(inputs_)) {
+        : o_(o), inputs_(kFixedInputs + int(o.extra.size()) + int(o.extra_history.size()) + 1), a_(inputs_, 80), b_(inputs_, 16), c_(inputs_, 160), d_(inputs_, 256), e_(inputs_, o.mixer_e_sets), st_(size_t(inputs_)) {
         extra_models_.assign(o.extra.size(), std::vector<BitModel>(1 << 16, BitModel(8)));
         extra_slot_.resize(o.extra.size());
+        extra_hist_.assign(o.extra_history.size(), std::vector<uint8_t>(1 << 16, uint8_t{1}));
+        extra_hist_map_.assign(o.extra_history.size(), std::vector<BitModel>(2560, BitModel(o.history_log2)));
+        extra_hist_slot_.resize(o.extra_history.size());
         static constexpr uint32_t kSizes[kDirect] = {10,  40,  40,   80,   50,  120, 240, 960, 1920, 2560, 640,
                                                      10240, 3840, 200, 400, 480, 160, 640, 2560, 640, 5120};
         for (int j = 0; j < kDirect; ++j) models_[size_t(j)].assign(kSizes[j], BitModel(o.window_log2));
@@ -655,6 +728,11 @@ public:
         if (o.final_map) maps_.emplace_back(o.final_rows, o.map_rate);
         if (!o.start[0].empty()) a_.start_at(o.start[0]), b_.start_at(o.start[1]), c_.start_at(o.start[2]), d_.start_at(o.start[o.mixer_d && !o.start[3].empty() ? 3 : 1]), e_.start_at(o.start[0]);
         for (std::vector<BitModel>* t : tables()) counts_.tables.emplace_back(t->size(), std::array<uint32_t, 2>{0, 0});
+        if (o.flat_count > 0) {
+            const std::vector<std::vector<BitModel>*> all = tables();
+            for (size_t t = 0; t + 3 < all.size(); ++t)
+                for (BitModel& m : *all[t]) m.n = uint16_t(o.flat_count);
+        }
         if (o.priors && o.prior_count > 0) {
             const std::vector<std::vector<BitModel>*> all = tables();
             const size_t last = o.prior_maps ? all.size() : all.size() - 3;
@@ -662,9 +740,13 @@ public:
             // curvature, size or Gauss bins.
             auto geometric = [&](size_t t) { return (t >= 6 && t <= 12) || (t >= 18 && t < all.size() - 3); };
             for (size_t t = 0; t < last; ++t)
-                for (size_t i = 0; i < all[t]->size() && (!o.prior_geometric_only || geometric(t)); ++i) {
+                for (size_t i = 0; i < all[t]->size() && (!o.prior_geometric_only || geometric(t)) &&
+                                   (o.prior_last_extras == 0 || (t + 3 + size_t(o.prior_last_extras) >= all.size() && t + 3 < all.size()));
+                     ++i) {
                     const auto [ones, n] = o.priors->tables[t][i];
+                    ++prior_slots_[0];
                     if (n == 0) continue;
+                    ++prior_slots_[1];
                     BitModel& m = (*all[t])[i];
                     const double p = (ones + 0.4) / (n + 0.8);
                     m.p = uint32_t(std::clamp(p * 4294967296.0, 65536.0, 4294967296.0 - 65536.0));
@@ -681,18 +763,23 @@ public:
         return all;
     }
     Counts counts_;
+    std::array<size_t, 2> prior_slots_{};  // slots of the tables with trained initial states, and those the training reached
     std::array<std::vector<double>, 4> mean_weights() const {
         return {a_.mean_weights(), b_.mean_weights(), c_.mean_weights(), o_.mixer_d ? d_.mean_weights() : std::vector<double>{}};
     }
 
     std::array<double, 8> level_bits{}, level_symbols{}, level_ones{};
-    double code(const std::vector<Symbol>& symbols, const std::vector<Extra>& extra) {
+    double code(const std::vector<Symbol>& symbols, const std::vector<Extra>& extra, const std::vector<Links>* links = nullptr) {
         double bits = 0;
+        std::vector<int16_t> p_of(symbols.size(), 2048);
         for (int pass = 0; pass < (o_.prime ? 2 : 1); ++pass) {
             bits = 0;
             for (size_t i = 0; i < symbols.size(); ++i) {
                 const Symbol& s = symbols[i];
-                const int p = p12(s.f, extra[i]);
+                Extra xi = extra[i];
+                if (links) fill_dynamic(xi, (*links)[i], p_of, symbols);
+                const int p = p12(s.f, xi);
+                p_of[i] = int16_t(p);
                 const double b = -std::log2(s.bit ? p / 4096.0 : 1 - p / 4096.0);
                 bits += b;
                 level_bits[s.f.level] += b, level_symbols[s.f.level] += 1, level_ones[s.f.level] += s.bit;
@@ -704,6 +791,23 @@ public:
 
 private:
     static constexpr int kIndirectOf[3] = {1, 4, 11};
+
+    static void fill_dynamic(Extra& x, const Links& k, const std::vector<int16_t>& p_of, const std::vector<Symbol>& symbols) {
+        if (k.parent >= 0) x.dyn_parent = uint8_t(1 + std::clamp((mixing::stretch(p_of[size_t(k.parent)]) + 2048) >> 8, 0, 15));
+        double d = 0, v = 0, d1 = 0;
+        for (int j = 0; j < k.all; ++j) {
+            const double p = p_of[size_t(k.earlier[j])] / 4096.0;
+            const double r = symbols[size_t(k.earlier[j])].bit - p;
+            d += r, v += p * (1 - p);
+            if (j < k.ring1) d1 += r;
+        }
+        x.dyn_count = uint8_t(std::min<int>(k.all, 7));
+        if (k.all) {
+            x.dyn_resid = uint8_t(std::clamp(int(std::floor(2 * d)) + 8, 1, 15));
+            x.dyn_z = uint8_t(std::clamp(int(std::floor(2 * d / std::sqrt(v + 0.05))) + 8, 1, 15));
+        }
+        if (k.ring1) x.dyn_resid1 = uint8_t(std::clamp(int(std::floor(2 * d1)) + 8, 1, 15));
+    }
 
     int p12(const MixedFeatures& f, const Extra& x) {
         const uint32_t g = f.group;
@@ -728,6 +832,7 @@ private:
                 m.n = uint16_t(o_.inherit_models);
             }
             st_[size_t(j)] = mixing::stretch(mixing::p12_of(m));
+            if (o_.confidence) st_[size_t(j)] = st_[size_t(j)] * int(m.n) / (int(m.n) + o_.confidence);
         }
         for (int k = 0; k < 3; ++k) {
             hctx_[size_t(k)] = slot_[size_t(kIndirectOf[k])];
@@ -737,6 +842,15 @@ private:
         for (size_t e = 0; e < o_.extra.size(); ++e) {
             extra_slot_[e] = o_.extra[e](f, x) & 0xffff;
             st_[size_t(kFixedInputs) + e] = mixing::stretch(mixing::p12_of(extra_models_[e][extra_slot_[e]]));
+            if (o_.confidence) {
+                const int n = extra_models_[e][extra_slot_[e]].n;
+                st_[size_t(kFixedInputs) + e] = st_[size_t(kFixedInputs) + e] * n / (n + o_.confidence);
+            }
+        }
+        for (size_t k = 0; k < o_.extra_history.size(); ++k) {
+            const uint32_t slot = extra_slot_[size_t(o_.extra_history[k])];
+            extra_hist_slot_[k] = g * 256 + extra_hist_[k][slot];
+            st_[size_t(kFixedInputs) + o_.extra.size() + k] = mixing::stretch(mixing::p12_of(extra_hist_map_[k][extra_hist_slot_[k]]));
         }
         for (int j = 0; j < inputs_ - 1; ++j)
             if (o_.drop >> j & 1) st_[size_t(j)] = 0;
@@ -783,10 +897,18 @@ private:
             p = std::clamp((p + maps_[5].refine(p, rows[5]) + 1) >> 1, 1, 4095);
             used_maps_ = 6;
         }
+        p_final_ = p;
         return p;
     }
 
     void update(bool bit) {
+        if (o_.fresh_from_final > 0) {
+            auto start = [&](BitModel& m) {
+                if (m.n == 0) m.p = uint32_t(p_final_) << 20, m.n = uint16_t(o_.fresh_from_final);
+            };
+            for (int j = 0; j < kDirect; ++j) start(models_[size_t(j)][slot_[size_t(j)]]);
+            for (size_t e = 0; e < extra_slot_.size(); ++e) start(extra_models_[e][extra_slot_[e]]);
+        }
         {
             size_t t = 0;
             for (int j = 0; j < kDirect; ++j, ++t) counts_.tables[t][slot_[size_t(j)]][0] += bit, ++counts_.tables[t][slot_[size_t(j)]][1];
@@ -803,6 +925,11 @@ private:
         if (o_.final_map) maps_[6 + o_.extra_maps.size()].update(bit);
         for (int j = 0; j < kDirect; ++j) models_[size_t(j)][slot_[size_t(j)]].update(bit);
         for (size_t e = 0; e < extra_slot_.size(); ++e) extra_models_[e][extra_slot_[e]].update(bit);
+        for (size_t k = 0; k < o_.extra_history.size(); ++k) {
+            extra_hist_map_[k][extra_hist_slot_[k]].update(bit);
+            uint8_t& h = extra_hist_[k][extra_slot_[size_t(o_.extra_history[k])]];
+            h = uint8_t(h < 128 ? h * 2 + bit : 128 + ((h * 2 + bit) & 127));
+        }
         for (int k = 0; k < 3; ++k) {
             history_maps_[size_t(k)][hslot_[size_t(k)]].update(bit);
             uint8_t& h = histories_[size_t(k)][hctx_[size_t(k)]];
@@ -816,6 +943,9 @@ private:
     std::array<std::vector<BitModel>, kDirect> models_;
     std::vector<std::vector<BitModel>> extra_models_;
     std::vector<uint32_t> extra_slot_;
+    std::vector<std::vector<uint8_t>> extra_hist_;
+    std::vector<std::vector<BitModel>> extra_hist_map_;
+    std::vector<uint32_t> extra_hist_slot_;
     std::array<std::vector<uint8_t>, 3> histories_;
     std::array<std::vector<BitModel>, 3> history_maps_;
     std::array<uint32_t, 3> hctx_{}, hslot_{};
@@ -824,6 +954,7 @@ private:
     std::vector<int> st_;
     std::vector<mixing::ProbabilityMap> maps_;
     int used_maps_ = 5;
+    int p_final_ = 2048;
     uint32_t last_ = 0;
     int level_ = -1;
 };
@@ -834,9 +965,11 @@ int main(int argc, char** argv) {
     const std::filesystem::path cache = std::getenv("CACHE_DIR") ? std::getenv("CACHE_DIR") : "/tmp/mixing_study";
     std::vector<ModelData> data;
     std::vector<std::vector<Extra>> extras;
+    std::vector<std::vector<Links>> links;
     for (int a = 1; a < argc; ++a) {
         data.push_back(mixed_study::load(argv[a], cache));
         extras.push_back(extra_features(argv[a], cache, data.back().symbols.size()));
+        links.push_back(links_of(argv[a], cache, data.back().symbols.size()));
     }
     struct Design {
         std::string name;
@@ -1325,6 +1458,57 @@ int main(int argc, char** argv) {
         for (int j : dropped) d |= uint64_t{1} << j, name += " " + std::to_string(j);
         add(name, [&, d](Options& o) { c6(o, 2), o.drop |= d, o.extra_set_b = 4; });
     }
+    // Session of 2026-12-05 morning: the sixth model (C6h) plus the model's own errors as contexts.
+    auto sixth_coded = [&](Options& o) { c6(o, 2), o.drop |= drops({19, 20, 27, 0, 5}), o.extra_set_b = 4; };
+    add("R7: sixth model (C6h)", sixth_coded);
+    auto r7_plus = plus("R7: sixth", sixth_coded);
+    auto parent_p = [](F f, X x) { return (x.dyn_parent * 8u + f.level) * 2 + f.center; };
+    auto resid_count = [](F f, X x) { return (x.dyn_resid * 8u + x.dyn_count) * 8 + f.level; };
+    auto z_count = [](F f, X x) { return (x.dyn_z * 8u + x.dyn_count) * 8 + f.level; };
+    r7_plus("parent p x level x center", {parent_p});
+    r7_plus("resid x count x level", {resid_count});
+    r7_plus("z x count x level", {z_count});
+    r7_plus("resid x group x resid1", {[](F f, X x) { return (f.group * 16u + x.dyn_resid) * 16 + x.dyn_resid1; }});
+    r7_plus("parent p x level x center, z x count x level", {parent_p, z_count});
+    add("R7: sixth, learning-cost bound (symbols coded twice, second pass counted)", [&](Options& o) { sixth_coded(o), o.prime = true; });
+    for (int c : {2, 4, 8}) add("R7: sixth, fresh slots start at count " + std::to_string(c), [&, c](Options& o) { sixth_coded(o), o.flat_count = c; });
+    for (int k : {1, 2, 4}) add("R7: sixth, inputs by confidence n / (n + " + std::to_string(k) + ")", [&, k](Options& o) { sixth_coded(o), o.confidence = k; });
+    for (int c : {2, 4}) add("R7: sixth + trained initial states, count " + std::to_string(c), [&, c](Options& o) { sixth_coded(o), o.prior_count = c; });
+    add("R7: sixth + trained initial states of the geometric tables, count 4", [&](Options& o) { sixth_coded(o), o.prior_count = 4, o.prior_geometric_only = true; });
+    // The sixth's last four extra tables: 0 cq1 H x size x level, 1 cq1 K x size x level, 2 cq1 H x
+    // group x K, 3 the threshold on it (as FORMAT.md 2.6's tables 31-34).
+    for (auto hist : {std::vector<int>{0}, std::vector<int>{0, 1}, std::vector<int>{0, 1, 2, 3}, std::vector<int>{-6, -5, 0, 1}}) {
+        std::string name = "R7: sixth + bit histories of the ring-quadric tables";
+        for (int k : hist) name += " " + std::to_string(31 + k);
+        add(name, [&, hist](Options& o) {
+            sixth_coded(o);
+            for (int k : hist) o.extra_history.push_back(int(o.extra.size()) - 4 + k);
+        });
+    }
+    add("R7: sixth + trained initial states of the ring-quadric tables 31-34, count 4", [&](Options& o) { sixth_coded(o), o.prior_count = 4, o.prior_last_extras = 4; });
+    add("R7: sixth + trained initial states of the geometric tables, count 4, + parent p x level x center, z x count x level", [&](Options& o) {
+        sixth_coded(o), o.extra.push_back(parent_p), o.extra.push_back(z_count);
+        o.prior_count = 4, o.prior_geometric_only = true;
+    });
+    add("R7: sixth + trained initial states of the geometric tables, count 2", [&](Options& o) { sixth_coded(o), o.prior_count = 2, o.prior_geometric_only = true; });
+    for (int c : {1, 2, 4}) add("R7: sixth, fresh slots start at the coded probability, count " + std::to_string(c), [&, c](Options& o) { sixth_coded(o), o.fresh_from_final = c; });
+    add("R7: sixth, tables 31 32 coarser (ring quadric / 2 x size / 4 x level)", [&](Options& o) {
+        sixth_coded(o);
+        const size_t k = o.extra.size() - 4;
+        o.extra[k] = [](F f, X x) { return (x.cq1_h / 2u * 16u + f.size / 4u) * 8 + f.level; };
+        o.extra[k + 1] = [](F f, X x) { return (x.cq1_k / 2u * 16u + f.size / 4u) * 8 + f.level; };
+    });
+    add("R7: sixth + tables 31 32 coarser beside them", [&](Options& o) {
+        sixth_coded(o);
+        o.extra.push_back([](F f, X x) { return (x.cq1_h / 2u * 16u + f.size / 4u) * 8 + f.level; });
+        o.extra.push_back([](F f, X x) { return (x.cq1_k / 2u * 16u + f.size / 4u) * 8 + f.level; });
+    });
+    add("R7: sixth + mixer E by z x count", [&](Options& o) {
+        sixth_coded(o), o.mixer_e = [](F, X x) { return x.dyn_z * 8u + x.dyn_count; }, o.mixer_e_sets = 128;
+    });
+    add("R7: sixth + final SSE (share 1/4) by z x count", [&](Options& o) {
+        sixth_coded(o), o.final_map = [](F, X x) { return x.dyn_z * 8u + x.dyn_count; }, o.final_rows = 128, o.final_share = 1;
+    });
     add("K6: sixth (B2)", sixth_design);
     add("K6: sixth (B2) without 0 3 5", [&](Options& o) { sixth_design(o), o.drop |= drops({0, 3, 5}); });
     add("K6: sixth (B2) without 0 3 5 20", [&](Options& o) { sixth_design(o), o.drop |= drops({0, 3, 5, 20}); });
@@ -1364,9 +1548,16 @@ int main(int argc, char** argv) {
     };
     std::vector<double> library;
     for (const ModelData& d : data) library.push_back(d.library_bits);
-    row("the coder's mixing mode (fifth model, version 17)", library);
+    row("the coder's mixing mode (as encoders write it: the sixth model, version 19)", library);
     for (const Design& design : designs) {
-        if (only && design.name.find(only) == std::string::npos && &design != &designs[0]) continue;
+        if (only && &design != &designs[0]) {  // ONLY=a|b|c: any of them
+            bool wanted = false;
+            for (size_t from = 0, bar = 0; bar != std::string::npos; from = bar + 1) {
+                bar = std::string(only).find('|', from);
+                wanted |= design.name.find(std::string(only).substr(from, bar - from)) != std::string::npos;
+            }
+            if (!wanted) continue;
+        }
         std::vector<double> bits;
         std::vector<std::array<std::vector<double>, 4>> ended;
         if (design.o.trained_start)
@@ -1374,7 +1565,7 @@ int main(int argc, char** argv) {
                 Options plain = design.o;
                 plain.trained_start = false;
                 Study study(plain);
-                study.code(data[m].symbols, extras[m]);
+                study.code(data[m].symbols, extras[m], &links[m]);
                 ended.push_back(study.mean_weights());
             }
         const char* weights_in = std::getenv("WEIGHTS_IN");
@@ -1409,7 +1600,7 @@ int main(int argc, char** argv) {
                 Options plain = design.o;
                 plain.prior_count = 0;
                 Study study(plain);
-                study.code(data[m].symbols, extras[m]);
+                study.code(data[m].symbols, extras[m], &links[m]);
                 counted.push_back(study.counts_);
             }
         auto mesh_of = [](const std::string& name) { return name.substr(0, name.rfind('_')); };
@@ -1439,8 +1630,11 @@ int main(int argc, char** argv) {
                 o.priors = &prior;
             }
             Study study(o);
-            bits.push_back(study.code(data[m].symbols, extras[m]));
-            if (std::getenv("PER_LEVEL") && &design == &designs[0]) {
+            bits.push_back(study.code(data[m].symbols, extras[m], &links[m]));
+            if (std::getenv("PRIOR_SLOTS") && o.prior_count > 0)
+                std::fprintf(stderr, "%s: %s: %zu slots with trained initial states, %zu reached by the training\n", design.name.c_str(),
+                             data[m].name.c_str(), study.prior_slots_[0], study.prior_slots_[1]);
+            if (std::getenv("PER_LEVEL") && (&design == &designs[0] || design.name == std::getenv("PER_LEVEL"))) {
                 std::fprintf(stderr, "%s:", data[m].name.c_str());
                 for (int l = 0; l < 8; ++l)
                     std::fprintf(stderr, " L%d %.0f sym %.0f%% ones %.0f bits", l, study.level_symbols[size_t(l)],
