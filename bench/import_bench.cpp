@@ -1,5 +1,6 @@
 // import_leaf_mesh throughput in leaf faces per second (docs/IMPORT.md, "Speed"): the leaf
-// meshes of the bench models (surface, random, fe) at about 10^5 and 10^6 nodes, vertices and
+// meshes of the bench models (surface, random, fe) at about 10^4, 10^5 and 10^6 nodes (10^4: the
+// refusal's growth with size, docs/IMPORT.md "Complexity and speed"), vertices and
 // faces shuffled, with new vertices at their midpoints (the exact path) or moved off them (the
 // connectivity paths); and the semi-regular bunny of ../shared/data when it is there.
 //
@@ -56,7 +57,7 @@ int main(int argc, char** argv) {
     const std::string filter = argc > 2 ? argv[2] : "";
     auto wanted = [&](const std::string& name) { return name.find(filter) != std::string::npos; };
     const char* names[] = {"surface", "random", "fe"};
-    for (int64_t nodes : {int64_t(100000), int64_t(1000000)}) {
+    for (int64_t nodes : {int64_t(10000), int64_t(100000), int64_t(1000000)}) {
         for (int model = 0; model < 3; ++model) {
             const std::string model_name = std::string(names[model]) + " " + std::to_string(nodes / 1000) + "k nodes";
             if (!wanted(model_name + ", midpoints") && !wanted(model_name + ", moved")) continue;

@@ -3,6 +3,7 @@
 // and compares the extracted leaf mesh with the input, face by face.
 #include <amc/import.h>
 
+#include "common/huge_pages.h"
 #include "common/no_index.h"
 #include "hierarchy/leaf_triangles.h"
 #include "import/anchored_reconstruction.h"
@@ -10,6 +11,7 @@
 #include "import/leaf_halfedges.h"
 #include "import/leaf_reconstruction.h"
 #include "import/position_index.h"
+#include "import/spatial_order.h"
 #include "import/uniform_lattice.h"
 
 #include <cmath>
@@ -35,7 +37,8 @@ std::string position_text(Vec3 p) {
 
 std::vector<uint32_t> match_base_vertices(const TriangleMesh& base, const TriangleMesh& leaf,
                                           const std::vector<uint32_t>& leaf_vertex_of_base,
-                                          const PositionIndex& leaf_positions, const std::string& what) {
+                                          const PositionIndex& leaf_positions,
+                                          const std::vector<uint32_t>& input_of_indexed, const std::string& what) {
     const size_t v0 = base.positions.size();
     std::vector<uint32_t> match(v0, kNoIndex);
     std::vector<uint32_t> base_of_leaf(leaf.positions.size(), kNoIndex);
@@ -45,7 +48,10 @@ std::vector<uint32_t> match_base_vertices(const TriangleMesh& base, const Triang
                            std::to_string(v0) + " base vertices");
         match = leaf_vertex_of_base;
     } else {
-        for (uint32_t b = 0; b < v0; ++b) match[b] = leaf_positions.find(base.positions[b]);
+        for (uint32_t b = 0; b < v0; ++b) {
+            const uint32_t l = leaf_positions.find(base.positions[b]);
+            match[b] = l == kNoIndex ? kNoIndex : input_of_indexed[l];
+        }
     }
     for (uint32_t b = 0; b < v0; ++b) {
         const uint32_t l = match[b];
@@ -63,6 +69,13 @@ std::vector<uint32_t> match_base_vertices(const TriangleMesh& base, const Triang
     return match;
 }
 
+// first[second[i]] for every i.
+std::vector<uint32_t> composed(const std::vector<uint32_t>& first, const std::vector<uint32_t>& second) {
+    std::vector<uint32_t> out(second.size());
+    for (size_t i = 0; i < second.size(); ++i) out[i] = first[second[i]];
+    return out;
+}
+
 std::vector<uint32_t> inverse(const std::vector<uint32_t>& order) {
     std::vector<uint32_t> out(order.size());
     for (uint32_t i = 0; i < order.size(); ++i) out[order[i]] = i;
@@ -73,10 +86,11 @@ TriangleMesh renumbered(const TriangleMesh& leaf, const std::vector<uint32_t>& i
                         const std::vector<uint32_t>& import_of) {
     TriangleMesh out;
     out.single_precision = leaf.single_precision;
-    out.positions.resize(input_of.size());
-    for (uint32_t v = 0; v < input_of.size(); ++v) out.positions[v] = leaf.positions[input_of[v]];
-    out.triangles = leaf.triangles;
-    detail::renumber(out.triangles, import_of);
+    // Fresh pages, a fault each per 4 KiB without huge pages: at 10^6 faces as much as the copy.
+    reserve_huge(out.positions, input_of.size());
+    reserve_huge(out.triangles, leaf.triangles.size());
+    for (uint32_t v : input_of) out.positions.push_back(leaf.positions[v]);
+    for (const Triangle& t : leaf.triangles) out.triangles.push_back({import_of[t[0]], import_of[t[1]], import_of[t[2]]});
     return out;
 }
 
@@ -86,14 +100,18 @@ TriangleMesh renumbered(const TriangleMesh& leaf, const std::vector<uint32_t>& i
 // anchored way's search depends on it); the position index takes the vertices in the input's
 // order and the k-d tree is the input's, renamed (which of two equal candidates is first), so the
 // answers are the input numbering's, and messages name the input's vertices (input_of).
+// `spatial_search` is the searches of the spatial numbering (SpatialLeaf), whose input ids are
+// spatial_input_of.
 struct RenumberedLeaf {
-    RenumberedLeaf(const TriangleMesh& leaf, const std::vector<uint32_t>& input_leaf_of_base, LeafSearch& input_search)
+    RenumberedLeaf(const TriangleMesh& leaf, const std::vector<uint32_t>& input_leaf_of_base,
+                   LeafSearch& spatial_search, const std::vector<uint32_t>& spatial_input_of)
         : input_of(detail::breadth_first_vertices(leaf.triangles, uint32_t(leaf.positions.size()))),
           import_of(inverse(input_of)),
           mesh(renumbered(leaf, input_of, import_of)),
           halfedges(mesh),
           positions(mesh.positions, nullptr, nullptr, &import_of),
-          search(input_search, import_of) {
+          import_of_spatial(composed(import_of, spatial_input_of)),
+          search(spatial_search, import_of_spatial) {
         leaf_of_base.reserve(input_leaf_of_base.size());
         for (uint32_t l : input_leaf_of_base) leaf_of_base.push_back(import_of[l]);
     }
@@ -101,6 +119,7 @@ struct RenumberedLeaf {
     const TriangleMesh mesh;
     const LeafHalfedges halfedges;
     const PositionIndex positions;
+    const std::vector<uint32_t> import_of_spatial;  // spatial id -> import id
     LeafSearch search;
     std::vector<uint32_t> leaf_of_base;
 };
@@ -109,17 +128,19 @@ struct RenumberedLeaf {
 // orientation, every input face one leaf triangle. Read in hierarchy vertex ids, in
 // extract_leaf_mesh's order, without its canonical numbering and copies (a tenth of a 10^6-face
 // import's instructions and pages).
+// `input_of` names leaf vertices in messages.
 void verify_leaf_mesh(const Hierarchy& h, const std::vector<uint32_t>& leaf_of_vertex, const TriangleMesh& leaf,
-                      const LeafHalfedges& halfedges, const std::string& what) {
+                      const LeafHalfedges& halfedges, const std::vector<uint32_t>& input_of, const std::string& what) {
     std::vector<uint8_t> used(leaf.triangles.size(), 0);
     auto leaf_vertex = [&](VertexId v) { return v < leaf_of_vertex.size() ? leaf_of_vertex[v] : kNoIndex; };
+    auto vertex_text = [&](uint32_t l) { return std::to_string(l == kNoIndex ? l : input_of[l]); };
     for_each_leaf_triangle(h, h.breadth_first_order(), -1, [&](NodeId, VertexId x, VertexId y, VertexId z, bool) {
         const uint32_t a = leaf_vertex(x), b = leaf_vertex(y), c = leaf_vertex(z);
         const LeafHalfedges::Edge e = (a == kNoIndex || b == kNoIndex) ? LeafHalfedges::Edge{} : halfedges.edge(a, b);
         const uint32_t f = e.face;
         if (f == kNoIndex || e.apex != c || used[f])
-            fail(what, "the reconstruction has a triangle (" + std::to_string(a) + ", " + std::to_string(b) + ", " +
-                           std::to_string(c) + ") that is not a face of the leaf mesh");
+            fail(what, "the reconstruction has a triangle (" + vertex_text(a) + ", " + vertex_text(b) + ", " +
+                           vertex_text(c) + ") that is not a face of the leaf mesh");
         used[f] = 1;
     });
     for (size_t f = 0; f < used.size(); ++f) {
@@ -143,8 +164,16 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     for (const Vec3& p : leaf.positions) {
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) validate_triangle_mesh(leaf, what);
     }
+    // Every way runs on the leaf mesh in spatial order (spatial_order.h; on a user's shuffled ids
+    // nearly every lookup of a large mesh misses the cache) and answers in the input's ids. The
+    // faces keep their order, and the position index and the k-d tree take the vertices in the
+    // input's order, so every choice (the first of two equal candidates) is the input order's.
+    const std::vector<uint32_t> input_of = detail::spatial_vertex_order(leaf.positions);  // spatial id -> input id
+    const std::vector<uint32_t> spatial_of = inverse(input_of);
+    const TriangleMesh spatial = renumbered(leaf, input_of, spatial_of);
     uint32_t first = kNoIndex, second = kNoIndex;
-    const PositionIndex leaf_positions(leaf.positions, &first, &second);
+    PositionIndex leaf_positions(leaf.positions, &first, &second);  // in input order: sequential reads
+    leaf_positions.rename(spatial.positions, spatial_of);
     // Two vertices at one position are refused where they make the input ambiguous (a base vertex
     // matched by position) or when the import fails; a projection may put two new vertices of a
     // valid refinement on one point.
@@ -155,14 +184,15 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     if (first != kNoIndex && leaf_vertex_of_base.empty()) {
         for (const Vec3& p : base.positions) {
             if (!leaf_positions.shared(p)) continue;
-            const uint32_t a = leaf_positions.find(p);
+            const uint32_t a = input_of[leaf_positions.find(p)];
             for (uint32_t b = a + 1; b < leaf.positions.size(); ++b) {
                 if (std::memcmp(&leaf.positions[b], &p, sizeof p) == 0) refuse_duplicate(a, b);
             }
         }
     }
     const std::vector<uint32_t> leaf_of_base =
-        match_base_vertices(base, leaf, leaf_vertex_of_base, leaf_positions, what);
+        match_base_vertices(base, leaf, leaf_vertex_of_base, leaf_positions, input_of, what);
+    const std::vector<uint32_t> spatial_leaf_of_base = composed(spatial_of, leaf_of_base);
 
     TriangleMesh hierarchy_base;
     hierarchy_base.triangles = base.triangles;
@@ -170,7 +200,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     hierarchy_base.positions.reserve(base.positions.size());
     for (uint32_t l : leaf_of_base) hierarchy_base.positions.push_back(leaf.positions[l]);
 
-    const LeafHalfedges halfedges(leaf);
+    const LeafHalfedges halfedges(spatial);
     ImportedHierarchy out;
     std::vector<uint32_t> leaf_of_vertex;
     // Six ways in, cheapest first, then three again (below); the first whose result is exactly the
@@ -186,7 +216,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     };
     // What the anchored way undid, kept for the guided ways' second round (in renumbered's ids).
     UndoSteps steps;
-    LeafSearch search(leaf);
+    LeafSearch search(spatial, &spatial_of);
     std::unique_ptr<RenumberedLeaf> renumbered;  // made for the anchored way
     auto guide_of = [](Way way) {
         return way == Way::exact_midpoints ? MidpointGuide::exact
@@ -194,16 +224,19 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
                : way == Way::subdivision   ? MidpointGuide::subdivision
                                            : MidpointGuide::surface;
     };
+    // Each attempt starts from a copy of the roots: copied into the last attempt's storage, whose
+    // pages are already mapped (a fresh 10^6-face hierarchy faults in about 60 MB).
+    const Hierarchy roots(hierarchy_base);
     auto attempt = [&](Way way, bool by_undo_steps) {
-        out.hierarchy = Hierarchy(hierarchy_base);
+        out.hierarchy = roots;
         // A leaf mesh of F faces comes from at most F leaves, so from at most 4F/3 + roots nodes.
         out.hierarchy.reserve(leaf.triangles.size() * 4 / 3 + base.triangles.size() + 4, leaf.positions.size());
         if (way == Way::uniform) {
-            leaf_of_vertex = reconstruct_uniform(out.hierarchy, leaf_of_base, leaf, halfedges);
+            leaf_of_vertex = reconstruct_uniform(out.hierarchy, spatial_leaf_of_base, spatial, halfedges);
             if (leaf_of_vertex.empty()) throw Error(what + ": not a uniform refinement");
         } else if (way == Way::anchored || by_undo_steps) {
             if (way == Way::anchored) validate_triangle_mesh(leaf, what);  // the inverse step needs an oriented manifold
-            if (!renumbered) renumbered = std::make_unique<RenumberedLeaf>(leaf, leaf_of_base, search);
+            if (!renumbered) renumbered = std::make_unique<RenumberedLeaf>(leaf, leaf_of_base, search, input_of);
             RenumberedLeaf& r = *renumbered;
             if (way == Way::anchored) {
                 leaf_of_vertex = reconstruct_anchored(out.hierarchy, r.leaf_of_base, r.mesh, what, &steps);
@@ -213,13 +246,13 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
                                                        r.positions, r.search, what, &steps, nullptr, &r.input_of);
             }
             for (uint32_t& l : leaf_of_vertex) {
-                if (l != kNoIndex) l = r.input_of[l];
+                if (l != kNoIndex) l = spatial_of[r.input_of[l]];
             }
         } else {
-            leaf_of_vertex = reconstruct_hierarchy(out.hierarchy, leaf_of_base, leaf, halfedges, guide_of(way),
-                                                   leaf_positions, search, what);
+            leaf_of_vertex = reconstruct_hierarchy(out.hierarchy, spatial_leaf_of_base, spatial, halfedges, guide_of(way),
+                                                   leaf_positions, search, what, nullptr, nullptr, &input_of);
         }
-        verify_leaf_mesh(out.hierarchy, leaf_of_vertex, leaf, halfedges, what);
+        verify_leaf_mesh(out.hierarchy, leaf_of_vertex, spatial, halfedges, input_of, what);
     };
     // The subdivision-guided way's error is the one reported: it goes furthest on most bad input.
     // The guided ways run a second time, their picks decided by the anchored way's undo steps,
@@ -257,10 +290,9 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
 
     out.vertex_of_input.assign(leaf.positions.size(), kNoIndex);
     for (VertexId v = 0; v < leaf_of_vertex.size(); ++v) {
-        const uint32_t l = leaf_of_vertex[v];
-        if (l == kNoIndex) continue;
-        out.vertex_of_input[l] = v;
-        out.hierarchy.set_position(v, leaf.positions[l]);
+        if (leaf_of_vertex[v] == kNoIndex) continue;
+        out.vertex_of_input[input_of[leaf_of_vertex[v]]] = v;
+        out.hierarchy.set_position(v, spatial.positions[leaf_of_vertex[v]]);  // the same position, read in order
     }
     for (uint32_t l = 0; l < leaf.positions.size(); ++l) {
         if (out.vertex_of_input[l] == kNoIndex) validate_triangle_mesh(leaf, what);  // an unused vertex

@@ -22,7 +22,7 @@ public:
     explicit PositionIndex(const std::vector<Vec3>& positions, uint32_t* first_duplicate = nullptr,
                            uint32_t* second_duplicate = nullptr,
                            const std::vector<uint32_t>* insertion_order = nullptr)
-        : positions_(positions) {
+        : positions_(&positions) {
         size_t capacity = 16;
         while (capacity < 2 * positions.size()) capacity *= 2;
         slots_.assign(capacity, kNoIndex);
@@ -44,11 +44,21 @@ public:
         }
     }
 
+    // The index of the same positions renumbered: vertex v is new_id[v] in `renumbered`
+    // (renumbered[new_id[v]] == positions[v]). Finds answer as an index built over `renumbered`
+    // with the same insertion order would, without its random reads of the positions.
+    void rename(const std::vector<Vec3>& renumbered, const std::vector<uint32_t>& new_id) {
+        for (uint32_t& slot : slots_) {
+            if (slot != kNoIndex) slot = new_id[slot];
+        }
+        positions_ = &renumbered;
+    }
+
     // The first vertex at exactly p, or kNoIndex.
     uint32_t find(Vec3 p) const {
         for (size_t s = slot_of(p);; s = (s + 1) & (slots_.size() - 1)) {
             if (slots_[s] == kNoIndex) return kNoIndex;
-            if (same(positions_[slots_[s]], p)) return slots_[s];
+            if (same((*positions_)[slots_[s]], p)) return slots_[s];
         }
     }
 
@@ -57,7 +67,7 @@ public:
         if (shared_.empty()) return false;
         for (size_t s = slot_of(p);; s = (s + 1) & (slots_.size() - 1)) {
             if (slots_[s] == kNoIndex) return false;
-            if (same(positions_[slots_[s]], p)) return shared_[s] != 0;
+            if (same((*positions_)[slots_[s]], p)) return shared_[s] != 0;
         }
     }
 
@@ -68,7 +78,7 @@ private:
         std::memcpy(bits, &p, sizeof bits);
         return size_t(hash_words(bits[0], bits[1], bits[2])) & (slots_.size() - 1);
     }
-    const std::vector<Vec3>& positions_;
+    const std::vector<Vec3>* positions_;
     std::vector<uint32_t> slots_;
     std::vector<uint8_t> shared_;  // per slot: another vertex has the same position (empty: none)
 };

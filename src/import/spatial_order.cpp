@@ -1,0 +1,68 @@
+#include "import/spatial_order.h"
+
+#include <algorithm>
+
+namespace amc::detail {
+
+namespace {
+
+constexpr uint32_t kCellsPerAxis = 1024;  // 30-bit codes: two 15-bit counting-sort passes
+
+// The 10 bits of x spread to every third bit.
+uint32_t spread_bits(uint32_t x) {
+    x &= 0x3ff;
+    x = (x | (x << 16)) & 0x030000ffu;
+    x = (x | (x << 8)) & 0x0300f00fu;
+    x = (x | (x << 4)) & 0x030c30c3u;
+    x = (x | (x << 2)) & 0x09249249u;
+    return x;
+}
+
+}  // namespace
+
+std::vector<uint32_t> spatial_vertex_order(const std::vector<Vec3>& positions) {
+    const uint32_t n = uint32_t(positions.size());
+    std::vector<uint32_t> order(n);
+    if (n == 0) return order;
+    double low[3] = {positions[0].x, positions[0].y, positions[0].z}, high[3] = {low[0], low[1], low[2]};
+    for (const Vec3& p : positions) {
+        const double c[3] = {p.x, p.y, p.z};
+        for (int a = 0; a < 3; ++a) {
+            low[a] = std::min(low[a], c[a]);
+            high[a] = std::max(high[a], c[a]);
+        }
+    }
+    double scale[3];
+    for (int a = 0; a < 3; ++a) {
+        const double extent = high[a] - low[a];  // may overflow to infinity: scale 0, one cell
+        scale[a] = extent > 0 ? double(kCellsPerAxis) / extent : 0;
+    }
+    std::vector<uint32_t> code(n);
+    for (uint32_t v = 0; v < n; ++v) {
+        const double c[3] = {positions[v].x, positions[v].y, positions[v].z};
+        uint32_t key = 0;
+        for (int a = 0; a < 3; ++a) {
+            const double t = (c[a] - low[a]) * scale[a];
+            const uint32_t cell = t >= 0 ? uint32_t(std::min(t, double(kCellsPerAxis - 1))) : 0;  // NaN: 0
+            key |= spread_bits(cell) << a;
+        }
+        code[v] = key;
+    }
+    // Least significant half first; each pass is stable.
+    constexpr uint32_t kBuckets = 1u << 15;
+    std::vector<uint32_t> count(kBuckets + 1), scratch(n);
+    auto pass = [&](const uint32_t* from, uint32_t* to, int shift, bool identity) {
+        std::fill(count.begin(), count.end(), 0);
+        for (uint32_t i = 0; i < n; ++i) ++count[((code[identity ? i : from[i]] >> shift) & (kBuckets - 1)) + 1];
+        for (uint32_t b = 1; b <= kBuckets; ++b) count[b] += count[b - 1];
+        for (uint32_t i = 0; i < n; ++i) {
+            const uint32_t v = identity ? i : from[i];
+            to[count[(code[v] >> shift) & (kBuckets - 1)]++] = v;
+        }
+    };
+    pass(nullptr, scratch.data(), 0, true);
+    pass(scratch.data(), order.data(), 15, false);
+    return order;
+}
+
+}  // namespace amc::detail
