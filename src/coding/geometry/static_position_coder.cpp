@@ -1391,20 +1391,20 @@ AMC_ALWAYS_INLINE void set_grid_frame_pair(const FramePairLanes& l, const GridSc
 }
 #endif
 
-// Coordinate `axis` of `p`, written through its object representation (Vec3 is three doubles).
-AMC_ALWAYS_INLINE void set_coordinate(Vec3& p, int axis, double value) {
-    std::memcpy(reinterpret_cast<unsigned char*>(&p) + sizeof(double) * size_t(axis), &value, sizeof(double));
-}
-static_assert(sizeof(Vec3) == 3 * sizeof(double) && offsetof(Vec3, y) == sizeof(double) && offsetof(Vec3, z) == 2 * sizeof(double),
+// A decoded vertex's coordinates, x, y, z, written as doubles (through a Vec3's object
+// representation, a store by memcpy could alias anything: the compiler then reloaded every value
+// it kept in memory after each); the chunk's are copied into Vec3s once made.
+using Coordinates = double[3];
+static_assert(sizeof(Vec3) == sizeof(Coordinates) && offsetof(Vec3, y) == sizeof(double) && offsetof(Vec3, z) == 2 * sizeof(double),
               "Vec3 is x, y, z");
 
 // Role 0's grid value q0 of a frame whose roles 1 and 2 are the axes a1 and a2: its coordinate,
 // written to `p`, and roles 1 and 2's grid predictions (predict_others' line along the normal).
 AMC_ALWAYS_INLINE GridPointPair grid_first_role(const GridFrame& f, int64_t q0, const GridScale& grid, const double* origin,
-                                                int a1, int a2, Vec3& p) {
+                                                int a1, int a2, Coordinates& p) {
     const int a0 = f.axis;
     const double value = origin[a0] + rounded(static_cast<double>(q0) * grid.step);
-    set_coordinate(p, a0, value);
+    p[a0] = value;
     double second = f.midpoint[a1], third = f.midpoint[a2];
     if (f.has_normal) {
         const double u = rounded((value - f.midpoint[a0]) / f.normal[a0]);
@@ -1416,16 +1416,16 @@ AMC_ALWAYS_INLINE GridPointPair grid_first_role(const GridFrame& f, int64_t q0, 
 
 // Roles 1 and 2's coordinates (axes a1 and a2) from their grid values.
 AMC_ALWAYS_INLINE void set_other_roles(int64_t q1, int64_t q2, const GridScale& grid, const double* origin, int a1, int a2,
-                                       Vec3& p) {
-    set_coordinate(p, a1, origin[a1] + rounded(static_cast<double>(q1) * grid.step));
-    set_coordinate(p, a2, origin[a2] + rounded(static_cast<double>(q2) * grid.step));
+                                       Coordinates& p) {
+    p[a1] = origin[a1] + rounded(static_cast<double>(q1) * grid.step);
+    p[a2] = origin[a2] + rounded(static_cast<double>(q2) * grid.step);
 }
 
 // decode_vertex<State, true> over a GridFrame: role r's axis is the frame's axis, then the two
 // others in increasing order.
 template <int State, bool Safe>
 AMC_ALWAYS_INLINE bool decode_grid_vertex(StencilStreams& s, const GridTable* t, const GridFrame& f, const GridScale& grid,
-                                          const double* origin, Vec3& p) {
+                                          const double* origin, Coordinates& p) {
     const int64_t q0 = grid_point_value<State, Safe>(s, t, f.first.point, f.first.table_offset, f.first.turn_mask);
     if (uint64_t(q0) > grid.max) return false;  // also q0 < 0
     const int a1 = f.axis == 0 ? 1 : 0, a2 = f.axis == 2 ? 1 : 2;
@@ -1447,16 +1447,17 @@ AMC_ALWAYS_INLINE bool decode_grid_vertex(StencilStreams& s, const GridTable* t,
 // 1.5 % fewer instructions, 1-9 % more time; the chain then runs with nothing beside it.)
 template <bool Safe>
 AMC_ALWAYS_INLINE bool decode_grid_grouped(StencilStreams& s, const GridTable* t, const GridFrame* frames, size_t count,
-                                           const GridScale& grid, const double* origin, Vec3* decoded) {
+                                           const GridScale& level_grid, const double* origin, Coordinates* decoded) {
+    const GridScale grid = level_grid;  // a local copy: the stores to `decoded` could alias the caller's
     GridPointPair second[kChunk];
-    uint64_t out_of_range = 0;
+    uint64_t largest = 0;  // of the role-0 grid values as unsigned, where a negative one is above any
     // Role 0's token of vertex k with state `State`, then its value and roles 1 and 2's
     // predictions, which the next token does not wait for.
     auto first = [&](auto state, size_t k) {
         constexpr int State = decltype(state)::value;
         const GridFrame& f = frames[k];
         const int64_t q0 = grid_point_value<State, Safe>(s, t, f.first.point, f.first.table_offset, f.first.turn_mask);
-        out_of_range |= uint64_t(q0) > grid.max;  // also q0 < 0
+        largest = std::max(largest, uint64_t(q0));
         second[k] = grid_first_role(f, q0, grid, origin, f.axis == 0 ? 1 : 0, f.axis == 2 ? 1 : 2, decoded[k]);
     };
     size_t k = 0;
@@ -1465,7 +1466,7 @@ AMC_ALWAYS_INLINE bool decode_grid_grouped(StencilStreams& s, const GridTable* t
         first(std::integral_constant<int, 1>{}, k + 1);
     }
     if (k < count) first(std::integral_constant<int, 0>{}, k);
-    if (out_of_range != 0) return false;
+    if (largest > grid.max) return false;  // also a q0 < 0
     auto roles_1_2 = [&](auto odd) {
         constexpr int S = decltype(odd)::value ? 1 : 0;  // role 1's state: count mod 2
         for (size_t i = 0; i < count; ++i) {
@@ -1502,6 +1503,7 @@ bool decode_grid_listed(Hierarchy& h, const FromList& created, const Quantizer& 
     // 8 bytes of the last raw load.
     constexpr size_t kChunkRans = 2 * 3 * kChunk, kChunkRaw = 3 * kChunk * (kMaxQuantizationBits - 2) / 8 + 16;
     std::array<GridFrame, kChunk> frames;
+    Coordinates coordinates[kChunk];
     Vec3 decoded[kChunk];
     for (size_t begin = 0; begin < created.count; begin += kChunk) {
         const size_t count = std::min(kChunk, created.count - begin);
@@ -1525,13 +1527,13 @@ bool decode_grid_listed(Hierarchy& h, const FromList& created, const Quantizer& 
             StencilStreams local = s;  // the chunk's copy, which the compiler keeps in registers
             bool ok = true;
             if (Grouped) {
-                ok = decode_grid_grouped<Safe>(local, t.data(), frames.data(), count, grid, origin, decoded);
+                ok = decode_grid_grouped<Safe>(local, t.data(), frames.data(), count, grid, origin, coordinates);
                 s = local;
                 return ok;
             }
             for (size_t k = 0; k < count && ok; k += 2) {  // token j of the level with state j mod 2
-                ok = decode_grid_vertex<0, Safe>(local, t.data(), frames[k], grid, origin, decoded[k]) &&
-                     (k + 1 == count || decode_grid_vertex<1, Safe>(local, t.data(), frames[k + 1], grid, origin, decoded[k + 1]));
+                ok = decode_grid_vertex<0, Safe>(local, t.data(), frames[k], grid, origin, coordinates[k]) &&
+                     (k + 1 == count || decode_grid_vertex<1, Safe>(local, t.data(), frames[k + 1], grid, origin, coordinates[k + 1]));
             }
             s = local;
             return ok;
@@ -1539,6 +1541,7 @@ bool decode_grid_listed(Hierarchy& h, const FromList& created, const Quantizer& 
         const bool inside = size_t(s.rans_end - s.rans) >= kChunkRans &&
                             raw_size - std::min<size_t>(raw_size, size_t(s.raw_bits_read >> 3)) >= kChunkRaw;
         if (!(inside ? run(std::false_type{}) : run(std::true_type{}))) return false;
+        std::memcpy(decoded, coordinates, count * sizeof(Vec3));
         if (append) {
             HierarchyBuilder::append_positions(h, decoded, count, near);
         } else {
