@@ -641,6 +641,8 @@ struct Options {
     // second model's three), a prior learnt from every slot for the slots seen a few times.
     std::vector<int> extra_history;
     int prior_last_extras = 0;  // > 0: trained initial states only for the last this many extra tables
+    int prior_skip_last = 0;    // with prior_last_extras: not the last this many of them
+    int prior_step = 0;         // > 0: a trained state's probability rounded to multiples of this in the stretched domain
     // > 0: a direct or extra model coded for the first time starts, before its update, at the
     // probability the symbol was coded with, as if it had seen this many symbols (an online prior).
     int fresh_from_final = 0;
@@ -741,14 +743,19 @@ public:
             auto geometric = [&](size_t t) { return (t >= 6 && t <= 12) || (t >= 18 && t < all.size() - 3); };
             for (size_t t = 0; t < last; ++t)
                 for (size_t i = 0; i < all[t]->size() && (!o.prior_geometric_only || geometric(t)) &&
-                                   (o.prior_last_extras == 0 || (t + 3 + size_t(o.prior_last_extras) >= all.size() && t + 3 < all.size()));
+                                   (o.prior_last_extras == 0 || (t + 3 + size_t(o.prior_last_extras) >= all.size() &&
+                                                                 t + 3 + size_t(o.prior_skip_last) < all.size()));
                      ++i) {
                     const auto [ones, n] = o.priors->tables[t][i];
                     ++prior_slots_[0];
                     if (n == 0) continue;
                     ++prior_slots_[1];
                     BitModel& m = (*all[t])[i];
-                    const double p = (ones + 0.4) / (n + 0.8);
+                    double p = (ones + 0.4) / (n + 0.8);
+                    if (o.prior_step > 0) {
+                        const double st = std::round(std::log(p / (1 - p)) * 256 / o.prior_step) * o.prior_step / 256;
+                        p = 1 / (1 + std::exp(-st));
+                    }
                     m.p = uint32_t(std::clamp(p * 4294967296.0, 65536.0, 4294967296.0 - 65536.0));
                     m.n = uint16_t(std::min<uint32_t>(uint32_t(o.prior_count), n));
                 }
@@ -1503,6 +1510,11 @@ int main(int argc, char** argv) {
         o.extra.push_back([](F f, X x) { return (x.cq1_h / 2u * 16u + f.size / 4u) * 8 + f.level; });
         o.extra.push_back([](F f, X x) { return (x.cq1_k / 2u * 16u + f.size / 4u) * 8 + f.level; });
     });
+    add("R7: sixth + trained initial states of tables 31 32 only, count 4", [&](Options& o) { sixth_coded(o), o.prior_count = 4, o.prior_last_extras = 4, o.prior_skip_last = 2; });
+    for (int step : {64, 128, 256})
+        add("R7: sixth + trained initial states of the geometric tables, count 4, rounded to " + std::to_string(step) + "/256 of a logit", [&, step](Options& o) {
+            sixth_coded(o), o.prior_count = 4, o.prior_geometric_only = true, o.prior_step = step;
+        });
     add("R7: sixth + mixer E by z x count", [&](Options& o) {
         sixth_coded(o), o.mixer_e = [](F, X x) { return x.dyn_z * 8u + x.dyn_count; }, o.mixer_e_sets = 128;
     });
