@@ -98,6 +98,32 @@ TEST(Rans, RoundTripsSeveralTablesInterleaved) {
     }
 }
 
+TEST(Rans, BackwardEncoderMakesTheQueuedEncodersStream) {
+    for (size_t n : {size_t(0), size_t(1), size_t(2), size_t(3), size_t(1001), size_t(50000)}) {
+        const std::vector<int> a = skewed_symbols(n, 40, 5), b = skewed_symbols(n, 7, 6);
+        const RansTable ta = RansTable::from_counts(counts_of(a, 40)), tb = RansTable::from_counts(counts_of(b, 7));
+        RansEncoder queued;
+        for (size_t i = 0; i < n; ++i) {
+            queued.put(ta, a[i]);
+            if (i % 3 != 0) queued.put(tb, b[i]);  // an odd count of symbols too
+        }
+        const size_t count = queued.symbols();
+        RansBackwardEncoder backward(count);
+        for (size_t i = n; i-- > 0;) {
+            if (i % 3 != 0) backward.put(tb, b[i]);
+            backward.put(ta, a[i]);
+        }
+        EXPECT_EQ(backward.finish(), queued.finish()) << n;
+    }
+    const RansTable t = RansTable::from_counts({3, 1});
+    RansBackwardEncoder short_of_one(2);
+    short_of_one.put(t, 0);
+    EXPECT_THROW(short_of_one.finish(), Error);
+    RansBackwardEncoder one(1);
+    one.put(t, 0);
+    EXPECT_THROW(one.put(t, 1), Error);
+}
+
 TEST(Rans, EncoderStepWithoutDivisionIsTheDivision) {
     // RansTable::Coding's reciprocal step against the definition, for every frequency, at the ends
     // of the states the encoder codes from ([x_max / 256, x_max) after renormalisation) and between.

@@ -131,25 +131,23 @@ double RansTable::cost_bits(int symbol) const {
 }
 
 std::vector<uint8_t> RansEncoder::finish() {
-    // Built back to front: a symbol writes at most two bytes (x < 2^31 before, x_max >= 2^19).
-    std::vector<uint8_t> out(2 * queue_.size() + kRansStateBytes);
-    uint8_t* const end = out.data() + out.size();
-    uint8_t* p = end;
-    uint32_t state[2] = {kRansLow, kRansLow};
-    for (size_t i = queue_.size(); i-- > 0;) {
-        uint32_t& x = state[i & 1];
-        const RansTable::Coding& c = *queue_[i];
-        while (x >= c.x_max) {
-            *--p = uint8_t(x);
-            x >>= 8;
-        }
-        x = c.code(x);
-    }
-    for (int s = 1; s >= 0; --s)
-        for (int shift = 24; shift >= 0; shift -= 8) *--p = uint8_t(state[s] >> shift);
+    RansBackwardEncoder backward(queue_.size());
+    for (size_t i = queue_.size(); i-- > 0;) backward.put_coding(*queue_[i]);
     queue_.clear();
-    out.erase(out.begin(), out.begin() + (p - out.data()));
-    return out;
+    return backward.finish();
+}
+
+RansBackwardEncoder::RansBackwardEncoder(size_t count)
+    : buffer_(new uint8_t[2 * count + kRansStateBytes]), end_(buffer_.get() + 2 * count + kRansStateBytes), begin_(end_),
+      left_(count) {}
+
+void RansBackwardEncoder::throw_too_many() { throw Error("RansBackwardEncoder::put: more symbols than it was made for"); }
+
+std::vector<uint8_t> RansBackwardEncoder::finish() {
+    if (left_ != 0) throw Error("RansBackwardEncoder::finish: " + std::to_string(left_) + " symbols were not put");
+    for (int s = 1; s >= 0; --s)
+        for (int shift = 24; shift >= 0; shift -= 8) *--begin_ = uint8_t(state_[s] >> shift);
+    return std::vector<uint8_t>(begin_, end_);
 }
 
 std::vector<uint8_t> RawBitWriter::finish() {

@@ -25,6 +25,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <memory>
 #include <vector>
 
 namespace amc {
@@ -116,6 +117,36 @@ public:
 
 private:
     std::vector<const RansTable::Coding*> queue_;
+};
+
+// RansEncoder's stream for a caller that can give its `count` symbols last to first (rANS codes
+// backwards): each is coded as it comes, with no queue (8 bytes a symbol, written and read again).
+class RansBackwardEncoder {
+public:
+    explicit RansBackwardEncoder(size_t count);
+    // The symbol before the one put last (the first call: the last symbol), of nonzero frequency.
+    void put(const RansTable& table, int symbol) { put_coding(table.coding(symbol)); }
+    void put_coding(const RansTable::Coding& c) {
+        if (left_ == 0) throw_too_many();  // the buffer holds `count` symbols' bytes
+        uint32_t& x = state_[--left_ & 1];  // symbol i of the stream takes state i mod 2
+        while (x >= c.x_max) {
+            *--begin_ = uint8_t(x);
+            x >>= 8;
+        }
+        x = c.code(x);
+    }
+    // The stream (once); throws Error unless exactly `count` symbols were put.
+    std::vector<uint8_t> finish();
+
+private:
+    [[noreturn]] static void throw_too_many();
+    // At most two bytes a symbol (x < 2^31 before, x_max >= 2^19) and the states, written from the
+    // end down; not zeroed, so the pages the code never reaches are never touched.
+    std::unique_ptr<uint8_t[]> buffer_;
+    uint8_t* end_;
+    uint8_t* begin_;  // the first byte written so far
+    size_t left_;     // symbols still to be put
+    uint32_t state_[2] = {kRansLow, kRansLow};
 };
 
 class RansDecoder {

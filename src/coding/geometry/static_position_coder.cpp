@@ -418,14 +418,15 @@ AMC_ALWAYS_INLINE void predict_others(const RoleFrame& f, double first_value, do
 
 }  // namespace
 
+// Both without branches: whether a residual is 0, small or large is a coin flip on surfaces.
 int static_token(bool negative, uint64_t magnitude) {
-    if (magnitude == 0) return 0;
-    if (magnitude < 8) return int(2 * magnitude - 1 + (negative ? 1 : 0));
-    const int k = bit_length(magnitude);
-    return kDirectTokens + 4 * (k - 4) + int((magnitude >> (k - 3)) & 3);
+    const int small = int(2 * magnitude - 1 + (negative ? 1 : 0)) & -int(magnitude != 0);
+    const int k = bit_length(magnitude | 8);
+    const int large = kDirectTokens + 4 * (k - 4) + int((magnitude >> (k - 3)) & 3);
+    return magnitude < 8 ? small : large;
 }
 
-int static_raw_bit_count(uint64_t magnitude) { return magnitude < 8 ? 0 : 1 + bit_length(magnitude) - 3; }
+int static_raw_bit_count(uint64_t magnitude) { return magnitude < 8 ? 0 : bit_length(magnitude) - 2; }
 
 template <class Mesh>
 StaticLevelEncoder::StaticLevelEncoder(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created,
@@ -460,20 +461,27 @@ void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, 
     if (counts_[0].empty())
         for (int i = 0; i < table_count_; ++i) counts_[size_t(i)].assign(size_t(token_limit(space_)), 0);
     symbols_.resize(end);
-    // Room for the residuals with raw bits, grown by doubling they were copied again and again: in
-    // float spaces nearly every coordinate has them, on a grid as many as on the part before.
-    const size_t more = space_.quantizer == nullptr ? kStaticRoles * (end - begin)
-                        : begin == 0                 ? 0
-                                                     : size_t(double(large_.size()) * double(end - begin) / double(begin));
-    large_.reserve(large_.size() + more);
+    // Room for the raw bits (grown by doubling they were copied again and again), at the rate of
+    // the part before (a little more: the writer zero-fills what it reserves as it starts to use
+    // it), or at first in float spaces, where nearly every coordinate has some, 64 a coordinate.
+    if (begin > 0) {
+        const double share = double(end - begin) / double(begin);
+        if (grouped_) large_.reserve(large_.size() + size_t(double(large_.size()) * share));
+        else raw_writer_.reserve_bits(uint64_t(double(raw_writer_.bits()) * share * 1.125) + 4096);
+    } else if (space_.quantizer == nullptr) {
+        raw_writer_.reserve_bits(uint64_t(kStaticRoles) * 64 * (end - begin));
+    }
     const bool float64 = space_.quantizer == nullptr && space_.precision == Precision::float64;
     switch (mode_) {
         case GeometryPredictor::normal_frame:
-            if (space_.quantizer != nullptr) add_vertices<false, false, kGridResiduals>(h, created, begin, end);
-            else if (float64) add_vertices<false, false, kFloat64Residuals>(h, created, begin, end);
-            else add_vertices<false, false, kAnyResiduals>(h, created, begin, end);
+            if (space_.quantizer != nullptr) add_vertices<false, false, kGridResiduals, false>(h, created, begin, end);
+            else if (float64) add_vertices<false, false, kFloat64Residuals, false>(h, created, begin, end);
+            else add_vertices<false, false, kAnyResiduals, false>(h, created, begin, end);
             break;
-        case GeometryPredictor::normal_frame_grid: add_vertices<true, true, kGridResiduals>(h, created, begin, end); break;
+        case GeometryPredictor::normal_frame_grid:
+            if (grouped_) add_vertices<true, true, kGridResiduals, true>(h, created, begin, end);
+            else add_vertices<true, true, kGridResiduals, false>(h, created, begin, end);
+            break;
         case GeometryPredictor::midpoint_static:
             if (float64) add_stencil_vertices<false, kFloat64Residuals>(h, created, begin, end);
             else add_stencil_vertices<false, kAnyResiduals>(h, created, begin, end);
@@ -483,8 +491,8 @@ void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, 
             else add_stencil_vertices<true, kAnyResiduals>(h, created, begin, end);
             break;
         default:
-            if (float64) add_vertices<true, false, kFloat64Residuals>(h, created, begin, end);
-            else add_vertices<true, false, kAnyResiduals>(h, created, begin, end);
+            if (float64) add_vertices<true, false, kFloat64Residuals, false>(h, created, begin, end);
+            else add_vertices<true, false, kAnyResiduals, false>(h, created, begin, end);
             break;
     }
 }
@@ -492,7 +500,7 @@ void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, 
 // The loop of add() for one mode: the frame's kind, the table split and the residuals' kind known when it is compiled.
 // A chunk's corners and frames as the decoder makes them (gather_chunk, frame_chunk), then each
 // vertex's residuals in role order.
-template <bool UnitNormals, bool GridBins, int Residuals, class Mesh>
+template <bool UnitNormals, bool GridBins, int Residuals, bool Grouped, class Mesh>
 void StaticLevelEncoder::add_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin,
                                       size_t end) {
     const CoordinateSpace space = space_;
@@ -529,7 +537,10 @@ void StaticLevelEncoder::add_vertices(const Mesh& h, const std::vector<std::pair
                     r = residual_of(space, axis, actual[axis], predicted[role]);
                 }
                 const int token = static_token(r.negative, r.magnitude);
-                if (token >= kDirectTokens) large_.push_back(r);
+                if (token >= kDirectTokens) {
+                    if (Grouped) large_.push_back(r);
+                    else put_raw(raw_writer_, r);
+                }
                 symbols[size_t(role)] = uint16_t(table << kTokenBits | token);
                 raw_bits += uint64_t(static_raw_bit_count(r.magnitude));
                 ++counts_[size_t(table)][size_t(token)];
@@ -553,7 +564,7 @@ void StaticLevelEncoder::add_stencil_vertices(const Mesh& h, const std::vector<s
             const Residual r = Residuals == kFloat64Residuals ? float64_residual(actual[axis], predicted[axis])
                                                               : residual_of(space_, axis, actual[axis], predicted[axis]);
             const int token = static_token(r.negative, r.magnitude);
-            if (token >= kDirectTokens) large_.push_back(r);
+            if (token >= kDirectTokens) put_raw(raw_writer_, r);  // never grouped
             symbols[size_t(axis)] = uint16_t(axis << kTokenBits | token);
             raw_bits += uint64_t(static_raw_bit_count(r.magnitude));
             ++counts_[size_t(axis)][size_t(token)];
@@ -598,37 +609,44 @@ void StaticLevelEncoder::make_tables() {
 
 void StaticLevelEncoder::code_streams() {
     if (coded_) return;
-    RansEncoder rans;
-    rans.reserve(kStaticRoles * symbols_.size());
-    RawBitWriter raw;
-    raw.reserve_bits(raw_bits_);
-    size_t next_large = 0;
-    auto put = [&](uint16_t symbol, size_t large) {
-        const int token = symbol & ((1 << kTokenBits) - 1);
-        rans.put(tables_[size_t(symbol >> kTokenBits)], token);
-        if (token >= kDirectTokens) put_raw(raw, large_[large]);
-    };
+    constexpr uint16_t kTokenMask = (1 << kTokenBits) - 1;
+    // The rANS stream back to front, straight from the symbol words (rANS codes backwards).
+    RansBackwardEncoder rans(kStaticRoles * symbols_.size());
+    auto put = [&](uint16_t symbol) { rans.put(tables_[size_t(symbol >> kTokenBits)], symbol & kTokenMask); };
     if (!grouped_) {
-        for (const std::array<uint16_t, kStaticRoles>& symbols : symbols_)
-            for (uint16_t symbol : symbols) {
-                put(symbol, next_large);
-                next_large += (symbol & ((1 << kTokenBits) - 1)) >= kDirectTokens;
-            }
+        for (size_t i = symbols_.size(); i-- > 0;)
+            for (int role = kStaticRoles; role-- > 0;) put(symbols_[i][size_t(role)]);
     } else {
-        for (size_t begin = 0; begin < symbols_.size(); begin += kGridGroup) {
-            const size_t count = std::min(kGridGroup, symbols_.size() - begin);
-            size_t large[kGridGroup][kStaticRoles];  // each token's residual in large_, read in the per-vertex order
-            for (size_t i = 0; i < count; ++i)
-                for (int role = 0; role < kStaticRoles; ++role) {
-                    large[i][role] = next_large;
-                    next_large += (symbols_[begin + i][size_t(role)] & ((1 << kTokenBits) - 1)) >= kDirectTokens;
-                }
-            for (size_t i = 0; i < count; ++i) put(symbols_[begin + i][0], large[i][0]);
-            for (size_t i = 0; i < count; ++i)
-                for (int role = 1; role < kStaticRoles; ++role) put(symbols_[begin + i][size_t(role)], large[i][role]);
+        // Each run: its role-0 tokens, then each vertex's roles 1 and 2 (FORMAT.md 5.7), backwards.
+        for (size_t run = (symbols_.size() + kGridGroup - 1) / kGridGroup; run-- > 0;) {
+            const size_t begin = run * kGridGroup, count = std::min(kGridGroup, symbols_.size() - begin);
+            for (size_t i = count; i-- > 0;)
+                for (int role = kStaticRoles; role-- > 1;) put(symbols_[begin + i][size_t(role)]);
+            for (size_t i = count; i-- > 0;) put(symbols_[begin + i][0]);
         }
     }
     rans_ = rans.finish();
+    // The raw bits front to back, in the tokens' order (written as they came unless grouped).
+    RawBitWriter& raw = raw_writer_;
+    if (grouped_ && !large_.empty()) {
+        raw.reserve_bits(raw_bits_);
+        size_t next_large = 0;
+        for (size_t begin = 0; begin < symbols_.size(); begin += kGridGroup) {
+            const size_t count = std::min(kGridGroup, symbols_.size() - begin);
+            size_t large[kGridGroup][kStaticRoles];  // each token's residual in large_, kept in the per-vertex order
+            for (size_t i = 0; i < count; ++i)
+                for (int role = 0; role < kStaticRoles; ++role) {
+                    large[i][role] = next_large;
+                    next_large += (symbols_[begin + i][size_t(role)] & kTokenMask) >= kDirectTokens;
+                }
+            auto put_raw_of = [&](size_t i, int role) {
+                if ((symbols_[begin + i][size_t(role)] & kTokenMask) >= kDirectTokens) put_raw(raw, large_[large[i][role]]);
+            };
+            for (size_t i = 0; i < count; ++i) put_raw_of(i, 0);
+            for (size_t i = 0; i < count; ++i)
+                for (int role = 1; role < kStaticRoles; ++role) put_raw_of(i, role);
+        }
+    }
     raw_ = raw.finish();
     symbols_ = {};
     large_ = {};

@@ -125,7 +125,8 @@ private:
     void add(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
     // How add_vertices takes the residuals of modes 3 and 5: residual_of, float64 inline, or grid points inline.
     static constexpr int kAnyResiduals = 0, kFloat64Residuals = 1, kGridResiduals = 2;
-    template <bool UnitNormals, bool GridBins, int Residuals, class Mesh>
+    // Grouped: mode 4 in the grouped order, whose raw bits wait in large_ (see below).
+    template <bool UnitNormals, bool GridBins, int Residuals, bool Grouped, class Mesh>
     void add_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
     // Modes 6 and 7: each axis against the stencil's prediction, with the table of its axis.
     template <bool Butterfly, int Residuals, class Mesh>
@@ -147,9 +148,12 @@ private:
     double token_bits_ = 0;  // the tokens' cost under the tables, sum of log2(M / f)
     uint64_t token_count_ = 0;
     // Until the streams are coded: each coordinate's table and token in one word (table_shifted |
-    // token), and the residuals of the tokens that have raw bits (from kDirectTokens on), in order.
+    // token). The raw bits of the tokens that have them (from kDirectTokens on): in the per-vertex
+    // order, the raw stream's order, they go to `raw_writer_` as the tokens are made; mode 4's
+    // grouped order keeps their residuals in `large_` for code_streams to write in its order.
     std::vector<std::array<uint16_t, kStaticRoles>> symbols_;
     std::vector<StaticResidual> large_;
+    RawBitWriter raw_writer_;
     uint64_t raw_bits_ = 0;
     mutable size_t coded_table_bytes_ = SIZE_MAX;  // coded_table_bytes(), or SIZE_MAX until asked
     bool coded_ = false;
