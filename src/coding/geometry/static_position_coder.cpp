@@ -1373,23 +1373,23 @@ AMC_ALWAYS_INLINE void set_grid_frame(const NormalFrame& f, const GridScale& gri
 }
 
 #if AMC_SSE2
+// A vector of three coordinates per lane: lane 0 to lane0[0..2], lane 1 to lane1[0..2].
+AMC_ALWAYS_INLINE void store_lanes(__m128d x, __m128d y, __m128d z, double* lane0, double* lane1) {
+    _mm_storel_pd(lane0 + 0, x);
+    _mm_storeh_pd(lane1 + 0, x);
+    _mm_storel_pd(lane0 + 1, y);
+    _mm_storeh_pd(lane1 + 1, y);
+    _mm_storel_pd(lane0 + 2, z);
+    _mm_storeh_pd(lane1 + 2, z);
+}
+
 // set_grid_frame for two vertices at once from frame_pair_lanes (each vertex in one lane):
 // set_axis's choice by lane masks, the coordinates stored from the lanes, role 0's grid
 // predictions in one pair. The same operations on the same values, so the same frames.
 AMC_ALWAYS_INLINE void set_grid_frame_pair(const FramePairLanes& l, const GridScale& grid, const double* origin, GridFrame& g0,
                                            GridFrame& g1) {
-    _mm_storel_pd(&g0.midpoint[0], l.mx);
-    _mm_storeh_pd(&g1.midpoint[0], l.mx);
-    _mm_storel_pd(&g0.midpoint[1], l.my);
-    _mm_storeh_pd(&g1.midpoint[1], l.my);
-    _mm_storel_pd(&g0.midpoint[2], l.mz);
-    _mm_storeh_pd(&g1.midpoint[2], l.mz);
-    _mm_storel_pd(&g0.normal[0], l.nx);
-    _mm_storeh_pd(&g1.normal[0], l.nx);
-    _mm_storel_pd(&g0.normal[1], l.ny);
-    _mm_storeh_pd(&g1.normal[1], l.ny);
-    _mm_storel_pd(&g0.normal[2], l.nz);
-    _mm_storeh_pd(&g1.normal[2], l.nz);
+    store_lanes(l.mx, l.my, l.mz, g0.midpoint, g1.midpoint);
+    store_lanes(l.nx, l.ny, l.nz, g0.normal, g1.normal);
     // set_axis: the first axis of largest |N_i|, and whether it is positive and finite.
     const __m128d sign = _mm_set1_pd(-0.0);
     const __m128d x = _mm_andnot_pd(sign, l.nx), y = _mm_andnot_pd(sign, l.ny), z = _mm_andnot_pd(sign, l.nz);
