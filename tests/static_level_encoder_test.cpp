@@ -172,8 +172,16 @@ TEST(StaticLevelEncoder, GridLevelsDecodeAlikeFromTheListAndFromTheNodes) {
                                                     rans_size, raw.data(), raw_size, as)
                           : decode_static_positions(out, created, space, mode, tables, rans.data(), rans_size, raw.data(), raw_size, as);
         };
-        for (bool listed : {false, true}) {
-            SCOPED_TRACE(listed ? "listed" : "nodes");
+        // From the nodes, and from the list with mode 4's frames four at a time (AVX2, where the
+        // processor has it) and two at a time: the same positions.
+        for (int way = 0; way < 3; ++way) {
+            const bool listed = way > 0;
+            SCOPED_TRACE(way == 0 ? "nodes" : way == 1 ? "listed, frames four at a time" : "listed, frames in pairs");
+            struct WideFrames {
+                bool before;
+                explicit WideFrames(bool allowed) : before(set_wide_frames(allowed)) {}
+                ~WideFrames() { set_wide_frames(before); }
+            } wide_frames(way != 2);
             Hierarchy decoded;
             ASSERT_TRUE(decode(listed, rans.size(), raw.size(), decoded, order));
             ASSERT_EQ(decoded.positions().size(), listed ? first + created.size() : first);

@@ -11,6 +11,7 @@
 #include "common/little_endian.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
@@ -1500,12 +1501,26 @@ AMC_ALWAYS_INLINE bool decode_grid_grouped(StencilStreams& s, const GridTable* t
     return count % 2 == 0 ? roles_1_2(std::false_type{}) : roles_1_2(std::true_type{});
 }
 
+// The frames of `count` listed vertices, two at a time with SSE2.
+struct PairFrames {
+    AMC_ALWAYS_INLINE void operator()(const Hierarchy& h, const FrameCorners* corners, size_t count, const GridScale& grid,
+                                      const double* origin, GridFrame* frames) const {
+        size_t i = 0;
+#if AMC_SSE2
+        for (; i + 1 < count; i += 2)
+            set_grid_frame_pair(frame_pair_lanes<true>(h, corners[i], corners[i + 1]), grid, origin, frames[i], frames[i + 1]);
+#endif
+        for (; i < count; ++i) set_grid_frame(frame_of<true>(h, corners[i]), grid, origin, frames[i]);
+    }
+};
+
 // The fast path's condition: a double-precision hierarchy (every quantized one) and narrow tables.
 // Grouped: the tokens in the grouped order (version 18), else vertex after vertex (one loop each,
-// so that either compiles as if alone).
-template <bool Grouped>
-bool decode_grid_listed(Hierarchy& h, const FromList& created, const Quantizer& quantizer, const StaticTables& tables,
-                        const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
+// so that either compiles as if alone). The frames by `make_frames` (PairFrames or QuadFrames).
+template <bool Grouped, class MakeFrames>
+AMC_ALWAYS_INLINE bool decode_grid_listed_with(Hierarchy& h, const FromList& created, const Quantizer& quantizer,
+                                               const StaticTables& tables, const uint8_t* rans_data, size_t rans_size,
+                                               const uint8_t* raw_data, size_t raw_size, MakeFrames make_frames) {
     std::array<GridTable, kMaxStaticTables> t;
     for (size_t k = 0; k < t.size(); ++k) make_grid_table(tables[k], t[k]);
     StencilStreams s;
@@ -1534,12 +1549,7 @@ bool decode_grid_listed(Hierarchy& h, const FromList& created, const Quantizer& 
             __builtin_prefetch(positions + k.c);
             if (k.d != kNoVertex) __builtin_prefetch(positions + k.d);
         }
-        size_t i = 0;
-#if AMC_SSE2
-        for (; i + 1 < count; i += 2)
-            set_grid_frame_pair(frame_pair_lanes<true>(h, corners[i], corners[i + 1]), grid, origin, frames[i], frames[i + 1]);
-#endif
-        for (; i < count; ++i) set_grid_frame(frame_of<true>(h, corners[i]), grid, origin, frames[i]);
+        make_frames(h, corners, count, grid, origin, frames.data());
         auto run = [&](auto safe) {
             constexpr bool Safe = decltype(safe)::value;
             StencilStreams local = s;  // the chunk's copy, which the compiler keeps in registers
@@ -1571,6 +1581,180 @@ bool decode_grid_listed(Hierarchy& h, const FromList& created, const Quantizer& 
         }
     }
     return s.ended_cleanly();
+}
+
+template <bool Grouped>
+bool decode_grid_listed(Hierarchy& h, const FromList& created, const Quantizer& quantizer, const StaticTables& tables,
+                        const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
+    return decode_grid_listed_with<Grouped>(h, created, quantizer, tables, rans_data, rans_size, raw_data, raw_size,
+                                            PairFrames{});
+}
+
+#if AMC_AVX2_AT_RUN_TIME
+// Whether decode_grid_listed may make its frames four at a time (set_wide_frames).
+std::atomic<bool> wide_frames_allowed{true};
+
+#pragma GCC push_options
+#pragma GCC target("avx2")
+// exact_float.h's rounded for AVX's vectors (a template instantiated outside this region would
+// pass them in the SSE2 ABI).
+inline __m256d rounded(__m256d x) {
+    __asm__("" : "+x"(x));
+    return x;
+}
+
+inline __m256d rounded_product(__m256d u, __m256d v) { return rounded(_mm256_mul_pd(u, v)); }
+
+// frame_pair_lanes<true> for four vertices, one in each lane of every AVX operation: the same IEEE
+// operations in the same order (the comparisons ordered, as SSE2's), so the same bits.
+struct FrameQuadLanes {
+    __m256d mx, my, mz, nx, ny, nz;
+};
+
+inline FrameQuadLanes frame_quad_lanes(const Hierarchy& h, const FrameCorners* k) {
+    struct Lanes {
+        __m256d x, y, z;
+    };
+    const Vec3* positions = h.positions().data();
+    auto load = [positions](VertexId v0, VertexId v1, VertexId v2, VertexId v3) {
+        auto pair = [positions](VertexId u, VertexId v, __m128d& x, __m128d& y, __m128d& z) {
+            const Vec3& p = positions[u];
+            const Vec3& q = positions[v];
+            const __m128d xy0 = _mm_loadu_pd(&p.x), xy1 = _mm_loadu_pd(&q.x);
+            x = _mm_unpacklo_pd(xy0, xy1);
+            y = _mm_unpackhi_pd(xy0, xy1);
+            z = _mm_loadh_pd(_mm_load_sd(&p.z), &q.z);
+        };
+        __m128d x01, y01, z01, x23, y23, z23;
+        pair(v0, v1, x01, y01, z01);
+        pair(v2, v3, x23, y23, z23);
+        return Lanes{_mm256_set_m128d(x23, x01), _mm256_set_m128d(y23, y01), _mm256_set_m128d(z23, z01)};
+    };
+    auto sub = [](const Lanes& u, const Lanes& v) {
+        return Lanes{_mm256_sub_pd(u.x, v.x), _mm256_sub_pd(u.y, v.y), _mm256_sub_pd(u.z, v.z)};
+    };
+    auto cross = [](const Lanes& u, const Lanes& v) {
+        return Lanes{_mm256_sub_pd(rounded_product(u.y, v.z), rounded_product(u.z, v.y)),
+                     _mm256_sub_pd(rounded_product(u.z, v.x), rounded_product(u.x, v.z)),
+                     _mm256_sub_pd(rounded_product(u.x, v.y), rounded_product(u.y, v.x))};
+    };
+    auto dot = [&](const Lanes& u) {  // exact_dot(u, u)
+        return _mm256_add_pd(_mm256_add_pd(rounded_product(u.x, u.x), rounded_product(u.y, u.y)), rounded_product(u.z, u.z));
+    };
+    const bool has_d[4] = {k[0].d != kNoVertex, k[1].d != kNoVertex, k[2].d != kNoVertex, k[3].d != kNoVertex};
+    const Lanes a = load(k[0].a, k[1].a, k[2].a, k[3].a), b = load(k[0].b, k[1].b, k[2].b, k[3].b),
+                c = load(k[0].c, k[1].c, k[2].c, k[3].c);
+    const Lanes d = load(has_d[0] ? k[0].d : k[0].a, has_d[1] ? k[1].d : k[1].a, has_d[2] ? k[2].d : k[2].a,
+                         has_d[3] ? k[3].d : k[3].a);
+    const __m256d half = _mm256_set1_pd(0.5);
+    const Lanes mid{rounded_product(_mm256_add_pd(a.x, b.x), half), rounded_product(_mm256_add_pd(a.y, b.y), half),
+                    rounded_product(_mm256_add_pd(a.z, b.z), half)};
+    const Lanes n1 = cross(sub(b, a), sub(c, a));
+    const Lanes n2 = cross(sub(a, b), sub(d, b));
+    const __m256d with_d = _mm256_castsi256_pd(
+        _mm256_set_epi64x(-int64_t(has_d[3]), -int64_t(has_d[2]), -int64_t(has_d[1]), -int64_t(has_d[0])));
+    auto pick = [with_d](__m256d u, __m256d v) {
+        return _mm256_or_pd(_mm256_and_pd(with_d, _mm256_add_pd(u, v)), _mm256_andnot_pd(with_d, u));
+    };
+    const __m256d zero = _mm256_setzero_pd(), infinity = _mm256_set1_pd(HUGE_VAL), one = _mm256_set1_pd(1.0);
+    const __m256d l1 = _mm256_sqrt_pd(dot(n1)), l2 = _mm256_sqrt_pd(dot(n2));
+    const __m256d r1 = _mm256_div_pd(one, l1), r2 = _mm256_div_pd(one, l2);
+    const __m256d v1 = _mm256_and_pd(_mm256_cmp_pd(l1, zero, _CMP_GT_OS), _mm256_cmp_pd(l1, infinity, _CMP_LT_OS));
+    const __m256d v2 = _mm256_and_pd(_mm256_cmp_pd(l2, zero, _CMP_GT_OS), _mm256_cmp_pd(l2, infinity, _CMP_LT_OS));
+    auto unit = [](const Lanes& u, __m256d r, __m256d valid) {
+        return Lanes{_mm256_and_pd(valid, rounded_product(r, u.x)), _mm256_and_pd(valid, rounded_product(r, u.y)),
+                     _mm256_and_pd(valid, rounded_product(r, u.z))};
+    };
+    const Lanes u1 = unit(n1, r1, v1), u2 = unit(n2, r2, v2);
+    return {mid.x, mid.y, mid.z, pick(u1.x, u2.x), pick(u1.y, u2.y), pick(u1.z, u2.z)};
+}
+
+// A vector of one coordinate per lane: lane j to frames[j].
+inline void store_quad(__m256d v, double (GridFrame::*array)[3], int axis, GridFrame* g) {
+    const __m128d low = _mm256_castpd256_pd128(v), high = _mm256_extractf128_pd(v, 1);
+    _mm_storel_pd(&(g[0].*array)[axis], low);
+    _mm_storeh_pd(&(g[1].*array)[axis], low);
+    _mm_storel_pd(&(g[2].*array)[axis], high);
+    _mm_storeh_pd(&(g[3].*array)[axis], high);
+}
+
+// set_grid_frame_pair for four vertices: set_axis by lane masks, role 0's grid predictions in two
+// pairs.
+inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, const double* origin, GridFrame* g) {
+    store_quad(l.mx, &GridFrame::midpoint, 0, g);
+    store_quad(l.my, &GridFrame::midpoint, 1, g);
+    store_quad(l.mz, &GridFrame::midpoint, 2, g);
+    store_quad(l.nx, &GridFrame::normal, 0, g);
+    store_quad(l.ny, &GridFrame::normal, 1, g);
+    store_quad(l.nz, &GridFrame::normal, 2, g);
+    const __m256d sign = _mm256_set1_pd(-0.0);
+    const __m256d x = _mm256_andnot_pd(sign, l.nx), y = _mm256_andnot_pd(sign, l.ny), z = _mm256_andnot_pd(sign, l.nz);
+    const __m256d y_wins = _mm256_cmp_pd(y, x, _CMP_GT_OS);
+    const __m256d best = _mm256_max_pd(y, x);
+    const __m256d z_wins = _mm256_cmp_pd(z, best, _CMP_GT_OS);
+    const __m256d largest = _mm256_max_pd(z, best);
+    const int has = _mm256_movemask_pd(_mm256_and_pd(_mm256_cmp_pd(largest, _mm256_setzero_pd(), _CMP_GT_OS),
+                                                     _mm256_cmp_pd(largest, _mm256_set1_pd(HUGE_VAL), _CMP_LT_OS)));
+    const int ys = _mm256_movemask_pd(y_wins), zs = _mm256_movemask_pd(z_wins);
+    for (int j = 0; j < 4; ++j) {
+        g[j].has_normal = ((has >> j) & 1) != 0;
+        g[j].axis = (has >> j) & 1 ? ((zs >> j) & 1 ? 2 : (ys >> j) & 1) : 0;
+    }
+    // Role 0's grid predictions (grid_point_pair's, four lanes): each lane's coordinate and origin
+    // on its axis chosen by the same masks.
+    const __m256d with_normal = _mm256_castsi256_pd(_mm256_set_epi64x(-int64_t((has >> 3) & 1), -int64_t((has >> 2) & 1),
+                                                                      -int64_t((has >> 1) & 1), -int64_t(has & 1)));
+    const __m256d on_z = _mm256_and_pd(with_normal, z_wins), on_y = _mm256_andnot_pd(z_wins, _mm256_and_pd(with_normal, y_wins));
+    const __m256d value = _mm256_blendv_pd(_mm256_blendv_pd(l.mx, l.my, on_y), l.mz, on_z);
+    const __m256d from = _mm256_blendv_pd(_mm256_blendv_pd(_mm256_set1_pd(origin[0]), _mm256_set1_pd(origin[1]), on_y),
+                                          _mm256_set1_pd(origin[2]), on_z);
+    const __m256d zero = _mm256_setzero_pd();
+    const __m256d t = rounded(_mm256_div_pd(_mm256_sub_pd(value, from), _mm256_set1_pd(grid.step)));
+    const __m256d high = _mm256_cmp_pd(t, _mm256_set1_pd(grid.top), _CMP_GE_OS);
+    const __m256d inside = _mm256_andnot_pd(high, _mm256_cmp_pd(t, zero, _CMP_GT_OS));
+    const __m128i p = _mm256_cvttpd_epi32(rounded(_mm256_add_pd(t, _mm256_set1_pd(0.5))));
+    const __m256d f = rounded(_mm256_sub_pd(t, _mm256_cvtepi32_pd(p)));
+    const __m256d bin = _mm256_and_pd(inside, _mm256_cmp_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), f), _mm256_set1_pd(0.25), _CMP_GE_OS));
+    const __m256d turn = _mm256_and_pd(inside, _mm256_cmp_pd(f, zero, _CMP_LT_OS));
+    const __m256i point = _mm256_or_si256(_mm256_and_si256(_mm256_castpd_si256(inside), _mm256_cvtepu32_epi64(p)),
+                                          _mm256_and_si256(_mm256_castpd_si256(high), _mm256_set1_epi64x(int64_t(grid.max))));
+    uint64_t points[4], offsets[4];
+    int64_t turns[4];
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(points), point);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(offsets),
+                        _mm256_and_si256(_mm256_castpd_si256(bin), _mm256_set1_epi64x(int64_t(sizeof(GridTable)))));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(turns), _mm256_castpd_si256(turn));
+    for (int j = 0; j < 4; ++j) g[j].first = {points[j], offsets[j], turns[j]};
+}
+
+// PairFrames four at a time.
+struct QuadFrames {
+    void operator()(const Hierarchy& h, const FrameCorners* corners, size_t count, const GridScale& grid, const double* origin,
+                    GridFrame* frames) const {
+        size_t i = 0;
+        for (; i + 3 < count; i += 4) set_grid_frame_quad(frame_quad_lanes(h, corners + i), grid, origin, frames + i);
+        PairFrames()(h, corners + i, count - i, grid, origin, frames + i);
+    }
+};
+
+template <bool Grouped>
+bool decode_grid_listed_avx2(Hierarchy& h, const FromList& created, const Quantizer& quantizer, const StaticTables& tables,
+                             const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
+    return decode_grid_listed_with<Grouped>(h, created, quantizer, tables, rans_data, rans_size, raw_data, raw_size,
+                                            QuadFrames{});
+}
+#pragma GCC pop_options
+#endif
+
+// decode_grid_listed, with AVX2's frames where the processor has them.
+template <bool Grouped>
+bool decode_grid_listed_fastest(Hierarchy& h, const FromList& created, const Quantizer& quantizer, const StaticTables& tables,
+                                const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
+#if AMC_AVX2_AT_RUN_TIME
+    if (has_avx2() && wide_frames_allowed.load(std::memory_order_relaxed))
+        return decode_grid_listed_avx2<Grouped>(h, created, quantizer, tables, rans_data, rans_size, raw_data, raw_size);
+#endif
+    return decode_grid_listed<Grouped>(h, created, quantizer, tables, rans_data, rans_size, raw_data, raw_size);
 }
 
 template <class Tables>
@@ -1629,14 +1813,23 @@ bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, G
     }
     if constexpr (std::is_same_v<Source, FromList>) {
         if (all_narrow && mode == GeometryPredictor::normal_frame_grid && space.quantizer != nullptr && !h.single_precision())
-            return grouped ? decode_grid_listed<true>(h, created, *space.quantizer, tables, rans_data, rans_size, raw_data, raw_size)
-                           : decode_grid_listed<false>(h, created, *space.quantizer, tables, rans_data, rans_size, raw_data, raw_size);
+            return grouped ? decode_grid_listed_fastest<true>(h, created, *space.quantizer, tables, rans_data, rans_size, raw_data, raw_size)
+                           : decode_grid_listed_fastest<false>(h, created, *space.quantizer, tables, rans_data, rans_size, raw_data, raw_size);
     }
     if (all_narrow) return decode_static_with(h, created, space, mode, narrow, rans_data, rans_size, raw_data, raw_size, grouped);
     return decode_static_with(h, created, space, mode, tables, rans_data, rans_size, raw_data, raw_size, grouped);
 }
 
 }  // namespace
+
+bool set_wide_frames(bool allowed) {
+#if AMC_AVX2_AT_RUN_TIME
+    return wide_frames_allowed.exchange(allowed);
+#else
+    (void)allowed;
+    return false;
+#endif
+}
 
 bool decode_static_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
                              GeometryPredictor mode, const StaticTables& tables, const uint8_t* rans_data, size_t rans_size,
