@@ -1565,7 +1565,7 @@ int main(int argc, char** argv) {
     };
     std::vector<double> library;
     for (const ModelData& d : data) library.push_back(d.library_bits);
-    row("the coder's mixing mode (as encoders write it: the sixth model, version 19)", library);
+    row("the coder's mixing mode (as encoders write it when the cache was made: since 2026-12-05 the seventh model, version 20)", library);
     for (const Design& design : designs) {
         if (only && &design != &designs[0]) {  // ONLY=a|b|c: any of them
             bool wanted = false;
@@ -1631,7 +1631,7 @@ int main(int argc, char** argv) {
         for (size_t m = 0; m < data.size(); ++m) {
             Options o = design.o;
             if (o.trained_start && weights_in) o.start = given;
-            else if (o.trained_start)
+            else if (o.trained_start && data.size() > 1)
                 for (size_t k = 0; k < mixers; ++k) {
                     std::vector<double> sum(ended[0][size_t(k)].size(), 0);
                     for (size_t other = 0; other < data.size(); ++other)
@@ -1639,6 +1639,10 @@ int main(int argc, char** argv) {
                             for (size_t i = 0; i < sum.size(); ++i) sum[i] += ended[other][size_t(k)][i] / double(data.size() - 1);
                     o.start[size_t(k)].assign(sum.begin(), sum.end());
                 }
+            // A single model leaves no other to start from: its mixers start at 1/n each (the
+            // mean over no model gave all-zero weights, every input ignored at first).
+            else if (o.trained_start && m == 0)
+                std::fprintf(stderr, "%s: one model: the mixers start at 1/n (no other model to take start weights from)\n", design.name.c_str());
             Counts prior;
             if (o.prior_count > 0) {
                 for (size_t other = 0; other < data.size(); ++other)

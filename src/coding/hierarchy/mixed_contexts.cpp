@@ -491,10 +491,13 @@ MixedHierarchyModel::MixedHierarchyModel(MixingModel model, const TrainedStateTa
         };
         if (model >= MixingModel::sixth) assign(kept_tables<MixingModel::sixth>(), later_tables<MixingModel::sixth>());
         if (model == MixingModel::seventh) {
+            // Each character's model once (an ASCII table), then a copy per slot.
+            std::array<BitModel, 128> start;
+            for (size_t c = 0; c < start.size(); ++c) start[c] = trained_state(char(c), kModelWindowLog2);
             for (size_t k = 0; k < kTrainedTables.size(); ++k) {
                 std::vector<BitModel>& table = models_[size_t(kTrainedTables[k])];
                 const char* states = trained[k];
-                for (size_t slot = 0; slot < table.size() && states[slot] != '\0'; ++slot) table[slot] = trained_state(states[slot], kModelWindowLog2);
+                for (size_t slot = 0; slot < table.size() && states[slot] != '\0'; ++slot) table[slot] = start[uint8_t(states[slot]) & 127u];
             }
         }
         else if (model == MixingModel::fifth) assign(kept_tables<MixingModel::fifth>(), later_tables<MixingModel::fifth>());
