@@ -75,17 +75,6 @@ std::array<std::string, kTables> state_strings(const SlotCounts& counts) {
     return out;
 }
 
-double code_length(const std::vector<Symbol>& symbols, MixingModel model, const TrainedStateTables& trained) {
-    MixedHierarchyModel coder(model, trained);
-    double bits = 0;
-    for (const Symbol& s : symbols) {
-        const double p = coder.p16(s.f) / 65536.0;
-        bits -= std::log2(s.bit ? p : 1 - p);
-        coder.update(s.bit != 0);
-    }
-    return bits;
-}
-
 TrainedStateTables pointers(const std::array<std::string, kTables>& strings) {
     TrainedStateTables t{};
     for (size_t k = 0; k < kTables; ++k) t[k] = strings[k].c_str();
@@ -158,9 +147,9 @@ int main(int argc, char** argv) {
             if (o != m && training(o) && mesh_of(data[o].name) != mesh_of(data[m].name)) add(others, counted[o]);
         const std::array<std::string, kTables> strings = state_strings(others);
         const ModelData& d = data[m];
-        const double b6 = code_length(d.symbols, MixingModel::sixth, kTrainedStateTables);
-        const double b7 = code_length(d.symbols, MixingModel::seventh, pointers(strings));
-        const double bc = code_length(d.symbols, MixingModel::seventh, kTrainedStateTables);
+        const double b6 = mixed_study::model_bits(MixingModel::sixth, d.symbols);
+        const double b7 = mixed_study::model_bits(MixingModel::seventh, d.symbols, pointers(strings));
+        const double bc = mixed_study::model_bits(MixingModel::seventh, d.symbols);
         auto change = [&](double b) { return 100.0 * (b - d.paper_bits) / d.paper_bits; };
         std::printf("| %s | %s | %.0f | %+.2f%% | %+.2f%% | %+.2f%% |\n", d.name.c_str(), training(m) ? "yes" : "no", d.paper_bits,
                     change(b6), change(b7), change(bc));
