@@ -67,9 +67,10 @@ struct ModelData {
     double second_bits = 0;   // the coder's second model (version 10) on the same symbols
 };
 
-// The adaptive code length of `symbols` under the coder's mixing model `model`.
-inline double model_bits(MixingModel model, const std::vector<Symbol>& symbols) {
-    MixedHierarchyModel coder(model);
+// The adaptive code length of `symbols` under the coder's mixing model `model` (the seventh's
+// trained initial states `trained`).
+inline double model_bits(MixingModel model, const std::vector<Symbol>& symbols, const TrainedStateTables& trained = kTrainedStateTables) {
+    MixedHierarchyModel coder(model, trained);
     double bits = 0;
     for (const Symbol& s : symbols) {
         const double p = coder.p16(s.f) / 65536.0;

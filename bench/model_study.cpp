@@ -643,6 +643,7 @@ struct Options {
     int prior_last_extras = 0;  // > 0: trained initial states only for the last this many extra tables
     int prior_skip_last = 0;    // with prior_last_extras: not the last this many of them
     int prior_step = 0;         // > 0: a trained state's probability rounded to multiples of this in the stretched domain
+    bool prior_count_fixed = false;  // every reached slot starts with count prior_count (the seventh model's form)
     // > 0: a direct or extra model coded for the first time starts, before its update, at the
     // probability the symbol was coded with, as if it had seen this many symbols (an online prior).
     int fresh_from_final = 0;
@@ -757,7 +758,7 @@ public:
                         p = 1 / (1 + std::exp(-st));
                     }
                     m.p = uint32_t(std::clamp(p * 4294967296.0, 65536.0, 4294967296.0 - 65536.0));
-                    m.n = uint16_t(std::min<uint32_t>(uint32_t(o.prior_count), n));
+                    m.n = uint16_t(o.prior_count_fixed ? uint32_t(o.prior_count) : std::min<uint32_t>(uint32_t(o.prior_count), n));
                 }
         }
     }
@@ -1515,6 +1516,10 @@ int main(int argc, char** argv) {
         add("R7: sixth + trained initial states of the geometric tables, count 4, rounded to " + std::to_string(step) + "/256 of a logit", [&, step](Options& o) {
             sixth_coded(o), o.prior_count = 4, o.prior_geometric_only = true, o.prior_step = step;
         });
+    // Session of 2026-12-05, the seventh model's form: every reached slot at count 4, half logits.
+    add("R7: sixth + trained initial states of the geometric tables, count 4 for every reached slot, rounded to 128/256 of a logit", [&](Options& o) {
+        sixth_coded(o), o.prior_count = 4, o.prior_geometric_only = true, o.prior_step = 128, o.prior_count_fixed = true;
+    });
     add("R7: sixth + mixer E by z x count", [&](Options& o) {
         sixth_coded(o), o.mixer_e = [](F, X x) { return x.dyn_z * 8u + x.dyn_count; }, o.mixer_e_sets = 128;
     });
@@ -1560,7 +1565,7 @@ int main(int argc, char** argv) {
     };
     std::vector<double> library;
     for (const ModelData& d : data) library.push_back(d.library_bits);
-    row("the coder's mixing mode (as encoders write it: the sixth model, version 19)", library);
+    row("the coder's mixing mode (as encoders write it when the cache was made: since 2026-12-05 the seventh model, version 20)", library);
     for (const Design& design : designs) {
         if (only && &design != &designs[0]) {  // ONLY=a|b|c: any of them
             bool wanted = false;
@@ -1626,7 +1631,7 @@ int main(int argc, char** argv) {
         for (size_t m = 0; m < data.size(); ++m) {
             Options o = design.o;
             if (o.trained_start && weights_in) o.start = given;
-            else if (o.trained_start)
+            else if (o.trained_start && data.size() > 1)
                 for (size_t k = 0; k < mixers; ++k) {
                     std::vector<double> sum(ended[0][size_t(k)].size(), 0);
                     for (size_t other = 0; other < data.size(); ++other)
@@ -1634,6 +1639,10 @@ int main(int argc, char** argv) {
                             for (size_t i = 0; i < sum.size(); ++i) sum[i] += ended[other][size_t(k)][i] / double(data.size() - 1);
                     o.start[size_t(k)].assign(sum.begin(), sum.end());
                 }
+            // A single model leaves no other to start from: its mixers start at 1/n each (the
+            // mean over no model gave all-zero weights, every input ignored at first).
+            else if (o.trained_start && m == 0)
+                std::fprintf(stderr, "%s: one model: the mixers start at 1/n (no other model to take start weights from)\n", design.name.c_str());
             Counts prior;
             if (o.prior_count > 0) {
                 for (size_t other = 0; other < data.size(); ++other)

@@ -157,7 +157,7 @@ std::vector<uint8_t> golden_file(const GoldenCase& c, int version, const std::ve
 
 // The file of c in the version its bytes say (14: an adaptive level of a bit-exact file with its
 // raw bits in a side stream; 15: a level of a bit-exact file in geometry mode 6 or 7; 16: the
-// mixing mode's fourth model; 17: its fifth; 19: its sixth) equals the encoder's bytes and decodes to c's hierarchy (every prefix
+// mixing mode's fourth model; 17: its fifth; 19: its sixth; 20: its seventh) equals the encoder's bytes and decodes to c's hierarchy (every prefix
 // of levels too); the cases pinned by older versions' tests that encoders now write as one of those
 // versions. The files of versions 14 to the written one's of the case still decode.
 void pin_newer_encoding(const GoldenCase& c, const std::vector<uint8_t>& bytes) {
@@ -446,13 +446,13 @@ TEST(Golden, ThirdMixingModelFilesDecodeAndPinTheEncoder) {
     }
 }
 
-// Version 16 (the mixing mode's fourth model, FORMAT.md 2.4), 17 (its fifth, 2.5) and 19 (its
-// sixth, 2.6): the encoder writes the sixth unless an older model codes the file smaller, so no case
-// grows against the file the third model made (its newest golden file of versions 11-15) nor
-// against the fourth's (v16/) or the fifth's (v17/), which encoders wrote before and which still
-// decode (the test above pins the bytes, in v19/ where 19).
-TEST(Golden, SixthMixingModelFilesAreNoLargerThanTheOlderModels) {
-    int fourth = 0, fifth = 0, sixth = 0;
+// Version 16 (the mixing mode's fourth model, FORMAT.md 2.4), 17 (its fifth, 2.5), 19 (its sixth,
+// 2.6) and 20 (its seventh, 2.7): the encoder writes the seventh unless an older model codes the
+// file smaller, so no case grows against the file the third model made (its newest golden file of
+// versions 11-15) nor against the fourth's (v16/), the fifth's (v17/) or the sixth's (v19/), which
+// encoders wrote before and which still decode (the test above pins the bytes, in v20/ where 20).
+TEST(Golden, SeventhMixingModelFilesAreNoLargerThanTheOlderModels) {
+    int fourth = 0, fifth = 0, sixth = 0, seventh = 0;
     for (const GoldenCase& c : later_mixing_cases()) {
         SCOPED_TRACE(c.name);
         const std::vector<uint8_t> bytes = encode(c.hierarchy, c.options);
@@ -462,24 +462,25 @@ TEST(Golden, SixthMixingModelFilesAreNoLargerThanTheOlderModels) {
         ASSERT_FALSE(third.empty());
         EXPECT_LE(bytes.size(), third.size());
         size_t smallest_older = third.size();
-        for (const int version : {kFourthMixingVersion, kFifthMixingVersion}) {
+        for (const int version : {kFourthMixingVersion, kFifthMixingVersion, kSixthMixingVersion}) {
             const std::vector<uint8_t> older = read_golden(golden_path(version, c.name));
             if (older.empty()) continue;
-            ++(version == kFourthMixingVersion ? fourth : fifth);
+            ++(version == kFourthMixingVersion ? fourth : version == kFifthMixingVersion ? fifth : sixth);
             check_decodes(older, c, version);
             EXPECT_LE(bytes.size(), older.size()) << "version " << version;
             smallest_older = std::min(smallest_older, older.size());
         }
-        if (bytes[4] == kSixthMixingVersion) {
-            sixth += bytes.size() < smallest_older;
-            check_decodes(bytes, c, kSixthMixingVersion);
+        if (bytes[4] == kSeventhMixingVersion) {
+            seventh += bytes.size() < smallest_older;
+            check_decodes(bytes, c, kSeventhMixingVersion);
         } else {
             EXPECT_EQ(bytes.size(), smallest_older) << "an older model's file, as before";
         }
     }
     EXPECT_GE(fourth, 1) << "some case has a fourth-model file";
     EXPECT_GE(fifth, 1) << "some case has a fifth-model file";
-    EXPECT_GE(sixth, 1) << "the quadric's ring means code some case smaller than every older model";
+    EXPECT_GE(sixth, 1) << "some case has a sixth-model file";
+    EXPECT_GE(seventh, 1) << "the trained states code some case smaller than every older model";
 }
 
 // Version 12 (level geometry mode 5, the normal frame of unit normals with three tables): the

@@ -8,6 +8,7 @@
 #include "coding/hierarchy/context_mixing.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
 #include "coding/hierarchy/mixed_contexts.h"
+#include "coding/hierarchy/trained_states.h"
 #include "hierarchy_checks.h"
 
 #include <amc/codec.h>
@@ -133,10 +134,10 @@ TEST(MixedContexts, RandomHierarchiesRoundTripBitExactlyUnderEverySwitch) {
         }
         options.predictor = GeometryPredictor(random.next() % 4);
         const std::vector<uint8_t> bytes = encode(h, options);
-        // The sixth model's version, or the fifth's, fourth's or third's where they code smaller (14
-        // where a bit-exact level is adaptive, its raw bits in a side stream).
-        ASSERT_TRUE(bytes[4] == kSixthMixingVersion || bytes[4] == kFifthMixingVersion || bytes[4] == kFourthMixingVersion ||
-                    bytes[4] == kThirdMixingVersion ||
+        // The seventh model's version, or an older model's where it codes smaller (14 where a
+        // bit-exact level is adaptive, its raw bits in a side stream).
+        ASSERT_TRUE(bytes[4] == kSeventhMixingVersion || bytes[4] == kSixthMixingVersion || bytes[4] == kFifthMixingVersion ||
+                    bytes[4] == kFourthMixingVersion || bytes[4] == kThirdMixingVersion ||
                     (options.quantize_bits == 0 && bytes[4] == kRawSideVersion))
             << trial;
         const Hierarchy back = decode(bytes.data(), bytes.size());
@@ -256,6 +257,47 @@ TEST(MixedContexts, TheQuadricsRingMeansCodeACurvedRemeshSmallerThanTheFifthMode
     EXPECT_GT(compared, 1000);
     const double fifth = mixing_model_bits(h, MixingModel::fifth), sixth = mixing_model_bits(h, MixingModel::sixth);
     EXPECT_LT(sixth, fifth);
+}
+
+// The seventh model's trained initial states (FORMAT.md 2.7): each table's string has a state per
+// slot, in the alphabet; a state starts its slot at squash(128 s) with kTrainedCount symbols seen
+// (known answers), an untrained slot flat.
+TEST(MixedContexts, TheTrainedStatesCoverTheirTablesAndStartAtTheirStates) {
+    const MixedHierarchyModel seventh(MixingModel::seventh);
+    size_t trained = 0, slots = 0;
+    for (size_t k = 0; k < kTrainedTables.size(); ++k) {
+        SCOPED_TRACE(kTrainedTables[k]);
+        const std::string states = kTrainedStateTables[k];
+        ASSERT_EQ(states.size(), seventh.table_size(kTrainedTables[k]));
+        for (char c : states) {
+            ASSERT_TRUE(c == kUntrainedSlot || trained_state_char(trained_state_of(c)) == c) << c;
+            trained += c != kUntrainedSlot;
+        }
+        slots += states.size();
+    }
+    EXPECT_EQ(slots, 112704u);
+    EXPECT_GT(trained, slots / 4);
+    for (int s = -kLargestTrainedState; s <= kLargestTrainedState; ++s) EXPECT_EQ(trained_state_of(trained_state_char(s)), s);
+    EXPECT_EQ(trained_state_char(0), '0');
+    EXPECT_EQ(trained_state_char(15), 'O');
+    EXPECT_EQ(trained_state_char(-1), 'a');
+    const BitModel flat = trained_state(kUntrainedSlot, 8), even = trained_state('0', 8), likely = trained_state('O', 8);
+    const BitModel unlikely = trained_state('a', 8);
+    EXPECT_EQ(flat.p, uint32_t{1} << 31);
+    EXPECT_EQ(flat.n, 0);
+    EXPECT_EQ(even.p, uint32_t{2047} << 20);  // squash(0)
+    EXPECT_EQ(likely.p, uint32_t{4093} << 20);    // squash(1920), the last knot but one
+    EXPECT_EQ(unlikely.p, uint32_t{1546} << 20);  // squash(-128): odds of e^-1/2
+    EXPECT_EQ(likely.n, kTrainedCount);
+    EXPECT_EQ(likely.limit_log2, 8);
+}
+
+// The trained states make a curved remesh's code smaller than the sixth model's: the remesh is none
+// of the training models (bunny, elephant and the rest: bench/trained_states).
+TEST(MixedContexts, TheTrainedStatesCodeACurvedRemeshSmallerThanTheSixthModel) {
+    const Hierarchy h = curved_remesh();
+    const double sixth = mixing_model_bits(h, MixingModel::sixth), seventh = mixing_model_bits(h, MixingModel::seventh);
+    EXPECT_LT(seventh, sixth);
 }
 
 TEST(MixedContexts, TheModeIsRefusedInOlderVersions) {

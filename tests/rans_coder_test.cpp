@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -122,6 +123,27 @@ TEST(Rans, BackwardEncoderMakesTheQueuedEncodersStream) {
     RansBackwardEncoder one(1);
     one.put(t, 0);
     EXPECT_THROW(one.put(t, 1), Error);
+}
+
+TEST(Rans, BackwardEncodersPutAllMakesThePutStream) {
+    // put_all in runs of every parity of length and stream position, mixed with single puts.
+    for (size_t n : {size_t(0), size_t(1), size_t(2), size_t(5), size_t(1000), size_t(30001)}) {
+        const std::vector<int> a = skewed_symbols(n, 40, 7);
+        const RansTable t = RansTable::from_counts(counts_of(a, 40));
+        RansBackwardEncoder one_by_one(n), in_runs(n);
+        for (size_t i = n; i-- > 0;) one_by_one.put(t, a[i]);
+        size_t left = n;
+        for (size_t run = 0; left > 0; ++run) {
+            const size_t count = std::min(left, run % 4 == 3 ? size_t(1) : run + 2);
+            const size_t first = left - count;
+            in_runs.put_all(count, [&](size_t j) -> const RansTable::Coding& { return t.coding(a[first + j]); });
+            left = first;
+        }
+        EXPECT_EQ(in_runs.finish(), one_by_one.finish()) << n;
+    }
+    const RansTable t = RansTable::from_counts({3, 1});
+    RansBackwardEncoder two(2);
+    EXPECT_THROW(two.put_all(3, [&](size_t) -> const RansTable::Coding& { return t.coding(0); }), Error);
 }
 
 TEST(Rans, EncoderStepWithoutDivisionIsTheDivision) {

@@ -68,6 +68,8 @@ TEST(StaticLevelEncoder, ExtendedFromASampleCodesAsMadeOverTheWholeLevel) {
     expect_extended_codes_as_whole(h, {Precision::float64, &quantizer}, GeometryPredictor::normal_frame_grid);
     expect_extended_codes_as_whole(h, {Precision::float64, nullptr}, GeometryPredictor::normal_frame);
     expect_extended_codes_as_whole(h, {Precision::float64, nullptr}, GeometryPredictor::unit_normal_frame);
+    expect_extended_codes_as_whole(h, {Precision::float64, nullptr}, GeometryPredictor::midpoint_static);
+    expect_extended_codes_as_whole(h, {Precision::float64, nullptr}, GeometryPredictor::butterfly_static);
 }
 
 // Bit-exact residuals of every bit length (0 to 64 bits of ordered float64 bits) decode to the

@@ -28,9 +28,10 @@ namespace amc {
 // 16 the fourth. Version 18 for files with a level in geometry mode 4 whose hierarchy symbols are
 // not in the mixing mode (chunked or not): mode 4's tokens in the grouped order (FORMAT.md 5.7);
 // mixed files keep the per-vertex order (versions 9-17 and 19). Version 19 for files in the mixing
-// mode's sixth model (FORMAT.md 2.6), which encoders write since; 17 keeps the fifth.
+// mode's sixth model (FORMAT.md 2.6); 17 keeps the fifth. Version 20 for files in its seventh model
+// (FORMAT.md 2.7: the sixth with trained initial states), which encoders write since.
 constexpr uint8_t kOldestReadableVersion = 1;
-constexpr uint8_t kNewestVersion = 19;
+constexpr uint8_t kNewestVersion = 20;
 constexpr uint8_t kBaseVersion = 2;       // everything but the numbering block and mode 2
 constexpr uint8_t kNumberingVersion = 3;  // the first version with a numbering block
 constexpr uint8_t kAngleBaseVersion = 4;  // the first version with base connectivity mode 2
@@ -65,11 +66,14 @@ constexpr uint8_t kGroupedGridVersion = 18;
 // The first version whose mixing mode is the sixth model (the quadric's ring means, FORMAT.md 2.6);
 // its level blocks are version 17's (mode 4 in the per-vertex order).
 constexpr uint8_t kSixthMixingVersion = 19;
+// The first version whose mixing mode is the seventh model (the sixth whose geometric tables start
+// at trained states, FORMAT.md 2.7); its level blocks are version 17's too.
+constexpr uint8_t kSeventhMixingVersion = 20;
 
 // Whether a file of `file_version` codes mode 4's tokens in the grouped order: version 18, whose
-// files are never mixed; the mixing mode's files keep the per-vertex order (versions 9-17 and 19).
+// files are never mixed; the mixing mode's files keep the per-vertex order (versions 9-17, 19, 20).
 constexpr bool grouped_grid_order(uint8_t file_version) {
-    return file_version >= kGroupedGridVersion && file_version != kSixthMixingVersion;
+    return file_version >= kGroupedGridVersion && file_version != kSixthMixingVersion && file_version != kSeventhMixingVersion;
 }
 
 // The lowest version a file's newest features need, 0 if it has none of them (older features then
@@ -114,6 +118,7 @@ constexpr uint8_t hierarchy_stream_version_of_file(uint8_t file_version) {
         case 17: return 2;
         case 18: return 2;
         case 19: return 2;
+        case 20: return 2;
     }
     return 0;
 }

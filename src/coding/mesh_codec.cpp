@@ -120,7 +120,7 @@ double snap_positions(const Hierarchy& h, const Quantizer& quantizer, unsigned t
 // The mixing mode's models, newest first, each with the first file version that holds it
 // (format_version.h): a mixed file of version v is in the newest model whose version is <= v.
 constexpr std::pair<MixingModel, uint8_t> kMixingModelVersions[] = {
-    {MixingModel::sixth, kSixthMixingVersion},   {MixingModel::fifth, kFifthMixingVersion},
+    {MixingModel::seventh, kSeventhMixingVersion}, {MixingModel::sixth, kSixthMixingVersion},   {MixingModel::fifth, kFifthMixingVersion},
     {MixingModel::fourth, kFourthMixingVersion}, {MixingModel::third, kThirdMixingVersion},
     {MixingModel::second, kSecondMixingVersion}, {MixingModel::first, kMixedContextsVersion}};
 
@@ -137,8 +137,8 @@ uint8_t first_version_of(MixingModel model) {
 }
 
 // The lowest version that holds what the file holds (format_version.h).
-// `mixing`: the mixing mode's model; the sixth only in version 19, the fifth only in 17, the fourth
-// only in 16 (never chunked; they hold every geometry mode); the third is in versions 11-15.
+// `mixing`: the mixing mode's model; the seventh only in version 20, the sixth only in 19, the fifth
+// only in 17, the fourth only in 16 (never chunked; they hold every geometry mode); the third is in versions 11-15.
 uint8_t file_version(bool stencil_tables, bool raw_side, bool unit_geometry, bool grid_geometry, bool mixed_contexts, MixingModel mixing,
                      bool chunked, bool static_geometry, BaseConnectivityMode base_mode, bool store_numbering) {
     if (mixed_contexts && mixing >= MixingModel::fourth) return first_version_of(mixing);
@@ -375,9 +375,12 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
                                           : one_chunk ? std::vector<RootRange>{RootRange{0, h.root_count()}}
                                                       : balanced_chunks(root_nodes, chunk_count_for(options, faces));
     const bool want_hierarchy_stats = stats_out != nullptr && options.hierarchy_statistics;
-    ForestCode fifth, fourth, third;  // the mixing mode's forest in its fifth, fourth and third models
+    ForestCode sixth, fifth, fourth, third;  // the mixing mode's forest in its older models
     const std::vector<std::pair<MixingModel, ForestCode*>> older =
-        mixed ? std::vector<std::pair<MixingModel, ForestCode*>>{{MixingModel::fifth, &fifth}, {MixingModel::fourth, &fourth}, {MixingModel::third, &third}}
+        mixed ? std::vector<std::pair<MixingModel, ForestCode*>>{{MixingModel::sixth, &sixth},
+                                                                  {MixingModel::fifth, &fifth},
+                                                                  {MixingModel::fourth, &fourth},
+                                                                  {MixingModel::third, &third}}
               : std::vector<std::pair<MixingModel, ForestCode*>>{};
     ForestCode forest = code_forest(h, root_of, chunks, faces, options, space, positions, threads, want_hierarchy_stats,
                                     first_pass.get(), turned_input && quantized ? &on_grid : nullptr, older);
@@ -386,11 +389,11 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     if (fewer < chunks.size())
         forest = code_forest(h, root_of, balanced_chunks(root_nodes, fewer), faces, options, space, positions, threads,
                              want_hierarchy_stats, nullptr, nullptr);
-    // The mixing mode's fifth, fourth or third model where it codes the file smaller (small files,
-    // whose new tables have little to learn from, or creased ones, by a few bytes): every file at
-    // most as large as each older model's. A tie keeps the newer model.
+    // An older model of the mixing mode where it codes the file smaller (small files, whose new
+    // tables have little to learn from, or creased ones, by a few bytes): every file at most as
+    // large as each older model's. A tie keeps the newer model.
     if (mixed)
-        for (ForestCode* other : {&fifth, &fourth, &third})
+        for (ForestCode* other : {&sixth, &fifth, &fourth, &third})
             if (other->bytes < forest.bytes) forest = std::move(*other);
 
     Metadata meta;

@@ -71,6 +71,8 @@ public:
     };
     static Coding coding_of(uint32_t start, uint32_t frequency);
     const Coding& coding(int symbol) const { return coding_[size_t(symbol)]; }
+    // Every symbol's Coding, by symbol.
+    const Coding* codings() const { return coding_.data(); }
     // -log2 of the symbol's probability (its code length in bits); the symbol must have a frequency.
     double cost_bits(int symbol) const;
 
@@ -134,6 +136,34 @@ public:
             x >>= 8;
         }
         x = c.code(x);
+    }
+    // put_coding for `count` symbols at once, the last first: coding_of(j) for j = count - 1 down
+    // to 0. Both states and the output stay in registers (put_coding's live in the object, where
+    // each byte written may alias them).
+    template <class CodingOf>
+    void put_all(size_t count, CodingOf&& coding_of) {
+        if (count > left_) throw_too_many();
+        const size_t first = left_ - count;  // the stream index of coding_of(0)
+        uint32_t x0 = state_[0], x1 = state_[1];
+        uint8_t* out = begin_;
+        auto step = [&out](uint32_t& x, const RansTable::Coding& c) {
+            while (x >= c.x_max) {
+                *--out = uint8_t(x);
+                x >>= 8;
+            }
+            x = c.code(x);
+        };
+        size_t j = count;  // symbol j takes state (first + j) mod 2
+        if (j > 0 && (first + j - 1) % 2 == 0) step(x0, coding_of(--j));
+        for (; j >= 2; j -= 2) {
+            step(x1, coding_of(j - 1));
+            step(x0, coding_of(j - 2));
+        }
+        if (j == 1) step(x1, coding_of(0));
+        state_[0] = x0;
+        state_[1] = x1;
+        begin_ = out;
+        left_ = first;
     }
     // The stream (once); throws Error unless exactly `count` symbols were put.
     std::vector<uint8_t> finish();

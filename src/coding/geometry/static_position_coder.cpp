@@ -177,12 +177,17 @@ void put_raw(RawBitWriter& raw, Residual r) {
     // The sign and the first value in one put (take_large reads them in one get); put's mask drops
     // the magnitude's three leading bits, which the token holds.
     const uint64_t sign = r.negative ? 1 : 0;
-    if (low > 32) {
+    if (low > 56) {
         raw.put((r.magnitude >> 32) << 1 | sign, low - 31);
         raw.put(r.magnitude & 0xFFFFFFFFull, 32);
-    } else {
-        raw.put(r.magnitude << 1 | sign, low + 1);
+        return;
     }
+    // Up to 57 bits in one put, the two values of low > 32 side by side as take_large reads them;
+    // without a branch on low, which bit-exact residuals put on both sides of 32 by turns.
+    const int rot = std::max(low - 32, 0);
+    const uint64_t first = (r.magnitude >> (32 & -int(rot > 0))) << 1 | sign;  // the magnitude itself when low <= 32
+    const uint64_t first_bits = rot > 0 ? first & ((uint64_t{2} << rot) - 1) : first;
+    raw.put(first_bits | (rot > 0 ? (r.magnitude & 0xFFFFFFFFull) << (rot + 1) : 0), low + 1);
 }
 
 // A token from kDirectTokens on, with its raw bits.
@@ -445,6 +450,8 @@ StaticLevelEncoder::StaticLevelEncoder(const Mesh& h, const std::vector<std::pai
     if (has_stencil_tables(mode) && space.quantizer != nullptr)
         throw Error("geometry modes 6 and 7 need bit-exact coordinates");
     count = std::min(count, created.size());
+    // A sample's raw bits wait in large_ (see the header): the mode choice drops most samples.
+    deferred_ = !grouped_ && count < created.size();
     add(h, created, 0, count);
     make_tables();
 }
@@ -452,6 +459,7 @@ StaticLevelEncoder::StaticLevelEncoder(const Mesh& h, const std::vector<std::pai
 template <class Mesh>
 void StaticLevelEncoder::extend(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created) {
     if (coded_) throw Error("StaticLevelEncoder::extend: the streams are coded already");
+    write_deferred_raw_bits(created.size());
     add(h, created, symbols_.size(), created.size());
     make_tables();
 }
@@ -464,35 +472,59 @@ void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, 
     // Room for the raw bits (grown by doubling they were copied again and again), at the rate of
     // the part before (a little more: the writer zero-fills what it reserves as it starts to use
     // it), or at first in float spaces, where nearly every coordinate has some, 64 a coordinate.
+    const bool keep_large = grouped_ || deferred_;
     if (begin > 0) {
         const double share = double(end - begin) / double(begin);
-        if (grouped_) large_.reserve(large_.size() + size_t(double(large_.size()) * share));
+        if (keep_large) large_.reserve(large_.size() + size_t(double(large_.size()) * share));
         else raw_writer_.reserve_bits(uint64_t(double(raw_writer_.bits()) * share * 1.125) + 4096);
     } else if (space_.quantizer == nullptr) {
-        raw_writer_.reserve_bits(uint64_t(kStaticRoles) * 64 * (end - begin));
+        if (deferred_) large_.reserve(size_t(kStaticRoles) * (end - begin));
+        else raw_writer_.reserve_bits(uint64_t(kStaticRoles) * 64 * (end - begin));
     }
     const bool float64 = space_.quantizer == nullptr && space_.precision == Precision::float64;
     switch (mode_) {
         case GeometryPredictor::normal_frame:
-            if (space_.quantizer != nullptr) add_vertices<false, false, kGridResiduals, false>(h, created, begin, end);
-            else if (float64) add_vertices<false, false, kFloat64Residuals, false>(h, created, begin, end);
-            else add_vertices<false, false, kAnyResiduals, false>(h, created, begin, end);
+            if (space_.quantizer != nullptr) {
+                if (keep_large) add_vertices<false, false, kGridResiduals, true>(h, created, begin, end);
+                else add_vertices<false, false, kGridResiduals, false>(h, created, begin, end);
+            } else if (float64) {
+                if (keep_large) add_vertices<false, false, kFloat64Residuals, true>(h, created, begin, end);
+                else add_vertices<false, false, kFloat64Residuals, false>(h, created, begin, end);
+            } else {
+                if (keep_large) add_vertices<false, false, kAnyResiduals, true>(h, created, begin, end);
+                else add_vertices<false, false, kAnyResiduals, false>(h, created, begin, end);
+            }
             break;
         case GeometryPredictor::normal_frame_grid:
-            if (grouped_) add_vertices<true, true, kGridResiduals, true>(h, created, begin, end);
+            if (keep_large) add_vertices<true, true, kGridResiduals, true>(h, created, begin, end);
             else add_vertices<true, true, kGridResiduals, false>(h, created, begin, end);
             break;
         case GeometryPredictor::midpoint_static:
-            if (float64) add_stencil_vertices<false, kFloat64Residuals>(h, created, begin, end);
-            else add_stencil_vertices<false, kAnyResiduals>(h, created, begin, end);
+            if (float64) {
+                if (keep_large) add_stencil_vertices<false, kFloat64Residuals, true>(h, created, begin, end);
+                else add_stencil_vertices<false, kFloat64Residuals, false>(h, created, begin, end);
+            } else {
+                if (keep_large) add_stencil_vertices<false, kAnyResiduals, true>(h, created, begin, end);
+                else add_stencil_vertices<false, kAnyResiduals, false>(h, created, begin, end);
+            }
             break;
         case GeometryPredictor::butterfly_static:
-            if (float64) add_stencil_vertices<true, kFloat64Residuals>(h, created, begin, end);
-            else add_stencil_vertices<true, kAnyResiduals>(h, created, begin, end);
+            if (float64) {
+                if (keep_large) add_stencil_vertices<true, kFloat64Residuals, true>(h, created, begin, end);
+                else add_stencil_vertices<true, kFloat64Residuals, false>(h, created, begin, end);
+            } else {
+                if (keep_large) add_stencil_vertices<true, kAnyResiduals, true>(h, created, begin, end);
+                else add_stencil_vertices<true, kAnyResiduals, false>(h, created, begin, end);
+            }
             break;
         default:
-            if (float64) add_vertices<true, false, kFloat64Residuals, false>(h, created, begin, end);
-            else add_vertices<true, false, kAnyResiduals, false>(h, created, begin, end);
+            if (float64) {
+                if (keep_large) add_vertices<true, false, kFloat64Residuals, true>(h, created, begin, end);
+                else add_vertices<true, false, kFloat64Residuals, false>(h, created, begin, end);
+            } else {
+                if (keep_large) add_vertices<true, false, kAnyResiduals, true>(h, created, begin, end);
+                else add_vertices<true, false, kAnyResiduals, false>(h, created, begin, end);
+            }
             break;
     }
 }
@@ -500,7 +532,7 @@ void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, 
 // The loop of add() for one mode: the frame's kind, the table split and the residuals' kind known when it is compiled.
 // A chunk's corners and frames as the decoder makes them (gather_chunk, frame_chunk), then each
 // vertex's residuals in role order.
-template <bool UnitNormals, bool GridBins, int Residuals, bool Grouped, class Mesh>
+template <bool UnitNormals, bool GridBins, int Residuals, bool KeepLarge, class Mesh>
 void StaticLevelEncoder::add_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin,
                                       size_t end) {
     const CoordinateSpace space = space_;
@@ -538,7 +570,7 @@ void StaticLevelEncoder::add_vertices(const Mesh& h, const std::vector<std::pair
                 }
                 const int token = static_token(r.negative, r.magnitude);
                 if (token >= kDirectTokens) {
-                    if (Grouped) large_.push_back(r);
+                    if (KeepLarge) large_.push_back(r);
                     else put_raw(raw_writer_, r);
                 }
                 symbols[size_t(role)] = uint16_t(table << kTokenBits | token);
@@ -550,7 +582,7 @@ void StaticLevelEncoder::add_vertices(const Mesh& h, const std::vector<std::pair
     raw_bits_ += raw_bits;
 }
 
-template <bool Butterfly, int Residuals, class Mesh>
+template <bool Butterfly, int Residuals, bool KeepLarge, class Mesh>
 void StaticLevelEncoder::add_stencil_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin,
                                               size_t end) {
     uint64_t raw_bits = 0;
@@ -564,7 +596,10 @@ void StaticLevelEncoder::add_stencil_vertices(const Mesh& h, const std::vector<s
             const Residual r = Residuals == kFloat64Residuals ? float64_residual(actual[axis], predicted[axis])
                                                               : residual_of(space_, axis, actual[axis], predicted[axis]);
             const int token = static_token(r.negative, r.magnitude);
-            if (token >= kDirectTokens) put_raw(raw_writer_, r);  // never grouped
+            if (token >= kDirectTokens) {  // never grouped
+                if (KeepLarge) large_.push_back(r);
+                else put_raw(raw_writer_, r);
+            }
             symbols[size_t(axis)] = uint16_t(axis << kTokenBits | token);
             raw_bits += uint64_t(static_raw_bit_count(r.magnitude));
             ++counts_[size_t(axis)][size_t(token)];
@@ -607,15 +642,31 @@ void StaticLevelEncoder::make_tables() {
     }
 }
 
+void StaticLevelEncoder::write_deferred_raw_bits(size_t level_size) {
+    if (!deferred_) return;
+    // Room for the level at the sample's rate (a little more, as add() reserves for an extension).
+    const double share = symbols_.empty() ? 1.0 : double(level_size) / double(symbols_.size());
+    raw_writer_.reserve_bits(uint64_t(double(raw_bits_) * share * 1.125) + 4096);
+    for (const Residual& r : large_) put_raw(raw_writer_, r);
+    large_ = {};
+    deferred_ = false;
+}
+
 void StaticLevelEncoder::code_streams() {
     if (coded_) return;
+    write_deferred_raw_bits(symbols_.size());
     constexpr uint16_t kTokenMask = (1 << kTokenBits) - 1;
     // The rANS stream back to front, straight from the symbol words (rANS codes backwards).
     RansBackwardEncoder rans(kStaticRoles * symbols_.size());
     auto put = [&](uint16_t symbol) { rans.put(tables_[size_t(symbol >> kTokenBits)], symbol & kTokenMask); };
     if (!grouped_) {
-        for (size_t i = symbols_.size(); i-- > 0;)
-            for (int role = kStaticRoles; role-- > 0;) put(symbols_[i][size_t(role)]);
+        // The symbol words one after the other (vertex after vertex, role after role).
+        static_assert(sizeof(symbols_[0]) == kStaticRoles * sizeof(uint16_t), "symbol words are contiguous");
+        const uint16_t* words = reinterpret_cast<const uint16_t*>(symbols_.data());
+        const RansTable::Coding* codings[kMaxStaticTables];
+        for (int i = 0; i < table_count_; ++i) codings[i] = tables_[size_t(i)].codings();
+        rans.put_all(kStaticRoles * symbols_.size(),
+                     [&](size_t j) -> const RansTable::Coding& { return codings[words[j] >> kTokenBits][words[j] & kTokenMask]; });
     } else {
         // Each run: its role-0 tokens, then each vertex's roles 1 and 2 (FORMAT.md 5.7), backwards.
         for (size_t run = (symbols_.size() + kGridGroup - 1) / kGridGroup; run-- > 0;) {

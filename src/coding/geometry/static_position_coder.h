@@ -125,12 +125,15 @@ private:
     void add(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
     // How add_vertices takes the residuals of modes 3 and 5: residual_of, float64 inline, or grid points inline.
     static constexpr int kAnyResiduals = 0, kFloat64Residuals = 1, kGridResiduals = 2;
-    // Grouped: mode 4 in the grouped order, whose raw bits wait in large_ (see below).
-    template <bool UnitNormals, bool GridBins, int Residuals, bool Grouped, class Mesh>
+    // KeepLarge: the raw bits wait in large_ (mode 4's grouped order, or a sample's; see below).
+    template <bool UnitNormals, bool GridBins, int Residuals, bool KeepLarge, class Mesh>
     void add_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
     // Modes 6 and 7: each axis against the stencil's prediction, with the table of its axis.
-    template <bool Butterfly, int Residuals, class Mesh>
+    template <bool Butterfly, int Residuals, bool KeepLarge, class Mesh>
     void add_stencil_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
+    // A sample's raw bits out of large_ into the raw stream, with room for a level of
+    // `level_size` vertices; nothing unless deferred_.
+    void write_deferred_raw_bits(size_t level_size);
     // lower_bound_bytes()' parts: the coded tables, and the rANS and raw streams.
     size_t table_bytes() const;
     // The tables coded alone, made once per make_tables() (the bounds and the size ask it up to three times).
@@ -150,9 +153,12 @@ private:
     // Until the streams are coded: each coordinate's table and token in one word (table_shifted |
     // token). The raw bits of the tokens that have them (from kDirectTokens on): in the per-vertex
     // order, the raw stream's order, they go to `raw_writer_` as the tokens are made; mode 4's
-    // grouped order keeps their residuals in `large_` for code_streams to write in its order.
+    // grouped order keeps their residuals in `large_` for code_streams to write in its order, and
+    // so does an encoder made over a sample (deferred_) until extend() or code_streams(): the
+    // automatic choice drops most samples, whose bits would be written for nothing.
     std::vector<std::array<uint16_t, kStaticRoles>> symbols_;
     std::vector<StaticResidual> large_;
+    bool deferred_ = false;
     RawBitWriter raw_writer_;
     uint64_t raw_bits_ = 0;
     mutable size_t coded_table_bytes_ = SIZE_MAX;  // coded_table_bytes(), or SIZE_MAX until asked

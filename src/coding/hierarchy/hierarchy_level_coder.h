@@ -30,9 +30,9 @@ struct CodedSymbol {
     bool refined;
 };
 
-// The mixing mode's newest model (.amc version 19): its features hold every older model's, so an
-// encoder computes them once and may code with the third model too (the smaller file is written).
-constexpr MixingModel kWrittenMixingModel = MixingModel::sixth;
+// The mixing mode's newest model (.amc version 20): its features hold every older model's, so an
+// encoder computes them once and may code with the older models too (the smallest file is written).
+constexpr MixingModel kWrittenMixingModel = MixingModel::seventh;
 
 // A hierarchy read in another base order without copying it (reorder_base's result, as a view):
 // root t of the coded forest is h's root old_root[t] with its local indices turned by turn[t] (its

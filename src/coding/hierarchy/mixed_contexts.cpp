@@ -215,9 +215,9 @@ double LevelShapes::base_edge(const Hierarchy& h) {
 MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, uint32_t i, int group, LevelShapes& shapes,
                              MixingModel model, bool older_too) {
     MixedFeatures f{};
-    // The sixth model leaves out what only older models read (bend_sum, disp, parent_sibs and the
-    // curvature's ring), unless they are wanted too.
-    const bool every = model != MixingModel::sixth || older_too;
+    // The sixth and seventh models leave out what only older models read (bend_sum, disp,
+    // parent_sibs and the curvature's ring), unless they are wanted too.
+    const bool every = model < MixingModel::sixth || older_too;
     f.group = uint8_t(group);
     const int l = h.level(n);
     f.level = uint8_t(std::min(l, 7));
@@ -327,10 +327,10 @@ MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, u
     double ring_quad[2] = {0, 0};
     if (model >= MixingModel::fourth) {
         const std::array<double, 2> quadric =
-            model == MixingModel::sixth ? shapes.quadric(h, n, i, bending.longest) : quadric_curvatures(h, n, bending.longest);
+            model >= MixingModel::sixth ? shapes.quadric(h, n, i, bending.longest) : quadric_curvatures(h, n, bending.longest);
         f.quad_mean = uint8_t(quarter_octave_bin(quadric[0], 40, 63));
         f.quad_gauss = uint8_t(quarter_octave_bin(quadric[1], 40, 63));
-        if (model == MixingModel::sixth) {
+        if (model >= MixingModel::sixth) {
             // The same over the node and its same-level neighbours, averaged: the remesher's
             // curvature is the input's, smoother at the node's scale than six points tell.
             double sum_mean = quadric[0], sum_gauss = quadric[1];
@@ -354,7 +354,7 @@ MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, u
         f.thr_unrefined = uint8_t(threshold_bin(curvature, most_unrefined));
         f.coded_refined = uint8_t(std::min(coded_refined, 7));
         f.coded_unrefined = uint8_t(std::min(coded_unrefined, 7));
-        if (model == MixingModel::sixth) {
+        if (model >= MixingModel::sixth) {
             f.quad_refined = uint8_t(threshold_bin(ring_quad[0], least_quad));
             f.quad_unrefined = uint8_t(threshold_bin(ring_quad[0], most_quad));
         }
@@ -457,7 +457,7 @@ namespace {
 // A mixer of `model` with `sets` weight sets: the third model's start at row `row` of its trained
 // weights, the others' at 1/n each.
 mixing::Mixer model_mixer(MixingModel model, int sets, int row) {
-    if (model == MixingModel::sixth)
+    if (model >= MixingModel::sixth)
         return mixing::Mixer(MixedHierarchyModel::kSixthInputs + 1, sets, kThirdMixerRate, kSixthStartWeights[row]);
     if (model == MixingModel::fifth)
         return mixing::Mixer(MixedHierarchyModel::kFifthInputs + 1, sets, kThirdMixerRate, kFifthStartWeights[row]);
@@ -471,7 +471,7 @@ mixing::Mixer model_mixer(MixingModel model, int sets, int row) {
 
 }  // namespace
 
-MixedHierarchyModel::MixedHierarchyModel(MixingModel model)
+MixedHierarchyModel::MixedHierarchyModel(MixingModel model, const TrainedStateTables& trained)
     : model_(model),
       mixer_a_(model_mixer(model, kContextGroupCount, 0)),
       mixer_b_(model_mixer(model, 16, 1)),
@@ -489,7 +489,17 @@ MixedHierarchyModel::MixedHierarchyModel(MixingModel model)
                                                               : kSixthContextSizes[j - kFifthDirect],
                                           BitModel(kModelWindowLog2));
         };
-        if (model == MixingModel::sixth) assign(kept_tables<MixingModel::sixth>(), later_tables<MixingModel::sixth>());
+        if (model >= MixingModel::sixth) assign(kept_tables<MixingModel::sixth>(), later_tables<MixingModel::sixth>());
+        if (model == MixingModel::seventh) {
+            // Each character's model once (an ASCII table), then a copy per slot.
+            std::array<BitModel, 128> start;
+            for (size_t c = 0; c < start.size(); ++c) start[c] = trained_state(char(c), kModelWindowLog2);
+            for (size_t k = 0; k < kTrainedTables.size(); ++k) {
+                std::vector<BitModel>& table = models_[size_t(kTrainedTables[k])];
+                const char* states = trained[k];
+                for (size_t slot = 0; slot < table.size() && states[slot] != '\0'; ++slot) table[slot] = start[uint8_t(states[slot]) & 127u];
+            }
+        }
         else if (model == MixingModel::fifth) assign(kept_tables<MixingModel::fifth>(), later_tables<MixingModel::fifth>());
         else assign(kept_tables<MixingModel::fourth>(), later_tables<MixingModel::fourth>());
     } else {
@@ -536,7 +546,7 @@ std::array<uint32_t, MixedHierarchyModel::kInputs> MixedHierarchyModel::direct_s
 
 uint32_t MixedHierarchyModel::p16(const MixedFeatures& f) {
     const uint32_t g = f.group;
-    if (model_ == MixingModel::sixth) {
+    if (model_ >= MixingModel::sixth) {
         // Only the slots the sixth model reads of tables 0-15 (3, 7, and 1, 4, 11 for the bit
         // histories), as direct_slots gives them.
         slot_[1] = g * 4 + f.inner;
@@ -670,7 +680,7 @@ void MixedHierarchyModel::update(bool bit) {
     mixer_c_.update(st_.data(), bit);
     if (model_ >= MixingModel::third) mixer_d_.update(st_.data(), bit);
     for (mixing::ProbabilityMap& map : maps_) map.update(bit);
-    if (model_ == MixingModel::sixth) {
+    if (model_ >= MixingModel::sixth) {
         update_fourth_tables<MixingModel::sixth>(bit);
     } else if (model_ == MixingModel::fifth) {
         update_fourth_tables<MixingModel::fifth>(bit);

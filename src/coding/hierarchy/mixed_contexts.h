@@ -1,6 +1,6 @@
 // The hierarchy coder's mixing mode (.amc version 8, docs/FORMAT.md section 2.1; its second model,
 // version 10, section 2.2; its third, version 11, section 2.3; its fourth, version 16, section 2.4; its fifth, version 17,
-// section 2.5): each coded symbol's probability comes from adaptive models under
+// section 2.5; its sixth, version 19, section 2.6; its seventh, version 20, section 2.7): each coded symbol's probability comes from adaptive models under
 // contexts richer than the paper's groups — the node's structure one level up, its decided
 // neighbours and their neighbours, and the decoded geometry around it — mixed by logistic mixing
 // (context_mixing.h) and refined by adaptive probability maps. Measured in
@@ -10,6 +10,7 @@
 #include "coding/entropy/arithmetic_coder.h"
 #include "coding/hierarchy/context_mixing.h"
 #include "coding/hierarchy/level_forest.h"
+#include "coding/hierarchy/trained_states.h"
 
 #include <amc/hierarchy.h>
 
@@ -25,8 +26,9 @@ namespace amc {
 // that start from trained weights, or version 16's (2.4), which adds the curvatures of a quadric
 // through the node's corners and its neighbours' far corners and leaves out seven direct inputs,
 // or version 17's (2.5), which adds the local threshold against the coded nodes two rings around,
-// or version 19's (2.6), which adds a least-squares quadric over the nodes two edges around.
-enum class MixingModel : uint8_t { first = 1, second = 2, third = 3, fourth = 4, fifth = 5, sixth = 6 };
+// or version 19's (2.6), which adds the quadric's means over the node and its neighbours, or
+// version 20's (2.7), the sixth whose geometric tables start at trained states.
+enum class MixingModel : uint8_t { first = 1, second = 2, third = 3, fourth = 4, fifth = 5, sixth = 6, seventh = 7 };
 
 // What the decoder knows of a node when its symbol comes.
 struct MixedFeatures {
@@ -120,8 +122,8 @@ std::array<double, 2> quadric_curvatures(const Hierarchy& h, NodeId n, double lo
 // on the traversal, and those that do from the level's state bytes: `i` is n's local index in
 // `level`, whose neighbours' states are as decided so far. `shapes` is started on `level`. The
 // ring features are computed for the second and later models, size and gauss for the third and
-// later, quad_mean and quad_gauss for the fourth and later, the thresholds for the fifth and sixth
-// (which mark n coded in `shapes`), the quadric's ring means for the sixth (which leaves out the
+// later, quad_mean and quad_gauss for the fourth and later, the thresholds for the fifth and later
+// (which mark n coded in `shapes`), the quadric's ring means for the sixth and seventh (which leave out the
 // ring features unless `older_too`: an encoder's features serve every older model as well).
 MixedFeatures mixed_features(const Hierarchy& h, NodeId n, const Level& level, uint32_t i, int group, LevelShapes& shapes,
                              MixingModel model, bool older_too = false);
@@ -155,11 +157,18 @@ public:
     static constexpr int kSixthKept = 3;         // the sixth model's direct models of tables 0-20
     static constexpr int kSixthLater = 12;       // and of tables 21-34
     static constexpr int kSixthInputs = kSixthKept + kIndirectInputs + kSixthLater;
-    explicit MixedHierarchyModel(MixingModel model);
+    // `trained`: the seventh model's initial states (the coder's; bench/trained_states passes others
+    // to measure them on models left out of their training).
+    explicit MixedHierarchyModel(MixingModel model, const TrainedStateTables& trained = kTrainedStateTables);
     MixingModel model() const { return model_; }
     // The 16-bit probability of a one for a symbol with these features (remembered for update).
     uint32_t p16(const MixedFeatures& f);
     void update(bool bit);
+    // The slot of direct table `table` (FORMAT.md's numbers) the last p16 read, for the tables its
+    // model reads (bench/trained_states counts the training symbols by it).
+    uint32_t slot(int table) const { return slot_[size_t(table)]; }
+    // The slots of direct table `table` (0 for a table its model does not read).
+    size_t table_size(int table) const { return models_[size_t(table)].size(); }
     // The slots of the first model's direct models for these features (FORMAT.md 2.1).
     static std::array<uint32_t, kInputs> direct_slots(const MixedFeatures& f);
 
