@@ -13,10 +13,13 @@
 //   chunks_bench decode-speed RUNS BITS model.amh  decodes only: RUNS pairs of a 1- and a 2-thread
 //                                                  decode, 0.2 s apart (for chrt -f: see decode_speed),
 //                                                  without and with a DecodeContext
-//   chunks_bench decode-rusage RUNS recycle|keep file.amc
+//   chunks_bench decode-rusage RUNS recycle|keep|free file.amc
 //                                                  RUNS pairs of a 1- and a 2-thread decode through
-//                                                  a DecodeContext each (results recycled or not):
-//                                                  wall, user and system time and faults per decode
+//                                                  a DecodeContext each (results recycled or not),
+//                                                  or without one (free): wall, user and system
+//                                                  time and faults per decode
+//   chunks_bench encode-rusage RUNS BITS model.amh RUNS pairs of a 1- and a 2-thread encode (default
+//                                                  options), 0.2 s apart: the same per encode
 //   chunks_bench repeat encode|decode RUNS THREADS BITS model.amh
 //                                                  encodes the model once (default options), then
 //                                                  encodes or decodes it RUNS times on THREADS
@@ -223,24 +226,20 @@ int decode_speed(int runs, int bits, const char* path) {
     return 0;
 }
 
-// RUNS pairs of a 1- and a 2-thread decode of the file, each through its own DecodeContext, 0.2 s
-// apart (for chrt -f), with every result recycled into its context or not: each decode's wall,
-// user and system time and minor faults, then the medians and the per-pair speed-up.
-int decode_rusage(int runs, bool recycle, const char* path) {
-    std::ifstream in(path, std::ios::binary);
-    const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    amc::DecodeContext contexts[2];
+// Wall, user and system time and minor faults of each of RUNS pairs of a 1- and a 2-thread call of
+// op(threads), 0.2 s apart (for chrt -f), then their medians and the per-pair speed-up. `what`
+// names the runs.
+template <class Op>
+int rusage_pairs(int runs, const std::string& what, Op&& op) {
     std::vector<double> wall[2], user[2], system[2], faults[2], ratio;
     auto seconds = [](const timeval& t) { return double(t.tv_sec) + 1e-6 * double(t.tv_usec); };
     for (int r = 0; r < runs; ++r) {
         for (unsigned threads : {1u, 2u}) {
             std::this_thread::sleep_for(std::chrono::milliseconds(200));
-            amc::DecodeOptions d;
-            d.threads = threads;
             rusage before{}, after{};
             getrusage(RUSAGE_SELF, &before);
             const double start = now();
-            amc::Hierarchy back = amc::decode(contexts[threads - 1], bytes.data(), bytes.size(), d);
+            if (!op(threads)) return 1;
             wall[threads - 1].push_back(now() - start);
             getrusage(RUSAGE_SELF, &after);
             user[threads - 1].push_back(seconds(after.ru_utime) - seconds(before.ru_utime));
@@ -248,17 +247,48 @@ int decode_rusage(int runs, bool recycle, const char* path) {
             faults[threads - 1].push_back(double(after.ru_minflt - before.ru_minflt));
             std::printf("%u thread%s: wall %.4f s, user %.4f s, system %.4f s, %.0f minor faults\n", threads, threads > 1 ? "s" : "",
                         wall[threads - 1].back(), user[threads - 1].back(), system[threads - 1].back(), faults[threads - 1].back());
-            if (recycle) contexts[threads - 1].recycle(std::move(back));
         }
         ratio.push_back(wall[0].back() / wall[1].back());
     }
     for (int t = 0; t < 2; ++t)
-        std::printf("%s, %d thread%s%s: medians wall %.4f s, user %.4f s, system %.4f s, %.0f minor faults\n", name_of(path).c_str(),
-                    t + 1, t ? "s" : "", recycle ? ", results recycled" : "", median(wall[t]), median(user[t]), median(system[t]),
-                    median(faults[t]));
+        std::printf("%s, %d thread%s: medians wall %.4f s, user %.4f s, system %.4f s, %.0f minor faults\n", what.c_str(), t + 1,
+                    t ? "s" : "", median(wall[t]), median(user[t]), median(system[t]), median(faults[t]));
     const Range r = range_of(ratio);
     std::printf("speed-up per pair %.2f [%.2f - %.2f]\n", r.median, r.low, r.high);
     return 0;
+}
+
+// RUNS pairs of a 1- and a 2-thread decode of the file, each through its own DecodeContext (results
+// recycled into it or kept by the caller), or without a context (`free`).
+int decode_rusage(int runs, const std::string& mode, const char* path) {
+    std::ifstream in(path, std::ios::binary);
+    const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    amc::DecodeContext contexts[2];
+    const std::string what = name_of(path) + (mode == "recycle" ? ", results recycled" : mode == "free" ? ", no context" : "");
+    return rusage_pairs(runs, what, [&](unsigned threads) {
+        amc::DecodeOptions d;
+        d.threads = threads;
+        amc::Hierarchy back = mode == "free" ? amc::decode(bytes.data(), bytes.size(), d)
+                                             : amc::decode(contexts[threads - 1], bytes.data(), bytes.size(), d);
+        if (mode == "recycle") contexts[threads - 1].recycle(std::move(back));
+        return true;
+    });
+}
+
+// RUNS pairs of a 1- and a 2-thread encode of the model (default options at BITS), each checked
+// to write the bytes of the first one.
+int encode_rusage(int runs, int bits, const char* path) {
+    const amc::Hierarchy h = amc::read_hierarchy(path);
+    amc::EncodeOptions options;
+    options.quantize_bits = bits;
+    const std::vector<uint8_t> bytes = amc::encode(h, options);
+    return rusage_pairs(runs, name_of(path) + ", " + std::to_string(bits) + " bits, encode", [&](unsigned threads) {
+        amc::EncodeOptions o = options;
+        o.threads = threads;
+        if (amc::encode(h, o) == bytes) return true;
+        std::fprintf(stderr, "%s: %u threads wrote other bytes\n", path, threads);
+        return false;
+    });
 }
 
 int repeat(const std::string& what, int runs, unsigned threads, int bits, const char* path) {
@@ -336,14 +366,17 @@ int main(int argc, char** argv) {
     if (mode == "decode-speed" && argc == 5) return decode_speed(std::max(1, std::atoi(argv[2])), std::atoi(argv[3]), argv[4]);
     if (mode == "decode-file" && (argc == 5 || (argc == 6 && std::string(argv[4]) == "context")))
         return decode_file(std::max(1, std::atoi(argv[2])), unsigned(std::atoi(argv[3])), argc == 6, argv[argc - 1]);
-    if (mode == "decode-rusage" && argc == 5 && (std::string(argv[3]) == "recycle" || std::string(argv[3]) == "keep"))
-        return decode_rusage(std::max(1, std::atoi(argv[2])), std::string(argv[3]) == "recycle", argv[4]);
+    if (mode == "decode-rusage" && argc == 5 &&
+        (std::string(argv[3]) == "recycle" || std::string(argv[3]) == "keep" || std::string(argv[3]) == "free"))
+        return decode_rusage(std::max(1, std::atoi(argv[2])), argv[3], argv[4]);
+    if (mode == "encode-rusage" && argc == 5) return encode_rusage(std::max(1, std::atoi(argv[2])), std::atoi(argv[3]), argv[4]);
     if (mode == "repeat" && argc == 7 && (std::string(argv[2]) == "encode" || std::string(argv[2]) == "decode"))
         return repeat(argv[2], std::max(1, std::atoi(argv[3])), unsigned(std::atoi(argv[4])), std::atoi(argv[5]), argv[6]);
     std::fprintf(stderr, "usage: chunks_bench sizes BITS model.amh ...\n       chunks_bench speed RUNS BITS CHUNKS model.amh\n"
                          "       chunks_bench decode-speed RUNS BITS model.amh\n"
                          "       chunks_bench decode-file RUNS THREADS [context] file.amc\n"
-                         "       chunks_bench decode-rusage RUNS recycle|keep file.amc\n"
+                         "       chunks_bench decode-rusage RUNS recycle|keep|free file.amc\n"
+                         "       chunks_bench encode-rusage RUNS BITS model.amh\n"
                          "       chunks_bench repeat encode|decode RUNS THREADS BITS model.amh\n");
     return 2;
 }

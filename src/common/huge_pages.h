@@ -48,6 +48,20 @@ inline void release_pages(void* begin, size_t bytes) {
 #endif
 }
 
+// Faults in the whole pages inside [begin, begin + bytes) as writable, zeroed, without writing
+// them (Linux 5.14 on; elsewhere nothing): memory that one thread makes resident before others
+// write it, since two threads faulting fresh pages in at once take several times as long on the
+// project's VM (docs/BENCHMARKS.md, "Threads and memory").
+inline void populate_pages(void* begin, size_t bytes) {
+#if defined(__linux__) && defined(MADV_POPULATE_WRITE)
+    static const uintptr_t page = uintptr_t(sysconf(_SC_PAGESIZE));
+    detail::advise_aligned(begin, bytes, page, MADV_POPULATE_WRITE);
+#else
+    (void)begin;
+    (void)bytes;
+#endif
+}
+
 // v.reserve(capacity), with the whole new buffer offered to huge pages before the old contents
 // are copied in, so that the copy itself faults in huge pages rather than 4 KiB ones.
 template <class T>

@@ -47,6 +47,16 @@ private:
     std::vector<std::unique_ptr<HierarchyLevelDecoder>> idle_;
 };
 
+// The whole's storage, made on another thread while the base mesh and the seam are decoded:
+// decoding chunks into slices of the whole (several threads, version 13 on) needs its positions
+// zeroed before any chunk starts (2 % of a decode), and its node and block pages faulted in by one
+// thread rather than by the decoders of the slices at once, which takes several times as long on
+// the project's VM (docs/BENCHMARKS.md, "Threads and memory").
+struct SliceStorage {
+    std::vector<Vec3> zeroed_positions;  // `vertices` of them
+    Hierarchy nodes;                     // HierarchyBuilder::resident_storage, for adopt_storage
+};
+
 struct ChunkMergeInput {
     const BlockReader* reader = nullptr;  // of the file: checks each chunk block before it is decoded
     const TriangleMesh* base = nullptr;  // the file's base mesh
@@ -57,10 +67,11 @@ struct ChunkMergeInput {
     uint64_t vertices = 0;   // the file's vertex count (metadata)
     size_t file_size = 0;
     DecodeOptions options;
-    // The whole's positions, being zeroed on another thread (start_zeroed_positions); may be null.
-    std::future<std::vector<Vec3>>* zeroed_positions = nullptr;
+    // The whole's storage, being made on another thread (start_slice_storage); may be null.
+    std::future<SliceStorage>* slice_storage = nullptr;
     // The caller's decoders, kept warm after the decode (DecodeContext); null: decoders made for
-    // this decode, which give their working memory back over their last chunk (ChunkPlace::last).
+    // this decode, which on one thread give their working memory back over their last chunk
+    // (ChunkPlace::last).
     ChunkDecoders* kept_decoders = nullptr;
     // A hierarchy the caller is done with (DecodeContext::recycle), or null: the whole is built in
     // its memory (HierarchyBuilder::adopt_storage), which is left empty.
@@ -73,11 +84,9 @@ struct MergedCounts {
     int depth = 0;       // Hierarchy::depth
 };
 
-// `count` positions, zeroed on another thread: decoding chunks into slices of the whole (several
-// threads, version 13 on) needs its positions zeroed before any chunk starts, which takes 2 % of a
-// decode; started before the base mesh and the seam are decoded, it is done when they are. An
+// Starts making a SliceStorage of `nodes` nodes and `vertices` positions on another thread; an
 // invalid future when no thread could be started.
-std::future<std::vector<Vec3>> start_zeroed_positions(size_t count);
+std::future<SliceStorage> start_slice_storage(size_t nodes, size_t vertices);
 
 // Decodes `jobs` (chunks in increasing order) and merges them: the hierarchy over base_of_roots of
 // their roots, its vertices the base's, the seam vertices the chunks hold (in seam order), then

@@ -6,10 +6,12 @@
 #include "coding/chunks/seam.h"
 #include "coding/file_metadata.h"
 #include "common/check.h"
+#include "common/huge_pages.h"
 #include "common/parallel.h"
 
 #include <algorithm>
 #include <cstddef>
+#include <memory>
 #include <string>
 
 namespace amc {
@@ -36,10 +38,13 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& ro
     const Seam seam(h, chunk_of_root, key_of_vertex);
     std::vector<ChunkCode> codes(ranges.size());
     std::vector<uint64_t> nodes(ranges.size()), own_vertices(ranges.size());
-    std::vector<NodeId> local(h.node_capacity());  // shared: the chunks' nodes are disjoint
+    // Shared: the chunks' nodes are disjoint, and each chunk writes its nodes' entries before it
+    // reads them (subforest), so they are not zeroed first; their pages are faulted in by the tasks.
+    const std::unique_ptr<NodeId[]> local(new NodeId[h.node_capacity()]);
+    advise_huge_pages(local.get(), size_t(h.node_capacity()) * sizeof(NodeId));
     parallel_for(ranges.size(), threads, [&](size_t c) {
         std::vector<VertexId> vertex_of;
-        const Hierarchy chunk = extract_roots(h, {ranges[c]}, root_of, local.data(), &vertex_of);
+        const Hierarchy chunk = extract_roots(h, {ranges[c]}, root_of, local.get(), &vertex_of);
         VertexKeys keys(vertex_of.size(), kNoVertex);
         for (size_t v = 0; v < vertex_of.size(); ++v)
             if (vertex_of[v] != kNoVertex) keys[v] = key_of_vertex[vertex_of[v]];
@@ -178,7 +183,7 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
     merge.vertices = input.vertices;
     merge.file_size = file_size;
     merge.options = input.options;
-    merge.zeroed_positions = input.zeroed_positions;
+    merge.slice_storage = input.slice_storage;
     merge.kept_decoders = input.kept_decoders;
     merge.spare = input.spare;
     MergedCounts counts;
