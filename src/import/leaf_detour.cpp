@@ -1,5 +1,7 @@
 #include "import/leaf_detour.h"
 
+#include <algorithm>
+
 namespace amc {
 
 LeafDetour::LeafDetour(const LeafHalfedges& halfedges)
@@ -105,6 +107,45 @@ bool LeafDetour::measure(uint32_t a, uint32_t b, int max_hops, const uint32_t* t
 
 int LeafDetour::detour(uint32_t c) const {
     return hops_a_[c] < 0 || hops_b_[c] < 0 ? kFar : hops_a_[c] + hops_b_[c] - shortest_;
+}
+
+uint32_t LeafDetour::keep_least_detour(uint32_t a, uint32_t b, int max_hops, uint32_t* candidates, uint32_t count) {
+    Answer* answer = nullptr;
+    if (count <= kRemembered && max_hops < 256) {
+        if (answers_.empty()) answers_.resize(kAnswerSlots);
+        uint64_t key = (uint64_t(a) << 32 | b) * 0x9e3779b97f4a7c15ull;
+        for (uint32_t i = 0; i < count; ++i) key = (key ^ candidates[i]) * 0xbf58476d1ce4e5b9ull;
+        answer = &answers_[(key >> 40) & (kAnswerSlots - 1)];
+        bool same = answer->count == count && answer->a == a && answer->b == b && answer->max_hops == max_hops;
+        for (uint32_t i = 0; same && i < count; ++i) same = answer->candidate[i] == candidates[i];
+        if (same) {
+            uint32_t kept = 0;
+            for (uint32_t i = 0; i < count; ++i) {
+                if ((answer->kept >> i) & 1) candidates[kept++] = candidates[i];
+            }
+            return kept;
+        }
+    }
+    uint32_t kept_mask = (1u << count) - 1;  // b farther than max_hops: all kept
+    if (measure(a, b, max_hops, candidates, count)) {
+        int least = kFar;
+        for (uint32_t i = 0; i < count; ++i) least = std::min(least, detour(candidates[i]));
+        kept_mask = 0;
+        for (uint32_t i = 0; i < count; ++i) kept_mask |= uint32_t(detour(candidates[i]) == least) << i;
+    }
+    if (answer) {
+        answer->a = a;
+        answer->b = b;
+        for (uint32_t i = 0; i < count; ++i) answer->candidate[i] = candidates[i];
+        answer->count = uint8_t(count);
+        answer->max_hops = uint8_t(max_hops);
+        answer->kept = uint8_t(kept_mask);
+    }
+    uint32_t kept = 0;
+    for (uint32_t i = 0; i < count; ++i) {
+        if ((kept_mask >> i) & 1) candidates[kept++] = candidates[i];
+    }
+    return kept;
 }
 
 }  // namespace amc

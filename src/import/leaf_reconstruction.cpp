@@ -229,6 +229,10 @@ bool Reconstruction::classify(NodeId n) {
             explain_misfit(n);
             fail_node(n, "has two split edges but no green closure on edge (" + edge_text(n, r.fault_edge) + ")");
     }
+    return take_reading(n, r);
+}
+
+bool Reconstruction::take_reading(NodeId n, const Reading& r) {
     if (r.unsplit_count == 0) return true;
     for (int e = 0; e < 3; ++e) {
         if (r.unsplit[e]) unsplit_edges_.push_back({n, e});
@@ -295,15 +299,9 @@ uint32_t Reconstruction::find_midpoint(NodeId n, int e) {
 }
 
 uint32_t Reconstruction::on_shortest_chains(uint32_t* candidates, uint32_t count, uint32_t a, uint32_t b) {
+    if (count < 2) return count;
     if (!detour_) detour_ = std::make_unique<LeafDetour>(he_);
-    if (count < 2 || !detour_->measure(a, b, kChainHops, candidates, count)) return count;
-    int least = LeafDetour::kFar;
-    for (uint32_t i = 0; i < count; ++i) least = std::min(least, detour_->detour(candidates[i]));
-    uint32_t kept = 0;
-    for (uint32_t i = 0; i < count; ++i) {
-        if (detour_->detour(candidates[i]) == least) candidates[kept++] = candidates[i];
-    }
-    return kept;
+    return detour_->keep_least_detour(a, b, kChainHops, candidates, count);
 }
 
 Vec3 Reconstruction::guide_position(NodeId n, int e) {

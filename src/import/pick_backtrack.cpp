@@ -109,14 +109,13 @@ int Reconstruction::local_misfits(int from, int depth, const std::vector<NodeId>
                     continue;
                 }
                 if (node.first < undo.nodes) undo.flags.push_back({node.first, h_.diagonal_flipped(node.first)});
-                bool refined = false;
-                try {
-                    refined = classify(node.first);
-                } catch (const Error&) {
+                const Reading reading = read(p);
+                if (reading.fault != Reading::none) {  // where classify throws
                     miss(node.second);
                     blame_node(node.second, node.first);
+                    continue;
                 }
-                if (!refined) continue;
+                if (!take_reading(node.first, reading)) continue;
                 if (h_.can_split(node.first)) {
                     h_.split(node.first);
                     undo.splits.push_back(node.first);

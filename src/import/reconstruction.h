@@ -331,6 +331,10 @@ private:
     // none. For a leaf, checks its red or green triangles and notes the hanging nodes, which are
     // the midpoints of the refined neighbours' edges.
     bool classify(NodeId n);
+    // classify's bookkeeping for a reading without a fault (a leaf's unsplit edges, reveals and
+    // diagonal); true when n reads refined. A lenient reconstruction (local_misfits) counts a
+    // fault instead of throwing its message (a refusal's judgements read thousands of misfits).
+    bool take_reading(NodeId n, const Reading& r);
     // A child whose faces do not fit often means that its parent, split on all three edges, was
     // closed by green triangles instead of being split red (closure): a leaf edge then joins a
     // midpoint of the parent to the opposite corner, as bisections and diagonals do.

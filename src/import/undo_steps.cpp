@@ -84,11 +84,19 @@ uint32_t UndoStepChoice::choose(const uint32_t* candidates, uint32_t count, uint
     // smaller detour d(a, c) + d(c, b) - d(a, b) wins, the nearer on a tie. d(a, b) is common to
     // both, so only the two candidates' distances are needed.
     measure_from(a, never, hops_from_a_, vertex_of_leaf);
-    measure_from(b, never, hops_from_b_, vertex_of_leaf);
     auto path_length = [&](uint32_t c) {
         return hops_from_a_[c] < 0 || hops_from_b_[c] < 0 ? 1 << 21 : hops_from_a_[c] + hops_from_b_[c];
     };
-    found = path_length(never[1]) < path_length(never[0]) ? never[1] : never[0];
+    // The second wins only with a path, and then against a first without one whatever its length:
+    // b's search is needed only for the candidates a reaches (a search that does not reach its
+    // targets looks at its whole ball).
+    if (hops_from_a_[never[1]] < 0) {
+        found = never[0];
+    } else {
+        const uint32_t wanted[2] = {hops_from_a_[never[0]] < 0 ? never[1] : never[0], never[1]};
+        measure_from(b, wanted, hops_from_b_, vertex_of_leaf);
+        found = path_length(never[1]) < path_length(never[0]) ? never[1] : never[0];
+    }
     for (uint32_t x : reached_) hops_from_a_[x] = hops_from_b_[x] = -1;
     reached_.clear();
     return found;
