@@ -392,9 +392,8 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
     // An older model of the mixing mode where it codes the file smaller (small files, whose new
     // tables have little to learn from, or creased ones, by a few bytes): every file at most as
     // large as each older model's. A tie keeps the newer model.
-    if (mixed)
-        for (ForestCode* other : {&sixth, &fifth, &fourth, &third})
-            if (other->bytes < forest.bytes) forest = std::move(*other);
+    for (const auto& model_and_code : older)
+        if (model_and_code.second->bytes < forest.bytes) forest = std::move(*model_and_code.second);
 
     Metadata meta;
     meta.base_vertices = h.base().positions.size();
