@@ -22,6 +22,12 @@ inline void advise_aligned(const void* begin, size_t bytes, uintptr_t alignment,
     const uintptr_t b = (reinterpret_cast<uintptr_t>(begin) + bytes) & ~(alignment - 1);
     if (b > a) madvise(reinterpret_cast<void*>(a), b - a, advice);
 }
+
+// madvise(advice) on the whole system pages inside [begin, begin + bytes).
+inline void advise_whole_pages(const void* begin, size_t bytes, int advice) {
+    static const uintptr_t page = uintptr_t(sysconf(_SC_PAGESIZE));
+    advise_aligned(begin, bytes, page, advice);
+}
 }  // namespace detail
 #endif
 
@@ -40,8 +46,7 @@ inline void advise_huge_pages(const void* begin, size_t bytes) {
 // working memory whose contents are dead, so that what a decoder writes next does not add to it.
 inline void release_pages(void* begin, size_t bytes) {
 #if defined(__linux__) && defined(MADV_DONTNEED)
-    static const uintptr_t page = uintptr_t(sysconf(_SC_PAGESIZE));
-    detail::advise_aligned(begin, bytes, page, MADV_DONTNEED);
+    detail::advise_whole_pages(begin, bytes, MADV_DONTNEED);
 #else
     (void)begin;
     (void)bytes;
@@ -54,8 +59,7 @@ inline void release_pages(void* begin, size_t bytes) {
 // project's VM (docs/BENCHMARKS.md, "Threads and memory").
 inline void populate_pages(void* begin, size_t bytes) {
 #if defined(__linux__) && defined(MADV_POPULATE_WRITE)
-    static const uintptr_t page = uintptr_t(sysconf(_SC_PAGESIZE));
-    detail::advise_aligned(begin, bytes, page, MADV_POPULATE_WRITE);
+    detail::advise_whole_pages(begin, bytes, MADV_POPULATE_WRITE);
 #else
     (void)begin;
     (void)bytes;
