@@ -2,10 +2,13 @@
 // corpus of hierarchies (.amh): connectivity sizes (the paper's Table 3), complete meshes at 12 and
 // 16 bits and lossless, encode and decode speeds (median of --runs, one thread, all in one
 // process), and a check of every decoded result against its input. See docs/BENCHMARKS.md.
+// With --kept-encoders, amcodec's complete files are encoded through one EncodeContext and Draco's
+// through one encoder object per model and mode, kept over the runs (as a caller coding a series
+// keeps them); without it every encode starts afresh.
 // A mesh file (OBJ, OFF, PLY, VTU) is a model as users have it: imported over the coarsest base
 // found in it (import_mesh), which for an irregular mesh is mostly the mesh itself.
 //
-//   compare_bench [--runs N] [--csv FILE] [--markdown FILE] corpus/*.amh mesh.obj ...
+//   compare_bench [--runs N] [--kept-encoders] [--csv FILE] [--markdown FILE] corpus/*.amh mesh.obj ...
 #include "bench_common.h"
 #include "compare_check.h"
 #include "compare_draco.h"
@@ -129,7 +132,7 @@ double largest_extent(const amc::TriangleMesh& mesh) {
     return std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
 }
 
-void measure_draco(const Model& m, int runs, std::vector<Result>& out) {
+void measure_draco(const Model& m, int runs, bool kept_encoders, std::vector<Result>& out) {
     const auto lossy_input = make_draco_mesh(m.leaf, false);
     const auto exact_input = make_draco_mesh(m.leaf, true);
     const double extent = largest_extent(m.leaf);
@@ -148,9 +151,10 @@ void measure_draco(const Model& m, int runs, std::vector<Result>& out) {
             DracoEncoded encoded;
             DracoDecoded decoded;
             std::vector<double> encode_times, decode_times;
+            DracoKeptEncoder kept;
             try {
                 for (int run = 0; run < runs; ++run) {
-                    encoded = draco_encode(input, settings);
+                    encoded = draco_encode(input, settings, kept_encoders ? &kept : nullptr);
                     encode_times.push_back(encoded.seconds);
                     connectivity_encode.push_back(encoded.connectivity_seconds);
                 }
@@ -225,7 +229,7 @@ std::vector<AmcMode> amc_connectivity_modes() {
             {"amc-best", amc::EncodeOptions{}.hierarchy}};
 }
 
-void measure_amcodec(const Model& m, int runs, std::vector<Result>& out) {
+void measure_amcodec(const Model& m, int runs, bool kept_encoders, std::vector<Result>& out) {
     const amc::TriangleMesh expected_leaf = amc::extract_leaf_mesh(m.expected).mesh;
     uint64_t base_connectivity_bytes = 0;
 
@@ -240,7 +244,10 @@ void measure_amcodec(const Model& m, int runs, std::vector<Result>& out) {
         amc::EncodeStats stats;
         std::vector<uint8_t> file;
         amc::Hierarchy back;
-        r.encode_seconds = median_seconds(runs, [&] { file = amc::encode(m.hierarchy, options, &stats); });
+        amc::EncodeContext context;
+        r.encode_seconds = median_seconds(runs, [&] {
+            file = kept_encoders ? amc::encode(context, m.hierarchy, options, &stats) : amc::encode(m.hierarchy, options, &stats);
+        });
         r.decode_seconds = median_seconds(runs, [&] { back = amc::decode(file.data(), file.size(), decode_options); });
         r.bytes = file.size();
         r.max_error = stats.max_error;
@@ -341,6 +348,7 @@ Model load_model(const std::string& path) {
 
 int run(int argc, char** argv) {
     int runs = 3;
+    bool kept_encoders = false;
     std::string csv_path, markdown_path;
     std::vector<std::string> inputs;
     for (int i = 1; i < argc; ++i) {
@@ -350,13 +358,14 @@ int run(int argc, char** argv) {
             return argv[++i];
         };
         if (arg == "--runs") runs = std::max(1, std::stoi(value()));
+        else if (arg == "--kept-encoders") kept_encoders = true;
         else if (arg == "--csv") csv_path = value();
         else if (arg == "--markdown") markdown_path = value();
         else if (arg.rfind("--", 0) == 0) throw std::runtime_error("unknown option " + arg);
         else inputs.push_back(arg);
     }
     if (inputs.empty()) {
-        std::fprintf(stderr, "usage: compare_bench [--runs N] [--csv FILE] [--markdown FILE] model.amh...\n");
+        std::fprintf(stderr, "usage: compare_bench [--runs N] [--kept-encoders] [--csv FILE] [--markdown FILE] model.amh...\n");
         return 2;
     }
     std::vector<Result> results;
@@ -365,8 +374,8 @@ int run(int argc, char** argv) {
         const Model m = load_model(path);
         const size_t first = results.size();
         measure_general_coders(m, runs, results);
-        measure_draco(m, runs, results);
-        measure_amcodec(m, runs, results);
+        measure_draco(m, runs, kept_encoders, results);
+        measure_amcodec(m, runs, kept_encoders, results);
         int failed = 0;
         for (size_t i = first; i < results.size(); ++i) failed += !passed(results[i]);
         std::fprintf(stderr, "%-18s %7zu faces  %5.1f s  %s\n", m.name.c_str(), m.leaf.triangles.size(), seconds_since(start),

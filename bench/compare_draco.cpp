@@ -87,20 +87,32 @@ std::shared_ptr<const draco::Mesh> make_draco_mesh(const amc::TriangleMesh& mesh
     return out;
 }
 
-DracoEncoded draco_encode(const draco::Mesh& mesh, const DracoSettings& settings) {
+// What draco::Encoder::EncodeMeshToBuffer does for an Edgebreaker speed (0..9), with our subclass
+// (its Encode() clears what an earlier call left).
+struct DracoEncoderState {
+    DracoEncoderState(const draco::Mesh& mesh, const DracoSettings& settings)
+        : options(configured_encoder(settings).CreateExpertEncoderOptions(mesh)) {
+        counting.SetMesh(mesh);
+    }
+    const draco::EncoderOptions options;
+    CountingEdgebreakerEncoder counting;
+};
+
+DracoKeptEncoder::DracoKeptEncoder() = default;
+DracoKeptEncoder::~DracoKeptEncoder() = default;
+
+DracoEncoded draco_encode(const draco::Mesh& mesh, const DracoSettings& settings, DracoKeptEncoder* kept) {
     DracoEncoded result;
     const Clock::time_point start = Clock::now();
-    // What draco::Encoder::EncodeMeshToBuffer does for an Edgebreaker speed (0..9), with our subclass.
-    const draco::Encoder encoder = configured_encoder(settings);
-    const draco::EncoderOptions options = encoder.CreateExpertEncoderOptions(mesh);
-    CountingEdgebreakerEncoder counting;
-    counting.SetMesh(mesh);
+    std::unique_ptr<DracoEncoderState> own;
+    std::unique_ptr<DracoEncoderState>& state = kept != nullptr ? kept->state : own;
+    if (state == nullptr) state = std::make_unique<DracoEncoderState>(mesh, settings);
     draco::EncoderBuffer buffer;
-    throw_unless_ok(counting.Encode(options, &buffer), "draco encode");
+    throw_unless_ok(state->counting.Encode(state->options, &buffer), "draco encode");
     result.seconds = seconds_since(start);
     result.bytes.assign(buffer.data(), buffer.data() + buffer.size());
-    result.connectivity_bytes = counting.connectivity_bytes;
-    result.connectivity_seconds = counting.connectivity_seconds;
+    result.connectivity_bytes = state->counting.connectivity_bytes;
+    result.connectivity_seconds = state->counting.connectivity_seconds;
     return result;
 }
 

@@ -35,8 +35,22 @@ struct DracoEncoded {
     double seconds = 0;               // the whole encode (Draco mesh in, file out)
     double connectivity_seconds = 0;  // inside EncodeConnectivity()
 };
-// Throws std::runtime_error with Draco's message on failure.
-DracoEncoded draco_encode(const draco::Mesh& mesh, const DracoSettings& settings);
+// Draco's encoder object kept over the encodes of one mesh at one setting, as a caller coding a
+// series keeps it (compare_bench --kept-encoders; amcodec's side keeps an EncodeContext): made at
+// the first encode through it, within its time, and used again by the next ones.
+struct DracoEncoderState;
+class DracoKeptEncoder {
+public:
+    DracoKeptEncoder();
+    ~DracoKeptEncoder();
+    DracoKeptEncoder(const DracoKeptEncoder&) = delete;
+    DracoKeptEncoder& operator=(const DracoKeptEncoder&) = delete;
+    std::unique_ptr<DracoEncoderState> state;
+};
+
+// Throws std::runtime_error with Draco's message on failure. With `kept`, through its encoder
+// (always the same mesh and settings).
+DracoEncoded draco_encode(const draco::Mesh& mesh, const DracoSettings& settings, DracoKeptEncoder* kept = nullptr);
 
 // The same settings through the public draco::Encoder, for the identity check.
 std::vector<char> draco_encode_public(const draco::Mesh& mesh, const DracoSettings& settings);

@@ -7,13 +7,17 @@
 // amcodec's speed over Draco's as the median [min - max] of the rounds' ratios: a round's two
 // timings are a second apart, so its ratio sees the same machine.
 //
-//   one_core_speed RUNS BITS model.amh ...
+//   one_core_speed [context] RUNS BITS model.amh ...
+//                                           `context`: amcodec encodes through one
+//                                           amc::EncodeContext and Draco through one encoder
+//                                           object per model, kept over the rounds
 //   one_core_speed decode RUNS file.amc     only decodes the file RUNS times on one thread: the
 //                                           process to profile or count instructions of
-//   one_core_speed encode RUNS BITS model.amh [EFFORT]
+//   one_core_speed encode RUNS BITS model.amh [EFFORT [context]]
 //                                           only encodes the model RUNS times on one thread
-//                                           (default options, or EncodeOptions::effort EFFORT),
-//                                           and prints the file's size and FNV-1a hash: the
+//                                           (default options, or EncodeOptions::effort EFFORT;
+//                                           `context`: through one amc::EncodeContext), and
+//                                           prints the file's size and FNV-1a hash: the
 //                                           process to profile; 0 runs reads the model only
 #include "compare_draco.h"
 #include "bench_common.h"
@@ -67,7 +71,7 @@ int decode_only(int runs, const char* path) {
     return 0;
 }
 
-int encode_only(int runs, int bits, const char* path, int effort) {
+int encode_only(int runs, int bits, const char* path, int effort, bool kept) {
     const amc::Hierarchy h = amc::read_hierarchy(path);
     amc::EncodeOptions options;
     options.quantize_bits = bits;
@@ -75,8 +79,10 @@ int encode_only(int runs, int bits, const char* path, int effort) {
     options.threads = 1;
     std::vector<double> rate;
     std::vector<uint8_t> bytes;
+    amc::EncodeContext context;
     for (int r = 0; r < runs; ++r)
-        rate.push_back(double(h.leaf_count()) / timed([&] { bytes = amc::encode(h, options); }) * 1e-6);
+        rate.push_back(double(h.leaf_count()) /
+                       timed([&] { bytes = kept ? amc::encode(context, h, options) : amc::encode(h, options); }) * 1e-6);
     uint64_t hash = 14695981039346656037ull;  // FNV-1a: equal files, equal hashes
     for (uint8_t b : bytes) hash = (hash ^ b) * 1099511628211ull;
     if (runs == 0) return 0;
@@ -90,12 +96,17 @@ int encode_only(int runs, int bits, const char* path, int effort) {
 
 int main(int argc, char** argv) {
     if (argc == 4 && std::strcmp(argv[1], "decode") == 0) return decode_only(std::max(1, std::atoi(argv[2])), argv[3]);
-    if ((argc == 5 || argc == 6) && std::strcmp(argv[1], "encode") == 0)
+    if (argc >= 5 && argc <= 7 && std::strcmp(argv[1], "encode") == 0 && (argc < 7 || std::strcmp(argv[6], "context") == 0))
         return encode_only(std::max(0, std::atoi(argv[2])), std::atoi(argv[3]), argv[4],
-                           argc == 6 ? std::atoi(argv[5]) : amc::kDefaultEffort);
+                           argc >= 6 ? std::atoi(argv[5]) : amc::kDefaultEffort, argc == 7);
+    const bool kept = argc > 1 && std::strcmp(argv[1], "context") == 0;
+    if (kept) {
+        --argc;
+        ++argv;
+    }
     if (argc < 4) {
-        std::fprintf(stderr, "usage: one_core_speed RUNS BITS model.amh ... | one_core_speed decode RUNS file.amc | "
-                             "one_core_speed encode RUNS BITS model.amh [EFFORT]\n");
+        std::fprintf(stderr, "usage: one_core_speed [context] RUNS BITS model.amh ... | one_core_speed decode RUNS file.amc | "
+                             "one_core_speed encode RUNS BITS model.amh [EFFORT [context]]\n");
         return 2;
     }
     const int runs = std::max(1, std::atoi(argv[1]));
@@ -118,11 +129,15 @@ int main(int argc, char** argv) {
             return 1;
         }
         std::vector<double> encode_amc, encode_draco, decode_amc, decode_draco, encode_ratio, decode_ratio;
+        amc::EncodeContext context;
+        draco::Encoder draco_encoder = draco_default_encoder(bits);
         for (int r = 0; r < runs; ++r) {
-            const double e_amc = timed([&] { amc::encode(h, encode_options); });
+            const double e_amc = timed([&] { kept ? amc::encode(context, h, encode_options) : amc::encode(h, encode_options); });
             const double e_draco = timed([&] {
                 draco::EncoderBuffer buffer;
-                if (!draco_default_encoder(bits).EncodeMeshToBuffer(*mesh, &buffer).ok()) std::exit(1);
+                const bool ok = kept ? draco_encoder.EncodeMeshToBuffer(*mesh, &buffer).ok()
+                                     : draco_default_encoder(bits).EncodeMeshToBuffer(*mesh, &buffer).ok();
+                if (!ok) std::exit(1);
             });
             const double d_amc = timed([&] {  // the result freed inside: each decode starts alike
                 const amc::Hierarchy back = amc::decode(amc_bytes.data(), amc_bytes.size(), decode_options);

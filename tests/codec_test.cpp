@@ -222,6 +222,58 @@ TEST(Codec, EffortOutsideItsRangeIsRefused) {
     }
 }
 
+// An EncodeContext's memory (the first pass's level forest and lists, the static modes' buffers)
+// goes from one encode to the next: hierarchies of other sizes, level counts and precisions, other
+// geometry modes and efforts, chunked and mixed files in between, and the context after
+// release() and after a move, must each give the bytes and sizes encode() gives without one.
+TEST(Codec, EncodesThroughAContextAreThoseWithoutOne) {
+    SurfaceRemeshOptions remesh;
+    remesh.base_triangles = 200;
+    remesh.max_level = 5;
+    remesh.target_faces = 6000;
+    const Hierarchy surface = remesh_adaptively(make_bumpy_sphere(4), remesh);
+    Hierarchy sphere(make_icosahedron());
+    refine_uniformly(sphere, 5);  // 7680 new vertices on the last level: the modes are weighed on a sample
+    testing::Random random{7};
+    for (VertexId v = 0; v < sphere.positions().size(); ++v) {
+        const Vec3 p = sphere.position(v);
+        sphere.set_position(v, (1.0 + 1e-3 * double(random.next() % 1000) / 1000.0) / std::sqrt(dot(p, p)) * p);
+    }
+    const Hierarchy small = random_hierarchy(2, false), single = random_hierarchy(5, true), exact = random_hierarchy(9, false);
+    struct Case {
+        const Hierarchy* h;
+        int bits, effort;
+        bool mixed, roles;
+        uint32_t chunks;
+    };
+    const Case cases[] = {{&sphere, 0, kDefaultEffort, false, false, 0}, {&surface, 0, kDefaultEffort, false, false, 0},
+                          {&small, 0, kDefaultEffort, false, false, 0},  {&sphere, 12, kDefaultEffort, false, false, 0},
+                          {&surface, 16, kMaxEffort, false, false, 0},   {&single, 0, kDefaultEffort, false, false, 0},
+                          {&surface, 0, kDefaultEffort, true, false, 0}, {&exact, 0, kDefaultEffort, false, false, 2},
+                          {&surface, 12, kDefaultEffort, false, true, 0}, {&sphere, 0, 0, false, false, 0}};
+    EncodeContext context;
+    for (int pass = 0; pass < 2; ++pass) {
+        for (size_t c = 0; c < std::size(cases); ++c) {
+            SCOPED_TRACE("case " + std::to_string(c) + ", pass " + std::to_string(pass));
+            EncodeOptions options;
+            options.quantize_bits = cases[c].bits;
+            options.effort = cases[c].effort;
+            options.hierarchy_contexts = cases[c].mixed ? HierarchyContexts::mixed : HierarchyContexts::paper;
+            options.grid_contexts = !cases[c].roles;
+            options.chunks = cases[c].chunks;
+            EncodeStats with, without;
+            const std::vector<uint8_t> bytes = encode(context, *cases[c].h, options, &with);
+            EXPECT_EQ(bytes, encode(*cases[c].h, options, &without));
+            EXPECT_EQ(with.total_bytes, without.total_bytes);
+            EXPECT_EQ(with.geometry_bytes, without.geometry_bytes);
+        }
+        if (pass == 0) context.release();
+    }
+    EncodeContext moved = std::move(context);
+    EXPECT_EQ(encode(moved, surface), encode(surface));
+    EXPECT_EQ(encode(context, sphere), encode(sphere));  // a moved-from context starts afresh
+}
+
 TEST(Codec, ProgressiveDecodingGivesEveryLevelMesh) {
     Hierarchy h(make_icosahedron());
     refine_randomly(h, 5000, 6, 21);

@@ -133,6 +133,31 @@ struct EncodeStats {
 // result is identical to reorder_base(h, ...) of the input — same elements, same positions.
 std::vector<uint8_t> encode(const Hierarchy& h, const EncodeOptions& options = {}, EncodeStats* stats = nullptr);
 
+// Working memory that encodes through it keep for the next one, as zstd's ZSTD_CCtx: the hierarchy
+// coder's first pass (its level forest and per-level lists) and the static geometry modes'
+// buffers, kept after the encode returns until release() or the context's end, so that the next
+// encode neither allocates them nor has the system fault their pages in again (docs/BENCHMARKS.md,
+// "One-core encode, nineteenth step"). encode() without a context keeps nothing. It serves files
+// of one chunk; a chunked file's chunks are coded as without it. A context serves one encode at a
+// time; the bytes are those of encode() without it.
+class EncodeContext {
+public:
+    EncodeContext();
+    ~EncodeContext();
+    EncodeContext(EncodeContext&&) noexcept;
+    EncodeContext& operator=(EncodeContext&&) noexcept;
+    EncodeContext(const EncodeContext&) = delete;
+    EncodeContext& operator=(const EncodeContext&) = delete;
+    void release();  // frees the kept memory (the next encode allocates it again)
+
+private:
+    struct Kept;
+    std::unique_ptr<Kept> kept_;
+    friend std::vector<uint8_t> encode(EncodeContext&, const Hierarchy&, const EncodeOptions&, EncodeStats*);
+};
+std::vector<uint8_t> encode(EncodeContext& context, const Hierarchy& h, const EncodeOptions& options = {},
+                            EncodeStats* stats = nullptr);
+
 // `h` as decode(encode(h, options)) returns it: over the base mesh in the base coder's order
 // (cheap: codes the base connectivity only), with the input's positions. The order depends on the
 // base positions the decoder sees, so pass the options of the encoding (only quantize_bits

@@ -184,6 +184,12 @@ void add_level_stats(EncodeStats& stats, size_t nodes, size_t new_vertices, size
     stats.per_level.push_back(level_stats);
 }
 
+// An EncodeContext's memory for the encode's one-chunk stages (null members: none, each stage's own).
+struct EncodeMemory {
+    HierarchyLevelEncoder::Memory* first_pass = nullptr;
+    StaticEncoderBuffers* statics = nullptr;
+};
+
 // The forest after the base mesh: one level block per level, or, in two chunks or more, the chunk
 // table, the seam and the chunk blocks (a version-7 file).
 struct ForestCode {
@@ -203,11 +209,11 @@ struct ForestCode {
 // the base geometry left them. The mixing mode (FORMAT.md 2.1) codes the forest as one stream, in
 // its written model, and also in each model of `older` into its ForestCode: the same first pass
 // and the same geometry (which does not depend on the hierarchy's model; each level's chosen
-// once), the hierarchy parts in the models' own arithmetic codes.
+// once), the hierarchy parts in the models' own arithmetic codes. One chunk is coded in `memory`.
 ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<RootRange>& chunks, uint64_t faces,
                        const EncodeOptions& options, CoordinateSpace space, PositionCoder positions, unsigned threads,
                        bool want_hierarchy_stats, HierarchyLevelEncoder* first_pass, const HierarchyOnGrid* on_grid,
-                       const std::vector<std::pair<MixingModel, ForestCode*>>& older = {}) {
+                       const std::vector<std::pair<MixingModel, ForestCode*>>& older = {}, EncodeMemory memory = {}) {
     ForestCode out;
     const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
     out.chunked = !mixed && chunks.size() > 1;
@@ -224,7 +230,8 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
     } else {
         std::unique_ptr<HierarchyLevelEncoder> own;
         if (first_pass == nullptr)
-            own = std::make_unique<HierarchyLevelEncoder>(h, options.hierarchy, kHierarchyStreamVersion, nullptr, mixed);
+            own = std::make_unique<HierarchyLevelEncoder>(h, options.hierarchy, kHierarchyStreamVersion, nullptr, mixed, nullptr,
+                                                          memory.first_pass);
         HierarchyLevelEncoder& hierarchy = first_pass != nullptr ? *first_pass : *own;
         std::vector<std::unique_ptr<HierarchyLevelEncoder>> older_hierarchies;
         std::vector<PositionCoder> older_positions;  // the same models level after level
@@ -263,7 +270,8 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
             // which hold mode 4 in the per-vertex order).
             const LevelGeometryCode geometry =
                 choose_level_geometry(geometry_of, created, positions, space, options.predictor, options.grid_contexts,
-                                      options.unit_normals, options.effort, mixed ? StaticOrder::per_vertex : StaticOrder::grouped);
+                                      options.unit_normals, options.effort, mixed ? StaticOrder::per_vertex : StaticOrder::grouped,
+                                      memory.statics);
             add_level(out, hierarchy, l, geometry_of, created, geometry, positions);
             for (size_t k = 0; k < older_hierarchies.size(); ++k)
                 add_level(*older[k].second, *older_hierarchies[k], l, geometry_of, created, geometry, older_positions[k]);
@@ -284,9 +292,8 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
     return out;
 }
 
-}  // namespace
-
-std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options, EncodeStats* stats_out) {
+// encode() through `memory` (an EncodeContext's, or none).
+std::vector<uint8_t> encode_file(const Hierarchy& input, const EncodeOptions& options, EncodeStats* stats_out, EncodeMemory memory) {
     EncodeStats stats;
     check_effort(options.effort, "encode");
     const unsigned threads = resolve_thread_count(options.threads);
@@ -343,8 +350,9 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
                 for (size_t i = 0; i < base.positions.size(); ++i) base.positions[i] = grid_positions[base_code.vertex_order[i]];
             reordered.hierarchy = Hierarchy(std::move(base));
             if (quantized) reordered.hierarchy.set_single_precision(false);
+            first_pass.reset();  // its memory back before the next one takes it
             first_pass = std::make_unique<HierarchyLevelEncoder>(input, options.hierarchy, kHierarchyStreamVersion, nullptr,
-                                                                 false, &turned);
+                                                                 false, &turned, memory.first_pass);
         };
         read_in_order(false);
         if (keeps_rotations(first_pass->diagonal_exceptions(), first_pass->unturned_diagonal_exceptions(),
@@ -383,7 +391,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
                                                                   {MixingModel::third, &third}}
               : std::vector<std::pair<MixingModel, ForestCode*>>{};
     ForestCode forest = code_forest(h, root_of, chunks, faces, options, space, positions, threads, want_hierarchy_stats,
-                                    first_pass.get(), turned_input && quantized ? &on_grid : nullptr, older);
+                                    first_pass.get(), turned_input && quantized ? &on_grid : nullptr, older, memory);
     const uint32_t fewer = automatic && forest.chunked ? chunk_count_for_size(options, uint32_t(chunks.size()), forest.bytes)
                                                        : uint32_t(chunks.size());
     if (fewer < chunks.size())
@@ -444,6 +452,31 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
         *stats_out = stats;
     }
     return out;
+}
+
+}  // namespace
+
+std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options, EncodeStats* stats_out) {
+    return encode_file(input, options, stats_out, {});
+}
+
+struct EncodeContext::Kept {
+    HierarchyLevelEncoder::Memory first_pass;
+    StaticEncoderBuffers statics;
+};
+
+EncodeContext::EncodeContext() : kept_(std::make_unique<Kept>()) {}
+EncodeContext::~EncodeContext() = default;
+EncodeContext::EncodeContext(EncodeContext&&) noexcept = default;
+EncodeContext& EncodeContext::operator=(EncodeContext&&) noexcept = default;
+
+void EncodeContext::release() {
+    if (kept_ != nullptr) kept_ = std::make_unique<Kept>();
+}
+
+std::vector<uint8_t> encode(EncodeContext& context, const Hierarchy& h, const EncodeOptions& options, EncodeStats* stats) {
+    if (context.kept_ == nullptr) context.kept_ = std::make_unique<EncodeContext::Kept>();  // moved from
+    return encode_file(h, options, stats, {&context.kept_->first_pass, &context.kept_->statics});
 }
 
 namespace {

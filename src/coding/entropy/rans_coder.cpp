@@ -138,16 +138,24 @@ std::vector<uint8_t> RansEncoder::finish() {
 }
 
 RansBackwardEncoder::RansBackwardEncoder(size_t count)
-    : buffer_(new uint8_t[2 * count + kRansStateBytes]), end_(buffer_.get() + 2 * count + kRansStateBytes), begin_(end_),
-      left_(count) {}
+    : buffer_(new uint8_t[buffer_bytes(count)]), end_(buffer_.get() + buffer_bytes(count)), begin_(end_), left_(count) {}
+
+RansBackwardEncoder::RansBackwardEncoder(size_t count, ScratchArray<uint8_t>& memory)
+    : end_(memory.reserve(buffer_bytes(count)) + buffer_bytes(count)), begin_(end_), left_(count) {}
 
 void RansBackwardEncoder::throw_too_many() { throw Error("RansBackwardEncoder::put: more symbols than it was made for"); }
 
 std::vector<uint8_t> RansBackwardEncoder::finish() {
+    std::vector<uint8_t> out;
+    finish(out);
+    return out;
+}
+
+void RansBackwardEncoder::finish(std::vector<uint8_t>& out) {
     if (left_ != 0) throw Error("RansBackwardEncoder::finish: " + std::to_string(left_) + " symbols were not put");
     for (int s = 1; s >= 0; --s)
         for (int shift = 24; shift >= 0; shift -= 8) *--begin_ = uint8_t(state_[s] >> shift);
-    return std::vector<uint8_t>(begin_, end_);
+    out.assign(begin_, end_);
 }
 
 std::vector<uint8_t> RawBitWriter::finish() {

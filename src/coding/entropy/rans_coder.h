@@ -19,6 +19,7 @@
 // its low bit first.
 #pragma once
 
+#include "common/huge_pages.h"
 #include "common/simd.h"
 
 #include <algorithm>
@@ -126,6 +127,8 @@ private:
 class RansBackwardEncoder {
 public:
     explicit RansBackwardEncoder(size_t count);
+    // The same in `memory`, kept by the caller from one encoder to the next.
+    RansBackwardEncoder(size_t count, ScratchArray<uint8_t>& memory);
     // The symbol before the one put last (the first call: the last symbol), of nonzero frequency.
     void put(const RansTable& table, int symbol) { put_coding(table.coding(symbol)); }
     void put_coding(const RansTable::Coding& c) {
@@ -167,11 +170,16 @@ public:
     }
     // The stream (once); throws Error unless exactly `count` symbols were put.
     std::vector<uint8_t> finish();
+    // The same into `out` (its capacity kept).
+    void finish(std::vector<uint8_t>& out);
 
 private:
     [[noreturn]] static void throw_too_many();
+    // The buffer's size for `count` symbols.
+    static size_t buffer_bytes(size_t count) { return 2 * count + kRansStateBytes; }
     // At most two bytes a symbol (x < 2^31 before, x_max >= 2^19) and the states, written from the
-    // end down; not zeroed, so the pages the code never reaches are never touched.
+    // end down; not zeroed, so the pages the code never reaches are never touched. Owned, or the
+    // caller's memory.
     std::unique_ptr<uint8_t[]> buffer_;
     uint8_t* end_;
     uint8_t* begin_;  // the first byte written so far
@@ -252,6 +260,12 @@ public:
     size_t bits() const { return used_ * 8 + size_t(filled_); }
     // Pads the last byte with zero bits and returns the bytes; the writer is empty again.
     std::vector<uint8_t> finish();
+    // Writes into `memory` from now on (emptied, its capacity kept): a buffer kept from an earlier
+    // writer's finish(). Only while the writer is empty.
+    void adopt(std::vector<uint8_t>&& memory) {
+        bytes_ = std::move(memory);
+        bytes_.clear();
+    }
 
 private:
     // The buffer's whole bytes (1..8) out at once: a byte at a time was a push_back each.

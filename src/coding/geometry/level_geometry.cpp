@@ -56,13 +56,13 @@ constexpr double kStencilPreference = 1.01;
 template <class Mesh>
 void keep_likely_static_modes(const Mesh& h, const NewVertices& created, CoordinateSpace space, size_t sample,
                               bool candidate[kStaticCandidates], std::unique_ptr<StaticLevelEncoder> on_sample[kStaticCandidates],
-                              StaticOrder grid_order) {
+                              StaticOrder grid_order, StaticEncoderBuffers* buffers) {
     const double scale = double(created.size()) / double(sample);
     double bound[kStaticCandidates], smallest = HUGE_VAL;
     for (int i = 0; i < kStaticCandidates; ++i) {
         bound[i] = HUGE_VAL;
         if (!candidate[i]) continue;
-        on_sample[i] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, kStaticModes[i], grid_order);
+        on_sample[i] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, kStaticModes[i], grid_order, buffers);
         bound[i] = on_sample[i]->projected_bound_bytes(scale);
         smallest = std::min(smallest, bound[i]);
     }
@@ -185,7 +185,7 @@ bool AdaptiveTrialJudge::checkpoint(size_t done, size_t bytes) {
 template <class Mesh>
 LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& created, const PositionCoder& positions,
                                         CoordinateSpace space, GeometryPredictor choice, bool grid_contexts, bool unit_normals,
-                                        int effort, StaticOrder grid_order) {
+                                        int effort, StaticOrder grid_order, StaticEncoderBuffers* buffers) {
     const bool automatic = choice == GeometryPredictor::automatic;
     LevelGeometryCode code;
     code.predictor = automatic ? GeometryPredictor::midpoint : choice;
@@ -193,7 +193,7 @@ LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& create
         throw Error("geometry mode 4 (normal_frame_grid) needs quantized coordinates");
     if (!automatic || created.empty()) {
         if (is_static_mode(code.predictor))
-            code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space, code.predictor, true, grid_order);
+            code.static_code = std::make_unique<StaticLevelEncoder>(h, created, space, code.predictor, true, grid_order, buffers);
         return code;
     }
     // The first of the smallest in the order midpoint, butterfly, normal frame, grid, unit frame,
@@ -204,14 +204,14 @@ LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& create
     const bool exact = space.quantizer == nullptr;
     bool candidate[kStaticCandidates] = {true, grid_contexts && !exact, unit_normals && exact, exact, exact};
     std::unique_ptr<StaticLevelEncoder> on_sample[kStaticCandidates];
-    if (sample != SIZE_MAX) keep_likely_static_modes(h, created, space, sample, candidate, on_sample, grid_order);
+    if (sample != SIZE_MAX) keep_likely_static_modes(h, created, space, sample, candidate, on_sample, grid_order, buffers);
     std::unique_ptr<StaticLevelEncoder> statics[kStaticCandidates];  // in the order of the choice
     size_t static_size[kStaticCandidates], bound[kStaticCandidates];
     for (int i = 0; i < kStaticCandidates; ++i) {
         static_size[i] = bound[i] = SIZE_MAX;
         if (!candidate[i]) continue;
         if (on_sample[i] == nullptr) {
-            statics[i] = std::make_unique<StaticLevelEncoder>(h, created, space, kStaticModes[i], false, grid_order);
+            statics[i] = std::make_unique<StaticLevelEncoder>(h, created, space, kStaticModes[i], false, grid_order, buffers);
         } else {
             on_sample[i]->extend(h, created);
             statics[i] = std::move(on_sample[i]);
@@ -305,9 +305,9 @@ std::vector<uint8_t> finish_level_payload(const Mesh& h, const NewVertices& crea
 }
 
 template LevelGeometryCode choose_level_geometry(const Hierarchy&, const NewVertices&, const PositionCoder&, CoordinateSpace,
-                                                 GeometryPredictor, bool, bool, int, StaticOrder);
+                                                 GeometryPredictor, bool, bool, int, StaticOrder, StaticEncoderBuffers*);
 template LevelGeometryCode choose_level_geometry(const HierarchyOnGrid&, const NewVertices&, const PositionCoder&,
-                                                 CoordinateSpace, GeometryPredictor, bool, bool, int, StaticOrder);
+                                                 CoordinateSpace, GeometryPredictor, bool, bool, int, StaticOrder, StaticEncoderBuffers*);
 template std::vector<uint8_t> finish_level_payload(const Hierarchy&, const NewVertices&, const LevelGeometryCode&,
                                                    PositionCoder&, ArithmeticEncoder&);
 template std::vector<uint8_t> finish_level_payload(const HierarchyOnGrid&, const NewVertices&, const LevelGeometryCode&,

@@ -44,13 +44,14 @@ struct LevelGeometryCode {
 // adaptive predictor tried on a copy of `positions`' models; mode 4 is a candidate only with
 // grid_contexts in a quantized space, mode 5 only with unit_normals in a bit-exact one. Below
 // kMaxEffort an adaptive predictor may be judged from a sample (EncodeOptions::effort). Mode 4's
-// tokens go in `grid_order` (grouped: a version-18 file; per_vertex: versions 9-17).
+// tokens go in `grid_order` (grouped: a version-18 file; per_vertex: versions 9-17). The static
+// modes' encoders work in `buffers` when given (StaticEncoderBuffers).
 // Mesh: Hierarchy or HierarchyOnGrid (hierarchy_on_grid.h: the input's nodes with their grid points).
 template <class Mesh>
 LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& created, const PositionCoder& positions,
                                         CoordinateSpace space, GeometryPredictor choice, bool grid_contexts = false,
                                         bool unit_normals = false, int effort = kMaxEffort,
-                                        StaticOrder grid_order = StaticOrder::grouped);
+                                        StaticOrder grid_order = StaticOrder::grouped, StaticEncoderBuffers* buffers = nullptr);
 
 // When an adaptive trial of a level of `count` new vertices stops, from the bytes its code has
 // committed after each vertex: once they pass `limit` (SIZE_MAX: none) by 8 bytes (exact: a

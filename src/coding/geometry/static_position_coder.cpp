@@ -436,25 +436,56 @@ int static_raw_bit_count(uint64_t magnitude) { return magnitude < 8 ? 0 : bit_le
 
 template <class Mesh>
 StaticLevelEncoder::StaticLevelEncoder(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created,
-                                       CoordinateSpace space, GeometryPredictor mode, bool streams, StaticOrder order)
-    : StaticLevelEncoder(h, created, created.size(), space, mode, order) {
+                                       CoordinateSpace space, GeometryPredictor mode, bool streams, StaticOrder order,
+                                       StaticEncoderBuffers* buffers)
+    : StaticLevelEncoder(h, created, created.size(), space, mode, order, buffers) {
     if (streams) code_streams();
 }
 
 template <class Mesh>
 StaticLevelEncoder::StaticLevelEncoder(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t count,
-                                       CoordinateSpace space, GeometryPredictor mode, StaticOrder order)
+                                       CoordinateSpace space, GeometryPredictor mode, StaticOrder order,
+                                       StaticEncoderBuffers* buffers)
     : mode_(mode), grouped_(has_grid_bins(mode) && order == StaticOrder::grouped), space_(space),
       table_count_(static_table_count(mode)) {
     if (!is_static_mode(mode)) throw Error("StaticLevelEncoder: geometry mode " + std::to_string(int(mode)) + " is not a static mode");
     if (has_grid_bins(mode) && space.quantizer == nullptr) throw Error("geometry mode 4 needs quantized coordinates");
     if (has_stencil_tables(mode) && space.quantizer != nullptr)
         throw Error("geometry modes 6 and 7 need bit-exact coordinates");
+    if (buffers != nullptr) {
+        StaticEncoderBuffers::Set set = buffers->take();
+        buffers_ = buffers;
+        symbols_ = std::move(set.symbols);
+        symbols_.clear();
+        large_ = std::move(set.large);
+        large_.clear();
+        raw_writer_.adopt(std::move(set.raw));
+        rans_ = std::move(set.rans);
+        rans_.clear();
+        rans_memory_ = std::move(set.rans_memory);
+        counts_ = std::move(set.counts);
+        for (std::vector<uint64_t>& counts : counts_) counts.clear();  // add() zeroes them
+    }
     count = std::min(count, created.size());
     // A sample's raw bits wait in large_ (see the header): the mode choice drops most samples.
     deferred_ = !grouped_ && count < created.size();
     add(h, created, 0, count);
     make_tables();
+}
+
+StaticLevelEncoder::~StaticLevelEncoder() {
+    if (buffers_ == nullptr) return;
+    StaticEncoderBuffers::Set set;
+    set.symbols = std::move(symbols_);
+    set.large = std::move(large_);
+    set.raw = coded_ ? std::move(raw_) : raw_writer_.finish();
+    set.rans = std::move(rans_);
+    set.rans_memory = std::move(rans_memory_);
+    set.counts = std::move(counts_);
+    try {
+        buffers_->give_back(std::move(set));
+    } catch (...) {  // no room to keep them: they are freed
+    }
 }
 
 template <class Mesh>
@@ -611,13 +642,13 @@ void StaticLevelEncoder::add_stencil_vertices(const Mesh& h, const std::vector<s
 
 // The encoder reads a hierarchy or the input's nodes with its grid points (hierarchy_on_grid.h).
 template StaticLevelEncoder::StaticLevelEncoder(const Hierarchy&, const std::vector<std::pair<NodeId, int>>&, CoordinateSpace,
-                                                GeometryPredictor, bool, StaticOrder);
+                                                GeometryPredictor, bool, StaticOrder, StaticEncoderBuffers*);
 template StaticLevelEncoder::StaticLevelEncoder(const HierarchyOnGrid&, const std::vector<std::pair<NodeId, int>>&,
-                                                CoordinateSpace, GeometryPredictor, bool, StaticOrder);
+                                                CoordinateSpace, GeometryPredictor, bool, StaticOrder, StaticEncoderBuffers*);
 template StaticLevelEncoder::StaticLevelEncoder(const Hierarchy&, const std::vector<std::pair<NodeId, int>>&, size_t,
-                                                CoordinateSpace, GeometryPredictor, StaticOrder);
+                                                CoordinateSpace, GeometryPredictor, StaticOrder, StaticEncoderBuffers*);
 template StaticLevelEncoder::StaticLevelEncoder(const HierarchyOnGrid&, const std::vector<std::pair<NodeId, int>>&, size_t,
-                                                CoordinateSpace, GeometryPredictor, StaticOrder);
+                                                CoordinateSpace, GeometryPredictor, StaticOrder, StaticEncoderBuffers*);
 template void StaticLevelEncoder::extend(const Hierarchy&, const std::vector<std::pair<NodeId, int>>&);
 template void StaticLevelEncoder::extend(const HierarchyOnGrid&, const std::vector<std::pair<NodeId, int>>&);
 
@@ -649,7 +680,7 @@ void StaticLevelEncoder::write_deferred_raw_bits(size_t level_size) {
     const double share = symbols_.empty() ? 1.0 : double(level_size) / double(symbols_.size());
     raw_writer_.reserve_bits(uint64_t(double(raw_bits_) * share * 1.125) + 4096);
     for (const Residual& r : large_) put_raw(raw_writer_, r);
-    large_ = {};
+    empty_out(large_);
     deferred_ = false;
 }
 
@@ -658,7 +689,7 @@ void StaticLevelEncoder::code_streams() {
     write_deferred_raw_bits(symbols_.size());
     constexpr uint16_t kTokenMask = (1 << kTokenBits) - 1;
     // The rANS stream back to front, straight from the symbol words (rANS codes backwards).
-    RansBackwardEncoder rans(kStaticRoles * symbols_.size());
+    RansBackwardEncoder rans(kStaticRoles * symbols_.size(), rans_memory_);
     auto put = [&](uint16_t symbol) { rans.put(tables_[size_t(symbol >> kTokenBits)], symbol & kTokenMask); };
     if (!grouped_) {
         // The symbol words one after the other (vertex after vertex, role after role).
@@ -677,7 +708,7 @@ void StaticLevelEncoder::code_streams() {
             for (size_t i = count; i-- > 0;) put(symbols_[begin + i][0]);
         }
     }
-    rans_ = rans.finish();
+    rans.finish(rans_);
     // The raw bits front to back, in the tokens' order (written as they came unless grouped).
     RawBitWriter& raw = raw_writer_;
     if (grouped_ && !large_.empty()) {
@@ -700,8 +731,9 @@ void StaticLevelEncoder::code_streams() {
         }
     }
     raw_ = raw.finish();
-    symbols_ = {};
-    large_ = {};
+    empty_out(symbols_);
+    empty_out(large_);
+    if (buffers_ == nullptr) rans_memory_ = {};
     coded_ = true;
 }
 

@@ -81,6 +81,30 @@ struct StaticResidual {
     uint64_t magnitude;
 };
 
+// Buffers of StaticLevelEncoders kept from one encoder to the next (an EncodeContext's): an encoder
+// made over them takes a set at its start and gives it back at its end, so that the levels and mode
+// trials of repeated encodes neither allocate them nor fault their pages in again. One thread at a time.
+class StaticEncoderBuffers {
+public:
+    struct Set {
+        std::vector<std::array<uint16_t, kStaticRoles>> symbols;
+        std::vector<StaticResidual> large;
+        std::vector<uint8_t> raw, rans;
+        ScratchArray<uint8_t> rans_memory;
+        std::array<std::vector<uint64_t>, kMaxStaticTables> counts;
+    };
+    Set take() {
+        if (free_.empty()) return {};
+        Set set = std::move(free_.back());
+        free_.pop_back();
+        return set;
+    }
+    void give_back(Set&& set) { free_.push_back(std::move(set)); }
+
+private:
+    std::vector<Set> free_;
+};
+
 class StaticLevelEncoder {
 public:
     // mode: a static mode (is_static_mode); mode 4 needs a quantized space, modes 6 and 7 a
@@ -88,16 +112,21 @@ public:
     // With `streams` false only the tokens and tables are made, until code_streams(): an encoder
     // weighing modes asks lower_bound_bytes() first.
     // Mesh: Hierarchy or HierarchyOnGrid (hierarchy_on_grid.h), here and below.
+    // `order`: mode 4's token order (the other modes have one). With `buffers`, the encoder works
+    // in a set of them, given back when it ends.
     template <class Mesh>
-    // `order`: mode 4's token order (the other modes have one).
     StaticLevelEncoder(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
                        GeometryPredictor mode = GeometryPredictor::normal_frame, bool streams = true,
-                       StaticOrder order = StaticOrder::grouped);
+                       StaticOrder order = StaticOrder::grouped, StaticEncoderBuffers* buffers = nullptr);
     // Over the first `count` of `created` only (no streams): an encoder weighing modes on a sample
     // of a level, which extend() may then carry on over the whole level.
     template <class Mesh>
     StaticLevelEncoder(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t count,
-                       CoordinateSpace space, GeometryPredictor mode, StaticOrder order = StaticOrder::grouped);
+                       CoordinateSpace space, GeometryPredictor mode, StaticOrder order = StaticOrder::grouped,
+                       StaticEncoderBuffers* buffers = nullptr);
+    ~StaticLevelEncoder();
+    StaticLevelEncoder(const StaticLevelEncoder&) = delete;
+    StaticLevelEncoder& operator=(const StaticLevelEncoder&) = delete;
     // Adds the rest of `created` (the vector the encoder was made over the first part of) and
     // remakes the tables: the encoder made over all of `created`, without its first part's frames
     // computed again. Before code_streams() only.
@@ -141,6 +170,12 @@ private:
     size_t stream_bound_bytes() const;
     // The tables from the counts, and the tokens' cost under them.
     void make_tables();
+    // Empties v, keeping its memory when it goes back to buffers_ (else freeing it now).
+    template <class T>
+    void empty_out(std::vector<T>& v) {
+        if (buffers_ != nullptr) v.clear();
+        else v = {};
+    }
 
     GeometryPredictor mode_;
     bool grouped_;  // mode 4 in StaticOrder::grouped
@@ -164,6 +199,8 @@ private:
     mutable size_t coded_table_bytes_ = SIZE_MAX;  // coded_table_bytes(), or SIZE_MAX until asked
     bool coded_ = false;
     std::vector<uint8_t> rans_, raw_;
+    ScratchArray<uint8_t> rans_memory_;  // the rANS encoder's
+    StaticEncoderBuffers* buffers_ = nullptr;
 };
 
 // Reads the tables of static mode `mode` (three, or six in mode 4); false when they are not valid

@@ -6,14 +6,36 @@
 #include "hierarchy/hierarchy_builder.h"
 
 #include <cmath>
+#include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 
 namespace amc {
 
+namespace {
+
+// List l of `kept` (emptied, its capacity kept), or a new one.
+template <class T>
+std::vector<T> take_list(std::vector<std::vector<T>>& kept, size_t l) {
+    if (l >= kept.size()) return {};
+    std::vector<T> list = std::move(kept[l]);
+    list.clear();
+    return list;
+}
+
+// Lists back into `kept`, list l at index l.
+template <class T>
+void give_back_lists(std::vector<std::vector<T>>& lists, std::vector<std::vector<T>>& kept) {
+    if (kept.size() < lists.size()) kept.resize(lists.size());
+    for (size_t l = 0; l < lists.size(); ++l) kept[l] = std::move(lists[l]);
+}
+
+}  // namespace
+
 HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const HierarchyCoderOptions& options,
                                              uint8_t stream_version, std::vector<CodedSymbol>* trace, bool mixed,
-                                             const TurnedRoots* turned)
+                                             const TurnedRoots* turned, Memory* memory)
     : options_(options), mixed_(mixed) {
     AMC_REQUIRE(!mixed || stream_version == kHierarchyStreamVersion, invalid_input,
                 "the hierarchy coder's mixing mode needs the newest hierarchy stream version");
@@ -26,20 +48,34 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
 
     // Pass 1: decide every node in the coder's order and record the events. The traversal runs on
     // the level forest (hierarchy_traversal.h); `ids` maps a level's local indices to h's nodes.
+    std::optional<Memory> own;  // without the caller's memory, the pass's own
+    if (memory == nullptr) own.emplace();
+    Memory& m = memory != nullptr ? *memory : *own;
+    memory_ = memory;
+    events_.swap(m.events);
+    events_.clear();
+    level_end_.swap(m.level_end);
+    level_end_.clear();
     events_.reserve(h.node_count());
-    std::vector<std::pair<int, bool>> two_hanging;  // (unrefined edge, flag) in stream order
+    std::vector<std::pair<int, bool>>& two_hanging = m.two_hanging;  // (unrefined edge, flag) in stream order
+    two_hanging.clear();
     static constexpr int kTurnedEdge[6] = {0, 1, 2, 0, 1, 2};  // (e + turn) % 3
-    std::vector<size_t> orientation_slots;         // event index of each two_hanging entry
-    LevelTraversal traversal(options, stream_version);
-    Level level, next;
-    std::vector<NodeId> ids, next_ids;
+    std::vector<size_t>& orientation_slots = m.orientation_slots;  // event index of each two_hanging entry
+    orientation_slots.clear();
+    LevelTraversal& traversal = m.traversal;
+    traversal.configure(options, stream_version);
+    Level& level = m.level;
+    Level& next = m.next;
+    std::vector<NodeId> ids = take_list(m.level_ids, 0), next_ids;
     // Per node of the level: bit 0 refined, bit 1 its diagonal flag, both read while its node is in
     // the cache (the pass over the leaves below missed it again on large levels).
-    std::vector<uint8_t> refined;
-    RefinedNumbering numbering;
+    std::vector<uint8_t>& refined = m.refined;
+    RefinedNumbering& numbering = m.numbering;
     LevelShapes shapes;  // mixing mode
     // Each node's turn (none without `turned`).
-    std::vector<uint8_t> turns, next_turns;
+    std::vector<uint8_t>& turns = m.turns;
+    std::vector<uint8_t>& next_turns = m.next_turns;
+    turns.clear();
     root_level(turned != nullptr ? *turned->roots : h, level, options.cull_one_regularity);
     ids.resize(h.root_count());
     for (NodeId r = 0; r < h.root_count(); ++r) ids[r] = turned != nullptr ? (*turned->old_root)[r] : r;
@@ -48,7 +84,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         const uint32_t n = static_cast<uint32_t>(level.size());
         stats.nodes += n;
         refined.resize(n);
-        next_ids.clear();
+        next_ids = take_list(m.level_ids, size_t(l) + 1);
         next_ids.reserve(4 * size_t(n));  // at most four children a node
         next_turns.clear();
         bool all_refined = true;
@@ -135,7 +171,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         level_end_.push_back(events_.size());
         scan_decided_level(level, numbering, nullptr);
         const uint64_t created_count = derive_next_level(level, numbering, next, options.cull_one_regularity);
-        std::vector<std::pair<NodeId, int>>& created = new_vertices_.emplace_back();
+        std::vector<std::pair<NodeId, int>>& created = new_vertices_.emplace_back(take_list(m.new_vertices, size_t(l)));
         created.reserve(created_count);
         if (turned != nullptr)
             for_each_new_vertex(level, numbering, [&](uint32_t i, int e) { created.emplace_back(ids[i], kTurnedEdge[e + turns[i]]); });
@@ -147,6 +183,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         next_ids = std::vector<NodeId>();
         turns.swap(next_turns);
     }
+    if (memory != nullptr && level_ids_.size() < m.level_ids.size()) m.level_ids[level_ids_.size()] = std::move(ids);
     stats.uniform_levels = uniform_levels;
     stats.faces = faces;
 
@@ -182,9 +219,19 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
     header_ = write_hierarchy_stream_header(header);
 }
 
+HierarchyLevelEncoder::~HierarchyLevelEncoder() {
+    if (memory_ == nullptr) return;
+    give_back_lists(level_ids_, memory_->level_ids);
+    give_back_lists(new_vertices_, memory_->new_vertices);
+    memory_->events.swap(events_);
+    memory_->level_end.swap(level_end_);
+}
+
 std::unique_ptr<HierarchyLevelEncoder> HierarchyLevelEncoder::fork() const {
     if (next_level_ != 0) throw Error("HierarchyLevelEncoder::fork: a level is coded already");
-    return std::unique_ptr<HierarchyLevelEncoder>(new HierarchyLevelEncoder(*this));
+    std::unique_ptr<HierarchyLevelEncoder> copy(new HierarchyLevelEncoder(*this));
+    copy->memory_ = nullptr;  // its lists are copies: the memory goes back once, from this one
+    return copy;
 }
 
 void HierarchyLevelEncoder::encode_level(int l, ArithmeticEncoder& encoder) {

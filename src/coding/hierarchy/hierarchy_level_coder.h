@@ -46,6 +46,7 @@ struct TurnedRoots {
 
 class HierarchyLevelEncoder {
 public:
+    struct Memory;
     // Decides every node (first pass): fixes the uniform levels, the diagonal rule and the number
     // of coded symbols, so the header is known before any level is coded. `stream_version`: an
     // older hierarchy stream version may be written for tests of the decoder's older paths.
@@ -56,9 +57,12 @@ public:
     // be the ones the decoder will have.
     // With `turned`, the forest coded is h in that base order (not with `mixed`); level_nodes and
     // new_vertices are then h's nodes and edges.
+    // With `memory`, the first pass works in it and the lists the encoder hands out are made in
+    // it, given back when the encoder ends (Memory).
     HierarchyLevelEncoder(const Hierarchy& h, const HierarchyCoderOptions& options,
                           uint8_t stream_version = kHierarchyStreamVersion, std::vector<CodedSymbol>* trace = nullptr,
-                          bool mixed = false, const TurnedRoots* turned = nullptr);
+                          bool mixed = false, const TurnedRoots* turned = nullptr, Memory* memory = nullptr);
+    ~HierarchyLevelEncoder();
     bool mixed() const { return mixed_; }
     // A coder of the same first pass that has coded no level yet (Error once this one has): the
     // encoder codes the mixing mode's forest in two models from one first pass.
@@ -147,8 +151,28 @@ private:
     // The mixing mode's state, made at the first level coded: null until then, so that fork()'s
     // copy shares none.
     std::shared_ptr<MixedHierarchyModel> mixed_model_;
+    Memory* memory_ = nullptr;  // where the lists go back to at the end (null: nowhere)
 
     HierarchyLevelEncoder(const HierarchyLevelEncoder&) = default;  // fork()'s
+
+public:
+    // The working memory of the first pass and the lists an encoder hands out, kept from one
+    // encoder to the next (an EncodeContext's): an encoder made over it takes it at its start and
+    // gives it back at its end, so that repeated encodes neither allocate it nor fault its pages
+    // in again (docs/BENCHMARKS.md, "One-core encode, nineteenth step"). One encoder at a time.
+    struct Memory {
+        LevelTraversal traversal{HierarchyCoderOptions{}, kHierarchyStreamVersion};
+        Level level, next;
+        RefinedNumbering numbering;
+        std::vector<uint8_t> refined, turns, next_turns;
+        std::vector<std::pair<int, bool>> two_hanging;
+        std::vector<size_t> orientation_slots;
+        std::vector<Event> events;
+        std::vector<size_t> level_end;
+        // Given back by the last encoder: level l's lists at index l.
+        std::vector<std::vector<NodeId>> level_ids;
+        std::vector<std::vector<std::pair<NodeId, int>>> new_vertices;
+    };
 };
 
 // Decides `level` of a version-1 stream (hierarchy_decoder_v1.cpp) as the decoder's general path
