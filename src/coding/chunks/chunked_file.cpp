@@ -21,8 +21,10 @@ uint64_t leaf_face_count(const Hierarchy& h, unsigned threads) {
     std::vector<uint64_t> faces((size_t(h.node_capacity()) + kRange - 1) / kRange, 0);
     parallel_for(faces.size(), threads, [&](size_t i) {
         const NodeId begin = NodeId(i) * kRange, end = std::min<NodeId>(h.node_capacity(), begin + kRange);
+        uint64_t count = 0;  // not faces[i]: the ranges' totals share cache lines, which two threads would trade
         for (NodeId n = begin; n < end; ++n)
-            if (h.is_alive(n) && h.is_leaf(n)) faces[i] += 1 + uint64_t(h.hanging_node_count(n));
+            if (h.is_alive(n) && h.is_leaf(n)) count += 1 + uint64_t(h.hanging_node_count(n));
+        faces[i] = count;
     });
     uint64_t sum = 0;
     for (uint64_t f : faces) sum += f;
