@@ -21,8 +21,9 @@
 // Designs "R7:" (2026-12-05 morning): the sixth model plus its own errors as contexts (the
 // probability it gave the parent's symbol, the residuals of the coded nodes two edges around,
 // filled while coding from Links), slower or confidence-scaled fresh slots, trained initial states
-// and its learning-cost bound ("Beyond the sixth model"). PER_LEVEL=name prints that design's bits
-// per level to stderr.
+// and its learning-cost bound ("Beyond the sixth model"). Designs "A21:" (2026-12-05 midday): the
+// seventh model's form plus its own residual, per-file rates, SSE, per-set trained mixer starts
+// ("Beyond the seventh model"). PER_LEVEL=name prints that design's bits per level to stderr.
 //   [CACHE_DIR=dir] [ONLY=text] [WEIGHTS_OUT=prefix | WEIGHTS_IN=prefix] [TRAIN=...] [LAW_DIR=dir] model_study model.amh ...
 #include "mixed_symbols.h"
 

@@ -2,7 +2,7 @@
 // whatever the contexts? (docs/HIERARCHY_CODER.md, "The random refinement: what its generator
 // leaves to code".)
 //
-//   random_refinement_bound [--simulate K] [--grid N] [--generate K] [--sequential N [--dump OUT]] FILE.amh
+//   random_refinement_bound [--simulate K] [--grid N] [--generate K] [--sequential N [--dump OUT]] [--proposal K [--draws D]] FILE.amh
 //
 // `amc refine --model random` (refine_randomly, adaptive_refinement.cpp) splits a leaf drawn
 // uniformly from the leaves below the level cap, with the forced splits of 1-regularity, until
@@ -17,7 +17,10 @@
 //    that knows the generator and sends T: every split, forced or not, coded as a free one), and
 //  - with --simulate K, the law's entropy: K forests of the same roots, cap and T drawn from the
 //    law itself (no forced splits), each coded by the same recursion; the mean code length is the
-//    entropy, what no coder of such forests beats on average.
+//    entropy, what no coder of such forests beats on average;
+//  - with --proposal K, a lower bound of the generator's entropy by a proposal over the picks'
+//    order (pick_steps below; docs/HIERARCHY_CODER.md, "a sequential lower bound of its entropy"),
+//    and with --draws D an importance-sampled estimate from above with D draws of the same proposal.
 #include "coding/entropy/arithmetic_coder.h"
 #include "common/mixing.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
@@ -271,27 +274,35 @@ struct PickSteps {
     size_t steps() const { return picked.size(); }
 };
 
+// The split nodes of X in each node's subtree (the node included): a node with much below it was
+// picked soon after its birth.
+std::vector<uint32_t> split_nodes_below(const Hierarchy& x) {
+    std::vector<uint32_t> below(x.node_capacity(), 0);
+    const std::vector<NodeId> order = x.breadth_first_order();
+    for (auto it = order.rbegin(); it != order.rend(); ++it) {
+        const NodeId v = *it;
+        if (x.is_leaf(v)) continue;
+        below[v] += 1;
+        if (x.parent(v) != kNoNode) below[x.parent(v)] += below[v];
+    }
+    return below;
+}
+
+// q's class of a node of A_t.
+int pick_class(int level, bool could_be_forced, uint32_t below, int age_bin) {
+    int bin = 0;
+    while (bin + 1 < PickSteps::kSizeBins && below >= (2u << bin)) ++bin;
+    return ((level * 2 + int(could_be_forced)) * PickSteps::kSizeBins + bin) * PickSteps::kAgeBins + age_bin;
+}
+
 PickSteps pick_steps(const GeneratorRun& x, uint32_t target_leaves, int max_level, uint64_t seed) {
     SplitMix64 random{seed};
     Hierarchy h(make_icosahedron());
     auto split_in_x = [&](NodeId n) { return n < x.h.node_capacity() && x.h.is_alive(n) && !x.h.is_leaf(n); };
-    // The split nodes of X in each node's subtree (the node included): a node with much below it
-    // was picked early after its birth.
-    std::vector<uint32_t> below(x.h.node_capacity(), 0);
-    const std::vector<NodeId> order = x.h.breadth_first_order();
-    for (auto it = order.rbegin(); it != order.rend(); ++it) {
-        const NodeId v = *it;
-        if (x.h.is_leaf(v)) continue;
-        below[v] += 1;
-        if (x.h.parent(v) != kNoNode) below[x.h.parent(v)] += below[v];
-    }
+    const std::vector<uint32_t> below = split_nodes_below(x.h);
     std::vector<uint8_t> age_bin(x.h.node_capacity(), 0);
     std::vector<std::vector<NodeId>> due;  // by step: nodes of A whose age bin grows then
-    auto class_of = [&](NodeId n) {
-        int bin = 0;
-        while (bin + 1 < PickSteps::kSizeBins && below[n] >= (2u << bin)) ++bin;
-        return ((int(h.level(n)) * 2 + int(x.could_be_forced[n])) * PickSteps::kSizeBins + bin) * PickSteps::kAgeBins + age_bin[n];
-    };
+    auto class_of = [&](NodeId n) { return pick_class(int(h.level(n)), x.could_be_forced[n] != 0, below[n], age_bin[n]); };
     auto schedule = [&](NodeId n, size_t birth) {  // the step at which n enters its next age bin
         if (age_bin[n] + 1 >= PickSteps::kAgeBins) return;
         const size_t at = birth + (size_t(2) << age_bin[n]) - 1;
@@ -399,6 +410,113 @@ ClassWeights fit_proposal(const PickSteps& s) {
         if (!gained) break;
     }
     return theta;
+}
+
+// An estimate from above with the same q (importance sampling): P(X) = E_q[P(picks) / q(picks | X)]
+// over pick sequences drawn from q given X (0 for one that would stop before X is complete), so
+// -log2 of the mean of w = P / q over draws is, in expectation, at least -log2 P(X) (Jensen), and
+// over runs of the generator at least H(X). Returns -log2 w of each draw (infinity for a draw the
+// generator could not make).
+std::vector<double> sampled_log_weights(const GeneratorRun& x, const ClassWeights& theta, uint32_t target_leaves, int max_level,
+                                        uint64_t seed, int draws) {
+    const std::vector<uint32_t> below = split_nodes_below(x.h);
+    auto split_in_x = [&](NodeId n) { return x.h.is_alive(n) && !x.h.is_leaf(n); };
+    size_t x_splits = 0;
+    for (NodeId n = 0; n < x.h.node_capacity(); ++n) x_splits += split_in_x(n);
+    std::vector<double> e(theta.size());
+    for (size_t c = 0; c < theta.size(); ++c) e[c] = std::exp(theta[c]);
+    std::mt19937_64 random(seed);
+    std::vector<double> out;
+    for (int d = 0; d < draws; ++d) {
+        Hierarchy h(make_icosahedron());
+        std::vector<NodeId> in_x(h.node_capacity(), kNoNode);  // this run's node -> X's node
+        for (NodeId r = 0; r < h.root_count(); ++r) in_x[r] = r;
+        std::vector<std::vector<NodeId>> members(PickSteps::kClasses);  // A_t by class
+        std::vector<uint32_t> slot, birth;
+        std::vector<uint8_t> age_bin;
+        std::vector<int> class_now;
+        std::vector<std::vector<NodeId>> due;
+        auto grow = [&](NodeId n) {
+            if (n >= slot.size()) slot.resize(n + 1), birth.resize(n + 1), age_bin.resize(n + 1), class_now.resize(n + 1, -1);
+        };
+        auto add = [&](NodeId n) {
+            const int c = pick_class(int(h.level(n)), x.could_be_forced[in_x[n]] != 0, below[in_x[n]], age_bin[n]);
+            class_now[n] = c, slot[n] = uint32_t(members[size_t(c)].size());
+            members[size_t(c)].push_back(n);
+        };
+        auto remove = [&](NodeId n) {
+            std::vector<NodeId>& m = members[size_t(class_now[n])];
+            const NodeId last = m.back();
+            m[slot[n]] = last, slot[last] = slot[n];
+            m.pop_back();
+            class_now[n] = -1;
+        };
+        auto schedule = [&](NodeId n) {
+            if (age_bin[n] + 1 >= PickSteps::kAgeBins) return;
+            const size_t at = birth[n] + (size_t(2) << age_bin[n]) - 1;
+            if (due.size() <= at) due.resize(at + 1);
+            due[at].push_back(n);
+        };
+        auto enter = [&](NodeId n, size_t t) {
+            grow(n);
+            if (in_x[n] == kNoNode || !split_in_x(in_x[n]) || h.level(n) >= max_level) return;
+            birth[n] = uint32_t(t), age_bin[n] = 0;
+            add(n);
+            schedule(n);
+        };
+        for (NodeId r = 0; r < h.root_count(); ++r) enter(r, 0);
+        size_t eligible = h.root_count(), remaining = x_splits;
+        double bits = 0;  // -log2 w
+        std::vector<NodeId> split;
+        for (size_t t = 0; remaining > 0; ++t) {
+            if (h.leaf_count() >= target_leaves) {  // the generator stops here, before X
+                bits = std::numeric_limits<double>::infinity();
+                break;
+            }
+            if (t < due.size()) {
+                for (NodeId a : due[t]) {
+                    if (class_now[a] < 0) continue;  // split since
+                    remove(a);
+                    ++age_bin[a];
+                    add(a);
+                    schedule(a);
+                }
+                std::vector<NodeId>().swap(due[t]);
+            }
+            double z = 0;
+            for (size_t c = 0; c < members.size(); ++c) z += double(members[c].size()) * e[c];
+            double u = std::uniform_real_distribution<double>(0, z)(random);
+            size_t c = members.size() - 1;
+            while (members[c].empty()) --c;  // the last class that has nodes (A_t is not empty: X is not complete)
+            for (size_t k = 0; k < c; ++k) {
+                const double share = double(members[k].size()) * e[k];
+                if (u < share && !members[k].empty()) {
+                    c = k;
+                    break;
+                }
+                u -= share;
+            }
+            const NodeId n = members[c][std::uniform_int_distribution<size_t>(0, members[c].size() - 1)(random)];
+            bits += std::log2(double(eligible)) + std::log2(e[c] / z);
+            split.clear();
+            h.refine(n, &split);
+            for (NodeId s : split) {
+                eligible += (h.level(s) + 1 < max_level ? 4 : 0) - 1;
+                if (class_now[s] < 0) throw std::runtime_error("sampled_log_weights: a split outside X");
+                remove(s);
+                --remaining;
+                for (int k = 0; k < 4; ++k) {
+                    const NodeId child = h.child(s, k);
+                    grow(child);
+                    if (child >= in_x.size()) in_x.resize(child + 1, kNoNode);
+                    in_x[child] = x.h.child(in_x[s], k);
+                    enter(child, t + 1);
+                }
+            }
+        }
+        out.push_back(bits);
+    }
+    return out;
 }
 
 // A coder of the coder's own symbols (paper's rules and order) whose probability is the law's
@@ -549,7 +667,7 @@ size_t leaves_of(const Forest& f) {
 
 int main(int argc, char** argv) {
     try {
-        int simulations = 0, grid = 4001, generate = 0, sequential = 0, proposal = 0;
+        int simulations = 0, grid = 4001, generate = 0, sequential = 0, proposal = 0, draws = 0;
         std::string path, dump;
         for (int a = 1; a < argc; ++a) {
             const std::string arg = argv[a];
@@ -558,11 +676,12 @@ int main(int argc, char** argv) {
             else if (arg == "--generate" && a + 1 < argc) generate = std::atoi(argv[++a]);
             else if (arg == "--sequential" && a + 1 < argc) sequential = std::atoi(argv[++a]);
             else if (arg == "--proposal" && a + 1 < argc) proposal = std::atoi(argv[++a]);
+            else if (arg == "--draws" && a + 1 < argc) draws = std::atoi(argv[++a]);
             else if (arg == "--dump" && a + 1 < argc) dump = argv[++a];
             else path = arg;
         }
         if (path.empty() || grid < 16) {
-            std::fprintf(stderr, "usage: random_refinement_bound [--simulate K] [--grid N] FILE.amh\n");
+            std::fprintf(stderr, "usage: random_refinement_bound [--simulate K] [--grid N] [--generate K] [--sequential N [--dump OUT]] [--proposal K [--draws D]] FILE.amh\n");
             return 2;
         }
         const double r_max = 12.0;
@@ -599,6 +718,20 @@ int main(int argc, char** argv) {
                         " by class (fitted on seed 7) %.0f; so H(X) >= %.0f / %.0f bits = %.0f / %.0f bytes\n",
                         (unsigned long long)seed, steps.steps(), steps.pick_bits, uniform, fitted, steps.pick_bits - uniform,
                         steps.pick_bits - fitted, (steps.pick_bits - uniform) / 8, (steps.pick_bits - fitted) / 8);
+            if (draws > 0) {
+                const std::vector<double> b = sampled_log_weights(run, theta, uint32_t(150000), file.depth(), seed + 1, draws);
+                double least = std::numeric_limits<double>::infinity(), sum = 0, sum2 = 0;
+                int finite = 0;
+                for (double x : b)
+                    if (std::isfinite(x)) least = std::min(least, x), sum += x, sum2 += x * x, ++finite;
+                double mean_w = 0;  // mean of 2^(least - b), then -log2 mean w = least - log2(mean)
+                for (double x : b) mean_w += std::isfinite(x) ? std::exp2(least - x) : 0.0;
+                mean_w /= double(b.size());
+                const double m = finite ? sum / finite : 0, sd = finite > 1 ? std::sqrt(std::max(0.0, sum2 / finite - m * m)) : 0;
+                std::printf("  importance sampling, %d draws of q (%d complete X): -log2 P(X) <~ %.0f bits = %.0f bytes; -log2 w"
+                            " per draw mean %.0f, sd %.0f, least %.0f bits\n",
+                            draws, finite, least - std::log2(mean_w), (least - std::log2(mean_w)) / 8, m, sd, least);
+            }
             std::fflush(stdout);
         }
         const Forest f = forest_of(file);
