@@ -138,9 +138,8 @@ std::vector<uint8_t> encode(const Hierarchy& h, const EncodeOptions& options = {
 // buffers, kept after the encode returns until release() or the context's end, so that the next
 // encode neither allocates them nor has the system fault their pages in again (docs/BENCHMARKS.md,
 // "One-core encode, nineteenth step"). encode() without a context keeps nothing. It serves files
-// of one chunk; a chunked file's chunks are coded as without it. The memory stays with the context
-// between encodes, where other work of the caller's might have reused it (release() gives it back).
-// A context serves one encode at a time; the bytes are those of encode() without it.
+// of one chunk; a chunked file's chunks are coded as without it. A context serves one encode at a
+// time; the bytes are those of encode() without it.
 class EncodeContext {
 public:
     EncodeContext();
