@@ -18,11 +18,6 @@ constexpr uint32_t kRepairableShare = 16;
 constexpr uint32_t kJudgedAfter = 512;
 // Settled blocks before an exploring growth is judged by its seed block.
 constexpr uint32_t kSeedJudgedAfter = 128;
-// An exploring growth with an invalid settled block whose blocks lie on the centers of growths
-// given up on their full sample more than kRetraceShare times as often as elsewhere (beyond
-// kRetraceSlack) retraces their reading: given up as well (docs/IMPORT.md, "Retraced readings given up").
-constexpr uint32_t kRetraceShare = 2;
-constexpr uint32_t kRetraceSlack = 32;
 // Blocks: smaller patches are taken or dropped whole (not repaired, their seed not questioned).
 constexpr uint32_t kRepairable = 16;
 // Blocks of the patches the last sweep looks for (commit_small_patches).
@@ -233,24 +228,9 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
     // A growth bounded below 2 * kJudgedAfter blocks is never judged by its share of invalid
     // settled blocks (there are never kJudgedAfter of them): they need not be counted.
     const bool judged = growth_limit_ >= 2 * kJudgedAfter;
-    const uint8_t bit = uint8_t(1u << int(preference));
-    uint32_t scanned = start, retraced = 0;  // blocks placed on centers of given-up growths
     for (uint32_t next = start; next < blocks_.size(); ++next) {
         for (; settled < start + (next - start) / 2; ++settled) settled_invalid += judged && !sides_valid(settled);
-        if (exploring) {
-            for (; scanned < blocks_.size(); ++scanned) retraced += (given_up_[blocks_[scanned].center] & bit) != 0;
-        }
-        const uint32_t elsewhere = uint32_t(blocks_.size()) - start - retraced;
-        const bool retracing = exploring && settled_invalid > 0 && retraced > kRetraceShare * elsewhere + kRetraceSlack;
-        if (retracing || hopeless(start, settled, settled_invalid, exploring)) {
-            // Judged on its full sample: a growth that retraces it later may be given up early.
-            if (exploring && !retracing && settled - start >= kJudgedAfter) {
-                for (uint32_t i = start; i < blocks_.size(); ++i) {
-                    const uint32_t c = blocks_[i].center;
-                    if (given_up_[c] == 0) given_up_list_.push_back(c);
-                    given_up_[c] |= bit;
-                }
-            }
+        if (hopeless(start, settled, settled_invalid, exploring)) {
             mark_explored(start, preference, exploring);
             roll_back(start);
             return 0;
@@ -401,8 +381,6 @@ Candidate LevelFinder::best_patch(uint32_t t, bool exploring, uint8_t failed) {
 uint32_t LevelFinder::commit_best_first(const std::vector<uint32_t>& seeds) {
     std::vector<Candidate> queue;
     for (uint32_t t : seeds) covered_[t] = 0;
-    for (uint32_t t : given_up_list_) given_up_[t] = 0;
-    given_up_list_.clear();
     for (uint32_t t : seeds) {
         if (covered_[t] == 3 || block_of_[t] != kNoIndex) continue;
         const Candidate c = best_patch(t, true);

@@ -92,7 +92,7 @@ public:
           midpoint_count_(vertex_count, 0), corner_count_(vertex_count, 0),
           midpoint_block_(vertex_count, {kNoIndex, kNoIndex}), first_coarse_edge_(vertex_count, kNoEdge), block_of_(fine.size(), kNoIndex), closure_of_(fine.size(), kNoIndex),
           pinned_old_(vertex_count, 0), covered_(fine.size(), 0),
-          banned_(fine.size(), 0), repair_banned_(fine.size(), 0), deferred_(fine.size(), 0), given_up_(fine.size(), 0),
+          banned_(fine.size(), 0), repair_banned_(fine.size(), 0), deferred_(fine.size(), 0),
           shape_of_(fine.size(), kNotRead), refined_near_(tri_.size(), 0) {
         // A midpoint has its block's three triangles on one side and the boundary, another block
         // (three) or a green closure (two or three triangles around it) on the other.
@@ -267,8 +267,7 @@ private:
     // wasted: of its `settled` blocks (the first half of those placed, whose sides the breadth-
     // first front has passed, so they rarely read differently later), too many are invalid, or,
     // exploring, the seed block itself is; or it has more blocks than growth_limit_.
-    // docs/IMPORT.md, "Hopeless growths given up". (grow_patch_once also gives up an exploring
-    // growth that retraces given-up ones: kRetraceShare.)
+    // docs/IMPORT.md, "Hopeless growths given up".
     bool hopeless(uint32_t start, uint32_t settled, uint32_t settled_invalid, bool exploring) const;
 
     // Marks the centers of the growth from blocks_[start] as explored under `preference`.
@@ -340,10 +339,6 @@ private:
     std::vector<uint8_t> banned_;          // per triangle: not a center (while a patch is improved)
     std::vector<uint8_t> repair_banned_;   // per triangle: not a center (while a patch is grown again)
     std::vector<uint8_t> deferred_;        // per triangle: center of a valid patch left for later
-    // Per triangle: bit p, a center of a growth with preference p given up on its full sample
-    // (kJudgedAfter settled blocks) in this commit_best_first; given_up_list_ lists them.
-    std::vector<uint8_t> given_up_;
-    std::vector<uint32_t> given_up_list_;
     static constexpr uint32_t kNotRead = kNoIndex, kImpossible = kNoIndex - 1;
     mutable std::vector<uint32_t> shape_of_;  // per triangle: kNotRead, kImpossible or its index in shapes_
     mutable std::vector<Block> shapes_;       // the blocks possible_block has read
