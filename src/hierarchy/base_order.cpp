@@ -143,6 +143,7 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
     const size_t ranges = (n + kRange - 1) / kRange;
     std::vector<uint64_t> first_vertex(ranges + 1, 0);
     parallel_for(ranges, threads, [&](size_t i) {
+        uint64_t created = 0;  // not first_vertex[i + 1]: neighbouring ranges' counts share cache lines
         for (size_t j = i * kRange; j < std::min(n, (i + 1) * kRange); ++j) {
             if (j + kAhead < n) prefetch(h, old_of[j + kAhead]);
             if (first_child[j] == kNoNode) continue;
@@ -150,10 +151,11 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
                 const NodeId q = h.neighbor(old_of[j], kEdgeMod3[e + turn[j]]);
                 if (q == kNoNode || h.is_leaf(q) || new_of[q] > j) {
                     creates[j] |= uint8_t(1u << e);
-                    ++first_vertex[i + 1];
+                    ++created;
                 }
             }
         }
+        first_vertex[i + 1] = created;
     });
     first_vertex[0] = out.positions_.size();
     for (size_t i = 0; i < ranges; ++i) first_vertex[i + 1] += first_vertex[i];

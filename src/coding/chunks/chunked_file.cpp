@@ -21,8 +21,10 @@ uint64_t leaf_face_count(const Hierarchy& h, unsigned threads) {
     std::vector<uint64_t> faces((size_t(h.node_capacity()) + kRange - 1) / kRange, 0);
     parallel_for(faces.size(), threads, [&](size_t i) {
         const NodeId begin = NodeId(i) * kRange, end = std::min<NodeId>(h.node_capacity(), begin + kRange);
+        uint64_t count = 0;  // not faces[i]: the ranges' totals share cache lines, which two threads would trade
         for (NodeId n = begin; n < end; ++n)
-            if (h.is_alive(n) && h.is_leaf(n)) faces[i] += 1 + uint64_t(h.hanging_node_count(n));
+            if (h.is_alive(n) && h.is_leaf(n)) count += 1 + uint64_t(h.hanging_node_count(n));
+        faces[i] = count;
     });
     uint64_t sum = 0;
     for (uint64_t f : faces) sum += f;
@@ -42,9 +44,24 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& ro
     // reads them (subforest), so they are not zeroed first; their pages are faulted in by the tasks.
     const std::unique_ptr<NodeId[]> local(new NodeId[h.node_capacity()]);
     advise_huge_pages(local.get(), size_t(h.node_capacity()) * sizeof(NodeId));
-    parallel_for(ranges.size(), threads, [&](size_t c) {
+    struct Extracted {
+        Hierarchy chunk;
         std::vector<VertexId> vertex_of;
-        const Hierarchy chunk = extract_roots(h, {ranges[c]}, root_of, local.get(), &vertex_of);
+    };
+    std::vector<Extracted> extracted(ranges.size());
+    auto extract = [&](size_t c) { extracted[c].chunk = extract_roots(h, {ranges[c]}, root_of, local.get(), &extracted[c].vertex_of); };
+    // The chunks the other threads take first (tasks 1 .. threads - 1: this thread, which starts them,
+    // almost always takes task 0) are extracted here before they start, so that their copies live
+    // in this thread's malloc arena and a worker's arena holds only its level coder's working
+    // memory, which glibc then keeps from one encode to the next. A worker that extracted its own
+    // chunk had its arena trimmed after each encode and faulted ~4,300 fresh pages into it again
+    // (docs/BENCHMARKS.md, "Threads and memory"). Which thread takes which chunk changes no byte.
+    const size_t extracted_first = threads > 1 ? std::min<size_t>(threads, ranges.size()) : 1;
+    for (size_t c = 1; c < extracted_first; ++c) extract(c);
+    parallel_for(ranges.size(), threads, [&](size_t c) {
+        if (c == 0 || c >= extracted_first) extract(c);
+        const Hierarchy chunk = std::move(extracted[c].chunk);  // freed with the task
+        const std::vector<VertexId> vertex_of = std::move(extracted[c].vertex_of);
         VertexKeys keys(vertex_of.size(), kNoVertex);
         for (size_t v = 0; v < vertex_of.size(); ++v)
             if (vertex_of[v] != kNoVertex) keys[v] = key_of_vertex[vertex_of[v]];
