@@ -21,8 +21,9 @@
 // Designs "R7:" (2026-12-05 morning): the sixth model plus its own errors as contexts (the
 // probability it gave the parent's symbol, the residuals of the coded nodes two edges around,
 // filled while coding from Links), slower or confidence-scaled fresh slots, trained initial states
-// and its learning-cost bound ("Beyond the sixth model"). PER_LEVEL=name prints that design's bits
-// per level to stderr.
+// and its learning-cost bound ("Beyond the sixth model"). Designs "A21:" (2026-12-05 midday): the
+// seventh model's form plus its own residual, per-file rates, SSE, per-set trained mixer starts
+// ("Beyond the seventh model"). PER_LEVEL=name prints that design's bits per level to stderr.
 //   [CACHE_DIR=dir] [ONLY=text] [WEIGHTS_OUT=prefix | WEIGHTS_IN=prefix] [TRAIN=...] [LAW_DIR=dir] model_study model.amh ...
 #include "mixed_symbols.h"
 
@@ -594,6 +595,7 @@ struct Counts;
 
 struct Options {
     int window_log2 = 8;       // direct models
+    int extra_window_log2 = 8; // extra direct models
     int history_log2 = 6;      // the bit histories' models
     int mixer_rate = 24;
     int map_rate = 7;
@@ -607,6 +609,10 @@ struct Options {
     bool prime = false;        // code the symbols twice, count the second pass (the learning cost's bound)
     bool trained_start = false;  // mixers start at the weights the other models ended with (leave one out)
     std::array<std::vector<int32_t>, 4> start;  // mixers A, B, C, D (D: B's when not trained with D)
+    // Session of 2026-12-05 midday: each weight set of mixers A-D starts at that set's own weights
+    // over the other models (averaged by their uses; a set they never used at `start`).
+    bool per_set_start = false;
+    std::array<std::vector<int32_t>, 4> set_start;  // every set's weights, set after set
     // Extra direct models (window 2^8), each one more mixer input: their contexts.
     std::vector<std::function<uint32_t(const MixedFeatures&, const Extra&)>> extra;
     int mixer_d = 0;  // a fourth mixer: 1 set by base size / 4 x level, 2 by curvature / 4 x level, 3 by gauss / 4 x level
@@ -681,6 +687,10 @@ public:
         for (double& x : m) x /= std::max(1.0, total);
         return m;
     }
+    void set_all(const std::vector<int32_t>& w) { std::copy(w.begin(), w.end(), w_.begin()); }
+    const std::vector<int32_t>& all_weights() const { return w_; }
+    const std::vector<uint32_t>& uses() const { return uses_; }
+    int inputs() const { return n_; }
     void copy_set(int to, const Mixer& from, int set) {
         std::copy_n(&from.w_[size_t(set) * size_t(n_)], n_, &w_[size_t(to) * size_t(n_)]);
     }
@@ -714,7 +724,7 @@ public:
     static constexpr int kFixedInputs = MixedHierarchyModel::kSecondInputs;
     explicit Study(const Options& o)
         : o_(o), inputs_(kFixedInputs + int(o.extra.size()) + int(o.extra_history.size()) + 1), a_(inputs_, 80), b_(inputs_, 16), c_(inputs_, 160), d_(inputs_, 256), e_(inputs_, o.mixer_e_sets), st_(size_t(inputs_)) {
-        extra_models_.assign(o.extra.size(), std::vector<BitModel>(1 << 16, BitModel(8)));
+        extra_models_.assign(o.extra.size(), std::vector<BitModel>(1 << 16, BitModel(o.extra_window_log2)));
         extra_slot_.resize(o.extra.size());
         extra_hist_.assign(o.extra_history.size(), std::vector<uint8_t>(1 << 16, uint8_t{1}));
         extra_hist_map_.assign(o.extra_history.size(), std::vector<BitModel>(2560, BitModel(o.history_log2)));
@@ -730,6 +740,7 @@ public:
         for (const auto& m : o.extra_maps) maps_.emplace_back(m.second, o.map_rate);
         if (o.final_map) maps_.emplace_back(o.final_rows, o.map_rate);
         if (!o.start[0].empty()) a_.start_at(o.start[0]), b_.start_at(o.start[1]), c_.start_at(o.start[2]), d_.start_at(o.start[o.mixer_d && !o.start[3].empty() ? 3 : 1]), e_.start_at(o.start[0]);
+        if (!o.set_start[0].empty()) a_.set_all(o.set_start[0]), b_.set_all(o.set_start[1]), c_.set_all(o.set_start[2]), d_.set_all(o.set_start[3]);
         for (std::vector<BitModel>* t : tables()) counts_.tables.emplace_back(t->size(), std::array<uint32_t, 2>{0, 0});
         if (o.flat_count > 0) {
             const std::vector<std::vector<BitModel>*> all = tables();
@@ -772,6 +783,7 @@ public:
     }
     Counts counts_;
     std::array<size_t, 2> prior_slots_{};  // slots of the tables with trained initial states, and those the training reached
+    const Mixer& mixer(int k) const { return k == 0 ? a_ : k == 1 ? b_ : k == 2 ? c_ : d_; }
     std::array<std::vector<double>, 4> mean_weights() const {
         return {a_.mean_weights(), b_.mean_weights(), c_.mean_weights(), o_.mixer_d ? d_.mean_weights() : std::vector<double>{}};
     }
@@ -1551,6 +1563,28 @@ int main(int argc, char** argv) {
     for (int b : {8, 24}) add("S: fifth, mixer boost " + std::to_string(b), [&, b](Options& o) { fifth_y(o), o.boost = b; });
     for (int r : {12, 20}) add("S: fifth, mixer rate " + std::to_string(r), [&, r](Options& o) { fifth_y(o), o.mixer_rate = r; });
     for (int j = 0; j < 28; ++j) add("D: quad2 without input " + std::to_string(j), [&, j](Options& o) { quad2(o), o.drop = uint64_t{1} << j; });
+    // Session of 2026-12-05 midday (designs "A21:"): candidates for the seventh model's successor,
+    // on the seventh model's form (sixth + trained states of the geometric tables, count 4, half
+    // logits): its own errors as contexts, rates a header could choose per file, SSE, a fifth mixer.
+    auto seventh = [&](Options& o) { sixth_coded(o), o.prior_count = 4, o.prior_geometric_only = true, o.prior_step = 128, o.prior_count_fixed = true; };
+    add("A21: seventh model", seventh);
+    add("A21: seventh + parent p x level x center, z x count x level", [&](Options& o) { seventh(o), o.extra.push_back(parent_p), o.extra.push_back(z_count); });
+    add("A21: seventh + z x count x level", [&](Options& o) { seventh(o), o.extra.push_back(z_count); });
+    add("A21: seventh + resid x count x level", [&](Options& o) { seventh(o), o.extra.push_back(resid_count); });
+    for (int r : {12, 20, 24}) add("A21: seventh, mixer rate " + std::to_string(r), [&, r](Options& o) { seventh(o), o.mixer_rate = r; });
+    for (int w : {7, 9}) add("A21: seventh, direct window 2^" + std::to_string(w), [&, w](Options& o) { seventh(o), o.window_log2 = w, o.extra_window_log2 = w; });
+    for (int c : {2, 8}) add("A21: seventh, trained count " + std::to_string(c), [&, c](Options& o) { seventh(o), o.prior_count = c; });
+    for (int share : {1, 2})
+        add("A21: seventh + final SSE (share " + std::to_string(share) + "/4) by group x level", [&, share](Options& o) {
+            seventh(o), o.final_map = [](F f, X) { return f.group * 8u + f.level; }, o.final_rows = 80, o.final_share = share;
+        });
+    add("A21: seventh + final SSE (share 1/4) by parent nbrs x inner x level", [&](Options& o) {
+        seventh(o), o.final_map = [](F f, X) { return (f.parent_nbrs * 4u + f.inner) * 8 + f.level; }, o.final_rows = 128, o.final_share = 1;
+    });
+    add("A21: seventh, every mixer weight set starts at its own trained weights", [&](Options& o) { seventh(o), o.per_set_start = true; });
+    add("A21: seventh + mixer E by level x center x inner", [&](Options& o) {
+        seventh(o), o.mixer_e = [](F f, X) { return (f.level * 2u + f.center) * 4 + f.inner; }, o.mixer_e_sets = 64;
+    });
     const char* only = std::getenv("ONLY");
 
     const double paper_total = mixed_study::print_design_table_head(data);
@@ -1577,13 +1611,18 @@ int main(int argc, char** argv) {
         }
         std::vector<double> bits;
         std::vector<std::array<std::vector<double>, 4>> ended;
+        std::vector<std::array<std::pair<std::vector<int32_t>, std::vector<uint32_t>>, 4>> ended_sets;
         if (design.o.trained_start)
             for (size_t m = 0; m < data.size(); ++m) {
                 Options plain = design.o;
-                plain.trained_start = false;
+                plain.trained_start = false, plain.per_set_start = false;
                 Study study(plain);
                 study.code(data[m].symbols, extras[m], &links[m]);
                 ended.push_back(study.mean_weights());
+                if (design.o.per_set_start) {
+                    ended_sets.emplace_back();
+                    for (int k = 0; k < 4; ++k) ended_sets.back()[size_t(k)] = {study.mixer(k).all_weights(), study.mixer(k).uses()};
+                }
             }
         const char* weights_in = std::getenv("WEIGHTS_IN");
         const char* weights_out = std::getenv("WEIGHTS_OUT");
@@ -1643,6 +1682,25 @@ int main(int argc, char** argv) {
             // mean over no model gave all-zero weights, every input ignored at first).
             else if (o.trained_start && m == 0)
                 std::fprintf(stderr, "%s: one model: the mixers start at 1/n (no other model to take start weights from)\n", design.name.c_str());
+            if (o.per_set_start && !o.start[0].empty())
+                for (size_t k = 0; k < 4; ++k) {
+                    const size_t n = size_t(MixedHierarchyModel::kSecondInputs + 1 + o.extra.size());
+                    const size_t sets = ended_sets[0][k].second.size();
+                    const std::vector<int32_t>& row = o.start[k < 3 || !o.start[3].empty() ? k : 1];
+                    std::vector<int32_t>& out = o.set_start[k];
+                    out.assign(sets * n, 0);
+                    for (size_t set = 0; set < sets; ++set) {
+                        std::vector<double> sum(n, 0);
+                        double uses = 0;
+                        for (size_t other = 0; other < data.size(); ++other) {
+                            if (other == m || mesh_of(data[other].name) == mesh_of(data[m].name)) continue;
+                            const double u = ended_sets[other][k].second[set];
+                            uses += u;
+                            for (size_t i = 0; i < n; ++i) sum[i] += u * ended_sets[other][k].first[set * n + i];
+                        }
+                        for (size_t i = 0; i < n; ++i) out[set * n + i] = uses > 0 ? int32_t(std::lround(sum[i] / uses)) : row[i];
+                    }
+                }
             Counts prior;
             if (o.prior_count > 0) {
                 for (size_t other = 0; other < data.size(); ++other)

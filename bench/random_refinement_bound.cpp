@@ -2,7 +2,7 @@
 // whatever the contexts? (docs/HIERARCHY_CODER.md, "The random refinement: what its generator
 // leaves to code".)
 //
-//   random_refinement_bound [--simulate K] [--grid N] [--generate K] [--sequential N [--dump OUT]] FILE.amh
+//   random_refinement_bound [--simulate K] [--grid N] [--generate K] [--sequential N [--dump OUT]] [--proposal K [--draws D]] FILE.amh
 //
 // `amc refine --model random` (refine_randomly, adaptive_refinement.cpp) splits a leaf drawn
 // uniformly from the leaves below the level cap, with the forced splits of 1-regularity, until
@@ -17,7 +17,10 @@
 //    that knows the generator and sends T: every split, forced or not, coded as a free one), and
 //  - with --simulate K, the law's entropy: K forests of the same roots, cap and T drawn from the
 //    law itself (no forced splits), each coded by the same recursion; the mean code length is the
-//    entropy, what no coder of such forests beats on average.
+//    entropy, what no coder of such forests beats on average;
+//  - with --proposal K, a lower bound of the generator's entropy by a proposal over the picks'
+//    order (pick_steps below; docs/HIERARCHY_CODER.md, "a sequential lower bound of its entropy"),
+//    and with --draws D an importance-sampled estimate from above with D draws of the same proposal.
 #include "coding/entropy/arithmetic_coder.h"
 #include "common/mixing.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
@@ -27,6 +30,7 @@
 #include <amc/refinement.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -171,6 +175,7 @@ struct GeneratorRun {
     double bound_bits = 0;    // log2 |I| + log2 C(|R|, m - |F|) + log2 m! - sum_F log2 |F below v|
     size_t picks = 0, splits = 0, required = 0;
     Hierarchy h;
+    std::vector<uint8_t> could_be_forced;  // by node id of h: a split node of R
 };
 
 GeneratorRun run_generator(uint32_t target_leaves, int max_level, uint64_t seed) {
@@ -226,6 +231,7 @@ GeneratorRun run_generator(uint32_t target_leaves, int max_level, uint64_t seed)
     std::vector<double> below(h.node_capacity(), 0);  // F nodes in v's subtree, v included
     std::vector<double> r_hooks;                        // an R node's |S below v| >= 1 + F nodes below it
     double log2_hooks = 0;
+    run.could_be_forced = could_be_forced;
     for (auto it = order.rbegin(); it != order.rend(); ++it) {
         const NodeId v = *it;
         if (h.is_leaf(v)) continue;
@@ -246,6 +252,271 @@ GeneratorRun run_generator(uint32_t target_leaves, int max_level, uint64_t seed)
     const double choose = log2_factorial(r) - log2_factorial(m - free_nodes) - log2_factorial(r - (m - free_nodes));
     run.bound_bits = std::log2(double(internal)) + choose + log2_factorial(m) - log2_hooks;
     return run;
+}
+
+// A tighter lower bound by a sequential proposal (2026-12-05 midday). For any distribution q of
+// pick sequences given X, H(picks | X) <= E[-log2 q(picks | X)] (cross-entropy), so
+//   H(X) >= E[sum_t log2 E_t + log2 q(picks | X)],
+// the expectation over the generator's own runs. q re-runs the picks one by one: at step t it
+// draws among A_t, the leaves below the cap that X splits (the true pick is one of them), with
+// weight e^theta[c] by the node's class c (R or F, times level); sum_t log2 E_t - log2 q(true
+// picks) is then the bound's sample. The classes' counts at every step are kept so that theta can
+// be fitted (a conditional logit, concave) on one run and applied to others.
+struct PickSteps {
+    static constexpr int kSizeBins = 12;  // log2 bins of the X-split nodes in the node's subtree, 1 .. 2048+
+    static constexpr int kAgeBins = 12;   // log2 bins of the picks since the node's birth, 0 .. 2047+
+    static constexpr int kClasses = 16 * kSizeBins * kAgeBins;  // 8 levels x {F, R} x size x age
+    // A_t's nodes per class, sparse: the (class, count) pairs of step t are pairs[first[t] .. first[t + 1]).
+    std::vector<std::pair<uint16_t, uint32_t>> pairs;
+    std::vector<size_t> first{0};
+    std::vector<uint16_t> picked;  // the true pick's class
+    double pick_bits = 0;          // sum_t log2 E_t
+    size_t steps() const { return picked.size(); }
+};
+
+// The split nodes of X in each node's subtree (the node included): a node with much below it was
+// picked soon after its birth.
+std::vector<uint32_t> split_nodes_below(const Hierarchy& x) {
+    std::vector<uint32_t> below(x.node_capacity(), 0);
+    const std::vector<NodeId> order = x.breadth_first_order();
+    for (auto it = order.rbegin(); it != order.rend(); ++it) {
+        const NodeId v = *it;
+        if (x.is_leaf(v)) continue;
+        below[v] += 1;
+        if (x.parent(v) != kNoNode) below[x.parent(v)] += below[v];
+    }
+    return below;
+}
+
+// q's class of a node of A_t.
+int pick_class(int level, bool could_be_forced, uint32_t below, int age_bin) {
+    int bin = 0;
+    while (bin + 1 < PickSteps::kSizeBins && below >= (2u << bin)) ++bin;
+    return ((level * 2 + int(could_be_forced)) * PickSteps::kSizeBins + bin) * PickSteps::kAgeBins + age_bin;
+}
+
+PickSteps pick_steps(const GeneratorRun& x, uint32_t target_leaves, int max_level, uint64_t seed) {
+    SplitMix64 random{seed};
+    Hierarchy h(make_icosahedron());
+    auto split_in_x = [&](NodeId n) { return n < x.h.node_capacity() && x.h.is_alive(n) && !x.h.is_leaf(n); };
+    const std::vector<uint32_t> below = split_nodes_below(x.h);
+    std::vector<uint8_t> age_bin(x.h.node_capacity(), 0);
+    std::vector<std::vector<NodeId>> due;  // by step: nodes of A whose age bin grows then
+    auto class_of = [&](NodeId n) { return pick_class(int(h.level(n)), x.could_be_forced[n] != 0, below[n], age_bin[n]); };
+    auto schedule = [&](NodeId n, size_t birth) {  // the step at which n enters its next age bin
+        if (age_bin[n] + 1 >= PickSteps::kAgeBins) return;
+        const size_t at = birth + (size_t(2) << age_bin[n]) - 1;
+        if (due.size() <= at) due.resize(at + 1);
+        due[at].push_back(n);
+    };
+    std::vector<uint32_t> birth(x.h.node_capacity(), 0);
+    PickSteps steps;
+    std::vector<uint32_t> in_a(PickSteps::kClasses, 0);
+    auto enter = [&](NodeId n, size_t t) {
+        if (!split_in_x(n) || h.level(n) >= max_level) return;
+        birth[n] = uint32_t(t), age_bin[n] = 0;
+        ++in_a[size_t(class_of(n))];
+        schedule(n, t);
+    };
+    std::vector<NodeId> candidates = h.leaves();
+    for (NodeId n : candidates) enter(n, 0);
+    std::vector<NodeId> split;
+    size_t eligible = candidates.size();
+    while (h.leaf_count() < target_leaves && !candidates.empty()) {
+        const size_t pick = random.below(candidates.size());
+        const NodeId n = candidates[pick];
+        if (!h.is_alive(n) || !h.is_leaf(n) || h.level(n) >= max_level) {
+            candidates[pick] = candidates.back();
+            candidates.pop_back();
+            continue;
+        }
+        if (!split_in_x(n)) throw std::runtime_error("pick_steps: a pick X does not split (the runs differ)");
+        const size_t t = steps.steps();
+        if (t < due.size()) {
+            for (NodeId a : due[t]) {
+                if (!h.is_leaf(a)) continue;  // split since: no longer in A
+                --in_a[size_t(class_of(a))];
+                ++age_bin[a];
+                ++in_a[size_t(class_of(a))];
+                schedule(a, birth[a]);
+            }
+            std::vector<NodeId>().swap(due[t]);
+        }
+        steps.pick_bits += std::log2(double(eligible));
+        for (size_t c = 0; c < in_a.size(); ++c)
+            if (in_a[c]) steps.pairs.push_back({uint16_t(c), in_a[c]});
+        steps.first.push_back(steps.pairs.size());
+        steps.picked.push_back(uint16_t(class_of(n)));
+        split.clear();
+        h.refine(n, &split);
+        for (NodeId s : split) {
+            eligible += (h.level(s) + 1 < max_level ? 4 : 0) - 1;
+            --in_a[size_t(class_of(s))];
+            for (int k = 0; k < 4; ++k) {
+                const NodeId c = h.child(s, k);
+                candidates.push_back(c);
+                enter(c, t + 1);
+            }
+        }
+    }
+    return steps;
+}
+
+using ClassWeights = std::vector<double>;  // theta by class: q draws a node of A_t with weight e^theta
+
+// -log2 q(true picks | X) under class weights e^theta.
+double proposal_bits(const PickSteps& s, const ClassWeights& theta) {
+    std::vector<double> e(theta.size());
+    for (size_t c = 0; c < theta.size(); ++c) e[c] = std::exp(theta[c]);
+    double nats = 0;
+    for (size_t t = 0; t < s.steps(); ++t) {
+        double z = 0;
+        for (size_t k = s.first[t]; k < s.first[t + 1]; ++k) z += s.pairs[k].second * e[s.pairs[k].first];
+        nats += std::log(z) - theta[s.picked[t]];
+    }
+    return nats / std::log(2.0);
+}
+
+// theta maximising log q(true picks | X) - theta^2 / 2 on `s` (diagonal Newton steps, halved until
+// they gain; the penalty keeps classes seldom seen near 0).
+ClassWeights fit_proposal(const PickSteps& s) {
+    ClassWeights theta(PickSteps::kClasses, 0.0);
+    auto objective = [&](const ClassWeights& th) {
+        double penalty = 0;
+        for (double v : th) penalty += v * v / 2;
+        return proposal_bits(s, th) * std::log(2.0) + penalty;
+    };
+    double best = objective(theta);
+    for (int it = 0; it < 60; ++it) {
+        std::vector<double> grad(theta.size(), 0.0), hess(theta.size(), 1.0), e(theta.size());
+        for (size_t c = 0; c < theta.size(); ++c) e[c] = std::exp(theta[c]), grad[c] = -theta[c];
+        for (size_t t = 0; t < s.steps(); ++t) {
+            double z = 0;
+            for (size_t k = s.first[t]; k < s.first[t + 1]; ++k) z += s.pairs[k].second * e[s.pairs[k].first];
+            for (size_t k = s.first[t]; k < s.first[t + 1]; ++k) {
+                const double share = s.pairs[k].second * e[s.pairs[k].first] / z;
+                grad[s.pairs[k].first] -= share;
+                hess[s.pairs[k].first] += share * (1 - share);
+            }
+            grad[s.picked[t]] += 1;
+        }
+        bool gained = false;
+        for (double alpha = 1; alpha > 1e-3 && !gained; alpha /= 2) {
+            ClassWeights next = theta;
+            for (size_t c = 0; c < theta.size(); ++c) next[c] += alpha * grad[c] / hess[c];
+            const double b = objective(next);
+            if (b < best - 1e-6) theta = next, best = b, gained = true;
+        }
+        if (!gained) break;
+    }
+    return theta;
+}
+
+// An estimate from above with the same q (importance sampling): P(X) = E_q[P(picks) / q(picks | X)]
+// over pick sequences drawn from q given X (0 for one that would stop before X is complete), so
+// -log2 of the mean of w = P / q over draws is, in expectation, at least -log2 P(X) (Jensen), and
+// over runs of the generator at least H(X). Returns -log2 w of each draw (infinity for a draw the
+// generator could not make).
+std::vector<double> sampled_log_weights(const GeneratorRun& x, const ClassWeights& theta, uint32_t target_leaves, int max_level,
+                                        uint64_t seed, int draws) {
+    const std::vector<uint32_t> below = split_nodes_below(x.h);
+    auto split_in_x = [&](NodeId n) { return x.h.is_alive(n) && !x.h.is_leaf(n); };
+    size_t x_splits = 0;
+    for (NodeId n = 0; n < x.h.node_capacity(); ++n) x_splits += split_in_x(n);
+    std::vector<double> e(theta.size());
+    for (size_t c = 0; c < theta.size(); ++c) e[c] = std::exp(theta[c]);
+    std::mt19937_64 random(seed);
+    std::vector<double> out;
+    for (int d = 0; d < draws; ++d) {
+        Hierarchy h(make_icosahedron());
+        std::vector<NodeId> in_x(h.node_capacity(), kNoNode);  // this run's node -> X's node
+        for (NodeId r = 0; r < h.root_count(); ++r) in_x[r] = r;
+        std::vector<std::vector<NodeId>> members(PickSteps::kClasses);  // A_t by class
+        std::vector<uint32_t> slot, birth;
+        std::vector<uint8_t> age_bin;
+        std::vector<int> class_now;
+        std::vector<std::vector<NodeId>> due;
+        auto grow = [&](NodeId n) {
+            if (n >= slot.size()) slot.resize(n + 1), birth.resize(n + 1), age_bin.resize(n + 1), class_now.resize(n + 1, -1);
+        };
+        auto add = [&](NodeId n) {
+            const int c = pick_class(int(h.level(n)), x.could_be_forced[in_x[n]] != 0, below[in_x[n]], age_bin[n]);
+            class_now[n] = c, slot[n] = uint32_t(members[size_t(c)].size());
+            members[size_t(c)].push_back(n);
+        };
+        auto remove = [&](NodeId n) {
+            std::vector<NodeId>& m = members[size_t(class_now[n])];
+            const NodeId last = m.back();
+            m[slot[n]] = last, slot[last] = slot[n];
+            m.pop_back();
+            class_now[n] = -1;
+        };
+        auto schedule = [&](NodeId n) {
+            if (age_bin[n] + 1 >= PickSteps::kAgeBins) return;
+            const size_t at = birth[n] + (size_t(2) << age_bin[n]) - 1;
+            if (due.size() <= at) due.resize(at + 1);
+            due[at].push_back(n);
+        };
+        auto enter = [&](NodeId n, size_t t) {
+            grow(n);
+            if (in_x[n] == kNoNode || !split_in_x(in_x[n]) || h.level(n) >= max_level) return;
+            birth[n] = uint32_t(t), age_bin[n] = 0;
+            add(n);
+            schedule(n);
+        };
+        for (NodeId r = 0; r < h.root_count(); ++r) enter(r, 0);
+        size_t eligible = h.root_count(), remaining = x_splits;
+        double bits = 0;  // -log2 w
+        std::vector<NodeId> split;
+        for (size_t t = 0; remaining > 0; ++t) {
+            if (h.leaf_count() >= target_leaves) {  // the generator stops here, before X
+                bits = std::numeric_limits<double>::infinity();
+                break;
+            }
+            if (t < due.size()) {
+                for (NodeId a : due[t]) {
+                    if (class_now[a] < 0) continue;  // split since
+                    remove(a);
+                    ++age_bin[a];
+                    add(a);
+                    schedule(a);
+                }
+                std::vector<NodeId>().swap(due[t]);
+            }
+            double z = 0;
+            for (size_t c = 0; c < members.size(); ++c) z += double(members[c].size()) * e[c];
+            double u = std::uniform_real_distribution<double>(0, z)(random);
+            size_t c = members.size() - 1;
+            while (members[c].empty()) --c;  // the last class that has nodes (A_t is not empty: X is not complete)
+            for (size_t k = 0; k < c; ++k) {
+                const double share = double(members[k].size()) * e[k];
+                if (u < share && !members[k].empty()) {
+                    c = k;
+                    break;
+                }
+                u -= share;
+            }
+            const NodeId n = members[c][std::uniform_int_distribution<size_t>(0, members[c].size() - 1)(random)];
+            bits += std::log2(double(eligible)) + std::log2(e[c] / z);
+            split.clear();
+            h.refine(n, &split);
+            for (NodeId s : split) {
+                eligible += (h.level(s) + 1 < max_level ? 4 : 0) - 1;
+                if (class_now[s] < 0) throw std::runtime_error("sampled_log_weights: a split outside X");
+                remove(s);
+                --remaining;
+                for (int k = 0; k < 4; ++k) {
+                    const NodeId child = h.child(s, k);
+                    grow(child);
+                    if (child >= in_x.size()) in_x.resize(child + 1, kNoNode);
+                    in_x[child] = x.h.child(in_x[s], k);
+                    enter(child, t + 1);
+                }
+            }
+        }
+        out.push_back(bits);
+    }
+    return out;
 }
 
 // A coder of the coder's own symbols (paper's rules and order) whose probability is the law's
@@ -396,7 +667,7 @@ size_t leaves_of(const Forest& f) {
 
 int main(int argc, char** argv) {
     try {
-        int simulations = 0, grid = 4001, generate = 0, sequential = 0;
+        int simulations = 0, grid = 4001, generate = 0, sequential = 0, proposal = 0, draws = 0;
         std::string path, dump;
         for (int a = 1; a < argc; ++a) {
             const std::string arg = argv[a];
@@ -404,11 +675,13 @@ int main(int argc, char** argv) {
             else if (arg == "--grid" && a + 1 < argc) grid = std::atoi(argv[++a]);
             else if (arg == "--generate" && a + 1 < argc) generate = std::atoi(argv[++a]);
             else if (arg == "--sequential" && a + 1 < argc) sequential = std::atoi(argv[++a]);
+            else if (arg == "--proposal" && a + 1 < argc) proposal = std::atoi(argv[++a]);
+            else if (arg == "--draws" && a + 1 < argc) draws = std::atoi(argv[++a]);
             else if (arg == "--dump" && a + 1 < argc) dump = argv[++a];
             else path = arg;
         }
         if (path.empty() || grid < 16) {
-            std::fprintf(stderr, "usage: random_refinement_bound [--simulate K] [--grid N] FILE.amh\n");
+            std::fprintf(stderr, "usage: random_refinement_bound [--simulate K] [--grid N] [--generate K] [--sequential N [--dump OUT]] [--proposal K [--draws D]] FILE.amh\n");
             return 2;
         }
         const double r_max = 12.0;
@@ -430,6 +703,35 @@ int main(int argc, char** argv) {
                         (unsigned long long)seed, k == 0 ? (identical(run.h, file) ? " (= FILE)" : " (differs from FILE)") : "",
                         run.picks, run.splits, run.splits - run.picks, run.required, run.pick_bits, run.bound_bits,
                         run.pick_bits - run.bound_bits, (run.pick_bits - run.bound_bits) / 8);
+            std::fflush(stdout);
+        }
+        // --proposal K: the sequential bound on seed 7 and K - 1 more seeds; theta fitted on seed 7.
+        ClassWeights theta(PickSteps::kClasses, 0.0);
+        for (int k = 0; k < proposal; ++k) {
+            const uint64_t seed = k == 0 ? 7 : 1000 + uint64_t(k);
+            const GeneratorRun run = run_generator(uint32_t(150000), file.depth(), seed);
+            const PickSteps steps = pick_steps(run, uint32_t(150000), file.depth(), seed);
+            const double uniform = proposal_bits(steps, ClassWeights(PickSteps::kClasses, 0.0));
+            if (k == 0) theta = fit_proposal(steps);
+            const double fitted = proposal_bits(steps, theta);
+            std::printf("sequential bound, seed %llu: %zu picks, sum log2 E_t %.0f bits; -log2 q(picks | X): uniform over A_t %.0f,"
+                        " by class (fitted on seed 7) %.0f; so H(X) >= %.0f / %.0f bits = %.0f / %.0f bytes\n",
+                        (unsigned long long)seed, steps.steps(), steps.pick_bits, uniform, fitted, steps.pick_bits - uniform,
+                        steps.pick_bits - fitted, (steps.pick_bits - uniform) / 8, (steps.pick_bits - fitted) / 8);
+            if (draws > 0) {
+                const std::vector<double> b = sampled_log_weights(run, theta, uint32_t(150000), file.depth(), seed + 1, draws);
+                double least = std::numeric_limits<double>::infinity(), sum = 0, sum2 = 0;
+                int finite = 0;
+                for (double x : b)
+                    if (std::isfinite(x)) least = std::min(least, x), sum += x, sum2 += x * x, ++finite;
+                double mean_w = 0;  // mean of 2^(least - b), then -log2 mean w = least - log2(mean)
+                for (double x : b) mean_w += std::isfinite(x) ? std::exp2(least - x) : 0.0;
+                mean_w /= double(b.size());
+                const double m = finite ? sum / finite : 0, sd = finite > 1 ? std::sqrt(std::max(0.0, sum2 / finite - m * m)) : 0;
+                std::printf("  importance sampling, %d draws of q (%d complete X): -log2 P(X) <~ %.0f bits = %.0f bytes; -log2 w"
+                            " per draw mean %.0f, sd %.0f, least %.0f bits\n",
+                            draws, finite, least - std::log2(mean_w), (least - std::log2(mean_w)) / 8, m, sd, least);
+            }
             std::fflush(stdout);
         }
         const Forest f = forest_of(file);

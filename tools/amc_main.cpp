@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
     encode_cmd->add_option("--threads", encode.threads, "Threads that code chunks at once (0: every core)")
         ->check(CLI::Range(0u, 4096u));
     encode_cmd->add_option("--hierarchy-contexts", encode.hierarchy_contexts,
-                           "paper (fastest decode) | mixed (smaller connectivity, slower decode, one chunk; .amc version 11)")
+                           "paper (fastest decode) | mixed (smaller connectivity, slower decode, one chunk; written as the version of the mixing model that codes smallest, docs/FORMAT.md)")
         ->check(CLI::IsMember({"paper", "mixed"}))
         ->capture_default_str();
     encode_cmd->add_option("--geometry-contexts", encode.geometry_contexts,

@@ -31,13 +31,21 @@ inline void advise_whole_pages(const void* begin, size_t bytes, int advice) {
 }  // namespace detail
 #endif
 
-inline void advise_huge_pages(const void* begin, size_t bytes) {
+// Which buffers are offered to huge pages. Scratch that grows and may be touched in part only
+// from 8 MiB on, so that a small array does not make 2 MiB resident for a few pages; an array
+// that one pass writes whole as soon as it is made (the encoder's reordered copy and chunks) from
+// one huge page on: none of its huge pages stays partly untouched, and on the project's VM a
+// 4 KiB page fault costs 15-25 us (docs/BENCHMARKS.md, "Threads and memory").
+enum class HugePages { large_scratch, written_whole };
+
+inline void advise_huge_pages(const void* begin, size_t bytes, HugePages kind = HugePages::large_scratch) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
     constexpr uintptr_t kHuge = uintptr_t(2) << 20;
-    if (bytes >= 4 * kHuge) detail::advise_aligned(begin, bytes, kHuge, MADV_HUGEPAGE);
+    if (bytes >= (kind == HugePages::written_whole ? kHuge : 4 * kHuge)) detail::advise_aligned(begin, bytes, kHuge, MADV_HUGEPAGE);
 #else
     (void)begin;
     (void)bytes;
+    (void)kind;
 #endif
 }
 
@@ -69,11 +77,11 @@ inline void populate_pages(void* begin, size_t bytes) {
 // v.reserve(capacity), with the whole new buffer offered to huge pages before the old contents
 // are copied in, so that the copy itself faults in huge pages rather than 4 KiB ones.
 template <class T>
-void reserve_huge(std::vector<T>& v, size_t capacity) {
+void reserve_huge(std::vector<T>& v, size_t capacity, HugePages kind = HugePages::large_scratch) {
     if (capacity <= v.capacity()) return;
     std::vector<T> fresh;
     fresh.reserve(capacity);
-    advise_huge_pages(fresh.data(), fresh.capacity() * sizeof(T));
+    advise_huge_pages(fresh.data(), fresh.capacity() * sizeof(T), kind);
     fresh.insert(fresh.end(), v.begin(), v.end());
     v.swap(fresh);
 }

@@ -78,13 +78,13 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
     // the split ones counted first, then their children placed after the level in that order.
     std::vector<NodeId> old_of(roots), first_child(roots);
     std::vector<uint8_t> turn(roots);
-    reserve_huge(old_of, h.node_count());
-    reserve_huge(first_child, h.node_count());
-    reserve_huge(turn, h.node_count());
+    reserve_huge(old_of, h.node_count(), HugePages::written_whole);
+    reserve_huge(first_child, h.node_count(), HugePages::written_whole);
+    reserve_huge(turn, h.node_count(), HugePages::written_whole);
     // Left unset: only live nodes are reached and looked up, and their entries are written by the
     // threads' first pass (which takes the first touch of its pages off the serial part too).
     const std::unique_ptr<NodeId[]> new_of(new NodeId[h.node_capacity()]);
-    advise_huge_pages(new_of.get(), size_t(h.node_capacity()) * sizeof(NodeId));
+    advise_huge_pages(new_of.get(), size_t(h.node_capacity()) * sizeof(NodeId), HugePages::written_whole);
     for (uint32_t t = 0; t < triangle_order.size(); ++t) {
         old_of[t] = triangle_order[t];
         turn[t] = rotation[t];
@@ -162,9 +162,10 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
     AMC_REQUIRE(first_vertex[ranges] < kNoVertex, limit_exceeded, "reorder_base: too many vertices");
     std::vector<VertexId> own_map;
     std::vector<VertexId>& vertex_map = vertex_map_out != nullptr ? *vertex_map_out : own_map;
+    reserve_huge(vertex_map, h.positions().size(), HugePages::written_whole);
     vertex_map.assign(h.positions().size(), kNoVertex);
     for (size_t v = 0; v < base_vertex_id.size(); ++v) vertex_map[v] = base_vertex_id[v];
-    reserve_huge(out.positions_, size_t(first_vertex[ranges]));
+    reserve_huge(out.positions_, size_t(first_vertex[ranges]), HugePages::written_whole);
     out.positions_.resize(size_t(first_vertex[ranges]));
     // The midpoints, numbered in the replay's order; each written by the node that creates it. (The
     // constructor marked far base positions.)
@@ -186,7 +187,7 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
     });
     reserve_huge(out.nodes_, n);
     out.nodes_.resize(n);  // Node() writes nothing: each is written whole below
-    reserve_huge(out.block_parent_, (n - roots) / 4);
+    reserve_huge(out.block_parent_, (n - roots) / 4, HugePages::written_whole);
     out.block_parent_.assign((n - roots) / 4, kNoNode);
     parallel_for(ranges, threads, [&](size_t i) {
         for (size_t j = i * kRange; j < std::min(n, (i + 1) * kRange); ++j) {
@@ -228,7 +229,7 @@ Hierarchy HierarchyBuilder::subforest(const Hierarchy& h, TriangleMesh base, con
     const NodeId root_count = out.root_count();
     // Node j of the result is node old_of[j] of h.
     std::vector<NodeId> old_of(roots);
-    reserve_huge(old_of, h.node_count());  // address space: only the chunk's part is touched
+    reserve_huge(old_of, h.node_count(), HugePages::written_whole);  // address space: only the chunk's part is touched
     for (size_t j = 0; j < old_of.size(); ++j) {
         const NodeId o = old_of[j];
         local[o] = NodeId(j);
@@ -238,10 +239,10 @@ Hierarchy HierarchyBuilder::subforest(const Hierarchy& h, TriangleMesh base, con
     const size_t n = old_of.size();
     auto taken = [&](NodeId q) { return q != kNoNode && root_in[root_of[q]] != 0; };
     std::vector<VertexId> vertex_of(base_vertex);
-    reserve_huge(vertex_of, h.positions().size());
+    reserve_huge(vertex_of, h.positions().size(), HugePages::written_whole);
     reserve_huge(out.nodes_, n);
     out.nodes_.resize(n);  // the roots stay as the constructor made them
-    reserve_huge(out.block_parent_, (n - root_count) / 4);
+    reserve_huge(out.block_parent_, (n - root_count) / 4, HugePages::written_whole);
     out.block_parent_.assign((n - root_count) / 4, kNoNode);
     // One pass in the replay's order: node j's links, flags and first child; when it is split, its
     // midpoints (a new vertex unless its neighbour there was split before it: split() then takes
@@ -287,7 +288,7 @@ Hierarchy HierarchyBuilder::subforest(const Hierarchy& h, TriangleMesh base, con
         }
         next_child += 4;
     }
-    reserve_huge(out.positions_, vertex_of.size());
+    reserve_huge(out.positions_, vertex_of.size(), HugePages::written_whole);
     out.positions_.resize(vertex_of.size());
     for (size_t v = base_vertex.size(); v < vertex_of.size(); ++v) {
         out.positions_[v] = h.position(vertex_of[v]);

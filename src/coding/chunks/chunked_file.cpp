@@ -43,7 +43,7 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& ro
     // Shared: the chunks' nodes are disjoint, and each chunk writes its nodes' entries before it
     // reads them (subforest), so they are not zeroed first; their pages are faulted in by the tasks.
     const std::unique_ptr<NodeId[]> local(new NodeId[h.node_capacity()]);
-    advise_huge_pages(local.get(), size_t(h.node_capacity()) * sizeof(NodeId));
+    advise_huge_pages(local.get(), size_t(h.node_capacity()) * sizeof(NodeId), HugePages::written_whole);
     struct Extracted {
         Hierarchy chunk;
         std::vector<VertexId> vertex_of;
