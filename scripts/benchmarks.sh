@@ -36,7 +36,7 @@ if [[ -d $data ]]; then
 fi
 
 # ---- measure -------------------------------------------------------------------------------
-"$build/bench/compare_bench" --runs "$runs" --kept-encoders --csv "$build/benchmarks.csv" --markdown "$build/benchmarks_tables.md" "${models[@]}"
+"$build/bench/compare_bench" --runs "$runs" --csv "$build/benchmarks.csv" --markdown "$build/benchmarks_tables.md" "${models[@]}"
 mkdir -p "$(dirname "$chart")"
 python3 "$here/scripts/bench_chart.py" "$build/benchmarks.csv" "$chart"
 
@@ -57,8 +57,8 @@ generated=$build/benchmarks_section.md
   echo "Debian $(cat /etc/debian_version), $(c++ --version | head -1), Linux $(uname -r); shared with other jobs."
   echo "**Peers:** libdraco-dev $(version libdraco-dev), libmeshoptimizer-dev $(version libmeshoptimizer-dev),"
   echo "libzstd-dev $(version libzstd-dev), liblzma-dev $(version liblzma-dev). **Allocator:** $allocator."
-  echo "**Encodes:** \`compare_bench --kept-encoders\`: amcodec through one \`EncodeContext\`, Draco through one encoder"
-  echo "object per model and mode, kept over the runs (docs/BENCHMARKS.md, \"Speeds\")."
+  echo "**Encodes:** one-shot, as \`amc encode\` does them: each from a fresh encoder on both sides (through a kept"
+  echo "\`EncodeContext\` and a kept Draco encoder: \`compare_bench --kept-encoders\`, docs/BENCHMARKS.md \"Speeds\")."
   echo
   cat "$build/benchmarks_tables.md"
   echo "<!-- end of generated part -->"
