@@ -58,6 +58,64 @@ TEST(RansTable, NormalisesCountsToTheScale) {
     EXPECT_THROW(RansTable::from_counts(std::vector<uint64_t>(kRansMaxSymbols + 1, 1)), Error);
 }
 
+// The frequencies as the normalisation was first written (the format's tables, so the bytes, rest
+// on them): floor(c M / total), at least 1; the deficit added one at a time to the symbols in order
+// of count (the lower symbol first on ties), round and round; the excess taken one at a time from
+// the first of the largest frequencies.
+std::vector<uint32_t> reference_frequencies(const std::vector<uint64_t>& counts) {
+    uint64_t total = 0;
+    size_t used = 0;
+    for (uint64_t c : counts) {
+        total += c;
+        used += c != 0;
+    }
+    std::vector<uint32_t> f(counts.size(), 0);
+    int64_t sum = 0;
+    for (size_t s = 0; s < counts.size(); ++s) {
+        if (counts[s] == 0) continue;
+        f[s] = uint32_t(std::max<uint64_t>(1, (counts[s] << kRansScaleBits) / total));
+        sum += f[s];
+    }
+    std::vector<size_t> by_count(counts.size());
+    for (size_t s = 0; s < by_count.size(); ++s) by_count[s] = s;
+    std::stable_sort(by_count.begin(), by_count.end(), [&](size_t a, size_t b) { return counts[a] > counts[b]; });
+    for (size_t i = 0; sum < int64_t(kRansScale); i = (i + 1) % used) {
+        if (f[by_count[i]] < kRansMaxFrequency) {
+            ++f[by_count[i]];
+            ++sum;
+        }
+    }
+    while (sum > int64_t(kRansScale)) {
+        --f[size_t(std::max_element(f.begin(), f.end()) - f.begin())];
+        --sum;
+    }
+    return f;
+}
+
+// Tables of a few common symbols and long tails of rare ones (many raised to 1: an excess to take
+// back, with ties among the largest), of near-uniform counts (a deficit, ties everywhere), and of
+// every size up to the largest alphabet: the reference's frequencies.
+TEST(RansTable, FrequenciesAreTheReferenceNormalisations) {
+    std::mt19937 rng(41);
+    for (int trial = 0; trial < 400; ++trial) {
+        const size_t size = 2 + rng() % (trial % 2 == 0 ? 300 : size_t(kRansMaxSymbols) - 1);
+        std::vector<uint64_t> counts(size, 0);
+        for (size_t s = 0; s < size; ++s) {
+            switch (trial % 4) {
+                case 0: counts[s] = rng() % 3 == 0 ? 0 : (s < 4 ? 100000 + rng() % 1000 : rng() % 3); break;
+                case 1: counts[s] = 500 + rng() % 7; break;
+                case 2: counts[s] = s % 5 == 0 ? 4096 : rng() % 2; break;
+                default: counts[s] = rng() % 4 == 0 ? rng() % 100000 : 0; break;
+            }
+        }
+        counts[rng() % size] += 1;  // one used symbol at least
+        size_t used = 0;
+        for (uint64_t c : counts) used += c != 0;
+        if (used < 2 || used >= kRansScale) continue;
+        ASSERT_EQ(RansTable::for_encoding(counts).frequencies(), reference_frequencies(counts)) << "trial " << trial;
+    }
+}
+
 TEST(RansTable, EncodersTableHasTheSameFrequenciesAndStarts) {
     const std::vector<std::vector<uint64_t>> cases = {{5, 0, 1000000, 1, 3}, {0, 0, 7}, {9}, counts_of(skewed_symbols(5000, 60, 5), 60)};
     for (const std::vector<uint64_t>& counts : cases) {

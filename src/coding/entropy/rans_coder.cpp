@@ -43,20 +43,36 @@ RansTable RansTable::for_encoding(const std::vector<uint64_t>& counts) {
             f[s] = uint32_t(std::max<uint64_t>(1, (counts[s] << kRansScaleBits) / total));
             sum += f[s];
         }
-        // Settle the rounding: add to the most frequent symbols, take from the largest frequencies.
-        std::vector<size_t> by_count(counts.size());
-        for (size_t s = 0; s < by_count.size(); ++s) by_count[s] = s;
-        std::stable_sort(by_count.begin(), by_count.end(), [&](size_t a, size_t b) { return counts[a] > counts[b]; });
-        for (size_t i = 0; sum < int64_t(kRansScale); i = (i + 1) % used) {
-            if (f[by_count[i]] < kRansMaxFrequency) {
-                ++f[by_count[i]];
-                ++sum;
+        // Settle the rounding: add to the most frequent symbols (by count, the first on ties), take
+        // from the largest frequencies (the first of the largest, one at a time).
+        if (sum < int64_t(kRansScale)) {
+            std::vector<size_t> by_count;  // the used symbols: the rest never get more
+            by_count.reserve(used);
+            for (size_t s = 0; s < counts.size(); ++s)
+                if (counts[s] != 0) by_count.push_back(s);
+            std::stable_sort(by_count.begin(), by_count.end(), [&](size_t a, size_t b) { return counts[a] > counts[b]; });
+            for (size_t i = 0; sum < int64_t(kRansScale); i = (i + 1) % used) {
+                if (f[by_count[i]] < kRansMaxFrequency) {
+                    ++f[by_count[i]];
+                    ++sum;
+                }
             }
         }
-        while (sum > int64_t(kRansScale)) {
-            const size_t s = size_t(std::max_element(f.begin(), f.end()) - f.begin());
-            --f[s];  // the largest is above 1: sum > M >= 2 * used would be needed otherwise
-            --sum;
+        if (sum > int64_t(kRansScale)) {
+            // A heap on (frequency, then the lower symbol) gives each step's largest as the scan for
+            // the first maximum did (tables of rare tokens bump many to 1: a scan per excess unit).
+            auto lower = [&](uint32_t a, uint32_t b) { return f[a] != f[b] ? f[a] < f[b] : a > b; };
+            std::vector<uint32_t> heap;
+            heap.reserve(used);
+            for (size_t s = 0; s < f.size(); ++s)
+                if (f[s] != 0) heap.push_back(uint32_t(s));
+            std::make_heap(heap.begin(), heap.end(), lower);
+            while (sum > int64_t(kRansScale)) {
+                std::pop_heap(heap.begin(), heap.end(), lower);
+                --f[heap.back()];  // the largest is above 1: sum > M >= 2 * used would be needed otherwise
+                --sum;
+                std::push_heap(heap.begin(), heap.end(), lower);
+            }
         }
     }
     RansTable table;
