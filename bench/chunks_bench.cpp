@@ -18,8 +18,11 @@
 //                                                  a DecodeContext each (results recycled or not),
 //                                                  or without one (free): wall, user and system
 //                                                  time and faults per decode
-//   chunks_bench encode-rusage RUNS BITS model.amh RUNS pairs of a 1- and a 2-thread encode (default
+//   chunks_bench encode-rusage RUNS BITS [context] model.amh
+//                                                  RUNS pairs of a 1- and a 2-thread encode (default
 //                                                  options), 0.2 s apart: the same per encode
+//                                                  (through one EncodeContext a thread count
+//                                                  with `context`)
 //   chunks_bench repeat encode|decode RUNS THREADS BITS model.amh
 //                                                  encodes the model once (default options), then
 //                                                  encodes or decodes it RUNS times on THREADS
@@ -276,16 +279,18 @@ int decode_rusage(int runs, const std::string& mode, const char* path) {
 }
 
 // RUNS pairs of a 1- and a 2-thread encode of the model (default options at BITS), each checked
-// to write the bytes of the first one.
-int encode_rusage(int runs, int bits, const char* path) {
+// to write the bytes of the first one; with `kept`, each through its own EncodeContext.
+int encode_rusage(int runs, int bits, bool kept, const char* path) {
     const amc::Hierarchy h = amc::read_hierarchy(path);
     amc::EncodeOptions options;
     options.quantize_bits = bits;
     const std::vector<uint8_t> bytes = amc::encode(h, options);
-    return rusage_pairs(runs, name_of(path) + ", " + std::to_string(bits) + " bits, encode", [&](unsigned threads) {
+    amc::EncodeContext contexts[2];
+    const std::string what = name_of(path) + ", " + std::to_string(bits) + " bits, encode" + (kept ? " with an EncodeContext" : "");
+    return rusage_pairs(runs, what, [&](unsigned threads) {
         amc::EncodeOptions o = options;
         o.threads = threads;
-        if (amc::encode(h, o) == bytes) return true;
+        if ((kept ? amc::encode(contexts[threads - 1], h, o) : amc::encode(h, o)) == bytes) return true;
         std::fprintf(stderr, "%s: %u threads wrote other bytes\n", path, threads);
         return false;
     });
@@ -369,14 +374,15 @@ int main(int argc, char** argv) {
     if (mode == "decode-rusage" && argc == 5 &&
         (std::string(argv[3]) == "recycle" || std::string(argv[3]) == "keep" || std::string(argv[3]) == "free"))
         return decode_rusage(std::max(1, std::atoi(argv[2])), argv[3], argv[4]);
-    if (mode == "encode-rusage" && argc == 5) return encode_rusage(std::max(1, std::atoi(argv[2])), std::atoi(argv[3]), argv[4]);
+    if (mode == "encode-rusage" && (argc == 5 || (argc == 6 && std::string(argv[4]) == "context")))
+        return encode_rusage(std::max(1, std::atoi(argv[2])), std::atoi(argv[3]), argc == 6, argv[argc - 1]);
     if (mode == "repeat" && argc == 7 && (std::string(argv[2]) == "encode" || std::string(argv[2]) == "decode"))
         return repeat(argv[2], std::max(1, std::atoi(argv[3])), unsigned(std::atoi(argv[4])), std::atoi(argv[5]), argv[6]);
     std::fprintf(stderr, "usage: chunks_bench sizes BITS model.amh ...\n       chunks_bench speed RUNS BITS CHUNKS model.amh\n"
                          "       chunks_bench decode-speed RUNS BITS model.amh\n"
                          "       chunks_bench decode-file RUNS THREADS [context] file.amc\n"
                          "       chunks_bench decode-rusage RUNS recycle|keep|free file.amc\n"
-                         "       chunks_bench encode-rusage RUNS BITS model.amh\n"
+                         "       chunks_bench encode-rusage RUNS BITS [context] model.amh\n"
                          "       chunks_bench repeat encode|decode RUNS THREADS BITS model.amh\n");
     return 2;
 }

@@ -250,7 +250,8 @@ TEST(Codec, EncodesThroughAContextAreThoseWithoutOne) {
                           {&small, 0, kDefaultEffort, false, false, 0},  {&sphere, 12, kDefaultEffort, false, false, 0},
                           {&surface, 16, kMaxEffort, false, false, 0},   {&single, 0, kDefaultEffort, false, false, 0},
                           {&surface, 0, kDefaultEffort, true, false, 0}, {&exact, 0, kDefaultEffort, false, false, 2},
-                          {&surface, 12, kDefaultEffort, false, true, 0}, {&sphere, 0, 0, false, false, 0}};
+                          {&surface, 12, kDefaultEffort, false, true, 0}, {&sphere, 0, 0, false, false, 0},
+                          {&surface, 12, kDefaultEffort, false, false, 4}, {&sphere, 0, kDefaultEffort, false, false, 3}};
     EncodeContext context;
     for (int pass = 0; pass < 2; ++pass) {
         for (size_t c = 0; c < std::size(cases); ++c) {
@@ -261,6 +262,7 @@ TEST(Codec, EncodesThroughAContextAreThoseWithoutOne) {
             options.hierarchy_contexts = cases[c].mixed ? HierarchyContexts::mixed : HierarchyContexts::paper;
             options.grid_contexts = !cases[c].roles;
             options.chunks = cases[c].chunks;
+            options.threads = cases[c].chunks > 1 ? 2 : 0;  // chunks: each thread's chunk memory kept, in turn
             EncodeStats with, without;
             const std::vector<uint8_t> bytes = encode(context, *cases[c].h, options, &with);
             EXPECT_EQ(bytes, encode(*cases[c].h, options, &without));

@@ -137,9 +137,10 @@ std::vector<uint8_t> encode(const Hierarchy& h, const EncodeOptions& options = {
 // coder's first pass (its level forest and per-level lists) and the static geometry modes'
 // buffers, kept after the encode returns until release() or the context's end, so that the next
 // encode neither allocates them nor has the system fault their pages in again (docs/BENCHMARKS.md,
-// "One-core encode, nineteenth step"). encode() without a context keeps nothing. It serves files
-// of one chunk; a chunked file's chunks are coded as without it. A context serves one encode at a
-// time; the bytes are those of encode() without it.
+// "One-core encode, nineteenth step"); for a chunked file, one such memory for each thread that
+// coded chunks (a worker thread's memory is otherwise fresh at every encode: "Threads and memory").
+// encode() without a context keeps nothing. A context serves one encode at a time; the bytes are
+// those of encode() without it.
 class EncodeContext {
 public:
     EncodeContext();

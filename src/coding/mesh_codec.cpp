@@ -188,6 +188,7 @@ void add_level_stats(EncodeStats& stats, size_t nodes, size_t new_vertices, size
 struct EncodeMemory {
     HierarchyLevelEncoder::Memory* first_pass = nullptr;
     StaticEncoderBuffers* statics = nullptr;
+    ChunkEncoderMemories* chunks = nullptr;  // a chunked file's, one a thread
 };
 
 // The forest after the base mesh: one level block per level, or, in two chunks or more, the chunk
@@ -218,7 +219,7 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
     const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
     out.chunked = !mixed && chunks.size() > 1;
     if (out.chunked) {
-        ChunkedBlocks parts = encode_chunked(h, root_of, chunks, options, space, threads, out.stats);
+        ChunkedBlocks parts = encode_chunked(h, root_of, chunks, options, space, threads, out.stats, memory.chunks);
         out.static_geometry = parts.static_geometry;
         out.grid_geometry = parts.grid_geometry;
         out.unit_geometry = parts.unit_geometry;
@@ -396,7 +397,7 @@ std::vector<uint8_t> encode_file(const Hierarchy& input, const EncodeOptions& op
                                                        : uint32_t(chunks.size());
     if (fewer < chunks.size())
         forest = code_forest(h, root_of, balanced_chunks(root_nodes, fewer), faces, options, space, positions, threads,
-                             want_hierarchy_stats, nullptr, nullptr);
+                             want_hierarchy_stats, nullptr, nullptr, {}, memory);
     // An older model of the mixing mode where it codes the file smaller (small files, whose new
     // tables have little to learn from, or creased ones, by a few bytes): every file at most as
     // large as each older model's. A tie keeps the newer model.
@@ -463,6 +464,7 @@ std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options
 struct EncodeContext::Kept {
     HierarchyLevelEncoder::Memory first_pass;
     StaticEncoderBuffers statics;
+    ChunkEncoderMemories chunks;
 };
 
 EncodeContext::EncodeContext() : kept_(std::make_unique<Kept>()) {}
@@ -476,7 +478,7 @@ void EncodeContext::release() {
 
 std::vector<uint8_t> encode(EncodeContext& context, const Hierarchy& h, const EncodeOptions& options, EncodeStats* stats) {
     if (context.kept_ == nullptr) context.kept_ = std::make_unique<EncodeContext::Kept>();  // moved from
-    return encode_file(h, options, stats, {&context.kept_->first_pass, &context.kept_->statics});
+    return encode_file(h, options, stats, {&context.kept_->first_pass, &context.kept_->statics, &context.kept_->chunks});
 }
 
 namespace {

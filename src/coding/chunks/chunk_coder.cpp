@@ -66,9 +66,11 @@ uint64_t for_each_seam_closure(const Hierarchy& h, const std::vector<NodeId>& le
 
 ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& seam, const HierarchyCoderOptions& options,
                        GeometryPredictor fixed_predictor, CoordinateSpace space, bool grid_contexts, bool unit_normals,
-                       int effort) {
+                       int effort, ChunkEncoderMemory* memory) {
     ChunkCode out;
-    HierarchyLevelEncoder hierarchy(h, options);
+    HierarchyLevelEncoder hierarchy(h, options, kHierarchyStreamVersion, nullptr, false, nullptr,
+                                    memory != nullptr ? &memory->first_pass : nullptr);
+    StaticEncoderBuffers* buffers = memory != nullptr ? &memory->statics : nullptr;
     const std::vector<uint8_t>& header = hierarchy.header();
     put_varint(out.bytes, header.size());
     out.bytes.insert(out.bytes.end(), header.begin(), header.end());
@@ -83,7 +85,8 @@ ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& s
         for (auto [n, e] : hierarchy.new_vertices(l))
             if (seam_vertex(h, keys, seam, n, e) < 0) created.emplace_back(n, e);
         // The predictor, as the whole file's encoder picks it (FORMAT.md 3.9, 5.6).
-        const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, fixed_predictor, grid_contexts, unit_normals, effort);
+        const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, fixed_predictor, grid_contexts, unit_normals, effort,
+                                                                 StaticOrder::grouped, buffers);
         ArithmeticEncoder encoder;
         hierarchy.encode_level(l, encoder);
         seam_hanging += for_each_seam_closure(h, level, keys, seam, [&](NodeId n) { encoder.encode(h.diagonal_flipped(n), flipped); });
@@ -108,6 +111,23 @@ ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& s
     }
     out.faces = hierarchy.faces() + seam_hanging;
     return out;
+}
+
+std::unique_ptr<ChunkEncoderMemory> ChunkEncoderMemories::take() {
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!idle_.empty()) {
+            std::unique_ptr<ChunkEncoderMemory> memory = std::move(idle_.back());
+            idle_.pop_back();
+            return memory;
+        }
+    }
+    return std::make_unique<ChunkEncoderMemory>();
+}
+
+void ChunkEncoderMemories::give_back(std::unique_ptr<ChunkEncoderMemory> memory) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    idle_.push_back(std::move(memory));
 }
 
 namespace {

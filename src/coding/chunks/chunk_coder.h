@@ -8,11 +8,14 @@
 #include "coding/chunks/seam.h"
 #include "coding/format_version.h"
 #include "coding/geometry/float_coder.h"  // CoordinateSpace
+#include "coding/geometry/static_position_coder.h"  // StaticEncoderBuffers
 #include "coding/hierarchy/hierarchy_level_coder.h"
 
 #include <amc/codec.h>
 
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <vector>
 
 namespace amc {
@@ -30,11 +33,35 @@ struct ChunkCode {
     std::vector<LevelStats> levels;
 };
 
+// The working memory of one chunk's encoder: its first pass's and its static geometry modes'
+// buffers, kept from one chunk to the next it codes.
+struct ChunkEncoderMemory {
+    HierarchyLevelEncoder::Memory first_pass;
+    StaticEncoderBuffers statics;
+};
+
+// Idle chunk encoders' memories (the mirror of ChunkDecoders): an encode takes one a thread and
+// gives it back after its chunks; an EncodeContext keeps its set between encodes, so that a worker
+// thread's memory is not freed into that thread's malloc arena, trimmed, and faulted in again by
+// the next encode (docs/BENCHMARKS.md, "Threads and memory"). Thread-safe.
+class ChunkEncoderMemories {
+public:
+    // An idle memory, or a new one when none is idle.
+    std::unique_ptr<ChunkEncoderMemory> take();
+    // A memory whose chunks all coded; one whose encode threw is dropped instead (not given back).
+    void give_back(std::unique_ptr<ChunkEncoderMemory> memory);
+
+private:
+    std::mutex mutex_;
+    std::vector<std::unique_ptr<ChunkEncoderMemory>> idle_;
+};
+
 // Codes `chunk` (extract_roots of the whole hierarchy, positions as the decoder will have them).
-// `keys` holds the seam keys of the chunk's vertex ids (seam.h).
+// `keys` holds the seam keys of the chunk's vertex ids (seam.h). The encoder works in `memory`
+// when given (one thread at a time).
 ChunkCode encode_chunk(const Hierarchy& chunk, const VertexKeys& keys, const Seam& seam, const HierarchyCoderOptions& options,
                        GeometryPredictor predictor, CoordinateSpace space, bool grid_contexts = false,
-                       bool unit_normals = false, int effort = kMaxEffort);
+                       bool unit_normals = false, int effort = kMaxEffort, ChunkEncoderMemory* memory = nullptr);
 
 struct ChunkDecodeLimits {
     uint64_t max_nodes = 0;     // the chunk's node count from the chunk table (within the caller's limit)

@@ -32,7 +32,8 @@ uint64_t leaf_face_count(const Hierarchy& h, unsigned threads) {
 }
 
 ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<RootRange>& ranges,
-                             const EncodeOptions& options, CoordinateSpace space, unsigned threads, EncodeStats& stats) {
+                             const EncodeOptions& options, CoordinateSpace space, unsigned threads, EncodeStats& stats,
+                             ChunkEncoderMemories* kept) {
     std::vector<uint32_t> chunk_of_root(h.root_count());
     for (uint32_t c = 0; c < ranges.size(); ++c)
         for (uint32_t r = ranges[c].first; r < ranges[c].first + ranges[c].count; ++r) chunk_of_root[r] = c;
@@ -58,7 +59,11 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& ro
     // (docs/BENCHMARKS.md, "Threads and memory"). Which thread takes which chunk changes no byte.
     const size_t extracted_first = threads > 1 ? std::min<size_t>(threads, ranges.size()) : 1;
     for (size_t c = 1; c < extracted_first; ++c) extract(c);
+    // With `kept`, one memory a thread for the chunks it takes (a task's end gives it back for the
+    // next task). Without, each chunk's encoder allocates its own, as before (a memory held through
+    // the whole encode only moves where glibc puts the other blocks: "Threads and memory").
     parallel_for(ranges.size(), threads, [&](size_t c) {
+        std::unique_ptr<ChunkEncoderMemory> memory = kept != nullptr ? kept->take() : nullptr;
         if (c == 0 || c >= extracted_first) extract(c);
         const Hierarchy chunk = std::move(extracted[c].chunk);  // freed with the task
         const std::vector<VertexId> vertex_of = std::move(extracted[c].vertex_of);
@@ -66,7 +71,8 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& ro
         for (size_t v = 0; v < vertex_of.size(); ++v)
             if (vertex_of[v] != kNoVertex) keys[v] = key_of_vertex[vertex_of[v]];
         codes[c] = encode_chunk(chunk, keys, seam, options.hierarchy, options.predictor, space, options.grid_contexts, options.unit_normals,
-                                options.effort);
+                                options.effort, memory.get());
+        if (kept != nullptr) kept->give_back(std::move(memory));
         codes[c].bytes.shrink_to_fit();  // held until the file is written: without the slack of its growth
         nodes[c] = chunk.node_count();
         own_vertices[c] = uint64_t(std::count(keys.begin(), keys.end(), kNoVertex));  // neither base nor seam vertices

@@ -3,6 +3,7 @@
 // may decode any subset of them.
 #pragma once
 
+#include "coding/chunks/chunk_coder.h"  // ChunkEncoderMemories
 #include "coding/chunks/chunk_layout.h"
 #include "coding/chunks/chunk_merge.h"
 #include "coding/container.h"
@@ -32,9 +33,11 @@ struct ChunkedBlocks {
 
 // Codes `h` (decoder base order, positions as the decoder will have them) in the chunks `ranges`
 // on up to `threads` threads; `root_of` is root_of_nodes(h). Adds the hierarchy and geometry bytes
-// and the level statistics (summed over chunks) to `stats`.
+// and the level statistics (summed over chunks) to `stats`. With `kept` (an EncodeContext's), each
+// thread codes its chunks in one memory of it.
 ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<RootRange>& ranges,
-                             const EncodeOptions& options, CoordinateSpace space, unsigned threads, EncodeStats& stats);
+                             const EncodeOptions& options, CoordinateSpace space, unsigned threads, EncodeStats& stats,
+                             ChunkEncoderMemories* kept = nullptr);
 
 // The chunk table of a file of `version`, read and checked against the base (root counts) and
 // the file's node count.
