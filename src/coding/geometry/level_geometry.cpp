@@ -58,12 +58,27 @@ void keep_likely_static_modes(const Mesh& h, const NewVertices& created, Coordin
                               bool candidate[kStaticCandidates], std::unique_ptr<StaticLevelEncoder> on_sample[kStaticCandidates],
                               StaticOrder grid_order, StaticEncoderBuffers* buffers) {
     const double scale = double(created.size()) / double(sample);
-    double bound[kStaticCandidates], smallest = HUGE_VAL;
+    double stream_bound[kStaticCandidates];
+    int first = -1;  // the candidate of the smallest streams' bound
+    for (int i = 0; i < kStaticCandidates; ++i) {
+        if (!candidate[i]) continue;
+        on_sample[i] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, kStaticModes[i], grid_order, buffers);
+        stream_bound[i] = on_sample[i]->projected_stream_bound_bytes(scale);
+        if (first < 0 || stream_bound[i] < stream_bound[first]) first = i;
+    }
+    if (first < 0) return;
+    // The tables are coded (to know their bytes) only for the modes that may pass the test: the
+    // smallest bound is at most `first`'s, and a bound at least 1 more than its streams' part, so a
+    // mode whose streams alone pass `first`'s limit fails the test against the smallest (surface
+    // levels: most samples; the same choice as with every bound made).
+    const double first_bound = on_sample[first]->projected_bound_bytes(scale);
+    const double first_limit = rounded(kStaticMargin * first_bound) + kSampleSlack;
+    double bound[kStaticCandidates], smallest = first_bound;
     for (int i = 0; i < kStaticCandidates; ++i) {
         bound[i] = HUGE_VAL;
         if (!candidate[i]) continue;
-        on_sample[i] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, kStaticModes[i], grid_order, buffers);
-        bound[i] = on_sample[i]->projected_bound_bytes(scale);
+        if (i == first) bound[i] = first_bound;
+        else if (1.0 + stream_bound[i] <= first_limit) bound[i] = on_sample[i]->projected_bound_bytes(scale);
         smallest = std::min(smallest, bound[i]);
     }
     for (int i = 0; i < kStaticCandidates; ++i) {

@@ -774,8 +774,10 @@ size_t StaticLevelEncoder::stream_bound_bytes() const {
 }
 
 double StaticLevelEncoder::projected_bound_bytes(double scale) const {
-    return double(table_bytes()) + rounded(scale * double(stream_bound_bytes()));
+    return double(table_bytes()) + projected_stream_bound_bytes(scale);
 }
+
+double StaticLevelEncoder::projected_stream_bound_bytes(double scale) const { return rounded(scale * double(stream_bound_bytes())); }
 
 bool read_static_tables(ArithmeticDecoder& decoder, CoordinateSpace space, GeometryPredictor mode, StaticTables& tables) {
     if (!is_static_mode(mode) || (has_grid_bins(mode) && space.quantizer == nullptr)) return false;

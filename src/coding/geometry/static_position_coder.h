@@ -147,6 +147,9 @@ public:
     // lower_bound_bytes() with its streams' part scaled by `scale` (the tables not): an encoder
     // made over a sample of a level projects the level's bound with the level's size over the sample's.
     double projected_bound_bytes(double scale) const;
+    // Its streams' part alone (known without coding the tables): projected_bound_bytes(scale) is
+    // at least 1 more.
+    double projected_stream_bound_bytes(double scale) const;
 
 private:
     // Tokens, residuals and counts of created[begin, end).
