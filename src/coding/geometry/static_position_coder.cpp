@@ -1794,15 +1794,17 @@ struct QuadRoles {
 };
 
 // set_grid_frame_pair for four vertices: set_axis by lane masks, role 0's grid predictions in two
-// pairs; with `roles`, the frames by role too.
+// pairs; with `roles`, the frames by role instead of the midpoints and normals in `g`.
 inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, const double* origin, GridFrame* g,
                                 QuadRoles* roles = nullptr) {
-    store_quad(l.mx, &GridFrame::midpoint, 0, g);
-    store_quad(l.my, &GridFrame::midpoint, 1, g);
-    store_quad(l.mz, &GridFrame::midpoint, 2, g);
-    store_quad(l.nx, &GridFrame::normal, 0, g);
-    store_quad(l.ny, &GridFrame::normal, 1, g);
-    store_quad(l.nz, &GridFrame::normal, 2, g);
+    if (roles == nullptr) {
+        store_quad(l.mx, &GridFrame::midpoint, 0, g);
+        store_quad(l.my, &GridFrame::midpoint, 1, g);
+        store_quad(l.mz, &GridFrame::midpoint, 2, g);
+        store_quad(l.nx, &GridFrame::normal, 0, g);
+        store_quad(l.ny, &GridFrame::normal, 1, g);
+        store_quad(l.nz, &GridFrame::normal, 2, g);
+    }
     const __m256d sign = _mm256_set1_pd(-0.0);
     const __m256d x = _mm256_andnot_pd(sign, l.nx), y = _mm256_andnot_pd(sign, l.ny), z = _mm256_andnot_pd(sign, l.nz);
     const __m256d y_wins = _mm256_cmp_pd(y, x, _CMP_GT_OS);
@@ -1908,13 +1910,16 @@ inline bool decode_grid_grouped_quads(StencilStreams& s, const GridTable* t, con
     return count % 2 == 0 ? roles_1_2(std::false_type{}) : roles_1_2(std::true_type{});
 }
 
-// PairFrames four at a time, with each four's frames by role for decode_grid_grouped_quads.
+// PairFrames four at a time; for the grouped order (by_role), each whole four's frames by role
+// for decode_grid_grouped_quads.
 struct QuadFrames {
+    bool by_role;
     QuadRoles roles[kChunk / 4];
     void operator()(const Hierarchy& h, const FrameCorners* corners, size_t count, const GridScale& grid, const double* origin,
                     GridFrame* frames) {
         size_t i = 0;
-        for (; i + 3 < count; i += 4) set_grid_frame_quad(frame_quad_lanes(h, corners + i), grid, origin, frames + i, roles + i / 4);
+        for (; i + 3 < count; i += 4)
+            set_grid_frame_quad(frame_quad_lanes(h, corners + i), grid, origin, frames + i, by_role ? roles + i / 4 : nullptr);
         PairFrames()(h, corners + i, count - i, grid, origin, frames + i);
     }
     template <bool Safe>
@@ -1928,6 +1933,7 @@ template <bool Grouped>
 bool decode_grid_listed_avx2(Hierarchy& h, const FromList& created, const Quantizer& quantizer, const StaticTables& tables,
                              const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
     QuadFrames quads;
+    quads.by_role = Grouped;
     return decode_grid_listed_with<Grouped>(h, created, quantizer, tables, rans_data, rans_size, raw_data, raw_size, quads);
 }
 #pragma GCC pop_options
