@@ -1604,7 +1604,8 @@ struct PairFrames {
 
 // The fast path's condition: a double-precision hierarchy (every quantized one) and narrow tables.
 // Grouped: the tokens in the grouped order (version 18), else vertex after vertex (one loop each,
-// so that either compiles as if alone). The frames by `make_frames` (PairFrames or QuadFrames).
+// so that either compiles as if alone). The frames, and the grouped order's tokens, by
+// `make_frames` (PairFrames or QuadFrames).
 template <bool Grouped, class MakeFrames>
 AMC_ALWAYS_INLINE bool decode_grid_listed_with(Hierarchy& h, const FromList& created, const Quantizer& quantizer,
                                                const StaticTables& tables, const uint8_t* rans_data, size_t rans_size,
