@@ -174,8 +174,9 @@ TEST(StaticLevelEncoder, GridLevelsDecodeAlikeFromTheListAndFromTheNodes) {
                                                     rans_size, raw.data(), raw_size, as)
                           : decode_static_positions(out, created, space, mode, tables, rans.data(), rans_size, raw.data(), raw_size, as);
         };
-        // From the nodes, and from the list with mode 4's frames four at a time (AVX2, where the
-        // processor has it) and two at a time: the same positions.
+        // From the nodes, and from the list with mode 4's frames (and the grouped order's roles 1
+        // and 2's predictions) four at a time (AVX2, where the processor has it) and two at a time:
+        // the same positions.
         for (int way = 0; way < 3; ++way) {
             const bool listed = way > 0;
             SCOPED_TRACE(way == 0 ? "nodes" : way == 1 ? "listed, frames four at a time" : "listed, frames in pairs");

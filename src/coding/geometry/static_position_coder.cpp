@@ -1595,15 +1595,21 @@ struct PairFrames {
 #endif
         for (; i < count; ++i) set_grid_frame(frame_of<true>(h, corners[i]), grid, origin, frames[i]);
     }
+    template <bool Safe>
+    AMC_ALWAYS_INLINE bool grouped(StencilStreams& s, const GridTable* t, const GridFrame* frames, size_t count,
+                                   const GridScale& grid, const double* origin, Coordinates* decoded) const {
+        return decode_grid_grouped<Safe>(s, t, frames, count, grid, origin, decoded);
+    }
 };
 
 // The fast path's condition: a double-precision hierarchy (every quantized one) and narrow tables.
 // Grouped: the tokens in the grouped order (version 18), else vertex after vertex (one loop each,
-// so that either compiles as if alone). The frames by `make_frames` (PairFrames or QuadFrames).
+// so that either compiles as if alone). The frames, and the grouped order's tokens, by
+// `make_frames` (PairFrames or QuadFrames).
 template <bool Grouped, class MakeFrames>
 AMC_ALWAYS_INLINE bool decode_grid_listed_with(Hierarchy& h, const FromList& created, const Quantizer& quantizer,
                                                const StaticTables& tables, const uint8_t* rans_data, size_t rans_size,
-                                               const uint8_t* raw_data, size_t raw_size, MakeFrames make_frames) {
+                                               const uint8_t* raw_data, size_t raw_size, MakeFrames& make_frames) {
     std::array<GridTable, kMaxStaticTables> t;
     for (size_t k = 0; k < t.size(); ++k) make_grid_table(tables[k], t[k]);
     StencilStreams s;
@@ -1638,7 +1644,7 @@ AMC_ALWAYS_INLINE bool decode_grid_listed_with(Hierarchy& h, const FromList& cre
             StencilStreams local = s;  // the chunk's copy, which the compiler keeps in registers
             bool ok = true;
             if (Grouped) {
-                ok = decode_grid_grouped<Safe>(local, t.data(), frames.data(), count, grid, origin, coordinates);
+                ok = make_frames.template grouped<Safe>(local, t.data(), frames.data(), count, grid, origin, coordinates);
                 s = local;
                 return ok;
             }
@@ -1669,8 +1675,8 @@ AMC_ALWAYS_INLINE bool decode_grid_listed_with(Hierarchy& h, const FromList& cre
 template <bool Grouped>
 bool decode_grid_listed(Hierarchy& h, const FromList& created, const Quantizer& quantizer, const StaticTables& tables,
                         const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
-    return decode_grid_listed_with<Grouped>(h, created, quantizer, tables, rans_data, rans_size, raw_data, raw_size,
-                                            PairFrames{});
+    PairFrames pairs;
+    return decode_grid_listed_with<Grouped>(h, created, quantizer, tables, rans_data, rans_size, raw_data, raw_size, pairs);
 }
 
 #if AMC_AVX2_AT_RUN_TIME
@@ -1761,15 +1767,45 @@ inline void store_quad(__m256d v, double (GridFrame::*array)[3], int axis, GridF
     _mm_storeh_pd(&(g[3].*array)[axis], high);
 }
 
+// grid_point_pair's grid predictions in four lanes: of `value` from `from` (each lane's origin on
+// its axis), to points, table offsets and turn masks.
+inline void grid_point_quad(__m256d value, __m256d from, const GridScale& grid, uint64_t* points, uint64_t* offsets,
+                            int64_t* turns) {
+    const __m256d zero = _mm256_setzero_pd();
+    const __m256d t = rounded(_mm256_div_pd(_mm256_sub_pd(value, from), _mm256_set1_pd(grid.step)));
+    const __m256d high = _mm256_cmp_pd(t, _mm256_set1_pd(grid.top), _CMP_GE_OS);
+    const __m256d inside = _mm256_andnot_pd(high, _mm256_cmp_pd(t, zero, _CMP_GT_OS));
+    const __m128i p = _mm256_cvttpd_epi32(rounded(_mm256_add_pd(t, _mm256_set1_pd(0.5))));
+    const __m256d f = rounded(_mm256_sub_pd(t, _mm256_cvtepi32_pd(p)));
+    const __m256d bin = _mm256_and_pd(inside, _mm256_cmp_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), f), _mm256_set1_pd(0.25), _CMP_GE_OS));
+    const __m256d turn = _mm256_and_pd(inside, _mm256_cmp_pd(f, zero, _CMP_LT_OS));
+    const __m256i point = _mm256_or_si256(_mm256_and_si256(_mm256_castpd_si256(inside), _mm256_cvtepu32_epi64(p)),
+                                          _mm256_and_si256(_mm256_castpd_si256(high), _mm256_set1_epi64x(int64_t(grid.max))));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(points), point);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(offsets),
+                        _mm256_and_si256(_mm256_castpd_si256(bin), _mm256_set1_epi64x(int64_t(sizeof(GridTable)))));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(turns), _mm256_castpd_si256(turn));
+}
+
+// Four vertices' frames by role (lane j: vertex j of the quad): the midpoint's and the normal's
+// coordinates and the origin on each role's axis, and all ones where the frame has a normal.
+struct QuadRoles {
+    __m256d midpoint[3], normal[3], origin[3];
+    __m256d with_normal;
+};
+
 // set_grid_frame_pair for four vertices: set_axis by lane masks, role 0's grid predictions in two
-// pairs.
-inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, const double* origin, GridFrame* g) {
-    store_quad(l.mx, &GridFrame::midpoint, 0, g);
-    store_quad(l.my, &GridFrame::midpoint, 1, g);
-    store_quad(l.mz, &GridFrame::midpoint, 2, g);
-    store_quad(l.nx, &GridFrame::normal, 0, g);
-    store_quad(l.ny, &GridFrame::normal, 1, g);
-    store_quad(l.nz, &GridFrame::normal, 2, g);
+// pairs; with `roles`, the frames by role instead of the midpoints and normals in `g`.
+inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, const double* origin, GridFrame* g,
+                                QuadRoles* roles = nullptr) {
+    if (roles == nullptr) {
+        store_quad(l.mx, &GridFrame::midpoint, 0, g);
+        store_quad(l.my, &GridFrame::midpoint, 1, g);
+        store_quad(l.mz, &GridFrame::midpoint, 2, g);
+        store_quad(l.nx, &GridFrame::normal, 0, g);
+        store_quad(l.ny, &GridFrame::normal, 1, g);
+        store_quad(l.nz, &GridFrame::normal, 2, g);
+    }
     const __m256d sign = _mm256_set1_pd(-0.0);
     const __m256d x = _mm256_andnot_pd(sign, l.nx), y = _mm256_andnot_pd(sign, l.ny), z = _mm256_andnot_pd(sign, l.nz);
     const __m256d y_wins = _mm256_cmp_pd(y, x, _CMP_GT_OS);
@@ -1791,40 +1827,115 @@ inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, 
     const __m256d value = _mm256_blendv_pd(_mm256_blendv_pd(l.mx, l.my, on_y), l.mz, on_z);
     const __m256d from = _mm256_blendv_pd(_mm256_blendv_pd(_mm256_set1_pd(origin[0]), _mm256_set1_pd(origin[1]), on_y),
                                           _mm256_set1_pd(origin[2]), on_z);
-    const __m256d zero = _mm256_setzero_pd();
-    const __m256d t = rounded(_mm256_div_pd(_mm256_sub_pd(value, from), _mm256_set1_pd(grid.step)));
-    const __m256d high = _mm256_cmp_pd(t, _mm256_set1_pd(grid.top), _CMP_GE_OS);
-    const __m256d inside = _mm256_andnot_pd(high, _mm256_cmp_pd(t, zero, _CMP_GT_OS));
-    const __m128i p = _mm256_cvttpd_epi32(rounded(_mm256_add_pd(t, _mm256_set1_pd(0.5))));
-    const __m256d f = rounded(_mm256_sub_pd(t, _mm256_cvtepi32_pd(p)));
-    const __m256d bin = _mm256_and_pd(inside, _mm256_cmp_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), f), _mm256_set1_pd(0.25), _CMP_GE_OS));
-    const __m256d turn = _mm256_and_pd(inside, _mm256_cmp_pd(f, zero, _CMP_LT_OS));
-    const __m256i point = _mm256_or_si256(_mm256_and_si256(_mm256_castpd_si256(inside), _mm256_cvtepu32_epi64(p)),
-                                          _mm256_and_si256(_mm256_castpd_si256(high), _mm256_set1_epi64x(int64_t(grid.max))));
     uint64_t points[4], offsets[4];
     int64_t turns[4];
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(points), point);
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(offsets),
-                        _mm256_and_si256(_mm256_castpd_si256(bin), _mm256_set1_epi64x(int64_t(sizeof(GridTable)))));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(turns), _mm256_castpd_si256(turn));
+    grid_point_quad(value, from, grid, points, offsets, turns);
     for (int j = 0; j < 4; ++j) g[j].first = {points[j], offsets[j], turns[j]};
+    if (roles == nullptr) return;
+    // Role 1's axis is 1 where the frame's is 0 (and without a normal), else 0; role 2's is 1 where
+    // the frame's is 2, else 2.
+    const __m256d on_x = _mm256_andnot_pd(_mm256_or_pd(on_y, on_z), _mm256_castsi256_pd(_mm256_set1_epi64x(-1)));
+    auto by_role = [&](__m256d x, __m256d y, __m256d z, __m256d* role) {
+        role[0] = _mm256_blendv_pd(_mm256_blendv_pd(x, y, on_y), z, on_z);
+        role[1] = _mm256_blendv_pd(x, y, on_x);
+        role[2] = _mm256_blendv_pd(z, y, on_z);
+    };
+    by_role(l.mx, l.my, l.mz, roles->midpoint);
+    by_role(l.nx, l.ny, l.nz, roles->normal);
+    by_role(_mm256_set1_pd(origin[0]), _mm256_set1_pd(origin[1]), _mm256_set1_pd(origin[2]), roles->origin);
+    roles->with_normal = with_normal;
 }
 
-// PairFrames four at a time.
+// decode_grid_grouped with roles 1 and 2's predictions made four vertices at a time from `roles`
+// (QuadFrames'), after every four role-0 tokens: the same operations on the same values in AVX's
+// lanes (no fused multiply-add), so the same predictions; the vertices past the last whole four
+// (a level's last chunk) one at a time, as decode_grid_grouped.
+template <bool Safe>
+inline bool decode_grid_grouped_quads(StencilStreams& s, const GridTable* t, const GridFrame* frames, const QuadRoles* roles,
+                                      size_t count, const GridScale& level_grid, const double* origin, Coordinates* decoded) {
+    const GridScale grid = level_grid;  // a local copy: the stores to `decoded` could alias the caller's
+    alignas(32) uint64_t point1[kChunk], point2[kChunk], offset1[kChunk], offset2[kChunk];
+    alignas(32) int64_t turn1[kChunk], turn2[kChunk];
+    uint64_t largest = 0;  // of the role-0 grid values as unsigned, where a negative one is above any
+    auto token = [&](auto state, size_t k) {
+        constexpr int State = decltype(state)::value;
+        const GridFrame& f = frames[k];
+        const int64_t q0 = grid_point_value<State, Safe>(s, t, f.first.point, f.first.table_offset, f.first.turn_mask);
+        largest = std::max(largest, uint64_t(q0));
+        return q0;
+    };
+    const __m256d step = _mm256_set1_pd(grid.step);
+    size_t k = 0;
+    for (; k + 3 < count; k += 4) {
+        const int64_t q0 = token(std::integral_constant<int, 0>{}, k), q1 = token(std::integral_constant<int, 1>{}, k + 1),
+                      q2 = token(std::integral_constant<int, 0>{}, k + 2), q3 = token(std::integral_constant<int, 1>{}, k + 3);
+        // A valid grid value is below 2^30 (kMaxQuantizationBits); an invalid one fails the check
+        // after the loop, whatever its lane made of it.
+        const __m256d q = _mm256_cvtepi32_pd(_mm_setr_epi32(int(q0), int(q1), int(q2), int(q3)));
+        const QuadRoles& r = roles[k / 4];
+        const __m256d value = _mm256_add_pd(r.origin[0], rounded(_mm256_mul_pd(q, step)));
+        alignas(32) double values[4];
+        _mm256_store_pd(values, value);
+        for (int j = 0; j < 4; ++j) decoded[k + size_t(j)][frames[k + size_t(j)].axis] = values[j];
+        const __m256d u = rounded(_mm256_div_pd(_mm256_sub_pd(value, r.midpoint[0]), r.normal[0]));
+        const __m256d second = _mm256_blendv_pd(r.midpoint[1], _mm256_add_pd(r.midpoint[1], rounded(_mm256_mul_pd(u, r.normal[1]))),
+                                                r.with_normal);
+        const __m256d third = _mm256_blendv_pd(r.midpoint[2], _mm256_add_pd(r.midpoint[2], rounded(_mm256_mul_pd(u, r.normal[2]))),
+                                               r.with_normal);
+        grid_point_quad(second, r.origin[1], grid, point1 + k, offset1 + k, turn1 + k);
+        grid_point_quad(third, r.origin[2], grid, point2 + k, offset2 + k, turn2 + k);
+    }
+    for (; k < count; ++k) {
+        const int64_t q0 = k % 2 == 0 ? token(std::integral_constant<int, 0>{}, k) : token(std::integral_constant<int, 1>{}, k);
+        const GridFrame& f = frames[k];
+        const GridPointPair g = grid_first_role(f, q0, grid, origin, f.axis == 0 ? 1 : 0, f.axis == 2 ? 1 : 2, decoded[k]);
+        point1[k] = g.point[0];
+        point2[k] = g.point[1];
+        offset1[k] = g.table_offset[0];
+        offset2[k] = g.table_offset[1];
+        turn1[k] = g.turn_mask[0];
+        turn2[k] = g.turn_mask[1];
+    }
+    if (largest > grid.max) return false;  // also a q0 < 0
+    auto roles_1_2 = [&](auto odd) {
+        constexpr int S = decltype(odd)::value ? 1 : 0;  // role 1's state: count mod 2
+        for (size_t i = 0; i < count; ++i) {
+            const int64_t v1 = grid_point_value<S, Safe>(s, t + kGridBins, point1[i], offset1[i], turn1[i]);
+            const int64_t v2 = grid_point_value<1 - S, Safe>(s, t + 2 * kGridBins, point2[i], offset2[i], turn2[i]);
+            if ((uint64_t(v1) > grid.max) | (uint64_t(v2) > grid.max)) return false;
+            const int a0 = frames[i].axis;
+            set_other_roles(v1, v2, grid, origin, a0 == 0 ? 1 : 0, a0 == 2 ? 1 : 2, decoded[i]);
+        }
+        return true;
+    };
+    return count % 2 == 0 ? roles_1_2(std::false_type{}) : roles_1_2(std::true_type{});
+}
+
+// PairFrames four at a time; for the grouped order (by_role), each whole four's frames by role
+// for decode_grid_grouped_quads.
 struct QuadFrames {
+    bool by_role;
+    QuadRoles roles[kChunk / 4];
     void operator()(const Hierarchy& h, const FrameCorners* corners, size_t count, const GridScale& grid, const double* origin,
-                    GridFrame* frames) const {
+                    GridFrame* frames) {
         size_t i = 0;
-        for (; i + 3 < count; i += 4) set_grid_frame_quad(frame_quad_lanes(h, corners + i), grid, origin, frames + i);
+        for (; i + 3 < count; i += 4)
+            set_grid_frame_quad(frame_quad_lanes(h, corners + i), grid, origin, frames + i, by_role ? roles + i / 4 : nullptr);
         PairFrames()(h, corners + i, count - i, grid, origin, frames + i);
+    }
+    template <bool Safe>
+    bool grouped(StencilStreams& s, const GridTable* t, const GridFrame* frames, size_t count, const GridScale& grid,
+                 const double* origin, Coordinates* decoded) const {
+        return decode_grid_grouped_quads<Safe>(s, t, frames, roles, count, grid, origin, decoded);
     }
 };
 
 template <bool Grouped>
 bool decode_grid_listed_avx2(Hierarchy& h, const FromList& created, const Quantizer& quantizer, const StaticTables& tables,
                              const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
-    return decode_grid_listed_with<Grouped>(h, created, quantizer, tables, rans_data, rans_size, raw_data, raw_size,
-                                            QuadFrames{});
+    QuadFrames quads;
+    quads.by_role = Grouped;
+    return decode_grid_listed_with<Grouped>(h, created, quantizer, tables, rans_data, rans_size, raw_data, raw_size, quads);
 }
 #pragma GCC pop_options
 #endif

@@ -208,9 +208,9 @@ private:
 // or the mode is not a static mode the space allows.
 bool read_static_tables(ArithmeticDecoder& decoder, CoordinateSpace space, GeometryPredictor mode, StaticTables& tables);
 
-// Mode 4's listed decoder makes its frames four at a time with AVX2 where the processor has it
-// (simd.h, AMC_AVX2_AT_RUN_TIME), else two at a time with SSE2: the same values. false makes it
-// take the pairs everywhere, so that tests decode both ways; returns the setting before.
+// Mode 4's listed decoder makes its frames, and the grouped order's roles 1 and 2 predictions, four
+// at a time with AVX2 where the processor has it (simd.h), else in pairs with SSE2: the same values.
+// false makes it take the pairs everywhere, so that tests decode both ways; returns the setting before.
 bool set_wide_frames(bool allowed);
 
 // Decodes the positions of `created` (in order) and sets them in h. False when the streams are
