@@ -3,12 +3,16 @@
 // does the one step and prints, in MiB, the resident set before it, after it (the result still
 // held) and at the peak, and the step's peak over the nodes and the faces; then the resident set
 // before and after split into anonymous memory (heap, results) and file pages (the code and
-// libraries the step ran, mapped as it faults them in). Linux only.
+// libraries the step ran, mapped as it faults them in), and the step's CPU time and minor page
+// faults. Linux only.
 //
 //   memory_peak prepare BITS model.amh PREFIX       writes PREFIX.amc (default options) and
 //                                                   PREFIX.drc (Draco's default speed 5; BITS 0:
 //                                                   positions as they are)
-//   memory_peak decode-amc PREFIX.amc THREADS      decode() of the file (read into memory first)
+//   memory_peak decode-amc PREFIX.amc THREADS [lean]
+//                                                  decode() of the file (read into memory first);
+//                                                  `lean`: with DecodeOptions::lean_memory, as
+//                                                  `amc decode` decodes
 //   memory_peak decode-amc-context PREFIX.amc THREADS
 //                                                  the second decode() of the file through one
 //                                                  DecodeContext: the step starts with the memory
@@ -25,6 +29,8 @@
 #include <draco/compression/decode.h>
 #include <draco/compression/encode.h>
 #include <draco/mesh/mesh.h>
+
+#include <sys/resource.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -45,7 +51,10 @@ int measure(const char* what, Step&& step) {
     reset_peak();
     const double before = status_mib("VmRSS"), anon_before = status_mib("RssAnon"), file_before = status_mib("RssFile");
     uint64_t nodes = 0, faces = 0;
+    rusage start{}, end{};
+    getrusage(RUSAGE_SELF, &start);
     step(nodes, faces);
+    getrusage(RUSAGE_SELF, &end);
     const double after = status_mib("VmRSS"), peak = status_mib("VmHWM");
     const double anon_after = status_mib("RssAnon"), file_after = status_mib("RssFile");
     const double step_bytes = (peak - before) * 1024 * 1024;
@@ -55,6 +64,11 @@ int measure(const char* what, Step&& step) {
                 faces ? step_bytes / double(faces) : 0.0, (unsigned long long)faces);
     std::printf("  resident before / after: anonymous %.2f / %.2f MiB, files (code, libraries) %.2f / %.2f MiB\n", anon_before,
                 anon_after, file_before, file_after);
+    auto seconds = [](const timeval& t) { return double(t.tv_sec) + 1e-6 * double(t.tv_usec); };
+    std::printf("  the step's CPU time %.4f s (user %.4f, system %.4f), minor page faults %ld\n",
+                seconds(end.ru_utime) + seconds(end.ru_stime) - seconds(start.ru_utime) - seconds(start.ru_stime),
+                seconds(end.ru_utime) - seconds(start.ru_utime), seconds(end.ru_stime) - seconds(start.ru_stime),
+                end.ru_minflt - start.ru_minflt);
     return 0;
 }
 
@@ -82,10 +96,11 @@ int main(int argc, char** argv) {
         write_file(std::string(argv[4]) + ".drc", buffer.data(), buffer.size());
         return 0;
     }
-    if (mode == "decode-amc" && argc == 4) {
+    if (mode == "decode-amc" && (argc == 4 || (argc == 5 && std::string(argv[4]) == "lean"))) {
         const std::vector<char> bytes = read_exact(argv[2]);
         amc::DecodeOptions options;
         options.threads = unsigned(std::atoi(argv[3]));
+        options.lean_memory = argc == 5;
         amc::Hierarchy h;
         const uint8_t* data = reinterpret_cast<const uint8_t*>(bytes.data());
         const uint64_t faces = amc::inspect(data, bytes.size()).faces;
@@ -152,7 +167,7 @@ int main(int argc, char** argv) {
         });
     }
     std::fprintf(stderr,
-                 "usage: memory_peak prepare BITS model.amh PREFIX | decode-amc FILE.amc THREADS | decode-draco FILE.drc |\n"
+                 "usage: memory_peak prepare BITS model.amh PREFIX | decode-amc FILE.amc THREADS [lean] | decode-draco FILE.drc |\n"
                  "       encode-amc BITS THREADS model.amh | encode-draco BITS model.amh\n");
     return 2;
 }

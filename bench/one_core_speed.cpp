@@ -11,8 +11,10 @@
 //                                           `context`: amcodec encodes through one
 //                                           amc::EncodeContext and Draco through one encoder
 //                                           object per model, kept over the rounds
-//   one_core_speed decode RUNS file.amc     only decodes the file RUNS times on one thread: the
-//                                           process to profile or count instructions of
+//   one_core_speed decode RUNS file.amc [lean]
+//                                           only decodes the file RUNS times on one thread: the
+//                                           process to profile or count instructions of (`lean`:
+//                                           with DecodeOptions::lean_memory, amc decode's mode)
 //   one_core_speed encode RUNS BITS model.amh [EFFORT [context]]
 //                                           only encodes the model RUNS times on one thread
 //                                           (default options, or EncodeOptions::effort EFFORT;
@@ -57,11 +59,12 @@ double timed(Step&& step) {
     return cpu_seconds() - start;
 }
 
-int decode_only(int runs, const char* path) {
+int decode_only(int runs, const char* path, bool lean) {
     std::ifstream in(path, std::ios::binary);
     const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     amc::DecodeOptions options;
     options.threads = 1;
+    options.lean_memory = lean;
     const double faces = double(amc::inspect(bytes.data(), bytes.size()).faces);
     std::vector<double> rate;
     for (int r = 0; r < runs; ++r)
@@ -95,7 +98,8 @@ int encode_only(int runs, int bits, const char* path, int effort, bool kept) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    if (argc == 4 && std::strcmp(argv[1], "decode") == 0) return decode_only(std::max(1, std::atoi(argv[2])), argv[3]);
+    if ((argc == 4 || (argc == 5 && std::strcmp(argv[4], "lean") == 0)) && std::strcmp(argv[1], "decode") == 0)
+        return decode_only(std::max(1, std::atoi(argv[2])), argv[3], argc == 5);
     if (argc >= 5 && argc <= 7 && std::strcmp(argv[1], "encode") == 0 && (argc < 7 || std::strcmp(argv[6], "context") == 0))
         return encode_only(std::max(0, std::atoi(argv[2])), std::atoi(argv[3]), argv[4],
                            argc >= 6 ? std::atoi(argv[5]) : amc::kDefaultEffort, argc == 7);
@@ -105,7 +109,7 @@ int main(int argc, char** argv) {
         ++argv;
     }
     if (argc < 4) {
-        std::fprintf(stderr, "usage: one_core_speed [context] RUNS BITS model.amh ... | one_core_speed decode RUNS file.amc | "
+        std::fprintf(stderr, "usage: one_core_speed [context] RUNS BITS model.amh ... | one_core_speed decode RUNS file.amc [lean] | "
                              "one_core_speed encode RUNS BITS model.amh [EFFORT [context]]\n");
         return 2;
     }

@@ -11,9 +11,12 @@
 //
 // Prints one line of fields `name=value`: nodes, faces, bytes, bits per face, the median and the
 // range of the wall and CPU seconds, M faces/s (CPU), the step's peak (the first run's: the peak
-// over what was resident before it) in MiB and bytes per node, and the process's peak in MiB.
+// over what was resident before it) in MiB and bytes per node, the process's peak in MiB, and the
+// first run's CPU seconds, how many of them the system's, and its minor page faults (getrusage).
 #include "bench_common.h"
 #include "process_memory.h"
+
+#include <sys/resource.h>
 
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
@@ -24,6 +27,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -43,7 +47,16 @@ amc::Vec3 on_bumpy_torus(void*, amc::Vec3 a, amc::Vec3 b) {
 struct Timings {
     std::vector<double> wall, cpu;
     double step_peak = 0, process_peak = 0;  // MiB, of the first run
+    double first_system = 0;                 // of the first run: system CPU seconds (part of cpu)
+    long first_faults = 0;                   // and minor page faults
 };
+
+// System CPU seconds and minor page faults of the process so far.
+std::pair<double, long> system_and_faults() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return {double(u.ru_stime.tv_sec) + 1e-6 * double(u.ru_stime.tv_usec), u.ru_minflt};
+}
 
 // Runs step() `runs` times, each after an untimed clear() that drops the run before's result; the
 // peak is the first run's (later runs may find memory the runs before left to the allocator).
@@ -54,6 +67,7 @@ Timings run(int runs, Clear&& clear, Step&& step) {
         clear();
         if (r == 0) reset_peak();
         const double before = status_mib("VmRSS");
+        const std::pair<double, long> system_start = system_and_faults();
         const Clock::time_point start = Clock::now();
         const double cpu_start = cpu_seconds();
         step();
@@ -62,6 +76,9 @@ Timings run(int runs, Clear&& clear, Step&& step) {
         if (r == 0) {
             t.process_peak = status_mib("VmHWM");
             t.step_peak = t.process_peak - before;
+            const std::pair<double, long> system_end = system_and_faults();
+            t.first_system = system_end.first - system_start.first;
+            t.first_faults = system_end.second - system_start.second;
         }
     }
     return t;
@@ -73,10 +90,11 @@ void print(const char* step, uint64_t nodes, uint64_t faces, size_t bytes, const
     const double cpu = median(t.cpu);
     std::printf("step=%s nodes=%llu faces=%llu bytes=%zu bits_per_face=%.3f runs=%zu wall=%.3f wall_low=%.3f "
                 "wall_high=%.3f cpu=%.3f cpu_low=%.3f cpu_high=%.3f mfaces_per_s=%.2f step_peak_mib=%.1f "
-                "bytes_per_node=%.1f process_peak_mib=%.1f\n",
+                "bytes_per_node=%.1f process_peak_mib=%.1f first_cpu=%.3f first_system=%.3f first_faults=%ld\n",
                 step, (unsigned long long)nodes, (unsigned long long)faces, bytes, 8.0 * double(bytes) / double(faces),
                 t.cpu.size(), median(t.wall), low(t.wall), high(t.wall), cpu, low(t.cpu), high(t.cpu),
-                double(faces) / cpu / 1e6, t.step_peak, t.step_peak * 1024 * 1024 / double(nodes), t.process_peak);
+                double(faces) / cpu / 1e6, t.step_peak, t.step_peak * 1024 * 1024 / double(nodes), t.process_peak,
+                t.cpu.front(), t.first_system, t.first_faults);
 }
 
 }  // namespace

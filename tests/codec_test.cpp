@@ -274,6 +274,45 @@ TEST(Codec, EncodesThroughAContextAreThoseWithoutOne) {
     EXPECT_EQ(encode(context, sphere), encode(sphere));  // a moved-from context starts afresh
 }
 
+// DecodeOptions::lean_memory gives working memory back to the system as soon as nothing reads it
+// (amc decode's setting); anything given back too early reads as zeros and builds a wrong
+// hierarchy. Lean against plain decodes: a uniform sphere (its last level all leaves, decided
+// without symbols: its links serve the split alone and go back at once), an adaptive remesh,
+// lossless and quantized, the mixing mode, two chunks, and a progressive decode.
+TEST(Codec, LeanDecodesBuildWhatPlainDecodesBuild) {
+    SurfaceRemeshOptions remesh;
+    remesh.base_triangles = 200;
+    remesh.max_level = 5;
+    remesh.target_faces = 6000;
+    const Hierarchy surface = remesh_adaptively(make_bumpy_sphere(4), remesh);
+    Hierarchy sphere(make_icosahedron());
+    refine_uniformly(sphere, 5);  // 20,480 leaves: the last level's links span many pages
+    struct Case {
+        const Hierarchy* h;
+        int bits;
+        bool mixed;
+        uint32_t chunks;
+        int max_level;
+    };
+    const Case cases[] = {{&sphere, 0, false, 0, -1},  {&sphere, 12, false, 0, -1}, {&surface, 0, false, 0, -1},
+                          {&surface, 16, false, 0, -1}, {&surface, 12, true, 0, -1}, {&surface, 12, false, 2, -1},
+                          {&sphere, 12, false, 0, 4}};
+    for (size_t c = 0; c < std::size(cases); ++c) {
+        SCOPED_TRACE("case " + std::to_string(c));
+        EncodeOptions options;
+        options.quantize_bits = cases[c].bits;
+        options.hierarchy_contexts = cases[c].mixed ? HierarchyContexts::mixed : HierarchyContexts::paper;
+        options.chunks = cases[c].chunks;
+        const std::vector<uint8_t> bytes = encode(*cases[c].h, options);
+        DecodeOptions plain, lean;
+        plain.max_level = lean.max_level = cases[c].max_level;
+        lean.lean_memory = true;
+        const Hierarchy expected = decode(bytes.data(), bytes.size(), plain);
+        EXPECT_TRUE(identical(decode(bytes.data(), bytes.size(), lean), expected));
+        EXPECT_EQ(expected.node_count(), cases[c].max_level < 0 ? cases[c].h->node_count() : 20u * (1 + 4 + 16 + 64 + 256));
+    }
+}
+
 TEST(Codec, ProgressiveDecodingGivesEveryLevelMesh) {
     Hierarchy h(make_icosahedron());
     refine_randomly(h, 5000, 6, 21);

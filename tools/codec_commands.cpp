@@ -217,6 +217,7 @@ void run_decode(const DecodeCommand& command, const GlobalOptions& global) {
     DecodeOptions options;
     options.max_level = command.level;
     options.threads = command.threads;
+    options.lean_memory = true;  // one decode in this process: nothing to keep for a next one
     if (command.max_nodes > 0) options.max_nodes = command.max_nodes;
     const bool some_chunks = !command.chunks.empty() || !command.triangles.empty();
     if (some_chunks && (command.partial || !command.map.empty() || !command.chunks.empty() == !command.triangles.empty()))

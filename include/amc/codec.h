@@ -168,6 +168,11 @@ struct DecodeOptions {
     int max_level = -1;                  // stop after this level: the mesh of that level
     uint64_t max_nodes = 1ull << 26;     // refuse files that would build more nodes than this
     unsigned threads = 0;                // threads that decode chunks at once; 0: every core
+    // Give working memory back to the system as soon as no later step reads it, over the last
+    // levels, for a lower peak (`amc decode` sets it: one decode a process). Same result; a
+    // process that decodes again faults those pages in again, several times slower on files of
+    // 10^5 faces (docs/BENCHMARKS.md, "Decode peak memory at corpus size").
+    bool lean_memory = false;
 };
 
 // Throws Error naming the problem (bad magic, newer version, checksum, structure) on a corrupt or

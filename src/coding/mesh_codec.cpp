@@ -595,6 +595,9 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
                                     std::min<uint64_t>(meta.nodes, options.max_nodes));
     if (meta.options & kOptionMixedContexts)
         hierarchy.use_mixed_contexts(mixing_model_of_file(reader.version()));
+    // The decode peaks at the last level built, whose nodes come on top of the working memory of
+    // the levels before: there that memory goes back to the system.
+    hierarchy.set_lean_at_end(options.lean_memory);
     Hierarchy& h = hierarchy.hierarchy();
     // The metadata's counts let the hierarchy grow in place, as far as the file's size warrants.
     const uint64_t reserved_nodes = std::min<uint64_t>(meta.nodes, meta.base_triangles + kReservedNodesPerFileByte * size);

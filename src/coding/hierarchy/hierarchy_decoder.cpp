@@ -105,6 +105,7 @@ void HierarchyLevelDecoder::start(NodeId first_root, uint32_t roots, const Hiera
     place_new_vertices_ = true;
     append_new_positions_ = false;
     lean_ = false;
+    lean_at_end_ = false;
     slice_ = nullptr;
     // Uniform levels alone would build roots * (4^(U+1) - 1) / 3 nodes: check before.
     uint64_t uniform_nodes = roots, level_nodes = roots;
@@ -149,10 +150,18 @@ void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder, uint64_t ma
         new_vertices_.reserve(vertex_count_ - vertices_before);  // once per level, not doubling vertex by vertex
         for_each_new_vertex(level, numbering_, [&](uint32_t i, int e) { new_vertices_.emplace_back(first + i, e); });
     }
-    if (lean_) release_before_build(size_t(vertex_count_ - vertices_before));
+    // The next level all leaves: this is the last level built, and nothing given back now is
+    // faulted in again by a later level of this decode.
+    const bool last_built = level_is_all_leaves();
+    const bool lean = lean_ || (lean_at_end_ && last_built);
+    if (lean) release_before_build(size_t(vertex_count_ - vertices_before));
     build_decided_levels();
-    if (lean_) {
+    if (lean) {
         for (Level& built : spare_) built.refined.release_from(0);
+        if (last_built) {  // the next level's links served the split alone
+            level_.nbr.release_from(0);
+            level_.edges.release_from(0);
+        }
     }
     new_vertex_count_ = appending_positions() ? size_t(vertex_count_ - vertices_before)
                                               : (slice_ != nullptr ? slice_->next_vertex : h_->positions().size()) - new_vertex_first_;
@@ -166,9 +175,7 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder, uint64_t ma
     // II-C, stream truncation: once the stored symbols are used up, the rest are 0. (Without it no
     // limit: UINT64_MAX - 1, so that no level can seem to have room for codable_symbols' UINT64_MAX.)
     const uint64_t symbol_limit = header_.options.truncate_stream ? header_.symbol_count : UINT64_MAX - 1;
-    if (symbols_read_ == symbol_limit && l >= header_.uniform_levels) {
-        // Every symbol left is 0, and with no node of this level refined yet no rule can force
-        // one: the level is all leaves (and the last). No traversal needed.
+    if (level_is_all_leaves()) {  // and the last: no traversal needed
         for (uint32_t i = 0; i < n; ++i) state[i] = uint8_t(state[i] | kDecided);
         level_.refined_count = 0;
         finish_level();
@@ -258,6 +265,11 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder, uint64_t ma
     models_ = models;
     symbols_read_ = symbols_read;
     finish_level();
+}
+
+bool HierarchyLevelDecoder::level_is_all_leaves() const {
+    // Every symbol left is 0, and with no node of the level refined yet no rule can force one.
+    return header_.options.truncate_stream && symbols_read_ == header_.symbol_count && level_index_ >= header_.uniform_levels;
 }
 
 void HierarchyLevelDecoder::finish_level() {

@@ -227,6 +227,10 @@ public:
     // for the last levels a decoder decodes, whose nodes and positions would otherwise come on top
     // of the working memory of the levels before them (the peak of a decode).
     void set_lean(bool lean) { lean_ = lean; }
+    // While set (restart clears it), decode_level is lean (set_lean) for the last level it builds
+    // alone, known once the next level is known to be all leaves: a decoder that gives back only
+    // what no later level faults in again.
+    void set_lean_at_end(bool lean) { lean_at_end_ = lean; }
     // Until the next restart, the levels are built in `slice` of hierarchy() (HierarchySlice,
     // hierarchy_builder.h), not at its end: decoders of chunks building one hierarchy at once.
     void set_slice(HierarchySlice* slice) { slice_ = slice; }
@@ -273,6 +277,9 @@ public:
 private:
     // Starts on the stream over the roots [first_root, first_root + roots) of *h_.
     void start(NodeId first_root, uint32_t roots, const HierarchyStreamHeader& header, uint64_t max_nodes);
+    // Whether the current level, not yet decided, is all leaves (and the last): the stored
+    // symbols are used up past the uniform levels.
+    bool level_is_all_leaves() const;
     // Counts the decided level's splits (level_.refined, numbered in numbering_) and the vertices
     // they create, and moves to the next level.
     void finish_level();
@@ -301,6 +308,7 @@ private:
     std::vector<std::pair<NodeId, int>> new_vertices_;  // of the last decode_level
     bool list_corners_ = false, place_new_vertices_ = true, append_new_positions_ = false;  // set_new_vertex_listing
     bool lean_ = false;                                      // set_lean
+    bool lean_at_end_ = false;                               // set_lean_at_end
     bool appending_positions() const {
         return append_new_positions_ && !place_new_vertices_ && slice_ == nullptr && boundary_vertex_ == nullptr;
     }
