@@ -23,8 +23,9 @@ DetectedBase undo_levels(const std::vector<Triangle>& leaf_triangles, uint32_t v
     std::vector<uint8_t> refined(leaf_triangles.size(), 0);
     std::vector<uint8_t> changed;
     while (detected.levels.size() < size_t(kMaxLevel) && triangles->size() > base_triangles) {
-        detail::CoarserLevel coarser = detail::undo_refinement_level(
-            *triangles, refined, vertex_count, detected.levels.empty() ? nullptr : &changed, &kept);
+        detail::CoarserLevel coarser =
+            detail::undo_refinement_level(*triangles, refined, vertex_count, detected.levels.empty() ? nullptr : &changed,
+                                          &kept, /*give_up_retraced=*/true);
         if (coarser.red_blocks == 0) break;
         DetectedLevel level;
         level.splits = std::move(coarser.splits);

@@ -228,9 +228,21 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
     // A growth bounded below 2 * kJudgedAfter blocks is never judged by its share of invalid
     // settled blocks (there are never kJudgedAfter of them): they need not be counted.
     const bool judged = growth_limit_ >= 2 * kJudgedAfter;
+    // A reading given up in this round is seeded again wherever its seeds were not among the
+    // centers it placed (random in a user's face order): such a growth, once it has placed a block
+    // on one of those centers and settled an invalid block, is given up too (docs/IMPORT.md,
+    // "Retraced readings given up"). Only judged growths settle invalid blocks.
+    const bool watch_retrace = give_up_retraced_ && exploring && judged;
+    const uint8_t bit = uint8_t(1u << int(preference));
+    uint32_t looked_at = start;
+    bool on_given_up = false;
     for (uint32_t next = start; next < blocks_.size(); ++next) {
         for (; settled < start + (next - start) / 2; ++settled) settled_invalid += judged && !sides_valid(settled);
-        if (hopeless(start, settled, settled_invalid, exploring)) {
+        for (; watch_retrace && !on_given_up && looked_at < blocks_.size(); ++looked_at)
+            on_given_up = (given_up_[blocks_[looked_at].center] & bit) != 0;
+        const bool retracing = on_given_up && settled_invalid > 0;
+        if (retracing || hopeless(start, settled, settled_invalid, exploring)) {
+            if (watch_retrace && (retracing || settled - start >= kJudgedAfter)) mark_given_up(start, preference);
             mark_explored(start, preference, exploring);
             roll_back(start);
             return 0;
@@ -354,6 +366,15 @@ void LevelFinder::mark_explored(uint32_t start, Preference preference, bool expl
     }
 }
 
+void LevelFinder::mark_given_up(uint32_t start, Preference preference) {
+    const uint8_t bit = uint8_t(1u << int(preference));
+    for (uint32_t i = start; i < blocks_.size(); ++i) {
+        const uint32_t c = blocks_[i].center;
+        if (given_up_[c] == 0) given_up_list_.push_back(c);
+        given_up_[c] |= bit;
+    }
+}
+
 Candidate LevelFinder::best_patch(uint32_t t, bool exploring, uint8_t failed) {
     Candidate best{0, t, Preference::closure_first};
     bool same_either_way = false;  // the closure-first growth met no side that block first reads otherwise
@@ -381,6 +402,8 @@ Candidate LevelFinder::best_patch(uint32_t t, bool exploring, uint8_t failed) {
 uint32_t LevelFinder::commit_best_first(const std::vector<uint32_t>& seeds) {
     std::vector<Candidate> queue;
     for (uint32_t t : seeds) covered_[t] = 0;
+    for (uint32_t t : given_up_list_) given_up_[t] = 0;  // a reading given up is judged again in each round
+    given_up_list_.clear();
     for (uint32_t t : seeds) {
         if (covered_[t] == 3 || block_of_[t] != kNoIndex) continue;
         const Candidate c = best_patch(t, true);

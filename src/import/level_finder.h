@@ -85,15 +85,16 @@ public:
     // the triangles are numbered for locality (local_order), and wherever the caller's order
     // decides (the order of seeds, ties between candidates, the coarser level's order) it is
     // looked up, so the numbering changes no result.
+    // `give_up_retraced`: see undo_refinement_level.
     LevelFinder(const std::vector<Triangle>& fine, const std::vector<uint8_t>& refined, uint32_t vertex_count,
-                const std::vector<uint8_t>* kept)
-        : caller_of_(local_order(fine, vertex_count)), local_of_(inverse(caller_of_)), tri_(permuted(fine, caller_of_)),
+                const std::vector<uint8_t>* kept, bool give_up_retraced = false)
+        : give_up_retraced_(give_up_retraced), caller_of_(local_order(fine, vertex_count)), local_of_(inverse(caller_of_)), tri_(permuted(fine, caller_of_)),
           refined_(permuted(refined, caller_of_)), adjacency_(tri_, vertex_count), forced_old_(vertex_count, 0),
           midpoint_count_(vertex_count, 0), corner_count_(vertex_count, 0),
           midpoint_block_(vertex_count, {kNoIndex, kNoIndex}), first_coarse_edge_(vertex_count, kNoEdge), block_of_(fine.size(), kNoIndex), closure_of_(fine.size(), kNoIndex),
           pinned_old_(vertex_count, 0), covered_(fine.size(), 0),
           banned_(fine.size(), 0), repair_banned_(fine.size(), 0), deferred_(fine.size(), 0),
-          shape_of_(fine.size(), kNotRead), refined_near_(tri_.size(), 0) {
+          given_up_(give_up_retraced ? fine.size() : 0, 0), shape_of_(fine.size(), kNotRead), refined_near_(tri_.size(), 0) {
         // A midpoint has its block's three triangles on one side and the boundary, another block
         // (three) or a green closure (two or three triangles around it) on the other.
         for (uint32_t v = 0; v < vertex_count; ++v) {
@@ -273,6 +274,10 @@ private:
     // Marks the centers of the growth from blocks_[start] as explored under `preference`.
     void mark_explored(uint32_t start, Preference preference, bool exploring);
 
+    // Marks the centers of the growth from blocks_[start] as those of a reading given up under
+    // `preference` in this round (give_up_retraced_ only).
+    void mark_given_up(uint32_t start, Preference preference);
+
     uint32_t grow_patch_once(uint32_t t, Preference preference, bool exploring, std::vector<uint32_t>* suspects);
 
     // The best patch grown from t under either preference (but those of bit mask `failed`, known
@@ -319,6 +324,7 @@ private:
     // more vertices (two true isolated blocks beat one wrong pair glued at an old vertex).
     void improve_patches(size_t first);
 
+    const bool give_up_retraced_;
     std::vector<uint32_t> caller_of_;  // per triangle: its index in the caller's numbering
     std::vector<uint32_t> local_of_;   // per caller's index: the triangle
     std::vector<Triangle> tri_;
@@ -339,6 +345,11 @@ private:
     std::vector<uint8_t> banned_;          // per triangle: not a center (while a patch is improved)
     std::vector<uint8_t> repair_banned_;   // per triangle: not a center (while a patch is grown again)
     std::vector<uint8_t> deferred_;        // per triangle: center of a valid patch left for later
+    // Per triangle (give_up_retraced_ only): bit p, a center of an exploring growth under
+    // preference p given up in this commit_best_first, on its full sample or as retracing one;
+    // given_up_list_ lists them, to clear them.
+    std::vector<uint8_t> given_up_;
+    std::vector<uint32_t> given_up_list_;
     static constexpr uint32_t kNotRead = kNoIndex, kImpossible = kNoIndex - 1;
     mutable std::vector<uint32_t> shape_of_;  // per triangle: kNotRead, kImpossible or its index in shapes_
     mutable std::vector<Block> shapes_;       // the blocks possible_block has read
