@@ -27,15 +27,6 @@ struct Random {
 // What the decoder must give back: the input expressed in the base coder's order.
 Hierarchy expected_decoding(const Hierarchy& h) { return in_decoder_order(h); }
 
-// A curved adaptive remesh of about 6,000 faces over 200 base triangles, up to level 5.
-Hierarchy small_surface_remesh() {
-    SurfaceRemeshOptions remesh;
-    remesh.base_triangles = 200;
-    remesh.max_level = 5;
-    remesh.target_faces = 6000;
-    return remesh_adaptively(make_bumpy_sphere(4), remesh);
-}
-
 // Coordinates that stress a lossless float coder: random bit patterns of finite values,
 // denormals, signed zeros, huge and tiny magnitudes, and exact midpoints.
 double stress_coordinate(Random& random, bool single) {
@@ -135,7 +126,7 @@ TEST(Codec, QuantizedErrorIsBounded) {
 // Geometry mode 3 (normal frame, static tables, rANS): bit-exact and on the grid, in float32 and
 // float64, and chosen by the automatic encoder on a curved surface remesh, where it codes smaller.
 TEST(Codec, NormalFrameModeRoundTripsAndWinsOnSurfaces) {
-    const Hierarchy surface = small_surface_remesh();
+    const Hierarchy surface = testing::curved_sphere_remesh(6000);
     for (int bits : {0, 12, 16}) {
         for (bool single : {false, true}) {
             if (single && bits != 0) continue;
@@ -232,7 +223,7 @@ TEST(Codec, EffortOutsideItsRangeIsRefused) {
 // geometry modes and efforts, chunked and mixed files in between, and the context after
 // release() and after a move, must each give the bytes and sizes encode() gives without one.
 TEST(Codec, EncodesThroughAContextAreThoseWithoutOne) {
-    const Hierarchy surface = small_surface_remesh();
+    const Hierarchy surface = testing::curved_sphere_remesh(6000);
     Hierarchy sphere(make_icosahedron());
     refine_uniformly(sphere, 5);  // 7680 new vertices on the last level: the modes are weighed on a sample
     testing::Random random{7};
@@ -283,7 +274,7 @@ TEST(Codec, EncodesThroughAContextAreThoseWithoutOne) {
 // without symbols: its links serve the split alone and go back at once), an adaptive remesh,
 // lossless and quantized, the mixing mode, two chunks, and a progressive decode.
 TEST(Codec, LeanDecodesBuildWhatPlainDecodesBuild) {
-    const Hierarchy surface = small_surface_remesh();
+    const Hierarchy surface = testing::curved_sphere_remesh(6000);
     Hierarchy sphere(make_icosahedron());
     refine_uniformly(sphere, 5);  // 20,480 leaves: the last level's links span many pages
     struct Case {

@@ -37,6 +37,16 @@ inline Hierarchy projected_sphere(uint32_t target_leaves, int max_level, uint64_
     return h;
 }
 
+// A curvature-adaptive remesh of the bumpy sphere over 200 base triangles, up to level 5, until
+// target_faces leaf triangles (new vertices on the surface, off their edges' midpoints).
+inline Hierarchy curved_sphere_remesh(uint32_t target_faces) {
+    SurfaceRemeshOptions remesh;
+    remesh.base_triangles = 200;
+    remesh.max_level = 5;
+    remesh.target_faces = target_faces;
+    return remesh_adaptively(make_bumpy_sphere(4), remesh);
+}
+
 // A torus refined at random, every vertex moved off its place by smooth bumps (new vertices off
 // their midpoints, every coordinate bit in use), optionally rounded to float32.
 inline Hierarchy bumpy_torus(bool single_precision, uint32_t target_leaves = 600, int max_level = 4) {

@@ -159,17 +159,8 @@ TEST(MixedContexts, RandomHierarchiesRoundTripBitExactlyUnderEverySwitch) {
     }
 }
 
-// A curvature-adaptive remesh of 20,000 faces over 200 base triangles.
-Hierarchy curved_remesh() {
-    SurfaceRemeshOptions remesh;
-    remesh.base_triangles = 200;
-    remesh.max_level = 5;
-    remesh.target_faces = 20000;
-    return remesh_adaptively(make_bumpy_sphere(4), remesh);
-}
-
 TEST(MixedContexts, SmallerThanThePapersContextsOnACurvedRemesh) {
-    const Hierarchy h = curved_remesh();
+    const Hierarchy h = testing::curved_sphere_remesh(20000);
     EncodeStats paper, mixed;
     encode(h, {}, &paper);
     EncodeOptions options;
@@ -212,7 +203,7 @@ void expect_zero_until_coded(const MixedFeatures& f, int refined, int unrefined)
 // The fifth model's local threshold (FORMAT.md 2.5): the features see only nodes coded before, and
 // they make a curved remesh's code smaller than the fourth model's.
 TEST(MixedContexts, TheLocalThresholdCodesACurvedRemeshSmallerThanTheFourthModel) {
-    const Hierarchy h = curved_remesh();
+    const Hierarchy h = testing::curved_sphere_remesh(20000);
     const HierarchyLevelEncoder coder(h, HierarchyCoderOptions{}, kHierarchyStreamVersion, nullptr, true);
     int compared = 0, first_of_level = 0, level = -1;
     for (const auto& [f, bit] : coder.mixed_symbols()) {
@@ -239,7 +230,7 @@ TEST(MixedContexts, TheLocalThresholdCodesACurvedRemeshSmallerThanTheFourthModel
 // curvature with its neighbours', their local threshold sees only nodes coded before, and they make
 // a curved remesh's code smaller than the fifth model's.
 TEST(MixedContexts, TheQuadricsRingMeansCodeACurvedRemeshSmallerThanTheFifthModel) {
-    const Hierarchy h = curved_remesh();
+    const Hierarchy h = testing::curved_sphere_remesh(20000);
     const HierarchyLevelEncoder coder(h, HierarchyCoderOptions{}, kHierarchyStreamVersion, nullptr, true);
     int level = -1, averaged = 0, compared = 0;
     for (const auto& [f, bit] : coder.mixed_symbols()) {
@@ -295,7 +286,7 @@ TEST(MixedContexts, TheTrainedStatesCoverTheirTablesAndStartAtTheirStates) {
 // The trained states make a curved remesh's code smaller than the sixth model's: the remesh is none
 // of the training models (bunny, elephant and the rest: bench/trained_states).
 TEST(MixedContexts, TheTrainedStatesCodeACurvedRemeshSmallerThanTheSixthModel) {
-    const Hierarchy h = curved_remesh();
+    const Hierarchy h = testing::curved_sphere_remesh(20000);
     const double sixth = mixing_model_bits(h, MixingModel::sixth), seventh = mixing_model_bits(h, MixingModel::seventh);
     EXPECT_LT(seventh, sixth);
 }
