@@ -360,6 +360,20 @@ TEST(HierarchyCoder, DecodedVerticesArePlacedByTheHierarchysPlacer) {
     }
 }
 
+// Every frame corner of the last decode_level's new vertices (new_vertex_corners()), walked in
+// runs of 1, 2, ... 64 vertices, so that runs end inside a parent's edges; asking past them throws.
+std::vector<FrameCorners> walked_corners(const HierarchyLevelDecoder& coder) {
+    NewVertexCorners walk = coder.new_vertex_corners();
+    std::vector<FrameCorners> out;
+    for (size_t run = 1; out.size() < walk.size(); run = run % NewVertexCorners::kRun + 1) {
+        const size_t n = std::min(run, walk.size() - out.size());
+        const FrameCorners* corners = walk.next(n);
+        out.insert(out.end(), corners, corners + n);
+    }
+    EXPECT_THROW(walk.next(1), Error);
+    return out;
+}
+
 // The complete decoder's listing (set_new_vertex_listing): each new vertex's frame corners as
 // frame_corners reads them in the built hierarchy, ids in listing order, positions left at zero
 // for the geometry; the same hierarchy as the decoder that lists (node, edge) pairs.
@@ -383,9 +397,11 @@ TEST(HierarchyCoder, ListedNewVerticesCarryTheirFrameCorners) {
             ASSERT_TRUE(corners.new_vertices().empty());
             ASSERT_EQ(corners.new_vertex_count(), pairs.new_vertices().size()) << "seed " << seed;
             ASSERT_EQ(corners.new_vertex_first() + corners.new_vertex_count(), b.positions().size());
+            const std::vector<FrameCorners> walked = walked_corners(corners);
+            ASSERT_EQ(walked.size(), corners.new_vertex_count());
             for (size_t k = 0; k < corners.new_vertex_count(); ++k) {
                 const auto [n, e] = pairs.new_vertices()[k];
-                const FrameCorners expected = frame_corners(a, n, e), got = corners.new_vertex_corners()[k];
+                const FrameCorners expected = frame_corners(a, n, e), got = walked[k];
                 ASSERT_TRUE(expected.a == got.a && expected.b == got.b && expected.c == got.c && expected.d == got.d)
                     << "seed " << seed << ", vertex " << k;
                 ASSERT_EQ(a.midpoint(n, e), corners.new_vertex_first() + k) << "seed " << seed;
@@ -460,8 +476,11 @@ TEST(HierarchyCoder, LeanDecoderBuildsWhatThePlainOneBuilds) {
             lean.decode_level(lean_decoder);
             ASSERT_EQ(lean.new_vertex_count(), plain.new_vertex_count()) << "seed " << seed;
             ASSERT_TRUE(lean.new_vertices() == plain.new_vertices()) << "seed " << seed;
+            const std::vector<FrameCorners> plain_corners = listed ? walked_corners(plain) : std::vector<FrameCorners>{};
+            const std::vector<FrameCorners> lean_corners = listed ? walked_corners(lean) : std::vector<FrameCorners>{};
+            ASSERT_EQ(plain_corners.size(), lean_corners.size());
             for (size_t k = 0; listed && k < plain.new_vertex_count(); ++k) {
-                const FrameCorners a = plain.new_vertex_corners()[k], b = lean.new_vertex_corners()[k];
+                const FrameCorners a = plain_corners[k], b = lean_corners[k];
                 ASSERT_TRUE(a.a == b.a && a.b == b.b && a.c == b.c && a.d == b.d) << "seed " << seed << ", vertex " << k;
             }
         }

@@ -170,8 +170,8 @@ TEST(StaticLevelEncoder, GridLevelsDecodeAlikeFromTheListAndFromTheNodes) {
         for (const auto& [n, e] : created) zeroed.set_position(zeroed.midpoint(n, e), Vec3{});
         auto decode = [&](bool listed, size_t rans_size, size_t raw_size, Hierarchy& out, StaticOrder as) {
             out = zeroed;
-            return listed ? decode_static_positions(out, corners.data(), corners.size(), first, space, mode, tables, rans.data(),
-                                                    rans_size, raw.data(), raw_size, as)
+            NewVertexCorners list(corners.data(), first, corners.size());
+            return listed ? decode_static_positions(out, list, space, mode, tables, rans.data(), rans_size, raw.data(), raw_size, as)
                           : decode_static_positions(out, created, space, mode, tables, rans.data(), rans_size, raw.data(), raw_size, as);
         };
         // From the nodes, and from the list with mode 4's frames (and the grouped order's roles 1

@@ -28,6 +28,8 @@ constexpr int kMaxLevel = 30;  // a level cap far beyond any mesh that fits in m
 
 struct Neighbors;    // internal (src/hierarchy/hierarchy_builder.h)
 struct LevelSplits;  // internal (src/hierarchy/hierarchy_builder.h)
+struct HierarchySlice;  // internal (src/hierarchy/hierarchy_builder.h)
+struct ChildLinkRoom;   // internal (src/hierarchy/hierarchy_builder.h)
 
 class Hierarchy {
 public:
@@ -146,6 +148,7 @@ private:
     // The decoders' bulk build of a level, split_level (src/hierarchy/hierarchy_builder.h).
     friend struct HierarchyBuilder;
     void split_level(const LevelSplits& splits);
+    ChildLinkRoom open_children(HierarchySlice* slice, uint32_t count);
 
     static constexpr uint8_t kDeadLevel = 0xff;
     // 32 bytes, aligned: a node never straddles two cache lines. Siblings share what their ids

@@ -638,8 +638,7 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
         // this block: it bounds R before the next level is allocated.
         hierarchy.decode_level(decoder, 2 * max_decodable_positions(block.size - 1) / 3);
         if (listed)
-            decode_listed_level_geometry(h, hierarchy.new_vertex_corners(), hierarchy.new_vertex_count(),
-                                         hierarchy.new_vertex_first(), parts, decoder, space, where);
+            decode_listed_level_geometry(h, hierarchy.new_vertex_corners(), parts, decoder, space, where);
         else
             decode_level_geometry(h, hierarchy.new_vertices(), parts, decoder, positions, space, level, where);
         ++level;

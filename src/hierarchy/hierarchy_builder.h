@@ -28,6 +28,43 @@ struct FrameCorners {
     VertexId a, b, c, d;
 };
 
+// The frame corners of the vertices a level's split made, ids first, first + 1, ... in the order
+// split_level made them, for decoders that take a run of vertices at a time (the static geometry
+// decoders): walked from the split parents in the built hierarchy, so that no list of a level's
+// corners (16 bytes a vertex, a tenth of a decode's peak) is kept; or read from a list.
+class NewVertexCorners {
+public:
+    static constexpr size_t kRun = 64;  // at most this many vertices a call of next()
+    NewVertexCorners() = default;
+    // The `count` vertices from `first` that splitting parents[0..parent_count) of h in this order
+    // made: edge e of parent p made the next id when that id is p's midpoint on e (an earlier
+    // parent's midpoint or a seam vertex is an older id).
+    NewVertexCorners(const Hierarchy& h, const NodeId* parents, uint32_t parent_count, VertexId first, size_t count)
+        : h_(&h), parents_(parents), parent_count_(parent_count), first_(first), count_(count), next_vertex_(first) {}
+    // `count` corners listed: vertex first + k's at list[k].
+    NewVertexCorners(const FrameCorners* list, VertexId first, size_t count) : list_(list), first_(first), count_(count) {}
+    size_t size() const { return count_; }
+    VertexId first() const { return first_; }
+    // The corners of the next n (at most kRun) vertices, valid until the next call. Throws Error
+    // when the parents made fewer vertices than announced.
+    const FrameCorners* next(size_t n);
+
+private:
+    const Hierarchy* h_ = nullptr;
+    const NodeId* parents_ = nullptr;
+    uint32_t parent_count_ = 0;
+    const FrameCorners* list_ = nullptr;
+    VertexId first_ = 0;
+    size_t count_ = 0;
+    size_t taken_ = 0;  // vertices handed out
+    // The walk: the next parent, the next vertex id, and run_'s corners (made_ of them, of which
+    // the last next() handed out handed_; a parent's last two may be left for the next run).
+    uint32_t parent_ = 0;
+    VertexId next_vertex_ = 0;
+    size_t made_ = 0, handed_ = 0;
+    FrameCorners run_[kRun + 2];
+};
+
 // Where split_level writes when decoders of several chunks build one hierarchy at once, each on
 // its own thread: the chunk's run of node ids and of vertex ids, made beforehand (open_slices),
 // filled from the front; the hierarchy's sizes and counts stay as open_slices set them.
@@ -52,10 +89,6 @@ struct LevelSplits {
     // chunk decoder's seam vertices (chunk_coder.h).
     VertexId (*boundary_vertex)(void* context, VertexId a, VertexId b) = nullptr;
     void* boundary_context = nullptr;
-    // When set, new vertex k of the call (id positions().size() + k taken before it, or the slice's
-    // next vertex + k; boundary_vertex's vertices are not new) gets its frame corners written to
-    // new_vertex_corners[k]: room for 3 * count.
-    FrameCorners* new_vertex_corners = nullptr;
     // False: the new vertices' positions are left at zero, for a decoder that sets every one of
     // them next (their midpoints would be read and computed for nothing).
     bool place_new_vertices = true;
@@ -71,11 +104,22 @@ struct LevelSplits {
     // When set, the children and new vertices go to the slice's next ids (throws Error when they
     // do not fit), not to the end of the hierarchy.
     HierarchySlice* slice = nullptr;
+    // When set (`children` null), the children's links, as `children` would hold them, are in
+    // their own nodes already: written into the room HierarchyBuilder::open_children made.
+    bool links_in_place = false;
 };
 
 // canonical_vertex_order (hierarchy.h) over h.breadth_first_order() made already, for callers
 // that walk that order too (the leaf mesh): one pass over the nodes instead of two.
 std::vector<uint32_t> canonical_vertex_order(const Hierarchy& h, const std::vector<NodeId>& breadth_first);
+
+// The room of the nodes the next split_level makes, opened before it (HierarchyBuilder::
+// open_children): node j of the room (child j % 4 of parents[j / 4]) has its three link words at
+// words + kStride * j. A level's links written there need no array of their own.
+struct ChildLinkRoom {
+    static constexpr size_t kStride = 8;  // words a node
+    uint32_t* words = nullptr;
+};
 
 struct HierarchyBuilder {
     // Splits level.parents in order with the result of calling split() on each in turn (same
@@ -88,6 +132,13 @@ struct HierarchyBuilder {
         // checked one) only read it.
         if (h.structure_checked_) h.structure_checked_ = false;
         h.split_level(level);
+    }
+    // Makes the nodes of the `count` blocks of four that the next split_level (with
+    // links_in_place) fills: at the hierarchy's end (grown, contents unset; node_capacity() counts
+    // them from now) or at `slice`'s next node. Only for a hierarchy that was only ever refined.
+    // Throws Error when the slice does not hold them.
+    static ChildLinkRoom open_children(Hierarchy& h, HierarchySlice* slice, uint32_t count) {
+        return h.open_children(slice, count);
     }
     // The next `count` positions of vertices split_level made with append_new_positions (ids
     // positions().size() on), within the room it reserved. `near`: none is Hierarchy::is_far.

@@ -178,25 +178,71 @@ AMC_ALWAYS_INLINE void store_neighbors(Node* child, const Neighbors* siblings, u
 #endif
 }
 
+// store_neighbors for links written in the children's own nodes (LevelSplits::links_in_place).
+template <class Node>
+AMC_ALWAYS_INLINE void turn_links_into_ids(Node* child, uint32_t offset) {
+#if AMC_SSE2
+    const __m128i all_ones = _mm_set1_epi32(-1);
+    const __m128i add = _mm_set1_epi32(int(offset));
+    for (int k = 0; k < 4; ++k) {
+        __m128i* at = reinterpret_cast<__m128i*>(child[k].nbr);  // the three links and the tail
+        const __m128i v = _mm_loadu_si128(at);
+        _mm_storeu_si128(at, _mm_or_si128(_mm_add_epi32(v, add), _mm_cmpeq_epi32(v, all_ones)));
+    }
+#else
+    for (int k = 0; k < 4; ++k) {
+        for (int e = 0; e < 3; ++e) {
+            const uint32_t t = child[k].nbr[e];
+            child[k].nbr[e] = t == kNoNode ? kNoNode : t + offset;
+        }
+    }
+#endif
+}
+
 }  // namespace
+
+ChildLinkRoom Hierarchy::open_children(HierarchySlice* slice, uint32_t count) {
+    AMC_REQUIRE(free_blocks_.empty() && free_vertices_.empty(), invalid_input,
+                "open_children: the room of a level needs a hierarchy that was only ever refined");
+    const size_t c0 = slice != nullptr ? slice->next_node : nodes_.size();
+    const size_t new_nodes = c0 + size_t(4) * count;
+    if (slice != nullptr) {
+        AMC_REQUIRE(new_nodes <= slice->node_end, corrupt, slice->owner + " does not hold the nodes the chunk table says");
+    } else {
+        if (new_nodes > nodes_.capacity()) reserve(std::max(new_nodes, nodes_.capacity() + nodes_.capacity() / 2), 0);
+        nodes_.resize(new_nodes);  // Node() writes nothing
+    }
+    ChildLinkRoom room;
+    static_assert(ChildLinkRoom::kStride * sizeof(uint32_t) == sizeof(Node), "the room's stride is a node");
+    if (count > 0) room.words = nodes_[c0].nbr;
+    return room;
+}
 
 void Hierarchy::split_level(const LevelSplits& splits) {
     const NodeId* const parents = splits.parents;
     const uint32_t count = splits.count;
     if (!free_blocks_.empty() || !free_vertices_.empty()) {
         // Reused ids: take the general path (the decoders never get here).
-        AMC_REQUIRE(splits.new_vertex_corners == nullptr && splits.place_new_vertices, invalid_input,
-                    "split_level: listed corners need a hierarchy that was only ever refined");
+        AMC_REQUIRE(splits.place_new_vertices, invalid_input,
+                    "split_level: unplaced vertices need a hierarchy that was only ever refined");
         for (uint32_t i = 0; i < count; ++i) split(parents[i]);
         return;
     }
-    // The neighbour of child e of parents[i] across the first half of the parent's edge e.
-    auto first_half = [children = splits.children](uint32_t i, int e) {
-        return children[size_t(4) * i + red_split::kFirstHalfChild[e]].nbr[e];
-    };
     HierarchySlice* const slice = splits.slice;
-    const size_t c0 = slice != nullptr ? slice->next_node : nodes_.size();
+    const bool in_place = splits.links_in_place;
+    // open_children grew the hierarchy's end already.
+    const size_t c0 = slice != nullptr ? slice->next_node : nodes_.size() - (in_place ? size_t(4) * count : 0);
     const size_t new_nodes = c0 + size_t(4) * count;
+    // The neighbour of child e of parents[i] across the first half of the parent's edge e: in the
+    // list, or in the child itself (a stride, not a test per read).
+    const char* const links = in_place ? reinterpret_cast<const char*>(nodes_.data() + c0) + offsetof(Node, nbr)
+                                       : reinterpret_cast<const char*>(splits.children);
+    const size_t link_stride = in_place ? sizeof(Node) : sizeof(Neighbors);
+    auto first_half = [links, link_stride](uint32_t i, int e) {
+        uint32_t t;
+        std::memcpy(&t, links + (size_t(4) * i + red_split::kFirstHalfChild[e]) * link_stride + sizeof(uint32_t) * size_t(e), 4);
+        return t;
+    };
     const size_t v0 = slice != nullptr ? slice->next_vertex : positions_.size();
     const size_t vertex_room = slice != nullptr ? slice->vertex_end : positions_.capacity();
     if (slice != nullptr) {
@@ -243,18 +289,11 @@ void Hierarchy::split_level(const LevelSplits& splits) {
     constexpr uint32_t kParentsAhead = 16;
     const uint32_t offset = uint32_t(c0);
     const auto boundary_vertex = splits.boundary_vertex;
-    FrameCorners* const corners = splits.new_vertex_corners;
     for (uint32_t chunk = 0; chunk < count; chunk += kChunk) {
         const uint32_t chunk_end = std::min(count, chunk + kChunk);
         uint32_t new_vertices = 0;
         for (uint32_t i = chunk; i < chunk_end; ++i) {
             if (i + kParentsAhead < count) __builtin_prefetch(nodes + parents[i + kParentsAhead]);
-            if (corners != nullptr && i + kParentsAhead / 2 < count) {
-                // The neighbours whose far vertices the corners take (a missing one, kNoNode, is
-                // fetched from nowhere: prefetches do not fault).
-                const Node& ahead = nodes[parents[i + kParentsAhead / 2]];
-                for (int e = 0; e < 3; ++e) __builtin_prefetch(nodes + ahead.nbr[e]);
-            }
             const NodeId n = parents[i];
             Node& parent = nodes[n];
             const NodeId c = NodeId(c0 + size_t(4) * i);
@@ -274,13 +313,6 @@ void Hierarchy::split_level(const LevelSplits& splits) {
                     if (existing != kNoVertex) {
                         m[e] = existing;
                     } else {
-                        if (corners != nullptr) {
-                            // frame_corners' (geometry_prediction.cpp), from the parent at hand.
-                            const NodeId q = parent.nbr[e];
-                            const unsigned eq = (parent.nbr_edge >> (2 * e)) & 3u;
-                            corners[next_vertex - v0] = {a, b, parent.v[e == 0 ? 2 : e - 1],
-                                                         q == kNoNode ? kNoVertex : nodes[q].v[eq == 0 ? 2 : eq - 1]};
-                        }
                         ends[new_vertices++] = {a, b};
                         m[e] = next_vertex++;
                     }
@@ -293,7 +325,10 @@ void Hierarchy::split_level(const LevelSplits& splits) {
             const unsigned boundary = parent.flags;
             Node* child = nodes + c;
             red_split_kernels::write_child_vertices(child, parent.v, m);  // write_vertices' (split() shares it)
-            store_neighbors(child, splits.children + size_t(4) * i, offset);
+            if (in_place)
+                turn_links_into_ids(child, offset);
+            else
+                store_neighbors(child, splits.children + size_t(4) * i, offset);
             const ChildTails& tails = kChildTails.of[outer | (boundary & 7u) << 6];
             for (int k = 0; k < 4; ++k) store_tail(child[k], tails.word[k] | level);
             parent.first_child = c;
@@ -333,6 +368,54 @@ void Hierarchy::split_level(const LevelSplits& splits) {
     }
     live_nodes_ += 4 * count;
     live_vertices_ += uint32_t(next_vertex - v0);
+}
+
+const FrameCorners* NewVertexCorners::next(size_t n) {
+    AMC_REQUIRE(n <= kRun && taken_ + n <= count_, invalid_input, "NewVertexCorners: more vertices asked for than made");
+    taken_ += n;
+    if (list_ != nullptr) return list_ + (taken_ - n);
+    // The corners a parent made past the last run come first.
+    const size_t carried = made_ - handed_;
+    std::memmove(run_, run_ + handed_, carried * sizeof(FrameCorners));
+    // The walk in locals: the stores of corners could alias members as far as the compiler knows.
+    const Hierarchy& h = *h_;
+    const NodeId* const parents = parents_;
+    const uint32_t parent_count = parent_count_;
+    uint32_t b = parent_;
+    VertexId next_vertex = next_vertex_;
+    FrameCorners* const out = run_;
+    size_t k = carried;
+    // The parents are fetched 16 ahead, their centre children and neighbours 8 ahead (as split_level).
+    constexpr uint32_t kParentsAhead = 16;
+    while (k < n) {
+        AMC_REQUIRE(b < parent_count, corrupt, "split parents made fewer vertices than listed");
+        if (b + kParentsAhead < parent_count) HierarchyBuilder::prefetch(h, parents[b + kParentsAhead]);
+        if (b + kParentsAhead / 2 < parent_count) {
+            const NodeId ahead = parents[b + kParentsAhead / 2];
+            HierarchyBuilder::prefetch(h, h.child(ahead, red_split::kCenter));
+            for (int e = 0; e < 3; ++e) HierarchyBuilder::prefetch(h, h.neighbor(ahead, e));  // kNoNode: prefetches do not fault
+        }
+        const NodeId p = parents[b++];
+        const NodeId center = h.child(p, red_split::kCenter);
+        const VertexId v[5] = {h.vertex(p, 0), h.vertex(p, 1), h.vertex(p, 2), h.vertex(p, 0), h.vertex(p, 1)};
+        const NodeId q[3] = {h.neighbor(p, 0), h.neighbor(p, 1), h.neighbor(p, 2)};
+        const unsigned edges = HierarchyBuilder::neighbor_edges(h, p);
+        const VertexId m[3] = {h.vertex(center, red_split::kCenterVertexOfMidpoint[0]),
+                               h.vertex(center, red_split::kCenterVertexOfMidpoint[1]),
+                               h.vertex(center, red_split::kCenterVertexOfMidpoint[2])};
+        for (int e = 0; e < 3; ++e) {
+            if (m[e] != next_vertex) continue;  // an earlier parent's midpoint, or a seam vertex
+            static constexpr int kOpposite[4] = {2, 0, 1, 2};  // (eq + 2) % 3
+            const VertexId d = q[e] == kNoNode ? kNoVertex : h.vertex(q[e], kOpposite[(edges >> (2 * e)) & 3u]);
+            out[k++] = {v[e], v[e + 1], v[e + 2], d};
+            ++next_vertex;
+        }
+    }
+    parent_ = b;
+    next_vertex_ = next_vertex;
+    made_ = k;
+    handed_ = n;
+    return run_;
 }
 
 }  // namespace amc

@@ -222,8 +222,7 @@ void decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, size_t 
         boundary.swap(next_boundary);
         AMC_REQUIRE(!decoder.overran(), corrupt, where + ": hierarchy part is truncated or corrupt");
         if (listed) {  // the seam's vertices are not new: not listed
-            decode_listed_level_geometry(h, hierarchy.new_vertex_corners(), hierarchy.new_vertex_count(),
-                                         hierarchy.new_vertex_first(), parts, decoder, space, where);
+            decode_listed_level_geometry(h, hierarchy.new_vertex_corners(), parts, decoder, space, where);
             continue;
         }
         if (!seam_splits.found) {  // every new vertex is the chunk's own

@@ -374,14 +374,13 @@ void decode_static_level(const LevelBlockParts& parts, ArithmeticDecoder& decode
 
 }  // namespace
 
-void decode_listed_level_geometry(Hierarchy& h, const FrameCorners* corners, size_t count, VertexId first,
-                                  const LevelBlockParts& parts, ArithmeticDecoder& decoder, CoordinateSpace space,
-                                  const std::string& where) {
+void decode_listed_level_geometry(Hierarchy& h, NewVertexCorners corners, const LevelBlockParts& parts,
+                                  ArithmeticDecoder& decoder, CoordinateSpace space, const std::string& where) {
     AMC_REQUIRE(is_static_mode(parts.predictor), invalid_input, where + ": listed corners need a static geometry mode");
     decode_static_level(parts, decoder, space, where,
                         [&](const StaticTables& tables, const uint8_t* rans, size_t rans_size, const uint8_t* raw, size_t raw_size) {
-                            return decode_static_positions(h, corners, count, first, space, parts.predictor, tables, rans,
-                                                           rans_size, raw, raw_size, parts.order);
+                            return decode_static_positions(h, corners, space, parts.predictor, tables, rans, rans_size,
+                                                           raw, raw_size, parts.order);
                         });
 }
 

@@ -344,17 +344,17 @@ struct FromNodes {
     }
 };
 struct FromList {
-    const FrameCorners* corners;
-    size_t count;
-    VertexId first;
-    size_t size() const { return count; }
+    NewVertexCorners& corners;  // taken in order, a chunk at a time
+    size_t size() const { return corners.size(); }
+    VertexId first() const { return corners.first(); }
     // The positions do not exist yet (HierarchyBuilder::append_positions).
-    bool appends(const Hierarchy& h) const { return first == h.positions().size(); }
+    bool appends(const Hierarchy& h) const { return first() == h.positions().size(); }
     void get(Chunk& c) const {
-        c.corners = corners + c.begin;  // read where they are: no copy
-        for (size_t i = 0; i < c.count; ++i) c.vertices[i] = first + VertexId(c.begin + i);
+        c.corners = corners.next(c.count);  // read where they are: no copy
+        for (size_t i = 0; i < c.count; ++i) c.vertices[i] = first() + VertexId(c.begin + i);
     }
 };
+static_assert(kChunk <= NewVertexCorners::kRun, "a chunk's corners come in one run");
 
 // Chunk c: vertices begin .. end - 1 of `source`, at most kChunk.
 template <class Mesh, class Source>
@@ -1629,9 +1629,9 @@ AMC_ALWAYS_INLINE bool decode_grid_listed_with(Hierarchy& h, const FromList& cre
     std::array<GridFrame, kChunk> frames;
     Coordinates coordinates[kChunk];
     Vec3 decoded[kChunk];
-    for (size_t begin = 0; begin < created.count; begin += kChunk) {
-        const size_t count = std::min(kChunk, created.count - begin);
-        const FrameCorners* corners = created.corners + begin;
+    for (size_t begin = 0; begin < created.size(); begin += kChunk) {
+        const size_t count = std::min(kChunk, created.size() - begin);
+        const FrameCorners* corners = created.corners.next(count);
         const Vec3* positions = h.positions().data();
         for (size_t i = 0; i < count; ++i) {  // a, b and c are always vertices
             const FrameCorners& k = corners[i];
@@ -1665,7 +1665,7 @@ AMC_ALWAYS_INLINE bool decode_grid_listed_with(Hierarchy& h, const FromList& cre
             HierarchyBuilder::append_positions(h, decoded, count, near);
         } else {
             for (size_t k = 0; k < count; ++k) {
-                const VertexId v = created.first + VertexId(begin + k);
+                const VertexId v = created.first() + VertexId(begin + k);
                 if (near) HierarchyBuilder::set_near_vertex_position(h, v, decoded[k]);
                 else HierarchyBuilder::set_new_vertex_position(h, v, decoded[k]);
             }
@@ -2034,10 +2034,10 @@ bool decode_static_positions(Hierarchy& h, const std::vector<std::pair<NodeId, i
                          order == StaticOrder::grouped);
 }
 
-bool decode_static_positions(Hierarchy& h, const FrameCorners* corners, size_t count, VertexId first, CoordinateSpace space,
-                             GeometryPredictor mode, const StaticTables& tables, const uint8_t* rans_data, size_t rans_size,
-                             const uint8_t* raw_data, size_t raw_size, StaticOrder order) {
-    return decode_static(h, FromList{corners, count, first}, space, mode, tables, rans_data, rans_size, raw_data, raw_size,
+bool decode_static_positions(Hierarchy& h, NewVertexCorners& corners, CoordinateSpace space, GeometryPredictor mode,
+                             const StaticTables& tables, const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data,
+                             size_t raw_size, StaticOrder order) {
+    return decode_static(h, FromList{corners}, space, mode, tables, rans_data, rans_size, raw_data, raw_size,
                          order == StaticOrder::grouped);
 }
 

@@ -223,10 +223,10 @@ bool set_wide_frames(bool allowed);
 bool decode_static_positions(Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, CoordinateSpace space,
                              GeometryPredictor mode, const StaticTables& tables, const uint8_t* rans, size_t rans_size, const uint8_t* raw,
                              size_t raw_size, StaticOrder order);
-// The same for `count` vertices first, first + 1, ... whose frame corners split_level listed
-// (LevelSplits::new_vertex_corners): no node is read. Modes with a frame only (has_frame).
-bool decode_static_positions(Hierarchy& h, const FrameCorners* corners, size_t count, VertexId first, CoordinateSpace space,
-                             GeometryPredictor mode, const StaticTables& tables, const uint8_t* rans, size_t rans_size,
-                             const uint8_t* raw, size_t raw_size, StaticOrder order);
+// The same for the vertices corners.first(), corners.first() + 1, ... with their frame corners
+// (NewVertexCorners, taken a run at a time from `corners`). Modes with a frame only (has_frame).
+bool decode_static_positions(Hierarchy& h, NewVertexCorners& corners, CoordinateSpace space, GeometryPredictor mode,
+                             const StaticTables& tables, const uint8_t* rans, size_t rans_size, const uint8_t* raw,
+                             size_t raw_size, StaticOrder order);
 
 }  // namespace amc

@@ -106,6 +106,9 @@ void HierarchyLevelDecoder::start(NodeId first_root, uint32_t roots, const Hiera
     append_new_positions_ = false;
     lean_ = false;
     lean_at_end_ = false;
+    next_links_in_room_ = false;
+    split_parents_ = nullptr;
+    split_parent_count_ = 0;
     slice_ = nullptr;
     // Uniform levels alone would build roots * (4^(U+1) - 1) / 3 nodes: check before.
     uint64_t uniform_nodes = roots, level_nodes = roots;
@@ -139,7 +142,7 @@ std::vector<NodeId> HierarchyLevelDecoder::level_nodes() const {
 
 void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder, uint64_t max_refined) {
     const uint64_t vertices_before = vertex_count_;
-    decide_level(decoder, max_refined);
+    decide(decoder, max_refined, true);
     // Node ids are consecutive level by level: the decided level's nodes come right before its
     // children, the last nodes counted.
     const Level& level = decided_.back();
@@ -154,10 +157,11 @@ void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder, uint64_t ma
     // faulted in again by a later level of this decode.
     const bool last_built = level_is_all_leaves();
     const bool lean = lean_ || (lean_at_end_ && last_built);
-    if (lean) release_before_build(size_t(vertex_count_ - vertices_before));
+    if (lean) release_before_build();
     build_decided_levels();
     if (lean) {
-        for (Level& built : spare_) built.refined.release_from(0);
+        for (Level& built : spare_)  // the split parents listed stay for new_vertex_corners()
+            if (built.refined.data() != split_parents_) built.refined.release_from(0);
         if (last_built) {  // the next level's links served the split alone
             level_.nbr.release_from(0);
             level_.edges.release_from(0);
@@ -168,6 +172,10 @@ void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder, uint64_t ma
 }
 
 void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder, uint64_t max_refined) {
+    decide(decoder, max_refined, false);
+}
+
+void HierarchyLevelDecoder::decide(ArithmeticDecoder& decoder, uint64_t max_refined, bool built_next) {
     AMC_REQUIRE(!done(), invalid_input, "hierarchy stream: no level left to decode");
     const int l = level_index_;
     uint8_t* state = level_.state();
@@ -178,7 +186,7 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder, uint64_t ma
     if (level_is_all_leaves()) {  // and the last: no traversal needed
         for (uint32_t i = 0; i < n; ++i) state[i] = uint8_t(state[i] | kDecided);
         level_.refined_count = 0;
-        finish_level();
+        finish_level(false);
         return;
     }
     // The coder's state lives in locals while the level is decided: every state byte the
@@ -264,15 +272,15 @@ void HierarchyLevelDecoder::decide_level(ArithmeticDecoder& decoder, uint64_t ma
     decoder = d;
     models_ = models;
     symbols_read_ = symbols_read;
-    finish_level();
+    finish_level(built_next);
 }
 
-bool HierarchyLevelDecoder::level_is_all_leaves() const {
+bool HierarchyLevelDecoder::all_leaves_from(int level) const {
     // Every symbol left is 0, and with no node of the level refined yet no rule can force one.
-    return header_.options.truncate_stream && symbols_read_ == header_.symbol_count && level_index_ >= header_.uniform_levels;
+    return header_.options.truncate_stream && symbols_read_ == header_.symbol_count && level >= header_.uniform_levels;
 }
 
-void HierarchyLevelDecoder::finish_level() {
+void HierarchyLevelDecoder::finish_level(bool built_next) {
     node_count_ += uint64_t(4) * level_.refined_count;
     leaf_faces_ += leaf_faces_of_level(level_);
     // The next level takes a spare level's memory only now, once the level before was built and
@@ -282,14 +290,21 @@ void HierarchyLevelDecoder::finish_level() {
         next = std::move(spare_.back());
         spare_.pop_back();
     }
-    level_.new_vertices = derive_next_level(level_, numbering_, next, header_.options.cull_one_regularity);
+    // A next level of leaves alone (the stored symbols used up), split now: nothing but the split
+    // reads its links, which go straight into the room of its nodes (the last level's links were
+    // an eighth of a decode's peak).
+    const bool links_in_room = built_next && level_.refined_count > 0 && all_leaves_from(level_index_ + 1);
+    const ChildLinkRoom room =
+        links_in_room ? HierarchyBuilder::open_children(*h_, slice_, level_.refined_count) : ChildLinkRoom{};
+    level_.new_vertices = derive_next_level(level_, numbering_, next, header_.options.cull_one_regularity, room);
+    next_links_in_room_ = links_in_room;
     vertex_count_ += level_.new_vertices;
     decided_.push_back(std::move(level_));
     level_ = std::move(next);
     ++level_index_;
 }
 
-void HierarchyLevelDecoder::release_before_build(size_t new_vertices) {
+void HierarchyLevelDecoder::release_before_build() {
     auto release_links = [](Level& level, size_t keep) {
         level.nbr.release_from(keep);
         level.edges.release_from(keep / 4);
@@ -304,10 +319,11 @@ void HierarchyLevelDecoder::release_before_build(size_t new_vertices) {
     numbering_.release();
     closures_.release_from(0);
     traversal_.release_working_memory();
-    corners_.release_from(new_vertices);
 }
 
 void HierarchyLevelDecoder::build_decided_levels() {
+    split_parents_ = nullptr;
+    split_parent_count_ = 0;
     for (size_t k = 0; k < decided_.size(); ++k) {
         Level& level = decided_[k];
         const Level& children = k + 1 < decided_.size() ? decided_[k + 1] : level_;
@@ -319,14 +335,18 @@ void HierarchyLevelDecoder::build_decided_levels() {
         const uint32_t count = level.refined_count;
         uint32_t* parents = level.refined.data();
         for (uint32_t b = 0; b < count; ++b) parents[b] += level_base_;
-        const NodeId first_child = slice_ != nullptr ? slice_->next_node : h_->node_capacity();
-        LevelSplits splits{parents, count, children.nbr.data(), boundary_vertex_, boundary_context_};
+        const bool in_place = k + 1 == decided_.size() && next_links_in_room_;  // open_children made the room
+        const NodeId first_child =
+            slice_ != nullptr ? slice_->next_node : h_->node_capacity() - (in_place ? 4 * count : 0);
+        LevelSplits splits{parents, count, in_place ? nullptr : children.nbr.data(), boundary_vertex_, boundary_context_};
+        splits.links_in_place = in_place;
         splits.slice = slice_;
         splits.new_vertex_count = level.new_vertices;
         // Listed or left unplaced for decode_level's caller, which takes one level at a time.
         if (list_corners_ || !place_new_vertices_) {
             AMC_REQUIRE(decided_.size() == 1, invalid_input, "hierarchy decoder: listed new vertices need decode_level");
-            splits.new_vertex_corners = list_corners_ ? corners_.reserve(size_t(3) * count) : nullptr;
+            split_parents_ = list_corners_ ? parents : nullptr;  // new_vertex_corners() walks them
+            split_parent_count_ = list_corners_ ? count : 0;
             splits.place_new_vertices = place_new_vertices_;
             splits.append_new_positions = appending_positions();
         }

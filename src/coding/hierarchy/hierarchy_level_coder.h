@@ -247,8 +247,11 @@ public:
     // first appearance (new_vertices_of_level of its level's nodes), positions not yet set.
     const std::vector<std::pair<NodeId, int>>& new_vertices() const { return new_vertices_; }
     // With set_new_vertex_listing(true, ...): the frame corners of the vertices the last
-    // decode_level created, vertex new_vertex_first() + k at index k, new_vertex_count() of them.
-    const FrameCorners* new_vertex_corners() const { return corners_.data(); }
+    // decode_level created, vertex new_vertex_first() + k the k-th, new_vertex_count() of them,
+    // walked from that level's split parents in hierarchy(): valid until the next decode_level.
+    NewVertexCorners new_vertex_corners() const {
+        return NewVertexCorners(*h_, split_parents_, split_parent_count_, new_vertex_first_, new_vertex_count_);
+    }
     VertexId new_vertex_first() const { return new_vertex_first_; }
     size_t new_vertex_count() const { return new_vertex_count_; }
     // Switches to the mixing mode (FORMAT.md 2.1: `model` first for .amc versions 8-9, second for
@@ -279,14 +282,18 @@ private:
     void start(NodeId first_root, uint32_t roots, const HierarchyStreamHeader& header, uint64_t max_nodes);
     // Whether the current level, not yet decided, is all leaves (and the last): the stored
     // symbols are used up past the uniform levels.
-    bool level_is_all_leaves() const;
+    bool level_is_all_leaves() const { return all_leaves_from(level_index_); }
+    // Whether `level` and every level after it are all leaves, once the levels before are decided.
+    bool all_leaves_from(int level) const;
     // Counts the decided level's splits (level_.refined, numbered in numbering_) and the vertices
-    // they create, and moves to the next level.
-    void finish_level();
+    // they create, and moves to the next level. `built_next`: the splits are made right after, by
+    // the same decode_level.
+    void finish_level(bool built_next);
+    // decide_level; `built_next`: decode_level's, which splits the level right after.
+    void decide(ArithmeticDecoder& decoder, uint64_t max_refined, bool built_next);
     // set_lean's release once the decided level is derived and its new vertices listed, before it
-    // is built: everything but the level's refined nodes, the next level's links and the room for
-    // `new_vertices` corners.
-    void release_before_build(size_t new_vertices);
+    // is built: everything but the level's refined nodes and the next level's links.
+    void release_before_build();
     // decide_level for a stream of the newest version, or of version 1 (kVersion1).
     template <bool kVersion1>
     void decide_level_of(ArithmeticDecoder& decoder);
@@ -309,10 +316,13 @@ private:
     bool list_corners_ = false, place_new_vertices_ = true, append_new_positions_ = false;  // set_new_vertex_listing
     bool lean_ = false;                                      // set_lean
     bool lean_at_end_ = false;                               // set_lean_at_end
+    bool next_links_in_room_ = false;  // level_'s links are in the room of its nodes (finish_level)
     bool appending_positions() const {
         return append_new_positions_ && !place_new_vertices_ && slice_ == nullptr && boundary_vertex_ == nullptr;
     }
-    ScratchArray<FrameCorners> corners_;  // of the last decode_level, when listed
+    // The last decode_level's split parents (ids, in its level's refined list), when listed.
+    const NodeId* split_parents_ = nullptr;
+    uint32_t split_parent_count_ = 0;
     VertexId new_vertex_first_ = 0;
     size_t new_vertex_count_ = 0;
     ScratchArray<uint32_t> closures_;  // the leaves with two or three hanging nodes

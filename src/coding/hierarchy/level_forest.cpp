@@ -7,6 +7,7 @@
 #include "hierarchy/red_split_kernels.h"
 
 #include <cstring>
+#include <type_traits>
 
 namespace amc {
 
@@ -121,8 +122,30 @@ uint64_t leaf_faces_of_level(const Level& level) {
     return faces;
 }
 
+namespace {
+
+// A block's twelve link words (four siblings' Neighbors) copied to its nodes' room, 16 bytes a
+// node: the fourth word lands in the node's tail, which split_level writes afterwards.
+inline void copy_links_to_room(const Neighbors* made, uint32_t* words) {
+    static_assert(ChildLinkRoom::kStride == 8, "the room's nodes are eight words apart");
+#if AMC_SSE2
+    const uint32_t* links = made[0].nbr;  // word 3k + e: child k, edge e (Neighbors' static_assert)
+    const __m128i t0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(links));
+    const __m128i t1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(links + 4));
+    const __m128i t2 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(links + 8));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(words), t0);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(words + 8), _mm_or_si128(_mm_srli_si128(t0, 12), _mm_slli_si128(t1, 4)));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(words + 16), _mm_or_si128(_mm_srli_si128(t1, 8), _mm_slli_si128(t2, 8)));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(words + 24), _mm_srli_si128(t2, 4));
+#else
+    for (int k = 0; k < 4; ++k) std::memcpy(words + 8 * k, made[k].nbr, sizeof(Neighbors));
+#endif
+}
+
+}  // namespace
+
 uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering, Level& next,
-                           bool cull_one_regularity) {
+                           bool cull_one_regularity, ChildLinkRoom room) {
     const uint32_t count = level.refined_count;
     const uint32_t* block = numbering.block_of();
     const uint32_t* refined = level.refined.data();
@@ -130,21 +153,26 @@ uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering
     next.flipped.clear();
     next.refined_count = 0;
     next.resize_state(size_t(4) * count);
-    Neighbors* out = next.nbr.reserve(size_t(4) * count);
+    Neighbors* const out = room.words == nullptr ? next.nbr.reserve(size_t(4) * count) : nullptr;
     BlockEdges* out_edges = next.edges.reserve(count);
-    uint32_t* lowered = next.lowered.reserve(size_t(2) * count);  // each block writes two words
+    uint32_t* lowered = room.words == nullptr ? next.lowered.reserve(size_t(2) * count) : nullptr;  // two words a block
     uint32_t lowered_count = 0;
     const NewBlock* const new_blocks = kNewBlocks.of[cull_one_regularity ? 1 : 0];
     uint8_t* out_state = next.state();
     // Each new vertex has two edge ends: one from each refined node on its edge, or both from one.
     uint64_t counts = 0;  // bits 0-31 the edge ends beyond 3 a block, 32-63 the incomplete nodes
-    with_links(level, [&](auto links) {
+    // In the room, a block's links are made in `made` and copied to its four nodes; no priority
+    // is lowered there, as the room's level is all leaves: its priorities are never read.
+    auto derive = [&](auto links, auto in_room) {
+        Neighbors made[4];
         for (uint32_t b = 0; b < count; ++b) {
             const LevelLinks p = links(refined[b]);
             const uint32_t c = 4 * b;
+            Neighbors* const block_links = decltype(in_room)::value ? made : out + c;
             const unsigned linked = red_split_kernels::write_child_links(
-                out + c, b, block[static_cast<int32_t>(p.nbr[0])], block[static_cast<int32_t>(p.nbr[1])],
+                block_links, b, block[static_cast<int32_t>(p.nbr[0])], block[static_cast<int32_t>(p.nbr[1])],
                 block[static_cast<int32_t>(p.nbr[2])], p.nbr_edge);  // kNoLocal for none
+            if (decltype(in_room)::value) copy_links_to_room(made, room.words + ChildLinkRoom::kStride * c);
             const NewBlock& entry = new_blocks[linked | ((p.flags & 7u) << 3)];
             out_edges[b] = {uint8_t(p.nbr_edge & entry.edge_mask), uint8_t(p.flags & 7)};
             counts += entry.counts;
@@ -156,11 +184,18 @@ uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering
             // Both words always, kept by the count (no branch: which blocks have incomplete
             // corners follows no pattern). memcpy: the words are read as the bytes of out's
             // array.
-            const char* words = reinterpret_cast<const char*>(out + c);
+            if (decltype(in_room)::value) continue;
+            const char* words = reinterpret_cast<const char*>(block_links);
             std::memcpy(lowered + lowered_count, words + entry.lowered_offset[0], 4);
             std::memcpy(lowered + lowered_count + 1, words + entry.lowered_offset[1], 4);
             lowered_count += entry.lowered_count;
         }
+    };
+    with_links(level, [&](auto links) {
+        if (room.words != nullptr)
+            derive(links, std::true_type{});
+        else
+            derive(links, std::false_type{});
     });
     next.incomplete_count = uint32_t(counts >> 32);
     // Those neighbours may lie in blocks written after theirs: lowered once every state is made.

@@ -198,8 +198,11 @@ uint64_t leaf_faces_of_level(const Level& level);
 // With `cull_one_regularity` the incomplete nodes start decided (not refined) and every other
 // node one bucket lower for each incomplete neighbour (NewBlock), as the improved traversal wants
 // them: what the culled nodes' decisions would do to their neighbours, in any order.
+// With `room` (words set, HierarchyBuilder::open_children's), the links go to the room of the
+// nodes they become instead of next.nbr, which is left as it was: a level that only split_level
+// (LevelSplits::links_in_place) reads, the last, needs no array of its own.
 uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering, Level& next,
-                           bool cull_one_regularity);
+                           bool cull_one_regularity, ChildLinkRoom room = {});
 
 // The vertices the splits of a decided, numbered level create (derive_next_level counts them), in
 // canonical order at their first appearance, as Hierarchy::split_level numbers them: f(i, e) for
