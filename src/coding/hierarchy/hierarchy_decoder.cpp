@@ -292,8 +292,11 @@ void HierarchyLevelDecoder::finish_level(bool built_next) {
     }
     // A next level of leaves alone (the stored symbols used up), split now: nothing but the split
     // reads its links, which go straight into the room of its nodes (the last level's links were
-    // an eighth of a decode's peak).
-    const bool links_in_room = built_next && level_.refined_count > 0 && all_leaves_from(level_index_ + 1);
+    // a sixth of a decode's peak). Not when lean: deriving them would fault the nodes in while the
+    // working memory is still there (release_before_build comes after); lean gives the links'
+    // array back after the split instead (lower peaks on the adaptive models, docs/BENCHMARKS.md).
+    const bool lean = lean_ || lean_at_end_;
+    const bool links_in_room = built_next && !lean && level_.refined_count > 0 && all_leaves_from(level_index_ + 1);
     const ChildLinkRoom room =
         links_in_room ? HierarchyBuilder::open_children(*h_, slice_, level_.refined_count) : ChildLinkRoom{};
     level_.new_vertices = derive_next_level(level_, numbering_, next, header_.options.cull_one_regularity, room);
@@ -315,7 +318,7 @@ void HierarchyLevelDecoder::release_before_build() {
         release_links(spare, 0);
         spare.refined.release_from(0);
     }
-    release_links(level_, level_.size());
+    release_links(level_, next_links_in_room_ ? 0 : level_.size());  // in the room: its array is unused
     numbering_.release();
     closures_.release_from(0);
     traversal_.release_working_memory();
