@@ -292,11 +292,14 @@ void HierarchyLevelDecoder::finish_level(bool built_next) {
     }
     // A next level of leaves alone (the stored symbols used up), split now: nothing but the split
     // reads its links, which go straight into the room of its nodes (the last level's links were
-    // a sixth of a decode's peak). Not when lean: deriving them would fault the nodes in while the
-    // working memory is still there (release_before_build comes after); lean gives the links'
-    // array back after the split instead (lower peaks on the adaptive models, docs/BENCHMARKS.md).
+    // a sixth of a decode's peak). Lean, deriving them there faults the nodes in while the
+    // working memory (about 20 bytes a node of this level) is still there, where the links' own
+    // array (12 bytes a node of the next) would have been given back after the split: the room
+    // only where the next level is more than twice this one's size (docs/BENCHMARKS.md).
     const bool lean = lean_ || lean_at_end_;
-    const bool links_in_room = built_next && !lean && level_.refined_count > 0 && all_leaves_from(level_index_ + 1);
+    const uint64_t next_nodes = uint64_t(4) * level_.refined_count;
+    const bool links_in_room =
+        built_next && next_nodes > 0 && all_leaves_from(level_index_ + 1) && (!lean || next_nodes > 2 * uint64_t(level_.size()));
     const ChildLinkRoom room =
         links_in_room ? HierarchyBuilder::open_children(*h_, slice_, level_.refined_count) : ChildLinkRoom{};
     level_.new_vertices = derive_next_level(level_, numbering_, next, header_.options.cull_one_regularity, room);
