@@ -12,7 +12,11 @@ namespace amc::detail {
 
 // The vertex ids in Morton (Z-curve) order of their positions on a 1024^3 grid over the
 // bounding box; vertices of one cell keep their order. Linear (two counting-sort passes).
-// Coordinates must be finite.
-std::vector<uint32_t> spatial_vertex_order(const std::vector<Vec3>& positions);
+// Coordinates must be finite. `sorted_codes`, if given, gets the codes in that order.
+std::vector<uint32_t> spatial_vertex_order(const std::vector<Vec3>& positions,
+                                           std::vector<uint32_t>* sorted_codes = nullptr);
+
+// The 30-bit Morton code of each vertex on that grid (bit 3k + a: bit k of the cell on axis a).
+std::vector<uint32_t> morton_codes(const std::vector<Vec3>& positions);
 
 }  // namespace amc::detail
