@@ -13,17 +13,16 @@
 
 namespace amc {
 
-LeafSearch::LeafSearch(const TriangleMesh& leaf, const std::vector<uint32_t>* insertion_order,
-                       const std::vector<uint32_t>* sorted_codes)
-    : leaf_(leaf), insertion_order_(insertion_order), sorted_codes_(sorted_codes) {}
+LeafSearch::LeafSearch(const TriangleMesh& leaf, const std::vector<uint32_t>* insertion_order)
+    : leaf_(leaf), insertion_order_(insertion_order) {}
 LeafSearch::LeafSearch(LeafSearch& input, const std::vector<uint32_t>& new_id)
-    : leaf_(input.leaf_), insertion_order_(nullptr), sorted_codes_(nullptr), input_(&input), new_id_(&new_id) {}
+    : leaf_(input.leaf_), insertion_order_(nullptr), input_(&input), new_id_(&new_id) {}
 LeafSearch::~LeafSearch() = default;
 
 const NearestVertex& LeafSearch::nearest() {
     if (!nearest_) {
         nearest_ = input_ ? std::make_unique<NearestVertex>(input_->nearest(), *new_id_)
-                          : std::make_unique<NearestVertex>(leaf_.positions, insertion_order_, sorted_codes_);
+                          : std::make_unique<NearestVertex>(leaf_.positions, insertion_order_);
     }
     return *nearest_;
 }

@@ -19,19 +19,16 @@ class ClosestPointQuery;
 class NearestVertex;
 
 // The search trees over the leaf mesh that the position-guided ways use, each built when first
-// needed and then shared by every way of one import (a tree costs about as much to build as a
+// needed and then shared by every way of one import (a k-d tree costs about as much to build as a
 // reconstruction's nearest-vertex queries; a refusal runs six guided ways).
 class LeafSearch {
 public:
-    // The k-d tree takes the vertices in `insertion_order` (NearestVertex), if given;
-    // `sorted_codes`, if given, are the Morton codes of the leaf mesh's vertices, which are in
-    // that order (spatial_order.h).
-    explicit LeafSearch(const TriangleMesh& leaf, const std::vector<uint32_t>* insertion_order = nullptr,
-                        const std::vector<uint32_t>* sorted_codes = nullptr);
+    // The k-d tree takes the vertices in `insertion_order` (NearestVertex), if given.
+    explicit LeafSearch(const TriangleMesh& leaf, const std::vector<uint32_t>* insertion_order = nullptr);
     // The searches of `input` on its mesh renumbered (`new_id`: input id -> this numbering, the
     // positions and faces otherwise the same): the surface tree is input's (closest points do not
-    // depend on the numbering), the nearest-vertex search input's with its ids mapped (the same
-    // points in the same order answer the same); neither is built a second time.
+    // depend on the numbering), the k-d tree input's with its ids mapped (the same points in the
+    // same order answer the same); neither is built a second time.
     LeafSearch(LeafSearch& input, const std::vector<uint32_t>& new_id);
     ~LeafSearch();
     const NearestVertex& nearest();
@@ -40,7 +37,6 @@ public:
 private:
     const TriangleMesh& leaf_;
     const std::vector<uint32_t>* insertion_order_;
-    const std::vector<uint32_t>* sorted_codes_;
     LeafSearch* input_ = nullptr;                 // the searches this one renumbers, if any
     const std::vector<uint32_t>* new_id_ = nullptr;
     std::unique_ptr<NearestVertex> nearest_;

@@ -7,30 +7,30 @@
 
 namespace amc {
 
-NearestVertex::NearestVertex(const std::vector<Vec3>& positions, const std::vector<uint32_t>* insertion_order,
-                             const std::vector<uint32_t>* sorted_codes)
+NearestVertex::NearestVertex(const std::vector<Vec3>& positions, const std::vector<uint32_t>* insertion_order)
     : positions_(&positions), insertion_order_(insertion_order) {
     const uint32_t n = uint32_t(positions.size());
     if (n == 0) return;
-    std::vector<uint32_t> order, codes;
-    if (!sorted_codes) {
-        order = detail::spatial_vertex_order(positions, &codes);
-        sorted_codes = &codes;
-    }
+    // Cubic cells: on a flat mesh moved off its plane, per-axis cells would split first on the
+    // noise of the thin axis, whose gaps prune nothing.
+    const std::vector<uint32_t> code = detail::morton_codes(positions, true);
+    const std::vector<uint32_t> order = detail::order_by_codes(code);
+    std::vector<uint32_t> sorted_codes(n);
     points_.reserve(n);
     advise_huge_pages(points_.data(), points_.capacity() * sizeof(Point));  // each query reads a few buckets
     for (uint32_t i = 0; i < n; ++i) {
-        const uint32_t v = order.empty() ? i : order[i];
+        const uint32_t v = order[i];
         points_.push_back({{positions[v].x, positions[v].y, positions[v].z}, v});
+        sorted_codes[i] = code[v];
     }
     nodes_.reserve(size_t(4) * (n / kBucket + 1));
-    build_node(*sorted_codes, 0, n, 0);
+    build_node(sorted_codes, 0, n, 0);
 }
 
 NearestVertex::Box NearestVertex::build_node(const std::vector<uint32_t>& codes, uint32_t begin, uint32_t end,
                                              int depth) {
     const uint32_t index = uint32_t(nodes_.size());
-    nodes_.push_back({0, 0, begin, end, kNoIndex, kNoAxis});
+    nodes_.push_back({0, 0, begin, end, kNoIndex, 0});
     if (end - begin <= kBucket || depth >= kMaxDepth) {
         Box box;
         for (int a = 0; a < 3; ++a) box.low[a] = box.high[a] = points_[begin].x[a];
@@ -43,14 +43,32 @@ NearestVertex::Box NearestVertex::build_node(const std::vector<uint32_t>& codes,
         return box;
     }
     const uint32_t differ = codes[begin] ^ codes[end - 1];
-    uint32_t split = begin + (end - begin) / 2;  // one cell: halved
-    uint32_t axis = kNoAxis;
+    uint32_t split, axis;
     if (differ != 0) {
         const int bit = 31 - __builtin_clz(differ);  // the codes agree above it
         axis = uint32_t(bit % 3);                    // spatial_order.cpp: bit 3k + a is axis a's
         split = uint32_t(std::partition_point(codes.begin() + begin, codes.begin() + end,
                                               [bit](uint32_t c) { return !(c >> bit & 1); }) -
                          codes.begin());
+    } else {
+        // One grid cell (a strongly graded mesh crowds thousands of vertices into one): split at
+        // the median of its largest extent, as a k-d tree does (the order inside a cell does not
+        // matter, ties being the k-d tree's to answer).
+        double low[3], high[3];
+        for (int a = 0; a < 3; ++a) low[a] = high[a] = points_[begin].x[a];
+        for (uint32_t i = begin + 1; i < end; ++i) {
+            for (int a = 0; a < 3; ++a) {
+                low[a] = std::min(low[a], points_[i].x[a]);
+                high[a] = std::max(high[a], points_[i].x[a]);
+            }
+        }
+        axis = 0;
+        for (uint32_t a = 1; a < 3; ++a) {
+            if (high[a] - low[a] > high[axis] - low[axis]) axis = a;
+        }
+        split = begin + (end - begin) / 2;
+        std::nth_element(points_.begin() + begin, points_.begin() + split, points_.begin() + end,
+                         [axis](const Point& a, const Point& b) { return a.x[axis] < b.x[axis]; });
     }
     const Box first = build_node(codes, begin, split, depth + 1);
     const uint32_t second_index = uint32_t(nodes_.size());
@@ -58,10 +76,8 @@ NearestVertex::Box NearestVertex::build_node(const std::vector<uint32_t>& codes,
     Node& node = nodes_[index];
     node.second = second_index;
     node.axis = axis;
-    if (axis != kNoAxis) {
-        node.below = first.high[axis];
-        node.above = second.low[axis];
-    }
+    node.below = first.high[axis];
+    node.above = second.low[axis];
     Box box;
     for (int a = 0; a < 3; ++a) {
         box.low[a] = std::min(first.low[a], second.low[a]);

@@ -125,12 +125,10 @@ public:
         std::vector<double> split_;
     };
 
-    // The k-d tree takes the points in `insertion_order` (KdTree). `sorted_codes`, if given, are
-    // the positions' Morton codes (spatial_order.h), the positions being in that order; otherwise
-    // they are computed and sorted. `positions` and `insertion_order` must outlive this object
-    // (the k-d tree is built from them when a tie first calls for it).
-    explicit NearestVertex(const std::vector<Vec3>& positions, const std::vector<uint32_t>* insertion_order = nullptr,
-                           const std::vector<uint32_t>* sorted_codes = nullptr);
+    // The k-d tree takes the points in `insertion_order` (KdTree). `positions` and
+    // `insertion_order` must outlive this object (the k-d tree is built from them when a tie
+    // first calls for it).
+    explicit NearestVertex(const std::vector<Vec3>& positions, const std::vector<uint32_t>* insertion_order = nullptr);
     // `other`'s searches with every vertex v named new_id[v]: what a build over the same positions
     // renumbered, inserted in other's order, makes, without the build. `other` and new_id must
     // outlive this object (other's k-d tree, if a tie calls for it, is built once and renamed).
@@ -163,16 +161,16 @@ public:
 private:
     // The Morton tree over points_ in Morton order: a node is a range of points whose codes share
     // a prefix, split where the next bit of the codes changes, so into the two halves of its cell
-    // along that bit's axis: every point of the first child lies below every point of the second
-    // on it. A cell holding more than a bucket is halved without an axis. A leaf holds at most
-    // kBucket points. Nodes in depth-first order: a node's first child follows it.
+    // along that bit's axis: every point of the first child lies at or below every point of the
+    // second on it. A cell holding more than a bucket is split at its median, as a k-d tree
+    // splits. A leaf holds at most kBucket points. Nodes in depth-first order: a node's first
+    // child follows it.
     struct Node {
         double below, above;  // the first child's greatest and the second's least coordinate on the axis
         uint32_t begin, end;  // its points
         uint32_t second;      // its second child; kNoIndex for a leaf
-        uint32_t axis;        // 0-2; kNoAxis where the children share a cell
+        uint32_t axis;
     };
-    static constexpr uint32_t kNoAxis = 3;
     static constexpr int kMaxDepth = 62;  // 30 code bits, then halvings
 
     // Depth first, the nearer child first, as the k-d tree searches, with a stack instead of calls.
@@ -193,10 +191,6 @@ private:
                     const double d = squared_distance(points_[i], p);
                     if (best.matters(d) && usable(points_[i].vertex)) best.offer(points_[i].vertex, d);
                 }
-            } else if (node.axis == kNoAxis) {
-                stack[top++] = {node.second, 0.0};
-                ++index;
-                continue;
             } else {
                 // The gap to each child on the axis, rounded as a coordinate difference is, then
                 // squared: both monotone, so no point of the child is nearer.

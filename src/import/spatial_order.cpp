@@ -20,7 +20,7 @@ uint32_t spread_bits(uint32_t x) {
 
 }  // namespace
 
-std::vector<uint32_t> morton_codes(const std::vector<Vec3>& positions) {
+std::vector<uint32_t> morton_codes(const std::vector<Vec3>& positions, bool cubic_cells) {
     const uint32_t n = uint32_t(positions.size());
     std::vector<uint32_t> code(n);
     if (n == 0) return code;
@@ -33,8 +33,9 @@ std::vector<uint32_t> morton_codes(const std::vector<Vec3>& positions) {
         }
     }
     double scale[3];
+    const double largest = std::max({high[0] - low[0], high[1] - low[1], high[2] - low[2]});
     for (int a = 0; a < 3; ++a) {
-        const double extent = high[a] - low[a];  // may overflow to infinity: scale 0, one cell
+        const double extent = cubic_cells ? largest : high[a] - low[a];  // may overflow to infinity: scale 0, one cell
         scale[a] = extent > 0 ? double(kCellsPerAxis) / extent : 0;
     }
     for (uint32_t v = 0; v < n; ++v) {
@@ -50,11 +51,14 @@ std::vector<uint32_t> morton_codes(const std::vector<Vec3>& positions) {
     return code;
 }
 
-std::vector<uint32_t> spatial_vertex_order(const std::vector<Vec3>& positions, std::vector<uint32_t>* sorted_codes) {
-    const uint32_t n = uint32_t(positions.size());
+std::vector<uint32_t> spatial_vertex_order(const std::vector<Vec3>& positions) {
+    return order_by_codes(morton_codes(positions, false));
+}
+
+std::vector<uint32_t> order_by_codes(const std::vector<uint32_t>& code) {
+    const uint32_t n = uint32_t(code.size());
     std::vector<uint32_t> order(n);
     if (n == 0) return order;
-    const std::vector<uint32_t> code = morton_codes(positions);
     // Least significant half first; each pass is stable.
     constexpr uint32_t kBuckets = 1u << 15;
     std::vector<uint32_t> count(kBuckets + 1), scratch(n);
@@ -69,10 +73,6 @@ std::vector<uint32_t> spatial_vertex_order(const std::vector<Vec3>& positions, s
     };
     pass(nullptr, scratch.data(), 0, true);
     pass(scratch.data(), order.data(), 15, false);
-    if (sorted_codes) {
-        sorted_codes->resize(n);
-        for (uint32_t i = 0; i < n; ++i) (*sorted_codes)[i] = code[order[i]];
-    }
     return order;
 }
 
