@@ -34,15 +34,24 @@ namespace amc_bench {
 namespace {
 
 // Runs `step` `runs` times and returns the median time; `step` keeps its last output itself.
-template <class Step>
-double median_seconds(int runs, Step&& step) {
+// `release`, untimed before each step, gives back the output of the step before: a decode then
+// reuses that memory, as a program that decodes file after file does, instead of having fresh
+// pages faulted in while the last output is still held (12-16 us a 4 KiB page on the project's VM:
+// on uniform that set the 12-bit figure, docs/BENCHMARKS.md "One core").
+template <class Step, class Release>
+double median_seconds(int runs, Step&& step, Release&& release) {
     std::vector<double> samples;
     for (int r = 0; r < runs; ++r) {
+        release();
         const Clock::time_point start = Clock::now();
         step();
         samples.push_back(seconds_since(start));
     }
     return median(samples);
+}
+template <class Step>
+double median_seconds(int runs, Step&& step) {
+    return median_seconds(runs, step, [] {});
 }
 
 struct Model {
@@ -94,7 +103,7 @@ void measure_general_coders(const Model& m, int runs, std::vector<Result>& out) 
         Result r = make_result(m, coder.id, "connectivity");
         std::vector<uint8_t> packed, unpacked;
         r.encode_seconds = median_seconds(runs, [&] { packed = coder.encode(m.indices.data(), raw_size); });
-        r.decode_seconds = median_seconds(runs, [&] { unpacked = coder.decode(packed, raw_size); });
+        r.decode_seconds = median_seconds(runs, [&] { unpacked = coder.decode(packed, raw_size); }, [&] { unpacked = {}; });
         r.bytes = packed.size();
         const bool same = unpacked.size() == raw_size && std::memcmp(unpacked.data(), m.indices.data(), raw_size) == 0;
         r.check = same ? "ok" : "decoded index buffer differs";
@@ -110,9 +119,12 @@ void measure_general_coders(const Model& m, int runs, std::vector<Result>& out) 
             packed = meshopt_encode(m.indices, vertex_count);
             if (with_zstd) packed = zstd_compress(packed.data(), packed.size(), 19);
         });
-        r.decode_seconds = median_seconds(runs, [&] {
-            indices = with_zstd ? meshopt_decode(zstd_decompress(packed), m.indices.size()) : meshopt_decode(packed, m.indices.size());
-        });
+        r.decode_seconds = median_seconds(
+            runs,
+            [&] {
+                indices = with_zstd ? meshopt_decode(zstd_decompress(packed), m.indices.size()) : meshopt_decode(packed, m.indices.size());
+            },
+            [&] { indices = {}; });
         r.bytes = packed.size();
         std::vector<amc::Triangle> faces(indices.size() / 3);
         for (size_t f = 0; f < faces.size(); ++f) faces[f] = {indices[3 * f], indices[3 * f + 1], indices[3 * f + 2]};
@@ -161,6 +173,7 @@ void measure_draco(const Model& m, int runs, bool kept_encoders, std::vector<Res
                     }
                 }
                 for (int run = 0; run < runs; ++run) {
+                    decoded = {};  // as median_seconds' release
                     decoded = draco_decode(encoded.bytes);
                     decode_times.push_back(decoded.seconds);
                     connectivity_decode.push_back(decoded.connectivity_seconds);
@@ -252,7 +265,7 @@ void measure_amcodec(const Model& m, int runs, bool kept_encoders, std::vector<R
                 file = kept_encoders ? amc::encode(context, m.hierarchy, options, &stats) : amc::encode(m.hierarchy, options, &stats);
             });
         }
-        r.decode_seconds = median_seconds(runs, [&] { back = amc::decode(file.data(), file.size(), decode_options); });
+        r.decode_seconds = median_seconds(runs, [&] { back = amc::decode(file.data(), file.size(), decode_options); }, [&] { back = {}; });
         r.bytes = file.size();
         r.max_error = stats.max_error;
         // In the file, hierarchy symbols and positions share one arithmetic code per level; the
@@ -297,7 +310,7 @@ void measure_amcodec(const Model& m, int runs, bool kept_encoders, std::vector<R
             imported = amc::in_decoder_order(amc::import_mesh(m.leaf, m.name).hierarchy);
             stream = amc::encode_hierarchy(imported, amc::EncodeOptions{}.hierarchy);
         });
-        r.decode_seconds = median_seconds(runs, [&] { back = amc::decode_hierarchy(imported.base(), stream.data(), stream.size()); });
+        r.decode_seconds = median_seconds(runs, [&] { back = amc::decode_hierarchy(imported.base(), stream.data(), stream.size()); }, [&] { back = {}; });
         amc::encode(imported, {}, &stats);
         r.bytes = stats.base_connectivity_bytes + stream.size();
         r.base_triangles = imported.root_count();
@@ -326,7 +339,7 @@ void measure_amcodec(const Model& m, int runs, bool kept_encoders, std::vector<R
         std::vector<uint8_t> stream;
         amc::Hierarchy back;
         r.encode_seconds = median_seconds(runs, [&] { stream = amc::encode_hierarchy(m.expected, mode.options); });
-        r.decode_seconds = median_seconds(runs, [&] { back = amc::decode_hierarchy(m.expected.base(), stream.data(), stream.size()); });
+        r.decode_seconds = median_seconds(runs, [&] { back = amc::decode_hierarchy(m.expected.base(), stream.data(), stream.size()); }, [&] { back = {}; });
         r.bytes = base_connectivity_bytes + stream.size();
         const amc::TriangleMesh got = amc::extract_leaf_mesh(back).mesh;
         r.check = got.triangles == expected_leaf.triangles ? "ok" : "decoded leaf mesh connectivity differs";
