@@ -1,5 +1,6 @@
 // The nearest-vertex search of the position-guided import (src/import/nearest_vertex.h) against
-// a brute-force scan: the same vertex for every query, on uniform and strongly graded point sets.
+// a brute-force scan: the same vertex for every query, on uniform and strongly graded point sets;
+// and, where vertices lie equally near, against the k-d tree whose order the import's answers follow.
 #include "import/nearest_vertex.h"
 
 #include <gtest/gtest.h>
@@ -7,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <numeric>
 #include <vector>
 
@@ -109,6 +111,75 @@ TEST(NearestVertex, RenamedTreeAnswersAsABuildOverTheRenumberedPoints) {
         ASSERT_EQ(na, nb) << "query " << query;
         for (uint32_t i = 0; i < na; ++i) EXPECT_EQ(a[i], b[i]) << "query " << query << ", rank " << i;
         EXPECT_EQ(built.find(p, usable), renamed.find(p, usable)) << "query " << query;
+    }
+}
+
+// Lattice points (many vertices equally near a query), taken into the k-d tree in a shuffled
+// order: the search answers as the k-d tree alone does, nearest first and the first found of
+// equally near ones, for every count and with a distance limit. Where no two answers tie, the
+// Morton tree answers; so that the k-d tree's turn is tested, many queries must tie.
+TEST(NearestVertex, EquallyNearVerticesComeInTheKdTreesOrder) {
+    Lcg random{31};
+    std::vector<amc::Vec3> points;
+    for (int i = 0; i < 30; ++i) {
+        for (int j = 0; j < 30; ++j) points.push_back({double(i), double(j), double((i * 7 + j * 3) % 4)});
+    }
+    std::vector<uint32_t> order(points.size());
+    std::iota(order.begin(), order.end(), 0u);
+    for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[size_t(random.unit() * double(i))]);
+    const amc::NearestVertex nearest(points, &order);
+    const amc::NearestVertex::KdTree kd_tree(points, &order);
+    auto usable = [](uint32_t v) { return v % 7 != 3; };
+    int tied = 0;
+    for (int query = 0; query < 400; ++query) {
+        const amc::Vec3 p = {std::floor(31 * random.unit()) - 0.5 * (query % 2), std::floor(31 * random.unit()),
+                             1.5 + 0.5 * (query % 3)};
+        for (uint32_t k : {1u, 2u, 4u, amc::NearestVertex::kMaxCount}) {
+            for (double limit : {std::numeric_limits<double>::infinity(), 6.25}) {
+                uint32_t a[amc::NearestVertex::kMaxCount], b[amc::NearestVertex::kMaxCount];
+                const uint32_t na = nearest.find_nearest(p, usable, k, a, limit);
+                const uint32_t nb = kd_tree.find_nearest(p, usable, k, b, limit);
+                ASSERT_EQ(na, nb) << "query " << query << ", k " << k;
+                for (uint32_t i = 0; i < na; ++i) EXPECT_EQ(a[i], b[i]) << "query " << query << ", k " << k << ", rank " << i;
+                // A tie within the answer, or with the first vertex left out of it.
+                uint32_t c[amc::NearestVertex::kMaxCount];
+                const uint32_t more = kd_tree.find_nearest(p, usable, std::min(k + 1, amc::NearestVertex::kMaxCount), c, limit);
+                for (uint32_t i = 1; i < more; ++i) {
+                    const amc::Vec3 d0 = points[c[i - 1]] - p, d1 = points[c[i]] - p;
+                    if (amc::dot(d0, d0) == amc::dot(d1, d1)) {
+                        ++tied;
+                        break;
+                    }
+                }
+            }
+        }
+    }
+    EXPECT_GT(tied, 1000);
+}
+
+// More points in one grid cell of the Morton order than a bucket holds (a cluster far from the
+// rest): the search still finds what a sort finds.
+TEST(NearestVertex, CrowdedCellsAreSearchedAsTheRest) {
+    Lcg random{41};
+    std::vector<amc::Vec3> points;
+    for (int i = 0; i < 200; ++i) points.push_back({1e-9 * random.unit(), 1e-9 * random.unit(), 1e-9 * random.unit()});
+    for (int i = 0; i < 200; ++i) points.push_back({random.unit(), random.unit(), random.unit()});
+    const amc::NearestVertex nearest(points);
+    for (int query = 0; query < 300; ++query) {
+        const amc::Vec3 p = query % 2 ? amc::Vec3{2e-9 * random.unit(), 1e-9 * random.unit(), 0}
+                                      : amc::Vec3{random.unit(), random.unit(), random.unit()};
+        auto usable = [](uint32_t v) { return v % 3 != 0; };
+        std::vector<uint32_t> sorted;
+        for (uint32_t v = 0; v < points.size(); ++v) {
+            if (usable(v)) sorted.push_back(v);
+        }
+        std::stable_sort(sorted.begin(), sorted.end(), [&](uint32_t a, uint32_t b) {
+            return amc::dot(points[a] - p, points[a] - p) < amc::dot(points[b] - p, points[b] - p);
+        });
+        uint32_t found[amc::NearestVertex::kMaxCount];
+        const uint32_t n = nearest.find_nearest(p, usable, amc::NearestVertex::kMaxCount, found);
+        ASSERT_EQ(n, amc::NearestVertex::kMaxCount);
+        for (uint32_t i = 0; i < n; ++i) EXPECT_EQ(found[i], sorted[i]) << "query " << query << ", rank " << i;
     }
 }
 

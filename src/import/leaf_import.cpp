@@ -131,20 +131,23 @@ struct RenumberedLeaf {
 // `input_of` names leaf vertices in messages.
 void verify_leaf_mesh(const Hierarchy& h, const std::vector<uint32_t>& leaf_of_vertex, const TriangleMesh& leaf,
                       const LeafHalfedges& halfedges, const std::vector<uint32_t>& input_of, const std::string& what) {
-    std::vector<uint8_t> used(leaf.triangles.size(), 0);
+    // A bit per face: the faces come in the input's order, so each mark is a random access, and
+    // 128 KiB per 10^6 faces stay in the cache where a byte each did not.
+    std::vector<uint64_t> used((leaf.triangles.size() + 63) / 64, 0);
     auto leaf_vertex = [&](VertexId v) { return v < leaf_of_vertex.size() ? leaf_of_vertex[v] : kNoIndex; };
     auto vertex_text = [&](uint32_t l) { return std::to_string(l == kNoIndex ? l : input_of[l]); };
     for_each_leaf_triangle(h, h.breadth_first_order(), -1, [&](NodeId, VertexId x, VertexId y, VertexId z, bool) {
         const uint32_t a = leaf_vertex(x), b = leaf_vertex(y), c = leaf_vertex(z);
         const LeafHalfedges::Edge e = (a == kNoIndex || b == kNoIndex) ? LeafHalfedges::Edge{} : halfedges.edge(a, b);
         const uint32_t f = e.face;
-        if (f == kNoIndex || e.apex != c || used[f])
+        if (f == kNoIndex || e.apex != c || (used[f / 64] >> (f % 64) & 1))
             fail(what, "the reconstruction has a triangle (" + vertex_text(a) + ", " + vertex_text(b) + ", " +
                            vertex_text(c) + ") that is not a face of the leaf mesh");
-        used[f] = 1;
+        used[f / 64] |= uint64_t(1) << (f % 64);
     });
-    for (size_t f = 0; f < used.size(); ++f) {
-        if (!used[f]) fail(what, "face " + std::to_string(f) + " is not part of a red-green refinement of the base");
+    for (size_t f = 0; f < leaf.triangles.size(); ++f) {
+        if (!(used[f / 64] >> (f % 64) & 1))
+            fail(what, "face " + std::to_string(f) + " is not part of a red-green refinement of the base");
     }
 }
 

@@ -1,6 +1,12 @@
-// Nearest vertex to a point among those a predicate accepts: a k-d tree over the leaf vertices,
-// which adapts to the density of an adaptive mesh (a uniform grid scans hundreds of vertices per
-// cell where the mesh is fine and many empty cells where it is coarse).
+// Nearest vertex to a point among those a predicate accepts, over the leaf vertices of an
+// adaptive mesh (a uniform grid scans hundreds of vertices per cell where the mesh is fine and
+// many empty cells where it is coarse).
+//
+// Two trees answer alike. A tree over the vertices in Morton order, built in one pass from their
+// codes, answers every query whose nearest usable vertices lie at distinct distances. Where two
+// lie at the same distance, which one is found first decides, and the import has always taken
+// the first in a k-d tree built from the vertices in a given order: that tree is built on the
+// first such query only, and answers it (docs/IMPORT.md, "Complexity and speed").
 #pragma once
 
 #include "common/exact_float.h"
@@ -10,58 +16,40 @@
 
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <vector>
 
 namespace amc {
 
 class NearestVertex {
-public:
-    // The tree is built from the points in `insertion_order` (vertex ids; null: 0, 1, ...): its
-    // shape, and so which of two equally near vertices is found first, follows that order.
-    explicit NearestVertex(const std::vector<Vec3>& positions, const std::vector<uint32_t>* insertion_order = nullptr);
-    // `other`'s tree with every vertex v named new_id[v]: what a build over the same positions
-    // renumbered, inserted in other's order, makes, without the build.
-    NearestVertex(const NearestVertex& other, const std::vector<uint32_t>& new_id);
-
-    // The vertex nearest to p among those for which usable(v) holds (tested only on vertices
-    // nearer than the best so far: it may cost more than a distance); kNoIndex when none is.
-    template <class Usable>
-    uint32_t find(Vec3 p, Usable usable) const {
-        Nearest best(1);
-        if (!points_.empty()) search(p, usable, 0, 0, uint32_t(points_.size()), best);
-        return best.count == 0 ? kNoIndex : best.vertex[0];
-    }
-
-    static constexpr uint32_t kMaxCount = 8;
-
-    // The up to `count` (at most kMaxCount) usable vertices nearest to p, nearest first, into
-    // `out`; returns how many there are.
-    // Only vertices nearer than sqrt(max_squared_distance) count: where none is usable, the
-    // search stops there instead of visiting the whole tree.
-    template <class Usable>
-    uint32_t find_nearest(Vec3 p, Usable usable, uint32_t count, uint32_t* out,
-                          double max_squared_distance = std::numeric_limits<double>::infinity()) const {
-        Nearest best(count < kMaxCount ? count : kMaxCount);
-        best.limit = max_squared_distance;
-        if (!points_.empty() && best.wanted > 0) search(p, usable, 0, 0, uint32_t(points_.size()), best);
-        for (uint32_t i = 0; i < best.count; ++i) out[i] = best.vertex[i];
-        return best.count;
-    }
-
-private:
-    static constexpr uint32_t kBucket = 16;  // points in a leaf of the tree
+    static constexpr uint32_t kBucket = 16;  // points in a leaf of either tree
     struct Point {
         double x[3];
         uint32_t vertex;
     };
-    // The nearest usable vertices found so far, nearest first (squared distances).
+    static double squared_distance(const Point& q, Vec3 p) {
+        const double dx = q.x[0] - p.x, dy = q.x[1] - p.y, dz = q.x[2] - p.z;
+        return exact_dot({dx, dy, dz}, {dx, dy, dz});  // the same pick in every build
+    }
+
+public:
+    static constexpr uint32_t kMaxCount = 8;
+
+private:
+    // The nearest usable vertices found so far, nearest first (squared distances). The k-d tree
+    // keeps the first found of equally near ones; the Morton tree notes the least distance at
+    // which it met two usable vertices (`tie`) instead.
     struct Nearest {
-        explicit Nearest(uint32_t n) : wanted(n) {}
+        explicit Nearest(uint32_t n, double max_squared_distance)
+            : wanted(n < kMaxCount ? n : kMaxCount), limit(max_squared_distance) {}
         uint32_t wanted, count = 0;
-        double limit = std::numeric_limits<double>::infinity();
+        double limit;
+        double tie = std::numeric_limits<double>::infinity();
         uint32_t vertex[kMaxCount];
         double distance[kMaxCount];
         bool improves(double d) const { return count < wanted ? d < limit : d < distance[count - 1]; }
+        // Whether a vertex at squared distance d may change the answer or tie with it.
+        bool matters(double d) const { return count < wanted ? d < limit : d <= distance[count - 1]; }
         void insert(uint32_t v, double d) {
             uint32_t i = count < wanted ? count++ : count - 1;
             for (; i > 0 && distance[i - 1] > d; --i) {
@@ -71,37 +59,174 @@ private:
             vertex[i] = v;
             distance[i] = d;
         }
+        // A usable vertex at d, where matters(d): a tie when a listed one is as near.
+        void offer(uint32_t v, double d) {
+            for (uint32_t i = 0; i < count; ++i) {
+                if (distance[i] == d) {
+                    if (d < tie) tie = d;
+                    return;
+                }
+            }
+            insert(v, d);
+        }
+        // Whether the answer has two vertices at one distance, or one as near as the last listed:
+        // then the order of the search decides it.
+        bool tied() const { return count < wanted ? tie < limit : count > 0 && tie <= distance[count - 1]; }
+        uint32_t copy_to(uint32_t* out) const {
+            for (uint32_t i = 0; i < count; ++i) out[i] = vertex[i];
+            return count;
+        }
     };
 
-    void build(uint32_t node, uint32_t lo, uint32_t hi);
-
-    template <class Usable>
-    void search(Vec3 p, Usable& usable, uint32_t node, uint32_t lo, uint32_t hi, Nearest& best) const {
-        if (hi - lo <= kBucket) {
-            for (uint32_t i = lo; i < hi; ++i) {
-                const Point& q = points_[i];
-                const double dx = q.x[0] - p.x, dy = q.x[1] - p.y, dz = q.x[2] - p.z;
-                const double distance = exact_dot({dx, dy, dz}, {dx, dy, dz});  // the same pick in every build
-                if (best.improves(distance) && usable(q.vertex)) best.insert(q.vertex, distance);
-            }
-            return;
+public:
+    // The k-d tree alone: the points split at their median along the axis of the largest extent,
+    // taken in `insertion_order` (vertex ids; null: 0, 1, ...), so which of two equally near
+    // vertices it finds first follows that order.
+    class KdTree {
+    public:
+        KdTree(const std::vector<Vec3>& positions, const std::vector<uint32_t>* insertion_order);
+        // `other` with every vertex v named new_id[v].
+        KdTree(const KdTree& other, const std::vector<uint32_t>& new_id);
+        // As NearestVertex::find_nearest.
+        template <class Usable>
+        uint32_t find_nearest(Vec3 p, Usable usable, uint32_t count, uint32_t* out,
+                              double max_squared_distance = std::numeric_limits<double>::infinity()) const {
+            Nearest best(count, max_squared_distance);
+            if (!points_.empty() && best.wanted > 0) search(p, usable, 0, 0, uint32_t(points_.size()), best);
+            return best.copy_to(out);
         }
-        const uint32_t mid = lo + (hi - lo) / 2;
-        const int axis = axis_[node];
-        const double coordinate = axis == 0 ? p.x : axis == 1 ? p.y : p.z;
-        const double offset = coordinate - split_[node];
-        // Points left of mid lie at or below its coordinate on the axis, points from mid on at or above.
-        const bool left_first = offset < 0;
-        search(p, usable, 2 * node + (left_first ? 1 : 2), left_first ? lo : mid, left_first ? mid : hi, best);
-        if (best.improves(offset * offset))
-            search(p, usable, 2 * node + (left_first ? 2 : 1), left_first ? mid : lo, left_first ? hi : mid, best);
+
+    private:
+        template <class Usable>
+        void search(Vec3 p, Usable& usable, uint32_t node, uint32_t lo, uint32_t hi, Nearest& best) const {
+            if (hi - lo <= kBucket) {
+                for (uint32_t i = lo; i < hi; ++i) {
+                    const Point& q = points_[i];
+                    const double distance = squared_distance(q, p);
+                    if (best.improves(distance) && usable(q.vertex)) best.insert(q.vertex, distance);
+                }
+                return;
+            }
+            const uint32_t mid = lo + (hi - lo) / 2;
+            const int axis = axis_[node];
+            const double coordinate = axis == 0 ? p.x : axis == 1 ? p.y : p.z;
+            const double offset = coordinate - split_[node];
+            // Points left of mid lie at or below its coordinate on the axis, points from mid on at or above.
+            const bool left_first = offset < 0;
+            search(p, usable, 2 * node + (left_first ? 1 : 2), left_first ? lo : mid, left_first ? mid : hi, best);
+            if (best.improves(offset * offset))
+                search(p, usable, 2 * node + (left_first ? 2 : 1), left_first ? mid : lo, left_first ? hi : mid, best);
+        }
+        void build(uint32_t node, uint32_t lo, uint32_t hi);
+        std::vector<Point> points_;  // in tree order
+        // Split axis and coordinate of each inner node, heap-numbered (children 2i+1, 2i+2); the
+        // children's builds reorder the points, so the split point's coordinate is kept here.
+        std::vector<uint8_t> axis_;
+        std::vector<double> split_;
+    };
+
+    // The k-d tree takes the points in `insertion_order` (KdTree). `positions` and
+    // `insertion_order` must outlive this object (the k-d tree is built from them when a tie
+    // first calls for it).
+    explicit NearestVertex(const std::vector<Vec3>& positions, const std::vector<uint32_t>* insertion_order = nullptr);
+    // `other`'s searches with every vertex v named new_id[v]: what a build over the same positions
+    // renumbered, inserted in other's order, makes, without the build. `other` and new_id must
+    // outlive this object (other's k-d tree, if a tie calls for it, is built once and renamed).
+    NearestVertex(const NearestVertex& other, const std::vector<uint32_t>& new_id);
+    ~NearestVertex();
+
+    // The vertex nearest to p among those for which usable(v) holds (tested only on vertices as
+    // near as the best so far or nearer: it may cost more than a distance; it must change
+    // nothing); kNoIndex when none is.
+    template <class Usable>
+    uint32_t find(Vec3 p, Usable usable) const {
+        uint32_t found = kNoIndex;
+        find_nearest(p, usable, 1, &found);
+        return found;
     }
 
-    std::vector<Point> points_;  // in tree order
-    // Split axis and coordinate of each inner node, heap-numbered (children 2i+1, 2i+2); the
-    // children's builds reorder the points, so the split point's coordinate is kept here.
-    std::vector<uint8_t> axis_;
-    std::vector<double> split_;
+    // The up to `count` (at most kMaxCount) usable vertices nearest to p, nearest first, into
+    // `out`; returns how many there are.
+    // Only vertices nearer than sqrt(max_squared_distance) count: where none is usable, the
+    // search stops there instead of visiting the whole tree.
+    template <class Usable>
+    uint32_t find_nearest(Vec3 p, Usable usable, uint32_t count, uint32_t* out,
+                          double max_squared_distance = std::numeric_limits<double>::infinity()) const {
+        Nearest best(count, max_squared_distance);
+        if (!points_.empty() && best.wanted > 0) search(p, usable, best);
+        if (best.tied()) return kd_tree().find_nearest(p, usable, count, out, max_squared_distance);
+        return best.copy_to(out);
+    }
+
+private:
+    // The Morton tree over points_ in Morton order: a node is a range of points whose codes share
+    // a prefix, split where the next bit of the codes changes, so into the two halves of its cell
+    // along that bit's axis: every point of the first child lies at or below every point of the
+    // second on it. A cell holding more than a bucket is split at its median, as a k-d tree
+    // splits. A leaf holds at most kBucket points. Nodes in depth-first order: a node's first
+    // child follows it.
+    struct Node {
+        double below, above;  // the first child's greatest and the second's least coordinate on the axis
+        uint32_t begin, end;  // its points
+        uint32_t second;      // its second child; kNoIndex for a leaf
+        uint32_t axis;
+    };
+    static constexpr int kMaxDepth = 62;  // 30 code bits, then halvings
+
+    // Depth first, the nearer child first, as the k-d tree searches, with a stack instead of calls.
+    template <class Usable>
+    void search(Vec3 p, Usable& usable, Nearest& best) const {
+        const double q[3] = {p.x, p.y, p.z};
+        struct Pending {
+            uint32_t node;
+            double gap;  // a lower bound of its points' squared distances
+        };
+        Pending stack[kMaxDepth + 1];
+        int top = 0;
+        uint32_t index = 0;
+        for (;;) {
+            const Node& node = nodes_[index];
+            if (node.second == kNoIndex) {
+                for (uint32_t i = node.begin; i < node.end; ++i) {
+                    const double d = squared_distance(points_[i], p);
+                    if (best.matters(d) && usable(points_[i].vertex)) best.offer(points_[i].vertex, d);
+                }
+            } else {
+                // The gap to each child on the axis, rounded as a coordinate difference is, then
+                // squared: both monotone, so no point of the child is nearer.
+                const double c = q[node.axis];
+                const double to_first = c > node.below ? c - node.below : 0.0;
+                const double to_second = c < node.above ? node.above - c : 0.0;
+                const bool first_nearer = to_first <= to_second;
+                const double far_gap = first_nearer ? to_second * to_second : to_first * to_first;
+                if (best.matters(far_gap)) stack[top++] = {first_nearer ? node.second : index + 1, far_gap};
+                const double near_gap = first_nearer ? to_first * to_first : to_second * to_second;
+                if (best.matters(near_gap)) {
+                    index = first_nearer ? index + 1 : node.second;
+                    continue;
+                }
+            }
+            do {
+                if (top == 0) return;
+                --top;
+            } while (!best.matters(stack[top].gap));
+            index = stack[top].node;
+        }
+    }
+    struct Box {
+        double low[3], high[3];
+    };
+    Box build_node(const std::vector<uint32_t>& codes, uint32_t begin, uint32_t end, int depth);
+    const KdTree& kd_tree() const;
+
+    std::vector<Point> points_;  // in Morton order
+    std::vector<Node> nodes_;
+    // What the k-d tree is built from: the positions and their order, or another's tree renamed.
+    const std::vector<Vec3>* positions_ = nullptr;
+    const std::vector<uint32_t>* insertion_order_ = nullptr;
+    const NearestVertex* renamed_from_ = nullptr;
+    const std::vector<uint32_t>* new_id_ = nullptr;
+    mutable std::unique_ptr<KdTree> kd_tree_;
 };
 
 }  // namespace amc

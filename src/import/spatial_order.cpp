@@ -20,10 +20,10 @@ uint32_t spread_bits(uint32_t x) {
 
 }  // namespace
 
-std::vector<uint32_t> spatial_vertex_order(const std::vector<Vec3>& positions) {
+std::vector<uint32_t> morton_codes(const std::vector<Vec3>& positions, bool cubic_cells) {
     const uint32_t n = uint32_t(positions.size());
-    std::vector<uint32_t> order(n);
-    if (n == 0) return order;
+    std::vector<uint32_t> code(n);
+    if (n == 0) return code;
     double low[3] = {positions[0].x, positions[0].y, positions[0].z}, high[3] = {low[0], low[1], low[2]};
     for (const Vec3& p : positions) {
         const double c[3] = {p.x, p.y, p.z};
@@ -33,11 +33,11 @@ std::vector<uint32_t> spatial_vertex_order(const std::vector<Vec3>& positions) {
         }
     }
     double scale[3];
+    const double largest = std::max({high[0] - low[0], high[1] - low[1], high[2] - low[2]});
     for (int a = 0; a < 3; ++a) {
-        const double extent = high[a] - low[a];  // may overflow to infinity: scale 0, one cell
+        const double extent = cubic_cells ? largest : high[a] - low[a];  // may overflow to infinity: scale 0, one cell
         scale[a] = extent > 0 ? double(kCellsPerAxis) / extent : 0;
     }
-    std::vector<uint32_t> code(n);
     for (uint32_t v = 0; v < n; ++v) {
         const double c[3] = {positions[v].x, positions[v].y, positions[v].z};
         uint32_t key = 0;
@@ -48,6 +48,17 @@ std::vector<uint32_t> spatial_vertex_order(const std::vector<Vec3>& positions) {
         }
         code[v] = key;
     }
+    return code;
+}
+
+std::vector<uint32_t> spatial_vertex_order(const std::vector<Vec3>& positions) {
+    return order_by_codes(morton_codes(positions, false));
+}
+
+std::vector<uint32_t> order_by_codes(const std::vector<uint32_t>& code) {
+    const uint32_t n = uint32_t(code.size());
+    std::vector<uint32_t> order(n);
+    if (n == 0) return order;
     // Least significant half first; each pass is stable.
     constexpr uint32_t kBuckets = 1u << 15;
     std::vector<uint32_t> count(kBuckets + 1), scratch(n);

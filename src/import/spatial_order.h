@@ -15,4 +15,14 @@ namespace amc::detail {
 // Coordinates must be finite.
 std::vector<uint32_t> spatial_vertex_order(const std::vector<Vec3>& positions);
 
+// The 30-bit Morton code of each vertex (bit 3k + a: bit k of its cell on axis a). Each axis
+// has 1024 cells over its extent, as spatial_vertex_order takes them; with `cubic_cells`, every
+// axis has cells of one size, 1024 over the largest extent (a flat mesh's thin axis then splits
+// no cell before the others do).
+std::vector<uint32_t> morton_codes(const std::vector<Vec3>& positions, bool cubic_cells);
+
+// The indices of `codes` in increasing order of their codes, equal ones in index order (two
+// counting-sort passes).
+std::vector<uint32_t> order_by_codes(const std::vector<uint32_t>& codes);
+
 }  // namespace amc::detail
