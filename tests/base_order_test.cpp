@@ -2,6 +2,7 @@
 #include "hierarchy_checks.h"
 
 #include "coding/hierarchy/hierarchy_level_coder.h"
+#include "common/huge_pages.h"
 #include "hierarchy/hierarchy_builder.h"
 
 #include <cstring>
@@ -187,6 +188,25 @@ TEST(BaseOrder, LevelsOfSeveralRangesGiveTheSameResultOnAnyThreads) {
             for (int r = 0; r < kDiagonalRuleCount; ++r) EXPECT_EQ(tally.by_rule[r], expected_tally.by_rule[r]) << threads << " threads, rule " << r;
         }
     }
+}
+
+// The reordered copy's and the chunks' arrays ask malloc for whole huge pages less its header
+// (huge_pages.h), from one huge page on; below that, for what they hold. Contents are kept.
+TEST(BaseOrder, ArraysWrittenWholeAskForWholeHugePages) {
+    EXPECT_EQ(written_whole_bytes(0), 0u);
+    EXPECT_EQ(written_whole_bytes(kHugePage - 1), kHugePage - 1);
+    EXPECT_EQ(written_whole_bytes(kHugePage), 2 * kHugePage - 2 * kMallocHeader);
+    EXPECT_EQ(written_whole_bytes(2 * kHugePage - 2 * kMallocHeader), 2 * kHugePage - 2 * kMallocHeader);
+    EXPECT_EQ(written_whole_bytes(2 * kHugePage - 2 * kMallocHeader + 1), 3 * kHugePage - 2 * kMallocHeader);
+    EXPECT_EQ(written_whole_bytes(37594000), 18 * kHugePage - 2 * kMallocHeader);  // feline_1m's reordered nodes
+    std::vector<uint32_t> ids = {7, 8, 9};
+    reserve_huge(ids, 1000000, HugePages::written_whole);
+    EXPECT_EQ(ids, (std::vector<uint32_t>{7, 8, 9}));
+    EXPECT_EQ(ids.capacity(), (2 * kHugePage - 2 * kMallocHeader) / sizeof(uint32_t));
+    std::vector<Vec3> small = {{1, 2, 3}};
+    reserve_huge(small, 1000, HugePages::written_whole);
+    EXPECT_EQ(small.capacity(), 1000u);
+    EXPECT_EQ(small[0].y, 2);
 }
 
 TEST(BaseOrder, BadOrdersAreRefused) {

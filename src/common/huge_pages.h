@@ -38,10 +38,39 @@ inline void advise_whole_pages(const void* begin, size_t bytes, int advice) {
 // 4 KiB page fault costs 15-25 us (docs/BENCHMARKS.md, "Threads and memory").
 enum class HugePages { large_scratch, written_whole };
 
+constexpr size_t kHugePage = size_t(2) << 20;
+
+// glibc's header before a block's bytes: a block that malloc maps on its own starts this far into
+// its mapping (glibc's mmapped chunks; elsewhere the rounding below only costs some address space).
+constexpr size_t kMallocHeader = 16;
+
+// The bytes to ask for an array of at least `bytes` that is written whole: from one huge page on,
+// a whole number of huge pages less malloc's header, so that a block malloc maps on its own fills
+// its mapping, whose length the kernel then aligns to a huge page (Linux 6.7 on). Its first and
+// last huge pages are then whole too, where a block at any offset pays up to 2 x 512 4 KiB faults.
+inline size_t written_whole_bytes(size_t bytes) {
+    if (bytes < kHugePage) return bytes;
+    return (bytes + 2 * kMallocHeader + kHugePage - 1) / kHugePage * kHugePage - 2 * kMallocHeader;  // >= bytes
+}
+
 inline void advise_huge_pages(const void* begin, size_t bytes, HugePages kind = HugePages::large_scratch) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
-    constexpr uintptr_t kHuge = uintptr_t(2) << 20;
-    if (bytes >= (kind == HugePages::written_whole ? kHuge : 4 * kHuge)) detail::advise_aligned(begin, bytes, kHuge, MADV_HUGEPAGE);
+    if (bytes < (kind == HugePages::written_whole ? kHugePage : 4 * kHugePage)) return;
+    const uintptr_t at = reinterpret_cast<uintptr_t>(begin);
+    if (kind == HugePages::written_whole && at % kHugePage == kMallocHeader) {
+        // A mapping of its own (written_whole_bytes): all of it, the header's huge page included,
+        // which malloc faulted in as a 4 KiB page when it wrote the header (collapsed: Linux 6.1 on).
+        void* const mapping = reinterpret_cast<void*>(at - kMallocHeader);
+        const size_t length = (bytes + kMallocHeader + kHugePage - 1) / kHugePage * kHugePage;
+        madvise(mapping, length, MADV_HUGEPAGE);
+#if defined(MADV_COLLAPSE)
+        madvise(mapping, kHugePage, MADV_COLLAPSE);
+#else
+        madvise(mapping, kHugePage, 25);  // MADV_COLLAPSE, where the C library's headers predate it
+#endif
+        return;
+    }
+    detail::advise_aligned(begin, bytes, kHugePage, MADV_HUGEPAGE);
 #else
     (void)begin;
     (void)bytes;
@@ -79,6 +108,7 @@ inline void populate_pages(void* begin, size_t bytes) {
 template <class T>
 void reserve_huge(std::vector<T>& v, size_t capacity, HugePages kind = HugePages::large_scratch) {
     if (capacity <= v.capacity()) return;
+    if (kind == HugePages::written_whole) capacity = written_whole_bytes(capacity * sizeof(T)) / sizeof(T);
     std::vector<T> fresh;
     fresh.reserve(capacity);
     advise_huge_pages(fresh.data(), fresh.capacity() * sizeof(T), kind);

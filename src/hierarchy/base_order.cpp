@@ -83,8 +83,9 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
     reserve_huge(turn, h.node_count(), HugePages::written_whole);
     // Left unset: only live nodes are reached and looked up, and their entries are written by the
     // threads' first pass (which takes the first touch of its pages off the serial part too).
-    const std::unique_ptr<NodeId[]> new_of(new NodeId[h.node_capacity()]);
-    advise_huge_pages(new_of.get(), size_t(h.node_capacity()) * sizeof(NodeId), HugePages::written_whole);
+    const size_t new_of_bytes = written_whole_bytes(size_t(h.node_capacity()) * sizeof(NodeId));
+    const std::unique_ptr<NodeId[]> new_of(new NodeId[new_of_bytes / sizeof(NodeId)]);
+    advise_huge_pages(new_of.get(), new_of_bytes, HugePages::written_whole);
     for (uint32_t t = 0; t < triangle_order.size(); ++t) {
         old_of[t] = triangle_order[t];
         turn[t] = rotation[t];
@@ -185,7 +186,7 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
         }
         out.far_positions_.raise_if(far);
     });
-    reserve_huge(out.nodes_, n);
+    reserve_huge(out.nodes_, n, HugePages::written_whole);
     out.nodes_.resize(n);  // Node() writes nothing: each is written whole below
     reserve_huge(out.block_parent_, (n - roots) / 4, HugePages::written_whole);
     out.block_parent_.assign((n - roots) / 4, kNoNode);
@@ -240,7 +241,7 @@ Hierarchy HierarchyBuilder::subforest(const Hierarchy& h, TriangleMesh base, con
     auto taken = [&](NodeId q) { return q != kNoNode && root_in[root_of[q]] != 0; };
     std::vector<VertexId> vertex_of(base_vertex);
     reserve_huge(vertex_of, h.positions().size(), HugePages::written_whole);
-    reserve_huge(out.nodes_, n);
+    reserve_huge(out.nodes_, n, HugePages::written_whole);
     out.nodes_.resize(n);  // the roots stay as the constructor made them
     reserve_huge(out.block_parent_, (n - root_count) / 4, HugePages::written_whole);
     out.block_parent_.assign((n - root_count) / 4, kNoNode);

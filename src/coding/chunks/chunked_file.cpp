@@ -43,8 +43,9 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& ro
     std::vector<uint64_t> nodes(ranges.size()), own_vertices(ranges.size());
     // Shared: the chunks' nodes are disjoint, and each chunk writes its nodes' entries before it
     // reads them (subforest), so they are not zeroed first; their pages are faulted in by the tasks.
-    const std::unique_ptr<NodeId[]> local(new NodeId[h.node_capacity()]);
-    advise_huge_pages(local.get(), size_t(h.node_capacity()) * sizeof(NodeId), HugePages::written_whole);
+    const size_t local_bytes = written_whole_bytes(size_t(h.node_capacity()) * sizeof(NodeId));
+    const std::unique_ptr<NodeId[]> local(new NodeId[local_bytes / sizeof(NodeId)]);
+    advise_huge_pages(local.get(), local_bytes, HugePages::written_whole);
     struct Extracted {
         Hierarchy chunk;
         std::vector<VertexId> vertex_of;
