@@ -322,14 +322,15 @@ uint32_t Reconstruction::only_unmatched_common_neighbor(uint32_t a, uint32_t b) 
     he_.for_each_neighbor_once(b, [&](uint32_t x) {
         if (vertex_of_leaf_[x] == kNoIndex) around_b_.push_back(x);
     });
+    if (around_b_.empty()) return kNoIndex;
     uint32_t found = kNoIndex;
-    bool ambiguous = false;
-    he_.for_each_neighbor_once(a, [&](uint32_t x) {
-        if (x == found || std::find(around_b_.begin(), around_b_.end(), x) == around_b_.end()) return;
-        if (found != kNoIndex) ambiguous = true;
+    const bool unique = he_.every_neighbor(a, [&](uint32_t x) {
+        if (x == found || std::find(around_b_.begin(), around_b_.end(), x) == around_b_.end()) return true;
+        if (found != kNoIndex) return false;  // a second one
         found = x;
+        return true;
     });
-    return ambiguous ? kNoIndex : found;
+    return unique ? found : kNoIndex;
 }
 
 std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
