@@ -76,10 +76,7 @@ bool undid_much(size_t base, size_t leaf) {
 }
 
 // The levels undone from step `from` on, the earlier ones of `run` standing; in step s the
-// vertices marked in kept[s] (if any) stay. Where the search stops after undoing much of an
-// adaptive mesh, it is seeded once more on the whole mesh and, if that undoes something, goes on,
-// a few rounds: a step seeds only where the last one changed the mesh, and readings that became
-// valid farther away are found no other way (docs/IMPORT.md, "Seeded everywhere once stopped").
+// vertices marked in kept[s] (if any) stay.
 void undo_levels_from(const std::vector<Triangle>& triangles, uint32_t vertex_count, size_t from,
                       const std::vector<std::vector<uint8_t>>& kept, SearchRun& run) {
     run.levels.resize(from);
@@ -89,11 +86,19 @@ void undo_levels_from(const std::vector<Triangle>& triangles, uint32_t vertex_co
     // Each level undone adds one to the depth of the hierarchy, which kMaxLevel caps.
     while (run.levels.size() < size_t(kMaxLevel) && undo_one_level(triangles, vertex_count, kept, false, run)) {
     }
+}
+
+// Where the search stopped after undoing much of an adaptive mesh: a step seeded on the whole
+// mesh and, if it undoes something, the steps after it, a few rounds. A step seeds only where
+// the last one changed the mesh, and its failing growths mark the true blocks they pass as
+// explored; a fresh step seeded everywhere reads the valid patches left so (docs/IMPORT.md,
+// "Seeded everywhere once stopped"). It only adds levels: the base found is never finer.
+void seed_everywhere_once_stopped(const std::vector<Triangle>& triangles, uint32_t vertex_count, SearchRun& run) {
     if (!undid_much(base_size(run, triangles.size()), triangles.size())) return;
     constexpr int kRounds = 8;
     for (int round = 0; round < kRounds && run.levels.size() + 1 < size_t(kMaxLevel); ++round) {
-        if (!undo_one_level(triangles, vertex_count, kept, true, run)) break;
-        while (run.levels.size() < size_t(kMaxLevel) && undo_one_level(triangles, vertex_count, kept, false, run)) {
+        if (!undo_one_level(triangles, vertex_count, {}, true, run)) break;
+        while (run.levels.size() < size_t(kMaxLevel) && undo_one_level(triangles, vertex_count, {}, false, run)) {
         }
     }
 }
@@ -241,6 +246,7 @@ DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what) {
         SearchRun other = search_levels(reversed, vertex_count);
         if (base_size(other, renumbered.size()) < base_size(run, renumbered.size())) run = std::move(other);
     }
+    seed_everywhere_once_stopped(renumbered, vertex_count, run);
     out.levels = std::move(run.levels);
     for (DetectedLevel& level : out.levels) {
         detail::renumber(level.triangles, input_of);
