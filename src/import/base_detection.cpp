@@ -42,9 +42,8 @@ struct SearchRun {
 };
 
 // One more level undone at the end of `run`, seeded only where the last step changed the mesh
-// or, `everywhere`, on the whole mesh with the valid rest of large failing growths kept (`peel`
-// of undo_refinement_level); in step s the vertices marked in kept[s] (if any) stay. Returns
-// whether the step undid anything.
+// or, `everywhere`, on the whole mesh; in step s the vertices marked in kept[s] (if any) stay.
+// Returns whether the step undid anything.
 bool undo_one_level(const std::vector<Triangle>& triangles, uint32_t vertex_count,
                     const std::vector<std::vector<uint8_t>>& kept, bool everywhere, SearchRun& run) {
     const size_t s = run.levels.size();
@@ -52,7 +51,7 @@ bool undo_one_level(const std::vector<Triangle>& triangles, uint32_t vertex_coun
     const std::vector<uint8_t> unrefined(s == 0 ? triangles.size() : 0, 0);
     detail::CoarserLevel coarser = detail::undo_refinement_level(
         s == 0 ? triangles : run.levels[s - 1].triangles, s == 0 ? unrefined : run.refined[s - 1], vertex_count,
-        s == 0 || everywhere ? nullptr : &run.changed[s - 1], has_kept ? &kept[s] : nullptr, false, everywhere);
+        s == 0 || everywhere ? nullptr : &run.changed[s - 1], has_kept ? &kept[s] : nullptr);
     if (coarser.red_blocks == 0) return false;
     DetectedLevel level;
     level.splits = std::move(coarser.splits);
@@ -93,7 +92,7 @@ void undo_levels_from(const std::vector<Triangle>& triangles, uint32_t vertex_co
 // mesh and, if it undoes something, the steps after it, a few rounds. A step seeds only where
 // the last one changed the mesh, and its failing growths mark the true blocks they pass as
 // explored; a fresh step seeded everywhere reads the valid patches left so (docs/IMPORT.md,
-// "Seeded everywhere once stopped"). It only adds levels to the run detect_base chose.
+// "Seeded everywhere once stopped"). It only adds levels: the base found is never finer.
 void seed_everywhere_once_stopped(const std::vector<Triangle>& triangles, uint32_t vertex_count, SearchRun& run) {
     if (!undid_much(base_size(run, triangles.size()), triangles.size())) return;
     constexpr int kRounds = 8;

@@ -13,12 +13,12 @@ using inverse::LevelFinder;
 
 CoarserLevel undo_refinement_level(const std::vector<Triangle>& fine, const std::vector<uint8_t>& refined,
                                    uint32_t vertex_count, const std::vector<uint8_t>* active,
-                                   const std::vector<uint8_t>* kept, bool give_up_retraced, bool peel) {
+                                   const std::vector<uint8_t>* kept, bool give_up_retraced) {
     // Large patches first: they are what a level looks like where the mesh is finest. Small
     // ones are also what wrong readings look like where it is not finest yet (the true blocks
     // there become valid only once the finer ones around are undone), so a small patch is kept
     // only when the next level confirms it: one of its parents lies in a valid patch there.
-    LevelFinder finder(fine, refined, vertex_count, kept, give_up_retraced, peel);
+    LevelFinder finder(fine, refined, vertex_count, kept, give_up_retraced);
     constexpr uint32_t kLarge = 12;  // vertices removed: four blocks or more
     const size_t all = finder.commit(active);
     std::vector<size_t> small;

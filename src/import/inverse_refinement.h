@@ -42,13 +42,10 @@ struct CoarserLevel {
 // `kept` (if given) marks vertices that must stay (the base vertices of an anchored import).
 // `give_up_retraced` (the anchored import's search) gives up the growths that retrace a reading
 // given up before (docs/IMPORT.md, "Retraced readings given up"); base detection keeps its answers.
-// `peel` keeps the valid rest of a large growth that fails: its invalid blocks are taken out until
-// every side left is valid (docs/IMPORT.md, "Seeded everywhere once stopped").
 // Returns red_blocks == 0 (and an empty mesh) when no level can be undone anywhere. Linear in
 // fine.size() + vertex_count.
 CoarserLevel undo_refinement_level(const std::vector<Triangle>& fine, const std::vector<uint8_t>& refined,
                                    uint32_t vertex_count, const std::vector<uint8_t>* active = nullptr,
-                                   const std::vector<uint8_t>* kept = nullptr, bool give_up_retraced = false,
-                                   bool peel = false);
+                                   const std::vector<uint8_t>* kept = nullptr, bool give_up_retraced = false);
 
 }  // namespace amc::detail

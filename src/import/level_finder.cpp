@@ -31,10 +31,6 @@ constexpr uint32_t kRivalGrowth = 256;
 // invalid sides may run across the parent of an earlier step's wrong block (LevelFinder::blockers).
 constexpr uint32_t kBlockedGrowth = 256;
 constexpr size_t kFewInvalid = 4;
-// A failing growth this large may be peeled (LevelFinder::peel_invalid), and is kept when at
-// least 1 / kPeelKept of its blocks stay.
-constexpr uint32_t kPeelable = 64;
-constexpr uint32_t kPeelKept = 2;
 
 }  // namespace
 
@@ -204,7 +200,6 @@ uint32_t LevelFinder::grow_patch(uint32_t t, Preference preference, bool explori
         }
         if (banned.size() == before) break;  // nothing new to take away: the same growth again
     }
-    if (removed == 0 && peel_) removed = grow_patch_once(t, preference, exploring, nullptr, true);
     for (uint32_t c : banned) repair_banned_[c] = 0;
     return removed;
 }
@@ -226,8 +221,7 @@ void LevelFinder::collect_suspects(const std::vector<uint32_t>& invalid, std::ve
     }
 }
 
-uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool exploring, std::vector<uint32_t>* suspects,
-                                      bool peel) {
+uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool exploring, std::vector<uint32_t>* suspects) {
     const uint32_t start = uint32_t(blocks_.size());
     if (!place_block(t)) return 0;
     uint32_t settled = start, settled_invalid = 0;
@@ -279,11 +273,6 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
         }
     }
     mark_explored(start, preference, exploring);
-    if (peel && blocks_.size() - start >= kPeelable) {
-        if (peel_invalid(start)) return removed_by_growth(start);
-        roll_back(start);
-        return 0;
-    }
     // A patch with invalid blocks is dropped; a large one with few is repaired (its suspects
     // collected), one with many is a wrong reading, not a true one with a few wrong turns.
     const uint32_t size = uint32_t(blocks_.size()) - start;
@@ -321,13 +310,8 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
             for (uint32_t c : blocks_[i].corner) covered_[c] = 3;
         }
     }
-    return removed_by_growth(start);
-}
-
-uint32_t LevelFinder::removed_by_growth(uint32_t start) const {
     uint32_t removed = 0;
     for (uint32_t i = start; i < blocks_.size(); ++i) {
-        if (!blocks_[i].alive) continue;  // peeled
         for (int e = 0; e < 3; ++e) {
             const auto& slots = midpoint_block_[blocks_[i].m[size_t(e)]];
             removed += slots[0] / 3 == i || (slots[0] / 3 < start && slots[1] / 3 == i);  // count each once
@@ -336,27 +320,7 @@ uint32_t LevelFinder::removed_by_growth(uint32_t start) const {
     return removed;
 }
 
-bool LevelFinder::peel_invalid(uint32_t start) {
-    // Releasing a block can make its neighbours' sides invalid in turn: until none is left.
-    const uint32_t size = uint32_t(blocks_.size()) - start;
-    uint32_t alive = size;
-    std::vector<uint32_t> invalid;
-    for (;;) {
-        invalid.clear();
-        for (uint32_t i = start; i < blocks_.size(); ++i) {
-            if (blocks_[i].alive && !sides_valid(i)) invalid.push_back(i);
-        }
-        if (invalid.empty()) return alive > 0;
-        for (uint32_t i : invalid) release(i);
-        alive -= uint32_t(invalid.size());
-        if (alive * kPeelKept < size) return false;
-    }
-}
-
 std::pair<uint32_t, uint32_t> LevelFinder::without_glued_seed(uint32_t start, Preference preference, uint32_t removed) {
-    for (uint32_t i = start; i < blocks_.size(); ++i) {
-        if (!blocks_[i].alive) return {blocks_[start].center, removed};  // peeled: left as it is
-    }
     const uint32_t seed = blocks_[start].center;
     for (uint32_t m : blocks_[start].m) {
         if (midpoint_count_[m] > 1) return {seed, removed};  // joined by a midpoint: not glued

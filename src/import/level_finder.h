@@ -85,10 +85,10 @@ public:
     // the triangles are numbered for locality (local_order), and wherever the caller's order
     // decides (the order of seeds, ties between candidates, the coarser level's order) it is
     // looked up, so the numbering changes no result.
-    // `give_up_retraced`, `peel`: see undo_refinement_level.
+    // `give_up_retraced`: see undo_refinement_level.
     LevelFinder(const std::vector<Triangle>& fine, const std::vector<uint8_t>& refined, uint32_t vertex_count,
-                const std::vector<uint8_t>* kept, bool give_up_retraced = false, bool peel = false)
-        : give_up_retraced_(give_up_retraced), peel_(peel), caller_of_(local_order(fine, vertex_count)), local_of_(inverse(caller_of_)), tri_(permuted(fine, caller_of_)),
+                const std::vector<uint8_t>* kept, bool give_up_retraced = false)
+        : give_up_retraced_(give_up_retraced), caller_of_(local_order(fine, vertex_count)), local_of_(inverse(caller_of_)), tri_(permuted(fine, caller_of_)),
           refined_(permuted(refined, caller_of_)), adjacency_(tri_, vertex_count), forced_old_(vertex_count, 0),
           midpoint_count_(vertex_count, 0), corner_count_(vertex_count, 0),
           midpoint_block_(vertex_count, {kNoIndex, kNoIndex}), first_coarse_edge_(vertex_count, kNoEdge), block_of_(fine.size(), kNoIndex), closure_of_(fine.size(), kNoIndex),
@@ -278,17 +278,7 @@ private:
     // `preference` in this round (give_up_retraced_ only).
     void mark_given_up(uint32_t start, Preference preference);
 
-    // `peel` (peel_ only, once the repairs are spent): a growth of at least kPeelable blocks that
-    // fails keeps its valid rest (peel_invalid) instead of being dropped.
-    uint32_t grow_patch_once(uint32_t t, Preference preference, bool exploring, std::vector<uint32_t>* suspects,
-                             bool peel = false);
-
-    // The vertices the growth from blocks_[start] removes (each midpoint counted once).
-    uint32_t removed_by_growth(uint32_t start) const;
-
-    // Takes the invalid blocks of the growth from blocks_[start] out until every block left has
-    // valid sides; returns whether at least half of its blocks are left.
-    bool peel_invalid(uint32_t start);
+    uint32_t grow_patch_once(uint32_t t, Preference preference, bool exploring, std::vector<uint32_t>* suspects);
 
     // The best patch grown from t under either preference (but those of bit mask `failed`, known
     // to fail), or none; the patch is not kept.
@@ -335,7 +325,6 @@ private:
     void improve_patches(size_t first);
 
     const bool give_up_retraced_;
-    const bool peel_;
     std::vector<uint32_t> caller_of_;  // per triangle: its index in the caller's numbering
     std::vector<uint32_t> local_of_;   // per caller's index: the triangle
     std::vector<Triangle> tri_;
