@@ -172,6 +172,10 @@ void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder, uint64_t ma
             level_.edges.release_from(0);
         }
     }
+    if (single_stream_ && last_built) {
+        level_.nbr.deallocate();
+        level_.edges.deallocate();
+    }
     // Before the level's new positions come.
     if (single_stream_) free_before_next_level();
     new_vertex_count_ = appending_positions() ? size_t(vertex_count_ - vertices_before)
@@ -300,14 +304,16 @@ void HierarchyLevelDecoder::finish_level(bool built_next) {
     }
     // A next level of leaves alone (the stored symbols used up), split now: nothing but the split
     // reads its links, which go straight into the room of its nodes (the last level's links were
-    // a sixth of a decode's peak). Lean, deriving them there faults the nodes in while the
-    // working memory (about 20 bytes a node of this level) is still there, where the links' own
-    // array (12 bytes a node of the next) would have been given back after the split: the room
-    // only where the next level is more than twice this one's size (docs/BENCHMARKS.md).
+    // a sixth of a decode's peak). Lean or single-stream, deriving them there faults the nodes in
+    // while the working memory (about 20 bytes a node of this level) is still there, where the
+    // links' own array (12 bytes a node of the next) would have gone back before the split: the
+    // room only where the next level is more than twice this one's size (lean) or larger than it
+    // (single-stream; docs/BENCHMARKS.md).
     const bool lean = lean_ || lean_at_end_;
     const uint64_t next_nodes = uint64_t(4) * level_.refined_count;
     const bool links_in_room =
-        built_next && next_nodes > 0 && all_leaves_from(level_index_ + 1) && (!lean || next_nodes > 2 * uint64_t(level_.size()));
+        built_next && next_nodes > 0 && all_leaves_from(level_index_ + 1) &&
+        next_nodes > (lean ? 2 * uint64_t(level_.size()) : single_stream_ ? uint64_t(level_.size()) : 0);
     if (single_stream_ && built_next && all_leaves_from(level_index_ + 1)) free_before_last_derive(next, links_in_room);
     const ChildLinkRoom room =
         links_in_room ? HierarchyBuilder::open_children(*h_, slice_, level_.refined_count) : ChildLinkRoom{};
