@@ -110,6 +110,37 @@ TEST(StencilTables, AutomaticChoiceTakesThemWhereSmallest) {
     }
 }
 
+// Where every new vertex is its edge's midpoint (the L-shaped FE model), the normal frame, the unit
+// frame and the static midpoint code the same zero tokens in a level's static bytes: the automatic
+// choice keeps the first of them, mode 3, on the levels a static mode wins (level_geometry.cpp
+// codes no static mode that could at best tie with an earlier one).
+TEST(StencilTables, ExactMidpointsKeepTheFirstOfTheTyingStaticModes) {
+    const Hierarchy h = make_l_shape_model(6);
+    EncodeStats chosen;
+    encode(h, {}, &chosen);
+    std::vector<EncodeStats> forced(3);
+    const GeometryPredictor tying[3] = {GeometryPredictor::normal_frame, GeometryPredictor::unit_normal_frame,
+                                        GeometryPredictor::midpoint_static};
+    for (int m = 0; m < 3; ++m) {
+        EncodeOptions options;
+        options.predictor = tying[m];
+        encode(h, options, &forced[size_t(m)]);
+    }
+    int static_levels = 0;
+    for (size_t l = 0; l < chosen.per_level.size(); ++l) {
+        if (chosen.per_level[l].new_vertices == 0) continue;
+        EXPECT_EQ(forced[1].per_level[l].bytes, forced[0].per_level[l].bytes) << "level " << l;
+        EXPECT_EQ(forced[2].per_level[l].bytes, forced[0].per_level[l].bytes) << "level " << l;
+        if (chosen.per_level[l].predictor == GeometryPredictor::midpoint ||
+            chosen.per_level[l].predictor == GeometryPredictor::butterfly)
+            continue;
+        ++static_levels;
+        EXPECT_EQ(chosen.per_level[l].predictor, GeometryPredictor::normal_frame) << "level " << l;
+        EXPECT_EQ(chosen.per_level[l].bytes, forced[0].per_level[l].bytes) << "level " << l;
+    }
+    EXPECT_GT(static_levels, 0);
+}
+
 TEST(StencilTables, QuantizedFilesRefuseThem) {
     const Hierarchy h = bumpy_torus(false);
     EncodeOptions quantized;

@@ -385,18 +385,22 @@ const FrameCorners* NewVertexCorners::next(size_t n) {
     VertexId next_vertex = next_vertex_;
     FrameCorners* const out = run_;
     size_t k = carried;
-    // The parents are fetched 16 ahead, their centre children and neighbours 8 ahead (as split_level).
+    // split_level made parents[b]'s children at first_child + 4 b: the centre child's id needs no
+    // load of the parent's, and the children are read in order.
+    const NodeId first_child = parent_count > 0 ? h.child(parents[0], 0) : 0;
+    AMC_REQUIRE(parent_count == 0 || h.child(parents[parent_count - 1], 0) == first_child + 4 * (parent_count - 1),
+                invalid_input, "NewVertexCorners: the parents' children are not consecutive");
+    // The parents are fetched 16 ahead, their neighbours 8 ahead (as split_level).
     constexpr uint32_t kParentsAhead = 16;
     while (k < n) {
         AMC_REQUIRE(b < parent_count, corrupt, "split parents made fewer vertices than listed");
         if (b + kParentsAhead < parent_count) HierarchyBuilder::prefetch(h, parents[b + kParentsAhead]);
         if (b + kParentsAhead / 2 < parent_count) {
             const NodeId ahead = parents[b + kParentsAhead / 2];
-            HierarchyBuilder::prefetch(h, h.child(ahead, red_split::kCenter));
             for (int e = 0; e < 3; ++e) HierarchyBuilder::prefetch(h, h.neighbor(ahead, e));  // kNoNode: prefetches do not fault
         }
+        const NodeId center = first_child + 4 * b + red_split::kCenter;
         const NodeId p = parents[b++];
-        const NodeId center = h.child(p, red_split::kCenter);
         const VertexId v[5] = {h.vertex(p, 0), h.vertex(p, 1), h.vertex(p, 2), h.vertex(p, 0), h.vertex(p, 1)};
         const NodeId q[3] = {h.neighbor(p, 0), h.neighbor(p, 1), h.neighbor(p, 2)};
         const unsigned edges = HierarchyBuilder::neighbor_edges(h, p);

@@ -1,10 +1,12 @@
 // A program of a user of the installed library: a small adaptive hierarchy over an octahedron,
 // encoded and decoded, and the decoded hierarchy compared with the input (and encoded again to
-// the same bytes). Built by CI against the installed amcodec through find_package (cmake/) and
-// pkg-config (pkgconfig/); exit status 0 when the round trip is exact.
+// the same bytes); with a library built with p4est, an octree forest balanced by p4est and coded
+// (which links p4est, sc and MPI into the program). Built by CI against the installed amcodec
+// through find_package (cmake/) and pkg-config (pkgconfig/); exit status 0 when all is exact.
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
 #include <amc/import.h>
+#include <amc/octree.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -57,6 +59,21 @@ int main() {
                     "imported leaf mesh round trip");
         ok &= check(amc::extract_leaf_mesh(leaf_decoded).mesh.triangles.size() == leaf.mesh.triangles.size(),
                     "same leaf triangle count");
+
+        if (amc::octree_p4est_available()) {
+            const amc::TreeConnectivity brick = amc::brick_connectivity(2, 2, 1);
+            const amc::OctreeForest sphere = amc::sphere_octree_forest(brick, {0.7, 0.4, 0}, 0.3, 5);
+            const amc::OctreeForest by_p4est = amc::balanced_by_p4est(sphere, amc::OctreeBalance::corner);
+            const std::vector<uint8_t> octree_file = amc::encode_octree_forest(by_p4est);
+            const amc::OctreeForest octree_decoded = amc::decode_octree_forest(octree_file.data(), octree_file.size());
+            ok &= check(amc::balance_octree_forest(sphere, amc::OctreeBalance::corner) == by_p4est,
+                        "amcodec's balance is p4est's");
+            ok &= check(octree_decoded == by_p4est, "decode(encode(forest)) is the forest");
+            ok &= check(amc::octree_p4est_checksum(octree_decoded) == amc::octree_p4est_checksum(by_p4est),
+                        "p4est-balanced forest round trip (p4est checksum)");
+            ok &= check(amc::is_balanced_in_p4est(octree_decoded, amc::OctreeBalance::corner),
+                        "decoded forest balanced in p4est");
+        }
         return ok ? EXIT_SUCCESS : EXIT_FAILURE;
     } catch (const amc::Error& e) {
         std::fprintf(stderr, "error: %s\n", e.what());

@@ -234,15 +234,22 @@ LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& create
         bound[i] = statics[i]->lower_bound_bytes();
     }
     size_t best_static = SIZE_MAX;
+    int first_best = kStaticCandidates;  // the first mode of size best_static
     for (int tries = 0; tries < kStaticCandidates; ++tries) {
         int next = -1;  // the untried mode of smallest bound
         for (int i = 0; i < kStaticCandidates; ++i)
             if (statics[i] != nullptr && static_size[i] == SIZE_MAX && bound[i] != SIZE_MAX && (next < 0 || bound[i] < bound[next]))
                 next = i;
         if (next < 0 || bound[next] > best_static) break;  // larger than a size known: never the smallest
-        statics[next]->code_streams();
-        static_size[next] = statics[next]->estimated_bytes();
-        best_static = std::min(best_static, static_size[next]);
+        // At best a tie with an earlier mode, which the choice keeps (exact-midpoint levels: modes
+        // 3, 5 and 6 code the same zero tokens to their bound): not coded.
+        const bool never_chosen = bound[next] == best_static && next > first_best;
+        if (!never_chosen) {
+            statics[next]->code_streams();
+            static_size[next] = statics[next]->estimated_bytes();
+            if (static_size[next] < best_static || (static_size[next] == best_static && next < first_best)) first_best = next;
+            best_static = std::min(best_static, static_size[next]);
+        }
         bound[next] = SIZE_MAX;
     }
     const bool count_raw_bits = exact;
