@@ -4,6 +4,7 @@
 #include "coding/chunks/chunk_layout.h"
 #include "coding/container.h"
 #include "coding/format_version.h"
+#include "hierarchy/hierarchy_builder.h"
 #include "hierarchy_checks.h"
 
 #include <amc/codec.h>
@@ -147,6 +148,33 @@ TEST(Chunks, ExtractedRootsHaveTheIdsOfASplitReplay) {
             EXPECT_EQ(chunk.base().triangles, expected.base().triangles);
             EXPECT_EQ(vertex_of, expected_vertex_of);
             EXPECT_TRUE(testing::hierarchy_is_valid(chunk));
+        }
+    }
+}
+
+// The chunked encoder copies each chunk into a room made beforehand (in the calling thread's
+// arena for the workers): a room too small or large enough must give the same chunk.
+TEST(Chunks, ExtractionIntoARoomIsTheSameChunk) {
+    for (uint64_t seed = 0; seed < 12; ++seed) {
+        SCOPED_TRACE("seed " + std::to_string(seed));
+        Hierarchy h = random_hierarchy(seed, false);
+        if (seed % 3 == 2) refine_randomly(h, h.leaf_count() + 300, 6, seed, 0.3);
+        const uint32_t roots = h.root_count();
+        const uint32_t cut = 1 + uint32_t(seed % (roots - 1));
+        const std::vector<uint32_t> root_of = root_of_nodes(h);
+        std::vector<NodeId> local(h.node_capacity());
+        for (const std::vector<RootRange>& part : {std::vector<RootRange>{RootRange{0, cut}}, {RootRange{cut, roots - cut}}}) {
+            std::vector<VertexId> expected_vertex_of;
+            const Hierarchy expected = extract_roots(h, part, &expected_vertex_of);
+            for (const size_t room_nodes : {size_t(1), size_t(expected.node_count()), size_t(h.node_count())}) {
+                SCOPED_TRACE("room for " + std::to_string(room_nodes) + " nodes");
+                SubforestRoom room = HierarchyBuilder::subforest_room(h, room_nodes, room_nodes / 2);
+                std::vector<VertexId> vertex_of;
+                const Hierarchy chunk = extract_roots(h, part, root_of, local.data(), &vertex_of, &room);
+                EXPECT_TRUE(identical(chunk, expected));
+                EXPECT_TRUE(same_ids(chunk, expected));
+                EXPECT_EQ(vertex_of, expected_vertex_of);
+            }
         }
     }
 }

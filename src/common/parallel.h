@@ -29,8 +29,8 @@ template <class Task>
 }
 
 // Calls task(i) for i in [0, count) on up to `threads` threads (the caller's thread is one of
-// them). The first exception a task throws is rethrown here once every thread has stopped; the
-// tasks not started by then are skipped.
+// them, and takes task 0 first). The first exception a task throws is rethrown here once every
+// thread has stopped; the tasks not started by then are skipped.
 template <class Task>
 void parallel_for(size_t count, unsigned threads, Task&& task) {
     const size_t workers = std::min<size_t>(count, std::max(1u, threads));
@@ -42,8 +42,8 @@ void parallel_for(size_t count, unsigned threads, Task&& task) {
     std::atomic<bool> failed{false};
     std::exception_ptr error;
     std::mutex error_mutex;
-    auto work = [&] {
-        for (size_t i = next++; i < count && !failed; i = next++) {
+    auto work = [&](size_t i) {
+        for (; i < count && !failed; i = next++) {
             try {
                 run_task(task, i);
             } catch (...) {
@@ -53,16 +53,17 @@ void parallel_for(size_t count, unsigned threads, Task&& task) {
             }
         }
     };
+    const size_t first = next++;  // this thread's first task is task 0, however fast the others start
     std::vector<std::thread> pool;
     pool.reserve(workers - 1);
     for (size_t t = 1; t < workers; ++t) {
         try {
-            pool.emplace_back(work);
+            pool.emplace_back([&] { work(next++); });
         } catch (const std::system_error&) {  // no more threads to be had: the others do the work
             break;
         }
     }
-    work();
+    work(first);
     for (std::thread& thread : pool) thread.join();
     if (error) std::rethrow_exception(error);
 }

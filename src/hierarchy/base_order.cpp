@@ -225,11 +225,15 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
 // Written in the replay's order, so that each node finds its parent's vertices and midpoints made.
 Hierarchy HierarchyBuilder::subforest(const Hierarchy& h, TriangleMesh base, const std::vector<NodeId>& roots,
                                       const std::vector<VertexId>& base_vertex, const std::vector<uint32_t>& root_of,
-                                      const std::vector<uint8_t>& root_in, NodeId* local, std::vector<VertexId>* vertex_of_out) {
+                                      const std::vector<uint8_t>& root_in, NodeId* local, std::vector<VertexId>* vertex_of_out,
+                                      SubforestRoom* room) {
     Hierarchy out(std::move(base));
+    if (room != nullptr) adopt_storage(out, std::move(room->arrays));
     const NodeId root_count = out.root_count();
     // Node j of the result is node old_of[j] of h.
-    std::vector<NodeId> old_of(roots);
+    std::vector<NodeId> old_of;
+    if (room != nullptr) old_of.swap(room->old_of);
+    old_of.assign(roots.begin(), roots.end());
     reserve_huge(old_of, h.node_count(), HugePages::written_whole);  // address space: only the chunk's part is touched
     for (size_t j = 0; j < old_of.size(); ++j) {
         const NodeId o = old_of[j];
@@ -239,7 +243,9 @@ Hierarchy HierarchyBuilder::subforest(const Hierarchy& h, TriangleMesh base, con
     }
     const size_t n = old_of.size();
     auto taken = [&](NodeId q) { return q != kNoNode && root_in[root_of[q]] != 0; };
-    std::vector<VertexId> vertex_of(base_vertex);
+    std::vector<VertexId> vertex_of;
+    if (room != nullptr) vertex_of.swap(room->vertex_of);
+    vertex_of.assign(base_vertex.begin(), base_vertex.end());
     reserve_huge(vertex_of, h.positions().size(), HugePages::written_whole);
     reserve_huge(out.nodes_, n, HugePages::written_whole);
     out.nodes_.resize(n);  // the roots stay as the constructor made them
@@ -299,6 +305,23 @@ Hierarchy HierarchyBuilder::subforest(const Hierarchy& h, TriangleMesh base, con
     out.live_vertices_ = uint32_t(out.positions_.size());
     if (vertex_of_out != nullptr) *vertex_of_out = std::move(vertex_of);
     return out;
+}
+
+SubforestRoom HierarchyBuilder::subforest_room(const Hierarchy& h, size_t nodes, size_t vertices) {
+    SubforestRoom room;
+    nodes = std::min<size_t>(nodes, h.node_count());
+    vertices = std::min(vertices, h.positions().size());
+    reserve_huge(room.arrays.nodes_, nodes, HugePages::written_whole);
+    reserve_huge(room.arrays.block_parent_, nodes / 4, HugePages::written_whole);
+    reserve_huge(room.arrays.positions_, h.positions().size(), HugePages::written_whole);  // address space
+    reserve_huge(room.old_of, h.node_count(), HugePages::written_whole);                  // as in subforest
+    reserve_huge(room.vertex_of, h.positions().size(), HugePages::written_whole);
+    populate_pages(room.arrays.nodes_.data(), nodes * sizeof(Hierarchy::Node));
+    populate_pages(room.arrays.block_parent_.data(), nodes / 4 * sizeof(NodeId));
+    populate_pages(room.arrays.positions_.data(), vertices * sizeof(Vec3));
+    populate_pages(room.old_of.data(), nodes * sizeof(NodeId));
+    populate_pages(room.vertex_of.data(), vertices * sizeof(VertexId));
+    return room;
 }
 
 }  // namespace amc

@@ -74,6 +74,13 @@ struct HierarchySlice {
     std::string owner = "a chunk";  // what fills it, in errors
 };
 
+// The arrays subforest() fills (HierarchyBuilder::subforest_room).
+struct SubforestRoom {
+    Hierarchy arrays;  // node, block and position arrays (adopt_storage)
+    std::vector<NodeId> old_of;
+    std::vector<VertexId> vertex_of;
+};
+
 // A whole level's splits: the distinct splittable leaves parents[0..count) of one level, whose
 // same-level neighbours are not refined yet, in the order they are split, and the links of the
 // nodes they make: children[4 * i + k] for child k of parents[i], with local index 4 * j + k'
@@ -226,10 +233,16 @@ struct HierarchyBuilder {
     // diagonal flags on leaves. root_of[q] is the root of h's node q and root_in[r] marks the
     // roots taken; local[q] (one word per node of h) receives the result's id of each node taken
     // and is read only for them, so calls on disjoint roots may share it at once. `vertex_of`
-    // receives each vertex's id in h.
+    // receives each vertex's id in h. With `room` (subforest_room's), its arrays are those of the
+    // result and of the replay.
     static Hierarchy subforest(const Hierarchy& h, TriangleMesh base, const std::vector<NodeId>& roots,
                                const std::vector<VertexId>& base_vertex, const std::vector<uint32_t>& root_of,
-                               const std::vector<uint8_t>& root_in, NodeId* local, std::vector<VertexId>* vertex_of);
+                               const std::vector<uint8_t>& root_in, NodeId* local, std::vector<VertexId>* vertex_of,
+                               SubforestRoom* room = nullptr);
+    // Room for a subforest of h of `nodes` nodes and about `vertices` vertices, made resident by
+    // the calling thread (populate_pages: on the project's VM several times cheaper than the
+    // subforest's writes faulting it in) and in its malloc arena, also when another thread fills it.
+    static SubforestRoom subforest_room(const Hierarchy& h, size_t nodes, size_t vertices);
     // The reader of a hierarchy file has made every structural check check_invariants makes (its
     // forest replayed with split() under can_split, the closure checked): writers may skip them
     // while nothing changes the forest (writer_checks.h).

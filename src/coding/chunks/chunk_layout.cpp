@@ -87,7 +87,7 @@ Hierarchy extract_roots(const Hierarchy& h, const std::vector<RootRange>& roots,
 }
 
 Hierarchy extract_roots(const Hierarchy& h, const std::vector<RootRange>& roots, const std::vector<uint32_t>& root_of,
-                        NodeId* local, std::vector<VertexId>* vertex_of) {
+                        NodeId* local, std::vector<VertexId>* vertex_of, SubforestRoom* room) {
     std::vector<VertexId> base_vertex;
     TriangleMesh base = base_of_roots(h.base(), roots, base_vertex);
     std::vector<NodeId> root_ids;
@@ -97,7 +97,7 @@ Hierarchy extract_roots(const Hierarchy& h, const std::vector<RootRange>& roots,
             root_ids.push_back(r);
             root_in[r] = 1;
         }
-    return HierarchyBuilder::subforest(h, std::move(base), root_ids, base_vertex, root_of, root_in, local, vertex_of);
+    return HierarchyBuilder::subforest(h, std::move(base), root_ids, base_vertex, root_of, root_in, local, vertex_of, room);
 }
 
 }  // namespace amc

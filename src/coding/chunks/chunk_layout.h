@@ -12,6 +12,8 @@
 
 namespace amc {
 
+struct SubforestRoom;
+
 struct RootRange {
     uint32_t first = 0, count = 0;
 };
@@ -35,8 +37,9 @@ TriangleMesh base_of_roots(const TriangleMesh& base, const std::vector<RootRange
 // diagonal flags. `vertex_of` receives, for each vertex id of the result, the id in h.
 Hierarchy extract_roots(const Hierarchy& h, const std::vector<RootRange>& roots, std::vector<VertexId>* vertex_of = nullptr);
 // The same with root_of_nodes(h) made once by the caller and `local` (h.node_capacity() words) as
-// scratch: calls on disjoint roots may share both and run at once.
+// scratch: calls on disjoint roots may share both and run at once. With `room`, the result and
+// its replay take its arrays (HierarchyBuilder::subforest_room).
 Hierarchy extract_roots(const Hierarchy& h, const std::vector<RootRange>& roots, const std::vector<uint32_t>& root_of,
-                        NodeId* local, std::vector<VertexId>* vertex_of);
+                        NodeId* local, std::vector<VertexId>* vertex_of, SubforestRoom* room = nullptr);
 
 }  // namespace amc

@@ -8,6 +8,7 @@
 #include "common/check.h"
 #include "common/huge_pages.h"
 #include "common/parallel.h"
+#include "hierarchy/hierarchy_builder.h"
 
 #include <algorithm>
 #include <cstddef>
@@ -46,28 +47,34 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& ro
     const size_t local_bytes = written_whole_bytes(size_t(h.node_capacity()) * sizeof(NodeId));
     const std::unique_ptr<NodeId[]> local(new NodeId[local_bytes / sizeof(NodeId)]);
     advise_huge_pages(local.get(), local_bytes, HugePages::written_whole);
-    struct Extracted {
-        Hierarchy chunk;
-        std::vector<VertexId> vertex_of;
+    // Each chunk is copied into a room made resident first (subforest_room). The rooms of the
+    // chunks the other threads take first (tasks 1 .. threads - 1; this thread, which starts them,
+    // takes task 0) are made here before they start, so that those copies live in this thread's
+    // malloc arena and a worker's arena holds only its level coder's working memory, which glibc
+    // then keeps from one encode to the next: a worker that allocated its own copy had its arena
+    // trimmed after each encode and faulted ~4,300 fresh pages into it again, and a worker whose
+    // copy this thread made had to wait for it (docs/BENCHMARKS.md, "Threads and memory"). Which
+    // thread takes which chunk changes no byte.
+    std::vector<uint64_t> chunk_nodes(ranges.size(), 0);
+    for (size_t c = 0; c < ranges.size(); ++c) chunk_nodes[c] = ranges[c].count;
+    for (NodeId n = h.root_count(); n < h.node_capacity(); n += 4)  // blocks of four siblings
+        if (root_of[n] != kNoNode) chunk_nodes[chunk_of_root[root_of[n]]] += 4;
+    auto room_for = [&](size_t c) {
+        // Vertices in proportion to nodes, with some slack (what the room lacks is faulted in).
+        const double share = double(chunk_nodes[c]) / double(std::max<size_t>(1, h.node_count()));
+        return HierarchyBuilder::subforest_room(h, size_t(chunk_nodes[c]), size_t(1.0625 * share * double(h.positions().size())));
     };
-    std::vector<Extracted> extracted(ranges.size());
-    auto extract = [&](size_t c) { extracted[c].chunk = extract_roots(h, {ranges[c]}, root_of, local.get(), &extracted[c].vertex_of); };
-    // The chunks the other threads take first (tasks 1 .. threads - 1: this thread, which starts them,
-    // almost always takes task 0) are extracted here before they start, so that their copies live
-    // in this thread's malloc arena and a worker's arena holds only its level coder's working
-    // memory, which glibc then keeps from one encode to the next. A worker that extracted its own
-    // chunk had its arena trimmed after each encode and faulted ~4,300 fresh pages into it again
-    // (docs/BENCHMARKS.md, "Threads and memory"). Which thread takes which chunk changes no byte.
-    const size_t extracted_first = threads > 1 ? std::min<size_t>(threads, ranges.size()) : 1;
-    for (size_t c = 1; c < extracted_first; ++c) extract(c);
+    const size_t made_first = threads > 1 ? std::min<size_t>(threads, ranges.size()) : 1;
+    std::vector<SubforestRoom> rooms(ranges.size());
+    for (size_t c = 1; c < made_first; ++c) rooms[c] = room_for(c);
     // With `kept`, one memory a thread for the chunks it takes (a task's end gives it back for the
     // next task). Without, each chunk's encoder allocates its own, as before (a memory held through
     // the whole encode only moves where glibc puts the other blocks: "Threads and memory").
     parallel_for(ranges.size(), threads, [&](size_t c) {
         std::unique_ptr<ChunkEncoderMemory> memory = kept != nullptr ? kept->take() : nullptr;
-        if (c == 0 || c >= extracted_first) extract(c);
-        const Hierarchy chunk = std::move(extracted[c].chunk);  // freed with the task
-        const std::vector<VertexId> vertex_of = std::move(extracted[c].vertex_of);
+        if (c == 0 || c >= made_first) rooms[c] = room_for(c);
+        std::vector<VertexId> vertex_of;
+        const Hierarchy chunk = extract_roots(h, {ranges[c]}, root_of, local.get(), &vertex_of, &rooms[c]);
         VertexKeys keys(vertex_of.size(), kNoVertex);
         for (size_t v = 0; v < vertex_of.size(); ++v)
             if (vertex_of[v] != kNoVertex) keys[v] = key_of_vertex[vertex_of[v]];
