@@ -5,10 +5,13 @@
 // With --kept-encoders, amcodec's complete files are encoded through one EncodeContext and Draco's
 // through one encoder object per model and mode, kept over the runs (as a caller coding a series
 // keeps them); without it every encode starts afresh.
+// With --faults FILE, every timed encode of a complete mesh (amcodec's and Draco's) writes a line
+// "coder model bits minor-page-faults seconds" there: the fresh pages an encode took in this
+// process (docs/BENCHMARKS.md, "One-core encode, twenty-first step").
 // A mesh file (OBJ, OFF, PLY, VTU) is a model as users have it: imported over the coarsest base
 // found in it (import_mesh), which for an irregular mesh is mostly the mesh itself.
 //
-//   compare_bench [--runs N] [--kept-encoders] [--csv FILE] [--markdown FILE] corpus/*.amh mesh.obj ...
+//   compare_bench [--runs N] [--kept-encoders] [--faults FILE] [--csv FILE] [--markdown FILE] corpus/*.amh mesh.obj ...
 #include "bench_common.h"
 #include "compare_check.h"
 #include "compare_draco.h"
@@ -29,9 +32,29 @@
 #include <string>
 #include <vector>
 
+#include <sys/resource.h>
+
 namespace amc_bench {
 
 namespace {
+
+FILE* fault_log = nullptr;  // --faults
+
+// step(), and with --faults its minor page faults and seconds as a line of the log.
+template <class Step>
+void logged_encode(const char* coder, const std::string& model, int bits, Step&& step) {
+    if (fault_log == nullptr) {
+        step();
+        return;
+    }
+    rusage before, after;
+    getrusage(RUSAGE_THREAD, &before);
+    const Clock::time_point start = Clock::now();
+    step();
+    const double seconds = seconds_since(start);
+    getrusage(RUSAGE_THREAD, &after);
+    std::fprintf(fault_log, "%s %s %d %ld %.6f\n", coder, model.c_str(), bits, after.ru_minflt - before.ru_minflt, seconds);
+}
 
 // Runs `step` `runs` times and returns the median time; `step` keeps its last output itself.
 // `release`, untimed before each step, gives back the output of the step before: a decode then
@@ -167,7 +190,8 @@ void measure_draco(const Model& m, int runs, bool kept_encoders, std::vector<Res
                 {
                     DracoKeptEncoder kept;  // given back before the decodes are timed
                     for (int run = 0; run < runs; ++run) {
-                        encoded = draco_encode(input, settings, kept_encoders ? &kept : nullptr);
+                        logged_encode(coder.c_str(), m.name, bits,
+                                      [&] { encoded = draco_encode(input, settings, kept_encoders ? &kept : nullptr); });
                         encode_times.push_back(encoded.seconds);
                         connectivity_encode.push_back(encoded.connectivity_seconds);
                     }
@@ -262,7 +286,9 @@ void measure_amcodec(const Model& m, int runs, bool kept_encoders, std::vector<R
         {
             amc::EncodeContext context;  // its memory given back before the decodes are timed
             r.encode_seconds = median_seconds(runs, [&] {
-                file = kept_encoders ? amc::encode(context, m.hierarchy, options, &stats) : amc::encode(m.hierarchy, options, &stats);
+                logged_encode("amc-best", m.name, bits, [&] {
+                    file = kept_encoders ? amc::encode(context, m.hierarchy, options, &stats) : amc::encode(m.hierarchy, options, &stats);
+                });
             });
         }
         r.decode_seconds = median_seconds(runs, [&] { back = amc::decode(file.data(), file.size(), decode_options); }, [&] { back = {}; });
@@ -366,7 +392,7 @@ Model load_model(const std::string& path) {
 int run(int argc, char** argv) {
     int runs = 3;
     bool kept_encoders = false;
-    std::string csv_path, markdown_path;
+    std::string csv_path, markdown_path, fault_path;
     std::vector<std::string> inputs;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
@@ -376,14 +402,19 @@ int run(int argc, char** argv) {
         };
         if (arg == "--runs") runs = std::max(1, std::stoi(value()));
         else if (arg == "--kept-encoders") kept_encoders = true;
+        else if (arg == "--faults") fault_path = value();
         else if (arg == "--csv") csv_path = value();
         else if (arg == "--markdown") markdown_path = value();
         else if (arg.rfind("--", 0) == 0) throw std::runtime_error("unknown option " + arg);
         else inputs.push_back(arg);
     }
     if (inputs.empty()) {
-        std::fprintf(stderr, "usage: compare_bench [--runs N] [--kept-encoders] [--csv FILE] [--markdown FILE] model.amh...\n");
+        std::fprintf(stderr, "usage: compare_bench [--runs N] [--kept-encoders] [--faults FILE] [--csv FILE] [--markdown FILE] model.amh...\n");
         return 2;
+    }
+    if (!fault_path.empty()) {
+        fault_log = std::fopen(fault_path.c_str(), "w");
+        if (fault_log == nullptr) throw std::runtime_error("can not write " + fault_path);
     }
     std::vector<Result> results;
     for (const std::string& path : inputs) {
@@ -398,6 +429,7 @@ int run(int argc, char** argv) {
         std::fprintf(stderr, "%-18s %7zu faces  %5.1f s  %s\n", m.name.c_str(), m.leaf.triangles.size(), seconds_since(start),
                      failed ? "SOME CHECKS FAILED" : "all checks passed");
     }
+    if (fault_log != nullptr) std::fclose(fault_log);
     if (!csv_path.empty()) write_csv(csv_path, results);
     if (!markdown_path.empty()) write_markdown(markdown_path, results, runs);
     return 0;

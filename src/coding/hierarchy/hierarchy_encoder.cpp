@@ -92,7 +92,9 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         // otherwise, and with the 1-regularity rule such nodes start decided as leaves.
         uint32_t unbalanced = n;
         const uint8_t* state = level.state();
-        constexpr uint32_t kAhead = 16;
+        // h's nodes in the level's order are blocks of four at scattered places: 128 nodes ahead
+        // keep about 32 blocks on their way (16 left the loop waiting on the node loads).
+        constexpr uint32_t kAhead = 128;
         for (uint32_t i = 0; i < n && i < kAhead; ++i) HierarchyBuilder::prefetch(h, ids[i]);
         for (uint32_t i = 0; i < n; ++i) {
             if (i + kAhead < n) HierarchyBuilder::prefetch(h, ids[i + kAhead]);
