@@ -41,6 +41,40 @@ struct SearchRun {
     std::vector<std::vector<Triangle>> blockers;
 };
 
+// One more level undone at the end of `run`, seeded only where the last step changed the mesh
+// or, `everywhere`, on the whole mesh; in step s the vertices marked in kept[s] (if any) stay.
+// Returns whether the step undid anything.
+bool undo_one_level(const std::vector<Triangle>& triangles, uint32_t vertex_count,
+                    const std::vector<std::vector<uint8_t>>& kept, bool everywhere, SearchRun& run) {
+    const size_t s = run.levels.size();
+    const bool has_kept = s < kept.size() && !kept[s].empty();
+    const std::vector<uint8_t> unrefined(s == 0 ? triangles.size() : 0, 0);
+    detail::CoarserLevel coarser = detail::undo_refinement_level(
+        s == 0 ? triangles : run.levels[s - 1].triangles, s == 0 ? unrefined : run.refined[s - 1], vertex_count,
+        s == 0 || everywhere ? nullptr : &run.changed[s - 1], has_kept ? &kept[s] : nullptr);
+    if (coarser.red_blocks == 0) return false;
+    DetectedLevel level;
+    level.splits = std::move(coarser.splits);
+    level.closures = coarser.green_groups;
+    level.triangles = std::move(coarser.triangles);
+    run.levels.push_back(std::move(level));
+    run.refined.push_back(std::move(coarser.refined));
+    run.changed.push_back(std::move(coarser.changed));
+    run.blockers.push_back(std::move(coarser.blockers));
+    return true;
+}
+
+size_t base_size(const SearchRun& run, size_t leaf_triangles) {
+    return run.levels.empty() ? leaf_triangles : run.levels.back().triangles.size();
+}
+
+// Whether a search that left `base` of the `leaf` triangles undid at least 1/10 of them: an
+// adaptive mesh, where an irregular one reads a few small patches only.
+bool undid_much(size_t base, size_t leaf) {
+    constexpr size_t kReadMuch = 10;  // base <= leaf * 9 / 10
+    return base * kReadMuch <= leaf * (kReadMuch - 1);
+}
+
 // The levels undone from step `from` on, the earlier ones of `run` standing; in step s the
 // vertices marked in kept[s] (if any) stay.
 void undo_levels_from(const std::vector<Triangle>& triangles, uint32_t vertex_count, size_t from,
@@ -49,28 +83,24 @@ void undo_levels_from(const std::vector<Triangle>& triangles, uint32_t vertex_co
     run.refined.resize(from);
     run.changed.resize(from);
     run.blockers.resize(from);
-    const std::vector<uint8_t> unrefined(triangles.size(), 0);
     // Each level undone adds one to the depth of the hierarchy, which kMaxLevel caps.
-    while (run.levels.size() < size_t(kMaxLevel)) {
-        const size_t s = run.levels.size();
-        const bool has_kept = s < kept.size() && !kept[s].empty();
-        detail::CoarserLevel coarser = detail::undo_refinement_level(
-            s == 0 ? triangles : run.levels[s - 1].triangles, s == 0 ? unrefined : run.refined[s - 1], vertex_count,
-            s == 0 ? nullptr : &run.changed[s - 1], has_kept ? &kept[s] : nullptr);
-        if (coarser.red_blocks == 0) break;
-        DetectedLevel level;
-        level.splits = std::move(coarser.splits);
-        level.closures = coarser.green_groups;
-        level.triangles = std::move(coarser.triangles);
-        run.levels.push_back(std::move(level));
-        run.refined.push_back(std::move(coarser.refined));
-        run.changed.push_back(std::move(coarser.changed));
-        run.blockers.push_back(std::move(coarser.blockers));
+    while (run.levels.size() < size_t(kMaxLevel) && undo_one_level(triangles, vertex_count, kept, false, run)) {
     }
 }
 
-size_t base_size(const SearchRun& run, size_t leaf_triangles) {
-    return run.levels.empty() ? leaf_triangles : run.levels.back().triangles.size();
+// Where the search stopped after undoing much of an adaptive mesh: a step seeded on the whole
+// mesh and, if it undoes something, the steps after it, a few rounds. A step seeds only where
+// the last one changed the mesh, and its failing growths mark the true blocks they pass as
+// explored; a fresh step seeded everywhere reads the valid patches left so (docs/IMPORT.md,
+// "Seeded everywhere once stopped"). It only adds levels: the base found is never finer.
+void seed_everywhere_once_stopped(const std::vector<Triangle>& triangles, uint32_t vertex_count, SearchRun& run) {
+    if (!undid_much(base_size(run, triangles.size()), triangles.size())) return;
+    constexpr int kRounds = 8;
+    for (int round = 0; round < kRounds && run.levels.size() + 1 < size_t(kMaxLevel); ++round) {
+        if (!undo_one_level(triangles, vertex_count, {}, true, run)) break;
+        while (run.levels.size() < size_t(kMaxLevel) && undo_one_level(triangles, vertex_count, {}, false, run)) {
+        }
+    }
 }
 
 std::array<uint32_t, 3> vertex_set(uint32_t a, uint32_t b, uint32_t c) {
@@ -192,8 +222,8 @@ void renumber(std::vector<Triangle>& triangles, const std::vector<uint32_t>& id)
 }  // namespace detail
 
 bool searched_again(size_t base, size_t leaf, size_t levels) {
-    constexpr size_t kFarFromBase = 16, kReadMuch = 10;  // base > leaf / 16; base <= leaf * 9 / 10
-    return base * kFarFromBase > leaf && (base * kReadMuch <= leaf * (kReadMuch - 1) || levels == 0);
+    constexpr size_t kFarFromBase = 16;  // base > leaf / 16
+    return base * kFarFromBase > leaf && (undid_much(base, leaf) || levels == 0);
 }
 
 DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what) {
@@ -216,6 +246,7 @@ DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what) {
         SearchRun other = search_levels(reversed, vertex_count);
         if (base_size(other, renumbered.size()) < base_size(run, renumbered.size())) run = std::move(other);
     }
+    seed_everywhere_once_stopped(renumbered, vertex_count, run);
     out.levels = std::move(run.levels);
     for (DetectedLevel& level : out.levels) {
         detail::renumber(level.triangles, input_of);
