@@ -2,6 +2,7 @@
 // a brute-force scan: the same vertex for every query, on uniform and strongly graded point sets;
 // and, where vertices lie equally near, against the k-d tree whose order the import's answers follow.
 #include "import/nearest_vertex.h"
+#include "import/spatial_order.h"
 
 #include <gtest/gtest.h>
 
@@ -180,6 +181,33 @@ TEST(NearestVertex, CrowdedCellsAreSearchedAsTheRest) {
         const uint32_t n = nearest.find_nearest(p, usable, amc::NearestVertex::kMaxCount, found);
         ASSERT_EQ(n, amc::NearestVertex::kMaxCount);
         for (uint32_t i = 0; i < n; ++i) EXPECT_EQ(found[i], sorted[i]) << "query " << query << ", rank " << i;
+    }
+}
+
+// The import numbers the leaf vertices in spatial order and hands the tree their codes
+// (spatial_vertex_order's), which it then neither computes nor sorts: the same answers.
+TEST(NearestVertex, TreeOverTheSpatialOrderTakesItsCodes) {
+    Lcg random{77};
+    for (bool graded : {false, true}) {
+        std::vector<amc::Vec3> points(3000);
+        for (amc::Vec3& p : points) {
+            p = {random.unit(), random.unit(), 0.01 * random.unit()};
+            if (graded) p = std::pow(random.unit(), 3.0) * p;
+        }
+        std::vector<uint32_t> codes;
+        const std::vector<uint32_t> order = amc::detail::spatial_vertex_order(points, &codes);  // spatial -> given
+        ASSERT_EQ(codes.size(), points.size());
+        ASSERT_TRUE(std::is_sorted(codes.begin(), codes.end()));
+        std::vector<amc::Vec3> spatial;
+        for (uint32_t v : order) spatial.push_back(points[v]);
+        EXPECT_EQ(codes, amc::detail::morton_codes(spatial));
+        const amc::NearestVertex nearest(spatial, nullptr, &codes);
+        for (int query = 0; query < 500; ++query) {
+            const amc::Vec3 p = {1.2 * random.unit() - 0.1, 1.2 * random.unit() - 0.1, 0.02 * random.unit()};
+            const uint32_t found = nearest.find(p, [&](uint32_t s) { return order[s] % 3 != 0; });
+            ASSERT_NE(found, amc::kNoIndex);
+            EXPECT_EQ(order[found], brute_force(points, p, 3)) << "graded " << graded << ", query " << query;
+        }
     }
 }
 

@@ -56,6 +56,17 @@ public:
         }
     }
 
+    // Whether p holds for every neighbour of u (as for_each_neighbor_once visits them), stopping
+    // at the first for which it does not.
+    template <class P>
+    bool every_neighbor(uint32_t u, P p) const {
+        for (uint32_t i = start_[u], end = start_[u + 1]; i < end; ++i) {
+            if (!p(entries_[i].to)) return false;
+            if (!(entries_[i].face & kApexIsEnd) && !p(entries_[i].apex)) return false;
+        }
+        return true;
+    }
+
 private:
     struct Entry {
         uint32_t to, apex, face;  // face: its top bit kApexIsEnd (faces are fewer than 2^30)

@@ -171,7 +171,8 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     // nearly every lookup of a large mesh misses the cache) and answers in the input's ids. The
     // faces keep their order, and the position index and the k-d tree take the vertices in the
     // input's order, so every choice (the first of two equal candidates) is the input order's.
-    const std::vector<uint32_t> input_of = detail::spatial_vertex_order(leaf.positions);  // spatial id -> input id
+    std::vector<uint32_t> spatial_codes;  // the nearest-vertex tree's, in spatial order
+    const std::vector<uint32_t> input_of = detail::spatial_vertex_order(leaf.positions, &spatial_codes);  // spatial id -> input id
     const std::vector<uint32_t> spatial_of = inverse(input_of);
     const TriangleMesh spatial = renumbered(leaf, input_of, spatial_of);
     uint32_t first = kNoIndex, second = kNoIndex;
@@ -219,7 +220,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     };
     // What the anchored way undid, kept for the guided ways' second round (in renumbered's ids).
     UndoSteps steps;
-    LeafSearch search(spatial, &spatial_of);
+    LeafSearch search(spatial, &spatial_of, &spatial_codes);
     std::unique_ptr<RenumberedLeaf> renumbered;  // made for the anchored way
     auto guide_of = [](Way way) {
         return way == Way::exact_midpoints ? MidpointGuide::exact

@@ -13,8 +13,9 @@
 
 namespace amc {
 
-LeafSearch::LeafSearch(const TriangleMesh& leaf, const std::vector<uint32_t>* insertion_order)
-    : leaf_(leaf), insertion_order_(insertion_order) {}
+LeafSearch::LeafSearch(const TriangleMesh& leaf, const std::vector<uint32_t>* insertion_order,
+                       const std::vector<uint32_t>* sorted_codes)
+    : leaf_(leaf), insertion_order_(insertion_order), sorted_codes_(sorted_codes) {}
 LeafSearch::LeafSearch(LeafSearch& input, const std::vector<uint32_t>& new_id)
     : leaf_(input.leaf_), insertion_order_(nullptr), input_(&input), new_id_(&new_id) {}
 LeafSearch::~LeafSearch() = default;
@@ -22,7 +23,7 @@ LeafSearch::~LeafSearch() = default;
 const NearestVertex& LeafSearch::nearest() {
     if (!nearest_) {
         nearest_ = input_ ? std::make_unique<NearestVertex>(input_->nearest(), *new_id_)
-                          : std::make_unique<NearestVertex>(leaf_.positions, insertion_order_);
+                          : std::make_unique<NearestVertex>(leaf_.positions, insertion_order_, sorted_codes_);
     }
     return *nearest_;
 }
@@ -105,10 +106,10 @@ void Reconstruction::read_level(const std::vector<NodeId>& level, std::vector<No
     for (NodeId n : level) {
         if (classify(n)) refined.push_back(n);
     }
-    for (NodeId n : refined) {
-        if (refined_mark_.size() <= n) refined_mark_.resize(size_t(n) + 1, 0);
-        refined_mark_[n] = 1;
-    }
+    // Sized once for every node the hierarchy can hold (grown a node at a time, its resizes were
+    // 1% of a 10^6-face import's instructions).
+    if (refined_mark_.size() < h_.node_capacity()) refined_mark_.resize(h_.node_capacity(), 0);
+    for (NodeId n : refined) refined_mark_[n] = 1;
     auto is_refined = [&](NodeId q) { return q != kNoNode && q < refined_mark_.size() && refined_mark_[q]; };
     try {
         for (NodeId n : refined) {
@@ -321,14 +322,15 @@ uint32_t Reconstruction::only_unmatched_common_neighbor(uint32_t a, uint32_t b) 
     he_.for_each_neighbor_once(b, [&](uint32_t x) {
         if (vertex_of_leaf_[x] == kNoIndex) around_b_.push_back(x);
     });
+    if (around_b_.empty()) return kNoIndex;
     uint32_t found = kNoIndex;
-    bool ambiguous = false;
-    he_.for_each_neighbor_once(a, [&](uint32_t x) {
-        if (x == found || std::find(around_b_.begin(), around_b_.end(), x) == around_b_.end()) return;
-        if (found != kNoIndex) ambiguous = true;
+    const bool unique = he_.every_neighbor(a, [&](uint32_t x) {
+        if (x == found || std::find(around_b_.begin(), around_b_.end(), x) == around_b_.end()) return true;
+        if (found != kNoIndex) return false;  // a second one
         found = x;
+        return true;
     });
-    return ambiguous ? kNoIndex : found;
+    return unique ? found : kNoIndex;
 }
 
 std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,

@@ -23,8 +23,10 @@ class NearestVertex;
 // reconstruction's nearest-vertex queries; a refusal runs six guided ways).
 class LeafSearch {
 public:
-    // The k-d tree takes the vertices in `insertion_order` (NearestVertex), if given.
-    explicit LeafSearch(const TriangleMesh& leaf, const std::vector<uint32_t>* insertion_order = nullptr);
+    // The k-d tree takes the vertices in `insertion_order` (NearestVertex), if given; the
+    // nearest-vertex tree takes `sorted_codes` (NearestVertex), if given.
+    explicit LeafSearch(const TriangleMesh& leaf, const std::vector<uint32_t>* insertion_order = nullptr,
+                        const std::vector<uint32_t>* sorted_codes = nullptr);
     // The searches of `input` on its mesh renumbered (`new_id`: input id -> this numbering, the
     // positions and faces otherwise the same): the surface tree is input's (closest points do not
     // depend on the numbering), the k-d tree input's with its ids mapped (the same points in the
@@ -37,6 +39,7 @@ public:
 private:
     const TriangleMesh& leaf_;
     const std::vector<uint32_t>* insertion_order_;
+    const std::vector<uint32_t>* sorted_codes_ = nullptr;
     LeafSearch* input_ = nullptr;                 // the searches this one renumbers, if any
     const std::vector<uint32_t>* new_id_ = nullptr;
     std::unique_ptr<NearestVertex> nearest_;

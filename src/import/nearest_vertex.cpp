@@ -7,24 +7,28 @@
 
 namespace amc {
 
-NearestVertex::NearestVertex(const std::vector<Vec3>& positions, const std::vector<uint32_t>* insertion_order)
+NearestVertex::NearestVertex(const std::vector<Vec3>& positions, const std::vector<uint32_t>* insertion_order,
+                             const std::vector<uint32_t>* sorted_codes)
     : positions_(&positions), insertion_order_(insertion_order) {
     const uint32_t n = uint32_t(positions.size());
     if (n == 0) return;
-    // Cubic cells: on a flat mesh moved off its plane, per-axis cells would split first on the
-    // noise of the thin axis, whose gaps prune nothing.
-    const std::vector<uint32_t> code = detail::morton_codes(positions, true);
-    const std::vector<uint32_t> order = detail::order_by_codes(code);
-    std::vector<uint32_t> sorted_codes(n);
     points_.reserve(n);
     advise_huge_pages(points_.data(), points_.capacity() * sizeof(Point));  // each query reads a few buckets
+    nodes_.reserve(size_t(4) * (n / kBucket + 1));
+    if (sorted_codes != nullptr && sorted_codes->size() == n) {
+        for (uint32_t v = 0; v < n; ++v) points_.push_back({{positions[v].x, positions[v].y, positions[v].z}, v});
+        build_node(*sorted_codes, 0, n, 0);
+        return;
+    }
+    const std::vector<uint32_t> code = detail::morton_codes(positions);
+    const std::vector<uint32_t> order = detail::order_by_codes(code);
+    std::vector<uint32_t> codes_in_order(n);
     for (uint32_t i = 0; i < n; ++i) {
         const uint32_t v = order[i];
         points_.push_back({{positions[v].x, positions[v].y, positions[v].z}, v});
-        sorted_codes[i] = code[v];
+        codes_in_order[i] = code[v];
     }
-    nodes_.reserve(size_t(4) * (n / kBucket + 1));
-    build_node(sorted_codes, 0, n, 0);
+    build_node(codes_in_order, 0, n, 0);
 }
 
 NearestVertex::Box NearestVertex::build_node(const std::vector<uint32_t>& codes, uint32_t begin, uint32_t end,

@@ -127,8 +127,10 @@ public:
 
     // The k-d tree takes the points in `insertion_order` (KdTree). `positions` and
     // `insertion_order` must outlive this object (the k-d tree is built from them when a tie
-    // first calls for it).
-    explicit NearestVertex(const std::vector<Vec3>& positions, const std::vector<uint32_t>* insertion_order = nullptr);
+    // first calls for it). `sorted_codes`: positions' Morton codes when they are already in Morton
+    // order (spatial_vertex_order's), which are then neither computed nor sorted again.
+    explicit NearestVertex(const std::vector<Vec3>& positions, const std::vector<uint32_t>* insertion_order = nullptr,
+                           const std::vector<uint32_t>* sorted_codes = nullptr);
     // `other`'s searches with every vertex v named new_id[v]: what a build over the same positions
     // renumbered, inserted in other's order, makes, without the build. `other` and new_id must
     // outlive this object (other's k-d tree, if a tie calls for it, is built once and renamed).

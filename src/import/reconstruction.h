@@ -155,14 +155,12 @@ private:
         bool operator()(uint32_t v) const {
             const uint32_t owner = r_.vertex_of_leaf_[v];
             if (owner != kNoIndex && !(swaps_ && r_.guided(owner))) return false;
-            bool fits = true;
-            r_.he_.for_each_neighbor_once(v, [&](uint32_t w) {
-                if (r_.vertex_of_leaf_[w] == kNoIndex) return;
+            return r_.he_.every_neighbor(v, [&](uint32_t w) {
+                if (r_.vertex_of_leaf_[w] == kNoIndex) return true;
                 bool listed = false;
                 for (uint32_t x : allowed_) listed |= x == w;
-                fits &= listed;
+                return listed;
             });
-            return fits;
         }
 
     private:

@@ -20,7 +20,7 @@ uint32_t spread_bits(uint32_t x) {
 
 }  // namespace
 
-std::vector<uint32_t> morton_codes(const std::vector<Vec3>& positions, bool cubic_cells) {
+std::vector<uint32_t> morton_codes(const std::vector<Vec3>& positions) {
     const uint32_t n = uint32_t(positions.size());
     std::vector<uint32_t> code(n);
     if (n == 0) return code;
@@ -32,17 +32,13 @@ std::vector<uint32_t> morton_codes(const std::vector<Vec3>& positions, bool cubi
             high[a] = std::max(high[a], c[a]);
         }
     }
-    double scale[3];
     const double largest = std::max({high[0] - low[0], high[1] - low[1], high[2] - low[2]});
-    for (int a = 0; a < 3; ++a) {
-        const double extent = cubic_cells ? largest : high[a] - low[a];  // may overflow to infinity: scale 0, one cell
-        scale[a] = extent > 0 ? double(kCellsPerAxis) / extent : 0;
-    }
+    const double scale = largest > 0 ? double(kCellsPerAxis) / largest : 0;  // may overflow to infinity: scale 0, one cell
     for (uint32_t v = 0; v < n; ++v) {
         const double c[3] = {positions[v].x, positions[v].y, positions[v].z};
         uint32_t key = 0;
         for (int a = 0; a < 3; ++a) {
-            const double t = (c[a] - low[a]) * scale[a];
+            const double t = (c[a] - low[a]) * scale;
             const uint32_t cell = t >= 0 ? uint32_t(std::min(t, double(kCellsPerAxis - 1))) : 0;  // NaN: 0
             key |= spread_bits(cell) << a;
         }
@@ -51,8 +47,14 @@ std::vector<uint32_t> morton_codes(const std::vector<Vec3>& positions, bool cubi
     return code;
 }
 
-std::vector<uint32_t> spatial_vertex_order(const std::vector<Vec3>& positions) {
-    return order_by_codes(morton_codes(positions, false));
+std::vector<uint32_t> spatial_vertex_order(const std::vector<Vec3>& positions, std::vector<uint32_t>* sorted_codes) {
+    const std::vector<uint32_t> codes = morton_codes(positions);
+    std::vector<uint32_t> order = order_by_codes(codes);
+    if (sorted_codes != nullptr) {
+        sorted_codes->resize(order.size());
+        for (size_t i = 0; i < order.size(); ++i) (*sorted_codes)[i] = codes[order[i]];
+    }
+    return order;
 }
 
 std::vector<uint32_t> order_by_codes(const std::vector<uint32_t>& code) {

@@ -10,16 +10,18 @@
 
 namespace amc::detail {
 
-// The vertex ids in Morton (Z-curve) order of their positions on a 1024^3 grid over the
-// bounding box; vertices of one cell keep their order. Linear (two counting-sort passes).
-// Coordinates must be finite.
-std::vector<uint32_t> spatial_vertex_order(const std::vector<Vec3>& positions);
+// The vertex ids in Morton (Z-curve) order of their positions on cubic cells (morton_codes);
+// vertices of one cell keep their order. Linear (two counting-sort passes). Coordinates must be
+// finite. `sorted_codes`, if given, receives the codes in that order (ascending), which the
+// nearest-vertex tree over the vertices so numbered takes instead of computing them again.
+std::vector<uint32_t> spatial_vertex_order(const std::vector<Vec3>& positions,
+                                           std::vector<uint32_t>* sorted_codes = nullptr);
 
-// The 30-bit Morton code of each vertex (bit 3k + a: bit k of its cell on axis a). Each axis
-// has 1024 cells over its extent, as spatial_vertex_order takes them; with `cubic_cells`, every
-// axis has cells of one size, 1024 over the largest extent (a flat mesh's thin axis then splits
-// no cell before the others do).
-std::vector<uint32_t> morton_codes(const std::vector<Vec3>& positions, bool cubic_cells);
+// The 30-bit Morton code of each vertex (bit 3k + a: bit k of its cell on axis a), on cubic
+// cells: 1024 over the largest extent, every axis cut in cells of that size (cells per axis
+// would split a flat mesh moved off its plane on its thin axis's noise first, scattering
+// neighbours over the whole order and the tree's first splits).
+std::vector<uint32_t> morton_codes(const std::vector<Vec3>& positions);
 
 // The indices of `codes` in increasing order of their codes, equal ones in index order (two
 // counting-sort passes).
