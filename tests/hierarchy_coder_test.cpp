@@ -6,6 +6,7 @@
 #include "hierarchy_checks.h"
 
 #include <amc/hierarchy_coder.h>
+#include <amc/refinement.h>
 
 #include <algorithm>
 #include <cmath>
@@ -489,6 +490,56 @@ TEST(HierarchyCoder, LeanDecoderBuildsWhatThePlainOneBuilds) {
         EXPECT_TRUE(identical(plain.hierarchy(), lean.hierarchy())) << "seed " << seed;
         EXPECT_TRUE(same_connectivity(h, lean.hierarchy())) << "seed " << seed;
         EXPECT_GT(largest_level, size_t(20000)) << "seed " << seed;  // links of many pages
+    }
+}
+
+// A single-stream decoder (set_single_stream, the default decode's) frees working memory as soon
+// as no later level reads it: before the last level (the stored symbols used up), and wherever a
+// level shrinks below half its scratch. Anything freed too early is read after its free (the
+// sanitizer builds catch it) or overwritten, and builds wrong levels. Every level against a plain
+// decoder, listing corners and (node, edge) pairs: a remesh, a uniform sphere (its last level
+// decided without symbols) and the graded L-shape, whose levels shrink past the finest region.
+TEST(HierarchyCoder, SingleStreamDecoderBuildsWhatThePlainOneBuilds) {
+    Hierarchy sphere(make_icosahedron());
+    refine_uniformly(sphere, 5);
+    const Hierarchy cases[] = {testing::projected_sphere(30000, 7, 3), std::move(sphere), make_l_shape_model(9)};
+    for (size_t c = 0; c < std::size(cases); ++c) {
+        const Hierarchy& h = cases[c];
+        const std::vector<uint8_t> bytes = encode_hierarchy(h, HierarchyCoderOptions{});
+        HierarchyStreamHeader header;
+        const size_t header_size = read_standalone_stream_header(bytes.data(), bytes.size(), header);
+        for (const bool listed : {false, true}) {
+            SCOPED_TRACE("case " + std::to_string(c) + (listed ? ", listed" : ""));
+            HierarchyLevelDecoder plain(h.base(), header, UINT64_MAX), single(h.base(), header, UINT64_MAX);
+            plain.set_new_vertex_listing(listed, true);
+            single.set_new_vertex_listing(listed, true);
+            single.set_single_stream(true);
+            ArithmeticDecoder plain_decoder(bytes.data() + header_size, bytes.size() - header_size);
+            ArithmeticDecoder single_decoder(bytes.data() + header_size, bytes.size() - header_size);
+            std::vector<size_t> level_sizes;
+            while (!plain.done()) {
+                ASSERT_FALSE(single.done());
+                level_sizes.push_back(plain.level_size());
+                plain.decode_level(plain_decoder);
+                single.decode_level(single_decoder);
+                ASSERT_EQ(single.new_vertex_count(), plain.new_vertex_count());
+                ASSERT_TRUE(single.new_vertices() == plain.new_vertices());
+                if (!listed) continue;
+                const std::vector<FrameCorners> a = walked_corners(plain), b = walked_corners(single);
+                ASSERT_EQ(a.size(), b.size());
+                for (size_t k = 0; k < a.size(); ++k)
+                    ASSERT_TRUE(a[k].a == b[k].a && a[k].b == b[k].b && a[k].c == b[k].c && a[k].d == b[k].d) << "vertex " << k;
+            }
+            ASSERT_TRUE(single.done());
+            single.finish();
+            EXPECT_TRUE(identical(plain.hierarchy(), single.hierarchy()));
+            EXPECT_TRUE(same_connectivity(h, single.hierarchy()));
+            if (c == 2) {  // the L-shape's levels shrink: some level less than half the one two before
+                bool shrinks = false;
+                for (size_t l = 2; l < level_sizes.size(); ++l) shrinks |= 2 * level_sizes[l] < level_sizes[l - 2];
+                EXPECT_TRUE(shrinks);
+            }
+        }
     }
 }
 

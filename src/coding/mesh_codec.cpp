@@ -600,6 +600,7 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     // The decode peaks at the last level built, whose nodes come on top of the working memory of
     // the levels before: there that memory goes back to the system.
     hierarchy.set_lean_at_end(options.lean_memory);
+    hierarchy.set_single_stream(true);
     Hierarchy& h = hierarchy.hierarchy();
     // The metadata's counts let the hierarchy grow in place, as far as the file's size warrants.
     const uint64_t reserved_nodes = std::min<uint64_t>(meta.nodes, meta.base_triangles + kReservedNodesPerFileByte * size);

@@ -147,10 +147,22 @@ public:
         return data_.get();
     }
     T* data() { return data_.get(); }
+    size_t capacity() const { return capacity_; }
     const T* data() const { return data_.get(); }
     // Gives the pages past element n back to the system (release_pages); the capacity stays.
     void release_from(size_t n) {
         if (n < capacity_) release_pages(data_.get() + n, (capacity_ - n) * sizeof(T));
+    }
+    // Gives the storage back to the allocator: capacity 0.
+    void deallocate() {
+        data_.reset();
+        capacity_ = 0;
+    }
+    // deallocate() when the storage holds more than kShrinkFactor times n elements: scratch for a
+    // level much smaller than the largest before keeps no more than it needs resident.
+    static constexpr size_t kShrinkFactor = 2;
+    void shrink_for(size_t n) {
+        if (capacity_ > kShrinkFactor * n) deallocate();
     }
 
 private:

@@ -57,6 +57,14 @@ public:
     void release() {
         for (ScratchArray<uint32_t>& stack : stacks_) stack.release_from(0);
     }
+    // Gives the buckets' storage back to the allocator: all of it, or when it is far larger than a
+    // level of n nodes needs (ScratchArray::shrink_for).
+    void deallocate() {
+        for (ScratchArray<uint32_t>& stack : stacks_) stack.deallocate();
+    }
+    void shrink_for(uint32_t n) {
+        for (ScratchArray<uint32_t>& stack : stacks_) stack.shrink_for(n);
+    }
 
 private:
     std::array<ScratchArray<uint32_t>, 4> stacks_;

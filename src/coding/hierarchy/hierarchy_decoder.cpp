@@ -106,6 +106,7 @@ void HierarchyLevelDecoder::start(NodeId first_root, uint32_t roots, const Hiera
     append_new_positions_ = false;
     lean_ = false;
     lean_at_end_ = false;
+    single_stream_ = false;
     next_links_in_room_ = false;
     split_parents_ = nullptr;
     split_parent_count_ = 0;
@@ -157,6 +158,10 @@ void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder, uint64_t ma
     // faulted in again by a later level of this decode.
     const bool last_built = level_is_all_leaves();
     const bool lean = lean_ || (lean_at_end_ && last_built);
+    if (single_stream_ && last_built && decided_.size() == 1) {  // derived and listed: the split reads the rest
+        decided_.back().free_all_but_splits();
+        numbering_.deallocate();
+    }
     if (lean) release_before_build();
     build_decided_levels();
     if (lean) {
@@ -167,6 +172,12 @@ void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder, uint64_t ma
             level_.edges.release_from(0);
         }
     }
+    if (single_stream_ && last_built) {
+        level_.nbr.deallocate();
+        level_.edges.deallocate();
+    }
+    // Before the level's new positions come.
+    if (single_stream_) free_before_next_level();
     new_vertex_count_ = appending_positions() ? size_t(vertex_count_ - vertices_before)
                                               : (slice_ != nullptr ? slice_->next_vertex : h_->positions().size()) - new_vertex_first_;
 }
@@ -289,17 +300,21 @@ void HierarchyLevelDecoder::finish_level(bool built_next) {
     if (!spare_.empty()) {
         next = std::move(spare_.back());
         spare_.pop_back();
+        if (single_stream_) next.shrink_for(size_t(4) * level_.refined_count);
     }
     // A next level of leaves alone (the stored symbols used up), split now: nothing but the split
     // reads its links, which go straight into the room of its nodes (the last level's links were
-    // a sixth of a decode's peak). Lean, deriving them there faults the nodes in while the
-    // working memory (about 20 bytes a node of this level) is still there, where the links' own
-    // array (12 bytes a node of the next) would have been given back after the split: the room
-    // only where the next level is more than twice this one's size (docs/BENCHMARKS.md).
+    // a sixth of a decode's peak). Lean or single-stream, deriving them there faults the nodes in
+    // while the working memory (about 20 bytes a node of this level) is still there, where the
+    // links' own array (12 bytes a node of the next) would have gone back before the split: the
+    // room only where the next level is more than twice this one's size (lean) or larger than it
+    // (single-stream; docs/BENCHMARKS.md).
     const bool lean = lean_ || lean_at_end_;
     const uint64_t next_nodes = uint64_t(4) * level_.refined_count;
     const bool links_in_room =
-        built_next && next_nodes > 0 && all_leaves_from(level_index_ + 1) && (!lean || next_nodes > 2 * uint64_t(level_.size()));
+        built_next && next_nodes > 0 && all_leaves_from(level_index_ + 1) &&
+        next_nodes > (lean ? 2 * uint64_t(level_.size()) : single_stream_ ? uint64_t(level_.size()) : 0);
+    if (single_stream_ && built_next && all_leaves_from(level_index_ + 1)) free_before_last_derive(next, links_in_room);
     const ChildLinkRoom room =
         links_in_room ? HierarchyBuilder::open_children(*h_, slice_, level_.refined_count) : ChildLinkRoom{};
     level_.new_vertices = derive_next_level(level_, numbering_, next, header_.options.cull_one_regularity, room);
@@ -308,6 +323,39 @@ void HierarchyLevelDecoder::finish_level(bool built_next) {
     decided_.push_back(std::move(level_));
     level_ = std::move(next);
     ++level_index_;
+}
+
+void HierarchyLevelDecoder::free_before_next_level() {
+    const int l = level_index_;
+    const uint32_t n = uint32_t(level_.size());
+    // The spare levels wait for the level after this one (at most 4n nodes), which is not derived
+    // when the stored symbols end in this level (the next is all leaves, all_leaves_from): this
+    // level reads at most codable_symbols of them, none if uniform. When this level is less than
+    // half the spare's, the levels shrink (a graded refinement past its finest region), and the
+    // level after is very likely smaller still: a smaller array then, not the spare's pages.
+    const bool symbols_may_end =
+        header_.options.truncate_stream && l + 1 >= header_.uniform_levels &&
+        header_.symbol_count - symbols_read_ <= (l < header_.uniform_levels ? 0 : codable_symbols(level_, header_));
+    for (Level& spare : spare_) {
+        if (!symbols_may_end && spare.nbr.capacity() <= ScratchArray<Neighbors>::kShrinkFactor * n) continue;
+        spare.free_all_but_splits();
+        if (spare.refined.data() != split_parents_) spare.refined.deallocate();  // new_vertex_corners() walks them
+    }
+    traversal_.shrink_working_memory(n);
+    numbering_.shrink_for(n);
+    closures_.shrink_for(n);
+}
+
+void HierarchyLevelDecoder::free_before_last_derive(Level& next, bool links_in_room) {
+    spare_.clear();
+    traversal_.free_working_memory();
+    closures_.deallocate();
+    level_.lowered.deallocate();  // its own derivation's
+    if (links_in_room) {  // the last level keeps its states and block edges alone
+        next.nbr.deallocate();
+        next.lowered.deallocate();
+        next.refined.deallocate();
+    }
 }
 
 void HierarchyLevelDecoder::release_before_build() {

@@ -231,6 +231,12 @@ public:
     // alone, known once the next level is known to be all leaves: a decoder that gives back only
     // what no later level faults in again.
     void set_lean_at_end(bool lean) { lean_at_end_ = lean; }
+    // While set (restart clears it), the decoder decodes no other stream: decode_level gives the
+    // working memory no later level reads back to the allocator once the level that may be the
+    // last to code symbols comes (the storage another stream would have reused), so that the last
+    // level's nodes do not come on top of it. Unlike set_lean, no page is given back that the
+    // allocator would have handed out again.
+    void set_single_stream(bool single) { single_stream_ = single; }
     // Until the next restart, the levels are built in `slice` of hierarchy() (HierarchySlice,
     // hierarchy_builder.h), not at its end: decoders of chunks building one hierarchy at once.
     void set_slice(HierarchySlice* slice) { slice_ = slice; }
@@ -294,6 +300,12 @@ private:
     // set_lean's release once the decided level is derived and its new vertices listed, before it
     // is built: everything but the level's refined nodes and the next level's links.
     void release_before_build();
+    // set_single_stream's frees: once a level is built, of the spare levels when the next level
+    // may use up the stored symbols or the levels shrink, and of the scratch far larger than the
+    // next level needs (ScratchArray::shrink_for); before the last level is derived, of the
+    // working memory its derivation does not read.
+    void free_before_next_level();
+    void free_before_last_derive(Level& next, bool links_in_room);
     // decide_level for a stream of the newest version, or of version 1 (kVersion1).
     template <bool kVersion1>
     void decide_level_of(ArithmeticDecoder& decoder);
@@ -316,6 +328,7 @@ private:
     bool list_corners_ = false, place_new_vertices_ = true, append_new_positions_ = false;  // set_new_vertex_listing
     bool lean_ = false;                                      // set_lean
     bool lean_at_end_ = false;                               // set_lean_at_end
+    bool single_stream_ = false;                             // set_single_stream
     bool next_links_in_room_ = false;  // level_'s links are in the room of its nodes (finish_level)
     bool appending_positions() const {
         return append_new_positions_ && !place_new_vertices_ && slice_ == nullptr && boundary_vertex_ == nullptr;

@@ -47,6 +47,10 @@ public:
 
     // Gives the working memory's pages back to the system until the next level (release_pages).
     void release_working_memory() { buckets_.release(); }
+    // Gives the working memory's storage back to the allocator: all of it, or when it is far
+    // larger than a level of n nodes needs.
+    void free_working_memory() { buckets_.deallocate(); }
+    void shrink_working_memory(uint32_t n) { buckets_.shrink_for(n); }
 
     // Decides every node of `level` (undecided, canonical order) and records the decisions in
     // the nodes' state; afterwards each state's refined-neighbour count is exact.

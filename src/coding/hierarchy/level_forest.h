@@ -101,6 +101,24 @@ struct Level {
         states_[0] = kNoNeighborState;
     }
     bool is_root_level() const { return !roots.empty(); }
+    // Gives the storage of everything but `refined` and `flipped` (what splitting the decided
+    // level reads) back to the allocator.
+    void free_all_but_splits() {
+        std::vector<LevelLinks>().swap(roots);
+        nbr.deallocate();
+        edges.deallocate();
+        lowered.deallocate();
+        std::vector<uint8_t>().swap(states_);
+    }
+    // Gives back the storage that is far larger than a level of n nodes needs
+    // (ScratchArray::shrink_for); its contents are dead.
+    void shrink_for(size_t n) {
+        nbr.shrink_for(n);
+        edges.shrink_for(n / 4);
+        lowered.shrink_for(n / 2);
+        refined.shrink_for(n);
+        if (states_.capacity() > ScratchArray<uint8_t>::kShrinkFactor * (n + 1)) std::vector<uint8_t>().swap(states_);
+    }
 
 private:
     std::vector<uint8_t> states_;
@@ -152,6 +170,10 @@ class RefinedNumbering {
 public:
     // Gives its pages back to the system (release_pages) until the next reset.
     void release() { blocks_.release_from(0); }
+    // Gives its storage back to the allocator: all of it, or when it is far larger than a level
+    // of n nodes needs.
+    void deallocate() { blocks_.deallocate(); }
+    void shrink_for(size_t n) { blocks_.shrink_for(n + 1); }
     // Null before the first reset (a level decided without a scan refines nothing: never read).
     const uint32_t* block_of() const { return blocks_.data() == nullptr ? nullptr : blocks_.data() + 1; }
     // Room for n nodes, which the caller fills (their contents are unspecified; the entry in
