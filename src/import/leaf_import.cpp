@@ -41,7 +41,16 @@ std::vector<uint32_t> match_base_vertices(const TriangleMesh& base, const Triang
                                           const std::vector<uint32_t>& input_of_indexed, const std::string& what) {
     const size_t v0 = base.positions.size();
     std::vector<uint32_t> match(v0, kNoIndex);
-    std::vector<uint32_t> base_of_leaf(leaf.positions.size(), kNoIndex);
+    // The base vertex of each matched leaf vertex, open addressing over the few base vertices
+    // (an array over every leaf vertex faulted in 4 KiB pages for v0 entries).
+    size_t slots = 16;
+    while (slots < 2 * v0) slots *= 2;
+    std::vector<std::pair<uint32_t, uint32_t>> base_of_leaf(slots, {kNoIndex, kNoIndex});  // (leaf, base)
+    auto slot_of = [&](uint32_t l) {
+        size_t s = size_t((uint64_t(l) * 0x9e3779b97f4a7c15ull) >> 32) & (slots - 1);
+        while (base_of_leaf[s].first != kNoIndex && base_of_leaf[s].first != l) s = (s + 1) & (slots - 1);
+        return s;
+    };
     if (!leaf_vertex_of_base.empty()) {
         if (leaf_vertex_of_base.size() != v0)
             fail(what, "the base vertex map has " + std::to_string(leaf_vertex_of_base.size()) + " entries for " +
@@ -61,10 +70,11 @@ std::vector<uint32_t> match_base_vertices(const TriangleMesh& base, const Triang
         if (l >= leaf.positions.size())
             fail(what, "base vertex " + std::to_string(b) + " maps to leaf vertex " + std::to_string(l) + " of " +
                            std::to_string(leaf.positions.size()));
-        if (base_of_leaf[l] != kNoIndex)
-            fail(what, "base vertices " + std::to_string(base_of_leaf[l]) + " and " + std::to_string(b) +
+        const size_t s = slot_of(l);
+        if (base_of_leaf[s].first == l)
+            fail(what, "base vertices " + std::to_string(base_of_leaf[s].second) + " and " + std::to_string(b) +
                            " both map to leaf vertex " + std::to_string(l));
-        base_of_leaf[l] = b;
+        base_of_leaf[s] = {l, b};
     }
     return match;
 }
@@ -87,8 +97,8 @@ TriangleMesh renumbered(const TriangleMesh& leaf, const std::vector<uint32_t>& i
     TriangleMesh out;
     out.single_precision = leaf.single_precision;
     // Fresh pages, a fault each per 4 KiB without huge pages: at 10^6 faces as much as the copy.
-    reserve_huge(out.positions, input_of.size());
-    reserve_huge(out.triangles, leaf.triangles.size());
+    reserve_huge(out.positions, input_of.size(), HugePages::written_whole);
+    reserve_huge(out.triangles, leaf.triangles.size(), HugePages::written_whole);
     for (uint32_t v : input_of) out.positions.push_back(leaf.positions[v]);
     for (const Triangle& t : leaf.triangles) out.triangles.push_back({import_of[t[0]], import_of[t[1]], import_of[t[2]]});
     return out;
@@ -124,6 +134,22 @@ struct RenumberedLeaf {
     std::vector<uint32_t> leaf_of_base;
 };
 
+// The node ids 0 .. count - 1, in order, as a range.
+struct NodeIdRange {
+    NodeId count;
+    struct Iterator {
+        NodeId n;
+        NodeId operator*() const { return n; }
+        Iterator& operator++() {
+            ++n;
+            return *this;
+        }
+        bool operator!=(Iterator other) const { return n != other.n; }
+    };
+    Iterator begin() const { return {0}; }
+    Iterator end() const { return {count}; }
+};
+
 // extract_leaf_mesh(h) must be the input: every leaf triangle an input face with the same
 // orientation, every input face one leaf triangle. Read in hierarchy vertex ids, in
 // extract_leaf_mesh's order, without its canonical numbering and copies (a tenth of a 10^6-face
@@ -135,6 +161,31 @@ void verify_leaf_mesh(const Hierarchy& h, const std::vector<uint32_t>& leaf_of_v
     // 128 KiB per 10^6 faces stay in the cache where a byte each did not.
     std::vector<uint64_t> used((leaf.triangles.size() + 63) / 64, 0);
     auto leaf_vertex = [&](VertexId v) { return v < leaf_of_vertex.size() ? leaf_of_vertex[v] : kNoIndex; };
+    // Whether every leaf triangle is an unused face, all faces used, read in node id order. With
+    // every node live (never coarsened), those are the nodes of the breadth-first order, so the
+    // answer is that order's, without computing it (a twentieth of the check). A failure is read
+    // again in breadth-first order below, whose first misfit the message names.
+    if (h.node_count() == h.node_capacity()) {
+        bool fits = true;
+        try {
+            for_each_leaf_triangle(h, NodeIdRange{h.node_capacity()}, -1, [&](NodeId, VertexId x, VertexId y, VertexId z, bool) {
+                const uint32_t a = leaf_vertex(x), b = leaf_vertex(y), c = leaf_vertex(z);
+                const LeafHalfedges::Edge e =
+                    (a == kNoIndex || b == kNoIndex) ? LeafHalfedges::Edge{} : halfedges.edge(a, b);
+                const uint32_t f = e.face;
+                if (f == kNoIndex || e.apex != c || (used[f / 64] >> (f % 64) & 1)) {
+                    fits = false;
+                    return;
+                }
+                used[f / 64] |= uint64_t(1) << (f % 64);
+            });
+        } catch (const Error&) {  // a leaf with three hanging nodes
+            fits = false;
+        }
+        for (size_t f = 0; fits && f < leaf.triangles.size(); ++f) fits = used[f / 64] >> (f % 64) & 1;
+        if (fits) return;
+        std::fill(used.begin(), used.end(), 0);
+    }
     auto vertex_text = [&](uint32_t l) { return std::to_string(l == kNoIndex ? l : input_of[l]); };
     for_each_leaf_triangle(h, h.breadth_first_order(), -1, [&](NodeId, VertexId x, VertexId y, VertexId z, bool) {
         const uint32_t a = leaf_vertex(x), b = leaf_vertex(y), c = leaf_vertex(z);
