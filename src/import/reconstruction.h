@@ -440,7 +440,8 @@ private:
     std::vector<uint32_t> leaf_of_vertex_;
     std::vector<uint32_t> vertex_of_leaf_;
     std::vector<Reveal> reveals_;
-    std::vector<uint32_t> around_b_;  // scratch of only_unmatched_common_neighbor
+    std::vector<uint32_t> near_b_;  // per leaf vertex: the stamp of the last call that found it next to b
+    uint32_t stamp_ = 0;            // (only_unmatched_common_neighbor)
     std::vector<UnsplitEdge> unsplit_edges_;
     std::vector<NodeId> refined_;        // scratch of reconstruct_level
     bool read_failed_ = false;           // reconstruct_level failed while reading its level
