@@ -1688,28 +1688,33 @@ bool decode_grid_listed(Hierarchy& h, const FromList& created, const Quantizer& 
     return decode_grid_listed_with<Grouped>(h, created, quantizer, tables, rans_data, rans_size, raw_data, raw_size, pairs);
 }
 
-// ---- mode 5 over split_level's list: the level decoder's fast path for bit-exact float64 ----------
+// ---- mode 5 over split_level's list: the level decoder's fast path for bit-exact files ------------
 //
-// decode_positions<false, true> for a listed level of a double-precision hierarchy with float64
-// coordinates and narrow tables (every bit-exact surface level): the float64 stencil decoder's
-// streams and table entries (a token's residual modulo 2^64 from one entry and one raw load,
-// StencilStreams::residual) and mode 4's frames in axis order (GridFrame without its grid
-// prediction, two or four at a time), instead of RoleFrame copies, RansDecoder and take().
-// The same tokens, operations and bits.
+// decode_positions<false, true> for a listed level with narrow tables (every bit-exact surface
+// level), float64 coordinates in a double-precision hierarchy or float32 in a single-precision one:
+// the float64 stencil decoder's streams and table entries (a token's residual modulo 2^64 from one
+// entry and one raw load, StencilStreams::residual) and mode 4's frames in axis order (GridFrame
+// without its grid prediction, two or four at a time), instead of RoleFrame copies, RansDecoder
+// and take(). The same tokens, operations and bits.
 
-// value_of's float64 path: the coordinate whose ordered bits are the prediction's (coder_prediction:
-// 0 if not finite) plus the residual, as IEEE bits.
-AMC_ALWAYS_INLINE uint64_t float64_value_bits(double predicted, uint64_t residual) {
+// value_of's bit-exact path: the coordinate whose ordered bits are the prediction's
+// (coder_prediction's) plus the residual, as the IEEE bits of a double.
+template <bool Float32>
+AMC_ALWAYS_INLINE uint64_t unit_value_bits(double predicted, uint64_t residual) {
+    if (Float32) {
+        const uint64_t p = ordered_bits(coder_prediction(predicted, Precision::float32), Precision::float32);
+        return bit_cast<uint64_t>(from_ordered_bits(p + residual, Precision::float32));  // modulo 2^32
+    }
     return double_bits_of(ordered_of(bit_cast<uint64_t>(std::isfinite(predicted) ? predicted : 0.0)) + residual);
 }
 
 // decode_vertex<State, false> over a GridFrame, into p's axes; `largest` takes the largest
 // magnitude's bits of the three coordinates (a non-finite one is above every finite one).
-template <int State, bool Safe>
+template <int State, bool Safe, bool Float32>
 AMC_ALWAYS_INLINE void decode_unit_vertex(StencilStreams& s, const StencilTable* t, const GridFrame& f, Coordinates& p,
                                           uint64_t& largest) {
     const int a0 = f.axis, a1 = a0 == 0 ? 1 : 0, a2 = a0 == 2 ? 1 : 2;
-    const uint64_t b0 = float64_value_bits(f.midpoint[a0], s.residual<State, Safe>(t[0]));
+    const uint64_t b0 = unit_value_bits<Float32>(f.midpoint[a0], s.residual<State, Safe>(t[0]));
     const double value = bit_cast<double>(b0);
     double second = f.midpoint[a1], third = f.midpoint[a2];
     if (f.has_normal) {  // predict_others
@@ -1717,12 +1722,19 @@ AMC_ALWAYS_INLINE void decode_unit_vertex(StencilStreams& s, const StencilTable*
         second = second + rounded(u * f.normal[a1]);
         third = third + rounded(u * f.normal[a2]);
     }
-    const uint64_t b1 = float64_value_bits(second, s.residual<1 - State, Safe>(t[1]));
-    const uint64_t b2 = float64_value_bits(third, s.residual<State, Safe>(t[2]));
+    const uint64_t b1 = unit_value_bits<Float32>(second, s.residual<1 - State, Safe>(t[1]));
+    const uint64_t b2 = unit_value_bits<Float32>(third, s.residual<State, Safe>(t[2]));
     p[a0] = value;
     p[a1] = bit_cast<double>(b1);
     p[a2] = bit_cast<double>(b2);
     largest = std::max(largest, std::max(b0 & ~kSign64, std::max(b1 & ~kSign64, b2 & ~kSign64)));
+}
+
+// frame_of's midpoint in a single-precision hierarchy, for the frames made in lanes (whose
+// normals and axes do not read the midpoint).
+AMC_ALWAYS_INLINE void round_midpoints_to_float(GridFrame* frames, size_t count) {
+    for (size_t i = 0; i < count; ++i)
+        for (double& m : frames[i].midpoint) m = rounded_to_float(m);
 }
 
 // The frames of `count` listed vertices without a grid, two at a time with SSE2.
@@ -1731,12 +1743,13 @@ struct PairUnitFrames {
         size_t i = 0;
 #if AMC_SSE2
         for (; i + 1 < count; i += 2) set_frame_pair(frame_pair_lanes<true>(h, corners[i], corners[i + 1]), frames[i], frames[i + 1]);
+        if (h.single_precision()) round_midpoints_to_float(frames, i);
 #endif
         for (; i < count; ++i) set_frame(frame_of<true>(h, corners[i]), frames[i]);
     }
 };
 
-template <class MakeFrames>
+template <bool Float32, class MakeFrames>
 AMC_ALWAYS_INLINE bool decode_unit_listed_with(Hierarchy& h, const FromList& created, const StaticTables& tables,
                                                const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data,
                                                size_t raw_size, const MakeFrames& make_frames) {
@@ -1768,10 +1781,10 @@ AMC_ALWAYS_INLINE bool decode_unit_listed_with(Hierarchy& h, const FromList& cre
             StencilStreams local = s;  // the chunk's copy, which the compiler keeps in registers
             size_t k = 0;
             for (; k + 1 < count; k += 2) {  // token j of the level with state j mod 2
-                decode_unit_vertex<0, Safe>(local, t.data(), frames[k], coordinates[k], largest);
-                decode_unit_vertex<1, Safe>(local, t.data(), frames[k + 1], coordinates[k + 1], largest);
+                decode_unit_vertex<0, Safe, Float32>(local, t.data(), frames[k], coordinates[k], largest);
+                decode_unit_vertex<1, Safe, Float32>(local, t.data(), frames[k + 1], coordinates[k + 1], largest);
             }
-            if (k < count) decode_unit_vertex<0, Safe>(local, t.data(), frames[k], coordinates[k], largest);
+            if (k < count) decode_unit_vertex<0, Safe, Float32>(local, t.data(), frames[k], coordinates[k], largest);
             s = local;
         };
         const bool inside = size_t(s.rans_end - s.rans) >= kChunkRans &&
@@ -1798,9 +1811,10 @@ AMC_ALWAYS_INLINE bool decode_unit_listed_with(Hierarchy& h, const FromList& cre
     return s.ended_cleanly();
 }
 
+template <bool Float32>
 bool decode_unit_listed(Hierarchy& h, const FromList& created, const StaticTables& tables, const uint8_t* rans_data,
                         size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
-    return decode_unit_listed_with(h, created, tables, rans_data, rans_size, raw_data, raw_size, PairUnitFrames{});
+    return decode_unit_listed_with<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size, PairUnitFrames{});
 }
 
 #if AMC_AVX2_AT_RUN_TIME
@@ -2070,13 +2084,15 @@ struct QuadUnitFrames {
     void operator()(const Hierarchy& h, const FrameCorners* corners, size_t count, GridFrame* frames) const {
         size_t i = 0;
         for (; i + 3 < count; i += 4) set_grid_frame_quad<false>(frame_quad_lanes(h, corners + i), GridScale{}, nullptr, frames + i);
+        if (h.single_precision()) round_midpoints_to_float(frames, i);
         PairUnitFrames()(h, corners + i, count - i, frames + i);
     }
 };
 
+template <bool Float32>
 bool decode_unit_listed_avx2(Hierarchy& h, const FromList& created, const StaticTables& tables, const uint8_t* rans_data,
                              size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
-    return decode_unit_listed_with(h, created, tables, rans_data, rans_size, raw_data, raw_size, QuadUnitFrames{});
+    return decode_unit_listed_with<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size, QuadUnitFrames{});
 }
 #pragma GCC pop_options
 #endif
@@ -2093,13 +2109,14 @@ bool decode_grid_listed_fastest(Hierarchy& h, const FromList& created, const Qua
 }
 
 // decode_unit_listed, with AVX2's frames where the processor has them.
+template <bool Float32>
 bool decode_unit_listed_fastest(Hierarchy& h, const FromList& created, const StaticTables& tables, const uint8_t* rans_data,
                                 size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
 #if AMC_AVX2_AT_RUN_TIME
     if (has_avx2() && wide_frames_allowed.load(std::memory_order_relaxed))
-        return decode_unit_listed_avx2(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+        return decode_unit_listed_avx2<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
 #endif
-    return decode_unit_listed(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+    return decode_unit_listed<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
 }
 
 template <class Tables>
@@ -2160,9 +2177,12 @@ bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, G
         if (all_narrow && mode == GeometryPredictor::normal_frame_grid && space.quantizer != nullptr && !h.single_precision())
             return grouped ? decode_grid_listed_fastest<true>(h, created, *space.quantizer, tables, rans_data, rans_size, raw_data, raw_size)
                            : decode_grid_listed_fastest<false>(h, created, *space.quantizer, tables, rans_data, rans_size, raw_data, raw_size);
-        if (all_narrow && mode == GeometryPredictor::unit_normal_frame && space.quantizer == nullptr &&
-            space.precision == Precision::float64 && !h.single_precision())
-            return decode_unit_listed_fastest(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+        if (all_narrow && mode == GeometryPredictor::unit_normal_frame && space.quantizer == nullptr) {
+            if (space.precision == Precision::float64 && !h.single_precision())
+                return decode_unit_listed_fastest<false>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+            if (space.precision == Precision::float32 && h.single_precision())
+                return decode_unit_listed_fastest<true>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+        }
     }
     if (all_narrow) return decode_static_with(h, created, space, mode, narrow, rans_data, rans_size, raw_data, raw_size, grouped);
     return decode_static_with(h, created, space, mode, tables, rans_data, rans_size, raw_data, raw_size, grouped);
