@@ -1838,7 +1838,8 @@ struct FrameQuadLanes {
     __m256d mx, my, mz, nx, ny, nz;
 };
 
-inline FrameQuadLanes frame_quad_lanes(const Hierarchy& h, const FrameCorners* k) {
+// Inlined in both quad frame makers: a call of its own passes the lanes through memory.
+AMC_ALWAYS_INLINE FrameQuadLanes frame_quad_lanes(const Hierarchy& h, const FrameCorners* k) {
     struct Lanes {
         __m256d x, y, z;
     };
