@@ -59,10 +59,30 @@ void keep_likely_static_modes(const Mesh& h, const NewVertices& created, Coordin
                               StaticOrder grid_order, StaticEncoderBuffers* buffers) {
     const double scale = double(created.size()) / double(sample);
     double stream_bound[kStaticCandidates];
+    // Bit-exact: mode 5, whose bound was the smallest on every surface level of the corpus, is
+    // weighed first; a mode whose raw bits alone then pass its limit (modes 3, 6 and 7 about halfway
+    // through the sample) fails the test below, whatever the others' bounds (the smallest is at most
+    // mode 5's), and is never `first`: it stops there. (Quantized levels have few raw bits.)
+    const int reference = candidate[2] ? 2 : -1;
+    uint64_t raw_bit_limit = UINT64_MAX;
+    if (reference >= 0) {
+        on_sample[reference] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, kStaticModes[reference], grid_order, buffers);
+        const double limit = rounded(kStaticMargin * on_sample[reference]->projected_bound_bytes(scale)) + kSampleSlack;
+        // Every bound is at least 1 + rounded(scale * (kRansStateBytes + raw bits / 8)).
+        raw_bit_limit = uint64_t(8 * (std::max(0.0, std::floor(limit / scale) - double(kRansStateBytes)) + 1)) + 7;
+    }
     int first = -1;  // the candidate of the smallest streams' bound
     for (int i = 0; i < kStaticCandidates; ++i) {
         if (!candidate[i]) continue;
-        on_sample[i] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, kStaticModes[i], grid_order, buffers);
+        if (i != reference) {
+            on_sample[i] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, kStaticModes[i], grid_order, buffers,
+                                                                raw_bit_limit);
+            if (on_sample[i]->gave_up()) {
+                candidate[i] = false;
+                on_sample[i].reset();
+                continue;
+            }
+        }
         stream_bound[i] = on_sample[i]->projected_stream_bound_bytes(scale);
         if (first < 0 || stream_bound[i] < stream_bound[first]) first = i;
     }
@@ -163,11 +183,11 @@ size_t adaptive_bytes(const Mesh& h, const NewVertices& created, GeometryPredict
     RawBitWriter raw;
     RawBitWriter* side = positions.quantized() ? nullptr : &raw;
     AdaptiveTrialJudge judge(created.size(), sample, limit);
-    // The vertex from which the level's own code is coded alongside: the start of a level without a
-    // sample, else the sample's end where the bytes so far leave a third of the limit (a guess: on
-    // exact-midpoint levels the code grows by 1-2 bytes a doubling of the vertices, and the trials
-    // that won left 5-14 bytes of a limit of 23-33 there, those that lost 2-5 of 17-21).
-    const size_t pair_from = level_code == nullptr ? SIZE_MAX : sample == SIZE_MAX ? 0 : judged;
+    // The vertex from which the level's own code is coded alongside: the sample's end (a level
+    // without one: its first eighth's), where the bytes so far leave a third of the limit (a guess:
+    // on exact-midpoint levels the code grows by 1-2 bytes a doubling of the vertices, and the
+    // sampled trials that won left 5-14 bytes of a limit of 23-33 there, those that lost 2-5 of 17-21).
+    const size_t pair_from = level_code == nullptr ? SIZE_MAX : sample == SIZE_MAX ? created.size() / 8 : judged;
     std::unique_ptr<ArithmeticEncoder> level;
     auto code_vertex = [&](auto& coder, size_t i) {
         const auto [n, e] = created[i];
@@ -179,7 +199,7 @@ size_t adaptive_bytes(const Mesh& h, const NewVertices& created, GeometryPredict
         code_vertex(encoder, i);
         if (judge.stops(i + 1, encoder.bytes_so_far() + raw.bits() / 8)) return SIZE_MAX;
     }
-    const bool paired = i == pair_from && (i == 0 || limit == SIZE_MAX || 3 * (encoder.bytes_so_far() + raw.bits() / 8) <= 2 * limit);
+    const bool paired = i == pair_from && (limit == SIZE_MAX || 3 * (encoder.bytes_so_far() + raw.bits() / 8) <= 2 * limit);
     if (paired) {
         level = std::make_unique<ArithmeticEncoder>(*level_code);
         PositionCoder caught_up = start;  // ends where `positions` is: the same symbols
