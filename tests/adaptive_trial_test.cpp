@@ -75,9 +75,10 @@ TEST(AdaptiveTrial, AnEarlyRateFromFewCommittedBytesDoesNotStopIt) {
 
 // choose_level_geometry with the level block's code (its hierarchy part) codes an adaptive trial
 // that looks like winning onto it as it goes, from the sample's end on (the vertices before again)
-// or, without a sample, from the start: the payloads and the models after each level must be those
-// of coding the level again in finish_level_payload. Exact midpoints: the adaptive midpoint wins
-// the small levels and the last (the corpus's uniform model), mode 3 those between.
+// or, without a sample, from the first eighth's: the payloads and the models after each level must
+// be those of coding the level again in finish_level_payload. Exact midpoints (the corpus's uniform
+// model): the adaptive midpoint wins the small levels and the last, the only one it looks like
+// winning early, mode 3 those between.
 TEST(AdaptiveTrial, AWinningTrialsCodingIsTheLevelsPayload) {
     Hierarchy h(make_icosahedron());
     refine_uniformly(h, 7);  // the last level's 122,880 new vertices are judged on a sample at effort 1
@@ -99,14 +100,14 @@ TEST(AdaptiveTrial, AWinningTrialsCodingIsTheLevelsPayload) {
                                                            effort, StaticOrder::grouped, nullptr, &taken_encoder);
             EXPECT_EQ(again.adaptive_code, nullptr);
             ASSERT_EQ(code.predictor, again.predictor);
-            EXPECT_EQ(code.adaptive_code != nullptr, !is_static_mode(code.predictor));
+            EXPECT_TRUE(code.adaptive_code == nullptr || !is_static_mode(code.predictor));
             taken += code.adaptive_code != nullptr;
             sampled += code.adaptive_code != nullptr && created.size() >= 2048;
             EXPECT_EQ(finish_level_payload(h, created, code, taken_models, taken_encoder),
                       finish_level_payload(h, created, again, again_models, again_encoder))
                 << created.size() << " new vertices";
         }
-        EXPECT_GE(taken, 4);
+        EXPECT_EQ(taken, 1);
         EXPECT_EQ(sampled, 1);
     }
 }
