@@ -184,10 +184,12 @@ size_t adaptive_bytes(const Mesh& h, const NewVertices& created, GeometryPredict
     RawBitWriter* side = positions.quantized() ? nullptr : &raw;
     AdaptiveTrialJudge judge(created.size(), sample, limit);
     // The vertex from which the level's own code is coded alongside: the sample's end (a level
-    // without one: its first eighth's), if the level's bytes projected there at the rate since half
-    // that point stay within the limit (a guess at winning; adaptive codes grow slower than that
-    // rate as their models learn: uniform's last level, 122,880 vertices, projects 33 bytes against
-    // 33 and codes in 27; the 12-bit surfaces' trials that run past their sample project more).
+    // without one: its first eighth's), on a level that codes in a few dozen bytes (the limit within
+    // kSampleSlack: exact midpoints, against the static modes' tables) whose bytes projected there
+    // at the rate since half that point stay within the limit (a guess at winning; such codes grow
+    // slower than that rate as their models learn: uniform's last level, 122,880 vertices, projects
+    // 33 bytes against 33 and codes in 27; 12-bit surface trials that projected 0.93-1.0 times
+    // their limit of thousands of bytes lost).
     const size_t pair_from = level_code == nullptr ? SIZE_MAX : sample == SIZE_MAX ? created.size() / 8 : judged;
     std::unique_ptr<ArithmeticEncoder> level;
     auto code_vertex = [&](auto& coder, size_t i) {
@@ -204,9 +206,10 @@ size_t adaptive_bytes(const Mesh& h, const NewVertices& created, GeometryPredict
     }
     bool paired = i == pair_from && pair_from >= 2;
     if (paired && limit != SIZE_MAX) {
+        paired = double(limit) <= kSampleSlack;
         const double bytes = double(encoder.bytes_so_far() + raw.bits() / 8);
         const double rate = (bytes - double(half_bytes)) / double(pair_from - pair_from / 2);
-        paired = bytes + rounded(rate * double(created.size() - pair_from)) <= double(limit);
+        paired = paired && bytes + rounded(rate * double(created.size() - pair_from)) <= double(limit);
     }
     if (paired) {
         level = std::make_unique<ArithmeticEncoder>(*level_code);
