@@ -184,13 +184,14 @@ size_t adaptive_bytes(const Mesh& h, const NewVertices& created, GeometryPredict
     RawBitWriter* side = positions.quantized() ? nullptr : &raw;
     AdaptiveTrialJudge judge(created.size(), sample, limit);
     // The vertex from which the level's own code is coded alongside: the sample's end (a level
-    // without one: its first eighth's), on a level that codes in a few dozen bytes (the limit within
-    // kSampleSlack: exact midpoints, against the static modes' tables) whose bytes projected there
-    // at the rate since half that point stay within the limit (a guess at winning; such codes grow
-    // slower than that rate as their models learn: uniform's last level, 122,880 vertices, projects
-    // 33 bytes against 33 and codes in 27; 12-bit surface trials that projected 0.93-1.0 times
-    // their limit of thousands of bytes lost).
-    const size_t pair_from = level_code == nullptr ? SIZE_MAX : sample == SIZE_MAX ? created.size() / 8 : judged;
+    // without one: its first eighth's), on a bit-exact level that codes in a few dozen bytes (the
+    // limit within kSampleSlack: exact midpoints, against the static modes' tables) whose bytes
+    // projected there at the rate since half that point stay within the limit. A guess at winning:
+    // such codes grow slower than that rate as their models learn (uniform's last level, 122,880
+    // vertices, projects 33 bytes against 33 and codes in 27); 12-bit surface trials projected
+    // within their limit of thousands of bytes and lost, and so did a 12-bit level of front_1
+    // projected at 11 bytes against 22 (BENCHMARKS.md, "One-core encode, twenty-second step").
+    const size_t pair_from = level_code == nullptr || side == nullptr ? SIZE_MAX : sample == SIZE_MAX ? created.size() / 8 : judged;
     std::unique_ptr<ArithmeticEncoder> level;
     auto code_vertex = [&](auto& coder, size_t i) {
         const auto [n, e] = created[i];
