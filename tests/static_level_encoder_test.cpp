@@ -6,6 +6,7 @@
 #include "coding/geometry/geometry_prediction.h"
 #include "coding/geometry/level_geometry.h"
 #include "coding/geometry/static_position_coder.h"
+#include "common/exact_float.h"
 
 #include <algorithm>
 #include <cmath>
@@ -234,6 +235,92 @@ TEST(StaticLevelEncoder, GridLevelsDecodeAlikeFromTheListAndFromTheNodes) {
         }
     }
     EXPECT_NE(streams_of[0], streams_of[1]) << "the orders code other streams";
+}
+
+// Mode 5's decoder of split_level's list (the bit-exact levels of whole files and chunks) and its
+// decoder of (node, edge) pairs decode the same positions, float64 and float32, with residuals of
+// every bit length up to 63 (narrow tables, as every bit-exact surface level has; raw bits in one
+// read and, past 57, in two), float64 coordinates past DBL_MAX / 2 (the chunks whose positions are
+// far) and a level whose last chunk has an odd count, with the frames four and two at a time; both
+// refuse the streams cut short.
+void expect_unit_levels_decode_alike(Precision precision) {
+    const bool single = precision == Precision::float32;
+    Hierarchy h = projected_sphere(6000, 6, 14);
+    if (single) {
+        h.set_single_precision(true);
+        for (VertexId v = 0; v < h.positions().size(); ++v) h.set_position(v, rounded_to_float(h.position(v)));
+    }
+    NewVertices created = largest_level(h);
+    if (created.size() % 2 == 0) created.pop_back();
+    ASSERT_GT(created.size(), 200u);
+    std::mt19937_64 rng(9);
+    const int lengths = single ? 33 : 64;  // the offsets' bit lengths, 0 .. lengths - 1
+    for (size_t i = 0; i < created.size(); ++i) {
+        const VertexId v = h.midpoint(created[i].first, created[i].second);
+        const Vec3 p = h.position(v);
+        double xyz[3] = {p.x, p.y, p.z};
+        for (int axis = 0; axis < 3; ++axis) {
+            const int length = int((3 * i + size_t(axis)) % size_t(lengths));
+            const uint64_t offset = length == 0 ? 0 : (uint64_t{1} << (length - 1)) | (rng() & ((uint64_t{1} << (length - 1)) - 1));
+            const uint64_t bits = ordered_bits(xyz[axis], precision);
+            const double moved = from_ordered_bits(rng() & 1 ? bits + offset : bits - offset, precision);
+            if (std::isfinite(moved) && std::fabs(moved) < 1e300) xyz[axis] = moved;
+        }
+        if (!single && i % 97 == 5) xyz[i % 3] = i % 2 == 0 ? 1.5e308 : -1.5e308;  // beyond DBL_MAX / 2
+        h.set_position(v, {xyz[0], xyz[1], xyz[2]});
+    }
+    const VertexId first = VertexId(h.positions().size());
+    std::vector<FrameCorners> corners;
+    for (const auto& [n, e] : created) corners.push_back(frame_corners(h, n, e));
+    const CoordinateSpace space{precision, nullptr};
+    const GeometryPredictor mode = GeometryPredictor::unit_normal_frame;
+    StaticLevelEncoder encoder(h, created, space, mode);
+    ArithmeticEncoder tables_out;
+    encoder.write_tables(tables_out);
+    const std::vector<uint8_t> table_bytes = tables_out.finish();
+    ArithmeticDecoder tables_in(table_bytes.data(), table_bytes.size());
+    StaticTables tables;
+    ASSERT_TRUE(read_static_tables(tables_in, space, mode, tables));
+    for (int k = 0; k < static_table_count(mode); ++k) ASSERT_NE(tables[size_t(k)].narrow_view().index, nullptr) << "table " << k;
+    const std::vector<uint8_t>& rans = encoder.rans_bytes();
+    const std::vector<uint8_t>& raw = encoder.raw_bytes();
+    Hierarchy zeroed = h;
+    for (const auto& [n, e] : created) zeroed.set_position(zeroed.midpoint(n, e), Vec3{});
+    auto decode = [&](bool listed, size_t rans_size, size_t raw_size, Hierarchy& out) {
+        out = zeroed;
+        NewVertexCorners list(corners.data(), first, corners.size());
+        return listed ? decode_static_positions(out, list, space, mode, tables, rans.data(), rans_size, raw.data(), raw_size,
+                                                StaticOrder::per_vertex)
+                      : decode_static_positions(out, created, space, mode, tables, rans.data(), rans_size, raw.data(), raw_size,
+                                                StaticOrder::per_vertex);
+    };
+    for (int way = 0; way < 3; ++way) {
+        const bool listed = way > 0;
+        SCOPED_TRACE(way == 0 ? "nodes" : way == 1 ? "listed, frames four at a time" : "listed, frames in pairs");
+        struct WideFrames {
+            bool before;
+            explicit WideFrames(bool allowed) : before(set_wide_frames(allowed)) {}
+            ~WideFrames() { set_wide_frames(before); }
+        } wide_frames(way != 2);
+        Hierarchy decoded;
+        ASSERT_TRUE(decode(listed, rans.size(), raw.size(), decoded));
+        ASSERT_EQ(decoded.positions().size(), listed ? first + created.size() : first);
+        for (size_t i = 0; i < created.size(); ++i) {
+            const VertexId v = h.midpoint(created[i].first, created[i].second);
+            const Vec3 a = h.position(v), b = decoded.positions()[listed ? first + i : v];
+            ASSERT_TRUE(std::memcmp(&a, &b, sizeof a) == 0) << "vertex " << v;
+        }
+        EXPECT_FALSE(decode(listed, rans.size() - 1, raw.size(), decoded));
+        EXPECT_FALSE(decode(listed, rans.size(), raw.size() - 1, decoded));
+        EXPECT_FALSE(decode(listed, rans.size(), raw.size() / 2, decoded));
+    }
+}
+
+TEST(StaticLevelEncoder, UnitLevelsDecodeAlikeFromTheListAndFromTheNodes) {
+    for (Precision precision : {Precision::float64, Precision::float32}) {
+        SCOPED_TRACE(precision == Precision::float32 ? "float32" : "float64");
+        expect_unit_levels_decode_alike(precision);
+    }
 }
 
 }  // namespace

@@ -1112,12 +1112,9 @@ bool open_stencil_streams(const uint8_t* rans_data, size_t rans_size, const uint
 }
 
 constexpr uint64_t kSign64 = uint64_t{1} << 63;
-// ordered_bits and from_ordered_bits for float64 without branches (the signs are coin flips);
-// the SSE2 paths below compute the same per lane, so only the scalar twins call these.
-#if !AMC_SSE2
+// ordered_bits and from_ordered_bits for float64 without branches (the signs are coin flips).
 AMC_ALWAYS_INLINE uint64_t ordered_of(uint64_t b) { return b ^ (uint64_t(int64_t(b) >> 63) | kSign64); }
 AMC_ALWAYS_INLINE uint64_t double_bits_of(uint64_t u) { return u ^ (~uint64_t(int64_t(u) >> 63) | kSign64); }
-#endif
 // Hierarchy::is_far's bound.
 constexpr double kHalfMax = 8.98846567431157953865e307;  // DBL_MAX / 2
 #if AMC_SSE2
@@ -1458,7 +1455,8 @@ struct GridFrame {
     bool has_normal;
 };
 
-AMC_ALWAYS_INLINE void set_grid_frame(const NormalFrame& f, const GridScale& grid, const double* origin, GridFrame& g) {
+// The frame alone (mode 5's listed decoder has no grid).
+AMC_ALWAYS_INLINE void set_frame(const NormalFrame& f, GridFrame& g) {
     g.midpoint[0] = f.midpoint.x;
     g.midpoint[1] = f.midpoint.y;
     g.midpoint[2] = f.midpoint.z;
@@ -1467,6 +1465,10 @@ AMC_ALWAYS_INLINE void set_grid_frame(const NormalFrame& f, const GridScale& gri
     g.normal[2] = f.normal.z;
     g.has_normal = f.has_normal;
     g.axis = f.has_normal ? f.axis : 0;
+}
+
+AMC_ALWAYS_INLINE void set_grid_frame(const NormalFrame& f, const GridScale& grid, const double* origin, GridFrame& g) {
+    set_frame(f, g);
     g.first = grid_point_of(grid_prediction_at(grid, origin[g.axis], g.midpoint[g.axis]));
 }
 
@@ -1484,8 +1486,8 @@ AMC_ALWAYS_INLINE void store_lanes(__m128d x, __m128d y, __m128d z, double* lane
 // set_grid_frame for two vertices at once from frame_pair_lanes (each vertex in one lane):
 // set_axis's choice by lane masks, the coordinates stored from the lanes, role 0's grid
 // predictions in one pair. The same operations on the same values, so the same frames.
-AMC_ALWAYS_INLINE void set_grid_frame_pair(const FramePairLanes& l, const GridScale& grid, const double* origin, GridFrame& g0,
-                                           GridFrame& g1) {
+// set_frame for two vertices at once.
+AMC_ALWAYS_INLINE void set_frame_pair(const FramePairLanes& l, GridFrame& g0, GridFrame& g1) {
     store_lanes(l.mx, l.my, l.mz, g0.midpoint, g1.midpoint);
     store_lanes(l.nx, l.ny, l.nz, g0.normal, g1.normal);
     // set_axis: the first axis of largest |N_i|, and whether it is positive and finite.
@@ -1501,6 +1503,11 @@ AMC_ALWAYS_INLINE void set_grid_frame_pair(const FramePairLanes& l, const GridSc
     g1.has_normal = (has & 2) != 0;
     g0.axis = has & 1 ? (zs & 1 ? 2 : ys & 1) : 0;
     g1.axis = has & 2 ? (zs & 2 ? 2 : (ys >> 1) & 1) : 0;
+}
+
+AMC_ALWAYS_INLINE void set_grid_frame_pair(const FramePairLanes& l, const GridScale& grid, const double* origin, GridFrame& g0,
+                                           GridFrame& g1) {
+    set_frame_pair(l, g0, g1);
     const GridPointPair first = grid_point_pair(grid, origin[g0.axis], g0.midpoint[g0.axis], origin[g1.axis], g1.midpoint[g1.axis]);
     g0.first = {first.point[0], first.table_offset[0], first.turn_mask[0]};
     g1.first = {first.point[1], first.table_offset[1], first.turn_mask[1]};
@@ -1693,6 +1700,135 @@ bool decode_grid_listed(Hierarchy& h, const FromList& created, const Quantizer& 
     return decode_grid_listed_with<Grouped>(h, created, quantizer, tables, rans_data, rans_size, raw_data, raw_size, pairs);
 }
 
+// ---- mode 5 over split_level's list: the level decoder's fast path for bit-exact files ------------
+//
+// decode_positions<false, true> for a listed level with narrow tables (every bit-exact surface
+// level), float64 coordinates in a double-precision hierarchy or float32 in a single-precision one:
+// the float64 stencil decoder's streams and table entries (a token's residual modulo 2^64 from one
+// entry and one raw load, StencilStreams::residual) and mode 4's frames in axis order (GridFrame
+// without its grid prediction, two or four at a time), instead of RoleFrame copies, RansDecoder
+// and take(). The same tokens, operations and bits.
+
+// value_of's bit-exact path: the coordinate whose ordered bits are the prediction's
+// (coder_prediction's) plus the residual, as the IEEE bits of a double.
+template <bool Float32>
+AMC_ALWAYS_INLINE uint64_t unit_value_bits(double predicted, uint64_t residual) {
+    if (Float32) {
+        const uint64_t p = ordered_bits(coder_prediction(predicted, Precision::float32), Precision::float32);
+        return bit_cast<uint64_t>(from_ordered_bits(p + residual, Precision::float32));  // modulo 2^32
+    }
+    return double_bits_of(ordered_of(bit_cast<uint64_t>(std::isfinite(predicted) ? predicted : 0.0)) + residual);
+}
+
+// decode_vertex<State, false> over a GridFrame, into p's axes; `largest` takes the largest
+// magnitude's bits of the three coordinates (a non-finite one is above every finite one).
+template <int State, bool Safe, bool Float32>
+AMC_ALWAYS_INLINE void decode_unit_vertex(StencilStreams& s, const StencilTable* t, const GridFrame& f, Coordinates& p,
+                                          uint64_t& largest) {
+    const int a0 = f.axis, a1 = a0 == 0 ? 1 : 0, a2 = a0 == 2 ? 1 : 2;
+    const uint64_t b0 = unit_value_bits<Float32>(f.midpoint[a0], s.residual<State, Safe>(t[0]));
+    const double value = bit_cast<double>(b0);
+    double second = f.midpoint[a1], third = f.midpoint[a2];
+    if (f.has_normal) {  // predict_others
+        const double u = rounded((value - f.midpoint[a0]) / f.normal[a0]);
+        second = second + rounded(u * f.normal[a1]);
+        third = third + rounded(u * f.normal[a2]);
+    }
+    const uint64_t b1 = unit_value_bits<Float32>(second, s.residual<1 - State, Safe>(t[1]));
+    const uint64_t b2 = unit_value_bits<Float32>(third, s.residual<State, Safe>(t[2]));
+    p[a0] = value;
+    p[a1] = bit_cast<double>(b1);
+    p[a2] = bit_cast<double>(b2);
+    largest = std::max(largest, std::max(b0 & ~kSign64, std::max(b1 & ~kSign64, b2 & ~kSign64)));
+}
+
+// frame_of's midpoint in a single-precision hierarchy, for the frames made in lanes (whose
+// normals and axes do not read the midpoint).
+AMC_ALWAYS_INLINE void round_midpoints_to_float(GridFrame* frames, size_t count) {
+    for (size_t i = 0; i < count; ++i)
+        for (double& m : frames[i].midpoint) m = rounded_to_float(m);
+}
+
+// The frames of `count` listed vertices without a grid, two at a time with SSE2.
+struct PairUnitFrames {
+    AMC_ALWAYS_INLINE void operator()(const Hierarchy& h, const FrameCorners* corners, size_t count, GridFrame* frames) const {
+        size_t i = 0;
+#if AMC_SSE2
+        for (; i + 1 < count; i += 2) set_frame_pair(frame_pair_lanes<true>(h, corners[i], corners[i + 1]), frames[i], frames[i + 1]);
+        if (h.single_precision()) round_midpoints_to_float(frames, i);
+#endif
+        for (; i < count; ++i) set_frame(frame_of<true>(h, corners[i]), frames[i]);
+    }
+};
+
+template <bool Float32, class MakeFrames>
+AMC_ALWAYS_INLINE bool decode_unit_listed_with(Hierarchy& h, const FromList& created, const StaticTables& tables,
+                                               const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data,
+                                               size_t raw_size, const MakeFrames& make_frames) {
+    std::array<StencilTable, 3> t;
+    for (size_t k = 0; k < t.size(); ++k) make_stencil_table(tables[k], t[k]);
+    StencilStreams s;
+    if (!open_stencil_streams(rans_data, rans_size, raw_data, raw_size, s)) return false;
+    const bool append = created.appends(h);
+    // What a chunk reads at most: two rANS bytes and the sign and 64 bits per coordinate.
+    constexpr size_t kChunkRans = 2 * 3 * kChunk, kChunkRaw = 3 * kChunk * 65 / 8 + 8;
+    std::array<GridFrame, kChunk> frames;
+    Coordinates coordinates[kChunk];
+    Vec3 decoded[kChunk];
+    for (size_t begin = 0; begin < created.size(); begin += kChunk) {
+        const size_t count = std::min(kChunk, created.size() - begin);
+        const FrameCorners* corners = created.corners.next(count);
+        const Vec3* positions = h.positions().data();
+        for (size_t i = 0; i < count; ++i) {  // a, b and c are always vertices
+            const FrameCorners& k = corners[i];
+            __builtin_prefetch(positions + k.a);
+            __builtin_prefetch(positions + k.b);
+            __builtin_prefetch(positions + k.c);
+            if (k.d != kNoVertex) __builtin_prefetch(positions + k.d);
+        }
+        make_frames(h, corners, count, frames.data());
+        uint64_t largest = 0;
+        auto run = [&](auto safe) {
+            constexpr bool Safe = decltype(safe)::value;
+            StencilStreams local = s;  // the chunk's copy, which the compiler keeps in registers
+            size_t k = 0;
+            for (; k + 1 < count; k += 2) {  // token j of the level with state j mod 2
+                decode_unit_vertex<0, Safe, Float32>(local, t.data(), frames[k], coordinates[k], largest);
+                decode_unit_vertex<1, Safe, Float32>(local, t.data(), frames[k + 1], coordinates[k + 1], largest);
+            }
+            if (k < count) decode_unit_vertex<0, Safe, Float32>(local, t.data(), frames[k], coordinates[k], largest);
+            s = local;
+        };
+        const bool inside = size_t(s.rans_end - s.rans) >= kChunkRans &&
+                            raw_size - std::min<size_t>(raw_size, size_t(s.raw_bits_read >> 3)) >= kChunkRaw;
+        if (inside) run(std::false_type{});
+        else run(std::true_type{});
+        std::memcpy(decoded, coordinates, count * sizeof(Vec3));
+        // Every coordinate at most DBL_MAX / 2 in magnitude: finite, and no position is far.
+        const bool near = largest <= bit_cast<uint64_t>(kHalfMax);
+        if (!near) {  // rare: value_of's refusal of a non-finite coordinate
+            for (size_t k = 0; k < count; ++k)
+                if (!std::isfinite(decoded[k].x) || !std::isfinite(decoded[k].y) || !std::isfinite(decoded[k].z)) return false;
+        }
+        if (append) {
+            HierarchyBuilder::append_positions(h, decoded, count, near);
+        } else {
+            for (size_t k = 0; k < count; ++k) {
+                const VertexId v = created.first() + VertexId(begin + k);
+                if (near) HierarchyBuilder::set_near_vertex_position(h, v, decoded[k]);
+                else HierarchyBuilder::set_new_vertex_position(h, v, decoded[k]);
+            }
+        }
+    }
+    return s.ended_cleanly();
+}
+
+template <bool Float32>
+bool decode_unit_listed(Hierarchy& h, const FromList& created, const StaticTables& tables, const uint8_t* rans_data,
+                        size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
+    return decode_unit_listed_with<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size, PairUnitFrames{});
+}
+
 #if AMC_AVX2_AT_RUN_TIME
 // Whether decode_grid_listed may make its frames four at a time (set_wide_frames).
 std::atomic<bool> wide_frames_allowed{true};
@@ -1714,7 +1850,8 @@ struct FrameQuadLanes {
     __m256d mx, my, mz, nx, ny, nz;
 };
 
-inline FrameQuadLanes frame_quad_lanes(const Hierarchy& h, const FrameCorners* k) {
+// Inlined in both quad frame makers: a call of its own passes the lanes through memory.
+AMC_ALWAYS_INLINE FrameQuadLanes frame_quad_lanes(const Hierarchy& h, const FrameCorners* k) {
     struct Lanes {
         __m256d x, y, z;
     };
@@ -1809,7 +1946,9 @@ struct QuadRoles {
 };
 
 // set_grid_frame_pair for four vertices: set_axis by lane masks, role 0's grid predictions in two
-// pairs; with `roles`, the frames by role instead of the midpoints and normals in `g`.
+// pairs; with `roles`, the frames by role instead of the midpoints and normals in `g`. Without
+// `Grid`, the frames alone (set_frame's).
+template <bool Grid = true>
 inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, const double* origin, GridFrame* g,
                                 QuadRoles* roles = nullptr) {
     if (roles == nullptr) {
@@ -1833,6 +1972,7 @@ inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, 
         g[j].has_normal = ((has >> j) & 1) != 0;
         g[j].axis = (has >> j) & 1 ? ((zs >> j) & 1 ? 2 : (ys >> j) & 1) : 0;
     }
+    if (!Grid) return;
     // Role 0's grid predictions (grid_point_pair's, four lanes): each lane's coordinate and origin
     // on its axis chosen by the same masks.
     const __m256d with_normal = _mm256_castsi256_pd(_mm256_set_epi64x(-int64_t((has >> 3) & 1), -int64_t((has >> 2) & 1),
@@ -1951,6 +2091,22 @@ bool decode_grid_listed_avx2(Hierarchy& h, const FromList& created, const Quanti
     quads.by_role = Grouped;
     return decode_grid_listed_with<Grouped>(h, created, quantizer, tables, rans_data, rans_size, raw_data, raw_size, quads);
 }
+
+// PairUnitFrames four at a time.
+struct QuadUnitFrames {
+    void operator()(const Hierarchy& h, const FrameCorners* corners, size_t count, GridFrame* frames) const {
+        size_t i = 0;
+        for (; i + 3 < count; i += 4) set_grid_frame_quad<false>(frame_quad_lanes(h, corners + i), GridScale{}, nullptr, frames + i);
+        if (h.single_precision()) round_midpoints_to_float(frames, i);
+        PairUnitFrames()(h, corners + i, count - i, frames + i);
+    }
+};
+
+template <bool Float32>
+bool decode_unit_listed_avx2(Hierarchy& h, const FromList& created, const StaticTables& tables, const uint8_t* rans_data,
+                             size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
+    return decode_unit_listed_with<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size, QuadUnitFrames{});
+}
 #pragma GCC pop_options
 #endif
 
@@ -1963,6 +2119,17 @@ bool decode_grid_listed_fastest(Hierarchy& h, const FromList& created, const Qua
         return decode_grid_listed_avx2<Grouped>(h, created, quantizer, tables, rans_data, rans_size, raw_data, raw_size);
 #endif
     return decode_grid_listed<Grouped>(h, created, quantizer, tables, rans_data, rans_size, raw_data, raw_size);
+}
+
+// decode_unit_listed, with AVX2's frames where the processor has them.
+template <bool Float32>
+bool decode_unit_listed_fastest(Hierarchy& h, const FromList& created, const StaticTables& tables, const uint8_t* rans_data,
+                                size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
+#if AMC_AVX2_AT_RUN_TIME
+    if (has_avx2() && wide_frames_allowed.load(std::memory_order_relaxed))
+        return decode_unit_listed_avx2<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+#endif
+    return decode_unit_listed<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
 }
 
 template <class Tables>
@@ -2023,6 +2190,12 @@ bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, G
         if (all_narrow && mode == GeometryPredictor::normal_frame_grid && space.quantizer != nullptr && !h.single_precision())
             return grouped ? decode_grid_listed_fastest<true>(h, created, *space.quantizer, tables, rans_data, rans_size, raw_data, raw_size)
                            : decode_grid_listed_fastest<false>(h, created, *space.quantizer, tables, rans_data, rans_size, raw_data, raw_size);
+        if (all_narrow && mode == GeometryPredictor::unit_normal_frame && space.quantizer == nullptr) {
+            if (space.precision == Precision::float64 && !h.single_precision())
+                return decode_unit_listed_fastest<false>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+            if (space.precision == Precision::float32 && h.single_precision())
+                return decode_unit_listed_fastest<true>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+        }
     }
     if (all_narrow) return decode_static_with(h, created, space, mode, narrow, rans_data, rans_size, raw_data, raw_size, grouped);
     return decode_static_with(h, created, space, mode, tables, rans_data, rans_size, raw_data, raw_size, grouped);
