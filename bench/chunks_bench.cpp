@@ -10,6 +10,11 @@
 //                                                  interleaved; median [min - max] and the ratio of
 //                                                  each run's pair (on a shared machine the load
 //                                                  moves: pairs taken a second apart compare best)
+//   chunks_bench speed-threads RUNS BITS model.amh the loop of `speed` (default chunks), each call's
+//                                                  CPU time and minor faults per thread (Linux:
+//                                                  /proc/self/task): the calling thread, the
+//                                                  threads alive after the call (the pool's
+//                                                  helpers) and those that ended during it
 //   chunks_bench decode-speed RUNS BITS model.amh  decodes only: RUNS pairs of a 1- and a 2-thread
 //                                                  decode, 0.2 s apart (for chrt -f: see decode_speed),
 //                                                  without and with a DecodeContext
@@ -42,17 +47,21 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstring>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include <dirent.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
 namespace {
 
@@ -181,6 +190,106 @@ int speed(int runs, int bits, uint32_t chunks, const char* path) {
     };
     faults_line("decode", decode_faults);
     faults_line("decode through a DecodeContext", kept_faults);
+    return 0;
+}
+
+// CPU seconds (schedstat: on the processor, faults' kernel time included) and minor faults of
+// each live thread of the process, by thread id.
+struct ThreadUse {
+    double cpu = 0, faults = 0;
+};
+std::map<int, ThreadUse> thread_use() {
+    std::map<int, ThreadUse> use;
+    DIR* tasks = opendir("/proc/self/task");
+    if (tasks == nullptr) return use;
+    while (const dirent* entry = readdir(tasks)) {
+        if (entry->d_name[0] == '.') continue;
+        const std::string dir = std::string("/proc/self/task/") + entry->d_name;
+        ThreadUse u;
+        std::ifstream stat(dir + "/stat");
+        std::string line, field;
+        std::getline(stat, line);
+        const size_t name_end = line.rfind(')');
+        if (name_end == std::string::npos) continue;
+        std::istringstream fields(line.substr(name_end + 2));
+        for (int i = 3; i <= 10; ++i) fields >> field;  // field 10: minflt
+        u.faults = std::atof(field.c_str());
+        std::ifstream schedstat(dir + "/schedstat");
+        double nanoseconds = 0;
+        schedstat >> nanoseconds;
+        u.cpu = 1e-9 * nanoseconds;
+        use[std::atoi(entry->d_name)] = u;
+    }
+    closedir(tasks);
+    return use;
+}
+
+// What one call cost, per thread: the calling thread, the threads alive after it (helpers), the
+// threads that ended during it (the process's totals less the live threads').
+struct CallUse {
+    double wall = 0, caller_cpu = 0, helper_cpu = 0, ended_cpu = 0, caller_faults = 0, helper_faults = 0, ended_faults = 0;
+};
+template <class Op>
+CallUse measure_call(Op&& op) {
+    const int caller = int(getpid());
+    const std::map<int, ThreadUse> before = thread_use();
+    const double faults_before = minor_faults(), cpu_before = cpu_seconds(), start = now();
+    op();
+    CallUse use;
+    use.wall = now() - start;
+    const double cpu = cpu_seconds() - cpu_before, faults = minor_faults() - faults_before;
+    for (const auto& [tid, after] : thread_use()) {
+        const auto was = before.find(tid);
+        const ThreadUse base = was == before.end() ? ThreadUse() : was->second;
+        (tid == caller ? use.caller_cpu : use.helper_cpu) += after.cpu - base.cpu;
+        (tid == caller ? use.caller_faults : use.helper_faults) += after.faults - base.faults;
+    }
+    use.ended_cpu = std::max(0.0, cpu - use.caller_cpu - use.helper_cpu);
+    use.ended_faults = std::max(0.0, faults - use.caller_faults - use.helper_faults);
+    return use;
+}
+
+int speed_threads(int runs, int bits, const char* path) {
+    const amc::Hierarchy h = amc::read_hierarchy(path);
+    amc::EncodeOptions options;
+    options.quantize_bits = bits;
+    const std::vector<uint8_t> bytes = amc::encode(h, options);
+    amc::DecodeContext contexts[2];
+    const char* const names[3] = {"encode", "decode", "decode through a DecodeContext"};
+    std::vector<CallUse> uses[3][2];
+    std::vector<double> ratio[3];
+    for (int r = 0; r < runs; ++r) {
+        for (unsigned threads : {1u, 2u}) {
+            amc::EncodeOptions o = options;
+            o.threads = threads;
+            amc::DecodeOptions d;
+            d.threads = threads;
+            uses[0][threads - 1].push_back(measure_call([&] {
+                if (amc::encode(h, o) != bytes) std::abort();
+            }));
+            uses[1][threads - 1].push_back(measure_call([&] { amc::Hierarchy back = amc::decode(bytes.data(), bytes.size(), d); }));
+            uses[2][threads - 1].push_back(
+                measure_call([&] { amc::Hierarchy back = amc::decode(contexts[threads - 1], bytes.data(), bytes.size(), d); }));
+        }
+        for (int k = 0; k < 3; ++k) ratio[k].push_back(uses[k][0].back().wall / uses[k][1].back().wall);
+    }
+    std::printf("%s, %d bits, %d runs (medians; CPU s and minor faults of the calling thread, of the helpers alive after the "
+                "call, of the threads that ended in it)\n",
+                name_of(path).c_str(), bits, runs);
+    for (int k = 0; k < 3; ++k)
+        for (int t = 0; t < 2; ++t) {
+            auto m = [&](double CallUse::*field) {
+                std::vector<double> v;
+                for (const CallUse& u : uses[k][t]) v.push_back(u.*field);
+                return median(v);
+            };
+            std::printf("  %s, %d thread%s: wall %.4f s; CPU caller %.4f, helpers %.4f, ended %.4f; faults caller %.0f, helpers "
+                        "%.0f, ended %.0f",
+                        names[k], t + 1, t ? "s" : "", m(&CallUse::wall), m(&CallUse::caller_cpu), m(&CallUse::helper_cpu),
+                        m(&CallUse::ended_cpu), m(&CallUse::caller_faults), m(&CallUse::helper_faults), m(&CallUse::ended_faults));
+            if (t == 1) std::printf("; speed-up per run %.2f", median(ratio[k]));
+            std::printf("\n");
+        }
     return 0;
 }
 
@@ -368,6 +477,7 @@ int main(int argc, char** argv) {
     if (mode == "sizes" && argc >= 4) return sizes(std::atoi(argv[2]), argc - 3, argv + 3);
     if (mode == "speed" && argc == 6)
         return speed(std::max(1, std::atoi(argv[2])), std::atoi(argv[3]), uint32_t(std::atoi(argv[4])), argv[5]);
+    if (mode == "speed-threads" && argc == 5) return speed_threads(std::max(1, std::atoi(argv[2])), std::atoi(argv[3]), argv[4]);
     if (mode == "decode-speed" && argc == 5) return decode_speed(std::max(1, std::atoi(argv[2])), std::atoi(argv[3]), argv[4]);
     if (mode == "decode-file" && (argc == 5 || (argc == 6 && std::string(argv[4]) == "context")))
         return decode_file(std::max(1, std::atoi(argv[2])), unsigned(std::atoi(argv[3])), argc == 6, argv[argc - 1]);
@@ -379,6 +489,7 @@ int main(int argc, char** argv) {
     if (mode == "repeat" && argc == 7 && (std::string(argv[2]) == "encode" || std::string(argv[2]) == "decode"))
         return repeat(argv[2], std::max(1, std::atoi(argv[3])), unsigned(std::atoi(argv[4])), std::atoi(argv[5]), argv[6]);
     std::fprintf(stderr, "usage: chunks_bench sizes BITS model.amh ...\n       chunks_bench speed RUNS BITS CHUNKS model.amh\n"
+                         "       chunks_bench speed-threads RUNS BITS model.amh\n"
                          "       chunks_bench decode-speed RUNS BITS model.amh\n"
                          "       chunks_bench decode-file RUNS THREADS [context] file.amc\n"
                          "       chunks_bench decode-rusage RUNS recycle|keep|free file.amc\n"

@@ -3,6 +3,8 @@
 // (AMC_SANITIZE_THREAD), where a data race is fatal; without it these tests still check results.
 #include "hierarchy_checks.h"
 
+#include "common/parallel.h"
+
 #include <amc/codec.h>
 #include <amc/hierarchy_coder.h>
 #include <amc/mesh.h>
@@ -16,9 +18,12 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <string>
 #include <thread>
 #include <vector>
 
+#include <sys/syscall.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 namespace amc {
@@ -174,6 +179,85 @@ TEST(ThreadSafety, ConcurrentAtomicWritesOfOnePathLeaveOneWholeFile) {
     }
     EXPECT_EQ(entries, 1);
     std::filesystem::remove_all(dir);
+}
+
+// parallel_for (src/common/parallel.h) called by several threads at once and from inside its own
+// tasks: every task runs once, and a task's exception comes back to its caller only.
+TEST(ThreadSafety, ParallelForRunsEveryTaskOnceFromManyCallersAndNested) {
+    constexpr size_t kTasks = 40, kInner = 7;
+    std::atomic<int> wrong{0};
+    std::vector<std::thread> threads;
+    for (int t = 0; t < kThreads; ++t) {
+        threads.emplace_back([&, t] {
+            for (int round = 0; round < 20; ++round) {
+                std::vector<std::atomic<int>> runs(kTasks * kInner);
+                parallel_for(kTasks, unsigned(2 + t % 3), [&](size_t i) {
+                    parallel_for(kInner, 2, [&](size_t k) { ++runs[i * kInner + k]; });
+                });
+                for (const std::atomic<int>& r : runs) wrong += r.load() != 1;
+                bool caught = false;
+                try {
+                    parallel_for(kTasks, 3, [&](size_t i) {
+                        if (i == kTasks / 2) throw Error("task " + std::to_string(i) + " of thread " + std::to_string(t));
+                    });
+                } catch (const Error& e) {
+                    caught = std::string(e.what()) == "task " + std::to_string(kTasks / 2) + " of thread " + std::to_string(t);
+                }
+                wrong += !caught;
+            }
+        });
+    }
+    for (std::thread& thread : threads) thread.join();
+    EXPECT_EQ(wrong.load(), 0);
+}
+
+// Task 1 of a 2-thread parallel_for runs on a helper (task 0, the caller's, waits until it has
+// started): the same helper thread every call, not a new one (docs/BENCHMARKS.md, "Threads and
+// memory": a new thread's memory is faulted in again).
+TEST(ThreadSafety, ParallelForKeepsItsHelperThread) {
+    std::vector<long> helper_ids;
+    for (int call = 0; call < 20; ++call) {
+        std::atomic<bool> started{false};
+        long id = 0;
+        parallel_for(2, 2, [&](size_t i) {
+            if (i == 1) {
+                id = long(syscall(SYS_gettid));
+                started = true;
+                return;
+            }
+            while (!started) std::this_thread::yield();
+        });
+        helper_ids.push_back(id);
+    }
+    EXPECT_NE(helper_ids[0], long(syscall(SYS_gettid)));
+    EXPECT_EQ(std::count(helper_ids.begin(), helper_ids.end(), helper_ids[0]), 20);
+}
+
+// A child forked after parallel_for has used helpers has none of them: its own parallel_for starts
+// new ones instead of waiting for threads that do not exist in it.
+TEST(ThreadSafety, ParallelForWorksInAForkedChild) {
+#if defined(__SANITIZE_THREAD__)
+    GTEST_SKIP() << "ThreadSanitizer ends a multi-threaded process's child that starts threads";
+#else
+    auto both_threads = [] {
+        std::atomic<bool> started{false};
+        parallel_for(2, 2, [&](size_t i) {
+            if (i == 1) started = true;
+            while (!started) std::this_thread::yield();
+        });
+    };
+    both_threads();
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        alarm(20);  // a child waiting for a helper that does not exist ends here, failed
+        both_threads();
+        _exit(0);
+    }
+    int status = 0;
+    ASSERT_EQ(waitpid(child, &status, 0), child);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "status " << status;
+#endif
 }
 
 }  // namespace

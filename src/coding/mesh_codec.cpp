@@ -503,7 +503,7 @@ struct ChunkRequest {
 // block, if any, and END.
 Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const TriangleMesh& base, CoordinateSpace space,
                               const DecodeOptions& options, LeafNumbering* numbering, PartialProgress* partial,
-                              const ChunkRequest* request, std::future<SliceStorage>* slice_storage,
+                              const ChunkRequest* request, std::future<std::vector<Vec3>>* zeroed_positions,
                               ChunkDecoders* kept_decoders, Hierarchy* spare) {
     AMC_REQUIRE(reader.version() >= kChunkedVersion, corrupt, "metadata block: chunks in a version-" + std::to_string(reader.version()) + " file");
     if (partial != nullptr) {
@@ -515,7 +515,7 @@ Hierarchy decode_chunked_file(BlockReader& reader, const Metadata& meta, const T
         while (!complete && probe.next_block_arrived() && probe.next(block)) complete = block.type == BlockType::end;
         if (!complete) return Hierarchy(base);
     }
-    const ChunkedDecodeInput input{&base, space, reader.version(), meta.vertices, options, slice_storage,
+    const ChunkedDecodeInput input{&base, space, reader.version(), meta.vertices, options, zeroed_positions,
                                    kept_decoders, spare};
     ChunkTable table;
     MergedCounts counts;
@@ -570,12 +570,12 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     };
     const Metadata meta = read_metadata(expect(BlockType::metadata), quantized);
     check_counts_against_size(meta, reader.remaining(), options);
-    // Several threads decode a whole chunked file into slices of its hierarchy, whose storage
-    // another thread makes meanwhile (the metadata's counts are bounded by the file's size).
-    std::future<SliceStorage> slice_storage;
+    // Several threads decode a whole chunked file into slices of its hierarchy, whose positions
+    // another thread zeroes meanwhile (the metadata's counts are bounded by the file's size).
+    std::future<std::vector<Vec3>> zeroed_positions;
     if ((meta.options & kOptionChunked) && reader.version() >= kChunkVerticesVersion && partial == nullptr &&
         request == nullptr && options.max_level < 0 && resolve_thread_count(options.threads) > 1)
-        slice_storage = start_slice_storage(spare != nullptr ? 0 : size_t(meta.nodes), size_t(meta.vertices));
+        zeroed_positions = start_zeroed_positions(size_t(meta.vertices));
     const Block connectivity_block = expect(BlockType::base_connectivity);
     const Block geometry_block = expect(BlockType::base_geometry);
     const CoordinateSpace space{precision, quantized ? &meta.quantizer : nullptr};
@@ -587,7 +587,7 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     AMC_REQUIRE(!((meta.options & kOptionMixedContexts) && (meta.options & kOptionChunked)), corrupt,
                 "metadata block: mixed hierarchy contexts in a chunked file");
     if (meta.options & kOptionChunked)
-        return decode_chunked_file(reader, meta, base, space, options, numbering, partial, request, &slice_storage,
+        return decode_chunked_file(reader, meta, base, space, options, numbering, partial, request, &zeroed_positions,
                                    kept_decoders, spare);
     if (request != nullptr) {  // a file without chunks is one chunk
         AMC_REQUIRE(request->chunks.size() == 1 && request->chunks[0] == 0, invalid_input,

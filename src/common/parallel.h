@@ -1,16 +1,16 @@
-// Runs independent tasks on several threads (std::thread, nothing else): the chunks of an .amc
-// file are coded this way. Tasks are handed out one at a time from a shared counter, so threads
-// that finish early take the next task and chunks of unequal cost still balance.
+// Runs independent tasks on several threads: the chunks of an .amc file are coded this way. Tasks
+// are handed out one at a time from a shared counter, so threads that finish early take the next
+// task and chunks of unequal cost still balance. The threads besides the caller's come from the
+// process's pool (parallel.cpp): they wait for the next call instead of ending.
 #pragma once
 
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
 #include <exception>
+#include <condition_variable>
 #include <mutex>
-#include <system_error>
 #include <thread>
-#include <vector>
 
 namespace amc {
 
@@ -27,6 +27,29 @@ template <class Task>
 [[gnu::noinline]] void run_task(Task& task, size_t i) {
     task(i);
 }
+
+namespace detail {
+// Calls work(context) on up to `helpers` threads of the process's pool at once, woken from their
+// wait or started when none waits, and returns at once: wait_for_helpers(group) returns once every
+// one of them has returned from it. A thread that can not be had is left out (work() must not
+// need it). A group is one call's; any thread may start groups, also from inside work().
+class HelperGroup {
+public:
+    HelperGroup() = default;
+    HelperGroup(const HelperGroup&) = delete;
+    HelperGroup& operator=(const HelperGroup&) = delete;
+    ~HelperGroup() { wait(); }
+    void start(size_t helpers, void (*work)(void*), void* context);
+    void wait();
+    // Called by a helper once its work has returned: the last thing it touches of the group.
+    void helper_done();
+
+private:
+    std::mutex mutex_;
+    std::condition_variable done_;
+    size_t running_ = 0;
+};
+}  // namespace detail
 
 // Calls task(i) for i in [0, count) on up to `threads` threads (the caller's thread is one of
 // them, and takes task 0 first). The first exception a task throws is rethrown here once every
@@ -54,17 +77,12 @@ void parallel_for(size_t count, unsigned threads, Task&& task) {
         }
     };
     const size_t first = next++;  // this thread's first task is task 0, however fast the others start
-    std::vector<std::thread> pool;
-    pool.reserve(workers - 1);
-    for (size_t t = 1; t < workers; ++t) {
-        try {
-            pool.emplace_back([&] { work(next++); });
-        } catch (const std::system_error&) {  // no more threads to be had: the others do the work
-            break;
-        }
-    }
-    work(first);
-    for (std::thread& thread : pool) thread.join();
+    auto helper_work = [&] { work(next++); };
+    {
+        detail::HelperGroup helpers;
+        helpers.start(workers - 1, [](void* context) { (*static_cast<decltype(helper_work)*>(context))(); }, &helper_work);
+        work(first);
+    }  // the helpers have returned
     if (error) std::rethrow_exception(error);
 }
 

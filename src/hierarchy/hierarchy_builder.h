@@ -177,10 +177,6 @@ struct HierarchyBuilder {
     // `vertices` positions (made on another thread), becomes the positions' storage; otherwise
     // they are zeroed here.
     static void open_slices(Hierarchy& h, size_t nodes, size_t vertices, std::vector<Vec3> zeroed = {});
-    // A hierarchy with no nodes whose node and block arrays have room for `nodes` nodes and
-    // `blocks` blocks, their pages resident (populate_pages): a spare for adopt_storage, made on
-    // another thread before the decoders of the slices write it.
-    static Hierarchy resident_storage(size_t nodes, size_t blocks);
     // Gives `h` (its roots only, as constructed) the node, block and position arrays of `spare`, a
     // hierarchy its owner is done with, where they hold more: a decode into `h` then writes memory
     // that is resident already instead of faulting fresh pages in. `spare` is left empty.

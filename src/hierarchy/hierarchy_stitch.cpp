@@ -33,15 +33,6 @@ void HierarchyBuilder::open_slices(Hierarchy& h, size_t nodes, size_t vertices, 
     h.live_vertices_ = uint32_t(vertices);
 }
 
-Hierarchy HierarchyBuilder::resident_storage(size_t nodes, size_t blocks) {
-    Hierarchy spare;
-    reserve_huge(spare.nodes_, nodes);
-    reserve_huge(spare.block_parent_, blocks);
-    populate_pages(spare.nodes_.data(), spare.nodes_.capacity() * sizeof(Hierarchy::Node));
-    populate_pages(spare.block_parent_.data(), spare.block_parent_.capacity() * sizeof(NodeId));
-    return spare;
-}
-
 void HierarchyBuilder::adopt_storage(Hierarchy& h, Hierarchy&& spare) {
     AMC_REQUIRE(h.nodes_.size() == h.root_count() && h.free_blocks_.empty() && h.free_vertices_.empty(), invalid_input,
                 "adopt_storage: the hierarchy is refined already");

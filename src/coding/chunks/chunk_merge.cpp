@@ -188,11 +188,10 @@ Hierarchy merge_in_order(const std::vector<ChunkJob>& jobs, const ChunkMergeInpu
 Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& input, MergePlan& plan,
                           std::vector<ChunkCounts>& counts, unsigned threads) {
     const size_t n = jobs.size();
-    SliceStorage storage;
-    if (input.slice_storage != nullptr && input.slice_storage->valid()) storage = input.slice_storage->get();
+    std::vector<Vec3> zeroed_positions;
+    if (input.zeroed_positions != nullptr && input.zeroed_positions->valid()) zeroed_positions = input.zeroed_positions->get();
     Hierarchy whole(plan.base);
     if (input.spare != nullptr) HierarchyBuilder::adopt_storage(whole, std::move(*input.spare));
-    HierarchyBuilder::adopt_storage(whole, std::move(storage.nodes));
     HierarchyBuilder::append_vertices(whole, input.seam->positions());
     std::vector<HierarchySlice> slices(n);
     uint64_t node = plan.base.triangles.size(), vertex = plan.own_start();
@@ -206,7 +205,7 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
         slices[i].owner = chunk_name(jobs[i]);
     }
     AMC_REQUIRE(vertex < kNoVertex, limit_exceeded, "too many vertices");
-    HierarchyBuilder::open_slices(whole, size_t(node), size_t(vertex), std::move(storage.zeroed_positions));
+    HierarchyBuilder::open_slices(whole, size_t(node), size_t(vertex), std::move(zeroed_positions));
     find_seam_edges(plan, whole, n);
     const std::vector<HierarchyBuilder::RootLink> cut = HierarchyBuilder::cut_root_links(whole, plan.seam_edges);
     std::vector<std::vector<uint8_t>> seam_used(n, std::vector<uint8_t>(plan.seam_count, 0));
@@ -215,8 +214,8 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
     auto decode_into_slice = [&](size_t i) {
         std::unique_ptr<HierarchyLevelDecoder> decoder = decoders.take();
         const ChunkJob& job = jobs[i];
-        // Never lean (ChunkPlace::last): the whole is resident already (start_slice_storage), and
-        // pages given back and faulted in again by two threads at once cost more than they save.
+        // Never lean (ChunkPlace::last): pages given back and faulted in again by two threads at
+        // once cost more than they save.
         const ChunkPlace place{&whole, plan.first_root[i], job.roots.count, plan.keys_in_whole(), seam_used[i].data(),
                                &slices[i], false};
         decode_job(*decoder, job, place, input, counts[i]);
@@ -270,14 +269,13 @@ void ChunkDecoders::clear() {
     idle_.clear();
 }
 
-std::future<SliceStorage> start_slice_storage(size_t nodes, size_t vertices) {
+std::future<std::vector<Vec3>> start_zeroed_positions(size_t vertices) {
     try {
-        return std::async(std::launch::async, [nodes, vertices] {
-            SliceStorage storage;
-            reserve_huge(storage.zeroed_positions, vertices);
-            storage.zeroed_positions.resize(vertices);
-            storage.nodes = HierarchyBuilder::resident_storage(nodes, nodes / 4);
-            return storage;
+        return std::async(std::launch::async, [vertices] {
+            std::vector<Vec3> positions;
+            reserve_huge(positions, vertices);
+            positions.resize(vertices);
+            return positions;
         });
     } catch (const std::system_error&) {  // no thread to be had: open_slices zeroes them
         return {};

@@ -47,16 +47,6 @@ private:
     std::vector<std::unique_ptr<HierarchyLevelDecoder>> idle_;
 };
 
-// The whole's storage, made on another thread while the base mesh and the seam are decoded:
-// decoding chunks into slices of the whole (several threads, version 13 on) needs its positions
-// zeroed before any chunk starts (2 % of a decode), and its node and block pages faulted in by one
-// thread rather than by the decoders of the slices at once, which takes several times as long on
-// the project's VM (docs/BENCHMARKS.md, "Threads and memory").
-struct SliceStorage {
-    std::vector<Vec3> zeroed_positions;  // `vertices` of them
-    Hierarchy nodes;                     // HierarchyBuilder::resident_storage, for adopt_storage
-};
-
 struct ChunkMergeInput {
     const BlockReader* reader = nullptr;  // of the file: checks each chunk block before it is decoded
     const TriangleMesh* base = nullptr;  // the file's base mesh
@@ -67,8 +57,8 @@ struct ChunkMergeInput {
     uint64_t vertices = 0;   // the file's vertex count (metadata)
     size_t file_size = 0;
     DecodeOptions options;
-    // The whole's storage, being made on another thread (start_slice_storage); may be null.
-    std::future<SliceStorage>* slice_storage = nullptr;
+    // The whole's positions, being zeroed on another thread (start_zeroed_positions); may be null.
+    std::future<std::vector<Vec3>>* zeroed_positions = nullptr;
     // The caller's decoders, kept warm after the decode (DecodeContext); null: decoders made for
     // this decode, which on one thread give their working memory back over their last chunk
     // (ChunkPlace::last).
@@ -84,9 +74,13 @@ struct MergedCounts {
     int depth = 0;       // Hierarchy::depth
 };
 
-// Starts making a SliceStorage of `nodes` nodes and `vertices` positions on another thread; an
-// invalid future when no thread could be started.
-std::future<SliceStorage> start_slice_storage(size_t nodes, size_t vertices);
+// Starts zeroing `vertices` positions on another thread while the base mesh and the seam are
+// decoded: decoding chunks into slices of the whole (several threads, version 13 on) needs them
+// before any chunk starts (2 % of a decode). An invalid future when no thread could be started.
+// The whole's node pages are faulted in by the decoders of the slices, each its own: made resident
+// here too they took 5-8 ms more than the base mesh, all of it waited for (docs/BENCHMARKS.md,
+// "Threads and memory").
+std::future<std::vector<Vec3>> start_zeroed_positions(size_t vertices);
 
 // Decodes `jobs` (chunks in increasing order) and merges them: the hierarchy over base_of_roots of
 // their roots, its vertices the base's, the seam vertices the chunks hold (in seam order), then

@@ -214,7 +214,7 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
     merge.vertices = input.vertices;
     merge.file_size = file_size;
     merge.options = input.options;
-    merge.slice_storage = input.slice_storage;
+    merge.zeroed_positions = input.zeroed_positions;
     merge.kept_decoders = input.kept_decoders;
     merge.spare = input.spare;
     MergedCounts counts;

@@ -56,7 +56,7 @@ struct ChunkedDecodeInput {
     uint8_t version = kChunkedVersion;
     uint64_t vertices = 0;  // the file's vertex count (metadata)
     DecodeOptions options;
-    std::future<SliceStorage>* slice_storage = nullptr;  // ChunkMergeInput's
+    std::future<std::vector<Vec3>>* zeroed_positions = nullptr;  // ChunkMergeInput's
     ChunkDecoders* kept_decoders = nullptr;                       // ChunkMergeInput's
     Hierarchy* spare = nullptr;                                   // ChunkMergeInput's
 };
