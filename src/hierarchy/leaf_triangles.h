@@ -11,10 +11,11 @@
 namespace amc {
 
 // Calls emit(n, a, b, c, green) for each triangle of the leaves of `breadth_first` (the nodes of
-// h in breadth-first order), in that order; with max_level >= 0, nodes of that level are taken
-// as leaves (whole, no closure) and finer ones are left out.
-template <class Emit>
-void for_each_leaf_triangle(const Hierarchy& h, const std::vector<NodeId>& breadth_first, int max_level, Emit emit) {
+// h in breadth-first order, or any range of node ids when max_level < 0), in that order; with
+// max_level >= 0, nodes of that level are taken as leaves (whole, no closure) and finer ones are
+// left out.
+template <class Nodes, class Emit>
+void for_each_leaf_triangle(const Hierarchy& h, const Nodes& breadth_first, int max_level, Emit emit) {
     const bool cut = max_level >= 0;
     for (NodeId n : breadth_first) {
         const bool at_cut = cut && h.level(n) >= max_level;

@@ -4,6 +4,7 @@
 #include <amc/import.h>
 
 #include "common/huge_pages.h"
+#include "common/mixing.h"
 #include "common/no_index.h"
 #include "hierarchy/leaf_triangles.h"
 #include "import/anchored_reconstruction.h"
@@ -37,21 +38,26 @@ std::string position_text(Vec3 p) {
 
 std::vector<uint32_t> match_base_vertices(const TriangleMesh& base, const TriangleMesh& leaf,
                                           const std::vector<uint32_t>& leaf_vertex_of_base,
-                                          const PositionIndex& leaf_positions,
-                                          const std::vector<uint32_t>& input_of_indexed, const std::string& what) {
+                                          const std::vector<uint32_t>& first_at_base, const std::string& what) {
     const size_t v0 = base.positions.size();
     std::vector<uint32_t> match(v0, kNoIndex);
-    std::vector<uint32_t> base_of_leaf(leaf.positions.size(), kNoIndex);
+    // The base vertex of each matched leaf vertex, open addressing over the few base vertices
+    // (an array over every leaf vertex faulted in 4 KiB pages for v0 entries).
+    size_t slots = 16;
+    while (slots < 2 * v0) slots *= 2;
+    std::vector<std::pair<uint32_t, uint32_t>> base_of_leaf(slots, {kNoIndex, kNoIndex});  // (leaf, base)
+    auto slot_of = [&](uint32_t l) {
+        size_t s = size_t((uint64_t(l) * 0x9e3779b97f4a7c15ull) >> 32) & (slots - 1);
+        while (base_of_leaf[s].first != kNoIndex && base_of_leaf[s].first != l) s = (s + 1) & (slots - 1);
+        return s;
+    };
     if (!leaf_vertex_of_base.empty()) {
         if (leaf_vertex_of_base.size() != v0)
             fail(what, "the base vertex map has " + std::to_string(leaf_vertex_of_base.size()) + " entries for " +
                            std::to_string(v0) + " base vertices");
         match = leaf_vertex_of_base;
     } else {
-        for (uint32_t b = 0; b < v0; ++b) {
-            const uint32_t l = leaf_positions.find(base.positions[b]);
-            match[b] = l == kNoIndex ? kNoIndex : input_of_indexed[l];
-        }
+        match = first_at_base;
     }
     for (uint32_t b = 0; b < v0; ++b) {
         const uint32_t l = match[b];
@@ -61,12 +67,57 @@ std::vector<uint32_t> match_base_vertices(const TriangleMesh& base, const Triang
         if (l >= leaf.positions.size())
             fail(what, "base vertex " + std::to_string(b) + " maps to leaf vertex " + std::to_string(l) + " of " +
                            std::to_string(leaf.positions.size()));
-        if (base_of_leaf[l] != kNoIndex)
-            fail(what, "base vertices " + std::to_string(base_of_leaf[l]) + " and " + std::to_string(b) +
+        const size_t s = slot_of(l);
+        if (base_of_leaf[s].first == l)
+            fail(what, "base vertices " + std::to_string(base_of_leaf[s].second) + " and " + std::to_string(b) +
                            " both map to leaf vertex " + std::to_string(l));
-        base_of_leaf[l] = b;
+        base_of_leaf[s] = {l, b};
     }
     return match;
+}
+
+// The first and second leaf vertex (input order) at exactly each base vertex's position, or
+// kNoIndex: one pass over the leaf positions with a table of the few base positions, where an index
+// of every leaf position hashes each into a table of eight times their count.
+struct LeafAtBase {
+    std::vector<uint32_t> first, second;
+};
+LeafAtBase leaf_vertices_at_base(const std::vector<Vec3>& base, const std::vector<Vec3>& leaf) {
+    auto same = [](const Vec3& a, const Vec3& b) { return std::memcmp(&a, &b, sizeof(Vec3)) == 0; };
+    size_t slots = 16;
+    while (slots < 2 * base.size()) slots *= 2;
+    std::vector<uint32_t> table(slots, kNoIndex);  // a base vertex at each distinct position
+    auto slot_of = [&](const Vec3& p) {
+        uint64_t bits[3];
+        std::memcpy(bits, &p, sizeof bits);
+        size_t s = size_t(hash_words(bits[0], bits[1], bits[2])) & (slots - 1);
+        while (table[s] != kNoIndex && !same(base[table[s]], p)) s = (s + 1) & (slots - 1);
+        return s;
+    };
+    std::vector<uint32_t> at(base.size());  // each base vertex's slot
+    for (uint32_t b = 0; b < base.size(); ++b) {
+        const size_t s = slot_of(base[b]);
+        if (table[s] == kNoIndex) table[s] = b;
+        at[b] = uint32_t(s);
+    }
+    std::vector<uint32_t> first(slots, kNoIndex), second(slots, kNoIndex);
+    for (uint32_t l = 0; l < leaf.size(); ++l) {
+        const size_t s = slot_of(leaf[l]);
+        if (table[s] == kNoIndex) continue;
+        if (first[s] == kNoIndex) {
+            first[s] = l;
+        } else if (second[s] == kNoIndex) {
+            second[s] = l;
+        }
+    }
+    LeafAtBase out;
+    out.first.reserve(base.size());
+    out.second.reserve(base.size());
+    for (uint32_t s : at) {
+        out.first.push_back(first[s]);
+        out.second.push_back(second[s]);
+    }
+    return out;
 }
 
 // first[second[i]] for every i.
@@ -87,8 +138,8 @@ TriangleMesh renumbered(const TriangleMesh& leaf, const std::vector<uint32_t>& i
     TriangleMesh out;
     out.single_precision = leaf.single_precision;
     // Fresh pages, a fault each per 4 KiB without huge pages: at 10^6 faces as much as the copy.
-    reserve_huge(out.positions, input_of.size());
-    reserve_huge(out.triangles, leaf.triangles.size());
+    reserve_huge(out.positions, input_of.size(), HugePages::written_whole);
+    reserve_huge(out.triangles, leaf.triangles.size(), HugePages::written_whole);
     for (uint32_t v : input_of) out.positions.push_back(leaf.positions[v]);
     for (const Triangle& t : leaf.triangles) out.triangles.push_back({import_of[t[0]], import_of[t[1]], import_of[t[2]]});
     return out;
@@ -109,7 +160,7 @@ struct RenumberedLeaf {
           import_of(inverse(input_of)),
           mesh(renumbered(leaf, input_of, import_of)),
           halfedges(mesh),
-          positions(mesh.positions, nullptr, nullptr, &import_of),
+          positions(PositionIndex::Deferred{}, mesh.positions, &import_of),  // the exact way does not run here
           import_of_spatial(composed(import_of, spatial_input_of)),
           search(spatial_search, import_of_spatial) {
         leaf_of_base.reserve(input_leaf_of_base.size());
@@ -124,6 +175,22 @@ struct RenumberedLeaf {
     std::vector<uint32_t> leaf_of_base;
 };
 
+// The node ids 0 .. count - 1, in order, as a range.
+struct NodeIdRange {
+    NodeId count;
+    struct Iterator {
+        NodeId n;
+        NodeId operator*() const { return n; }
+        Iterator& operator++() {
+            ++n;
+            return *this;
+        }
+        bool operator!=(Iterator other) const { return n != other.n; }
+    };
+    Iterator begin() const { return {0}; }
+    Iterator end() const { return {count}; }
+};
+
 // extract_leaf_mesh(h) must be the input: every leaf triangle an input face with the same
 // orientation, every input face one leaf triangle. Read in hierarchy vertex ids, in
 // extract_leaf_mesh's order, without its canonical numbering and copies (a tenth of a 10^6-face
@@ -135,6 +202,31 @@ void verify_leaf_mesh(const Hierarchy& h, const std::vector<uint32_t>& leaf_of_v
     // 128 KiB per 10^6 faces stay in the cache where a byte each did not.
     std::vector<uint64_t> used((leaf.triangles.size() + 63) / 64, 0);
     auto leaf_vertex = [&](VertexId v) { return v < leaf_of_vertex.size() ? leaf_of_vertex[v] : kNoIndex; };
+    // Whether every leaf triangle is an unused face, all faces used, read in node id order. With
+    // every node live (never coarsened), those are the nodes of the breadth-first order, so the
+    // answer is that order's, without computing it (a twentieth of the check). A failure is read
+    // again in breadth-first order below, whose first misfit the message names.
+    if (h.node_count() == h.node_capacity()) {
+        bool fits = true;
+        try {
+            for_each_leaf_triangle(h, NodeIdRange{h.node_capacity()}, -1, [&](NodeId, VertexId x, VertexId y, VertexId z, bool) {
+                const uint32_t a = leaf_vertex(x), b = leaf_vertex(y), c = leaf_vertex(z);
+                const LeafHalfedges::Edge e =
+                    (a == kNoIndex || b == kNoIndex) ? LeafHalfedges::Edge{} : halfedges.edge(a, b);
+                const uint32_t f = e.face;
+                if (f == kNoIndex || e.apex != c || (used[f / 64] >> (f % 64) & 1)) {
+                    fits = false;
+                    return;
+                }
+                used[f / 64] |= uint64_t(1) << (f % 64);
+            });
+        } catch (const Error&) {  // a leaf with three hanging nodes
+            fits = false;
+        }
+        for (size_t f = 0; fits && f < leaf.triangles.size(); ++f) fits = used[f / 64] >> (f % 64) & 1;
+        if (fits) return;
+        std::fill(used.begin(), used.end(), 0);
+    }
     auto vertex_text = [&](uint32_t l) { return std::to_string(l == kNoIndex ? l : input_of[l]); };
     for_each_leaf_triangle(h, h.breadth_first_order(), -1, [&](NodeId, VertexId x, VertexId y, VertexId z, bool) {
         const uint32_t a = leaf_vertex(x), b = leaf_vertex(y), c = leaf_vertex(z);
@@ -175,8 +267,8 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     const std::vector<uint32_t> input_of = detail::spatial_vertex_order(leaf.positions, &spatial_codes);  // spatial id -> input id
     const std::vector<uint32_t> spatial_of = inverse(input_of);
     const TriangleMesh spatial = renumbered(leaf, input_of, spatial_of);
-    uint32_t first = kNoIndex, second = kNoIndex;
-    PositionIndex leaf_positions(leaf.positions, &first, &second);  // in input order: sequential reads
+    // In input order (sequential reads), built when the exact way looks a second vertex up.
+    PositionIndex leaf_positions(PositionIndex::Deferred{}, leaf.positions);
     leaf_positions.rename(spatial.positions, spatial_of);
     // Two vertices at one position are refused where they make the input ambiguous (a base vertex
     // matched by position) or when the import fails; a projection may put two new vertices of a
@@ -185,17 +277,15 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
         fail(what, "vertices " + std::to_string(a) + " and " + std::to_string(b) + " have the same position " +
                        position_text(leaf.positions[a]) + " (duplicate vertex)");
     };
-    if (first != kNoIndex && leaf_vertex_of_base.empty()) {
-        for (const Vec3& p : base.positions) {
-            if (!leaf_positions.shared(p)) continue;
-            const uint32_t a = input_of[leaf_positions.find(p)];
-            for (uint32_t b = a + 1; b < leaf.positions.size(); ++b) {
-                if (std::memcmp(&leaf.positions[b], &p, sizeof p) == 0) refuse_duplicate(a, b);
-            }
+    LeafAtBase at_base;
+    if (leaf_vertex_of_base.empty()) {
+        at_base = leaf_vertices_at_base(base.positions, leaf.positions);
+        for (size_t b = 0; b < base.positions.size(); ++b) {
+            if (at_base.second[b] != kNoIndex) refuse_duplicate(at_base.first[b], at_base.second[b]);
         }
     }
     const std::vector<uint32_t> leaf_of_base =
-        match_base_vertices(base, leaf, leaf_vertex_of_base, leaf_positions, input_of, what);
+        match_base_vertices(base, leaf, leaf_vertex_of_base, at_base.first, what);
     const std::vector<uint32_t> spatial_leaf_of_base = composed(spatial_of, leaf_of_base);
 
     TriangleMesh hierarchy_base;
@@ -281,6 +371,8 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
         }
     }
     if (!done) {
+        uint32_t first = kNoIndex, second = kNoIndex;
+        const PositionIndex duplicates(leaf.positions, &first, &second);  // the first two at one position
         if (first != kNoIndex) refuse_duplicate(first, second);
         validate_triangle_mesh(leaf, what);  // a structural fault has the clearer message
         // Where midpoints were guessed, the fault found may be a wrong guess's, not the input's.

@@ -316,16 +316,23 @@ Vec3 Reconstruction::guide_position(NodeId n, int e) {
 }
 
 uint32_t Reconstruction::only_unmatched_common_neighbor(uint32_t a, uint32_t b) {
-    // b's unmatched neighbours listed once, so a's are tested without reading their own
-    // edge lists (a cache miss each in a shuffled mesh).
-    around_b_.clear();
+    // b's unmatched neighbours stamped, so each of a's is tested with one read, without reading
+    // its own edge list (a cache miss each in a shuffled mesh) or searching a list of b's.
+    if (near_b_.empty()) near_b_.assign(leaf_.positions.size(), 0);
+    if (++stamp_ == 0) {  // wrapped: no stamp of an earlier call may match
+        std::fill(near_b_.begin(), near_b_.end(), 0);
+        stamp_ = 1;
+    }
+    bool any = false;
     he_.for_each_neighbor_once(b, [&](uint32_t x) {
-        if (vertex_of_leaf_[x] == kNoIndex) around_b_.push_back(x);
+        if (vertex_of_leaf_[x] != kNoIndex) return;
+        near_b_[x] = stamp_;
+        any = true;
     });
-    if (around_b_.empty()) return kNoIndex;
+    if (!any) return kNoIndex;
     uint32_t found = kNoIndex;
     const bool unique = he_.every_neighbor(a, [&](uint32_t x) {
-        if (x == found || std::find(around_b_.begin(), around_b_.end(), x) == around_b_.end()) return true;
+        if (x == found || near_b_[x] != stamp_) return true;
         if (found != kNoIndex) return false;  // a second one
         found = x;
         return true;

@@ -15,7 +15,8 @@
 namespace amc {
 
 void Reconstruction::remember(int depth, const std::vector<NodeId>& level) {
-    if (depth > 0 && !keep_levels_ && !(judges_picks() && depth <= kCertifiedLevels)) return;
+    // Only way 5's first attempt goes back to a level (run): the others keep no state.
+    if (!judges_picks() || (depth > 0 && !keep_levels_ && depth > kCertifiedLevels)) return;
     if (states_.size() <= size_t(depth)) states_.resize(size_t(depth) + 1);
     // Levels more than kBacktrackLevels up are not gone back to: their memory is given back.
     if (keep_levels_ && depth > kBacktrackLevels) states_[size_t(depth - kBacktrackLevels - 1)] = LevelState();

@@ -4,6 +4,7 @@
 // down contradicts them (pick_backtrack.cpp). Internal to leaf_reconstruction.h's function.
 #pragma once
 
+#include "common/huge_pages.h"
 #include "common/no_index.h"
 #include "geometry/closest_point.h"
 #include "import/leaf_detour.h"
@@ -28,6 +29,12 @@ public:
         : h_(h), leaf_(leaf), he_(halfedges), guide_(guide), positions_(positions), search_(search), what_(what),
           referee_(referee), input_of_(input_of) {
         if (steps) choice_ = std::make_unique<UndoStepChoice>(*steps);
+        // A level's lists hold at most three unsplit edges and two reveals per node, and a
+        // node is a leaf face at most once: room for the largest level, offered to huge pages
+        // (grown by doubling, their copies and fresh 4 KiB pages were a third of the page
+        // faults of a 10^6-face import). Only the pages a level writes become resident.
+        reserve_huge(unsplit_edges_, 3 * leaf.triangles.size());
+        reserve_huge(reveals_, 2 * leaf.triangles.size());
         leaf_of_vertex_.assign(h.positions().size(), kNoIndex);
         vertex_of_leaf_.assign(leaf.positions.size(), kNoIndex);
         for (VertexId v = 0; v < leaf_of_base.size(); ++v) assign(v, leaf_of_base[v]);
@@ -433,7 +440,8 @@ private:
     std::vector<uint32_t> leaf_of_vertex_;
     std::vector<uint32_t> vertex_of_leaf_;
     std::vector<Reveal> reveals_;
-    std::vector<uint32_t> around_b_;  // scratch of only_unmatched_common_neighbor
+    std::vector<uint32_t> near_b_;  // per leaf vertex: the stamp of the last call that found it next to b
+    uint32_t stamp_ = 0;            // (only_unmatched_common_neighbor)
     std::vector<UnsplitEdge> unsplit_edges_;
     std::vector<NodeId> refined_;        // scratch of reconstruct_level
     bool read_failed_ = false;           // reconstruct_level failed while reading its level
