@@ -1,8 +1,12 @@
 // When an adaptive geometry trial stops (AdaptiveTrialJudge, coding/geometry/level_geometry.h):
 // the exact limit always; the sample's projections (from its first eighth on, the first two only
 // from rates over enough committed bytes), and past the sample one more projection at the end of
-// every further sample's length.
+// every further sample's length. A trial that wins leaves the level's payload coded.
+#include "coding/geometry/geometry_prediction.h"
 #include "coding/geometry/level_geometry.h"
+
+#include <amc/hierarchy.h>
+#include <amc/refinement.h>
 
 #include <gtest/gtest.h>
 
@@ -67,6 +71,45 @@ TEST(AdaptiveTrial, AnEarlyRateFromFewCommittedBytesDoesNotStopIt) {
     // rates (6 and 13 committed bytes) would project 768 and 831 bytes against a limit of 100,
     // but rest on too few bytes; halfway the rate is 0, and the level codes in 25 bytes.
     EXPECT_EQ(stopped_at(8192, 1024, 100, two_rates(256, 0.0)), 0u);
+}
+
+// choose_level_geometry with the level block's code (its hierarchy part) codes an adaptive trial
+// that looks like winning onto it as it goes, from the sample's end on (the vertices before again)
+// or, without a sample, from the first eighth's: the payloads and the models after each level must
+// be those of coding the level again in finish_level_payload. Exact midpoints (the corpus's uniform
+// model): the adaptive midpoint wins the small levels and the last, the only one it looks like
+// winning early, mode 3 those between.
+TEST(AdaptiveTrial, AWinningTrialsCodingIsTheLevelsPayload) {
+    Hierarchy h(make_icosahedron());
+    refine_uniformly(h, 7);  // the last level's 122,880 new vertices are judged on a sample at effort 1
+    for (int effort : {1, kMaxEffort}) {
+        SCOPED_TRACE("effort " + std::to_string(effort));
+        const CoordinateSpace space;  // float64, bit-exact: raw bits in the side stream
+        PositionCoder again_models(space), taken_models(space);
+        int taken = 0, sampled = 0;
+        for (const std::vector<NodeId>& level : nodes_by_level(h)) {
+            const NewVertices created = new_vertices_of_level(h, level);
+            if (created.empty()) continue;
+            ArithmeticEncoder hierarchy_part;  // stands for the level's hierarchy symbols
+            BitModel model;
+            for (size_t i = 0; i < level.size(); ++i) hierarchy_part.encode(i % 3 == 0, model);
+            ArithmeticEncoder again_encoder = hierarchy_part, taken_encoder = hierarchy_part;
+            LevelGeometryCode again = choose_level_geometry(h, created, again_models, space, GeometryPredictor::automatic, false,
+                                                            true, effort);
+            LevelGeometryCode code = choose_level_geometry(h, created, taken_models, space, GeometryPredictor::automatic, false, true,
+                                                           effort, StaticOrder::grouped, nullptr, &taken_encoder);
+            EXPECT_EQ(again.adaptive_code, nullptr);
+            ASSERT_EQ(code.predictor, again.predictor);
+            EXPECT_TRUE(code.adaptive_code == nullptr || !is_static_mode(code.predictor));
+            taken += code.adaptive_code != nullptr;
+            sampled += code.adaptive_code != nullptr && created.size() >= 2048;
+            EXPECT_EQ(finish_level_payload(h, created, code, taken_models, taken_encoder),
+                      finish_level_payload(h, created, again, again_models, again_encoder))
+                << created.size() << " new vertices";
+        }
+        EXPECT_EQ(taken, 1);
+        EXPECT_EQ(sampled, 1);
+    }
 }
 
 }  // namespace

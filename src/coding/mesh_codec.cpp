@@ -251,10 +251,9 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
         };
         start(out, hierarchy);
         for (size_t k = 0; k < older_hierarchies.size(); ++k) start(*older[k].second, *older_hierarchies[k]);
+        // `encoder` holds the level's hierarchy part (coder's).
         auto add_level = [&](ForestCode& code, HierarchyLevelEncoder& coder, int l, const auto& geometry_of, const NewVertices& created,
-                             const LevelGeometryCode& geometry, PositionCoder& models) {
-            ArithmeticEncoder encoder;
-            coder.encode_level(l, encoder);
+                             LevelGeometryCode& geometry, PositionCoder& models, ArithmeticEncoder& encoder) {
             const size_t hierarchy_part = encoder.bytes_so_far();
             std::vector<uint8_t> payload = finish_level_payload(geometry_of, created, geometry, models, encoder);
             code.static_geometry |= geometry.predictor == GeometryPredictor::normal_frame;
@@ -267,15 +266,20 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
         };
         auto code_level = [&](int l, const auto& geometry_of) {
             const NewVertices& created = hierarchy.new_vertices(l);
+            ArithmeticEncoder encoder;
+            hierarchy.encode_level(l, encoder);
             // The mixing mode's files share each level's geometry across its models' versions (11-17,
-            // which hold mode 4 in the per-vertex order).
-            const LevelGeometryCode geometry =
+            // which hold mode 4 in the per-vertex order); only the written model's takes a trial's coding.
+            LevelGeometryCode geometry =
                 choose_level_geometry(geometry_of, created, positions, space, options.predictor, options.grid_contexts,
                                       options.unit_normals, options.effort, mixed ? StaticOrder::per_vertex : StaticOrder::grouped,
-                                      memory.statics);
-            add_level(out, hierarchy, l, geometry_of, created, geometry, positions);
-            for (size_t k = 0; k < older_hierarchies.size(); ++k)
-                add_level(*older[k].second, *older_hierarchies[k], l, geometry_of, created, geometry, older_positions[k]);
+                                      memory.statics, &encoder);
+            add_level(out, hierarchy, l, geometry_of, created, geometry, positions, encoder);
+            for (size_t k = 0; k < older_hierarchies.size(); ++k) {
+                ArithmeticEncoder older_encoder;
+                older_hierarchies[k]->encode_level(l, older_encoder);
+                add_level(*older[k].second, *older_hierarchies[k], l, geometry_of, created, geometry, older_positions[k], older_encoder);
+            }
         };
         for (int l = 0; l < hierarchy.level_count(); ++l) {
             if (on_grid != nullptr)

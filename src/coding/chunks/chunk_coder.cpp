@@ -84,13 +84,13 @@ ChunkCode encode_chunk(const Hierarchy& h, const VertexKeys& keys, const Seam& s
         created.reserve(hierarchy.new_vertices(l).size());
         for (auto [n, e] : hierarchy.new_vertices(l))
             if (seam_vertex(h, keys, seam, n, e) < 0) created.emplace_back(n, e);
-        // The predictor, as the whole file's encoder picks it (FORMAT.md 3.9, 5.6).
-        const LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, fixed_predictor, grid_contexts, unit_normals, effort,
-                                                                 StaticOrder::grouped, buffers);
         ArithmeticEncoder encoder;
         hierarchy.encode_level(l, encoder);
         seam_hanging += for_each_seam_closure(h, level, keys, seam, [&](NodeId n) { encoder.encode(h.diagonal_flipped(n), flipped); });
         const size_t hierarchy_part = encoder.bytes_so_far();
+        // The predictor, as the whole file's encoder picks it (FORMAT.md 3.9, 5.6).
+        LevelGeometryCode geometry = choose_level_geometry(h, created, positions, space, fixed_predictor, grid_contexts, unit_normals,
+                                                           effort, StaticOrder::grouped, buffers, &encoder);
         const std::vector<uint8_t> payload = finish_level_payload(h, created, geometry, positions, encoder);
         out.static_geometry |= geometry.predictor == GeometryPredictor::normal_frame;
         out.grid_geometry |= geometry.predictor == GeometryPredictor::normal_frame_grid;

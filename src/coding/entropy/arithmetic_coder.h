@@ -186,6 +186,30 @@ private:
     std::vector<uint8_t> out_;
 };
 
+// Two arithmetic codes of the same symbols, each from its own state, the models read and updated
+// once: an adaptive geometry trial sized from a fresh code while it also codes the level's own
+// (which holds its hierarchy part), so that a winning trial need not be coded again.
+class ArithmeticEncoderPair {
+public:
+    ArithmeticEncoderPair(ArithmeticEncoder& first, ArithmeticEncoder& second) : first_(first), second_(second) {}
+
+    template <int kLimitLog2>
+    void encode_with_limit(bool bit, BitModel& model) {
+        const uint32_t p16 = model.p16();
+        first_.encode_with_probability(bit, p16);
+        second_.encode_with_probability(bit, p16);
+        model.update_with_limit(bit, kLimitLog2);
+    }
+    void encode_bits_raw(uint32_t value, int count) {
+        first_.encode_bits_raw(value, count);
+        second_.encode_bits_raw(value, count);
+    }
+
+private:
+    ArithmeticEncoder& first_;
+    ArithmeticEncoder& second_;
+};
+
 class ArithmeticDecoder {
 public:
     // Reads at most `size` bytes from `data`; never past it. `data` must outlive the decoder.

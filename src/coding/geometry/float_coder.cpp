@@ -52,25 +52,27 @@ AMC_ALWAYS_INLINE uint64_t get_side_raw_bits(RawBitReader& raw, int count) {
 
 // A residual as sign and magnitude; magnitude has at most kMaxLength bits.
 // The raw bits go to `raw` when given (FORMAT.md 5.2: version 14's side stream), else to the coder.
-void encode_residual(ArithmeticEncoder& encoder, FloatResidualModels::Context& ctx, int depth,
+// Encoder: ArithmeticEncoder or ArithmeticEncoderPair.
+template <class Encoder>
+void encode_residual(Encoder& encoder, FloatResidualModels::Context& ctx, int depth,
                      bool negative, uint64_t magnitude, RawBitWriter* raw = nullptr) {
     const int k = bit_length(magnitude);
     int node = 1;
     for (int i = depth - 1; i >= 0; --i) {
         const int bit = (k >> i) & 1;
-        encoder.encode_with_limit<kWindowLog2>(bit != 0, ctx.length[node]);
+        encoder.template encode_with_limit<kWindowLog2>(bit != 0, ctx.length[node]);
         node = 2 * node + bit;
     }
     if (k == 0) return;
-    encoder.encode_with_limit<kWindowLog2>(negative, ctx.sign);
+    encoder.template encode_with_limit<kWindowLog2>(negative, ctx.sign);
     int remaining = k - 1;  // bits below the leading one
     if (remaining > 0) {
         const bool first = (magnitude >> (remaining - 1)) & 1;
-        encoder.encode_with_limit<kWindowLog2>(first, ctx.high[k][0]);
+        encoder.template encode_with_limit<kWindowLog2>(first, ctx.high[k][0]);
         --remaining;
         if (remaining > 0) {
             const bool second = (magnitude >> (remaining - 1)) & 1;
-            encoder.encode_with_limit<kWindowLog2>(second, ctx.high[k][1 + int(first)]);
+            encoder.template encode_with_limit<kWindowLog2>(second, ctx.high[k][1 + int(first)]);
             --remaining;
         }
     }
@@ -148,6 +150,45 @@ inline void check_bits(int bits, const char* where) {
     if (bits < kMinQuantizationBits || bits > kMaxQuantizationBits) refuse_bits(bits, where);
 }
 
+template <class Encoder>
+void encode_coordinate_with(Encoder& encoder, FloatResidualModels& models, int context,
+                            Precision precision, double actual, double predicted, RawBitWriter* raw) {
+    FloatResidualModels::Context& ctx = models.context(context);
+    if (precision == Precision::float32 && !std::isnan(actual)) {
+        const bool in_range = !std::isfinite(actual) || std::fabs(actual) <= FLT_MAX;
+        if (!in_range || rounded_to_float(actual) != actual ||
+            std::signbit(static_cast<float>(actual)) != std::signbit(actual)) {
+            throw Error("encode_coordinate: " + std::to_string(actual) +
+                        " is not a single precision value");
+        }
+    }
+    const CoordinateResidual r = coordinate_residual(precision, actual, predicted);
+    encode_residual(encoder, ctx, tree_depth(precision), r.negative, r.magnitude, raw);
+}
+
+template <class Encoder>
+void encode_position_with(Encoder& encoder, FloatResidualModels& models, int first_context, Precision precision, Vec3 actual,
+                          Vec3 predicted, RawBitWriter* raw) {
+    encode_coordinate_with(encoder, models, first_context + 0, precision, actual.x, predicted.x, raw);
+    encode_coordinate_with(encoder, models, first_context + 1, precision, actual.y, predicted.y, raw);
+    encode_coordinate_with(encoder, models, first_context + 2, precision, actual.z, predicted.z, raw);
+}
+
+template <class Encoder>
+void encode_quantized_with(Encoder& encoder, FloatResidualModels& models, int context,
+                           int bits, uint32_t actual, uint32_t predicted) {
+    check_bits(bits, "encode_quantized");
+    FloatResidualModels::Context& ctx = models.context(context);
+    const uint32_t top = (uint32_t{1} << bits) - 1;
+    if (actual > top || predicted > top) {
+        throw Error("encode_quantized: grid coordinate outside [0, 2^" + std::to_string(bits) +
+                    ")");
+    }
+    const bool negative = actual < predicted;
+    const uint64_t magnitude = negative ? predicted - actual : actual - predicted;
+    encode_residual(encoder, ctx, kQuantizedTreeDepth, negative, magnitude);
+}
+
 }  // namespace
 
 void encode_signed_residual(ArithmeticEncoder& encoder, FloatResidualModels::Context& context, bool negative,
@@ -179,19 +220,18 @@ void FloatResidualModels::context_out_of_range(int c) const {
 
 // ---- floating-point residuals -------------------------------------------------------------------
 
-void encode_coordinate(ArithmeticEncoder& encoder, FloatResidualModels& models, int context,
-                       Precision precision, double actual, double predicted, RawBitWriter* raw) {
-    FloatResidualModels::Context& ctx = models.context(context);
-    if (precision == Precision::float32 && !std::isnan(actual)) {
-        const bool in_range = !std::isfinite(actual) || std::fabs(actual) <= FLT_MAX;
-        if (!in_range || rounded_to_float(actual) != actual ||
-            std::signbit(static_cast<float>(actual)) != std::signbit(actual)) {
-            throw Error("encode_coordinate: " + std::to_string(actual) +
-                        " is not a single precision value");
-        }
-    }
-    const CoordinateResidual r = coordinate_residual(precision, actual, predicted);
-    encode_residual(encoder, ctx, tree_depth(precision), r.negative, r.magnitude, raw);
+void encode_coordinate(ArithmeticEncoder& encoder, FloatResidualModels& models, int context, Precision precision, double actual,
+                       double predicted, RawBitWriter* raw) {
+    encode_coordinate_with(encoder, models, context, precision, actual, predicted, raw);
+}
+
+void encode_position(ArithmeticEncoder& encoder, FloatResidualModels& models, int first_context, Precision precision, Vec3 actual,
+                     Vec3 predicted, RawBitWriter* raw) {
+    encode_position_with(encoder, models, first_context, precision, actual, predicted, raw);
+}
+void encode_position(ArithmeticEncoderPair& encoder, FloatResidualModels& models, int first_context, Precision precision,
+                     Vec3 actual, Vec3 predicted, RawBitWriter* raw) {
+    encode_position_with(encoder, models, first_context, precision, actual, predicted, raw);
 }
 
 double decode_coordinate(ArithmeticDecoder& decoder, FloatResidualModels& models, int context,
@@ -205,13 +245,6 @@ double decode_coordinate(ArithmeticDecoder& decoder, FloatResidualModels& models
     const uint64_t p = ordered_bits(coder_prediction(predicted, precision), precision);
     const uint64_t a = (negative ? p - magnitude : p + magnitude) & mask;
     return from_ordered_bits(a, precision);
-}
-
-void encode_position(ArithmeticEncoder& encoder, FloatResidualModels& models, int first_context,
-                     Precision precision, Vec3 actual, Vec3 predicted, RawBitWriter* raw) {
-    encode_coordinate(encoder, models, first_context + 0, precision, actual.x, predicted.x, raw);
-    encode_coordinate(encoder, models, first_context + 1, precision, actual.y, predicted.y, raw);
-    encode_coordinate(encoder, models, first_context + 2, precision, actual.z, predicted.z, raw);
 }
 
 uint64_t position_raw_bits(Precision precision, Vec3 actual, Vec3 predicted) {
@@ -294,18 +327,13 @@ double max_quantization_error(const Quantizer& quantizer, const std::vector<Vec3
     return worst;
 }
 
-void encode_quantized(ArithmeticEncoder& encoder, FloatResidualModels& models, int context,
-                      int bits, uint32_t actual, uint32_t predicted) {
-    check_bits(bits, "encode_quantized");
-    FloatResidualModels::Context& ctx = models.context(context);
-    const uint32_t top = (uint32_t{1} << bits) - 1;
-    if (actual > top || predicted > top) {
-        throw Error("encode_quantized: grid coordinate outside [0, 2^" + std::to_string(bits) +
-                    ")");
-    }
-    const bool negative = actual < predicted;
-    const uint64_t magnitude = negative ? predicted - actual : actual - predicted;
-    encode_residual(encoder, ctx, kQuantizedTreeDepth, negative, magnitude);
+void encode_quantized(ArithmeticEncoder& encoder, FloatResidualModels& models, int context, int bits, uint32_t actual,
+                      uint32_t predicted) {
+    encode_quantized_with(encoder, models, context, bits, actual, predicted);
+}
+void encode_quantized(ArithmeticEncoderPair& encoder, FloatResidualModels& models, int context, int bits, uint32_t actual,
+                      uint32_t predicted) {
+    encode_quantized_with(encoder, models, context, bits, actual, predicted);
 }
 
 int quantized_raw_bits(uint32_t actual, uint32_t predicted) {

@@ -143,6 +143,9 @@ double decode_coordinate(ArithmeticDecoder& decoder, FloatResidualModels& models
 // The three coordinates with contexts first_context + 0, 1, 2 (x, y, z).
 void encode_position(ArithmeticEncoder& encoder, FloatResidualModels& models, int first_context,
                      Precision precision, Vec3 actual, Vec3 predicted, RawBitWriter* raw = nullptr);
+// The same symbols into both codes of the pair.
+void encode_position(ArithmeticEncoderPair& encoder, FloatResidualModels& models, int first_context,
+                     Precision precision, Vec3 actual, Vec3 predicted, RawBitWriter* raw = nullptr);
 Vec3 decode_position(ArithmeticDecoder& decoder, FloatResidualModels& models, int first_context,
                      Precision precision, Vec3 predicted, RawBitReader* raw = nullptr);
 
@@ -245,6 +248,8 @@ double max_quantization_error(const Quantizer& quantizer, const std::vector<Vec3
 // throws Error otherwise). Predictions in quantized mode come from reconstructed (dequantized)
 // positions, quantized again (closed loop), so both sides see the same values.
 void encode_quantized(ArithmeticEncoder& encoder, FloatResidualModels& models, int context,
+                      int bits, uint32_t actual, uint32_t predicted);
+void encode_quantized(ArithmeticEncoderPair& encoder, FloatResidualModels& models, int context,
                       int bits, uint32_t actual, uint32_t predicted);
 uint32_t decode_quantized(ArithmeticDecoder& decoder, FloatResidualModels& models, int context,
                           int bits, uint32_t predicted);

@@ -59,10 +59,30 @@ void keep_likely_static_modes(const Mesh& h, const NewVertices& created, Coordin
                               StaticOrder grid_order, StaticEncoderBuffers* buffers) {
     const double scale = double(created.size()) / double(sample);
     double stream_bound[kStaticCandidates];
+    // Bit-exact: mode 5, whose bound was the smallest on every surface level of the corpus, is
+    // weighed first; a mode whose raw bits alone then pass its limit (modes 3, 6 and 7 about halfway
+    // through the sample) fails the test below, whatever the others' bounds (the smallest is at most
+    // mode 5's), and is never `first`: it stops there. (Quantized levels have few raw bits.)
+    const int reference = candidate[2] ? 2 : -1;
+    uint64_t raw_bit_limit = UINT64_MAX;
+    if (reference >= 0) {
+        on_sample[reference] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, kStaticModes[reference], grid_order, buffers);
+        const double limit = rounded(kStaticMargin * on_sample[reference]->projected_bound_bytes(scale)) + kSampleSlack;
+        // Every bound is at least 1 + rounded(scale * (kRansStateBytes + raw bits / 8)).
+        raw_bit_limit = uint64_t(8 * (std::max(0.0, std::floor(limit / scale) - double(kRansStateBytes)) + 1)) + 7;
+    }
     int first = -1;  // the candidate of the smallest streams' bound
     for (int i = 0; i < kStaticCandidates; ++i) {
         if (!candidate[i]) continue;
-        on_sample[i] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, kStaticModes[i], grid_order, buffers);
+        if (i != reference) {
+            on_sample[i] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, kStaticModes[i], grid_order, buffers,
+                                                                raw_bit_limit);
+            if (on_sample[i]->gave_up()) {
+                candidate[i] = false;
+                on_sample[i].reset();
+                continue;
+            }
+        }
         stream_bound[i] = on_sample[i]->projected_stream_bound_bytes(scale);
         if (first < 0 || stream_bound[i] < stream_bound[first]) first = i;
     }
@@ -131,9 +151,16 @@ void encode_adaptive(const Mesh& h, const NewVertices& created, GeometryPredicto
 // With a `sample` of fewer vertices than the level, that pass covers the sample only, and the
 // trial stops when the sample's raw bits scaled to the level pass the limit by kSampleMargin, or
 // when AdaptiveTrialJudge says so.
+//
+// With `level_code` (the level block's arithmetic code holding its hierarchy part), a trial that
+// looks like winning codes the level onto a copy of it too, as finish_level_payload would (the
+// vertices before, again from `start`'s models), and leaves that coding in `*kept` when it codes
+// the whole level.
 template <class Mesh>
-size_t adaptive_bytes(const Mesh& h, const NewVertices& created, GeometryPredictor predictor, PositionCoder positions,
-                      size_t limit, bool count_raw_bits, size_t sample) {
+size_t adaptive_bytes(const Mesh& h, const NewVertices& created, GeometryPredictor predictor, const PositionCoder& start,
+                      size_t limit, bool count_raw_bits, size_t sample, const ArithmeticEncoder* level_code,
+                      std::unique_ptr<AdaptiveLevelCode>* kept) {
+    PositionCoder positions = start;
     const size_t judged = std::min(sample, created.size());
     std::vector<Vec3> predicted(count_raw_bits ? judged : 0);
     auto too_many_raw_bits = [&](uint64_t raw_bits) {
@@ -156,14 +183,58 @@ size_t adaptive_bytes(const Mesh& h, const NewVertices& created, GeometryPredict
     RawBitWriter raw;
     RawBitWriter* side = positions.quantized() ? nullptr : &raw;
     AdaptiveTrialJudge judge(created.size(), sample, limit);
-    for (size_t i = 0; i < created.size(); ++i) {
+    // The vertex from which the level's own code is coded alongside: the sample's end (a level
+    // without one: its first eighth's), on a bit-exact level that codes in a few dozen bytes (the
+    // limit within kSampleSlack: exact midpoints, against the static modes' tables) whose bytes
+    // projected there at the rate since half that point stay within the limit. A guess at winning:
+    // such codes grow slower than that rate as their models learn (uniform's last level, 122,880
+    // vertices, projects 33 bytes against 33 and codes in 27); 12-bit surface trials projected
+    // within their limit of thousands of bytes and lost, and so did a 12-bit level of front_1
+    // projected at 11 bytes against 22 (BENCHMARKS.md, "One-core encode, twenty-second step").
+    const size_t pair_from = level_code == nullptr || side == nullptr ? SIZE_MAX : sample == SIZE_MAX ? created.size() / 8 : judged;
+    std::unique_ptr<ArithmeticEncoder> level;
+    auto code_vertex = [&](auto& coder, size_t i) {
         const auto [n, e] = created[i];
-        positions.encode(encoder, level_context(h.level(n)), h.position(h.midpoint(n, e)),
+        positions.encode(coder, level_context(h.level(n)), h.position(h.midpoint(n, e)),
                          i < predicted.size() ? predicted[i] : predict(h, predictor, n, e), side);
+    };
+    size_t i = 0, half_bytes = 0;
+    for (; i < std::min(pair_from, created.size()); ++i) {
+        code_vertex(encoder, i);
+        const size_t bytes = encoder.bytes_so_far() + raw.bits() / 8;
+        if (judge.stops(i + 1, bytes)) return SIZE_MAX;
+        if (i + 1 == pair_from / 2) half_bytes = bytes;
+    }
+    bool paired = i == pair_from && pair_from >= 2;
+    if (paired && limit != SIZE_MAX) {
+        paired = double(limit) <= kSampleSlack;
+        const double bytes = double(encoder.bytes_so_far() + raw.bits() / 8);
+        const double rate = (bytes - double(half_bytes)) / double(pair_from - pair_from / 2);
+        paired = paired && bytes + rounded(rate * double(created.size() - pair_from)) <= double(limit);
+    }
+    if (paired) {
+        level = std::make_unique<ArithmeticEncoder>(*level_code);
+        PositionCoder caught_up = start;  // ends where `positions` is: the same symbols
+        RawBitWriter unused;              // the trial's `raw` has these bits already
+        for (size_t j = 0; j < i; ++j) {
+            const auto [n, e] = created[j];
+            caught_up.encode(*level, level_context(h.level(n)), h.position(h.midpoint(n, e)),
+                             j < predicted.size() ? predicted[j] : predict(h, predictor, n, e), side != nullptr ? &unused : nullptr);
+        }
+        ArithmeticEncoderPair pair(encoder, *level);
+        for (; i < created.size(); ++i) {
+            code_vertex(pair, i);
+            if (judge.stops(i + 1, encoder.bytes_so_far() + raw.bits() / 8)) return SIZE_MAX;
+        }
+    }
+    for (; i < created.size(); ++i) {
+        code_vertex(encoder, i);
         if (judge.stops(i + 1, encoder.bytes_so_far() + raw.bits() / 8)) return SIZE_MAX;
     }
+    const size_t raw_bits_coded = raw.bits();
     const size_t coded = encoder.finish().size();
-    return side == nullptr ? coded : coded + varint_size(coded) + (raw.bits() + 7) / 8;
+    if (level != nullptr) *kept = std::make_unique<AdaptiveLevelCode>(AdaptiveLevelCode{std::move(*level), std::move(raw), std::move(positions)});
+    return side == nullptr ? coded : coded + varint_size(coded) + (raw_bits_coded + 7) / 8;
 }
 
 }  // namespace
@@ -200,7 +271,8 @@ bool AdaptiveTrialJudge::checkpoint(size_t done, size_t bytes) {
 template <class Mesh>
 LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& created, const PositionCoder& positions,
                                         CoordinateSpace space, GeometryPredictor choice, bool grid_contexts, bool unit_normals,
-                                        int effort, StaticOrder grid_order, StaticEncoderBuffers* buffers) {
+                                        int effort, StaticOrder grid_order, StaticEncoderBuffers* buffers,
+                                        const ArithmeticEncoder* level_code) {
     const bool automatic = choice == GeometryPredictor::automatic;
     LevelGeometryCode code;
     code.predictor = automatic ? GeometryPredictor::midpoint : choice;
@@ -264,18 +336,21 @@ LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& create
                                : static_size[chosen];
     // Effort 0 takes a static mode for a sampled level without trying the adaptive predictors.
     const bool adaptive_trials = effort > 0 || sample == SIZE_MAX || best_static == SIZE_MAX;
-    const size_t midpoint = adaptive_trials
-                                ? adaptive_bytes(h, created, GeometryPredictor::midpoint, positions, to_beat, count_raw_bits, sample)
-                                : SIZE_MAX;
+    std::unique_ptr<AdaptiveLevelCode> midpoint_code, butterfly_code;
+    const size_t midpoint = adaptive_trials ? adaptive_bytes(h, created, GeometryPredictor::midpoint, positions, to_beat, count_raw_bits,
+                                                             sample, level_code, &midpoint_code)
+                                            : SIZE_MAX;
     // The butterfly must be smaller than the midpoint, and than what beats the static mode.
     const size_t butterfly_limit = midpoint == SIZE_MAX ? to_beat : std::min(midpoint - 1, to_beat);
-    const size_t butterfly =
-        adaptive_trials ? adaptive_bytes(h, created, GeometryPredictor::butterfly, positions, butterfly_limit, count_raw_bits, sample)
-                        : SIZE_MAX;
+    const size_t butterfly = adaptive_trials ? adaptive_bytes(h, created, GeometryPredictor::butterfly, positions, butterfly_limit,
+                                                              count_raw_bits, sample, level_code, &butterfly_code)
+                                             : SIZE_MAX;
     size_t best = midpoint;
+    code.adaptive_code = std::move(midpoint_code);
     if (butterfly < best) {
         best = butterfly;
         code.predictor = GeometryPredictor::butterfly;
+        code.adaptive_code = std::move(butterfly_code);
     }
     // Ties go to the earlier mode: the adaptive ones.
     const bool static_wins = chosen >= 0 && (has_stencil_tables(kStaticModes[chosen])
@@ -284,6 +359,7 @@ LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& create
     if (static_wins) {
         code.predictor = kStaticModes[chosen];
         code.static_code = std::move(statics[chosen]);
+        code.adaptive_code.reset();
     }
     return code;
 }
@@ -294,7 +370,7 @@ void check_effort(int effort, const std::string& what) {
 }
 
 template <class Mesh>
-std::vector<uint8_t> finish_level_payload(const Mesh& h, const NewVertices& created, const LevelGeometryCode& code,
+std::vector<uint8_t> finish_level_payload(const Mesh& h, const NewVertices& created, LevelGeometryCode& code,
                                           PositionCoder& positions, ArithmeticEncoder& encoder) {
     std::vector<uint8_t> payload{uint8_t(code.predictor)};
     if (is_static_mode(code.predictor)) {
@@ -309,7 +385,13 @@ std::vector<uint8_t> finish_level_payload(const Mesh& h, const NewVertices& crea
         return payload;
     }
     if (positions.quantized() || created.empty()) {  // no raw bits: the layout of every version
-        encode_adaptive(h, created, code.predictor, positions, encoder, nullptr);
+        if (code.adaptive_code != nullptr) {
+            encoder = std::move(code.adaptive_code->level);
+            positions = std::move(code.adaptive_code->positions);
+            code.adaptive_code.reset();
+        } else {
+            encode_adaptive(h, created, code.predictor, positions, encoder, nullptr);
+        }
         const std::vector<uint8_t> coded = encoder.finish();
         payload.insert(payload.end(), coded.begin(), coded.end());
         return payload;
@@ -317,7 +399,14 @@ std::vector<uint8_t> finish_level_payload(const Mesh& h, const NewVertices& crea
     // Bit-exact (version 14): the flag, the arithmetic part's length, the arithmetic part, the raw bits.
     payload[0] |= kRawSideFlag;
     RawBitWriter raw;
-    encode_adaptive(h, created, code.predictor, positions, encoder, &raw);
+    if (code.adaptive_code != nullptr) {
+        raw = std::move(code.adaptive_code->raw);
+        encoder = std::move(code.adaptive_code->level);
+        positions = std::move(code.adaptive_code->positions);
+        code.adaptive_code.reset();
+    } else {
+        encode_adaptive(h, created, code.predictor, positions, encoder, &raw);
+    }
     const std::vector<uint8_t> coded = encoder.finish();
     put_varint(payload, coded.size());
     payload.insert(payload.end(), coded.begin(), coded.end());
@@ -327,12 +416,14 @@ std::vector<uint8_t> finish_level_payload(const Mesh& h, const NewVertices& crea
 }
 
 template LevelGeometryCode choose_level_geometry(const Hierarchy&, const NewVertices&, const PositionCoder&, CoordinateSpace,
-                                                 GeometryPredictor, bool, bool, int, StaticOrder, StaticEncoderBuffers*);
+                                                 GeometryPredictor, bool, bool, int, StaticOrder, StaticEncoderBuffers*,
+                                                 const ArithmeticEncoder*);
 template LevelGeometryCode choose_level_geometry(const HierarchyOnGrid&, const NewVertices&, const PositionCoder&,
-                                                 CoordinateSpace, GeometryPredictor, bool, bool, int, StaticOrder, StaticEncoderBuffers*);
-template std::vector<uint8_t> finish_level_payload(const Hierarchy&, const NewVertices&, const LevelGeometryCode&,
+                                                 CoordinateSpace, GeometryPredictor, bool, bool, int, StaticOrder, StaticEncoderBuffers*,
+                                                 const ArithmeticEncoder*);
+template std::vector<uint8_t> finish_level_payload(const Hierarchy&, const NewVertices&, LevelGeometryCode&,
                                                    PositionCoder&, ArithmeticEncoder&);
-template std::vector<uint8_t> finish_level_payload(const HierarchyOnGrid&, const NewVertices&, const LevelGeometryCode&,
+template std::vector<uint8_t> finish_level_payload(const HierarchyOnGrid&, const NewVertices&, LevelGeometryCode&,
                                                    PositionCoder&, ArithmeticEncoder&);
 
 LevelBlockParts split_level_block(const Block& block, uint8_t file_version, bool quantized, const std::string& where) {

@@ -33,10 +33,19 @@ using NewVertices = std::vector<std::pair<NodeId, int>>;
 
 // ---- encoder ------------------------------------------------------------------------------------
 
+// A winning adaptive trial's coding of the level: the level's arithmetic code (its hierarchy part,
+// then the positions), the raw bits of its side stream, and the models after them.
+struct AdaptiveLevelCode {
+    ArithmeticEncoder level;
+    RawBitWriter raw;
+    PositionCoder positions;
+};
+
 // A level's geometry code, chosen before the level block is written.
 struct LevelGeometryCode {
     GeometryPredictor predictor = GeometryPredictor::midpoint;
     std::unique_ptr<StaticLevelEncoder> static_code;  // mode 3's, 4's or 5's streams, when chosen
+    std::unique_ptr<AdaptiveLevelCode> adaptive_code;  // mode 1's or 2's, when a trial coded it
 };
 
 // The predictor of the level that creates `created` (positions set in h as the decoder will have
@@ -45,13 +54,16 @@ struct LevelGeometryCode {
 // grid_contexts in a quantized space, mode 5 only with unit_normals in a bit-exact one. Below
 // kMaxEffort an adaptive predictor may be judged from a sample (EncodeOptions::effort). Mode 4's
 // tokens go in `grid_order` (grouped: a version-18 file; per_vertex: versions 9-17). The static
-// modes' encoders work in `buffers` when given (StaticEncoderBuffers).
+// modes' encoders work in `buffers` when given (StaticEncoderBuffers). With `level_code`, the level
+// block's arithmetic code after its hierarchy part, a winning adaptive trial that coded the whole
+// level leaves that coding in adaptive_code (the same bytes as coding it again).
 // Mesh: Hierarchy or HierarchyOnGrid (hierarchy_on_grid.h: the input's nodes with their grid points).
 template <class Mesh>
 LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& created, const PositionCoder& positions,
                                         CoordinateSpace space, GeometryPredictor choice, bool grid_contexts = false,
                                         bool unit_normals = false, int effort = kMaxEffort,
-                                        StaticOrder grid_order = StaticOrder::grouped, StaticEncoderBuffers* buffers = nullptr);
+                                        StaticOrder grid_order = StaticOrder::grouped, StaticEncoderBuffers* buffers = nullptr,
+                                        const ArithmeticEncoder* level_code = nullptr);
 
 // When an adaptive trial of a level of `count` new vertices stops, from the bytes its code has
 // committed after each vertex: once they pass `limit` (SIZE_MAX: none) by 8 bytes (exact: a
@@ -86,9 +98,10 @@ private:
 void check_effort(int effort, const std::string& what);
 
 // The payload of a level block whose hierarchy part `encoder` holds: the predictor byte, then the
-// arithmetic code finished with the level's geometry (and mode 3's streams).
+// arithmetic code finished with the level's geometry (and mode 3's streams). A code's adaptive_code
+// (made from `encoder` as it is) is taken instead of coding the positions again.
 template <class Mesh>
-std::vector<uint8_t> finish_level_payload(const Mesh& h, const NewVertices& created, const LevelGeometryCode& code,
+std::vector<uint8_t> finish_level_payload(const Mesh& h, const NewVertices& created, LevelGeometryCode& code,
                                           PositionCoder& positions, ArithmeticEncoder& encoder);
 
 // ---- decoder ------------------------------------------------------------------------------------

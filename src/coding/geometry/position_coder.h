@@ -23,7 +23,9 @@ public:
         if (space.quantizer != nullptr) quantizer_ = *space.quantizer;
     }
     // `raw`: the side stream of bit-exact raw bits (float_coder.h); unused when quantized.
-    void encode(ArithmeticEncoder& encoder, int context, Vec3 actual, Vec3 predicted, RawBitWriter* raw = nullptr) {
+    // Encoder: ArithmeticEncoder, or ArithmeticEncoderPair (the same symbols into two codes).
+    template <class Encoder>
+    void encode(Encoder& encoder, int context, Vec3 actual, Vec3 predicted, RawBitWriter* raw = nullptr) {
         if (!quantized_) {
             encode_position(encoder, models_, context, precision_, actual, predicted, raw);
             return;

@@ -445,7 +445,7 @@ StaticLevelEncoder::StaticLevelEncoder(const Mesh& h, const std::vector<std::pai
 template <class Mesh>
 StaticLevelEncoder::StaticLevelEncoder(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t count,
                                        CoordinateSpace space, GeometryPredictor mode, StaticOrder order,
-                                       StaticEncoderBuffers* buffers)
+                                       StaticEncoderBuffers* buffers, uint64_t raw_bit_limit)
     : mode_(mode), grouped_(has_grid_bins(mode) && order == StaticOrder::grouped), space_(space),
       table_count_(static_table_count(mode)) {
     if (!is_static_mode(mode)) throw Error("StaticLevelEncoder: geometry mode " + std::to_string(int(mode)) + " is not a static mode");
@@ -469,7 +469,19 @@ StaticLevelEncoder::StaticLevelEncoder(const Mesh& h, const std::vector<std::pai
     count = std::min(count, created.size());
     // A sample's raw bits wait in large_ (see the header): the mode choice drops most samples.
     deferred_ = !grouped_ && count < created.size();
-    add(h, created, 0, count);
+    if (raw_bit_limit == UINT64_MAX) {
+        add(h, created, 0, count);
+    } else {
+        // In steps, with the room for the whole count made first (add() reserves by the part before).
+        constexpr size_t kStep = 4 * kChunk;
+        symbols_.reserve(count);
+        if (space.quantizer == nullptr && (deferred_ || grouped_)) large_.reserve(size_t(kStaticRoles) * count);
+        for (size_t begin = 0; begin < count && !gave_up_; begin += kStep) {
+            add(h, created, begin, std::min(count, begin + kStep));
+            gave_up_ = raw_bits_ > raw_bit_limit && begin + kStep < count;
+        }
+        if (gave_up_) return;
+    }
     make_tables();
 }
 
@@ -646,9 +658,9 @@ template StaticLevelEncoder::StaticLevelEncoder(const Hierarchy&, const std::vec
 template StaticLevelEncoder::StaticLevelEncoder(const HierarchyOnGrid&, const std::vector<std::pair<NodeId, int>>&,
                                                 CoordinateSpace, GeometryPredictor, bool, StaticOrder, StaticEncoderBuffers*);
 template StaticLevelEncoder::StaticLevelEncoder(const Hierarchy&, const std::vector<std::pair<NodeId, int>>&, size_t,
-                                                CoordinateSpace, GeometryPredictor, StaticOrder, StaticEncoderBuffers*);
+                                                CoordinateSpace, GeometryPredictor, StaticOrder, StaticEncoderBuffers*, uint64_t);
 template StaticLevelEncoder::StaticLevelEncoder(const HierarchyOnGrid&, const std::vector<std::pair<NodeId, int>>&, size_t,
-                                                CoordinateSpace, GeometryPredictor, StaticOrder, StaticEncoderBuffers*);
+                                                CoordinateSpace, GeometryPredictor, StaticOrder, StaticEncoderBuffers*, uint64_t);
 template void StaticLevelEncoder::extend(const Hierarchy&, const std::vector<std::pair<NodeId, int>>&);
 template void StaticLevelEncoder::extend(const HierarchyOnGrid&, const std::vector<std::pair<NodeId, int>>&);
 

@@ -119,11 +119,13 @@ public:
                        GeometryPredictor mode = GeometryPredictor::normal_frame, bool streams = true,
                        StaticOrder order = StaticOrder::grouped, StaticEncoderBuffers* buffers = nullptr);
     // Over the first `count` of `created` only (no streams): an encoder weighing modes on a sample
-    // of a level, which extend() may then carry on over the whole level.
+    // of a level, which extend() may then carry on over the whole level. It stops short once its raw
+    // bits pass `raw_bit_limit` (gave_up(): then good only for being dropped; the raw bits only grow,
+    // and every bound of the mode is at least their bytes).
     template <class Mesh>
     StaticLevelEncoder(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t count,
                        CoordinateSpace space, GeometryPredictor mode, StaticOrder order = StaticOrder::grouped,
-                       StaticEncoderBuffers* buffers = nullptr);
+                       StaticEncoderBuffers* buffers = nullptr, uint64_t raw_bit_limit = UINT64_MAX);
     ~StaticLevelEncoder();
     StaticLevelEncoder(const StaticLevelEncoder&) = delete;
     StaticLevelEncoder& operator=(const StaticLevelEncoder&) = delete;
@@ -150,6 +152,8 @@ public:
     // Its streams' part alone (known without coding the tables): projected_bound_bytes(scale) is
     // at least 1 more.
     double projected_stream_bound_bytes(double scale) const;
+    // Whether the raw bits passed the limit the encoder was made with before its last vertex.
+    bool gave_up() const { return gave_up_; }
 
 private:
     // Tokens, residuals and counts of created[begin, end).
@@ -201,6 +205,7 @@ private:
     uint64_t raw_bits_ = 0;
     mutable size_t coded_table_bytes_ = SIZE_MAX;  // coded_table_bytes(), or SIZE_MAX until asked
     bool coded_ = false;
+    bool gave_up_ = false;
     std::vector<uint8_t> rans_, raw_;
     ScratchArray<uint8_t> rans_memory_;  // the rANS encoder's
     StaticEncoderBuffers* buffers_ = nullptr;
