@@ -60,23 +60,25 @@ void keep_likely_static_modes(const Mesh& h, const NewVertices& created, Coordin
     const double scale = double(created.size()) / double(sample);
     double stream_bound[kStaticCandidates];
     // Bit-exact: mode 5, whose bound was the smallest on every surface level of the corpus, is
-    // weighed first; a mode whose raw bits alone then pass its limit (modes 3, 6 and 7 about halfway
-    // through the sample) fails the test below, whatever the others' bounds (the smallest is at most
-    // mode 5's), and is never `first`: it stops there. (Quantized levels have few raw bits.)
+    // weighed first; a mode whose streams' bound then passes its limit (modes 3, 6 and 7 within the
+    // first half of the sample, by their raw bits and their tokens' entropy so far) fails the test
+    // below, whatever the others' bounds (the smallest is at most mode 5's), and is never `first`:
+    // it stops there. (Quantized levels: mode 3 against mode 4 passes it only near its sample's end.)
     const int reference = candidate[2] ? 2 : -1;
-    uint64_t raw_bit_limit = UINT64_MAX;
+    size_t stream_byte_limit = SIZE_MAX;
     if (reference >= 0) {
         on_sample[reference] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, kStaticModes[reference], grid_order, buffers);
         const double limit = rounded(kStaticMargin * on_sample[reference]->projected_bound_bytes(scale)) + kSampleSlack;
-        // Every bound is at least 1 + rounded(scale * (kRansStateBytes + raw bits / 8)).
-        raw_bit_limit = uint64_t(8 * (std::max(0.0, std::floor(limit / scale) - double(kRansStateBytes)) + 1)) + 7;
+        // A bound is at least 1 + rounded(scale * streams' bound): past the limit once the streams'
+        // bound passes limit / scale.
+        stream_byte_limit = size_t(std::floor(limit / scale)) + 1;
     }
     int first = -1;  // the candidate of the smallest streams' bound
     for (int i = 0; i < kStaticCandidates; ++i) {
         if (!candidate[i]) continue;
         if (i != reference) {
             on_sample[i] = std::make_unique<StaticLevelEncoder>(h, created, sample, space, kStaticModes[i], grid_order, buffers,
-                                                                raw_bit_limit);
+                                                                stream_byte_limit);
             if (on_sample[i]->gave_up()) {
                 candidate[i] = false;
                 on_sample[i].reset();

@@ -445,7 +445,7 @@ StaticLevelEncoder::StaticLevelEncoder(const Mesh& h, const std::vector<std::pai
 template <class Mesh>
 StaticLevelEncoder::StaticLevelEncoder(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t count,
                                        CoordinateSpace space, GeometryPredictor mode, StaticOrder order,
-                                       StaticEncoderBuffers* buffers, uint64_t raw_bit_limit)
+                                       StaticEncoderBuffers* buffers, size_t stream_byte_limit)
     : mode_(mode), grouped_(has_grid_bins(mode) && order == StaticOrder::grouped), space_(space),
       table_count_(static_table_count(mode)) {
     if (!is_static_mode(mode)) throw Error("StaticLevelEncoder: geometry mode " + std::to_string(int(mode)) + " is not a static mode");
@@ -469,7 +469,7 @@ StaticLevelEncoder::StaticLevelEncoder(const Mesh& h, const std::vector<std::pai
     count = std::min(count, created.size());
     // A sample's raw bits wait in large_ (see the header): the mode choice drops most samples.
     deferred_ = !grouped_ && count < created.size();
-    if (raw_bit_limit == UINT64_MAX) {
+    if (stream_byte_limit == SIZE_MAX) {
         add(h, created, 0, count);
     } else {
         // In steps, with the room for the whole count made first (add() reserves by the part before).
@@ -478,7 +478,11 @@ StaticLevelEncoder::StaticLevelEncoder(const Mesh& h, const std::vector<std::pai
         if (space.quantizer == nullptr && (deferred_ || grouped_)) large_.reserve(size_t(kStaticRoles) * count);
         for (size_t begin = 0; begin < count && !gave_up_; begin += kStep) {
             add(h, created, begin, std::min(count, begin + kStep));
-            gave_up_ = raw_bits_ > raw_bit_limit && begin + kStep < count;
+            if (begin + kStep >= count) break;
+            // The raw bits' part first; the tokens' entropy (a pass over the counts) once it is half way.
+            const size_t raw_part = kRansStateBytes + size_t(raw_bits_ / 8);
+            gave_up_ = raw_part > stream_byte_limit ||
+                       (2 * raw_part > stream_byte_limit && stream_bound_below(uint64_t(kStaticRoles) * count) > stream_byte_limit);
         }
         if (gave_up_) return;
     }
@@ -658,9 +662,9 @@ template StaticLevelEncoder::StaticLevelEncoder(const Hierarchy&, const std::vec
 template StaticLevelEncoder::StaticLevelEncoder(const HierarchyOnGrid&, const std::vector<std::pair<NodeId, int>>&,
                                                 CoordinateSpace, GeometryPredictor, bool, StaticOrder, StaticEncoderBuffers*);
 template StaticLevelEncoder::StaticLevelEncoder(const Hierarchy&, const std::vector<std::pair<NodeId, int>>&, size_t,
-                                                CoordinateSpace, GeometryPredictor, StaticOrder, StaticEncoderBuffers*, uint64_t);
+                                                CoordinateSpace, GeometryPredictor, StaticOrder, StaticEncoderBuffers*, size_t);
 template StaticLevelEncoder::StaticLevelEncoder(const HierarchyOnGrid&, const std::vector<std::pair<NodeId, int>>&, size_t,
-                                                CoordinateSpace, GeometryPredictor, StaticOrder, StaticEncoderBuffers*, uint64_t);
+                                                CoordinateSpace, GeometryPredictor, StaticOrder, StaticEncoderBuffers*, size_t);
 template void StaticLevelEncoder::extend(const Hierarchy&, const std::vector<std::pair<NodeId, int>>&);
 template void StaticLevelEncoder::extend(const HierarchyOnGrid&, const std::vector<std::pair<NodeId, int>>&);
 
@@ -783,6 +787,22 @@ size_t StaticLevelEncoder::stream_bound_bytes() const {
     const double rans_bits = token_bits_ - 16 - rounded(0.001 * double(token_count_));
     const size_t rans = kRansStateBytes + (rans_bits > 0 ? size_t(rans_bits / 8.01) : 0);
     return rans + size_t(raw_bits_ / 8);
+}
+
+// The tokens so far cost at least their empirical entropy under any table (Gibbs' inequality),
+// which only grows as tokens are added; the raw bits only grow. The entropy is taken a bit low, so
+// that its roundings can not pass the tables' costs.
+size_t StaticLevelEncoder::stream_bound_below(uint64_t tokens) const {
+    double entropy = 0;
+    for (int i = 0; i < table_count_; ++i) {
+        const std::vector<uint64_t>& counts = counts_[size_t(i)];
+        uint64_t n = 0;
+        for (uint64_t c : counts) n += c;
+        for (uint64_t c : counts)
+            if (c != 0) entropy += rounded(double(c) * std::log2(double(n) / double(c)));
+    }
+    const double rans_bits = rounded(entropy * (1 - 1e-9)) - 1 - 16 - rounded(0.001 * double(tokens));
+    return kRansStateBytes + (rans_bits > 0 ? size_t(rans_bits / 8.01) : 0) + size_t(raw_bits_ / 8);
 }
 
 double StaticLevelEncoder::projected_bound_bytes(double scale) const {

@@ -119,13 +119,13 @@ public:
                        GeometryPredictor mode = GeometryPredictor::normal_frame, bool streams = true,
                        StaticOrder order = StaticOrder::grouped, StaticEncoderBuffers* buffers = nullptr);
     // Over the first `count` of `created` only (no streams): an encoder weighing modes on a sample
-    // of a level, which extend() may then carry on over the whole level. It stops short once its raw
-    // bits pass `raw_bit_limit` (gave_up(): then good only for being dropped; the raw bits only grow,
-    // and every bound of the mode is at least their bytes).
+    // of a level, which extend() may then carry on over the whole level. It stops short once its
+    // streams' bound over the `count` vertices is known to pass `stream_byte_limit` (gave_up(): then
+    // good only for being dropped).
     template <class Mesh>
     StaticLevelEncoder(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t count,
                        CoordinateSpace space, GeometryPredictor mode, StaticOrder order = StaticOrder::grouped,
-                       StaticEncoderBuffers* buffers = nullptr, uint64_t raw_bit_limit = UINT64_MAX);
+                       StaticEncoderBuffers* buffers = nullptr, size_t stream_byte_limit = SIZE_MAX);
     ~StaticLevelEncoder();
     StaticLevelEncoder(const StaticLevelEncoder&) = delete;
     StaticLevelEncoder& operator=(const StaticLevelEncoder&) = delete;
@@ -152,7 +152,7 @@ public:
     // Its streams' part alone (known without coding the tables): projected_bound_bytes(scale) is
     // at least 1 more.
     double projected_stream_bound_bytes(double scale) const;
-    // Whether the raw bits passed the limit the encoder was made with before its last vertex.
+    // Whether the streams' bound passed the limit the encoder was made with before its last vertex.
     bool gave_up() const { return gave_up_; }
 
 private:
@@ -175,6 +175,9 @@ private:
     // The tables coded alone, made once per make_tables() (the bounds and the size ask it up to three times).
     size_t coded_table_bytes() const;
     size_t stream_bound_bytes() const;
+    // At most stream_bound_bytes() of an encoder of `tokens` tokens that begins with these (before
+    // the tables are made).
+    size_t stream_bound_below(uint64_t tokens) const;
     // The tables from the counts, and the tokens' cost under them.
     void make_tables();
     // Empties v, keeping its memory when it goes back to buffers_ (else freeing it now).
