@@ -1643,6 +1643,21 @@ struct PairFrames {
     }
 };
 
+// A listed fast path's decoded chunk (the vertices from created.first() + begin on) into the
+// hierarchy: appended when the level's positions do not exist yet, else set one by one.
+AMC_ALWAYS_INLINE void store_listed_chunk(Hierarchy& h, const FromList& created, size_t begin, const Vec3* decoded, size_t count,
+                                          bool append, bool near) {
+    if (append) {
+        HierarchyBuilder::append_positions(h, decoded, count, near);
+        return;
+    }
+    for (size_t k = 0; k < count; ++k) {
+        const VertexId v = created.first() + VertexId(begin + k);
+        if (near) HierarchyBuilder::set_near_vertex_position(h, v, decoded[k]);
+        else HierarchyBuilder::set_new_vertex_position(h, v, decoded[k]);
+    }
+}
+
 // The fast path's condition: a double-precision hierarchy (every quantized one) and narrow tables.
 // Grouped: the tokens in the grouped order (version 18), else vertex after vertex (one loop each,
 // so that either compiles as if alone). The frames, and the grouped order's tokens, by
@@ -1700,15 +1715,7 @@ AMC_ALWAYS_INLINE bool decode_grid_listed_with(Hierarchy& h, const FromList& cre
                             raw_size - std::min<size_t>(raw_size, size_t(s.raw_bits_read >> 3)) >= kChunkRaw;
         if (!(inside ? run(std::false_type{}) : run(std::true_type{}))) return false;
         std::memcpy(decoded, coordinates, count * sizeof(Vec3));
-        if (append) {
-            HierarchyBuilder::append_positions(h, decoded, count, near);
-        } else {
-            for (size_t k = 0; k < count; ++k) {
-                const VertexId v = created.first() + VertexId(begin + k);
-                if (near) HierarchyBuilder::set_near_vertex_position(h, v, decoded[k]);
-                else HierarchyBuilder::set_new_vertex_position(h, v, decoded[k]);
-            }
-        }
+        store_listed_chunk(h, created, begin, decoded, count, append, near);
     }
     return s.ended_cleanly();
 }
@@ -1830,15 +1837,7 @@ AMC_ALWAYS_INLINE bool decode_unit_listed_with(Hierarchy& h, const FromList& cre
             for (size_t k = 0; k < count; ++k)
                 if (!std::isfinite(decoded[k].x) || !std::isfinite(decoded[k].y) || !std::isfinite(decoded[k].z)) return false;
         }
-        if (append) {
-            HierarchyBuilder::append_positions(h, decoded, count, near);
-        } else {
-            for (size_t k = 0; k < count; ++k) {
-                const VertexId v = created.first() + VertexId(begin + k);
-                if (near) HierarchyBuilder::set_near_vertex_position(h, v, decoded[k]);
-                else HierarchyBuilder::set_new_vertex_position(h, v, decoded[k]);
-            }
-        }
+        store_listed_chunk(h, created, begin, decoded, count, append, near);
     }
     return s.ended_cleanly();
 }
