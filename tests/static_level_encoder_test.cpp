@@ -21,6 +21,13 @@ namespace {
 
 using testing::projected_sphere;
 
+// Whether the listed decoders may make mode 4's and 5's frames four at a time (AVX2), for a scope.
+struct WideFramesAllowed {
+    bool before;
+    explicit WideFramesAllowed(bool allowed) : before(set_wide_frames(allowed)) {}
+    ~WideFramesAllowed() { set_wide_frames(before); }
+};
+
 // The level with the most new vertices.
 NewVertices largest_level(const Hierarchy& h) {
     NewVertices largest;
@@ -213,11 +220,7 @@ TEST(StaticLevelEncoder, GridLevelsDecodeAlikeFromTheListAndFromTheNodes) {
         for (int way = 0; way < 3; ++way) {
             const bool listed = way > 0;
             SCOPED_TRACE(way == 0 ? "nodes" : way == 1 ? "listed, frames four at a time" : "listed, frames in pairs");
-            struct WideFrames {
-                bool before;
-                explicit WideFrames(bool allowed) : before(set_wide_frames(allowed)) {}
-                ~WideFrames() { set_wide_frames(before); }
-            } wide_frames(way != 2);
+            const WideFramesAllowed wide_frames(way != 2);
             Hierarchy decoded;
             ASSERT_TRUE(decode(listed, rans.size(), raw.size(), decoded, order));
             ASSERT_EQ(decoded.positions().size(), listed ? first + created.size() : first);
@@ -295,11 +298,7 @@ void expect_unit_levels_decode_alike(Precision precision) {
     for (int way = 0; way < 3; ++way) {
         const bool listed = way > 0;
         SCOPED_TRACE(way == 0 ? "nodes" : way == 1 ? "listed, frames four at a time" : "listed, frames in pairs");
-        struct WideFrames {
-            bool before;
-            explicit WideFrames(bool allowed) : before(set_wide_frames(allowed)) {}
-            ~WideFrames() { set_wide_frames(before); }
-        } wide_frames(way != 2);
+        const WideFramesAllowed wide_frames(way != 2);
         Hierarchy decoded;
         ASSERT_TRUE(decode(listed, rans.size(), raw.size(), decoded));
         ASSERT_EQ(decoded.positions().size(), listed ? first + created.size() : first);
