@@ -1643,6 +1643,18 @@ struct PairFrames {
     }
 };
 
+// The positions a listed chunk's frames read, fetched before its frames are made.
+AMC_ALWAYS_INLINE void prefetch_corner_positions(const Hierarchy& h, const FrameCorners* corners, size_t count) {
+    const Vec3* positions = h.positions().data();
+    for (size_t i = 0; i < count; ++i) {  // a, b and c are always vertices
+        const FrameCorners& k = corners[i];
+        __builtin_prefetch(positions + k.a);
+        __builtin_prefetch(positions + k.b);
+        __builtin_prefetch(positions + k.c);
+        if (k.d != kNoVertex) __builtin_prefetch(positions + k.d);
+    }
+}
+
 // A listed fast path's decoded chunk (the vertices from created.first() + begin on) into the
 // hierarchy: appended when the level's positions do not exist yet, else set one by one.
 AMC_ALWAYS_INLINE void store_listed_chunk(Hierarchy& h, const FromList& created, size_t begin, const Vec3* decoded, size_t count,
@@ -1686,14 +1698,7 @@ AMC_ALWAYS_INLINE bool decode_grid_listed_with(Hierarchy& h, const FromList& cre
     for (size_t begin = 0; begin < created.size(); begin += kChunk) {
         const size_t count = std::min(kChunk, created.size() - begin);
         const FrameCorners* corners = created.corners.next(count);
-        const Vec3* positions = h.positions().data();
-        for (size_t i = 0; i < count; ++i) {  // a, b and c are always vertices
-            const FrameCorners& k = corners[i];
-            __builtin_prefetch(positions + k.a);
-            __builtin_prefetch(positions + k.b);
-            __builtin_prefetch(positions + k.c);
-            if (k.d != kNoVertex) __builtin_prefetch(positions + k.d);
-        }
+        prefetch_corner_positions(h, corners, count);
         make_frames(h, corners, count, grid, origin, frames.data());
         auto run = [&](auto safe) {
             constexpr bool Safe = decltype(safe)::value;
@@ -1805,14 +1810,7 @@ AMC_ALWAYS_INLINE bool decode_unit_listed_with(Hierarchy& h, const FromList& cre
     for (size_t begin = 0; begin < created.size(); begin += kChunk) {
         const size_t count = std::min(kChunk, created.size() - begin);
         const FrameCorners* corners = created.corners.next(count);
-        const Vec3* positions = h.positions().data();
-        for (size_t i = 0; i < count; ++i) {  // a, b and c are always vertices
-            const FrameCorners& k = corners[i];
-            __builtin_prefetch(positions + k.a);
-            __builtin_prefetch(positions + k.b);
-            __builtin_prefetch(positions + k.c);
-            if (k.d != kNoVertex) __builtin_prefetch(positions + k.d);
-        }
+        prefetch_corner_positions(h, corners, count);
         make_frames(h, corners, count, frames.data());
         uint64_t largest = 0;
         auto run = [&](auto safe) {
