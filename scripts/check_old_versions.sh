@@ -16,6 +16,7 @@ pairs=("$@")
 if ((${#pairs[@]} == 0)); then
   pairs=(7146847:1 31e1487:1 73985d0:2)
 fi
+scripts/install-deps.sh --compat
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cmake -S scripts/compat -B "$work/new" -DAMC_SOURCE="$PWD" -DPROGRAM=check_vectors -DCMAKE_BUILD_TYPE=Release >/dev/null

@@ -5,13 +5,15 @@ packages=(g++ cmake make pkg-config libcli11-dev libgtest-dev libgmock-dev libbe
           libmeshoptimizer-dev libxxhash-dev zlib1g-dev
           pybind11-dev python3-dev python3-numpy python3-pytest python3-meshio python3-vtk9)
 # --bench: the peers of bench/compare_bench; --p4est: octree interoperability; --mpi: Open MPI for
-# amcodec_mpi; --fuzz: clang and its libFuzzer runtime (tests/fuzz).
+# amcodec_mpi; --fuzz: clang and its libFuzzer runtime (tests/fuzz); --compat: what the older commits
+# that scripts/check_old_versions.sh builds need (their OBJ reader was tinyobjloader).
 for arg in "$@"; do
   case "$arg" in
     --bench) packages+=(libdraco-dev libzstd-dev liblzma-dev libzfp-dev python3) ;;
     --p4est) packages+=(libp4est-dev libopenmpi-dev) ;;  # cmake -DAMC_WITH_P4EST=ON (octree forests)
     --mpi) packages+=(libopenmpi-dev openmpi-bin) ;;     # cmake -DAMC_WITH_MPI=ON (amcodec_mpi, mpirun for its tests)
     --fuzz) packages+=(clang libclang-rt-14-dev) ;;
+    --compat) packages+=(libtinyobjloader-dev) ;;
   esac
 done
 missing=()
