@@ -202,6 +202,21 @@ void verify_leaf_mesh(const Hierarchy& h, const std::vector<uint32_t>& leaf_of_v
     // 128 KiB per 10^6 faces stay in the cache where a byte each did not.
     std::vector<uint64_t> used((leaf.triangles.size() + 63) / 64, 0);
     auto leaf_vertex = [&](VertexId v) { return v < leaf_of_vertex.size() ? leaf_of_vertex[v] : kNoIndex; };
+    // Marks the leaf face that triangle (x, y, z) is; false when it is no face of that orientation
+    // or one marked already.
+    auto claim = [&](VertexId x, VertexId y, VertexId z) {
+        const uint32_t a = leaf_vertex(x), b = leaf_vertex(y), c = leaf_vertex(z);
+        const LeafHalfedges::Edge e = (a == kNoIndex || b == kNoIndex) ? LeafHalfedges::Edge{} : halfedges.edge(a, b);
+        const uint32_t f = e.face;
+        if (f == kNoIndex || e.apex != c || (used[f / 64] >> (f % 64) & 1)) return false;
+        used[f / 64] |= uint64_t(1) << (f % 64);
+        return true;
+    };
+    auto first_unused_face = [&] {
+        size_t f = 0;
+        while (f < leaf.triangles.size() && (used[f / 64] >> (f % 64) & 1)) ++f;
+        return f;
+    };
     // Whether every leaf triangle is an unused face, all faces used, read in node id order. With
     // every node live (never coarsened), those are the nodes of the breadth-first order, so the
     // answer is that order's, without computing it (a twentieth of the check). A failure is read
@@ -210,37 +225,23 @@ void verify_leaf_mesh(const Hierarchy& h, const std::vector<uint32_t>& leaf_of_v
         bool fits = true;
         try {
             for_each_leaf_triangle(h, NodeIdRange{h.node_capacity()}, -1, [&](NodeId, VertexId x, VertexId y, VertexId z, bool) {
-                const uint32_t a = leaf_vertex(x), b = leaf_vertex(y), c = leaf_vertex(z);
-                const LeafHalfedges::Edge e =
-                    (a == kNoIndex || b == kNoIndex) ? LeafHalfedges::Edge{} : halfedges.edge(a, b);
-                const uint32_t f = e.face;
-                if (f == kNoIndex || e.apex != c || (used[f / 64] >> (f % 64) & 1)) {
-                    fits = false;
-                    return;
-                }
-                used[f / 64] |= uint64_t(1) << (f % 64);
+                fits = fits && claim(x, y, z);
             });
         } catch (const Error&) {  // a leaf with three hanging nodes
             fits = false;
         }
-        for (size_t f = 0; fits && f < leaf.triangles.size(); ++f) fits = used[f / 64] >> (f % 64) & 1;
-        if (fits) return;
+        if (fits && first_unused_face() == leaf.triangles.size()) return;
         std::fill(used.begin(), used.end(), 0);
     }
     auto vertex_text = [&](uint32_t l) { return std::to_string(l == kNoIndex ? l : input_of[l]); };
     for_each_leaf_triangle(h, h.breadth_first_order(), -1, [&](NodeId, VertexId x, VertexId y, VertexId z, bool) {
-        const uint32_t a = leaf_vertex(x), b = leaf_vertex(y), c = leaf_vertex(z);
-        const LeafHalfedges::Edge e = (a == kNoIndex || b == kNoIndex) ? LeafHalfedges::Edge{} : halfedges.edge(a, b);
-        const uint32_t f = e.face;
-        if (f == kNoIndex || e.apex != c || (used[f / 64] >> (f % 64) & 1))
-            fail(what, "the reconstruction has a triangle (" + vertex_text(a) + ", " + vertex_text(b) + ", " +
-                           vertex_text(c) + ") that is not a face of the leaf mesh");
-        used[f / 64] |= uint64_t(1) << (f % 64);
+        if (!claim(x, y, z))
+            fail(what, "the reconstruction has a triangle (" + vertex_text(leaf_vertex(x)) + ", " + vertex_text(leaf_vertex(y)) +
+                           ", " + vertex_text(leaf_vertex(z)) + ") that is not a face of the leaf mesh");
     });
-    for (size_t f = 0; f < leaf.triangles.size(); ++f) {
-        if (!(used[f / 64] >> (f % 64) & 1))
-            fail(what, "face " + std::to_string(f) + " is not part of a red-green refinement of the base");
-    }
+    const size_t f = first_unused_face();
+    if (f < leaf.triangles.size())
+        fail(what, "face " + std::to_string(f) + " is not part of a red-green refinement of the base");
 }
 
 }  // namespace
