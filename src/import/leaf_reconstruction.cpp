@@ -2,6 +2,7 @@
 #include "import/leaf_reconstruction.h"
 
 #include "common/exact_float.h"
+#include "hierarchy/hierarchy_builder.h"
 #include "import/reconstruction.h"
 
 #include <algorithm>
@@ -60,7 +61,7 @@ void Reconstruction::reconstruct_level(std::vector<NodeId>& level, std::vector<N
     read_failed_ = true;
     read_level_or_repair(level, refined);
     read_failed_ = false;
-    for (NodeId n : refined) h_.split(n);
+    split_refined(refined);
     leaf_of_vertex_.resize(h_.positions().size(), kNoIndex);
     for (const Reveal& r : reveals_) {
         const NodeId q = h_.neighbor(r.node, r.edge);
@@ -106,11 +107,8 @@ void Reconstruction::read_level(const std::vector<NodeId>& level, std::vector<No
     for (NodeId n : level) {
         if (classify(n)) refined.push_back(n);
     }
-    // Sized once for every node the hierarchy can hold (grown a node at a time, its resizes were
-    // 1% of a 10^6-face import's instructions).
-    if (refined_mark_.size() < h_.node_capacity()) refined_mark_.resize(h_.node_capacity(), 0);
-    for (NodeId n : refined) refined_mark_[n] = 1;
-    auto is_refined = [&](NodeId q) { return q != kNoNode && q < refined_mark_.size() && refined_mark_[q]; };
+    mark_refined(refined);
+    auto is_refined = [&](NodeId q) { return q != kNoNode && q < refined_index_.size() && refined_index_[q] != kNoIndex; };
     try {
         for (NodeId n : refined) {
             if (!h_.can_split(n)) fail_node(n, "is refined next to a coarser element (2:1 balance violated)");
@@ -135,10 +133,63 @@ void Reconstruction::read_level(const std::vector<NodeId>& level, std::vector<No
                      " would be used twice by the refinement (not a red-green refinement)");
         }
     } catch (const Error&) {
-        for (NodeId n : refined) refined_mark_[n] = 0;
+        unmark_refined(refined);
         throw;
     }
-    for (NodeId n : refined) refined_mark_[n] = 0;
+    unmark_refined(refined);
+}
+
+void Reconstruction::mark_refined(const std::vector<NodeId>& refined) {
+    // Sized once for every node the hierarchy can hold (grown a node at a time, its resizes were
+    // 1% of a 10^6-face import's instructions).
+    if (refined_index_.size() < h_.node_capacity()) refined_index_.resize(h_.node_capacity(), kNoIndex);
+    for (uint32_t i = 0; i < refined.size(); ++i) refined_index_[refined[i]] = i;
+}
+
+void Reconstruction::unmark_refined(const std::vector<NodeId>& refined) {
+    for (NodeId n : refined) refined_index_[n] = kNoIndex;
+}
+
+void Reconstruction::split_refined(const std::vector<NodeId>& refined) {
+    const uint32_t count = uint32_t(refined.size());
+    if (count == 0) return;
+    mark_refined(refined);
+    // A same-level neighbour outside the list is a leaf (the level is read whole before it is
+    // split), which split_level's links assume; otherwise node at a time, as it always did.
+    for (NodeId n : refined) {
+        for (int e = 0; e < 3; ++e) {
+            const NodeId q = h_.neighbor(n, e);
+            if (q != kNoNode && refined_index_[q] == kNoIndex && !h_.is_leaf(q)) {
+                unmark_refined(refined);
+                for (NodeId x : refined) h_.split(x);
+                return;
+            }
+        }
+    }
+    // The children's links as local indices (child k of refined[i] is 4 i + k), written into the
+    // room of the children themselves.
+    const ChildLinkRoom room = HierarchyBuilder::open_children(h_, nullptr, count);
+    for (uint32_t i = 0; i < count; ++i) {
+        const NodeId n = refined[i];
+        uint32_t* const words = room.words + ChildLinkRoom::kStride * 4 * size_t(i);
+        auto link = [words](int k, int e) -> uint32_t& { return words[ChildLinkRoom::kStride * size_t(k) + size_t(e)]; };
+        for (int w = 0; w < 12; ++w) {  // a constant table: unrolled to the six sibling words
+            const red_split::LinkSource s = red_split::kLinkSources.of[w];
+            if (s.kind == red_split::LinkSource::kSibling) link(w / 3, w % 3) = 4 * i + s.sibling;
+        }
+        // The edge runs the other way in the neighbour: the first half of ours is the second of its.
+        for (int e = 0; e < 3; ++e) {
+            const NodeId q = h_.neighbor(n, e);
+            const uint32_t j = q == kNoNode ? kNoIndex : refined_index_[q];
+            const int eq = h_.neighbor_edge(n, e);
+            link(red_split::kFirstHalfChild[e], e) = j == kNoIndex ? kNoNode : 4 * j + red_split::kSecondHalfChild[eq];
+            link(red_split::kSecondHalfChild[e], e) = j == kNoIndex ? kNoNode : 4 * j + red_split::kFirstHalfChild[eq];
+        }
+    }
+    unmark_refined(refined);
+    LevelSplits splits{refined.data(), count, nullptr};
+    splits.links_in_place = true;
+    HierarchyBuilder::split_level(h_, splits);
 }
 
 Reconstruction::Reading Reconstruction::read(const uint32_t p[3]) const {
