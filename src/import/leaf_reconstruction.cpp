@@ -193,10 +193,11 @@ void Reconstruction::split_refined(const std::vector<NodeId>& refined) {
 }
 
 Reconstruction::Reading Reconstruction::read(const uint32_t p[3]) const {
+    // p[e] -> p[e+1], looked up once for the tests below, before anything is written to r (whose
+    // stores the compiler must assume to reach the index: it read the index's arrays again).
+    const LeafHalfedges::Edge ahead[3] = {he_.edge(p[0], p[1]), he_.edge(p[1], p[2]), he_.edge(p[2], p[0])};
     Reading r;
-    LeafHalfedges::Edge ahead[3];  // p[e] -> p[e+1], looked up once for the tests below
     for (int e = 0; e < 3; ++e) {
-        ahead[e] = he_.edge(p[e], p[(e + 1) % 3]);
         r.unsplit[e] = ahead[e].face != kNoIndex;
         r.unsplit_count += r.unsplit[e];
     }
