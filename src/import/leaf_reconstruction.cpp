@@ -291,7 +291,9 @@ bool Reconstruction::take_reading(NodeId n, const Reading& r) {
         if (r.unsplit[e]) unsplit_edges_.push_back({n, e});
     }
     for (int i = 0; i < r.reveal_count; ++i) reveals_.push_back({n, r.reveal_edge[i], r.reveal_vertex[i]});
-    h_.set_diagonal_flipped(n, r.flipped);  // a level read again after a repair may read otherwise
+    // A level read again after a repair may read otherwise. Written only when it changes (rarely:
+    // the call was a twentieth of a reading's instructions).
+    if (h_.diagonal_flipped(n) != r.flipped) h_.set_diagonal_flipped(n, r.flipped);
     return false;
 }
 
