@@ -1,6 +1,7 @@
 // Top-down reconstruction of the forest from the leaf mesh (docs/IMPORT.md, section 1).
 #include "import/leaf_reconstruction.h"
 
+#include "common/compiler.h"
 #include "common/exact_float.h"
 #include "hierarchy/hierarchy_builder.h"
 #include "import/reconstruction.h"
@@ -10,6 +11,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace amc {
@@ -53,7 +55,7 @@ std::vector<uint32_t> Reconstruction::run() {
         level.swap(next);
         ++depth;
     }
-    return leaf_of_vertex_;
+    return std::move(leaf_of_vertex_);  // run() is the reconstruction's last use (a copy: 4 bytes a vertex)
 }
 
 void Reconstruction::reconstruct_level(std::vector<NodeId>& level, std::vector<NodeId>& next) {
@@ -192,7 +194,9 @@ void Reconstruction::split_refined(const std::vector<NodeId>& refined) {
     HierarchyBuilder::split_level(h_, splits);
 }
 
-Reconstruction::Reading Reconstruction::read(const uint32_t p[3]) const {
+Reconstruction::Reading Reconstruction::read(const uint32_t p[3]) const { return read_inline(p); }
+
+AMC_ALWAYS_INLINE Reconstruction::Reading Reconstruction::read_inline(const uint32_t p[3]) const {
     // p[e] -> p[e+1], looked up once for the tests below, before anything is written to r (whose
     // stores the compiler must assume to reach the index: it read the index's arrays again).
     const LeafHalfedges::Edge ahead[3] = {he_.edge(p[0], p[1]), he_.edge(p[1], p[2]), he_.edge(p[2], p[0])};
@@ -257,7 +261,7 @@ Reconstruction::Reading Reconstruction::read(const uint32_t p[3]) const {
 
 bool Reconstruction::classify(NodeId n) {
     const uint32_t p[3] = {corner(n, 0), corner(n, 1), corner(n, 2)};
-    const Reading r = read(p);
+    const Reading r = read_inline(p);
     switch (r.fault) {
         case Reading::none:
             break;

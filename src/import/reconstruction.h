@@ -40,6 +40,7 @@ public:
         for (VertexId v = 0; v < leaf_of_base.size(); ++v) assign(v, leaf_of_base[v]);
     }
 
+    // The leaf vertex of each hierarchy vertex (kNoIndex: none); once per reconstruction.
     std::vector<uint32_t> run();
 
 private:
@@ -201,6 +202,9 @@ private:
     }
 
     Reading read(const uint32_t p[3]) const;
+    // read's body, inlined into classify (its result then stays in registers), and used by this
+    // file only (leaf_reconstruction.cpp); read is it out of line.
+    Reading read_inline(const uint32_t p[3]) const;
     // One level: read (repairing the previous level's picks), split, its midpoints found; `next`
     // gets the children.
     void reconstruct_level(std::vector<NodeId>& level, std::vector<NodeId>& next);
