@@ -23,8 +23,7 @@ LeafHalfedges::LeafHalfedges(const TriangleMesh& mesh) {
     }
     slots_.pop_back();
     // Which apexes are also out-edge ends (all of them in a closed fan): for_each_neighbor_once.
-    // u's ends are stamped with u, so each apex is tested with one read (searching u's ends for
-    // each apex was half of the build's instructions).
+    // u's ends are stamped with u: each apex is tested with one read, not a search of the list.
     std::vector<uint32_t> end_of(n, kNoIndex);  // the last vertex seen with this one as an out-edge end
     for (uint32_t u = 0; u < n; ++u) {
         Entry* const first = entries_.get() + slots_[u].start;

@@ -73,9 +73,8 @@ private:
     };
     static constexpr uint32_t kApexIsEnd = 0x80000000u;  // the apex is also the end of an out-edge of u
     static constexpr uint32_t kFaceBits = ~kApexIsEnd;
-    // A vertex's first entry, and a filter of its out-edge ends: the bit end_bit(v) of each end v
-    // is set, so a vertex whose bit is clear is no end (no search). Most lookups of a node's
-    // reading find no edge (a refined node's six), and searched the whole list.
+    // A vertex's first entry, and a filter of its out-edge ends (bit end_bit(v) of each end v): a
+    // clear bit answers "no edge" without a search, as most of a node reading's lookups answer.
     struct Slot {
         uint32_t start, ends;
     };

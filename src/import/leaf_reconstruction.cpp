@@ -110,7 +110,9 @@ void Reconstruction::read_level(const std::vector<NodeId>& level, std::vector<No
         if (classify(n)) refined.push_back(n);
     }
     mark_refined(refined);
-    auto is_refined = [&](NodeId q) { return q != kNoNode && q < refined_index_.size() && refined_index_[q] != kNoIndex; };
+    auto is_refined = [&](NodeId q) {
+        return q != kNoNode && q < refined_index_.size() && refined_index_[q] != kNoIndex;
+    };
     try {
         for (NodeId n : refined) {
             if (!h_.can_split(n)) fail_node(n, "is refined next to a coarser element (2:1 balance violated)");
@@ -174,7 +176,9 @@ void Reconstruction::split_refined(const std::vector<NodeId>& refined) {
     for (uint32_t i = 0; i < count; ++i) {
         const NodeId n = refined[i];
         uint32_t* const words = room.words + ChildLinkRoom::kStride * 4 * size_t(i);
-        auto link = [words](int k, int e) -> uint32_t& { return words[ChildLinkRoom::kStride * size_t(k) + size_t(e)]; };
+        auto link = [words](int k, int e) -> uint32_t& {
+            return words[ChildLinkRoom::kStride * size_t(k) + size_t(e)];
+        };
         for (int w = 0; w < 12; ++w) {  // a constant table: unrolled to the six sibling words
             const red_split::LinkSource s = red_split::kLinkSources.of[w];
             if (s.kind == red_split::LinkSource::kSibling) link(w / 3, w % 3) = 4 * i + s.sibling;
@@ -197,8 +201,7 @@ void Reconstruction::split_refined(const std::vector<NodeId>& refined) {
 Reconstruction::Reading Reconstruction::read(const uint32_t p[3]) const { return read_inline(p); }
 
 AMC_ALWAYS_INLINE Reconstruction::Reading Reconstruction::read_inline(const uint32_t p[3]) const {
-    // p[e] -> p[e+1], looked up once for the tests below, before anything is written to r (whose
-    // stores the compiler must assume to reach the index: it read the index's arrays again).
+    // p[e] -> p[e+1], looked up once, before r is written (its stores may alias the index's arrays).
     const LeafHalfedges::Edge ahead[3] = {he_.edge(p[0], p[1]), he_.edge(p[1], p[2]), he_.edge(p[2], p[0])};
     Reading r;
     for (int e = 0; e < 3; ++e) {
@@ -295,8 +298,7 @@ bool Reconstruction::take_reading(NodeId n, const Reading& r) {
         if (r.unsplit[e]) unsplit_edges_.push_back({n, e});
     }
     for (int i = 0; i < r.reveal_count; ++i) reveals_.push_back({n, r.reveal_edge[i], r.reveal_vertex[i]});
-    // A level read again after a repair may read otherwise. Written only when it changes (rarely:
-    // the call was a twentieth of a reading's instructions).
+    // A level read again after a repair may read otherwise; written only on a change (an out-of-line call).
     if (h_.diagonal_flipped(n) != r.flipped) h_.set_diagonal_flipped(n, r.flipped);
     return false;
 }

@@ -25,8 +25,7 @@ namespace amc {
 
 class NearestVertex {
     static constexpr uint32_t kBucket = 16;  // points in a leaf of the k-d tree (its ties depend on it)
-    // Points in a leaf of the Morton tree (its answers do not depend on it): 8 took 1-2% fewer
-    // instructions per import than 16 (4 and 32 more).
+    // Points in a leaf of the Morton tree, whose answers do not depend on it (docs/IMPORT.md).
     static constexpr uint32_t kMortonBucket = 8;
     struct Point {
         double x[3];
@@ -51,9 +50,8 @@ private:
               bound(below(max_squared_distance)) {}
         uint32_t wanted, count = 0;
         double limit;
-        // matters(d) is d <= bound: while fewer than wanted are listed, the largest double below
-        // limit (d < limit, exactly), then the last listed distance. One compare where a test of
-        // the count and two loads were a tenth of a query's instructions.
+        // matters(d) is d <= bound: the largest double below limit while fewer than wanted are
+        // listed (d < limit, exactly), then the last listed distance. One compare per tree node.
         double bound;
         double tie = std::numeric_limits<double>::infinity();
         uint32_t vertex[kMaxCount];

@@ -202,15 +202,13 @@ private:
     }
 
     Reading read(const uint32_t p[3]) const;
-    // read's body, inlined into classify (its result then stays in registers), and used by this
-    // file only (leaf_reconstruction.cpp); read is it out of line.
+    // read's body, inlined into classify (used in leaf_reconstruction.cpp only); read is it out of line.
     Reading read_inline(const uint32_t p[3]) const;
     // One level: read (repairing the previous level's picks), split, its midpoints found; `next`
     // gets the children.
     void reconstruct_level(std::vector<NodeId>& level, std::vector<NodeId>& next);
-    // Splits a level's refined nodes in one pass (HierarchyBuilder::split_level, the decoders'
-    // bulk build): the node ids, vertex ids, positions and links of split() node by node, which
-    // cost about 470 instructions a split here.
+    // Splits a level's refined nodes in one pass (HierarchyBuilder::split_level): the node ids,
+    // vertex ids, positions and links of split() node by node.
     void split_refined(const std::vector<NodeId>& refined);
     void mark_refined(const std::vector<NodeId>& refined);    // refined_index_
     void unmark_refined(const std::vector<NodeId>& refined);
