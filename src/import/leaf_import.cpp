@@ -324,7 +324,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     // Each attempt starts from a copy of the roots: copied into the last attempt's storage, whose
     // pages are already mapped (a fresh 10^6-face hierarchy faults in about 60 MB).
     const Hierarchy roots(hierarchy_base);
-    auto attempt = [&](Way way, bool by_undo_steps) {
+    auto attempt = [&](Way way, bool by_undo_steps, bool vote_on_guides = false) {
         out.hierarchy = roots;
         // A leaf mesh of F faces comes from at most F leaves, so from at most 4F/3 + roots nodes.
         out.hierarchy.reserve(leaf.triangles.size() * 4 / 3 + base.triangles.size() + 4, leaf.positions.size());
@@ -347,7 +347,8 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
             }
         } else {
             leaf_of_vertex = reconstruct_hierarchy(out.hierarchy, spatial_leaf_of_base, spatial, halfedges, guide_of(way),
-                                                   leaf_positions, search, what, nullptr, nullptr, &input_of);
+                                                   leaf_positions, search, what, nullptr, nullptr, &input_of,
+                                                   vote_on_guides);
         }
         verify_leaf_mesh(out.hierarchy, leaf_of_vertex, spatial, halfedges, input_of, what);
     };
@@ -361,16 +362,37 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
         {Way::exact_midpoints, false}, {Way::uniform, false}, {Way::leaf_midpoint, false}, {Way::subdivision, false},
         {Way::surface, false},         {Way::anchored, false}, {Way::leaf_midpoint, true},  {Way::subdivision, true},
         {Way::surface, true}};
-    for (const auto& [way, by_undo_steps] : ways) {
-        if (by_undo_steps && steps.step.empty()) break;
+    // The leaf-midpoint way gives way to the subdivision way when its first levels' revealed
+    // midpoints vote for that guide; if the subdivision way fails, the old order resumes.
+    enum class Outcome { imported, failed, subdivision_closer };
+    auto try_way = [&](Way way, bool by_undo_steps, bool vote_on_guides) {
         try {
-            attempt(way, by_undo_steps);
-            done = true;
-            break;
+            attempt(way, by_undo_steps, vote_on_guides);
+            return Outcome::imported;
+        } catch (const SubdivisionGuideCloser&) {
+            return Outcome::subdivision_closer;
         } catch (const MidpointNotFound&) {
             midpoints_guessed = true;
         } catch (const Error& e) {
             if (way == Way::subdivision && !by_undo_steps) first_error = e.what();
+        }
+        return Outcome::failed;
+    };
+    bool subdivision_failed = false;
+    for (const auto& [way, by_undo_steps] : ways) {
+        if (by_undo_steps && steps.step.empty()) break;
+        if (way == Way::subdivision && !by_undo_steps && subdivision_failed) continue;
+        Outcome outcome = try_way(way, by_undo_steps, way == Way::leaf_midpoint && !by_undo_steps);
+        if (outcome == Outcome::subdivision_closer) {
+            outcome = try_way(Way::subdivision, false, false);
+            if (outcome != Outcome::imported) {
+                subdivision_failed = true;
+                outcome = try_way(way, by_undo_steps, false);
+            }
+        }
+        if (outcome == Outcome::imported) {
+            done = true;
+            break;
         }
     }
     if (!done) {

@@ -76,6 +76,7 @@ void Reconstruction::reconstruct_level(std::vector<NodeId>& level, std::vector<N
                  " both split the edge (" + edge_text(q, h_.neighbor_edge(r.node, r.edge)) + ")");
         }
     }
+    if (vote_on_guides_) vote_on_guides();
     next.clear();
     for (NodeId n : refined) {
         failed_node_ = n;
@@ -86,6 +87,24 @@ void Reconstruction::reconstruct_level(std::vector<NodeId>& level, std::vector<N
         for (int k = 0; k < 4; ++k) next.push_back(h_.child(n, k));
     }
     failed_node_ = kNoNode;
+}
+
+void Reconstruction::vote_on_guides() {
+    // Level 0's midpoints split base edges, where both guides put them at the same point.
+    if (vote_level_++ == 0) return;
+    for (const Reveal& r : reveals_) {
+        const NodeId q = h_.neighbor(r.node, r.edge);
+        const Vec3& at = leaf_.positions[r.leaf_vertex];
+        const Vec3 d_leaf = at - 0.5 * (leaf_.positions[corner(r.node, r.edge)] +
+                                        leaf_.positions[corner(r.node, (r.edge + 1) % 3)]);
+        const Vec3 d_subdivision = at - h_.position(h_.midpoint(q, h_.neighbor_edge(r.node, r.edge)));
+        const double leaf = exact_dot(d_leaf, d_leaf), subdivision = exact_dot(d_subdivision, d_subdivision);
+        votes_leaf_ += leaf < subdivision;
+        votes_subdivision_ += subdivision < leaf;
+    }
+    if (votes_leaf_ + votes_subdivision_ < kMinVotes) return;
+    vote_on_guides_ = false;  // decided once
+    if (votes_subdivision_ >= kVoteRatio * votes_leaf_) throw SubdivisionGuideCloser(what_ + ": the subdivision guide is closer");
 }
 
 void Reconstruction::read_level_or_repair(const std::vector<NodeId>& level, std::vector<NodeId>& refined) {
@@ -404,8 +423,10 @@ std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint
                                             const TriangleMesh& leaf, const LeafHalfedges& halfedges,
                                             MidpointGuide guide, const PositionIndex& positions,
                                             LeafSearch& search, const std::string& what, const UndoSteps* steps,
-                                            const PickReferee* referee, const std::vector<uint32_t>* input_of) {
-    return Reconstruction(h, leaf_of_base, leaf, halfedges, guide, positions, search, what, steps, referee, input_of)
+                                            const PickReferee* referee, const std::vector<uint32_t>* input_of,
+                                            bool vote_on_guides) {
+    return Reconstruction(h, leaf_of_base, leaf, halfedges, guide, positions, search, what, steps, referee, input_of,
+                          vote_on_guides)
         .run();
 }
 

@@ -63,6 +63,13 @@ public:
     using Error::Error;
 };
 
+// The leaf-midpoint-guided way's early end (`vote_on_guides`): the midpoints its first levels'
+// green leaves revealed lie nearer where midpoint subdivision of the base puts them.
+class SubdivisionGuideCloser : public Error {
+public:
+    using Error::Error;
+};
+
 // A position-guided pick of the vertex that splits the edge (a, b) of a node of `level`: the
 // candidates the choice saw (nearest first; only the pick when no choice was made) and the pick;
 // `repaired`: seen again after the level's children have had their say (no candidates then).
@@ -94,6 +101,7 @@ std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint
                                             LeafSearch& search, const std::string& what,
                                             const UndoSteps* steps = nullptr,
                                             const PickReferee* referee = nullptr,
-                                            const std::vector<uint32_t>* input_of = nullptr);
+                                            const std::vector<uint32_t>* input_of = nullptr,
+                                            bool vote_on_guides = false);
 
 }  // namespace amc

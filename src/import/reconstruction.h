@@ -25,8 +25,8 @@ public:
     Reconstruction(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base, const TriangleMesh& leaf,
                    const LeafHalfedges& halfedges, MidpointGuide guide, const PositionIndex& positions,
                    LeafSearch& search, const std::string& what, const UndoSteps* steps, const PickReferee* referee,
-                   const std::vector<uint32_t>* input_of)
-        : h_(h), leaf_(leaf), he_(halfedges), guide_(guide), positions_(positions), search_(search), what_(what),
+                   const std::vector<uint32_t>* input_of, bool vote_on_guides = false)
+        : vote_on_guides_(vote_on_guides && guide == MidpointGuide::leaf_midpoint), h_(h), leaf_(leaf), he_(halfedges), guide_(guide), positions_(positions), search_(search), what_(what),
           referee_(referee), input_of_(input_of) {
         if (steps) choice_ = std::make_unique<UndoStepChoice>(*steps);
         // A level's lists hold at most three unsplit edges and two reveals per node, and a
@@ -392,6 +392,17 @@ private:
     // misfitting. Swaps undo the picks of neighbouring edges that took each other's vertex
     // (measured: most wrong picks of the finest levels).
     Move best_move(VertexId v, NodeId misfit);
+
+    // The revealed midpoints of the first levels below level 0, known for certain, as a vote between
+    // the guides: each counts for the guide that puts it nearer. Decided at the first level with
+    // kMinVotes in all; SubdivisionGuideCloser when subdivision has kVoteRatio times leaf's votes
+    // (docs/IMPORT.md, "Complexity and speed": the margin to the corpus's surface models).
+    void vote_on_guides();
+    static constexpr uint64_t kMinVotes = 16;
+    static constexpr uint64_t kVoteRatio = 2;
+    bool vote_on_guides_;
+    int vote_level_ = 0;
+    uint64_t votes_leaf_ = 0, votes_subdivision_ = 0;
 
     Hierarchy& h_;
     const TriangleMesh& leaf_;
