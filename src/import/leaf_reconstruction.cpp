@@ -76,7 +76,10 @@ void Reconstruction::reconstruct_level(std::vector<NodeId>& level, std::vector<N
                  " both split the edge (" + edge_text(q, h_.neighbor_edge(r.node, r.edge)) + ")");
         }
     }
-    if (vote_on_guides_) vote_on_guides();
+    if (vote_on_guides_) {
+        vote_on_guides();
+        if (votes_leaf_ + votes_subdivision_ >= kMinVotes) decide_guides();
+    }
     next.clear();
     for (NodeId n : refined) {
         failed_node_ = n;
@@ -90,21 +93,23 @@ void Reconstruction::reconstruct_level(std::vector<NodeId>& level, std::vector<N
 }
 
 void Reconstruction::vote_on_guides() {
-    // Level 0's midpoints split base edges, where both guides put them at the same point.
-    if (vote_level_++ == 0) return;
     for (const Reveal& r : reveals_) {
-        const NodeId q = h_.neighbor(r.node, r.edge);
+        // Level 0's midpoints split base edges, where both guides put them at the same point.
+        if (h_.level(r.node) == 0) continue;
+        const int e = r.edge, f = (e + 1) % 3;
         const Vec3& at = leaf_.positions[r.leaf_vertex];
-        const Vec3 d_leaf = at - 0.5 * (leaf_.positions[corner(r.node, r.edge)] +
-                                        leaf_.positions[corner(r.node, (r.edge + 1) % 3)]);
-        const Vec3 d_subdivision = at - h_.position(h_.midpoint(q, h_.neighbor_edge(r.node, r.edge)));
+        const Vec3 d_leaf = at - 0.5 * (leaf_.positions[corner(r.node, e)] + leaf_.positions[corner(r.node, f)]);
+        const Vec3 d_subdivision = at - 0.5 * (h_.position(h_.vertex(r.node, e)) + h_.position(h_.vertex(r.node, f)));
         const double leaf = exact_dot(d_leaf, d_leaf), subdivision = exact_dot(d_subdivision, d_subdivision);
         votes_leaf_ += leaf < subdivision;
         votes_subdivision_ += subdivision < leaf;
     }
-    if (votes_leaf_ + votes_subdivision_ < kMinVotes) return;
-    vote_on_guides_ = false;  // decided once
-    if (votes_subdivision_ >= kVoteRatio * votes_leaf_) throw SubdivisionGuideCloser(what_ + ": the subdivision guide is closer");
+}
+
+void Reconstruction::decide_guides() {
+    vote_on_guides_ = false;
+    if (votes_leaf_ + votes_subdivision_ >= kMinVotes && votes_subdivision_ >= kVoteRatio * votes_leaf_)
+        throw SubdivisionGuideCloser(what_ + ": the subdivision guide is closer");
 }
 
 void Reconstruction::read_level_or_repair(const std::vector<NodeId>& level, std::vector<NodeId>& refined) {
@@ -114,6 +119,10 @@ void Reconstruction::read_level_or_repair(const std::vector<NodeId>& level, std:
     } catch (const Error&) {
         if (guided_.empty()) throw;
         misfit = true;
+    }
+    if (misfit && vote_on_guides_) {  // the reveals read before the misfit
+        vote_on_guides();
+        decide_guides();
     }
     if (misfit) repair_picks();
     if (referee_ && referee_after_repair()) misfit = true;

@@ -94,7 +94,9 @@ using PickReferee = std::function<uint32_t(const GuidedPick&)>;
 // is chosen among the nearest candidates by them (undo_steps.h); `referee` (if given) sees each
 // such pick. Throws Error when the leaf mesh
 // does not fit, naming leaf vertex l as input_of[l] when input_of is given (the caller's numbering
-// of a renumbered leaf mesh); the caller verifies the whole leaf mesh afterwards.
+// of a renumbered leaf mesh); the caller verifies the whole leaf mesh afterwards. With
+// `vote_on_guides` (the leaf-midpoint guide), throws SubdivisionGuideCloser when the first levels'
+// revealed midpoints lie nearer where the subdivision guide would look.
 std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
                                             const TriangleMesh& leaf, const LeafHalfedges& halfedges,
                                             MidpointGuide guide, const PositionIndex& positions,

@@ -26,8 +26,8 @@ public:
                    const LeafHalfedges& halfedges, MidpointGuide guide, const PositionIndex& positions,
                    LeafSearch& search, const std::string& what, const UndoSteps* steps, const PickReferee* referee,
                    const std::vector<uint32_t>* input_of, bool vote_on_guides = false)
-        : vote_on_guides_(vote_on_guides && guide == MidpointGuide::leaf_midpoint), h_(h), leaf_(leaf), he_(halfedges), guide_(guide), positions_(positions), search_(search), what_(what),
-          referee_(referee), input_of_(input_of) {
+        : vote_on_guides_(vote_on_guides && guide == MidpointGuide::leaf_midpoint), h_(h), leaf_(leaf), he_(halfedges),
+          guide_(guide), positions_(positions), search_(search), what_(what), referee_(referee), input_of_(input_of) {
         if (steps) choice_ = std::make_unique<UndoStepChoice>(*steps);
         // A level's lists hold at most three unsplit edges and two reveals per node, and a
         // node is a leaf face at most once: room for the largest level, offered to huge pages
@@ -393,15 +393,15 @@ private:
     // (measured: most wrong picks of the finest levels).
     Move best_move(VertexId v, NodeId misfit);
 
-    // The revealed midpoints of the first levels below level 0, known for certain, as a vote between
-    // the guides: each counts for the guide that puts it nearer. Decided at the first level with
-    // kMinVotes in all; SubdivisionGuideCloser when subdivision has kVoteRatio times leaf's votes
-    // (docs/IMPORT.md, "Complexity and speed": the margin to the corpus's surface models).
+    // The leaf-midpoint way's revealed midpoints (known for certain; below level 0) as a vote between
+    // the guides, each for the guide that puts it nearer; decided at the first level with kMinVotes
+    // in all, or at the first misfit: SubdivisionGuideCloser when subdivision has kVoteRatio times
+    // leaf's votes (docs/IMPORT.md, "Complexity and speed": the margin to the corpus's surface models).
     void vote_on_guides();
+    void decide_guides();
     static constexpr uint64_t kMinVotes = 16;
     static constexpr uint64_t kVoteRatio = 2;
     bool vote_on_guides_;
-    int vote_level_ = 0;
     uint64_t votes_leaf_ = 0, votes_subdivision_ = 0;
 
     Hierarchy& h_;
