@@ -4,6 +4,7 @@
 // of percent (docs/BENCHMARKS.md, "One-core complete decode, tenth step").
 //
 //   decode_ab A.so B.so ROUNDS file.amc ...
+//   decode_ab A.so B.so ROUNDS a.amc=b.amc ...   (a format change: A decodes a.amc, B b.amc)
 //
 // A.so and B.so are the two builds' libraries as shared objects: a build configured with
 // -DBUILD_SHARED_LIBS=ON, or a static build's libamcodec.a made one by
@@ -24,6 +25,7 @@
 #include <ctime>
 #include <fstream>
 #include <iterator>
+#include <string>
 #include <vector>
 
 namespace {
@@ -67,20 +69,26 @@ int main(int argc, char** argv) {
     amc::DecodeOptions options;
     options.threads = 1;
     for (int a = 4; a < argc; ++a) {
-        std::ifstream in(argv[a], std::ios::binary);
-        const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-        if (!in && !in.eof()) {
-            std::fprintf(stderr, "decode_ab: can not read %s\n", argv[a]);
-            return 1;
+        const std::string arg = argv[a];
+        const size_t split = arg.find('=');
+        const std::string path[2] = {arg.substr(0, split), split == std::string::npos ? arg : arg.substr(split + 1)};
+        std::vector<uint8_t> file[2];
+        for (int k = 0; k < 2; ++k) {
+            std::ifstream in(path[k], std::ios::binary);
+            file[k].assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+            if (!in && !in.eof()) {
+                std::fprintf(stderr, "decode_ab: can not read %s\n", path[k].c_str());
+                return 1;
+            }
         }
-        for (int k = 0; k < 2; ++k) decode[k](bytes.data(), bytes.size(), options, nullptr);
+        for (int k = 0; k < 2; ++k) decode[k](file[k].data(), file[k].size(), options, nullptr);
         std::vector<double> ms[2], ratio;
         for (int r = 0; r < rounds; ++r) {
             double seconds[2];
             for (int j = 0; j < 2; ++j) {
                 const int k = (r + j) % 2;
                 const double start = thread_seconds();
-                { const amc::Hierarchy h = decode[k](bytes.data(), bytes.size(), options, nullptr); }
+                { const amc::Hierarchy h = decode[k](file[k].data(), file[k].size(), options, nullptr); }
                 seconds[k] = thread_seconds() - start;
                 ms[k].push_back(1e3 * seconds[k]);
             }

@@ -3,6 +3,7 @@
 // makes, the size it saves where the surface is flat at the grid's scale, and the errors a decoder
 // reports for a mode-4 block where the format does not allow one.
 #include "hierarchy_checks.h"
+#include "level_block_rewrite.h"
 
 #include "coding/container.h"
 #include "coding/format_version.h"
@@ -32,20 +33,13 @@ std::string decode_error(const std::vector<uint8_t>& bytes) {
 // The file's blocks rewritten with `version` (checksums made anew), the first level block's
 // predictor byte set to `predictor`.
 std::vector<uint8_t> with_first_predictor(const std::vector<uint8_t>& bytes, uint8_t version, uint8_t predictor) {
-    BlockReader reader(bytes.data(), bytes.size());
-    BlockWriter writer(version, reader.flags());
-    Block block;
     bool first = true;
-    while (reader.next(block)) {
-        if (block.type == BlockType::end) break;
-        std::vector<uint8_t> payload(block.payload, block.payload + block.size);
-        if (block.type == BlockType::level && first && !payload.empty()) {
+    return testing::rewritten(bytes, version, bytes[5], [&](std::vector<uint8_t>& payload) {
+        if (first && !payload.empty()) {
             payload[0] = predictor;
             first = false;
         }
-        writer.add(block.type, payload);
-    }
-    return writer.finish();
+    });
 }
 
 TEST(GridGeometry, RoundTripsOnEveryGridAsModeThreeDoes) {
@@ -166,7 +160,8 @@ TEST(GridGeometry, EncoderRefusesItWithoutAGrid) {
     EncodeStats stats;
     const std::vector<uint8_t> bytes = encode(h, automatic, &stats);
     EXPECT_FALSE(uses(stats, GeometryPredictor::normal_frame_grid));
-    EXPECT_TRUE(bytes[4] < kGridGeometryVersion || bytes[4] == kRawSideVersion);  // 14: adaptive levels' raw side streams
+    // 14: adaptive levels' raw side streams; 21: the base's too.
+    EXPECT_TRUE(bytes[4] < kGridGeometryVersion || bytes[4] == kRawSideVersion || bytes[4] == kBaseRawSideVersion);
 }
 
 // Grid contexts are the encoder's default for quantized files (the automatic choice tries mode 4

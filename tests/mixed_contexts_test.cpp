@@ -135,10 +135,11 @@ TEST(MixedContexts, RandomHierarchiesRoundTripBitExactlyUnderEverySwitch) {
         options.predictor = GeometryPredictor(random.next() % 4);
         const std::vector<uint8_t> bytes = encode(h, options);
         // The seventh model's version, or an older model's where it codes smaller (14 where a
-        // bit-exact level is adaptive, its raw bits in a side stream).
+        // bit-exact level is adaptive, its raw bits in a side stream; 21 where the seventh model's
+        // bit-exact base has its raw bits in one).
         ASSERT_TRUE(bytes[4] == kSeventhMixingVersion || bytes[4] == kSixthMixingVersion || bytes[4] == kFifthMixingVersion ||
                     bytes[4] == kFourthMixingVersion || bytes[4] == kThirdMixingVersion ||
-                    (options.quantize_bits == 0 && bytes[4] == kRawSideVersion))
+                    (options.quantize_bits == 0 && (bytes[4] == kRawSideVersion || bytes[4] == kBaseRawSideVersion)))
             << trial;
         const Hierarchy back = decode(bytes.data(), bytes.size());
         Hierarchy expected = in_decoder_order(h, options);
@@ -174,7 +175,8 @@ TEST(MixedContexts, SmallerThanThePapersContextsOnACurvedRemesh) {
     EncodeOptions paper_options;
     paper_options.unit_normals = false;
     std::vector<uint8_t> plain = encode(h, paper_options);
-    EXPECT_TRUE(plain[4] < kMixedContextsVersion || plain[4] == kRawSideVersion);  // 14: adaptive levels' raw side streams
+    // 14: adaptive levels' raw side streams; 21: the base's too.
+    EXPECT_TRUE(plain[4] < kMixedContextsVersion || plain[4] == kRawSideVersion || plain[4] == kBaseRawSideVersion);
 }
 
 // The coded symbols' code length under `model` (the hierarchy's own features, as the encoder

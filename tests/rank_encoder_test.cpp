@@ -133,14 +133,15 @@ TEST(RankEncoder, RanksWriteTheSerialEncodersQuantizedBytes) {
     EXPECT_EQ(bytes, encode(sphere, serial_options(options, counts)));
 }
 
-// Bit-exact chunks in geometry mode 5 (FORMAT.md 5.8): the ranks' file is version 13 (chunks), as the serial one.
+// Bit-exact chunks in geometry mode 5 (FORMAT.md 5.8): the ranks' file is version 21 (chunks, the
+// base's and the seam's raw bits in side streams), as the serial one.
 TEST(RankEncoder, RanksWriteTheSerialEncodersUnitFrameBytes) {
     const Hierarchy sphere = projected_sphere(20000, 7, 5);
     EncodeOptions options;
     options.predictor = GeometryPredictor::unit_normal_frame;
     const std::vector<uint32_t> counts{7, 6, 7};
     const std::vector<uint8_t> bytes = write_by_ranks(sphere.base(), ranks_of(sphere, counts, 1), options);
-    EXPECT_EQ(bytes[4], kChunkVerticesVersion);
+    EXPECT_EQ(bytes[4], kBaseRawSideVersion);
     EXPECT_EQ(bytes, encode(sphere, serial_options(options, counts)));
     const Hierarchy back = decode(bytes.data(), bytes.size());
     EXPECT_TRUE(identical(back, sphere));

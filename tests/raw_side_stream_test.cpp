@@ -2,7 +2,8 @@
 // bit-exact files carry their coordinates' raw bits in a side stream after the arithmetic code,
 // flagged by bit 7 of the predictor byte. Round trips, the version it makes and where it is not
 // made, the size against the same symbols in the arithmetic code, and the errors a decoder reports
-// for a flag where the format has none and for a side stream cut short or overlong.
+// for a flag where the format has none and for a side stream cut short or overlong. Such files are
+// version 21 now (their bases' raw bits in a side stream too: base_raw_side_test.cpp).
 #include "hierarchy_checks.h"
 #include "level_block_rewrite.h"
 
@@ -33,12 +34,14 @@ TEST(RawSideStream, BitExactAdaptiveLevelsRoundTripAsVersion14) {
             EncodeOptions options;
             options.predictor = p;
             const std::vector<uint8_t> bytes = encode(h, options);
-            ASSERT_EQ(bytes[4], kRawSideVersion);
+            ASSERT_EQ(bytes[4], kBaseRawSideVersion);
             EXPECT_TRUE(identical(decode(bytes.data(), bytes.size()), in_decoder_order(h, options)));
+            const std::vector<uint8_t> as14 = rewritten(bytes, kRawSideVersion, bytes[5], [](std::vector<uint8_t>&) {});
+            EXPECT_TRUE(identical(decode(as14.data(), as14.size()), in_decoder_order(h, options)));
             // In chunks too (a version-14 file holds chunks as version 13 does).
             options.chunks = 3;
             const std::vector<uint8_t> chunked = encode(h, options);
-            ASSERT_EQ(chunked[4], kRawSideVersion);
+            ASSERT_EQ(chunked[4], kBaseRawSideVersion);
             EXPECT_EQ(inspect(chunked.data(), chunked.size()).chunks.size(), 3u);
             EXPECT_TRUE(identical(decode(chunked.data(), chunked.size()), decode(bytes.data(), bytes.size())));
         }
@@ -53,7 +56,13 @@ TEST(RawSideStream, QuantizedFilesAndStaticModesKeepTheirVersions) {
     EXPECT_LT(encode(h, quantized)[4], kRawSideVersion);
     EncodeOptions unit;
     unit.predictor = GeometryPredictor::unit_normal_frame;  // the last level (no vertices) stays unflagged
-    EXPECT_EQ(encode(h, unit)[4], kUnitFrameVersion);
+    const std::vector<uint8_t> bytes = encode(h, unit);
+    EXPECT_EQ(bytes[4], kBaseRawSideVersion);  // the base's raw bits: version 12 as it was before
+    BlockReader reader(bytes.data(), bytes.size());
+    Block block;
+    while (reader.next(block)) {
+        if (block.type == BlockType::level) EXPECT_EQ(block.payload[0] & 0x80, 0);
+    }
 }
 
 // The same symbols as the arithmetic coder's raw bits: the side stream costs its varint and
@@ -96,10 +105,11 @@ TEST(RawSideStream, DecoderRefusesTheFlagWhereTheFormatHasNoneAndBadSideStreams)
     EncodeOptions butterfly;
     butterfly.predictor = GeometryPredictor::butterfly;
     const std::vector<uint8_t> bytes = encode(h, butterfly);
-    ASSERT_EQ(bytes[4], kRawSideVersion);
+    ASSERT_EQ(bytes[4], kBaseRawSideVersion);
     const uint8_t flags = bytes[5];
     auto same = [](std::vector<uint8_t>&) {};
     EXPECT_EQ(decode_error(rewritten(bytes, kRawSideVersion, flags, same)), "");
+    EXPECT_EQ(decode_error(rewritten(bytes, kBaseRawSideVersion, flags, same)), "");
     // Version 13 and older have no flag.
     EXPECT_NE(decode_error(rewritten(bytes, kChunkVerticesVersion, flags, same)).find("bad predictor"), std::string::npos);
     // Not on a static mode's predictor, nor in a quantized file.

@@ -41,7 +41,7 @@ TEST(StencilTables, ForcedModesRoundTripAsVersion15) {
             options.predictor = p;
             EncodeStats stats;
             const std::vector<uint8_t> bytes = encode(h, options, &stats);
-            ASSERT_EQ(bytes[4], kStencilTablesVersion);
+            ASSERT_EQ(bytes[4], kBaseRawSideVersion);  // 15 with the base's raw bits in a side stream
             EXPECT_TRUE(uses(stats, p));
             const Hierarchy back = decode(bytes.data(), bytes.size());
             EXPECT_TRUE(identical(back, in_decoder_order(h, options)));
@@ -54,7 +54,7 @@ TEST(StencilTables, ForcedModesRoundTripAsVersion15) {
             // In chunks too (a version-15 file holds chunks as version 13 does), on 1 and 2 threads.
             options.chunks = 3;
             const std::vector<uint8_t> chunked = encode(h, options);
-            ASSERT_EQ(chunked[4], kStencilTablesVersion);
+            ASSERT_EQ(chunked[4], kBaseRawSideVersion);
             EXPECT_EQ(inspect(chunked.data(), chunked.size()).chunks.size(), 3u);
             for (unsigned threads : {1u, 2u}) {
                 DecodeOptions on;
@@ -99,7 +99,7 @@ TEST(StencilTables, AutomaticChoiceTakesThemWhereSmallest) {
     const Hierarchy h = bumpy_torus(false, 6000, 5);
     EncodeStats stats;
     const std::vector<uint8_t> bytes = encode(h, {}, &stats);
-    ASSERT_EQ(bytes[4], kStencilTablesVersion);
+    ASSERT_EQ(bytes[4], kBaseRawSideVersion);  // 15 with the base's raw bits in a side stream
     EXPECT_TRUE(uses(stats, GeometryPredictor::midpoint_static) || uses(stats, GeometryPredictor::butterfly_static));
     EXPECT_TRUE(identical(decode(bytes.data(), bytes.size()), in_decoder_order(h, {})));
     for (GeometryPredictor p : {GeometryPredictor::midpoint, GeometryPredictor::butterfly}) {
@@ -155,7 +155,7 @@ TEST(StencilTables, DecoderRefusesThemWhereTheFormatHasNoneAndCutStreams) {
     EncodeOptions options;
     options.predictor = GeometryPredictor::butterfly_static;
     const std::vector<uint8_t> bytes = encode(h, options);
-    ASSERT_EQ(bytes[4], kStencilTablesVersion);
+    ASSERT_EQ(bytes[4], kBaseRawSideVersion);  // 15 with the base's raw bits in a side stream (rewritten() makes it 15)
     auto same = [](std::vector<uint8_t>&) {};
     EXPECT_EQ(decode_error(rewritten(bytes, kStencilTablesVersion, bytes[5], same)), "");
     // Version 14 and older have no predictors 6 and 7, nor a side-stream flag on them.

@@ -3,6 +3,7 @@
 // remesh (whose new vertices lie on that frame's line), the version it makes, the option that keeps
 // version 11's choices, and the errors a decoder reports for a mode-5 block where the format has none.
 #include "hierarchy_checks.h"
+#include "level_block_rewrite.h"
 
 #include "coding/container.h"
 #include "coding/format_version.h"
@@ -31,16 +32,9 @@ std::string decode_error(const std::vector<uint8_t>& bytes) {
 // The file's blocks rewritten with `version` (checksums made anew), every level block's predictor
 // byte that is `from` set to `to`.
 std::vector<uint8_t> with_predictors(const std::vector<uint8_t>& bytes, uint8_t version, uint8_t from, uint8_t to) {
-    BlockReader reader(bytes.data(), bytes.size());
-    BlockWriter writer(version, reader.flags());
-    Block block;
-    while (reader.next(block)) {
-        if (block.type == BlockType::end) break;
-        std::vector<uint8_t> payload(block.payload, block.payload + block.size);
-        if (block.type == BlockType::level && !payload.empty() && payload[0] == from) payload[0] = to;
-        writer.add(block.type, payload);
-    }
-    return writer.finish();
+    return testing::rewritten(bytes, version, bytes[5], [&](std::vector<uint8_t>& payload) {
+        if (!payload.empty() && payload[0] == from) payload[0] = to;
+    });
 }
 
 // A small adaptive remesh of the bumpy sphere (new vertices placed along the summed unit normals).
@@ -61,7 +55,7 @@ TEST(UnitFrameGeometry, RoundTripsBitExactInBothPrecisionsAndOnAGrid) {
         forced.predictor = GeometryPredictor::unit_normal_frame;
         EncodeStats stats;
         const std::vector<uint8_t> bytes = encode(h, forced, &stats);
-        EXPECT_EQ(bytes[4], kUnitFrameVersion);
+        EXPECT_EQ(bytes[4], kBaseRawSideVersion);  // 12 with the base's raw bits in a side stream
         EXPECT_TRUE(uses(stats, GeometryPredictor::unit_normal_frame));
         EXPECT_TRUE(identical(decode(bytes.data(), bytes.size()), in_decoder_order(h, forced)));
     }
@@ -107,9 +101,9 @@ TEST(UnitFrameGeometry, AutomaticChoiceAndTheOptionThatKeepsTheOldChoices) {
     const std::vector<uint8_t> bytes = encode(h, defaults, &stats);
     const std::vector<uint8_t> old_bytes = encode(h, old, &old_stats);
     EXPECT_TRUE(uses(stats, GeometryPredictor::unit_normal_frame));
-    EXPECT_EQ(bytes[4], kUnitFrameVersion);
+    EXPECT_EQ(bytes[4], kBaseRawSideVersion);  // 12 with the base's raw bits in a side stream
     EXPECT_FALSE(uses(old_stats, GeometryPredictor::unit_normal_frame));
-    EXPECT_LT(old_bytes[4], kUnitFrameVersion);
+    EXPECT_EQ(old_bytes[4], kBaseRawSideVersion);  // before version 21: below 12
     EXPECT_LT(bytes.size(), old_bytes.size());
     EXPECT_TRUE(identical(decode(bytes.data(), bytes.size()), decode(old_bytes.data(), old_bytes.size())));
     EncodeOptions quantized;
@@ -119,12 +113,13 @@ TEST(UnitFrameGeometry, AutomaticChoiceAndTheOptionThatKeepsTheOldChoices) {
     EXPECT_TRUE(quantized_version < kUnitFrameVersion || quantized_version == kGroupedGridVersion)  // 18: mode 4's levels
         << int(quantized_version);
     EXPECT_FALSE(uses(q, GeometryPredictor::unit_normal_frame));
-    // Chunked files carry it too (version 13: chunks, whatever their geometry modes).
+    // Chunked files carry it too (version 13: chunks, whatever their geometry modes; 21 with the
+    // base's and the seam's raw bits in side streams).
     EncodeOptions chunked;
     chunked.chunks = 3;
     EncodeStats c;
     const std::vector<uint8_t> chunked_bytes = encode(h, chunked, &c);
-    EXPECT_EQ(chunked_bytes[4], kChunkVerticesVersion);
+    EXPECT_EQ(chunked_bytes[4], kBaseRawSideVersion);
     EXPECT_EQ(inspect(chunked_bytes.data(), chunked_bytes.size()).chunks.size(), 3u);
     EXPECT_TRUE(identical(decode(chunked_bytes.data(), chunked_bytes.size()), decode(bytes.data(), bytes.size())));
 }
@@ -134,7 +129,7 @@ TEST(UnitFrameGeometry, DecoderRefusesModeFiveWhereTheFormatHasNone) {
     EncodeOptions forced;
     forced.predictor = GeometryPredictor::unit_normal_frame;
     const std::vector<uint8_t> bytes = encode(h, forced);
-    ASSERT_EQ(bytes[4], kUnitFrameVersion);
+    ASSERT_EQ(bytes[4], kBaseRawSideVersion);  // with_predictors() rewrites it as older versions
     EXPECT_EQ(decode_error(with_predictors(bytes, kUnitFrameVersion, 5, 5)), "");
     // Version 11 and older have no predictor 5.
     EXPECT_NE(decode_error(with_predictors(bytes, kThirdMixingVersion, 5, 5)).find("bad predictor"), std::string::npos);

@@ -29,9 +29,12 @@ namespace amc {
 // not in the mixing mode (chunked or not): mode 4's tokens in the grouped order (FORMAT.md 5.7);
 // mixed files keep the per-vertex order (versions 9-17 and 19). Version 19 for files in the mixing
 // mode's sixth model (FORMAT.md 2.6); 17 keeps the fifth. Version 20 for files in its seventh model
-// (FORMAT.md 2.7: the sixth with trained initial states), which encoders write since.
+// (FORMAT.md 2.7: the sixth with trained initial states), which encoders write since. Version 21
+// for bit-exact files whose base positions (or seam vertices) have raw bits: they go to a side
+// stream after the base geometry block's (the seam block's) arithmetic code; mixed files of
+// version 21 are in the seventh model, and an older model keeps its version and the old layout.
 constexpr uint8_t kOldestReadableVersion = 1;
-constexpr uint8_t kNewestVersion = 20;
+constexpr uint8_t kNewestVersion = 21;
 constexpr uint8_t kBaseVersion = 2;       // everything but the numbering block and mode 2
 constexpr uint8_t kNumberingVersion = 3;  // the first version with a numbering block
 constexpr uint8_t kAngleBaseVersion = 4;  // the first version with base connectivity mode 2
@@ -69,9 +72,18 @@ constexpr uint8_t kSixthMixingVersion = 19;
 // The first version whose mixing mode is the seventh model (the sixth whose geometric tables start
 // at trained states, FORMAT.md 2.7); its level blocks are version 17's too.
 constexpr uint8_t kSeventhMixingVersion = 20;
+// The first version whose bit-exact files carry the raw bits of the base positions and of the seam
+// vertices in a byte-aligned side stream after the arithmetic code of the base geometry block and of
+// the seam block (FORMAT.md 3.5, 3.13); bit-exact files only (a quantized version-21 file is an
+// error), everything else as in version 20 (mixed files: the seventh model).
+constexpr uint8_t kBaseRawSideVersion = 21;
+
+// Whether a file's base geometry and seam blocks have the side stream: bit-exact, version 21 on.
+constexpr bool base_raw_side(uint8_t file_version, bool quantized) { return file_version >= kBaseRawSideVersion && !quantized; }
 
 // Whether a file of `file_version` codes mode 4's tokens in the grouped order: version 18, whose
-// files are never mixed; the mixing mode's files keep the per-vertex order (versions 9-17, 19, 20).
+// files are never mixed; the mixing mode's files keep the per-vertex order (versions 9-17, 19, 20;
+// version 21 holds no mode 4: its files are bit-exact).
 constexpr bool grouped_grid_order(uint8_t file_version) {
     return file_version >= kGroupedGridVersion && file_version != kSixthMixingVersion && file_version != kSeventhMixingVersion;
 }
@@ -79,9 +91,11 @@ constexpr bool grouped_grid_order(uint8_t file_version) {
 // The lowest version a file's newest features need, 0 if it has none of them (older features then
 // decide): the one rule for encode()'s files and the chunked file head the MPI ranks write.
 // `grouped_grid`: a mode-4 level in the grouped order (only quantized files have one; stencil
-// tables and raw side streams only bit-exact ones).
-constexpr uint8_t newest_features_version(bool grouped_grid, bool stencil_tables, bool raw_side, bool chunked) {
-    return grouped_grid     ? kGroupedGridVersion
+// tables and raw side streams only bit-exact ones). `base_side`: the base's (and seam's) raw bits in
+// side streams.
+constexpr uint8_t newest_features_version(bool grouped_grid, bool stencil_tables, bool raw_side, bool chunked, bool base_side) {
+    return base_side        ? kBaseRawSideVersion
+           : grouped_grid   ? kGroupedGridVersion
            : stencil_tables ? kStencilTablesVersion
            : raw_side       ? kRawSideVersion
            : chunked        ? kChunkVerticesVersion
@@ -119,6 +133,7 @@ constexpr uint8_t hierarchy_stream_version_of_file(uint8_t file_version) {
         case 18: return 2;
         case 19: return 2;
         case 20: return 2;
+        case 21: return 2;
     }
     return 0;
 }

@@ -137,13 +137,14 @@ uint8_t first_version_of(MixingModel model) {
 }
 
 // The lowest version that holds what the file holds (format_version.h).
-// `mixing`: the mixing mode's model; the seventh only in version 20, the sixth only in 19, the fifth
+// `mixing`: the mixing mode's model; the seventh only in versions 20 and 21, the sixth only in 19, the fifth
 // only in 17, the fourth only in 16 (never chunked; they hold every geometry mode); the third is in versions 11-15.
+// `base_side`: the base's (and seam's) raw bits in side streams, only with the seventh model when mixed.
 uint8_t file_version(bool stencil_tables, bool raw_side, bool unit_geometry, bool grid_geometry, bool mixed_contexts, MixingModel mixing,
-                     bool chunked, bool static_geometry, BaseConnectivityMode base_mode, bool store_numbering) {
-    if (mixed_contexts && mixing >= MixingModel::fourth) return first_version_of(mixing);
+                     bool chunked, bool static_geometry, BaseConnectivityMode base_mode, bool store_numbering, bool base_side) {
+    if (mixed_contexts && mixing >= MixingModel::fourth) return base_side ? kBaseRawSideVersion : first_version_of(mixing);
     // Mixed files keep mode 4's per-vertex order (code_forest): only the others hold the grouped one.
-    if (const uint8_t newest = newest_features_version(grid_geometry && !mixed_contexts, stencil_tables, raw_side, chunked))
+    if (const uint8_t newest = newest_features_version(grid_geometry && !mixed_contexts, stencil_tables, raw_side, chunked, base_side))
         return newest;
     return unit_geometry                                 ? kUnitFrameVersion
            : mixed_contexts                              ? kThirdMixingVersion
@@ -197,6 +198,7 @@ struct ForestCode {
     std::vector<std::pair<BlockType, std::vector<uint8_t>>> blocks;
     uint64_t bytes = 0;  // of the blocks, framing included
     bool chunked = false, static_geometry = false, grid_geometry = false, unit_geometry = false, raw_side = false, stencil_tables = false;
+    bool base_side = false;  // chunked: the seam's and the base's raw bits in side streams (version 21)
     MixingModel mixing = MixingModel::third;  // the mixing mode's model (when the file is mixed)
     uint64_t faces = 0, levels = 0;          // the metadata's
     std::vector<uint8_t> hierarchy_header;  // the metadata's (none with chunks)
@@ -211,16 +213,19 @@ struct ForestCode {
 // its written model, and also in each model of `older` into its ForestCode: the same first pass
 // and the same geometry (which does not depend on the hierarchy's model; each level's chosen
 // once), the hierarchy parts in the models' own arithmetic codes. One chunk is coded in `memory`.
+// `base_raw_bits`: the base geometry has raw bits for a side stream (encode_chunked).
 ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<uint64_t>& root_nodes,
                        const std::vector<RootRange>& chunks, uint64_t faces,
-                       const EncodeOptions& options, CoordinateSpace space, PositionCoder positions, unsigned threads,
+                       const EncodeOptions& options, CoordinateSpace space, PositionCoder positions, bool base_raw_bits, unsigned threads,
                        bool want_hierarchy_stats, HierarchyLevelEncoder* first_pass, const HierarchyOnGrid* on_grid,
                        const std::vector<std::pair<MixingModel, ForestCode*>>& older = {}, EncodeMemory memory = {}) {
     ForestCode out;
     const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
     out.chunked = !mixed && chunks.size() > 1;
     if (out.chunked) {
-        ChunkedBlocks parts = encode_chunked(h, root_of, root_nodes, chunks, options, space, threads, out.stats, memory.chunks);
+        ChunkedBlocks parts = encode_chunked(h, root_of, root_nodes, chunks, options, space, threads, out.stats, base_raw_bits,
+                                             memory.chunks);
+        out.base_side = parts.base_side;
         out.static_geometry = parts.static_geometry;
         out.grid_geometry = parts.grid_geometry;
         out.unit_geometry = parts.unit_geometry;
@@ -380,8 +385,21 @@ std::vector<uint8_t> encode_file(const Hierarchy& input, const EncodeOptions& op
     // The forest (FORMAT.md 3.6, 3.11), after the base geometry, whose adaptive models the level
     // blocks go on with. Chunks the caller leaves to the encoder are tried first at chunk_faces
     // faces each, then fewer if that code is too small for them (chunk_policy.h).
+    // Bit-exact: the raw bits apart (version 21) unless the file ends up without any or in an older
+    // mixing model (below); they are the same symbols either way, so `positions` is the same.
     PositionCoder positions(space);
-    std::vector<uint8_t> base_geometry = encode_base_geometry(reordered.hierarchy, base_code, reordered.keep_rotations, positions);
+    const RawSideCode base_geometry = encode_base_geometry(reordered.hierarchy, base_code, reordered.keep_rotations, positions, !quantized);
+    const bool base_raw_bits = !base_geometry.raw.empty();
+    // The base geometry block of the versions before 21: its raw bits in the arithmetic code.
+    std::vector<uint8_t> base_inline;
+    auto inline_base = [&]() -> const std::vector<uint8_t>& {
+        if (!base_raw_bits) return base_geometry.arithmetic;
+        if (base_inline.empty()) {
+            PositionCoder again(space);
+            base_inline = encode_base_geometry(reordered.hierarchy, base_code, reordered.keep_rotations, again, false).arithmetic;
+        }
+        return base_inline;
+    };
     const std::vector<uint32_t> root_of = one_chunk ? std::vector<uint32_t>() : root_of_nodes(h);
     const std::vector<uint64_t> root_nodes = one_chunk ? std::vector<uint64_t>() : nodes_per_root(h, root_of);
     const std::vector<RootRange> chunks = !options.chunk_roots.empty() ? explicit_chunks(options.chunk_roots, h.root_count())
@@ -395,18 +413,26 @@ std::vector<uint8_t> encode_file(const Hierarchy& input, const EncodeOptions& op
                                                                   {MixingModel::fourth, &fourth},
                                                                   {MixingModel::third, &third}}
               : std::vector<std::pair<MixingModel, ForestCode*>>{};
-    ForestCode forest = code_forest(h, root_of, root_nodes, chunks, faces, options, space, positions, threads, want_hierarchy_stats,
-                                    first_pass.get(), turned_input && quantized ? &on_grid : nullptr, older, memory);
+    ForestCode forest = code_forest(h, root_of, root_nodes, chunks, faces, options, space, positions, base_raw_bits, threads,
+                                    want_hierarchy_stats, first_pass.get(), turned_input && quantized ? &on_grid : nullptr, older, memory);
     const uint32_t fewer = automatic && forest.chunked ? chunk_count_for_size(options, uint32_t(chunks.size()), forest.bytes)
                                                        : uint32_t(chunks.size());
     if (fewer < chunks.size())
-        forest = code_forest(h, root_of, root_nodes, balanced_chunks(root_nodes, fewer), faces, options, space, positions, threads,
-                             want_hierarchy_stats, nullptr, nullptr, {}, memory);
+        forest = code_forest(h, root_of, root_nodes, balanced_chunks(root_nodes, fewer), faces, options, space, positions,
+                             base_raw_bits, threads, want_hierarchy_stats, nullptr, nullptr, {}, memory);
     // An older model of the mixing mode where it codes the file smaller (small files, whose new
     // tables have little to learn from, or creased ones, by a few bytes): every file at most as
-    // large as each older model's. A tie keeps the newer model.
-    for (const auto& model_and_code : older)
-        if (model_and_code.second->bytes < forest.bytes) forest = std::move(*model_and_code.second);
+    // large as each older model's. A tie keeps the newer model. The seventh model's base block is
+    // version 21's (bit-exact), the older ones' that of their versions.
+    if (!older.empty()) {
+        const uint64_t newest_base = base_raw_bits ? base_geometry.joined().size() : base_geometry.arithmetic.size();
+        uint64_t best = forest.bytes + newest_base;
+        for (const auto& model_and_code : older)
+            if (model_and_code.second->bytes + inline_base().size() < best) {
+                best = model_and_code.second->bytes + inline_base().size();
+                forest = std::move(*model_and_code.second);
+            }
+    }
 
     Metadata meta;
     meta.base_vertices = h.base().positions.size();
@@ -426,8 +452,13 @@ std::vector<uint8_t> encode_file(const Hierarchy& input, const EncodeOptions& op
     stats.header_bytes = kFileHeaderSize + kBlockOverhead + blocks.back().second.size() + forest.stats.header_bytes;
     blocks.emplace_back(BlockType::base_connectivity, base_code.bytes);
     stats.base_connectivity_bytes = base_code.bytes.size();
-    stats.base_geometry_bytes = base_geometry.size();
-    blocks.emplace_back(BlockType::base_geometry, std::move(base_geometry));
+    // Version 21 (bit-exact): the base's raw bits apart when it or the seam has some, with the
+    // seventh mixing model when mixed; an older model's version holds them in the arithmetic code.
+    const bool base_side =
+        forest.chunked ? forest.base_side : base_raw_bits && (!mixed || forest.mixing == mixing_model_of_file(kBaseRawSideVersion));
+    std::vector<uint8_t> base_block = base_side ? base_geometry.joined() : inline_base();
+    stats.base_geometry_bytes = base_block.size();
+    blocks.emplace_back(BlockType::base_geometry, std::move(base_block));
     stats.hierarchy_bytes = forest.stats.hierarchy_bytes;
     stats.geometry_bytes = forest.stats.geometry_bytes;
     stats.framing_bytes = forest.stats.framing_bytes;
@@ -440,7 +471,7 @@ std::vector<uint8_t> encode_file(const Hierarchy& input, const EncodeOptions& op
     }
     BlockWriter writer(file_version(forest.stencil_tables, forest.raw_side, forest.unit_geometry, forest.grid_geometry, mixed, forest.mixing,
                                     forest.chunked, forest.static_geometry,
-                                    base_code.mode, store_numbering),
+                                    base_code.mode, store_numbering, base_side),
                        uint8_t((precision == Precision::float32 ? kFlagSinglePrecision : 0) | (quantized ? kFlagQuantized : 0)));
     for (const auto& block : blocks) writer.add(block.first, block.second);
     std::vector<uint8_t> out = writer.finish();
@@ -559,6 +590,8 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     const bool quantized = reader.flags() & kFlagQuantized;
     const Precision precision = (reader.flags() & kFlagSinglePrecision) ? Precision::float32 : Precision::float64;
     AMC_REQUIRE(!(quantized && precision == Precision::float32), corrupt, "file header: quantized and float32 flags together");
+    AMC_REQUIRE(!(quantized && reader.version() == kBaseRawSideVersion), corrupt,
+                "file header: a quantized file of version " + std::to_string(kBaseRawSideVersion) + " (bit-exact only)");
     Block block{};
     auto expect = [&](BlockType type) {
         AMC_REQUIRE(partial == nullptr || reader.next_block_arrived(), truncated,

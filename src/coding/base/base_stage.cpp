@@ -111,21 +111,24 @@ ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& ba
     return r;
 }
 
-std::vector<uint8_t> encode_base_geometry(const Hierarchy& h, const BaseMeshCode& base_code, bool keep_rotations,
-                                          PositionCoder& positions) {
+RawSideCode encode_base_geometry(const Hierarchy& h, const BaseMeshCode& base_code, bool keep_rotations, PositionCoder& positions,
+                                 bool raw_side) {
     ArithmeticEncoder encoder;
     if (keep_rotations) {
         RotationModels models;
         for (uint8_t r : base_code.triangle_rotation) encode_rotation(encoder, models, r);
     }
+    RawBitWriter raw;
     std::vector<Vec3> decoded;
     const size_t base_vertices = h.base().positions.size();
+    decoded.reserve(base_vertices);
     for (uint32_t i = 0; i < base_vertices; ++i) {
         const Vec3 p = h.position(i);
-        positions.encode(encoder, kBaseGeometryContext, p, predict_parallelogram(decoded, base_code.stencils[i]));
+        positions.encode(encoder, kBaseGeometryContext, p, predict_parallelogram(decoded, base_code.stencils[i]),
+                         raw_side ? &raw : nullptr);
         decoded.push_back(p);
     }
-    return encoder.finish();
+    return RawSideCode{encoder.finish(), raw.finish()};
 }
 
 TriangleMesh decode_base(const Block& connectivity, const Block& geometry, const Metadata& meta, uint8_t file_version,
@@ -140,7 +143,12 @@ TriangleMesh decode_base(const Block& connectivity, const Block& geometry, const
 
     TriangleMesh base;
     base.single_precision = single_precision;
-    ArithmeticDecoder decoder(geometry.payload, geometry.size);
+    // Version 21's bit-exact files: the positions' raw bits after the arithmetic code (FORMAT.md 3.5).
+    const bool side = base_raw_side(file_version, positions.quantized());
+    const RawSideParts parts = side ? split_raw_side(geometry.payload, geometry.size, "base geometry block")
+                                    : RawSideParts{geometry.payload, geometry.size, nullptr, 0};
+    ArithmeticDecoder decoder(parts.arithmetic, parts.arithmetic_size);
+    RawBitReader raw(parts.raw, parts.raw_size);
     std::vector<uint8_t> rotations;
     if (meta.options & kOptionRootRotations) {
         RotationModels models;
@@ -156,7 +164,8 @@ TriangleMesh decode_base(const Block& connectivity, const Block& geometry, const
         connectivity.payload, connectivity.size, uint32_t(meta.base_vertices),
         [&](uint32_t, const BaseStencil& stencil, const std::vector<Vec3>& previous) {
             AMC_REQUIRE(!decoder.overran(), corrupt, "base geometry block is truncated or corrupt");
-            const Vec3 p = positions.decode(decoder, kBaseGeometryContext, predict_parallelogram(previous, stencil));
+            const Vec3 p =
+                positions.decode(decoder, kBaseGeometryContext, predict_parallelogram(previous, stencil), side ? &raw : nullptr);
             AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
                         "base geometry is corrupt (non-finite coordinate)");
             return p;
@@ -165,6 +174,7 @@ TriangleMesh decode_base(const Block& connectivity, const Block& geometry, const
     AMC_REQUIRE(decoded.vertex_count == meta.base_vertices && decoded.triangles.size() == meta.base_triangles, corrupt,
                 "base connectivity does not match the metadata");
     AMC_REQUIRE(!decoder.overran() && !positions.saw_invalid_symbol(), corrupt, "base geometry block is truncated or corrupt");
+    AMC_REQUIRE(!side || raw.ended_cleanly(), corrupt, "base geometry block: raw bits are truncated or left over");
     base.triangles = std::move(decoded.triangles);
     base.positions = std::move(decoded.positions);
     // Undo the base coder's rotations: decoded (o[r], o[r+1], o[r+2]) back to o.

@@ -49,9 +49,11 @@ struct ReorderedInput {
 ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& base_code, bool want_vertex_map,
                                   unsigned threads = 1);
 
-// The base geometry block of h (in base code order, positions as the decoder reconstructs them).
-std::vector<uint8_t> encode_base_geometry(const Hierarchy& h, const BaseMeshCode& base_code, bool keep_rotations,
-                                          PositionCoder& positions);
+// The base geometry block of h (in base code order, positions as the decoder reconstructs them):
+// its arithmetic code, and with `raw_side` (bit-exact coordinates) the positions' raw bits apart
+// (version 21: RawSideCode::joined() is the block), else in the code (the block is `arithmetic`).
+RawSideCode encode_base_geometry(const Hierarchy& h, const BaseMeshCode& base_code, bool keep_rotations, PositionCoder& positions,
+                                 bool raw_side);
 
 // Decodes the base mesh from its two blocks of a file of `file_version`, checked against the
 // metadata; the result is a valid triangle mesh. Throws Error on a corrupt or truncated block.

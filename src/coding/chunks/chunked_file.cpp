@@ -35,7 +35,7 @@ uint64_t leaf_face_count(const Hierarchy& h, unsigned threads) {
 ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<uint64_t>& root_nodes,
                              const std::vector<RootRange>& ranges,
                              const EncodeOptions& options, CoordinateSpace space, unsigned threads, EncodeStats& stats,
-                             ChunkEncoderMemories* kept) {
+                             bool base_raw_bits, ChunkEncoderMemories* kept) {
     std::vector<uint32_t> chunk_of_root(h.root_count());
     for (uint32_t c = 0; c < ranges.size(); ++c)
         for (uint32_t r = ranges[c].first; r < ranges[c].first + ranges[c].count; ++r) chunk_of_root[r] = c;
@@ -87,7 +87,11 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& ro
         own_vertices[c] = uint64_t(std::count(keys.begin(), keys.end(), kNoVertex));  // neither base nor seam vertices
     });
     ChunkedBlocks out;
-    std::vector<uint8_t> seam_bytes = seam.encode(space);
+    // Bit-exact: the seam's raw bits apart when the file has any there or in its base (version 21);
+    // without any, the arithmetic code alone is the block of the older versions.
+    const RawSideCode seam_code = seam.encode(space, space.quantizer == nullptr);
+    out.base_side = space.quantizer == nullptr && (base_raw_bits || !seam_code.raw.empty());
+    std::vector<uint8_t> seam_bytes = out.base_side ? seam_code.joined() : seam_code.arithmetic;
     // Table: count, then per chunk its roots, nodes, own vertices and where its block starts,
     // counted from the end of the table block (so the table's own size does not matter).
     std::vector<uint8_t> table;
@@ -175,7 +179,8 @@ Hierarchy decode_chunked(BlockReader& reader, const ChunkedDecodeInput& input, u
     for (uint32_t c = 0; c < table.roots.size(); ++c)
         for (uint32_t r = table.roots[c].first; r < table.roots[c].first + table.roots[c].count; ++r) chunk_of_root[r] = c;
     const Seam seam = Seam::decode(block.payload, block.size, base, chunk_of_root, input.space,
-                                   input.vertices - base.positions.size());
+                                   input.vertices - base.positions.size(),
+                                   base_raw_side(input.version, input.space.quantizer != nullptr));
     std::vector<uint32_t> chunks;
     if (selected != nullptr) {
         chunks = *selected;

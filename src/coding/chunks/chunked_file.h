@@ -28,6 +28,7 @@ struct ChunkedBlocks {
     bool unit_geometry = false;    // some chunk level uses geometry mode 5
     bool raw_side = false;         // some chunk level has its raw bits in a side stream (version 14)
     bool stencil_tables = false;   // some chunk level uses geometry mode 6 or 7 (version 15)
+    bool base_side = false;        // the seam block (and so the base geometry block) has a raw side stream (version 21)
     int levels = 0;                // of the deepest chunk
 };
 
@@ -35,10 +36,12 @@ struct ChunkedBlocks {
 // on up to `threads` threads; `root_of` is root_of_nodes(h), `root_nodes` nodes_per_root(h,
 // root_of). Adds the hierarchy and geometry bytes and the level statistics (summed over chunks) to
 // `stats`. With `kept` (an EncodeContext's), each thread codes its chunks in one memory of it.
+// `base_raw_bits`: the base geometry block has raw bits for a side stream (a bit-exact file of
+// version 21 then; so too when the seam has some, and then both blocks are in that layout).
 ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<uint64_t>& root_nodes,
                              const std::vector<RootRange>& ranges,
                              const EncodeOptions& options, CoordinateSpace space, unsigned threads, EncodeStats& stats,
-                             ChunkEncoderMemories* kept = nullptr);
+                             bool base_raw_bits, ChunkEncoderMemories* kept = nullptr);
 
 // The chunk table of a file of `version`, read and checked against the base (root counts) and
 // the file's node count.

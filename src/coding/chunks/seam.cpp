@@ -165,28 +165,31 @@ Seam Seam::from_splits(const TriangleMesh& base, const std::vector<uint32_t>& ch
     return seam;
 }
 
-std::vector<uint8_t> Seam::encode(CoordinateSpace space) const {
+RawSideCode Seam::encode(CoordinateSpace space, bool raw_side) const {
     ArithmeticEncoder encoder;
+    RawBitWriter raw;
     SplitModels models;
     PositionCoder positions(space);
     for (const Segment& s : trace_) {
         encoder.encode(s.split, split_model(models, s.level));
         if (s.split)
             positions.encode(encoder, level_context(s.level), positions_[s.vertex],
-                             midpoint_prediction(s.a, s.b, single_precision_));
+                             midpoint_prediction(s.a, s.b, single_precision_), raw_side ? &raw : nullptr);
     }
-    return encoder.finish();
+    return RawSideCode{encoder.finish(), raw.finish()};
 }
 
 Seam Seam::decode(const uint8_t* data, size_t size, const TriangleMesh& base, const std::vector<uint32_t>& chunk_of_root,
-                  CoordinateSpace space, uint64_t max_vertices) {
+                  CoordinateSpace space, uint64_t max_vertices, bool raw_side) {
+    const RawSideParts parts = raw_side ? split_raw_side(data, size, "seam block") : RawSideParts{data, size, nullptr, 0};
     Seam seam;
     seam.base_vertices_ = uint32_t(base.positions.size());
     seam.single_precision_ = base.single_precision;
     // Keys (base vertices, then seam vertices) stay below kNoVertex.
     const uint64_t limit = std::min<uint64_t>({max_vertices, max_decodable_positions(size),
                                                uint64_t(kNoVertex) - 1 - seam.base_vertices_});
-    ArithmeticDecoder decoder(data, size);
+    ArithmeticDecoder decoder(parts.arithmetic, parts.arithmetic_size);
+    RawBitReader raw(parts.raw, parts.raw_size);
     SplitModels models;
     PositionCoder positions(space);
     std::vector<Vec3> key_positions(base.positions);  // by key: base vertices, then seam vertices
@@ -201,7 +204,8 @@ Seam Seam::decode(const uint8_t* data, size_t size, const TriangleMesh& base, co
         AMC_REQUIRE(seam.positions_.size() < limit, corrupt,
                     "seam block holds more vertices than the file's counts or its " + std::to_string(size) + " bytes allow");
         const Vec3 p = positions.decode(decoder, level_context(level),
-                                        midpoint_prediction(key_positions[a], key_positions[b], seam.single_precision_));
+                                        midpoint_prediction(key_positions[a], key_positions[b], seam.single_precision_),
+                                        raw_side ? &raw : nullptr);
         AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
                     "seam block is corrupt (non-finite coordinate)");
         const uint32_t m = seam.base_vertices_ + uint32_t(seam.positions_.size());
@@ -213,6 +217,7 @@ Seam Seam::decode(const uint8_t* data, size_t size, const TriangleMesh& base, co
     };
     for (auto [t, e] : seam_edges(base, chunk_of_root)) walk(walk, base.triangles[t][e], base.triangles[t][(e + 1) % 3], 0);
     AMC_REQUIRE(!decoder.overran() && !positions.saw_invalid_symbol(), corrupt, "seam block is truncated or corrupt");
+    AMC_REQUIRE(!raw_side || raw.ended_cleanly(), corrupt, "seam block: raw bits are truncated or left over");
     return seam;
 }
 

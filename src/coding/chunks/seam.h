@@ -10,6 +10,7 @@
 #pragma once
 
 #include "coding/geometry/float_coder.h"  // CoordinateSpace
+#include "coding/geometry/position_coder.h"  // RawSideCode
 
 #include <amc/hierarchy.h>
 
@@ -45,12 +46,15 @@ public:
     // The same seam from the splits of every side, in any order (a split made by both sides may be
     // listed twice). Throws Error (invalid_input) when two give one vertex different positions.
     static Seam from_splits(const TriangleMesh& base, const std::vector<uint32_t>& chunk_of_root, std::vector<SeamSplit> splits);
-    // The seam block's payload (FORMAT.md 3.13).
-    std::vector<uint8_t> encode(CoordinateSpace space) const;
-    // Reads a seam block. `max_vertices` bounds the seam vertices (the file's refinement vertices);
-    // the block's size bounds them too. Throws Error on a corrupt block.
+    // The seam block's payload (FORMAT.md 3.13): its arithmetic code, and with `raw_side` (bit-exact
+    // coordinates) the positions' raw bits apart (version 21: RawSideCode::joined() is the block),
+    // else in the code (the block is `arithmetic`).
+    RawSideCode encode(CoordinateSpace space, bool raw_side) const;
+    // Reads a seam block, with its raw bits in a side stream when `raw_side` (base_raw_side()).
+    // `max_vertices` bounds the seam vertices (the file's refinement vertices); the block's size
+    // bounds them too. Throws Error on a corrupt block.
     static Seam decode(const uint8_t* data, size_t size, const TriangleMesh& base, const std::vector<uint32_t>& chunk_of_root,
-                       CoordinateSpace space, uint64_t max_vertices);
+                       CoordinateSpace space, uint64_t max_vertices, bool raw_side);
 
     uint32_t base_vertex_count() const { return base_vertices_; }
     uint32_t vertex_count() const { return uint32_t(positions_.size()); }

@@ -232,8 +232,14 @@ std::vector<uint8_t> chunked_file_head(const TriangleMesh& base, const Seam& sea
     }
     meta.options = kOptionChunked;
     if (grid != nullptr) meta.quantizer = *grid;
+    // Bit-exact: the base's and the seam's raw bits apart when either has some (version 21), as
+    // encode() writes them.
+    const bool exact = grid == nullptr;
     PositionCoder positions(space);
-    std::vector<uint8_t> seam_bytes = seam.encode(space);
+    const RawSideCode base_geometry = encode_base_geometry(roots, base_code, false, positions, exact);
+    const RawSideCode seam_code = seam.encode(space, exact);
+    const bool base_side = exact && (!base_geometry.raw.empty() || !seam_code.raw.empty());
+    const std::vector<uint8_t> seam_bytes = base_side ? seam_code.joined() : seam_code.arithmetic;
     std::vector<uint8_t> table;
     put_varint(table, chunks.size());
     uint64_t offset = kBlockOverhead + seam_bytes.size();
@@ -250,10 +256,10 @@ std::vector<uint8_t> chunked_file_head(const TriangleMesh& base, const Seam& sea
         stencil_tables |= c.stencil_tables != 0;
         grid_geometry |= c.grid_geometry != 0;  // chunks code mode 4 in the grouped order
     }
-    BlockWriter writer(newest_features_version(grid_geometry, stencil_tables, raw_side, true), grid != nullptr ? kFlagQuantized : base.single_precision ? kFlagSinglePrecision : 0);
+    BlockWriter writer(newest_features_version(grid_geometry, stencil_tables, raw_side, true, base_side), grid != nullptr ? kFlagQuantized : base.single_precision ? kFlagSinglePrecision : 0);
     writer.add(BlockType::metadata, write_metadata(meta, grid != nullptr));
     writer.add(BlockType::base_connectivity, base_code.bytes);
-    writer.add(BlockType::base_geometry, encode_base_geometry(roots, base_code, false, positions));
+    writer.add(BlockType::base_geometry, base_side ? base_geometry.joined() : base_geometry.arithmetic);
     writer.add(BlockType::chunk_table, table);
     writer.add(BlockType::seam, seam_bytes);
     std::vector<uint8_t> out = writer.finish();

@@ -3,10 +3,15 @@
 // Base vertices and each level's new vertices code under contexts of their own.
 #pragma once
 
+#include "coding/container.h"
 #include "coding/entropy/arithmetic_coder.h"
+#include "coding/entropy/rans_coder.h"
 #include "coding/geometry/float_coder.h"
+#include "common/check.h"
 
 #include <algorithm>
+#include <string>
+#include <vector>
 
 namespace amc {
 
@@ -57,5 +62,38 @@ private:
     Quantizer quantizer_;
     FloatResidualModels models_;
 };
+
+// An arithmetic code whose coordinates' raw bits went to a side stream, written as [varint A, the A
+// bytes of the code, the raw bits' bytes]: an adaptive level block after its predictor byte (version
+// 14), the base geometry block and the seam block of a bit-exact file (version 21; FORMAT.md 3.5,
+// 3.6, 3.13).
+struct RawSideCode {
+    std::vector<uint8_t> arithmetic, raw;
+    std::vector<uint8_t> joined() const {
+        std::vector<uint8_t> out;
+        put_varint(out, arithmetic.size());
+        out.insert(out.end(), arithmetic.begin(), arithmetic.end());
+        out.insert(out.end(), raw.begin(), raw.end());
+        return out;
+    }
+};
+// The two parts of such a payload. Throws Error (corrupt) when A passes the payload's end.
+struct RawSideParts {
+    const uint8_t* arithmetic = nullptr;
+    size_t arithmetic_size = 0;
+    const uint8_t* raw = nullptr;
+    size_t raw_size = 0;
+};
+inline RawSideParts split_raw_side(const uint8_t* payload, size_t size, const char* what) {
+    PayloadReader in(payload, size, what);
+    const uint64_t arithmetic = in.varint();
+    AMC_REQUIRE(arithmetic <= in.remaining(), corrupt, std::string(what) + ": arithmetic part is longer than the block");
+    RawSideParts parts;
+    parts.arithmetic = in.rest();
+    parts.arithmetic_size = size_t(arithmetic);
+    parts.raw = in.rest() + arithmetic;
+    parts.raw_size = in.remaining() - size_t(arithmetic);
+    return parts;
+}
 
 }  // namespace amc
