@@ -101,7 +101,8 @@ inline void populate_pages(void* begin, size_t bytes) {
 #if defined(__linux__) && defined(MADV_POPULATE_WRITE)
     const uintptr_t end = reinterpret_cast<uintptr_t>(begin) + bytes;
     for (uintptr_t at = reinterpret_cast<uintptr_t>(begin); at < end;) {
-        const uintptr_t next = std::min<uintptr_t>(end, (at + kHugePage) & ~uintptr_t(kHugePage - 1));  // cut at huge pages: the same pages
+        // Cut at huge pages (so at whole pages): the same pages as one call.
+        const uintptr_t next = std::min<uintptr_t>(end, (at + kHugePage) & ~uintptr_t(kHugePage - 1));
         detail::advise_whole_pages(reinterpret_cast<void*>(at), size_t(next - at), MADV_POPULATE_WRITE);
         at = next;
     }
