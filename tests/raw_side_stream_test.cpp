@@ -57,11 +57,13 @@ TEST(RawSideStream, QuantizedFilesAndStaticModesKeepTheirVersions) {
     EncodeOptions unit;
     unit.predictor = GeometryPredictor::unit_normal_frame;  // the last level (no vertices) stays unflagged
     const std::vector<uint8_t> bytes = encode(h, unit);
-    EXPECT_EQ(bytes[4], kBaseRawSideVersion);  // the base's raw bits: version 12 as it was before
+    EXPECT_EQ(bytes[4], kBaseRawSideVersion);  // for the base's raw bits; version 12 before them
     BlockReader reader(bytes.data(), bytes.size());
     Block block;
     while (reader.next(block)) {
-        if (block.type == BlockType::level) EXPECT_EQ(block.payload[0] & 0x80, 0);
+        if (block.type == BlockType::level) {
+            EXPECT_EQ(block.payload[0] & 0x80, 0);
+        }
     }
 }
 

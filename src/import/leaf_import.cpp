@@ -15,6 +15,7 @@
 #include "import/spatial_order.h"
 #include "import/uniform_lattice.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -212,10 +213,11 @@ void verify_leaf_mesh(const Hierarchy& h, const std::vector<uint32_t>& leaf_of_v
         used[f / 64] |= uint64_t(1) << (f % 64);
         return true;
     };
-    auto first_unused_face = [&] {
-        size_t f = 0;
-        while (f < leaf.triangles.size() && (used[f / 64] >> (f % 64) & 1)) ++f;
-        return f;
+    auto first_unused_face = [&] {  // a word at a time; the faces' count if all are used
+        size_t w = 0;
+        while (w < used.size() && used[w] == ~uint64_t(0)) ++w;
+        if (w == used.size()) return leaf.triangles.size();
+        return std::min(leaf.triangles.size(), 64 * w + size_t(__builtin_ctzll(~used[w])));
     };
     // Whether every leaf triangle is an unused face, all faces used, read in node id order. With
     // every node live (never coarsened), those are the nodes of the breadth-first order, so the

@@ -1,7 +1,9 @@
 // Top-down reconstruction of the forest from the leaf mesh (docs/IMPORT.md, section 1).
 #include "import/leaf_reconstruction.h"
 
+#include "common/compiler.h"
 #include "common/exact_float.h"
+#include "hierarchy/hierarchy_builder.h"
 #include "import/reconstruction.h"
 
 #include <algorithm>
@@ -9,6 +11,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace amc {
@@ -52,7 +55,7 @@ std::vector<uint32_t> Reconstruction::run() {
         level.swap(next);
         ++depth;
     }
-    return leaf_of_vertex_;
+    return std::move(leaf_of_vertex_);  // run() is the reconstruction's last use (a copy: 4 bytes a vertex)
 }
 
 void Reconstruction::reconstruct_level(std::vector<NodeId>& level, std::vector<NodeId>& next) {
@@ -60,7 +63,7 @@ void Reconstruction::reconstruct_level(std::vector<NodeId>& level, std::vector<N
     read_failed_ = true;
     read_level_or_repair(level, refined);
     read_failed_ = false;
-    for (NodeId n : refined) h_.split(n);
+    split_refined(refined);
     leaf_of_vertex_.resize(h_.positions().size(), kNoIndex);
     for (const Reveal& r : reveals_) {
         const NodeId q = h_.neighbor(r.node, r.edge);
@@ -106,11 +109,10 @@ void Reconstruction::read_level(const std::vector<NodeId>& level, std::vector<No
     for (NodeId n : level) {
         if (classify(n)) refined.push_back(n);
     }
-    // Sized once for every node the hierarchy can hold (grown a node at a time, its resizes were
-    // 1% of a 10^6-face import's instructions).
-    if (refined_mark_.size() < h_.node_capacity()) refined_mark_.resize(h_.node_capacity(), 0);
-    for (NodeId n : refined) refined_mark_[n] = 1;
-    auto is_refined = [&](NodeId q) { return q != kNoNode && q < refined_mark_.size() && refined_mark_[q]; };
+    mark_refined(refined);
+    auto is_refined = [&](NodeId q) {
+        return q != kNoNode && q < refined_index_.size() && refined_index_[q] != kNoIndex;
+    };
     try {
         for (NodeId n : refined) {
             if (!h_.can_split(n)) fail_node(n, "is refined next to a coarser element (2:1 balance violated)");
@@ -135,17 +137,74 @@ void Reconstruction::read_level(const std::vector<NodeId>& level, std::vector<No
                      " would be used twice by the refinement (not a red-green refinement)");
         }
     } catch (const Error&) {
-        for (NodeId n : refined) refined_mark_[n] = 0;
+        unmark_refined(refined);
         throw;
     }
-    for (NodeId n : refined) refined_mark_[n] = 0;
+    unmark_refined(refined);
 }
 
-Reconstruction::Reading Reconstruction::read(const uint32_t p[3]) const {
+void Reconstruction::mark_refined(const std::vector<NodeId>& refined) {
+    // Sized once for every node the hierarchy can hold (grown a node at a time, its resizes were
+    // 1% of a 10^6-face import's instructions).
+    if (refined_index_.size() < h_.node_capacity()) refined_index_.resize(h_.node_capacity(), kNoIndex);
+    for (uint32_t i = 0; i < refined.size(); ++i) refined_index_[refined[i]] = i;
+}
+
+void Reconstruction::unmark_refined(const std::vector<NodeId>& refined) {
+    for (NodeId n : refined) refined_index_[n] = kNoIndex;
+}
+
+void Reconstruction::split_refined(const std::vector<NodeId>& refined) {
+    const uint32_t count = uint32_t(refined.size());
+    if (count == 0) return;
+    mark_refined(refined);
+    // A same-level neighbour outside the list is a leaf (the level is read whole before it is
+    // split), which split_level's links assume; otherwise node at a time, as it always did.
+    for (NodeId n : refined) {
+        for (int e = 0; e < 3; ++e) {
+            const NodeId q = h_.neighbor(n, e);
+            if (q != kNoNode && refined_index_[q] == kNoIndex && !h_.is_leaf(q)) {
+                unmark_refined(refined);
+                for (NodeId x : refined) h_.split(x);
+                return;
+            }
+        }
+    }
+    // The children's links as local indices (child k of refined[i] is 4 i + k), written into the
+    // room of the children themselves.
+    const ChildLinkRoom room = HierarchyBuilder::open_children(h_, nullptr, count);
+    for (uint32_t i = 0; i < count; ++i) {
+        const NodeId n = refined[i];
+        uint32_t* const words = room.words + ChildLinkRoom::kStride * 4 * size_t(i);
+        auto link = [words](int k, int e) -> uint32_t& {
+            return words[ChildLinkRoom::kStride * size_t(k) + size_t(e)];
+        };
+        for (int w = 0; w < 12; ++w) {  // a constant table: unrolled to the six sibling words
+            const red_split::LinkSource s = red_split::kLinkSources.of[w];
+            if (s.kind == red_split::LinkSource::kSibling) link(w / 3, w % 3) = 4 * i + s.sibling;
+        }
+        // The edge runs the other way in the neighbour: the first half of ours is the second of its.
+        for (int e = 0; e < 3; ++e) {
+            const NodeId q = h_.neighbor(n, e);
+            const uint32_t j = q == kNoNode ? kNoIndex : refined_index_[q];
+            const int eq = h_.neighbor_edge(n, e);
+            link(red_split::kFirstHalfChild[e], e) = j == kNoIndex ? kNoNode : 4 * j + red_split::kSecondHalfChild[eq];
+            link(red_split::kSecondHalfChild[e], e) = j == kNoIndex ? kNoNode : 4 * j + red_split::kFirstHalfChild[eq];
+        }
+    }
+    unmark_refined(refined);
+    LevelSplits splits{refined.data(), count, nullptr};
+    splits.links_in_place = true;
+    HierarchyBuilder::split_level(h_, splits);
+}
+
+Reconstruction::Reading Reconstruction::read(const uint32_t p[3]) const { return read_inline(p); }
+
+AMC_ALWAYS_INLINE Reconstruction::Reading Reconstruction::read_inline(const uint32_t p[3]) const {
+    // p[e] -> p[e+1], looked up once, before r is written (its stores may alias the index's arrays).
+    const LeafHalfedges::Edge ahead[3] = {he_.edge(p[0], p[1]), he_.edge(p[1], p[2]), he_.edge(p[2], p[0])};
     Reading r;
-    LeafHalfedges::Edge ahead[3];  // p[e] -> p[e+1], looked up once for the tests below
     for (int e = 0; e < 3; ++e) {
-        ahead[e] = he_.edge(p[e], p[(e + 1) % 3]);
         r.unsplit[e] = ahead[e].face != kNoIndex;
         r.unsplit_count += r.unsplit[e];
     }
@@ -205,7 +264,7 @@ Reconstruction::Reading Reconstruction::read(const uint32_t p[3]) const {
 
 bool Reconstruction::classify(NodeId n) {
     const uint32_t p[3] = {corner(n, 0), corner(n, 1), corner(n, 2)};
-    const Reading r = read(p);
+    const Reading r = read_inline(p);
     switch (r.fault) {
         case Reading::none:
             break;
@@ -239,7 +298,8 @@ bool Reconstruction::take_reading(NodeId n, const Reading& r) {
         if (r.unsplit[e]) unsplit_edges_.push_back({n, e});
     }
     for (int i = 0; i < r.reveal_count; ++i) reveals_.push_back({n, r.reveal_edge[i], r.reveal_vertex[i]});
-    h_.set_diagonal_flipped(n, r.flipped);  // a level read again after a repair may read otherwise
+    // A level read again after a repair may read otherwise; written only on a change (an out-of-line call).
+    if (h_.diagonal_flipped(n) != r.flipped) h_.set_diagonal_flipped(n, r.flipped);
     return false;
 }
 

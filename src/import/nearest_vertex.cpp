@@ -14,7 +14,7 @@ NearestVertex::NearestVertex(const std::vector<Vec3>& positions, const std::vect
     if (n == 0) return;
     points_.reserve(n);
     advise_huge_pages(points_.data(), points_.capacity() * sizeof(Point));  // each query reads a few buckets
-    nodes_.reserve(size_t(4) * (n / kBucket + 1));
+    nodes_.reserve(size_t(4) * (n / kMortonBucket + 1));
     if (sorted_codes != nullptr && sorted_codes->size() == n) {
         for (uint32_t v = 0; v < n; ++v) points_.push_back({{positions[v].x, positions[v].y, positions[v].z}, v});
         build_node(*sorted_codes, 0, n, 0);
@@ -35,7 +35,7 @@ NearestVertex::Box NearestVertex::build_node(const std::vector<uint32_t>& codes,
                                              int depth) {
     const uint32_t index = uint32_t(nodes_.size());
     nodes_.push_back({0, 0, begin, end, kNoIndex, 0});
-    if (end - begin <= kBucket || depth >= kMaxDepth) {
+    if (end - begin <= kMortonBucket || depth >= kMaxDepth) {
         Box box;
         for (int a = 0; a < 3; ++a) box.low[a] = box.high[a] = points_[begin].x[a];
         for (uint32_t i = begin + 1; i < end; ++i) {

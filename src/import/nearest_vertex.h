@@ -14,7 +14,9 @@
 
 #include <amc/mesh.h>
 
+#include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <vector>
@@ -22,7 +24,9 @@
 namespace amc {
 
 class NearestVertex {
-    static constexpr uint32_t kBucket = 16;  // points in a leaf of either tree
+    static constexpr uint32_t kBucket = 16;  // points in a leaf of the k-d tree (its ties depend on it)
+    // Points in a leaf of the Morton tree, whose answers do not depend on it (docs/IMPORT.md).
+    static constexpr uint32_t kMortonBucket = 8;
     struct Point {
         double x[3];
         uint32_t vertex;
@@ -41,15 +45,32 @@ private:
     // which it met two usable vertices (`tie`) instead.
     struct Nearest {
         explicit Nearest(uint32_t n, double max_squared_distance)
-            : wanted(n < kMaxCount ? n : kMaxCount), limit(max_squared_distance) {}
+            : wanted(n < kMaxCount ? n : kMaxCount),
+              limit(max_squared_distance),
+              bound(below(max_squared_distance)) {}
         uint32_t wanted, count = 0;
         double limit;
+        // matters(d) is d <= bound: the largest double below limit while fewer than wanted are
+        // listed (d < limit, exactly), then the last listed distance. One compare per tree node.
+        double bound;
         double tie = std::numeric_limits<double>::infinity();
         uint32_t vertex[kMaxCount];
         double distance[kMaxCount];
+        // The largest double below x (std::nextafter towards -infinity, without its call for the
+        // limits queries pass: infinity, and positive finite values).
+        static double below(double x) {
+            if (x == std::numeric_limits<double>::infinity()) return std::numeric_limits<double>::max();
+            if (!(x > 0 && x < std::numeric_limits<double>::infinity()))
+                return std::nextafter(x, -std::numeric_limits<double>::infinity());
+            uint64_t bits;
+            std::memcpy(&bits, &x, sizeof bits);
+            --bits;  // a positive finite double's predecessor (to 0 from the least subnormal)
+            std::memcpy(&x, &bits, sizeof bits);
+            return x;
+        }
         bool improves(double d) const { return count < wanted ? d < limit : d < distance[count - 1]; }
         // Whether a vertex at squared distance d may change the answer or tie with it.
-        bool matters(double d) const { return count < wanted ? d < limit : d <= distance[count - 1]; }
+        bool matters(double d) const { return d <= bound; }
         void insert(uint32_t v, double d) {
             uint32_t i = count < wanted ? count++ : count - 1;
             for (; i > 0 && distance[i - 1] > d; --i) {
@@ -58,6 +79,7 @@ private:
             }
             vertex[i] = v;
             distance[i] = d;
+            if (count == wanted) bound = distance[count - 1];
         }
         // A usable vertex at d, where matters(d): a tie when a listed one is as near.
         void offer(uint32_t v, double d) {
@@ -165,7 +187,7 @@ private:
     // a prefix, split where the next bit of the codes changes, so into the two halves of its cell
     // along that bit's axis: every point of the first child lies at or below every point of the
     // second on it. A cell holding more than a bucket is split at its median, as a k-d tree
-    // splits. A leaf holds at most kBucket points. Nodes in depth-first order: a node's first
+    // splits. A leaf holds at most kMortonBucket points. Nodes in depth-first order: a node's first
     // child follows it.
     struct Node {
         double below, above;  // the first child's greatest and the second's least coordinate on the axis

@@ -40,6 +40,7 @@ public:
         for (VertexId v = 0; v < leaf_of_base.size(); ++v) assign(v, leaf_of_base[v]);
     }
 
+    // The leaf vertex of each hierarchy vertex (kNoIndex: none); once per reconstruction.
     std::vector<uint32_t> run();
 
 private:
@@ -201,9 +202,16 @@ private:
     }
 
     Reading read(const uint32_t p[3]) const;
+    // read's body, inlined into classify (used in leaf_reconstruction.cpp only); read is it out of line.
+    Reading read_inline(const uint32_t p[3]) const;
     // One level: read (repairing the previous level's picks), split, its midpoints found; `next`
     // gets the children.
     void reconstruct_level(std::vector<NodeId>& level, std::vector<NodeId>& next);
+    // Splits a level's refined nodes in one pass (HierarchyBuilder::split_level): the node ids,
+    // vertex ids, positions and links of split() node by node.
+    void split_refined(const std::vector<NodeId>& refined);
+    void mark_refined(const std::vector<NodeId>& refined);    // refined_index_
+    void unmark_refined(const std::vector<NodeId>& refined);
     // Keeps the state before level `depth` is read (from the first failure on; before that
     // level 0's, to start again from, and those the certification of picks goes back to).
     void remember(int depth, const std::vector<NodeId>& level);
@@ -446,7 +454,8 @@ private:
     std::vector<NodeId> refined_;        // scratch of reconstruct_level
     bool read_failed_ = false;           // reconstruct_level failed while reading its level
     NodeId failed_node_ = kNoNode;       // else the node of the level whose vertices did not fit
-    std::vector<uint8_t> refined_mark_;  // per node: read refined in the level being read
+    // Per node: its index in the list of refined nodes being read or split, or kNoIndex.
+    std::vector<uint32_t> refined_index_;
     std::unique_ptr<UndoStepChoice> choice_;
 };
 
