@@ -1,6 +1,6 @@
 // The default chunk count (src/coding/chunks/chunk_policy.h): one chunk per chunk_faces leaf faces,
-// then fewer when the chunked code holds less than min_chunk_bytes per chunk; chunk counts the
-// caller gives are kept.
+// then fewer when the chunked code holds less than min_chunk_bytes per chunk and a quarter of the
+// chunks or more would go; chunk counts the caller gives are kept.
 #include "coding/chunks/chunk_policy.h"
 #include "coding/container.h"
 #include "hierarchy_checks.h"
@@ -79,6 +79,20 @@ TEST(ChunkPolicy, FewerChunksWhenTheCodeIsSmall) {
     EXPECT_EQ(chunk_count_for_size(policy(100, 0), 4, 10), 4u) << "min_chunk_bytes 0: never fewer";
 }
 
+TEST(ChunkPolicy, CodedAgainOnlyForAQuarterOfTheChunks) {
+    // A second code doubles the forest's encode time (the 5*10^7-face torus at 12 bits: 101 chunks
+    // of 63 KiB made 97 for 0.07 % of the file), so it must remove a quarter of the chunks or more:
+    // a code kept holds more than 3/4 of min_chunk_bytes a chunk.
+    const EncodeOptions options = policy(100, 1000);
+    EXPECT_EQ(chunk_count_for_size(options, 10, 9999), 10u) << "9 of 10: kept";
+    EXPECT_EQ(chunk_count_for_size(options, 101, 97999), 101u) << "97 of 101: kept";
+    EXPECT_EQ(chunk_count_for_size(options, 10, 8000), 10u) << "800 bytes a chunk: kept";
+    EXPECT_EQ(chunk_count_for_size(options, 10, 7999), 7u) << "7 of 10: coded again";
+    EXPECT_EQ(chunk_count_for_size(options, 8, 6999), 6u) << "6 of 8: exactly a quarter fewer";
+    EXPECT_EQ(chunk_count_for_size(options, 8, 7000), 8u) << "7 of 8: kept";
+    EXPECT_EQ(chunk_count_for_size(options, 2, 1999), 1u) << "1 of 2";
+}
+
 TEST(ChunkPolicy, SmallCodesAreWrittenInOneChunk) {
     const Hierarchy h = midpoint_sphere();
     const std::vector<uint8_t> cut = encode(h, policy(2048, 0));
@@ -97,9 +111,10 @@ TEST(ChunkPolicy, TheSecondTryTakesOneChunkPerMinChunkBytes) {
     const uint64_t bytes = forest_bytes(ten);
     ASSERT_GT(bytes, 10000u);
     EXPECT_EQ(encode(h, policy(790, bytes / 10)), ten) << "exactly min_chunk_bytes per chunk: kept";
-    const std::vector<uint8_t> nine = encode(h, policy(790, bytes / 10 + 1));
-    EXPECT_EQ(chunk_count(nine), 9u);
-    EXPECT_EQ(nine, encode(h, fixed(9)));
+    EXPECT_EQ(encode(h, policy(790, bytes / 10 + 1)), ten) << "nine chunks would remove less than a quarter: kept";
+    const std::vector<uint8_t> seven = encode(h, policy(790, bytes / 7));
+    EXPECT_EQ(chunk_count(seven), 7u);
+    EXPECT_EQ(seven, encode(h, fixed(7)));
     const std::vector<uint8_t> three = encode(h, policy(790, bytes / 3));
     EXPECT_EQ(three, encode(h, fixed(3)));
     EXPECT_TRUE(identical(decode(three.data(), three.size()), decode(ten.data(), ten.size())));

@@ -87,8 +87,8 @@ int main(int argc, char** argv) {
     encode_cmd->add_option("--predictor", encode.predictor, "auto | midpoint | butterfly | normal | grid (normal, --quantize only) | unit (normal frame of unit normals) | midpoint-static | butterfly-static (static tables, bit-exact only)")
         ->capture_default_str();
     encode_cmd->add_option("--chunks", encode.chunks,
-                           "Cut the forest into this many chunks, each decodable alone (0: one per --chunk-faces faces, fewer when a chunk would code to less than " +
-                               std::to_string(EncodeOptions{}.min_chunk_bytes / 1024) + " KiB)")
+                           "Cut the forest into this many chunks, each decodable alone (0: one per --chunk-faces faces, coded again in one per " +
+                               std::to_string(EncodeOptions{}.min_chunk_bytes / 1024) + " KiB of code when that removes a quarter of them or more)")
         ->check(CLI::Range(0u, 1u << 30));
     encode_cmd->add_option("--chunk-faces", encode.chunk_faces, "Faces per chunk when --chunks is 0")
         ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 40))

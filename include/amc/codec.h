@@ -76,9 +76,10 @@ struct EncodeOptions {
     bool store_numbering = true;
     // Chunks (docs/FORMAT.md 3.11): the forest cut into runs of roots, each decodable on its own,
     // coded and decoded on several threads. 0: one chunk per `chunk_faces` faces of the leaf mesh
-    // (at least one), and fewer when that code holds less than `min_chunk_bytes` per chunk (it is
-    // then coded again in one chunk per min_chunk_bytes; 0: never): each chunk costs some bytes of
-    // its own, which weigh about 1 % in a chunk of 64 KiB (docs/CODEC.md, "Chunks"). A file of one
+    // (at least one), and fewer when that code holds less than `min_chunk_bytes` per chunk and one
+    // chunk per min_chunk_bytes removes a quarter of them or more (it is then coded again in that
+    // many; 0: never): each chunk costs some bytes of its own, which weigh about 1 % in a chunk of
+    // 64 KiB, and coding again doubles the forest's encode time (docs/CODEC.md, "Chunks"). A file of one
     // chunk is written as before chunks existed (version 6 or lower, byte for byte); more chunks
     // make a version-7 file.
     uint32_t chunks = 0;
