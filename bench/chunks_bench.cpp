@@ -29,9 +29,9 @@
 //                                                  (through one EncodeContext a thread count
 //                                                  with `context`)
 //   chunks_bench repeat encode|decode RUNS THREADS BITS model.amh
-//                                                  encodes the model once (default options), then
-//                                                  encodes or decodes it RUNS times on THREADS
-//                                                  threads: the process to profile
+//                                                  encodes the model once (default options, one
+//                                                  thread), then encodes or decodes it RUNS times
+//                                                  on THREADS threads: the process to profile
 //                                                  (scripts/serial_fraction.sh)
 //   chunks_bench decode-file RUNS THREADS [context] file.amc
 //                                                  decodes the file RUNS times on THREADS threads
@@ -409,6 +409,7 @@ int repeat(const std::string& what, int runs, unsigned threads, int bits, const 
     const amc::Hierarchy h = amc::read_hierarchy(path);
     amc::EncodeOptions options;
     options.quantize_bits = bits;
+    options.threads = 1;
     std::vector<uint8_t> bytes = amc::encode(h, options);  // on one thread: any other thread's work is the loop's
     options.threads = threads;
     uint64_t check = 0;

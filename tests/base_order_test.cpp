@@ -11,6 +11,11 @@
 #include <array>
 #include <numeric>
 
+#if defined(__linux__)
+#include <sys/mman.h>
+#include <unistd.h>
+#endif
+
 namespace amc {
 namespace {
 
@@ -208,6 +213,28 @@ TEST(BaseOrder, ArraysWrittenWholeAskForWholeHugePages) {
     EXPECT_EQ(small.capacity(), 1000u);
     EXPECT_EQ(small[0].y, 2);
 }
+
+#if defined(__linux__) && defined(MADV_POPULATE_WRITE)
+// populate_pages goes one huge page a call: every whole page of its range is still made resident,
+// from and to addresses that are not page-aligned, and none outside it.
+TEST(BaseOrder, PopulatedPagesAreTheWholePagesOfTheRange) {
+    const size_t page = size_t(sysconf(_SC_PAGESIZE));
+    const size_t pages = 3 * kHugePage / page + 5, bytes = pages * page;
+    void* map = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    ASSERT_NE(map, MAP_FAILED);
+    madvise(map, bytes, MADV_NOHUGEPAGE);  // a fault makes one page resident, whatever the system's default
+    if (madvise(map, page, MADV_POPULATE_WRITE) != 0) {
+        munmap(map, bytes);
+        GTEST_SKIP() << "no MADV_POPULATE_WRITE (Linux before 5.14)";
+    }
+    char* const first = static_cast<char*>(map);
+    populate_pages(first + 3 * page + 100, bytes - 3 * page - 100 - 200);  // whole pages 4 .. pages - 2
+    std::vector<unsigned char> resident(pages);
+    ASSERT_EQ(mincore(map, bytes, resident.data()), 0);
+    for (size_t p = 1; p < pages; ++p) EXPECT_EQ(resident[p] & 1, p >= 4 && p + 1 < pages ? 1 : 0) << "page " << p;
+    munmap(map, bytes);
+}
+#endif
 
 TEST(BaseOrder, BadOrdersAreRefused) {
     Hierarchy h(make_icosahedron());

@@ -214,7 +214,8 @@ struct ForestCode {
 // and the same geometry (which does not depend on the hierarchy's model; each level's chosen
 // once), the hierarchy parts in the models' own arithmetic codes. One chunk is coded in `memory`.
 // `base_raw_bits`: the base geometry has raw bits for a side stream (encode_chunked).
-ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<RootRange>& chunks, uint64_t faces,
+ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<uint64_t>& root_nodes,
+                       const std::vector<RootRange>& chunks, uint64_t faces,
                        const EncodeOptions& options, CoordinateSpace space, PositionCoder positions, bool base_raw_bits, unsigned threads,
                        bool want_hierarchy_stats, HierarchyLevelEncoder* first_pass, const HierarchyOnGrid* on_grid,
                        const std::vector<std::pair<MixingModel, ForestCode*>>& older = {}, EncodeMemory memory = {}) {
@@ -222,7 +223,8 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
     const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
     out.chunked = !mixed && chunks.size() > 1;
     if (out.chunked) {
-        ChunkedBlocks parts = encode_chunked(h, root_of, chunks, options, space, threads, out.stats, base_raw_bits, memory.chunks);
+        ChunkedBlocks parts = encode_chunked(h, root_of, root_nodes, chunks, options, space, threads, out.stats, base_raw_bits,
+                                             memory.chunks);
         out.base_side = parts.base_side;
         out.static_geometry = parts.static_geometry;
         out.grid_geometry = parts.grid_geometry;
@@ -399,8 +401,7 @@ std::vector<uint8_t> encode_file(const Hierarchy& input, const EncodeOptions& op
         return base_inline;
     };
     const std::vector<uint32_t> root_of = one_chunk ? std::vector<uint32_t>() : root_of_nodes(h);
-    const std::vector<uint64_t> root_nodes =
-        options.chunk_roots.empty() && !one_chunk ? nodes_per_root(h, root_of) : std::vector<uint64_t>();
+    const std::vector<uint64_t> root_nodes = one_chunk ? std::vector<uint64_t>() : nodes_per_root(h, root_of);
     const std::vector<RootRange> chunks = !options.chunk_roots.empty() ? explicit_chunks(options.chunk_roots, h.root_count())
                                           : one_chunk ? std::vector<RootRange>{RootRange{0, h.root_count()}}
                                                       : balanced_chunks(root_nodes, chunk_count_for(options, faces));
@@ -412,13 +413,13 @@ std::vector<uint8_t> encode_file(const Hierarchy& input, const EncodeOptions& op
                                                                   {MixingModel::fourth, &fourth},
                                                                   {MixingModel::third, &third}}
               : std::vector<std::pair<MixingModel, ForestCode*>>{};
-    ForestCode forest = code_forest(h, root_of, chunks, faces, options, space, positions, base_raw_bits, threads, want_hierarchy_stats,
-                                    first_pass.get(), turned_input && quantized ? &on_grid : nullptr, older, memory);
+    ForestCode forest = code_forest(h, root_of, root_nodes, chunks, faces, options, space, positions, base_raw_bits, threads,
+                                    want_hierarchy_stats, first_pass.get(), turned_input && quantized ? &on_grid : nullptr, older, memory);
     const uint32_t fewer = automatic && forest.chunked ? chunk_count_for_size(options, uint32_t(chunks.size()), forest.bytes)
                                                        : uint32_t(chunks.size());
     if (fewer < chunks.size())
-        forest = code_forest(h, root_of, balanced_chunks(root_nodes, fewer), faces, options, space, positions, base_raw_bits, threads,
-                             want_hierarchy_stats, nullptr, nullptr, {}, memory);
+        forest = code_forest(h, root_of, root_nodes, balanced_chunks(root_nodes, fewer), faces, options, space, positions,
+                             base_raw_bits, threads, want_hierarchy_stats, nullptr, nullptr, {}, memory);
     // An older model of the mixing mode where it codes the file smaller (small files, whose new
     // tables have little to learn from, or creased ones, by a few bytes): every file at most as
     // large as each older model's. A tie keeps the newer model. The seventh model's base block is

@@ -2,6 +2,7 @@
 // fresh part of a large buffer is offered to transparent huge pages (a hint; harmless elsewhere).
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -93,10 +94,18 @@ inline void release_pages(void* begin, size_t bytes) {
 // Faults in the whole pages inside [begin, begin + bytes) as writable, zeroed, without writing
 // them (Linux 5.14 on; elsewhere nothing): memory that one thread makes resident before others
 // write it, since two threads faulting fresh pages in at once take several times as long on the
-// project's VM (docs/BENCHMARKS.md, "Threads and memory").
+// project's VM (docs/BENCHMARKS.md, "Threads and memory"). One huge page a call: each call holds
+// the process's memory map lock, and another thread's brk, mprotect or madvise waited for a whole
+// array's call (up to 5 ms).
 inline void populate_pages(void* begin, size_t bytes) {
 #if defined(__linux__) && defined(MADV_POPULATE_WRITE)
-    detail::advise_whole_pages(begin, bytes, MADV_POPULATE_WRITE);
+    const uintptr_t end = reinterpret_cast<uintptr_t>(begin) + bytes;
+    for (uintptr_t at = reinterpret_cast<uintptr_t>(begin); at < end;) {
+        // Cut at huge pages (so at whole pages): the same pages as one call.
+        const uintptr_t next = std::min<uintptr_t>(end, (at + kHugePage) & ~uintptr_t(kHugePage - 1));
+        detail::advise_whole_pages(reinterpret_cast<void*>(at), size_t(next - at), MADV_POPULATE_WRITE);
+        at = next;
+    }
 #else
     (void)begin;
     (void)bytes;

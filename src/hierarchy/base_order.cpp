@@ -316,12 +316,17 @@ SubforestRoom HierarchyBuilder::subforest_room(const Hierarchy& h, size_t nodes,
     reserve_huge(room.arrays.positions_, h.positions().size(), HugePages::written_whole);  // address space
     reserve_huge(room.old_of, h.node_count(), HugePages::written_whole);                  // as in subforest
     reserve_huge(room.vertex_of, h.positions().size(), HugePages::written_whole);
-    populate_pages(room.arrays.nodes_.data(), nodes * sizeof(Hierarchy::Node));
-    populate_pages(room.arrays.block_parent_.data(), nodes / 4 * sizeof(NodeId));
-    populate_pages(room.arrays.positions_.data(), vertices * sizeof(Vec3));
-    populate_pages(room.old_of.data(), nodes * sizeof(NodeId));
-    populate_pages(room.vertex_of.data(), vertices * sizeof(VertexId));
+    room.nodes = nodes;
+    room.vertices = vertices;
     return room;
+}
+
+void HierarchyBuilder::make_resident(SubforestRoom& room) {
+    populate_pages(room.arrays.nodes_.data(), room.nodes * sizeof(Hierarchy::Node));
+    populate_pages(room.arrays.block_parent_.data(), room.nodes / 4 * sizeof(NodeId));
+    populate_pages(room.arrays.positions_.data(), room.vertices * sizeof(Vec3));
+    populate_pages(room.old_of.data(), room.nodes * sizeof(NodeId));
+    populate_pages(room.vertex_of.data(), room.vertices * sizeof(VertexId));
 }
 
 }  // namespace amc

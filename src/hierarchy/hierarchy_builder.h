@@ -79,6 +79,7 @@ struct SubforestRoom {
     Hierarchy arrays;  // node, block and position arrays (adopt_storage)
     std::vector<NodeId> old_of;
     std::vector<VertexId> vertex_of;
+    size_t nodes = 0, vertices = 0;  // the entries HierarchyBuilder::make_resident populates
 };
 
 // A whole level's splits: the distinct splittable leaves parents[0..count) of one level, whose
@@ -235,10 +236,14 @@ struct HierarchyBuilder {
                                const std::vector<VertexId>& base_vertex, const std::vector<uint32_t>& root_of,
                                const std::vector<uint8_t>& root_in, NodeId* local, std::vector<VertexId>* vertex_of,
                                SubforestRoom* room = nullptr);
-    // Room for a subforest of h of `nodes` nodes and about `vertices` vertices, made resident by
-    // the calling thread (populate_pages: on the project's VM several times cheaper than the
-    // subforest's writes faulting it in) and in its malloc arena, also when another thread fills it.
+    // Room for a subforest of h of `nodes` nodes and about `vertices` vertices, reserved (not yet
+    // resident: SubforestRoom::make_resident) in the calling thread's malloc arena, also when
+    // another thread fills it.
     static SubforestRoom subforest_room(const Hierarchy& h, size_t nodes, size_t vertices);
+    // Makes the room's entries for its nodes and vertices resident (populate_pages: on the
+    // project's VM several times cheaper than subforest()'s writes faulting them in). Any thread
+    // may call it, so that the thread that fills a room populates it while others fill theirs.
+    static void make_resident(SubforestRoom& room);
     // The reader of a hierarchy file has made every structural check check_invariants makes (its
     // forest replayed with split() under can_split, the closure checked): writers may skip them
     // while nothing changes the forest (writer_checks.h).

@@ -32,7 +32,8 @@ uint64_t leaf_face_count(const Hierarchy& h, unsigned threads) {
     return sum;
 }
 
-ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<RootRange>& ranges,
+ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<uint64_t>& root_nodes,
+                             const std::vector<RootRange>& ranges,
                              const EncodeOptions& options, CoordinateSpace space, unsigned threads, EncodeStats& stats,
                              bool base_raw_bits, ChunkEncoderMemories* kept) {
     std::vector<uint32_t> chunk_of_root(h.root_count());
@@ -47,18 +48,17 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& ro
     const size_t local_bytes = written_whole_bytes(size_t(h.node_capacity()) * sizeof(NodeId));
     const std::unique_ptr<NodeId[]> local(new NodeId[local_bytes / sizeof(NodeId)]);
     advise_huge_pages(local.get(), local_bytes, HugePages::written_whole);
-    // Each chunk is copied into a room made resident first (subforest_room). The rooms of the
-    // chunks the other threads take first (tasks 1 .. threads - 1; this thread, which starts them,
-    // takes task 0) are made here before they start, so that those copies live in this thread's
-    // malloc arena and a worker's arena holds only its level coder's working memory, which glibc
-    // then keeps from one encode to the next: a worker that allocated its own copy had its arena
-    // trimmed after each encode and faulted ~4,300 fresh pages into it again, and a worker whose
-    // copy this thread made had to wait for it (docs/BENCHMARKS.md, "Threads and memory"). Which
-    // thread takes which chunk changes no byte.
+    // Each chunk is copied into a room made resident first (subforest_room, make_resident). The
+    // rooms of the chunks the other threads take first (tasks 1 .. threads - 1; this thread, which
+    // starts them, takes task 0) are reserved here before they start, so that those copies live in
+    // this thread's malloc arena and a worker's arena holds only its level coder's working memory,
+    // which glibc then keeps from one encode to the next: a worker that allocated its own copy had
+    // its arena trimmed after each encode and faulted ~4,300 fresh pages into it again
+    // (docs/BENCHMARKS.md, "Threads and memory"). Each task makes its room resident, so that the
+    // threads populate their rooms at once. Which thread takes which chunk changes no byte.
     std::vector<uint64_t> chunk_nodes(ranges.size(), 0);
-    for (size_t c = 0; c < ranges.size(); ++c) chunk_nodes[c] = ranges[c].count;
-    for (NodeId n = h.root_count(); n < h.node_capacity(); n += 4)  // blocks of four siblings
-        if (root_of[n] != kNoNode) chunk_nodes[chunk_of_root[root_of[n]]] += 4;
+    for (size_t c = 0; c < ranges.size(); ++c)
+        for (uint32_t r = ranges[c].first; r < ranges[c].first + ranges[c].count; ++r) chunk_nodes[c] += root_nodes[r];
     auto room_for = [&](size_t c) {
         // Vertices in proportion to nodes, with some slack (what the room lacks is faulted in).
         const double share = double(chunk_nodes[c]) / double(std::max<size_t>(1, h.node_count()));
@@ -73,6 +73,7 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& ro
     parallel_for(ranges.size(), threads, [&](size_t c) {
         std::unique_ptr<ChunkEncoderMemory> memory = kept != nullptr ? kept->take() : nullptr;
         if (c == 0 || c >= made_first) rooms[c] = room_for(c);
+        HierarchyBuilder::make_resident(rooms[c]);
         std::vector<VertexId> vertex_of;
         const Hierarchy chunk = extract_roots(h, {ranges[c]}, root_of, local.get(), &vertex_of, &rooms[c]);
         VertexKeys keys(vertex_of.size(), kNoVertex);

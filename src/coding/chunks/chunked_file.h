@@ -33,12 +33,13 @@ struct ChunkedBlocks {
 };
 
 // Codes `h` (decoder base order, positions as the decoder will have them) in the chunks `ranges`
-// on up to `threads` threads; `root_of` is root_of_nodes(h). Adds the hierarchy and geometry bytes
-// and the level statistics (summed over chunks) to `stats`. With `kept` (an EncodeContext's), each
-// thread codes its chunks in one memory of it.
+// on up to `threads` threads; `root_of` is root_of_nodes(h), `root_nodes` nodes_per_root(h,
+// root_of). Adds the hierarchy and geometry bytes and the level statistics (summed over chunks) to
+// `stats`. With `kept` (an EncodeContext's), each thread codes its chunks in one memory of it.
 // `base_raw_bits`: the base geometry block has raw bits for a side stream (a bit-exact file of
 // version 21 then; so too when the seam has some, and then both blocks are in that layout).
-ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<RootRange>& ranges,
+ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& root_of, const std::vector<uint64_t>& root_nodes,
+                             const std::vector<RootRange>& ranges,
                              const EncodeOptions& options, CoordinateSpace space, unsigned threads, EncodeStats& stats,
                              bool base_raw_bits, ChunkEncoderMemories* kept = nullptr);
 
