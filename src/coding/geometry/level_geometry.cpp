@@ -409,11 +409,8 @@ std::vector<uint8_t> finish_level_payload(const Mesh& h, const NewVertices& crea
     } else {
         encode_adaptive(h, created, code.predictor, positions, encoder, &raw);
     }
-    const std::vector<uint8_t> coded = encoder.finish();
-    put_varint(payload, coded.size());
-    payload.insert(payload.end(), coded.begin(), coded.end());
-    const std::vector<uint8_t> raw_bytes = raw.finish();
-    payload.insert(payload.end(), raw_bytes.begin(), raw_bytes.end());
+    const std::vector<uint8_t> side = RawSideCode{encoder.finish(), raw.finish()}.joined();
+    payload.insert(payload.end(), side.begin(), side.end());
     return payload;
 }
 
@@ -438,17 +435,14 @@ LevelBlockParts split_level_block(const Block& block, uint8_t file_version, bool
                 corrupt, "level block: bad predictor");
     parts.predictor = GeometryPredictor(predictor);
     parts.order = grouped_grid_order(file_version) ? StaticOrder::grouped : StaticOrder::per_vertex;
-    PayloadReader in(block.payload + 1, block.size - 1, "level block");
-    size_t arithmetic_size = block.size - 1;
-    if (is_static_mode(parts.predictor) || parts.raw_side) {
-        const uint64_t size = in.varint();
-        AMC_REQUIRE(size <= in.remaining(), corrupt, where + ": arithmetic part is longer than the block");
-        arithmetic_size = size_t(size);
-    }
-    parts.arithmetic = in.rest();
-    parts.arithmetic_size = arithmetic_size;
-    parts.after_arithmetic = in.rest() + arithmetic_size;
-    parts.after_arithmetic_size = in.remaining() - arithmetic_size;
+    // A static mode's tables and a version-14 level's raw bits follow a length-prefixed arithmetic part.
+    const RawSideParts split = is_static_mode(parts.predictor) || parts.raw_side
+                                   ? split_raw_side(block.payload + 1, block.size - 1, where, "level block")
+                                   : RawSideParts{block.payload + 1, block.size - 1, block.payload + block.size, 0};
+    parts.arithmetic = split.arithmetic;
+    parts.arithmetic_size = split.arithmetic_size;
+    parts.after_arithmetic = split.raw;
+    parts.after_arithmetic_size = split.raw_size;
     return parts;
 }
 

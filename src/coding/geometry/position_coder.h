@@ -77,17 +77,19 @@ struct RawSideCode {
         return out;
     }
 };
-// The two parts of such a payload. Throws Error (corrupt) when A passes the payload's end.
+// The two parts of such a payload (`raw`: all that follows the arithmetic part). Throws Error
+// (corrupt) naming `what` when A passes the payload's end; `reader`, if given, names the payload in
+// PayloadReader's own messages instead.
 struct RawSideParts {
     const uint8_t* arithmetic = nullptr;
     size_t arithmetic_size = 0;
     const uint8_t* raw = nullptr;
     size_t raw_size = 0;
 };
-inline RawSideParts split_raw_side(const uint8_t* payload, size_t size, const char* what) {
-    PayloadReader in(payload, size, what);
+inline RawSideParts split_raw_side(const uint8_t* payload, size_t size, const std::string& what, const char* reader = nullptr) {
+    PayloadReader in(payload, size, reader != nullptr ? reader : what.c_str());
     const uint64_t arithmetic = in.varint();
-    AMC_REQUIRE(arithmetic <= in.remaining(), corrupt, std::string(what) + ": arithmetic part is longer than the block");
+    AMC_REQUIRE(arithmetic <= in.remaining(), corrupt, what + ": arithmetic part is longer than the block");
     RawSideParts parts;
     parts.arithmetic = in.rest();
     parts.arithmetic_size = size_t(arithmetic);
