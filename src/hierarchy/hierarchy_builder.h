@@ -237,7 +237,7 @@ struct HierarchyBuilder {
                                const std::vector<uint8_t>& root_in, NodeId* local, std::vector<VertexId>* vertex_of,
                                SubforestRoom* room = nullptr);
     // Room for a subforest of h of `nodes` nodes and about `vertices` vertices, reserved (not yet
-    // resident: SubforestRoom::make_resident) in the calling thread's malloc arena, also when
+    // resident: make_resident below) in the calling thread's malloc arena, also when
     // another thread fills it.
     static SubforestRoom subforest_room(const Hierarchy& h, size_t nodes, size_t vertices);
     // Makes the room's entries for its nodes and vertices resident (populate_pages: on the
