@@ -98,8 +98,8 @@ void Reconstruction::vote_on_guides() {
         if (h_.level(r.node) == 0) continue;
         const int e = r.edge, f = (e + 1) % 3;
         const Vec3& at = leaf_.positions[r.leaf_vertex];
-        const Vec3 d_leaf = at - 0.5 * (leaf_.positions[corner(r.node, e)] + leaf_.positions[corner(r.node, f)]);
-        const Vec3 d_subdivision = at - 0.5 * (h_.position(h_.vertex(r.node, e)) + h_.position(h_.vertex(r.node, f)));
+        const Vec3 d_leaf = at - rounded_scaled(0.5, leaf_.positions[corner(r.node, e)] + leaf_.positions[corner(r.node, f)]);
+        const Vec3 d_subdivision = at - rounded_scaled(0.5, h_.position(h_.vertex(r.node, e)) + h_.position(h_.vertex(r.node, f)));
         const double leaf = exact_dot(d_leaf, d_leaf), subdivision = exact_dot(d_subdivision, d_subdivision);
         votes_leaf_ += leaf < subdivision;
         votes_subdivision_ += subdivision < leaf;
