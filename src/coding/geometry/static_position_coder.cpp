@@ -73,6 +73,15 @@ AMC_ALWAYS_INLINE Residual float64_residual(double actual, double predicted) {
     return {negative, negative ? uint64_t{0} - r : r};
 }
 
+// residual_of's for float32 coordinates (a single-precision hierarchy's, bit-exact), inline in the
+// encoder's loops as float64_residual.
+AMC_ALWAYS_INLINE Residual float32_residual(double actual, double predicted) {
+    const uint32_t r = uint32_t(ordered_bits(actual, Precision::float32)) -
+                       uint32_t(ordered_bits(coder_prediction(predicted, Precision::float32), Precision::float32));
+    const bool negative = (r >> 31) != 0;
+    return {negative, negative ? uint64_t(0u - r) : uint64_t(r)};
+}
+
 // Branch-free: residual signs are coin flips, which a branch would mispredict half the time.
 AMC_ALWAYS_INLINE int64_t negated_if(int64_t x, bool negate) {
     const int64_t m = -int64_t(negate);
@@ -530,6 +539,7 @@ void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, 
         else raw_writer_.reserve_bits(uint64_t(kStaticRoles) * 64 * (end - begin));
     }
     const bool float64 = space_.quantizer == nullptr && space_.precision == Precision::float64;
+    // Modes 3 (without a quantizer), 6 and 7 are bit-exact: float64 or float32.
     switch (mode_) {
         case GeometryPredictor::normal_frame:
             if (space_.quantizer != nullptr) {
@@ -539,8 +549,8 @@ void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, 
                 if (keep_large) add_vertices<false, false, kFloat64Residuals, true>(h, created, begin, end);
                 else add_vertices<false, false, kFloat64Residuals, false>(h, created, begin, end);
             } else {
-                if (keep_large) add_vertices<false, false, kAnyResiduals, true>(h, created, begin, end);
-                else add_vertices<false, false, kAnyResiduals, false>(h, created, begin, end);
+                if (keep_large) add_vertices<false, false, kFloat32Residuals, true>(h, created, begin, end);
+                else add_vertices<false, false, kFloat32Residuals, false>(h, created, begin, end);
             }
             break;
         case GeometryPredictor::normal_frame_grid:
@@ -552,8 +562,8 @@ void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, 
                 if (keep_large) add_stencil_vertices<false, kFloat64Residuals, true>(h, created, begin, end);
                 else add_stencil_vertices<false, kFloat64Residuals, false>(h, created, begin, end);
             } else {
-                if (keep_large) add_stencil_vertices<false, kAnyResiduals, true>(h, created, begin, end);
-                else add_stencil_vertices<false, kAnyResiduals, false>(h, created, begin, end);
+                if (keep_large) add_stencil_vertices<false, kFloat32Residuals, true>(h, created, begin, end);
+                else add_stencil_vertices<false, kFloat32Residuals, false>(h, created, begin, end);
             }
             break;
         case GeometryPredictor::butterfly_static:
@@ -561,14 +571,17 @@ void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, 
                 if (keep_large) add_stencil_vertices<true, kFloat64Residuals, true>(h, created, begin, end);
                 else add_stencil_vertices<true, kFloat64Residuals, false>(h, created, begin, end);
             } else {
-                if (keep_large) add_stencil_vertices<true, kAnyResiduals, true>(h, created, begin, end);
-                else add_stencil_vertices<true, kAnyResiduals, false>(h, created, begin, end);
+                if (keep_large) add_stencil_vertices<true, kFloat32Residuals, true>(h, created, begin, end);
+                else add_stencil_vertices<true, kFloat32Residuals, false>(h, created, begin, end);
             }
             break;
         default:
             if (float64) {
                 if (keep_large) add_vertices<true, false, kFloat64Residuals, true>(h, created, begin, end);
                 else add_vertices<true, false, kFloat64Residuals, false>(h, created, begin, end);
+            } else if (space_.quantizer == nullptr) {
+                if (keep_large) add_vertices<true, false, kFloat32Residuals, true>(h, created, begin, end);
+                else add_vertices<true, false, kFloat32Residuals, false>(h, created, begin, end);
             } else {
                 if (keep_large) add_vertices<true, false, kAnyResiduals, true>(h, created, begin, end);
                 else add_vertices<true, false, kAnyResiduals, false>(h, created, begin, end);
@@ -609,6 +622,8 @@ void StaticLevelEncoder::add_vertices(const Mesh& h, const std::vector<std::pair
                     table = kGridBins * role + g.bin;
                 } else if (Residuals == kFloat64Residuals) {
                     r = float64_residual(actual[axis], predicted[role]);
+                } else if (Residuals == kFloat32Residuals) {
+                    r = float32_residual(actual[axis], predicted[role]);
                 } else if (Residuals == kGridResiduals) {  // residual_of's grid points, with the level's GridScale
                     const uint32_t a = grid_point_of_grid_value(grid, f.origin[role], actual[axis]);
                     const uint32_t q = grid_point_at(grid, f.origin[role], predicted[role]);
@@ -641,8 +656,9 @@ void StaticLevelEncoder::add_stencil_vertices(const Mesh& h, const std::vector<s
         const double actual[3] = {p.x, p.y, p.z}, predicted[3] = {q.x, q.y, q.z};
         std::array<uint16_t, kStaticRoles>& symbols = symbols_[i];
         for (int axis = 0; axis < 3; ++axis) {
-            const Residual r = Residuals == kFloat64Residuals ? float64_residual(actual[axis], predicted[axis])
-                                                              : residual_of(space_, axis, actual[axis], predicted[axis]);
+            const Residual r = Residuals == kFloat64Residuals   ? float64_residual(actual[axis], predicted[axis])
+                               : Residuals == kFloat32Residuals ? float32_residual(actual[axis], predicted[axis])
+                                                                : residual_of(space_, axis, actual[axis], predicted[axis]);
             const int token = static_token(r.negative, r.magnitude);
             if (token >= kDirectTokens) {  // never grouped
                 if (KeepLarge) large_.push_back(r);
