@@ -153,21 +153,32 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
                 }
                 return (truth[i] & 1) != 0;
             });
+        // The leaves' faces (a leaf and its hanging nodes' green triangles) in a pass over the
+        // states alone, with the leaves of two or three hanging nodes listed, then those.
+        std::vector<uint32_t>& two_or_more = m.two_or_more;
+        if (two_or_more.size() < n) two_or_more.resize(n);  // no clearing: only the listed part is read
+        uint32_t listed = 0;
+        uint64_t level_faces = 0;
         for (uint32_t i = 0; i < n; ++i) {
-            if (state[i] & kRefined) continue;
+            const uint32_t leaf = (state[i] & kRefined) == 0;
+            const uint32_t hanging = uint32_t(refined_neighbors(state[i]));
+            level_faces += (1 + hanging) & (0 - leaf);
+            two_or_more[listed] = i;
+            listed += leaf & uint32_t(hanging >= 2);
+        }
+        faces += level_faces;
+        for (uint32_t j = 0; j < listed; ++j) {
+            const uint32_t i = two_or_more[j];
             const int hanging = refined_neighbors(state[i]);
             AMC_REQUIRE(hanging != 3, invalid_input,
                         "encode_hierarchy: node " + std::to_string(ids[i]) + " of level " + std::to_string(l) +
                             " has three hanging nodes but is not refined (the hierarchy is not closed)");
-            faces += 1 + uint64_t(hanging);
-            if (hanging == 2) {
-                const int unrefined = unrefined_edge(level, i);
-                const bool flipped = (truth[i] >> 1) != 0;
-                two_hanging.push_back({unrefined, flipped});
-                if (turned != nullptr) unturned_exceptions_.add(kTurnedEdge[unrefined + turns[i]], flipped);
-                orientation_slots.push_back(events_.size());
-                events_.push_back({kOrientationEvent, 0});
-            }
+            const int unrefined = unrefined_edge(level, i);
+            const bool flipped = (truth[i] >> 1) != 0;
+            two_hanging.push_back({unrefined, flipped});
+            if (turned != nullptr) unturned_exceptions_.add(kTurnedEdge[unrefined + turns[i]], flipped);
+            orientation_slots.push_back(events_.size());
+            events_.push_back({kOrientationEvent, 0});
         }
         stats.levels = l + 1;
         level_end_.push_back(events_.size());
