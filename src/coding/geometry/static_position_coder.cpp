@@ -722,22 +722,24 @@ void StaticLevelEncoder::code_streams() {
     constexpr uint16_t kTokenMask = (1 << kTokenBits) - 1;
     // The rANS stream back to front, straight from the symbol words (rANS codes backwards).
     RansBackwardEncoder rans(kStaticRoles * symbols_.size(), rans_memory_);
-    auto put = [&](uint16_t symbol) { rans.put(tables_[size_t(symbol >> kTokenBits)], symbol & kTokenMask); };
+    static_assert(sizeof(symbols_[0]) == kStaticRoles * sizeof(uint16_t), "symbol words are contiguous");
+    const uint16_t* words = reinterpret_cast<const uint16_t*>(symbols_.data());
+    const RansTable::Coding* codings[kMaxStaticTables];
+    for (int i = 0; i < table_count_; ++i) codings[i] = tables_[size_t(i)].codings();
+    auto coding = [&](uint16_t word) -> const RansTable::Coding& { return codings[word >> kTokenBits][word & kTokenMask]; };
     if (!grouped_) {
         // The symbol words one after the other (vertex after vertex, role after role).
-        static_assert(sizeof(symbols_[0]) == kStaticRoles * sizeof(uint16_t), "symbol words are contiguous");
-        const uint16_t* words = reinterpret_cast<const uint16_t*>(symbols_.data());
-        const RansTable::Coding* codings[kMaxStaticTables];
-        for (int i = 0; i < table_count_; ++i) codings[i] = tables_[size_t(i)].codings();
-        rans.put_all(kStaticRoles * symbols_.size(),
-                     [&](size_t j) -> const RansTable::Coding& { return codings[words[j] >> kTokenBits][words[j] & kTokenMask]; });
+        rans.put_all(kStaticRoles * symbols_.size(), [&](size_t j) -> const RansTable::Coding& { return coding(words[j]); });
     } else {
-        // Each run: its role-0 tokens, then each vertex's roles 1 and 2 (FORMAT.md 5.7), backwards.
+        // Each run: its role-0 tokens, then each vertex's roles 1 and 2 (FORMAT.md 5.7); the runs backwards.
         for (size_t run = (symbols_.size() + kGridGroup - 1) / kGridGroup; run-- > 0;) {
             const size_t begin = run * kGridGroup, count = std::min(kGridGroup, symbols_.size() - begin);
-            for (size_t i = count; i-- > 0;)
-                for (int role = kStaticRoles; role-- > 1;) put(symbols_[begin + i][size_t(role)]);
-            for (size_t i = count; i-- > 0;) put(symbols_[begin + i][0]);
+            const uint16_t* run_words = words + kStaticRoles * begin;
+            rans.put_all(kStaticRoles * count, [&](size_t j) -> const RansTable::Coding& {
+                if (j < count) return coding(run_words[kStaticRoles * j]);
+                const size_t k = j - count;  // vertex k / 2, role 1 + k % 2
+                return coding(run_words[kStaticRoles * (k >> 1) + 1 + (k & 1)]);
+            });
         }
     }
     rans.finish(rans_);
