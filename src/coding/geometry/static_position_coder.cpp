@@ -576,6 +576,19 @@ void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, 
             }
             break;
         default:
+            if constexpr (std::is_same_v<Mesh, Hierarchy>) {
+                // Bit-exact in the hierarchy's own precision: every bit-exact level.
+                if (space_.quantizer == nullptr && float64 != h.single_precision()) {
+                    if (float64) {
+                        if (keep_large) add_unit_vertices<false, true>(h, created, begin, end);
+                        else add_unit_vertices<false, false>(h, created, begin, end);
+                    } else {
+                        if (keep_large) add_unit_vertices<true, true>(h, created, begin, end);
+                        else add_unit_vertices<true, false>(h, created, begin, end);
+                    }
+                    break;
+                }
+            }
             if (float64) {
                 if (keep_large) add_vertices<true, false, kFloat64Residuals, true>(h, created, begin, end);
                 else add_vertices<true, false, kFloat64Residuals, false>(h, created, begin, end);
@@ -2236,7 +2249,61 @@ bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, G
     return decode_static_with(h, created, space, mode, tables, rans_data, rans_size, raw_data, raw_size, grouped);
 }
 
+// The frames of `count` vertices without a grid (mode 5's), for the encoder as its listed
+// decoder makes them: four at a time where the processor has AVX2, else two.
+void make_unit_frames(const Hierarchy& h, const FrameCorners* corners, size_t count, GridFrame* frames) {
+#if AMC_AVX2_AT_RUN_TIME
+    if (has_avx2() && wide_frames_allowed.load(std::memory_order_relaxed)) {
+        QuadUnitFrames()(h, corners, count, frames);
+        return;
+    }
+#endif
+    PairUnitFrames()(h, corners, count, frames);
+}
+
 }  // namespace
+
+// add_vertices<true, false, kFloat64Residuals or kFloat32Residuals> (mode 5, bit-exact) with the
+// frames of decode_unit_listed (GridFrame in axis order, two or four at a time) instead of
+// RoleFrame copies: the same predictions, residuals and tokens in the same order.
+template <bool Float32, bool KeepLarge>
+void StaticLevelEncoder::add_unit_vertices(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin,
+                                           size_t end) {
+    uint64_t raw_bits = 0;
+    Chunk c;
+    std::array<GridFrame, kChunk> frames;
+    for (size_t first = begin; first < end; first += kChunk) {
+        gather_chunk(h, FromNodes<Hierarchy>{h, created}, first, end, c);
+        for (size_t i = 0; i < c.count; ++i) __builtin_prefetch(&h.positions()[c.vertices[i]]);
+        make_unit_frames(h, c.corners, c.count, frames.data());
+        for (size_t i = 0; i < c.count; ++i) {
+            const GridFrame& f = frames[i];
+            const Vec3 p = h.position(c.vertices[i]);
+            const double actual[3] = {p.x, p.y, p.z};
+            const int axes[3] = {f.axis, f.axis == 0 ? 1 : 0, f.axis == 2 ? 1 : 2};  // role_axes'
+            double predicted[3] = {f.midpoint[axes[0]], f.midpoint[axes[1]], f.midpoint[axes[2]]};
+            if (f.has_normal) {  // predict_others
+                const double t = rounded((actual[axes[0]] - f.midpoint[axes[0]]) / f.normal[axes[0]]);
+                predicted[1] = predicted[1] + rounded(t * f.normal[axes[1]]);
+                predicted[2] = predicted[2] + rounded(t * f.normal[axes[2]]);
+            }
+            std::array<uint16_t, kStaticRoles>& symbols = symbols_[first + i];
+            for (int role = 0; role < kStaticRoles; ++role) {
+                const double value = actual[axes[role]];
+                const Residual r = Float32 ? float32_residual(value, predicted[role]) : float64_residual(value, predicted[role]);
+                const int token = static_token(r.negative, r.magnitude);
+                if (token >= kDirectTokens) {
+                    if (KeepLarge) large_.push_back(r);
+                    else put_raw(raw_writer_, r);
+                }
+                symbols[size_t(role)] = uint16_t(role << kTokenBits | token);
+                raw_bits += uint64_t(static_raw_bit_count(r.magnitude));
+                ++counts_[size_t(role)][size_t(token)];
+            }
+        }
+    }
+    raw_bits_ += raw_bits;
+}
 
 bool set_wide_frames(bool allowed) {
 #if AMC_AVX2_AT_RUN_TIME

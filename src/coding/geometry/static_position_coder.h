@@ -165,6 +165,10 @@ private:
     // KeepLarge: the raw bits wait in large_ (mode 4's grouped order, or a sample's; see below).
     template <bool UnitNormals, bool GridBins, int Residuals, bool KeepLarge, class Mesh>
     void add_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
+    // Mode 5 bit-exact in the hierarchy's own precision (float32 in a single-precision one):
+    // add_vertices with the listed decoder's frames.
+    template <bool Float32, bool KeepLarge>
+    void add_unit_vertices(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
     // Modes 6 and 7: each axis against the stencil's prediction, with the table of its axis.
     template <bool Butterfly, int Residuals, bool KeepLarge, class Mesh>
     void add_stencil_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
