@@ -105,13 +105,16 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
             if (r && !(state[i] & kComplete) && unbalanced == n) unbalanced = i;
             if (r) {
                 const NodeId c = h.child(id, 0);
+                // push_back, which inlines (two range inserts here were calls).
                 if (turned == nullptr) {
-                    next_ids.insert(next_ids.end(), {c, c + 1, c + 2, c + 3});
+                    for (NodeId k = 0; k < 4; ++k) next_ids.push_back(c + k);
                 } else {  // the children in their turned order, turned alike
                     const uint8_t turn = turns[i];
                     const uint8_t* child = red_split::kRotatedChild[turn];
-                    next_ids.insert(next_ids.end(), {c + child[0], c + child[1], c + child[2], c + child[3]});
-                    next_turns.insert(next_turns.end(), {turn, turn, turn, turn});
+                    for (int k = 0; k < 4; ++k) {
+                        next_ids.push_back(c + child[k]);
+                        next_turns.push_back(turn);
+                    }
                 }
             }
         }
