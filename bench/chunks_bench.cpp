@@ -28,6 +28,20 @@
 //                                                  options), 0.2 s apart: the same per encode
 //                                                  (through one EncodeContext a thread count
 //                                                  with `context`)
+//   chunks_bench vcpu-speeds SECONDS [BITS model.amh]
+//                                                  a chain of multiplies, random reads of 32 MiB of
+//                                                  fresh memory (mapped, written, read, unmapped) and
+//                                                  of 32 MiB kept from the start, with a model then a
+//                                                  one-thread decode of its file, back to back on each
+//                                                  of the first two processors at once, one thread
+//                                                  pinned to each: per second each processor's median
+//                                                  CPU time for each and their ratio (under chrt -f)
+//   chunks_bench alone-together encode|decode BITS SECONDS model.amh
+//                                                  two processes: this one codes on one thread back
+//                                                  to back, a forked copy does the same in even
+//                                                  seconds and sleeps in odd ones; the median thread
+//                                                  CPU time of this one's calls in each kind of second
+//                                                  (does a second process doing the same slow it?)
 //   chunks_bench repeat encode|decode RUNS THREADS BITS model.amh
 //                                                  encodes the model once (default options, one
 //                                                  thread), then encodes or decodes it RUNS times
@@ -60,7 +74,12 @@
 #include <vector>
 
 #include <dirent.h>
+#include <pthread.h>
+#include <sched.h>
+#include <signal.h>
+#include <sys/mman.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 namespace {
@@ -405,6 +424,189 @@ int encode_rusage(int runs, int bits, bool kept, const char* path) {
     });
 }
 
+double thread_cpu_seconds() {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+// The rulers of vcpu-speeds: 300,000 random reads of 32 MiB offered to huge pages, either fresh
+// (mapped, written a word a page, read, unmapped: a decode's output and working memory are fresh)
+// or kept (mapped and written once; then only read).
+struct HugeBuffer {
+    static constexpr size_t kBytes = size_t(32) << 20, kHuge = size_t(2) << 20, kCount = kBytes / sizeof(uint64_t);
+    void* mapping = nullptr;
+    uint64_t* words = nullptr;
+    HugeBuffer() {
+        mapping = mmap(nullptr, kBytes + kHuge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        if (mapping == MAP_FAILED) std::abort();
+        words = reinterpret_cast<uint64_t*>((reinterpret_cast<uintptr_t>(mapping) + kHuge - 1) & ~uintptr_t(kHuge - 1));
+        madvise(words, kBytes, MADV_HUGEPAGE);
+        for (size_t i = 0; i < kCount; i += 512) words[i] = i;
+    }
+    ~HugeBuffer() { munmap(mapping, kBytes + kHuge); }
+    HugeBuffer(const HugeBuffer&) = delete;
+    HugeBuffer& operator=(const HugeBuffer&) = delete;
+    uint64_t read_at_random(uint64_t seed) const {
+        uint64_t x = seed, sum = 0;
+        for (int i = 0; i < 300000; ++i) {
+            x = x * 6364136223846793005ull + 1442695040888963407ull;
+            sum += words[(x >> 20) % kCount];
+        }
+        return x + sum;
+    }
+};
+
+// Per processor and second: the median CPU seconds of the rulers and, with a model, of a one-thread
+// decode of its file; the two threads run at once, one pinned to each processor.
+int vcpu_speeds(double seconds, int bits, const char* path) {
+    cpu_set_t allowed;
+    CPU_ZERO(&allowed);
+    sched_getaffinity(0, sizeof allowed, &allowed);
+    std::vector<int> cpus;
+    for (int c = 0; c < CPU_SETSIZE && cpus.size() < 2; ++c)
+        if (CPU_ISSET(c, &allowed)) cpus.push_back(c);
+    if (cpus.size() < 2) {
+        std::fprintf(stderr, "vcpu-speeds: needs two processors\n");
+        return 1;
+    }
+    std::vector<uint8_t> bytes;
+    if (path != nullptr) {
+        amc::EncodeOptions options;
+        options.quantize_bits = bits;
+        bytes = amc::encode(amc::read_hierarchy(path), options);
+    }
+    struct Call {
+        int second;
+        double arithmetic, fresh, kept, decode;
+    };
+    std::vector<Call> calls[2];
+    const double start = now();
+    std::vector<std::thread> threads;
+    for (int k = 0; k < 2; ++k)
+        threads.emplace_back([&, k] {
+            cpu_set_t one;
+            CPU_ZERO(&one);
+            CPU_SET(cpus[k], &one);
+            pthread_setaffinity_np(pthread_self(), sizeof one, &one);
+            amc::DecodeOptions d;
+            d.threads = 1;
+            const HugeBuffer kept;
+            uint64_t seed = 1;
+            while (now() - start < seconds) {
+                const double t = now() - start, a0 = thread_cpu_seconds();
+                for (int i = 0; i < 2000000; ++i) seed = seed * 6364136223846793005ull + 1;
+                const double c0 = thread_cpu_seconds();
+                seed = HugeBuffer().read_at_random(seed);
+                const double c1 = thread_cpu_seconds();
+                seed = kept.read_at_random(seed);
+                const double c2 = thread_cpu_seconds();
+                if (!bytes.empty()) {
+                    const amc::Hierarchy back = amc::decode(bytes.data(), bytes.size(), d);
+                    seed += back.node_count();
+                }
+                calls[k].push_back({int(t), c0 - a0, c1 - c0, c2 - c1, thread_cpu_seconds() - c2});
+            }
+            if (seed == 0) std::printf(" ");  // keeps the work
+        });
+    for (std::thread& t : threads) t.join();
+    std::printf("processors %d and %d at once, each second's median CPU seconds on each: a chain of multiplies, fresh memory read, "
+                "kept memory read%s; slower over faster\n",
+                cpus[0], cpus[1], bytes.empty() ? "" : ", a one-thread decode");
+    std::vector<double> arithmetic_ratios, ruler_ratios, kept_ratios, decode_ratios;
+    for (int second = 0; second < int(seconds); ++second) {
+        std::vector<double> arithmetic[2], ruler[2], kept[2], decode[2];
+        for (int k = 0; k < 2; ++k)
+            for (const Call& c : calls[k])
+                if (c.second == second) {
+                    arithmetic[k].push_back(c.arithmetic);
+                    ruler[k].push_back(c.fresh);
+                    kept[k].push_back(c.kept);
+                    decode[k].push_back(c.decode);
+                }
+        if (ruler[0].empty() || ruler[1].empty()) continue;
+        const double a = median(ruler[0]), b = median(ruler[1]), da = median(decode[0]), db = median(decode[1]);
+        const double ka = median(kept[0]), kb = median(kept[1]), aa = median(arithmetic[0]), ab = median(arithmetic[1]);
+        arithmetic_ratios.push_back(std::max(aa, ab) / std::min(aa, ab));
+        ruler_ratios.push_back(std::max(a, b) / std::min(a, b));
+        kept_ratios.push_back(std::max(ka, kb) / std::min(ka, kb));
+        std::printf("  second %2d: multiplies %.5f %.5f (%.2f), fresh %.5f %.5f (%.2f), kept %.5f %.5f (%.2f)", second, aa, ab,
+                    arithmetic_ratios.back(), a, b, ruler_ratios.back(), ka, kb, kept_ratios.back());
+        if (!bytes.empty()) {
+            decode_ratios.push_back(std::max(da, db) / std::min(da, db));
+            std::printf("; decode %.4f %.4f (%.2f), slower where fresh memory is: %s", da, db, decode_ratios.back(),
+                        (da > db) == (a > b) ? "yes" : "no");
+        }
+        std::printf("\n");
+    }
+    const Range r = range_of(ruler_ratios), kr = range_of(kept_ratios), ar = range_of(arithmetic_ratios);
+    std::printf("slower over faster, median [min - max] over %zu seconds: multiplies %.2f [%.2f - %.2f], fresh memory %.2f [%.2f - "
+                "%.2f], kept memory %.2f [%.2f - %.2f]",
+                ruler_ratios.size(), ar.median, ar.low, ar.high, r.median, r.low, r.high, kr.median, kr.low, kr.high);
+    if (!decode_ratios.empty()) {
+        const Range dr = range_of(decode_ratios);
+        std::printf("; decode: median %.2f [%.2f - %.2f]", dr.median, dr.low, dr.high);
+    }
+    std::printf("\n");
+    return 0;
+}
+
+int alone_together(const std::string& what, int bits, double seconds, const char* path) {
+    const amc::Hierarchy h = amc::read_hierarchy(path);
+    amc::EncodeOptions options;
+    options.quantize_bits = bits;
+    options.threads = 1;
+    const std::vector<uint8_t> bytes = amc::encode(h, options);
+    amc::DecodeOptions d;
+    d.threads = 1;
+    auto call = [&] {
+        if (what == "encode") {
+            if (amc::encode(h, options) != bytes) std::abort();
+        } else {
+            const amc::Hierarchy back = amc::decode(bytes.data(), bytes.size(), d);
+            if (back.node_count() != h.node_count()) std::abort();
+        }
+    };
+    // Seconds on the system-wide monotonic clock, which both processes read.
+    auto clock_seconds = [] {
+        timespec t{};
+        clock_gettime(CLOCK_MONOTONIC, &t);
+        return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+    };
+    const double start = std::floor(clock_seconds()) + 2, end = start + seconds;
+    const pid_t other = fork();
+    if (other < 0) return 1;
+    if (other == 0) {  // the second process: busy in even seconds, starting a call only if it ends within the second
+        double last = 0;
+        while (clock_seconds() < end + 1) {
+            const double t = clock_seconds();
+            if (long(t) % 2 == 0 && t + last < std::floor(t) + 1) {
+                call();
+                last = clock_seconds() - t;
+            } else {
+                usleep(1000);
+            }
+        }
+        _exit(0);
+    }
+    std::vector<double> cpu[2];  // [0]: calls within an even second (the other process busy), [1]: odd
+    while (clock_seconds() < start) usleep(1000);
+    while (clock_seconds() < end) {
+        const double t0 = clock_seconds(), c0 = thread_cpu_seconds();
+        call();
+        const double c1 = thread_cpu_seconds(), t1 = clock_seconds();
+        if (long(t0) == long(t1)) cpu[long(t0) % 2].push_back(c1 - c0);
+    }
+    kill(other, SIGTERM);
+    waitpid(other, nullptr, 0);
+    const Range together = range_of(cpu[0]), alone = range_of(cpu[1]);
+    std::printf("%s, %s on one thread, %d bits: CPU seconds a call with another process doing the same %.4f [%.4f - %.4f] (%zu "
+                "calls), alone %.4f [%.4f - %.4f] (%zu calls); together / alone %.3f\n",
+                name_of(path).c_str(), what.c_str(), bits, together.median, together.low, together.high, cpu[0].size(), alone.median,
+                alone.low, alone.high, cpu[1].size(), together.median / alone.median);
+    return 0;
+}
+
 int repeat(const std::string& what, int runs, unsigned threads, int bits, const char* path) {
     const amc::Hierarchy h = amc::read_hierarchy(path);
     amc::EncodeOptions options;
@@ -487,6 +689,10 @@ int main(int argc, char** argv) {
         return decode_rusage(std::max(1, std::atoi(argv[2])), argv[3], argv[4]);
     if (mode == "encode-rusage" && (argc == 5 || (argc == 6 && std::string(argv[4]) == "context")))
         return encode_rusage(std::max(1, std::atoi(argv[2])), std::atoi(argv[3]), argc == 6, argv[argc - 1]);
+    if (mode == "vcpu-speeds" && (argc == 3 || argc == 5))
+        return vcpu_speeds(std::max(2.0, std::atof(argv[2])), argc == 5 ? std::atoi(argv[3]) : 0, argc == 5 ? argv[4] : nullptr);
+    if (mode == "alone-together" && argc == 6 && (std::string(argv[2]) == "encode" || std::string(argv[2]) == "decode"))
+        return alone_together(argv[2], std::atoi(argv[3]), std::max(4.0, std::atof(argv[4])), argv[5]);
     if (mode == "repeat" && argc == 7 && (std::string(argv[2]) == "encode" || std::string(argv[2]) == "decode"))
         return repeat(argv[2], std::max(1, std::atoi(argv[3])), unsigned(std::atoi(argv[4])), std::atoi(argv[5]), argv[6]);
     std::fprintf(stderr, "usage: chunks_bench sizes BITS model.amh ...\n       chunks_bench speed RUNS BITS CHUNKS model.amh\n"
@@ -495,6 +701,8 @@ int main(int argc, char** argv) {
                          "       chunks_bench decode-file RUNS THREADS [context] file.amc\n"
                          "       chunks_bench decode-rusage RUNS recycle|keep|free file.amc\n"
                          "       chunks_bench encode-rusage RUNS BITS [context] model.amh\n"
+                         "       chunks_bench vcpu-speeds SECONDS [BITS model.amh]\n"
+                         "       chunks_bench alone-together encode|decode BITS SECONDS model.amh\n"
                          "       chunks_bench repeat encode|decode RUNS THREADS BITS model.amh\n");
     return 2;
 }

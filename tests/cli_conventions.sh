@@ -56,6 +56,15 @@ expect 1 "$amc" extract r.amh -o l.ply --level 29
 expect 0 "$amc" decode r.amc -o l1.vtu --level 1
 expect 2 "$amc" encode r.amh -o q.amc --quantize 31
 
+# --traversal naive: another file, the same hierarchy back.
+expect 0 "$amc" encode front_1.amh -o tn.amc --traversal naive --quantize 12
+expect 0 "$amc" encode front_1.amh -o ti.amc --quantize 12
+cmp -s tn.amc ti.amc && fail "--traversal naive wrote the file of the improved traversal"
+expect 0 "$amc" decode tn.amc -o tn.amh
+expect 0 "$amc" decode ti.amc -o ti.amh
+cmp -s tn.amh ti.amh || fail "the naive traversal's file decodes to another hierarchy"
+expect 2 "$amc" encode front_1.amh -o tx.amc --traversal sideways
+
 # Kinds from magic bytes, not from names.
 cp r.amc renamed.bin
 expect 0 "$amc" info renamed.bin

@@ -104,9 +104,9 @@ void print_encode_stats(std::FILE* out, const std::string& name, const EncodeSta
 void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     if (command.series || is_pvd(command.input)) {
         if (command.keep_numbering || !command.map.empty() || command.quantize_bits != 0 || command.predictor != "auto" ||
-            command.hierarchy_contexts != "paper" || command.geometry_contexts != "grid")
-            throw UsageError("--keep-numbering, --map, --quantize, --predictor, --hierarchy-contexts and --geometry-contexts do not "
-                             "apply to a series");
+            command.hierarchy_contexts != "paper" || command.geometry_contexts != "grid" || command.traversal != "improved")
+            throw UsageError("--keep-numbering, --map, --quantize, --predictor, --hierarchy-contexts, --geometry-contexts and "
+                             "--traversal do not apply to a series");
         SeriesEncodeCommand series;
         series.inputs = {command.input};
         series.output = command.output;
@@ -145,6 +145,7 @@ void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     options.chunk_faces = command.chunk_faces;
     options.threads = command.threads;
     options.hierarchy_contexts = command.hierarchy_contexts == "mixed" ? HierarchyContexts::mixed : HierarchyContexts::paper;
+    options.hierarchy.traversal = command.traversal == "naive" ? Traversal::naive : Traversal::improved;
     Hierarchy h;
     LeafNumbering numbering;
     auto start = std::chrono::steady_clock::now();
