@@ -106,8 +106,8 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"grid", "roles"}))
         ->capture_default_str();
     encode_cmd->add_option("--traversal", encode.traversal,
-                           "improved (the paper's priority order, smallest) | naive (canonical order: about 15 % faster "
-                           "decode, 1-4 % larger surface files, far larger graded FE ones; docs/CODEC.md)")
+                           "improved (the paper's priority order, smallest) | naive (canonical order: about 15 % less "
+                           "decode time; surface files up to 4 % larger, graded FE ones far larger; docs/CODEC.md)")
         ->check(CLI::IsMember({"improved", "naive"}))
         ->capture_default_str();
     encode_cmd->add_option("--effort", encode.effort,
