@@ -8,6 +8,7 @@
 # debug info of a -g build), and serial otherwise. CPU-time samples: the shares do not depend on the machine's load. Amdahl's law
 # then bounds the speed-up on T threads by 1 / (serial + (1 - serial) / T).
 # Usage: scripts/serial_fraction.sh model.amh [build-dir] [runs]   (needs perf; BITS 0 and 12; THREADS=2)
+# (BITS_LIST="12" or WHAT_LIST="encode" in the environment for fewer of them)
 set -euo pipefail
 model=$1
 build=${2:-$(cd "$(dirname "$0")/.." && pwd)/build-bench}
@@ -15,8 +16,8 @@ runs=${3:-5}
 threads=${THREADS:-2}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-for bits in 0 12; do
-  for what in encode decode; do
+for bits in ${BITS_LIST:-0 12}; do
+  for what in ${WHAT_LIST:-encode decode}; do
     perf record -q --call-graph=dwarf,16384 -F 999 -o "$tmp/perf.data" \
       "$build/bench/chunks_bench" repeat "$what" "$runs" "$threads" "$bits" "$model" > /dev/null 2>&1
     perf script -i "$tmp/perf.data" 2> /dev/null > "$tmp/perf.txt"

@@ -112,6 +112,16 @@ inline void populate_pages(void* begin, size_t bytes) {
 #endif
 }
 
+// An array of at least `count` T left unset (no pass of zeros), sized and offered to huge pages as
+// written whole: for arrays whose every entry a pass writes before any is read.
+template <class T>
+std::unique_ptr<T[]> written_whole_array(size_t count) {
+    const size_t bytes = written_whole_bytes(count * sizeof(T));
+    std::unique_ptr<T[]> array(new T[bytes / sizeof(T)]);
+    advise_huge_pages(array.get(), bytes, HugePages::written_whole);
+    return array;
+}
+
 // v.reserve(capacity), with the whole new buffer offered to huge pages before the old contents
 // are copied in, so that the copy itself faults in huge pages rather than 4 KiB ones.
 template <class T>

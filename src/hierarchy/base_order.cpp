@@ -76,16 +76,13 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
     // The replay's order: node j of the result is old node old_of[j] turned by turn[j]. It is
     // breadth-first, so made a level at a time: each level's nodes in ranges on `threads` threads,
     // the split ones counted first, then their children placed after the level in that order.
-    std::vector<NodeId> old_of(roots), first_child(roots);
-    std::vector<uint8_t> turn(roots);
-    reserve_huge(old_of, h.node_count(), HugePages::written_whole);
-    reserve_huge(first_child, h.node_count(), HugePages::written_whole);
-    reserve_huge(turn, h.node_count(), HugePages::written_whole);
-    // Left unset: only live nodes are reached and looked up, and their entries are written by the
-    // threads' first pass (which takes the first touch of its pages off the serial part too).
-    const size_t new_of_bytes = written_whole_bytes(size_t(h.node_capacity()) * sizeof(NodeId));
-    const std::unique_ptr<NodeId[]> new_of(new NodeId[new_of_bytes / sizeof(NodeId)]);
-    advise_huge_pages(new_of.get(), new_of_bytes, HugePages::written_whole);
+    // These arrays, new_of and creates are left unset: only live nodes are reached and looked up,
+    // and each entry is written by the threads' passes before it is read, which takes the first
+    // touch of their pages off the serial part too (they were zeroed by resizes there).
+    const std::unique_ptr<NodeId[]> old_of = written_whole_array<NodeId>(h.node_capacity());
+    const std::unique_ptr<NodeId[]> first_child = written_whole_array<NodeId>(h.node_capacity());
+    const std::unique_ptr<uint8_t[]> turn = written_whole_array<uint8_t>(h.node_capacity());
+    const std::unique_ptr<NodeId[]> new_of = written_whole_array<NodeId>(h.node_capacity());
     for (uint32_t t = 0; t < triangle_order.size(); ++t) {
         old_of[t] = triangle_order[t];
         turn[t] = rotation[t];
@@ -94,14 +91,15 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
     constexpr size_t kAhead = 16;
     constexpr size_t kRange = size_t(1) << 16;  // nodes per task
     std::vector<uint64_t> split_before;  // per range of the level: its split nodes, then the ranges' before it
-    for (size_t begin = 0, end = roots; begin < end;) {
+    size_t begin = 0, end = roots;  // the level's nodes; at the end, every node
+    while (begin < end) {
         const size_t level_ranges = (end - begin + kRange - 1) / kRange;
         split_before.assign(level_ranges + 1, 0);
         // (Through local pointers and counts: a store through a uint8_t may alias anything, and made
         // the compiler reload the vectors' pointers after each.)
         parallel_for(level_ranges, threads, [&](size_t i) {  // first_child[j]: the old node's, for now
-            const NodeId* old = old_of.data();
-            NodeId* first = first_child.data();
+            const NodeId* old = old_of.get();
+            NodeId* first = first_child.get();
             uint64_t split = 0;
             for (size_t j = begin + i * kRange, stop = std::min(end, begin + (i + 1) * kRange); j < stop; ++j) {
                 if (j + kAhead < end) prefetch(h, old[j + kAhead]);
@@ -114,13 +112,10 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
         for (size_t i = 0; i < level_ranges; ++i) split_before[i + 1] += split_before[i];
         const size_t next_end = end + 4 * size_t(split_before[level_ranges]);
         AMC_REQUIRE(next_end <= h.node_capacity(), limit_exceeded, "reorder_base: more nodes than the hierarchy holds");
-        old_of.resize(next_end);
-        turn.resize(next_end);
-        first_child.resize(next_end);
         parallel_for(level_ranges, threads, [&](size_t i) {
-            NodeId* old = old_of.data();
-            NodeId* first = first_child.data();
-            uint8_t* turned = turn.data();
+            NodeId* old = old_of.get();
+            NodeId* first = first_child.get();
+            uint8_t* turned = turn.get();
             size_t next = end + 4 * size_t(split_before[i]);
             for (size_t j = begin + i * kRange, stop = std::min(end, begin + (i + 1) * kRange); j < stop; ++j) {
                 const NodeId old_first = first[j];
@@ -137,24 +132,26 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
         begin = end;
         end = next_end;
     }
-    const size_t n = old_of.size();
+    const size_t n = end;
     // Split node j creates the midpoint of its edge e unless its same-level neighbour there was
     // split before it (split() then takes the neighbour's): bit e of creates[j].
-    std::vector<uint8_t> creates(n, 0);
+    const std::unique_ptr<uint8_t[]> creates = written_whole_array<uint8_t>(n);
     const size_t ranges = (n + kRange - 1) / kRange;
     std::vector<uint64_t> first_vertex(ranges + 1, 0);
     parallel_for(ranges, threads, [&](size_t i) {
         uint64_t created = 0;  // not first_vertex[i + 1]: neighbouring ranges' counts share cache lines
         for (size_t j = i * kRange; j < std::min(n, (i + 1) * kRange); ++j) {
             if (j + kAhead < n) prefetch(h, old_of[j + kAhead]);
-            if (first_child[j] == kNoNode) continue;
-            for (int e = 0; e < 3; ++e) {
-                const NodeId q = h.neighbor(old_of[j], kEdgeMod3[e + turn[j]]);
-                if (q == kNoNode || h.is_leaf(q) || new_of[q] > j) {
-                    creates[j] |= uint8_t(1u << e);
-                    ++created;
+            uint8_t made = 0;
+            if (first_child[j] != kNoNode)
+                for (int e = 0; e < 3; ++e) {
+                    const NodeId q = h.neighbor(old_of[j], kEdgeMod3[e + turn[j]]);
+                    if (q == kNoNode || h.is_leaf(q) || new_of[q] > j) {
+                        made |= uint8_t(1u << e);
+                        ++created;
+                    }
                 }
-            }
+            creates[j] = made;
         }
         first_vertex[i + 1] = created;
     });

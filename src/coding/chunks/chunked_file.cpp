@@ -45,9 +45,7 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& ro
     std::vector<uint64_t> nodes(ranges.size()), own_vertices(ranges.size());
     // Shared: the chunks' nodes are disjoint, and each chunk writes its nodes' entries before it
     // reads them (subforest), so they are not zeroed first; their pages are faulted in by the tasks.
-    const size_t local_bytes = written_whole_bytes(size_t(h.node_capacity()) * sizeof(NodeId));
-    const std::unique_ptr<NodeId[]> local(new NodeId[local_bytes / sizeof(NodeId)]);
-    advise_huge_pages(local.get(), local_bytes, HugePages::written_whole);
+    const std::unique_ptr<NodeId[]> local = written_whole_array<NodeId>(h.node_capacity());
     // Each chunk is copied into a room made resident first (subforest_room, make_resident). The
     // rooms of the chunks the other threads take first (tasks 1 .. threads - 1; this thread, which
     // starts them, takes task 0) are reserved here before they start, so that those copies live in
@@ -70,7 +68,14 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& ro
     // With `kept`, one memory a thread for the chunks it takes (a task's end gives it back for the
     // next task). Without, each chunk's encoder allocates its own, as before (a memory held through
     // the whole encode only moves where glibc puts the other blocks: "Threads and memory").
-    parallel_for(ranges.size(), threads, [&](size_t c) {
+    // The seam's code is the last task: the first thread done with its chunk takes it, where it
+    // ran on one thread after all chunks.
+    RawSideCode seam_code;
+    parallel_for(ranges.size() + 1, threads, [&](size_t c) {
+        if (c == ranges.size()) {
+            seam_code = seam.encode(space, space.quantizer == nullptr);
+            return;
+        }
         std::unique_ptr<ChunkEncoderMemory> memory = kept != nullptr ? kept->take() : nullptr;
         if (c == 0 || c >= made_first) rooms[c] = room_for(c);
         HierarchyBuilder::make_resident(rooms[c]);
@@ -89,7 +94,6 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& ro
     ChunkedBlocks out;
     // Bit-exact: the seam's raw bits apart when the file has any there or in its base (version 21);
     // without any, the arithmetic code alone is the block of the older versions.
-    const RawSideCode seam_code = seam.encode(space, space.quantizer == nullptr);
     out.base_side = space.quantizer == nullptr && (base_raw_bits || !seam_code.raw.empty());
     std::vector<uint8_t> seam_bytes = out.base_side ? seam_code.joined() : seam_code.arithmetic;
     // Table: count, then per chunk its roots, nodes, own vertices and where its block starts,
