@@ -78,7 +78,7 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
     // the split ones counted first, then their children placed after the level in that order.
     // These arrays, new_of and creates are left unset: only live nodes are reached and looked up,
     // and each entry is written by the threads' passes before it is read, which takes the first
-    // touch of their pages off the serial part too (they were zeroed by resizes there).
+    // touch of their pages off the serial part too.
     const std::unique_ptr<NodeId[]> old_of = written_whole_array<NodeId>(h.node_capacity());
     const std::unique_ptr<NodeId[]> first_child = written_whole_array<NodeId>(h.node_capacity());
     const std::unique_ptr<uint8_t[]> turn = written_whole_array<uint8_t>(h.node_capacity());

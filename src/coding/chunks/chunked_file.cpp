@@ -68,8 +68,8 @@ ChunkedBlocks encode_chunked(const Hierarchy& h, const std::vector<uint32_t>& ro
     // With `kept`, one memory a thread for the chunks it takes (a task's end gives it back for the
     // next task). Without, each chunk's encoder allocates its own, as before (a memory held through
     // the whole encode only moves where glibc puts the other blocks: "Threads and memory").
-    // The seam's code is the last task: the first thread done with its chunk takes it, where it
-    // ran on one thread after all chunks.
+    // The seam's code is the last task: the first thread done with its chunk takes it while the
+    // others finish theirs.
     RawSideCode seam_code;
     parallel_for(ranges.size() + 1, threads, [&](size_t c) {
         if (c == ranges.size()) {
