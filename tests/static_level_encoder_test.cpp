@@ -243,7 +243,7 @@ TEST(StaticLevelEncoder, GridLevelsDecodeAlikeFromTheListAndFromTheNodes) {
 // every bit length up to 63 (narrow tables, as every bit-exact surface level has; raw bits in one
 // read and, past 57, in two), float64 coordinates past DBL_MAX / 2 (the chunks whose positions are
 // far) and a level whose last chunk has an odd count, with the frames four and two at a time; both
-// refuse the streams cut short.
+// refuse the streams cut short. The encoder's frames four and two at a time code the same streams.
 void expect_unit_levels_decode_alike(Precision precision) {
     const bool single = precision == Precision::float32;
     Hierarchy h = projected_sphere(6000, 6, 14);
@@ -285,6 +285,12 @@ void expect_unit_levels_decode_alike(Precision precision) {
     for (int k = 0; k < static_table_count(mode); ++k) ASSERT_NE(tables[size_t(k)].narrow_view().index, nullptr) << "table " << k;
     const std::vector<uint8_t>& rans = encoder.rans_bytes();
     const std::vector<uint8_t>& raw = encoder.raw_bytes();
+    {  // the encoder makes its frames as the listed decoder does: in pairs, the same streams
+        const WideFramesAllowed pairs(false);
+        const StaticLevelEncoder paired(h, created, space, mode);
+        EXPECT_EQ(paired.rans_bytes(), rans);
+        EXPECT_EQ(paired.raw_bytes(), raw);
+    }
     Hierarchy zeroed = h;
     for (const auto& [n, e] : created) zeroed.set_position(zeroed.midpoint(n, e), Vec3{});
     auto decode = [&](bool listed, size_t rans_size, size_t raw_size, Hierarchy& out) {

@@ -149,11 +149,15 @@ public:
         const size_t first = left_ - count;  // the stream index of coding_of(0)
         uint32_t x0 = state_[0], x1 = state_[1];
         uint8_t* out = begin_;
+        // Without a branch on the bytes a symbol renormalises (0, 1 or 2, by turns on
+        // bit-exact residuals): both written below `out`, where the buffer has room for two a
+        // symbol, and `out` moved over those that count; the others are written over later.
         auto step = [&out](uint32_t& x, const RansTable::Coding& c) {
-            while (x >= c.x_max) {
-                *--out = uint8_t(x);
-                x >>= 8;
-            }
+            const uint32_t bytes = uint32_t(x >= c.x_max) + uint32_t((x >> 8) >= c.x_max);
+            out[-1] = uint8_t(x);
+            out[-2] = uint8_t(x >> 8);
+            out -= bytes;
+            x >>= 8 * bytes;
             x = c.code(x);
         };
         size_t j = count;  // symbol j takes state (first + j) mod 2

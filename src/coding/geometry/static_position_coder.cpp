@@ -73,6 +73,15 @@ AMC_ALWAYS_INLINE Residual float64_residual(double actual, double predicted) {
     return {negative, negative ? uint64_t{0} - r : r};
 }
 
+// residual_of's for float32 coordinates (a single-precision hierarchy's, bit-exact), inline in the
+// encoder's loops as float64_residual.
+AMC_ALWAYS_INLINE Residual float32_residual(double actual, double predicted) {
+    const uint32_t r = uint32_t(ordered_bits(actual, Precision::float32)) -
+                       uint32_t(ordered_bits(coder_prediction(predicted, Precision::float32), Precision::float32));
+    const bool negative = (r >> 31) != 0;
+    return {negative, negative ? uint64_t(0u - r) : uint64_t(r)};
+}
+
 // Branch-free: residual signs are coin flips, which a branch would mispredict half the time.
 AMC_ALWAYS_INLINE int64_t negated_if(int64_t x, bool negate) {
     const int64_t m = -int64_t(negate);
@@ -530,6 +539,7 @@ void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, 
         else raw_writer_.reserve_bits(uint64_t(kStaticRoles) * 64 * (end - begin));
     }
     const bool float64 = space_.quantizer == nullptr && space_.precision == Precision::float64;
+    // Modes 3 (without a quantizer), 6 and 7 are bit-exact: float64 or float32.
     switch (mode_) {
         case GeometryPredictor::normal_frame:
             if (space_.quantizer != nullptr) {
@@ -539,8 +549,8 @@ void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, 
                 if (keep_large) add_vertices<false, false, kFloat64Residuals, true>(h, created, begin, end);
                 else add_vertices<false, false, kFloat64Residuals, false>(h, created, begin, end);
             } else {
-                if (keep_large) add_vertices<false, false, kAnyResiduals, true>(h, created, begin, end);
-                else add_vertices<false, false, kAnyResiduals, false>(h, created, begin, end);
+                if (keep_large) add_vertices<false, false, kFloat32Residuals, true>(h, created, begin, end);
+                else add_vertices<false, false, kFloat32Residuals, false>(h, created, begin, end);
             }
             break;
         case GeometryPredictor::normal_frame_grid:
@@ -552,8 +562,8 @@ void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, 
                 if (keep_large) add_stencil_vertices<false, kFloat64Residuals, true>(h, created, begin, end);
                 else add_stencil_vertices<false, kFloat64Residuals, false>(h, created, begin, end);
             } else {
-                if (keep_large) add_stencil_vertices<false, kAnyResiduals, true>(h, created, begin, end);
-                else add_stencil_vertices<false, kAnyResiduals, false>(h, created, begin, end);
+                if (keep_large) add_stencil_vertices<false, kFloat32Residuals, true>(h, created, begin, end);
+                else add_stencil_vertices<false, kFloat32Residuals, false>(h, created, begin, end);
             }
             break;
         case GeometryPredictor::butterfly_static:
@@ -561,14 +571,30 @@ void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, 
                 if (keep_large) add_stencil_vertices<true, kFloat64Residuals, true>(h, created, begin, end);
                 else add_stencil_vertices<true, kFloat64Residuals, false>(h, created, begin, end);
             } else {
-                if (keep_large) add_stencil_vertices<true, kAnyResiduals, true>(h, created, begin, end);
-                else add_stencil_vertices<true, kAnyResiduals, false>(h, created, begin, end);
+                if (keep_large) add_stencil_vertices<true, kFloat32Residuals, true>(h, created, begin, end);
+                else add_stencil_vertices<true, kFloat32Residuals, false>(h, created, begin, end);
             }
             break;
         default:
+            if constexpr (std::is_same_v<Mesh, Hierarchy>) {
+                // Bit-exact in the hierarchy's own precision: every bit-exact level.
+                if (space_.quantizer == nullptr && float64 != h.single_precision()) {
+                    if (float64) {
+                        if (keep_large) add_unit_vertices<false, true>(h, created, begin, end);
+                        else add_unit_vertices<false, false>(h, created, begin, end);
+                    } else {
+                        if (keep_large) add_unit_vertices<true, true>(h, created, begin, end);
+                        else add_unit_vertices<true, false>(h, created, begin, end);
+                    }
+                    break;
+                }
+            }
             if (float64) {
                 if (keep_large) add_vertices<true, false, kFloat64Residuals, true>(h, created, begin, end);
                 else add_vertices<true, false, kFloat64Residuals, false>(h, created, begin, end);
+            } else if (space_.quantizer == nullptr) {
+                if (keep_large) add_vertices<true, false, kFloat32Residuals, true>(h, created, begin, end);
+                else add_vertices<true, false, kFloat32Residuals, false>(h, created, begin, end);
             } else {
                 if (keep_large) add_vertices<true, false, kAnyResiduals, true>(h, created, begin, end);
                 else add_vertices<true, false, kAnyResiduals, false>(h, created, begin, end);
@@ -609,6 +635,8 @@ void StaticLevelEncoder::add_vertices(const Mesh& h, const std::vector<std::pair
                     table = kGridBins * role + g.bin;
                 } else if (Residuals == kFloat64Residuals) {
                     r = float64_residual(actual[axis], predicted[role]);
+                } else if (Residuals == kFloat32Residuals) {
+                    r = float32_residual(actual[axis], predicted[role]);
                 } else if (Residuals == kGridResiduals) {  // residual_of's grid points, with the level's GridScale
                     const uint32_t a = grid_point_of_grid_value(grid, f.origin[role], actual[axis]);
                     const uint32_t q = grid_point_at(grid, f.origin[role], predicted[role]);
@@ -641,8 +669,9 @@ void StaticLevelEncoder::add_stencil_vertices(const Mesh& h, const std::vector<s
         const double actual[3] = {p.x, p.y, p.z}, predicted[3] = {q.x, q.y, q.z};
         std::array<uint16_t, kStaticRoles>& symbols = symbols_[i];
         for (int axis = 0; axis < 3; ++axis) {
-            const Residual r = Residuals == kFloat64Residuals ? float64_residual(actual[axis], predicted[axis])
-                                                              : residual_of(space_, axis, actual[axis], predicted[axis]);
+            const Residual r = Residuals == kFloat64Residuals   ? float64_residual(actual[axis], predicted[axis])
+                               : Residuals == kFloat32Residuals ? float32_residual(actual[axis], predicted[axis])
+                                                                : residual_of(space_, axis, actual[axis], predicted[axis]);
             const int token = static_token(r.negative, r.magnitude);
             if (token >= kDirectTokens) {  // never grouped
                 if (KeepLarge) large_.push_back(r);
@@ -706,22 +735,24 @@ void StaticLevelEncoder::code_streams() {
     constexpr uint16_t kTokenMask = (1 << kTokenBits) - 1;
     // The rANS stream back to front, straight from the symbol words (rANS codes backwards).
     RansBackwardEncoder rans(kStaticRoles * symbols_.size(), rans_memory_);
-    auto put = [&](uint16_t symbol) { rans.put(tables_[size_t(symbol >> kTokenBits)], symbol & kTokenMask); };
+    static_assert(sizeof(symbols_[0]) == kStaticRoles * sizeof(uint16_t), "symbol words are contiguous");
+    const uint16_t* words = reinterpret_cast<const uint16_t*>(symbols_.data());
+    const RansTable::Coding* codings[kMaxStaticTables];
+    for (int i = 0; i < table_count_; ++i) codings[i] = tables_[size_t(i)].codings();
+    auto coding = [&](uint16_t word) -> const RansTable::Coding& { return codings[word >> kTokenBits][word & kTokenMask]; };
     if (!grouped_) {
         // The symbol words one after the other (vertex after vertex, role after role).
-        static_assert(sizeof(symbols_[0]) == kStaticRoles * sizeof(uint16_t), "symbol words are contiguous");
-        const uint16_t* words = reinterpret_cast<const uint16_t*>(symbols_.data());
-        const RansTable::Coding* codings[kMaxStaticTables];
-        for (int i = 0; i < table_count_; ++i) codings[i] = tables_[size_t(i)].codings();
-        rans.put_all(kStaticRoles * symbols_.size(),
-                     [&](size_t j) -> const RansTable::Coding& { return codings[words[j] >> kTokenBits][words[j] & kTokenMask]; });
+        rans.put_all(kStaticRoles * symbols_.size(), [&](size_t j) -> const RansTable::Coding& { return coding(words[j]); });
     } else {
-        // Each run: its role-0 tokens, then each vertex's roles 1 and 2 (FORMAT.md 5.7), backwards.
+        // Each run: its role-0 tokens, then each vertex's roles 1 and 2 (FORMAT.md 5.7); the runs backwards.
         for (size_t run = (symbols_.size() + kGridGroup - 1) / kGridGroup; run-- > 0;) {
             const size_t begin = run * kGridGroup, count = std::min(kGridGroup, symbols_.size() - begin);
-            for (size_t i = count; i-- > 0;)
-                for (int role = kStaticRoles; role-- > 1;) put(symbols_[begin + i][size_t(role)]);
-            for (size_t i = count; i-- > 0;) put(symbols_[begin + i][0]);
+            const uint16_t* run_words = words + kStaticRoles * begin;
+            rans.put_all(kStaticRoles * count, [&](size_t j) -> const RansTable::Coding& {
+                if (j < count) return coding(run_words[kStaticRoles * j]);
+                const size_t k = j - count;  // vertex k / 2, role 1 + k % 2
+                return coding(run_words[kStaticRoles * (k >> 1) + 1 + (k & 1)]);
+            });
         }
     }
     rans.finish(rans_);
@@ -2218,7 +2249,61 @@ bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, G
     return decode_static_with(h, created, space, mode, tables, rans_data, rans_size, raw_data, raw_size, grouped);
 }
 
+// The frames of `count` vertices without a grid (mode 5's), for the encoder as its listed
+// decoder makes them: four at a time where the processor has AVX2, else two.
+void make_unit_frames(const Hierarchy& h, const FrameCorners* corners, size_t count, GridFrame* frames) {
+#if AMC_AVX2_AT_RUN_TIME
+    if (has_avx2() && wide_frames_allowed.load(std::memory_order_relaxed)) {
+        QuadUnitFrames()(h, corners, count, frames);
+        return;
+    }
+#endif
+    PairUnitFrames()(h, corners, count, frames);
+}
+
 }  // namespace
+
+// add_vertices<true, false, kFloat64Residuals or kFloat32Residuals> (mode 5, bit-exact) with the
+// frames of decode_unit_listed (GridFrame in axis order, two or four at a time) instead of
+// RoleFrame copies: the same predictions, residuals and tokens in the same order.
+template <bool Float32, bool KeepLarge>
+void StaticLevelEncoder::add_unit_vertices(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin,
+                                           size_t end) {
+    uint64_t raw_bits = 0;
+    Chunk c;
+    std::array<GridFrame, kChunk> frames;
+    for (size_t first = begin; first < end; first += kChunk) {
+        gather_chunk(h, FromNodes<Hierarchy>{h, created}, first, end, c);
+        for (size_t i = 0; i < c.count; ++i) __builtin_prefetch(&h.positions()[c.vertices[i]]);
+        make_unit_frames(h, c.corners, c.count, frames.data());
+        for (size_t i = 0; i < c.count; ++i) {
+            const GridFrame& f = frames[i];
+            const Vec3 p = h.position(c.vertices[i]);
+            const double actual[3] = {p.x, p.y, p.z};
+            const int axes[3] = {f.axis, f.axis == 0 ? 1 : 0, f.axis == 2 ? 1 : 2};  // role_axes'
+            double predicted[3] = {f.midpoint[axes[0]], f.midpoint[axes[1]], f.midpoint[axes[2]]};
+            if (f.has_normal) {  // predict_others
+                const double t = rounded((actual[axes[0]] - f.midpoint[axes[0]]) / f.normal[axes[0]]);
+                predicted[1] = predicted[1] + rounded(t * f.normal[axes[1]]);
+                predicted[2] = predicted[2] + rounded(t * f.normal[axes[2]]);
+            }
+            std::array<uint16_t, kStaticRoles>& symbols = symbols_[first + i];
+            for (int role = 0; role < kStaticRoles; ++role) {
+                const double value = actual[axes[role]];
+                const Residual r = Float32 ? float32_residual(value, predicted[role]) : float64_residual(value, predicted[role]);
+                const int token = static_token(r.negative, r.magnitude);
+                if (token >= kDirectTokens) {
+                    if (KeepLarge) large_.push_back(r);
+                    else put_raw(raw_writer_, r);
+                }
+                symbols[size_t(role)] = uint16_t(role << kTokenBits | token);
+                raw_bits += uint64_t(static_raw_bit_count(r.magnitude));
+                ++counts_[size_t(role)][size_t(token)];
+            }
+        }
+    }
+    raw_bits_ += raw_bits;
+}
 
 bool set_wide_frames(bool allowed) {
 #if AMC_AVX2_AT_RUN_TIME

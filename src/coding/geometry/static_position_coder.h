@@ -159,11 +159,16 @@ private:
     // Tokens, residuals and counts of created[begin, end).
     template <class Mesh>
     void add(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
-    // How add_vertices takes the residuals of modes 3 and 5: residual_of, float64 inline, or grid points inline.
-    static constexpr int kAnyResiduals = 0, kFloat64Residuals = 1, kGridResiduals = 2;
+    // How add_vertices takes the residuals of modes 3 and 5 (and add_stencil_vertices those of 6
+    // and 7): residual_of, float64 or float32 inline, or grid points inline.
+    static constexpr int kAnyResiduals = 0, kFloat64Residuals = 1, kGridResiduals = 2, kFloat32Residuals = 3;
     // KeepLarge: the raw bits wait in large_ (mode 4's grouped order, or a sample's; see below).
     template <bool UnitNormals, bool GridBins, int Residuals, bool KeepLarge, class Mesh>
     void add_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
+    // Mode 5 bit-exact in the hierarchy's own precision (float32 in a single-precision one):
+    // add_vertices with the listed decoder's frames.
+    template <bool Float32, bool KeepLarge>
+    void add_unit_vertices(const Hierarchy& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
     // Modes 6 and 7: each axis against the stencil's prediction, with the table of its axis.
     template <bool Butterfly, int Residuals, bool KeepLarge, class Mesh>
     void add_stencil_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);

@@ -105,20 +105,14 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
             if (r && !(state[i] & kComplete) && unbalanced == n) unbalanced = i;
             if (r) {
                 const NodeId c = h.child(id, 0);
-                next_ids.insert(next_ids.end(), {c, c + 1, c + 2, c + 3});
-            }
-        }
-        if (turned != nullptr) {  // the children in their turned order, turned alike (apart: no cost without turns)
-            NodeId* children = next_ids.data();
-            for (uint32_t i = 0; i < n; ++i) {
-                if (!(refined[i] & 1)) continue;
-                const uint8_t* child = red_split::kRotatedChild[turns[i]];
-                const NodeId c = children[0];
-                for (int k = 0; k < 4; ++k) {
-                    children[k] = c + child[k];
-                    next_turns.push_back(turns[i]);
+                if (turned == nullptr) {
+                    next_ids.insert(next_ids.end(), {c, c + 1, c + 2, c + 3});
+                } else {  // the children in their turned order, turned alike
+                    const uint8_t turn = turns[i];
+                    const uint8_t* child = red_split::kRotatedChild[turn];
+                    next_ids.insert(next_ids.end(), {c + child[0], c + child[1], c + child[2], c + child[3]});
+                    next_turns.insert(next_turns.end(), {turn, turn, turn, turn});
                 }
-                children += 4;
             }
         }
         const bool uniform = options.uniform_levels && all_refined && l == uniform_levels && l < kMaxUniformLevels;
@@ -153,32 +147,48 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
                 }
                 return (truth[i] & 1) != 0;
             });
+        // The leaves' faces (a leaf and its hanging nodes' green triangles) in a pass over the
+        // states alone, with the leaves of two or three hanging nodes listed, then those.
+        std::vector<uint32_t>& two_or_more = m.two_or_more;
+        if (two_or_more.size() < n) two_or_more.resize(n);  // no clearing: only the listed part is read
+        uint32_t listed = 0;
+        uint64_t level_faces = 0;
         for (uint32_t i = 0; i < n; ++i) {
-            if (state[i] & kRefined) continue;
+            const uint32_t leaf = (state[i] & kRefined) == 0;
+            const uint32_t hanging = uint32_t(refined_neighbors(state[i]));
+            level_faces += (1 + hanging) & (0 - leaf);
+            two_or_more[listed] = i;
+            listed += leaf & uint32_t(hanging >= 2);
+        }
+        faces += level_faces;
+        for (uint32_t j = 0; j < listed; ++j) {
+            const uint32_t i = two_or_more[j];
             const int hanging = refined_neighbors(state[i]);
             AMC_REQUIRE(hanging != 3, invalid_input,
                         "encode_hierarchy: node " + std::to_string(ids[i]) + " of level " + std::to_string(l) +
                             " has three hanging nodes but is not refined (the hierarchy is not closed)");
-            faces += 1 + uint64_t(hanging);
-            if (hanging == 2) {
-                const int unrefined = unrefined_edge(level, i);
-                const bool flipped = (truth[i] >> 1) != 0;
-                two_hanging.push_back({unrefined, flipped});
-                if (turned != nullptr) unturned_exceptions_.add(kTurnedEdge[unrefined + turns[i]], flipped);
-                orientation_slots.push_back(events_.size());
-                events_.push_back({kOrientationEvent, 0});
-            }
+            const int unrefined = unrefined_edge(level, i);
+            const bool flipped = (truth[i] >> 1) != 0;
+            two_hanging.push_back({unrefined, flipped});
+            if (turned != nullptr) unturned_exceptions_.add(kTurnedEdge[unrefined + turns[i]], flipped);
+            orientation_slots.push_back(events_.size());
+            events_.push_back({kOrientationEvent, 0});
         }
         stats.levels = l + 1;
         level_end_.push_back(events_.size());
         scan_decided_level(level, numbering, nullptr);
-        const uint64_t created_count = derive_next_level(level, numbering, next, options.cull_one_regularity);
+        derive_next_level(level, numbering, next, options.cull_one_regularity);
         std::vector<std::pair<NodeId, int>>& created = new_vertices_.emplace_back(take_list(m.new_vertices, size_t(l)));
-        created.reserve(created_count);
-        if (turned != nullptr)
-            for_each_new_vertex(level, numbering, [&](uint32_t i, int e) { created.emplace_back(ids[i], kTurnedEdge[e + turns[i]]); });
-        else
-            for_each_new_vertex(level, numbering, [&](uint32_t i, int e) { created.emplace_back(ids[i], e); });
+        // Written into a room that only grows, then copied once (the room holds every edge).
+        std::vector<std::pair<NodeId, int>>& room = m.new_vertex_room;
+        if (room.size() < 3 * size_t(level.refined_count)) room.resize(3 * size_t(level.refined_count));
+        const size_t made = turned != nullptr ? write_new_vertices(level, numbering, room.data(), [&](uint32_t i, int e) {
+            return std::pair<NodeId, int>(ids[i], kTurnedEdge[e + turns[i]]);
+        })
+                                              : write_new_vertices(level, numbering, room.data(), [&](uint32_t i, int e) {
+                                                    return std::pair<NodeId, int>(ids[i], e);
+                                                });
+        created.assign(room.data(), room.data() + made);
         std::swap(level, next);
         level_ids_.push_back(std::move(ids));  // kept whole: no copy of the level's ids
         ids = std::move(next_ids);
@@ -201,13 +211,18 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         events_[orientation_slots[i]].bit = uint8_t(diagonal_flag_by_rule(stats.diagonal_rule, edge) != flag);
     }
 
-    // Stream truncation (II-C): symbols after the last coded 1 are implied zeros.
-    uint64_t symbol_count = 0;
-    for (const Event& e : events_) {
+    // Stream truncation (II-C): symbols after the last coded 1 are implied zeros. Found from the
+    // end (a pass from the front branched on every symbol's bit, a coin flip).
+    const uint64_t symbol_count = events_.size() - orientation_slots.size();
+    uint64_t trailing_zeros = 0;
+    size_t k = events_.size();
+    for (; k > 0; --k) {
+        const Event& e = events_[k - 1];
         if (e.group == kOrientationEvent) continue;
-        ++symbol_count;
-        if (e.bit) kept_symbols_ = symbol_count;
+        if (e.bit) break;
+        ++trailing_zeros;
     }
+    kept_symbols_ = k == 0 ? 0 : symbol_count - trailing_zeros;
     if (!options.truncate_stream) kept_symbols_ = symbol_count;
     stats.truncated = symbol_count - kept_symbols_;
     stats.coded = kept_symbols_;

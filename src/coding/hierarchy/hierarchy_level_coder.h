@@ -166,6 +166,8 @@ public:
         RefinedNumbering numbering;
         std::vector<uint8_t> refined, turns, next_turns;
         std::vector<std::pair<int, bool>> two_hanging;
+        std::vector<uint32_t> two_or_more;  // a level's leaves of two or three hanging nodes
+        std::vector<std::pair<NodeId, int>> new_vertex_room;  // write_new_vertices' room
         std::vector<size_t> orientation_slots;
         std::vector<Event> events;
         std::vector<size_t> level_end;

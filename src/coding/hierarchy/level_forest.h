@@ -230,6 +230,9 @@ uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering
 // canonical order at their first appearance, as Hierarchy::split_level numbers them: f(i, e) for
 // edge e of the refined node i (local index) unless the neighbour across e is a refined node
 // numbered before i (which made that midpoint).
+inline bool makes_midpoint(const uint32_t* block, uint32_t neighbor, uint32_t b) {
+    return block[static_cast<int32_t>(neighbor)] > b;  // kNoLocal for none
+}
 template <class F>
 void for_each_new_vertex(const Level& level, const RefinedNumbering& numbering, F&& f) {
     const uint32_t* block = numbering.block_of();
@@ -238,10 +241,31 @@ void for_each_new_vertex(const Level& level, const RefinedNumbering& numbering, 
         for (uint32_t b = 0; b < level.refined_count; ++b) {
             const Neighbors node = links.neighbors(refined[b]);
             for (int e = 0; e < 3; ++e) {
-                if (block[static_cast<int32_t>(node.nbr[e])] > b) f(refined[b], e);  // kNoLocal for none
+                if (makes_midpoint(block, node.nbr[e], b)) f(refined[b], e);
             }
         }
     });
+}
+
+// for_each_new_vertex without a branch per edge (whether a neighbour made the midpoint is a coin
+// flip): out[k] = make(i, e) for every edge of every refined node, k moved past the new ones only.
+// `out` has room for 3 * level.refined_count; returns the count.
+template <class T, class Make>
+size_t write_new_vertices(const Level& level, const RefinedNumbering& numbering, T* out, Make&& make) {
+    const uint32_t* block = numbering.block_of();
+    const uint32_t* refined = level.refined.data();
+    size_t k = 0;
+    with_links(level, [&](auto links) {
+        for (uint32_t b = 0; b < level.refined_count; ++b) {
+            const uint32_t i = refined[b];
+            const Neighbors node = links.neighbors(i);
+            for (int e = 0; e < 3; ++e) {
+                out[k] = make(i, e);
+                k += makes_midpoint(block, node.nbr[e], b);
+            }
+        }
+    });
+    return k;
 }
 
 // The unrefined edge of a decided leaf with exactly two hanging nodes. Which edge it is follows
