@@ -211,6 +211,35 @@ TEST(NearestVertex, TreeOverTheSpatialOrderTakesItsCodes) {
     }
 }
 
+// A query is searched first in the subtree of its cell of 32^3 code cells, whose answer stands
+// only where no point outside the cell can be as near: points crowd both sides of the cells'
+// sides (the codes' cells are unit cubes here), queries lie just inside them, and the answer is
+// a brute-force scan's, also where the nearest lies just across a side.
+TEST(NearestVertex, NearestAcrossTheSideOfTheQuerysCellIsFound) {
+    Lcg random{53};
+    std::vector<amc::Vec3> points = {{0, 0, 0}, {1024, 1024, 1024}};  // 1024 cells of size 1
+    for (int i = 0; i < 4000; ++i) {
+        const double side = 32 * std::floor(1 + 30 * random.unit());
+        const double across = 1e-4 * (random.unit() - 0.5);
+        amc::Vec3 p = {1024 * random.unit(), 1024 * random.unit(), 1024 * random.unit()};
+        (i % 3 == 0 ? p.x : i % 3 == 1 ? p.y : p.z) = side + across;
+        points.push_back(p);
+    }
+    const amc::NearestVertex nearest(points);
+    int across = 0;
+    for (int query = 0; query < 2000; ++query) {
+        const amc::Vec3 near = points[2 + size_t(random.unit() * 4000)];
+        const amc::Vec3 p = near + 3e-5 * amc::Vec3{random.unit() - 0.5, random.unit() - 0.5, random.unit() - 0.5};
+        const uint32_t found = nearest.find(p, [](uint32_t v) { return v % 3 != 0; });
+        const uint32_t expected = brute_force(points, p, 3);
+        EXPECT_EQ(found, expected) << "query " << query;
+        const amc::Vec3& q = points[expected];
+        across += std::floor(q.x / 32) != std::floor(p.x / 32) || std::floor(q.y / 32) != std::floor(p.y / 32) ||
+                  std::floor(q.z / 32) != std::floor(p.z / 32);
+    }
+    EXPECT_GT(across, 100);  // the case the test is for
+}
+
 TEST(NearestVertex, NoUsableVertexIsNoIndex) {
     const std::vector<amc::Vec3> points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
     const amc::NearestVertex nearest(points);

@@ -17,7 +17,7 @@ NearestVertex::NearestVertex(const std::vector<Vec3>& positions, const std::vect
     nodes_.reserve(size_t(4) * (n / kMortonBucket + 1));
     if (sorted_codes != nullptr && sorted_codes->size() == n) {
         for (uint32_t v = 0; v < n; ++v) points_.push_back({{positions[v].x, positions[v].y, positions[v].z}, v});
-        build_node(*sorted_codes, 0, n, 0);
+        build_jumps(*sorted_codes, build_node(*sorted_codes, 0, n, 0));
         return;
     }
     const std::vector<uint32_t> code = detail::morton_codes(positions);
@@ -28,7 +28,33 @@ NearestVertex::NearestVertex(const std::vector<Vec3>& positions, const std::vect
         points_.push_back({{positions[v].x, positions[v].y, positions[v].z}, v});
         codes_in_order[i] = code[v];
     }
-    build_node(codes_in_order, 0, n, 0);
+    build_jumps(codes_in_order, build_node(codes_in_order, 0, n, 0));
+}
+
+void NearestVertex::build_jumps(const std::vector<uint32_t>& codes, const Box& all) {
+    frame_ = detail::MortonFrame(all.low, all.high);  // the codes' (morton_codes): the same least and greatest coordinates
+    if (!(frame_.scale > 0 && frame_.scale < std::numeric_limits<double>::infinity())) return;
+    constexpr uint32_t kShift = 30 - kJumpBits;  // a prefix's bits in the code
+    jump_.assign(size_t(1) << kJumpBits, Jump{});
+    for (uint32_t prefix = 0; prefix < jump_.size(); ++prefix) {
+        // Down from the root along the prefix, through nodes split by a code bit (a node's points
+        // are then all those with its common prefix), to the first whose points share the whole
+        // prefix, or a leaf, or a cell split at its median.
+        uint32_t x = 0;
+        for (;;) {
+            const Node& node = nodes_[x];
+            const uint32_t differ = codes[node.begin] ^ codes[node.end - 1];
+            const uint32_t shared = differ == 0 ? 30 : 30 - (32 - __builtin_clz(differ));  // top bits in common
+            const uint32_t bits = std::min(shared, kJumpBits);
+            if ((codes[node.begin] >> (30 - bits)) != (prefix >> (kJumpBits - bits))) break;  // no point has the prefix
+            if (bits == kJumpBits || node.second == kNoIndex || differ == 0) {
+                jump_[prefix] = {x, bits};
+                break;
+            }
+            const uint32_t bit = 31 - __builtin_clz(differ);  // >= kShift: the prefix's bit decides
+            x = (prefix >> (bit - kShift) & 1) ? node.second : x + 1;
+        }
+    }
 }
 
 NearestVertex::Box NearestVertex::build_node(const std::vector<uint32_t>& codes, uint32_t begin, uint32_t end,
@@ -91,7 +117,7 @@ NearestVertex::Box NearestVertex::build_node(const std::vector<uint32_t>& codes,
 }
 
 NearestVertex::NearestVertex(const NearestVertex& other, const std::vector<uint32_t>& new_id)
-    : nodes_(other.nodes_), renamed_from_(&other), new_id_(&new_id) {
+    : nodes_(other.nodes_), frame_(other.frame_), jump_(other.jump_), renamed_from_(&other), new_id_(&new_id) {
     points_.reserve(other.points_.size());
     advise_huge_pages(points_.data(), points_.capacity() * sizeof(Point));
     for (const Point& p : other.points_) points_.push_back({{p.x[0], p.x[1], p.x[2]}, new_id[p.vertex]});

@@ -11,6 +11,7 @@
 
 #include "common/exact_float.h"
 #include "common/no_index.h"
+#include "import/spatial_order.h"
 
 #include <amc/mesh.h>
 
@@ -177,7 +178,11 @@ public:
     uint32_t find_nearest(Vec3 p, Usable usable, uint32_t count, uint32_t* out,
                           double max_squared_distance = std::numeric_limits<double>::infinity()) const {
         Nearest best(count, max_squared_distance);
-        if (!points_.empty() && best.wanted > 0) search(p, usable, best);
+        if (!points_.empty() && best.wanted > 0) {
+            // The answer and whether it ties do not depend on the order in which points are met.
+            const uint32_t searched = best.wanted == 1 ? search_cell(p, usable, best) : kNoIndex;
+            if (searched != 0) search(p, usable, best, 0, searched);
+        }
         if (best.tied()) return kd_tree().find_nearest(p, usable, count, out, max_squared_distance);
         return best.copy_to(out);
     }
@@ -197,9 +202,10 @@ private:
     };
     static constexpr int kMaxDepth = 62;  // 30 code bits, then halvings
 
-    // Depth first, the nearer child first, as the k-d tree searches, with a stack instead of calls.
+    // The subtree of node `start` less that of node `skip` (searched already), depth first, the
+    // nearer child first, as the k-d tree searches, with a stack instead of calls.
     template <class Usable>
-    void search(Vec3 p, Usable& usable, Nearest& best) const {
+    void search(Vec3 p, Usable& usable, Nearest& best, uint32_t start, uint32_t skip = kNoIndex) const {
         const double q[3] = {p.x, p.y, p.z};
         struct Pending {
             uint32_t node;
@@ -207,7 +213,7 @@ private:
         };
         Pending stack[kMaxDepth + 1];
         int top = 0;
-        uint32_t index = 0;
+        uint32_t index = start;
         for (;;) {
             const Node& node = nodes_[index];
             if (node.second == kNoIndex) {
@@ -223,10 +229,12 @@ private:
                 const double to_second = c < node.above ? node.above - c : 0.0;
                 const bool first_nearer = to_first <= to_second;
                 const double far_gap = first_nearer ? to_second * to_second : to_first * to_first;
-                if (best.matters(far_gap)) stack[top++] = {first_nearer ? node.second : index + 1, far_gap};
+                const uint32_t far = first_nearer ? node.second : index + 1;
+                if (best.matters(far_gap) && far != skip) stack[top++] = {far, far_gap};
                 const double near_gap = first_nearer ? to_first * to_first : to_second * to_second;
-                if (best.matters(near_gap)) {
-                    index = first_nearer ? index + 1 : node.second;
+                const uint32_t near = first_nearer ? index + 1 : node.second;
+                if (best.matters(near_gap) && near != skip) {
+                    index = near;
                     continue;
                 }
             }
@@ -237,14 +245,66 @@ private:
             index = stack[top].node;
         }
     }
+    // A single nearest vertex, searched first in the subtree that holds every point of p's cell of
+    // kJumpBits code bits (jump_: no descent from the root, most of a query's inner nodes). Returns
+    // 0 when that found one nearer than any point outside the cell can be: the whole tree's answer,
+    // ties included (every point as near lies in the cell). Else the subtree searched (kNoIndex:
+    // none), which the search of the rest skips.
+    template <class Usable>
+    uint32_t search_cell(Vec3 p, Usable& usable, Nearest& best) const {
+        if (jump_.empty()) return kNoIndex;
+        const double c[3] = {p.x, p.y, p.z};
+        double t[3];
+        uint32_t cell[3], prefix = 0;
+        for (int a = 0; a < 3; ++a) {
+            t[a] = frame_.t(c[a], a);
+            if (!(std::fabs(t[a]) < kMaxCellUnits)) return kNoIndex;  // far outside (or NaN): the margin below would not hold
+            cell[a] = detail::MortonFrame::cell_of(t[a]);
+            for (uint32_t k = 0; k < kJumpBits / 3; ++k) prefix |= (cell[a] >> (10 - kJumpBits / 3 + k) & 1) << (3 * k + a);
+        }
+        const Jump jump = jump_[prefix];
+        if (jump.node == kNoIndex || jump.node == 0) return kNoIndex;
+        search(p, usable, best, jump.node);
+        if (best.count == 0) return jump.node;
+        // The cell of the node's common prefix (jump.bits of the code's top bits; all of the node's
+        // points share it, and every point with that prefix is the node's): its range on axis a
+        // is [low, low + 2^free) in cells, and a point outside it lies at t <= low or t >= high.
+        // The least gap from t to a side that points lie beyond (none lie below cell 0 or above
+        // the last), less a margin for the rounding of t (about 1e-13 cells here), bounds the
+        // distance to every point outside.
+        double gap = std::numeric_limits<double>::infinity();
+        const uint32_t free_bits = 30 - jump.bits;
+        for (int a = 0; a < 3; ++a) {
+            const uint32_t free = free_bits > uint32_t(a) ? (free_bits - a + 2) / 3 : 0;  // axis a's bits 3k + a below the prefix
+            const uint32_t low = cell[a] >> free << free, high = low + (1u << free);
+            if (low > 0) gap = std::min(gap, t[a] - low);
+            if (high < detail::MortonFrame::kCellsPerAxis) gap = std::min(gap, high - t[a]);
+        }
+        if (gap == std::numeric_limits<double>::infinity()) return 0;
+        const double distance = (gap - kCellMargin) / frame_.scale;
+        return distance > 0 && best.distance[0] < distance * distance * (1 - 1e-9) ? 0 : jump.node;
+    }
+    static constexpr uint32_t kJumpBits = 15;  // 32768 cells of 32^3 of the 1024^3 (128 KiB of jumps)
+    static constexpr double kMaxCellUnits = 1e6;
+    static constexpr double kCellMargin = 1e-6;
+    // The node to start from for each kJumpBits-bit code prefix, and how many of the code's top
+    // bits its points share (kNoIndex: no node holds that cell's points; search the whole tree).
+    struct Jump {
+        uint32_t node = kNoIndex;
+        uint32_t bits = 0;
+    };
     struct Box {
         double low[3], high[3];
     };
     Box build_node(const std::vector<uint32_t>& codes, uint32_t begin, uint32_t end, int depth);
+    // jump_ and frame_, after build_node: `all` is the root's box.
+    void build_jumps(const std::vector<uint32_t>& codes, const Box& all);
     const KdTree& kd_tree() const;
 
     std::vector<Point> points_;  // in Morton order
     std::vector<Node> nodes_;
+    detail::MortonFrame frame_;  // the cells of the codes the tree was built from
+    std::vector<Jump> jump_;     // empty: the frame is not the codes' (no jumps)
     // What the k-d tree is built from: the positions and their order, or another's tree renamed.
     const std::vector<Vec3>* positions_ = nullptr;
     const std::vector<uint32_t>* insertion_order_ = nullptr;

@@ -10,7 +10,10 @@
 namespace amc {
 
 void Reconstruction::note_guided(VertexId m, NodeId n, int e) {
-    if (guided_of_vertex_.size() <= m) guided_of_vertex_.resize(h_.positions().size(), kNoIndex);
+    if (guided_of_vertex_.size() <= m) {
+        guided_of_vertex_.reserve(leaf_.positions.size());  // as leaf_of_vertex_
+        guided_of_vertex_.resize(h_.positions().size(), kNoIndex);
+    }
     guided_of_vertex_[m] = uint32_t(guided_.size());
     guided_.push_back({n, e});
 }

@@ -6,7 +6,7 @@ namespace amc::detail {
 
 namespace {
 
-constexpr uint32_t kCellsPerAxis = 1024;  // 30-bit codes: two 15-bit counting-sort passes
+constexpr uint32_t kCellsPerAxis = MortonFrame::kCellsPerAxis;  // two 15-bit counting-sort passes
 
 // The 10 bits of x spread to every third bit.
 constexpr uint32_t spread_bits(uint32_t x) {
@@ -30,11 +30,10 @@ constexpr SpreadCells kSpreadCells{};
 
 }  // namespace
 
-std::vector<uint32_t> morton_codes(const std::vector<Vec3>& positions) {
-    const uint32_t n = uint32_t(positions.size());
-    std::vector<uint32_t> code(n);
-    if (n == 0) return code;
-    double low[3] = {positions[0].x, positions[0].y, positions[0].z}, high[3] = {low[0], low[1], low[2]};
+MortonFrame::MortonFrame(const std::vector<Vec3>& positions) {
+    if (positions.empty()) return;
+    double high[3] = {positions[0].x, positions[0].y, positions[0].z};
+    for (int a = 0; a < 3; ++a) low[a] = high[a];
     for (const Vec3& p : positions) {
         const double c[3] = {p.x, p.y, p.z};
         for (int a = 0; a < 3; ++a) {
@@ -42,16 +41,24 @@ std::vector<uint32_t> morton_codes(const std::vector<Vec3>& positions) {
             high[a] = std::max(high[a], c[a]);
         }
     }
-    const double largest = std::max({high[0] - low[0], high[1] - low[1], high[2] - low[2]});
-    const double scale = largest > 0 ? double(kCellsPerAxis) / largest : 0;  // may overflow to infinity: scale 0, one cell
+    *this = MortonFrame(low, high);
+}
+
+MortonFrame::MortonFrame(const double least[3], const double greatest[3]) {
+    for (int a = 0; a < 3; ++a) low[a] = least[a];
+    const double largest = std::max({greatest[0] - low[0], greatest[1] - low[1], greatest[2] - low[2]});
+    scale = largest > 0 ? double(kCellsPerAxis) / largest : 0;  // may overflow to infinity: scale 0, one cell
+}
+
+std::vector<uint32_t> morton_codes(const std::vector<Vec3>& positions) {
+    const uint32_t n = uint32_t(positions.size());
+    std::vector<uint32_t> code(n);
+    if (n == 0) return code;
+    const MortonFrame frame(positions);
     for (uint32_t v = 0; v < n; ++v) {
         const double c[3] = {positions[v].x, positions[v].y, positions[v].z};
         uint32_t key = 0;
-        for (int a = 0; a < 3; ++a) {
-            const double t = (c[a] - low[a]) * scale;
-            const uint32_t cell = t >= 0 ? uint32_t(std::min(t, double(kCellsPerAxis - 1))) : 0;  // NaN: 0
-            key |= kSpreadCells.of[cell] << a;
-        }
+        for (int a = 0; a < 3; ++a) key |= kSpreadCells.of[MortonFrame::cell_of(frame.t(c[a], a))] << a;
         code[v] = key;
     }
     return code;

@@ -23,6 +23,21 @@ std::vector<uint32_t> spatial_vertex_order(const std::vector<Vec3>& positions,
 // neighbours over the whole order and the tree's first splits).
 std::vector<uint32_t> morton_codes(const std::vector<Vec3>& positions);
 
+// The cells of morton_codes: a coordinate c on axis a lies at t = (c - low[a]) * scale in cell
+// units, in cell cell_of(t) of 1024 (clamped: the largest coordinate, and points outside, fall in
+// the end cells).
+struct MortonFrame {
+    static constexpr uint32_t kCellsPerAxis = 1024;  // 30-bit codes
+    double low[3] = {0, 0, 0};
+    double scale = 0;  // 0: one cell (no extent, or one too large)
+    MortonFrame() = default;
+    explicit MortonFrame(const std::vector<Vec3>& positions);
+    // From the positions' least and greatest coordinates.
+    MortonFrame(const double least[3], const double greatest[3]);
+    double t(double c, int a) const { return (c - low[a]) * scale; }
+    static uint32_t cell_of(double t) { return t >= 0 ? uint32_t(t < kCellsPerAxis - 1 ? t : kCellsPerAxis - 1) : 0; }  // NaN: 0
+};
+
 // The indices of `codes` in increasing order of their codes, equal ones in index order (two
 // counting-sort passes).
 std::vector<uint32_t> order_by_codes(const std::vector<uint32_t>& codes);
