@@ -603,6 +603,18 @@ void StaticLevelEncoder::add(const Mesh& h, const std::vector<std::pair<NodeId, 
     }
 }
 
+template <bool KeepLarge>
+AMC_ALWAYS_INLINE void StaticLevelEncoder::take_residual(const Residual& r, int table, uint16_t& symbol, uint64_t& raw_bits) {
+    const int token = static_token(r.negative, r.magnitude);
+    if (token >= kDirectTokens) {  // the raw bits of a large residual: grouped order keeps them for code_streams
+        if (KeepLarge) large_.push_back(r);
+        else put_raw(raw_writer_, r);
+    }
+    symbol = uint16_t(table << kTokenBits | token);
+    raw_bits += uint64_t(static_raw_bit_count(r.magnitude));
+    ++counts_[size_t(table)][size_t(token)];
+}
+
 // The loop of add() for one mode: the frame's kind, the table split and the residuals' kind known when it is compiled.
 // A chunk's corners and frames as the decoder makes them (gather_chunk, frame_chunk), then each
 // vertex's residuals in role order.
@@ -644,14 +656,7 @@ void StaticLevelEncoder::add_vertices(const Mesh& h, const std::vector<std::pair
                 } else {
                     r = residual_of(space, axis, actual[axis], predicted[role]);
                 }
-                const int token = static_token(r.negative, r.magnitude);
-                if (token >= kDirectTokens) {
-                    if (KeepLarge) large_.push_back(r);
-                    else put_raw(raw_writer_, r);
-                }
-                symbols[size_t(role)] = uint16_t(table << kTokenBits | token);
-                raw_bits += uint64_t(static_raw_bit_count(r.magnitude));
-                ++counts_[size_t(table)][size_t(token)];
+                take_residual<KeepLarge>(r, table, symbols[size_t(role)], raw_bits);
             }
         }
     }
@@ -672,14 +677,7 @@ void StaticLevelEncoder::add_stencil_vertices(const Mesh& h, const std::vector<s
             const Residual r = Residuals == kFloat64Residuals   ? float64_residual(actual[axis], predicted[axis])
                                : Residuals == kFloat32Residuals ? float32_residual(actual[axis], predicted[axis])
                                                                 : residual_of(space_, axis, actual[axis], predicted[axis]);
-            const int token = static_token(r.negative, r.magnitude);
-            if (token >= kDirectTokens) {  // never grouped
-                if (KeepLarge) large_.push_back(r);
-                else put_raw(raw_writer_, r);
-            }
-            symbols[size_t(axis)] = uint16_t(axis << kTokenBits | token);
-            raw_bits += uint64_t(static_raw_bit_count(r.magnitude));
-            ++counts_[size_t(axis)][size_t(token)];
+            take_residual<KeepLarge>(r, axis, symbols[size_t(axis)], raw_bits);  // never grouped
         }
     }
     raw_bits_ += raw_bits;
@@ -2291,14 +2289,7 @@ void StaticLevelEncoder::add_unit_vertices(const Hierarchy& h, const std::vector
             for (int role = 0; role < kStaticRoles; ++role) {
                 const double value = actual[axes[role]];
                 const Residual r = Float32 ? float32_residual(value, predicted[role]) : float64_residual(value, predicted[role]);
-                const int token = static_token(r.negative, r.magnitude);
-                if (token >= kDirectTokens) {
-                    if (KeepLarge) large_.push_back(r);
-                    else put_raw(raw_writer_, r);
-                }
-                symbols[size_t(role)] = uint16_t(role << kTokenBits | token);
-                raw_bits += uint64_t(static_raw_bit_count(r.magnitude));
-                ++counts_[size_t(role)][size_t(token)];
+                take_residual<KeepLarge>(r, role, symbols[size_t(role)], raw_bits);
             }
         }
     }

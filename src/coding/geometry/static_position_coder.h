@@ -162,6 +162,10 @@ private:
     // How add_vertices takes the residuals of modes 3 and 5 (and add_stencil_vertices those of 6
     // and 7): residual_of, float64 or float32 inline, or grid points inline.
     static constexpr int kAnyResiduals = 0, kFloat64Residuals = 1, kGridResiduals = 2, kFloat32Residuals = 3;
+    // One residual of table `table`: its token into `symbol`, its count, and its raw bits (if any)
+    // to large_ (KeepLarge) or the raw stream; raw_bits adds their number.
+    template <bool KeepLarge>
+    void take_residual(const StaticResidual& r, int table, uint16_t& symbol, uint64_t& raw_bits);
     // KeepLarge: the raw bits wait in large_ (mode 4's grouped order, or a sample's; see below).
     template <bool UnitNormals, bool GridBins, int Residuals, bool KeepLarge, class Mesh>
     void add_vertices(const Mesh& h, const std::vector<std::pair<NodeId, int>>& created, size_t begin, size_t end);
