@@ -32,12 +32,6 @@
 
 namespace {
 
-double thread_seconds() {
-    timespec t;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
 // Draco's Edgebreaker decoder, timing DecodeConnectivity() in CPU time.
 class CpuTimedEdgebreakerDecoder : public draco::MeshEdgebreakerDecoder {
 public:

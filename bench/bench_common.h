@@ -34,6 +34,13 @@ inline bool read_level(const amc::Hierarchy& h, const std::vector<amc::NodeId>& 
     return all_refined;
 }
 
+// CPU time of the calling thread, seconds: on the shared machine wall time also counts other jobs' turns.
+inline double thread_seconds() {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
 // A hierarchy file's model name: its file name without directory and extension.
 inline std::string model_name(const std::string& path) {
     const std::string file = path.substr(path.find_last_of('/') + 1);

@@ -424,12 +424,6 @@ int encode_rusage(int runs, int bits, bool kept, const char* path) {
     });
 }
 
-double thread_cpu_seconds() {
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
 // The rulers of vcpu-speeds: 300,000 random reads of 32 MiB offered to huge pages, either fresh
 // (mapped, written a word a page, read, unmapped: a decode's output and working memory are fresh)
 // or kept (mapped and written once; then only read).
@@ -494,18 +488,18 @@ int vcpu_speeds(double seconds, int bits, const char* path) {
             const HugeBuffer kept;
             uint64_t seed = 1;
             while (now() - start < seconds) {
-                const double t = now() - start, a0 = thread_cpu_seconds();
+                const double t = now() - start, a0 = thread_seconds();
                 for (int i = 0; i < 2000000; ++i) seed = seed * 6364136223846793005ull + 1;
-                const double c0 = thread_cpu_seconds();
+                const double c0 = thread_seconds();
                 seed = HugeBuffer().read_at_random(seed);
-                const double c1 = thread_cpu_seconds();
+                const double c1 = thread_seconds();
                 seed = kept.read_at_random(seed);
-                const double c2 = thread_cpu_seconds();
+                const double c2 = thread_seconds();
                 if (!bytes.empty()) {
                     const amc::Hierarchy back = amc::decode(bytes.data(), bytes.size(), d);
                     seed += back.node_count();
                 }
-                calls[k].push_back({int(t), c0 - a0, c1 - c0, c2 - c1, thread_cpu_seconds() - c2});
+                calls[k].push_back({int(t), c0 - a0, c1 - c0, c2 - c1, thread_seconds() - c2});
             }
             if (seed == 0) std::printf(" ");  // keeps the work
         });
@@ -567,22 +561,17 @@ int alone_together(const std::string& what, int bits, double seconds, const char
             if (back.node_count() != h.node_count()) std::abort();
         }
     };
-    // Seconds on the system-wide monotonic clock, which both processes read.
-    auto clock_seconds = [] {
-        timespec t{};
-        clock_gettime(CLOCK_MONOTONIC, &t);
-        return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-    };
-    const double start = std::floor(clock_seconds()) + 2, end = start + seconds;
+    // now() reads steady_clock, CLOCK_MONOTONIC on Linux: a clock both processes share.
+    const double start = std::floor(now()) + 2, end = start + seconds;
     const pid_t other = fork();
     if (other < 0) return 1;
     if (other == 0) {  // the second process: busy in even seconds, starting a call only if it ends within the second
         double last = 0;
-        while (clock_seconds() < end + 1) {
-            const double t = clock_seconds();
+        while (now() < end + 1) {
+            const double t = now();
             if (long(t) % 2 == 0 && t + last < std::floor(t) + 1) {
                 call();
-                last = clock_seconds() - t;
+                last = now() - t;
             } else {
                 usleep(1000);
             }
@@ -590,11 +579,11 @@ int alone_together(const std::string& what, int bits, double seconds, const char
         _exit(0);
     }
     std::vector<double> cpu[2];  // [0]: calls within an even second (the other process busy), [1]: odd
-    while (clock_seconds() < start) usleep(1000);
-    while (clock_seconds() < end) {
-        const double t0 = clock_seconds(), c0 = thread_cpu_seconds();
+    while (now() < start) usleep(1000);
+    while (now() < end) {
+        const double t0 = now(), c0 = thread_seconds();
         call();
-        const double c1 = thread_cpu_seconds(), t1 = clock_seconds();
+        const double c1 = thread_seconds(), t1 = now();
         if (long(t0) == long(t1)) cpu[long(t0) % 2].push_back(c1 - c0);
     }
     kill(other, SIGTERM);

@@ -23,13 +23,6 @@
 
 namespace {
 
-// CPU time of this thread: on the shared machine wall time also counts other jobs' turns.
-double thread_seconds() {
-    timespec t;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
 void run(const char* name, const amc::TriangleMesh& base, const amc::TriangleMesh& leaf, int repetitions) {
     std::vector<double> rates;
     for (int r = 0; r < repetitions; ++r) {

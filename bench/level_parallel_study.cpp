@@ -434,12 +434,6 @@ struct Decoder2p {
     }
 };
 
-double thread_seconds() {
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
 // The library's deciding (decode_phases' decide phase): every level, no build.
 uint64_t decide_library(HierarchyLevelDecoder& coder, const Hierarchy& h, const std::vector<uint8_t>& bytes) {
     HierarchyStreamHeader header;

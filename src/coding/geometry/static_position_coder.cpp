@@ -1781,25 +1781,39 @@ AMC_ALWAYS_INLINE uint64_t unit_value_bits(double predicted, uint64_t residual) 
     return double_bits_of(ordered_of(bit_cast<uint64_t>(std::isfinite(predicted) ? predicted : 0.0)) + residual);
 }
 
+// A GridFrame's axes in role order (role_axes'): its axis, then the two others in increasing order.
+AMC_ALWAYS_INLINE std::array<int, 3> unit_role_axes(const GridFrame& f) {
+    return {f.axis, f.axis == 0 ? 1 : 0, f.axis == 2 ? 1 : 2};
+}
+
+// predict_others over a GridFrame: roles 1 and 2's predictions (`axes` from unit_role_axes) once
+// role 0's value is known.
+AMC_ALWAYS_INLINE void predict_unit_others(const GridFrame& f, const std::array<int, 3>& axes, double first_value, double& second,
+                                           double& third) {
+    second = f.midpoint[axes[1]];
+    third = f.midpoint[axes[2]];
+    if (f.has_normal) {
+        const double u = rounded((first_value - f.midpoint[axes[0]]) / f.normal[axes[0]]);
+        second = second + rounded(u * f.normal[axes[1]]);
+        third = third + rounded(u * f.normal[axes[2]]);
+    }
+}
+
 // decode_vertex<State, false> over a GridFrame, into p's axes; `largest` takes the largest
 // magnitude's bits of the three coordinates (a non-finite one is above every finite one).
 template <int State, bool Safe, bool Float32>
 AMC_ALWAYS_INLINE void decode_unit_vertex(StencilStreams& s, const StencilTable* t, const GridFrame& f, Coordinates& p,
                                           uint64_t& largest) {
-    const int a0 = f.axis, a1 = a0 == 0 ? 1 : 0, a2 = a0 == 2 ? 1 : 2;
-    const uint64_t b0 = unit_value_bits<Float32>(f.midpoint[a0], s.residual<State, Safe>(t[0]));
+    const std::array<int, 3> axes = unit_role_axes(f);
+    const uint64_t b0 = unit_value_bits<Float32>(f.midpoint[axes[0]], s.residual<State, Safe>(t[0]));
     const double value = bit_cast<double>(b0);
-    double second = f.midpoint[a1], third = f.midpoint[a2];
-    if (f.has_normal) {  // predict_others
-        const double u = rounded((value - f.midpoint[a0]) / f.normal[a0]);
-        second = second + rounded(u * f.normal[a1]);
-        third = third + rounded(u * f.normal[a2]);
-    }
+    double second, third;
+    predict_unit_others(f, axes, value, second, third);
     const uint64_t b1 = unit_value_bits<Float32>(second, s.residual<1 - State, Safe>(t[1]));
     const uint64_t b2 = unit_value_bits<Float32>(third, s.residual<State, Safe>(t[2]));
-    p[a0] = value;
-    p[a1] = bit_cast<double>(b1);
-    p[a2] = bit_cast<double>(b2);
+    p[axes[0]] = value;
+    p[axes[1]] = bit_cast<double>(b1);
+    p[axes[2]] = bit_cast<double>(b2);
     largest = std::max(largest, std::max(b0 & ~kSign64, std::max(b1 & ~kSign64, b2 & ~kSign64)));
 }
 
@@ -2278,13 +2292,10 @@ void StaticLevelEncoder::add_unit_vertices(const Hierarchy& h, const std::vector
             const GridFrame& f = frames[i];
             const Vec3 p = h.position(c.vertices[i]);
             const double actual[3] = {p.x, p.y, p.z};
-            const int axes[3] = {f.axis, f.axis == 0 ? 1 : 0, f.axis == 2 ? 1 : 2};  // role_axes'
-            double predicted[3] = {f.midpoint[axes[0]], f.midpoint[axes[1]], f.midpoint[axes[2]]};
-            if (f.has_normal) {  // predict_others
-                const double t = rounded((actual[axes[0]] - f.midpoint[axes[0]]) / f.normal[axes[0]]);
-                predicted[1] = predicted[1] + rounded(t * f.normal[axes[1]]);
-                predicted[2] = predicted[2] + rounded(t * f.normal[axes[2]]);
-            }
+            const std::array<int, 3> axes = unit_role_axes(f);
+            double second, third;
+            predict_unit_others(f, axes, actual[axes[0]], second, third);
+            const double predicted[3] = {f.midpoint[axes[0]], second, third};
             std::array<uint16_t, kStaticRoles>& symbols = symbols_[first + i];
             for (int role = 0; role < kStaticRoles; ++role) {
                 const double value = actual[axes[role]];

@@ -226,13 +226,16 @@ uint64_t leaf_faces_of_level(const Level& level);
 uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering, Level& next,
                            bool cull_one_regularity, ChildLinkRoom room = {});
 
+// Whether refined node b (local index) makes the midpoint of its edge to `neighbor`: unless the
+// neighbour is a refined node numbered before b (which made it).
+inline bool makes_midpoint(const uint32_t* block, uint32_t neighbor, uint32_t b) {
+    return block[static_cast<int32_t>(neighbor)] > b;  // kNoLocal for none
+}
+
 // The vertices the splits of a decided, numbered level create (derive_next_level counts them), in
 // canonical order at their first appearance, as Hierarchy::split_level numbers them: f(i, e) for
 // edge e of the refined node i (local index) unless the neighbour across e is a refined node
 // numbered before i (which made that midpoint).
-inline bool makes_midpoint(const uint32_t* block, uint32_t neighbor, uint32_t b) {
-    return block[static_cast<int32_t>(neighbor)] > b;  // kNoLocal for none
-}
 template <class F>
 void for_each_new_vertex(const Level& level, const RefinedNumbering& numbering, F&& f) {
     const uint32_t* block = numbering.block_of();
