@@ -639,8 +639,13 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     hierarchy.set_lean_at_end(options.lean_memory);
     hierarchy.set_single_stream(true);
     Hierarchy& h = hierarchy.hierarchy();
-    // The metadata's counts let the hierarchy grow in place, as far as the file's size warrants.
-    const uint64_t reserved_nodes = std::min<uint64_t>(meta.nodes, meta.base_triangles + kReservedNodesPerFileByte * size);
+    // The metadata's counts let the hierarchy grow in place, as far as the file's size warrants,
+    // or the uniform levels, which are built whatever the stream holds (a file of uniform levels
+    // is tiny: grown level by level, its old arrays raised glibc's thresholds, and with them
+    // the freed memory it keeps).
+    const uint64_t reserved_nodes = std::min<uint64_t>(
+        meta.nodes, std::max<uint64_t>(meta.base_triangles + kReservedNodesPerFileByte * size,
+                                       hierarchy.uniform_node_count(options.max_level)));
     h.reserve(reserved_nodes, std::min<uint64_t>(meta.vertices, meta.base_vertices + reserved_nodes));
     int level = 0;
     Block numbering_block{};

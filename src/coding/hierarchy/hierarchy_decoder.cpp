@@ -5,6 +5,7 @@
 #include "common/compiler.h"
 #include "hierarchy/hierarchy_builder.h"
 
+#include <algorithm>
 #include <string>
 #include <utility>
 
@@ -134,6 +135,16 @@ void HierarchyLevelDecoder::start(NodeId first_root, uint32_t roots, const Hiera
     leaf_faces_ = 0;
 }
 
+uint64_t HierarchyLevelDecoder::uniform_node_count(int max_level) const {
+    const int levels = max_level < 0 ? header_.uniform_levels : std::min(int(header_.uniform_levels), max_level);
+    uint64_t nodes = level_size(), level_nodes = nodes;
+    for (int l = 0; l < levels; ++l) {
+        level_nodes *= 4;
+        nodes += level_nodes;
+    }
+    return nodes;
+}
+
 std::vector<NodeId> HierarchyLevelDecoder::level_nodes() const {
     const size_t n = level_size();
     std::vector<NodeId> ids(n);
@@ -163,6 +174,8 @@ void HierarchyLevelDecoder::decode_level(ArithmeticDecoder& decoder, uint64_t ma
         numbering_.deallocate();
     }
     if (lean) release_before_build();
+    // What the level after this one will not reuse goes before the split faults its children in.
+    if (single_stream_ && !last_built) free_before_next_level();
     build_decided_levels();
     if (lean) {
         for (Level& built : spare_)  // the split parents listed stay for new_vertex_corners()
@@ -336,11 +349,17 @@ void HierarchyLevelDecoder::free_before_next_level() {
     const bool symbols_may_end =
         header_.options.truncate_stream && l + 1 >= header_.uniform_levels &&
         header_.symbol_count - symbols_read_ <= (l < header_.uniform_levels ? 0 : codable_symbols(level_, header_));
+    auto dead = [&](const Level& spare) {
+        return symbols_may_end || spare.nbr.capacity() > ScratchArray<Neighbors>::kShrinkFactor * n;
+    };
     for (Level& spare : spare_) {
-        if (!symbols_may_end && spare.nbr.capacity() <= ScratchArray<Neighbors>::kShrinkFactor * n) continue;
+        if (!dead(spare)) continue;
         spare.free_all_but_splits();
         if (spare.refined.data() != split_parents_) spare.refined.deallocate();  // new_vertex_corners() walks them
     }
+    // A spare once split, which reads its refined nodes alone (of several decided levels, each
+    // one's links are the split of the one before).
+    if (decided_.size() == 1 && dead(decided_.back())) decided_.back().free_all_but_splits();
     traversal_.shrink_working_memory(n);
     numbering_.shrink_for(n);
     closures_.shrink_for(n);

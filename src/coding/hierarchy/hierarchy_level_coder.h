@@ -274,6 +274,9 @@ public:
     void build_decided_levels();
     uint64_t node_count() const { return node_count_; }
     uint64_t vertex_count() const { return vertex_count_; }
+    // The nodes of the stream's levels 0 .. min(uniform levels, max_level) (max_level < 0: no
+    // limit), which every decode builds without reading a symbol (checked against max_nodes).
+    uint64_t uniform_node_count(int max_level) const;
     // Faces of the conforming leaf mesh that the leaves of the decided levels have (1 + hanging
     // nodes each): after the last level, the leaf mesh's face count, without a pass over the nodes.
     uint64_t leaf_faces() const { return leaf_faces_; }
@@ -302,10 +305,11 @@ private:
     // set_lean's release once the decided level is derived and its new vertices listed, before it
     // is built: everything but the level's refined nodes and the next level's links.
     void release_before_build();
-    // set_single_stream's frees: once a level is built, of the spare levels when the next level
-    // may use up the stored symbols or the levels shrink, and of the scratch far larger than the
-    // next level needs (ScratchArray::shrink_for); before the last level is derived, of the
-    // working memory its derivation does not read.
+    // set_single_stream's frees: before a level is built and again after, of the spare levels
+    // (and of the decided level, which the split makes one) when the next level may use up the
+    // stored symbols or the levels shrink, and of the scratch far larger than the next level
+    // needs (ScratchArray::shrink_for); before the last level is derived, of the working memory
+    // its derivation does not read.
     void free_before_next_level();
     void free_before_last_derive(Level& next, bool links_in_room);
     // decide_level for a stream of the newest version, or of version 1 (kVersion1).
