@@ -674,14 +674,17 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
         const LevelBlockParts parts = split_level_block(block, reader.version(), space.quantizer != nullptr, where);
         ArithmeticDecoder decoder(parts.arithmetic, parts.arithmetic_size);
         // Every new vertex gets its decoded position below; a static mode with a frame takes their
-        // frame corners from the split, without reading the nodes again.
-        const bool listed = has_frame(parts.predictor);
-        hierarchy.set_new_vertex_listing(listed, false, listed);
+        // frame corners from the split, without reading the nodes again; the arithmetic modes
+        // walk the split's parents for their edges (a list would be 8 bytes a vertex at the peak).
+        const bool listed = has_frame(parts.predictor), walked = !is_static_mode(parts.predictor);
+        hierarchy.set_new_vertex_listing(listed || walked, false, listed);
         // The refined nodes R of a level create at least 1.5 R vertices, whose positions are in
         // this block: it bounds R before the next level is allocated.
         hierarchy.decode_level(decoder, 2 * max_decodable_positions(block.size - 1) / 3);
         if (listed)
             decode_listed_level_geometry(h, hierarchy.new_vertex_corners(), parts, decoder, space, where);
+        else if (walked)
+            decode_walked_level_geometry(h, hierarchy.new_vertex_edges(), parts, decoder, positions, level, where);
         else
             decode_level_geometry(h, hierarchy.new_vertices(), parts, decoder, positions, space, level, where);
         ++level;

@@ -478,6 +478,27 @@ void decode_listed_level_geometry(Hierarchy& h, NewVertexCorners corners, const 
                         });
 }
 
+namespace {
+
+// The arithmetic-coded modes (midpoint, butterfly) over each (node, edge) that for_each visits.
+template <class ForEach>
+void decode_arithmetic_level(Hierarchy& h, ForEach&& for_each, const LevelBlockParts& parts, ArithmeticDecoder& decoder,
+                             PositionCoder& positions, int level, const std::string& where) {
+    RawBitReader raw(parts.after_arithmetic, parts.after_arithmetic_size);
+    RawBitReader* side = parts.raw_side ? &raw : nullptr;
+    for_each([&](NodeId n, int e) {
+        const Vec3 p = positions.decode(decoder, level_context(h.level(n)), predict(h, parts.predictor, n, e), side);
+        AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
+                    "level " + std::to_string(level) + " geometry is corrupt (non-finite coordinate)");
+        h.set_position(h.midpoint(n, e), p);
+    });
+    AMC_REQUIRE(!positions.saw_invalid_symbol(), corrupt, where + " is truncated or corrupt");
+    AMC_REQUIRE(!decoder.overran(), corrupt, where + " is truncated or corrupt");
+    AMC_REQUIRE(side == nullptr || raw.ended_cleanly(), corrupt, where + ": raw bits are truncated or left over");
+}
+
+}  // namespace
+
 void decode_level_geometry(Hierarchy& h, const NewVertices& created, const LevelBlockParts& parts, ArithmeticDecoder& decoder,
                            PositionCoder& positions, CoordinateSpace space, int level, const std::string& where) {
     if (is_static_mode(parts.predictor)) {
@@ -488,17 +509,16 @@ void decode_level_geometry(Hierarchy& h, const NewVertices& created, const Level
                             });
         return;
     }
-    RawBitReader raw(parts.after_arithmetic, parts.after_arithmetic_size);
-    RawBitReader* side = parts.raw_side ? &raw : nullptr;
-    for (auto [n, e] : created) {
-        const Vec3 p = positions.decode(decoder, level_context(h.level(n)), predict(h, parts.predictor, n, e), side);
-        AMC_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), corrupt,
-                    "level " + std::to_string(level) + " geometry is corrupt (non-finite coordinate)");
-        h.set_position(h.midpoint(n, e), p);
-    }
-    AMC_REQUIRE(!positions.saw_invalid_symbol(), corrupt, where + " is truncated or corrupt");
-    AMC_REQUIRE(!decoder.overran(), corrupt, where + " is truncated or corrupt");
-    AMC_REQUIRE(side == nullptr || raw.ended_cleanly(), corrupt, where + ": raw bits are truncated or left over");
+    auto for_each = [&](auto&& visit) {
+        for (auto [n, e] : created) visit(n, e);
+    };
+    decode_arithmetic_level(h, for_each, parts, decoder, positions, level, where);
+}
+
+void decode_walked_level_geometry(Hierarchy& h, const NewVertexEdges& edges, const LevelBlockParts& parts,
+                                  ArithmeticDecoder& decoder, PositionCoder& positions, int level, const std::string& where) {
+    AMC_REQUIRE(!is_static_mode(parts.predictor), invalid_input, where + ": walked edges need a mode without tables");
+    decode_arithmetic_level(h, [&](auto&& visit) { edges.for_each(visit); }, parts, decoder, positions, level, where);
 }
 
 }  // namespace amc

@@ -125,6 +125,10 @@ LevelBlockParts split_level_block(const Block& block, uint8_t file_version, bool
 // in h. Throws Error on a corrupt or truncated block.
 void decode_level_geometry(Hierarchy& h, const NewVertices& created, const LevelBlockParts& parts, ArithmeticDecoder& decoder,
                            PositionCoder& positions, CoordinateSpace space, int level, const std::string& where);
+// The same for a level in a mode without tables (midpoint, butterfly: not is_static_mode, else
+// Error) whose new vertices `edges` walks (HierarchyLevelDecoder::new_vertex_edges).
+void decode_walked_level_geometry(Hierarchy& h, const NewVertexEdges& edges, const LevelBlockParts& parts,
+                                  ArithmeticDecoder& decoder, PositionCoder& positions, int level, const std::string& where);
 // The same for a level in a static mode (is_static_mode(parts.predictor), else Error) whose new
 // vertices `corners` lists with their frame corners (HierarchyLevelDecoder::new_vertex_corners).
 void decode_listed_level_geometry(Hierarchy& h, NewVertexCorners corners, const LevelBlockParts& parts,

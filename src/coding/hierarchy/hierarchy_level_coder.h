@@ -214,8 +214,8 @@ public:
         boundary_context_ = context;
     }
     // Until the next restart, how decode_level hands over the vertices it creates: with
-    // `corners`, as their frame corners (new_vertex_corners()) instead of new_vertices(), which
-    // stays empty; with `placed` false, their positions left at zero for the caller to set (a
+    // `corners`, as their frame corners (new_vertex_corners()) or their parents' edges
+    // (new_vertex_edges()) instead of new_vertices(), which stays empty; with `placed` false, their positions left at zero for the caller to set (a
     // decoder whose geometry sets every one of them); with `appended` too, where the level is
     // built at the hierarchy's end without seam vertices, not even made: the caller appends them
     // in id order (HierarchyBuilder::append_positions) before the next level.
@@ -259,6 +259,10 @@ public:
     // walked from that level's split parents in hierarchy(): valid until the next decode_level.
     NewVertexCorners new_vertex_corners() const {
         return NewVertexCorners(*h_, split_parents_, split_parent_count_, new_vertex_first_, new_vertex_count_);
+    }
+    // The same vertices as (parent, edge), walked from the same split parents.
+    NewVertexEdges new_vertex_edges() const {
+        return NewVertexEdges(*h_, split_parents_, split_parent_count_, new_vertex_first_, new_vertex_count_);
     }
     VertexId new_vertex_first() const { return new_vertex_first_; }
     size_t new_vertex_count() const { return new_vertex_count_; }
