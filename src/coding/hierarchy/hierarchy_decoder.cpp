@@ -370,8 +370,9 @@ void HierarchyLevelDecoder::free_before_last_derive(Level& next, bool links_in_r
     traversal_.free_working_memory();
     closures_.deallocate();
     level_.lowered.deallocate();  // its own derivation's
-    if (links_in_room) {  // the last level keeps its states and block edges alone
+    if (links_in_room) {  // the last level keeps its states alone
         next.nbr.deallocate();
+        next.edges.deallocate();
         next.lowered.deallocate();
         next.refined.deallocate();
     }

@@ -154,7 +154,8 @@ uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering
     next.refined_count = 0;
     next.resize_state(size_t(4) * count);
     Neighbors* const out = room.words == nullptr ? next.nbr.reserve(size_t(4) * count) : nullptr;
-    BlockEdges* out_edges = next.edges.reserve(count);
+    // A level in the room is all leaves: no traversal nor derivation reads its block edges.
+    BlockEdges* out_edges = room.words == nullptr ? next.edges.reserve(count) : nullptr;
     uint32_t* lowered = room.words == nullptr ? next.lowered.reserve(size_t(2) * count) : nullptr;  // two words a block
     uint32_t lowered_count = 0;
     const NewBlock* const new_blocks = kNewBlocks.of[cull_one_regularity ? 1 : 0];
@@ -174,7 +175,7 @@ uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering
                 block[static_cast<int32_t>(p.nbr[2])], p.nbr_edge);  // kNoLocal for none
             if (decltype(in_room)::value) copy_links_to_room(made, room.words + ChildLinkRoom::kStride * c);
             const NewBlock& entry = new_blocks[linked | ((p.flags & 7u) << 3)];
-            out_edges[b] = {uint8_t(p.nbr_edge & entry.edge_mask), uint8_t(p.flags & 7)};
+            if (!decltype(in_room)::value) out_edges[b] = {uint8_t(p.nbr_edge & entry.edge_mask), uint8_t(p.flags & 7)};
             counts += entry.counts;
 #if AMC_LITTLE_ENDIAN
             std::memcpy(out_state + c, &entry.states, 4);  // byte k: child k

@@ -221,8 +221,9 @@ uint64_t leaf_faces_of_level(const Level& level);
 // node one bucket lower for each incomplete neighbour (NewBlock), as the improved traversal wants
 // them: what the culled nodes' decisions would do to their neighbours, in any order.
 // With `room` (words set, HierarchyBuilder::open_children's), the links go to the room of the
-// nodes they become instead of next.nbr, which is left as it was: a level that only split_level
-// (LevelSplits::links_in_place) reads, the last, needs no array of its own.
+// nodes they become instead of next.nbr, and no block edges are made (next.nbr and next.edges are
+// left as they were): a level that only split_level (LevelSplits::links_in_place) reads, the
+// last, needs neither.
 uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering, Level& next,
                            bool cull_one_regularity, ChildLinkRoom room = {});
 
