@@ -209,9 +209,16 @@ FloatResidualModels::FloatResidualModels(int contexts) {
     if (contexts < 1) {
         throw Error("FloatResidualModels: context count " + std::to_string(contexts) + " < 1");
     }
-    // One context made, then copied: a 132 KB table of 51 contexts is a memcpy, not 16,500
-    // BitModel constructors (a fifth of the amc_decode fuzz target's time, instrumented).
-    contexts_.assign(static_cast<size_t>(contexts), Context{});
+    contexts_.resize(static_cast<size_t>(contexts));
+    made_.assign(static_cast<size_t>(contexts), 0);
+}
+
+void FloatResidualModels::make(int c) {
+    // A fresh context copied, not 324 BitModel constructors (the table made whole at once cost a
+    // fifth of the amc_decode fuzz target's time, instrumented).
+    static const Context kFresh{};
+    ::new (static_cast<void*>(contexts_[static_cast<size_t>(c)].bytes)) Context(kFresh);
+    made_[static_cast<size_t>(c)] = 1;
 }
 
 void FloatResidualModels::context_out_of_range(int c) const {

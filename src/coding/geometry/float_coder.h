@@ -42,6 +42,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <new>
+#include <type_traits>
 #include <vector>
 
 namespace amc {
@@ -117,7 +119,9 @@ public:
     // Throws Error for a context outside [0, context_count()).
     Context& context(int c) {
         if (c < 0 || c >= context_count()) context_out_of_range(c);
-        return contexts_[static_cast<size_t>(c)];
+        Slot& slot = contexts_[static_cast<size_t>(c)];
+        if (!made_[static_cast<size_t>(c)]) make(c);
+        return *std::launder(reinterpret_cast<Context*>(slot.bytes));
     }
 
     // Set by the decoding functions when they met a symbol an encoder cannot produce (a bit
@@ -128,7 +132,17 @@ public:
 
 private:
     [[noreturn]] void context_out_of_range(int c) const;
-    std::vector<Context> contexts_;
+    void make(int c);
+    // A context is made when first used: a decode uses a few of them, and the pages of the
+    // others (2.6 KB a context) are then never touched (a tenth of a MiB at a decode's peak).
+    struct Slot {
+        Slot() {}  // uninitialized: make() writes the context
+        alignas(Context) unsigned char bytes[sizeof(Context)];
+    };
+    static_assert(std::is_trivially_copyable_v<Context> && std::is_trivially_destructible_v<Context>,
+                  "slots are copied and dropped as bytes");
+    std::vector<Slot> contexts_;
+    std::vector<uint8_t> made_;
     bool invalid_ = false;
 };
 
