@@ -2,7 +2,6 @@
 // level in one pass, and fetch nodes ahead. Internal: not part of the installed headers.
 #pragma once
 
-#include "common/check.h"
 #include "common/compiler.h"
 
 #include <amc/hierarchy.h>
@@ -64,40 +63,6 @@ private:
     VertexId next_vertex_ = 0;
     size_t made_ = 0, handed_ = 0;
     FrameCorners run_[kRun + 2];
-};
-
-// The (parent, edge) of each of the `count` vertices from `first` that splitting
-// parents[0..parent_count) of h in this order made, in id order: NewVertexCorners' walk, for the
-// geometry modes that predict from the parent's edge (midpoint, butterfly), where a list of the
-// pairs would take 8 bytes a vertex at a decode's peak.
-class NewVertexEdges {
-public:
-    NewVertexEdges(const Hierarchy& h, const NodeId* parents, uint32_t parent_count, VertexId first, size_t count)
-        : h_(&h), parents_(parents), parent_count_(parent_count), first_(first), count_(count) {}
-    size_t size() const { return count_; }
-    // visit(parent, edge) for each vertex in id order; throws Error when the parents made fewer.
-    template <class Visit>
-    void for_each(Visit&& visit) const {
-        const Hierarchy& h = *h_;
-        VertexId next = first_;
-        const VertexId end = VertexId(first_ + count_);
-        for (uint32_t b = 0; b < parent_count_ && next != end; ++b) {
-            const NodeId p = parents_[b];
-            for (int e = 0; e < 3; ++e) {
-                if (h.midpoint(p, e) != next) continue;  // an earlier parent's midpoint
-                visit(p, e);
-                if (++next == end) break;
-            }
-        }
-        AMC_REQUIRE(next == end, corrupt, "split parents made fewer vertices than listed");
-    }
-
-private:
-    const Hierarchy* h_;
-    const NodeId* parents_;
-    uint32_t parent_count_;
-    VertexId first_;
-    size_t count_;
 };
 
 // Where split_level writes when decoders of several chunks build one hierarchy at once, each on
@@ -295,6 +260,30 @@ struct HierarchyBuilder {
     static unsigned neighbor_edges(const Hierarchy& h, NodeId n) { return h.nodes_[n].nbr_edge; }
     // Hints the processor to fetch node n (for traversals that know their next nodes early).
     static void prefetch(const Hierarchy& h, NodeId n) { __builtin_prefetch(h.nodes_.data() + n); }
+};
+
+// The (parent, edge) of each of the `count` vertices from `first` that splitting
+// parents[0..parent_count) of h in this order made, in id order: NewVertexCorners' walk, for the
+// geometry modes that predict from the parent's edge (midpoint, butterfly), where a list of the
+// pairs would take 8 bytes a vertex at a decode's peak. Taken a run at a time, as
+// NewVertexCorners' corners. Its reads of the centre children (in the level just made) cost time
+// where the level is large: a tenth of uniform's lossless decode when it came alone
+// (docs/BENCHMARKS.md).
+class NewVertexEdges {
+public:
+    NewVertexEdges(const Hierarchy& h, const NodeId* parents, uint32_t parent_count, VertexId first, size_t count)
+        : h_(&h), parents_(parents), parent_count_(parent_count), next_vertex_(first), end_(VertexId(first + count)) {}
+    // Writes the next vertices' (parent, edge), at most n, to out; returns how many (0 at the
+    // end). Throws Error when the parents made fewer vertices than announced.
+    size_t take(std::pair<NodeId, int>* out, size_t n);
+
+private:
+    const Hierarchy* h_;
+    const NodeId* parents_;
+    uint32_t parent_count_;
+    uint32_t parent_ = 0;  // the next parent
+    int edge_ = 0;         // its next edge
+    VertexId next_vertex_, end_;
 };
 
 }  // namespace amc

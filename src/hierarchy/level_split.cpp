@@ -370,6 +370,31 @@ void Hierarchy::split_level(const LevelSplits& splits) {
     live_vertices_ += uint32_t(next_vertex - v0);
 }
 
+size_t NewVertexEdges::take(std::pair<NodeId, int>* out, size_t n) {
+    const Hierarchy& h = *h_;
+    size_t k = 0;
+    uint32_t b = parent_;
+    int e = edge_;
+    VertexId next = next_vertex_;
+    while (k < n && next != end_) {
+        AMC_REQUIRE(b < parent_count_, corrupt, "split parents made fewer vertices than listed");
+        const NodeId p = parents_[b];
+        for (; e < 3 && k < n; ++e) {
+            if (h.midpoint(p, e) != next) continue;  // an earlier parent's midpoint
+            out[k++] = {p, e};
+            ++next;
+        }
+        if (e == 3) {
+            e = 0;
+            ++b;
+        }
+    }
+    parent_ = b;
+    edge_ = e;
+    next_vertex_ = next;
+    return k;
+}
+
 const FrameCorners* NewVertexCorners::next(size_t n) {
     AMC_REQUIRE(n <= kRun && taken_ + n <= count_, invalid_input, "NewVertexCorners: more vertices asked for than made");
     taken_ += n;

@@ -518,7 +518,13 @@ void decode_level_geometry(Hierarchy& h, const NewVertices& created, const Level
 void decode_walked_level_geometry(Hierarchy& h, const NewVertexEdges& edges, const LevelBlockParts& parts,
                                   ArithmeticDecoder& decoder, PositionCoder& positions, int level, const std::string& where) {
     AMC_REQUIRE(!is_static_mode(parts.predictor), invalid_input, where + ": walked edges need a mode without tables");
-    decode_arithmetic_level(h, [&](auto&& visit) { edges.for_each(visit); }, parts, decoder, positions, level, where);
+    NewVertexEdges walk = edges;
+    auto for_each = [&](auto&& visit) {
+        std::pair<NodeId, int> run[64];
+        for (size_t k; (k = walk.take(run, 64)) > 0;)
+            for (size_t i = 0; i < k; ++i) visit(run[i].first, run[i].second);
+    };
+    decode_arithmetic_level(h, for_each, parts, decoder, positions, level, where);
 }
 
 }  // namespace amc
