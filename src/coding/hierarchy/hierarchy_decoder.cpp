@@ -208,7 +208,8 @@ void HierarchyLevelDecoder::decide(ArithmeticDecoder& decoder, uint64_t max_refi
     // limit: UINT64_MAX - 1, so that no level can seem to have room for codable_symbols' UINT64_MAX.)
     const uint64_t symbol_limit = header_.options.truncate_stream ? header_.symbol_count : UINT64_MAX - 1;
     if (level_is_all_leaves()) {  // and the last: no traversal needed
-        for (uint32_t i = 0; i < n; ++i) state[i] = uint8_t(state[i] | kDecided);
+        if (!level_.leaves_only())
+            for (uint32_t i = 0; i < n; ++i) state[i] = uint8_t(state[i] | kDecided);
         level_.refined_count = 0;
         finish_level(false);
         return;
@@ -370,7 +371,7 @@ void HierarchyLevelDecoder::free_before_last_derive(Level& next, bool links_in_r
     traversal_.free_working_memory();
     closures_.deallocate();
     level_.lowered.deallocate();  // its own derivation's
-    if (links_in_room) {  // the last level keeps its states alone
+    if (links_in_room) {  // the last level needs no array of its own
         next.nbr.deallocate();
         next.edges.deallocate();
         next.lowered.deallocate();

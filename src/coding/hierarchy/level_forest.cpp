@@ -99,6 +99,7 @@ DecidedLevelScan scan_decided_level(Level& level, RefinedNumbering& numbering, u
 
 uint64_t leaf_faces_of_level(const Level& level) {
     const uint32_t n = static_cast<uint32_t>(level.size());
+    if (level.leaves_only()) return n;  // no neighbour of a leaf is refined there
     const uint8_t* state = level.state();
     uint64_t faces = 0;
     uint32_t i = 0;
@@ -152,14 +153,17 @@ uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering
     next.roots.clear();
     next.flipped.clear();
     next.refined_count = 0;
-    next.resize_state(size_t(4) * count);
+    if (room.words != nullptr)
+        next.set_leaves(size_t(4) * count);
+    else
+        next.resize_state(size_t(4) * count);
     Neighbors* const out = room.words == nullptr ? next.nbr.reserve(size_t(4) * count) : nullptr;
     // A level in the room is all leaves: no traversal nor derivation reads its block edges.
     BlockEdges* out_edges = room.words == nullptr ? next.edges.reserve(count) : nullptr;
     uint32_t* lowered = room.words == nullptr ? next.lowered.reserve(size_t(2) * count) : nullptr;  // two words a block
     uint32_t lowered_count = 0;
     const NewBlock* const new_blocks = kNewBlocks.of[cull_one_regularity ? 1 : 0];
-    uint8_t* out_state = next.state();
+    uint8_t* out_state = room.words == nullptr ? next.state() : nullptr;
     // Each new vertex has two edge ends: one from each refined node on its edge, or both from one.
     uint64_t counts = 0;  // bits 0-31 the edge ends beyond 3 a block, 32-63 the incomplete nodes
     // In the room, a block's links are made in `made` and copied to its four nodes; no priority
@@ -177,6 +181,7 @@ uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering
             const NewBlock& entry = new_blocks[linked | ((p.flags & 7u) << 3)];
             if (!decltype(in_room)::value) out_edges[b] = {uint8_t(p.nbr_edge & entry.edge_mask), uint8_t(p.flags & 7)};
             counts += entry.counts;
+            if (decltype(in_room)::value) continue;
 #if AMC_LITTLE_ENDIAN
             std::memcpy(out_state + c, &entry.states, 4);  // byte k: child k
 #else
@@ -185,7 +190,6 @@ uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering
             // Both words always, kept by the count (no branch: which blocks have incomplete
             // corners follows no pattern). memcpy: the words are read as the bytes of out's
             // array.
-            if (decltype(in_room)::value) continue;
             const char* words = reinterpret_cast<const char*>(block_links);
             std::memcpy(lowered + lowered_count, words + entry.lowered_offset[0], 4);
             std::memcpy(lowered + lowered_count + 1, words + entry.lowered_offset[1], 4);

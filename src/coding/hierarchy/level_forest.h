@@ -86,7 +86,7 @@ struct Level {
     // The vertices their splits create (derive_next_level's count).
     uint64_t new_vertices = 0;
 
-    size_t size() const { return states_.empty() ? 0 : states_.size() - 1; }
+    size_t size() const { return leaves_ != 0 ? leaves_ : states_.empty() ? 0 : states_.size() - 1; }
     bool empty() const { return size() == 0; }
     // One state byte a node, preceded by kNoNeighborState: a neighbour index q reads its state at
     // state()[int32_t(q)], which for kNoLocal (-1) is that byte, so the hot loops need no test
@@ -99,7 +99,15 @@ struct Level {
     void resize_state(size_t n) {
         resize_scratch(states_, n + 1);
         states_[0] = kNoNeighborState;
+        leaves_ = 0;
     }
+    // A level of n leaves alone, derived into the room of its nodes (derive_next_level): no
+    // states, which nothing would read (it is never traversed, and each node is one leaf face).
+    void set_leaves(size_t n) {
+        resize_state(0);
+        leaves_ = n;
+    }
+    bool leaves_only() const { return leaves_ != 0; }
     bool is_root_level() const { return !roots.empty(); }
     // Gives the storage of everything but `refined` and `flipped` (what splitting the decided
     // level reads) back to the allocator.
@@ -109,6 +117,7 @@ struct Level {
         edges.deallocate();
         lowered.deallocate();
         std::vector<uint8_t>().swap(states_);
+        leaves_ = 0;
     }
     // Gives back the storage that is far larger than a level of n nodes needs
     // (ScratchArray::shrink_for); its contents are dead.
@@ -118,10 +127,12 @@ struct Level {
         lowered.shrink_for(n / 2);
         refined.shrink_for(n);
         if (states_.capacity() > ScratchArray<uint8_t>::kShrinkFactor * (n + 1)) std::vector<uint8_t>().swap(states_);
+        leaves_ = 0;
     }
 
 private:
     std::vector<uint8_t> states_;
+    size_t leaves_ = 0;  // set_leaves
 };
 
 // The state byte of neighbour q (kNoLocal included, see Level::state).
@@ -221,9 +232,9 @@ uint64_t leaf_faces_of_level(const Level& level);
 // node one bucket lower for each incomplete neighbour (NewBlock), as the improved traversal wants
 // them: what the culled nodes' decisions would do to their neighbours, in any order.
 // With `room` (words set, HierarchyBuilder::open_children's), the links go to the room of the
-// nodes they become instead of next.nbr, and no block edges are made (next.nbr and next.edges are
-// left as they were): a level that only split_level (LevelSplits::links_in_place) reads, the
-// last, needs neither.
+// nodes they become instead of next.nbr, and neither block edges nor states are made (next.nbr
+// and next.edges are left as they were, next is Level::set_leaves): a level that only
+// split_level (LevelSplits::links_in_place) reads, the last, needs none of them.
 uint64_t derive_next_level(const Level& level, const RefinedNumbering& numbering, Level& next,
                            bool cull_one_regularity, ChildLinkRoom room = {});
 
