@@ -1,12 +1,17 @@
 // Issue 29 item 3's question, third form: a level-synchronous, phased hierarchy code. Each level's
-// split symbols are coded in a few phases fixed by the node's place (its child index, or a
-// colouring the decoder can compute from the level's links), so that a node's context reads only
-// the level above (complete) and the nodes of earlier phases of its own level: every phase could
-// decode as a flat loop over an array, with no priority queue. What does it cost in size against
-// the paper's improved traversal?
+// split symbols are coded in a few phases fixed by the node's place (its child index, a colouring
+// the decoder can compute from the level's links, its ancestry), so that a node's context reads
+// only the level above (complete) and the nodes of earlier phases of its own level: every phase
+// could decode as a flat loop over an array, with no priority queue. What does it cost in size
+// against the paper's improved traversal, and how fast does it decide?
 //
-//   phased_study FILE.amh...      one row per file: the improved traversal's symbol bytes and
-//                                 each design's, adaptive and with static per-level tables
+//   phased_study FILE.amh...              every design x context set: bytes adaptive and static
+//   phased_study --table FILE.amh...      the table of docs/HIERARCHY_CODER.md (a few designs)
+//   phased_study --speed RUNS FILE.amh... deep3 (g,cn) coded for real, every decoded bit checked,
+//                                         and decided by a prototype against the library's
+//                                         deciding, alternating run by run (thread CPU time;
+//                                         ONLY=lib or ONLY=proto runs one of them, for callgrind)
+//   PHASED_DEBUG=phases/contexts          (first form) that design's bits per phase
 //
 // Every design keeps the paper's rules: 1-regularity culls (incomplete nodes take no symbol),
 // uniform levels take none, a node whose three neighbours are known refined when its phase comes
@@ -15,9 +20,9 @@
 // roots only. Sizes are exact: "adaptive" codes the symbols through the library's arithmetic coder
 // with one BitModel (the coder's window) per context; "static" is the ideal code length under one
 // table per level made from that level's counts (a 12-bit probability per context that holds both
-// symbols, 2 bits per context slot to say unused / all 0 / all 1 / coded) plus the rANS state.
-// The header and orientation bits are the same in every design and left out; "stream" is the
-// library's whole hierarchy stream for reference.
+// symbols, 2 bits per context slot to say unused / all 0 / all 1 / coded, 12 bits to list each
+// context in use) plus the rANS state. The header and orientation bits are the same in every
+// design and left out; "stream" is the library's whole hierarchy stream for reference.
 //
 // Phases (of a node c, child k of parent p; children 0-2 are corners, 3 the center, whose three
 // neighbours are its siblings; a corner's other two neighbours are corners of p's neighbours'
@@ -32,15 +37,23 @@
 //          order), so that every corner knows its center and the corners of earlier classes
 //   f3|c   those corner classes first, then the centers
 //   g4     a greedy proper colouring of the whole level (at most four colours) in canonical order
+//   c4|f3  the centers in four classes of a colouring of their parents, then the corners as c|f3
+//   cP|f3  the centers whose parent is a center first, then the others in three classes by their
+//          parent's corner colour; then the corners as c|f3
+//   cPP|cP|f3   cP|f3's first class split again by the grandparent
+//   deepD  the same recursion D levels deep (phased_symbols)
 // Contexts: g = the paper's group of the neighbours known so far (refined, not refined, unknown;
 // a missing neighbour counts as not refined), the phase, r(p) = p's refined neighbours (0-3),
 // s(p) = the sum of r(q) over p's neighbours q (0-9, in four bins), two = the refined nodes among
-// the known second ring (0-3+).
+// the known second ring (0-3+), cn = the refined and unknown centers of the neighbouring families
+// (a corner: the blocks across its outer edges; a center: its far centers, see deepD),
+// d(p) = p's hop distance to a node not refined in the level above (capped at 8).
 #include "bench_common.h"
 #include "coding/entropy/arithmetic_coder.h"
 #include "coding/entropy/rans_coder.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
 #include "coding/hierarchy/hierarchy_traversal.h"
+#include "coding/hierarchy/hierarchy_stream.h"
 
 #include <amc/hierarchy.h>
 #include <amc/hierarchy_coder.h>
@@ -143,6 +156,7 @@ const ContextDesign kContextDesigns[] = {
     {kGroup | kRp | kRing2, "g,r(p),two"}, {kGroup | kRp | kSp | kRing2, "g,r(p),s(p),two"},
     {kGroup | kRp | kSp | kRing2 | kCn, "g,r(p),s(p),two,cn"}, {kGroup | kRp | kRing2 | kCn, "g,r(p),two,cn"},
     {kGroup | kRp | kRing2 | kCn | kDist, "g,r(p),two,cn,d(p)"}, {kGroup | kRing2 | kCn | kDist, "g,two,cn,d(p)"},
+    {kGroup | kCn, "g,cn"}, {kGroup | kRp | kCn, "g,r(p),cn"}, {kGroup | kRing2 | kCn, "g,two,cn"},
 };
 
 // The phase of every node of level d (0..), or -1 for a culled node; returns the phase count.
@@ -613,6 +627,316 @@ double static_bytes(const std::vector<Symbol>& roots, const LevelSymbols& levels
 
 }  // namespace
 
+
+// ---- deep3 with the g,cn contexts, coded for real and decided: the speed prototype ----
+//
+// The decoder's loop as a flat pass per phase: each level's per-block class (depth j and the
+// colour of the first corner ancestor) and far families come from the level above's in one pass
+// over the blocks; the corners' colouring is one greedy pass; the nodes are bucketed by phase;
+// each phase reads only states written before it, and its decisions are written to the states
+// (and counted at the neighbours) after it. The roots go through the library's improved
+// traversal. Encoder and decoder run the same code (`Code`), so they agree on every context.
+
+constexpr int kProtoDepth = 3;
+constexpr int kProtoPhases = 3 * kProtoDepth + 4;
+constexpr uint32_t kProtoContexts = uint32_t(kProtoPhases) * 10 * 17;
+constexpr uint8_t kTop = 0xff;
+
+struct ProtoBlocks {
+    std::vector<uint8_t> depth;   // per block: j (0..kProtoDepth-1) or kTop
+    std::vector<uint8_t> colour;  // per block: the colour of its first corner ancestor
+    std::vector<uint32_t> far;    // per block: the centers of three far blocks of this level, or kNoLocal
+};
+
+struct ProtoDecider {
+    Level prev, cur, next;
+    RefinedNumbering numbering;
+    std::vector<uint32_t> closures;
+    ProtoBlocks up_blocks, blocks;  // the classes of this level's blocks, and of the next level's
+    std::vector<int8_t> up_colour, colour;  // the corners' colouring of the level above and of this one
+    std::vector<uint32_t> order, start;
+    std::vector<uint8_t> phase;
+    std::vector<BitModel> models;
+    HierarchyModels root_models;
+    // Symbols the stream still holds (the decoder: its count; everything after is 0).
+    uint32_t symbols_left = 0xffffffffu;
+
+    // code(context, node, level) -> bool: the encoder codes the truth, the decoder decodes.
+    template <class Code>
+    uint64_t run(const Hierarchy& roots_source, uint32_t uniform_levels, Code&& code) {
+        models.assign(kProtoContexts, BitModel{});
+        root_models = HierarchyModels{};
+        HierarchyCoderOptions options;
+        LevelTraversal traversal(options, kHierarchyStreamVersion);
+        root_level(roots_source, cur, true);
+        uint64_t nodes = cur.size();
+        uint32_t l = 0;
+        while (!cur.empty()) {
+            const uint32_t n = uint32_t(cur.size());
+            uint8_t* state = cur.state();
+            const bool uniform = l < uniform_levels;
+            if (uniform || cur.is_root_level()) {
+                traversal.run(
+                    cur, uniform,
+                    [&](uint32_t i, int group) {
+                        if (symbols_left == 0) return false;
+                        --symbols_left;
+                        return code(root_models.groups[size_t(group)], i, l);
+                    },
+                    [&](uint32_t, Fate, bool refined) { return refined; });
+                corner_colours_of(cur, colour);  // for the next level's classes
+            } else {
+                decide_phases(n, state, l, code);
+            }
+            closures.resize(n);
+            scan_decided_level(cur, numbering, closures.data());
+            derive_next_level(cur, numbering, next, true);
+            nodes += next.size();
+            classes_of_next(cur, next);
+            std::swap(prev, cur);
+            std::swap(cur, next);
+            std::swap(up_colour, colour);
+            std::swap(up_blocks, blocks);
+            ++l;
+        }
+        return nodes;
+    }
+
+    // The corners' greedy colouring (canonical order), as corner_colours: 0-2 for corners, 3 for
+    // centers and in the slot in front (read for a missing neighbour), so that a colour's bit
+    // 1 << 3 never blocks a corner colour; a corner not yet coloured reads 3 as well.
+    static void corner_colours_of(const Level& level, std::vector<int8_t>& out) {
+        const uint32_t n = uint32_t(level.size());
+        out.assign(size_t(n) + 1, 3);
+        if (level.is_root_level()) return;
+        int8_t* colour = out.data() + 1;
+        const Neighbors* nbr = level.nbr.data();
+        for (uint32_t c = 0; c < n; ++c) {
+            if ((c & 3) == uint32_t(red_split::kCenter)) continue;
+            const Neighbors node = nbr[c];
+            const unsigned used = (1u << colour[int32_t(node.nbr[0])]) | (1u << colour[int32_t(node.nbr[1])]) |
+                                  (1u << colour[int32_t(node.nbr[2])]);
+            colour[c] = int8_t(__builtin_ctz(~used));
+        }
+    }
+
+    // The class and far blocks of every block of `below` (derived from `level`, whose numbering
+    // is current).
+    void classes_of_next(const Level& level, const Level& below) {
+        const uint32_t blocks_below = uint32_t(below.size() / 4);
+        blocks.depth.resize(blocks_below);
+        blocks.colour.resize(blocks_below);
+        blocks.far.resize(size_t(blocks_below) * 3);
+        const uint32_t* block_of = numbering.block_of();
+        const uint32_t* parent = level.refined.data();
+        const bool roots = level.is_root_level();
+        for (uint32_t b = 0; b < blocks_below; ++b) {
+            const uint32_t x = parent[b];
+            uint32_t* far = &blocks.far[3 * size_t(b)];
+            if (roots) {
+                blocks.depth[b] = kTop;
+                far[0] = far[1] = far[2] = kNoLocal;
+                continue;
+            }
+            if ((x & 3) != uint32_t(red_split::kCenter)) {
+                blocks.depth[b] = 0;
+                blocks.colour[b] = uint8_t(colour[size_t(x) + 1]);
+                const Neighbors nb = level.nbr.data()[x];
+                for (int e = 0; e < 3; ++e) {
+                    const uint32_t f = block_of[int32_t(nb.nbr[e])];
+                    far[e] = f == kNoLocal ? kNoLocal : 4 * f + uint32_t(red_split::kCenter);
+                }
+                continue;
+            }
+            const uint32_t pb = x >> 2;
+            const uint8_t j = up_blocks.depth[pb];
+            if (j == kTop || j + 1 == kProtoDepth) {
+                blocks.depth[b] = kTop;
+                far[0] = far[1] = far[2] = kNoLocal;
+                continue;
+            }
+            blocks.depth[b] = uint8_t(j + 1);
+            blocks.colour[b] = up_blocks.colour[pb];
+            for (int e = 0; e < 3; ++e) {
+                const uint32_t f = block_of[int32_t(up_blocks.far[3 * size_t(pb) + size_t(e)])];
+                far[e] = f == kNoLocal ? kNoLocal : 4 * f + uint32_t(red_split::kCenter);
+            }
+        }
+    }
+
+    template <class Code>
+    void decide_phases(uint32_t n, uint8_t* state, uint32_t l, Code& code) {
+        if (symbols_left == 0) {
+            // The stream has ended: every node of the level is not refined (none is, so the
+            // hanging-node rule forces none); the next level is empty.
+            for (uint32_t c = 0; c < n; ++c) state[c] = uint8_t(state[c] | kDecided);
+            colour.assign(size_t(n) + 1, 3);
+            return;
+        }
+        const Neighbors* nbr = cur.nbr.data();
+        // One pass over the blocks: the corners' greedy colouring (as corner_colours_of), every
+        // node's phase and the phases' sizes; then the nodes bucketed by phase (canonical order
+        // within a phase).
+        colour.assign(size_t(n) + 1, 3);
+        int8_t* corner_colour = colour.data() + 1;
+        phase.resize(n);
+        const uint8_t* depth = up_blocks.depth.data();
+        const uint8_t* first_colour = up_blocks.colour.data();
+        uint32_t counts[kProtoPhases + 1] = {};
+        for (uint32_t b = 0; b < n / 4; ++b) {
+            for (uint32_t c = 4 * b; c < 4 * b + 3; ++c) {
+                const Neighbors node = nbr[c];
+                const unsigned used = (1u << corner_colour[int32_t(node.nbr[0])]) | (1u << corner_colour[int32_t(node.nbr[1])]) |
+                                      (1u << corner_colour[int32_t(node.nbr[2])]);
+                const int k = __builtin_ctz(~used);
+                corner_colour[c] = int8_t(k);
+                const uint8_t ph = state[c] & kDecided ? uint8_t(kProtoPhases) : uint8_t(3 * kProtoDepth + 1 + k);
+                phase[c] = ph;
+                ++counts[ph];
+            }
+            const uint8_t j = depth[b];
+            const uint8_t ph = state[4 * b + 3] & kDecided ? uint8_t(kProtoPhases)
+                               : j == kTop                  ? 0
+                                                            : uint8_t(1 + 3 * (kProtoDepth - 1 - j) + first_colour[b]);
+            phase[4 * b + 3] = ph;
+            ++counts[ph];
+        }
+        start.assign(kProtoPhases + 1, 0);
+        for (int k = 0; k < kProtoPhases; ++k) start[size_t(k) + 1] = start[size_t(k)] + counts[k];
+        order.resize(start[kProtoPhases] + 1);
+        {
+            uint32_t at[kProtoPhases + 1];
+            for (int k = 0; k < kProtoPhases; ++k) at[k] = start[size_t(k)];
+            at[kProtoPhases] = start[kProtoPhases];  // the decided ones go to one spare slot
+            uint32_t* out = order.data();
+            for (uint32_t c = 0; c < n; ++c) {
+                const unsigned k = phase[c];
+                out[at[k]] = c;
+                at[k] += k != unsigned(kProtoPhases);
+            }
+        }
+        const uint32_t* far = up_blocks.far.data();
+        // One node: the hanging-node rule, or its symbol in context (phase, group, cn); its state
+        // written at once and counted at its neighbours. No context reads a node of its own phase
+        // (the phases are independent sets, and cn reads centers of other classes), so this is
+        // the same as writing the phase's decisions after it.
+        auto decide = [&](uint32_t c, int ph, const Neighbors& node, unsigned code_bits, unsigned cn) {
+            const int group = kContextTable.group[code_bits];
+            bool refined = group == 9;  // (3,0,0): the hanging-node rule
+            if (!refined && symbols_left != 0) {
+                --symbols_left;
+                refined = code(models[(uint32_t(ph) * 10 + uint32_t(group)) * 17 + cn], c, l);
+            }
+            // Counted at the neighbours without a branch (whether a node is refined is a coin
+            // flip); a missing neighbour's shared byte takes the count harmlessly (Level::state).
+            state[c] = uint8_t(state[c] | kDecided | (refined ? kRefined : 0));
+            const uint8_t add = uint8_t(refined ? kRefinedNeighbor : 0);
+            for (int e = 0; e < 3; ++e) {
+                uint8_t& t = neighbor_state(state, node.nbr[e]);
+                t = uint8_t(t + add);
+            }
+        };
+        auto refined_unknown = [](uint8_t s) { return 4 * ((s >> 1) & 1u) + !(s & kDecided); };
+        for (int ph = 0; ph < kProtoPhases; ++ph) {
+            const uint32_t* first = order.data() + start[size_t(ph)];
+            const uint32_t* last = order.data() + start[size_t(ph) + 1];
+            if (ph == 0) {
+                // The first class of centers: only the siblings (nothing of this level is known).
+                for (const uint32_t* it = first; it != last; ++it) {
+                    const uint32_t c = *it;
+                    const unsigned code_bits = unsigned(state[c - 3] & (kDecided | kRefined)) |
+                                               unsigned(state[c - 2] & (kDecided | kRefined)) << 2 |
+                                               unsigned(state[c - 1] & (kDecided | kRefined)) << 4;
+                    decide(c, 0, nbr[c], code_bits, 0);
+                }
+            } else if (ph <= 3 * kProtoDepth) {
+                // Centers: the neighbours are the siblings; the far centers of earlier classes.
+                for (const uint32_t* it = first; it != last; ++it) {
+                    const uint32_t c = *it, b = c >> 2;
+                    const unsigned code_bits = unsigned(state[c - 3] & (kDecided | kRefined)) |
+                                               unsigned(state[c - 2] & (kDecided | kRefined)) << 2 |
+                                               unsigned(state[c - 1] & (kDecided | kRefined)) << 4;
+                    const uint32_t* f = far + 3 * size_t(b);
+                    const unsigned cn = 1 + refined_unknown(state[int32_t(f[0])]) + refined_unknown(state[int32_t(f[1])]) +
+                                        refined_unknown(state[int32_t(f[2])]);
+                    decide(c, ph, nbr[c], code_bits, cn);
+                }
+            } else {
+                // Corners: the three neighbours; the centers of the blocks across them, less the own.
+                for (const uint32_t* it = first; it != last; ++it) {
+                    const uint32_t c = *it;
+                    const Neighbors node = nbr[c];
+                    unsigned code_bits = 0, across = 0;
+                    for (int e = 0; e < 3; ++e) {
+                        const uint32_t q = node.nbr[e];
+                        code_bits |= unsigned(neighbor_state(state, q) & (kDecided | kRefined)) << (2 * e);
+                        across += refined_unknown(state[int32_t(q | 3u)]);
+                    }
+                    decide(c, ph, node, code_bits, 1 + across - refined_unknown(state[c | 3u]));
+                }
+            }
+        }
+    }
+};
+
+// The prototype's stream: uniform level count, kept symbol count, the arithmetic-coded bytes.
+struct ProtoStream {
+    uint32_t uniform_levels = 0, kept = 0;
+    std::vector<uint8_t> bytes;
+};
+
+uint32_t uniform_level_count(const Collected& data) {
+    uint32_t u = 0;
+    while (u < data.levels.size() && data.levels[u].uniform) ++u;
+    return u;
+}
+
+ProtoStream encode_proto(const Hierarchy& h, const Collected& data) {
+    ProtoStream s;
+    s.uniform_levels = uniform_level_count(data);
+    ProtoDecider coder;
+    struct Coded {
+        BitModel* model;
+        bool bit;
+    };
+    // First the symbols (models are only identified here), then the code up to the last 1.
+    std::vector<std::pair<uint32_t, bool>> symbols;  // (model index, bit): roots after kProtoContexts
+    coder.run(h, s.uniform_levels, [&](BitModel& model, uint32_t i, uint32_t l) {
+        const bool bit = data.levels[l].truth[i] != 0;
+        const uint32_t index = &model >= coder.models.data() && &model < coder.models.data() + coder.models.size()
+                                   ? uint32_t(&model - coder.models.data())
+                                   : kProtoContexts + uint32_t(&model - coder.root_models.groups.data());
+        symbols.push_back({index, bit});
+        return bit;
+    });
+    size_t kept = symbols.size();
+    while (kept > 0 && !symbols[kept - 1].second) --kept;
+    s.kept = uint32_t(kept);
+    std::vector<BitModel> models(kProtoContexts + kContextGroupCount);
+    ArithmeticEncoder encoder;
+    for (size_t k = 0; k < kept; ++k) encoder.encode_with_limit<kHierarchyModelLimit>(symbols[k].second, models[symbols[k].first]);
+    s.bytes = encoder.finish();
+    return s;
+}
+
+uint64_t decide_proto(ProtoDecider& decider, const Hierarchy& roots_only, const ProtoStream& s) {
+    ArithmeticDecoder d(s.bytes.data(), s.bytes.size());
+    decider.symbols_left = s.kept;
+    return decider.run(roots_only, s.uniform_levels, [&](BitModel& model, uint32_t, uint32_t) {
+        return d.decode_with_limit<kHierarchyModelLimit>(model);
+    });
+}
+
+// The library's deciding (as decode_phases' decide phase): every level, no build.
+uint64_t decide_library(HierarchyLevelDecoder& coder, const Hierarchy& h, const std::vector<uint8_t>& bytes) {
+    HierarchyStreamHeader header;
+    const size_t header_size = read_standalone_stream_header(bytes.data(), bytes.size(), header);
+    coder.restart(h.base(), header, HierarchyDecodeOptions().max_nodes);
+    ArithmeticDecoder decoder(bytes.data() + header_size, bytes.size() - header_size);
+    while (!coder.done()) coder.decide_level(decoder);
+    return coder.node_count();
+}
+
 // The table of docs/HIERARCHY_CODER.md: a few designs per model (--table).
 struct TableColumn {
     Phases phases;
@@ -626,13 +950,19 @@ const TableColumn kTable[] = {
     {Phases::cp_f3, kGroup | kRp | kRing2 | kCn, true, "cP|f3 +cn"},
     {Phases::cpp_f3, kGroup | kRp | kRing2 | kCn, true, "cPP|cP|f3 +cn"},
     {Phases::deep3, kGroup | kRp | kRing2 | kCn, true, "deep3 +cn"},
-    {Phases::deep3, kGroup | kRp | kRing2 | kCn, false, "deep3 +cn, static"},
+    {Phases::deep3, kGroup | kCn, true, "deep3 g,cn"},
+    {Phases::deep3, kGroup | kCn, false, "deep3 g,cn, static"},
 };
 
 int main(int argc, char** argv) {
     int first = 1;
     const bool table = argc > 1 && std::string(argv[1]) == "--table";
     if (table) first = 2;
+    int speed_runs = 0;
+    if (argc > 2 && std::string(argv[1]) == "--speed") {
+        speed_runs = std::max(1, std::atoi(argv[2]));
+        first = 3;
+    }
     if (first >= argc) {
         std::fprintf(stderr, "usage: phased_study [--table] FILE.amh...\n");
         return 2;
@@ -652,6 +982,58 @@ int main(int argc, char** argv) {
         const Hierarchy& h = *read;
         const Collected data = collect(h);
         const size_t improved = adaptive_bytes(data.improved, kContextGroupCount);
+        if (speed_runs > 0) {
+            // deep3 (g,cn) decided by the prototype against the library's deciding of
+            // today's stream, alternating run by run (thread CPU time); ONLY=lib or ONLY=proto
+            // runs one of them (callgrind).
+            const ProtoStream stream = encode_proto(h, data);
+            const std::vector<uint8_t> library_bytes = encode_hierarchy(h);
+            const Hierarchy roots_only(h.base());
+            HierarchyLevelDecoder library;
+            ProtoDecider proto;
+            // The decoded decisions must be the hierarchy's: decide once, every decoded bit checked.
+            {
+                ArithmeticDecoder d(stream.bytes.data(), stream.bytes.size());
+                proto.symbols_left = stream.kept;
+                uint64_t wrong = 0;
+                const uint64_t nodes = proto.run(roots_only, stream.uniform_levels, [&](BitModel& model, uint32_t i, uint32_t l) {
+                    const bool bit = d.decode_with_limit<kHierarchyModelLimit>(model);
+                    wrong += bit != (data.levels[l].truth[i] != 0);
+                    return bit;
+                });
+                if (nodes != h.node_count() || wrong != 0) {
+                    std::fprintf(stderr, "%s: the prototype decided %llu nodes, not %u; %llu wrong bits\n", model_name(path).c_str(),
+                                 (unsigned long long)nodes, h.node_count(), (unsigned long long)wrong);
+                    return 1;
+                }
+            }
+            const char* only = std::getenv("ONLY");
+            std::vector<double> lib_s, proto_s, ratio;
+            for (int r = 0; r < speed_runs; ++r) {
+                const double t0 = thread_seconds();
+                if (only == nullptr || std::string(only) == "lib") decide_library(library, h, library_bytes);
+                const double t1 = thread_seconds();
+                if (only == nullptr || std::string(only) == "proto") decide_proto(proto, roots_only, stream);
+                const double t2 = thread_seconds();
+                lib_s.push_back(t1 - t0);
+                proto_s.push_back(t2 - t1);
+                ratio.push_back((t1 - t0) / std::max(t2 - t1, 1e-9));
+            }
+            const Range rs = range_of(ratio);
+            std::printf("%s: %u nodes; stream %zu bytes, deep3 %zu bytes (+ 8 bytes of counts; study %.0f); decide ms library %.2f, "
+                        "deep3 %.2f (medians); ratio library/deep3 median %.3f [%.3f-%.3f]\n",
+                        model_name(path).c_str(), h.node_count(), library_bytes.size(), stream.bytes.size(),
+                        [&] {
+                            const LevelSymbols levels = phased_symbols(data, Phases::deep3, kGroup | kCn);
+                            std::vector<Symbol> all;
+                            for (const Symbol& sy : data.roots) all.push_back({kContextSlots + sy.context, sy.bit, 255});
+                            for (const auto& level : levels.levels) all.insert(all.end(), level.begin(), level.end());
+                            return double(adaptive_bytes(all, kContextSlots + kContextGroupCount));
+                        }(),
+                        1e3 * median(lib_s), 1e3 * median(proto_s), rs.median, rs.low, rs.high);
+            std::fflush(stdout);
+            continue;
+        }
         auto design_bytes = [&](Phases phases, unsigned features, bool adaptive, bool print_phases) {
             const LevelSymbols levels = phased_symbols(data, phases, features);
             std::vector<Symbol> all;
