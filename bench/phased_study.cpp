@@ -10,7 +10,10 @@
 //   phased_study --speed RUNS FILE.amh... deep3 (g,cn) coded for real, every decoded bit checked,
 //                                         and decided by a prototype against the library's
 //                                         deciding, alternating run by run (thread CPU time;
-//                                         ONLY=lib or ONLY=proto runs one of them, for callgrind)
+//                                         ONLY=lib, ONLY=proto or ONLY=levels runs one of them,
+//                                         for callgrind); "levels alone": the decisions written
+//                                         from the hierarchy, then scan and derivation (the part
+//                                         of deciding no stream layout removes)
 //   PHASED_DEBUG=phases/contexts          (first form) that design's bits per phase
 //
 // Every design keeps the paper's rules: 1-regularity culls (incomplete nodes take no symbol),
@@ -927,6 +930,40 @@ uint64_t decide_proto(ProtoDecider& decider, const Hierarchy& roots_only, const 
     });
 }
 
+// What deciding costs without any traversal or symbol: every level's truth written straight into
+// its states (counted at the neighbours), then the library's scan and derivation, as the
+// decoders run them. No stream layout can decide for less.
+uint64_t levels_only(ProtoDecider& scratch, const Hierarchy& roots_only, const Collected& data) {
+    Level& cur = scratch.cur;
+    Level& next = scratch.next;
+    root_level(roots_only, cur, true);
+    uint64_t nodes = cur.size();
+    for (size_t l = 0; !cur.empty(); ++l) {
+        const uint32_t n = uint32_t(cur.size());
+        uint8_t* state = cur.state();
+        const uint8_t* truth = data.levels[l].truth.data();
+        with_links(cur, [&](auto links) {
+            for (uint32_t i = 0; i < n; ++i) {
+                if (state[i] & kDecided) continue;
+                const bool refined = truth[i] != 0;
+                state[i] = uint8_t(state[i] | kDecided | (refined ? kRefined : 0));
+                const uint8_t add = uint8_t(refined ? kRefinedNeighbor : 0);
+                const Neighbors node = links.neighbors(i);
+                for (int e = 0; e < 3; ++e) {
+                    uint8_t& t = neighbor_state(state, node.nbr[e]);
+                    t = uint8_t(t + add);
+                }
+            }
+        });
+        scratch.closures.resize(n);
+        scan_decided_level(cur, scratch.numbering, scratch.closures.data());
+        derive_next_level(cur, scratch.numbering, next, true);
+        nodes += next.size();
+        std::swap(cur, next);
+    }
+    return nodes;
+}
+
 // The library's deciding (as decode_phases' decide phase): every level, no build.
 uint64_t decide_library(HierarchyLevelDecoder& coder, const Hierarchy& h, const std::vector<uint8_t>& bytes) {
     HierarchyStreamHeader header;
@@ -1008,20 +1045,43 @@ int main(int argc, char** argv) {
                 }
             }
             const char* only = std::getenv("ONLY");
-            std::vector<double> lib_s, proto_s, ratio;
+            ProtoDecider bare;
+            if (levels_only(bare, roots_only, data) != h.node_count()) {
+                std::fprintf(stderr, "%s: the levels alone made a different node count\n", model_name(path).c_str());
+                return 1;
+            }
+            std::vector<double> lib_s, proto_s, ratio, bare_s, bare_share, build_s, bound;
             for (int r = 0; r < speed_runs; ++r) {
                 const double t0 = thread_seconds();
                 if (only == nullptr || std::string(only) == "lib") decide_library(library, h, library_bytes);
                 const double t1 = thread_seconds();
+                if (only == nullptr || std::string(only) == "lib") {
+                    // The rest of a decode (decode_phases' build phase): the Hierarchy made.
+                    library.finish();
+                    library.hierarchy().reserve(library.node_count(), library.vertex_count());
+                    library.build_decided_levels();
+                }
+                const double t1b = thread_seconds();
+                build_s.push_back(t1b - t1);
                 if (only == nullptr || std::string(only) == "proto") decide_proto(proto, roots_only, stream);
                 const double t2 = thread_seconds();
+                if (only == nullptr || std::string(only) == "levels") levels_only(bare, roots_only, data);
+                const double t3 = thread_seconds();
                 lib_s.push_back(t1 - t0);
-                proto_s.push_back(t2 - t1);
-                ratio.push_back((t1 - t0) / std::max(t2 - t1, 1e-9));
+                proto_s.push_back(t2 - t1b);
+                bare_s.push_back(t3 - t2);
+                ratio.push_back((t1 - t0) / std::max(t2 - t1b, 1e-9));
+                bare_share.push_back((t3 - t2) / std::max(t1 - t0, 1e-9));
+                // A decode whose deciding took no more than the levels alone, against today's.
+                bound.push_back((t1b - t0) / std::max(t3 - t2 + t1b - t1, 1e-9));
             }
             const Range rs = range_of(ratio);
+            const Range bs = range_of(bare_share);
+            const Range ds = range_of(bound);
             std::printf("%s: %u nodes; stream %zu bytes, deep3 %zu bytes (+ 8 bytes of counts; study %.0f); decide ms library %.2f, "
-                        "deep3 %.2f (medians); ratio library/deep3 median %.3f [%.3f-%.3f]\n",
+                        "deep3 %.2f (medians); ratio library/deep3 median %.3f [%.3f-%.3f]; levels alone %.2f ms, "
+                        "%.3f [%.3f-%.3f] of the library's; build %.2f ms; decode with the levels alone %.2f [%.2f-%.2f] "
+                        "times as fast\n",
                         model_name(path).c_str(), h.node_count(), library_bytes.size(), stream.bytes.size(),
                         [&] {
                             const LevelSymbols levels = phased_symbols(data, Phases::deep3, kGroup | kCn);
@@ -1030,7 +1090,8 @@ int main(int argc, char** argv) {
                             for (const auto& level : levels.levels) all.insert(all.end(), level.begin(), level.end());
                             return double(adaptive_bytes(all, kContextSlots + kContextGroupCount));
                         }(),
-                        1e3 * median(lib_s), 1e3 * median(proto_s), rs.median, rs.low, rs.high);
+                        1e3 * median(lib_s), 1e3 * median(proto_s), rs.median, rs.low, rs.high, 1e3 * median(bare_s), bs.median,
+                        bs.low, bs.high, 1e3 * median(build_s), ds.median, ds.low, ds.high);
             std::fflush(stdout);
             continue;
         }

@@ -3,7 +3,8 @@
 # level-synchronous, phased hierarchy codes against the improved traversal on the benchmark corpus
 # (scripts/corpus.sh) and the held-out remeshes (bench/phased_study, a build with
 # -DAMC_BUILD_BENCH=ON; exact sizes). With `runs` > 0 also the prototype decoder of design deep3
-# against the library's deciding, `runs` alternating pairs a model (thread CPU time).
+# against the library's deciding and build and the levels alone, `runs` rounds a model (thread
+# CPU time).
 # Usage: scripts/phased_table.sh [build-dir] [runs]   (AMC_REUSE_CORPUS=1 keeps a corpus)
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
