@@ -360,7 +360,14 @@ void HierarchyLevelDecoder::free_before_next_level() {
     }
     // A spare once split, which reads its refined nodes alone (of several decided levels, each
     // one's links are the split of the one before).
-    if (decided_.size() == 1 && dead(decided_.back())) decided_.back().free_all_but_splits();
+    if (decided_.size() == 1 && dead(decided_.back())) {
+        Level& decided = decided_.back();
+        const bool shrinking = decided.nbr.capacity() > ScratchArray<Neighbors>::kShrinkFactor * n;
+        decided.free_all_but_splits();
+        // Lean, where the levels shrink, the heap glibc keeps goes too: freed but kept, the
+        // largest level's working memory stayed resident to the end (lshape, docs/BENCHMARKS.md).
+        if (lean_at_end_ && shrinking) release_free_heap();
+    }
     traversal_.shrink_working_memory(n);
     numbering_.shrink_for(n);
     closures_.shrink_for(n);
