@@ -3,6 +3,7 @@
 // cache directory after the first run: the input of bench/mixing_study and bench/model_study.
 #pragma once
 
+#include <amc/codec.h>
 #include <amc/hierarchy.h>
 
 #include "coding/entropy/arithmetic_coder.h"
@@ -81,10 +82,14 @@ inline double model_bits(MixingModel model, const std::vector<Symbol>& symbols, 
 }
 
 // The model's symbols with their features, and the paper's coded bits, from the cache or computed.
-inline ModelData load(const std::string& path, const std::filesystem::path& cache) {
+// `traversal`: the mixing mode's order of the symbols (the paper's bits are always the improved
+// traversal's, the common reference). The naive traversal's symbols are those of the hierarchy in
+// the decoder's base order (in_decoder_order), the order of a level's nodes in a file; the improved
+// traversal's, which depend little on it, of the hierarchy as read (the seventh model's training).
+inline ModelData load(const std::string& path, const std::filesystem::path& cache, Traversal traversal = Traversal::improved) {
     ModelData d;
     d.name = std::filesystem::path(path).stem().string();
-    const std::filesystem::path file = cache / (d.name + ".mf8");
+    const std::filesystem::path file = cache / (d.name + (traversal == Traversal::naive ? "-naive" : "") + ".mf8");
     if (std::ifstream in{file, std::ios::binary}) {
         uint64_t n = 0;
         in.read(reinterpret_cast<char*>(&d.paper_bits), sizeof d.paper_bits);
@@ -98,7 +103,7 @@ inline ModelData load(const std::string& path, const std::filesystem::path& cach
         }
         d.symbols.clear();
     }
-    const Hierarchy h = read_hierarchy(path);
+    const Hierarchy h = traversal == Traversal::naive ? in_decoder_order(read_hierarchy(path)) : read_hierarchy(path);
     {
         HierarchyLevelEncoder paper(h, HierarchyCoderOptions{});
         ArithmeticEncoder sink;
@@ -106,7 +111,9 @@ inline ModelData load(const std::string& path, const std::filesystem::path& cach
         for (const ContextGroupStats& g : paper.stats().groups) d.paper_bits += g.coded_bits;
     }
     std::vector<CodedSymbol> trace;
-    const HierarchyLevelEncoder mixed(h, HierarchyCoderOptions{}, kHierarchyStreamVersion, &trace, true);
+    HierarchyCoderOptions mixed_options;
+    mixed_options.traversal = traversal;
+    const HierarchyLevelEncoder mixed(h, mixed_options, kHierarchyStreamVersion, &trace, true);
     for (const auto& [f, bit] : mixed.mixed_symbols()) d.symbols.push_back({f, uint8_t(bit)});
     {
         HierarchyLevelEncoder& coder = const_cast<HierarchyLevelEncoder&>(mixed);

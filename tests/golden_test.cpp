@@ -284,21 +284,22 @@ TEST(Golden, ChunkedFilesOfVersion7Decode) {
 // Version 8 (the hierarchy coder's mixing mode, FORMAT.md 2.1): the projected sphere of version 6
 // bit-exact and at 12 bits (geometric contexts from decoded positions), the graded L-shape
 // (planar: structure only) and the torus with the naive traversal and no context groups (the
-// switches under the mixing mode).
+// switches under the mixing mode). Each in the traversal its options name: the encoder's choice of
+// the smaller (EncodeOptions::choose_traversal) is tested in mixed_contexts_test.cpp.
 std::vector<GoldenCase> mixed_contexts_cases() {
     std::vector<GoldenCase> cases;
-    EncodeOptions mixed;
-    mixed.hierarchy_contexts = HierarchyContexts::mixed;
     for (GoldenCase& c : static_geometry_cases()) {
         if (c.name == "bumpy_random_float32_normal") continue;
         c.name += "_mixed";
         c.options.hierarchy_contexts = HierarchyContexts::mixed;
+        c.options.choose_traversal = false;
         cases.push_back(c);
     }
     for (GoldenCase& c : golden_cases()) {
         if (c.name != "lshape_graded" && c.name != "torus_naive_butterfly" && c.name != "bumpy_random_float32") continue;
         c.name += "_mixed";
         c.options.hierarchy_contexts = HierarchyContexts::mixed;
+        c.options.choose_traversal = false;
         cases.push_back(c);
     }
     return cases;
@@ -340,6 +341,7 @@ std::vector<GoldenCase> grid_geometry_cases() {
         cases.push_back({"sphere_random_q12_grid_forced_chunks4", c.hierarchy, chunked});
         EncodeOptions mixed = grid;
         mixed.hierarchy_contexts = HierarchyContexts::mixed;
+        mixed.choose_traversal = false;  // the improved traversal, as the case was made
         cases.push_back({"sphere_random_q12_grid_mixed", c.hierarchy, mixed});
     }
     return cases;
@@ -503,6 +505,7 @@ std::vector<GoldenCase> unit_frame_cases() {
         cases.push_back({"sphere_random_unit_chunks4", c.hierarchy, chunked});
         EncodeOptions mixed;
         mixed.hierarchy_contexts = HierarchyContexts::mixed;
+        mixed.choose_traversal = false;  // the improved traversal, as the case was made
         cases.push_back({"sphere_random_unit_mixed", c.hierarchy, mixed});
     }
     return cases;

@@ -16,6 +16,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <string>
 
 namespace amc {
@@ -291,6 +292,100 @@ TEST(MixedContexts, TheTrainedStatesCodeACurvedRemeshSmallerThanTheSixthModel) {
     const Hierarchy h = testing::curved_sphere_remesh(20000);
     const double sixth = mixing_model_bits(h, MixingModel::sixth), seventh = mixing_model_bits(h, MixingModel::seventh);
     EXPECT_LT(seventh, sixth);
+}
+
+// The traversal bit of the hierarchy header (FORMAT.md 2) in every mixing model's version the
+// encoder writes: the same hierarchy coded in the naive and in the improved traversal gives two
+// files whose hierarchy codes differ, and each decodes to the input; a decoder that read either
+// file in the other traversal's order would decode another forest (or fail). The older models'
+// versions come from small random hierarchies, where they code smaller, the seventh's (20, and 21
+// bit-exact) from curved remeshes.
+TEST(MixedContexts, EveryMixingVersionDecodesBothTraversals) {
+    std::map<int, int> seen[2];  // by traversal: version -> files
+    auto round_trips = [&](const Hierarchy& h, int bits, const std::string& name) {
+        EncodeOptions options;
+        options.hierarchy_contexts = HierarchyContexts::mixed;
+        options.choose_traversal = false;
+        options.quantize_bits = bits;
+        std::vector<uint8_t> files[2];
+        for (const Traversal t : {Traversal::naive, Traversal::improved}) {
+            SCOPED_TRACE(name + (t == Traversal::naive ? ", naive" : ", improved"));
+            options.hierarchy.traversal = t;
+            std::vector<uint8_t>& bytes = files[int(t)];
+            bytes = encode(h, options);
+            Hierarchy expected = in_decoder_order(h, options);
+            const Hierarchy back = decode(bytes.data(), bytes.size());
+            if (bits != 0) {
+                ASSERT_EQ(back.vertex_count(), expected.vertex_count());
+                expected.set_single_precision(false);
+                for (VertexId v = 0; v < expected.positions().size(); ++v) expected.set_position(v, back.position(v));
+            }
+            ASSERT_TRUE(identical(back, expected));
+            ++seen[int(t)][bytes[4]];
+        }
+        ASSERT_NE(files[0], files[1]) << name;
+    };
+    Random random{31};
+    const auto meshes = testing::fixture_meshes();
+    for (int trial = 0; trial < 120; ++trial) {
+        Hierarchy h(meshes[random.next() % meshes.size()].mesh);
+        refine_randomly(h, h.root_count() + uint32_t(random.next() % 800), 2 + int(random.next() % 4), random.next());
+        for (VertexId v = 0; v < h.positions().size(); ++v) {
+            const Vec3 p = h.position(v);
+            h.set_position(v, p + 0.01 * double(random.next() % 100) * Vec3{p.y, p.z, p.x});
+        }
+        round_trips(h, trial % 2 == 0 ? 0 : 12, "trial " + std::to_string(trial));
+    }
+    const Hierarchy remesh = testing::curved_sphere_remesh(8000);
+    for (const int bits : {0, 12}) round_trips(remesh, bits, "remesh, " + std::to_string(bits) + " bits");
+    for (const int version : {int(kThirdMixingVersion), int(kFourthMixingVersion), int(kFifthMixingVersion), int(kSixthMixingVersion),
+                              int(kSeventhMixingVersion), int(kBaseRawSideVersion)}) {
+        EXPECT_GE(seen[int(Traversal::naive)][version], 1) << "no naive file of version " << version;
+        EXPECT_GE(seen[int(Traversal::improved)][version], 1) << "no improved file of version " << version;
+    }
+}
+
+// EncodeOptions::choose_traversal: the mixing mode's file is the smaller of the two traversals'
+// (the seventh model's, or an older model's in the asked traversal), a tie the asked one's; the
+// paper mode ignores it.
+TEST(MixedContexts, TheEncoderKeepsTheSmallerTraversal) {
+    int naive_won = 0, improved_won = 0;
+    for (const uint32_t faces : {3000u, 8000u, 20000u}) {
+        const Hierarchy h = testing::curved_sphere_remesh(faces);
+        for (const int bits : {0, 12}) {
+            EncodeOptions options;
+            options.hierarchy_contexts = HierarchyContexts::mixed;
+            options.quantize_bits = bits;
+            options.choose_traversal = false;
+            std::vector<uint8_t> files[2];
+            for (const Traversal t : {Traversal::naive, Traversal::improved}) {
+                options.hierarchy.traversal = t;
+                files[int(t)] = encode(h, options);
+            }
+            options.choose_traversal = true;
+            options.hierarchy.traversal = Traversal::improved;
+            const std::vector<uint8_t> chosen = encode(h, options);
+            const bool naive = files[0].size() < files[1].size();
+            // The naive file in the seventh model (an older one is not tried in the other traversal).
+            const bool naive_seventh = files[0][4] == kSeventhMixingVersion || files[0][4] == kBaseRawSideVersion;
+            if (naive && naive_seventh) {
+                EXPECT_EQ(chosen, files[0]) << faces << " faces, " << bits << " bits";
+                ++naive_won;
+            } else if (!naive) {
+                EXPECT_EQ(chosen, files[1]) << faces << " faces, " << bits << " bits";
+                ++improved_won;
+            }
+            EXPECT_LE(chosen.size(), files[1].size());
+            EXPECT_TRUE(identical(decode(chosen.data(), chosen.size()), in_decoder_order(h, options)) || bits != 0);
+            EncodeOptions paper = options;
+            paper.hierarchy_contexts = HierarchyContexts::paper;
+            EncodeOptions paper_asked = paper;
+            paper_asked.choose_traversal = false;
+            EXPECT_EQ(encode(h, paper), encode(h, paper_asked));
+        }
+    }
+    EXPECT_GE(naive_won, 1);
+    EXPECT_GE(improved_won, 1);
 }
 
 TEST(MixedContexts, TheModeIsRefusedInOlderVersions) {

@@ -104,7 +104,7 @@ void print_encode_stats(std::FILE* out, const std::string& name, const EncodeSta
 void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     if (command.series || is_pvd(command.input)) {
         if (command.keep_numbering || !command.map.empty() || command.quantize_bits != 0 || command.predictor != "auto" ||
-            command.hierarchy_contexts != "paper" || command.geometry_contexts != "grid" || command.traversal != "improved")
+            command.hierarchy_contexts != "paper" || command.geometry_contexts != "grid" || command.traversal != "auto")
             throw UsageError("--keep-numbering, --map, --quantize, --predictor, --hierarchy-contexts, --geometry-contexts and "
                              "--traversal do not apply to a series");
         SeriesEncodeCommand series;
@@ -146,6 +146,7 @@ void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     options.threads = command.threads;
     options.hierarchy_contexts = command.hierarchy_contexts == "mixed" ? HierarchyContexts::mixed : HierarchyContexts::paper;
     options.hierarchy.traversal = command.traversal == "naive" ? Traversal::naive : Traversal::improved;
+    options.choose_traversal = command.traversal == "auto";
     Hierarchy h;
     LeafNumbering numbering;
     auto start = std::chrono::steady_clock::now();

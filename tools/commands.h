@@ -33,7 +33,7 @@ struct EncodeCommand {
     unsigned threads = 0;         // 0: every core
     std::string hierarchy_contexts = "paper";
     std::string geometry_contexts = "grid";  // grid (mode 4 where smaller in quantized files, mode 5 in bit-exact ones) | roles (mode 3 only)
-    std::string traversal = "improved";      // the hierarchy coder's order within a level (HierarchyCoderOptions)
+    std::string traversal = "auto";  // the hierarchy coder's order within a level (HierarchyCoderOptions)
     int effort = kDefaultEffort;  // EncodeOptions::effort
     bool series = false;          // the input is a series (.pvd, or a list of VTU files): run_series_encode
 };

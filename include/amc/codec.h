@@ -50,6 +50,11 @@ constexpr int kDefaultEffort = 1;
 struct EncodeOptions {
     HierarchyCoderOptions hierarchy;  // the connectivity coder's switches (defaults: the full method)
     HierarchyContexts hierarchy_contexts = HierarchyContexts::paper;
+    // The mixing mode also codes the forest in the other traversal (the written model only) and
+    // keeps the smaller file; a tie keeps hierarchy.traversal. About 30 % more encode time
+    // (docs/HIERARCHY_CODER.md, "The traversal of the mixing mode"). False: hierarchy.traversal
+    // alone. The paper mode ignores it.
+    bool choose_traversal = true;
     // 0: bit-exact coordinates. 1..30: coordinates quantized to a grid of 2^bits steps over the
     // bounding box (lossy; EncodeStats::max_error tells how much).
     int quantize_bits = 0;

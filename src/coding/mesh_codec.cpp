@@ -205,6 +205,14 @@ struct ForestCode {
     EncodeStats stats;  // header (the chunk table), hierarchy, geometry and framing bytes, levels, hierarchy
 };
 
+// Another code of the mixing mode's forest: in `model`, and in the traversal that is not
+// EncodeOptions::hierarchy's when `other_traversal`.
+struct MixedAlternative {
+    MixingModel model;
+    bool other_traversal;
+    ForestCode* code;
+};
+
 // Codes the forest of `h` (decoder base order, or h read in it by `first_pass`, the one chunk's
 // hierarchy coder made over TurnedRoots; positions as the decoder will have them, or those of
 // `on_grid` when given: one chunk's input nodes with their grid points) in `chunks`;
@@ -218,7 +226,7 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
                        const std::vector<RootRange>& chunks, uint64_t faces,
                        const EncodeOptions& options, CoordinateSpace space, PositionCoder positions, bool base_raw_bits, unsigned threads,
                        bool want_hierarchy_stats, HierarchyLevelEncoder* first_pass, const HierarchyOnGrid* on_grid,
-                       const std::vector<std::pair<MixingModel, ForestCode*>>& older = {}, EncodeMemory memory = {}) {
+                       const std::vector<MixedAlternative>& older = {}, EncodeMemory memory = {}) {
     ForestCode out;
     const bool mixed = options.hierarchy_contexts == HierarchyContexts::mixed;
     out.chunked = !mixed && chunks.size() > 1;
@@ -242,10 +250,27 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
         HierarchyLevelEncoder& hierarchy = first_pass != nullptr ? *first_pass : *own;
         std::vector<std::unique_ptr<HierarchyLevelEncoder>> older_hierarchies;
         std::vector<PositionCoder> older_positions;  // the same models level after level
+        // The first pass in the other traversal, for the alternatives that code in it (its last one
+        // takes it, the others a copy).
+        std::unique_ptr<HierarchyLevelEncoder> other_pass;
+        size_t other_users = 0;
+        for (const MixedAlternative& alternative : older) other_users += alternative.other_traversal;
+        if (mixed && other_users > 0) {
+            HierarchyCoderOptions other = options.hierarchy;
+            other.traversal = other.traversal == Traversal::naive ? Traversal::improved : Traversal::naive;
+            bool older_models = false;
+            for (const MixedAlternative& alternative : older)
+                older_models |= alternative.other_traversal && alternative.model < MixingModel::sixth;
+            other_pass = std::make_unique<HierarchyLevelEncoder>(h, other, kHierarchyStreamVersion, nullptr, true, nullptr,
+                                                                 nullptr, older_models);
+        }
         if (mixed)
-            for (const auto& [model, code] : older) {
-                older_hierarchies.push_back(hierarchy.fork());
-                older_hierarchies.back()->set_mixing_model(model);
+            for (const MixedAlternative& alternative : older) {
+                if (!alternative.other_traversal)
+                    older_hierarchies.push_back(hierarchy.fork());
+                else
+                    older_hierarchies.push_back(--other_users == 0 ? std::move(other_pass) : other_pass->fork());
+                older_hierarchies.back()->set_mixing_model(alternative.model);
                 older_positions.push_back(positions);
             }
         hierarchy.set_mixing_model(kWrittenMixingModel);
@@ -256,7 +281,7 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
             code.hierarchy_header = coder.header();
         };
         start(out, hierarchy);
-        for (size_t k = 0; k < older_hierarchies.size(); ++k) start(*older[k].second, *older_hierarchies[k]);
+        for (size_t k = 0; k < older_hierarchies.size(); ++k) start(*older[k].code, *older_hierarchies[k]);
         // `encoder` holds the level's hierarchy part (coder's).
         auto add_level = [&](ForestCode& code, HierarchyLevelEncoder& coder, int l, const auto& geometry_of, const NewVertices& created,
                              LevelGeometryCode& geometry, PositionCoder& models, ArithmeticEncoder& encoder) {
@@ -284,7 +309,7 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
             for (size_t k = 0; k < older_hierarchies.size(); ++k) {
                 ArithmeticEncoder older_encoder;
                 older_hierarchies[k]->encode_level(l, older_encoder);
-                add_level(*older[k].second, *older_hierarchies[k], l, geometry_of, created, geometry, older_positions[k], older_encoder);
+                add_level(*older[k].code, *older_hierarchies[k], l, geometry_of, created, geometry, older_positions[k], older_encoder);
             }
         };
         for (int l = 0; l < hierarchy.level_count(); ++l) {
@@ -295,11 +320,11 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
         }
         if (want_hierarchy_stats) out.stats.hierarchy = hierarchy.stats();
         if (want_hierarchy_stats)
-            for (size_t k = 0; k < older_hierarchies.size(); ++k) older[k].second->stats.hierarchy = older_hierarchies[k]->stats();
+            for (size_t k = 0; k < older_hierarchies.size(); ++k) older[k].code->stats.hierarchy = older_hierarchies[k]->stats();
     }
     for (const auto& block : out.blocks) out.bytes += kBlockOverhead + block.second.size();
-    for (const auto& [model, code] : older)
-        for (const auto& block : code->blocks) code->bytes += kBlockOverhead + block.second.size();
+    for (const MixedAlternative& alternative : older)
+        for (const auto& block : alternative.code->blocks) alternative.code->bytes += kBlockOverhead + block.second.size();
     return out;
 }
 
@@ -406,13 +431,13 @@ std::vector<uint8_t> encode_file(const Hierarchy& input, const EncodeOptions& op
                                           : one_chunk ? std::vector<RootRange>{RootRange{0, h.root_count()}}
                                                       : balanced_chunks(root_nodes, chunk_count_for(options, faces));
     const bool want_hierarchy_stats = stats_out != nullptr && options.hierarchy_statistics;
-    ForestCode sixth, fifth, fourth, third;  // the mixing mode's forest in its older models
-    const std::vector<std::pair<MixingModel, ForestCode*>> older =
-        mixed ? std::vector<std::pair<MixingModel, ForestCode*>>{{MixingModel::sixth, &sixth},
-                                                                  {MixingModel::fifth, &fifth},
-                                                                  {MixingModel::fourth, &fourth},
-                                                                  {MixingModel::third, &third}}
-              : std::vector<std::pair<MixingModel, ForestCode*>>{};
+    // The mixing mode's forest in its older models, and with choose_traversal in the other traversal.
+    ForestCode sixth, fifth, fourth, third, other_seventh;
+    std::vector<MixedAlternative> older;
+    if (mixed)
+        older = {{MixingModel::sixth, false, &sixth}, {MixingModel::fifth, false, &fifth},
+                 {MixingModel::fourth, false, &fourth}, {MixingModel::third, false, &third}};
+    if (mixed && options.choose_traversal) older.push_back({kWrittenMixingModel, true, &other_seventh});
     ForestCode forest = code_forest(h, root_of, root_nodes, chunks, faces, options, space, positions, base_raw_bits, threads,
                                     want_hierarchy_stats, first_pass.get(), turned_input && quantized ? &on_grid : nullptr, older, memory);
     const uint32_t fewer = automatic && forest.chunked ? chunk_count_for_size(options, uint32_t(chunks.size()), forest.bytes)
@@ -422,16 +447,19 @@ std::vector<uint8_t> encode_file(const Hierarchy& input, const EncodeOptions& op
                              base_raw_bits, threads, want_hierarchy_stats, nullptr, nullptr, {}, memory);
     // An older model of the mixing mode where it codes the file smaller (small files, whose new
     // tables have little to learn from, or creased ones, by a few bytes): every file at most as
-    // large as each older model's. A tie keeps the newer model. The seventh model's base block is
-    // version 21's (bit-exact), the older ones' that of their versions.
+    // large as each older model's. A tie keeps the newer model, then the asked traversal. The
+    // seventh model's base block is version 21's (bit-exact), the older ones' that of their versions.
     if (!older.empty()) {
         const uint64_t newest_base = base_raw_bits ? base_geometry.joined().size() : base_geometry.arithmetic.size();
         uint64_t best = forest.bytes + newest_base;
-        for (const auto& model_and_code : older)
-            if (model_and_code.second->bytes + inline_base().size() < best) {
-                best = model_and_code.second->bytes + inline_base().size();
-                forest = std::move(*model_and_code.second);
+        for (const MixedAlternative& alternative : older) {
+            const uint64_t bytes =
+                alternative.code->bytes + (alternative.model == kWrittenMixingModel ? newest_base : inline_base().size());
+            if (bytes < best) {
+                best = bytes;
+                forest = std::move(*alternative.code);
             }
+        }
     }
 
     Metadata meta;

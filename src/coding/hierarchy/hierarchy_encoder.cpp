@@ -35,8 +35,8 @@ void give_back_lists(std::vector<std::vector<T>>& lists, std::vector<std::vector
 
 HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const HierarchyCoderOptions& options,
                                              uint8_t stream_version, std::vector<CodedSymbol>* trace, bool mixed,
-                                             const TurnedRoots* turned, Memory* memory)
-    : options_(options), mixed_(mixed) {
+                                             const TurnedRoots* turned, Memory* memory, bool older_models)
+    : options_(options), mixed_(mixed), older_models_(older_models) {
     AMC_REQUIRE(!mixed || stream_version == kHierarchyStreamVersion, invalid_input,
                 "the hierarchy coder's mixing mode needs the newest hierarchy stream version");
     AMC_REQUIRE(!mixed || turned == nullptr, invalid_input, "the hierarchy coder's mixing mode reads no turned roots");
@@ -136,7 +136,7 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
                 if (mixed_) {
                     if (event_feature_.size() < events_.size() + 1) event_feature_.resize(events_.size() + 1);
                     event_feature_[events_.size()] = uint32_t(mixed_features_.size());
-                    mixed_features_.push_back(mixed_features(h, ids[i], level, i, group, shapes, kWrittenMixingModel, true));
+                    mixed_features_.push_back(mixed_features(h, ids[i], level, i, group, shapes, kWrittenMixingModel, older_models_));
                 }
                 events_.push_back({uint8_t(group), uint8_t(r)});
                 if (trace != nullptr) trace->push_back({ids[i], uint8_t(group), r});
