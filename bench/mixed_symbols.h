@@ -85,7 +85,7 @@ inline double model_bits(MixingModel model, const std::vector<Symbol>& symbols, 
 // `traversal`: the mixing mode's order of the symbols (the paper's bits are always the improved
 // traversal's, the common reference). The naive traversal's symbols are those of the hierarchy in
 // the decoder's base order (in_decoder_order), the order of a level's nodes in a file; the improved
-// traversal's, which depend little on it, of the hierarchy as read (the seventh model's training).
+// traversal's of the hierarchy as read, as the seventh model's table was trained.
 inline ModelData load(const std::string& path, const std::filesystem::path& cache, Traversal traversal = Traversal::improved) {
     ModelData d;
     d.name = std::filesystem::path(path).stem().string();
