@@ -64,6 +64,10 @@ expect 0 "$amc" decode tn.amc -o tn.amh
 expect 0 "$amc" decode ti.amc -o ti.amh
 cmp -s tn.amh ti.amh || fail "the naive traversal's file decodes to another hierarchy"
 expect 2 "$amc" encode front_1.amh -o tx.amc --traversal sideways
+# A series (here of one frame) is coded in the improved traversal: naming it is no usage error,
+# naming naive is.
+expect 0 "$amc" encode --series front_1.amh -o tx.amcs --traversal improved
+expect 2 "$amc" encode --series front_1.amh -o tx.amcs --traversal naive
 
 # Kinds from magic bytes, not from names.
 cp r.amc renamed.bin

@@ -104,7 +104,8 @@ void print_encode_stats(std::FILE* out, const std::string& name, const EncodeSta
 void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     if (command.series || is_pvd(command.input)) {
         if (command.keep_numbering || !command.map.empty() || command.quantize_bits != 0 || command.predictor != "auto" ||
-            command.hierarchy_contexts != "paper" || command.geometry_contexts != "grid" || command.traversal != "auto")
+            command.hierarchy_contexts != "paper" || command.geometry_contexts != "grid" ||
+            (command.traversal != "auto" && command.traversal != "improved"))
             throw UsageError("--keep-numbering, --map, --quantize, --predictor, --hierarchy-contexts, --geometry-contexts and "
                              "--traversal do not apply to a series");
         SeriesEncodeCommand series;
