@@ -29,6 +29,7 @@
 // improved traversal's symbols through one adaptive binary coder (as bench/traversal_order_study),
 // "stream" the library's whole hierarchy stream (header and orientation bits included).
 #include "bench_common.h"
+#include "decide_only.h"
 #include "coding/entropy/arithmetic_coder.h"
 #include "coding/entropy/rans_coder.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
@@ -433,16 +434,6 @@ struct Decoder2p {
         return nodes;
     }
 };
-
-// The library's deciding (decode_phases' decide phase): every level, no build.
-uint64_t decide_library(HierarchyLevelDecoder& coder, const Hierarchy& h, const std::vector<uint8_t>& bytes) {
-    HierarchyStreamHeader header;
-    const size_t header_size = read_standalone_stream_header(bytes.data(), bytes.size(), header);
-    coder.restart(h.base(), header, HierarchyDecodeOptions().max_nodes);
-    ArithmeticDecoder decoder(bytes.data() + header_size, bytes.size() - header_size);
-    while (!coder.done()) coder.decide_level(decoder);
-    return coder.node_count();
-}
 
 }  // namespace
 

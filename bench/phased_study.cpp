@@ -52,6 +52,7 @@
 // (a corner: the blocks across its outer edges; a center: its far centers, see deepD),
 // d(p) = p's hop distance to a node not refined in the level above (capped at 8).
 #include "bench_common.h"
+#include "decide_only.h"
 #include "coding/entropy/arithmetic_coder.h"
 #include "coding/entropy/rans_coder.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
@@ -962,16 +963,6 @@ uint64_t levels_only(ProtoDecider& scratch, const Hierarchy& roots_only, const C
         std::swap(cur, next);
     }
     return nodes;
-}
-
-// The library's deciding (as decode_phases' decide phase): every level, no build.
-uint64_t decide_library(HierarchyLevelDecoder& coder, const Hierarchy& h, const std::vector<uint8_t>& bytes) {
-    HierarchyStreamHeader header;
-    const size_t header_size = read_standalone_stream_header(bytes.data(), bytes.size(), header);
-    coder.restart(h.base(), header, HierarchyDecodeOptions().max_nodes);
-    ArithmeticDecoder decoder(bytes.data() + header_size, bytes.size() - header_size);
-    while (!coder.done()) coder.decide_level(decoder);
-    return coder.node_count();
 }
 
 // The table of docs/HIERARCHY_CODER.md: a few designs per model (--table).
