@@ -30,6 +30,7 @@
 // "stream" the library's whole hierarchy stream (header and orientation bits included).
 #include "bench_common.h"
 #include "decide_only.h"
+#include "static_table_cost.h"
 #include "coding/entropy/arithmetic_coder.h"
 #include "coding/entropy/rans_coder.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
@@ -99,16 +100,7 @@ struct Counts {
 // Bits of one level's symbols under static tables made from their counts, and the tables.
 double static_bits(const Counts& c, int contexts, double* table_bits) {
     double bits = 0;
-    for (int k = 0; k < contexts; ++k) {
-        const uint64_t n0 = c.n[k][0], n1 = c.n[k][1];
-        *table_bits += 2;
-        if (n0 == 0 || n1 == 0) continue;
-        *table_bits += 12;
-        uint32_t f1 = uint32_t(std::lround(double(n1) / double(n0 + n1) * kRansScale));
-        f1 = std::min(std::max(f1, 1u), kRansScale - 1);
-        const uint32_t f0 = kRansScale - f1;
-        bits += double(n0) * -std::log2(double(f0) / kRansScale) + double(n1) * -std::log2(double(f1) / kRansScale);
-    }
+    for (int k = 0; k < contexts; ++k) bits += static_slot_bits(c.n[k][0], c.n[k][1], table_bits);
     return bits;
 }
 

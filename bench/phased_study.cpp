@@ -53,6 +53,7 @@
 // d(p) = p's hop distance to a node not refined in the level above (capped at 8).
 #include "bench_common.h"
 #include "decide_only.h"
+#include "static_table_cost.h"
 #include "coding/entropy/arithmetic_coder.h"
 #include "coding/entropy/rans_coder.h"
 #include "coding/hierarchy/hierarchy_level_coder.h"
@@ -590,16 +591,7 @@ void print_phase_costs(const std::vector<Symbol>& symbols, uint32_t contexts) {
 // to *table_bits (2 bits a slot in use, 12 for a coded probability).
 double static_bits(const std::vector<std::array<uint64_t, 2>>& counts, double* table_bits) {
     double bits = 0;
-    for (const auto& c : counts) {
-        const uint64_t n0 = c[0], n1 = c[1];
-        *table_bits += 2;
-        if (n0 == 0 || n1 == 0) continue;
-        *table_bits += 12;
-        uint32_t f1 = uint32_t(std::lround(double(n1) / double(n0 + n1) * kRansScale));
-        f1 = std::min(std::max(f1, 1u), kRansScale - 1);
-        const uint32_t f0 = kRansScale - f1;
-        bits += double(n0) * -std::log2(double(f0) / kRansScale) + double(n1) * -std::log2(double(f1) / kRansScale);
-    }
+    for (const auto& c : counts) bits += static_slot_bits(c[0], c[1], table_bits);
     return bits;
 }
 
