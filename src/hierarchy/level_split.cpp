@@ -289,6 +289,10 @@ void Hierarchy::split_level(const LevelSplits& splits) {
     constexpr uint32_t kParentsAhead = 16;
     const uint32_t offset = uint32_t(c0);
     const auto boundary_vertex = splits.boundary_vertex;
+    // No seam vertices and the blocks' edges given: a midpoint is new unless an earlier parent
+    // made it, and the children's tails need not be found from their links.
+    const BlockEdges* const child_edges = splits.child_edges;
+    const bool fast = boundary_vertex == nullptr && child_edges != nullptr;
     for (uint32_t chunk = 0; chunk < count; chunk += kChunk) {
         const uint32_t chunk_end = std::min(count, chunk + kChunk);
         uint32_t new_vertices = 0;
@@ -299,7 +303,17 @@ void Hierarchy::split_level(const LevelSplits& splits) {
             const NodeId c = NodeId(c0 + size_t(4) * i);
             unsigned linked_edges = 0;
             VertexId m[3];
-            for (int e = 0; e < 3; ++e) {
+            for (int e = 0; fast && e < 3; ++e) {
+                const uint32_t t = first_half(i, e);  // kNoNode / 4 is never below i
+                if (t / 4 < i) {
+                    const unsigned eq = (parent.nbr_edge >> (2 * e)) & 3u;
+                    m[e] = nodes[c0 + (t & ~3u) + red_split::kCenter].v[red_split::kCenterVertexOfMidpoint[eq]];
+                } else {
+                    ends[new_vertices++] = {parent.v[e], parent.v[e == 2 ? 0 : e + 1]};
+                    m[e] = next_vertex++;
+                }
+            }
+            for (int e = 0; !fast && e < 3; ++e) {
                 const uint32_t t = first_half(i, e);  // kNoNode / 4 is never below i
                 linked_edges |= t == kNoNode ? 0u : 3u << (2 * e);
                 if (t / 4 < i) {
@@ -320,16 +334,16 @@ void Hierarchy::split_level(const LevelSplits& splits) {
             }
             // The children's edges (red_split::kChildEdges): linked outer edges take the parent's neighbour
             // edge index.
-            const unsigned outer = parent.nbr_edge & linked_edges;
+            const unsigned tail_code = fast ? child_edges[i].nbr_edge | unsigned(child_edges[i].boundary & 7u) << 6
+                                            : (parent.nbr_edge & linked_edges) | (parent.flags & 7u) << 6;
             const uint32_t level = uint32_t(parent.level + 1) << 8;
-            const unsigned boundary = parent.flags;
             Node* child = nodes + c;
             red_split_kernels::write_child_vertices(child, parent.v, m);  // write_vertices' (split() shares it)
             if (in_place)
                 turn_links_into_ids(child, offset);
             else
                 store_neighbors(child, splits.children + size_t(4) * i, offset);
-            const ChildTails& tails = kChildTails.of[outer | (boundary & 7u) << 6];
+            const ChildTails& tails = kChildTails.of[tail_code];
             for (int k = 0; k < 4; ++k) store_tail(child[k], tails.word[k] | level);
             parent.first_child = c;
         }

@@ -39,13 +39,6 @@ struct LevelLinks {
 };
 static_assert(sizeof(LevelLinks) == 16, "LevelLinks is meant to be 16 bytes");
 
-// What the four children of one refined node p take from p besides their neighbours: p's
-// neighbour_edge (2 bits per edge, 0 where the neighbour is not refined) and boundary edges.
-struct BlockEdges {
-    uint8_t nbr_edge;
-    uint8_t boundary;  // bits 0-2
-};
-
 // The links of child k (0..3) of a block, by its parent's BlockEdges (red_split::kChildEdges).
 inline LevelLinks child_links(const Neighbors& nbr, BlockEdges parent, unsigned k) {
     LevelLinks out;
