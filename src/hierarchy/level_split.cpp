@@ -220,6 +220,51 @@ AMC_ALWAYS_INLINE void turn_links_into_ids(Node* child, uint32_t offset) {
 #endif
 }
 
+// The parents i in [begin, end) of split_level's common case (links in `children`, the blocks'
+// edges given, no seam vertex), in a loop of its own: in split_level's loop, which
+// serves every case, GCC kept the loop's counters and the midpoints on the stack (about 25 loads
+// and stores a parent). Returns the new vertices listed in `ends`; next_vertex moves past them.
+// The parents are fetched kAhead parents early (what else was tried: HIERARCHY_CODER.md, Speed, item 13).
+template <class Node>
+AMC_NOIPA uint32_t split_plain_parents(Node* nodes, const uint32_t* parents, uint32_t begin, uint32_t end,
+                                       uint32_t count, size_t c0, const Neighbors* children,
+                                       const BlockEdges* child_edges, VertexId& next_vertex, Ends* ends) {
+    constexpr uint32_t kAhead = 16;
+    const uint32_t offset = uint32_t(c0);
+    VertexId next = next_vertex;
+    uint32_t listed = 0;
+    for (uint32_t i = begin; i < end; ++i) {
+        if (i + kAhead < count) __builtin_prefetch(nodes + parents[i + kAhead]);
+        Node& parent = nodes[parents[i]];
+        const size_t c = c0 + size_t(4) * i;
+        VertexId m[3];
+        for (int e = 0; e < 3; ++e) {
+            const uint32_t t = children[size_t(4) * i + red_split::kFirstHalfChild[e]].nbr[e];  // kNoNode / 4 is never below i
+            if (t / 4 < i) {  // made by the parent of block t / 4, in its centre child
+                const unsigned eq = (parent.nbr_edge >> (2 * e)) & 3u;
+                m[e] = nodes[c0 + (t & ~3u) + red_split::kCenter].v[red_split::kCenterVertexOfMidpoint[eq]];
+            } else {
+                ends[listed++] = {parent.v[e], parent.v[e == 2 ? 0 : e + 1]};
+                m[e] = next++;
+            }
+        }
+        const uint32_t level = uint32_t(parent.level + 1) << 8;
+        Node* child = nodes + c;
+#if AMC_SSE2
+        // A leaf's first 16 bytes: its corners and first_child, kNoNode, the children's fourth word.
+        red_split_sse2::write_child_vertices(child, _mm_loadu_si128(reinterpret_cast<const __m128i*>(parent.v)), m);
+#else
+        red_split_kernels::write_child_vertices(child, parent.v, m);
+#endif
+        store_neighbors(child, children + size_t(4) * i, offset);
+        const ChildTails& tails = kChildTails.of[child_edges[i].nbr_edge | unsigned(child_edges[i].boundary & 7u) << 6];
+        for (int k = 0; k < 4; ++k) store_tail(child[k], tails.word[k] | level);
+        parent.first_child = NodeId(c);
+    }
+    next_vertex = next;
+    return listed;
+}
+
 }  // namespace
 
 ChildLinkRoom Hierarchy::open_children(HierarchySlice* slice, uint32_t count) {
@@ -314,10 +359,14 @@ void Hierarchy::split_level(const LevelSplits& splits) {
     // made it, and the children's tails need not be found from their links.
     const BlockEdges* const child_edges = splits.child_edges;
     const bool fast = boundary_vertex == nullptr && child_edges != nullptr;
+    const bool plain = fast && !in_place;
     for (uint32_t chunk = 0; chunk < count; chunk += kChunk) {
         const uint32_t chunk_end = std::min(count, chunk + kChunk);
         uint32_t new_vertices = 0;
-        for (uint32_t i = chunk; i < chunk_end; ++i) {
+        if (plain)
+            new_vertices = split_plain_parents(nodes, parents, chunk, chunk_end, count, c0, splits.children,
+                                               child_edges, next_vertex, ends);
+        for (uint32_t i = plain ? chunk_end : chunk; i < chunk_end; ++i) {
             if (i + kParentsAhead < count) __builtin_prefetch(nodes + parents[i + kParentsAhead]);
             const NodeId n = parents[i];
             Node& parent = nodes[n];
