@@ -1146,6 +1146,43 @@ struct StencilStreams {
     }
 };
 
+// The last bytes of a level's streams, copied with zeros after them once fewer remain than a chunk
+// may read (Rans and Raw bytes), so that every chunk reads without a bounds test per byte, as if
+// inside the streams: bytes past an end read as 0, as the safe reads give them, and a chunk that
+// went past an end makes the level corrupt (overran()). At 12 bits a level's raw stream is often
+// shorter than a chunk's bound, and every chunk of it took the safe reads.
+template <size_t Rans, size_t Raw>
+class PaddedTails {
+public:
+    // Before each chunk: the streams' tails moved here where they are that short.
+    void pad(StencilStreams& s) {
+        if (!rans_padded_ && size_t(s.rans_end - s.rans) < Rans) {
+            const size_t n = size_t(s.rans_end - s.rans);
+            std::memcpy(rans_, s.rans, n);
+            std::memset(rans_ + n, 0, sizeof rans_ - n);
+            s.rans = rans_;
+            s.rans_end = rans_ + n;
+            rans_padded_ = true;
+        }
+        const size_t at = size_t(s.raw_bits_read >> 3);  // at most raw_size (overran() after each chunk)
+        if (!raw_padded_ && s.raw_size - at < Raw) {
+            const size_t n = s.raw_size - at;
+            if (n > 0) std::memcpy(raw_, s.raw + at, n);
+            std::memset(raw_ + n, 0, sizeof raw_ - n);
+            s.raw = raw_;
+            s.raw_size = n;
+            s.raw_bits_read -= uint64_t(at) * 8;
+            raw_padded_ = true;
+        }
+    }
+    // After each chunk: whether it read past a stream's end.
+    static bool overran(const StencilStreams& s) { return s.rans > s.rans_end || s.raw_bits_read > uint64_t(s.raw_size) * 8; }
+
+private:
+    uint8_t rans_[2 * Rans], raw_[2 * Raw];
+    bool rans_padded_ = false, raw_padded_ = false;
+};
+
 // The streams of a level with both rANS states read; false where the level is too short for them
 // or a state is below L (no encoder ends there).
 bool open_stencil_streams(const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size,
@@ -1724,30 +1761,25 @@ AMC_ALWAYS_INLINE bool decode_grid_listed_with(Hierarchy& h, const FromList& cre
     std::array<GridFrame, kChunk> frames;
     Coordinates coordinates[kChunk];
     Vec3 decoded[kChunk];
+    PaddedTails<kChunkRans, kChunkRaw> tails;
     for (size_t begin = 0; begin < created.size(); begin += kChunk) {
         const size_t count = std::min(kChunk, created.size() - begin);
         const FrameCorners* corners = created.corners.next(count);
         prefetch_corner_positions(h, corners, count);
         make_frames(h, corners, count, grid, origin, frames.data());
-        auto run = [&](auto safe) {
-            constexpr bool Safe = decltype(safe)::value;
-            StencilStreams local = s;  // the chunk's copy, which the compiler keeps in registers
-            bool ok = true;
-            if (Grouped) {
-                ok = make_frames.template grouped<Safe>(local, t.data(), frames.data(), count, grid, origin, coordinates);
-                s = local;
-                return ok;
-            }
+        tails.pad(s);
+        StencilStreams local = s;  // the chunk's copy, which the compiler keeps in registers
+        bool ok = true;
+        if (Grouped) {
+            ok = make_frames.template grouped<false>(local, t.data(), frames.data(), count, grid, origin, coordinates);
+        } else {
             for (size_t k = 0; k < count && ok; k += 2) {  // token j of the level with state j mod 2
-                ok = decode_grid_vertex<0, Safe>(local, t.data(), frames[k], grid, origin, coordinates[k]) &&
-                     (k + 1 == count || decode_grid_vertex<1, Safe>(local, t.data(), frames[k + 1], grid, origin, coordinates[k + 1]));
+                ok = decode_grid_vertex<0, false>(local, t.data(), frames[k], grid, origin, coordinates[k]) &&
+                     (k + 1 == count || decode_grid_vertex<1, false>(local, t.data(), frames[k + 1], grid, origin, coordinates[k + 1]));
             }
-            s = local;
-            return ok;
-        };
-        const bool inside = size_t(s.rans_end - s.rans) >= kChunkRans &&
-                            raw_size - std::min<size_t>(raw_size, size_t(s.raw_bits_read >> 3)) >= kChunkRaw;
-        if (!(inside ? run(std::false_type{}) : run(std::true_type{}))) return false;
+        }
+        s = local;
+        if (!ok || tails.overran(s)) return false;
         std::memcpy(decoded, coordinates, count * sizeof(Vec3));
         store_listed_chunk(h, created, begin, decoded, count, append, near);
     }
