@@ -1882,27 +1882,23 @@ AMC_ALWAYS_INLINE bool decode_unit_listed_with(Hierarchy& h, const FromList& cre
     std::array<GridFrame, kChunk> frames;
     Coordinates coordinates[kChunk];
     Vec3 decoded[kChunk];
+    PaddedTails<kChunkRans, kChunkRaw> tails;
     for (size_t begin = 0; begin < created.size(); begin += kChunk) {
         const size_t count = std::min(kChunk, created.size() - begin);
         const FrameCorners* corners = created.corners.next(count);
         prefetch_corner_positions(h, corners, count);
         make_frames(h, corners, count, frames.data());
         uint64_t largest = 0;
-        auto run = [&](auto safe) {
-            constexpr bool Safe = decltype(safe)::value;
-            StencilStreams local = s;  // the chunk's copy, which the compiler keeps in registers
-            size_t k = 0;
-            for (; k + 1 < count; k += 2) {  // token j of the level with state j mod 2
-                decode_unit_vertex<0, Safe, Float32>(local, t.data(), frames[k], coordinates[k], largest);
-                decode_unit_vertex<1, Safe, Float32>(local, t.data(), frames[k + 1], coordinates[k + 1], largest);
-            }
-            if (k < count) decode_unit_vertex<0, Safe, Float32>(local, t.data(), frames[k], coordinates[k], largest);
-            s = local;
-        };
-        const bool inside = size_t(s.rans_end - s.rans) >= kChunkRans &&
-                            raw_size - std::min<size_t>(raw_size, size_t(s.raw_bits_read >> 3)) >= kChunkRaw;
-        if (inside) run(std::false_type{});
-        else run(std::true_type{});
+        tails.pad(s);
+        StencilStreams local = s;  // the chunk's copy, which the compiler keeps in registers
+        size_t k = 0;
+        for (; k + 1 < count; k += 2) {  // token j of the level with state j mod 2
+            decode_unit_vertex<0, false, Float32>(local, t.data(), frames[k], coordinates[k], largest);
+            decode_unit_vertex<1, false, Float32>(local, t.data(), frames[k + 1], coordinates[k + 1], largest);
+        }
+        if (k < count) decode_unit_vertex<0, false, Float32>(local, t.data(), frames[k], coordinates[k], largest);
+        s = local;
+        if (tails.overran(s)) return false;
         std::memcpy(decoded, coordinates, count * sizeof(Vec3));
         // Every coordinate at most DBL_MAX / 2 in magnitude: finite, and no position is far.
         const bool near = largest <= bit_cast<uint64_t>(kHalfMax);
