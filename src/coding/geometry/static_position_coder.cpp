@@ -1856,15 +1856,18 @@ AMC_ALWAYS_INLINE void round_midpoints_to_float(GridFrame* frames, size_t count)
         for (double& m : frames[i].midpoint) m = rounded_to_float(m);
 }
 
-// The frames of `count` listed vertices without a grid, two at a time with SSE2.
+// The frames of `count` listed vertices without a grid, two at a time with SSE2: mode 5's (unit
+// normals), or mode 3's.
+template <bool UnitNormals = true>
 struct PairUnitFrames {
     AMC_ALWAYS_INLINE void operator()(const Hierarchy& h, const FrameCorners* corners, size_t count, GridFrame* frames) const {
         size_t i = 0;
 #if AMC_SSE2
-        for (; i + 1 < count; i += 2) set_frame_pair(frame_pair_lanes<true>(h, corners[i], corners[i + 1]), frames[i], frames[i + 1]);
+        for (; i + 1 < count; i += 2)
+            set_frame_pair(frame_pair_lanes<UnitNormals>(h, corners[i], corners[i + 1]), frames[i], frames[i + 1]);
         if (h.single_precision()) round_midpoints_to_float(frames, i);
 #endif
-        for (; i < count; ++i) set_frame(frame_of<true>(h, corners[i]), frames[i]);
+        for (; i < count; ++i) set_frame(frame_of<UnitNormals>(h, corners[i]), frames[i]);
     }
 };
 
@@ -1911,10 +1914,13 @@ AMC_ALWAYS_INLINE bool decode_unit_listed_with(Hierarchy& h, const FromList& cre
     return s.ended_cleanly();
 }
 
-template <bool Float32>
+// Mode 5's levels, or mode 3's (UnitNormals false: the same streams and roles, the frame's normal
+// the sum of the cross products).
+template <bool Float32, bool UnitNormals>
 bool decode_unit_listed(Hierarchy& h, const FromList& created, const StaticTables& tables, const uint8_t* rans_data,
                         size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
-    return decode_unit_listed_with<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size, PairUnitFrames{});
+    return decode_unit_listed_with<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size,
+                                            PairUnitFrames<UnitNormals>{});
 }
 
 #if AMC_AVX2_AT_RUN_TIME
@@ -1938,7 +1944,9 @@ struct FrameQuadLanes {
     __m256d mx, my, mz, nx, ny, nz;
 };
 
-// Inlined in both quad frame makers: a call of its own passes the lanes through memory.
+// Inlined in the quad frame makers: a call of its own passes the lanes through memory. Mode 3's
+// normals without UnitNormals.
+template <bool UnitNormals = true>
 AMC_ALWAYS_INLINE FrameQuadLanes frame_quad_lanes(const Hierarchy& h, const FrameCorners* k) {
     struct Lanes {
         __m256d x, y, z;
@@ -1984,6 +1992,7 @@ AMC_ALWAYS_INLINE FrameQuadLanes frame_quad_lanes(const Hierarchy& h, const Fram
     auto pick = [with_d](__m256d u, __m256d v) {
         return _mm256_or_pd(_mm256_and_pd(with_d, _mm256_add_pd(u, v)), _mm256_andnot_pd(with_d, u));
     };
+    if (!UnitNormals) return {mid.x, mid.y, mid.z, pick(n1.x, n2.x), pick(n1.y, n2.y), pick(n1.z, n2.z)};
     const __m256d zero = _mm256_setzero_pd(), infinity = _mm256_set1_pd(HUGE_VAL), one = _mm256_set1_pd(1.0);
     const __m256d l1 = _mm256_sqrt_pd(dot(n1)), l2 = _mm256_sqrt_pd(dot(n2));
     const __m256d r1 = _mm256_div_pd(one, l1), r2 = _mm256_div_pd(one, l2);
@@ -2181,19 +2190,22 @@ bool decode_grid_listed_avx2(Hierarchy& h, const FromList& created, const Quanti
 }
 
 // PairUnitFrames four at a time.
+template <bool UnitNormals = true>
 struct QuadUnitFrames {
     void operator()(const Hierarchy& h, const FrameCorners* corners, size_t count, GridFrame* frames) const {
         size_t i = 0;
-        for (; i + 3 < count; i += 4) set_grid_frame_quad<false>(frame_quad_lanes(h, corners + i), GridScale{}, nullptr, frames + i);
+        for (; i + 3 < count; i += 4)
+            set_grid_frame_quad<false>(frame_quad_lanes<UnitNormals>(h, corners + i), GridScale{}, nullptr, frames + i);
         if (h.single_precision()) round_midpoints_to_float(frames, i);
-        PairUnitFrames()(h, corners + i, count - i, frames + i);
+        PairUnitFrames<UnitNormals>()(h, corners + i, count - i, frames + i);
     }
 };
 
-template <bool Float32>
+template <bool Float32, bool UnitNormals>
 bool decode_unit_listed_avx2(Hierarchy& h, const FromList& created, const StaticTables& tables, const uint8_t* rans_data,
                              size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
-    return decode_unit_listed_with<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size, QuadUnitFrames{});
+    return decode_unit_listed_with<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size,
+                                            QuadUnitFrames<UnitNormals>{});
 }
 #pragma GCC pop_options
 #endif
@@ -2210,14 +2222,14 @@ bool decode_grid_listed_fastest(Hierarchy& h, const FromList& created, const Qua
 }
 
 // decode_unit_listed, with AVX2's frames where the processor has them.
-template <bool Float32>
+template <bool Float32, bool UnitNormals>
 bool decode_unit_listed_fastest(Hierarchy& h, const FromList& created, const StaticTables& tables, const uint8_t* rans_data,
                                 size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
 #if AMC_AVX2_AT_RUN_TIME
     if (has_avx2() && wide_frames_allowed.load(std::memory_order_relaxed))
-        return decode_unit_listed_avx2<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+        return decode_unit_listed_avx2<Float32, UnitNormals>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
 #endif
-    return decode_unit_listed<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+    return decode_unit_listed<Float32, UnitNormals>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
 }
 
 template <class Tables>
@@ -2278,11 +2290,18 @@ bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, G
         if (all_narrow && mode == GeometryPredictor::normal_frame_grid && space.quantizer != nullptr && !h.single_precision())
             return grouped ? decode_grid_listed_fastest<true>(h, created, *space.quantizer, tables, rans_data, rans_size, raw_data, raw_size)
                            : decode_grid_listed_fastest<false>(h, created, *space.quantizer, tables, rans_data, rans_size, raw_data, raw_size);
+        // Modes 5 and 3 bit-exact (the FE models' middle levels take mode 3).
         if (all_narrow && mode == GeometryPredictor::unit_normal_frame && space.quantizer == nullptr) {
             if (space.precision == Precision::float64 && !h.single_precision())
-                return decode_unit_listed_fastest<false>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+                return decode_unit_listed_fastest<false, true>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
             if (space.precision == Precision::float32 && h.single_precision())
-                return decode_unit_listed_fastest<true>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+                return decode_unit_listed_fastest<true, true>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+        }
+        if (all_narrow && mode == GeometryPredictor::normal_frame && space.quantizer == nullptr) {
+            if (space.precision == Precision::float64 && !h.single_precision())
+                return decode_unit_listed_fastest<false, false>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+            if (space.precision == Precision::float32 && h.single_precision())
+                return decode_unit_listed_fastest<true, false>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
         }
     }
     if (all_narrow) return decode_static_with(h, created, space, mode, narrow, rans_data, rans_size, raw_data, raw_size, grouped);
@@ -2294,11 +2313,11 @@ bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, G
 void make_unit_frames(const Hierarchy& h, const FrameCorners* corners, size_t count, GridFrame* frames) {
 #if AMC_AVX2_AT_RUN_TIME
     if (has_avx2() && wide_frames_allowed.load(std::memory_order_relaxed)) {
-        QuadUnitFrames()(h, corners, count, frames);
+        QuadUnitFrames<>()(h, corners, count, frames);
         return;
     }
 #endif
-    PairUnitFrames()(h, corners, count, frames);
+    PairUnitFrames<>()(h, corners, count, frames);
 }
 
 }  // namespace
