@@ -74,6 +74,32 @@ BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const 
     return encode_base_connectivity(base, resolve_thread_count(options.threads), base_search_budget(h));
 }
 
+std::vector<BaseMeshCode> base_order_candidates(const Hierarchy& h, const Quantizer* quantizer, const BaseMeshCode& own,
+                                                uint32_t count) {
+    const TriangleMesh base = base_as_decoded(h, quantizer);
+    const size_t triangles = base.triangles.size();
+    std::vector<BaseMeshCode> out;
+    auto same_order = [](const BaseMeshCode& a, const BaseMeshCode& b) {
+        return a.triangle_order == b.triangle_order && a.triangle_rotation == b.triangle_rotation && a.vertex_order == b.vertex_order;
+    };
+    for (uint32_t k = 0; k < count; ++k) {
+        BaseStart start;
+        start.first = uint32_t(uint64_t{k} * triangles / count);
+        if (k > 0 && start.first == uint32_t(uint64_t{k - 1} * triangles / count)) continue;  // fewer triangles than starts
+        BaseMeshCode code;
+        try {
+            code = encode_base_connectivity(base, start);
+        } catch (const Error&) {  // mode 2 does not fit from there: the other starts may
+            continue;
+        }
+        if (same_order(code, own)) continue;
+        bool seen = false;
+        for (const BaseMeshCode& other : out) seen |= same_order(code, other);
+        if (!seen) out.push_back(std::move(code));
+    }
+    return out;
+}
+
 bool keeps_rotations(const DiagonalExceptions& rotated, const DiagonalExceptions& unrotated, size_t triangles) {
     if (rotated.fewest() == 0) return false;
     const double rotated_bits = binary_entropy_bits(rotated.fewest(), rotated.leaves);

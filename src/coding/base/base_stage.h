@@ -24,6 +24,12 @@ uint64_t base_search_budget(const Hierarchy& h);
 // grid when `quantizer` is set).
 BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const EncodeOptions& options);
 
+// Other orders of the base of `h` (EncodeOptions::effort 3): mode 2's codes from `count` start
+// triangles spread over it (its first corner, gate radius 5), those whose order differs from
+// `own`'s and from each other's, in start order. Quantized files pass their grid (`quantizer`).
+std::vector<BaseMeshCode> base_order_candidates(const Hierarchy& h, const Quantizer* quantizer, const BaseMeshCode& own,
+                                                uint32_t count);
+
 // The base coder may rotate each triangle's vertices. The default diagonal rule does not care, but
 // hierarchies made under a rule of absolute local indices would pay orientation bits: then storing
 // each root's rotation (log2 3 bits) to keep the input's local order may be cheaper. Both readings
