@@ -10,14 +10,17 @@
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
 namespace amc {
 
-// The effort that searches the base order, and the start triangles it weighs.
+// The effort that searches the base order, the start triangles it weighs, and how many of those
+// orders the mixing mode codes in full (the smallest in the paper mode).
 constexpr int kBaseOrderEffort = 3;
 constexpr uint32_t kBaseOrderStarts = 16;
+constexpr size_t kBaseOrderTrials = 4;
 
 // encode() with `base` as the base connectivity code (one of base_order_candidates(), say): a
 // study's or a test's way to weigh one order.

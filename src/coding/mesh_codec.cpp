@@ -25,6 +25,7 @@
 #include <cstddef>
 #include <future>
 #include <memory>
+#include <numeric>
 #include <string>
 #include <utility>
 
@@ -537,15 +538,32 @@ std::vector<uint8_t> encode_choosing_base(const Hierarchy& input, const EncodeOp
     BaseMeshCode own = base_code_of(input, quantizer.get(), at_two);
     EncodeStats best_stats;
     std::vector<uint8_t> best = encode_file(input, at_two, stats_out != nullptr ? &best_stats : nullptr, memory, &own);
+    std::vector<BaseMeshCode> candidates;
     if (options.effort >= kBaseOrderEffort && !fixed_order)
-        for (BaseMeshCode& candidate : base_order_candidates(input, quantizer.get(), own, kBaseOrderStarts)) {
-            EncodeStats stats;
-            std::vector<uint8_t> file = encode_file(input, at_two, stats_out != nullptr ? &stats : nullptr, memory, &candidate);
-            if (file.size() >= best.size()) continue;
-            best = std::move(file);
-            best_stats = std::move(stats);
-            own = std::move(candidate);
-        }
+        candidates = base_order_candidates(input, quantizer.get(), own, kBaseOrderStarts);
+    // The mixing mode codes only the orders whose paper-mode file (a tenth of its encode time; the
+    // same base and geometry bytes) is among the kBaseOrderTrials smallest, in that rank.
+    std::vector<size_t> trials(candidates.size());
+    std::iota(trials.begin(), trials.end(), size_t{0});
+    if (options.hierarchy_contexts == HierarchyContexts::mixed && candidates.size() > kBaseOrderTrials) {
+        EncodeOptions paper = at_two;
+        paper.hierarchy_contexts = HierarchyContexts::paper;
+        paper.effort = kDefaultEffort;
+        std::vector<std::pair<size_t, size_t>> ranked;  // (paper file bytes, candidate)
+        for (size_t c = 0; c < candidates.size(); ++c)
+            ranked.emplace_back(encode_file(input, paper, nullptr, memory, &candidates[c]).size(), c);
+        std::sort(ranked.begin(), ranked.end());
+        for (size_t k = 0; k < kBaseOrderTrials; ++k) trials[k] = ranked[k].second;
+        trials.resize(kBaseOrderTrials);
+    }
+    for (const size_t c : trials) {
+        EncodeStats stats;
+        std::vector<uint8_t> file = encode_file(input, at_two, stats_out != nullptr ? &stats : nullptr, memory, &candidates[c]);
+        if (file.size() >= best.size()) continue;
+        best = std::move(file);
+        best_stats = std::move(stats);
+        own = std::move(candidates[c]);
+    }
     if (stats_out != nullptr) *stats_out = std::move(best_stats);
     if (chosen != nullptr) *chosen = std::move(own);
     return best;
