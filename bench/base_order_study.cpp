@@ -1,7 +1,8 @@
 // The base order as an encoder choice (docs/HIERARCHY_CODER.md, "The base order as an encoder
 // choice"): for the base coder's order and the orders of base_order_candidates() (mode 2 from N
-// start triangles), the whole file's parts at effort 2 in the asked hierarchy mode, and the paper
-// mode's file in the same order (a cheap stand-in for ranking orders).
+// start triangles), the whole file's parts at effort 2 in the asked hierarchy mode, the paper
+// mode's file in the same order, and the base blocks' bytes (base_blocks_bytes: what efforts 3 and
+// 4 rank the orders by).
 //   base_order_study model.amh [starts, default 16] [mixed|paper, default mixed] [quantize bits, default 0]
 #include "coding/base/base_stage.h"
 #include "coding/base_order_search.h"
@@ -20,7 +21,7 @@ using namespace amc;
 int main(int argc, char** argv) {
     if (argc < 2) return 2;
     const Hierarchy h = read_hierarchy(argv[1]);
-    const uint32_t starts = argc > 2 ? uint32_t(std::atoi(argv[2])) : kBaseOrderStarts;
+    const uint32_t starts = argc > 2 ? uint32_t(std::atoi(argv[2])) : kBaseOrderSearches[0].starts;
     EncodeOptions options;
     options.effort = kMaxGeometryEffort;
     if (argc > 3 && std::strcmp(argv[3], "paper") == 0) options.hierarchy_contexts = HierarchyContexts::paper;
@@ -29,22 +30,22 @@ int main(int argc, char** argv) {
     EncodeOptions paper = options;
     paper.hierarchy_contexts = HierarchyContexts::paper;
     const std::vector<uint8_t> reference = encode(h, options);
-    std::printf("order base_conn base_geom hierarchy geometry file paper_hierarchy paper_file\n");
-    auto row = [&](const char* name, const BaseMeshCode& code) {
-        EncodeStats s, p;
-        const std::vector<uint8_t> file = encode_with_base(h, options, code, &s);
-        encode_with_base(h, paper, code, &p);
-        std::printf("%s %llu %llu %llu %llu %zu %llu %llu\n", name, (unsigned long long)s.base_connectivity_bytes,
-                    (unsigned long long)s.base_geometry_bytes, (unsigned long long)s.hierarchy_bytes,
-                    (unsigned long long)s.geometry_bytes, file.size(), (unsigned long long)p.hierarchy_bytes,
-                    (unsigned long long)p.total_bytes);
-        std::fflush(stdout);
-        return file;
-    };
+    std::printf("order base_conn base_geom hierarchy geometry file paper_hierarchy paper_file base_blocks\n");
     // The base coder codes a quantized file's base on its grid (encode()'s, for a forest without free ids).
     Quantizer grid;
     if (options.quantize_bits != 0) grid = make_quantizer(h.positions(), options.quantize_bits);
     const Quantizer* q = options.quantize_bits != 0 ? &grid : nullptr;
+    auto row = [&](const char* name, const BaseMeshCode& code) {
+        EncodeStats s, p;
+        const std::vector<uint8_t> file = encode_with_base(h, options, code, &s);
+        encode_with_base(h, paper, code, &p);
+        std::printf("%s %llu %llu %llu %llu %zu %llu %llu %llu\n", name, (unsigned long long)s.base_connectivity_bytes,
+                    (unsigned long long)s.base_geometry_bytes, (unsigned long long)s.hierarchy_bytes,
+                    (unsigned long long)s.geometry_bytes, file.size(), (unsigned long long)p.hierarchy_bytes,
+                    (unsigned long long)p.total_bytes, (unsigned long long)base_blocks_bytes(h, q, code));
+        std::fflush(stdout);
+        return file;
+    };
     const BaseMeshCode own = base_code_of(h, q, options);
     if (row("own", own) != reference) std::printf("(own order's file differs from encode()'s)\n");
     int k = 0;

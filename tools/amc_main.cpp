@@ -114,8 +114,8 @@ int main(int argc, char** argv) {
     encode_cmd->add_option("--effort", encode.effort,
                            "How hard the encoder looks: " + std::to_string(kMaxGeometryEffort) +
                                " codes every geometry mode of each level until it can not be the smallest; lower judges the "
-                               "adaptive predictors from a sample of the level (faster, slightly larger); 3 also tries 16 other "
-                               "base orders and keeps the smallest file (some 10 times slower)")
+                               "adaptive predictors from a sample of the level (faster, slightly larger); 3 and 4 also code 4 and 16 "
+                               "other base orders and keep the smallest file (about 5 and 17 times effort 2's time)")
         ->check(CLI::Range(0, kMaxEffort))
         ->capture_default_str();
     encode_cmd->add_flag("--series", encode.series, "The input is a series (as 'amc series encode'; implied by a .pvd input)");

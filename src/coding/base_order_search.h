@@ -12,15 +12,21 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <iterator>
 #include <vector>
 
 namespace amc {
 
-// The effort that searches the base order, the start triangles it weighs, and how many of those
-// orders the mixing mode codes in full (the smallest in the paper mode).
+// The efforts that search the base order: from kBaseOrderEffort on, each weighs `starts` start
+// triangles and codes in full the `trials` orders whose base blocks (base_blocks_bytes, a small
+// part of the encode) are smallest.
 constexpr int kBaseOrderEffort = 3;
-constexpr uint32_t kBaseOrderStarts = 16;
-constexpr size_t kBaseOrderTrials = 4;
+struct BaseOrderSearch {
+    uint32_t starts;
+    size_t trials;
+};
+constexpr BaseOrderSearch kBaseOrderSearches[] = {{16, 4}, {64, 16}};  // efforts 3 and 4
+static_assert(kBaseOrderEffort + int(std::size(kBaseOrderSearches)) - 1 == kMaxEffort, "a search for every effort above 2");
 
 // encode() with `base` as the base connectivity code (one of base_order_candidates(), say): a
 // study's or a test's way to weigh one order.

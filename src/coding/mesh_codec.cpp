@@ -25,7 +25,6 @@
 #include <cstddef>
 #include <future>
 #include <memory>
-#include <numeric>
 #include <string>
 #include <utility>
 
@@ -539,22 +538,14 @@ std::vector<uint8_t> encode_choosing_base(const Hierarchy& input, const EncodeOp
     EncodeStats best_stats;
     std::vector<uint8_t> best = encode_file(input, at_two, stats_out != nullptr ? &best_stats : nullptr, memory, &own);
     std::vector<BaseMeshCode> candidates;
-    if (options.effort >= kBaseOrderEffort && !fixed_order)
-        candidates = base_order_candidates(input, quantizer.get(), own, kBaseOrderStarts);
-    // The mixing mode codes only the orders whose paper-mode file (a tenth of its encode time; the
-    // same base and geometry bytes) is among the kBaseOrderTrials smallest, in that rank.
-    std::vector<size_t> trials(candidates.size());
-    std::iota(trials.begin(), trials.end(), size_t{0});
-    if (options.hierarchy_contexts == HierarchyContexts::mixed && candidates.size() > kBaseOrderTrials) {
-        EncodeOptions paper = at_two;
-        paper.hierarchy_contexts = HierarchyContexts::paper;
-        paper.effort = kDefaultEffort;
-        std::vector<std::pair<size_t, size_t>> ranked;  // (paper file bytes, candidate)
-        for (size_t c = 0; c < candidates.size(); ++c)
-            ranked.emplace_back(encode_file(input, paper, nullptr, memory, &candidates[c]).size(), c);
+    std::vector<size_t> trials;  // candidates coded in full, in the rank of their base blocks' bytes
+    if (options.effort >= kBaseOrderEffort && !fixed_order) {
+        const BaseOrderSearch search = kBaseOrderSearches[options.effort - kBaseOrderEffort];
+        candidates = base_order_candidates(input, quantizer.get(), own, search.starts);
+        std::vector<std::pair<uint64_t, size_t>> ranked;
+        for (size_t c = 0; c < candidates.size(); ++c) ranked.emplace_back(base_blocks_bytes(input, quantizer.get(), candidates[c]), c);
         std::sort(ranked.begin(), ranked.end());
-        for (size_t k = 0; k < kBaseOrderTrials; ++k) trials[k] = ranked[k].second;
-        trials.resize(kBaseOrderTrials);
+        for (size_t k = 0; k < std::min(search.trials, ranked.size()); ++k) trials.push_back(ranked[k].second);
     }
     for (const size_t c : trials) {
         EncodeStats stats;

@@ -137,8 +137,12 @@ ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& ba
     return r;
 }
 
-RawSideCode encode_base_geometry(const Hierarchy& h, const BaseMeshCode& base_code, bool keep_rotations, PositionCoder& positions,
-                                 bool raw_side) {
+namespace {
+
+// The base geometry block of `base_vertices` positions, decoder vertex i at position_of(i).
+template <class PositionOf>
+RawSideCode base_geometry_code(size_t base_vertices, PositionOf&& position_of, const BaseMeshCode& base_code, bool keep_rotations,
+                               PositionCoder& positions, bool raw_side) {
     ArithmeticEncoder encoder;
     if (keep_rotations) {
         RotationModels models;
@@ -146,15 +150,32 @@ RawSideCode encode_base_geometry(const Hierarchy& h, const BaseMeshCode& base_co
     }
     RawBitWriter raw;
     std::vector<Vec3> decoded;
-    const size_t base_vertices = h.base().positions.size();
     decoded.reserve(base_vertices);
     for (uint32_t i = 0; i < base_vertices; ++i) {
-        const Vec3 p = h.position(i);
+        const Vec3 p = position_of(i);
         positions.encode(encoder, kBaseGeometryContext, p, predict_parallelogram(decoded, base_code.stencils[i]),
                          raw_side ? &raw : nullptr);
         decoded.push_back(p);
     }
     return RawSideCode{encoder.finish(), raw.finish()};
+}
+
+}  // namespace
+
+RawSideCode encode_base_geometry(const Hierarchy& h, const BaseMeshCode& base_code, bool keep_rotations, PositionCoder& positions,
+                                 bool raw_side) {
+    return base_geometry_code(
+        h.base().positions.size(), [&h](uint32_t i) { return h.position(i); }, base_code, keep_rotations, positions, raw_side);
+}
+
+uint64_t base_blocks_bytes(const Hierarchy& h, const Quantizer* quantizer, const BaseMeshCode& base_code) {
+    const TriangleMesh base = base_as_decoded(h, quantizer);
+    const bool quantized = quantizer != nullptr;
+    PositionCoder positions(CoordinateSpace{h.single_precision() && !quantized ? Precision::float32 : Precision::float64, quantizer});
+    const RawSideCode code = base_geometry_code(
+        base.positions.size(), [&](uint32_t i) { return base.positions[base_code.vertex_order[i]]; }, base_code, false, positions,
+        !quantized);
+    return base_code.bytes.size() + (quantized ? code.arithmetic.size() : code.joined().size());
 }
 
 TriangleMesh decode_base(const Block& connectivity, const Block& geometry, const Metadata& meta, uint8_t file_version,

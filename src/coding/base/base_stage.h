@@ -61,6 +61,11 @@ ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& ba
 RawSideCode encode_base_geometry(const Hierarchy& h, const BaseMeshCode& base_code, bool keep_rotations, PositionCoder& positions,
                                  bool raw_side);
 
+// The payloads of the base connectivity and base geometry blocks of a file of h coded over
+// `base_code` (the roots in the base coder's rotations; a bit-exact file's raw bits apart, as version
+// 21's): how an effort-3 encode ranks orders before coding the rest (base_order_search.h).
+uint64_t base_blocks_bytes(const Hierarchy& h, const Quantizer* quantizer, const BaseMeshCode& base_code);
+
 // Decodes the base mesh from its two blocks of a file of `file_version`, checked against the
 // metadata; the result is a valid triangle mesh. Throws Error on a corrupt or truncated block.
 TriangleMesh decode_base(const Block& connectivity, const Block& geometry, const Metadata& meta, uint8_t file_version,
