@@ -81,6 +81,35 @@ inline double model_bits(MixingModel model, const std::vector<Symbol>& symbols, 
     return bits;
 }
 
+// A cache entry: the paper's and the coder's bits, the symbol count, the symbols. read_cache
+// fills d (its second_bits too) and says whether `file` held one.
+inline bool read_cache(const std::filesystem::path& file, ModelData& d) {
+    std::ifstream in{file, std::ios::binary};
+    if (!in) return false;
+    uint64_t n = 0;
+    in.read(reinterpret_cast<char*>(&d.paper_bits), sizeof d.paper_bits);
+    in.read(reinterpret_cast<char*>(&d.library_bits), sizeof d.library_bits);
+    in.read(reinterpret_cast<char*>(&n), sizeof n);
+    d.symbols.resize(n);
+    in.read(reinterpret_cast<char*>(d.symbols.data()), std::streamsize(n * sizeof(Symbol)));
+    if (!in) {
+        d.symbols.clear();
+        return false;
+    }
+    d.second_bits = model_bits(MixingModel::second, d.symbols);
+    return true;
+}
+
+inline void write_cache(const std::filesystem::path& file, const ModelData& d) {
+    std::filesystem::create_directories(file.parent_path());
+    std::ofstream out(file, std::ios::binary);
+    const uint64_t n = d.symbols.size();
+    out.write(reinterpret_cast<const char*>(&d.paper_bits), sizeof d.paper_bits);
+    out.write(reinterpret_cast<const char*>(&d.library_bits), sizeof d.library_bits);
+    out.write(reinterpret_cast<const char*>(&n), sizeof n);
+    out.write(reinterpret_cast<const char*>(d.symbols.data()), std::streamsize(n * sizeof(Symbol)));
+}
+
 // The model's symbols with their features, and the paper's coded bits, from the cache or computed.
 // `traversal`: the mixing mode's order of the symbols (the paper's bits are always the improved
 // traversal's, the common reference). The naive traversal's symbols are those of the hierarchy in
@@ -90,19 +119,7 @@ inline ModelData load(const std::string& path, const std::filesystem::path& cach
     ModelData d;
     d.name = std::filesystem::path(path).stem().string();
     const std::filesystem::path file = cache / (d.name + (traversal == Traversal::naive ? "-naive" : "") + ".mf8");
-    if (std::ifstream in{file, std::ios::binary}) {
-        uint64_t n = 0;
-        in.read(reinterpret_cast<char*>(&d.paper_bits), sizeof d.paper_bits);
-        in.read(reinterpret_cast<char*>(&d.library_bits), sizeof d.library_bits);
-        in.read(reinterpret_cast<char*>(&n), sizeof n);
-        d.symbols.resize(n);
-        in.read(reinterpret_cast<char*>(d.symbols.data()), std::streamsize(n * sizeof(Symbol)));
-        if (in) {
-            d.second_bits = model_bits(MixingModel::second, d.symbols);
-            return d;
-        }
-        d.symbols.clear();
-    }
+    if (read_cache(file, d)) return d;
     const Hierarchy h = traversal == Traversal::naive ? in_decoder_order(read_hierarchy(path)) : read_hierarchy(path);
     {
         HierarchyLevelEncoder paper(h, HierarchyCoderOptions{});
@@ -152,13 +169,7 @@ inline ModelData load(const std::string& path, const std::filesystem::path& cach
         d.symbols[i].parent_curv = uint8_t(quarter_bin(sum2 / double(seen.size())));
     }
     d.second_bits = model_bits(MixingModel::second, d.symbols);
-    std::filesystem::create_directories(cache);
-    std::ofstream out(file, std::ios::binary);
-    const uint64_t n = d.symbols.size();
-    out.write(reinterpret_cast<const char*>(&d.paper_bits), sizeof d.paper_bits);
-    out.write(reinterpret_cast<const char*>(&d.library_bits), sizeof d.library_bits);
-    out.write(reinterpret_cast<const char*>(&n), sizeof n);
-    out.write(reinterpret_cast<const char*>(d.symbols.data()), std::streamsize(n * sizeof(Symbol)));
+    write_cache(file, d);
     return d;
 }
 

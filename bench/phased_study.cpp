@@ -14,7 +14,13 @@
 //                                         for callgrind); "levels alone": the decisions written
 //                                         from the hierarchy, then scan and derivation (the part
 //                                         of deciding no stream layout removes)
+//   phased_study --mixed FILE.amh...      the mixing mode's seventh model (issue 30) in deep3's
+//                                         and other phased orders against its two traversals
+//                                         (CACHE_DIR=dir: deep3's symbols written for
+//                                         bench/trained_states ORDER=deep3)
 //   PHASED_DEBUG=phases/contexts          (first form) that design's bits per phase
+//   PHASED_DEBUG=mixed[:design]           (--mixed) deep3's (or the design's) bits per phase
+//                                         against each traversal's on the same nodes
 //
 // Every design keeps the paper's rules: 1-regularity culls (incomplete nodes take no symbol),
 // uniform levels take none, a node whose three neighbours are known refined when its phase comes
@@ -53,6 +59,7 @@
 // d(p) = p's hop distance to a node not refined in the level above (capped at 8).
 #include "bench_common.h"
 #include "decide_only.h"
+#include "mixed_symbols.h"
 #include "static_table_cost.h"
 #include "coding/entropy/arithmetic_coder.h"
 #include "coding/entropy/rans_coder.h"
@@ -80,6 +87,7 @@ struct LevelData {
     std::vector<uint8_t> truth;
     std::vector<uint8_t> culled;   // decided before the traversal (1-regularity): not refined
     std::vector<uint32_t> parent;  // per block of four: the parent's local index in the level above
+    std::vector<NodeId> ids;       // the nodes in h (--mixed: the features read them)
     bool uniform = false;
     uint32_t size() const { return uint32_t(truth.size()); }
 };
@@ -111,6 +119,7 @@ Collected collect(const Hierarchy& h) {
         const uint32_t n = uint32_t(level.size());
         LevelData& d = out.levels.emplace_back();
         const bool all_refined = read_level(h, ids, n, d.truth, next_ids);
+        d.ids = ids;
         d.uniform = uniform_so_far && all_refined;
         uniform_so_far = d.uniform;
         d.nbr.resize(n);
@@ -957,6 +966,217 @@ uint64_t levels_only(ProtoDecider& scratch, const Hierarchy& roots_only, const C
     return nodes;
 }
 
+// ---- The mixing mode in deep3 order (--mixed; issue 30) ----
+//
+// The mixing mode's seventh model (MixedHierarchyModel over mixed_features, the library's own)
+// codes the same symbols in deep3's order instead of a traversal's: the prototype's order
+// (ProtoDecider::run: each decision written at once), each node's features read from the level's
+// states as they stand at its turn, so a node of a later phase sees its neighbours on all sides.
+// Against it, the library's mixed symbols in the improved and the naive traversal
+// (HierarchyLevelEncoder::mixed_symbols). The hierarchy is taken in the decoder's base order
+// (in_decoder_order), as files code it. Bytes are the symbols' payload through the library's
+// arithmetic coder up to the last 1; the header and the orientation bits, the same in every
+// order, are left out (the file's hierarchy bytes less the smaller traversal's payload is that
+// rest, for a file the seventh model wrote).
+
+struct MixedSymbol {
+    MixedFeatures f;
+    bool bit;
+    uint8_t phase;     // deep3's phase (0 .. kProtoPhases - 1), kTop for the roots and the traversals' symbols
+    uint32_t context;  // deep3's (phase, group, cn) context of the prototype, kProtoContexts + group for the others
+    NodeId node;
+};
+
+// The library's mixed symbols (the coded ones) of h in `traversal`.
+std::vector<MixedSymbol> traversal_mixed_symbols(const Hierarchy& h, Traversal traversal) {
+    HierarchyCoderOptions options;
+    options.traversal = traversal;
+    std::vector<CodedSymbol> trace;
+    const HierarchyLevelEncoder coder(h, options, kHierarchyStreamVersion, &trace, true, nullptr, nullptr, false);
+    std::vector<MixedSymbol> out;
+    for (const auto& [f, bit] : coder.mixed_symbols()) out.push_back({f, bit, kTop, kProtoContexts + f.group, trace[out.size()].node});
+    return out;
+}
+
+// The symbols of h (collected in `data`) in deep3's order with the seventh model's features, up
+// to the last 1.
+std::vector<MixedSymbol> deep3_mixed_symbols(const Hierarchy& h, const Collected& data) {
+    ProtoDecider coder;
+    LevelShapes shapes;
+    uint32_t shaped = UINT32_MAX;  // the level `shapes` holds
+    std::vector<MixedSymbol> out;
+    coder.run(h, uniform_level_count(data), [&](BitModel& model, uint32_t i, uint32_t l) {
+        if (l != shaped) shapes.start_level(coder.cur.size()), shaped = l;
+        // The prototype's model index is (phase * 10 + group) * 17 + cn; the roots' models are groups.
+        int group = 0;
+        uint8_t phase = kTop;
+        uint32_t context = 0;
+        if (&model >= coder.models.data() && &model < coder.models.data() + coder.models.size()) {
+            context = uint32_t(&model - coder.models.data());
+            group = int(context / 17 % 10);
+            phase = uint8_t(context / 170);
+        } else {
+            group = int(&model - coder.root_models.groups.data());
+            context = kProtoContexts + uint32_t(group);
+        }
+        const bool bit = data.levels[l].truth[i] != 0;
+        const NodeId node = data.levels[l].ids[i];
+        out.push_back({mixed_features(h, node, coder.cur, i, group, shapes, MixingModel::seventh), bit, phase, context, node});
+        return bit;
+    });
+    size_t kept = out.size();
+    while (kept > 0 && !out[kept - 1].bit) --kept;
+    out.resize(kept);
+    return out;
+}
+
+// The same in the phases of one of assign_phases' designs (not deepD): the roots and uniform
+// levels as the improved traversal codes them, then each level's nodes phase by phase, canonical
+// order within a phase, each decision written at once (the hanging-node rule as everywhere).
+std::vector<MixedSymbol> phased_mixed_symbols(const Hierarchy& h, const Collected& data, Phases design) {
+    HierarchyCoderOptions options;
+    LevelTraversal traversal(options, kHierarchyStreamVersion);
+    Level level, next;
+    RefinedNumbering numbering;
+    LevelShapes shapes;
+    std::vector<int8_t> phase;
+    std::vector<MixedSymbol> out;
+    root_level(h, level, options.cull_one_regularity);
+    for (size_t l = 0; !level.empty(); ++l) {
+        const LevelData& d = data.levels[l];
+        const uint32_t n = uint32_t(level.size());
+        uint8_t* state = level.state();
+        shapes.start_level(n);
+        auto symbol = [&](uint32_t i, int group, uint8_t ph) {
+            const bool bit = d.truth[i] != 0;
+            out.push_back({mixed_features(h, d.ids[i], level, i, group, shapes, MixingModel::seventh), bit, ph,
+                           kProtoContexts + uint32_t(group), d.ids[i]});
+            return bit;
+        };
+        if (level.is_root_level() || d.uniform) {
+            traversal.run(
+                level, d.uniform, [&](uint32_t i, int group) { return symbol(i, group, kTop); },
+                [&](uint32_t i, Fate, bool) { return d.truth[i] != 0; });
+        } else {
+            const int phases = assign_phases(d, data.levels[l - 1], l >= 2 ? &data.levels[l - 2] : nullptr, design, phase);
+            const Neighbors* nbr = level.nbr.data();
+            for (int ph = 0; ph < phases; ++ph) {
+                for (uint32_t c = 0; c < n; ++c) {
+                    if (phase[c] != ph || (state[c] & kDecided)) continue;
+                    unsigned code_bits = 0;
+                    for (int e = 0; e < 3; ++e) code_bits |= unsigned(neighbor_state(state, nbr[c].nbr[e]) & (kDecided | kRefined)) << (2 * e);
+                    const int group = kContextTable.group[code_bits];
+                    const bool refined = group == 9 ? true : symbol(c, group, uint8_t(ph));  // (3,0,0): the hanging-node rule
+                    state[c] = uint8_t(state[c] | kDecided | (refined ? kRefined : 0));
+                    if (refined)
+                        for (int e = 0; e < 3; ++e) neighbor_state(state, nbr[c].nbr[e]) += kRefinedNeighbor;
+                }
+            }
+        }
+        scan_decided_level(level, numbering, nullptr);
+        derive_next_level(level, numbering, next, options.cull_one_regularity);
+        std::swap(level, next);
+    }
+    size_t kept = out.size();
+    while (kept > 0 && !out[kept - 1].bit) --kept;
+    out.resize(kept);
+    return out;
+}
+
+// The other phased orders --mixed measures (phased_mixed_symbols): one phase (the naive order
+// below the roots), the centers first or last, a colouring of the whole level.
+constexpr Phases kMixedDesigns[] = {Phases::one, Phases::corner_center, Phases::center_f3, Phases::f3_center, Phases::g4};
+
+// What a deep3 version could add after the seventh model (study-only stages on its probability):
+//   map: averaged with an adaptive map's refinement of it by phase x group (the node's phase says
+//        what it knows);
+//   cn:  mixed (a 3-input mixer, weight set by phase) with the prototype's adaptive model of the
+//        node's (phase, group, cn) context: the far centers, which no mixed feature reads.
+enum class Stage { none, map, cn };
+
+// Payload bytes of `symbols` coded by the seventh model (initial states `trained`) and `stage`.
+size_t mixed_payload(const std::vector<MixedSymbol>& symbols, Stage stage, const TrainedStateTables& trained = kTrainedStateTables) {
+    MixedHierarchyModel model(MixingModel::seventh, trained);
+    mixing::ProbabilityMap map((kProtoPhases + 1) * kContextGroupCount, 7);
+    std::vector<BitModel> contexts(kProtoContexts + kContextGroupCount);
+    constexpr int32_t kStart[3] = {1 << 16, 0, 0};
+    mixing::Mixer mixer(3, kProtoPhases + 1, 16, kStart);
+    int st[mixing::Mixer::padded(3)] = {};
+    ArithmeticEncoder encoder;
+    for (const MixedSymbol& s : symbols) {
+        uint32_t p = model.p16(s.f);
+        const int phase = s.phase == kTop ? kProtoPhases : s.phase;
+        if (stage == Stage::map) {
+            const uint32_t refined = uint32_t(map.refine(int(p >> 4), phase * kContextGroupCount + s.f.group)) << 4;
+            p = std::clamp<uint32_t>((p + refined) / 2, 1, 65535);
+        } else if (stage == Stage::cn) {
+            st[0] = mixing::stretch(std::clamp(int(p >> 4), 1, 4095));
+            st[1] = mixing::stretch(mixing::p12_of(contexts[s.context]));
+            st[2] = 256;
+            p = std::clamp<uint32_t>(uint32_t(mixer.mix(st, phase)) << 4, 1, 65535);
+        }
+        encoder.encode_with_probability(s.bit, p);
+        model.update(s.bit);
+        if (stage == Stage::map) map.update(s.bit);
+        if (stage == Stage::cn) {
+            mixer.update(st, s.bit);
+            contexts[s.context].update_with_limit(s.bit, kHierarchyModelLimit);
+        }
+    }
+    return encoder.finish().size();
+}
+
+// PHASED_DEBUG=mixed: where deep3 gains and loses against a traversal, by deep3's phase: each
+// node's code length in both orders (the seventh model), summed over the nodes both code.
+void print_mixed_phase_costs(const std::vector<MixedSymbol>& deep3, const std::vector<MixedSymbol>& traversal, size_t nodes) {
+    auto costs = [&](const std::vector<MixedSymbol>& symbols) {
+        std::vector<double> bits(nodes, -1);
+        MixedHierarchyModel model(MixingModel::seventh);
+        for (const MixedSymbol& s : symbols) {
+            const double p = model.p16(s.f) / 65536.0;
+            bits[s.node] = -std::log2(s.bit ? p : 1 - p);
+            model.update(s.bit);
+        }
+        return bits;
+    };
+    const std::vector<double> in_deep3 = costs(deep3), in_traversal = costs(traversal);
+    double d[kProtoPhases + 1] = {}, t[kProtoPhases + 1] = {}, only_d = 0, only_t = 0;
+    uint64_t count[kProtoPhases + 1] = {}, ones[kProtoPhases + 1] = {};
+    for (const MixedSymbol& s : deep3) {
+        const int phase = s.phase == kTop ? kProtoPhases : s.phase;
+        if (in_traversal[s.node] < 0) {
+            only_d += in_deep3[s.node];
+            continue;
+        }
+        d[phase] += in_deep3[s.node], t[phase] += in_traversal[s.node], ++count[phase], ones[phase] += s.bit;
+    }
+    for (const MixedSymbol& s : traversal)
+        if (in_deep3[s.node] < 0) only_t += in_traversal[s.node];
+    for (int p = 0; p <= kProtoPhases; ++p) {
+        if (count[p] == 0) continue;
+        std::fprintf(stderr, "    phase %2d%s: %7llu symbols, %5.1f%% ones, deep3 %8.0f bits, traversal %8.0f bits (%+.1f%%)\n", p,
+                     p == kProtoPhases ? " (roots)" : "", (unsigned long long)count[p], 100.0 * double(ones[p]) / double(count[p]), d[p],
+                     t[p], 100.0 * (d[p] - t[p]) / t[p]);
+    }
+    std::fprintf(stderr, "    coded in one order only: deep3 %.0f bits, traversal %.0f bits\n", only_d, only_t);
+}
+
+// bench/mixed_symbols.h's cache entry of deep3's symbols (CACHE_DIR/<model>-deep3.mf8), for
+// bench/trained_states ORDER=deep3: states trained on them, measured without the model's mesh.
+void write_mixed_cache(const std::string& dir, const std::string& name, const Hierarchy& h, const std::vector<MixedSymbol>& symbols) {
+    mixed_study::ModelData d;
+    d.name = name;
+    {
+        HierarchyLevelEncoder paper(h, HierarchyCoderOptions{});
+        ArithmeticEncoder sink;
+        for (int l = 0; l < paper.level_count(); ++l) paper.encode_level(l, sink);
+        for (const ContextGroupStats& g : paper.stats().groups) d.paper_bits += g.coded_bits;
+    }
+    for (const MixedSymbol& s : symbols) d.symbols.push_back({s.f, uint8_t(s.bit)});
+    d.library_bits = mixed_study::model_bits(MixingModel::seventh, d.symbols);
+    mixed_study::write_cache(std::filesystem::path(dir) / (name + "-deep3.mf8"), d);
+}
+
 // The table of docs/HIERARCHY_CODER.md: a few designs per model (--table).
 struct TableColumn {
     Phases phases;
@@ -977,7 +1197,8 @@ const TableColumn kTable[] = {
 int main(int argc, char** argv) {
     int first = 1;
     const bool table = argc > 1 && std::string(argv[1]) == "--table";
-    if (table) first = 2;
+    const bool mixed = argc > 1 && std::string(argv[1]) == "--mixed";
+    if (table || mixed) first = 2;
     int speed_runs = 0;
     if (argc > 2 && std::string(argv[1]) == "--speed") {
         speed_runs = std::max(1, std::atoi(argv[2]));
@@ -988,6 +1209,19 @@ int main(int argc, char** argv) {
         return 2;
     }
     const char* debug = std::getenv("PHASED_DEBUG");  // "phases/contexts": that design's cost per phase
+    if (mixed) {
+        std::printf("| model | file: base + hierarchy | improved | naive | deep3 | deep3 + map | deep3 + cn |");
+        for (Phases design : kMixedDesigns)
+            for (const PhaseDesign& pd : kPhaseDesigns)
+                if (pd.phases == design) {
+                    std::string name = pd.name;  // a table cell: '|' escaped
+                    for (size_t at = name.find('|'); at != std::string::npos; at = name.find('|', at + 2)) name.insert(at, "\\");
+                    std::printf(" %s |", name.c_str());
+                }
+        std::printf(" improved / naive + map | improved / naive + cn's stage |\n|---|---:|---:|---:|---:|---:|---:|");
+        for (size_t k = 0; k < sizeof kMixedDesigns / sizeof kMixedDesigns[0]; ++k) std::printf("---:|");
+        std::printf("---:|---:|\n");
+    }
     if (table) {
         std::printf("| model | stream | improved |");
         for (const TableColumn& t : kTable) std::printf(" %s |", t.name);
@@ -999,6 +1233,47 @@ int main(int argc, char** argv) {
         const std::string path = argv[a];
         std::optional<Hierarchy> read = read_hierarchy_or_report("phased_study", path);
         if (!read) return 1;
+        if (mixed) {
+            // Today's mixed file (the smaller traversal, or an older model where it codes smaller).
+            EncodeOptions options;
+            options.hierarchy_contexts = HierarchyContexts::mixed;
+            EncodeStats stats;
+            encode(*read, options, &stats);
+            const Hierarchy h = in_decoder_order(*read);
+            const Collected data = collect(h);
+            const std::vector<MixedSymbol> improved = traversal_mixed_symbols(h, Traversal::improved);
+            const std::vector<MixedSymbol> naive = traversal_mixed_symbols(h, Traversal::naive);
+            const std::vector<MixedSymbol> deep3 = deep3_mixed_symbols(h, data);
+            if (const char* dir = std::getenv("CACHE_DIR")) write_mixed_cache(dir, model_name(path), h, deep3);
+            const size_t bi = mixed_payload(improved, Stage::none), bn = mixed_payload(naive, Stage::none);
+            const double smaller = double(std::min(bi, bn));
+            auto ratio = [&](size_t b) { return smaller > 0 ? double(b) / smaller : 0.0; };
+            std::printf("| %s | %llu + %llu | %zu | %zu |", model_name(path).c_str(), (unsigned long long)stats.base_connectivity_bytes,
+                        (unsigned long long)stats.hierarchy_bytes, bi, bn);
+            for (Stage stage : {Stage::none, Stage::map, Stage::cn}) {
+                const size_t b = mixed_payload(deep3, stage);
+                std::printf(" %zu (%.3f) |", b, ratio(b));
+            }
+            for (Phases design : kMixedDesigns) {
+                const size_t b = mixed_payload(phased_mixed_symbols(h, data, design), Stage::none);
+                std::printf(" %zu (%.3f) |", b, ratio(b));
+            }
+            for (Stage stage : {Stage::map, Stage::cn}) std::printf(" %zu / %zu |", mixed_payload(improved, stage), mixed_payload(naive, stage));
+            std::printf("\n");
+            std::fflush(stdout);
+            if (debug != nullptr && std::string(debug).rfind("mixed", 0) == 0) {
+                // "mixed": deep3's phases; "mixed:DESIGN": that design's.
+                const std::string name = std::string(debug).size() > 6 ? std::string(debug).substr(6) : "deep3";
+                std::vector<MixedSymbol> phased = deep3;
+                for (const PhaseDesign& pd : kPhaseDesigns)
+                    if (name == pd.name && name != "deep3") phased = phased_mixed_symbols(h, data, pd.phases);
+                std::fprintf(stderr, "%s, %s against the improved traversal:\n", model_name(path).c_str(), name.c_str());
+                print_mixed_phase_costs(phased, improved, h.node_count());
+                std::fprintf(stderr, "%s, %s against the naive traversal:\n", model_name(path).c_str(), name.c_str());
+                print_mixed_phase_costs(phased, naive, h.node_count());
+            }
+            continue;
+        }
         const Hierarchy& h = *read;
         const Collected data = collect(h);
         const size_t improved = adaptive_bytes(data.improved, kContextGroupCount);

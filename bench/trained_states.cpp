@@ -8,7 +8,8 @@
 //   [CACHE_DIR=dir] [TRAIN=stem,stem,...] [TABLE_OUT=path] [TRAVERSAL=naive] trained_states model.amh ...
 // TRAIN names the training models (default: every model given). TRAVERSAL=naive: the symbols in
 // the naive traversal's order, the table the naive traversal's (kNaiveTrainedStateTables); the
-// last column then codes with the states of all training models. The coder's table is
+// last column then codes with the states of all training models. ORDER=deep3: the symbols
+// bench/phased_study --mixed wrote to CACHE_DIR in deep3's order. The coder's table is
 //   TABLE_OUT=src/coding/hierarchy/trained_states_table.inc build/bench/trained_states <the 23
 //   models of scripts/corpus.sh's make_corpus but uniform.amh>
 // (docs/HIERARCHY_CODER.md, "The seventh model").
@@ -118,8 +119,19 @@ int main(int argc, char** argv) {
     const bool naive = traversal != nullptr && std::string(traversal) == "naive";
     std::vector<ModelData> data;
     std::vector<SlotCounts> counted;
+    const char* order = std::getenv("ORDER");
     for (int i = 1; i < argc; ++i) {
-        data.push_back(mixed_study::load(argv[i], cache, naive ? Traversal::naive : Traversal::improved));
+        if (order != nullptr) {
+            ModelData& d = data.emplace_back();
+            d.name = std::filesystem::path(argv[i]).stem().string();
+            const std::filesystem::path file = cache / (d.name + "-" + order + ".mf8");
+            if (!mixed_study::read_cache(file, d)) {
+                std::fprintf(stderr, "trained_states: no %s (phased_study --mixed with CACHE_DIR writes it)\n", file.c_str());
+                return 2;
+            }
+        } else {
+            data.push_back(mixed_study::load(argv[i], cache, naive ? Traversal::naive : Traversal::improved));
+        }
         counted.push_back(count_slots(data.back().symbols));
     }
     const char* train = std::getenv("TRAIN");
@@ -143,9 +155,11 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "%s: %zu of %zu slots trained, from %zu models\n", out, reached, slots, names.size());
     }
 
+    // Another order than the table's: a column of states trained on all training models in it.
+    const bool other_order = naive || order != nullptr;
     std::printf("| model | training | paper bits | sixth | seventh, states without its mesh | seventh, the coder's states%s |\n",
-                naive ? " (the improved traversal's) | seventh, states of all training models" : "");
-    std::printf("|---|---|---:|---:|---:|---:|%s\n", naive ? "---:|" : "");
+                other_order ? " (the improved traversal's) | seventh, states of all training models" : "");
+    std::printf("|---|---|---:|---:|---:|---:|%s\n", other_order ? "---:|" : "");
     const std::array<std::string, kTables> all_strings = state_strings(all);
     double paper = 0, sixth = 0, left_out = 0, coder = 0, trained_all = 0;
     for (size_t m = 0; m < data.size(); ++m) {
@@ -158,17 +172,17 @@ int main(int argc, char** argv) {
         const double b7 = mixed_study::model_bits(MixingModel::seventh, d.symbols, pointers(strings));
         const double bc = mixed_study::model_bits(MixingModel::seventh, d.symbols);
         auto change = [&](double b) { return 100.0 * (b - d.paper_bits) / d.paper_bits; };
-        const double ba = naive ? mixed_study::model_bits(MixingModel::seventh, d.symbols, pointers(all_strings)) : 0;
+        const double ba = other_order ? mixed_study::model_bits(MixingModel::seventh, d.symbols, pointers(all_strings)) : 0;
         std::printf("| %s | %s | %.0f | %+.2f%% | %+.2f%% | %+.2f%% |", d.name.c_str(), training(m) ? "yes" : "no", d.paper_bits,
                     change(b6), change(b7), change(bc));
-        if (naive) std::printf(" %+.2f%% |", change(ba));
+        if (other_order) std::printf(" %+.2f%% |", change(ba));
         std::printf("\n");
         std::fflush(stdout);
         paper += d.paper_bits, sixth += b6, left_out += b7, coder += bc, trained_all += ba;
     }
     auto change = [&](double b) { return 100.0 * (b - paper) / paper; };
     std::printf("| all | | %.0f | %+.2f%% | %+.2f%% | %+.2f%% |", paper, change(sixth), change(left_out), change(coder));
-    if (naive) std::printf(" %+.2f%% |", change(trained_all));
+    if (other_order) std::printf(" %+.2f%% |", change(trained_all));
     std::printf("\n");
     return 0;
 }
