@@ -2043,19 +2043,15 @@ struct QuadRoles {
 };
 
 // set_grid_frame_pair for four vertices: set_axis by lane masks, role 0's grid predictions in two
-// pairs; with `roles`, the frames by role instead of the midpoints and normals in `g`. Without
-// `Grid`, the frames alone (set_frame's).
+// pairs. Without `Grid`, the frames alone (set_frame's).
 template <bool Grid = true>
-inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, const double* origin, GridFrame* g,
-                                QuadRoles* roles = nullptr) {
-    if (roles == nullptr) {
-        store_quad(l.mx, &GridFrame::midpoint, 0, g);
-        store_quad(l.my, &GridFrame::midpoint, 1, g);
-        store_quad(l.mz, &GridFrame::midpoint, 2, g);
-        store_quad(l.nx, &GridFrame::normal, 0, g);
-        store_quad(l.ny, &GridFrame::normal, 1, g);
-        store_quad(l.nz, &GridFrame::normal, 2, g);
-    }
+inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, const double* origin, GridFrame* g) {
+    store_quad(l.mx, &GridFrame::midpoint, 0, g);
+    store_quad(l.my, &GridFrame::midpoint, 1, g);
+    store_quad(l.mz, &GridFrame::midpoint, 2, g);
+    store_quad(l.nx, &GridFrame::normal, 0, g);
+    store_quad(l.ny, &GridFrame::normal, 1, g);
+    store_quad(l.nz, &GridFrame::normal, 2, g);
     const __m256d sign = _mm256_set1_pd(-0.0);
     const __m256d x = _mm256_andnot_pd(sign, l.nx), y = _mm256_andnot_pd(sign, l.ny), z = _mm256_andnot_pd(sign, l.nz);
     const __m256d y_wins = _mm256_cmp_pd(y, x, _CMP_GT_OS);
@@ -2082,7 +2078,46 @@ inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, 
     int64_t turns[4];
     grid_point_quad(value, from, grid, points, offsets, turns);
     for (int j = 0; j < 4; ++j) g[j].first = {points[j], offsets[j], turns[j]};
-    if (roles == nullptr) return;
+}
+
+// Role 0's grid predictions and the frame's axes of a chunk's vertices, by vertex: the grouped
+// order's decoder reads them so (QuadFrames), where the GridFrame of each took a lane's fields one
+// at a time.
+struct FirstRoles {
+    alignas(32) uint64_t point[kChunk], offset[kChunk];
+    alignas(32) int64_t turn[kChunk];
+    alignas(16) int32_t axis[kChunk];
+    void set(size_t k, const GridFrame& f) {
+        point[k] = f.first.point;
+        offset[k] = f.first.table_offset;
+        turn[k] = f.first.turn_mask;
+        axis[k] = f.axis;
+    }
+};
+
+// set_grid_frame_quad for the grouped order's decoder: vertices k .. k + 3's frames by role in
+// `roles`, their role-0 grid predictions and axes in `first`, each made in the lanes and stored
+// whole (the same values).
+inline void set_grid_roles_quad(const FrameQuadLanes& l, const GridScale& grid, const double* origin, QuadRoles& roles,
+                                FirstRoles& first, size_t k) {
+    const __m256d sign = _mm256_set1_pd(-0.0);
+    const __m256d x = _mm256_andnot_pd(sign, l.nx), y = _mm256_andnot_pd(sign, l.ny), z = _mm256_andnot_pd(sign, l.nz);
+    const __m256d y_wins = _mm256_cmp_pd(y, x, _CMP_GT_OS);
+    const __m256d best = _mm256_max_pd(y, x);
+    const __m256d z_wins = _mm256_cmp_pd(z, best, _CMP_GT_OS);
+    const __m256d largest = _mm256_max_pd(z, best);
+    const __m256d with_normal = _mm256_and_pd(_mm256_cmp_pd(largest, _mm256_setzero_pd(), _CMP_GT_OS),
+                                              _mm256_cmp_pd(largest, _mm256_set1_pd(HUGE_VAL), _CMP_LT_OS));
+    const __m256d on_z = _mm256_and_pd(with_normal, z_wins), on_y = _mm256_andnot_pd(z_wins, _mm256_and_pd(with_normal, y_wins));
+    // The axis: 2 on z, 1 on y, else 0 (set_frame's; 0 without a normal), as four int32.
+    const __m256i axis = _mm256_or_si256(_mm256_and_si256(_mm256_castpd_si256(on_y), _mm256_set1_epi64x(1)),
+                                         _mm256_and_si256(_mm256_castpd_si256(on_z), _mm256_set1_epi64x(2)));
+    _mm_store_si128(reinterpret_cast<__m128i*>(first.axis + k),
+                    _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(axis, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0))));
+    const __m256d value = _mm256_blendv_pd(_mm256_blendv_pd(l.mx, l.my, on_y), l.mz, on_z);
+    const __m256d from = _mm256_blendv_pd(_mm256_blendv_pd(_mm256_set1_pd(origin[0]), _mm256_set1_pd(origin[1]), on_y),
+                                          _mm256_set1_pd(origin[2]), on_z);
+    grid_point_quad(value, from, grid, first.point + k, first.offset + k, first.turn + k);
     // Role 1's axis is 1 where the frame's is 0 (and without a normal), else 0; role 2's is 1 where
     // the frame's is 2, else 2.
     const __m256d on_x = _mm256_andnot_pd(_mm256_or_pd(on_y, on_z), _mm256_castsi256_pd(_mm256_set1_epi64x(-1)));
@@ -2091,10 +2126,10 @@ inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, 
         role[1] = _mm256_blendv_pd(x, y, on_x);
         role[2] = _mm256_blendv_pd(z, y, on_z);
     };
-    by_role(l.mx, l.my, l.mz, roles->midpoint);
-    by_role(l.nx, l.ny, l.nz, roles->normal);
-    by_role(_mm256_set1_pd(origin[0]), _mm256_set1_pd(origin[1]), _mm256_set1_pd(origin[2]), roles->origin);
-    roles->with_normal = with_normal;
+    by_role(l.mx, l.my, l.mz, roles.midpoint);
+    by_role(l.nx, l.ny, l.nz, roles.normal);
+    by_role(_mm256_set1_pd(origin[0]), _mm256_set1_pd(origin[1]), _mm256_set1_pd(origin[2]), roles.origin);
+    roles.with_normal = with_normal;
 }
 
 // decode_grid_grouped with roles 1 and 2's predictions made four vertices at a time from `roles`
@@ -2102,16 +2137,16 @@ inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, 
 // lanes (no fused multiply-add), so the same predictions; the vertices past the last whole four
 // (a level's last chunk) one at a time, as decode_grid_grouped.
 template <bool Safe>
-inline bool decode_grid_grouped_quads(StencilStreams& s, const GridTable* t, const GridFrame* frames, const QuadRoles* roles,
-                                      size_t count, const GridScale& level_grid, const double* origin, Coordinates* decoded) {
+inline bool decode_grid_grouped_quads(StencilStreams& s, const GridTable* t, const GridFrame* frames, const FirstRoles& firsts,
+                                      const QuadRoles* roles, size_t count, const GridScale& level_grid, const double* origin,
+                                      Coordinates* decoded) {
     const GridScale grid = level_grid;  // a local copy: the stores to `decoded` could alias the caller's
     alignas(32) uint64_t point1[kChunk], point2[kChunk], offset1[kChunk], offset2[kChunk];
     alignas(32) int64_t turn1[kChunk], turn2[kChunk];
     uint64_t largest = 0;  // of the role-0 grid values as unsigned, where a negative one is above any
     auto token = [&](auto state, size_t k) {
         constexpr int State = decltype(state)::value;
-        const GridFrame& f = frames[k];
-        const int64_t q0 = grid_point_value<State, Safe>(s, t, f.first.point, f.first.table_offset, f.first.turn_mask);
+        const int64_t q0 = grid_point_value<State, Safe>(s, t, firsts.point[k], firsts.offset[k], firsts.turn[k]);
         largest = std::max(largest, uint64_t(q0));
         return q0;
     };
@@ -2127,7 +2162,7 @@ inline bool decode_grid_grouped_quads(StencilStreams& s, const GridTable* t, con
         const __m256d value = _mm256_add_pd(r.origin[0], rounded(_mm256_mul_pd(q, step)));
         alignas(32) double values[4];
         _mm256_store_pd(values, value);
-        for (int j = 0; j < 4; ++j) decoded[k + size_t(j)][frames[k + size_t(j)].axis] = values[j];
+        for (int j = 0; j < 4; ++j) decoded[k + size_t(j)][firsts.axis[k + size_t(j)]] = values[j];
         const __m256d u = rounded(_mm256_div_pd(_mm256_sub_pd(value, r.midpoint[0]), r.normal[0]));
         const __m256d second = _mm256_blendv_pd(r.midpoint[1], _mm256_add_pd(r.midpoint[1], rounded(_mm256_mul_pd(u, r.normal[1]))),
                                                 r.with_normal);
@@ -2154,7 +2189,7 @@ inline bool decode_grid_grouped_quads(StencilStreams& s, const GridTable* t, con
             const int64_t v1 = grid_point_value<S, Safe>(s, t + kGridBins, point1[i], offset1[i], turn1[i]);
             const int64_t v2 = grid_point_value<1 - S, Safe>(s, t + 2 * kGridBins, point2[i], offset2[i], turn2[i]);
             if ((uint64_t(v1) > grid.max) | (uint64_t(v2) > grid.max)) return false;
-            const int a0 = frames[i].axis;
+            const int a0 = firsts.axis[i];
             set_other_roles(v1, v2, grid, origin, a0 == 0 ? 1 : 0, a0 == 2 ? 1 : 2, decoded[i]);
         }
         return true;
@@ -2163,21 +2198,28 @@ inline bool decode_grid_grouped_quads(StencilStreams& s, const GridTable* t, con
 }
 
 // PairFrames four at a time; for the grouped order (by_role), each whole four's frames by role
-// for decode_grid_grouped_quads.
+// and role 0's predictions by vertex for decode_grid_grouped_quads (the last few of a level's
+// last chunk as GridFrames, their role 0 copied).
 struct QuadFrames {
     bool by_role;
     QuadRoles roles[kChunk / 4];
+    FirstRoles firsts;
     void operator()(const Hierarchy& h, const FrameCorners* corners, size_t count, const GridScale& grid, const double* origin,
                     GridFrame* frames) {
         size_t i = 0;
-        for (; i + 3 < count; i += 4)
-            set_grid_frame_quad(frame_quad_lanes(h, corners + i), grid, origin, frames + i, by_role ? roles + i / 4 : nullptr);
+        if (by_role) {
+            for (; i + 3 < count; i += 4) set_grid_roles_quad(frame_quad_lanes(h, corners + i), grid, origin, roles[i / 4], firsts, i);
+            PairFrames()(h, corners + i, count - i, grid, origin, frames + i);
+            for (; i < count; ++i) firsts.set(i, frames[i]);
+            return;
+        }
+        for (; i + 3 < count; i += 4) set_grid_frame_quad(frame_quad_lanes(h, corners + i), grid, origin, frames + i);
         PairFrames()(h, corners + i, count - i, grid, origin, frames + i);
     }
     template <bool Safe>
     bool grouped(StencilStreams& s, const GridTable* t, const GridFrame* frames, size_t count, const GridScale& grid,
                  const double* origin, Coordinates* decoded) const {
-        return decode_grid_grouped_quads<Safe>(s, t, frames, roles, count, grid, origin, decoded);
+        return decode_grid_grouped_quads<Safe>(s, t, frames, firsts, roles, count, grid, origin, decoded);
     }
 };
 
