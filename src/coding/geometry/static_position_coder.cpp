@@ -2143,6 +2143,7 @@ inline bool decode_grid_grouped_quads(StencilStreams& s, const GridTable* t, con
     const GridScale grid = level_grid;  // a local copy: the stores to `decoded` could alias the caller's
     alignas(32) uint64_t point1[kChunk], point2[kChunk], offset1[kChunk], offset2[kChunk];
     alignas(32) int64_t turn1[kChunk], turn2[kChunk];
+    alignas(32) double first_values[kChunk];  // the whole fours' role-0 coordinates
     uint64_t largest = 0;  // of the role-0 grid values as unsigned, where a negative one is above any
     auto token = [&](auto state, size_t k) {
         constexpr int State = decltype(state)::value;
@@ -2151,6 +2152,7 @@ inline bool decode_grid_grouped_quads(StencilStreams& s, const GridTable* t, con
         return q0;
     };
     const __m256d step = _mm256_set1_pd(grid.step);
+    const size_t fours = count / 4 * 4;
     size_t k = 0;
     for (; k + 3 < count; k += 4) {
         const int64_t q0 = token(std::integral_constant<int, 0>{}, k), q1 = token(std::integral_constant<int, 1>{}, k + 1),
@@ -2160,9 +2162,7 @@ inline bool decode_grid_grouped_quads(StencilStreams& s, const GridTable* t, con
         const __m256d q = _mm256_cvtepi32_pd(_mm_setr_epi32(int(q0), int(q1), int(q2), int(q3)));
         const QuadRoles& r = roles[k / 4];
         const __m256d value = _mm256_add_pd(r.origin[0], rounded(_mm256_mul_pd(q, step)));
-        alignas(32) double values[4];
-        _mm256_store_pd(values, value);
-        for (int j = 0; j < 4; ++j) decoded[k + size_t(j)][firsts.axis[k + size_t(j)]] = values[j];
+        _mm256_store_pd(first_values + k, value);
         const __m256d u = rounded(_mm256_div_pd(_mm256_sub_pd(value, r.midpoint[0]), r.normal[0]));
         const __m256d second = _mm256_blendv_pd(r.midpoint[1], _mm256_add_pd(r.midpoint[1], rounded(_mm256_mul_pd(u, r.normal[1]))),
                                                 r.with_normal);
@@ -2183,18 +2183,56 @@ inline bool decode_grid_grouped_quads(StencilStreams& s, const GridTable* t, con
         turn2[k] = g.turn_mask[1];
     }
     if (largest > grid.max) return false;  // also a q0 < 0
+    // Roles 1 and 2's grid values, then the coordinates: the whole fours' in the lanes (the same
+    // operations as set_other_roles), each lane's roles put on their axes and stored as x, y, z.
+    alignas(16) int32_t second_points[kChunk], third_points[kChunk];
+    uint64_t others = 0;  // the largest of roles 1 and 2's grid values as unsigned
     auto roles_1_2 = [&](auto odd) {
         constexpr int S = decltype(odd)::value ? 1 : 0;  // role 1's state: count mod 2
         for (size_t i = 0; i < count; ++i) {
             const int64_t v1 = grid_point_value<S, Safe>(s, t + kGridBins, point1[i], offset1[i], turn1[i]);
             const int64_t v2 = grid_point_value<1 - S, Safe>(s, t + 2 * kGridBins, point2[i], offset2[i], turn2[i]);
-            if ((uint64_t(v1) > grid.max) | (uint64_t(v2) > grid.max)) return false;
-            const int a0 = firsts.axis[i];
-            set_other_roles(v1, v2, grid, origin, a0 == 0 ? 1 : 0, a0 == 2 ? 1 : 2, decoded[i]);
+            others = std::max(others, std::max(uint64_t(v1), uint64_t(v2)));
+            second_points[i] = int32_t(v1);  // below 2^30 where valid; an invalid one fails below
+            third_points[i] = int32_t(v2);
         }
-        return true;
     };
-    return count % 2 == 0 ? roles_1_2(std::false_type{}) : roles_1_2(std::true_type{});
+    if (count % 2 == 0) roles_1_2(std::false_type{});
+    else roles_1_2(std::true_type{});
+    if (others > grid.max) return false;
+    for (size_t i = 0; i < fours; i += 4) {
+        const QuadRoles& r = roles[i / 4];
+        const __m256d first = _mm256_load_pd(first_values + i);
+        const __m256d second = _mm256_add_pd(
+            r.origin[1], rounded(_mm256_mul_pd(_mm256_cvtepi32_pd(_mm_load_si128(reinterpret_cast<const __m128i*>(second_points + i))), step)));
+        const __m256d third = _mm256_add_pd(
+            r.origin[2], rounded(_mm256_mul_pd(_mm256_cvtepi32_pd(_mm_load_si128(reinterpret_cast<const __m128i*>(third_points + i))), step)));
+        // Role 0 on the frame's axis; role 1 on x, or on y where the axis is x; role 2 on z, or on
+        // y where the axis is z.
+        const __m256i axis = _mm256_cvtepi32_epi64(_mm_load_si128(reinterpret_cast<const __m128i*>(firsts.axis + i)));
+        const __m256d on_x = _mm256_castsi256_pd(_mm256_cmpeq_epi64(axis, _mm256_setzero_si256()));
+        const __m256d on_y = _mm256_castsi256_pd(_mm256_cmpeq_epi64(axis, _mm256_set1_epi64x(1)));
+        const __m256d on_z = _mm256_castsi256_pd(_mm256_cmpeq_epi64(axis, _mm256_set1_epi64x(2)));
+        const __m256d x = _mm256_blendv_pd(second, first, on_x);
+        const __m256d y = _mm256_blendv_pd(_mm256_blendv_pd(third, first, on_y), second, on_x);
+        const __m256d z = _mm256_blendv_pd(third, first, on_z);
+        const __m256d xy02 = _mm256_unpacklo_pd(x, y), xy13 = _mm256_unpackhi_pd(x, y);  // (x0 y0 x2 y2), (x1 y1 x3 y3)
+        const __m128d z01 = _mm256_castpd256_pd128(z), z23 = _mm256_extractf128_pd(z, 1);
+        double* p = decoded[i];
+        _mm_storeu_pd(p, _mm256_castpd256_pd128(xy02));
+        _mm_storel_pd(p + 2, z01);
+        _mm_storeu_pd(p + 3, _mm256_castpd256_pd128(xy13));
+        _mm_storeh_pd(p + 5, z01);
+        _mm_storeu_pd(p + 6, _mm256_extractf128_pd(xy02, 1));
+        _mm_storel_pd(p + 8, z23);
+        _mm_storeu_pd(p + 9, _mm256_extractf128_pd(xy13, 1));
+        _mm_storeh_pd(p + 11, z23);
+    }
+    for (size_t i = fours; i < count; ++i) {  // role 0 is on its axis already (grid_first_role)
+        const int a0 = firsts.axis[i];
+        set_other_roles(second_points[i], third_points[i], grid, origin, a0 == 0 ? 1 : 0, a0 == 2 ? 1 : 2, decoded[i]);
+    }
+    return true;
 }
 
 // PairFrames four at a time; for the grouped order (by_role), each whole four's frames by role
