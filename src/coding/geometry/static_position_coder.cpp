@@ -2058,19 +2058,23 @@ inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, 
     const __m256d best = _mm256_max_pd(y, x);
     const __m256d z_wins = _mm256_cmp_pd(z, best, _CMP_GT_OS);
     const __m256d largest = _mm256_max_pd(z, best);
-    const int has = _mm256_movemask_pd(_mm256_and_pd(_mm256_cmp_pd(largest, _mm256_setzero_pd(), _CMP_GT_OS),
-                                                     _mm256_cmp_pd(largest, _mm256_set1_pd(HUGE_VAL), _CMP_LT_OS)));
-    const int ys = _mm256_movemask_pd(y_wins), zs = _mm256_movemask_pd(z_wins);
+    const __m256d with_normal = _mm256_and_pd(_mm256_cmp_pd(largest, _mm256_setzero_pd(), _CMP_GT_OS),
+                                              _mm256_cmp_pd(largest, _mm256_set1_pd(HUGE_VAL), _CMP_LT_OS));
+    const __m256d on_z = _mm256_and_pd(with_normal, z_wins), on_y = _mm256_andnot_pd(z_wins, _mm256_and_pd(with_normal, y_wins));
+    // The axes made in the lanes (2 on z, 1 on y, else 0), as set_grid_roles_quad makes them.
+    alignas(16) int32_t axes[4];
+    const __m256i axis = _mm256_or_si256(_mm256_and_si256(_mm256_castpd_si256(on_y), _mm256_set1_epi64x(1)),
+                                         _mm256_and_si256(_mm256_castpd_si256(on_z), _mm256_set1_epi64x(2)));
+    _mm_store_si128(reinterpret_cast<__m128i*>(axes),
+                    _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(axis, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0))));
+    const int has = _mm256_movemask_pd(with_normal);
     for (int j = 0; j < 4; ++j) {
         g[j].has_normal = ((has >> j) & 1) != 0;
-        g[j].axis = (has >> j) & 1 ? ((zs >> j) & 1 ? 2 : (ys >> j) & 1) : 0;
+        g[j].axis = axes[j];
     }
     if (!Grid) return;
     // Role 0's grid predictions (grid_point_pair's, four lanes): each lane's coordinate and origin
     // on its axis chosen by the same masks.
-    const __m256d with_normal = _mm256_castsi256_pd(_mm256_set_epi64x(-int64_t((has >> 3) & 1), -int64_t((has >> 2) & 1),
-                                                                      -int64_t((has >> 1) & 1), -int64_t(has & 1)));
-    const __m256d on_z = _mm256_and_pd(with_normal, z_wins), on_y = _mm256_andnot_pd(z_wins, _mm256_and_pd(with_normal, y_wins));
     const __m256d value = _mm256_blendv_pd(_mm256_blendv_pd(l.mx, l.my, on_y), l.mz, on_z);
     const __m256d from = _mm256_blendv_pd(_mm256_blendv_pd(_mm256_set1_pd(origin[0]), _mm256_set1_pd(origin[1]), on_y),
                                           _mm256_set1_pd(origin[2]), on_z);
