@@ -239,12 +239,13 @@ TEST(StaticLevelEncoder, GridLevelsDecodeAlikeFromTheListAndFromTheNodes) {
 }
 
 // Mode 5's decoder of split_level's list (the bit-exact levels of whole files and chunks) and its
-// decoder of (node, edge) pairs decode the same positions, float64 and float32, with residuals of
+// decoder of (node, edge) pairs decode the same positions, and so do mode 3's (the same listed
+// decoder with the frames of mode 3, against the generic decoder of the pairs), float64 and float32, with residuals of
 // every bit length up to 63 (narrow tables, as every bit-exact surface level has; raw bits in one
 // read and, past 57, in two), float64 coordinates past DBL_MAX / 2 (the chunks whose positions are
 // far) and a level whose last chunk has an odd count, with the frames four and two at a time; both
 // refuse the streams cut short. The encoder's frames four and two at a time code the same streams.
-void expect_unit_levels_decode_alike(Precision precision) {
+void expect_unit_levels_decode_alike(Precision precision, GeometryPredictor mode) {
     const bool single = precision == Precision::float32;
     Hierarchy h = projected_sphere(6000, 6, 14);
     if (single) {
@@ -274,7 +275,6 @@ void expect_unit_levels_decode_alike(Precision precision) {
     std::vector<FrameCorners> corners;
     for (const auto& [n, e] : created) corners.push_back(frame_corners(h, n, e));
     const CoordinateSpace space{precision, nullptr};
-    const GeometryPredictor mode = GeometryPredictor::unit_normal_frame;
     StaticLevelEncoder encoder(h, created, space, mode);
     ArithmeticEncoder tables_out;
     encoder.write_tables(tables_out);
@@ -322,7 +322,14 @@ void expect_unit_levels_decode_alike(Precision precision) {
 TEST(StaticLevelEncoder, UnitLevelsDecodeAlikeFromTheListAndFromTheNodes) {
     for (Precision precision : {Precision::float64, Precision::float32}) {
         SCOPED_TRACE(precision == Precision::float32 ? "float32" : "float64");
-        expect_unit_levels_decode_alike(precision);
+        expect_unit_levels_decode_alike(precision, GeometryPredictor::unit_normal_frame);
+    }
+}
+
+TEST(StaticLevelEncoder, BitExactModeThreeLevelsDecodeAlikeFromTheListAndFromTheNodes) {
+    for (Precision precision : {Precision::float64, Precision::float32}) {
+        SCOPED_TRACE(precision == Precision::float32 ? "float32" : "float64");
+        expect_unit_levels_decode_alike(precision, GeometryPredictor::normal_frame);
     }
 }
 

@@ -1146,6 +1146,43 @@ struct StencilStreams {
     }
 };
 
+// The last bytes of a level's streams, copied with zeros after them once fewer remain than a chunk
+// may read (Rans and Raw bytes), so that every chunk reads without a bounds test per byte, as if
+// inside the streams: bytes past an end read as 0, as the safe reads give them, and a chunk that
+// went past an end makes the level corrupt (overran()). At 12 bits a level's raw stream is often
+// shorter than a chunk's bound, and every chunk of it took the safe reads.
+template <size_t Rans, size_t Raw>
+class PaddedTails {
+public:
+    // Before each chunk: the streams' tails moved here where they are that short.
+    void pad(StencilStreams& s) {
+        if (!rans_padded_ && size_t(s.rans_end - s.rans) < Rans) {
+            const size_t n = size_t(s.rans_end - s.rans);
+            std::memcpy(rans_, s.rans, n);
+            std::memset(rans_ + n, 0, sizeof rans_ - n);
+            s.rans = rans_;
+            s.rans_end = rans_ + n;
+            rans_padded_ = true;
+        }
+        const size_t at = size_t(s.raw_bits_read >> 3);  // at most raw_size (overran() after each chunk)
+        if (!raw_padded_ && s.raw_size - at < Raw) {
+            const size_t n = s.raw_size - at;
+            if (n > 0) std::memcpy(raw_, s.raw + at, n);
+            std::memset(raw_ + n, 0, sizeof raw_ - n);
+            s.raw = raw_;
+            s.raw_size = n;
+            s.raw_bits_read -= uint64_t(at) * 8;
+            raw_padded_ = true;
+        }
+    }
+    // After each chunk: whether it read past a stream's end.
+    static bool overran(const StencilStreams& s) { return s.rans > s.rans_end || s.raw_bits_read > uint64_t(s.raw_size) * 8; }
+
+private:
+    uint8_t rans_[2 * Rans], raw_[2 * Raw];
+    bool rans_padded_ = false, raw_padded_ = false;
+};
+
 // The streams of a level with both rANS states read; false where the level is too short for them
 // or a state is below L (no encoder ends there).
 bool open_stencil_streams(const uint8_t* rans_data, size_t rans_size, const uint8_t* raw_data, size_t raw_size,
@@ -1724,30 +1761,25 @@ AMC_ALWAYS_INLINE bool decode_grid_listed_with(Hierarchy& h, const FromList& cre
     std::array<GridFrame, kChunk> frames;
     Coordinates coordinates[kChunk];
     Vec3 decoded[kChunk];
+    PaddedTails<kChunkRans, kChunkRaw> tails;
     for (size_t begin = 0; begin < created.size(); begin += kChunk) {
         const size_t count = std::min(kChunk, created.size() - begin);
         const FrameCorners* corners = created.corners.next(count);
         prefetch_corner_positions(h, corners, count);
         make_frames(h, corners, count, grid, origin, frames.data());
-        auto run = [&](auto safe) {
-            constexpr bool Safe = decltype(safe)::value;
-            StencilStreams local = s;  // the chunk's copy, which the compiler keeps in registers
-            bool ok = true;
-            if (Grouped) {
-                ok = make_frames.template grouped<Safe>(local, t.data(), frames.data(), count, grid, origin, coordinates);
-                s = local;
-                return ok;
-            }
+        tails.pad(s);
+        StencilStreams local = s;  // the chunk's copy, which the compiler keeps in registers
+        bool ok = true;
+        if (Grouped) {
+            ok = make_frames.template grouped<false>(local, t.data(), frames.data(), count, grid, origin, coordinates);
+        } else {
             for (size_t k = 0; k < count && ok; k += 2) {  // token j of the level with state j mod 2
-                ok = decode_grid_vertex<0, Safe>(local, t.data(), frames[k], grid, origin, coordinates[k]) &&
-                     (k + 1 == count || decode_grid_vertex<1, Safe>(local, t.data(), frames[k + 1], grid, origin, coordinates[k + 1]));
+                ok = decode_grid_vertex<0, false>(local, t.data(), frames[k], grid, origin, coordinates[k]) &&
+                     (k + 1 == count || decode_grid_vertex<1, false>(local, t.data(), frames[k + 1], grid, origin, coordinates[k + 1]));
             }
-            s = local;
-            return ok;
-        };
-        const bool inside = size_t(s.rans_end - s.rans) >= kChunkRans &&
-                            raw_size - std::min<size_t>(raw_size, size_t(s.raw_bits_read >> 3)) >= kChunkRaw;
-        if (!(inside ? run(std::false_type{}) : run(std::true_type{}))) return false;
+        }
+        s = local;
+        if (!ok || tails.overran(s)) return false;
         std::memcpy(decoded, coordinates, count * sizeof(Vec3));
         store_listed_chunk(h, created, begin, decoded, count, append, near);
     }
@@ -1824,15 +1856,18 @@ AMC_ALWAYS_INLINE void round_midpoints_to_float(GridFrame* frames, size_t count)
         for (double& m : frames[i].midpoint) m = rounded_to_float(m);
 }
 
-// The frames of `count` listed vertices without a grid, two at a time with SSE2.
+// The frames of `count` listed vertices without a grid, two at a time with SSE2: mode 5's (unit
+// normals), or mode 3's.
+template <bool UnitNormals = true>
 struct PairUnitFrames {
     AMC_ALWAYS_INLINE void operator()(const Hierarchy& h, const FrameCorners* corners, size_t count, GridFrame* frames) const {
         size_t i = 0;
 #if AMC_SSE2
-        for (; i + 1 < count; i += 2) set_frame_pair(frame_pair_lanes<true>(h, corners[i], corners[i + 1]), frames[i], frames[i + 1]);
+        for (; i + 1 < count; i += 2)
+            set_frame_pair(frame_pair_lanes<UnitNormals>(h, corners[i], corners[i + 1]), frames[i], frames[i + 1]);
         if (h.single_precision()) round_midpoints_to_float(frames, i);
 #endif
-        for (; i < count; ++i) set_frame(frame_of<true>(h, corners[i]), frames[i]);
+        for (; i < count; ++i) set_frame(frame_of<UnitNormals>(h, corners[i]), frames[i]);
     }
 };
 
@@ -1850,27 +1885,23 @@ AMC_ALWAYS_INLINE bool decode_unit_listed_with(Hierarchy& h, const FromList& cre
     std::array<GridFrame, kChunk> frames;
     Coordinates coordinates[kChunk];
     Vec3 decoded[kChunk];
+    PaddedTails<kChunkRans, kChunkRaw> tails;
     for (size_t begin = 0; begin < created.size(); begin += kChunk) {
         const size_t count = std::min(kChunk, created.size() - begin);
         const FrameCorners* corners = created.corners.next(count);
         prefetch_corner_positions(h, corners, count);
         make_frames(h, corners, count, frames.data());
         uint64_t largest = 0;
-        auto run = [&](auto safe) {
-            constexpr bool Safe = decltype(safe)::value;
-            StencilStreams local = s;  // the chunk's copy, which the compiler keeps in registers
-            size_t k = 0;
-            for (; k + 1 < count; k += 2) {  // token j of the level with state j mod 2
-                decode_unit_vertex<0, Safe, Float32>(local, t.data(), frames[k], coordinates[k], largest);
-                decode_unit_vertex<1, Safe, Float32>(local, t.data(), frames[k + 1], coordinates[k + 1], largest);
-            }
-            if (k < count) decode_unit_vertex<0, Safe, Float32>(local, t.data(), frames[k], coordinates[k], largest);
-            s = local;
-        };
-        const bool inside = size_t(s.rans_end - s.rans) >= kChunkRans &&
-                            raw_size - std::min<size_t>(raw_size, size_t(s.raw_bits_read >> 3)) >= kChunkRaw;
-        if (inside) run(std::false_type{});
-        else run(std::true_type{});
+        tails.pad(s);
+        StencilStreams local = s;  // the chunk's copy, which the compiler keeps in registers
+        size_t k = 0;
+        for (; k + 1 < count; k += 2) {  // token j of the level with state j mod 2
+            decode_unit_vertex<0, false, Float32>(local, t.data(), frames[k], coordinates[k], largest);
+            decode_unit_vertex<1, false, Float32>(local, t.data(), frames[k + 1], coordinates[k + 1], largest);
+        }
+        if (k < count) decode_unit_vertex<0, false, Float32>(local, t.data(), frames[k], coordinates[k], largest);
+        s = local;
+        if (tails.overran(s)) return false;
         std::memcpy(decoded, coordinates, count * sizeof(Vec3));
         // Every coordinate at most DBL_MAX / 2 in magnitude: finite, and no position is far.
         const bool near = largest <= bit_cast<uint64_t>(kHalfMax);
@@ -1883,10 +1914,13 @@ AMC_ALWAYS_INLINE bool decode_unit_listed_with(Hierarchy& h, const FromList& cre
     return s.ended_cleanly();
 }
 
-template <bool Float32>
+// Mode 5's levels, or mode 3's (UnitNormals false: the same streams and roles, the frame's normal
+// the sum of the cross products).
+template <bool Float32, bool UnitNormals>
 bool decode_unit_listed(Hierarchy& h, const FromList& created, const StaticTables& tables, const uint8_t* rans_data,
                         size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
-    return decode_unit_listed_with<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size, PairUnitFrames{});
+    return decode_unit_listed_with<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size,
+                                            PairUnitFrames<UnitNormals>{});
 }
 
 #if AMC_AVX2_AT_RUN_TIME
@@ -1910,7 +1944,9 @@ struct FrameQuadLanes {
     __m256d mx, my, mz, nx, ny, nz;
 };
 
-// Inlined in both quad frame makers: a call of its own passes the lanes through memory.
+// Inlined in the quad frame makers: a call of its own passes the lanes through memory. Mode 3's
+// normals without UnitNormals.
+template <bool UnitNormals = true>
 AMC_ALWAYS_INLINE FrameQuadLanes frame_quad_lanes(const Hierarchy& h, const FrameCorners* k) {
     struct Lanes {
         __m256d x, y, z;
@@ -1956,6 +1992,7 @@ AMC_ALWAYS_INLINE FrameQuadLanes frame_quad_lanes(const Hierarchy& h, const Fram
     auto pick = [with_d](__m256d u, __m256d v) {
         return _mm256_or_pd(_mm256_and_pd(with_d, _mm256_add_pd(u, v)), _mm256_andnot_pd(with_d, u));
     };
+    if (!UnitNormals) return {mid.x, mid.y, mid.z, pick(n1.x, n2.x), pick(n1.y, n2.y), pick(n1.z, n2.z)};
     const __m256d zero = _mm256_setzero_pd(), infinity = _mm256_set1_pd(HUGE_VAL), one = _mm256_set1_pd(1.0);
     const __m256d l1 = _mm256_sqrt_pd(dot(n1)), l2 = _mm256_sqrt_pd(dot(n2));
     const __m256d r1 = _mm256_div_pd(one, l1), r2 = _mm256_div_pd(one, l2);
@@ -2153,19 +2190,22 @@ bool decode_grid_listed_avx2(Hierarchy& h, const FromList& created, const Quanti
 }
 
 // PairUnitFrames four at a time.
+template <bool UnitNormals = true>
 struct QuadUnitFrames {
     void operator()(const Hierarchy& h, const FrameCorners* corners, size_t count, GridFrame* frames) const {
         size_t i = 0;
-        for (; i + 3 < count; i += 4) set_grid_frame_quad<false>(frame_quad_lanes(h, corners + i), GridScale{}, nullptr, frames + i);
+        for (; i + 3 < count; i += 4)
+            set_grid_frame_quad<false>(frame_quad_lanes<UnitNormals>(h, corners + i), GridScale{}, nullptr, frames + i);
         if (h.single_precision()) round_midpoints_to_float(frames, i);
-        PairUnitFrames()(h, corners + i, count - i, frames + i);
+        PairUnitFrames<UnitNormals>()(h, corners + i, count - i, frames + i);
     }
 };
 
-template <bool Float32>
+template <bool Float32, bool UnitNormals>
 bool decode_unit_listed_avx2(Hierarchy& h, const FromList& created, const StaticTables& tables, const uint8_t* rans_data,
                              size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
-    return decode_unit_listed_with<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size, QuadUnitFrames{});
+    return decode_unit_listed_with<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size,
+                                            QuadUnitFrames<UnitNormals>{});
 }
 #pragma GCC pop_options
 #endif
@@ -2182,14 +2222,14 @@ bool decode_grid_listed_fastest(Hierarchy& h, const FromList& created, const Qua
 }
 
 // decode_unit_listed, with AVX2's frames where the processor has them.
-template <bool Float32>
+template <bool Float32, bool UnitNormals>
 bool decode_unit_listed_fastest(Hierarchy& h, const FromList& created, const StaticTables& tables, const uint8_t* rans_data,
                                 size_t rans_size, const uint8_t* raw_data, size_t raw_size) {
 #if AMC_AVX2_AT_RUN_TIME
     if (has_avx2() && wide_frames_allowed.load(std::memory_order_relaxed))
-        return decode_unit_listed_avx2<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+        return decode_unit_listed_avx2<Float32, UnitNormals>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
 #endif
-    return decode_unit_listed<Float32>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+    return decode_unit_listed<Float32, UnitNormals>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
 }
 
 template <class Tables>
@@ -2250,11 +2290,18 @@ bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, G
         if (all_narrow && mode == GeometryPredictor::normal_frame_grid && space.quantizer != nullptr && !h.single_precision())
             return grouped ? decode_grid_listed_fastest<true>(h, created, *space.quantizer, tables, rans_data, rans_size, raw_data, raw_size)
                            : decode_grid_listed_fastest<false>(h, created, *space.quantizer, tables, rans_data, rans_size, raw_data, raw_size);
+        // Modes 5 and 3 bit-exact (the FE models' middle levels take mode 3).
         if (all_narrow && mode == GeometryPredictor::unit_normal_frame && space.quantizer == nullptr) {
             if (space.precision == Precision::float64 && !h.single_precision())
-                return decode_unit_listed_fastest<false>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+                return decode_unit_listed_fastest<false, true>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
             if (space.precision == Precision::float32 && h.single_precision())
-                return decode_unit_listed_fastest<true>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+                return decode_unit_listed_fastest<true, true>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+        }
+        if (all_narrow && mode == GeometryPredictor::normal_frame && space.quantizer == nullptr) {
+            if (space.precision == Precision::float64 && !h.single_precision())
+                return decode_unit_listed_fastest<false, false>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
+            if (space.precision == Precision::float32 && h.single_precision())
+                return decode_unit_listed_fastest<true, false>(h, created, tables, rans_data, rans_size, raw_data, raw_size);
         }
     }
     if (all_narrow) return decode_static_with(h, created, space, mode, narrow, rans_data, rans_size, raw_data, raw_size, grouped);
@@ -2266,11 +2313,11 @@ bool decode_static(Hierarchy& h, const Source& created, CoordinateSpace space, G
 void make_unit_frames(const Hierarchy& h, const FrameCorners* corners, size_t count, GridFrame* frames) {
 #if AMC_AVX2_AT_RUN_TIME
     if (has_avx2() && wide_frames_allowed.load(std::memory_order_relaxed)) {
-        QuadUnitFrames()(h, corners, count, frames);
+        QuadUnitFrames<>()(h, corners, count, frames);
         return;
     }
 #endif
-    PairUnitFrames()(h, corners, count, frames);
+    PairUnitFrames<>()(h, corners, count, frames);
 }
 
 }  // namespace
