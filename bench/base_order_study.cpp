@@ -1,61 +1,58 @@
-// The mixing mode's hierarchy bytes (seventh model, naive and improved traversal) with the base
-// connectivity bytes for several start triangles of the base coder's mode 2 (gate radius 5, no
-// search), against the encoder's base (bit-exact): how much a base order chosen for the hierarchy
-// could save (docs/HIERARCHY_CODER.md, "The traversal of the mixing mode").
-//   base_order_study model.amh [candidates, default 16]
-#include "coding/base/base_mesh_coder.h"
+// The base order as an encoder choice (docs/HIERARCHY_CODER.md, "The base order as an encoder
+// choice"): for the base coder's order and the orders of base_order_candidates() (mode 2 from N
+// start triangles), the whole file's parts at effort 2 in the asked hierarchy mode, the paper
+// mode's file in the same order, and the base blocks' bytes (base_blocks_bytes: what efforts 3 and
+// 4 rank the orders by).
+//   base_order_study model.amh [starts, default 16] [mixed|paper, default mixed] [quantize bits, default 0]
 #include "coding/base/base_stage.h"
-#include "coding/hierarchy/hierarchy_level_coder.h"
+#include "coding/base_order_search.h"
+#include "coding/geometry/float_coder.h"
 
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
 
 #include <cstdio>
 #include <cstdlib>
-#include <numeric>
-#include <utility>
+#include <cstring>
 #include <vector>
 
 using namespace amc;
 
-static size_t hierarchy_bytes(const Hierarchy& g, Traversal t) {
-    HierarchyCoderOptions o;
-    o.traversal = t;
-    HierarchyLevelEncoder c(g, o, kHierarchyStreamVersion, nullptr, true, nullptr, nullptr, false);
-    ArithmeticEncoder sink;
-    for (int l = 0; l < c.level_count(); ++l) c.encode_level(l, sink);
-    return sink.finish().size();
-}
-
 int main(int argc, char** argv) {
     if (argc < 2) return 2;
     const Hierarchy h = read_hierarchy(argv[1]);
-    const int k = argc > 2 ? std::atoi(argv[2]) : 16;
-    const TriangleMesh& base = h.base();
-    const BaseMeshCode searched = base_code_of(h, nullptr, EncodeOptions{});
-    const Hierarchy hs = in_base_code_order(h, searched, false).hierarchy;
-    std::printf("encoder base %zu naive %zu improved %zu\n", searched.bytes.size(), hierarchy_bytes(hs, Traversal::naive),
-                hierarchy_bytes(hs, Traversal::improved));
-    const size_t n = base.triangles.size();
-    for (int c = 0; c < k; ++c) {
-        const size_t t = size_t(c) * n / size_t(k);
-        std::vector<uint32_t> perm(n);
-        std::iota(perm.begin(), perm.end(), 0u);
-        std::swap(perm[0], perm[t]);
-        TriangleMesh m = base;
-        for (size_t i = 0; i < n; ++i) m.triangles[i] = base.triangles[perm[i]];
-        BaseMeshCode code;
-        try {
-            code = encode_base_connectivity(m, BaseConnectivityMode::angle, false);
-        } catch (const std::exception& e) {
-            std::printf("start %zu: %s\n", t, e.what());
-            continue;
-        }
-        for (uint32_t& o : code.triangle_order) o = perm[o];
-        const Hierarchy g = in_base_code_order(h, code, false).hierarchy;
-        std::printf("start %zu base %zu naive %zu improved %zu\n", t, code.bytes.size(), hierarchy_bytes(g, Traversal::naive),
-                    hierarchy_bytes(g, Traversal::improved));
+    const uint32_t starts = argc > 2 ? uint32_t(std::atoi(argv[2])) : kBaseOrderSearches[0].starts;
+    EncodeOptions options;
+    options.effort = kMaxGeometryEffort;
+    if (argc > 3 && std::strcmp(argv[3], "paper") == 0) options.hierarchy_contexts = HierarchyContexts::paper;
+    else options.hierarchy_contexts = HierarchyContexts::mixed;
+    options.quantize_bits = argc > 4 ? std::atoi(argv[4]) : 0;
+    EncodeOptions paper = options;
+    paper.hierarchy_contexts = HierarchyContexts::paper;
+    const std::vector<uint8_t> reference = encode(h, options);
+    std::printf("order base_conn base_geom hierarchy geometry file paper_hierarchy paper_file base_blocks\n");
+    // The base coder codes a quantized file's base on its grid (encode()'s, for a forest without free ids).
+    Quantizer grid;
+    if (options.quantize_bits != 0) grid = make_quantizer(h.positions(), options.quantize_bits);
+    const Quantizer* q = options.quantize_bits != 0 ? &grid : nullptr;
+    auto row = [&](const char* name, const BaseMeshCode& code) {
+        EncodeStats s, p;
+        const std::vector<uint8_t> file = encode_with_base(h, options, code, &s);
+        encode_with_base(h, paper, code, &p);
+        std::printf("%s %llu %llu %llu %llu %zu %llu %llu %llu\n", name, (unsigned long long)s.base_connectivity_bytes,
+                    (unsigned long long)s.base_geometry_bytes, (unsigned long long)s.hierarchy_bytes,
+                    (unsigned long long)s.geometry_bytes, file.size(), (unsigned long long)p.hierarchy_bytes,
+                    (unsigned long long)p.total_bytes, (unsigned long long)base_blocks_bytes(h, q, code));
         std::fflush(stdout);
+        return file;
+    };
+    const BaseMeshCode own = base_code_of(h, q, options);
+    if (row("own", own) != reference) std::printf("(own order's file differs from encode()'s)\n");
+    int k = 0;
+    for (const BaseMeshCode& code : base_order_candidates(h, q, own, starts)) {
+        char name[32];
+        std::snprintf(name, sizeof name, "start%d", k++);
+        row(name, code);
     }
     return 0;
 }

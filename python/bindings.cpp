@@ -276,8 +276,8 @@ PYBIND11_MODULE(_amcodec, m) {
                  }
                  return to_bytes(data);
              }, py::arg("quantize") = 0, py::arg("effort") = kDefaultEffort,
-             "Compresses to .amc bytes (quantize: 0 bit-exact, else bits per axis; effort 0 to 2: how hard each\n"
-             "level's geometry mode is sought, as amc encode --effort).")
+             "Compresses to .amc bytes (quantize: 0 bit-exact, else bits per axis; effort 0 to 4: how hard the\n"
+             "encoder looks, as amc encode --effort).")
         .def("identical", [](const Hierarchy& a, const Hierarchy& b) { return identical(a, b); }, py::arg("other"),
              "Same base, forest, diagonals and bit-identical positions (canonical order).");
 
@@ -310,7 +310,7 @@ PYBIND11_MODULE(_amcodec, m) {
           py::arg("quantize") = 0, py::arg("return_stats") = false, py::arg("effort") = kDefaultEffort,
           "Compresses a triangle mesh to .amc bytes. The mesh is imported over `base` (a (points, triangles) pair) or\n"
           "over the coarsest base found in it. keep_numbering stores the mesh's own vertex and face numbering, so\n"
-          "that decode returns it; return_stats also returns a dict of sizes and the numbering map; effort (0 to 2)\n"
+          "that decode returns it; return_stats also returns a dict of sizes and the numbering map; effort (0 to 4)\n"
           "as amc encode --effort.");
 
     m.def("decode", [](py::bytes data, int level, bool canonical, bool partial) {

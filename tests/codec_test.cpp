@@ -1,4 +1,5 @@
 // The .amc file: bit-exact round trips, quantization, progressive decoding, corrupt files.
+#include "coding/base_order_search.h"
 #include "coding/container.h"
 #include "coding/hierarchy/coder_switches.h"
 #include "coding/hierarchy/hierarchy_stream.h"
@@ -195,15 +196,64 @@ TEST(Codec, EveryEffortDecodesToTheSameHierarchy) {
     for (int bits : {0, 12}) {
         EncodeOptions options;
         options.quantize_bits = bits;
-        options.effort = kMaxEffort;
+        options.effort = kMaxGeometryEffort;
         const std::vector<uint8_t> best = encode(h, options);
         const Hierarchy expected = decode(best.data(), best.size());
-        for (int effort = 0; effort < kMaxEffort; ++effort) {
+        for (int effort = 0; effort < kMaxGeometryEffort; ++effort) {
             options.effort = effort;
             const std::vector<uint8_t> bytes = encode(h, options);
             EXPECT_TRUE(identical(decode(bytes.data(), bytes.size()), expected)) << "bits " << bits << ", effort " << effort;
             EXPECT_LE(double(bytes.size()), 1.02 * double(best.size())) << "bits " << bits << ", effort " << effort;
         }
+    }
+}
+
+// Efforts 3 and 4 (coding/base_order_search.h) also code the file in other base orders and keep
+// the smallest: it decodes bit-exactly in the order in_decoder_order gives at that effort, is never
+// larger than effort 2's or the default's, and is smaller on a curved remesh whose base (200
+// triangles: a single try of the base coder) starts badly, in both hierarchy modes: a search
+// skipped fails.
+TEST(Codec, EffortsThreeAndFourChooseTheBaseOrder) {
+    const Hierarchy h = testing::curved_sphere_remesh(6000);
+    for (const HierarchyContexts contexts : {HierarchyContexts::paper, HierarchyContexts::mixed}) {
+        int smaller = 0;
+        for (const int bits : {0, 12}) {
+            EncodeOptions options;
+            options.hierarchy_contexts = contexts;
+            options.quantize_bits = bits;
+            const std::vector<uint8_t> fallback = encode(h, options);
+            options.effort = kMaxGeometryEffort;
+            const std::vector<uint8_t> two = encode(h, options);
+            for (int effort = kBaseOrderEffort; effort <= kMaxEffort; ++effort) {
+                SCOPED_TRACE(std::string(contexts == HierarchyContexts::mixed ? "mixed" : "paper") + ", bits " +
+                             std::to_string(bits) + ", effort " + std::to_string(effort));
+                options.effort = effort;
+                options.keep_base_order = false;
+                EncodeStats stats;
+                const std::vector<uint8_t> searched = encode(h, options, &stats);
+                EXPECT_EQ(stats.total_bytes, searched.size());
+                EXPECT_LE(searched.size(), two.size());
+                EXPECT_LE(searched.size(), fallback.size());
+                smaller += searched.size() < two.size();
+                const Hierarchy back = decode(searched.data(), searched.size());
+                const Hierarchy ordered = in_decoder_order(h, options);
+                if (bits == 0) {
+                    EXPECT_TRUE(identical(back, ordered));
+                } else {  // on the grid: the same as that order kept by the explicit base mode
+                    EncodeOptions kept = options;
+                    kept.keep_base_order = true;
+                    const std::vector<uint8_t> file = encode(ordered, kept);
+                    EXPECT_TRUE(identical(back, decode(file.data(), file.size())));
+                }
+                EXPECT_FALSE(identical(in_decoder_order(h), ordered) && searched.size() < two.size());
+                // A fixed base order leaves nothing to choose: effort 2's bytes.
+                options.keep_base_order = true;
+                const std::vector<uint8_t> fixed = encode(h, options);
+                options.effort = kMaxGeometryEffort;
+                EXPECT_EQ(fixed, encode(h, options));
+            }
+        }
+        EXPECT_GE(smaller, 2);
     }
 }
 
@@ -245,10 +295,11 @@ TEST(Codec, EncodesThroughAContextAreThoseWithoutOne) {
     };
     const Case cases[] = {{&sphere, 0, kDefaultEffort, false, false, 0}, {&surface, 0, kDefaultEffort, false, false, 0},
                           {&small, 0, kDefaultEffort, false, false, 0},  {&sphere, 12, kDefaultEffort, false, false, 0},
-                          {&surface, 16, kMaxEffort, false, false, 0},   {&single, 0, kDefaultEffort, false, false, 0},
+                          {&surface, 16, kMaxGeometryEffort, false, false, 0},   {&single, 0, kDefaultEffort, false, false, 0},
                           {&surface, 0, kDefaultEffort, true, false, 0}, {&exact, 0, kDefaultEffort, false, false, 2},
                           {&surface, 12, kDefaultEffort, false, true, 0}, {&sphere, 0, 0, false, false, 0},
-                          {&surface, 12, kDefaultEffort, false, false, 4}, {&sphere, 0, kDefaultEffort, false, false, 3}};
+                          {&surface, 12, kDefaultEffort, false, false, 4}, {&sphere, 0, kDefaultEffort, false, false, 3},
+                          {&surface, 12, kBaseOrderEffort, false, false, 0}};
     EncodeContext context;
     for (int pass = 0; pass < 2; ++pass) {
         for (size_t c = 0; c < std::size(cases); ++c) {

@@ -44,7 +44,8 @@ enum class HierarchyContexts : uint8_t {
     mixed = 1,
 };
 
-constexpr int kMaxEffort = 2;
+constexpr int kMaxGeometryEffort = 2;  // the highest effort that weighs the geometry modes alone
+constexpr int kMaxEffort = 4;
 constexpr int kDefaultEffort = 1;
 
 struct EncodeOptions {
@@ -67,10 +68,14 @@ struct EncodeOptions {
     // bit-exact file and keeps it where it codes smaller (such files are version 12); false keeps
     // the choices of version 11's encoder.
     bool unit_normals = true;
-    // How hard the automatic predictor weighs each level's geometry modes (docs/CODEC.md, "Encode
-    // effort"): kMaxEffort codes every candidate until it is the smallest or can not be; lower
-    // efforts judge the adaptive predictors from a sample of the level first (faster encodes,
-    // slightly larger files). The decoder reads every choice alike. encode() refuses an effort
+    // How hard the encoder looks (docs/CODEC.md, "Encode effort"). 0..kMaxGeometryEffort weigh
+    // each level's geometry modes: kMaxGeometryEffort codes every candidate until it is the
+    // smallest or can not be; lower efforts judge the adaptive predictors from a sample of the
+    // level first (faster encodes, slightly larger files). 3 and 4 also choose the base order: the
+    // file at effort 2 in the base coder's order and in the 4 (16) of 16 (64) other start
+    // triangles' orders with the smallest base blocks, the smallest file kept (docs/HIERARCHY_CODER.md,
+    // "The base order as an encoder choice", for sizes and times); with keep_base_order or a stored
+    // numbering they are effort 2. The decoder reads every choice alike. encode() refuses an effort
     // outside 0..kMaxEffort (invalid_input).
     int effort = kDefaultEffort;
     // The caller's numbering of the input's leaf mesh (leaf_numbering()), or null. The encoder
@@ -168,7 +173,8 @@ std::vector<uint8_t> encode(EncodeContext& context, const Hierarchy& h, const En
 // `h` as decode(encode(h, options)) returns it: over the base mesh in the base coder's order
 // (cheap: codes the base connectivity only), with the input's positions. The order depends on the
 // base positions the decoder sees, so pass the options of the encoding (only quantize_bits
-// matters). identical(decode(encode(h)), in_decoder_order(h)) holds for every bit-exact encoding.
+// matters, and efforts 3 and 4, whose order is their search's: then it codes the whole file).
+// identical(decode(encode(h)), in_decoder_order(h)) holds for every bit-exact encoding.
 Hierarchy in_decoder_order(const Hierarchy& h, const EncodeOptions& options = {});
 
 struct DecodeOptions {

@@ -144,13 +144,17 @@ def test_meshio_file_in_and_out(tmp_path):
 def test_every_effort_decodes_alike_and_others_are_refused():
     h, points, triangles = adaptive_leaf_mesh(3)
     expected = amcodec.decode_hierarchy(h.encode(quantize=12)).leaf_mesh()
-    for effort in (0, 1, 2):
+    for effort in (0, 1, 2, 3, 4):
         back = amcodec.decode_hierarchy(h.encode(quantize=12, effort=effort)).leaf_mesh()
-        assert np.array_equal(back["points"], expected["points"])
-        assert np.array_equal(back["triangles"], expected["triangles"])
+        if effort <= 2:
+            assert np.array_equal(back["points"], expected["points"])
+            assert np.array_equal(back["triangles"], expected["triangles"])
+        else:  # the base order is the search's: the same mesh, maybe numbered otherwise
+            assert np.array_equal(np.unique(back["points"], axis=0), np.unique(expected["points"], axis=0))
+            assert len(back["triangles"]) == len(expected["triangles"])
         mesh = amcodec.decode(amcodec.encode(points, triangles, keep_numbering=True, effort=effort))
         assert np.array_equal(mesh["points"], points)
-    for effort in (-1, 3):
+    for effort in (-1, 5):
         with pytest.raises(Exception, match="effort"):
             h.encode(effort=effort)
         with pytest.raises(Exception, match="effort"):

@@ -6,6 +6,7 @@
 #include <amc/codec.h>
 
 #include "coding/base/base_stage.h"
+#include "coding/base_order_search.h"
 #include "coding/chunks/chunk_policy.h"
 #include "coding/chunks/chunked_file.h"
 #include "coding/container.h"
@@ -329,7 +330,9 @@ ForestCode code_forest(const Hierarchy& h, const std::vector<uint32_t>& root_of,
 }
 
 // encode() through `memory` (an EncodeContext's, or none).
-std::vector<uint8_t> encode_file(const Hierarchy& input, const EncodeOptions& options, EncodeStats* stats_out, EncodeMemory memory) {
+// With `given_base`, that base connectivity code instead of the base coder's choice.
+std::vector<uint8_t> encode_file(const Hierarchy& input, const EncodeOptions& options, EncodeStats* stats_out, EncodeMemory memory,
+                                 const BaseMeshCode* given_base = nullptr) {
     EncodeStats stats;
     check_effort(options.effort, "encode");
     const unsigned threads = resolve_thread_count(options.threads);
@@ -358,7 +361,7 @@ std::vector<uint8_t> encode_file(const Hierarchy& input, const EncodeOptions& op
     // is coded from the input read in that order (TurnedRoots): reorder_base's copy was a quarter
     // of a 10^5-face encode. Chunks are cut from the reordered copy, and a numbering is mapped
     // through it; a forest with free ids (none after reading a file) is copied too.
-    const BaseMeshCode base_code = base_code_of(input, space.quantizer, options);
+    const BaseMeshCode base_code = given_base != nullptr ? *given_base : base_code_of(input, space.quantizer, options);
     const bool turned_input = one_chunk && !mixed && options.numbering == nullptr && input.node_count() == input.node_capacity() &&
                               input.vertex_count() == input.positions().size();
     ReorderedInput reordered;  // the whole in base code order, or with turned_input its base alone
@@ -518,10 +521,53 @@ std::vector<uint8_t> encode_file(const Hierarchy& input, const EncodeOptions& op
     return out;
 }
 
+// encode_file(), at effort 3 with the base order chosen (base_order_search.h): the file in the
+// base coder's order first, then in each candidate's; a smaller file replaces it (a tie keeps the
+// earlier). `chosen`, when given, gets the kept base code.
+std::vector<uint8_t> encode_choosing_base(const Hierarchy& input, const EncodeOptions& options, EncodeStats* stats_out,
+                                          EncodeMemory memory, BaseMeshCode* chosen = nullptr) {
+    check_effort(options.effort, "encode");
+    const bool fixed_order = options.keep_base_order || (options.numbering != nullptr && options.store_numbering);
+    if (options.effort < kBaseOrderEffort && chosen == nullptr) return encode_file(input, options, stats_out, memory);
+    EncodeOptions at_two = options;
+    at_two.effort = std::min(options.effort, kMaxGeometryEffort);
+    std::unique_ptr<Quantizer> quantizer;
+    if (options.quantize_bits != 0)
+        quantizer = std::make_unique<Quantizer>(quantizer_of(input, options.quantize_bits, resolve_thread_count(options.threads)));
+    BaseMeshCode own = base_code_of(input, quantizer.get(), at_two);
+    EncodeStats best_stats;
+    std::vector<uint8_t> best = encode_file(input, at_two, stats_out != nullptr ? &best_stats : nullptr, memory, &own);
+    std::vector<BaseMeshCode> candidates;
+    std::vector<size_t> trials;  // candidates coded in full, in the rank of their base blocks' bytes
+    if (options.effort >= kBaseOrderEffort && !fixed_order) {
+        const BaseOrderSearch search = kBaseOrderSearches[options.effort - kBaseOrderEffort];
+        candidates = base_order_candidates(input, quantizer.get(), own, search.starts);
+        std::vector<std::pair<uint64_t, size_t>> ranked;
+        for (size_t c = 0; c < candidates.size(); ++c) ranked.emplace_back(base_blocks_bytes(input, quantizer.get(), candidates[c]), c);
+        std::sort(ranked.begin(), ranked.end());
+        for (size_t k = 0; k < std::min(search.trials, ranked.size()); ++k) trials.push_back(ranked[k].second);
+    }
+    for (const size_t c : trials) {
+        EncodeStats stats;
+        std::vector<uint8_t> file = encode_file(input, at_two, stats_out != nullptr ? &stats : nullptr, memory, &candidates[c]);
+        if (file.size() >= best.size()) continue;
+        best = std::move(file);
+        best_stats = std::move(stats);
+        own = std::move(candidates[c]);
+    }
+    if (stats_out != nullptr) *stats_out = std::move(best_stats);
+    if (chosen != nullptr) *chosen = std::move(own);
+    return best;
+}
+
 }  // namespace
 
 std::vector<uint8_t> encode(const Hierarchy& input, const EncodeOptions& options, EncodeStats* stats_out) {
-    return encode_file(input, options, stats_out, {});
+    return encode_choosing_base(input, options, stats_out, {});
+}
+
+std::vector<uint8_t> encode_with_base(const Hierarchy& h, const EncodeOptions& options, const BaseMeshCode& base, EncodeStats* stats) {
+    return encode_file(h, options, stats, {}, &base);
 }
 
 struct EncodeContext::Kept {
@@ -541,7 +587,7 @@ void EncodeContext::release() {
 
 std::vector<uint8_t> encode(EncodeContext& context, const Hierarchy& h, const EncodeOptions& options, EncodeStats* stats) {
     if (context.kept_ == nullptr) context.kept_ = std::make_unique<EncodeContext::Kept>();  // moved from
-    return encode_file(h, options, stats, {&context.kept_->first_pass, &context.kept_->statics, &context.kept_->chunks});
+    return encode_choosing_base(h, options, stats, {&context.kept_->first_pass, &context.kept_->statics, &context.kept_->chunks});
 }
 
 namespace {
@@ -809,6 +855,11 @@ std::vector<uint32_t> chunks_covering(const FileInfo& info, const std::vector<ui
 }
 
 Hierarchy in_decoder_order(const Hierarchy& h, const EncodeOptions& options) {
+    if (options.effort >= kBaseOrderEffort) {
+        BaseMeshCode chosen;
+        encode_choosing_base(h, options, nullptr, {}, &chosen);
+        return in_base_code_order(h, chosen, false).hierarchy;
+    }
     std::unique_ptr<Quantizer> quantizer;
     if (options.quantize_bits != 0)
         quantizer = std::make_unique<Quantizer>(make_quantizer(live_positions(h), options.quantize_bits));

@@ -32,6 +32,9 @@ namespace amc {
 // else version 4's single try. Throws EncoderGaveUp when the mesh does not fit the mode.
 std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, bool search,
                                        unsigned threads, uint64_t search_budget);
+// The stream from one start (the shortest context set). Throws EncoderGaveUp as above, invalid_input
+// when the start is not one of the mesh's.
+std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, const BaseStart& start);
 
 // Decodes the rest of a mode-2 stream (after the two mode bits) of `size` bytes, reading the
 // positions from `source` as vertices are created. Throws Error.

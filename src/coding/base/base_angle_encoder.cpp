@@ -5,6 +5,7 @@
 #include "coding/base/base_angle_border.h"
 #include "coding/base/base_angle_coder.h"
 #include "coding/base/base_mesh_closing.h"
+#include "common/check.h"
 #include "common/parallel.h"
 
 #include <algorithm>
@@ -405,9 +406,7 @@ private:
 constexpr uint32_t kSearchStarts = 16;                // start triangles spread over the input order
 constexpr uint32_t kSearchRadii[] = {5, 3, 4, 6, 7};  // 5 first: the best single radius
 
-struct Start {
-    uint32_t first, rotation, radius;
-};
+using Start = BaseStart;
 
 // The candidates in the order they are tried, as many as the budget allows (at least one: the
 // first triangle in input order, radius 5).
@@ -436,11 +435,11 @@ uint64_t one_start_search_budget(uint64_t triangles) {
     return uint64_t(angle_mode::kContextSets) * 3 * std::size(kSearchRadii) * triangles;
 }
 
-std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, bool search, unsigned threads,
-                                       uint64_t search_budget) {
-    const ClosedMesh cm = make_closed(mesh);
-    std::vector<Start> candidates = search_candidates(cm.real_triangles, cm.triangles.size(), search_budget);
-    if (!search) candidates.resize(1);
+namespace {
+
+// The shortest stream of the candidates (the earliest among equals) into `code`.
+std::vector<uint8_t> encode_angle_candidates(const TriangleMesh& mesh, const ClosedMesh& cm, BaseMeshCode& code,
+                                             const std::vector<Start>& candidates, unsigned threads) {
     // Every start is coded on its own, in every context set at once, on up to `threads` threads;
     // the shortest (start, set) wins, the earliest among equals, so the choice does not depend on
     // the threads. Only the best so far is kept: holding every candidate's code cost 10 MiB on a
@@ -480,6 +479,22 @@ std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& c
     code.triangle_rotation = std::move(best.code.triangle_rotation);
     code.stencils = std::move(best.code.stencils);
     return best.bytes;
+}
+
+}  // namespace
+
+std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, bool search, unsigned threads,
+                                       uint64_t search_budget) {
+    const ClosedMesh cm = make_closed(mesh);
+    std::vector<Start> candidates = search_candidates(cm.real_triangles, cm.triangles.size(), search_budget);
+    if (!search) candidates.resize(1);
+    return encode_angle_candidates(mesh, cm, code, candidates, threads);
+}
+
+std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, const BaseStart& start) {
+    AMC_REQUIRE(start.radius < 8 && start.rotation < 3 && start.first < mesh.triangles.size(), invalid_input,
+                "base mesh coder: no such start");
+    return encode_angle_candidates(mesh, make_closed(mesh), code, {start}, 1);
 }
 
 }  // namespace amc

@@ -74,13 +74,17 @@ std::vector<BaseStencil> cut_border_stencils(const TriangleMesh& mesh, const Bas
 // Codes with one mode; false when the mode does not fit the mesh. The encoders track what the
 // decoder will do (orders, stencils); tests/base_mesh_coder_test.cpp decodes every mode's
 // streams and compares. Mode 2's search runs on up to `threads` threads.
+// With `start`, mode 2 from there alone.
 bool try_mode(const TriangleMesh& mesh, BaseConnectivityMode mode, BaseMeshCode& code, bool search = true,
-              unsigned threads = 1, uint64_t search_budget = kFullBaseSearch) {
+              unsigned threads = 1, uint64_t search_budget = kFullBaseSearch, const BaseStart* start = nullptr) {
     try {
         code = BaseMeshCode{};
         code.mode = mode;
         switch (mode) {
-            case BaseConnectivityMode::angle: code.bytes = encode_angle_mode(mesh, code, search, threads, search_budget); break;
+            case BaseConnectivityMode::angle:
+                code.bytes = start != nullptr ? encode_angle_mode(mesh, code, *start)
+                                              : encode_angle_mode(mesh, code, search, threads, search_budget);
+                break;
             case BaseConnectivityMode::cut_border: code.bytes = encode_cut_border(mesh, code); break;
             case BaseConnectivityMode::explicit_triangles: code.bytes = encode_explicit(mesh, code); break;
         }
@@ -118,6 +122,14 @@ BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh, BaseConnectivity
     BaseMeshCode code;
     if (!try_mode(mesh, mode, code, search))
         throw Error("base mesh coder: the mesh does not fit mode " + std::to_string(int(mode)));
+    return code;
+}
+
+BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh, const BaseStart& start) {
+    check_encodable(mesh);
+    BaseMeshCode code;
+    if (!try_mode(mesh, BaseConnectivityMode::angle, code, false, 1, 0, &start))
+        throw Error("base mesh coder: the mesh does not fit mode 2 from this start");
     return code;
 }
 

@@ -60,6 +60,16 @@ BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh, unsigned threads
 // with gate radius 5 alone: the stream format version 4's encoder wrote (FORMAT.md 4.16).
 BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh, BaseConnectivityMode mode, bool search = true);
 
+// Where mode 2's conquest starts: the input's triangle `first` from its corner `rotation` (0-2),
+// with gate radius `radius` (0-7). The decoder reads any start alike (FORMAT.md 4.16); the start
+// fixes the decoder's base order, so an encoder may choose it for the rest of the file too
+// (EncodeOptions::effort 3).
+struct BaseStart {
+    uint32_t first = 0, rotation = 0, radius = 5;
+};
+// Mode 2 from `start` alone; throws Error when the mesh does not fit mode 2 from there.
+BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh, const BaseStart& start);
+
 // The decoder's source of base positions: the position of decoder vertex `vertex`, whose
 // stencil is `stencil`, given the positions of vertices 0 .. vertex-1 in `decoded`. Called once
 // per vertex, in order 0, 1, ...; mode 2 calls it while it decodes the connectivity, the other

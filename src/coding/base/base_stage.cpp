@@ -74,6 +74,32 @@ BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const 
     return encode_base_connectivity(base, resolve_thread_count(options.threads), base_search_budget(h));
 }
 
+std::vector<BaseMeshCode> base_order_candidates(const Hierarchy& h, const Quantizer* quantizer, const BaseMeshCode& own,
+                                                uint32_t count) {
+    const TriangleMesh base = base_as_decoded(h, quantizer);
+    const size_t triangles = base.triangles.size();
+    std::vector<BaseMeshCode> out;
+    auto same_order = [](const BaseMeshCode& a, const BaseMeshCode& b) {
+        return a.triangle_order == b.triangle_order && a.triangle_rotation == b.triangle_rotation && a.vertex_order == b.vertex_order;
+    };
+    for (uint32_t k = 0; k < count; ++k) {
+        BaseStart start;
+        start.first = uint32_t(uint64_t{k} * triangles / count);
+        if (k > 0 && start.first == uint32_t(uint64_t{k - 1} * triangles / count)) continue;  // fewer triangles than starts
+        BaseMeshCode code;
+        try {
+            code = encode_base_connectivity(base, start);
+        } catch (const Error&) {  // mode 2 does not fit from there: the other starts may
+            continue;
+        }
+        if (same_order(code, own)) continue;
+        bool seen = false;
+        for (const BaseMeshCode& other : out) seen |= same_order(code, other);
+        if (!seen) out.push_back(std::move(code));
+    }
+    return out;
+}
+
 bool keeps_rotations(const DiagonalExceptions& rotated, const DiagonalExceptions& unrotated, size_t triangles) {
     if (rotated.fewest() == 0) return false;
     const double rotated_bits = binary_entropy_bits(rotated.fewest(), rotated.leaves);
@@ -111,8 +137,12 @@ ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& ba
     return r;
 }
 
-RawSideCode encode_base_geometry(const Hierarchy& h, const BaseMeshCode& base_code, bool keep_rotations, PositionCoder& positions,
-                                 bool raw_side) {
+namespace {
+
+// The base geometry block of `base_vertices` positions, decoder vertex i at position_of(i).
+template <class PositionOf>
+RawSideCode base_geometry_code(size_t base_vertices, PositionOf&& position_of, const BaseMeshCode& base_code, bool keep_rotations,
+                               PositionCoder& positions, bool raw_side) {
     ArithmeticEncoder encoder;
     if (keep_rotations) {
         RotationModels models;
@@ -120,15 +150,32 @@ RawSideCode encode_base_geometry(const Hierarchy& h, const BaseMeshCode& base_co
     }
     RawBitWriter raw;
     std::vector<Vec3> decoded;
-    const size_t base_vertices = h.base().positions.size();
     decoded.reserve(base_vertices);
     for (uint32_t i = 0; i < base_vertices; ++i) {
-        const Vec3 p = h.position(i);
+        const Vec3 p = position_of(i);
         positions.encode(encoder, kBaseGeometryContext, p, predict_parallelogram(decoded, base_code.stencils[i]),
                          raw_side ? &raw : nullptr);
         decoded.push_back(p);
     }
     return RawSideCode{encoder.finish(), raw.finish()};
+}
+
+}  // namespace
+
+RawSideCode encode_base_geometry(const Hierarchy& h, const BaseMeshCode& base_code, bool keep_rotations, PositionCoder& positions,
+                                 bool raw_side) {
+    return base_geometry_code(
+        h.base().positions.size(), [&h](uint32_t i) { return h.position(i); }, base_code, keep_rotations, positions, raw_side);
+}
+
+uint64_t base_blocks_bytes(const Hierarchy& h, const Quantizer* quantizer, const BaseMeshCode& base_code) {
+    const TriangleMesh base = base_as_decoded(h, quantizer);
+    const bool quantized = quantizer != nullptr;
+    PositionCoder positions(CoordinateSpace{h.single_precision() && !quantized ? Precision::float32 : Precision::float64, quantizer});
+    const RawSideCode code = base_geometry_code(
+        base.positions.size(), [&](uint32_t i) { return base.positions[base_code.vertex_order[i]]; }, base_code, false, positions,
+        !quantized);
+    return base_code.bytes.size() + (quantized ? code.arithmetic.size() : code.joined().size());
 }
 
 TriangleMesh decode_base(const Block& connectivity, const Block& geometry, const Metadata& meta, uint8_t file_version,

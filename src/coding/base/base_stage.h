@@ -24,6 +24,12 @@ uint64_t base_search_budget(const Hierarchy& h);
 // grid when `quantizer` is set).
 BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const EncodeOptions& options);
 
+// Other orders of the base of `h` (EncodeOptions::effort 3): mode 2's codes from `count` start
+// triangles spread over it (its first corner, gate radius 5), those whose order differs from
+// `own`'s and from each other's, in start order. Quantized files pass their grid (`quantizer`).
+std::vector<BaseMeshCode> base_order_candidates(const Hierarchy& h, const Quantizer* quantizer, const BaseMeshCode& own,
+                                                uint32_t count);
+
 // The base coder may rotate each triangle's vertices. The default diagonal rule does not care, but
 // hierarchies made under a rule of absolute local indices would pay orientation bits: then storing
 // each root's rotation (log2 3 bits) to keep the input's local order may be cheaper. Both readings
@@ -54,6 +60,11 @@ ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& ba
 // (version 21: RawSideCode::joined() is the block), else in the code (the block is `arithmetic`).
 RawSideCode encode_base_geometry(const Hierarchy& h, const BaseMeshCode& base_code, bool keep_rotations, PositionCoder& positions,
                                  bool raw_side);
+
+// The payloads of the base connectivity and base geometry blocks of a file of h coded over
+// `base_code` (the roots in the base coder's rotations; a bit-exact file's raw bits apart, as version
+// 21's): how an effort-3 encode ranks orders before coding the rest (base_order_search.h).
+uint64_t base_blocks_bytes(const Hierarchy& h, const Quantizer* quantizer, const BaseMeshCode& base_code);
 
 // Decodes the base mesh from its two blocks of a file of `file_version`, checked against the
 // metadata; the result is a valid triangle mesh. Throws Error on a corrupt or truncated block.

@@ -61,7 +61,7 @@ private:
 // when given (one thread at a time).
 ChunkCode encode_chunk(const Hierarchy& chunk, const VertexKeys& keys, const Seam& seam, const HierarchyCoderOptions& options,
                        GeometryPredictor predictor, CoordinateSpace space, bool grid_contexts = false,
-                       bool unit_normals = false, int effort = kMaxEffort, ChunkEncoderMemory* memory = nullptr);
+                       bool unit_normals = false, int effort = kMaxGeometryEffort, ChunkEncoderMemory* memory = nullptr);
 
 struct ChunkDecodeLimits {
     uint64_t max_nodes = 0;     // the chunk's node count from the chunk table (within the caller's limit)

@@ -19,7 +19,7 @@ namespace amc {
 
 namespace {
 
-// Effort below kMaxEffort, on levels of kSampleShare * kMinSample new vertices or more: the
+// Effort below kMaxGeometryEffort, on levels of kSampleShare * kMinSample new vertices or more: the
 // static modes are weighed on the first 1/kSampleShare of the level, and only those whose bound
 // projected to the level is within kStaticMargin of the smallest are made for the whole level (the
 // sample's own bounds favoured mode 3: its three tables against mode 4's six); an adaptive trial is
@@ -289,7 +289,7 @@ LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& create
     // static midpoint, static butterfly, as if every mode were coded to its end. The static modes
     // come first, each coded only when its lower bound leaves it a chance (smallest bound first), so
     // that an adaptive trial stops as soon as its code so far shows it can not be the smallest.
-    const size_t sample = effort >= kMaxEffort || created.size() / kSampleShare < kMinSample ? SIZE_MAX : created.size() / kSampleShare;
+    const size_t sample = effort >= kMaxGeometryEffort || created.size() / kSampleShare < kMinSample ? SIZE_MAX : created.size() / kSampleShare;
     const bool exact = space.quantizer == nullptr;
     bool candidate[kStaticCandidates] = {true, grid_contexts && !exact, unit_normals && exact, exact, exact};
     std::unique_ptr<StaticLevelEncoder> on_sample[kStaticCandidates];

@@ -52,7 +52,7 @@ struct LevelGeometryCode {
 // them): `choice`, or when it is automatic the one that codes the level in the fewest bytes, each
 // adaptive predictor tried on a copy of `positions`' models; mode 4 is a candidate only with
 // grid_contexts in a quantized space, mode 5 only with unit_normals in a bit-exact one. Below
-// kMaxEffort an adaptive predictor may be judged from a sample (EncodeOptions::effort). Mode 4's
+// kMaxGeometryEffort an adaptive predictor may be judged from a sample (EncodeOptions::effort). Mode 4's
 // tokens go in `grid_order` (grouped: a version-18 file; per_vertex: versions 9-17). The static
 // modes' encoders work in `buffers` when given (StaticEncoderBuffers). With `level_code`, the level
 // block's arithmetic code after its hierarchy part, a winning adaptive trial that coded the whole
@@ -61,7 +61,7 @@ struct LevelGeometryCode {
 template <class Mesh>
 LevelGeometryCode choose_level_geometry(const Mesh& h, const NewVertices& created, const PositionCoder& positions,
                                         CoordinateSpace space, GeometryPredictor choice, bool grid_contexts = false,
-                                        bool unit_normals = false, int effort = kMaxEffort,
+                                        bool unit_normals = false, int effort = kMaxGeometryEffort,
                                         StaticOrder grid_order = StaticOrder::grouped, StaticEncoderBuffers* buffers = nullptr,
                                         const ArithmeticEncoder* level_code = nullptr);
 
