@@ -2043,38 +2043,38 @@ struct QuadRoles {
 };
 
 // set_grid_frame_pair for four vertices: set_axis by lane masks, role 0's grid predictions in two
-// pairs; with `roles`, the frames by role instead of the midpoints and normals in `g`. Without
-// `Grid`, the frames alone (set_frame's).
+// pairs. Without `Grid`, the frames alone (set_frame's).
 template <bool Grid = true>
-inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, const double* origin, GridFrame* g,
-                                QuadRoles* roles = nullptr) {
-    if (roles == nullptr) {
-        store_quad(l.mx, &GridFrame::midpoint, 0, g);
-        store_quad(l.my, &GridFrame::midpoint, 1, g);
-        store_quad(l.mz, &GridFrame::midpoint, 2, g);
-        store_quad(l.nx, &GridFrame::normal, 0, g);
-        store_quad(l.ny, &GridFrame::normal, 1, g);
-        store_quad(l.nz, &GridFrame::normal, 2, g);
-    }
+inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, const double* origin, GridFrame* g) {
+    store_quad(l.mx, &GridFrame::midpoint, 0, g);
+    store_quad(l.my, &GridFrame::midpoint, 1, g);
+    store_quad(l.mz, &GridFrame::midpoint, 2, g);
+    store_quad(l.nx, &GridFrame::normal, 0, g);
+    store_quad(l.ny, &GridFrame::normal, 1, g);
+    store_quad(l.nz, &GridFrame::normal, 2, g);
     const __m256d sign = _mm256_set1_pd(-0.0);
     const __m256d x = _mm256_andnot_pd(sign, l.nx), y = _mm256_andnot_pd(sign, l.ny), z = _mm256_andnot_pd(sign, l.nz);
     const __m256d y_wins = _mm256_cmp_pd(y, x, _CMP_GT_OS);
     const __m256d best = _mm256_max_pd(y, x);
     const __m256d z_wins = _mm256_cmp_pd(z, best, _CMP_GT_OS);
     const __m256d largest = _mm256_max_pd(z, best);
-    const int has = _mm256_movemask_pd(_mm256_and_pd(_mm256_cmp_pd(largest, _mm256_setzero_pd(), _CMP_GT_OS),
-                                                     _mm256_cmp_pd(largest, _mm256_set1_pd(HUGE_VAL), _CMP_LT_OS)));
-    const int ys = _mm256_movemask_pd(y_wins), zs = _mm256_movemask_pd(z_wins);
+    const __m256d with_normal = _mm256_and_pd(_mm256_cmp_pd(largest, _mm256_setzero_pd(), _CMP_GT_OS),
+                                              _mm256_cmp_pd(largest, _mm256_set1_pd(HUGE_VAL), _CMP_LT_OS));
+    const __m256d on_z = _mm256_and_pd(with_normal, z_wins), on_y = _mm256_andnot_pd(z_wins, _mm256_and_pd(with_normal, y_wins));
+    // The axes made in the lanes (2 on z, 1 on y, else 0), as set_grid_roles_quad makes them.
+    alignas(16) int32_t axes[4];
+    const __m256i axis = _mm256_or_si256(_mm256_and_si256(_mm256_castpd_si256(on_y), _mm256_set1_epi64x(1)),
+                                         _mm256_and_si256(_mm256_castpd_si256(on_z), _mm256_set1_epi64x(2)));
+    _mm_store_si128(reinterpret_cast<__m128i*>(axes),
+                    _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(axis, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0))));
+    const int has = _mm256_movemask_pd(with_normal);
     for (int j = 0; j < 4; ++j) {
         g[j].has_normal = ((has >> j) & 1) != 0;
-        g[j].axis = (has >> j) & 1 ? ((zs >> j) & 1 ? 2 : (ys >> j) & 1) : 0;
+        g[j].axis = axes[j];
     }
     if (!Grid) return;
     // Role 0's grid predictions (grid_point_pair's, four lanes): each lane's coordinate and origin
     // on its axis chosen by the same masks.
-    const __m256d with_normal = _mm256_castsi256_pd(_mm256_set_epi64x(-int64_t((has >> 3) & 1), -int64_t((has >> 2) & 1),
-                                                                      -int64_t((has >> 1) & 1), -int64_t(has & 1)));
-    const __m256d on_z = _mm256_and_pd(with_normal, z_wins), on_y = _mm256_andnot_pd(z_wins, _mm256_and_pd(with_normal, y_wins));
     const __m256d value = _mm256_blendv_pd(_mm256_blendv_pd(l.mx, l.my, on_y), l.mz, on_z);
     const __m256d from = _mm256_blendv_pd(_mm256_blendv_pd(_mm256_set1_pd(origin[0]), _mm256_set1_pd(origin[1]), on_y),
                                           _mm256_set1_pd(origin[2]), on_z);
@@ -2082,7 +2082,46 @@ inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, 
     int64_t turns[4];
     grid_point_quad(value, from, grid, points, offsets, turns);
     for (int j = 0; j < 4; ++j) g[j].first = {points[j], offsets[j], turns[j]};
-    if (roles == nullptr) return;
+}
+
+// Role 0's grid predictions and the frame's axes of a chunk's vertices, by vertex: the grouped
+// order's decoder reads them so (QuadFrames), where the GridFrame of each took a lane's fields one
+// at a time.
+struct FirstRoles {
+    alignas(32) uint64_t point[kChunk], offset[kChunk];
+    alignas(32) int64_t turn[kChunk];
+    alignas(16) int32_t axis[kChunk];
+    void set(size_t k, const GridFrame& f) {
+        point[k] = f.first.point;
+        offset[k] = f.first.table_offset;
+        turn[k] = f.first.turn_mask;
+        axis[k] = f.axis;
+    }
+};
+
+// set_grid_frame_quad for the grouped order's decoder: vertices k .. k + 3's frames by role in
+// `roles`, their role-0 grid predictions and axes in `first`, each made in the lanes and stored
+// whole (the same values).
+inline void set_grid_roles_quad(const FrameQuadLanes& l, const GridScale& grid, const double* origin, QuadRoles& roles,
+                                FirstRoles& first, size_t k) {
+    const __m256d sign = _mm256_set1_pd(-0.0);
+    const __m256d x = _mm256_andnot_pd(sign, l.nx), y = _mm256_andnot_pd(sign, l.ny), z = _mm256_andnot_pd(sign, l.nz);
+    const __m256d y_wins = _mm256_cmp_pd(y, x, _CMP_GT_OS);
+    const __m256d best = _mm256_max_pd(y, x);
+    const __m256d z_wins = _mm256_cmp_pd(z, best, _CMP_GT_OS);
+    const __m256d largest = _mm256_max_pd(z, best);
+    const __m256d with_normal = _mm256_and_pd(_mm256_cmp_pd(largest, _mm256_setzero_pd(), _CMP_GT_OS),
+                                              _mm256_cmp_pd(largest, _mm256_set1_pd(HUGE_VAL), _CMP_LT_OS));
+    const __m256d on_z = _mm256_and_pd(with_normal, z_wins), on_y = _mm256_andnot_pd(z_wins, _mm256_and_pd(with_normal, y_wins));
+    // The axis: 2 on z, 1 on y, else 0 (set_frame's; 0 without a normal), as four int32.
+    const __m256i axis = _mm256_or_si256(_mm256_and_si256(_mm256_castpd_si256(on_y), _mm256_set1_epi64x(1)),
+                                         _mm256_and_si256(_mm256_castpd_si256(on_z), _mm256_set1_epi64x(2)));
+    _mm_store_si128(reinterpret_cast<__m128i*>(first.axis + k),
+                    _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(axis, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0))));
+    const __m256d value = _mm256_blendv_pd(_mm256_blendv_pd(l.mx, l.my, on_y), l.mz, on_z);
+    const __m256d from = _mm256_blendv_pd(_mm256_blendv_pd(_mm256_set1_pd(origin[0]), _mm256_set1_pd(origin[1]), on_y),
+                                          _mm256_set1_pd(origin[2]), on_z);
+    grid_point_quad(value, from, grid, first.point + k, first.offset + k, first.turn + k);
     // Role 1's axis is 1 where the frame's is 0 (and without a normal), else 0; role 2's is 1 where
     // the frame's is 2, else 2.
     const __m256d on_x = _mm256_andnot_pd(_mm256_or_pd(on_y, on_z), _mm256_castsi256_pd(_mm256_set1_epi64x(-1)));
@@ -2091,10 +2130,10 @@ inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, 
         role[1] = _mm256_blendv_pd(x, y, on_x);
         role[2] = _mm256_blendv_pd(z, y, on_z);
     };
-    by_role(l.mx, l.my, l.mz, roles->midpoint);
-    by_role(l.nx, l.ny, l.nz, roles->normal);
-    by_role(_mm256_set1_pd(origin[0]), _mm256_set1_pd(origin[1]), _mm256_set1_pd(origin[2]), roles->origin);
-    roles->with_normal = with_normal;
+    by_role(l.mx, l.my, l.mz, roles.midpoint);
+    by_role(l.nx, l.ny, l.nz, roles.normal);
+    by_role(_mm256_set1_pd(origin[0]), _mm256_set1_pd(origin[1]), _mm256_set1_pd(origin[2]), roles.origin);
+    roles.with_normal = with_normal;
 }
 
 // decode_grid_grouped with roles 1 and 2's predictions made four vertices at a time from `roles`
@@ -2102,20 +2141,22 @@ inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, 
 // lanes (no fused multiply-add), so the same predictions; the vertices past the last whole four
 // (a level's last chunk) one at a time, as decode_grid_grouped.
 template <bool Safe>
-inline bool decode_grid_grouped_quads(StencilStreams& s, const GridTable* t, const GridFrame* frames, const QuadRoles* roles,
-                                      size_t count, const GridScale& level_grid, const double* origin, Coordinates* decoded) {
+inline bool decode_grid_grouped_quads(StencilStreams& s, const GridTable* t, const GridFrame* frames, const FirstRoles& firsts,
+                                      const QuadRoles* roles, size_t count, const GridScale& level_grid, const double* origin,
+                                      Coordinates* decoded) {
     const GridScale grid = level_grid;  // a local copy: the stores to `decoded` could alias the caller's
     alignas(32) uint64_t point1[kChunk], point2[kChunk], offset1[kChunk], offset2[kChunk];
     alignas(32) int64_t turn1[kChunk], turn2[kChunk];
+    alignas(32) double first_values[kChunk];  // the whole fours' role-0 coordinates
     uint64_t largest = 0;  // of the role-0 grid values as unsigned, where a negative one is above any
     auto token = [&](auto state, size_t k) {
         constexpr int State = decltype(state)::value;
-        const GridFrame& f = frames[k];
-        const int64_t q0 = grid_point_value<State, Safe>(s, t, f.first.point, f.first.table_offset, f.first.turn_mask);
+        const int64_t q0 = grid_point_value<State, Safe>(s, t, firsts.point[k], firsts.offset[k], firsts.turn[k]);
         largest = std::max(largest, uint64_t(q0));
         return q0;
     };
     const __m256d step = _mm256_set1_pd(grid.step);
+    const size_t fours = count / 4 * 4;
     size_t k = 0;
     for (; k + 3 < count; k += 4) {
         const int64_t q0 = token(std::integral_constant<int, 0>{}, k), q1 = token(std::integral_constant<int, 1>{}, k + 1),
@@ -2125,9 +2166,7 @@ inline bool decode_grid_grouped_quads(StencilStreams& s, const GridTable* t, con
         const __m256d q = _mm256_cvtepi32_pd(_mm_setr_epi32(int(q0), int(q1), int(q2), int(q3)));
         const QuadRoles& r = roles[k / 4];
         const __m256d value = _mm256_add_pd(r.origin[0], rounded(_mm256_mul_pd(q, step)));
-        alignas(32) double values[4];
-        _mm256_store_pd(values, value);
-        for (int j = 0; j < 4; ++j) decoded[k + size_t(j)][frames[k + size_t(j)].axis] = values[j];
+        _mm256_store_pd(first_values + k, value);
         const __m256d u = rounded(_mm256_div_pd(_mm256_sub_pd(value, r.midpoint[0]), r.normal[0]));
         const __m256d second = _mm256_blendv_pd(r.midpoint[1], _mm256_add_pd(r.midpoint[1], rounded(_mm256_mul_pd(u, r.normal[1]))),
                                                 r.with_normal);
@@ -2148,36 +2187,81 @@ inline bool decode_grid_grouped_quads(StencilStreams& s, const GridTable* t, con
         turn2[k] = g.turn_mask[1];
     }
     if (largest > grid.max) return false;  // also a q0 < 0
+    // Roles 1 and 2's grid values, then the coordinates: the whole fours' in the lanes (the same
+    // operations as set_other_roles), each lane's roles put on their axes and stored as x, y, z.
+    alignas(16) int32_t second_points[kChunk], third_points[kChunk];
+    uint64_t others = 0;  // the largest of roles 1 and 2's grid values as unsigned
     auto roles_1_2 = [&](auto odd) {
         constexpr int S = decltype(odd)::value ? 1 : 0;  // role 1's state: count mod 2
         for (size_t i = 0; i < count; ++i) {
             const int64_t v1 = grid_point_value<S, Safe>(s, t + kGridBins, point1[i], offset1[i], turn1[i]);
             const int64_t v2 = grid_point_value<1 - S, Safe>(s, t + 2 * kGridBins, point2[i], offset2[i], turn2[i]);
-            if ((uint64_t(v1) > grid.max) | (uint64_t(v2) > grid.max)) return false;
-            const int a0 = frames[i].axis;
-            set_other_roles(v1, v2, grid, origin, a0 == 0 ? 1 : 0, a0 == 2 ? 1 : 2, decoded[i]);
+            others = std::max(others, std::max(uint64_t(v1), uint64_t(v2)));
+            second_points[i] = int32_t(v1);  // below 2^30 where valid; an invalid one fails below
+            third_points[i] = int32_t(v2);
         }
-        return true;
     };
-    return count % 2 == 0 ? roles_1_2(std::false_type{}) : roles_1_2(std::true_type{});
+    if (count % 2 == 0) roles_1_2(std::false_type{});
+    else roles_1_2(std::true_type{});
+    if (others > grid.max) return false;
+    for (size_t i = 0; i < fours; i += 4) {
+        const QuadRoles& r = roles[i / 4];
+        const __m256d first = _mm256_load_pd(first_values + i);
+        const __m256d second = _mm256_add_pd(
+            r.origin[1], rounded(_mm256_mul_pd(_mm256_cvtepi32_pd(_mm_load_si128(reinterpret_cast<const __m128i*>(second_points + i))), step)));
+        const __m256d third = _mm256_add_pd(
+            r.origin[2], rounded(_mm256_mul_pd(_mm256_cvtepi32_pd(_mm_load_si128(reinterpret_cast<const __m128i*>(third_points + i))), step)));
+        // Role 0 on the frame's axis; role 1 on x, or on y where the axis is x; role 2 on z, or on
+        // y where the axis is z.
+        const __m256i axis = _mm256_cvtepi32_epi64(_mm_load_si128(reinterpret_cast<const __m128i*>(firsts.axis + i)));
+        const __m256d on_x = _mm256_castsi256_pd(_mm256_cmpeq_epi64(axis, _mm256_setzero_si256()));
+        const __m256d on_y = _mm256_castsi256_pd(_mm256_cmpeq_epi64(axis, _mm256_set1_epi64x(1)));
+        const __m256d on_z = _mm256_castsi256_pd(_mm256_cmpeq_epi64(axis, _mm256_set1_epi64x(2)));
+        const __m256d x = _mm256_blendv_pd(second, first, on_x);
+        const __m256d y = _mm256_blendv_pd(_mm256_blendv_pd(third, first, on_y), second, on_x);
+        const __m256d z = _mm256_blendv_pd(third, first, on_z);
+        const __m256d xy02 = _mm256_unpacklo_pd(x, y), xy13 = _mm256_unpackhi_pd(x, y);  // (x0 y0 x2 y2), (x1 y1 x3 y3)
+        const __m128d z01 = _mm256_castpd256_pd128(z), z23 = _mm256_extractf128_pd(z, 1);
+        double* p = decoded[i];
+        _mm_storeu_pd(p, _mm256_castpd256_pd128(xy02));
+        _mm_storel_pd(p + 2, z01);
+        _mm_storeu_pd(p + 3, _mm256_castpd256_pd128(xy13));
+        _mm_storeh_pd(p + 5, z01);
+        _mm_storeu_pd(p + 6, _mm256_extractf128_pd(xy02, 1));
+        _mm_storel_pd(p + 8, z23);
+        _mm_storeu_pd(p + 9, _mm256_extractf128_pd(xy13, 1));
+        _mm_storeh_pd(p + 11, z23);
+    }
+    for (size_t i = fours; i < count; ++i) {  // role 0 is on its axis already (grid_first_role)
+        const int a0 = firsts.axis[i];
+        set_other_roles(second_points[i], third_points[i], grid, origin, a0 == 0 ? 1 : 0, a0 == 2 ? 1 : 2, decoded[i]);
+    }
+    return true;
 }
 
 // PairFrames four at a time; for the grouped order (by_role), each whole four's frames by role
-// for decode_grid_grouped_quads.
+// and role 0's predictions by vertex for decode_grid_grouped_quads (the last few of a level's
+// last chunk as GridFrames, their role 0 copied).
 struct QuadFrames {
     bool by_role;
     QuadRoles roles[kChunk / 4];
+    FirstRoles firsts;
     void operator()(const Hierarchy& h, const FrameCorners* corners, size_t count, const GridScale& grid, const double* origin,
                     GridFrame* frames) {
         size_t i = 0;
-        for (; i + 3 < count; i += 4)
-            set_grid_frame_quad(frame_quad_lanes(h, corners + i), grid, origin, frames + i, by_role ? roles + i / 4 : nullptr);
+        if (by_role) {
+            for (; i + 3 < count; i += 4) set_grid_roles_quad(frame_quad_lanes(h, corners + i), grid, origin, roles[i / 4], firsts, i);
+            PairFrames()(h, corners + i, count - i, grid, origin, frames + i);
+            for (; i < count; ++i) firsts.set(i, frames[i]);
+            return;
+        }
+        for (; i + 3 < count; i += 4) set_grid_frame_quad(frame_quad_lanes(h, corners + i), grid, origin, frames + i);
         PairFrames()(h, corners + i, count - i, grid, origin, frames + i);
     }
     template <bool Safe>
     bool grouped(StencilStreams& s, const GridTable* t, const GridFrame* frames, size_t count, const GridScale& grid,
                  const double* origin, Coordinates* decoded) const {
-        return decode_grid_grouped_quads<Safe>(s, t, frames, roles, count, grid, origin, decoded);
+        return decode_grid_grouped_quads<Safe>(s, t, frames, firsts, roles, count, grid, origin, decoded);
     }
 };
 
