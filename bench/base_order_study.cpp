@@ -4,6 +4,7 @@
 // mode's file in the same order, and the base blocks' bytes (base_blocks_bytes: what efforts 3 and
 // 4 rank the orders by).
 //   base_order_study model.amh [starts, default 16] [mixed|paper, default mixed] [quantize bits, default 0]
+//                    [starts|rotations|radii, default starts]
 #include "coding/base/base_stage.h"
 #include "coding/base_order_search.h"
 #include "coding/geometry/float_coder.h"
@@ -14,6 +15,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <string>
 #include <vector>
 
 using namespace amc;
@@ -48,6 +50,26 @@ int main(int argc, char** argv) {
     };
     const BaseMeshCode own = base_code_of(h, q, options);
     if (row("own", own) != reference) std::printf("(own order's file differs from encode()'s)\n");
+    // `rotations` / `radii` (bit-exact only): each start also from its other corners / with gate
+    // radii 3, 4, 6 and 7, the base coder's other candidates, not deduplicated.
+    const std::string kind = argc > 5 ? argv[5] : "starts";
+    if (kind == "rotations" || kind == "radii") {
+        const size_t n = h.base().triangles.size();
+        for (uint32_t k = 0; k < starts; ++k)
+            for (const uint32_t variant : kind == "rotations" ? std::vector<uint32_t>{0, 1, 2} : std::vector<uint32_t>{5, 3, 4, 6, 7}) {
+                BaseStart start;
+                start.first = uint32_t(uint64_t{k} * n / starts);
+                (kind == "rotations" ? start.rotation : start.radius) = variant;
+                char name[48];
+                std::snprintf(name, sizeof name, "start%u.%s%u", k, kind == "rotations" ? "rotation" : "radius", variant);
+                try {
+                    row(name, encode_base_connectivity(h.base(), start));
+                } catch (const Error&) {
+                    std::printf("%s does not fit mode 2\n", name);
+                }
+            }
+        return 0;
+    }
     int k = 0;
     for (const BaseMeshCode& code : base_order_candidates(h, q, own, starts)) {
         char name[32];

@@ -1,14 +1,15 @@
 #!/bin/sh
 # .amc sizes at each encode effort (docs/CODEC.md, "Encode effort"): every model encoded by the amc
-# binary AMC with --quantize BITS (0: bit-exact) at each effort from the highest down to 0; one
-# Markdown row per model with the exact file sizes and each size over the highest effort's.
-#   scripts/effort_table.sh AMC BITS corpus/*.amh
+# binary AMC with --quantize BITS (0: bit-exact) at each effort from TOP (default: the highest
+# `amc encode --help` offers) down to 0; one Markdown row per model with the exact file sizes and
+# each size over effort TOP's.
+#   [TOP=2] scripts/effort_table.sh AMC BITS corpus/*.amh
 set -eu
 amc=$1 bits=$2
 shift 2
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-max=$("$amc" encode --help | sed -n 's/.*--effort INT:INT in \[0 - \([0-9]*\)\].*/\1/p' | head -n 1)
+max=${TOP:-$("$amc" encode --help | sed -n 's/.*--effort INT:INT in \[0 - \([0-9]*\)\].*/\1/p' | head -n 1)}
 max=${max:-2}
 printf '| model | bits |'
 e=$max

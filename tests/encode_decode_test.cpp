@@ -6,6 +6,7 @@
 #include "coding/base/base_stage.h"
 #include "coding/hierarchy/coder_switches.h"
 #include "coding/geometry/float_coder.h"
+#include "common/exact_float.h"
 #include "hierarchy_checks.h"
 
 #include <amc/codec.h>
@@ -317,6 +318,34 @@ TEST(EncodeDecode, TheFirstBadPositionIsNamedOnAnyThreads) {
         EncodeOptions options;
         options.threads = threads;
         EXPECT_EQ(encode_error(h, options), "encode: vertex 70000 has a non-finite coordinate") << threads << " threads";
+    }
+}
+
+// The writer's float32 test passes coordinates that are zero or normal float32 values in one
+// integer pass and tests the others exactly: values on both sides of each of its bounds.
+TEST(EncodeDecode, SinglePrecisionPositionsAreTestedExactlyAtTheFloatBounds) {
+    Hierarchy h(make_icosahedron());
+    refine_uniformly(h, 1);
+    for (VertexId v = 0; v < h.positions().size(); ++v) {
+        const Vec3 p = h.position(v);
+        h.set_position(v, {rounded_to_float(p.x), rounded_to_float(p.y), rounded_to_float(p.z)});
+    }
+    h.set_single_precision(true);
+    ASSERT_EQ(encode_error(h), "");
+    const double floats[] = {0.0, -0.0, FLT_MAX, -FLT_MAX, FLT_MIN, -FLT_MIN, std::ldexp(1.0, -127), std::ldexp(3.0, -149),
+                             FLT_TRUE_MIN, std::ldexp(1.0 + std::ldexp(1.0, -23), 5), std::ldexp(1.0, 127)};
+    const double others[] = {std::ldexp(1.0, 128), std::nextafter(double(FLT_MAX), 1e300), std::ldexp(1.0, -150),
+                             std::ldexp(1.0 + std::ldexp(1.0, -24), 5), std::ldexp(1.0 + std::ldexp(1.0, -20), -140),
+                             std::ldexp(1.0, -1074), 1e300, std::nextafter(0.5, 1.0)};
+    for (const double x : floats) {
+        Hierarchy with = h;
+        with.set_position(7, {0.5, x, 0.25});
+        EXPECT_EQ(encode_error(with), "") << x;
+    }
+    for (const double x : others) {
+        Hierarchy with = h;
+        with.set_position(7, {0.5, x, 0.25});
+        EXPECT_NE(encode_error(with).find("is not a float32 value"), std::string::npos) << x;
     }
 }
 

@@ -12,6 +12,8 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <sstream>
 
 namespace amc {
@@ -147,10 +149,35 @@ std::string check_position_range(const Hierarchy& h, const std::vector<uint32_t>
 // Whether every coordinate of vertices [begin, end) passes check_position_range's tests: one pass
 // without branches or messages (every encode checks its whole input), the messages only for a
 // range that fails. Out-of-range values are not converted to float (a select, not a branch).
+// Whether every coordinate (the bits of `coordinates` doubles at `bytes`) is zero or a normal
+// float32 value: at most 23 fraction bits and an exponent of -126 to 127. Integer operations
+// only (the differences' sign bits), over the coordinates as one array, which GCC vectorises.
+bool zero_or_normal_floats(const unsigned char* bytes, size_t coordinates) {
+    uint64_t failed = 0;
+    for (size_t k = 0; k < coordinates; ++k) {
+        uint64_t x;
+        std::memcpy(&x, bytes + 8 * k, 8);
+        const uint64_t exponent = (x >> 52) & 0x7FF;
+        const uint64_t out_of_range = ((exponent - 897) | (1150 - exponent)) >> 63;  // float32's -126..127
+        const uint64_t magnitude = x << 1;
+        const uint64_t nonzero = (magnitude | (0 - magnitude)) >> 63;
+        const uint64_t fraction_below_float = ((x & 0x1FFFFFFF) + 0x1FFFFFFF) >> 29;  // any of the 29 low bits
+        failed |= (out_of_range & nonzero) | fraction_below_float;
+    }
+    return failed == 0;
+}
+
+// Whether every coordinate of vertices [begin, end) passes check_position_range's tests: one pass
+// without branches or messages (every encode checks its whole input), the messages only for a
+// range that fails. Out-of-range values are not converted to float (a select, not a branch).
 bool positions_pass(const Hierarchy& h, VertexId begin, VertexId end) {
+    static_assert(sizeof(Vec3) == 3 * sizeof(double), "a position is three coordinates");
     const Vec3* positions = h.positions().data();
-    bool bad = false;
+    const unsigned char* bytes = reinterpret_cast<const unsigned char*>(positions + begin);
+    const size_t coordinates = 3 * size_t(end - begin);
     if (h.single_precision()) {
+        if (zero_or_normal_floats(bytes, coordinates)) return true;
+        bool bad = false;  // subnormal float32 values, or a failure: the exact tests
         for (VertexId v = begin; v < end; ++v) {
             for (const double x : {positions[v].x, positions[v].y, positions[v].z}) {
                 const bool in_range = std::fabs(x) <= FLT_MAX;  // false for NaN too
@@ -158,11 +185,19 @@ bool positions_pass(const Hierarchy& h, VertexId begin, VertexId end) {
                 bad |= !in_range | (rounded_to_float(y) != y);
             }
         }
-    } else {
-        for (VertexId v = begin; v < end; ++v)
-            for (const double x : {positions[v].x, positions[v].y, positions[v].z}) bad |= !(std::fabs(x) <= DBL_MAX);
+        return !bad;
     }
-    return !bad;
+    // A coordinate is not finite when its exponent bits are all set: adding one to the exponent
+    // then carries into the sign bit. Integer ORs over the coordinates as one array, which GCC
+    // vectorises (the compares were not).
+    constexpr uint64_t kExponent = 0x7FF0000000000000ull, kExponentOne = 0x0010000000000000ull;
+    uint64_t carries = 0;
+    for (size_t k = 0; k < coordinates; ++k) {
+        uint64_t x;
+        std::memcpy(&x, bytes + 8 * k, 8);
+        carries |= (x & kExponent) + kExponentOne;
+    }
+    return (carries >> 63) == 0;
 }
 
 // Ranges of vertices checked on `threads` threads; the first problem in vertex order is reported.

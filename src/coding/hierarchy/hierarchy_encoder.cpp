@@ -129,27 +129,46 @@ HierarchyLevelEncoder::HierarchyLevelEncoder(const Hierarchy& h, const Hierarchy
         if (options.cull_one_regularity && !uniform) stats.culled_one_regularity += level.incomplete_count;
         const uint8_t* truth = refined.data();
         if (mixed_) shapes.start_level(n);
-        traversal.run(
-            level, uniform,
-            [&](uint32_t i, int group) {
-                const bool r = (truth[i] & 1) != 0;
-                if (mixed_) {
-                    if (event_feature_.size() < events_.size() + 1) event_feature_.resize(events_.size() + 1);
-                    event_feature_[events_.size()] = uint32_t(mixed_features_.size());
-                    mixed_features_.push_back(mixed_features(h, ids[i], level, i, group, shapes, kWrittenMixingModel, older_models_));
-                }
-                events_.push_back({uint8_t(group), uint8_t(r)});
-                if (trace != nullptr) trace->push_back({ids[i], uint8_t(group), r});
-                return r;
-            },
-            [&](uint32_t i, Fate fate, bool) {
-                switch (fate) {
-                    case Fate::uniform: ++stats.culled_uniform; break;
-                    case Fate::hanging_nodes: ++stats.culled_hanging_nodes; break;
-                    case Fate::coded: break;
-                }
-                return (truth[i] & 1) != 0;
-            });
+        auto force = [&](uint32_t i, Fate fate, bool) {
+            switch (fate) {
+                case Fate::uniform: ++stats.culled_uniform; break;
+                case Fate::hanging_nodes: ++stats.culled_hanging_nodes; break;
+                case Fate::coded: break;
+            }
+            return (truth[i] & 1) != 0;
+        };
+        if (!mixed_ && trace == nullptr) {
+            // The level's symbols (at most one a node) through a local pointer: push_back read and
+            // wrote the vector's end in memory at every node, as the state bytes stored between
+            // may alias it.
+            const size_t before = events_.size();
+            events_.resize(before + n);
+            Event* out = events_.data() + before;
+            traversal.run(
+                level, uniform,
+                [&](uint32_t i, int group) {
+                    const bool r = (truth[i] & 1) != 0;
+                    *out++ = {uint8_t(group), uint8_t(r)};
+                    return r;
+                },
+                force);
+            events_.resize(size_t(out - events_.data()));
+        } else {
+            traversal.run(
+                level, uniform,
+                [&](uint32_t i, int group) {
+                    const bool r = (truth[i] & 1) != 0;
+                    if (mixed_) {
+                        if (event_feature_.size() < events_.size() + 1) event_feature_.resize(events_.size() + 1);
+                        event_feature_[events_.size()] = uint32_t(mixed_features_.size());
+                        mixed_features_.push_back(mixed_features(h, ids[i], level, i, group, shapes, kWrittenMixingModel, older_models_));
+                    }
+                    events_.push_back({uint8_t(group), uint8_t(r)});
+                    if (trace != nullptr) trace->push_back({ids[i], uint8_t(group), r});
+                    return r;
+                },
+                force);
+        }
         // The leaves' faces (a leaf and its hanging nodes' green triangles) in a pass over the
         // states alone, with the leaves of two or three hanging nodes listed, then those.
         std::vector<uint32_t>& two_or_more = m.two_or_more;

@@ -115,16 +115,23 @@ private:
     // (`symbols` counts those passed so far). encode_level codes them, stats() replays them.
     template <class F>
     void for_each_coded(size_t begin, size_t end, HierarchyModels& models, uint64_t& symbols, F&& f) const {
+        // Locals: the models' and the coder's stores may alias the members and `symbols`, which
+        // were read again (and the count stored) at every symbol.
+        const Event* const events = events_.data();
+        const uint64_t kept = kept_symbols_;
+        const bool orientation_coded = stats_.orientation_coded, use_contexts = options_.use_contexts;
+        uint64_t count = symbols;
         for (size_t k = begin; k < end; ++k) {
-            const Event e = events_[k];
+            const Event e = events[k];
             if (e.group == kOrientationEvent) {
-                if (stats_.orientation_coded) f(models.orientation, e, k);
+                if (orientation_coded) f(models.orientation, e, k);
                 continue;
             }
-            if (symbols == kept_symbols_) continue;
-            ++symbols;
-            f(models.for_group(e.group, options_.use_contexts), e, k);
+            if (count == kept) continue;
+            ++count;
+            f(models.for_group(e.group, use_contexts), e, k);
         }
+        symbols = count;
     }
     // The mixing mode's coded symbols of [begin, end): f(probability, event) with the model's
     // update after each.
