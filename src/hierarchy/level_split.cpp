@@ -355,17 +355,15 @@ void Hierarchy::split_level(const LevelSplits& splits) {
     constexpr uint32_t kParentsAhead = 16;
     const uint32_t offset = uint32_t(c0);
     const auto boundary_vertex = splits.boundary_vertex;
-    // No seam vertices and the blocks' edges given: a midpoint is new unless an earlier parent
-    // made it, and the children's tails need not be found from their links.
-    const BlockEdges* const child_edges = splits.child_edges;
-    const bool fast = boundary_vertex == nullptr && child_edges != nullptr;
-    const bool plain = fast && !in_place;
+    // No seam vertices, the links in `children` and the blocks' edges given: the common case, in
+    // split_plain_parents. Every other case takes the loop below.
+    const bool plain = boundary_vertex == nullptr && splits.child_edges != nullptr && !in_place;
     for (uint32_t chunk = 0; chunk < count; chunk += kChunk) {
         const uint32_t chunk_end = std::min(count, chunk + kChunk);
         uint32_t new_vertices = 0;
         if (plain)
             new_vertices = split_plain_parents(nodes, parents, chunk, chunk_end, count, c0, splits.children,
-                                               child_edges, next_vertex, ends);
+                                               splits.child_edges, next_vertex, ends);
         for (uint32_t i = plain ? chunk_end : chunk; i < chunk_end; ++i) {
             if (i + kParentsAhead < count) __builtin_prefetch(nodes + parents[i + kParentsAhead]);
             const NodeId n = parents[i];
@@ -373,17 +371,7 @@ void Hierarchy::split_level(const LevelSplits& splits) {
             const NodeId c = NodeId(c0 + size_t(4) * i);
             unsigned linked_edges = 0;
             VertexId m[3];
-            for (int e = 0; fast && e < 3; ++e) {
-                const uint32_t t = first_half(i, e);  // kNoNode / 4 is never below i
-                if (t / 4 < i) {
-                    const unsigned eq = (parent.nbr_edge >> (2 * e)) & 3u;
-                    m[e] = nodes[c0 + (t & ~3u) + red_split::kCenter].v[red_split::kCenterVertexOfMidpoint[eq]];
-                } else {
-                    ends[new_vertices++] = {parent.v[e], parent.v[e == 2 ? 0 : e + 1]};
-                    m[e] = next_vertex++;
-                }
-            }
-            for (int e = 0; !fast && e < 3; ++e) {
+            for (int e = 0; e < 3; ++e) {
                 const uint32_t t = first_half(i, e);  // kNoNode / 4 is never below i
                 linked_edges |= t == kNoNode ? 0u : 3u << (2 * e);
                 if (t / 4 < i) {
@@ -404,8 +392,7 @@ void Hierarchy::split_level(const LevelSplits& splits) {
             }
             // The children's edges (red_split::kChildEdges): linked outer edges take the parent's neighbour
             // edge index.
-            const unsigned tail_code = fast ? child_edges[i].nbr_edge | unsigned(child_edges[i].boundary & 7u) << 6
-                                            : (parent.nbr_edge & linked_edges) | (parent.flags & 7u) << 6;
+            const unsigned tail_code = (parent.nbr_edge & linked_edges) | (parent.flags & 7u) << 6;
             const uint32_t level = uint32_t(parent.level + 1) << 8;
             Node* child = nodes + c;
 #if AMC_SSE2
