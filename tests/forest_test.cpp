@@ -169,6 +169,21 @@ TEST(Forest, ResetGivesTheFreshHierarchy) {
     }
 }
 
+// A base that reset refuses (a triangle past its vertices) leaves the hierarchy as it was: the
+// base is checked before anything is cleared.
+TEST(Forest, ResetToARefusedBaseKeepsTheHierarchy) {
+    const auto meshes = fixture_meshes();
+    Hierarchy h(meshes[0].mesh);
+    refine_randomly(h, h.root_count() + 200, 4, 3);
+    const Hierarchy before = h;
+    TriangleMesh bad = meshes[0].mesh;
+    bad.triangles[0][1] = uint32_t(bad.positions.size());
+    EXPECT_THROW(h.reset(bad), Error);
+    EXPECT_TRUE(identical(h, before));
+    EXPECT_EQ(h.node_capacity(), before.node_capacity());
+    EXPECT_EQ(h.positions().size(), before.positions().size());
+}
+
 // The same nodes under the same ids: what the import's trials need of undo_splits, since they go on
 // splitting after it as if the undone splits had never been made.
 ::testing::AssertionResult same_ids(const Hierarchy& a, const Hierarchy& b) {

@@ -166,6 +166,8 @@ private:
         uint8_t flags;  // bits 0-2: boundary edge; bit 3: diagonal flipped
         uint8_t reserved;  // 0
     };
+    // The roots over base_ (vertices below vertex_end, checked), linked, and the base's positions.
+    void make_roots(uint64_t vertex_end);
     void link(NodeId a, int ea, NodeId b, int eb);
     static void write_vertices(Node* child, const VertexId corner[3], const VertexId m[3]);
     VertexId new_vertex(Vec3 p);

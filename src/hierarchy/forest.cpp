@@ -7,7 +7,6 @@
 #include "common/check.h"
 #include "common/huge_pages.h"
 #include "hierarchy/midpoint_placers.h"
-#include "mesh/vertex_buckets.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -22,26 +21,44 @@ Vec3 midpoint_placer(void* single_precision, Vec3 a, Vec3 b) {
     return round_if(single_precision, {midpoint_coordinate(a.x, b.x), midpoint_coordinate(a.y, b.y), midpoint_coordinate(a.z, b.z)});
 }
 
-Hierarchy::Hierarchy(TriangleMesh base) : base_(std::move(base)) {
+namespace {
+
+// One past the highest vertex the triangles use; throws Error when that is not a vertex of the
+// mesh (not a validated mesh: refused before anything is sized by it).
+uint64_t checked_vertex_end(const TriangleMesh& base) {
+    uint32_t highest = 0;
+    for (const Triangle& t : base.triangles) highest = std::max({highest, t[0], t[1], t[2]});
+    const uint64_t vertex_end = base.triangles.empty() ? 0 : uint64_t{highest} + 1;
+    if (vertex_end > base.positions.size())
+        throw Error("base mesh: a triangle refers to vertex " + std::to_string(vertex_end - 1) + " of " +
+                    std::to_string(base.positions.size()));
+    return vertex_end;
+}
+
+}  // namespace
+
+Hierarchy::Hierarchy(TriangleMesh base) : base_(std::move(base)) { make_roots(checked_vertex_end(base_)); }
+
+void Hierarchy::make_roots(uint64_t vertex_end) {
     const uint32_t f0 = root_count();
+    const Triangle* const triangles = base_.triangles.data();
     nodes_.resize(f0);
-    positions_ = base_.positions;
+    positions_.assign(base_.positions.begin(), base_.positions.end());
     for (const Vec3& p : positions_) far_positions_.raise_if(is_far(p));
     live_nodes_ = f0;
     live_vertices_ = static_cast<uint32_t>(positions_.size());
 
-    // The directed edges grouped by their first vertex (bucket_by_vertex, linear in the mesh),
-    // each as (second vertex, 3 * triangle + edge) in triangle order. The neighbour across (a,b) is
-    // the triangle with (b,a), among the few edges leaving b; the last one if there are several
-    // (a mesh that is not consistently oriented). A decoder starts from the base mesh for
-    // every stream, and sorting the edges took 3% of a 10^5-node decode over 500 roots.
-    uint64_t vertex_end = 0;  // one past the highest vertex used
+    // The directed edges grouped by their first vertex (a counting sort, linear in the mesh), each
+    // as (second vertex, triangle, edge) in triangle order. The neighbour across (a,b) is the
+    // triangle with (b,a), among the few edges leaving b; the last one if there are several (a
+    // mesh that is not consistently oriented). A decoder starts from the base mesh for every
+    // stream: sorting the edges took 3% of a 10^5-node decode over 500 roots, and a division
+    // by 3 per half-edge a tenth of a decode's restart over 4000 (docs/HIERARCHY_CODER.md, Speed).
     for (uint32_t t = 0; t < f0; ++t) {
         Node& node = nodes_[t];
         for (int i = 0; i < 3; ++i) {
-            node.v[i] = base_.triangles[t][i];
+            node.v[i] = triangles[t][i];
             node.nbr[i] = kNoNode;
-            vertex_end = std::max(vertex_end, uint64_t{node.v[i]} + 1);
         }
         node.first_child = kNoNode;
         node.nbr_edge = 0;
@@ -49,30 +66,33 @@ Hierarchy::Hierarchy(TriangleMesh base) : base_(std::move(base)) {
         node.flags = 0;
         node.reserved = 0;
     }
-    if (vertex_end > positions_.size())  // not a validated mesh: refuse before sizing by it
-        throw Error("base mesh: a triangle refers to vertex " + std::to_string(vertex_end - 1) + " of " +
-                    std::to_string(positions_.size()));
     struct Leaving {
         uint32_t to;
-        uint32_t half_edge;  // 3 * triangle + edge
+        uint32_t triangle;
+        uint32_t edge;
     };
-    std::vector<Leaving> leaving;
-    const std::vector<size_t> start = bucket_by_vertex(
-        size_t(vertex_end), 3 * size_t(f0), [&](size_t h) { return nodes_[h / 3].v[h % 3]; },
-        [&](size_t h) { return Leaving{nodes_[h / 3].v[(h % 3 + 1) % 3], uint32_t(h)}; }, leaving);
-    // Per vertex b: b's leaving edges (b, to) noted by `to`, then the edge (a, b) before each in its
-    // triangle finds its neighbour's (b, a) at once; the last one in triangle order, as a search would.
-    std::vector<uint32_t> leaving_to(size_t(vertex_end), kNoNode);  // a note left by a vertex before b fails `from b`
+    std::vector<size_t> start(size_t(vertex_end) + 2, 0);
+    for (uint32_t t = 0; t < f0; ++t)
+        for (int i = 0; i < 3; ++i) ++start[size_t(triangles[t][i]) + 2];
+    for (size_t v = 2; v < start.size(); ++v) start[v] += start[v - 1];
+    std::vector<Leaving> leaving(3 * size_t(f0));
+    for (uint32_t t = 0; t < f0; ++t)
+        for (uint32_t i = 0; i < 3; ++i) leaving[start[size_t(triangles[t][i]) + 1]++] = {triangles[t][i == 2 ? 0 : i + 1], t, i};
+    // Per vertex b: b's leaving edges (b, to) noted by `to` (the entry's index), then the edge
+    // (a, b) before each in its triangle finds its neighbour's (b, a) at once; the last one in
+    // triangle order, as a search would. A note left by a vertex before b lies outside b's entries.
+    std::vector<size_t> leaving_to(size_t(vertex_end), ~size_t{0});
     for (size_t b = 0; b < vertex_end; ++b) {
-        for (size_t k = start[b]; k < start[b + 1]; ++k) leaving_to[leaving[k].to] = leaving[k].half_edge;
-        for (size_t k = start[b]; k < start[b + 1]; ++k) {
-            const uint32_t t = leaving[k].half_edge / 3, e = (leaving[k].half_edge % 3 + 2) % 3;  // (a, b)
-            const uint32_t found = leaving_to[nodes_[t].v[e]];
-            if (found == kNoNode || nodes_[found / 3].v[found % 3] != b) {
+        const size_t first = start[b], count = start[b + 1] - first;
+        for (size_t k = first; k < first + count; ++k) leaving_to[leaving[k].to] = k;
+        for (size_t k = first; k < first + count; ++k) {
+            const uint32_t t = leaving[k].triangle, e = leaving[k].edge == 0 ? 2 : leaving[k].edge - 1;  // (a, b)
+            const size_t found = leaving_to[nodes_[t].v[e]];
+            if (found - first >= count) {
                 nodes_[t].flags |= uint8_t(1u << e);
             } else {
-                nodes_[t].nbr[e] = found / 3;
-                nodes_[t].nbr_edge |= uint8_t((found % 3) << (2 * e));
+                nodes_[t].nbr[e] = leaving[found].triangle;
+                nodes_[t].nbr_edge |= uint8_t(leaving[found].edge << (2 * e));
             }
         }
     }
@@ -80,18 +100,18 @@ Hierarchy::Hierarchy(TriangleMesh base) : base_(std::move(base)) {
 }
 
 void Hierarchy::reset(TriangleMesh base) {
-    Hierarchy roots(std::move(base));
-    nodes_.assign(roots.nodes_.begin(), roots.nodes_.end());
+    // The node and position arrays keep their memory; nothing is copied twice. A base that is
+    // refused leaves the hierarchy as it was.
+    const uint64_t vertex_end = checked_vertex_end(base);
+    base_ = std::move(base);
+    nodes_.clear();
     block_parent_.clear();
-    positions_.assign(roots.positions_.begin(), roots.positions_.end());
-    far_positions_ = roots.far_positions_;
+    positions_.clear();
+    far_positions_ = FarFlag();
     free_blocks_.clear();
     free_vertices_.clear();
-    base_ = std::move(roots.base_);
-    live_nodes_ = roots.live_nodes_;
-    live_vertices_ = roots.live_vertices_;
     structure_checked_ = false;
-    set_vertex_placer(nullptr, nullptr);
+    make_roots(vertex_end);
 }
 
 void Hierarchy::set_vertex_placer(VertexPlacer placer, void* context) {

@@ -20,6 +20,15 @@ struct Neighbors {
 };
 static_assert(sizeof(Neighbors) == 12, "split_level reads four siblings' Neighbors as twelve words");
 
+// What the four children of one refined node p take from p besides their neighbours: p's
+// neighbour_edge (2 bits per edge) on the edges whose neighbour is refined too (0 on the others)
+// and p's boundary edges (bits 0-2). The coder's level forest keeps one per block of four siblings
+// and split_level reads them as they are.
+struct BlockEdges {
+    uint8_t nbr_edge;
+    uint8_t boundary;
+};
+
 // The four vertices the normal frame of a new vertex reads (coding/geometry/geometry_prediction.h):
 // a and b, the ends of the split edge e of node n (a = v[e], b = v[(e + 1) % 3]), c, n's vertex
 // opposite the edge, and d, the vertex opposite the edge in n's same-level neighbour across it
@@ -92,6 +101,9 @@ struct LevelSplits {
     const NodeId* parents = nullptr;
     uint32_t count = 0;
     const Neighbors* children = nullptr;
+    // When set (with `children`), child_edges[i] is what the children of parents[i] take from it
+    // (BlockEdges): their tails need not be found from their links.
+    const BlockEdges* child_edges = nullptr;
     // When set, asked for the vertex splitting each boundary edge (a, b) of a parent: an
     // existing vertex's id (placed already: no new vertex), or kNoVertex for a new one. The
     // chunk decoder's seam vertices (chunk_coder.h).

@@ -216,7 +216,7 @@ Hierarchy parse_hierarchy(const std::string& bytes, const std::string& what) {
         const uint64_t made = derive_next_level(level, numbering, next, false);
         uint32_t* parents = level.refined.data();
         for (uint32_t b = 0; b < level.refined_count; ++b) parents[b] += uint32_t(first);
-        LevelSplits splits{parents, level.refined_count, next.nbr.data()};
+        LevelSplits splits{parents, level.refined_count, next.nbr.data(), next.edges.data()};
         splits.place_new_vertices = false;  // the file's positions follow
         splits.new_vertex_count = made;
         HierarchyBuilder::split_level(h, splits);

@@ -25,10 +25,15 @@ struct Ends {
     VertexId a, b;
 };
 
+// The end points' positions miss the cache far more often than the nodes: with 8 vertices
+// ahead, the loads still waited.
+constexpr std::ptrdiff_t kPositionsAhead = 32;
+
 // A random-access range over the end points of new vertices whose elements are their positions,
 // made by `Place` as std::vector::insert copies them: each is written once, into the reserved
 // capacity, with no test of the capacity per vertex (push_back's) and no zero-fill first
-// (resize's). The end points' positions are fetched kAhead vertices early.
+// (resize's). The end points' positions are fetched kPositionsAhead vertices early, from entries
+// the list holds past its end (so that no test guards the fetch).
 template <class Place>
 class NewPositions {
 public:
@@ -38,14 +43,11 @@ public:
     using pointer = const Vec3*;
     using reference = Vec3;
 
-    NewPositions(const Ends* at, const Ends* end, const Vec3* positions, Place place)
-        : at_(at), end_(end), positions_(positions), place_(place) {}
+    NewPositions(const Ends* at, const Vec3* positions, Place place) : at_(at), positions_(positions), place_(place) {}
     Vec3 operator*() const { return place_(positions_[at_->a], positions_[at_->b]); }
     NewPositions& operator++() {
-        if (at_ + kAhead < end_) {
-            __builtin_prefetch(positions_ + at_[kAhead].a);
-            __builtin_prefetch(positions_ + at_[kAhead].b);
-        }
+        __builtin_prefetch(positions_ + at_[kPositionsAhead].a);
+        __builtin_prefetch(positions_ + at_[kPositionsAhead].b);
         ++at_;
         return *this;
     }
@@ -84,14 +86,33 @@ public:
     bool operator>=(const NewPositions& other) const { return at_ >= other.at_; }
 
 private:
-    // The end points' positions miss the cache far more often than the nodes: with 8 vertices
-    // ahead, the loads still waited.
-    static constexpr std::ptrdiff_t kAhead = 32;
     const Ends* at_;
-    const Ends* end_;
     const Vec3* positions_;
     Place place_;
 };
+
+// near_midpoint_placer (midpoint_placers.h), rounded to float when `to_float`: x and y in one
+// SSE2 register (the same IEEE operations, so the same bits).
+template <bool to_float>
+AMC_ALWAYS_INLINE Vec3 near_midpoint(const Vec3& a, const Vec3& b) {
+#if AMC_SSE2
+    static_assert(sizeof(Vec3) == 24 && offsetof(Vec3, y) == 8 && offsetof(Vec3, z) == 16, "Vec3 is x, y, z");
+    const __m128d half = _mm_set1_pd(0.5);
+    __m128d xy = _mm_mul_pd(_mm_add_pd(_mm_loadu_pd(&a.x), _mm_loadu_pd(&b.x)), half);
+    __m128d z = _mm_mul_sd(_mm_add_sd(_mm_load_sd(&a.z), _mm_load_sd(&b.z)), half);
+    if (to_float) {
+        xy = _mm_cvtps_pd(_mm_cvtpd_ps(xy));
+        z = _mm_cvtss_sd(z, _mm_cvtsd_ss(_mm_setzero_ps(), z));
+    }
+    Vec3 m;
+    _mm_storeu_pd(&m.x, xy);
+    _mm_store_sd(&m.z, z);
+    return m;
+#else
+    static int round_to_float;  // any non-null context asks the placer to round
+    return near_midpoint_placer(to_float ? &round_to_float : nullptr, a, b);
+#endif
+}
 
 }  // namespace
 
@@ -199,6 +220,51 @@ AMC_ALWAYS_INLINE void turn_links_into_ids(Node* child, uint32_t offset) {
 #endif
 }
 
+// The parents i in [begin, end) of split_level's common case (links in `children`, the blocks'
+// edges given, no seam vertex), in a loop of its own: in split_level's loop, which
+// serves every case, GCC kept the loop's counters and the midpoints on the stack (about 25 loads
+// and stores a parent). Returns the new vertices listed in `ends`; next_vertex moves past them.
+// The parents are fetched kAhead parents early (what else was tried: HIERARCHY_CODER.md, Speed, item 13).
+template <class Node>
+AMC_NOIPA uint32_t split_plain_parents(Node* nodes, const uint32_t* parents, uint32_t begin, uint32_t end,
+                                       uint32_t count, size_t c0, const Neighbors* children,
+                                       const BlockEdges* child_edges, VertexId& next_vertex, Ends* ends) {
+    constexpr uint32_t kAhead = 16;
+    const uint32_t offset = uint32_t(c0);
+    VertexId next = next_vertex;
+    uint32_t listed = 0;
+    for (uint32_t i = begin; i < end; ++i) {
+        if (i + kAhead < count) __builtin_prefetch(nodes + parents[i + kAhead]);
+        Node& parent = nodes[parents[i]];
+        const size_t c = c0 + size_t(4) * i;
+        VertexId m[3];
+        for (int e = 0; e < 3; ++e) {
+            const uint32_t t = children[size_t(4) * i + red_split::kFirstHalfChild[e]].nbr[e];  // kNoNode / 4 is never below i
+            if (t / 4 < i) {  // made by the parent of block t / 4, in its centre child
+                const unsigned eq = (parent.nbr_edge >> (2 * e)) & 3u;
+                m[e] = nodes[c0 + (t & ~3u) + red_split::kCenter].v[red_split::kCenterVertexOfMidpoint[eq]];
+            } else {
+                ends[listed++] = {parent.v[e], parent.v[e == 2 ? 0 : e + 1]};
+                m[e] = next++;
+            }
+        }
+        const uint32_t level = uint32_t(parent.level + 1) << 8;
+        Node* child = nodes + c;
+#if AMC_SSE2
+        // A leaf's first 16 bytes: its corners and first_child, kNoNode, the children's fourth word.
+        red_split_sse2::write_child_vertices(child, _mm_loadu_si128(reinterpret_cast<const __m128i*>(parent.v)), m);
+#else
+        red_split_kernels::write_child_vertices(child, parent.v, m);
+#endif
+        store_neighbors(child, children + size_t(4) * i, offset);
+        const ChildTails& tails = kChildTails.of[child_edges[i].nbr_edge | unsigned(child_edges[i].boundary & 7u) << 6];
+        for (int k = 0; k < 4; ++k) store_tail(child[k], tails.word[k] | level);
+        parent.first_child = NodeId(c);
+    }
+    next_vertex = next;
+    return listed;
+}
+
 }  // namespace
 
 ChildLinkRoom Hierarchy::open_children(HierarchySlice* slice, uint32_t count) {
@@ -284,22 +350,40 @@ void Hierarchy::split_level(const LevelSplits& splits) {
     // new vertices, then the new vertices' positions. Apart, the position loads (which miss the
     // cache) overlap each other instead of stalling the loop that writes the nodes.
     constexpr uint32_t kChunk = 256;
-    Ends ends[3 * kChunk];
+    Ends ends[3 * kChunk + kPositionsAhead] = {};  // set: the fetches ahead read past the chunk's
     // The parents are fetched 16 parents early (what else was tried: HIERARCHY_CODER.md, Speed, item 13).
     constexpr uint32_t kParentsAhead = 16;
     const uint32_t offset = uint32_t(c0);
     const auto boundary_vertex = splits.boundary_vertex;
+    // No seam vertices and the blocks' edges given: a midpoint is new unless an earlier parent
+    // made it, and the children's tails need not be found from their links.
+    const BlockEdges* const child_edges = splits.child_edges;
+    const bool fast = boundary_vertex == nullptr && child_edges != nullptr;
+    const bool plain = fast && !in_place;
     for (uint32_t chunk = 0; chunk < count; chunk += kChunk) {
         const uint32_t chunk_end = std::min(count, chunk + kChunk);
         uint32_t new_vertices = 0;
-        for (uint32_t i = chunk; i < chunk_end; ++i) {
+        if (plain)
+            new_vertices = split_plain_parents(nodes, parents, chunk, chunk_end, count, c0, splits.children,
+                                               child_edges, next_vertex, ends);
+        for (uint32_t i = plain ? chunk_end : chunk; i < chunk_end; ++i) {
             if (i + kParentsAhead < count) __builtin_prefetch(nodes + parents[i + kParentsAhead]);
             const NodeId n = parents[i];
             Node& parent = nodes[n];
             const NodeId c = NodeId(c0 + size_t(4) * i);
             unsigned linked_edges = 0;
             VertexId m[3];
-            for (int e = 0; e < 3; ++e) {
+            for (int e = 0; fast && e < 3; ++e) {
+                const uint32_t t = first_half(i, e);  // kNoNode / 4 is never below i
+                if (t / 4 < i) {
+                    const unsigned eq = (parent.nbr_edge >> (2 * e)) & 3u;
+                    m[e] = nodes[c0 + (t & ~3u) + red_split::kCenter].v[red_split::kCenterVertexOfMidpoint[eq]];
+                } else {
+                    ends[new_vertices++] = {parent.v[e], parent.v[e == 2 ? 0 : e + 1]};
+                    m[e] = next_vertex++;
+                }
+            }
+            for (int e = 0; !fast && e < 3; ++e) {
                 const uint32_t t = first_half(i, e);  // kNoNode / 4 is never below i
                 linked_edges |= t == kNoNode ? 0u : 3u << (2 * e);
                 if (t / 4 < i) {
@@ -320,16 +404,21 @@ void Hierarchy::split_level(const LevelSplits& splits) {
             }
             // The children's edges (red_split::kChildEdges): linked outer edges take the parent's neighbour
             // edge index.
-            const unsigned outer = parent.nbr_edge & linked_edges;
+            const unsigned tail_code = fast ? child_edges[i].nbr_edge | unsigned(child_edges[i].boundary & 7u) << 6
+                                            : (parent.nbr_edge & linked_edges) | (parent.flags & 7u) << 6;
             const uint32_t level = uint32_t(parent.level + 1) << 8;
-            const unsigned boundary = parent.flags;
             Node* child = nodes + c;
+#if AMC_SSE2
+            // A leaf's first 16 bytes: its corners and first_child, kNoNode, the children's fourth word.
+            red_split_sse2::write_child_vertices(child, _mm_loadu_si128(reinterpret_cast<const __m128i*>(parent.v)), m);
+#else
             red_split_kernels::write_child_vertices(child, parent.v, m);  // write_vertices' (split() shares it)
+#endif
             if (in_place)
                 turn_links_into_ids(child, offset);
             else
                 store_neighbors(child, splits.children + size_t(4) * i, offset);
-            const ChildTails& tails = kChildTails.of[outer | (boundary & 7u) << 6];
+            const ChildTails& tails = kChildTails.of[tail_code];
             for (int k = 0; k < 4; ++k) store_tail(child[k], tails.word[k] | level);
             parent.first_child = c;
         }
@@ -345,7 +434,7 @@ void Hierarchy::split_level(const LevelSplits& splits) {
         const size_t first = positions_written;
         auto append = [&](auto place) {
             using Made = NewPositions<decltype(place)>;
-            const Made from(ends, ends + new_vertices, positions, place), to(ends + new_vertices, ends + new_vertices, positions, place);
+            const Made from(ends, positions, place), to(ends + new_vertices, positions, place);
             if (slice != nullptr)
                 std::copy(from, to, positions_.begin() + std::ptrdiff_t(first));
             else
@@ -356,9 +445,9 @@ void Hierarchy::split_level(const LevelSplits& splits) {
             append([placer = placer_, context = placer_context_](Vec3 a, Vec3 b) { return placer(context, a, b); });
             for (size_t v = first; v < positions_written; ++v) far_positions_.raise_if(is_far(positions_[v]));
         } else if (placer_context_ != nullptr) {
-            append([context = placer_context_](Vec3 a, Vec3 b) { return near_midpoint_placer(context, a, b); });
+            append([](const Vec3& a, const Vec3& b) { return near_midpoint<true>(a, b); });
         } else {
-            append([](Vec3 a, Vec3 b) { return near_midpoint_placer(nullptr, a, b); });
+            append([](const Vec3& a, const Vec3& b) { return near_midpoint<false>(a, b); });
         }
     }
     if (slice != nullptr) {

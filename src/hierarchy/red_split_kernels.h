@@ -142,9 +142,10 @@ inline __m128 child_vertex_vector(__m128 p, __m128 q, __m128 pq) {
     return shuffle_ps<plan.imm>(a, b);
 }
 
+// The same with the corners as lanes 0-2 of `pi` and all ones in lane 3 (a leaf's first 16 bytes,
+// loaded whole).
 template <class Node>
-inline void write_child_vertices(Node* child, const uint32_t corner[3], const uint32_t mid[3]) {
-    const __m128i pi = _mm_set_epi32(-1, int(corner[2]), int(corner[1]), int(corner[0]));
+inline void write_child_vertices(Node* child, __m128i pi, const uint32_t mid[3]) {
     const __m128i qi = _mm_set_epi32(-1, int(mid[2]), int(mid[1]), int(mid[0]));
     const __m128 p = _mm_castsi128_ps(pi), q = _mm_castsi128_ps(qi);
     const __m128 pq = _mm_castsi128_ps(_mm_unpacklo_epi32(pi, qi));
@@ -155,6 +156,11 @@ inline void write_child_vertices(Node* child, const uint32_t corner[3], const ui
     store(child[1], child_vertex_vector<1>(p, q, pq));
     store(child[2], child_vertex_vector<2>(p, q, pq));
     store(child[3], child_vertex_vector<3>(p, q, pq));
+}
+
+template <class Node>
+inline void write_child_vertices(Node* child, const uint32_t corner[3], const uint32_t mid[3]) {
+    write_child_vertices(child, _mm_set_epi32(-1, int(corner[2]), int(corner[1]), int(corner[0])), mid);
 }
 
 // Links: the sources are F = (first0, first1, first2, c + kFirstLane3) and S = (second0..2,

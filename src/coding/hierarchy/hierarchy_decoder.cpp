@@ -420,7 +420,8 @@ void HierarchyLevelDecoder::build_decided_levels() {
         const bool in_place = k + 1 == decided_.size() && next_links_in_room_;  // open_children made the room
         const NodeId first_child =
             slice_ != nullptr ? slice_->next_node : h_->node_capacity() - (in_place ? 4 * count : 0);
-        LevelSplits splits{parents, count, in_place ? nullptr : children.nbr.data(), boundary_vertex_, boundary_context_};
+        LevelSplits splits{parents, count, in_place ? nullptr : children.nbr.data(), in_place ? nullptr : children.edges.data(),
+                           boundary_vertex_, boundary_context_};
         splits.links_in_place = in_place;
         splits.slice = slice_;
         splits.new_vertex_count = level.new_vertices;

@@ -39,13 +39,6 @@ struct LevelLinks {
 };
 static_assert(sizeof(LevelLinks) == 16, "LevelLinks is meant to be 16 bytes");
 
-// What the four children of one refined node p take from p besides their neighbours: p's
-// neighbour_edge (2 bits per edge, 0 where the neighbour is not refined) and boundary edges.
-struct BlockEdges {
-    uint8_t nbr_edge;
-    uint8_t boundary;  // bits 0-2
-};
-
 // The links of child k (0..3) of a block, by its parent's BlockEdges (red_split::kChildEdges).
 inline LevelLinks child_links(const Neighbors& nbr, BlockEdges parent, unsigned k) {
     LevelLinks out;
@@ -86,7 +79,7 @@ struct Level {
     // The vertices their splits create (derive_next_level's count).
     uint64_t new_vertices = 0;
 
-    size_t size() const { return leaves_ != 0 ? leaves_ : states_.empty() ? 0 : states_.size() - 1; }
+    size_t size() const { return leaves_ != 0 ? leaves_ : state_count_ == 0 ? 0 : state_count_ - 1; }
     bool empty() const { return size() == 0; }
     // One state byte a node, preceded by kNoNeighborState: a neighbour index q reads its state at
     // state()[int32_t(q)], which for kNoLocal (-1) is that byte, so the hot loops need no test
@@ -96,9 +89,10 @@ struct Level {
     // (derive_next_level).
     uint8_t* state() { return states_.data() + 1; }
     const uint8_t* state() const { return states_.data() + 1; }
+    // Their contents are unset (not zeroed: the level's maker writes every one).
     void resize_state(size_t n) {
-        resize_scratch(states_, n + 1);
-        states_[0] = kNoNeighborState;
+        states_.reserve(n + 1)[0] = kNoNeighborState;
+        state_count_ = n + 1;
         leaves_ = 0;
     }
     // A level of n leaves alone, derived into the room of its nodes (derive_next_level): no
@@ -116,7 +110,8 @@ struct Level {
         nbr.deallocate();
         edges.deallocate();
         lowered.deallocate();
-        std::vector<uint8_t>().swap(states_);
+        states_.deallocate();
+        state_count_ = 0;
         leaves_ = 0;
     }
     // Gives back the storage that is far larger than a level of n nodes needs
@@ -126,13 +121,15 @@ struct Level {
         edges.shrink_for(n / 4);
         lowered.shrink_for(n / 2);
         refined.shrink_for(n);
-        if (states_.capacity() > ScratchArray<uint8_t>::kShrinkFactor * (n + 1)) std::vector<uint8_t>().swap(states_);
+        states_.shrink_for(n + 1);
+        if (states_.capacity() == 0) state_count_ = 0;
         leaves_ = 0;
     }
 
 private:
-    std::vector<uint8_t> states_;
-    size_t leaves_ = 0;  // set_leaves
+    ScratchArray<uint8_t> states_;
+    size_t state_count_ = 0;  // the level's nodes and the byte in front
+    size_t leaves_ = 0;       // set_leaves
 };
 
 // The state byte of neighbour q (kNoLocal included, see Level::state).
