@@ -2042,6 +2042,43 @@ struct QuadRoles {
     __m256d with_normal;
 };
 
+// The frame's axis of four vertices as lane masks (set_frame's rule: the normal's largest absolute
+// coordinate, z before y before x on ties; axis 0 without a finite non-zero normal).
+struct QuadAxes {
+    __m256d with_normal, on_y, on_z;
+};
+
+inline QuadAxes quad_axes(const FrameQuadLanes& l) {
+    const __m256d sign = _mm256_set1_pd(-0.0);
+    const __m256d x = _mm256_andnot_pd(sign, l.nx), y = _mm256_andnot_pd(sign, l.ny), z = _mm256_andnot_pd(sign, l.nz);
+    const __m256d y_wins = _mm256_cmp_pd(y, x, _CMP_GT_OS);
+    const __m256d best = _mm256_max_pd(y, x);
+    const __m256d z_wins = _mm256_cmp_pd(z, best, _CMP_GT_OS);
+    const __m256d largest = _mm256_max_pd(z, best);
+    const __m256d with_normal = _mm256_and_pd(_mm256_cmp_pd(largest, _mm256_setzero_pd(), _CMP_GT_OS),
+                                              _mm256_cmp_pd(largest, _mm256_set1_pd(HUGE_VAL), _CMP_LT_OS));
+    const __m256d on_z = _mm256_and_pd(with_normal, z_wins), on_y = _mm256_andnot_pd(z_wins, _mm256_and_pd(with_normal, y_wins));
+    return {with_normal, on_y, on_z};
+}
+
+// The four axes as int32 (2 on z, 1 on y, else 0) at `out`, 16-byte aligned.
+inline void store_quad_axes(const QuadAxes& a, int32_t* out) {
+    const __m256i axis = _mm256_or_si256(_mm256_and_si256(_mm256_castpd_si256(a.on_y), _mm256_set1_epi64x(1)),
+                                         _mm256_and_si256(_mm256_castpd_si256(a.on_z), _mm256_set1_epi64x(2)));
+    _mm_store_si128(reinterpret_cast<__m128i*>(out),
+                    _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(axis, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0))));
+}
+
+// Role 0's grid predictions of four vertices (grid_point_pair's, four lanes): each lane's midpoint
+// coordinate and origin on its axis.
+inline void grid_first_quad(const FrameQuadLanes& l, const QuadAxes& a, const GridScale& grid, const double* origin,
+                            uint64_t* points, uint64_t* offsets, int64_t* turns) {
+    const __m256d value = _mm256_blendv_pd(_mm256_blendv_pd(l.mx, l.my, a.on_y), l.mz, a.on_z);
+    const __m256d from = _mm256_blendv_pd(_mm256_blendv_pd(_mm256_set1_pd(origin[0]), _mm256_set1_pd(origin[1]), a.on_y),
+                                          _mm256_set1_pd(origin[2]), a.on_z);
+    grid_point_quad(value, from, grid, points, offsets, turns);
+}
+
 // set_grid_frame_pair for four vertices: set_axis by lane masks, role 0's grid predictions in two
 // pairs. Without `Grid`, the frames alone (set_frame's).
 template <bool Grid = true>
@@ -2052,35 +2089,18 @@ inline void set_grid_frame_quad(const FrameQuadLanes& l, const GridScale& grid, 
     store_quad(l.nx, &GridFrame::normal, 0, g);
     store_quad(l.ny, &GridFrame::normal, 1, g);
     store_quad(l.nz, &GridFrame::normal, 2, g);
-    const __m256d sign = _mm256_set1_pd(-0.0);
-    const __m256d x = _mm256_andnot_pd(sign, l.nx), y = _mm256_andnot_pd(sign, l.ny), z = _mm256_andnot_pd(sign, l.nz);
-    const __m256d y_wins = _mm256_cmp_pd(y, x, _CMP_GT_OS);
-    const __m256d best = _mm256_max_pd(y, x);
-    const __m256d z_wins = _mm256_cmp_pd(z, best, _CMP_GT_OS);
-    const __m256d largest = _mm256_max_pd(z, best);
-    const __m256d with_normal = _mm256_and_pd(_mm256_cmp_pd(largest, _mm256_setzero_pd(), _CMP_GT_OS),
-                                              _mm256_cmp_pd(largest, _mm256_set1_pd(HUGE_VAL), _CMP_LT_OS));
-    const __m256d on_z = _mm256_and_pd(with_normal, z_wins), on_y = _mm256_andnot_pd(z_wins, _mm256_and_pd(with_normal, y_wins));
-    // The axes made in the lanes (2 on z, 1 on y, else 0), as set_grid_roles_quad makes them.
+    const QuadAxes a = quad_axes(l);
     alignas(16) int32_t axes[4];
-    const __m256i axis = _mm256_or_si256(_mm256_and_si256(_mm256_castpd_si256(on_y), _mm256_set1_epi64x(1)),
-                                         _mm256_and_si256(_mm256_castpd_si256(on_z), _mm256_set1_epi64x(2)));
-    _mm_store_si128(reinterpret_cast<__m128i*>(axes),
-                    _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(axis, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0))));
-    const int has = _mm256_movemask_pd(with_normal);
+    store_quad_axes(a, axes);
+    const int has = _mm256_movemask_pd(a.with_normal);
     for (int j = 0; j < 4; ++j) {
         g[j].has_normal = ((has >> j) & 1) != 0;
         g[j].axis = axes[j];
     }
     if (!Grid) return;
-    // Role 0's grid predictions (grid_point_pair's, four lanes): each lane's coordinate and origin
-    // on its axis chosen by the same masks.
-    const __m256d value = _mm256_blendv_pd(_mm256_blendv_pd(l.mx, l.my, on_y), l.mz, on_z);
-    const __m256d from = _mm256_blendv_pd(_mm256_blendv_pd(_mm256_set1_pd(origin[0]), _mm256_set1_pd(origin[1]), on_y),
-                                          _mm256_set1_pd(origin[2]), on_z);
     uint64_t points[4], offsets[4];
     int64_t turns[4];
-    grid_point_quad(value, from, grid, points, offsets, turns);
+    grid_first_quad(l, a, grid, origin, points, offsets, turns);
     for (int j = 0; j < 4; ++j) g[j].first = {points[j], offsets[j], turns[j]};
 }
 
@@ -2104,24 +2124,10 @@ struct FirstRoles {
 // whole (the same values).
 inline void set_grid_roles_quad(const FrameQuadLanes& l, const GridScale& grid, const double* origin, QuadRoles& roles,
                                 FirstRoles& first, size_t k) {
-    const __m256d sign = _mm256_set1_pd(-0.0);
-    const __m256d x = _mm256_andnot_pd(sign, l.nx), y = _mm256_andnot_pd(sign, l.ny), z = _mm256_andnot_pd(sign, l.nz);
-    const __m256d y_wins = _mm256_cmp_pd(y, x, _CMP_GT_OS);
-    const __m256d best = _mm256_max_pd(y, x);
-    const __m256d z_wins = _mm256_cmp_pd(z, best, _CMP_GT_OS);
-    const __m256d largest = _mm256_max_pd(z, best);
-    const __m256d with_normal = _mm256_and_pd(_mm256_cmp_pd(largest, _mm256_setzero_pd(), _CMP_GT_OS),
-                                              _mm256_cmp_pd(largest, _mm256_set1_pd(HUGE_VAL), _CMP_LT_OS));
-    const __m256d on_z = _mm256_and_pd(with_normal, z_wins), on_y = _mm256_andnot_pd(z_wins, _mm256_and_pd(with_normal, y_wins));
-    // The axis: 2 on z, 1 on y, else 0 (set_frame's; 0 without a normal), as four int32.
-    const __m256i axis = _mm256_or_si256(_mm256_and_si256(_mm256_castpd_si256(on_y), _mm256_set1_epi64x(1)),
-                                         _mm256_and_si256(_mm256_castpd_si256(on_z), _mm256_set1_epi64x(2)));
-    _mm_store_si128(reinterpret_cast<__m128i*>(first.axis + k),
-                    _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(axis, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0))));
-    const __m256d value = _mm256_blendv_pd(_mm256_blendv_pd(l.mx, l.my, on_y), l.mz, on_z);
-    const __m256d from = _mm256_blendv_pd(_mm256_blendv_pd(_mm256_set1_pd(origin[0]), _mm256_set1_pd(origin[1]), on_y),
-                                          _mm256_set1_pd(origin[2]), on_z);
-    grid_point_quad(value, from, grid, first.point + k, first.offset + k, first.turn + k);
+    const QuadAxes a = quad_axes(l);
+    const __m256d on_y = a.on_y, on_z = a.on_z;
+    store_quad_axes(a, first.axis + k);
+    grid_first_quad(l, a, grid, origin, first.point + k, first.offset + k, first.turn + k);
     // Role 1's axis is 1 where the frame's is 0 (and without a normal), else 0; role 2's is 1 where
     // the frame's is 2, else 2.
     const __m256d on_x = _mm256_andnot_pd(_mm256_or_pd(on_y, on_z), _mm256_castsi256_pd(_mm256_set1_epi64x(-1)));
@@ -2133,7 +2139,7 @@ inline void set_grid_roles_quad(const FrameQuadLanes& l, const GridScale& grid, 
     by_role(l.mx, l.my, l.mz, roles.midpoint);
     by_role(l.nx, l.ny, l.nz, roles.normal);
     by_role(_mm256_set1_pd(origin[0]), _mm256_set1_pd(origin[1]), _mm256_set1_pd(origin[2]), roles.origin);
-    roles.with_normal = with_normal;
+    roles.with_normal = a.with_normal;
 }
 
 // decode_grid_grouped with roles 1 and 2's predictions made four vertices at a time from `roles`
