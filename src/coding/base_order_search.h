@@ -1,4 +1,4 @@
-// Effort 3 (EncodeOptions::effort): the base order as an encoder choice. Mode 2's start triangle
+// Efforts 3 and 4 (EncodeOptions::effort): the base order as an encoder choice. Mode 2's start triangle
 // fixes the decoder's base order (FORMAT.md 4.16), and the roots' order moves the hierarchy's code
 // and the level geometry (docs/HIERARCHY_CODER.md, "The base order as an encoder choice"). The
 // encoder codes the file at effort 2 in the base coder's order and in the orders of other starts
