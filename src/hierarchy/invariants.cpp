@@ -146,9 +146,6 @@ std::string check_position_range(const Hierarchy& h, const std::vector<uint32_t>
     return "";
 }
 
-// Whether every coordinate of vertices [begin, end) passes check_position_range's tests: one pass
-// without branches or messages (every encode checks its whole input), the messages only for a
-// range that fails. Out-of-range values are not converted to float (a select, not a branch).
 // Whether every coordinate (the bits of `coordinates` doubles at `bytes`) is zero or a normal
 // float32 value: at most 23 fraction bits and an exponent of -126 to 127. Integer operations
 // only (the differences' sign bits), over the coordinates as one array, which GCC vectorises.
