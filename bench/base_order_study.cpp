@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
     Quantizer grid;
     if (options.quantize_bits != 0) grid = make_quantizer(h.positions(), options.quantize_bits);
     const Quantizer* q = options.quantize_bits != 0 ? &grid : nullptr;
+    const TriangleMesh base = base_as_decoded(h, q);
     auto row = [&](const char* name, const BaseMeshCode& code) {
         EncodeStats s, p;
         const std::vector<uint8_t> file = encode_with_base(h, options, code, &s);
@@ -44,7 +45,7 @@ int main(int argc, char** argv) {
         std::printf("%s %llu %llu %llu %llu %zu %llu %llu %llu\n", name, (unsigned long long)s.base_connectivity_bytes,
                     (unsigned long long)s.base_geometry_bytes, (unsigned long long)s.hierarchy_bytes,
                     (unsigned long long)s.geometry_bytes, file.size(), (unsigned long long)p.hierarchy_bytes,
-                    (unsigned long long)p.total_bytes, (unsigned long long)base_blocks_bytes(h, q, code));
+                    (unsigned long long)p.total_bytes, (unsigned long long)base_blocks_bytes(base, q, code));
         std::fflush(stdout);
         return file;
     };
@@ -71,7 +72,7 @@ int main(int argc, char** argv) {
         return 0;
     }
     int k = 0;
-    for (const BaseMeshCode& code : base_order_candidates(h, q, own, starts)) {
+    for (const BaseMeshCode& code : base_order_candidates(base, own, starts)) {
         char name[32];
         std::snprintf(name, sizeof name, "start%d", k++);
         row(name, code);

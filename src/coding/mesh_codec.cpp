@@ -536,16 +536,17 @@ std::vector<uint8_t> encode_choosing_base(const Hierarchy& input, const EncodeOp
     at_two.effort = std::min(options.effort, kMaxGeometryEffort);
     std::unique_ptr<Quantizer> quantizer;
     if (options.quantize_bits != 0) quantizer = std::make_unique<Quantizer>(quantizer_of(input, options.quantize_bits, threads));
-    BaseMeshCode own = base_code_of(input, quantizer.get(), at_two);
+    const TriangleMesh base = base_as_decoded(input, quantizer.get());  // what every order codes
+    BaseMeshCode own = base_code_of(input, base, at_two);
     EncodeStats best_stats;
     std::vector<uint8_t> best = encode_file(input, at_two, stats_out != nullptr ? &best_stats : nullptr, memory, &own);
     std::vector<BaseMeshCode> trials;  // coded in full, in the rank of their base blocks' bytes
     if (options.effort >= kBaseOrderEffort && !fixed_order) {
         const BaseOrderSearch search = kBaseOrderSearches[options.effort - kBaseOrderEffort];
-        std::vector<BaseMeshCode> candidates = base_order_candidates(input, quantizer.get(), own, search.starts, threads);
+        std::vector<BaseMeshCode> candidates = base_order_candidates(base, own, search.starts, threads);
         std::vector<std::pair<uint64_t, size_t>> ranked(candidates.size());
         parallel_for(candidates.size(), threads,
-                     [&](size_t c) { ranked[c] = {base_blocks_bytes(input, quantizer.get(), candidates[c]), c}; });
+                     [&](size_t c) { ranked[c] = {base_blocks_bytes(base, quantizer.get(), candidates[c]), c}; });
         std::sort(ranked.begin(), ranked.end());
         for (size_t k = 0; k < std::min(search.trials, ranked.size()); ++k) trials.push_back(std::move(candidates[ranked[k].second]));
     }

@@ -34,15 +34,14 @@ uint8_t decode_rotation(ArithmeticDecoder& decoder, RotationModels& models) {
     return decoder.decode(models.one) ? 1 : 2;
 }
 
-// The base mesh with the positions the decoder reconstructs: the base coder predicts from them.
+}  // namespace
+
 TriangleMesh base_as_decoded(const Hierarchy& h, const Quantizer* quantizer) {
     TriangleMesh base = h.base();
     if (quantizer != nullptr)
         for (Vec3& p : base.positions) p = dequantize(*quantizer, snap_to_grid(*quantizer, p));
     return base;
 }
-
-}  // namespace
 
 // The base of a refined hierarchy gets a small search: on the corpus the full one (2^20
 // triangles) took half of a 12-bit encode and gained nothing, the base order it picks moving the
@@ -62,8 +61,7 @@ uint64_t base_search_budget(const Hierarchy& h) {
 // the input's first triangle, which moves the decoder's base order away from the input's; a stored
 // numbering pays for that more than the search saves (tests/numbering_test.cpp: 134 bytes instead
 // of 92 for the canonical order), so with one the encoder makes version 4's single try.
-BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const EncodeOptions& options) {
-    const TriangleMesh base = base_as_decoded(h, quantizer);
+BaseMeshCode base_code_of(const Hierarchy& h, const TriangleMesh& base, const EncodeOptions& options) {
     if (options.keep_base_order) return encode_base_connectivity(base, BaseConnectivityMode::explicit_triangles);
     if (options.numbering != nullptr && options.store_numbering) {
         try {
@@ -74,9 +72,8 @@ BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const 
     return encode_base_connectivity(base, resolve_thread_count(options.threads), base_search_budget(h));
 }
 
-std::vector<BaseMeshCode> base_order_candidates(const Hierarchy& h, const Quantizer* quantizer, const BaseMeshCode& own,
-                                                uint32_t count, unsigned threads) {
-    const TriangleMesh base = base_as_decoded(h, quantizer);
+std::vector<BaseMeshCode> base_order_candidates(const TriangleMesh& base, const BaseMeshCode& own, uint32_t count,
+                                                unsigned threads) {
     const size_t triangles = base.triangles.size();
     auto first_of = [&](uint32_t k) { return uint32_t(uint64_t{k} * triangles / count); };
     std::vector<BaseMeshCode> codes(count);
@@ -172,10 +169,9 @@ RawSideCode encode_base_geometry(const Hierarchy& h, const BaseMeshCode& base_co
         h.base().positions.size(), [&h](uint32_t i) { return h.position(i); }, base_code, keep_rotations, positions, raw_side);
 }
 
-uint64_t base_blocks_bytes(const Hierarchy& h, const Quantizer* quantizer, const BaseMeshCode& base_code) {
-    const TriangleMesh base = base_as_decoded(h, quantizer);
+uint64_t base_blocks_bytes(const TriangleMesh& base, const Quantizer* quantizer, const BaseMeshCode& base_code) {
     const bool quantized = quantizer != nullptr;
-    PositionCoder positions(CoordinateSpace{h.single_precision() && !quantized ? Precision::float32 : Precision::float64, quantizer});
+    PositionCoder positions(CoordinateSpace{base.single_precision && !quantized ? Precision::float32 : Precision::float64, quantizer});
     const RawSideCode code = base_geometry_code(
         base.positions.size(), [&](uint32_t i) { return base.positions[base_code.vertex_order[i]]; }, base_code, false, positions,
         !quantized);

@@ -20,16 +20,21 @@ namespace amc {
 // Triangles mode 2's search may code for the base of `h` (FORMAT.md 4.16).
 uint64_t base_search_budget(const Hierarchy& h);
 
-// The base connectivity code of the input (positions as the decoder reconstructs them: on the
-// grid when `quantizer` is set).
-BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const EncodeOptions& options);
+// The base mesh of h with the positions the decoder reconstructs (on the grid when `quantizer` is
+// set): what the base coder codes and predicts from.
+TriangleMesh base_as_decoded(const Hierarchy& h, const Quantizer* quantizer);
 
-// Other orders of the base of `h` (EncodeOptions::effort 3): mode 2's codes from `count` start
+// The base connectivity code of the input, whose base_as_decoded is `base`.
+BaseMeshCode base_code_of(const Hierarchy& h, const TriangleMesh& base, const EncodeOptions& options);
+inline BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const EncodeOptions& options) {
+    return base_code_of(h, base_as_decoded(h, quantizer), options);
+}
+
+// Other orders of a base_as_decoded (EncodeOptions::effort 3): mode 2's codes from `count` start
 // triangles spread over it (its first corner, gate radius 5), those whose order differs from
-// `own`'s and from each other's, in start order, coded on up to `threads` threads. Quantized files
-// pass their grid (`quantizer`).
-std::vector<BaseMeshCode> base_order_candidates(const Hierarchy& h, const Quantizer* quantizer, const BaseMeshCode& own,
-                                                uint32_t count, unsigned threads = 1);
+// `own`'s and from each other's, in start order, coded on up to `threads` threads.
+std::vector<BaseMeshCode> base_order_candidates(const TriangleMesh& base, const BaseMeshCode& own, uint32_t count,
+                                                unsigned threads = 1);
 
 // The base coder may rotate each triangle's vertices. The default diagonal rule does not care, but
 // hierarchies made under a rule of absolute local indices would pay orientation bits: then storing
@@ -62,10 +67,11 @@ ReorderedInput in_base_code_order(const Hierarchy& input, const BaseMeshCode& ba
 RawSideCode encode_base_geometry(const Hierarchy& h, const BaseMeshCode& base_code, bool keep_rotations, PositionCoder& positions,
                                  bool raw_side);
 
-// The payloads of the base connectivity and base geometry blocks of a file of h coded over
-// `base_code` (the roots in the base coder's rotations; a bit-exact file's raw bits apart, as version
-// 21's): how an effort-3 encode ranks orders before coding the rest (base_order_search.h).
-uint64_t base_blocks_bytes(const Hierarchy& h, const Quantizer* quantizer, const BaseMeshCode& base_code);
+// The payloads of the base connectivity and base geometry blocks of a file coded over `base_code`,
+// whose base_as_decoded(h, quantizer) is `base` (the roots in the base coder's rotations; a bit-exact
+// file's raw bits apart, as version 21's): how an effort-3 encode ranks orders before coding the
+// rest (base_order_search.h).
+uint64_t base_blocks_bytes(const TriangleMesh& base, const Quantizer* quantizer, const BaseMeshCode& base_code);
 
 // Decodes the base mesh from its two blocks of a file of `file_version`, checked against the
 // metadata; the result is a valid triangle mesh. Throws Error on a corrupt or truncated block.
