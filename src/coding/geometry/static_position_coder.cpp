@@ -1081,8 +1081,8 @@ void make_stencil_table(const RansTable& table, StencilTable& out) {
     }
 }
 
-// The rANS and raw streams of a level. Safe: every byte read is tested against the end (bytes
-// past it read as 0 and make the level corrupt); else the caller knows the reads stay inside.
+// The rANS and raw streams of a level, read without bounds tests: each decoder pads the streams'
+// tails (PaddedTails) so that its chunks' reads stay inside.
 struct StencilStreams {
     uint32_t x[2];
     const uint8_t* rans;
@@ -1090,31 +1090,15 @@ struct StencilStreams {
     const uint8_t* raw;
     uint64_t raw_bits_read = 0;
     size_t raw_size;
-    bool overran = false;
 
-    template <bool Safe>
-    AMC_ALWAYS_INLINE uint32_t rans_byte() {
-        if (!Safe || rans < rans_end) return *rans++;
-        overran = true;
-        return 0;
-    }
+    AMC_ALWAYS_INLINE uint32_t rans_byte() { return *rans++; }
     // kMaxRawRead bits or more from bit `position` of the raw stream on (bit 0 first).
-    template <bool Safe>
     AMC_ALWAYS_INLINE uint64_t raw_peek(uint64_t position) const {
-        const size_t at = size_t(position >> 3);
-        const unsigned shift = unsigned(position & 7);
-        uint64_t word;
-        if (!Safe || at + 8 <= raw_size) {
-            word = load_le64(raw + at);
-        } else {
-            word = 0;
-            for (size_t k = 0; k < 8 && at + k < raw_size; ++k) word |= uint64_t(raw[at + k]) << (8 * k);
-        }
-        return word >> shift;
+        return load_le64(raw + size_t(position >> 3)) >> unsigned(position & 7);
     }
     // The next token of state State, under `table`, as the residual it gives modulo 2^64: what
     // it adds to the prediction's ordered bits.
-    template <int State, bool Safe>
+    template <int State>
     AMC_ALWAYS_INLINE uint64_t residual(const StencilTable& table) {
         uint32_t& s = x[State];
         const uint32_t slot = s & (kRansScale - 1);
@@ -1122,11 +1106,11 @@ struct StencilStreams {
         s = uint32_t(e.frequency) * (s >> kRansScaleBits) + slot - e.start;
         // At most two bytes: s >= 2^11 here (s >= L before, a frequency >= 1).
         if (s < kRansLow) {
-            s = (s << 8) | rans_byte<Safe>();
-            if (s < kRansLow) s = (s << 8) | rans_byte<Safe>();
+            s = (s << 8) | rans_byte();
+            if (s < kRansLow) s = (s << 8) | rans_byte();
         }
         const uint64_t at = raw_bits_read;
-        const uint64_t w = raw_peek<Safe>(at);
+        const uint64_t w = raw_peek(at);
         raw_bits_read += e.raw_count;
         uint64_t negative, magnitude;
         if (e.raw_count <= kMaxRawRead) {
@@ -1136,21 +1120,20 @@ struct StencilStreams {
             const int first = e.raw_count - 32;
             negative = w & 1;
             magnitude = e.high | ((w >> 1) & ((uint64_t{1} << (first - 1)) - 1)) << 32 |
-                        (raw_peek<Safe>(at + uint64_t(first)) & 0xFFFFFFFFull);
+                        (raw_peek(at + uint64_t(first)) & 0xFFFFFFFFull);
         }
         return (magnitude ^ (0 - negative)) + negative;  // -magnitude when negative
     }
     bool ended_cleanly() const {
-        return !overran && x[0] == kRansLow && x[1] == kRansLow && rans == rans_end &&
+        return x[0] == kRansLow && x[1] == kRansLow && rans == rans_end &&
                raw_bits_read <= uint64_t(raw_size) * 8 && uint64_t(raw_size) * 8 - raw_bits_read < 8;
     }
 };
 
 // The last bytes of a level's streams, copied with zeros after them once fewer remain than a chunk
 // may read (Rans and Raw bytes), so that every chunk reads without a bounds test per byte, as if
-// inside the streams: bytes past an end read as 0, as the safe reads give them, and a chunk that
-// went past an end makes the level corrupt (overran()). At 12 bits a level's raw stream is often
-// shorter than a chunk's bound, and every chunk of it took the safe reads.
+// inside the streams: bytes past an end read as 0, and a chunk that went past an end makes the
+// level corrupt (overran()).
 template <size_t Rans, size_t Raw>
 class PaddedTails {
 public:
@@ -1304,23 +1287,22 @@ AMC_ALWAYS_INLINE void stencil_prediction(const Hierarchy& h, const Vec3* positi
 
 // Adds the residuals of `count` vertices to their predictions' ordered bits, token j of the level
 // with state j mod 2: x and z with the vertex's parity, y with the other.
-template <bool Safe>
 AMC_ALWAYS_INLINE void add_residuals(StencilStreams& streams, const std::array<StencilTable, 3>& t, uint64_t (*predicted)[3],
                                      size_t count) {
     StencilStreams s = streams;  // a local copy: its fields stay in registers
     size_t i = 0;
     for (; i + 1 < count; i += 2) {
-        predicted[i][0] += s.residual<0, Safe>(t[0]);
-        predicted[i][1] += s.residual<1, Safe>(t[1]);
-        predicted[i][2] += s.residual<0, Safe>(t[2]);
-        predicted[i + 1][0] += s.residual<1, Safe>(t[0]);
-        predicted[i + 1][1] += s.residual<0, Safe>(t[1]);
-        predicted[i + 1][2] += s.residual<1, Safe>(t[2]);
+        predicted[i][0] += s.residual<0>(t[0]);
+        predicted[i][1] += s.residual<1>(t[1]);
+        predicted[i][2] += s.residual<0>(t[2]);
+        predicted[i + 1][0] += s.residual<1>(t[0]);
+        predicted[i + 1][1] += s.residual<0>(t[1]);
+        predicted[i + 1][2] += s.residual<1>(t[2]);
     }
     if (i < count) {
-        predicted[i][0] += s.residual<0, Safe>(t[0]);
-        predicted[i][1] += s.residual<1, Safe>(t[1]);
-        predicted[i][2] += s.residual<0, Safe>(t[2]);
+        predicted[i][0] += s.residual<0>(t[0]);
+        predicted[i][1] += s.residual<1>(t[1]);
+        predicted[i][2] += s.residual<0>(t[2]);
     }
     streams = s;
 }
@@ -1334,6 +1316,7 @@ bool decode_stencil_float64(Hierarchy& h, const std::vector<std::pair<NodeId, in
     if (!open_stencil_streams(rans_data, rans_size, raw_data, raw_size, streams)) return false;
     // What a chunk reads at most: two rANS bytes and the sign and 64 bits per coordinate.
     constexpr size_t kChunkRans = 2 * 3 * kChunk, kChunkRaw = 3 * kChunk * 65 / 8 + 8;
+    PaddedTails<kChunkRans, kChunkRaw> tails;
     uint64_t predicted[kChunk][3];
     std::array<VertexId, kChunk> vertices;
     // split_level numbers a level's new vertices in the order `created` lists them (the listed
@@ -1356,9 +1339,9 @@ bool decode_stencil_float64(Hierarchy& h, const std::vector<std::pair<NodeId, in
 #else
         uint64_t largest_magnitude = 0;
 #endif
-        const bool inside = size_t(streams.rans_end - streams.rans) >= kChunkRans && raw_size - std::min<size_t>(raw_size, size_t(streams.raw_bits_read >> 3)) >= kChunkRaw;
-        if (inside) add_residuals<false>(streams, t, predicted, count);
-        else add_residuals<true>(streams, t, predicted, count);
+        tails.pad(streams);
+        add_residuals(streams, t, predicted, count);
+        if (tails.overran(streams)) return false;
         // from_ordered_bits of each sum, and whether every coordinate of the chunk is at most
         // DBL_MAX / 2 in magnitude (not Hierarchy::is_far, and finite), in the bits of each lane.
         auto vertex = [&](size_t i) { return consecutive ? VertexId(first + begin + i) : vertices[i]; };
@@ -1458,18 +1441,18 @@ void make_grid_table(const RansTable& table, GridTable& out) {
 }
 
 // The next token of state State under `table`, as its signed residual.
-template <int State, bool Safe>
+template <int State>
 AMC_ALWAYS_INLINE int64_t grid_token(StencilStreams& s, const GridTable& table) {
     uint32_t& x = s.x[State];
     const uint32_t slot = x & (kRansScale - 1);
     const GridEntry& e = table.entries[table.index[slot]];
     x = uint32_t(e.frequency) * (x >> kRansScaleBits) + slot - e.start;
     if (x < kRansLow) {  // at most two bytes (StencilStreams::residual)
-        x = (x << 8) | s.rans_byte<Safe>();
-        if (x < kRansLow) x = (x << 8) | s.rans_byte<Safe>();
+        x = (x << 8) | s.rans_byte();
+        if (x < kRansLow) x = (x << 8) | s.rans_byte();
     }
     if (e.raw_count == 0) return e.value;  // most quantized tokens: the branch predicts well
-    const uint64_t r = s.raw_peek<Safe>(s.raw_bits_read) & e.raw_mask;
+    const uint64_t r = s.raw_peek(s.raw_bits_read) & e.raw_mask;
     s.raw_bits_read += e.raw_count;
     return negated_if(int64_t(uint64_t(uint32_t(e.value)) | r >> 1), (r & 1) != 0);
 }
@@ -1489,11 +1472,11 @@ AMC_ALWAYS_INLINE GridPoint grid_point_of(const GridPrediction& g) {
 
 // The grid value of a prediction and the next token of state State under its table, among the
 // role's tables from `role_tables`.
-template <int State, bool Safe>
+template <int State>
 AMC_ALWAYS_INLINE int64_t grid_point_value(StencilStreams& s, const GridTable* role_tables, uint64_t point, uint64_t table_offset,
                                            int64_t turn_mask) {
     const GridTable& table = *reinterpret_cast<const GridTable*>(reinterpret_cast<const unsigned char*>(role_tables) + table_offset);
-    const int64_t r = grid_token<State, Safe>(s, table);
+    const int64_t r = grid_token<State>(s, table);
     return int64_t(point) + ((r ^ turn_mask) - turn_mask);  // negated_if(r, turn)
 }
 
@@ -1632,16 +1615,16 @@ AMC_ALWAYS_INLINE void set_other_roles(int64_t q1, int64_t q2, const GridScale& 
 
 // decode_vertex<State, true> over a GridFrame: role r's axis is the frame's axis, then the two
 // others in increasing order.
-template <int State, bool Safe>
+template <int State>
 AMC_ALWAYS_INLINE bool decode_grid_vertex(StencilStreams& s, const GridTable* t, const GridFrame& f, const GridScale& grid,
                                           const double* origin, Coordinates& p) {
-    const int64_t q0 = grid_point_value<State, Safe>(s, t, f.first.point, f.first.table_offset, f.first.turn_mask);
+    const int64_t q0 = grid_point_value<State>(s, t, f.first.point, f.first.table_offset, f.first.turn_mask);
     if (uint64_t(q0) > grid.max) return false;  // also q0 < 0
     const int a1 = f.axis == 0 ? 1 : 0, a2 = f.axis == 2 ? 1 : 2;
     const GridPointPair g = grid_first_role(f, q0, grid, origin, a1, a2, p);
-    const int64_t q1 = grid_point_value<1 - State, Safe>(s, t + kGridBins, g.point[0], g.table_offset[0], g.turn_mask[0]);
+    const int64_t q1 = grid_point_value<1 - State>(s, t + kGridBins, g.point[0], g.table_offset[0], g.turn_mask[0]);
     if (uint64_t(q1) > grid.max) return false;
-    const int64_t q2 = grid_point_value<State, Safe>(s, t + 2 * kGridBins, g.point[1], g.table_offset[1], g.turn_mask[1]);
+    const int64_t q2 = grid_point_value<State>(s, t + 2 * kGridBins, g.point[1], g.table_offset[1], g.turn_mask[1]);
     if (uint64_t(q2) > grid.max) return false;
     set_other_roles(q1, q2, grid, origin, a1, a2, p);
     return true;
@@ -1654,7 +1637,6 @@ AMC_ALWAYS_INLINE bool decode_grid_vertex(StencilStreams& s, const GridTable* t,
 // (states count mod 2 and the other). The chain from one token to the next is the rANS state's
 // alone. (Roles 1 and 2's tokens read into an array and their values made in a pass of their own:
 // 1.5 % fewer instructions, 1-9 % more time; the chain then runs with nothing beside it.)
-template <bool Safe>
 AMC_ALWAYS_INLINE bool decode_grid_grouped(StencilStreams& s, const GridTable* t, const GridFrame* frames, size_t count,
                                            const GridScale& level_grid, const double* origin, Coordinates* decoded) {
     const GridScale grid = level_grid;  // a local copy: the stores to `decoded` could alias the caller's
@@ -1665,7 +1647,7 @@ AMC_ALWAYS_INLINE bool decode_grid_grouped(StencilStreams& s, const GridTable* t
     auto first = [&](auto state, size_t k) {
         constexpr int State = decltype(state)::value;
         const GridFrame& f = frames[k];
-        const int64_t q0 = grid_point_value<State, Safe>(s, t, f.first.point, f.first.table_offset, f.first.turn_mask);
+        const int64_t q0 = grid_point_value<State>(s, t, f.first.point, f.first.table_offset, f.first.turn_mask);
         largest = std::max(largest, uint64_t(q0));
         second[k] = grid_first_role(f, q0, grid, origin, f.axis == 0 ? 1 : 0, f.axis == 2 ? 1 : 2, decoded[k]);
     };
@@ -1680,8 +1662,8 @@ AMC_ALWAYS_INLINE bool decode_grid_grouped(StencilStreams& s, const GridTable* t
         constexpr int S = decltype(odd)::value ? 1 : 0;  // role 1's state: count mod 2
         for (size_t i = 0; i < count; ++i) {
             const GridPointPair& g = second[i];
-            const int64_t q1 = grid_point_value<S, Safe>(s, t + kGridBins, g.point[0], g.table_offset[0], g.turn_mask[0]);
-            const int64_t q2 = grid_point_value<1 - S, Safe>(s, t + 2 * kGridBins, g.point[1], g.table_offset[1], g.turn_mask[1]);
+            const int64_t q1 = grid_point_value<S>(s, t + kGridBins, g.point[0], g.table_offset[0], g.turn_mask[0]);
+            const int64_t q2 = grid_point_value<1 - S>(s, t + 2 * kGridBins, g.point[1], g.table_offset[1], g.turn_mask[1]);
             if ((uint64_t(q1) > grid.max) | (uint64_t(q2) > grid.max)) return false;
             const int a0 = frames[i].axis;
             set_other_roles(q1, q2, grid, origin, a0 == 0 ? 1 : 0, a0 == 2 ? 1 : 2, decoded[i]);
@@ -1702,10 +1684,9 @@ struct PairFrames {
 #endif
         for (; i < count; ++i) set_grid_frame(frame_of<true>(h, corners[i]), grid, origin, frames[i]);
     }
-    template <bool Safe>
     AMC_ALWAYS_INLINE bool grouped(StencilStreams& s, const GridTable* t, const GridFrame* frames, size_t count,
                                    const GridScale& grid, const double* origin, Coordinates* decoded) const {
-        return decode_grid_grouped<Safe>(s, t, frames, count, grid, origin, decoded);
+        return decode_grid_grouped(s, t, frames, count, grid, origin, decoded);
     }
 };
 
@@ -1771,11 +1752,11 @@ AMC_ALWAYS_INLINE bool decode_grid_listed_with(Hierarchy& h, const FromList& cre
         StencilStreams local = s;  // the chunk's copy, which the compiler keeps in registers
         bool ok = true;
         if (Grouped) {
-            ok = make_frames.template grouped<false>(local, t.data(), frames.data(), count, grid, origin, coordinates);
+            ok = make_frames.grouped(local, t.data(), frames.data(), count, grid, origin, coordinates);
         } else {
             for (size_t k = 0; k < count && ok; k += 2) {  // token j of the level with state j mod 2
-                ok = decode_grid_vertex<0, false>(local, t.data(), frames[k], grid, origin, coordinates[k]) &&
-                     (k + 1 == count || decode_grid_vertex<1, false>(local, t.data(), frames[k + 1], grid, origin, coordinates[k + 1]));
+                ok = decode_grid_vertex<0>(local, t.data(), frames[k], grid, origin, coordinates[k]) &&
+                     (k + 1 == count || decode_grid_vertex<1>(local, t.data(), frames[k + 1], grid, origin, coordinates[k + 1]));
             }
         }
         s = local;
@@ -1833,16 +1814,16 @@ AMC_ALWAYS_INLINE void predict_unit_others(const GridFrame& f, const std::array<
 
 // decode_vertex<State, false> over a GridFrame, into p's axes; `largest` takes the largest
 // magnitude's bits of the three coordinates (a non-finite one is above every finite one).
-template <int State, bool Safe, bool Float32>
+template <int State, bool Float32>
 AMC_ALWAYS_INLINE void decode_unit_vertex(StencilStreams& s, const StencilTable* t, const GridFrame& f, Coordinates& p,
                                           uint64_t& largest) {
     const std::array<int, 3> axes = unit_role_axes(f);
-    const uint64_t b0 = unit_value_bits<Float32>(f.midpoint[axes[0]], s.residual<State, Safe>(t[0]));
+    const uint64_t b0 = unit_value_bits<Float32>(f.midpoint[axes[0]], s.residual<State>(t[0]));
     const double value = bit_cast<double>(b0);
     double second, third;
     predict_unit_others(f, axes, value, second, third);
-    const uint64_t b1 = unit_value_bits<Float32>(second, s.residual<1 - State, Safe>(t[1]));
-    const uint64_t b2 = unit_value_bits<Float32>(third, s.residual<State, Safe>(t[2]));
+    const uint64_t b1 = unit_value_bits<Float32>(second, s.residual<1 - State>(t[1]));
+    const uint64_t b2 = unit_value_bits<Float32>(third, s.residual<State>(t[2]));
     p[axes[0]] = value;
     p[axes[1]] = bit_cast<double>(b1);
     p[axes[2]] = bit_cast<double>(b2);
@@ -1896,10 +1877,10 @@ AMC_ALWAYS_INLINE bool decode_unit_listed_with(Hierarchy& h, const FromList& cre
         StencilStreams local = s;  // the chunk's copy, which the compiler keeps in registers
         size_t k = 0;
         for (; k + 1 < count; k += 2) {  // token j of the level with state j mod 2
-            decode_unit_vertex<0, false, Float32>(local, t.data(), frames[k], coordinates[k], largest);
-            decode_unit_vertex<1, false, Float32>(local, t.data(), frames[k + 1], coordinates[k + 1], largest);
+            decode_unit_vertex<0, Float32>(local, t.data(), frames[k], coordinates[k], largest);
+            decode_unit_vertex<1, Float32>(local, t.data(), frames[k + 1], coordinates[k + 1], largest);
         }
-        if (k < count) decode_unit_vertex<0, false, Float32>(local, t.data(), frames[k], coordinates[k], largest);
+        if (k < count) decode_unit_vertex<0, Float32>(local, t.data(), frames[k], coordinates[k], largest);
         s = local;
         if (tails.overran(s)) return false;
         std::memcpy(decoded, coordinates, count * sizeof(Vec3));
@@ -2146,7 +2127,6 @@ inline void set_grid_roles_quad(const FrameQuadLanes& l, const GridScale& grid, 
 // (QuadFrames'), after every four role-0 tokens: the same operations on the same values in AVX's
 // lanes (no fused multiply-add), so the same predictions; the vertices past the last whole four
 // (a level's last chunk) one at a time, as decode_grid_grouped.
-template <bool Safe>
 inline bool decode_grid_grouped_quads(StencilStreams& s, const GridTable* t, const GridFrame* frames, const FirstRoles& firsts,
                                       const QuadRoles* roles, size_t count, const GridScale& level_grid, const double* origin,
                                       Coordinates* decoded) {
@@ -2157,7 +2137,7 @@ inline bool decode_grid_grouped_quads(StencilStreams& s, const GridTable* t, con
     uint64_t largest = 0;  // of the role-0 grid values as unsigned, where a negative one is above any
     auto token = [&](auto state, size_t k) {
         constexpr int State = decltype(state)::value;
-        const int64_t q0 = grid_point_value<State, Safe>(s, t, firsts.point[k], firsts.offset[k], firsts.turn[k]);
+        const int64_t q0 = grid_point_value<State>(s, t, firsts.point[k], firsts.offset[k], firsts.turn[k]);
         largest = std::max(largest, uint64_t(q0));
         return q0;
     };
@@ -2200,8 +2180,8 @@ inline bool decode_grid_grouped_quads(StencilStreams& s, const GridTable* t, con
     auto roles_1_2 = [&](auto odd) {
         constexpr int S = decltype(odd)::value ? 1 : 0;  // role 1's state: count mod 2
         for (size_t i = 0; i < count; ++i) {
-            const int64_t v1 = grid_point_value<S, Safe>(s, t + kGridBins, point1[i], offset1[i], turn1[i]);
-            const int64_t v2 = grid_point_value<1 - S, Safe>(s, t + 2 * kGridBins, point2[i], offset2[i], turn2[i]);
+            const int64_t v1 = grid_point_value<S>(s, t + kGridBins, point1[i], offset1[i], turn1[i]);
+            const int64_t v2 = grid_point_value<1 - S>(s, t + 2 * kGridBins, point2[i], offset2[i], turn2[i]);
             others = std::max(others, std::max(uint64_t(v1), uint64_t(v2)));
             second_points[i] = int32_t(v1);  // below 2^30 where valid; an invalid one fails below
             third_points[i] = int32_t(v2);
@@ -2264,10 +2244,9 @@ struct QuadFrames {
         for (; i + 3 < count; i += 4) set_grid_frame_quad(frame_quad_lanes(h, corners + i), grid, origin, frames + i);
         PairFrames()(h, corners + i, count - i, grid, origin, frames + i);
     }
-    template <bool Safe>
     bool grouped(StencilStreams& s, const GridTable* t, const GridFrame* frames, size_t count, const GridScale& grid,
                  const double* origin, Coordinates* decoded) const {
-        return decode_grid_grouped_quads<Safe>(s, t, frames, firsts, roles, count, grid, origin, decoded);
+        return decode_grid_grouped_quads(s, t, frames, firsts, roles, count, grid, origin, decoded);
     }
 };
 
