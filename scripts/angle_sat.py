@@ -390,7 +390,8 @@ def main():
                     "vlevels (vertex levels), ends (diagonal ends), corner (closure corner red), "
                     "chains (base edges straight, 60 degrees apart), anchor (some face at level 0)")
     ap.add_argument("--unique", action="store_true", help="solve again with the labelling found excluded")
-    ap.add_argument("--truth-levels", action="store_true", help="give the solver the true face levels")
+    ap.add_argument("--truth-levels", type=float, default=0, metavar="SHARE",
+                    help="give the solver the true levels of that share of the faces (random ones)")
     ap.add_argument("--truth-flags", action="store_true", help="give the solver the true base edges")
     ap.add_argument("--show", type=int, default=0, help="print that many faces where the second solution differs")
     ap.add_argument("--timeout", type=int, default=600)
@@ -418,8 +419,8 @@ def main():
         return 1
     t0 = time.time()
     cnf, x = build(mesh, valence, args.levels if args.levels is not None else depth + 2, set(args.extra.split(",")))
-    if args.truth_levels:  # how far the true face levels alone take the solver
-        for f in range(len(faces)):
+    if args.truth_levels:  # how far the true levels of a share of the faces take the solver
+        for f in rnd.sample(range(len(faces)), round(args.truth_levels * len(faces))):
             for k in range(1, cnf.levels + 1):
                 cnf.add(cnf.ge[f] + k - 1 if level[f] >= k else -(cnf.ge[f] + k - 1))
     if args.truth_flags and "chains" in args.extra:  # how far the truth's base edges alone take the solver
