@@ -68,6 +68,36 @@ TEST(ThreadSafety, ConcurrentEncodesAndDecodesGiveTheSerialResults) {
     EXPECT_EQ(mismatches.load(), 0);
 }
 
+// Effort 3 codes its base orders' files several at once (encode_choosing_base): an encode on four
+// threads, and two at once from two threads, each on two threads with an EncodeContext of its own
+// (whose memory serves one file at a time), write the one-thread bytes and choose its order.
+TEST(ThreadSafety, EffortThreeOnThreadsGivesTheOneThreadFile) {
+    const Hierarchy h = testing::curved_sphere_remesh(3000);
+    EncodeOptions options;
+    options.hierarchy_contexts = HierarchyContexts::mixed;
+    options.effort = 3;
+    options.threads = 1;
+    const std::vector<uint8_t> serial = encode(h, options);
+    const Hierarchy serial_order = in_decoder_order(h, options);
+    EncodeOptions two = options;
+    two.effort = kMaxGeometryEffort;
+    ASSERT_LT(serial.size(), encode(h, two).size()) << "the search keeps the base coder's order: nothing to choose between";
+    options.threads = 4;
+    EXPECT_EQ(encode(h, options), serial);
+    EXPECT_TRUE(identical(in_decoder_order(h, options), serial_order));
+    options.threads = 2;
+    std::atomic<int> mismatches{0};
+    std::vector<std::thread> threads;
+    for (int t = 0; t < 2; ++t) {
+        threads.emplace_back([&] {
+            EncodeContext context;
+            for (int round = 0; round < 2; ++round) mismatches += encode(context, h, options) != serial;
+        });
+    }
+    for (std::thread& thread : threads) thread.join();
+    EXPECT_EQ(mismatches.load(), 0);
+}
+
 // The series file and the octree coder the same way: one shared file read by every thread (each with
 // a reader of its own: SeriesReader keeps the frame it decoded last), one shared forest encoded by
 // all, and each thread writing a series and a forest of its own.

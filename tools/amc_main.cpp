@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
     encode_cmd->add_option("--chunk-faces", encode.chunk_faces, "Faces per chunk when --chunks is 0")
         ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 40))
         ->capture_default_str();
-    encode_cmd->add_option("--threads", encode.threads, "Threads that code chunks at once (0: every core)")
+    encode_cmd->add_option("--threads", encode.threads, "Threads that code chunks, or at --effort 3 and 4 the base orders' files, at once (0: every core)")
         ->check(CLI::Range(0u, 4096u));
     encode_cmd->add_option("--hierarchy-contexts", encode.hierarchy_contexts,
                            "paper (fastest decode) | mixed (smaller connectivity, slower decode, one chunk; written as the version of the mixing model that codes smallest, docs/FORMAT.md)")

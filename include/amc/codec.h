@@ -105,7 +105,8 @@ struct EncodeOptions {
     // of the input, so chunks are runs of the caller's roots. Costs about 3 log2(V) bits per base
     // triangle where the base coder needs 1-2 bits per vertex (docs/MPI.md).
     bool keep_base_order = false;
-    // Threads that code chunks at once; 0: every core. The bytes do not depend on it.
+    // Threads that code chunks, or at efforts 3 and 4 the base orders' files, at once; 0: every
+    // core. The bytes do not depend on it.
     unsigned threads = 0;
     // Fill EncodeStats::hierarchy (the hierarchy coder's own statistics, for files of one chunk):
     // the coded symbols are replayed through the models, about 4 % of a default encode and the

@@ -25,6 +25,7 @@
 #include <cstddef>
 #include <future>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <utility>
 
@@ -522,41 +523,58 @@ std::vector<uint8_t> encode_file(const Hierarchy& input, const EncodeOptions& op
 }
 
 // encode_file(), at effort 3 with the base order chosen (base_order_search.h): the file in the
-// base coder's order first, then in each candidate's; a smaller file replaces it (a tie keeps the
-// earlier). `chosen`, when given, gets the kept base code.
+// base coder's order first, then in each candidate's, several at once on `threads` threads; the
+// smallest is kept, of equal ones the earliest, so the bytes do not depend on the threads.
+// `chosen`, when given, gets the kept base code.
 std::vector<uint8_t> encode_choosing_base(const Hierarchy& input, const EncodeOptions& options, EncodeStats* stats_out,
                                           EncodeMemory memory, BaseMeshCode* chosen = nullptr) {
     check_effort(options.effort, "encode");
     const bool fixed_order = options.keep_base_order || (options.numbering != nullptr && options.store_numbering);
     if (options.effort < kBaseOrderEffort && chosen == nullptr) return encode_file(input, options, stats_out, memory);
+    const unsigned threads = resolve_thread_count(options.threads);
     EncodeOptions at_two = options;
     at_two.effort = std::min(options.effort, kMaxGeometryEffort);
     std::unique_ptr<Quantizer> quantizer;
-    if (options.quantize_bits != 0)
-        quantizer = std::make_unique<Quantizer>(quantizer_of(input, options.quantize_bits, resolve_thread_count(options.threads)));
+    if (options.quantize_bits != 0) quantizer = std::make_unique<Quantizer>(quantizer_of(input, options.quantize_bits, threads));
     BaseMeshCode own = base_code_of(input, quantizer.get(), at_two);
     EncodeStats best_stats;
     std::vector<uint8_t> best = encode_file(input, at_two, stats_out != nullptr ? &best_stats : nullptr, memory, &own);
-    std::vector<BaseMeshCode> candidates;
-    std::vector<size_t> trials;  // candidates coded in full, in the rank of their base blocks' bytes
+    std::vector<BaseMeshCode> trials;  // coded in full, in the rank of their base blocks' bytes
     if (options.effort >= kBaseOrderEffort && !fixed_order) {
         const BaseOrderSearch search = kBaseOrderSearches[options.effort - kBaseOrderEffort];
-        candidates = base_order_candidates(input, quantizer.get(), own, search.starts);
-        std::vector<std::pair<uint64_t, size_t>> ranked;
-        for (size_t c = 0; c < candidates.size(); ++c) ranked.emplace_back(base_blocks_bytes(input, quantizer.get(), candidates[c]), c);
+        std::vector<BaseMeshCode> candidates = base_order_candidates(input, quantizer.get(), own, search.starts, threads);
+        std::vector<std::pair<uint64_t, size_t>> ranked(candidates.size());
+        parallel_for(candidates.size(), threads,
+                     [&](size_t c) { ranked[c] = {base_blocks_bytes(input, quantizer.get(), candidates[c]), c}; });
         std::sort(ranked.begin(), ranked.end());
-        for (size_t k = 0; k < std::min(search.trials, ranked.size()); ++k) trials.push_back(ranked[k].second);
+        for (size_t k = 0; k < std::min(search.trials, ranked.size()); ++k) trials.push_back(std::move(candidates[ranked[k].second]));
     }
-    for (const size_t c : trials) {
+    // The trials at once, each on the threads left to it. The caller's memory serves one at a time:
+    // a worker takes a memory for each trial and gives it back (one that threw stops, keeping its).
+    const unsigned workers = unsigned(std::max<size_t>(1, std::min<size_t>(trials.size(), threads)));
+    at_two.threads = threads / workers;
+    std::mutex mutex;
+    std::vector<EncodeMemory> free_memory(workers);
+    free_memory[0] = memory;
+    size_t kept = trials.size();  // none: the base coder's order
+    parallel_for(trials.size(), workers, [&](size_t i) {
+        EncodeMemory mine;
+        {
+            std::lock_guard<std::mutex> lock(mutex);
+            mine = free_memory.back();
+            free_memory.pop_back();
+        }
         EncodeStats stats;
-        std::vector<uint8_t> file = encode_file(input, at_two, stats_out != nullptr ? &stats : nullptr, memory, &candidates[c]);
-        if (file.size() >= best.size()) continue;
+        std::vector<uint8_t> file = encode_file(input, at_two, stats_out != nullptr ? &stats : nullptr, mine, &trials[i]);
+        std::lock_guard<std::mutex> lock(mutex);
+        free_memory.push_back(mine);
+        if (file.size() > best.size() || (file.size() == best.size() && (kept == trials.size() || kept < i))) return;
         best = std::move(file);
         best_stats = std::move(stats);
-        own = std::move(candidates[c]);
-    }
+        kept = i;
+    });
     if (stats_out != nullptr) *stats_out = std::move(best_stats);
-    if (chosen != nullptr) *chosen = std::move(own);
+    if (chosen != nullptr) *chosen = kept < trials.size() ? std::move(trials[kept]) : std::move(own);
     return best;
 }
 

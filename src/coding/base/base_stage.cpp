@@ -75,27 +75,31 @@ BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const 
 }
 
 std::vector<BaseMeshCode> base_order_candidates(const Hierarchy& h, const Quantizer* quantizer, const BaseMeshCode& own,
-                                                uint32_t count) {
+                                                uint32_t count, unsigned threads) {
     const TriangleMesh base = base_as_decoded(h, quantizer);
     const size_t triangles = base.triangles.size();
-    std::vector<BaseMeshCode> out;
+    auto first_of = [&](uint32_t k) { return uint32_t(uint64_t{k} * triangles / count); };
+    std::vector<BaseMeshCode> codes(count);
+    std::vector<uint8_t> coded(count, 0);
+    parallel_for(count, threads, [&](size_t k) {
+        if (k > 0 && first_of(uint32_t(k)) == first_of(uint32_t(k - 1))) return;  // fewer triangles than starts
+        BaseStart start;
+        start.first = first_of(uint32_t(k));
+        try {
+            codes[k] = encode_base_connectivity(base, start);
+            coded[k] = 1;
+        } catch (const Error&) {  // mode 2 does not fit from there: the other starts may
+        }
+    });
     auto same_order = [](const BaseMeshCode& a, const BaseMeshCode& b) {
         return a.triangle_order == b.triangle_order && a.triangle_rotation == b.triangle_rotation && a.vertex_order == b.vertex_order;
     };
+    std::vector<BaseMeshCode> out;
     for (uint32_t k = 0; k < count; ++k) {
-        BaseStart start;
-        start.first = uint32_t(uint64_t{k} * triangles / count);
-        if (k > 0 && start.first == uint32_t(uint64_t{k - 1} * triangles / count)) continue;  // fewer triangles than starts
-        BaseMeshCode code;
-        try {
-            code = encode_base_connectivity(base, start);
-        } catch (const Error&) {  // mode 2 does not fit from there: the other starts may
-            continue;
-        }
-        if (same_order(code, own)) continue;
+        if (coded[k] == 0 || same_order(codes[k], own)) continue;
         bool seen = false;
-        for (const BaseMeshCode& other : out) seen |= same_order(code, other);
-        if (!seen) out.push_back(std::move(code));
+        for (const BaseMeshCode& other : out) seen |= same_order(codes[k], other);
+        if (!seen) out.push_back(std::move(codes[k]));
     }
     return out;
 }

@@ -26,9 +26,10 @@ BaseMeshCode base_code_of(const Hierarchy& h, const Quantizer* quantizer, const 
 
 // Other orders of the base of `h` (EncodeOptions::effort 3): mode 2's codes from `count` start
 // triangles spread over it (its first corner, gate radius 5), those whose order differs from
-// `own`'s and from each other's, in start order. Quantized files pass their grid (`quantizer`).
+// `own`'s and from each other's, in start order, coded on up to `threads` threads. Quantized files
+// pass their grid (`quantizer`).
 std::vector<BaseMeshCode> base_order_candidates(const Hierarchy& h, const Quantizer* quantizer, const BaseMeshCode& own,
-                                                uint32_t count);
+                                                uint32_t count, unsigned threads = 1);
 
 // The base coder may rotate each triangle's vertices. The default diagonal rule does not care, but
 // hierarchies made under a rule of absolute local indices would pay orientation bits: then storing
