@@ -5,6 +5,7 @@
 #include <amc/refinement.h>
 
 #include "hierarchy/leaf_triangles.h"
+#include "random_hierarchies.h"
 
 #include <cstdio>
 #include <cstdlib>
@@ -14,38 +15,6 @@
 using namespace amc;
 
 namespace {
-
-// tests/hierarchy_checks.h's generator and tests/import_leaf_test.cpp's varied_random_hierarchy, so
-// that seed s here is that test's seed s.
-struct Random {
-    uint64_t state;
-    uint64_t next() {
-        state = state * 6364136223846793005ull + 1442695040888963407ull;
-        return state >> 33;
-    }
-};
-
-Hierarchy varied_random_hierarchy(uint64_t seed) {
-    const TriangleMesh fixtures[4] = {make_icosahedron(), make_torus(6, 5, 2.0, 0.7), make_square(3), make_l_shape(1)};
-    Random random{seed * 13 + 5};
-    const uint32_t leaves = 20 + uint32_t(random.next() % 2000);
-    const int max_level = 1 + int(random.next() % 7);
-    TriangleMesh base = fixtures[seed % 4];
-    const bool single = seed % 3 == 0;
-    base.single_precision = single;
-    if (single) {
-        for (Vec3& p : base.positions) p = {double(float(p.x)), double(float(p.y)), double(float(p.z))};
-    }
-    Hierarchy h(std::move(base));
-    refine_randomly(h, leaves, max_level, seed, 0.2);
-    if (seed % 2 == 0) {
-        Random flips{seed * 7 + 1};
-        for (NodeId n = 0; n < h.node_capacity(); ++n) {
-            if (h.is_alive(n) && flips.next() % 2) h.set_diagonal_flipped(n, true);
-        }
-    }
-    return h;
-}
 
 struct Face {
     VertexId v[3];
@@ -58,10 +27,10 @@ struct Face {
 
 int main(int argc, char** argv) {
     if (argc != 3 && !(argc == 4 && std::string(argv[1]) == "--random")) {
-        std::fprintf(stderr, "usage: angle_labels IN.amh OUT | angle_labels --random SEED OUT\n");
+        std::fprintf(stderr, "usage: angle_labels IN.amh OUT | angle_labels --random SEED OUT (seed SEED of the import tests' random hierarchies)\n");
         return 2;
     }
-    const Hierarchy h = argc == 4 ? varied_random_hierarchy(std::strtoull(argv[2], nullptr, 10)) : read_hierarchy(argv[1]);
+    const Hierarchy h = argc == 4 ? testing::varied_random_hierarchy(std::strtoull(argv[2], nullptr, 10)) : read_hierarchy(argv[1]);
     std::vector<Face> faces;
     // The angles follow for_each_leaf_triangle's corner order for each pattern (docs/HIERARCHY.md).
     for_each_leaf_triangle(h, h.breadth_first_order(), -1, [&](NodeId n, VertexId a, VertexId b, VertexId c, bool green) {

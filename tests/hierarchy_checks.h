@@ -2,6 +2,8 @@
 // full set of invariants every hierarchy must satisfy.
 #pragma once
 
+#include "random_hierarchies.h"
+
 #include <amc/hierarchy.h>
 #include <amc/refinement.h>
 
@@ -15,15 +17,6 @@
 #include <vector>
 
 namespace amc::testing {
-
-// A tiny generator whose output is the same on every platform (std distributions are not).
-struct Random {
-    uint64_t state;
-    uint64_t next() {
-        state = state * 6364136223846793005ull + 1442695040888963407ull;
-        return state >> 33;
-    }
-};
 
 // A random refinement of the icosahedron with every vertex projected onto the unit sphere (new
 // vertices off their edge's midpoint along the normal, as in a surface remesh).
@@ -81,19 +74,6 @@ inline TriangleMesh shuffled(const TriangleMesh& mesh, uint64_t seed, std::vecto
     }
     if (new_index != nullptr) *new_index = order;
     return out;
-}
-
-struct NamedMesh {
-    std::string name;
-    TriangleMesh mesh;
-};
-
-// Closed genus 0, closed genus 1, open (one boundary loop), non-convex open domain.
-inline std::vector<NamedMesh> fixture_meshes() {
-    return {{"icosahedron", make_icosahedron()},
-            {"torus", make_torus(6, 5, 2.0, 0.7)},
-            {"square", make_square(3)},
-            {"l_shape", make_l_shape(1)}};
 }
 
 inline int64_t euler_characteristic(const TriangleMesh& mesh) {

@@ -18,6 +18,8 @@ namespace amc {
 namespace {
 
 using testing::Random;
+using testing::random_hierarchy;
+using testing::varied_random_hierarchy;
 using testing::shuffled;
 
 // A hierarchy's leaf mesh as a user would hold it: vertices and faces in random order, each
@@ -103,22 +105,6 @@ UserLeafMesh user_leaf_mesh(const Hierarchy& h, uint64_t seed, Placement placeme
     return ::testing::AssertionSuccess();
 }
 
-Hierarchy random_hierarchy(TriangleMesh base, uint32_t leaves, int max_level, uint64_t seed, bool flips, bool single) {
-    base.single_precision = single;
-    if (single) {
-        for (Vec3& p : base.positions) p = {double(float(p.x)), double(float(p.y)), double(float(p.z))};
-    }
-    Hierarchy h(std::move(base));
-    refine_randomly(h, leaves, max_level, seed, 0.2);
-    if (flips) {
-        Random random{seed * 7 + 1};
-        for (NodeId n = 0; n < h.node_capacity(); ++n) {
-            if (h.is_alive(n) && random.next() % 2) h.set_diagonal_flipped(n, true);
-        }
-    }
-    return h;
-}
-
 TEST(ImportLeafMesh, ExactMidpointsRoundTrip) {
     for (const auto& fixture : testing::fixture_meshes()) {
         for (uint64_t seed = 1; seed <= 6; ++seed) {
@@ -188,14 +174,6 @@ TEST(ImportLeafMesh, UniformRefinementsWithScatteredVerticesRoundTrip) {
 // Random hierarchies (adaptive refinement and coarsening, green closures of both diagonals, every
 // fixture topology, float and double, depth 1 to 7), vertices and faces shuffled, every non-base
 // vertex moved off its midpoint: each imports back identical, base matched by index and by position.
-Hierarchy varied_random_hierarchy(uint64_t seed) {
-    const auto fixtures = testing::fixture_meshes();
-    Random random{seed * 13 + 5};
-    const uint32_t leaves = 20 + uint32_t(random.next() % 2000);
-    const int max_level = 1 + int(random.next() % 7);
-    return random_hierarchy(fixtures[seed % fixtures.size()].mesh, leaves, max_level, seed, seed % 2 == 0, seed % 3 == 0);
-}
-
 TEST(ImportLeafMesh, ManyRandomHierarchiesWithMovedVerticesRoundTrip) {
     for (uint64_t seed = 1; seed <= 200; ++seed) {
         const Hierarchy h = varied_random_hierarchy(seed);
