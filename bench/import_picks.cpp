@@ -1,9 +1,10 @@
 // Position-guided picks against the true hierarchy (docs/IMPORT.md, "Undo steps decide between
 // the nearest" and "The children repair the picks"): for every corpus hierarchy, its leaf mesh as
 // a user holds it (as import_corpus makes it), the top-down reconstruction with the base run with
-// each guide three times: picking the nearest candidate (ways 3 and 4 of import_leaf_mesh), then
-// way 5's choice (undo steps and, at the fine levels, the shortest chains), judged when the pick
-// is made and again after the level's repair (as import_leaf_mesh runs it). Every pick is compared
+// each guide (or those --guide names) four times: picking the nearest candidate (way 3 of
+// import_leaf_mesh), judged when the pick is made and again after the level's repair, then way 5's
+// choice (undo steps and, at the fine levels, the shortest chains), judged the same two ways (as
+// import_leaf_mesh runs them). Every pick is compared
 // with the true hierarchy's vertex and the reconstruction goes on with the true one, so each pick
 // is judged on a correct past. Prints a Markdown table: guided picks, wrong ones of each rule, per
 // level, and how many wrong picks the repair fixed and right ones it broke.
@@ -13,7 +14,7 @@
 // neighbour of the true vertex, whether it lies on the true chain of the edge, how much finer it
 // is, and how many levels below the pick the reconstruction fails when that pick alone is wrong.
 //
-// Usage: import_picks [--move X] [--classify] corpus/*.amh
+// Usage: import_picks [--move X] [--classify] [--guide leaf|subdivision|surface|ray]... corpus/*.amh
 #include "user_leaf_mesh.h"
 
 #include "import/anchored_reconstruction.h"
@@ -57,6 +58,7 @@ struct Count {
 int main(int argc, char** argv) {
     double move = 0.3;
     bool classify = false;
+    std::vector<int> only;  // --guide: the guides to run (all when none given)
     std::vector<std::string> files;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
@@ -64,20 +66,31 @@ int main(int argc, char** argv) {
             move = std::atof(argv[++i]);
         } else if (arg == "--classify") {
             classify = true;
+        } else if (arg == "--guide" && i + 1 < argc) {
+            const std::string name = argv[++i];
+            const char* names[] = {"leaf", "subdivision", "surface", "ray"};
+            int g = 0;
+            while (g < 4 && name != names[g]) ++g;
+            if (g == 4) {
+                std::fprintf(stderr, "unknown guide %s (leaf, subdivision, surface, ray)\n", name.c_str());
+                return 2;
+            }
+            only.push_back(g);
         } else {
             files.push_back(arg);
         }
     }
     if (files.empty()) {
-        std::fprintf(stderr, "usage: import_picks [--move X] hierarchy.amh...\n");
+        std::fprintf(stderr, "usage: import_picks [--move X] [--classify] [--guide leaf|subdivision|surface|ray]... hierarchy.amh...\n");
         return 2;
     }
     const amc::MidpointGuide guides[] = {amc::MidpointGuide::leaf_midpoint, amc::MidpointGuide::subdivision,
-                                         amc::MidpointGuide::surface};
-    const char* guide_names[] = {"leaf midpoint", "subdivision", "surface"};
-    std::printf("| model | guide | guided picks | wrong: the nearest | wrong: undo steps and chains | of them per level "
-                "0, 1, ... | wrong after the children's repair | of them per level | repair: fixed / broken |\n");
-    std::printf("|---|---|---:|---:|---:|---|---:|---|---|\n");
+                                         amc::MidpointGuide::surface, amc::MidpointGuide::normal_ray};
+    const char* guide_names[] = {"leaf midpoint", "subdivision", "surface", "normal ray"};
+    std::printf("| model | guide | guided picks | wrong: the nearest (per level 0, 1, ...) | the nearest, after the children's "
+                "repair | wrong: undo steps and chains | of them per level | the same after the children's repair | of "
+                "them per level | repair: fixed / broken |\n");
+    std::printf("|---|---|---:|---|---|---:|---|---:|---|---|\n");
     for (const std::string& file : files) {
         const amc::Hierarchy h = amc::read_hierarchy(file);
         const amc::LeafMesh leaf = amc::extract_leaf_mesh(h);
@@ -145,21 +158,24 @@ int main(int argc, char** argv) {
             amc::reconstruct_anchored(anchored, leaf_of_base, user, file, &steps);
         }
         const std::string name = std::filesystem::path(file).stem().string();
-        for (int g = 0; g < 3; ++g) {
-            Count counts[3];
+        for (int g = 0; g < 4; ++g) {
+            if (!only.empty() && std::find(only.begin(), only.end(), g) == only.end()) continue;
+            Count counts[4];
             std::unordered_map<uint64_t, uint32_t> first_pick;
-            for (int rule = 0; rule < 3; ++rule) {
+            for (int rule = 0; rule < 4; ++rule) {
                 Count& c = counts[rule];
+                // Rule 3: the nearest candidate (ways 3 and 4), judged after the level's repair.
+                const bool after_repair = rule >= 2;
                 const amc::PickReferee referee = [&](const amc::GuidedPick& pick) {
-                    // Rule 2 judges the picks after the level's repair, the others when made.
+                    // Rules 2 and 3 judge the picks after the level's repair, the others when made.
                     const auto it = truth.find((uint64_t(pick.a) << 32) | pick.b);
-                    if (rule == 2 && !pick.repaired && it != truth.end()) first_pick[it->first] = pick.picked;
-                    if (rule == 2 && pick.repaired && it != truth.end()) {
+                    if (after_repair && !pick.repaired && it != truth.end()) first_pick[it->first] = pick.picked;
+                    if (after_repair && pick.repaired && it != truth.end()) {
                         const bool was_right = first_pick[it->first] == it->second;
                         c.fixed += !was_right && pick.picked == it->second;
                         c.broken += was_right && pick.picked != it->second;
                     }
-                    if (pick.repaired != (rule == 2)) return pick.picked;
+                    if (pick.repaired != after_repair) return pick.picked;
                     if (it == truth.end()) return pick.picked;  // an edge the true hierarchy does not split
                     ++c.picks;
                     if (pick.picked != it->second) {
@@ -167,7 +183,7 @@ int main(int argc, char** argv) {
                         const size_t level = size_t(pick.level);
                         if (c.wrong_per_level.size() <= level) c.wrong_per_level.resize(level + 1, 0);
                         ++c.wrong_per_level[level];
-                        if (classify && g == 0 && rule >= 1) {
+                        if (classify && g == 0 && (rule == 1 || rule == 2)) {
                             WrongPick w = classify_pick(pick, it->second);
                             w.after_repair = rule == 2;
                             w.right_when_made = rule == 2 && first_pick[it->first] == it->second;
@@ -179,7 +195,7 @@ int main(int argc, char** argv) {
                 amc::Hierarchy reconstructed = fresh();
                 try {
                     amc::reconstruct_hierarchy(reconstructed, leaf_of_base, user, halfedges, guides[g], positions, search, file,
-                                               rule >= 1 ? &steps : nullptr, &referee);
+                                               rule == 1 || rule == 2 ? &steps : nullptr, &referee);
                 } catch (const amc::Error&) {
                     c.failed = true;
                 }
@@ -190,11 +206,12 @@ int main(int argc, char** argv) {
                     text += (l ? ", " : "") + std::to_string(c.wrong_per_level[l]);
                 return text;
             };
-            std::printf("| %s | %s | %ld | %ld%s | %ld%s | %s | %ld%s | %s | %ld / %ld |\n", name.c_str(), guide_names[g],
-                        counts[0].picks, counts[0].wrong, counts[0].failed ? " (stopped)" : "", counts[1].wrong,
-                        counts[1].failed ? " (stopped)" : "", levels(counts[1]).c_str(), counts[2].wrong,
-                        counts[2].failed ? " (stopped)" : "", levels(counts[2]).c_str(), counts[2].fixed,
-                        counts[2].broken);
+            std::printf("| %s | %s | %ld | %ld%s (%s) | %ld%s (%s) | %ld%s | %s | %ld%s | %s | %ld / %ld |\n", name.c_str(),
+                        guide_names[g], counts[0].picks, counts[0].wrong, counts[0].failed ? " (stopped)" : "",
+                        levels(counts[0]).c_str(), counts[3].wrong, counts[3].failed ? " (stopped)" : "",
+                        levels(counts[3]).c_str(), counts[1].wrong, counts[1].failed ? " (stopped)" : "",
+                        levels(counts[1]).c_str(), counts[2].wrong, counts[2].failed ? " (stopped)" : "",
+                        levels(counts[2]).c_str(), counts[2].fixed, counts[2].broken);
             std::fflush(stdout);
         }
         if (!classify) continue;

@@ -549,6 +549,21 @@ TEST(ImportLeafMeshSharedData, FandiskGaussRemeshMovedImportsWithItsBase) {
     EXPECT_TRUE(imports_back(h, user_leaf_mesh(h, 23, Placement::moved), false));
 }
 
+// fandisk remeshed by mean curvature to 40,000 faces at up to level 7, as a user's remesh holds it
+// (shuffled, every new vertex where the remesher put it): its coarse hidden midpoints lie off the
+// midpoints of their edges' leaf vertices by more than the fine leaves' spacing (the sagitta of a
+// long chord), where only the normal-ray guide finds them; refused without it.
+TEST(ImportLeafMeshSharedData, FandiskMeanDeepRemeshUnmovedImportsWithItsBase) {
+    const std::string dir = AMC_SHARED_DATA_DIR;
+    if (!std::ifstream(dir + "/fandisk.obj").good()) GTEST_SKIP() << "shared data not found (" << dir << ")";
+    SurfaceRemeshOptions options;
+    options.base_triangles = 500;
+    options.target_faces = 40000;
+    options.max_level = 7;
+    const Hierarchy h = remesh_adaptively(read_mesh(dir + "/fandisk.obj"), options);
+    for (uint64_t seed : {1u, 2u, 3u}) EXPECT_TRUE(imports_back(h, user_leaf_mesh(h, seed, Placement::midpoints), false)) << "seed " << seed;
+}
+
 // The corpus's fandisk_mean as a user's remesh holds it: shuffled, its new vertices where the
 // remesher projected them (import_corpus --move 0). The anchored way's search stops short of the
 // base in this face order (three levels undone) and reaches it in others; import_corpus --move 0

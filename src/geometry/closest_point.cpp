@@ -414,7 +414,7 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::closest_facing(Vec3 p, 
 namespace amc {
 
 std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 origin, Vec3 direction,
-                                                                       double reach) const {
+                                                                       double reach, double tolerance) const {
     const double direction_length = std::sqrt(squared_length(direction));
     if (!(direction_length > 0) || !(reach >= 0)) return std::nullopt;
     const Vec3 d = (1 / direction_length) * direction;
@@ -462,10 +462,10 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 ori
                 const double inv = 1 / det;
                 const Vec3 tv = origin - record.a;
                 const double u = dot(tv, pv) * inv;
-                if (u < 0 || u > 1) continue;
+                if (u < -tolerance || u > 1 + tolerance) continue;
                 const Vec3 qv = cross(tv, e1);
                 const double v = dot(d, qv) * inv;
-                if (v < 0 || u + v > 1) continue;
+                if (v < -tolerance || u + v > 1 + tolerance) continue;
                 const double t = dot(e2, qv) * inv;
                 const double at = std::fabs(t);
                 if (at < best || (at == best && best_record != kEmpty && triangles_[r] < best_triangle)) {

@@ -57,7 +57,10 @@ public:
     // `direction` (as closest_facing with min_cosine 0: dot(n, direction) > 0) of least |t|,
     // among |t| * |direction| <= reach; nullopt if there is none. Ties go to the lower triangle
     // index. Hit::distance_squared is the squared distance from origin to the hit point.
-    std::optional<Hit> intersect_line(Vec3 origin, Vec3 direction, double reach) const;
+    // `tolerance` widens every triangle by that much of its barycentric range, so that a line
+    // through a vertex or along an edge is not lost to rounding (the importer's normal ray aims
+    // at vertices; the remesher keeps 0).
+    std::optional<Hit> intersect_line(Vec3 origin, Vec3 direction, double reach, double tolerance = 0) const;
 
     std::size_t triangle_count() const { return triangles_.size(); }
     std::size_t node_count() const { return nodes_.size(); }

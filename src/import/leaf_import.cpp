@@ -300,7 +300,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     const LeafHalfedges halfedges(spatial);
     ImportedHierarchy out;
     std::vector<uint32_t> leaf_of_vertex;
-    // Six ways in, cheapest first, then three again (below); the first whose result is exactly the
+    // Seven ways in, cheapest first, then three again (below); the first whose result is exactly the
     // leaf mesh wins.
     enum class Way {
         exact_midpoints,  // new vertices at edge midpoints (as amcodec writes them): found by position
@@ -308,6 +308,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
         leaf_midpoint,    // the general reconstruction, guided by the midpoint of the edge's leaf vertices
         subdivision,      // the same, guided by midpoint subdivision of the base
         surface,          // the same, guided by the surface: new vertices projected onto it
+        normal_ray,       // the same, guided by the normal ray (as the surface remesher places them)
         anchored,         // levels undone bottom-up from the connectivity alone, the base vertices kept
                           // (positions anywhere; not every adaptive mesh yet, docs/IMPORT.md)
     };
@@ -319,6 +320,7 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
         return way == Way::exact_midpoints ? MidpointGuide::exact
                : way == Way::leaf_midpoint ? MidpointGuide::leaf_midpoint
                : way == Way::subdivision   ? MidpointGuide::subdivision
+               : way == Way::normal_ray    ? MidpointGuide::normal_ray
                                            : MidpointGuide::surface;
     };
     // Each attempt starts from a copy of the roots: copied into the last attempt's storage, whose
@@ -359,9 +361,9 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     bool midpoints_guessed = false;
     bool done = false;
     const std::pair<Way, bool> ways[] = {
-        {Way::exact_midpoints, false}, {Way::uniform, false}, {Way::leaf_midpoint, false}, {Way::subdivision, false},
-        {Way::surface, false},         {Way::anchored, false}, {Way::leaf_midpoint, true},  {Way::subdivision, true},
-        {Way::surface, true}};
+        {Way::exact_midpoints, false}, {Way::uniform, false},  {Way::leaf_midpoint, false}, {Way::subdivision, false},
+        {Way::surface, false},         {Way::normal_ray, false}, {Way::anchored, false},    {Way::leaf_midpoint, true},
+        {Way::subdivision, true},      {Way::surface, true}};
     // The leaf-midpoint way gives way to the subdivision way when its first levels' revealed
     // midpoints vote for that guide; if the subdivision way fails, the old order resumes.
     enum class Outcome { imported, failed, subdivision_closer };

@@ -399,8 +399,29 @@ Vec3 Reconstruction::guide_position(NodeId n, int e) {
                                                  : 0.5 * (leaf_.positions[a] + leaf_.positions[b]);
     if (guide_ == MidpointGuide::surface) {
         m = search_.surface().closest(m).point;
+    } else if (guide_ == MidpointGuide::normal_ray) {
+        m = normal_ray_hit(n, e, m);
     }
     return m;
+}
+
+Vec3 Reconstruction::normal_ray_hit(NodeId n, int e, Vec3 mid) {
+    const uint32_t a = corner(n, e), b = corner(n, (e + 1) % 3), c = corner(n, (e + 2) % 3);
+    const NodeId q = h_.neighbor(n, e);
+    const uint32_t d = q == kNoNode ? kNoIndex : corner(q, (h_.neighbor_edge(n, e) + 2) % 3);
+    // A boundary edge's vertex lies on the boundary curve, not along a normal: the midpoint.
+    if (c == kNoIndex || d == kNoIndex) return mid;
+    const std::vector<Vec3>& p = leaf_.positions;
+    auto unit = [](Vec3 v) {
+        const double length = std::sqrt(dot(v, v));
+        return length > 0 ? (1 / length) * v : v;
+    };
+    // The remesher's line (vertex_placement.cpp): the sum of the two elements' unit normals, as
+    // far as an edge is long. The tolerance keeps a line through a vertex, as it is where the
+    // remesher's vertex stays put, from slipping between its triangles.
+    const Vec3 normal = unit(cross(p[b] - p[a], p[c] - p[a])) + unit(cross(p[a] - p[b], p[d] - p[b]));
+    const auto hit = search_.surface().intersect_line(mid, normal, std::sqrt(dot(p[b] - p[a], p[b] - p[a])), 1e-9);
+    return hit ? hit->point : mid;
 }
 
 uint32_t Reconstruction::only_unmatched_common_neighbor(uint32_t a, uint32_t b) {

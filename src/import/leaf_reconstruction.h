@@ -54,6 +54,9 @@ enum class MidpointGuide {
     subdivision,    // the vertex nearest to where midpoint subdivision of the base puts it
     surface,        // the vertex nearest to the leaf mesh's surface point closest to the
                     // midpoint of the edge's end vertices (meshes projected onto a surface)
+    normal_ray,     // the vertex nearest to where the line through that midpoint along the two
+                    // elements' mean normal meets the leaf mesh (normal projection, as the
+                    // surface remesher places vertices)
 };
 
 // The exact way's refusal when a split edge's midpoint holds no leaf vertex: the input's new

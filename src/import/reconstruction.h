@@ -365,8 +365,11 @@ private:
     // Where the guide expects the vertex that splits edge e of n: where midpoint subdivision of
     // the base puts it (the hierarchy's default placer has computed it), or the midpoint of the
     // edge as the leaf mesh places its ends (which follows projected and moved ends; the surface
-    // guide then projects it onto the mesh).
+    // guide then projects it onto the mesh, the normal-ray guide casts the remesher's line from it).
     Vec3 guide_position(NodeId n, int e);
+    // Where the line through `mid` (edge e of n's midpoint) along the mean normal of n and the
+    // element across meets the leaf mesh, nearest `mid`; `mid` when it meets nothing within reach.
+    Vec3 normal_ray_hit(NodeId n, int e, Vec3 mid);
     // When the children along an edge (a, b) keep their halves unsplit, its midpoint is a common
     // neighbour of a and b, and the only unmatched one: inside the two elements on the edge, a's
     // leaf edges stay in the corner child at a and b's in the corner child at b, which meet only
