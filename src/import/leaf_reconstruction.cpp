@@ -417,8 +417,8 @@ Vec3 Reconstruction::normal_ray_hit(NodeId n, int e, Vec3 mid) {
         return length > 0 ? (1 / length) * v : v;
     };
     // The remesher's line (vertex_placement.cpp): the sum of the two elements' unit normals, as
-    // far as an edge is long. The tolerance keeps a line through a vertex, as it is where the
-    // remesher's vertex stays put, from slipping between its triangles.
+    // far as the edge is long. The tolerance keeps a line through a vertex (the remesher's vertex,
+    // unless it moved it later) from slipping between that vertex's triangles.
     const Vec3 normal = unit(cross(p[b] - p[a], p[c] - p[a])) + unit(cross(p[a] - p[b], p[d] - p[b]));
     const auto hit = search_.surface().intersect_line(mid, normal, std::sqrt(dot(p[b] - p[a], p[b] - p[a])), 1e-9);
     return hit ? hit->point : mid;
