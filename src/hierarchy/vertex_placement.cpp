@@ -3,6 +3,7 @@
 
 #include "common/mixing.h"
 #include "common/no_index.h"
+#include "geometry/placement_normal.h"
 #include "geometry/surface_quality.h"
 
 #include <algorithm>
@@ -471,9 +472,8 @@ void VertexPlacement::place_midpoint(NodeId s, int e, VertexId m) {
         const Vec3 d = h_.position(h_.vertex(q, (h_.neighbor_edge(s, e) + 2) % 3));
         halves.push_back({b, mid, d});
         halves.push_back({d, mid, a});
-        const Vec3 other = cross(a - b, d - b);
-        folded = dot(normal, other) < 0;
-        normal = unit(normal) + unit(other);
+        folded = dot(normal, cross(a - b, d - b)) < 0;
+        normal = placement_normal(a, b, c, d);
     }
     Vec3 p = single_ ? round_to_float(mid) : mid;
     auto take = [&](std::optional<Vec3> candidate) {

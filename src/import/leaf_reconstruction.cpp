@@ -3,6 +3,7 @@
 
 #include "common/compiler.h"
 #include "common/exact_float.h"
+#include "geometry/placement_normal.h"
 #include "hierarchy/hierarchy_builder.h"
 #include "import/reconstruction.h"
 
@@ -412,14 +413,9 @@ Vec3 Reconstruction::normal_ray_hit(NodeId n, int e, Vec3 mid) {
     // A boundary edge's vertex lies on the boundary curve, not along a normal: the midpoint.
     if (c == kNoIndex || d == kNoIndex) return mid;
     const std::vector<Vec3>& p = leaf_.positions;
-    auto unit = [](Vec3 v) {
-        const double length = std::sqrt(dot(v, v));
-        return length > 0 ? (1 / length) * v : v;
-    };
-    // The remesher's line (vertex_placement.cpp): the sum of the two elements' unit normals, as
-    // far as the edge is long. The tolerance keeps a line through a vertex (the remesher's vertex,
-    // unless it moved it later) from slipping between that vertex's triangles.
-    const Vec3 normal = unit(cross(p[b] - p[a], p[c] - p[a])) + unit(cross(p[a] - p[b], p[d] - p[b]));
+    // The remesher's line, as far as the edge is long. The tolerance keeps a line through a vertex
+    // (the remesher's vertex, unless it moved it later) from slipping between that vertex's triangles.
+    const Vec3 normal = placement_normal(p[a], p[b], p[c], p[d]);
     const auto hit = search_.surface().intersect_line(mid, normal, std::sqrt(dot(p[b] - p[a], p[b] - p[a])), 1e-9);
     return hit ? hit->point : mid;
 }
