@@ -326,7 +326,9 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
     // Each attempt starts from a copy of the roots: copied into the last attempt's storage, whose
     // pages are already mapped (a fresh 10^6-face hierarchy faults in about 60 MB).
     const Hierarchy roots(hierarchy_base);
+    LeafFacesRead faces_read;
     auto attempt = [&](Way way, bool by_undo_steps, bool vote_on_guides = false) {
+        faces_read.filled = false;
         out.hierarchy = roots;
         // A leaf mesh of F faces comes from at most F leaves, so from at most 4F/3 + roots nodes.
         out.hierarchy.reserve(leaf.triangles.size() * 4 / 3 + base.triangles.size() + 4, leaf.positions.size());
@@ -350,9 +352,13 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
         } else {
             leaf_of_vertex = reconstruct_hierarchy(out.hierarchy, spatial_leaf_of_base, spatial, halfedges, guide_of(way),
                                                    leaf_positions, search, what, nullptr, nullptr, &input_of,
-                                                   vote_on_guides);
+                                                   vote_on_guides, &faces_read);
         }
-        verify_leaf_mesh(out.hierarchy, leaf_of_vertex, spatial, halfedges, input_of, what);
+        // The leaves' last readings found each face once: their triangles, which the extraction
+        // emits as read, are the leaf mesh (docs/IMPORT.md, "The final check"). Otherwise the
+        // extraction itself is compared, and its first misfit named.
+        if (!faces_read.all_once(spatial.triangles.size()))
+            verify_leaf_mesh(out.hierarchy, leaf_of_vertex, spatial, halfedges, input_of, what);
     };
     // The subdivision-guided way's error is the one reported: it goes furthest on most bad input.
     // The guided ways run a second time, their picks decided by the anchored way's undo steps,

@@ -64,6 +64,7 @@ void Reconstruction::reconstruct_level(std::vector<NodeId>& level, std::vector<N
     read_failed_ = true;
     read_level_or_repair(level, refined);
     read_failed_ = false;
+    if (faces_read_) add_level_faces();
     split_refined(refined);
     leaf_of_vertex_.resize(h_.positions().size(), kNoIndex);
     for (const Reveal& r : reveals_) {
@@ -91,6 +92,19 @@ void Reconstruction::reconstruct_level(std::vector<NodeId>& level, std::vector<N
         for (int k = 0; k < 4; ++k) next.push_back(h_.child(n, k));
     }
     failed_node_ = kNoNode;
+}
+
+void Reconstruction::add_level_faces() {
+    std::vector<uint64_t>& bits = faces_read_->bits;
+    uint64_t twice = 0;
+    for (const uint32_t* f_at = level_faces_.get(); f_at != level_faces_end_; ++f_at) {
+        const uint32_t f = *f_at;
+        const uint64_t bit = uint64_t(1) << (f % 64);
+        twice |= bits[f / 64] & bit;
+        bits[f / 64] |= bit;
+    }
+    faces_read_->twice |= twice != 0;
+    faces_read_->count += uint64_t(level_faces_end_ - level_faces_.get());
 }
 
 void Reconstruction::vote_on_guides() {
@@ -135,6 +149,13 @@ void Reconstruction::read_level(const std::vector<NodeId>& level, std::vector<No
     refined.clear();
     reveals_.clear();
     unsplit_edges_.clear();
+    if (faces_read_) {
+        if (level_faces_room_ < 3 * level.size()) {
+            level_faces_room_ = 3 * level.size();
+            level_faces_.reset(new uint32_t[level_faces_room_]);
+        }
+        level_faces_end_ = level_faces_.get();
+    }
     for (NodeId n : level) {
         if (classify(n)) refined.push_back(n);
     }
@@ -254,6 +275,7 @@ AMC_ALWAYS_INLINE Reconstruction::Reading Reconstruction::read_inline(const uint
         }
     } else if (r.unsplit_count == 3) {
         if (ahead[0].apex != p[2]) r.fault = Reading::not_a_face;
+        r.faces[r.face_count++] = ahead[0].face;
     } else if (r.unsplit_count == 2) {
         const int e = !r.unsplit[0] ? 0 : !r.unsplit[1] ? 1 : 2;  // the split edge
         const uint32_t m = ahead[(e + 1) % 3].apex;
@@ -265,25 +287,36 @@ AMC_ALWAYS_INLINE Reconstruction::Reading Reconstruction::read_inline(const uint
             r.fault_detail[1] = m;
         } else {
             reveal(e, m);
+            r.faces[r.face_count++] = ahead[(e + 1) % 3].face;
+            r.faces[r.face_count++] = ahead[(e + 2) % 3].face;
         }
     } else {
         const int u = r.unsplit[0] ? 0 : r.unsplit[1] ? 1 : 2;  // the unsplit edge
         const uint32_t a = p[u], b = p[(u + 1) % 3], c = p[(u + 2) % 3];
         const uint32_t w = ahead[u].apex;
         // Default diagonal m_{u+1}--v_u: (a, b, m1), (a, m1, m2), (m2, m1, c).
-        const uint32_t x = he_.apex(a, w);
-        const bool as_default = x != kNoIndex && he_.apex(x, w) == c;
+        const LeafHalfedges::Edge aw = he_.edge(a, w);
+        const uint32_t x = aw.apex;
+        const LeafHalfedges::Edge xw = x != kNoIndex ? he_.edge(x, w) : LeafHalfedges::Edge{};
+        const bool as_default = x != kNoIndex && xw.apex == c;
         // Flipped diagonal m_{u+2}--v_{u+1}: (a, b, m2), (b, m1, m2), (m2, m1, c).
-        const uint32_t y = he_.apex(w, b);
-        const bool as_flipped = !as_default && y != kNoIndex && he_.apex(w, y) == c;
+        const LeafHalfedges::Edge wb = as_default ? LeafHalfedges::Edge{} : he_.edge(w, b);
+        const uint32_t y = wb.apex;
+        const LeafHalfedges::Edge wy = !as_default && y != kNoIndex ? he_.edge(w, y) : LeafHalfedges::Edge{};
+        const bool as_flipped = !as_default && y != kNoIndex && wy.apex == c;
         r.fault_edge = u;
+        r.faces[r.face_count++] = ahead[u].face;
         if (as_default) {
             reveal((u + 1) % 3, w);
             reveal((u + 2) % 3, x);
+            r.faces[r.face_count++] = aw.face;
+            r.faces[r.face_count++] = xw.face;
         } else if (as_flipped) {
             reveal((u + 1) % 3, y);
             reveal((u + 2) % 3, w);
             r.flipped = true;
+            r.faces[r.face_count++] = wb.face;
+            r.faces[r.face_count++] = wy.face;
         } else {
             r.fault = Reading::no_closure;
         }
@@ -327,6 +360,12 @@ bool Reconstruction::take_reading(NodeId n, const Reading& r) {
         if (r.unsplit[e]) unsplit_edges_.push_back({n, e});
     }
     for (int i = 0; i < r.reveal_count; ++i) reveals_.push_back({n, r.reveal_edge[i], r.reveal_vertex[i]});
+    if (faces_read_) {  // all three written (room for them), face_count kept: no loop, no call
+        level_faces_end_[0] = r.faces[0];
+        level_faces_end_[1] = r.faces[1];
+        level_faces_end_[2] = r.faces[2];
+        level_faces_end_ += r.face_count;
+    }
     // A level read again after a repair may read otherwise; written only on a change (an out-of-line call).
     if (h_.diagonal_flipped(n) != r.flipped) h_.set_diagonal_flipped(n, r.flipped);
     return false;
@@ -450,9 +489,9 @@ std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint
                                             MidpointGuide guide, const PositionIndex& positions,
                                             LeafSearch& search, const std::string& what, const UndoSteps* steps,
                                             const PickReferee* referee, const std::vector<uint32_t>* input_of,
-                                            bool vote_on_guides) {
+                                            bool vote_on_guides, LeafFacesRead* faces_read) {
     return Reconstruction(h, leaf_of_base, leaf, halfedges, guide, positions, search, what, steps, referee, input_of,
-                          vote_on_guides)
+                          vote_on_guides, faces_read)
         .run();
 }
 

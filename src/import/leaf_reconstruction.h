@@ -89,6 +89,18 @@ struct GuidedPick {
 // and goes on with the true vertex (bench/import_picks.cpp).
 using PickReferee = std::function<uint32_t(const GuidedPick&)>;
 
+// The leaf faces that a reconstruction's last reading of each leaf found, one bit each: its red
+// triangle, or its green ones (docs/IMPORT.md, "The final check"). Filled only by the ways that
+// read each level once for good (no undo steps, no referee).
+struct LeafFacesRead {
+    bool filled = false;
+    bool twice = false;  // a face found for two leaves
+    uint64_t count = 0;  // faces found, with repeats
+    std::vector<uint64_t> bits;
+    // Every face of the leaf mesh found exactly once: the leaves' triangles are its faces.
+    bool all_once(size_t faces) const { return filled && !twice && count == faces; }
+};
+
 // Builds the forest of `h` (a hierarchy of unrefined roots over the base, whose vertex i is leaf
 // vertex leaf_of_base[i]) so that its leaf mesh is `leaf`; returns the leaf vertex of every
 // vertex of `h` (0xffffffff for none). With `exact_midpoints`, the vertex an edge split creates is
@@ -99,7 +111,8 @@ using PickReferee = std::function<uint32_t(const GuidedPick&)>;
 // does not fit, naming leaf vertex l as input_of[l] when input_of is given (the caller's numbering
 // of a renumbered leaf mesh); the caller verifies the whole leaf mesh afterwards. With
 // `vote_on_guides` (the leaf-midpoint guide), throws SubdivisionGuideCloser when the first levels'
-// revealed midpoints lie nearer where the subdivision guide would look.
+// revealed midpoints lie nearer where the subdivision guide would look. `faces_read` (if given)
+// gets the faces of the leaves' readings, where the way fills it (LeafFacesRead).
 std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
                                             const TriangleMesh& leaf, const LeafHalfedges& halfedges,
                                             MidpointGuide guide, const PositionIndex& positions,
@@ -107,6 +120,6 @@ std::vector<uint32_t> reconstruct_hierarchy(Hierarchy& h, const std::vector<uint
                                             const UndoSteps* steps = nullptr,
                                             const PickReferee* referee = nullptr,
                                             const std::vector<uint32_t>* input_of = nullptr,
-                                            bool vote_on_guides = false);
+                                            bool vote_on_guides = false, LeafFacesRead* faces_read = nullptr);
 
 }  // namespace amc

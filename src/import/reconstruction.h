@@ -25,10 +25,19 @@ public:
     Reconstruction(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base, const TriangleMesh& leaf,
                    const LeafHalfedges& halfedges, MidpointGuide guide, const PositionIndex& positions,
                    LeafSearch& search, const std::string& what, const UndoSteps* steps, const PickReferee* referee,
-                   const std::vector<uint32_t>* input_of, bool vote_on_guides = false)
+                   const std::vector<uint32_t>* input_of, bool vote_on_guides = false,
+                   LeafFacesRead* faces_read = nullptr)
         : vote_on_guides_(vote_on_guides && guide == MidpointGuide::leaf_midpoint), h_(h), leaf_(leaf), he_(halfedges),
           guide_(guide), positions_(positions), search_(search), what_(what), referee_(referee), input_of_(input_of) {
         if (steps) choice_ = std::make_unique<UndoStepChoice>(*steps);
+        // Without undo steps or a referee each level's last reading is final (no level is gone
+        // back to, no local reconstruction reads it).
+        if (faces_read && !steps && !referee) {
+            faces_read_ = faces_read;
+            *faces_read_ = LeafFacesRead{};
+            faces_read_->filled = true;
+            faces_read_->bits.assign((leaf.triangles.size() + 63) / 64, 0);
+        }
         // A level's lists hold at most three unsplit edges and two reveals per node, and a
         // node is a leaf face at most once: room for the largest level, offered to huge pages
         // (grown by doubling, their copies and fresh 4 KiB pages were a third of the page
@@ -142,6 +151,8 @@ private:
         int reveal_edge[2] = {0, 0};
         uint32_t reveal_vertex[2] = {kNoIndex, kNoIndex};
         bool flipped = false;
+        int face_count = 0;
+        uint32_t faces[3] = {0, 0, 0};  // a leaf's faces: its triangle, or its green ones
         int fault_edge = 0;
         uint32_t fault_detail[2] = {kNoIndex, kNoIndex};  // edge_across: the face; two_vertices: both
         bool refined() const { return fault == none && unsplit_count == 0; }
@@ -470,6 +481,14 @@ private:
     std::vector<uint32_t> near_b_;  // per leaf vertex: the stamp of the last call that found it next to b
     uint32_t stamp_ = 0;            // (only_unmatched_common_neighbor)
     std::vector<UnsplitEdge> unsplit_edges_;
+    LeafFacesRead* faces_read_ = nullptr;  // the caller's, when every reading is final (the constructor)
+    // The faces of the leaves of the level read last: room for three per node of the level
+    // (written through a pointer: a vector's insert was a call per leaf).
+    std::unique_ptr<uint32_t[]> level_faces_;
+    size_t level_faces_room_ = 0;
+    uint32_t* level_faces_end_ = nullptr;
+    // The faces of a level's leaves (its last reading: final) added to faces_read_.
+    void add_level_faces();
     std::vector<NodeId> refined_;        // scratch of reconstruct_level
     bool read_failed_ = false;           // reconstruct_level failed while reading its level
     NodeId failed_node_ = kNoNode;       // else the node of the level whose vertices did not fit
