@@ -148,7 +148,6 @@ void Reconstruction::read_level_or_repair(const std::vector<NodeId>& level, std:
 void Reconstruction::read_level(const std::vector<NodeId>& level, std::vector<NodeId>& refined) {
     refined.clear();
     reveals_.clear();
-    unsplit_edges_.clear();
     if (faces_read_) {
         if (level_faces_room_ < 3 * level.size()) {
             level_faces_room_ = 3 * level.size();
@@ -167,14 +166,9 @@ void Reconstruction::read_level(const std::vector<NodeId>& level, std::vector<No
         for (NodeId n : refined) {
             if (!h_.can_split(n)) fail_node(n, "is refined next to a coarser element (2:1 balance violated)");
         }
-        // A leaf edge across which the same-level neighbour is refined: the neighbour's
-        // vertex on it is not closed on this side.
-        for (const UnsplitEdge& u : unsplit_edges_) {
-            if (is_refined(h_.neighbor(u.node, u.edge)))
-                fail("face " + std::to_string(he_.face(corner(u.node, u.edge), corner(u.node, (u.edge + 1) % 3))) +
-                     " has the edge (" + edge_text(u.node, u.edge) +
-                     ") whole, but the element across splits it (T-junction)");
-        }
+        // A leaf edge across which the same-level neighbour is refined needs no test of its own:
+        // that neighbour's reading (classify, every node of the level before this) found the
+        // edge a leaf edge in its reverse direction and refused it ("nothing on its other side").
         for (const Reveal& r : reveals_) {
             if (!is_refined(h_.neighbor(r.node, r.edge))) {
                 explain_misfit(r.node);
@@ -327,6 +321,12 @@ AMC_ALWAYS_INLINE Reconstruction::Reading Reconstruction::read_inline(const uint
 bool Reconstruction::classify(NodeId n) {
     const uint32_t p[3] = {corner(n, 0), corner(n, 1), corner(n, 2)};
     const Reading r = read_inline(p);
+    // The messages out of line: their strings made every reading save and restore registers.
+    if (__builtin_expect(r.fault != Reading::none, 0)) fail_reading(n, p, r);
+    return take_reading(n, r);
+}
+
+void Reconstruction::fail_reading(NodeId n, const uint32_t p[3], const Reading& r) const {
     switch (r.fault) {
         case Reading::none:
             break;
@@ -351,14 +351,11 @@ bool Reconstruction::classify(NodeId n) {
             explain_misfit(n);
             fail_node(n, "has two split edges but no green closure on edge (" + edge_text(n, r.fault_edge) + ")");
     }
-    return take_reading(n, r);
+    fail("internal: a reading without a fault taken for one");
 }
 
 bool Reconstruction::take_reading(NodeId n, const Reading& r) {
     if (r.unsplit_count == 0) return true;
-    for (int e = 0; e < 3; ++e) {
-        if (r.unsplit[e]) unsplit_edges_.push_back({n, e});
-    }
     for (int i = 0; i < r.reveal_count; ++i) reveals_.push_back({n, r.reveal_edge[i], r.reveal_vertex[i]});
     if (faces_read_) {  // all three written (room for them), face_count kept: no loop, no call
         level_faces_end_[0] = r.faces[0];

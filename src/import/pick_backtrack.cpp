@@ -99,7 +99,6 @@ int Reconstruction::local_misfits(int from, int depth, const std::vector<NodeId>
     try {
         for (int d = from; d < depth && !nodes.empty() && misfits < cap; ++d) {
             reveals_.clear();
-            unsplit_edges_.clear();
             std::vector<std::pair<NodeId, uint32_t>> split;
             // The count only grows: once it reaches the cap, the rest is not read.
             for (const auto& node : nodes) {

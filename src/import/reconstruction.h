@@ -4,6 +4,7 @@
 // down contradicts them (pick_backtrack.cpp). Internal to leaf_reconstruction.h's function.
 #pragma once
 
+#include "common/compiler.h"
 #include "common/huge_pages.h"
 #include "common/no_index.h"
 #include "geometry/closest_point.h"
@@ -38,11 +39,10 @@ public:
             faces_read_->filled = true;
             faces_read_->bits.assign((leaf.triangles.size() + 63) / 64, 0);
         }
-        // A level's lists hold at most three unsplit edges and two reveals per node, and a
-        // node is a leaf face at most once: room for the largest level, offered to huge pages
+        // A level's reveals are at most two per node, and a node is a leaf face at most once:
+        // room for the largest level, offered to huge pages
         // (grown by doubling, their copies and fresh 4 KiB pages were a third of the page
         // faults of a 10^6-face import). Only the pages a level writes become resident.
-        reserve_huge(unsplit_edges_, 3 * leaf.triangles.size());
         reserve_huge(reveals_, 2 * leaf.triangles.size());
         // Each hierarchy vertex has a leaf vertex of its own: room for all of them once (grown a
         // level at a time, these arrays were copied about twice over, 2% of an import).
@@ -56,10 +56,6 @@ public:
     std::vector<uint32_t> run();
 
 private:
-    struct UnsplitEdge {
-        NodeId node;
-        int edge;
-    };
     struct Reveal {
         NodeId node;
         int edge;
@@ -360,6 +356,8 @@ private:
     // none. For a leaf, checks its red or green triangles and notes the hanging nodes, which are
     // the midpoints of the refined neighbours' edges.
     bool classify(NodeId n);
+    // classify's refusal of reading r of n (corners p), whose fault the message names.
+    [[noreturn]] AMC_NOIPA void fail_reading(NodeId n, const uint32_t p[3], const Reading& r) const;
     // classify's bookkeeping for a reading without a fault (a leaf's unsplit edges, reveals and
     // diagonal); true when n reads refined. A lenient reconstruction (local_misfits) counts a
     // fault instead of throwing its message (a refusal's judgements read thousands of misfits).
@@ -480,7 +478,6 @@ private:
     std::vector<Reveal> reveals_;
     std::vector<uint32_t> near_b_;  // per leaf vertex: the stamp of the last call that found it next to b
     uint32_t stamp_ = 0;            // (only_unmatched_common_neighbor)
-    std::vector<UnsplitEdge> unsplit_edges_;
     LeafFacesRead* faces_read_ = nullptr;  // the caller's, when every reading is final (the constructor)
     // The faces of the leaves of the level read last: room for three per node of the level
     // (written through a pointer: a vector's insert was a call per leaf).
