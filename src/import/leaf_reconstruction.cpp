@@ -82,14 +82,16 @@ void Reconstruction::reconstruct_level(std::vector<NodeId>& level, std::vector<N
         vote_on_guides();
         if (votes_leaf_ + votes_subdivision_ >= kMinVotes) decide_guides();
     }
-    next.clear();
+    next.resize(4 * refined.size());  // written through a pointer: push_back checked its room per child
+    NodeId* children = next.data();
     for (NodeId n : refined) {
         failed_node_ = n;
         for (int e = 0; e < 3; ++e) {
             const VertexId m = h_.midpoint(n, e);
             if (leaf_of_vertex_[m] == kNoIndex) assign(m, find_midpoint(n, e));
         }
-        for (int k = 0; k < 4; ++k) next.push_back(h_.child(n, k));
+        for (int k = 0; k < 4; ++k) children[k] = h_.child(n, k);
+        children += 4;
     }
     failed_node_ = kNoNode;
 }
@@ -160,7 +162,7 @@ void Reconstruction::read_level(const std::vector<NodeId>& level, std::vector<No
     }
     mark_refined(refined);
     auto is_refined = [&](NodeId q) {
-        return q != kNoNode && q < refined_index_.size() && refined_index_[q] != kNoIndex;
+        return q != kNoNode && refined_index_[q] != kNoIndex;  // sized to every node (mark_refined)
     };
     try {
         for (NodeId n : refined) {
