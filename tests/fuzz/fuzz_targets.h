@@ -9,6 +9,8 @@
 #include <amc/hierarchy.h>
 #include <amc/mesh.h>
 
+#include "../random_hierarchies.h"
+
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -50,14 +52,8 @@ Vec3 base_position(uint32_t v);
 constexpr int kGeometryContexts = 51;           // as many as an .amc file has
 constexpr size_t kMaxGeometryCoordinates = 512;  // decoded a run at most
 
-// A generator whose output is the same on every platform.
-struct Random {
-    uint64_t state;
-    uint64_t next() {
-        state = state * 6364136223846793005ull + 1442695040888963407ull;
-        return state >> 33;
-    }
-};
+// The tests' generator, whose output is the same on every platform.
+using Random = amc::testing::Random;
 
 // Reads fixed-size values front to back; past the end they read as 0.
 class ByteReader {
