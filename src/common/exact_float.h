@@ -12,6 +12,8 @@
 
 #include <amc/mesh.h>
 
+#include "common/compiler.h"
+
 #if defined(__FAST_MATH__)
 #error "amcodec must not be built with -ffast-math (or -fassociative-math): its coders need IEEE arithmetic"
 #endif
@@ -43,5 +45,9 @@ inline Vec3 rounded_to_float(Vec3 p) { return {rounded_to_float(p.x), rounded_to
 // mesh.h's dot and cross with every product rounded before it is added: IEEE binary64 in exactly
 // the order written, for the decisions both sides of a coder take on positions.
 inline double exact_dot(Vec3 a, Vec3 b) { return rounded(a.x * b.x) + rounded(a.y * b.y) + rounded(a.z * b.z); }
+AMC_ALWAYS_INLINE Vec3 exact_cross(Vec3 a, Vec3 b) {  // the static decoders compute one per vertex
+    return {rounded(a.y * b.z) - rounded(a.z * b.y), rounded(a.z * b.x) - rounded(a.x * b.z),
+            rounded(a.x * b.y) - rounded(a.y * b.x)};
+}
 
 }  // namespace amc

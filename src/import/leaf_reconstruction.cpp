@@ -454,7 +454,7 @@ Vec3 Reconstruction::normal_ray_hit(NodeId n, int e, Vec3 mid) {
     // The remesher's line, as far as the edge is long. The tolerance keeps a line through a vertex
     // (the remesher's vertex, unless it moved it later) from slipping between that vertex's triangles.
     const Vec3 normal = placement_normal(p[a], p[b], p[c], p[d]);
-    const auto hit = search_.surface().intersect_line(mid, normal, std::sqrt(dot(p[b] - p[a], p[b] - p[a])), 1e-9);
+    const auto hit = search_.surface().intersect_line(mid, normal, std::sqrt(exact_dot(p[b] - p[a], p[b] - p[a])), 1e-9);
     return hit ? hit->point : mid;
 }
 

@@ -100,12 +100,6 @@ Vec3 predict_parallelogram(const std::vector<Vec3>& decoded, std::array<int32_t,
 
 namespace frame_detail {
 
-// u x v with every product rounded before the subtraction (no fused multiply-add).
-AMC_ALWAYS_INLINE Vec3 exact_cross(Vec3 u, Vec3 v) {
-    return {rounded(u.y * v.z) - rounded(u.z * v.y), rounded(u.z * v.x) - rounded(u.x * v.z),
-            rounded(u.x * v.y) - rounded(u.y * v.x)};
-}
-
 // 1 / L for the lengths L = sqrt(squared) of two vectors, each correctly rounded, and whether L is
 // positive and finite (else the unit vector is the zero vector). With SSE2 both square roots and
 // both divisions are one instruction each: they are most of the unit-normal frame.
@@ -155,8 +149,8 @@ AMC_ALWAYS_INLINE NormalFrame frame_of(const Mesh& h, const FrameCorners& corner
     f.midpoint = rounded_scaled(0.5, a + b);  // predict_midpoint's
     if (h.single_precision()) f.midpoint = rounded_to_float(f.midpoint);
     const bool has_d = corners.d != kNoVertex;
-    const Vec3 n1 = frame_detail::exact_cross(b - a, c - a);
-    const Vec3 n2 = has_d ? frame_detail::exact_cross(a - b, h.position(corners.d) - b) : Vec3{};
+    const Vec3 n1 = exact_cross(b - a, c - a);
+    const Vec3 n2 = has_d ? exact_cross(a - b, h.position(corners.d) - b) : Vec3{};
     if (UnitNormals) {
         // Modes 4 and 5 sum unit normals (the remesher's direction, vertex_placement.cpp).
         const frame_detail::InverseLengths r = frame_detail::inverse_lengths(exact_dot(n1, n1), exact_dot(n2, n2));
@@ -197,7 +191,7 @@ AMC_ALWAYS_INLINE FramePairLanes frame_pair_lanes(const Mesh& h, const FrameCorn
     // GCC's intrinsics are vector arithmetic: a product fed to an add fuses into an FMA under
     // -ffp-contract=fast unless it goes through `rounded`, as in the scalar frame_of.
     auto mul = [](__m128d u, __m128d v) { return rounded(_mm_mul_pd(u, v)); };
-    auto cross = [mul](const Lanes& u, const Lanes& v) {  // frame_detail::exact_cross
+    auto cross = [mul](const Lanes& u, const Lanes& v) {  // exact_cross (exact_float.h)
         return Lanes{_mm_sub_pd(mul(u.y, v.z), mul(u.z, v.y)), _mm_sub_pd(mul(u.z, v.x), mul(u.x, v.z)),
                      _mm_sub_pd(mul(u.x, v.y), mul(u.y, v.x))};
     };

@@ -14,11 +14,6 @@ namespace amc {
 
 namespace {
 
-Vec3 exact_cross(Vec3 a, Vec3 b) {
-    return {rounded(a.y * b.z) - rounded(a.z * b.y), rounded(a.z * b.x) - rounded(a.x * b.z),
-            rounded(a.x * b.y) - rounded(a.y * b.x)};
-}
-
 double exact_length(Vec3 a) { return std::sqrt(exact_dot(a, a)); }
 
 // The longest edge of node n, as LevelShapes::bending measures it (a correctly rounded root keeps
