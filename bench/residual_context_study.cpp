@@ -81,11 +81,6 @@ double static_bits(const Table& t) {
     return bits;
 }
 
-Vec3 exact_cross(Vec3 u, Vec3 v) {
-    return {rounded(u.y * v.z) - rounded(u.z * v.y), rounded(u.z * v.x) - rounded(u.x * v.z),
-            rounded(u.x * v.y) - rounded(u.y * v.x)};
-}
-
 double component(Vec3 p, int a) { return a == 0 ? p.x : a == 1 ? p.y : p.z; }
 
 constexpr int kDesigns = 8;
