@@ -52,6 +52,94 @@ EncodeOptions with_chunks(uint32_t chunks, unsigned threads = 0, int bits = 0) {
     return options;
 }
 
+// The encoder's split (and MPI's of a file's chunks among ranks): runs of consecutive roots, chunk k
+// closing at the first root where the nodes so far reach (k + 1) / chunks of all, at least one root
+// for each chunk still to come. Nodes are the weight: docs/BENCHMARKS.md, "Threads and memory", "What
+// a chunk's work follows" measured chunk work against nodes, vertices, faces, roots and bytes.
+TEST(Chunks, BalancedChunksCloseEachChunkAtItsShareOfTheNodes) {
+    auto ranges = [](const std::vector<uint64_t>& nodes, uint32_t chunks) {
+        std::vector<std::pair<uint32_t, uint32_t>> out;
+        for (const RootRange& r : balanced_chunks(nodes, chunks)) out.emplace_back(r.first, r.count);
+        return out;
+    };
+    using Ranges = std::vector<std::pair<uint32_t, uint32_t>>;
+    // One heavy root: the first chunk closes right after it, at 22 of 30 nodes.
+    EXPECT_EQ(ranges({1, 21, 1, 1, 5, 1}, 2), (Ranges{{0, 2}, {2, 4}}));
+    EXPECT_EQ(ranges({1, 21, 1, 1, 5, 1}, 3), (Ranges{{0, 2}, {2, 1}, {3, 3}}));
+    // A share reached exactly closes the chunk.
+    EXPECT_EQ(ranges({2, 2, 2, 2}, 2), (Ranges{{0, 2}, {2, 2}}));
+    // A heavy last root still gets a chunk of its own.
+    EXPECT_EQ(ranges({1, 1, 1, 1, 100}, 2), (Ranges{{0, 4}, {4, 1}}));
+    // No more chunks than roots, and at least one.
+    EXPECT_EQ(ranges({5, 5}, 4), (Ranges{{0, 1}, {1, 1}}));
+    EXPECT_EQ(ranges({7}, 0), (Ranges{{0, 1}}));
+
+    // A forest with known uneven roots: root 0 refined uniformly four levels deep, root 11 two,
+    // the others by balance and closure only. nodes_per_root counts each root's tree as a walk does.
+    Hierarchy h(make_icosahedron());
+    auto leaves_of = [&h](NodeId root) {
+        std::vector<NodeId> leaves, stack{root};
+        while (!stack.empty()) {
+            const NodeId n = stack.back();
+            stack.pop_back();
+            if (h.is_leaf(n)) {
+                leaves.push_back(n);
+                continue;
+            }
+            for (int k = 0; k < 4; ++k) stack.push_back(h.child(n, k));
+        }
+        return leaves;
+    };
+    auto refine_below = [&](NodeId root, int depth) {
+        for (int level = 0; level < depth; ++level)
+            for (NodeId leaf : leaves_of(root))
+                if (h.level(leaf) == level) h.refine(leaf);
+    };
+    refine_below(0, 4);
+    refine_below(11, 2);
+    std::vector<uint64_t> walked(h.root_count(), 0);
+    for (NodeId r = 0; r < h.root_count(); ++r) {
+        std::vector<NodeId> stack{r};
+        while (!stack.empty()) {
+            const NodeId n = stack.back();
+            stack.pop_back();
+            ++walked[r];
+            if (h.is_leaf(n)) continue;
+            for (int k = 0; k < 4; ++k) stack.push_back(h.child(n, k));
+        }
+    }
+    const std::vector<uint64_t> per_root = nodes_per_root(h, root_of_nodes(h));
+    ASSERT_EQ(per_root, walked);
+    uint64_t total = 0;
+    for (uint64_t n : per_root) total += n;
+    ASSERT_EQ(total, h.node_count());
+    ASSERT_GT(per_root[0], total / 2);  // uneven indeed: root 0 holds more than half of the forest
+    for (uint32_t chunks : {2u, 3u, 5u}) {
+        SCOPED_TRACE("chunks " + std::to_string(chunks));
+        const std::vector<RootRange> split = balanced_chunks(per_root, chunks);
+        ASSERT_EQ(split.size(), chunks);
+        uint64_t running = 0;
+        uint32_t next_root = 0;
+        for (uint32_t k = 0; k < chunks; ++k) {
+            ASSERT_EQ(split[k].first, next_root);
+            ASSERT_GE(split[k].count, 1u);
+            for (uint32_t r = split[k].first; r < split[k].first + split[k].count; ++r) {
+                running += per_root[r];
+                const bool last_root = r + 1 == split[k].first + split[k].count;
+                const bool share_reached = running * chunks >= total * (k + 1);
+                const bool roots_needed = h.root_count() - (r + 1) <= chunks - (k + 1);
+                if (k + 1 < chunks) {
+                    EXPECT_EQ(last_root, share_reached || roots_needed) << "root " << r;
+                }
+            }
+            next_root = split[k].first + split[k].count;
+        }
+        EXPECT_EQ(next_root, h.root_count());
+        // Root 0's tree alone reaches the first share of any of these counts: chunk 0 is that root.
+        EXPECT_EQ(split[0].count, 1u);
+    }
+}
+
 TEST(Chunks, ChunkedFilesDecodeToWhatUnchunkedFilesDo) {
     int chunked_files = 0;
     for (uint64_t seed = 0; seed < 60; ++seed) {
