@@ -17,8 +17,11 @@
 // "A refined node across a closure").
 //
 // With --detect, also what detect_base (import_mesh's search, its rerun included) undid per level.
+// With --wrong, the free steps' wrong splits counted by the coarsest vertex each reads as a
+// midpoint (its level in the true hierarchy: 0 for a base vertex, l + 1 for a midpoint of a level-l
+// node), beside the finest level the step undid (docs/IMPORT.md, "The demo's wrong undos").
 //
-// Usage: import_levels [--steps] [--ready] [--detect] [--seed N] corpus/*.amh   (--seed: the shuffle's, 23 by default)
+// Usage: import_levels [--steps] [--ready] [--detect] [--wrong] [--seed N] corpus/*.amh   (--seed: the shuffle's, 23 by default)
 #include "user_leaf_mesh.h"
 
 #include "import/base_detection.h"
@@ -215,7 +218,7 @@ std::string list(const std::vector<size_t>& v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    bool print_steps = false, print_ready = false, print_detected = false;
+    bool print_steps = false, print_ready = false, print_detected = false, print_wrong = false;
     uint64_t seed = 23;
     std::vector<std::string> files;
     for (int i = 1; i < argc; ++i) {
@@ -228,12 +231,14 @@ int main(int argc, char** argv) {
             print_ready = true;
         } else if (arg == "--detect") {
             print_detected = true;
+        } else if (arg == "--wrong") {
+            print_wrong = true;
         } else {
             files.push_back(arg);
         }
     }
     if (files.empty()) {
-        std::fprintf(stderr, "usage: import_levels [--steps] [--ready] [--detect] [--seed N] hierarchy.amh...\n");
+        std::fprintf(stderr, "usage: import_levels [--steps] [--ready] [--detect] [--wrong] [--seed N] hierarchy.amh...\n");
         return 2;
     }
     std::printf("| model | depth | refined nodes | ideal, whole patches: undone per step | ideal, partial | finest level's nodes found in step 1 | free: true / wrong blocks, triangles left | anchored: true / wrong, triangles left (base) |\n");
@@ -262,8 +267,30 @@ int main(int argc, char** argv) {
         std::vector<uint8_t> kept(user.positions.size(), 0);
         for (amc::VertexId v = 0; v < h.base().positions.size(); ++v) kept[user_vertex(v)] = 1;
         ReadyTrace ready(h, std::move(node_of_split));
-        StepObserver observe;
-        if (print_ready) observe = [&](int step, const std::vector<std::array<uint32_t, 6>>& splits) { ready.step(step, splits); };
+        // Per user vertex: the level at which it appears in the true hierarchy.
+        std::vector<int> vertex_level(user.positions.size(), 0);
+        for (NodeId n : h.breadth_first_order()) {
+            if (h.is_leaf(n)) continue;
+            for (int k = 0; k < 3; ++k) vertex_level[user_vertex(h.midpoint(n, k))] = h.level(n) + 1;
+        }
+        StepObserver observe = [&](int step, const std::vector<std::array<uint32_t, 6>>& splits) {
+            if (print_ready) ready.step(step, splits);
+            if (!print_wrong) return;
+            std::map<int, size_t> wrong_by_level;  // coarsest vertex read as a midpoint -> wrong splits
+            int finest_undone = -1;
+            for (const auto& s : splits) {
+                const auto it = level_of_split.find(sorted_key(s[3], s[4], s[5]));
+                if (it != level_of_split.end()) {
+                    finest_undone = std::max(finest_undone, it->second);
+                    continue;
+                }
+                ++wrong_by_level[std::min({vertex_level[s[3]], vertex_level[s[4]], vertex_level[s[5]]})];
+            }
+            std::printf("|   step %d: finest node level undone %d; wrong splits by the coarsest vertex read as a midpoint:", step + 1,
+                        finest_undone);
+            for (const auto& [level, count] : wrong_by_level) std::printf(" level %d: %zu", level, count);
+            std::printf(" | | | | | | | |\n");
+        };
         const Detection free = detect(user, level_of_split, finest, nullptr, observe);
         const Detection anchored = detect(user, level_of_split, finest, &kept);
         const std::string name = std::filesystem::path(file).stem().string();
