@@ -55,7 +55,7 @@ EncodeOptions with_chunks(uint32_t chunks, unsigned threads = 0, int bits = 0) {
 // The encoder's split (and MPI's of a file's chunks among ranks): runs of consecutive roots, chunk k
 // closing at the first root where the nodes so far reach (k + 1) / chunks of all, at least one root
 // for each chunk still to come. Nodes are the weight: docs/BENCHMARKS.md, "Threads and memory", "What
-// a chunk's work follows" measured chunk work against nodes, vertices, faces, roots and bytes.
+// a chunk's work follows" measured chunk work against roots, nodes, vertices, leaf faces and symbols.
 TEST(Chunks, BalancedChunksCloseEachChunkAtItsShareOfTheNodes) {
     auto ranges = [](const std::vector<uint64_t>& nodes, uint32_t chunks) {
         std::vector<std::pair<uint32_t, uint32_t>> out;
