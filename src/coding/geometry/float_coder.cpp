@@ -289,9 +289,30 @@ Quantizer make_quantizer(Vec3 box_min, Vec3 box_max, int bits) {
     q.step = extent > 0.0 ? extent / static_cast<double>(q.max_coordinate()) : 1.0;
     if (q.step == 0.0) q.step = std::numeric_limits<double>::denorm_min();
     // Every grid point must be a finite double: o + (2^bits - 1) * step may round past DBL_MAX
-    // when the box reaches it (the decoder refuses non-finite coordinates).
-    for (int axis = 0; axis < 3; ++axis) {
-        while (!std::isfinite(dequantize_coordinate(q, axis, q.max_coordinate()))) q.step = std::nextafter(q.step, 0.0);
+    // when the box reaches it (the decoder refuses non-finite coordinates). The largest step not
+    // above this one that keeps the top grid point finite on every axis: finiteness falls off
+    // monotonically with the step, so a bisection over the positive doubles' bit patterns finds
+    // it (one ulp at a time could take up to 2^52 steps).
+    auto top_is_finite = [&q](double step) {
+        Quantizer t = q;
+        t.step = step;
+        for (int axis = 0; axis < 3; ++axis)
+            if (!std::isfinite(dequantize_coordinate(t, axis, t.max_coordinate()))) return false;
+        return true;
+    };
+    if (!top_is_finite(q.step)) {
+        auto as_double = [](uint64_t bits) {
+            double d;
+            std::memcpy(&d, &bits, sizeof d);
+            return d;
+        };
+        uint64_t finite_bits = 0, infinite_bits;  // step 0 keeps every grid point at the finite origin
+        std::memcpy(&infinite_bits, &q.step, sizeof infinite_bits);
+        while (infinite_bits - finite_bits > 1) {
+            const uint64_t middle = finite_bits + (infinite_bits - finite_bits) / 2;
+            (top_is_finite(as_double(middle)) ? finite_bits : infinite_bits) = middle;
+        }
+        q.step = as_double(finite_bits);
     }
     return q;
 }
