@@ -6,6 +6,7 @@
 #include "common/bits.h"
 #include "common/compiler.h"
 #include "common/exact_float.h"
+#include "common/little_endian.h"
 
 #include <algorithm>
 #include <cfloat>
@@ -301,18 +302,13 @@ Quantizer make_quantizer(Vec3 box_min, Vec3 box_max, int bits) {
         return true;
     };
     if (!top_is_finite(q.step)) {
-        auto as_double = [](uint64_t bits) {
-            double d;
-            std::memcpy(&d, &bits, sizeof d);
-            return d;
-        };
-        uint64_t finite_bits = 0, infinite_bits;  // step 0 keeps every grid point at the finite origin
-        std::memcpy(&infinite_bits, &q.step, sizeof infinite_bits);
+        uint64_t finite_bits = 0;  // step 0 keeps every grid point at the finite origin
+        uint64_t infinite_bits = bit_cast<uint64_t>(q.step);
         while (infinite_bits - finite_bits > 1) {
             const uint64_t middle = finite_bits + (infinite_bits - finite_bits) / 2;
-            (top_is_finite(as_double(middle)) ? finite_bits : infinite_bits) = middle;
+            (top_is_finite(bit_cast<double>(middle)) ? finite_bits : infinite_bits) = middle;
         }
-        q.step = as_double(finite_bits);
+        q.step = bit_cast<double>(finite_bits);
     }
     return q;
 }
