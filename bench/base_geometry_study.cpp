@@ -7,9 +7,11 @@
 // coded at this vertex. Each design is coded for real (the library's arithmetic coder and
 // residual models) in mode 2's vertex order; the table gives bytes of the positions' code (raw
 // side bits included) and the ratio to today's.
-//   base_geometry_study [--bits 12,16,0] [--shrink L] mesh ...
+//   base_geometry_study [--bits 12,16,0] [--shrink L] [--dihedral S] mesh ...
 // --shrink L predicts m + L (m - c) instead of the parallelogram's m + (m - c) (m the gate edge's
-// middle, c the stencil's opposite vertex).
+// middle, c the stencil's opposite vertex). --dihedral S turns the parallelogram about the gate edge
+// by S times the bend between the gate triangle and its decoded neighbour across another edge (the
+// surface assumed to keep bending as it did; S < 0 bends the other way).
 #include <amc/mesh_io.h>
 
 #include "coding/base/base_mesh_coder.h"
@@ -18,6 +20,8 @@
 #include "coding/geometry/geometry_prediction.h"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
@@ -27,6 +31,40 @@
 namespace {
 
 using namespace amc;
+
+// The mesh's triangles in decoder vertex ids, and each vertex's triangles.
+struct DecoderTriangles {
+    std::vector<Triangle> triangles;
+    std::vector<std::vector<uint32_t>> of_vertex;
+};
+
+// The third vertex of a triangle on edge (u, w) other than `not_v`, decoded before `limit`; -1 if
+// none. (A triangle whose corners are decoded is taken as known: mode 2 may not have closed it yet,
+// so this favours the predictor that uses it.)
+int64_t third_decoded(const DecoderTriangles& mesh, uint32_t u, uint32_t w, uint32_t not_v, uint32_t limit) {
+    for (uint32_t t : mesh.of_vertex[u]) {
+        const Triangle& tr = mesh.triangles[t];
+        bool has_w = false;
+        uint32_t other = UINT32_MAX;
+        for (int j = 0; j < 3; ++j) {
+            if (tr[j] == w) has_w = true;
+            else if (tr[j] != u) other = tr[j];
+        }
+        if (has_w && other != not_v && other < limit) return other;
+    }
+    return -1;
+}
+
+Vec3 rotate_about(Vec3 p, Vec3 origin, Vec3 axis, double angle) {
+    const Vec3 v = p - origin;
+    const double c = std::cos(angle), s = std::sin(angle);
+    return origin + (c * v) + (s * cross(axis, v)) + ((1 - c) * dot(axis, v)) * axis;
+}
+
+Vec3 unit(Vec3 v) {
+    const double n = std::sqrt(dot(v, v));
+    return n > 0 ? (1.0 / n) * v : v;
+}
 
 int bit_length64(uint64_t v) {
     int k = 0;
@@ -93,7 +131,18 @@ int residual_bit_length(double actual, double predicted, Precision precision) {
 
 // Bytes of the base positions of `mesh` (decoder order of `code`) under each design.
 std::vector<uint64_t> code_sizes(const TriangleMesh& mesh, const BaseMeshCode& code, const Quantizer* quantizer,
-                                 Precision precision, double shrink) {
+                                 Precision precision, double shrink, double bend_share) {
+    DecoderTriangles by_id;
+    {
+        std::vector<uint32_t> decoder_id(mesh.positions.size());
+        for (size_t i = 0; i < code.vertex_order.size(); ++i) decoder_id[code.vertex_order[i]] = uint32_t(i);
+        by_id.of_vertex.assign(mesh.positions.size(), {});
+        for (const Triangle& t : mesh.triangles) {
+            const Triangle d = {decoder_id[t[0]], decoder_id[t[1]], decoder_id[t[2]]};
+            for (int j = 0; j < 3; ++j) by_id.of_vertex[d[j]].push_back(uint32_t(by_id.triangles.size()));
+            by_id.triangles.push_back(d);
+        }
+    }
     std::vector<uint64_t> sizes;
     for (const Design& design : designs()) {
         ArithmeticEncoder encoder;
@@ -111,6 +160,32 @@ std::vector<uint64_t> code_sizes(const TriangleMesh& mesh, const BaseMeshCode& c
             Vec3 predicted = predict_parallelogram(decoded, st);
             if (known.full_stencil) {
                 const Vec3 a = decoded[size_t(st[0])], b = decoded[size_t(st[1])], c = decoded[size_t(st[2])];
+                if (bend_share != 0.0) {
+                    // The bend across (c, a) or (c, b) from the triangle before, carried across the gate (a, b).
+                    const uint32_t ia = uint32_t(st[0]), ib = uint32_t(st[1]), ic = uint32_t(st[2]);
+                    int64_t x = third_decoded(by_id, ic, ia, ib, uint32_t(i));
+                    Vec3 e0 = a, e1 = c;
+                    if (x < 0) {
+                        x = third_decoded(by_id, ic, ib, ia, uint32_t(i));
+                        e0 = b;
+                    }
+                    if (x >= 0) {
+                        const Vec3 xp = decoded[size_t(x)];
+                        const Vec3 n = unit(cross(b - a, c - a));
+                        // bend angle across edge (e0, e1): between T's plane and the triangle (e0, e1, x)
+                        const Vec3 edge = unit(e1 - e0);
+                        const Vec3 in_t = unit((c + a + b - (3.0 * e0)) - dot(c + a + b - (3.0 * e0), edge) * edge);  // into T, perpendicular to the edge
+                        const Vec3 to_x = (xp - e0) - dot(xp - e0, edge) * edge;
+                        const double along = dot(to_x, -1.0 * in_t), up = dot(to_x, n);
+                        const double bend = std::atan2(up, along);  // 0 when flat
+                        const Vec3 gate = unit(b - a);
+                        const Vec3 q1 = rotate_about(predicted, a, gate, std::fabs(bend_share) * bend);
+                        const Vec3 q2 = rotate_about(predicted, a, gate, -std::fabs(bend_share) * bend);
+                        // The rotation that bends the way x lies (above or below T's plane), or with a
+                        // negative share the other way.
+                        predicted = (((dot(q1 - a, n) > 0) == (up > 0)) == (bend_share > 0)) ? q1 : q2;
+                    }
+                }
                 if (shrink != 1.0) {
                     const Vec3 m = {0.5 * (a.x + b.x), 0.5 * (a.y + b.y), 0.5 * (a.z + b.z)};
                     predicted = {m.x + shrink * (m.x - c.x), m.y + shrink * (m.y - c.y), m.z + shrink * (m.z - c.z)};
@@ -161,16 +236,18 @@ std::vector<int> parse_list(const std::string& s) {
 
 int main(int argc, char** argv) {
     std::vector<int> bit_list = {12, 16, 0};
-    double shrink = 1.0;
+    double shrink = 1.0, bend_share = 0.0;
     std::vector<std::string> paths;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         if (arg == "--bits" && i + 1 < argc) {
             bit_list = parse_list(argv[++i]);
+        } else if (arg == "--dihedral" && i + 1 < argc) {
+            bend_share = std::atof(argv[++i]);
         } else if (arg == "--shrink" && i + 1 < argc) {
             shrink = std::atof(argv[++i]);
         } else if (!arg.empty() && arg[0] == '-') {
-            std::fprintf(stderr, "usage: base_geometry_study [--bits 12,16,0] [--shrink L] mesh ...\n");
+            std::fprintf(stderr, "usage: base_geometry_study [--bits 12,16,0] [--shrink L] [--dihedral S] mesh ...\n");
             return 2;
         } else {
             paths.push_back(arg);
@@ -195,7 +272,7 @@ int main(int argc, char** argv) {
             }
             const BaseMeshCode code = encode_base_connectivity(mesh, 1, kFullBaseSearch);
             const Precision precision = mesh.single_precision && !grid ? Precision::float32 : Precision::float64;
-            const std::vector<uint64_t> sizes = code_sizes(mesh, code, grid, precision, shrink);
+            const std::vector<uint64_t> sizes = code_sizes(mesh, code, grid, precision, shrink, bend_share);
             const std::string stem = path.substr(path.find_last_of('/') + 1);
             std::printf("| %s | %d | %zu |", stem.c_str(), bits, mesh.positions.size());
             for (uint64_t size : sizes)
