@@ -8,6 +8,7 @@
 #include "coding/entropy/arithmetic_coder.h"
 #include "coding/base/base_mesh_coder.h"
 #include "coding/container.h"
+#include "coding/format_version.h"
 #include "coding/geometry/float_coder.h"
 #include "coding/hierarchy/hierarchy_stream.h"
 #include "common/bits.h"
@@ -342,6 +343,34 @@ TEST(CraftedFiles, UnrefinedHierarchiesDecode) {
         const std::vector<uint8_t> stream = encode_hierarchy(h);
         EXPECT_EQ(decode_hierarchy(h.base(), stream.data(), stream.size()).node_count(), h.node_count());
     }
+}
+
+// ---- chunked files (sections 3.11-3.14) --------------------------------------------------------
+
+// A valid file of one root a chunk (2,048 chunks, 21,000 seam vertices): decoded on two threads it
+// allocates about what one thread does. Until 2026-12-07 each chunk had an array over every seam
+// vertex (chunks times seam vertices, the square of the file): 43.8 MB more here (docs/FUZZING.md).
+TEST(CraftedFiles, ManyChunksDecodeOnThreadsInTheMemoryOfOne) {
+    Hierarchy h(make_square(32));
+    refine_uniformly(h, 3);
+    EncodeOptions options;
+    options.quantize_bits = 12;
+    options.chunks = h.root_count();
+    options.min_chunk_bytes = 0;
+    const std::vector<uint8_t> file = encode(h, options);
+    ASSERT_EQ(inspect(file.data(), file.size()).chunks.size(), size_t(h.root_count()));
+    uint64_t allocated[2] = {0, 0};
+    Hierarchy decoded[2];
+    for (unsigned threads : {1u, 2u}) {
+        DecodeOptions decode_options;
+        decode_options.threads = threads;
+        const uint64_t before = g_allocated.load();
+        decoded[threads - 1] = decode(file.data(), file.size(), decode_options);
+        allocated[threads - 1] = g_allocated.load() - before;
+        std::printf("  %u thread(s): %llu bytes allocated\n", threads, (unsigned long long)allocated[threads - 1]);
+    }
+    EXPECT_TRUE(identical(decoded[0], decoded[1]));
+    EXPECT_LT(allocated[1], allocated[0] + (uint64_t(8) << 20));
 }
 
 // ---- the base connectivity stream's own counts (section 4) -----------------------------------
