@@ -909,6 +909,7 @@ FileInfo inspect(const uint8_t* data, size_t size) {
     const bool quantized = reader.flags() & kFlagQuantized;
     Block block{};
     int level = 0;
+    size_t table_start = 0;  // the last chunk table's first entry in info.chunks
     while (reader.next(block)) {
         FileBlock entry;
         entry.type = uint8_t(block.type);
@@ -928,12 +929,16 @@ FileInfo inspect(const uint8_t* data, size_t size) {
         if (block.type == BlockType::level) entry.level = level++;
         if (block.type == BlockType::chunk_table) {
             const ChunkTable table = read_chunk_table(block, info.version, info.base_triangles, info.nodes, size);
+            table_start = info.chunks.size();
             for (size_t c = 0; c < table.roots.size(); ++c)
                 info.chunks.push_back({table.roots[c].first, table.roots[c].count, table.nodes[c], table.end + table.offsets[c], 0});
         }
         if (block.type == BlockType::chunk) {
-            for (ChunkInfo& chunk : info.chunks)
-                if (chunk.offset == block.offset) chunk.size = entry.size;
+            // A table's offsets increase (read_chunk_table): a search, not a pass over every chunk per block.
+            const auto chunk = std::lower_bound(info.chunks.begin() + std::ptrdiff_t(table_start), info.chunks.end(),
+                                                uint64_t(block.offset),
+                                                [](const ChunkInfo& c, uint64_t offset) { return c.offset < offset; });
+            if (chunk != info.chunks.end() && chunk->offset == block.offset) chunk->size = entry.size;
         }
         info.blocks.push_back(entry);
     }
