@@ -404,6 +404,33 @@ TEST(CraftedFiles, InspectOfManyChunksIsLinear) {
     EXPECT_LT(milliseconds, 1000.0);
 }
 
+// A chunked file (version 13 on) of 813 bytes whose metadata announces 2^26 nodes and 25.2 M
+// vertices (within the bytes' bound on coded positions): refused without a thread zeroing the
+// announced vertices' positions first (604 MB on two threads until 2026-12-07, docs/FUZZING.md).
+TEST(CraftedFiles, ChunkedMetadataCountsBeyondTheFile) {
+    Hierarchy h(make_icosahedron());
+    refine_randomly(h, 3000, 6, 3);
+    EncodeOptions options;
+    options.chunks = 2;
+    options.min_chunk_bytes = 0;
+    Parts parts = take_apart(encode(h, options));
+    ASSERT_GE(parts.version, kChunkVerticesVersion);
+    std::vector<uint8_t>& payload = payload_of(parts, BlockType::metadata);
+    Metadata m = read_metadata(payload);
+    const uint64_t refined = ((uint64_t(1) << 26) - m.base_triangles) / 4;
+    m.nodes = m.base_triangles + 4 * refined;
+    m.vertices = m.base_vertices + (3 * refined + 1) / 2;  // the fewest R refined nodes make
+    m.faces = m.nodes - refined;
+    payload = write_metadata(m, m.header.size());
+    const std::vector<uint8_t> file = put_together(parts);
+    for (unsigned threads : {1u, 2u}) {
+        DecodeOptions decode_options;
+        decode_options.threads = threads;
+        expect_refused_cheaply("2^26 nodes in " + std::to_string(file.size()) + " bytes, " + std::to_string(threads) + " thread(s)",
+                               ErrorCode::corrupt, [&] { decode(file.data(), file.size(), decode_options); });
+    }
+}
+
 // ---- the base connectivity stream's own counts (section 4) -----------------------------------
 
 void put_count(ArithmeticEncoder& encoder, uint64_t x) {

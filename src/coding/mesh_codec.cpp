@@ -697,10 +697,12 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     const Metadata meta = read_metadata(expect(BlockType::metadata), quantized);
     check_counts_against_size(meta, reader.remaining(), options);
     // Several threads decode a whole chunked file into slices of its hierarchy, whose positions
-    // another thread zeroes meanwhile (the metadata's counts are bounded by the file's size).
+    // another thread zeroes meanwhile, where the file's size warrants its counts (as for slices:
+    // plan_merge).
     std::future<std::vector<Vec3>> zeroed_positions;
     if ((meta.options & kOptionChunked) && reader.version() >= kChunkVerticesVersion && partial == nullptr &&
-        request == nullptr && options.max_level < 0 && resolve_thread_count(options.threads) > 1)
+        request == nullptr && options.max_level < 0 && resolve_thread_count(options.threads) > 1 &&
+        meta.nodes <= reservable_nodes(meta.base_triangles, size))
         zeroed_positions = start_zeroed_positions(size_t(meta.vertices));
     const Block connectivity_block = expect(BlockType::base_connectivity);
     const Block geometry_block = expect(BlockType::base_geometry);
@@ -737,7 +739,7 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     // is tiny: grown level by level, its old arrays raised glibc's thresholds, and with them
     // the freed memory it keeps).
     const uint64_t reserved_nodes = std::min<uint64_t>(
-        meta.nodes, std::max<uint64_t>(meta.base_triangles + kReservedNodesPerFileByte * size,
+        meta.nodes, std::max<uint64_t>(reservable_nodes(meta.base_triangles, size),
                                        hierarchy.uniform_node_count(options.max_level)));
     h.reserve(reserved_nodes, std::min<uint64_t>(meta.vertices, meta.base_vertices + reserved_nodes));
     int level = 0;

@@ -65,7 +65,7 @@ MergePlan plan_merge(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& i
     // file's size. Beyond that (a file of uniform levels, or a crafted one) the whole grows as
     // the chunks are decoded.
     plan.trusted = input.options.max_level < 0 &&
-                   plan.nodes <= plan.base.triangles.size() + kReservedNodesPerFileByte * uint64_t(input.file_size);
+                   plan.nodes <= reservable_nodes(plan.base.triangles.size(), input.file_size);
     plan.full = input.whole_file && input.options.max_level < 0;
     plan.seam_start = VertexId(plan.base.positions.size());
     plan.seam_count = input.seam->vertex_count();
