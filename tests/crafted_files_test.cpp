@@ -643,6 +643,48 @@ TEST(CraftedFiles, OctreeUniformForestBomb) {
     EXPECT_EQ(decode_octree_forest(unpadded.data(), unpadded.size(), tight).leaves.size(), small.leaves);
 }
 
+// A valid .amq of one leaf and 2^17 leaf fields (2.6 MB): decoded in time linear in its fields.
+// Each field's name was compared with every one before it (11.2 s of CPU for this file until
+// 2026-12-07; docs/FUZZING.md). CPU time, as the other crafted files.
+TEST(CraftedFiles, OctreeManyLeafFieldsDecodeInLinearTime) {
+    OctreeForest forest;
+    forest.connectivity = brick_connectivity(2, 1, 1);
+    forest.tree_offsets = {0, 1};
+    forest.leaves = {Octant{}};
+    for (uint32_t f = 0; f < 3; ++f) {
+        Field field;
+        field.name = "f" + std::to_string(f);
+        field.association = FieldAssociation::cell;
+        field.type = FieldType::int8;
+        field.integers = {int64_t(f % 100)};
+        forest.leaf_data.push_back(field);
+    }
+    // A name twice is refused: of three fields, the last block made a copy of the one before.
+    const std::vector<uint8_t> three = encode_octree_forest(forest);
+    BlockReader reader(three.data(), three.size(), kOctreeFraming);
+    std::vector<std::pair<uint8_t, std::vector<uint8_t>>> blocks;
+    for (Block b{}; reader.next(b) && uint8_t(b.type) != uint8_t(OctreeBlock::end);)
+        blocks.push_back({uint8_t(b.type), std::vector<uint8_t>(b.payload, b.payload + b.size)});
+    blocks.back().second = blocks[blocks.size() - 2].second;
+    BlockWriter writer(kOctreeFraming, reader.version(), reader.flags());
+    for (const auto& [type, payload] : blocks) writer.add(type, payload);
+    expect_octree_refused("a leaf field named twice", ErrorCode::corrupt, writer.finish(), "two leaf fields named \"f1\"");
+
+    for (uint32_t f = 3; f < (uint32_t(1) << 17); ++f) {
+        Field field = forest.leaf_data.back();
+        field.name = "f" + std::to_string(f);
+        field.integers = {int64_t(f % 100)};
+        forest.leaf_data.push_back(std::move(field));
+    }
+    const std::vector<uint8_t> file = encode_octree_forest(forest);
+    const double start = cpu_milliseconds();
+    const OctreeForest back = decode_octree_forest(file.data(), file.size());
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  %zu leaf fields (%zu bytes): %.1f ms\n", forest.leaf_data.size(), file.size(), milliseconds);
+    EXPECT_TRUE(back == forest);
+    EXPECT_LT(milliseconds, 3000.0);
+}
+
 TEST(CraftedFiles, OctreeWriterPadsCostlessForests) {
     // A uniform quadtree of depth 10 (1.4 M octants) costs no symbol: the writer pads its last
     // level block so that the file holds at most kOctreeOctantsPerByte octants per byte after the
