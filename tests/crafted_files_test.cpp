@@ -401,7 +401,7 @@ TEST(CraftedFiles, InspectOfManyChunksIsLinear) {
         EXPECT_EQ(info.chunks[c].first_root, c);
     }
     EXPECT_EQ(info.chunks.back().size, kBlockOverhead);
-    EXPECT_LT(milliseconds, 1000.0);
+    EXPECT_LT(milliseconds, 1000.0);  // 0.14 s under ASan (CI)
 }
 
 // A chunked file (version 13 on) of 813 bytes whose metadata announces 2^26 nodes and 25.2 M
@@ -682,7 +682,7 @@ TEST(CraftedFiles, OctreeManyLeafFieldsDecodeInLinearTime) {
     const double milliseconds = cpu_milliseconds() - start;
     std::printf("  %zu leaf fields (%zu bytes): %.1f ms\n", forest.leaf_data.size(), file.size(), milliseconds);
     EXPECT_TRUE(back == forest);
-    EXPECT_LT(milliseconds, 3000.0);
+    EXPECT_LT(milliseconds, 5000.0);  // 1.1 s under ASan (CI)
 }
 
 TEST(CraftedFiles, OctreeWriterPadsCostlessForests) {
