@@ -26,6 +26,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <ctime>
 #include <functional>
@@ -429,6 +430,43 @@ TEST(CraftedFiles, ChunkedMetadataCountsBeyondTheFile) {
         expect_refused_cheaply("2^26 nodes in " + std::to_string(file.size()) + " bytes, " + std::to_string(threads) + " thread(s)",
                                ErrorCode::corrupt, [&] { decode(file.data(), file.size(), decode_options); });
     }
+}
+
+// A chunked file over a bipyramid of 2^17 sides (two base vertices of valence 2^17; 1.8 MB with
+// the base kept in its order): the seam's base edges are found in time linear in the base. Each
+// edge's neighbour was searched among its end's edges, quadratic in the valence (decode and
+// encode alike) until 2026-12-07 (docs/FUZZING.md). CPU time, as the other crafted files.
+TEST(CraftedFiles, ChunkedFileOverAHighValenceBaseDecodesInLinearTime) {
+    constexpr uint32_t sides = uint32_t(1) << 17;
+    TriangleMesh bipyramid;
+    for (uint32_t i = 0; i < sides; ++i) {
+        const double angle = 2 * 3.141592653589793 * double(i) / double(sides);
+        bipyramid.positions.push_back({std::cos(angle), std::sin(angle), 0});
+    }
+    bipyramid.positions.push_back({0, 0, 1});
+    bipyramid.positions.push_back({0, 0, -1});
+    for (uint32_t i = 0; i < sides; ++i) {
+        bipyramid.triangles.push_back({i, (i + 1) % sides, sides});
+        bipyramid.triangles.push_back({(i + 1) % sides, i, sides + 1});
+    }
+    const Hierarchy h(bipyramid);
+    EncodeOptions options;
+    options.quantize_bits = 12;
+    options.keep_base_order = true;  // the base coder's closing is quadratic in the valence too (an encoder's matter)
+    options.chunks = 1;
+    const std::vector<uint8_t> whole = encode(h, options);
+    options.chunks = 2;
+    options.min_chunk_bytes = 0;
+    const std::vector<uint8_t> file = encode(h, options);
+    ASSERT_EQ(inspect(file.data(), file.size()).chunks.size(), 2u);
+    DecodeOptions one_thread;
+    one_thread.threads = 1;
+    const double start = cpu_milliseconds();
+    const Hierarchy chunked = decode(file.data(), file.size(), one_thread);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  %zu roots in 2 chunks (%zu bytes): %.1f ms\n", size_t(chunked.root_count()), file.size(), milliseconds);
+    EXPECT_TRUE(identical(chunked, decode(whole.data(), whole.size(), one_thread)));
+    EXPECT_LT(milliseconds, 1000.0);
 }
 
 // ---- the base connectivity stream's own counts (section 4) -----------------------------------
