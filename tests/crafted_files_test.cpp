@@ -19,6 +19,7 @@
 
 #include <amc/codec.h>
 #include <amc/hierarchy_coder.h>
+#include <amc/mesh_io.h>
 #include <amc/octree.h>
 #include <amc/refinement.h>
 #include <amc/series.h>
@@ -741,6 +742,35 @@ TEST(CraftedFiles, OctreeManyLeafFieldsDecodeInLinearTime) {
     std::printf("  %zu leaf fields (%zu bytes): %.1f ms\n", forest.leaf_data.size(), file.size(), milliseconds);
     EXPECT_TRUE(back == forest);
     EXPECT_LT(milliseconds, 5000.0);  // 1.1 s under ASan (CI)
+}
+
+// An .amq over 4,000 quadtrees around one coarse vertex, each refined once (220 KB), and its
+// conforming mesh (`amc octree decode --conforming`): each point named once, in time linear in
+// the trees. Each place of a point was searched among all its places, and every place at the
+// vertex went around it again: cubic in the trees (8.9 s of CPU here until 2026-12-07,
+// docs/FUZZING.md). CPU time, as the other crafted files.
+TEST(CraftedFiles, ConformingMeshAroundAVertexOfManyTreesIsLinear) {
+    constexpr uint32_t trees = 4000;
+    std::vector<Vec3> vertices = {{0, 0, 0}};
+    for (uint32_t i = 0; i < trees; ++i) {
+        const double a = 2 * 3.141592653589793 * double(i) / trees, b = 2 * 3.141592653589793 * (i + 0.5) / trees;
+        vertices.push_back({std::cos(a), std::sin(a), 0});
+        vertices.push_back({1.2 * std::cos(b), 1.2 * std::sin(b), 0});
+    }
+    std::vector<uint32_t> tree_to_vertex;  // centre, rim vertex i, rim vertex i + 1, the point between them outside
+    for (uint32_t i = 0; i < trees; ++i)
+        for (uint32_t v : {0u, 1 + 2 * i, 1 + 2 * ((i + 1) % trees), 2 + 2 * i}) tree_to_vertex.push_back(v);
+    const OctreeForest forest = uniform_octree_forest(connectivity_from_vertices(2, vertices, tree_to_vertex), 1);
+    const std::vector<uint8_t> file = encode_octree_forest(forest);
+    const OctreeForest decoded = decode_octree_forest(file.data(), file.size());
+    const double start = cpu_milliseconds();
+    const ConformingLeafMesh mesh = conforming_leaf_mesh(decoded);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  conforming mesh of %u trees around a vertex (%zu bytes): %.1f ms\n", trees, file.size(), milliseconds);
+    // Per tree: its far corner, one rim vertex, three edge midpoints and its centre; the centre once.
+    EXPECT_EQ(mesh.corner_points, 6 * trees + 1);
+    EXPECT_EQ(mesh.cell_count(), 8 * size_t(trees));
+    EXPECT_LT(milliseconds, 1000.0);
 }
 
 TEST(CraftedFiles, OctreeWriterPadsCostlessForests) {
