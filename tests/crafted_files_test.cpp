@@ -20,6 +20,7 @@
 #include <amc/codec.h>
 #include <amc/hierarchy_coder.h>
 #include <amc/mesh_io.h>
+#include <amc/numbering.h>
 #include <amc/octree.h>
 #include <amc/refinement.h>
 #include <amc/series.h>
@@ -488,6 +489,37 @@ TEST(CraftedFiles, HighValenceBaseEncodesInLinearTime) {
     std::printf("  %zu base triangles encoded (%zu bytes): %.1f ms\n", h.base().triangles.size(), file.size(), milliseconds);
     EXPECT_EQ(decode(file.data(), file.size()).root_count(), h.root_count());
     EXPECT_LT(milliseconds, 6000.0);  // 64-68 ms, 1.6 s under ASan (CI); 13 s in Release before
+}
+
+// The caller's numbering of a leaf mesh whose vertices 0 and 1 are the lowest corner of every face
+// (a bipyramid of 2^17 sides, its apexes first): found in time linear in the faces. Each face was
+// searched among all the faces at its lowest vertex (7 s of CPU here until 2026-12-07;
+// docs/FUZZING.md): an encoder's input (encode with a numbering, the importer), not a file.
+TEST(CraftedFiles, NumberingOfAVertexLowestInManyFacesIsLinear) {
+    TriangleMesh base = bipyramid(uint32_t(1) << 17);
+    const uint32_t sides = uint32_t(1) << 17;
+    std::vector<uint32_t> renamed(base.positions.size());  // the apexes (last) become 0 and 1
+    for (uint32_t v = 0; v < sides; ++v) renamed[v] = v + 2;
+    renamed[sides] = 0;
+    renamed[sides + 1] = 1;
+    std::vector<Vec3> positions(base.positions.size());
+    for (uint32_t v = 0; v < positions.size(); ++v) positions[renamed[v]] = base.positions[v];
+    base.positions = positions;
+    for (Triangle& t : base.triangles)
+        for (uint32_t& v : t) v = renamed[v];
+    const Hierarchy h(base);
+    const LeafMesh leaf = extract_leaf_mesh(h);
+    std::vector<VertexId> identity(h.vertex_count());
+    for (VertexId v = 0; v < identity.size(); ++v) identity[v] = v;
+    const double start = cpu_milliseconds();
+    const LeafNumbering numbering = leaf_numbering(h, leaf.mesh, identity);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  numbering of %zu faces: %.1f ms\n", leaf.mesh.triangles.size(), milliseconds);
+    for (uint32_t j = 0; j < numbering.face.size(); ++j) {
+        ASSERT_EQ(numbering.face[j], j);
+        ASSERT_EQ(numbering.rotation[j], 0);
+    }
+    EXPECT_LT(milliseconds, 2000.0);
 }
 
 // ---- the base connectivity stream's own counts (section 4) -----------------------------------
