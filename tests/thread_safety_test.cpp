@@ -68,6 +68,44 @@ TEST(ThreadSafety, ConcurrentEncodesAndDecodesGiveTheSerialResults) {
     EXPECT_EQ(mismatches.load(), 0);
 }
 
+// A chunked file decoded on several threads, each chunk into its slice of one hierarchy (with the
+// seam vertices each thread's chunks split off in an array of the thread's), also through a
+// DecodeContext kept by each of two threads decoding at once: the one-thread hierarchy.
+TEST(ThreadSafety, ChunkedFileDecodesInSlicesOnManyThreads) {
+    Hierarchy h(make_square(12));
+    refine_randomly(h, 4000, 6, 11);
+    for (int bits : {0, 12}) {
+        EncodeOptions options;
+        options.quantize_bits = bits;
+        options.chunks = 16;
+        options.min_chunk_bytes = 0;
+        const std::vector<uint8_t> file = encode(h, options);
+        ASSERT_EQ(inspect(file.data(), file.size()).chunks.size(), 16u);
+        DecodeOptions one;
+        one.threads = 1;
+        const Hierarchy serial = decode(file.data(), file.size(), one);
+        DecodeOptions four;
+        four.threads = 4;
+        EXPECT_TRUE(identical(decode(file.data(), file.size(), four), serial));
+        std::atomic<int> mismatches{0};
+        std::vector<std::thread> threads;
+        for (int t = 0; t < 2; ++t) {
+            threads.emplace_back([&] {
+                DecodeContext context;
+                DecodeOptions two;
+                two.threads = 2;
+                for (int round = 0; round < 2; ++round) {
+                    Hierarchy back = decode(context, file.data(), file.size(), two);
+                    mismatches += !identical(back, serial);
+                    context.recycle(std::move(back));
+                }
+            });
+        }
+        for (std::thread& thread : threads) thread.join();
+        EXPECT_EQ(mismatches.load(), 0);
+    }
+}
+
 // Effort 3 codes its base orders' files several at once (encode_choosing_base): an encode on four
 // threads, and two at once from two threads, each on two threads with an EncodeContext of its own
 // (whose memory serves one file at a time), write the one-thread bytes and choose its order.
