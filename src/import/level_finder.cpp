@@ -144,6 +144,10 @@ CoarserLevel LevelFinder::coarser_level(std::vector<uint32_t>* parent_of_block) 
     CoarserLevel out;
     if (parent_of_block) parent_of_block->assign(blocks_.size(), kNoIndex);
     std::vector<uint8_t> merged(tri_.size(), 0);
+    // The coarser level has fewer triangles than this one: no reallocation on the way.
+    out.triangles.reserve(tri_.size());
+    out.refined.reserve(tri_.size());
+    out.changed.reserve(tri_.size());
     for (uint32_t index = 0; index < blocks_.size(); ++index) {
         const Block& b = blocks_[index];
         if (!b.alive) continue;
