@@ -281,14 +281,17 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
     // collected), one with many is a wrong reading, not a true one with a few wrong turns.
     const uint32_t size = uint32_t(blocks_.size()) - start;
     const bool repairable = suspects && size >= kRepairable;
+    // Only the whole set of invalid blocks counts, or that there are too many: the blocks placed
+    // last, on the front where a wrong reading ends, are checked first.
     std::vector<uint32_t> invalid;
-    for (uint32_t i = start; i < blocks_.size(); ++i) {
+    for (uint32_t i = uint32_t(blocks_.size()); i-- > start;) {
         if (sides_valid(i)) continue;
         invalid.push_back(i);
         const bool counting = repairable ? invalid.size() * kRepairableShare <= size
                                          : size >= kBlockedGrowth && invalid.size() <= kFewInvalid;
         if (!counting) break;
     }
+    std::reverse(invalid.begin(), invalid.end());
     if (!invalid.empty()) {
         // A large growth held by a few blocks: what refined triangles stood in their way.
         if (size >= kBlockedGrowth && invalid.size() <= kFewInvalid) {
