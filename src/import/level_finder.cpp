@@ -252,8 +252,9 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
             return 0;
         }
         for (int i = 0; i < 3; ++i) {
-            const Fan fan = blocks_[next].fan[size_t(i)];  // a copy: placing blocks moves blocks_
-            if (fan.kind != Fan::triangles || block_of_[fan.triangle[1]] != kNoIndex) continue;
+            const Fan& side = blocks_[next].fan[size_t(i)];
+            if (side.kind != Fan::triangles || block_of_[side.triangle[1]] != kNoIndex) continue;
+            const Fan fan = side;  // a copy: placing blocks moves blocks_
             if (preference == Preference::closure_first) {
                 const uint32_t partner = closure_partner(blocks_[next], i, fan);
                 if (partner != kNoIndex) {
