@@ -8,6 +8,7 @@
 #include "coding/entropy/arithmetic_coder.h"
 #include "coding/base/base_mesh_coder.h"
 #include "coding/container.h"
+#include "coding/format_version.h"
 #include "coding/geometry/float_coder.h"
 #include "coding/hierarchy/hierarchy_stream.h"
 #include "common/bits.h"
@@ -18,6 +19,8 @@
 
 #include <amc/codec.h>
 #include <amc/hierarchy_coder.h>
+#include <amc/mesh_io.h>
+#include <amc/numbering.h>
 #include <amc/octree.h>
 #include <amc/refinement.h>
 #include <amc/series.h>
@@ -25,6 +28,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <ctime>
 #include <functional>
@@ -344,6 +348,180 @@ TEST(CraftedFiles, UnrefinedHierarchiesDecode) {
     }
 }
 
+// ---- chunked files (sections 3.11-3.14) --------------------------------------------------------
+
+// A valid file of one root a chunk (2,048 chunks, 21,000 seam vertices): decoded on two threads it
+// allocates about what one thread does. Until 2026-12-07 each chunk had an array over every seam
+// vertex (chunks times seam vertices, the square of the file): 43.8 MB more here (docs/FUZZING.md).
+TEST(CraftedFiles, ManyChunksDecodeOnThreadsInTheMemoryOfOne) {
+    Hierarchy h(make_square(32));
+    refine_uniformly(h, 3);
+    EncodeOptions options;
+    options.quantize_bits = 12;
+    options.chunks = h.root_count();
+    options.min_chunk_bytes = 0;
+    const std::vector<uint8_t> file = encode(h, options);
+    ASSERT_EQ(inspect(file.data(), file.size()).chunks.size(), size_t(h.root_count()));
+    uint64_t allocated[2] = {0, 0};
+    Hierarchy decoded[2];
+    for (unsigned threads : {1u, 2u}) {
+        DecodeOptions decode_options;
+        decode_options.threads = threads;
+        const uint64_t before = g_allocated.load();
+        decoded[threads - 1] = decode(file.data(), file.size(), decode_options);
+        allocated[threads - 1] = g_allocated.load() - before;
+        std::printf("  %u thread(s): %llu bytes allocated\n", threads, (unsigned long long)allocated[threads - 1]);
+    }
+    EXPECT_TRUE(identical(decoded[0], decoded[1]));
+    EXPECT_LT(allocated[1], allocated[0] + (uint64_t(8) << 20));
+}
+
+// A chunk table of 2^17 chunks, each an empty block: inspect finds each chunk block's entry
+// without a pass over all of them (that pass made inspect quadratic: 12 s of CPU for this 2 MB
+// file, and `amc decode --triangles` inspects first). CPU time, as the other crafted files.
+TEST(CraftedFiles, InspectOfManyChunksIsLinear) {
+    constexpr uint64_t chunks = uint64_t(1) << 17;
+    BlockWriter writer(kNewestVersion, 0);
+    std::vector<uint8_t> metadata;
+    for (uint64_t v : {uint64_t(3), chunks, chunks, uint64_t(3), chunks, uint64_t(1), uint64_t(2), uint64_t(0)})
+        put_varint(metadata, v);  // base vertices, triangles, nodes, vertices, faces, levels, chunked, no header
+    writer.add(BlockType::metadata, metadata);
+    std::vector<uint8_t> table;
+    put_varint(table, chunks);
+    for (uint64_t c = 0; c < chunks; ++c)
+        for (uint64_t v : {uint64_t(1), uint64_t(1), uint64_t(0), kBlockOverhead * (c + 1)}) put_varint(table, v);
+    writer.add(BlockType::chunk_table, table);
+    writer.add(BlockType::seam, {});
+    for (uint64_t c = 0; c < chunks; ++c) writer.add(BlockType::chunk, {});
+    const std::vector<uint8_t> file = writer.finish();
+    const double start = cpu_milliseconds();
+    const FileInfo info = inspect(file.data(), file.size());
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  inspect of %llu chunks (%zu bytes): %.1f ms\n", (unsigned long long)chunks, file.size(), milliseconds);
+    ASSERT_EQ(info.chunks.size(), chunks);
+    for (uint64_t c = 0; c < chunks; c += 4099) {
+        EXPECT_EQ(info.chunks[c].size, kBlockOverhead);
+        EXPECT_EQ(info.chunks[c].first_root, c);
+    }
+    EXPECT_EQ(info.chunks.back().size, kBlockOverhead);
+    EXPECT_LT(milliseconds, 1000.0);  // 0.14 s under ASan (CI)
+}
+
+// A chunked file (version 13 on) of 813 bytes whose metadata announces 2^26 nodes and 25.2 M
+// vertices (within the bytes' bound on coded positions): refused without a thread zeroing the
+// announced vertices' positions first (604 MB on two threads until 2026-12-07, docs/FUZZING.md).
+TEST(CraftedFiles, ChunkedMetadataCountsBeyondTheFile) {
+    Hierarchy h(make_icosahedron());
+    refine_randomly(h, 3000, 6, 3);
+    EncodeOptions options;
+    options.chunks = 2;
+    options.min_chunk_bytes = 0;
+    Parts parts = take_apart(encode(h, options));
+    ASSERT_GE(parts.version, kChunkVerticesVersion);
+    std::vector<uint8_t>& payload = payload_of(parts, BlockType::metadata);
+    Metadata m = read_metadata(payload);
+    const uint64_t refined = ((uint64_t(1) << 26) - m.base_triangles) / 4;
+    m.nodes = m.base_triangles + 4 * refined;
+    m.vertices = m.base_vertices + (3 * refined + 1) / 2;  // the fewest R refined nodes make
+    m.faces = m.nodes - refined;
+    payload = write_metadata(m, m.header.size());
+    const std::vector<uint8_t> file = put_together(parts);
+    for (unsigned threads : {1u, 2u}) {
+        DecodeOptions decode_options;
+        decode_options.threads = threads;
+        expect_refused_cheaply("2^26 nodes in " + std::to_string(file.size()) + " bytes, " + std::to_string(threads) + " thread(s)",
+                               ErrorCode::corrupt, [&] { decode(file.data(), file.size(), decode_options); });
+    }
+}
+
+// A bipyramid of 2^17 sides: two base vertices of valence 2^17.
+TriangleMesh bipyramid(uint32_t sides) {
+    TriangleMesh mesh;
+    for (uint32_t i = 0; i < sides; ++i) {
+        const double angle = 2 * 3.141592653589793 * double(i) / double(sides);
+        mesh.positions.push_back({std::cos(angle), std::sin(angle), 0});
+    }
+    mesh.positions.push_back({0, 0, 1});
+    mesh.positions.push_back({0, 0, -1});
+    for (uint32_t i = 0; i < sides; ++i) {
+        mesh.triangles.push_back({i, (i + 1) % sides, sides});
+        mesh.triangles.push_back({(i + 1) % sides, i, sides + 1});
+    }
+    return mesh;
+}
+
+// A chunked file over a bipyramid of 2^17 sides (1.8 MB with the base kept in its order): the
+// seam's base edges are found in time linear in the base. Each edge's neighbour was searched among
+// its end's edges, quadratic in the valence (decode and encode alike) until 2026-12-07
+// (docs/FUZZING.md). CPU time, as the other crafted files.
+TEST(CraftedFiles, ChunkedFileOverAHighValenceBaseDecodesInLinearTime) {
+    const Hierarchy h(bipyramid(uint32_t(1) << 17));
+    EncodeOptions options;
+    options.quantize_bits = 12;
+    options.keep_base_order = true;  // the seam alone: not the base coder (HighValenceBaseEncodesInLinearTime)
+    options.chunks = 1;
+    const std::vector<uint8_t> whole = encode(h, options);
+    options.chunks = 2;
+    options.min_chunk_bytes = 0;
+    const std::vector<uint8_t> file = encode(h, options);
+    ASSERT_EQ(inspect(file.data(), file.size()).chunks.size(), 2u);
+    DecodeOptions one_thread;
+    one_thread.threads = 1;
+    const double start = cpu_milliseconds();
+    const Hierarchy chunked = decode(file.data(), file.size(), one_thread);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  %zu roots in 2 chunks (%zu bytes): %.1f ms\n", size_t(chunked.root_count()), file.size(), milliseconds);
+    EXPECT_TRUE(identical(chunked, decode(whole.data(), whole.size(), one_thread)));
+    EXPECT_LT(milliseconds, 3000.0);  // 30 ms, 0.7 s under ASan (CI); 4.4 s in Release before
+}
+
+// The same base through the base coder: closing it (make_closed) found each halfedge's twin by a
+// pass over its end's halfedges, quadratic in the valence (13 s of CPU to encode this base until
+// 2026-12-07, 0.15 s after). An encoder's input, not a file; here beside its decoder's twin above.
+TEST(CraftedFiles, HighValenceBaseEncodesInLinearTime) {
+    const Hierarchy h(bipyramid(uint32_t(1) << 17));
+    EncodeOptions options;
+    options.quantize_bits = 12;
+    options.threads = 1;
+    const double start = cpu_milliseconds();
+    const std::vector<uint8_t> file = encode(h, options);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  %zu base triangles encoded (%zu bytes): %.1f ms\n", h.base().triangles.size(), file.size(), milliseconds);
+    EXPECT_EQ(decode(file.data(), file.size()).root_count(), h.root_count());
+    EXPECT_LT(milliseconds, 6000.0);  // 64-68 ms, 1.6 s under ASan (CI); 13 s in Release before
+}
+
+// The caller's numbering of a leaf mesh whose vertices 0 and 1 are the lowest corner of every face
+// (a bipyramid of 2^17 sides, its apexes first): found in time linear in the faces. Each face was
+// searched among all the faces at its lowest vertex (7 s of CPU here until 2026-12-07;
+// docs/FUZZING.md): an encoder's input (encode with a numbering, the importer), not a file.
+TEST(CraftedFiles, NumberingOfAVertexLowestInManyFacesIsLinear) {
+    TriangleMesh base = bipyramid(uint32_t(1) << 17);
+    const uint32_t sides = uint32_t(1) << 17;
+    std::vector<uint32_t> renamed(base.positions.size());  // the apexes (last) become 0 and 1
+    for (uint32_t v = 0; v < sides; ++v) renamed[v] = v + 2;
+    renamed[sides] = 0;
+    renamed[sides + 1] = 1;
+    std::vector<Vec3> positions(base.positions.size());
+    for (uint32_t v = 0; v < positions.size(); ++v) positions[renamed[v]] = base.positions[v];
+    base.positions = positions;
+    for (Triangle& t : base.triangles)
+        for (uint32_t& v : t) v = renamed[v];
+    const Hierarchy h(base);
+    const LeafMesh leaf = extract_leaf_mesh(h);
+    std::vector<VertexId> identity(h.vertex_count());
+    for (VertexId v = 0; v < identity.size(); ++v) identity[v] = v;
+    const double start = cpu_milliseconds();
+    const LeafNumbering numbering = leaf_numbering(h, leaf.mesh, identity);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  numbering of %zu faces: %.1f ms\n", leaf.mesh.triangles.size(), milliseconds);
+    for (uint32_t j = 0; j < numbering.face.size(); ++j) {
+        ASSERT_EQ(numbering.face[j], j);
+        ASSERT_EQ(numbering.rotation[j], 0);
+    }
+    EXPECT_LT(milliseconds, 2000.0);
+}
+
 // ---- the base connectivity stream's own counts (section 4) -----------------------------------
 
 void put_count(ArithmeticEncoder& encoder, uint64_t x) {
@@ -554,6 +732,77 @@ TEST(CraftedFiles, OctreeUniformForestBomb) {
     // The bound lifted, the unpadded file decodes too (files written before it).
     tight.max_octants_per_byte = 0;
     EXPECT_EQ(decode_octree_forest(unpadded.data(), unpadded.size(), tight).leaves.size(), small.leaves);
+}
+
+// A valid .amq of one leaf and 2^17 leaf fields (2.6 MB): decoded in time linear in its fields.
+// Each field's name was compared with every one before it (11.2 s of CPU for this file until
+// 2026-12-07; docs/FUZZING.md). CPU time, as the other crafted files.
+TEST(CraftedFiles, OctreeManyLeafFieldsDecodeInLinearTime) {
+    OctreeForest forest;
+    forest.connectivity = brick_connectivity(2, 1, 1);
+    forest.tree_offsets = {0, 1};
+    forest.leaves = {Octant{}};
+    for (uint32_t f = 0; f < 3; ++f) {
+        Field field;
+        field.name = "f" + std::to_string(f);
+        field.association = FieldAssociation::cell;
+        field.type = FieldType::int8;
+        field.integers = {int64_t(f % 100)};
+        forest.leaf_data.push_back(field);
+    }
+    // A name twice is refused: of three fields, the last block made a copy of the one before.
+    const std::vector<uint8_t> three = encode_octree_forest(forest);
+    BlockReader reader(three.data(), three.size(), kOctreeFraming);
+    std::vector<std::pair<uint8_t, std::vector<uint8_t>>> blocks;
+    for (Block b{}; reader.next(b) && uint8_t(b.type) != uint8_t(OctreeBlock::end);)
+        blocks.push_back({uint8_t(b.type), std::vector<uint8_t>(b.payload, b.payload + b.size)});
+    blocks.back().second = blocks[blocks.size() - 2].second;
+    BlockWriter writer(kOctreeFraming, reader.version(), reader.flags());
+    for (const auto& [type, payload] : blocks) writer.add(type, payload);
+    expect_octree_refused("a leaf field named twice", ErrorCode::corrupt, writer.finish(), "two leaf fields named \"f1\"");
+
+    for (uint32_t f = 3; f < (uint32_t(1) << 17); ++f) {
+        Field field = forest.leaf_data.back();
+        field.name = "f" + std::to_string(f);
+        field.integers = {int64_t(f % 100)};
+        forest.leaf_data.push_back(std::move(field));
+    }
+    const std::vector<uint8_t> file = encode_octree_forest(forest);
+    const double start = cpu_milliseconds();
+    const OctreeForest back = decode_octree_forest(file.data(), file.size());
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  %zu leaf fields (%zu bytes): %.1f ms\n", forest.leaf_data.size(), file.size(), milliseconds);
+    EXPECT_TRUE(back == forest);
+    EXPECT_LT(milliseconds, 5000.0);  // 1.1 s under ASan (CI)
+}
+
+// An .amq over 4,000 quadtrees around one coarse vertex, each refined once (220 KB), and its
+// conforming mesh (`amc octree decode --conforming`): each point named once, in time linear in
+// the trees. Each place of a point was searched among all its places, and every place at the
+// vertex went around it again: cubic in the trees (8.9 s of CPU here until 2026-12-07,
+// docs/FUZZING.md). CPU time, as the other crafted files.
+TEST(CraftedFiles, ConformingMeshAroundAVertexOfManyTreesIsLinear) {
+    constexpr uint32_t trees = 4000;
+    std::vector<Vec3> vertices = {{0, 0, 0}};
+    for (uint32_t i = 0; i < trees; ++i) {
+        const double a = 2 * 3.141592653589793 * double(i) / trees, b = 2 * 3.141592653589793 * (i + 0.5) / trees;
+        vertices.push_back({std::cos(a), std::sin(a), 0});
+        vertices.push_back({1.2 * std::cos(b), 1.2 * std::sin(b), 0});
+    }
+    std::vector<uint32_t> tree_to_vertex;  // centre, rim vertex i, rim vertex i + 1, the point between them outside
+    for (uint32_t i = 0; i < trees; ++i)
+        for (uint32_t v : {0u, 1 + 2 * i, 1 + 2 * ((i + 1) % trees), 2 + 2 * i}) tree_to_vertex.push_back(v);
+    const OctreeForest forest = uniform_octree_forest(connectivity_from_vertices(2, vertices, tree_to_vertex), 1);
+    const std::vector<uint8_t> file = encode_octree_forest(forest);
+    const OctreeForest decoded = decode_octree_forest(file.data(), file.size());
+    const double start = cpu_milliseconds();
+    const ConformingLeafMesh mesh = conforming_leaf_mesh(decoded);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  conforming mesh of %u trees around a vertex (%zu bytes): %.1f ms\n", trees, file.size(), milliseconds);
+    // Per tree: its far corner, one rim vertex, three edge midpoints and its centre; the centre once.
+    EXPECT_EQ(mesh.corner_points, 6 * trees + 1);
+    EXPECT_EQ(mesh.cell_count(), 8 * size_t(trees));
+    EXPECT_LT(milliseconds, 1000.0);
 }
 
 TEST(CraftedFiles, OctreeWriterPadsCostlessForests) {

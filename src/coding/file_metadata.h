@@ -35,6 +35,11 @@ Metadata read_metadata(const Block& block, bool quantized);
 // decoded in memory of their final size, while a small file that announces a large hierarchy gets
 // no more than its bytes warrant before it is decoded (more grows as the levels are built).
 constexpr uint64_t kReservedNodesPerFileByte = 128;
+// The nodes of a hierarchy over `base_triangles` roots that a file of `file_size` bytes may have
+// allocated up front.
+constexpr uint64_t reservable_nodes(uint64_t base_triangles, uint64_t file_size) {
+    return base_triangles + kReservedNodesPerFileByte * file_size;
+}
 
 // Checks the metadata's counts against the `bytes_after` bytes of the file that follow it, before
 // anything is allocated for them: every vertex costs at least max_decodable_positions' share of a

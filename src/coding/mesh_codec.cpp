@@ -697,10 +697,12 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     const Metadata meta = read_metadata(expect(BlockType::metadata), quantized);
     check_counts_against_size(meta, reader.remaining(), options);
     // Several threads decode a whole chunked file into slices of its hierarchy, whose positions
-    // another thread zeroes meanwhile (the metadata's counts are bounded by the file's size).
+    // another thread zeroes meanwhile, where the file's size warrants its counts (as for slices:
+    // plan_merge).
     std::future<std::vector<Vec3>> zeroed_positions;
     if ((meta.options & kOptionChunked) && reader.version() >= kChunkVerticesVersion && partial == nullptr &&
-        request == nullptr && options.max_level < 0 && resolve_thread_count(options.threads) > 1)
+        request == nullptr && options.max_level < 0 && resolve_thread_count(options.threads) > 1 &&
+        meta.nodes <= reservable_nodes(meta.base_triangles, size))
         zeroed_positions = start_zeroed_positions(size_t(meta.vertices));
     const Block connectivity_block = expect(BlockType::base_connectivity);
     const Block geometry_block = expect(BlockType::base_geometry);
@@ -737,7 +739,7 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
     // is tiny: grown level by level, its old arrays raised glibc's thresholds, and with them
     // the freed memory it keeps).
     const uint64_t reserved_nodes = std::min<uint64_t>(
-        meta.nodes, std::max<uint64_t>(meta.base_triangles + kReservedNodesPerFileByte * size,
+        meta.nodes, std::max<uint64_t>(reservable_nodes(meta.base_triangles, size),
                                        hierarchy.uniform_node_count(options.max_level)));
     h.reserve(reserved_nodes, std::min<uint64_t>(meta.vertices, meta.base_vertices + reserved_nodes));
     int level = 0;
@@ -909,6 +911,7 @@ FileInfo inspect(const uint8_t* data, size_t size) {
     const bool quantized = reader.flags() & kFlagQuantized;
     Block block{};
     int level = 0;
+    size_t table_start = 0;  // the last chunk table's first entry in info.chunks
     while (reader.next(block)) {
         FileBlock entry;
         entry.type = uint8_t(block.type);
@@ -928,12 +931,16 @@ FileInfo inspect(const uint8_t* data, size_t size) {
         if (block.type == BlockType::level) entry.level = level++;
         if (block.type == BlockType::chunk_table) {
             const ChunkTable table = read_chunk_table(block, info.version, info.base_triangles, info.nodes, size);
+            table_start = info.chunks.size();
             for (size_t c = 0; c < table.roots.size(); ++c)
                 info.chunks.push_back({table.roots[c].first, table.roots[c].count, table.nodes[c], table.end + table.offsets[c], 0});
         }
         if (block.type == BlockType::chunk) {
-            for (ChunkInfo& chunk : info.chunks)
-                if (chunk.offset == block.offset) chunk.size = entry.size;
+            // A table's offsets increase (read_chunk_table): a search, not a pass over every chunk per block.
+            const auto chunk = std::lower_bound(info.chunks.begin() + std::ptrdiff_t(table_start), info.chunks.end(),
+                                                uint64_t(block.offset),
+                                                [](const ChunkInfo& c, uint64_t offset) { return c.offset < offset; });
+            if (chunk != info.chunks.end() && chunk->offset == block.offset) chunk->size = entry.size;
         }
         info.blocks.push_back(entry);
     }

@@ -1,24 +1,37 @@
 // The caller's numbering of a leaf mesh, found by matching faces, and the leaf mesh renumbered by it.
 #include <amc/numbering.h>
 
+#include <algorithm>
 #include <string>
 
 namespace amc {
 
 namespace {
 
-// Leaf triangles grouped by their smallest vertex (a CSR table): a face is found among the
-// few triangles at its smallest vertex, in linear time overall.
+// Leaf triangles grouped by their smallest vertex (a CSR table), each group sorted by the two
+// vertices that follow it: a face is found by binary search (a pass over the group was quadratic
+// where one vertex is the smallest of many faces).
 struct TrianglesByLowestVertex {
-    std::vector<uint32_t> start, triangles;
+    struct Entry {
+        uint32_t next, after, triangle;  // the vertices after the lowest, in order; the leaf triangle
+        bool operator<(const Entry& o) const {
+            return next != o.next ? next < o.next : after != o.after ? after < o.after : triangle < o.triangle;
+        }
+    };
+    std::vector<uint32_t> start;
+    std::vector<Entry> entries;
     TrianglesByLowestVertex(const std::vector<Triangle>& mesh, size_t vertices) : start(vertices + 1, 0) {
-        for (const Triangle& t : mesh) ++start[lowest(t) + 1];
+        for (const Triangle& t : mesh) ++start[t[lowest_corner(t)] + 1];
         for (size_t v = 0; v < vertices; ++v) start[v + 1] += start[v];
-        triangles.resize(mesh.size());
+        entries.resize(mesh.size());
         std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-        for (uint32_t i = 0; i < mesh.size(); ++i) triangles[fill[lowest(mesh[i])]++] = i;
+        for (uint32_t i = 0; i < mesh.size(); ++i) {
+            const int r = lowest_corner(mesh[i]);
+            entries[fill[mesh[i][r]]++] = {mesh[i][(r + 1) % 3], mesh[i][(r + 2) % 3], i};
+        }
+        for (size_t v = 0; v < vertices; ++v) std::sort(entries.begin() + start[v], entries.begin() + start[v + 1]);
     }
-    static uint32_t lowest(const Triangle& t) { return std::min(t[0], std::min(t[1], t[2])); }
+    static int lowest_corner(const Triangle& t) { return t[0] < t[1] ? (t[0] < t[2] ? 0 : 2) : (t[1] < t[2] ? 1 : 2); }
 };
 
 }  // namespace
@@ -77,18 +90,17 @@ LeafNumbering leaf_numbering(const Hierarchy& h, const TriangleMesh& mesh, const
             if (mesh.triangles[j][c] >= vertices) throw Error("numbering: face " + std::to_string(j) + " has a vertex out of range");
             face[c] = numbering.vertex[mesh.triangles[j][c]];
         }
-        const uint32_t low = TrianglesByLowestVertex::lowest(face);
-        bool found = false;
-        for (uint32_t k = index.start[low]; k < index.start[low + 1] && !found; ++k) {
-            const Triangle& t = leaf[index.triangles[k]];
-            for (int r = 0; r < 3 && !found; ++r) {
-                if (t[r] == face[0] && t[(r + 1) % 3] == face[1] && t[(r + 2) % 3] == face[2] && !matched[index.triangles[k]]) {
-                    found = true;
-                    matched[index.triangles[k]] = true;
-                    numbering.face[j] = index.triangles[k];
-                    numbering.rotation[j] = uint8_t(r);
-                }
-            }
+        // The first unmatched leaf triangle with the same corners in the same cyclic order.
+        const int r = TrianglesByLowestVertex::lowest_corner(face);
+        const uint32_t low = face[r], next = face[(r + 1) % 3], after = face[(r + 2) % 3];
+        const auto end = index.entries.begin() + index.start[low + 1];
+        auto k = std::lower_bound(index.entries.begin() + index.start[low], end, TrianglesByLowestVertex::Entry{next, after, 0});
+        while (k != end && k->next == next && k->after == after && matched[k->triangle]) ++k;
+        const bool found = k != end && k->next == next && k->after == after;
+        if (found) {
+            matched[k->triangle] = true;
+            numbering.face[j] = k->triangle;
+            numbering.rotation[j] = uint8_t((TrianglesByLowestVertex::lowest_corner(leaf[k->triangle]) + 3 - r) % 3);
         }
         if (!found) throw Error("numbering: face " + std::to_string(j) + " is not a triangle of the leaf mesh (or is listed twice)");
     }

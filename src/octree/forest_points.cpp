@@ -90,8 +90,16 @@ ForestPoints::Point ForestPoints::add_inside(uint32_t tree, const int64_t p[3]) 
 }
 
 size_t ForestPoints::place_index(const Place& place) {
-    for (size_t i = 0; i < places_.size(); ++i)
-        if (places_[i].tree == place.tree && std::equal(place.p, place.p + 3, places_[i].p)) return i;
+    if (places_.size() <= kSearchedPlaces) {
+        for (size_t i = 0; i < places_.size(); ++i)
+            if (places_[i].tree == place.tree && std::equal(place.p, place.p + 3, places_[i].p)) return i;
+    } else {
+        if (index_of_place_.empty())
+            for (size_t i = 0; i < places_.size(); ++i)
+                index_of_place_.emplace(std::make_pair(key(places_[i].tree, places_[i].p).coords, places_[i].tree), i);
+        const auto [it, added] = index_of_place_.emplace(std::make_pair(key(place.tree, place.p).coords, place.tree), places_.size());
+        if (!added) return it->second;
+    }
     places_.push_back(place);
     parent_.push_back(places_.size() - 1);
     return places_.size() - 1;
@@ -110,6 +118,8 @@ void ForestPoints::join(size_t a, size_t b) {
 void ForestPoints::collect_places(uint32_t tree, const int64_t p[3]) {
     places_.clear();
     parent_.clear();
+    index_of_place_.clear();
+    gone_around_.clear();
     place_index({tree, {p[0], p[1], p[2]}});
     for (size_t i = 0; i < places_.size(); ++i) {
         const Place here = places_[i];
@@ -135,6 +145,21 @@ void ForestPoints::collect_places(uint32_t tree, const int64_t p[3]) {
         if (on_boundary < 2) continue;
         int32_t c[3] = {0, 0, 0};
         for (int a = 0; a < dim_; ++a) c[a] = here.p[a] == 0 ? -1 : here.p[a] == n_ ? int32_t(n_) : int32_t(here.p[a]);
+        // Every place at a coarse vertex (edge point) finds the same places around it, which the
+        // first one found joined already: once for each.
+        if (!conn_.vertices.empty()) {
+            int corner = 0;
+            for (int a = 0; a < dim_; ++a) corner |= here.p[a] == n_ ? 1 << a : 0;
+            const size_t corners = size_t(1) << dim_;
+            const uint64_t v = conn_.tree_to_vertex[here.tree * corners + size_t(corner)];
+            std::array<uint64_t, 3> around{v, UINT64_MAX, 0};
+            if (on_boundary < dim_) {  // 3D, a coarse edge along inside_axis: its two vertices and the point
+                const uint64_t w = conn_.tree_to_vertex[here.tree * corners + size_t(corner | 1 << inside_axis)];
+                around = {std::min(v, w), std::max(v, w), uint64_t(v < w ? here.p[inside_axis] : n_ - here.p[inside_axis])};
+            }
+            if (std::find(gone_around_.begin(), gone_around_.end(), around) != gone_around_.end()) continue;
+            gone_around_.push_back(around);
+        }
         around_.clear();
         if (on_boundary == dim_) {  // a coarse corner: the octant's corner there is the point
             corners_.neighbours(here.tree, octree_root_log2(dim_), c, around_);

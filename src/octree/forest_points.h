@@ -14,7 +14,10 @@
 
 #include <amc/octree.h>
 
+#include <array>
 #include <cstdint>
+#include <map>
+#include <utility>
 #include <vector>
 
 namespace amc {
@@ -86,6 +89,11 @@ private:
     std::vector<Place> places_;
     std::vector<size_t> parent_;
     std::vector<TreeCorners::Place> around_, around_next_;
+    // Around a coarse vertex or edge of many trees: places_ looked up, not searched, beyond
+    // kSearchedPlaces, and each coarse vertex (edge point) gone around once; else cubic in the trees.
+    static constexpr size_t kSearchedPlaces = 32;
+    std::map<std::pair<uint64_t, uint32_t>, size_t> index_of_place_;
+    std::vector<std::array<uint64_t, 3>> gone_around_;  // coarse vertex; or edge's two vertices and point
 };
 
 }  // namespace amc

@@ -6,6 +6,9 @@
 #include "octree/octree_leaf_data.h"
 #include "octree/octree_traversal.h"
 
+#include <string>
+#include <unordered_set>
+
 namespace amc {
 
 namespace {
@@ -84,6 +87,7 @@ OctreeForest decode_octree_forest(const uint8_t* data, size_t size, const Octree
         OctreeForest forest = levels.leaves(conn);
         // Leaf field blocks (version 2), then the end block.
         uint64_t values = 0;
+        std::unordered_set<std::string> names;  // not a pass over the fields before each: quadratic in them
         for (block = next_block(reader); uint8_t(block.type) != uint8_t(OctreeBlock::end); block = next_block(reader)) {
             AMC_REQUIRE(uint8_t(block.type) == uint8_t(OctreeBlock::leaf_field), corrupt,
                         "block at byte " + std::to_string(block.offset) + ": expected a leaf field or end block, found a " +
@@ -91,8 +95,7 @@ OctreeForest decode_octree_forest(const uint8_t* data, size_t size, const Octree
             AMC_REQUIRE(values <= options.max_leaf_values, limit_exceeded, "the leaf fields hold more values than the limit");
             Field field = read_leaf_field(block.payload, block.size, forest.leaves, options.max_leaf_values - values);
             values += field.value_count();
-            for (const Field& other : forest.leaf_data)
-                AMC_REQUIRE(other.name != field.name, corrupt, "two leaf fields named \"" + field.name + "\"");
+            AMC_REQUIRE(names.insert(field.name).second, corrupt, "two leaf fields named \"" + field.name + "\"");
             forest.leaf_data.push_back(std::move(field));
         }
         return forest;

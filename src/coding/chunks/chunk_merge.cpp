@@ -65,7 +65,7 @@ MergePlan plan_merge(const std::vector<ChunkJob>& jobs, const ChunkMergeInput& i
     // file's size. Beyond that (a file of uniform levels, or a crafted one) the whole grows as
     // the chunks are decoded.
     plan.trusted = input.options.max_level < 0 &&
-                   plan.nodes <= plan.base.triangles.size() + kReservedNodesPerFileByte * uint64_t(input.file_size);
+                   plan.nodes <= reservable_nodes(plan.base.triangles.size(), input.file_size);
     plan.full = input.whole_file && input.options.max_level < 0;
     plan.seam_start = VertexId(plan.base.positions.size());
     plan.seam_count = input.seam->vertex_count();
@@ -208,15 +208,26 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
     HierarchyBuilder::open_slices(whole, size_t(node), size_t(vertex), std::move(zeroed_positions));
     find_seam_edges(plan, whole, n);
     const std::vector<HierarchyBuilder::RootLink> cut = HierarchyBuilder::cut_root_links(whole, plan.seam_edges);
-    std::vector<std::vector<uint8_t>> seam_used(n, std::vector<uint8_t>(plan.seam_count, 0));
+    // The seam vertices the chunks split off, in an array a thread (one a chunk grew as the file's square).
+    std::vector<std::vector<uint8_t>> idle_used;
+    std::mutex used_mutex;
     ChunkDecoders own;
     ChunkDecoders& decoders = input.kept_decoders != nullptr ? *input.kept_decoders : own;
     auto decode_into_slice = [&](size_t i) {
         std::unique_ptr<HierarchyLevelDecoder> decoder = decoders.take();
+        std::vector<uint8_t> seam_used;
+        {
+            std::lock_guard<std::mutex> lock(used_mutex);
+            if (!idle_used.empty()) {
+                seam_used = std::move(idle_used.back());
+                idle_used.pop_back();
+            }
+        }
+        if (seam_used.empty()) seam_used.assign(plan.seam_count, 0);
         const ChunkJob& job = jobs[i];
         // Never lean (ChunkPlace::last): pages given back and faulted in again by two threads at
         // once cost more than they save.
-        const ChunkPlace place{&whole, plan.first_root[i], job.roots.count, plan.keys_in_whole(), seam_used[i].data(),
+        const ChunkPlace place{&whole, plan.first_root[i], job.roots.count, plan.keys_in_whole(), seam_used.data(),
                                &slices[i], false};
         decode_job(*decoder, job, place, input, counts[i]);
         AMC_REQUIRE(slices[i].next_node == slices[i].node_end, corrupt,
@@ -224,6 +235,8 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
         AMC_REQUIRE(slices[i].next_vertex == slices[i].vertex_end, corrupt,
                     chunk_name(job) + " does not hold the vertices the chunk table says");
         decoders.give_back(std::move(decoder));
+        std::lock_guard<std::mutex> lock(used_mutex);
+        idle_used.push_back(std::move(seam_used));
     };
     // A corrupt file fails with its first bad chunk's error, as on one thread in chunk order.
     std::vector<std::exception_ptr> error(n);
@@ -238,8 +251,8 @@ Hierarchy merge_in_slices(const std::vector<ChunkJob>& jobs, const ChunkMergeInp
         if (e) std::rethrow_exception(e);
     HierarchyBuilder::relink_roots(whole, cut);
     std::vector<uint8_t> used(plan.seam_count, 0);
-    for (const std::vector<uint8_t>& chunk_used : seam_used)
-        for (uint32_t s = 0; s < plan.seam_count; ++s) used[s] |= chunk_used[s];
+    for (const std::vector<uint8_t>& thread_used : idle_used)
+        for (uint32_t s = 0; s < plan.seam_count; ++s) used[s] |= thread_used[s];
     finish_vertices(whole, plan, used, input);
     HierarchyBuilder::stitch_seams(whole, plan.seam_edges);
     return whole;

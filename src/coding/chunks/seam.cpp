@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <string>
 
@@ -56,11 +57,12 @@ int32_t Seam::SegmentTable::find(uint64_t key) const {
 }
 
 std::vector<std::pair<uint32_t, int>> seam_edges(const TriangleMesh& base, const std::vector<uint32_t>& chunk_of_root) {
-    // The directed edges grouped by their first vertex, each as (second vertex, triangle), in
-    // triangle order: the neighbour across (a, b) is the first triangle with (b, a), found among
-    // the few edges leaving b (a valid base mesh uses an edge at most once per direction).
+    // The directed edges grouped by their first vertex, each as (second vertex, triangle, edge), in
+    // triangle order. The neighbour across (a, b) is the first triangle with (b, a): per vertex b,
+    // its edges (b, to) noted by `to`, so that each edge (a, b) finds it at once (a search among
+    // b's edges was quadratic in b's valence). A note left by a vertex before b lies outside b's.
     struct Leaving {
-        uint32_t to, triangle;
+        uint32_t to, triangle, edge;
     };
     size_t vertex_end = 0;
     for (const auto& t : base.triangles)
@@ -68,15 +70,24 @@ std::vector<std::pair<uint32_t, int>> seam_edges(const TriangleMesh& base, const
     std::vector<Leaving> leaving;
     const std::vector<size_t> start = bucket_by_vertex(
         vertex_end, 3 * base.triangles.size(), [&](size_t h) { return base.triangles[h / 3][h % 3]; },
-        [&](size_t h) { return Leaving{base.triangles[h / 3][(h % 3 + 1) % 3], uint32_t(h / 3)}; }, leaving);
+        [&](size_t h) { return Leaving{base.triangles[h / 3][(h % 3 + 1) % 3], uint32_t(h / 3), uint32_t(h % 3)}; }, leaving);
+    std::vector<uint32_t> across(3 * base.triangles.size(), UINT32_MAX);  // the neighbour across edge e of t: 3 t + e
+    std::vector<size_t> leaving_to(vertex_end, SIZE_MAX);
+    for (size_t b = 0; b < vertex_end; ++b) {
+        const size_t first = start[b], count = start[b + 1] - first;
+        for (size_t k = first + count; k-- > first;) leaving_to[leaving[k].to] = k;  // the first edge (b, to) noted last
+        for (size_t k = first; k < first + count; ++k) {
+            const uint32_t t = leaving[k].triangle, e = (leaving[k].edge + 2) % 3;  // (a, b)
+            const size_t found = leaving_to[base.triangles[t][e]];
+            if (found - first < count) across[3 * size_t(t) + e] = leaving[found].triangle;
+        }
+    }
     std::vector<std::pair<uint32_t, int>> edges;
     for (uint32_t t = 0; t < base.triangles.size(); ++t) {
         for (int e = 0; e < 3; ++e) {
-            const uint32_t a = base.triangles[t][e], b = base.triangles[t][(e + 1) % 3];
-            size_t k = start[b];
-            while (k < start[b + 1] && leaving[k].to != a) ++k;
-            if (k == start[b + 1] || leaving[k].triangle <= t) continue;
-            if (chunk_of_root[leaving[k].triangle] != chunk_of_root[t]) edges.emplace_back(t, e);
+            const uint32_t q = across[3 * size_t(t) + size_t(e)];
+            if (q == UINT32_MAX || q <= t) continue;
+            if (chunk_of_root[q] != chunk_of_root[t]) edges.emplace_back(t, e);
         }
     }
     return edges;
