@@ -405,6 +405,18 @@ TEST(CraftedFiles, InspectOfManyChunksIsLinear) {
     }
     EXPECT_EQ(info.chunks.back().size, kBlockOverhead);
     EXPECT_LT(milliseconds, 1000.0);  // 0.14 s under ASan (CI)
+    // Every root's chunk (amc decode --triangles): each found by a search, not a pass over the
+    // chunks (2.9 s of CPU until 2026-12-07).
+    std::vector<uint32_t> roots(chunks);
+    for (uint32_t r = 0; r < chunks; ++r) roots[r] = chunks - 1 - r;
+    const double covering_start = cpu_milliseconds();
+    const std::vector<uint32_t> covering = chunks_covering(info, roots);
+    const double covering_milliseconds = cpu_milliseconds() - covering_start;
+    std::printf("  chunks of %llu roots: %.1f ms\n", (unsigned long long)chunks, covering_milliseconds);
+    ASSERT_EQ(covering.size(), chunks);
+    for (uint32_t c = 0; c < chunks; ++c) ASSERT_EQ(covering[c], c);
+    EXPECT_EQ(chunks_covering(info, {0, 5, 5, 131071}), (std::vector<uint32_t>{0, 5, 131071}));
+    EXPECT_LT(covering_milliseconds, 1000.0);
 }
 
 // A chunked file (version 13 on) of 813 bytes whose metadata announces 2^26 nodes and 25.2 M

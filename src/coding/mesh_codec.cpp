@@ -866,9 +866,10 @@ std::vector<uint32_t> chunks_covering(const FileInfo& info, const std::vector<ui
     for (uint32_t t : base_triangles) {
         AMC_REQUIRE(t < info.base_triangles, invalid_input,
                     "base triangle " + std::to_string(t) + " is not in the file (it has " + std::to_string(info.base_triangles) + ")");
-        uint32_t c = 0;
-        while (c + 1 < info.chunks.size() && info.chunks[c + 1].first_root <= t) ++c;
-        out.push_back(c);
+        // The last chunk starting at or before t (first roots increase): a search, not a pass per triangle.
+        const auto after = std::upper_bound(info.chunks.begin(), info.chunks.end(), t,
+                                            [](uint32_t root, const ChunkInfo& chunk) { return root < chunk.first_root; });
+        out.push_back(after == info.chunks.begin() ? 0 : uint32_t(after - info.chunks.begin()) - 1);
     }
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
