@@ -144,6 +144,10 @@ CoarserLevel LevelFinder::coarser_level(std::vector<uint32_t>* parent_of_block) 
     CoarserLevel out;
     if (parent_of_block) parent_of_block->assign(blocks_.size(), kNoIndex);
     std::vector<uint8_t> merged(tri_.size(), 0);
+    // The coarser level has fewer triangles than this one: no reallocation on the way.
+    out.triangles.reserve(tri_.size());
+    out.refined.reserve(tri_.size());
+    out.changed.reserve(tri_.size());
     for (uint32_t index = 0; index < blocks_.size(); ++index) {
         const Block& b = blocks_[index];
         if (!b.alive) continue;
@@ -248,8 +252,9 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
             return 0;
         }
         for (int i = 0; i < 3; ++i) {
-            const Fan fan = blocks_[next].fan[size_t(i)];  // a copy: placing blocks moves blocks_
-            if (fan.kind != Fan::triangles || block_of_[fan.triangle[1]] != kNoIndex) continue;
+            const Fan& side = blocks_[next].fan[size_t(i)];
+            if (side.kind != Fan::triangles || block_of_[side.triangle[1]] != kNoIndex) continue;
+            const Fan fan = side;  // a copy: placing blocks moves blocks_
             if (preference == Preference::closure_first) {
                 const uint32_t partner = closure_partner(blocks_[next], i, fan);
                 if (partner != kNoIndex) {
@@ -277,14 +282,17 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
     // collected), one with many is a wrong reading, not a true one with a few wrong turns.
     const uint32_t size = uint32_t(blocks_.size()) - start;
     const bool repairable = suspects && size >= kRepairable;
+    // Only the whole set of invalid blocks counts, or that there are too many: the blocks placed
+    // last, on the front where a wrong reading ends, are checked first.
     std::vector<uint32_t> invalid;
-    for (uint32_t i = start; i < blocks_.size(); ++i) {
+    for (uint32_t i = uint32_t(blocks_.size()); i-- > start;) {
         if (sides_valid(i)) continue;
         invalid.push_back(i);
         const bool counting = repairable ? invalid.size() * kRepairableShare <= size
                                          : size >= kBlockedGrowth && invalid.size() <= kFewInvalid;
         if (!counting) break;
     }
+    std::reverse(invalid.begin(), invalid.end());
     if (!invalid.empty()) {
         // A large growth held by a few blocks: what refined triangles stood in their way.
         if (size >= kBlockedGrowth && invalid.size() <= kFewInvalid) {

@@ -178,7 +178,13 @@ private:
     // one's, a coarse edge already an edge). The mesh alone decides it, and growths read the same
     // triangles again and again, so it is read once per triangle and kept. The pointer lasts
     // until the next call.
-    const Block* possible_block(uint32_t t) const;
+    const Block* possible_block(uint32_t t) const {
+        const uint32_t known = shape_of_[t];
+        if (known == kNotRead) return read_shape(t);  // out of line: the kept answer is the common case
+        return known == kImpossible ? nullptr : &shapes_[known];
+    }
+    // possible_block's first reading of t, kept.
+    const Block* read_shape(uint32_t t) const;
 
     Fan walk_fan(const Block& b, int i) const;
 

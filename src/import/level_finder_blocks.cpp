@@ -39,10 +39,7 @@ bool LevelFinder::read_block(uint32_t t, Block& b) const {
     return true;
 }
 
-const Block* LevelFinder::possible_block(uint32_t t) const {
-    const uint32_t known = shape_of_[t];
-    if (known == kImpossible) return nullptr;
-    if (known != kNotRead) return &shapes_[known];
+const Block* LevelFinder::read_shape(uint32_t t) const {
     Block b;
     bool possible = read_block(t, b);
     for (int i = 0; i < 3 && possible; ++i) {
@@ -97,10 +94,13 @@ bool LevelFinder::fits(const Block& b) const {
 }
 
 bool LevelFinder::has_other_midpoint(uint32_t a, uint32_t b, uint32_t m) const {
+    // An edge as one 64-bit key, so that each neighbour costs one comparison per direction.
+    auto key = [](uint32_t s, uint32_t t) { return uint64_t(s) | uint64_t(t) << 32; };
+    const uint64_t ab = key(a, b), ba = key(b, a);
     auto splits_ab = [&](uint32_t w) {
-        if (w == m) return false;
         const auto [s, t] = first_coarse_edge_[w];  // (kNoIndex, kNoIndex) unless w is a midpoint
-        return (s == a && t == b) || (s == b && t == a);
+        const uint64_t edge = key(s, t);
+        return (edge == ab || edge == ba) && w != m;
     };
     for (const uint32_t* w = adjacency_.ends_begin(a); w != adjacency_.ends_end(a); ++w) {
         if (splits_ab(*w)) return true;
@@ -116,20 +116,15 @@ bool LevelFinder::has_other_midpoint(uint32_t a, uint32_t b, uint32_t m) const {
 bool LevelFinder::place_block(uint32_t t) {
     const Block* shape = possible_block(t);
     if (shape == nullptr || !fits(*shape)) return false;
+    // Old once the block is placed: its parent vertices are too (checked before claiming it).
+    auto old_once_placed = [&](uint32_t x) { return is_old(x) || x == shape->v[0] || x == shape->v[1] || x == shape->v[2]; };
     for (const Fan& fan : shape->fan) {
         if (fan.kind == Fan::invalid) return false;
-    }
-    const uint32_t index = uint32_t(blocks_.size());
-    blocks_.push_back(*shape);
-    claim(index);
-    for (const Fan& fan : blocks_[index].fan) {
         // Neither a block nor a two-hanging-node closure fits two old vertices there.
-        if (fan.size == 3 && is_old(fan.inner[0]) && is_old(fan.inner[1])) {
-            release(index);
-            blocks_.pop_back();
-            return false;
-        }
+        if (fan.size == 3 && old_once_placed(fan.inner[0]) && old_once_placed(fan.inner[1])) return false;
     }
+    blocks_.push_back(*shape);
+    claim(uint32_t(blocks_.size() - 1));
     return true;
 }
 
@@ -340,18 +335,20 @@ Side LevelFinder::classify(uint32_t index, int i) const {
 
 bool LevelFinder::sides_valid(uint32_t index) const {
     const Block& b = blocks_[index];
-    for (int i = 0; i < 3; ++i) {
-        if (has_other_midpoint(b.v[size_t(i)], b.v[size_t(i + 1) % 3], b.m[size_t(i)])) return false;
-    }
+    // The sides first: they fail more often than the coarse edges, and both only read.
     uint32_t red_neighbor[3];
     for (int i = 0; i < 3; ++i) {
         const Side side = classify(index, i);
         if (side.kind == Side::invalid) return false;
-        red_neighbor[i] = side.kind == Side::red ? block_of_[adjacency_.twin(blocks_[index].second_half[size_t(i)]) / 3]
+        red_neighbor[i] = side.kind == Side::red ? block_of_[adjacency_.twin(b.second_half[size_t(i)]) / 3]
                                                  : kNoIndex - uint32_t(i);
     }
     // Two blocks glued along all three edges would make two coincident coarse triangles.
-    return !(red_neighbor[0] == red_neighbor[1] && red_neighbor[1] == red_neighbor[2]);
+    if (red_neighbor[0] == red_neighbor[1] && red_neighbor[1] == red_neighbor[2]) return false;
+    for (int i = 0; i < 3; ++i) {
+        if (has_other_midpoint(b.v[size_t(i)], b.v[size_t(i + 1) % 3], b.m[size_t(i)])) return false;
+    }
+    return true;
 }
 
 }  // namespace amc::detail::inverse

@@ -13,8 +13,8 @@ TriangleAdjacency::TriangleAdjacency(const std::vector<Triangle>& triangles, uin
         for (uint32_t v : t) ++out_start_[v + 2];
     }
     for (size_t v = 2; v < out_start_.size(); ++v) out_start_[v] += out_start_[v - 1];
-    out_end_.resize(half_edges);
-    out_half_edge_.resize(half_edges);
+    out_end_.reset(new uint32_t[half_edges]);
+    out_half_edge_.reset(new uint32_t[half_edges]);
     for (uint32_t t = 0; t < triangles.size(); ++t) {
         for (uint32_t k = 0; k < 3; ++k) {
             const uint32_t slot = out_start_[triangles[t][k] + 1]++;
@@ -54,16 +54,16 @@ TriangleAdjacency::TriangleAdjacency(const std::vector<Triangle>& triangles, uin
 }
 
 uint32_t TriangleAdjacency::find(uint32_t from, uint32_t to) const {
-    const uint32_t* first = out_end_.data() + out_start_[from];
-    const uint32_t* last = out_end_.data() + out_start_[from + 1];
+    const uint32_t* first = out_end_.get() + out_start_[from];
+    const uint32_t* last = out_end_.get() + out_start_[from + 1];
     // A vertex has about six half-edges: a scan beats a binary search; a large fan is sorted and searched.
     const uint32_t* it = first;
     if (last - first > kScanned) {
         it = std::lower_bound(first, last, to);
-        return it != last && *it == to ? out_half_edge_[size_t(it - out_end_.data())] : kNoHalfEdge;
+        return it != last && *it == to ? out_half_edge_[size_t(it - out_end_.get())] : kNoHalfEdge;
     }
     while (it != last && *it != to) ++it;
-    return it != last ? out_half_edge_[size_t(it - out_end_.data())] : kNoHalfEdge;
+    return it != last ? out_half_edge_[size_t(it - out_end_.get())] : kNoHalfEdge;
 }
 
 }  // namespace amc::detail

@@ -8,6 +8,7 @@
 #include <amc/mesh.h>
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace amc::detail {
@@ -24,12 +25,12 @@ public:
     uint32_t twin(uint32_t half_edge) const { return twin_[half_edge]; }
     // The half-edges that start at v: one per triangle around v.
     uint32_t star_size(uint32_t v) const { return out_start_[v + 1] - out_start_[v]; }
-    const uint32_t* outgoing_begin(uint32_t v) const { return out_half_edge_.data() + out_start_[v]; }
-    const uint32_t* outgoing_end(uint32_t v) const { return out_half_edge_.data() + out_start_[v + 1]; }
+    const uint32_t* outgoing_begin(uint32_t v) const { return out_half_edge_.get() + out_start_[v]; }
+    const uint32_t* outgoing_end(uint32_t v) const { return out_half_edge_.get() + out_start_[v + 1]; }
     // Their end vertices, in no particular order: every neighbour of v but, on the boundary, the
     // one before v.
-    const uint32_t* ends_begin(uint32_t v) const { return out_end_.data() + out_start_[v]; }
-    const uint32_t* ends_end(uint32_t v) const { return out_end_.data() + out_start_[v + 1]; }
+    const uint32_t* ends_begin(uint32_t v) const { return out_end_.get() + out_start_[v]; }
+    const uint32_t* ends_end(uint32_t v) const { return out_end_.get() + out_start_[v + 1]; }
     bool on_boundary(uint32_t v) const { return boundary_[v] != 0; }
     // Whether some triangle has the edge a-b (in either direction).
     // (Around an inner vertex every neighbour is the end of an outgoing half-edge.)
@@ -43,8 +44,10 @@ private:
 
     std::vector<uint32_t> twin_;
     std::vector<uint32_t> out_start_;      // half-edges by start vertex: [out_start_[v], out_start_[v+1])
-    std::vector<uint32_t> out_end_;        // their end vertices (ascending for more than kScanned)
-    std::vector<uint32_t> out_half_edge_;  // their ids
+    // Their end vertices (ascending for more than kScanned) and ids; every entry is written by the
+    // counting sort, so they are allocated without being zeroed first (a vector would).
+    std::unique_ptr<uint32_t[]> out_end_;
+    std::unique_ptr<uint32_t[]> out_half_edge_;
     std::vector<uint8_t> boundary_;
 };
 
