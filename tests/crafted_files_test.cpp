@@ -788,13 +788,8 @@ TEST(CraftedFiles, OctreeManyLeafFieldsDecodeInLinearTime) {
     EXPECT_LT(milliseconds, 5000.0);  // 1.1 s under ASan (CI)
 }
 
-// An .amq over 4,000 quadtrees around one coarse vertex, each refined once (220 KB), and its
-// conforming mesh (`amc octree decode --conforming`): each point named once, in time linear in
-// the trees. Each place of a point was searched among all its places, and every place at the
-// vertex went around it again: cubic in the trees (8.9 s of CPU here until 2026-12-07,
-// docs/FUZZING.md). CPU time, as the other crafted files.
-TEST(CraftedFiles, ConformingMeshAroundAVertexOfManyTreesIsLinear) {
-    constexpr uint32_t trees = 4000;
+// `trees` quadtrees around one coarse vertex, corner 0 of each.
+TreeConnectivity quadtree_fan(uint32_t trees) {
     std::vector<Vec3> vertices = {{0, 0, 0}};
     for (uint32_t i = 0; i < trees; ++i) {
         const double a = 2 * 3.141592653589793 * double(i) / trees, b = 2 * 3.141592653589793 * (i + 0.5) / trees;
@@ -804,7 +799,17 @@ TEST(CraftedFiles, ConformingMeshAroundAVertexOfManyTreesIsLinear) {
     std::vector<uint32_t> tree_to_vertex;  // centre, rim vertex i, rim vertex i + 1, the point between them outside
     for (uint32_t i = 0; i < trees; ++i)
         for (uint32_t v : {0u, 1 + 2 * i, 1 + 2 * ((i + 1) % trees), 2 + 2 * i}) tree_to_vertex.push_back(v);
-    const OctreeForest forest = uniform_octree_forest(connectivity_from_vertices(2, vertices, tree_to_vertex), 1);
+    return connectivity_from_vertices(2, vertices, tree_to_vertex);
+}
+
+// An .amq over 4,000 quadtrees around one coarse vertex, each refined once (220 KB), and its
+// conforming mesh (`amc octree decode --conforming`): each point named once, in time linear in
+// the trees. Each place of a point was searched among all its places, and every place at the
+// vertex went around it again: cubic in the trees (8.9 s of CPU here until 2026-12-07,
+// docs/FUZZING.md). CPU time, as the other crafted files.
+TEST(CraftedFiles, ConformingMeshAroundAVertexOfManyTreesIsLinear) {
+    constexpr uint32_t trees = 4000;
+    const OctreeForest forest = uniform_octree_forest(quadtree_fan(trees), 1);
     const std::vector<uint8_t> file = encode_octree_forest(forest);
     const OctreeForest decoded = decode_octree_forest(file.data(), file.size());
     const double start = cpu_milliseconds();
@@ -815,6 +820,33 @@ TEST(CraftedFiles, ConformingMeshAroundAVertexOfManyTreesIsLinear) {
     EXPECT_EQ(mesh.corner_points, 6 * trees + 1);
     EXPECT_EQ(mesh.cell_count(), 8 * size_t(trees));
     EXPECT_LT(milliseconds, 1000.0);
+}
+
+// 8,000 quadtrees around one coarse vertex, uniform at level 2, tree 0 refined twice more at the
+// vertex: corner balance refines every other tree's octant there once. Each refined octant at the
+// vertex went around it, finding the same octants again: quadratic in the trees (10.3 s of CPU
+// and 2.1 GB here until 2026-12-07, docs/FUZZING.md), as was octree_balance_violation (1.3 s).
+TEST(CraftedFiles, CornerBalanceAroundAVertexOfManyTreesIsLinear) {
+    constexpr uint32_t trees = 8000;
+    const OctreeForest forest = refine_octree_forest(
+        uniform_octree_forest(quadtree_fan(trees), 2),
+        [](uint32_t tree, const Octant& o) { return tree == 0 && o.x == 0 && o.y == 0 && o.level < 4; }, 4);
+    const uint64_t allocated_before = g_allocated.load();
+    const double start = cpu_milliseconds();
+    const OctreeForest balanced = balance_octree_forest(forest, OctreeBalance::corner);
+    const std::string before = octree_balance_violation(forest, OctreeBalance::corner);
+    const std::string after = octree_balance_violation(balanced, OctreeBalance::corner);
+    const double milliseconds = cpu_milliseconds() - start;
+    const uint64_t allocated = g_allocated.load() - allocated_before;
+    std::printf("  corner balance of %u trees around a vertex: %.1f ms, %llu bytes allocated\n", trees, milliseconds,
+                (unsigned long long)allocated);
+    // 16 leaves a tree, 3 more where each octant at the vertex is split, 3 more in tree 0.
+    EXPECT_EQ(balanced.leaves.size(), 19 * size_t(trees) + 3);
+    EXPECT_EQ(before, "tree 0 octant (0, 0, 0) of level 3 is refined, but its neighbour at offset (0, -1, 0) in tree " +
+                          std::to_string(trees - 1) + " lies in a leaf two or more levels coarser");
+    EXPECT_EQ(after, "");
+    EXPECT_LT(milliseconds, 5000.0);  // 0.12 s; 1.6 s with the octree files under ASan at -O0
+    EXPECT_LT(allocated, uint64_t(512) << 20);  // 122 MB; 4.4 GB before
 }
 
 TEST(CraftedFiles, OctreeWriterPadsCostlessForests) {

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <set>
 
 namespace amc {
 
@@ -45,14 +46,17 @@ struct Key {  // an octant of some level: its tree and coordinates
 };
 
 // The same-level positions an offset from octant c of `tree` reaches: across faces one after the
-// other, and (offsets that leave the tree on two or more axes) around the coarse vertex or edge.
+// other, and (offsets that leave the tree on two or more axes) around the coarse vertex or edge
+// unless `gone_around` (this level's) holds it: from every octant there the same positions but
+// its own, which is the octant or its face neighbour. Once each, else quadratic in the trees there.
 void reached(const TreeFaces& faces, const TreeCorners& corners, uint32_t tree, int l, const int32_t c[3],
-             const std::array<int, 3>& off, std::vector<TreeCorners::Place>& out) {
+             const std::array<int, 3>& off, std::set<TreeCorners::Meeting>& gone_around,
+             std::vector<TreeCorners::Place>& out) {
     out.clear();
     TreeCorners::Place q{tree, {c[0] + off[0], c[1] + off[1], c[2] + off[2]}};
     int outside = 0;
     for (int a = 0; a < 3; ++a) outside += q.c[a] < 0 || q.c[a] >= (int32_t(1) << l);
-    if (outside >= 2) corners.neighbours(tree, l, q.c, out);
+    if (outside >= 2 && gone_around.insert(corners.meeting(tree, l, q.c)).second) corners.neighbours(tree, l, q.c, out);
     if (faces.wrap(q.tree, l, q.c)) out.push_back(q);
 }
 
@@ -72,6 +76,7 @@ OctreeForest balance_octree_forest(const OctreeForest& forest, OctreeBalance bal
     const TreeCorners corners(forest.connectivity);
     const auto offsets = neighbor_offsets(forest.dim(), balance);
     std::vector<TreeCorners::Place> places;
+    std::set<TreeCorners::Meeting> gone_around;
     // must[l]: the octants of level l that must be refined, sorted.
     std::vector<std::vector<Key>> must(levels.depth() + 1);
     for (int l = 0; l <= levels.depth(); ++l) {
@@ -82,10 +87,11 @@ OctreeForest balance_octree_forest(const OctreeForest& forest, OctreeBalance bal
     for (int l = levels.depth(); l >= 1; --l) {
         std::sort(must[l].begin(), must[l].end());
         must[l].erase(std::unique(must[l].begin(), must[l].end()), must[l].end());
+        gone_around.clear();
         for (const Key& k : must[l]) {
             must[l - 1].push_back({k.tree, {k.c[0] >> 1, k.c[1] >> 1, k.c[2] >> 1}});
             for (const auto& off : offsets) {
-                reached(faces, corners, k.tree, l, k.c, off, places);
+                reached(faces, corners, k.tree, l, k.c, off, gone_around, places);
                 for (const TreeCorners::Place& q : places) must[l - 1].push_back({q.tree, {q.c[0] >> 1, q.c[1] >> 1, q.c[2] >> 1}});
             }
         }
@@ -110,12 +116,14 @@ std::string octree_balance_violation(const OctreeForest& forest, OctreeBalance b
     const auto offsets = neighbor_offsets(forest.dim(), balance);
     const TreeCorners corners(forest.connectivity);
     std::vector<TreeCorners::Place> places;
+    std::set<TreeCorners::Meeting> gone_around;
     for (int l = 1; l <= levels.depth(); ++l) {
         const OctreeLevel& lv = levels.level(l);
+        gone_around.clear();
         for (uint32_t n = 0; n < lv.size(); ++n) {
             if (!refined[l][n]) continue;
             for (const auto& off : offsets) {
-                reached(levels.faces(), corners, lv.tree[n], l, &lv.coord[3 * size_t(n)], off, places);
+                reached(levels.faces(), corners, lv.tree[n], l, &lv.coord[3 * size_t(n)], off, gone_around, places);
                 for (const TreeCorners::Place& q : places)
                     if (levels.find(q.tree, l, q.c) == kNoOctant)
                         return describe(lv, n, l) + " is refined, but its neighbour at offset (" + std::to_string(off[0]) + ", " +

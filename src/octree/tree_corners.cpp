@@ -1,6 +1,8 @@
 // Corner and edge neighbours of the coarse mesh through shared vertices; see tree_corners.h.
 #include "octree/tree_corners.h"
 
+#include <algorithm>
+
 namespace amc {
 
 namespace {
@@ -44,19 +46,38 @@ TreeCorners::TreeCorners(const TreeConnectivity& conn) : dim_(conn.dim), conn_(&
     }
 }
 
+TreeCorners::Around TreeCorners::around(int level, const int32_t c[3]) const {
+    const int32_t n = int32_t(1) << level;
+    Around out;
+    for (int a = 0; a < dim_; ++a) {
+        if (c[a] >= 0 && c[a] < n) {
+            out.inside_axis = a;
+            continue;
+        }
+        ++out.out_axes;
+        if (c[a] >= n) out.corner |= 1 << a;
+    }
+    return out;
+}
+
+TreeCorners::Meeting TreeCorners::meeting(uint32_t tree, int level, const int32_t c[3]) const {
+    if (at_vertex_.empty()) return {UINT32_MAX, UINT32_MAX, 0};  // nothing is around anything
+    const int corners = 1 << dim_;
+    const Around at = around(level, c);
+    const uint32_t a = conn_->tree_to_vertex[size_t(tree) * corners + at.corner];
+    if (at.out_axes == dim_) return {a, UINT32_MAX, 0};
+    const uint32_t b = conn_->tree_to_vertex[size_t(tree) * corners + (at.corner | (1 << at.inside_axis))];
+    // The place counted from the lower vertex, as neighbours() turns it for trees the other way round.
+    const int32_t along = c[at.inside_axis], n = int32_t(1) << level;
+    return {std::min(a, b), std::max(a, b), uint32_t(a < b ? along : n - 1 - along)};
+}
+
 void TreeCorners::neighbours(uint32_t tree, int level, const int32_t c[3], std::vector<Place>& out) const {
     if (at_vertex_.empty()) return;
     const int32_t n = int32_t(1) << level;
     const int corners = 1 << dim_;
-    int out_axes = 0, inside_axis = -1, corner = 0;
-    for (int a = 0; a < dim_; ++a) {
-        if (c[a] >= 0 && c[a] < n) {
-            inside_axis = a;
-            continue;
-        }
-        ++out_axes;
-        if (c[a] >= n) corner |= 1 << a;
-    }
+    const Around at = around(level, c);
+    const int out_axes = at.out_axes, inside_axis = at.inside_axis, corner = at.corner;
     const auto at_corner = [&](uint32_t t, int k, int32_t along_axis, int32_t along) {
         Place p{t, {0, 0, 0}};
         for (int a = 0; a < dim_; ++a) p.c[a] = a == along_axis ? along : ((k >> a) & 1) ? n - 1 : 0;

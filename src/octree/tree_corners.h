@@ -31,7 +31,19 @@ public:
     // that touch the same coarse vertex, or the same coarse edge at the same place.
     void neighbours(uint32_t tree, int level, const int32_t c[3], std::vector<Place>& out) const;
 
+    // Names what neighbours(tree, level, c) goes around: the coarse vertex, or the coarse edge and
+    // the place along it. The same from every octant there, so a caller can go around it once.
+    using Meeting = std::array<uint32_t, 3>;
+    Meeting meeting(uint32_t tree, int level, const int32_t c[3]) const;
+
 private:
+    struct Around {  // how position c lies outside its tree
+        int out_axes = 0;     // on how many axes
+        int inside_axis = -1; // 3D, out on two: the axis along the coarse edge
+        int corner = 0;       // the tree's corner it is beyond (its edge's low end)
+    };
+    Around around(int level, const int32_t c[3]) const;
+
     int dim_ = 2;
     const TreeConnectivity* conn_ = nullptr;
     std::vector<std::vector<std::pair<uint32_t, uint8_t>>> at_vertex_;  // vertex -> (tree, corner)
