@@ -153,7 +153,11 @@ VtuMesh parse_vtu(std::string_view bytes, const std::string& what, unsigned thre
             }
             const DataArray coordinates = vtu::decode_array(layout, *points, piece.points, prefix, what, threads);
             if (points->type != ValueType::float32) out.mesh.single_precision = false;
-            out.mesh.positions.reserve(first_point + piece.points);
+            // Exact for one piece, doubling over several: an exact reserve for each piece copied all
+            // the earlier pieces' points, quadratic in the pieces (docs/FUZZING.md).
+            if (out.mesh.positions.capacity() < first_point + piece.points) {
+                out.mesh.positions.reserve(std::max<std::size_t>(first_point + piece.points, 2 * out.mesh.positions.capacity()));
+            }
             std::visit(
                 [&](const auto& v) {
                     for (std::size_t i = 0; i + 2 < v.size(); i += 3) {
