@@ -12,6 +12,7 @@
 #include "coding/geometry/float_coder.h"
 #include "coding/hierarchy/hierarchy_stream.h"
 #include "common/bits.h"
+#include "mesh/vtu_reader.h"
 #include "octree/octree_file.h"
 #include "octree/octree_traversal.h"
 #include "series/series_format.h"
@@ -19,6 +20,7 @@
 
 #include <amc/codec.h>
 #include <amc/hierarchy_coder.h>
+#include <amc/import.h>
 #include <amc/mesh_io.h>
 #include <amc/numbering.h>
 #include <amc/octree.h>
@@ -31,9 +33,13 @@
 #include <cmath>
 #include <cstdlib>
 #include <ctime>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <new>
 #include <string>
+
+#include <unistd.h>
 
 namespace {
 std::atomic<uint64_t> g_allocated{0};
@@ -531,6 +537,77 @@ TEST(CraftedFiles, NumberingOfAVertexLowestInManyFacesIsLinear) {
         ASSERT_EQ(numbering.face[j], j);
         ASSERT_EQ(numbering.rotation[j], 0);
     }
+    EXPECT_LT(milliseconds, 2000.0);
+}
+
+// The leaf mesh of a bipyramid of 2^16 sides refined once (2^18 faces, two vertices of valence
+// 2^16): import_mesh finds its base in time linear in it. The level finder searched a block's
+// coarse edge for another midpoint in its first vertex's whole star, from every block at an apex:
+// 26 s of CPU here (6.9 s at 2^15 sides, 1.9 s at 2^14) until 2026-12-07 (docs/FUZZING.md).
+TEST(CraftedFiles, ImportOfAHighValenceLeafMeshIsLinear) {
+    Hierarchy refined(bipyramid(uint32_t(1) << 16));
+    refine_uniformly(refined, 1);
+    const LeafMesh leaf = extract_leaf_mesh(refined);
+    const double start = cpu_milliseconds();
+    const ImportedHierarchy imported = import_mesh(leaf.mesh);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  import of %zu faces: %.1f ms\n", leaf.mesh.triangles.size(), milliseconds);
+    EXPECT_EQ(imported.hierarchy.root_count(), refined.root_count());
+    EXPECT_EQ(imported.hierarchy.node_count(), refined.node_count());
+    EXPECT_LT(milliseconds, 8000.0);
+}
+
+// A VTU of 2^15 pieces of one triangle each (ASCII, 13 MB): read in memory linear in its points.
+// Each piece reserved exactly its points on top of the earlier ones', so every piece copied all
+// the points before it: 38 GB allocated, 8 s of CPU (mostly the kernel's page faults) until
+// 2026-12-07 (docs/FUZZING.md).
+TEST(CraftedFiles, VtuOfManyPiecesReadsInLinearMemory) {
+    const uint32_t pieces = uint32_t(1) << 15;
+    std::string vtu = "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n";
+    for (uint32_t k = 0; k < pieces; ++k) {
+        const std::string x = std::to_string(k);
+        vtu += "<Piece NumberOfPoints=\"3\" NumberOfCells=\"1\"><Points><DataArray type=\"Float64\" "
+               "NumberOfComponents=\"3\" format=\"ascii\">" + x + " 0 0 " + x + " 1 0 " + x + ".5 0 1</DataArray></Points>"
+               "<Cells><DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">0 1 2</DataArray>"
+               "<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">3</DataArray>"
+               "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">5</DataArray></Cells></Piece>\n";
+    }
+    vtu += "</UnstructuredGrid>\n</VTKFile>\n";
+    const uint64_t allocated_before = g_allocated.load();
+    const double start = cpu_milliseconds();
+    const VtuMesh mesh = parse_vtu(vtu, "pieces.vtu", 1);
+    const double milliseconds = cpu_milliseconds() - start;
+    const uint64_t allocated = g_allocated.load() - allocated_before;
+    std::printf("  %u pieces (%zu bytes): %.1f ms, %.1f MB allocated\n", pieces, vtu.size(), milliseconds, 1e-6 * double(allocated));
+    ASSERT_EQ(mesh.mesh.positions.size(), 3 * size_t(pieces));
+    ASSERT_EQ(mesh.mesh.triangles.size(), size_t(pieces));
+    EXPECT_EQ(mesh.mesh.positions.back().x, double(pieces - 1) + 0.5);
+    EXPECT_EQ(mesh.mesh.triangles.back(), (Triangle{3 * pieces - 3, 3 * pieces - 2, 3 * pieces - 1}));
+    EXPECT_LT(allocated, uint64_t(200) << 20);
+    EXPECT_LT(milliseconds, 4000.0);
+}
+
+// A ParaView collection of 2^15 DataSets (2.3 MB): read in time linear in them. Each DataSet's
+// line was counted from the start of the file for a message it would only need on an error: 9.5 s
+// of CPU until 2026-12-07 (docs/FUZZING.md; `amc series encode` of a .pvd reads it first).
+TEST(CraftedFiles, PvdOfManyDataSetsReadsInLinearTime) {
+    const uint32_t entries = uint32_t(1) << 15;
+    const std::string path = (std::filesystem::temp_directory_path() /
+                              ("amc_crafted_" + std::to_string(getpid()) + "_many.pvd")).string();
+    {
+        std::ofstream out(path);
+        out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
+        for (uint32_t k = 0; k < entries; ++k) out << "<DataSet timestep=\"" << k << "\" part=\"0\" file=\"f_" << k << ".vtu\"/>\n";
+        out << "</Collection>\n</VTKFile>\n";
+    }
+    const double start = cpu_milliseconds();
+    const std::vector<PvdEntry> read = read_pvd(path);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::filesystem::remove(path);
+    std::printf("  %u DataSets: %.1f ms\n", entries, milliseconds);
+    ASSERT_EQ(read.size(), size_t(entries));
+    EXPECT_EQ(read.back().file, "f_" + std::to_string(entries - 1) + ".vtu");
+    EXPECT_EQ(read.back().time, double(entries - 1));
     EXPECT_LT(milliseconds, 2000.0);
 }
 

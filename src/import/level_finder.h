@@ -195,7 +195,7 @@ private:
     bool fits(const Block& b) const;
 
     // Whether a midpoint other than m already splits the coarse edge a-b. It would be a neighbour
-    // of a (the first half of its edge), so a's star is searched.
+    // of a and of b (the halves of its edge), so the smaller of their stars is searched.
     bool has_other_midpoint(uint32_t a, uint32_t b, uint32_t m) const;
 
     // Places the block centered at t if it fits and each of its sides has a shape a block side

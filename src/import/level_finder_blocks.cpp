@@ -102,12 +102,16 @@ bool LevelFinder::has_other_midpoint(uint32_t a, uint32_t b, uint32_t m) const {
         const uint64_t edge = key(s, t);
         return (edge == ab || edge == ba) && w != m;
     };
-    for (const uint32_t* w = adjacency_.ends_begin(a); w != adjacency_.ends_end(a); ++w) {
+    // Such a midpoint neighbours both a and b (it halves their edge): the smaller star is searched,
+    // since a's alone made the blocks around a vertex of high valence quadratic in it (docs/FUZZING.md).
+    const auto star = [&](uint32_t v) { return adjacency_.ends_end(v) - adjacency_.ends_begin(v); };
+    const uint32_t v = star(b) < star(a) ? b : a;
+    for (const uint32_t* w = adjacency_.ends_begin(v); w != adjacency_.ends_end(v); ++w) {
         if (splits_ab(*w)) return true;
     }
-    if (!adjacency_.on_boundary(a)) return false;
-    // The neighbour before a along the boundary is only the third vertex of one of its triangles.
-    for (const uint32_t* h = adjacency_.outgoing_begin(a); h != adjacency_.outgoing_end(a); ++h) {
+    if (!adjacency_.on_boundary(v)) return false;
+    // The neighbour before v along the boundary is only the third vertex of one of its triangles.
+    for (const uint32_t* h = adjacency_.outgoing_begin(v); h != adjacency_.outgoing_end(v); ++h) {
         if (splits_ab(vertex_at(*h, 2))) return true;
     }
     return false;
