@@ -557,6 +557,34 @@ TEST(CraftedFiles, ImportOfAHighValenceLeafMeshIsLinear) {
     EXPECT_LT(milliseconds, 8000.0);
 }
 
+// A series of 2^17 unchanged frames over a tetrahedron after one keyframe (3.5 MB), read in order
+// in time linear in the frames: each frame(k) walked back to the keyframe to find where to start,
+// though the reader held frame k - 1 (6.6 s of CPU until 2026-12-07, docs/FUZZING.md; `amc
+// series decode` reads every frame so).
+TEST(CraftedFiles, SeriesOfManyFramesAfterOneKeyframeReadsInLinearTime) {
+    TriangleMesh base;
+    base.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    base.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+    const Hierarchy h(base);
+    SeriesOptions options;
+    options.choose_keyframes = false;
+    SeriesWriter writer(h.base(), options);
+    const size_t frames = size_t(1) << 17;
+    for (size_t k = 0; k < frames; ++k) writer.add_frame(h, double(k));
+    writer.close();
+    SeriesReader reader(writer.bytes(), "frames.amcs");
+    ASSERT_EQ(reader.frame_count(), frames);
+    const double start = cpu_milliseconds();
+    size_t nodes = 0;
+    for (size_t k = 0; k < frames; ++k) nodes += reader.frame(k).hierarchy.node_count();
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  %zu frames (%zu bytes) read in order: %.1f ms\n", frames, writer.bytes().size(), milliseconds);
+    EXPECT_EQ(nodes, 4 * frames);
+    EXPECT_FALSE(reader.info(frames - 1).keyframe);
+    EXPECT_TRUE(identical(reader.frame(frames / 2).hierarchy, h));  // random access still from the keyframe
+    EXPECT_LT(milliseconds, 3000.0);
+}
+
 // A VTU of 2^15 pieces of one triangle each (ASCII, 13 MB): read in memory linear in its points.
 // Each piece reserved exactly its points on top of the earlier ones', so every piece copied all
 // the points before it: 38 GB allocated, 8 s of CPU (mostly the kernel's page faults) until
