@@ -6,6 +6,7 @@
 
 #include <amc/mesh.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -82,11 +83,20 @@ private:
     const Entry* find(uint32_t u, uint32_t v) const {
         const Slot* const slot = slots_.data() + u;
         if (!(slot[0].ends & end_bit(v))) return nullptr;
+        if (slot[1].start - slot[0].start > kScanned) {  // a large fan, sorted by end
+            const Entry* const first = entries_.get() + slot[0].start;
+            const Entry* const last = entries_.get() + slot[1].start;
+            const Entry* e = std::lower_bound(first, last, v, [](const Entry& x, uint32_t to) { return x.to < to; });
+            return e != last && e->to == v ? e : nullptr;
+        }
         for (uint32_t i = slot[0].start, end = slot[1].start; i < end; ++i) {
             if (entries_[i].to == v) return &entries_[i];
         }
         return nullptr;
     }
+    // A fan of more out-edges than this (a vertex of high valence) is sorted by their ends and
+    // bisected: scanned, it made the lookups from its faces quadratic in the valence.
+    static constexpr uint32_t kScanned = 64;
     std::vector<Slot> slots_;  // per vertex, and one past the last
     std::unique_ptr<Entry[]> entries_;  // 3 per face, grouped by start vertex; filled, never zeroed
 };
