@@ -148,15 +148,7 @@ void ForestPoints::collect_places(uint32_t tree, const int64_t p[3]) {
         // Every place at a coarse vertex (edge point) finds the same places around it, which the
         // first one found joined already: once for each.
         if (!conn_.vertices.empty()) {
-            int corner = 0;
-            for (int a = 0; a < dim_; ++a) corner |= here.p[a] == n_ ? 1 << a : 0;
-            const size_t corners = size_t(1) << dim_;
-            const uint64_t v = conn_.tree_to_vertex[here.tree * corners + size_t(corner)];
-            std::array<uint64_t, 3> around{v, UINT64_MAX, 0};
-            if (on_boundary < dim_) {  // 3D, a coarse edge along inside_axis: its two vertices and the point
-                const uint64_t w = conn_.tree_to_vertex[here.tree * corners + size_t(corner | 1 << inside_axis)];
-                around = {std::min(v, w), std::max(v, w), uint64_t(v < w ? here.p[inside_axis] : n_ - here.p[inside_axis])};
-            }
+            const TreeCorners::Meeting around = corners_.meeting(here.tree, octree_root_log2(dim_), c, true);
             if (std::find(gone_around_.begin(), gone_around_.end(), around) != gone_around_.end()) continue;
             gone_around_.push_back(around);
         }

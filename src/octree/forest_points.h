@@ -93,7 +93,7 @@ private:
     // kSearchedPlaces, and each coarse vertex (edge point) gone around once; else cubic in the trees.
     static constexpr size_t kSearchedPlaces = 32;
     std::map<std::pair<uint64_t, uint32_t>, size_t> index_of_place_;
-    std::vector<std::array<uint64_t, 3>> gone_around_;  // coarse vertex; or edge's two vertices and point
+    std::vector<TreeCorners::Meeting> gone_around_;  // the coarse vertices and edge points gone around
 };
 
 }  // namespace amc

@@ -60,7 +60,7 @@ TreeCorners::Around TreeCorners::around(int level, const int32_t c[3]) const {
     return out;
 }
 
-TreeCorners::Meeting TreeCorners::meeting(uint32_t tree, int level, const int32_t c[3]) const {
+TreeCorners::Meeting TreeCorners::meeting(uint32_t tree, int level, const int32_t c[3], bool point) const {
     if (at_vertex_.empty()) return {UINT32_MAX, UINT32_MAX, 0};  // nothing is around anything
     const int corners = 1 << dim_;
     const Around at = around(level, c);
@@ -69,7 +69,7 @@ TreeCorners::Meeting TreeCorners::meeting(uint32_t tree, int level, const int32_
     const uint32_t b = conn_->tree_to_vertex[size_t(tree) * corners + (at.corner | (1 << at.inside_axis))];
     // The place counted from the lower vertex, as neighbours() turns it for trees the other way round.
     const int32_t along = c[at.inside_axis], n = int32_t(1) << level;
-    return {std::min(a, b), std::max(a, b), uint32_t(a < b ? along : n - 1 - along)};
+    return {std::min(a, b), std::max(a, b), uint32_t(a < b ? along : (point ? n : n - 1) - along)};
 }
 
 void TreeCorners::neighbours(uint32_t tree, int level, const int32_t c[3], std::vector<Place>& out) const {

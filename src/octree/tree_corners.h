@@ -33,8 +33,9 @@ public:
 
     // Names what neighbours(tree, level, c) goes around: the coarse vertex, or the coarse edge and
     // the place along it. The same from every octant there, so a caller can go around it once.
+    // With `point`, c[along the edge] is a lattice point (0 .. 2^level) rather than an octant.
     using Meeting = std::array<uint32_t, 3>;
-    Meeting meeting(uint32_t tree, int level, const int32_t c[3]) const;
+    Meeting meeting(uint32_t tree, int level, const int32_t c[3], bool point = false) const;
 
 private:
     struct Around {  // how position c lies outside its tree
