@@ -384,6 +384,28 @@ TEST(CraftedFiles, ManyChunksDecodeOnThreadsInTheMemoryOfOne) {
     EXPECT_LT(allocated[1], allocated[0] + (uint64_t(8) << 20));
 }
 
+// 2^17 chunks of one root each (`amc encode --chunks N` takes N up to the roots), encoded in time
+// linear in them: each chunk's extraction marked its base vertices over the whole base and its
+// roots over all roots (3.1 s of CPU here until 2026-12-07, 12 s for 2^18; docs/FUZZING.md). An
+// encoder's input, not a file.
+TEST(CraftedFiles, EncodeOfOneRootChunksIsLinear) {
+    const Hierarchy h(make_square(256));
+    EncodeOptions options;
+    options.quantize_bits = 12;
+    options.threads = 1;
+    options.chunks = h.root_count();
+    options.min_chunk_bytes = 0;
+    const double start = cpu_milliseconds();
+    const std::vector<uint8_t> file = encode(h, options);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  %u one-root chunks encoded (%zu bytes): %.1f ms\n", h.root_count(), file.size(), milliseconds);
+    ASSERT_EQ(inspect(file.data(), file.size()).chunks.size(), size_t(h.root_count()));
+    options.chunks = 1;
+    const std::vector<uint8_t> whole = encode(h, options);
+    EXPECT_TRUE(identical(decode(file.data(), file.size()), decode(whole.data(), whole.size())));
+    EXPECT_LT(milliseconds, 1500.0 * kSanitizerSlowdown);  // 0.42 s in Release
+}
+
 // A chunk table of 2^17 chunks, each an empty block: inspect finds each chunk block's entry
 // without a pass over all of them (that pass made inspect quadratic: 12 s of CPU for this 2 MB
 // file, and `amc decode --triangles` inspects first). CPU time, as the other crafted files.
