@@ -567,6 +567,32 @@ TEST(CraftedFiles, ImportOfAHighValenceLeafMeshIsLinear) {
     EXPECT_LT(with_base_milliseconds, 3000.0 * kSanitizerSlowdown);
 }
 
+// A half disc of 2^15 roots around one boundary vertex, in clockwise order, refined once with its
+// new vertices moved off their edges: the uniform way reads it in time linear in it. Each root at
+// that vertex searched its out-edges for the one toward its next corner, since its turn around
+// the vertex stops at the boundary at once: 31 s of CPU here until 2026-12-07 (docs/FUZZING.md).
+TEST(CraftedFiles, UniformImportAtABoundaryVertexOfManyRootsIsLinear) {
+    const uint32_t roots = uint32_t(1) << 15;
+    TriangleMesh base;
+    base.positions.push_back({0, 0, 0});
+    for (uint32_t i = 0; i <= roots; ++i) {
+        const double angle = 3.141592653589793 * double(i) / double(roots);
+        base.positions.push_back({std::cos(angle), std::sin(angle), 0});
+    }
+    for (uint32_t i = roots; i-- > 0;) base.triangles.push_back({0, i + 1, i + 2});
+    Hierarchy refined(base);
+    refine_uniformly(refined, 1);
+    LeafMesh leaf = extract_leaf_mesh(refined);
+    for (size_t v = base.positions.size(); v < leaf.mesh.positions.size(); ++v) leaf.mesh.positions[v].z = 0.01;
+    const double start = cpu_milliseconds();
+    const ImportedHierarchy imported = import_leaf_mesh(base, leaf.mesh);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  import of %zu faces over %u roots: %.1f ms\n", leaf.mesh.triangles.size(), roots, milliseconds);
+    EXPECT_EQ(imported.hierarchy.node_count(), refined.node_count());
+    EXPECT_EQ(imported.hierarchy.depth(), 1);
+    EXPECT_LT(milliseconds, 3000.0 * kSanitizerSlowdown);
+}
+
 // A series of 2^17 unchanged frames over a tetrahedron after one keyframe (3.5 MB), read in order
 // in time linear in the frames: each frame(k) walked back to the keyframe to find where to start,
 // though the reader held frame k - 1 (6.6 s of CPU until 2026-12-07, docs/FUZZING.md; `amc
