@@ -593,6 +593,41 @@ TEST(CraftedFiles, UniformImportAtABoundaryVertexOfManyRootsIsLinear) {
     EXPECT_LT(milliseconds, 3000.0 * kSanitizerSlowdown);
 }
 
+// A step coarsening a chain of 2^15 candidates in a row of roots, each freed only by the one
+// after it (its third neighbour refined), in time linear in them: each pass over the row freed one,
+// 23 s of CPU here until 2026-12-07 (docs/FUZZING.md). A library caller's history, not a file.
+TEST(CraftedFiles, CoarseningAChainOfCandidatesIsLinear) {
+    const uint32_t width = uint32_t(1) << 14;  // three rows of 2 * width roots
+    TriangleMesh base;
+    for (uint32_t j = 0; j <= 3; ++j)
+        for (uint32_t i = 0; i <= width; ++i) base.positions.push_back({i + 0.5 * j, 0.866 * j, 0});
+    const auto vertex = [&](uint32_t i, uint32_t j) { return j * (width + 1) + i; };
+    for (uint32_t j = 0; j < 3; ++j)
+        for (uint32_t i = 0; i < width; ++i) {
+            base.triangles.push_back({vertex(i, j), vertex(i + 1, j), vertex(i, j + 1)});
+            base.triangles.push_back({vertex(i + 1, j), vertex(i + 1, j + 1), vertex(i, j + 1)});
+        }
+    // Every root refined but the middle row's last: that row's others but its first are the chain,
+    // each (the last but one first) free once the one after it is a leaf again.
+    Hierarchy h(base);
+    const NodeId first = 2 * width, last = 4 * width - 1;
+    for (NodeId r = 0; r < h.root_count(); ++r)
+        if (r != last) h.refine(r);
+    const LeafMesh leaf = extract_leaf_mesh(h);
+    std::vector<uint32_t> coarsen;
+    for (uint32_t e = 0; e < leaf.source.size(); ++e) {
+        const NodeId parent = h.parent(leaf.source[e]);
+        if (parent > first && parent < last) coarsen.push_back(e);
+    }
+    const double start = cpu_milliseconds();
+    apply_adaptation_step(h, {}, coarsen);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  a chain of %u candidates coarsened: %.1f ms\n", last - first - 1, milliseconds);
+    for (NodeId r = 0; r < h.root_count(); ++r) ASSERT_EQ(h.is_leaf(r), r > first && r <= last) << "root " << r;
+    EXPECT_EQ(check_invariants(h), "");
+    EXPECT_LT(milliseconds, 2000.0 * kSanitizerSlowdown);
+}
+
 // A series of 2^17 unchanged frames over a tetrahedron after one keyframe (3.5 MB), read in order
 // in time linear in the frames: each frame(k) walked back to the keyframe to find where to start,
 // though the reader held frame k - 1 (6.6 s of CPU until 2026-12-07, docs/FUZZING.md; `amc
