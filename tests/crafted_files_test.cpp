@@ -567,6 +567,36 @@ TEST(CraftedFiles, ImportOfAHighValenceLeafMeshIsLinear) {
     EXPECT_LT(with_base_milliseconds, 3000.0 * kSanitizerSlowdown);
 }
 
+// The leaf mesh of a random refinement of the icosahedron (about 27,000 faces) with every new
+// vertex at one point, its centre, imported over its base: refused in time linear in it. Every
+// vertex is then equally near each guide, and each guided way's nearest-vertex searches examined
+// (and tested) them all: 10.2 s of CPU here until 2026-12-07 (60 s at four times the faces;
+// docs/FUZZING.md). A way's searches are now budgeted, and ties no longer test vertices as far.
+TEST(CraftedFiles, ImportOfALeafMeshWithItsNewVerticesAtOnePointIsLinear) {
+    Hierarchy h(make_icosahedron());
+    refine_randomly(h, 20000, 7, 3);
+    LeafMesh leaf = extract_leaf_mesh(h);
+    uint32_t moved = 0;
+    for (Vec3& p : leaf.mesh.positions) {
+        bool at_base = false;
+        for (const Vec3& b : h.base().positions) at_base |= p.x == b.x && p.y == b.y && p.z == b.z;
+        if (!at_base) p = Vec3{0, 0, 0}, ++moved;
+    }
+    ASSERT_GT(moved, 10000u);
+    const double start = cpu_milliseconds();
+    std::string message;
+    try {
+        import_leaf_mesh(h.base(), leaf.mesh);
+    } catch (const Error& e) {
+        message = e.what();
+    }
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  import of %zu faces, %u vertices at one point: %.1f ms\n", leaf.mesh.triangles.size(), moved,
+                milliseconds);
+    EXPECT_NE(message.find("have the same position (0, 0, 0) (duplicate vertex)"), std::string::npos) << message;
+    EXPECT_LT(milliseconds, 4000.0 * kSanitizerSlowdown);
+}
+
 // A series of 2^17 unchanged frames over a tetrahedron after one keyframe (3.5 MB), read in order
 // in time linear in the frames: each frame(k) walked back to the keyframe to find where to start,
 // though the reader held frame k - 1 (6.6 s of CPU until 2026-12-07, docs/FUZZING.md; `amc
