@@ -432,7 +432,10 @@ uint32_t Reconstruction::find_midpoint(NodeId n, int e) {
 uint32_t Reconstruction::on_shortest_chains(uint32_t* candidates, uint32_t count, uint32_t a, uint32_t b) {
     if (count < 2) return count;
     if (!detour_) detour_ = std::make_unique<LeafDetour>(he_);
-    return detour_->keep_least_detour(a, b, kChainHops, candidates, count);
+    const uint64_t walked = detour_->walked();
+    const uint32_t kept = detour_->keep_least_detour(a, b, kChainHops, candidates, count);
+    charge_search(walked_, detour_->walked() - walked, kWalkedPerFace);
+    return kept;
 }
 
 Vec3 Reconstruction::guide_position(NodeId n, int e) {

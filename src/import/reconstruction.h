@@ -123,7 +123,8 @@ private:
     // meshes): where many vertices lie at one distance from the guides (all at one point, say),
     // every search examines them all, and a way would take time quadratic in the mesh. The
     // corpus's and held-out models' imports, at moves 0 and 0.3, examine at most 532 vertices a
-    // face in a way and walk at most 1,344 entries a face comparing candidates (UndoStepChoice).
+    // face in a way and walk at most 1,457 entries a face comparing candidates (UndoStepChoice,
+    // LeafDetour).
     void charge_search(uint64_t& spent, uint64_t work, uint64_t per_face) {
         spent += work;
         if (spent > per_face * leaf_.triangles.size() + kSearchFloor)
