@@ -12,6 +12,7 @@
 #include "coding/geometry/float_coder.h"
 #include "coding/hierarchy/hierarchy_stream.h"
 #include "common/bits.h"
+#include "import/leaf_detour.h"
 #include "mesh/vtu_reader.h"
 #include "octree/octree_file.h"
 #include "octree/octree_traversal.h"
@@ -631,6 +632,122 @@ TEST(CraftedFiles, ImportOfAHighValenceLeafMeshIsLinear) {
     std::printf("  import of %zu faces over their base: %.1f ms\n", leaf.mesh.triangles.size(), with_base_milliseconds);
     EXPECT_EQ(with_base.hierarchy.node_count(), refined.node_count());
     EXPECT_LT(with_base_milliseconds, 3000.0 * kSanitizerSlowdown);
+}
+
+// A half disc of 2^15 roots around one boundary vertex, in clockwise order, refined once with its
+// new vertices moved off their edges: the uniform way reads it in time linear in it. Each root at
+// that vertex searched its out-edges for the one toward its next corner, since its turn around
+// the vertex stops at the boundary at once: 31 s of CPU here until 2026-12-07 (docs/FUZZING.md).
+TEST(CraftedFiles, UniformImportAtABoundaryVertexOfManyRootsIsLinear) {
+    const uint32_t roots = uint32_t(1) << 15;
+    TriangleMesh base;
+    base.positions.push_back({0, 0, 0});
+    for (uint32_t i = 0; i <= roots; ++i) {
+        const double angle = 3.141592653589793 * double(i) / double(roots);
+        base.positions.push_back({std::cos(angle), std::sin(angle), 0});
+    }
+    for (uint32_t i = roots; i-- > 0;) base.triangles.push_back({0, i + 1, i + 2});
+    Hierarchy refined(base);
+    refine_uniformly(refined, 1);
+    LeafMesh leaf = extract_leaf_mesh(refined);
+    for (size_t v = base.positions.size(); v < leaf.mesh.positions.size(); ++v) leaf.mesh.positions[v].z = 0.01;
+    const double start = cpu_milliseconds();
+    const ImportedHierarchy imported = import_leaf_mesh(base, leaf.mesh);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  import of %zu faces over %u roots: %.1f ms\n", leaf.mesh.triangles.size(), roots, milliseconds);
+    EXPECT_EQ(imported.hierarchy.node_count(), refined.node_count());
+    EXPECT_EQ(imported.hierarchy.depth(), 1);
+    EXPECT_LT(milliseconds, 3000.0 * kSanitizerSlowdown);
+}
+
+// A step coarsening a chain of 2^15 candidates in a row of roots, each freed only by the one
+// after it (its third neighbour refined), in time linear in them: each pass over the row freed one,
+// 23 s of CPU here until 2026-12-07 (docs/FUZZING.md). A library caller's history, not a file.
+TEST(CraftedFiles, CoarseningAChainOfCandidatesIsLinear) {
+    const uint32_t width = uint32_t(1) << 14;  // three rows of 2 * width roots
+    TriangleMesh base;
+    for (uint32_t j = 0; j <= 3; ++j)
+        for (uint32_t i = 0; i <= width; ++i) base.positions.push_back({i + 0.5 * j, 0.866 * j, 0});
+    const auto vertex = [&](uint32_t i, uint32_t j) { return j * (width + 1) + i; };
+    for (uint32_t j = 0; j < 3; ++j)
+        for (uint32_t i = 0; i < width; ++i) {
+            base.triangles.push_back({vertex(i, j), vertex(i + 1, j), vertex(i, j + 1)});
+            base.triangles.push_back({vertex(i + 1, j), vertex(i + 1, j + 1), vertex(i, j + 1)});
+        }
+    // Every root refined but the middle row's last: that row's others but its first are the chain,
+    // each (the last but one first) free once the one after it is a leaf again.
+    Hierarchy h(base);
+    const NodeId first = 2 * width, last = 4 * width - 1;
+    for (NodeId r = 0; r < h.root_count(); ++r)
+        if (r != last) h.refine(r);
+    const LeafMesh leaf = extract_leaf_mesh(h);
+    std::vector<uint32_t> coarsen;
+    for (uint32_t e = 0; e < leaf.source.size(); ++e) {
+        const NodeId parent = h.parent(leaf.source[e]);
+        if (parent > first && parent < last) coarsen.push_back(e);
+    }
+    const double start = cpu_milliseconds();
+    apply_adaptation_step(h, {}, coarsen);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  a chain of %u candidates coarsened: %.1f ms\n", last - first - 1, milliseconds);
+    for (NodeId r = 0; r < h.root_count(); ++r) ASSERT_EQ(h.is_leaf(r), r > first && r <= last) << "root " << r;
+    EXPECT_EQ(check_invariants(h), "");
+    EXPECT_LT(milliseconds, 2000.0 * kSanitizerSlowdown);
+}
+
+// The leaf mesh of a random refinement of the icosahedron (about 27,000 faces) with every new
+// vertex at one point, its centre, imported over its base: refused in time linear in it. Every
+// vertex is then equally near each guide, and each guided way's nearest-vertex searches examined
+// (and tested) them all: 10.2 s of CPU here until 2026-12-07 (60 s at four times the faces;
+// docs/FUZZING.md). A way's searches are now budgeted, and ties no longer test vertices as far.
+TEST(CraftedFiles, ImportOfALeafMeshWithItsNewVerticesAtOnePointIsLinear) {
+    Hierarchy h(make_icosahedron());
+    refine_randomly(h, 20000, 7, 3);
+    LeafMesh leaf = extract_leaf_mesh(h);
+    uint32_t moved = 0;
+    for (Vec3& p : leaf.mesh.positions) {
+        bool at_base = false;
+        for (const Vec3& b : h.base().positions) at_base |= p.x == b.x && p.y == b.y && p.z == b.z;
+        if (!at_base) p = Vec3{0, 0, 0}, ++moved;
+    }
+    ASSERT_GT(moved, 10000u);
+    const double start = cpu_milliseconds();
+    std::string message;
+    try {
+        import_leaf_mesh(h.base(), leaf.mesh);
+    } catch (const Error& e) {
+        message = e.what();
+    }
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  import of %zu faces, %u vertices at one point: %.1f ms\n", leaf.mesh.triangles.size(), moved,
+                milliseconds);
+    EXPECT_NE(message.find("have the same position (0, 0, 0) (duplicate vertex)"), std::string::npos) << message;
+    EXPECT_LT(milliseconds, 4000.0 * kSanitizerSlowdown);
+}
+
+// The importer's measure of a candidate's detour across a bipyramid of 2^17 sides, whose poles'
+// fans are closed and of valence 2^17: in time linear in the valence. Whether a fan was closed
+// was found by looking each apex up among its ends, 1.7 * 10^10 comparisons here (2.1 s of CPU)
+// until 2026-12-07 (docs/FUZZING.md); the neighbours are now the index's, each once.
+TEST(CraftedFiles, DetourAcrossAFanOfHighValenceIsLinear) {
+    const uint32_t sides = uint32_t(1) << 17;
+    TriangleMesh mesh;
+    mesh.positions.resize(sides + 2);
+    const uint32_t north = sides, south = sides + 1;
+    for (uint32_t i = 0; i < sides; ++i) {
+        mesh.triangles.push_back({north, i, (i + 1) % sides});
+        mesh.triangles.push_back({south, (i + 1) % sides, i});
+    }
+    const LeafHalfedges halfedges(mesh);
+    LeafDetour detour(halfedges);
+    uint32_t candidates[2] = {north, sides / 2 + 1};
+    const double start = cpu_milliseconds();
+    const uint32_t kept = detour.keep_least_detour(0, sides / 2, 2, candidates, 2);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  detour across a fan of %u: %.1f ms\n", sides, milliseconds);
+    EXPECT_EQ(kept, 1u);  // 0-north-b has no detour; sides/2 + 1 is two hops from 0, one from b
+    EXPECT_EQ(candidates[0], north);
+    EXPECT_LT(milliseconds, 300.0 * kSanitizerSlowdown);
 }
 
 // A series of 2^17 unchanged frames over a tetrahedron after one keyframe (3.5 MB), read in order

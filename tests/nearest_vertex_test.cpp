@@ -248,3 +248,29 @@ TEST(NearestVertex, NoUsableVertexIsNoIndex) {
 }
 
 }  // namespace
+
+// Many vertices at one point, equally near a query: the answer is the k-d tree's (the first of
+// them in its order), and the use of each is not tested (a tie lowers the search's bound below it;
+// each was tested until 2026-12-07, which made the import of such a mesh quadratic: docs/FUZZING.md).
+TEST(NearestVertex, ManyVerticesAtOnePointAreNotEachTested) {
+    Lcg random{5};
+    std::vector<amc::Vec3> points(20000, amc::Vec3{0.25, 0.5, 0.75});
+    for (int i = 0; i < 200; ++i) points.push_back({4 + random.unit(), 4 + random.unit(), random.unit()});
+    std::vector<uint32_t> order(points.size());
+    std::iota(order.begin(), order.end(), 0u);
+    for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[size_t(random.unit() * double(i))]);
+    const amc::NearestVertex nearest(points, &order);
+    const amc::NearestVertex::KdTree kd_tree(points, &order);
+    for (uint32_t k : {1u, 4u}) {
+        uint64_t tested = 0;
+        auto usable = [&](uint32_t v) { return ++tested, v % 3 != 0; };
+        uint32_t a[amc::NearestVertex::kMaxCount], b[amc::NearestVertex::kMaxCount];
+        const uint64_t examined = nearest.examined();
+        const uint32_t na = nearest.find_nearest({1, 1, 1}, usable, k, a);
+        EXPECT_GE(nearest.examined() - examined, 20000u);  // the k-d tree visits them all
+        EXPECT_LT(tested, 64u) << "k " << k;
+        auto kd_usable = [](uint32_t v) { return v % 3 != 0; };
+        ASSERT_EQ(na, kd_tree.find_nearest({1, 1, 1}, kd_usable, k, b));
+        for (uint32_t i = 0; i < na; ++i) EXPECT_EQ(a[i], b[i]) << "k " << k << ", rank " << i;
+    }
+}

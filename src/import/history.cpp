@@ -3,8 +3,10 @@
 #include <amc/import.h>
 
 #include "common/check.h"
+#include "common/no_index.h"
 
 #include <algorithm>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -60,21 +62,47 @@ void apply_adaptation_step(Hierarchy& h, const std::vector<uint32_t>& refine, co
     for (uint32_t e : refine) h.refine(leaf.source[e]);
     // Deepest first: a parent's children may be candidates themselves, whose coarsening only
     // helps. Within a level, coarsening a parent can let a neighbour follow (it leaves the
-    // neighbour fewer refined neighbours), so a level is passed over until nothing changes.
+    // neighbour fewer refined neighbours), so a level is passed over in order until nothing
+    // changes; a pass looks again only at the neighbours of what was coarsened since it last
+    // looked (nothing else changes their answer), so a chain of candidates each freed only by the
+    // next costs a step each, not a pass over the level each.
     std::stable_sort(candidates.begin(), candidates.end(),
                      [&h](NodeId a, NodeId b) { return h.level(a) > h.level(b); });
+    std::vector<uint32_t> index_of(h.node_capacity(), kNoIndex);  // a candidate's index in `candidates`
+    for (size_t i = 0; i < candidates.size(); ++i) index_of[candidates[i]] = uint32_t(i);
+    std::vector<uint32_t> due(candidates.size(), 0);  // the pass that is to look at a candidate
+    uint32_t pass = 1;
+    const auto first_look = std::greater<uint32_t>();  // the passes' heaps give the lowest index first
     for (size_t begin = 0; begin < candidates.size();) {
         size_t end = begin;
         while (end < candidates.size() && h.level(candidates[end]) == h.level(candidates[begin])) ++end;
-        for (bool changed = true; changed;) {
-            changed = false;
-            for (size_t i = begin; i < end; ++i) {
+        std::vector<uint32_t> look, next;  // this pass's indices (a heap), the next pass's
+        for (size_t i = begin; i < end; ++i) look.push_back(uint32_t(i)), due[i] = pass;
+        while (!look.empty()) {
+            while (!look.empty()) {
+                std::pop_heap(look.begin(), look.end(), first_look);
+                const uint32_t i = look.back();
+                look.pop_back();
                 const NodeId n = candidates[i];
-                if (n != kNoNode && h.coarsen(n)) {
-                    candidates[i] = kNoNode;
-                    changed = true;
+                if (!h.coarsen(n)) continue;
+                candidates[i] = kNoNode;
+                for (int e = 0; e < 3; ++e) {  // the same-level neighbours it may free
+                    const NodeId q = h.neighbor(n, e);
+                    const uint32_t j = q == kNoNode ? kNoIndex : index_of[q];
+                    if (j == kNoIndex || j < begin || j >= end || candidates[j] == kNoNode) continue;
+                    if (j > i && due[j] != pass) {  // still ahead in this pass
+                        due[j] = pass;
+                        look.push_back(j);
+                        std::push_heap(look.begin(), look.end(), first_look);
+                    } else if (j < i && due[j] != pass + 1) {
+                        due[j] = pass + 1;
+                        next.push_back(j);
+                    }
                 }
             }
+            ++pass;
+            std::sort(next.begin(), next.end());  // ascending: a heap for first_look
+            look.swap(next);
         }
         begin = end;
     }

@@ -6,29 +6,8 @@ namespace amc {
 
 LeafDetour::LeafDetour(const LeafHalfedges& halfedges)
     : he_(halfedges),
-      fan_(halfedges.vertex_count(), 0),
       hops_a_(halfedges.vertex_count(), -1),
       hops_b_(halfedges.vertex_count(), -1) {}
-
-template <class F>
-void LeafDetour::for_each_neighbor(uint32_t u, F f) {
-    const uint32_t d = he_.degree(u);
-    if (fan_[u] == 0) {
-        // In a closed fan every apex is also an out-edge's end: the ends alone list the
-        // neighbours, and each once, which halves a search's lookups in its hop counts.
-        bool closed = true;
-        for (uint32_t j = 0; j < d && closed; ++j) {
-            const uint32_t x = he_.out_apex(u, j);
-            bool is_end = false;
-            for (uint32_t k = 0; k < d && !is_end; ++k) is_end = he_.out_vertex(u, k) == x;
-            closed = is_end;
-        }
-        fan_[u] = closed ? kClosedFan : kOpenFan;
-    }
-    for (uint32_t j = 0; j < d; ++j) f(he_.out_vertex(u, j));
-    if (fan_[u] == kOpenFan)
-        for (uint32_t j = 0; j < d; ++j) f(he_.out_apex(u, j));
-}
 
 // Breadth-first over the leaf mesh from `source`, up to max_hops; clears the previous search.
 void LeafDetour::search(uint32_t source, std::vector<int>& hops, std::vector<uint32_t>& reached, int max_hops,
@@ -68,7 +47,8 @@ void LeafDetour::extend(std::vector<int>& hops, std::vector<uint32_t>& reached, 
         if (stops && pending_count == 0) return;
         const uint32_t u = reached[i];
         if (hops[u] == max_hops) continue;
-        for_each_neighbor(u, [&](uint32_t x) {
+        walked_ += he_.degree(u);
+        he_.for_each_neighbor_once(u, [&](uint32_t x) {
             if (hops[x] >= 0) return;
             hops[x] = hops[u] + 1;
             reached.push_back(x);

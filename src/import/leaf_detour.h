@@ -32,6 +32,8 @@ public:
     // kRemembered candidates are remembered.
     uint32_t keep_least_detour(uint32_t a, uint32_t b, int max_hops, uint32_t* candidates, uint32_t count);
     static constexpr uint32_t kRemembered = 4;
+    // The faces around the vertices the searches so far looked around (a caller's budget).
+    uint64_t walked() const { return walked_; }
 
 private:
     // One remembered answer: the question, and which candidates it kept (bit i: candidate i).
@@ -51,18 +53,12 @@ private:
     void extend(std::vector<int>& hops, std::vector<uint32_t>& reached, int radius, int max_hops,
                 uint32_t* pending, uint32_t pending_count);
 
-    // Calls f on every neighbour of u: the ends of its out-edges, and where some apex of its faces
-    // is none of them (an open fan: the mesh boundary, or a broken input), the apexes too.
-    template <class F>
-    void for_each_neighbor(uint32_t u, F f);
-
     const LeafHalfedges& he_;
-    std::vector<uint8_t> fan_;  // per vertex: 0 not looked at yet, kClosedFan, kOpenFan
-    static constexpr uint8_t kClosedFan = 1, kOpenFan = 2;
     std::vector<int> hops_a_, hops_b_;  // -1: not reached
     std::vector<uint32_t> reached_a_, reached_b_;
     int shortest_ = 0;
     std::vector<Answer> answers_;  // allocated on the first question
+    uint64_t walked_ = 0;
 };
 
 }  // namespace amc

@@ -47,6 +47,8 @@ std::vector<uint32_t> Reconstruction::run() {
         if (judges_picks() && certify_picks(depth, level)) continue;
         try {
             reconstruct_level(level, next);
+        } catch (const SearchBudgetSpent&) {
+            throw;
         } catch (const Error& e) {
             if (!judges_picks()) throw;
             if (!backtrack(depth, level, read_failed_, e.what())) throw Error(first_error_);
@@ -405,18 +407,19 @@ uint32_t Reconstruction::find_midpoint(NodeId n, int e) {
     // From the connectivity alone where it tells: the halves of the edge are leaf edges.
     const uint32_t common = only_unmatched_common_neighbor(a, b);
     if (common != kNoIndex) return common;
-    const NearestVertex& nearest_vertex = search_.nearest();
     const MidpointTest may_be_midpoint(*this, n, e);
     uint32_t found;
     uint32_t nearest[kCandidates];
     uint32_t count = 0;
     const double limit = pick_search_limit(a, b);
     if (choice_) {
-        count = nearest_vertex.find_nearest(guide_position(n, e), may_be_midpoint, kCandidates, nearest, limit);
+        count = nearest_usable(guide_position(n, e), may_be_midpoint, kCandidates, nearest, limit);
         const uint32_t kept = on_shortest_chains(nearest, count, a, b);
+        const uint64_t walked = choice_->walked();
         found = choice_->choose(nearest, kept, a, b, vertex_of_leaf_);
+        charge_search(walked_, choice_->walked() - walked, kWalkedPerFace);
     } else {
-        count = nearest_vertex.find_nearest(guide_position(n, e), may_be_midpoint, 1, nearest, limit);
+        count = nearest_usable(guide_position(n, e), may_be_midpoint, 1, nearest, limit);
         found = count ? nearest[0] : kNoIndex;
     }
     if (referee_ && found != kNoIndex) found = (*referee_)(GuidedPick{h_.level(n), a, b, found, nearest, count, false});
@@ -429,7 +432,10 @@ uint32_t Reconstruction::find_midpoint(NodeId n, int e) {
 uint32_t Reconstruction::on_shortest_chains(uint32_t* candidates, uint32_t count, uint32_t a, uint32_t b) {
     if (count < 2) return count;
     if (!detour_) detour_ = std::make_unique<LeafDetour>(he_);
-    return detour_->keep_least_detour(a, b, kChainHops, candidates, count);
+    const uint64_t walked = detour_->walked();
+    const uint32_t kept = detour_->keep_least_detour(a, b, kChainHops, candidates, count);
+    charge_search(walked_, detour_->walked() - walked, kWalkedPerFace);
+    return kept;
 }
 
 Vec3 Reconstruction::guide_position(NodeId n, int e) {

@@ -73,6 +73,14 @@ public:
     using Error::Error;
 };
 
+// A guided way's end when its searches for candidates (nearest vertices, the walks comparing
+// them) have done more than the mesh's size warrants (Reconstruction::charge_search): not a
+// fault of the input, whose other ways go on; not backtracked from.
+class SearchBudgetSpent : public Error {
+public:
+    using Error::Error;
+};
+
 // A position-guided pick of the vertex that splits the edge (a, b) of a node of `level`: the
 // candidates the choice saw (nearest first; only the pick when no choice was made) and the pick;
 // `repaired`: seen again after the level's children have had their say (no candidates then).

@@ -52,9 +52,11 @@ private:
         uint32_t wanted, count = 0;
         double limit;
         // matters(d) is d <= bound: the largest double below limit while fewer than wanted are
-        // listed (d < limit, exactly), then the last listed distance. One compare per tree node.
+        // listed (d < limit, exactly), then the last listed distance; once a tie is noted, below
+        // it too. One compare per tree node.
         double bound;
         double tie = std::numeric_limits<double>::infinity();
+        uint64_t examined = 0;  // points whose distance the search computed
         uint32_t vertex[kMaxCount];
         double distance[kMaxCount];
         // The largest double below x (std::nextafter towards -infinity, without its call for the
@@ -80,13 +82,17 @@ private:
             }
             vertex[i] = v;
             distance[i] = d;
-            if (count == wanted) bound = distance[count - 1];
+            if (count == wanted && distance[count - 1] < bound) bound = distance[count - 1];
         }
-        // A usable vertex at d, where matters(d): a tie when a listed one is as near.
+        // A usable vertex at d, where matters(d): a tie when a listed one is as near. Vertices as
+        // far as a tie or farther can no longer change whether the answer ties, nor the answer
+        // when it does not (it lies nearer then): they no longer matter, so a search among many
+        // vertices at one distance does not test each one's use.
         void offer(uint32_t v, double d) {
             for (uint32_t i = 0; i < count; ++i) {
                 if (distance[i] == d) {
                     if (d < tie) tie = d;
+                    bound = below(d);  // d <= bound, so this only lowers it
                     return;
                 }
             }
@@ -110,12 +116,14 @@ public:
         KdTree(const std::vector<Vec3>& positions, const std::vector<uint32_t>* insertion_order);
         // `other` with every vertex v named new_id[v].
         KdTree(const KdTree& other, const std::vector<uint32_t>& new_id);
-        // As NearestVertex::find_nearest.
+        // As NearestVertex::find_nearest; adds the points it examined to *examined, when given.
         template <class Usable>
         uint32_t find_nearest(Vec3 p, Usable usable, uint32_t count, uint32_t* out,
-                              double max_squared_distance = std::numeric_limits<double>::infinity()) const {
+                              double max_squared_distance = std::numeric_limits<double>::infinity(),
+                              uint64_t* examined = nullptr) const {
             Nearest best(count, max_squared_distance);
             if (!points_.empty() && best.wanted > 0) search(p, usable, 0, 0, uint32_t(points_.size()), best);
+            if (examined) *examined += best.examined;
             return best.copy_to(out);
         }
 
@@ -123,6 +131,7 @@ public:
         template <class Usable>
         void search(Vec3 p, Usable& usable, uint32_t node, uint32_t lo, uint32_t hi, Nearest& best) const {
             if (hi - lo <= kBucket) {
+                best.examined += hi - lo;
                 for (uint32_t i = lo; i < hi; ++i) {
                     const Point& q = points_[i];
                     const double distance = squared_distance(q, p);
@@ -183,9 +192,14 @@ public:
             const uint32_t searched = best.wanted == 1 ? search_cell(p, usable, best) : kNoIndex;
             if (searched != 0) search(p, usable, best, 0, searched);
         }
-        if (best.tied()) return kd_tree().find_nearest(p, usable, count, out, max_squared_distance);
+        examined_ += best.examined;
+        if (best.tied()) return kd_tree().find_nearest(p, usable, count, out, max_squared_distance, &examined_);
         return best.copy_to(out);
     }
+
+    // The points whose distance the searches so far computed: what a caller bounds when many
+    // vertices lie at one distance (every one of them is examined) or most near ones are unusable.
+    uint64_t examined() const { return examined_; }
 
 private:
     // The Morton tree over points_ in Morton order: a node is a range of points whose codes share
@@ -217,6 +231,7 @@ private:
         for (;;) {
             const Node& node = nodes_[index];
             if (node.second == kNoIndex) {
+                best.examined += node.end - node.begin;
                 for (uint32_t i = node.begin; i < node.end; ++i) {
                     const double d = squared_distance(points_[i], p);
                     if (best.matters(d) && usable(points_[i].vertex)) best.offer(points_[i].vertex, d);
@@ -311,6 +326,7 @@ private:
     const NearestVertex* renamed_from_ = nullptr;
     const std::vector<uint32_t>* new_id_ = nullptr;
     mutable std::unique_ptr<KdTree> kd_tree_;
+    mutable uint64_t examined_ = 0;
 };
 
 }  // namespace amc

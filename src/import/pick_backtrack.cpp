@@ -149,7 +149,9 @@ int Reconstruction::local_misfits(int from, int depth, const std::vector<NodeId>
                             match(m, found);
                             continue;
                         }
-                    } catch (const Error&) {
+                    } catch (const SearchBudgetSpent&) {
+                        throw;
+                    } catch (const Error&) {  // a misfit
                     }
                     miss(node.second);
                     blame_node(node.second, node.first);
@@ -233,8 +235,7 @@ void Reconstruction::plan_retries(int depth, NodeId x) {
                 });
                 return fits_above;
             };
-            const uint32_t found = search_.nearest().find_nearest(guide_position(ancestor, e), usable, kRepairCandidates,
-                                                          s.candidates);
+            const uint32_t found = nearest_usable(guide_position(ancestor, e), usable, kRepairCandidates, s.candidates);
             for (uint32_t i = 0; i < found; ++i) {
                 if (tried_.count(retry_key(s.a, s.b, s.candidates[i]))) continue;
                 // A candidate another pick of the level holds: the two would swap.

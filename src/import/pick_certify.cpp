@@ -71,8 +71,7 @@ bool Reconstruction::certify_picks(int& depth, std::vector<NodeId>& level) {
             return fits_above;
         };
         uint32_t found[kRepairCandidates];
-        const uint32_t count =
-            search_.nearest().find_nearest(guide_position(g.node, g.edge), usable, kRepairCandidates, found);
+        const uint32_t count = nearest_usable(guide_position(g.node, g.edge), usable, kRepairCandidates, found);
         for (uint32_t i = 0; i < count; ++i) {
             const uint32_t holder = vertex_of_leaf_[found[i]];
             s.swap_edge[s.count] = holder != kNoIndex && holder < pick_level_.size() && pick_level_[holder] == picked_level

@@ -29,8 +29,7 @@ uint32_t Reconstruction::joint_candidates(uint32_t a, uint32_t b, uint32_t verte
     const Vec3 pa = leaf_.positions[a], pb = leaf_.positions[b];
     const Vec3 ab = pb - pa;
     auto usable = [&](uint32_t v) { return v != vertex && vertex_of_leaf_[v] == kNoIndex; };
-    uint32_t count = search_.nearest().find_nearest(0.5 * (pa + pb), usable, NearestVertex::kMaxCount, out,
-                                                    exact_dot(ab, ab));
+    uint32_t count = nearest_usable(0.5 * (pa + pb), usable, NearestVertex::kMaxCount, out, exact_dot(ab, ab));
     // The truth of a wrong pick that is not among the nearest is most often next to it (measured).
     for_each_neighbor(vertex, [&](uint32_t w) {
         if (count < kMaxJointCandidates && usable(w) && std::find(out, out + count, w) == out + count) out[count++] = w;

@@ -149,7 +149,7 @@ Reconstruction::Move Reconstruction::best_move(VertexId v, NodeId misfit) {
     const uint32_t original = leaf_of_vertex_[v];
     uint32_t candidates[kRepairCandidates];
     unassign(v);
-    const uint32_t found = search_.nearest().find_nearest(
+    const uint32_t found = nearest_usable(
         guide_position(s.node, s.edge), MidpointTest(*this, s.node, s.edge, true), kRepairCandidates, candidates,
         pick_search_limit(corner(s.node, s.edge), corner(s.node, (s.edge + 1) % 3)));
     assign(v, original);

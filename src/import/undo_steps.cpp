@@ -55,7 +55,9 @@ void UndoStepChoice::measure_from(uint32_t source, const uint32_t targets[2], st
     for (size_t i = 0; i < queue_.size(); ++i) {
         if (hops[targets[0]] >= 0 && hops[targets[1]] >= 0) return;
         const uint32_t u = queue_[i];
+        ++walked_;
         if (hops[u] == kMaxHops || (u != source && vertex_of_leaf[u] != kNoIndex)) continue;
+        walked_ += first_neighbor_[u + 1] - first_neighbor_[u];
         for (uint32_t j = first_neighbor_[u]; j < first_neighbor_[u + 1]; ++j) {
             const uint32_t x = neighbors_[j];
             if (hops[x] >= 0) continue;

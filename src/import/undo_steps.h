@@ -28,6 +28,8 @@ public:
     // winning ties.
     uint32_t choose(const uint32_t* candidates, uint32_t count, uint32_t a, uint32_t b,
                     const std::vector<uint32_t>& vertex_of_leaf);
+    // The vertices and neighbour entries the comparisons so far walked (a caller's budget).
+    uint64_t walked() const { return walked_; }
 
 private:
     void measure_from(uint32_t source, const uint32_t targets[2], std::vector<int>& hops,
@@ -37,6 +39,7 @@ private:
     std::vector<uint32_t> first_neighbor_, neighbors_;  // the remaining mesh's vertex neighbours
     std::vector<int> hops_from_a_, hops_from_b_;        // -1: not reached
     std::vector<uint32_t> reached_, queue_;
+    uint64_t walked_ = 0;
 };
 
 }  // namespace amc

@@ -6,6 +6,7 @@
 
 #include <amc/red_split.h>
 
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -34,6 +35,36 @@ uint32_t walk(const LeafHalfedges& he, uint32_t a, uint32_t x, uint32_t steps) {
     return p;
 }
 
+// The first out-edge of a leaf vertex (in its fan's order) whose walk of `steps` edges ends at a
+// given vertex. Each out-edge is walked once and its end kept: the roots at a boundary vertex,
+// whose turns stop at the boundary, each ask, and a fan of k of them asked in the wrong order
+// walked k out-edges k times.
+class RayFinder {
+public:
+    RayFinder(const LeafHalfedges& he, uint32_t steps) : he_(he), steps_(steps), walked_(he.vertex_count(), 0) {}
+
+    // The vertex after a toward b, or kNoIndex: the answer of a scan of a's out-edges in order.
+    uint32_t toward(uint32_t a, uint32_t b) {
+        const auto known = first_toward_.find(key(a, b));
+        if (known != first_toward_.end()) return known->second;
+        for (uint32_t& i = walked_[a]; i < he_.degree(a);) {
+            const uint32_t candidate = he_.out_vertex(a, i++);
+            const uint32_t end = walk(he_, a, candidate, steps_);
+            if (end == kNoIndex) continue;
+            first_toward_.try_emplace(key(a, end), candidate);  // an earlier out-edge to the same end stays
+            if (end == b) return candidate;
+        }
+        return kNoIndex;
+    }
+
+private:
+    static uint64_t key(uint32_t a, uint32_t b) { return (uint64_t(a) << 32) | b; }
+    const LeafHalfedges& he_;
+    const uint32_t steps_;
+    std::vector<uint32_t> walked_;  // per leaf vertex: its out-edges walked so far
+    std::unordered_map<uint64_t, uint32_t> first_toward_;
+};
+
 }  // namespace
 
 std::vector<uint32_t> reconstruct_uniform(Hierarchy& h, const std::vector<uint32_t>& leaf_of_base,
@@ -48,6 +79,7 @@ std::vector<uint32_t> reconstruct_uniform(Hierarchy& h, const std::vector<uint32
 
     // The first leaf vertex on root t's edge c (from corner c toward corner c + 1).
     std::vector<uint32_t> ray(3 * size_t(f0), kNoIndex);
+    RayFinder rays(he, n);
     for (NodeId t = 0; t < f0; ++t) {
         for (int c = 0; c < 3; ++c) {
             if (ray[3 * t + c] != kNoIndex) continue;
@@ -55,11 +87,7 @@ std::vector<uint32_t> reconstruct_uniform(Hierarchy& h, const std::vector<uint32
             // then turn around the corner: one leaf face per base triangle.
             const uint32_t a = leaf_of_base[h.vertex(t, c)];
             const uint32_t b = leaf_of_base[h.vertex(t, (c + 1) % 3)];
-            uint32_t x = kNoIndex;
-            for (uint32_t i = 0; i < he.degree(a) && x == kNoIndex; ++i) {
-                const uint32_t candidate = he.out_vertex(a, i);
-                if (walk(he, a, candidate, n) == b) x = candidate;
-            }
+            uint32_t x = rays.toward(a, b);
             if (x == kNoIndex) return {};
             NodeId r = t;
             int corner = c;
