@@ -30,6 +30,19 @@ set(cases
   "2|--quantize|encode x.amh -o ${OUT}/x.amc --quantize 31"
   "2|--runs|report x.amh --runs 0"
   "1|chunk 1073741823 is not in the file (it has 1 chunk)|decode ${GOLDEN} -o ${OUT}/chunks.amh --chunks 0-1073741823"
+  # The review of the command line (2026-12-07): sizes asked for that cannot fit, refused before
+  # they are made, and numbers CLI11's checks let through (NaN, overflow, trailing text).
+  "2|--trees 4194304x4194304x4194304: brick: sizes must be|octree make --dim 3 --trees 4194304x4194304x4194304 -o ${OUT}/t.amq"
+  "2|--trees: expected|octree make --dim 2 --trees 99999999999x1 -o ${OUT}/t.amq"
+  "2|--trees: expected|octree make --dim 2 --trees 2x2junk -o ${OUT}/t.amq"
+  "2|--trees: expected|octree make --dim 2 --trees 2x2x5 -o ${OUT}/t.amq"
+  "2|the uniform forest: more than 4096 leaves (--max-leaves)|octree make --dim 3 --model uniform --level 18 --max-leaves 4096 -o ${OUT}/u.amq"
+  "2|the sphere forest: more than 4096 leaves (--max-leaves)|octree make --dim 3 --model sphere --level 18 --max-leaves 4096 -o ${OUT}/s.amq"
+  "2|make more than the 67108864 nodes of --max-nodes|refine --model uniform --levels 30 -o ${OUT}/u.amh"
+  "2|make more than the 1000 nodes of --max-nodes|refine --model uniform --levels 3 --max-nodes 1000 -o ${OUT}/u.amh"
+  "2|--faces 1073741824 --max-level 30: more leaves than the 67108864 nodes of --max-nodes|refine --model random --faces 1073741824 --max-level 30 -o ${OUT}/r.amh"
+  "2|--error-bound: NaN is not a number here|series encode ${GOLDEN} -o ${OUT}/s.amcs --error-bound nan"
+  "2|--vertex-step: NaN is not a number here|octree encode ${OUT}/none.amq -o ${OUT}/v.amq --vertex-step nan"
 )
 set(failures "")
 foreach(case IN LISTS cases)

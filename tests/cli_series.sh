@@ -75,6 +75,10 @@ expect 2 "$amc" series decode key.amcs -o x.amc
 expect 2 "$amc" series decode key.amcs -o -
 expect 2 "$amc" series encode front_0.pvd -o x.amc
 expect 2 "$amc" series encode front_0.pvd --base base.vtu --field-bound level -o y.amcs
+# A bound naming no field is refused, not ignored (the fields of front_0.pvd include "level").
+expect 2 "$amc" series encode front_0.pvd --base base.vtu --field-bound levle=0.5 -o y.amcs
+grep -q 'no frame has a field of that name' err.txt || fail "a bound naming no field: $(head -c 200 err.txt)"
+expect 0 "$amc" series encode front_0.pvd --base base.vtu --field-bound level=0.5 -o named.amcs
 expect 2 "$amc" series decode key.amcs --frame -1
 expect 2 "$amc" decode front_0.amc --frame 1
 expect 2 "$amc" encode front_0.pvd --quantize 12 -o z.amcs

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -53,6 +54,14 @@ void add_per_byte_bound(CLI::App* command, const std::string& flag, const std::s
                         "whose writer did not pad, before 2026-12-02)")
         ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
 }
+
+// CLI11's ranges compare, and NaN passes every comparison: a number option that must be one.
+const CLI::Validator kNotNan(
+    [](std::string& text) -> std::string {
+        double value = 0;
+        return CLI::detail::lexical_cast(text, value) && std::isnan(value) ? "NaN is not a number here" : "";
+    },
+    "NUMBER");
 
 }  // namespace
 
@@ -174,6 +183,10 @@ int main(int argc, char** argv) {
     refine_cmd->add_option("--levels", refine.levels, "Levels of uniform refinement")->capture_default_str()->check(CLI::Range(0, kMaxLevel));
     refine_cmd->add_option("--steps", refine.steps, "Time steps of the moving front")->capture_default_str()->check(CLI::Range(1, 100000));
     refine_cmd->add_option("--seed", refine.seed, "Seed of random refinement")->capture_default_str();
+    refine_cmd->add_option("--max-nodes", refine.max_nodes,
+                           "Models uniform and random: refuse to make more nodes, counted before they are made (default "
+                           "2^26, what decoders read by default)")
+        ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 32));
     refine_cmd->add_option("-o,--output", refine.output,
                            "Hierarchy (.amh) or leaf mesh (.obj .off .ply .vtu); --model front: one file per step, "
                            "NAME_<step>.amh")->required();
@@ -206,7 +219,8 @@ int main(int argc, char** argv) {
                                 "Keyframes only where --keyframe puts them (no frame made a keyframe because it is smaller alone)");
     series_encode_cmd->add_option("--error-bound", series_encode.error_bound,
                                   "Absolute error bound of every float field (default 0: bit-exact)")
-        ->check(CLI::Range(0.0, 1e300));
+        ->check(CLI::Range(0.0, 1e300))
+        ->check(kNotNan);
     series_encode_cmd->add_option("--field-bound", series_encode.field_bounds, "NAME=BOUND: a bound for one field (repeatable)");
     SeriesDecodeCommand series_decode;
     auto* series_decode_cmd = series->add_subcommand("decode", "Decompress an .amcs file to a .pvd and one VTU per frame");
@@ -251,6 +265,9 @@ int main(int argc, char** argv) {
     octree_make_cmd->add_option("--trees", octree_make.trees, "Brick of trees, NXxNY or NXxNYxNZ")->capture_default_str();
     octree_make_cmd->add_option("--balance", octree_make.balance, "face, edge, corner or none")->capture_default_str();
     octree_make_cmd->add_option("--seed", octree_make.seed, "Random model's seed")->capture_default_str();
+    octree_make_cmd->add_option("--max-leaves", octree_make.max_leaves,
+                                "Refuse to make a forest of more leaves (default 2^26, the octants readers accept by default)")
+        ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 32));
     octree_make_cmd->add_option("-o,--output", octree_make.output, "Output (.amq, .vtu, .p4est; - for .amq to stdout)")->required();
     octree_make_cmd->add_flag("--conforming", octree_make.conforming,
                               "VTU output as triangles / tetrahedra without hanging nodes (else quads / hexahedra)");
@@ -263,7 +280,8 @@ int main(int argc, char** argv) {
                                   "Float32, Float64; default one UInt8 field p4est_data)");
     octree_encode_cmd->add_option("--vertex-step", octree_encode.vertex_step,
                                   "Coarse-mesh vertices on a grid of this step (default 0: bit-exact)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(CLI::NonNegativeNumber)
+        ->check(kNotNan);
     OctreeDecodeCommand octree_decode;
     auto* octree_decode_cmd = octree->add_subcommand("decode", "Decompress an .amq file to VTU (or p4est)");
     octree_decode_cmd->add_option("input", octree_decode.input, ".amq file, or - for stdin")->required();

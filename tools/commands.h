@@ -5,6 +5,7 @@
 #include <amc/codec.h>
 #include <amc/mesh.h>
 #include <amc/mesh_io.h>
+#include <amc/octree.h>
 #include <amc/refinement.h>
 
 #include <cstdint>
@@ -81,6 +82,7 @@ struct RefineCommand {
     uint32_t faces = 150000, base_faces = 500;
     int max_level = 7, levels = 3, steps = 5;
     uint64_t seed = 1;
+    uint64_t max_nodes = DecodeOptions{}.max_nodes;  // uniform and random: refused beyond, counted before
 };
 void run_refine(const RefineCommand& command, const GlobalOptions& global);
 
@@ -123,6 +125,7 @@ struct OctreeMakeCommand {
     std::string model = "sphere", trees = "1x1x1", balance = "face", output;
     uint64_t seed = 1;
     bool conforming = false;  // VTU output as triangles / tetrahedra without hanging nodes
+    uint64_t max_leaves = OctreeDecodeOptions{}.max_nodes;  // the makers stop with an error beyond
 };
 void run_octree_make(const OctreeMakeCommand& command, const GlobalOptions& global);
 struct OctreeEncodeCommand {

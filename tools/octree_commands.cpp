@@ -6,12 +6,16 @@
 #include <amc/mesh_io.h>
 #include <amc/octree.h>
 
+#include <array>
+#include <cctype>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <limits>
 #include <sstream>
 
 namespace amc::cli {
@@ -93,20 +97,53 @@ OctreeBalance balance_named(const std::string& name) {
     throw UsageError("--balance: expected face, edge, corner or none, got '" + name + "'");
 }
 
+// --trees NXxNY or NXxNYxNZ (a third size of 1 in 2D, as the default 1x1x1): whole numbers only,
+// each parsed without overflow; brick_connectivity bounds their product.
+std::array<int, 3> brick_sizes(const std::string& trees, int dim) {
+    std::array<int, 3> n = {1, 1, 1};
+    int sizes = 0;
+    const char* p = trees.c_str();
+    for (; sizes < 3 && std::isdigit(static_cast<unsigned char>(*p)); ++sizes) {
+        char* end = nullptr;
+        errno = 0;
+        const long value = std::strtol(p, &end, 10);
+        if (errno != 0 || value < 1 || value > std::numeric_limits<int>::max()) break;
+        n[sizes] = int(value);
+        p = end;
+        if (*p != 'x') {
+            ++sizes;
+            break;
+        }
+        ++p;
+    }
+    if (*p != 0 || sizes < dim || (dim == 2 && n[2] != 1))
+        throw UsageError("--trees: expected NXxNY (2D) or NXxNYxNZ (3D), sizes from 1, got '" + trees + "'");
+    return n;
+}
+
 }  // namespace
 
 void run_octree_make(const OctreeMakeCommand& c, const GlobalOptions& global) {
-    int n[3] = {1, 1, 1};
-    if (std::sscanf(c.trees.c_str(), "%dx%dx%d", &n[0], &n[1], &n[2]) < c.dim || n[0] < 1 || n[1] < 1 || n[2] < 1)
-        throw UsageError("--trees: expected NXxNY (2D) or NXxNYxNZ (3D), got '" + c.trees + "'");
-    const TreeConnectivity conn = brick_connectivity(c.dim, n[0], n[1], c.dim == 3 ? n[2] : 1);
+    const std::array<int, 3> n = brick_sizes(c.trees, c.dim);
+    TreeConnectivity conn;
+    try {
+        conn = brick_connectivity(c.dim, n[0], n[1], n[2]);
+    } catch (const Error& e) {
+        throw UsageError("--trees " + c.trees + ": " + e.what());
+    }
     const Vec3 center{0.5 * n[0], 0.5 * n[1], c.dim == 3 ? 0.5 * n[2] : 0.0};
     OctreeForest forest;
-    if (c.model == "sphere") forest = sphere_octree_forest(conn, center, 0.35 * std::min(n[0], n[1]), c.level);
-    else if (c.model == "front") forest = front_octree_forest(conn, 0.5 * n[0], c.level);
-    else if (c.model == "random") forest = random_octree_forest(conn, c.seed, 0.4, std::min(2, c.level), c.level);
-    else if (c.model == "uniform") forest = uniform_octree_forest(conn, c.level);
-    else throw UsageError("--model: expected sphere, front, random or uniform, got '" + c.model + "'");
+    const uint64_t most = c.max_leaves;
+    try {
+        if (c.model == "sphere") forest = sphere_octree_forest(conn, center, 0.35 * std::min(n[0], n[1]), c.level, most);
+        else if (c.model == "front") forest = front_octree_forest(conn, 0.5 * n[0], c.level, most);
+        else if (c.model == "random") forest = random_octree_forest(conn, c.seed, 0.4, std::min(2, c.level), c.level, most);
+        else if (c.model == "uniform") forest = uniform_octree_forest(conn, c.level, most);
+        else throw UsageError("--model: expected sphere, front, random or uniform, got '" + c.model + "'");
+    } catch (const Error& e) {
+        if (e.code() != ErrorCode::limit_exceeded) throw;
+        throw UsageError("--level " + std::to_string(c.level) + ": the " + c.model + " " + e.what() + " (--max-leaves)");
+    }
     if (c.balance != "none") forest = balance_octree_forest(forest, balance_named(c.balance));
     write_forest(c.output, forest, global, {}, c.conforming);
 }

@@ -22,6 +22,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <set>
 
 namespace amc::cli {
 
@@ -343,6 +344,13 @@ void run_series_encode(const SeriesEncodeCommand& command, const GlobalOptions& 
         }
         encode_seconds += seconds_since(start);
     }
+    // A bound naming no field (a typo, or NAME=B,NAME2=B2 in one option) would leave it bit-exact unsaid.
+    std::set<std::string> field_names;
+    for (const SeriesFrameStats& s : stats)
+        for (const auto& f : s.fields) field_names.insert(f.name);
+    for (const auto& bound : options.field_bounds)
+        if (field_names.count(bound.first) == 0)
+            throw UsageError("--field-bound " + bound.first + "=...: no frame has a field of that name");
     writer->close();
     const std::vector<uint8_t>& bytes = writer->bytes();
     write_output(output, std::string(bytes.begin(), bytes.end()), global.force);

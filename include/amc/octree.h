@@ -104,23 +104,29 @@ OctreeForest balance_octree_forest(const OctreeForest& forest, OctreeBalance bal
 std::string octree_balance_violation(const OctreeForest& forest, OctreeBalance balance);
 
 // ---- forests for tests and benchmarks --------------------------------------------------------
-OctreeForest uniform_octree_forest(const TreeConnectivity& conn, int level);
+// Each maker throws Error(limit_exceeded) naming the count once its forest would have more than
+// `max_leaves` leaves (a 3D sphere at level 18 would hold about 10^11: asked of `amc octree make`).
+constexpr uint64_t kNoLeafLimit = ~uint64_t{0};
+OctreeForest uniform_octree_forest(const TreeConnectivity& conn, int level, uint64_t max_leaves = kNoLeafLimit);
 // Refines leaves (recursively, children too) while refine(tree, octant) says so, up to max_level.
 OctreeForest refine_octree_forest(const OctreeForest& forest,
                                   const std::function<bool(uint32_t tree, const Octant&)>& refine,
-                                  int max_level);
+                                  int max_level, uint64_t max_leaves = kNoLeafLimit);
 // The point of a tree at reference coordinates u, v, w in [0, 1]: multilinear in its corner
 // vertices (the unit cube at the origin when the connectivity has no vertices).
 Vec3 tree_point(const TreeConnectivity& conn, uint32_t tree, double u, double v, double w);
 // Refined where the octant's box meets the sphere |p - center| = radius (the circle in 2D), up
 // to max_level: the classic test of p4est's examples. Not balanced.
-OctreeForest sphere_octree_forest(const TreeConnectivity& conn, Vec3 center, double radius, int max_level);
+OctreeForest sphere_octree_forest(const TreeConnectivity& conn, Vec3 center, double radius, int max_level,
+                                  uint64_t max_leaves = kNoLeafLimit);
 // A moving front: the curve / surface x + 0.3 sin(4 y) (+ 0.2 cos(3 z)) = t, refined up to
 // max_level in a band of about two leaves around it, and graded away from it. Not balanced.
-OctreeForest front_octree_forest(const TreeConnectivity& conn, double t, int max_level);
+OctreeForest front_octree_forest(const TreeConnectivity& conn, double t, int max_level,
+                                 uint64_t max_leaves = kNoLeafLimit);
 // Random refinement: uniform down to min_level, then leaves split with probability `p` per level
 // until max_level. Not balanced.
-OctreeForest random_octree_forest(const TreeConnectivity& conn, uint64_t seed, double p, int min_level, int max_level);
+OctreeForest random_octree_forest(const TreeConnectivity& conn, uint64_t seed, double p, int min_level, int max_level,
+                                  uint64_t max_leaves = kNoLeafLimit);
 
 // Levels and counts.
 struct OctreeForestCounts {

@@ -66,16 +66,16 @@ OctreeForestCounts count_octree_forest(const OctreeForest& forest) {
     return counts;
 }
 
-OctreeForest uniform_octree_forest(const TreeConnectivity& conn, int level) {
+OctreeForest uniform_octree_forest(const TreeConnectivity& conn, int level, uint64_t max_leaves) {
     OctreeForest roots;
     roots.connectivity = conn;
     for (uint32_t t = 0; t <= conn.tree_count(); ++t) roots.tree_offsets.push_back(t);
     roots.leaves.assign(conn.tree_count(), Octant{});
-    return refine_octree_forest(roots, [](uint32_t, const Octant&) { return true; }, level);
+    return refine_octree_forest(roots, [](uint32_t, const Octant&) { return true; }, level, max_leaves);
 }
 
 OctreeForest refine_octree_forest(const OctreeForest& forest, const std::function<bool(uint32_t, const Octant&)>& refine,
-                                  int max_level) {
+                                  int max_level, uint64_t max_leaves) {
     validate_octree_forest(forest, "refine_octree_forest");
     const int d = forest.dim(), root = octree_root_log2(d);
     max_level = std::min(max_level, octree_max_level(d));
@@ -90,6 +90,8 @@ OctreeForest refine_octree_forest(const OctreeForest& forest, const std::functio
                 const Octant o = stack.back();
                 stack.pop_back();
                 if (o.level >= max_level || !refine(t, o)) {
+                    AMC_REQUIRE(out.leaves.size() < max_leaves, limit_exceeded,
+                                "forest: more than " + std::to_string(max_leaves) + " leaves");
                     out.leaves.push_back(o);
                     continue;
                 }
@@ -134,7 +136,7 @@ int octant_corners(const TreeConnectivity& conn, uint32_t tree, const Octant& o,
 
 }  // namespace
 
-OctreeForest sphere_octree_forest(const TreeConnectivity& conn, Vec3 center, double radius, int max_level) {
+OctreeForest sphere_octree_forest(const TreeConnectivity& conn, Vec3 center, double radius, int max_level, uint64_t max_leaves) {
     return refine_octree_forest(uniform_octree_forest(conn, 0),
                                 [&](uint32_t t, const Octant& o) {
                                     Vec3 p[8];
@@ -154,10 +156,10 @@ OctreeForest sphere_octree_forest(const TreeConnectivity& conn, Vec3 center, dou
                                     const double df = std::sqrt(exact_dot(far - center, far - center));
                                     return dn <= radius && radius <= df;
                                 },
-                                max_level);
+                                max_level, max_leaves);
 }
 
-OctreeForest front_octree_forest(const TreeConnectivity& conn, double t, int max_level) {
+OctreeForest front_octree_forest(const TreeConnectivity& conn, double t, int max_level, uint64_t max_leaves) {
     return refine_octree_forest(uniform_octree_forest(conn, 0),
                                 [&](uint32_t tree, const Octant& o) {
                                     Vec3 p[8];
@@ -170,14 +172,15 @@ OctreeForest front_octree_forest(const TreeConnectivity& conn, double t, int max
                                     // A band of about two octants at every level: graded towards the front.
                                     return std::abs(phi) < 1.2 * size;
                                 },
-                                max_level);
+                                max_level, max_leaves);
 }
 
-OctreeForest random_octree_forest(const TreeConnectivity& conn, uint64_t seed, double p, int min_level, int max_level) {
+OctreeForest random_octree_forest(const TreeConnectivity& conn, uint64_t seed, double p, int min_level, int max_level,
+                                  uint64_t max_leaves) {
     SplitMix64 random{seed * kGoldenGamma + 1};
     return refine_octree_forest(uniform_octree_forest(conn, 0),
                                 [&](uint32_t, const Octant& o) { return o.level < min_level || random.unit() < p; },
-                                max_level);
+                                max_level, max_leaves);
 }
 
 }  // namespace amc

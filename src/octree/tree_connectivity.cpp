@@ -170,7 +170,10 @@ void validate_connectivity(const TreeConnectivity& conn, const std::string& what
 TreeConnectivity brick_connectivity(int dim, int nx, int ny, int nz, bool periodic_x, bool periodic_y, bool periodic_z) {
     AMC_REQUIRE(dim == 2 || dim == 3, invalid_input, "brick: dimension " + std::to_string(dim) + " is not 2 or 3");
     if (dim == 2) nz = 1, periodic_z = false;
-    AMC_REQUIRE(nx >= 1 && ny >= 1 && nz >= 1 && uint64_t(nx) * ny * nz < (uint64_t{1} << 24), invalid_input,
+    // nx * ny bounded first: three sizes of 2^22 would wrap the product of all three to 0.
+    AMC_REQUIRE(nx >= 1 && ny >= 1 && nz >= 1 && uint64_t(nx) * ny < (uint64_t{1} << 24) &&
+                    uint64_t(nx) * ny * nz < (uint64_t{1} << 24),
+                invalid_input,
                 "brick: sizes must be at least 1 and at most 2^24 trees");
     TreeConnectivity conn;
     conn.dim = dim;
