@@ -30,6 +30,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
@@ -385,6 +386,28 @@ TEST(CraftedFiles, ManyChunksDecodeOnThreadsInTheMemoryOfOne) {
     EXPECT_LT(allocated[1], allocated[0] + (uint64_t(8) << 20));
 }
 
+// 2^17 chunks of one root each (`amc encode --chunks N` takes N up to the roots), encoded in time
+// linear in them: each chunk's extraction marked its base vertices over the whole base and its
+// roots over all roots (3.1 s of CPU here until 2026-12-07, 12 s for 2^18; docs/FUZZING.md). An
+// encoder's input, not a file.
+TEST(CraftedFiles, EncodeOfOneRootChunksIsLinear) {
+    const Hierarchy h(make_square(256));
+    EncodeOptions options;
+    options.quantize_bits = 12;
+    options.threads = 1;
+    options.chunks = h.root_count();
+    options.min_chunk_bytes = 0;
+    const double start = cpu_milliseconds();
+    const std::vector<uint8_t> file = encode(h, options);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  %u one-root chunks encoded (%zu bytes): %.1f ms\n", h.root_count(), file.size(), milliseconds);
+    ASSERT_EQ(inspect(file.data(), file.size()).chunks.size(), size_t(h.root_count()));
+    options.chunks = 1;
+    const std::vector<uint8_t> whole = encode(h, options);
+    EXPECT_TRUE(identical(decode(file.data(), file.size()), decode(whole.data(), whole.size())));
+    EXPECT_LT(milliseconds, 1500.0 * kSanitizerSlowdown);  // 0.42 s in Release
+}
+
 // A chunk table of 2^17 chunks, each an empty block: inspect finds each chunk block's entry
 // without a pass over all of them (that pass made inspect quadratic: 12 s of CPU for this 2 MB
 // file, and `amc decode --triangles` inspects first). CPU time, as the other crafted files.
@@ -510,6 +533,49 @@ TEST(CraftedFiles, HighValenceBaseEncodesInLinearTime) {
     std::printf("  %zu base triangles encoded (%zu bytes): %.1f ms\n", h.base().triangles.size(), file.size(), milliseconds);
     EXPECT_EQ(decode(file.data(), file.size()).root_count(), h.root_count());
     EXPECT_LT(milliseconds, 6000.0);  // 64-68 ms, 1.6 s under ASan (CI); 13 s in Release before
+}
+
+// The closed surface of a plate of 2048 x 128 grid cells with a hole through every other cell in
+// both directions (31,713 handles, 1.3 M triangles). Each merge of the base coder's conquest (one a
+// handle) looked for its tip by a pass over the border loops below the top of the stack, node by
+// node, a pass the walk budget did not charge: 3.6 s of CPU for this base's single try until
+// 2026-12-07 (which then wrote the explicit mode, 0.37 s after; docs/FUZZING.md). An encoder's
+// input, not a file.
+TEST(CraftedFiles, BaseOfManyHandlesEncodesInLinearTime) {
+    constexpr uint32_t kLength = 2048, kWidth = 128;
+    auto id = [](uint32_t i, uint32_t j) { return j * (kLength + 1) + i; };
+    TriangleMesh top;
+    for (uint32_t j = 0; j <= kWidth; ++j)
+        for (uint32_t i = 0; i <= kLength; ++i) top.positions.push_back({double(i), double(j), 0.01 * double((7 * i + 13 * j) % 5)});
+    for (uint32_t j = 0; j < kWidth; ++j)
+        for (uint32_t i = 0; i < kLength; ++i) {
+            if (i % 2 == 1 && j % 2 == 1 && i + 1 < kLength && j + 1 < kWidth) continue;  // a hole
+            top.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+            top.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+        }
+    // The bottom, a copy turned over one unit below, and a wall under each boundary edge of the top.
+    const uint32_t n = uint32_t(top.positions.size());
+    TriangleMesh mesh = top;
+    for (uint32_t v = 0; v < n; ++v) mesh.positions.push_back(top.positions[v] - Vec3{0, 0, 1});
+    for (const Triangle& t : top.triangles) mesh.triangles.push_back({t[0] + n, t[2] + n, t[1] + n});
+    std::vector<uint64_t> edges;
+    for (const Triangle& t : top.triangles)
+        for (int k = 0; k < 3; ++k) edges.push_back(uint64_t(t[k]) << 32 | t[(k + 1) % 3]);
+    std::sort(edges.begin(), edges.end());
+    for (const Triangle& t : top.triangles)
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t a = t[k], b = t[(k + 1) % 3];
+            if (std::binary_search(edges.begin(), edges.end(), uint64_t(b) << 32 | a)) continue;
+            mesh.triangles.push_back({b, a, a + n});
+            mesh.triangles.push_back({b, a + n, b + n});
+        }
+    const double start = cpu_milliseconds();
+    const BaseMeshCode code = encode_base_connectivity(mesh, 1, 0);  // the single try
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  base of %zu triangles coded in mode %d (%zu bytes): %.1f ms\n", mesh.triangles.size(), int(code.mode),
+                code.bytes.size(), milliseconds);
+    EXPECT_EQ(code.vertex_order.size(), mesh.positions.size());
+    EXPECT_LT(milliseconds, 1500.0 * kSanitizerSlowdown);
 }
 
 // The caller's numbering of a leaf mesh whose vertices 0 and 1 are the lowest corner of every face

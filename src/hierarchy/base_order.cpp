@@ -222,8 +222,8 @@ Hierarchy HierarchyBuilder::reordered(const Hierarchy& h, TriangleMesh base, con
 // Written in the replay's order, so that each node finds its parent's vertices and midpoints made.
 Hierarchy HierarchyBuilder::subforest(const Hierarchy& h, TriangleMesh base, const std::vector<NodeId>& roots,
                                       const std::vector<VertexId>& base_vertex, const std::vector<uint32_t>& root_of,
-                                      const std::vector<uint8_t>& root_in, NodeId* local, std::vector<VertexId>* vertex_of_out,
-                                      SubforestRoom* room) {
+                                      const std::vector<uint8_t>& root_in, uint32_t root_in_first, NodeId* local,
+                                      std::vector<VertexId>* vertex_of_out, SubforestRoom* room) {
     Hierarchy out(std::move(base));
     if (room != nullptr) adopt_storage(out, std::move(room->arrays));
     const NodeId root_count = out.root_count();
@@ -239,7 +239,9 @@ Hierarchy HierarchyBuilder::subforest(const Hierarchy& h, TriangleMesh base, con
             for (int k = 0; k < 4; ++k) old_of.push_back(h.child(o, k));
     }
     const size_t n = old_of.size();
-    auto taken = [&](NodeId q) { return q != kNoNode && root_in[root_of[q]] != 0; };
+    auto taken = [&](NodeId q) {
+        return q != kNoNode && root_of[q] - root_in_first < root_in.size() && root_in[root_of[q] - root_in_first] != 0;
+    };
     std::vector<VertexId> vertex_of;
     if (room != nullptr) vertex_of.swap(room->vertex_of);
     vertex_of.assign(base_vertex.begin(), base_vertex.end());

@@ -239,15 +239,15 @@ struct HierarchyBuilder {
     // The trees of `roots` (ids in h, in this order) as a hierarchy of their own over `base`, their
     // triangles in that order (its vertex i being h's base_vertex[i]), as replaying their splits
     // breadth-first with split() makes it: the same node and vertex ids, links and boundary flags,
-    // diagonal flags on leaves. root_of[q] is the root of h's node q and root_in[r] marks the
-    // roots taken; local[q] (one word per node of h) receives the result's id of each node taken
-    // and is read only for them, so calls on disjoint roots may share it at once. `vertex_of`
-    // receives each vertex's id in h. With `room` (subforest_room's), its arrays are those of the
-    // result and of the replay.
+    // diagonal flags on leaves. root_of[q] is the root of h's node q and root_in[r - root_in_first]
+    // marks the roots taken (none outside its span); local[q] (one word per node of h) receives
+    // the result's id of each node taken and is read only for them, so calls on disjoint roots may
+    // share it at once. `vertex_of` receives each vertex's id in h. With `room` (subforest_room's),
+    // its arrays are those of the result and of the replay.
     static Hierarchy subforest(const Hierarchy& h, TriangleMesh base, const std::vector<NodeId>& roots,
                                const std::vector<VertexId>& base_vertex, const std::vector<uint32_t>& root_of,
-                               const std::vector<uint8_t>& root_in, NodeId* local, std::vector<VertexId>* vertex_of,
-                               SubforestRoom* room = nullptr);
+                               const std::vector<uint8_t>& root_in, uint32_t root_in_first, NodeId* local,
+                               std::vector<VertexId>* vertex_of, SubforestRoom* room = nullptr);
     // Room for a subforest of h of `nodes` nodes and about `vertices` vertices, reserved (not yet
     // resident: make_resident below) in the calling thread's malloc arena, also when
     // another thread fills it.

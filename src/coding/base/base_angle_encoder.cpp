@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <iterator>
 #include <mutex>
+#include <utility>
 
 namespace amc {
 
@@ -81,6 +82,9 @@ private:
     // border still; per decoder vertex, a list of its nodes (first node, then node to node).
     std::vector<uint32_t> out_he_, node_link_, first_node_;
     std::vector<uint8_t> alive_, processed_;
+    // The loops below the top (note_loop_below): each gate's serial + 1 (0: none), the Fenwick tree.
+    std::vector<uint32_t> gate_serial_, below_;
+    uint32_t serials_ = 0;
     std::vector<uint32_t> triangles_;  // closed triangles in decoder order
     std::vector<uint8_t> rotations_;
     uint64_t walked_ = 0;
@@ -289,6 +293,7 @@ private:
             if (loop.length == 3) {
                 alive_[g] = alive_[nv] = alive_[p] = 0;
                 b.op_end();
+                if (!b.stack.empty()) forget_loop_below(b.top().gate);  // the last loop below is the top now
             } else {
                 alive_[g] = 0;
                 out_he_[p] = to_v;
@@ -339,30 +344,73 @@ private:
             encode_split_tip(g, nv, n, k, loop.length);
             visit_triangle(he);
             nw = b.op_split(n, k);
+            note_loop_below(b.stack[b.stack.size() - 2].gate);
         } else {
-            size_t index = b.stack.size();
-            uint32_t offset = 0;
-            for (size_t j = 0; j + 1 < b.stack.size() && index == b.stack.size(); ++j) {
-                uint32_t y = b.stack[j].gate;
-                for (uint32_t s = 0; s < b.stack[j].length; ++s, y = b.next(y)) {
-                    if (y == n) {
-                        index = j;
-                        offset = s;
-                        break;
-                    }
-                }
-            }
-            if (index == b.stack.size()) throw EncoderGaveUp{};
+            const auto [index, offset] = merge_tip(n);
             ++merges_seen_;
             const uint32_t length = b.stack[index].length;
             put_index_all(static_cast<uint32_t>(b.stack.size() - 2 - index), static_cast<uint32_t>(b.stack.size() - 1));
             put_index_all(offset, length);
             charge_walk(std::min(offset, length - offset));
             visit_triangle(he);
+            forget_loop_below(b.stack[index].gate);
             nw = b.op_merge(n, index);
         }
         out_he_[g] = to_w;
         track(nw, to_v);
+    }
+
+    // The loops below the top of the stack, for M's tip: splits append them (just below the top),
+    // M removes any of them and E makes the last the top, so their stack order is the order of
+    // their serial numbers. Each one's gate node (gates change only at the top) is marked with its
+    // serial + 1, and a Fenwick tree over the serials counts those still below the top.
+    void note_loop_below(uint32_t gate) {
+        if (below_.empty()) below_.assign(cm_.triangles.size() + 2, 0);  // a split takes a triangle: fewer serials
+        const uint32_t serial = serials_++;
+        if (size_t(serial) + 1 >= below_.size()) throw EncoderGaveUp{};
+        if (gate_serial_.size() <= gate) gate_serial_.resize(std::max<size_t>(size_t(gate) + 1, 2 * gate_serial_.size()), 0);
+        gate_serial_[gate] = serial + 1;
+        for (size_t i = size_t(serial) + 1; i < below_.size(); i += i & (~i + 1)) ++below_[i];
+    }
+    void forget_loop_below(uint32_t gate) {
+        const uint32_t serial = gate_serial_[gate] - 1;
+        gate_serial_[gate] = 0;
+        for (size_t i = size_t(serial) + 1; i < below_.size(); i += i & (~i + 1)) --below_[i];
+    }
+    // Loops below the top with serials up to `serial`.
+    uint32_t loops_below_through(uint32_t serial) const {
+        uint32_t count = 0;
+        for (size_t i = size_t(serial) + 1; i > 0; i &= i - 1) count += below_[i];
+        return count;
+    }
+    bool marks_gate(uint32_t node) const { return node < gate_serial_.size() && gate_serial_[node] != 0; }
+
+    // M's tip n: the stack loop below the top that holds it and its offset from that loop's gate,
+    // found by going round n both ways to the first gate: min(offset, length - offset) steps, the
+    // walk the decoder is charged for. A pass over the loops below, node by node, was quadratic
+    // in a base of many handles.
+    std::pair<size_t, uint32_t> merge_tip(uint32_t n) const {
+        const Border& b = border_;
+        uint32_t back = n, ahead = n, gate = kNoVertex;
+        size_t steps = 0;
+        bool behind = true;  // the gate found going back from n (n is `steps` after it)
+        for (; steps < out_he_.size(); ++steps, back = b.prev(back), ahead = b.next(ahead)) {
+            if (marks_gate(back)) {
+                gate = back;
+                break;
+            }
+            if (marks_gate(ahead)) {
+                gate = ahead;
+                behind = false;
+                break;
+            }
+        }
+        if (gate == kNoVertex) throw EncoderGaveUp{};
+        // Stack order is serial order: the loops below the top up to this one's serial end at its index.
+        const size_t index = loops_below_through(gate_serial_[gate] - 1) - 1;
+        if (index + 1 >= b.stack.size() || b.stack[index].gate != gate || steps >= b.stack[index].length) throw EncoderGaveUp{};
+        const uint32_t length = b.stack[index].length;
+        return {index, behind ? uint32_t(steps) : uint32_t((length - steps) % length)};
     }
 
     // The decoder's rule (base_angle_decoder.cpp, split_tip): the nearest-tip bit when there is a

@@ -62,22 +62,43 @@ std::vector<RootRange> balanced_chunks(const std::vector<uint64_t>& nodes_per_ro
 }
 
 TriangleMesh base_of_roots(const TriangleMesh& base, const std::vector<RootRange>& roots, std::vector<VertexId>& base_vertex) {
-    std::vector<VertexId> index(base.positions.size(), kNoVertex);
-    for (const RootRange& range : roots)
-        for (uint32_t t = range.first; t < range.first + range.count; ++t)
-            for (int i = 0; i < 3; ++i) index[base.triangles[t][i]] = 0;
+    size_t triangles = 0;
+    for (const RootRange& range : roots) triangles += range.count;
+    base_vertex.clear();
+    std::vector<VertexId> index;  // with a pass over the whole base: its vertices' new ids
+    // The roots' vertices in increasing order: marked in a pass over the whole base's, or sorted
+    // when the roots are few against it (the encoder's chunks: that pass for each made N chunks
+    // quadratic). Either way the same numbering.
+    const bool sorted = triangles < base.positions.size() / 32;
+    if (sorted) {
+        base_vertex.reserve(3 * triangles);
+        for (const RootRange& range : roots)
+            for (uint32_t t = range.first; t < range.first + range.count; ++t)
+                base_vertex.insert(base_vertex.end(), base.triangles[t].begin(), base.triangles[t].end());
+        std::sort(base_vertex.begin(), base_vertex.end());
+        base_vertex.erase(std::unique(base_vertex.begin(), base_vertex.end()), base_vertex.end());
+    } else {
+        index.assign(base.positions.size(), kNoVertex);
+        for (const RootRange& range : roots)
+            for (uint32_t t = range.first; t < range.first + range.count; ++t)
+                for (int i = 0; i < 3; ++i) index[base.triangles[t][i]] = 0;
+        for (VertexId v = 0; v < index.size(); ++v) {
+            if (index[v] == kNoVertex) continue;
+            index[v] = VertexId(base_vertex.size());
+            base_vertex.push_back(v);
+        }
+    }
+    auto new_id = [&](VertexId v) {
+        return sorted ? VertexId(std::lower_bound(base_vertex.begin(), base_vertex.end(), v) - base_vertex.begin()) : index[v];
+    };
     TriangleMesh out;
     out.single_precision = base.single_precision;
-    base_vertex.clear();
-    for (VertexId v = 0; v < index.size(); ++v) {
-        if (index[v] == kNoVertex) continue;
-        index[v] = VertexId(base_vertex.size());
-        base_vertex.push_back(v);
-        out.positions.push_back(base.positions[v]);
-    }
+    out.positions.reserve(base_vertex.size());
+    for (VertexId v : base_vertex) out.positions.push_back(base.positions[v]);
+    out.triangles.reserve(triangles);
     for (const RootRange& range : roots)
         for (uint32_t t = range.first; t < range.first + range.count; ++t)
-            out.triangles.push_back({index[base.triangles[t][0]], index[base.triangles[t][1]], index[base.triangles[t][2]]});
+            out.triangles.push_back({new_id(base.triangles[t][0]), new_id(base.triangles[t][1]), new_id(base.triangles[t][2])});
     return out;
 }
 
@@ -91,13 +112,20 @@ Hierarchy extract_roots(const Hierarchy& h, const std::vector<RootRange>& roots,
     std::vector<VertexId> base_vertex;
     TriangleMesh base = base_of_roots(h.base(), roots, base_vertex);
     std::vector<NodeId> root_ids;
-    std::vector<uint8_t> root_in(h.root_count(), 0);
+    // Marks over the span of the roots taken, not over all roots: one chunk's extraction is linear in it.
+    uint32_t span_first = UINT32_MAX, span_end = 0;
+    for (const RootRange& range : roots) {
+        if (range.count == 0) continue;
+        span_first = std::min(span_first, range.first);
+        span_end = std::max(span_end, range.first + range.count);
+    }
+    std::vector<uint8_t> root_in(span_end > span_first ? span_end - span_first : 0, 0);
     for (const RootRange& range : roots)
         for (uint32_t r = range.first; r < range.first + range.count; ++r) {
             root_ids.push_back(r);
-            root_in[r] = 1;
+            root_in[r - span_first] = 1;
         }
-    return HierarchyBuilder::subforest(h, std::move(base), root_ids, base_vertex, root_of, root_in, local, vertex_of, room);
+    return HierarchyBuilder::subforest(h, std::move(base), root_ids, base_vertex, root_of, root_in, span_first, local, vertex_of, room);
 }
 
 }  // namespace amc
