@@ -58,6 +58,7 @@ void report(const std::string& path, const std::vector<int>& bits, double tolera
                 continue;
             const amc::TriangleMesh mesh = amc::extract_leaf_mesh(partial.hierarchy).mesh;
             const amc::SurfaceDistance d = amc::surface_distance(full, mesh, tolerance);
+            if (!d.complete()) std::fprintf(stderr, "rate_distortion: the distance was not measured (its queries cost too much)\n");
             std::printf("| %s | %s | %d | %zu | %.1f%% | %.3f | %zu | %.3f (%.3f) | %.4f |\n", name.c_str(),
                         precision.c_str(), partial.level, cut, 100.0 * double(cut) / double(file.size()),
                         8.0 * double(cut) / double(full.triangles.size()), mesh.triangles.size(), 1e3 * d.max,

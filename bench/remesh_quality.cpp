@@ -32,6 +32,7 @@ void print_measures(const amc::TriangleMesh& reference, const amc::MeshShape& in
                     double tolerance) {
     const amc::MeshShape shape = amc::measure_shape(mesh);
     const amc::SurfaceDistance d = amc::surface_distance(reference, mesh, tolerance);
+    if (!d.complete()) std::fprintf(stderr, "remesh_quality: the distance was not measured (its queries cost too much)\n");
     std::printf("%zu\t%d\t%u\t%u\t%u\t%u\t%.3g\t%.3f\t%.3e\t%.3e\t%.3e\t%u\t%.3g", mesh.triangles.size(),
                 int(mesh.single_precision), input.fold_overs, shape.fold_overs, shape.degenerate_triangles,
                 shape.coincident_vertices, shape.min_quality, shape.mean_quality, d.max, d.max_upper, d.rms,

@@ -29,6 +29,7 @@ set(cases
   "2|--steps|refine --model front --steps 0"
   "2|--quantize|encode x.amh -o ${OUT}/x.amc --quantize 31"
   "2|--runs|report x.amh --runs 0"
+  "1|chunk 1073741823 is not in the file (it has 1 chunk)|decode ${GOLDEN} -o ${OUT}/chunks.amh --chunks 0-1073741823"
 )
 set(failures "")
 foreach(case IN LISTS cases)

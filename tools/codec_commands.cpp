@@ -45,8 +45,9 @@ GeometryPredictor parse_predictor(const std::string& name) {
                      "' (auto, midpoint, butterfly, normal, grid, unit, midpoint-static, butterfly-static)");
 }
 
-// "0,3-5" -> 0, 3, 4, 5 (increasing, each once).
-std::vector<uint32_t> parse_chunk_list(const std::string& text) {
+// "0,3-5" -> 0, 3, 4, 5 (increasing, each once), of a file of `chunk_count` chunks (a range is
+// checked against it before it is expanded: "0-1073741823" would list a billion chunks).
+std::vector<uint32_t> parse_chunk_list(const std::string& text, uint32_t chunk_count) {
     std::vector<uint32_t> out;
     size_t pos = 0;
     while (pos <= text.size()) {
@@ -63,6 +64,9 @@ std::vector<uint32_t> parse_chunk_list(const std::string& text) {
                 if (used != item.size() - dash - 1) throw std::invalid_argument(item);
             }
             if (last < first || last >= (1ul << 30)) throw std::invalid_argument(item);
+            if (last >= chunk_count)
+                throw Error("chunk " + std::to_string(last) + " is not in the file (it has " + std::to_string(chunk_count) +
+                            (chunk_count == 1 ? " chunk)" : " chunks)"));
             for (unsigned long c = first; c <= last; ++c) out.push_back(uint32_t(c));
         } catch (const std::logic_error&) {
             throw UsageError("--chunks: '" + item + "' is not a chunk number or range (e.g. 0,3-5)");
@@ -233,9 +237,11 @@ void run_decode(const DecodeCommand& command, const GlobalOptions& global) {
     if (some_chunks) {
         const auto* data = reinterpret_cast<const uint8_t*>(input.bytes.data());
         try {
-            const std::vector<uint32_t> chunks = !command.chunks.empty()
-                                                     ? parse_chunk_list(command.chunks)
-                                                     : chunks_covering(inspect(data, input.bytes.size()), command.triangles);
+            const FileInfo info = inspect(data, input.bytes.size());
+            const std::vector<uint32_t> chunks =
+                !command.chunks.empty()
+                    ? parse_chunk_list(command.chunks, info.chunks.empty() ? 1 : uint32_t(info.chunks.size()))
+                    : chunks_covering(info, command.triangles);
             h = decode_chunks(data, input.bytes.size(), chunks, options).hierarchy;
         } catch (const Error& e) {
             throw e.prefixed(input.name);

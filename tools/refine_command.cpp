@@ -43,11 +43,15 @@ void print_remesh_report(std::FILE* out, const SurfaceRemeshStats& s, uint32_t a
                  s.base_triangles, s.base_attempts, s.base_fold_overs, s.base_distance, s.faces, asked,
                  s.corrected_vertices);
     if (!measured) return;
-    std::fprintf(out,
-                 "remesh: fold-overs %u (input %u), coincident vertices %u, worst triangle quality %.3g; distance to "
-                 "the input: max %.3e (certified <= %.3e), RMS %.3e of the bounding-box diagonal\n",
-                 s.fold_overs, s.reference_fold_overs, s.coincident_vertices, s.min_quality, s.max_distance,
-                 s.max_distance_bound, s.rms_distance);
+    std::fprintf(out, "remesh: fold-overs %u (input %u), coincident vertices %u, worst triangle quality %.3g; ",
+                 s.fold_overs, s.reference_fold_overs, s.coincident_vertices, s.min_quality);
+    if (!s.distance_measured) {
+        std::fprintf(out, "distance to the input not measured (its closest-point queries cost too much: long thin "
+                          "triangles around a vertex?)\n");
+        return;
+    }
+    std::fprintf(out, "distance to the input: max %.3e (certified <= %.3e), RMS %.3e of the bounding-box diagonal\n",
+                 s.max_distance, s.max_distance_bound, s.rms_distance);
 }
 
 }  // namespace

@@ -71,6 +71,9 @@ struct SurfaceRemeshStats {
     uint32_t coincident_vertices = 0;
     double min_quality = 0;
     double max_distance = 0, max_distance_bound = 0, rms_distance = 0;
+    // False when the distance was not measured: the reference's closest-point queries tested too
+    // many triangles each (long thin triangles around one vertex); the three above are then 0.
+    bool distance_measured = true;
     double simplify_seconds = 0, refine_seconds = 0, correct_seconds = 0, measure_seconds = 0;
 };
 

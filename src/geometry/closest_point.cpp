@@ -329,8 +329,8 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
 }
 
 template <class Accept>
-std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p, double bound_squared,
-                                                                const Accept& accept) const {
+std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p, double bound_squared, const Accept& accept,
+                                                                uint64_t* tested) const {
     double best = bound_squared;
     double prune = best * (1 + kPruneSlack);
     uint32_t best_record = kEmpty;
@@ -348,6 +348,7 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p, double b
     while (size > 0) {
         const Entry entry = stack[--size];
         if (entry.distance_squared > prune) continue;
+        if (tested) *tested += entry.count > 0 ? entry.count : 1;
         if (entry.count > 0) {
             for (uint32_t r = entry.index; r < entry.index + entry.count; ++r) {
                 if (!accept(r)) continue;
@@ -387,7 +388,12 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p, double b
 }
 
 ClosestPointQuery::Hit ClosestPointQuery::closest(Vec3 p) const {
-    std::optional<Hit> hit = search(p, std::numeric_limits<double>::infinity(), [](uint32_t) { return true; });
+    uint64_t tested = 0;
+    return closest(p, tested);
+}
+
+ClosestPointQuery::Hit ClosestPointQuery::closest(Vec3 p, uint64_t& tested) const {
+    std::optional<Hit> hit = search(p, std::numeric_limits<double>::infinity(), [](uint32_t) { return true; }, &tested);
     if (!hit) {
         // Only non-finite input (a NaN coordinate) compares false against every distance.
         throw Error("closest point query: the query point is not finite");

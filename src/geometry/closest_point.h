@@ -42,6 +42,9 @@ public:
     explicit ClosestPointQuery(const TriangleMesh& reference);
 
     Hit closest(Vec3 p) const;
+    // As closest(p), adding the boxes and triangles it tested to `tested`: a caller's budget, where
+    // a reference of long thin triangles around one vertex has boxes that all overlap there.
+    Hit closest(Vec3 p, uint64_t& tested) const;
 
     // As closest(p), but only among points within `max_distance` of p (inclusive); nullopt if
     // there are none. Faster than closest(p) when the bound prunes most of the tree.
@@ -80,7 +83,7 @@ private:
     };
 
     template <class Accept>
-    std::optional<Hit> search(Vec3 p, double bound_squared, const Accept& accept) const;
+    std::optional<Hit> search(Vec3 p, double bound_squared, const Accept& accept, uint64_t* tested = nullptr) const;
 
     std::vector<Node> nodes_;           // nodes_[0] is the root
     std::vector<Record> records_;

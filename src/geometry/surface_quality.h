@@ -50,6 +50,10 @@ struct OneSidedDistance {
     double rms = 0;        // sqrt(integral of d^2 / area)
     double area = 0;       // area of A
     uint64_t evaluations = 0;
+    uint64_t tested = 0;    // boxes and triangles of B the closest-point queries tested
+    // False when the queries tested more than the evaluations warrant (a reference of long thin
+    // triangles around one vertex, whose boxes all overlap there): nothing is measured.
+    bool complete = true;
 };
 OneSidedDistance one_sided_distance(const TriangleMesh& from, const TriangleMesh& to, double tolerance);
 
@@ -61,6 +65,7 @@ struct SurfaceDistance {
     double rms = 0;        // sqrt of (integral of d^2 over both surfaces) / (both areas)
     double diagonal = 0;   // bounding-box diagonal of the reference, the unit of the three above
     OneSidedDistance to_reference, from_reference;  // absolute units
+    bool complete() const { return to_reference.complete && from_reference.complete; }
 };
 // `tolerance` is relative to the diagonal.
 SurfaceDistance surface_distance(const TriangleMesh& reference, const TriangleMesh& approximation,

@@ -376,9 +376,12 @@ Hierarchy remesh_adaptively(const TriangleMesh& reference, const SurfaceRemeshOp
         s.coincident_vertices = shape.coincident_vertices;
         s.min_quality = shape.min_quality;
         const SurfaceDistance d = surface_distance(reference, leaf);
-        s.max_distance = d.max;
-        s.max_distance_bound = d.max_upper;
-        s.rms_distance = d.rms;
+        s.distance_measured = d.complete();
+        if (s.distance_measured) {
+            s.max_distance = d.max;
+            s.max_distance_bound = d.max_upper;
+            s.rms_distance = d.rms;
+        }
         s.measure_seconds = seconds_since(start);
     }
     return h;
