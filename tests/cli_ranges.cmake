@@ -41,6 +41,8 @@ set(cases
   "2|make more than the 67108864 nodes of --max-nodes|refine --model uniform --levels 30 -o ${OUT}/u.amh"
   "2|make more than the 1000 nodes of --max-nodes|refine --model uniform --levels 3 --max-nodes 1000 -o ${OUT}/u.amh"
   "2|--faces 1073741824 --max-level 30: more leaves than the 67108864 nodes of --max-nodes|refine --model random --faces 1073741824 --max-level 30 -o ${OUT}/r.amh"
+  "2|: the front makes more than 10000 nodes in its first 1 steps (--max-nodes)|refine --model front --max-level 30 --max-nodes 10000 -o ${OUT}/front.amh"
+  "2|--steps 100000: the front makes more than 100000 nodes|refine --model front --max-level 3 --steps 100000 --max-nodes 100000 -o ${OUT}/front.amh"
   "2|--error-bound: NaN is not a number here|series encode ${GOLDEN} -o ${OUT}/s.amcs --error-bound nan"
   "2|--vertex-step: NaN is not a number here|octree encode ${OUT}/none.amq -o ${OUT}/v.amq --vertex-step nan"
 )

@@ -120,7 +120,14 @@ void run_refine(const RefineCommand& c, const GlobalOptions& global) {
     } else if (c.model == "lshape") {
         results.emplace_back("lshape", make_l_shape_model(c.max_level));
     } else if (c.model == "front") {
-        std::vector<Hierarchy> sequence = make_moving_front_sequence(c.steps, c.max_level);
+        std::vector<Hierarchy> sequence;
+        try {
+            sequence = make_moving_front_sequence(c.steps, c.max_level, c.max_nodes);
+        } catch (const Error& e) {
+            if (e.code() != ErrorCode::limit_exceeded) throw;
+            throw UsageError("--max-level " + std::to_string(c.max_level) + " --steps " + std::to_string(c.steps) +
+                             ": the front makes " + e.what() + " (--max-nodes)");
+        }
         for (size_t i = 0; i < sequence.size(); ++i) results.emplace_back("front_" + std::to_string(i), std::move(sequence[i]));
     } else {
         Hierarchy h(c.input.empty() ? make_icosahedron() : mesh_of(read_input(c.input)));

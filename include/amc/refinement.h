@@ -29,8 +29,10 @@ void refine_uniformly(Hierarchy& h, int levels);
 void refine_randomly(Hierarchy& h, uint32_t target_leaves, int max_level, uint64_t seed,
                      double coarsen_ratio = 0.0);
 // Refines every leaf whose size exceeds the local target size given by `size_at(centroid)`,
-// until none does or max_level is reached (the classic a-priori adaptive FE loop).
-void refine_to_size(Hierarchy& h, const std::function<double(Vec3)>& size_at, int max_level);
+// until none does or max_level is reached (the classic a-priori adaptive FE loop). Throws
+// Error(limit_exceeded) once the hierarchy holds more than `max_nodes` nodes.
+void refine_to_size(Hierarchy& h, const std::function<double(Vec3)>& size_at, int max_level,
+                    uint64_t max_nodes = ~uint64_t{0});
 
 // ---- surface remeshing -----------------------------------------------------------------------
 enum class RefinementCriterion { mean_curvature, gauss_curvature, approximation_error };
@@ -100,8 +102,10 @@ Hierarchy remesh_adaptively(const TriangleMesh& reference, const SurfaceRemeshOp
 // about as 1 / size_scale^2.
 Hierarchy make_l_shape_model(int max_level, double size_scale = 0.025);
 // A front (a circular arc) sweeping across the unit square: one hierarchy per time step, each
-// obtained from the previous one by coarsening behind the front and refining ahead of it.
-std::vector<Hierarchy> make_moving_front_sequence(int steps, int max_level);
+// obtained from the previous one by coarsening behind the front and refining ahead of it. Throws
+// Error(limit_exceeded) once the steps' hierarchies, all kept, hold more than `max_nodes` nodes
+// together (the front is refined to max_level along its length: 2^max_level nodes and more).
+std::vector<Hierarchy> make_moving_front_sequence(int steps, int max_level, uint64_t max_nodes = ~uint64_t{0});
 
 // ---- statistics ------------------------------------------------------------------------------
 struct HierarchyStats {

@@ -2,11 +2,13 @@
 // remesher is in surface_remeshing.cpp.
 #include <amc/refinement.h>
 
+#include "common/check.h"
 #include "common/mixing.h"
 #include "hierarchy/node_shape.h"
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace amc {
 
@@ -51,7 +53,7 @@ void refine_randomly(Hierarchy& h, uint32_t target_leaves, int max_level, uint64
     }
 }
 
-void refine_to_size(Hierarchy& h, const std::function<double(Vec3)>& size_at, int max_level) {
+void refine_to_size(Hierarchy& h, const std::function<double(Vec3)>& size_at, int max_level, uint64_t max_nodes) {
     std::vector<NodeId> todo = h.leaves();
     std::vector<NodeId> split;
     while (!todo.empty()) {
@@ -61,6 +63,7 @@ void refine_to_size(Hierarchy& h, const std::function<double(Vec3)>& size_at, in
         if (node_diameter(h, n) <= size_at(node_centroid(h, n))) continue;
         split.clear();
         h.refine(n, &split);
+        AMC_REQUIRE(h.node_count() <= max_nodes, limit_exceeded, "more than " + std::to_string(max_nodes) + " nodes");
         push_children(h, split, todo);
     }
 }
@@ -110,8 +113,9 @@ Hierarchy make_l_shape_model(int max_level, double size_scale) {
     return h;
 }
 
-std::vector<Hierarchy> make_moving_front_sequence(int steps, int max_level) {
+std::vector<Hierarchy> make_moving_front_sequence(int steps, int max_level, uint64_t max_nodes) {
     std::vector<Hierarchy> sequence;
+    uint64_t kept = 0;  // nodes of the steps in `sequence`
     Hierarchy h(make_square(8));
     for (int step = 0; step < steps; ++step) {
         // A circular front around (-0.3, -0.2) sweeping outwards across the square.
@@ -121,7 +125,16 @@ std::vector<Hierarchy> make_moving_front_sequence(int steps, int max_level) {
             return 1.2 * std::fabs(std::sqrt(dx * dx + dy * dy) - radius);
         };
         coarsen_to_size(h, size_at);
-        refine_to_size(h, size_at, max_level);
+        bool fits = true;  // within the nodes the steps before left
+        try {
+            refine_to_size(h, size_at, max_level, max_nodes - kept);
+        } catch (const Error& e) {
+            if (e.code() != ErrorCode::limit_exceeded) throw;
+            fits = false;
+        }
+        kept += h.node_count();
+        AMC_REQUIRE(fits && kept <= max_nodes, limit_exceeded,
+                    "more than " + std::to_string(max_nodes) + " nodes in its first " + std::to_string(step + 1) + " steps");
         sequence.push_back(h);
     }
     return sequence;
