@@ -43,6 +43,8 @@ set(cases
   "2|--faces 1073741824 --max-level 30: more leaves than the 67108864 nodes of --max-nodes|refine --model random --faces 1073741824 --max-level 30 -o ${OUT}/r.amh"
   "2|: the front makes more than 10000 nodes in its first 1 steps (--max-nodes)|refine --model front --max-level 30 --max-nodes 10000 -o ${OUT}/front.amh"
   "2|--steps 100000: the front makes more than 100000 nodes|refine --model front --max-level 3 --steps 100000 --max-nodes 100000 -o ${OUT}/front.amh"
+  "2|--faces 1073741824 --max-level 30: remesh: at least 357913941 leaves, more than 67108864 nodes (--max-nodes)|refine --model bumpy --faces 1073741824 --max-level 30 --no-measure -o ${OUT}/bumpy.amh"
+  "2|--faces 250000 --max-level 30: remesh: more than 100000 nodes (--max-nodes)|refine --model bumpy --faces 250000 --max-level 30 --no-measure --max-nodes 100000 -o ${OUT}/bumpy.amh"
   "2|--error-bound: NaN is not a number here|series encode ${GOLDEN} -o ${OUT}/s.amcs --error-bound nan"
   "2|--vertex-step: NaN is not a number here|octree encode ${OUT}/none.amq -o ${OUT}/v.amq --vertex-step nan"
 )

@@ -184,8 +184,8 @@ int main(int argc, char** argv) {
     refine_cmd->add_option("--steps", refine.steps, "Time steps of the moving front")->capture_default_str()->check(CLI::Range(1, 100000));
     refine_cmd->add_option("--seed", refine.seed, "Seed of random refinement")->capture_default_str();
     refine_cmd->add_option("--max-nodes", refine.max_nodes,
-                           "Models uniform, random and front: refuse to make more nodes (uniform and random: counted before "
-                           "they are made; front: all its steps together) (default 2^26, what decoders read by default)")
+                           "Refuse to make more nodes (uniform and random: counted before they are made; front: all its "
+                           "steps together; lshape is bounded by its grading) (default 2^26, what decoders read by default)")
         ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 32));
     refine_cmd->add_option("-o,--output", refine.output,
                            "Hierarchy (.amh) or leaf mesh (.obj .off .ply .vtu); --model front: one file per step, "

@@ -82,7 +82,7 @@ struct RefineCommand {
     uint32_t faces = 150000, base_faces = 500;
     int max_level = 7, levels = 3, steps = 5;
     uint64_t seed = 1;
-    uint64_t max_nodes = DecodeOptions{}.max_nodes;  // uniform, random (counted before), front (its steps together): refused beyond
+    uint64_t max_nodes = DecodeOptions{}.max_nodes;  // refused beyond (uniform and random counted before; front: its steps together)
 };
 void run_refine(const RefineCommand& command, const GlobalOptions& global);
 

@@ -115,7 +115,14 @@ void run_refine(const RefineCommand& c, const GlobalOptions& global) {
                              : c.precision == "float64" ? SurfacePrecision::float64
                                                         : SurfacePrecision::as_reference;
         options.measure = !c.no_measure && global.verbosity > 0;
-        results.emplace_back(name + "_" + c.criterion, remesh_adaptively(reference, options, &remesh_stats));
+        options.max_nodes = c.max_nodes;
+        try {
+            results.emplace_back(name + "_" + c.criterion, remesh_adaptively(reference, options, &remesh_stats));
+        } catch (const Error& e) {
+            if (e.code() != ErrorCode::limit_exceeded) throw;
+            throw UsageError("--faces " + std::to_string(c.faces) + " --max-level " + std::to_string(c.max_level) + ": " +
+                             e.what() + " (--max-nodes)");
+        }
         remeshed = true;
     } else if (c.model == "lshape") {
         results.emplace_back("lshape", make_l_shape_model(c.max_level));

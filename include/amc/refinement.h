@@ -50,6 +50,9 @@ struct SurfaceRemeshOptions {
     double min_quality = 0.1;
     SurfacePrecision precision = SurfacePrecision::as_reference;
     bool measure = false;             // fill the measures of SurfaceRemeshStats (about 2 s per 10^5 faces)
+    // Error(limit_exceeded) once the hierarchy holds more nodes (target_faces up to 2^30 and
+    // max_level up to 30 would fill any memory).
+    uint64_t max_nodes = ~uint64_t{0};
 };
 
 struct SurfaceRemeshStats {

@@ -4,6 +4,7 @@
 // and coincident vertices, and the measures of the result (docs/REMESHER.md).
 #include <amc/refinement.h>
 
+#include "common/check.h"
 #include "geometry/curvature.h"
 #include "geometry/reference_surface.h"
 #include "geometry/shape_improvement.h"
@@ -307,6 +308,14 @@ Hierarchy remesh_adaptively(const TriangleMesh& reference, const SurfaceRemeshOp
     if (!have_base) throw Error(problem);
     Hierarchy h(std::move(base));
     s.base_triangles = h.root_count();
+    // Refused before refining where the target can only be met past max_nodes: a leaf shows at
+    // most 3 triangles, and short of the target every leaf reaches max_level (counted up to 2^32).
+    uint64_t leaves_at_max_level = h.root_count();
+    for (int l = 0; l < options.max_level && leaves_at_max_level <= (uint64_t{1} << 32); ++l) leaves_at_max_level *= 4;
+    const uint64_t fewest_leaves = std::min<uint64_t>(options.target_faces / 3, leaves_at_max_level);
+    AMC_REQUIRE(fewest_leaves <= options.max_nodes, limit_exceeded,
+                "remesh: at least " + std::to_string(fewest_leaves) + " leaves, more than " +
+                    std::to_string(options.max_nodes) + " nodes");
     s.simplify_seconds = seconds_since(start);
 
     start = std::chrono::steady_clock::now();
@@ -338,6 +347,8 @@ Hierarchy remesh_adaptively(const TriangleMesh& reference, const SurfaceRemeshOp
             if (!h.is_leaf(n) || h.level(n) >= options.max_level) continue;
             split.clear();
             h.refine(n, &split);
+            AMC_REQUIRE(h.node_count() <= options.max_nodes, limit_exceeded,
+                        "remesh: more than " + std::to_string(options.max_nodes) + " nodes");
             placement.place(split);
             faces.add(h, split);
             any = true;
@@ -353,6 +364,8 @@ Hierarchy remesh_adaptively(const TriangleMesh& reference, const SurfaceRemeshOp
         if (!h.is_leaf(n) || h.level(n) >= options.max_level) continue;
         split.clear();
         h.refine(n, &split);
+        AMC_REQUIRE(h.node_count() <= options.max_nodes, limit_exceeded,
+                    "remesh: more than " + std::to_string(options.max_nodes) + " nodes");
         placement.place(split);
         faces.add(h, split);
         for (NodeId sn : split) {
