@@ -1,6 +1,7 @@
 // `amc refine`: adaptive red-green hierarchies from the refinement drivers.
 #include "cli_files.h"
 #include "commands.h"
+#include "hierarchy/refinement_counts.h"
 #include "progress.h"
 
 #include <amc/mesh_io.h>
@@ -53,19 +54,6 @@ void print_remesh_report(std::FILE* out, const SurfaceRemeshStats& s, uint32_t a
     }
     std::fprintf(out, "distance to the input: max %.3e (certified <= %.3e), RMS %.3e of the bounding-box diagonal\n",
                  s.max_distance, s.max_distance_bound, s.rms_distance);
-}
-
-// Leaves and nodes of `roots` triangles refined uniformly `levels` times, counted until they pass
-// `cap` (they grow by 4 a level: 30 levels of the icosahedron would make 7.7 * 10^19 nodes).
-uint64_t uniform_leaves(uint64_t roots, int levels, uint64_t cap) {
-    uint64_t leaves = roots;
-    for (int l = 0; l < levels && leaves <= cap; ++l) leaves *= 4;
-    return leaves;
-}
-uint64_t uniform_nodes(uint64_t roots, int levels, uint64_t cap) {
-    uint64_t nodes = roots;
-    for (int l = 1; l <= levels && nodes <= cap; ++l) nodes += uniform_leaves(roots, l, cap);
-    return nodes;
 }
 
 }  // namespace
@@ -139,14 +127,14 @@ void run_refine(const RefineCommand& c, const GlobalOptions& global) {
     } else {
         Hierarchy h(c.input.empty() ? make_icosahedron() : mesh_of(read_input(c.input)));
         if (c.model == "uniform") {
-            if (uniform_nodes(h.root_count(), c.levels, c.max_nodes) > c.max_nodes)
+            if (uniform_node_count(h.root_count(), c.levels, c.max_nodes) > c.max_nodes)
                 throw UsageError("--levels " + std::to_string(c.levels) + ": " + std::to_string(h.root_count()) +
                                  " base triangles refined so often make more than the " + std::to_string(c.max_nodes) +
                                  " nodes of --max-nodes");
             refine_uniformly(h, c.levels);
         } else {
             // It stops at --faces leaves, or where every leaf is at --max-level.
-            if (std::min<uint64_t>(c.faces, uniform_leaves(h.root_count(), c.max_level, c.max_nodes)) > c.max_nodes)
+            if (std::min<uint64_t>(c.faces, uniform_leaf_count(h.root_count(), c.max_level, c.max_nodes)) > c.max_nodes)
                 throw UsageError("--faces " + std::to_string(c.faces) + " --max-level " + std::to_string(c.max_level) +
                                  ": more leaves than the " + std::to_string(c.max_nodes) + " nodes of --max-nodes");
             refine_randomly(h, c.faces, c.max_level, c.seed);

@@ -10,6 +10,7 @@
 #include "geometry/shape_improvement.h"
 #include "geometry/surface_quality.h"
 #include "hierarchy/node_shape.h"
+#include "hierarchy/refinement_counts.h"
 #include "hierarchy/vertex_placement.h"
 
 #include <meshoptimizer.h>
@@ -310,8 +311,7 @@ Hierarchy remesh_adaptively(const TriangleMesh& reference, const SurfaceRemeshOp
     s.base_triangles = h.root_count();
     // Refused before refining where the target can only be met past max_nodes: a leaf shows at
     // most 3 triangles, and short of the target every leaf reaches max_level (counted up to 2^32).
-    uint64_t leaves_at_max_level = h.root_count();
-    for (int l = 0; l < options.max_level && leaves_at_max_level <= (uint64_t{1} << 32); ++l) leaves_at_max_level *= 4;
+    const uint64_t leaves_at_max_level = uniform_leaf_count(h.root_count(), options.max_level, uint64_t{1} << 32);
     const uint64_t fewest_leaves = std::min<uint64_t>(options.target_faces / 3, leaves_at_max_level);
     AMC_REQUIRE(fewest_leaves <= options.max_nodes, limit_exceeded,
                 "remesh: at least " + std::to_string(fewest_leaves) + " leaves, more than " +
