@@ -12,6 +12,7 @@
 #include "coding/geometry/float_coder.h"
 #include "coding/hierarchy/hierarchy_stream.h"
 #include "common/bits.h"
+#include "common/mixing.h"
 #include "geometry/surface_quality.h"
 #include "import/leaf_detour.h"
 #include "mesh/vtu_reader.h"
@@ -35,6 +36,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -634,6 +636,66 @@ TEST(CraftedFiles, ImportOfAHighValenceLeafMeshIsLinear) {
     std::printf("  import of %zu faces over their base: %.1f ms\n", leaf.mesh.triangles.size(), with_base_milliseconds);
     EXPECT_EQ(with_base.hierarchy.node_count(), refined.node_count());
     EXPECT_LT(with_base_milliseconds, 3000.0 * kSanitizerSlowdown);
+}
+
+// A height field of side x side vertices (spacing 100, heights in [1, 2)) whose positions all have
+// the same 64-bit hash_words, the unkeyed hash the importer's position tables used until
+// 2026-12-07: the height is solved from the hash's last step (it inverts), the x nudged in its
+// last bits until that height lies in [1, 2).
+TriangleMesh grid_of_one_position_hash(uint32_t side) {
+    auto bits = [](double d) { uint64_t u; std::memcpy(&u, &d, 8); return u; };
+    auto real = [](uint64_t u) { double d; std::memcpy(&d, &u, 8); return d; };
+    uint64_t inverse_c2 = 0x94d049bb133111ebull;  // Newton's iteration for the inverse mod 2^64
+    for (int i = 0; i < 5; ++i) inverse_c2 *= 2 - 0x94d049bb133111ebull * inverse_c2;
+    const uint64_t target = 0x0123456789abcdefull, before_multiply = (target ^ (target >> 32)) * inverse_c2;
+    TriangleMesh mesh;
+    for (uint32_t j = 0; j < side; ++j) {
+        for (uint32_t i = 0; i < side; ++i) {
+            const double y = 100.0 * j;
+            for (uint64_t nudge = 0;; ++nudge) {
+                const double x = real(bits(100.0 * i) ^ nudge);
+                uint64_t h = bits(x) * kGoldenGamma;
+                h = (h ^ (h >> 29) ^ bits(y)) * 0xbf58476d1ce4e5b9ull;
+                const double z = real(before_multiply ^ h ^ (h >> 31));
+                if (z >= 1.0 && z < 2.0) {
+                    mesh.positions.push_back({x, y, z});
+                    break;
+                }
+            }
+        }
+    }
+    for (uint32_t j = 0; j + 1 < side; ++j) {
+        for (uint32_t i = 0; i + 1 < side; ++i) {
+            const uint32_t a = j * side + i, b = a + 1, c = a + side, d = c + 1;
+            mesh.triangles.push_back({a, b, d});
+            mesh.triangles.push_back({a, d, c});
+        }
+    }
+    return mesh;
+}
+
+// That height field of 40,000 vertices refined once, imported over it: the base's positions and
+// the leaf positions' index hashed every vertex into one slot (2.7 s of CPU here until 2026-12-07,
+// docs/FUZZING.md; 47 ms since their hash is keyed per process).
+TEST(CraftedFiles, ImportOfPositionsOfOneHashIsLinear) {
+    const TriangleMesh base = grid_of_one_position_hash(200);
+    for (size_t v = 1; v < base.positions.size(); v += 997) {
+        const Vec3 p = base.positions[v], q = base.positions[0];
+        uint64_t a[3], b[3];
+        std::memcpy(a, &p, sizeof a);
+        std::memcpy(b, &q, sizeof b);
+        ASSERT_EQ(hash_words(a[0], a[1], a[2]), hash_words(b[0], b[1], b[2]));  // the crafting holds
+    }
+    Hierarchy refined(base);
+    refine_uniformly(refined, 1);
+    const LeafMesh leaf = extract_leaf_mesh(refined);
+    const double start = cpu_milliseconds();
+    const ImportedHierarchy imported = import_leaf_mesh(base, leaf.mesh);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  import of %zu faces over a base of one position hash: %.1f ms\n", leaf.mesh.triangles.size(),
+                milliseconds);
+    EXPECT_EQ(imported.hierarchy.node_count(), refined.node_count());
+    EXPECT_LT(milliseconds, 1000.0 * kSanitizerSlowdown);
 }
 
 // A half disc of 2^15 roots around one boundary vertex, in clockwise order, refined once with its
