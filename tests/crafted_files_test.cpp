@@ -1169,6 +1169,52 @@ TEST(CraftedFiles, OctreeManyLeafFieldsDecodeInLinearTime) {
     EXPECT_LT(milliseconds, 5000.0);  // 1.1 s under ASan (CI)
 }
 
+// A valid .amq of one leaf and 2^15 leaf fields whose names (240 bytes) all have one std::hash
+// (libstdc++'s is an unkeyed Murmur hash: a pair of 8-byte words can flip the top bit of both
+// words' mixed values, which the multiply between them keeps and the second cancels; 15 pairs,
+// each either way). The decoder's set of names was an unordered_set: 2.3 s of CPU for this file
+// until 2026-12-07 (docs/FUZZING.md), 30 ms since with an ordered set, as the encoder's check.
+TEST(CraftedFiles, OctreeLeafFieldNamesOfOneHashDecodeInLinearTime) {
+    const uint64_t mul = (uint64_t{0xc6a4a793} << 32) + 0x5bd1e995;  // _Hash_bytes's multiplier
+    uint64_t inverse = mul;  // Newton's iteration for its inverse mod 2^64
+    for (int i = 0; i < 5; ++i) inverse *= 2 - mul * inverse;
+    auto shift_mix = [](uint64_t v) { return v ^ (v >> 47); };  // its own inverse
+    const int pairs = 15;
+    uint64_t words[pairs][2][2];  // pair i, either way, its two words
+    SplitMix64 random{7};
+    for (int i = 0; i < pairs; ++i) {
+        for (int j = 0; j < 2; ++j) {
+            words[i][0][j] = random.next();
+            const uint64_t flipped = (shift_mix(words[i][0][j] * mul) * mul) ^ (uint64_t{1} << 63);
+            words[i][1][j] = shift_mix(flipped * inverse) * inverse;
+        }
+    }
+    OctreeForest forest;
+    forest.connectivity = brick_connectivity(2, 1, 1);
+    forest.tree_offsets = {0, 1};
+    forest.leaves = {Octant{}};
+    for (uint32_t f = 0; f < (uint32_t{1} << pairs); ++f) {
+        Field field;
+        for (int i = 0; i < pairs; ++i)
+            for (int j = 0; j < 2; ++j) field.name.append(reinterpret_cast<const char*>(&words[i][(f >> i) & 1][j]), 8);
+        field.association = FieldAssociation::cell;
+        field.type = FieldType::int8;
+        field.integers = {int64_t(f % 100)};
+        forest.leaf_data.push_back(std::move(field));
+    }
+    const std::hash<std::string> hash;
+    for (size_t f = 1; f < forest.leaf_data.size(); f += 999)
+        ASSERT_EQ(hash(forest.leaf_data[f].name), hash(forest.leaf_data[0].name));  // the crafting holds
+    const std::vector<uint8_t> file = encode_octree_forest(forest);
+    const double start = cpu_milliseconds();
+    const OctreeForest back = decode_octree_forest(file.data(), file.size());
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  %zu leaf fields of one name hash (%zu bytes): %.1f ms\n", forest.leaf_data.size(), file.size(),
+                milliseconds);
+    EXPECT_TRUE(back == forest);
+    EXPECT_LT(milliseconds, 1000.0 * kSanitizerSlowdown);
+}
+
 // `trees` quadtrees around one coarse vertex, corner 0 of each.
 TreeConnectivity quadtree_fan(uint32_t trees) {
     std::vector<Vec3> vertices = {{0, 0, 0}};
