@@ -43,6 +43,7 @@
 #include <functional>
 #include <new>
 #include <string>
+#include <unordered_map>
 
 #include <unistd.h>
 
@@ -1247,6 +1248,64 @@ TEST(CraftedFiles, ConformingMeshAroundAVertexOfManyTreesIsLinear) {
     EXPECT_EQ(mesh.corner_points, 6 * trees + 1);
     EXPECT_EQ(mesh.cell_count(), 8 * size_t(trees));
     EXPECT_LT(milliseconds, 1000.0);
+}
+
+// The Morton code of a quadtree lattice point (31 bits an axis).
+uint64_t morton_2d(uint64_t x, uint64_t y) {
+    uint64_t m = 0;
+    for (int b = 0; b < 31; ++b) m |= ((x >> b) & 1) << (2 * b) | ((y >> b) & 1) << (2 * b + 1);
+    return m;
+}
+
+// One quadtree refined to the finest level at 10,000 points (x, y), x even and consecutive, y the
+// even one of the two smallest with x * 2^31 + y = 0 mod P, P the bucket count libstdc++'s
+// unordered_map has at the forest's corner count: the VTU's corner index (keys x << 31 | y, the
+// identity hash) put all of them in one bucket once it had grown to P buckets: 2.4 s of CPU for
+// the VTU (30,000 such points, `amc octree decode` of their 74 KB .amq: 136 s) until 2026-12-07,
+// docs/FUZZING.md; 0.22 s since the index's hash is keyed per process.
+TEST(CraftedFiles, OctreeVtuOfCornersInOneBucketIsLinear) {
+    std::unordered_map<uint64_t, uint32_t> sized;  // the bucket count at 400,000 keys, as the VTU's index grows
+    for (uint64_t k = 0; k < 400000; ++k) sized.emplace(k, 0);
+    const uint64_t buckets = sized.bucket_count();
+    std::vector<uint64_t> targets;  // Morton codes, sorted
+    for (uint64_t x = uint64_t(1) << 29; targets.size() < 10000; x += 2) {
+        uint64_t y = (buckets - ((x << 31) % buckets)) % buckets;
+        if (y % 2 == 1) y += buckets;
+        targets.push_back(morton_2d(x, y));
+    }
+    std::sort(targets.begin(), targets.end());
+    OctreeForest forest;
+    forest.connectivity = brick_connectivity(2, 1, 1);
+    forest.tree_offsets = {0, 1};
+    forest.leaves = {Octant{}};
+    forest = refine_octree_forest(
+        forest,
+        [&](uint32_t, const Octant& o) {
+            const uint64_t first = morton_2d(uint64_t(o.x), uint64_t(o.y)), end = first + (uint64_t(1) << (2 * (30 - o.level)));
+            const auto it = std::lower_bound(targets.begin(), targets.end(), first);
+            return it != targets.end() && *it < end;
+        },
+        octree_max_level(2));
+    std::vector<uint64_t> corners;  // the index's keys
+    for (const Octant& o : forest.leaves) {
+        const uint64_t length = uint64_t(1) << (30 - o.level);
+        for (uint64_t c = 0; c < 4; ++c)
+            corners.push_back((uint64_t(o.x) + (c & 1) * length) << 31 | (uint64_t(o.y) + (c >> 1) * length));
+    }
+    std::sort(corners.begin(), corners.end());
+    corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+    std::unordered_map<uint64_t, uint32_t> grown;  // the crafting holds: the index ends at that bucket count
+    for (uint64_t k = 0; k < corners.size(); ++k) grown.emplace(k, 0);
+    ASSERT_EQ(grown.bucket_count(), buckets) << corners.size() << " corners";
+    const std::string path = (std::filesystem::temp_directory_path() /
+                              ("amc_crafted_" + std::to_string(getpid()) + "_corners.vtu")).string();
+    const double start = cpu_milliseconds();
+    write_octree_vtu(path, forest);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::filesystem::remove(path);
+    std::printf("  VTU of %zu leaves, %zu corners, 10,000 of them in one residue of %llu: %.1f ms\n", forest.leaves.size(),
+                corners.size(), (unsigned long long)buckets, milliseconds);
+    EXPECT_LT(milliseconds, 1000.0 * kSanitizerSlowdown);
 }
 
 // 8,000 quadtrees around one coarse vertex, uniform at level 2, tree 0 refined twice more at the

@@ -5,6 +5,7 @@
 
 #include "common/mixing.h"
 
+#include <cstddef>
 #include <cstdint>
 
 namespace amc {
@@ -17,5 +18,12 @@ uint64_t process_hash_key();
 inline uint64_t keyed_hash_words(uint64_t key, uint64_t a, uint64_t b, uint64_t c) {
     return splitmix64_mix(splitmix64_mix(splitmix64_mix(a ^ key) ^ b) ^ c);
 }
+
+// For std::unordered_map and std::unordered_set of 64-bit keys an input sets: libstdc++ hashes an
+// integer to itself and its bucket counts are known primes, so keys of one residue share a bucket.
+struct KeyedWordHash {
+    uint64_t key = process_hash_key();
+    size_t operator()(uint64_t word) const { return size_t(splitmix64_mix(word ^ key)); }
+};
 
 }  // namespace amc
