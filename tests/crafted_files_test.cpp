@@ -1308,6 +1308,51 @@ TEST(CraftedFiles, OctreeVtuOfCornersInOneBucketIsLinear) {
     EXPECT_LT(milliseconds, 1000.0 * kSanitizerSlowdown);
 }
 
+// One quadtree refined to the finest level at 30,000 even points (x, y) whose key x << 31 | y
+// has splitmix64_mix(key) below 256 modulo the slots of the conforming mesh's point table
+// (ForestPoints: open addressing over twice the 2 * leaves + 64 places conforming_leaf_mesh
+// reserves, rounded up to a power of two), found by trying points in turn: they all probed one run
+// of slots, quadratic in them (2.7 s of CPU here until 2026-12-07, docs/FUZZING.md; 60,000 such
+// points, `amc octree decode --conforming`: 9.7 s against 2.4 s); keyed per process since.
+TEST(CraftedFiles, ConformingMeshOfPointsInOneRunOfSlotsIsLinear) {
+    const size_t count = kSanitizerSlowdown > 1 ? 6000 : 30000;
+    int slot_bits = kSanitizerSlowdown > 1 ? 20 : 22;
+    OctreeForest forest;
+    for (int attempt = 0; attempt < 3; ++attempt) {  // until the table's size is the one aimed at
+        std::vector<uint64_t> targets;  // Morton codes, sorted
+        const uint64_t mask = (uint64_t(1) << slot_bits) - 1, first = uint64_t(1) << 29, span = uint64_t(1) << 24;
+        for (uint64_t x = first, y = first; targets.size() < count;) {
+            if ((splitmix64_mix(x << 31 | y) & mask) < 256) targets.push_back(morton_2d(x, y));
+            y += 2;
+            if (y == first + span) y = first, x += 2;
+        }
+        std::sort(targets.begin(), targets.end());
+        forest.connectivity = brick_connectivity(2, 1, 1);
+        forest.tree_offsets = {0, 1};
+        forest.leaves = {Octant{}};
+        forest.leaf_data.clear();
+        forest = refine_octree_forest(
+            forest,
+            [&](uint32_t, const Octant& o) {
+                const uint64_t begin = morton_2d(uint64_t(o.x), uint64_t(o.y)), end = begin + (uint64_t(1) << (2 * (30 - o.level)));
+                const auto it = std::lower_bound(targets.begin(), targets.end(), begin);
+                return it != targets.end() && *it < end;
+            },
+            octree_max_level(2));
+        int bits = 6;  // ForestPoints starts at 64 slots
+        while ((uint64_t(1) << bits) < 2 * (2 * forest.leaves.size() + 64)) ++bits;
+        if (bits == slot_bits) break;
+        slot_bits = bits;
+    }
+    const double start = cpu_milliseconds();
+    const ConformingLeafMesh mesh = conforming_leaf_mesh(forest);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  conforming mesh of %zu leaves, %zu points in one run of 2^%d slots: %.1f ms\n", forest.leaves.size(),
+                count, slot_bits, milliseconds);
+    EXPECT_GT(mesh.corner_points, forest.leaves.size());
+    EXPECT_LT(milliseconds, 1600.0 * kSanitizerSlowdown);  // 0.78 s in Release
+}
+
 // 8,000 quadtrees around one coarse vertex, uniform at level 2, tree 0 refined twice more at the
 // vertex: corner balance refines every other tree's octant there once. Each refined octant at the
 // vertex went around it, finding the same octants again: quadratic in the trees (10.3 s of CPU
