@@ -141,6 +141,22 @@ void expect_refused_cheaply(const std::string& what, ErrorCode expected, const s
                 message.c_str());
 }
 
+// A 256 MB file of zeros (sparse) is no hierarchy or series file: its first bytes say so, and the
+// readers by path refused it only after reading it whole (256 MB allocated, until 2026-12-07).
+TEST(CraftedFiles, LargeFilesOfAnotherKindAreRefusedAtTheirFirstBytes) {
+    const std::string path = (std::filesystem::temp_directory_path() /
+                              ("amc_crafted_" + std::to_string(getpid()) + "_zeros.bin")).string();
+    std::ofstream(path, std::ios::binary).close();
+    std::filesystem::resize_file(path, uint64_t(256) << 20);
+    expect_refused_cheaply("read_hierarchy of 256 MB of zeros", ErrorCode::bad_magic, [&] { read_hierarchy(path); },
+                           "not a hierarchy file (bad magic)");
+    expect_refused_cheaply("SeriesReader::open of 256 MB of zeros", ErrorCode::bad_magic,
+                           [&] { SeriesReader::open(path); }, "not an amcodec series file (magic)");
+    expect_refused_cheaply("ForestSeriesReader::open of 256 MB of zeros", ErrorCode::bad_magic,
+                           [&] { ForestSeriesReader::open(path); }, "not an amcodec series file (magic)");
+    std::filesystem::remove(path);
+}
+
 // ---- an .amc file taken apart and put together again, with valid checksums --------------------
 
 struct Parts {

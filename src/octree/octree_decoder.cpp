@@ -30,6 +30,11 @@ Block next_block(BlockReader& reader, OctreeBlock expected) {
 
 }  // namespace
 
+void check_octree_file_start(const uint8_t* data, size_t size) {
+    const BlockReader header(data, size, kOctreeFraming);  // decode_octree_forest's first check
+    (void)header;
+}
+
 OctreeForest decode_octree_forest(const uint8_t* data, size_t size, const OctreeDecodeOptions& options) {
     return with_allocation_errors_as_limits("decode_octree_forest", [&]() {
         BlockReader reader(data, size, kOctreeFraming);
