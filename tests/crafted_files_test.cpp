@@ -12,6 +12,7 @@
 #include "coding/geometry/float_coder.h"
 #include "coding/hierarchy/hierarchy_stream.h"
 #include "common/bits.h"
+#include "common/mixing.h"
 #include "geometry/surface_quality.h"
 #include "import/leaf_detour.h"
 #include "mesh/vtu_reader.h"
@@ -35,12 +36,14 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <new>
 #include <string>
+#include <unordered_map>
 
 #include <unistd.h>
 
@@ -136,6 +139,22 @@ void expect_refused_cheaply(const std::string& what, ErrorCode expected, const s
     EXPECT_LT(milliseconds, kMaxMilliseconds) << what << " (" << message << ")";
     std::printf("  %-48s %8.3f ms %9llu bytes  %s\n", what.c_str(), milliseconds, (unsigned long long)allocated,
                 message.c_str());
+}
+
+// A 256 MB file of zeros (sparse) is no hierarchy or series file: its first bytes say so, and the
+// readers by path refused it only after reading it whole (256 MB allocated, until 2026-12-07).
+TEST(CraftedFiles, LargeFilesOfAnotherKindAreRefusedAtTheirFirstBytes) {
+    const std::string path = (std::filesystem::temp_directory_path() /
+                              ("amc_crafted_" + std::to_string(getpid()) + "_zeros.bin")).string();
+    std::ofstream(path, std::ios::binary).close();
+    std::filesystem::resize_file(path, uint64_t(256) << 20);
+    expect_refused_cheaply("read_hierarchy of 256 MB of zeros", ErrorCode::bad_magic, [&] { read_hierarchy(path); },
+                           "not a hierarchy file (bad magic)");
+    expect_refused_cheaply("SeriesReader::open of 256 MB of zeros", ErrorCode::bad_magic,
+                           [&] { SeriesReader::open(path); }, "not an amcodec series file (magic)");
+    expect_refused_cheaply("ForestSeriesReader::open of 256 MB of zeros", ErrorCode::bad_magic,
+                           [&] { ForestSeriesReader::open(path); }, "not an amcodec series file (magic)");
+    std::filesystem::remove(path);
 }
 
 // ---- an .amc file taken apart and put together again, with valid checksums --------------------
@@ -636,6 +655,66 @@ TEST(CraftedFiles, ImportOfAHighValenceLeafMeshIsLinear) {
     EXPECT_LT(with_base_milliseconds, 3000.0 * kSanitizerSlowdown);
 }
 
+// A height field of side x side vertices (spacing 100, heights in [1, 2)) whose positions all have
+// the same 64-bit hash_words, the unkeyed hash the importer's position tables used until
+// 2026-12-07: the height is solved from the hash's last step (it inverts), the x nudged in its
+// last bits until that height lies in [1, 2).
+TriangleMesh grid_of_one_position_hash(uint32_t side) {
+    auto bits = [](double d) { uint64_t u; std::memcpy(&u, &d, 8); return u; };
+    auto real = [](uint64_t u) { double d; std::memcpy(&d, &u, 8); return d; };
+    uint64_t inverse_c2 = 0x94d049bb133111ebull;  // Newton's iteration for the inverse mod 2^64
+    for (int i = 0; i < 5; ++i) inverse_c2 *= 2 - 0x94d049bb133111ebull * inverse_c2;
+    const uint64_t target = 0x0123456789abcdefull, before_multiply = (target ^ (target >> 32)) * inverse_c2;
+    TriangleMesh mesh;
+    for (uint32_t j = 0; j < side; ++j) {
+        for (uint32_t i = 0; i < side; ++i) {
+            const double y = 100.0 * j;
+            for (uint64_t nudge = 0;; ++nudge) {
+                const double x = real(bits(100.0 * i) ^ nudge);
+                uint64_t h = bits(x) * kGoldenGamma;
+                h = (h ^ (h >> 29) ^ bits(y)) * 0xbf58476d1ce4e5b9ull;
+                const double z = real(before_multiply ^ h ^ (h >> 31));
+                if (z >= 1.0 && z < 2.0) {
+                    mesh.positions.push_back({x, y, z});
+                    break;
+                }
+            }
+        }
+    }
+    for (uint32_t j = 0; j + 1 < side; ++j) {
+        for (uint32_t i = 0; i + 1 < side; ++i) {
+            const uint32_t a = j * side + i, b = a + 1, c = a + side, d = c + 1;
+            mesh.triangles.push_back({a, b, d});
+            mesh.triangles.push_back({a, d, c});
+        }
+    }
+    return mesh;
+}
+
+// That height field of 40,000 vertices refined once, imported over it: the base's positions and
+// the leaf positions' index hashed every vertex into one slot (2.7 s of CPU here until 2026-12-07,
+// docs/FUZZING.md; 47 ms since their hash is keyed per process).
+TEST(CraftedFiles, ImportOfPositionsOfOneHashIsLinear) {
+    const TriangleMesh base = grid_of_one_position_hash(200);
+    for (size_t v = 1; v < base.positions.size(); v += 997) {
+        const Vec3 p = base.positions[v], q = base.positions[0];
+        uint64_t a[3], b[3];
+        std::memcpy(a, &p, sizeof a);
+        std::memcpy(b, &q, sizeof b);
+        ASSERT_EQ(hash_words(a[0], a[1], a[2]), hash_words(b[0], b[1], b[2]));  // the crafting holds
+    }
+    Hierarchy refined(base);
+    refine_uniformly(refined, 1);
+    const LeafMesh leaf = extract_leaf_mesh(refined);
+    const double start = cpu_milliseconds();
+    const ImportedHierarchy imported = import_leaf_mesh(base, leaf.mesh);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  import of %zu faces over a base of one position hash: %.1f ms\n", leaf.mesh.triangles.size(),
+                milliseconds);
+    EXPECT_EQ(imported.hierarchy.node_count(), refined.node_count());
+    EXPECT_LT(milliseconds, 1000.0 * kSanitizerSlowdown);
+}
+
 // A half disc of 2^15 roots around one boundary vertex, in clockwise order, refined once with its
 // new vertices moved off their edges: the uniform way reads it in time linear in it. Each root at
 // that vertex searched its out-edges for the one toward its next corner, since its turn around
@@ -1107,6 +1186,52 @@ TEST(CraftedFiles, OctreeManyLeafFieldsDecodeInLinearTime) {
     EXPECT_LT(milliseconds, 5000.0);  // 1.1 s under ASan (CI)
 }
 
+// A valid .amq of one leaf and 2^15 leaf fields whose names (240 bytes) all have one std::hash
+// (libstdc++'s is an unkeyed Murmur hash: a pair of 8-byte words can flip the top bit of both
+// words' mixed values, which the multiply between them keeps and the second cancels; 15 pairs,
+// each either way). The decoder's set of names was an unordered_set: 2.3 s of CPU for this file
+// until 2026-12-07 (docs/FUZZING.md), 30 ms since with an ordered set, as the encoder's check.
+TEST(CraftedFiles, OctreeLeafFieldNamesOfOneHashDecodeInLinearTime) {
+    const uint64_t mul = (uint64_t{0xc6a4a793} << 32) + 0x5bd1e995;  // _Hash_bytes's multiplier
+    uint64_t inverse = mul;  // Newton's iteration for its inverse mod 2^64
+    for (int i = 0; i < 5; ++i) inverse *= 2 - mul * inverse;
+    auto shift_mix = [](uint64_t v) { return v ^ (v >> 47); };  // its own inverse
+    const int pairs = 15;
+    uint64_t words[pairs][2][2];  // pair i, either way, its two words
+    SplitMix64 random{7};
+    for (int i = 0; i < pairs; ++i) {
+        for (int j = 0; j < 2; ++j) {
+            words[i][0][j] = random.next();
+            const uint64_t flipped = (shift_mix(words[i][0][j] * mul) * mul) ^ (uint64_t{1} << 63);
+            words[i][1][j] = shift_mix(flipped * inverse) * inverse;
+        }
+    }
+    OctreeForest forest;
+    forest.connectivity = brick_connectivity(2, 1, 1);
+    forest.tree_offsets = {0, 1};
+    forest.leaves = {Octant{}};
+    for (uint32_t f = 0; f < (uint32_t{1} << pairs); ++f) {
+        Field field;
+        for (int i = 0; i < pairs; ++i)
+            for (int j = 0; j < 2; ++j) field.name.append(reinterpret_cast<const char*>(&words[i][(f >> i) & 1][j]), 8);
+        field.association = FieldAssociation::cell;
+        field.type = FieldType::int8;
+        field.integers = {int64_t(f % 100)};
+        forest.leaf_data.push_back(std::move(field));
+    }
+    const std::hash<std::string> hash;
+    for (size_t f = 1; f < forest.leaf_data.size(); f += 999)
+        ASSERT_EQ(hash(forest.leaf_data[f].name), hash(forest.leaf_data[0].name));  // the crafting holds
+    const std::vector<uint8_t> file = encode_octree_forest(forest);
+    const double start = cpu_milliseconds();
+    const OctreeForest back = decode_octree_forest(file.data(), file.size());
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  %zu leaf fields of one name hash (%zu bytes): %.1f ms\n", forest.leaf_data.size(), file.size(),
+                milliseconds);
+    EXPECT_TRUE(back == forest);
+    EXPECT_LT(milliseconds, 1000.0 * kSanitizerSlowdown);
+}
+
 // `trees` quadtrees around one coarse vertex, corner 0 of each.
 TreeConnectivity quadtree_fan(uint32_t trees) {
     std::vector<Vec3> vertices = {{0, 0, 0}};
@@ -1139,6 +1264,109 @@ TEST(CraftedFiles, ConformingMeshAroundAVertexOfManyTreesIsLinear) {
     EXPECT_EQ(mesh.corner_points, 6 * trees + 1);
     EXPECT_EQ(mesh.cell_count(), 8 * size_t(trees));
     EXPECT_LT(milliseconds, 1000.0);
+}
+
+// The Morton code of a quadtree lattice point (31 bits an axis).
+uint64_t morton_2d(uint64_t x, uint64_t y) {
+    uint64_t m = 0;
+    for (int b = 0; b < 31; ++b) m |= ((x >> b) & 1) << (2 * b) | ((y >> b) & 1) << (2 * b + 1);
+    return m;
+}
+
+// One quadtree refined to the finest level at 10,000 points (x, y), x even and consecutive, y the
+// even one of the two smallest with x * 2^31 + y = 0 mod P, P the bucket count libstdc++'s
+// unordered_map has at the forest's corner count: the VTU's corner index (keys x << 31 | y, the
+// identity hash) put all of them in one bucket once it had grown to P buckets: 2.4 s of CPU for
+// the VTU (30,000 such points, `amc octree decode` of their 74 KB .amq: 136 s) until 2026-12-07,
+// docs/FUZZING.md; 0.22 s since the index's hash is keyed per process.
+TEST(CraftedFiles, OctreeVtuOfCornersInOneBucketIsLinear) {
+    std::unordered_map<uint64_t, uint32_t> sized;  // the bucket count at 400,000 keys, as the VTU's index grows
+    for (uint64_t k = 0; k < 400000; ++k) sized.emplace(k, 0);
+    const uint64_t buckets = sized.bucket_count();
+    std::vector<uint64_t> targets;  // Morton codes, sorted
+    for (uint64_t x = uint64_t(1) << 29; targets.size() < 10000; x += 2) {
+        uint64_t y = (buckets - ((x << 31) % buckets)) % buckets;
+        if (y % 2 == 1) y += buckets;
+        targets.push_back(morton_2d(x, y));
+    }
+    std::sort(targets.begin(), targets.end());
+    OctreeForest forest;
+    forest.connectivity = brick_connectivity(2, 1, 1);
+    forest.tree_offsets = {0, 1};
+    forest.leaves = {Octant{}};
+    forest = refine_octree_forest(
+        forest,
+        [&](uint32_t, const Octant& o) {
+            const uint64_t first = morton_2d(uint64_t(o.x), uint64_t(o.y)), end = first + (uint64_t(1) << (2 * (30 - o.level)));
+            const auto it = std::lower_bound(targets.begin(), targets.end(), first);
+            return it != targets.end() && *it < end;
+        },
+        octree_max_level(2));
+    std::vector<uint64_t> corners;  // the index's keys
+    for (const Octant& o : forest.leaves) {
+        const uint64_t length = uint64_t(1) << (30 - o.level);
+        for (uint64_t c = 0; c < 4; ++c)
+            corners.push_back((uint64_t(o.x) + (c & 1) * length) << 31 | (uint64_t(o.y) + (c >> 1) * length));
+    }
+    std::sort(corners.begin(), corners.end());
+    corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+    std::unordered_map<uint64_t, uint32_t> grown;  // the crafting holds: the index ends at that bucket count
+    for (uint64_t k = 0; k < corners.size(); ++k) grown.emplace(k, 0);
+    ASSERT_EQ(grown.bucket_count(), buckets) << corners.size() << " corners";
+    const std::string path = (std::filesystem::temp_directory_path() /
+                              ("amc_crafted_" + std::to_string(getpid()) + "_corners.vtu")).string();
+    const double start = cpu_milliseconds();
+    write_octree_vtu(path, forest);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::filesystem::remove(path);
+    std::printf("  VTU of %zu leaves, %zu corners, 10,000 of them in one residue of %llu: %.1f ms\n", forest.leaves.size(),
+                corners.size(), (unsigned long long)buckets, milliseconds);
+    EXPECT_LT(milliseconds, 1000.0 * kSanitizerSlowdown);
+}
+
+// One quadtree refined to the finest level at 30,000 even points (x, y) whose key x << 31 | y
+// has splitmix64_mix(key) below 256 modulo the slots of the conforming mesh's point table
+// (ForestPoints: open addressing over twice the 2 * leaves + 64 places conforming_leaf_mesh
+// reserves, rounded up to a power of two), found by trying points in turn: they all probed one run
+// of slots, quadratic in them (2.7 s of CPU here until 2026-12-07, docs/FUZZING.md; 60,000 such
+// points, `amc octree decode --conforming`: 9.7 s against 2.4 s); keyed per process since.
+TEST(CraftedFiles, ConformingMeshOfPointsInOneRunOfSlotsIsLinear) {
+    const size_t count = kSanitizerSlowdown > 1 ? 6000 : 30000;
+    int slot_bits = kSanitizerSlowdown > 1 ? 20 : 22;
+    OctreeForest forest;
+    for (int attempt = 0; attempt < 3; ++attempt) {  // until the table's size is the one aimed at
+        std::vector<uint64_t> targets;  // Morton codes, sorted
+        const uint64_t mask = (uint64_t(1) << slot_bits) - 1, first = uint64_t(1) << 29, span = uint64_t(1) << 24;
+        for (uint64_t x = first, y = first; targets.size() < count;) {
+            if ((splitmix64_mix(x << 31 | y) & mask) < 256) targets.push_back(morton_2d(x, y));
+            y += 2;
+            if (y == first + span) y = first, x += 2;
+        }
+        std::sort(targets.begin(), targets.end());
+        forest.connectivity = brick_connectivity(2, 1, 1);
+        forest.tree_offsets = {0, 1};
+        forest.leaves = {Octant{}};
+        forest.leaf_data.clear();
+        forest = refine_octree_forest(
+            forest,
+            [&](uint32_t, const Octant& o) {
+                const uint64_t begin = morton_2d(uint64_t(o.x), uint64_t(o.y)), end = begin + (uint64_t(1) << (2 * (30 - o.level)));
+                const auto it = std::lower_bound(targets.begin(), targets.end(), begin);
+                return it != targets.end() && *it < end;
+            },
+            octree_max_level(2));
+        int bits = 6;  // ForestPoints starts at 64 slots
+        while ((uint64_t(1) << bits) < 2 * (2 * forest.leaves.size() + 64)) ++bits;
+        if (bits == slot_bits) break;
+        slot_bits = bits;
+    }
+    const double start = cpu_milliseconds();
+    const ConformingLeafMesh mesh = conforming_leaf_mesh(forest);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  conforming mesh of %zu leaves, %zu points in one run of 2^%d slots: %.1f ms\n", forest.leaves.size(),
+                count, slot_bits, milliseconds);
+    EXPECT_GT(mesh.corner_points, forest.leaves.size());
+    EXPECT_LT(milliseconds, 1600.0 * kSanitizerSlowdown);  // 0.78 s in Release
 }
 
 // 8,000 quadtrees around one coarse vertex, uniform at level 2, tree 0 refined twice more at the

@@ -3,14 +3,15 @@
 
 #include <amc/hierarchy.h>
 #include <amc/mesh_io.h>
+#include <amc/octree.h>
 
 #include "common/file_io.h"
 
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
-#include <iterator>
 
 namespace amc::cli {
 
@@ -36,32 +37,48 @@ const char* file_kind_name(FileKind kind) {
     return "?";
 }
 
-InputFile read_input(const std::string& path) {
-    InputFile in;
-    if (path == "-") {
-        in.name = "stdin";
-        in.bytes.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
-        if (std::cin.bad()) throw Error(ErrorCode::io, "stdin: read error");
-    } else {
-        in.name = path;
-        in.bytes = read_whole_file(path);
-    }
-    if (starts_with(in.bytes, "AMCF")) {
+namespace {
+
+// The kind of an input from its first bytes (and, for OBJ, which has no magic word, its name);
+// throws when no kind fits. mesh_format_from_content reads no further than kFirstBytes.
+void judge_kind(InputFile& in, const std::string& path, const std::string& bytes) {
+    if (starts_with(bytes, "AMCF")) {
         in.kind = FileKind::compressed;
-    } else if (starts_with(in.bytes, "AMCH")) {
+    } else if (starts_with(bytes, "AMCH")) {
         in.kind = FileKind::hierarchy;
-    } else if (starts_with(in.bytes, "AMCS")) {
+    } else if (starts_with(bytes, "AMCS")) {
         in.kind = FileKind::series;
-    } else if (mesh_format_from_content(in.bytes, in.mesh_format)) {
+    } else if (mesh_format_from_content(bytes, in.mesh_format)) {
         in.kind = FileKind::mesh;
     } else if (lower_extension(path) == ".obj") {
         in.kind = FileKind::mesh;  // OBJ has no magic word: trust the name
         in.mesh_format = MeshFormat::obj;
     } else {
-        throw Error(ErrorCode::bad_magic, in.name + ": " + (in.bytes.empty() ? "empty file" : "not a file amc reads") +
+        throw Error(ErrorCode::bad_magic, in.name + ": " + (bytes.empty() ? "empty file" : "not a file amc reads") +
                     " (expected .amc, .amh, .amcs, or a mesh: OBJ, OFF, PLY, VTU)");
     }
+}
+
+}  // namespace
+
+InputFile read_input(const std::string& path) {
+    static_assert(kFirstBytes >= kMeshFormatContentBytes, "the kind is judged on the first bytes alone");
+    InputFile in;
+    in.name = path == "-" ? "stdin" : path;
+    // Judged before the rest is read: `yes | amc info -` is refused at once, not when memory runs out.
+    const FirstBytesCheck judge = [&](const std::string& first) { judge_kind(in, path, first); };
+    in.bytes = path == "-" ? read_whole_stream(std::cin, in.name, judge) : read_whole_file(path, judge);
     return in;
+}
+
+std::string read_octree_input(const std::string& path) {
+    const FirstBytesCheck header = [](const std::string& first) {
+        check_octree_file_start(reinterpret_cast<const uint8_t*>(first.data()), first.size());
+    };
+    if (path == "-") return read_whole_stream(std::cin, "stdin", header);
+    std::ifstream in(path, std::ios::binary);  // not read_whole_file: a pipe or a device is read too
+    if (!in) throw Error(ErrorCode::io, "can not open");
+    return read_whole_stream(in, path, header);
 }
 
 std::string default_output(const std::string& input, const std::string& extension) {

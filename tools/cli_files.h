@@ -32,6 +32,10 @@ struct InputFile {
 // Error naming the file when no kind fits.
 InputFile read_input(const std::string& path);
 
+// The bytes of an .amq input (a path, or - for stdin), refused on its first bytes where they are
+// no .amq header (check_octree_file_start). Errors do not name the input: callers prefix them.
+std::string read_octree_input(const std::string& path);
+
 // The input's name with its extension replaced ("-" stays "-").
 std::string default_output(const std::string& input, const std::string& extension);
 

@@ -12,9 +12,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <iostream>
-#include <iterator>
 #include <limits>
 #include <sstream>
 
@@ -29,10 +26,11 @@ std::string extension_of(const std::string& path) {
 }
 
 std::string read_bytes(const std::string& path) {
-    if (path == "-") return std::string(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(ErrorCode::io, path + ": can not open");
-    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    try {
+        return read_octree_input(path);
+    } catch (const Error& e) {
+        throw e.prefixed(path);  // as decode_bytes names it
+    }
 }
 
 OctreeForest decode_bytes(const std::string& name, const std::string& bytes, const OctreeDecodeOptions& options) {

@@ -17,8 +17,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -142,10 +140,8 @@ bool is_forest_input(const std::string& path) {
 OctreeForest read_forest_frame(const std::string& path) {
     try {
         if (lower_extension(path) == ".p4est") return read_p4est_file(path);
-        std::ifstream in(path, std::ios::binary);
-        if (!in) throw Error(ErrorCode::io, "can not open");
-        const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-        return decode_octree_forest(bytes.data(), bytes.size());
+        const std::string bytes = read_octree_input(path);
+        return decode_octree_forest(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());
     } catch (const Error& e) {
         throw e.prefixed(path);
     }

@@ -8,6 +8,7 @@
 #include <amc/mesh.h>
 #include <amc/octree.h>
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -20,7 +21,9 @@ MeshFormat mesh_format_from_path(const std::string& path);
 
 // The format a file's first bytes announce (PLY, OFF and VTU have magic words; OBJ has none and
 // is taken for text that starts like an OBJ file). Returns false when the bytes name no format.
+// Reads no further than the first kMeshFormatContentBytes (a byte-order mark, white space, a word).
 bool mesh_format_from_content(const std::string& bytes, MeshFormat& format);
+inline constexpr size_t kMeshFormatContentBytes = 4096 + 8;
 
 // Reads an OBJ, OFF, PLY or VTU file (by extension) and validates it with
 // validate_triangle_mesh. Throws Error naming the file and the first offending element.

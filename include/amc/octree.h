@@ -177,6 +177,9 @@ struct OctreeDecodeOptions {
 // Throws Error (truncated, checksum, corrupt, limit_exceeded, ...) on anything but a file
 // encode_octree_forest writes. Progressive decoding (max_level) leaves out the leaf data.
 OctreeForest decode_octree_forest(const uint8_t* data, size_t size, const OctreeDecodeOptions& options = {});
+// Throws as decode_octree_forest does on a file's first bytes (its 12-byte header; all of a
+// shorter file), with the same errors: a reader of a stream refuses what is no .amq file at once.
+void check_octree_file_start(const uint8_t* data, size_t size);
 
 // ---- p4est (optional: cmake -DAMC_WITH_P4EST=ON with Debian's libp4est-dev) -------------------
 // Without it every function below but octree_p4est_available throws Error.

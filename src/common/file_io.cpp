@@ -16,7 +16,30 @@
 
 namespace amc {
 
-std::string read_whole_file(const std::string& path) {
+namespace {
+
+// Reads `in` to its end: the first kFirstBytes (or all of a shorter input) are shown to `check`
+// before anything more is read or reserved; `size_hint` (0: unknown) is reserved after it.
+std::string read_to_end(std::istream& in, const std::string& name, const FirstBytesCheck& check, size_t size_hint) {
+    std::string bytes;
+    char buffer[1 << 16];
+    static_assert(sizeof buffer >= kFirstBytes, "the first bytes arrive in one buffer");
+    size_t first = 0;  // the first bytes gathered (a pipe may deliver them in several reads)
+    while (first < kFirstBytes && (in.read(buffer + first, std::streamsize(kFirstBytes - first)) || in.gcount() > 0))
+        first += size_t(in.gcount());
+    if (in.bad()) throw Error(ErrorCode::io, name + ": read error");
+    bytes.assign(buffer, first);
+    if (check) check(bytes);
+    // Room for the size the file has now, so that a large file is not copied as the string grows.
+    if (size_hint > bytes.size()) bytes.reserve(size_hint);
+    while (in.read(buffer, sizeof buffer) || in.gcount() > 0) bytes.append(buffer, size_t(in.gcount()));
+    if (in.bad()) throw Error(ErrorCode::io, name + ": read error");
+    return bytes;
+}
+
+}  // namespace
+
+std::string read_whole_file(const std::string& path, const FirstBytesCheck& check) {
     std::error_code ec;
     const std::filesystem::file_status status = std::filesystem::status(path, ec);
     if (ec || !std::filesystem::exists(status)) {
@@ -26,14 +49,12 @@ std::string read_whole_file(const std::string& path) {
     if (!std::filesystem::is_regular_file(status)) throw Error(ErrorCode::io, path + ": not a regular file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(ErrorCode::io, path + ": cannot open file (" + std::strerror(errno) + ")");
-    std::string bytes;
-    // Room for the size the file has now, so that a large file is not copied as the string grows.
     const std::uintmax_t size = std::filesystem::file_size(path, ec);
-    if (!ec) bytes.reserve(size_t(size));
-    char buffer[1 << 16];
-    while (in.read(buffer, sizeof buffer) || in.gcount() > 0) bytes.append(buffer, in.gcount());
-    if (in.bad()) throw Error(ErrorCode::io, path + ": read error");
-    return bytes;
+    return read_to_end(in, path, check, ec ? 0 : size_t(size));
+}
+
+std::string read_whole_stream(std::istream& in, const std::string& name, const FirstBytesCheck& check) {
+    return read_to_end(in, name, check, 0);
 }
 
 void write_file_atomically(const std::string& path, const std::string& bytes) {

@@ -122,10 +122,16 @@ std::string serialize_hierarchy(const Hierarchy& h) {
 
 namespace {
 
-Hierarchy parse_hierarchy(const std::string& bytes, const std::string& what) {
+// The parse's first check, which read_hierarchy also asks of a file's first bytes alone.
+void check_hierarchy_magic(const std::string& bytes, const std::string& what) {
     Reader in(bytes, what);
-    const char* magic = in.take(4);
-    if (std::memcmp(magic, kMagic, 4) != 0) in.fail("not a hierarchy file (bad magic)", ErrorCode::bad_magic);
+    if (std::memcmp(in.take(4), kMagic, 4) != 0) in.fail("not a hierarchy file (bad magic)", ErrorCode::bad_magic);
+}
+
+Hierarchy parse_hierarchy(const std::string& bytes, const std::string& what) {
+    check_hierarchy_magic(bytes, what);
+    Reader in(bytes, what);
+    in.take(4);
     const uint32_t version = in.u32();
     if (version != kVersion)
         in.fail("unsupported hierarchy file version " + std::to_string(version), ErrorCode::unsupported_version);
@@ -274,7 +280,8 @@ void write_hierarchy(const std::string& path, const Hierarchy& h) {
 }
 
 Hierarchy read_hierarchy(const std::string& path) {
-    return deserialize_hierarchy(read_whole_file(path), path);
+    return deserialize_hierarchy(read_whole_file(path, [&](const std::string& first) { check_hierarchy_magic(first, path); }),
+                                 path);
 }
 
 }  // namespace amc

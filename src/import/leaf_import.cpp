@@ -4,7 +4,7 @@
 #include <amc/import.h>
 
 #include "common/huge_pages.h"
-#include "common/mixing.h"
+#include "common/keyed_hash.h"
 #include "common/no_index.h"
 #include "hierarchy/leaf_triangles.h"
 #include "import/anchored_reconstruction.h"
@@ -88,10 +88,11 @@ LeafAtBase leaf_vertices_at_base(const std::vector<Vec3>& base, const std::vecto
     size_t slots = 16;
     while (slots < 2 * base.size()) slots *= 2;
     std::vector<uint32_t> table(slots, kNoIndex);  // a base vertex at each distinct position
+    const uint64_t key = process_hash_key();      // keyed, as PositionIndex is: the positions are the input's
     auto slot_of = [&](const Vec3& p) {
         uint64_t bits[3];
         std::memcpy(bits, &p, sizeof bits);
-        size_t s = size_t(hash_words(bits[0], bits[1], bits[2])) & (slots - 1);
+        size_t s = size_t(keyed_hash_words(key, bits[0], bits[1], bits[2])) & (slots - 1);
         while (table[s] != kNoIndex && !same(base[table[s]], p)) s = (s + 1) & (slots - 1);
         return s;
     };

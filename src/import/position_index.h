@@ -2,7 +2,7 @@
 // vertices to leaf vertices, finding duplicate vertices, and the exact-midpoint fast path.
 #pragma once
 
-#include "common/mixing.h"
+#include "common/keyed_hash.h"
 #include "common/no_index.h"
 
 #include <amc/mesh.h>
@@ -114,15 +114,18 @@ private:
         return kNoIndex;
     }
     static bool same(Vec3 a, Vec3 b) { return std::memcmp(&a, &b, sizeof(Vec3)) == 0; }
+    // Keyed: a mesh's positions are the input's to choose, and an unkeyed hash's collisions are
+    // found offline (positions sharing one slot made building the index quadratic).
     size_t slot_of(Vec3 p) const {
         uint64_t bits[3];
         std::memcpy(bits, &p, sizeof bits);
-        return size_t(hash_words(bits[0], bits[1], bits[2])) & (slots_.size() - 1);
+        return size_t(keyed_hash_words(key_, bits[0], bits[1], bits[2])) & (slots_.size() - 1);
     }
     const std::vector<Vec3>* indexed_;                  // the positions as inserted
     const std::vector<uint32_t>* insertion_order_;
     const std::vector<Vec3>* positions_;                // as found (renamed)
     const std::vector<uint32_t>* new_id_ = nullptr;     // a rename to apply when built
+    const uint64_t key_ = process_hash_key();
     mutable bool built_ = false, scanned_ = false;
     mutable std::vector<uint32_t> slots_;
     mutable std::vector<uint8_t> shared_;  // per slot: another vertex has the same position (empty: none)

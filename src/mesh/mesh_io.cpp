@@ -33,7 +33,10 @@ MeshFormat mesh_format_from_path(const std::string& path) {
 bool mesh_format_from_content(const std::string& bytes, MeshFormat& format) {
     size_t start = 0;  // skip a byte-order mark and leading white space
     if (bytes.compare(0, 3, "\xEF\xBB\xBF") == 0) start = 3;
-    while (start < bytes.size() && start < 4096 && std::isspace(static_cast<unsigned char>(bytes[start]))) ++start;
+    constexpr size_t kLongestWord = 8;  // "<VTKFile"
+    while (start < bytes.size() && start < kMeshFormatContentBytes - kLongestWord &&
+           std::isspace(static_cast<unsigned char>(bytes[start])))
+        ++start;
     auto starts_with = [&](const char* word) { return bytes.compare(start, std::strlen(word), word) == 0; };
     if (bytes.compare(0, 4, "ply\n") == 0 || bytes.compare(0, 5, "ply\r\n") == 0) {
         format = MeshFormat::ply;

@@ -7,7 +7,7 @@
 // in space, so that the mesh is conforming across the gluing and still drawn where it lies.
 #pragma once
 
-#include "common/mixing.h"
+#include "common/keyed_hash.h"
 #include "common/no_index.h"
 #include "octree/tree_corners.h"
 #include "octree/tree_faces.h"
@@ -57,8 +57,9 @@ private:
         Key key{0, kNoIndex};  // tree kNoIndex: empty
         Point point;
     };
-    static uint64_t hash(const Key& k) {
-        return splitmix64_mix(k.coords ^ (uint64_t(k.tree) * kGoldenGamma));
+    // Keyed: a forest can refine to points whose unkeyed mix shares a run of slots (found offline).
+    uint64_t hash(const Key& k) const {
+        return splitmix64_mix(k.coords ^ (uint64_t(k.tree) * kGoldenGamma) ^ hash_key_);
     }
     struct Place {
         uint32_t tree;
@@ -80,6 +81,7 @@ private:
     TreeCorners corners_;
     std::vector<uint8_t> face_in_place_;  // per tree face: the face across is at the same place in space
     void insert(const Key& key, Point point);
+    const uint64_t hash_key_ = process_hash_key();
     std::vector<Slot> slots_;  // a power of two, at most half full
     size_t used_ = 0;
     std::vector<Vec3> positions_;

@@ -6,8 +6,8 @@
 #include "octree/octree_leaf_data.h"
 #include "octree/octree_traversal.h"
 
+#include <set>
 #include <string>
-#include <unordered_set>
 
 namespace amc {
 
@@ -29,6 +29,11 @@ Block next_block(BlockReader& reader, OctreeBlock expected) {
 }
 
 }  // namespace
+
+void check_octree_file_start(const uint8_t* data, size_t size) {
+    const BlockReader header(data, size, kOctreeFraming);  // decode_octree_forest's first check
+    (void)header;
+}
 
 OctreeForest decode_octree_forest(const uint8_t* data, size_t size, const OctreeDecodeOptions& options) {
     return with_allocation_errors_as_limits("decode_octree_forest", [&]() {
@@ -87,7 +92,9 @@ OctreeForest decode_octree_forest(const uint8_t* data, size_t size, const Octree
         OctreeForest forest = levels.leaves(conn);
         // Leaf field blocks (version 2), then the end block.
         uint64_t values = 0;
-        std::unordered_set<std::string> names;  // not a pass over the fields before each: quadratic in them
+        // Ordered, as the encoder's check (validate_leaf_fields): std::hash of a string is unkeyed,
+        // and names chosen to share it made this set quadratic in the fields.
+        std::set<std::string> names;
         for (block = next_block(reader); uint8_t(block.type) != uint8_t(OctreeBlock::end); block = next_block(reader)) {
             AMC_REQUIRE(uint8_t(block.type) == uint8_t(OctreeBlock::leaf_field), corrupt,
                         "block at byte " + std::to_string(block.offset) + ": expected a leaf field or end block, found a " +

@@ -4,6 +4,7 @@
 #include <amc/mesh_io.h>
 
 #include "common/check.h"
+#include "common/keyed_hash.h"
 #include "mesh/vtu_writer.h"
 
 #include <amc/series.h>
@@ -25,8 +26,9 @@ void leaf_cells(const OctreeForest& forest, std::vector<Vec3>& points, std::vect
     const TreeConnectivity& conn = forest.connectivity;
     const int d = forest.dim(), root = octree_root_log2(d), corners = 1 << d;
     connectivity.reserve(forest.leaves.size() * corners);
-    // Corners shared within a tree, by their integer coordinates (up to 2^root on each axis).
-    std::unordered_map<uint64_t, uint32_t> index;
+    // Corners shared within a tree, by their integer coordinates (up to 2^root on each axis);
+    // keyed: a forest can put many corners in one residue of the identity hash's bucket count.
+    std::unordered_map<uint64_t, uint32_t, KeyedWordHash> index;
     for (uint32_t t = 0; t < forest.tree_count(); ++t) {
         index.clear();
         for (uint64_t i = forest.tree_offsets[t]; i < forest.tree_offsets[t + 1]; ++i) {

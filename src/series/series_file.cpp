@@ -365,7 +365,9 @@ SeriesReader::SeriesReader(std::vector<uint8_t> bytes, const std::string& what, 
 }
 
 SeriesReader SeriesReader::open(const std::string& path, const SeriesReadOptions& options) {
-    const std::string text = read_whole_file(path);
+    const std::string text = read_whole_file(path, [&](const std::string& first) {  // a file of something else: at once
+        check_series_header(reinterpret_cast<const uint8_t*>(first.data()), first.size(), path, kSeriesFlagSinglePrecision);
+    });
     return SeriesReader(std::vector<uint8_t>(text.begin(), text.end()), path, options);
 }
 

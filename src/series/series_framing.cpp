@@ -36,10 +36,7 @@ std::vector<uint8_t> series_block(uint8_t type, const std::vector<uint8_t>& payl
     return out;
 }
 
-SeriesScan scan_series_file(const std::vector<uint8_t>& bytes, const std::string& what, bool allow_unfinished,
-                            uint8_t allowed_flags, uint8_t max_type) {
-    const uint8_t* data = bytes.data();
-    const size_t size = bytes.size();
+void check_series_header(const uint8_t* data, size_t size, const std::string& what, uint8_t allowed_flags) {
     AMC_REQUIRE(size >= 4 && std::memcmp(data, kSeriesMagic, 4) == 0, bad_magic, what + ": not an amcodec series file (magic)");
     AMC_REQUIRE(size >= 5, truncated, what + ": truncated header");
     AMC_REQUIRE(data[4] != 0, corrupt, what + ": unknown series version 0");
@@ -49,6 +46,13 @@ SeriesScan scan_series_file(const std::vector<uint8_t>& bytes, const std::string
     AMC_REQUIRE(size >= kSeriesHeaderSize, truncated, what + ": truncated header");
     AMC_REQUIRE(XXH32(data, 12, 0) == load_le32(data + 12), checksum, what + ": checksum mismatch in the header");
     AMC_REQUIRE((data[5] & ~allowed_flags) == 0 && data[6] == 0 && data[7] == 0, corrupt, what + ": reserved header bits set");
+}
+
+SeriesScan scan_series_file(const std::vector<uint8_t>& bytes, const std::string& what, bool allow_unfinished,
+                            uint8_t allowed_flags, uint8_t max_type) {
+    const uint8_t* data = bytes.data();
+    const size_t size = bytes.size();
+    check_series_header(data, size, what, allowed_flags);
     SeriesScan scan;
     scan.version = data[4];
     scan.flags = data[5];

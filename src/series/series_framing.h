@@ -37,6 +37,9 @@ struct SeriesScan {
 // first block. Throws Error naming `what`.
 SeriesScan scan_series_file(const std::vector<uint8_t>& bytes, const std::string& what, bool allow_unfinished,
                             uint8_t allowed_flags, uint8_t max_type);
+// The header's checks alone, scan_series_file's first: on a file's first bytes (kSeriesHeaderSize
+// or more, or all of a shorter file) they throw what the scan of the whole file would.
+void check_series_header(const uint8_t* data, size_t size, const std::string& what, uint8_t allowed_flags);
 
 // A frame block's payload: `head` (time and counts), the connectivity section (its length as a
 // varint, then its bytes) and `tail`. The connectivity section, which ends with an arithmetic-coded
