@@ -47,6 +47,12 @@ set(cases
   "2|--faces 250000 --max-level 30: remesh: more than 100000 nodes (--max-nodes)|refine --model bumpy --faces 250000 --max-level 30 --no-measure --max-nodes 100000 -o ${OUT}/bumpy.amh"
   "2|--error-bound: NaN is not a number here|series encode ${GOLDEN} -o ${OUT}/s.amcs --error-bound nan"
   "2|--vertex-step: NaN is not a number here|octree encode ${OUT}/none.amq -o ${OUT}/v.amq --vertex-step nan"
+  # Integers read decimal, as zstd and xz read them (CLI11 alone reads base 0: 010 is 8, 0x1 is 1,
+  # and an unsigned option takes -1 as 2^64 - 1).
+  "1|level 10 requested but the hierarchy has levels 0..2|decode ${GOLDEN} -o ${mesh} --level 010"
+  "2|--level: '0x1' is not a decimal integer|decode ${GOLDEN} -o ${mesh} --level 0x1"
+  "2|--seed: '-1' is not a decimal number|refine --model random --faces 100 --seed -1 -o ${OUT}/seed.amh"
+  "2|--triangles: '0x0' is not a decimal number|decode ${GOLDEN} -o ${mesh} --triangles 0x0"
 )
 set(failures "")
 foreach(case IN LISTS cases)
@@ -59,6 +65,16 @@ foreach(case IN LISTS cases)
   string(FIND "${out}${err}" "${expected_words}" position)
   if(NOT result STREQUAL expected_code OR position EQUAL -1)
     string(APPEND failures "\n  amc ${arguments}: exit '${result}' (expected ${expected_code}), output: ${out}${err}")
+  endif()
+endforeach()
+# An empty list, an empty argument (which the cases above cannot hold), is a usage error: it
+# decoded every chunk.
+foreach(option --chunks --triangles)
+  execute_process(COMMAND "${AMC}" -f decode "${GOLDEN}" -o "${OUT}/empty.obj" ${option} ""
+                  RESULT_VARIABLE result OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 60)
+  string(FIND "${out}${err}" "${option}: " position)
+  if(NOT result STREQUAL "2" OR position EQUAL -1)
+    string(APPEND failures "\n  amc decode ${option} '': exit '${result}' (expected 2), output: ${out}${err}")
   endif()
 endforeach()
 if(NOT failures STREQUAL "")

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -62,6 +63,31 @@ const CLI::Validator kNotNan(
         return CLI::detail::lexical_cast(text, value) && std::isnan(value) ? "NaN is not a number here" : "";
     },
     "NUMBER");
+
+// CLI11 reads integers with strtoll / strtoull in base 0: "010" would be 8 and "0x10" 16, and an
+// unsigned option takes "-1" as 2^64 - 1. Decimal only, as zstd and xz read them; zeros before
+// the first digit that counts are dropped.
+CLI::Validator decimal_integer(bool is_signed) {
+    return CLI::Validator(
+        [is_signed](std::string& text) -> std::string {
+            const size_t sign = !text.empty() && (text[0] == '+' || (is_signed && text[0] == '-')) ? 1 : 0;
+            if (text.size() == sign || text.find_first_not_of("0123456789", sign) != std::string::npos)
+                return "'" + text + "' is not a decimal " + (is_signed ? "integer" : "number (0, 1, 2, ...)");
+            text.erase(sign, std::min(text.find_first_not_of('0', sign), text.size() - 1) - sign);
+            return std::string();
+        },
+        "");
+}
+
+// Every integer option of `app` and its subcommands, flags aside, reads decimal (decimal_integer).
+void read_integers_in_decimal(CLI::App& app) {
+    for (CLI::Option* option : app.get_options()) {
+        const std::string type = option->get_type_name();
+        const bool is_signed = type.rfind("INT", 0) == 0, is_unsigned = type.rfind("UINT", 0) == 0;
+        if ((is_signed || is_unsigned) && option->get_type_size_min() > 0) option->transform(decimal_integer(is_signed));
+    }
+    for (CLI::App* command : app.get_subcommands([](CLI::App*) { return true; })) read_integers_in_decimal(*command);
+}
 
 }  // namespace
 
@@ -146,7 +172,8 @@ int main(int argc, char** argv) {
     decode_cmd->add_option("--threads", decode.threads, "Threads that decode chunks at once and compress a VTU output (0: every core)")
         ->check(CLI::Range(0u, 4096u));
     decode_cmd->add_option("--chunks", decode.chunks,
-                           "Decode only these chunks (amc info lists them), e.g. 0,3-5: their roots' trees alone");
+                           "Decode only these chunks (amc info lists them), e.g. 0,3-5: their roots' trees alone")
+        ->check(CLI::Validator([](std::string& text) { return text.empty() ? "no chunk listed (e.g. 0,3-5)" : ""; }, ""));
     decode_cmd->add_option("--triangles", decode.triangles,
                            "Decode only the chunks that hold these base triangles (file order), e.g. 7,120")
         ->delimiter(',');
@@ -301,6 +328,7 @@ int main(int argc, char** argv) {
     add_per_byte_bound(octree_info_cmd, "--max-octants-per-byte", "octants", octree_info.max_octants_per_byte);
 
     try {
+        read_integers_in_decimal(app);
         app.parse(argc, argv);
         if (quiet && verbose) throw CLI::ValidationError("-q and -v exclude each other");
     } catch (const CLI::ParseError& e) {
