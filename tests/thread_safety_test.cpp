@@ -139,21 +139,25 @@ TEST(ThreadSafety, EffortThreeOnThreadsGivesTheOneThreadFile) {
 
 // Base detection runs its second search (the triangles in reverse order) beside the first on two
 // threads, and cancels it when the first finds it not needed: the hierarchy is the one-thread one
-// either way. The random refinement's search stops far from its base (so the second one counts);
-// the uniform one finds its base (so the second one is cancelled).
+// either way. The deep random refinement's search stops far from its base (the second search
+// counts); the shallow one reaches its base after the second may start (it is cancelled, before
+// or within a step as the threads' timing falls); the uniform one's steps leave a quarter each,
+// so the second never starts before the first reaches its base.
 TEST(ThreadSafety, BaseSearchOnTwoThreadsGivesTheOneThreadHierarchy) {
-    Hierarchy random(make_icosahedron());
-    refine_randomly(random, 3000, 6, 11);
+    Hierarchy deep(make_icosahedron());
+    refine_randomly(deep, 3000, 6, 11);
+    Hierarchy shallow(make_icosahedron());
+    refine_randomly(shallow, 3000, 4, 1);
     Hierarchy uniform(make_icosahedron());
     refine_uniformly(uniform, 3);
-    for (const Hierarchy* h : {&random, &uniform}) {
+    for (const Hierarchy* h : {&deep, &shallow, &uniform}) {
         const TriangleMesh leaf = extract_leaf_mesh(*h).mesh;
         const ImportedHierarchy one = import_mesh(leaf, "leaf", 1);
         const ImportedHierarchy two = import_mesh(leaf, "leaf", 2);
         EXPECT_TRUE(identical(one.hierarchy, two.hierarchy));
         EXPECT_EQ(one.vertex_of_input, two.vertex_of_input);
         const bool far_from_base = one.hierarchy.base().triangles.size() * 16 > leaf.triangles.size();
-        EXPECT_EQ(far_from_base, h == &random) << "the case does not take the path it is there for";
+        EXPECT_EQ(far_from_base, h == &deep) << "the case does not take the path it is there for";
     }
 }
 

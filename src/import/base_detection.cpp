@@ -46,17 +46,21 @@ struct SearchRun {
     std::vector<std::vector<Triangle>> blockers;
 };
 
+// Set when a search's answer is no longer wanted: it stops within its step.
+using Cancel = std::atomic<bool>;
+
 // One more level undone at the end of `run`, seeded only where the last step changed the mesh
 // or, `everywhere`, on the whole mesh; in step s the vertices marked in kept[s] (if any) stay.
-// Returns whether the step undid anything.
+// Returns whether the step undid anything (false also when `cancel`, if given, was set).
 bool undo_one_level(const std::vector<Triangle>& triangles, uint32_t vertex_count,
-                    const std::vector<std::vector<uint8_t>>& kept, bool everywhere, SearchRun& run) {
+                    const std::vector<std::vector<uint8_t>>& kept, bool everywhere, SearchRun& run,
+                    const Cancel* cancel = nullptr) {
     const size_t s = run.levels.size();
     const bool has_kept = s < kept.size() && !kept[s].empty();
     const std::vector<uint8_t> unrefined(s == 0 ? triangles.size() : 0, 0);
     detail::CoarserLevel coarser = detail::undo_refinement_level(
         s == 0 ? triangles : run.levels[s - 1].triangles, s == 0 ? unrefined : run.refined[s - 1], vertex_count,
-        s == 0 || everywhere ? nullptr : &run.changed[s - 1], has_kept ? &kept[s] : nullptr);
+        s == 0 || everywhere ? nullptr : &run.changed[s - 1], has_kept ? &kept[s] : nullptr, false, cancel);
     if (coarser.red_blocks == 0) return false;
     DetectedLevel level;
     level.splits = std::move(coarser.splits);
@@ -80,8 +84,6 @@ bool undid_much(size_t base, size_t leaf) {
     return base * kReadMuch <= leaf * (kReadMuch - 1);
 }
 
-// Set when a search's answer is no longer wanted: it stops before its next step.
-using Cancel = std::atomic<bool>;
 // Called after each step a search undid.
 using StepObserver = std::function<void(const SearchRun&)>;
 
@@ -95,7 +97,7 @@ void undo_levels_from(const std::vector<Triangle>& triangles, uint32_t vertex_co
     run.changed.resize(from);
     run.blockers.resize(from);
     // Each level undone adds one to the depth of the hierarchy, which kMaxLevel caps.
-    while (run.levels.size() < size_t(kMaxLevel) && !cancel && undo_one_level(triangles, vertex_count, kept, false, run)) {
+    while (run.levels.size() < size_t(kMaxLevel) && !cancel && undo_one_level(triangles, vertex_count, kept, false, run, &cancel)) {
         if (observe) observe(run);
     }
 }
@@ -193,10 +195,11 @@ SearchRun search_levels(const std::vector<Triangle>& triangles, uint32_t vertex_
     return run;
 }
 
-// When the reverse search may run beside the first: once the first has undone much of the mesh, so
-// that it will most likely be searched again (an irregular mesh, where the first search undoes
-// little, gets its second search only once the first has ended needing it); cancelled once the
-// first has ended not needing it.
+// When the reverse search may run beside the first: once the first has undone much of the mesh in
+// steps that each leave more than half of it, so that it will most likely be searched again (an
+// irregular mesh, where the first undoes little, and a uniform refinement, whose steps leave a
+// quarter, get their second search only once the first has ended needing it); cancelled, within
+// its step, once the first has ended not needing it.
 class SecondSearchGate {
 public:
     void open_if(bool likely_needed) {
@@ -296,7 +299,10 @@ DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what, unsi
         if (task == 0) {
             try {
                 run = search_levels(renumbered, vertex_count, never, [&](const SearchRun& so_far) {
-                    gate.open_if(undid_much(base_size(so_far, renumbered.size()), renumbered.size()));
+                    const size_t steps = so_far.levels.size();
+                    const size_t before = steps < 2 ? renumbered.size() : so_far.levels[steps - 2].triangles.size();
+                    const size_t after = so_far.levels.back().triangles.size();
+                    gate.open_if(undid_much(after, renumbered.size()) && 2 * after > before);
                 });
             } catch (...) {
                 gate.first_ended(false);  // the other task must not wait for ever

@@ -93,14 +93,16 @@ Neighbourhood neighbourhood(const std::vector<Triangle>& mesh, const std::vector
 
 CoarserLevel undo_refinement_level(const std::vector<Triangle>& fine, const std::vector<uint8_t>& refined,
                                    uint32_t vertex_count, const std::vector<uint8_t>* active,
-                                   const std::vector<uint8_t>* kept, bool give_up_retraced) {
+                                   const std::vector<uint8_t>* kept, bool give_up_retraced,
+                                   const std::atomic<bool>* cancel) {
     // Large patches first: they are what a level looks like where the mesh is finest. Small
     // ones are also what wrong readings look like where it is not finest yet (the true blocks
     // there become valid only once the finer ones around are undone), so a small patch is kept
     // only when the next level confirms it: one of its parents lies in a valid patch there.
-    LevelFinder finder(fine, refined, vertex_count, kept, give_up_retraced);
+    LevelFinder finder(fine, refined, vertex_count, kept, give_up_retraced, cancel);
     constexpr uint32_t kLarge = 12;  // vertices removed: four blocks or more
     const size_t all = finder.commit(active);
+    if (finder.cancelled()) return CoarserLevel{};
     std::vector<size_t> small;
     for (size_t id = 0; id < all; ++id) {
         if (finder.removed_by(id) < kLarge) small.push_back(id);

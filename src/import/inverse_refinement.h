@@ -14,6 +14,7 @@
 #include <amc/mesh.h>
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -42,10 +43,12 @@ struct CoarserLevel {
 // `kept` (if given) marks vertices that must stay (the base vertices of an anchored import).
 // `give_up_retraced` (the anchored import's search) gives up the growths that retrace a reading
 // given up before (docs/IMPORT.md, "Retraced readings given up"); base detection keeps its answers.
-// Returns red_blocks == 0 (and an empty mesh) when no level can be undone anywhere. Linear in
+// Returns red_blocks == 0 (and an empty mesh) when no level can be undone anywhere, or when
+// `cancel` (if given) is set while the step runs (its answer is then not wanted). Linear in
 // fine.size() + vertex_count.
 CoarserLevel undo_refinement_level(const std::vector<Triangle>& fine, const std::vector<uint8_t>& refined,
                                    uint32_t vertex_count, const std::vector<uint8_t>* active = nullptr,
-                                   const std::vector<uint8_t>* kept = nullptr, bool give_up_retraced = false);
+                                   const std::vector<uint8_t>* kept = nullptr, bool give_up_retraced = false,
+                                   const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace amc::detail

@@ -61,10 +61,11 @@ size_t LevelFinder::commit(const std::vector<uint8_t>* active) {
     const std::vector<uint32_t> region = seeds;
     for (int round = 0; round < 4 && !seeds.empty(); ++round) {
         const size_t before = patches_.size();
-        if (commit_best_first(seeds) == 0) break;
+        if (commit_best_first(seeds) == 0 || cancelled()) break;
         // The next round seeds only near what this one committed.
         seeds = free_triangles_near(before);
     }
+    if (cancelled()) return patches_.size();
     commit_small_patches(region);
     improve_patches(first);
     return patches_.size();
@@ -414,13 +415,14 @@ uint32_t LevelFinder::commit_best_first(const std::vector<uint32_t>& seeds) {
     given_up_list_.clear();
     for (uint32_t t : seeds) {
         if (covered_[t] == 3 || block_of_[t] != kNoIndex) continue;
+        if (cancelled()) return 0;
         const Candidate c = best_patch(t, true);
         if (c.removed > 0) queue.push_back(c);
     }
     auto worse = [this](const Candidate& a, const Candidate& b) { return this->worse(a, b); };
     std::make_heap(queue.begin(), queue.end(), worse);
     uint32_t total = 0;
-    while (!queue.empty()) {
+    while (!queue.empty() && !cancelled()) {
         std::pop_heap(queue.begin(), queue.end(), worse);
         Candidate c = queue.back();
         queue.pop_back();
@@ -517,7 +519,7 @@ void LevelFinder::hold(uint32_t id, bool on) {
 
 void LevelFinder::improve_patches(size_t first) {
     const size_t count = patches_.size();
-    for (size_t r = first; r < count; ++r) {
+    for (size_t r = first; r < count && !cancelled(); ++r) {
         const Patch patch = patches_[r];
         uint32_t before = 0;
         std::vector<uint32_t> seeds, taken;

@@ -8,6 +8,7 @@
 #include "import/triangle_adjacency.h"
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -86,9 +87,10 @@ public:
     // decides (the order of seeds, ties between candidates, the coarser level's order) it is
     // looked up, so the numbering changes no result.
     // `give_up_retraced`: see undo_refinement_level.
+    // `cancel` (if given): once set, commit stops early (its answer is not wanted).
     LevelFinder(const std::vector<Triangle>& fine, const std::vector<uint8_t>& refined, uint32_t vertex_count,
-                const std::vector<uint8_t>* kept, bool give_up_retraced = false)
-        : give_up_retraced_(give_up_retraced), caller_of_(local_order(fine, vertex_count)), local_of_(inverse(caller_of_)), tri_(permuted(fine, caller_of_)),
+                const std::vector<uint8_t>* kept, bool give_up_retraced = false, const std::atomic<bool>* cancel = nullptr)
+        : give_up_retraced_(give_up_retraced), cancel_(cancel), caller_of_(local_order(fine, vertex_count)), local_of_(inverse(caller_of_)), tri_(permuted(fine, caller_of_)),
           refined_(permuted(refined, caller_of_)), adjacency_(tri_, vertex_count), forced_old_(vertex_count, 0),
           midpoint_count_(vertex_count, 0), corner_count_(vertex_count, 0),
           midpoint_block_(vertex_count, {kNoIndex, kNoIndex}), first_coarse_edge_(vertex_count, kNoEdge), block_of_(fine.size(), kNoIndex), closure_of_(fine.size(), kNoIndex),
@@ -119,6 +121,9 @@ public:
     // `active` (if given) limits the first seeds to the triangles it marks and two rings around
     // them: elsewhere the mesh is what the previous step left unchanged, with nothing to undo.
     size_t commit(const std::vector<uint8_t>* active);
+
+    // Whether `cancel` was set: commit stopped early, what it left is not the step's answer.
+    bool cancelled() const { return cancel_ != nullptr && cancel_->load(std::memory_order_relaxed); }
 
     // The vertices patch `id` removes.
     uint32_t removed_by(size_t id) const;
@@ -331,6 +336,7 @@ private:
     void improve_patches(size_t first);
 
     const bool give_up_retraced_;
+    const std::atomic<bool>* const cancel_;
     std::vector<uint32_t> caller_of_;  // per triangle: its index in the caller's numbering
     std::vector<uint32_t> local_of_;   // per caller's index: the triangle
     std::vector<Triangle> tri_;
