@@ -333,7 +333,7 @@ void measure_amcodec(const Model& m, int runs, bool kept_encoders, std::vector<R
         std::vector<uint8_t> stream;
         amc::EncodeStats stats;
         r.encode_seconds = median_seconds(runs, [&] {
-            imported = amc::in_decoder_order(amc::import_mesh(m.leaf, m.name).hierarchy);
+            imported = amc::in_decoder_order(amc::import_mesh(m.leaf, m.name, 1).hierarchy);  // one core, as Draco
             stream = amc::encode_hierarchy(imported, amc::EncodeOptions{}.hierarchy);
         });
         r.decode_seconds = median_seconds(runs, [&] { back = amc::decode_hierarchy(imported.base(), stream.data(), stream.size()); }, [&] { back = {}; });

@@ -27,6 +27,15 @@ expect 0 "$amc" refine --model front --steps 2 --max-level 5 -o front.amh
 [[ -f front_0.amh && -f front_1.amh ]] || fail "refine --model front -o front.amh wrote no front_0.amh, front_1.amh"
 expect 2 "$amc" refine --model lshape --max-level 40 -o l.amh
 
+# The base search's threads change no byte of the hierarchy (the second search, run beside the
+# first on two threads, is cancelled or kept exactly as one thread would).
+expect 0 "$amc" import r.obj -o import1.amh --threads 1
+expect 0 "$amc" import r.obj -o import2.amh --threads 2
+cmp -s import1.amh import2.amh || fail "import --threads 2 wrote another hierarchy than --threads 1"
+expect 0 "$amc" encode r.obj -o import1.amc --threads 1
+expect 0 "$amc" encode r.obj -o import2.amc --threads 2
+cmp -s import1.amc import2.amc || fail "encode of a mesh --threads 2 wrote another file than --threads 1"
+
 # Progress only on a terminal: a run of a few seconds with stderr in a file leaves it empty.
 expect 0 "$amc" refine --model random --faces 600000 --max-level 9 -o big.amh
 [[ -s err.txt ]] && fail "progress or messages written to stderr that is not a terminal: $(head -c 200 err.txt)"

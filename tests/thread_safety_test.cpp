@@ -7,6 +7,7 @@
 
 #include <amc/codec.h>
 #include <amc/hierarchy_coder.h>
+#include <amc/import.h>
 #include <amc/mesh.h>
 #include <amc/mesh_io.h>
 #include <amc/octree.h>
@@ -134,6 +135,26 @@ TEST(ThreadSafety, EffortThreeOnThreadsGivesTheOneThreadFile) {
     }
     for (std::thread& thread : threads) thread.join();
     EXPECT_EQ(mismatches.load(), 0);
+}
+
+// Base detection runs its second search (the triangles in reverse order) beside the first on two
+// threads, and cancels it when the first finds it not needed: the hierarchy is the one-thread one
+// either way. The random refinement's search stops far from its base (so the second one counts);
+// the uniform one finds its base (so the second one is cancelled).
+TEST(ThreadSafety, BaseSearchOnTwoThreadsGivesTheOneThreadHierarchy) {
+    Hierarchy random(make_icosahedron());
+    refine_randomly(random, 3000, 6, 11);
+    Hierarchy uniform(make_icosahedron());
+    refine_uniformly(uniform, 3);
+    for (const Hierarchy* h : {&random, &uniform}) {
+        const TriangleMesh leaf = extract_leaf_mesh(*h).mesh;
+        const ImportedHierarchy one = import_mesh(leaf, "leaf", 1);
+        const ImportedHierarchy two = import_mesh(leaf, "leaf", 2);
+        EXPECT_TRUE(identical(one.hierarchy, two.hierarchy));
+        EXPECT_EQ(one.vertex_of_input, two.vertex_of_input);
+        const bool far_from_base = one.hierarchy.base().triangles.size() * 16 > leaf.triangles.size();
+        EXPECT_EQ(far_from_base, h == &random) << "the case does not take the path it is there for";
+    }
 }
 
 // The series file and the octree coder the same way: one shared file read by every thread (each with

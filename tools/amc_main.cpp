@@ -128,7 +128,7 @@ int main(int argc, char** argv) {
     encode_cmd->add_option("--chunk-faces", encode.chunk_faces, "Faces per chunk when --chunks is 0")
         ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 40))
         ->capture_default_str();
-    encode_cmd->add_option("--threads", encode.threads, "Threads that code chunks, or at --effort 3 and 4 the base orders' files, at once (0: every core)")
+    encode_cmd->add_option("--threads", encode.threads, "Threads that code chunks, or at --effort 3 and 4 the base orders' files, at once, and of the base search of a mesh input (0: every core)")
         ->check(CLI::Range(0u, 4096u));
     encode_cmd->add_option("--hierarchy-contexts", encode.hierarchy_contexts,
                            "paper (fastest decode) | mixed (smaller connectivity, slower decode, one chunk; written as the version of the mixing model that codes smallest, docs/FORMAT.md)")
@@ -184,6 +184,8 @@ int main(int argc, char** argv) {
     import_cmd->add_option("-o,--output", import.output, "Hierarchy file (default: the input with .amh)");
     import_cmd->add_option("--base", import.base, "Base mesh (default: the coarsest base found)");
     import_cmd->add_option("--map", import.map, "Write the map from the input's numbering to the hierarchy's leaf mesh");
+    import_cmd->add_option("--threads", import.threads, "Threads of the base search without --base (it uses up to two; 0: every core)")
+        ->check(CLI::Range(0u, 4096u));
 
     ExtractCommand extract;
     auto* extract_cmd = app.add_subcommand("extract", "Write the leaf mesh, or the mesh of one level, of a hierarchy");

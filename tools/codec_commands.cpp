@@ -159,7 +159,7 @@ void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
         h = hierarchy_of(input);
     } else {
         progress.phase("importing " + input.name);
-        ImportedMesh imported = import_input(input, command.base, global);
+        ImportedMesh imported = import_input(input, command.base, command.threads, global);
         h = std::move(imported.hierarchy);
         numbering = std::move(imported.numbering);
         options.numbering = &numbering;

@@ -59,6 +59,7 @@ struct ImportCommand {
     std::string input, output;
     std::string base;
     std::string map;
+    unsigned threads = 0;  // 0: every core
 };
 void run_import(const ImportCommand& command, const GlobalOptions& global);
 

@@ -9,9 +9,9 @@
 
 namespace amc::cli {
 
-ImportedMesh import_input(const InputFile& input, const std::string& base_path, const GlobalOptions& global) {
+ImportedMesh import_input(const InputFile& input, const std::string& base_path, unsigned threads, const GlobalOptions& global) {
     const TriangleMesh mesh = mesh_of(input);
-    ImportedHierarchy imported = base_path.empty() ? import_mesh(mesh, input.name)
+    ImportedHierarchy imported = base_path.empty() ? import_mesh(mesh, input.name, threads)
                                                    : import_leaf_mesh(mesh_of(read_input(base_path)), mesh, {}, input.name);
     if (global.verbosity > 1) {
         const HierarchyStats stats = compute_stats(imported.hierarchy);
@@ -46,7 +46,7 @@ void run_import(const ImportCommand& command, const GlobalOptions& global) {
     }
     progress.phase("importing " + input.name);
     const auto start = std::chrono::steady_clock::now();
-    const ImportedMesh imported = import_input(input, command.base, global);
+    const ImportedMesh imported = import_input(input, command.base, command.threads, global);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     write_output(output, serialize_hierarchy(imported.hierarchy), global.force);
     if (!command.map.empty()) write_output(command.map, format_numbering_map(imported.numbering), global.force);

@@ -17,7 +17,7 @@ struct ImportedMesh {
 };
 
 // A mesh input over the base mesh in `base_path`, or over the coarsest base found in it.
-ImportedMesh import_input(const InputFile& input, const std::string& base_path, const GlobalOptions& global);
+ImportedMesh import_input(const InputFile& input, const std::string& base_path, unsigned threads, const GlobalOptions& global);
 
 // The map as text (docs/IMPORT.md, "The numbering map"): for every input vertex its leaf vertex,
 // for every input face its leaf triangle and rotation.

@@ -41,8 +41,9 @@ ImportedHierarchy import_leaf_mesh(const TriangleMesh& base, const TriangleMesh&
 // (vertex_of_input as in ImportedHierarchy): adaptive and semi-regular meshes get their forest,
 // an irregular mesh (mostly) itself as the base with no refinement. Combinatorial: no position is
 // consulted. Never fails on a valid mesh (validate_triangle_mesh; `what` names it in the error
-// otherwise). Linear time in practice (docs/IMPORT.md, "Speed").
-ImportedHierarchy import_mesh(const TriangleMesh& mesh, const std::string& what = "mesh");
+// otherwise). Linear time in practice (docs/IMPORT.md, "Speed"). The search runs on up to two of
+// `threads` threads (0: every core); the result does not depend on it.
+ImportedHierarchy import_mesh(const TriangleMesh& mesh, const std::string& what = "mesh", unsigned threads = 0);
 
 // ---- refinement histories (docs/IMPORT.md, section 3) -----------------------------------------
 

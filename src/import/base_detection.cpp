@@ -1,11 +1,16 @@
 #include "import/base_detection.h"
 
 #include "common/no_index.h"
+#include "common/parallel.h"
 #include "import/inverse_refinement.h"
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <condition_variable>
+#include <functional>
 #include <map>
+#include <mutex>
 #include <utility>
 #include <vector>
 
@@ -75,16 +80,23 @@ bool undid_much(size_t base, size_t leaf) {
     return base * kReadMuch <= leaf * (kReadMuch - 1);
 }
 
+// Set when a search's answer is no longer wanted: it stops before its next step.
+using Cancel = std::atomic<bool>;
+// Called after each step a search undid.
+using StepObserver = std::function<void(const SearchRun&)>;
+
 // The levels undone from step `from` on, the earlier ones of `run` standing; in step s the
 // vertices marked in kept[s] (if any) stay.
 void undo_levels_from(const std::vector<Triangle>& triangles, uint32_t vertex_count, size_t from,
-                      const std::vector<std::vector<uint8_t>>& kept, SearchRun& run) {
+                      const std::vector<std::vector<uint8_t>>& kept, const Cancel& cancel, const StepObserver& observe,
+                      SearchRun& run) {
     run.levels.resize(from);
     run.refined.resize(from);
     run.changed.resize(from);
     run.blockers.resize(from);
     // Each level undone adds one to the depth of the hierarchy, which kMaxLevel caps.
-    while (run.levels.size() < size_t(kMaxLevel) && undo_one_level(triangles, vertex_count, kept, false, run)) {
+    while (run.levels.size() < size_t(kMaxLevel) && !cancel && undo_one_level(triangles, vertex_count, kept, false, run)) {
+        if (observe) observe(run);
     }
 }
 
@@ -159,26 +171,60 @@ bool wrong_single_blocks(const SearchRun& run, uint32_t vertex_count, size_t& st
 
 // The levels undone from the leaf mesh `triangles` (search ids), with the rerun of "One-block
 // patches taken back".
-SearchRun search_levels(const std::vector<Triangle>& triangles, uint32_t vertex_count) {
+SearchRun search_levels(const std::vector<Triangle>& triangles, uint32_t vertex_count, const Cancel& cancel,
+                        const StepObserver& observe = {}) {
     SearchRun run;
-    undo_levels_from(triangles, vertex_count, 0, {}, run);
+    undo_levels_from(triangles, vertex_count, 0, {}, cancel, observe, run);
     // A one-block patch can be a wrong reading that its step cannot tell from a true one; a later
     // step then finds its parent in the way of a large patch. Such patches are left out and the
     // search run again from their step, once; the run that ends at the coarser base stands
     // (docs/IMPORT.md, "One-block patches taken back").
     size_t step = 0;
     std::vector<std::vector<uint8_t>> kept;
-    if (wrong_single_blocks(run, vertex_count, step, kept)) {
+    if (!cancel && wrong_single_blocks(run, vertex_count, step, kept)) {
         SearchRun trial;
         trial.levels.assign(run.levels.begin(), run.levels.begin() + std::ptrdiff_t(step));
         trial.refined.assign(run.refined.begin(), run.refined.begin() + std::ptrdiff_t(step));
         trial.changed.assign(run.changed.begin(), run.changed.begin() + std::ptrdiff_t(step));
         trial.blockers.assign(run.blockers.begin(), run.blockers.begin() + std::ptrdiff_t(step));
-        undo_levels_from(triangles, vertex_count, step, kept, trial);
+        undo_levels_from(triangles, vertex_count, step, kept, cancel, {}, trial);
         if (base_size(trial, triangles.size()) < base_size(run, triangles.size())) run = std::move(trial);
     }
     return run;
 }
+
+// When the reverse search may run beside the first: once the first has undone much of the mesh, so
+// that it will most likely be searched again (an irregular mesh, where the first search undoes
+// little, gets its second search only once the first has ended needing it); cancelled once the
+// first has ended not needing it.
+class SecondSearchGate {
+public:
+    void open_if(bool likely_needed) {
+        if (!likely_needed) return;
+        std::lock_guard<std::mutex> lock(mutex_);
+        open_ = true;
+        opened_.notify_all();
+    }
+    void first_ended(bool needed) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        cancelled_ = !needed;
+        open_ = true;
+        opened_.notify_all();
+    }
+    // Blocks until the search may start; false when it is not needed.
+    bool wait() {
+        std::unique_lock<std::mutex> lock(mutex_);
+        opened_.wait(lock, [this] { return open_; });
+        return !cancelled_;
+    }
+    const Cancel& cancelled() const { return cancelled_; }
+
+private:
+    std::mutex mutex_;
+    std::condition_variable opened_;
+    bool open_ = false;
+    Cancel cancelled_{false};
+};
 
 }  // namespace
 
@@ -226,7 +272,7 @@ bool searched_again(size_t base, size_t leaf, size_t levels) {
     return base * kFarFromBase > leaf && (undid_much(base, leaf) || levels == 0);
 }
 
-DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what) {
+DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what, unsigned threads) {
     validate_triangle_mesh(mesh, what);
     const uint32_t vertex_count = uint32_t(mesh.positions.size());
     DetectedBase out;
@@ -240,12 +286,31 @@ DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what) {
     // The search takes the triangles' order wherever two readings tie, and in some orders a few
     // wrong early readings keep it far from the base: such a search is run again over the
     // triangles in reverse order, and the coarser base stands (docs/IMPORT.md, "Searched twice").
-    SearchRun run = search_levels(renumbered, vertex_count);
-    if (searched_again(base_size(run, renumbered.size()), renumbered.size(), run.levels.size())) {
-        const std::vector<Triangle> reversed(renumbered.rbegin(), renumbered.rend());
-        SearchRun other = search_levels(reversed, vertex_count);
-        if (base_size(other, renumbered.size()) < base_size(run, renumbered.size())) run = std::move(other);
-    }
+    // With a second thread the reverse search runs beside the first (SecondSearchGate); on one
+    // thread it runs after it, when needed. Either way the answer is the same.
+    SearchRun run, other;
+    bool again = false;
+    SecondSearchGate gate;
+    const Cancel never{false};
+    parallel_for(2, resolve_thread_count(threads), [&](size_t task) {
+        if (task == 0) {
+            try {
+                run = search_levels(renumbered, vertex_count, never, [&](const SearchRun& so_far) {
+                    gate.open_if(undid_much(base_size(so_far, renumbered.size()), renumbered.size()));
+                });
+            } catch (...) {
+                gate.first_ended(false);  // the other task must not wait for ever
+                throw;
+            }
+            again = searched_again(base_size(run, renumbered.size()), renumbered.size(), run.levels.size());
+            gate.first_ended(again);
+        } else {
+            if (!gate.wait()) return;
+            const std::vector<Triangle> reversed(renumbered.rbegin(), renumbered.rend());
+            other = search_levels(reversed, vertex_count, gate.cancelled());
+        }
+    });
+    if (again && base_size(other, renumbered.size()) < base_size(run, renumbered.size())) run = std::move(other);
     seed_everywhere_once_stopped(renumbered, vertex_count, run);
     out.levels = std::move(run.levels);
     for (DetectedLevel& level : out.levels) {

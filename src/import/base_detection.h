@@ -27,8 +27,9 @@ struct DetectedBase {
     std::vector<DetectedLevel> levels;          // the levels undone, finest first
 };
 
-// Validates `mesh` (validate_triangle_mesh; `what` names it in messages) and finds its base.
-DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what = "mesh");
+// Validates `mesh` (validate_triangle_mesh; `what` names it in messages) and finds its base, on
+// up to two of `threads` threads (0: every core; the answer does not depend on it).
+DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what = "mesh", unsigned threads = 0);
 
 // Whether a search that left `base` of the `leaf` triangles, undoing `levels` levels, is run again
 // over the triangles in reverse order (docs/IMPORT.md, "Searched twice"): its base keeps more than

@@ -6,8 +6,8 @@
 
 namespace amc {
 
-ImportedHierarchy import_mesh(const TriangleMesh& mesh, const std::string& what) {
-    const DetectedBase detected = detect_base(mesh, what);
+ImportedHierarchy import_mesh(const TriangleMesh& mesh, const std::string& what, unsigned threads) {
+    const DetectedBase detected = detect_base(mesh, what, threads);
     // The build checks the result against the input; should a detected level ever fail that
     // check, the coarser levels are given up one by one, down to the mesh itself as its base.
     for (size_t levels = detected.levels.size();; --levels) {
