@@ -715,6 +715,79 @@ TEST(CraftedFiles, ImportOfPositionsOfOneHashIsLinear) {
     EXPECT_LT(milliseconds, 1000.0 * kSanitizerSlowdown);
 }
 
+// A triangulated side x side grid numbered so that one direction of each edge of a perfect
+// matching (horizontal pairs) hashes into the first 512 slots of the import's table of directed
+// edges (hierarchy_from_levels: open addressing over the next power of two of 6 keys a face), as
+// its hash was until 2026-12-07: (k G) ^ (k G >> 29) for k = a << 32 | b. For a given b, the slot
+// fixes a modulo 2^(m-3), so a is solved; b is drawn from the unused ids until one fits.
+TriangleMesh grid_of_one_edge_run(uint32_t side) {
+    const uint32_t vertices = side * side;
+    const uint64_t faces = 2ull * (side - 1) * (side - 1);
+    uint64_t slots = 16;
+    while (slots < 6 * faces) slots *= 2;
+    int bits = 0;
+    while ((uint64_t(1) << bits) < slots) ++bits;
+    const uint64_t mask = slots - 1, residues = uint64_t(1) << (bits - 3);
+    uint64_t inverse = kGoldenGamma;  // Newton's iteration for the inverse mod 2^64
+    for (int i = 0; i < 5; ++i) inverse *= 2 - kGoldenGamma * inverse;
+    std::vector<uint32_t> id(vertices, kNoIndex), unused(vertices);
+    std::vector<uint8_t> used(vertices, 0);
+    for (uint32_t i = 0; i < vertices; ++i) unused[i] = i;
+    SplitMix64 random{11};
+    for (uint32_t i = vertices; i > 1; --i) std::swap(unused[i - 1], unused[random.below(i)]);
+    size_t next = 0;
+    auto take = [&] {
+        while (used[unused[next]]) ++next;
+        used[unused[next]] = 1;
+        return unused[next];
+    };
+    for (uint32_t v = 0; v + 1 < vertices; v += 2) {  // vertex v + 1 gets a, vertex v gets b
+        for (int tries = 0; tries < 8 && id[v] == kNoIndex; ++tries) {
+            const uint32_t b = take();
+            const uint64_t u = uint64_t(b) * kGoldenGamma;
+            for (uint64_t slot = (u ^ (u >> 29)) & 7; slot < 512 && id[v] == kNoIndex; slot += 8) {
+                const uint64_t want = ((slot ^ (u & mask)) >> 3) & (residues - 1);
+                for (uint64_t a = ((want - (u >> 32)) * inverse) & (residues - 1); a < vertices; a += residues) {
+                    if (used[a]) continue;
+                    used[a] = 1;
+                    id[v + 1] = uint32_t(a);
+                    id[v] = b;
+                    break;
+                }
+            }
+            if (id[v] == kNoIndex) used[b] = 0;
+            std::swap(unused[next], unused[next + random.below(vertices - next)]);
+        }
+    }
+    for (uint32_t v = 0; v < vertices; ++v)
+        if (id[v] == kNoIndex) id[v] = take();
+    TriangleMesh mesh;
+    mesh.positions.resize(vertices);
+    for (uint32_t v = 0; v < vertices; ++v) mesh.positions[id[v]] = {double(v % side), double(v / side), 0};
+    for (uint32_t j = 0; j + 1 < side; ++j) {
+        for (uint32_t i = 0; i + 1 < side; ++i) {
+            const uint32_t a = j * side + i, b = a + 1, c = a + side, d = c + 1;
+            mesh.triangles.push_back({id[a], id[b], id[d]});
+            mesh.triangles.push_back({id[a], id[d], id[c]});
+        }
+    }
+    return mesh;
+}
+
+// That grid (160,000 vertices) imported without a base: the edges of the matching, half the
+// vertices, probed one run of slots (3.8 s of CPU here until 2026-12-07, docs/FUZZING.md); 1.3 s
+// since the table's hash is keyed per process, most of it base detection.
+TEST(CraftedFiles, ImportOfEdgesInOneProbeRunIsLinear) {
+    const TriangleMesh mesh = grid_of_one_edge_run(kSanitizerSlowdown > 1 ? 150 : 400);
+    const double start = cpu_milliseconds();
+    const ImportedHierarchy imported = import_mesh(mesh);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  import of a %zu-face grid, a matching's edges in one probe run: %.1f ms\n", mesh.triangles.size(),
+                milliseconds);
+    EXPECT_EQ(imported.vertex_of_input.size(), mesh.positions.size());
+    EXPECT_LT(milliseconds, 2000.0 * kSanitizerSlowdown);
+}
+
 // A half disc of 2^15 roots around one boundary vertex, in clockwise order, refined once with its
 // new vertices moved off their edges: the uniform way reads it in time linear in it. Each root at
 // that vertex searched its out-edges for the one toward its next corner, since its turn around
