@@ -775,8 +775,9 @@ TriangleMesh grid_of_one_edge_run(uint32_t side) {
 }
 
 // That grid (160,000 vertices) imported without a base: the edges of the matching, half the
-// vertices, probed one run of slots (3.8 s of CPU here until 2026-12-07, docs/FUZZING.md); 1.3 s
-// since the table's hash is keyed per process, most of it base detection.
+// vertices, probed one run of slots (3.6-3.8 s of this thread's CPU here until 2026-12-07,
+// docs/FUZZING.md); 0.6 s since the table's hash is keyed per process, most of it base detection
+// (whose second thread is not counted).
 TEST(CraftedFiles, ImportOfEdgesInOneProbeRunIsLinear) {
     const TriangleMesh mesh = grid_of_one_edge_run(kSanitizerSlowdown > 1 ? 150 : 400);
     const double start = cpu_milliseconds();
