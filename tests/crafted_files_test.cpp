@@ -639,7 +639,7 @@ TEST(CraftedFiles, ImportOfAHighValenceLeafMeshIsLinear) {
     refine_uniformly(refined, 1);
     const LeafMesh leaf = extract_leaf_mesh(refined);
     const double start = cpu_milliseconds();
-    const ImportedHierarchy imported = import_mesh(leaf.mesh);
+    const ImportedHierarchy imported = import_mesh(leaf.mesh, "mesh", 1);  // one thread: cpu_milliseconds counts it all
     const double milliseconds = cpu_milliseconds() - start;
     std::printf("  import of %zu faces: %.1f ms\n", leaf.mesh.triangles.size(), milliseconds);
     EXPECT_EQ(imported.hierarchy.root_count(), refined.root_count());
@@ -776,17 +776,18 @@ TriangleMesh grid_of_one_edge_run(uint32_t side) {
 
 // That grid (160,000 vertices) imported without a base: the edges of the matching, half the
 // vertices, probed one run of slots (3.6-3.8 s of this thread's CPU here until 2026-12-07,
-// docs/FUZZING.md); 0.6 s since the table's hash is keyed per process, most of it base detection
-// (whose second thread is not counted).
+// docs/FUZZING.md); 0.6 s since the table's hash is keyed per process, most of it base detection,
+// whose second search a second thread ran: on one thread here (so that this thread's CPU counts
+// all of it) 1.4-1.5 s, hence the bound.
 TEST(CraftedFiles, ImportOfEdgesInOneProbeRunIsLinear) {
     const TriangleMesh mesh = grid_of_one_edge_run(kSanitizerSlowdown > 1 ? 150 : 400);
     const double start = cpu_milliseconds();
-    const ImportedHierarchy imported = import_mesh(mesh);
+    const ImportedHierarchy imported = import_mesh(mesh, "mesh", 1);
     const double milliseconds = cpu_milliseconds() - start;
     std::printf("  import of a %zu-face grid, a matching's edges in one probe run: %.1f ms\n", mesh.triangles.size(),
                 milliseconds);
     EXPECT_EQ(imported.vertex_of_input.size(), mesh.positions.size());
-    EXPECT_LT(milliseconds, 2000.0 * kSanitizerSlowdown);
+    EXPECT_LT(milliseconds, 3000.0 * kSanitizerSlowdown);
 }
 
 // A half disc of 2^15 roots around one boundary vertex, in clockwise order, refined once with its
