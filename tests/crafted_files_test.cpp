@@ -13,6 +13,8 @@
 #include "coding/hierarchy/hierarchy_stream.h"
 #include "common/bits.h"
 #include "common/mixing.h"
+#include "geometry/reference_surface.h"
+#include "geometry/shape_improvement.h"
 #include "geometry/surface_quality.h"
 #include "import/leaf_detour.h"
 #include "mesh/vtu_reader.h"
@@ -923,6 +925,49 @@ TEST(CraftedFiles, DistanceToAFanOfLongTrianglesIsNotMeasuredForLong) {
     const SurfaceDistance same = surface_distance(octahedron, octahedron, 1e-2);
     EXPECT_TRUE(same.complete());
     EXPECT_LT(same.max_upper, 2e-2);
+}
+
+// A height field of side x side squares, two triangles each, over [0, 1]^2; `jitter` (a fraction
+// of a square) moves the inner vertices off the lattice, so that relaxation has work.
+TriangleMesh bumpy_grid(uint32_t side, double jitter = 0) {
+    TriangleMesh mesh;
+    for (uint32_t j = 0; j <= side; ++j) {
+        for (uint32_t i = 0; i <= side; ++i) {
+            const bool inner = i > 0 && j > 0 && i < side && j < side;
+            const double dx = inner ? jitter * std::sin(12.9898 * i + 78.233 * j) : 0;
+            const double dy = inner ? jitter * std::cos(39.346 * i + 11.135 * j) : 0;
+            const double x = (i + dx) / side, y = (j + dy) / side;
+            mesh.positions.push_back({x, y, 0.05 * std::sin(6 * x) * std::cos(5 * y)});
+        }
+    }
+    for (uint32_t j = 0; j < side; ++j) {
+        for (uint32_t i = 0; i < side; ++i) {
+            const uint32_t a = j * (side + 1) + i, b = a + 1, c = a + side + 1, d = c + 1;
+            mesh.triangles.push_back({a, b, d});
+            mesh.triangles.push_back({a, d, c});
+        }
+    }
+    return mesh;
+}
+
+// The remesher's base improvement of a large base (20,000 triangles) on a reference of 40,401
+// vertices, in time linear in both: the largest distance of a reference vertex to the base, its
+// bound, was a loop over every base triangle for every reference vertex (`amc refine --model
+// surface --base-faces 20000` of bunny-hr spent 14 of its 16.5 s there) until 2026-12-07
+// (docs/FUZZING.md).
+TEST(CraftedFiles, ShapeImprovementOfALargeBaseIsLinear) {
+    const TriangleMesh reference = bumpy_grid(200);
+    const ReferenceSurface surface(reference);
+    TriangleMesh base = bumpy_grid(100, 0.3);
+    const std::vector<uint8_t> locked(base.positions.size(), 0);
+    const double start = cpu_milliseconds();
+    const ShapeImprovementStats stats = improve_shapes(base, surface, reference, locked);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  shape improvement of %zu triangles on %zu reference vertices: %.1f ms, %u flips, %u moves\n",
+                base.triangles.size(), reference.positions.size(), milliseconds, stats.flips, stats.moves);
+    EXPECT_EQ(stats.fold_overs_after, 0u);
+    EXPECT_GE(stats.min_quality_after, stats.min_quality_before);
+    EXPECT_LT(milliseconds, 1500.0 * kSanitizerSlowdown);
 }
 
 // A series of 2^17 unchanged frames over a tetrahedron after one keyframe (3.5 MB), read in order

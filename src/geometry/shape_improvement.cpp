@@ -60,12 +60,16 @@ class Improver {
 public:
     Improver(TriangleMesh& mesh, const ReferenceSurface& surface, const TriangleMesh& reference)
         : mesh_(mesh), surface_(surface), reference_(reference), owned_(mesh.triangles.size()) {
+        // The nearest triangle's distance is owned_error over the whole mesh (the query's is the
+        // same closest_point_on_triangle), without a loop over all triangles for every vertex.
         const ClosestPointQuery nearest(mesh);
-        for (uint32_t v = 0; v < reference.positions.size(); ++v)
-            owned_[nearest.closest(reference.positions[v]).triangle].push_back(v);
-        std::vector<uint32_t> all(mesh.triangles.size());
-        for (uint32_t t = 0; t < all.size(); ++t) all[t] = t;
-        allowed_owned_ = owned_error(all, mesh.triangles);
+        double farthest_squared = 0;
+        for (uint32_t v = 0; v < reference.positions.size(); ++v) {
+            const ClosestPointQuery::Hit hit = nearest.closest(reference.positions[v]);
+            owned_[hit.triangle].push_back(v);
+            farthest_squared = std::max(farthest_squared, hit.distance_squared);
+        }
+        allowed_owned_ = std::sqrt(farthest_squared);
         allowed_chord_ = chord_error(mesh.triangles);
     }
 
