@@ -1393,6 +1393,23 @@ uint64_t morton_2d(uint64_t x, uint64_t y) {
     return m;
 }
 
+// One quadtree refined to the finest level at the lattice points whose Morton codes `targets`
+// (sorted) lists.
+OctreeForest quadtree_refined_at(const std::vector<uint64_t>& targets) {
+    OctreeForest forest;
+    forest.connectivity = brick_connectivity(2, 1, 1);
+    forest.tree_offsets = {0, 1};
+    forest.leaves = {Octant{}};
+    return refine_octree_forest(
+        forest,
+        [&](uint32_t, const Octant& o) {
+            const uint64_t first = morton_2d(uint64_t(o.x), uint64_t(o.y)), end = first + (uint64_t(1) << (2 * (30 - o.level)));
+            const auto it = std::lower_bound(targets.begin(), targets.end(), first);
+            return it != targets.end() && *it < end;
+        },
+        octree_max_level(2));
+}
+
 // One quadtree refined to the finest level at 10,000 points (x, y), x even and consecutive, y the
 // even one of the two smallest with x * 2^31 + y = 0 mod P, P the bucket count libstdc++'s
 // unordered_map has at the forest's corner count: the VTU's corner index (keys x << 31 | y, the
@@ -1410,18 +1427,7 @@ TEST(CraftedFiles, OctreeVtuOfCornersInOneBucketIsLinear) {
         targets.push_back(morton_2d(x, y));
     }
     std::sort(targets.begin(), targets.end());
-    OctreeForest forest;
-    forest.connectivity = brick_connectivity(2, 1, 1);
-    forest.tree_offsets = {0, 1};
-    forest.leaves = {Octant{}};
-    forest = refine_octree_forest(
-        forest,
-        [&](uint32_t, const Octant& o) {
-            const uint64_t first = morton_2d(uint64_t(o.x), uint64_t(o.y)), end = first + (uint64_t(1) << (2 * (30 - o.level)));
-            const auto it = std::lower_bound(targets.begin(), targets.end(), first);
-            return it != targets.end() && *it < end;
-        },
-        octree_max_level(2));
+    const OctreeForest forest = quadtree_refined_at(targets);
     std::vector<uint64_t> corners;  // the index's keys
     for (const Octant& o : forest.leaves) {
         const uint64_t length = uint64_t(1) << (30 - o.level);
@@ -1463,18 +1469,7 @@ TEST(CraftedFiles, ConformingMeshOfPointsInOneRunOfSlotsIsLinear) {
             if (y == first + span) y = first, x += 2;
         }
         std::sort(targets.begin(), targets.end());
-        forest.connectivity = brick_connectivity(2, 1, 1);
-        forest.tree_offsets = {0, 1};
-        forest.leaves = {Octant{}};
-        forest.leaf_data.clear();
-        forest = refine_octree_forest(
-            forest,
-            [&](uint32_t, const Octant& o) {
-                const uint64_t begin = morton_2d(uint64_t(o.x), uint64_t(o.y)), end = begin + (uint64_t(1) << (2 * (30 - o.level)));
-                const auto it = std::lower_bound(targets.begin(), targets.end(), begin);
-                return it != targets.end() && *it < end;
-            },
-            octree_max_level(2));
+        forest = quadtree_refined_at(targets);
         int bits = 6;  // ForestPoints starts at 64 slots
         while ((uint64_t(1) << bits) < 2 * (2 * forest.leaves.size() + 64)) ++bits;
         if (bits == slot_bits) break;
