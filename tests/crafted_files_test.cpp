@@ -930,22 +930,14 @@ TEST(CraftedFiles, DistanceToAFanOfLongTrianglesIsNotMeasuredForLong) {
 // A height field of side x side squares, two triangles each, over [0, 1]^2; `jitter` (a fraction
 // of a square) moves the inner vertices off the lattice, so that relaxation has work.
 TriangleMesh bumpy_grid(uint32_t side, double jitter = 0) {
-    TriangleMesh mesh;
-    for (uint32_t j = 0; j <= side; ++j) {
-        for (uint32_t i = 0; i <= side; ++i) {
-            const bool inner = i > 0 && j > 0 && i < side && j < side;
-            const double dx = inner ? jitter * std::sin(12.9898 * i + 78.233 * j) : 0;
-            const double dy = inner ? jitter * std::cos(39.346 * i + 11.135 * j) : 0;
-            const double x = (i + dx) / side, y = (j + dy) / side;
-            mesh.positions.push_back({x, y, 0.05 * std::sin(6 * x) * std::cos(5 * y)});
-        }
-    }
-    for (uint32_t j = 0; j < side; ++j) {
-        for (uint32_t i = 0; i < side; ++i) {
-            const uint32_t a = j * (side + 1) + i, b = a + 1, c = a + side + 1, d = c + 1;
-            mesh.triangles.push_back({a, b, d});
-            mesh.triangles.push_back({a, d, c});
-        }
+    TriangleMesh mesh = make_square(int(side));
+    for (Vec3& p : mesh.positions) {
+        const double i = std::round(p.x * side), j = std::round(p.y * side);
+        const bool inner = i > 0 && j > 0 && i < side && j < side;
+        const double dx = inner ? jitter * std::sin(12.9898 * i + 78.233 * j) : 0;
+        const double dy = inner ? jitter * std::cos(39.346 * i + 11.135 * j) : 0;
+        const double x = (i + dx) / side, y = (j + dy) / side;
+        p = {x, y, 0.05 * std::sin(6 * x) * std::cos(5 * y)};
     }
     return mesh;
 }
