@@ -27,8 +27,8 @@ TripleKey triple_key(uint32_t a, uint32_t b, uint32_t c) {
 }
 // Keyed (common/keyed_hash.h): the ids are the input's numbering, which a file chooses, and an
 // unkeyed multiply-xorshift let one direction of a matching's edges fill one probe run.
-size_t hash_of(TripleKey k, uint64_t key) { return size_t(splitmix64_mix(splitmix64_mix(k.low ^ key) ^ k.high)); }
-size_t hash_of(uint64_t k, uint64_t key) { return size_t(splitmix64_mix(k ^ key)); }
+size_t hash_of(TripleKey k, const KeyedWordHash& hash) { return size_t(splitmix64_mix(hash(k.low) ^ k.high)); }
+size_t hash_of(uint64_t k, const KeyedWordHash& hash) { return hash(k); }
 
 // Open addressing with linear probing, sized once for at most `count` keys: the node and edge
 // tables here hold a few entries per leaf face, and a node-based map spent most of this file's
@@ -53,12 +53,12 @@ public:
 
 private:
     size_t probe(Key key) const {
-        size_t s = hash_of(key, hash_key_) & (slots_.size() - 1);
+        size_t s = hash_of(key, hash_) & (slots_.size() - 1);
         while (!(slots_[s].first == empty_) && !(slots_[s].first == key)) s = (s + 1) & (slots_.size() - 1);
         return s;
     }
     Key empty_;
-    const uint64_t hash_key_ = process_hash_key();
+    const KeyedWordHash hash_;
     std::vector<std::pair<Key, Value>> slots_;
 };
 
