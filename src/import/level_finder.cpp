@@ -497,7 +497,7 @@ std::vector<uint32_t> LevelFinder::free_near(std::vector<uint32_t> ring, int rin
 
 void LevelFinder::hold(uint32_t id, bool on) {
     const Patch& patch = patches_[id];
-    std::vector<Side> sides;
+    std::vector<Side> closures;
     // Read with the patch's id on its blocks (the triangles it holds carry that id, so a
     // release reads its closures as such), then set.
     for (uint32_t i = patch.first; i < patch.end; ++i) {
@@ -506,12 +506,12 @@ void LevelFinder::hold(uint32_t id, bool on) {
     for (uint32_t i = patch.first; i < patch.end; ++i) {
         if (!blocks_[i].alive) continue;
         for (int e = 0; e < 3; ++e) {
-            sides.push_back(classify(i, e));
+            const Side side = classify(i, e);
+            if (side.kind == Side::green) closures.push_back(side);
         }
         if (!on) blocks_[i].patch = kNoIndex;
     }
-    for (const Side& side : sides) {
-        if (side.kind != Side::green) continue;
+    for (const Side& side : closures) {
         for (int k = 0; k < side.count; ++k) closure_of_[side.group[k]] = on ? id : kNoIndex;
         for (uint32_t v : side.coarse) on ? ++pinned_old_[v] : --pinned_old_[v];
     }
