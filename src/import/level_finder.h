@@ -115,9 +115,12 @@ public:
                 if (h != kNoHalfEdge) refined_near_[h / 3] = 1;
             }
         }
-        // Room for every triangle's shape up front: pages never read stay unused, where growing
-        // would copy the shapes and hold both copies (the peak memory of a uniform mesh's step).
-        shapes_.reserve(tri_.size());
+        // A large mesh's shapes get room for every triangle up front: the allocator maps so large
+        // a block, whose pages never read stay unused, where growing would copy the shapes and
+        // hold both copies (the peak memory of a uniform mesh's step). A small one's would sit in
+        // the heap, whose reused pages are resident.
+        constexpr size_t kShapesReserved = size_t(1) << 18;
+        if (tri_.size() >= kShapesReserved) shapes_.reserve(tri_.size());
     }
 
     // Commits patches best first, in rounds (patches that could not grow while other readings were
