@@ -1006,6 +1006,29 @@ TEST(CraftedFiles, ShapeImprovementOfALargeBaseIsLinear) {
     EXPECT_LT(milliseconds, 1500.0 * kSanitizerSlowdown);
 }
 
+// The remesher's base improvement of a bipyramid of 2^13 sides, apexes off its axis, on itself:
+// the guard of an apex's move compared each reference vertex its ring owns with every triangle of
+// the ring, time the square of the valence, until 2026-12-07; the ring is now searched by a
+// ClosestPointQuery, whose apex forms a fan of direction cones (docs/REMESHER.md, "Fans of long
+// triangles").
+TEST(CraftedFiles, ShapeImprovementAroundAVertexOfHighValenceIsFast) {
+    const uint32_t sides = uint32_t(1) << (kSanitizerSlowdown > 1 ? 11 : 13);
+    TriangleMesh reference = bipyramid(sides);
+    reference.positions[sides] = {0.3, 0.1, 1};
+    reference.positions[sides + 1] = {-0.2, 0.1, -1};
+    const ReferenceSurface surface(reference);
+    TriangleMesh base = reference;
+    const std::vector<uint8_t> locked(base.positions.size(), 0);
+    const double start = cpu_milliseconds();
+    const ShapeImprovementStats stats = improve_shapes(base, surface, reference, locked);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  shape improvement of a bipyramid of %u sides on itself: %.1f ms, %u flips, %u moves\n", sides, milliseconds,
+                stats.flips, stats.moves);
+    EXPECT_EQ(stats.fold_overs_after, 0u);
+    EXPECT_GE(stats.min_quality_after, stats.min_quality_before);
+    EXPECT_LT(milliseconds, 600.0 * kSanitizerSlowdown);  // 199 ms in Release; 1,932 ms before
+}
+
 // A series of 2^17 unchanged frames over a tetrahedron after one keyframe (3.5 MB), read in order
 // in time linear in the frames: each frame(k) walked back to the keyframe to find where to start,
 // though the reader held frame k - 1 (6.6 s of CPU until 2026-12-07, docs/FUZZING.md; `amc
