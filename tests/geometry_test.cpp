@@ -445,7 +445,7 @@ TEST(ClosestPointQuery, FanOfHighValenceAnswersAsTheBoxTree) {
         return !a || (a->triangle == b->triangle && a->point == b->point && a->distance_squared == b->distance_squared &&
                       a->barycentric == b->barycentric);
     };
-    int lines_hit = 0;
+    int lines_hit = 0, normals_hit = 0;
     for (const Vec3& p : queries_near_a_fan(mesh, 9)) {
         const double reach = std::pow(10.0, -4 * unit(rng));
         ASSERT_TRUE(same(fans.closest(p, reach), boxes.closest(p, reach)));
@@ -454,8 +454,16 @@ TEST(ClosestPointQuery, FanOfHighValenceAnswersAsTheBoxTree) {
         const std::optional<ClosestPointQuery::Hit> line = fans.intersect_line(p, direction, reach);
         ASSERT_TRUE(same(line, boxes.intersect_line(p, direction, reach)));
         lines_hit += line.has_value();
+        // Along the normal of the nearest triangle, as the remesher projects, and widened.
+        const Triangle& t = mesh.triangles[fans.closest(p).triangle];
+        const Vec3 normal = cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]);
+        const std::optional<ClosestPointQuery::Hit> along = fans.intersect_line(p, normal, reach);
+        ASSERT_TRUE(same(along, boxes.intersect_line(p, normal, reach)));
+        ASSERT_TRUE(same(fans.intersect_line(p, normal, reach, 1e-9), boxes.intersect_line(p, normal, reach, 1e-9)));
+        normals_hit += along.has_value();
     }
     EXPECT_GT(lines_hit, 1000);
+    EXPECT_GT(normals_hit, 3000);
 }
 
 TEST(ClosestPointQuery, RejectsUnusableMeshesAndPoints) {

@@ -560,6 +560,30 @@ double ClosestPointQuery::cone_node_distance_squared(const ConeNode& node, Vec3 
     return gap > 0 ? std::max(box, gap * gap) : box;
 }
 
+// False when a plane through the apex has the node's cone on one side and the segment from
+// apex + w0 to apex + w1 more than `slack` beyond it on the other: the plane at 90 degrees plus
+// the half-angle from the axis, towards the segment's direction nearest the axis (where the plane
+// through the apex and the segment comes nearest it, else the nearer end's). Any such plane would
+// do: its choice only decides how often the test prunes.
+bool ClosestPointQuery::cone_may_meet_segment(const ConeNode& node, Vec3 w0, Vec3 w1, double slack) const {
+    if (!node.has_cone) return true;
+    const Vec3 u = node.axis;
+    const double l0 = std::sqrt(squared_length(w0)), l1 = std::sqrt(squared_length(w1));
+    if (!(l0 > 0 && l1 > 0)) return true;
+    Vec3 nearest = dot(w0, u) * l1 >= dot(w1, u) * l0 ? w0 : w1;
+    const Vec3 normal = cross(w0, w1);
+    const double normal_squared = squared_length(normal);
+    if (normal_squared > 0) {
+        const Vec3 in_plane = u - (dot(u, normal) / normal_squared) * normal;
+        if (dot(cross(w0, in_plane), normal) >= 0 && dot(cross(in_plane, w1), normal) >= 0) nearest = in_plane;
+    }
+    const Vec3 radial = nearest - dot(nearest, u) * u;
+    const double radial_length = std::sqrt(squared_length(radial));
+    if (!(radial_length > 0)) return true;
+    const Vec3 side = (node.cosine / radial_length) * radial - node.sine * u;  // unit, at 90 degrees + a from u
+    return !(dot(w0, side) > slack && dot(w1, side) > slack);
+}
+
 template <class Accept>
 std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p, double bound_squared, const Accept& accept,
                                                                 uint64_t* tested) const {
@@ -742,14 +766,21 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 ori
             }
         }
     };
-    // A fan's tree, by its boxes.
+    // A fan's tree, by its boxes and (unless triangles are widened) its cones.
     auto search_fan = [&](const Fan& fan) {
+        const Vec3 from_apex = origin - fan.apex;
+        auto may_meet = [&](const ConeNode& node) {
+            if (tolerance > 0) return true;
+            const Vec3 w0 = from_apex - best * d, w1 = from_apex + best * d;
+            return cone_may_meet_segment(node, w0, w1, kConeSlack * (std::sqrt(squared_length(w0)) + std::sqrt(squared_length(w1))) + 2 * margin_);
+        };
         struct ConeEntry {
             uint32_t node;
             double near;
         };
         ConeEntry stack[kConeStackSize];
         int size = 0;
+        if (!may_meet(cone_nodes_[fan.root])) return;
         stack[size++] = {fan.root, 0.0};
         while (size > 0) {
             const ConeEntry entry = stack[--size];
@@ -763,7 +794,7 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 ori
             bool hit[2];
             for (uint32_t slot = 0; slot < 2; ++slot) {
                 const ConeNode& child = cone_nodes_[node.index + slot];
-                hit[slot] = enters(child.lo, child.hi, near[slot]);
+                hit[slot] = enters(child.lo, child.hi, near[slot]) && may_meet(child);
             }
             const int first = hit[1] && (!hit[0] || near[1] < near[0]) ? 1 : 0;
             for (int slot : {1 - first, first}) {
