@@ -13,6 +13,7 @@
 #include "coding/hierarchy/hierarchy_stream.h"
 #include "common/bits.h"
 #include "common/mixing.h"
+#include "geometry/closest_point.h"
 #include "geometry/reference_surface.h"
 #include "geometry/shape_improvement.h"
 #include "geometry/surface_quality.h"
@@ -44,6 +45,7 @@
 #include <fstream>
 #include <functional>
 #include <new>
+#include <optional>
 #include <string>
 #include <unordered_map>
 
@@ -903,14 +905,74 @@ TEST(CraftedFiles, DetourAcrossAFanOfHighValenceIsLinear) {
     EXPECT_LT(milliseconds, 300.0 * kSanitizerSlowdown);
 }
 
-// The distance between a bipyramid of 2^11 sides and itself (its long triangles' boxes all overlap
-// near the apexes, so a closest-point query there tests every one): refused as not measured in
-// time linear in the mesh. The measure ran its 4 * 10^6 evaluations at about 400 boxes and
-// triangles each (`amc refine --model surface` of this input measured for 31.5 s of CPU, of 2^13
-// sides 99.6 s) until 2026-12-07 (docs/FUZZING.md).
+// The same triangles with every corner its own vertex: the same surface without a vertex of high
+// valence, so its fans stay in ClosestPointQuery's box tree.
+TriangleMesh without_shared_vertices(const TriangleMesh& mesh) {
+    TriangleMesh apart;
+    for (const Triangle& t : mesh.triangles) {
+        const uint32_t base = static_cast<uint32_t>(apart.positions.size());
+        for (uint32_t v : t) apart.positions.push_back(mesh.positions[v]);
+        apart.triangles.push_back({base, base + 1, base + 2});
+    }
+    return apart;
+}
+
+// 5,000 closest points near the apex of a bipyramid of 2^16 sides, 1e-3 off the middle of a face 1-50 %
+// of the way to the rim: the boxes of its long triangles all overlap there, so each query tested a
+// share of all of them until 2026-12-07 (docs/REMESHER.md, "Fans of long triangles"); the apexes'
+// fans are now searched by their directions from the apex (ClosestPointQuery's direction cones).
+TEST(CraftedFiles, ClosestPointsNearAVertexOfHighValenceTestFewTriangles) {
+    const uint32_t sides = uint32_t(1) << (kSanitizerSlowdown > 1 ? 13 : 16);
+    const TriangleMesh mesh = bipyramid(sides);
+    const Vec3 apex = mesh.positions[sides];
+    const int kQueries = kSanitizerSlowdown > 1 ? 1000 : 5000;
+    const ClosestPointQuery query(mesh);
+    uint64_t tested = 0;
+    const double start = cpu_milliseconds();
+    for (int i = 0; i < kQueries; ++i) {
+        const uint32_t face = uint32_t((uint64_t(i) * 2654435761u) % sides);  // upper triangle 2 * face
+        const Vec3 a = mesh.positions[face], b = mesh.positions[(face + 1) % sides];
+        const Vec3 normal = cross(b - a, apex - a);
+        const double t = 0.01 + 0.49 * double(i) / kQueries;
+        const Vec3 on = (1 - t) * apex + t * (0.5 * (a + b));
+        const Vec3 p = on + (1e-3 / std::sqrt(dot(normal, normal))) * normal;
+        const ClosestPointQuery::Hit hit = query.closest(p, tested);
+        ASSERT_EQ(hit.triangle, 2 * face) << i;
+        ASSERT_NEAR(std::sqrt(hit.distance_squared), 1e-3, 1e-12) << i;
+    }
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  %d closest points near the apex of a bipyramid of %u sides: %.1f ms, %.1f boxes and triangles tested each\n",
+                kQueries, sides, milliseconds, double(tested) / kQueries);
+    EXPECT_LT(tested, 100u * kQueries);  // 59.6 a query; 21,725 before
+    EXPECT_LT(milliseconds, 300.0 * kSanitizerSlowdown);  // 20 ms in Release; 1.45 s before
+    // The same points projected along the face's normal (as the remesher places a vertex): the
+    // fan's cones prune the lines too (8.6 ms in Release; 1,414 ms with its boxes alone).
+    const double lines_start = cpu_milliseconds();
+    for (int i = 0; i < kQueries; ++i) {
+        const uint32_t face = uint32_t((uint64_t(i) * 2654435761u) % sides);
+        const Vec3 a = mesh.positions[face], b = mesh.positions[(face + 1) % sides];
+        const Vec3 normal = cross(b - a, apex - a);
+        const double t = 0.01 + 0.49 * double(i) / kQueries;
+        const Vec3 on = (1 - t) * apex + t * (0.5 * (a + b));
+        const Vec3 p = on + (1e-3 / std::sqrt(dot(normal, normal))) * normal;
+        const std::optional<ClosestPointQuery::Hit> hit = query.intersect_line(p, normal, 2e-3);
+        ASSERT_TRUE(hit.has_value()) << i;
+        ASSERT_EQ(hit->triangle, 2 * face) << i;
+    }
+    const double lines_milliseconds = cpu_milliseconds() - lines_start;
+    std::printf("  %d lines through them: %.1f ms\n", kQueries, lines_milliseconds);
+    EXPECT_LT(lines_milliseconds, 300.0 * kSanitizerSlowdown);
+}
+
+// The distance between a bipyramid of 2^11 sides without shared vertices and itself (its long
+// triangles' boxes all overlap near the apexes, so a closest-point query there tests every one):
+// refused as not measured in time linear in the mesh. The measure ran its 4 * 10^6 evaluations at
+// about 400 boxes and triangles each (`amc refine --model surface` of the bipyramid measured for
+// 31.5 s of CPU, of 2^13 sides 99.6 s) until 2026-12-07 (docs/FUZZING.md). With its vertices
+// shared the bipyramid is now measured: its apexes' fans are searched by direction cones.
 TEST(CraftedFiles, DistanceToAFanOfLongTrianglesIsNotMeasuredForLong) {
     const uint32_t sides = uint32_t(1) << 11;
-    const TriangleMesh fan = bipyramid(sides);
+    const TriangleMesh fan = without_shared_vertices(bipyramid(sides));
     const double start = cpu_milliseconds();
     const SurfaceDistance d = surface_distance(fan, fan);
     const double milliseconds = cpu_milliseconds() - start;
@@ -960,6 +1022,29 @@ TEST(CraftedFiles, ShapeImprovementOfALargeBaseIsLinear) {
     EXPECT_EQ(stats.fold_overs_after, 0u);
     EXPECT_GE(stats.min_quality_after, stats.min_quality_before);
     EXPECT_LT(milliseconds, 1500.0 * kSanitizerSlowdown);
+}
+
+// The remesher's base improvement of a bipyramid of 2^13 sides, apexes off its axis, on itself:
+// the guard of an apex's move compared each reference vertex its ring owns with every triangle of
+// the ring, time the square of the valence, until 2026-12-07; the ring is now searched by a
+// ClosestPointQuery, whose apex forms a fan of direction cones (docs/REMESHER.md, "Fans of long
+// triangles").
+TEST(CraftedFiles, ShapeImprovementAroundAVertexOfHighValenceIsFast) {
+    const uint32_t sides = uint32_t(1) << (kSanitizerSlowdown > 1 ? 11 : 13);
+    TriangleMesh reference = bipyramid(sides);
+    reference.positions[sides] = {0.3, 0.1, 1};
+    reference.positions[sides + 1] = {-0.2, 0.1, -1};
+    const ReferenceSurface surface(reference);
+    TriangleMesh base = reference;
+    const std::vector<uint8_t> locked(base.positions.size(), 0);
+    const double start = cpu_milliseconds();
+    const ShapeImprovementStats stats = improve_shapes(base, surface, reference, locked);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  shape improvement of a bipyramid of %u sides on itself: %.1f ms, %u flips, %u moves\n", sides, milliseconds,
+                stats.flips, stats.moves);
+    EXPECT_EQ(stats.fold_overs_after, 0u);
+    EXPECT_GE(stats.min_quality_after, stats.min_quality_before);
+    EXPECT_LT(milliseconds, 600.0 * kSanitizerSlowdown);  // 199 ms in Release; 1,932 ms before
 }
 
 // A series of 2^17 unchanged frames over a tetrahedron after one keyframe (3.5 MB), read in order

@@ -8,6 +8,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <random>
 #include <utility>
 #include <vector>
@@ -353,6 +354,116 @@ TEST(ClosestPointQuery, BoundedQueryAgreesWithUnbounded) {
     // The bound is inclusive: a vertex at distance 0 is found with bound 0.
     EXPECT_TRUE(query.closest(mesh.positions[0], 0.0).has_value());
     EXPECT_FALSE(query.closest({5, 5, 5}, -1.0).has_value());
+}
+
+// A bipyramid of `sides` long triangles around two apexes off its axis (the remesher's case of
+// docs/REMESHER.md, "Fans of long triangles"), with repeats of some triangles (ties, the repeat
+// turned over for closest_facing) and zero-area triangles at the upper apex: a segment and a
+// triangle with the apex twice.
+TriangleMesh bipyramid_with_ties(uint32_t sides) {
+    TriangleMesh mesh;
+    for (uint32_t i = 0; i < sides; ++i) {
+        const double angle = 2 * kPi * double(i) / double(sides);
+        mesh.positions.push_back({std::cos(angle), std::sin(angle), 0});
+    }
+    const uint32_t top = sides, bottom = sides + 1;
+    mesh.positions.push_back({0.3, 0.1, 1});
+    mesh.positions.push_back({-0.2, 0.1, -1});
+    for (uint32_t i = 0; i < sides; ++i) {
+        mesh.triangles.push_back({i, (i + 1) % sides, top});
+        mesh.triangles.push_back({(i + 1) % sides, i, bottom});
+        if (i % 7 == 3) mesh.triangles.push_back({top, i, (i + 1) % sides});
+        if (i % 11 == 5) mesh.triangles.push_back({i, bottom, (i + 1) % sides});
+    }
+    mesh.triangles.push_back({top, 5, 5});
+    mesh.triangles.push_back({top, top, 9});
+    return mesh;
+}
+
+// The same triangles with every corner its own vertex: no vertex of high valence, so no fans.
+TriangleMesh without_shared_vertices(const TriangleMesh& mesh) {
+    TriangleMesh apart;
+    for (const Triangle& t : mesh.triangles) {
+        const uint32_t base = static_cast<uint32_t>(apart.positions.size());
+        for (uint32_t v : t) apart.positions.push_back(mesh.positions[v]);
+        apart.triangles.push_back({base, base + 1, base + 2});
+    }
+    return apart;
+}
+
+// Points near the bipyramid's upper apex (1e-7 to 1 away, in every direction), near its surface
+// (a point of a triangle moved off it by 0 to 1e-2), on its vertices, far away.
+std::vector<Vec3> queries_near_a_fan(const TriangleMesh& mesh, uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> gaussian;
+    std::uniform_real_distribution<double> unit(0, 1);
+    const Vec3 apex = mesh.positions[mesh.positions.size() - 2];
+    std::vector<Vec3> queries{apex, {0, 0, 0}, {100, -50, 7}};
+    for (int i = 0; i < 2000; ++i) {
+        const Vec3 direction = normalized({gaussian(rng), gaussian(rng), gaussian(rng)});
+        queries.push_back(apex + std::pow(10.0, -7 * unit(rng)) * direction);
+    }
+    for (int i = 0; i < 2000; ++i) {
+        const Triangle& t = mesh.triangles[std::uniform_int_distribution<size_t>(0, mesh.triangles.size() - 1)(rng)];
+        double u = unit(rng), v = unit(rng);
+        if (u + v > 1) u = 1 - u, v = 1 - v;
+        const Vec3 a = mesh.positions[t[0]], b = mesh.positions[t[1]], c = mesh.positions[t[2]];
+        const Vec3 on = a + u * (b - a) + v * (c - a);
+        const double off = i % 4 == 0 ? 0.0 : std::pow(10.0, -2 - 6 * unit(rng));
+        queries.push_back(on + off * Vec3{gaussian(rng), gaussian(rng), gaussian(rng)});
+    }
+    for (const Vec3& p : mesh.positions) queries.push_back(p);
+    return queries;
+}
+
+TEST(ClosestPointQuery, FanOfHighValenceMatchesBruteForce) {
+    const TriangleMesh mesh = bipyramid_with_ties(1024);
+    ASSERT_EQ(ClosestPointQuery(mesh).fan_count(), 2u);  // the apexes' fans, out of the box tree
+    expect_same_as_brute_force(mesh, queries_near_a_fan(mesh, 5));
+    // Far from the origin (the margins scale with the coordinates), and beyond float range.
+    for (double scale : {1e-30, 1e3, 1e60}) {
+        TriangleMesh scaled = mesh;
+        for (Vec3& p : scaled.positions) p = scale * p + Vec3{scale, -2 * scale, 0};
+        std::vector<Vec3> queries = queries_near_a_fan(mesh, 6);
+        queries.resize(800);
+        for (Vec3& p : queries) p = scale * p + Vec3{scale, -2 * scale, 0};
+        expect_same_as_brute_force(scaled, queries);
+    }
+}
+
+// The fans change no answer of the other queries either: each equals the box tree's alone.
+TEST(ClosestPointQuery, FanOfHighValenceAnswersAsTheBoxTree) {
+    const TriangleMesh mesh = bipyramid_with_ties(1024);
+    const ClosestPointQuery fans(mesh), boxes(without_shared_vertices(mesh));
+    ASSERT_EQ(fans.fan_count(), 2u);
+    ASSERT_EQ(boxes.fan_count(), 0u);
+    std::mt19937 rng(8);
+    std::normal_distribution<double> gaussian;
+    std::uniform_real_distribution<double> unit(0, 1);
+    auto same = [](const std::optional<ClosestPointQuery::Hit>& a, const std::optional<ClosestPointQuery::Hit>& b) {
+        if (a.has_value() != b.has_value()) return false;
+        return !a || (a->triangle == b->triangle && a->point == b->point && a->distance_squared == b->distance_squared &&
+                      a->barycentric == b->barycentric);
+    };
+    int lines_hit = 0, normals_hit = 0;
+    for (const Vec3& p : queries_near_a_fan(mesh, 9)) {
+        const double reach = std::pow(10.0, -4 * unit(rng));
+        ASSERT_TRUE(same(fans.closest(p, reach), boxes.closest(p, reach)));
+        const Vec3 direction{gaussian(rng), gaussian(rng), gaussian(rng)};
+        ASSERT_TRUE(same(fans.closest_facing(p, direction, 0.3, reach), boxes.closest_facing(p, direction, 0.3, reach)));
+        const std::optional<ClosestPointQuery::Hit> line = fans.intersect_line(p, direction, reach);
+        ASSERT_TRUE(same(line, boxes.intersect_line(p, direction, reach)));
+        lines_hit += line.has_value();
+        // Along the normal of the nearest triangle, as the remesher projects, and widened.
+        const Triangle& t = mesh.triangles[fans.closest(p).triangle];
+        const Vec3 normal = cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]);
+        const std::optional<ClosestPointQuery::Hit> along = fans.intersect_line(p, normal, reach);
+        ASSERT_TRUE(same(along, boxes.intersect_line(p, normal, reach)));
+        ASSERT_TRUE(same(fans.intersect_line(p, normal, reach, 1e-9), boxes.intersect_line(p, normal, reach, 1e-9)));
+        normals_hit += along.has_value();
+    }
+    EXPECT_GT(lines_hit, 1000);
+    EXPECT_GT(normals_hit, 3000);
 }
 
 TEST(ClosestPointQuery, RejectsUnusableMeshesAndPoints) {

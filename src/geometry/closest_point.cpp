@@ -2,6 +2,8 @@
 // Ericson's point-triangle test, searched branch and bound, nearer child first.
 #include "geometry/closest_point.h"
 
+#include "common/compiler.h"
+
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
@@ -23,6 +25,15 @@ constexpr int kStackSize = kSahDepth + 34;
 // slack: both squared distances carry a few ulps of rounding error, and a node must never be
 // pruned when it holds a triangle whose computed distance equals or beats the best.
 constexpr double kPruneSlack = 1e-13;
+// A child of the box tree that is a fan (Node::index is then into fans_).
+constexpr uint32_t kFanLeaf = kEmpty;
+// A fan's cone is widened by this angle (radians) for the rounding of its directions, and its
+// distance bound lowered by this share of the distance to the apex for the rounding of the bound.
+constexpr double kConeWidening = 1e-9;
+constexpr double kConeSlack = 1e-10;
+constexpr double kRightAngle = 1.5707963267948966;
+// A fan's tree halves its triangles at each level: at most 32 levels, one stack entry more each.
+constexpr int kConeStackSize = 34;
 
 double squared_length(Vec3 v) { return dot(v, v); }
 
@@ -49,6 +60,22 @@ Vec3 component_max(Vec3 a, Vec3 b) {
     return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)};
 }
 double component(Vec3 v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
+
+// Inlined: the box tree's descent spends most of its time here.
+AMC_ALWAYS_INLINE double box_distance_squared(const float* lo, const float* hi, Vec3 p) {
+    double dx = std::max(std::max(lo[0] - p.x, p.x - hi[0]), 0.0);
+    double dy = std::max(std::max(lo[1] - p.y, p.y - hi[1]), 0.0);
+    double dz = std::max(std::max(lo[2] - p.z, p.z - hi[2]), 0.0);
+    return dx * dx + dy * dy + dz * dz;
+}
+
+// The box [lo, hi] widened by margin, as floats rounded outward.
+void store_box(Vec3 lo, Vec3 hi, double margin, float* lo_out, float* hi_out) {
+    for (int axis = 0; axis < 3; ++axis) {
+        lo_out[axis] = float_below(component(lo, axis) - margin);
+        hi_out[axis] = float_above(component(hi, axis) + margin);
+    }
+}
 
 // Closest point to p on segment [x, y]; t is the weight of y.
 Vec3 closest_point_on_segment(Vec3 p, Vec3 x, Vec3 y, double& t) {
@@ -146,10 +173,10 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
     }
     const uint32_t n = static_cast<uint32_t>(triangles.size());
 
-    // Per-triangle centroids and the largest coordinate magnitude, which sizes the margin that
-    // covers the rounding of computed closest points (a few ulps of the coordinates).
-    std::vector<Vec3> centroids(n);
+    // The largest coordinate magnitude sizes the margin that covers the rounding of computed
+    // closest points (a few ulps of the coordinates).
     double max_abs = 0;
+    std::vector<uint32_t> valence(positions.size(), 0);
     for (uint32_t t = 0; t < n; ++t) {
         for (uint32_t v : triangles[t]) {
             if (v >= positions.size()) {
@@ -159,18 +186,91 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
             }
             const Vec3& q = positions[v];
             max_abs = std::max({max_abs, std::abs(q.x), std::abs(q.y), std::abs(q.z)});
+            ++valence[v];
         }
-        const Vec3& a = positions[triangles[t][0]];
-        const Vec3& b = positions[triangles[t][1]];
-        const Vec3& c = positions[triangles[t][2]];
-        centroids[t] = (1.0 / 3.0) * a + (1.0 / 3.0) * b + (1.0 / 3.0) * c;  // no overflow
     }
     const double margin = 16 * DBL_EPSILON * max_abs;
+    margin_ = margin;
 
-    std::vector<uint32_t> order(n);
-    for (uint32_t t = 0; t < n; ++t) order[t] = t;
+    // The fans: each triangle goes to its corner of highest valence (ties to the lower vertex)
+    // when that reaches kFanValence. A fan whose directions cannot be measured (a corner not
+    // finite, a squared length that overflows) stays in the box tree.
+    std::vector<uint32_t> fan_of_vertex(positions.size(), kEmpty);
+    std::vector<uint32_t> fan_apexes;
+    std::vector<std::vector<uint32_t>> fan_triangles;
+    for (uint32_t t = 0; t < n; ++t) {
+        uint32_t apex = kEmpty;
+        for (uint32_t v : triangles[t]) {
+            if (valence[v] >= kFanValence && (apex == kEmpty || valence[v] > valence[apex] || (valence[v] == valence[apex] && v < apex))) apex = v;
+        }
+        if (apex == kEmpty) continue;
+        if (fan_of_vertex[apex] == kEmpty) {
+            fan_of_vertex[apex] = static_cast<uint32_t>(fan_apexes.size());
+            fan_apexes.push_back(apex);
+            fan_triangles.emplace_back();
+        }
+        fan_triangles[fan_of_vertex[apex]].push_back(t);
+    }
+    std::vector<bool> in_fan(n, false);
+    {
+        size_t kept = 0;
+        for (size_t f = 0; f < fan_apexes.size(); ++f) {
+            const Vec3 apex = positions[fan_apexes[f]];
+            bool measurable = true;
+            for (uint32_t t : fan_triangles[f]) {
+                for (uint32_t v : triangles[t]) {
+                    const Vec3 e = positions[v] - apex;
+                    if (!std::isfinite(squared_length(e))) measurable = false;
+                }
+            }
+            if (!measurable) continue;
+            for (uint32_t t : fan_triangles[f]) in_fan[t] = true;
+            if (kept != f) {
+                fan_apexes[kept] = fan_apexes[f];
+                fan_triangles[kept] = std::move(fan_triangles[f]);
+            }
+            ++kept;
+        }
+        fan_apexes.resize(kept);
+        fan_triangles.resize(kept);
+    }
 
-    // Bounds of the triangles order[begin, end) and of their centroids.
+    // The box tree's items: the triangles outside the fans, in index order, then the fans. Each
+    // has a box and a centroid (a fan's: its box's centre).
+    std::vector<uint32_t> item_triangle;
+    for (uint32_t t = 0; t < n; ++t) {
+        if (!in_fan[t]) item_triangle.push_back(t);
+    }
+    const uint32_t first_fan_item = static_cast<uint32_t>(item_triangle.size());
+    const uint32_t items = first_fan_item + static_cast<uint32_t>(fan_apexes.size());
+    std::vector<Vec3> item_lo(items, Vec3{DBL_MAX, DBL_MAX, DBL_MAX});
+    std::vector<Vec3> item_hi(items, Vec3{-DBL_MAX, -DBL_MAX, -DBL_MAX});
+    std::vector<Vec3> centroids(items);
+    for (uint32_t i = 0; i < first_fan_item; ++i) {
+        const Triangle& triangle = triangles[item_triangle[i]];
+        for (uint32_t v : triangle) {
+            item_lo[i] = component_min(item_lo[i], positions[v]);
+            item_hi[i] = component_max(item_hi[i], positions[v]);
+        }
+        const Vec3& a = positions[triangle[0]];
+        const Vec3& b = positions[triangle[1]];
+        const Vec3& c = positions[triangle[2]];
+        centroids[i] = (1.0 / 3.0) * a + (1.0 / 3.0) * b + (1.0 / 3.0) * c;  // no overflow
+    }
+    for (uint32_t i = first_fan_item; i < items; ++i) {
+        for (uint32_t t : fan_triangles[i - first_fan_item]) {
+            for (uint32_t v : triangles[t]) {
+                item_lo[i] = component_min(item_lo[i], positions[v]);
+                item_hi[i] = component_max(item_hi[i], positions[v]);
+            }
+        }
+        centroids[i] = 0.5 * item_lo[i] + 0.5 * item_hi[i];
+    }
+
+    std::vector<uint32_t> order(items);
+    for (uint32_t i = 0; i < items; ++i) order[i] = i;
+
+    // Bounds of the items order[begin, end) and of their centroids.
     struct Bounds {
         Vec3 lo{DBL_MAX, DBL_MAX, DBL_MAX}, hi{-DBL_MAX, -DBL_MAX, -DBL_MAX};
         Vec3 centroid_lo{DBL_MAX, DBL_MAX, DBL_MAX}, centroid_hi{-DBL_MAX, -DBL_MAX, -DBL_MAX};
@@ -179,10 +279,8 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
         Bounds bounds;
         for (uint32_t i = begin; i < end; ++i) {
             uint32_t t = order[i];
-            for (uint32_t v : triangles[t]) {
-                bounds.lo = component_min(bounds.lo, positions[v]);
-                bounds.hi = component_max(bounds.hi, positions[v]);
-            }
+            bounds.lo = component_min(bounds.lo, item_lo[t]);
+            bounds.hi = component_max(bounds.hi, item_hi[t]);
             bounds.centroid_lo = component_min(bounds.centroid_lo, centroids[t]);
             bounds.centroid_hi = component_max(bounds.centroid_hi, centroids[t]);
         }
@@ -191,8 +289,8 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
     // Binned surface area heuristic (SAH-lite) on the longest centroid axis: of the kBins - 1
     // planes between equal-width centroid bins, the one minimising area(left) * count(left) +
     // area(right) * count(right). From depth kSahDepth on, or when the centroids do not separate,
-    // the object median instead (ties by triangle index, so the tree does not depend on the
-    // standard library's nth_element), which bounds the depth. Returns the split position.
+    // the object median instead (ties by item, so the tree does not depend on the standard
+    // library's nth_element), which bounds the depth. Returns the split position.
     auto split = [&](uint32_t begin, uint32_t end, const Bounds& bounds, uint32_t depth) {
         const Vec3 extent = bounds.centroid_hi - bounds.centroid_lo;
         const int axis =
@@ -212,10 +310,8 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
                 const uint32_t t = order[i];
                 const int bin = bin_of(t);
                 ++counts[bin];
-                for (uint32_t v : triangles[t]) {
-                    bins[bin].lo = component_min(bins[bin].lo, positions[v]);
-                    bins[bin].hi = component_max(bins[bin].hi, positions[v]);
-                }
+                bins[bin].lo = component_min(bins[bin].lo, item_lo[t]);
+                bins[bin].hi = component_max(bins[bin].hi, item_hi[t]);
             }
             auto half_area = [](Vec3 lo, Vec3 hi) {
                 Vec3 e = hi - lo;
@@ -262,6 +358,12 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
                          });
         return mid;
     };
+    // A leaf holds at most kLeafSize triangles, or one fan.
+    auto is_leaf = [&](uint32_t begin, uint32_t end) {
+        if (end - begin > kLeafSize) return false;
+        if (end - begin == 1) return true;
+        return std::all_of(order.begin() + begin, order.begin() + end, [&](uint32_t i) { return i < first_fan_item; });
+    };
 
     // Top-down build with an explicit work list: each item is a range of triangles that becomes
     // child `slot` of node `parent`. Every level touches each triangle a constant number of times
@@ -270,12 +372,12 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
         uint32_t parent, slot, begin, end, depth;
     };
     std::vector<Work> work;
-    nodes_.reserve(n / 2 + 1);
+    nodes_.reserve(items / 2 + 1);
     nodes_.push_back(Node{});
     {
-        Bounds all = measure(0, n);
-        if (n <= kLeafSize) {
-            work.push_back({0, 0, 0, n, 1});
+        Bounds all = measure(0, items);
+        if (is_leaf(0, items)) {
+            work.push_back({0, 0, 0, items, 1});
             Node& root = nodes_[0];
             for (int axis = 0; axis < 3; ++axis) {
                 root.lo[1][axis] = std::numeric_limits<float>::infinity();
@@ -284,8 +386,8 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
             root.index[1] = kEmpty;
             root.count[1] = 0;
         } else {
-            uint32_t mid = split(0, n, all, 0);
-            work.push_back({0, 1, mid, n, 1});
+            uint32_t mid = split(0, items, all, 0);
+            work.push_back({0, 1, mid, items, 1});
             work.push_back({0, 0, 0, mid, 1});
         }
     }
@@ -293,16 +395,11 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
         Work item = work.back();
         work.pop_back();
         Bounds bounds = measure(item.begin, item.end);
-        const Vec3 lo = bounds.lo - Vec3{margin, margin, margin};
-        const Vec3 hi = bounds.hi + Vec3{margin, margin, margin};
-        for (int axis = 0; axis < 3; ++axis) {
-            nodes_[item.parent].lo[item.slot][axis] = float_below(component(lo, axis));
-            nodes_[item.parent].hi[item.slot][axis] = float_above(component(hi, axis));
-        }
-        const uint32_t count = item.end - item.begin;
-        if (count <= kLeafSize) {
-            nodes_[item.parent].index[item.slot] = item.begin;
-            nodes_[item.parent].count[item.slot] = count;
+        store_box(bounds.lo, bounds.hi, margin, nodes_[item.parent].lo[item.slot], nodes_[item.parent].hi[item.slot]);
+        if (is_leaf(item.begin, item.end)) {
+            const bool fan = order[item.begin] >= first_fan_item;
+            nodes_[item.parent].index[item.slot] = fan ? order[item.begin] - first_fan_item : item.begin;
+            nodes_[item.parent].count[item.slot] = fan ? kFanLeaf : item.end - item.begin;
             continue;
         }
         const uint32_t child = static_cast<uint32_t>(nodes_.size());
@@ -314,18 +411,177 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
         work.push_back({child, 0, item.begin, mid, item.depth + 1});
     }
 
-    records_.resize(n);
-    triangles_.resize(n);
-    normals_.resize(n);
-    for (uint32_t i = 0; i < n; ++i) {
-        uint32_t t = order[i];
-        const Record record{positions[triangles[t][0]], positions[triangles[t][1]], positions[triangles[t][2]]};
-        records_[i] = record;
-        triangles_[i] = t;
-        const Vec3 normal = cross(record.b - record.a, record.c - record.a);
-        const double length = std::sqrt(squared_length(normal));
-        normals_[i] = length > 0 && std::isfinite(length) ? (1 / length) * normal : Vec3{};
+    // The records: the box tree's triangles in leaf order (its leaves' positions in `order`
+    // renumbered without the fans), then each fan's in its tree's leaf order.
+    records_.reserve(n);
+    triangles_.reserve(n);
+    normals_.reserve(n);
+    std::vector<uint32_t> record_of_position(items, kEmpty);
+    for (uint32_t i = 0; i < items; ++i) {
+        if (order[i] >= first_fan_item) continue;
+        record_of_position[i] = static_cast<uint32_t>(records_.size());
+        add_record(reference, item_triangle[order[i]]);
     }
+    for (Node& node : nodes_) {
+        for (int slot = 0; slot < 2; ++slot) {
+            if (node.count[slot] > 0 && node.count[slot] != kFanLeaf) node.index[slot] = record_of_position[node.index[slot]];
+        }
+    }
+    for (uint32_t f = 0; f < fan_apexes.size(); ++f) {
+        fans_.push_back(Fan{positions[fan_apexes[f]], build_fan(reference, fan_apexes[f], fan_triangles[f], margin)});
+    }
+}
+
+void ClosestPointQuery::add_record(const TriangleMesh& reference, uint32_t t) {
+    const Triangle& triangle = reference.triangles[t];
+    const Record record{reference.positions[triangle[0]], reference.positions[triangle[1]], reference.positions[triangle[2]]};
+    records_.push_back(record);
+    triangles_.push_back(t);
+    const Vec3 normal = cross(record.b - record.a, record.c - record.a);
+    const double length = std::sqrt(squared_length(normal));
+    normals_.push_back(length > 0 && std::isfinite(length) ? (1 / length) * normal : Vec3{});
+}
+
+// The fan's tree: median splits of the triangles' middle directions from the apex along their
+// widest axis, at most kLeafSize triangles a leaf. A node's cone is about the normalised sum of
+// its triangles' unit directions to their other corners; it holds their triangles because a
+// triangle's directions are the non-negative combinations of those two, and a cone of half-angle
+// up to 90 degrees is convex.
+uint32_t ClosestPointQuery::build_fan(const TriangleMesh& reference, uint32_t apex_vertex, const std::vector<uint32_t>& fan,
+                                      double margin) {
+    const std::vector<Vec3>& positions = reference.positions;
+    const Vec3 apex = positions[apex_vertex];
+    const uint32_t m = static_cast<uint32_t>(fan.size());
+    struct Directions {
+        Vec3 to[2];      // unit directions to the corners other than the apex; zero for one at it
+        Vec3 middle;     // the sort key: their normalised sum, or zero
+    };
+    auto unit = [](Vec3 v) {
+        const double length = std::sqrt(squared_length(v));
+        return length > 0 ? (1 / length) * v : Vec3{};
+    };
+    std::vector<Directions> directions(m);
+    std::vector<uint32_t> local(m);
+    for (uint32_t i = 0; i < m; ++i) {
+        local[i] = i;
+        const Triangle& triangle = reference.triangles[fan[i]];
+        int k = 0;
+        bool skipped_apex = false;
+        for (uint32_t v : triangle) {
+            if (v == apex_vertex && !skipped_apex) {
+                skipped_apex = true;
+                continue;
+            }
+            directions[i].to[k++] = unit(positions[v] - apex);
+        }
+        directions[i].middle = unit(directions[i].to[0] + directions[i].to[1]);
+    }
+
+    const uint32_t root = static_cast<uint32_t>(cone_nodes_.size());
+    const uint32_t first_record = static_cast<uint32_t>(records_.size());
+    cone_nodes_.push_back(ConeNode{});
+    struct Work {
+        uint32_t node, begin, end;
+    };
+    std::vector<Work> work{{root, 0, m}};
+    while (!work.empty()) {
+        const Work item = work.back();
+        work.pop_back();
+        ConeNode node;
+        Vec3 lo{DBL_MAX, DBL_MAX, DBL_MAX}, hi{-DBL_MAX, -DBL_MAX, -DBL_MAX};
+        Vec3 sum{0, 0, 0};
+        Vec3 middle_lo{DBL_MAX, DBL_MAX, DBL_MAX}, middle_hi{-DBL_MAX, -DBL_MAX, -DBL_MAX};
+        for (uint32_t i = item.begin; i < item.end; ++i) {
+            const uint32_t j = local[i];
+            for (uint32_t v : reference.triangles[fan[j]]) {
+                lo = component_min(lo, positions[v]);
+                hi = component_max(hi, positions[v]);
+            }
+            sum = sum + directions[j].to[0] + directions[j].to[1];
+            middle_lo = component_min(middle_lo, directions[j].middle);
+            middle_hi = component_max(middle_hi, directions[j].middle);
+        }
+        store_box(lo, hi, margin, node.lo, node.hi);
+        const Vec3 axis = unit(sum);
+        if (squared_length(axis) > 0) {
+            double half_angle = 0;  // by atan2, which (unlike acos) stays accurate near 0
+            for (uint32_t i = item.begin; i < item.end; ++i) {
+                for (Vec3 to : directions[local[i]].to) {
+                    if (squared_length(to) > 0) {
+                        half_angle = std::max(half_angle, std::atan2(std::sqrt(squared_length(cross(to, axis))), dot(to, axis)));
+                    }
+                }
+            }
+            half_angle += kConeWidening;
+            if (half_angle <= kRightAngle) {
+                node.axis = axis;
+                node.cosine = std::cos(half_angle);
+                node.sine = std::sin(half_angle);
+                node.has_cone = true;
+            }
+        }
+        if (item.end - item.begin <= kLeafSize) {
+            node.index = first_record + item.begin;
+            node.count = item.end - item.begin;
+            cone_nodes_[item.node] = node;
+            continue;
+        }
+        const Vec3 extent = middle_hi - middle_lo;
+        const int split_axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
+        const uint32_t mid = item.begin + (item.end - item.begin) / 2;
+        std::nth_element(local.begin() + item.begin, local.begin() + mid, local.begin() + item.end, [&](uint32_t s, uint32_t t) {
+            const double cs = component(directions[s].middle, split_axis);
+            const double ct = component(directions[t].middle, split_axis);
+            return cs < ct || (cs == ct && s < t);
+        });
+        node.index = static_cast<uint32_t>(cone_nodes_.size());
+        node.count = 0;
+        cone_nodes_[item.node] = node;
+        cone_nodes_.push_back(ConeNode{});
+        cone_nodes_.push_back(ConeNode{});
+        work.push_back({node.index, item.begin, mid});
+        work.push_back({node.index + 1, mid, item.end});
+    }
+    for (uint32_t i = 0; i < m; ++i) add_record(reference, fan[local[i]]);
+    return root;
+}
+
+// A lower bound on the distance from p to the triangles of a fan's node, w = p - apex: its box's,
+// and its cone's, which every triangle of the fan holds as it holds the apex (at angle theta from
+// the axis, p is |w| sin(theta - half-angle) from the cone, |w| from 90 degrees beyond it on).
+double ClosestPointQuery::cone_node_distance_squared(const ConeNode& node, Vec3 p, Vec3 w, double w_length) const {
+    const double box = box_distance_squared(node.lo, node.hi, p);
+    if (!node.has_cone) return box;
+    const double along = dot(w, node.axis);
+    const double across = std::sqrt(squared_length(cross(w, node.axis)));
+    double gap = along * node.cosine + across * node.sine <= 0 ? w_length : across * node.cosine - along * node.sine;
+    // The rounding of the bound, and of the computed closest points (margin_ an axis: < 2 margin_ in all).
+    gap -= kConeSlack * w_length + 2 * margin_;
+    return gap > 0 ? std::max(box, gap * gap) : box;
+}
+
+// False when a plane through the apex has the node's cone on one side and the segment from
+// apex + w0 to apex + w1 more than `slack` beyond it on the other: the plane at 90 degrees plus
+// the half-angle from the axis, towards the segment's direction nearest the axis (where the plane
+// through the apex and the segment comes nearest it, else the nearer end's). Any such plane would
+// do: its choice only decides how often the test prunes.
+bool ClosestPointQuery::cone_may_meet_segment(const ConeNode& node, Vec3 w0, Vec3 w1, double slack) const {
+    if (!node.has_cone) return true;
+    const Vec3 u = node.axis;
+    const double l0 = std::sqrt(squared_length(w0)), l1 = std::sqrt(squared_length(w1));
+    if (!(l0 > 0 && l1 > 0)) return true;
+    Vec3 nearest = dot(w0, u) * l1 >= dot(w1, u) * l0 ? w0 : w1;
+    const Vec3 normal = cross(w0, w1);
+    const double normal_squared = squared_length(normal);
+    if (normal_squared > 0) {
+        const Vec3 in_plane = u - (dot(u, normal) / normal_squared) * normal;
+        if (dot(cross(w0, in_plane), normal) >= 0 && dot(cross(in_plane, w1), normal) >= 0) nearest = in_plane;
+    }
+    const Vec3 radial = nearest - dot(nearest, u) * u;
+    const double radial_length = std::sqrt(squared_length(radial));
+    if (!(radial_length > 0)) return true;
+    const Vec3 side = (node.cosine / radial_length) * radial - node.sine * u;  // unit, at 90 degrees + a from u
+    return !(dot(w0, side) > slack && dot(w1, side) > slack);
 }
 
 template <class Accept>
@@ -336,6 +592,51 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p, double b
     uint32_t best_record = kEmpty;
     uint32_t best_triangle = kEmpty;
     Vec3 best_point, best_barycentric;
+    auto test_records = [&](uint32_t begin, uint32_t end) {
+        for (uint32_t r = begin; r < end; ++r) {
+            if (!accept(r)) continue;
+            const Record& record = records_[r];
+            Vec3 barycentric;
+            Vec3 q = closest_point_on_triangle(p, record.a, record.b, record.c, barycentric);
+            double d = squared_length(p - q);
+            if (d < best || (d == best && triangles_[r] < best_triangle)) {
+                best = d;
+                prune = best * (1 + kPruneSlack);
+                best_record = r;
+                best_triangle = triangles_[r];
+                best_point = q;
+                best_barycentric = barycentric;
+            }
+        }
+    };
+    // A fan's tree, as the box tree below: nearer child first.
+    auto search_fan = [&](const Fan& fan) {
+        const Vec3 w = p - fan.apex;
+        const double w_length = std::sqrt(squared_length(w));
+        struct ConeEntry {
+            uint32_t node;
+            double distance_squared;
+        };
+        ConeEntry stack[kConeStackSize];
+        int size = 0;
+        stack[size++] = {fan.root, cone_node_distance_squared(cone_nodes_[fan.root], p, w, w_length)};
+        while (size > 0) {
+            const ConeEntry entry = stack[--size];
+            if (entry.distance_squared > prune) continue;
+            const ConeNode& node = cone_nodes_[entry.node];
+            if (tested) *tested += node.count > 0 ? node.count : 1;
+            if (node.count > 0) {
+                test_records(node.index, node.index + node.count);
+                continue;
+            }
+            const double d[2] = {cone_node_distance_squared(cone_nodes_[node.index], p, w, w_length),
+                                 cone_node_distance_squared(cone_nodes_[node.index + 1], p, w, w_length)};
+            const int near = d[1] < d[0] ? 1 : 0;
+            for (int slot : {1 - near, near}) {
+                if (d[slot] <= prune) stack[size++] = {node.index + slot, d[slot]};
+            }
+        }
+    };
 
     // Pending subtrees (or leaves), each with the squared distance to its box.
     struct Entry {
@@ -348,33 +649,19 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p, double b
     while (size > 0) {
         const Entry entry = stack[--size];
         if (entry.distance_squared > prune) continue;
+        if (entry.count == kFanLeaf) {
+            if (tested) *tested += 1;
+            search_fan(fans_[entry.index]);
+            continue;
+        }
         if (tested) *tested += entry.count > 0 ? entry.count : 1;
         if (entry.count > 0) {
-            for (uint32_t r = entry.index; r < entry.index + entry.count; ++r) {
-                if (!accept(r)) continue;
-                const Record& record = records_[r];
-                Vec3 barycentric;
-                Vec3 q = closest_point_on_triangle(p, record.a, record.b, record.c, barycentric);
-                double d = squared_length(p - q);
-                if (d < best || (d == best && triangles_[r] < best_triangle)) {
-                    best = d;
-                    prune = best * (1 + kPruneSlack);
-                    best_record = r;
-                    best_triangle = triangles_[r];
-                    best_point = q;
-                    best_barycentric = barycentric;
-                }
-            }
+            test_records(entry.index, entry.index + entry.count);
             continue;
         }
         const Node& node = nodes_[entry.index];
         double d[2];
-        for (int slot = 0; slot < 2; ++slot) {
-            double dx = std::max(std::max(node.lo[slot][0] - p.x, p.x - node.hi[slot][0]), 0.0);
-            double dy = std::max(std::max(node.lo[slot][1] - p.y, p.y - node.hi[slot][1]), 0.0);
-            double dz = std::max(std::max(node.lo[slot][2] - p.z, p.z - node.hi[slot][2]), 0.0);
-            d[slot] = dx * dx + dy * dy + dz * dz;
-        }
+        for (int slot = 0; slot < 2; ++slot) d[slot] = box_distance_squared(node.lo[slot], node.hi[slot], p);
         // Push the farther child first, so that the nearer one is searched first.
         const int near = d[1] < d[0] ? 1 : 0;
         for (int slot : {1 - near, near}) {
@@ -453,34 +740,77 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 ori
     Entry stack[kStackSize];
     int size = 0;
     stack[size++] = {0, 0, 0.0};
+    auto test_records = [&](uint32_t begin, uint32_t end) {
+        for (uint32_t r = begin; r < end; ++r) {
+            if (!(dot(normals_[r], d) > 0)) continue;
+            // Moller-Trumbore, two-sided in t.
+            const Record& record = records_[r];
+            const Vec3 e1 = record.b - record.a, e2 = record.c - record.a;
+            const Vec3 pv = cross(d, e2);
+            const double det = dot(e1, pv);
+            if (!(std::fabs(det) > 0)) continue;
+            const double inv = 1 / det;
+            const Vec3 tv = origin - record.a;
+            const double u = dot(tv, pv) * inv;
+            if (u < -tolerance || u > 1 + tolerance) continue;
+            const Vec3 qv = cross(tv, e1);
+            const double v = dot(d, qv) * inv;
+            if (v < -tolerance || u + v > 1 + tolerance) continue;
+            const double t = dot(e2, qv) * inv;
+            const double at = std::fabs(t);
+            if (at < best || (at == best && best_record != kEmpty && triangles_[r] < best_triangle)) {
+                best = at;
+                best_record = r;
+                best_triangle = triangles_[r];
+                best_barycentric = {1 - u - v, u, v};
+            }
+        }
+    };
+    // A fan's tree, by its boxes and (unless triangles are widened) its cones.
+    auto search_fan = [&](const Fan& fan) {
+        const Vec3 from_apex = origin - fan.apex;
+        auto may_meet = [&](const ConeNode& node) {
+            if (tolerance > 0) return true;
+            const Vec3 w0 = from_apex - best * d, w1 = from_apex + best * d;
+            return cone_may_meet_segment(node, w0, w1, kConeSlack * (std::sqrt(squared_length(w0)) + std::sqrt(squared_length(w1))) + 2 * margin_);
+        };
+        struct ConeEntry {
+            uint32_t node;
+            double near;
+        };
+        ConeEntry stack[kConeStackSize];
+        int size = 0;
+        if (!may_meet(cone_nodes_[fan.root])) return;
+        stack[size++] = {fan.root, 0.0};
+        while (size > 0) {
+            const ConeEntry entry = stack[--size];
+            if (entry.near > best) continue;
+            const ConeNode& node = cone_nodes_[entry.node];
+            if (node.count > 0) {
+                test_records(node.index, node.index + node.count);
+                continue;
+            }
+            double near[2];
+            bool hit[2];
+            for (uint32_t slot = 0; slot < 2; ++slot) {
+                const ConeNode& child = cone_nodes_[node.index + slot];
+                hit[slot] = enters(child.lo, child.hi, near[slot]) && may_meet(child);
+            }
+            const int first = hit[1] && (!hit[0] || near[1] < near[0]) ? 1 : 0;
+            for (int slot : {1 - first, first}) {
+                if (hit[slot]) stack[size++] = {node.index + slot, near[slot]};
+            }
+        }
+    };
     while (size > 0) {
         const Entry entry = stack[--size];
         if (entry.near > best) continue;
+        if (entry.count == kFanLeaf) {
+            search_fan(fans_[entry.index]);
+            continue;
+        }
         if (entry.count > 0) {
-            for (uint32_t r = entry.index; r < entry.index + entry.count; ++r) {
-                if (!(dot(normals_[r], d) > 0)) continue;
-                // Moller-Trumbore, two-sided in t.
-                const Record& record = records_[r];
-                const Vec3 e1 = record.b - record.a, e2 = record.c - record.a;
-                const Vec3 pv = cross(d, e2);
-                const double det = dot(e1, pv);
-                if (!(std::fabs(det) > 0)) continue;
-                const double inv = 1 / det;
-                const Vec3 tv = origin - record.a;
-                const double u = dot(tv, pv) * inv;
-                if (u < -tolerance || u > 1 + tolerance) continue;
-                const Vec3 qv = cross(tv, e1);
-                const double v = dot(d, qv) * inv;
-                if (v < -tolerance || u + v > 1 + tolerance) continue;
-                const double t = dot(e2, qv) * inv;
-                const double at = std::fabs(t);
-                if (at < best || (at == best && best_record != kEmpty && triangles_[r] < best_triangle)) {
-                    best = at;
-                    best_record = r;
-                    best_triangle = triangles_[r];
-                    best_barycentric = {1 - u - v, u, v};
-                }
-            }
+            test_records(entry.index, entry.index + entry.count);
             continue;
         }
         const Node& node = nodes_[entry.index];

@@ -26,6 +26,12 @@ Vec3 closest_point_on_triangle(Vec3 p, Vec3 a, Vec3 b, Vec3 c, Vec3& barycentric
 // corners of every triangle, in leaf order), so the mesh may be dropped after
 // construction. Queries are const and keep no state: any number of threads may query at once.
 //
+// The triangles around a vertex of high valence (kFanValence or more) are kept out of the box
+// tree: near such a vertex the boxes of a fan of long triangles all overlap, and a query there
+// would test a constant share of them. They sit as one leaf of the box tree holding a tree of
+// direction cones around the vertex (every triangle holds it), searched with the cone's lower
+// bound on the distance, and with boxes as well (docs/REMESHER.md, "Fans of long triangles").
+//
 // Results are deterministic and independent of the tree: the hit is the triangle of least
 // distance, ties broken by the lowest triangle index, exactly as a brute-force loop over all
 // triangles calling closest_point_on_triangle() would find it.
@@ -65,13 +71,18 @@ public:
     // at vertices; the remesher keeps 0).
     std::optional<Hit> intersect_line(Vec3 origin, Vec3 direction, double reach, double tolerance = 0) const;
 
+    // A vertex with at least this many triangles has its fan searched by direction cones.
+    static constexpr uint32_t kFanValence = 32;
+
     std::size_t triangle_count() const { return triangles_.size(); }
     std::size_t node_count() const { return nodes_.size(); }
+    std::size_t fan_count() const { return fans_.size(); }
 
 private:
     // One cache line: the bounds of both children (float, rounded outward) and what they are.
     // A child with count > 0 is a leaf: records [index, index + count); with count == 0 it is
-    // the inner node nodes_[index]; index kEmpty marks the missing second child of a tiny tree.
+    // the inner node nodes_[index]; with count kFanLeaf it is the fan fans_[index]; index kEmpty
+    // marks the missing second child of a tiny tree.
     struct alignas(64) Node {
         float lo[2][3];
         float hi[2][3];
@@ -81,6 +92,26 @@ private:
     struct Record {  // the corners of one triangle, in leaf order
         Vec3 a, b, c;
     };
+    // A node of a fan's tree: its triangles' directions from the apex lie within the cone of unit
+    // `axis` and half-angle (cosine, sine), widened for rounding (no cone when they span more than
+    // a half-space), and their corners within the box. count > 0: records [index, index + count);
+    // count == 0: children cone_nodes_[index] and cone_nodes_[index + 1].
+    struct ConeNode {
+        Vec3 axis;
+        double cosine = 0, sine = 0;
+        bool has_cone = false;
+        float lo[3], hi[3];
+        uint32_t index = 0, count = 0;
+    };
+    struct Fan {
+        Vec3 apex;
+        uint32_t root;  // into cone_nodes_
+    };
+
+    void add_record(const TriangleMesh& reference, uint32_t triangle);
+    uint32_t build_fan(const TriangleMesh& reference, uint32_t apex, const std::vector<uint32_t>& triangles, double margin);
+    double cone_node_distance_squared(const ConeNode& node, Vec3 p, Vec3 w, double w_length) const;
+    bool cone_may_meet_segment(const ConeNode& node, Vec3 w0, Vec3 w1, double slack) const;
 
     template <class Accept>
     std::optional<Hit> search(Vec3 p, double bound_squared, const Accept& accept, uint64_t* tested = nullptr) const;
@@ -89,6 +120,9 @@ private:
     std::vector<Record> records_;
     std::vector<uint32_t> triangles_;   // triangle index of each record
     std::vector<Vec3> normals_;         // unit normal of each record, zero for zero-area ones
+    std::vector<Fan> fans_;
+    std::vector<ConeNode> cone_nodes_;
+    double margin_ = 0;                 // covers the rounding of computed closest points, per axis
 };
 
 }  // namespace amc

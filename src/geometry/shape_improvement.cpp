@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <set>
+#include <unordered_map>
 
 namespace amc {
 namespace {
@@ -90,7 +92,13 @@ private:
         return length(c - p);
     }
     // The largest distance of the reference vertices owned by `owners` to the triangles `shape`.
+    // A shape around a vertex of high valence is searched (the ring of a moved vertex, each of its
+    // owned vertices against every triangle, was quadratic in the valence): the query's nearest
+    // triangle is the loop's, by the same closest_point_on_triangle, so the same double.
     double owned_error(const std::vector<uint32_t>& owners, const std::vector<Triangle>& shape) const {
+        if (shape.size() >= ClosestPointQuery::kFanValence) {
+            if (std::optional<double> worst = searched_owned_error(owners, shape)) return *worst;
+        }
         double worst = 0;
         for (uint32_t t : owners) {
             for (uint32_t r : owned_[t]) {
@@ -98,6 +106,31 @@ private:
                 for (const Triangle& s : shape) nearest = std::min(nearest, distance_to(reference_.positions[r], s));
                 worst = std::max(worst, nearest);
             }
+        }
+        return worst;
+    }
+    // owned_error by a ClosestPointQuery over `shape` (its vertices shared, so that the ring's
+    // centre forms a fan); nullopt where a corner is not finite (the loop then decides).
+    std::optional<double> searched_owned_error(const std::vector<uint32_t>& owners, const std::vector<Triangle>& shape) const {
+        TriangleMesh local;
+        std::unordered_map<uint32_t, uint32_t> local_of;
+        for (const Triangle& t : shape) {
+            Triangle corners;
+            for (int k = 0; k < 3; ++k) {
+                const auto [it, added] = local_of.try_emplace(t[k], uint32_t(local.positions.size()));
+                if (added) {
+                    const Vec3 p = mesh_.positions[t[k]];
+                    if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z))) return std::nullopt;
+                    local.positions.push_back(p);
+                }
+                corners[k] = it->second;
+            }
+            local.triangles.push_back(corners);
+        }
+        const ClosestPointQuery nearest(local);
+        double worst = 0;
+        for (uint32_t t : owners) {
+            for (uint32_t r : owned_[t]) worst = std::max(worst, std::sqrt(nearest.closest(reference_.positions[r]).distance_squared));
         }
         return worst;
     }
