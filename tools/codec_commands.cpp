@@ -121,7 +121,7 @@ void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     }
     Progress progress(global.verbosity > 0);
     progress.phase("reading " + command.input);
-    const InputFile input = read_input(command.input);
+    InputFile input = read_input(command.input);
     const std::string output = command.output.empty() ? default_output(command.input, ".amc") : command.output;
     const OutputKind kind = output_kind(output);
     if (output != "-" && (kind == OutputKind::mesh || kind == OutputKind::hierarchy))

@@ -9,8 +9,9 @@
 
 namespace amc::cli {
 
-ImportedMesh import_input(const InputFile& input, const std::string& base_path, unsigned threads, const GlobalOptions& global) {
+ImportedMesh import_input(InputFile& input, const std::string& base_path, unsigned threads, const GlobalOptions& global) {
     const TriangleMesh mesh = mesh_of(input);
+    std::string().swap(input.bytes);
     ImportedHierarchy imported = base_path.empty() ? import_mesh(mesh, input.name, threads)
                                                    : import_leaf_mesh(mesh_of(read_input(base_path)), mesh, {}, input.name);
     if (global.verbosity > 1) {
@@ -36,7 +37,7 @@ std::string format_numbering_map(const LeafNumbering& numbering) {
 void run_import(const ImportCommand& command, const GlobalOptions& global) {
     Progress progress(global.verbosity > 0);
     progress.phase("reading " + command.input);
-    const InputFile input = read_input(command.input);
+    InputFile input = read_input(command.input);
     const std::string output = command.output.empty() ? default_output(command.input, ".amh") : command.output;
     if (output != "-" && output_kind(output) != OutputKind::hierarchy)
         throw UsageError("import writes a hierarchy file (.amh), not " + output);

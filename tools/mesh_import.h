@@ -16,8 +16,9 @@ struct ImportedMesh {
     LeafNumbering numbering;  // the input mesh's numbering against extract_leaf_mesh(hierarchy)
 };
 
-// A mesh input over the base mesh in `base_path`, or over the coarsest base found in it.
-ImportedMesh import_input(const InputFile& input, const std::string& base_path, unsigned threads, const GlobalOptions& global);
+// A mesh input over the base mesh in `base_path`, or over the coarsest base found in it. The
+// input's bytes are let go once read: a large text mesh's file is larger than the mesh.
+ImportedMesh import_input(InputFile& input, const std::string& base_path, unsigned threads, const GlobalOptions& global);
 
 // The map as text (docs/IMPORT.md, "The numbering map"): for every input vertex its leaf vertex,
 // for every input face its leaf triangle and rotation.
