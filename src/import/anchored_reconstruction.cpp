@@ -15,32 +15,37 @@ Triangle normalized(Triangle t) {
     return {t[size_t(r)], t[size_t(r + 1) % 3], t[size_t(r + 2) % 3]};
 }
 
-// Levels undone from `triangles` until the base's count is left or nothing more can be undone.
-DetectedBase undo_levels(const std::vector<Triangle>& leaf_triangles, uint32_t vertex_count, size_t base_triangles,
-                         const std::vector<uint8_t>& kept) {
+// The levels undone and the mesh they leave (`remaining`, the leaf triangles while none is).
+struct UndoneLevels {
     DetectedBase detected;
-    const std::vector<Triangle>* triangles = &leaf_triangles;
+    std::vector<Triangle> remaining;
+};
+
+// Levels undone from `leaf_triangles` until the base's count is left or nothing more can be undone.
+UndoneLevels undo_levels(const std::vector<Triangle>& leaf_triangles, uint32_t vertex_count, size_t base_triangles,
+                         const std::vector<uint8_t>& kept) {
+    UndoneLevels out;
+    out.remaining = leaf_triangles;
     std::vector<uint8_t> refined(leaf_triangles.size(), 0);
     std::vector<uint8_t> changed;
-    while (detected.levels.size() < size_t(kMaxLevel) && triangles->size() > base_triangles) {
-        detail::CoarserLevel coarser =
-            detail::undo_refinement_level(*triangles, refined, vertex_count, detected.levels.empty() ? nullptr : &changed,
-                                          &kept, /*give_up_retraced=*/true);
+    std::vector<DetectedLevel>& levels = out.detected.levels;
+    while (levels.size() < size_t(kMaxLevel) && out.remaining.size() > base_triangles) {
+        detail::CoarserLevel coarser = detail::undo_refinement_level(
+            out.remaining, refined, vertex_count, levels.empty() ? nullptr : &changed, &kept, /*give_up_retraced=*/true);
         if (coarser.red_blocks == 0) break;
+        // The coarser level lists the triangles it made first (CoarserLevel).
+        const size_t made = size_t(coarser.red_blocks) + coarser.green_groups;
         DetectedLevel level;
         level.splits = std::move(coarser.splits);
         level.closures = coarser.green_groups;
-        level.triangles = std::move(coarser.triangles);
+        level.made.assign(coarser.triangles.begin(), coarser.triangles.begin() + std::ptrdiff_t(made));
+        level.triangles_left = coarser.triangles.size();
+        out.remaining = std::move(coarser.triangles);
         refined = std::move(coarser.refined);
         changed = std::move(coarser.changed);
-        detected.levels.push_back(std::move(level));
-        triangles = &detected.levels.back().triangles;
+        levels.push_back(std::move(level));
     }
-    return detected;
-}
-
-const std::vector<Triangle>& remaining(const DetectedBase& detected, const std::vector<Triangle>& leaf_triangles) {
-    return detected.levels.empty() ? leaf_triangles : detected.levels.back().triangles;
+    return out;
 }
 
 bool ends_at_base(const std::vector<Triangle>& triangles, const Hierarchy& h, const std::vector<uint32_t>& leaf_of_base) {
@@ -89,28 +94,29 @@ std::vector<uint32_t> reconstruct_anchored(Hierarchy& h, const std::vector<uint3
         kept[search_of_base[b]] = 1;
     }
     const size_t base_triangles = h.base().triangles.size();
-    DetectedBase detected = undo_levels(search_triangles, vertex_count, base_triangles, kept);
+    UndoneLevels undone = undo_levels(search_triangles, vertex_count, base_triangles, kept);
     if (steps) {  // the given order's, whatever the other orders below find
         steps->step.assign(vertex_count, kNeverUndone);
-        for (size_t step = 0; step < detected.levels.size(); ++step) {
-            for (const std::array<uint32_t, 6>& split : detected.levels[step].splits) {
+        for (size_t step = 0; step < undone.detected.levels.size(); ++step) {
+            for (const std::array<uint32_t, 6>& split : undone.detected.levels[step].splits) {
                 for (int k = 3; k < 6; ++k) steps->step[leaf_of[split[size_t(k)]]] = uint8_t(step + 1);
             }
         }
-        steps->remaining = remaining(detected, search_triangles);
+        steps->remaining = undone.remaining;
         detail::renumber(steps->remaining, leaf_of);
     }
     // The inverse step's search depends on the face order (where its growths seed): one order
     // may commit a wrong block and stop short of the base where another reaches it.
     constexpr int kOtherOrders = 3;
-    for (int k = 1; k <= kOtherOrders && !ends_at_base(remaining(detected, search_triangles), h, search_of_base); ++k) {
+    for (int k = 1; k <= kOtherOrders && !ends_at_base(undone.remaining, h, search_of_base); ++k) {
         const std::vector<Triangle> triangles = reordered(search_triangles, k);
-        detected = undo_levels(triangles, vertex_count, base_triangles, kept);
-        if (detected.levels.empty()) break;  // no order undoes anything: none will
+        undone = undo_levels(triangles, vertex_count, base_triangles, kept);
+        if (undone.detected.levels.empty()) break;  // no order undoes anything: none will
     }
-    if (!ends_at_base(remaining(detected, search_triangles), h, search_of_base)) return {};
+    if (!ends_at_base(undone.remaining, h, search_of_base)) return {};
+    DetectedBase& detected = undone.detected;
     for (DetectedLevel& level : detected.levels) {
-        detail::renumber(level.triangles, leaf_of);
+        detail::renumber(level.made, leaf_of);
         for (auto& split : level.splits) {
             for (uint32_t& v : split) v = leaf_of[v];
         }

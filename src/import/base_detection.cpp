@@ -38,12 +38,18 @@ void set_base(const TriangleMesh& mesh, const std::vector<Triangle>& triangles, 
     for (const Triangle& t : triangles) out.base.triangles.push_back({base_index[t[0]], base_index[t[1]], base_index[t[2]]});
 }
 
-// One run of the search: the levels it undid and, per level, what the next step needs (the
-// refined and changed triangles) and the blockers its step reported.
+// One run of the search: the levels it undid, per level what a search from it needs besides the
+// level (which made triangles are refined: the splits' parents; the positions in its mesh of the
+// triangles its step left for later) and the blockers its step reported; and the mesh the last
+// level left, with its flags, where the next step starts (only the last: a large mesh has tens of
+// levels).
 struct SearchRun {
     std::vector<DetectedLevel> levels;
-    std::vector<std::vector<uint8_t>> refined, changed;
+    std::vector<std::vector<uint8_t>> made_refined;
+    std::vector<std::vector<uint32_t>> deferred;
     std::vector<std::vector<Triangle>> blockers;
+    std::vector<Triangle> mesh;           // empty while no level is undone
+    std::vector<uint8_t> refined, changed;  // per triangle of `mesh`
 };
 
 // Set when a search's answer is no longer wanted: it stops within its step.
@@ -59,22 +65,61 @@ bool undo_one_level(const std::vector<Triangle>& triangles, uint32_t vertex_coun
     const bool has_kept = s < kept.size() && !kept[s].empty();
     const std::vector<uint8_t> unrefined(s == 0 ? triangles.size() : 0, 0);
     detail::CoarserLevel coarser = detail::undo_refinement_level(
-        s == 0 ? triangles : run.levels[s - 1].triangles, s == 0 ? unrefined : run.refined[s - 1], vertex_count,
-        s == 0 || everywhere ? nullptr : &run.changed[s - 1], has_kept ? &kept[s] : nullptr, false, cancel);
+        s == 0 ? triangles : run.mesh, s == 0 ? unrefined : run.refined, vertex_count,
+        s == 0 || everywhere ? nullptr : &run.changed, has_kept ? &kept[s] : nullptr, false, cancel);
     if (coarser.red_blocks == 0) return false;
+    // The coarser level lists the triangles it made first (CoarserLevel).
+    const size_t made = size_t(coarser.red_blocks) + coarser.green_groups;
     DetectedLevel level;
     level.splits = std::move(coarser.splits);
     level.closures = coarser.green_groups;
-    level.triangles = std::move(coarser.triangles);
+    level.made.assign(coarser.triangles.begin(), coarser.triangles.begin() + std::ptrdiff_t(made));
+    level.triangles_left = coarser.triangles.size();
+    std::vector<uint32_t> deferred;
+    for (size_t i = made; i < coarser.changed.size(); ++i) {
+        if (coarser.changed[i]) deferred.push_back(uint32_t(i));
+    }
     run.levels.push_back(std::move(level));
-    run.refined.push_back(std::move(coarser.refined));
-    run.changed.push_back(std::move(coarser.changed));
+    run.made_refined.emplace_back(coarser.refined.begin(), coarser.refined.begin() + std::ptrdiff_t(made));
+    run.deferred.push_back(std::move(deferred));
     run.blockers.push_back(std::move(coarser.blockers));
+    run.mesh = std::move(coarser.triangles);
+    run.refined = std::move(coarser.refined);
+    run.changed = std::move(coarser.changed);
     return true;
 }
 
 size_t base_size(const SearchRun& run, size_t leaf_triangles) {
-    return run.levels.empty() ? leaf_triangles : run.levels.back().triangles.size();
+    return run.levels.empty() ? leaf_triangles : run.levels.back().triangles_left;
+}
+
+// The first `count` levels of `run` (leaf triangles `triangles`), the later ones dropped, with
+// the mesh and flags they leave made again from the leaf.
+SearchRun first_levels(const SearchRun& run, const std::vector<Triangle>& triangles, uint32_t vertex_count,
+                       size_t count) {
+    SearchRun out;
+    out.levels.assign(run.levels.begin(), run.levels.begin() + std::ptrdiff_t(count));
+    out.made_refined.assign(run.made_refined.begin(), run.made_refined.begin() + std::ptrdiff_t(count));
+    out.deferred.assign(run.deferred.begin(), run.deferred.begin() + std::ptrdiff_t(count));
+    out.blockers.assign(run.blockers.begin(), run.blockers.begin() + std::ptrdiff_t(count));
+    if (count == 0) return out;
+    std::vector<uint8_t> removed(vertex_count, 0);
+    std::vector<uint32_t> kept_from;
+    std::vector<Triangle> mesh = triangles;
+    std::vector<uint8_t> refined(triangles.size(), 0);
+    for (size_t s = 0; s < count; ++s) {
+        mesh = detail::mesh_after_level(mesh, out.levels[s], removed, &kept_from);
+        std::vector<uint8_t> next = out.made_refined[s];
+        next.reserve(mesh.size());
+        for (uint32_t from : kept_from) next.push_back(refined[from]);
+        refined = std::move(next);
+    }
+    out.changed.assign(mesh.size(), 0);
+    std::fill(out.changed.begin(), out.changed.begin() + std::ptrdiff_t(out.levels[count - 1].made.size()), 1);
+    for (uint32_t i : out.deferred[count - 1]) out.changed[i] = 1;
+    out.mesh = std::move(mesh);
+    out.refined = std::move(refined);
+    return out;
 }
 
 // Whether a search that left `base` of the `leaf` triangles undid at least 1/10 of them: an
@@ -87,15 +132,10 @@ bool undid_much(size_t base, size_t leaf) {
 // Called after each step a search undid.
 using StepObserver = std::function<void(const SearchRun&)>;
 
-// The levels undone from step `from` on, the earlier ones of `run` standing; in step s the
-// vertices marked in kept[s] (if any) stay.
-void undo_levels_from(const std::vector<Triangle>& triangles, uint32_t vertex_count, size_t from,
+// More levels undone at the end of `run`; in step s the vertices marked in kept[s] (if any) stay.
+void undo_more_levels(const std::vector<Triangle>& triangles, uint32_t vertex_count,
                       const std::vector<std::vector<uint8_t>>& kept, const Cancel& cancel, const StepObserver& observe,
                       SearchRun& run) {
-    run.levels.resize(from);
-    run.refined.resize(from);
-    run.changed.resize(from);
-    run.blockers.resize(from);
     // Each level undone adds one to the depth of the hierarchy, which kMaxLevel caps.
     while (run.levels.size() < size_t(kMaxLevel) && !cancel && undo_one_level(triangles, vertex_count, kept, false, run, &cancel)) {
         if (observe) observe(run);
@@ -176,7 +216,7 @@ bool wrong_single_blocks(const SearchRun& run, uint32_t vertex_count, size_t& st
 SearchRun search_levels(const std::vector<Triangle>& triangles, uint32_t vertex_count, const Cancel& cancel,
                         const StepObserver& observe = {}) {
     SearchRun run;
-    undo_levels_from(triangles, vertex_count, 0, {}, cancel, observe, run);
+    undo_more_levels(triangles, vertex_count, {}, cancel, observe, run);
     // A one-block patch can be a wrong reading that its step cannot tell from a true one; a later
     // step then finds its parent in the way of a large patch. Such patches are left out and the
     // search run again from their step, once; the run that ends at the coarser base stands
@@ -184,12 +224,8 @@ SearchRun search_levels(const std::vector<Triangle>& triangles, uint32_t vertex_
     size_t step = 0;
     std::vector<std::vector<uint8_t>> kept;
     if (!cancel && wrong_single_blocks(run, vertex_count, step, kept)) {
-        SearchRun trial;
-        trial.levels.assign(run.levels.begin(), run.levels.begin() + std::ptrdiff_t(step));
-        trial.refined.assign(run.refined.begin(), run.refined.begin() + std::ptrdiff_t(step));
-        trial.changed.assign(run.changed.begin(), run.changed.begin() + std::ptrdiff_t(step));
-        trial.blockers.assign(run.blockers.begin(), run.blockers.begin() + std::ptrdiff_t(step));
-        undo_levels_from(triangles, vertex_count, step, kept, cancel, {}, trial);
+        SearchRun trial = first_levels(run, triangles, vertex_count, step);
+        undo_more_levels(triangles, vertex_count, kept, cancel, {}, trial);
         if (base_size(trial, triangles.size()) < base_size(run, triangles.size())) run = std::move(trial);
     }
     return run;
@@ -268,6 +304,27 @@ void renumber(std::vector<Triangle>& triangles, const std::vector<uint32_t>& id)
     }
 }
 
+std::vector<Triangle> mesh_after_level(const std::vector<Triangle>& mesh, const DetectedLevel& level,
+                                       std::vector<uint8_t>& removed, std::vector<uint32_t>* kept_from) {
+    for (const auto& split : level.splits) {
+        for (size_t k = 3; k < 6; ++k) removed[split[k]] = 1;
+    }
+    std::vector<Triangle> out;
+    out.reserve(level.made.size() + mesh.size());
+    out.insert(out.end(), level.made.begin(), level.made.end());
+    if (kept_from) kept_from->clear();
+    for (uint32_t t = 0; t < mesh.size(); ++t) {
+        const Triangle& triangle = mesh[t];
+        if (removed[triangle[0]] | removed[triangle[1]] | removed[triangle[2]]) continue;
+        out.push_back(triangle);
+        if (kept_from) kept_from->push_back(t);
+    }
+    for (const auto& split : level.splits) {
+        for (size_t k = 3; k < 6; ++k) removed[split[k]] = 0;
+    }
+    return out;
+}
+
 }  // namespace detail
 
 bool searched_again(size_t base, size_t leaf, size_t levels) {
@@ -300,8 +357,8 @@ DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what, unsi
             try {
                 run = search_levels(renumbered, vertex_count, never, [&](const SearchRun& so_far) {
                     const size_t steps = so_far.levels.size();
-                    const size_t before = steps < 2 ? renumbered.size() : so_far.levels[steps - 2].triangles.size();
-                    const size_t after = so_far.levels.back().triangles.size();
+                    const size_t before = steps < 2 ? renumbered.size() : so_far.levels[steps - 2].triangles_left;
+                    const size_t after = so_far.levels.back().triangles_left;
                     gate.open_if(undid_much(after, renumbered.size()) && 2 * after > before);
                 });
             } catch (...) {
@@ -316,22 +373,42 @@ DetectedBase detect_base(const TriangleMesh& mesh, const std::string& what, unsi
             other = search_levels(reversed, vertex_count, gate.cancelled());
         }
     });
-    if (again && base_size(other, renumbered.size()) < base_size(run, renumbered.size())) run = std::move(other);
+    if (again && base_size(other, renumbered.size()) < base_size(run, renumbered.size())) {
+        run = std::move(other);
+        out.found_in_reverse = true;
+    }
     seed_everywhere_once_stopped(renumbered, vertex_count, run);
     out.levels = std::move(run.levels);
     for (DetectedLevel& level : out.levels) {
-        detail::renumber(level.triangles, input_of);
+        detail::renumber(level.made, input_of);
         for (auto& split : level.splits) {
             for (uint32_t& v : split) v = input_of[v];
         }
     }
-    set_base(mesh, out.levels.empty() ? mesh.triangles : out.levels.back().triangles, out);
+    detail::renumber(run.mesh, input_of);
+    set_base(mesh, out.levels.empty() ? mesh.triangles : run.mesh, out);
     return out;
 }
 
+std::vector<Triangle> mesh_after(const std::vector<Triangle>& leaf, const std::vector<DetectedLevel>& levels,
+                                 size_t count, uint32_t vertex_count) {
+    std::vector<uint8_t> removed(vertex_count, 0);
+    std::vector<Triangle> mesh = leaf;
+    for (size_t s = 0; s < std::min(count, levels.size()); ++s) mesh = detail::mesh_after_level(mesh, levels[s], removed);
+    return mesh;
+}
+
 DetectedBase truncated(const TriangleMesh& mesh, DetectedBase detected, size_t levels) {
-    detected.levels.resize(std::min(levels, detected.levels.size()));
-    set_base(mesh, detected.levels.empty() ? mesh.triangles : detected.levels.back().triangles, detected);
+    if (levels >= detected.levels.size()) return detected;
+    detected.levels.resize(levels);
+    if (levels == 0) {
+        set_base(mesh, mesh.triangles, detected);
+    } else {
+        const std::vector<Triangle> leaf = detected.found_in_reverse
+                                               ? std::vector<Triangle>(mesh.triangles.rbegin(), mesh.triangles.rend())
+                                               : mesh.triangles;
+        set_base(mesh, mesh_after(leaf, detected.levels, levels, uint32_t(mesh.positions.size())), detected);
+    }
     return detected;
 }
 

@@ -13,19 +13,29 @@
 
 namespace amc {
 
+// A level keeps what it changed, not the mesh it leaves (a search undoes tens of levels of a
+// large mesh): that mesh is `made` followed by the triangles of the mesh before it that keep
+// every vertex (none is a midpoint of `splits`), in their order (mesh_after).
 struct DetectedLevel {
     // Every split undone at this level: parent (v0, v1, v2) and midpoints (m0 on v0 -> v1, m1,
     // m2), as vertex ids of the input mesh.
     std::vector<std::array<uint32_t, 6>> splits;
     uint32_t closures = 0;             // green closures merged into their coarse triangle
-    std::vector<Triangle> triangles;   // the mesh left after this level (input vertex ids)
+    std::vector<Triangle> made;        // the splits' parents and the closures' coarse triangles
+    size_t triangles_left = 0;         // the size of the mesh this level leaves
 };
 
 struct DetectedBase {
     TriangleMesh base;                          // positions copied from the input mesh
     std::vector<uint32_t> leaf_vertex_of_base;  // base vertex i is input vertex leaf_vertex_of_base[i]
     std::vector<DetectedLevel> levels;          // the levels undone, finest first
+    bool found_in_reverse = false;              // the levels were found over the input triangles reversed
 };
+
+// The mesh that levels [0, count) of `levels` leave of `leaf` (the triangles they were found over,
+// in that order; count 0: `leaf` itself), over vertex ids below vertex_count.
+std::vector<Triangle> mesh_after(const std::vector<Triangle>& leaf, const std::vector<DetectedLevel>& levels,
+                                 size_t count, uint32_t vertex_count);
 
 // Validates `mesh` (validate_triangle_mesh; `what` names it in messages) and finds its base, on
 // up to two of `threads` threads (0: every core; the answer does not depend on it).
@@ -52,6 +62,12 @@ std::vector<uint32_t> breadth_first_vertices(const std::vector<Triangle>& triang
 
 // Every vertex v of `triangles` replaced by id[v].
 void renumber(std::vector<Triangle>& triangles, const std::vector<uint32_t>& id);
+
+// The mesh that `level` leaves of `mesh`, the one before it (see DetectedLevel). `removed` is
+// scratch, one zero per vertex, given back zeroed; `kept_from` (if given) receives the index in
+// `mesh` of each triangle after the made ones.
+std::vector<Triangle> mesh_after_level(const std::vector<Triangle>& mesh, const DetectedLevel& level,
+                                       std::vector<uint8_t>& removed, std::vector<uint32_t>* kept_from = nullptr);
 
 }  // namespace detail
 

@@ -80,53 +80,58 @@ ImportedHierarchy hierarchy_from_levels(const TriangleMesh& mesh, const Detected
     Hierarchy& h = out.hierarchy;
     h = Hierarchy(detected.base);
     std::vector<uint32_t> input_of = detected.leaf_vertex_of_base;  // hierarchy vertex -> input vertex
-    size_t node_count = h.root_count();
-    for (const DetectedLevel& level : detected.levels) node_count += 4 * level.splits.size();
-    FlatMap<TripleKey, NodeId> node_of(node_count, kEmptyTriple);
-    auto key_of = [&](NodeId n) { return triple_key(input_of[h.vertex(n, 0)], input_of[h.vertex(n, 1)], input_of[h.vertex(n, 2)]); };
-    for (NodeId root = 0; root < h.root_count(); ++root) node_of[key_of(root)] = root;
+    // The build's tables are freed before the check makes its own (a large mesh's peak memory).
+    {
+        size_t node_count = h.root_count();
+        for (const DetectedLevel& level : detected.levels) node_count += 4 * level.splits.size();
+        FlatMap<TripleKey, NodeId> node_of(node_count, kEmptyTriple);
+        auto key_of = [&](NodeId n) { return triple_key(input_of[h.vertex(n, 0)], input_of[h.vertex(n, 1)], input_of[h.vertex(n, 2)]); };
+        for (NodeId root = 0; root < h.root_count(); ++root) node_of[key_of(root)] = root;
 
-    for (size_t level = detected.levels.size(); level-- > 0;) {
-        for (const auto& s : detected.levels[level].splits) {
-            const NodeId* found = node_of.find(triple_key(s[0], s[1], s[2]));
-            if (found == nullptr || !h.is_leaf(*found)) {
-                fail("level " + std::to_string(level) + " splits a triangle that is not a leaf");
-            }
-            const NodeId n = *found;
-            int r = 0;
-            while (r < 3 && input_of[h.vertex(n, r)] != s[0]) ++r;
-            if (r == 3 || input_of[h.vertex(n, (r + 1) % 3)] != s[1] || input_of[h.vertex(n, (r + 2) % 3)] != s[2]) {
-                fail("a split parent has the wrong orientation");
-            }
-            if (!h.can_split(n)) fail("a split breaks balance");
-            h.split(n);
-            for (int e = 0; e < 3; ++e) {
-                const VertexId v = h.midpoint(n, e);
-                const uint32_t m = s[size_t(3 + (e - r + 3) % 3)];  // node edge e is split edge e - r
-                if (v >= input_of.size()) input_of.resize(size_t(v) + 1, kNoIndex);
-                if (input_of[v] == kNoIndex) {
-                    input_of[v] = m;
-                    h.set_position(v, mesh.positions[m]);
-                } else if (input_of[v] != m) {
-                    fail("two midpoints for one edge");
+        for (size_t level = detected.levels.size(); level-- > 0;) {
+            for (const auto& s : detected.levels[level].splits) {
+                const NodeId* found = node_of.find(triple_key(s[0], s[1], s[2]));
+                if (found == nullptr || !h.is_leaf(*found)) {
+                    fail("level " + std::to_string(level) + " splits a triangle that is not a leaf");
                 }
+                const NodeId n = *found;
+                int r = 0;
+                while (r < 3 && input_of[h.vertex(n, r)] != s[0]) ++r;
+                if (r == 3 || input_of[h.vertex(n, (r + 1) % 3)] != s[1] || input_of[h.vertex(n, (r + 2) % 3)] != s[2]) {
+                    fail("a split parent has the wrong orientation");
+                }
+                if (!h.can_split(n)) fail("a split breaks balance");
+                h.split(n);
+                for (int e = 0; e < 3; ++e) {
+                    const VertexId v = h.midpoint(n, e);
+                    const uint32_t m = s[size_t(3 + (e - r + 3) % 3)];  // node edge e is split edge e - r
+                    if (v >= input_of.size()) input_of.resize(size_t(v) + 1, kNoIndex);
+                    if (input_of[v] == kNoIndex) {
+                        input_of[v] = m;
+                        h.set_position(v, mesh.positions[m]);
+                    } else if (input_of[v] != m) {
+                        fail("two midpoints for one edge");
+                    }
+                }
+                for (int k = 0; k < 4; ++k) node_of[key_of(h.child(n, k))] = h.child(n, k);
             }
-            for (int k = 0; k < 4; ++k) node_of[key_of(h.child(n, k))] = h.child(n, k);
         }
     }
 
     // Diagonals of two-hanging-node leaves: the default one joins m_{u+1} and v_u (a triangle
     // (v_u, m_{u+1}, m_{u+2}) exists), the other m_{u+2} and v_{u+1}.
-    FlatMap<uint64_t, uint8_t> edges(mesh.triangles.size() * 3, ~0ull);  // directed edges of the input
-    for (const Triangle& t : mesh.triangles) {
-        for (int e = 0; e < 3; ++e) edges[directed(t[size_t(e)], t[size_t(e + 1) % 3])] = 1;
-    }
-    for (NodeId n : h.leaves()) {
-        if (h.hanging_node_count(n) != 2) continue;
-        const int u = !h.has_hanging_node(n, 0) ? 0 : !h.has_hanging_node(n, 1) ? 1 : 2;
-        const int e1 = (u + 1) % 3;
-        const VertexId m1 = h.midpoint(h.neighbor(n, e1), h.neighbor_edge(n, e1));
-        h.set_diagonal_flipped(n, edges.find(directed(input_of[h.vertex(n, u)], input_of[m1])) == nullptr);
+    {
+        FlatMap<uint64_t, uint8_t> edges(mesh.triangles.size() * 3, ~0ull);  // directed edges of the input
+        for (const Triangle& t : mesh.triangles) {
+            for (int e = 0; e < 3; ++e) edges[directed(t[size_t(e)], t[size_t(e + 1) % 3])] = 1;
+        }
+        for (NodeId n : h.leaves()) {
+            if (h.hanging_node_count(n) != 2) continue;
+            const int u = !h.has_hanging_node(n, 0) ? 0 : !h.has_hanging_node(n, 1) ? 1 : 2;
+            const int e1 = (u + 1) % 3;
+            const VertexId m1 = h.midpoint(h.neighbor(n, e1), h.neighbor_edge(n, e1));
+            h.set_diagonal_flipped(n, edges.find(directed(input_of[h.vertex(n, u)], input_of[m1])) == nullptr);
+        }
     }
 
     // The check: every input vertex used once, the same triangles, a valid hierarchy.

@@ -91,7 +91,7 @@ uint32_t LevelFinder::readable_sides(uint32_t t) const {
     uint32_t count = 1;
     for (const Fan& fan : fans) {
         count += fan.kind == Fan::boundary ||
-                 (fan.kind == Fan::triangles && fan.size == 3 && possible_block(fan.triangle[1]) != nullptr);
+                 (fan.kind == Fan::triangles && fan.size == 3 && possible_block(fan.triangle(1)) != nullptr);
     }
     return count;
 }
@@ -212,11 +212,11 @@ uint32_t LevelFinder::grow_patch(uint32_t t, Preference preference, bool explori
 void LevelFinder::collect_suspects(const std::vector<uint32_t>& invalid, std::vector<uint32_t>& suspects) const {
     for_each_invalid_fan(invalid, [&](uint32_t i, const Fan& fan) {
         for (int k = 0; k < fan.size; ++k) {
-            const uint32_t owner = block_of_[fan.triangle[k]];
+            const uint32_t owner = block_of_[fan.triangle(k)];
             if (owner != kNoIndex && owner != i) suspects.push_back(blocks_[owner].center);
         }
         Block across;
-        if (fan.size != 3 || !read_block(fan.triangle[1], across)) return;
+        if (fan.size != 3 || !read_block(fan.triangle(1), across)) return;
         for (uint32_t v : across.v) {
             for (uint8_t k = 0; k < midpoint_count_[v]; ++k) suspects.push_back(blocks_[midpoint_block_[v][k] / 3].center);
         }
@@ -254,7 +254,7 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
         }
         for (int i = 0; i < 3; ++i) {
             const Fan& side = blocks_[next].fan[size_t(i)];
-            if (side.kind != Fan::triangles || block_of_[side.triangle[1]] != kNoIndex) continue;
+            if (side.kind != Fan::triangles || block_of_[side.triangle(1)] != kNoIndex) continue;
             const Fan fan = side;  // a copy: placing blocks moves blocks_
             if (preference == Preference::closure_first) {
                 const uint32_t partner = closure_partner(blocks_[next], i, fan);
@@ -264,15 +264,15 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
                     bool across_fits = false;
                     if (!preference_mattered_ && fan.size == 3) {
                         const uint32_t size = uint32_t(blocks_.size());
-                        if (place_block(fan.triangle[1])) across_fits = true, roll_back(size);
+                        if (place_block(fan.triangle(1))) across_fits = true, roll_back(size);
                     }
                     if (place_block(partner)) {
                         if (fan.size == 2 || across_fits) preference_mattered_ = true;
                         continue;
                     }
                 }
-                if (fan.size == 3) place_block(fan.triangle[1]);
-            } else if (fan.size == 3 && !place_block(fan.triangle[1])) {
+                if (fan.size == 3) place_block(fan.triangle(1));
+            } else if (fan.size == 3 && !place_block(fan.triangle(1))) {
                 const uint32_t partner = closure_partner(blocks_[next], i, fan);
                 if (partner != kNoIndex) place_block(partner);
             }
@@ -299,7 +299,7 @@ uint32_t LevelFinder::grow_patch_once(uint32_t t, Preference preference, bool ex
         if (size >= kBlockedGrowth && invalid.size() <= kFewInvalid) {
             for_each_invalid_fan(invalid, [&](uint32_t i, const Fan& fan) {
                 for (int k = 0; k < fan.size; ++k) {
-                    const uint32_t g = fan.triangle[k];
+                    const uint32_t g = fan.triangle(k);
                     if (refined_[g]) blockers_.push_back(g);
                     for (int f = 0; f < 3; ++f) {
                         const uint32_t h = adjacency_.twin(3 * g + uint32_t(f));
@@ -497,7 +497,7 @@ std::vector<uint32_t> LevelFinder::free_near(std::vector<uint32_t> ring, int rin
 
 void LevelFinder::hold(uint32_t id, bool on) {
     const Patch& patch = patches_[id];
-    std::vector<Side> sides;
+    std::vector<Side> closures;
     // Read with the patch's id on its blocks (the triangles it holds carry that id, so a
     // release reads its closures as such), then set.
     for (uint32_t i = patch.first; i < patch.end; ++i) {
@@ -506,12 +506,12 @@ void LevelFinder::hold(uint32_t id, bool on) {
     for (uint32_t i = patch.first; i < patch.end; ++i) {
         if (!blocks_[i].alive) continue;
         for (int e = 0; e < 3; ++e) {
-            sides.push_back(classify(i, e));
+            const Side side = classify(i, e);
+            if (side.kind == Side::green) closures.push_back(side);
         }
         if (!on) blocks_[i].patch = kNoIndex;
     }
-    for (const Side& side : sides) {
-        if (side.kind != Side::green) continue;
+    for (const Side& side : closures) {
         for (int k = 0; k < side.count; ++k) closure_of_[side.group[k]] = on ? id : kNoIndex;
         for (uint32_t v : side.coarse) on ? ++pinned_old_[v] : --pinned_old_[v];
     }

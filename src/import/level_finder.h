@@ -41,10 +41,12 @@ namespace amc::detail::inverse {
 // The triangles around midpoint m_i outside its block, walked from v_{i+1} to v_i.
 struct Fan {
     enum Kind : uint8_t { invalid, boundary, triangles } kind = invalid;
-    int size = 0;            // 2 or 3 triangles
-    uint32_t triangle[3] = {};
+    uint8_t size = 0;        // 2 or 3 triangles
     uint32_t entry[3] = {};  // the half-edge by which the walk entered each (x -> m)
     uint32_t inner[2] = {};  // the vertices between consecutive fan triangles
+    // Triangle k of the fan, the one its entry half-edge belongs to (a block's shape is kept
+    // for every triangle read, so the fan stays small).
+    uint32_t triangle(int k) const { return entry[k] / 3; }
 };
 
 struct Block {
@@ -113,6 +115,12 @@ public:
                 if (h != kNoHalfEdge) refined_near_[h / 3] = 1;
             }
         }
+        // A large mesh's shapes get room for every triangle up front: the allocator maps so large
+        // a block, whose pages never read stay unused, where growing would copy the shapes and
+        // hold both copies (the peak memory of a uniform mesh's step). A small one's would sit in
+        // the heap, whose reused pages are resident.
+        constexpr size_t kShapesReserved = size_t(1) << 18;
+        if (tri_.size() >= kShapesReserved) shapes_.reserve(tri_.size());
     }
 
     // Commits patches best first, in rounds (patches that could not grow while other readings were

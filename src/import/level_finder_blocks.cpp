@@ -67,7 +67,6 @@ Fan LevelFinder::walk_fan(const Block& b, int i) const {
     for (int k = 0; k < 3; ++k) {
         const uint32_t t = h / 3;
         if (t == b.center || t == b.corner[0] || t == b.corner[1] || t == b.corner[2]) return fan;
-        fan.triangle[k] = t;
         fan.entry[k] = h;
         const uint32_t p = vertex_at(h, 2);
         if (p == a) {
@@ -252,18 +251,18 @@ Side LevelFinder::classify(uint32_t index, int i) const {
         return side;
     }
     if (fan.kind != Fan::triangles) return side;
-    const uint32_t other = block_of_[fan.triangle[0]];
-    if (other != kNoIndex || block_of_[fan.triangle[1]] != kNoIndex || (fan.size == 3 && block_of_[fan.triangle[2]] != kNoIndex)) {
-        if (fan.size == 3 && other != index && block_of_[fan.triangle[1]] == other && block_of_[fan.triangle[2]] == other)
+    const uint32_t other = block_of_[fan.triangle(0)];
+    if (other != kNoIndex || block_of_[fan.triangle(1)] != kNoIndex || (fan.size == 3 && block_of_[fan.triangle(2)] != kNoIndex)) {
+        if (fan.size == 3 && other != index && block_of_[fan.triangle(1)] == other && block_of_[fan.triangle(2)] == other)
             side.kind = Side::red;
         return side;
     }
     for (int k = 0; k < fan.size; ++k) {
-        if (closure_of_[fan.triangle[k]] != kNoIndex && closure_of_[fan.triangle[k]] != b.patch) return side;
+        if (closure_of_[fan.triangle(k)] != kNoIndex && closure_of_[fan.triangle(k)] != b.patch) return side;
     }
     const uint32_t a = b.v[size_t(i)], bb = b.v[size_t(i + 1) % 3];
     side.count = fan.size;
-    for (int k = 0; k < fan.size; ++k) side.group[k] = fan.triangle[k];
+    for (int k = 0; k < fan.size; ++k) side.group[k] = fan.triangle(k);
     if (fan.size == 2) {
         const uint32_t p = fan.inner[0];
         if (!is_new(p)) {  // one hanging node: (b, m, p), (m, a, p)
