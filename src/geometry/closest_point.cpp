@@ -504,15 +504,18 @@ uint32_t ClosestPointQuery::build_fan(const TriangleMesh& reference, uint32_t ap
         store_box(lo, hi, margin, node.lo, node.hi);
         const Vec3 axis = unit(sum);
         if (squared_length(axis) > 0) {
-            double half_angle = 0;  // by atan2, which (unlike acos) stays accurate near 0
+            // The widest direction by its (sine, cosine) from the axis (a before b where sin(a - b) > 0,
+            // both in [0, 180] degrees), then its angle by atan2, which (unlike acos) stays accurate
+            // near 0; a choice off by rounding is within the widening.
+            double widest_sine = 0, widest_cosine = 1;
             for (uint32_t i = item.begin; i < item.end; ++i) {
                 for (Vec3 to : directions[local[i]].to) {
-                    if (squared_length(to) > 0) {
-                        half_angle = std::max(half_angle, std::atan2(std::sqrt(squared_length(cross(to, axis))), dot(to, axis)));
-                    }
+                    if (!(squared_length(to) > 0)) continue;
+                    const double sine = std::sqrt(squared_length(cross(to, axis))), cosine = dot(to, axis);
+                    if (sine * widest_cosine - cosine * widest_sine > 0) widest_sine = sine, widest_cosine = cosine;
                 }
             }
-            half_angle += kConeWidening;
+            const double half_angle = std::atan2(widest_sine, widest_cosine) + kConeWidening;
             if (half_angle <= kRightAngle) {
                 node.axis = axis;
                 node.cosine = std::cos(half_angle);

@@ -30,7 +30,8 @@ Vec3 closest_point_on_triangle(Vec3 p, Vec3 a, Vec3 b, Vec3 c, Vec3& barycentric
 // tree: near such a vertex the boxes of a fan of long triangles all overlap, and a query there
 // would test a constant share of them. They sit as one leaf of the box tree holding a tree of
 // direction cones around the vertex (every triangle holds it), searched with the cone's lower
-// bound on the distance, and with boxes as well (docs/REMESHER.md, "Fans of long triangles").
+// bound on the distance (intersect_line: a plane through the vertex between the cone and the
+// segment), and with boxes as well (docs/REMESHER.md, "Fans of long triangles").
 //
 // Results are deterministic and independent of the tree: the hit is the triangle of least
 // distance, ties broken by the lowest triangle index, exactly as a brute-force loop over all
