@@ -8,6 +8,7 @@
 #include "coding/entropy/arithmetic_coder.h"
 #include "coding/base/base_mesh_coder.h"
 #include "coding/container.h"
+#include "coding/distributed/rank_encoder.h"
 #include "coding/format_version.h"
 #include "coding/geometry/float_coder.h"
 #include "coding/hierarchy/hierarchy_stream.h"
@@ -719,6 +720,22 @@ TEST(CraftedFiles, ImportOfPositionsOfOneHashIsLinear) {
     EXPECT_LT(milliseconds, 1000.0 * kSanitizerSlowdown);
 }
 
+// The triangulated grid of width x width vertices, vertex v (row v / width) numbered id[v]:
+// squares (a, b, d, c) from the lower left, counterclockwise, as triangles (a, b, d) and (a, d, c).
+TriangleMesh numbered_grid(uint32_t width, const std::vector<uint32_t>& id) {
+    TriangleMesh mesh;
+    mesh.positions.resize(id.size());
+    for (uint32_t v = 0; v < id.size(); ++v) mesh.positions[id[v]] = {double(v % width), double(v / width), 0};
+    for (uint32_t j = 0; j + 1 < width; ++j) {
+        for (uint32_t i = 0; i + 1 < width; ++i) {
+            const uint32_t a = j * width + i, b = a + 1, c = a + width, d = c + 1;
+            mesh.triangles.push_back({id[a], id[b], id[d]});
+            mesh.triangles.push_back({id[a], id[d], id[c]});
+        }
+    }
+    return mesh;
+}
+
 // A triangulated side x side grid numbered so that one direction of each edge of a perfect
 // matching (horizontal pairs) hashes into the first 512 slots of the import's table of directed
 // edges (hierarchy_from_levels: open addressing over the next power of two of 6 keys a face), as
@@ -765,17 +782,7 @@ TriangleMesh grid_of_one_edge_run(uint32_t side) {
     }
     for (uint32_t v = 0; v < vertices; ++v)
         if (id[v] == kNoIndex) id[v] = take();
-    TriangleMesh mesh;
-    mesh.positions.resize(vertices);
-    for (uint32_t v = 0; v < vertices; ++v) mesh.positions[id[v]] = {double(v % side), double(v / side), 0};
-    for (uint32_t j = 0; j + 1 < side; ++j) {
-        for (uint32_t i = 0; i + 1 < side; ++i) {
-            const uint32_t a = j * side + i, b = a + 1, c = a + side, d = c + 1;
-            mesh.triangles.push_back({id[a], id[b], id[d]});
-            mesh.triangles.push_back({id[a], id[d], id[c]});
-        }
-    }
-    return mesh;
+    return numbered_grid(side, id);
 }
 
 // That grid (160,000 vertices) imported without a base: the edges of the matching, half the
@@ -792,6 +799,131 @@ TEST(CraftedFiles, ImportOfEdgesInOneProbeRunIsLinear) {
                 milliseconds);
     EXPECT_EQ(imported.vertex_of_input.size(), mesh.positions.size());
     EXPECT_LT(milliseconds, 3000.0 * kSanitizerSlowdown);
+}
+
+// A base of side x side squares (two triangles each) numbered so that the horizontal edges of a
+// matching, one on every other square of each inner grid line, key the first 512 slots of the
+// seam's table of segments, as its Fibonacci hash did until 2026-12-07: slot = (a G + (b G >> 32))
+// mod 2^m for the key a << 32 | b (a < b), so for each b an a < b is solved. With keep_base_order
+// and one chunk per row of squares, every inner horizontal edge is a seam edge.
+Hierarchy chunk_rows_of_one_seam_run(uint32_t side, EncodeOptions& options) {
+    const uint32_t width = side + 1, vertices = width * width;
+    const uint64_t keys = uint64_t(side) * (side - 1);  // the seam edges, each one unsplit segment
+    uint64_t slots = 16;
+    while (slots < 2 * keys) slots *= 2;  // the table is at most half full
+    const uint64_t mask = slots - 1;
+    uint64_t inverse = kGoldenGamma;  // Newton's iteration for the inverse mod 2^64
+    for (int i = 0; i < 5; ++i) inverse *= 2 - kGoldenGamma * inverse;
+    std::vector<uint32_t> id(vertices, kNoIndex), unused(vertices);
+    std::vector<uint8_t> used(vertices, 0);
+    for (uint32_t i = 0; i < vertices; ++i) unused[i] = i;
+    SplitMix64 random{13};
+    for (uint32_t i = vertices; i > 1; --i) std::swap(unused[i - 1], unused[random.below(i)]);
+    size_t next = 0;
+    auto take = [&] {
+        while (used[unused[next]]) ++next;
+        used[unused[next]] = 1;
+        return unused[next];
+    };
+    for (uint32_t j = 1; j < side; ++j) {
+        for (uint32_t i = 0; i + 1 <= side; i += 2) {
+            const uint32_t first = j * width + i;  // gets a; first + 1 gets b
+            for (int tries = 0; tries < 8 && id[first] == kNoIndex; ++tries) {
+                const uint32_t b = take();
+                const uint64_t high = (uint64_t(b) * kGoldenGamma) >> 32;
+                for (uint64_t slot = 0; slot < 512 && id[first] == kNoIndex; ++slot) {
+                    const uint64_t a = (((slot - high) & mask) * inverse) & mask;
+                    if (a >= b || used[a]) continue;
+                    used[a] = 1;
+                    id[first] = uint32_t(a);
+                    id[first + 1] = b;
+                }
+                if (id[first] == kNoIndex) used[b] = 0;
+                std::swap(unused[next], unused[next + random.below(vertices - next)]);
+            }
+        }
+    }
+    for (uint32_t v = 0; v < vertices; ++v)
+        if (id[v] == kNoIndex) id[v] = take();
+    options.keep_base_order = true;
+    options.chunk_roots.assign(side, 2 * side);
+    options.threads = 1;
+    return Hierarchy(numbered_grid(width, id));
+}
+
+// That base's chunked file: its decoder (and encoder) set every seam segment in the table, a
+// matching's (a quarter of the base vertices) in one probe run: super-linear until 2026-12-07
+// (docs/FUZZING.md).
+TEST(CraftedFiles, SeamSegmentsInOneProbeRunDecodeInLinearTime) {
+    EncodeOptions options;
+    const Hierarchy h = chunk_rows_of_one_seam_run(kSanitizerSlowdown > 1 ? 100 : 300, options);
+    const std::vector<uint8_t> file = encode(h, options);
+    DecodeOptions decode_options;
+    decode_options.threads = 1;
+    const double start = cpu_milliseconds();
+    const Hierarchy decoded = decode(file.data(), file.size(), decode_options);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  decode of %u roots in %zu chunks, a matching's seam segments in one probe run: %.1f ms\n",
+                h.root_count(), options.chunk_roots.size(), milliseconds);
+    EXPECT_EQ(decoded.root_count(), h.root_count());
+    EXPECT_EQ(decoded.base().triangles, h.base().triangles);  // the base kept in its order
+    EXPECT_LT(milliseconds, 1000.0 * kSanitizerSlowdown);
+}
+
+// A base of side x side squares numbered so that, in the quarter of its rows that rank 0 owns,
+// edge a -> b of each square's bottom (every other square) has a << 32 | b = 0 modulo P, the
+// prime bucket count rank 0's table of its directed edges (seam_splits) reaches, where libstdc++
+// hashes an integer to itself, as it did until 2026-12-07: for a drawn a, b is solved (the other
+// three quarters' vertices leave every residue one or more ids below the vertex count).
+TEST(CraftedFiles, RankEdgesInOneBucketSplitTheSeamInLinearTime) {
+    const uint32_t side = kSanitizerSlowdown > 1 ? 200 : 480, width = side + 1, vertices = width * width;
+    const uint32_t rows = side / 4, owned = 2 * side * rows;
+    std::unordered_map<uint64_t, std::pair<NodeId, int>> same_size;  // its bucket count, as the table's
+    for (uint64_t k = 0; k < 3ull * owned; ++k) same_size.emplace(k, std::make_pair(NodeId(0), 0));
+    const uint64_t buckets = same_size.bucket_count(), shift = (uint64_t(1) << 32) % buckets;
+    std::vector<uint32_t> id(vertices, kNoIndex), unused(vertices);
+    std::vector<uint8_t> used(vertices, 0);
+    for (uint32_t i = 0; i < vertices; ++i) unused[i] = i;
+    SplitMix64 random{17};
+    for (uint32_t i = vertices; i > 1; --i) std::swap(unused[i - 1], unused[random.below(i)]);
+    size_t next = 0, in_one_bucket = 0;
+    auto take = [&] {
+        while (used[unused[next]]) ++next;
+        used[unused[next]] = 1;
+        return unused[next];
+    };
+    for (uint32_t j = 0; j < rows; ++j) {
+        for (uint32_t i = 0; i + 1 <= side; i += 2) {
+            const uint32_t first = j * width + i;  // gets a; first + 1 gets b
+            for (int tries = 0; tries < 64 && id[first] == kNoIndex; ++tries) {
+                const uint64_t a = unused[next + random.below(vertices - next)];
+                if (used[a]) continue;
+                for (uint64_t b = (buckets - a % buckets * shift % buckets) % buckets; b < vertices; b += buckets) {
+                    if (used[b] || b == a) continue;
+                    used[a] = used[b] = 1;
+                    id[first] = uint32_t(a);
+                    id[first + 1] = uint32_t(b);
+                    ++in_one_bucket;
+                    break;
+                }
+            }
+        }
+    }
+    for (uint32_t v = 0; v < vertices; ++v)
+        if (id[v] == kNoIndex) id[v] = take();
+    const TriangleMesh base = numbered_grid(width, id);
+    const uint32_t roots = uint32_t(base.triangles.size());
+    const RankLayout layout = rank_layout(roots, {{0, owned}, {owned, roots - owned}});
+    const Hierarchy forest = extract_roots(Hierarchy(base), {RootRange{0, owned}});
+    const double start = cpu_milliseconds();
+    const RankChunk part = rank_chunk(base, 0, forest, "rank 0");
+    const std::vector<SeamSplit> splits = seam_splits(part, base, layout);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  rank 0's %u roots, %zu directed edges in one of %llu buckets: %.1f ms\n", owned, in_one_bucket,
+                (unsigned long long)buckets, milliseconds);
+    EXPECT_GT(in_one_bucket, size_t(owned) / 5);  // the numbering does what it is meant to
+    EXPECT_TRUE(splits.empty());                  // nothing refined: no seam vertex
+    EXPECT_LT(milliseconds, 1000.0 * kSanitizerSlowdown);
 }
 
 // A half disc of 2^15 roots around one boundary vertex, in clockwise order, refined once with its

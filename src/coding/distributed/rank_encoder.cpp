@@ -9,6 +9,7 @@
 #include "coding/geometry/level_geometry.h"
 #include "coding/geometry/position_coder.h"
 #include "common/check.h"
+#include "common/keyed_hash.h"
 #include "hierarchy/writer_checks.h"
 
 #include <algorithm>
@@ -127,7 +128,9 @@ std::vector<SeamSplit> seam_splits(const RankChunk& part, const TriangleMesh& ba
     const uint32_t first = part.first_root, count = h.root_count();
     if (count == 0) return out;
     // The rank's root edges by their ends in the whole base, to find the far side of a seam edge.
-    std::unordered_map<uint64_t, std::pair<NodeId, int>> own_edge;
+    // Keyed: the caller numbers the base vertices, and the identity hash let the edges of a
+    // matching share one bucket (docs/FUZZING.md).
+    std::unordered_map<uint64_t, std::pair<NodeId, int>, KeyedWordHash> own_edge;
     for (uint32_t i = 0; i < count; ++i)
         for (int e = 0; e < 3; ++e)
             own_edge.emplace(directed(base.triangles[first + i][e], base.triangles[first + i][(e + 1) % 3]), std::make_pair(i, e));
