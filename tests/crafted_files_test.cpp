@@ -952,6 +952,78 @@ TEST(CraftedFiles, UniformImportAtABoundaryVertexOfManyRootsIsLinear) {
     EXPECT_LT(milliseconds, 3000.0 * kSanitizerSlowdown);
 }
 
+// A grid base of side x side squares and one far triangle (every grid vertex then in one Morton
+// cell, so that the importer's spatial order is the input's), refined once with its new vertices
+// off their midpoints: the uniform way. Each inner base vertex x first asks for its ray toward its
+// lower left neighbour y, so the key x << 32 | y is inserted in the ray finder's table; the leaf
+// numbers x and y so that the key is 0 modulo the prime bucket count the table reaches (libstdc++
+// hashes an integer to itself), for a matching (x in every other row): super-linear until 2026-12-07.
+TEST(CraftedFiles, UniformImportOfRaysInOneBucketIsLinear) {
+    const uint32_t side = kSanitizerSlowdown > 1 ? 100 : 250, width = side + 1;
+    TriangleMesh base = numbered_grid(width, [&] {
+        std::vector<uint32_t> identity(size_t(width) * width);
+        for (uint32_t v = 0; v < identity.size(); ++v) identity[v] = v;
+        return identity;
+    }());
+    const uint32_t far = uint32_t(base.positions.size());
+    base.positions.insert(base.positions.end(), {{1e9, 0, 0}, {1e9 + 1, 0, 0}, {1e9, 1, 0}});
+    base.triangles.push_back({far, far + 1, far + 2});
+    Hierarchy refined(base);
+    refine_uniformly(refined, 1);
+    const LeafMesh leaf = extract_leaf_mesh(refined);
+    const uint32_t vertices = uint32_t(leaf.mesh.positions.size()), near = vertices - 6;  // the far triangle's last
+    std::unordered_map<uint64_t, uint32_t> same_size;  // its bucket count, as the table's (about a key per base vertex)
+    for (uint64_t k = 0; k < uint64_t(width) * width; ++k) same_size.emplace(k, 0);
+    const uint64_t buckets = same_size.bucket_count(), shift = (uint64_t(1) << 32) % buckets;
+    std::vector<uint32_t> id(vertices, kNoIndex), unused(near);
+    std::vector<uint8_t> used(near, 0);
+    for (uint32_t i = 0; i < near; ++i) unused[i] = i;
+    SplitMix64 random{19};
+    for (uint32_t i = near; i > 1; --i) std::swap(unused[i - 1], unused[random.below(i)]);
+    size_t next = 0, in_one_bucket = 0;
+    for (uint32_t j = 1; j <= side; j += 2) {
+        for (uint32_t i = 1; i <= side; ++i) {
+            const uint32_t x = j * width + i, y = x - width - 1;  // hierarchy ids: base vertices first
+            for (int tries = 0; tries < 64 && id[x] == kNoIndex; ++tries) {
+                const uint64_t a = unused[next + random.below(near - next)];
+                if (used[a]) continue;
+                for (uint64_t b = (buckets - a % buckets * shift % buckets) % buckets; b < near; b += buckets) {
+                    if (used[b] || b == a) continue;
+                    used[a] = used[b] = 1;
+                    id[x] = uint32_t(a);
+                    id[y] = uint32_t(b);
+                    ++in_one_bucket;
+                    break;
+                }
+            }
+        }
+    }
+    uint32_t far_id = near;
+    for (uint32_t v = 0; v < vertices; ++v) {
+        if (id[v] != kNoIndex) continue;
+        if (leaf.mesh.positions[v].x > 1e8) {
+            id[v] = far_id++;
+            continue;
+        }
+        while (used[unused[next]]) ++next;
+        used[unused[next]] = 1;
+        id[v] = unused[next];
+    }
+    TriangleMesh input;
+    input.positions.resize(vertices);
+    for (uint32_t v = 0; v < vertices; ++v) input.positions[id[v]] = leaf.mesh.positions[v];
+    for (uint32_t v = far + 3; v < vertices; ++v) input.positions[id[v]].z = 0.01;  // new vertices off their midpoints
+    for (const Triangle& t : leaf.mesh.triangles) input.triangles.push_back({id[t[0]], id[t[1]], id[t[2]]});
+    const double start = cpu_milliseconds();
+    const ImportedHierarchy imported = import_leaf_mesh(base, input);
+    const double milliseconds = cpu_milliseconds() - start;
+    std::printf("  uniform import of %zu faces, %zu rays in one of %llu buckets: %.1f ms\n", input.triangles.size(),
+                in_one_bucket, (unsigned long long)buckets, milliseconds);
+    EXPECT_GT(in_one_bucket, size_t(side) * side / 3);  // the numbering does what it is meant to
+    EXPECT_EQ(imported.hierarchy.node_count(), refined.node_count());
+    EXPECT_LT(milliseconds, 1000.0 * kSanitizerSlowdown);
+}
+
 // A step coarsening a chain of 2^15 candidates in a row of roots, each freed only by the one
 // after it (its third neighbour refined), in time linear in them: each pass over the row freed one,
 // 23 s of CPU here until 2026-12-07 (docs/FUZZING.md). A library caller's history, not a file.

@@ -2,6 +2,7 @@
 // triangular grid of each base triangle (docs/IMPORT.md, "uniform refinement").
 #include "import/uniform_lattice.h"
 
+#include "common/keyed_hash.h"
 #include "common/no_index.h"
 
 #include <amc/red_split.h>
@@ -62,7 +63,9 @@ private:
     const LeafHalfedges& he_;
     const uint32_t steps_;
     std::vector<uint32_t> walked_;  // per leaf vertex: its out-edges walked so far
-    std::unordered_map<uint64_t, uint32_t> first_toward_;
+    // Keyed (keyed_hash.h): libstdc++ hashes an integer to itself, and the leaf ids are the file's
+    // numbering where one Morton cell holds the mesh (a far component stretches the box; docs/FUZZING.md).
+    std::unordered_map<uint64_t, uint32_t, KeyedWordHash> first_toward_;
 };
 
 }  // namespace
