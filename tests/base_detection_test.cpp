@@ -163,16 +163,29 @@ TEST(ImportMesh, SearchedAgainWhereTheSearchStoppedFarFromABase) {
 // shuffled, comes back as a valid hierarchy with that leaf mesh. How often the base found is as
 // coarse as the true one is printed and must not fall below today's figures (docs/IMPORT.md,
 // section 2, states them).
-TEST(ImportMesh, RandomHierarchiesRoundTrip) {
+// Random hierarchy s of the tests below (refinement and coarsening over fixture s mod 4) and its
+// leaf mesh, shuffled.
+struct RandomCase {
+    std::string name;
+    Hierarchy truth;
+    TriangleMesh input;
+};
+
+RandomCase random_case(int s) {
     const auto meshes = testing::fixture_meshes();
+    const auto& [name, mesh] = meshes[size_t(s) % meshes.size()];
+    Random random{uint64_t(s) * 7 + 3};
+    Hierarchy h(mesh);
+    refine_randomly(h, 50 + uint32_t(random.next() % 1500), 2 + int(random.next() % 5), uint64_t(s), (s % 3) * 0.2);
+    TriangleMesh input = shuffled(extract_leaf_mesh(h).mesh, uint64_t(s));
+    return {name, std::move(h), std::move(input)};
+}
+
+TEST(ImportMesh, RandomHierarchiesRoundTrip) {
     int at_most_true = 0, total = 0;
     uint64_t found = 0, truth = 0;
     for (int s = 0; s < 200; ++s) {
-        const auto& [name, mesh] = meshes[size_t(s) % meshes.size()];
-        Random random{uint64_t(s) * 7 + 3};
-        Hierarchy h(mesh);
-        refine_randomly(h, 50 + uint32_t(random.next() % 1500), 2 + int(random.next() % 5), uint64_t(s), (s % 3) * 0.2);
-        const TriangleMesh input = shuffled(extract_leaf_mesh(h).mesh, uint64_t(s));
+        const auto [name, h, input] = random_case(s);
         const ImportedHierarchy imported = import_mesh(input, name);
         ASSERT_TRUE(reproduces(imported, input)) << name << " seed " << s;
         ++total;
@@ -191,14 +204,9 @@ TEST(ImportMesh, RandomHierarchiesRoundTrip) {
 // won), and must be the mesh the search left: the whole replay gives the base triangle for
 // triangle, and the first k levels alone build a hierarchy that reproduces the input.
 TEST(ImportMesh, DetectedLevelsReplayToTheMeshesTheyLeft) {
-    const auto meshes = testing::fixture_meshes();
     int reversed = 0, cases = 0;
     for (int s : {3, 10, 17, 54, 64, 71, 100, 133}) {
-        const auto& [name, mesh] = meshes[size_t(s) % meshes.size()];
-        Random random{uint64_t(s) * 7 + 3};
-        Hierarchy h(mesh);
-        refine_randomly(h, 50 + uint32_t(random.next() % 1500), 2 + int(random.next() % 5), uint64_t(s), (s % 3) * 0.2);
-        const TriangleMesh input = shuffled(extract_leaf_mesh(h).mesh, uint64_t(s));
+        const auto [name, h, input] = random_case(s);
         const DetectedBase detected = detect_base(input, name);
         reversed += detected.found_in_reverse;
         const std::vector<Triangle> leaf = detected.found_in_reverse

@@ -4,6 +4,7 @@
 // is allocated for it). A test binary of its own: it counts every allocation through a global
 // operator new.
 #include "padded_series.h"
+#include "random_hierarchies.h"
 
 #include "coding/entropy/arithmetic_coder.h"
 #include "coding/base/base_mesh_coder.h"
@@ -1109,18 +1110,6 @@ TEST(CraftedFiles, DetourAcrossAFanOfHighValenceIsLinear) {
     EXPECT_LT(milliseconds, 300.0 * kSanitizerSlowdown);
 }
 
-// The same triangles with every corner its own vertex: the same surface without a vertex of high
-// valence, so its fans stay in ClosestPointQuery's box tree.
-TriangleMesh without_shared_vertices(const TriangleMesh& mesh) {
-    TriangleMesh apart;
-    for (const Triangle& t : mesh.triangles) {
-        const uint32_t base = static_cast<uint32_t>(apart.positions.size());
-        for (uint32_t v : t) apart.positions.push_back(mesh.positions[v]);
-        apart.triangles.push_back({base, base + 1, base + 2});
-    }
-    return apart;
-}
-
 // 5,000 closest points near the apex of a bipyramid of 2^16 sides, 1e-3 off the middle of a face 1-50 %
 // of the way to the rim: the boxes of its long triangles all overlap there, so each query tested a
 // share of all of them until 2026-12-07 (docs/REMESHER.md, "Fans of long triangles"); the apexes'
@@ -1176,7 +1165,7 @@ TEST(CraftedFiles, ClosestPointsNearAVertexOfHighValenceTestFewTriangles) {
 // shared the bipyramid is now measured: its apexes' fans are searched by direction cones.
 TEST(CraftedFiles, DistanceToAFanOfLongTrianglesIsNotMeasuredForLong) {
     const uint32_t sides = uint32_t(1) << 11;
-    const TriangleMesh fan = without_shared_vertices(bipyramid(sides));
+    const TriangleMesh fan = testing::without_shared_vertices(bipyramid(sides));
     const double start = cpu_milliseconds();
     const SurfaceDistance d = surface_distance(fan, fan);
     const double milliseconds = cpu_milliseconds() - start;

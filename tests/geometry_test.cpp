@@ -1,5 +1,7 @@
 // Geometric queries of the refinement driver: closest point on a mesh (against brute force) and
 // discrete curvature (against the smooth surfaces the meshes sample).
+#include "random_hierarchies.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -380,17 +382,6 @@ TriangleMesh bipyramid_with_ties(uint32_t sides) {
     return mesh;
 }
 
-// The same triangles with every corner its own vertex: no vertex of high valence, so no fans.
-TriangleMesh without_shared_vertices(const TriangleMesh& mesh) {
-    TriangleMesh apart;
-    for (const Triangle& t : mesh.triangles) {
-        const uint32_t base = static_cast<uint32_t>(apart.positions.size());
-        for (uint32_t v : t) apart.positions.push_back(mesh.positions[v]);
-        apart.triangles.push_back({base, base + 1, base + 2});
-    }
-    return apart;
-}
-
 // Points near the bipyramid's upper apex (1e-7 to 1 away, in every direction), near its surface
 // (a point of a triangle moved off it by 0 to 1e-2), on its vertices, far away.
 std::vector<Vec3> queries_near_a_fan(const TriangleMesh& mesh, uint32_t seed) {
@@ -434,7 +425,7 @@ TEST(ClosestPointQuery, FanOfHighValenceMatchesBruteForce) {
 // The fans change no answer of the other queries either: each equals the box tree's alone.
 TEST(ClosestPointQuery, FanOfHighValenceAnswersAsTheBoxTree) {
     const TriangleMesh mesh = bipyramid_with_ties(1024);
-    const ClosestPointQuery fans(mesh), boxes(without_shared_vertices(mesh));
+    const ClosestPointQuery fans(mesh), boxes(testing::without_shared_vertices(mesh));
     ASSERT_EQ(fans.fan_count(), 2u);
     ASSERT_EQ(boxes.fan_count(), 0u);
     std::mt19937 rng(8);

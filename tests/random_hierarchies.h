@@ -21,6 +21,18 @@ struct Random {
     }
 };
 
+// The same triangles with every corner its own vertex: the same surface without a vertex of high
+// valence (ClosestPointQuery keeps no fan for it).
+inline TriangleMesh without_shared_vertices(const TriangleMesh& mesh) {
+    TriangleMesh apart;
+    for (const Triangle& t : mesh.triangles) {
+        const uint32_t base = static_cast<uint32_t>(apart.positions.size());
+        for (uint32_t v : t) apart.positions.push_back(mesh.positions[v]);
+        apart.triangles.push_back({base, base + 1, base + 2});
+    }
+    return apart;
+}
+
 struct NamedMesh {
     std::string name;
     TriangleMesh mesh;
