@@ -721,6 +721,46 @@ TEST(CraftedFiles, ImportOfPositionsOfOneHashIsLinear) {
     EXPECT_LT(milliseconds, 1000.0 * kSanitizerSlowdown);
 }
 
+// The inverse of an odd number mod 2^64 (Newton's iteration), to solve a multiplicative hash
+// for the key that gives a chosen slot.
+uint64_t inverse_mod_2_64(uint64_t odd) {
+    uint64_t inverse = odd;
+    for (int i = 0; i < 5; ++i) inverse *= 2 - odd * inverse;
+    return inverse;
+}
+
+// Vertex ids 0..count-1, each given out once: at random (take) or as asked (claim), for the
+// numberings below that put chosen keys in one slot or run of a table.
+class IdPool {
+public:
+    IdPool(uint32_t count, uint64_t seed) : unused_(count), used_(count, 0), random_{seed} {
+        for (uint32_t i = 0; i < count; ++i) unused_[i] = i;
+        for (uint32_t i = count; i > 1; --i) std::swap(unused_[i - 1], unused_[random_.below(i)]);
+    }
+    uint32_t take() {
+        while (used_[unused_[next_]]) ++next_;
+        used_[unused_[next_]] = 1;
+        return unused_[next_];
+    }
+    bool in_use(uint64_t id) const { return used_[id] != 0; }
+    // An id drawn at random from those take has not passed yet (it may be in use).
+    uint32_t pick() { return unused_[next_ + random_.below(unused_.size() - next_)]; }
+    bool claim(uint64_t id) {
+        if (used_[id]) return false;
+        used_[id] = 1;
+        return true;
+    }
+    void give_back(uint32_t id) { used_[id] = 0; }
+    // The next take draws from the rest at random again (not the id just given back).
+    void stir() { std::swap(unused_[next_], unused_[next_ + random_.below(unused_.size() - next_)]); }
+
+private:
+    std::vector<uint32_t> unused_;
+    std::vector<uint8_t> used_;
+    SplitMix64 random_;
+    size_t next_ = 0;
+};
+
 // The triangulated grid of width x width vertices, vertex v (row v / width) numbered id[v]:
 // squares (a, b, d, c) from the lower left, counterclockwise, as triangles (a, b, d) and (a, d, c).
 TriangleMesh numbered_grid(uint32_t width, const std::vector<uint32_t>& id) {
@@ -750,39 +790,28 @@ TriangleMesh grid_of_one_edge_run(uint32_t side) {
     int bits = 0;
     while ((uint64_t(1) << bits) < slots) ++bits;
     const uint64_t mask = slots - 1, residues = uint64_t(1) << (bits - 3);
-    uint64_t inverse = kGoldenGamma;  // Newton's iteration for the inverse mod 2^64
-    for (int i = 0; i < 5; ++i) inverse *= 2 - kGoldenGamma * inverse;
-    std::vector<uint32_t> id(vertices, kNoIndex), unused(vertices);
-    std::vector<uint8_t> used(vertices, 0);
-    for (uint32_t i = 0; i < vertices; ++i) unused[i] = i;
-    SplitMix64 random{11};
-    for (uint32_t i = vertices; i > 1; --i) std::swap(unused[i - 1], unused[random.below(i)]);
-    size_t next = 0;
-    auto take = [&] {
-        while (used[unused[next]]) ++next;
-        used[unused[next]] = 1;
-        return unused[next];
-    };
+    const uint64_t inverse = inverse_mod_2_64(kGoldenGamma);
+    std::vector<uint32_t> id(vertices, kNoIndex);
+    IdPool pool(vertices, 11);
     for (uint32_t v = 0; v + 1 < vertices; v += 2) {  // vertex v + 1 gets a, vertex v gets b
         for (int tries = 0; tries < 8 && id[v] == kNoIndex; ++tries) {
-            const uint32_t b = take();
+            const uint32_t b = pool.take();
             const uint64_t u = uint64_t(b) * kGoldenGamma;
             for (uint64_t slot = (u ^ (u >> 29)) & 7; slot < 512 && id[v] == kNoIndex; slot += 8) {
                 const uint64_t want = ((slot ^ (u & mask)) >> 3) & (residues - 1);
                 for (uint64_t a = ((want - (u >> 32)) * inverse) & (residues - 1); a < vertices; a += residues) {
-                    if (used[a]) continue;
-                    used[a] = 1;
+                    if (!pool.claim(a)) continue;
                     id[v + 1] = uint32_t(a);
                     id[v] = b;
                     break;
                 }
             }
-            if (id[v] == kNoIndex) used[b] = 0;
-            std::swap(unused[next], unused[next + random.below(vertices - next)]);
+            if (id[v] == kNoIndex) pool.give_back(b);
+            pool.stir();
         }
     }
     for (uint32_t v = 0; v < vertices; ++v)
-        if (id[v] == kNoIndex) id[v] = take();
+        if (id[v] == kNoIndex) id[v] = pool.take();
     return numbered_grid(side, id);
 }
 
@@ -813,39 +842,28 @@ Hierarchy chunk_rows_of_one_seam_run(uint32_t side, EncodeOptions& options) {
     uint64_t slots = 16;
     while (slots < 2 * keys) slots *= 2;  // the table is at most half full
     const uint64_t mask = slots - 1;
-    uint64_t inverse = kGoldenGamma;  // Newton's iteration for the inverse mod 2^64
-    for (int i = 0; i < 5; ++i) inverse *= 2 - kGoldenGamma * inverse;
-    std::vector<uint32_t> id(vertices, kNoIndex), unused(vertices);
-    std::vector<uint8_t> used(vertices, 0);
-    for (uint32_t i = 0; i < vertices; ++i) unused[i] = i;
-    SplitMix64 random{13};
-    for (uint32_t i = vertices; i > 1; --i) std::swap(unused[i - 1], unused[random.below(i)]);
-    size_t next = 0;
-    auto take = [&] {
-        while (used[unused[next]]) ++next;
-        used[unused[next]] = 1;
-        return unused[next];
-    };
+    const uint64_t inverse = inverse_mod_2_64(kGoldenGamma);
+    std::vector<uint32_t> id(vertices, kNoIndex);
+    IdPool pool(vertices, 13);
     for (uint32_t j = 1; j < side; ++j) {
         for (uint32_t i = 0; i + 1 <= side; i += 2) {
             const uint32_t first = j * width + i;  // gets a; first + 1 gets b
             for (int tries = 0; tries < 8 && id[first] == kNoIndex; ++tries) {
-                const uint32_t b = take();
+                const uint32_t b = pool.take();
                 const uint64_t high = (uint64_t(b) * kGoldenGamma) >> 32;
                 for (uint64_t slot = 0; slot < 512 && id[first] == kNoIndex; ++slot) {
                     const uint64_t a = (((slot - high) & mask) * inverse) & mask;
-                    if (a >= b || used[a]) continue;
-                    used[a] = 1;
+                    if (a >= b || !pool.claim(a)) continue;
                     id[first] = uint32_t(a);
                     id[first + 1] = b;
                 }
-                if (id[first] == kNoIndex) used[b] = 0;
-                std::swap(unused[next], unused[next + random.below(vertices - next)]);
+                if (id[first] == kNoIndex) pool.give_back(b);
+                pool.stir();
             }
         }
     }
     for (uint32_t v = 0; v < vertices; ++v)
-        if (id[v] == kNoIndex) id[v] = take();
+        if (id[v] == kNoIndex) id[v] = pool.take();
     options.keep_base_order = true;
     options.chunk_roots.assign(side, 2 * side);
     options.threads = 1;
@@ -882,26 +900,18 @@ TEST(CraftedFiles, RankEdgesInOneBucketSplitTheSeamInLinearTime) {
     std::unordered_map<uint64_t, std::pair<NodeId, int>> same_size;  // its bucket count, as the table's
     for (uint64_t k = 0; k < 3ull * owned; ++k) same_size.emplace(k, std::make_pair(NodeId(0), 0));
     const uint64_t buckets = same_size.bucket_count(), shift = (uint64_t(1) << 32) % buckets;
-    std::vector<uint32_t> id(vertices, kNoIndex), unused(vertices);
-    std::vector<uint8_t> used(vertices, 0);
-    for (uint32_t i = 0; i < vertices; ++i) unused[i] = i;
-    SplitMix64 random{17};
-    for (uint32_t i = vertices; i > 1; --i) std::swap(unused[i - 1], unused[random.below(i)]);
-    size_t next = 0, in_one_bucket = 0;
-    auto take = [&] {
-        while (used[unused[next]]) ++next;
-        used[unused[next]] = 1;
-        return unused[next];
-    };
+    std::vector<uint32_t> id(vertices, kNoIndex);
+    IdPool pool(vertices, 17);
+    size_t in_one_bucket = 0;
     for (uint32_t j = 0; j < rows; ++j) {
         for (uint32_t i = 0; i + 1 <= side; i += 2) {
             const uint32_t first = j * width + i;  // gets a; first + 1 gets b
             for (int tries = 0; tries < 64 && id[first] == kNoIndex; ++tries) {
-                const uint64_t a = unused[next + random.below(vertices - next)];
-                if (used[a]) continue;
+                const uint64_t a = pool.pick();
+                if (pool.in_use(a)) continue;
                 for (uint64_t b = (buckets - a % buckets * shift % buckets) % buckets; b < vertices; b += buckets) {
-                    if (used[b] || b == a) continue;
-                    used[a] = used[b] = 1;
+                    if (b == a || !pool.claim(b)) continue;
+                    pool.claim(a);
                     id[first] = uint32_t(a);
                     id[first + 1] = uint32_t(b);
                     ++in_one_bucket;
@@ -911,7 +921,7 @@ TEST(CraftedFiles, RankEdgesInOneBucketSplitTheSeamInLinearTime) {
         }
     }
     for (uint32_t v = 0; v < vertices; ++v)
-        if (id[v] == kNoIndex) id[v] = take();
+        if (id[v] == kNoIndex) id[v] = pool.take();
     const TriangleMesh base = numbered_grid(width, id);
     const uint32_t roots = uint32_t(base.triangles.size());
     const RankLayout layout = rank_layout(roots, {{0, owned}, {owned, roots - owned}});
@@ -976,21 +986,18 @@ TEST(CraftedFiles, UniformImportOfRaysInOneBucketIsLinear) {
     std::unordered_map<uint64_t, uint32_t> same_size;  // its bucket count, as the table's (about a key per base vertex)
     for (uint64_t k = 0; k < uint64_t(width) * width; ++k) same_size.emplace(k, 0);
     const uint64_t buckets = same_size.bucket_count(), shift = (uint64_t(1) << 32) % buckets;
-    std::vector<uint32_t> id(vertices, kNoIndex), unused(near);
-    std::vector<uint8_t> used(near, 0);
-    for (uint32_t i = 0; i < near; ++i) unused[i] = i;
-    SplitMix64 random{19};
-    for (uint32_t i = near; i > 1; --i) std::swap(unused[i - 1], unused[random.below(i)]);
-    size_t next = 0, in_one_bucket = 0;
+    std::vector<uint32_t> id(vertices, kNoIndex);
+    IdPool pool(near, 19);
+    size_t in_one_bucket = 0;
     for (uint32_t j = 1; j <= side; j += 2) {
         for (uint32_t i = 1; i <= side; ++i) {
             const uint32_t x = j * width + i, y = x - width - 1;  // hierarchy ids: base vertices first
             for (int tries = 0; tries < 64 && id[x] == kNoIndex; ++tries) {
-                const uint64_t a = unused[next + random.below(near - next)];
-                if (used[a]) continue;
+                const uint64_t a = pool.pick();
+                if (pool.in_use(a)) continue;
                 for (uint64_t b = (buckets - a % buckets * shift % buckets) % buckets; b < near; b += buckets) {
-                    if (used[b] || b == a) continue;
-                    used[a] = used[b] = 1;
+                    if (b == a || !pool.claim(b)) continue;
+                    pool.claim(a);
                     id[x] = uint32_t(a);
                     id[y] = uint32_t(b);
                     ++in_one_bucket;
@@ -1006,9 +1013,7 @@ TEST(CraftedFiles, UniformImportOfRaysInOneBucketIsLinear) {
             id[v] = far_id++;
             continue;
         }
-        while (used[unused[next]]) ++next;
-        used[unused[next]] = 1;
-        id[v] = unused[next];
+        id[v] = pool.take();
     }
     TriangleMesh input;
     input.positions.resize(vertices);
@@ -1583,8 +1588,7 @@ TEST(CraftedFiles, OctreeManyLeafFieldsDecodeInLinearTime) {
 // until 2026-12-07 (docs/FUZZING.md), 30 ms since with an ordered set, as the encoder's check.
 TEST(CraftedFiles, OctreeLeafFieldNamesOfOneHashDecodeInLinearTime) {
     const uint64_t mul = (uint64_t{0xc6a4a793} << 32) + 0x5bd1e995;  // _Hash_bytes's multiplier
-    uint64_t inverse = mul;  // Newton's iteration for its inverse mod 2^64
-    for (int i = 0; i < 5; ++i) inverse *= 2 - mul * inverse;
+    const uint64_t inverse = inverse_mod_2_64(mul);
     auto shift_mix = [](uint64_t v) { return v ^ (v >> 47); };  // its own inverse
     const int pairs = 15;
     uint64_t words[pairs][2][2];  // pair i, either way, its two words
