@@ -33,17 +33,10 @@ UndoneLevels undo_levels(const std::vector<Triangle>& leaf_triangles, uint32_t v
         detail::CoarserLevel coarser = detail::undo_refinement_level(
             out.remaining, refined, vertex_count, levels.empty() ? nullptr : &changed, &kept, /*give_up_retraced=*/true);
         if (coarser.red_blocks == 0) break;
-        // The coarser level lists the triangles it made first (CoarserLevel).
-        const size_t made = size_t(coarser.red_blocks) + coarser.green_groups;
-        DetectedLevel level;
-        level.splits = std::move(coarser.splits);
-        level.closures = coarser.green_groups;
-        level.made.assign(coarser.triangles.begin(), coarser.triangles.begin() + std::ptrdiff_t(made));
-        level.triangles_left = coarser.triangles.size();
+        levels.push_back(detail::detected_level(coarser));
         out.remaining = std::move(coarser.triangles);
         refined = std::move(coarser.refined);
         changed = std::move(coarser.changed);
-        levels.push_back(std::move(level));
     }
     return out;
 }

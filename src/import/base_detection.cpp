@@ -68,13 +68,8 @@ bool undo_one_level(const std::vector<Triangle>& triangles, uint32_t vertex_coun
         s == 0 ? triangles : run.mesh, s == 0 ? unrefined : run.refined, vertex_count,
         s == 0 || everywhere ? nullptr : &run.changed, has_kept ? &kept[s] : nullptr, false, cancel);
     if (coarser.red_blocks == 0) return false;
-    // The coarser level lists the triangles it made first (CoarserLevel).
-    const size_t made = size_t(coarser.red_blocks) + coarser.green_groups;
-    DetectedLevel level;
-    level.splits = std::move(coarser.splits);
-    level.closures = coarser.green_groups;
-    level.made.assign(coarser.triangles.begin(), coarser.triangles.begin() + std::ptrdiff_t(made));
-    level.triangles_left = coarser.triangles.size();
+    DetectedLevel level = detail::detected_level(coarser);
+    const size_t made = level.made.size();
     std::vector<uint32_t> deferred;
     for (size_t i = made; i < coarser.changed.size(); ++i) {
         if (coarser.changed[i]) deferred.push_back(uint32_t(i));
@@ -302,6 +297,16 @@ void renumber(std::vector<Triangle>& triangles, const std::vector<uint32_t>& id)
     for (Triangle& t : triangles) {
         for (uint32_t& v : t) v = id[v];
     }
+}
+
+DetectedLevel detected_level(CoarserLevel& coarser) {
+    const size_t made = size_t(coarser.red_blocks) + coarser.green_groups;
+    DetectedLevel level;
+    level.splits = std::move(coarser.splits);
+    level.closures = coarser.green_groups;
+    level.made.assign(coarser.triangles.begin(), coarser.triangles.begin() + std::ptrdiff_t(made));
+    level.triangles_left = coarser.triangles.size();
+    return level;
 }
 
 std::vector<Triangle> mesh_after_level(const std::vector<Triangle>& mesh, const DetectedLevel& level,

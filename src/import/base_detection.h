@@ -54,6 +54,12 @@ DetectedBase truncated(const TriangleMesh& mesh, DetectedBase detected, size_t l
 
 namespace detail {
 
+struct CoarserLevel;
+
+// The level that an inverse step's answer (inverse_refinement.h) undid: its splits, closures and the
+// triangles it made, which the answer lists first; `coarser` keeps its mesh and flags.
+DetectedLevel detected_level(CoarserLevel& coarser);
+
 // The vertices in breadth-first order over the triangles (input ids; unused vertices last). The
 // inverse step reads the labels of a vertex's neighbours at every step: numbered this way they
 // share cache lines, where a shuffled input's numbering makes each read a miss. The search never

@@ -33,7 +33,7 @@ Vec3 midpoint_prediction(Vec3 a, Vec3 b, bool single_precision) {
 
 size_t Seam::SegmentTable::slot_of(uint64_t key) const {
     const size_t mask = slots_.size() - 1;
-    size_t i = size_t(splitmix64_mix(key ^ hash_key_)) & mask;  // keyed: a file numbers the base vertices
+    size_t i = hash_(key) & mask;
     while (slots_[i].first != key && slots_[i].first != kEmpty) i = (i + 1) & mask;
     return i;
 }

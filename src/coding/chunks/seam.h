@@ -76,9 +76,9 @@ private:
     private:
         static constexpr uint64_t kEmpty = ~uint64_t{0};  // no segment's key: its two ends differ
         size_t slot_of(uint64_t key) const;
-        // Mixed into the slots (keyed_hash.h): a file numbers its base vertices as it likes, and
-        // the unkeyed Fibonacci hash let a matching's segments share one probe run (docs/FUZZING.md).
-        uint64_t hash_key_ = process_hash_key();
+        // Keyed (keyed_hash.h): a file numbers its base vertices as it likes, and the unkeyed
+        // Fibonacci hash let a matching's segments share one probe run (docs/FUZZING.md).
+        KeyedWordHash hash_;
         std::vector<std::pair<uint64_t, int32_t>> slots_;
         size_t used_ = 0;
     };
