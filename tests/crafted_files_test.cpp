@@ -1095,6 +1095,28 @@ TEST(CraftedFiles, ImportOfALeafMeshWithItsNewVerticesAtOnePointIsLinear) {
     EXPECT_LT(milliseconds, 4000.0 * kSanitizerSlowdown);
 }
 
+// A random refinement of the icosahedron scaled by 10^-300 beside one far triangle at +-1.7 * 10^308
+// (beyond DBL_MAX / 2, where a + b overflows), refined with it: imported with its base as amcodec
+// wrote it, by the exact way. That way looked each midpoint up at 0.5 * (a + b), infinite on the
+// far triangle's edges, where the placer puts 0.5 * a + 0.5 * b; the guided ways after it find no
+// vertex where squared distances underflow (the icosahedron's): refused until 2026-12-07
+// (docs/FUZZING.md, "review of far components").
+TEST(CraftedFiles, ImportBesideAFarTriangleBeyondHalfOfDblMaxFindsItsMidpoints) {
+    for (const double far : {1.7e308, -1.7e308}) {
+        TriangleMesh base = make_icosahedron();
+        for (Vec3& p : base.positions) p = 1e-300 * p;
+        const uint32_t v = uint32_t(base.positions.size());
+        base.positions.insert(base.positions.end(), {{far, 0, 0}, {far, 1, 0}, {far, 0, 1}});
+        base.triangles.push_back({v, v + 1, v + 2});
+        Hierarchy h(base);
+        refine_randomly(h, 20000, 7, 3);
+        ASSERT_FALSE(h.is_leaf(h.root_count() - 1));  // the far triangle is split: its midpoints are looked up
+        const LeafMesh leaf = extract_leaf_mesh(h);
+        const ImportedHierarchy imported = import_leaf_mesh(base, leaf.mesh);
+        EXPECT_TRUE(identical(imported.hierarchy, h)) << far;
+    }
+}
+
 // The importer's measure of a candidate's detour across a bipyramid of 2^17 sides, whose poles'
 // fans are closed and of valence 2^17: in time linear in the valence. Whether a fan was closed
 // was found by looking each apex up among its ends, 1.7 * 10^10 comparisons here (2.1 s of CPU)
@@ -1160,6 +1182,45 @@ TEST(CraftedFiles, ClosestPointsNearAVertexOfHighValenceTestFewTriangles) {
     const double lines_milliseconds = cpu_milliseconds() - lines_start;
     std::printf("  %d lines through them: %.1f ms\n", kQueries, lines_milliseconds);
     EXPECT_LT(lines_milliseconds, 300.0 * kSanitizerSlowdown);
+}
+
+// Closest points and lines 10^-3 above the faces of a unit square of 2 * 256^2 triangles that has
+// one more triangle far away (10^15, then 10^300): each query tests a few boxes and triangles. Every
+// box was widened by the rounding margin of the mesh's largest coordinate, the far one's, so by
+// more than the square (3.6 at 10^15; float infinity at 10^300), and each query tested all of
+// them: the guided ways' surface and normal-ray guides of a leaf mesh with a far component took
+// time quadratic in it until 2026-12-07 (docs/FUZZING.md, "review of far components").
+TEST(CraftedFiles, ClosestPointsBesideAFarTriangleTestFewBoxes) {
+    const int cells = kSanitizerSlowdown > 1 ? 64 : 256;
+    const int kQueries = 2000;
+    for (const double far : {1e15, 1e300}) {
+        TriangleMesh mesh = make_square(cells);
+        const uint32_t square_faces = uint32_t(mesh.triangles.size()), v = uint32_t(mesh.positions.size());
+        mesh.positions.insert(mesh.positions.end(), {{far, 0, 0}, {far, 1, 0}, {far, 0, 1}});
+        mesh.triangles.push_back({v, v + 1, v + 2});
+        const ClosestPointQuery query(mesh);
+        uint64_t tested = 0;
+        const double start = cpu_milliseconds();
+        for (int i = 0; i < kQueries; ++i) {
+            const uint32_t face = uint32_t((uint64_t(i) * 2654435761u) % square_faces);
+            const Triangle& t = mesh.triangles[face];
+            const Vec3 a = mesh.positions[t[0]], b = mesh.positions[t[1]], c = mesh.positions[t[2]];
+            const Vec3 normal = cross(b - a, c - a);
+            const Vec3 up = (1 / std::sqrt(dot(normal, normal))) * normal;
+            const Vec3 p = (1.0 / 3) * (a + b + c) + 1e-3 * up;
+            const ClosestPointQuery::Hit hit = query.closest(p, tested);
+            ASSERT_EQ(hit.triangle, face) << far << " " << i;
+            ASSERT_NEAR(std::sqrt(hit.distance_squared), 1e-3, 1e-12) << far << " " << i;
+            const std::optional<ClosestPointQuery::Hit> line = query.intersect_line(p, up, 2e-3, 1e-9);
+            ASSERT_TRUE(line.has_value()) << far << " " << i;
+            ASSERT_EQ(line->triangle, face) << far << " " << i;
+        }
+        const double milliseconds = cpu_milliseconds() - start;
+        std::printf("  %d closest points and lines beside a triangle %g away: %.1f ms, %.1f boxes and triangles tested each\n",
+                    kQueries, far, milliseconds, double(tested) / kQueries);
+        EXPECT_LT(tested, 100u * kQueries) << far;  // all 2 * 256^2 triangles and their boxes before
+        EXPECT_LT(milliseconds, 300.0 * kSanitizerSlowdown) << far;
+    }
 }
 
 // The distance between a bipyramid of 2^11 sides without shared vertices and itself (its long

@@ -69,8 +69,15 @@ AMC_ALWAYS_INLINE double box_distance_squared(const float* lo, const float* hi, 
     return dx * dx + dy * dy + dz * dz;
 }
 
-// The box [lo, hi] widened by margin, as floats rounded outward.
-void store_box(Vec3 lo, Vec3 hi, double margin, float* lo_out, float* hi_out) {
+// What covers the rounding of the closest points computed on triangles whose coordinates are at
+// most max_abs in magnitude (a few ulps of them), an axis.
+double rounding_margin(double max_abs) { return 16 * DBL_EPSILON * max_abs; }
+
+// The box [lo, hi] widened by the rounding margin of its own coordinates (not the whole mesh's:
+// one far-away triangle would widen every box to the size of the mesh), as floats rounded outward.
+void store_box(Vec3 lo, Vec3 hi, float* lo_out, float* hi_out) {
+    const double margin = rounding_margin(std::max({std::fabs(lo.x), std::fabs(lo.y), std::fabs(lo.z), std::fabs(hi.x),
+                                                    std::fabs(hi.y), std::fabs(hi.z)}));
     for (int axis = 0; axis < 3; ++axis) {
         lo_out[axis] = float_below(component(lo, axis) - margin);
         hi_out[axis] = float_above(component(hi, axis) + margin);
@@ -173,9 +180,6 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
     }
     const uint32_t n = static_cast<uint32_t>(triangles.size());
 
-    // The largest coordinate magnitude sizes the margin that covers the rounding of computed
-    // closest points (a few ulps of the coordinates).
-    double max_abs = 0;
     std::vector<uint32_t> valence(positions.size(), 0);
     for (uint32_t t = 0; t < n; ++t) {
         for (uint32_t v : triangles[t]) {
@@ -184,13 +188,9 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
                             " refers to vertex " + std::to_string(v) + " of " +
                             std::to_string(positions.size()));
             }
-            const Vec3& q = positions[v];
-            max_abs = std::max({max_abs, std::abs(q.x), std::abs(q.y), std::abs(q.z)});
             ++valence[v];
         }
     }
-    const double margin = 16 * DBL_EPSILON * max_abs;
-    margin_ = margin;
 
     // The fans: each triangle goes to its corner of highest valence (ties to the lower vertex)
     // when that reaches kFanValence. A fan whose directions cannot be measured (a corner not
@@ -395,7 +395,7 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
         Work item = work.back();
         work.pop_back();
         Bounds bounds = measure(item.begin, item.end);
-        store_box(bounds.lo, bounds.hi, margin, nodes_[item.parent].lo[item.slot], nodes_[item.parent].hi[item.slot]);
+        store_box(bounds.lo, bounds.hi, nodes_[item.parent].lo[item.slot], nodes_[item.parent].hi[item.slot]);
         if (is_leaf(item.begin, item.end)) {
             const bool fan = order[item.begin] >= first_fan_item;
             nodes_[item.parent].index[item.slot] = fan ? order[item.begin] - first_fan_item : item.begin;
@@ -428,7 +428,15 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
         }
     }
     for (uint32_t f = 0; f < fan_apexes.size(); ++f) {
-        fans_.push_back(Fan{positions[fan_apexes[f]], build_fan(reference, fan_apexes[f], fan_triangles[f], margin)});
+        double max_abs = 0;  // the fan's own coordinates size its cones' margin, as a box's
+        for (uint32_t t : fan_triangles[f]) {
+            for (uint32_t v : triangles[t]) {
+                const Vec3& q = positions[v];
+                max_abs = std::max({max_abs, std::fabs(q.x), std::fabs(q.y), std::fabs(q.z)});
+            }
+        }
+        fans_.push_back(Fan{positions[fan_apexes[f]], build_fan(reference, fan_apexes[f], fan_triangles[f]),
+                            rounding_margin(max_abs)});
     }
 }
 
@@ -447,8 +455,7 @@ void ClosestPointQuery::add_record(const TriangleMesh& reference, uint32_t t) {
 // its triangles' unit directions to their other corners; it holds their triangles because a
 // triangle's directions are the non-negative combinations of those two, and a cone of half-angle
 // up to 90 degrees is convex.
-uint32_t ClosestPointQuery::build_fan(const TriangleMesh& reference, uint32_t apex_vertex, const std::vector<uint32_t>& fan,
-                                      double margin) {
+uint32_t ClosestPointQuery::build_fan(const TriangleMesh& reference, uint32_t apex_vertex, const std::vector<uint32_t>& fan) {
     const std::vector<Vec3>& positions = reference.positions;
     const Vec3 apex = positions[apex_vertex];
     const uint32_t m = static_cast<uint32_t>(fan.size());
@@ -501,7 +508,7 @@ uint32_t ClosestPointQuery::build_fan(const TriangleMesh& reference, uint32_t ap
             middle_lo = component_min(middle_lo, directions[j].middle);
             middle_hi = component_max(middle_hi, directions[j].middle);
         }
-        store_box(lo, hi, margin, node.lo, node.hi);
+        store_box(lo, hi, node.lo, node.hi);
         const Vec3 axis = unit(sum);
         if (squared_length(axis) > 0) {
             // The widest direction by its (sine, cosine) from the axis (a before b where sin(a - b) > 0,
@@ -552,14 +559,15 @@ uint32_t ClosestPointQuery::build_fan(const TriangleMesh& reference, uint32_t ap
 // A lower bound on the distance from p to the triangles of a fan's node, w = p - apex: its box's,
 // and its cone's, which every triangle of the fan holds as it holds the apex (at angle theta from
 // the axis, p is |w| sin(theta - half-angle) from the cone, |w| from 90 degrees beyond it on).
-double ClosestPointQuery::cone_node_distance_squared(const ConeNode& node, Vec3 p, Vec3 w, double w_length) const {
+double ClosestPointQuery::cone_node_distance_squared(const ConeNode& node, Vec3 p, Vec3 w, double w_length,
+                                                     double margin) const {
     const double box = box_distance_squared(node.lo, node.hi, p);
     if (!node.has_cone) return box;
     const double along = dot(w, node.axis);
     const double across = std::sqrt(squared_length(cross(w, node.axis)));
     double gap = along * node.cosine + across * node.sine <= 0 ? w_length : across * node.cosine - along * node.sine;
-    // The rounding of the bound, and of the computed closest points (margin_ an axis: < 2 margin_ in all).
-    gap -= kConeSlack * w_length + 2 * margin_;
+    // The rounding of the bound, and of the computed closest points (margin an axis: < 2 margin in all).
+    gap -= kConeSlack * w_length + 2 * margin;
     return gap > 0 ? std::max(box, gap * gap) : box;
 }
 
@@ -622,7 +630,7 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p, double b
         };
         ConeEntry stack[kConeStackSize];
         int size = 0;
-        stack[size++] = {fan.root, cone_node_distance_squared(cone_nodes_[fan.root], p, w, w_length)};
+        stack[size++] = {fan.root, cone_node_distance_squared(cone_nodes_[fan.root], p, w, w_length, fan.margin)};
         while (size > 0) {
             const ConeEntry entry = stack[--size];
             if (entry.distance_squared > prune) continue;
@@ -632,8 +640,8 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p, double b
                 test_records(node.index, node.index + node.count);
                 continue;
             }
-            const double d[2] = {cone_node_distance_squared(cone_nodes_[node.index], p, w, w_length),
-                                 cone_node_distance_squared(cone_nodes_[node.index + 1], p, w, w_length)};
+            const double d[2] = {cone_node_distance_squared(cone_nodes_[node.index], p, w, w_length, fan.margin),
+                                 cone_node_distance_squared(cone_nodes_[node.index + 1], p, w, w_length, fan.margin)};
             const int near = d[1] < d[0] ? 1 : 0;
             for (int slot : {1 - near, near}) {
                 if (d[slot] <= prune) stack[size++] = {node.index + slot, d[slot]};
@@ -775,7 +783,7 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 ori
         auto may_meet = [&](const ConeNode& node) {
             if (tolerance > 0) return true;
             const Vec3 w0 = from_apex - best * d, w1 = from_apex + best * d;
-            return cone_may_meet_segment(node, w0, w1, kConeSlack * (std::sqrt(squared_length(w0)) + std::sqrt(squared_length(w1))) + 2 * margin_);
+            return cone_may_meet_segment(node, w0, w1, kConeSlack * (std::sqrt(squared_length(w0)) + std::sqrt(squared_length(w1))) + 2 * fan.margin);
         };
         struct ConeEntry {
             uint32_t node;

@@ -107,11 +107,12 @@ private:
     struct Fan {
         Vec3 apex;
         uint32_t root;  // into cone_nodes_
+        double margin;  // covers the rounding of closest points computed on its triangles, an axis
     };
 
     void add_record(const TriangleMesh& reference, uint32_t triangle);
-    uint32_t build_fan(const TriangleMesh& reference, uint32_t apex, const std::vector<uint32_t>& triangles, double margin);
-    double cone_node_distance_squared(const ConeNode& node, Vec3 p, Vec3 w, double w_length) const;
+    uint32_t build_fan(const TriangleMesh& reference, uint32_t apex, const std::vector<uint32_t>& triangles);
+    double cone_node_distance_squared(const ConeNode& node, Vec3 p, Vec3 w, double w_length, double margin) const;
     bool cone_may_meet_segment(const ConeNode& node, Vec3 w0, Vec3 w1, double slack) const;
 
     template <class Accept>
@@ -123,7 +124,6 @@ private:
     std::vector<Vec3> normals_;         // unit normal of each record, zero for zero-area ones
     std::vector<Fan> fans_;
     std::vector<ConeNode> cone_nodes_;
-    double margin_ = 0;                 // covers the rounding of computed closest points, per axis
 };
 
 }  // namespace amc

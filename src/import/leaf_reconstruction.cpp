@@ -5,6 +5,7 @@
 #include "common/exact_float.h"
 #include "geometry/placement_normal.h"
 #include "hierarchy/hierarchy_builder.h"
+#include "hierarchy/midpoint_placers.h"
 #include "import/reconstruction.h"
 
 #include <algorithm>
@@ -390,7 +391,7 @@ void Reconstruction::explain_misfit(NodeId n) const {
 uint32_t Reconstruction::find_midpoint(NodeId n, int e) {
     const uint32_t a = corner(n, e), b = corner(n, (e + 1) % 3);
     if (guide_ == MidpointGuide::exact) {
-        Vec3 m = rounded_scaled(0.5, leaf_.positions[a] + leaf_.positions[b]);  // as the placer computes it
+        Vec3 m = midpoint_placer(nullptr, leaf_.positions[a], leaf_.positions[b]);  // finite beyond DBL_MAX / 2 too
         if (leaf_.single_precision) m = rounded_to_float(m);
         const uint32_t found = positions_.find(m);
         if (found == kNoIndex)
