@@ -1,6 +1,6 @@
 // The one place that chooses the instruction set of the hand-vectorised kernels (level_split.cpp,
 // hierarchy/red_split_kernels.h, coding/hierarchy/hierarchy_traversal.h, mode 4's frames in
-// static_position_coder.cpp): SSE2 where the compiler targets it, else their scalar twins, which
+// static_frame_decoder.cpp): SSE2 where the compiler targets it, else their scalar twins, which
 // compute the same; mode 4's frames and roles 1-2 predictions also four at a time with AVX2.
 // AMC_SCALAR (CMake option AMC_SCALAR) forces the scalar twins and the byte-by-byte forms of the
 // little-endian shortcuts, so that CI builds and tests them on x86-64.

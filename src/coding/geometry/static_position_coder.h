@@ -18,6 +18,10 @@
 // 0 or a step towards the second-nearest grid point, about evenly, when t is near half-way (the
 // midpoint of two grid points whose sum is odd). The residual's sign is turned so that positive
 // points towards the second-nearest grid point.
+//
+// The encoder is static_position_encoder.cpp, the decoder static_position_decoder.cpp with its fast
+// paths in static_stencil_decoder.cpp and static_frame_decoder.cpp; their shared pieces are in
+// static_position_internal.h.
 #pragma once
 
 #include "coding/entropy/arithmetic_coder.h"
