@@ -74,14 +74,16 @@ AMC_ALWAYS_INLINE double box_distance_squared(const float* lo, const float* hi, 
 double rounding_margin(double max_abs) { return 16 * DBL_EPSILON * max_abs; }
 
 // The box [lo, hi] widened by the rounding margin of its own coordinates (not the whole mesh's:
-// one far-away triangle would widen every box to the size of the mesh), as floats rounded outward.
-void store_box(Vec3 lo, Vec3 hi, float* lo_out, float* hi_out) {
+// one far-away triangle would widen every box to the size of the mesh), as floats rounded outward;
+// returns that margin.
+double store_box(Vec3 lo, Vec3 hi, float* lo_out, float* hi_out) {
     const double margin = rounding_margin(std::max({std::fabs(lo.x), std::fabs(lo.y), std::fabs(lo.z), std::fabs(hi.x),
                                                     std::fabs(hi.y), std::fabs(hi.z)}));
     for (int axis = 0; axis < 3; ++axis) {
         lo_out[axis] = float_below(component(lo, axis) - margin);
         hi_out[axis] = float_above(component(hi, axis) + margin);
     }
+    return margin;
 }
 
 // Closest point to p on segment [x, y]; t is the weight of y.
@@ -427,17 +429,7 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
             if (node.count[slot] > 0 && node.count[slot] != kFanLeaf) node.index[slot] = record_of_position[node.index[slot]];
         }
     }
-    for (uint32_t f = 0; f < fan_apexes.size(); ++f) {
-        double max_abs = 0;  // the fan's own coordinates size its cones' margin, as a box's
-        for (uint32_t t : fan_triangles[f]) {
-            for (uint32_t v : triangles[t]) {
-                const Vec3& q = positions[v];
-                max_abs = std::max({max_abs, std::fabs(q.x), std::fabs(q.y), std::fabs(q.z)});
-            }
-        }
-        fans_.push_back(Fan{positions[fan_apexes[f]], build_fan(reference, fan_apexes[f], fan_triangles[f]),
-                            rounding_margin(max_abs)});
-    }
+    for (uint32_t f = 0; f < fan_apexes.size(); ++f) fans_.push_back(build_fan(reference, fan_apexes[f], fan_triangles[f]));
 }
 
 void ClosestPointQuery::add_record(const TriangleMesh& reference, uint32_t t) {
@@ -455,7 +447,8 @@ void ClosestPointQuery::add_record(const TriangleMesh& reference, uint32_t t) {
 // its triangles' unit directions to their other corners; it holds their triangles because a
 // triangle's directions are the non-negative combinations of those two, and a cone of half-angle
 // up to 90 degrees is convex.
-uint32_t ClosestPointQuery::build_fan(const TriangleMesh& reference, uint32_t apex_vertex, const std::vector<uint32_t>& fan) {
+ClosestPointQuery::Fan ClosestPointQuery::build_fan(const TriangleMesh& reference, uint32_t apex_vertex,
+                                                   const std::vector<uint32_t>& fan) {
     const std::vector<Vec3>& positions = reference.positions;
     const Vec3 apex = positions[apex_vertex];
     const uint32_t m = static_cast<uint32_t>(fan.size());
@@ -485,6 +478,7 @@ uint32_t ClosestPointQuery::build_fan(const TriangleMesh& reference, uint32_t ap
     }
 
     const uint32_t root = static_cast<uint32_t>(cone_nodes_.size());
+    double margin = 0;  // the root box's: the fan's own coordinates size its cones' margin
     const uint32_t first_record = static_cast<uint32_t>(records_.size());
     cone_nodes_.push_back(ConeNode{});
     struct Work {
@@ -508,7 +502,8 @@ uint32_t ClosestPointQuery::build_fan(const TriangleMesh& reference, uint32_t ap
             middle_lo = component_min(middle_lo, directions[j].middle);
             middle_hi = component_max(middle_hi, directions[j].middle);
         }
-        store_box(lo, hi, node.lo, node.hi);
+        const double box_margin = store_box(lo, hi, node.lo, node.hi);
+        if (item.node == root) margin = box_margin;
         const Vec3 axis = unit(sum);
         if (squared_length(axis) > 0) {
             // The widest direction by its (sine, cosine) from the axis (a before b where sin(a - b) > 0,
@@ -553,7 +548,7 @@ uint32_t ClosestPointQuery::build_fan(const TriangleMesh& reference, uint32_t ap
         work.push_back({node.index + 1, mid, item.end});
     }
     for (uint32_t i = 0; i < m; ++i) add_record(reference, fan[local[i]]);
-    return root;
+    return Fan{apex, root, margin};
 }
 
 // A lower bound on the distance from p to the triangles of a fan's node, w = p - apex: its box's,

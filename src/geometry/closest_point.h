@@ -111,7 +111,7 @@ private:
     };
 
     void add_record(const TriangleMesh& reference, uint32_t triangle);
-    uint32_t build_fan(const TriangleMesh& reference, uint32_t apex, const std::vector<uint32_t>& triangles);
+    Fan build_fan(const TriangleMesh& reference, uint32_t apex, const std::vector<uint32_t>& triangles);
     double cone_node_distance_squared(const ConeNode& node, Vec3 p, Vec3 w, double w_length, double margin) const;
     bool cone_may_meet_segment(const ConeNode& node, Vec3 w0, Vec3 w1, double slack) const;
 
