@@ -1,5 +1,7 @@
 // The Python module amcodec._amcodec: numpy arrays in and out of the public C++ API. Errors are
-// raised as amcodec.Error with the library's message; long calls release the GIL.
+// raised as amcodec.Error with the library's message. A call releases the GIL only while it works
+// on its own copies: one that reads or changes a Hierarchy, reader or writer that other Python
+// threads can reach holds it (the library's calls are not safe against a concurrent change).
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
 #include <amc/import.h>
@@ -10,6 +12,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <cstring>
 #include <memory>
 #include <optional>
@@ -22,30 +25,55 @@ using namespace amc;
 namespace {
 
 using PointArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
-using IndexArray = py::array_t<int64_t, py::array::c_style | py::array::forcecast>;
+
+// The triangles' vertex indices: an integer array, or a float one whose values are all integers
+// (as np.loadtxt gives); a fraction would otherwise be truncated to another vertex without a word.
+std::vector<Triangle> triangles_from_array(const py::array& triangles, size_t vertex_count, const char* what) {
+    const char kind = triangles.dtype().kind();
+    if (triangles.ndim() != 2 || triangles.shape(1) != 3 || (kind != 'i' && kind != 'u' && kind != 'f'))
+        throw Error(std::string(what) + ": triangles must be an (m, 3) integer array");
+    std::vector<Triangle> out(size_t(triangles.shape(0)));
+    auto check = [&](py::ssize_t i, int c, auto v, const std::string& shown) {
+        if (!(v >= 0 && v < decltype(v)(vertex_count)))
+            throw Error(std::string(what) + ": triangle " + std::to_string(i) + " has vertex index " + shown + " out of range");
+        out[size_t(i)][c] = uint32_t(v);
+    };
+    if (kind == 'f') {
+        const auto t = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(triangles);
+        auto tv = t.unchecked<2>();
+        for (py::ssize_t i = 0; i < t.shape(0); ++i) {
+            for (int c = 0; c < 3; ++c) {
+                const double v = tv(i, c);
+                const std::string shown = py::str(py::float_(v));
+                if (v != std::floor(v))
+                    throw Error(std::string(what) + ": triangle " + std::to_string(i) + " has vertex index " + shown + ", not an integer");
+                check(i, c, v, shown);
+            }
+        }
+    } else if (kind == 'u') {
+        const auto t = py::array_t<uint64_t, py::array::c_style | py::array::forcecast>::ensure(triangles);
+        auto tv = t.unchecked<2>();
+        for (py::ssize_t i = 0; i < t.shape(0); ++i)
+            for (int c = 0; c < 3; ++c) check(i, c, tv(i, c), std::to_string(tv(i, c)));
+    } else {
+        const auto t = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(triangles);
+        auto tv = t.unchecked<2>();
+        for (py::ssize_t i = 0; i < t.shape(0); ++i)
+            for (int c = 0; c < 3; ++c) check(i, c, tv(i, c), std::to_string(tv(i, c)));
+    }
+    return out;
+}
 
 // A numpy (n, 3) array of coordinates; float32 input keeps single precision (bit-exact files).
 TriangleMesh mesh_from_arrays(const py::array& points, const py::array& triangles, const char* what) {
     TriangleMesh mesh;
     mesh.single_precision = points.dtype().is(py::dtype::of<float>());
     const PointArray p = PointArray::ensure(points);
-    const IndexArray t = IndexArray::ensure(triangles);
     if (!p || p.ndim() != 2 || p.shape(1) != 3) throw Error(std::string(what) + ": points must be an (n, 3) array");
-    if (!t || t.ndim() != 2 || t.shape(1) != 3) throw Error(std::string(what) + ": triangles must be an (m, 3) integer array");
     auto pv = p.unchecked<2>();
     mesh.positions.resize(size_t(p.shape(0)));
     for (py::ssize_t i = 0; i < p.shape(0); ++i) mesh.positions[size_t(i)] = {pv(i, 0), pv(i, 1), pv(i, 2)};
-    auto tv = t.unchecked<2>();
-    mesh.triangles.resize(size_t(t.shape(0)));
-    for (py::ssize_t i = 0; i < t.shape(0); ++i) {
-        for (int c = 0; c < 3; ++c) {
-            const int64_t v = tv(i, c);
-            if (v < 0 || v >= int64_t(mesh.positions.size()))
-                throw Error(std::string(what) + ": triangle " + std::to_string(i) + " has vertex index " + std::to_string(v) +
-                            " out of range");
-            mesh.triangles[size_t(i)][c] = uint32_t(v);
-        }
-    }
+    mesh.triangles = triangles_from_array(triangles, mesh.positions.size(), what);
     validate_triangle_mesh(mesh, what);
     return mesh;
 }
@@ -133,6 +161,12 @@ ImportedHierarchy import_arrays(const TriangleMesh& mesh, const py::object& base
     const TriangleMesh base_mesh = mesh_from_arrays(pair[0].cast<py::array>(), pair[1].cast<py::array>(), "base mesh");
     py::gil_scoped_release release;
     return import_leaf_mesh(base_mesh, mesh, {}, "mesh");
+}
+
+// The library reads a node id unchecked: one from Python is looked up first.
+NodeId existing_node(const Hierarchy& h, NodeId n, const char* what) {
+    if (!h.is_alive(n)) throw Error(std::string(what) + ": no node " + std::to_string(n));
+    return n;
 }
 
 py::bytes to_bytes(const std::vector<uint8_t>& data) { return py::bytes(reinterpret_cast<const char*>(data.data()), data.size()); }
@@ -248,16 +282,14 @@ PYBIND11_MODULE(_amcodec, m) {
         .def_property_readonly("leaf_count", &Hierarchy::leaf_count)
         .def_property_readonly("vertex_count", &Hierarchy::vertex_count)
         .def_property_readonly("depth", &Hierarchy::depth)
-        .def("is_leaf", &Hierarchy::is_leaf, py::arg("node"))
-        .def("level", &Hierarchy::level, py::arg("node"))
+        .def("is_leaf", [](const Hierarchy& h, NodeId n) { return h.is_leaf(existing_node(h, n, "is_leaf")); }, py::arg("node"))
+        .def("level", [](const Hierarchy& h, NodeId n) { return h.level(existing_node(h, n, "level")); }, py::arg("node"))
         .def("leaves", &Hierarchy::leaves, "Leaf node ids in breadth-first order.")
         .def("refine", [](Hierarchy& h, NodeId n) {
-                 if (!h.is_alive(n)) throw Error("refine: no node " + std::to_string(n));
-                 return h.refine(n);
+                 return h.refine(existing_node(h, n, "refine"));
              }, py::arg("node"), "Red-refines a leaf with balance and closure; returns the number of nodes split.")
         .def("coarsen", [](Hierarchy& h, NodeId n) {
-                 if (!h.is_alive(n)) throw Error("coarsen: no node " + std::to_string(n));
-                 return h.coarsen(n);
+                 return h.coarsen(existing_node(h, n, "coarsen"));
              }, py::arg("node"), "Removes a node's four leaf children where balance allows; returns whether it did.")
         .def("check", &check_invariants, "Every structural invariant: '' if valid, else the first violation.")
         .def("leaf_mesh", [](const Hierarchy& h, int level) {
@@ -269,12 +301,7 @@ PYBIND11_MODULE(_amcodec, m) {
                  EncodeOptions options;
                  options.quantize_bits = quantize;
                  options.effort = effort;
-                 std::vector<uint8_t> data;
-                 {
-                     py::gil_scoped_release release;
-                     data = encode(h, options);
-                 }
-                 return to_bytes(data);
+                 return to_bytes(encode(h, options));
              }, py::arg("quantize") = 0, py::arg("effort") = kDefaultEffort,
              "Compresses to .amc bytes (quantize: 0 bit-exact, else bits per axis; effort 0 to 4: how hard the\n"
              "encoder looks, as amc encode --effort).")
@@ -391,12 +418,7 @@ PYBIND11_MODULE(_amcodec, m) {
                  std::vector<Field> fields;
                  for (const DataArray& a : data_arrays_of(point_data)) fields.push_back(field_from_array(a, FieldAssociation::point));
                  for (const DataArray& a : data_arrays_of(cell_data)) fields.push_back(field_from_array(a, FieldAssociation::cell));
-                 SeriesFrameStats stats;
-                 {
-                     py::gil_scoped_release release;
-                     stats = w.writer->add_frame(h, time, fields);
-                 }
-                 return frame_stats_dict(stats);
+                 return frame_stats_dict(w.writer->add_frame(h, time, fields));
              },
              py::arg("hierarchy"), py::arg("time") = 0.0, py::arg("point_data") = py::dict(), py::arg("cell_data") = py::dict(),
              "Adds a Hierarchy over the base; point_data arrays follow its leaf mesh's vertices (canonical order), cell_data\n"
@@ -407,13 +429,13 @@ PYBIND11_MODULE(_amcodec, m) {
                  vtu.mesh = mesh_from_arrays(points, triangles, "frame");
                  vtu.point_data = data_arrays_of(point_data);
                  vtu.cell_data = data_arrays_of(cell_data);
-                 SeriesFrameStats stats;
+                 const std::string name = "frame " + std::to_string(w.writer->frame_count());
+                 SeriesFrame frame;
                  {
-                     py::gil_scoped_release release;
-                     const SeriesFrame frame = frame_from_vtu(w.base, vtu, time, "frame " + std::to_string(w.writer->frame_count()));
-                     stats = w.writer->add_frame(frame.hierarchy, frame.time, frame.fields);
+                     py::gil_scoped_release release;  // the import reads only copies and the base, set once
+                     frame = frame_from_vtu(w.base, vtu, time, name);
                  }
-                 return frame_stats_dict(stats);
+                 return frame_stats_dict(w.writer->add_frame(frame.hierarchy, frame.time, frame.fields));
              },
              py::arg("points"), py::arg("triangles"), py::arg("time") = 0.0, py::arg("point_data") = py::dict(),
              py::arg("cell_data") = py::dict(),
@@ -443,22 +465,12 @@ PYBIND11_MODULE(_amcodec, m) {
                  if (k < 0) k += int64_t(r.frame_count());
                  if (k < 0 || uint64_t(k) >= r.frame_count())
                      throw py::index_error("frame " + std::to_string(k) + " of " + std::to_string(r.frame_count()));
-                 SeriesFrame frame;
-                 {
-                     py::gil_scoped_release release;
-                     frame = r.frame(size_t(k));
-                 }
-                 return frame_dict(frame);
+                 return frame_dict(r.frame(size_t(k)));
              }, py::arg("k"),
              "Frame k as a dict: points, triangles, level, green (canonical numbering), time, point_data, cell_data.")
         .def("hierarchy", [](SeriesReader& r, size_t k) {
                  if (k >= r.frame_count()) throw py::index_error("frame " + std::to_string(k) + " of " + std::to_string(r.frame_count()));
-                 Hierarchy h;
-                 {
-                     py::gil_scoped_release release;
-                     h = r.frame(k).hierarchy;
-                 }
-                 return h;
+                 return r.frame(k).hierarchy;
              }, py::arg("k"), "Frame k's Hierarchy.")
         .def("info", [](const SeriesReader& r, size_t k) {
                  if (k >= r.frame_count()) throw py::index_error("frame " + std::to_string(k) + " of " + std::to_string(r.frame_count()));

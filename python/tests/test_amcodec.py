@@ -1,4 +1,6 @@
 """The Python module: arrays in and out, round trips exact, numbering kept, errors as exceptions."""
+import threading
+
 import numpy as np
 import pytest
 
@@ -159,3 +161,75 @@ def test_every_effort_decodes_alike_and_others_are_refused():
             h.encode(effort=effort)
         with pytest.raises(Exception, match="effort"):
             amcodec.encode(points, triangles, effort=effort)
+
+
+def test_node_ids_are_checked():
+    points, triangles = icosahedron()
+    h = amcodec.Hierarchy(points, triangles)
+    h.refine(0)
+    assert h.level(h.node_count - 1) == 1 and h.is_leaf(h.node_count - 1)
+    # Read out of the node array until 2026-12-07 (level(10**8) crashed the interpreter).
+    for call in (h.is_leaf, h.level, h.refine, h.coarsen):
+        for node in (h.node_count, 10 ** 8, 2 ** 32 - 1):
+            with pytest.raises(amcodec.Error, match="no node"):
+                call(node)
+
+
+def test_triangle_indices_must_be_integers():
+    _, points, triangles = adaptive_leaf_mesh(4)
+    data = amcodec.encode(points, triangles)
+    # Whole numbers in a float array (np.loadtxt) are taken; a fraction was truncated to another
+    # vertex without a word until 2026-12-07.
+    assert amcodec.encode(points, triangles.astype(np.float64)) == data
+    assert amcodec.encode(points, triangles.astype(np.uint32)) == data
+    fractional = triangles.astype(np.float64)
+    fractional[3, 1] += 0.5
+    with pytest.raises(amcodec.Error, match=r"triangle 3 has vertex index .*, not an integer"):
+        amcodec.encode(points, fractional)
+    with pytest.raises(amcodec.Error, match="out of range"):
+        amcodec.encode(points, np.array([[0, 1, 2 ** 64 - 1]], dtype=np.uint64))
+    for wrong in (triangles.astype(bool), triangles.astype(str), triangles[:, :2]):
+        with pytest.raises(amcodec.Error, match=r"triangles must be an \(m, 3\) integer array"):
+            amcodec.encode(points, wrong)
+
+
+def test_a_hierarchy_changed_by_one_thread_while_another_encodes_it():
+    # Hierarchy.encode released the GIL until 2026-12-07, so refine and coarsen on another thread
+    # changed the hierarchy under it ("invalid hierarchy", or a crash); now each encode sees one state.
+    h, _, _ = adaptive_leaf_mesh(5)
+    for _ in range(1500):
+        leaves = h.leaves()
+        h.refine(leaves[len(leaves) // 2])
+    errors = []
+
+    def encode_repeatedly():
+        try:
+            for _ in range(30):
+                back = amcodec.decode_hierarchy(h.encode())
+                assert back.check() == ""
+        except Exception as e:  # noqa: BLE001 - reported by the assertion below
+            errors.append(e)
+
+    def change_repeatedly():
+        rng = np.random.default_rng(6)
+        try:
+            for _ in range(6000):
+                leaves = h.leaves()
+                node = int(leaves[rng.integers(len(leaves))])
+                if rng.random() < 0.5:
+                    h.refine(node)
+                else:
+                    try:
+                        h.coarsen(max(0, node - 3))
+                    except amcodec.Error:  # not a node (any more)
+                        pass
+        except Exception as e:  # noqa: BLE001 - reported by the assertion below
+            errors.append(e)
+
+    threads = [threading.Thread(target=encode_repeatedly), threading.Thread(target=change_repeatedly)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert errors == []
+    assert h.check() == ""
