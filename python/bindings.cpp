@@ -64,15 +64,18 @@ std::vector<Triangle> triangles_from_array(const py::array& triangles, size_t ve
     return out;
 }
 
-// A numpy (n, 3) array of coordinates; float32 input keeps single precision (bit-exact files).
+// A numpy (n, 3) array of coordinates, or (n, 2) for a planar mesh (z = 0, as meshio and FE codes
+// hand 2-D meshes); float32 input keeps single precision (bit-exact files).
 TriangleMesh mesh_from_arrays(const py::array& points, const py::array& triangles, const char* what) {
     TriangleMesh mesh;
     mesh.single_precision = points.dtype().is(py::dtype::of<float>());
     const PointArray p = PointArray::ensure(points);
-    if (!p || p.ndim() != 2 || p.shape(1) != 3) throw Error(std::string(what) + ": points must be an (n, 3) array");
+    if (!p || p.ndim() != 2 || (p.shape(1) != 3 && p.shape(1) != 2))
+        throw Error(std::string(what) + ": points must be an (n, 3) or (n, 2) array");
     auto pv = p.unchecked<2>();
+    const bool planar = p.shape(1) == 2;
     mesh.positions.resize(size_t(p.shape(0)));
-    for (py::ssize_t i = 0; i < p.shape(0); ++i) mesh.positions[size_t(i)] = {pv(i, 0), pv(i, 1), pv(i, 2)};
+    for (py::ssize_t i = 0; i < p.shape(0); ++i) mesh.positions[size_t(i)] = {pv(i, 0), pv(i, 1), planar ? 0.0 : pv(i, 2)};
     mesh.triangles = triangles_from_array(triangles, mesh.positions.size(), what);
     validate_triangle_mesh(mesh, what);
     return mesh;

@@ -233,3 +233,14 @@ def test_a_hierarchy_changed_by_one_thread_while_another_encodes_it():
         t.join()
     assert errors == []
     assert h.check() == ""
+
+
+def test_planar_points_are_taken_at_z_zero():
+    _, points, triangles = adaptive_leaf_mesh(7)
+    flat = points.copy()
+    flat[:, 2] = 0
+    data = amcodec.encode(flat[:, :2], triangles, keep_numbering=True)
+    assert data == amcodec.encode(flat, triangles, keep_numbering=True)
+    assert np.array_equal(amcodec.decode(data)["points"], flat)
+    with pytest.raises(amcodec.Error, match=r"points must be an \(n, 3\) or \(n, 2\) array"):
+        amcodec.encode(points[:, :1], triangles)
