@@ -319,12 +319,16 @@ PYBIND11_MODULE(_amcodec, m) {
               std::vector<uint8_t> data;
               {
                   py::gil_scoped_release release;
-                  const LeafNumbering numbering = leaf_numbering(imported.hierarchy, mesh, imported.vertex_of_input);
+                  // Only when stored or returned: given one, the encoder takes a slower path.
+                  LeafNumbering numbering;
                   EncodeOptions options;
                   options.quantize_bits = quantize;
                   options.effort = effort;
-                  options.numbering = &numbering;
-                  options.store_numbering = keep_numbering;
+                  if (keep_numbering || return_stats) {
+                      numbering = leaf_numbering(imported.hierarchy, mesh, imported.vertex_of_input);
+                      options.numbering = &numbering;
+                      options.store_numbering = keep_numbering;
+                  }
                   data = encode(imported.hierarchy, options, &stats);
               }
               if (!return_stats) return to_bytes(data);
