@@ -16,6 +16,7 @@
 #include <cstring>
 #include <memory>
 #include <optional>
+#include <type_traits>
 #include <variant>
 #include <string>
 
@@ -33,34 +34,31 @@ std::vector<Triangle> triangles_from_array(const py::array& triangles, size_t ve
     if (triangles.ndim() != 2 || triangles.shape(1) != 3 || (kind != 'i' && kind != 'u' && kind != 'f'))
         throw Error(std::string(what) + ": triangles must be an (m, 3) integer array");
     std::vector<Triangle> out(size_t(triangles.shape(0)));
-    auto check = [&](py::ssize_t i, int c, auto v, const std::string& shown) {
-        if (!(v >= 0 && v < decltype(v)(vertex_count)))
-            throw Error(std::string(what) + ": triangle " + std::to_string(i) + " has vertex index " + shown + " out of range");
-        out[size_t(i)][c] = uint32_t(v);
+    auto refuse = [&](py::ssize_t i, const std::string& shown, const char* why) {
+        throw Error(std::string(what) + ": triangle " + std::to_string(i) + " has vertex index " + shown + why);
     };
-    if (kind == 'f') {
-        const auto t = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(triangles);
-        auto tv = t.unchecked<2>();
+    auto shown = [](auto v) -> std::string {
+        if constexpr (std::is_floating_point_v<decltype(v)>) return py::str(py::float_(v));
+        else return std::to_string(v);
+    };
+    auto take = [&](const auto& t) {
+        auto tv = t.template unchecked<2>();
         for (py::ssize_t i = 0; i < t.shape(0); ++i) {
             for (int c = 0; c < 3; ++c) {
-                const double v = tv(i, c);
-                const std::string shown = py::str(py::float_(v));
-                if (v != std::floor(v))
-                    throw Error(std::string(what) + ": triangle " + std::to_string(i) + " has vertex index " + shown + ", not an integer");
-                check(i, c, v, shown);
+                const auto v = tv(i, c);
+                if constexpr (std::is_floating_point_v<decltype(v)>)
+                    if (v != std::floor(v)) refuse(i, shown(v), ", not an integer");  // a fraction, or NaN
+                if (!(v >= 0 && v < decltype(v)(vertex_count))) refuse(i, shown(v), " out of range");
+                out[size_t(i)][c] = uint32_t(v);
             }
         }
-    } else if (kind == 'u') {
-        const auto t = py::array_t<uint64_t, py::array::c_style | py::array::forcecast>::ensure(triangles);
-        auto tv = t.unchecked<2>();
-        for (py::ssize_t i = 0; i < t.shape(0); ++i)
-            for (int c = 0; c < 3; ++c) check(i, c, tv(i, c), std::to_string(tv(i, c)));
-    } else {
-        const auto t = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(triangles);
-        auto tv = t.unchecked<2>();
-        for (py::ssize_t i = 0; i < t.shape(0); ++i)
-            for (int c = 0; c < 3; ++c) check(i, c, tv(i, c), std::to_string(tv(i, c)));
-    }
+    };
+    if (kind == 'f')
+        take(py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(triangles));
+    else if (kind == 'u')
+        take(py::array_t<uint64_t, py::array::c_style | py::array::forcecast>::ensure(triangles));
+    else
+        take(py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(triangles));
     return out;
 }
 
