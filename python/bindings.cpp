@@ -170,6 +170,36 @@ NodeId existing_node(const Hierarchy& h, NodeId n, const char* what) {
     return n;
 }
 
+// A vertex id from Python, checked against the hierarchy's ids.
+VertexId existing_vertex(const Hierarchy& h, VertexId v, const char* what) {
+    if (v >= h.positions().size()) throw Error(std::string(what) + ": no vertex " + std::to_string(v));
+    return v;
+}
+
+py::object node_or_none(NodeId n) { return n == kNoNode ? py::object(py::none()) : py::object(py::int_(n)); }
+
+py::array_t<double> vec3_array(Vec3 p) {
+    py::array_t<double> out(3);
+    auto o = out.mutable_unchecked<1>();
+    o(0) = p.x, o(1) = p.y, o(2) = p.z;
+    return out;
+}
+
+// Hierarchy.leaf_mesh: the mesh with, per triangle, the node it belongs to and, per point, its
+// hierarchy vertex id, which tie the mesh to the nodes and vertices the other methods name.
+py::dict leaf_dict(const Hierarchy& h, int level) {
+    const LeafMesh leaf = extract_leaf_mesh(h, level);
+    py::dict d = mesh_dict(leaf.mesh, leaf.cells, nullptr);
+    d.attr("pop")("numbering");
+    d["node"] = vector_array(leaf.source);
+    const std::vector<uint32_t> canonical = canonical_vertex_order(h);
+    std::vector<uint32_t> vertex_of_point(leaf.mesh.positions.size(), kNoVertex);
+    for (VertexId v = 0; v < canonical.size(); ++v)
+        if (canonical[v] < vertex_of_point.size()) vertex_of_point[canonical[v]] = v;
+    d["vertex"] = vector_array(vertex_of_point);
+    return d;
+}
+
 py::bytes to_bytes(const std::vector<uint8_t>& data) { return py::bytes(reinterpret_cast<const char*>(data.data()), data.size()); }
 
 // ---- series (.amcs): fields as numpy arrays, (n,) or (n, components), of the field's own type ----
@@ -293,11 +323,39 @@ PYBIND11_MODULE(_amcodec, m) {
                  return h.coarsen(existing_node(h, n, "coarsen"));
              }, py::arg("node"), "Removes a node's four leaf children where balance allows; returns whether it did.")
         .def("check", &check_invariants, "Every structural invariant: '' if valid, else the first violation.")
-        .def("leaf_mesh", [](const Hierarchy& h, int level) {
-                 const LeafMesh leaf = extract_leaf_mesh(h, level);
-                 return mesh_dict(leaf.mesh, leaf.cells, nullptr);
-             }, py::arg("level") = -1,
-             "The conforming leaf mesh (or the mesh of one level): dict with points, triangles, level, green.")
+        .def("leaf_mesh", &leaf_dict, py::arg("level") = -1,
+             "The conforming leaf mesh (or the mesh of one level, its nodes as leaves): dict with points, triangles,\n"
+             "level and green per triangle, node (the node each triangle belongs to) and vertex (each point's vertex id).")
+        .def_property_readonly("node_capacity", &Hierarchy::node_capacity,
+                               "Node ids are below it (roots first: 0 .. root_count - 1); removed nodes' ids are reused.")
+        .def("is_alive", &Hierarchy::is_alive, py::arg("node"), "Whether the id names a node (not removed).")
+        .def("parent", [](const Hierarchy& h, NodeId n) { return node_or_none(h.parent(existing_node(h, n, "parent"))); },
+             py::arg("node"), "The parent node, None for a root.")
+        .def("children", [](const Hierarchy& h, NodeId n) {
+                 py::list out;
+                 if (!h.is_leaf(existing_node(h, n, "children")))
+                     for (int k = 0; k < 4; ++k) out.append(h.child(n, k));
+                 return out;
+             }, py::arg("node"), "The four children (three corners, then the center; docs/HIERARCHY.md), [] for a leaf.")
+        .def("vertices", [](const Hierarchy& h, NodeId n) {
+                 existing_node(h, n, "vertices");
+                 return py::make_tuple(h.vertex(n, 0), h.vertex(n, 1), h.vertex(n, 2));
+             }, py::arg("node"), "The node's three corner vertex ids, in its orientation (the base triangle's, for every node of its tree).")
+        .def("neighbors", [](const Hierarchy& h, NodeId n) {
+                 existing_node(h, n, "neighbors");
+                 return py::make_tuple(node_or_none(h.neighbor(n, 0)), node_or_none(h.neighbor(n, 1)), node_or_none(h.neighbor(n, 2)));
+             }, py::arg("node"),
+             "The same-level neighbours across edges 0, 1, 2 (edge e from vertex e to vertex e + 1); None at the\n"
+             "boundary or where the mesh there is coarser.")
+        .def("position", [](const Hierarchy& h, VertexId v) { return vec3_array(h.position(existing_vertex(h, v, "position"))); },
+             py::arg("vertex"), "The vertex's position, a (3,) array.")
+        .def("set_position", [](Hierarchy& h, VertexId v, const PointArray& p) {
+                 if (p.size() != 3) throw Error("set_position: expected three coordinates");
+                 h.set_position(existing_vertex(h, v, "set_position"), {p.data()[0], p.data()[1], p.data()[2]});
+             }, py::arg("vertex"), py::arg("point"), "Moves a vertex (checked when the hierarchy is encoded).")
+        .def_property_readonly("base", [](const Hierarchy& h) {
+                 return py::make_tuple(points_array(h.base()), triangles_array(h.base().triangles));
+             }, "The base mesh: (points, triangles); base vertex i is vertex id i, base triangle t root node t.")
         .def("encode", [](const Hierarchy& h, int quantize, int effort) {
                  EncodeOptions options;
                  options.quantize_bits = quantize;

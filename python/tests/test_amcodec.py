@@ -244,3 +244,48 @@ def test_planar_points_are_taken_at_z_zero():
     assert np.array_equal(amcodec.decode(data)["points"], flat)
     with pytest.raises(amcodec.Error, match=r"points must be an \(n, 3\) or \(n, 2\) array"):
         amcodec.encode(points[:, :1], triangles)
+
+
+def test_the_forest_can_be_walked_and_ties_to_the_leaf_mesh():
+    h, _, _ = adaptive_leaf_mesh(9)
+    points, triangles = h.base
+    assert len(triangles) == h.root_count
+    alive = [n for n in range(h.node_capacity) if h.is_alive(n)]
+    assert len(alive) == h.node_count
+    for n in alive:
+        parent = h.parent(n)
+        assert (parent is None) == (n < h.root_count)
+        if parent is not None:
+            assert n in h.children(parent) and h.level(n) == h.level(parent) + 1
+        kids = h.children(n)
+        assert (kids == []) == h.is_leaf(n)
+        if kids:  # the center's corners are the parent's edge midpoints, each shared with a corner child
+            center = set(h.vertices(kids[3]))
+            for k in range(3):
+                assert len(center & set(h.vertices(kids[k]))) == 2
+                assert h.vertices(n)[k] in h.vertices(kids[k])
+        for e, q in enumerate(h.neighbors(n)):
+            if q is not None:  # the same edge, the other way round
+                a, b = h.vertices(n)[e], h.vertices(n)[(e + 1) % 3]
+                assert h.level(q) == h.level(n) and {a, b} <= set(h.vertices(q))
+    for level in (-1, 2):
+        mesh = h.leaf_mesh(level)
+        assert np.array_equal(mesh["points"], np.array([h.position(v) for v in mesh["vertex"]]))
+        for t, node, node_level, green in zip(mesh["triangles"], mesh["node"], mesh["level"], mesh["green"]):
+            assert h.is_leaf(node) or h.level(node) == level
+            assert h.level(node) == node_level
+            # A red leaf is its node's triangle; a green one keeps one or two of its corners.
+            corners = {int(mesh["vertex"][i]) for i in t}
+            assert len(corners & set(h.vertices(node))) == 3 if not green else 1 <= len(corners & set(h.vertices(node))) <= 2
+    v = h.vertices(h.leaves()[0])[0]
+    h.set_position(v, [0.5, 0.25, 2.0])
+    assert np.array_equal(h.position(v), [0.5, 0.25, 2.0])
+    back = amcodec.decode_hierarchy(h.encode())
+    assert np.array_equal(np.sort(back.leaf_mesh()["points"], axis=0), np.sort(h.leaf_mesh()["points"], axis=0))
+    for call in (h.parent, h.children, h.vertices, h.neighbors):
+        with pytest.raises(amcodec.Error, match="no node"):
+            call(h.node_capacity)
+    with pytest.raises(amcodec.Error, match="no vertex"):
+        h.position(10 ** 7)
+    with pytest.raises(amcodec.Error, match="three coordinates"):
+        h.set_position(v, [1.0, 2.0])
