@@ -356,14 +356,16 @@ PYBIND11_MODULE(_amcodec, m) {
         .def_property_readonly("base", [](const Hierarchy& h) {
                  return py::make_tuple(points_array(h.base()), triangles_array(h.base().triangles));
              }, "The base mesh: (points, triangles); base vertex i is vertex id i, base triangle t root node t.")
-        .def("encode", [](const Hierarchy& h, int quantize, int effort) {
+        .def("encode", [](const Hierarchy& h, int quantize, int effort, uint32_t chunks) {
                  EncodeOptions options;
                  options.quantize_bits = quantize;
                  options.effort = effort;
+                 options.chunks = chunks;
                  return to_bytes(encode(h, options));
-             }, py::arg("quantize") = 0, py::arg("effort") = kDefaultEffort,
+             }, py::arg("quantize") = 0, py::arg("effort") = kDefaultEffort, py::arg("chunks") = 0,
              "Compresses to .amc bytes (quantize: 0 bit-exact, else bits per axis; effort 0 to 4: how hard the\n"
-             "encoder looks, as amc encode --effort).")
+             "encoder looks, as amc encode --effort; chunks: that many independently decodable runs of roots, as\n"
+             "amc encode --chunks, 0: one per 500,000 faces).")
         .def("identical", [](const Hierarchy& a, const Hierarchy& b) { return identical(a, b); }, py::arg("other"),
              "Same base, forest, diagonals and bit-identical positions (canonical order).");
 
@@ -443,6 +445,59 @@ PYBIND11_MODULE(_amcodec, m) {
           "when the file stores it, unless canonical=True; level cuts the decoding at that level. partial=True\n"
           "accepts a file still arriving (cut after its base mesh): the levels complete so far, with 'complete',\n"
           "'reached_level' and 'levels' in the dict.");
+
+    m.def("info", [](py::bytes data) {
+              const std::string bytes = data;
+              const FileInfo info = inspect(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());
+              py::dict d;
+              d["version"] = info.version;
+              d["single_precision"] = info.single_precision;
+              d["quantize_bits"] = info.quantize_bits;
+              d["base_vertices"] = info.base_vertices;
+              d["base_triangles"] = info.base_triangles;
+              d["nodes"] = info.nodes;
+              d["vertices"] = info.vertices;
+              d["faces"] = info.faces;
+              d["levels"] = info.levels;
+              py::list blocks, chunks;
+              for (const FileBlock& b : info.blocks) {
+                  py::dict block;
+                  block["name"] = b.name;
+                  block["offset"] = b.offset;
+                  block["bytes"] = b.size;
+                  block["level"] = b.level >= 0 ? py::object(py::int_(b.level)) : py::object(py::none());
+                  blocks.append(block);
+              }
+              for (const ChunkInfo& c : info.chunks) {
+                  py::dict chunk;
+                  chunk["first_root"] = c.first_root;
+                  chunk["roots"] = c.roots;
+                  chunk["nodes"] = c.nodes;
+                  chunk["offset"] = c.offset;
+                  chunk["bytes"] = c.size;
+                  chunks.append(chunk);
+              }
+              d["blocks"] = blocks;
+              d["chunks"] = chunks;
+              return d;
+          },
+          py::arg("data"),
+          "What an .amc file holds, without decoding it (as amc info): version, precision, counts, levels, its\n"
+          "blocks (name, offset, bytes, level) and chunks (first_root, roots, nodes, offset, bytes; [] without chunks).");
+
+    m.def("decode_chunks", [](py::bytes data, const std::vector<uint32_t>& chunks) {
+              const std::string bytes = data;
+              ChunkDecode part;
+              {
+                  py::gil_scoped_release release;
+                  part = decode_chunks(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size(), chunks);
+              }
+              return py::make_tuple(std::move(part.hierarchy), vector_array(part.roots), vector_array(part.base_vertices));
+          },
+          py::arg("data"), py::arg("chunks"),
+          "Some chunks of a chunked file alone (indices into info(data)['chunks'], increasing; a file without chunks\n"
+          "has chunk 0): (Hierarchy over their roots, the file's root of each of its roots, the file's base vertex of\n"
+          "each of its base vertices).");
 
     m.def("decode_hierarchy", [](py::bytes data) {
               const std::string bytes = data;

@@ -23,11 +23,11 @@ Series (.amcs, one file for every output step of an adaptive run, with its field
     frame = reader.frame(40)  # dict: points, triangles, level, green, time, point_data, cell_data
 """
 
-from ._amcodec import (Error, Hierarchy, SeriesReader, SeriesWriter, __version__, decode, decode_hierarchy, encode,
-                       import_mesh)
+from ._amcodec import (Error, Hierarchy, SeriesReader, SeriesWriter, __version__, decode, decode_chunks, decode_hierarchy,
+                       encode, import_mesh, info)
 
-__all__ = ["Error", "Hierarchy", "SeriesReader", "SeriesWriter", "__version__", "decode", "decode_hierarchy", "encode",
-           "import_mesh", "encode_meshio", "decode_meshio"]
+__all__ = ["Error", "Hierarchy", "SeriesReader", "SeriesWriter", "__version__", "decode", "decode_chunks",
+           "decode_hierarchy", "encode", "import_mesh", "info", "encode_meshio", "decode_meshio"]
 
 
 def encode_meshio(mesh, keep_numbering=True, quantize=0, base=None):

@@ -289,3 +289,28 @@ def test_the_forest_can_be_walked_and_ties_to_the_leaf_mesh():
         h.position(10 ** 7)
     with pytest.raises(amcodec.Error, match="three coordinates"):
         h.set_position(v, [1.0, 2.0])
+
+
+def test_info_and_chunks_without_decoding_the_whole_file():
+    h, _, _ = adaptive_leaf_mesh(10)
+    whole = h.encode()
+    info = amcodec.info(whole)
+    assert (info["faces"], info["nodes"], info["chunks"]) == (len(h.leaf_mesh()["triangles"]), h.node_count, [])
+    assert sum(b["bytes"] for b in info["blocks"]) + 12 == len(whole)  # the 12-byte file header before them
+    data = h.encode(chunks=4)
+    chunks = amcodec.info(data)["chunks"]
+    assert len(chunks) == 4 and sum(c["roots"] for c in chunks) == h.root_count
+    back = amcodec.decode_hierarchy(data)
+    total_nodes = 0
+    for k, chunk in enumerate(chunks):
+        part, roots, base_vertices = amcodec.decode_chunks(data, [k])
+        assert list(roots) == list(range(chunk["first_root"], chunk["first_root"] + chunk["roots"]))
+        assert part.node_count == chunk["nodes"]
+        total_nodes += part.node_count
+        base_points, _ = back.base
+        assert np.array_equal(part.base[0], base_points[base_vertices])
+    assert total_nodes == back.node_count
+    with pytest.raises(amcodec.Error, match="chunk"):
+        amcodec.decode_chunks(data, [4])
+    with pytest.raises(amcodec.Error, match="magic"):
+        amcodec.info(b"not an amc file")
