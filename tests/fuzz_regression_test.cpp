@@ -55,6 +55,17 @@ TEST_P(FuzzRegressions, EveryFoundInputPasses) {
     }
 }
 
+// The nearest-vertex target's seeds (a lattice, copies of a point, a cluster beside an outlier,
+// tiny and huge scales, a graded box): every answer of NearestVertex as the target's oracles want.
+TEST(FuzzSeeds, NearestVertexSeedsPassTheOracles) {
+    const std::vector<std::vector<uint8_t>> seeds = fuzz::nearest_vertex_seeds();
+    EXPECT_GE(seeds.size(), 3u);
+    for (size_t i = 0; i < seeds.size(); ++i) {
+        SCOPED_TRACE("seed " + std::to_string(i));
+        fuzz::nearest_vertex(seeds[i].data(), seeds[i].size());
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(All, FuzzRegressions, ::testing::ValuesIn(fuzz::targets()),
                          [](const ::testing::TestParamInfo<fuzz::Target>& info) { return std::string(info.param.name); });
 
