@@ -446,23 +446,25 @@ struct SeedWriter {
     void box(uint32_t m, uint32_t radius, int e, bool graded, uint32_t seed) {
         u8(5), u16(m - 1), u8(radius - 1), u16(uint32_t(e)), u8(graded), u32(seed);
     }
-    // `queries` of every kind in turn, counts 0 .. kMaxCount + 1, every kind of limit and of mask.
-    void queries(uint32_t queries, uint32_t points, uint32_t seed) {
+    // `queries` of every kind in turn, counts 0 .. kMaxCount + 1, every kind of limit and of mask;
+    // nudges off a point of up to 127 2^(nudge - k), k < 8. Single: nudges only, of count 1 (whose
+    // search starts in the query's cell).
+    void queries(uint32_t queries, uint32_t points, uint32_t seed, int nudge = 0, bool single = false) {
         u8(queries - 1);
         Random random{seed};
         auto point = [&] { u16(uint32_t(random.next() % points)); };
         for (uint32_t i = 0; i < queries; ++i) {
-            const uint32_t kind = i % 6;
+            const uint32_t kind = single ? 2 : i % 6;
             u8(kind);
             switch (kind) {
                 case 0: point(); break;
                 case 1: point(), point(); break;
-                case 2: point(), u16(uint32_t(-int(random.next() % 8))), u8(random.next()), u8(random.next()), u8(random.next()); break;
+                case 2: point(), u16(uint32_t(nudge - int(random.next() % 8))), u8(random.next()), u8(random.next()), u8(random.next()); break;
                 case 3: real(double(random.next() % 64) - 8), real(double(random.next() % 64) - 8), real(0.5); break;
                 case 4: point(), u8(random.next()), u8(random.next()), u16(uint32_t(random.next() % 40)); break;
                 default: point(), u8(random.next()), u8(random.next()); break;
             }
-            u8(i % (kMaxCount + 2));
+            u8(single ? 1 : i % (kMaxCount + 2));
             const uint32_t limit = i / 2 % 8;
             u8(limit);
             point();
@@ -515,6 +517,15 @@ std::vector<std::vector<uint8_t>> nearest_vertex_seeds() {
     {  // a graded random box of 2048 points, as an adaptive mesh crowds its vertices, reversed
         SeedWriter s;
         s.u8(4), s.u8(0), s.box(2048, 255, -8, true, 6), s.u32(11), s.queries(32, 2048, 6);
+        seeds.push_back(s.bytes);
+    }
+    {  // cells of unit size (points at 0 and 1024), a lattice on the sides of the 32^3 cells that a
+       // query searches first, clusters across them: nearest vertices just across a side
+        SeedWriter s;
+        s.u8(0), s.u8(12), s.u8(0), s.u8(1), s.real(0), s.real(0), s.real(0), s.real(1024), s.real(1024), s.real(1024);
+        s.lattice(5, 0, 0, 8, 8, 8);
+        for (uint32_t k = 0; k < 11; ++k) s.cluster(2 + k * 47, -20, 64, 20 + k);
+        s.u32(14), s.queries(32, 1218, 9, -22, true);
         seeds.push_back(s.bytes);
     }
     {  // one point
