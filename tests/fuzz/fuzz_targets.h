@@ -39,6 +39,7 @@ void series_read(const uint8_t* data, size_t size);        // .amcs reader, ever
 void forest_series_read(const uint8_t* data, size_t size); // .amcs forest series reader, every frame, written again
 void octree_decode(const uint8_t* data, size_t size);      // .amq decode: whole, progressive, encoded again
 void leaf_import(const uint8_t* data, size_t size);        // leaf mesh (damaged or not) -> hierarchy, with the base or alone
+void closest_point(const uint8_t* data, size_t size);      // ClosestPointQuery against a brute-force loop
 
 // Input layouts of the stream targets, which fuzz_seeds writes too.
 //   hierarchy_stream: u8 base (index into stream_bases()), u8 max_level + 1 (0: all levels), the stream.
@@ -46,6 +47,9 @@ void leaf_import(const uint8_t* data, size_t size);        // leaf mesh (damaged
 //             u8 n (1 + n % 16 predictions), n u64 predictions (the IEEE bits of a double, or a
 //             grid coordinate in the low 32 bits), the payload.
 const std::vector<TriangleMesh>& stream_bases();
+//   closest_point: a mesh and its queries (closest_point_fuzzer.cpp); its seeds, which fuzz_seeds
+//             writes and amc_tests runs: a fan, a far component, a translated lattice and more.
+std::vector<std::vector<uint8_t>> closest_point_seeds();
 //   base_connectivity: u16 vertex count (little endian), the stream; decoder vertex v is at
 //             base_position(v).
 Vec3 base_position(uint32_t v);
