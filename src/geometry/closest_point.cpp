@@ -32,6 +32,9 @@ constexpr uint32_t kFanLeaf = kEmpty;
 constexpr double kConeWidening = 1e-9;
 constexpr double kConeSlack = 1e-10;
 constexpr double kRightAngle = 1.5707963267948966;
+// A direction this close to a cone's axis (radians) is taken to meet the cone: the side plane
+// facing it is found from its part across the axis, which below this is too much rounding.
+constexpr double kNearAxis = 1e-4;
 // A fan's tree halves its triangles at each level: at most 32 levels, one stack entry more each.
 constexpr int kConeStackSize = 34;
 
@@ -507,14 +510,16 @@ ClosestPointQuery::Fan ClosestPointQuery::build_fan(const TriangleMesh& referenc
         const Vec3 axis = unit(sum);
         if (squared_length(axis) > 0) {
             // The widest direction by its (sine, cosine) from the axis (a before b where sin(a - b) > 0,
-            // both in [0, 180] degrees), then its angle by atan2, which (unlike acos) stays accurate
+            // both in [0, 180] degrees, or sin(a - b) = 0 and cos a < cos b: a direction opposite the
+            // axis against 0 degrees), then its angle by atan2, which (unlike acos) stays accurate
             // near 0; a choice off by rounding is within the widening.
             double widest_sine = 0, widest_cosine = 1;
             for (uint32_t i = item.begin; i < item.end; ++i) {
                 for (Vec3 to : directions[local[i]].to) {
                     if (!(squared_length(to) > 0)) continue;
                     const double sine = std::sqrt(squared_length(cross(to, axis))), cosine = dot(to, axis);
-                    if (sine * widest_cosine - cosine * widest_sine > 0) widest_sine = sine, widest_cosine = cosine;
+                    const double turn = sine * widest_cosine - cosine * widest_sine;
+                    if (turn > 0 || (turn == 0 && cosine < widest_cosine)) widest_sine = sine, widest_cosine = cosine;
                 }
             }
             const double half_angle = std::atan2(widest_sine, widest_cosine) + kConeWidening;
@@ -585,7 +590,8 @@ bool ClosestPointQuery::cone_may_meet_segment(const ConeNode& node, Vec3 w0, Vec
     }
     const Vec3 radial = nearest - dot(nearest, u) * u;
     const double radial_length = std::sqrt(squared_length(radial));
-    if (!(radial_length > 0)) return true;
+    // Near the axis the radial part is rounding noise, whose direction (maybe along u) says nothing.
+    if (!(radial_length > kNearAxis * std::sqrt(squared_length(nearest)))) return true;
     const Vec3 side = (node.cosine / radial_length) * radial - node.sine * u;  // unit, at 90 degrees + a from u
     return !(dot(w0, side) > slack && dot(w1, side) > slack);
 }
@@ -718,15 +724,23 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 ori
     if (!(direction_length > 0) || !(reach >= 0)) return std::nullopt;
     const Vec3 d = (1 / direction_length) * direction;
     double best = reach;  // |t| of the best hit so far, in units of length
+    // A box is pruned beyond this: its slab bounds and a hit's t carry rounding relative to |t|
+    // (from an origin far away, more than the box's own margin covers), as search's distances do.
+    double prune = best * (1 + kPruneSlack);
     uint32_t best_record = kEmpty, best_triangle = kEmpty;
     Vec3 best_barycentric;
-    // Slab test of the segment origin + t d, |t| <= best, against a box; returns its |t| lower bound.
+    // Slab test of the segment origin + t d, |t| <= prune, against a box; returns its |t| lower bound.
+    // A triangle widened by `tolerance` reaches 2 tolerance times its extent beyond its box on each
+    // axis (each widened corner moves by tolerance times its two edges), so a box is widened by that
+    // much of its own extent, which holds its triangles'.
+    const double widening = 2 * tolerance;
     const double inverse[3] = {1 / d.x, 1 / d.y, 1 / d.z};
     const double o[3] = {origin.x, origin.y, origin.z};
     auto enters = [&](const float* lo, const float* hi, double& near) {
-        double t0 = -best, t1 = best;
+        double t0 = -prune, t1 = prune;
         for (int axis = 0; axis < 3; ++axis) {
-            double a = (lo[axis] - o[axis]) * inverse[axis], b = (hi[axis] - o[axis]) * inverse[axis];
+            const double widen = widening > 0 ? widening * (double(hi[axis]) - lo[axis]) : 0.0;
+            double a = (lo[axis] - widen - o[axis]) * inverse[axis], b = (hi[axis] + widen - o[axis]) * inverse[axis];
             if (std::isnan(a) || std::isnan(b)) {  // parallel to the slab, on its plane: inside it
                 a = -std::numeric_limits<double>::infinity();
                 b = std::numeric_limits<double>::infinity();
@@ -737,7 +751,7 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 ori
         }
         if (t0 > t1) return false;
         near = t0 <= 0 && t1 >= 0 ? 0 : std::min(std::fabs(t0), std::fabs(t1));
-        return near <= best;
+        return near <= prune;
     };
     struct Entry {
         uint32_t index, count;
@@ -764,8 +778,12 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 ori
             if (v < -tolerance || u + v > 1 + tolerance) continue;
             const double t = dot(e2, qv) * inv;
             const double at = std::fabs(t);
-            if (at < best || (at == best && best_record != kEmpty && triangles_[r] < best_triangle)) {
+            // A hit at exactly `reach` counts (the header's |t| <= reach), as a tie with a lower index
+            // does; an infinite |t| (overflow) does not.
+            if (at < best || (at == best && at < std::numeric_limits<double>::infinity() &&
+                              (best_record == kEmpty || triangles_[r] < best_triangle))) {
                 best = at;
+                prune = best * (1 + kPruneSlack);
                 best_record = r;
                 best_triangle = triangles_[r];
                 best_barycentric = {1 - u - v, u, v};
@@ -790,7 +808,7 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 ori
         stack[size++] = {fan.root, 0.0};
         while (size > 0) {
             const ConeEntry entry = stack[--size];
-            if (entry.near > best) continue;
+            if (entry.near > prune) continue;
             const ConeNode& node = cone_nodes_[entry.node];
             if (node.count > 0) {
                 test_records(node.index, node.index + node.count);
@@ -810,7 +828,7 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 ori
     };
     while (size > 0) {
         const Entry entry = stack[--size];
-        if (entry.near > best) continue;
+        if (entry.near > prune) continue;
         if (entry.count == kFanLeaf) {
             search_fan(fans_[entry.index]);
             continue;
