@@ -1223,6 +1223,52 @@ TEST(CraftedFiles, ClosestPointsBesideAFarTriangleTestFewBoxes) {
     }
 }
 
+// Closest points and lines 10^-3 above the faces of a unit square of 2 * 256^2 triangles moved 10^9
+// and 10^11 away from the origin (and once with one more triangle 10^15 beyond it): each query tests
+// a few boxes and triangles, and its answer is the brute-force one. The boxes were floats of
+// absolute coordinates, whose ulp there (64; 8,192) is larger than the square: every box was the
+// whole square and every query tested all of them (a leaf mesh at 10^9 imported in 26-28 s instead
+// of 0.3 s) until 2026-12-07 (docs/FUZZING.md, "review of far components").
+TEST(CraftedFiles, ClosestPointsOnAMeshFarFromTheOriginTestFewBoxes) {
+    const int cells = kSanitizerSlowdown > 1 ? 64 : 256;
+    const int kQueries = 2000;
+    struct Case {
+        double offset;
+        bool far_triangle;
+    };
+    for (const Case c : {Case{1e9, false}, Case{1e11, false}, Case{1e9, true}}) {
+        TriangleMesh mesh = make_square(cells);
+        for (Vec3& p : mesh.positions) p = p + Vec3{c.offset, -c.offset, 0.5 * c.offset};
+        const uint32_t square_faces = uint32_t(mesh.triangles.size()), v = uint32_t(mesh.positions.size());
+        if (c.far_triangle) {
+            mesh.positions.insert(mesh.positions.end(), {{1e15, 0, 0}, {1e15, 1, 0}, {1e15, 0, 1}});
+            mesh.triangles.push_back({v, v + 1, v + 2});
+        }
+        const ClosestPointQuery query(mesh);
+        uint64_t tested = 0;
+        const double start = cpu_milliseconds();
+        for (int i = 0; i < kQueries; ++i) {
+            const uint32_t face = uint32_t((uint64_t(i) * 2654435761u) % square_faces);
+            const Triangle& t = mesh.triangles[face];
+            const Vec3 a = mesh.positions[t[0]], b = mesh.positions[t[1]], corner = mesh.positions[t[2]];
+            const Vec3 normal = cross(b - a, corner - a);
+            const Vec3 up = (1 / std::sqrt(dot(normal, normal))) * normal;
+            const Vec3 p = (1.0 / 3) * a + (1.0 / 3) * b + (1.0 / 3) * corner + 1e-3 * up;
+            const ClosestPointQuery::Hit hit = query.closest(p, tested);
+            ASSERT_EQ(hit.triangle, face) << c.offset << " " << i;
+            ASSERT_NEAR(std::sqrt(hit.distance_squared), 1e-3, 1e-4) << c.offset << " " << i;
+            const std::optional<ClosestPointQuery::Hit> line = query.intersect_line(p, up, 2e-3, 1e-9);
+            ASSERT_TRUE(line.has_value()) << c.offset << " " << i;
+            ASSERT_EQ(line->triangle, face) << c.offset << " " << i;
+        }
+        const double milliseconds = cpu_milliseconds() - start;
+        std::printf("  %d closest points and lines on a square %g from the origin%s: %.1f ms, %.1f boxes and triangles tested each\n",
+                    kQueries, c.offset, c.far_triangle ? " beside a triangle at 1e15" : "", milliseconds,
+                    double(tested) / kQueries);
+        EXPECT_LT(tested, 100u * kQueries) << c.offset;  // all 2 * 256^2 triangles and their boxes before
+    }
+}
+
 // The distance between a bipyramid of 2^11 sides without shared vertices and itself (its long
 // triangles' boxes all overlap near the apexes, so a closest-point query there tests every one):
 // refused as not measured in time linear in the mesh. The measure ran its 4 * 10^6 evaluations at

@@ -76,17 +76,42 @@ AMC_ALWAYS_INLINE double box_distance_squared(const float* lo, const float* hi, 
 // most max_abs in magnitude (a few ulps of them), an axis.
 double rounding_margin(double max_abs) { return 16 * DBL_EPSILON * max_abs; }
 
-// The box [lo, hi] widened by the rounding margin of its own coordinates (not the whole mesh's:
-// one far-away triangle would widen every box to the size of the mesh), as floats rounded outward;
-// returns that margin.
-double store_box(Vec3 lo, Vec3 hi, float* lo_out, float* hi_out) {
-    const double margin = rounding_margin(std::max({std::fabs(lo.x), std::fabs(lo.y), std::fabs(lo.z), std::fabs(hi.x),
-                                                    std::fabs(hi.y), std::fabs(hi.z)}));
+double max_abs_component(Vec3 lo, Vec3 hi) {
+    return std::max({std::fabs(lo.x), std::fabs(lo.y), std::fabs(lo.z), std::fabs(hi.x), std::fabs(hi.y), std::fabs(hi.z)});
+}
+
+// The box [lo, hi] relative to `origin`, widened by the rounding margin of its own coordinates (not
+// the whole mesh's: one far-away triangle would widen every box to the size of the mesh) and by the
+// rounding of the subtraction of the origin (here and in a query), as floats rounded outward;
+// returns the first margin.
+double store_box(Vec3 lo, Vec3 hi, Vec3 origin, float* lo_out, float* hi_out) {
+    const double margin = rounding_margin(max_abs_component(lo, hi));
+    const Vec3 relative_lo = lo - origin, relative_hi = hi - origin;
+    const double widening = margin + 4 * DBL_EPSILON * max_abs_component(relative_lo, relative_hi);
     for (int axis = 0; axis < 3; ++axis) {
-        lo_out[axis] = float_below(component(lo, axis) - margin);
-        hi_out[axis] = float_above(component(hi, axis) + margin);
+        lo_out[axis] = float_below(component(relative_lo, axis) - widening);
+        hi_out[axis] = float_above(component(relative_hi, axis) + widening);
     }
     return margin;
+}
+
+// Per axis, the median of the finite coordinates (0 where there are none): an origin near most of
+// the mesh whatever a few far-away parts add.
+Vec3 median_of_finite(const std::vector<Vec3>& points) {
+    std::vector<double> values;
+    values.reserve(points.size());
+    double median[3] = {0, 0, 0};
+    for (int axis = 0; axis < 3; ++axis) {
+        values.clear();
+        for (const Vec3& p : points) {
+            const double x = component(p, axis);
+            if (std::isfinite(x)) values.push_back(x);
+        }
+        if (values.empty()) continue;
+        std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+        median[axis] = values[values.size() / 2];
+    }
+    return {median[0], median[1], median[2]};
 }
 
 // Closest point to p on segment [x, y]; t is the weight of y.
@@ -272,6 +297,8 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
         centroids[i] = 0.5 * item_lo[i] + 0.5 * item_hi[i];
     }
 
+    box_origin_ = median_of_finite(centroids);
+
     std::vector<uint32_t> order(items);
     for (uint32_t i = 0; i < items; ++i) order[i] = i;
 
@@ -400,7 +427,7 @@ ClosestPointQuery::ClosestPointQuery(const TriangleMesh& reference) {
         Work item = work.back();
         work.pop_back();
         Bounds bounds = measure(item.begin, item.end);
-        store_box(bounds.lo, bounds.hi, nodes_[item.parent].lo[item.slot], nodes_[item.parent].hi[item.slot]);
+        store_box(bounds.lo, bounds.hi, box_origin_, nodes_[item.parent].lo[item.slot], nodes_[item.parent].hi[item.slot]);
         if (is_leaf(item.begin, item.end)) {
             const bool fan = order[item.begin] >= first_fan_item;
             nodes_[item.parent].index[item.slot] = fan ? order[item.begin] - first_fan_item : item.begin;
@@ -505,7 +532,7 @@ ClosestPointQuery::Fan ClosestPointQuery::build_fan(const TriangleMesh& referenc
             middle_lo = component_min(middle_lo, directions[j].middle);
             middle_hi = component_max(middle_hi, directions[j].middle);
         }
-        const double box_margin = store_box(lo, hi, node.lo, node.hi);
+        const double box_margin = store_box(lo, hi, box_origin_, node.lo, node.hi);
         if (item.node == root) margin = box_margin;
         const Vec3 axis = unit(sum);
         if (squared_length(axis) > 0) {
@@ -556,12 +583,13 @@ ClosestPointQuery::Fan ClosestPointQuery::build_fan(const TriangleMesh& referenc
     return Fan{apex, root, margin};
 }
 
-// A lower bound on the distance from p to the triangles of a fan's node, w = p - apex: its box's,
-// and its cone's, which every triangle of the fan holds as it holds the apex (at angle theta from
-// the axis, p is |w| sin(theta - half-angle) from the cone, |w| from 90 degrees beyond it on).
-double ClosestPointQuery::cone_node_distance_squared(const ConeNode& node, Vec3 p, Vec3 w, double w_length,
+// A lower bound on the distance from p to the triangles of a fan's node, w = p - apex, box_p = p -
+// box_origin_: its box's, and its cone's, which every triangle of the fan holds as it holds the apex
+// (at angle theta from the axis, p is |w| sin(theta - half-angle) from the cone, |w| from 90 degrees
+// beyond it on).
+double ClosestPointQuery::cone_node_distance_squared(const ConeNode& node, Vec3 box_p, Vec3 w, double w_length,
                                                      double margin) const {
-    const double box = box_distance_squared(node.lo, node.hi, p);
+    const double box = box_distance_squared(node.lo, node.hi, box_p);
     if (!node.has_cone) return box;
     const double along = dot(w, node.axis);
     const double across = std::sqrt(squared_length(cross(w, node.axis)));
@@ -599,6 +627,7 @@ bool ClosestPointQuery::cone_may_meet_segment(const ConeNode& node, Vec3 w0, Vec
 template <class Accept>
 std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p, double bound_squared, const Accept& accept,
                                                                 uint64_t* tested) const {
+    const Vec3 box_p = p - box_origin_;
     double best = bound_squared;
     double prune = best * (1 + kPruneSlack);
     uint32_t best_record = kEmpty;
@@ -631,7 +660,7 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p, double b
         };
         ConeEntry stack[kConeStackSize];
         int size = 0;
-        stack[size++] = {fan.root, cone_node_distance_squared(cone_nodes_[fan.root], p, w, w_length, fan.margin)};
+        stack[size++] = {fan.root, cone_node_distance_squared(cone_nodes_[fan.root], box_p, w, w_length, fan.margin)};
         while (size > 0) {
             const ConeEntry entry = stack[--size];
             if (entry.distance_squared > prune) continue;
@@ -641,8 +670,8 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p, double b
                 test_records(node.index, node.index + node.count);
                 continue;
             }
-            const double d[2] = {cone_node_distance_squared(cone_nodes_[node.index], p, w, w_length, fan.margin),
-                                 cone_node_distance_squared(cone_nodes_[node.index + 1], p, w, w_length, fan.margin)};
+            const double d[2] = {cone_node_distance_squared(cone_nodes_[node.index], box_p, w, w_length, fan.margin),
+                                 cone_node_distance_squared(cone_nodes_[node.index + 1], box_p, w, w_length, fan.margin)};
             const int near = d[1] < d[0] ? 1 : 0;
             for (int slot : {1 - near, near}) {
                 if (d[slot] <= prune) stack[size++] = {node.index + slot, d[slot]};
@@ -673,7 +702,7 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p, double b
         }
         const Node& node = nodes_[entry.index];
         double d[2];
-        for (int slot = 0; slot < 2; ++slot) d[slot] = box_distance_squared(node.lo[slot], node.hi[slot], p);
+        for (int slot = 0; slot < 2; ++slot) d[slot] = box_distance_squared(node.lo[slot], node.hi[slot], box_p);
         // Push the farther child first, so that the nearer one is searched first.
         const int near = d[1] < d[0] ? 1 : 0;
         for (int slot : {1 - near, near}) {
@@ -735,7 +764,8 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 ori
     // much of its own extent, which holds its triangles'.
     const double widening = 2 * tolerance;
     const double inverse[3] = {1 / d.x, 1 / d.y, 1 / d.z};
-    const double o[3] = {origin.x, origin.y, origin.z};
+    const Vec3 box_origin = origin - box_origin_;
+    const double o[3] = {box_origin.x, box_origin.y, box_origin.z};
     auto enters = [&](const float* lo, const float* hi, double& near) {
         double t0 = -prune, t1 = prune;
         for (int axis = 0; axis < 3; ++axis) {

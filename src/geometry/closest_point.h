@@ -80,7 +80,8 @@ public:
     std::size_t fan_count() const { return fans_.size(); }
 
 private:
-    // One cache line: the bounds of both children (float, rounded outward) and what they are.
+    // One cache line: the bounds of both children (float, relative to box_origin_, rounded outward)
+    // and what they are.
     // A child with count > 0 is a leaf: records [index, index + count); with count == 0 it is
     // the inner node nodes_[index]; with count kFanLeaf it is the fan fans_[index]; index kEmpty
     // marks the missing second child of a tiny tree.
@@ -95,7 +96,7 @@ private:
     };
     // A node of a fan's tree: its triangles' directions from the apex lie within the cone of unit
     // `axis` and half-angle (cosine, sine), widened for rounding (no cone when they span more than
-    // a half-space), and their corners within the box. count > 0: records [index, index + count);
+    // a half-space), and their corners within the box (relative to box_origin_). count > 0: records [index, index + count);
     // count == 0: children cone_nodes_[index] and cone_nodes_[index + 1].
     struct ConeNode {
         Vec3 axis;
@@ -112,12 +113,15 @@ private:
 
     void add_record(const TriangleMesh& reference, uint32_t triangle);
     Fan build_fan(const TriangleMesh& reference, uint32_t apex, const std::vector<uint32_t>& triangles);
-    double cone_node_distance_squared(const ConeNode& node, Vec3 p, Vec3 w, double w_length, double margin) const;
+    double cone_node_distance_squared(const ConeNode& node, Vec3 box_p, Vec3 w, double w_length, double margin) const;
     bool cone_may_meet_segment(const ConeNode& node, Vec3 w0, Vec3 w1, double slack) const;
 
     template <class Accept>
     std::optional<Hit> search(Vec3 p, double bound_squared, const Accept& accept, uint64_t* tested = nullptr) const;
 
+    // Every box is stored relative to this point near most of the mesh: at 10^9 a float's ulp is 64,
+    // so absolute float boxes of a unit-sized mesh there would all be the whole mesh.
+    Vec3 box_origin_;
     std::vector<Node> nodes_;           // nodes_[0] is the root
     std::vector<Record> records_;
     std::vector<uint32_t> triangles_;   // triangle index of each record
