@@ -31,6 +31,7 @@ constexpr uint32_t kFanLeaf = kEmpty;
 // distance bound lowered by this share of the distance to the apex for the rounding of the bound.
 constexpr double kConeWidening = 1e-9;
 constexpr double kConeSlack = 1e-10;
+constexpr double kUnderflowSlack = 8 * std::numeric_limits<double>::denorm_min();
 constexpr double kRightAngle = 1.5707963267948966;
 // A direction this close to a cone's axis (radians) is taken to meet the cone: the side plane
 // facing it is found from its part across the axis, which below this is too much rounding.
@@ -93,6 +94,21 @@ double store_box(Vec3 lo, Vec3 hi, Vec3 origin, float* lo_out, float* hi_out) {
         hi_out[axis] = float_above(component(relative_hi, axis) + widening);
     }
     return margin;
+}
+
+// Whether q lies in the box of triangle (a, b, c) widened by the rounding margin of its coordinates
+// and by `widening` times its extent on each axis: where a line's hit must be for the tree's boxes,
+// which hold that much around their triangles, to find it.
+bool in_triangle_box(Vec3 q, Vec3 a, Vec3 b, Vec3 c, double widening) {
+    const Vec3 lo = component_min(component_min(a, b), c), hi = component_max(component_max(a, b), c);
+    const double margin = rounding_margin(max_abs_component(lo, hi));
+    for (int axis = 0; axis < 3; ++axis) {
+        const double extent = component(hi, axis) - component(lo, axis);
+        const double w = margin + (widening > 0 ? widening * extent : 0.0);
+        const double x = component(q, axis);
+        if (!(x >= component(lo, axis) - w && x <= component(hi, axis) + w)) return false;
+    }
+    return true;
 }
 
 // Per axis, the median of the finite coordinates (0 where there are none): an origin near most of
@@ -596,7 +612,9 @@ double ClosestPointQuery::cone_node_distance_squared(const ConeNode& node, Vec3 
     double gap = along * node.cosine + across * node.sine <= 0 ? w_length : across * node.cosine - along * node.sine;
     // The rounding of the bound, and of the computed closest points (margin an axis: < 2 margin in all).
     gap -= kConeSlack * w_length + 2 * margin;
-    return gap > 0 ? std::max(box, gap * gap) : box;
+    // Below DBL_MIN a triangle's squared distance (three squares, each rounded to a multiple of the
+    // least subnormal) may round under this one square: lowered by a few of those units.
+    return gap > 0 ? std::max(box, gap * gap - kUnderflowSlack) : box;
 }
 
 // False when a plane through the apex has the node's cone on one side and the segment from
@@ -810,8 +828,11 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 ori
             const double at = std::fabs(t);
             // A hit at exactly `reach` counts (the header's |t| <= reach), as a tie with a lower index
             // does; an infinite |t| (overflow) does not.
-            if (at < best || (at == best && at < std::numeric_limits<double>::infinity() &&
-                              (best_record == kEmpty || triangles_[r] < best_triangle))) {
+            // A line (nearly) in the triangle's plane can round to a hit anywhere in that plane: it
+            // counts only inside the triangle's box (the header).
+            if ((at < best || (at == best && at < std::numeric_limits<double>::infinity() &&
+                               (best_record == kEmpty || triangles_[r] < best_triangle))) &&
+                in_triangle_box(origin + t * d, record.a, record.b, record.c, widening)) {
                 best = at;
                 prune = best * (1 + kPruneSlack);
                 best_record = r;

@@ -19,6 +19,7 @@
 #include "geometry/closest_point.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -165,11 +166,28 @@ std::optional<ClosestPointQuery::Hit> brute_facing(const TriangleMesh& mesh, Vec
     });
 }
 
+// The header's box a line's hit must lie in: the triangle's, widened by 16 ulps of its largest
+// coordinate (closest_point.cpp's rounding margin) and by `widening` of its extent on each axis.
+bool in_widened_box(Vec3 q, Vec3 a, Vec3 b, Vec3 c, double widening) {
+    const double lo[3] = {std::min(std::min(a.x, b.x), c.x), std::min(std::min(a.y, b.y), c.y), std::min(std::min(a.z, b.z), c.z)};
+    const double hi[3] = {std::max(std::max(a.x, b.x), c.x), std::max(std::max(a.y, b.y), c.y), std::max(std::max(a.z, b.z), c.z)};
+    double max_abs = 0;
+    for (int axis = 0; axis < 3; ++axis) max_abs = std::max({max_abs, std::fabs(lo[axis]), std::fabs(hi[axis])});
+    const double margin = 16 * DBL_EPSILON * max_abs;
+    const double x[3] = {q.x, q.y, q.z};
+    for (int axis = 0; axis < 3; ++axis) {
+        const double w = margin + (widening > 0 ? widening * (hi[axis] - lo[axis]) : 0.0);
+        if (!(x[axis] >= lo[axis] - w && x[axis] <= hi[axis] + w)) return false;
+    }
+    return true;
+}
+
 // The header's intersect_line: among the triangles facing the direction (dot(n, d) > 0, d the unit
 // direction), widened by `tolerance` of their barycentric range, the hit of least |t| (t in units of
 // length along d, so |t| <= reach is the header's |t| * |direction| <= reach), ties to the lowest
-// index. The hit and its t are computed as closest_point.cpp computes them (Moller-Trumbore, two-sided
-// in t), and the point as the barycentric combination of the corners.
+// index, counted only inside the triangle's widened box. The hit and its t are computed as
+// closest_point.cpp computes them (Moller-Trumbore, two-sided in t), and the point as the
+// barycentric combination of the corners.
 std::optional<ClosestPointQuery::Hit> brute_line(const TriangleMesh& mesh, Vec3 origin, Vec3 direction, double reach,
                                                  double tolerance, double* hit_t = nullptr) {
     const double direction_length = std::sqrt(squared_length(direction));
@@ -193,8 +211,10 @@ std::optional<ClosestPointQuery::Hit> brute_line(const TriangleMesh& mesh, Vec3 
         const Vec3 qv = cross(tv, e1);
         const double v = dot(d, qv) * inv;
         if (v < -tolerance || u + v > 1 + tolerance) continue;
-        const double at = std::fabs(dot(e2, qv) * inv);
-        if (at < best || (at == best && at < kInfinity && best_triangle == kNoTriangle)) {
+        const double line_t = dot(e2, qv) * inv;
+        const double at = std::fabs(line_t);
+        if ((at < best || (at == best && at < kInfinity && best_triangle == kNoTriangle)) &&
+            in_widened_box(origin + line_t * d, a, b, c, 2 * tolerance)) {
             best = at;
             best_triangle = t;
             best_barycentric = {1 - u - v, u, v};
