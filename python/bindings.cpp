@@ -1,5 +1,7 @@
 // The Python module amcodec._amcodec: numpy arrays in and out of the public C++ API. Errors are
-// raised as amcodec.Error with the library's message; long calls release the GIL.
+// raised as amcodec.Error with the library's message. A call releases the GIL only while it works
+// on its own copies: one that reads or changes a Hierarchy, reader or writer that other Python
+// threads can reach holds it (the library's calls are not safe against a concurrent change).
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
 #include <amc/import.h>
@@ -10,9 +12,11 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <cstring>
 #include <memory>
 #include <optional>
+#include <type_traits>
 #include <variant>
 #include <string>
 
@@ -22,30 +26,55 @@ using namespace amc;
 namespace {
 
 using PointArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
-using IndexArray = py::array_t<int64_t, py::array::c_style | py::array::forcecast>;
 
-// A numpy (n, 3) array of coordinates; float32 input keeps single precision (bit-exact files).
+// The triangles' vertex indices: an integer array, or a float one whose values are all integers
+// (as np.loadtxt gives); a fraction would otherwise be truncated to another vertex without a word.
+std::vector<Triangle> triangles_from_array(const py::array& triangles, size_t vertex_count, const char* what) {
+    const char kind = triangles.dtype().kind();
+    if (triangles.ndim() != 2 || triangles.shape(1) != 3 || (kind != 'i' && kind != 'u' && kind != 'f'))
+        throw Error(std::string(what) + ": triangles must be an (m, 3) integer array");
+    std::vector<Triangle> out(size_t(triangles.shape(0)));
+    auto refuse = [&](py::ssize_t i, const std::string& shown, const char* why) {
+        throw Error(std::string(what) + ": triangle " + std::to_string(i) + " has vertex index " + shown + why);
+    };
+    auto shown = [](auto v) -> std::string {
+        if constexpr (std::is_floating_point_v<decltype(v)>) return py::str(py::float_(v));
+        else return std::to_string(v);
+    };
+    auto take = [&](const auto& t) {
+        auto tv = t.template unchecked<2>();
+        for (py::ssize_t i = 0; i < t.shape(0); ++i) {
+            for (int c = 0; c < 3; ++c) {
+                const auto v = tv(i, c);
+                if constexpr (std::is_floating_point_v<decltype(v)>)
+                    if (v != std::floor(v)) refuse(i, shown(v), ", not an integer");  // a fraction, or NaN
+                if (!(v >= 0 && v < decltype(v)(vertex_count))) refuse(i, shown(v), " out of range");
+                out[size_t(i)][c] = uint32_t(v);
+            }
+        }
+    };
+    if (kind == 'f')
+        take(py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(triangles));
+    else if (kind == 'u')
+        take(py::array_t<uint64_t, py::array::c_style | py::array::forcecast>::ensure(triangles));
+    else
+        take(py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(triangles));
+    return out;
+}
+
+// A numpy (n, 3) array of coordinates, or (n, 2) for a planar mesh (z = 0, as meshio and FE codes
+// hand 2-D meshes); float32 input keeps single precision (bit-exact files).
 TriangleMesh mesh_from_arrays(const py::array& points, const py::array& triangles, const char* what) {
     TriangleMesh mesh;
     mesh.single_precision = points.dtype().is(py::dtype::of<float>());
     const PointArray p = PointArray::ensure(points);
-    const IndexArray t = IndexArray::ensure(triangles);
-    if (!p || p.ndim() != 2 || p.shape(1) != 3) throw Error(std::string(what) + ": points must be an (n, 3) array");
-    if (!t || t.ndim() != 2 || t.shape(1) != 3) throw Error(std::string(what) + ": triangles must be an (m, 3) integer array");
+    if (!p || p.ndim() != 2 || (p.shape(1) != 3 && p.shape(1) != 2))
+        throw Error(std::string(what) + ": points must be an (n, 3) or (n, 2) array");
     auto pv = p.unchecked<2>();
+    const bool planar = p.shape(1) == 2;
     mesh.positions.resize(size_t(p.shape(0)));
-    for (py::ssize_t i = 0; i < p.shape(0); ++i) mesh.positions[size_t(i)] = {pv(i, 0), pv(i, 1), pv(i, 2)};
-    auto tv = t.unchecked<2>();
-    mesh.triangles.resize(size_t(t.shape(0)));
-    for (py::ssize_t i = 0; i < t.shape(0); ++i) {
-        for (int c = 0; c < 3; ++c) {
-            const int64_t v = tv(i, c);
-            if (v < 0 || v >= int64_t(mesh.positions.size()))
-                throw Error(std::string(what) + ": triangle " + std::to_string(i) + " has vertex index " + std::to_string(v) +
-                            " out of range");
-            mesh.triangles[size_t(i)][c] = uint32_t(v);
-        }
-    }
+    for (py::ssize_t i = 0; i < p.shape(0); ++i) mesh.positions[size_t(i)] = {pv(i, 0), pv(i, 1), planar ? 0.0 : pv(i, 2)};
+    mesh.triangles = triangles_from_array(triangles, mesh.positions.size(), what);
     validate_triangle_mesh(mesh, what);
     return mesh;
 }
@@ -133,6 +162,42 @@ ImportedHierarchy import_arrays(const TriangleMesh& mesh, const py::object& base
     const TriangleMesh base_mesh = mesh_from_arrays(pair[0].cast<py::array>(), pair[1].cast<py::array>(), "base mesh");
     py::gil_scoped_release release;
     return import_leaf_mesh(base_mesh, mesh, {}, "mesh");
+}
+
+// The library reads a node id unchecked: one from Python is looked up first.
+NodeId existing_node(const Hierarchy& h, NodeId n, const char* what) {
+    if (!h.is_alive(n)) throw Error(std::string(what) + ": no node " + std::to_string(n));
+    return n;
+}
+
+// A vertex id from Python, checked against the hierarchy's ids.
+VertexId existing_vertex(const Hierarchy& h, VertexId v, const char* what) {
+    if (v >= h.positions().size()) throw Error(std::string(what) + ": no vertex " + std::to_string(v));
+    return v;
+}
+
+py::object node_or_none(NodeId n) { return n == kNoNode ? py::object(py::none()) : py::object(py::int_(n)); }
+
+py::array_t<double> vec3_array(Vec3 p) {
+    py::array_t<double> out(3);
+    auto o = out.mutable_unchecked<1>();
+    o(0) = p.x, o(1) = p.y, o(2) = p.z;
+    return out;
+}
+
+// Hierarchy.leaf_mesh: the mesh with, per triangle, the node it belongs to and, per point, its
+// hierarchy vertex id, which tie the mesh to the nodes and vertices the other methods name.
+py::dict leaf_dict(const Hierarchy& h, int level) {
+    const LeafMesh leaf = extract_leaf_mesh(h, level);
+    py::dict d = mesh_dict(leaf.mesh, leaf.cells, nullptr);
+    d.attr("pop")("numbering");
+    d["node"] = vector_array(leaf.source);
+    const std::vector<uint32_t> canonical = canonical_vertex_order(h);
+    std::vector<uint32_t> vertex_of_point(leaf.mesh.positions.size(), kNoVertex);
+    for (VertexId v = 0; v < canonical.size(); ++v)
+        if (canonical[v] < vertex_of_point.size()) vertex_of_point[canonical[v]] = v;
+    d["vertex"] = vector_array(vertex_of_point);
+    return d;
 }
 
 py::bytes to_bytes(const std::vector<uint8_t>& data) { return py::bytes(reinterpret_cast<const char*>(data.data()), data.size()); }
@@ -248,36 +313,59 @@ PYBIND11_MODULE(_amcodec, m) {
         .def_property_readonly("leaf_count", &Hierarchy::leaf_count)
         .def_property_readonly("vertex_count", &Hierarchy::vertex_count)
         .def_property_readonly("depth", &Hierarchy::depth)
-        .def("is_leaf", &Hierarchy::is_leaf, py::arg("node"))
-        .def("level", &Hierarchy::level, py::arg("node"))
+        .def("is_leaf", [](const Hierarchy& h, NodeId n) { return h.is_leaf(existing_node(h, n, "is_leaf")); }, py::arg("node"))
+        .def("level", [](const Hierarchy& h, NodeId n) { return h.level(existing_node(h, n, "level")); }, py::arg("node"))
         .def("leaves", &Hierarchy::leaves, "Leaf node ids in breadth-first order.")
         .def("refine", [](Hierarchy& h, NodeId n) {
-                 if (!h.is_alive(n)) throw Error("refine: no node " + std::to_string(n));
-                 return h.refine(n);
+                 return h.refine(existing_node(h, n, "refine"));
              }, py::arg("node"), "Red-refines a leaf with balance and closure; returns the number of nodes split.")
         .def("coarsen", [](Hierarchy& h, NodeId n) {
-                 if (!h.is_alive(n)) throw Error("coarsen: no node " + std::to_string(n));
-                 return h.coarsen(n);
+                 return h.coarsen(existing_node(h, n, "coarsen"));
              }, py::arg("node"), "Removes a node's four leaf children where balance allows; returns whether it did.")
         .def("check", &check_invariants, "Every structural invariant: '' if valid, else the first violation.")
-        .def("leaf_mesh", [](const Hierarchy& h, int level) {
-                 const LeafMesh leaf = extract_leaf_mesh(h, level);
-                 return mesh_dict(leaf.mesh, leaf.cells, nullptr);
-             }, py::arg("level") = -1,
-             "The conforming leaf mesh (or the mesh of one level): dict with points, triangles, level, green.")
-        .def("encode", [](const Hierarchy& h, int quantize, int effort) {
+        .def("leaf_mesh", &leaf_dict, py::arg("level") = -1,
+             "The conforming leaf mesh (or the mesh of one level, its nodes as leaves): dict with points, triangles,\n"
+             "level and green per triangle, node (the node each triangle belongs to) and vertex (each point's vertex id).")
+        .def_property_readonly("node_capacity", &Hierarchy::node_capacity,
+                               "Node ids are below it (roots first: 0 .. root_count - 1); removed nodes' ids are reused.")
+        .def("is_alive", &Hierarchy::is_alive, py::arg("node"), "Whether the id names a node (not removed).")
+        .def("parent", [](const Hierarchy& h, NodeId n) { return node_or_none(h.parent(existing_node(h, n, "parent"))); },
+             py::arg("node"), "The parent node, None for a root.")
+        .def("children", [](const Hierarchy& h, NodeId n) {
+                 py::list out;
+                 if (!h.is_leaf(existing_node(h, n, "children")))
+                     for (int k = 0; k < 4; ++k) out.append(h.child(n, k));
+                 return out;
+             }, py::arg("node"), "The four children (three corners, then the center; docs/HIERARCHY.md), [] for a leaf.")
+        .def("vertices", [](const Hierarchy& h, NodeId n) {
+                 existing_node(h, n, "vertices");
+                 return py::make_tuple(h.vertex(n, 0), h.vertex(n, 1), h.vertex(n, 2));
+             }, py::arg("node"), "The node's three corner vertex ids, in its orientation (the base triangle's, for every node of its tree).")
+        .def("neighbors", [](const Hierarchy& h, NodeId n) {
+                 existing_node(h, n, "neighbors");
+                 return py::make_tuple(node_or_none(h.neighbor(n, 0)), node_or_none(h.neighbor(n, 1)), node_or_none(h.neighbor(n, 2)));
+             }, py::arg("node"),
+             "The same-level neighbours across edges 0, 1, 2 (edge e from vertex e to vertex e + 1); None at the\n"
+             "boundary or where the mesh there is coarser.")
+        .def("position", [](const Hierarchy& h, VertexId v) { return vec3_array(h.position(existing_vertex(h, v, "position"))); },
+             py::arg("vertex"), "The vertex's position, a (3,) array.")
+        .def("set_position", [](Hierarchy& h, VertexId v, const PointArray& p) {
+                 if (p.size() != 3) throw Error("set_position: expected three coordinates");
+                 h.set_position(existing_vertex(h, v, "set_position"), {p.data()[0], p.data()[1], p.data()[2]});
+             }, py::arg("vertex"), py::arg("point"), "Moves a vertex (checked when the hierarchy is encoded).")
+        .def_property_readonly("base", [](const Hierarchy& h) {
+                 return py::make_tuple(points_array(h.base()), triangles_array(h.base().triangles));
+             }, "The base mesh: (points, triangles); base vertex i is vertex id i, base triangle t root node t.")
+        .def("encode", [](const Hierarchy& h, int quantize, int effort, uint32_t chunks) {
                  EncodeOptions options;
                  options.quantize_bits = quantize;
                  options.effort = effort;
-                 std::vector<uint8_t> data;
-                 {
-                     py::gil_scoped_release release;
-                     data = encode(h, options);
-                 }
-                 return to_bytes(data);
-             }, py::arg("quantize") = 0, py::arg("effort") = kDefaultEffort,
+                 options.chunks = chunks;
+                 return to_bytes(encode(h, options));
+             }, py::arg("quantize") = 0, py::arg("effort") = kDefaultEffort, py::arg("chunks") = 0,
              "Compresses to .amc bytes (quantize: 0 bit-exact, else bits per axis; effort 0 to 4: how hard the\n"
-             "encoder looks, as amc encode --effort).")
+             "encoder looks, as amc encode --effort; chunks: that many independently decodable runs of roots, as\n"
+             "amc encode --chunks, 0: one per 500,000 faces).")
         .def("identical", [](const Hierarchy& a, const Hierarchy& b) { return identical(a, b); }, py::arg("other"),
              "Same base, forest, diagonals and bit-identical positions (canonical order).");
 
@@ -289,12 +377,16 @@ PYBIND11_MODULE(_amcodec, m) {
               std::vector<uint8_t> data;
               {
                   py::gil_scoped_release release;
-                  const LeafNumbering numbering = leaf_numbering(imported.hierarchy, mesh, imported.vertex_of_input);
+                  // Only when stored or returned: given one, the encoder takes a slower path.
+                  LeafNumbering numbering;
                   EncodeOptions options;
                   options.quantize_bits = quantize;
                   options.effort = effort;
-                  options.numbering = &numbering;
-                  options.store_numbering = keep_numbering;
+                  if (keep_numbering || return_stats) {
+                      numbering = leaf_numbering(imported.hierarchy, mesh, imported.vertex_of_input);
+                      options.numbering = &numbering;
+                      options.store_numbering = keep_numbering;
+                  }
                   data = encode(imported.hierarchy, options, &stats);
               }
               if (!return_stats) return to_bytes(data);
@@ -354,6 +446,59 @@ PYBIND11_MODULE(_amcodec, m) {
           "accepts a file still arriving (cut after its base mesh): the levels complete so far, with 'complete',\n"
           "'reached_level' and 'levels' in the dict.");
 
+    m.def("info", [](py::bytes data) {
+              const std::string bytes = data;
+              const FileInfo info = inspect(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());
+              py::dict d;
+              d["version"] = info.version;
+              d["single_precision"] = info.single_precision;
+              d["quantize_bits"] = info.quantize_bits;
+              d["base_vertices"] = info.base_vertices;
+              d["base_triangles"] = info.base_triangles;
+              d["nodes"] = info.nodes;
+              d["vertices"] = info.vertices;
+              d["faces"] = info.faces;
+              d["levels"] = info.levels;
+              py::list blocks, chunks;
+              for (const FileBlock& b : info.blocks) {
+                  py::dict block;
+                  block["name"] = b.name;
+                  block["offset"] = b.offset;
+                  block["bytes"] = b.size;
+                  block["level"] = b.level >= 0 ? py::object(py::int_(b.level)) : py::object(py::none());
+                  blocks.append(block);
+              }
+              for (const ChunkInfo& c : info.chunks) {
+                  py::dict chunk;
+                  chunk["first_root"] = c.first_root;
+                  chunk["roots"] = c.roots;
+                  chunk["nodes"] = c.nodes;
+                  chunk["offset"] = c.offset;
+                  chunk["bytes"] = c.size;
+                  chunks.append(chunk);
+              }
+              d["blocks"] = blocks;
+              d["chunks"] = chunks;
+              return d;
+          },
+          py::arg("data"),
+          "What an .amc file holds, without decoding it (as amc info): version, precision, counts, levels, its\n"
+          "blocks (name, offset, bytes, level) and chunks (first_root, roots, nodes, offset, bytes; [] without chunks).");
+
+    m.def("decode_chunks", [](py::bytes data, const std::vector<uint32_t>& chunks) {
+              const std::string bytes = data;
+              ChunkDecode part;
+              {
+                  py::gil_scoped_release release;
+                  part = decode_chunks(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size(), chunks);
+              }
+              return py::make_tuple(std::move(part.hierarchy), vector_array(part.roots), vector_array(part.base_vertices));
+          },
+          py::arg("data"), py::arg("chunks"),
+          "Some chunks of a chunked file alone (indices into info(data)['chunks'], increasing; a file without chunks\n"
+          "has chunk 0): (Hierarchy over their roots, the file's root of each of its roots, the file's base vertex of\n"
+          "each of its base vertices).");
+
     m.def("decode_hierarchy", [](py::bytes data) {
               const std::string bytes = data;
               py::gil_scoped_release release;
@@ -391,12 +536,7 @@ PYBIND11_MODULE(_amcodec, m) {
                  std::vector<Field> fields;
                  for (const DataArray& a : data_arrays_of(point_data)) fields.push_back(field_from_array(a, FieldAssociation::point));
                  for (const DataArray& a : data_arrays_of(cell_data)) fields.push_back(field_from_array(a, FieldAssociation::cell));
-                 SeriesFrameStats stats;
-                 {
-                     py::gil_scoped_release release;
-                     stats = w.writer->add_frame(h, time, fields);
-                 }
-                 return frame_stats_dict(stats);
+                 return frame_stats_dict(w.writer->add_frame(h, time, fields));
              },
              py::arg("hierarchy"), py::arg("time") = 0.0, py::arg("point_data") = py::dict(), py::arg("cell_data") = py::dict(),
              "Adds a Hierarchy over the base; point_data arrays follow its leaf mesh's vertices (canonical order), cell_data\n"
@@ -407,13 +547,13 @@ PYBIND11_MODULE(_amcodec, m) {
                  vtu.mesh = mesh_from_arrays(points, triangles, "frame");
                  vtu.point_data = data_arrays_of(point_data);
                  vtu.cell_data = data_arrays_of(cell_data);
-                 SeriesFrameStats stats;
+                 const std::string name = "frame " + std::to_string(w.writer->frame_count());
+                 SeriesFrame frame;
                  {
-                     py::gil_scoped_release release;
-                     const SeriesFrame frame = frame_from_vtu(w.base, vtu, time, "frame " + std::to_string(w.writer->frame_count()));
-                     stats = w.writer->add_frame(frame.hierarchy, frame.time, frame.fields);
+                     py::gil_scoped_release release;  // the import reads only copies and the base, set once
+                     frame = frame_from_vtu(w.base, vtu, time, name);
                  }
-                 return frame_stats_dict(stats);
+                 return frame_stats_dict(w.writer->add_frame(frame.hierarchy, frame.time, frame.fields));
              },
              py::arg("points"), py::arg("triangles"), py::arg("time") = 0.0, py::arg("point_data") = py::dict(),
              py::arg("cell_data") = py::dict(),
@@ -443,22 +583,12 @@ PYBIND11_MODULE(_amcodec, m) {
                  if (k < 0) k += int64_t(r.frame_count());
                  if (k < 0 || uint64_t(k) >= r.frame_count())
                      throw py::index_error("frame " + std::to_string(k) + " of " + std::to_string(r.frame_count()));
-                 SeriesFrame frame;
-                 {
-                     py::gil_scoped_release release;
-                     frame = r.frame(size_t(k));
-                 }
-                 return frame_dict(frame);
+                 return frame_dict(r.frame(size_t(k)));
              }, py::arg("k"),
              "Frame k as a dict: points, triangles, level, green (canonical numbering), time, point_data, cell_data.")
         .def("hierarchy", [](SeriesReader& r, size_t k) {
                  if (k >= r.frame_count()) throw py::index_error("frame " + std::to_string(k) + " of " + std::to_string(r.frame_count()));
-                 Hierarchy h;
-                 {
-                     py::gil_scoped_release release;
-                     h = r.frame(k).hierarchy;
-                 }
-                 return h;
+                 return r.frame(k).hierarchy;
              }, py::arg("k"), "Frame k's Hierarchy.")
         .def("info", [](const SeriesReader& r, size_t k) {
                  if (k >= r.frame_count()) throw py::index_error("frame " + std::to_string(k) + " of " + std::to_string(r.frame_count()));

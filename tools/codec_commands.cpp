@@ -159,11 +159,14 @@ void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
         h = hierarchy_of(input);
     } else {
         progress.phase("importing " + input.name);
-        ImportedMesh imported = import_input(input, command.base, command.threads, global);
+        const bool with_numbering = command.keep_numbering || !command.map.empty();
+        ImportedMesh imported = import_input(input, command.base, command.threads, global, with_numbering);
         h = std::move(imported.hierarchy);
-        numbering = std::move(imported.numbering);
-        options.numbering = &numbering;
-        options.store_numbering = command.keep_numbering;
+        if (with_numbering) {
+            numbering = std::move(imported.numbering);
+            options.numbering = &numbering;
+            options.store_numbering = command.keep_numbering;
+        }
     }
     const double import_seconds = seconds_since(start);
     EncodeStats stats;

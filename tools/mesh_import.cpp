@@ -9,7 +9,8 @@
 
 namespace amc::cli {
 
-ImportedMesh import_input(InputFile& input, const std::string& base_path, unsigned threads, const GlobalOptions& global) {
+ImportedMesh import_input(InputFile& input, const std::string& base_path, unsigned threads, const GlobalOptions& global,
+                          bool with_numbering) {
     const TriangleMesh mesh = mesh_of(input);
     std::string().swap(input.bytes);
     ImportedHierarchy imported = base_path.empty() ? import_mesh(mesh, input.name, threads)
@@ -20,7 +21,7 @@ ImportedMesh import_input(InputFile& input, const std::string& base_path, unsign
                      stats.levels, stats.nodes);
     }
     ImportedMesh out;
-    out.numbering = leaf_numbering(imported.hierarchy, mesh, imported.vertex_of_input);
+    if (with_numbering) out.numbering = leaf_numbering(imported.hierarchy, mesh, imported.vertex_of_input);
     out.hierarchy = std::move(imported.hierarchy);
     return out;
 }
@@ -47,7 +48,7 @@ void run_import(const ImportCommand& command, const GlobalOptions& global) {
     }
     progress.phase("importing " + input.name);
     const auto start = std::chrono::steady_clock::now();
-    const ImportedMesh imported = import_input(input, command.base, command.threads, global);
+    const ImportedMesh imported = import_input(input, command.base, command.threads, global, !command.map.empty());
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     write_output(output, serialize_hierarchy(imported.hierarchy), global.force);
     if (!command.map.empty()) write_output(command.map, format_numbering_map(imported.numbering), global.force);

@@ -13,12 +13,14 @@ namespace amc::cli {
 
 struct ImportedMesh {
     Hierarchy hierarchy;
-    LeafNumbering numbering;  // the input mesh's numbering against extract_leaf_mesh(hierarchy)
+    LeafNumbering numbering;  // with_numbering: the input mesh's numbering against extract_leaf_mesh(hierarchy)
 };
 
 // A mesh input over the base mesh in `base_path`, or over the coarsest base found in it. The
-// input's bytes are let go once read: a large text mesh's file is larger than the mesh.
-ImportedMesh import_input(InputFile& input, const std::string& base_path, unsigned threads, const GlobalOptions& global);
+// input's bytes are let go once read: a large text mesh's file is larger than the mesh. The
+// numbering only `with_numbering` (an encoder given one keeps the input's order, a slower path).
+ImportedMesh import_input(InputFile& input, const std::string& base_path, unsigned threads, const GlobalOptions& global,
+                          bool with_numbering);
 
 // The map as text (docs/IMPORT.md, "The numbering map"): for every input vertex its leaf vertex,
 // for every input face its leaf triangle and rotation.

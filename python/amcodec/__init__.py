@@ -6,8 +6,8 @@ Arrays in, arrays out::
     data = amcodec.encode(points, triangles, keep_numbering=True)   # bytes of an .amc file
     mesh = amcodec.decode(data)                                    # dict: points, triangles, level, green, numbering
 
-``points`` is an (n, 3) float array (float32 stays float32, bit-exact), ``triangles`` an (m, 3)
-integer array. The mesh may be any edge-manifold, consistently oriented triangle mesh: the
+``points`` is an (n, 3) float array (float32 stays float32, bit-exact), or (n, 2) for a planar
+mesh (z = 0; decoding returns (n, 3)); ``triangles`` an (m, 3) integer array. The mesh may be any edge-manifold, consistently oriented triangle mesh: the
 coarsest red-green base is found in it (adaptive and semi-regular meshes), or given as
 ``base=(base_points, base_triangles)``. Errors raise :class:`amcodec.Error` (a ValueError) with the
 library's message.
@@ -23,11 +23,11 @@ Series (.amcs, one file for every output step of an adaptive run, with its field
     frame = reader.frame(40)  # dict: points, triangles, level, green, time, point_data, cell_data
 """
 
-from ._amcodec import (Error, Hierarchy, SeriesReader, SeriesWriter, __version__, decode, decode_hierarchy, encode,
-                       import_mesh)
+from ._amcodec import (Error, Hierarchy, SeriesReader, SeriesWriter, __version__, decode, decode_chunks, decode_hierarchy,
+                       encode, import_mesh, info)
 
-__all__ = ["Error", "Hierarchy", "SeriesReader", "SeriesWriter", "__version__", "decode", "decode_hierarchy", "encode",
-           "import_mesh", "encode_meshio", "decode_meshio"]
+__all__ = ["Error", "Hierarchy", "SeriesReader", "SeriesWriter", "__version__", "decode", "decode_chunks",
+           "decode_hierarchy", "encode", "import_mesh", "info", "encode_meshio", "decode_meshio"]
 
 
 def encode_meshio(mesh, keep_numbering=True, quantize=0, base=None):

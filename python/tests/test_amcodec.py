@@ -1,4 +1,6 @@
 """The Python module: arrays in and out, round trips exact, numbering kept, errors as exceptions."""
+import threading
+
 import numpy as np
 import pytest
 
@@ -159,3 +161,156 @@ def test_every_effort_decodes_alike_and_others_are_refused():
             h.encode(effort=effort)
         with pytest.raises(Exception, match="effort"):
             amcodec.encode(points, triangles, effort=effort)
+
+
+def test_node_ids_are_checked():
+    points, triangles = icosahedron()
+    h = amcodec.Hierarchy(points, triangles)
+    h.refine(0)
+    assert h.level(h.node_count - 1) == 1 and h.is_leaf(h.node_count - 1)
+    # Read out of the node array until 2026-12-07 (level(10**8) crashed the interpreter).
+    for call in (h.is_leaf, h.level, h.refine, h.coarsen):
+        for node in (h.node_count, 10 ** 8, 2 ** 32 - 1):
+            with pytest.raises(amcodec.Error, match="no node"):
+                call(node)
+
+
+def test_triangle_indices_must_be_integers():
+    _, points, triangles = adaptive_leaf_mesh(4)
+    data = amcodec.encode(points, triangles)
+    # Whole numbers in a float array (np.loadtxt) are taken; a fraction was truncated to another
+    # vertex without a word until 2026-12-07.
+    assert amcodec.encode(points, triangles.astype(np.float64)) == data
+    assert amcodec.encode(points, triangles.astype(np.uint32)) == data
+    fractional = triangles.astype(np.float64)
+    fractional[3, 1] += 0.5
+    with pytest.raises(amcodec.Error, match=r"triangle 3 has vertex index .*, not an integer"):
+        amcodec.encode(points, fractional)
+    with pytest.raises(amcodec.Error, match="out of range"):
+        amcodec.encode(points, np.array([[0, 1, 2 ** 64 - 1]], dtype=np.uint64))
+    for wrong in (triangles.astype(bool), triangles.astype(str), triangles[:, :2]):
+        with pytest.raises(amcodec.Error, match=r"triangles must be an \(m, 3\) integer array"):
+            amcodec.encode(points, wrong)
+
+
+def test_a_hierarchy_changed_by_one_thread_while_another_encodes_it():
+    # Hierarchy.encode released the GIL until 2026-12-07, so refine and coarsen on another thread
+    # changed the hierarchy under it ("invalid hierarchy", or a crash); now each encode sees one state.
+    h, _, _ = adaptive_leaf_mesh(5)
+    for _ in range(1500):
+        leaves = h.leaves()
+        h.refine(leaves[len(leaves) // 2])
+    errors = []
+
+    def encode_repeatedly():
+        try:
+            for _ in range(30):
+                back = amcodec.decode_hierarchy(h.encode())
+                assert back.check() == ""
+        except Exception as e:  # noqa: BLE001 - reported by the assertion below
+            errors.append(e)
+
+    def change_repeatedly():
+        rng = np.random.default_rng(6)
+        try:
+            for _ in range(6000):
+                leaves = h.leaves()
+                node = int(leaves[rng.integers(len(leaves))])
+                if rng.random() < 0.5:
+                    h.refine(node)
+                else:
+                    try:
+                        h.coarsen(max(0, node - 3))
+                    except amcodec.Error:  # not a node (any more)
+                        pass
+        except Exception as e:  # noqa: BLE001 - reported by the assertion below
+            errors.append(e)
+
+    threads = [threading.Thread(target=encode_repeatedly), threading.Thread(target=change_repeatedly)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert errors == []
+    assert h.check() == ""
+
+
+def test_planar_points_are_taken_at_z_zero():
+    _, points, triangles = adaptive_leaf_mesh(7)
+    flat = points.copy()
+    flat[:, 2] = 0
+    data = amcodec.encode(flat[:, :2], triangles, keep_numbering=True)
+    assert data == amcodec.encode(flat, triangles, keep_numbering=True)
+    assert np.array_equal(amcodec.decode(data)["points"], flat)
+    with pytest.raises(amcodec.Error, match=r"points must be an \(n, 3\) or \(n, 2\) array"):
+        amcodec.encode(points[:, :1], triangles)
+
+
+def test_the_forest_can_be_walked_and_ties_to_the_leaf_mesh():
+    h, _, _ = adaptive_leaf_mesh(9)
+    points, triangles = h.base
+    assert len(triangles) == h.root_count
+    alive = [n for n in range(h.node_capacity) if h.is_alive(n)]
+    assert len(alive) == h.node_count
+    for n in alive:
+        parent = h.parent(n)
+        assert (parent is None) == (n < h.root_count)
+        if parent is not None:
+            assert n in h.children(parent) and h.level(n) == h.level(parent) + 1
+        kids = h.children(n)
+        assert (kids == []) == h.is_leaf(n)
+        if kids:  # the center's corners are the parent's edge midpoints, each shared with a corner child
+            center = set(h.vertices(kids[3]))
+            for k in range(3):
+                assert len(center & set(h.vertices(kids[k]))) == 2
+                assert h.vertices(n)[k] in h.vertices(kids[k])
+        for e, q in enumerate(h.neighbors(n)):
+            if q is not None:  # the same edge, the other way round
+                a, b = h.vertices(n)[e], h.vertices(n)[(e + 1) % 3]
+                assert h.level(q) == h.level(n) and {a, b} <= set(h.vertices(q))
+    for level in (-1, 2):
+        mesh = h.leaf_mesh(level)
+        assert np.array_equal(mesh["points"], np.array([h.position(v) for v in mesh["vertex"]]))
+        for t, node, node_level, green in zip(mesh["triangles"], mesh["node"], mesh["level"], mesh["green"]):
+            assert h.is_leaf(node) or h.level(node) == level
+            assert h.level(node) == node_level
+            # A red leaf is its node's triangle; a green one keeps one or two of its corners.
+            corners = {int(mesh["vertex"][i]) for i in t}
+            assert len(corners & set(h.vertices(node))) == 3 if not green else 1 <= len(corners & set(h.vertices(node))) <= 2
+    v = h.vertices(h.leaves()[0])[0]
+    h.set_position(v, [0.5, 0.25, 2.0])
+    assert np.array_equal(h.position(v), [0.5, 0.25, 2.0])
+    back = amcodec.decode_hierarchy(h.encode())
+    assert np.array_equal(np.sort(back.leaf_mesh()["points"], axis=0), np.sort(h.leaf_mesh()["points"], axis=0))
+    for call in (h.parent, h.children, h.vertices, h.neighbors):
+        with pytest.raises(amcodec.Error, match="no node"):
+            call(h.node_capacity)
+    with pytest.raises(amcodec.Error, match="no vertex"):
+        h.position(10 ** 7)
+    with pytest.raises(amcodec.Error, match="three coordinates"):
+        h.set_position(v, [1.0, 2.0])
+
+
+def test_info_and_chunks_without_decoding_the_whole_file():
+    h, _, _ = adaptive_leaf_mesh(10)
+    whole = h.encode()
+    info = amcodec.info(whole)
+    assert (info["faces"], info["nodes"], info["chunks"]) == (len(h.leaf_mesh()["triangles"]), h.node_count, [])
+    assert sum(b["bytes"] for b in info["blocks"]) + 12 == len(whole)  # the 12-byte file header before them
+    data = h.encode(chunks=4)
+    chunks = amcodec.info(data)["chunks"]
+    assert len(chunks) == 4 and sum(c["roots"] for c in chunks) == h.root_count
+    back = amcodec.decode_hierarchy(data)
+    total_nodes = 0
+    for k, chunk in enumerate(chunks):
+        part, roots, base_vertices = amcodec.decode_chunks(data, [k])
+        assert list(roots) == list(range(chunk["first_root"], chunk["first_root"] + chunk["roots"]))
+        assert part.node_count == chunk["nodes"]
+        total_nodes += part.node_count
+        base_points, _ = back.base
+        assert np.array_equal(part.base[0], base_points[base_vertices])
+    assert total_nodes == back.node_count
+    with pytest.raises(amcodec.Error, match="chunk"):
+        amcodec.decode_chunks(data, [4])
+    with pytest.raises(amcodec.Error, match="magic"):
+        amcodec.info(b"not an amc file")

@@ -1,5 +1,7 @@
 """Series (.amcs) from Python: frames with fields written and read back exactly, random access with
 keyframes, meshes in their own numbering, error bounds, unfinished files, errors as exceptions."""
+import threading
+
 import numpy as np
 import pytest
 
@@ -114,3 +116,34 @@ def test_bad_series_raise_amcodec_error():
     data[len(data) // 2] ^= 0x10
     with pytest.raises(amcodec.Error, match="checksum"):
         amcodec.SeriesReader(bytes(data))
+
+
+def test_one_reader_from_many_threads():
+    # SeriesReader.frame released the GIL until 2026-12-07 while it changed the reader's state (the
+    # frame decoded last), so threads reading one reader crashed the interpreter.
+    seq = frames(count=12, seed=8)
+    points, triangles = series_base(seq)
+    writer = amcodec.SeriesWriter(points, triangles, keyframe_interval=4)
+    for h, time, point_data, cell_data in seq:
+        writer.add_frame(h, time, point_data, cell_data)
+    writer.close()
+    reader = amcodec.SeriesReader(writer.bytes())
+    errors = []
+
+    def read(seed):
+        rng = np.random.default_rng(seed)
+        try:
+            for _ in range(40):
+                k = int(rng.integers(len(seq)))
+                frame = reader.frame(k)
+                assert np.array_equal(frame["points"], seq[k][0].leaf_mesh()["points"])
+                assert np.array_equal(frame["point_data"]["u"], seq[k][2]["u"])
+        except Exception as e:  # noqa: BLE001 - reported by the assertion below
+            errors.append(e)
+
+    threads = [threading.Thread(target=read, args=(seed,)) for seed in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert errors == []
