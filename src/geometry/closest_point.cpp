@@ -786,9 +786,16 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 ori
     const double o[3] = {box_origin.x, box_origin.y, box_origin.z};
     auto enters = [&](const float* lo, const float* hi, double& near) {
         double t0 = -prune, t1 = prune;
+        double box_lo[3] = {lo[0], lo[1], lo[2]}, box_hi[3] = {hi[0], hi[1], hi[2]};
+        if (widening > 0) {
+            for (int axis = 0; axis < 3; ++axis) {
+                const double widen = widening * (box_hi[axis] - box_lo[axis]);
+                box_lo[axis] -= widen;
+                box_hi[axis] += widen;
+            }
+        }
         for (int axis = 0; axis < 3; ++axis) {
-            const double widen = widening > 0 ? widening * (double(hi[axis]) - lo[axis]) : 0.0;
-            double a = (lo[axis] - widen - o[axis]) * inverse[axis], b = (hi[axis] + widen - o[axis]) * inverse[axis];
+            double a = (box_lo[axis] - o[axis]) * inverse[axis], b = (box_hi[axis] - o[axis]) * inverse[axis];
             if (std::isnan(a) || std::isnan(b)) {  // parallel to the slab, on its plane: inside it
                 a = -std::numeric_limits<double>::infinity();
                 b = std::numeric_limits<double>::infinity();
