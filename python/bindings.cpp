@@ -152,16 +152,32 @@ py::dict stats_dict(const EncodeStats& s) {
     return d;
 }
 
-ImportedHierarchy import_arrays(const TriangleMesh& mesh, const py::object& base) {
+// `base_map` (or None): per base vertex, the index of its vertex in `mesh` (instead of matching
+// them by position), as import_leaf_mesh takes it.
+ImportedHierarchy import_arrays(const TriangleMesh& mesh, const py::object& base, const py::object& base_map) {
     if (base.is_none()) {
+        if (!base_map.is_none()) throw Error("base_map: given without a base");
         py::gil_scoped_release release;
         return import_mesh(mesh, "mesh");
     }
     const py::tuple pair = base.cast<py::tuple>();
     if (pair.size() != 2) throw Error("base: expected a (points, triangles) pair");
     const TriangleMesh base_mesh = mesh_from_arrays(pair[0].cast<py::array>(), pair[1].cast<py::array>(), "base mesh");
+    std::vector<uint32_t> map;
+    if (!base_map.is_none()) {
+        const py::array a = py::array::ensure(base_map);
+        const char kind = a ? a.dtype().kind() : 'O';
+        if (!a || a.ndim() != 1 || (kind != 'i' && kind != 'u')) throw Error("base_map: expected an (n,) integer array");
+        const auto values = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+        auto v = values.unchecked<1>();
+        for (py::ssize_t i = 0; i < values.shape(0); ++i) {
+            if (v(i) < 0 || v(i) > int64_t(UINT32_MAX))
+                throw Error("base_map: base vertex " + std::to_string(i) + " maps to " + std::to_string(v(i)) + ", not a vertex");
+            map.push_back(uint32_t(v(i)));
+        }
+    }
     py::gil_scoped_release release;
-    return import_leaf_mesh(base_mesh, mesh, {}, "mesh");
+    return import_leaf_mesh(base_mesh, mesh, map, "mesh");
 }
 
 // The library reads a node id unchecked: one from Python is looked up first.
@@ -370,9 +386,9 @@ PYBIND11_MODULE(_amcodec, m) {
              "Same base, forest, diagonals and bit-identical positions (canonical order).");
 
     m.def("encode", [](const py::array& points, const py::array& triangles, const py::object& base, bool keep_numbering,
-                       int quantize, bool return_stats, int effort) -> py::object {
+                       int quantize, bool return_stats, int effort, const py::object& base_map) -> py::object {
               const TriangleMesh mesh = mesh_from_arrays(points, triangles, "mesh");
-              ImportedHierarchy imported = import_arrays(mesh, base);
+              ImportedHierarchy imported = import_arrays(mesh, base, base_map);
               EncodeStats stats;
               std::vector<uint8_t> data;
               {
@@ -400,10 +416,12 @@ PYBIND11_MODULE(_amcodec, m) {
           },
           py::arg("points"), py::arg("triangles"), py::arg("base") = py::none(), py::arg("keep_numbering") = false,
           py::arg("quantize") = 0, py::arg("return_stats") = false, py::arg("effort") = kDefaultEffort,
+          py::arg("base_map") = py::none(),
           "Compresses a triangle mesh to .amc bytes. The mesh is imported over `base` (a (points, triangles) pair) or\n"
           "over the coarsest base found in it. keep_numbering stores the mesh's own vertex and face numbering, so\n"
           "that decode returns it; return_stats also returns a dict of sizes and the numbering map; effort (0 to 4)\n"
-          "as amc encode --effort.");
+          "as amc encode --effort; base_map: per base vertex the index of its vertex in the mesh (default: matched by\n"
+          "position).");
 
     m.def("decode", [](py::bytes data, int level, bool canonical, bool partial) {
               const std::string bytes = data;
@@ -506,12 +524,13 @@ PYBIND11_MODULE(_amcodec, m) {
           },
           py::arg("data"), "Decodes .amc bytes to a Hierarchy.");
 
-    m.def("import_mesh", [](const py::array& points, const py::array& triangles, const py::object& base) {
-              ImportedHierarchy imported = import_arrays(mesh_from_arrays(points, triangles, "mesh"), base);
+    m.def("import_mesh", [](const py::array& points, const py::array& triangles, const py::object& base, const py::object& base_map) {
+              ImportedHierarchy imported = import_arrays(mesh_from_arrays(points, triangles, "mesh"), base, base_map);
               return py::make_tuple(std::move(imported.hierarchy), vector_array(imported.vertex_of_input));
           },
-          py::arg("points"), py::arg("triangles"), py::arg("base") = py::none(),
-          "A mesh as a Hierarchy (over `base` or the coarsest base found) and, per input vertex, its hierarchy vertex id.");
+          py::arg("points"), py::arg("triangles"), py::arg("base") = py::none(), py::arg("base_map") = py::none(),
+          "A mesh as a Hierarchy (over `base` or the coarsest base found; base_map as for encode) and, per input\n"
+          "vertex, its hierarchy vertex id.");
 
     py::class_<PySeriesWriter>(m, "SeriesWriter",
                                "Writes a series (.amcs) frame by frame: in memory (bytes()) or appended to `path` as each\n"

@@ -107,6 +107,28 @@ cmp -s m.map m2.map || fail "the map stored in the file differs from the one enc
 expect 1 "$amc" decode r.amc -o r3.ply --map r3.map
 expect 2 "$amc" encode r.amh -o r4.amc --keep-numbering
 
+# A base whose vertices lie elsewhere than the leaf mesh's (written with other digits, moved) is
+# matched by --base-map (per base vertex its leaf vertex); by position it is refused.
+expect 0 "$amc" extract r.amh -o leaf.obj
+expect 0 "$amc" extract r.amh --level 0 -o base.obj
+awk 'NR == FNR { if ($1 == "v") index_of[$2 " " $3 " " $4] = n++; next } $1 == "v" { print index_of[$2 " " $3 " " $4] }' \
+  leaf.obj base.obj > base.map
+awk '$1 == "v" { printf "v %.9g %s %s\n", $2 + 0.001, $3, $4; next } { print }' base.obj > moved_base.obj
+expect 0 "$amc" import leaf.obj --base base.obj -o by_position.amh
+expect 1 "$amc" import leaf.obj --base moved_base.obj -o moved.amh
+[[ -e moved.amh ]] && fail "import of a base that does not fit wrote its output"
+expect 0 "$amc" import leaf.obj --base moved_base.obj --base-map base.map -o by_map.amh
+cmp -s by_position.amh by_map.amh || fail "import --base-map made another hierarchy than the base's exact positions"
+expect 0 "$amc" encode leaf.obj --base moved_base.obj --base-map base.map -o by_map.amc
+expect 0 "$amc" encode leaf.obj --base base.obj -o by_position.amc
+cmp -s by_position.amc by_map.amc || fail "encode --base-map wrote another file than the base's exact positions"
+expect 2 "$amc" import leaf.obj --base-map base.map -o x.amh
+head -2 base.map > short.map
+expect 1 "$amc" import leaf.obj --base moved_base.obj --base-map short.map -o x.amh
+grep -q 'short.map: 2 vertex indices for the' err.txt || fail "a short base map is not named: $(cat err.txt)"
+expect 1 "$amc" import leaf.obj --base moved_base.obj --base-map leaf.obj -o x.amh
+grep -q 'not a base vertex map' err.txt || fail "an OBJ as base map is not refused as such: $(cat err.txt)"
+
 # A file still arriving: --partial decodes the complete levels and says how far it got.
 size=$(stat -c %s r.amc)
 head -c $((size * 3 / 4)) r.amc > cut.amc

@@ -55,6 +55,17 @@ TEST_P(FuzzRegressions, EveryFoundInputPasses) {
     }
 }
 
+// The closest-point target's seeds (a fan, a far component, a translated lattice, fans at 2^-1000
+// and 2^1000): every answer of ClosestPointQuery equals the brute-force loop's, on every build.
+TEST(FuzzSeeds, ClosestPointSeedsMatchBruteForce) {
+    const std::vector<std::vector<uint8_t>> seeds = fuzz::closest_point_seeds();
+    EXPECT_GE(seeds.size(), 3u);
+    for (size_t i = 0; i < seeds.size(); ++i) {
+        SCOPED_TRACE("seed " + std::to_string(i));
+        fuzz::closest_point(seeds[i].data(), seeds[i].size());
+    }
+}
+
 // The nearest-vertex target's seeds (a lattice, copies of a point, a cluster beside an outlier,
 // tiny and huge scales, a graded box): every answer of NearestVertex as the target's oracles want.
 TEST(FuzzSeeds, NearestVertexSeedsPassTheOracles) {

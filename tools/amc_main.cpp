@@ -114,6 +114,8 @@ int main(int argc, char** argv) {
     encode_cmd->add_option("input", encode.input, "Mesh (OBJ, OFF, PLY, VTU), hierarchy (.amh), or - for stdin")->required();
     encode_cmd->add_option("-o,--output", encode.output, "Compressed file (default: the input with .amc; - for stdout)");
     encode_cmd->add_option("--base", encode.base, "Base mesh of a leaf-mesh input (default: the coarsest base found)");
+    encode_cmd->add_option("--base-map", encode.base_map,
+                           "With --base: the input's vertex of each base vertex (text, one index a base vertex; default: by position)");
     encode_cmd->add_flag("--keep-numbering", encode.keep_numbering,
                          "Store the input mesh's vertex and face numbering, so that decode restores it");
     encode_cmd->add_option("--map", encode.map, "Write the map from the input's numbering to the decoded mesh (text)");
@@ -183,6 +185,8 @@ int main(int argc, char** argv) {
     import_cmd->add_option("input", import.input, "Leaf mesh (OBJ, OFF, PLY, VTU), or - for stdin")->required();
     import_cmd->add_option("-o,--output", import.output, "Hierarchy file (default: the input with .amh)");
     import_cmd->add_option("--base", import.base, "Base mesh (default: the coarsest base found)");
+    import_cmd->add_option("--base-map", import.base_map,
+                           "With --base: the input's vertex of each base vertex (text, one index a base vertex; default: by position)");
     import_cmd->add_option("--map", import.map, "Write the map from the input's numbering to the hierarchy's leaf mesh");
     import_cmd->add_option("--threads", import.threads, "Threads of the base search without --base (it uses up to two; 0: every core)")
         ->check(CLI::Range(0u, 4096u));

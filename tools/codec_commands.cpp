@@ -130,6 +130,7 @@ void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     if (input.kind == FileKind::compressed) throw Error(input.name + ": already compressed .amc data");
     if (!command.base.empty() && input.kind != FileKind::mesh)
         throw UsageError("--base applies to a mesh input; " + input.name + " is " + file_kind_name(input.kind));
+    if (!command.base_map.empty() && command.base.empty()) throw UsageError("--base-map needs --base");
     if ((command.keep_numbering || !command.map.empty()) && input.kind != FileKind::mesh)
         throw UsageError("--keep-numbering and --map apply to a mesh input; " + input.name + " is " +
                          file_kind_name(input.kind) + ", which is numbered canonically already");
@@ -160,7 +161,7 @@ void run_encode(const EncodeCommand& command, const GlobalOptions& global) {
     } else {
         progress.phase("importing " + input.name);
         const bool with_numbering = command.keep_numbering || !command.map.empty();
-        ImportedMesh imported = import_input(input, command.base, command.threads, global, with_numbering);
+        ImportedMesh imported = import_input(input, command.base, command.base_map, command.threads, global, with_numbering);
         h = std::move(imported.hierarchy);
         if (with_numbering) {
             numbering = std::move(imported.numbering);

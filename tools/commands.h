@@ -25,6 +25,7 @@ struct GlobalOptions {
 struct EncodeCommand {
     std::string input, output;
     std::string base;             // a mesh input's base mesh; empty: detected
+    std::string base_map;         // with base: the leaf vertex of each base vertex (text); empty: by position
     bool keep_numbering = false;  // store the input mesh's own numbering in the file
     std::string map;              // write the numbering map (input -> decoded) here
     int quantize_bits = 0;
@@ -58,6 +59,7 @@ void run_decode(const DecodeCommand& command, const GlobalOptions& global);
 struct ImportCommand {
     std::string input, output;
     std::string base;
+    std::string base_map;  // as EncodeCommand's
     std::string map;
     unsigned threads = 0;  // 0: every core
 };

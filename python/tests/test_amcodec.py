@@ -314,3 +314,24 @@ def test_info_and_chunks_without_decoding_the_whole_file():
         amcodec.decode_chunks(data, [4])
     with pytest.raises(amcodec.Error, match="magic"):
         amcodec.info(b"not an amc file")
+
+
+def test_a_base_elsewhere_is_matched_by_its_map():
+    h, points, triangles = adaptive_leaf_mesh(11)
+    base_points, base_triangles = h.base
+    # Per base vertex its index among the shuffled points (the leaf mesh has them bit for bit).
+    where = {tuple(p): i for i, p in enumerate(points)}
+    base_map = np.array([where[tuple(p)] for p in base_points])
+    by_position = amcodec.encode(points, triangles, base=(base_points, base_triangles))
+    moved = base_points + 0.001
+    with pytest.raises(amcodec.Error, match="not a vertex of the leaf mesh"):
+        amcodec.encode(points, triangles, base=(moved, base_triangles))
+    assert amcodec.encode(points, triangles, base=(moved, base_triangles), base_map=base_map) == by_position
+    imported, vertex_of_input = amcodec.import_mesh(points, triangles, base=(moved, base_triangles), base_map=base_map)
+    assert np.array_equal(imported.base[0], base_points)  # the leaf mesh's positions, not the moved base's
+    for wrong, message in ((base_map[:-1], "entries for"), (np.append(base_map[:-1], base_map[0]), "both map to"),
+                           (-base_map - 1, "not a vertex"), (base_map.astype(float), r"\(n,\) integer array")):
+        with pytest.raises(amcodec.Error, match=message):
+            amcodec.encode(points, triangles, base=(moved, base_triangles), base_map=wrong)
+    with pytest.raises(amcodec.Error, match="without a base"):
+        amcodec.encode(points, triangles, base_map=base_map)

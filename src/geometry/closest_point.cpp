@@ -31,7 +31,11 @@ constexpr uint32_t kFanLeaf = kEmpty;
 // distance bound lowered by this share of the distance to the apex for the rounding of the bound.
 constexpr double kConeWidening = 1e-9;
 constexpr double kConeSlack = 1e-10;
+constexpr double kUnderflowSlack = 8 * std::numeric_limits<double>::denorm_min();
 constexpr double kRightAngle = 1.5707963267948966;
+// A direction this close to a cone's axis (radians) is taken to meet the cone: the side plane
+// facing it is found from its part across the axis, which below this is too much rounding.
+constexpr double kNearAxis = 1e-4;
 // A fan's tree halves its triangles at each level: at most 32 levels, one stack entry more each.
 constexpr int kConeStackSize = 34;
 
@@ -90,6 +94,21 @@ double store_box(Vec3 lo, Vec3 hi, Vec3 origin, float* lo_out, float* hi_out) {
         hi_out[axis] = float_above(component(relative_hi, axis) + widening);
     }
     return margin;
+}
+
+// Whether q lies in the box of triangle (a, b, c) widened by the rounding margin of its coordinates
+// and by `widening` times its extent on each axis: where a line's hit must be for the tree's boxes,
+// which hold that much around their triangles, to find it.
+bool in_triangle_box(Vec3 q, Vec3 a, Vec3 b, Vec3 c, double widening) {
+    const Vec3 lo = component_min(component_min(a, b), c), hi = component_max(component_max(a, b), c);
+    const double margin = rounding_margin(max_abs_component(lo, hi));
+    for (int axis = 0; axis < 3; ++axis) {
+        const double extent = component(hi, axis) - component(lo, axis);
+        const double w = margin + (widening > 0 ? widening * extent : 0.0);
+        const double x = component(q, axis);
+        if (!(x >= component(lo, axis) - w && x <= component(hi, axis) + w)) return false;
+    }
+    return true;
 }
 
 // Per axis, the median of the finite coordinates (0 where there are none): an origin near most of
@@ -534,14 +553,16 @@ ClosestPointQuery::Fan ClosestPointQuery::build_fan(const TriangleMesh& referenc
         const Vec3 axis = unit(sum);
         if (squared_length(axis) > 0) {
             // The widest direction by its (sine, cosine) from the axis (a before b where sin(a - b) > 0,
-            // both in [0, 180] degrees), then its angle by atan2, which (unlike acos) stays accurate
+            // both in [0, 180] degrees, or sin(a - b) = 0 and cos a < cos b: a direction opposite the
+            // axis against 0 degrees), then its angle by atan2, which (unlike acos) stays accurate
             // near 0; a choice off by rounding is within the widening.
             double widest_sine = 0, widest_cosine = 1;
             for (uint32_t i = item.begin; i < item.end; ++i) {
                 for (Vec3 to : directions[local[i]].to) {
                     if (!(squared_length(to) > 0)) continue;
                     const double sine = std::sqrt(squared_length(cross(to, axis))), cosine = dot(to, axis);
-                    if (sine * widest_cosine - cosine * widest_sine > 0) widest_sine = sine, widest_cosine = cosine;
+                    const double turn = sine * widest_cosine - cosine * widest_sine;
+                    if (turn > 0 || (turn == 0 && cosine < widest_cosine)) widest_sine = sine, widest_cosine = cosine;
                 }
             }
             const double half_angle = std::atan2(widest_sine, widest_cosine) + kConeWidening;
@@ -591,7 +612,9 @@ double ClosestPointQuery::cone_node_distance_squared(const ConeNode& node, Vec3 
     double gap = along * node.cosine + across * node.sine <= 0 ? w_length : across * node.cosine - along * node.sine;
     // The rounding of the bound, and of the computed closest points (margin an axis: < 2 margin in all).
     gap -= kConeSlack * w_length + 2 * margin;
-    return gap > 0 ? std::max(box, gap * gap) : box;
+    // Below DBL_MIN a triangle's squared distance (three squares, each rounded to a multiple of the
+    // least subnormal) may round under this one square: lowered by a few of those units.
+    return gap > 0 ? std::max(box, gap * gap - kUnderflowSlack) : box;
 }
 
 // False when a plane through the apex has the node's cone on one side and the segment from
@@ -613,7 +636,8 @@ bool ClosestPointQuery::cone_may_meet_segment(const ConeNode& node, Vec3 w0, Vec
     }
     const Vec3 radial = nearest - dot(nearest, u) * u;
     const double radial_length = std::sqrt(squared_length(radial));
-    if (!(radial_length > 0)) return true;
+    // Near the axis the radial part is rounding noise, whose direction (maybe along u) says nothing.
+    if (!(radial_length > kNearAxis * std::sqrt(squared_length(nearest)))) return true;
     const Vec3 side = (node.cosine / radial_length) * radial - node.sine * u;  // unit, at 90 degrees + a from u
     return !(dot(w0, side) > slack && dot(w1, side) > slack);
 }
@@ -747,16 +771,31 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 ori
     if (!(direction_length > 0) || !(reach >= 0)) return std::nullopt;
     const Vec3 d = (1 / direction_length) * direction;
     double best = reach;  // |t| of the best hit so far, in units of length
+    // A box is pruned beyond this: its slab bounds and a hit's t carry rounding relative to |t|
+    // (from an origin far away, more than the box's own margin covers), as search's distances do.
+    double prune = best * (1 + kPruneSlack);
     uint32_t best_record = kEmpty, best_triangle = kEmpty;
     Vec3 best_barycentric;
-    // Slab test of the segment origin + t d, |t| <= best, against a box; returns its |t| lower bound.
+    // Slab test of the segment origin + t d, |t| <= prune, against a box; returns its |t| lower bound.
+    // A triangle widened by `tolerance` reaches 2 tolerance times its extent beyond its box on each
+    // axis (each widened corner moves by tolerance times its two edges), so a box is widened by that
+    // much of its own extent, which holds its triangles'.
+    const double widening = 2 * tolerance;
     const double inverse[3] = {1 / d.x, 1 / d.y, 1 / d.z};
     const Vec3 box_origin = origin - box_origin_;
     const double o[3] = {box_origin.x, box_origin.y, box_origin.z};
     auto enters = [&](const float* lo, const float* hi, double& near) {
-        double t0 = -best, t1 = best;
+        double t0 = -prune, t1 = prune;
+        double box_lo[3] = {lo[0], lo[1], lo[2]}, box_hi[3] = {hi[0], hi[1], hi[2]};
+        if (widening > 0) {
+            for (int axis = 0; axis < 3; ++axis) {
+                const double widen = widening * (box_hi[axis] - box_lo[axis]);
+                box_lo[axis] -= widen;
+                box_hi[axis] += widen;
+            }
+        }
         for (int axis = 0; axis < 3; ++axis) {
-            double a = (lo[axis] - o[axis]) * inverse[axis], b = (hi[axis] - o[axis]) * inverse[axis];
+            double a = (box_lo[axis] - o[axis]) * inverse[axis], b = (box_hi[axis] - o[axis]) * inverse[axis];
             if (std::isnan(a) || std::isnan(b)) {  // parallel to the slab, on its plane: inside it
                 a = -std::numeric_limits<double>::infinity();
                 b = std::numeric_limits<double>::infinity();
@@ -767,7 +806,7 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 ori
         }
         if (t0 > t1) return false;
         near = t0 <= 0 && t1 >= 0 ? 0 : std::min(std::fabs(t0), std::fabs(t1));
-        return near <= best;
+        return near <= prune;
     };
     struct Entry {
         uint32_t index, count;
@@ -794,8 +833,15 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 ori
             if (v < -tolerance || u + v > 1 + tolerance) continue;
             const double t = dot(e2, qv) * inv;
             const double at = std::fabs(t);
-            if (at < best || (at == best && best_record != kEmpty && triangles_[r] < best_triangle)) {
+            // A hit at exactly `reach` counts (the header's |t| <= reach), as a tie with a lower index
+            // does; an infinite |t| (overflow) does not.
+            // A line (nearly) in the triangle's plane can round to a hit anywhere in that plane: it
+            // counts only inside the triangle's box (the header).
+            if ((at < best || (at == best && at < std::numeric_limits<double>::infinity() &&
+                               (best_record == kEmpty || triangles_[r] < best_triangle))) &&
+                in_triangle_box(origin + t * d, record.a, record.b, record.c, widening)) {
                 best = at;
+                prune = best * (1 + kPruneSlack);
                 best_record = r;
                 best_triangle = triangles_[r];
                 best_barycentric = {1 - u - v, u, v};
@@ -820,7 +866,7 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 ori
         stack[size++] = {fan.root, 0.0};
         while (size > 0) {
             const ConeEntry entry = stack[--size];
-            if (entry.near > best) continue;
+            if (entry.near > prune) continue;
             const ConeNode& node = cone_nodes_[entry.node];
             if (node.count > 0) {
                 test_records(node.index, node.index + node.count);
@@ -840,7 +886,7 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::intersect_line(Vec3 ori
     };
     while (size > 0) {
         const Entry entry = stack[--size];
-        if (entry.near > best) continue;
+        if (entry.near > prune) continue;
         if (entry.count == kFanLeaf) {
             search_fan(fans_[entry.index]);
             continue;

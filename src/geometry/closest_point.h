@@ -65,11 +65,14 @@ public:
 
     // The intersection of the line {origin + t * direction} with the triangles facing
     // `direction` (as closest_facing with min_cosine 0: dot(n, direction) > 0) of least |t|,
-    // among |t| * |direction| <= reach; nullopt if there is none. Ties go to the lower triangle
-    // index. Hit::distance_squared is the squared distance from origin to the hit point.
-    // `tolerance` widens every triangle by that much of its barycentric range, so that a line
-    // through a vertex or along an edge is not lost to rounding (the importer's normal ray aims
-    // at vertices; the remesher keeps 0).
+    // among |t| * |direction| <= reach (t finite: one that overflows is no hit); nullopt if there
+    // is none. Ties go to the lower triangle index. Hit::distance_squared is the squared distance
+    // from origin to the hit point. `tolerance` widens every triangle by that much of its
+    // barycentric range, so that a line through a vertex or along an edge is not lost to rounding
+    // (the importer's normal ray aims at vertices; the remesher keeps 0). A hit counts only where
+    // origin + t * unit direction lies in the triangle's bounding box widened by 16 ulps of its
+    // largest coordinate and by 2 * tolerance of its extent: a line (nearly) in a triangle's plane
+    // may round to an intersection anywhere in that plane, which is no hit.
     std::optional<Hit> intersect_line(Vec3 origin, Vec3 direction, double reach, double tolerance = 0) const;
 
     // A vertex with at least this many triangles has its fan searched by direction cones.

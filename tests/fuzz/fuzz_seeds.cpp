@@ -330,6 +330,7 @@ int main(int argc, char** argv) {
     series_seeds();
     forest_series_seeds();
     octree_seeds();
+    for (const std::vector<uint8_t>& seed : fuzz::closest_point_seeds()) write_seed("closest_point", seed);
     for (const std::vector<uint8_t>& seed : fuzz::nearest_vertex_seeds()) write_seed("nearest_vertex", seed);
     for (const char* target : {"amc_decode", "amc_inspect"}) {
         copy_files(data / "golden", target, ".amc");

@@ -25,6 +25,7 @@ const std::vector<Target>& targets() {
         {"forest_series_read", forest_series_read},
         {"octree_decode", octree_decode},
         {"leaf_import", leaf_import},
+        {"closest_point", closest_point},
         {"nearest_vertex", nearest_vertex},
     };
     return all;

@@ -39,6 +39,7 @@ void series_read(const uint8_t* data, size_t size);        // .amcs reader, ever
 void forest_series_read(const uint8_t* data, size_t size); // .amcs forest series reader, every frame, written again
 void octree_decode(const uint8_t* data, size_t size);      // .amq decode: whole, progressive, encoded again
 void leaf_import(const uint8_t* data, size_t size);        // leaf mesh (damaged or not) -> hierarchy, with the base or alone
+void closest_point(const uint8_t* data, size_t size);      // ClosestPointQuery against a brute-force loop
 void nearest_vertex(const uint8_t* data, size_t size);     // NearestVertex against a brute-force scan and the k-d tree
 
 // Input layouts of the stream targets, which fuzz_seeds writes too.
@@ -47,6 +48,9 @@ void nearest_vertex(const uint8_t* data, size_t size);     // NearestVertex agai
 //             u8 n (1 + n % 16 predictions), n u64 predictions (the IEEE bits of a double, or a
 //             grid coordinate in the low 32 bits), the payload.
 const std::vector<TriangleMesh>& stream_bases();
+//   closest_point: a mesh and its queries (closest_point_fuzzer.cpp); its seeds, which fuzz_seeds
+//             writes and amc_tests runs: a fan, a far component, a translated lattice and more.
+std::vector<std::vector<uint8_t>> closest_point_seeds();
 //   nearest_vertex: a point set and its queries (nearest_vertex_fuzzer.cpp); its seeds, which
 //             fuzz_seeds writes and amc_tests runs: a lattice, many copies of a point, a cluster
 //             beside an outlier, tiny and huge scales, a graded box, one point.
