@@ -180,6 +180,41 @@ ImportedHierarchy import_arrays(const TriangleMesh& mesh, const py::object& base
     return import_leaf_mesh(base_mesh, mesh, map, "mesh");
 }
 
+// amcodec.info: what inspect() reads of a file, as amc info prints it.
+py::dict info_dict(const FileInfo& info) {
+    py::dict d;
+    d["version"] = info.version;
+    d["single_precision"] = info.single_precision;
+    d["quantize_bits"] = info.quantize_bits;
+    d["base_vertices"] = info.base_vertices;
+    d["base_triangles"] = info.base_triangles;
+    d["nodes"] = info.nodes;
+    d["vertices"] = info.vertices;
+    d["faces"] = info.faces;
+    d["levels"] = info.levels;
+    py::list blocks, chunks;
+    for (const FileBlock& b : info.blocks) {
+        py::dict block;
+        block["name"] = b.name;
+        block["offset"] = b.offset;
+        block["bytes"] = b.size;
+        block["level"] = b.level >= 0 ? py::object(py::int_(b.level)) : py::object(py::none());
+        blocks.append(block);
+    }
+    for (const ChunkInfo& c : info.chunks) {
+        py::dict chunk;
+        chunk["first_root"] = c.first_root;
+        chunk["roots"] = c.roots;
+        chunk["nodes"] = c.nodes;
+        chunk["offset"] = c.offset;
+        chunk["bytes"] = c.size;
+        chunks.append(chunk);
+    }
+    d["blocks"] = blocks;
+    d["chunks"] = chunks;
+    return d;
+}
+
 // The library reads a node id unchecked: one from Python is looked up first.
 NodeId existing_node(const Hierarchy& h, NodeId n, const char* what) {
     if (!h.is_alive(n)) throw Error(std::string(what) + ": no node " + std::to_string(n));
@@ -466,38 +501,7 @@ PYBIND11_MODULE(_amcodec, m) {
 
     m.def("info", [](py::bytes data) {
               const std::string bytes = data;
-              const FileInfo info = inspect(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());
-              py::dict d;
-              d["version"] = info.version;
-              d["single_precision"] = info.single_precision;
-              d["quantize_bits"] = info.quantize_bits;
-              d["base_vertices"] = info.base_vertices;
-              d["base_triangles"] = info.base_triangles;
-              d["nodes"] = info.nodes;
-              d["vertices"] = info.vertices;
-              d["faces"] = info.faces;
-              d["levels"] = info.levels;
-              py::list blocks, chunks;
-              for (const FileBlock& b : info.blocks) {
-                  py::dict block;
-                  block["name"] = b.name;
-                  block["offset"] = b.offset;
-                  block["bytes"] = b.size;
-                  block["level"] = b.level >= 0 ? py::object(py::int_(b.level)) : py::object(py::none());
-                  blocks.append(block);
-              }
-              for (const ChunkInfo& c : info.chunks) {
-                  py::dict chunk;
-                  chunk["first_root"] = c.first_root;
-                  chunk["roots"] = c.roots;
-                  chunk["nodes"] = c.nodes;
-                  chunk["offset"] = c.offset;
-                  chunk["bytes"] = c.size;
-                  chunks.append(chunk);
-              }
-              d["blocks"] = blocks;
-              d["chunks"] = chunks;
-              return d;
+              return info_dict(inspect(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()));
           },
           py::arg("data"),
           "What an .amc file holds, without decoding it (as amc info): version, precision, counts, levels, its\n"
