@@ -53,7 +53,8 @@ const std::vector<TriangleMesh>& stream_bases();
 std::vector<std::vector<uint8_t>> closest_point_seeds();
 //   nearest_vertex: a point set and its queries (nearest_vertex_fuzzer.cpp); its seeds, which
 //             fuzz_seeds writes and amc_tests runs: a lattice, many copies of a point, a cluster
-//             beside an outlier, tiny and huge scales, a graded box, one point.
+//             beside an outlier, tiny and huge scales, a graded box, ties across
+//             the side of a query's cell, one point.
 std::vector<std::vector<uint8_t>> nearest_vertex_seeds();
 //   base_connectivity: u16 vertex count (little endian), the stream; decoder vertex v is at
 //             base_position(v).

@@ -447,14 +447,14 @@ struct SeedWriter {
         u8(5), u16(m - 1), u8(radius - 1), u16(uint32_t(e)), u8(graded), u32(seed);
     }
     // `queries` of every kind in turn, counts 0 .. kMaxCount + 1, every kind of limit and of mask;
-    // nudges off a point of up to 127 2^(nudge - k), k < 8. Single: nudges only, of count 1 (whose
-    // search starts in the query's cell).
+    // nudges off a point of up to 127 2^(nudge - k), k < 8. Single: midpoints and nudges only, of
+    // count 1 (whose search starts in the query's cell).
     void queries(uint32_t queries, uint32_t points, uint32_t seed, int nudge = 0, bool single = false) {
         u8(queries - 1);
         Random random{seed};
         auto point = [&] { u16(uint32_t(random.next() % points)); };
         for (uint32_t i = 0; i < queries; ++i) {
-            const uint32_t kind = single ? 2 : i % 6;
+            const uint32_t kind = single ? 1 + i % 2 : i % 6;
             u8(kind);
             switch (kind) {
                 case 0: point(); break;
@@ -526,6 +526,28 @@ std::vector<std::vector<uint8_t>> nearest_vertex_seeds() {
         s.lattice(5, 0, 0, 8, 8, 8);
         for (uint32_t k = 0; k < 11; ++k) s.cluster(2 + k * 47, -20, 64, 20 + k);
         s.u32(14), s.queries(32, 1218, 9, -22, true);
+        seeds.push_back(s.bytes);
+    }
+    {  // unit cells again, and pairs of vertices equally near a query of count 1, one in its 32^3
+       // cell and one just across its side, both nearer than 1.1 times the gap to that side: the
+       // cell's answer must not stand (a tie is the k-d tree's)
+        SeedWriter s;
+        s.u8(0), s.u8(3), s.u8(0), s.u8(1), s.real(0), s.real(0), s.real(0), s.real(1024), s.real(1024), s.real(1024);
+        for (int group = 0; group < 3; ++group) {
+            s.u8(0), s.u8(7);
+            for (int pair = 0; pair < 4; ++pair) {
+                const double side = 32.0 * (1 + 4 * group + pair), across = 16.0 + 32 * (group + pair);
+                s.real(side - 0.125), s.real(across), s.real(across);  // 4.125 below the query, outside
+                s.real(side + 8.125), s.real(across), s.real(across);  // 4.125 above it, inside
+            }
+        }
+        s.u32(15), s.u8(11);
+        for (int group = 0; group < 3; ++group) {
+            for (int pair = 0; pair < 4; ++pair) {
+                const double side = 32.0 * (1 + 4 * group + pair), across = 16.0 + 32 * (group + pair);
+                s.u8(3), s.real(side + 4), s.real(across), s.real(across), s.u8(1), s.u8(0), s.u16(0), s.u8(0), s.u8(0);
+            }
+        }
         seeds.push_back(s.bytes);
     }
     {  // one point
