@@ -55,27 +55,22 @@ TEST_P(FuzzRegressions, EveryFoundInputPasses) {
     }
 }
 
-// The closest-point target's seeds (a fan, a far component, a translated lattice, fans at 2^-1000
-// and 2^1000): every answer of ClosestPointQuery equals the brute-force loop's, on every build.
-TEST(FuzzSeeds, ClosestPointSeedsMatchBruteForce) {
-    const std::vector<std::vector<uint8_t>> seeds = fuzz::closest_point_seeds();
+// Every seed of a target passes it (its properties and oracles), on every build.
+void replay_seeds(const std::vector<std::vector<uint8_t>>& seeds, void (*target)(const uint8_t*, size_t)) {
     EXPECT_GE(seeds.size(), 3u);
     for (size_t i = 0; i < seeds.size(); ++i) {
         SCOPED_TRACE("seed " + std::to_string(i));
-        fuzz::closest_point(seeds[i].data(), seeds[i].size());
+        target(seeds[i].data(), seeds[i].size());
     }
 }
 
+// The closest-point target's seeds (a fan, a far component, a translated lattice, fans at 2^-1000
+// and 2^1000): every answer of ClosestPointQuery equals the brute-force loop's.
+TEST(FuzzSeeds, ClosestPointSeedsMatchBruteForce) { replay_seeds(fuzz::closest_point_seeds(), fuzz::closest_point); }
+
 // The nearest-vertex target's seeds (a lattice, copies of a point, a cluster beside an outlier,
 // tiny and huge scales, a graded box): every answer of NearestVertex as the target's oracles want.
-TEST(FuzzSeeds, NearestVertexSeedsPassTheOracles) {
-    const std::vector<std::vector<uint8_t>> seeds = fuzz::nearest_vertex_seeds();
-    EXPECT_GE(seeds.size(), 3u);
-    for (size_t i = 0; i < seeds.size(); ++i) {
-        SCOPED_TRACE("seed " + std::to_string(i));
-        fuzz::nearest_vertex(seeds[i].data(), seeds[i].size());
-    }
-}
+TEST(FuzzSeeds, NearestVertexSeedsPassTheOracles) { replay_seeds(fuzz::nearest_vertex_seeds(), fuzz::nearest_vertex); }
 
 INSTANTIATE_TEST_SUITE_P(All, FuzzRegressions, ::testing::ValuesIn(fuzz::targets()),
                          [](const ::testing::TestParamInfo<fuzz::Target>& info) { return std::string(info.param.name); });

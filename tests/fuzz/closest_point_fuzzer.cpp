@@ -442,8 +442,8 @@ void run_query(const Case& c, const ClosestPointQuery& query, ByteReader& in) {
             const std::optional<ClosestPointQuery::Hit> got = query.closest_facing(p, direction, cosine, bound);
             if (!same_hit(expected, got))
                 mismatch(c,
-                         describe("closest_facing", p) + describe("direction", direction.x) + describe("", direction.y) +
-                             describe("", direction.z) + describe("min_cosine", cosine) + describe("max_distance", bound),
+                         describe("closest_facing", p) + describe(" direction", direction) + describe("min_cosine", cosine) +
+                             describe("max_distance", bound),
                          expected, got);
             return;
         }
@@ -458,8 +458,8 @@ void run_query(const Case& c, const ClosestPointQuery& query, ByteReader& in) {
             if (expected && grazes(c, expected->triangle, direction)) return;  // open: see kGrazing
             if (!same_hit(expected, got))
                 mismatch(c,
-                         describe("intersect_line", p) + describe("direction", direction.x) + describe("", direction.y) +
-                             describe("", direction.z) + describe("reach", reach) + describe("tolerance", tolerance),
+                         describe("intersect_line", p) + describe(" direction", direction) + describe("reach", reach) +
+                             describe("tolerance", tolerance),
                          expected, got);
             return;
         }
