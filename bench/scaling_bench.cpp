@@ -5,6 +5,9 @@
 //   scaling_bench make LEAVES OUT.amh                          a model of any size in linear time:
 //                                                              random leaves of a torus refined,
 //                                                              new vertices on a bumpy torus
+//   scaling_bench make-mesh FACES OUT.ply                      a plain irregular mesh of about
+//                                                              FACES triangles (make_irregular_torus,
+//                                                              seed 1), for `amc encode` as users run it
 //   scaling_bench encode BITS RUNS THREADS model.amh OUT.amc   encodes (default options, BITS 0:
 //                                                              lossless) and writes OUT.amc
 //   scaling_bench decode RUNS THREADS FILE.amc                 decodes the file
@@ -21,6 +24,7 @@
 #include <amc/codec.h>
 #include <amc/hierarchy.h>
 #include <amc/refinement.h>
+#include <amc/mesh_io.h>
 
 #include <algorithm>
 #include <cmath>
@@ -108,6 +112,13 @@ int main(int argc, char** argv) {
         amc::write_hierarchy(argv[3], h);
         return 0;
     }
+    if (mode == "make-mesh" && argc == 4) {
+        const double cells = std::max(9.0, std::strtod(argv[2], nullptr) / 2);
+        const int rings = std::max(3, int(std::lround(std::sqrt(cells))));
+        const int segments = std::max(3, int(std::lround(cells / rings)));
+        amc::write_mesh(argv[3], amc::make_irregular_torus(rings, segments, 1));
+        return 0;
+    }
     if (mode == "encode" && argc == 7) {
         const amc::Hierarchy h = amc::read_hierarchy(argv[5]);
         amc::EncodeOptions options;
@@ -140,6 +151,6 @@ int main(int argc, char** argv) {
         print("decode", h.node_count(), info.faces, file.size(), t);
         return 0;
     }
-    std::fprintf(stderr, "usage: scaling_bench make LEAVES OUT.amh | encode BITS RUNS THREADS model.amh OUT.amc | decode RUNS THREADS FILE.amc\n");
+    std::fprintf(stderr, "usage: scaling_bench make LEAVES OUT.amh | make-mesh FACES OUT.ply | encode BITS RUNS THREADS model.amh OUT.amc | decode RUNS THREADS FILE.amc\n");
     return 2;
 }

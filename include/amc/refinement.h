@@ -15,6 +15,10 @@ namespace amc {
 // ---- procedural base meshes ------------------------------------------------------------------
 TriangleMesh make_icosahedron();                  // 12 vertices, 20 triangles, closed, genus 0
 TriangleMesh make_torus(int rings, int segments, double major_radius, double minor_radius);  // genus 1
+// An irregular mesh of any size: the torus above (radii 3 and 1) with every vertex jittered by up
+// to 0.3 of a cell and every cell cut along a random diagonal (valences 3 to 9), coordinates
+// rounded to float32; 2 * rings * segments triangles, deterministic per seed.
+TriangleMesh make_irregular_torus(int rings, int segments, uint32_t seed);
 TriangleMesh make_square(int cells);             // [0,1]^2 in z=0, 2*cells^2 triangles, boundary
 // L-shaped domain [-1,1]^2 without (0,1]x[-1,0): re-entrant corner at the origin.
 TriangleMesh make_l_shape(int cells_per_unit);

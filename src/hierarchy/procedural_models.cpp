@@ -1,8 +1,11 @@
 // Procedural base meshes: no input files needed for the embedded default and the tests.
 #include <amc/refinement.h>
 
+#include "common/check.h"
+
 #include <cmath>
 #include <map>
+#include <random>
 #include <utility>
 
 namespace amc {
@@ -78,6 +81,37 @@ TriangleMesh make_torus(int rings, int segments, double major_radius, double min
             mesh.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
         }
     }
+    return mesh;
+}
+
+TriangleMesh make_irregular_torus(int rings, int segments, uint32_t seed) {
+    AMC_REQUIRE(rings >= 3 && segments >= 3, invalid_input, "irregular torus: at least 3 rings and 3 segments");
+    std::mt19937 rng(seed);  // its raw bits only: the same mesh from every standard library
+    auto jitter = [&] { return (double(rng() >> 8) * 0x1p-24 - 0.5) * 0.6; };
+    TriangleMesh mesh;
+    mesh.positions.reserve(size_t(rings) * segments);
+    for (int i = 0; i < rings; ++i) {
+        for (int j = 0; j < segments; ++j) {
+            const double u = (i + jitter()) * 2 * kPi / rings, v = (j + jitter()) * 2 * kPi / segments;
+            const double r = 3.0 + std::cos(v);
+            mesh.positions.push_back({r * std::cos(u), r * std::sin(u), std::sin(v)});
+        }
+    }
+    auto id = [&](int i, int j) { return uint32_t((i % rings) * segments + (j % segments)); };
+    mesh.triangles.reserve(2 * size_t(rings) * segments);
+    for (int i = 0; i < rings; ++i) {
+        for (int j = 0; j < segments; ++j) {
+            const uint32_t a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1), d = id(i, j + 1);
+            if (rng() & 1) {
+                mesh.triangles.push_back({a, b, c});
+                mesh.triangles.push_back({a, c, d});
+            } else {
+                mesh.triangles.push_back({a, b, d});
+                mesh.triangles.push_back({b, c, d});
+            }
+        }
+    }
+    make_single_precision(mesh);
     return mesh;
 }
 

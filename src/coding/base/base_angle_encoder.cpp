@@ -21,6 +21,9 @@ using angle_mode::Models;
 
 namespace {
 
+// The decoder's walk (FORMAT.md 4.14) would pass its budget: another gate radius may not.
+struct WalkOverBudget : EncoderGaveUp {};
+
 class Encoder {
 public:
     Encoder(const TriangleMesh& mesh, const ClosedMesh& cm, uint32_t gate_radius, uint32_t first, uint32_t rotation)
@@ -138,7 +141,7 @@ private:
     }
     void charge_walk(uint64_t nodes) {
         walked_ += nodes;
-        if (walked_ > angle_mode::walk_budget(cm_.triangles.size())) throw EncoderGaveUp{};
+        if (walked_ > angle_mode::walk_budget(cm_.triangles.size())) throw WalkOverBudget{};
     }
 
     // The final index of decoder vertex id, or -1 (none, or a dummy).
@@ -332,10 +335,9 @@ private:
             return;
         }
         // S if the tip is on the current loop, M otherwise.
-        uint32_t k = 0;
-        for (uint32_t x = nv; k < loop.length && x != n; x = b.next(x)) ++k;
-        charge_walk(k);
-        const bool split = k < loop.length;
+        const TipPlace place = locate_tip(n, g, loop.length);
+        const bool split = place.split;
+        const uint32_t k = place.k;
         if (split && (k < 2 || k + 3 > loop.length)) throw EncoderGaveUp{};
         if ((split && !can_split) || (!split && !can_merge)) throw EncoderGaveUp{};
         if (can_split && can_merge) put_bit(split, [](int, Models& m) -> BitModel& { return m.split; });
@@ -346,7 +348,8 @@ private:
             nw = b.op_split(n, k);
             note_loop_below(b.stack[b.stack.size() - 2].gate);
         } else {
-            const auto [index, offset] = merge_tip(n);
+            const size_t index = place.index;
+            const uint32_t offset = place.offset;
             ++merges_seen_;
             const uint32_t length = b.stack[index].length;
             put_index_all(static_cast<uint32_t>(b.stack.size() - 2 - index), static_cast<uint32_t>(b.stack.size() - 1));
@@ -385,32 +388,48 @@ private:
     }
     bool marks_gate(uint32_t node) const { return node < gate_serial_.size() && gate_serial_[node] != 0; }
 
-    // M's tip n: the stack loop below the top that holds it and its offset from that loop's gate,
-    // found by going round n both ways to the first gate: min(offset, length - offset) steps, the
-    // walk the decoder is charged for. A pass over the loops below, node by node, was quadratic
-    // in a base of many handles.
-    std::pair<size_t, uint32_t> merge_tip(uint32_t n) const {
+    // Where tip n lies: on the top loop, k steps after the gate's next node (S), or on the loop
+    // below the top at stack index `index`, `offset` steps after that loop's gate (M). Found by
+    // going round n both ways to the first gate, the top's or a marked one: no further than the
+    // decoder walks for the same operation (FORMAT.md 4.14) plus two nodes, so its budget bounds
+    // this search too and is charged only what the decoder charges.
+    struct TipPlace {
+        bool split = false;
+        uint32_t k = 0;
+        size_t index = 0;
+        uint32_t offset = 0;
+    };
+    TipPlace locate_tip(uint32_t n, uint32_t top_gate, uint32_t top_length) const {
         const Border& b = border_;
         uint32_t back = n, ahead = n, gate = kNoVertex;
         size_t steps = 0;
         bool behind = true;  // the gate found going back from n (n is `steps` after it)
         for (; steps < out_he_.size(); ++steps, back = b.prev(back), ahead = b.next(ahead)) {
-            if (marks_gate(back)) {
+            if (back == top_gate || marks_gate(back)) {
                 gate = back;
                 break;
             }
-            if (marks_gate(ahead)) {
+            if (ahead == top_gate || marks_gate(ahead)) {
                 gate = ahead;
                 behind = false;
                 break;
             }
         }
         if (gate == kNoVertex) throw EncoderGaveUp{};
+        TipPlace place;
+        if (gate == top_gate) {
+            if (steps == 0 || steps >= top_length) throw EncoderGaveUp{};
+            place.split = true;
+            place.k = static_cast<uint32_t>(behind ? steps - 1 : top_length - steps - 1);
+            return place;
+        }
         // Stack order is serial order: the loops below the top up to this one's serial end at its index.
         const size_t index = loops_below_through(gate_serial_[gate] - 1) - 1;
         if (index + 1 >= b.stack.size() || b.stack[index].gate != gate || steps >= b.stack[index].length) throw EncoderGaveUp{};
         const uint32_t length = b.stack[index].length;
-        return {index, behind ? uint32_t(steps) : uint32_t((length - steps) % length)};
+        place.index = index;
+        place.offset = behind ? uint32_t(steps) : uint32_t((length - steps) % length);
+        return place;
     }
 
     // The decoder's rule (base_angle_decoder.cpp, split_tip): the nearest-tip bit when there is a
@@ -453,6 +472,7 @@ private:
 // The first candidate is what version 4's encoder wrote.
 constexpr uint32_t kSearchStarts = 16;                // start triangles spread over the input order
 constexpr uint32_t kSearchRadii[] = {5, 3, 4, 6, 7};  // 5 first: the best single radius
+constexpr uint32_t kRetryRadii[] = {7, 6, 4, 3};       // after every candidate walked over the budget
 
 using Start = BaseStart;
 
@@ -497,6 +517,7 @@ std::vector<uint8_t> encode_angle_candidates(const TriangleMesh& mesh, const Clo
         BaseMeshCode code;
         size_t index = SIZE_MAX;
     } best;
+    bool over_budget = false;
     std::mutex best_mutex;
     parallel_for(candidates.size(), threads, [&](size_t c) {
         const Start& start = candidates[c];
@@ -505,8 +526,12 @@ std::vector<uint8_t> encode_angle_candidates(const TriangleMesh& mesh, const Clo
         try {
             Encoder e(mesh, cm, start.radius, start.first, start.rotation);
             streams = e.run(tried);
+        } catch (const WalkOverBudget&) {
+            const std::lock_guard<std::mutex> lock(best_mutex);
+            over_budget = true;
+            return;
         } catch (const EncoderGaveUp&) {
-            return;  // this start does not fit (a walk over the budget, say): the others may
+            return;  // this start does not fit: the others may
         }
         const std::lock_guard<std::mutex> lock(best_mutex);
         bool won = false;
@@ -521,7 +546,10 @@ std::vector<uint8_t> encode_angle_candidates(const TriangleMesh& mesh, const Clo
         }
         if (won) best.code = std::move(tried);  // the same orders in every set
     });
-    if (best.index == SIZE_MAX) throw EncoderGaveUp{};
+    if (best.index == SIZE_MAX) {
+        if (over_budget) throw WalkOverBudget{};
+        throw EncoderGaveUp{};
+    }
     code.vertex_order = std::move(best.code.vertex_order);
     code.triangle_order = std::move(best.code.triangle_order);
     code.triangle_rotation = std::move(best.code.triangle_rotation);
@@ -536,7 +564,24 @@ std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& c
     const ClosedMesh cm = make_closed(mesh);
     std::vector<Start> candidates = search_candidates(cm.real_triangles, cm.triangles.size(), search_budget);
     if (!search) candidates.resize(1);
-    return encode_angle_candidates(mesh, cm, code, candidates, threads);
+    try {
+        return encode_angle_candidates(mesh, cm, code, candidates, threads);
+    } catch (const WalkOverBudget&) {
+    }
+    // Meshes of millions of triangles walk close to the budget's 16 nodes a triangle, and how
+    // close depends on the radius: the first start's other radii not tried yet, the first that fits.
+    for (uint32_t radius : kRetryRadii) {
+        const Start start{candidates.front().first, candidates.front().rotation, radius};
+        const bool tried = std::any_of(candidates.begin(), candidates.end(), [&](const Start& c) {
+            return c.first == start.first && c.rotation == start.rotation && c.radius == start.radius;
+        });
+        if (tried) continue;
+        try {
+            return encode_angle_candidates(mesh, cm, code, {start}, 1);
+        } catch (const EncoderGaveUp&) {
+        }
+    }
+    throw EncoderGaveUp{};
 }
 
 std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, const BaseStart& start) {

@@ -112,6 +112,9 @@ BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh, unsigned threads
     check_encodable(mesh);
     BaseMeshCode code;
     if (try_mode(mesh, BaseConnectivityMode::angle, code, true, threads, search_budget)) return code;
+    // Mode 0 needs no positions and no walk budget: a few bits a vertex where mode 1 spends
+    // three indices a triangle.
+    if (try_mode(mesh, BaseConnectivityMode::cut_border, code)) return code;
     if (!try_mode(mesh, BaseConnectivityMode::explicit_triangles, code))
         throw Error("base mesh coder: the explicit mode failed");
     return code;
