@@ -281,6 +281,20 @@ TEST(BaseMeshCoder, ModeZeroWhereModeTwoCanNot) {
     EXPECT_LT(bits, 4.0);
 }
 
+// A long strip keeps a border loop as long as itself: mode 2's nearest-tip scans of the whole loop
+// pass the walk budget at 9,000 triangles, mode 3's window (FORMAT.md 4.17) stays far below it,
+// and where both fit (a shorter strip) mode 3 codes about as small.
+TEST(BaseMeshCoder, ModeThreeWhereModeTwoWalksTooFar) {
+    const TriangleMesh strip = make_irregular_strip(1500, 3, 1);
+    EXPECT_THROW(encode_base_connectivity(strip, BaseConnectivityMode::angle), Error);
+    const double bits = check_round_trip(strip, "irregular-strip", BaseConnectivityMode::angle_windowed);
+    EXPECT_LT(bits, 1.2);
+    const TriangleMesh shorter = make_irregular_strip(400, 3, 1);
+    const double two = check_round_trip(shorter, "short strip mode 2", BaseConnectivityMode::angle, false);
+    const double three = check_round_trip(shorter, "short strip mode 3", BaseConnectivityMode::angle_windowed, false);
+    EXPECT_LT(three, two * 1.02);
+}
+
 // The encoder gives up only where the decoder would refuse. Named apart from the BaseMeshCoder
 // suite, which .ci/run repeats under the sanitizers: a second of work in Release.
 TEST(LargeBaseMesh, MillionTriangleTorusStaysInModeTwo) {
@@ -306,8 +320,8 @@ TEST(BaseMeshCoder, EveryModeRoundTrips) {
         {"bowtie", bowtie},
     };
     for (const auto& [name, mesh] : meshes) {
-        for (BaseConnectivityMode mode : {BaseConnectivityMode::angle, BaseConnectivityMode::cut_border,
-                                          BaseConnectivityMode::explicit_triangles})
+        for (BaseConnectivityMode mode : {BaseConnectivityMode::angle, BaseConnectivityMode::angle_windowed,
+                                          BaseConnectivityMode::cut_border, BaseConnectivityMode::explicit_triangles})
             check_round_trip(mesh, name + " mode " + std::to_string(int(mode)), mode, false);
     }
 }
@@ -588,8 +602,8 @@ TEST(BaseMeshCoder, CorruptStreams) {
     TriangleMesh bowtie;
     bowtie.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}};
     bowtie.triangles = {{0, 1, 2}, {0, 3, 4}};
-    for (BaseConnectivityMode mode : {BaseConnectivityMode::angle, BaseConnectivityMode::cut_border,
-                                      BaseConnectivityMode::explicit_triangles}) {
+    for (BaseConnectivityMode mode : {BaseConnectivityMode::angle, BaseConnectivityMode::angle_windowed,
+                                      BaseConnectivityMode::cut_border, BaseConnectivityMode::explicit_triangles}) {
         const BaseMeshCode code = encode_base_connectivity(mesh, mode);
         check_corruption(mesh, code);
         check_corruption(bowtie, encode_base_connectivity(bowtie, mode));

@@ -19,6 +19,9 @@ TriangleMesh make_torus(int rings, int segments, double major_radius, double min
 // to 0.3 of a cell and every cell cut along a random diagonal (valences 3 to 9), coordinates
 // rounded to float32; 2 * rings * segments triangles, deterministic per seed.
 TriangleMesh make_irregular_torus(int rings, int segments, uint32_t seed);
+// A long open strip of `length` x `width` cells, jittered, gently bumped out of the plane and cut
+// along random diagonals like the torus above: its conquest keeps a border loop as long as the strip.
+TriangleMesh make_irregular_strip(int length, int width, uint32_t seed);
 TriangleMesh make_square(int cells);             // [0,1]^2 in z=0, 2*cells^2 triangles, boundary
 // L-shaped domain [-1,1]^2 without (0,1]x[-1,0): re-entrant corner at the origin.
 TriangleMesh make_l_shape(int cells_per_unit);

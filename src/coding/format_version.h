@@ -33,8 +33,12 @@ namespace amc {
 // for bit-exact files whose base positions (or seam vertices) have raw bits: they go to a side
 // stream after the base geometry block's (the seam block's) arithmetic code; mixed files of
 // version 21 are in the seventh model, and an older model keeps its version and the old layout.
+// Version 22 for files whose base connectivity is in mode 3 (mode 2 with split tips looked for near
+// the gate, FORMAT.md 4.17), written where mode 2's walk passes its budget; everything else as the
+// newest version before it holds it: bit-exact files as version 21, quantized ones as version 18
+// (mode 4 in the grouped order) or, mixed, as version 20 (the seventh model, the per-vertex order).
 constexpr uint8_t kOldestReadableVersion = 1;
-constexpr uint8_t kNewestVersion = 21;
+constexpr uint8_t kNewestVersion = 22;
 constexpr uint8_t kBaseVersion = 2;       // everything but the numbering block and mode 2
 constexpr uint8_t kNumberingVersion = 3;  // the first version with a numbering block
 constexpr uint8_t kAngleBaseVersion = 4;  // the first version with base connectivity mode 2
@@ -77,24 +81,29 @@ constexpr uint8_t kSeventhMixingVersion = 20;
 // the seam block (FORMAT.md 3.5, 3.13); bit-exact files only (a quantized version-21 file is an
 // error), everything else as in version 20 (mixed files: the seventh model).
 constexpr uint8_t kBaseRawSideVersion = 21;
+// The first version whose base connectivity may be in mode 3 (FORMAT.md 4.17).
+constexpr uint8_t kWindowedTipVersion = 22;
 
 // Whether a file's base geometry and seam blocks have the side stream: bit-exact, version 21 on.
 constexpr bool base_raw_side(uint8_t file_version, bool quantized) { return file_version >= kBaseRawSideVersion && !quantized; }
 
 // Whether a file of `file_version` codes mode 4's tokens in the grouped order: version 18, whose
-// files are never mixed; the mixing mode's files keep the per-vertex order (versions 9-17, 19, 20;
-// version 21 holds no mode 4: its files are bit-exact).
-constexpr bool grouped_grid_order(uint8_t file_version) {
-    return file_version >= kGroupedGridVersion && file_version != kSixthMixingVersion && file_version != kSeventhMixingVersion;
+// files are never mixed, and version 22's files that are not mixed; the mixing mode's files keep
+// the per-vertex order (versions 9-17, 19, 20, 22; version 21 holds no mode 4: its files are bit-exact).
+constexpr bool grouped_grid_order(uint8_t file_version, bool mixed) {
+    return file_version >= kGroupedGridVersion && file_version != kSixthMixingVersion && file_version != kSeventhMixingVersion &&
+           !(file_version >= kWindowedTipVersion && mixed);
 }
 
 // The lowest version a file's newest features need, 0 if it has none of them (older features then
 // decide): the one rule for encode()'s files and the chunked file head the MPI ranks write.
 // `grouped_grid`: a mode-4 level in the grouped order (only quantized files have one; stencil
 // tables and raw side streams only bit-exact ones). `base_side`: the base's (and seam's) raw bits in
-// side streams.
-constexpr uint8_t newest_features_version(bool grouped_grid, bool stencil_tables, bool raw_side, bool chunked, bool base_side) {
-    return base_side        ? kBaseRawSideVersion
+// side streams. `windowed_base`: base connectivity in mode 3.
+constexpr uint8_t newest_features_version(bool grouped_grid, bool stencil_tables, bool raw_side, bool chunked, bool base_side,
+                                          bool windowed_base) {
+    return windowed_base    ? kWindowedTipVersion
+           : base_side      ? kBaseRawSideVersion
            : grouped_grid   ? kGroupedGridVersion
            : stencil_tables ? kStencilTablesVersion
            : raw_side       ? kRawSideVersion
@@ -134,6 +143,7 @@ constexpr uint8_t hierarchy_stream_version_of_file(uint8_t file_version) {
         case 19: return 2;
         case 20: return 2;
         case 21: return 2;
+        case 22: return 2;
     }
     return 0;
 }

@@ -142,11 +142,14 @@ uint8_t first_version_of(MixingModel model) {
 // `mixing`: the mixing mode's model; the seventh only in versions 20 and 21, the sixth only in 19, the fifth
 // only in 17, the fourth only in 16 (never chunked; they hold every geometry mode); the third is in versions 11-15.
 // `base_side`: the base's (and seam's) raw bits in side streams, only with the seventh model when mixed.
+// A base in mode 3 makes version 22, whose bit-exact files have the side streams and whose mixed
+// files are in the seventh model (encode() sees to both).
 uint8_t file_version(bool stencil_tables, bool raw_side, bool unit_geometry, bool grid_geometry, bool mixed_contexts, MixingModel mixing,
                      bool chunked, bool static_geometry, BaseConnectivityMode base_mode, bool store_numbering, bool base_side) {
+    if (base_mode == BaseConnectivityMode::angle_windowed) return kWindowedTipVersion;  // holds the rest (format_version.h)
     if (mixed_contexts && mixing >= MixingModel::fourth) return base_side ? kBaseRawSideVersion : first_version_of(mixing);
     // Mixed files keep mode 4's per-vertex order (code_forest): only the others hold the grouped one.
-    if (const uint8_t newest = newest_features_version(grid_geometry && !mixed_contexts, stencil_tables, raw_side, chunked, base_side))
+    if (const uint8_t newest = newest_features_version(grid_geometry && !mixed_contexts, stencil_tables, raw_side, chunked, base_side, false))
         return newest;
     return unit_geometry                                 ? kUnitFrameVersion
            : mixed_contexts                              ? kThirdMixingVersion
@@ -418,7 +421,9 @@ std::vector<uint8_t> encode_file(const Hierarchy& input, const EncodeOptions& op
     // mixing model (below); they are the same symbols either way, so `positions` is the same.
     PositionCoder positions(space);
     const RawSideCode base_geometry = encode_base_geometry(reordered.hierarchy, base_code, reordered.keep_rotations, positions, !quantized);
-    const bool base_raw_bits = !base_geometry.raw.empty();
+    // Version 22 (a base in mode 3) keeps the side stream of a bit-exact base even without raw bits.
+    const bool windowed_base = base_code.mode == BaseConnectivityMode::angle_windowed;
+    const bool base_raw_bits = !base_geometry.raw.empty() || (windowed_base && !quantized);
     // The base geometry block of the versions before 21: its raw bits in the arithmetic code.
     std::vector<uint8_t> base_inline;
     auto inline_base = [&]() -> const std::vector<uint8_t>& {
@@ -438,7 +443,7 @@ std::vector<uint8_t> encode_file(const Hierarchy& input, const EncodeOptions& op
     // The mixing mode's forest in its older models, and with choose_traversal in the other traversal.
     ForestCode sixth, fifth, fourth, third, other_seventh;
     std::vector<MixedAlternative> older =
-        mixed ? std::vector<MixedAlternative>{{MixingModel::sixth, false, &sixth}, {MixingModel::fifth, false, &fifth},
+        mixed && !windowed_base ? std::vector<MixedAlternative>{{MixingModel::sixth, false, &sixth}, {MixingModel::fifth, false, &fifth},
                                               {MixingModel::fourth, false, &fourth}, {MixingModel::third, false, &third}}
               : std::vector<MixedAlternative>();
     if (mixed && options.choose_traversal) older.push_back({kWrittenMixingModel, true, &other_seventh});
@@ -766,7 +771,8 @@ Hierarchy decode_file(const uint8_t* data, size_t size, const DecodeOptions& opt
         AMC_REQUIRE(!hierarchy.done(), corrupt, "level block after the last level");
         if (options.max_level >= 0 && level >= options.max_level) return std::move(h);  // progressive: stop here
         const std::string where = "level " + std::to_string(level) + " block";
-        const LevelBlockParts parts = split_level_block(block, reader.version(), space.quantizer != nullptr, where);
+        const LevelBlockParts parts = split_level_block(block, reader.version(), space.quantizer != nullptr,
+                                                        (meta.options & kOptionMixedContexts) != 0, where);
         ArithmeticDecoder decoder(parts.arithmetic, parts.arithmetic_size);
         // Every new vertex gets its decoded position below; a static mode with a frame takes their
         // frame corners from the split, without reading the nodes again; the arithmetic modes

@@ -115,6 +115,34 @@ TriangleMesh make_irregular_torus(int rings, int segments, uint32_t seed) {
     return mesh;
 }
 
+TriangleMesh make_irregular_strip(int length, int width, uint32_t seed) {
+    AMC_REQUIRE(length >= 1 && width >= 1, invalid_input, "irregular strip: at least one cell each way");
+    std::mt19937 rng(seed);
+    auto jitter = [&] { return (double(rng() >> 8) * 0x1p-24 - 0.5) * 0.6; };
+    TriangleMesh mesh;
+    for (int i = 0; i <= length; ++i) {
+        for (int j = 0; j <= width; ++j) {
+            const double x = i + jitter(), y = j + jitter();
+            mesh.positions.push_back({x, y, 0.1 * std::sin(0.7 * x) * std::cos(1.3 * y)});
+        }
+    }
+    auto id = [&](int i, int j) { return uint32_t(i * (width + 1) + j); };
+    for (int i = 0; i < length; ++i) {
+        for (int j = 0; j < width; ++j) {
+            const uint32_t a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1), d = id(i, j + 1);
+            if (rng() & 1) {
+                mesh.triangles.push_back({a, b, c});
+                mesh.triangles.push_back({a, c, d});
+            } else {
+                mesh.triangles.push_back({a, b, d});
+                mesh.triangles.push_back({b, c, d});
+            }
+        }
+    }
+    make_single_precision(mesh);
+    return mesh;
+}
+
 namespace {
 
 // A grid of cells over [x0, x0+w] x [y0, y0+h]; cells flagged by `keep` are triangulated with

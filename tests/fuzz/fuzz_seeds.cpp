@@ -124,11 +124,15 @@ void amc_seeds(const std::vector<Hierarchy>& hierarchies) {
 // A base_connectivity seed: the mesh with decoder vertex v at fuzz::base_position(v), as the
 // target decodes it. The coder's vertex order depends on the positions (mode 2): positions are
 // assigned in the order of a first encoding, then the mesh is encoded again; when that changes
-// the order, the seed still decodes (to another mesh), which is all a seed needs.
-void write_base_seed(TriangleMesh mesh) {
-    const BaseMeshCode first = encode_base_connectivity(mesh);
+// the order, the seed still decodes (to another mesh), which is all a seed needs. `windowed`: in
+// mode 3, which the coder chooses only for long loops.
+void write_base_seed(TriangleMesh mesh, bool windowed = false) {
+    auto code = [&] {
+        return windowed ? encode_base_connectivity(mesh, BaseConnectivityMode::angle_windowed) : encode_base_connectivity(mesh);
+    };
+    const BaseMeshCode first = code();
     for (uint32_t i = 0; i < first.vertex_order.size(); ++i) mesh.positions[first.vertex_order[i]] = fuzz::base_position(i);
-    const std::vector<uint8_t> stream = encode_base_connectivity(mesh).bytes;
+    const std::vector<uint8_t> stream = code().bytes;
     const uint32_t n = uint32_t(mesh.positions.size());
     std::vector<uint8_t> seed = {uint8_t(n), uint8_t(n >> 8)};
     seed.insert(seed.end(), stream.begin(), stream.end());
@@ -148,6 +152,7 @@ void stream_seeds(const std::vector<Hierarchy>& hierarchies) {
         }
         write_base_seed(bases[b]);
     }
+    write_base_seed(bases.back(), true);
     // Two tetrahedra sharing a vertex (a vertex copy) and a mesh with two components.
     TriangleMesh pinched;
     pinched.positions.resize(7);

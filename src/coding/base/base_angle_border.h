@@ -124,6 +124,7 @@ public:
     };
     std::vector<Loop> stack;
     uint32_t gate_radius = 5;  // the stream's: how far from a closed vertex the next gate is looked for
+    uint32_t tip_window = 0;   // mode 3's window of split tips around the gate (nearest_tip); 0 in mode 2
 
     void reserve(size_t vertices, size_t nodes) {
         vertices_.reserve(vertices);
@@ -154,10 +155,12 @@ public:
     // A split's predicted tip (FORMAT.md 4.14): the node of the gate's loop of `length` nodes,
     // k = 2 .. length - 3 links after gate g's next node nv, nearest to the parallelogram over the
     // gate's triangle; node kNoBorderNode when no located node is a candidate. `predicted` is
-    // false (and the loop not walked) when the gate's triangle lacks a position.
+    // false (and the loop not walked) when the gate's triangle lacks a position. With a
+    // `tip_window` W (mode 3, FORMAT.md 4.17) only k = 2 .. W + 1 and length - 2 - W .. length - 3
+    // are candidates. `charge`: the candidates' count, what the walk budget is charged.
     struct NearestTip {
         bool predicted = false;
-        uint32_t node = kNoBorderNode, k = 0;
+        uint32_t node = kNoBorderNode, k = 0, charge = 0;
     };
     NearestTip nearest_tip(uint32_t g, uint32_t nv, uint32_t length) const {
         NearestTip tip;
@@ -166,9 +169,8 @@ public:
         tip.predicted = true;
         const Vec3 predicted = (position(vert(g)) + position(vert(nv))) - position(o);
         double best_distance = 0;
-        uint32_t x = next(next(nv));
-        for (uint32_t i = 2; i + 3 <= length; ++i, x = next(x)) {
-            if (!located(vert(x))) continue;
+        auto consider = [&](uint32_t x, uint32_t i) {
+            if (!located(vert(x))) return;
             const Vec3 d = position(vert(x)) - predicted;
             const double distance = exact_dot(d, d);
             if (tip.node == kNoBorderNode || distance < best_distance) {
@@ -176,7 +178,20 @@ public:
                 tip.k = i;
                 best_distance = distance;
             }
+        };
+        const uint32_t last = length - 3;
+        const bool whole = tip_window == 0 || uint64_t{length} <= 2 * uint64_t{tip_window} + 4;
+        const uint32_t front_end = whole ? last : tip_window + 1;
+        uint32_t x = next(next(nv));
+        for (uint32_t i = 2; i <= front_end; ++i, x = next(x)) consider(x, i);
+        if (whole) {
+            tip.charge = length - 4;
+            return tip;
         }
+        const uint32_t back_start = length - 2 - tip_window;  // tip_window + 1 links before g
+        x = walk(g, -int64_t{tip_window} - 1);
+        for (uint32_t i = back_start; i <= last; ++i, x = next(x)) consider(x, i);
+        tip.charge = 2 * tip_window;
         return tip;
     }
 

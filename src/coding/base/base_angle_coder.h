@@ -26,19 +26,27 @@
 
 namespace amc {
 
-// The whole stream, mode bits included; fills the code's orders. With `search`, the shortest of
-// several start triangles and gate radii (FORMAT.md 4.16), as many as `search_budget` (triangles
-// coded in all) allows, tried on up to `threads` threads (the result does not depend on them),
-// else version 4's single try. Throws EncoderGaveUp when the mesh does not fit the mode.
-std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, bool search,
-                                       unsigned threads, uint64_t search_budget);
-// The stream from one start (the shortest context set). Throws EncoderGaveUp as above, invalid_input
-// when the start is not one of the mesh's.
+// Mode 3 is mode 2 with a split's predicted tip looked for only this many candidates from either
+// end of the loop (FORMAT.md 4.17), so that its walk stays linear on meshes of long loops.
+constexpr uint32_t kTipWindow = 8;
+constexpr uint32_t tip_window_of(BaseConnectivityMode mode) {
+    return mode == BaseConnectivityMode::angle_windowed ? kTipWindow : 0;
+}
+
+// The whole stream of `mode` (2 or 3), mode bits included; fills the code's orders. With `search`,
+// the shortest of several start triangles and gate radii (FORMAT.md 4.16), as many as
+// `search_budget` (triangles coded in all) allows, tried on up to `threads` threads (the result
+// does not depend on them), else version 4's single try. Throws EncoderGaveUp when the mesh does
+// not fit the mode.
+std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, BaseConnectivityMode mode,
+                                       bool search, unsigned threads, uint64_t search_budget);
+// The mode-2 stream from one start (the shortest context set). Throws EncoderGaveUp as above,
+// invalid_input when the start is not one of the mesh's.
 std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, const BaseStart& start);
 
-// Decodes the rest of a mode-2 stream (after the two mode bits) of `size` bytes, reading the
-// positions from `source` as vertices are created. Throws Error.
+// Decodes the rest of a mode-2 or mode-3 stream (after the two mode bits) of `size` bytes, reading
+// the positions from `source` as vertices are created. Throws Error.
 DecodedBaseMesh decode_angle_mode(ArithmeticDecoder& dec, size_t size, uint32_t vertex_count,
-                                  const BasePositionSource& source, uint32_t max_isolated);
+                                  const BasePositionSource& source, uint32_t max_isolated, BaseConnectivityMode mode);
 
 }  // namespace amc

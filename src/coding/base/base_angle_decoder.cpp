@@ -61,10 +61,12 @@ Header read_header(ArithmeticDecoder& dec, size_t size, uint32_t vertex_count, u
 
 class Decoder {
 public:
-    Decoder(ArithmeticDecoder& dec, size_t size, const Header& header, uint32_t vertex_count, const BasePositionSource& source)
+    Decoder(ArithmeticDecoder& dec, size_t size, const Header& header, uint32_t vertex_count, const BasePositionSource& source,
+            uint32_t tip_window)
         : dec_(dec), h_(header), source_(source), models_(header.context_set) {
         out_.vertex_count = vertex_count;
         border_.gate_radius = h_.gate_radius;
+        border_.tip_window = tip_window;
         // The counts are consistent but the stream may still stop early: memory is reserved for
         // what a stream of this size typically holds and grows with what is decoded. Nodes: one
         // per vertex, plus one per split or merge (few).
@@ -156,7 +158,7 @@ private:
     // FORMAT.md 4.14: the nearest-tip bit, else the offset k - 2 from the gate's next node.
     uint32_t split_tip(uint32_t g, uint32_t nv, uint32_t length, uint32_t& k) {
         const Border::NearestTip tip = border_.nearest_tip(g, nv, length);
-        if (tip.predicted) charge_walk(length - 4);
+        charge_walk(tip.charge);
         if (tip.node != angle_mode::kNoBorderNode && dec_.decode(models_.nearest)) {
             k = tip.k;
             return tip.node;
@@ -231,9 +233,9 @@ private:
 }  // namespace
 
 DecodedBaseMesh decode_angle_mode(ArithmeticDecoder& dec, size_t size, uint32_t vertex_count,
-                                  const BasePositionSource& source, uint32_t max_isolated) {
+                                  const BasePositionSource& source, uint32_t max_isolated, BaseConnectivityMode mode) {
     const Header header = read_header(dec, size, vertex_count, max_isolated);
-    return Decoder(dec, size, header, vertex_count, source).run();
+    return Decoder(dec, size, header, vertex_count, source, tip_window_of(mode)).run();
 }
 
 }  // namespace amc

@@ -21,14 +21,13 @@ using angle_mode::Models;
 
 namespace {
 
-// The decoder's walk (FORMAT.md 4.14) would pass its budget: another gate radius may not.
-struct WalkOverBudget : EncoderGaveUp {};
-
 class Encoder {
 public:
-    Encoder(const TriangleMesh& mesh, const ClosedMesh& cm, uint32_t gate_radius, uint32_t first, uint32_t rotation)
-        : mesh_(mesh), cm_(cm), first_(first), rotation_(rotation) {
+    Encoder(const TriangleMesh& mesh, const ClosedMesh& cm, BaseConnectivityMode mode, uint32_t gate_radius, uint32_t first,
+            uint32_t rotation)
+        : mesh_(mesh), cm_(cm), mode_(mode), first_(first), rotation_(rotation) {
         border_.gate_radius = gate_radius;
+        border_.tip_window = tip_window_of(mode);
         for (int set = 0; set < angle_mode::kContextSets; ++set) streams_.emplace_back(set);
     }
 
@@ -39,7 +38,7 @@ public:
         const uint32_t isolated = static_cast<uint32_t>(mesh_.positions.size()) - used_;
         const bool plain = isolated == 0 && cm_.dummies == 0 && copies_ == 0 && components_ == 1 && merges_ == 0;
         for (SetStream& s : streams_) {
-            s.enc.encode_bits_raw(uint32_t(BaseConnectivityMode::angle), 2);
+            s.enc.encode_bits_raw(uint32_t(mode_), 2);
             s.enc.encode_bits_raw(static_cast<uint32_t>(s.set), 2);
             s.enc.encode_bits_raw(border_.gate_radius, 3);
             s.enc.encode_bits_raw(plain ? 1 : 0, 1);
@@ -72,6 +71,7 @@ private:
 
     const TriangleMesh& mesh_;
     const ClosedMesh& cm_;
+    const BaseConnectivityMode mode_;  // 2, or 3 with the tip window
     const uint32_t first_, rotation_;  // the first component's start triangle and its first corner
     uint32_t used_ = 0, copies_ = 0, components_ = 0, merges_ = 0, merges_seen_ = 0;
     std::vector<SetStream> streams_;
@@ -141,7 +141,7 @@ private:
     }
     void charge_walk(uint64_t nodes) {
         walked_ += nodes;
-        if (walked_ > angle_mode::walk_budget(cm_.triangles.size())) throw WalkOverBudget{};
+        if (walked_ > angle_mode::walk_budget(cm_.triangles.size())) throw EncoderGaveUp{};
     }
 
     // The final index of decoder vertex id, or -1 (none, or a dummy).
@@ -436,7 +436,7 @@ private:
     // prediction, else the offset.
     void encode_split_tip(uint32_t g, uint32_t nv, uint32_t n, uint32_t k, uint32_t length) {
         const Border::NearestTip tip = border_.nearest_tip(g, nv, length);
-        if (tip.predicted) charge_walk(length - 4);
+        charge_walk(tip.charge);
         if (tip.node != angle_mode::kNoBorderNode) {
             put_bit(tip.node == n, [](int, Models& m) -> BitModel& { return m.nearest; });
             if (tip.node == n) return;
@@ -472,7 +472,6 @@ private:
 // The first candidate is what version 4's encoder wrote.
 constexpr uint32_t kSearchStarts = 16;                // start triangles spread over the input order
 constexpr uint32_t kSearchRadii[] = {5, 3, 4, 6, 7};  // 5 first: the best single radius
-constexpr uint32_t kRetryRadii[] = {7, 6, 4, 3};       // after every candidate walked over the budget
 
 using Start = BaseStart;
 
@@ -507,7 +506,8 @@ namespace {
 
 // The shortest stream of the candidates (the earliest among equals) into `code`.
 std::vector<uint8_t> encode_angle_candidates(const TriangleMesh& mesh, const ClosedMesh& cm, BaseMeshCode& code,
-                                             const std::vector<Start>& candidates, unsigned threads) {
+                                             BaseConnectivityMode mode, const std::vector<Start>& candidates,
+                                             unsigned threads) {
     // Every start is coded on its own, in every context set at once, on up to `threads` threads;
     // the shortest (start, set) wins, the earliest among equals, so the choice does not depend on
     // the threads. Only the best so far is kept: holding every candidate's code cost 10 MiB on a
@@ -517,21 +517,16 @@ std::vector<uint8_t> encode_angle_candidates(const TriangleMesh& mesh, const Clo
         BaseMeshCode code;
         size_t index = SIZE_MAX;
     } best;
-    bool over_budget = false;
     std::mutex best_mutex;
     parallel_for(candidates.size(), threads, [&](size_t c) {
         const Start& start = candidates[c];
         BaseMeshCode tried;
         std::vector<std::vector<uint8_t>> streams;
         try {
-            Encoder e(mesh, cm, start.radius, start.first, start.rotation);
+            Encoder e(mesh, cm, mode, start.radius, start.first, start.rotation);
             streams = e.run(tried);
-        } catch (const WalkOverBudget&) {
-            const std::lock_guard<std::mutex> lock(best_mutex);
-            over_budget = true;
-            return;
         } catch (const EncoderGaveUp&) {
-            return;  // this start does not fit: the others may
+            return;  // this start does not fit (a walk over the budget, say): the others may
         }
         const std::lock_guard<std::mutex> lock(best_mutex);
         bool won = false;
@@ -546,10 +541,7 @@ std::vector<uint8_t> encode_angle_candidates(const TriangleMesh& mesh, const Clo
         }
         if (won) best.code = std::move(tried);  // the same orders in every set
     });
-    if (best.index == SIZE_MAX) {
-        if (over_budget) throw WalkOverBudget{};
-        throw EncoderGaveUp{};
-    }
+    if (best.index == SIZE_MAX) throw EncoderGaveUp{};
     code.vertex_order = std::move(best.code.vertex_order);
     code.triangle_order = std::move(best.code.triangle_order);
     code.triangle_rotation = std::move(best.code.triangle_rotation);
@@ -559,35 +551,18 @@ std::vector<uint8_t> encode_angle_candidates(const TriangleMesh& mesh, const Clo
 
 }  // namespace
 
-std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, bool search, unsigned threads,
-                                       uint64_t search_budget) {
+std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, BaseConnectivityMode mode,
+                                       bool search, unsigned threads, uint64_t search_budget) {
     const ClosedMesh cm = make_closed(mesh);
     std::vector<Start> candidates = search_candidates(cm.real_triangles, cm.triangles.size(), search_budget);
     if (!search) candidates.resize(1);
-    try {
-        return encode_angle_candidates(mesh, cm, code, candidates, threads);
-    } catch (const WalkOverBudget&) {
-    }
-    // Meshes of millions of triangles walk close to the budget's 16 nodes a triangle, and how
-    // close depends on the radius: the first start's other radii not tried yet, the first that fits.
-    for (uint32_t radius : kRetryRadii) {
-        const Start start{candidates.front().first, candidates.front().rotation, radius};
-        const bool tried = std::any_of(candidates.begin(), candidates.end(), [&](const Start& c) {
-            return c.first == start.first && c.rotation == start.rotation && c.radius == start.radius;
-        });
-        if (tried) continue;
-        try {
-            return encode_angle_candidates(mesh, cm, code, {start}, 1);
-        } catch (const EncoderGaveUp&) {
-        }
-    }
-    throw EncoderGaveUp{};
+    return encode_angle_candidates(mesh, cm, code, mode, candidates, threads);
 }
 
 std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, const BaseStart& start) {
     AMC_REQUIRE(start.radius < 8 && start.rotation < 3 && start.first < mesh.triangles.size(), invalid_input,
                 "base mesh coder: no such start");
-    return encode_angle_candidates(mesh, make_closed(mesh), code, {start}, 1);
+    return encode_angle_candidates(mesh, make_closed(mesh), code, BaseConnectivityMode::angle, {start}, 1);
 }
 
 }  // namespace amc

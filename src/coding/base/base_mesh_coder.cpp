@@ -82,8 +82,9 @@ bool try_mode(const TriangleMesh& mesh, BaseConnectivityMode mode, BaseMeshCode&
         code.mode = mode;
         switch (mode) {
             case BaseConnectivityMode::angle:
+            case BaseConnectivityMode::angle_windowed:
                 code.bytes = start != nullptr ? encode_angle_mode(mesh, code, *start)
-                                              : encode_angle_mode(mesh, code, search, threads, search_budget);
+                                              : encode_angle_mode(mesh, code, mode, search, threads, search_budget);
                 break;
             case BaseConnectivityMode::cut_border: code.bytes = encode_cut_border(mesh, code); break;
             case BaseConnectivityMode::explicit_triangles: code.bytes = encode_explicit(mesh, code); break;
@@ -112,8 +113,9 @@ BaseMeshCode encode_base_connectivity(const TriangleMesh& mesh, unsigned threads
     check_encodable(mesh);
     BaseMeshCode code;
     if (try_mode(mesh, BaseConnectivityMode::angle, code, true, threads, search_budget)) return code;
-    // Mode 0 needs no positions and no walk budget: a few bits a vertex where mode 1 spends
-    // three indices a triangle.
+    // Long loops (a long strip, millions of triangles) walk mode 2 over its budget; mode 3 stays in it.
+    if (try_mode(mesh, BaseConnectivityMode::angle_windowed, code, true, threads, search_budget)) return code;
+    // Mode 0 needs no positions: a few bits a vertex where mode 1 spends three indices a triangle.
     if (try_mode(mesh, BaseConnectivityMode::cut_border, code)) return code;
     if (!try_mode(mesh, BaseConnectivityMode::explicit_triangles, code))
         throw Error("base mesh coder: the explicit mode failed");
@@ -149,8 +151,8 @@ DecodedBaseMesh decode_base_mesh(const uint8_t* data, size_t size, uint32_t vert
         ArithmeticDecoder dec(data, size);
         const uint32_t mode = dec.decode_bits_raw(2);
         DecodedBaseMesh out;
-        if (mode == uint32_t(BaseConnectivityMode::angle)) {
-            out = decode_angle_mode(dec, size, vertex_count, positions, max_isolated);
+        if (mode == uint32_t(BaseConnectivityMode::angle) || mode == uint32_t(BaseConnectivityMode::angle_windowed)) {
+            out = decode_angle_mode(dec, size, vertex_count, positions, max_isolated, BaseConnectivityMode(mode));
         } else {
             if (mode == uint32_t(BaseConnectivityMode::cut_border)) out = decode_cut_border(dec, size, vertex_count, max_isolated);
             else if (mode == uint32_t(BaseConnectivityMode::explicit_triangles))

@@ -27,7 +27,9 @@
 namespace amc {
 
 // Written to the stream (its first two raw bits): values are frozen.
-enum class BaseConnectivityMode : uint8_t { cut_border = 0, explicit_triangles = 1, angle = 2 };
+// angle_windowed (mode 3, files of version 22 on) is `angle` with its split tips looked for near
+// the gate only (FORMAT.md 4.17).
+enum class BaseConnectivityMode : uint8_t { cut_border = 0, explicit_triangles = 1, angle = 2, angle_windowed = 3 };
 
 // Parallelogram stencil (a, b, c) of a vertex: predict a + b - c from vertices decoded earlier.
 // (a, -1, -1) means "predict a"; (-1, -1, -1) means no prediction.

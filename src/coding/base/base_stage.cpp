@@ -184,9 +184,11 @@ TriangleMesh decode_base(const Block& connectivity, const Block& geometry, const
                 "metadata block: " + std::to_string(meta.base_vertices) + " base vertices can not be coded in the " +
                     std::to_string(geometry.size) + " bytes of the base geometry block");
     AMC_REQUIRE(meta.base_vertices <= UINT32_MAX, limit_exceeded, "metadata block: too many base vertices");
-    AMC_REQUIRE(base_connectivity_mode(connectivity.payload, connectivity.size) != BaseConnectivityMode::angle ||
-                    file_version >= kAngleBaseVersion,
-                corrupt, "base connectivity block: mode 2 in a version-" + std::to_string(file_version) + " file");
+    const BaseConnectivityMode mode = base_connectivity_mode(connectivity.payload, connectivity.size);
+    AMC_REQUIRE(mode != BaseConnectivityMode::angle || file_version >= kAngleBaseVersion, corrupt,
+                "base connectivity block: mode 2 in a version-" + std::to_string(file_version) + " file");
+    AMC_REQUIRE(mode != BaseConnectivityMode::angle_windowed || file_version >= kWindowedTipVersion, corrupt,
+                "base connectivity block: mode 3 in a version-" + std::to_string(file_version) + " file");
 
     TriangleMesh base;
     base.single_precision = single_precision;

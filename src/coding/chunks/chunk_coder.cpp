@@ -196,7 +196,9 @@ void decode_chunk(HierarchyLevelDecoder& hierarchy, const uint8_t* data, size_t 
         const uint64_t length = in.varint();
         AMC_REQUIRE(length >= 1 && length <= in.remaining(), corrupt, where + ": bad length");
         const Block level_block{BlockType::level, in.bytes(length), size_t(length), 0};
-        const LevelBlockParts parts = split_level_block(level_block, limits.file_version, space.quantizer != nullptr, where);
+        // Chunked files are never in the mixing mode.
+        const LevelBlockParts parts =
+            split_level_block(level_block, limits.file_version, space.quantizer != nullptr, false, where);
         ArithmeticDecoder decoder(parts.arithmetic, parts.arithmetic_size);
         seam_splits.found = false;
         // Every new vertex gets its decoded position below; a static mode with a frame takes their

@@ -241,7 +241,8 @@ std::vector<uint8_t> chunked_file_head(const TriangleMesh& base, const Seam& sea
     PositionCoder positions(space);
     const RawSideCode base_geometry = encode_base_geometry(roots, base_code, false, positions, exact);
     const RawSideCode seam_code = seam.encode(space, exact);
-    const bool base_side = exact && (!base_geometry.raw.empty() || !seam_code.raw.empty());
+    const bool windowed_base = base_code.mode == BaseConnectivityMode::angle_windowed;  // version 22: side streams
+    const bool base_side = exact && (!base_geometry.raw.empty() || !seam_code.raw.empty() || windowed_base);
     const std::vector<uint8_t> seam_bytes = base_side ? seam_code.joined() : seam_code.arithmetic;
     std::vector<uint8_t> table;
     put_varint(table, chunks.size());
@@ -259,7 +260,7 @@ std::vector<uint8_t> chunked_file_head(const TriangleMesh& base, const Seam& sea
         stencil_tables |= c.stencil_tables != 0;
         grid_geometry |= c.grid_geometry != 0;  // chunks code mode 4 in the grouped order
     }
-    BlockWriter writer(newest_features_version(grid_geometry, stencil_tables, raw_side, true, base_side), grid != nullptr ? kFlagQuantized : base.single_precision ? kFlagSinglePrecision : 0);
+    BlockWriter writer(newest_features_version(grid_geometry, stencil_tables, raw_side, true, base_side, windowed_base), grid != nullptr ? kFlagQuantized : base.single_precision ? kFlagSinglePrecision : 0);
     writer.add(BlockType::metadata, write_metadata(meta, grid != nullptr));
     writer.add(BlockType::base_connectivity, base_code.bytes);
     writer.add(BlockType::base_geometry, base_side ? base_geometry.joined() : base_geometry.arithmetic);

@@ -425,7 +425,8 @@ template std::vector<uint8_t> finish_level_payload(const Hierarchy&, const NewVe
 template std::vector<uint8_t> finish_level_payload(const HierarchyOnGrid&, const NewVertices&, LevelGeometryCode&,
                                                    PositionCoder&, ArithmeticEncoder&);
 
-LevelBlockParts split_level_block(const Block& block, uint8_t file_version, bool quantized, const std::string& where) {
+LevelBlockParts split_level_block(const Block& block, uint8_t file_version, bool quantized, bool mixed,
+                                  const std::string& where) {
     AMC_REQUIRE(block.size >= 1, corrupt, "level block: bad predictor");
     LevelBlockParts parts;
     parts.raw_side = (block.payload[0] & kRawSideFlag) != 0;
@@ -434,7 +435,7 @@ LevelBlockParts split_level_block(const Block& block, uint8_t file_version, bool
                     (!parts.raw_side || (file_version >= kRawSideVersion && !quantized && !is_static_mode(GeometryPredictor(predictor)))),
                 corrupt, "level block: bad predictor");
     parts.predictor = GeometryPredictor(predictor);
-    parts.order = grouped_grid_order(file_version) ? StaticOrder::grouped : StaticOrder::per_vertex;
+    parts.order = grouped_grid_order(file_version, mixed) ? StaticOrder::grouped : StaticOrder::per_vertex;
     // A static mode's tables and a version-14 level's raw bits follow a length-prefixed arithmetic part.
     const RawSideParts split = is_static_mode(parts.predictor) || parts.raw_side
                                    ? split_raw_side(block.payload + 1, block.size - 1, where, "level block")

@@ -119,7 +119,8 @@ struct LevelBlockParts {
 
 // Throws Error on a predictor the file's version does not have (mode 4 also in a file that is not
 // quantized) and on a mode-3 or mode-4 arithmetic length beyond the block. `where` names the block in messages.
-LevelBlockParts split_level_block(const Block& block, uint8_t file_version, bool quantized, const std::string& where);
+LevelBlockParts split_level_block(const Block& block, uint8_t file_version, bool quantized, bool mixed,
+                                  const std::string& where);
 
 // Decodes the positions of `created` (the level `level` just decoded from `decoder`) and sets them
 // in h. Throws Error on a corrupt or truncated block.
