@@ -8,6 +8,8 @@
 //   scaling_bench make-mesh FACES OUT.ply                      a plain irregular mesh of about
 //                                                              FACES triangles (make_irregular_torus,
 //                                                              seed 1), for `amc encode` as users run it
+//   scaling_bench make-strip LENGTH WIDTH OUT.ply              an irregular strip of LENGTH x WIDTH
+//                                                              cells (make_irregular_strip, seed 1)
 //   scaling_bench encode BITS RUNS THREADS model.amh OUT.amc   encodes (default options, BITS 0:
 //                                                              lossless) and writes OUT.amc
 //   scaling_bench decode RUNS THREADS FILE.amc                 decodes the file
@@ -119,6 +121,10 @@ int main(int argc, char** argv) {
         amc::write_mesh(argv[3], amc::make_irregular_torus(rings, segments, 1));
         return 0;
     }
+    if (mode == "make-strip" && argc == 5) {
+        amc::write_mesh(argv[4], amc::make_irregular_strip(std::atoi(argv[2]), std::atoi(argv[3]), 1));
+        return 0;
+    }
     if (mode == "encode" && argc == 7) {
         const amc::Hierarchy h = amc::read_hierarchy(argv[5]);
         amc::EncodeOptions options;
@@ -151,6 +157,6 @@ int main(int argc, char** argv) {
         print("decode", h.node_count(), info.faces, file.size(), t);
         return 0;
     }
-    std::fprintf(stderr, "usage: scaling_bench make LEAVES OUT.amh | make-mesh FACES OUT.ply | encode BITS RUNS THREADS model.amh OUT.amc | decode RUNS THREADS FILE.amc\n");
+    std::fprintf(stderr, "usage: scaling_bench make LEAVES OUT.amh | make-mesh FACES OUT.ply | make-strip LENGTH WIDTH OUT.ply | encode BITS RUNS THREADS model.amh OUT.amc | decode RUNS THREADS FILE.amc\n");
     return 2;
 }
