@@ -619,10 +619,16 @@ TEST(Golden, WindowedTipFilesDecodeAndPinTheEncoder) {
         SCOPED_TRACE(golden_path(kWindowedTipVersion, c.name));
         EXPECT_THROW(encode_base_connectivity(c.hierarchy.base(), BaseConnectivityMode::angle), Error)
             << "mode 2 walks over its budget on this base";
-        const std::vector<uint8_t> golden = pinned_encoding(c, kWindowedTipVersion);
+        EncodeStats stats;
+        const std::vector<uint8_t> golden = pinned_encoding(c, kWindowedTipVersion, &stats);
         ASSERT_FALSE(golden.empty()) << "missing";
         const FileInfo info = inspect(golden.data(), golden.size());
         EXPECT_EQ(info.version, kWindowedTipVersion);
+        if (c.options.quantize_bits != 0) {
+            EXPECT_TRUE(std::any_of(stats.per_level.begin(), stats.per_level.end(), [](const LevelStats& l) {
+                return l.predictor == GeometryPredictor::normal_frame_grid;
+            })) << "the case exercises geometry mode 4 (grouped order, or per vertex when mixed)";
+        }
         EXPECT_EQ(info.quantize_bits, c.options.quantize_bits);
         check_decodes(golden, c, kWindowedTipVersion);
         // Mode 3 is an error in a file of an older version.
