@@ -84,10 +84,36 @@ TriangleMesh make_torus(int rings, int segments, double major_radius, double min
     return mesh;
 }
 
+namespace {
+
+// A vertex's offset from its grid point along one axis: up to 0.3 of a cell either way.
+double cell_jitter(std::mt19937& rng) { return (double(rng() >> 8) * 0x1p-24 - 0.5) * 0.6; }
+
+// Cuts each cell (i, j) of a rows x columns grid, corners id(i, j) .. id(i + 1, j + 1), along the
+// diagonal one draw of `rng` picks, cell after cell in row order.
+template <class Id>
+void cut_cells_at_random(TriangleMesh& mesh, int rows, int columns, std::mt19937& rng, Id id) {
+    mesh.triangles.reserve(mesh.triangles.size() + 2 * size_t(rows) * size_t(columns));
+    for (int i = 0; i < rows; ++i) {
+        for (int j = 0; j < columns; ++j) {
+            const uint32_t a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1), d = id(i, j + 1);
+            if (rng() & 1) {
+                mesh.triangles.push_back({a, b, c});
+                mesh.triangles.push_back({a, c, d});
+            } else {
+                mesh.triangles.push_back({a, b, d});
+                mesh.triangles.push_back({b, c, d});
+            }
+        }
+    }
+}
+
+}  // namespace
+
 TriangleMesh make_irregular_torus(int rings, int segments, uint32_t seed) {
     AMC_REQUIRE(rings >= 3 && segments >= 3, invalid_input, "irregular torus: at least 3 rings and 3 segments");
     std::mt19937 rng(seed);  // its raw bits only: the same mesh from every standard library
-    auto jitter = [&] { return (double(rng() >> 8) * 0x1p-24 - 0.5) * 0.6; };
+    auto jitter = [&] { return cell_jitter(rng); };
     TriangleMesh mesh;
     mesh.positions.reserve(size_t(rings) * segments);
     for (int i = 0; i < rings; ++i) {
@@ -97,20 +123,8 @@ TriangleMesh make_irregular_torus(int rings, int segments, uint32_t seed) {
             mesh.positions.push_back({r * std::cos(u), r * std::sin(u), std::sin(v)});
         }
     }
-    auto id = [&](int i, int j) { return uint32_t((i % rings) * segments + (j % segments)); };
-    mesh.triangles.reserve(2 * size_t(rings) * segments);
-    for (int i = 0; i < rings; ++i) {
-        for (int j = 0; j < segments; ++j) {
-            const uint32_t a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1), d = id(i, j + 1);
-            if (rng() & 1) {
-                mesh.triangles.push_back({a, b, c});
-                mesh.triangles.push_back({a, c, d});
-            } else {
-                mesh.triangles.push_back({a, b, d});
-                mesh.triangles.push_back({b, c, d});
-            }
-        }
-    }
+    cut_cells_at_random(mesh, rings, segments, rng,
+                        [&](int i, int j) { return uint32_t((i % rings) * segments + (j % segments)); });
     make_single_precision(mesh);
     return mesh;
 }
@@ -118,7 +132,7 @@ TriangleMesh make_irregular_torus(int rings, int segments, uint32_t seed) {
 TriangleMesh make_irregular_strip(int length, int width, uint32_t seed) {
     AMC_REQUIRE(length >= 1 && width >= 1, invalid_input, "irregular strip: at least one cell each way");
     std::mt19937 rng(seed);
-    auto jitter = [&] { return (double(rng() >> 8) * 0x1p-24 - 0.5) * 0.6; };
+    auto jitter = [&] { return cell_jitter(rng); };
     TriangleMesh mesh;
     for (int i = 0; i <= length; ++i) {
         for (int j = 0; j <= width; ++j) {
@@ -126,19 +140,7 @@ TriangleMesh make_irregular_strip(int length, int width, uint32_t seed) {
             mesh.positions.push_back({x, y, 0.1 * std::sin(0.7 * x) * std::cos(1.3 * y)});
         }
     }
-    auto id = [&](int i, int j) { return uint32_t(i * (width + 1) + j); };
-    for (int i = 0; i < length; ++i) {
-        for (int j = 0; j < width; ++j) {
-            const uint32_t a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1), d = id(i, j + 1);
-            if (rng() & 1) {
-                mesh.triangles.push_back({a, b, c});
-                mesh.triangles.push_back({a, c, d});
-            } else {
-                mesh.triangles.push_back({a, b, d});
-                mesh.triangles.push_back({b, c, d});
-            }
-        }
-    }
+    cut_cells_at_random(mesh, length, width, rng, [&](int i, int j) { return uint32_t(i * (width + 1) + j); });
     make_single_precision(mesh);
     return mesh;
 }
