@@ -342,6 +342,11 @@ std::vector<uint8_t> encode_cut_border(const TriangleMesh& mesh, BaseMeshCode& c
         ec.vertex_sequence.push_back(v);
     };
     std::vector<uint32_t> degree1(vc, 0);
+    // Mode 0's decoder scans the whole loop for the next gate after every R and E, so a stream of
+    // long loops decodes in quadratic time: the encoder writes none that scans more than this
+    // (its own searches for split and merge tips counted too).
+    const uint64_t scan_budget = 64 * uint64_t{fc} + (uint64_t{1} << 24);
+    uint64_t scanned = 0;
     auto visit_triangle = [&](uint32_t he) {
         const uint32_t t = he / 3;
         if (processed[t]) throw EncoderGaveUp{};
@@ -417,6 +422,7 @@ std::vector<uint8_t> encode_cut_border(const TriangleMesh& mesh, BaseMeshCode& c
                     border.op_right();
                     out_he[p] = to_v;
                 }
+                if (!border.stack.empty() && (scanned += border.top().length) > scan_budget) throw EncoderGaveUp{};
                 border.choose_gate(degree1);
                 continue;
             }
@@ -440,6 +446,7 @@ std::vector<uint8_t> encode_cut_border(const TriangleMesh& mesh, BaseMeshCode& c
                 x = border.next[x];
                 ++k;
             }
+            if ((scanned += k) > scan_budget) throw EncoderGaveUp{};  // the decoder walks k to a split's tip
             if (x == n) {
                 if (k < 2 || k + 3 > loop.length) throw EncoderGaveUp{};
                 ops.push_back({4, k - 2, loop.length - 4});
@@ -454,6 +461,7 @@ std::vector<uint8_t> encode_cut_border(const TriangleMesh& mesh, BaseMeshCode& c
             for (size_t j = 0; j + 1 < border.stack.size() && index == border.stack.size(); ++j) {
                 uint32_t y = border.stack[j].gate;
                 for (uint32_t s = 0; s < border.stack[j].length; ++s, y = border.next[y]) {
+                    if (++scanned > scan_budget) throw EncoderGaveUp{};
                     if (y == n) {
                         index = j;
                         offset = s;
