@@ -442,10 +442,12 @@ std::vector<uint8_t> encode_file(const Hierarchy& input, const EncodeOptions& op
     const bool want_hierarchy_stats = stats_out != nullptr && options.hierarchy_statistics;
     // The mixing mode's forest in its older models, and with choose_traversal in the other traversal.
     ForestCode sixth, fifth, fourth, third, other_seventh;
+    // Version 22 (a base in mode 3) holds the seventh model only.
     std::vector<MixedAlternative> older =
-        mixed && !windowed_base ? std::vector<MixedAlternative>{{MixingModel::sixth, false, &sixth}, {MixingModel::fifth, false, &fifth},
-                                              {MixingModel::fourth, false, &fourth}, {MixingModel::third, false, &third}}
-              : std::vector<MixedAlternative>();
+        mixed && !windowed_base
+            ? std::vector<MixedAlternative>{{MixingModel::sixth, false, &sixth}, {MixingModel::fifth, false, &fifth},
+                                            {MixingModel::fourth, false, &fourth}, {MixingModel::third, false, &third}}
+            : std::vector<MixedAlternative>();
     if (mixed && options.choose_traversal) older.push_back({kWrittenMixingModel, true, &other_seventh});
     ForestCode forest = code_forest(h, root_of, root_nodes, chunks, faces, options, space, positions, base_raw_bits, threads,
                                     want_hierarchy_stats, first_pass.get(), turned_input && quantized ? &on_grid : nullptr, older, memory);
