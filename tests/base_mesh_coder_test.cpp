@@ -295,9 +295,9 @@ TEST(BaseMeshCoder, ModeThreeWhereModeTwoWalksTooFar) {
     EXPECT_LT(three, two * 1.02);
 }
 
-// Mode 0's decoder scans the whole loop for each new gate: on a strip of 160,000 triangles that is
-// about 3·10^9 nodes (2.4 s; 40,000 triangles: 0.14 s), so the encoder refuses a mode-0 stream
-// scanning more than 64 nodes a triangle plus 2^24, and a short strip still fits.
+// Mode 0's decoder scans the whole loop for each new gate, as long as the strip here: quadratic in
+// the triangles, so the encoder refuses a mode-0 stream scanning more than 64 nodes a triangle plus
+// 2^24, and a short strip still fits.
 TEST(BaseMeshCoder, ModeZeroIsNotWrittenWhereItsDecodeWouldBeQuadratic) {
     EXPECT_THROW(encode_base_connectivity(make_irregular_strip(20000, 4, 1), BaseConnectivityMode::cut_border), Error);
     check_round_trip(make_irregular_strip(1000, 4, 1), "short strip mode 0", BaseConnectivityMode::cut_border, false);

@@ -146,10 +146,12 @@ uint8_t first_version_of(MixingModel model) {
 // files are in the seventh model (encode() sees to both).
 uint8_t file_version(bool stencil_tables, bool raw_side, bool unit_geometry, bool grid_geometry, bool mixed_contexts, MixingModel mixing,
                      bool chunked, bool static_geometry, BaseConnectivityMode base_mode, bool store_numbering, bool base_side) {
-    if (base_mode == BaseConnectivityMode::angle_windowed) return kWindowedTipVersion;  // holds the rest (format_version.h)
-    if (mixed_contexts && mixing >= MixingModel::fourth) return base_side ? kBaseRawSideVersion : first_version_of(mixing);
+    const bool windowed_base = base_mode == BaseConnectivityMode::angle_windowed;
+    if (mixed_contexts && mixing >= MixingModel::fourth && !windowed_base)
+        return base_side ? kBaseRawSideVersion : first_version_of(mixing);
     // Mixed files keep mode 4's per-vertex order (code_forest): only the others hold the grouped one.
-    if (const uint8_t newest = newest_features_version(grid_geometry && !mixed_contexts, stencil_tables, raw_side, chunked, base_side, false))
+    if (const uint8_t newest = newest_features_version(grid_geometry && !mixed_contexts, stencil_tables, raw_side, chunked,
+                                                       base_side, windowed_base))
         return newest;
     return unit_geometry                                 ? kUnitFrameVersion
            : mixed_contexts                              ? kThirdMixingVersion

@@ -113,12 +113,11 @@ void cut_cells_at_random(TriangleMesh& mesh, int rows, int columns, std::mt19937
 TriangleMesh make_irregular_torus(int rings, int segments, uint32_t seed) {
     AMC_REQUIRE(rings >= 3 && segments >= 3, invalid_input, "irregular torus: at least 3 rings and 3 segments");
     std::mt19937 rng(seed);  // its raw bits only: the same mesh from every standard library
-    auto jitter = [&] { return cell_jitter(rng); };
     TriangleMesh mesh;
     mesh.positions.reserve(size_t(rings) * segments);
     for (int i = 0; i < rings; ++i) {
         for (int j = 0; j < segments; ++j) {
-            const double u = (i + jitter()) * 2 * kPi / rings, v = (j + jitter()) * 2 * kPi / segments;
+            const double u = (i + cell_jitter(rng)) * 2 * kPi / rings, v = (j + cell_jitter(rng)) * 2 * kPi / segments;
             const double r = 3.0 + std::cos(v);
             mesh.positions.push_back({r * std::cos(u), r * std::sin(u), std::sin(v)});
         }
@@ -132,11 +131,10 @@ TriangleMesh make_irregular_torus(int rings, int segments, uint32_t seed) {
 TriangleMesh make_irregular_strip(int length, int width, uint32_t seed) {
     AMC_REQUIRE(length >= 1 && width >= 1, invalid_input, "irregular strip: at least one cell each way");
     std::mt19937 rng(seed);
-    auto jitter = [&] { return cell_jitter(rng); };
     TriangleMesh mesh;
     for (int i = 0; i <= length; ++i) {
         for (int j = 0; j <= width; ++j) {
-            const double x = i + jitter(), y = j + jitter();
+            const double x = i + cell_jitter(rng), y = j + cell_jitter(rng);
             mesh.positions.push_back({x, y, 0.1 * std::sin(0.7 * x) * std::cos(1.3 * y)});
         }
     }

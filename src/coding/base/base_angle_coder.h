@@ -40,9 +40,10 @@ constexpr uint32_t tip_window_of(BaseConnectivityMode mode) {
 // not fit the mode.
 std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, BaseConnectivityMode mode,
                                        bool search, unsigned threads, uint64_t search_budget);
-// The mode-2 stream from one start (the shortest context set). Throws EncoderGaveUp as above,
+// The stream of `mode` from one start (the shortest context set). Throws EncoderGaveUp as above,
 // invalid_input when the start is not one of the mesh's.
-std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, const BaseStart& start);
+std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, BaseConnectivityMode mode,
+                                       const BaseStart& start);
 
 // Decodes the rest of a mode-2 or mode-3 stream (after the two mode bits) of `size` bytes, reading
 // the positions from `source` as vertices are created. Throws Error.

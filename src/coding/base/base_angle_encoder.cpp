@@ -559,10 +559,11 @@ std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& c
     return encode_angle_candidates(mesh, cm, code, mode, candidates, threads);
 }
 
-std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, const BaseStart& start) {
+std::vector<uint8_t> encode_angle_mode(const TriangleMesh& mesh, BaseMeshCode& code, BaseConnectivityMode mode,
+                                       const BaseStart& start) {
     AMC_REQUIRE(start.radius < 8 && start.rotation < 3 && start.first < mesh.triangles.size(), invalid_input,
                 "base mesh coder: no such start");
-    return encode_angle_candidates(mesh, make_closed(mesh), code, BaseConnectivityMode::angle, {start}, 1);
+    return encode_angle_candidates(mesh, make_closed(mesh), code, mode, {start}, 1);
 }
 
 }  // namespace amc

@@ -83,7 +83,7 @@ bool try_mode(const TriangleMesh& mesh, BaseConnectivityMode mode, BaseMeshCode&
         switch (mode) {
             case BaseConnectivityMode::angle:
             case BaseConnectivityMode::angle_windowed:
-                code.bytes = start != nullptr ? encode_angle_mode(mesh, code, *start)
+                code.bytes = start != nullptr ? encode_angle_mode(mesh, code, mode, *start)
                                               : encode_angle_mode(mesh, code, mode, search, threads, search_budget);
                 break;
             case BaseConnectivityMode::cut_border: code.bytes = encode_cut_border(mesh, code); break;
