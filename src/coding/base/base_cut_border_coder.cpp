@@ -2,6 +2,8 @@
 // versions 1 and 2, kept so that their files decode. See base_cut_border_coder.h.
 #include "coding/base/base_cut_border_coder.h"
 
+#include "coding/base/base_cut_border.h"
+
 #include "coding/base/base_mesh_closing.h"
 #include "common/bits.h"
 
@@ -26,118 +28,9 @@ struct OpModels {
     BitModel& new_model(uint32_t du) { return is_new[degree_class(du)]; }
 };
 
-// The cut border: a stack of loops of border nodes (doubly linked, cyclic). A node stands for a
-// vertex on the border and for the border edge leaving it; `opp` is the third vertex of the
-// decoded triangle on the other side of that edge (the parallelogram stencil of a new vertex).
-// The top of the stack is the current loop; its gate is the edge leaving the gate node.
-struct CutBorder {
-    struct Loop {
-        uint32_t gate;
-        uint32_t length;
-    };
-    std::vector<uint32_t> next, prev, vert, opp;
-    std::vector<Loop> stack;
-
-    uint32_t new_node(uint32_t v, uint32_t o) {
-        next.push_back(kNoVertex);
-        prev.push_back(kNoVertex);
-        vert.push_back(v);
-        opp.push_back(o);
-        return static_cast<uint32_t>(vert.size() - 1);
-    }
-    void link(uint32_t a, uint32_t b) {
-        next[a] = b;
-        prev[b] = a;
-    }
-    Loop& top() { return stack.back(); }
-
-    // Starts a component with triangle (a, b, c): loop a -> c -> b, gate at a.
-    void start(uint32_t a, uint32_t b, uint32_t c) {
-        const uint32_t na = new_node(a, b), nc = new_node(c, a), nb = new_node(b, c);
-        link(na, nc);
-        link(nc, nb);
-        link(nb, na);
-        stack.push_back({na, 3});
-    }
-    // C: new vertex w on the gate; returns its node.
-    uint32_t op_new(uint32_t w) {
-        Loop& l = top();
-        const uint32_t g = l.gate, nv = next[g];
-        const uint32_t nw = new_node(w, vert[g]);
-        opp[g] = vert[nv];
-        link(g, nw);
-        link(nw, nv);
-        ++l.length;
-        return nw;
-    }
-    // R: the tip is the vertex before u; u leaves the border, the gate moves back.
-    void op_right() {
-        Loop& l = top();
-        const uint32_t g = l.gate, p = prev[g], nv = next[g];
-        opp[p] = vert[g];
-        link(p, nv);
-        l.gate = p;
-        --l.length;
-    }
-    // L: the tip is the vertex after v; v leaves the border.
-    void op_left() {
-        Loop& l = top();
-        const uint32_t g = l.gate, nv = next[g], nw = next[nv];
-        opp[g] = vert[nv];
-        link(g, nw);
-        --l.length;
-    }
-    // E: the 3-loop is closed.
-    void op_end() { stack.pop_back(); }
-    // S: the tip is node n = k steps after v (2 <= k <= length - 3). The part v .. n becomes a
-    // loop of its own, pushed below the current one; returns the new node of w in that part.
-    uint32_t op_split(uint32_t n, uint32_t k) {
-        const uint32_t nw = close_gate_at(n);
-        top().length -= k;
-        stack.insert(stack.end() - 1, Loop{nw, k + 1});
-        return nw;
-    }
-    // M: the tip is node n of the stack loop `index` (stack position); the loops are merged.
-    uint32_t op_merge(uint32_t n, size_t index) {
-        const uint32_t other_length = stack[index].length;
-        stack.erase(stack.begin() + static_cast<std::ptrdiff_t>(index));
-        const uint32_t nw = close_gate_at(n);
-        top().length += other_length + 1;
-        return nw;
-    }
-    // S and M alike: the gate's triangle has its tip at node n elsewhere on the loops (so n's
-    // predecessor is not the gate and n is not the gate's far end). The gate now leads to n, and
-    // a second node of the tip's vertex joins n's predecessor to the gate's far end; returns it.
-    uint32_t close_gate_at(uint32_t n) {
-        const uint32_t g = top().gate, nv = next[g], pn = prev[n];
-        const uint32_t nw = new_node(vert[n], vert[g]);
-        opp[g] = vert[nv];
-        link(g, n);
-        link(pn, nw);
-        link(nw, nv);
-        return nw;
-    }
-    // Moves the gate of the current loop to the node whose vertex has the most decoded triangles
-    // (the vertex closest to completion: fewer splits, as in Alliez–Desbrun's conquest), the
-    // first such node after the current gate on ties.
-    void choose_gate(const std::vector<uint32_t>& degree) {
-        if (stack.empty()) return;
-        Loop& l = top();
-        uint32_t best = l.gate, best_degree = degree[vert[best]], n = l.gate;
-        for (uint32_t i = 1; i < l.length; ++i) {
-            n = next[n];
-            if (degree[vert[n]] > best_degree) {
-                best = n;
-                best_degree = degree[vert[n]];
-            }
-        }
-        l.gate = best;
-    }
-    uint32_t walk(uint32_t n, uint32_t steps) const {
-        for (uint32_t i = 0; i < steps; ++i) n = next[n];
-        return n;
-    }
-};
+// Mode 0 keeps its decode linear up to logarithms: a stream whose border nodes need more degree
+// updates than this (FORMAT.md 4.5; a vertex holding many border nodes at once) is refused.
+uint64_t update_budget(uint32_t closed_faces) { return 64 * uint64_t{closed_faces} + (uint64_t{1} << 24); }
 
 }  // namespace
 
@@ -169,22 +62,22 @@ DecodedBaseMesh decode_cut_border(ArithmeticDecoder& dec, size_t size, uint32_t 
         fail_base_stream("triangle count exceeds the stream");
 
     OpModels models;
-    CutBorder border;
     const uint32_t vc = static_cast<uint32_t>(closed_vertices);
     const uint32_t fc = static_cast<uint32_t>(closed_faces);
-    std::vector<uint32_t> degree;
+    CutBorder border(0, update_budget(fc));
+    const std::vector<uint32_t>& degree = border.degree;
     std::vector<uint8_t> is_dummy;
     std::vector<BaseStencil> raw_stencils;
     std::vector<Triangle> tris;
     // Room for what a stream of this size typically holds (a few triangles a byte); more grows.
     const uint64_t typical = 64 * uint64_t{size} + 64;
-    degree.reserve(std::min<uint64_t>(vc, typical));
+    border.degree.reserve(std::min<uint64_t>(vc, typical));
     tris.reserve(std::min<uint64_t>(fc, typical));
     uint32_t dummy_seen = 0;
 
     auto add_vertex = [&](BaseStencil s, bool dummy) {
         if (degree.size() >= vc) fail_base_stream("more vertices than announced");
-        degree.push_back(0);
+        border.add_vertex();
         is_dummy.push_back(dummy ? 1 : 0);
         raw_stencils.push_back(s);
         return static_cast<uint32_t>(degree.size() - 1);
@@ -193,9 +86,7 @@ DecodedBaseMesh decode_cut_border(ArithmeticDecoder& dec, size_t size, uint32_t 
         if (tris.size() >= fc) fail_base_stream("more triangles than announced");
         if (a == b || b == c || a == c) fail_base_stream("degenerate triangle");
         tris.push_back({a, b, c});
-        ++degree[a];
-        ++degree[b];
-        ++degree[c];
+        if (!border.count_triangle(a, b, c)) fail_base_stream("too many border nodes of the same vertices");
     };
 
     for (uint32_t comp = 0; comp < components; ++comp) {
@@ -226,7 +117,7 @@ DecodedBaseMesh decode_cut_border(ArithmeticDecoder& dec, size_t size, uint32_t 
                 add_triangle(u, v, border.vert[border.prev[g]]);
                 if (length == 3) border.op_end();
                 else border.op_right();
-                border.choose_gate(degree);
+                border.choose_gate();
                 continue;
             }
             if (length > 3 && dec.decode(models.is_left[OpModels::degree_class(degree[v])])) {
@@ -332,37 +223,25 @@ std::vector<uint8_t> encode_cut_border(const TriangleMesh& mesh, BaseMeshCode& c
     ClosedTraversal ec;
     std::vector<uint32_t> decoder_index(vc, kNoVertex);
     std::vector<uint8_t> processed(fc, 0);
-    CutBorder border;
+    CutBorder border(vc, update_budget(fc));
     std::vector<uint32_t> out_he;  // per node: the unprocessed halfedge of its border edge
-    std::vector<std::vector<uint32_t>> nodes_of(vc);
-    std::vector<uint8_t> alive;
 
     auto visit_vertex = [&](uint32_t v) {
         decoder_index[v] = static_cast<uint32_t>(ec.vertex_sequence.size());
         ec.vertex_sequence.push_back(v);
     };
-    std::vector<uint32_t> degree1(vc, 0);
-    // Mode 0's decoder scans the whole loop for the next gate after every R and E, so a stream of
-    // long loops decodes in quadratic time: the encoder writes none that scans more than this
-    // (its own searches for split and merge tips counted too).
-    const uint64_t scan_budget = 64 * uint64_t{fc} + (uint64_t{1} << 24);
-    uint64_t scanned = 0;
     auto visit_triangle = [&](uint32_t he) {
         const uint32_t t = he / 3;
         if (processed[t]) throw EncoderGaveUp{};
         processed[t] = 1;
-        for (uint32_t x : cm.triangles[t]) ++degree1[x];
+        const Triangle& tri = cm.triangles[t];
+        if (!border.count_triangle(tri[0], tri[1], tri[2])) throw EncoderGaveUp{};
         ec.triangle_sequence.push_back(t);
         ec.rotation.push_back(static_cast<uint8_t>(he % 3));
     };
     auto track = [&](uint32_t node, uint32_t he) {
-        if (out_he.size() <= node) {
-            out_he.resize(node + 1, kNoVertex);
-            alive.resize(node + 1, 0);
-        }
+        if (out_he.size() <= node) out_he.resize(node + 1, kNoVertex);
         out_he[node] = he;
-        alive[node] = 1;
-        nodes_of[border.vert[node]].push_back(node);
     };
     // Is triangle t in the unprocessed sector of node n (between its out edge and in edge)?
     auto sector_holds = [&](uint32_t n, uint32_t t) {
@@ -415,39 +294,27 @@ std::vector<uint8_t> encode_cut_border(const TriangleMesh& mesh, BaseMeshCode& c
             if (border.vert[p] == w) {
                 ops.push_back({2});
                 if (loop.length == 3) {
-                    alive[g] = alive[nv] = alive[p] = 0;
                     border.op_end();
                 } else {
-                    alive[g] = 0;
                     border.op_right();
                     out_he[p] = to_v;
                 }
-                if (!border.stack.empty() && (scanned += border.top().length) > scan_budget) throw EncoderGaveUp{};
-                border.choose_gate(degree1);
+                border.choose_gate();
                 continue;
             }
             if (loop.length > 3 && border.vert[border.next[nv]] == w) {
                 ops.push_back({3});
-                alive[nv] = 0;
                 border.op_left();
                 out_he[g] = to_w;
                 continue;
             }
             uint32_t n = kNoVertex;
-            for (uint32_t cand : nodes_of[w]) {
-                if (alive[cand] && sector_holds(cand, t)) {
-                    n = cand;
-                    break;
-                }
-            }
+            for (uint32_t x = border.first_node_of(w); x != CutBorder::kNoNode && n == kNoVertex;
+                 x = border.next_node_of(x))
+                if (sector_holds(x, t)) n = x;
             if (n == kNoVertex) throw EncoderGaveUp{};
-            uint32_t k = 0, x = nv;
-            while (k < loop.length && x != n) {
-                x = border.next[x];
-                ++k;
-            }
-            if ((scanned += k) > scan_budget) throw EncoderGaveUp{};  // the decoder walks k to a split's tip
-            if (x == n) {
+            if (border.same_loop(n, g)) {
+                const uint32_t k = border.steps_between(nv, n);
                 if (k < 2 || k + 3 > loop.length) throw EncoderGaveUp{};
                 ops.push_back({4, k - 2, loop.length - 4});
                 const uint32_t nw = border.op_split(n, k);
@@ -455,21 +322,11 @@ std::vector<uint8_t> encode_cut_border(const TriangleMesh& mesh, BaseMeshCode& c
                 track(nw, to_v);
                 continue;
             }
-            // Another loop of the stack: find it by walking from n to a loop's gate.
             size_t index = border.stack.size();
-            uint32_t offset = 0;
-            for (size_t j = 0; j + 1 < border.stack.size() && index == border.stack.size(); ++j) {
-                uint32_t y = border.stack[j].gate;
-                for (uint32_t s = 0; s < border.stack[j].length; ++s, y = border.next[y]) {
-                    if (++scanned > scan_budget) throw EncoderGaveUp{};
-                    if (y == n) {
-                        index = j;
-                        offset = s;
-                        break;
-                    }
-                }
-            }
+            for (size_t j = 0; j + 1 < border.stack.size() && index == border.stack.size(); ++j)
+                if (border.same_loop(n, border.stack[j].gate)) index = j;
             if (index == border.stack.size()) throw EncoderGaveUp{};
+            const uint32_t offset = border.steps_between(border.stack[index].gate, n);
             ++ec.merges;
             const uint32_t depth = static_cast<uint32_t>(border.stack.size() - 2 - index);
             ops.push_back({5, depth, offset});
@@ -520,12 +377,12 @@ std::vector<uint8_t> encode_cut_border(const TriangleMesh& mesh, BaseMeshCode& c
     put_count(enc, ec.components);
     put_count(enc, ec.merges);
     OpModels models;
-    CutBorder replay;  // only for the contexts (degrees) and loop lengths: mirrors the decoder
-    std::vector<uint32_t> degree(vc, 0);
+    CutBorder replay(vc, UINT64_MAX);  // only for the contexts (degrees) and loop lengths: mirrors the decoder
+    const std::vector<uint32_t>& degree = replay.degree;
     size_t next_vertex = 0, next_triangle = 0;
     auto count_triangle = [&]() {
         const Triangle& tri = cm.triangles[ec.triangle_sequence[next_triangle++]];
-        for (uint32_t v : tri) ++degree[decoder_index[v]];
+        replay.count_triangle(decoder_index[tri[0]], decoder_index[tri[1]], decoder_index[tri[2]]);
     };
     for (size_t i = 0; i < ops.size(); ++i) {
         const Op& op = ops[i];
@@ -550,7 +407,7 @@ std::vector<uint8_t> encode_cut_border(const TriangleMesh& mesh, BaseMeshCode& c
         if (op.kind == 2) {
             if (loop.length == 3) replay.op_end();
             else replay.op_right();
-            replay.choose_gate(degree);
+            replay.choose_gate();
             continue;
         }
         if (loop.length > 3) enc.encode(op.kind == 3, models.is_left[OpModels::degree_class(degree[v] - 1)]);

@@ -1,8 +1,8 @@
 // Mode 0 of the base connectivity stream: the cut-border coder of format versions 1 and 2 (a
 // Gumhold–Straßer cut-border machine with Edgebreaker-like C/R/L/E/S ops and M merges, ops
 // coded with contexts from the number of triangles decoded around the gate's vertices; FORMAT.md
-// 4.3-4.7). The encoder no longer chooses it; it is kept so that earlier files decode, and its
-// encoder so that tests can make such streams.
+// 4.3-4.7). The writer takes it only where modes 2 and 3 do not fit (it needs no positions);
+// earlier files decode with it. The cut border itself: base_cut_border.h.
 #pragma once
 
 #include "coding/entropy/arithmetic_coder.h"
