@@ -101,7 +101,7 @@ TEST(CutBorder, EveryBorderNodeOfAVertexIsListed) {
     const uint32_t nv = border.next[border.top().gate];
     border.op_split(border.walk(nv, 2), 2);
     std::vector<uint32_t> nodes;
-    for (uint32_t x = border.first_node_of(2); x != CutBorder::kNoNode; x = border.next_node_of(x))
+    for (uint32_t x = border.first_node_of(2); x != CutBorder::kNoBorderNode; x = border.next_node_of(x))
         nodes.push_back(x);
     ASSERT_EQ(nodes.size(), 2u);
     EXPECT_EQ(border.vert[nodes[0]], 2u);

@@ -50,6 +50,7 @@ public:
         const std::pair<Key, Value>& slot = slots_[probe(key)];
         return slot.first == empty_ ? nullptr : &slot.second;
     }
+    Value* find(Key key) { return const_cast<Value*>(static_cast<const FlatMap&>(*this).find(key)); }
 
 private:
     size_t probe(Key key) const {
@@ -81,16 +82,31 @@ ImportedHierarchy hierarchy_from_levels(const TriangleMesh& mesh, const Detected
     h = Hierarchy(detected.base);
     std::vector<uint32_t> input_of = detected.leaf_vertex_of_base;  // hierarchy vertex -> input vertex
     // The build's tables are freed before the check makes its own (a large mesh's peak memory).
+    // They hold the splits' parents and children, not every root: a plain mesh's base is nearly
+    // the mesh, and a table of its roots cost a large mesh most of this function's time.
     {
-        size_t node_count = h.root_count();
-        for (const DetectedLevel& level : detected.levels) node_count += 4 * level.splits.size();
-        FlatMap<TripleKey, NodeId> node_of(node_count, kEmptyTriple);
+        size_t split_count = 0;
+        for (const DetectedLevel& level : detected.levels) split_count += level.splits.size();
         auto key_of = [&](NodeId n) { return triple_key(input_of[h.vertex(n, 0)], input_of[h.vertex(n, 1)], input_of[h.vertex(n, 2)]); };
-        for (NodeId root = 0; root < h.root_count(); ++root) node_of[key_of(root)] = root;
+        // The root of each split's triangle, found in one pass over the roots (the last root of a
+        // vertex set, as a table of every root filled in order would hold).
+        FlatMap<TripleKey, NodeId> root_of(split_count, kEmptyTriple);
+        for (const DetectedLevel& level : detected.levels)
+            for (const auto& s : level.splits) root_of[triple_key(s[0], s[1], s[2])] = kNoNode;
+        if (split_count > 0) {
+            for (NodeId root = 0; root < h.root_count(); ++root)
+                if (NodeId* r = root_of.find(key_of(root))) *r = root;
+        }
+        FlatMap<TripleKey, NodeId> child_of(4 * split_count, kEmptyTriple);
+        auto node_of = [&](TripleKey key) -> const NodeId* {
+            if (const NodeId* child = child_of.find(key)) return child;  // written after the roots: it wins
+            const NodeId* root = root_of.find(key);
+            return root != nullptr && *root != kNoNode ? root : nullptr;
+        };
 
         for (size_t level = detected.levels.size(); level-- > 0;) {
             for (const auto& s : detected.levels[level].splits) {
-                const NodeId* found = node_of.find(triple_key(s[0], s[1], s[2]));
+                const NodeId* found = node_of(triple_key(s[0], s[1], s[2]));
                 if (found == nullptr || !h.is_leaf(*found)) {
                     fail("level " + std::to_string(level) + " splits a triangle that is not a leaf");
                 }
@@ -113,25 +129,39 @@ ImportedHierarchy hierarchy_from_levels(const TriangleMesh& mesh, const Detected
                         fail("two midpoints for one edge");
                     }
                 }
-                for (int k = 0; k < 4; ++k) node_of[key_of(h.child(n, k))] = h.child(n, k);
+                for (int k = 0; k < 4; ++k) child_of[key_of(h.child(n, k))] = h.child(n, k);
             }
         }
     }
 
     // Diagonals of two-hanging-node leaves: the default one joins m_{u+1} and v_u (a triangle
-    // (v_u, m_{u+1}, m_{u+2}) exists), the other m_{u+2} and v_{u+1}.
+    // (v_u, m_{u+1}, m_{u+2}) exists), the other m_{u+2} and v_{u+1}. The input's directed edges are
+    // looked up only from those leaves' v_u (a table of every edge was most of a large plain
+    // mesh's peak memory).
     {
-        FlatMap<uint64_t, uint8_t> edges(mesh.triangles.size() * 3, ~0ull);  // directed edges of the input
-        for (const Triangle& t : mesh.triangles) {
-            for (int e = 0; e < 3; ++e) edges[directed(t[size_t(e)], t[size_t(e + 1) % 3])] = 1;
-        }
+        struct Green {
+            NodeId node;
+            uint32_t from, to;  // input ids of v_u and m_{u+1}
+        };
+        std::vector<Green> greens;
+        std::vector<uint8_t> asked(mesh.positions.size(), 0);
         for (NodeId n : h.leaves()) {
             if (h.hanging_node_count(n) != 2) continue;
             const int u = !h.has_hanging_node(n, 0) ? 0 : !h.has_hanging_node(n, 1) ? 1 : 2;
             const int e1 = (u + 1) % 3;
             const VertexId m1 = h.midpoint(h.neighbor(n, e1), h.neighbor_edge(n, e1));
-            h.set_diagonal_flipped(n, edges.find(directed(input_of[h.vertex(n, u)], input_of[m1])) == nullptr);
+            greens.push_back({n, input_of[h.vertex(n, u)], input_of[m1]});
+            if (greens.back().from < asked.size()) asked[greens.back().from] = 1;
         }
+        size_t asked_edges = 0;
+        for (const Triangle& t : mesh.triangles)
+            for (uint32_t v : t) asked_edges += asked[v];
+        FlatMap<uint64_t, uint8_t> edges(asked_edges, ~0ull);  // the input's directed edges from those v_u
+        for (const Triangle& t : mesh.triangles) {
+            for (int e = 0; e < 3; ++e)
+                if (asked[t[size_t(e)]]) edges[directed(t[size_t(e)], t[size_t(e + 1) % 3])] = 1;
+        }
+        for (const Green& g : greens) h.set_diagonal_flipped(g.node, edges.find(directed(g.from, g.to)) == nullptr);
     }
 
     // The check: every input vertex used once, the same triangles, a valid hierarchy.
@@ -152,21 +182,37 @@ ImportedHierarchy hierarchy_from_levels(const TriangleMesh& mesh, const Detected
     for (VertexId v = 0; v < canonical.size(); ++v) {
         if (canonical[v] < input_of_canonical.size()) input_of_canonical[canonical[v]] = input_of[v];
     }
-    // The same triangles as a multiset: each built one takes one given one of its key (the
-    // oriented triangle, smallest id first), and there are as many of each.
-    FlatMap<TripleKey, uint32_t> given(mesh.triangles.size(), kEmptyTriple);
-    auto oriented_key = [](const Triangle& t) {
-        const Triangle n = normalized(t);
-        return TripleKey{(uint64_t(n[0]) << 32) | n[1], n[2]};
+    // The same triangles as a multiset: both lists, each triangle rotated to start at its smallest
+    // id, bucketed by that id and sorted within buckets, are equal (a bucket sort keeps the ids'
+    // locality in the file, where a hash table scatters them).
+    const uint32_t vertex_count = static_cast<uint32_t>(mesh.positions.size());
+    auto bucketed = [&](const std::vector<Triangle>& triangles, auto input_id, std::vector<uint32_t>& start,
+                        std::vector<uint64_t>& rest) {
+        start.assign(size_t(vertex_count) + 1, 0);
+        for (const Triangle& t : triangles) {
+            const Triangle n = normalized({input_id(t[0]), input_id(t[1]), input_id(t[2])});
+            if (n[0] >= vertex_count || n[1] >= vertex_count || n[2] >= vertex_count) return false;
+            ++start[n[0] + 1];
+        }
+        for (size_t v = 0; v < vertex_count; ++v) start[v + 1] += start[v];
+        std::vector<uint32_t> cursor(start.begin(), start.end() - 1);
+        rest.resize(triangles.size());
+        for (const Triangle& t : triangles) {
+            const Triangle n = normalized({input_id(t[0]), input_id(t[1]), input_id(t[2])});
+            rest[cursor[n[0]]++] = (uint64_t(n[1]) << 32) | n[2];
+        }
+        for (size_t v = 0; v < vertex_count; ++v)
+            if (start[v + 1] - start[v] > 1) std::sort(rest.begin() + start[v], rest.begin() + start[v + 1]);
+        return true;
     };
-    for (const Triangle& t : mesh.triangles) ++given[oriented_key(t)];
     bool same = leaf.mesh.triangles.size() == mesh.triangles.size();
-    for (size_t i = 0; same && i < leaf.mesh.triangles.size(); ++i) {
-        const Triangle& t = leaf.mesh.triangles[i];
-        const TripleKey key = oriented_key({input_of_canonical[t[0]], input_of_canonical[t[1]], input_of_canonical[t[2]]});
-        const uint32_t* count = given.find(key);
-        same = count != nullptr && *count != 0;
-        if (same) --given[key];
+    if (same) {
+        std::vector<uint32_t> given_start, built_start;
+        std::vector<uint64_t> given, built;
+        same = bucketed(mesh.triangles, [](uint32_t v) { return v; }, given_start, given) &&
+               bucketed(leaf.mesh.triangles, [&](uint32_t v) { return v < input_of_canonical.size() ? input_of_canonical[v] : kNoIndex; },
+                        built_start, built) &&
+               given_start == built_start && given == built;
     }
     if (!same) fail("the hierarchy's leaf mesh differs from the input");
     return out;

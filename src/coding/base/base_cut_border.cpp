@@ -6,18 +6,18 @@
 namespace amc {
 
 CutBorder::CutBorder(uint32_t vertices, uint64_t update_budget)
-    : degree(vertices, 0), first_of_vertex_(vertices, kNoNode), update_budget_(update_budget) {}
+    : degree(vertices, 0), first_of_vertex_(vertices, kNoBorderNode), update_budget_(update_budget) {}
 
 uint32_t CutBorder::add_vertex() {
     degree.push_back(0);
-    first_of_vertex_.push_back(kNoNode);
+    first_of_vertex_.push_back(kNoBorderNode);
     return static_cast<uint32_t>(degree.size() - 1);
 }
 
 bool CutBorder::count_triangle(uint32_t a, uint32_t b, uint32_t c) {
     for (uint32_t v : {a, b, c}) {
         ++degree[v];
-        for (uint32_t x = first_of_vertex_[v]; x != kNoNode; x = next_of_vertex_[x]) {
+        for (uint32_t x = first_of_vertex_[v]; x != kNoBorderNode; x = next_of_vertex_[x]) {
             ++updates_;
             splay(x);  // x's subtree is then its whole tree: one pull updates every maximum
             pull(x);
@@ -28,32 +28,32 @@ bool CutBorder::count_triangle(uint32_t a, uint32_t b, uint32_t c) {
 
 uint32_t CutBorder::new_node(uint32_t v, uint32_t o) {
     const uint32_t x = static_cast<uint32_t>(vert.size());
-    next.push_back(kNoNode);
-    prev.push_back(kNoNode);
+    next.push_back(kNoBorderNode);
+    prev.push_back(kNoBorderNode);
     vert.push_back(v);
     opp.push_back(o);
-    left_.push_back(kNoNode);
-    right_.push_back(kNoNode);
-    parent_.push_back(kNoNode);
+    left_.push_back(kNoBorderNode);
+    right_.push_back(kNoBorderNode);
+    parent_.push_back(kNoBorderNode);
     size_.push_back(1);
     max_degree_.push_back(degree[v]);
     next_of_vertex_.push_back(first_of_vertex_[v]);
-    prev_of_vertex_.push_back(kNoNode);
-    if (first_of_vertex_[v] != kNoNode) prev_of_vertex_[first_of_vertex_[v]] = x;
+    prev_of_vertex_.push_back(kNoBorderNode);
+    if (first_of_vertex_[v] != kNoBorderNode) prev_of_vertex_[first_of_vertex_[v]] = x;
     first_of_vertex_[v] = x;
     return x;
 }
 
 void CutBorder::retire(uint32_t x) {
     const uint32_t before = prev_of_vertex_[x], after = next_of_vertex_[x];
-    if (before == kNoNode) first_of_vertex_[vert[x]] = after;
+    if (before == kNoBorderNode) first_of_vertex_[vert[x]] = after;
     else next_of_vertex_[before] = after;
-    if (after != kNoNode) prev_of_vertex_[after] = before;
+    if (after != kNoBorderNode) prev_of_vertex_[after] = before;
     splay(x);
     const uint32_t a = left_[x], b = right_[x];
-    if (a != kNoNode) parent_[a] = kNoNode;
-    if (b != kNoNode) parent_[b] = kNoNode;
-    left_[x] = right_[x] = kNoNode;
+    if (a != kNoBorderNode) parent_[a] = kNoBorderNode;
+    if (b != kNoBorderNode) parent_[b] = kNoBorderNode;
+    left_[x] = right_[x] = kNoBorderNode;
     join(a, b);
 }
 
@@ -76,7 +76,7 @@ uint32_t CutBorder::op_new(uint32_t w) {
     ++l.length;
     splay(g);
     right_[nw] = right_[g];
-    if (right_[nw] != kNoNode) parent_[right_[nw]] = nw;
+    if (right_[nw] != kNoBorderNode) parent_[right_[nw]] = nw;
     pull(nw);
     right_[g] = nw;
     parent_[nw] = g;
@@ -149,9 +149,9 @@ void CutBorder::choose_gate() {
     const uint32_t most = max_degree_[g];
     uint32_t x = g;
     if (degree[vert[g]] != most) {
-        x = right_[g] != kNoNode && max_degree_[right_[g]] == most ? right_[g] : left_[g];
+        x = right_[g] != kNoBorderNode && max_degree_[right_[g]] == most ? right_[g] : left_[g];
         for (;;) {
-            if (left_[x] != kNoNode && max_degree_[left_[x]] == most) x = left_[x];
+            if (left_[x] != kNoBorderNode && max_degree_[left_[x]] == most) x = left_[x];
             else if (degree[vert[x]] == most) break;
             else x = right_[x];
         }
@@ -187,15 +187,15 @@ uint32_t CutBorder::steps_between(uint32_t from, uint32_t to) {
 bool CutBorder::same_loop(uint32_t a, uint32_t b) {
     splay(a);
     splay(b);  // in a's tree, a is then below b
-    return a == b || parent_[a] != kNoNode;
+    return a == b || parent_[a] != kNoBorderNode;
 }
 
 void CutBorder::pull(uint32_t x) {
     const uint32_t l = left_[x], r = right_[x];
     size_[x] = 1 + size_of(l) + size_of(r);
     uint32_t most = degree[vert[x]];
-    if (l != kNoNode) most = std::max(most, max_degree_[l]);
-    if (r != kNoNode) most = std::max(most, max_degree_[r]);
+    if (l != kNoBorderNode) most = std::max(most, max_degree_[l]);
+    if (r != kNoBorderNode) most = std::max(most, max_degree_[r]);
     max_degree_[x] = most;
 }
 
@@ -203,33 +203,33 @@ void CutBorder::rotate(uint32_t x) {
     const uint32_t p = parent_[x], g = parent_[p];
     if (left_[p] == x) {
         left_[p] = right_[x];
-        if (right_[x] != kNoNode) parent_[right_[x]] = p;
+        if (right_[x] != kNoBorderNode) parent_[right_[x]] = p;
         right_[x] = p;
     } else {
         right_[p] = left_[x];
-        if (left_[x] != kNoNode) parent_[left_[x]] = p;
+        if (left_[x] != kNoBorderNode) parent_[left_[x]] = p;
         left_[x] = p;
     }
     parent_[p] = x;
     parent_[x] = g;
-    if (g != kNoNode) (left_[g] == p ? left_[g] : right_[g]) = x;
+    if (g != kNoBorderNode) (left_[g] == p ? left_[g] : right_[g]) = x;
     pull(p);
     pull(x);
 }
 
 void CutBorder::splay(uint32_t x) {
-    while (parent_[x] != kNoNode) {
+    while (parent_[x] != kNoBorderNode) {
         const uint32_t p = parent_[x], g = parent_[p];
-        if (g != kNoNode) rotate((left_[g] == p) == (left_[p] == x) ? p : x);
+        if (g != kNoBorderNode) rotate((left_[g] == p) == (left_[p] == x) ? p : x);
         rotate(x);
     }
 }
 
 uint32_t CutBorder::join(uint32_t a, uint32_t b) {
-    if (a == kNoNode) return b;
-    if (b == kNoNode) return a;
+    if (a == kNoBorderNode) return b;
+    if (b == kNoBorderNode) return a;
     uint32_t last = a;
-    while (right_[last] != kNoNode) last = right_[last];
+    while (right_[last] != kNoBorderNode) last = right_[last];
     splay(last);
     right_[last] = b;
     parent_[b] = last;
@@ -240,9 +240,9 @@ uint32_t CutBorder::join(uint32_t a, uint32_t b) {
 uint32_t CutBorder::cut_after(uint32_t x) {
     splay(x);
     const uint32_t rest = right_[x];
-    if (rest == kNoNode) return kNoNode;
-    parent_[rest] = kNoNode;
-    right_[x] = kNoNode;
+    if (rest == kNoBorderNode) return kNoBorderNode;
+    parent_[rest] = kNoBorderNode;
+    right_[x] = kNoBorderNode;
     pull(x);
     return rest;
 }
@@ -250,9 +250,9 @@ uint32_t CutBorder::cut_after(uint32_t x) {
 uint32_t CutBorder::cut_before(uint32_t x) {
     splay(x);
     const uint32_t rest = left_[x];
-    if (rest == kNoNode) return kNoNode;
-    parent_[rest] = kNoNode;
-    left_[x] = kNoNode;
+    if (rest == kNoBorderNode) return kNoBorderNode;
+    parent_[rest] = kNoBorderNode;
+    left_[x] = kNoBorderNode;
     pull(x);
     return rest;
 }

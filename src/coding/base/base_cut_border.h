@@ -56,10 +56,10 @@ struct CutBorder {
     // Steps from node `from` forward to node `to` of the same loop.
     uint32_t steps_between(uint32_t from, uint32_t to);
     bool same_loop(uint32_t a, uint32_t b);
-    // The border nodes holding vertex v: first_node_of(v), then next_node_of(x) until kNoNode.
+    // The border nodes holding vertex v: first_node_of(v), then next_node_of(x) until kNoBorderNode.
     uint32_t first_node_of(uint32_t v) const { return first_of_vertex_[v]; }
     uint32_t next_node_of(uint32_t node) const { return next_of_vertex_[node]; }
-    static constexpr uint32_t kNoNode = UINT32_MAX;
+    static constexpr uint32_t kNoBorderNode = UINT32_MAX;
 
 private:
     uint32_t new_node(uint32_t v, uint32_t o);
@@ -83,7 +83,7 @@ private:
     uint32_t cut_before(uint32_t x);               // x's tree keeps x ..; returns the rest's root
     uint32_t ending_at(uint32_t x);                // x's loop rotated to end at x; returns its root
     uint32_t index_of(uint32_t x);                 // x's position in its tree (x becomes the root)
-    uint32_t size_of(uint32_t x) const { return x == kNoNode ? 0 : size_[x]; }
+    uint32_t size_of(uint32_t x) const { return x == kNoBorderNode ? 0 : size_[x]; }
     std::vector<uint32_t> left_, right_, parent_, size_, max_degree_;
 
     std::vector<uint32_t> first_of_vertex_, next_of_vertex_, prev_of_vertex_;

@@ -309,7 +309,7 @@ std::vector<uint8_t> encode_cut_border(const TriangleMesh& mesh, BaseMeshCode& c
                 continue;
             }
             uint32_t n = kNoVertex;
-            for (uint32_t x = border.first_node_of(w); x != CutBorder::kNoNode && n == kNoVertex;
+            for (uint32_t x = border.first_node_of(w); x != CutBorder::kNoBorderNode && n == kNoVertex;
                  x = border.next_node_of(x))
                 if (sector_holds(x, t)) n = x;
             if (n == kNoVertex) throw EncoderGaveUp{};
