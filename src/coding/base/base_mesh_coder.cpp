@@ -61,8 +61,8 @@ std::vector<uint8_t> encode_explicit(const TriangleMesh& mesh, BaseMeshCode& cod
     return enc.finish();
 }
 
-// Mode 0 is written for tests and studies of old files only: its stencils are read off its own
-// decode rather than tracked by its encoder.
+// Mode 0's stencils are read off its own decode rather than tracked by its encoder (it is the
+// writer's fallback after modes 2 and 3, and what versions 1-3 wrote).
 std::vector<BaseStencil> cut_border_stencils(const TriangleMesh& mesh, const BaseMeshCode& code) {
     return decode_base_mesh(code.bytes.data(), code.bytes.size(), static_cast<uint32_t>(mesh.positions.size()),
                             [&](uint32_t vertex, const BaseStencil&, const std::vector<Vec3>&) {
