@@ -237,22 +237,16 @@ uint32_t CutBorder::join(uint32_t a, uint32_t b) {
     return last;
 }
 
-uint32_t CutBorder::cut_after(uint32_t x) {
-    splay(x);
-    const uint32_t rest = right_[x];
-    if (rest == kNoBorderNode) return kNoBorderNode;
-    parent_[rest] = kNoBorderNode;
-    right_[x] = kNoBorderNode;
-    pull(x);
-    return rest;
-}
+uint32_t CutBorder::cut_after(uint32_t x) { return cut_off(x, right_); }
 
-uint32_t CutBorder::cut_before(uint32_t x) {
+uint32_t CutBorder::cut_before(uint32_t x) { return cut_off(x, left_); }
+
+uint32_t CutBorder::cut_off(uint32_t x, std::vector<uint32_t>& side) {
     splay(x);
-    const uint32_t rest = left_[x];
+    const uint32_t rest = side[x];
     if (rest == kNoBorderNode) return kNoBorderNode;
     parent_[rest] = kNoBorderNode;
-    left_[x] = kNoBorderNode;
+    side[x] = kNoBorderNode;
     pull(x);
     return rest;
 }

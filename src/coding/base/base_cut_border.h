@@ -81,6 +81,7 @@ private:
     uint32_t join(uint32_t a, uint32_t b);         // roots; returns the root of a then b
     uint32_t cut_after(uint32_t x);                // x's tree keeps .. x; returns the rest's root
     uint32_t cut_before(uint32_t x);               // x's tree keeps x ..; returns the rest's root
+    uint32_t cut_off(uint32_t x, std::vector<uint32_t>& side);  // x splayed; its `side` subtree cut
     uint32_t ending_at(uint32_t x);                // x's loop rotated to end at x; returns its root
     uint32_t index_of(uint32_t x);                 // x's position in its tree (x becomes the root)
     uint32_t size_of(uint32_t x) const { return x == kNoBorderNode ? 0 : size_[x]; }

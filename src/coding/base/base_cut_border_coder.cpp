@@ -1,9 +1,8 @@
 // Mode 0 of the base connectivity stream (FORMAT.md 4.3-4.7): the cut-border coder of format
-// versions 1 and 2, kept so that their files decode. See base_cut_border_coder.h.
+// versions 1 and 2, and the writer's fallback after modes 2 and 3. See base_cut_border_coder.h.
 #include "coding/base/base_cut_border_coder.h"
 
 #include "coding/base/base_cut_border.h"
-
 #include "coding/base/base_mesh_closing.h"
 #include "common/bits.h"
 
