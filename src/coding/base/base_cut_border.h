@@ -17,8 +17,8 @@ struct CutBorder {
         uint32_t gate;
         uint32_t length;
     };
-    // Per node: the ring, the node's vertex and the third vertex of the decoded triangle beyond
-    // the border edge leaving it (the parallelogram stencil of a new vertex).
+    // Per node: the ring, the node's vertex and the third vertex of the decoded triangle on the
+    // border edge leaving it (the parallelogram stencil of a new vertex there).
     std::vector<uint32_t> next, prev, vert, opp;
     std::vector<Loop> stack;      // the top is the current loop; its gate is the edge leaving `gate`
     std::vector<uint32_t> degree;  // per vertex: triangles created around it
