@@ -32,6 +32,10 @@ constexpr uint32_t kFanLeaf = kEmpty;
 constexpr double kConeWidening = 1e-9;
 constexpr double kConeSlack = 1e-10;
 constexpr double kUnderflowSlack = 8 * std::numeric_limits<double>::denorm_min();
+// Vectors shorter than this have squares below DBL_MIN: their lengths are taken after scaling by
+// kTinyScale, a power of two (exact).
+constexpr double kTinyLength = 0x1p-500;
+constexpr double kTinyScale = 0x1p+600;
 constexpr double kRightAngle = 1.5707963267948966;
 // A direction this close to a cone's axis (radians) is taken to meet the cone: the side plane
 // facing it is found from its part across the axis, which below this is too much rounding.
@@ -71,6 +75,12 @@ AMC_ALWAYS_INLINE double box_distance_squared(const float* lo, const float* hi, 
     double dy = std::max(std::max(lo[1] - p.y, p.y - hi[1]), 0.0);
     double dz = std::max(std::max(lo[2] - p.z, p.z - hi[2]), 0.0);
     return dx * dx + dy * dy + dz * dz;
+}
+
+// |v|, accurate where its squares would fall below DBL_MIN.
+double length_without_underflow(Vec3 v) {
+    const double length = std::sqrt(squared_length(v));
+    return length < kTinyLength ? std::sqrt(squared_length(kTinyScale * v)) / kTinyScale : length;
 }
 
 // What covers the rounding of the closest points computed on triangles whose coordinates are at
@@ -503,8 +513,11 @@ ClosestPointQuery::Fan ClosestPointQuery::build_fan(const TriangleMesh& referenc
         Vec3 middle;     // the sort key: their normalised sum, or zero
     };
     auto unit = [](Vec3 v) {
-        const double length = std::sqrt(squared_length(v));
-        return length > 0 ? (1 / length) * v : Vec3{};
+        // A direction whose squares fall below DBL_MIN (or to 0: it would be dropped from its cone)
+        // is scaled by a power of two first.
+        const Vec3 scaled = length_without_underflow(v) < kTinyLength ? kTinyScale * v : v;
+        const double length = std::sqrt(squared_length(scaled));
+        return length > 0 ? (1 / length) * scaled : Vec3{};
     };
     std::vector<Directions> directions(m);
     std::vector<uint32_t> local(m);
@@ -607,9 +620,13 @@ double ClosestPointQuery::cone_node_distance_squared(const ConeNode& node, Vec3 
                                                      double margin) const {
     const double box = box_distance_squared(node.lo, node.hi, box_p);
     if (!node.has_cone) return box;
-    const double along = dot(w, node.axis);
-    const double across = std::sqrt(squared_length(cross(w, node.axis)));
-    double gap = along * node.cosine + across * node.sine <= 0 ? w_length : across * node.cosine - along * node.sine;
+    // Where |w|'s squares fall below DBL_MIN, |w x axis| would lose most of its digits: w is
+    // scaled by a power of two first (exactly) and the gap scaled back.
+    const double scale = w_length < kTinyLength ? kTinyScale : 1;
+    const Vec3 ws = scale * w;
+    const double along = dot(ws, node.axis);
+    const double across = std::sqrt(squared_length(cross(ws, node.axis)));
+    double gap = (along * node.cosine + across * node.sine <= 0 ? scale * w_length : across * node.cosine - along * node.sine) / scale;
     // The rounding of the bound, and of the computed closest points (margin an axis: < 2 margin in all).
     gap -= kConeSlack * w_length + 2 * margin;
     // Below DBL_MIN a triangle's squared distance (three squares, each rounded to a multiple of the
@@ -671,7 +688,7 @@ std::optional<ClosestPointQuery::Hit> ClosestPointQuery::search(Vec3 p, double b
     // A fan's tree, as the box tree below: nearer child first.
     auto search_fan = [&](const Fan& fan) {
         const Vec3 w = p - fan.apex;
-        const double w_length = std::sqrt(squared_length(w));
+        const double w_length = length_without_underflow(w);
         struct ConeEntry {
             uint32_t node;
             double distance_squared;
