@@ -513,11 +513,12 @@ ClosestPointQuery::Fan ClosestPointQuery::build_fan(const TriangleMesh& referenc
         Vec3 middle;     // the sort key: their normalised sum, or zero
     };
     auto unit = [](Vec3 v) {
-        // A direction whose squares fall below DBL_MIN (or to 0: it would be dropped from its cone)
-        // is scaled by a power of two first.
-        const Vec3 scaled = length_without_underflow(v) < kTinyLength ? kTinyScale * v : v;
-        const double length = std::sqrt(squared_length(scaled));
-        return length > 0 ? (1 / length) * scaled : Vec3{};
+        double length = std::sqrt(squared_length(v));
+        if (length < kTinyLength) {  // squares below DBL_MIN, or 0: the direction would leave its cone
+            v = kTinyScale * v;
+            length = std::sqrt(squared_length(v));
+        }
+        return length > 0 ? (1 / length) * v : Vec3{};
     };
     std::vector<Directions> directions(m);
     std::vector<uint32_t> local(m);
